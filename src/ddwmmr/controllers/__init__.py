@@ -1,0 +1,19 @@
+"""Controllers: the registry and the resolution/closed-loop methods."""
+
+from ddwmmr.controllers.base import (
+    Controller,
+    StepInfo,
+    available_methods,
+    make_controller,
+    method_description,
+    register,
+)
+
+__all__ = [
+    "Controller",
+    "StepInfo",
+    "available_methods",
+    "make_controller",
+    "method_description",
+    "register",
+]

@@ -1,0 +1,122 @@
+"""The controller interface and the method registry.
+
+A controller turns the current configuration and the desired end-effector motion into an
+input command ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s)::
+
+    controller = make_controller("ats", Robot(), aux="sum")
+    controller.reset(trajectory, q0)          # optional for most methods
+    u = controller.command(t, q, pose_d, velocity_d)
+    controller.last                           # StepInfo of that command
+
+Controllers never see the plant: the simulation loop (``ddwmmr.sim``) connects them.
+A new method is one class decorated with :func:`register`.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.model import Robot
+
+
+@dataclass
+class StepInfo:
+    """What a controller reports about its last command.
+
+    Attributes:
+        singular: damping was applied because the robot was near a singularity.
+        nonholonomic_residual: sideways base speed (m/s) the method asked for and the
+            differential drive cannot produce (dropped from the command).
+        fallback: the method could not produce its nominal command and used a safe one.
+        extra: method-specific values (e.g. QP slack, active stability constraint).
+    """
+
+    singular: bool = False
+    nonholonomic_residual: float = 0.0
+    fallback: bool = False
+    extra: dict[str, float] = field(default_factory=dict)
+
+
+class Controller(Protocol):
+    """Structural type of every controller."""
+
+    name: str
+    last: StepInfo
+
+    def reset(self, trajectory: Any, q0: np.ndarray) -> None:  # pragma: no cover - protocol
+        """Prepare for a run of ``trajectory`` from configuration ``q0``."""
+        ...
+
+    def command(
+        self, t: float, q: np.ndarray, pose_d: np.ndarray, velocity_d: np.ndarray
+    ) -> np.ndarray:  # pragma: no cover - protocol
+        """Input ``u = [v, w, th1dot, th2dot]`` for time t (s) and configuration q."""
+        ...
+
+
+_REGISTRY: dict[str, Callable[..., Controller]] = {}
+_DESCRIPTIONS: dict[str, str] = {}
+#: Modules that register the built-in methods (imported on first registry use).
+BUILTIN_MODULES = (
+    "ddwmmr.controllers.resolved_rate",
+    "ddwmmr.controllers.clrrmc",
+)
+_loaded = False
+
+
+def register(name: str) -> Callable[[type], type]:
+    """Class decorator adding a controller class to the registry under ``name``."""
+
+    def decorate(cls: type) -> type:
+        _REGISTRY[name] = cls
+        _DESCRIPTIONS[name] = (inspect.getdoc(cls) or "").splitlines()[0]
+        cls.name = name
+        return cls
+
+    return decorate
+
+
+def _load_builtins() -> None:
+    global _loaded
+    if not _loaded:
+        _loaded = True
+        for module in BUILTIN_MODULES:
+            importlib.import_module(module)
+
+
+def available_methods() -> list[str]:
+    """Registered method names, in registration order."""
+    _load_builtins()
+    return list(_REGISTRY)
+
+
+def method_description(name: str) -> str:
+    """First docstring line of a registered method."""
+    _load_builtins()
+    return _DESCRIPTIONS[name]
+
+
+def make_controller(name: str, robot: Robot | None = None, **options: Any) -> Controller:
+    """Build the registered controller ``name`` for ``robot`` (default: ``Robot()``).
+
+    Unknown method names and unknown options raise :class:`ParameterError`.
+    """
+    _load_builtins()
+    if name not in _REGISTRY:
+        raise ParameterError(f"method: unknown method {name!r} (known: {', '.join(_REGISTRY)})")
+    cls = _REGISTRY[name]
+    accepted = set(inspect.signature(cls).parameters) - {"robot"}
+    unknown = sorted(set(options) - accepted)
+    if unknown:
+        raise ParameterError(
+            f"method {name}: unknown option {unknown[0]!r} "
+            f"(accepted: {', '.join(sorted(accepted)) or 'none'})"
+        )
+    return cls(robot if robot is not None else Robot(), **options)

@@ -1,0 +1,141 @@
+"""Closed-loop resolved-rate motion control (SPEC §4): ``clrrmc-cs`` and ``clrrmc-ts``.
+
+Gains are given as time constants ``tau`` (s): ``K = 1/tau``. The error dynamics are then
+``e_dot + K e = 0``, i.e. each error decays as ``exp(-t / tau)`` while the plant follows the
+command (see ``ddwmmr.sim.loops.error_loop`` for the python-control model).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from ddwmmr.controllers.base import StepInfo, register
+from ddwmmr.controllers.resolved_rate import check_aux
+from ddwmmr.errors import ParameterError
+from ddwmmr.model import Robot
+from ddwmmr.resolution import kernels
+from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
+
+#: Default time constant (s) of every closed-loop channel.
+DEFAULT_TAU = 0.5
+
+
+def gains_from_tau(tau: float | Sequence[float], size: int) -> tuple[float, ...]:
+    """Gains ``K_i = 1/tau_i`` (1/s) from one time constant or ``size`` of them.
+
+    ``tau = inf`` switches a channel's feedback off (gain 0).
+    """
+    values = [tau] * size if isinstance(tau, int | float) else list(tau)
+    if len(values) != size:
+        raise ParameterError(f"tau must be one value or {size} values (got {len(values)})")
+    gains = []
+    for value in values:
+        value = float(value)
+        if math.isnan(value) or value <= 0.0:
+            raise ParameterError(f"tau must be > 0 s, or inf to disable a channel (got {value:g})")
+        gains.append(0.0 if math.isinf(value) else 1.0 / value)
+    return tuple(gains)
+
+
+@register("clrrmc-ts")
+class TaskSpaceController:
+    """CLRRMC-TS: qdot = J_aug^-1 [Xd_dot + K (Xd - X)], feedback on xE, yE, phiE."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        tau: float | Sequence[float] = DEFAULT_TAU,
+        aux: str = "shoulder",
+        singularity_threshold: float = kernels.SINGULARITY_THRESHOLD,
+        damping: float = kernels.MAX_DAMPING,
+    ) -> None:
+        self.robot = robot
+        self.kx, self.ky, self.kphi = gains_from_tau(tau, 3)
+        self.aux = check_aux(aux)
+        self.threshold = singularity_threshold
+        self.damping = damping
+        self.last = StepInfo()
+
+    def reset(self, trajectory: object, q0: np.ndarray) -> None:
+        """Nothing to prepare: the feedback uses the measured configuration."""
+        self.last = StepInfo()
+
+    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+        """Input for the desired velocity plus the pose-error correction."""
+        x, y, phi, th1, th2 = q.tolist()
+        L1, L2 = self.robot.L1, self.robot.L2
+        a1 = phi + th1
+        a12 = a1 + th2
+        xe = x + L1 * math.cos(a1) + L2 * math.cos(a12)
+        ye = y + L1 * math.sin(a1) + L2 * math.sin(a12)
+        px, py, pphi = pose_d.tolist()
+        vx, vy, vphi = velocity_d.tolist()
+        u, singular = kernels.ats(
+            L1,
+            L2,
+            phi,
+            th1,
+            th2,
+            vx + self.kx * (px - xe),
+            vy + self.ky * (py - ye),
+            vphi + self.kphi * (pphi - a12),
+            self.aux,
+            self.threshold,
+            self.damping,
+        )
+        self.last = StepInfo(singular=singular)
+        return np.array(u)
+
+
+@register("clrrmc-cs")
+class ConfigurationSpaceController:
+    """CLRRMC-CS: qdot = qdot_d + K (q_d - q) around an ATS reference q_d(t)."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        tau: float | Sequence[float] = DEFAULT_TAU,
+        aux: str = "shoulder",
+        reference_step: float = 0.002,
+    ) -> None:
+        self.robot = robot
+        self.gains = gains_from_tau(tau, 5)
+        self.aux = check_aux(aux)
+        if not reference_step > 0:
+            raise ParameterError(f"reference_step must be > 0 s (got {reference_step})")
+        self.reference_step = float(reference_step)
+        self.reference: ReferenceTrajectory | None = None
+        self.last = StepInfo()
+
+    def reset(self, trajectory: object, q0: np.ndarray) -> None:
+        """Build the reference q_d(t) from :func:`start_configuration` of ``trajectory``.
+
+        The reference starts at the home arm pose placed on the trajectory start, which is
+        also where :func:`ddwmmr.simulate` starts before applying its initial offset.
+        """
+        self.reference = ReferenceTrajectory(
+            self.robot,
+            trajectory,
+            start_configuration(self.robot, trajectory),
+            self.aux,
+            self.reference_step,
+        )
+        self.reference(getattr(trajectory, "duration", 0.0))  # precompute one period
+        self.last = StepInfo()
+
+    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+        """Reference rate plus configuration-error feedback, projected on the inputs.
+
+        The sideways part of the commanded base velocity cannot be produced; it is reported
+        in ``last.nonholonomic_residual`` (m/s).
+        """
+        if self.reference is None:
+            raise RuntimeError("clrrmc-cs needs reset(trajectory, q0) before command()")
+        q_ref, qdot_ref = self.reference(t)
+        qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q.tolist())]
+        c, s = math.cos(q[2]), math.sin(q[2])
+        self.last = StepInfo(nonholonomic_residual=-qdot[0] * s + qdot[1] * c)
+        return np.array([qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4]])

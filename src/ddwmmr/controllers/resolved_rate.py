@@ -1,0 +1,106 @@
+"""Open-loop redundancy resolution controllers (SPEC §3): ``pi``, ``ats``, ``ap``.
+
+They feed the desired end-effector velocity forward through an inverse of the Jacobian and
+ignore the pose error, so an initial offset is kept (and integration errors accumulate).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ddwmmr.controllers.base import StepInfo, register
+from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import AUX_ROWS
+from ddwmmr.resolution import kernels
+
+
+class _ResolvedRate:
+    """Shared state: robot lengths, singularity handling, last step info."""
+
+    name = "base"
+
+    def __init__(
+        self,
+        robot: Robot,
+        singularity_threshold: float = kernels.SINGULARITY_THRESHOLD,
+        damping: float = kernels.MAX_DAMPING,
+    ) -> None:
+        self.robot = robot
+        self.L1, self.L2 = robot.L1, robot.L2
+        self.threshold = check_positive("singularity_threshold", singularity_threshold)
+        self.damping = check_nonnegative("damping", damping)
+        self.last = StepInfo()
+
+    def reset(self, trajectory: object, q0: np.ndarray) -> None:
+        """Nothing to prepare: open-loop methods are memoryless."""
+        self.last = StepInfo()
+
+    def _finish(self, u: tuple[float, float, float, float], singular: bool) -> np.ndarray:
+        self.last = StepInfo(singular=singular)
+        return np.array(u)
+
+
+def check_aux(aux: str) -> str:
+    """Validate the auxiliary constraint name of the augmented task space."""
+    if aux not in AUX_ROWS:
+        raise ParameterError(f"aux must be one of {', '.join(AUX_ROWS)} (got {aux!r})")
+    return aux
+
+
+@register("pi")
+class PseudoinverseController(_ResolvedRate):
+    """RR-PI: pseudoinverse resolution qdot = J^# Xd_dot (open loop)."""
+
+    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+        """Minimum-norm input for the desired end-effector velocity (m/s, rad/s)."""
+        _, _, phi, th1, th2 = q.tolist()
+        xd, yd, pd = velocity_d.tolist()
+        return self._finish(
+            *kernels.pseudoinverse(
+                self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
+            )
+        )
+
+
+@register("ats")
+class AugmentedTaskSpaceController(_ResolvedRate):
+    """RR-ATS: augmented task space, one auxiliary row (aux = sum | shoulder), open loop."""
+
+    def __init__(self, robot: Robot, aux: str = "shoulder", **kwargs) -> None:
+        super().__init__(robot, **kwargs)
+        self.aux = check_aux(aux)
+
+    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+        """Input solving the square augmented system for the desired velocity."""
+        _, _, phi, th1, th2 = q.tolist()
+        xd, yd, pd = velocity_d.tolist()
+        return self._finish(
+            *kernels.ats(
+                self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.aux, self.threshold, self.damping
+            )
+        )
+
+
+@register("ap")
+class ArtificialPotentialController(_ResolvedRate):
+    """RR-AP: pseudoinverse plus null-space descent of V = K1 th1^2 + K2 th2^2 + K3 phi^2."""
+
+    def __init__(
+        self, robot: Robot, K1: float = 1.0, K2: float = 0.25, K3: float = 0.66, **kwargs
+    ) -> None:
+        super().__init__(robot, **kwargs)
+        self.K1 = check_nonnegative("K1", K1)
+        self.K2 = check_nonnegative("K2", K2)
+        self.K3 = check_nonnegative("K3", K3)
+
+    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+        """Pseudoinverse input plus the projected potential descent (K2 has no effect: th2
+        cannot move without moving the end effector, so it is not in the null space)."""
+        _, _, phi, th1, th2 = q.tolist()
+        xd, yd, pd = velocity_d.tolist()
+        (v, w, t1, t2), singular = kernels.pseudoinverse(
+            self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
+        )
+        k = kernels.null_space_rate(phi, th1, 2.0 * self.K3 * phi, 2.0 * self.K1 * th1)
+        return self._finish((v, w + k, t1 - k, t2), singular)

@@ -1,0 +1,109 @@
+"""Kinematics of the planar differential-drive mobile manipulator (SPEC §1).
+
+Configuration ``q = [x, y, phi, th1, th2]`` in the world frame (metres, radians): base
+position at the wheel-axle midpoint (where the arm is mounted), base heading, then the arm
+joint angles (``th1`` relative to the base heading). Inputs ``u = [v, w, th1dot, th2dot]``:
+forward speed (m/s), yaw rate (rad/s), joint rates (rad/s).
+
+The functions here take plain floats or small arrays and are written for speed: they are
+called every control step.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+#: Names of the configuration coordinates, in order.
+Q_NAMES = ("x", "y", "phi", "th1", "th2")
+#: Names of the input coordinates, in order.
+U_NAMES = ("v", "w", "th1dot", "th2dot")
+
+
+def forward_kinematics(L1: float, L2: float, q) -> tuple[float, float, float]:
+    """End-effector pose ``(xE, yE, phiE)`` in the world frame (m, m, rad)."""
+    x, y, phi, th1, th2 = (float(v) for v in q)
+    a1 = phi + th1
+    a12 = a1 + th2
+    return (
+        x + L1 * math.cos(a1) + L2 * math.cos(a12),
+        y + L1 * math.sin(a1) + L2 * math.sin(a12),
+        a12,
+    )
+
+
+def jacobian(L1: float, L2: float, q) -> np.ndarray:
+    """The 4x5 task Jacobian of SPEC §1: rows xE, yE, phiE and the nonholonomic constraint."""
+    _, _, phi, th1, th2 = (float(v) for v in q)
+    s1, c1 = math.sin(phi + th1), math.cos(phi + th1)
+    s12, c12 = math.sin(phi + th1 + th2), math.cos(phi + th1 + th2)
+    dx = -L1 * s1 - L2 * s12
+    dy = L1 * c1 + L2 * c12
+    return np.array(
+        [
+            [1.0, 0.0, dx, dx, -L2 * s12],
+            [0.0, 1.0, dy, dy, L2 * c12],
+            [0.0, 0.0, 1.0, 1.0, 1.0],
+            [-math.sin(phi), math.cos(phi), 0.0, 0.0, 0.0],
+        ]
+    )
+
+
+#: Auxiliary rows of the augmented task space method (SPEC §3).
+AUX_ROWS = {
+    "sum": (0.0, 0.0, 0.0, 1.0, 1.0),  # th1dot + th2dot = 0
+    "shoulder": (0.0, 0.0, 0.0, 1.0, 0.0),  # th1dot = 0
+}
+
+
+def augmented_jacobian(L1: float, L2: float, q, aux: str) -> np.ndarray:
+    """The square 5x5 augmented Jacobian: :func:`jacobian` plus the auxiliary row ``aux``."""
+    return np.vstack([jacobian(L1, L2, q), np.array(AUX_ROWS[aux])])
+
+
+def input_matrix(phi: float) -> np.ndarray:
+    """The 5x4 matrix B with ``qdot = B(phi) u``; its columns are orthonormal."""
+    c, s = math.cos(phi), math.sin(phi)
+    return np.array(
+        [
+            [c, 0.0, 0.0, 0.0],
+            [s, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
+
+
+def qdot_from_u(phi: float, u) -> np.ndarray:
+    """Configuration rate ``qdot`` (5,) produced by inputs ``u = [v, w, th1dot, th2dot]``."""
+    v, w, t1, t2 = (float(a) for a in u)
+    return np.array([v * math.cos(phi), v * math.sin(phi), w, t1, t2])
+
+
+def u_from_qdot(phi: float, qdot) -> tuple[np.ndarray, float]:
+    """Project a configuration rate on the inputs.
+
+    Returns ``(u, residual)`` where ``residual = -xdot sin(phi) + ydot cos(phi)`` (m/s) is
+    the sideways base velocity the differential drive cannot produce.
+    """
+    xd, yd, pd, t1, t2 = (float(a) for a in qdot)
+    c, s = math.cos(phi), math.sin(phi)
+    return np.array([xd * c + yd * s, pd, t1, t2]), -xd * s + yd * c
+
+
+def end_effector_jacobian_u(L1: float, L2: float, q) -> np.ndarray:
+    """The 3x4 Jacobian ``A = J_E B`` mapping inputs u to end-effector rates."""
+    _, _, phi, th1, th2 = (float(v) for v in q)
+    s1, c1 = math.sin(phi + th1), math.cos(phi + th1)
+    s12, c12 = math.sin(phi + th1 + th2), math.cos(phi + th1 + th2)
+    dx = -L1 * s1 - L2 * s12
+    dy = L1 * c1 + L2 * c12
+    return np.array(
+        [
+            [math.cos(phi), dx, dx, -L2 * s12],
+            [math.sin(phi), dy, dy, L2 * c12],
+            [0.0, 1.0, 1.0, 1.0],
+        ]
+    )

@@ -1,0 +1,242 @@
+"""The robot description: :class:`Robot`, a validated frozen dataclass.
+
+``Robot()`` is the thesis robot of SPEC §1 (thesis Tables 3.1/3.2, planar arm). Units are SI
+throughout: metres, kilograms, radians, seconds.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.errors import ParameterError, check_finite, check_nonnegative, check_positive
+from ddwmmr.model import kinematics, stability
+
+_PI = math.pi
+
+
+@dataclass(frozen=True)
+class Robot:
+    """Planar differential-drive mobile manipulator with a two-link arm.
+
+    Attributes:
+        L1, L2: arm link lengths (m).
+        wheel_radius: drive wheel radius r (m).
+        track_width: distance between the wheels Lw (m).
+        base_length, base_width: rectangular footprint, centred on the axle midpoint (m).
+        base_mass: base mass (kg); base_inertia: base yaw inertia (kg m^2).
+        link_masses: masses of link 1 and link 2 (kg), each concentrated at its midpoint.
+        payload: payload mass at the end effector (kg).
+        joint_limits: ``((th1_min, th1_max), (th2_min, th2_max))`` (rad).
+        joint_speed_limit: maximum |th1dot|, |th2dot| (rad/s).
+        wheel_speed_limit: maximum wheel angular speed (rad/s).
+        home_pose: default arm pose ``(th1, th2)`` (rad) used for start configurations.
+    """
+
+    L1: float = 0.35
+    L2: float = 0.30
+    wheel_radius: float = 0.0975
+    track_width: float = 0.35
+    base_length: float = 0.45
+    base_width: float = 0.35
+    base_mass: float = 10.0
+    base_inertia: float = 0.5
+    link_masses: tuple[float, float] = (1.0, 1.0)
+    payload: float = 1.25
+    joint_limits: tuple[tuple[float, float], tuple[float, float]] = ((-_PI, _PI), (-_PI, _PI))
+    joint_speed_limit: float = 2.0
+    wheel_speed_limit: float = 15.0
+    home_pose: tuple[float, float] = (-0.3, 0.6)
+    _com: stability.ComCoefficients = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        for name in (
+            "L1",
+            "L2",
+            "wheel_radius",
+            "track_width",
+            "base_length",
+            "base_width",
+            "base_mass",
+            "base_inertia",
+            "joint_speed_limit",
+            "wheel_speed_limit",
+        ):
+            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
+        object.__setattr__(self, "payload", check_nonnegative("payload", self.payload))
+        masses = _pair("link_masses", self.link_masses)
+        for i, m in enumerate(masses, start=1):
+            check_nonnegative(f"link_masses[{i}]", m)
+        object.__setattr__(self, "link_masses", masses)
+        limits = []
+        for i, pair in enumerate(_pairs("joint_limits", self.joint_limits), start=1):
+            low, high = (check_finite(f"joint_limits[{i}]", v) for v in pair)
+            if not low < high:
+                raise ParameterError(f"joint_limits[{i}] must satisfy min < max (got {pair})")
+            limits.append((low, high))
+        object.__setattr__(self, "joint_limits", tuple(limits))
+        home = tuple(check_finite("home_pose", v) for v in _pair("home_pose", self.home_pose))
+        object.__setattr__(self, "home_pose", home)
+        object.__setattr__(
+            self,
+            "_com",
+            stability.com_coefficients(
+                self.L1,
+                self.L2,
+                masses[0],
+                masses[1],
+                self.payload,
+                self.base_mass,
+                self.base_length,
+                self.base_width,
+            ),
+        )
+
+    # -- construction -------------------------------------------------------------------
+    @classmethod
+    def from_toml(cls, path: str | Path) -> Robot:
+        """Load a robot from a TOML file whose keys are the field names (missing = default).
+
+        A ``[robot]`` table is accepted as well as top-level keys.
+        """
+        path = Path(path)
+        try:
+            data = tomllib.loads(path.read_text())
+        except OSError as exc:
+            raise ParameterError(f"robot: cannot read {path} ({exc.strerror})") from None
+        except tomllib.TOMLDecodeError as exc:
+            raise ParameterError(f"robot: {path} is not valid TOML ({exc})") from None
+        return cls.from_dict(data.get("robot", data))
+
+    @classmethod
+    def from_dict(cls, data: dict[str, Any]) -> Robot:
+        """Build a robot from a mapping of field names to values; unknown keys are errors."""
+        known = {f.name for f in fields(cls) if f.init}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ParameterError(
+                f"robot: unknown parameter {unknown[0]!r} (known: {', '.join(sorted(known))})"
+            )
+        return cls(**data)
+
+    def with_payload(self, payload: float) -> Robot:
+        """A copy of this robot carrying ``payload`` kg at the end effector."""
+        return replace(self, payload=payload)
+
+    # -- kinematics -----------------------------------------------------------------------
+    @property
+    def reach(self) -> float:
+        """Maximum arm reach L1 + L2 (m)."""
+        return self.L1 + self.L2
+
+    def fk(self, q) -> np.ndarray:
+        """End-effector pose ``[xE, yE, phiE]`` (world frame, m and rad) at configuration q."""
+        return np.array(kinematics.forward_kinematics(self.L1, self.L2, q))
+
+    def jacobian(self, q) -> np.ndarray:
+        """The 4x5 Jacobian of SPEC §1 (rows xE, yE, phiE, nonholonomic constraint)."""
+        return kinematics.jacobian(self.L1, self.L2, q)
+
+    def augmented_jacobian(self, q, aux: str = "sum") -> np.ndarray:
+        """The 5x5 augmented Jacobian (``aux`` is ``"sum"`` or ``"shoulder"``)."""
+        if aux not in kinematics.AUX_ROWS:
+            raise ParameterError(f"aux must be one of {sorted(kinematics.AUX_ROWS)} (got {aux!r})")
+        return kinematics.augmented_jacobian(self.L1, self.L2, q, aux)
+
+    # -- wheels ---------------------------------------------------------------------------
+    def wheel_speeds_from_u(self, v: float, w: float) -> tuple[float, float]:
+        """Wheel angular speeds ``(phidot_l, phidot_r)`` (rad/s) for base speeds v (m/s), w."""
+        r, lw = self.wheel_radius, self.track_width
+        return (2.0 * v - lw * w) / (2.0 * r), (2.0 * v + lw * w) / (2.0 * r)
+
+    def wheel_speeds(self, q, qdot) -> np.ndarray:
+        """Wheel angular speeds ``[phidot_l, phidot_r]`` (rad/s) for configuration rate qdot.
+
+        Only the forward part ``xdot cos(phi) + ydot sin(phi)`` of the base velocity drives
+        the wheels; a sideways part cannot be produced and is ignored here.
+        """
+        (v, w, _, _), _ = kinematics.u_from_qdot(float(q[2]), qdot)
+        return np.array(self.wheel_speeds_from_u(v, w))
+
+    def base_velocity(self, wheel_speeds) -> np.ndarray:
+        """Inverse of the wheel map: ``[v, w]`` (m/s, rad/s) from ``[phidot_l, phidot_r]``."""
+        left, right = (float(s) for s in wheel_speeds)
+        r = self.wheel_radius
+        return np.array([r * (left + right) / 2.0, r * (right - left) / self.track_width])
+
+    # -- performance metrics ------------------------------------------------------------
+    def manipulability(self, q) -> float:
+        """Normalised manipulability ``eta = |sin(th2)|`` in [0, 1]."""
+        return stability.manipulability(float(q[4]))
+
+    def stability(self, q) -> tuple[float, float, float]:
+        """Tip-over stability ``(S_lon, S_lat, S)``; ``S > 1`` is stable (capped at 10)."""
+        return stability.stability_terms(self._com, float(q[3]), float(q[4]))
+
+    def stability_gradient(self, q) -> np.ndarray:
+        """Gradient of the capped stability margin S with respect to q (5,), per rad."""
+        _, g1, g2 = stability.stability_gradient(self._com, float(q[3]), float(q[4]))
+        return np.array([0.0, 0.0, 0.0, g1, g2])
+
+    def centre_of_mass(self, q) -> np.ndarray:
+        """Arm+payload+base centre of mass ``[x_com, y_com]`` in the base frame (m)."""
+        return np.array(stability.centre_of_mass(self._com, float(q[3]), float(q[4])))
+
+    @property
+    def com_coefficients(self) -> stability.ComCoefficients:
+        """Precomputed centre-of-mass coefficients (for fast inner loops)."""
+        return self._com
+
+    # -- inverse kinematics ---------------------------------------------------------------
+    def base_for_end_effector(self, pose_e, th1: float, th2: float) -> np.ndarray:
+        """The configuration with arm pose (th1, th2) that puts the end effector at ``pose_e``.
+
+        ``pose_e = [xE, yE, phiE]``; the base heading follows from ``phiE - th1 - th2``.
+        """
+        xe, ye, phie = (float(v) for v in pose_e)
+        phi = phie - th1 - th2
+        x = xe - self.L1 * math.cos(phi + th1) - self.L2 * math.cos(phie)
+        y = ye - self.L1 * math.sin(phi + th1) - self.L2 * math.sin(phie)
+        return np.array([x, y, phi, th1, th2])
+
+    def arm_ik(self, dx: float, dy: float, elbow: int = 1) -> tuple[float, float] | None:
+        """Two-link inverse kinematics in the base frame: joint angles reaching (dx, dy) m.
+
+        ``elbow`` = +1 or -1 selects the elbow branch (sign of th2). Returns None when the
+        point is out of reach.
+        """
+        r2 = dx * dx + dy * dy
+        c2 = (r2 - self.L1**2 - self.L2**2) / (2.0 * self.L1 * self.L2)
+        if c2 > 1.0 + 1e-12 or c2 < -1.0 - 1e-12:
+            return None
+        c2 = min(1.0, max(-1.0, c2))
+        th2 = math.copysign(math.acos(c2), elbow)
+        th1 = math.atan2(dy, dx) - math.atan2(
+            self.L2 * math.sin(th2), self.L1 + self.L2 * math.cos(th2)
+        )
+        return math.atan2(math.sin(th1), math.cos(th1)), th2
+
+
+def _pair(name: str, value) -> tuple[float, float]:
+    try:
+        items = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ParameterError(f"{name} must be a pair of numbers (got {value!r})") from None
+    if len(items) != 2:
+        raise ParameterError(f"{name} must be a pair of numbers (got {value!r})")
+    return items  # type: ignore[return-value]
+
+
+def _pairs(name: str, value) -> tuple:
+    try:
+        items = tuple(value)
+    except TypeError:
+        raise ParameterError(f"{name} must be two (min, max) pairs (got {value!r})") from None
+    if len(items) != 2:
+        raise ParameterError(f"{name} must be two (min, max) pairs (got {value!r})")
+    return tuple(_pair(f"{name}[{i}]", p) for i, p in enumerate(items, start=1))

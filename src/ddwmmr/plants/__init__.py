@@ -1,0 +1,5 @@
+"""Plants: what the controllers' commands act on (kinematic model, thesis dynamics)."""
+
+from ddwmmr.plants.kinematic import INTEGRATORS, KinematicPlant
+
+__all__ = ["INTEGRATORS", "KinematicPlant"]

@@ -1,0 +1,162 @@
+"""Elliptical and rectangular end-effector trajectories (SPEC §2).
+
+Both are parametrised by ``(x0, y0, a, b, beta, N, T)``: centre (m), semi-axes (m), rotation
+(rad), number of samples per period and period (s). With ``alpha = 2 pi t / T``:
+
+    ellipse:    [xE, yE] = [x0, y0] + R(beta) [a cos(alpha), b sin(alpha)]
+    rectangle:  [xE, yE] = [x0, y0] + R(beta) [a(|c|c - |s|s), b(|c|c + |s|s)]
+
+Both run counter-clockwise. The desired orientation is the direction of travel
+(``orientation="tangent"``, unwrapped so that it is continuous, jumping by pi/2 only at the
+rectangle's corners) or a fixed angle (``orientation="constant"``, ``phi=...``).
+"""
+
+from __future__ import annotations
+
+import math
+from abc import ABC, abstractmethod
+from dataclasses import dataclass
+
+import numpy as np
+
+from ddwmmr.errors import ParameterError, check_finite, check_int_at_least, check_positive
+
+ORIENTATIONS = ("tangent", "constant")
+
+
+@dataclass(frozen=True)
+class _Parametric(ABC):
+    """Shared parameters and validation of the SPEC §2 trajectories."""
+
+    x0: float = 0.0
+    y0: float = 0.0
+    a: float = 2.0
+    b: float = 1.5
+    beta: float = 0.0
+    N: int = 2000
+    T: float = 40.0
+    orientation: str = "tangent"
+    phi: float = 0.0
+
+    def __post_init__(self) -> None:
+        for name in ("x0", "y0", "beta", "phi"):
+            object.__setattr__(self, name, check_finite(name, getattr(self, name)))
+        for name in ("a", "b", "T"):
+            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
+        object.__setattr__(self, "N", check_int_at_least("N", self.N, 2))
+        if self.orientation not in ORIENTATIONS:
+            raise ParameterError(
+                f"orientation must be one of {', '.join(ORIENTATIONS)} (got {self.orientation!r})"
+            )
+
+    @property
+    def duration(self) -> float:
+        """One period T (s)."""
+        return self.T
+
+    @property
+    def samples(self) -> int:
+        """Resolution N (samples per period)."""
+        return self.N
+
+    @property
+    def alpha_rate(self) -> float:
+        """``alphadot = 2 pi / T`` (rad/s)."""
+        return 2.0 * math.pi / self.T
+
+    def _rotate(self, px: float, py: float) -> tuple[float, float]:
+        cb, sb = math.cos(self.beta), math.sin(self.beta)
+        return cb * px - sb * py, sb * px + cb * py
+
+    def pose(self, t: float) -> np.ndarray:
+        """Desired ``[xE, yE, phiE]`` at time t (s)."""
+        alpha = self.alpha_rate * t
+        px, py = self._shape(alpha)
+        rx, ry = self._rotate(px, py)
+        if self.orientation == "tangent":
+            heading = self.beta + self._tangent(alpha)
+        else:
+            heading = self.phi
+        return np.array([self.x0 + rx, self.y0 + ry, heading])
+
+    def velocity(self, t: float) -> np.ndarray:
+        """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s)."""
+        alpha = self.alpha_rate * t
+        dx, dy = self._shape_derivative(alpha)
+        rx, ry = self._rotate(dx * self.alpha_rate, dy * self.alpha_rate)
+        rate = self._tangent_rate(alpha) * self.alpha_rate if self.orientation == "tangent" else 0.0
+        return np.array([rx, ry, rate])
+
+    # Shape-specific pieces, in the unrotated frame, as functions of alpha.
+    @abstractmethod
+    def _shape(self, alpha: float) -> tuple[float, float]:
+        """Unrotated offset from the centre (m)."""
+
+    @abstractmethod
+    def _shape_derivative(self, alpha: float) -> tuple[float, float]:
+        """d(offset)/d(alpha) (m/rad)."""
+
+    @abstractmethod
+    def _tangent(self, alpha: float) -> float:
+        """Unwrapped direction of travel in the unrotated frame (rad)."""
+
+    @abstractmethod
+    def _tangent_rate(self, alpha: float) -> float:
+        """d(tangent)/d(alpha) (dimensionless)."""
+
+
+@dataclass(frozen=True)
+class Ellipse(_Parametric):
+    """Elliptical trajectory (SPEC §2). Defaults: 2.0 m x 1.5 m semi-axes, 40 s period.
+
+    The smallest radius of curvature, b^2/a = 1.1 m, exceeds the arm reach (0.65 m): with a
+    tighter ellipse the base cannot follow a tangent-oriented end effector without driving
+    the shoulder into its singularity (see docs/theory.md).
+    """
+
+    name: str = "ellipse"
+
+    def _shape(self, alpha: float) -> tuple[float, float]:
+        return self.a * math.cos(alpha), self.b * math.sin(alpha)
+
+    def _shape_derivative(self, alpha: float) -> tuple[float, float]:
+        return -self.a * math.sin(alpha), self.b * math.cos(alpha)
+
+    def _tangent(self, alpha: float) -> float:
+        # Direction of (-a sin, b cos), measured from the radial normal (-sin, cos) at angle
+        # alpha + pi/2; that offset stays in (-pi/2, pi/2), so the sum is continuous.
+        s, c = math.sin(alpha), math.cos(alpha)
+        offset = math.atan2((self.a - self.b) * s * c, self.a * s * s + self.b * c * c)
+        return alpha + 0.5 * math.pi + offset
+
+    def _tangent_rate(self, alpha: float) -> float:
+        # d(heading)/d(alpha) = (x' y'' - y' x'') / |p'|^2 = a b / (a^2 sin^2 + b^2 cos^2)
+        s, c = math.sin(alpha), math.cos(alpha)
+        return self.a * self.b / (self.a**2 * s * s + self.b**2 * c * c)
+
+
+@dataclass(frozen=True)
+class Rectangle(_Parametric):
+    """Rectangular trajectory (SPEC §2): corners at alpha = k pi/2, non-uniform timing."""
+
+    name: str = "rectangle"
+
+    def _shape(self, alpha: float) -> tuple[float, float]:
+        c, s = math.cos(alpha), math.sin(alpha)
+        return self.a * (abs(c) * c - abs(s) * s), self.b * (abs(c) * c + abs(s) * s)
+
+    def _shape_derivative(self, alpha: float) -> tuple[float, float]:
+        c, s = math.cos(alpha), math.sin(alpha)
+        return (
+            self.a * (-2.0 * abs(c) * s - 2.0 * abs(s) * c),
+            self.b * (-2.0 * abs(c) * s + 2.0 * abs(s) * c),
+        )
+
+    def _tangent(self, alpha: float) -> float:
+        # Edges run -x, -y, +x, +y in turn; at a corner the edge being entered counts.
+        # The small offset keeps sampled corners (alpha = k pi/2 up to rounding) on that edge.
+        edge = math.floor(alpha / (0.5 * math.pi) + 1e-9)
+        return math.pi + 0.5 * math.pi * edge
+
+    def _tangent_rate(self, alpha: float) -> float:
+        return 0.0

@@ -1,0 +1,160 @@
+"""Trajectories defined by samples, interpolated smoothly (C1 cubic Hermite).
+
+CSV format (header required): ``t,x,y`` and optionally ``phi``; times in s strictly
+increasing, positions in m, angles in rad. Without ``phi`` the orientation is the direction
+of travel (unwrapped). If the first and last points coincide the path is treated as closed
+and the tangents at the ends are matched (periodic).
+"""
+
+from __future__ import annotations
+
+import bisect
+import csv
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ddwmmr.errors import ParameterError
+
+
+def _tangents(times: np.ndarray, values: np.ndarray, periodic: bool) -> np.ndarray:
+    """Catmull-Rom style slopes (finite differences) at each knot, per column."""
+    slopes = np.empty_like(values)
+    dt = np.diff(times)
+    secant = np.diff(values, axis=0) / dt[:, None]
+    slopes[1:-1] = (secant[:-1] * dt[1:, None] + secant[1:] * dt[:-1, None]) / (
+        dt[:-1, None] + dt[1:, None]
+    )
+    if periodic:
+        end = (secant[0] * dt[-1] + secant[-1] * dt[0]) / (dt[0] + dt[-1])
+        slopes[0] = slopes[-1] = end
+    else:
+        slopes[0], slopes[-1] = secant[0], secant[-1]
+    return slopes
+
+
+@dataclass(frozen=True)
+class SampledTrajectory:
+    """End-effector trajectory through sampled points, C1 cubic Hermite interpolation.
+
+    Args:
+        times: sample times (s), strictly increasing, starting anywhere.
+        points: (n, 2) positions (m) or (n, 3) poses with orientation (rad).
+        name: label used in reports.
+    """
+
+    times: np.ndarray
+    points: np.ndarray
+    name: str = "sampled"
+    _slopes: np.ndarray = field(init=False, repr=False, compare=False)
+    _knots: list = field(init=False, repr=False, compare=False)
+    _has_phi: bool = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        times = np.asarray(self.times, dtype=float)
+        points = np.asarray(self.points, dtype=float)
+        if times.ndim != 1 or len(times) < 3:
+            raise ParameterError("trajectory samples: need at least 3 rows (t, x, y)")
+        if points.ndim != 2 or points.shape[0] != len(times) or points.shape[1] not in (2, 3):
+            raise ParameterError("trajectory samples: points must be (n, 2) or (n, 3)")
+        if not (np.all(np.isfinite(times)) and np.all(np.isfinite(points))):
+            raise ParameterError("trajectory samples: every value must be a finite number")
+        if np.any(np.diff(times) <= 0):
+            raise ParameterError("trajectory samples: column t must be strictly increasing")
+        periodic = bool(np.allclose(points[0, :2], points[-1, :2], atol=1e-9))
+        object.__setattr__(self, "times", times)
+        object.__setattr__(self, "points", points)
+        object.__setattr__(self, "_has_phi", points.shape[1] == 3)
+        object.__setattr__(self, "_slopes", _tangents(times, points, periodic))
+        object.__setattr__(self, "_knots", times.tolist())
+
+    @property
+    def duration(self) -> float:
+        """Time from the first to the last sample (s)."""
+        return float(self.times[-1] - self.times[0])
+
+    @property
+    def samples(self) -> int:
+        """Number of samples."""
+        return len(self.times)
+
+    def _segment(self, t: float) -> tuple[int, float, float]:
+        t_abs = min(max(t + self._knots[0], self._knots[0]), self._knots[-1])
+        i = min(bisect.bisect_right(self._knots, t_abs) - 1, len(self._knots) - 2)
+        h = self._knots[i + 1] - self._knots[i]
+        return i, (t_abs - self._knots[i]) / h, h
+
+    def _hermite(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Value, first and second time derivative of the interpolant at t (from start)."""
+        i, s, h = self._segment(t)
+        p0, p1 = self.points[i], self.points[i + 1]
+        m0, m1 = self._slopes[i] * h, self._slopes[i + 1] * h
+        s2, s3 = s * s, s * s * s
+        value = (
+            (2 * s3 - 3 * s2 + 1) * p0
+            + (s3 - 2 * s2 + s) * m0
+            + (-2 * s3 + 3 * s2) * p1
+            + (s3 - s2) * m1
+        )
+        first = ((6 * s2 - 6 * s) * p0 + (3 * s2 - 4 * s + 1) * m0) + (
+            (-6 * s2 + 6 * s) * p1 + (3 * s2 - 2 * s) * m1
+        )
+        second = (12 * s - 6) * p0 + (6 * s - 4) * m0 + (-12 * s + 6) * p1 + (6 * s - 2) * m1
+        return value, first / h, second / (h * h)
+
+    def _heading_reference(self, t: float) -> float:
+        """Unwrapped direction of travel at the knots, linearly interpolated (for unwrapping)."""
+        i, s, _ = self._segment(t)
+        headings = self._knot_headings()
+        return (1 - s) * headings[i] + s * headings[i + 1]
+
+    def _knot_headings(self) -> np.ndarray:
+        cached = self.__dict__.get("_headings_cache")
+        if cached is None:
+            cached = np.unwrap(np.arctan2(self._slopes[:, 1], self._slopes[:, 0]))
+            self.__dict__["_headings_cache"] = cached
+        return cached
+
+    def pose(self, t: float) -> np.ndarray:
+        """Desired ``[xE, yE, phiE]`` at time t (s, from the first sample)."""
+        value, first, _ = self._hermite(t)
+        if self._has_phi:
+            return value.copy()
+        heading = math.atan2(first[1], first[0])
+        reference = self._heading_reference(t)
+        heading += 2 * math.pi * round((reference - heading) / (2 * math.pi))
+        return np.array([value[0], value[1], heading])
+
+    def velocity(self, t: float) -> np.ndarray:
+        """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s)."""
+        _, first, second = self._hermite(t)
+        if self._has_phi:
+            return first.copy()
+        speed2 = first[0] ** 2 + first[1] ** 2
+        rate = 0.0 if speed2 < 1e-12 else (first[0] * second[1] - first[1] * second[0]) / speed2
+        return np.array([first[0], first[1], rate])
+
+
+def read_csv(path: str | Path) -> SampledTrajectory:
+    """Load a :class:`SampledTrajectory` from a CSV file with columns t, x, y[, phi]."""
+    path = Path(path)
+    try:
+        with path.open(newline="") as handle:
+            rows = list(csv.DictReader(row for row in handle if not row.startswith("#")))
+    except OSError as exc:
+        raise ParameterError(f"traj: cannot read {path} ({exc.strerror})") from None
+    if not rows:
+        raise ParameterError(f"traj: {path} has no data rows")
+    columns = set(rows[0])
+    missing = {"t", "x", "y"} - columns
+    if missing:
+        raise ParameterError(f"traj: {path} lacks column(s) {', '.join(sorted(missing))}")
+    keys = ["x", "y", "phi"] if "phi" in columns else ["x", "y"]
+    try:
+        times = np.array([float(r["t"]) for r in rows])
+        points = np.array([[float(r[k]) for k in keys] for r in rows])
+    except (TypeError, ValueError):
+        raise ParameterError(f"traj: {path} has a non-numeric value") from None
+    return SampledTrajectory(times, points, name=path.stem)
