@@ -42,7 +42,7 @@ def damping_squared(cos_th1: float, threshold: float, damping: float) -> float:
 def _solve2(
     m11: float, m12: float, m21: float, m22: float, r1: float, r2: float, lam2: float
 ) -> tuple[float, float]:
-    """Solve ``M z = r`` (``lam2 == 0``) or its damped least squares ``(M^T M + lam2 I) z = M^T r``."""
+    """Solve ``M z = r`` (lam2 = 0) or the damped ``(M^T M + lam2 I) z = M^T r``."""
     if lam2 == 0.0:
         det = m11 * m22 - m12 * m21
         return (m22 * r1 - m12 * r2) / det, (m11 * r2 - m21 * r1) / det
