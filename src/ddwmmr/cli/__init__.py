@@ -1,0 +1,1 @@
+"""Command-line entry points: track, compare, scenarios, bench (``python -m ddwmmr.<tool>``)."""

@@ -1,0 +1,191 @@
+"""Figures of a tracking run: paths with the robot drawn, errors, rates, metrics, animation.
+
+All functions take a :class:`ddwmmr.sim.SimulationResult`; ``save_run_figures`` writes the
+standard set of PNGs that ``python -m ddwmmr.track`` produces. World frame, metres, radians.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only: never needs a screen
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from ddwmmr.model import Robot
+
+FIGURE_NAMES = ("path.png", "errors.png", "rates.png", "metrics.png")
+
+
+def robot_outline(robot: Robot, q) -> dict[str, np.ndarray]:
+    """Polylines (world frame, m) of the robot at q: ``footprint`` (closed) and ``arm``."""
+    x, y, phi, th1, _ = (float(v) for v in q)
+    c, s = math.cos(phi), math.sin(phi)
+    hl, hw = robot.base_length / 2, robot.base_width / 2
+    corners = np.array([[hl, hw], [-hl, hw], [-hl, -hw], [hl, -hw], [hl, hw]])
+    footprint = corners @ np.array([[c, s], [-s, c]]) + [x, y]
+    elbow = (x + robot.L1 * math.cos(phi + th1), y + robot.L1 * math.sin(phi + th1))
+    tip = robot.fk(q)[:2]
+    arm = np.array([[x, y], elbow, tip])
+    heading = np.array([[x, y], [x + hl * c, y + hl * s]])
+    return {"footprint": footprint, "arm": arm, "heading": heading}
+
+
+def draw_robot(ax: Axes, robot: Robot, q, color: str = "0.35", alpha: float = 0.8) -> None:
+    """Draw the base footprint, heading and the two arm links at configuration q."""
+    shape = robot_outline(robot, q)
+    ax.plot(*shape["footprint"].T, color=color, lw=0.8, alpha=alpha)
+    ax.plot(*shape["heading"].T, color=color, lw=0.8, alpha=alpha)
+    ax.plot(*shape["arm"].T, color="tab:orange", lw=1.4, alpha=alpha, marker="o", ms=2)
+
+
+def plot_path(result, ax: Axes | None = None, snapshots: int = 8) -> Figure:
+    """Desired vs actual end-effector path, base path, and the robot at ``snapshots`` times."""
+    ts = result.timeseries
+    fig, ax = _axes(ax, figsize=(6.5, 5.5))
+    ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=1, label="desired end effector")
+    ax.plot(ts["xE"], ts["yE"], color="tab:blue", lw=1.5, label="actual end effector")
+    ax.plot(ts["x"], ts["y"], color="tab:green", lw=1, label="base (axle midpoint)")
+    q = result.configurations()
+    for k in np.linspace(0, len(q) - 1, snapshots).astype(int):
+        draw_robot(ax, result.robot, q[k])
+    ax.plot(ts["xE"][0], ts["yE"][0], "o", color="tab:blue", ms=5, label="start")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_title(_title(result, "paths"))
+    ax.legend(loc="best", fontsize=8)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def plot_errors(result) -> Figure:
+    """End-effector position error (log scale) and orientation error vs time."""
+    ts = result.timeseries
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    ax1.semilogy(ts["t"], np.maximum(ts["position_error_m"], 1e-9), color="tab:blue")
+    ax1.set_ylabel("position error (m)")
+    ax1.grid(alpha=0.3, which="both")
+    ax2.plot(ts["t"], ts["orientation_error_rad"], color="tab:red")
+    ax2.set_ylabel("orientation error (rad)")
+    ax2.set_xlabel("t (s)")
+    ax2.grid(alpha=0.3)
+    ax1.set_title(_title(result, "tracking errors"))
+    fig.tight_layout()
+    return fig
+
+
+def plot_rates(result) -> Figure:
+    """Joint rates and wheel speeds vs time, with the robot's limits."""
+    ts, robot = result.timeseries, result.robot
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    ax1.plot(ts["t"], ts["th1dot"], label="th1dot")
+    ax1.plot(ts["t"], ts["th2dot"], label="th2dot")
+    ax1.plot(ts["t"], ts["w"], label="w (base yaw)", lw=0.8)
+    for sign in (-1, 1):
+        ax1.axhline(sign * robot.joint_speed_limit, color="0.5", ls=":", lw=0.8)
+    ax1.set_ylabel("rate (rad/s)")
+    ax1.legend(fontsize=8, ncol=3)
+    ax1.grid(alpha=0.3)
+    ax2.plot(ts["t"], ts["wheel_left_rad_s"], label="left wheel")
+    ax2.plot(ts["t"], ts["wheel_right_rad_s"], label="right wheel")
+    for sign in (-1, 1):
+        ax2.axhline(sign * robot.wheel_speed_limit, color="0.5", ls=":", lw=0.8)
+    ax2.set_ylabel("wheel speed (rad/s)")
+    ax2.set_xlabel("t (s)")
+    ax2.legend(fontsize=8)
+    ax2.grid(alpha=0.3)
+    ax1.set_title(_title(result, "rates"))
+    fig.tight_layout()
+    return fig
+
+
+def plot_metrics(result) -> Figure:
+    """Manipulability eta and tip-over stability S vs time (S = 1 tips)."""
+    ts = result.timeseries
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    ax1.plot(ts["t"], ts["manipulability"], color="tab:purple")
+    ax1.set_ylim(0, 1.05)
+    ax1.set_ylabel("manipulability eta")
+    ax1.grid(alpha=0.3)
+    ax2.plot(ts["t"], ts["stability"], color="tab:brown", label="S = min(S_lon, S_lat)")
+    ax2.axhline(1.0, color="tab:red", ls="--", lw=1, label="tip-over (S = 1)")
+    stability_min = result.summary.get("stability_min")
+    if stability_min:
+        ax2.axhline(stability_min, color="tab:orange", ls=":", lw=1, label="S_min")
+    ax2.set_ylabel("stability S")
+    ax2.set_xlabel("t (s)")
+    ax2.legend(fontsize=8)
+    ax2.grid(alpha=0.3)
+    ax1.set_title(_title(result, "performance metrics"))
+    fig.tight_layout()
+    return fig
+
+
+def save_run_figures(result, folder: str | Path) -> list[Path]:
+    """Write path.png, errors.png, rates.png and metrics.png into ``folder``."""
+    folder = Path(folder)
+    paths = []
+    for name, make in zip(FIGURE_NAMES, (plot_path, plot_errors, plot_rates, plot_metrics)):
+        fig = make(result)
+        path = folder / name
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+def save_animation(result, path: str | Path, frames: int = 80, fps: int = 15) -> Path:
+    """Write a GIF of the robot following the trajectory (``frames`` evenly spaced)."""
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    ts, robot = result.timeseries, result.robot
+    q = result.configurations()
+    fig, ax = plt.subplots(figsize=(5, 4.5))
+    ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=1)
+    reach = robot.reach + robot.base_length
+    ax.set_xlim(
+        min(ts["x"].min(), ts["xE"].min()) - reach, max(ts["x"].max(), ts["xE"].max()) + reach
+    )
+    ax.set_ylim(
+        min(ts["y"].min(), ts["yE"].min()) - reach, max(ts["y"].max(), ts["yE"].max()) + reach
+    )
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    (trace,) = ax.plot([], [], color="tab:blue", lw=1.2)
+    (footprint,) = ax.plot([], [], color="0.3")
+    (arm,) = ax.plot([], [], color="tab:orange", lw=2, marker="o", ms=3)
+    indices = np.linspace(0, len(q) - 1, frames).astype(int)
+
+    def update(frame: int):
+        k = indices[frame]
+        shape = robot_outline(robot, q[k])
+        trace.set_data(ts["xE"][: k + 1], ts["yE"][: k + 1])
+        footprint.set_data(*shape["footprint"].T)
+        arm.set_data(*shape["arm"].T)
+        ax.set_title(f"{_title(result, '')} t = {ts['t'][k]:.1f} s")
+        return trace, footprint, arm
+
+    animation = FuncAnimation(fig, update, frames=len(indices), blit=False)
+    path = Path(path)
+    animation.save(path, writer=PillowWriter(fps=fps))
+    plt.close(fig)
+    return path
+
+
+def _axes(ax: Axes | None, figsize: tuple[float, float]) -> tuple[Figure, Axes]:
+    if ax is not None:
+        return ax.figure, ax
+    fig, ax = plt.subplots(figsize=figsize)
+    return fig, ax
+
+
+def _title(result, what: str) -> str:
+    summary = result.summary
+    return f"{summary.get('method', '?')} on {summary.get('trajectory', '?')}: {what}".rstrip(": ")

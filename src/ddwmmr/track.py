@@ -1,0 +1,8 @@
+"""``python -m ddwmmr.track``: see :mod:`ddwmmr.cli.track`."""
+
+import sys
+
+from ddwmmr.cli.track import run
+
+if __name__ == "__main__":
+    sys.exit(run())

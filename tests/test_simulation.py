@@ -1,0 +1,190 @@
+"""Closed- and open-loop tracking on the kinematic plant (SPEC §3–4, slides' observations).
+
+The documented tracking bounds (docs/theory.md, "Tracking bounds") are asserted here.
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from ddwmmr import Ellipse, ParameterError, Rectangle, Robot, load_trajectory, simulate
+from ddwmmr.plants import KinematicPlant
+from ddwmmr.resolution.reference import start_configuration
+
+ON_TRACK = (0.0, 0.0)
+
+# (method, options, trajectory, horizon in s, bound on the max position error in m)
+BOUNDS = [
+    ("ats", {"aux": "shoulder"}, "ellipse", 40.0, 1e-6),
+    ("ats", {"aux": "sum"}, "ellipse", 40.0, 1e-6),
+    ("ap", {"K3": 0.0}, "ellipse", 40.0, 1e-6),
+    ("clrrmc-ts", {}, "ellipse", 40.0, 1e-6),
+    ("clrrmc-cs", {}, "ellipse", 40.0, 1e-6),
+    ("pi", {}, "ellipse", 10.0, 1e-6),  # then crosses cos(th1) = 0 (see docs)
+    ("ap", {}, "ellipse", 4.0, 1e-6),  # K3 phi^2 drags th1 into the singularity
+    ("ats", {}, "rectangle", 30.0, 1e-6),  # then th2 winds into its -pi limit
+    ("clrrmc-cs", {}, "rectangle", 30.0, 1e-6),
+    ("clrrmc-ts", {}, "rectangle", 40.0, 0.25),  # orientation jumps at corners saturate
+    ("pi", {}, "rectangle", 14.0, 1e-6),
+]
+
+
+@pytest.mark.parametrize(("method", "options", "traj", "horizon", "bound"), BOUNDS)
+def test_documented_tracking_bounds(method, options, traj, horizon, bound):
+    result = simulate(
+        Robot(), load_trajectory(traj), method, duration=horizon, initial_offset=ON_TRACK, **options
+    )
+    assert result.summary["max_position_error_m"] < bound
+    assert result.summary["max_nonholonomic_residual_m_s"] < 1e-6
+
+
+def test_pseudoinverse_reaches_the_shoulder_singularity_on_the_ellipse():
+    # Documented failure mode: min-norm splits the yaw between base and shoulder.
+    result = simulate(Robot(), Ellipse(), "pi", initial_offset=ON_TRACK)
+    assert result.summary["singular_steps"] > 0
+    assert np.min(np.abs(np.cos(result.timeseries["th1"]))) < 0.05
+    assert result.summary["max_position_error_m"] > 0.5
+
+
+@pytest.mark.parametrize("method", ["clrrmc-ts", "clrrmc-cs"])
+@pytest.mark.parametrize("traj", [Ellipse(), Rectangle()])
+def test_closed_loop_removes_the_initial_offset_within_five_tau(method, traj):
+    tau = 0.5
+    result = simulate(Robot(), traj, method, duration=3.0, tau=tau)
+    ts = result.timeseries
+    assert ts["position_error_m"][0] == pytest.approx(math.hypot(0.03, 0.03), rel=1e-6)
+    k = int(np.searchsorted(ts["t"], 5 * tau))
+    assert ts["position_error_m"][k] < 1e-3
+    # First-order decay: at t = tau the error is about exp(-1) of the start.
+    k_tau = int(np.searchsorted(ts["t"], tau))
+    ratio = ts["position_error_m"][k_tau] / ts["position_error_m"][0]
+    assert ratio == pytest.approx(math.exp(-1), abs=0.05)
+
+
+@pytest.mark.parametrize("method", ["pi", "ats", "ap"])
+def test_open_loop_methods_keep_the_initial_offset(method):
+    result = simulate(Robot(), Ellipse(), method, duration=3.0)
+    error = result.timeseries["position_error_m"]
+    assert error[0] == pytest.approx(0.0424, abs=1e-3)
+    assert error[-1] == pytest.approx(error[0], rel=0.1)
+
+
+def test_larger_tau_is_more_sluggish():
+    errors = []
+    for tau in (0.25, 0.5, 1.0, 2.0):
+        ts = simulate(Robot(), Ellipse(), "clrrmc-ts", duration=2.0, tau=tau).timeseries
+        errors.append(ts["position_error_m"][-1])
+    assert errors == sorted(errors)
+    assert errors[-1] > 10 * errors[0]
+
+
+def test_euler_drifts_more_than_rk4():
+    kwargs = {"dt": 0.1, "initial_offset": ON_TRACK}
+    euler = simulate(Robot(), Ellipse(), "ats", integrator="euler", **kwargs).summary
+    rk4 = simulate(Robot(), Ellipse(), "ats", integrator="rk4", **kwargs).summary
+    assert euler["final_position_error_m"] > 100 * rk4["final_position_error_m"]
+    assert euler["final_position_error_m"] > 1e-3
+
+
+def test_euler_drift_shrinks_with_the_step():
+    drift = [
+        simulate(
+            Robot(), Ellipse(), "ats", integrator="euler", dt=dt, initial_offset=ON_TRACK
+        ).summary["final_position_error_m"]
+        for dt in (0.1, 0.05, 0.025)
+    ]
+    # First-order method: halving the step roughly halves the drift.
+    assert drift[0] / drift[1] == pytest.approx(2.0, rel=0.25)
+    assert drift[1] / drift[2] == pytest.approx(2.0, rel=0.25)
+
+
+def test_start_configuration_puts_the_end_effector_on_the_trajectory(robot):
+    for traj in (Ellipse(), Rectangle(), load_trajectory("figure8")):
+        q = start_configuration(robot, traj)
+        np.testing.assert_allclose(robot.fk(q), traj.pose(0.0), atol=1e-12)
+        np.testing.assert_allclose(q[3:], robot.home_pose)
+
+
+def test_kinematic_plant_never_moves_the_base_sideways(robot, rng):
+    plant = KinematicPlant(robot)
+    q = np.array([0.0, 0.0, 0.4, 0.1, 0.5])
+    for _ in range(50):
+        u = rng.uniform(-0.5, 0.5, 4)
+        q_next, _, _ = plant.step(0.0, q, 0.01, lambda t, x, u=u: u)
+        # Constant (v, w) moves the base along an arc: the chord is at heading phi + w dt / 2.
+        chord = q_next[:2] - q[:2]
+        mid_heading = q[2] + 0.5 * (q_next[2] - q[2])
+        assert -chord[0] * math.sin(mid_heading) + chord[1] * math.cos(mid_heading) == (
+            pytest.approx(0.0, abs=1e-9)
+        )
+        q = q_next
+
+
+def test_plant_saturates_wheels_and_joints(robot):
+    plant = KinematicPlant(robot)
+    q = np.zeros(5)
+    u, saturated = plant.saturate(q, np.array([5.0, 1.0, 3.0, -0.5]))
+    left, right = robot.wheel_speeds_from_u(u[0], u[1])
+    assert saturated
+    assert max(abs(left), abs(right)) == pytest.approx(robot.wheel_speed_limit)
+    assert u[0] / u[1] == pytest.approx(5.0)  # curvature kept
+    assert u[2] == pytest.approx(robot.joint_speed_limit) and u[3] == -0.5
+    # At the joint position limit a joint cannot be driven further out.
+    at_limit = np.array([0, 0, 0, robot.joint_limits[0][1], 0.0])
+    u, _ = plant.saturate(at_limit, np.array([0.0, 0.0, 1.0, 0.0]))
+    assert u[2] == 0.0
+
+
+def test_summary_keys_and_shapes():
+    result = simulate(Robot(), Ellipse(), "clrrmc-ts", duration=1.0)
+    required = {
+        "method",
+        "trajectory",
+        "rms_position_error_m",
+        "max_position_error_m",
+        "final_position_error_m",
+        "rms_orientation_error_rad",
+        "max_nonholonomic_residual_m_s",
+        "max_wheel_speed_rad_s",
+        "min_manipulability",
+        "min_stability",
+        "singular_steps",
+        "steps",
+        "median_step_us",
+    }
+    assert required <= set(result.summary)
+    assert result.summary["steps"] == 50
+    assert all(len(v) == 51 for v in result.timeseries.values())
+    assert result.summary["median_step_us"] > 0
+
+
+def test_custom_trajectory_object_is_accepted():
+    class Line:
+        duration = 4.0
+
+        def pose(self, t):
+            return np.array([0.1 * t, 0.5, 0.0])
+
+        def velocity(self, t):
+            return np.array([0.1, 0.0, 0.0])
+
+    result = simulate(Robot(), Line(), "clrrmc-ts", dt=0.01, initial_offset=ON_TRACK)
+    assert result.summary["max_position_error_m"] < 1e-6
+    assert result.summary["trajectory"] == "line"
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"dt": 0.0}, "dt must be > 0"),
+        ({"dt": -0.1}, "dt must be > 0"),
+        ({"dt": float("nan")}, "dt must be a finite number"),
+        ({"duration": -1.0}, "duration must be > 0"),
+        ({"integrator": "rk45"}, "integrator must be one of"),
+        ({"initial_offset": (2.0, 0.0)}, "cannot be reached with the arm"),
+    ],
+)
+def test_simulate_rejects_bad_input(kwargs, message):
+    with pytest.raises(ParameterError, match=message):
+        simulate(Robot(), Ellipse(), "ats", **kwargs)

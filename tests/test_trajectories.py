@@ -1,0 +1,118 @@
+"""Trajectories: shapes, derivatives, orientation, files (SPEC §2)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ddwmmr import Ellipse, ParameterError, Rectangle, load_trajectory
+from ddwmmr.trajectories import SampledTrajectory, read_csv
+
+
+def numeric_velocity(trajectory, t, h=1e-5):
+    return (trajectory.pose(t + h) - trajectory.pose(t - h)) / (2 * h)
+
+
+def test_ellipse_shape_and_rotation():
+    traj = Ellipse(x0=1.0, y0=-2.0, a=2.0, b=1.0, beta=math.pi / 2, T=10.0)
+    np.testing.assert_allclose(traj.pose(0.0)[:2], [1.0, 0.0], atol=1e-12)  # (a, 0) rotated
+    np.testing.assert_allclose(traj.pose(2.5)[:2], [0.0, -2.0], atol=1e-12)  # (0, b) rotated
+
+
+def test_rectangle_corners_and_edges():
+    traj = Rectangle(a=2.0, b=1.0, T=8.0)
+    corners = [(2.0, 1.0), (-2.0, 1.0), (-2.0, -1.0), (2.0, -1.0)]
+    for k, corner in enumerate(corners):
+        np.testing.assert_allclose(traj.pose(2.0 * k)[:2], corner, atol=1e-12)
+    # Mid-edge of the first side: y = b exactly and x = a cos(2 alpha) (non-uniform timing).
+    pose = traj.pose(0.5)
+    assert pose[1] == pytest.approx(1.0)
+    assert pose[0] == pytest.approx(2.0 * math.cos(2 * (2 * math.pi * 0.5 / 8.0)))
+
+
+@pytest.mark.parametrize("orientation", ["tangent", "constant"])
+def test_ellipse_velocity_matches_finite_differences(orientation):
+    traj = Ellipse(x0=0.5, a=2.0, b=1.2, beta=0.4, T=17.0, orientation=orientation, phi=0.3)
+    for t in np.linspace(0.0, 34.0, 23):
+        np.testing.assert_allclose(traj.velocity(t), numeric_velocity(traj, t), atol=1e-7)
+
+
+def test_rectangle_velocity_matches_finite_differences_away_from_corners():
+    traj = Rectangle(a=1.5, b=0.8, beta=-0.3, T=12.0)
+    corner_times = np.arange(0, 25, 3.0)
+    for t in np.linspace(0.1, 23.9, 41):
+        if np.min(np.abs(corner_times - t)) < 0.05:
+            continue
+        np.testing.assert_allclose(traj.velocity(t), numeric_velocity(traj, t), atol=1e-6)
+
+
+def test_tangent_orientation_is_the_direction_of_travel():
+    for traj in (Ellipse(a=2.0, b=0.7, beta=0.5), Rectangle(a=2.0, b=0.7, beta=0.5)):
+        for t in np.linspace(0.3, 39.7, 37):
+            vx, vy, _ = traj.velocity(t)
+            if math.hypot(vx, vy) < 1e-6:
+                continue
+            heading = traj.pose(t)[2]
+            assert math.cos(heading) * vx + math.sin(heading) * vy == pytest.approx(
+                math.hypot(vx, vy), rel=1e-9
+            )
+
+
+def test_ellipse_tangent_is_continuous_and_turns_once_per_period():
+    traj = Ellipse(a=2.0, b=0.5)
+    headings = np.array([traj.pose(t)[2] for t in np.linspace(0, traj.T, 4001)])
+    assert np.max(np.abs(np.diff(headings))) < 0.02
+    assert headings[-1] - headings[0] == pytest.approx(2 * math.pi)
+
+
+def test_rectangle_tangent_jumps_by_quarter_turns_at_corners():
+    traj = Rectangle(T=8.0)
+    assert traj.pose(1.999)[2] == pytest.approx(math.pi)
+    assert traj.pose(2.001)[2] == pytest.approx(1.5 * math.pi)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "name"),
+    [({"a": 0.0}, "a"), ({"T": -1.0}, "T"), ({"N": 1}, "N"), ({"b": math.nan}, "b")],
+)
+def test_invalid_trajectory_parameters(kwargs, name):
+    with pytest.raises(ParameterError, match=f"^{name} must"):
+        Ellipse(**kwargs)
+
+
+def test_shipped_toml_files_equal_the_defaults():
+    assert load_trajectory("ellipse") == Ellipse()
+    assert load_trajectory("rectangle") == Rectangle()
+
+
+def test_sampled_trajectory_reproduces_a_smooth_path():
+    # Samples of a circle of radius 1 at 1 rad/s; C1 Hermite interpolation error O(h^3).
+    times = np.linspace(0.0, 2 * math.pi, 201)
+    points = np.column_stack([np.cos(times), np.sin(times)])
+    traj = SampledTrajectory(times, points)
+    for t in np.linspace(0.05, 6.2, 17):
+        pose, velocity = traj.pose(t), traj.velocity(t)
+        np.testing.assert_allclose(pose[:2], [math.cos(t), math.sin(t)], atol=1e-5)
+        np.testing.assert_allclose(velocity[:2], [-math.sin(t), math.cos(t)], atol=1e-3)
+        # Tangent heading t + pi/2 (unwrapped) and turn rate 1 rad/s.
+        assert pose[2] == pytest.approx(t + math.pi / 2, abs=1e-3)
+        assert velocity[2] == pytest.approx(1.0, abs=2e-2)
+        np.testing.assert_allclose(velocity, numeric_velocity(traj, t), atol=2e-4)
+
+
+def test_shipped_figure_eight_csv():
+    traj = load_trajectory("figure8")
+    assert traj.duration == pytest.approx(60.0)
+    np.testing.assert_allclose(traj.pose(0.0)[:2], traj.pose(60.0)[:2], atol=1e-9)
+
+
+def test_csv_errors(tmp_path):
+    path = tmp_path / "bad.csv"
+    path.write_text("t,x\n0,1\n1,2\n2,3\n")
+    with pytest.raises(ParameterError, match="lacks column"):
+        read_csv(path)
+    path.write_text("t,x,y\n0,1,0\n0,2,0\n1,3,0\n")
+    with pytest.raises(ParameterError, match="strictly increasing"):
+        read_csv(path)
+    with pytest.raises(ParameterError, match="unknown trajectory 'nope'"):
+        load_trajectory("nope")
