@@ -65,7 +65,7 @@ METHOD_OPTIONS = {
 def build_parser() -> ArgumentParser:
     """The argument parser (also used to render docs/cli.md)."""
     methods = available_methods()
-    method_help = "; ".join(f"{m}: {method_description(m)}" for m in methods)
+    method_help = "; ".join(f"{m}: {method_description(m).rstrip('.')}" for m in methods)
     parser = ArgumentParser(
         prog="python -m ddwmmr.track",
         description=(
