@@ -99,7 +99,7 @@ class ConfigurationSpaceController:
         robot: Robot,
         tau: float | Sequence[float] = DEFAULT_TAU,
         aux: str = "shoulder",
-        reference_step: float = 0.002,
+        reference_step: float = 0.01,
     ) -> None:
         self.robot = robot
         self.gains = gains_from_tau(tau, 5)

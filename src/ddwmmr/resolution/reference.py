@@ -61,7 +61,7 @@ class ReferenceTrajectory:
         trajectory,
         q_start: np.ndarray,
         aux: str = "shoulder",
-        step: float = 0.002,
+        step: float = 0.01,
     ) -> None:
         self.robot = robot
         self.trajectory = trajectory
@@ -71,6 +71,8 @@ class ReferenceTrajectory:
         q0 = [float(v) for v in q_start]
         self._q = [q0]
         self._qdot = [self._rate(0.0, q0)]
+        self._coefficients: dict[int, tuple[tuple[float, ...], ...]] = {}
+        self._end = -1.0  # queries up to this time need no extension
 
     def _rate(self, t: float, q: list[float]) -> list[float]:
         xd, yd, pd = self.trajectory.velocity(t).tolist()
@@ -96,22 +98,30 @@ class ReferenceTrajectory:
             self._q.append(q_next)
             self._qdot.append(self._rate(tk + h, q_next))
 
+    def _segment(self, i: int) -> tuple[tuple[float, ...], ...]:
+        """Cubic coefficients ``(c0, c1, c2, c3)`` per coordinate of segment i (in s = 0..1)."""
+        cached = self._coefficients.get(i)
+        if cached is None:
+            h = self.step
+            cached = tuple(
+                (a, h * da, 3.0 * (b - a) - h * (2.0 * da + db), 2.0 * (a - b) + h * (da + db))
+                for a, b, da, db in zip(
+                    self._q[i], self._q[i + 1], self._qdot[i], self._qdot[i + 1]
+                )
+            )
+            self._coefficients[i] = cached
+        return cached
+
     def __call__(self, t: float) -> tuple[list[float], list[float]]:
         """``(q_d, qdot_d)`` at time t >= 0 (s), as lists of 5 floats."""
-        self._extend_to(t)
+        if t > self._end:
+            self._extend_to(t)
+            self._end = (len(self._q) - 2) * self.step
         h = self.step
         i = min(int(t / h), len(self._q) - 2)
         s = t / h - i
-        q0, q1 = self._q[i], self._q[i + 1]
-        d0, d1 = self._qdot[i], self._qdot[i + 1]
-        s2 = s * s
-        s3 = s2 * s
-        h00, h10, h01, h11 = 2 * s3 - 3 * s2 + 1, s3 - 2 * s2 + s, -2 * s3 + 3 * s2, s3 - s2
-        g00, g10, g01, g11 = 6 * s2 - 6 * s, 3 * s2 - 4 * s + 1, -6 * s2 + 6 * s, 3 * s2 - 2 * s
-        position = [
-            h00 * a + h10 * h * da + h01 * b + h11 * h * db for a, b, da, db in zip(q0, q1, d0, d1)
-        ]
-        rate = [
-            (g00 * a + g01 * b) / h + g10 * da + g11 * db for a, b, da, db in zip(q0, q1, d0, d1)
-        ]
+        position, rate = [], []
+        for c0, c1, c2, c3 in self._segment(i):
+            position.append(c0 + s * (c1 + s * (c2 + s * c3)))
+            rate.append((c1 + s * (2.0 * c2 + 3.0 * s * c3)) / h)
         return position, rate

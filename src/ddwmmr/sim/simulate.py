@@ -149,7 +149,6 @@ def simulate(
                 progress(k + 1, steps)
     timeseries = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
     summary = summarize(timeseries, robot)
-    summary["median_step_us"] = float(np.median(call_ns)) / 1000.0
     summary.update(
         method=getattr(controller, "name", type(controller).__name__),
         trajectory=trajectory_name(trajectory),
