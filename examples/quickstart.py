@@ -1,0 +1,46 @@
+"""Quickstart: simulate a method on the default ellipse and print its summary.
+
+Run: ``python examples/quickstart.py [method]`` (default ``clrrmc-ts``). Prints only.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from ddwmmr import Ellipse, Robot, available_methods, make_controller, simulate
+
+KEYS = (
+    "rms_position_error_m",
+    "max_position_error_m",
+    "final_position_error_m",
+    "rms_orientation_error_rad",
+    "min_manipulability",
+    "min_stability",
+    "singular_steps",
+    "steps",
+    "median_step_us",
+)
+
+
+def main(method: str = "clrrmc-ts") -> None:
+    """Simulate ``method`` for one period (40 s, 2000 RK4 steps) and print the summary."""
+    robot, trajectory = Robot(), Ellipse()
+    result = simulate(robot, trajectory, method)
+    print(f"{method} on {trajectory.name} (methods: {', '.join(available_methods())})")
+    for key in KEYS:
+        print(f"  {key:<26} {result.summary[key]:.6g}")
+
+    # The same controller used directly, outside the simulator: one command u = (v, w,
+    # th1dot, th2dot) in m/s and rad/s for the recorded start configuration.
+    controller = make_controller(method, robot)
+    controller.reset(trajectory, result.configurations()[0])
+    u = controller.command(
+        0.0, result.configurations()[0], trajectory.pose(0.0), trajectory.velocity(0.0)
+    )
+    print("  first command u =", np.array2string(u, precision=4))
+
+
+if __name__ == "__main__":
+    main(*sys.argv[1:2])
