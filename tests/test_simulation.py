@@ -1,6 +1,6 @@
 """Closed- and open-loop tracking on the kinematic plant (SPEC §3–4, slides' observations).
 
-The documented tracking bounds (docs/theory.md, "Tracking bounds") are asserted here.
+The measured behaviour documented in docs/theory.md ("Measured behaviour") is asserted here.
 """
 
 import math
