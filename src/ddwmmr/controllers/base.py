@@ -67,6 +67,7 @@ _DESCRIPTIONS: dict[str, str] = {}
 BUILTIN_MODULES = (
     "ddwmmr.controllers.resolved_rate",
     "ddwmmr.controllers.clrrmc",
+    "ddwmmr.controllers.qp",
 )
 _loaded = False
 

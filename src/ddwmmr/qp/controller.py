@@ -1,0 +1,247 @@
+"""The QP task-priority controller (registered as method ``qp`` in ddwmmr.controllers.qp).
+
+Every control step solves one small QP over ``u = (v, w, th1dot, th2dot)`` plus the
+tracking slack (see :mod:`ddwmmr.qp.problem`):
+
+* hard limits: tip-over stability ``S >= S_min`` (velocity damper, exact gradient),
+  wheel speeds, joint speeds, joint positions (dampers), a margin from the shoulder
+  singularity ``cos th1 = 0``, base-footprint clearance from circular obstacles;
+* tasks, by priority: end-effector tracking (feed-forward + feedback, slack weighted
+  ``tracking_weight``), then manipulability, posture and regularisation (low weights),
+  plus a heading task for far-away targets when the orientation is not tracked.
+
+After the solve, the exact stability one step ``dt`` ahead is checked and the joint rates
+are scaled back if the linearisation was too optimistic. If the QP fails, a safe command
+is used (base stopped, arm still or moving to raise S) and counted as a fallback.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.controllers.base import StepInfo
+from ddwmmr.errors import check_nonnegative, check_positive
+from ddwmmr.model import Robot
+from ddwmmr.qp.context import StepContext
+from ddwmmr.qp.limits import (
+    Circle,
+    JointLimit,
+    Limit,
+    ObstacleLimit,
+    ShoulderSingularityLimit,
+    StabilityLimit,
+    WheelSpeedLimit,
+    as_circles,
+    footprint_clearances,
+    safe_arm_scale,
+    stability_terms_gradient,
+)
+from ddwmmr.qp.problem import QPProblem
+from ddwmmr.qp.solve import check_mode, make_backend, solve
+from ddwmmr.qp.tasks import (
+    Detour,
+    EndEffectorTask,
+    HeadingTask,
+    ManipulabilityTask,
+    ObstacleSteeringTask,
+    PostureTask,
+    RegularizationTask,
+    Task,
+)
+
+#: Look-ahead step (s) when neither ``dt`` nor the trajectory's resolution is known.
+DEFAULT_DT = 0.02
+#: Default solver: the fastest measured (docs/qp.md, "Solvers").
+DEFAULT_SOLVER = "daqp"
+
+
+class QPControllerCore:
+    """QP task priorities: hard stability/limits, tracking with slack, soft manipulability.
+
+    Args:
+        robot: the robot (payload included).
+        stability_min: floor S_min of the tip-over margin (hard).
+        manipulability_weight: weight of the manipulability task (soft, >= 0).
+        obstacles: circles (``Circle`` or (x, y, radius) triples, m) or a TOML file path.
+        solver: a qpsolvers backend name; ``"daqp"`` (default) is called directly.
+        mode: ``"weighted"`` (one QP) or ``"hierarchical"`` (strict lexicographic levels).
+        tau: tracking time constant(s) (s), one or three (xE, yE, phiE).
+        track_orientation: False tracks the end-effector position only.
+        max_speed: clip of the feedback end-effector velocity (m/s), None for no clip.
+        tracking_weight: slack penalty of the tracking rows (per (m/s)^2).
+        posture_weight: weight of the posture task (shoulder towards the heading).
+        regularization_weight: weight of the input-norm task.
+        heading_weight: weight of the far-target heading task; default 1 when the
+            orientation is not tracked, else 0 (off).
+        stability_gain: damper gain of the stability limit (1/s).
+        obstacle_margin: clearance kept from every obstacle (m).
+        singularity_margin: angle (rad) kept between link 1 and the base heading's normal
+            (shoulder singularity, ``cos th1 = 0``); None switches the limit off.
+        dt: look-ahead step of the exact stability check (s); default the trajectory's
+            ``duration / samples`` at reset, else 0.02 s.
+        warm_start: pass the previous solution to the solver (default: on for the
+            qpsolvers path, off for direct DAQP where it does not pay off).
+        tasks, limits: extra user-defined :class:`Task`/:class:`Limit` objects.
+    """
+
+    name = "qp"
+
+    def __init__(
+        self,
+        robot: Robot,
+        stability_min: float = 1.25,
+        manipulability_weight: float = 0.5,
+        obstacles: Sequence[Circle | Sequence[float]] | str = (),
+        solver: str = DEFAULT_SOLVER,
+        mode: str = "weighted",
+        tau: float | Sequence[float] = 0.5,
+        track_orientation: bool = True,
+        max_speed: float | None = None,
+        tracking_weight: float = 1e4,
+        posture_weight: float = 0.1,
+        regularization_weight: float = 1e-3,
+        heading_weight: float | None = None,
+        stability_gain: float = 5.0,
+        obstacle_margin: float = 0.05,
+        singularity_margin: float | None = 0.25,
+        dt: float | None = None,
+        warm_start: bool | None = None,
+        tasks: Sequence[Task] = (),
+        limits: Sequence[Limit] = (),
+    ) -> None:
+        self.robot = robot
+        self.mode = check_mode(mode)
+        self.solver = solver
+        self.backend = self._make_backend(solver, warm_start)
+        self.obstacles = as_circles(obstacles)
+        if heading_weight is None:
+            heading_weight = 0.0 if track_orientation else 1.0
+        self.tracking = EndEffectorTask(tracking_weight, tau, track_orientation, max_speed)
+        self.tasks: list[Task] = [
+            self.tracking,
+            ManipulabilityTask(
+                check_nonnegative("manipulability_weight", manipulability_weight),
+                arm_row=not track_orientation,
+            ),
+            PostureTask(posture_weight),
+            RegularizationTask(regularization_weight),
+        ]
+        heading = HeadingTask(heading_weight, distance=0.8 * robot.reach)
+        if heading_weight > 0.0:
+            self.tasks.append(heading)
+        self.tasks.extend(tasks)
+        self.stability = StabilityLimit(
+            robot.com_coefficients,
+            stability_min,
+            stability_gain,
+            joint_speed=robot.joint_speed_limit,
+        )
+        self.stability_min = self.stability.stability_min
+        self.limits: list[Limit] = [self.stability, WheelSpeedLimit(robot), JointLimit(robot)]
+        if singularity_margin is not None:
+            self.limits.append(
+                ShoulderSingularityLimit(singularity_margin, joint_speed=robot.joint_speed_limit)
+            )
+        if self.obstacles:
+            self.limits.append(ObstacleLimit(robot, self.obstacles, margin=obstacle_margin))
+            self.tasks.append(
+                ObstacleSteeringTask(
+                    self.obstacles,
+                    0.5 * robot.base_length,
+                    0.5 * robot.base_width,
+                    # Steering must be able to bend tracking round a post: scale with it.
+                    weight=3e-3 * self.tracking.weight,
+                )
+            )
+            half_diagonal = 0.5 * math.hypot(robot.base_length, robot.base_width)
+            detour = Detour(self.obstacles, half_diagonal + 2.0 * obstacle_margin)
+            self.tracking.detour = heading.detour = detour
+        self.limits.extend(limits)
+        self.problem = QPProblem(self.tasks, self.limits)
+        self._dt_option = None if dt is None else check_positive("dt", dt)
+        self.ctx = StepContext(robot, self._dt_option or DEFAULT_DT)
+        self.fallbacks = 0
+        self.last = StepInfo()
+
+    def _make_backend(self, solver: str, warm_start: bool | None):
+        """The solver backend (overridden by the naive benchmark variant)."""
+        return make_backend(solver, warm_start)
+
+    # -- controller protocol ------------------------------------------------------------
+    def reset(self, trajectory: Any, q0: np.ndarray) -> None:
+        """Forget warm starts and counters; take the look-ahead step from the trajectory."""
+        if self._dt_option is None:
+            samples = getattr(trajectory, "samples", None)
+            duration = getattr(trajectory, "duration", None)
+            self.ctx.dt = duration / samples if samples and duration else DEFAULT_DT
+        self.backend.reset()
+        self.fallbacks = 0
+        self.last = StepInfo()
+
+    def command(self, t: float, q: np.ndarray, pose_d: np.ndarray, velocity_d: np.ndarray):
+        """Input ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s) for this step."""
+        ctx = self.ctx
+        ctx.update(t, q, pose_d, velocity_d)
+        x = self._solve(ctx)
+        if x is None:
+            return self._fallback(ctx)
+        v, w, r1, r2 = x[:4].tolist()
+        scale = safe_arm_scale(
+            self.robot.com_coefficients, ctx.th1, ctx.th2, r1, r2, ctx.dt, self.stability_min
+        )
+        self.last = StepInfo(extra={"slack": float(np.abs(x[4:]).max()), "arm_scale": scale})
+        return np.array([v, w, r1 * scale, r2 * scale])
+
+    def _solve(self, ctx: StepContext) -> np.ndarray | None:
+        """Build and solve this step's QP; None on failure."""
+        self.problem.build(ctx)
+        return solve(self.problem, self.backend, self.mode).x
+
+    def _fallback(self, ctx: StepContext) -> np.ndarray:
+        """Safe command: stop the base; move the arm up the stability gradient of every
+        term below the floor (else hold it)."""
+        self.fallbacks += 1
+        r1 = r2 = 0.0
+        floor = self.stability_min + self.stability.margin
+        for s_i, g1, g2 in stability_terms_gradient(self.robot.com_coefficients, ctx.th1, ctx.th2):
+            norm = math.hypot(g1, g2)
+            if s_i < floor and norm > 0.0:
+                r1 += g1 / norm
+                r2 += g2 / norm
+        norm = math.hypot(r1, r2)
+        speed = 0.5 * self.robot.joint_speed_limit
+        if norm > 0.0:
+            r1, r2 = speed * r1 / norm, speed * r2 / norm
+        self.last = StepInfo(fallback=True, extra={"slack": float("nan"), "arm_scale": 1.0})
+        return np.array([0.0, 0.0, r1, r2])
+
+    # -- reporting ----------------------------------------------------------------------
+    def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
+        """QP metrics merged into the run summary (see module docstring of controllers.qp)."""
+        stability = np.asarray(timeseries["stability"])
+        clearance = None
+        if self.obstacles:
+            clearance = float(
+                np.min(
+                    footprint_clearances(
+                        0.5 * self.robot.base_length,
+                        0.5 * self.robot.base_width,
+                        timeseries["x"],
+                        timeseries["y"],
+                        timeseries["phi"],
+                        self.obstacles,
+                    )
+                )
+            )
+        return {
+            "stability_min": self.stability_min,
+            "stability_violations": int(np.sum(stability < self.stability_min)),
+            "qp_fallbacks": int(np.sum(np.asarray(timeseries["fallback"]) > 0)),
+            "min_obstacle_clearance_m": clearance,
+            "qp_mode": self.mode,
+            "qp_solver": self.solver,
+        }

@@ -1,0 +1,38 @@
+"""Hard constraints of the QP controller, one module each (see :class:`Limit`)."""
+
+from ddwmmr.qp.limits.base import INF, Limit
+from ddwmmr.qp.limits.joints import JointLimit
+from ddwmmr.qp.limits.obstacles import (
+    Circle,
+    ObstacleLimit,
+    as_circles,
+    clearance_and_rate,
+    footprint_clearances,
+    load_obstacles,
+)
+from ddwmmr.qp.limits.singularity import ShoulderSingularityLimit
+from ddwmmr.qp.limits.stability import (
+    StabilityLimit,
+    exact_stability,
+    safe_arm_scale,
+    stability_terms_gradient,
+)
+from ddwmmr.qp.limits.wheels import WheelSpeedLimit
+
+__all__ = [
+    "INF",
+    "Circle",
+    "JointLimit",
+    "Limit",
+    "ObstacleLimit",
+    "ShoulderSingularityLimit",
+    "StabilityLimit",
+    "WheelSpeedLimit",
+    "as_circles",
+    "clearance_and_rate",
+    "exact_stability",
+    "footprint_clearances",
+    "load_obstacles",
+    "safe_arm_scale",
+    "stability_terms_gradient",
+]

@@ -1,0 +1,41 @@
+"""The limit interface: one hard constraint block of the QP controller.
+
+A limit restricts the inputs ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s)
+either through general rows ``lower <= G u <= upper`` (``rows`` of them) or by tightening
+the box ``lb <= u <= ub``. A new constraint is one subclass implementing
+:meth:`Limit.compute`. Use :data:`INF` for a missing side.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+import numpy as np
+
+from ddwmmr.qp.context import StepContext
+
+#: "No bound": DAQP's infinity; other backends drop rows and bounds at this magnitude.
+INF = 1e30
+
+
+class Limit(ABC):
+    """A hard constraint on the inputs (rows ``lower <= G u <= upper`` and/or the box)."""
+
+    rows: int = 0
+    name: str = "limit"
+
+    @abstractmethod
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
+        """Fill ``G`` (rows x 4), ``lower``, ``upper`` (rows,) and tighten ``lb``/``ub`` (4,).
+
+        ``G``/``lower``/``upper`` are views into the stacked problem: write every entry,
+        every step. ``lb``/``ub`` arrive holding the bounds of earlier limits: only tighten.
+        """

@@ -1,0 +1,197 @@
+"""Circular obstacles and the clearance of the rectangular base footprint.
+
+The footprint is the ``base_length x base_width`` rectangle centred on the base position
+(x, y) and aligned with the heading phi. The clearance of a circle is the distance from
+the rectangle to the circle's edge (m, negative when they overlap). Its rate under the
+inputs is, with ``p`` the circle centre in the base frame and ``n`` the unit normal from
+the rectangle towards it (base frame),
+
+    d_dot = -n_x v + (n_x p_y - n_y p_x) w
+
+(the arm does not enter). :class:`ObstacleLimit` keeps ``d_dot >= -gain (d - margin)``
+for every circle within ``influence`` of the footprint (a velocity damper).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ddwmmr.errors import ParameterError, check_finite, check_nonnegative, check_positive
+from ddwmmr.model import Robot
+from ddwmmr.qp.context import StepContext
+from ddwmmr.qp.limits.base import INF, Limit
+
+
+@dataclass(frozen=True)
+class Circle:
+    """A circular obstacle: centre (x, y) in the world frame (m), radius (m, > 0)."""
+
+    x: float
+    y: float
+    radius: float
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "x", check_finite("obstacle x", self.x))
+        object.__setattr__(self, "y", check_finite("obstacle y", self.y))
+        object.__setattr__(self, "radius", check_positive("obstacle radius", self.radius))
+
+
+def load_obstacles(path: str | Path) -> list[Circle]:
+    """Read circles from a TOML file of ``[[obstacle]]`` tables with x, y, radius (m)."""
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_text())
+    except OSError as exc:
+        raise ParameterError(f"obstacles: cannot read {path} ({exc.strerror})") from None
+    except tomllib.TOMLDecodeError as exc:
+        message = str(exc).splitlines()[0]
+        raise ParameterError(f"obstacles: {path} is not valid TOML ({message})") from None
+    tables = data.get("obstacle")
+    unknown = sorted(set(data) - {"obstacle"})
+    if unknown:
+        raise ParameterError(
+            f"obstacles: {path}: unknown key {unknown[0]!r} (expected [[obstacle]])"
+        )
+    if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables or [None]):
+        raise ParameterError(f"obstacles: {path} needs [[obstacle]] tables with x, y, radius in m")
+    circles = []
+    for i, table in enumerate(tables, start=1):
+        keys = set(table)
+        if keys != {"x", "y", "radius"}:
+            raise ParameterError(
+                f"obstacles: {path}: obstacle {i} needs exactly x, y, radius in m "
+                f"(got {sorted(keys)})"
+            )
+        if not all(
+            isinstance(table[k], int | float) and not isinstance(table[k], bool) for k in keys
+        ):
+            raise ParameterError(f"obstacles: {path}: obstacle {i}: x, y, radius must be numbers")
+        try:
+            circles.append(Circle(table["x"], table["y"], table["radius"]))
+        except ParameterError as exc:
+            raise ParameterError(f"obstacles: {path}: obstacle {i}: {exc}") from None
+    return circles
+
+
+def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> list[Circle]:
+    """Normalise the ``obstacles`` option: circles, (x, y, radius) triples, or a TOML path."""
+    if isinstance(obstacles, str | Path):
+        return load_obstacles(obstacles)
+    circles = []
+    for item in obstacles:
+        if isinstance(item, Circle):
+            circles.append(item)
+            continue
+        try:
+            x, y, radius = item
+        except (TypeError, ValueError):
+            raise ParameterError(
+                f"obstacles must be Circle(x, y, radius) or (x, y, radius) triples (got {item!r})"
+            ) from None
+        circles.append(Circle(x, y, radius))
+    return circles
+
+
+def clearance_and_rate(
+    half_length: float, half_width: float, x: float, y: float, phi: float, circle: Circle
+) -> tuple[float, float, float]:
+    """``(d, dd/dv, dd/dw)``: footprint-to-circle clearance (m) and its input rates."""
+    dx, dy = circle.x - x, circle.y - y
+    c, s = math.cos(phi), math.sin(phi)
+    px, py = c * dx + s * dy, -s * dx + c * dy  # circle centre in the base frame
+    qx = min(max(px, -half_length), half_length)
+    qy = min(max(py, -half_width), half_width)
+    ex, ey = px - qx, py - qy
+    dist = math.hypot(ex, ey)
+    if dist > 0.0:
+        nx, ny = ex / dist, ey / dist
+        d = dist - circle.radius
+    else:  # centre inside the footprint: leave through the nearest side
+        depth_x, depth_y = half_length - abs(px), half_width - abs(py)
+        if depth_x < depth_y:
+            nx, ny, depth = math.copysign(1.0, px), 0.0, depth_x
+        else:
+            nx, ny, depth = 0.0, math.copysign(1.0, py), depth_y
+        d = -depth - circle.radius
+    return d, -nx, nx * py - ny * px
+
+
+def footprint_clearances(
+    half_length: float,
+    half_width: float,
+    x: np.ndarray,
+    y: np.ndarray,
+    phi: np.ndarray,
+    circles: Sequence[Circle],
+) -> np.ndarray:
+    """Smallest clearance (m) over ``circles`` at each pose; vectorised over poses.
+
+    Same convention as :func:`clearance_and_rate`: negative when the circle overlaps.
+    """
+    x, y, phi = (np.asarray(a, dtype=float) for a in (x, y, phi))
+    best = np.full(np.broadcast(x, y, phi).shape, np.inf)
+    c, s = np.cos(phi), np.sin(phi)
+    for circle in circles:
+        dx, dy = circle.x - x, circle.y - y
+        px, py = c * dx + s * dy, -s * dx + c * dy
+        ex = px - np.clip(px, -half_length, half_length)
+        ey = py - np.clip(py, -half_width, half_width)
+        depth = np.minimum(half_length - np.abs(px), half_width - np.abs(py))
+        outside = np.hypot(ex, ey)
+        d = np.where(outside > 0.0, outside, -depth) - circle.radius
+        best = np.minimum(best, d)
+    return best
+
+
+class ObstacleLimit(Limit):
+    """One damper row per circle: ``d_dot >= -gain (d - margin)`` when ``d < influence``.
+
+    Args:
+        robot: gives the footprint and the base speed limits (to keep rows feasible).
+        circles: the obstacles.
+        margin: clearance kept from every circle (m).
+        influence: rows farther than this (m) are switched off.
+        gain: damper gain (1/s).
+    """
+
+    name = "obstacles"
+
+    def __init__(
+        self,
+        robot: Robot,
+        circles: Sequence[Circle],
+        margin: float = 0.05,
+        influence: float = 0.6,
+        gain: float = 2.0,
+    ) -> None:
+        self.circles = list(circles)
+        self.rows = len(self.circles)
+        self.half_length, self.half_width = 0.5 * robot.base_length, 0.5 * robot.base_width
+        self.margin = check_nonnegative("obstacle margin", margin)
+        self.influence = check_positive("obstacle influence", influence)
+        if self.influence <= self.margin:
+            raise ParameterError(
+                f"obstacle influence must be > margin ({margin:g} m) (got {influence:g})"
+            )
+        self.gain = check_positive("obstacle gain", gain)
+        r, lw, limit = robot.wheel_radius, robot.track_width, robot.wheel_speed_limit
+        self.v_max, self.w_max = r * limit, 2.0 * r * limit / lw
+
+    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+        """Rows ``[dd/dv, dd/dw, 0, 0]`` for circles within ``influence``."""
+        hl, hw = self.half_length, self.half_width
+        for row, circle in enumerate(self.circles):
+            d, a_v, a_w = clearance_and_rate(hl, hw, ctx.x, ctx.y, ctx.phi, circle)
+            G[row, 0], G[row, 1], G[row, 2], G[row, 3] = a_v, a_w, 0.0, 0.0
+            upper[row] = INF
+            if d >= self.influence:
+                lower[row] = -INF
+                continue
+            achievable = 0.25 * (abs(a_v) * self.v_max + abs(a_w) * self.w_max)
+            lower[row] = min(-self.gain * (d - self.margin), achievable)

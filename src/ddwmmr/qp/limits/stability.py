@@ -1,0 +1,130 @@
+"""Tip-over stability ``S >= S_min`` as a velocity damper with the exact gradient (SPEC §1).
+
+``S = min(S_lon, S_lat)`` with ``S_lon = hl / |x_com|`` and ``S_lat = hw / |y_com|``, so
+``S >= S_min`` holds exactly when both terms do. Each term is smooth where it is below the
+cap, with ``dS_i/dth = -S_i c_i' / c_i`` (``c_i`` the centre-of-mass coordinate), so the
+limit constrains each term separately (no kink at the switch between them):
+
+    dS_i/dt = g_i . (th1dot, th2dot) >= -gain (S_i - S_min - margin)
+
+Above ``S_min + margin`` the term may fall at most exponentially towards the floor; below
+it, the term must rise. The right-hand side is capped at half of what the joint-speed box
+can deliver, so the row alone is always feasible. :func:`safe_arm_scale` then checks the
+exact (nonlinear) S one control step ahead.
+"""
+
+from __future__ import annotations
+
+import math
+
+from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.model.stability import STABILITY_CAP, ComCoefficients
+from ddwmmr.qp.context import StepContext
+from ddwmmr.qp.limits.base import INF, Limit
+
+
+def stability_terms_gradient(
+    k: ComCoefficients, th1: float, th2: float
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """``((S_lon, dS_lon/dth1, dS_lon/dth2), (S_lat, dS_lat/dth1, dS_lat/dth2))`` (1/rad).
+
+    A capped term (``S_i >= STABILITY_CAP``) has zero gradient.
+    """
+    s1, c1 = math.sin(th1), math.cos(th1)
+    s12, c12 = math.sin(th1 + th2), math.cos(th1 + th2)
+    x_com = k.A * c1 + k.B * c12
+    y_com = k.A * s1 + k.B * s12
+    if abs(x_com) * STABILITY_CAP <= k.half_length:
+        lon = (STABILITY_CAP, 0.0, 0.0)
+    else:
+        s_lon = k.half_length / abs(x_com)
+        f = -s_lon / x_com
+        lon = (s_lon, f * (-k.A * s1 - k.B * s12), f * (-k.B * s12))
+    if abs(y_com) * STABILITY_CAP <= k.half_width:
+        lat = (STABILITY_CAP, 0.0, 0.0)
+    else:
+        s_lat = k.half_width / abs(y_com)
+        f = -s_lat / y_com
+        lat = (s_lat, f * (k.A * c1 + k.B * c12), f * (k.B * c12))
+    return lon, lat
+
+
+def exact_stability(k: ComCoefficients, th1: float, th2: float) -> float:
+    """The capped margin ``S = min(S_lon, S_lat)`` (dimensionless)."""
+    x_com = k.A * math.cos(th1) + k.B * math.cos(th1 + th2)
+    y_com = k.A * math.sin(th1) + k.B * math.sin(th1 + th2)
+    s_lon = (
+        STABILITY_CAP if abs(x_com) * STABILITY_CAP <= k.half_length else k.half_length / abs(x_com)
+    )
+    s_lat = (
+        STABILITY_CAP if abs(y_com) * STABILITY_CAP <= k.half_width else k.half_width / abs(y_com)
+    )
+    return min(s_lon, s_lat)
+
+
+def safe_arm_scale(
+    k: ComCoefficients,
+    th1: float,
+    th2: float,
+    rate1: float,
+    rate2: float,
+    dt: float,
+    stability_min: float,
+    halvings: int = 8,
+) -> float:
+    """Largest of 1, 1/2, 1/4, ... (or 0) scaling the joint rates so that the exact S after
+    one step ``dt`` (s) stays >= ``min(S_min, S_now)``: the linearised limit's second-order
+    error cannot take the robot below the floor. The base does not enter S."""
+    floor = min(stability_min, exact_stability(k, th1, th2))
+    scale = 1.0
+    for _ in range(halvings):
+        if exact_stability(k, th1 + scale * dt * rate1, th2 + scale * dt * rate2) >= floor:
+            return scale
+        scale *= 0.5
+    return 0.0
+
+
+class StabilityLimit(Limit):
+    """Two rows, ``dS_lon/dt`` and ``dS_lat/dt`` >= damper bound (see module docstring).
+
+    Args:
+        robot_com: the robot's centre-of-mass coefficients (``Robot.com_coefficients``).
+        stability_min: the floor S_min (> 1 keeps a safety factor against tipping).
+        gain: damper gain (1/s): how fast S may approach the floor.
+        margin: the damper aims at ``S_min + margin`` so the floor itself is not grazed.
+        joint_speed: the joint-speed limit (rad/s), used to keep the row feasible.
+    """
+
+    rows = 2
+    name = "stability"
+
+    def __init__(
+        self,
+        robot_com: ComCoefficients,
+        stability_min: float = 1.25,
+        gain: float = 5.0,
+        margin: float = 0.01,
+        joint_speed: float = 2.0,
+    ) -> None:
+        self.com = robot_com
+        self.stability_min = check_positive("stability_min", stability_min)
+        if self.stability_min >= STABILITY_CAP:
+            raise ParameterError(
+                f"stability_min must be in (0, {STABILITY_CAP:g}) (got {stability_min:g})"
+            )
+        self.gain = check_positive("stability gain", gain)
+        self.margin = check_positive("stability margin", margin)
+        self.joint_speed = check_positive("joint speed", joint_speed)
+
+    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+        """Rows ``[0, 0, dS_i/dth1, dS_i/dth2]`` with lower bound ``-gain (S_i - floor)``."""
+        target = self.stability_min + self.margin
+        for row, (s_i, g1, g2) in enumerate(stability_terms_gradient(self.com, ctx.th1, ctx.th2)):
+            G[row, 0] = G[row, 1] = 0.0
+            G[row, 2], G[row, 3] = g1, g2
+            upper[row] = INF
+            if s_i >= STABILITY_CAP:
+                lower[row] = -INF
+                continue
+            achievable = 0.5 * self.joint_speed * (abs(g1) + abs(g2))
+            lower[row] = min(-self.gain * (s_i - target), achievable)

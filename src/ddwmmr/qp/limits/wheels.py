@@ -1,0 +1,26 @@
+"""Wheel-speed limits: ``|phidot_l|, |phidot_r| <= wheel_speed_limit`` (SPEC §1 wheel map)."""
+
+from __future__ import annotations
+
+from ddwmmr.model import Robot
+from ddwmmr.qp.context import StepContext
+from ddwmmr.qp.limits.base import Limit
+
+
+class WheelSpeedLimit(Limit):
+    """Rows ``phidot_l = (2v - Lw w)/(2r)`` and ``phidot_r = (2v + Lw w)/(2r)`` in +-limit."""
+
+    rows = 2
+    name = "wheels"
+
+    def __init__(self, robot: Robot, scale: float = 1.0) -> None:
+        r, lw = robot.wheel_radius, robot.track_width
+        self.rows_lr = ((1.0 / r, -lw / (2.0 * r)), (1.0 / r, lw / (2.0 * r)))
+        # A hair inside the plant's limit so the plant never has to rescale our command.
+        self.limit = robot.wheel_speed_limit * scale * (1.0 - 1e-6)
+
+    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+        """Constant rows; written every step because the arrays are shared views."""
+        for row, (a_v, a_w) in enumerate(self.rows_lr):
+            G[row, 0], G[row, 1], G[row, 2], G[row, 3] = a_v, a_w, 0.0, 0.0
+            lower[row], upper[row] = -self.limit, self.limit

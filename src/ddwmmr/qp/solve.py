@@ -1,0 +1,195 @@
+"""Solve the stacked QP with any qpsolvers backend (DAQP called directly by default).
+
+:func:`solve` runs one control step's optimisation in either mode:
+
+* ``"weighted"``: one QP, every task in the cost (slack tasks heavily weighted);
+* ``"hierarchical"``: strict lexicographic order. Level 1 minimises the slack of the
+  tracking task (plus tasks flagged ``primary``) with a ridge of :data:`TIE_BREAK` times
+  the largest slack weight on u to make the optimum unique; level 2 freezes that slack
+  (to :data:`SLACK_TOLERANCE`) and minimises the remaining tasks in what is left. Limits
+  are hard at both levels.
+
+Backends: ``"daqp"`` calls ``daqp.solve`` directly on the preallocated arrays (its rows
+take two-sided bounds and equalities natively: no conversion). Every other name goes
+through :func:`qpsolvers.solve_qp`, converting the problem to ``G x <= h, A x = b``.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+import qpsolvers
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.qp.limits.base import INF
+from ddwmmr.qp.problem import QPProblem
+
+MODES = ("weighted", "hierarchical")
+#: Level-1 ridge on u relative to the slack weight in hierarchical mode (uniqueness only).
+TIE_BREAK = 1e-6
+#: Slack frozen after level 1 to within this band (m/s or rad/s).
+SLACK_TOLERANCE = 1e-7
+#: Rows and bounds at least this large are treated as absent by the generic path.
+_BIG = 0.5 * INF
+
+
+def check_mode(mode: str) -> str:
+    """Validate the ``mode`` option."""
+    if mode not in MODES:
+        raise ParameterError(f"mode must be one of {', '.join(MODES)} (got {mode!r})")
+    return mode
+
+
+def check_solver(solver: str) -> str:
+    """Validate the ``solver`` option against the installed qpsolvers backends."""
+    if solver not in qpsolvers.available_solvers:
+        raise ParameterError(
+            f"solver must be one of {', '.join(qpsolvers.available_solvers)} (got {solver!r})"
+        )
+    return solver
+
+
+@dataclass
+class SolveResult:
+    """Outcome of :func:`solve`: the decision vector (or None on failure) and solve count."""
+
+    x: np.ndarray | None
+    solves: int
+
+
+class DaqpBackend:
+    """DAQP's low-level ``daqp.solve`` on the problem's own arrays (no copies, no checks)."""
+
+    name = "daqp"
+
+    def __init__(self, warm_start: bool = False) -> None:
+        import daqp  # local: only this backend needs it
+
+        self._solve = daqp.solve
+        self.warm_start = warm_start
+        self._previous: np.ndarray | None = None
+
+    def reset(self) -> None:
+        """Forget the warm start."""
+        self._previous = None
+
+    def __call__(self, problem: QPProblem) -> np.ndarray | None:
+        """Solve; None when DAQP reports anything but an optimum."""
+        sense = problem.sense.copy()  # DAQP may mark active rows in place
+        if self.warm_start and self._previous is not None:
+            x, _, flag, _ = self._solve(
+                problem.H,
+                problem.f,
+                problem.C,
+                problem.upper,
+                problem.lower,
+                sense,
+                primal_start=self._previous,
+            )
+        else:
+            x, _, flag, _ = self._solve(
+                problem.H, problem.f, problem.C, problem.upper, problem.lower, sense
+            )
+        if flag <= 0:
+            return None
+        self._previous = x
+        return x
+
+
+class QpsolversBackend:
+    """Any qpsolvers backend through :func:`qpsolvers.solve_qp` (sparse where it wants)."""
+
+    def __init__(self, solver: str, warm_start: bool = True) -> None:
+        self.name = self.solver = check_solver(solver)
+        self.sparse = solver in qpsolvers.sparse_solvers and solver not in qpsolvers.dense_solvers
+        self.warm_start = warm_start
+        self._previous: np.ndarray | None = None
+
+    def reset(self) -> None:
+        """Forget the warm start."""
+        self._previous = None
+
+    def __call__(self, problem: QPProblem) -> np.ndarray | None:
+        """Convert to ``G x <= h, A x = b`` (finite sides only) and solve."""
+        P, q, G, h, A, b = to_standard_form(problem)
+        if self.sparse:
+            from scipy import sparse
+
+            P, G, A = sparse.csc_matrix(P), sparse.csc_matrix(G), sparse.csc_matrix(A)
+        initvals = self._previous if self.warm_start else None
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            x = qpsolvers.solve_qp(P, q, G, h, A, b, solver=self.solver, initvals=initvals)
+        if x is None or not np.all(np.isfinite(x)):
+            return None
+        self._previous = x
+        return x
+
+
+def to_standard_form(problem: QPProblem):
+    """``(P, q, G, h, A, b)`` with ``G x <= h`` from the finite box and row bounds and
+    ``A x = b`` from the equality rows. Box entries pinned to a narrow band (the frozen
+    slack of hierarchical mode) become equalities: a band thinner than a solver's
+    feasibility tolerance can make it report infeasibility."""
+    n, m_eq = problem.n, problem.m_eq
+    eye = np.eye(n)
+    rows_c = problem.C[m_eq:]
+    cl, cu = problem.cl[m_eq:], problem.cu[m_eq:]
+    lb, ub = problem.lb, problem.ub
+    pinned = (ub - lb) <= 2.0 * SLACK_TOLERANCE
+    up_box, lo_box = (ub < _BIG) & ~pinned, (lb > -_BIG) & ~pinned
+    up_row, lo_row = cu < _BIG, cl > -_BIG
+    G = np.vstack([eye[up_box], -eye[lo_box], rows_c[up_row], -rows_c[lo_row]])
+    h = np.concatenate([ub[up_box], -lb[lo_box], cu[up_row], -cl[lo_row]])
+    A = np.vstack([problem.C[:m_eq], eye[pinned]])
+    b = np.concatenate([problem.cu[:m_eq], 0.5 * (lb[pinned] + ub[pinned])])
+    return problem.H, problem.f, G, h, A, b
+
+
+def make_backend(solver: str, warm_start: bool | None = None):
+    """The backend for ``solver``: DAQP direct for ``"daqp"``, qpsolvers for the rest.
+
+    ``"qpsolvers-daqp"`` forces DAQP through qpsolvers (for comparisons).
+    """
+    if solver == "daqp":
+        return DaqpBackend(warm_start=bool(warm_start))
+    if solver == "qpsolvers-daqp":
+        backend = QpsolversBackend("daqp", warm_start=bool(warm_start))
+        backend.name = solver
+        return backend
+    return QpsolversBackend(solver, warm_start=True if warm_start is None else warm_start)
+
+
+def solve(problem: QPProblem, backend, mode: str = "weighted") -> SolveResult:
+    """Solve the built ``problem`` (see :meth:`QPProblem.build`) in ``mode``.
+
+    Returns the decision vector ``x = (u, s)`` or None if a level failed (infeasible
+    limits, solver error, non-finite output).
+    """
+    if not problem.box_consistent():
+        return SolveResult(None, 0)
+    if mode == "weighted" or problem.n_slack == 0:
+        return SolveResult(_checked(backend(problem)), 1)
+    ridge = TIE_BREAK * float(problem.slack_weights.max())
+    problem.set_cost(secondary=0.0, primary=1.0, ridge=ridge)
+    first = _checked(backend(problem))
+    if first is None:
+        return SolveResult(None, 1)
+    slack = first[problem.n - problem.n_slack :]
+    problem.lb[problem.n - problem.n_slack :] = slack - SLACK_TOLERANCE
+    problem.ub[problem.n - problem.n_slack :] = slack + SLACK_TOLERANCE
+    problem.set_cost(secondary=1.0, primary=1.0)
+    second = _checked(backend(problem))
+    # Level 2 can only fail numerically (level 1's answer is feasible): keep level 1.
+    return SolveResult(first if second is None else second, 2)
+
+
+def _checked(x: np.ndarray | None) -> np.ndarray | None:
+    if x is None:
+        return None
+    if not all(math.isfinite(v) for v in x.tolist()):
+        return None
+    return x

@@ -1,0 +1,48 @@
+"""The task interface: one soft objective of the QP controller.
+
+A task asks for ``J u = e``: ``J`` (rows x 4) maps the inputs ``u = (v, w, th1dot, th2dot)``
+(m/s, rad/s, rad/s, rad/s) to some task rate, ``e`` is the rate it wants. The solver adds
+``weight * ||J u - e||^2`` to the cost, or, for a task with ``slack = True``, turns the rows
+into equality constraints ``J u - s = e`` whose slack ``s`` is penalised by ``weight``.
+A new objective is one subclass implementing :meth:`Task.compute`.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+import numpy as np
+
+from ddwmmr.errors import check_nonnegative
+from ddwmmr.qp.context import StepContext
+
+
+class Task(ABC):
+    """A soft objective ``weight * ||J u - e||^2`` over the inputs u.
+
+    Class attributes:
+        rows: number of task rows.
+        slack: True puts the rows into equality constraints with penalised slack (the
+            primary, tracking level); False adds them to the cost directly.
+        primary: a cost task solved at the primary level in hierarchical mode (next to
+            the slack tasks) instead of in the secondary level.
+    """
+
+    rows: int = 1
+    slack: bool = False
+    primary: bool = False
+    name: str = "task"
+
+    def __init__(self, weight: float) -> None:
+        self.weight = check_nonnegative(f"{self.name} weight", weight)
+
+    def row_weights(self) -> np.ndarray:
+        """Weight of each row (cost per squared task-rate unit); default: ``weight``."""
+        return np.full(self.rows, self.weight)
+
+    @abstractmethod
+    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        """Fill ``jac`` (rows x 4) and ``error`` (rows,) in place for this step.
+
+        Both arrays are views into the stacked problem: write every entry, every step.
+        """

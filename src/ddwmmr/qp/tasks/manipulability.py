@@ -1,0 +1,97 @@
+"""Manipulability reward: raise ``eta = |sin th2|`` towards 1 (thesis 4.1.1).
+
+With the end effector tracked, ``th2dot`` is fixed by the tracking rows: the arm is
+mounted on the base's rotation centre, so the only free input direction is turning the
+base while counter-rotating the shoulder (``w = -th1dot``). Manipulability then changes
+through where the base drives: ``th2`` is set by the shoulder-to-end-effector distance
+``rho`` (``rho^2 = L1^2 + L2^2 + 2 L1 L2 cos th2``). The task has two rows:
+
+* **arm row** ``[0, 0, 0, d(eta^2)/d th2] u = gain (1 - eta^2)``: climb eta directly
+  (acts when tracking leaves th2 free, e.g. position-only tracking). ``eta^2 = sin^2 th2``
+  is used rather than eta: same maximisers, but a smooth gradient ``sin(2 th2)`` where
+  eta's kink at th2 = 0 would make the row flip sign every step (chattering);
+* **steering row** ``w = heading_gain * wrap(psi* - phi)``: point the base along
+  ``v_B* = Xd_dot + base_gain * grad_pB(eta^2) / 2``, the desired end-effector velocity
+  plus the ascent direction of ``eta^2 = 1 - cos^2 th2`` with respect to the base
+  position, ``grad_pB(eta^2) = 2 cos(th2) rho / (L1 L2) n`` (``n``: unit vector from the
+  shoulder to the end effector). ``eta^2`` has the same maximiser as eta and, unlike eta,
+  a bounded gradient at the stretched arm.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ddwmmr.errors import check_positive
+from ddwmmr.qp.context import StepContext, wrap
+from ddwmmr.qp.tasks.base import Task
+
+#: Below this desired base speed (m/s) the steering row is switched off.
+_MIN_SPEED = 1e-3
+
+
+def manipulability_gradient(th2: float) -> float:
+    """``d eta / d th2`` of ``eta = |sin th2|`` (1/rad); at sin th2 = 0 the +th2 side."""
+    s = math.sin(th2)
+    return math.copysign(1.0, s) * math.cos(th2) if s else math.cos(th2)
+
+
+def eta_squared_gradient(th2: float) -> float:
+    """``d(eta^2)/d th2 = sin(2 th2)`` (1/rad), smooth everywhere."""
+    return math.sin(2.0 * th2)
+
+
+def base_gradient(L1: float, L2: float, ctx: StepContext) -> tuple[float, float]:
+    """``grad_pB(eta^2)`` (1/m): gradient of eta^2 w.r.t. the base position (world frame)."""
+    dx, dy = ctx.pose_e[0] - ctx.x, ctx.pose_e[1] - ctx.y
+    rho = math.hypot(dx, dy)
+    if rho == 0.0:
+        return 0.0, 0.0
+    factor = 2.0 * math.cos(ctx.th2) / (L1 * L2)  # 2 cos(th2) rho / (L1 L2) * (d / rho)
+    return factor * dx, factor * dy
+
+
+class ManipulabilityTask(Task):
+    """Arm row and base-steering row (see module docstring); soft, low weight.
+
+    ``arm_row=False`` zeroes the arm row's weight: with the orientation tracked, th2dot is
+    fixed by tracking, so that row could only trade tracking accuracy for nothing.
+    """
+
+    rows = 2
+    name = "manipulability"
+
+    def __init__(
+        self,
+        weight: float = 1.0,
+        gain: float = 2.0,
+        base_gain: float = 0.02,
+        heading_gain: float = 2.0,
+        arm_row: bool = True,
+    ) -> None:
+        super().__init__(weight)
+        self.arm_row = bool(arm_row)
+        self.gain = check_positive("manipulability gain", gain)
+        self.base_gain = check_positive("manipulability base_gain", base_gain)
+        self.heading_gain = check_positive("manipulability heading_gain", heading_gain)
+
+    def row_weights(self) -> np.ndarray:
+        """``(weight, weight)``, or ``(0, weight)`` without the arm row."""
+        return np.array([self.weight if self.arm_row else 0.0, self.weight])
+
+    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        """Row 0 on th2dot, row 1 on w."""
+        th2 = ctx.th2
+        jac[:] = 0.0
+        jac[0, 3] = eta_squared_gradient(th2)
+        error[0] = self.gain * math.cos(th2) ** 2  # 1 - eta^2
+        gx, gy = base_gradient(ctx.L1, ctx.L2, ctx)
+        vx = ctx.velocity_d[0] + 0.5 * self.base_gain * gx
+        vy = ctx.velocity_d[1] + 0.5 * self.base_gain * gy
+        if math.hypot(vx, vy) < _MIN_SPEED:
+            error[1] = 0.0
+            return
+        jac[1, 1] = 1.0
+        error[1] = self.heading_gain * wrap(math.atan2(vy, vx) - ctx.phi)

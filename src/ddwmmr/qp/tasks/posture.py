@@ -1,0 +1,48 @@
+"""Posture / artificial potential ``V = K1 th1^2 + K2 th2^2 + K3 phi^2`` (SPEC §3)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ddwmmr.errors import check_nonnegative, check_positive
+from ddwmmr.qp.context import StepContext
+from ddwmmr.qp.tasks.base import Task
+
+
+class PostureTask(Task):
+    """Descend V: rows ``w = -gain phi``, ``th1dot = -gain th1``, ``th2dot = -gain th2``.
+
+    Row weights are ``weight * (K3, K1, K2)``, so the unconstrained optimum is the
+    K-weighted gradient descent of V. The QP default keeps only K1 (shoulder towards the
+    heading): K2 would fight the manipulability reward, and K3 pins the base heading to 0,
+    which a closed path around the origin cannot respect.
+    """
+
+    rows = 3
+    name = "posture"
+
+    def __init__(
+        self,
+        weight: float = 0.1,
+        K1: float = 1.0,
+        K2: float = 0.0,
+        K3: float = 0.0,
+        gain: float = 1.0,
+    ) -> None:
+        super().__init__(weight)
+        self.K1 = check_nonnegative("K1", K1)
+        self.K2 = check_nonnegative("K2", K2)
+        self.K3 = check_nonnegative("K3", K3)
+        self.gain = check_positive("posture gain", gain)
+
+    def row_weights(self) -> np.ndarray:
+        """``weight * (K3, K1, K2)`` for the rows (w, th1dot, th2dot)."""
+        return self.weight * np.array([self.K3, self.K1, self.K2])
+
+    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        """Identity rows on (w, th1dot, th2dot), targets ``-gain * (phi, th1, th2)``."""
+        jac[:] = 0.0
+        jac[0, 1] = jac[1, 2] = jac[2, 3] = 1.0
+        error[0] = -self.gain * ctx.phi
+        error[1] = -self.gain * ctx.th1
+        error[2] = -self.gain * ctx.th2

@@ -1,0 +1,35 @@
+"""Regularisation: small input norm, so the problem is strictly convex and commands calm."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ddwmmr.errors import check_positive
+from ddwmmr.qp.context import StepContext
+from ddwmmr.qp.tasks.base import Task
+
+
+class RegularizationTask(Task):
+    """``u = 0`` with weights ``weight * (1, length^2, length^2, length^2)``.
+
+    ``length`` (m) converts rates (rad/s) into end-effector speeds (m/s), so a base speed
+    and a joint rate moving the end effector equally fast cost the same.
+    """
+
+    rows = 4
+    name = "regularization"
+
+    def __init__(self, weight: float = 1e-3, length: float = 0.5) -> None:
+        super().__init__(weight)
+        self.length = check_positive("regularization length", length)
+
+    def row_weights(self) -> np.ndarray:
+        """Per-input weights (cost per (m/s)^2 and per (rad/s)^2)."""
+        l2 = self.length**2
+        return self.weight * np.array([1.0, l2, l2, l2])
+
+    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        """Identity rows, zero targets (constant: written every step for simplicity)."""
+        jac[:] = 0.0
+        jac[0, 0] = jac[1, 1] = jac[2, 2] = jac[3, 3] = 1.0
+        error[:] = 0.0
