@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ddwmmr import Robot, load_trajectory, simulate
-from ddwmmr.cli.track import run
+from ddwmmr.cli.track import main as run
 
 
 def test_track_writes_csv_summary_and_figures(tmp_path, capsys):

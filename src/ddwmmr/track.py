@@ -2,7 +2,7 @@
 
 import sys
 
-from ddwmmr.cli.track import run
+from ddwmmr.cli.track import main
 
 if __name__ == "__main__":
-    sys.exit(run())
+    sys.exit(main())

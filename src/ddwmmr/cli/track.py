@@ -174,8 +174,8 @@ def format_table(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point; returns the exit status."""
+def _main(argv: Sequence[str] | None = None) -> int:
+    """Run the tool; bad input raises :class:`ParameterError`."""
     args = build_parser().parse_args(argv)
     robot = robot_from_arguments(args)
     trajectory = load_trajectory(args.traj)
@@ -218,10 +218,10 @@ def _steps_hint(trajectory, args: argparse.Namespace) -> int:
     return max(1, round(duration / step))
 
 
-def run(argv: Sequence[str] | None = None) -> int:
-    """:func:`main` with bad input reported as one line and exit status 2."""
-    return run_main(main, argv)
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; bad input prints one line on stderr and returns 2."""
+    return run_main(_main, argv)
 
 
 if __name__ == "__main__":  # pragma: no cover
-    sys.exit(run())
+    sys.exit(main())

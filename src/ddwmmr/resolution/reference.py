@@ -42,8 +42,9 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
         if abs(np.linalg.det(arm_jacobian)) < 1e-9:
             break
         q[3:5] += np.linalg.solve(arm_jacobian, error)
+    dx, dy = (float(v) for v in offset)
     raise ParameterError(
-        f"initial_offset {tuple(np.round(offset, 4))} m cannot be reached with the arm alone"
+        f"initial_offset ({dx:g}, {dy:g}) m cannot be reached with the arm alone"
     )
 
 
