@@ -8,6 +8,8 @@ exit with status 2.
 from __future__ import annotations
 
 import math
+import tomllib
+from pathlib import Path
 
 
 class ParameterError(ValueError):
@@ -52,3 +54,18 @@ def _as_float(name: str, value: float) -> float:
     if not math.isfinite(number):
         raise ParameterError(f"{name} must be a finite number (got {value!r})")
     return number
+
+
+def load_toml(path: str | Path, label: str) -> dict:
+    """Parse a TOML file; unreadable or invalid files raise :class:`ParameterError`.
+
+    ``label`` names the option in the message (``robot``, ``traj``, ``obstacles``).
+    """
+    path = Path(path)
+    try:
+        return tomllib.loads(path.read_text())
+    except OSError as exc:
+        raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
+    except tomllib.TOMLDecodeError as exc:
+        message = str(exc).splitlines()[0]
+        raise ParameterError(f"{label}: {path} is not valid TOML ({message})") from None

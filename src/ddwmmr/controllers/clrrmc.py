@@ -15,29 +15,13 @@ import numpy as np
 from ddwmmr.controllers.base import StepInfo, register
 from ddwmmr.controllers.resolved_rate import check_aux
 from ddwmmr.errors import ParameterError
+from ddwmmr.gains import gains_from_tau
 from ddwmmr.model import Robot
 from ddwmmr.resolution import kernels
 from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
 
 #: Default time constant (s) of every closed-loop channel.
 DEFAULT_TAU = 0.5
-
-
-def gains_from_tau(tau: float | Sequence[float], size: int) -> tuple[float, ...]:
-    """Gains ``K_i = 1/tau_i`` (1/s) from one time constant or ``size`` of them.
-
-    ``tau = inf`` switches a channel's feedback off (gain 0).
-    """
-    values = [tau] * size if isinstance(tau, int | float) else list(tau)
-    if len(values) != size:
-        raise ParameterError(f"tau must be one value or {size} values (got {len(values)})")
-    gains = []
-    for value in values:
-        value = float(value)
-        if math.isnan(value) or value <= 0.0:
-            raise ParameterError(f"tau must be > 0 s, or inf to disable a channel (got {value:g})")
-        gains.append(0.0 if math.isinf(value) else 1.0 / value)
-    return tuple(gains)
 
 
 @register("clrrmc-ts")

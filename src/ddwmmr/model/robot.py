@@ -7,14 +7,19 @@ throughout: metres, kilograms, radians, seconds.
 from __future__ import annotations
 
 import math
-import tomllib
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_finite, check_nonnegative, check_positive
+from ddwmmr.errors import (
+    ParameterError,
+    check_finite,
+    check_nonnegative,
+    check_positive,
+    load_toml,
+)
 from ddwmmr.model import kinematics, stability
 
 _PI = math.pi
@@ -104,13 +109,7 @@ class Robot:
 
         A ``[robot]`` table is accepted as well as top-level keys.
         """
-        path = Path(path)
-        try:
-            data = tomllib.loads(path.read_text())
-        except OSError as exc:
-            raise ParameterError(f"robot: cannot read {path} ({exc.strerror})") from None
-        except tomllib.TOMLDecodeError as exc:
-            raise ParameterError(f"robot: {path} is not valid TOML ({exc})") from None
+        data = load_toml(path, "robot")
         return cls.from_dict(data.get("robot", data))
 
     @classmethod

@@ -21,7 +21,7 @@ from collections.abc import Sequence
 import control
 import numpy as np
 
-from ddwmmr.controllers.clrrmc import gains_from_tau
+from ddwmmr.gains import gains_from_tau
 
 #: Feedback channels of each closed-loop method, in the order of its ``tau`` values.
 CHANNELS = {

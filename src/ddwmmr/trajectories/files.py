@@ -22,10 +22,9 @@ Parametric TOML::
 from __future__ import annotations
 
 import os
-import tomllib
 from pathlib import Path
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, load_toml
 from ddwmmr.trajectories.parametric import Ellipse, Rectangle
 from ddwmmr.trajectories.sampled import read_csv
 
@@ -80,12 +79,7 @@ def _load_file(path: Path, overrides: dict):
 def read_toml(path: str | Path, **overrides):
     """Load a parametric trajectory (ellipse or rectangle) from a TOML file."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise ParameterError(f"traj: cannot read {path} ({exc.strerror})") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ParameterError(f"traj: {path} is not valid TOML ({exc})") from None
+    data = load_toml(path, "traj")
     table = dict(data.get("trajectory", data))
     shape = table.pop("shape", None)
     if shape not in SHAPES:

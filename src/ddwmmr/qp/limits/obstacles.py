@@ -15,14 +15,19 @@ for every circle within ``influence`` of the footprint (a velocity damper).
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_finite, check_nonnegative, check_positive
+from ddwmmr.errors import (
+    ParameterError,
+    check_finite,
+    check_nonnegative,
+    check_positive,
+    load_toml,
+)
 from ddwmmr.model import Robot
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
@@ -45,13 +50,7 @@ class Circle:
 def load_obstacles(path: str | Path) -> list[Circle]:
     """Read circles from a TOML file of ``[[obstacle]]`` tables with x, y, radius (m)."""
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise ParameterError(f"obstacles: cannot read {path} ({exc.strerror})") from None
-    except tomllib.TOMLDecodeError as exc:
-        message = str(exc).splitlines()[0]
-        raise ParameterError(f"obstacles: {path} is not valid TOML ({message})") from None
+    data = load_toml(path, "obstacles")
     tables = data.get("obstacle")
     unknown = sorted(set(data) - {"obstacle"})
     if unknown:

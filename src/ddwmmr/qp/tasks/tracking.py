@@ -7,23 +7,16 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.errors import check_positive
+from ddwmmr.gains import gains_from_tau
 from ddwmmr.qp.context import StepContext, wrap
 from ddwmmr.qp.tasks.base import Task
 
 
 def feedback_gains(tau: float | Sequence[float]) -> tuple[float, float, float]:
     """Gains ``K = 1/tau`` (1/s) for xE, yE, phiE from one time constant or three (s)."""
-    values = [tau] * 3 if isinstance(tau, int | float) else list(tau)
-    if len(values) != 3:
-        raise ParameterError(f"tau must be one value or 3 values in s (got {len(values)})")
-    gains = []
-    for value in values:
-        value = float(value)
-        if math.isnan(value) or value <= 0.0:
-            raise ParameterError(f"tau must be > 0 s, or inf to disable a channel (got {value:g})")
-        gains.append(0.0 if math.isinf(value) else 1.0 / value)
-    return gains[0], gains[1], gains[2]
+    kx, ky, kphi = gains_from_tau(tau, 3)
+    return kx, ky, kphi
 
 
 class EndEffectorTask(Task):
