@@ -1,0 +1,33 @@
+"""The arbiter interface: what the thesis controller needs from any arbiter.
+
+The thesis's state machine (:mod:`ddwmmr.arbiters.state_machine`) is one implementation;
+another (e.g. the competitive-dynamics arbiter of SPEC §6) only has to provide the same
+three members. An arbiter may evaluate any of the behaviours it is given, but it must
+return a proposal made by one of them (or a blend in the common proposal format) and name
+the state it is in, which the metrics count.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:  # behaviours import the arbiter package; avoid a cycle at run time
+    from ddwmmr.arbiters.state_machine import Selection
+    from ddwmmr.behaviours.base import Behaviour, Percept
+
+
+class Arbiter(Protocol):
+    """Structural type of an arbiter."""
+
+    state: str
+
+    def reset(self) -> None:  # pragma: no cover - protocol
+        """Start a new run."""
+        ...
+
+    def select(
+        self, p: Percept, behaviours: Mapping[str, Behaviour]
+    ) -> Selection:  # pragma: no cover - protocol
+        """Choose the state and the proposal for percept p."""
+        ...

@@ -1,0 +1,390 @@
+"""``python -m ddwmmr.scenarios``: the thesis's 100-scenario benchmark (thesis ch. 5).
+
+Examples::
+
+    python -m ddwmmr.scenarios --out runs/thesis                  # thesis controller, 100
+    python -m ddwmmr.scenarios --controller qp --plant kinematic --out runs/qp
+    python -m ddwmmr.scenarios --stability 1.4 1.7 --out runs/high-stability
+    python -m ddwmmr.scenarios --study thresholds --out runs/thresholds
+    python -m ddwmmr.scenarios --study obstacles --out runs/obstacles
+    python -m ddwmmr.scenarios --executor dask --scheduler tcp://10.0.0.5:8786 --out runs/d
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, replace
+from pathlib import Path
+from typing import Any
+
+from ddwmmr.cli.common import ArgumentParser, atomic_output_dir, run_main
+from ddwmmr.errors import ParameterError, check_int_at_least, check_nonnegative
+from ddwmmr.model import Robot
+from ddwmmr.progress import ProgressBar
+from ddwmmr.scenarios import report, studies
+from ddwmmr.scenarios.executors import EXECUTORS, default_jobs, run_many
+from ddwmmr.scenarios.generator import Scenario, generate
+from ddwmmr.scenarios.protocol import CONTROLLERS, PLANTS, Outcome, RunConfig, run_scenario
+from ddwmmr.sim.result import json_safe, write_atomic
+
+#: File whose presence marks a folder as ours (so --out may replace it).
+MARKER = "summary.json"
+STUDIES = ("thresholds", "obstacles")
+
+DESCRIPTION = """\
+Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly (seeded) in
+an 8 m x 8 m square; the end effector must reach them in order within 0.01 m in 60 s
+(120 s with obstacles) while the tip-over stability S stays above 1. Writes scenarios.csv
+(one row per scenario), summary.json, table.txt (thesis Table 5.2 format) and figures
+(per-scenario bars as thesis Figs 5.3-5.9, paths, a state timeline) into --out, and prints
+the table. Controllers: 'thesis' (behaviour-based, state-machine arbiter) on the thesis
+force-driven plant; 'qp' (the library's QP controller) on the thesis plant through a
+velocity-tracking loop, or on the kinematic plant."""
+
+EPILOG = """\
+The default payload is 3.0 kg: with the thesis's 1.25 kg the planar arm can never tip
+(S >= 1.56), so the stability behaviour could never be needed. Results are identical for
+any --executor and --jobs. Bad input prints one line and exits with status 2, leaving no
+output behind."""
+
+
+def build_parser() -> ArgumentParser:
+    """The argument parser (also used to render --help in the docs)."""
+    parser = ArgumentParser(
+        prog="python -m ddwmmr.scenarios",
+        description=DESCRIPTION,
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument(
+        "--controller",
+        choices=CONTROLLERS,
+        default="thesis",
+        help="controller to benchmark (default: thesis)",
+    )
+    parser.add_argument(
+        "--plant",
+        choices=PLANTS,
+        default="thesis",
+        help="plant: 'thesis' force-driven dynamics (default) or 'kinematic'",
+    )
+    parser.add_argument(
+        "--n", type=int, default=100, metavar="N", help="number of scenarios (default: 100)"
+    )
+    parser.add_argument("--seed", type=int, default=0, help="generator seed (default: 0)")
+    parser.add_argument(
+        "--out",
+        required=True,
+        metavar="DIR",
+        help="output folder (replaced if it holds a previous run)",
+    )
+    parser.add_argument(
+        "--payload",
+        type=float,
+        default=3.0,
+        metavar="KG",
+        help="end-effector payload in kg (default: 3.0; thesis: 1.25)",
+    )
+    parser.add_argument(
+        "--stability",
+        nargs=2,
+        type=float,
+        default=(1.25, 1.60),
+        metavar=("ENTER", "EXIT"),
+        help="stability thresholds: enter below ENTER, leave at EXIT (default: 1.25 1.60)",
+    )
+    parser.add_argument(
+        "--manipulability",
+        nargs=2,
+        type=float,
+        default=(0.75, 0.90),
+        metavar=("ENTER", "EXIT"),
+        help="manipulability thresholds (default: 0.75 0.90)",
+    )
+    parser.add_argument(
+        "--no-hysteresis",
+        action="append",
+        default=[],
+        choices=("stability", "manipulability"),
+        help="leave that fix state as soon as the metric is back above ENTER (repeatable)",
+    )
+    parser.add_argument(
+        "--obstacles",
+        action="store_true",
+        help="run thesis scenarios 1, 3, 7, 10 with two obstacles (r 0.3 m) each, 120 s limit",
+    )
+    parser.add_argument(
+        "--time-limit",
+        type=float,
+        metavar="S",
+        help="time limit per scenario in s (default: 60, 120 with obstacles)",
+    )
+    parser.add_argument(
+        "--dt",
+        type=float,
+        default=0.01,
+        metavar="S",
+        help="control and integration step in s (default: 0.01, the thesis "
+        "controller's sample time)",
+    )
+    parser.add_argument(
+        "--jobs", type=int, metavar="N", help="worker processes (default: the CPUs available)"
+    )
+    parser.add_argument(
+        "--executor",
+        choices=EXECUTORS,
+        default="local",
+        help="'local' process pool (default) or 'dask'",
+    )
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="Dask scheduler address (with --executor dask; default: start a LocalCluster)",
+    )
+    parser.add_argument(
+        "--study",
+        choices=STUDIES,
+        help="'thresholds': rerun thesis Tables 5.5-5.20 threshold variations; "
+        "'obstacles': thesis Table 5.21",
+    )
+    parser.add_argument(
+        "--qp-stability-min",
+        type=float,
+        default=1.25,
+        metavar="S",
+        help="qp controller's hard stability bound (default: 1.25)",
+    )
+    parser.add_argument(
+        "--qp-max-speed",
+        type=float,
+        default=1.0,
+        metavar="M_S",
+        help="qp controller's end-effector speed limit (default: 1.0 m/s)",
+    )
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return parser  # fmt: skip
+
+
+def config_from_arguments(args: argparse.Namespace) -> RunConfig:
+    """Validate the options and build the run configuration (before any output exists)."""
+    check_int_at_least("n", args.n, 1)
+    check_nonnegative("seed", args.seed)
+    if args.jobs is not None:
+        check_int_at_least("jobs", args.jobs, 1)
+    if args.scheduler and args.executor != "dask":
+        raise ParameterError("scheduler: only used with --executor dask")
+    if args.study == "thresholds" and args.controller != "thesis":
+        raise ParameterError("study: the threshold study needs --controller thesis")
+    if args.study and args.obstacles:
+        raise ParameterError("study: --obstacles is implied by --study obstacles")
+    for name in ("payload", "dt", "time_limit", "qp_stability_min", "qp_max_speed"):
+        value = getattr(args, name)
+        allowed_zero = name == "payload" and value == 0
+        if value is not None and not (math.isfinite(value) and value > 0) and not allowed_zero:
+            raise ParameterError(f"{name.replace('_', '-')} must be > 0 (got {value:g})")
+    if args.dt > 0.1:
+        raise ParameterError(f"dt must be <= 0.1 s (got {args.dt:g})")
+    thresholds = {}
+    for name in ("stability", "manipulability"):
+        enter, exit_ = getattr(args, name)
+        if not (math.isfinite(enter) and math.isfinite(exit_)):
+            raise ParameterError(f"{name} thresholds must be finite (got {enter}, {exit_})")
+        thresholds[name] = (enter, enter) if name in args.no_hysteresis else (enter, exit_)
+    return RunConfig(
+        controller=args.controller,
+        plant=args.plant,
+        payload=args.payload,
+        stability=thresholds["stability"],
+        manipulability=thresholds["manipulability"],
+        dt=args.dt,
+        time_limit=args.time_limit,
+        qp_stability_min=args.qp_stability_min,
+        qp_max_speed=args.qp_max_speed,
+    )
+
+
+class Runner:
+    """Runs batches with the chosen executor, a progress bar and timing."""
+
+    def __init__(self, args: argparse.Namespace) -> None:
+        self.jobs = args.jobs or default_jobs()
+        self.executor = args.executor
+        self.scheduler = args.scheduler
+        self.progress = not args.no_progress
+
+    def run(self, scenarios: list[Scenario], config: RunConfig, label: str):
+        """Outcomes in scenario order and the wall time (s)."""
+        start = time.perf_counter()
+        with ProgressBar(len(scenarios), label, enabled=self.progress) as bar:
+            outcomes = run_many(
+                scenarios,
+                config,
+                jobs=self.jobs,
+                executor=self.executor,
+                scheduler=self.scheduler,
+                on_done=bar.advance,
+            )
+        return outcomes, time.perf_counter() - start
+
+
+def _title(config: RunConfig) -> str:
+    s, m = config.stability, config.manipulability
+    return (
+        f"{config.controller} controller, {config.plant} plant, payload {config.payload:g} kg, "
+        f"S {s[0]:g}/{s[1]:g}, eta {m[0]:g}/{m[1]:g}"
+    )
+
+
+def write_batch(
+    folder: Path,
+    scenarios: list[Scenario],
+    outcomes: list[Outcome],
+    config: RunConfig,
+    wall: float,
+    extra: dict[str, Any],
+) -> dict[str, Any]:
+    """scenarios.csv, summary.json, table.txt and the figures of one batch."""
+    summary = report.summarize(outcomes, wall)
+    summary.update(extra)
+    summary["config"] = asdict(config)
+    title = _title(config)
+    write_atomic(folder / "scenarios.csv", report.metrics_csv(outcomes))
+    table = report.format_table(summary, f"Table 5.2 format: {title}")
+    write_atomic(folder / "table.txt", table)
+    _figures(folder, scenarios, outcomes, config)
+    write_atomic(folder / MARKER, json.dumps(json_safe(summary), indent=2) + "\n")
+    print(table, end="")
+    return summary
+
+
+def _figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
+    short = f"{config.controller} / {config.plant}"
+    report.plot_state_times(outcomes, folder / "thesis_times.png", f"{short}: time per state")
+    report.plot_speeds(outcomes, folder / "thesis_speed.png", short)
+    if config.controller == "thesis":
+        for key in ("stability", "manipulability"):
+            report.plot_fix_state(outcomes, key, folder / f"thesis_{key}.png", short)
+    # Re-run (deterministically) the scenarios to draw, with a trace: the first two and
+    # the one to look at (the first failure, else the most fix-state transitions).
+    focus = highlight(outcomes)
+    chosen = sorted({0, min(1, len(scenarios) - 1), focus})
+    traced = replace(config, record=True)
+    items = [(scenarios[i], run_scenario(scenarios[i], traced)) for i in chosen]
+    report.plot_paths(items, folder / "thesis_paths.png", f"{short}: paths")
+    timeline = next(o for (s, o) in items if s.index == scenarios[focus].index)
+    report.plot_timeline(timeline, folder / "thesis_timeline.png", short)
+
+
+def highlight(outcomes: list[Outcome]) -> int:
+    """Position of the scenario to draw in detail: first failure, else busiest in fix states."""
+    for i, o in enumerate(outcomes):
+        if not o.metrics["success"]:
+            return i
+    return max(
+        range(len(outcomes)),
+        key=lambda i: (
+            _count(outcomes[i].metrics["transitions_stability"])
+            + _count(outcomes[i].metrics["transitions_manipulability"]),
+            -i,
+        ),
+    )
+
+
+def _count(value: Any) -> float:
+    return 0.0 if isinstance(value, float) and math.isnan(value) else float(value)
+
+
+def _run_benchmark(args, config, runner, folder: Path) -> None:
+    scenarios = generate(args.n, args.seed)
+    if args.obstacles:
+        scenarios = studies.obstacle_scenarios(scenarios)
+    outcomes, wall = runner.run(scenarios, config, "scenarios")
+    summary = write_batch(folder, scenarios, outcomes, config, wall, {"seed": args.seed})
+    print(
+        f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
+        f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
+        f"({runner.jobs} {args.executor} workers)",
+        file=sys.stderr,
+    )
+
+
+def _run_thresholds(args, config, runner, folder: Path) -> None:
+    scenarios = generate(args.n, args.seed)
+    results = []
+    rows = []
+    for variant in studies.THRESHOLD_VARIANTS:
+        cfg = replace(config, stability=variant.stability, manipulability=variant.manipulability)
+        outcomes, wall = runner.run(scenarios, cfg, variant.key)
+        summary = report.summarize(outcomes, wall)
+        results.append((variant, summary))
+        rows.append({"variant": variant.key, **{k: summary[k] for k in summary if k != "failures"}})
+        write_atomic(folder / f"{variant.key}.csv", report.metrics_csv(outcomes))
+    table = studies.threshold_table(results)
+    write_atomic(folder / "thresholds.md", table)
+    total = {
+        "study": "thresholds",
+        "n": len(scenarios),
+        "seed": args.seed,
+        "config": asdict(config),
+        "variants": rows,
+        "wall_time_s": sum(s["wall_time_s"] for _, s in results),
+    }
+    write_atomic(folder / MARKER, json.dumps(json_safe(total), indent=2) + "\n")
+    print("Threshold study: cells are thesis / ours\n")
+    print(table, end="")
+
+
+def _run_obstacles(args, config, runner, folder: Path) -> None:
+    scenarios = studies.obstacle_scenarios(generate(max(args.n, 10), args.seed))
+    outcomes, wall = runner.run(scenarios, config, "obstacles")
+    write_batch(
+        folder, scenarios, outcomes, config, wall, {"seed": args.seed, "study": "obstacles"}
+    )
+    table = studies.obstacle_table([o.metrics for o in outcomes])
+    write_atomic(folder / "obstacles.md", table)
+    report.plot_paths(
+        [(s, run_scenario(s, replace(config, record=True))) for s in scenarios],
+        folder / "thesis_obstacle_paths.png",
+        "obstacle study: paths",
+    )
+    print("\nTable 5.21 format: cells are thesis / ours\n")
+    print(table, end="")
+
+
+def config_robot(config: RunConfig) -> Robot:
+    """The robot a configuration simulates."""
+    return Robot().with_payload(config.payload)
+
+
+def _main(argv: Sequence[str] | None = None) -> int:
+    """Run the tool; bad input raises :class:`ParameterError`."""
+    args = build_parser().parse_args(argv)
+    config = config_from_arguments(args)
+    if config.controller == "qp":
+        from ddwmmr.scenarios.protocol import make_qp
+
+        make_qp(config_robot(config), generate(1, 0)[0], config)  # fail early, before output
+    runner = Runner(args)
+    with atomic_output_dir(args.out, MARKER) as folder:
+        if args.study == "thresholds":
+            _run_thresholds(args, config, runner, folder)
+        elif args.study == "obstacles":
+            _run_obstacles(args, config, runner, folder)
+        else:
+            _run_benchmark(args, config, runner, folder)
+    print(f"wrote {args.out}", file=sys.stderr)
+    return 0
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; bad input prints one line on stderr and returns 2."""
+    return run_main(_main, argv)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,287 @@
+"""Summaries, tables (thesis Table 5.2 format), CSV and figures of a scenario batch."""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.arbiters.state_machine import STATES
+from ddwmmr.scenarios.generator import Scenario
+from ddwmmr.scenarios.protocol import METRICS, Outcome
+from ddwmmr.sim.result import write_atomic
+
+#: (summary key, metric column) pairs reported as mean and sample standard deviation.
+AVERAGED = (
+    ("time_s", "time_s"),
+    ("speed_m_s", "speed_m_s"),
+    ("time_base_s", "time_base_s"),
+    ("time_arm_s", "time_arm_s"),
+    ("time_manipulability_s", "time_manipulability_s"),
+    ("transitions_manipulability", "transitions_manipulability"),
+    ("time_stability_s", "time_stability_s"),
+    ("transitions_stability", "transitions_stability"),
+    ("time_obstacle_s", "time_obstacle_s"),
+    ("transitions_obstacle", "transitions_obstacle"),
+)
+
+
+def _column(outcomes: Sequence[Outcome], key: str) -> np.ndarray:
+    return np.array([float(o.metrics[key]) for o in outcomes])
+
+
+def _mean_sd(values: np.ndarray) -> tuple[float, float]:
+    if values.size == 0 or np.all(np.isnan(values)):
+        return math.nan, math.nan
+    sd = float(np.std(values, ddof=1)) if values.size > 1 else 0.0
+    return float(np.mean(values)), sd
+
+
+def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]:
+    """Batch summary: failures, mean and sd of every metric, minimum stability, speed.
+
+    Means are over all scenarios (a failed scenario counts with the time at which it
+    stopped); ``sd_*`` are sample standard deviations (n - 1).
+    """
+    failed = [o.metrics for o in outcomes if not o.metrics["success"]]
+    summary: dict[str, Any] = {"n": len(outcomes), "failed": len(failed)}
+    for key, column in AVERAGED:
+        mean, sd = _mean_sd(_column(outcomes, column))
+        name = "mean_time_s" if key == "time_s" else key
+        name = "mean_speed_m_s" if key == "speed_m_s" else name
+        summary[name] = mean
+        summary["sd_" + key] = sd
+    summary["min_stability"] = float(np.min(_column(outcomes, "min_stability")))
+    summary["min_manipulability"] = float(np.min(_column(outcomes, "min_manipulability")))
+    sim_time = float(np.sum(_column(outcomes, "time_s")))
+    summary["sim_time_s"] = sim_time
+    summary["wall_time_s"] = wall_time_s
+    summary["sim_seconds_per_wall_second"] = sim_time / wall_time_s if wall_time_s > 0 else None
+    summary["failures"] = [
+        {
+            "scenario": m["scenario"],
+            "reason": m["reason"],
+            "waypoints_reached": m["waypoints_reached"],
+        }
+        for m in failed
+    ]
+    return summary
+
+
+def _fmt(value: float) -> str:
+    """Three significant figures, as the thesis reports (thesis 5.1)."""
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return "n/a"
+    return f"{value:.3g}"
+
+
+def table_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
+    """Rows of thesis Table 5.2: label and "mean (share of time) (sd)" text."""
+    total = summary["mean_time_s"]
+
+    def with_share(key: str) -> str:
+        mean, sd = summary[key], summary["sd_" + key]
+        if isinstance(mean, float) and math.isnan(mean):
+            return "n/a"
+        return f"{_fmt(mean)} ({_fmt(100.0 * mean / total)}%) ({_fmt(sd)})"
+
+    def plain(mean_key: str, sd_key: str) -> str:
+        if isinstance(summary[mean_key], float) and math.isnan(summary[mean_key]):
+            return "n/a"
+        return f"{_fmt(summary[mean_key])} ({_fmt(summary[sd_key])})"
+
+    rows = [
+        ("No. of failed scenarios", str(summary["failed"])),
+        ("Simulation time (s)", plain("mean_time_s", "sd_time_s")),
+        ("Simulation speed (m/s)", plain("mean_speed_m_s", "sd_speed_m_s")),
+        ("Time spent moving base (s)", with_share("time_base_s")),
+        ("Time spent moving manipulator (s)", with_share("time_arm_s")),
+        ("Time in manipulability state (s)", with_share("time_manipulability_s")),
+        (
+            "No. of manipulability state transitions",
+            plain("transitions_manipulability", "sd_transitions_manipulability"),
+        ),
+        ("Time in stability state (s)", with_share("time_stability_s")),
+        (
+            "No. of stability state transitions",
+            plain("transitions_stability", "sd_transitions_stability"),
+        ),
+    ]
+    if summary.get("time_obstacle_s", 0.0) and not math.isnan(summary["time_obstacle_s"]):
+        rows.append(("Time in obstacle state (s)", with_share("time_obstacle_s")))
+    return rows
+
+
+def format_table(summary: dict[str, Any], title: str) -> str:
+    """Plain-text table in the format of thesis Table 5.2 (mean (sd))."""
+    rows = table_rows(summary)
+    width = max(len(label) for label, _ in rows)
+    lines = [title, "-" * len(title)]
+    lines += [f"{label:<{width}}  {value}" for label, value in rows]
+    lines.append(f"{'Minimum stability S':<{width}}  {_fmt(summary['min_stability'])}")
+    return "\n".join(lines) + "\n"
+
+
+def metrics_csv(outcomes: Sequence[Outcome]) -> str:
+    """One CSV row per scenario with every metric of :data:`METRICS`."""
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(METRICS)
+    for o in outcomes:
+        writer.writerow([_cell(o.metrics[k]) for k in METRICS])
+    return buffer.getvalue()
+
+
+def _cell(value: Any) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return "nan" if math.isnan(value) else repr(value)
+    return str(value)
+
+
+# -- figures ------------------------------------------------------------------------------
+def _figure(rows: int = 1, cols: int = 1, height: float = 3.2):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt.subplots(rows, cols, figsize=(10, height * rows), squeeze=False)
+
+
+def _save(fig, path) -> None:
+    import matplotlib.pyplot as plt
+
+    buffer = io.BytesIO()
+    fig.tight_layout()
+    fig.savefig(buffer, format="png", dpi=110)
+    plt.close(fig)
+    write_atomic(path, buffer.getvalue())
+
+
+def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
+    """Stacked per-scenario time in each state (thesis Figs 5.3, 5.10, 5.11).
+
+    Controllers without states move base and arm together, so their times overlap: they
+    are drawn as grouped bars (total, base moving, arm moving) instead of stacked.
+    """
+    fig, ax = _figure()
+    ax = ax[0, 0]
+    index = np.array([o.metrics["scenario"] for o in outcomes])
+    if np.all(np.isnan(_column(outcomes, "time_stability_s"))):
+        for shift, key, label in (
+            (-0.3, "time_s", "total"),
+            (0.0, "time_base_s", "base moving"),
+            (0.3, "time_arm_s", "arm moving"),
+        ):
+            ax.bar(index + shift, _column(outcomes, key), width=0.3, label=label)
+        ax.set(xlabel="scenario", ylabel="time (s)", title=title)
+        ax.legend(loc="upper right", ncol=3, fontsize=8)
+        _save(fig, path)
+        return
+    bottom = np.zeros(len(outcomes))
+    for key, label in (
+        ("time_base_s", "moving base"),
+        ("time_arm_s", "moving arm"),
+        ("time_manipulability_s", "manipulability"),
+        ("time_stability_s", "stability"),
+        ("time_obstacle_s", "obstacle"),
+    ):
+        values = np.nan_to_num(_column(outcomes, key))
+        if np.any(values):
+            ax.bar(index, values, bottom=bottom, label=label, width=0.85)
+            bottom += values
+    ax.set(xlabel="scenario", ylabel="time (s)", title=title)
+    ax.legend(loc="upper right", ncol=5, fontsize=8)
+    _save(fig, path)
+
+
+def plot_speeds(outcomes: Sequence[Outcome], path, title: str) -> None:
+    """Per-scenario speed (Fig 5.4) and speed over base-moving time only (Fig 5.5)."""
+    fig, axes = _figure(2, 1)
+    index = [o.metrics["scenario"] for o in outcomes]
+    length = _column(outcomes, "path_length_m")
+    axes[0, 0].bar(index, _column(outcomes, "speed_m_s"), width=0.85)
+    axes[0, 0].set(ylabel="speed (m/s)", title=f"{title}: path length / total time")
+    base = _column(outcomes, "time_base_s")
+    with np.errstate(divide="ignore", invalid="ignore"):
+        axes[1, 0].bar(index, np.where(base > 0, length / base, np.nan), width=0.85)
+    axes[1, 0].set(xlabel="scenario", ylabel="speed (m/s)", title="path length / base-moving time")
+    _save(fig, path)
+
+
+def plot_fix_state(outcomes: Sequence[Outcome], key: str, path, title: str) -> None:
+    """Per-scenario time in and transitions into one fix state (Figs 5.7, 5.9)."""
+    fig, axes = _figure(2, 1)
+    index = [o.metrics["scenario"] for o in outcomes]
+    axes[0, 0].bar(index, np.nan_to_num(_column(outcomes, f"time_{key}_s")), width=0.85)
+    axes[0, 0].set(ylabel="time (s)", title=f"{title}: time in {key} state")
+    axes[1, 0].bar(index, np.nan_to_num(_column(outcomes, f"transitions_{key}")), width=0.85)
+    axes[1, 0].set(xlabel="scenario", ylabel="transitions", title=f"transitions into {key}")
+    _save(fig, path)
+
+
+def plot_paths(items: Sequence[tuple[Scenario, Outcome]], path, title: str) -> None:
+    """Base and end-effector paths with waypoints (and obstacles) of chosen scenarios."""
+    import matplotlib.patches as patches
+
+    cols = min(len(items), 2)
+    rows = math.ceil(len(items) / cols)
+    fig, axes = _figure(rows, cols, height=4.6)
+    for ax, (scenario, outcome) in zip(axes.flat, items):
+        tr = outcome.trace or {}
+        ax.plot(tr.get("x", []), tr.get("y", []), lw=1.2, label="base")
+        ax.plot(tr.get("xe", []), tr.get("ye", []), lw=0.8, label="end effector")
+        wx, wy = zip(*scenario.waypoints)
+        ax.plot(wx, wy, "kx", ms=8, label="waypoints")
+        for i, (x, y) in enumerate(scenario.waypoints, start=1):
+            ax.annotate(str(i), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8)
+        ax.plot([0.0], [0.0], "go", ms=5, label="start")
+        for ox, oy, radius in scenario.obstacles:
+            ax.add_patch(patches.Circle((ox, oy), radius, color="0.5", alpha=0.6))
+        m = outcome.metrics
+        ax.set(
+            aspect="equal",
+            title=f"scenario {m['scenario']}: {m['reason']}, {m['time_s']:.1f} s",
+            xlabel="x (m)",
+            ylabel="y (m)",
+        )
+        ax.legend(fontsize=7, loc="best")
+    for ax in list(axes.flat)[len(items) :]:
+        ax.axis("off")
+    fig.suptitle(title)
+    _save(fig, path)
+
+
+def plot_timeline(outcome: Outcome, path, title: str) -> None:
+    """Controller state, stability and manipulability over time for one scenario (Fig 5.17)."""
+    tr = outcome.trace or {}
+    fig, axes = _figure(3, 1, height=2.6)
+    ax = axes[0, 0]
+    ax.step(tr.get("t", []), tr.get("state", []), where="post")
+    number = outcome.metrics["scenario"]
+    if isinstance(outcome.metrics["transitions_stability"], float) and math.isnan(
+        outcome.metrics["transitions_stability"]
+    ):  # no arbiter: the trace only tells whether the base moves
+        ax.set_yticks([0, 1], ["base moving", "base at rest"])
+        ax.set(title=f"{title}: scenario {number} base motion")
+    else:
+        ax.set_yticks(range(len(STATES)), [s.replace("_", " ") for s in STATES])
+        ax.set(title=f"{title}: scenario {number} controller state")
+    ax2 = axes[1, 0]
+    ax2.plot(tr.get("t", []), tr.get("s", []), label="stability S")
+    ax2.plot(tr.get("t", []), tr.get("eta", []), label="manipulability eta")
+    ax2.axhline(1.0, color="k", lw=0.6, ls="--")
+    ax2.set(ylim=(0.0, 3.0))
+    ax2.legend(fontsize=8)
+    ax3 = axes[2, 0]
+    ax3.semilogy(tr.get("t", []), np.maximum(tr.get("distance", []), 1e-4))
+    ax3.axhline(0.01, color="k", lw=0.6, ls="--", label="tolerance 0.01 m")
+    ax3.set(xlabel="time (s)", ylabel="to waypoint (m)")
+    ax3.legend(fontsize=8)
+    _save(fig, path)

@@ -1,0 +1,135 @@
+"""``python -m ddwmmr.scenarios``: smoke runs, outputs, studies and bad input."""
+
+from __future__ import annotations
+
+import csv
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from ddwmmr.cli.scenarios import main as cli
+from ddwmmr.scenarios.protocol import METRICS
+
+SUMMARY_KEYS = {
+    "n", "failed", "mean_time_s", "sd_time_s", "mean_speed_m_s", "time_base_s", "time_arm_s",
+    "time_manipulability_s", "transitions_manipulability", "time_stability_s",
+    "transitions_stability", "min_stability", "wall_time_s",
+}  # fmt: skip
+FAST = ["--n", "3", "--time-limit", "12", "--jobs", "1", "--no-progress"]
+
+
+def test_benchmark_writes_csv_summary_table_and_figures(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert cli([*FAST, "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert set(summary) >= SUMMARY_KEYS
+    assert summary["n"] == 3
+    rows = list(csv.DictReader((out / "scenarios.csv").open()))
+    assert [r["scenario"] for r in rows] == ["1", "2", "3"]
+    assert set(METRICS) == set(rows[0])
+    for name in ("times", "speed", "stability", "manipulability", "paths", "timeline"):
+        assert (out / f"thesis_{name}.png").stat().st_size > 1000
+    printed = capsys.readouterr().out
+    assert "No. of failed scenarios" in printed and "Simulation time (s)" in printed
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no staging left
+
+
+def test_no_hysteresis_option_sets_exit_to_enter(tmp_path):
+    out = tmp_path / "run"
+    args = [*FAST, "--out", str(out), "--stability", "1.3", "1.7", "--no-hysteresis", "stability"]
+    assert cli(args) == 0
+    config = json.loads((out / "summary.json").read_text())["config"]
+    assert config["stability"] == [1.3, 1.3]
+    assert config["manipulability"] == [0.75, 0.9]
+
+
+def test_obstacle_study_table(tmp_path, capsys):
+    out = tmp_path / "obs"
+    args = ["--study", "obstacles", "--time-limit", "6", "--jobs", "1", "--no-progress"]
+    assert cli([*args, "--out", str(out)]) == 0
+    table = (out / "obstacles.md").read_text()
+    assert "scenario 1" in table and "scenario 10" in table
+    assert "Time in obstacle state (s)" in table
+    assert (out / "thesis_obstacle_paths.png").exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--n", "0"], "n must be an integer >= 1"),
+        (["--stability", "1.6", "1.2"], "enter must be <= exit"),
+        (["--controller", "nope"], "invalid choice"),
+        (["--controller", "thesis", "--plant", "kinematic"], "needs --plant thesis"),
+        (["--payload", "-1"], "payload must be > 0"),
+        (["--scheduler", "tcp://x:1"], "only used with --executor dask"),
+        (["--jobs", "0"], "jobs must be an integer >= 1"),
+        (["--study", "thresholds", "--controller", "qp"], "needs --controller thesis"),
+        (["--dt", "0"], "dt must be > 0"),
+    ],
+)
+def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, message):
+    out = tmp_path / "bad"
+    result = subprocess.run(
+        [sys.executable, "-m", "ddwmmr.scenarios", *args, "--out", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0]
+    assert "Traceback" not in result.stderr
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_refuses_to_replace_a_foreign_folder(tmp_path, capsys):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep me")
+    assert cli([*FAST, "--out", str(out)]) == 2
+    assert "not an output folder" in capsys.readouterr().err
+    assert (out / "notes.txt").read_text() == "keep me"
+
+
+def test_help_explains_protocol(capsys):
+    with pytest.raises(SystemExit) as exc:
+        cli(["--help"])
+    assert exc.value.code == 0
+    text = capsys.readouterr().out
+    for word in ("--no-hysteresis", "--executor", "--study", "0.01 m", "3.0 kg"):
+        assert word in text
+
+
+def test_threshold_study_table_has_thesis_and_our_numbers(tmp_path, capsys):
+    out = tmp_path / "thr"
+    args = ["--study", "thresholds", "--n", "2", "--time-limit", "4", "--jobs", "1"]
+    assert cli([*args, "--no-progress", "--out", str(out)]) == 0
+    table = (out / "thresholds.md").read_text()
+    lines = [line for line in table.splitlines() if line.startswith("| ")]
+    assert len(lines) == 1 + 18  # header + every variant of Tables 5.5-5.20
+    assert "| Baseline (5.2) | 1.25/1.6 | 0.75/0.9 | 0 / 2 | 44.9 / 4 |" in table
+    assert "42 / " in table  # Table 5.12 threshold 5
+    summary = json.loads((out / "summary.json").read_text())
+    assert len(summary["variants"]) == 18
+
+
+def test_docs_thesis_python_snippets_run(tmp_path):
+    page = Path(__file__).resolve().parents[1] / "docs" / "thesis.md"
+    blocks, inside = [], False
+    for line in page.read_text().splitlines():
+        if line.strip() == "```python":
+            inside = True
+        elif line.strip() == "```" and inside:
+            inside = False
+        elif inside:
+            blocks.append(line)
+    code = "\n".join(blocks)
+    assert "run_many" in code
+    done = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert "ok" in done.stdout and "move_arm" in done.stdout

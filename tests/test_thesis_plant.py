@@ -1,0 +1,119 @@
+"""The thesis plant: base dynamics (closed forms), force limit, inertia, arm servo."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from ddwmmr.model import Robot
+from ddwmmr.plants.thesis import ThesisPlant, ThesisState, arm_step
+
+ROBOT = Robot().with_payload(3.0)
+POSE = (-0.7, 1.5)
+
+
+def run(plant: ThesisPlant, f_left: float, f_right: float, seconds: float, dt: float = 0.01):
+    state = ThesisState(0.0, 0.0, 0.0, *POSE)
+    for _ in range(round(seconds / dt)):
+        plant.step(state, f_left, f_right, POSE, dt)
+    return state
+
+
+def test_total_mass_includes_arm_and_payload():
+    assert ThesisPlant(ROBOT).mass == pytest.approx(10.0 + 1.0 + 1.0 + 3.0)
+
+
+def test_constant_force_reaches_terminal_velocity_f_over_c1():
+    plant = ThesisPlant(ROBOT)
+    state = run(plant, 4.0, 4.0, 30.0)  # 30 s >> m/c1 = 1 s
+    assert state.v == pytest.approx(8.0 / 15.0, rel=1e-9)
+    assert state.w == pytest.approx(0.0, abs=1e-12)
+    assert state.y == pytest.approx(0.0, abs=1e-12)
+
+
+def test_velocity_after_one_time_constant_and_distance_closed_form():
+    plant = ThesisPlant(ROBOT)
+    tau = plant.mass / 15.0  # m / c1 (s)
+    state = run(plant, 5.0, 5.0, tau, dt=tau / 100)
+    v_ss = 10.0 / 15.0
+    assert state.v == pytest.approx(v_ss * (1.0 - math.exp(-1.0)), rel=1e-9)
+    # x(t) = v_ss (t - tau (1 - e^{-t/tau})), integrated by hand
+    assert state.x == pytest.approx(v_ss * (tau - tau * (1.0 - math.exp(-1.0))), rel=1e-9)
+
+
+def test_exact_step_matches_fine_explicit_integration():
+    """Independent check: 1 ms Euler integration of m v' = F - c1 v vs the 0.02 s plant."""
+    plant = ThesisPlant(ROBOT)
+    state = run(plant, 3.0, 7.0, 2.0, dt=0.02)
+    v = w = x = y = phi = 0.0
+    h = 1e-4
+    inertia = plant.inertia(*POSE)
+    for _ in range(20000):
+        x += h * v * math.cos(phi)
+        y += h * v * math.sin(phi)
+        phi += h * w
+        v += h * (10.0 - 15.0 * v) / plant.mass
+        w += h * ((7.0 - 3.0) * 0.175 - 4.0 * w) / inertia
+    assert state.v == pytest.approx(v, rel=1e-3)
+    assert state.w == pytest.approx(w, rel=1e-3)
+    assert state.phi == pytest.approx(phi, rel=1e-3)
+    assert (state.x, state.y) == pytest.approx((x, y), abs=2e-3)
+
+
+def test_force_limit_10_newton_per_wheel():
+    plant = ThesisPlant(ROBOT)
+    limited = run(plant, 100.0, 100.0, 5.0)
+    at_limit = run(plant, 10.0, 10.0, 5.0)
+    assert limited.v == pytest.approx(at_limit.v, rel=1e-12)
+    assert limited.v < 20.0 / 15.0
+
+
+def test_turning_torque_and_terminal_yaw_rate():
+    plant = ThesisPlant(ROBOT)
+    state = run(plant, -2.0, 2.0, 20.0)
+    torque = (2.0 - -2.0) * ROBOT.base_width / 2.0  # T = (F2 - F1) w / 2
+    assert state.w == pytest.approx(torque / 4.0, rel=1e-9)
+    assert state.v == pytest.approx(0.0, abs=1e-12)
+    assert math.hypot(state.x, state.y) < 1e-12
+
+
+def test_inertia_against_discretised_links():
+    """Pose-dependent yaw inertia vs 2000 point masses along the links plus the payload."""
+    plant = ThesisPlant(ROBOT)
+    th1, th2 = 0.4, -1.1
+    n = 2000
+    total = ROBOT.base_inertia
+    for length, mass, start, angle in (
+        (ROBOT.L1, 1.0, (0.0, 0.0), th1),
+        (ROBOT.L2, 1.0, (ROBOT.L1 * math.cos(th1), ROBOT.L1 * math.sin(th1)), th1 + th2),
+    ):
+        for i in range(n):
+            s = (i + 0.5) / n * length
+            px, py = start[0] + s * math.cos(angle), start[1] + s * math.sin(angle)
+            total += mass / n * (px * px + py * py)
+    xe = ROBOT.L1 * math.cos(th1) + ROBOT.L2 * math.cos(th1 + th2)
+    ye = ROBOT.L1 * math.sin(th1) + ROBOT.L2 * math.sin(th1 + th2)
+    total += 3.0 * (xe * xe + ye * ye)
+    assert plant.inertia(th1, th2) == pytest.approx(total, rel=1e-6)
+    assert plant.inertia(0.0, 0.0) > plant.inertia(0.0, 2.5)  # stretched arm: more inertia
+
+
+def test_arm_servo_eq_4_10_synchronised_and_limited():
+    # errors 1.0 and -0.5 rad: largest moves at 2 rad/s, the other at 1 rad/s
+    th1, th2 = arm_step(0.0, 0.0, 1.0, -0.5, 2.0, 0.1)
+    assert (th1, th2) == pytest.approx((0.2, -0.1))
+    steps = 0
+    while (th1, th2) != (1.0, -0.5):
+        th1, th2 = arm_step(th1, th2, 1.0, -0.5, 2.0, 0.1)
+        steps += 1
+        assert abs(th1) <= 1.0 and abs(th2) <= 0.5  # never overshoots
+    assert steps == 4  # 1 rad at 2 rad/s = 0.5 s = 5 steps in all, both arrive together
+
+
+def test_arm_servo_inside_plant_and_no_motion_at_target():
+    plant = ThesisPlant(ROBOT)
+    state = ThesisState(0.0, 0.0, 0.0, 0.0, 1.0)
+    plant.step(state, 0.0, 0.0, (0.3, 1.0), 0.01)
+    assert (state.th1, state.th2) == pytest.approx((0.02, 1.0))
+    assert arm_step(0.3, 1.0, 0.3, 1.0, 2.0, 0.01) == (0.3, 1.0)
