@@ -43,9 +43,7 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
             break
         q[3:5] += np.linalg.solve(arm_jacobian, error)
     dx, dy = (float(v) for v in offset)
-    raise ParameterError(
-        f"initial_offset ({dx:g}, {dy:g}) m cannot be reached with the arm alone"
-    )
+    raise ParameterError(f"initial_offset ({dx:g}, {dy:g}) m cannot be reached with the arm alone")
 
 
 class ReferenceTrajectory:
