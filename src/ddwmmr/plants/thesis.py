@@ -136,6 +136,23 @@ class ThesisPlant:
         tip = r.L1**2 + r.L2**2 + 2.0 * r.L1 * r.L2 * c2
         return self._inertia_fixed + m1 * 0.25 * r.L1**2 + m2 * mid2 + r.payload * tip
 
+    def velocity_envelope(self, fraction: float = 0.8) -> dict[str, float]:
+        """What a velocity command can ask of this base, as ``fraction`` of the physics.
+
+        Top speeds where the full force balances damping (``2 F / c1`` m/s,
+        ``2 F (width/2) / c2`` rad/s) and accelerations from rest with the largest yaw
+        inertia (arm stretched). Keys match the ``qp`` controller's options.
+        """
+        total = 2.0 * self.force_limit
+        torque = total * self._half_width
+        stretched = self.inertia(0.0, 0.0)
+        return {
+            "max_base_speed": fraction * total / self.c1,
+            "max_yaw_rate": fraction * torque / self.c2,
+            "max_acceleration": fraction * total / self.mass,
+            "max_yaw_acceleration": fraction * torque / stretched,
+        }
+
     def clip_force(self, force: float) -> float:
         """A wheel force limited to ``+-force_limit`` (N)."""
         return min(self.force_limit, max(-self.force_limit, force))

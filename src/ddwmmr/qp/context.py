@@ -34,6 +34,8 @@ class StepContext:
         pose_d, velocity_d: desired pose and velocity (world frame), as float tuples.
         jac_e: (3, 4) array, end-effector rates per input, ``d(xE, yE, phiE)/du``.
         dt: control step (s) used for one-step look-ahead checks.
+        previous_command: ``(v, w)`` of the controller's previous command, None after a
+            reset (kept by the controller, read by slew limits).
     """
 
     def __init__(self, robot: Robot, dt: float) -> None:
@@ -44,6 +46,7 @@ class StepContext:
         self.jac_e[2, 1:] = 1.0  # phiE = phi + th1 + th2, constant rows
         self.t = 0.0
         self.q = (0.0, 0.0, 0.0, 0.0, 0.0)
+        self.previous_command: tuple[float, float] | None = None
 
     def update(self, t: float, q: np.ndarray, pose_d: np.ndarray, velocity_d: np.ndarray) -> None:
         """Refresh every shared quantity for time t (s) and configuration q."""

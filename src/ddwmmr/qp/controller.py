@@ -28,6 +28,8 @@ from ddwmmr.errors import check_nonnegative, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import (
+    INF,
+    BaseMotionLimit,
     Circle,
     JointLimit,
     Limit,
@@ -79,6 +81,10 @@ class QPControllerCore:
             orientation is not tracked, else 0 (off).
         stability_gain: damper gain of the stability limit (1/s).
         obstacle_margin: clearance kept from every obstacle (m).
+        max_base_speed, max_yaw_rate: caps on v (m/s) and w (rad/s), e.g. a force-limited
+            base's top speeds; None (default) leaves only the wheel-speed limit.
+        max_acceleration, max_yaw_acceleration: slew limits on v (m/s^2) and w (rad/s^2)
+            around the previous command (one call per control step assumed); None: off.
         singularity_margin: angle (rad) kept between link 1 and the base heading's normal
             (shoulder singularity, ``cos th1 = 0``); None switches the limit off.
         dt: look-ahead step of the exact stability check (s); default the trajectory's
@@ -108,6 +114,10 @@ class QPControllerCore:
         stability_gain: float = 5.0,
         obstacle_margin: float = 0.05,
         singularity_margin: float | None = 0.25,
+        max_base_speed: float | None = None,
+        max_yaw_rate: float | None = None,
+        max_acceleration: float | None = None,
+        max_yaw_acceleration: float | None = None,
         dt: float | None = None,
         warm_start: bool | None = None,
         tasks: Sequence[Task] = (),
@@ -142,6 +152,16 @@ class QPControllerCore:
         )
         self.stability_min = self.stability.stability_min
         self.limits: list[Limit] = [self.stability, WheelSpeedLimit(robot), JointLimit(robot)]
+        motion = (max_base_speed, max_yaw_rate, max_acceleration, max_yaw_acceleration)
+        if any(value is not None for value in motion):
+            self.limits.append(
+                BaseMotionLimit(
+                    max_base_speed if max_base_speed is not None else INF,
+                    max_yaw_rate if max_yaw_rate is not None else INF,
+                    max_acceleration,
+                    max_yaw_acceleration,
+                )
+            )
         if singularity_margin is not None:
             self.limits.append(
                 ShoulderSingularityLimit(singularity_margin, joint_speed=robot.joint_speed_limit)
@@ -179,6 +199,7 @@ class QPControllerCore:
             duration = getattr(trajectory, "duration", None)
             self.ctx.dt = duration / samples if samples and duration else DEFAULT_DT
         self.backend.reset()
+        self.ctx.previous_command = None
         self.fallbacks = 0
         self.last = StepInfo()
 
@@ -194,6 +215,7 @@ class QPControllerCore:
             self.robot.com_coefficients, ctx.th1, ctx.th2, r1, r2, ctx.dt, self.stability_min
         )
         self.last = StepInfo(extra={"slack": float(np.abs(x[4:]).max()), "arm_scale": scale})
+        ctx.previous_command = (v, w)
         return np.array([v, w, r1 * scale, r2 * scale])
 
     def _solve(self, ctx: StepContext) -> np.ndarray | None:
@@ -217,6 +239,7 @@ class QPControllerCore:
         if norm > 0.0:
             r1, r2 = speed * r1 / norm, speed * r2 / norm
         self.last = StepInfo(fallback=True, extra={"slack": float("nan"), "arm_scale": 1.0})
+        ctx.previous_command = (0.0, 0.0)
         return np.array([0.0, 0.0, r1, r2])
 
     # -- reporting ----------------------------------------------------------------------

@@ -339,8 +339,14 @@ class VelocityLoop:
         return 0.5 * f_t - 0.5 * f_r, 0.5 * f_t + 0.5 * f_r
 
 
-def make_qp(robot: Robot, scenario: Scenario, config: RunConfig) -> Any:
-    """The registry's ``qp`` controller configured for waypoint tasks."""
+def make_qp(
+    robot: Robot, scenario: Scenario, config: RunConfig, envelope: dict[str, float] | None = None
+) -> Any:
+    """The registry's ``qp`` controller configured for waypoint tasks.
+
+    ``envelope`` (the plant's :meth:`ThesisPlant.velocity_envelope`) keeps the commanded
+    (v, w) within what a force-limited base can follow.
+    """
     from ddwmmr.controllers import available_methods, make_controller
 
     if "qp" not in available_methods():
@@ -353,11 +359,13 @@ def make_qp(robot: Robot, scenario: Scenario, config: RunConfig) -> Any:
         max_speed=config.qp_max_speed,
         obstacles=[tuple(o) for o in scenario.obstacles],
         dt=config.dt,
+        **(envelope or {}),
     )
 
 
 def _run_qp(robot: Robot, scenario: Scenario, config: RunConfig) -> Outcome:
-    controller = make_qp(robot, scenario, config)
+    envelope = ThesisPlant(robot).velocity_envelope() if config.plant == "thesis" else None
+    controller = make_qp(robot, scenario, config, envelope)
     pose0 = default_pose(robot)
     q = np.array([0.0, 0.0, 0.0, pose0[0], pose0[1]])
     tally = _Tally(robot, scenario, config)

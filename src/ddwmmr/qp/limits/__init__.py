@@ -1,6 +1,7 @@
 """Hard constraints of the QP controller, one module each (see :class:`Limit`)."""
 
 from ddwmmr.qp.limits.base import INF, Limit
+from ddwmmr.qp.limits.base_motion import BaseMotionLimit
 from ddwmmr.qp.limits.joints import JointLimit
 from ddwmmr.qp.limits.obstacles import (
     Circle,
@@ -21,6 +22,7 @@ from ddwmmr.qp.limits.wheels import WheelSpeedLimit
 
 __all__ = [
     "INF",
+    "BaseMotionLimit",
     "Circle",
     "JointLimit",
     "Limit",

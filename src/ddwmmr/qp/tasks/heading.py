@@ -15,7 +15,9 @@ class HeadingTask(Task):
     """``w = gain * wrap(bearing - phi)`` while the target is farther than ``distance`` (m).
 
     ``bearing`` is the direction from the base to the desired end-effector position. Near
-    the target the row is switched off (all zeros), leaving the arm to finish the job.
+    the target the row fades out (scaled by ``(d - distance) / fade``, clipped to [0, 1]),
+    leaving the arm to finish the job. The fade matters: a row that switched off at once
+    made the command jump as the base crossed ``distance``, and the base chattered there.
     Without it a differential drive asked to move sideways can end up parked broadside,
     its arm stretched, making no progress.
     """
@@ -23,23 +25,27 @@ class HeadingTask(Task):
     rows = 1
     name = "heading"
 
-    def __init__(self, weight: float = 1.0, gain: float = 2.0, distance: float = 0.8) -> None:
+    def __init__(
+        self, weight: float = 1.0, gain: float = 2.0, distance: float = 0.8, fade: float = 0.3
+    ) -> None:
         super().__init__(weight)
         self.gain = check_positive("heading gain", gain)
         self.distance = check_nonnegative("heading distance", distance)
+        self.fade = check_positive("heading fade", fade)
         #: Optional :class:`~ddwmmr.qp.tasks.avoidance.Detour` for the bearing.
         self.detour = None
 
     def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
-        """One row on w; zero when the target is within ``distance`` of the base."""
+        """One row on w, scaled by the fade factor (zero within ``distance`` of the base)."""
         dx, dy = ctx.pose_d[0] - ctx.x, ctx.pose_d[1] - ctx.y
         jac[0, 0] = jac[0, 2] = jac[0, 3] = 0.0
-        if math.hypot(dx, dy) <= self.distance:
+        factor = min(1.0, (math.hypot(dx, dy) - self.distance) / self.fade)
+        if factor <= 0.0:
             jac[0, 1] = 0.0
             error[0] = 0.0
             return
         if self.detour is not None:
             ax, ay = self.detour.aim(ctx.x, ctx.y, ctx.pose_d[0], ctx.pose_d[1])
             dx, dy = ax - ctx.x, ay - ctx.y
-        jac[0, 1] = 1.0
-        error[0] = self.gain * wrap(math.atan2(dy, dx) - ctx.phi)
+        jac[0, 1] = factor
+        error[0] = factor * self.gain * wrap(math.atan2(dy, dx) - ctx.phi)

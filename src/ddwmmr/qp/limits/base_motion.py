@@ -1,0 +1,70 @@
+"""Base motion envelope: speed caps and slew (acceleration) limits on ``v`` and ``w``.
+
+A force-limited base cannot reach any ``(v, w)`` within one step: its velocity changes at
+most ``a_max dt`` per step and settles at a top speed set by force limit and damping. A
+QP that ignores this asks for commands the plant cannot follow and, from one step to the
+next, can alternate between far-apart commands that the plant averages to nothing. This
+limit keeps each command within the plant's envelope around the previous command:
+
+    max(-v_max, v_prev - a dt) <= v <= min(v_max, v_prev + a dt)
+    max(-w_max, w_prev - alpha dt) <= w <= min(w_max, w_prev + alpha dt)
+
+``v_prev, w_prev`` is the controller's previous command (``StepContext.previous_command``);
+the slew part is skipped on the first step after a reset.
+"""
+
+from __future__ import annotations
+
+from ddwmmr.errors import check_positive
+from ddwmmr.qp.context import StepContext
+from ddwmmr.qp.limits.base import Limit
+
+
+class BaseMotionLimit(Limit):
+    """Box bounds on v (m/s) and w (rad/s): caps and per-step slew around the last command.
+
+    Args:
+        max_speed: |v| cap (m/s); max_yaw_rate: |w| cap (rad/s).
+        max_acceleration: |dv/dt| (m/s^2); max_yaw_acceleration: |dw/dt| (rad/s^2);
+            None leaves that slew unbounded.
+    """
+
+    rows = 0
+    name = "base motion"
+
+    def __init__(
+        self,
+        max_speed: float,
+        max_yaw_rate: float,
+        max_acceleration: float | None = None,
+        max_yaw_acceleration: float | None = None,
+    ) -> None:
+        self.max_speed = check_positive("max_base_speed", max_speed)
+        self.max_yaw_rate = check_positive("max_yaw_rate", max_yaw_rate)
+        self.max_acceleration = (
+            None
+            if max_acceleration is None
+            else check_positive("max_acceleration", max_acceleration)
+        )
+        self.max_yaw_acceleration = (
+            None
+            if max_yaw_acceleration is None
+            else check_positive("max_yaw_acceleration", max_yaw_acceleration)
+        )
+
+    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+        """Tighten the (v, w) box; no general rows."""
+        low_v, high_v = -self.max_speed, self.max_speed
+        low_w, high_w = -self.max_yaw_rate, self.max_yaw_rate
+        previous = ctx.previous_command
+        if previous is not None:
+            v_prev, w_prev = previous
+            if self.max_acceleration is not None:
+                step = self.max_acceleration * ctx.dt
+                low_v, high_v = max(low_v, v_prev - step), min(high_v, v_prev + step)
+            if self.max_yaw_acceleration is not None:
+                step = self.max_yaw_acceleration * ctx.dt
+                low_w, high_w = max(low_w, w_prev - step), min(high_w, w_prev + step)
+        # A previous command beyond a cap (e.g. a cap lowered mid-run) must not empty the box.
+        lb[0], ub[0] = max(lb[0], min(low_v, high_v)), min(ub[0], max(low_v, high_v))
+        lb[1], ub[1] = max(lb[1], min(low_w, high_w)), min(ub[1], max(low_w, high_w))
