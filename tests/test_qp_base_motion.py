@@ -15,7 +15,7 @@ from ddwmmr import Robot, make_controller
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import BaseMotionLimit
-from ddwmmr.qp.tasks import HeadingTask
+from ddwmmr.qp.tasks import HeadingTask, ManipulabilityTask
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 
 ROBOT = Robot().with_payload(3.0)
@@ -100,3 +100,36 @@ def test_previously_failing_scenarios_now_complete_on_the_thesis_plant(index):
     assert outcome.metrics["success"], outcome.metrics["reason"]
     assert outcome.metrics["min_stability"] > 1.25
     assert outcome.metrics["time_s"] < 45.0
+
+
+def test_manipulability_steering_row_fades_through_the_optimum():
+    # Across th2 = pi/2 the ascent direction flips; the row must shrink to zero, not jump.
+    task = ManipulabilityTask(weight=1.0)
+    ctx = StepContext(ROBOT, 0.01)
+    rows = []
+    for th2 in np.linspace(math.pi / 2 - 0.05, math.pi / 2 + 0.05, 101):
+        q = np.array([0.0, 0.0, 0.3, 0.4, th2])
+        ctx.update(0.0, q, ROBOT.fk(q), np.zeros(3))
+        jac, error = np.zeros((2, 4)), np.zeros(2)
+        task.compute(ctx, jac, error)
+        rows.append((jac[1, 1], error[1]))
+    rows = np.array(rows)
+    assert np.max(np.abs(rows[50])) < 1e-9  # at the optimum the row is off
+    assert np.max(np.abs(np.diff(rows, axis=0))) < 0.05
+
+
+def test_far_waypoints_are_reached_at_a_coarse_step():
+    # Scenario 2 of the docs' waypoint demo stalled 1.4 cm short at dt = 0.02 s while the
+    # steering row switched on and off every step.
+    rng = np.random.default_rng(0)
+    goals = [rng.uniform(-4.0, 4.0, size=(5, 2)) for _ in range(3)][2]
+    controller = make_controller("qp", ROBOT, track_orientation=False, max_speed=1.0, dt=0.02)
+    q = np.array([0.0, 0.0, 0.0, *ROBOT.home_pose])
+    controller.reset(None, q)
+    t = 0.0
+    for goal in goals:
+        while math.dist(ROBOT.fk(q)[:2], goal) > 0.01:
+            assert t < 60.0, f"stalled {math.dist(ROBOT.fk(q)[:2], goal):.4f} m from {goal}"
+            u = controller.command(t, q, np.array([*goal, 0.0]), np.zeros(3))
+            q = q + 0.02 * np.array([u[0] * math.cos(q[2]), u[0] * math.sin(q[2]), *u[1:]])
+            t += 0.02
