@@ -35,6 +35,8 @@ bench: $(STAMP)
 
 docs: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python docs/make_figures.py
+	MPLBACKEND=Agg $(BIN)/python docs/qp_figures.py
+	MPLBACKEND=Agg $(BIN)/python docs/make_run_figures.py
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache
