@@ -70,7 +70,8 @@ class ReferenceTrajectory:
         q0 = [float(v) for v in q_start]
         self._q = [q0]
         self._qdot = [self._rate(0.0, q0)]
-        self._coefficients: dict[int, tuple[tuple[float, ...], ...]] = {}
+        #: Cubic coefficients of each segment, appended as the reference is integrated.
+        self._coefficients: list[tuple[tuple[float, ...], ...]] = []
         self._end = -1.0  # queries up to this time need no extension
 
     def _rate(self, t: float, q: list[float]) -> list[float]:
@@ -96,20 +97,18 @@ class ReferenceTrajectory:
             ]
             self._q.append(q_next)
             self._qdot.append(self._rate(tk + h, q_next))
+            self._coefficients.append(self._segment(len(self._q) - 2))
 
     def _segment(self, i: int) -> tuple[tuple[float, ...], ...]:
-        """Cubic coefficients ``(c0, c1, c2, c3)`` per coordinate of segment i (in s = 0..1)."""
-        cached = self._coefficients.get(i)
-        if cached is None:
-            h = self.step
-            cached = tuple(
-                (a, h * da, 3.0 * (b - a) - h * (2.0 * da + db), 2.0 * (a - b) + h * (da + db))
-                for a, b, da, db in zip(
-                    self._q[i], self._q[i + 1], self._qdot[i], self._qdot[i + 1]
-                )
-            )
-            self._coefficients[i] = cached
-        return cached
+        """Cubic coefficients ``(c0, c1, c2, c3)`` per coordinate of segment i (in s = 0..1).
+
+        Computed once per segment while integrating, so a lookup is a polynomial evaluation.
+        """
+        h = self.step
+        return tuple(
+            (a, h * da, 3.0 * (b - a) - h * (2.0 * da + db), 2.0 * (a - b) + h * (da + db))
+            for a, b, da, db in zip(self._q[i], self._q[i + 1], self._qdot[i], self._qdot[i + 1])
+        )
 
     def __call__(self, t: float) -> tuple[list[float], list[float]]:
         """``(q_d, qdot_d)`` at time t >= 0 (s), as lists of 5 floats."""
@@ -120,7 +119,7 @@ class ReferenceTrajectory:
         i = min(int(t / h), len(self._q) - 2)
         s = t / h - i
         position, rate = [], []
-        for c0, c1, c2, c3 in self._segment(i):
+        for c0, c1, c2, c3 in self._coefficients[i]:
             position.append(c0 + s * (c1 + s * (c2 + s * c3)))
             rate.append((c1 + s * (2.0 * c2 + 3.0 * s * c3)) / h)
         return position, rate
