@@ -9,6 +9,7 @@ import pytest
 
 from ddwmmr import Robot, load_trajectory, simulate
 from ddwmmr.cli.track import main as run
+from expected import REQUIRED_SUMMARY_KEYS
 
 
 def test_track_writes_csv_summary_and_figures(tmp_path, capsys):
@@ -19,21 +20,7 @@ def test_track_writes_csv_summary_and_figures(tmp_path, capsys):
     assert {"timeseries.csv", "summary.json", "path.png", "errors.png", "rates.png"} <= names
     assert "metrics.png" in names
     summary = json.loads((out / "summary.json").read_text())
-    for key in (
-        "method",
-        "trajectory",
-        "rms_position_error_m",
-        "max_position_error_m",
-        "final_position_error_m",
-        "rms_orientation_error_rad",
-        "max_nonholonomic_residual_m_s",
-        "max_wheel_speed_rad_s",
-        "min_manipulability",
-        "min_stability",
-        "singular_steps",
-        "steps",
-        "median_step_us",
-    ):
+    for key in REQUIRED_SUMMARY_KEYS:
         assert key in summary
     assert summary["steps"] == 100
     # The CSV holds the same run: its last position error is the summary's final one.
