@@ -1,0 +1,253 @@
+"""Why a run scored as it did, and the measurements the studies share.
+
+:func:`diagnose` turns a run's time series into :class:`Finding` sentences (shoulder
+singularity, orientation lost at corners, joint limits, saturation, kept offset,
+convergence); :func:`convergence_time`, :func:`observed_order` and :func:`corner_times`
+serve the studies.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.model import Robot
+from ddwmmr.reports.compare.constants import CONVERGED_FRACTION, SINGULAR_COS, SINGULAR_LOSS_M
+from ddwmmr.reports.compare.document import fmt, mm
+from ddwmmr.reports.compare.plan import CompareConfig, Plan, RunOutput, RunSpec
+
+# -- the reasons a run scores as it does --------------------------------------------------
+
+
+def singularity_onset(ts: Mapping[str, np.ndarray]) -> int | None:
+    """Index of the first sample with |cos th1| < :data:`SINGULAR_COS`, or None."""
+    hits = np.nonzero(np.abs(np.cos(ts["th1"])) < SINGULAR_COS)[0]
+    return int(hits[0]) if len(hits) else None
+
+
+def saturation_span(
+    ts: Mapping[str, np.ndarray], exclude: np.ndarray | None = None
+) -> tuple[int, float, float]:
+    """Number of saturated steps (not in ``exclude``) and the first and last such time (s)."""
+    saturated = ts["saturated"] > 0
+    if exclude is not None:
+        saturated &= ~exclude
+    hits = np.nonzero(saturated)[0]
+    if not len(hits):
+        return 0, math.nan, math.nan
+    return len(hits), float(ts["t"][hits[0]]), float(ts["t"][hits[-1]])
+
+
+def orientation_jumps(ts: Mapping[str, np.ndarray]) -> int:
+    """Number of steps of the desired orientation (> 1 rad between samples: corners)."""
+    return int(np.sum(np.abs(np.diff(ts["phiE_d"])) > 1.0))
+
+
+def at_joint_limit(ts: Mapping[str, np.ndarray], robot: Robot) -> np.ndarray:
+    """Boolean per sample: th1 or th2 sits at one of the robot's joint limits."""
+    hit = np.zeros(len(ts["t"]), dtype=bool)
+    for name, (low, high) in zip(("th1", "th2"), robot.joint_limits):
+        hit |= (ts[name] <= low + 1e-6) | (ts[name] >= high - 1e-6)
+    return hit
+
+
+def _joint_limit_reason(ts: Mapping[str, np.ndarray], limited: np.ndarray) -> str:
+    first = int(np.argmax(limited))
+    joint = "th2" if abs(ts["th2"][first]) >= abs(ts["th1"][first]) else "th1"
+    text = (
+        f"{'the elbow' if joint == 'th2' else 'the shoulder'} {joint} ran into its joint limit "
+        f"({ts[joint][first]:+.2f} rad) at t = {ts['t'][first]:.1f} s and stayed there for "
+        f"{int(np.sum(limited))} steps; the plant stops a joint at its limit, so the commanded "
+        "motion is not produced"
+    )
+    if joint == "th2":
+        text += " (an elbow at +-pi folds the arm back: manipulability 0)"
+    return text
+
+
+def saturated_after_jumps(ts: Mapping[str, np.ndarray], exclude: np.ndarray) -> bool:
+    """True if every saturated step (not in ``exclude``) lies within 10 % of the run after a
+    step of the desired orientation."""
+    t = ts["t"]
+    jumps = t[1:][np.abs(np.diff(ts["phiE_d"])) > 1.0]
+    saturated = t[(ts["saturated"] > 0) & ~exclude]
+    if not len(jumps) or not len(saturated):
+        return False
+    lag = saturated[:, None] - jumps[None, :]
+    return bool(np.all(np.any((lag >= 0) & (lag <= 0.1 * t[-1]), axis=1)))
+
+
+def keeps_offset(summary: Mapping[str, Any]) -> bool:
+    """Final and largest position error within 10 % of the initial offset (open loop)."""
+    initial = float(summary["initial_offset_m"])
+    return initial > 0 and (
+        abs(summary["final_position_error_m"] - initial) <= 0.1 * initial
+        and summary["max_position_error_m"] <= 1.1 * initial
+    )
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One data-backed sentence about a run; ``adverse`` if it explains a poor score."""
+
+    text: str
+    adverse: bool = True
+
+
+def diagnose(
+    config: CompareConfig, plan: Plan, outputs: Mapping[RunSpec, RunOutput], spec: RunSpec
+) -> list[Finding]:
+    """Why the run ``spec`` scored as it did: singularity, lost corner orientation,
+    saturation, kept offset (adverse) or convergence (not adverse)."""
+    ts, summary = outputs[spec].timeseries, outputs[spec].summary
+    findings = []
+    onset = singularity_onset(ts)
+    if onset is not None:
+        before = float(np.max(ts["position_error_m"][: onset + 1]))
+        after = float(np.max(ts["position_error_m"][onset:]))
+        if after > max(2.0 * before, SINGULAR_LOSS_M):
+            findings.append(Finding(_singularity_reason(spec, ts, onset, plan, outputs)))
+        else:
+            findings.append(
+                Finding(
+                    f"it passes the singularity cos(th1) = 0 at t = {ts['t'][onset]:.1f} s "
+                    f"without losing the path (largest error after it {mm(after)} mm)",
+                    False,
+                )
+            )
+            onset = None
+    jumps = orientation_jumps(ts)
+    if jumps and summary["rms_orientation_error_rad"] > 0.5 and onset is None:
+        findings.append(Finding(_corner_reason(spec, summary, jumps)))
+    limited = at_joint_limit(ts, config.robot)
+    if np.any(limited):
+        findings.append(Finding(_joint_limit_reason(ts, limited)))
+    count, first, last = saturation_span(ts, exclude=limited)
+    if count:
+        where = (
+            f"all within {fmt(0.1 * ts['t'][-1])} s after a corner's orientation step"
+            if saturated_after_jumps(ts, limited)
+            else f"t = {first:.1f} to {last:.1f} s"
+        )
+        more = " more" if np.any(limited) else ""
+        findings.append(
+            Finding(
+                f"the command exceeded the wheel or joint speed limits in {count}{more} steps "
+                f"({where}), so the robot could not follow it"
+            )
+        )
+    if keeps_offset(summary):
+        findings.append(
+            Finding(
+                "it is open loop: it keeps the initial end-effector offset "
+                f"({mm(summary['initial_offset_m'])} mm) for the whole run"
+            )
+        )
+    settle = convergence_time(ts["t"], ts["position_error_m"])
+    if summary["initial_offset_m"] > 0 and not math.isnan(settle):
+        findings.append(
+            Finding(f"it removes the initial offset (below 5 % after {fmt(settle)} s)", False)
+        )
+    if not any(f.adverse for f in findings):
+        findings.append(Finding("no singularity, saturation or orientation loss was detected"))
+    return findings
+
+
+def _singularity_reason(
+    spec: RunSpec,
+    ts: Mapping[str, np.ndarray],
+    onset: int,
+    plan: Plan,
+    outputs: Mapping[RunSpec, RunOutput],
+) -> str:
+    t = float(ts["t"][onset])
+    d_th1 = float(ts["th1"][onset] - ts["th1"][0])
+    d_phi = float(ts["phi"][onset] - ts["phi"][0])
+    text = (
+        f"it drove the shoulder into the singularity cos(th1) = 0 at t = {t:.1f} s "
+        f"(th1 moved by {d_th1:+.2f} rad while the base heading moved by {d_phi:+.2f} rad); "
+        "near it the damped inverse cannot produce the commanded motion and the end effector "
+        f"leaves the path (largest error {mm(np.max(ts['position_error_m'][onset:]))} mm)"
+    )
+    if spec.method == "pi" and abs(d_th1 - d_phi) <= 0.25 * abs(d_phi):
+        text += (
+            ". Why: the base-yaw and shoulder columns of J are identical, so the "
+            "minimum-norm solution splits the yaw rate equally between them and th1 follows "
+            "the base heading, which must turn 2 pi per loop"
+        )
+    variant = next(
+        (v for v in plan.variants if v.method == spec.method and v.trajectory == spec.trajectory),
+        None,
+    )
+    if spec.method == "ap" and not spec.options and variant is not None:
+        run = outputs[variant]
+        if singularity_onset(run.timeseries) is None:
+            text += (
+                ". Why: the K3 phi^2 term of the potential (K3 = 0.66, the slides' value) "
+                "pushes the base heading toward 0 while the tangent heading must turn 2 pi "
+                "per loop; in the null space of J, turning the base by +k turns the shoulder "
+                "by -k, so the shoulder absorbs the heading the base is denied and th1 is "
+                "dragged to pi/2. With K3 = 0 the same run never gets near the singularity "
+                f"(RMS {mm(run.summary['rms_position_error_m'])} mm)"
+            )
+    return text
+
+
+def _corner_reason(spec: RunSpec, summary: Mapping[str, Any], jumps: int) -> str:
+    text = (
+        f"it does not follow the pi/2 steps of the desired orientation at the {jumps} "
+        "corners: the steps are not in Xd_dot, which is all it integrates, so phiE lags by "
+        f"k pi/2 after corner k (RMS orientation error "
+        f"{summary['rms_orientation_error_rad']:.2f} rad)"
+    )
+    if spec.method == "clrrmc-cs":
+        text += (
+            ". Its feedback acts on q_d - q, and the reference q_d is the augmented-Jacobian "
+            "resolution integrated from Xd_dot alone, so it tracks the reference's own "
+            "orientation loss faithfully"
+        )
+    return text
+
+
+# -- studies ------------------------------------------------------------------------------
+
+
+def convergence_time(
+    t: np.ndarray, error: np.ndarray, fraction: float = CONVERGED_FRACTION
+) -> float:
+    """First time (s) after which ``error`` stays below ``fraction`` of its initial value.
+
+    0 for a run that starts on the path; NaN if it never settles within the run.
+    """
+    if error[0] <= 0.0:
+        return 0.0
+    above = np.nonzero(error > fraction * error[0])[0]
+    last = int(above[-1])
+    return float(t[last + 1]) if last + 1 < len(t) else math.nan
+
+
+def observed_order(values: Mapping[float, float]) -> float:
+    """Median slope of log(error) vs log(dt): the integrator's observed order of accuracy.
+
+    Pairs with an error below 1e-12 m (round-off) are skipped; NaN if none is left.
+    """
+    steps = sorted(values)
+    slopes = [
+        math.log(values[b] / values[a]) / math.log(b / a)
+        for a, b in itertools.pairwise(steps)
+        if values[a] > 1e-12 and values[b] > 1e-12
+    ]
+    return float(np.median(slopes)) if slopes else math.nan
+
+
+def corner_times(trajectory: Any, duration: float) -> list[float]:
+    """Times (s) of the rectangle's corners alpha = k pi/2 (k >= 1) within the run."""
+    quarter = getattr(trajectory, "T", trajectory.duration) / 4.0
+    return [
+        k * quarter for k in range(1, int(duration / quarter + 1e-9) + 1) if k * quarter < duration
+    ]

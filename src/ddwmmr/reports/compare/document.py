@@ -1,0 +1,180 @@
+"""Text output: number formatting (:func:`fmt`, :func:`mm`), the :class:`Document`
+model rendered as Markdown and as self-contained HTML, and the plain-text table of the
+console summary (:func:`text_table`).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import math
+import re
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+# -- number formatting --------------------------------------------------------------------
+
+
+def fmt(value: Any, digits: int = 3) -> str:
+    """``value`` with ``digits`` significant digits, plain notation for 1e-3 <= |v| < 1e5."""
+    if value is None or value == "":
+        return "n/a"
+    if isinstance(value, bool | int | np.integer):
+        return str(int(value))
+    value = float(value)
+    if math.isnan(value):
+        return "n/a"
+    if math.isinf(value) or value == 0.0:
+        return str(value) if math.isinf(value) else "0"
+    magnitude = abs(value)
+    if 1e-3 <= magnitude < 1e5:
+        decimals = max(0, digits - 1 - math.floor(math.log10(magnitude)))
+        return f"{value:.{decimals}f}"
+    return f"{value:.{digits - 1}e}"
+
+
+def mm(value_m: float) -> str:
+    """A length in m written in mm (3 significant digits)."""
+    return fmt(1000.0 * float(value_m))
+
+
+# -- the document model -------------------------------------------------------------------
+
+
+class Document:
+    """A small block document rendered both as Markdown and as self-contained HTML.
+
+    Inline markup in text: ``**bold**`` and backquoted ``code`` only.
+    """
+
+    def __init__(self, title: str) -> None:
+        self.title = title
+        self.blocks: list[tuple[str, Any]] = []
+
+    def heading(self, text: str, level: int = 2) -> None:
+        """Section heading (level 2..4)."""
+        self.blocks.append(("heading", (level, text)))
+
+    def paragraph(self, text: str) -> None:
+        """A paragraph."""
+        self.blocks.append(("paragraph", text))
+
+    def bullets(self, items: Sequence[str]) -> None:
+        """A bullet list."""
+        self.blocks.append(("bullets", list(items)))
+
+    def table(self, headers: Sequence[str], rows: Sequence[Sequence[str]]) -> None:
+        """A table; the first column is left aligned, the others right aligned."""
+        self.blocks.append(("table", (list(headers), [list(r) for r in rows])))
+
+    def figure(self, filename: str, caption: str) -> None:
+        """A PNG figure (file in the report folder) with its caption."""
+        self.blocks.append(("figure", (filename, caption)))
+
+    def to_markdown(self) -> str:
+        """Markdown text; figures are linked by relative file name."""
+        parts = [f"# {self.title}"]
+        for kind, data in self.blocks:
+            parts.append(_MARKDOWN[kind](data))
+        return "\n\n".join(parts) + "\n"
+
+    def to_html(self, folder: Path) -> str:
+        """A self-contained HTML page: figures from ``folder`` embedded as data URIs."""
+        body = [f"<h1>{_inline(self.title)}</h1>"]
+        for kind, data in self.blocks:
+            body.append(_html_figure(data, folder) if kind == "figure" else _HTML[kind](data))
+        return _HTML_PAGE.format(title=html.escape(self.title), body="\n".join(body))
+
+
+def _md_table(data: tuple[list[str], list[list[str]]]) -> str:
+    headers, rows = data
+    lines = [
+        "| " + " | ".join(headers) + " |",
+        "|" + "|".join([":---"] + ["---:"] * (len(headers) - 1)) + "|",
+    ]
+    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    return "\n".join(lines)
+
+
+_MARKDOWN: dict[str, Callable[[Any], str]] = {
+    "heading": lambda d: "#" * d[0] + " " + d[1],
+    "paragraph": lambda d: d,
+    "bullets": lambda d: "\n".join(f"- {item}" for item in d),
+    "table": _md_table,
+    "figure": lambda d: f"![{d[1]}]({d[0]})\n\n*{d[1]}*",
+}
+
+
+def _inline(text: str) -> str:
+    """HTML for the inline markup of :class:`Document` text."""
+    text = html.escape(text, quote=False)
+    text = re.sub(r"\*\*(.+?)\*\*", r"<strong>\1</strong>", text)
+    return re.sub(r"`(.+?)`", r"<code>\1</code>", text)
+
+
+def _html_table(data: tuple[list[str], list[list[str]]]) -> str:
+    headers, rows = data
+    head = "".join(f"<th>{_inline(h)}</th>" for h in headers)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{_inline(c)}</td>" for c in row) + "</tr>" for row in rows
+    )
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _html_figure(data: tuple[str, str], folder: Path) -> str:
+    filename, caption = data
+    encoded = base64.b64encode((folder / filename).read_bytes()).decode("ascii")
+    return (
+        f'<figure><img alt="{html.escape(caption)}" src="data:image/png;base64,{encoded}">'
+        f"<figcaption>{_inline(caption)}</figcaption></figure>"
+    )
+
+
+_HTML: dict[str, Callable[[Any], str]] = {
+    "heading": lambda d: f"<h{d[0]}>{_inline(d[1])}</h{d[0]}>",
+    "paragraph": lambda d: f"<p>{_inline(d)}</p>",
+    "bullets": lambda d: "<ul>" + "".join(f"<li>{_inline(i)}</li>" for i in d) + "</ul>",
+    "table": _html_table,
+}
+
+_HTML_PAGE = """<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<title>{title}</title>
+<style>
+body {{ font-family: sans-serif; max-width: 1100px; margin: 2em auto; padding: 0 1em;
+       line-height: 1.45; color: #222; }}
+table {{ border-collapse: collapse; margin: 1em 0; font-size: 0.9em; }}
+th, td {{ border: 1px solid #ccc; padding: 0.25em 0.55em; text-align: right; }}
+th:first-child, td:first-child {{ text-align: left; }}
+thead {{ background: #f0f0f0; }}
+figure {{ margin: 1.5em 0; }}
+img {{ max-width: 100%; }}
+figcaption {{ font-style: italic; color: #555; }}
+code {{ background: #f4f4f4; padding: 0 0.2em; }}
+</style>
+</head>
+<body>
+{body}
+</body>
+</html>
+"""
+
+
+# -- console summary ----------------------------------------------------------------------
+
+
+def text_table(headers: Sequence[str], rows: Sequence[Sequence[str]], left: int = 2) -> str:
+    """An aligned plain-text table: the first ``left`` columns left aligned, others right."""
+    widths = [max(len(str(x)) for x in column) for column in zip(headers, *rows)]
+
+    def line(cells: Sequence[str]) -> str:
+        parts = [str(x).ljust(w) for x, w in zip(cells[:left], widths[:left])]
+        parts += [str(x).rjust(w) for x, w in zip(cells[left:], widths[left:])]
+        return "  ".join(parts).rstrip()
+
+    return "\n".join([line(headers), *(line(r) for r in rows)])

@@ -1,0 +1,277 @@
+"""What to run, and running it: :class:`CompareConfig`, :class:`RunSpec` and
+:class:`RunOutput`, the :class:`Plan` of runs per report section (main comparison,
+explanatory variants, studies) and :func:`execute` (serial or in worker processes).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.controllers.base import make_controller
+from ddwmmr.errors import ParameterError
+from ddwmmr.model import Robot
+from ddwmmr.progress import ProgressBar
+from ddwmmr.reports.compare.constants import (
+    CORNER_TRAJECTORY,
+    DEFAULT_TRAJECTORIES,
+    OFFSET_SCALES,
+    STEP_SIZES,
+    STUDIES,
+    STUDY_TRAJECTORY,
+    TAUS,
+    VARIANTS,
+)
+from ddwmmr.resolution.reference import (
+    DEFAULT_INITIAL_OFFSET,
+    offset_configuration,
+    start_configuration,
+)
+from ddwmmr.sim.simulate import simulate
+
+# -- configuration and plan ---------------------------------------------------------------
+
+
+@dataclass
+class CompareConfig:
+    """What to compare.
+
+    Attributes:
+        methods: registered method names.
+        trajectories: name -> trajectory object, in report order.
+        robot: the robot every run uses.
+        duration: simulated time per run (s); None = one period of each trajectory.
+        studies: studies to run (subset of :data:`STUDIES`).
+        study_methods: methods the studies run (default: ``methods``); sweeping fewer
+            saves time when a method is slow.
+        command: the command line, quoted in the report so it can be reproduced.
+    """
+
+    methods: tuple[str, ...]
+    trajectories: dict[str, Any]
+    robot: Robot = field(default_factory=Robot)
+    duration: float | None = None
+    studies: tuple[str, ...] = STUDIES
+    study_methods: tuple[str, ...] | None = None
+    command: str = ""
+
+    def __post_init__(self) -> None:
+        if self.study_methods is None:
+            self.study_methods = tuple(self.methods)
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """One simulation: method (+ options) on a trajectory with a step, integrator, offset."""
+
+    method: str
+    trajectory: str
+    dt: float
+    integrator: str = "rk4"
+    initial_offset: tuple[float, float] = DEFAULT_INITIAL_OFFSET
+    options: tuple[tuple[str, Any], ...] = ()
+
+    def label(self) -> str:
+        """Short text such as ``ap (K3=0)``."""
+        extra = ", ".join(
+            f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in self.options
+        )
+        return f"{self.method} ({extra})" if extra else self.method
+
+
+@dataclass
+class RunOutput:
+    """What a run returns to the report: its summary and its time series."""
+
+    summary: dict[str, Any]
+    timeseries: dict[str, np.ndarray]
+
+
+@dataclass
+class Plan:
+    """Runs per report section (a run needed by two sections is listed in both)."""
+
+    main: list[RunSpec]
+    variants: list[RunSpec] = field(default_factory=list)
+    studies: dict[str, list[RunSpec]] = field(default_factory=dict)
+
+    def all_specs(self) -> list[RunSpec]:
+        """Every distinct run, in a fixed order (so results never depend on scheduling)."""
+        seen: dict[RunSpec, None] = {}
+        for spec in [*self.main, *self.variants, *(s for v in self.studies.values() for s in v)]:
+            seen.setdefault(spec, None)
+        return list(seen)
+
+
+def default_step(trajectory: Any) -> float:
+    """The simulation's default step (s): ``duration / samples`` of the trajectory."""
+    return trajectory.duration / getattr(trajectory, "samples", 1000)
+
+
+def run_duration(config: CompareConfig, name: str) -> float:
+    """Simulated time (s) of runs on trajectory ``name``."""
+    return config.duration if config.duration is not None else config.trajectories[name].duration
+
+
+def main_spec(config: CompareConfig, method: str, name: str, **changes: Any) -> RunSpec:
+    """The comparison's standard run of ``method`` on ``name`` with ``changes`` applied."""
+    spec = {"dt": default_step(config.trajectories[name]), **changes}
+    return RunSpec(method, name, **spec)
+
+
+def accepts_option(method: str, option: str, value: Any) -> bool:
+    """Whether the registered ``method`` takes controller option ``option``."""
+    try:
+        make_controller(method, Robot(), **{option: value})
+    except ParameterError:
+        return False
+    return True
+
+
+def plan_runs(config: CompareConfig) -> Plan:
+    """The runs the report needs: main comparison, explanatory variants, studies."""
+    names = list(config.trajectories)
+    plan = Plan(main=[main_spec(config, m, n) for n in names for m in config.methods])
+    plan.variants = [
+        main_spec(config, method, n, options=options)
+        for method, options in VARIANTS
+        if method in config.methods
+        for n in names
+        if n in DEFAULT_TRAJECTORIES
+    ]
+    builders: dict[str, Callable[[CompareConfig], list[RunSpec]]] = {
+        "tau": _plan_tau,
+        "dt": _plan_dt,
+        "integrator": _plan_integrator,
+        "init": _plan_init,
+        "corners": lambda c: [],  # uses the main rectangle runs
+    }
+    for study in config.studies:
+        if _study_possible(config, study):
+            plan.studies[study] = builders[study](config)
+    return plan
+
+
+def _study_possible(config: CompareConfig, study: str) -> bool:
+    needed = CORNER_TRAJECTORY if study == "corners" else STUDY_TRAJECTORY
+    return needed in config.trajectories
+
+
+def tau_methods(config: CompareConfig) -> list[str]:
+    """Selected methods with a closed-loop time constant option ``tau``."""
+    return [m for m in config.study_methods if accepts_option(m, "tau", 1.0)]
+
+
+def _plan_tau(config: CompareConfig) -> list[RunSpec]:
+    names = [n for n in (STUDY_TRAJECTORY, CORNER_TRAJECTORY) if n in config.trajectories]
+    return [
+        main_spec(config, m, n, options=(("tau", tau),))
+        for m in tau_methods(config)
+        for n in names
+        for tau in TAUS
+    ]
+
+
+def study_steps(config: CompareConfig) -> list[float]:
+    """Steps of the dt sweep that fit at least ten times in the run."""
+    duration = run_duration(config, STUDY_TRAJECTORY)
+    return [dt for dt in STEP_SIZES if dt <= duration / 10]
+
+
+def _plan_dt(config: CompareConfig) -> list[RunSpec]:
+    # No initial offset: every error left is numerical drift.
+    return [
+        main_spec(config, m, STUDY_TRAJECTORY, dt=dt, integrator=i, initial_offset=(0.0, 0.0))
+        for m in config.study_methods
+        for i in ("euler", "rk4")
+        for dt in study_steps(config)
+    ]
+
+
+def _plan_integrator(config: CompareConfig) -> list[RunSpec]:
+    return [
+        main_spec(config, m, STUDY_TRAJECTORY, integrator=i, initial_offset=(0.0, 0.0))
+        for m in config.study_methods
+        for i in ("euler", "rk4")
+    ]
+
+
+def study_offsets(config: CompareConfig) -> list[tuple[float, float]]:
+    """Initial offsets (dx, dy) in m of the offset sweep that the robot's arm can reach
+    from the start configuration (a small arm cannot take the largest ones)."""
+    dx, dy = DEFAULT_INITIAL_OFFSET
+    start = start_configuration(config.robot, config.trajectories[STUDY_TRAJECTORY])
+    offsets = []
+    for scale in OFFSET_SCALES:
+        try:
+            offset_configuration(config.robot, start, (scale * dx, scale * dy))
+        except ParameterError:
+            continue
+        offsets.append((scale * dx, scale * dy))
+    return offsets
+
+
+def _plan_init(config: CompareConfig) -> list[RunSpec]:
+    return [
+        main_spec(config, m, STUDY_TRAJECTORY, initial_offset=offset)
+        for m in config.study_methods
+        for offset in study_offsets(config)
+    ]
+
+
+# -- execution ----------------------------------------------------------------------------
+
+
+def run_one(task: tuple[Robot, Any, float | None, RunSpec]) -> RunOutput:
+    """Simulate one :class:`RunSpec` (module level, so worker processes can run it)."""
+    robot, trajectory, duration, spec = task
+    result = simulate(
+        robot,
+        trajectory,
+        spec.method,
+        dt=spec.dt,
+        duration=duration,
+        integrator=spec.integrator,
+        initial_offset=spec.initial_offset,
+        **dict(spec.options),
+    )
+    return RunOutput(dict(result.summary), dict(result.timeseries))
+
+
+def execute(
+    config: CompareConfig, specs: Sequence[RunSpec], jobs: int = 1, progress: bool = False
+) -> dict[RunSpec, RunOutput]:
+    """Run every spec, in ``jobs`` worker processes when ``jobs > 1``.
+
+    Each run is deterministic and independent, so the outputs do not depend on ``jobs``
+    (only the wall-clock timings such as ``median_step_us`` vary).
+    """
+    # Longest runs first keeps every worker busy to the end; the order never changes results.
+    queue = sorted(specs, key=lambda s: -estimated_cost(config, s))
+    tasks = [(config.robot, config.trajectories[s.trajectory], config.duration, s) for s in queue]
+    outputs: dict[RunSpec, RunOutput] = {}
+    with ProgressBar(len(tasks), "compare: runs", enabled=progress) as bar:
+        if jobs <= 1:
+            for spec, task in zip(queue, tasks):
+                outputs[spec] = run_one(task)
+                bar.advance()
+        else:
+            with ProcessPoolExecutor(max_workers=jobs) as pool:
+                futures = {pool.submit(run_one, task): spec for spec, task in zip(queue, tasks)}
+                try:
+                    for future in as_completed(futures):
+                        outputs[futures[future]] = future.result()
+                        bar.advance()
+                except BaseException:
+                    pool.shutdown(cancel_futures=True)
+                    raise
+    return {spec: outputs[spec] for spec in specs}
+
+
+def estimated_cost(config: CompareConfig, spec: RunSpec) -> float:
+    """Rough relative cost of a run: its number of controller calls (RK4 calls 4 a step)."""
+    return run_duration(config, spec.trajectory) / spec.dt * (4 if spec.integrator == "rk4" else 1)

@@ -1,0 +1,169 @@
+"""Metrics and ranking: ``metrics.csv`` rows, the score, ties, the :class:`Ranking`, and
+the check of the slides' ranking (:func:`check_slides`).
+
+**Ranking score**: the RMS end-effector position error over the whole run (m), per
+trajectory; lower is better. Every method starts from the same configuration with the
+same initial offset, so the score rewards removing the offset quickly and penalises
+drift. Scores within 5 % (or 0.1 mm) of a better one count as a tie, which is what the
+slides' ``>=`` allows. The overall score is the geometric mean over trajectories (errors
+span orders of magnitude, so the mean of their logarithms is the fair summary).
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from ddwmmr.reports.compare.constants import SLIDES_ORDER, TIE_ABSOLUTE_M, TIE_RELATIVE
+from ddwmmr.reports.compare.diagnosis import diagnose
+from ddwmmr.reports.compare.plan import CompareConfig, Plan, RunOutput, RunSpec
+from ddwmmr.sim.result import json_safe
+
+# -- metrics and ranking ------------------------------------------------------------------
+
+
+def metrics_rows(plan: Plan, outputs: Mapping[RunSpec, RunOutput]) -> list[dict[str, Any]]:
+    """One row per main run: ``method``, ``trajectory`` and every summary field."""
+    rows = []
+    for spec in plan.main:
+        summary = outputs[spec].summary
+        rows.append({"method": spec.method, "trajectory": spec.trajectory, **summary})
+    return rows
+
+
+def metrics_csv(rows: Sequence[Mapping[str, Any]]) -> str:
+    """CSV text of ``rows``: union of their keys, floats written exactly (repr)."""
+    columns: dict[str, None] = {}
+    for row in rows:
+        columns.update(dict.fromkeys(row))
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(columns)
+    for row in rows:
+        writer.writerow([_csv_value(row.get(c, "")) for c in columns])
+    return buffer.getvalue()
+
+
+def _csv_value(value: Any) -> str:
+    """Exact text of a summary value: floats by repr (round-trips), None as empty."""
+    value = json_safe(value)
+    if value is None:
+        return ""
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def score(summary: Mapping[str, Any]) -> float:
+    """Ranking score (m): RMS end-effector position error over the run; NaN counts as inf."""
+    value = float(summary["rms_position_error_m"])
+    return math.inf if math.isnan(value) else value
+
+
+def at_least_as_good(a: float, b: float) -> bool:
+    """Score ``a`` is better than or tied with ``b`` (see :data:`TIE_RELATIVE`)."""
+    return a <= b * (1.0 + TIE_RELATIVE) + TIE_ABSOLUTE_M
+
+
+def rank_with_ties(scores: Mapping[str, float]) -> dict[str, int]:
+    """Competition ranks (1 = best); a score tied with its group's best shares its rank."""
+    ranks: dict[str, int] = {}
+    leader = math.nan
+    rank = 0
+    for position, (method, value) in enumerate(sorted(scores.items(), key=lambda x: (x[1], x[0]))):
+        if position == 0 or not at_least_as_good(value, leader):
+            leader, rank = value, position + 1
+        ranks[method] = rank
+    return ranks
+
+
+def geometric_mean(values: Iterable[float]) -> float:
+    """Geometric mean of positive values (zeros are floored at 1e-15 m)."""
+    logs = [math.log(max(v, 1e-15)) for v in values]
+    return math.exp(sum(logs) / len(logs)) if logs else math.nan
+
+
+@dataclass
+class Ranking:
+    """Scores (m) and ranks per trajectory and overall (see the module docstring)."""
+
+    scores: dict[str, dict[str, float]]
+    ranks: dict[str, dict[str, int]]
+    overall: dict[str, float]
+    overall_rank: dict[str, int]
+
+    @property
+    def order(self) -> list[str]:
+        """Methods, best first."""
+        return sorted(self.overall, key=lambda m: (self.overall_rank[m], self.overall[m], m))
+
+
+def build_ranking(plan: Plan, outputs: Mapping[RunSpec, RunOutput]) -> Ranking:
+    """Rank the main runs by :func:`score`, per trajectory and by geometric mean."""
+    scores: dict[str, dict[str, float]] = {}
+    for spec in plan.main:
+        scores.setdefault(spec.trajectory, {})[spec.method] = score(outputs[spec].summary)
+    methods = list(next(iter(scores.values())))
+    overall = {m: geometric_mean(scores[n][m] for n in scores) for m in methods}
+    return Ranking(
+        scores=scores,
+        ranks={n: rank_with_ties(s) for n, s in scores.items()},
+        overall=overall,
+        overall_rank=rank_with_ties(overall),
+    )
+
+
+# -- the slides' ranking (the reasons it fails come from diagnosis.diagnose) --------------
+
+
+@dataclass
+class Violation:
+    """On ``trajectory``, ``expected_better`` scored worse than ``expected_worse``."""
+
+    trajectory: str
+    expected_better: str
+    expected_worse: str
+    better_score: float
+    worse_score: float
+
+
+@dataclass
+class SlidesCheck:
+    """Whether CLRRMC-TS >= CLRRMC-CS >= RR-AP >= RR-ATS >= RR-PI holds, per trajectory."""
+
+    chain: list[str]
+    holds: dict[str, bool]
+    violations: list[Violation]
+    reasons: dict[tuple[str, str], list[str]]  # (trajectory, method) -> explanations
+
+    @property
+    def holds_everywhere(self) -> bool:
+        """True when the chain holds on every trajectory."""
+        return all(self.holds.values())
+
+
+def check_slides(
+    config: CompareConfig, plan: Plan, outputs: Mapping[RunSpec, RunOutput], ranking: Ranking
+) -> SlidesCheck:
+    """Test every pair the slides' chain implies (a before b: a at least as good as b)."""
+    chain = [m for m in SLIDES_ORDER if m in config.methods]
+    holds: dict[str, bool] = {}
+    violations: list[Violation] = []
+    reasons: dict[tuple[str, str], list[str]] = {}
+    by_key = {(s.method, s.trajectory): s for s in plan.main}
+    for name, scores in ranking.scores.items():
+        found = [
+            Violation(name, a, b, scores[a], scores[b])
+            for i, a in enumerate(chain)
+            for b in chain[i + 1 :]
+            if not at_least_as_good(scores[a], scores[b])
+        ]
+        holds[name] = not found
+        violations += found
+        for method in dict.fromkeys(v.expected_better for v in found):
+            spec = by_key[(method, name)]
+            findings = diagnose(config, plan, outputs, spec)
+            reasons[(name, method)] = [f.text for f in findings if f.adverse]
+    return SlidesCheck(chain, holds, violations, reasons)
