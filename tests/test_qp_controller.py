@@ -233,3 +233,8 @@ def test_one_step_keeps_exact_stability_above_the_floor(th1, side, elbow, excess
     assert np.all(np.isfinite(u)) and not controller.last.fallback
     q_next = q + dt * KinematicPlant.derivative(q, u)  # zero-order hold: joints exact
     assert exact_stability(com, q_next[3], q_next[4]) >= floor - 1e-9
+
+
+def test_unknown_or_missing_solver_is_a_parameter_error():
+    with pytest.raises(ParameterError, match="solver must be one of the installed QP solvers"):
+        make_controller("qp", ROBOT, solver="nope")

@@ -149,11 +149,25 @@ def to_standard_form(problem: QPProblem):
     return problem.H, problem.f, G, h, A, b
 
 
+def installed_solvers() -> list[str]:
+    """Solver names :func:`make_backend` accepts on this machine (qpsolvers' installed
+    backends, plus ``qpsolvers-daqp`` when DAQP is one of them)."""
+    names = sorted(qpsolvers.available_solvers)
+    return [*names, "qpsolvers-daqp"] if "daqp" in names else names
+
+
 def make_backend(solver: str, warm_start: bool | None = None):
     """The backend for ``solver``: DAQP direct for ``"daqp"``, qpsolvers for the rest.
 
-    ``"qpsolvers-daqp"`` forces DAQP through qpsolvers (for comparisons).
+    ``"qpsolvers-daqp"`` forces DAQP through qpsolvers (for comparisons). A solver that is
+    not installed raises :class:`ParameterError` naming the installed ones.
     """
+    installed = installed_solvers()
+    if solver not in installed:
+        raise ParameterError(
+            f"solver must be one of the installed QP solvers: {', '.join(installed)} "
+            f"(got {solver!r})"
+        )
     if solver == "daqp":
         return DaqpBackend(warm_start=bool(warm_start))
     if solver == "qpsolvers-daqp":
