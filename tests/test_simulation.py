@@ -174,3 +174,11 @@ def test_custom_trajectory_object_is_accepted():
 def test_simulate_rejects_bad_input(kwargs, message):
     with pytest.raises(ParameterError, match=message):
         simulate(Robot(), Ellipse(), "ats", **kwargs)
+
+
+def test_plant_holds_a_given_command_without_a_policy_only_for_euler(robot):
+    u = np.array([0.2, 0.1, 0.0, 0.0])
+    q_next, _, _ = KinematicPlant(robot, "euler").step(0.0, np.zeros(5), 0.1, None, u)
+    np.testing.assert_allclose(q_next, [0.02, 0.0, 0.01, 0.0, 0.0])
+    with pytest.raises(ValueError, match="a policy is needed"):
+        KinematicPlant(robot, "rk4").step(0.0, np.zeros(5), 0.1, None, u)

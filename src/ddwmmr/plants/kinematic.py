@@ -73,7 +73,7 @@ class KinematicPlant:
         t: float,
         q: np.ndarray,
         dt: float,
-        policy: Policy,
+        policy: Policy | None,
         first_command: np.ndarray | None = None,
     ) -> tuple[np.ndarray, np.ndarray, bool]:
         """Advance q by dt under ``policy``.
@@ -82,8 +82,11 @@ class KinematicPlant:
         input applied at the start of the step. ``euler`` calls the policy once per step;
         ``rk4`` evaluates the closed-loop vector field at its four stages (the control law
         treated as continuous in time, as in an ODE solver). ``first_command``, if given, is
-        used instead of calling the policy at (t, q).
+        used instead of calling the policy at (t, q); with ``euler`` the policy may then be
+        None (a zero-order hold of ``first_command``).
         """
+        if policy is None and (first_command is None or self.integrator != "euler"):
+            raise ValueError("a policy is needed unless euler steps a given first_command")
         command = policy(t, q) if first_command is None else first_command
         u0, saturated0 = self.saturate(q, command)
         k1 = self.derivative(q, u0)

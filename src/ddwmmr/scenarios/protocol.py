@@ -273,11 +273,6 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
     return _run_qp(robot, scenario, config)
 
 
-def _unused_policy(t: float, q: np.ndarray) -> np.ndarray:  # pragma: no cover
-    # Euler with first_command never calls the policy; the plant API requires one.
-    raise AssertionError("the Euler kinematic plant called its policy")
-
-
 def _run_thesis(robot: Robot, scenario: Scenario, config: RunConfig) -> Outcome:
     dt = config.dt
     plant = ThesisPlant(robot)
@@ -398,7 +393,7 @@ def _run_qp(robot: Robot, scenario: Scenario, config: RunConfig) -> Outcome:
             break
         if kinematic is not None:
             u, _ = kinematic.saturate(q, u)
-            q = kinematic.step(t, q, dt, _unused_policy, first_command=u)[0]
+            q = kinematic.step(t, q, dt, None, first_command=u)[0]
             base_moving = abs(u[0]) > MOVING_SPEED or abs(u[1]) > MOVING_RATE
         else:
             assert state is not None and loop is not None and plant is not None
