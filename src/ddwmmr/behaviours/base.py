@@ -128,11 +128,6 @@ class Behaviour(Protocol):
         ...
 
 
-def wrap(angle: float) -> float:
-    """Angle wrapped to [-pi, pi) (rad)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
-
-
 def elbow_of(th2: float) -> int:
     """Elbow branch (+1 / -1) of the current pose; kept so IK solutions do not flip."""
     return 1 if th2 >= 0.0 else -1

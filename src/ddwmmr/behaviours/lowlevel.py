@@ -32,8 +32,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ddwmmr.behaviours.base import BRAKE, DRIVE, TURN, Percept, Proposal, wrap
+from ddwmmr.behaviours.base import BRAKE, DRIVE, TURN, Percept, Proposal
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import wrap_angle
 
 _DEG = 180.0 / math.pi
 
@@ -78,7 +79,7 @@ class BaseMover:
         else:
             alpha = math.atan2(ly, lx)
             if lx < 0.0:  # target behind: point the rear at it and reverse
-                alpha = wrap(alpha + math.pi)
+                alpha = wrap_angle(alpha + math.pi)
         f_t = g.translation_p * lx - self._dt_gain * p.v
         f_r = g.rotation_p * alpha * _DEG - self._dr_gain * p.w * _DEG
         return f_t, f_r
@@ -86,7 +87,7 @@ class BaseMover:
     def turn_forces(self, p: Percept, heading: float) -> tuple[float, float]:
         """Forces (N) turning in place to world heading (rad), braking any translation."""
         g = self.gains
-        alpha = wrap(heading - p.phi)
+        alpha = wrap_angle(heading - p.phi)
         return -g.brake_p * p.v, g.rotation_p * alpha * _DEG - self._dr_gain * p.w * _DEG
 
     def brake_forces(self, p: Percept) -> tuple[float, float]:

@@ -16,8 +16,9 @@ from __future__ import annotations
 import math
 from collections.abc import Iterable
 
-from ddwmmr.behaviours.base import DRIVE, Percept, Proposal, wrap
+from ddwmmr.behaviours.base import DRIVE, Percept, Proposal
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import wrap_angle
 
 
 def base_bubble(robot: Robot) -> float:
@@ -58,7 +59,7 @@ class ObstacleAvoidance:
             if distance >= reach or (best is not None and distance >= best[3]):
                 continue
             bearing = math.atan2(oy - p.y, ox - p.x)
-            if abs(wrap(bearing - target_bearing)) < self.in_way_angle:
+            if abs(wrap_angle(bearing - target_bearing)) < self.in_way_angle:
                 best = (ox, oy, radius, distance)
         return best
 

@@ -14,8 +14,9 @@ from __future__ import annotations
 
 import math
 
-from ddwmmr.behaviours.base import DRIVE, TURN, Percept, Proposal, reach_toward, wrap
+from ddwmmr.behaviours.base import DRIVE, TURN, Percept, Proposal, reach_toward
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import wrap_angle
 
 
 class Stability:
@@ -32,9 +33,9 @@ class Stability:
         arm = reach_toward(self.robot, p, *p.hold)
         if p.s_lat <= p.s_lon:
             facing = math.atan2(p.hold[1] - p.y, p.hold[0] - p.x)
-            if abs(wrap(facing - p.phi)) > 0.5 * math.pi:
+            if abs(wrap_angle(facing - p.phi)) > 0.5 * math.pi:
                 facing += math.pi  # reversing is as good as driving forward (thesis 4.2.3)
-            return Proposal(TURN, arm, heading=p.phi + wrap(facing - p.phi))
+            return Proposal(TURN, arm, heading=p.phi + wrap_angle(facing - p.phi))
         sign = 1.0 if p.x_com >= 0.0 else -1.0
         bx = p.x + sign * self.adjust * math.cos(p.phi)
         by = p.y + sign * self.adjust * math.sin(p.phi)

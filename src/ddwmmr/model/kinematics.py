@@ -21,6 +21,11 @@ Q_NAMES = ("x", "y", "phi", "th1", "th2")
 U_NAMES = ("v", "w", "th1dot", "th2dot")
 
 
+def wrap_angle(angle: float) -> float:
+    """Angle wrapped to [-pi, pi) (rad)."""
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
 def forward_kinematics(L1: float, L2: float, q) -> tuple[float, float, float]:
     """End-effector pose ``(xE, yE, phiE)`` in the world frame (m, m, rad)."""
     x, y, phi, th1, th2 = (float(v) for v in q)

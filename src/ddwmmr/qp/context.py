@@ -18,11 +18,6 @@ from ddwmmr.model import Robot
 NU = 4
 
 
-def wrap(angle: float) -> float:
-    """Angle wrapped to [-pi, pi) (rad)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
-
-
 class StepContext:
     """Measured state, desired motion and the end-effector Jacobian of one control step.
 

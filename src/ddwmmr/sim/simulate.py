@@ -12,6 +12,7 @@ import numpy as np
 from ddwmmr.controllers.base import Controller, make_controller
 from ddwmmr.errors import ParameterError, check_finite, check_positive
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import wrap_angle
 from ddwmmr.plants.kinematic import KinematicPlant
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
@@ -53,11 +54,6 @@ COLUMNS = (
     "fallback",
     "step_us",
 )
-
-
-def wrap_angle(angle: float) -> float:
-    """Angle wrapped to [-pi, pi) (rad)."""
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def simulate(

@@ -7,12 +7,13 @@ import math
 import numpy as np
 
 from ddwmmr.errors import check_nonnegative, check_positive
-from ddwmmr.qp.context import StepContext, wrap
+from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import Task
 
 
 class HeadingTask(Task):
-    """``w = gain * wrap(bearing - phi)`` while the target is farther than ``distance`` (m).
+    """``w = gain * wrap_angle(bearing - phi)`` while the target is farther than ``distance`` (m).
 
     ``bearing`` is the direction from the base to the desired end-effector position. Near
     the target the row fades out (scaled by ``(d - distance) / fade``, clipped to [0, 1]),
@@ -48,4 +49,4 @@ class HeadingTask(Task):
             ax, ay = self.detour.aim(ctx.x, ctx.y, ctx.pose_d[0], ctx.pose_d[1])
             dx, dy = ax - ctx.x, ay - ctx.y
         jac[0, 1] = factor
-        error[0] = factor * self.gain * wrap(math.atan2(dy, dx) - ctx.phi)
+        error[0] = factor * self.gain * wrap_angle(math.atan2(dy, dx) - ctx.phi)

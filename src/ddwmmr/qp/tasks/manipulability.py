@@ -10,7 +10,7 @@ through where the base drives: ``th2`` is set by the shoulder-to-end-effector di
   (acts when tracking leaves th2 free, e.g. position-only tracking). ``eta^2 = sin^2 th2``
   is used rather than eta: same maximisers, but a smooth gradient ``sin(2 th2)`` where
   eta's kink at th2 = 0 would make the row flip sign every step (chattering);
-* **steering row** ``w = heading_gain * wrap(psi* - phi)``: point the base along
+* **steering row** ``w = heading_gain * wrap_angle(psi* - phi)``: point the base along
   ``v_B* = Xd_dot + base_gain * grad_pB(eta^2) / 2``, the desired end-effector velocity
   plus the ascent direction of ``eta^2 = 1 - cos^2 th2`` with respect to the base
   position, ``grad_pB(eta^2) = 2 cos(th2) rho / (L1 L2) n`` (``n``: unit vector from the
@@ -25,7 +25,8 @@ import math
 import numpy as np
 
 from ddwmmr.errors import check_positive
-from ddwmmr.qp.context import StepContext, wrap
+from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import Task
 
 #: Desired base speed (m/s) at which the steering row reaches full weight; below it the row
@@ -99,4 +100,4 @@ class ManipulabilityTask(Task):
             error[1] = 0.0
             return
         jac[1, 1] = factor
-        error[1] = factor * self.heading_gain * wrap(math.atan2(vy, vx) - ctx.phi)
+        error[1] = factor * self.heading_gain * wrap_angle(math.atan2(vy, vx) - ctx.phi)

@@ -9,7 +9,8 @@ import numpy as np
 
 from ddwmmr.errors import check_positive
 from ddwmmr.gains import gains_from_tau
-from ddwmmr.qp.context import StepContext, wrap
+from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import Task
 
 
@@ -68,7 +69,7 @@ class EndEffectorTask(Task):
         error[0], error[1] = vx + fx, vy + fy
         if self.track_orientation:
             # Wrapped: a pose 2 pi away is the same orientation.
-            error[2] = vphi + self.kphi * wrap(phid - phie)
+            error[2] = vphi + self.kphi * wrap_angle(phid - phie)
         else:
             jac[2] = 0.0
             error[2] = 0.0
