@@ -22,20 +22,25 @@ EXPECTED = {
 }
 
 
+def _run_python(arguments: list[str], cwd: Path) -> subprocess.CompletedProcess:
+    """Run Python with ``arguments`` in ``cwd`` (headless matplotlib), capturing output."""
+    return subprocess.run(
+        [sys.executable, *arguments],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+    )
+
+
 def test_examples_exist() -> None:
     assert {p.name for p in SCRIPTS} >= set(EXPECTED)
 
 
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.name)
 def test_example_runs(script: Path, tmp_path: Path) -> None:
-    done = subprocess.run(
-        [sys.executable, str(script)],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env={**os.environ, "MPLBACKEND": "Agg"},
-    )
+    done = _run_python([str(script)], tmp_path)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip()
     for text in EXPECTED.get(script.name, ()):
@@ -59,7 +64,9 @@ def test_custom_trajectory_velocity_is_the_pose_derivative() -> None:
 
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
-DOC_PAGES = ("api.md", "tutorial_custom_trajectory.md", "theory.md")
+DOC_PAGES = ("api.md", "tutorial_custom_trajectory.md", "theory.md", "thesis.md")
+#: Per page: (text its snippets must contain, text they must print).
+DOC_EXPECTED = {"thesis.md": (("run_many",), ("ok", "move_arm"))}
 
 
 def _python_blocks(page: Path) -> str:
@@ -80,12 +87,10 @@ def _python_blocks(page: Path) -> str:
 def test_doc_snippets_run(page: str, tmp_path: Path) -> None:
     code = _python_blocks(DOCS / page)
     assert code.strip()
-    done = subprocess.run(
-        [sys.executable, "-c", code],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env={**os.environ, "MPLBACKEND": "Agg"},
-    )
+    in_code, in_output = DOC_EXPECTED.get(page, ((), ()))
+    for text in in_code:
+        assert text in code
+    done = _run_python(["-c", code], tmp_path)
     assert done.returncode == 0, done.stderr
+    for text in in_output:
+        assert text in done.stdout

@@ -6,7 +6,6 @@ import csv
 import json
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
@@ -114,22 +113,3 @@ def test_threshold_study_table_has_thesis_and_our_numbers(tmp_path, capsys):
     assert "42 / " in table  # Table 5.12 threshold 5
     summary = json.loads((out / "summary.json").read_text())
     assert len(summary["variants"]) == 18
-
-
-def test_docs_thesis_python_snippets_run(tmp_path):
-    page = Path(__file__).resolve().parents[1] / "docs" / "thesis.md"
-    blocks, inside = [], False
-    for line in page.read_text().splitlines():
-        if line.strip() == "```python":
-            inside = True
-        elif line.strip() == "```" and inside:
-            inside = False
-        elif inside:
-            blocks.append(line)
-    code = "\n".join(blocks)
-    assert "run_many" in code
-    done = subprocess.run(
-        [sys.executable, "-c", code], cwd=tmp_path, capture_output=True, text=True, check=False
-    )
-    assert done.returncode == 0, done.stderr
-    assert "ok" in done.stdout and "move_arm" in done.stdout
