@@ -1,0 +1,42 @@
+"""Actuator commands: what a controller hands to a plant (through the simulation loop).
+
+Controllers and plants never import each other; both import this neutral module. A plant
+accepts one or both of two command interfaces (``Plant.interfaces``):
+
+* ``"velocity"``: ``u = (v, w, th1dot, th2dot)`` as a float array of shape (4,): forward
+  speed (m/s) along the base heading, yaw rate (rad/s) and the joint rates (rad/s). Every
+  kinematic controller (pi, ats, ap, clrrmc-*, qp, mpc) speaks it; a plant with dynamics
+  tracks it with its own velocity servos (and may lag, slip or saturate).
+* ``"force"``: :class:`WheelForces`, the thesis plant's actuation (thesis ch. 3): a
+  traction force per wheel (N, along the heading) and joint position targets (rad) for the
+  arm servo. Force-level controllers (the thesis behaviour controller, ``mpc`` with the
+  thesis model) speak it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+#: The command interfaces, by name.
+VELOCITY, FORCE = "velocity", "force"
+INTERFACES = (VELOCITY, FORCE)
+
+
+@dataclass(frozen=True, slots=True)
+class WheelForces:
+    """Force-level actuation: wheel forces (N) and arm joint targets (rad).
+
+    Attributes:
+        left, right: traction force of the left / right wheel along the base heading (N).
+        th1_target, th2_target: joint position targets of the arm servo (rad).
+    """
+
+    left: float
+    right: float
+    th1_target: float
+    th2_target: float
+
+
+def interface_of(command: object) -> str:
+    """``"force"`` for a :class:`WheelForces`, else ``"velocity"`` (an array-like u)."""
+    return FORCE if isinstance(command, WheelForces) else VELOCITY

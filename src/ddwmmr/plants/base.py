@@ -1,0 +1,101 @@
+"""The plant interface: what every plant (kinematic, thesis dynamics, physics) provides.
+
+A plant holds the robot's physical state and advances it under actuator commands
+(:mod:`ddwmmr.commands`). The one simulation loop (:mod:`ddwmmr.sim`) drives any plant the
+same way::
+
+    plant.reset(q0, dt)                      # start state, control step (s)
+    obs = plant.observe()                    # what the sensors report now
+    applied, saturated = plant.limit(obs.q, u)   # velocity command after actuator limits
+    plant.step(t, command, dt, policy)       # advance by one control step
+    plant.extra_values()                     # plant-specific columns at the current state
+
+Plants never see controllers. ``policy`` (optional) lets an integrator of the kinematic
+plant re-evaluate a continuous-time control law at its intermediate stages (RK4); every
+other plant holds the command over the step (zero-order hold) and ignores it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+#: A continuous-time control law for integrator stages: (t s, q) -> velocity command u.
+Policy = Callable[[float, np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True, slots=True)
+class Observation:
+    """The plant's measured state at one instant.
+
+    Attributes:
+        q: configuration ``[x, y, phi, th1, th2]`` (world frame; m, m, rad, rad, rad).
+        v: forward speed of the base along its heading (m/s).
+        w: yaw rate of the base (rad/s).
+    """
+
+    q: np.ndarray
+    v: float
+    w: float
+
+
+class PlantDivergedError(RuntimeError):
+    """The plant's state became non-finite (or left the engine's valid range) in a step.
+
+    The loop stops the run there, keeps what was recorded and reports the step.
+    """
+
+
+class Plant(Protocol):
+    """Structural type of every plant.
+
+    Attributes:
+        name: short name used in reports (``"kinematic"``, ``"thesis"``, ``"mujoco"``).
+        interfaces: command interfaces accepted (``"velocity"``, ``"force"``).
+        robot: the :class:`~ddwmmr.model.Robot` it simulates.
+        extra_columns: names of plant-specific time-series columns (may be empty).
+    """
+
+    name: str
+    interfaces: tuple[str, ...]
+    robot: Any
+    extra_columns: tuple[str, ...]
+
+    def reset(self, q0: np.ndarray, dt: float) -> None:  # pragma: no cover - protocol
+        """Place the robot at rest at configuration ``q0`` for a run with control step dt (s).
+
+        Raises :class:`~ddwmmr.errors.ParameterError` if dt does not suit the plant (e.g.
+        not a multiple of a physics engine's timestep).
+        """
+        ...
+
+    def observe(self) -> Observation:  # pragma: no cover - protocol
+        """The current measured state."""
+        ...
+
+    def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:  # pragma: no cover
+        """Velocity command ``u`` as the plant's actuator limits will apply it at ``q``, and
+        whether a limit was hit (recorded as the run's commanded input)."""
+        ...
+
+    def step(
+        self, t: float, command: Any, dt: float, policy: Policy | None = None
+    ) -> None:  # pragma: no cover - protocol
+        """Advance the state by ``dt`` (s) from time ``t`` under ``command``.
+
+        ``command`` is a velocity array u or a :class:`~ddwmmr.commands.WheelForces`,
+        whichever of ``interfaces`` it belongs to. Raises :class:`PlantDivergedError` when
+        the new state is not finite.
+        """
+        ...
+
+    def extra_values(self) -> Sequence[float]:  # pragma: no cover - protocol
+        """Values of ``extra_columns`` at the current state."""
+        ...
+
+    def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:  # pragma: no cover
+        """Plant-specific summary keys computed from a recorded run (may be empty)."""
+        ...
