@@ -277,7 +277,7 @@ def waypoints(scenarios: int = 10, seed: int = 0) -> str:
                     break
                 u = controller.command(t, q, target, np.zeros(3))
                 peak = max(peak, *(abs(w) for w in ROBOT.wheel_speeds_from_u(u[0], u[1])))
-                q = plant.step(t, q, dt, None, first_command=u)[0]
+                q = plant.integrate(t, q, dt, None, first_command=u)[0]
                 min_s = min(min_s, ROBOT.stability(q)[2])
                 t += dt
                 path.append(q[:2].copy())

@@ -27,16 +27,16 @@ def test_envelope_matches_the_plant_physics():
     # Full forward force on both wheels: the base settles at the top speed 2F/c1.
     state = ThesisState(0.0, 0.0, 0.0, 0.0, 0.0)
     for _ in range(3000):
-        plant.step(state, plant.force_limit, plant.force_limit, (0.0, 0.0), 0.01)
+        plant.advance(state, plant.force_limit, plant.force_limit, (0.0, 0.0), 0.01)
     assert state.v == pytest.approx(envelope["max_base_speed"], rel=1e-6)
     # Opposite forces: the yaw rate settles at 2F (width/2) / c2.
     state = ThesisState(0.0, 0.0, 0.0, 0.0, 0.0)
     for _ in range(3000):
-        plant.step(state, -plant.force_limit, plant.force_limit, (0.0, 0.0), 0.01)
+        plant.advance(state, -plant.force_limit, plant.force_limit, (0.0, 0.0), 0.01)
     assert state.w == pytest.approx(envelope["max_yaw_rate"], rel=1e-6)
     # From rest, one small step gains a dt in speed (damping negligible at v = 0).
     state = ThesisState(0.0, 0.0, 0.0, 0.0, 0.0)
-    plant.step(state, plant.force_limit, plant.force_limit, (0.0, 0.0), 1e-4)
+    plant.advance(state, plant.force_limit, plant.force_limit, (0.0, 0.0), 1e-4)
     assert state.v / 1e-4 == pytest.approx(envelope["max_acceleration"], rel=1e-3)
 
 

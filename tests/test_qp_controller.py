@@ -191,7 +191,7 @@ def test_far_waypoint_is_reached_with_bounded_commands():
     while math.dist(ROBOT.fk(q)[:2], target[:2]) > 0.01 and t < 30.0:
         u = controller.command(t, q, target, np.zeros(3))
         peak = max(peak, abs(u[0]))
-        q = plant.step(t, q, 0.02, None, first_command=u)[0]
+        q = plant.integrate(t, q, 0.02, None, first_command=u)[0]
         t += 0.02
     assert math.dist(ROBOT.fk(q)[:2], target[:2]) <= 0.01
     assert t < 20.0

@@ -146,18 +146,17 @@ def test_qp_controller_runs_on_both_plants_with_state_metrics_not_applicable():
 
 def test_velocity_loop_tracks_commanded_speeds_on_thesis_plant():
     """The qp adapter: damping feed-forward gives exact steady-state tracking."""
-    from ddwmmr.plants.thesis import ThesisPlant, ThesisState
-    from ddwmmr.scenarios.protocol import VelocityLoop
+    from ddwmmr.plants.thesis import ThesisPlant, ThesisState, VelocityServo
 
     plant = ThesisPlant(ROBOT)
-    loop = VelocityLoop(plant)
+    loop = VelocityServo(plant)
     state = ThesisState(0.0, 0.0, 0.0, -0.7, 1.57)
     for _ in range(300):  # 3 s = 30 loop time constants
-        plant.step(state, *loop.forces(state, 0.5, 0.3), (-0.7, 1.57), 0.01)
+        plant.advance(state, *loop.forces(state, 0.5, 0.3), (-0.7, 1.57), 0.01)
     assert (state.v, state.w) == pytest.approx((0.5, 0.3), abs=1e-6)
     # beyond the force limit the base settles at its top speed 20 N / c1
     for _ in range(1000):
-        plant.step(state, *loop.forces(state, 3.0, 0.0), (-0.7, 1.57), 0.01)
+        plant.advance(state, *loop.forces(state, 3.0, 0.0), (-0.7, 1.57), 0.01)
     assert state.v == pytest.approx(20.0 / 15.0, rel=1e-4)  # 10 s = 10 time constants m/c1
 
 

@@ -112,7 +112,7 @@ def test_kinematic_plant_never_moves_the_base_sideways(robot, rng):
     q = np.array([0.0, 0.0, 0.4, 0.1, 0.5])
     for _ in range(50):
         u = rng.uniform(-0.5, 0.5, 4)
-        q_next, _, _ = plant.step(0.0, q, 0.01, lambda t, x, u=u: u)
+        q_next, _, _ = plant.integrate(0.0, q, 0.01, lambda t, x, u=u: u)
         # Constant (v, w) moves the base along an arc: the chord is at heading phi + w dt / 2.
         chord = q_next[:2] - q[:2]
         mid_heading = q[2] + 0.5 * (q_next[2] - q[2])
@@ -176,9 +176,16 @@ def test_simulate_rejects_bad_input(kwargs, message):
         simulate(Robot(), Ellipse(), "ats", **kwargs)
 
 
-def test_plant_holds_a_given_command_without_a_policy_only_for_euler(robot):
-    u = np.array([0.2, 0.1, 0.0, 0.0])
-    q_next, _, _ = KinematicPlant(robot, "euler").step(0.0, np.zeros(5), 0.1, None, u)
-    np.testing.assert_allclose(q_next, [0.02, 0.0, 0.01, 0.0, 0.0])
-    with pytest.raises(ValueError, match="a policy is needed"):
-        KinematicPlant(robot, "rk4").step(0.0, np.zeros(5), 0.1, None, u)
+def test_plant_holds_a_given_command_without_a_policy(robot):
+    """Zero-order hold: Euler is exact for the first step; RK4 integrates the held input
+    along the arc of constant (v, w): x = v/w sin(w t), y = v/w (1 - cos(w t))."""
+    u = np.array([0.2, 0.1, 0.3, -0.2])
+    q_next, _, _ = KinematicPlant(robot, "euler").integrate(0.0, np.zeros(5), 0.1, None, u)
+    np.testing.assert_allclose(q_next, [0.02, 0.0, 0.01, 0.03, -0.02], rtol=0, atol=1e-15)
+    dt = 0.1
+    q_rk4, _, _ = KinematicPlant(robot, "rk4").integrate(0.0, np.zeros(5), dt, None, u)
+    v, w = u[0], u[1]
+    arc = [v / w * math.sin(w * dt), v / w * (1 - math.cos(w * dt)), w * dt, 0.3 * dt, -0.2 * dt]
+    np.testing.assert_allclose(q_rk4, arc, rtol=0, atol=1e-10)
+    with pytest.raises(ValueError, match="a policy or a first_command is needed"):
+        KinematicPlant(robot, "rk4").integrate(0.0, np.zeros(5), 0.1, None, None)

@@ -144,6 +144,6 @@ def test_arbiter_is_replaceable():
     state = ThesisState(0.0, 0.0, 0.0, *controller.default_pose)
     for k in range(1500):
         f_left, f_right, a1, a2 = controller.act(k * 0.01, state.q, state.v, state.w)
-        plant.step(state, f_left, f_right, (a1, a2), 0.01)
+        plant.advance(state, f_left, f_right, (a1, a2), 0.01)
     xe, ye, _ = ROBOT.fk(list(state.q))
     assert (xe, ye) == pytest.approx((1.5, -0.5), abs=1e-3)

@@ -177,7 +177,7 @@ def test_translation_step_response_meets_thesis_design_criterion():
     for _ in range(1500):
         p = sense(ROBOT, 0.0, state.q, state.v, state.w, None)
         f_t, f_r = mover.drive_forces(p, 0.1, 0.0)
-        plant.step(state, *mover.mix(f_t, f_r), default_pose(ROBOT), 0.01)
+        plant.advance(state, *mover.mix(f_t, f_r), default_pose(ROBOT), 0.01)
         xs.append(state.x)
     t10 = next(i for i, x in enumerate(xs) if x >= 0.01) * 0.01
     t90 = next(i for i, x in enumerate(xs) if x >= 0.09) * 0.01
@@ -197,7 +197,7 @@ def test_controller_reaches_a_waypoint_on_the_plant():
     for k in range(2000):
         forces = controller.act(k * 0.01, state.q, state.v, state.w)
         seen.add(controller.state)
-        plant.step(state, forces[0], forces[1], forces[2:], 0.01)
+        plant.advance(state, forces[0], forces[1], forces[2:], 0.01)
     xe, ye, _ = ROBOT.fk(list(state.q))
     assert math.hypot(xe - 2.0, ye - 1.0) < 1e-3
     assert seen == {"move_base", "move_arm"}

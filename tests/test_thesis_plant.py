@@ -16,7 +16,7 @@ POSE = (-0.7, 1.5)
 def run(plant: ThesisPlant, f_left: float, f_right: float, seconds: float, dt: float = 0.01):
     state = ThesisState(0.0, 0.0, 0.0, *POSE)
     for _ in range(round(seconds / dt)):
-        plant.step(state, f_left, f_right, POSE, dt)
+        plant.advance(state, f_left, f_right, POSE, dt)
     return state
 
 
@@ -114,6 +114,6 @@ def test_arm_servo_eq_4_10_synchronised_and_limited():
 def test_arm_servo_inside_plant_and_no_motion_at_target():
     plant = ThesisPlant(ROBOT)
     state = ThesisState(0.0, 0.0, 0.0, 0.0, 1.0)
-    plant.step(state, 0.0, 0.0, (0.3, 1.0), 0.01)
+    plant.advance(state, 0.0, 0.0, (0.3, 1.0), 0.01)
     assert (state.th1, state.th2) == pytest.approx((0.02, 1.0))
     assert arm_step(0.3, 1.0, 0.3, 1.0, 2.0, 0.01) == (0.3, 1.0)

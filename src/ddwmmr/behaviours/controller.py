@@ -7,12 +7,16 @@ mover turns the proposal into wheel forces, the arm mover into joint targets.
 
 The controller sees only sensor values (configuration and base velocities) and outputs
 actuator commands (wheel forces in N, joint targets in rad); which plant consumes them is
-up to the simulation loop.
+up to the simulation loop. It speaks the force interface of :mod:`ddwmmr.commands`:
+:meth:`ThesisController.command` is the loop's entry point (the same call as every other
+controller, with the measured base velocity), :meth:`ThesisController.act` the plain form.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable
+
+import numpy as np
 
 from ddwmmr.arbiters.base import Arbiter
 from ddwmmr.arbiters.state_machine import StateMachineArbiter
@@ -22,6 +26,7 @@ from ddwmmr.behaviours.manipulability import Manipulability
 from ddwmmr.behaviours.objective import Objective
 from ddwmmr.behaviours.obstacle import ObstacleAvoidance
 from ddwmmr.behaviours.stability import Stability
+from ddwmmr.commands import FORCE, WheelForces
 from ddwmmr.model import Robot
 
 #: Actuator command: (left wheel force N, right wheel force N, th1 target rad, th2 target rad).
@@ -41,6 +46,10 @@ class ThesisController:
     """
 
     name = "thesis"
+    #: Loop contract: wheel forces out, measured (v, w) in, one call per control step.
+    interface = FORCE
+    wants_base_velocity = True
+    zero_order_hold = True
 
     def __init__(
         self,
@@ -72,8 +81,12 @@ class ThesisController:
         """Arm pose held while driving (rad); scenarios start in it."""
         return self.behaviours["objective"].pose  # type: ignore[attr-defined]
 
-    def reset(self, target: tuple[float, float] | None = None) -> None:
-        """Start a new run toward ``target`` (m, world)."""
+    def reset(self, target: tuple[float, float] | None = None, q0: object = None) -> None:
+        """Start a new run toward ``target`` (m, world); ``q0`` is not needed.
+
+        The loop calls ``reset(None, q0)`` like for every controller; the target then
+        arrives with each :meth:`command`.
+        """
         self.arbiter.reset()
         self.state = self.arbiter.state
         self.target = target
@@ -82,6 +95,25 @@ class ThesisController:
     def set_target(self, target: tuple[float, float] | None) -> None:
         """Change the task point (the next waypoint), or None when the task is done."""
         self.target = target
+
+    def command(
+        self,
+        t: float,
+        q: np.ndarray,
+        pose_d: np.ndarray,
+        velocity_d: np.ndarray,
+        *,
+        base_velocity: tuple[float, float] = (0.0, 0.0),
+    ) -> WheelForces:
+        """Wheel forces and joint targets for the task point ``pose_d[:2]`` (m, world).
+
+        ``base_velocity`` is the measured ``(v, w)`` (m/s, rad/s); ``velocity_d`` is unused
+        (the behaviours work on points, not trajectories).
+        """
+        self.target = (float(pose_d[0]), float(pose_d[1]))
+        v, w = base_velocity
+        f_left, f_right, a1, a2 = self.act(t, tuple(np.asarray(q, dtype=float).tolist()), v, w)
+        return WheelForces(f_left, f_right, a1, a2)
 
     def act(
         self, t: float, q: tuple[float, float, float, float, float], v: float, w: float

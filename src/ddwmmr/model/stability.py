@@ -20,6 +20,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 #: Reported stability is capped here: a vanishing tipping moment gives an infinite ratio.
 STABILITY_CAP = 10.0
 
@@ -102,3 +104,23 @@ def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[floa
 def manipulability(th2: float) -> float:
     """Normalised manipulability ``eta = |sin(th2)|`` in [0, 1] (thesis 4.1.1)."""
     return abs(math.sin(th2))
+
+
+def stability_arrays(
+    k: ComCoefficients, th1: np.ndarray, th2: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`stability_terms` over arrays of joint angles: ``(S_lon, S_lat, S)``."""
+    th1 = np.asarray(th1, dtype=float)
+    th2 = np.asarray(th2, dtype=float)
+    x_com = k.A * np.cos(th1) + k.B * np.cos(th1 + th2)
+    y_com = k.A * np.sin(th1) + k.B * np.sin(th1 + th2)
+    s_lon = _ratio_array(k.half_length, x_com)
+    s_lat = _ratio_array(k.half_width, y_com)
+    return s_lon, s_lat, np.minimum(s_lon, s_lat)
+
+
+def _ratio_array(half_extent: float, offset: np.ndarray) -> np.ndarray:
+    magnitude = np.abs(offset)
+    capped = magnitude * STABILITY_CAP <= half_extent
+    with np.errstate(divide="ignore"):
+        return np.where(capped, STABILITY_CAP, half_extent / np.where(capped, 1.0, magnitude))

@@ -23,10 +23,16 @@ joint targets from a simulation loop.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
+import numpy as np
+
+from ddwmmr.commands import FORCE, VELOCITY, WheelForces
 from ddwmmr.errors import check_positive
 from ddwmmr.model import Robot
+from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
 
 #: Thesis Table 3.1 damping constants: translation (N s/m) and rotation (N m s/rad).
 C1_DEFAULT = 15.0
@@ -35,6 +41,8 @@ C2_DEFAULT = 4.0
 FORCE_LIMIT_DEFAULT = 10.0
 #: Thesis 4.4.2 maximum joint speed (rad/s).
 JOINT_SPEED_DEFAULT = 2.0
+#: Bandwidth (1/s) of the velocity servo that follows velocity commands.
+VELOCITY_BANDWIDTH = 10.0
 
 
 @dataclass(slots=True)
@@ -101,7 +109,15 @@ class ThesisPlant:
         c1: translational damping (N s/m); c2: rotational damping (N m s/rad).
         force_limit: per-wheel force limit (N).
         joint_speed: maximum joint speed of the arm servo (rad/s).
+        velocity_bandwidth: bandwidth of the velocity servo for velocity commands (1/s).
+
+    Extra time-series columns: the wheel forces applied over the step that starts at the
+    sample (N), ``force_left_n`` and ``force_right_n``.
     """
+
+    name = "thesis"
+    interfaces = (FORCE, VELOCITY)
+    extra_columns = ("force_left_n", "force_right_n")
 
     def __init__(
         self,
@@ -110,6 +126,7 @@ class ThesisPlant:
         c2: float = C2_DEFAULT,
         force_limit: float = FORCE_LIMIT_DEFAULT,
         joint_speed: float = JOINT_SPEED_DEFAULT,
+        velocity_bandwidth: float = VELOCITY_BANDWIDTH,
     ) -> None:
         self.robot = robot
         self.c1 = check_positive("c1", c1)
@@ -121,7 +138,58 @@ class ThesisPlant:
         # Pose-independent part of the yaw inertia: base plus each link about its own centre.
         self._inertia_fixed = robot.base_inertia + (m1 * robot.L1**2 + m2 * robot.L2**2) / 12.0
         self._half_width = 0.5 * robot.base_width
+        self.servo = VelocityServo(self, velocity_bandwidth)
+        self.state = ThesisState()
+        self._forces = (0.0, 0.0)
 
+    # -- Plant interface ------------------------------------------------------------------
+    def reset(self, q0: np.ndarray, dt: float) -> None:
+        """Start at rest at configuration ``q0`` (the dynamics are exact for any dt)."""
+        check_positive("dt", dt)
+        self.state = ThesisState(*(float(v) for v in q0))
+        self._forces = (0.0, 0.0)
+
+    def observe(self) -> Observation:
+        """Configuration and base velocities, exactly."""
+        s = self.state
+        return Observation(np.array(s.q), s.v, s.w)
+
+    def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
+        """Joint rates clipped to the joint-speed limit; (v, w) pass (forces saturate)."""
+        v, w, r1, r2 = (float(a) for a in u)
+        limit = self.robot.joint_speed_limit
+        c1, c2 = min(limit, max(-limit, r1)), min(limit, max(-limit, r2))
+        return np.array([v, w, c1, c2]), (c1 != r1 or c2 != r2)
+
+    def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
+        """Advance by dt under wheel forces or a velocity command (zero-order hold)."""
+        state = self.state
+        if isinstance(command, WheelForces):
+            f_left, f_right = command.left, command.right
+            target = (command.th1_target, command.th2_target)
+        else:
+            v, w, r1, r2 = (float(a) for a in command)
+            f_left, f_right = self.servo.forces(state, v, w)
+            limit = self.robot.joint_speed_limit
+            r1 = min(limit, max(-limit, r1))
+            r2 = min(limit, max(-limit, r2))
+            target = (state.th1 + r1 * dt, state.th2 + r2 * dt)
+        self._forces = (self.clip_force(f_left), self.clip_force(f_right))
+        self.advance(state, f_left, f_right, target, dt)
+        if not all(math.isfinite(v) for v in (*state.q, state.v, state.w)):
+            raise PlantDivergedError(f"thesis plant: non-finite state at t = {t + dt:g} s")
+
+    def extra_values(self) -> Sequence[float]:
+        """Wheel forces (N) of the last step."""
+        return self._forces
+
+    def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
+        """Peak wheel force (N) over the run."""
+        left = np.abs(timeseries.get("force_left_n", np.zeros(1)))
+        right = np.abs(timeseries.get("force_right_n", np.zeros(1)))
+        return {"max_wheel_force_n": float(max(np.max(left), np.max(right)))}
+
+    # -- the model --------------------------------------------------------------------------
     def inertia(self, th1: float, th2: float) -> float:
         """Yaw inertia of the whole robot about the base centre at arm pose (th1, th2) (kg m^2).
 
@@ -157,7 +225,7 @@ class ThesisPlant:
         """A wheel force limited to ``+-force_limit`` (N)."""
         return min(self.force_limit, max(-self.force_limit, force))
 
-    def step(
+    def advance(
         self,
         state: ThesisState,
         f_left: float,
@@ -183,3 +251,29 @@ class ThesisPlant:
         state.th1, state.th2 = arm_step(
             state.th1, state.th2, arm_target[0], arm_target[1], self.joint_speed, dt
         )
+
+
+class VelocityServo:
+    """Wheel forces (N) tracking a commanded (v, w) on the thesis plant.
+
+    ``F = c1 v_d + k m (v_d - v)`` and ``T = c2 w_d + k I (w_d - w)`` (the damping
+    feed-forward makes steady-state tracking exact; ``k`` is the loop bandwidth in 1/s),
+    ``F_r = T / (width/2)``, mixed into wheel forces with rotation priority.
+    """
+
+    def __init__(self, plant: ThesisPlant, bandwidth: float = VELOCITY_BANDWIDTH) -> None:
+        self.plant = plant
+        self.bandwidth = check_positive("velocity_bandwidth", bandwidth)
+        self._half_width = 0.5 * plant.robot.base_width
+        self._total = 2.0 * plant.force_limit
+
+    def forces(self, state: ThesisState, v_d: float, w_d: float) -> tuple[float, float]:
+        """Left/right wheel forces (N) for the desired speed (m/s) and yaw rate (rad/s)."""
+        p = self.plant
+        k = self.bandwidth
+        f_t = p.c1 * v_d + k * p.mass * (v_d - state.v)
+        torque = p.c2 * w_d + k * p.inertia(state.th1, state.th2) * (w_d - state.w)
+        f_r = min(self._total, max(-self._total, torque / self._half_width))
+        room = self._total - abs(f_r)
+        f_t = min(room, max(-room, f_t))
+        return 0.5 * f_t - 0.5 * f_r, 0.5 * f_t + 0.5 * f_r

@@ -5,17 +5,19 @@ within the time limit (60 s, 120 s with obstacles), with ``S > 1`` at every step
 obstacles) the base's enclosing circle never touching an obstacle. The run stops at the
 first failure.
 
-Simulation loops here connect controllers to plants; controllers never import plants and
-plants never import controllers:
+A scenario is a :class:`WaypointTask` run by the library's one simulation loop
+(:func:`ddwmmr.sim.loop.run_loop`), which connects any controller to any plant through
+the plant interface (controllers never import plants and plants never import controllers):
 
-* thesis controller on the thesis plant: wheel forces and joint targets straight through.
-  It is a force-level controller and has no kinematic-plant run: the kinematic plant is
-  the thesis plant's massless limit (``v = F / c1``), where its brake (P 100 > c1 = 15)
+* thesis controller (force interface: wheel forces and joint targets) on the thesis
+  plant, straight through. It has no kinematic-plant run: the kinematic plant is the
+  thesis plant's massless limit (``v = F / c1``), where its brake (P 100 > c1 = 15)
   becomes an unstable algebraic loop;
-* ``qp`` controller (input ``u = (v, w, th1dot, th2dot)``) on the thesis plant through a
-  model-based velocity-tracking loop (feed-forward of the damping plus a proportional
-  term, bandwidth ``VELOCITY_BANDWIDTH``) and joint-rate commands turned into one-step joint
-  targets; or on the kinematic plant directly (Euler, one controller call per step).
+* ``qp`` controller (velocity interface ``u = (v, w, th1dot, th2dot)``) on the thesis
+  plant, whose velocity servo (feed-forward of the damping plus a proportional term,
+  :class:`ddwmmr.plants.thesis.VelocityServo`) turns (v, w) into wheel forces and joint
+  rates into one-step joint targets; or on the kinematic plant directly (Euler, one
+  controller call per step).
 
 Metrics (seconds unless noted): ``time_s`` (time to the last waypoint, or to the failure),
 ``speed_m_s`` (straight-line length start -> waypoints / ``time_s``), ``time_base_s`` and
@@ -48,14 +50,13 @@ from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.behaviours.obstacle import base_bubble
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
-from ddwmmr.plants.kinematic import KinematicPlant
-from ddwmmr.plants.thesis import ThesisPlant, ThesisState
+from ddwmmr.plants import make_plant
+from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.scenarios.generator import Scenario
+from ddwmmr.sim.loop import run_loop
 
 CONTROLLERS = ("thesis", "qp")
 PLANTS = ("thesis", "kinematic")
-#: Velocity-loop bandwidth (1/s) of the qp-on-thesis-plant adapter.
-VELOCITY_BANDWIDTH = 10.0
 #: Motion detection thresholds for controllers without states (m/s, rad/s).
 MOVING_SPEED, MOVING_RATE = 1e-3, 1e-3
 #: Trace sampling interval for recorded scenarios (s).
@@ -170,6 +171,7 @@ class _Tally:
             keys = ("t", "x", "y", "phi", "xe", "ye", "state", "s", "eta", "distance")
             self.trace = {k: [] for k in keys}
         self._every = max(1, round(TRACE_INTERVAL / config.dt))
+        self.steps = round(config.limit_for(scenario) / config.dt)
 
     @property
     def target(self) -> tuple[float, float] | None:
@@ -265,73 +267,105 @@ class _Tally:
         return Outcome({k: metrics[k] for k in METRICS}, self.trace)
 
 
+class WaypointTask:
+    """The thesis protocol as a loop task: reference = current waypoint, judged by a tally.
+
+    ``has_states``: the controller is the thesis state machine (its states are counted);
+    otherwise base and arm motion are detected from the measured state and the command.
+    """
+
+    trajectory = None
+
+    def __init__(self, tally: _Tally, controller: Any, has_states: bool) -> None:
+        self.tally = tally
+        self.controller = controller
+        self.has_states = has_states
+        self._velocity_d = np.zeros(3)
+        self._L1, self._L2 = tally.robot.L1, tally.robot.L2
+
+    def start(self, obs: Observation) -> bool:
+        """A payload too heavy for the start pose fails at once."""
+        return self.tally.check(tuple(obs.q.tolist()))
+
+    def finished(self, k: int, t: float, obs: Observation) -> bool:
+        """Every waypoint reached, or the time limit (checked before commanding)."""
+        x, y, phi, th1, th2 = obs.q.tolist()
+        a1 = phi + th1
+        a12 = a1 + th2
+        xe = x + self._L1 * math.cos(a1) + self._L2 * math.cos(a12)
+        ye = y + self._L1 * math.sin(a1) + self._L2 * math.sin(a12)
+        return self.tally.advance(xe, ye) or k == self.tally.steps
+
+    def reference(self, t: float, obs: Observation | None) -> tuple[np.ndarray, np.ndarray]:
+        """The current waypoint as a pose (orientation 0, not tracked) at rest."""
+        goal = self.tally.target
+        assert goal is not None
+        return np.array([goal[0], goal[1], 0.0]), self._velocity_d
+
+    def record(self, k, t, obs, command, applied, saturated, info, step_ns) -> None:
+        """State-machine controllers: count the state and trace the pre-step state."""
+        if self.has_states:
+            state = self.controller.state
+            self.tally.count(state)
+            self.tally.record(k, t, tuple(obs.q.tolist()), state)
+
+    def after_step(self, k: int, t: float, obs: Observation, applied: Any) -> bool:
+        """Motion tallies (stateless controllers), then stability and collision."""
+        q = tuple(obs.q.tolist())
+        if not self.has_states:
+            base_moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
+            self.tally.steps_base += int(base_moving)
+            self.tally.steps_arm += int(max(abs(applied[2]), abs(applied[3])) > MOVING_RATE)
+            self.tally.record(k, t, q, MOVE_BASE if base_moving else MOVE_ARM)
+        return self.tally.check(q)
+
+    def controller_error(self, k: int, error: Exception) -> bool:
+        """A controller failure ends the scenario with the error as its reason."""
+        self.tally.reason = f"controller error: {type(error).__name__}: {error}".splitlines()[0]
+        return True
+
+    def diverged(self, k: int, error: PlantDivergedError) -> None:
+        """The plant blew up: the scenario fails."""
+        self.tally.reason = "diverged"
+
+
 def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
     """Run one scenario under ``config`` and return its outcome."""
     robot = Robot().with_payload(config.payload)
+    plant = make_scenario_plant(robot, config)
     if config.controller == "thesis":
-        return _run_thesis(robot, scenario, config)
-    return _run_qp(robot, scenario, config)
+        controller: Any = make_thesis_controller(robot, scenario, config)
+        q0 = np.array([0.0, 0.0, 0.0, *controller.default_pose])
+    else:
+        controller = make_qp(robot, scenario, config, _envelope(plant))
+        q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
+    has_states = config.controller == "thesis"
+    tally = _Tally(robot, scenario, config)
+    tally.steps = round(config.limit_for(scenario) / config.dt)
+    task = WaypointTask(tally, controller, has_states)
+    end = run_loop(plant, controller, task, q0, config.dt, tally.steps)
+    return tally.outcome(end.samples * config.dt, end.samples, has_states=has_states)
 
 
-def _run_thesis(robot: Robot, scenario: Scenario, config: RunConfig) -> Outcome:
-    dt = config.dt
-    plant = ThesisPlant(robot)
+def make_scenario_plant(robot: Robot, config: RunConfig) -> Plant:
+    """The plant of ``config``: thesis dynamics, or the kinematic model (Euler)."""
+    if config.plant == "kinematic":
+        return make_plant("kinematic", robot, integrator="euler")
+    return make_plant(config.plant, robot)
+
+
+def _envelope(plant: Plant) -> dict[str, float] | None:
+    """What a velocity command can ask of a force-limited base (None: no limit)."""
+    envelope = getattr(plant, "velocity_envelope", None)
+    return envelope() if envelope is not None else None
+
+
+def make_thesis_controller(robot: Robot, scenario: Scenario, config: RunConfig) -> Any:
+    """The thesis behaviour controller with the state-machine arbiter of ``config``."""
     arbiter = StateMachineArbiter(
         stability=Hysteresis(*config.stability), manipulability=Hysteresis(*config.manipulability)
     )
-    controller = ThesisController(robot, arbiter, obstacles=scenario.obstacles)
-    state = ThesisState(0.0, 0.0, 0.0, *controller.default_pose)
-    tally = _Tally(robot, scenario, config)
-    controller.reset(tally.target)
-    steps = round(config.limit_for(scenario) / dt)
-    r = robot
-    if tally.check(state.q):  # a payload too heavy for the start pose
-        return tally.outcome(0.0, 0, has_states=True)
-    k = 0
-    for k in range(steps + 1):
-        t = k * dt
-        a1 = state.phi + state.th1
-        a12 = a1 + state.th2
-        xe = state.x + r.L1 * math.cos(a1) + r.L2 * math.cos(a12)
-        ye = state.y + r.L1 * math.sin(a1) + r.L2 * math.sin(a12)
-        if tally.advance(xe, ye) or k == steps:
-            break
-        controller.set_target(tally.target)
-        f_left, f_right, th1_t, th2_t = controller.act(t, state.q, state.v, state.w)
-        tally.count(controller.state)
-        tally.record(k, t, state.q, controller.state)
-        plant.step(state, f_left, f_right, (th1_t, th2_t), dt)
-        if tally.check(state.q):
-            k += 1
-            break
-    return tally.outcome(k * dt, k, has_states=True)
-
-
-class VelocityLoop:
-    """Wheel forces (N) tracking a commanded (v, w) on the thesis plant.
-
-    ``F = c1 v_d + k m (v_d - v)`` and ``T = c2 w_d + k I (w_d - w)`` (the damping
-    feed-forward makes steady-state tracking exact; ``k`` is the loop bandwidth in 1/s),
-    ``F_r = T / (width/2)``, mixed into wheel forces with rotation priority.
-    """
-
-    def __init__(self, plant: ThesisPlant, bandwidth: float = VELOCITY_BANDWIDTH) -> None:
-        self.plant = plant
-        self.bandwidth = bandwidth
-        self._half_width = 0.5 * plant.robot.base_width
-        limit = plant.force_limit
-        self._total = 2.0 * limit
-
-    def forces(self, state: ThesisState, v_d: float, w_d: float) -> tuple[float, float]:
-        """Left/right wheel forces (N) for the desired speed (m/s) and yaw rate (rad/s)."""
-        p = self.plant
-        k = self.bandwidth
-        f_t = p.c1 * v_d + k * p.mass * (v_d - state.v)
-        torque = p.c2 * w_d + k * p.inertia(state.th1, state.th2) * (w_d - state.w)
-        f_r = min(self._total, max(-self._total, torque / self._half_width))
-        room = self._total - abs(f_r)
-        f_t = min(room, max(-room, f_t))
-        return 0.5 * f_t - 0.5 * f_r, 0.5 * f_t + 0.5 * f_r
+    return ThesisController(robot, arbiter, obstacles=scenario.obstacles)
 
 
 def make_qp(
@@ -358,56 +392,15 @@ def make_qp(
     )
 
 
-def _run_qp(robot: Robot, scenario: Scenario, config: RunConfig) -> Outcome:
-    envelope = ThesisPlant(robot).velocity_envelope() if config.plant == "thesis" else None
-    controller = make_qp(robot, scenario, config, envelope)
-    pose0 = default_pose(robot)
-    q = np.array([0.0, 0.0, 0.0, pose0[0], pose0[1]])
-    tally = _Tally(robot, scenario, config)
-    if hasattr(controller, "reset"):
-        controller.reset(None, q.copy())
-    dt = config.dt
-    steps = round(config.limit_for(scenario) / dt)
-    kinematic = KinematicPlant(robot, "euler") if config.plant == "kinematic" else None
-    plant = ThesisPlant(robot) if kinematic is None else None
-    state = ThesisState(*q.tolist()) if plant is not None else None
-    loop = VelocityLoop(plant) if plant is not None else None
-    velocity_d = np.zeros(3)
-    if tally.check(tuple(q.tolist())):
-        return tally.outcome(0.0, 0, has_states=False)
-    k = 0
-    for k in range(steps + 1):
-        t = k * dt
-        xe, ye, _ = robot.fk(q)
-        if tally.advance(float(xe), float(ye)) or k == steps:
-            break
-        goal = tally.target
-        assert goal is not None
-        try:
-            u = np.asarray(
-                controller.command(t, q, np.array([goal[0], goal[1], 0.0]), velocity_d),
-                dtype=float,
-            )
-        except Exception as exc:  # report a controller failure as the scenario's reason
-            tally.reason = f"controller error: {type(exc).__name__}: {exc}".splitlines()[0]
-            break
-        if kinematic is not None:
-            u, _ = kinematic.saturate(q, u)
-            q = kinematic.step(t, q, dt, None, first_command=u)[0]
-            base_moving = abs(u[0]) > MOVING_SPEED or abs(u[1]) > MOVING_RATE
-        else:
-            assert state is not None and loop is not None and plant is not None
-            f_left, f_right = loop.forces(state, float(u[0]), float(u[1]))
-            limit = robot.joint_speed_limit
-            r1 = min(limit, max(-limit, float(u[2])))
-            r2 = min(limit, max(-limit, float(u[3])))
-            plant.step(state, f_left, f_right, (state.th1 + r1 * dt, state.th2 + r2 * dt), dt)
-            q = np.array(state.q)
-            base_moving = abs(state.v) > MOVING_SPEED or abs(state.w) > MOVING_RATE
-        tally.steps_base += int(base_moving)
-        tally.steps_arm += int(max(abs(u[2]), abs(u[3])) > MOVING_RATE)
-        tally.record(k, t, tuple(q.tolist()), MOVE_BASE if base_moving else MOVE_ARM)
-        if tally.check(tuple(q.tolist())):
-            k += 1
-            break
-    return tally.outcome(k * dt, k, has_states=False)
+__all__ = [
+    "CONTROLLERS",
+    "METRICS",
+    "PLANTS",
+    "Outcome",
+    "RunConfig",
+    "WaypointTask",
+    "make_qp",
+    "make_scenario_plant",
+    "make_thesis_controller",
+    "run_scenario",
+]

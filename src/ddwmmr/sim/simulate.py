@@ -1,9 +1,7 @@
-"""The simulation loop: connects a controller to a plant along a desired trajectory."""
+"""``simulate``: one controller tracking one trajectory on one plant (through the loop)."""
 
 from __future__ import annotations
 
-import math
-import time
 from collections.abc import Callable
 from typing import Any
 
@@ -12,48 +10,19 @@ import numpy as np
 from ddwmmr.controllers.base import Controller, make_controller
 from ddwmmr.errors import ParameterError, check_finite, check_positive
 from ddwmmr.model import Robot
-from ddwmmr.model.kinematics import wrap_angle
-from ddwmmr.plants.kinematic import KinematicPlant
+from ddwmmr.plants import make_plant
+from ddwmmr.plants.base import Plant
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     offset_configuration,
     start_configuration,
 )
+from ddwmmr.sim.loop import run_loop
 from ddwmmr.sim.result import SimulationResult
+from ddwmmr.sim.tracking import COLUMNS, TrackingTask
 from ddwmmr.trajectories.base import trajectory_name
 
-#: Column names of the recorded time series, in order.
-COLUMNS = (
-    "t",
-    "x",
-    "y",
-    "phi",
-    "th1",
-    "th2",
-    "v",
-    "w",
-    "th1dot",
-    "th2dot",
-    "xE",
-    "yE",
-    "phiE",
-    "xE_d",
-    "yE_d",
-    "phiE_d",
-    "position_error_m",
-    "orientation_error_rad",
-    "wheel_left_rad_s",
-    "wheel_right_rad_s",
-    "manipulability",
-    "stability_lon",
-    "stability_lat",
-    "stability",
-    "nonholonomic_residual_m_s",
-    "singular",
-    "saturated",
-    "fallback",
-    "step_us",
-)
+__all__ = ["COLUMNS", "max_condition_number", "simulate", "summarize"]
 
 
 def simulate(
@@ -63,13 +32,15 @@ def simulate(
     *,
     dt: float | None = None,
     duration: float | None = None,
-    integrator: str = "rk4",
+    integrator: str | None = None,
     initial_offset: tuple[float, float] = DEFAULT_INITIAL_OFFSET,
     q0: np.ndarray | None = None,
+    plant: str | Plant = "kinematic",
+    plant_options: dict[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
     **controller_options: Any,
 ) -> SimulationResult:
-    """Simulate ``method`` tracking ``trajectory`` on the kinematic plant.
+    """Simulate ``method`` tracking ``trajectory`` on a plant.
 
     Args:
         robot: the robot (default ``Robot()``).
@@ -78,16 +49,22 @@ def simulate(
         dt: control/integration step (s); default ``duration / samples`` of the trajectory
             (its resolution N), or duration / 1000.
         duration: simulated time (s); default one trajectory period.
-        integrator: ``"rk4"`` (default) or ``"euler"``.
+        integrator: ``"rk4"`` (default) or ``"euler"``; the kinematic plant's integrator
+            (the other plants integrate their own dynamics and take no integrator).
         initial_offset: end-effector offset (dx, dy) in m, applied with the arm joints to
             the start configuration, so closed-loop convergence shows. ``(0, 0)`` starts on
             the trajectory.
         q0: explicit start configuration (overrides the construction above).
+        plant: ``"kinematic"`` (default), ``"thesis"`` (force-driven base, velocity servo),
+            any name of :func:`ddwmmr.plants.available_plants`, or a plant object.
+        plant_options: keyword options of the named plant.
         progress: optional callback ``progress(step, steps)``.
         **controller_options: passed to :func:`make_controller` when ``method`` is a name.
 
     Returns:
-        A :class:`SimulationResult` with ``.timeseries`` and ``.summary``.
+        A :class:`SimulationResult` with ``.timeseries`` and ``.summary``. If the plant's
+        state blows up, the run stops there: ``summary["diverged_at_step"]`` says where and
+        the time series hold what was recorded until then.
     """
     robot = robot if robot is not None else Robot()
     if isinstance(method, str):
@@ -103,7 +80,7 @@ def simulate(
     if dt > duration:
         raise ParameterError(f"dt must be <= duration ({duration:g} s) (got {dt:g})")
     steps = max(1, round(duration / dt))
-    plant = KinematicPlant(robot, integrator)
+    the_plant = _plant(plant, robot, integrator, plant_options)
     if q0 is None:
         offset = tuple(check_finite("initial_offset", v) for v in initial_offset)
         if len(offset) != 2:
@@ -113,81 +90,45 @@ def simulate(
         q = np.array(q0, dtype=float)
         if q.shape != (5,) or not np.all(np.isfinite(q)):
             raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
-    controller.reset(trajectory, q.copy())
-
-    rows = np.zeros((steps + 1, len(COLUMNS)))
-    call_ns: list[int] = []  # duration of every controller call
-
-    def policy(t: float, q_now: np.ndarray) -> np.ndarray:
-        pose_d = trajectory.pose(t)
-        velocity_d = trajectory.velocity(t)
-        start = time.perf_counter_ns()
-        u = controller.command(t, q_now, pose_d, velocity_d)
-        call_ns.append(time.perf_counter_ns() - start)
-        return u
-
-    for k in range(steps + 1):
-        t = k * dt
-        first_call = len(call_ns)
-        if k < steps:
-            # The step's first controller call (at q, t) is the one recorded: rk4 calls the
-            # controller again at its stages, and those leave controller.last behind.
-            u, saturated = plant.saturate(q, policy(t, q))
-            info = controller.last
-            q_next = plant.step(t, q, dt, policy, first_command=u)[0]
-        else:
-            u, saturated = plant.saturate(q, policy(t, q))
-            info = controller.last
-        rows[k] = _record(robot, trajectory, t, q, u, info, saturated, call_ns[first_call])
-        if k < steps:
-            q = q_next
-            if progress is not None:
-                progress(k + 1, steps)
-    timeseries = {name: rows[:, i] for i, name in enumerate(COLUMNS)}
+    task = TrackingTask(trajectory, the_plant, steps + 1)
+    run_loop(the_plant, controller, task, q, dt, steps, progress)
+    timeseries = task.timeseries(robot)
     summary = summarize(timeseries, robot)
+    recorded_steps = len(timeseries["t"]) - 1
     summary.update(
         method=getattr(controller, "name", type(controller).__name__),
         trajectory=trajectory_name(trajectory),
-        integrator=integrator,
+        plant=the_plant.name,
+        integrator=getattr(the_plant, "integrator", None),
         dt=dt,
-        duration=steps * dt,
-        steps=steps,
+        duration=recorded_steps * dt,
+        steps=recorded_steps,
         initial_offset_m=float(timeseries["position_error_m"][0]),
     )
+    if task.diverged_at is not None:
+        summary.update(diverged_at_step=task.diverged_at, diverged=task.diverged_message)
+    summary.update(the_plant.summarize(timeseries))
     if hasattr(controller, "summarize"):
         summary.update(controller.summarize(timeseries))
     return SimulationResult(timeseries, summary, robot, trajectory, controller)
 
 
-def _record(robot, trajectory, t, q, u, info, saturated, step_ns) -> np.ndarray:
-    pose = robot.fk(q)
-    pose_d = trajectory.pose(t)
-    wheels = robot.wheel_speeds_from_u(u[0], u[1])
-    s_lon, s_lat, s = robot.stability(q)
-    return np.concatenate(
-        [
-            [t],
-            q,
-            u,
-            pose,
-            pose_d,
-            [
-                math.hypot(pose_d[0] - pose[0], pose_d[1] - pose[1]),
-                wrap_angle(pose_d[2] - pose[2]),
-                wheels[0],
-                wheels[1],
-                robot.manipulability(q),
-                s_lon,
-                s_lat,
-                s,
-                info.nonholonomic_residual,
-                float(info.singular),
-                float(saturated),
-                float(info.fallback),
-                step_ns / 1000.0,
-            ],
-        ]
-    )
+def _plant(
+    plant: str | Plant, robot: Robot, integrator: str | None, options: dict[str, Any] | None
+) -> Plant:
+    """The plant object for ``simulate``'s ``plant``/``integrator``/``plant_options``."""
+    if not isinstance(plant, str):
+        if integrator is not None or options:
+            raise ParameterError("integrator and plant_options need a plant name, not an object")
+        return plant
+    options = dict(options or {})
+    if plant == "kinematic":
+        options.setdefault("integrator", integrator or "rk4")
+    elif integrator is not None:
+        raise ParameterError(
+            f"integrator: only the kinematic plant takes an integrator (plant {plant!r})"
+        )
+    return make_plant(plant, robot, **options)
 
 
 def summarize(ts: dict[str, np.ndarray], robot: Robot) -> dict[str, Any]:

@@ -1,0 +1,191 @@
+"""The one simulation loop: connects a controller to a plant, fed and judged by a task.
+
+Every run of the library goes through :func:`run_loop`: trajectory tracking
+(:func:`ddwmmr.simulate`, the ``track``/``compare`` tools, the GUI) and the thesis's
+waypoint protocol (:mod:`ddwmmr.scenarios`). What differs between them is the *task*
+(:class:`Task`): where the references come from, what is recorded, when a run ends or
+fails. What differs between plants (kinematic, thesis dynamics, physics) is behind
+:class:`ddwmmr.plants.base.Plant`. One sample ``k`` (time ``t = k dt``) is::
+
+    obs = plant.observe()                         # measured state at t
+    if task.finished(k, t, obs): stop             # e.g. every waypoint reached
+    pose_d, velocity_d = task.reference(t, obs)
+    command = controller.command(t, obs.q, pose_d, velocity_d)   # timed
+    applied, saturated = plant.limit(obs.q, command)             # velocity commands
+    task.record(k, t, obs, applied, saturated, info, step_ns)
+    plant.step(t, applied, dt, policy)            # not after the last sample
+    if task.after_step(k, t, plant.observe(), applied): stop      # e.g. tipped over
+
+Controller contract (class attributes, all optional):
+
+* ``interface``: ``"velocity"`` (default; ``command`` returns u) or ``"force"`` (returns
+  :class:`~ddwmmr.commands.WheelForces`); the plant must accept it.
+* ``zero_order_hold``: True for sampled-data controllers (MPC, the thesis controller): the
+  command is held over the step. Otherwise the kinematic plant's RK4 re-evaluates the
+  control law at its stages (the closed loop integrated as one ODE).
+* ``wants_base_velocity``: True passes the measured ``base_velocity=(v, w)`` to
+  ``command`` (force-level controllers need it).
+* ``last``: a :class:`~ddwmmr.controllers.base.StepInfo` about the last command.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+
+from ddwmmr.commands import FORCE, VELOCITY
+from ddwmmr.errors import ParameterError
+from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+
+#: Progress callback: (samples done, samples in all).
+Progress = Callable[[int, int], None]
+
+
+@dataclass(frozen=True, slots=True)
+class NoInfo:
+    """StepInfo stand-in for controllers that report nothing (all fields at rest)."""
+
+    singular: bool = False
+    nonholonomic_residual: float = 0.0
+    fallback: bool = False
+
+
+_NO_INFO = NoInfo()
+
+
+class Task(Protocol):
+    """What a run is for: references in, records and verdicts out."""
+
+    #: Trajectory handed to ``controller.reset`` (None for point-to-point tasks).
+    trajectory: Any
+
+    def start(self, obs: Observation) -> bool:  # pragma: no cover - protocol
+        """Inspect the start state; True ends the run before the first command."""
+        ...
+
+    def finished(self, k: int, t: float, obs: Observation) -> bool:  # pragma: no cover
+        """True ends the run at sample k, before commanding."""
+        ...
+
+    def reference(self, t: float, obs: Observation) -> tuple[np.ndarray, np.ndarray]:
+        """Desired end-effector pose and velocity ``([xE, yE, phiE], rates)`` at t."""
+        ...  # pragma: no cover - protocol
+
+    def record(
+        self,
+        k: int,
+        t: float,
+        obs: Observation,
+        command: Any,
+        applied: Any,
+        saturated: bool,
+        info: Any,
+        step_ns: int,
+    ) -> None:  # pragma: no cover - protocol
+        """Sample k: the state before the step and the command applied over it."""
+        ...
+
+    def after_step(
+        self, k: int, t: float, obs: Observation, applied: Any
+    ) -> bool:  # pragma: no cover - protocol
+        """State after the step from sample k; True ends the run (a failure)."""
+        ...
+
+    def controller_error(self, k: int, error: Exception) -> bool:  # pragma: no cover
+        """The controller raised at sample k; True ends the run quietly, False re-raises."""
+        ...
+
+    def diverged(self, k: int, error: PlantDivergedError) -> None:  # pragma: no cover
+        """The plant's state blew up in the step from sample k; the run stops."""
+        ...
+
+
+@dataclass(frozen=True)
+class LoopEnd:
+    """How a run ended: ``samples`` is the end index (time ``samples * dt``)."""
+
+    samples: int
+    reason: str  # "steps", "finished", "failed", "controller_error", "diverged", "start"
+
+
+def check_interface(controller: Any, plant: Plant) -> str:
+    """The controller's command interface, if the plant accepts it."""
+    interface = getattr(controller, "interface", VELOCITY)
+    if interface not in plant.interfaces:
+        name = getattr(controller, "name", type(controller).__name__)
+        raise ParameterError(
+            f"plant: {plant.name} does not accept {interface} commands from {name} "
+            f"(accepts: {', '.join(plant.interfaces)})"
+        )
+    return interface
+
+
+def run_loop(
+    plant: Plant,
+    controller: Any,
+    task: Task,
+    q0: np.ndarray,
+    dt: float,
+    steps: int,
+    progress: Progress | None = None,
+) -> LoopEnd:
+    """Run ``controller`` on ``plant`` from ``q0`` for up to ``steps`` steps of ``dt`` (s).
+
+    The plant and the controller are reset first. See the module docstring for the
+    sequence of one sample and the controller contract.
+    """
+    force = check_interface(controller, plant) == FORCE
+    plant.reset(q0, dt)
+    controller.reset(task.trajectory, np.array(q0, dtype=float))
+    wants_velocity = getattr(controller, "wants_base_velocity", False)
+    command_of = controller.command
+    clock = time.perf_counter_ns
+
+    def policy(t: float, q: np.ndarray) -> np.ndarray:
+        """The closed-loop law at an integrator stage (not recorded)."""
+        pose_d, velocity_d = task.reference(t, None)  # type: ignore[arg-type]
+        return command_of(t, q, pose_d, velocity_d)
+
+    stage_policy = None if (force or getattr(controller, "zero_order_hold", False)) else policy
+    obs = plant.observe()
+    if task.start(obs):
+        return LoopEnd(0, "start")
+    for k in range(steps + 1):
+        t = k * dt
+        if task.finished(k, t, obs):
+            return LoopEnd(k, "finished")
+        pose_d, velocity_d = task.reference(t, obs)
+        try:
+            start = clock()
+            if wants_velocity:
+                command = command_of(t, obs.q, pose_d, velocity_d, base_velocity=(obs.v, obs.w))
+            else:
+                command = command_of(t, obs.q, pose_d, velocity_d)
+            elapsed = clock() - start
+        except Exception as error:
+            if task.controller_error(k, error):
+                return LoopEnd(k, "controller_error")
+            raise
+        info = getattr(controller, "last", _NO_INFO)
+        if force:
+            applied, saturated = command, False
+        else:
+            applied, saturated = plant.limit(obs.q, command)
+        task.record(k, t, obs, command, applied, saturated, info, elapsed)
+        if k == steps:
+            break
+        try:
+            plant.step(t, applied, dt, stage_policy)
+        except PlantDivergedError as error:
+            task.diverged(k, error)
+            return LoopEnd(k + 1, "diverged")
+        obs = plant.observe()
+        if task.after_step(k, t, obs, applied):
+            return LoopEnd(k + 1, "failed")
+        if progress is not None:
+            progress(k + 1, steps)
+    return LoopEnd(steps, "steps")

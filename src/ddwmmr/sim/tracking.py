@@ -1,0 +1,194 @@
+"""The tracking task: follow a desired end-effector trajectory, record every sample.
+
+:class:`TrackingTask` feeds :func:`ddwmmr.sim.loop.run_loop` the trajectory's pose and
+velocity and records, per sample, only what the loop knows cheaply (time, state, applied
+input, the desired pose, the controller's flags and timing, the plant's extra columns).
+Everything derived (end-effector pose, errors, wheel speeds, manipulability, stability) is
+computed afterwards, vectorised over the run, by :func:`derive_columns`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.commands import WheelForces
+from ddwmmr.model import Robot
+from ddwmmr.model.stability import stability_arrays
+from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+
+#: Column names of the recorded time series, in order (plant columns follow).
+COLUMNS = (
+    "t",
+    "x",
+    "y",
+    "phi",
+    "th1",
+    "th2",
+    "v",
+    "w",
+    "th1dot",
+    "th2dot",
+    "xE",
+    "yE",
+    "phiE",
+    "xE_d",
+    "yE_d",
+    "phiE_d",
+    "position_error_m",
+    "orientation_error_rad",
+    "wheel_left_rad_s",
+    "wheel_right_rad_s",
+    "manipulability",
+    "stability_lon",
+    "stability_lat",
+    "stability",
+    "nonholonomic_residual_m_s",
+    "singular",
+    "saturated",
+    "fallback",
+    "step_us",
+)
+#: What is recorded per sample (the rest of COLUMNS is derived after the run).
+RECORDED = (
+    "t",
+    "x",
+    "y",
+    "phi",
+    "th1",
+    "th2",
+    "v",
+    "w",
+    "th1dot",
+    "th2dot",
+    "xE_d",
+    "yE_d",
+    "phiE_d",
+    "nonholonomic_residual_m_s",
+    "singular",
+    "saturated",
+    "fallback",
+    "step_us",
+)
+
+
+class TrackingTask:
+    """Reference from ``trajectory``; records every sample; never ends a run early.
+
+    Args:
+        trajectory: any object with ``pose(t)`` and ``velocity(t)`` (world frame).
+        plant: the plant (for its extra columns).
+        samples: number of samples the run will record at most (steps + 1).
+    """
+
+    def __init__(self, trajectory: Any, plant: Plant, samples: int) -> None:
+        self.trajectory = trajectory
+        self.plant = plant
+        self.rows: list[tuple[float, ...]] = []
+        self.extra: list[tuple[float, ...]] = []
+        self.samples = samples
+        self.diverged_at: int | None = None
+        self.diverged_message = ""
+        self._pose = trajectory.pose
+        self._velocity = trajectory.velocity
+        self._extra_values = plant.extra_values if plant.extra_columns else None
+
+    # -- Task protocol ----------------------------------------------------------------------
+    def start(self, obs: Observation) -> bool:
+        """Tracking starts from any state."""
+        return False
+
+    def finished(self, k: int, t: float, obs: Observation) -> bool:
+        """Tracking runs to the end."""
+        return False
+
+    def reference(self, t: float, obs: Observation | None) -> tuple[np.ndarray, np.ndarray]:
+        """The trajectory's pose and velocity at t (s)."""
+        return self._pose(t), self._velocity(t)
+
+    def record(self, k, t, obs, command, applied, saturated, info, step_ns) -> None:
+        """One row: t, q, u, the desired pose, flags, timing (us)."""
+        if isinstance(applied, WheelForces):
+            u = _force_equivalent(obs)
+        else:
+            u = applied.tolist()
+        self.rows.append(
+            (
+                t,
+                *obs.q.tolist(),
+                *u,
+                *self._pose(t).tolist(),
+                info.nonholonomic_residual,
+                float(info.singular),
+                float(saturated),
+                float(info.fallback),
+                step_ns / 1000.0,
+            )
+        )
+        if self._extra_values is not None:
+            self.extra.append(tuple(self._extra_values()))
+
+    def after_step(self, k: int, t: float, obs: Observation, applied: Any) -> bool:
+        """Tracking never fails."""
+        return False
+
+    def controller_error(self, k: int, error: Exception) -> bool:
+        """A controller error is the caller's problem: re-raise."""
+        return False
+
+    def diverged(self, k: int, error: PlantDivergedError) -> None:
+        """Keep what was recorded; remember where the plant blew up."""
+        self.diverged_at = k + 1
+        self.diverged_message = str(error).splitlines()[0] if str(error) else "diverged"
+
+    # -- results ----------------------------------------------------------------------------
+    def timeseries(self, robot: Robot) -> dict[str, np.ndarray]:
+        """Every column of :data:`COLUMNS` (and the plant's), one entry per recorded sample."""
+        table = np.array(self.rows, dtype=float).reshape(len(self.rows), len(RECORDED))
+        recorded = {name: table[:, i] for i, name in enumerate(RECORDED)}
+        derived = derive_columns(robot, recorded)
+        series = {name: recorded[name] if name in recorded else derived[name] for name in COLUMNS}
+        if self.plant.extra_columns:
+            extra = np.array(self.extra, dtype=float).reshape(
+                len(self.extra), len(self.plant.extra_columns)
+            )
+            for i, name in enumerate(self.plant.extra_columns):
+                series[name] = extra[:, i]
+        return series
+
+
+def _force_equivalent(obs: Observation) -> list[float]:
+    """Inputs of a force-commanded sample: measured (v, w); joint rates unknown (NaN)."""
+    return [obs.v, obs.w, math.nan, math.nan]
+
+
+def derive_columns(robot: Robot, ts: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """End-effector pose, errors, wheel speeds, manipulability and stability, vectorised.
+
+    Errors: position ``|p_d - p_E|`` (m), orientation ``phiE_d - phiE`` wrapped to
+    [-pi, pi) (rad).
+    """
+    phi, th1, th2 = ts["phi"], ts["th1"], ts["th2"]
+    a1 = phi + th1
+    a12 = a1 + th2
+    x_e = ts["x"] + robot.L1 * np.cos(a1) + robot.L2 * np.cos(a12)
+    y_e = ts["y"] + robot.L1 * np.sin(a1) + robot.L2 * np.sin(a12)
+    r, lw = robot.wheel_radius, robot.track_width
+    v, w = ts["v"], ts["w"]
+    s_lon, s_lat, s = stability_arrays(robot.com_coefficients, th1, th2)
+    heading_error = ts["phiE_d"] - a12
+    return {
+        "xE": x_e,
+        "yE": y_e,
+        "phiE": a12,
+        "position_error_m": np.hypot(ts["xE_d"] - x_e, ts["yE_d"] - y_e),
+        "orientation_error_rad": np.mod(heading_error + math.pi, 2.0 * math.pi) - math.pi,
+        "wheel_left_rad_s": (2.0 * v - lw * w) / (2.0 * r),
+        "wheel_right_rad_s": (2.0 * v + lw * w) / (2.0 * r),
+        "manipulability": np.abs(np.sin(th2)),
+        "stability_lon": s_lon,
+        "stability_lat": s_lat,
+        "stability": s,
+    }
