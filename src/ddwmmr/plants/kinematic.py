@@ -48,8 +48,14 @@ class KinematicPlant:
             )
         self.robot = robot
         self.integrator = integrator
+        # Constants of the saturation, read once (it runs at every integrator stage).
+        self._wheel = (1.0 / robot.wheel_radius, 0.5 * robot.track_width / robot.wheel_radius)
+        self._wheel_limit = robot.wheel_speed_limit
+        self._joint_speed = robot.joint_speed_limit
+        self._joint_limits = robot.joint_limits
         self._q = np.zeros(5)
         self._v = self._w = 0.0
+        self._limited: np.ndarray | None = None
 
     # -- Plant interface ------------------------------------------------------------------
     def reset(self, q0: np.ndarray, dt: float) -> None:
@@ -66,11 +72,16 @@ class KinematicPlant:
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
         """Same as :meth:`saturate`."""
-        return self.saturate(q, u)
+        applied, saturated = self.saturate(q, u)
+        self._limited = applied  # step() need not saturate this exact command again
+        return applied, saturated
 
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
         """Advance by dt under velocity ``command`` (see :meth:`integrate`)."""
-        q_next, u0, _ = self.integrate(t, self._q, dt, policy, first_command=command)
+        trusted = command is self._limited
+        q_next, u0, _ = self.integrate(
+            t, self._q, dt, policy, first_command=command, saturated=trusted
+        )
         if not all(math.isfinite(v) for v in q_next.tolist()):
             raise PlantDivergedError(f"kinematic plant: non-finite state at t = {t + dt:g} s")
         self._q = q_next
@@ -87,36 +98,38 @@ class KinematicPlant:
     # -- the model --------------------------------------------------------------------------
     def saturate(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
         """The input the robot can actually apply at q, and whether any limit was hit."""
-        robot = self.robot
-        v, w, t1, t2 = np.asarray(u, dtype=float).tolist()
-        if not all(math.isfinite(a) for a in (v, w, t1, t2)):
+        (v, w, t1, t2), saturated = self._saturate(q[3], q[4], u)
+        return np.array([v, w, t1, t2]), saturated
+
+    def _saturate(self, th1: float, th2: float, u) -> tuple[tuple[float, ...], bool]:
+        """:meth:`saturate` on floats (joint angles th1, th2 in rad)."""
+        v, w, t1, t2 = u.tolist() if isinstance(u, np.ndarray) else (float(a) for a in u)
+        if not (math.isfinite(v) and math.isfinite(w) and math.isfinite(t1) and math.isfinite(t2)):
             raise FloatingPointError(f"non-finite command u = {u}")
         saturated = False
-        left, right = robot.wheel_speeds_from_u(v, w)
-        peak = max(abs(left), abs(right))
-        if peak > robot.wheel_speed_limit:
-            scale = robot.wheel_speed_limit / peak
+        # Wheel speeds (SPEC §1): (2v -+ Lw w) / (2r) = v / r -+ (Lw / 2r) w.
+        per_v, per_w = self._wheel
+        peak = max(abs(v * per_v - w * per_w), abs(v * per_v + w * per_w))
+        limit = self._wheel_limit
+        if peak > limit:
+            scale = limit / peak
             v, w = v * scale, w * scale
             saturated = True
-        rates = []
-        for rate, angle, (low, high) in zip((t1, t2), q[3:5].tolist(), robot.joint_limits):
-            limited = min(max(rate, -robot.joint_speed_limit), robot.joint_speed_limit)
-            if (angle >= high and limited > 0) or (angle <= low and limited < 0):
-                limited = 0.0
-            saturated |= limited != rate
-            rates.append(limited)
-        return np.array([v, w, rates[0], rates[1]]), saturated
+        speed = self._joint_speed
+        (low1, high1), (low2, high2) = self._joint_limits
+        r1 = min(max(t1, -speed), speed)
+        if (th1 >= high1 and r1 > 0) or (th1 <= low1 and r1 < 0):
+            r1 = 0.0
+        r2 = min(max(t2, -speed), speed)
+        if (th2 >= high2 and r2 > 0) or (th2 <= low2 and r2 < 0):
+            r2 = 0.0
+        return (v, w, r1, r2), saturated or r1 != t1 or r2 != t2
 
     @staticmethod
     def derivative(q: np.ndarray, u: np.ndarray) -> np.ndarray:
         """Configuration rate ``qdot = B(phi) u``."""
         phi = q[2]
         return np.array([u[0] * math.cos(phi), u[0] * math.sin(phi), u[1], u[2], u[3]])
-
-    def _clamp(self, q: np.ndarray) -> np.ndarray:
-        for i, (low, high) in zip((3, 4), self.robot.joint_limits):
-            q[i] = min(max(q[i], low), high)
-        return q
 
     def integrate(
         self,
@@ -125,6 +138,7 @@ class KinematicPlant:
         dt: float,
         policy: Policy | None,
         first_command: np.ndarray | None = None,
+        saturated: bool = False,
     ) -> tuple[np.ndarray, np.ndarray, bool]:
         """Advance configuration q by dt: ``(q_next, u0, saturated0)``, no plant state.
 
@@ -132,26 +146,53 @@ class KinematicPlant:
         the policy once per step; ``rk4`` with a policy evaluates the closed-loop vector
         field at its four stages, and without one holds ``first_command`` over the step.
         ``first_command``, if given, is used instead of calling the policy at (t, q).
+        ``saturated=True`` says ``first_command`` already is :meth:`saturate`'s output at q
+        (it is used as is; ``saturated0`` is then False). Joint angles are clamped to their
+        limits after the step.
         """
         if first_command is None and policy is None:
             raise ValueError("a policy or a first_command is needed")
         command = policy(t, q) if first_command is None else first_command
-        u0, saturated0 = self.saturate(q, command)
-        k1 = self.derivative(q, u0)
-        if self.integrator == "euler":
-            return self._clamp(q + dt * k1), u0, saturated0
-        half = 0.5 * dt
-        q2 = q + half * k1
-        if policy is None:  # zero-order hold: the same input at every stage
-            k2 = self.derivative(q2, u0)
-            q3 = q + half * k2
-            k3 = self.derivative(q3, u0)
-            q4 = q + dt * k3
-            k4 = self.derivative(q4, u0)
+        x, y, phi, th1, th2 = q.tolist()
+        if saturated and first_command is not None:
+            u0, saturated0 = tuple(first_command.tolist()), False
         else:
-            k2 = self.derivative(q2, self.saturate(q2, policy(t + half, q2))[0])
-            q3 = q + half * k2
-            k3 = self.derivative(q3, self.saturate(q3, policy(t + half, q3))[0])
-            q4 = q + dt * k3
-            k4 = self.derivative(q4, self.saturate(q4, policy(t + dt, q4))[0])
-        return self._clamp(q + dt / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)), u0, saturated0
+            u0, saturated0 = self._saturate(th1, th2, command)
+        v, w, r1, r2 = u0
+        k1 = (v * math.cos(phi), v * math.sin(phi), w, r1, r2)
+        state = (x, y, phi, th1, th2)
+        if self.integrator == "euler":
+            new = [a + dt * b for a, b in zip(state, k1)]
+        else:
+            half = 0.5 * dt
+            k2 = self._stage(t + half, state, k1, half, policy, u0)
+            k3 = self._stage(t + half, state, k2, half, policy, u0)
+            k4 = self._stage(t + dt, state, k3, dt, policy, u0)
+            sixth = dt / 6.0
+            new = [
+                a + sixth * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
+                for a, b1, b2, b3, b4 in zip(state, k1, k2, k3, k4)
+            ]
+        (low1, high1), (low2, high2) = self.robot.joint_limits
+        new[3] = min(max(new[3], low1), high1)
+        new[4] = min(max(new[4], low2), high2)
+        return np.array(new), np.array(u0), saturated0
+
+    def _stage(
+        self,
+        t: float,
+        state: tuple[float, ...],
+        slope: tuple[float, ...],
+        h: float,
+        policy: Policy | None,
+        held: tuple[float, ...],
+    ) -> tuple[float, ...]:
+        """RK4 stage derivative at ``state + h slope``: the policy's (saturated) input there,
+        or the held input ``held`` (zero-order hold)."""
+        stage = [a + h * b for a, b in zip(state, slope)]
+        if policy is None:
+            v, w, r1, r2 = held
+        else:
+            (v, w, r1, r2), _ = self._saturate(stage[3], stage[4], policy(t, np.array(stage)))
+        phi = stage[2]
+        return (v * math.cos(phi), v * math.sin(phi), w, r1, r2)

@@ -303,21 +303,27 @@ class WaypointTask:
         return np.array([goal[0], goal[1], 0.0]), self._velocity_d
 
     def record(self, k, t, obs, command, applied, saturated, info, step_ns) -> None:
-        """State-machine controllers: count the state and trace the pre-step state."""
+        """Count the controller's state (state machines) and trace the state at t.
+
+        Controllers without states are traced as moving the base when the measured base
+        velocity says so (|v| > 1 mm/s or |w| > 1 mrad/s).
+        """
+        q = tuple(obs.q.tolist())
         if self.has_states:
             state = self.controller.state
             self.tally.count(state)
-            self.tally.record(k, t, tuple(obs.q.tolist()), state)
+        else:
+            moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
+            state = MOVE_BASE if moving else MOVE_ARM
+        self.tally.record(k, t, q, state)
 
     def after_step(self, k: int, t: float, obs: Observation, applied: Any) -> bool:
         """Motion tallies (stateless controllers), then stability and collision."""
-        q = tuple(obs.q.tolist())
         if not self.has_states:
             base_moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
             self.tally.steps_base += int(base_moving)
             self.tally.steps_arm += int(max(abs(applied[2]), abs(applied[3])) > MOVING_RATE)
-            self.tally.record(k, t, q, MOVE_BASE if base_moving else MOVE_ARM)
-        return self.tally.check(q)
+        return self.tally.check(tuple(obs.q.tolist()))
 
     def controller_error(self, k: int, error: Exception) -> bool:
         """A controller failure ends the scenario with the error as its reason."""

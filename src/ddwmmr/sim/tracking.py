@@ -93,6 +93,8 @@ class TrackingTask:
         self.diverged_message = ""
         self._pose = trajectory.pose
         self._velocity = trajectory.velocity
+        # Reference cache: RK4 asks twice at t + dt/2, and the recorder again at t.
+        self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         self._extra_values = plant.extra_values if plant.extra_columns else None
 
     # -- Task protocol ----------------------------------------------------------------------
@@ -105,8 +107,13 @@ class TrackingTask:
         return False
 
     def reference(self, t: float, obs: Observation | None) -> tuple[np.ndarray, np.ndarray]:
-        """The trajectory's pose and velocity at t (s)."""
-        return self._pose(t), self._velocity(t)
+        """The trajectory's pose and velocity at t (s) (the arrays must not be modified)."""
+        cached = self._cache.get(t)
+        if cached is None:
+            if len(self._cache) > 4:
+                self._cache.clear()
+            cached = self._cache[t] = (self._pose(t), self._velocity(t))
+        return cached
 
     def record(self, k, t, obs, command, applied, saturated, info, step_ns) -> None:
         """One row: t, q, u, the desired pose, flags, timing (us)."""
@@ -119,7 +126,7 @@ class TrackingTask:
                 t,
                 *obs.q.tolist(),
                 *u,
-                *self._pose(t).tolist(),
+                *self.reference(t, obs)[0].tolist(),
                 info.nonholonomic_residual,
                 float(info.singular),
                 float(saturated),
