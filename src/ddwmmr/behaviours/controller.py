@@ -112,7 +112,8 @@ class ThesisController:
         """
         self.target = (float(pose_d[0]), float(pose_d[1]))
         v, w = base_velocity
-        f_left, f_right, a1, a2 = self.act(t, tuple(np.asarray(q, dtype=float).tolist()), v, w)
+        q = tuple(q.tolist()) if isinstance(q, np.ndarray) else tuple(float(a) for a in q)
+        f_left, f_right, a1, a2 = self.act(t, q, v, w)
         return WheelForces(f_left, f_right, a1, a2)
 
     def act(

@@ -174,9 +174,15 @@ class ThesisPlant:
             r1 = min(limit, max(-limit, r1))
             r2 = min(limit, max(-limit, r2))
             target = (state.th1 + r1 * dt, state.th2 + r2 * dt)
-        self._forces = (self.clip_force(f_left), self.clip_force(f_right))
+        limit = self.force_limit
+        f_left = min(limit, max(-limit, f_left))
+        f_right = min(limit, max(-limit, f_right))
+        self._forces = (f_left, f_right)
         self.advance(state, f_left, f_right, target, dt)
-        if not all(math.isfinite(v) for v in (*state.q, state.v, state.w)):
+        # One sum tests all seven values: any inf or nan makes it non-finite.
+        if not math.isfinite(
+            state.x + state.y + state.phi + state.th1 + state.th2 + state.v + state.w
+        ):
             raise PlantDivergedError(f"thesis plant: non-finite state at t = {t + dt:g} s")
 
     def extra_values(self) -> Sequence[float]:

@@ -308,14 +308,14 @@ class WaypointTask:
         Controllers without states are traced as moving the base when the measured base
         velocity says so (|v| > 1 mm/s or |w| > 1 mrad/s).
         """
-        q = tuple(obs.q.tolist())
         if self.has_states:
             state = self.controller.state
             self.tally.count(state)
         else:
             moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
             state = MOVE_BASE if moving else MOVE_ARM
-        self.tally.record(k, t, q, state)
+        if self.tally.trace is not None:
+            self.tally.record(k, t, tuple(obs.q.tolist()), state)
 
     def after_step(self, k: int, t: float, obs: Observation, applied: Any) -> bool:
         """Motion tallies (stateless controllers), then stability and collision."""

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -93,7 +93,8 @@ def simulate(
     task = TrackingTask(trajectory, the_plant, steps + 1)
     run_loop(the_plant, controller, task, q, dt, steps, progress)
     timeseries = task.timeseries(robot)
-    summary = summarize(timeseries, robot)
+    corners = getattr(trajectory, "corner_windows", None)
+    summary = summarize(timeseries, robot, corners(duration) if corners is not None else ())
     recorded_steps = len(timeseries["t"]) - 1
     summary.update(
         method=getattr(controller, "name", type(controller).__name__),
@@ -131,15 +132,41 @@ def _plant(
     return make_plant(plant, robot, **options)
 
 
-def summarize(ts: dict[str, np.ndarray], robot: Robot) -> dict[str, Any]:
-    """Scalar metrics of a recorded run (errors in m and rad, speeds in rad/s and m/s)."""
+#: Share of the run's (corner-free) samples, at its end, over which the final error is
+#: taken: the last sample alone can sit on a transient (the rectangle ends on a corner).
+FINAL_WINDOW_FRACTION = 0.05
+
+
+def summarize(
+    ts: dict[str, np.ndarray],
+    robot: Robot,
+    corner_windows: Sequence[tuple[float, float]] = (),
+) -> dict[str, Any]:
+    """Scalar metrics of a recorded run (errors in m and rad, speeds in rad/s and m/s).
+
+    ``final_position_error_m`` is the RMS position error over the settled end of the run:
+    the last :data:`FINAL_WINDOW_FRACTION` of the samples outside every corner window
+    (``(start, end)`` times in s, e.g. :meth:`Rectangle.corner_windows`).
+    ``end_position_error_m`` is the error at the last sample and
+    ``corner_position_error_m`` the largest error inside the corner windows (None
+    without corners).
+    """
     position = ts["position_error_m"]
     orientation = ts["orientation_error_rad"]
     q = np.column_stack([ts[k] for k in ("x", "y", "phi", "th1", "th2")])
+    in_corner = np.zeros(len(position), dtype=bool)
+    for start, end in corner_windows:
+        in_corner |= (ts["t"] >= start) & (ts["t"] <= end)
+    settled = position[~in_corner] if not np.all(in_corner) else position
+    window = settled[-max(1, round(FINAL_WINDOW_FRACTION * len(settled))) :]
     return {
         "rms_position_error_m": float(np.sqrt(np.mean(position**2))),
         "max_position_error_m": float(np.max(position)),
-        "final_position_error_m": float(position[-1]),
+        "final_position_error_m": float(np.sqrt(np.mean(window**2))),
+        "end_position_error_m": float(position[-1]),
+        "corner_position_error_m": (
+            float(np.max(position[in_corner])) if np.any(in_corner) else None
+        ),
         "rms_orientation_error_rad": float(np.sqrt(np.mean(orientation**2))),
         "max_orientation_error_rad": float(np.max(np.abs(orientation))),
         "max_nonholonomic_residual_m_s": float(np.max(np.abs(ts["nonholonomic_residual_m_s"]))),

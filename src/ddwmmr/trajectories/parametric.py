@@ -160,3 +160,19 @@ class Rectangle(_Parametric):
 
     def _tangent_rate(self, alpha: float) -> float:
         return 0.0
+
+    #: Corner window length after each corner, as a share of the period T: the orientation
+    #: steps by pi/2 there and the closed-loop transients last a few time constants.
+    CORNER_SETTLE = 0.1
+
+    def corner_times(self, duration: float) -> list[float]:
+        """Times (s) of the corners alpha = k pi/2, k >= 1, up to ``duration`` (inclusive)."""
+        quarter = 0.25 * self.T
+        count = int(duration / quarter + 1e-9)
+        return [k * quarter for k in range(1, count + 1)]
+
+    def corner_windows(self, duration: float) -> list[tuple[float, float]]:
+        """``(start, end)`` (s) around each corner: from just before it (the sample at the
+        corner already sees the new orientation) to ``CORNER_SETTLE * T`` after it."""
+        lead = 1e-6 * self.T
+        return [(c - lead, c + self.CORNER_SETTLE * self.T) for c in self.corner_times(duration)]
