@@ -280,9 +280,20 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
         integrator="implicitfast",
         cone=options.cone,
     )
+    visual = _sub(root, "visual")  # only for MuJoCo's own renderer
+    _sub(visual, "headlight", ambient="0.45 0.45 0.45", diffuse="0.5 0.5 0.5")
     default = _sub(root, "default")
     _sub(default, "geom", solref=_fmt(options.contact_time_constant, 1.0))
     world = _sub(root, "worldbody")
+    _sub(
+        world,
+        "light",
+        directional="true",
+        pos="0 0 3",
+        dir="0.3 0.3 -1",
+        diffuse="0.5 0.5 0.5",
+        castshadow="false",
+    )
     _sub(
         world,
         "geom",
@@ -291,7 +302,7 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
         size="0 0 0.05",
         friction=_fmt(options.friction, 0.005, 0.0001),
         condim=3,
-        rgba="0.8 0.8 0.8 1",
+        rgba="0.75 0.78 0.8 1",
     )
     base = _sub(world, "body", name="base", pos=_fmt(0, 0, r))
     _sub(base, "freejoint", name="base")
