@@ -259,7 +259,7 @@ def servo_gains(robot: Robot, time_constant: float) -> tuple[float, float, float
 
 
 def _fmt(*values: float) -> str:
-    return " ".join(f"{v:.10g}" for v in values)
+    return " ".join(f"{v:.17g}" for v in values)
 
 
 def _sub(parent: ET.Element, tag: str, **attributes) -> ET.Element:
@@ -276,7 +276,7 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
     _sub(
         root,
         "option",
-        timestep=f"{options.timestep:.10g}",
+        timestep=f"{options.timestep:.17g}",
         integrator="implicitfast",
         cone=options.cone,
     )
@@ -312,7 +312,7 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
         base,
         "inertial",
         pos=_fmt(0, 0, box_z),
-        mass=f"{base_mass:.10g}",
+        mass=f"{base_mass:.17g}",
         diaginertia=_fmt(*_base_inertia_diagonal(robot)),
     )
     _sub(
@@ -331,7 +331,7 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
                 "geom",
                 name=support.name,
                 type="sphere",
-                size=f"{CASTER_RADIUS:.10g}",
+                size=f"{CASTER_RADIUS:.17g}",
                 pos=_fmt(*support.point, CASTER_RADIUS - r),
                 condim=1,
                 priority=1,
@@ -349,10 +349,19 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
             wheel,
             "inertial",
             pos="0 0 0",
-            mass=f"{robot.wheel_mass:.10g}",
+            mass=f"{robot.wheel_mass:.17g}",
             diaginertia=_fmt(diameter, axle, diameter),
         )
-        _sub(wheel, "geom", name=support.name, type="sphere", size=f"{r:.10g}", rgba="0 0 0 0")
+        _sub(
+            wheel,
+            "geom",
+            name=support.name,
+            type="sphere",
+            size=f"{r:.17g}",
+            # MuJoCo takes the larger friction of the two geoms: set both to the floor's
+            friction=_fmt(options.friction, 0.005, 0.0001),
+            rgba="0 0 0 0",
+        )
         _sub(
             wheel,
             "geom",
@@ -378,21 +387,21 @@ def _arm(base: ET.Element, robot: Robot) -> None:
         link1,
         "inertial",
         pos=_fmt(0.5 * robot.L1, 0, 0),
-        mass=f"{m1:.10g}",
+        mass=f"{m1:.17g}",
         diaginertia=_fmt(0.5 * m1 * LINK_RADIUS**2, m1 * robot.L1**2 / 12, m1 * robot.L1**2 / 12),
     )
     _link_geom(link1, "link1", robot.L1)
     link2 = _sub(link1, "body", name="link2", pos=_fmt(robot.L1, 0, 0))
     _sub(link2, "joint", name="elbow", type="hinge", axis="0 0 1", range=_fmt(low2, high2))
     mass, com, inertia = _link2_inertial(robot)
-    _sub(link2, "inertial", pos=_fmt(com, 0, 0), mass=f"{mass:.10g}", diaginertia=_fmt(*inertia))
+    _sub(link2, "inertial", pos=_fmt(com, 0, 0), mass=f"{mass:.17g}", diaginertia=_fmt(*inertia))
     _link_geom(link2, "link2", robot.L2)
     _sub(
         link2,
         "geom",
         name="payload",
         type="sphere",
-        size=f"{PAYLOAD_RADIUS:.10g}",
+        size=f"{PAYLOAD_RADIUS:.17g}",
         pos=_fmt(robot.L2, 0, 0),
         contype=0,
         conaffinity=0,
@@ -408,7 +417,7 @@ def _link_geom(body: ET.Element, name: str, length: float) -> None:
         name=name,
         type="capsule",
         fromto=_fmt(0, 0, 0, length, 0, 0),
-        size=f"{LINK_RADIUS:.10g}",
+        size=f"{LINK_RADIUS:.17g}",
         contype=0,
         conaffinity=0,
         rgba="0.95 0.6 0.1 1",
@@ -429,7 +438,7 @@ def _actuators(root: ET.Element, robot: Robot, options: EngineOptions) -> None:
             "velocity",
             name=name,
             joint=name,
-            kv=f"{kv:.10g}",
+            kv=f"{kv:.17g}",
             forcelimited="true",
             forcerange=_fmt(-limit, limit),
         )
