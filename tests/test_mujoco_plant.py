@@ -185,12 +185,14 @@ def test_bad_start_configurations_are_parameter_errors():
         plant.reset(np.array([0.0, 0.0, 0.0, 0.0, 4.0]), DT)
 
 
-def test_a_diverged_engine_state_names_the_step():
+def test_a_diverged_engine_state_names_the_step(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     plant = fresh()
     hold(plant, np.zeros(4), 3 * DT)
     plant.data.qvel[0] = 1e20  # far beyond what MuJoCo accepts: it flags a bad state
     with pytest.raises(PlantDivergedError, match=r"in control step 3 \(t = 0.06 to 0.08 s\)"):
         plant.step(3 * DT, np.zeros(4), DT)
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()  # the warning went to logging
 
 
 def test_non_finite_commands_are_refused():
@@ -247,3 +249,16 @@ def test_summary_of_a_stable_and_of_a_tipping_hold():
     assert tipping.result["max_base_tilt_rad"] > 0.01
     for key in ("min_support_force_n", "max_wheel_slip_m_s", "min_physics_stability"):
         assert math.isfinite(tipping.result[key])
+
+
+def test_docs_page_snippet_runs():
+    """The python block of docs/physics.md runs (the plant loop written out) and prints."""
+    from pathlib import Path
+
+    from test_examples import _python_blocks
+
+    page = Path(__file__).resolve().parents[1] / "docs" / "physics.md"
+    namespace: dict = {}
+    exec(compile(_python_blocks(page), "docs/physics.md", "exec"), namespace)
+    summary = namespace["summary"]
+    assert not summary["tipped"] and not summary["support_lost"]

@@ -22,6 +22,7 @@ is read (:mod:`ddwmmr.plants.mujoco.support`). Runs are deterministic.
 
 from __future__ import annotations
 
+import logging
 import math
 from typing import Any
 
@@ -56,6 +57,19 @@ LIFT_TIME_S = 0.1
 #: ... or the base tilted beyond this angle (rad; 5.7 deg, 20x the contact compliance's
 #: tilt under the heaviest static load).
 TIP_TILT_RAD = 0.1
+_LOG = logging.getLogger(__name__)
+
+
+def _log_engine_warning(message: str) -> None:
+    # The plant reads MuJoCo's warning counters itself and raises PlantDivergedError; by
+    # default MuJoCo would also print the warning and append it to MUJOCO_LOG.TXT in the
+    # working directory, a file nobody asked for.
+    _LOG.warning("MuJoCo: %s", message)
+
+
+if mujoco.get_mju_user_warning() is None:  # leave a handler someone else installed
+    mujoco.set_mju_user_warning(_log_engine_warning)
+
 _WARNINGS = (
     mujoco.mjtWarning.mjWARN_BADQACC,
     mujoco.mjtWarning.mjWARN_BADQPOS,
