@@ -54,8 +54,8 @@ SETTLE_DAMPING_TIME_S = 0.01
 UNLOADED_FRACTION = 1e-4
 #: ``tipped``: an edge unloaded for at least this long (s) ...
 LIFT_TIME_S = 0.1
-#: ... or the base tilted beyond this angle (rad; 5.7 deg, 20x the contact compliance's
-#: tilt under the heaviest static load).
+#: ... or the base tilted beyond this angle (rad; 5.7 deg, far beyond the contacts' own
+#: compliance: a base at rest leans at most ~6e-4 rad into its contacts).
 TIP_TILT_RAD = 0.1
 _LOG = logging.getLogger(__name__)
 
