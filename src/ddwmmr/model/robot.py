@@ -41,6 +41,23 @@ class Robot:
         joint_speed_limit: maximum |th1dot|, |th2dot| (rad/s).
         wheel_speed_limit: maximum wheel angular speed (rad/s).
         home_pose: default arm pose ``(th1, th2)`` (rad) used for start configurations.
+
+    Physical fields, used by the physics plant (:class:`ddwmmr.plants.MujocoPlant`, see
+    docs/physics.md) and ignored by the kinematic and thesis plants:
+
+    Attributes:
+        caster_positions: base-frame contact points ``((x, y), ...)`` (m) of the passive,
+            frictionless casters. ``None`` (default) puts one at each footprint corner
+            ``(+-base_length/2, +-base_width/2)``: with the wheels on the footprint's side
+            edges (``track_width <= base_width``) the support polygon is then exactly the
+            footprint that the stability margin S uses (see :attr:`casters`).
+        wheel_mass: mass of each drive wheel (kg), part of ``base_mass`` (so the total
+            mass and S are unchanged); ``2 wheel_mass < base_mass``.
+        base_height: height of the base box (m); sets its roll/pitch inertia.
+        arm_height: height of the arm's horizontal plane above the floor (m); the height
+            of the links' and payload's masses, which matters for dynamic tipping only.
+        wheel_torque_limit: peak torque of each wheel motor (N m).
+        joint_torque_limits: peak torques of the shoulder and elbow motors (N m).
     """
 
     L1: float = 0.35
@@ -57,6 +74,12 @@ class Robot:
     joint_speed_limit: float = 2.0
     wheel_speed_limit: float = 15.0
     home_pose: tuple[float, float] = (-0.3, 0.6)
+    caster_positions: tuple[tuple[float, float], ...] | None = None
+    wheel_mass: float = 0.5
+    base_height: float = 0.2
+    arm_height: float = 0.35
+    wheel_torque_limit: float = 2.0
+    joint_torque_limits: tuple[float, float] = (20.0, 10.0)
     _com: stability.ComCoefficients = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -71,6 +94,10 @@ class Robot:
             "base_inertia",
             "joint_speed_limit",
             "wheel_speed_limit",
+            "wheel_mass",
+            "base_height",
+            "arm_height",
+            "wheel_torque_limit",
         ):
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
         object.__setattr__(self, "payload", check_nonnegative("payload", self.payload))
@@ -87,6 +114,17 @@ class Robot:
         object.__setattr__(self, "joint_limits", tuple(limits))
         home = tuple(check_finite("home_pose", v) for v in _pair("home_pose", self.home_pose))
         object.__setattr__(self, "home_pose", home)
+        if not 2.0 * self.wheel_mass < self.base_mass:
+            raise ParameterError(
+                f"wheel_mass must be < base_mass / 2 = {self.base_mass / 2:g} kg (the wheels "
+                f"are part of the base) (got {self.wheel_mass:g})"
+            )
+        torques = _pair("joint_torque_limits", self.joint_torque_limits)
+        for i, torque in enumerate(torques, start=1):
+            check_positive(f"joint_torque_limits[{i}]", torque)
+        object.__setattr__(self, "joint_torque_limits", torques)
+        if self.caster_positions is not None:
+            object.__setattr__(self, "caster_positions", _points(self.caster_positions))
         object.__setattr__(
             self,
             "_com",
@@ -126,6 +164,16 @@ class Robot:
     def with_payload(self, payload: float) -> Robot:
         """A copy of this robot carrying ``payload`` kg at the end effector."""
         return replace(self, payload=payload)
+
+    # -- physical layout ----------------------------------------------------------------
+    @property
+    def casters(self) -> tuple[tuple[float, float], ...]:
+        """Base-frame caster contact points (m): ``caster_positions`` or the four footprint
+        corners (front-left, front-right, back-left, back-right)."""
+        if self.caster_positions is not None:
+            return self.caster_positions
+        hl, hw = 0.5 * self.base_length, 0.5 * self.base_width
+        return ((hl, hw), (hl, -hw), (-hl, hw), (-hl, -hw))
 
     # -- kinematics -----------------------------------------------------------------------
     @property
@@ -229,6 +277,22 @@ def _pair(name: str, value) -> tuple[float, float]:
     if len(items) != 2:
         raise ParameterError(f"{name} must be a pair of numbers (got {value!r})")
     return items  # type: ignore[return-value]
+
+
+def _points(value) -> tuple[tuple[float, float], ...]:
+    name = "caster_positions"
+    try:
+        items = tuple(value)
+    except TypeError:
+        raise ParameterError(
+            f"{name} must be a list of (x, y) pairs in m (got {value!r})"
+        ) from None
+    if not items:
+        raise ParameterError(f"{name} must list at least one (x, y) pair (got {value!r})")
+    return tuple(
+        tuple(check_finite(f"{name}[{i}]", v) for v in _pair(f"{name}[{i}]", p))
+        for i, p in enumerate(items, start=1)
+    )
 
 
 def _pairs(name: str, value) -> tuple:

@@ -1,4 +1,4 @@
-"""Plants: what the controllers' commands act on (kinematic model, thesis dynamics).
+"""Plants: what the controllers' commands act on (kinematic model, thesis dynamics, MuJoCo).
 
 Every plant implements :class:`ddwmmr.plants.base.Plant`; :func:`make_plant` builds one by
 name (``available_plants()`` lists the names) for the simulation loop.
@@ -14,10 +14,12 @@ from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.plants.kinematic import INTEGRATORS, KinematicPlant
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState, VelocityServo
 
-#: Plant name -> "module:class" (imported on first use, so optional engines stay optional).
+#: Plant name -> "module:class" (imported on first use: importing mujoco takes ~0.4 s, which
+#: every other user of the package, such as CLI start-up or kinematic runs, should not pay).
 PLANT_CLASSES = {
     "kinematic": "ddwmmr.plants.kinematic:KinematicPlant",
     "thesis": "ddwmmr.plants.thesis:ThesisPlant",
+    "mujoco": "ddwmmr.plants.mujoco:MujocoPlant",
 }
 
 
@@ -39,10 +41,18 @@ def make_plant(name: str, robot: Any, **options: Any) -> Plant:
     return plant_class(name)(robot, **options)
 
 
+def __getattr__(name: str) -> Any:
+    # ``from ddwmmr.plants import MujocoPlant`` works, importing mujoco only then.
+    if name == "MujocoPlant":
+        return plant_class("mujoco")
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
 __all__ = [
     "INTEGRATORS",
     "PLANT_CLASSES",
     "KinematicPlant",
+    "MujocoPlant",
     "Observation",
     "Plant",
     "PlantDivergedError",

@@ -1,0 +1,459 @@
+"""The physics plant: the robot as a MuJoCo rigid-body model (:class:`MujocoPlant`).
+
+Implements the :class:`~ddwmmr.plants.base.Plant` interface. Commands:
+
+* **velocity** ``u = (v, w, th1dot, th2dot)``: limited like the kinematic plant (wheel
+  speed, joint rate and joint position limits), then turned into wheel speed targets
+  (SPEC §1 wheel map) and joint rate targets for the velocity servos of the model. The
+  servos' torques are clipped at the robot's motor limits, the wheels grip the floor
+  through friction: the base may lag, slip or saturate, and the controller sees it.
+* **force** :class:`~ddwmmr.commands.WheelForces`: each wheel force F (N) is applied as
+  the wheel torque ``F r`` (clipped at ``wheel_torque_limit``); the arm targets go through
+  the thesis's synchronised position servo (thesis eq. 4.10, the
+  :func:`~ddwmmr.plants.thesis.arm_step` law at ``joint_speed_limit``), whose joint rates
+  drive the same joint velocity servos.
+
+The engine advances at its own ``timestep``; the control step must be a whole multiple
+of it. :meth:`observe` reports what the engine's state says: ``q = (x, y, phi, th1, th2)``
+of the axle midpoint, its heading (continuous, not wrapped), the joint angles, and the
+measured forward speed and yaw rate. Every step the floor's normal force on each support
+is read (:mod:`ddwmmr.plants.mujoco.support`). Runs are deterministic.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from ddwmmr.commands import VELOCITY, WheelForces, interface_of
+from ddwmmr.errors import ParameterError
+from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
+from ddwmmr.plants.kinematic import KinematicPlant
+from ddwmmr.plants.mujoco.model import (
+    ACTUATORS,
+    EngineOptions,
+    build_model,
+    supports,
+)
+from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
+from ddwmmr.plants.thesis import arm_step
+
+#: Time (s) the robot settles on its supports in :meth:`MujocoPlant.reset` before t = 0,
+#: so that the first recorded contact forces carry the robot's weight.
+SETTLE_TIME_S = 0.2
+#: Time constant (s) of the damping that holds the base still while it settles.
+SETTLE_DAMPING_TIME_S = 0.01
+#: An edge of the support polygon is unloaded when the supports off it carry less than
+#: this fraction of the robot's weight.
+UNLOADED_FRACTION = 1e-4
+#: ``tipped``: an edge unloaded for at least this long (s) ...
+LIFT_TIME_S = 0.1
+#: ... or the base tilted beyond this angle (rad; 5.7 deg, far beyond the contacts' own
+#: compliance: a base at rest leans at most ~6e-4 rad into its contacts).
+TIP_TILT_RAD = 0.1
+_LOG = logging.getLogger(__name__)
+
+
+def _log_engine_warning(message: str) -> None:
+    # The plant reads MuJoCo's warning counters itself and raises PlantDivergedError; by
+    # default MuJoCo would also print the warning and append it to MUJOCO_LOG.TXT in the
+    # working directory, a file nobody asked for.
+    _LOG.warning("MuJoCo: %s", message)
+
+
+if mujoco.get_mju_user_warning() is None:  # leave a handler someone else installed
+    mujoco.set_mju_user_warning(_log_engine_warning)
+
+_WARNINGS = (
+    mujoco.mjtWarning.mjWARN_BADQACC,
+    mujoco.mjtWarning.mjWARN_BADQPOS,
+    mujoco.mjtWarning.mjWARN_BADQVEL,
+)
+
+
+class MujocoPlant:
+    """The robot simulated by MuJoCo (rigid bodies, contacts, friction, motor limits).
+
+    Args:
+        robot: the robot; its MJCF model is generated from it (:mod:`.model`).
+        timestep: engine step (s), default 0.002 (docs/physics.md, "Settings").
+        friction: wheel-floor sliding friction coefficient.
+        servo_time_constant: response time of the velocity servos (s).
+        cone: MuJoCo friction cone, ``"pyramidal"`` or ``"elliptic"``.
+        contact_time_constant: stiffness of the contacts as a time constant (s).
+
+    Raises:
+        ParameterError: for a robot or option MuJoCo cannot build (one line).
+    """
+
+    name = "mujoco"
+    interfaces = ("velocity", "force")
+
+    def __init__(
+        self,
+        robot: Robot,
+        *,
+        timestep: float | None = None,
+        friction: float | None = None,
+        servo_time_constant: float | None = None,
+        cone: str | None = None,
+        contact_time_constant: float | None = None,
+    ) -> None:
+        given = {
+            "timestep": timestep,
+            "friction": friction,
+            "servo_time_constant": servo_time_constant,
+            "cone": cone,
+            "contact_time_constant": contact_time_constant,
+        }
+        self.options = EngineOptions(**{k: v for k, v in given.items() if v is not None})
+        self.robot = robot
+        self.model = build_model(robot, self.options)
+        self.data = mujoco.MjData(self.model)
+        self.supports = supports(robot)
+        self.geometry = SupportGeometry([s.point for s in self.supports])
+        self.extra_columns = (
+            "min_support_force_n",
+            *(f"support_force_{s.name}_n" for s in self.supports),
+            "min_edge_load_n",
+            "physics_stability",
+            "base_tilt_rad",
+            "wheel_slip_m_s",
+        )
+        self.weight_n = float(np.sum(self.model.body_mass)) * -float(self.model.opt.gravity[2])
+        self._limits = KinematicPlant(robot, "euler")
+        self._ids = self._lookup_ids()
+        self._kv = self.model.actuator_gainprm[:, 0].copy()
+        self._wheel_mode = VELOCITY
+        self._force_buffer = np.zeros(6)
+        self._velocity_buffer = np.zeros(6)
+        self._dt: float | None = None
+        self._substeps = 0
+        self._step_count = 0
+        self._warnings = 0
+        self._phi = 0.0
+        self._cache: tuple[float, ...] | None = None
+        mass = float(np.sum(self.model.body_mass))
+        inertia = mass * (robot.base_length**2 + robot.base_width**2) / 12.0 + robot.base_inertia
+        # damping (N s/m, N m s/rad) for a SETTLE_DAMPING_TIME_S time constant of the base
+        self._settle_damping = np.array([mass] * 3 + [inertia] * 3) / SETTLE_DAMPING_TIME_S
+
+    # -- set-up -------------------------------------------------------------------------
+    def _lookup_ids(self) -> dict[str, Any]:
+        model = self.model
+
+        def find(kind, name: str) -> int:
+            return mujoco.mj_name2id(model, kind, name)
+
+        geom_support = np.full(model.ngeom, -1, dtype=int)
+        for i, support in enumerate(self.supports):
+            geom_support[find(mujoco.mjtObj.mjOBJ_GEOM, support.name)] = i
+        return {
+            "base": find(mujoco.mjtObj.mjOBJ_BODY, "base"),
+            "wheels": [find(mujoco.mjtObj.mjOBJ_BODY, n) for n in ("wheel_left", "wheel_right")],
+            "geom_support": geom_support,
+            "shoulder_qpos": model.jnt_qposadr[find(mujoco.mjtObj.mjOBJ_JOINT, "shoulder")],
+            "elbow_qpos": model.jnt_qposadr[find(mujoco.mjtObj.mjOBJ_JOINT, "elbow")],
+            "wheel_actuators": [ACTUATORS.index("wheel_left"), ACTUATORS.index("wheel_right")],
+        }
+
+    def control_step_choices(self, count: int = 3) -> str:
+        """The first ``count`` allowed control steps (s), for messages."""
+        h = self.options.timestep
+        return ", ".join(f"{k * h:g}" for k in range(1, count + 1))
+
+    def _check_dt(self, dt: float) -> int:
+        h = self.options.timestep
+        try:
+            ratio = float(dt) / h
+        except (TypeError, ValueError):
+            raise ParameterError(f"dt must be a number (got {dt!r})") from None
+        substeps = round(ratio) if math.isfinite(ratio) else 0
+        if substeps < 1 or abs(substeps * h - dt) > 1e-9 * max(1.0, abs(dt)):
+            raise ParameterError(
+                f"dt must be a whole multiple of the MuJoCo timestep {h:g} s "
+                f"({self.control_step_choices()}, ...) (got {dt!r})"
+            )
+        return substeps
+
+    def reset(self, q0: np.ndarray, dt: float) -> None:
+        """Place the robot at rest at ``q0`` on the floor for control step ``dt`` (s).
+
+        The robot first settles on its supports for :data:`SETTLE_TIME_S` with the servos
+        holding still; then x, y, heading and joints are put back exactly to ``q0``.
+        Raises :class:`ParameterError` if dt is not a multiple of the engine timestep or q0
+        is not 5 finite numbers with the joints inside their limits.
+        """
+        self._substeps = self._check_dt(dt)
+        self._dt = float(dt)
+        q0 = np.asarray(q0, dtype=float)
+        if q0.shape != (5,) or not np.all(np.isfinite(q0)):
+            raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
+        for i, (angle, (low, high)) in enumerate(zip(q0[3:], self.robot.joint_limits), 1):
+            if not low <= angle <= high:
+                raise ParameterError(
+                    f"q0 joint th{i} must be within joint_limits[{i}] = [{low:g}, {high:g}] "
+                    f"(got {angle:g})"
+                )
+        model, data = self.model, self.data
+        mujoco.mj_resetData(model, data)
+        self._set_wheel_mode(VELOCITY)
+        self._place(q0, z=self.robot.wheel_radius)
+        mujoco.mj_forward(model, data)
+        data.ctrl[:] = 0.0
+        # Settle with the base's six degrees of freedom heavily damped, so that it sinks
+        # into its contacts without bouncing or rocking (a pose close to S = 1 would
+        # otherwise rock onto its edge and back).
+        self._warnings = self._warning_count()
+        model.dof_damping[0:6] = self._settle_damping
+        mujoco.mj_step(model, data, max(1, round(SETTLE_TIME_S / model.opt.timestep)))
+        model.dof_damping[0:6] = 0.0
+        self._check_state("while the robot settled at reset")
+        self._step_count = 0
+        self._place(q0, z=float(data.qpos[2]), keep_tilt=True)
+        data.qvel[:] = 0.0
+        data.time = 0.0
+        mujoco.mj_forward(model, data)
+        self._phi = float(q0[2])
+        self._cache = None
+
+    def _place(self, q: np.ndarray, z: float, keep_tilt: bool = False) -> None:
+        """Set the base at (x, y, z) with heading q[2] (keeping roll/pitch if asked) and
+        the joints at q[3:5]; the wheel angles stay as they are."""
+        qpos = self.data.qpos
+        yaw = np.array([math.cos(0.5 * q[2]), 0.0, 0.0, math.sin(0.5 * q[2])])
+        if keep_tilt:
+            # remove the settled quaternion's own yaw, keep its roll and pitch
+            current = qpos[3:7].copy()
+            unyaw = np.zeros(4)
+            mujoco.mju_negQuat(unyaw, _yaw_quaternion(_heading(current)))
+            tilt = np.zeros(4)
+            mujoco.mju_mulQuat(tilt, unyaw, current)
+            mujoco.mju_mulQuat(yaw, yaw.copy(), tilt)
+        qpos[0:3] = (q[0], q[1], z)
+        qpos[3:7] = yaw
+        qpos[self._ids["shoulder_qpos"]] = q[3]
+        qpos[self._ids["elbow_qpos"]] = q[4]
+
+    def _set_wheel_mode(self, mode: str) -> None:
+        """Wheel actuators as velocity servos (``"velocity"``) or torque motors (else)."""
+        if mode == self._wheel_mode:
+            return
+        for i in self._ids["wheel_actuators"]:
+            gain = self._kv[i] if mode == VELOCITY else 1.0
+            self.model.actuator_gainprm[i, 0] = gain
+            self.model.actuator_biasprm[i, 2] = -gain if mode == VELOCITY else 0.0
+        self._wheel_mode = mode
+
+    # -- the plant interface --------------------------------------------------------------
+    def observe(self) -> Observation:
+        """Measured ``q`` (world frame), forward speed v (m/s) and yaw rate w (rad/s)."""
+        qpos, qvel = self.data.qpos, self.data.qvel
+        phi = self._phi
+        q = np.array(
+            [qpos[0], qpos[1], phi, qpos[self._ids["shoulder_qpos"]], qpos[self._ids["elbow_qpos"]]]
+        )
+        v = float(qvel[0] * math.cos(phi) + qvel[1] * math.sin(phi))
+        # qvel[3:6] is the base's angular velocity in its own frame: world z component
+        rotation = self.data.xmat[self._ids["base"]]
+        w = float(rotation[6] * qvel[3] + rotation[7] * qvel[4] + rotation[8] * qvel[5])
+        return Observation(q=q, v=v, w=w)
+
+    def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
+        """``u`` after the kinematic plant's limits (wheel speed, joint rate and position),
+        which are the servo targets; torque limits act later, in the engine."""
+        return self._limits.saturate(np.asarray(q, dtype=float), np.asarray(u, dtype=float))
+
+    def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
+        """Hold ``command`` for ``dt`` (s): ``dt / timestep`` engine steps (``policy`` unused).
+
+        Raises :class:`PlantDivergedError` (naming the step) if the engine state becomes
+        invalid, :class:`ParameterError` if dt differs from the reset's control step
+        and is not a multiple of the timestep.
+        """
+        if self._dt is None:
+            raise RuntimeError("reset(q0, dt) must be called before step")
+        substeps = self._substeps if dt == self._dt else self._check_dt(dt)
+        q = self.observe().q
+        if interface_of(command) == VELOCITY:
+            self._velocity_controls(q, np.asarray(command, dtype=float))
+        else:
+            self._force_controls(q, command, dt)
+        mujoco.mj_step(self.model, self.data, substeps)
+        self._check_state(f"in control step {self._step_count} (t = {t:.6g} to {t + dt:.6g} s)")
+        self._step_count += 1
+        mujoco.mj_forward(self.model, self.data)
+        self._phi += wrap_angle(_heading(self.data.qpos[3:7]) - self._phi)
+        self._cache = None
+
+    def _velocity_controls(self, q: np.ndarray, u: np.ndarray) -> None:
+        applied, _ = self.limit(q, u)
+        self._set_wheel_mode(VELOCITY)
+        left, right = self.robot.wheel_speeds_from_u(applied[0], applied[1])
+        self.data.ctrl[:] = (left, right, applied[2], applied[3])
+
+    def _force_controls(self, q: np.ndarray, command: WheelForces, dt: float) -> None:
+        values = (command.left, command.right, command.th1_target, command.th2_target)
+        if not all(math.isfinite(float(v)) for v in values):
+            raise FloatingPointError(f"non-finite command {command}")
+        self._set_wheel_mode("force")
+        th1, th2 = float(q[3]), float(q[4])
+        new1, new2 = arm_step(
+            th1, th2, command.th1_target, command.th2_target, self.robot.joint_speed_limit, dt
+        )
+        r = self.robot.wheel_radius
+        self.data.ctrl[:] = (
+            command.left * r,
+            command.right * r,
+            (new1 - th1) / dt,
+            (new2 - th2) / dt,
+        )
+
+    def _warning_count(self) -> int:
+        return sum(int(self.data.warning[w].number) for w in _WARNINGS)
+
+    def _check_state(self, where: str) -> None:
+        """Raise :class:`PlantDivergedError` if the engine warned of a bad state (it then
+        resets its data silently) or the state is not finite."""
+        data = self.data
+        count = self._warning_count()
+        finite = np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel))
+        if count != self._warnings or not finite:
+            self._warnings = count
+            raise PlantDivergedError(
+                f"MuJoCo state diverged {where}: non-finite or unstable accelerations "
+                "(try a smaller timestep)"
+            )
+
+    # -- readout ------------------------------------------------------------------------
+    def support_forces(self) -> tuple[np.ndarray, np.ndarray]:
+        """Floor normal force on each support (N) and its contact point in the base frame
+        (m), in the order of :attr:`supports` (an unloaded support: 0 N at its nominal
+        point)."""
+        model, data = self.model, self.data
+        forces = np.zeros(len(self.supports))
+        moments = np.zeros((len(self.supports), 2))
+        geom_support = self._ids["geom_support"]
+        base = self._ids["base"]
+        origin = data.xpos[base][:2]
+        c, s = math.cos(self._phi), math.sin(self._phi)
+        for i in range(data.ncon):
+            contact = data.contact[i]
+            index = max(geom_support[contact.geom1], geom_support[contact.geom2])
+            if index < 0:
+                continue
+            mujoco.mj_contactForce(model, data, i, self._force_buffer)
+            force = self._force_buffer[0]
+            dx, dy = contact.pos[0] - origin[0], contact.pos[1] - origin[1]
+            forces[index] += force
+            moments[index] += force * np.array([c * dx + s * dy, -s * dx + c * dy])
+        points = np.array([s.point for s in self.supports], dtype=float)
+        loaded = forces > 1e-12
+        points[loaded] = moments[loaded] / forces[loaded, None]
+        return forces, points
+
+    def base_tilt(self) -> float:
+        """Angle (rad) between the base's z axis and the vertical."""
+        return float(math.acos(min(1.0, max(-1.0, self.data.xmat[self._ids["base"]][8]))))
+
+    def wheel_slip(self) -> float:
+        """Largest horizontal speed (m/s) of a wheel's contact point over the floor."""
+        r = self.robot.wheel_radius
+        worst = 0.0
+        for body in self._ids["wheels"]:
+            mujoco.mj_objectVelocity(
+                self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, body, self._velocity_buffer, 0
+            )
+            wx, wy, _, vx, vy, _ = self._velocity_buffer
+            # velocity of the wheel's lowest point: v + omega x (0, 0, -r)
+            worst = max(worst, math.hypot(vx - r * wy, vy + r * wx))
+        return worst
+
+    def extra_values(self) -> tuple[float, ...]:
+        """Values of :attr:`extra_columns` at the current state."""
+        if self._cache is None:
+            forces, points = self.support_forces()
+            cop = centre_of_pressure(points, forces)
+            stability = 0.0 if cop is None else self.geometry.stability(cop)
+            self._cache = (
+                float(np.min(forces)),
+                *(float(f) for f in forces),
+                float(np.min(self.geometry.edge_loads(forces))),
+                stability,
+                self.base_tilt(),
+                self.wheel_slip(),
+            )
+        return self._cache
+
+    def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
+        """Physics summary of a recorded run.
+
+        Keys: ``tipped`` (see :func:`tip_time_s`), ``tip_time_s`` (when, None if never),
+        ``support_lost`` (some polygon edge carried no load at some sample),
+        ``unloaded_time_s`` (total time with an unloaded edge), ``min_support_force_n``,
+        ``min_edge_load_n``, ``min_physics_stability``, ``max_base_tilt_rad``,
+        ``max_wheel_slip_m_s`` and ``mujoco_timestep_s``.
+        """
+        t = np.asarray(timeseries["t"], dtype=float)
+        edge_load = np.asarray(timeseries["min_edge_load_n"], dtype=float)
+        unloaded = edge_load < UNLOADED_FRACTION * self.weight_n
+        interval = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+        tip_time = tip_time_s(
+            t, edge_load, np.asarray(timeseries["base_tilt_rad"], dtype=float), self.weight_n
+        )
+        return {
+            "tipped": tip_time is not None,
+            "tip_time_s": tip_time,
+            "support_lost": bool(np.any(unloaded)),
+            "unloaded_time_s": float(np.sum(unloaded) * interval),
+            "min_support_force_n": float(np.min(timeseries["min_support_force_n"])),
+            "min_edge_load_n": float(np.min(edge_load)),
+            "min_physics_stability": float(np.min(timeseries["physics_stability"])),
+            "max_base_tilt_rad": float(np.max(timeseries["base_tilt_rad"])),
+            "max_wheel_slip_m_s": float(np.max(timeseries["wheel_slip_m_s"])),
+            "mujoco_timestep_s": self.options.timestep,
+        }
+
+
+def tip_time_s(
+    t: np.ndarray, edge_load: np.ndarray, tilt: np.ndarray, weight_n: float
+) -> float | None:
+    """First time (s) a recorded run counts as tipped, or None.
+
+    Tipped: some edge of the support polygon stays unloaded (the supports off it carry less
+    than :data:`UNLOADED_FRACTION` of the weight ``weight_n``, N) over consecutive samples
+    spanning at least :data:`LIFT_TIME_S` (n samples span n sample intervals), or the base
+    tilts beyond :data:`TIP_TILT_RAD`. The time returned is the sample where the criterion
+    is first met. ``edge_load`` is the ``min_edge_load_n`` column, ``tilt`` the
+    ``base_tilt_rad`` column.
+    """
+    candidates = []
+    tilted = np.flatnonzero(tilt > TIP_TILT_RAD)
+    if tilted.size:
+        candidates.append(float(t[tilted[0]]))
+    if len(t) > 1:
+        interval = float(np.median(np.diff(t)))
+        needed = max(1, math.ceil(LIFT_TIME_S / interval - 1e-9))
+        run = 0
+        for k, unloaded in enumerate(edge_load < UNLOADED_FRACTION * weight_n):
+            run = run + 1 if unloaded else 0
+            if run >= needed:
+                candidates.append(float(t[k]))
+                break
+    return min(candidates) if candidates else None
+
+
+def _heading(quaternion) -> float:
+    """Heading (rad) of a body's x axis projected on the floor, from its quaternion."""
+    w, x, y, z = (float(v) for v in quaternion)
+    return math.atan2(2.0 * (x * y + w * z), 1.0 - 2.0 * (y * y + z * z))
+
+
+def _yaw_quaternion(angle: float) -> np.ndarray:
+    return np.array([math.cos(0.5 * angle), 0.0, 0.0, math.sin(0.5 * angle)])

@@ -1,0 +1,128 @@
+"""Figures of a physics (MuJoCo) run: support loads drawn on the robot, tipping animation.
+
+Works from a recorded run (a :class:`~ddwmmr.sim.SimulationResult` whose time series has
+the :class:`~ddwmmr.plants.MujocoPlant` columns ``support_force_<name>_n``,
+``physics_stability``, ``base_tilt_rad`` and the kinematic ``stability``). World frame,
+metres, newtons. The robot is drawn with :func:`ddwmmr.reports.plots.robot_outline`.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")  # files only: never needs a screen
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.axes import Axes
+
+from ddwmmr.reports.plots import robot_outline
+
+
+def support_names(timeseries: dict[str, np.ndarray]) -> list[str]:
+    """Support names recorded in a physics time series (``support_force_<name>_n``)."""
+    prefix, suffix = "support_force_", "_n"
+    return [c[len(prefix) : -len(suffix)] for c in timeseries if c.startswith(prefix)]
+
+
+def support_points_world(q, points) -> np.ndarray:
+    """Base-frame support points (n, 2) placed at configuration q (world frame, m)."""
+    x, y, phi = (float(v) for v in q[:3])
+    c, s = math.cos(phi), math.sin(phi)
+    pts = np.asarray(points, dtype=float)
+    return np.column_stack([x + c * pts[:, 0] - s * pts[:, 1], y + s * pts[:, 0] + c * pts[:, 1]])
+
+
+def draw_supports(ax: Axes, q, points, forces, weight_n: float) -> None:
+    """Support points at q as discs whose area is proportional to their load; an unloaded
+    support is an empty red ring."""
+    world = support_points_world(q, points)
+    forces = np.asarray(forces, dtype=float)
+    loaded = forces > 1e-3 * weight_n
+    sizes = 600.0 * forces / weight_n
+    ax.scatter(*world[loaded].T, s=sizes[loaded], color="tab:blue", alpha=0.6, zorder=3)
+    ax.scatter(*world[~loaded].T, s=40, facecolors="none", edgecolors="tab:red", zorder=3)
+
+
+def save_physics_animation(
+    result,
+    points,
+    weight_n: float,
+    path: str | Path,
+    frames: int = 60,
+    fps: int = 12,
+    after_tip_s: float = 1.0,
+) -> Path:
+    """GIF of a physics run: top view with the support loads, and S / S_phys / tilt in time.
+
+    Args:
+        result: the recorded run (time series with the physics columns).
+        points: nominal base-frame support points (n, 2), in the order of the columns.
+        weight_n: the robot's weight (N), to scale the load discs.
+        path: output ``.gif``.
+        after_tip_s: a run that tipped (``summary["tip_time_s"]``) is shown only this long
+            after it tipped (the top view of a fallen robot means nothing).
+    """
+    from matplotlib.animation import FuncAnimation, PillowWriter
+
+    robot = result.robot
+    ts = result.timeseries
+    tip_time = result.summary.get("tip_time_s")
+    if tip_time is not None:
+        keep = ts["t"] <= tip_time + after_tip_s
+        ts = {name: values[keep] for name, values in ts.items()}
+    names = support_names(ts)
+    forces = np.column_stack([ts[f"support_force_{n}_n"] for n in names])
+    q = np.column_stack([ts[k] for k in ("x", "y", "phi", "th1", "th2")])
+    fig, (ax, ax_s) = plt.subplots(1, 2, figsize=(9.5, 4.2), width_ratios=(1, 1.25))
+    reach = robot.reach + 0.5 * robot.base_length
+    ax.set_xlim(ts["x"].min() - reach, ts["x"].max() + reach)
+    ax.set_ylim(ts["y"].min() - reach, ts["y"].max() + reach)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    if "xE_d" in ts:
+        ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=0.8)
+    ax_s.plot(ts["t"], ts["stability"], color="tab:brown", label="S (kinematic)")
+    ax_s.plot(ts["t"], ts["physics_stability"], color="tab:blue", lw=0.8, label="S_phys")
+    ax_s.axhline(1.0, color="tab:red", ls="--", lw=0.8)
+    ax_s.set_ylim(0.0, 2.0)
+    if tip_time is not None:
+        ax_s.axvline(tip_time, color="tab:red", lw=0.8)
+        ax_s.annotate(" tipped", (tip_time, 1.85), color="tab:red", fontsize=8)
+    ax_s.set_xlabel("t (s)")
+    ax_s.set_ylabel("stability margin")
+    tilt_axis = ax_s.twinx()
+    tilt_axis.plot(ts["t"], np.degrees(ts["base_tilt_rad"]), color="0.5", lw=0.8)
+    tilt_axis.set_ylabel("base tilt (deg, grey)")
+    ax_s.legend(loc="lower left", fontsize=8)
+    cursor = ax_s.axvline(0.0, color="k", lw=0.8)
+    (footprint,) = ax.plot([], [], color="0.3")
+    (arm,) = ax.plot([], [], color="tab:orange", lw=2, marker="o", ms=3)
+    discs = ax.scatter([], [], s=[], color="tab:blue", alpha=0.6, zorder=3)
+    indices = np.linspace(0, len(q) - 1, frames).astype(int)
+    title = f"{result.summary.get('method', '?')}, payload {robot.payload:g} kg"
+
+    def update(frame: int):
+        k = indices[frame]
+        shape = robot_outline(robot, q[k])
+        footprint.set_data(*shape["footprint"].T)
+        arm.set_data(*shape["arm"].T)
+        discs.set_offsets(support_points_world(q[k], points))
+        discs.set_sizes(np.maximum(600.0 * forces[k] / weight_n, 4.0))
+        discs.set_color(["tab:blue" if f > 1e-3 * weight_n else "tab:red" for f in forces[k]])
+        cursor.set_xdata([ts["t"][k], ts["t"][k]])
+        fallen = " (tipped)" if tip_time is not None and ts["t"][k] >= tip_time else ""
+        ax.set_title(f"{title}: t = {ts['t'][k]:.2f} s{fallen}", fontsize=9)
+        return footprint, arm, discs, cursor
+
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    animation = FuncAnimation(fig, update, frames=len(indices), blit=False)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    animation.save(path, writer=PillowWriter(fps=fps))
+    plt.close(fig)
+    return path
