@@ -5,10 +5,8 @@ Run from the repository root::
     MPLBACKEND=Agg .venv/bin/python docs/physics_figures.py
 
 Writes ``docs/figures/physics_*.png`` and ``physics_tipping.gif`` and prints the tables
-quoted in docs/physics.md (markdown). The dynamic runs use :func:`run_closed_loop`, a small
-stand-in for ``simulate(..., plant=...)`` that follows the loop of
-:mod:`ddwmmr.plants.base` exactly (reset, then per step observe -> controller.command ->
-limit -> record -> step); tests/test_mujoco_validation.py imports it from here.
+quoted in docs/physics.md (markdown). The dynamic runs are ``simulate(..., plant="mujoco")``
+(the library's one loop); tests/test_mujoco_validation.py imports helpers from here.
 """
 
 from __future__ import annotations
@@ -28,8 +26,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ddwmmr import Ellipse, Robot, load_trajectory, make_controller, simulate
-from ddwmmr.plants.base import PlantDivergedError
+from ddwmmr import Ellipse, Robot, load_trajectory, simulate
 from ddwmmr.plants.mujoco import MujocoPlant
 from ddwmmr.plants.mujoco.plant import TIP_TILT_RAD, UNLOADED_FRACTION
 from ddwmmr.resolution.reference import (
@@ -37,7 +34,6 @@ from ddwmmr.resolution.reference import (
     offset_configuration,
     start_configuration,
 )
-from ddwmmr.sim.result import SimulationResult
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = ROOT / "docs" / "figures"
@@ -47,66 +43,6 @@ HOLD_S = 0.5
 #: Bisection resolution of the static tipping searches (kg and rad).
 PAYLOAD_RESOLUTION_KG = 1e-3
 ANGLE_RESOLUTION_RAD = 1e-4
-
-
-# -- the interim closed loop ------------------------------------------------------------
-#: Columns :func:`run_closed_loop` records before the plant's own (v, w are the applied
-#: command; ``*_measured`` what the plant reports).
-LOOP_COLUMNS = (
-    "t", "x", "y", "phi", "th1", "th2", "v_measured", "w_measured", "v", "w", "th1dot",
-    "th2dot", "xE", "yE", "xE_d", "yE_d", "position_error_m", "stability", "saturated",
-)  # fmt: skip
-
-
-def run_closed_loop(
-    plant, controller, trajectory, q0, dt: float = DT, duration: float | None = None
-) -> SimulationResult:
-    """Run ``controller`` on ``plant`` along ``trajectory`` (stand-in for simulate(plant=)).
-
-    The loop of :mod:`ddwmmr.plants.base`: ``plant.reset(q0, dt)``, then per step
-    observe -> ``controller.command`` -> ``plant.limit`` -> record -> ``plant.step``. A
-    diverged engine stops the run and keeps what was recorded. Columns: t, q, measured v
-    and w, the applied command, end-effector pose and error, kinematic S and the plant's
-    extra columns.
-    """
-    duration = trajectory.duration if duration is None else duration
-    robot = plant.robot
-    steps = round(duration / dt)
-    plant.reset(np.asarray(q0, dtype=float), dt)
-    controller.reset(trajectory, np.asarray(q0, dtype=float).copy())
-    columns = (*LOOP_COLUMNS, *plant.extra_columns)
-    rows = []
-    diverged = None
-    for k in range(steps + 1):
-        t = k * dt
-        obs = plant.observe()
-        pose_d = trajectory.pose(t)
-        u = controller.command(t, obs.q, pose_d, trajectory.velocity(t))
-        applied, saturated = plant.limit(obs.q, u)
-        pose = robot.fk(obs.q)
-        error = math.hypot(pose_d[0] - pose[0], pose_d[1] - pose[1])
-        stability = robot.stability(obs.q)[2]
-        rows.append([t, *obs.q, obs.v, obs.w, *applied, *pose[:2], *pose_d[:2], error, stability])
-        rows[-1] += [float(saturated), *plant.extra_values()]
-        if k == steps:
-            break
-        try:
-            plant.step(t, applied, dt)
-        except PlantDivergedError as exc:
-            diverged = str(exc)
-            break
-    data = np.array(rows)
-    timeseries = {name: data[:, i] for i, name in enumerate(columns)}
-    summary = {
-        "method": getattr(controller, "name", type(controller).__name__),
-        "trajectory": getattr(trajectory, "name", type(trajectory).__name__.lower()),
-        "plant": plant.name,
-        "rms_position_error_m": float(np.sqrt(np.mean(timeseries["position_error_m"] ** 2))),
-        "min_stability": float(np.min(timeseries["stability"])),
-        "diverged": diverged,
-        **plant.summarize(timeseries),
-    }
-    return SimulationResult(timeseries, summary, robot, trajectory, controller)
 
 
 # -- static holds -------------------------------------------------------------------------
@@ -306,9 +242,7 @@ def sideways_reach_runs(payloads=(3.0, 3.5, 4.0)) -> tuple[str, dict]:
         robot = Robot().with_payload(payload)
         q0 = robot.base_for_end_effector(trajectory.pose(0.0), 1.0, 1.6)
         for method, options in methods:
-            result = run_closed_loop(
-                MujocoPlant(robot), make_controller(method, robot, **options), trajectory, q0
-            )
+            result = simulate(robot, trajectory, method, plant="mujoco", q0=q0, dt=DT, **options)
             runs[payload, method] = result
             s = result.summary
             below = result.timeseries["t"][result.timeseries["stability"] < 1.0]
@@ -388,7 +322,7 @@ def ellipse_run(plant: MujocoPlant, method: str = "clrrmc-ts"):
     robot = plant.robot
     trajectory = Ellipse()
     q0 = offset_configuration(robot, start_configuration(robot, trajectory), DEFAULT_INITIAL_OFFSET)
-    return run_closed_loop(plant, make_controller(method, robot), trajectory, q0)
+    return simulate(robot, trajectory, method, plant=plant, q0=q0, dt=DT)
 
 
 def tracking_reasons() -> str:

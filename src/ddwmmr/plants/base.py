@@ -57,6 +57,9 @@ class Plant(Protocol):
         interfaces: command interfaces accepted (``"velocity"``, ``"force"``).
         robot: the :class:`~ddwmmr.model.Robot` it simulates.
         extra_columns: names of plant-specific time-series columns (may be empty).
+
+    Optional: ``timestep`` (s), an engine step that control steps must be whole multiples
+    of (``simulate`` rounds its default step to one).
     """
 
     name: str

@@ -47,7 +47,8 @@ def simulate(
         trajectory: any object with ``duration``, ``pose(t)`` and ``velocity(t)``.
         method: a registered method name (see ``available_methods()``) or a controller.
         dt: control/integration step (s); default ``duration / samples`` of the trajectory
-            (its resolution N), or duration / 1000.
+            (its resolution N), or duration / 1000, rounded to a whole multiple of the
+            plant's engine ``timestep`` if it has one.
         duration: simulated time (s); default one trajectory period.
         integrator: ``"rk4"`` (default) or ``"euler"``; the kinematic plant's integrator
             (the other plants integrate their own dynamics and take no integrator).
@@ -74,13 +75,16 @@ def simulate(
     else:
         controller = method
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
+    the_plant = _plant(plant, robot, integrator, plant_options)
     if dt is None:
         dt = trajectory.duration / getattr(trajectory, "samples", 1000)
+        quantum = getattr(the_plant, "timestep", None)
+        if quantum:  # an engine step: the nearest whole multiple of it
+            dt = max(1, round(dt / quantum)) * quantum
     dt = check_positive("dt", dt)
     if dt > duration:
         raise ParameterError(f"dt must be <= duration ({duration:g} s) (got {dt:g})")
     steps = max(1, round(duration / dt))
-    the_plant = _plant(plant, robot, integrator, plant_options)
     if q0 is None:
         offset = tuple(check_finite("initial_offset", v) for v in initial_offset)
         if len(offset) != 2:

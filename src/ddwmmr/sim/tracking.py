@@ -2,7 +2,8 @@
 
 :class:`TrackingTask` feeds :func:`ddwmmr.sim.loop.run_loop` the trajectory's pose and
 velocity and records, per sample, only what the loop knows cheaply (time, state, applied
-input, the desired pose, the controller's flags and timing, the plant's extra columns).
+input ``v, w, th1dot, th2dot``, the measured base velocities ``v_measured, w_measured``
+(which lag the command on plants with dynamics), the desired pose, the controller's flags and timing, the plant's extra columns).
 Everything derived (end-effector pose, errors, wheel speeds, manipulability, stability) is
 computed afterwards, vectorised over the run, by :func:`derive_columns`.
 """
@@ -31,6 +32,8 @@ COLUMNS = (
     "w",
     "th1dot",
     "th2dot",
+    "v_measured",
+    "w_measured",
     "xE",
     "yE",
     "phiE",
@@ -63,6 +66,8 @@ RECORDED = (
     "w",
     "th1dot",
     "th2dot",
+    "v_measured",
+    "w_measured",
     "xE_d",
     "yE_d",
     "phiE_d",
@@ -126,6 +131,8 @@ class TrackingTask:
                 t,
                 *obs.q.tolist(),
                 *u,
+                obs.v,
+                obs.w,
                 *self.reference(t, obs)[0].tolist(),
                 info.nonholonomic_residual,
                 float(info.singular),

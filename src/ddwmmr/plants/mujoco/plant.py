@@ -163,6 +163,11 @@ class MujocoPlant:
             "wheel_actuators": [ACTUATORS.index("wheel_left"), ACTUATORS.index("wheel_right")],
         }
 
+    @property
+    def timestep(self) -> float:
+        """Engine step (s): control steps must be whole multiples of it."""
+        return self.options.timestep
+
     def control_step_choices(self, count: int = 3) -> str:
         """The first ``count`` allowed control steps (s), for messages."""
         h = self.options.timestep
