@@ -3,7 +3,8 @@
 :class:`TrackingTask` feeds :func:`ddwmmr.sim.loop.run_loop` the trajectory's pose and
 velocity and records, per sample, only what the loop knows cheaply (time, state, applied
 input ``v, w, th1dot, th2dot``, the measured base velocities ``v_measured, w_measured``
-(which lag the command on plants with dynamics), the desired pose, the controller's flags and timing, the plant's extra columns).
+(which lag the command on plants with dynamics), the desired pose, the controller's flags
+and timing, the plant's extra columns).
 Everything derived (end-effector pose, errors, wheel speeds, manipulability, stability) is
 computed afterwards, vectorised over the run, by :func:`derive_columns`.
 """
