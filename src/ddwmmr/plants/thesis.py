@@ -101,6 +101,33 @@ def arm_step(
     return th1 + e1 * fraction, th2 + e2 * fraction
 
 
+def damped_base_envelope(
+    force_limit: float,
+    c1: float,
+    c2: float,
+    mass: float,
+    half_width: float,
+    stretched_inertia: float,
+    fraction: float = 0.8,
+) -> dict[str, float]:
+    """What a velocity command can ask of a damped, force-limited base, as ``fraction`` of
+    the physics.
+
+    Top speeds where the full force balances damping (``2 F / c1`` m/s,
+    ``2 F (width/2) / c2`` rad/s) and accelerations from rest with the largest yaw inertia
+    (arm stretched): ``2 F / m`` (m/s^2), ``2 F (width/2) / I`` (rad/s^2). ``force_limit``
+    is per wheel (N). Keys match the ``qp`` controller's options.
+    """
+    total = 2.0 * force_limit
+    torque = total * half_width
+    return {
+        "max_base_speed": fraction * total / c1,
+        "max_yaw_rate": fraction * torque / c2,
+        "max_acceleration": fraction * total / mass,
+        "max_yaw_acceleration": fraction * torque / stretched_inertia,
+    }
+
+
 class ThesisPlant:
     """Force-driven base dynamics with the arm pseudo-controller (thesis ch. 3 and 4.4.2).
 
@@ -211,21 +238,16 @@ class ThesisPlant:
         return self._inertia_fixed + m1 * 0.25 * r.L1**2 + m2 * mid2 + r.payload * tip
 
     def velocity_envelope(self, fraction: float = 0.8) -> dict[str, float]:
-        """What a velocity command can ask of this base, as ``fraction`` of the physics.
-
-        Top speeds where the full force balances damping (``2 F / c1`` m/s,
-        ``2 F (width/2) / c2`` rad/s) and accelerations from rest with the largest yaw
-        inertia (arm stretched). Keys match the ``qp`` controller's options.
-        """
-        total = 2.0 * self.force_limit
-        torque = total * self._half_width
-        stretched = self.inertia(0.0, 0.0)
-        return {
-            "max_base_speed": fraction * total / self.c1,
-            "max_yaw_rate": fraction * torque / self.c2,
-            "max_acceleration": fraction * total / self.mass,
-            "max_yaw_acceleration": fraction * torque / stretched,
-        }
+        """What a velocity command can ask of this base: :func:`damped_base_envelope`."""
+        return damped_base_envelope(
+            self.force_limit,
+            self.c1,
+            self.c2,
+            self.mass,
+            self._half_width,
+            self.inertia(0.0, 0.0),
+            fraction,
+        )
 
     def clip_force(self, force: float) -> float:
         """A wheel force limited to ``+-force_limit`` (N)."""

@@ -52,11 +52,12 @@ from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.plants import make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+from ddwmmr.plants.thesis import C1_DEFAULT, C2_DEFAULT
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.loop import run_loop
 
 CONTROLLERS = ("thesis", "qp")
-PLANTS = ("thesis", "kinematic")
+PLANTS = ("thesis", "kinematic", "mujoco")
 #: Motion detection thresholds for controllers without states (m/s, rad/s).
 MOVING_SPEED, MOVING_RATE = 1e-3, 1e-3
 #: Trace sampling interval for recorded scenarios (s).
@@ -118,9 +119,10 @@ class RunConfig:
             )
         if self.plant not in PLANTS:
             raise ParameterError(f"plant must be one of {', '.join(PLANTS)} (got {self.plant!r})")
-        if self.controller == "thesis" and self.plant != "thesis":
+        if self.controller == "thesis" and self.plant == "kinematic":
             raise ParameterError(
-                "plant: the thesis controller outputs wheel forces and needs --plant thesis"
+                "plant: the thesis controller outputs wheel forces and needs a plant that "
+                "takes them (thesis or mujoco)"
             )
         Hysteresis(*self.stability)
         Hysteresis(*self.manipulability)
@@ -354,9 +356,17 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
 
 
 def make_scenario_plant(robot: Robot, config: RunConfig) -> Plant:
-    """The plant of ``config``: thesis dynamics, or the kinematic model (Euler)."""
+    """The plant of ``config``: thesis dynamics, the kinematic model (Euler), or MuJoCo.
+
+    The MuJoCo plant carries the thesis plant's base damping (c1, c2): the benchmark then
+    differs between the thesis and the physics plant only by what physics adds (contacts,
+    tipping, wheel slip, motor torque limits, arm inertia), and the thesis controller's PD
+    gains meet the damped base they were designed for.
+    """
     if config.plant == "kinematic":
         return make_plant("kinematic", robot, integrator="euler")
+    if config.plant == "mujoco":
+        return make_plant("mujoco", robot, base_damping=(C1_DEFAULT, C2_DEFAULT))
     return make_plant(config.plant, robot)
 
 

@@ -42,7 +42,7 @@ from ddwmmr.plants.mujoco.model import (
     supports,
 )
 from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
-from ddwmmr.plants.thesis import arm_step
+from ddwmmr.plants.thesis import ThesisPlant, arm_step, damped_base_envelope
 
 #: Time (s) the robot settles on its supports in :meth:`MujocoPlant.reset` before t = 0,
 #: so that the first recorded contact forces carry the robot's weight.
@@ -87,6 +87,11 @@ class MujocoPlant:
         servo_time_constant: response time of the velocity servos (s).
         cone: MuJoCo friction cone, ``"pyramidal"`` or ``"elliptic"``.
         contact_time_constant: stiffness of the contacts as a time constant (s).
+        base_damping: ``(c_translation N s/m, c_yaw N m s/rad)`` viscous damping of the
+            base's horizontal and yaw motion (the thesis plant's c1, c2: rolling resistance
+            and drive friction as the thesis models them); None (default): none, the
+            engine's own friction only. Force-level controllers tuned on the thesis plant
+            (its PD gains assume that damping) need it.
 
     Raises:
         ParameterError: for a robot or option MuJoCo cannot build (one line).
@@ -104,7 +109,9 @@ class MujocoPlant:
         servo_time_constant: float | None = None,
         cone: str | None = None,
         contact_time_constant: float | None = None,
+        base_damping: tuple[float, float] | None = None,
     ) -> None:
+        self.base_damping = _check_damping(base_damping)
         given = {
             "timestep": timestep,
             "friction": friction,
@@ -163,6 +170,24 @@ class MujocoPlant:
             "wheel_actuators": [ACTUATORS.index("wheel_left"), ACTUATORS.index("wheel_right")],
         }
 
+    def velocity_envelope(self, fraction: float = 0.8) -> dict[str, float] | None:
+        """With ``base_damping``: what a velocity command can ask of the damped base
+        (:func:`~ddwmmr.plants.thesis.damped_base_envelope` with the wheel force the motor
+        torque limit allows, ``wheel_torque_limit / wheel_radius``); None without damping
+        (no drag: the wheel-speed and torque limits are the whole story)."""
+        if self.base_damping is None:
+            return None
+        robot = self.robot
+        return damped_base_envelope(
+            robot.wheel_torque_limit / robot.wheel_radius,
+            self.base_damping[0],
+            self.base_damping[1],
+            float(np.sum(self.model.body_mass)),
+            0.5 * robot.base_width,
+            ThesisPlant(robot).inertia(0.0, 0.0),
+            fraction,
+        )
+
     @property
     def timestep(self) -> float:
         """Engine step (s): control steps must be whole multiples of it."""
@@ -219,6 +244,11 @@ class MujocoPlant:
         model.dof_damping[0:6] = self._settle_damping
         mujoco.mj_step(model, data, max(1, round(SETTLE_TIME_S / model.opt.timestep)))
         model.dof_damping[0:6] = 0.0
+        if self.base_damping is not None:
+            # free joint: dofs 0-2 translate in the world frame, 3-5 rotate in the body's
+            # (z is the yaw axis while the base stands); roll and pitch stay undamped.
+            model.dof_damping[0] = model.dof_damping[1] = self.base_damping[0]
+            model.dof_damping[5] = self.base_damping[1]
         self._check_state("while the robot settled at reset")
         self._step_count = 0
         self._place(q0, z=float(data.qpos[2]), keep_tilt=True)
@@ -462,3 +492,19 @@ def _heading(quaternion) -> float:
 
 def _yaw_quaternion(angle: float) -> np.ndarray:
     return np.array([math.cos(0.5 * angle), 0.0, 0.0, math.sin(0.5 * angle)])
+
+
+def _check_damping(value: tuple[float, float] | None) -> tuple[float, float] | None:
+    """Validate the ``base_damping`` option: None or two numbers >= 0."""
+    if value is None:
+        return None
+    try:
+        c_t, c_yaw = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ParameterError(
+            f"base_damping must be (N s/m, N m s/rad), two numbers >= 0 (got {value!r})"
+        ) from None
+    for name, number in (("base_damping[1]", c_t), ("base_damping[2]", c_yaw)):
+        if not (math.isfinite(number) and number >= 0.0):
+            raise ParameterError(f"{name} must be a finite number >= 0 (got {number!r})")
+    return c_t, c_yaw
