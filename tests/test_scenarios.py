@@ -129,11 +129,6 @@ def test_high_threshold_without_hysteresis_oscillates_in_stability():
     assert m["transitions_stability"] > 20  # thesis 5.3.2: many re-entries without hysteresis
 
 
-def test_thesis_controller_needs_thesis_plant():
-    with pytest.raises(ParameterError, match="needs --plant thesis"):
-        RunConfig(controller="thesis", plant="kinematic")
-
-
 def test_qp_controller_runs_on_both_plants_with_state_metrics_not_applicable():
     s = Scenario(0, ((1.0, 0.5), (1.5, 1.0), (1.0, 1.5), (0.5, 1.0), (1.0, 0.5)))
     for plant in ("kinematic", "thesis"):
