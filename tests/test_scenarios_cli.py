@@ -61,7 +61,7 @@ def test_obstacle_study_table(tmp_path, capsys):
         (["--n", "0"], "n must be an integer >= 1"),
         (["--stability", "1.6", "1.2"], "enter must be <= exit"),
         (["--controller", "nope"], "invalid choice"),
-        (["--controller", "thesis", "--plant", "kinematic"], "needs --plant thesis"),
+        (["--controller", "thesis", "--plant", "kinematic"], "thesis or mujoco"),
         (["--payload", "-1"], "payload must be > 0"),
         (["--scheduler", "tcp://x:1"], "only used with --executor dask"),
         (["--jobs", "0"], "jobs must be an integer >= 1"),
