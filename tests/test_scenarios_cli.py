@@ -58,13 +58,13 @@ def test_obstacle_study_table(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--n", "0"], "n must be an integer >= 1"),
+        (["--n", "0"], "n must be an integer in [1, 100000]"),
         (["--stability", "1.6", "1.2"], "enter must be <= exit"),
         (["--controller", "nope"], "invalid choice"),
         (["--controller", "thesis", "--plant", "kinematic"], "needs --plant thesis"),
         (["--payload", "-1"], "payload must be > 0"),
         (["--scheduler", "tcp://x:1"], "only used with --executor dask"),
-        (["--jobs", "0"], "jobs must be an integer >= 1"),
+        (["--jobs", "0"], "jobs must be an integer in [1, 256]"),
         (["--study", "thresholds", "--controller", "qp"], "needs --controller thesis"),
         (["--dt", "0"], "dt must be > 0"),
     ],
@@ -89,7 +89,7 @@ def test_refuses_to_replace_a_foreign_folder(tmp_path, capsys):
     out.mkdir()
     (out / "notes.txt").write_text("keep me")
     assert cli([*FAST, "--out", str(out)]) == 2
-    assert "not an output folder" in capsys.readouterr().err
+    assert "holds files no ddwmmr scenarios run wrote" in capsys.readouterr().err
     assert (out / "notes.txt").read_text() == "keep me"
 
 
