@@ -21,7 +21,6 @@ usual ``022``), not the ``0600``/``0700`` of temporary files.
 from __future__ import annotations
 
 import contextlib
-import functools
 import json
 import os
 import shutil
@@ -41,9 +40,13 @@ _OLD_PREFIX = ".ddwmmr-old-"
 
 
 # -- permissions ------------------------------------------------------------------------
-@functools.cache
 def umask() -> int:
-    """The process umask (read once: ``os.umask`` can only be read by setting it)."""
+    """The process umask: from ``/proc/self/status`` on Linux (no race with other
+    threads), else by setting and restoring it (``os.umask`` can only be read so)."""
+    with contextlib.suppress(OSError, ValueError):
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
     mask = os.umask(0o022)
     os.umask(mask)
     return mask

@@ -453,7 +453,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     args.argv = argv  # recorded in the summary
     config = config_from_arguments(args)
-    out = Path(args.out) if args.out else default_out()
+    out = Path(args.out) if args.out is not None else default_out()
     check_output_folder(out, "scenarios", args.force)
     if config.controller == "qp":
         from ddwmmr.scenarios.protocol import make_qp

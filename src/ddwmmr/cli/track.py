@@ -29,7 +29,7 @@ from ddwmmr.cli.common import (
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, make_controller, method_description
-from ddwmmr.errors import ParameterError, check_step_count, read_text_file
+from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file
 from ddwmmr.model import Robot
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
@@ -241,6 +241,8 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     else:
         step = args.dt
     offset = DEFAULT_INITIAL_OFFSET if args.offset is None else tuple(args.offset)
+    for value in offset:
+        check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
     return RunInputs(
         args.method,
         options,
@@ -325,7 +327,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     inputs = inputs_from_record(args) if args.rerun else inputs_from_arguments(args)
     steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
     controller = make_controller(inputs.method, inputs.robot, **inputs.options)
-    out = Path(args.out) if args.out else default_out(inputs.method, inputs.label)
+    out = Path(args.out) if args.out is not None else default_out(inputs.method, inputs.label)
     check_output_folder(out, "track", args.force)
     record = run_record(inputs, argv, args.rerun)
     progress = not args.no_progress
