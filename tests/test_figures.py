@@ -56,16 +56,20 @@ def test_obstacles_are_drawn_in_the_path_plot(rectangle_run):
     plt.close(fig)
 
 
-def test_timeline_axes_are_labelled(tmp_path, monkeypatch):
+def test_timeline_axes_are_labelled_and_waypoints_marked(tmp_path, monkeypatch):
     scenario = generate(1, 0)[0]
-    outcome = run_scenario(scenario, RunConfig(time_limit=3.0, record=True))
+    outcome = run_scenario(scenario, RunConfig(time_limit=15.0, record=True))
+    reached = outcome.metrics["waypoints_reached"]
+    assert reached >= 2
     figures = []
     monkeypatch.setattr(report, "_save", lambda fig, path: figures.append(fig))
-    report.plot_timeline(outcome, tmp_path / "t.png", "thesis")
+    report.plot_timeline(outcome, tmp_path / "t.png", "thesis", scenario)
     labels = [ax.get_ylabel() for ax in figures[0].axes]
     assert labels[0] == "state" and "stability S" in labels[1]
     assert "manipulability" in labels[2] and "waypoint (m)" in labels[3]
     assert figures[0].axes[3].get_xlabel() == "time (s)"
+    marks = [line for line in figures[0].axes[3].lines if line.get_linestyle() == ":"]
+    assert len(marks) == reached  # one per waypoint reached while the trace ran
     plt.close(figures[0])
 
 

@@ -244,3 +244,24 @@ def test_files_and_folders_follow_the_umask(tmp_path, mask):
     assert stat.S_IMODE(out.stat().st_mode) == 0o777 & ~mask
     for path in out.iterdir():
         assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask, path.name
+
+
+# -- the compare and scenarios records (issue 8 item 6) ----------------------------------
+def test_compare_records_everything_to_rerun(made):
+    record = json.loads((made["compare"] / "run.json").read_text())
+    assert record["tool"] == "compare" and record["methods"] == ["pi"]
+    assert record["options"] == {"pi": {"singularity_threshold": 0.05, "damping": 0.05}}
+    assert record["robot"]["payload"] == 1.25 and record["duration"] == 0.2
+    ellipse = record["trajectories"]["ellipse"]
+    assert ellipse["type"] == "ellipse" and ellipse["parameters"]["a"] == 2.0
+    assert ellipse["sha256"] and record["studies"] == [] and record["jobs"] == 1
+    assert record["argv"][:2] == ["--methods", "pi"] and "--only ellipse" in record["command"]
+
+
+def test_scenarios_records_everything_to_rerun(made):
+    summary = json.loads((made["scenarios"] / "summary.json").read_text())
+    record = summary["run"]
+    assert record["tool"] == "scenarios" and record["n"] == 1 and record["seed"] == 0
+    assert record["config"]["time_limit"] == 0.3 and record["config"]["payload"] == 3.0
+    assert record["robot"]["payload"] == 3.0 and record["plant"] == {"name": "thesis"}
+    assert record["command"].startswith("python -m ddwmmr.scenarios --n 1")

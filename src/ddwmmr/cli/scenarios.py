@@ -345,8 +345,8 @@ def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
     traced = replace(config, record=True)
     items = [(scenarios[i], run_scenario(scenarios[i], traced)) for i in chosen]
     report.plot_paths(items, folder / "thesis_paths.png", f"{short}: paths")
-    timeline = next(o for (s, o) in items if s.index == scenarios[focus].index)
-    report.plot_timeline(timeline, folder / "thesis_timeline.png", short)
+    scenario, timeline = next((s, o) for (s, o) in items if s.index == scenarios[focus].index)
+    report.plot_timeline(timeline, folder / "thesis_timeline.png", short, scenario)
 
 
 def highlight(outcomes: list[Outcome]) -> int:
