@@ -241,3 +241,14 @@ def test_package_main_lists_the_tools():
         assert any(f"ddwmmr-{tool}" in line for line in lines)
     done = subprocess.run([sys.executable, "-m", "ddwmmr", "nope"], capture_output=True, text=True)
     assert done.returncode == 2 and len(done.stderr.splitlines()) == 1
+
+
+def test_progress_off_a_terminal_is_one_line_per_phase(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert run(["--method", "pi", "--traj", "ellipse", "--duration", "2", "--out", str(out)]) == 0
+    err = capsys.readouterr().err.splitlines()  # captured: not a terminal
+    assert err[0].startswith("track: steps: 100/100 done in ")
+    assert all(line.startswith("track: ") for line in err)
+    assert run(["--method", "pi", "--traj", "ellipse", "--duration", "2", "--no-progress",
+                "--out", str(out)]) == 0  # fmt: skip
+    assert capsys.readouterr().err == ""

@@ -113,3 +113,26 @@ def test_threshold_study_table_has_thesis_and_our_numbers(tmp_path, capsys):
     assert "42 / " in table  # Table 5.12 threshold 5
     summary = json.loads((out / "summary.json").read_text())
     assert len(summary["variants"]) == 18
+
+
+def test_default_out_is_a_new_timestamped_folder(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert cli(["--n", "1", "--time-limit", "0.3", "--jobs", "1", "--no-progress"]) == 0
+    (folder,) = (tmp_path / "runs").iterdir()
+    assert folder.name.startswith("scenarios-") and (folder / "summary.json").is_file()
+    assert f"wrote runs/{folder.name}" in capsys.readouterr().err
+
+
+def test_payload_that_tips_the_start_pose_is_refused_with_the_limit(tmp_path, capsys):
+    from ddwmmr.behaviours.objective import default_pose
+    from ddwmmr.model import Robot
+
+    assert cli(["--payload", "10", "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err
+    limit = float(err.rsplit("at most ", 1)[1].split()[0])
+    # Just below the limit the start pose stands (S > 1), just above it tips (S <= 1).
+    for payload, stands in ((0.99 * limit, True), (1.01 * limit, False)):
+        robot = Robot().with_payload(payload)
+        s = robot.stability((0.0, 0.0, 0.0, *default_pose(robot)))[2]
+        assert (s > 1.0) is stands
+    assert list(tmp_path.iterdir()) == []
