@@ -310,7 +310,11 @@ def _swap(staging: Path, target: Path, existing: Existing) -> None:
     old = Path(tempfile.mkdtemp(prefix=_OLD_PREFIX, dir=target.parent))
     old.rmdir()
     os.rename(target, old)
-    os.rename(staging, target)
+    try:
+        os.rename(staging, target)
+    except BaseException:
+        os.rename(old, target)  # put the old folder back before reporting the error
+        raise
     for name in [*existing.listed, MANIFEST]:
         _unlink_regular(old / name)
     _prune_empty(old)
