@@ -1,43 +1,56 @@
 # ddwmmr: two commands set everything up on a fresh machine with python3 and make.
-#   make demo   creates .venv, installs, runs the main job (writes runs/demo/)
-#   make test   creates .venv, installs with test extras, runs the suite
+#   make demo   creates .venv, installs the package (runtime dependencies only), runs the
+#               main job (writes runs/demo/)
+#   make test   creates .venv, installs with the test extras, runs the suite
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
-STAMP := $(VENV)/.installed
+# Two install stamps: the demo needs only the runtime dependencies; test, lint and docs
+# need the test extras (pytest, ruff, hypothesis, the optional QP backends, dask).
+STAMP_RUN := $(VENV)/.installed-run
+STAMP_TEST := $(VENV)/.installed-test
 
-.PHONY: demo test lint format bench docs clean
+.PHONY: demo test lint format bench docs docs-timings clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 
-$(STAMP): pyproject.toml | $(BIN)/python
-	$(BIN)/python -m pip install --quiet -e ".[test]"
-	touch $(STAMP)
+$(STAMP_RUN): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e .
+	touch $(STAMP_RUN)
 
-demo: $(STAMP)
+$(STAMP_TEST): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[test]"
+	touch $(STAMP_TEST) $(STAMP_RUN)
+
+demo: $(STAMP_RUN)
 	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.compare --out runs/demo
 
-test: $(STAMP)
+test: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python -m pytest
 
-lint: $(STAMP)
+lint: $(STAMP_TEST)
 	$(BIN)/ruff check src tests examples docs/*.py
 	$(BIN)/ruff format --check src tests examples docs/*.py
 
-format: $(STAMP)
+format: $(STAMP_TEST)
 	$(BIN)/ruff format src tests examples docs/*.py
 	$(BIN)/ruff check --fix src tests examples docs/*.py
 
-bench: $(STAMP)
+bench: $(STAMP_RUN)
 	$(BIN)/python -m ddwmmr.bench
 
-docs: $(STAMP)
+# Regenerates docs/figures byte for byte (no time stamps, no wall-clock content).
+docs: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python docs/make_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/qp_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/make_run_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/physics_figures.py
+
+# The figures of measured step times (machine-dependent: they change on every run).
+docs-timings: $(STAMP_TEST)
+	MPLBACKEND=Agg $(BIN)/python docs/qp_figures.py --timings
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache

@@ -1,12 +1,16 @@
 """``python -m ddwmmr.track``: outputs, summary keys, bad input (exit 2, nothing left)."""
 
+import dataclasses
+import hashlib
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+import ddwmmr
 from ddwmmr import Robot, load_trajectory, simulate
 from ddwmmr.cli.track import main as run
 from expected import REQUIRED_SUMMARY_KEYS
@@ -132,3 +136,119 @@ def test_help_explains_methods():
     assert process.returncode == 0
     for word in ("--method", "--traj", "--tau", "clrrmc-ts", "pseudoinverse", "--animate"):
         assert word in process.stdout
+
+
+# -- reproducibility: summary.json records the run, --rerun repeats it (issue 8) ----------
+def _rows_without_timing(path):
+    """timeseries.csv with the wall-clock column (step_us) removed, as text rows."""
+    lines = path.read_text().splitlines()
+    header = lines[0].split(",")
+    keep = [i for i, name in enumerate(header) if not name.endswith("_us")]
+    assert len(keep) == len(header) - 1  # exactly one timing column
+    return [[row.split(",")[i] for i in keep] for row in lines]
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["--method", "clrrmc-ts", "--traj", "rectangle", "--tau", "0.3", "0.3", "inf",
+         "--duration", "3", "--integrator", "euler", "--offset", "0.05", "0.01"],
+        ["--method", "ap", "--traj", "figure8", "--duration", "2", "--dt", "0.03",
+         "--payload", "2.5"],
+        ["--method", "qp", "--traj", "ellipse", "--obstacles", "ellipse_post",
+         "--stability-min", "1.3", "--duration", "1"],
+    ],
+    ids=["clrrmc-ts-inf-tau", "ap-csv", "qp-obstacles"],
+)  # fmt: skip
+def test_rerun_reproduces_the_run_bit_for_bit(tmp_path, args, capsys):
+    robot_file = tmp_path / "robot.toml"
+    robot_file.write_text("L2 = 0.32\nlink_masses = [1.2, 0.8]\n")
+    first, second = tmp_path / "first", tmp_path / "second"
+    assert run([*args, "--robot", str(robot_file), "--no-plots", "--out", str(first)]) == 0
+    robot_file.unlink()  # the record must not need the robot file any more
+    assert run(["--rerun", str(first / "summary.json"), "--no-plots", "--out", str(second)]) == 0
+    assert _rows_without_timing(first / "timeseries.csv") == _rows_without_timing(
+        second / "timeseries.csv"
+    )
+    one, two = (json.loads((f / "summary.json").read_text()) for f in (first, second))
+    record, again = one.pop("run"), two.pop("run")
+    for key in one:
+        if not key.endswith("_us"):
+            assert one[key] == two[key], key
+    for key in ("method", "options", "robot", "trajectory", "dt", "duration", "integrator"):
+        assert record[key] == again[key], key
+    assert again["rerun_of"] == str((first / "summary.json").resolve())
+
+
+def test_run_record_holds_everything_to_rerun(tmp_path):
+    out = tmp_path / "run"
+    argv = ["--method", "ats", "--traj", "figure8", "--duration", "1", "--no-plots"]
+    assert run([*argv, "--out", str(out)]) == 0
+    record = json.loads((out / "summary.json").read_text())["run"]
+    assert record["tool"] == "track" and record["version"] == ddwmmr.__version__
+    assert record["argv"] == [*argv, "--out", str(out)]
+    assert record["command"].startswith("python -m ddwmmr.track --method ats")
+    # Every option with its default filled in; the robot with all its fields.
+    assert record["options"] == {"aux": "shoulder", "singularity_threshold": 0.05, "damping": 0.05}
+    assert set(record["robot"]) == {f.name for f in dataclasses.fields(Robot) if f.init}
+    assert record["robot"]["payload"] == 1.25
+    # A sampled trajectory: its file and hash (computed here independently).
+    trajectory = record["trajectory"]
+    assert trajectory["type"] == "samples" and trajectory["name"] == "figure8"
+    data = Path(trajectory["file"]).read_bytes()
+    assert trajectory["sha256"] == hashlib.sha256(data).hexdigest()
+    assert record["dt"] == 60.0 / 241 and record["duration"] == 1.0
+    assert record["integrator"] == "rk4" and record["initial_offset"] == [0.03, -0.03]
+    assert record["plant"] == {"name": "kinematic"} and record["seed"] is None
+    git = record["git"]
+    assert git is None or len(git["commit"]) == 40
+
+
+def test_rerun_refuses_a_changed_trajectory_file_and_extra_options(tmp_path, capsys):
+    traj = tmp_path / "line.csv"
+    traj.write_text("t,x,y\n0,0,0\n1,0.1,0\n2,0.2,0\n3,0.3,0\n")
+    out = tmp_path / "run"
+    args = ["--method", "pi", "--traj", str(traj), "--offset", "0", "0", "--no-plots"]
+    assert run([*args, "--out", str(out)]) == 0
+    summary = str(out / "summary.json")
+    assert run(["--rerun", summary, "--dt", "0.1", "--out", str(tmp_path / "b")]) == 2
+    assert "--dt cannot be combined with --rerun" in capsys.readouterr().err
+    traj.write_text("t,x,y\n0,0,0\n1,0.2,0\n2,0.4,0\n3,0.6,0\n")
+    assert run(["--rerun", summary, "--out", str(tmp_path / "c")]) == 2
+    assert "changed since the run" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["line.csv", "run"]
+
+
+def test_errors_are_printed_in_mm(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert run(["--method", "pi", "--traj", "ellipse", "--duration", "1", "--no-plots",
+                "--out", str(out)]) == 0  # fmt: skip
+    printed = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    line = next(x for x in printed.splitlines() if "RMS position error (mm)" in x)
+    assert float(line.split()[-1]) == pytest.approx(
+        1000 * summary["rms_position_error_m"], rel=1e-5
+    )
+    assert "(m)" not in printed
+
+
+def test_package_main_lists_the_tools():
+    done = subprocess.run([sys.executable, "-m", "ddwmmr"], capture_output=True, text=True)
+    assert done.returncode == 0
+    lines = done.stdout.splitlines()
+    for tool in ("track", "compare", "scenarios", "bench"):
+        assert sum(f"python -m ddwmmr.{tool} " in line for line in lines) == 1
+        assert any(f"ddwmmr-{tool}" in line for line in lines)
+    done = subprocess.run([sys.executable, "-m", "ddwmmr", "nope"], capture_output=True, text=True)
+    assert done.returncode == 2 and len(done.stderr.splitlines()) == 1
+
+
+def test_progress_off_a_terminal_is_one_line_per_phase(tmp_path, capsys):
+    out = tmp_path / "run"
+    assert run(["--method", "pi", "--traj", "ellipse", "--duration", "2", "--out", str(out)]) == 0
+    err = capsys.readouterr().err.splitlines()  # captured: not a terminal
+    assert err[0].startswith("track: steps: 100/100 done in ")
+    assert all(line.startswith("track: ") for line in err)
+    assert run(["--method", "pi", "--traj", "ellipse", "--duration", "2", "--no-progress",
+                "--out", str(out)]) == 0  # fmt: skip
+    assert capsys.readouterr().err == ""

@@ -79,6 +79,7 @@ def test_metrics_equal_the_track_summary(report, tmp_path, method, trajectory):
     )
     assert status == 0
     summary = json.loads((out / "summary.json").read_text())
+    assert summary.pop("run")["method"] == method  # the run record: not a metric
     row = read_metrics(report / "metrics.csv")[(method, trajectory)]
     assert set(summary) <= set(row)
     for key, value in summary.items():
@@ -190,7 +191,7 @@ def test_bad_input_is_one_line_exit_2_and_no_folder(tmp_path, capsys, argv):
 def test_an_unrelated_folder_is_never_replaced(tmp_path, capsys):
     (tmp_path / "keep.txt").write_text("mine")
     assert main(["--study", "none", *SHORT, "--out", str(tmp_path)]) == 2
-    assert "not a compare report" in capsys.readouterr().err
+    assert "holds files no ddwmmr compare run wrote" in capsys.readouterr().err
     assert [p.name for p in tmp_path.iterdir()] == ["keep.txt"]
 
 

@@ -3,13 +3,18 @@
 from __future__ import annotations
 
 import importlib.util
+import math
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+
+from ddwmmr import Ellipse, Robot
+from ddwmmr.resolution.reference import offset_configuration, start_configuration
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 SCRIPTS = sorted(EXAMPLES.glob("*.py"))
@@ -38,14 +43,116 @@ def test_examples_exist() -> None:
     assert {p.name for p in SCRIPTS} >= set(EXPECTED)
 
 
+@pytest.fixture(scope="module")
+def printed(tmp_path_factory) -> dict[str, str]:
+    """Each example's standard output (each runs once, in an empty folder)."""
+    outputs = {}
+    for script in SCRIPTS:
+        folder = tmp_path_factory.mktemp(script.stem)
+        done = _run_python([str(script)], folder)
+        assert done.returncode == 0, done.stderr
+        assert list(folder.iterdir()) == []  # nothing written in the working directory
+        outputs[script.name] = done.stdout
+    return outputs
+
+
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.name)
-def test_example_runs(script: Path, tmp_path: Path) -> None:
-    done = _run_python([str(script)], tmp_path)
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.strip()
+def test_example_runs(script: Path, printed) -> None:
+    assert printed[script.name].strip()
     for text in EXPECTED.get(script.name, ()):
-        assert text in done.stdout
-    assert list(tmp_path.iterdir()) == []  # nothing written in the working directory
+        assert text in printed[script.name]
+
+
+# -- the examples' numbers against independent expectations --------------------------------
+#: Initial end-effector offset of every example run (simulate's default, 30 mm, -30 mm).
+E0 = math.hypot(0.03, -0.03)
+
+
+def closed_loop_rms(samples: int, dt: float, tau: float = 0.5) -> float:
+    """RMS over samples + 1 recorded instants of e0 exp(-t / tau), the exact closed-loop
+    decay of CLRRMC-TS's position error (K = 1/tau on x and y): a geometric series."""
+    ratio = math.exp(-2.0 * dt / tau)
+    return E0 * math.sqrt((1.0 - ratio ** (samples + 1)) / ((samples + 1) * (1.0 - ratio)))
+
+
+def _numbers(line: str) -> list[float]:
+    return [float(x) for x in re.findall(r"-?\d+\.?\d*(?:e-?\d+)?", line)]
+
+
+def test_quickstart_numbers(printed) -> None:
+    values = {}
+    for line in printed["quickstart.py"].splitlines()[1:]:
+        key, _, value = line.strip().partition(" ")
+        values[key] = value.strip()
+    # One 40 s period of the default ellipse in 2000 RK4 steps of 0.02 s.
+    assert int(values["steps"]) == 2000
+    assert float(values["max_position_error_m"]) == pytest.approx(E0, rel=1e-5)
+    assert float(values["rms_position_error_m"]) == pytest.approx(
+        closed_loop_rms(2000, 0.02), rel=1e-4
+    )
+    assert float(values["final_position_error_m"]) < E0 * math.exp(-40.0 / 0.5) + 1e-9
+    assert int(values["singular_steps"]) == 0
+
+
+def test_quickstart_first_command_tracks_with_the_feedback(printed) -> None:
+    """u makes the end effector move at Xd_dot + K (Xd - X) (checked by finite differences
+    of the forward kinematics), and the shoulder row of the ATS keeps th1dot = 0."""
+    line = next(x for x in printed["quickstart.py"].splitlines() if "first command u" in x)
+    v, w, th1dot, th2dot = _numbers(line.split("=")[1])
+    assert th1dot == 0.0
+    robot, trajectory = Robot(), Ellipse()
+    q = offset_configuration(robot, start_configuration(robot, trajectory), (0.03, -0.03))
+    qdot = np.array([v * math.cos(q[2]), v * math.sin(q[2]), w, th1dot, th2dot])
+    h = 1e-6
+    moved = (robot.fk(q + h * qdot) - robot.fk(q - h * qdot)) / (2 * h)
+    wanted = trajectory.velocity(0.0) + 2.0 * (trajectory.pose(0.0) - robot.fk(q))
+    np.testing.assert_allclose(moved[:2], wanted[:2], atol=2e-4)  # u printed to 4 decimals
+
+
+def test_custom_trajectory_numbers(printed) -> None:
+    lines = {x.split()[0]: _numbers(x) for x in printed["custom_trajectory.py"].splitlines()}
+    rms, final, singular = lines["ats"]
+    # Open loop: the offset is kept (exact velocity feed-forward, RK4 drift far below 1 um).
+    assert rms == pytest.approx(1000 * E0, abs=0.01) and final == pytest.approx(1000 * E0, abs=0.01)
+    rms, final, singular = lines["clrrmc-ts"]
+    # 30 s, 1500 samples: dt = 0.02 s; the error decays as exp(-t / 0.5 s).
+    assert rms == pytest.approx(1000 * closed_loop_rms(1500, 0.02), abs=0.01)
+    assert final == 0.0 and singular == 0
+
+
+def test_compare_aux_numbers(printed) -> None:
+    rows = {}
+    for line in printed["compare_aux.py"].splitlines()[1:]:
+        name, aux, *numbers = line.split()
+        rows[(name, aux)] = [float(x) for x in numbers]
+    for aux in ("shoulder", "sum"):  # on the ellipse, open loop keeps the offset exactly
+        rms, worst, singular, saturated = rows[("ellipse", aux)]
+        assert rms == pytest.approx(E0, abs=1e-4) and worst == pytest.approx(E0, abs=1e-4)
+        assert singular == 0 and saturated == 0
+    # On the rectangle, aux = sum drives the arm into cos(th1) = 0: damped steps, larger error.
+    assert rows[("rectangle", "sum")][2] > 0 == rows[("rectangle", "shoulder")][2]
+    assert rows[("rectangle", "sum")][0] > 10 * rows[("rectangle", "shoulder")][0]
+
+
+def test_own_robot_numbers(printed) -> None:
+    lines = printed["own_robot.py"].splitlines()
+    found = {line[:22].strip(): _numbers(line[22:]) for line in lines}
+    for label, reach, payload in (
+        ("default (thesis)", 0.35 + 0.30, 1.25),
+        ("default, 3 kg payload", 0.35 + 0.30, 3.0),
+        ("long arm (TOML)", 0.45 + 0.35, 2.0),
+        ("long arm, 6 kg payload", 0.45 + 0.35, 6.0),
+    ):
+        got_reach, got_payload, _, rms = found[label][:4]
+        assert got_reach == pytest.approx(reach, abs=0.005)
+        assert got_payload == pytest.approx(payload, abs=0.005)
+        # Closed loop on the default ellipse: the same decay for any robot (no saturation).
+        assert rms == pytest.approx(1000 * closed_loop_rms(2000, 0.02), abs=0.005)
+    stability = {label: numbers[2] for label, numbers in found.items()}
+    # More payload at the end effector moves the centre of mass out: less stable.
+    assert stability["default, 3 kg payload"] < stability["default (thesis)"]
+    assert stability["long arm, 6 kg payload"] <= 1.0 < stability["long arm (TOML)"]
+    assert "would tip over" in lines[3] and "would tip over" not in "".join(lines[:3])
 
 
 def _load(name: str):
@@ -63,19 +170,29 @@ def test_custom_trajectory_velocity_is_the_pose_derivative() -> None:
         np.testing.assert_allclose(wave.velocity(t), numeric, atol=1e-7)
 
 
-DOCS = Path(__file__).resolve().parents[1] / "docs"
-DOC_PAGES = ("api.md", "tutorial_custom_trajectory.md", "theory.md", "thesis.md")
+ROOT = Path(__file__).resolve().parents[1]
+#: Every page with Python snippets: README.md and docs/*.md, found automatically (a page a
+#: helper adds is tested as soon as it has a ```python block). Blocks not meant to run use
+#: another fence (```text, ```sh, ```toml).
+DOC_PAGES = [
+    p.relative_to(ROOT).as_posix()
+    for p in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    if "```python" in p.read_text()
+]
 #: Per page: (text its snippets must contain, text they must print).
-DOC_EXPECTED = {"thesis.md": (("run_many",), ("ok", "move_arm"))}
+DOC_EXPECTED = {
+    "docs/thesis.md": (("run_many",), ("ok", "move_arm")),
+    "README.md": (("make_controller", "simulate"), ("u = [",)),
+}
 
 
-def _python_blocks(page: Path) -> str:
+def python_blocks(page: Path) -> str:
     """The page's ```python blocks, concatenated (they run top to bottom in one session)."""
     blocks, inside = [], False
     for line in page.read_text().splitlines():
         if line.strip() == "```python":
             inside = True
-        elif line.strip() == "```" and inside:
+        elif line.strip().startswith("```") and inside:
             inside = False
             blocks.append("")
         elif inside:
@@ -83,14 +200,18 @@ def _python_blocks(page: Path) -> str:
     return "\n".join(blocks)
 
 
+def test_snippet_pages_are_found() -> None:
+    assert {"README.md", "docs/api.md", "docs/qp.md", "docs/thesis.md"} <= set(DOC_PAGES)
+
+
 @pytest.mark.parametrize("page", DOC_PAGES)
 def test_doc_snippets_run(page: str, tmp_path: Path) -> None:
-    code = _python_blocks(DOCS / page)
+    code = python_blocks(ROOT / page)
     assert code.strip()
     in_code, in_output = DOC_EXPECTED.get(page, ((), ()))
     for text in in_code:
         assert text in code
-    done = _run_python(["-c", code], tmp_path)
+    done = _run_python(["-c", code], tmp_path)  # in an empty folder, as a new user would
     assert done.returncode == 0, done.stderr
     for text in in_output:
         assert text in done.stdout

@@ -58,13 +58,13 @@ def test_obstacle_study_table(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--n", "0"], "n must be an integer >= 1"),
+        (["--n", "0"], "n must be an integer in [1, 100000]"),
         (["--stability", "1.6", "1.2"], "enter must be <= exit"),
         (["--controller", "nope"], "invalid choice"),
         (["--controller", "thesis", "--plant", "kinematic"], "thesis or mujoco"),
         (["--payload", "-1"], "payload must be > 0"),
         (["--scheduler", "tcp://x:1"], "only used with --executor dask"),
-        (["--jobs", "0"], "jobs must be an integer >= 1"),
+        (["--jobs", "0"], "jobs must be an integer in [1, 256]"),
         (["--study", "thresholds", "--controller", "qp"], "needs --controller thesis"),
         (["--dt", "0"], "dt must be > 0"),
     ],
@@ -89,7 +89,7 @@ def test_refuses_to_replace_a_foreign_folder(tmp_path, capsys):
     out.mkdir()
     (out / "notes.txt").write_text("keep me")
     assert cli([*FAST, "--out", str(out)]) == 2
-    assert "not an output folder" in capsys.readouterr().err
+    assert "holds files no ddwmmr scenarios run wrote" in capsys.readouterr().err
     assert (out / "notes.txt").read_text() == "keep me"
 
 
@@ -113,3 +113,26 @@ def test_threshold_study_table_has_thesis_and_our_numbers(tmp_path, capsys):
     assert "42 / " in table  # Table 5.12 threshold 5
     summary = json.loads((out / "summary.json").read_text())
     assert len(summary["variants"]) == 18
+
+
+def test_default_out_is_a_new_timestamped_folder(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert cli(["--n", "1", "--time-limit", "0.3", "--jobs", "1", "--no-progress"]) == 0
+    (folder,) = (tmp_path / "runs").iterdir()
+    assert folder.name.startswith("scenarios-") and (folder / "summary.json").is_file()
+    assert f"wrote runs/{folder.name}" in capsys.readouterr().err
+
+
+def test_payload_that_tips_the_start_pose_is_refused_with_the_limit(tmp_path, capsys):
+    from ddwmmr.behaviours.objective import default_pose
+    from ddwmmr.model import Robot
+
+    assert cli(["--payload", "10", "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err
+    limit = float(err.rsplit("at most ", 1)[1].split()[0])
+    # Just below the limit the start pose stands (S > 1), just above it tips (S <= 1).
+    for payload, stands in ((0.99 * limit, True), (1.01 * limit, False)):
+        robot = Robot().with_payload(payload)
+        s = robot.stability((0.0, 0.0, 0.0, *default_pose(robot)))[2]
+        assert (s > 1.0) is stands
+    assert list(tmp_path.iterdir()) == []

@@ -1,12 +1,19 @@
 """Trajectories: shapes, derivatives, orientation, files (SPEC §2)."""
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from ddwmmr import Ellipse, ParameterError, Rectangle, load_trajectory
 from ddwmmr.trajectories import SampledTrajectory, read_csv
+from ddwmmr.trajectories.files import (
+    find_obstacle_file,
+    find_trajectory_file,
+    is_name,
+    package_folder,
+)
 
 
 def numeric_velocity(trajectory, t, h=1e-5):
@@ -116,3 +123,86 @@ def test_csv_errors(tmp_path):
         read_csv(path)
     with pytest.raises(ParameterError, match="unknown trajectory 'nope'"):
         load_trajectory("nope")
+
+
+# -- shipped files, names and paths (issue 8) ---------------------------------------------
+PROJECT_FOLDER = Path(__file__).resolve().parents[1] / "trajectories"
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes() for p in folder.rglob("*") if p.is_file()
+    }
+
+
+def test_package_data_is_identical_to_the_top_level_folder():
+    shipped = _files(package_folder())
+    assert shipped == _files(PROJECT_FOLDER)
+    assert {"ellipse.toml", "rectangle.toml", "figure8.csv", "obstacles/ellipse_post.toml"} <= set(
+        shipped
+    )
+
+
+def test_names_load_from_the_package_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # no ./trajectories here
+    monkeypatch.delenv("DDWMMR_TRAJECTORIES", raising=False)
+    assert find_trajectory_file("figure8") == package_folder() / "figure8.csv"
+    assert load_trajectory("figure8").duration == pytest.approx(60.0)
+    assert (
+        find_obstacle_file("ellipse_post") == package_folder() / "obstacles" / "ellipse_post.toml"
+    )
+
+
+def test_a_user_folder_comes_before_the_shipped_one(tmp_path, monkeypatch):
+    (tmp_path / "ellipse.toml").write_text('shape = "ellipse"\na = 3.0\n')
+    monkeypatch.setenv("DDWMMR_TRAJECTORIES", str(tmp_path))
+    assert load_trajectory("ellipse").a == 3.0
+
+
+@pytest.mark.parametrize(
+    "value", ["../trajectories/ellipse", "..", "../../etc/passwd", "sub/figure8", ".hidden", "a/.."]
+)
+def test_a_name_never_resolves_outside_the_folders(value, tmp_path, monkeypatch):
+    # Even when the file the name points at exists (as a .toml next to the folder).
+    (tmp_path / "trajectories").mkdir()
+    (tmp_path / "ellipse.toml").write_text('shape = "ellipse"\n')
+    monkeypatch.chdir(tmp_path / "trajectories")
+    assert not is_name(value)
+    with pytest.raises(
+        ParameterError, match=r"is neither a trajectory name \(.*\) nor a \.toml/\.csv path"
+    ):
+        load_trajectory(value)
+
+
+def test_explicit_paths_still_work(tmp_path):
+    path = tmp_path / "wide.toml"
+    path.write_text('[trajectory]\nshape = "rectangle"\na = 3.0\nb = 1.0\n')
+    assert load_trajectory(str(path)) == Rectangle(a=3.0, b=1.0, name="wide")
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ('shape = "ellipse"\nN = "2000"\n', "N must be a number"),
+        ('shape = "ellipse"\na = "2.0"\n', "a must be a number"),
+        ('shape = "ellipse"\nN = true\n', "N must be a number"),
+        ('shape = "ellipse"\norientation = 1\n', "orientation must be a string"),
+        ('shape = "ellipse"\nN = 1e9\n', r"N must be an integer in \[2, 1000000\]"),
+        ('shape = "ellipse"\na = 1e300\n', r"a must be in \[1e-06, 1000\] m"),
+        ('shape = "ellipse"\nx0 = 1e300\n', r"x0 must be in \[-1e\+06, 1e\+06\] m"),
+        ('shape = "ellipse"\nspeed = 1\n', "unknown key 'speed'"),
+        ('[[trajectory]]\nshape = "ellipse"\n', "must be one table"),
+    ],
+)
+def test_toml_values_must_have_their_type_and_range(tmp_path, text, message):
+    path = tmp_path / "t.toml"
+    path.write_text(text)
+    with pytest.raises(ParameterError, match=message):
+        load_trajectory(str(path))
+
+
+def test_parametric_api_rejects_strings_and_booleans():
+    with pytest.raises(ParameterError, match=r"^a must be a number"):
+        Ellipse(a="2.0")
+    with pytest.raises(ParameterError, match=r"^N must be an integer"):
+        Ellipse(N=True)

@@ -1,15 +1,49 @@
-"""Exceptions raised by ddwmmr.
+"""Exceptions raised by ddwmmr, input checks and the documented caps on input sizes.
 
 Every user-facing validation problem raises :class:`ParameterError`, whose message is a
 single line naming the parameter and the allowed range; the command-line tools print it and
 exit with status 2.
+
+The caps below are the one home of every documented limit (docs/cli.md, "Limits"): they
+keep absurd inputs (``--duration 1e12``, ``N = 1e30``, ``a = 1e300``) from reaching an
+allocation or overflow, and are checked before anything is allocated.
 """
 
 from __future__ import annotations
 
 import math
+import os
+import stat
 import tomllib
 from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+#: Most simulation steps of one run. The recorded time series holds 29 float64 columns per
+#: step, so a run at the cap keeps about 230 MB in memory (and timeseries.csv ~500 MB).
+MAX_STEPS = 1_000_000
+#: Most samples a trajectory may have: ``N`` of a parametric trajectory (the default step
+#: is T / N) and data rows of a sampled CSV trajectory.
+MAX_TRAJECTORY_SAMPLES = 1_000_000
+#: Most scenarios of one ``python -m ddwmmr.scenarios`` batch (the thesis runs 100).
+MAX_SCENARIOS = 100_000
+#: Largest input file read (robot/trajectory/obstacle TOML, trajectory CSV), bytes.
+MAX_INPUT_BYTES = 64 * 1024 * 1024
+#: Allowed range of every length (m): robot links, wheel radius, track width, footprint,
+#: trajectory semi-axes. A micrometre to a kilometre covers any mobile manipulator.
+LENGTH_RANGE_M = (1e-6, 1e3)
+#: Largest |coordinate| (m) of a trajectory centre, and largest |angle| (rad) of a rotation.
+MAX_COORDINATE_M = 1e6
+MAX_ANGLE_RAD = 1e6
+#: Allowed range of masses (kg; payload and link masses may be 0) and inertias (kg m^2).
+MASS_RANGE_KG = (0.0, 1e5)
+INERTIA_RANGE_KG_M2 = (1e-9, 1e6)
+#: Allowed range of speed limits (rad/s) and of durations / periods (s).
+SPEED_RANGE_RAD_S = (1e-6, 1e6)
+#: Motor torque limits (N m).
+TORQUE_RANGE_N_M = (1e-6, 1e6)
+DURATION_RANGE_S = (1e-6, 1e9)
 
 
 class ParameterError(ValueError):
@@ -37,23 +71,102 @@ def check_finite(name: str, value: float) -> float:
     return _as_float(name, value)
 
 
-def check_int_at_least(name: str, value: int, minimum: int) -> int:
-    """Return ``value`` as int if it is an integer >= ``minimum``."""
-    if isinstance(value, bool) or not float(value).is_integer():
-        raise ParameterError(f"{name} must be an integer >= {minimum} (got {value!r})")
-    if int(value) < minimum:
-        raise ParameterError(f"{name} must be an integer >= {minimum} (got {value!r})")
-    return int(value)
+def check_range(name: str, value: float, low: float, high: float, unit: str = "") -> float:
+    """Return ``value`` as float if ``low <= value <= high`` (finite), else raise."""
+    value = _as_float(name, value)
+    if not low <= value <= high:
+        suffix = f" {unit}" if unit else ""
+        raise ParameterError(f"{name} must be in [{low:g}, {high:g}]{suffix} (got {value:g})")
+    return value
+
+
+def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None = None) -> int:
+    """Return ``value`` as int if it is an integer >= ``minimum`` (and <= ``maximum``)."""
+    allowed = f">= {minimum}" if maximum is None else f"in [{minimum}, {maximum}]"
+    integral = isinstance(value, int | np.integer) or (
+        isinstance(value, float | np.floating)
+        and math.isfinite(value)
+        and float(value).is_integer()
+    )
+    if isinstance(value, bool | np.bool_) or not integral:
+        raise ParameterError(f"{name} must be an integer {allowed} (got {value!r})")
+    number = int(value)
+    if number < minimum or (maximum is not None and number > maximum):
+        raise ParameterError(f"{name} must be an integer {allowed} (got {value!r})")
+    return number
+
+
+def check_step_count(duration: float, dt: float) -> int:
+    """Number of steps ``max(1, round(duration / dt))`` of a run, within :data:`MAX_STEPS`.
+
+    ``duration`` and ``dt`` (s) must be finite and > 0 with ``dt <= duration``; each
+    message names the parameter at fault. Call it before allocating the time series.
+    """
+    duration = check_positive("duration", duration)
+    dt = check_positive("dt", dt)
+    if dt > duration:
+        raise ParameterError(f"dt must be <= duration ({duration:g} s) (got {dt:g})")
+    ratio = duration / dt
+    if not ratio <= MAX_STEPS:
+        raise ParameterError(
+            f"duration / dt must be <= {MAX_STEPS} steps per run (got {duration:g} s / "
+            f"{dt:g} s = {ratio:.3g}); use a larger dt or a shorter duration"
+        )
+    return max(1, round(ratio))
+
+
+def check_number_type(name: str, value: Any) -> Any:
+    """Reject values read from a file that are not numbers (strings, booleans, tables)."""
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ParameterError(f"{name} must be a number (got {value!r})")
+    return value
 
 
 def _as_float(name: str, value: float) -> float:
+    # Strings and booleans are not numbers here, even though float() accepts them: a file
+    # saying N = "2000" or L1 = true is a mistake worth reporting.
+    if isinstance(value, bool | np.bool_ | str | bytes):
+        raise ParameterError(f"{name} must be a number (got {value!r})")
     try:
         number = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ParameterError(f"{name} must be a number (got {value!r})") from None
     if not math.isfinite(number):
         raise ParameterError(f"{name} must be a finite number (got {value!r})")
     return number
+
+
+def read_text_file(path: str | Path, label: str) -> str:
+    """The UTF-8 text of a regular file; anything else raises :class:`ParameterError`.
+
+    The file is checked with ``os.stat`` before it is opened, so a FIFO, a device or a
+    folder is refused instead of blocking or failing; files above :data:`MAX_INPUT_BYTES`
+    are refused too. ``label`` names the option in the message.
+    """
+    path = Path(path)
+    try:
+        info = os.stat(path)
+    except OSError as exc:
+        raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
+    except ValueError:  # e.g. an embedded NUL byte
+        raise ParameterError(f"{label}: invalid file name {str(path)!r}") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise ParameterError(f"{label}: {path} is not a regular file")
+    if info.st_size > MAX_INPUT_BYTES:
+        raise ParameterError(
+            f"{label}: {path} is too large ({info.st_size} bytes, at most {MAX_INPUT_BYTES})"
+        )
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ParameterError(
+            f"{label}: {path} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
+            f"{exc.start})"
+        ) from None
 
 
 def load_toml(path: str | Path, label: str) -> dict:
@@ -62,10 +175,9 @@ def load_toml(path: str | Path, label: str) -> dict:
     ``label`` names the option in the message (``robot``, ``traj``, ``obstacles``).
     """
     path = Path(path)
+    text = read_text_file(path, label)
     try:
-        return tomllib.loads(path.read_text())
-    except OSError as exc:
-        raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
+        return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         message = str(exc).splitlines()[0]
         raise ParameterError(f"{label}: {path} is not valid TOML ({message})") from None

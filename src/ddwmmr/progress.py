@@ -1,16 +1,45 @@
-"""A dependency-free progress bar for long runs (written to stderr, only on a terminal)."""
+"""Progress on stderr for long runs: a ``tqdm`` bar on a terminal, short lines elsewhere.
+
+* On a terminal, :class:`ProgressBar` draws a tqdm bar (rate, elapsed time, ETA).
+* When stderr is not a terminal (``make demo | tee``, CI logs), a bar would print control
+  characters, so a :class:`ProgressBar` prints one short line when it finishes (and one
+  every :data:`LOG_INTERVAL_S` of a long phase), e.g. ``compare: runs 120/120 in 41.3 s``.
+* :func:`phase` marks a long step without a known count (report writing, GIF encoding):
+  a line when it starts on a terminal, and one line with its duration when it ends
+  (elsewhere only for phases of :data:`QUIET_PHASE_S` or more).
+
+``enabled=False`` (the tools' ``--no-progress``) silences everything.
+"""
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
+from collections.abc import Iterator
 from typing import TextIO
+
+from tqdm import tqdm
+
+#: Seconds between the progress lines of a long phase when stderr is not a terminal.
+LOG_INTERVAL_S = 30.0
+#: Phases shorter than this (s) print nothing when stderr is not a terminal.
+QUIET_PHASE_S = 1.0
+
+
+def _is_terminal(stream: TextIO) -> bool:
+    return bool(getattr(stream, "isatty", lambda: False)())
 
 
 class ProgressBar:
-    """Text progress bar: ``with ProgressBar(total, "runs") as bar: bar.advance()``.
+    """Progress of ``total`` items: ``with ProgressBar(total, "runs") as bar: bar.advance()``.
 
-    Silent when ``enabled`` is False or the stream is not a terminal (CI logs stay clean).
+    Args:
+        total: number of items (steps, runs, scenarios).
+        label: what is counted, printed in front (``"track: steps"``).
+        enabled: False prints nothing.
+        stream: where to write (default stderr).
+        unit: name of one item in the bar (``"step"``, ``"run"``).
     """
 
     def __init__(
@@ -19,39 +48,76 @@ class ProgressBar:
         label: str = "",
         enabled: bool = True,
         stream: TextIO | None = None,
-        width: int = 30,
+        unit: str = "it",
     ) -> None:
         self.total = max(int(total), 1)
         self.label = label
         self.stream = stream if stream is not None else sys.stderr
-        self.enabled = enabled and getattr(self.stream, "isatty", lambda: False)()
-        self.width = width
+        self.enabled = enabled
         self.done = 0
         self._start = time.perf_counter()
-        self._last_draw = 0.0
+        self._last_line = self._start
+        self._bar: tqdm | None = None
+        if enabled and _is_terminal(self.stream):
+            self._bar = tqdm(
+                total=self.total,
+                desc=label,
+                unit=unit,
+                file=self.stream,
+                mininterval=0.2,
+                dynamic_ncols=True,
+                leave=True,
+            )
 
     def advance(self, count: int = 1) -> None:
-        """Record ``count`` finished items and redraw (at most every 0.1 s)."""
-        self.done = min(self.done + count, self.total)
-        now = time.perf_counter()
-        if self.enabled and (now - self._last_draw > 0.1 or self.done == self.total):
-            self._last_draw = now
-            self._draw(now)
+        """Record ``count`` finished items."""
+        count = min(count, self.total - self.done)
+        self.done += count
+        if self._bar is not None:
+            self._bar.update(count)
+        elif self.enabled and self.done < self.total:
+            now = time.perf_counter()
+            if now - self._last_line >= LOG_INTERVAL_S:
+                self._last_line = now
+                self._line(f"{self.done}/{self.total} after {now - self._start:.0f} s")
 
-    def _draw(self, now: float) -> None:
-        filled = int(self.width * self.done / self.total)
-        elapsed = now - self._start
-        eta = elapsed / self.done * (self.total - self.done) if self.done else 0.0
-        bar = "#" * filled + "-" * (self.width - filled)
-        self.stream.write(
-            f"\r{self.label} [{bar}] {self.done}/{self.total} {elapsed:5.1f}s eta {eta:5.1f}s"
-        )
+    def _line(self, text: str) -> None:
+        self.stream.write(f"{self.label}: {text}\n" if self.label else f"{text}\n")
         self.stream.flush()
+
+    def close(self) -> None:
+        """Finish the bar (terminal) or print the one-line summary (elsewhere)."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+        elif self.enabled and self.done:
+            elapsed = time.perf_counter() - self._start
+            self._line(f"{self.done}/{self.total} done in {elapsed:.1f} s")
+            self.enabled = False  # print the summary once
 
     def __enter__(self) -> ProgressBar:
         return self
 
     def __exit__(self, *exc: object) -> None:
-        if self.enabled:
-            self.stream.write("\n")
-            self.stream.flush()
+        if exc[0] is not None and self._bar is None:
+            self.enabled = False  # interrupted: the error line says what happened
+        self.close()
+
+
+@contextlib.contextmanager
+def phase(label: str, enabled: bool = True, stream: TextIO | None = None) -> Iterator[None]:
+    """Report a long step without a count: ``with phase("compare: writing report"): ...``."""
+    stream = stream if stream is not None else sys.stderr
+    if not enabled:
+        yield
+        return
+    terminal = _is_terminal(stream)
+    if terminal:
+        stream.write(f"{label} ...\n")
+        stream.flush()
+    start = time.perf_counter()
+    yield
+    elapsed = time.perf_counter() - start
+    if terminal or elapsed >= QUIET_PHASE_S:
+        stream.write(f"{label}: done in {elapsed:.1f} s\n")
+        stream.flush()

@@ -1,20 +1,47 @@
-"""Helpers shared by the command-line tools: error reporting, robots, output folders."""
+"""Helpers shared by the command-line tools: error reporting, signals, robots, outputs.
+
+Every tool's ``main(argv)`` runs through :func:`run_main`, which gives the tools one
+behaviour for everything that is not a result:
+
+* bad input (:class:`ParameterError`): one line ``error: ...`` on stderr, status 2;
+* Ctrl-C (SIGINT): one line, status 130; SIGTERM: one line, status 143 (128 + the signal
+  number, the shell convention). Both first stop the tool's worker processes and unwind
+  the stack, so the output folder's staging copy is removed (:mod:`ddwmmr.outputs`);
+* an operating-system error while writing (disk full...): one line, status 1.
+"""
 
 from __future__ import annotations
 
 import argparse
 import contextlib
-import shutil
+import multiprocessing
+import os
+import signal
 import sys
-import tempfile
+import threading
 from collections.abc import Callable, Iterator, Sequence
-from pathlib import Path
 
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
+from ddwmmr.outputs import check_output_folder, output_folder
 
 #: Exit status for bad input (argparse uses the same).
 EXIT_USAGE = 2
+#: Exit statuses after SIGINT (Ctrl-C) and SIGTERM: 128 + the signal number.
+EXIT_INTERRUPTED = 128 + signal.SIGINT
+EXIT_TERMINATED = 128 + signal.SIGTERM
+
+__all__ = [
+    "EXIT_USAGE",
+    "ArgumentParser",
+    "Terminated",
+    "add_force_argument",
+    "add_robot_arguments",
+    "check_output_folder",
+    "output_folder",
+    "robot_from_arguments",
+    "run_main",
+]
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -24,13 +51,77 @@ class ArgumentParser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
 
 
-def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:
-    """Run ``main`` and turn a :class:`ParameterError` into one line on stderr and status 2."""
+class Terminated(BaseException):
+    """SIGTERM arrived: raised in the main thread so that cleanup code runs."""
+
+
+def stop_workers(timeout: float = 2.0) -> None:
+    """Stop the worker processes this process started (process pools, Dask's nannies)."""
+    children = multiprocessing.active_children()
+    for child in children:
+        child.terminate()
+    for child in children:
+        child.join(timeout)
+        if child.is_alive():
+            child.kill()
+
+
+@contextlib.contextmanager
+def interruptible() -> Iterator[None]:
+    """Turn SIGINT and SIGTERM into exceptions raised after the workers are stopped.
+
+    Forked workers inherit the handler: there it ignores SIGINT (a Ctrl-C reaches the
+    whole process group, and the parent stops the workers itself, so they print no
+    traceback) and exits at once on SIGTERM (the parent's :func:`stop_workers`).
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    owner = os.getpid()
+
+    def handle(signum: int, frame: object) -> None:
+        if os.getpid() != owner:
+            if signum == signal.SIGTERM:
+                os._exit(EXIT_TERMINATED)
+            return
+        for number in (signal.SIGINT, signal.SIGTERM):  # one signal is enough
+            signal.signal(number, signal.SIG_IGN)
+        stop_workers()
+        raise KeyboardInterrupt if signum == signal.SIGINT else Terminated
+
+    previous = {s: signal.signal(s, handle) for s in (signal.SIGINT, signal.SIGTERM)}
     try:
-        return main(argv)
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:
+    """Run ``main``: bad input, interrupts and write errors become one line on stderr."""
+    try:
+        with interruptible():
+            return main(argv)
     except ParameterError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        _say(f"error: {exc}")
         return EXIT_USAGE
+    except KeyboardInterrupt:
+        _say("interrupted (Ctrl-C): stopped; unfinished output removed")
+        return EXIT_INTERRUPTED
+    except Terminated:
+        _say("terminated (SIGTERM): stopped; unfinished output removed")
+        return EXIT_TERMINATED
+    except BrokenPipeError:  # e.g. output piped into head: nothing left to say
+        return 1
+    except OSError as exc:
+        where = f"{exc.filename}: " if exc.filename else ""
+        _say(f"error: {where}{exc.strerror or exc}")
+        return 1
+
+
+def _say(line: str) -> None:
+    with contextlib.suppress(OSError):
+        print(line, file=sys.stderr)
 
 
 def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
@@ -46,36 +137,19 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def add_force_argument(parser: argparse.ArgumentParser) -> None:
+    """``--force``: write into an existing folder another tool or the user made."""
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="also write into an --out that is not this tool's earlier output; deletes only "
+        "files a ddwmmr manifest lists, every other file is kept",
+    )
+
+
 def robot_from_arguments(args: argparse.Namespace) -> Robot:
     """The robot selected by ``--robot`` / ``--payload``."""
     robot = Robot.from_toml(args.robot) if args.robot else Robot()
     if args.payload is not None:
         robot = robot.with_payload(args.payload)
     return robot
-
-
-@contextlib.contextmanager
-def atomic_output_dir(target: str | Path, marker: str) -> Iterator[Path]:
-    """Yield a temporary folder that replaces ``target`` only if the block succeeds.
-
-    An existing ``target`` is replaced only when it holds ``marker`` (a file a previous run
-    of the same tool wrote), so a user's unrelated folder is never deleted. On any error
-    the temporary folder is removed: nothing half-written is left behind.
-    """
-    target = Path(target)
-    if target.exists() and (
-        not target.is_dir() or (any(target.iterdir()) and not (target / marker).exists())
-    ):
-        raise ParameterError(
-            f"out: {target} exists and is not an output folder of this tool (no {marker})"
-        )
-    target.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(prefix=f".{target.name}.", dir=target.parent))
-    try:
-        yield staging
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
-    if target.exists():
-        shutil.rmtree(target)
-    staging.rename(target)

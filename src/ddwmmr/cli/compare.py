@@ -5,11 +5,13 @@ Examples::
     python -m ddwmmr.compare --out report
     python -m ddwmmr.compare --methods ats clrrmc-ts --study tau --jobs 2 --out tau-report
     python -m ddwmmr.compare --traj figure8 --study none --duration 20 --out quick
+    python -m ddwmmr.compare --only figure8 --study none --out figure8-only
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import time
@@ -17,18 +19,21 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from ddwmmr.cli import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
+    add_force_argument,
     add_robot_arguments,
-    atomic_output_dir,
+    check_output_folder,
+    output_folder,
     robot_from_arguments,
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, method_description
-from ddwmmr.errors import ParameterError, check_int_at_least, check_positive
+from ddwmmr.errors import ParameterError, check_int_at_least, check_positive, check_step_count
+from ddwmmr.progress import phase
 from ddwmmr.reports.compare import (
     DEFAULT_TRAJECTORIES,
-    MARKER,
     OFFSET_SCALES,
     STEP_SIZES,
     STUDIES,
@@ -44,23 +49,33 @@ from ddwmmr.reports.compare import (
     text_table,
     write_report,
 )
+from ddwmmr.reports.compare.plan import run_duration
+from ddwmmr.sim.result import json_safe, write_atomic
 from ddwmmr.trajectories import available_trajectories, load_trajectory, trajectory_name
+from ddwmmr.trajectories.files import find_trajectory_file
 
 PROG = "python -m ddwmmr.compare"
 DEFAULT_OUT = "runs/compare"
 #: Default number of worker processes: the CPUs, at most 8.
 DEFAULT_JOBS = min(os.cpu_count() or 1, 8)
+#: Most worker processes --jobs may ask for.
+MAX_JOBS = 256
 
 EPILOG_TEXT = f"""\
 outputs (in --out):
   report.html   self-contained report (figures embedded, no external files)
   report.md     the same report as Markdown, linking the PNG figures next to it
-  metrics.csv   one row per method x trajectory: method, trajectory and every field of
+  metrics.csv   one row per method x trajectory: method, trajectory and every metric of
                 the summary.json that `python -m ddwmmr.track` writes for that run
+  run.json      everything needed to repeat the comparison: methods and their options
+                with defaults, robot, trajectories (parameters or file SHA-256),
+                studies, version, git commit and the exact command line
   *.png         paths, errors, wheel speeds and per-method panels per trajectory; one
                 figure per study
   The folder is built next to --out and renamed into place when complete; an existing
-  --out is replaced only if it is an earlier compare report (it holds {MARKER}).
+  --out is replaced only if it is an earlier compare report holding nothing else (its
+  .ddwmmr-manifest.json lists every file); --force writes into another folder and still
+  deletes only files a manifest lists.
 
 ranking:
   score = RMS end-effector position error over the whole run (mm), per trajectory; lower
@@ -115,6 +130,15 @@ def build_parser() -> ArgumentParser:
         f"({', '.join(available_trajectories())}) or a .toml/.csv path",
     )
     parser.add_argument(
+        "--only",
+        nargs="+",
+        action="extend",
+        default=[],
+        metavar="NAME|FILE",
+        help="compare on these trajectories instead of ellipse and rectangle (the studies "
+        "need the ellipse, the corner study the rectangle: others are skipped)",
+    )
+    parser.add_argument(
         "--methods",
         nargs="+",
         action="extend",
@@ -156,6 +180,7 @@ def build_parser() -> ArgumentParser:
         "each trajectory)",
     )
     add_robot_arguments(parser)
+    add_force_argument(parser)
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     return parser
 
@@ -189,18 +214,27 @@ def parse_studies(values: Sequence[str] | None) -> tuple[str, ...]:
     return tuple(s for s in STUDIES if s in names)
 
 
-def load_trajectories(extra: Sequence[str]) -> dict[str, Any]:
-    """Ellipse, rectangle and the ``--traj`` trajectories, keyed by unique name."""
-    trajectories = {name: load_trajectory(name) for name in DEFAULT_TRAJECTORIES}
-    for value in split_list(extra):
-        if value in DEFAULT_TRAJECTORIES:
-            continue
+def load_trajectories(
+    extra: Sequence[str], only: Sequence[str] = (), sources: dict[str, Any] | None = None
+) -> dict[str, Any]:
+    """Ellipse, rectangle (or the ``--only`` ones) and the ``--traj`` ones, by unique name.
+
+    ``sources`` (if given) receives each name's file (None for a built-in default).
+    """
+    chosen = split_list(only)
+    values = [*(chosen or DEFAULT_TRAJECTORIES), *split_list(extra)]
+    trajectories: dict[str, Any] = {}
+    files: dict[str, Any] = {}
+    for value in dict.fromkeys(values):
         trajectory = load_trajectory(value)
         name = base = trajectory_name(trajectory)
         suffix = 2
         while name in trajectories:  # two files with the same stem: keep both
             name, suffix = f"{base}-{suffix}", suffix + 1
         trajectories[name] = trajectory
+        files[name] = find_trajectory_file(value)
+    if sources is not None:
+        sources.update(files)
     return trajectories
 
 
@@ -218,21 +252,44 @@ def check_duration(duration: float | None, trajectories: dict[str, Any]) -> floa
     return duration
 
 
-def check_out(path: Path) -> Path:
-    """Fail early (before any simulation) if ``--out`` may not be written or replaced."""
-    if path.exists() and (
-        not path.is_dir() or (any(path.iterdir()) and not (path / MARKER).exists())
-    ):
-        raise ParameterError(
-            f"out: {path} exists and is not a compare report folder (no {MARKER}); "
-            "choose another --out"
-        )
-    return path
+def check_steps(config: CompareConfig, specs: Sequence[Any]) -> None:
+    """Every planned run within the step cap (:data:`ddwmmr.errors.MAX_STEPS`)."""
+    for spec in specs:
+        try:
+            check_step_count(run_duration(config, spec.trajectory), spec.dt)
+        except ParameterError as exc:
+            raise ParameterError(f"{exc} (run {spec.label()} on {spec.trajectory})") from None
 
 
-def config_from_arguments(args: argparse.Namespace, argv: Sequence[str] | None) -> CompareConfig:
-    """Validated :class:`CompareConfig` from the parsed arguments."""
-    trajectories = load_trajectories(args.traj)
+def run_record(
+    config: CompareConfig, sources: dict[str, Any], argv: Sequence[str] | None, jobs: int
+) -> dict[str, Any]:
+    """run.json: everything needed to repeat the comparison."""
+    record = provenance.header("compare", PROG, argv)
+    record.update(
+        methods=list(config.methods),
+        study_methods=list(config.study_methods or ()),
+        options={m: provenance.options_record(m, {}) for m in config.methods},
+        robot=provenance.robot_record(config.robot),
+        trajectories={
+            name: provenance.trajectory_record(t, sources.get(name))
+            for name, t in config.trajectories.items()
+        },
+        duration=config.duration,
+        studies=list(config.studies),
+        jobs=jobs,
+        plant={"name": "kinematic"},
+        seed=None,  # nothing random in a comparison
+    )
+    return record
+
+
+def config_from_arguments(
+    args: argparse.Namespace, argv: Sequence[str] | None, sources: dict[str, Any] | None = None
+) -> CompareConfig:
+    """Validated :class:`CompareConfig` from the parsed arguments (``sources``: see
+    :func:`load_trajectories`)."""
+    trajectories = load_trajectories(args.traj, args.only, sources)
     command = " ".join([PROG, *(argv if argv is not None else sys.argv[1:])])
     methods = parse_methods(args.methods)
     study_methods = (
@@ -278,15 +335,22 @@ def format_summary(info: ReportInfo, out: Path, runs: int, seconds: float, jobs:
 
 def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
-    jobs = check_int_at_least("jobs", args.jobs, 1)
-    out = check_out(Path(args.out))
-    config = config_from_arguments(args, argv)
+    jobs = check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
+    out = Path(args.out)
+    check_output_folder(out, "compare", args.force)
+    sources: dict[str, Any] = {}
+    config = config_from_arguments(args, argv, sources)
     plan = plan_runs(config)
     specs = plan.all_specs()
+    check_steps(config, specs)
+    record = run_record(config, sources, argv, jobs)
+    progress = not args.no_progress
     start = time.perf_counter()
-    outputs = execute(config, specs, jobs=jobs, progress=not args.no_progress)
-    with atomic_output_dir(out, marker=MARKER) as staging:
-        info = write_report(config, plan, outputs, staging)
+    with output_folder(out, "compare", args.force) as staging:
+        outputs = execute(config, specs, jobs=jobs, progress=progress)
+        with phase("compare: writing the report (figures, HTML, Markdown)", enabled=progress):
+            info = write_report(config, plan, outputs, staging)
+            write_atomic(staging / "run.json", json.dumps(json_safe(record), indent=2) + "\n")
     seconds = time.perf_counter() - start
     print(format_summary(info, out, len(specs), seconds, jobs))
     return 0

@@ -13,6 +13,7 @@ Examples::
 from __future__ import annotations
 
 import argparse
+import datetime as dt
 import json
 import math
 import sys
@@ -22,19 +23,38 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.cli.common import ArgumentParser, atomic_output_dir, run_main
-from ddwmmr.errors import ParameterError, check_int_at_least, check_nonnegative
+from ddwmmr.behaviours.objective import default_pose
+from ddwmmr.cli import provenance
+from ddwmmr.cli.common import (
+    ArgumentParser,
+    add_force_argument,
+    check_output_folder,
+    output_folder,
+    run_main,
+)
+from ddwmmr.errors import (
+    MASS_RANGE_KG,
+    MAX_SCENARIOS,
+    ParameterError,
+    check_int_at_least,
+    check_nonnegative,
+    check_range,
+    check_step_count,
+)
 from ddwmmr.model import Robot
-from ddwmmr.progress import ProgressBar
+from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.executors import EXECUTORS, default_jobs, run_many
 from ddwmmr.scenarios.generator import Scenario, generate
 from ddwmmr.scenarios.protocol import CONTROLLERS, PLANTS, Outcome, RunConfig, run_scenario
 from ddwmmr.sim.result import json_safe, write_atomic
 
-#: File whose presence marks a folder as ours (so --out may replace it).
+#: The batch summary (holds the run record: everything needed to repeat the batch).
 MARKER = "summary.json"
 STUDIES = ("thresholds", "obstacles")
+PROG = "python -m ddwmmr.scenarios"
+#: Most worker processes --jobs may ask for.
+MAX_JOBS = 256
 
 DESCRIPTION = """\
 Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly (seeded) in
@@ -56,7 +76,7 @@ output behind."""
 def build_parser() -> ArgumentParser:
     """The argument parser (also used to render --help in the docs)."""
     parser = ArgumentParser(
-        prog="python -m ddwmmr.scenarios",
+        prog=PROG,
         description=DESCRIPTION,
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -74,15 +94,20 @@ def build_parser() -> ArgumentParser:
         help="plant: 'thesis' force-driven dynamics (default) or 'kinematic'",
     )
     parser.add_argument(
-        "--n", type=int, default=100, metavar="N", help="number of scenarios (default: 100)"
+        "--n",
+        type=int,
+        default=100,
+        metavar="N",
+        help=f"number of scenarios (default: 100, at most {MAX_SCENARIOS})",
     )
     parser.add_argument("--seed", type=int, default=0, help="generator seed (default: 0)")
     parser.add_argument(
         "--out",
-        required=True,
         metavar="DIR",
-        help="output folder (replaced if it holds a previous run)",
+        help="output folder (default: runs/scenarios-<time>/; replaced only if it holds "
+        "nothing but a previous scenarios run)",
     )
+    add_force_argument(parser)
     parser.add_argument(
         "--payload",
         type=float,
@@ -170,12 +195,42 @@ def build_parser() -> ArgumentParser:
     return parser  # fmt: skip
 
 
+def default_out() -> Path:
+    """``runs/scenarios-<YYYYmmdd-HHMMSS>`` (like track's default)."""
+    return Path("runs") / f"scenarios-{dt.datetime.now().strftime('%Y%m%d-%H%M%S')}"
+
+
+def check_start_pose(payload: float) -> None:
+    """Refuse a payload that already tips the robot in the scenarios' start pose (S <= 1)."""
+    robot = Robot().with_payload(payload)
+    th1, th2 = default_pose(robot)
+    s = robot.stability((0.0, 0.0, 0.0, th1, th2))[2]
+    if s <= 1.0:
+        raise ParameterError(
+            f"payload: {payload:g} kg tips the robot over in the start pose (S = {s:.3g} <= 1); "
+            f"the start pose holds at most {max_start_payload():.3g} kg"
+        )
+
+
+def max_start_payload() -> float:
+    """Largest payload (kg) with S > 1 in the start pose (bisection; S falls with payload)."""
+    low, high = 0.0, MASS_RANGE_KG[1]
+    for _ in range(80):
+        middle = 0.5 * (low + high)
+        robot = Robot().with_payload(middle)
+        if robot.stability((0.0, 0.0, 0.0, *default_pose(robot)))[2] > 1.0:
+            low = middle
+        else:
+            high = middle
+    return low
+
+
 def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     """Validate the options and build the run configuration (before any output exists)."""
-    check_int_at_least("n", args.n, 1)
+    check_int_at_least("n", args.n, 1, MAX_SCENARIOS)
     check_nonnegative("seed", args.seed)
     if args.jobs is not None:
-        check_int_at_least("jobs", args.jobs, 1)
+        check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
     if args.scheduler and args.executor != "dask":
         raise ParameterError("scheduler: only used with --executor dask")
     if args.study == "thresholds" and args.controller != "thesis":
@@ -189,6 +244,14 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
             raise ParameterError(f"{name.replace('_', '-')} must be > 0 (got {value:g})")
     if args.dt > 0.1:
         raise ParameterError(f"dt must be <= 0.1 s (got {args.dt:g})")
+    check_range("payload", args.payload, *MASS_RANGE_KG, "kg")
+    obstacles = args.obstacles or args.study == "obstacles"
+    longest = args.time_limit if args.time_limit is not None else (120.0 if obstacles else 60.0)
+    try:
+        check_step_count(longest, args.dt)
+    except ParameterError as exc:
+        raise ParameterError(str(exc).replace("duration", "time-limit")) from None
+    check_start_pose(args.payload)
     thresholds = {}
     for name in ("stability", "manipulability"):
         enter, exit_ = getattr(args, name)
@@ -247,6 +310,7 @@ def write_batch(
     config: RunConfig,
     wall: float,
     extra: dict[str, Any],
+    progress: bool = True,
 ) -> dict[str, Any]:
     """scenarios.csv, summary.json, table.txt and the figures of one batch."""
     summary = report.summarize(outcomes, wall)
@@ -256,13 +320,18 @@ def write_batch(
     write_atomic(folder / "scenarios.csv", report.metrics_csv(outcomes))
     table = report.format_table(summary, f"Table 5.2 format: {title}")
     write_atomic(folder / "table.txt", table)
-    _figures(folder, scenarios, outcomes, config)
+    _figures(folder, scenarios, outcomes, config, progress)
     write_atomic(folder / MARKER, json.dumps(json_safe(summary), indent=2) + "\n")
     print(table, end="")
     return summary
 
 
-def _figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
+def _figures(folder: Path, scenarios, outcomes, config: RunConfig, progress: bool) -> None:
+    with phase("scenarios: figures", enabled=progress):
+        _draw_figures(folder, scenarios, outcomes, config)
+
+
+def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
     short = f"{config.controller} / {config.plant}"
     report.plot_state_times(outcomes, folder / "thesis_times.png", f"{short}: time per state")
     report.plot_speeds(outcomes, folder / "thesis_speed.png", short)
@@ -276,8 +345,8 @@ def _figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
     traced = replace(config, record=True)
     items = [(scenarios[i], run_scenario(scenarios[i], traced)) for i in chosen]
     report.plot_paths(items, folder / "thesis_paths.png", f"{short}: paths")
-    timeline = next(o for (s, o) in items if s.index == scenarios[focus].index)
-    report.plot_timeline(timeline, folder / "thesis_timeline.png", short)
+    scenario, timeline = next((s, o) for (s, o) in items if s.index == scenarios[focus].index)
+    report.plot_timeline(timeline, folder / "thesis_timeline.png", short, scenario)
 
 
 def highlight(outcomes: list[Outcome]) -> int:
@@ -304,7 +373,8 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     if args.obstacles:
         scenarios = studies.obstacle_scenarios(scenarios)
     outcomes, wall = runner.run(scenarios, config, "scenarios")
-    summary = write_batch(folder, scenarios, outcomes, config, wall, {"seed": args.seed})
+    extra = {"seed": args.seed, "run": _record(args, config)}
+    summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
@@ -333,6 +403,7 @@ def _run_thresholds(args, config, runner, folder: Path) -> None:
         "config": asdict(config),
         "variants": rows,
         "wall_time_s": sum(s["wall_time_s"] for _, s in results),
+        "run": _record(args, config),
     }
     write_atomic(folder / MARKER, json.dumps(json_safe(total), indent=2) + "\n")
     print("Threshold study: cells are thesis / ours\n")
@@ -342,9 +413,8 @@ def _run_thresholds(args, config, runner, folder: Path) -> None:
 def _run_obstacles(args, config, runner, folder: Path) -> None:
     scenarios = studies.obstacle_scenarios(generate(max(args.n, 10), args.seed))
     outcomes, wall = runner.run(scenarios, config, "obstacles")
-    write_batch(
-        folder, scenarios, outcomes, config, wall, {"seed": args.seed, "study": "obstacles"}
-    )
+    extra = {"seed": args.seed, "study": "obstacles", "run": _record(args, config)}
+    write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     table = studies.obstacle_table([o.metrics for o in outcomes])
     write_atomic(folder / "obstacles.md", table)
     report.plot_paths(
@@ -361,23 +431,43 @@ def config_robot(config: RunConfig) -> Robot:
     return Robot().with_payload(config.payload)
 
 
+def _record(args: argparse.Namespace, config: RunConfig) -> dict[str, Any]:
+    """summary.json["run"]: everything needed to repeat the batch."""
+    record = provenance.header("scenarios", PROG, args.argv)
+    record.update(
+        config=provenance.encode(asdict(config)),
+        n=args.n,
+        seed=args.seed,
+        study=args.study,
+        obstacles=bool(args.obstacles),
+        robot=provenance.robot_record(config_robot(config)),
+        plant={"name": config.plant},
+        executor=args.executor,
+        jobs=args.jobs,
+    )
+    return record
+
+
 def _main(argv: Sequence[str] | None = None) -> int:
     """Run the tool; bad input raises :class:`ParameterError`."""
     args = build_parser().parse_args(argv)
+    args.argv = argv  # recorded in the summary
     config = config_from_arguments(args)
+    out = Path(args.out) if args.out is not None else default_out()
+    check_output_folder(out, "scenarios", args.force)
     if config.controller == "qp":
         from ddwmmr.scenarios.protocol import make_qp
 
         make_qp(config_robot(config), generate(1, 0)[0], config)  # fail early, before output
     runner = Runner(args)
-    with atomic_output_dir(args.out, MARKER) as folder:
+    with output_folder(out, "scenarios", args.force) as folder:
         if args.study == "thresholds":
             _run_thresholds(args, config, runner, folder)
         elif args.study == "obstacles":
             _run_obstacles(args, config, runner, folder)
         else:
             _run_benchmark(args, config, runner, folder)
-    print(f"wrote {args.out}", file=sys.stderr)
+    print(f"wrote {out}", file=sys.stderr)
     return 0
 
 

@@ -11,31 +11,47 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
+import json
 import sys
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ddwmmr.cli import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
+    add_force_argument,
     add_robot_arguments,
-    atomic_output_dir,
+    check_output_folder,
+    output_folder,
     robot_from_arguments,
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, make_controller, method_description
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file
+from ddwmmr.model import Robot
 from ddwmmr.plants.kinematic import INTEGRATORS
-from ddwmmr.progress import ProgressBar
+from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
 from ddwmmr.sim.simulate import simulate
 from ddwmmr.trajectories import available_trajectories, load_trajectory
+from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
-#: Keys printed in the summary table, with their labels.
+PROG = "python -m ddwmmr.track"
+#: The plant every track run uses (recorded; the only one until simulate() takes others).
+PLANT = "kinematic"
+#: Options that fix what is simulated: they come from the record with --rerun.
+RUN_OPTIONS = (
+    "method", "traj", "aux", "tau", "dt", "duration", "integrator", "offset", "robot",
+    "payload", "stability_min", "manipulability_weight", "obstacles", "solver", "qp_mode",
+)  # fmt: skip
+
+#: Keys printed in the summary table, with their labels; errors in mm (as in compare).
 TABLE_KEYS = (
-    ("rms_position_error_m", "RMS position error (m)"),
-    ("max_position_error_m", "max position error (m)"),
-    ("final_position_error_m", "final position error (m)"),
+    ("rms_position_error_m", "RMS position error (mm)"),
+    ("max_position_error_m", "max position error (mm)"),
+    ("final_position_error_m", "final position error (mm)"),
     ("rms_orientation_error_rad", "RMS orientation error (rad)"),
     ("max_nonholonomic_residual_m_s", "max nonholonomic residual (m/s)"),
     ("max_wheel_speed_rad_s", "max wheel speed (rad/s)"),
@@ -45,10 +61,17 @@ TABLE_KEYS = (
     ("saturated_steps", "saturated steps"),
     ("stability_violations", "steps with S < S_min"),
     ("qp_fallbacks", "QP fallbacks"),
-    ("min_obstacle_clearance_m", "min obstacle clearance (m)"),
+    ("min_obstacle_clearance_m", "min obstacle clearance (mm)"),
     ("steps", "steps"),
     ("median_step_us", "median controller step (us)"),
 )
+#: Summary keys shown in mm in the table (stored in m in summary.json).
+MM_KEYS = {
+    "rms_position_error_m",
+    "max_position_error_m",
+    "final_position_error_m",
+    "min_obstacle_clearance_m",
+}
 
 #: CLI option -> (controller keyword, methods it applies to; None = any method accepting it).
 METHOD_OPTIONS = {
@@ -67,21 +90,30 @@ def build_parser() -> ArgumentParser:
     methods = available_methods()
     method_help = "; ".join(f"{m}: {method_description(m).rstrip('.')}" for m in methods)
     parser = ArgumentParser(
-        prog="python -m ddwmmr.track",
+        prog=PROG,
         description=(
             "Simulate a differential-drive mobile manipulator tracking a desired end-effector "
             "trajectory with one redundancy-resolution / control method. Writes "
-            "timeseries.csv, summary.json and figures into --out and prints a summary table."
+            "timeseries.csv, summary.json and figures into --out and prints a summary table "
+            "(errors in mm). summary.json records everything needed to repeat the run: "
+            f"`{PROG} --rerun DIR/summary.json` reproduces it bit for bit."
         ),
         epilog=f"Methods - {method_help}.",
     )
-    parser.add_argument("--method", required=True, choices=methods, help="control method")
+    parser.add_argument(
+        "--method", choices=methods, help="control method (required unless --rerun)"
+    )
     parser.add_argument(
         "--traj",
-        required=True,
         metavar="NAME|FILE",
-        help=f"trajectory name from trajectories/ ({', '.join(available_trajectories())}) "
-        "or a .toml/.csv path",
+        help=f"trajectory name ({', '.join(available_trajectories())}) or a .toml/.csv path "
+        "(required unless --rerun)",
+    )
+    parser.add_argument(
+        "--rerun",
+        metavar="SUMMARY",
+        help="repeat the run a summary.json records (method, options, robot, trajectory, "
+        "step...); only the output options may be given with it",
     )
     parser.add_argument(
         "--aux",
@@ -102,15 +134,12 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--duration", type=float, metavar="S", help="simulated time in s (default one period)"
     )
-    parser.add_argument(
-        "--integrator", choices=INTEGRATORS, default="rk4", help="integrator (default rk4)"
-    )
+    parser.add_argument("--integrator", choices=INTEGRATORS, help="integrator (default rk4)")
     parser.add_argument(
         "--offset",
         type=float,
         nargs=2,
         metavar=("DX", "DY"),
-        default=DEFAULT_INITIAL_OFFSET,
         help="initial end-effector offset in m, applied with the arm (default "
         f"{DEFAULT_INITIAL_OFFSET[0]:.2f} {DEFAULT_INITIAL_OFFSET[1]:.2f})",
     )
@@ -124,7 +153,10 @@ def build_parser() -> ArgumentParser:
         help="weight of the manipulability reward",
     )
     qp.add_argument(
-        "--obstacles", metavar="FILE", help="TOML list of circles ([[obstacle]] x, y, radius)"
+        "--obstacles",
+        metavar="NAME|FILE",
+        help="circles to avoid: a TOML file of [[obstacle]] tables x, y, radius (m), or the "
+        "name of a shipped one (ellipse_post); drawn in path.png",
     )
     qp.add_argument(
         "--solver", help="qpsolvers backend (osqp, daqp, quadprog, proxqp, clarabel...)"
@@ -134,9 +166,10 @@ def build_parser() -> ArgumentParser:
     out.add_argument(
         "--out", metavar="DIR", help="output folder (default runs/<method>-<traj>-<time>/)"
     )
+    add_force_argument(out)
     out.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
     out.add_argument("--animate", action="store_true", help="also write animation.gif")
-    out.add_argument("--no-progress", action="store_true", help="no progress bar")
+    out.add_argument("--no-progress", action="store_true", help="no progress output on stderr")
     return parser
 
 
@@ -152,7 +185,8 @@ def controller_options(args: argparse.Namespace) -> dict[str, Any]:
         if attribute == "obstacles":
             from ddwmmr.qp.limits.obstacles import load_obstacles
 
-            value = load_obstacles(value)
+            circles = load_obstacles(find_obstacle_file(value))
+            value = [(c.x, c.y, c.radius) for c in circles]  # plain numbers: recordable
         options[keyword] = value
     return options
 
@@ -164,58 +198,171 @@ def default_out(method: str, traj: str) -> Path:
 
 
 def format_table(summary: dict[str, Any]) -> str:
-    """The summary as an aligned two-column text table."""
+    """The summary as an aligned two-column text table (lengths in mm)."""
     lines = [f"{summary['method']} on {summary['trajectory']}"]
     for key, label in TABLE_KEYS:
         if key in summary and summary[key] is not None:
             value = summary[key]
+            if key in MM_KEYS:
+                value = 1000.0 * value
             text = f"{value:.6g}" if isinstance(value, float) else str(value)
             lines.append(f"  {label:<36} {text}")
     return "\n".join(lines)
 
 
+@dataclass
+class RunInputs:
+    """Everything a track run simulates (from the options, or from a --rerun record)."""
+
+    method: str
+    options: dict[str, Any]
+    robot: Robot
+    trajectory: Any
+    trajectory_file: Path | None
+    dt: float
+    duration: float
+    integrator: str
+    offset: tuple[float, float]
+    label: str  # trajectory as the user named it (for the default folder name)
+
+
+def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
+    """Validated inputs from the command-line options."""
+    if args.method is None or args.traj is None:
+        missing = "--method" if args.method is None else "--traj"
+        raise ParameterError(f"{missing.lstrip('-')}: {missing} is required (or give --rerun)")
+    robot = robot_from_arguments(args)
+    source = find_trajectory_file(args.traj)
+    trajectory = load_trajectory(args.traj)
+    options = controller_options(args)
+    duration = trajectory.duration if args.duration is None else args.duration
+    if args.dt is None:
+        step = trajectory.duration / getattr(trajectory, "samples", 1000)
+    else:
+        step = args.dt
+    offset = DEFAULT_INITIAL_OFFSET if args.offset is None else tuple(args.offset)
+    for value in offset:
+        check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
+    return RunInputs(
+        args.method,
+        options,
+        robot,
+        trajectory,
+        source,
+        step,
+        duration,
+        args.integrator or "rk4",
+        offset,
+        args.traj,
+    )
+
+
+def inputs_from_record(args: argparse.Namespace) -> RunInputs:
+    """The inputs a summary.json records (``--rerun``); simulation options are refused."""
+    given = [name for name in RUN_OPTIONS if getattr(args, name) is not None]
+    if given:
+        option = "--" + given[0].replace("_", "-")
+        raise ParameterError(
+            f"rerun: {option} cannot be combined with --rerun (the record fixes it)"
+        )
+    record = load_run_record(args.rerun)
+    try:
+        plant = record["plant"]["name"]
+        if plant != PLANT:
+            raise ParameterError(f"rerun: plant {plant!r} is not supported by this version")
+        trajectory = provenance.trajectory_from_record(record["trajectory"])
+        source = record["trajectory"].get("file")
+        return RunInputs(
+            record["method"],
+            provenance.decode(record["options"]),
+            provenance.robot_from_record(record["robot"]),
+            trajectory,
+            Path(source) if source else None,
+            float(record["dt"]),
+            float(record["duration"]),
+            record["integrator"],
+            tuple(provenance.decode(record["initial_offset"])),
+            record["trajectory"].get("name") or "rerun",
+        )
+    except (KeyError, TypeError, AttributeError) as exc:
+        raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
+
+
+def load_run_record(path: str) -> dict[str, Any]:
+    """The ``run`` record of a track summary.json."""
+    text = read_text_file(path, "rerun")
+    try:
+        summary = json.loads(text)
+    except ValueError as exc:
+        raise ParameterError(f"rerun: {path} is not valid JSON ({exc})") from None
+    record = summary.get("run") if isinstance(summary, dict) else None
+    if not isinstance(record, dict) or record.get("tool") != "track":
+        raise ParameterError(f"rerun: {path} is not a summary.json written by {PROG}")
+    return record
+
+
+def run_record(inputs: RunInputs, argv: Sequence[str] | None, rerun: str | None) -> dict:
+    """What summary.json["run"] holds: enough to repeat the run (``--rerun``)."""
+    record = provenance.header("track", PROG, argv)
+    record.update(
+        method=inputs.method,
+        options=provenance.options_record(inputs.method, inputs.options),
+        robot=provenance.robot_record(inputs.robot),
+        trajectory=provenance.trajectory_record(inputs.trajectory, inputs.trajectory_file),
+        dt=inputs.dt,
+        duration=inputs.duration,
+        integrator=inputs.integrator,
+        initial_offset=list(inputs.offset),
+        plant={"name": PLANT},
+        seed=None,  # nothing random in a track run
+    )
+    if rerun is not None:
+        record["rerun_of"] = str(Path(rerun).resolve())
+    return record
+
+
 def _main(argv: Sequence[str] | None = None) -> int:
     """Run the tool; bad input raises :class:`ParameterError`."""
     args = build_parser().parse_args(argv)
-    robot = robot_from_arguments(args)
-    trajectory = load_trajectory(args.traj)
-    options = controller_options(args)
-    controller = make_controller(args.method, robot, **options)
-    out = Path(args.out) if args.out else default_out(args.method, args.traj)
-    with atomic_output_dir(out, marker="summary.json") as staging:
-        steps_hint = _steps_hint(trajectory, args)
-        with ProgressBar(steps_hint, "track", enabled=not args.no_progress) as bar:
+    inputs = inputs_from_record(args) if args.rerun else inputs_from_arguments(args)
+    steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
+    controller = make_controller(inputs.method, inputs.robot, **inputs.options)
+    out = Path(args.out) if args.out is not None else default_out(inputs.method, inputs.label)
+    check_output_folder(out, "track", args.force)
+    record = run_record(inputs, argv, args.rerun)
+    progress = not args.no_progress
+    with output_folder(out, "track", args.force) as staging:
+        with ProgressBar(steps, "track: steps", enabled=progress, unit="step") as bar:
             result = simulate(
-                robot,
-                trajectory,
+                inputs.robot,
+                inputs.trajectory,
                 controller,
-                dt=args.dt,
-                duration=args.duration,
-                integrator=args.integrator,
-                initial_offset=tuple(args.offset),
+                dt=inputs.dt,
+                duration=inputs.duration,
+                integrator=inputs.integrator,
+                initial_offset=inputs.offset,
                 progress=lambda k, n: bar.advance(),
             )
-        result.write_csv(staging / "timeseries.csv")
-        result.write_summary(staging / "summary.json")
+        with phase("track: writing timeseries.csv, summary.json", enabled=progress):
+            result.write_csv(staging / "timeseries.csv")
+            result.write_summary(staging / "summary.json", run=record)
         if not args.no_plots:
             from ddwmmr.reports.plots import save_run_figures
 
-            save_run_figures(result, staging)
+            with phase("track: figures", enabled=progress):
+                save_run_figures(result, staging, obstacles=inputs.options.get("obstacles"))
         if args.animate:
             from ddwmmr.reports.plots import save_animation
 
-            save_animation(result, staging / "animation.gif")
+            save_animation(
+                result,
+                staging / "animation.gif",
+                obstacles=inputs.options.get("obstacles"),
+                progress=progress,
+            )
     print(format_table(result.summary))
     print(f"wrote {out}/")
     return 0
-
-
-def _steps_hint(trajectory, args: argparse.Namespace) -> int:
-    duration = args.duration or trajectory.duration
-    step = args.dt or trajectory.duration / getattr(trajectory, "samples", 1000)
-    if not (step and step > 0 and duration and duration > 0):
-        raise ParameterError(f"dt must be > 0 s (got {args.dt})")
-    return max(1, round(duration / step))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

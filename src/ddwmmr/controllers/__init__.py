@@ -6,6 +6,7 @@ from ddwmmr.controllers.base import (
     available_methods,
     make_controller,
     method_description,
+    method_options,
     register,
 )
 
@@ -15,5 +16,6 @@ __all__ = [
     "available_methods",
     "make_controller",
     "method_description",
+    "method_options",
     "register",
 ]

@@ -104,16 +104,40 @@ def method_description(name: str) -> str:
     return _DESCRIPTIONS[name]
 
 
-def make_controller(name: str, robot: Robot | None = None, **options: Any) -> Controller:
-    """Build the registered controller ``name`` for ``robot`` (default: ``Robot()``).
-
-    Unknown method names and unknown options raise :class:`ParameterError`.
-    """
+def _registered(name: str) -> Callable[..., Controller]:
     _load_builtins()
     if name not in _REGISTRY:
         raise ParameterError(f"method: unknown method {name!r} (known: {', '.join(_REGISTRY)})")
-    cls = _REGISTRY[name]
-    accepted = set(inspect.signature(cls).parameters) - {"robot"}
+    return _REGISTRY[name]
+
+
+def method_options(name: str) -> dict[str, Any]:
+    """Options of method ``name`` and their defaults (``inspect.Parameter.empty`` if none).
+
+    The options are the named parameters of the ``__init__`` of the method's class and of
+    its parents (the MRO, most derived first: a subclass's default wins), without
+    ``self``, ``robot``, ``*args`` and ``**kwargs``: what ``make_controller`` accepts.
+    """
+    options: dict[str, Any] = {}
+    for klass in inspect.getmro(_registered(name)):
+        init = klass.__dict__.get("__init__")
+        if init is None or klass is object:
+            continue
+        for parameter in list(inspect.signature(init).parameters.values())[1:]:
+            variadic = parameter.kind in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD)
+            if not variadic and parameter.name != "robot":
+                options.setdefault(parameter.name, parameter.default)
+    return options
+
+
+def make_controller(name: str, robot: Robot | None = None, **options: Any) -> Controller:
+    """Build the registered controller ``name`` for ``robot`` (default: ``Robot()``).
+
+    Unknown method names and unknown options (see :func:`method_options`) raise
+    :class:`ParameterError`.
+    """
+    cls = _registered(name)
+    accepted = set(method_options(name))
     unknown = sorted(set(options) - accepted)
     if unknown:
         raise ParameterError(

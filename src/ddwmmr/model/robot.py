@@ -14,15 +14,45 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.errors import (
+    INERTIA_RANGE_KG_M2,
+    LENGTH_RANGE_M,
+    MASS_RANGE_KG,
+    MAX_ANGLE_RAD,
+    SPEED_RANGE_RAD_S,
+    TORQUE_RANGE_N_M,
     ParameterError,
     check_finite,
     check_nonnegative,
     check_positive,
+    check_range,
     load_toml,
 )
 from ddwmmr.model import kinematics, stability
 
 _PI = math.pi
+#: Allowed range (low, high, unit) of each scalar field; see ddwmmr.errors for the caps.
+_RANGES = {
+    **{
+        name: (*LENGTH_RANGE_M, "m")
+        for name in (
+            "L1",
+            "L2",
+            "wheel_radius",
+            "track_width",
+            "base_length",
+            "base_width",
+            "base_height",
+            "arm_height",
+        )
+    },
+    "wheel_mass": (*MASS_RANGE_KG, "kg"),
+    "wheel_torque_limit": (*TORQUE_RANGE_N_M, "N m"),
+    "base_mass": (*MASS_RANGE_KG, "kg"),
+    "payload": (*MASS_RANGE_KG, "kg"),
+    "base_inertia": (*INERTIA_RANGE_KG_M2, "kg m^2"),
+    "joint_speed_limit": (*SPEED_RANGE_RAD_S, "rad/s"),
+    "wheel_speed_limit": (*SPEED_RANGE_RAD_S, "rad/s"),
+}
 
 
 @dataclass(frozen=True)
@@ -125,6 +155,7 @@ class Robot:
         object.__setattr__(self, "joint_torque_limits", torques)
         if self.caster_positions is not None:
             object.__setattr__(self, "caster_positions", _points(self.caster_positions))
+        self._check_magnitudes()
         object.__setattr__(
             self,
             "_com",
@@ -140,6 +171,19 @@ class Robot:
             ),
         )
 
+    def _check_magnitudes(self) -> None:
+        """Documented physical ranges (ddwmmr.errors): ``wheel_radius = 1e-320`` or
+        ``L1 = 1e300`` would only overflow or divide by ~0 later."""
+        for name, (low, high, unit) in _RANGES.items():
+            check_range(name, getattr(self, name), low, high, unit)
+        for i, mass in enumerate(self.link_masses, start=1):
+            check_range(f"link_masses[{i}]", mass, *MASS_RANGE_KG, "kg")
+        for i, torque in enumerate(self.joint_torque_limits, start=1):
+            check_range(f"joint_torque_limits[{i}]", torque, *TORQUE_RANGE_N_M, "N m")
+        for i, pair in enumerate(self.joint_limits, start=1):
+            for value in pair:
+                check_range(f"joint_limits[{i}]", value, -MAX_ANGLE_RAD, MAX_ANGLE_RAD, "rad")
+
     # -- construction -------------------------------------------------------------------
     @classmethod
     def from_toml(cls, path: str | Path) -> Robot:
@@ -148,17 +192,32 @@ class Robot:
         A ``[robot]`` table is accepted as well as top-level keys.
         """
         data = load_toml(path, "robot")
-        return cls.from_dict(data.get("robot", data))
+        table = data.get("robot", data)
+        if not isinstance(table, dict):
+            raise ParameterError(
+                f"robot: {path}: [robot] must be one table of Robot fields "
+                f"(got {'an array of tables [[robot]]' if isinstance(table, list) else table!r})"
+            )
+        try:
+            return cls.from_dict(table)
+        except ParameterError as exc:
+            raise ParameterError(f"robot: {path}: {str(exc).removeprefix('robot: ')}") from None
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Robot:
-        """Build a robot from a mapping of field names to values; unknown keys are errors."""
-        known = {f.name for f in fields(cls) if f.init}
-        unknown = sorted(set(data) - known)
+        """Build a robot from a mapping of field names to values (a TOML table, a JSON
+        record); unknown keys and values of the wrong type (``L1 = "0.3"``, ``L1 = true``,
+        a number where a pair is expected) are errors naming the key."""
+        if not isinstance(data, dict):
+            raise ParameterError(f"robot: expected a table of Robot fields (got {data!r})")
+        known = {f.name: f for f in fields(cls) if f.init}
+        unknown = sorted(set(data) - set(known))
         if unknown:
             raise ParameterError(
                 f"robot: unknown parameter {unknown[0]!r} (known: {', '.join(sorted(known))})"
             )
+        for key, value in data.items():
+            _check_field_type(key, value, known[key].default)
         return cls(**data)
 
     def with_payload(self, payload: float) -> Robot:
@@ -267,6 +326,34 @@ class Robot:
             self.L2 * math.sin(th2), self.L1 + self.L2 * math.cos(th2)
         )
         return math.atan2(math.sin(th1), math.cos(th1)), th2
+
+
+def _check_field_type(key: str, value: Any, default: Any) -> None:
+    """``value`` (as read from a file) has the type of the field's ``default``.
+
+    Numbers for number fields (not strings, not booleans), strings for string fields,
+    booleans for boolean fields, and nested pairs shaped like a tuple default; fields
+    without a plain default are left to ``__post_init__``.
+    """
+    if isinstance(default, bool):
+        ok, wanted = isinstance(value, bool), "true or false"
+    elif isinstance(default, int | float):
+        ok = isinstance(value, int | float) and not isinstance(value, bool)
+        wanted = "a number"
+    elif isinstance(default, str):
+        ok, wanted = isinstance(value, str), "a string"
+    elif isinstance(default, tuple):
+        ok = isinstance(value, list | tuple) and len(value) == len(default)
+        wanted = (
+            "a pair of numbers" if not isinstance(default[0], tuple) else "two [min, max] pairs"
+        )
+        if ok:
+            for item, item_default in zip(value, default):
+                _check_field_type(key, item, item_default)
+    else:
+        return
+    if not ok:
+        raise ParameterError(f"robot: {key} must be {wanted} (got {value!r})")
 
 
 def _pair(name: str, value) -> tuple[float, float]:

@@ -20,6 +20,9 @@ from matplotlib.figure import Figure
 from ddwmmr.model import Robot
 
 FIGURE_NAMES = ("path.png", "errors.png", "rates.png", "metrics.png")
+#: PNG text chunks: none (not even the matplotlib version), so equal runs give
+#: byte-identical figures.
+PNG_METADATA = {"Software": None}
 
 
 def robot_outline(robot: Robot, q) -> dict[str, np.ndarray]:
@@ -44,10 +47,45 @@ def draw_robot(ax: Axes, robot: Robot, q, color: str = "0.35", alpha: float = 0.
     ax.plot(*shape["arm"].T, color="tab:orange", lw=1.4, alpha=alpha, marker="o", ms=2)
 
 
-def plot_path(result, ax: Axes | None = None, snapshots: int = 8) -> Figure:
-    """Desired vs actual end-effector path, base path, and the robot at ``snapshots`` times."""
+def circles_of(obstacles) -> list[tuple[float, float, float]]:
+    """Obstacles as ``(x, y, radius)`` triples (m): from circles, triples or None."""
+    found = []
+    for item in obstacles or ():
+        if hasattr(item, "radius"):
+            found.append((float(item.x), float(item.y), float(item.radius)))
+        else:
+            x, y, radius = (float(v) for v in item)
+            found.append((x, y, radius))
+    return found
+
+
+def draw_obstacles(ax: Axes, obstacles, label: str = "obstacle") -> None:
+    """Grey discs for circular obstacles (world frame, m); one legend entry."""
+    for i, (x, y, radius) in enumerate(circles_of(obstacles)):
+        disc = plt.Circle(
+            (x, y), radius, color="0.55", alpha=0.45, lw=1, label=label if i == 0 else None
+        )
+        ax.add_patch(disc)
+        ax.update_datalim([(x - radius, y - radius), (x + radius, y + radius)])
+
+
+def break_wraps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(t, angle)`` with a NaN gap where a wrapped angle jumps across +-pi.
+
+    A wrapped error that crosses pi reappears at -pi; a line drawn through the jump
+    would be a false vertical stroke, so the line is broken there instead.
+    """
+    t, angle = np.asarray(t, dtype=float), np.asarray(angle, dtype=float)
+    jumps = np.flatnonzero(np.abs(np.diff(angle)) > math.pi) + 1
+    return np.insert(t, jumps, np.nan), np.insert(angle, jumps, np.nan)
+
+
+def plot_path(result, ax: Axes | None = None, snapshots: int = 8, obstacles=None) -> Figure:
+    """Desired vs actual end-effector path, base path, the robot at ``snapshots`` times and
+    the obstacles (``(x, y, radius)`` circles, m) if any."""
     ts = result.timeseries
     fig, ax = _axes(ax, figsize=(6.5, 5.5))
+    draw_obstacles(ax, obstacles)
     ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=1, label="desired end effector")
     ax.plot(ts["xE"], ts["yE"], color="tab:blue", lw=1.5, label="actual end effector")
     ax.plot(ts["x"], ts["y"], color="tab:green", lw=1, label="base (axle midpoint)")
@@ -71,8 +109,8 @@ def plot_errors(result) -> Figure:
     ax1.semilogy(ts["t"], np.maximum(ts["position_error_m"], 1e-9), color="tab:blue")
     ax1.set_ylabel("position error (m)")
     ax1.grid(alpha=0.3, which="both")
-    ax2.plot(ts["t"], ts["orientation_error_rad"], color="tab:red")
-    ax2.set_ylabel("orientation error (rad)")
+    ax2.plot(*break_wraps(ts["t"], ts["orientation_error_rad"]), color="tab:red")
+    ax2.set_ylabel("orientation error (rad)\nwrapped to [-pi, pi)")
     ax2.set_xlabel("t (s)")
     ax2.grid(alpha=0.3)
     ax1.set_title(_title(result, "tracking errors"))
@@ -127,26 +165,43 @@ def plot_metrics(result) -> Figure:
     return fig
 
 
-def save_run_figures(result, folder: str | Path) -> list[Path]:
-    """Write path.png, errors.png, rates.png and metrics.png into ``folder``."""
+def save_run_figures(result, folder: str | Path, obstacles=None) -> list[Path]:
+    """Write path.png (with ``obstacles``), errors.png, rates.png, metrics.png in ``folder``."""
     folder = Path(folder)
     paths = []
-    for name, make in zip(FIGURE_NAMES, (plot_path, plot_errors, plot_rates, plot_metrics)):
+    makers = (
+        lambda r: plot_path(r, obstacles=obstacles),
+        plot_errors,
+        plot_rates,
+        plot_metrics,
+    )
+    for name, make in zip(FIGURE_NAMES, makers):
         fig = make(result)
         path = folder / name
-        fig.savefig(path, dpi=110)
+        fig.savefig(path, dpi=110, metadata=PNG_METADATA)
         plt.close(fig)
         paths.append(path)
     return paths
 
 
-def save_animation(result, path: str | Path, frames: int = 80, fps: int = 15) -> Path:
-    """Write a GIF of the robot following the trajectory (``frames`` evenly spaced)."""
+def save_animation(
+    result,
+    path: str | Path,
+    frames: int = 80,
+    fps: int = 15,
+    obstacles=None,
+    progress: bool = False,
+) -> Path:
+    """Write a GIF of the robot following the trajectory (``frames`` evenly spaced);
+    ``progress`` shows the encoding on stderr (:mod:`ddwmmr.progress`)."""
     from matplotlib.animation import FuncAnimation, PillowWriter
+
+    from ddwmmr.progress import ProgressBar
 
     ts, robot = result.timeseries, result.robot
     q = result.configurations()
     fig, ax = plt.subplots(figsize=(5, 4.5))
+    draw_obstacles(ax, obstacles)
     ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=1)
     reach = robot.reach + robot.base_length
     ax.set_xlim(
@@ -174,7 +229,10 @@ def save_animation(result, path: str | Path, frames: int = 80, fps: int = 15) ->
 
     animation = FuncAnimation(fig, update, frames=len(indices), blit=False)
     path = Path(path)
-    animation.save(path, writer=PillowWriter(fps=fps))
+    with ProgressBar(len(indices), "track: animation.gif", enabled=progress, unit="frame") as bar:
+        animation.save(
+            path, writer=PillowWriter(fps=fps), progress_callback=lambda i, n: bar.advance()
+        )
     plt.close(fig)
     return path
 

@@ -87,7 +87,9 @@ def table_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
         mean, sd = summary[key], summary["sd_" + key]
         if isinstance(mean, float) and math.isnan(mean):
             return "n/a"
-        return f"{_fmt(mean)} ({_fmt(100.0 * mean / total)}%) ({_fmt(sd)})"
+        # Every scenario may stop at t = 0 (a payload that tips the start pose): no share.
+        share = _fmt(100.0 * mean / total) + "%" if total and total > 0 else "n/a"
+        return f"{_fmt(mean)} ({share}) ({_fmt(sd)})"
 
     def plain(mean_key: str, sd_key: str) -> str:
         if isinstance(summary[mean_key], float) and math.isnan(summary[mean_key]):
@@ -258,30 +260,71 @@ def plot_paths(items: Sequence[tuple[Scenario, Outcome]], path, title: str) -> N
     _save(fig, path)
 
 
-def plot_timeline(outcome: Outcome, path, title: str) -> None:
-    """Controller state, stability and manipulability over time for one scenario (Fig 5.17)."""
+def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None = None) -> None:
+    """Controller state, stability, manipulability and the distance to the current waypoint
+    over time for one scenario (thesis Fig 5.17); with ``scenario``, the instants at which
+    each waypoint was reached are marked."""
     tr = outcome.trace or {}
-    fig, axes = _figure(3, 1, height=2.6)
+    t = tr.get("t", [])
+    fig, axes = _figure(4, 1, height=2.2)
     ax = axes[0, 0]
-    ax.step(tr.get("t", []), tr.get("state", []), where="post")
+    ax.step(t, tr.get("state", []), where="post")
     number = outcome.metrics["scenario"]
     if isinstance(outcome.metrics["transitions_stability"], float) and math.isnan(
         outcome.metrics["transitions_stability"]
     ):  # no arbiter: the trace only tells whether the base moves
         ax.set_yticks([0, 1], ["base moving", "base at rest"])
-        ax.set(title=f"{title}: scenario {number} base motion")
+        ax.set(title=f"{title}: scenario {number} base motion", ylabel="base")
     else:
         ax.set_yticks(range(len(STATES)), [s.replace("_", " ") for s in STATES])
-        ax.set(title=f"{title}: scenario {number} controller state")
+        ax.set(title=f"{title}: scenario {number} controller state", ylabel="state")
     ax2 = axes[1, 0]
-    ax2.plot(tr.get("t", []), tr.get("s", []), label="stability S")
-    ax2.plot(tr.get("t", []), tr.get("eta", []), label="manipulability eta")
-    ax2.axhline(1.0, color="k", lw=0.6, ls="--")
-    ax2.set(ylim=(0.0, 3.0))
-    ax2.legend(fontsize=8)
+    ax2.plot(t, tr.get("s", []), color="tab:brown", label="stability S")
+    ax2.axhline(1.0, color="tab:red", lw=0.8, ls="--", label="S = 1 (tips over)")
+    top = max(3.0, 1.05 * max(tr.get("s", [0.0]), default=0.0))
+    ax2.set(ylim=(0.0, top), ylabel="stability S (-)")
+    ax2.legend(fontsize=8, ncol=2, loc="upper right")
     ax3 = axes[2, 0]
-    ax3.semilogy(tr.get("t", []), np.maximum(tr.get("distance", []), 1e-4))
-    ax3.axhline(0.01, color="k", lw=0.6, ls="--", label="tolerance 0.01 m")
-    ax3.set(xlabel="time (s)", ylabel="to waypoint (m)")
-    ax3.legend(fontsize=8)
+    ax3.plot(t, tr.get("eta", []), color="tab:purple", label="manipulability eta = |sin th2|")
+    ax3.set(ylim=(0.0, 1.05), ylabel="manipulability\neta (-)")
+    ax3.legend(fontsize=8, loc="lower right")
+    ax4 = axes[3, 0]
+    ax4.semilogy(t, np.maximum(tr.get("distance", []), 1e-4), label="distance")
+    ax4.axhline(0.01, color="k", lw=0.6, ls="--", label="tolerance 0.01 m")
+    if scenario is not None:
+        _mark_waypoints(ax4, tr, scenario)
+    if len(t) > 1:
+        ax4.text(
+            0.99, 0.04, f"trace sampled every {t[1] - t[0]:.3g} s", transform=ax4.transAxes,
+            ha="right", fontsize=7, color="0.4",
+        )  # fmt: skip
+    ax4.set(xlabel="time (s)", ylabel="end effector to\nwaypoint (m)", ylim=(1e-4, 30.0))
+    ax4.legend(fontsize=8, loc="lower left", ncol=3)
+    for axis in (ax, ax2, ax3):
+        axis.sharex(ax4)
+        axis.grid(alpha=0.3)
+    ax4.grid(alpha=0.3)
     _save(fig, path)
+
+
+def _mark_waypoints(ax, trace: dict, scenario: Scenario) -> None:
+    """Dotted verticals at the first trace sample after each waypoint was reached.
+
+    The trace records the distance to the *current* waypoint; the waypoint it refers to is
+    the one at exactly that distance from the end effector, so a change of that index is
+    a waypoint reached (not merely the distance growing as the arm moves).
+    """
+    t = np.asarray(trace.get("t", []), dtype=float)
+    xe = np.asarray(trace.get("xe", []), dtype=float)
+    ye = np.asarray(trace.get("ye", []), dtype=float)
+    distance = np.asarray(trace.get("distance", []), dtype=float)
+    if len(t) < 2:
+        return
+    points = np.asarray(scenario.waypoints, dtype=float)  # (5, 2)
+    to_each = np.hypot(xe[:, None] - points[None, :, 0], ye[:, None] - points[None, :, 1])
+    current = np.maximum.accumulate(np.argmin(np.abs(to_each - distance[:, None]), axis=1))
+    done = distance == 0.0  # after the last waypoint
+    current[done] = len(points)
+    for i, k in enumerate(np.flatnonzero(np.diff(current) > 0) + 1):
+        label = "waypoint reached" if i == 0 else None
+        ax.axvline(t[k], color="tab:green", lw=0.6, ls=":", label=label)

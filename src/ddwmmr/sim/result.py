@@ -14,6 +14,8 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr.outputs import file_mode, folder_mode
+
 
 @dataclass
 class SimulationResult:
@@ -45,9 +47,9 @@ class SimulationResult:
             writer.writerow([_format(v) for v in row])
         write_atomic(path, buffer.getvalue())
 
-    def write_summary(self, path: str | Path) -> None:
-        """Write the summary as JSON (atomically)."""
-        write_atomic(path, json.dumps(json_safe(self.summary), indent=2) + "\n")
+    def write_summary(self, path: str | Path, **extra: Any) -> None:
+        """Write the summary as JSON (atomically), with ``extra`` keys (e.g. ``run``)."""
+        write_atomic(path, json.dumps(json_safe({**self.summary, **extra}), indent=2) + "\n")
 
 
 def _format(value: float) -> str:
@@ -68,14 +70,19 @@ def json_safe(value: Any) -> Any:
 
 
 def write_atomic(path: str | Path, data: str | bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file and an atomic rename."""
+    """Write ``data`` to ``path`` through a temporary file and an atomic rename.
+
+    The file gets the user's umask (``0644`` for umask 022), like any normal file, not
+    the ``0600`` of the temporary file; text is written as UTF-8.
+    """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    mode = "wb" if isinstance(data, bytes) else "w"
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    path.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
+    payload = data if isinstance(data, bytes) else data.encode("utf-8")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".ddwmmr-", suffix=".tmp")
     try:
-        with os.fdopen(fd, mode) as handle:
-            handle.write(data)
+        with os.fdopen(fd, "wb") as handle:
+            os.fchmod(handle.fileno(), file_mode())
+            handle.write(payload)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

@@ -1,9 +1,15 @@
 """Load trajectories by name or path: parametric TOML and sampled CSV files.
 
-A name (``ellipse``, ``figure8``...) is looked up as ``<name>.toml`` or ``<name>.csv`` in the
-trajectory folders: ``$DDWMMR_TRAJECTORIES`` (os.pathsep-separated), ``./trajectories`` and
-the project's top-level ``trajectories/`` folder. The names ``ellipse`` and ``rectangle``
-fall back to the built-in defaults if no folder holds them.
+A *name* (``ellipse``, ``figure8``...: letters, digits, ``_``, ``-`` and inner dots, no
+path separator) is looked up as ``<name>.toml`` or ``<name>.csv`` in the trajectory
+folders, in order: ``$DDWMMR_TRAJECTORIES`` (os.pathsep-separated), ``./trajectories``
+and the named trajectories shipped inside the package (``ddwmmr/trajectories/data``, the
+same files as the project's top-level ``trajectories/`` folder, so a wheel install has
+them). The names ``ellipse`` and ``rectangle`` fall back to the built-in defaults if no
+folder holds them. Anything else (a value with a path separator or a ``.toml`` / ``.csv``
+suffix) is a *path* and is read as given; a name never resolves outside the folders.
+
+Obstacle files (``--obstacles``) resolve the same way, in the ``obstacles/`` subfolder.
 
 Parametric TOML::
 
@@ -21,22 +27,41 @@ Parametric TOML::
 
 from __future__ import annotations
 
+import hashlib
 import os
+import re
+from dataclasses import fields
+from importlib import resources
 from pathlib import Path
+from typing import Any
 
-from ddwmmr.errors import ParameterError, load_toml
+from ddwmmr.errors import ParameterError, check_number_type, load_toml
 from ddwmmr.trajectories.parametric import Ellipse, Rectangle
 from ddwmmr.trajectories.sampled import read_csv
 
 SHAPES = {"ellipse": Ellipse, "rectangle": Rectangle}
-_PROJECT_FOLDER = Path(__file__).resolve().parents[3] / "trajectories"
+SUFFIXES = (".toml", ".csv")
+#: A trajectory or obstacle-file name: no separator, no leading dot, no "..".
+_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+#: Keys of a parametric TOML trajectory and the type each must have.
+_STRING_KEYS = {"shape", "orientation", "name"}
+
+
+def package_folder() -> Path:
+    """The named trajectories shipped inside the package (``ddwmmr/trajectories/data``)."""
+    return Path(str(resources.files("ddwmmr.trajectories").joinpath("data")))
 
 
 def trajectory_folders() -> list[Path]:
     """Folders searched for trajectory names, in order."""
     folders = [Path(p) for p in os.environ.get("DDWMMR_TRAJECTORIES", "").split(os.pathsep) if p]
-    folders += [Path.cwd() / "trajectories", _PROJECT_FOLDER]
+    folders += [Path.cwd() / "trajectories", package_folder()]
     return folders
+
+
+def is_name(value: str) -> bool:
+    """Whether ``value`` is a trajectory/obstacle *name* rather than a path."""
+    return bool(_NAME.fullmatch(value)) and ".." not in value and not value.endswith(SUFFIXES)
 
 
 def available_trajectories() -> list[str]:
@@ -44,28 +69,69 @@ def available_trajectories() -> list[str]:
     names = set(SHAPES)
     for folder in trajectory_folders():
         if folder.is_dir():
-            names.update(p.stem for p in folder.iterdir() if p.suffix in (".toml", ".csv"))
+            names.update(
+                p.stem for p in folder.iterdir() if p.suffix in SUFFIXES and is_name(p.stem)
+            )
     return sorted(names)
+
+
+def find_trajectory_file(name_or_path: str | Path) -> Path | None:
+    """The file a trajectory name or path refers to; None for a built-in-only name.
+
+    Raises :class:`ParameterError` for an unknown name or a path that is not a
+    ``.toml``/``.csv`` file.
+    """
+    text = str(name_or_path)
+    if not is_name(text):
+        path = Path(text)
+        if path.suffix not in SUFFIXES:
+            known = ", ".join(available_trajectories())
+            raise ParameterError(
+                f"traj: {text!r} is neither a trajectory name ({known}) nor a .toml/.csv path"
+            )
+        if not os.path.lexists(path):
+            raise ParameterError(f"traj: no such file {path}")
+        return path
+    for folder in trajectory_folders():
+        for suffix in SUFFIXES:
+            candidate = folder / f"{text}{suffix}"
+            if candidate.is_file():
+                return candidate
+    if text in SHAPES:
+        return None
+    raise ParameterError(
+        f"traj: unknown trajectory {text!r} "
+        f"(known: {', '.join(available_trajectories())}; or give a .toml/.csv path)"
+    )
 
 
 def load_trajectory(name_or_path: str | Path, **overrides):
     """Resolve a trajectory name or file path; ``overrides`` replace TOML parameters."""
-    path = Path(name_or_path)
-    if path.suffix in (".toml", ".csv") or path.exists():
-        if not path.is_file():
-            raise ParameterError(f"traj: no such file {path}")
-        return _load_file(path, overrides)
-    for folder in trajectory_folders():
-        for suffix in (".toml", ".csv"):
-            candidate = folder / f"{name_or_path}{suffix}"
-            if candidate.is_file():
-                return _load_file(candidate, overrides)
-    if str(name_or_path) in SHAPES:
+    path = find_trajectory_file(name_or_path)
+    if path is None:
         return SHAPES[str(name_or_path)](**overrides)
+    return _load_file(path, overrides)
+
+
+def find_obstacle_file(name_or_path: str | Path) -> Path:
+    """The obstacle TOML a name (``ellipse_post``) or a path refers to."""
+    text = str(name_or_path)
+    if not is_name(text):
+        return Path(text)
+    for folder in trajectory_folders():
+        candidate = folder / "obstacles" / f"{text}.toml"
+        if candidate.is_file():
+            return candidate
+    known = sorted({p.stem for f in trajectory_folders() for p in (f / "obstacles").glob("*.toml")})
     raise ParameterError(
-        f"traj: unknown trajectory {str(name_or_path)!r} "
-        f"(known: {', '.join(available_trajectories())}; or give a .toml/.csv path)"
+        f"obstacles: unknown obstacle file {text!r} (known: {', '.join(known) or 'none'}; "
+        "or give a .toml path)"
     )
+
+
+def file_sha256(path: str | Path) -> str:
+    """Hex SHA-256 of a file's bytes (recorded so a rerun can tell the file changed)."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
 def _load_file(path: Path, overrides: dict):
@@ -77,16 +143,46 @@ def _load_file(path: Path, overrides: dict):
 
 
 def read_toml(path: str | Path, **overrides):
-    """Load a parametric trajectory (ellipse or rectangle) from a TOML file."""
+    """Load a parametric trajectory (ellipse or rectangle) from a TOML file.
+
+    Every value must have its documented type (numbers for lengths, angles, N and T,
+    strings for shape, orientation and name): ``N = "2000"`` is an error naming ``N``.
+    """
     path = Path(path)
     data = load_toml(path, "traj")
-    table = dict(data.get("trajectory", data))
+    table = data.get("trajectory", data)
+    if not isinstance(table, dict):
+        raise ParameterError(
+            f"traj: {path}: [trajectory] must be one table (got {type(table).__name__})"
+        )
+    table = dict(table)
     shape = table.pop("shape", None)
     if shape not in SHAPES:
         raise ParameterError(f"traj: {path} needs shape = one of {', '.join(SHAPES)}")
     table.setdefault("name", path.stem)
     table.update(overrides)
+    known = [f.name for f in fields(SHAPES[shape])]
+    unknown = sorted(set(table) - set(known))
+    if unknown:
+        raise ParameterError(
+            f"traj: {path}: unknown key {unknown[0]!r} (known: shape, {', '.join(known)})"
+        )
+    _check_types(path, table)
     try:
         return SHAPES[shape](**table)
     except TypeError as exc:
         raise ParameterError(f"traj: {path}: {exc}") from None
+    except ParameterError as exc:
+        raise ParameterError(f"traj: {path}: {exc}") from None
+
+
+def _check_types(path: Path, table: dict[str, Any]) -> None:
+    for key, value in table.items():
+        if key in _STRING_KEYS:
+            if not isinstance(value, str):
+                raise ParameterError(f"traj: {path}: {key} must be a string (got {value!r})")
+        else:
+            try:
+                check_number_type(key, value)
+            except ParameterError as exc:
+                raise ParameterError(f"traj: {path}: {exc}") from None

@@ -19,7 +19,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_finite, check_int_at_least, check_positive
+from ddwmmr.errors import (
+    DURATION_RANGE_S,
+    LENGTH_RANGE_M,
+    MAX_ANGLE_RAD,
+    MAX_COORDINATE_M,
+    MAX_TRAJECTORY_SAMPLES,
+    ParameterError,
+    check_finite,
+    check_int_at_least,
+    check_positive,
+    check_range,
+)
 
 ORIENTATIONS = ("tangent", "constant")
 
@@ -43,7 +54,15 @@ class _Parametric(ABC):
             object.__setattr__(self, name, check_finite(name, getattr(self, name)))
         for name in ("a", "b", "T"):
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
-        object.__setattr__(self, "N", check_int_at_least("N", self.N, 2))
+        # Documented magnitudes (ddwmmr.errors): no overflow, no absurd allocation later.
+        for name in ("x0", "y0"):
+            check_range(name, getattr(self, name), -MAX_COORDINATE_M, MAX_COORDINATE_M, "m")
+        for name in ("beta", "phi"):
+            check_range(name, getattr(self, name), -MAX_ANGLE_RAD, MAX_ANGLE_RAD, "rad")
+        for name in ("a", "b"):
+            check_range(name, getattr(self, name), *LENGTH_RANGE_M, "m")
+        check_range("T", self.T, *DURATION_RANGE_S, "s")
+        object.__setattr__(self, "N", check_int_at_least("N", self.N, 2, MAX_TRAJECTORY_SAMPLES))
         if self.orientation not in ORIENTATIONS:
             raise ParameterError(
                 f"orientation must be one of {', '.join(ORIENTATIONS)} (got {self.orientation!r})"

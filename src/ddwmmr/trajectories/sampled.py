@@ -16,7 +16,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import (
+    DURATION_RANGE_S,
+    MAX_COORDINATE_M,
+    MAX_TRAJECTORY_SAMPLES,
+    ParameterError,
+    read_text_file,
+)
+
+MAX_TIME_S = DURATION_RANGE_S[1]
 
 
 def _tangents(times: np.ndarray, values: np.ndarray, periodic: bool) -> np.ndarray:
@@ -61,6 +69,15 @@ class SampledTrajectory:
             raise ParameterError("trajectory samples: points must be (n, 2) or (n, 3)")
         if not (np.all(np.isfinite(times)) and np.all(np.isfinite(points))):
             raise ParameterError("trajectory samples: every value must be a finite number")
+        if len(times) > MAX_TRAJECTORY_SAMPLES:
+            raise ParameterError(
+                f"trajectory samples: at most {MAX_TRAJECTORY_SAMPLES} rows (got {len(times)})"
+            )
+        if np.max(np.abs(points)) > MAX_COORDINATE_M or np.max(np.abs(times)) > MAX_TIME_S:
+            raise ParameterError(
+                f"trajectory samples: |x|, |y|, |phi| must be <= {MAX_COORDINATE_M:g} and "
+                f"|t| <= {MAX_TIME_S:g} s"
+            )
         if np.any(np.diff(times) <= 0):
             raise ParameterError("trajectory samples: column t must be strictly increasing")
         periodic = bool(np.allclose(points[0, :2], points[-1, :2], atol=1e-9))
@@ -140,11 +157,16 @@ class SampledTrajectory:
 def read_csv(path: str | Path) -> SampledTrajectory:
     """Load a :class:`SampledTrajectory` from a CSV file with columns t, x, y[, phi]."""
     path = Path(path)
+    text = read_text_file(path, "traj")
+    lines = [line for line in text.splitlines() if not line.startswith("#")]
+    if len(lines) > MAX_TRAJECTORY_SAMPLES + 1:
+        raise ParameterError(
+            f"traj: {path} has {len(lines) - 1} rows (at most {MAX_TRAJECTORY_SAMPLES})"
+        )
     try:
-        with path.open(newline="") as handle:
-            rows = list(csv.DictReader(row for row in handle if not row.startswith("#")))
-    except OSError as exc:
-        raise ParameterError(f"traj: cannot read {path} ({exc.strerror})") from None
+        rows = list(csv.DictReader(lines))
+    except csv.Error as exc:
+        raise ParameterError(f"traj: {path} is not valid CSV ({exc})") from None
     if not rows:
         raise ParameterError(f"traj: {path} has no data rows")
     columns = set(rows[0])
@@ -157,4 +179,7 @@ def read_csv(path: str | Path) -> SampledTrajectory:
         points = np.array([[float(r[k]) for k in keys] for r in rows])
     except (TypeError, ValueError):
         raise ParameterError(f"traj: {path} has a non-numeric value") from None
-    return SampledTrajectory(times, points, name=path.stem)
+    try:
+        return SampledTrajectory(times, points, name=path.stem)
+    except ParameterError as exc:
+        raise ParameterError(f"traj: {path}: {exc}") from None

@@ -1,0 +1,41 @@
+"""``python -m ddwmmr``: the command-line tools, one line each."""
+
+from __future__ import annotations
+
+import sys
+
+#: (module run with ``python -m``, console script, what it does).
+TOOLS = (
+    ("ddwmmr.track", "ddwmmr-track", "one method on one trajectory: time series, figures"),
+    ("ddwmmr.compare", "ddwmmr-compare", "every method on the same trajectories: HTML report"),
+    ("ddwmmr.scenarios", "ddwmmr-scenarios", "the thesis's 100-scenario waypoint benchmark"),
+    ("ddwmmr.bench", "ddwmmr-bench", "per-step latency and throughput of the controllers"),
+)
+
+
+def usage() -> str:
+    """The list of tools printed by ``python -m ddwmmr``."""
+    width = max(len(module) for module, _, _ in TOOLS) + len("python -m ")
+    script_width = max(len(script) for _, script, _ in TOOLS)
+    lines = ["ddwmmr command-line tools (each answers --help; console script in the middle):"]
+    for module, script, text in TOOLS:
+        lines.append(f"  {'python -m ' + module:<{width}}  {script:<{script_width}}  {text}")
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Print the tools; any argument other than --help is an error (status 2)."""
+    arguments = sys.argv[1:] if argv is None else argv
+    if arguments and arguments[0] not in ("-h", "--help"):
+        print(
+            f"python -m ddwmmr: error: no tool {arguments[0]!r}; run python -m ddwmmr.<tool> "
+            "(track, compare, scenarios, bench)",
+            file=sys.stderr,
+        )
+        return 2
+    print(usage())
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

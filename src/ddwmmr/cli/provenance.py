@@ -1,0 +1,168 @@
+"""What a tool records so a run can be repeated: the ``run`` record of its summary.
+
+Every tool writes a record (``summary.json["run"]`` for track and scenarios, ``run.json``
+for compare) with the tool, the package version, the git commit of the source when it is
+a git checkout, the exact command line and working folder, and the tool's inputs in full:
+method and every option with its default filled in, the robot (all fields), the
+trajectory (its parameters, or its file's path and SHA-256), step, integrator, offset,
+plant and seed. Values are JSON: tuples become lists, non-finite floats the strings
+``"inf"``, ``"-inf"``, ``"nan"`` (:func:`decode` turns them back).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import math
+import os
+import shlex
+import subprocess
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.controllers.base import method_options
+from ddwmmr.errors import ParameterError
+from ddwmmr.model import Robot
+from ddwmmr.outputs import package_version
+from ddwmmr.trajectories.files import SHAPES, file_sha256
+from ddwmmr.trajectories.sampled import SampledTrajectory, read_csv
+
+#: Version of the record layout (bump when a key changes meaning).
+RECORD_VERSION = 1
+_NON_FINITE = {"inf": math.inf, "-inf": -math.inf, "nan": math.nan}
+
+
+def encode(value: Any) -> Any:
+    """A JSON-ready copy of ``value`` (see the module docstring); unknown objects: repr."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: encode(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, dict):
+        return {str(k): encode(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        return [encode(v) for v in value]
+    if isinstance(value, np.generic):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf")
+    if value is None or isinstance(value, bool | int | float | str):
+        return value
+    return {"repr": repr(value)}
+
+
+def decode(value: Any) -> Any:
+    """Inverse of :func:`encode` for numbers: ``"inf"`` etc. back to floats."""
+    if isinstance(value, dict):
+        return {k: decode(v) for k, v in value.items()}
+    if isinstance(value, list):
+        return [decode(v) for v in value]
+    if isinstance(value, str) and value in _NON_FINITE:
+        return _NON_FINITE[value]
+    return value
+
+
+def git_state() -> dict[str, Any] | None:
+    """``{"commit", "dirty"}`` of the source checkout this package runs from, else None.
+
+    Only when the package is ``<top>/src/ddwmmr`` of a git work tree (an editable
+    install); an installed wheel has no commit to report.
+    """
+    package = Path(__file__).resolve().parents[1]
+    top = package.parents[1]
+    if package != top / "src" / "ddwmmr" or not (top / ".git").exists():
+        return None
+    try:
+        commit = _git(top, "rev-parse", "HEAD")
+        status = _git(top, "status", "--porcelain", "--untracked-files=no")
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return {"commit": commit, "dirty": bool(status)}
+
+
+def _git(top: Path, *arguments: str) -> str:
+    done = subprocess.run(
+        ["git", "-C", str(top), *arguments],
+        capture_output=True,
+        text=True,
+        timeout=10,
+        check=True,
+    )
+    return done.stdout.strip()
+
+
+def command_record(prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
+    """The exact command line (``argv`` as given, or ``sys.argv[1:]``) and working folder."""
+    arguments = list(argv if argv is not None else sys.argv[1:])
+    return {
+        "command": shlex.join([*shlex.split(prog), *arguments]),
+        "argv": arguments,
+        "cwd": os.getcwd(),
+    }
+
+
+def header(tool: str, prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
+    """The start of every record: tool, versions, commit, command line."""
+    return {
+        "record_version": RECORD_VERSION,
+        "tool": tool,
+        "version": package_version(),
+        "git": git_state(),
+        "python": sys.version.split()[0],
+        "numpy": np.__version__,
+        **command_record(prog, argv),
+    }
+
+
+def robot_record(robot: Robot) -> dict[str, Any]:
+    """Every constructor field of the robot (payload included)."""
+    return {f.name: encode(getattr(robot, f.name)) for f in dataclasses.fields(robot) if f.init}
+
+
+def robot_from_record(record: dict[str, Any]) -> Robot:
+    """The robot a :func:`robot_record` describes."""
+    return Robot.from_dict(decode(record))
+
+
+def options_record(method: str, given: dict[str, Any]) -> dict[str, Any]:
+    """Every option of ``method``: the given value, else its default."""
+    defaults = method_options(method)
+    merged = {k: v for k, v in defaults.items() if v is not inspect.Parameter.empty}
+    merged.update(given)
+    return encode(merged)
+
+
+def trajectory_record(trajectory: Any, source: Path | None) -> dict[str, Any]:
+    """Parameters of a parametric trajectory, or the sample file's path and SHA-256."""
+    record: dict[str, Any] = {"name": str(getattr(trajectory, "name", ""))}
+    if source is not None:
+        record["file"] = str(Path(source).resolve())
+        record["sha256"] = file_sha256(source)
+    shape = next((k for k, cls in SHAPES.items() if type(trajectory) is cls), None)
+    if shape is not None:
+        record["type"] = shape
+        record["parameters"] = encode(trajectory)
+    elif isinstance(trajectory, SampledTrajectory):
+        record["type"] = "samples"
+    else:
+        record["type"] = type(trajectory).__name__
+    return record
+
+
+def trajectory_from_record(record: dict[str, Any]) -> Any:
+    """The trajectory a :func:`trajectory_record` describes (a changed file is an error)."""
+    kind = record.get("type")
+    if kind in SHAPES:
+        return SHAPES[kind](**decode(record["parameters"]))
+    if kind == "samples":
+        path = Path(record["file"])
+        if not path.is_file():
+            raise ParameterError(f"rerun: the trajectory file {path} is gone")
+        if file_sha256(path) != record["sha256"]:
+            raise ParameterError(
+                f"rerun: the trajectory file {path} changed since the run (SHA-256 differs)"
+            )
+        return read_csv(path)
+    raise ParameterError(f"rerun: cannot rebuild a trajectory of type {kind!r}")

@@ -1,0 +1,354 @@
+"""Output folders of the command-line tools: never lose a user's file.
+
+Every tool (track, compare, scenarios) writes its results through :func:`output_folder`:
+
+* the files are written into a hidden staging folder next to ``--out`` and moved into place
+  only when the run succeeded; the staging folder is removed on any error, Ctrl-C or
+  SIGTERM (:mod:`ddwmmr.cli.common` turns SIGTERM into an exception so this happens);
+* a folder written by a tool carries a manifest, :data:`MANIFEST`, naming the tool, the
+  package version and every file written;
+* an existing ``--out`` is replaced only if it is empty, or if its manifest names the same
+  tool and it holds nothing but the files that manifest lists. Anything else is refused
+  with one line (a :class:`ParameterError`);
+* ``force=True`` (``--force``) also writes into a folder another tool or the user made,
+  and even then deletes only the files its manifest lists: a file no manifest lists always
+  survives (a new file that would overwrite it is refused).
+
+Files and folders get the user's umask like any normal file (``0644``/``0755`` for the
+usual ``022``), not the ``0600``/``0700`` of temporary files.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import stat
+import sys
+import tempfile
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from pathlib import Path, PurePosixPath
+
+from ddwmmr.errors import ParameterError
+
+#: Name of the manifest file each tool writes into its output folder.
+MANIFEST = ".ddwmmr-manifest.json"
+STAGING_PREFIX = ".ddwmmr-staging-"
+_OLD_PREFIX = ".ddwmmr-old-"
+
+
+# -- permissions ------------------------------------------------------------------------
+def umask() -> int:
+    """The process umask: from ``/proc/self/status`` on Linux (no race with other
+    threads), else by setting and restoring it (``os.umask`` can only be read so)."""
+    with contextlib.suppress(OSError, ValueError):
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def file_mode() -> int:
+    """Mode of a new output file under the user's umask (``0o644`` for umask 022)."""
+    return 0o666 & ~umask()
+
+
+def folder_mode() -> int:
+    """Mode of a new output folder under the user's umask (``0o755`` for umask 022)."""
+    return 0o777 & ~umask()
+
+
+def package_version() -> str:
+    """The installed ddwmmr version."""
+    from ddwmmr import __version__
+
+    return __version__
+
+
+# -- what is at the target ----------------------------------------------------------------
+@dataclass
+class Existing:
+    """What ``--out`` currently is.
+
+    ``kind``: ``absent``, ``empty``, ``own`` (this tool's manifest lists every file),
+    ``foreign`` (files no manifest of this tool lists). ``listed``: files a valid manifest
+    lists (any tool); ``foreign``: the other files; ``tool``: the manifest's tool.
+    """
+
+    kind: str
+    listed: list[str] = field(default_factory=list)
+    foreign: list[str] = field(default_factory=list)
+    tool: str | None = None
+
+
+def _safe_relative(name: object) -> bool:
+    """A manifest entry that stays inside its folder (no absolute path, no ``..``)."""
+    if not isinstance(name, str) or not name or "\\" in name or "\0" in name:
+        return False
+    path = PurePosixPath(name)
+    return not path.is_absolute() and all(part not in ("", ".", "..") for part in path.parts)
+
+
+def read_manifest(folder: Path) -> dict | None:
+    """The folder's manifest if it is a valid one (tool and safe file names), else None."""
+    path = folder / MANIFEST
+    try:
+        if not stat.S_ISREG(os.lstat(path).st_mode):
+            return None
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    if not isinstance(data, dict) or not isinstance(data.get("tool"), str):
+        return None
+    files = data.get("files")
+    if not isinstance(files, list) or not all(_safe_relative(f) for f in files):
+        return None
+    return data
+
+
+def _entries(folder: Path) -> list[str]:
+    """Every file (not folder) below ``folder``, relative, posix style, sorted."""
+    found = []
+    for root, dirs, files in os.walk(folder, followlinks=False):
+        base = Path(root).relative_to(folder)
+        # A symlink to a folder is listed by os.walk in dirs: count it as an entry.
+        for name in [*files, *(d for d in dirs if (Path(root) / d).is_symlink())]:
+            found.append((base / name).as_posix())
+    return sorted(found)
+
+
+def inspect(target: Path, tool: str) -> Existing:
+    """Classify an existing folder (see :class:`Existing`); ``target`` must be a folder."""
+    entries = [e for e in _entries(target) if e != MANIFEST]
+    has_manifest = os.path.lexists(target / MANIFEST)
+    if not entries and not has_manifest and not any(target.iterdir()):
+        return Existing("empty")
+    manifest = read_manifest(target)
+    listed = set(manifest["files"]) if manifest else set()
+    regular = {e for e in entries if _is_regular(target / e)}
+    foreign = sorted(e for e in entries if e not in listed or e not in regular)
+    if has_manifest and manifest is None:
+        foreign = sorted([*foreign, MANIFEST])  # not ours to overwrite: unreadable
+    present = sorted(e for e in entries if e in listed and e in regular)
+    owner = manifest["tool"] if manifest else None
+    kind = "own" if manifest and owner == tool and not foreign else "foreign"
+    if kind == "own" and _has_foreign_folders(target, present):
+        kind = "foreign"
+    return Existing(kind, present, foreign, owner)
+
+
+def _is_regular(path: Path) -> bool:
+    try:
+        return stat.S_ISREG(os.lstat(path).st_mode)
+    except OSError:
+        return False
+
+
+def _has_foreign_folders(target: Path, files: list[str]) -> bool:
+    """Empty folders (nothing listed inside) are foreign too: a user may have made them."""
+    needed = {str(PurePosixPath(f).parent) for f in files}
+    for root, dirs, _ in os.walk(target):
+        for name in dirs:
+            rel = (Path(root) / name).relative_to(target).as_posix()
+            if not any(n == rel or n.startswith(rel + "/") for n in needed):
+                return True
+    return False
+
+
+# -- checks before anything is written --------------------------------------------------
+def _name_max(folder: Path) -> int:
+    try:
+        return os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        return 255
+
+
+def _first_existing_ancestor(path: Path) -> Path:
+    for candidate in [path, *path.parents]:
+        if os.path.lexists(candidate):
+            return candidate
+    return Path(path.anchor or "/")  # pragma: no cover - the root always exists
+
+
+def check_output_folder(target: str | Path, tool: str, force: bool = False) -> Path:
+    """Refuse (one-line :class:`ParameterError`) an ``--out`` that may not be written.
+
+    Returns the absolute target path. Called before any simulation, so bad output paths
+    fail fast; :func:`output_folder` checks again just before it moves files into place.
+    """
+    text = str(target)
+    if "\0" in text:
+        raise ParameterError("out: the folder name contains a NUL byte")
+    path = Path(os.path.abspath(text or "."))
+    cwd = Path.cwd()
+    real = Path(os.path.realpath(path))
+    if cwd in (path, real) or path in cwd.parents or real in cwd.parents:
+        raise ParameterError(
+            f"out: {text or '.'} is the current folder or one of its parents; give a new folder"
+        )
+    if os.path.islink(path):
+        raise ParameterError(
+            f"out: {text} is a symbolic link (to {os.readlink(path)}); give a real folder"
+        )
+    ancestor = _first_existing_ancestor(path.parent)
+    name_max = _name_max(ancestor if ancestor.is_dir() else Path("/"))
+    for part in path.relative_to(ancestor).parts:
+        size = len(os.fsencode(part))
+        if size > name_max:
+            raise ParameterError(
+                f"out: the name {part[:20]}... is too long ({size} bytes, at most {name_max})"
+            )
+    if len(os.fsencode(str(path))) >= 4096:
+        raise ParameterError("out: the path is too long (at most 4095 bytes)")
+    if os.path.islink(ancestor) and not ancestor.exists():
+        raise ParameterError(f"out: {ancestor} is a dangling symbolic link")
+    if not ancestor.is_dir():
+        raise ParameterError(f"out: {ancestor} is not a folder")
+    if not os.access(ancestor, os.W_OK | os.X_OK):
+        raise ParameterError(f"out: cannot write in {ancestor} (permission denied)")
+    if not os.path.lexists(path):
+        return path
+    if not path.is_dir():
+        raise ParameterError(f"out: {text} exists and is not a folder; choose another --out")
+    existing = inspect(path, tool)
+    if existing.kind == "foreign" and not force:
+        raise ParameterError(_refusal(text, tool, existing))
+    return path
+
+
+def _refusal(text: str, tool: str, existing: Existing) -> str:
+    if existing.tool is not None and existing.tool != tool:
+        what = f"was written by ddwmmr {existing.tool}, not {tool}"
+    else:
+        sample = ", ".join(existing.foreign[:2]) + (", ..." if len(existing.foreign) > 2 else "")
+        what = f"holds files no ddwmmr {tool} run wrote ({sample})"
+    return (
+        f"out: {text} {what}; choose another --out, or add --force (deletes only files a "
+        "ddwmmr manifest lists)"
+    )
+
+
+# -- the staging folder -------------------------------------------------------------------
+@contextlib.contextmanager
+def output_folder(target: str | Path, tool: str, force: bool = False) -> Iterator[Path]:
+    """Yield a staging folder whose files replace or join ``target`` if the block succeeds.
+
+    On success a manifest listing every staged file is added and the files are moved into
+    ``target`` (see the module docstring for when an existing folder may be replaced). On
+    any exception (Ctrl-C and SIGTERM included) the staging folder, and any parent folder
+    created for it, is removed and nothing else is touched.
+    """
+    path = check_output_folder(target, tool, force)
+    created = _make_parents(path.parent)
+    try:
+        staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=path.parent))
+    except OSError as exc:
+        _remove_created(created)
+        raise ParameterError(f"out: cannot write in {path.parent} ({exc.strerror})") from None
+    try:
+        os.chmod(staging, folder_mode())
+        yield staging
+        _commit(staging, path, tool, force, str(target))
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        _remove_created(created)
+        raise
+
+
+def _make_parents(folder: Path) -> list[Path]:
+    """Create missing parent folders; return them (deepest last) so a failure can undo."""
+    missing = []
+    for candidate in [folder, *folder.parents]:
+        if os.path.lexists(candidate):
+            break
+        missing.append(candidate)
+    for candidate in reversed(missing):
+        try:
+            candidate.mkdir(mode=folder_mode())
+        except OSError as exc:
+            _remove_created([m for m in missing if m != candidate and m.is_dir()])
+            raise ParameterError(f"out: cannot create {candidate} ({exc.strerror})") from None
+    return list(reversed(missing))
+
+
+def _remove_created(created: list[Path]) -> None:
+    for folder in reversed(created):
+        with contextlib.suppress(OSError):
+            folder.rmdir()
+
+
+def _commit(staging: Path, target: Path, tool: str, force: bool, text: str) -> None:
+    files = _entries(staging)
+    manifest = {"tool": tool, "version": package_version(), "files": files}
+    _write_manifest(staging, manifest)
+    if not os.path.lexists(target):
+        os.rename(staging, target)
+        return
+    if os.path.islink(target) or not target.is_dir():
+        raise ParameterError(f"out: {text} changed during the run and is not a folder any more")
+    existing = inspect(target, tool)
+    if existing.kind in ("empty", "own"):
+        _swap(staging, target, existing)
+    elif force:
+        _merge(staging, target, files, existing, text)
+    else:
+        raise ParameterError(_refusal(text, tool, existing))
+
+
+def _write_manifest(folder: Path, manifest: dict) -> None:
+    path = folder / MANIFEST
+    path.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+    os.chmod(path, file_mode())
+
+
+def _swap(staging: Path, target: Path, existing: Existing) -> None:
+    """Replace ``target`` (empty, or only this tool's listed files) by ``staging``."""
+    old = Path(tempfile.mkdtemp(prefix=_OLD_PREFIX, dir=target.parent))
+    old.rmdir()
+    os.rename(target, old)
+    try:
+        os.rename(staging, target)
+    except BaseException:
+        os.rename(old, target)  # put the old folder back before reporting the error
+        raise
+    for name in [*existing.listed, MANIFEST]:
+        _unlink_regular(old / name)
+    _prune_empty(old)
+    if old.exists():  # something appeared meanwhile: keep it, say where
+        print(f"warning: kept unexpected files of the old {target} in {old}", file=sys.stderr)
+
+
+def _merge(staging: Path, target: Path, files: list[str], existing: Existing, text: str) -> None:
+    """``--force``: delete the listed files of ``target``, move the new ones in."""
+    listed = set(existing.listed)
+    clashes = [f for f in files if os.path.lexists(target / f) and f not in listed]
+    if MANIFEST in existing.foreign:  # an unreadable manifest is not ours to overwrite
+        clashes.append(MANIFEST)
+    if clashes:
+        raise ParameterError(
+            f"out: {text}/{clashes[0]} is not a file a ddwmmr manifest lists and would be "
+            "overwritten; move it or choose another --out"
+        )
+    for name in existing.listed:
+        _unlink_regular(target / name)
+    for name in [*files, MANIFEST]:
+        destination = target / name
+        destination.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
+        os.replace(staging / name, destination)
+    shutil.rmtree(staging, ignore_errors=True)
+
+
+def _unlink_regular(path: Path) -> None:
+    if _is_regular(path):
+        path.unlink()
+
+
+def _prune_empty(folder: Path) -> None:
+    """Remove ``folder`` and its sub-folders bottom-up where they are empty."""
+    for root, _, _ in sorted(os.walk(folder), key=lambda w: -len(w[0])):
+        with contextlib.suppress(OSError):
+            os.rmdir(root)

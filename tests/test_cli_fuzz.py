@@ -1,0 +1,333 @@
+"""Bad input to every tool (track, compare, scenarios): one line, exit 2, nothing written.
+
+A table of the cases issue 8 found (absurd sizes, broken files, FIFOs, output paths,
+trajectory names with ``..``, wrong TOML types) plus property tests over invalid numbers.
+Tools run in-process through their ``main(argv)``; the working folder is a fresh
+temporary folder whose content must not change. (A read-only output folder: see
+tests/test_outputs.py, which also covers running as root, who may write there.)
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from ddwmmr.cli.compare import main as compare_main
+from ddwmmr.cli.scenarios import main as scenarios_main
+from ddwmmr.cli.track import main as track_main
+from ddwmmr.errors import MAX_SCENARIOS, MAX_STEPS
+
+MAINS = {"track": track_main, "compare": compare_main, "scenarios": scenarios_main}
+#: Arguments that make each tool's run small (the cases add the bad part).
+BASE = {
+    "track": ["--method", "ats", "--traj", "ellipse", "--duration", "0.2", "--no-plots"],
+    "compare": ["--methods", "pi", "--only", "ellipse", "--study", "none", "--jobs", "1"],
+    "scenarios": ["--n", "1", "--time-limit", "0.2", "--jobs", "1"],
+}
+
+#: Input files the cases refer to as {name}; written into inputs/ before the snapshot.
+FILES = {
+    "robot_latin1.toml": b"L1 = 0.4  # \xe9paule\n",
+    "robot_array.toml": b"[[robot]]\nL1 = 0.4\n",
+    "robot_L1_string.toml": b'L1 = "0.3"\n',
+    "robot_L1_bool.toml": b"L1 = true\n",
+    "robot_tiny_wheel.toml": b"wheel_radius = 1e-320\n",
+    "robot_huge_L1.toml": b"L1 = 1e300\n",
+    "robot_masses_number.toml": b"link_masses = 1.0\n",
+    "robot_masses_text.toml": b'link_masses = [1.0, "a"]\n',
+    "robot_payload_nan.toml": b"payload = nan\n",
+    "robot_unknown.toml": b"arm_length = 0.3\n",
+    "robot_bad.toml": b"L1 = = 0.3\n",
+    "traj_N_string.toml": b'shape = "ellipse"\nN = "2000"\n',
+    "traj_a_string.toml": b'shape = "ellipse"\na = "2.0"\n',
+    "traj_N_1e9.toml": b'shape = "ellipse"\nN = 1e9\n',
+    "traj_N_1e30.toml": b'shape = "ellipse"\nN = 1e30\n',
+    "traj_a_1e300.toml": b'shape = "ellipse"\na = 1e300\n',
+    "traj_T_inf.toml": b'shape = "ellipse"\nT = inf\n',
+    "traj_array.toml": b'[[trajectory]]\nshape = "ellipse"\n',
+    "traj_unknown_key.toml": b'shape = "ellipse"\nradius = 2.0\n',
+    "traj_no_shape.toml": b"a = 2.0\n",
+    "traj_latin1.toml": b'shape = "ellipse"  # \xe9\n',
+    "traj_latin1.csv": b"t,x,y\n0,0,0\n1,1,0\n2,2,\xff\n",
+    "traj_text.csv": b"t,x,y\n0,0,0\n1,a,0\n2,2,0\n",
+    "traj_huge.csv": b"t,x,y\n0,0,0\n1,1e300,0\n2,2,0\n",
+    "traj_short.csv": b"t,x,y\n0,0,0\n",
+    "obstacles_text.toml": b'[[obstacle]]\nx = "1"\ny = 0.0\nradius = 0.3\n',
+    "a_file.txt": b"not a folder\n",
+}
+
+# (tool, arguments, text the one line must contain)
+ROBOT_CASES = [
+    (["--robot", "{robot_latin1.toml}"], "not UTF-8 text (byte 0xe9"),
+    (["--robot", "{robot_array.toml}"], "[[robot]]"),
+    (["--robot", "{robot_L1_string.toml}"], "L1 must be a number"),
+    (["--robot", "{robot_L1_bool.toml}"], "L1 must be a number"),
+    (["--robot", "{robot_tiny_wheel.toml}"], "wheel_radius must be in [1e-06, 1000] m"),
+    (["--robot", "{robot_huge_L1.toml}"], "L1 must be in"),
+    (["--robot", "{robot_masses_number.toml}"], "link_masses must be a pair of numbers"),
+    (["--robot", "{robot_masses_text.toml}"], "link_masses must be a number (got 'a')"),
+    (["--robot", "{robot_payload_nan.toml}"], "payload must be a finite number"),
+    (["--robot", "{robot_unknown.toml}"], "unknown parameter 'arm_length'"),
+    (["--robot", "{robot_bad.toml}"], "is not valid TOML"),
+    (["--robot", "{fifo}"], "is not a regular file"),
+    (["--robot", "{inputs}"], "is not a regular file"),
+    (["--robot", "missing.toml"], "cannot read missing.toml"),
+    (["--payload", "1e300"], "payload must be in [0, 100000] kg"),
+    (["--payload", "-1"], "payload must be >= 0 (got -1)"),
+    (["--payload", "nan"], "payload must be a finite number"),
+]
+TRAJ_CASES = [
+    ("{traj_N_string.toml}", "N must be a number (got '2000')"),
+    ("{traj_a_string.toml}", "a must be a number (got '2.0')"),
+    ("{traj_N_1e9.toml}", "N must be an integer in [2, 1000000]"),
+    ("{traj_N_1e30.toml}", "N must be an integer in [2, 1000000]"),
+    ("{traj_a_1e300.toml}", "a must be in [1e-06, 1000] m"),
+    ("{traj_T_inf.toml}", "T must be a finite number"),
+    ("{traj_array.toml}", "[trajectory] must be one table"),
+    ("{traj_unknown_key.toml}", "unknown key 'radius'"),
+    ("{traj_no_shape.toml}", "needs shape = one of ellipse, rectangle"),
+    ("{traj_latin1.toml}", "not UTF-8 text"),
+    ("{traj_latin1.csv}", "not UTF-8 text (byte 0xff"),
+    ("{traj_text.csv}", "non-numeric value"),
+    ("{traj_huge.csv}", "must be <= 1e+06"),
+    ("{traj_short.csv}", "need at least 3 rows"),
+    ("{fifo_csv}", "is not a regular file"),
+    ("../trajectories/ellipse", "neither a trajectory name"),
+    ("../../etc/passwd", "neither a trajectory name"),
+    ("..", "neither a trajectory name"),
+    ("sub/figure8", "neither a trajectory name"),
+    ("nowhere", "unknown trajectory 'nowhere'"),
+    ("missing.csv", "no such file missing.csv"),
+]
+OUT_CASES = [
+    ("{a_file.txt}/out", "is not a folder"),
+    ("{a_file.txt}", "exists and is not a folder"),
+    ("x" * 300, "is too long (300 bytes, at most 255)"),
+    (".", "is the current folder"),
+    ("", "is the current folder"),
+    ("..", "is the current folder or one of its parents"),
+    ("{link_to_dir}", "is a symbolic link"),
+    ("{dangling_link}", "is a symbolic link"),
+    ("{dangling_link}/out", "is a dangling symbolic link"),
+]
+
+CASES: list[tuple[str, list[str], str]] = []
+for tool in ("track", "compare"):
+    CASES += [(tool, args, text) for args, text in ROBOT_CASES]
+CASES += [("track", ["--traj", traj], text) for traj, text in TRAJ_CASES]
+CASES += [("compare", ["--only", traj], text) for traj, text in TRAJ_CASES[:4] + TRAJ_CASES[15:]]
+CASES += [("compare", ["--traj", traj], text) for traj, text in TRAJ_CASES[10:13]]
+for tool in MAINS:
+    CASES += [(tool, ["--out", out], text) for out, text in OUT_CASES]
+CASES += [
+    ("track", ["--duration", "1e9"], f"duration / dt must be <= {MAX_STEPS} steps"),
+    ("track", ["--duration", "inf"], "duration must be a finite number"),
+    ("track", ["--duration", "1e12"], "duration / dt must be <="),
+    ("track", ["--duration", "-5"], "duration must be > 0 (got -5)"),
+    ("track", ["--duration", "nan"], "duration must be a finite number"),
+    ("track", ["--duration", "0"], "duration must be > 0"),
+    ("track", ["--dt", "1e-7"], "duration / dt must be <="),
+    ("track", ["--dt", "1e-300"], "duration / dt must be <="),
+    ("track", ["--dt", "0"], "dt must be > 0"),
+    ("track", ["--dt", "-0.1"], "dt must be > 0"),
+    ("track", ["--dt", "nan"], "dt must be a finite number"),
+    ("track", ["--dt", "1"], "dt must be <= duration (0.2 s)"),
+    ("track", ["--dt", "abc"], "argument --dt: invalid float value"),
+    ("track", ["--method", "clrrmc-ts", "--tau", "-2"], "tau must be > 0"),
+    ("track", ["--method", "clrrmc-ts", "--tau", "1", "2"], "tau must be one value or 3"),
+    ("track", ["--method", "pi", "--aux", "sum"], "unknown option 'aux'"),
+    ("track", ["--tau", "1"], "unknown option 'tau'"),
+    ("track", ["--method", "nope"], "invalid choice: 'nope'"),
+    ("track", ["--offset", "nan", "0"], "offset must be a finite number"),
+    ("track", ["--offset", "1e300", "0"], "offset must be in [-0.65, 0.65] m"),
+    ("track", ["--rerun", "{traj_N_string.toml}"], "is not valid JSON"),
+    ("track", ["--rerun", "{fifo}"], "is not a regular file"),
+    ("track", ["--method", "qp", "--obstacles", "{obstacles_text.toml}"], "must be numbers"),
+    ("track", ["--method", "qp", "--obstacles", "../x"], "cannot read ../x"),
+    ("track", ["--method", "qp", "--obstacles", "nope"], "unknown obstacle file 'nope'"),
+    ("compare", ["--duration", "1e9"], "duration / dt must be <="),
+    ("compare", ["--duration", "inf"], "duration must be a finite number"),
+    ("compare", ["--duration", "-5"], "duration must be > 0 (got -5)"),
+    ("compare", ["--duration", "nan"], "duration must be a finite number"),
+    ("compare", ["--jobs", "0"], "jobs must be an integer in [1, 256]"),
+    ("compare", ["--jobs", "100000"], "jobs must be an integer in [1, 256]"),
+    ("compare", ["--jobs", "1e9"], "argument --jobs: invalid int value"),
+    ("compare", ["--methods", "nope"], "unknown method 'nope'"),
+    ("compare", ["--study", "nope"], "unknown study 'nope'"),
+    ("scenarios", ["--n", "1000000000"], f"n must be an integer in [1, {MAX_SCENARIOS}]"),
+    ("scenarios", ["--n", "0"], "n must be an integer in [1,"),
+    ("scenarios", ["--dt", "1e-7"], "time-limit / dt must be <="),
+    ("scenarios", ["--dt", "1e-300"], "time-limit / dt must be <="),
+    ("scenarios", ["--dt", "nan"], "dt must be > 0"),
+    ("scenarios", ["--time-limit", "1e12"], "time-limit / dt must be <="),
+    ("scenarios", ["--time-limit", "inf"], "time-limit must be > 0"),
+    ("scenarios", ["--payload", "10"], "10 kg tips the robot over in the start pose"),
+    ("scenarios", ["--payload", "1e300"], "payload must be in [0, 100000] kg"),
+    ("scenarios", ["--seed", "-1"], "seed must be >= 0"),
+    ("scenarios", ["--stability", "nan", "1"], "stability thresholds must be finite"),
+    ("scenarios", ["--jobs", "0"], "jobs must be an integer in [1, 256]"),
+]
+
+
+@pytest.fixture
+def workdir(tmp_path, monkeypatch) -> dict[str, str]:
+    """A fresh working folder with the input files; returns the {name} substitutions."""
+    inputs = tmp_path / "inputs"
+    inputs.mkdir()
+    for name, data in FILES.items():
+        (inputs / name).write_bytes(data)
+    os.mkfifo(inputs / "fifo.toml")
+    os.mkfifo(inputs / "fifo.csv")
+    (inputs / "a_dir").mkdir()
+    os.symlink(inputs / "a_dir", inputs / "link_to_dir")
+    os.symlink(inputs / "gone", inputs / "dangling_link")
+    monkeypatch.chdir(tmp_path)
+    names = {name: str(inputs / name) for name in FILES}
+    names.update(
+        fifo=str(inputs / "fifo.toml"),
+        fifo_csv=str(inputs / "fifo.csv"),
+        inputs=str(inputs),
+        link_to_dir=str(inputs / "link_to_dir"),
+        dangling_link=str(inputs / "dangling_link"),
+    )
+    return names
+
+
+def tree(folder: Path) -> list[tuple[str, float]]:
+    """Every path below ``folder`` with its modification time."""
+    return sorted((str(p), os.lstat(p).st_mtime) for p in folder.rglob("*"))
+
+
+def expand(args: list[str], names: dict[str, str]) -> list[str]:
+    out = []
+    for arg in args:
+        for name, value in names.items():
+            arg = arg.replace("{" + name + "}", value)
+        out.append(arg)
+    return out
+
+
+def run_bad(tool: str, args: list[str], capsys) -> tuple[int, str]:
+    """Run ``tool`` with BASE + args (+ --out out unless given); status and stderr."""
+    extra = [] if "--out" in args else ["--out", "out"]
+    base = [] if "--rerun" in args else BASE[tool]  # a rerun takes no simulation options
+    try:
+        status = MAINS[tool]([*base, *args, *extra])
+    except SystemExit as exc:  # argparse's own errors
+        status = exc.code
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    return status, captured.err
+
+
+@pytest.mark.parametrize(
+    ("tool", "args", "text"), CASES, ids=[f"{t}:{' '.join(a)[:60]}" for t, a, _ in CASES]
+)
+def test_bad_input_one_line_exit_2_nothing_written(workdir, tool, args, text, capsys):
+    cwd = Path.cwd()
+    before = tree(cwd)
+    status, err = run_bad(tool, expand(args, workdir), capsys)
+    lines = err.strip().splitlines()
+    assert status == 2, err
+    assert len(lines) == 1, err
+    assert "Traceback" not in err
+    assert expand([text], workdir)[0] in lines[0]
+    assert tree(cwd) == before
+
+
+def test_duration_message_names_duration_not_dt(workdir, capsys):
+    status, err = run_bad("track", ["--duration", "-5"], capsys)
+    assert status == 2 and "duration" in err and "dt" not in err
+
+
+# -- properties: any number outside the documented domain is refused ------------------------
+INVALID_STEP = st.one_of(
+    st.floats(max_value=0.0),
+    st.sampled_from([math.inf, -math.inf, math.nan]),
+    st.floats(min_value=1e-320, max_value=0.2 / (MAX_STEPS + 1), exclude_min=False),
+)
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(dt=INVALID_STEP)
+def test_any_invalid_step_is_refused(workdir, capsys, dt):
+    status, err = run_bad("track", ["--dt", repr(dt)], capsys)
+    assert status == 2 and len(err.strip().splitlines()) == 1 and "dt" in err
+    assert not Path("out").exists()
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    duration=st.one_of(
+        st.floats(max_value=0.0),
+        st.sampled_from([math.inf, math.nan]),
+        st.floats(min_value=0.02 * (MAX_STEPS + 1), allow_infinity=False),
+    )
+)
+def test_any_invalid_duration_is_refused(workdir, capsys, duration):
+    for tool in ("track", "compare"):
+        status, err = run_bad(tool, ["--duration", repr(duration)], capsys)
+        assert status == 2 and len(err.strip().splitlines()) == 1 and "duration" in err
+    assert not Path("out").exists()
+
+
+@settings(
+    max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(n=st.one_of(st.integers(max_value=0), st.integers(min_value=MAX_SCENARIOS + 1)))
+def test_any_invalid_scenario_count_is_refused(workdir, capsys, n):
+    status, err = run_bad("scenarios", ["--n", str(n)], capsys)
+    assert status == 2 and len(err.strip().splitlines()) == 1 and "n must be" in err
+
+
+@settings(
+    max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    key=st.sampled_from(["L1", "L2", "wheel_radius", "track_width", "base_length"]),
+    value=st.one_of(
+        st.text(max_size=5).map(lambda s: f'"{s}"'),
+        st.booleans().map(lambda b: str(b).lower()),
+        st.sampled_from(["1e300", "1e-320", "-1.0", "nan", "inf", "[1.0]", "{x = 1}"]),
+    ),
+)
+def test_any_mistyped_or_absurd_robot_value_is_refused(workdir, capsys, key, value):
+    path = Path(workdir["inputs"]) / "robot_fuzz.toml"
+    path.write_text(f"{key} = {value}\n")
+    status, err = run_bad("track", ["--robot", str(path)], capsys)
+    assert status == 2 and len(err.strip().splitlines()) == 1
+    assert key in err or "not valid TOML" in err
+
+
+# -- as a user runs them: python -m, FIFOs (which would block if opened) ---------------------
+@pytest.mark.parametrize(
+    ("tool", "args"),
+    [
+        ("track", ["--robot", "{fifo}"]),
+        ("track", ["--traj", "{fifo_csv}"]),
+        ("compare", ["--robot", "{fifo}"]),
+        ("scenarios", ["--payload", "10"]),
+    ],
+)
+def test_as_a_module_one_line_and_no_traceback(workdir, tool, args):
+    done = subprocess.run(
+        [sys.executable, "-m", f"ddwmmr.{tool}", *BASE[tool], *expand(args, workdir)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+    )
+    assert done.returncode == 2
+    assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
+    assert not Path("runs").exists()

@@ -1,0 +1,119 @@
+"""Ctrl-C and SIGTERM: one line, exit 130 / 143, staging removed, worker processes stopped.
+
+The tools run as a user runs them (``python -m``, a subprocess); the signal is sent once
+the staging folder exists (and, with ``--jobs 2``, once the worker processes run).
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+LONG = {
+    "track": ["--method", "ats", "--traj", "ellipse", "--duration", "20000", "--no-plots"],
+    "compare": ["--methods", "ats", "pi", "--only", "ellipse", "--study", "none",
+                "--duration", "4000", "--jobs", "2"],
+    "scenarios": ["--n", "60", "--jobs", "2"],
+}  # fmt: skip
+
+
+def children(pid: int) -> set[int]:
+    """Processes whose parent is ``pid`` (from /proc)."""
+    found = set()
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                fields = (entry / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if int(fields[1]) == pid:
+                found.add(int(entry.name))
+    return found
+
+
+def alive(pid: int) -> bool:
+    """Running (not gone, not a zombie waiting to be reaped)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def wait_for(condition, timeout: float = 60.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, "timed out"
+        time.sleep(0.05)
+
+
+def start(tool: str, folder: Path, **popen) -> subprocess.Popen:
+    return subprocess.Popen(
+        [sys.executable, "-m", f"ddwmmr.{tool}", *LONG[tool], "--no-progress",
+         "--out", str(folder / "out")],
+        cwd=folder,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+        **popen,
+    )  # fmt: skip
+
+
+def staging(folder: Path) -> list[Path]:
+    return [p for p in folder.iterdir() if p.name.startswith(".ddwmmr-")]
+
+
+@pytest.mark.parametrize(
+    ("tool", "signum", "status", "word"),
+    [
+        ("track", signal.SIGINT, 130, "interrupted"),
+        ("track", signal.SIGTERM, 143, "terminated"),
+        ("scenarios", signal.SIGTERM, 143, "terminated"),
+        ("compare", signal.SIGINT, 130, "interrupted"),
+    ],
+)
+def test_signal_stops_cleanly(tmp_path, tool, signum, status, word):
+    process = start(tool, tmp_path)
+    try:
+        wait_for(lambda: staging(tmp_path) or process.poll() is not None)
+        if "--jobs" in LONG[tool]:
+            wait_for(lambda: len(children(process.pid)) >= 2 or process.poll() is not None)
+        workers = children(process.pid)
+        time.sleep(0.3)
+        assert process.poll() is None, process.stderr.read()
+        process.send_signal(signum)
+        _, err = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert process.returncode == status, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and word in lines[0], err
+    assert "Traceback" not in err
+    assert list(tmp_path.iterdir()) == []  # neither out nor its staging folder
+    wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
+
+
+def test_ctrl_c_on_the_whole_process_group(tmp_path):
+    """A terminal's Ctrl-C reaches the workers too: still one line, no worker traceback."""
+    process = start("compare", tmp_path, start_new_session=True)
+    try:
+        wait_for(lambda: len(children(process.pid)) >= 2 or process.poll() is not None)
+        workers = children(process.pid)
+        wait_for(lambda: staging(tmp_path) or process.poll() is not None)
+        time.sleep(0.5)
+        assert process.poll() is None, process.stderr.read()
+        os.killpg(process.pid, signal.SIGINT)
+        _, err = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert process.returncode == 130, err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+    assert list(tmp_path.iterdir()) == []
+    wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)

@@ -1,0 +1,80 @@
+"""Track and scenario figures (issue 8 item 9): obstacles drawn, no false wrap jumps,
+labelled timeline axes; the scenario table never divides by zero."""
+
+from __future__ import annotations
+
+import math
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+
+from ddwmmr import load_trajectory, simulate
+from ddwmmr.reports.plots import break_wraps, plot_errors, plot_path
+from ddwmmr.scenarios import report
+from ddwmmr.scenarios.generator import generate
+from ddwmmr.scenarios.protocol import RunConfig, run_scenario
+
+
+def test_break_wraps_cuts_only_the_wrap():
+    t = np.arange(6.0)
+    angle = np.array([3.0, 3.1, -3.1, -3.0, -2.9, 0.1])  # wraps once, then a real step
+    tb, ab = break_wraps(t, angle)
+    assert np.isnan(ab).sum() == 1 and np.isnan(ab[2]) and np.isnan(tb[2])
+    np.testing.assert_array_equal(ab[~np.isnan(ab)], angle)
+    # Between any two consecutive drawn points the line moves less than pi.
+    pieces = np.split(ab, np.flatnonzero(np.isnan(ab)))
+    assert all(np.all(np.abs(np.diff(p[~np.isnan(p)])) < math.pi) for p in pieces)
+
+
+@pytest.fixture(scope="module")
+def rectangle_run():
+    """clrrmc-cs on the rectangle: its wrapped orientation error crosses +-pi."""
+    return simulate(None, load_trajectory("rectangle"), "clrrmc-cs")
+
+
+def test_orientation_error_line_has_no_vertical_wrap_stroke(rectangle_run):
+    error = rectangle_run.timeseries["orientation_error_rad"]
+    wraps = int(np.sum(np.abs(np.diff(error)) > math.pi))
+    assert wraps >= 1  # the case the figure must handle
+    fig = plot_errors(rectangle_run)
+    line = fig.axes[1].lines[0]
+    y = np.asarray(line.get_ydata(), dtype=float)
+    assert np.isnan(y).sum() == wraps
+    drawn = [seg[~np.isnan(seg)] for seg in np.split(y, np.flatnonzero(np.isnan(y)))]
+    assert max(np.max(np.abs(np.diff(s)), initial=0.0) for s in drawn) < math.pi
+    assert "orientation error (rad)" in fig.axes[1].get_ylabel()
+    plt.close(fig)
+
+
+def test_obstacles_are_drawn_in_the_path_plot(rectangle_run):
+    circles = [(0.5, 1.0, 0.3), (-1.0, -0.5, 0.2)]
+    fig = plot_path(rectangle_run, obstacles=circles)
+    discs = [p for p in fig.axes[0].patches if isinstance(p, plt.Circle)]
+    assert sorted((d.center[0], d.center[1], d.radius) for d in discs) == sorted(circles)
+    assert "obstacle" in [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    plt.close(fig)
+
+
+def test_timeline_axes_are_labelled_and_waypoints_marked(tmp_path, monkeypatch):
+    scenario = generate(1, 0)[0]
+    outcome = run_scenario(scenario, RunConfig(time_limit=15.0, record=True))
+    reached = outcome.metrics["waypoints_reached"]
+    assert reached >= 2
+    figures = []
+    monkeypatch.setattr(report, "_save", lambda fig, path: figures.append(fig))
+    report.plot_timeline(outcome, tmp_path / "t.png", "thesis", scenario)
+    labels = [ax.get_ylabel() for ax in figures[0].axes]
+    assert labels[0] == "state" and "stability S" in labels[1]
+    assert "manipulability" in labels[2] and "waypoint (m)" in labels[3]
+    assert figures[0].axes[3].get_xlabel() == "time (s)"
+    marks = [line for line in figures[0].axes[3].lines if line.get_linestyle() == ":"]
+    assert len(marks) == reached  # one per waypoint reached while the trace ran
+    plt.close(figures[0])
+
+
+def test_table_rows_without_time_do_not_divide_by_zero():
+    outcome = run_scenario(generate(1, 0)[0], RunConfig(payload=10.0, time_limit=1.0))
+    assert outcome.metrics["time_s"] == 0.0 and outcome.metrics["reason"] == "tipped"
+    rows = dict(report.table_rows(report.summarize([outcome, outcome], 0.0)))
+    assert rows["Time spent moving base (s)"] == "0 (n/a) (0)"

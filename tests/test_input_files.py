@@ -1,0 +1,109 @@
+"""Input files and values (issue 8): types, documented caps, FIFOs, encodings."""
+
+from __future__ import annotations
+
+import math
+import os
+
+import pytest
+
+from ddwmmr import ParameterError, Robot
+from ddwmmr.errors import MAX_STEPS, check_int_at_least, check_step_count, read_text_file
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ('L1 = "0.3"', "robot: .*: L1 must be a number \\(got '0.3'\\)"),
+        ("L1 = true", "L1 must be a number \\(got True\\)"),
+        ("wheel_radius = 1e-320", r"wheel_radius must be in \[1e-06, 1000\] m"),
+        ("L1 = 1e300", r"L1 must be in \[1e-06, 1000\] m"),
+        ("base_mass = 1e9", r"base_mass must be in \[0, 100000\] kg"),
+        ("link_masses = 1.0", "link_masses must be a pair of numbers"),
+        ("joint_limits = [[-1, 1]]", r"joint_limits must be two \[min, max\] pairs"),
+        ('home_pose = [0.1, "x"]', "home_pose must be a number"),
+        ("[[robot]]\nL1 = 0.4", r"\[robot\] must be one table .*\[\[robot\]\]"),
+        ("robot = 3", r"\[robot\] must be one table"),
+    ],
+)
+def test_robot_toml_types_and_ranges(tmp_path, text, message):
+    path = tmp_path / "robot.toml"
+    path.write_text(text + "\n")
+    with pytest.raises(ParameterError, match=message):
+        Robot.from_toml(path)
+
+
+def test_valid_robot_toml_still_loads(tmp_path):
+    path = tmp_path / "robot.toml"
+    path.write_text("[robot]\nL1 = 0.4\nlink_masses = [1, 2]\njoint_limits = [[-3, 3], [-2, 2]]\n")
+    robot = Robot.from_toml(path)
+    assert robot.L1 == 0.4 and robot.link_masses == (1.0, 2.0)
+    assert robot.joint_limits == ((-3.0, 3.0), (-2.0, 2.0))
+
+
+def test_api_robot_magnitudes():
+    with pytest.raises(ParameterError, match="wheel_radius must be in"):
+        Robot(wheel_radius=1e-320)
+    with pytest.raises(ParameterError, match="payload must be in"):
+        Robot().with_payload(1e300)
+    assert Robot(L1=1e-3).L1 == 1e-3
+
+
+def test_fifo_is_never_opened(tmp_path):
+    fifo = tmp_path / "pipe.toml"
+    os.mkfifo(fifo)  # opening it for reading would block forever
+    with pytest.raises(ParameterError, match="is not a regular file"):
+        read_text_file(fifo, "robot")
+    with pytest.raises(ParameterError, match="is not a regular file"):
+        Robot.from_toml(fifo)
+
+
+def test_non_utf8_names_the_byte_and_offset(tmp_path):
+    path = tmp_path / "robot.toml"
+    path.write_bytes(b"L1 = 0.4\n# caf\xe9\n")
+    with pytest.raises(ParameterError, match=r"not UTF-8 text \(byte 0xe9 at offset 14\)"):
+        Robot.from_toml(path)
+
+
+def test_oversized_file_is_refused(tmp_path, monkeypatch):
+    monkeypatch.setattr("ddwmmr.errors.MAX_INPUT_BYTES", 10)
+    path = tmp_path / "big.toml"
+    path.write_text("L1 = 0.40000000\n")
+    with pytest.raises(ParameterError, match=r"too large \(16 bytes, at most 10\)"):
+        read_text_file(path, "robot")
+
+
+@pytest.mark.parametrize(
+    ("duration", "dt", "steps"),
+    [(40.0, 0.02, 2000), (1.0, 0.3, 3), (0.2, 0.2, 1), (20000.0, 0.02, MAX_STEPS)],
+)
+def test_step_count(duration, dt, steps):
+    assert check_step_count(duration, dt) == steps
+
+
+@pytest.mark.parametrize(
+    ("duration", "dt", "message"),
+    [
+        (-5.0, 0.02, r"^duration must be > 0 \(got -5\)"),
+        (math.nan, 0.02, "^duration must be a finite number"),
+        (math.inf, 0.02, "^duration must be a finite number"),
+        (40.0, 0.0, r"^dt must be > 0 \(got 0\)"),
+        (40.0, -1.0, "^dt must be > 0"),
+        (1.0, 2.0, r"^dt must be <= duration \(1 s\)"),
+        (1e9, 0.02, f"^duration / dt must be <= {MAX_STEPS} steps per run"),
+        (40.0, 1e-300, "^duration / dt must be <="),
+        ("40", 0.02, "^duration must be a number"),
+    ],
+)
+def test_step_count_names_the_parameter(duration, dt, message):
+    with pytest.raises(ParameterError, match=message):
+        check_step_count(duration, dt)
+
+
+def test_int_checks_refuse_huge_floats_and_text():
+    assert check_int_at_least("n", 10**30, 1) == 10**30
+    with pytest.raises(ParameterError, match=r"n must be an integer in \[1, 5\]"):
+        check_int_at_least("n", 1e30, 1, 5)
+    for bad in ("3", True, math.inf, 2.5):
+        with pytest.raises(ParameterError, match="n must be an integer"):
+            check_int_at_least("n", bad, 1)

@@ -1,0 +1,74 @@
+"""make_controller's options: every parameter of the class's and its parents' __init__.
+
+Issue 8: ``ats``/``ap`` rejected ``damping`` (the signature read stopped at ``**kwargs``).
+"""
+
+from __future__ import annotations
+
+import inspect
+
+import numpy as np
+import pytest
+
+from ddwmmr import Ellipse, ParameterError, Robot
+from ddwmmr.controllers import available_methods, make_controller, method_options
+from ddwmmr.controllers import base as registry
+
+#: Options each resolution method documents (docs/theory.md, docs/cli.md), written out here
+#: independently of the code that discovers them.
+DOCUMENTED = {
+    "pi": {"singularity_threshold", "damping"},
+    "ats": {"aux", "singularity_threshold", "damping"},
+    "ap": {"K1", "K2", "K3", "singularity_threshold", "damping"},
+    "clrrmc-ts": {"tau", "aux", "singularity_threshold", "damping"},
+    "clrrmc-cs": {"tau", "aux", "reference_step"},
+    "qp": {"stability_min", "manipulability_weight", "obstacles", "solver", "mode", "tau"},
+}
+PAIRS = [(m, o) for m in available_methods() for o in method_options(m)]
+
+
+@pytest.mark.parametrize("method", sorted(DOCUMENTED))
+def test_documented_options_are_accepted(method):
+    assert DOCUMENTED[method] <= set(method_options(method))
+
+
+def _first_command(controller) -> np.ndarray:
+    trajectory = Ellipse()
+    q = np.array([1.4, -0.2, 1.7, -0.3, 0.6])
+    controller.reset(trajectory, q.copy())
+    return controller.command(0.0, q, trajectory.pose(0.0), trajectory.velocity(0.0))
+
+
+@pytest.mark.parametrize(("method", "option"), PAIRS, ids=[f"{m}-{o}" for m, o in PAIRS])
+def test_every_option_with_its_default_changes_nothing(method, option):
+    default = method_options(method)[option]
+    assert default is not inspect.Parameter.empty, "every option has a default"
+    given = make_controller(method, Robot(), **{option: default})
+    np.testing.assert_array_equal(_first_command(given), _first_command(make_controller(method)))
+
+
+def test_options_reach_the_parent_class():
+    assert make_controller("ats", damping=0.2).damping == 0.2
+    assert make_controller("ap", singularity_threshold=0.1, K3=0.0).threshold == 0.1
+
+
+def test_unknown_option_lists_the_accepted_ones():
+    with pytest.raises(ParameterError, match=r"unknown option 'tau' \(accepted: aux, damping, "):
+        make_controller("ats", tau=1.0)
+
+
+def test_mro_walk_most_derived_default_wins(monkeypatch):
+    class Parent:
+        def __init__(self, robot, a=1.0, b=2.0, *args):
+            self.a, self.b = a, b
+
+    class Child(Parent):
+        def __init__(self, robot, c=3.0, b=5.0, **kwargs):
+            super().__init__(robot, b=b, **kwargs)
+            self.c = c
+
+    monkeypatch.setitem(registry._REGISTRY, "tmp-child", Child)
+    assert method_options("tmp-child") == {"c": 3.0, "b": 5.0, "a": 1.0}
+    assert make_controller("tmp-child", a=7.0).a == 7.0
+    with pytest.raises(ParameterError, match="unknown option 'kwargs'"):
+        make_controller("tmp-child", kwargs=1)

@@ -1,0 +1,267 @@
+"""Output folders (ddwmmr.outputs): a user's file survives every case, for every tool.
+
+Cases per tool: a new folder, the tool's own earlier folder, another tool's folder, a
+user's folder, and --force into each. A folder is replaced only when it holds nothing but
+the files its manifest lists for the same tool; --force deletes only listed files.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import stat
+from pathlib import Path
+
+import pytest
+
+from ddwmmr.cli.compare import main as compare_main
+from ddwmmr.cli.scenarios import main as scenarios_main
+from ddwmmr.cli.track import main as track_main
+from ddwmmr.errors import ParameterError
+from ddwmmr.outputs import MANIFEST, STAGING_PREFIX, check_output_folder, output_folder
+
+TOOLS = {
+    "track": (
+        track_main,
+        ["--method", "pi", "--traj", "ellipse", "--duration", "0.2", "--no-plots"],
+    ),
+    "compare": (
+        compare_main,
+        ["--methods", "pi", "--only", "ellipse", "--study", "none", "--duration", "0.2"],
+    ),
+    "scenarios": (scenarios_main, ["--n", "1", "--time-limit", "0.3"]),
+}
+FAST = ["--no-progress"]
+#: A file each tool writes (a user's file of that name must not be overwritten).
+WRITES = {"track": "summary.json", "compare": "report.md", "scenarios": "summary.json"}
+OTHER = {"track": "scenarios", "compare": "track", "scenarios": "compare"}
+
+
+def run(tool: str, out: Path, *extra: str) -> int:
+    """Run ``tool`` (in-process, small and fast) into ``out``; its exit status."""
+    main, args = TOOLS[tool]
+    jobs = [] if tool == "track" else ["--jobs", "1"]
+    return main([*args, *FAST, *jobs, "--out", str(out), *extra])
+
+
+def snapshot(folder: Path) -> dict[str, bytes]:
+    """Every file below ``folder`` (relative path -> bytes)."""
+    return {
+        p.relative_to(folder).as_posix(): p.read_bytes() for p in folder.rglob("*") if p.is_file()
+    }
+
+
+def leftovers(parent: Path) -> list[str]:
+    """Hidden staging/old folders the tools must never leave behind."""
+    return [p.name for p in parent.iterdir() if p.name.startswith(".ddwmmr-")]
+
+
+@pytest.fixture(scope="module")
+def made(tmp_path_factory) -> dict[str, Path]:
+    """One output folder per tool, made once (tests copy them)."""
+    base = tmp_path_factory.mktemp("made")
+    folders = {}
+    for tool in TOOLS:
+        assert run(tool, base / tool) == 0
+        folders[tool] = base / tool
+    return folders
+
+
+def copy_of(made: dict[str, Path], tool: str, where: Path) -> Path:
+    target = where / "out"
+    shutil.copytree(made[tool], target)
+    return target
+
+
+def listed(folder: Path) -> list[str]:
+    return json.loads((folder / MANIFEST).read_text())["files"]
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_manifest_lists_every_file_and_names_the_tool(made, tool):
+    manifest = json.loads((made[tool] / MANIFEST).read_text())
+    assert manifest["tool"] == tool
+    files = sorted(p.name for p in made[tool].iterdir() if p.name != MANIFEST)
+    assert manifest["files"] == files and WRITES[tool] in files
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_new_folder_next_to_a_user_file(tmp_path, tool, capsys):
+    (tmp_path / "thesis.tex").write_text("mine")
+    assert run(tool, tmp_path / "out") == 0
+    assert (tmp_path / "thesis.tex").read_text() == "mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "thesis.tex"]
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_own_folder_is_replaced(made, tmp_path, tool):
+    out = copy_of(made, tool, tmp_path)
+    (tmp_path / "thesis.tex").write_text("mine")
+    stale = out / WRITES[tool]
+    stale.write_bytes(stale.read_bytes() + b"\nstale")  # still a listed file
+    assert run(tool, out) == 0
+    assert not stale.read_bytes().endswith(b"stale")  # replaced by the new run
+    assert sorted(listed(out)) == sorted(p for p in snapshot(out) if p != MANIFEST)
+    assert (tmp_path / "thesis.tex").read_text() == "mine"
+    assert leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_own_folder_with_a_user_file_is_refused(made, tmp_path, tool, capsys):
+    out = copy_of(made, tool, tmp_path)
+    (out / "thesis.tex").write_text("mine")
+    before = snapshot(out)
+    assert run(tool, out) == 2
+    assert "thesis.tex" in capsys.readouterr().err
+    assert snapshot(out) == before and leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_other_tools_folder_is_refused(made, tmp_path, tool, capsys):
+    out = copy_of(made, OTHER[tool], tmp_path)
+    before = snapshot(out)
+    assert run(tool, out) == 2
+    err = capsys.readouterr().err
+    assert f"was written by ddwmmr {OTHER[tool]}" in err and len(err.splitlines()) == 1
+    assert snapshot(out) == before and leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_user_folder_is_refused(tmp_path, tool, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.json").write_text("{}")  # the old guard only looked for this name
+    (out / "thesis.tex").write_text("mine")
+    assert run(tool, out) == 2
+    assert "--force" in capsys.readouterr().err
+    assert snapshot(out) == {"summary.json": b"{}", "thesis.tex": b"mine"}
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_force_into_a_user_folder_keeps_the_user_files(tmp_path, tool):
+    out = tmp_path / "out"
+    (out / "notes").mkdir(parents=True)
+    (out / "notes" / "thesis.tex").write_text("mine")
+    assert run(tool, out, "--force") == 0
+    files = snapshot(out)
+    assert files["notes/thesis.tex"] == b"mine"
+    assert sorted(listed(out)) == sorted(
+        f for f in files if f not in (MANIFEST, "notes/thesis.tex")
+    )
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_force_into_another_tools_folder_deletes_only_its_listed_files(made, tmp_path, tool):
+    out = copy_of(made, OTHER[tool], tmp_path)
+    old_files = set(listed(out))
+    (out / "thesis.tex").write_text("mine")
+    assert run(tool, out, "--force") == 0
+    files = set(snapshot(out))
+    assert (out / "thesis.tex").read_text() == "mine"
+    assert json.loads((out / MANIFEST).read_text())["tool"] == tool
+    # The other tool's files are gone unless this tool wrote one of the same name.
+    assert files - {MANIFEST, "thesis.tex"} == set(listed(out))
+    assert not (old_files - set(listed(out))) & files
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_force_never_overwrites_a_user_file(tmp_path, tool, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / WRITES[tool]).write_text("mine")
+    assert run(tool, out, "--force") == 2
+    assert "would be overwritten" in capsys.readouterr().err
+    assert snapshot(out) == {WRITES[tool]: b"mine"} and leftovers(tmp_path) == []
+
+
+# -- the module itself --------------------------------------------------------------------
+def test_manifest_entries_outside_the_folder_are_never_deleted(tmp_path):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("mine")
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / MANIFEST).write_text(json.dumps({"tool": "track", "files": ["../victim.txt"]}))
+    with pytest.raises(ParameterError, match="holds files"):
+        check_output_folder(out, "track")
+    refused = pytest.raises(ParameterError, match="would be overwritten")  # bad manifest
+    with refused, output_folder(out, "track", force=True) as staging:
+        (staging / "a.txt").write_text("new")
+    assert victim.read_text() == "mine"
+    assert snapshot(out) == {MANIFEST: (out / MANIFEST).read_bytes()}
+
+
+def test_error_in_the_block_removes_staging_and_created_parents(tmp_path):
+    with pytest.raises(RuntimeError), output_folder(tmp_path / "a" / "b" / "out", "x") as staging:
+        (staging / "f.txt").write_text("half")
+        assert staging.name.startswith(STAGING_PREFIX)
+        raise RuntimeError
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_keyboard_interrupt_removes_staging(tmp_path):
+    with pytest.raises(KeyboardInterrupt), output_folder(tmp_path / "out", "x") as staging:
+        (staging / "f.txt").write_text("half")
+        raise KeyboardInterrupt
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cannot_create_staging_is_one_parameter_error(tmp_path, monkeypatch):
+    def refuse(*args, **kwargs):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr("tempfile.mkdtemp", refuse)
+    refused = pytest.raises(ParameterError, match=r"cannot write in .*Permission denied")
+    with refused, output_folder(tmp_path / "new" / "out", "x"):
+        pass
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_read_only_parent_is_refused(tmp_path):
+    parent = tmp_path / "ro"
+    parent.mkdir()
+    parent.chmod(0o555)
+    try:
+        if os.access(parent, os.W_OK):  # root may write anyway: then writing must work
+            with output_folder(parent / "out", "x") as staging:
+                (staging / "f.txt").write_text("ok")
+            assert (parent / "out" / "f.txt").read_text() == "ok"
+        else:
+            with pytest.raises(ParameterError, match="permission denied"):
+                check_output_folder(parent / "out", "x")
+    finally:
+        parent.chmod(0o755)
+
+
+@pytest.mark.parametrize("mask", [0o022, 0o027, 0o077])
+def test_files_and_folders_follow_the_umask(tmp_path, mask):
+    old = os.umask(mask)
+    try:
+        assert track_main([*TOOLS["track"][1], *FAST, "--out", str(tmp_path / "out")]) == 0
+    finally:
+        os.umask(old)
+    out = tmp_path / "out"
+    assert stat.S_IMODE(out.stat().st_mode) == 0o777 & ~mask
+    for path in out.iterdir():
+        assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask, path.name
+
+
+# -- the compare and scenarios records (issue 8 item 6) ----------------------------------
+def test_compare_records_everything_to_rerun(made):
+    record = json.loads((made["compare"] / "run.json").read_text())
+    assert record["tool"] == "compare" and record["methods"] == ["pi"]
+    assert record["options"] == {"pi": {"singularity_threshold": 0.05, "damping": 0.05}}
+    assert record["robot"]["payload"] == 1.25 and record["duration"] == 0.2
+    ellipse = record["trajectories"]["ellipse"]
+    assert ellipse["type"] == "ellipse" and ellipse["parameters"]["a"] == 2.0
+    assert ellipse["sha256"] and record["studies"] == [] and record["jobs"] == 1
+    assert record["argv"][:2] == ["--methods", "pi"] and "--only ellipse" in record["command"]
+
+
+def test_scenarios_records_everything_to_rerun(made):
+    summary = json.loads((made["scenarios"] / "summary.json").read_text())
+    record = summary["run"]
+    assert record["tool"] == "scenarios" and record["n"] == 1 and record["seed"] == 0
+    assert record["config"]["time_limit"] == 0.3 and record["config"]["payload"] == 3.0
+    assert record["robot"]["payload"] == 3.0 and record["plant"] == {"name": "thesis"}
+    assert record["command"].startswith("python -m ddwmmr.scenarios --n 1")
