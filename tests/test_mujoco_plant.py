@@ -249,16 +249,3 @@ def test_summary_of_a_stable_and_of_a_tipping_hold():
     assert tipping.result["max_base_tilt_rad"] > 0.01
     for key in ("min_support_force_n", "max_wheel_slip_m_s", "min_physics_stability"):
         assert math.isfinite(tipping.result[key])
-
-
-def test_docs_page_snippet_runs():
-    """The python block of docs/physics.md runs (the plant loop written out) and prints."""
-    from pathlib import Path
-
-    from test_examples import _python_blocks
-
-    page = Path(__file__).resolve().parents[1] / "docs" / "physics.md"
-    namespace: dict = {}
-    exec(compile(_python_blocks(page), "docs/physics.md", "exec"), namespace)
-    summary = namespace["summary"]
-    assert not summary["tipped"] and not summary["support_lost"]
