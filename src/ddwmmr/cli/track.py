@@ -24,6 +24,7 @@ from ddwmmr.cli.common import (
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, make_controller, method_description
+from ddwmmr.controllers.presets import PRESETS
 from ddwmmr.errors import ParameterError
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar
@@ -97,6 +98,13 @@ def build_parser() -> ArgumentParser:
         help="closed-loop time constant(s) in s, K = 1/tau: one value, or 3 (x, y, phi) for "
         "clrrmc-ts, 5 (x, y, phi, th1, th2) for clrrmc-cs; inf disables a channel "
         "(default 0.5)",
+    )
+    parser.add_argument(
+        "--preset",
+        choices=PRESETS,
+        default="default",
+        help="option values: default (the library's) or slides (the slides' settings: "
+        "aux sum, no orientation feedback for clrrmc-ts); explicit options override it",
     )
     parser.add_argument("--dt", type=float, metavar="S", help="step in s (default T/N)")
     parser.add_argument(
@@ -180,7 +188,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     robot = robot_from_arguments(args)
     trajectory = load_trajectory(args.traj)
     options = controller_options(args)
-    controller = make_controller(args.method, robot, **options)
+    controller = make_controller(args.method, robot, preset=args.preset, **options)
     out = Path(args.out) if args.out else default_out(args.method, args.traj)
     with atomic_output_dir(out, marker="summary.json") as staging:
         steps_hint = _steps_hint(trajectory, args)

@@ -104,14 +104,22 @@ def method_description(name: str) -> str:
     return _DESCRIPTIONS[name]
 
 
-def make_controller(name: str, robot: Robot | None = None, **options: Any) -> Controller:
+def make_controller(
+    name: str, robot: Robot | None = None, preset: str | None = None, **options: Any
+) -> Controller:
     """Build the registered controller ``name`` for ``robot`` (default: ``Robot()``).
 
-    Unknown method names and unknown options raise :class:`ParameterError`.
+    ``preset`` (``"default"`` or ``"slides"``, see :mod:`ddwmmr.controllers.presets`)
+    supplies option values; explicit ``options`` override them. Unknown method names,
+    presets and options raise :class:`ParameterError`.
     """
     _load_builtins()
     if name not in _REGISTRY:
         raise ParameterError(f"method: unknown method {name!r} (known: {', '.join(_REGISTRY)})")
+    if preset is not None:  # preset hook: explicit options win
+        from ddwmmr.controllers.presets import preset_options
+
+        options = {**preset_options(name, preset), **options}
     cls = _REGISTRY[name]
     accepted = set(inspect.signature(cls).parameters) - {"robot"}
     unknown = sorted(set(options) - accepted)

@@ -50,8 +50,14 @@ class ReferenceTrajectory:
     """Reference configurations ``q_d(t)`` and rates ``qdot_d(t)`` for a task trajectory.
 
     Integrated with classical RK4 at step ``step`` (s) through the augmented task space
-    resolution with auxiliary row ``aux``; extended lazily when queried past its end.
-    Lookups are cubic Hermite (fourth-order accurate, like the integrator).
+    resolution with auxiliary row ``aux`` (damped as in :func:`kernels.ats` with
+    ``threshold`` and ``damping``); extended lazily when queried past its end. Lookups are
+    cubic Hermite (fourth-order accurate, like the integrator).
+
+    Attributes:
+        singular_nodes: number of rate evaluations (nodes and RK4 stages) that were damped.
+        last_damped: whether the segment of the last lookup was integrated with damping at
+            any of its rate evaluations (how ``clrrmc-cs`` reports singular steps).
     """
 
     def __init__(
@@ -61,26 +67,45 @@ class ReferenceTrajectory:
         q_start: np.ndarray,
         aux: str = "shoulder",
         step: float = 0.01,
+        threshold: float = kernels.SINGULARITY_THRESHOLD,
+        damping: float = kernels.MAX_DAMPING,
     ) -> None:
         self.robot = robot
         self.trajectory = trajectory
         self.aux = aux
         self.step = float(step)
+        self.threshold = float(threshold)
+        self.damping = float(damping)
         self.singular_nodes = 0
+        self.last_damped = False
         q0 = [float(v) for v in q_start]
         self._q = [q0]
-        self._qdot = [self._rate(0.0, q0)]
+        rate, damped = self._rate(0.0, q0)
+        self._qdot = [rate]
+        self._node_damped = [damped]
+        #: Per segment: was any rate evaluation that defines it damped?
+        self._segment_damped: list[bool] = []
         #: Cubic coefficients of each segment, appended as the reference is integrated.
         self._coefficients: list[tuple[tuple[float, ...], ...]] = []
         self._end = -1.0  # queries up to this time need no extension
 
-    def _rate(self, t: float, q: list[float]) -> list[float]:
+    def _rate(self, t: float, q: list[float]) -> tuple[list[float], bool]:
         xd, yd, pd = self.trajectory.velocity(t).tolist()
         (v, w, t1, t2), singular = kernels.ats(
-            self.robot.L1, self.robot.L2, q[2], q[3], q[4], xd, yd, pd, self.aux
+            self.robot.L1,
+            self.robot.L2,
+            q[2],
+            q[3],
+            q[4],
+            xd,
+            yd,
+            pd,
+            self.aux,
+            self.threshold,
+            self.damping,
         )
         self.singular_nodes += singular
-        return [v * math.cos(q[2]), v * math.sin(q[2]), w, t1, t2]
+        return [v * math.cos(q[2]), v * math.sin(q[2]), w, t1, t2], singular
 
     def _extend_to(self, t: float) -> None:
         h = self.step
@@ -88,15 +113,18 @@ class ReferenceTrajectory:
             tk = (len(self._q) - 1) * h
             q = self._q[-1]
             k1 = self._qdot[-1]
-            k2 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k1)])
-            k3 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k2)])
-            k4 = self._rate(tk + h, [a + h * b for a, b in zip(q, k3)])
+            k2, d2 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k1)])
+            k3, d3 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k2)])
+            k4, d4 = self._rate(tk + h, [a + h * b for a, b in zip(q, k3)])
             q_next = [
                 a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
                 for a, b1, b2, b3, b4 in zip(q, k1, k2, k3, k4)
             ]
+            rate_next, d_next = self._rate(tk + h, q_next)
+            self._segment_damped.append(self._node_damped[-1] or d2 or d3 or d4 or d_next)
             self._q.append(q_next)
-            self._qdot.append(self._rate(tk + h, q_next))
+            self._qdot.append(rate_next)
+            self._node_damped.append(d_next)
             self._coefficients.append(self._segment(len(self._q) - 2))
 
     def _segment(self, i: int) -> tuple[tuple[float, ...], ...]:
@@ -117,6 +145,7 @@ class ReferenceTrajectory:
             self._end = (len(self._q) - 2) * self.step
         h = self.step
         i = min(int(t / h), len(self._q) - 2)
+        self.last_damped = self._segment_damped[i]
         s = t / h - i
         position, rate = [], []
         for c0, c1, c2, c3 in self._coefficients[i]:
