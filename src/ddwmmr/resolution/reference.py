@@ -1,7 +1,9 @@
 """Start configurations and reference configuration trajectories.
 
 * :func:`start_configuration` places the robot's home arm pose on the trajectory start.
-* :func:`offset_configuration` moves the end effector by a small offset using the arm only.
+* :func:`offset_configuration` moves the end effector by a small offset using the arm only;
+  the offset is expressed in the end effector's frame, so whether the arm can reach it does
+  not depend on which way the trajectory starts.
 * :class:`ReferenceTrajectory` integrates ``q_d(t)`` from the desired task trajectory
   through the augmented task space resolution (RK4 on a fine grid, cubic Hermite lookup):
   the configuration-space reference of CLRRMC-CS (SPEC §4).
@@ -17,8 +19,12 @@ from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.resolution import kernels
 
-#: Default initial end-effector offset (m, world frame): closed-loop convergence shows.
-DEFAULT_INITIAL_OFFSET = (0.03, -0.03)
+#: Default initial end-effector offset (m) in the end effector's start frame (x along its
+#: orientation phiE, y to its left): 30 mm back and 30 mm to the right, 42.4 mm in all, so
+#: closed-loop convergence shows. On the default ellipse (start heading +y) this is the
+#: world offset (0.03, -0.03) m. Any start heading gives the same arm motion, which the
+#: home arm pose can always make (it moves E towards the arm mount).
+DEFAULT_INITIAL_OFFSET = (-0.03, -0.03)
 
 
 def start_configuration(robot: Robot, trajectory) -> np.ndarray:
@@ -30,10 +36,15 @@ def start_configuration(robot: Robot, trajectory) -> np.ndarray:
 def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
     """``q`` with the arm joints changed so the end effector moves by ``offset`` (dx, dy) m.
 
-    Newton iterations on the arm's 2x2 position Jacobian; the base does not move.
+    The offset is in the end effector's frame at ``q``: dx along its orientation phiE, dy
+    to its left. Newton iterations on the arm's 2x2 position Jacobian; the base does not
+    move. An offset the arm cannot reach raises :class:`ParameterError`.
     """
     q = np.array(q, dtype=float)
-    target = robot.fk(q)[:2] + np.asarray(offset, dtype=float)
+    dx, dy = (float(v) for v in offset)
+    x_e, y_e, phi_e = robot.fk(q)
+    c, s = math.cos(phi_e), math.sin(phi_e)
+    target = np.array([x_e + c * dx - s * dy, y_e + s * dx + c * dy])
     for _ in range(50):
         error = target - robot.fk(q)[:2]
         if float(np.hypot(*error)) < 1e-12:
@@ -42,8 +53,10 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
         if abs(np.linalg.det(arm_jacobian)) < 1e-9:
             break
         q[3:5] += np.linalg.solve(arm_jacobian, error)
-    dx, dy = (float(v) for v in offset)
-    raise ParameterError(f"initial_offset ({dx:g}, {dy:g}) m cannot be reached with the arm alone")
+    raise ParameterError(
+        f"initial_offset ({dx:g}, {dy:g}) m (end-effector frame) cannot be reached with the "
+        "arm alone"
+    )
 
 
 class ReferenceTrajectory:
