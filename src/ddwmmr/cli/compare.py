@@ -25,6 +25,7 @@ from ddwmmr.cli.common import (
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, method_description
+from ddwmmr.controllers.presets import PRESETS
 from ddwmmr.errors import ParameterError, check_int_at_least, check_positive
 from ddwmmr.reports.compare import (
     DEFAULT_TRAJECTORIES,
@@ -155,6 +156,13 @@ def build_parser() -> ArgumentParser:
         help="simulated time of every run, studies included, in s (default: one period of "
         "each trajectory)",
     )
+    parser.add_argument(
+        "--preset",
+        choices=PRESETS,
+        default="default",
+        help="settings of the main comparison and the studies: default (the library's) or "
+        "slides (the slides' auxiliary row and gains); the report ranks both either way",
+    )
     add_robot_arguments(parser)
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     return parser
@@ -246,6 +254,7 @@ def config_from_arguments(args: argparse.Namespace, argv: Sequence[str] | None) 
         duration=check_duration(args.duration, trajectories),
         studies=parse_studies(args.study),
         command=command,
+        preset=args.preset,
     )
 
 

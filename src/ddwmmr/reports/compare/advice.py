@@ -165,7 +165,8 @@ def recommendations(items: Sequence[Profile], slides: Ranking | None = None) -> 
         lines.append(
             f"**Tightest step-time budget with feedback**: `{fastest.method}` "
             f"({fmt(fastest.step_us)} us per step on this machine; it removes the initial "
-            f"offset, below 5 % after {fmt(fastest.settle_s)} s on the {fastest.settle_trajectory})."
+            f"offset, below 5 % after {fmt(fastest.settle_s)} s on the "
+            f"{fastest.settle_trajectory})."
         )
     guarded = [p for p in items if p.stability_floor is not None and p.stability_violations == 0]
     if guarded:

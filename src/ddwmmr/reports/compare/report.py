@@ -416,16 +416,35 @@ def _trajectory_section(c: _Context, name: str) -> None:
     c.doc.table(["method", *[h for h, _, _ in METRIC_COLUMNS]], rows)
     series = {m: c.main(m, name).timeseries for m in c.config.methods}
     colors = c.colors
+    trajectory = c.config.trajectories[name]
+    quarter = getattr(trajectory, "T", trajectory.duration) / 4.0
+    offset = math.hypot(*DEFAULT_INITIAL_OFFSET)
+    zooms = [("A", 0.0, 3.0 * offset)]
+    if quarter < run_duration(c.config, name):
+        zooms.append(("B", quarter, None))
     c.add_figure(
         f"paths_{name}.png",
-        plots.plot_paths(series, colors, f"{name}: end-effector paths"),
-        f"{name}: end-effector paths of every method over the desired path (dashed); the "
-        "frame is the desired path plus 0.5 m, so a method that drifts away leaves it.",
+        plots.plot_paths(series, colors, f"{name}: end-effector paths", zooms),
+        f"{name}: end-effector paths over the desired path (thin dashed, drawn first; the "
+        "methods from wide to thin lines on top, so coinciding ones stay visible). The main "
+        "frame is the desired path plus 0.5 m, so a method that drifts away leaves it. Zoom "
+        "A: the start, where the closed-loop methods remove the initial offset and the "
+        "open-loop ones keep it"
+        + (
+            f"; zoom B: around t = T/4 = {quarter:g} s"
+            + (" (the first corner)" if name == CORNER_TRAJECTORY else "")
+            + ", dots mark where each method is at that time"
+            if len(zooms) > 1
+            else ""
+        )
+        + ".",
     )
     c.add_figure(
         f"errors_{name}.png",
         plots.plot_errors(series, colors, f"{name}: tracking errors"),
-        f"{name}: position error (log scale, floored at 1e-12 m) and orientation error vs time.",
+        f"{name}: position error (log scale, floored at 1e-12 m) and orientation error vs "
+        "time (wrapped to [-pi, pi); the line is broken where it crosses +-pi instead of "
+        "jumping across the plot).",
     )
     c.add_figure(
         f"wheels_{name}.png",
@@ -435,7 +454,9 @@ def _trajectory_section(c: _Context, name: str) -> None:
     c.add_figure(
         f"methods_{name}.png",
         plots.plot_small_multiples(series, colors, c.config.robot, name),
-        f"{name}: one panel per method, with the robot drawn at six instants.",
+        f"{name}: one panel per method (axes in m): desired path dashed, end effector in the "
+        "method's colour, base path grey, the robot (grey footprint, black arm) at six "
+        "instants labelled with their time.",
     )
 
 
@@ -480,7 +501,28 @@ def _tau_section(c: _Context) -> None:
     c.add_figure(
         "study_tau.png",
         plots.plot_tau_study(curves, convergence, theory, c.colors),
-        "Time-constant sweep: error vs time per tau, and convergence time vs tau.",
+        "Time-constant sweep: error vs time per tau (left), convergence time / tau per method "
+        f"(right; dotted: the first-order {theory:.2f}). " + _tau_overlap(convergence),
+    )
+
+
+def _tau_overlap(convergence: Mapping[str, Mapping[float, float]]) -> str:
+    """Say which methods have the same convergence times (their markers overlap)."""
+    methods = list(convergence)
+    same = [
+        m
+        for m in methods[1:]
+        if all(
+            math.isclose(convergence[m][tau], convergence[methods[0]][tau], rel_tol=0.02)
+            for tau in convergence[m]
+        )
+    ]
+    if not same:
+        return "The methods are offset by a few per cent in tau so no marker hides another."
+    names = ", ".join([methods[0], *same])
+    return (
+        f"{names} converge in the same time (within 2 %) at every tau: their markers would "
+        "coincide, so the methods are offset by a few per cent in tau."
     )
 
 
