@@ -57,15 +57,15 @@ class TaskSpaceController:
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Input for the desired velocity plus the pose-error correction."""
-        check_inputs(t, q, pose_d, velocity_d)
-        x, y, phi, th1, th2 = q.tolist()
+        q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        x, y, phi, th1, th2 = q
         L1, L2 = self.robot.L1, self.robot.L2
         a1 = phi + th1
         a12 = a1 + th2
         xe = x + L1 * math.cos(a1) + L2 * math.cos(a12)
         ye = y + L1 * math.sin(a1) + L2 * math.sin(a12)
-        px, py, pphi = pose_d.tolist()
-        vx, vy, vphi = velocity_d.tolist()
+        px, py, pphi = pose_d
+        vx, vy, vphi = velocity_d
         u, singular = kernels.ats(
             L1,
             L2,
@@ -137,10 +137,10 @@ class ConfigurationSpaceController:
         """
         if self.reference is None:
             raise RuntimeError("clrrmc-cs needs reset(trajectory, q0) before command()")
-        check_inputs(t, q, pose_d, velocity_d)
+        q, _, _ = check_inputs(t, q, pose_d, velocity_d)
         reference = self.reference
         q_ref, qdot_ref = reference(t)
-        qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q.tolist())]
+        qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q)]
         c, s = math.cos(q[2]), math.sin(q[2])
         self.last = StepInfo(
             singular=reference.last_damped, nonholonomic_residual=-qdot[0] * s + qdot[1] * c

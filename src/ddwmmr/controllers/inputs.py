@@ -8,7 +8,8 @@ word (and the QP would count a fallback). :func:`check_inputs` turns it into a o
 It runs every control step, so the common case (everything finite) is one sum over the
 values: a sum is finite only if every term is finite. Only when it is not (or when the
 arguments are not flat numeric sequences) does the slow path look at each argument, which
-also clears sums that merely overflowed.
+also clears sums that merely overflowed. It returns the arguments as lists of floats, which
+the closed-form controllers work with anyway (one conversion instead of two).
 """
 
 from __future__ import annotations
@@ -28,7 +29,11 @@ _ARGUMENTS = (
 )
 
 
-def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> None:
+Lists = tuple[list[float], list[float], list[float]]
+_isfinite = math.isfinite
+
+
+def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
     """Raise :class:`ParameterError` naming the first argument that is not finite.
 
     Args:
@@ -36,15 +41,23 @@ def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> None:
         q: configuration, 5 numbers.
         pose_d: desired end-effector pose, 3 numbers.
         velocity_d: desired end-effector velocity, 3 numbers.
+
+    Returns:
+        ``(q, pose_d, velocity_d)`` as lists of floats.
     """
     try:
-        total = t + sum(q.tolist()) + sum(pose_d.tolist()) + sum(velocity_d.tolist())
-        sizes_ok = len(q) == 5 and len(pose_d) == 3 and len(velocity_d) == 3
+        ql, pl, vl = q.tolist(), pose_d.tolist(), velocity_d.tolist()
+        values = ql + pl + vl
+        if len(values) == 11 and len(ql) == 5 and len(pl) == 3 and _isfinite(sum(values, t)):
+            return ql, pl, vl
     except (AttributeError, TypeError):
-        total, sizes_ok = math.nan, False
-    if sizes_ok and math.isfinite(total):
-        return
+        pass
     _check_each(t, q, pose_d, velocity_d)
+    return (
+        np.asarray(q, dtype=float).tolist(),
+        np.asarray(pose_d, dtype=float).tolist(),
+        np.asarray(velocity_d, dtype=float).tolist(),
+    )
 
 
 def _check_each(t: Any, q: Any, pose_d: Any, velocity_d: Any) -> None:

@@ -61,9 +61,9 @@ class PseudoinverseController(_ResolvedRate):
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Minimum-norm input for the desired end-effector velocity (m/s, rad/s)."""
-        check_inputs(t, q, pose_d, velocity_d)
-        _, _, phi, th1, th2 = q.tolist()
-        xd, yd, pd = velocity_d.tolist()
+        q, _, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        _, _, phi, th1, th2 = q
+        xd, yd, pd = velocity_d
         return self._finish(
             *kernels.pseudoinverse(
                 self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
@@ -81,9 +81,9 @@ class AugmentedTaskSpaceController(_ResolvedRate):
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Input solving the square augmented system for the desired velocity."""
-        check_inputs(t, q, pose_d, velocity_d)
-        _, _, phi, th1, th2 = q.tolist()
-        xd, yd, pd = velocity_d.tolist()
+        q, _, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        _, _, phi, th1, th2 = q
+        xd, yd, pd = velocity_d
         return self._finish(
             *kernels.ats(
                 self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.aux, self.threshold, self.damping
@@ -106,9 +106,9 @@ class ArtificialPotentialController(_ResolvedRate):
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Pseudoinverse input plus the projected potential descent (K2 has no effect: th2
         cannot move without moving the end effector, so it is not in the null space)."""
-        check_inputs(t, q, pose_d, velocity_d)
-        _, _, phi, th1, th2 = q.tolist()
-        xd, yd, pd = velocity_d.tolist()
+        q, _, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        _, _, phi, th1, th2 = q
+        xd, yd, pd = velocity_d
         (v, w, t1, t2), singular = kernels.pseudoinverse(
             self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
         )

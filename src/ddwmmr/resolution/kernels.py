@@ -81,9 +81,23 @@ def smallest_singular_value_m(L1: float, cos_th1: float) -> float:
     ``sigma_min^2 = 2 det^2 / (T + sqrt(T^2 - 4 det^2))`` with ``T = 1 + L1^2`` (the form
     without cancellation near the singularity).
     """
+    return math.sqrt(_sigma_min_squared_m(1.0 + L1 * L1, (L1 * cos_th1) ** 2))
+
+
+def _sigma_min_squared_m(total: float, det2: float) -> float:
+    return 2.0 * det2 / (total + math.sqrt(max(total * total - 4.0 * det2, 0.0)))
+
+
+def _ats_damping_squared(L1: float, cos_th1: float, threshold: float, damping: float) -> float:
+    """:func:`damping_squared` of ``M`` at ``sigma = sigma_min(M)``, without the square roots
+    outside the band: ``sigma_min(M) < threshold`` exactly when
+    ``det^2 < threshold^2 (T - threshold^2)`` (``sigma_1^2 = T - sigma_min^2``)."""
     total = 1.0 + L1 * L1
     det2 = (L1 * cos_th1) ** 2
-    return math.sqrt(2.0 * det2 / (total + math.sqrt(max(total * total - 4.0 * det2, 0.0))))
+    threshold2 = threshold * threshold
+    if det2 >= threshold2 * (total - threshold2):
+        return 0.0
+    return damping * damping * (1.0 - _sigma_min_squared_m(total, det2) / threshold2)
 
 
 def _solve2(
@@ -120,8 +134,7 @@ def ats(
     a1 = phi + th1
     s1, c1 = math.sin(a1), math.cos(a1)
     s12, c12 = math.sin(a1 + th2), math.cos(a1 + th2)
-    sigma = smallest_singular_value_m(L1, c * c1 + s * s1)  # cos th1 = cos(a1 - phi)
-    lam2 = damping_squared(sigma, threshold, damping)
+    lam2 = _ats_damping_squared(L1, c * c1 + s * s1, threshold, damping)  # cos(a1 - phi)
     m12, m22 = -L1 * s1, L1 * c1
     if aux == "sum":
         w = phidot_e

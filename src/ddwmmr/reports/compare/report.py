@@ -745,8 +745,8 @@ def _init_section(c: _Context) -> None:
     }
     c.doc.paragraph(
         f"{STUDY_TRAJECTORY}: the end effector starts off the path by multiples of the default "
-        "offset (same direction), moved with the arm; offsets the arm cannot reach are left "
-        "out. Final position error per method: an "
+        "offset (same direction in the end effector's frame), moved with the arm; offsets the "
+        "arm cannot reach are left out. Final position error per method: an "
         "open-loop method ends with its offset, a closed-loop one removes it."
     )
     headers = ["method", *[f"offset {1000 * k:.1f} mm" for k in sorted(next(iter(final.values())))]]
@@ -845,7 +845,8 @@ def _definitions_section(c: _Context) -> None:
             "nonholonomic residual: sideways base speed a method asked for and the "
             "differential drive cannot produce (m/s)",
             "manipulability: |sin th2| in [0, 1]; stability S: tip-over margin, S <= 1 tips",
-            "singular steps: steps with damping near a singularity; saturated steps: steps "
+            "singular steps: steps with damping near a singularity (for `clrrmc-cs`: steps "
+            "whose reference segment was integrated with damping); saturated steps: steps "
             "where a wheel or joint speed limit was hit",
             "step latency: median wall-clock time of one controller call (us); a timing, so "
             "it varies between runs and machines",
