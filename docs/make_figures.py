@@ -20,6 +20,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ddwmmr import Ellipse, Rectangle, Robot, simulate
+from ddwmmr.resolution import kernels
 from ddwmmr.sim.loops import closed_form_step, error_response, step_response
 
 FIGURES = Path(__file__).resolve().parent / "figures"
@@ -57,14 +58,92 @@ def singularity_map(robot: Robot) -> Path:
         (det, "|det J_aug| (m), both aux rows"),
         (sigma, "smallest singular value of the 4x5 J"),
     )
+    # Where the damping starts (kernels docstring): sigma_min(M) = sigma0 for ats, the
+    # pseudoinverse's measure 2 sqrt(2) L1 |cos th1| / trace(A A^T) = sigma0 for pi.
+    ats_measure = np.vectorize(lambda c: kernels.smallest_singular_value_m(robot.L1, c))
+    pi_measure = np.empty_like(th1)
+    for i in range(len(GRID)):
+        for j in range(len(GRID)):
+            q = [0.0, 0.0, 0.4, th1[i, j], th2[i, j]]
+            a = robot.jacobian(q)[:3] @ _input_matrix(0.4)
+            pi_measure[i, j] = (
+                2 * math.sqrt(2) * robot.L1 * abs(math.cos(th1[i, j])) / np.trace(a @ a.T)
+            )
     for ax, (values, title) in zip(axes, panels):
         image = ax.pcolormesh(th2, th1, values, shading="auto", cmap="viridis")
-        ax.contour(th2, th1, np.abs(np.cos(th1)), levels=[0.05], colors="w", linewidths=1)
+        sigma0 = kernels.SINGULARITY_THRESHOLD
+        ax.contour(th2, th1, ats_measure(np.cos(th1)), levels=[sigma0], colors="w", linewidths=1)
+        ax.contour(th2, th1, pi_measure, levels=[sigma0], colors="w", linewidths=1, linestyles="--")
         fig.colorbar(image, ax=ax)
         ax.set_title(title)
         _angle_axes(ax)
-    fig.suptitle("Singular where cos θ1 = 0 (white: |cos θ1| = 0.05, where damping starts)")
+    fig.suptitle(
+        "Singular where cos θ1 = 0; damping bands: white solid ats (|cos θ1| < 0.15), dashed pi"
+    )
     return _save(fig, "singularity")
+
+
+def _input_matrix(phi: float) -> np.ndarray:
+    from ddwmmr.model.kinematics import input_matrix
+
+    return input_matrix(phi)
+
+
+def damping_gain(robot: Robot) -> Path:
+    """Largest |u| / |Xdot| of the ats and pi kernels across the singularity: the damping
+    of the library against the earlier |cos θ1| < 0.05 band (re-implemented here)."""
+    cos_values = np.geomspace(1e-4, 1.0, 400)
+    th2 = 0.6
+    curves: dict[str, list[float]] = {"ats (shoulder)": [], "pi": [], "ats, earlier band": []}
+    for c in cos_values:
+        q = [0.0, 0.0, 0.3, math.acos(c), th2]
+        curves["ats (shoulder)"].append(
+            _gain(lambda x, q=q: kernels.ats(robot.L1, robot.L2, *q[2:], *x)[0])
+        )
+        curves["pi"].append(
+            _gain(lambda x, q=q: kernels.pseudoinverse(robot.L1, robot.L2, *q[2:], *x)[0])
+        )
+        curves["ats, earlier band"].append(_gain(lambda x, q=q: _earlier_ats(robot, q, x)))
+    fig, ax = plt.subplots(figsize=(8, 4.6), constrained_layout=True)
+    styles = {"ats (shoulder)": "C0-", "pi": "C1-", "ats, earlier band": "C3--"}
+    for label, values in curves.items():
+        ax.loglog(cos_values, values, styles[label], label=label, lw=1.4)
+    ats_bound = kernels.ats_gain(robot.L1, robot.L2)
+    ax.axhline(ats_bound, color="C0", ls=":", lw=1, label=f"documented ats bound {ats_bound:.1f}")
+    ax.axhline(
+        kernels.pi_gain(),
+        color="C1",
+        ls=":",
+        lw=1,
+        label=f"documented pi bound {kernels.pi_gain():.0f}",
+    )
+    ax.axvline(0.05, color="0.5", ls="-.", lw=0.8)
+    ax.annotate("earlier band edge |cos θ1| = 0.05", (0.05, 1.2), fontsize=8, color="0.3")
+    ax.set_xlabel("|cos θ1|  (θ2 = 0.6 rad, φ = 0.3 rad)")
+    ax.set_ylabel("largest |u| / |Xdot|")
+    ax.set_title("command gain near the singularity: continuous and bounded")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, which="both")
+    return _save(fig, "damping")
+
+
+def _gain(kernel) -> float:
+    """Operator 2-norm of the (linear) kernel Xdot -> u, from its columns."""
+    matrix = np.column_stack([kernel(e) for e in np.eye(3)])
+    return float(np.linalg.svd(matrix, compute_uv=False)[0])
+
+
+def _earlier_ats(robot: Robot, q, xdot) -> np.ndarray:
+    """The earlier ats (shoulder) kernel: damping on |cos θ1| < 0.05 with lambda = 0.05."""
+    c = abs(math.cos(q[3]))
+    lam2 = 0.0 if c >= 0.05 else 0.05**2 * (1 - (c / 0.05) ** 2)
+    a = robot.jacobian(q)[:3] @ _input_matrix(q[2])
+    columns = np.array([[1, 0], [0, 1], [0, 0], [0, -1]], dtype=float)
+    known = np.array([0, 0, 0, xdot[2]])
+    m = (a @ columns)[:2]
+    r = (np.asarray(xdot) - a @ known)[:2]
+    z = np.linalg.solve(m.T @ m + lam2 * np.eye(2), m.T @ r)
+    return columns @ z + known
 
 
 def step_responses(robot: Robot) -> Path:
@@ -194,6 +273,7 @@ def main() -> int:
     for make in (singularity_map, step_responses, stability_maps, robot_and_workspace):
         print(make(robot))
     print(method_drift(robot))
+    print(damping_gain(robot))
     return 0
 
 

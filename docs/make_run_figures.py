@@ -30,6 +30,7 @@ JOBS: list[tuple[list[str], dict[str, str]]] = [
             f"{name}.png": f"compare_{name}.png"
             for name in (
                 "paths_ellipse",
+                "paths_rectangle",
                 "errors_rectangle",
                 "methods_ellipse",
                 "study_tau",

@@ -30,6 +30,7 @@ from ddwmmr.cli.common import (
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, method_description
+from ddwmmr.controllers.presets import PRESETS
 from ddwmmr.errors import ParameterError, check_int_at_least, check_positive, check_step_count
 from ddwmmr.progress import phase
 from ddwmmr.reports.compare import (
@@ -179,6 +180,13 @@ def build_parser() -> ArgumentParser:
         help="simulated time of every run, studies included, in s (default: one period of "
         "each trajectory)",
     )
+    parser.add_argument(
+        "--preset",
+        choices=PRESETS,
+        default="default",
+        help="settings of the main comparison and the studies: default (the library's) or "
+        "slides (the slides' auxiliary row and gains); the report ranks both either way",
+    )
     add_robot_arguments(parser)
     add_force_argument(parser)
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
@@ -303,6 +311,7 @@ def config_from_arguments(
         duration=check_duration(args.duration, trajectories),
         studies=parse_studies(args.study),
         command=command,
+        preset=args.preset,
     )
 
 

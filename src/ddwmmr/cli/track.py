@@ -29,6 +29,7 @@ from ddwmmr.cli.common import (
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, make_controller, method_description
+from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file
 from ddwmmr.model import Robot
 from ddwmmr.plants.kinematic import INTEGRATORS
@@ -45,6 +46,7 @@ PLANT = "kinematic"
 RUN_OPTIONS = (
     "method", "traj", "aux", "tau", "dt", "duration", "integrator", "offset", "robot",
     "payload", "stability_min", "manipulability_weight", "obstacles", "solver", "qp_mode",
+    "preset",
 )  # fmt: skip
 
 #: Keys printed in the summary table, with their labels; errors in mm (as in compare).
@@ -129,6 +131,13 @@ def build_parser() -> ArgumentParser:
         help="closed-loop time constant(s) in s, K = 1/tau: one value, or 3 (x, y, phi) for "
         "clrrmc-ts, 5 (x, y, phi, th1, th2) for clrrmc-cs; inf disables a channel "
         "(default 0.5)",
+    )
+    parser.add_argument(
+        "--preset",
+        choices=PRESETS,
+        help="option values: default (the library's, the default) or slides (the slides' "
+        "settings: aux sum, no orientation feedback for clrrmc-ts); explicit options "
+        "override it",
     )
     parser.add_argument("--dt", type=float, metavar="S", help="step in s (default T/N)")
     parser.add_argument(
@@ -234,7 +243,8 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     robot = robot_from_arguments(args)
     source = find_trajectory_file(args.traj)
     trajectory = load_trajectory(args.traj)
-    options = controller_options(args)
+    # The preset's values, then the explicit options (they win): the record keeps them all.
+    options = {**preset_options(args.method, args.preset or "default"), **controller_options(args)}
     duration = trajectory.duration if args.duration is None else args.duration
     if args.dt is None:
         step = trajectory.duration / getattr(trajectory, "samples", 1000)

@@ -130,13 +130,20 @@ def method_options(name: str) -> dict[str, Any]:
     return options
 
 
-def make_controller(name: str, robot: Robot | None = None, **options: Any) -> Controller:
+def make_controller(
+    name: str, robot: Robot | None = None, preset: str | None = None, **options: Any
+) -> Controller:
     """Build the registered controller ``name`` for ``robot`` (default: ``Robot()``).
 
-    Unknown method names and unknown options (see :func:`method_options`) raise
-    :class:`ParameterError`.
+    ``preset`` (``"default"`` or ``"slides"``, see :mod:`ddwmmr.controllers.presets`)
+    supplies option values; explicit ``options`` override them. Unknown method names,
+    presets and options (see :func:`method_options`) raise :class:`ParameterError`.
     """
     cls = _registered(name)
+    if preset is not None:  # preset hook: explicit options win
+        from ddwmmr.controllers.presets import preset_options
+
+        options = {**preset_options(name, preset), **options}
     accepted = set(method_options(name))
     unknown = sorted(set(options) - accepted)
     if unknown:

@@ -13,10 +13,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register
+from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.controllers.resolved_rate import check_aux
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import wrap_angle
 from ddwmmr.resolution import kernels
 from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
 
@@ -26,7 +28,13 @@ DEFAULT_TAU = 0.5
 
 @register("clrrmc-ts")
 class TaskSpaceController:
-    """CLRRMC-TS: qdot = J_aug^-1 [Xd_dot + K (Xd - X)], feedback on xE, yE, phiE."""
+    """CLRRMC-TS: qdot = J_aug^-1 [Xd_dot + K (Xd - X)], feedback on xE, yE, phiE.
+
+    The orientation error ``phiE_d - phiE`` is wrapped to [-pi, pi) (one turn of the end
+    effector is no error), so a desired heading given wrapped or unwrapped gives the same
+    run. ``tau`` is one time constant (s) or three (x, y, phi); ``inf`` switches a channel
+    off (the slides' K3 = 0 is ``tau = (0.5, 0.5, inf)``).
+    """
 
     def __init__(
         self,
@@ -39,8 +47,8 @@ class TaskSpaceController:
         self.robot = robot
         self.kx, self.ky, self.kphi = gains_from_tau(tau, 3)
         self.aux = check_aux(aux)
-        self.threshold = singularity_threshold
-        self.damping = damping
+        self.threshold = check_positive("singularity_threshold", singularity_threshold)
+        self.damping = check_nonnegative("damping", damping)
         self.last = StepInfo()
 
     def reset(self, trajectory: object, q0: np.ndarray) -> None:
@@ -49,14 +57,15 @@ class TaskSpaceController:
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Input for the desired velocity plus the pose-error correction."""
-        x, y, phi, th1, th2 = q.tolist()
+        q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        x, y, phi, th1, th2 = q
         L1, L2 = self.robot.L1, self.robot.L2
         a1 = phi + th1
         a12 = a1 + th2
         xe = x + L1 * math.cos(a1) + L2 * math.cos(a12)
         ye = y + L1 * math.sin(a1) + L2 * math.sin(a12)
-        px, py, pphi = pose_d.tolist()
-        vx, vy, vphi = velocity_d.tolist()
+        px, py, pphi = pose_d
+        vx, vy, vphi = velocity_d
         u, singular = kernels.ats(
             L1,
             L2,
@@ -65,7 +74,7 @@ class TaskSpaceController:
             th2,
             vx + self.kx * (px - xe),
             vy + self.ky * (py - ye),
-            vphi + self.kphi * (pphi - a12),
+            vphi + self.kphi * wrap_angle(pphi - a12),
             self.aux,
             self.threshold,
             self.damping,
@@ -76,7 +85,11 @@ class TaskSpaceController:
 
 @register("clrrmc-cs")
 class ConfigurationSpaceController:
-    """CLRRMC-CS: qdot = qdot_d + K (q_d - q) around an ATS reference q_d(t)."""
+    """CLRRMC-CS: qdot = qdot_d + K (q_d - q) around an ATS reference q_d(t).
+
+    A step counts as singular (``last.singular``) when the reference segment it looks up
+    was integrated with damping (the reference passed near cos th1 = 0 there).
+    """
 
     def __init__(
         self,
@@ -84,6 +97,8 @@ class ConfigurationSpaceController:
         tau: float | Sequence[float] = DEFAULT_TAU,
         aux: str = "shoulder",
         reference_step: float = 0.01,
+        singularity_threshold: float = kernels.SINGULARITY_THRESHOLD,
+        damping: float = kernels.MAX_DAMPING,
     ) -> None:
         self.robot = robot
         self.gains = gains_from_tau(tau, 5)
@@ -91,6 +106,8 @@ class ConfigurationSpaceController:
         if not reference_step > 0:
             raise ParameterError(f"reference_step must be > 0 s (got {reference_step})")
         self.reference_step = float(reference_step)
+        self.threshold = check_positive("singularity_threshold", singularity_threshold)
+        self.damping = check_nonnegative("damping", damping)
         self.reference: ReferenceTrajectory | None = None
         self.last = StepInfo()
 
@@ -106,6 +123,8 @@ class ConfigurationSpaceController:
             start_configuration(self.robot, trajectory),
             self.aux,
             self.reference_step,
+            self.threshold,
+            self.damping,
         )
         self.reference(getattr(trajectory, "duration", 0.0))  # precompute one period
         self.last = StepInfo()
@@ -118,8 +137,12 @@ class ConfigurationSpaceController:
         """
         if self.reference is None:
             raise RuntimeError("clrrmc-cs needs reset(trajectory, q0) before command()")
-        q_ref, qdot_ref = self.reference(t)
-        qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q.tolist())]
+        q, _, _ = check_inputs(t, q, pose_d, velocity_d)
+        reference = self.reference
+        q_ref, qdot_ref = reference(t)
+        qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q)]
         c, s = math.cos(q[2]), math.sin(q[2])
-        self.last = StepInfo(nonholonomic_residual=-qdot[0] * s + qdot[1] * c)
+        self.last = StepInfo(
+            singular=reference.last_damped, nonholonomic_residual=-qdot[0] * s + qdot[1] * c
+        )
         return np.array([qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4]])

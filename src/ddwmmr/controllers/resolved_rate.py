@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register
+from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import AUX_ROWS
@@ -16,7 +17,13 @@ from ddwmmr.resolution import kernels
 
 
 class _ResolvedRate:
-    """Shared state: robot lengths, singularity handling, last step info."""
+    """Shared state: robot lengths, singularity handling, last step info.
+
+    ``singularity_threshold`` is the smallest singular value below which the inverse is
+    damped and ``damping`` the damping factor at the singularity (see
+    :mod:`ddwmmr.resolution.kernels`: with ``damping >= singularity_threshold`` the command
+    is bounded by a documented constant times the desired speed at every state).
+    """
 
     name = "base"
 
@@ -54,8 +61,9 @@ class PseudoinverseController(_ResolvedRate):
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Minimum-norm input for the desired end-effector velocity (m/s, rad/s)."""
-        _, _, phi, th1, th2 = q.tolist()
-        xd, yd, pd = velocity_d.tolist()
+        q, _, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        _, _, phi, th1, th2 = q
+        xd, yd, pd = velocity_d
         return self._finish(
             *kernels.pseudoinverse(
                 self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
@@ -73,8 +81,9 @@ class AugmentedTaskSpaceController(_ResolvedRate):
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Input solving the square augmented system for the desired velocity."""
-        _, _, phi, th1, th2 = q.tolist()
-        xd, yd, pd = velocity_d.tolist()
+        q, _, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        _, _, phi, th1, th2 = q
+        xd, yd, pd = velocity_d
         return self._finish(
             *kernels.ats(
                 self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.aux, self.threshold, self.damping
@@ -97,8 +106,9 @@ class ArtificialPotentialController(_ResolvedRate):
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Pseudoinverse input plus the projected potential descent (K2 has no effect: th2
         cannot move without moving the end effector, so it is not in the null space)."""
-        _, _, phi, th1, th2 = q.tolist()
-        xd, yd, pd = velocity_d.tolist()
+        q, _, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        _, _, phi, th1, th2 = q
+        xd, yd, pd = velocity_d
         (v, w, t1, t2), singular = kernels.pseudoinverse(
             self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
         )

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo
+from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import check_nonnegative, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.qp.context import StepContext
@@ -205,6 +206,7 @@ class QPControllerCore:
 
     def command(self, t: float, q: np.ndarray, pose_d: np.ndarray, velocity_d: np.ndarray):
         """Input ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s) for this step."""
+        check_inputs(t, q, pose_d, velocity_d)
         ctx = self.ctx
         ctx.update(t, q, pose_d, velocity_d)
         x = self._solve(ctx)

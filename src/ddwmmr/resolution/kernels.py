@@ -17,26 +17,87 @@ formulations in ``tests/test_resolution.py``):
    ``z = [0, 0, 1, -1, 0] / sqrt(2)``: yawing the base about the arm mount while counter-
    rotating the shoulder leaves the end effector still. So ``I - J^# J = z z^T``.
 
-Near ``cos(th1) = 0`` the inverses are damped least squares with a damping that grows
-smoothly from 0 at ``|cos th1| = threshold`` to ``damping`` at ``cos th1 = 0``.
+**Damping** (Nakamura & Hanafusa 1986; Chiaverini 1997). Every inverse is a damped least
+squares ``(M^T M + lambda^2 I)^-1 M^T`` (resp. ``A^T (A A^T + lambda^2 I)^-1``) with
+
+    lambda^2 = damping^2 (1 - (sigma / threshold)^2)   for sigma < threshold, else 0
+
+where ``sigma`` is the smallest singular value of the matrix inverted (exact for ``M``; for
+``A`` the lower bound ``2 sqrt(det A A^T) / trace(A A^T) = 2 sqrt(2) L1 |cos th1| /
+trace(A A^T)``, 0.73-0.88 of it). The damping rises continuously from 0 as ``sigma`` falls
+below ``threshold``. A singular value ``s`` of the matrix is mapped to the gain
+``s / (s^2 + lambda^2)``; with ``damping >= threshold`` (the defaults are equal) that gain
+is at most ``s / threshold^2`` inside the band and ``1 / s`` outside it, so it never exceeds
+``1 / threshold`` at any state (no cliff at the band edge). Hence the documented bounds
+(``sigma0 = threshold``, ``|.|`` the Euclidean norm, ``Xdot = (xEdot, yEdot, phiEdot)`` in
+m/s and rad/s)::
+
+    pseudoinverse:  |u| <= |Xdot| / sigma0                                 (pi_gain)
+    ats:            |u| <= (2 sqrt(1 + (L1 + L2)^2) / sigma0 + 1) |Xdot|    (ats_gain)
+
+(``ats``: ``|z| <= |r| / sigma0`` and ``|r| <= sqrt(1 + (L1+L2)^2) |Xdot|``; the other
+entries of ``u`` add at most ``|z| + |phiEdot|``.) With the defaults: 20 and 48.7 for the
+default robot. The threshold is chosen from that bound; ``sigma0 = 0.05`` damps only where
+``|cos th1| < 0.15`` for ``ats`` (``< 0.21-0.25`` for the pseudoinverse, depending on th2),
+so runs that stay away from the singularity are not changed by it.
 """
 
 from __future__ import annotations
 
 import math
 
-#: Default |cos(th1)| below which damping starts.
+#: Default smallest singular value below which damping starts (``sigma0``).
 SINGULARITY_THRESHOLD = 0.05
-#: Default maximum damping factor lambda (applied at cos(th1) = 0).
+#: Default damping factor lambda at the singularity (``>= sigma0``: the gain bound holds).
 MAX_DAMPING = 0.05
+_SQRT2 = math.sqrt(2.0)
 
 
-def damping_squared(cos_th1: float, threshold: float, damping: float) -> float:
-    """``lambda^2`` of the damped least squares: 0 when ``|cos th1| >= threshold``."""
-    ratio = abs(cos_th1) / threshold
+def damping_squared(sigma: float, threshold: float, damping: float) -> float:
+    """``lambda^2`` of the damped least squares for smallest singular value ``sigma``.
+
+    ``damping^2 (1 - (sigma/threshold)^2)`` below ``threshold``, 0 at and above it.
+    """
+    ratio = sigma / threshold
     if ratio >= 1.0:
         return 0.0
     return damping * damping * (1.0 - ratio * ratio)
+
+
+def pi_gain(threshold: float = SINGULARITY_THRESHOLD) -> float:
+    """Bound of ``|u| / |Xdot|`` of :func:`pseudoinverse` (when damping >= threshold)."""
+    return 1.0 / threshold
+
+
+def ats_gain(L1: float, L2: float, threshold: float = SINGULARITY_THRESHOLD) -> float:
+    """Bound of ``|u| / |Xdot|`` of :func:`ats` (when damping >= threshold)."""
+    return 2.0 * math.sqrt(1.0 + (L1 + L2) ** 2) / threshold + 1.0
+
+
+def smallest_singular_value_m(L1: float, cos_th1: float) -> float:
+    """Smallest singular value of the 2x2 ``M`` of the augmented system.
+
+    ``|M|_F^2 = 1 + L1^2`` and ``|det M| = L1 |cos th1|``, so
+    ``sigma_min^2 = 2 det^2 / (T + sqrt(T^2 - 4 det^2))`` with ``T = 1 + L1^2`` (the form
+    without cancellation near the singularity).
+    """
+    return math.sqrt(_sigma_min_squared_m(1.0 + L1 * L1, (L1 * cos_th1) ** 2))
+
+
+def _sigma_min_squared_m(total: float, det2: float) -> float:
+    return 2.0 * det2 / (total + math.sqrt(max(total * total - 4.0 * det2, 0.0)))
+
+
+def _ats_damping_squared(L1: float, cos_th1: float, threshold: float, damping: float) -> float:
+    """:func:`damping_squared` of ``M`` at ``sigma = sigma_min(M)``, without the square roots
+    outside the band: ``sigma_min(M) < threshold`` exactly when
+    ``det^2 < threshold^2 (T - threshold^2)`` (``sigma_1^2 = T - sigma_min^2``)."""
+    total = 1.0 + L1 * L1
+    det2 = (L1 * cos_th1) ** 2
+    threshold2 = threshold * threshold
+    if det2 >= threshold2 * (total - threshold2):
+        return 0.0
+    return damping * damping * (1.0 - _sigma_min_squared_m(total, det2) / threshold2)
 
 
 def _solve2(
@@ -73,7 +134,7 @@ def ats(
     a1 = phi + th1
     s1, c1 = math.sin(a1), math.cos(a1)
     s12, c12 = math.sin(a1 + th2), math.cos(a1 + th2)
-    lam2 = damping_squared(math.cos(th1), threshold, damping)
+    lam2 = _ats_damping_squared(L1, c * c1 + s * s1, threshold, damping)  # cos(a1 - phi)
     m12, m22 = -L1 * s1, L1 * c1
     if aux == "sum":
         w = phidot_e
@@ -104,17 +165,23 @@ def pseudoinverse(
     """Minimum-norm resolution ``qdot = J^# [Xdot; 0]`` in input form (damped near cos th1 = 0)."""
     c, s = math.cos(phi), math.sin(phi)
     a1 = phi + th1
+    s1, c1 = math.sin(a1), math.cos(a1)
     s12, c12 = math.sin(a1 + th2), math.cos(a1 + th2)
-    dx = -L1 * math.sin(a1) - L2 * s12
-    dy = L1 * math.cos(a1) + L2 * c12
+    dx = -L1 * s1 - L2 * s12
+    dy = L1 * c1 + L2 * c12
     ex, ey = -L2 * s12, L2 * c12
-    lam2 = damping_squared(math.cos(th1), threshold, damping)
     # Gram matrix G = A A^T of A = [[c, dx, dx, ex], [s, dy, dy, ey], [0, 1, 1, 1]].
-    g11 = c * c + 2.0 * dx * dx + ex * ex + lam2
+    g11 = c * c + 2.0 * dx * dx + ex * ex
     g12 = c * s + 2.0 * dx * dy + ex * ey
     g13 = 2.0 * dx + ex
-    g22 = s * s + 2.0 * dy * dy + ey * ey + lam2
+    g22 = s * s + 2.0 * dy * dy + ey * ey
     g23 = 2.0 * dy + ey
+    # det G = 2 L1^2 cos^2 th1 and sigma_1 sigma_2 <= trace(G) / 2 give the lower bound
+    # sigma_min(A) >= 2 sqrt(2) L1 |cos th1| / trace(G).
+    sigma = 2.0 * _SQRT2 * L1 * abs(c * c1 + s * s1) / (g11 + g22 + 3.0)
+    lam2 = damping_squared(sigma, threshold, damping)
+    g11 += lam2
+    g22 += lam2
     g33 = 3.0 + lam2
     # Solve G y = XEdot by the adjugate (G is symmetric positive definite).
     k11 = g22 * g33 - g23 * g23

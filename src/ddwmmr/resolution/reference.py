@@ -1,7 +1,9 @@
 """Start configurations and reference configuration trajectories.
 
 * :func:`start_configuration` places the robot's home arm pose on the trajectory start.
-* :func:`offset_configuration` moves the end effector by a small offset using the arm only.
+* :func:`offset_configuration` moves the end effector by a small offset using the arm only;
+  the offset is expressed in the end effector's frame, so whether the arm can reach it does
+  not depend on which way the trajectory starts.
 * :class:`ReferenceTrajectory` integrates ``q_d(t)`` from the desired task trajectory
   through the augmented task space resolution (RK4 on a fine grid, cubic Hermite lookup):
   the configuration-space reference of CLRRMC-CS (SPEC §4).
@@ -17,8 +19,12 @@ from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.resolution import kernels
 
-#: Default initial end-effector offset (m, world frame): closed-loop convergence shows.
-DEFAULT_INITIAL_OFFSET = (0.03, -0.03)
+#: Default initial end-effector offset (m) in the end effector's start frame (x along its
+#: orientation phiE, y to its left): 30 mm back and 30 mm to the right, 42.4 mm in all, so
+#: closed-loop convergence shows. On the default ellipse (start heading +y) this is the
+#: world offset (0.03, -0.03) m. Any start heading gives the same arm motion, which the
+#: home arm pose can always make (it moves E towards the arm mount).
+DEFAULT_INITIAL_OFFSET = (-0.03, -0.03)
 
 
 def start_configuration(robot: Robot, trajectory) -> np.ndarray:
@@ -30,10 +36,15 @@ def start_configuration(robot: Robot, trajectory) -> np.ndarray:
 def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
     """``q`` with the arm joints changed so the end effector moves by ``offset`` (dx, dy) m.
 
-    Newton iterations on the arm's 2x2 position Jacobian; the base does not move.
+    The offset is in the end effector's frame at ``q``: dx along its orientation phiE, dy
+    to its left. Newton iterations on the arm's 2x2 position Jacobian; the base does not
+    move. An offset the arm cannot reach raises :class:`ParameterError`.
     """
     q = np.array(q, dtype=float)
-    target = robot.fk(q)[:2] + np.asarray(offset, dtype=float)
+    dx, dy = (float(v) for v in offset)
+    x_e, y_e, phi_e = robot.fk(q)
+    c, s = math.cos(phi_e), math.sin(phi_e)
+    target = np.array([x_e + c * dx - s * dy, y_e + s * dx + c * dy])
     for _ in range(50):
         error = target - robot.fk(q)[:2]
         if float(np.hypot(*error)) < 1e-12:
@@ -42,16 +53,24 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
         if abs(np.linalg.det(arm_jacobian)) < 1e-9:
             break
         q[3:5] += np.linalg.solve(arm_jacobian, error)
-    dx, dy = (float(v) for v in offset)
-    raise ParameterError(f"initial_offset ({dx:g}, {dy:g}) m cannot be reached with the arm alone")
+    raise ParameterError(
+        f"initial_offset ({dx:g}, {dy:g}) m (end-effector frame) cannot be reached with the "
+        "arm alone"
+    )
 
 
 class ReferenceTrajectory:
     """Reference configurations ``q_d(t)`` and rates ``qdot_d(t)`` for a task trajectory.
 
     Integrated with classical RK4 at step ``step`` (s) through the augmented task space
-    resolution with auxiliary row ``aux``; extended lazily when queried past its end.
-    Lookups are cubic Hermite (fourth-order accurate, like the integrator).
+    resolution with auxiliary row ``aux`` (damped as in :func:`kernels.ats` with
+    ``threshold`` and ``damping``); extended lazily when queried past its end. Lookups are
+    cubic Hermite (fourth-order accurate, like the integrator).
+
+    Attributes:
+        singular_nodes: number of rate evaluations (nodes and RK4 stages) that were damped.
+        last_damped: whether the segment of the last lookup was integrated with damping at
+            any of its rate evaluations (how ``clrrmc-cs`` reports singular steps).
     """
 
     def __init__(
@@ -61,26 +80,45 @@ class ReferenceTrajectory:
         q_start: np.ndarray,
         aux: str = "shoulder",
         step: float = 0.01,
+        threshold: float = kernels.SINGULARITY_THRESHOLD,
+        damping: float = kernels.MAX_DAMPING,
     ) -> None:
         self.robot = robot
         self.trajectory = trajectory
         self.aux = aux
         self.step = float(step)
+        self.threshold = float(threshold)
+        self.damping = float(damping)
         self.singular_nodes = 0
+        self.last_damped = False
         q0 = [float(v) for v in q_start]
         self._q = [q0]
-        self._qdot = [self._rate(0.0, q0)]
+        rate, damped = self._rate(0.0, q0)
+        self._qdot = [rate]
+        self._node_damped = [damped]
+        #: Per segment: was any rate evaluation that defines it damped?
+        self._segment_damped: list[bool] = []
         #: Cubic coefficients of each segment, appended as the reference is integrated.
         self._coefficients: list[tuple[tuple[float, ...], ...]] = []
         self._end = -1.0  # queries up to this time need no extension
 
-    def _rate(self, t: float, q: list[float]) -> list[float]:
+    def _rate(self, t: float, q: list[float]) -> tuple[list[float], bool]:
         xd, yd, pd = self.trajectory.velocity(t).tolist()
         (v, w, t1, t2), singular = kernels.ats(
-            self.robot.L1, self.robot.L2, q[2], q[3], q[4], xd, yd, pd, self.aux
+            self.robot.L1,
+            self.robot.L2,
+            q[2],
+            q[3],
+            q[4],
+            xd,
+            yd,
+            pd,
+            self.aux,
+            self.threshold,
+            self.damping,
         )
         self.singular_nodes += singular
-        return [v * math.cos(q[2]), v * math.sin(q[2]), w, t1, t2]
+        return [v * math.cos(q[2]), v * math.sin(q[2]), w, t1, t2], singular
 
     def _extend_to(self, t: float) -> None:
         h = self.step
@@ -88,15 +126,18 @@ class ReferenceTrajectory:
             tk = (len(self._q) - 1) * h
             q = self._q[-1]
             k1 = self._qdot[-1]
-            k2 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k1)])
-            k3 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k2)])
-            k4 = self._rate(tk + h, [a + h * b for a, b in zip(q, k3)])
+            k2, d2 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k1)])
+            k3, d3 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k2)])
+            k4, d4 = self._rate(tk + h, [a + h * b for a, b in zip(q, k3)])
             q_next = [
                 a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
                 for a, b1, b2, b3, b4 in zip(q, k1, k2, k3, k4)
             ]
+            rate_next, d_next = self._rate(tk + h, q_next)
+            self._segment_damped.append(self._node_damped[-1] or d2 or d3 or d4 or d_next)
             self._q.append(q_next)
-            self._qdot.append(self._rate(tk + h, q_next))
+            self._qdot.append(rate_next)
+            self._node_damped.append(d_next)
             self._coefficients.append(self._segment(len(self._q) - 2))
 
     def _segment(self, i: int) -> tuple[tuple[float, ...], ...]:
@@ -117,6 +158,7 @@ class ReferenceTrajectory:
             self._end = (len(self._q) - 2) * self.step
         h = self.step
         i = min(int(t / h), len(self._q) - 2)
+        self.last_damped = self._segment_damped[i]
         s = t / h - i
         position, rate = [], []
         for c0, c1, c2, c3 in self._coefficients[i]:

@@ -30,6 +30,19 @@ def singularity_onset(ts: Mapping[str, np.ndarray]) -> int | None:
     return int(hits[0]) if len(hits) else None
 
 
+def singularity_outcome(ts: Mapping[str, np.ndarray]) -> tuple[str, int | None]:
+    """What the shoulder singularity did to a run: ``("away", None)`` if |cos th1| never
+    fell below :data:`SINGULAR_COS`, else ``("lost", onset)`` when the error afterwards
+    exceeds twice the largest error before it and :data:`SINGULAR_LOSS_M`, or
+    ``("passes", onset)``."""
+    onset = singularity_onset(ts)
+    if onset is None:
+        return "away", None
+    before = float(np.max(ts["position_error_m"][: onset + 1]))
+    after = float(np.max(ts["position_error_m"][onset:]))
+    return ("lost" if after > max(2.0 * before, SINGULAR_LOSS_M) else "passes"), onset
+
+
 def saturation_span(
     ts: Mapping[str, np.ndarray], exclude: np.ndarray | None = None
 ) -> tuple[int, float, float]:
@@ -106,21 +119,19 @@ def diagnose(
     saturation, kept offset (adverse) or convergence (not adverse)."""
     ts, summary = outputs[spec].timeseries, outputs[spec].summary
     findings = []
-    onset = singularity_onset(ts)
-    if onset is not None:
-        before = float(np.max(ts["position_error_m"][: onset + 1]))
+    outcome, onset = singularity_outcome(ts)
+    if outcome == "lost":
+        findings.append(Finding(_singularity_reason(spec, ts, onset, plan, outputs)))
+    elif outcome == "passes":
         after = float(np.max(ts["position_error_m"][onset:]))
-        if after > max(2.0 * before, SINGULAR_LOSS_M):
-            findings.append(Finding(_singularity_reason(spec, ts, onset, plan, outputs)))
-        else:
-            findings.append(
-                Finding(
-                    f"it passes the singularity cos(th1) = 0 at t = {ts['t'][onset]:.1f} s "
-                    f"without losing the path (largest error after it {mm(after)} mm)",
-                    False,
-                )
+        findings.append(
+            Finding(
+                f"it passes the singularity cos(th1) = 0 at t = {ts['t'][onset]:.1f} s "
+                f"without losing the path (largest error after it {mm(after)} mm)",
+                False,
             )
-            onset = None
+        )
+        onset = None
     jumps = orientation_jumps(ts)
     if jumps and summary["rms_orientation_error_rad"] > 0.5 and onset is None:
         findings.append(Finding(_corner_reason(spec, summary, jumps)))

@@ -1,10 +1,16 @@
 """What to run, and running it: :class:`CompareConfig`, :class:`RunSpec` and
-:class:`RunOutput`, the :class:`Plan` of runs per report section (main comparison,
+:class:`RunOutput`, the :class:`Plan` of runs per report section (main comparison under the
+chosen preset, the same under the other preset, the effect of each preset setting alone,
 explanatory variants, studies) and :func:`execute` (serial or in worker processes).
+
+Presets (:mod:`ddwmmr.controllers.presets`) enter the runs as options: a run under the
+``slides`` preset carries exactly the options whose slides value differs from the
+method's default, so a method the presets treat alike runs once and serves both rankings.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
@@ -13,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import make_controller
+from ddwmmr.controllers.presets import PRESETS, check_preset, preset_differences
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.progress import ProgressBar
@@ -46,9 +53,13 @@ class CompareConfig:
         robot: the robot every run uses.
         duration: simulated time per run (s); None = one period of each trajectory.
         studies: studies to run (subset of :data:`STUDIES`).
-        study_methods: methods the studies run (default: ``methods``); sweeping fewer
-            saves time when a method is slow.
+        study_methods: methods the studies run. Default: the compared methods except
+            those whose controller class sets ``in_studies = False`` (a slow method, such
+            as an MPC, is then compared and ranked but not swept); naming it here
+            includes it.
         command: the command line, quoted in the report so it can be reproduced.
+        preset: the option preset of the main comparison and the studies (``"default"``
+            or ``"slides"``); the report also ranks the methods under the other one.
     """
 
     methods: tuple[str, ...]
@@ -58,10 +69,22 @@ class CompareConfig:
     studies: tuple[str, ...] = STUDIES
     study_methods: tuple[str, ...] | None = None
     command: str = ""
+    preset: str = "default"
 
     def __post_init__(self) -> None:
+        check_preset(self.preset)
         if self.study_methods is None:
-            self.study_methods = tuple(self.methods)
+            self.study_methods = tuple(m for m in self.methods if in_studies(m))
+
+    @property
+    def other_preset(self) -> str:
+        """The preset the report compares the main one with."""
+        return next(p for p in PRESETS if p != self.preset)
+
+
+def in_studies(method: str) -> bool:
+    """Whether ``method`` runs in the studies by default (class attribute ``in_studies``)."""
+    return bool(getattr(make_controller(method, Robot()), "in_studies", True))
 
 
 @dataclass(frozen=True)
@@ -98,11 +121,18 @@ class Plan:
     main: list[RunSpec]
     variants: list[RunSpec] = field(default_factory=list)
     studies: dict[str, list[RunSpec]] = field(default_factory=dict)
+    #: The main runs under the other preset (same order as ``main``).
+    alternative: list[RunSpec] = field(default_factory=list)
+    #: The default settings with one slides setting applied, for methods whose presets
+    #: differ in more than one option (what each setting does on its own).
+    preset_effects: list[RunSpec] = field(default_factory=list)
 
     def all_specs(self) -> list[RunSpec]:
         """Every distinct run, in a fixed order (so results never depend on scheduling)."""
         seen: dict[RunSpec, None] = {}
-        for spec in [*self.main, *self.variants, *(s for v in self.studies.values() for s in v)]:
+        sections = [self.main, self.alternative, self.preset_effects, self.variants]
+        sections += list(self.studies.values())
+        for spec in (s for section in sections for s in section):
             seen.setdefault(spec, None)
         return list(seen)
 
@@ -117,10 +147,45 @@ def run_duration(config: CompareConfig, name: str) -> float:
     return config.duration if config.duration is not None else config.trajectories[name].duration
 
 
-def main_spec(config: CompareConfig, method: str, name: str, **changes: Any) -> RunSpec:
-    """The comparison's standard run of ``method`` on ``name`` with ``changes`` applied."""
+def preset_changes(method: str, preset: str) -> tuple[tuple[str, Any], ...]:
+    """Run options of ``preset`` for ``method``: the values that differ from its defaults."""
+    if preset == "default":
+        return ()
+    return tuple((key, slides) for key, (slides, _) in preset_differences(method).items())
+
+
+def main_spec(
+    config: CompareConfig, method: str, name: str, *, preset: str | None = None, **changes: Any
+) -> RunSpec:
+    """The comparison's standard run of ``method`` on ``name`` with ``changes`` applied.
+
+    ``preset`` defaults to the config's; ``options`` in ``changes`` override its values.
+    """
+    options = dict(preset_changes(method, config.preset if preset is None else preset))
+    options.update(changes.pop("options", ()))
     spec = {"dt": default_step(config.trajectories[name]), **changes}
-    return RunSpec(method, name, **spec)
+    return RunSpec(method, name, options=tuple(options.items()), **spec)
+
+
+def effect_specs(config: CompareConfig, method: str, name: str) -> list[RunSpec]:
+    """Default settings plus one slides setting, one run per differing option (only for
+    methods whose presets differ in more than one option)."""
+    differences = preset_differences(method)
+    if len(differences) < 2:
+        return []
+    return [
+        main_spec(config, method, name, preset="default", options=((key, slides),))
+        for key, (slides, _) in differences.items()
+    ]
+
+
+def study_tau(config: CompareConfig, method: str, tau: float) -> float | tuple[float, ...]:
+    """The ``tau`` option of the tau sweep: ``tau`` on every channel the preset feeds back
+    (a preset channel switched off with inf stays off, e.g. the slides' K3 = 0)."""
+    preset_tau = dict(preset_changes(method, config.preset)).get("tau")
+    if isinstance(preset_tau, tuple):
+        return tuple(tau if math.isfinite(v) else v for v in preset_tau)
+    return tau
 
 
 def accepts_option(method: str, option: str, value: Any) -> bool:
@@ -136,6 +201,12 @@ def plan_runs(config: CompareConfig) -> Plan:
     """The runs the report needs: main comparison, explanatory variants, studies."""
     names = list(config.trajectories)
     plan = Plan(main=[main_spec(config, m, n) for n in names for m in config.methods])
+    plan.alternative = [
+        main_spec(config, m, n, preset=config.other_preset) for n in names for m in config.methods
+    ]
+    plan.preset_effects = [
+        spec for n in names for m in config.methods for spec in effect_specs(config, m, n)
+    ]
     plan.variants = [
         main_spec(config, method, n, options=options)
         for method, options in VARIANTS
@@ -169,7 +240,7 @@ def tau_methods(config: CompareConfig) -> list[str]:
 def _plan_tau(config: CompareConfig) -> list[RunSpec]:
     names = [n for n in (STUDY_TRAJECTORY, CORNER_TRAJECTORY) if n in config.trajectories]
     return [
-        main_spec(config, m, n, options=(("tau", tau),))
+        main_spec(config, m, n, options=(("tau", study_tau(config, m, tau)),))
         for m in tau_methods(config)
         for n in names
         for tau in TAUS

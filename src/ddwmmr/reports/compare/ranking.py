@@ -100,10 +100,13 @@ class Ranking:
         return sorted(self.overall, key=lambda m: (self.overall_rank[m], self.overall[m], m))
 
 
-def build_ranking(plan: Plan, outputs: Mapping[RunSpec, RunOutput]) -> Ranking:
-    """Rank the main runs by :func:`score`, per trajectory and by geometric mean."""
+def build_ranking(
+    plan: Plan, outputs: Mapping[RunSpec, RunOutput], specs: Sequence[RunSpec] | None = None
+) -> Ranking:
+    """Rank the main runs (or ``specs``, e.g. ``plan.alternative``) by :func:`score`, per
+    trajectory and by geometric mean."""
     scores: dict[str, dict[str, float]] = {}
-    for spec in plan.main:
+    for spec in plan.main if specs is None else specs:
         scores.setdefault(spec.trajectory, {})[spec.method] = score(outputs[spec].summary)
     methods = list(next(iter(scores.values())))
     overall = {m: geometric_mean(scores[n][m] for n in scores) for m in methods}
@@ -145,14 +148,19 @@ class SlidesCheck:
 
 
 def check_slides(
-    config: CompareConfig, plan: Plan, outputs: Mapping[RunSpec, RunOutput], ranking: Ranking
+    config: CompareConfig,
+    plan: Plan,
+    outputs: Mapping[RunSpec, RunOutput],
+    ranking: Ranking,
+    specs: Sequence[RunSpec] | None = None,
 ) -> SlidesCheck:
-    """Test every pair the slides' chain implies (a before b: a at least as good as b)."""
+    """Test every pair the slides' chain implies (a before b: a at least as good as b) on
+    the runs ``specs`` that ``ranking`` ranked (default: the main runs)."""
     chain = [m for m in SLIDES_ORDER if m in config.methods]
     holds: dict[str, bool] = {}
     violations: list[Violation] = []
     reasons: dict[tuple[str, str], list[str]] = {}
-    by_key = {(s.method, s.trajectory): s for s in plan.main}
+    by_key = {(s.method, s.trajectory): s for s in (plan.main if specs is None else specs)}
     for name, scores in ranking.scores.items():
         found = [
             Violation(name, a, b, scores[a], scores[b])

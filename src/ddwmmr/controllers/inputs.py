@@ -1,0 +1,83 @@
+"""Validation of the arguments of ``Controller.command`` shared by every method.
+
+A NaN or an infinity in the configuration, the desired pose, the desired velocity or the
+time would otherwise come out of the closed-form methods as a NaN/inf command without a
+word (and the QP would count a fallback). :func:`check_inputs` turns it into a one-line
+:class:`~ddwmmr.errors.ParameterError` (a ``ValueError``) that names the argument.
+
+It runs every control step, so the common case (everything finite) is one sum over the
+values: a sum is finite only if every term is finite. Only when it is not (or when the
+arguments are not flat numeric sequences) does the slow path look at each argument, which
+also clears sums that merely overflowed. It returns the arguments as lists of floats, which
+the closed-form controllers work with anyway (one conversion instead of two).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.errors import ParameterError
+
+#: (argument, expected length, what its entries are) of ``command(t, q, pose_d, velocity_d)``.
+_ARGUMENTS = (
+    ("q", 5, "[x, y, phi, th1, th2] (m, rad)"),
+    ("pose_d", 3, "[xE, yE, phiE] (m, rad)"),
+    ("velocity_d", 3, "[xEdot, yEdot, phiEdot] (m/s, rad/s)"),
+)
+
+
+Lists = tuple[list[float], list[float], list[float]]
+_isfinite = math.isfinite
+
+
+def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
+    """Raise :class:`ParameterError` naming the first argument that is not finite.
+
+    Args:
+        t: time (s).
+        q: configuration, 5 numbers.
+        pose_d: desired end-effector pose, 3 numbers.
+        velocity_d: desired end-effector velocity, 3 numbers.
+
+    Returns:
+        ``(q, pose_d, velocity_d)`` as lists of floats.
+    """
+    try:
+        ql, pl, vl = q.tolist(), pose_d.tolist(), velocity_d.tolist()
+        values = ql + pl + vl
+        if len(values) == 11 and len(ql) == 5 and len(pl) == 3 and _isfinite(sum(values, t)):
+            return ql, pl, vl
+    except (AttributeError, TypeError):
+        pass
+    _check_each(t, q, pose_d, velocity_d)
+    return (
+        np.asarray(q, dtype=float).tolist(),
+        np.asarray(pose_d, dtype=float).tolist(),
+        np.asarray(velocity_d, dtype=float).tolist(),
+    )
+
+
+def _check_each(t: Any, q: Any, pose_d: Any, velocity_d: Any) -> None:
+    """The slow path: check every argument on its own and name the bad one."""
+    try:
+        time = float(t)
+    except (TypeError, ValueError):
+        raise ParameterError(f"t must be a finite time in s (got {t!r})") from None
+    if not math.isfinite(time):
+        raise ParameterError(f"t must be a finite time in s (got {time!r})")
+    for (name, size, entries), value in zip(_ARGUMENTS, (q, pose_d, velocity_d)):
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise ParameterError(f"{name} must be {size} finite numbers {entries}") from None
+        if array.shape != (size,):
+            raise ParameterError(
+                f"{name} must be {size} finite numbers {entries} (got shape {array.shape})"
+            )
+        if not np.all(np.isfinite(array)):
+            raise ParameterError(
+                f"{name} must be {size} finite numbers {entries} (got {array.tolist()})"
+            )

@@ -1,0 +1,240 @@
+""" "Which method should I use": a profile of every method from the main runs (accuracy,
+step time, offset removal, tip-over stability guarantee, singularity behaviour) and one
+recommendation per use case, each computed from the runs of the report (nothing here is
+a fixed opinion: another robot or trajectory gives other lines).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from ddwmmr.reports.compare.constants import CORNER_TRAJECTORY, SLIDES_ORDER, STUDY_TRAJECTORY
+from ddwmmr.reports.compare.diagnosis import convergence_time, keeps_offset, singularity_outcome
+from ddwmmr.reports.compare.document import fmt, mm
+from ddwmmr.reports.compare.plan import CompareConfig, RunOutput, RunSpec, main_spec
+from ddwmmr.reports.compare.ranking import Ranking, at_least_as_good
+
+
+@dataclass
+class Profile:
+    """What the main runs say about one method.
+
+    Attributes:
+        scores: trajectory -> RMS position error (m).
+        step_us: median over the trajectories of the run's median step time (us).
+        settle_trajectory: the trajectory the offset removal is judged on (the study
+            trajectory, the ellipse, when it ran: the rectangle's corners bring the error
+            back above 5 % of the offset for every method).
+        settle_s: time (s) after which the error stays below 5 % of the initial offset
+            there (NaN: never).
+        open_loop: it kept the initial offset on some trajectory (no pose feedback).
+        stability_floor: the hard floor S_min the method enforces, None if it has none.
+        stability_violations: steps below that floor, summed over the runs.
+        min_stability: smallest tip-over margin S over the runs.
+        singularity: trajectory -> (``away`` | ``passes`` | ``lost``, time in s or NaN).
+        min_cos_th1: smallest |cos th1| over the runs.
+    """
+
+    method: str
+    scores: dict[str, float]
+    step_us: float
+    settle_trajectory: str
+    settle_s: float
+    open_loop: bool
+    stability_floor: float | None
+    stability_violations: int
+    min_stability: float
+    singularity: dict[str, tuple[str, float]]
+    min_cos_th1: float
+
+    @property
+    def converges(self) -> bool:
+        """It removed the initial offset (on :attr:`settle_trajectory`)."""
+        return not math.isnan(self.settle_s)
+
+
+def profiles(
+    config: CompareConfig, outputs: Mapping[RunSpec, RunOutput], ranking: Ranking
+) -> list[Profile]:
+    """One :class:`Profile` per compared method, best ranked first."""
+    result = []
+    names = list(config.trajectories)
+    settle_on = STUDY_TRAJECTORY if STUDY_TRAJECTORY in names else names[0]
+    for method in ranking.order:
+        runs = {n: outputs[main_spec(config, method, n)] for n in config.trajectories}
+        summaries = [r.summary for r in runs.values()]
+        floors = [s["stability_min"] for s in summaries if s.get("stability_min") is not None]
+        singularity = {}
+        for name, run in runs.items():
+            outcome, onset = singularity_outcome(run.timeseries)
+            time = math.nan if onset is None else float(run.timeseries["t"][onset])
+            singularity[name] = (outcome, time)
+        result.append(
+            Profile(
+                method=method,
+                scores={n: ranking.scores[n][method] for n in ranking.scores},
+                step_us=float(np.median([s["median_step_us"] for s in summaries])),
+                settle_trajectory=settle_on,
+                settle_s=convergence_time(
+                    runs[settle_on].timeseries["t"], runs[settle_on].timeseries["position_error_m"]
+                ),
+                open_loop=any(keeps_offset(s) for s in summaries),
+                stability_floor=min(floors) if floors else None,
+                stability_violations=sum(int(s.get("stability_violations", 0)) for s in summaries),
+                min_stability=min(float(s["min_stability"]) for s in summaries),
+                singularity=singularity,
+                min_cos_th1=min(
+                    float(np.min(np.abs(np.cos(r.timeseries["th1"])))) for r in runs.values()
+                ),
+            )
+        )
+    return result
+
+
+ADVICE_HEADERS = [
+    "method",
+    "RMS per trajectory (mm)",
+    "step (us)",
+    "initial offset",
+    "tip-over stability",
+    "shoulder singularity cos th1 = 0",
+]
+
+
+def advice_rows(items: Sequence[Profile]) -> list[list[str]]:
+    """One table row per method (see :data:`ADVICE_HEADERS`)."""
+    return [
+        [
+            p.method,
+            ", ".join(f"{n} {mm(v)}" for n, v in p.scores.items()),
+            fmt(p.step_us),
+            _offset_text(p),
+            _stability_text(p),
+            _singularity_text(p),
+        ]
+        for p in items
+    ]
+
+
+def _offset_text(p: Profile) -> str:
+    if p.converges:
+        return f"removed: below 5 % after {fmt(p.settle_s)} s on the {p.settle_trajectory}"
+    if p.open_loop:
+        return "kept (open loop, no pose feedback)"
+    return f"not removed on the {p.settle_trajectory}"
+
+
+def _stability_text(p: Profile) -> str:
+    if p.stability_floor is not None:
+        return (
+            f"hard constraint S >= {fmt(p.stability_floor)} "
+            f"({p.stability_violations} steps below it)"
+        )
+    return f"not enforced (min S {fmt(p.min_stability)} on this robot)"
+
+
+def _singularity_text(p: Profile) -> str:
+    outcomes = {o for o, _ in p.singularity.values()}
+    if outcomes == {"away"}:
+        return f"stays away (min |cos th1| {fmt(p.min_cos_th1, 2)})"
+    parts = []
+    for name, (outcome, time) in p.singularity.items():
+        if outcome == "lost":
+            parts.append(f"{name}: reaches it at {fmt(time)} s and loses the path")
+        elif outcome == "passes":
+            parts.append(f"{name}: passes it at {fmt(time)} s, keeps the path")
+    return "; ".join(parts)
+
+
+def recommendations(items: Sequence[Profile], slides: Ranking | None = None) -> list[str]:
+    """One line per use case, from the profiles (best ranked first) and the ranking under
+    the slides' settings (``slides``)."""
+    lines = [_best_line("Best tracking over all trajectories", items, _overall)]
+    for name, label in ((STUDY_TRAJECTORY, "Smooth paths"), (CORNER_TRAJECTORY, "Sharp corners")):
+        if items and name in items[0].scores:
+            lines.append(
+                _best_line(f"{label} (like the {name})", items, lambda p, n=name: p.scores[n])
+            )
+    closed = [p for p in items if p.converges]
+    if closed:
+        fastest = min(closed, key=lambda p: p.step_us)
+        lines.append(
+            f"**Tightest step-time budget with feedback**: `{fastest.method}` "
+            f"({fmt(fastest.step_us)} us per step on this machine; it removes the initial "
+            f"offset, below 5 % after {fmt(fastest.settle_s)} s on the "
+            f"{fastest.settle_trajectory})."
+        )
+    guarded = [p for p in items if p.stability_floor is not None and p.stability_violations == 0]
+    if guarded:
+        names = ", ".join(f"`{p.method}` (S >= {fmt(p.stability_floor)})" for p in guarded)
+        lines.append(
+            f"**Tip-over stability as a hard guarantee**: {names}; no other compared method "
+            "constrains S."
+        )
+    else:
+        lines.append(
+            "**Tip-over stability as a hard guarantee**: none of the compared methods "
+            "enforces a floor on S (the `qp` method does)."
+        )
+    lines.append(_singularity_line(items))
+    open_loop = [p for p in items if p.open_loop and not p.converges]
+    if open_loop:
+        best = min(open_loop, key=_overall)
+        lines.append(
+            f"**No pose measurement (feed-forward only)**: `{best.method}` (best open-loop "
+            f"score, overall {mm(_overall(best))} mm; it keeps any initial offset)."
+        )
+    ours = [m for m in slides.order if m in SLIDES_ORDER] if slides is not None else []
+    if ours:
+        best = ours[0]
+        scores = ", ".join(f"{n} {mm(v[best])} mm" for n, v in slides.scores.items())
+        lines.append(
+            "**Reproducing the slides**: `--preset slides` (their auxiliary row and gains); the "
+            f"best of their methods under their settings is `{best}` ({scores})."
+        )
+    return lines
+
+
+def _overall(p: Profile) -> float:
+    logs = [math.log(max(v, 1e-15)) for v in p.scores.values()]
+    return math.exp(sum(logs) / len(logs))
+
+
+def _best_line(label: str, items: Sequence[Profile], key) -> str:
+    """The best method by ``key`` and everything tied with it; the fastest tied one first."""
+    best = min(key(p) for p in items)
+    tied = sorted((p for p in items if at_least_as_good(key(p), best)), key=lambda p: p.step_us)
+    first, others = tied[0], tied[1:]
+    text = f"**{label}**: `{first.method}` ({mm(key(first))} mm RMS, {fmt(first.step_us)} us)"
+    if others:
+        text += "; tied with it within 5 % but slower per step: " + ", ".join(
+            f"`{p.method}` ({mm(key(p))} mm, {fmt(p.step_us)} us)" for p in others
+        )
+    return text + "."
+
+
+def _singularity_line(items: Sequence[Profile]) -> str:
+    lost = [p.method for p in items if any(o == "lost" for o, _ in p.singularity.values())]
+    passes = [
+        p.method
+        for p in items
+        if p.method not in lost and any(o == "passes" for o, _ in p.singularity.values())
+    ]
+    away = [p.method for p in items if p.method not in lost and p.method not in passes]
+    text = "**Near the shoulder singularity cos th1 = 0**: "
+    parts = []
+    if passes:
+        parts.append(f"{_names(passes)} pass it and keep the path")
+    if away:
+        parts.append(f"{_names(away)} stay away from it on these trajectories")
+    if lost:
+        parts.append(f"avoid {_names(lost)}: they are driven into it and lose the path")
+    return text + "; ".join(parts) + "."
+
+
+def _names(methods: Sequence[str]) -> str:
+    return ", ".join(f"`{m}`" for m in methods)

@@ -1,0 +1,143 @@
+"""The slides' settings against the library's: the table of settings that differ, the
+results of every method under both presets, and the effect of each setting on its own.
+
+The runs come from :class:`~ddwmmr.reports.compare.plan.Plan` (``main`` under the chosen
+preset, ``alternative`` under the other one, ``preset_effects`` with one slides setting
+applied to the defaults); the settings from :mod:`ddwmmr.controllers.presets`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+from ddwmmr.controllers.presets import preset_differences
+from ddwmmr.reports.compare.document import fmt, mm
+from ddwmmr.reports.compare.plan import CompareConfig, Plan, RunOutput, RunSpec
+
+#: What each option means, for the settings table.
+OPTION_NAMES = {"aux": "auxiliary row of J_aug", "tau": "time constants (x, y, phi)"}
+
+
+def value_text(key: str, value: Any) -> str:
+    """A preset value in words (``aux = sum`` -> ``sum [0 0 0 1 1]: th1dot + th2dot = 0``)."""
+    if key == "aux":
+        return {
+            "sum": "sum [0 0 0 1 1]: th1dot + th2dot = 0",
+            "shoulder": "shoulder [0 0 0 1 0]: th1dot = 0",
+        }.get(value, str(value))
+    if key == "tau":
+        values = value if isinstance(value, tuple | list) else (value,) * 3
+        gains = ", ".join("0" if math.isinf(v) else f"{1.0 / v:g}" for v in values)
+        text = f"({', '.join(f'{v:g}' for v in values)}) s, K = ({gains}) 1/s"
+        return text + (": no orientation feedback" if math.isinf(values[-1]) else "")
+    return fmt(value) if isinstance(value, float) else str(value)
+
+
+def setting_rows(methods: Sequence[str]) -> list[list[str]]:
+    """``[method, setting, slides, ours]`` for every option the presets set differently."""
+    rows = []
+    for method in methods:
+        for key, (slides, ours) in preset_differences(method).items():
+            rows.append(
+                [method, OPTION_NAMES.get(key, key), value_text(key, slides), value_text(key, ours)]
+            )
+    return rows
+
+
+def runs_by_preset(config: CompareConfig, plan: Plan) -> dict[str, dict[tuple[str, str], RunSpec]]:
+    """preset -> (method, trajectory) -> the run of the main comparison under it."""
+    return {
+        preset: {(s.method, s.trajectory): s for s in specs}
+        for preset, specs in ((config.preset, plan.main), (config.other_preset, plan.alternative))
+    }
+
+
+def result_rows(
+    config: CompareConfig, plan: Plan, outputs: Mapping[RunSpec, RunOutput]
+) -> list[list[str]]:
+    """``[method, trajectory, RMS slides, RMS ours, final slides, final ours]`` (mm) and
+    the singular / saturated steps under both, for every method whose presets differ (the
+    others run once and are the same in both)."""
+    runs = runs_by_preset(config, plan)
+    rows = []
+    for name in config.trajectories:
+        for method in config.methods:
+            if not preset_differences(method):
+                continue
+            slides = outputs[runs["slides"][(method, name)]].summary
+            ours = outputs[runs["default"][(method, name)]].summary
+            rows.append(
+                [method, name]
+                + [mm(s[key]) for key in _ERRORS for s in (slides, ours)]
+                + [fmt(s[_ORIENTATION]) for s in (slides, ours)]
+                + [f"{fmt(s[key])} / {fmt(o[key])}" for key in _COUNTS for s, o in [(slides, ours)]]
+            )
+    return rows
+
+
+#: Error columns (m, written in mm) and step counts of :func:`result_rows`.
+_ERRORS = ("rms_position_error_m", "final_position_error_m")
+_ORIENTATION = "rms_orientation_error_rad"
+_COUNTS = ("singular_steps", "saturated_steps")
+RESULT_HEADERS = [
+    "method",
+    "trajectory",
+    "RMS slides (mm)",
+    "RMS ours (mm)",
+    "final slides (mm)",
+    "final ours (mm)",
+    "RMS orient. slides (rad)",
+    "RMS orient. ours (rad)",
+    "singular steps slides / ours",
+    "saturated steps slides / ours",
+]
+EFFECT_HEADERS = [
+    "method",
+    "trajectory",
+    "ours with only this slides setting",
+    "RMS (mm)",
+    "RMS ours (mm)",
+    "RMS slides (mm)",
+    "RMS orient. (rad)",
+    "RMS orient. ours (rad)",
+]
+SETTING_HEADERS = ["method", "setting", "slides", "ours"]
+
+
+def effect_rows(
+    config: CompareConfig, plan: Plan, outputs: Mapping[RunSpec, RunOutput]
+) -> list[list[str]]:
+    """``[method, trajectory, setting, RMS with it alone, RMS ours, RMS slides]`` (mm) for
+    the methods whose presets differ in more than one option."""
+    runs = runs_by_preset(config, plan)
+    rows = []
+    for spec in plan.preset_effects:
+        (key, value), *_ = spec.options
+        key_pair = (spec.method, spec.trajectory)
+        alone = outputs[spec].summary
+        ours = outputs[runs["default"][key_pair]].summary
+        slides = outputs[runs["slides"][key_pair]].summary
+        rows.append(
+            [
+                spec.method,
+                spec.trajectory,
+                f"{OPTION_NAMES.get(key, key)} = {value_text(key, value)}",
+            ]
+            + [mm(s["rms_position_error_m"]) for s in (alone, ours, slides)]
+            + [fmt(s[_ORIENTATION]) for s in (alone, ours)]
+        )
+    return rows
+
+
+def same_in_both() -> list[str]:
+    """Settings that are the same in both presets, and why (for the report's notes)."""
+    return [
+        "`ap`: the slides' potential V = 0.66 phi^2 + th1^2 + 0.25 th2^2 is also the "
+        "library's default (the explanatory run with K3 = 0 shows what it costs)",
+        "time constants: the slides give no numbers; tau = 0.5 s in both",
+        "damping near cos th1 = 0: the slides invert J_aug and take J^# undamped, which is "
+        "unbounded at the singularity; both presets use the same damped least squares",
+        "robot, start configuration, initial offset, integrator (rk4) and step: the same runs",
+    ]
