@@ -13,6 +13,7 @@ import pytest
 import ddwmmr
 from ddwmmr import Robot, load_trajectory, simulate
 from ddwmmr.cli.track import main as run
+from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
 from expected import REQUIRED_SUMMARY_KEYS
 
 
@@ -152,7 +153,7 @@ def _rows_without_timing(path):
     "args",
     [
         ["--method", "clrrmc-ts", "--traj", "rectangle", "--tau", "0.3", "0.3", "inf",
-         "--duration", "3", "--integrator", "euler", "--offset", "0.05", "0.01"],
+         "--duration", "3", "--integrator", "euler", "--offset", "-0.04", "0.02"],
         ["--method", "ap", "--traj", "figure8", "--duration", "2", "--dt", "0.03",
          "--payload", "2.5"],
         ["--method", "qp", "--traj", "ellipse", "--obstacles", "ellipse_post",
@@ -198,7 +199,9 @@ def test_run_record_holds_everything_to_rerun(tmp_path):
     data = Path(trajectory["file"]).read_bytes()
     assert trajectory["sha256"] == hashlib.sha256(data).hexdigest()
     assert record["dt"] == 60.0 / 241 and record["duration"] == 1.0
-    assert record["integrator"] == "rk4" and record["initial_offset"] == [0.03, -0.03]
+    assert record["integrator"] == "rk4" and record["initial_offset"] == list(
+        DEFAULT_INITIAL_OFFSET
+    )
     assert record["plant"] == {"name": "kinematic"} and record["seed"] is None
     git = record["git"]
     assert git is None or len(git["commit"]) == 40

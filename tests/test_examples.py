@@ -14,7 +14,11 @@ import numpy as np
 import pytest
 
 from ddwmmr import Ellipse, Robot
-from ddwmmr.resolution.reference import offset_configuration, start_configuration
+from ddwmmr.resolution.reference import (
+    DEFAULT_INITIAL_OFFSET,
+    offset_configuration,
+    start_configuration,
+)
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 SCRIPTS = sorted(EXAMPLES.glob("*.py"))
@@ -64,7 +68,7 @@ def test_example_runs(script: Path, printed) -> None:
 
 
 # -- the examples' numbers against independent expectations --------------------------------
-#: Initial end-effector offset of every example run (simulate's default, 30 mm, -30 mm).
+#: Initial end-effector offset of every example run (simulate's default, |(-30, -30)| mm).
 E0 = math.hypot(0.03, -0.03)
 
 
@@ -101,7 +105,7 @@ def test_quickstart_first_command_tracks_with_the_feedback(printed) -> None:
     v, w, th1dot, th2dot = _numbers(line.split("=")[1])
     assert th1dot == 0.0
     robot, trajectory = Robot(), Ellipse()
-    q = offset_configuration(robot, start_configuration(robot, trajectory), (0.03, -0.03))
+    q = offset_configuration(robot, start_configuration(robot, trajectory), DEFAULT_INITIAL_OFFSET)
     qdot = np.array([v * math.cos(q[2]), v * math.sin(q[2]), w, th1dot, th2dot])
     h = 1e-6
     moved = (robot.fk(q + h * qdot) - robot.fk(q - h * qdot)) / (2 * h)

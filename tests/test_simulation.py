@@ -95,7 +95,7 @@ def test_larger_tau_is_more_sluggish():
     assert errors[-1] > 10 * errors[0]
 
 
-def drift(integrator, dt, key="final_position_error_m"):
+def drift(integrator, dt, key="end_position_error_m"):
     """Open-loop drift of ats on the ellipse, started on the path."""
     return simulate(
         Robot(), Ellipse(), "ats", integrator=integrator, dt=dt, initial_offset=ON_TRACK
