@@ -1,0 +1,998 @@
+"""The simulator window: control panel, view with live plots, run/playback, export.
+
+One matplotlib figure holds everything (``App(figure)``); with the Tk backend it is a
+desktop window, with Agg it is drawn off-screen (tests, ``--snapshot``). The app never
+simulates by itself: Run builds the controllers with :func:`ddwmmr.make_controller` and
+calls :func:`ddwmmr.simulate` (through :func:`ddwmmr.gui.settings.simulate_settings`) in a
+background :class:`~ddwmmr.gui.worker.Worker`; the finished run is then played back (the
+time slider scrubs it).
+
+Every handler is guarded: a bad value shows a one-line message in the window and the
+previous valid setting stays; an unexpected error is shown the same way, never as a
+traceback that ends the app.
+"""
+
+from __future__ import annotations
+
+import datetime
+import functools
+import textwrap
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
+from matplotlib.widgets import Slider
+
+from ddwmmr.controllers.base import available_methods
+from ddwmmr.errors import ParameterError
+from ddwmmr.gui import export
+from ddwmmr.gui.options import OptionSpec, format_choice, method_options, plant_names
+from ddwmmr.gui.settings import (
+    GEOMETRY,
+    SLOTS,
+    Settings,
+    build_controller,
+    build_trajectory,
+    check_geometry,
+    check_settings,
+    geometry_of,
+    simulate_settings,
+)
+from ddwmmr.gui.view import RunView, add_view_axes
+from ddwmmr.gui.widgets import (
+    FONT,
+    CycleButton,
+    Field,
+    button,
+    describe_error,
+    panel_axes,
+    radio,
+    set_radio_silently,
+)
+from ddwmmr.gui.worker import Worker
+from ddwmmr.plants.kinematic import INTEGRATORS
+from ddwmmr.trajectories import available_trajectories, load_trajectory
+
+#: Window size (inches) and resolution of the window and its snapshot.
+FIGSIZE = (16.0, 10.0)
+DPI = 100
+#: Entry of the trajectory list that stands for the path typed in the file field.
+FILE_ENTRY = "file"
+#: Entry of slot B's list that switches the side-by-side mode off.
+OFF_ENTRY = "off"
+#: Playback speeds (simulated seconds per wall-clock second).
+SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
+DEFAULT_SPEED = 4.0
+#: Playback frame and progress poll intervals (ms).
+FRAME_MS = 40
+POLL_MS = 100
+#: Method options shown per page (two columns).
+OPTIONS_PER_PAGE = 12
+PAYLOAD_RANGE = (0.0, 5.0)
+
+
+def guarded(handler: Callable[..., Any]) -> Callable[..., Any]:
+    """Show any error of a widget handler in the window instead of raising it."""
+
+    @functools.wraps(handler)
+    def wrapper(self: App, *args: Any, **kwargs: Any) -> Any:
+        try:
+            return handler(self, *args, **kwargs)
+        except Exception as exc:  # the window must survive anything a handler meets
+            self.say(describe_error(exc), error=True)
+        return None
+
+    return wrapper
+
+
+class _OptionGroup:
+    """The option widgets of one method in one slot (created when first shown)."""
+
+    def __init__(self, specs: tuple[OptionSpec, ...], widgets: list[Field | CycleButton]) -> None:
+        self.specs = specs
+        self.widgets = widgets
+
+    @property
+    def pages(self) -> int:
+        return max(1, -(-len(self.widgets) // OPTIONS_PER_PAGE))
+
+    def set_visible(self, visible: bool, page: int = 0) -> None:
+        for number, widget in enumerate(self.widgets):
+            widget.set_visible(visible and number // OPTIONS_PER_PAGE == page)
+
+
+class App:
+    """The simulator window in ``figure`` (see the module docstring).
+
+    Args:
+        figure: an empty figure with a canvas (Tk for a desktop window, Agg off-screen).
+        settings: initial settings (checked; bad ones raise :class:`ParameterError`).
+        interactive: run timers for playback and progress (a desktop window); off-screen
+            apps are advanced by :meth:`wait` and :meth:`advance`.
+    """
+
+    def __init__(
+        self, figure: Figure, settings: Settings | None = None, interactive: bool = False
+    ) -> None:
+        self.figure = figure
+        self.interactive = interactive
+        self.settings = check_settings(settings or Settings())
+        self.results: list[Any] | None = None
+        self.run_settings: Settings | None = None
+        self.worker: Worker | None = None
+        self.playing = False
+        self.message = ""
+        self.failure: tuple[str, bool] | None = None
+        self.export_dir: Path | None = None
+        self._run_stamp = ""
+        self._options_slot = 0
+        self._options_page = 0
+        self._groups: dict[tuple[int, str], _OptionGroup] = {}
+        self._last_tick = 0.0
+        self._moving_slider = False
+        self._build()
+        for widget in self._drawing_widgets():
+            widget.drawon = interactive
+        self.time_slider.drawon = False  # drawn with the playback frames (see _refresh)
+        self._canvas = figure.canvas
+        self._blitting = interactive and figure.canvas.supports_blit
+        self._background = None
+        if self._blitting:
+            figure.canvas.mpl_connect("draw_event", self._on_full_draw)
+        self._sync_widgets()
+        self._preview()
+        self._play_timer = figure.canvas.new_timer(interval=FRAME_MS)
+        self._play_timer.add_callback(self._on_frame)
+        self._poll_timer = figure.canvas.new_timer(interval=POLL_MS)
+        self._poll_timer.add_callback(self._poll)
+        self.closed = False
+        self.frames_shown = 0  # instants drawn by show_index (playback frames)
+        figure.canvas.mpl_connect("close_event", self._on_close)
+
+    # ================================================================ layout
+    def _build(self) -> None:
+        fig = self.figure
+        fig.text(0.012, 0.972, "ddwmmr simulator", fontsize=13, weight="bold")
+        fig.text(0.15, 0.974, "python -m ddwmmr.gui", fontsize=FONT, color="0.4")
+        self._build_trajectory()
+        self._build_methods()
+        self._build_options()
+        self._build_simulation()
+        self._build_export()
+        self._build_messages()
+        self._build_view()
+        self._build_transport()
+
+    def _drawing_widgets(self) -> list[Any]:
+        """Widgets that redraw the canvas themselves when set (radios, sliders)."""
+        return [
+            self.traj_radio,
+            *self.method_radios,
+            self.plant_radio,
+            self.integrator_radio,
+            self.payload_slider,
+            self.speed_slider,
+            self.time_slider,
+        ]
+
+    def _heading(self, x: float, y: float, text: str):
+        return self.figure.text(x, y, text, fontsize=FONT + 1.5, weight="bold", color="0.15")
+
+    def _build_trajectory(self) -> None:
+        self._heading(0.012, 0.945, "Trajectory")
+        names = [*available_trajectories(), FILE_ENTRY]
+        height = min(0.026 * len(names), 0.16)
+        self.traj_radio = radio(self.figure, (0.008, 0.935 - height, 0.12, height), names, 0)
+        self.traj_radio.on_clicked(self._on_trajectory)
+        self.file_field = Field(
+            self.figure,
+            (0.032, 0.905 - height, 0.128, 0.024),
+            "file",
+            "",
+            self._apply_file,
+            self._report,
+        )
+        self.figure.text(
+            0.012,
+            0.885 - height,
+            ".toml (ellipse/rectangle) or .csv t,x,y[,phi]",
+            fontsize=FONT - 1,
+            color="0.4",
+        )
+        self._heading(0.19, 0.945, "Geometry")
+        self.geometry_fields: dict[str, Field] = {}
+        for row, (name, unit, allowed) in enumerate(GEOMETRY):
+            label = name if unit == "-" else f"{name} ({unit})"
+            self.geometry_fields[name] = Field(
+                self.figure,
+                (0.235, 0.912 - 0.027 * row, 0.06, 0.023),
+                label,
+                "",
+                functools.partial(self._apply_geometry, name),
+                self._report,
+                hint=allowed,
+            )
+
+    def _build_methods(self) -> None:
+        methods = available_methods()
+        top = 0.72
+        self._heading(0.012, top + 0.008, "Method A")
+        self._heading(0.122, top + 0.008, "Compare: B")
+        height_a = min(0.026 * len(methods), 0.2)
+        height_b = min(0.026 * (len(methods) + 1), 0.2)
+        self.method_radios = [
+            radio(self.figure, (0.008, top - height_a, 0.11, height_a), methods, 0),
+            radio(self.figure, (0.118, top - height_b, 0.11, height_b), [OFF_ENTRY, *methods], 0),
+        ]
+        self.method_radios[0].on_clicked(functools.partial(self._on_method, 0))
+        self.method_radios[1].on_clicked(functools.partial(self._on_method, 1))
+        self._heading(0.235, top + 0.008, "Plant")
+        plants = plant_names()
+        height = 0.026 * len(plants)
+        self.plant_radio = radio(self.figure, (0.232, top - height, 0.1, height), plants, 0)
+        self.plant_radio.on_clicked(self._on_plant)
+        below = top - height - 0.02
+        self._heading(0.235, below, "Integrator")
+        height = 0.026 * len(INTEGRATORS)
+        self.integrator_radio = radio(
+            self.figure, (0.232, below - 0.008 - height, 0.1, height), list(INTEGRATORS), 0
+        )
+        self.integrator_radio.on_clicked(self._on_integrator)
+        self._methods_bottom = min(top - height_b, below - 0.008 - height)
+
+    def _build_options(self) -> None:
+        top = self._methods_bottom - 0.02
+        self._options_top = top - 0.012
+        self.options_title = self._heading(0.012, top, "Options")
+        self.options_slot_button = CycleButton(
+            self.figure,
+            (0.19, top - 0.004, 0.07, 0.022),
+            "edit",
+            list(SLOTS),
+            "A",
+            self._apply_options_slot,
+            self._report,
+        )
+        self.options_page_button = CycleButton(
+            self.figure,
+            (0.265, top - 0.004, 0.065, 0.022),
+            "page",
+            [1],
+            1,
+            self._apply_options_page,
+            self._report,
+        )
+        self.options_note = self.figure.text(
+            0.012, self._options_top - 0.03 * 6 - 0.018, "", fontsize=FONT - 1, color="0.4"
+        )
+
+    def _build_simulation(self) -> None:
+        top = self._options_top - 0.03 * 6 - 0.048
+        self._heading(0.012, top, "Simulation")
+        self.payload_ax = panel_axes(self.figure, (0.09, top - 0.03, 0.17, 0.02))
+        self.payload_slider = Slider(
+            self.payload_ax,
+            "payload (kg)",
+            *PAYLOAD_RANGE,
+            valinit=self.settings.payload,
+            valstep=0.05,
+            valfmt="%.2f kg",
+        )
+        self.payload_slider.label.set_fontsize(FONT)
+        self.payload_slider.valtext.set_fontsize(FONT)
+        self.payload_slider.on_changed(self._on_payload)
+        row = top - 0.062
+        self.dt_field = Field(
+            self.figure,
+            (0.09, row, 0.06, 0.023),
+            "dt (s)",
+            "",
+            self._apply_dt,
+            self._report,
+            hint="blank: T/N",
+        )
+        self.duration_field = Field(
+            self.figure,
+            (0.255, row, 0.05, 0.023),
+            "duration (s)",
+            "",
+            self._apply_duration,
+            self._report,
+            hint="blank: T",
+        )
+        self.offset_field = Field(
+            self.figure,
+            (0.09, row - 0.03, 0.09, 0.023),
+            "offset dx dy (m)",
+            "",
+            self._apply_offset,
+            self._report,
+            hint="start error of the end effector",
+        )
+        self._simulation_bottom = row - 0.03
+
+    def _build_export(self) -> None:
+        top = self._simulation_bottom - 0.035
+        self._heading(0.012, top, "Export")
+        self.export_field = Field(
+            self.figure,
+            (0.09, top - 0.032, 0.24, 0.023),
+            "folder",
+            "runs/gui",
+            self._apply_export_dir,
+            self._report,
+        )
+        row = top - 0.07
+        self.export_buttons = {
+            "data": button(self.figure, (0.012, row, 0.075, 0.028), "CSV + JSON", self.export_data),
+            "png": button(self.figure, (0.092, row, 0.075, 0.028), "PNG (window)", self.export_png),
+            "gif": button(
+                self.figure,
+                (0.172, row, 0.075, 0.028),
+                "GIF",
+                functools.partial(self.export_animation, "gif"),
+            ),
+            "mp4": button(
+                self.figure,
+                (0.252, row, 0.075, 0.028),
+                "MP4",
+                functools.partial(self.export_animation, "mp4"),
+            ),
+        }
+        for widget in self.export_buttons.values():
+            widget.label.set_fontsize(FONT)
+        self._export_bottom = row
+
+    def _build_messages(self) -> None:
+        bottom, top = 0.015, self._export_bottom - 0.012
+        ax = panel_axes(self.figure, (0.008, bottom, 0.325, top - bottom))
+        ax.set_xticks([])
+        ax.set_yticks([])
+        ax.set_facecolor("0.97")
+        self.message_text = ax.text(
+            0.02,
+            0.94,
+            "",
+            transform=ax.transAxes,
+            fontsize=FONT,
+            va="top",
+            ha="left",
+            family="monospace",
+        )
+
+    def _build_view(self) -> None:
+        path_ax, plot_axes = add_view_axes(
+            self.figure, (0.385, 0.33, 0.31, 0.625), (0.745, 0.265, 0.245, 0.69)
+        )
+        self.view = RunView(path_ax, plot_axes)
+        self.summary_text = self.figure.text(
+            0.385, 0.228, "", fontsize=FONT, va="top", linespacing=1.6
+        )
+
+    def _build_transport(self) -> None:
+        row = 0.1
+        self.transport = {
+            "run": button(self.figure, (0.385, row, 0.055, 0.038), "Run", self.run),
+            "pause": button(self.figure, (0.445, row, 0.055, 0.038), "Pause", self.pause),
+            "step": button(self.figure, (0.505, row, 0.055, 0.038), "Step", self.step),
+            "reset": button(self.figure, (0.565, row, 0.055, 0.038), "Reset", self.reset),
+        }
+        self.speed_ax = panel_axes(self.figure, (0.68, row + 0.01, 0.1, 0.02))
+        self.speed_slider = Slider(
+            self.speed_ax,
+            "speed",
+            0,
+            len(SPEEDS) - 1,
+            valinit=SPEEDS.index(DEFAULT_SPEED),
+            valstep=1,
+        )
+        self.speed_slider.label.set_fontsize(FONT)
+        self.speed_slider.valtext.set_fontsize(FONT)
+        self.speed_slider.on_changed(self._on_speed)
+        self._on_speed(self.speed_slider.val)
+        self.progress_ax = panel_axes(self.figure, (0.845, row + 0.004, 0.145, 0.03))
+        self.progress_ax.set_xlim(0, 1)
+        self.progress_ax.set_ylim(0, 1)
+        self.progress_ax.set_xticks([])
+        self.progress_ax.set_yticks([])
+        self.progress_bar = Rectangle((0, 0), 0, 1, color="tab:green", alpha=0.5)
+        self.progress_ax.add_patch(self.progress_bar)
+        self.progress_text = self.progress_ax.text(
+            0.5,
+            0.5,
+            "idle",
+            ha="center",
+            va="center",
+            fontsize=FONT,
+            transform=self.progress_ax.transAxes,
+        )
+        self.time_ax = panel_axes(self.figure, (0.42, 0.045, 0.52, 0.025))
+        self.time_slider = Slider(self.time_ax, "time", 0.0, 1.0, valinit=0.0, valfmt="%.2f")
+        self.time_slider.label.set_fontsize(FONT)
+        self.time_slider.valtext.set_fontsize(FONT)
+        self.time_slider.on_changed(self._on_time_slider)
+
+    # ================================================================ messages
+    def say(self, text: str, error: bool = False) -> None:
+        """Show ``text`` in the message area (red for errors) and redraw."""
+        self.message = text
+        wrapped = "\n".join(textwrap.wrap(text, 62)) if text else ""
+        self.message_text.set_text(("error: " if error else "") + wrapped)
+        self.message_text.set_color("tab:red" if error else "0.1")
+        self._redraw()
+
+    def _report(self, text: str) -> None:
+        self.say(text, error=True)
+
+    def _redraw(self) -> None:
+        """Redraw the whole window (soon). Off-screen (Agg) draw_idle would render at once:
+        there the figure is drawn only when saved."""
+        if self.interactive:
+            self.figure.canvas.draw_idle()
+
+    # ---------------------------------------------------------------- fast redraws
+    # Playback and progress change only a few artists (robots, trails, plot lines,
+    # cursors, time slider, progress bar). On a desktop canvas that can blit, those are
+    # "animated": a full draw leaves them out and saves the background, and every frame
+    # restores it and draws just them (matplotlib's blitting recipe).
+    def _dynamic_artists(self) -> list[Any]:
+        slider = self.time_slider
+        handle = getattr(slider, "_handle", None)  # the knob; private in matplotlib
+        extra = [slider.poly, slider.valtext, self.progress_bar, self.progress_text]
+        return [*self.view.dynamic_artists(), *extra, *([handle] if handle else [])]
+
+    def _animate(self, on: bool) -> None:
+        """Mark the dynamic artists as animated (blitting) or normal (full draws)."""
+        for artist in self._dynamic_artists():
+            artist.set_animated(on)
+
+    def _on_full_draw(self, event: Any) -> None:
+        if event.canvas is not self._canvas:  # savefig draws on a temporary canvas
+            return
+        self._background = self._canvas.copy_from_bbox(self.figure.bbox)
+        self._draw_dynamic()
+
+    def _draw_dynamic(self) -> None:
+        for artist in self._dynamic_artists():
+            self.figure.draw_artist(artist)
+
+    def _refresh(self) -> None:
+        """Show changed dynamic artists: blit them when possible, else redraw."""
+        if not self.interactive or self.closed:
+            return
+        if not self._blitting or self._background is None:
+            self._redraw()
+            return
+        canvas = self._canvas
+        self._animate(True)  # artists created since the last frame join the animation
+        canvas.restore_region(self._background)
+        self._draw_dynamic()
+        canvas.blit(self.figure.bbox)
+
+    # ================================================================ settings
+    def apply(self, settings: Settings) -> None:
+        """Replace the settings (checked first: bad ones raise ParameterError)."""
+        check_settings(settings)
+        self._set_settings(settings)
+        self._sync_widgets()
+
+    def _set_settings(self, settings: Settings) -> None:
+        """Take checked settings; a run made with other settings is dropped."""
+        changed = settings != self.settings
+        self.settings = settings
+        if changed:
+            self._cancel_worker()
+            if self.results is not None:
+                self.results = None
+                self.run_settings = None
+                self.say("settings changed: press Run")
+            self._preview()
+
+    def _try(self, settings: Settings) -> None:
+        """Take ``settings`` if they check out (ParameterError propagates to the widget)."""
+        self._set_settings(check_settings(settings))
+
+    def _sync_widgets(self) -> None:
+        """Show the current settings in every widget (without applying anything)."""
+        s = self.settings
+        names = [t.get_text() for t in self.traj_radio.labels]
+        if s.trajectory in names and s.trajectory != FILE_ENTRY:
+            set_radio_silently(self.traj_radio, s.trajectory)
+        else:
+            set_radio_silently(self.traj_radio, FILE_ENTRY)
+            self.file_field.show(s.trajectory)
+        self._show_geometry()
+        set_radio_silently(self.method_radios[0], s.methods[0])
+        set_radio_silently(self.method_radios[1], s.methods[1] or OFF_ENTRY)
+        set_radio_silently(self.plant_radio, s.plant)
+        set_radio_silently(self.integrator_radio, s.integrator)
+        events = self.payload_slider.eventson
+        self.payload_slider.eventson = False
+        self.payload_slider.set_val(s.payload)
+        self.payload_slider.eventson = events
+        self.dt_field.show("" if s.dt is None else f"{s.dt:g}")
+        self.duration_field.show("" if s.duration is None else f"{s.duration:g}")
+        self.offset_field.show(f"{s.offset[0]:g} {s.offset[1]:g}")
+        if s.methods[self._options_slot] is None:
+            self._options_slot = 0
+        self._show_options()
+
+    def _show_geometry(self) -> None:
+        own = {**geometry_of(load_trajectory(self.settings.trajectory)), **self.settings.geometry}
+        for name, field in self.geometry_fields.items():
+            value = own.get(name)
+            field.show("" if value is None else f"{value:.6g}")
+            field.set_visible(value is not None)
+
+    # ---------------------------------------------------------------- trajectory
+    @guarded
+    def _on_trajectory(self, label: str) -> None:
+        if label == FILE_ENTRY:
+            path = self.file_field.text.strip()
+            if not path:
+                self._undo_radio(self.traj_radio, self.settings.trajectory)
+                raise ParameterError("traj: type a .toml or .csv path into the file field")
+            target = path
+        else:
+            target = label
+        try:
+            self._try(self.settings.replace(trajectory=target, geometry={}))
+        except ParameterError:
+            self._undo_radio(self.traj_radio, self.settings.trajectory)
+            raise
+        self._show_geometry()
+        self.say(f"trajectory: {target}")
+
+    def _undo_radio(self, buttons, value: str) -> None:
+        names = [t.get_text() for t in buttons.labels]
+        set_radio_silently(buttons, value if value in names else FILE_ENTRY)
+
+    def _apply_file(self, text: str) -> str:
+        path = text.strip()
+        if not path:
+            return ""
+        self._try(self.settings.replace(trajectory=path, geometry={}))
+        set_radio_silently(self.traj_radio, FILE_ENTRY)
+        self._show_geometry()
+        self.say(f"trajectory file: {path}")
+        return path
+
+    def _apply_geometry(self, name: str, text: str) -> str:
+        try:
+            number = float(text)
+        except ValueError:
+            raise ParameterError(f"{name} must be a number (got {text!r})") from None
+        value = check_geometry(name, number)
+        self._try(self.settings.with_geometry(name, value))
+        return f"{value:.6g}"
+
+    # ---------------------------------------------------------------- methods
+    @guarded
+    def _on_method(self, slot: int, label: str) -> None:
+        method = None if label == OFF_ENTRY else label
+        try:
+            self._try(self.settings.with_method(slot, method))
+        except ParameterError:
+            self._undo_radio(self.method_radios[slot], self.settings.methods[slot] or OFF_ENTRY)
+            raise
+        if method is not None:
+            self._options_slot, self._options_page = slot, 0
+        elif self._options_slot == slot:
+            self._options_slot, self._options_page = 0, 0
+        self._show_options()
+        self._redraw()
+
+    def _apply_options_slot(self, slot_name: str) -> None:
+        slot = SLOTS.index(slot_name)
+        if self.settings.methods[slot] is None:
+            raise ParameterError("slot B is off: pick a method under Compare: B first")
+        self._options_slot, self._options_page = slot, 0
+        self._show_options()
+
+    def _apply_options_page(self, page: int) -> None:
+        self._options_page = page - 1
+        self._show_options()
+
+    def _show_options(self) -> None:
+        """Show the option widgets of the edited slot's method (one page of them)."""
+        slot = self._options_slot
+        method = self.settings.methods[slot]
+        for group in self._groups.values():
+            group.set_visible(False)
+        group = self._option_group(slot, method)
+        pages = group.pages
+        self._options_page = min(self._options_page, pages - 1)
+        group.set_visible(True, self._options_page)
+        self.options_title.set_text(f"Options of {SLOTS[slot]}: {method}")
+        self.options_slot_button.show(SLOTS[slot])
+        self.options_page_button.values = list(range(1, pages + 1))
+        self.options_page_button.format_value = lambda page: f"{page}/{pages}"
+        self.options_page_button.show(self._options_page + 1)
+        self.options_page_button.set_visible(pages > 1)
+        changed = dict(self.settings.options[slot])
+        for spec, widget in zip(group.specs, group.widgets):
+            value = changed.get(spec.name, spec.default)
+            if isinstance(widget, CycleButton):
+                widget.show(value)
+            else:
+                widget.show(spec.format(value))
+        self.options_note.set_text(
+            "none (this method has no options)"
+            if not group.specs
+            else "blank number field: automatic value (None); Enter applies a field"
+        )
+
+    def _option_group(self, slot: int, method: str) -> _OptionGroup:
+        key = (slot, method)
+        if key not in self._groups:
+            specs = method_options(method)
+            widgets = [self._option_widget(slot, n, spec) for n, spec in enumerate(specs)]
+            self._groups[key] = _OptionGroup(specs, widgets)
+        return self._groups[key]
+
+    def _option_widget(self, slot: int, number: int, spec: OptionSpec) -> Field | CycleButton:
+        row, column = divmod(number % OPTIONS_PER_PAGE, 2)
+        left = 0.012 + 0.163 * column
+        bottom = self._options_top - 0.03 * (row + 1)
+        apply = functools.partial(self._apply_option, slot, spec)
+        if spec.kind == "choice":
+            return CycleButton(
+                self.figure,
+                (left, bottom, 0.155, 0.024),
+                spec.label,
+                spec.choices,
+                spec.default,
+                apply,
+                self._report,
+                format_choice,
+            )
+        return Field(
+            self.figure,
+            (left + 0.092, bottom, 0.062, 0.024),
+            spec.label,
+            spec.format(spec.default),
+            lambda text: self._apply_option_text(slot, spec, text),
+            self._report,
+        )
+
+    def _apply_option(self, slot: int, spec: OptionSpec, value: Any) -> None:
+        self._try(self.settings.with_option(slot, spec.name, value))
+        shown = spec.format(value) or "auto"
+        self.say(f"{SLOTS[slot]} {self.settings.methods[slot]}: {spec.name} = {shown}")
+
+    def _apply_option_text(self, slot: int, spec: OptionSpec, text: str) -> str:
+        value = spec.parse(text)
+        self._apply_option(slot, spec, value)
+        return spec.format(value)
+
+    # ---------------------------------------------------------------- simulation settings
+    @guarded
+    def _on_plant(self, label: str) -> None:
+        try:
+            self._try(self.settings.replace(plant=label))
+        except ParameterError:
+            self._undo_radio(self.plant_radio, self.settings.plant)
+            raise
+
+    @guarded
+    def _on_integrator(self, label: str) -> None:
+        self._try(self.settings.replace(integrator=label))
+
+    @guarded
+    def _on_payload(self, value: float) -> None:
+        self._try(self.settings.replace(payload=round(float(value), 6)))
+
+    def _apply_dt(self, text: str) -> str:
+        value = _optional_positive("dt", text)
+        self._try(self.settings.replace(dt=value))
+        return "" if value is None else f"{value:g}"
+
+    def _apply_duration(self, text: str) -> str:
+        value = _optional_positive("duration", text)
+        self._try(self.settings.replace(duration=value))
+        return "" if value is None else f"{value:g}"
+
+    def _apply_offset(self, text: str) -> str:
+        parts = text.replace(",", " ").split()
+        try:
+            values = tuple(float(p) for p in parts)
+        except ValueError:
+            raise ParameterError(f"offset must be two numbers dx dy in m (got {text!r})") from None
+        if len(values) != 2:
+            raise ParameterError(f"offset must be two numbers dx dy in m (got {text!r})")
+        self._try(self.settings.replace(offset=values))
+        return f"{values[0]:g} {values[1]:g}"
+
+    def _apply_export_dir(self, text: str) -> str:
+        if not text.strip():
+            raise ParameterError("export folder must not be empty")
+        self.export_dir = None  # the next export makes a new run folder under the new root
+        return text.strip()
+
+    # ================================================================ preview and runs
+    def _obstacles(self, settings: Settings) -> list[Any]:
+        circles: list[Any] = []
+        for slot in settings.active_slots:
+            circles += list(getattr(build_controller(settings, slot), "obstacles", ()) or ())
+        return circles
+
+    def _preview(self) -> None:
+        self.view.preview(build_trajectory(self.settings), self._obstacles(self.settings))
+        self._animate(self._blitting)
+        self.summary_text.set_text("")
+        self._set_slider_time(0.0)
+        self._set_progress(0.0, "idle")
+        self._redraw()
+
+    def labels(self) -> list[str]:
+        """Labels of the current runs: the method, or ``A-<method>``/``B-<method>`` side by side."""
+        settings = self.run_settings or self.settings
+        slots = settings.active_slots
+        if len(slots) == 1:
+            return [settings.methods[slots[0]]]
+        return [f"{SLOTS[s]}-{settings.methods[s]}" for s in slots]
+
+    @guarded
+    def run(self) -> None:
+        """Run button: simulate (if needed) and play the run from its start."""
+        worker = self.worker
+        if worker is not None and not worker.finished:
+            if worker.state == "paused":
+                worker.resume()
+                self.say("simulation resumed")
+            return
+        if self.results is not None and self.run_settings == self.settings:
+            if self.view.index >= self.view.last_index:
+                self.show_index(0)
+            self._play()
+            return
+        self._start_worker()
+
+    def _start_worker(self) -> None:
+        settings = check_settings(self.settings)
+        self.run_settings = settings
+        self.results = None
+        self.failure = None
+        self._stop()
+        self.worker = Worker(
+            lambda progress: simulate_settings(settings, progress), len(settings.active_slots)
+        )
+        self._started = time.perf_counter()
+        self.worker.start()
+        self._set_progress(0.0, "simulating 0 %")
+        self.say("simulating " + " and ".join(self.labels()) + " ...")
+        if self.interactive:
+            self._poll_timer.start()
+
+    def wait(self) -> None:
+        """Block until the current simulation ends and take its result (off-screen use)."""
+        if self.worker is not None:
+            self.worker.join()
+        self._poll()
+
+    @guarded
+    def _poll(self) -> None:
+        worker = self.worker
+        if worker is None or self.closed:
+            return
+        state, fraction = worker.state, worker.fraction
+        if state in ("running", "paused"):
+            word = "simulating" if state == "running" else "paused"
+            self._set_progress(fraction, f"{word} {100 * fraction:.0f} %")
+            self._refresh()
+            return
+        if self.interactive:
+            self._poll_timer.stop()
+        self.worker = None
+        if state == "done":
+            self._take_results(worker.result)
+        elif state == "failed":
+            self.run_settings = None
+            self.failure = (worker.error, worker.bad_input)
+            self._set_progress(0.0, "failed")
+            self.say(worker.error, error=True)
+        else:
+            self.run_settings = None
+            self._set_progress(0.0, "cancelled")
+
+    def _take_results(self, results: list[Any]) -> None:
+        elapsed = time.perf_counter() - self._started
+        self.results = results
+        self._run_stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
+        self.export_dir = None
+        self.view.set_runs(results, self.labels(), self._obstacles(self.run_settings))
+        self._animate(self._blitting)
+        steps = results[0].summary["steps"]
+        self._set_progress(1.0, f"done: {steps} steps, {elapsed:.1f} s")
+        self.summary_text.set_text(
+            "\n".join(_summary_line(label, r) for label, r in zip(self.labels(), results))
+        )
+        self.say(f"run finished ({steps} steps per method): playing; drag time to scrub")
+        self.show_index(0)
+        self._play()
+
+    def _cancel_worker(self) -> None:
+        if self.worker is not None and not self.worker.finished:
+            self.worker.cancel()
+            self.worker.join()
+            self._poll()
+
+    # ================================================================ playback
+    def _play(self) -> None:
+        self.playing = True
+        self._last_tick = time.perf_counter()
+        if self.interactive:
+            self._play_timer.start()
+
+    def _stop(self) -> None:
+        self.playing = False
+        if self.interactive:
+            self._play_timer.stop()
+
+    @guarded
+    def pause(self) -> None:
+        """Pause button: hold the simulation (while computing) or the playback."""
+        if self.worker is not None and not self.worker.finished:
+            self.worker.pause()
+            self._poll()
+            self.say("simulation paused: Run resumes it")
+            return
+        self._stop()
+        self.say(f"paused at t = {self.view.time:.2f} s")
+
+    @guarded
+    def step(self) -> None:
+        """Step button: pause and move the playback one recorded step (dt) forward."""
+        if self.results is None:
+            raise ParameterError("step: no finished run yet (press Run)")
+        self._stop()
+        self.show_index(self.view.index + 1)
+
+    @guarded
+    def reset(self) -> None:
+        """Reset button: stop any simulation and playback, back to t = 0."""
+        self._cancel_worker()
+        self._stop()
+        if self.results is not None:
+            self.show_index(0)
+        else:
+            self._preview()
+        self.say("reset to t = 0")
+
+    @property
+    def speed(self) -> float:
+        """Playback speed (simulated s per wall-clock s)."""
+        return SPEEDS[round(self.speed_slider.val)]
+
+    def _on_speed(self, position: float) -> None:
+        self.speed_slider.valtext.set_text(f"{SPEEDS[round(position)]:g} x real time")
+
+    def advance(self, wall_seconds: float) -> None:
+        """Move a playing run forward by ``speed * wall_seconds`` of simulated time."""
+        if not self.playing or self.results is None:
+            return
+        target = self.view.time + self.speed * wall_seconds
+        if target >= self.view.duration:
+            self.show_index(self.view.last_index)
+            self._stop()
+            return
+        self.show_time(target)
+
+    def _on_close(self, _event: Any) -> None:
+        """The window closes: stop the timers and any simulation."""
+        self.closed = True
+        self._play_timer.stop()
+        self._poll_timer.stop()
+        if self.worker is not None:
+            self.worker.cancel()
+
+    @guarded
+    def _on_frame(self) -> None:
+        now = time.perf_counter()
+        elapsed, self._last_tick = now - self._last_tick, now
+        self.advance(elapsed)
+
+    def show_time(self, t: float) -> int:
+        """Show the run at time ``t`` (s); returns the recorded index shown."""
+        return self.show_index(self.view.index_at(t))
+
+    def show_index(self, k: int) -> int:
+        """Show the recorded instant ``k`` of the run; returns it (clipped)."""
+        k = self.view.show_index(k)
+        self.frames_shown += 1
+        duration = self.view.duration
+        self._set_slider_time(self.view.time / duration if duration > 0 else 0.0)
+        self._refresh()
+        return k
+
+    def _set_slider_time(self, fraction: float) -> None:
+        self._moving_slider = True
+        try:
+            self.time_slider.set_val(fraction)
+        finally:
+            self._moving_slider = False
+        self.time_slider.valtext.set_text(f"{self.view.time:.2f} s")
+
+    @guarded
+    def _on_time_slider(self, fraction: float) -> None:
+        if self._moving_slider or self.results is None:
+            if self.results is None and not self._moving_slider:
+                self.time_slider.valtext.set_text("no run")
+            return
+        self._stop()
+        self.show_time(float(fraction) * self.view.duration)
+
+    def _set_progress(self, fraction: float, text: str) -> None:
+        self.progress_bar.set_width(fraction)
+        self.progress_text.set_text(text)
+
+    # ================================================================ export
+    def _export_folder(self) -> Path:
+        if self.results is None:
+            raise ParameterError("export: no finished run yet (press Run)")
+        if self.export_dir is None:
+            settings = self.run_settings
+            names = "-vs-".join(settings.methods[s] for s in settings.active_slots)
+            trajectory = Path(settings.trajectory).stem
+            root = Path(self.export_field.text.strip() or "runs/gui")
+            self.export_dir = export.run_folder(root, f"{names}-{trajectory}-{self._run_stamp}")
+        return self.export_dir
+
+    @guarded
+    def export_data(self) -> list[Path]:
+        """Export button: timeseries.csv and summary.json (the files `track` writes)."""
+        folder = self._export_folder()
+        paths = export.write_run_data(folder, self.results, self.labels())
+        self.say(f"wrote {len(paths)} files to {folder}")
+        return paths
+
+    @guarded
+    def export_png(self) -> Path:
+        """Export button: a PNG of the whole window."""
+        folder = self._export_folder()
+        self._animate(False)  # a saved figure leaves animated artists out
+        try:
+            path = export.write_window_png(self.figure, folder)
+        finally:
+            self._animate(self._blitting)
+        self.say(f"wrote {path}")
+        return path
+
+    @guarded
+    def export_animation(self, fmt: str = "gif") -> Path:
+        """Export button: the run's animation as GIF or MP4."""
+        folder = self._export_folder()
+        self.say(f"writing {fmt} ...")
+        obstacles = self._obstacles(self.run_settings)
+        path = export.write_animation(self.results, self.labels(), obstacles, folder, fmt)
+        self.say(f"wrote {path}")
+        return path
+
+
+def _optional_positive(name: str, text: str) -> float | None:
+    text = text.strip()
+    if not text:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise ParameterError(f"{name} must be a number > 0 in s, or blank (got {text!r})") from None
+    if not (value > 0 and np.isfinite(value)):
+        raise ParameterError(f"{name} must be > 0 s, or blank (got {text})")
+    return value
+
+
+def _summary_line(label: str, result: Any) -> str:
+    s = result.summary
+    return (
+        f"{label}: RMS pos {s['rms_position_error_m']:.3g} m,"
+        f" max {s['max_position_error_m']:.3g} m,"
+        f" RMS orient {s['rms_orientation_error_rad']:.3g} rad, max wheel"
+        f" {s['max_wheel_speed_rad_s']:.3g} rad/s, min S {s['min_stability']:.3g},"
+        f" min eta {s['min_manipulability']:.2f}, saturated {s['saturated_steps']},"
+        f" fallbacks {s['fallback_steps']}"
+    )
