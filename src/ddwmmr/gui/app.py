@@ -14,11 +14,12 @@ traceback that ends the app.
 
 from __future__ import annotations
 
+import contextlib
 import datetime
 import functools
 import textwrap
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -75,6 +76,17 @@ OPTIONS_PER_PAGE = 12
 PAYLOAD_RANGE = (0.0, 5.0)
 
 
+@contextlib.contextmanager
+def _drawing_deferred(canvas: Any) -> Iterator[None]:
+    """Hold back the redraws widgets request while they are built (a Slider draws itself
+    when created; on Agg each request is a full render)."""
+    canvas.draw_idle = lambda *args, **kwargs: None
+    try:
+        yield
+    finally:
+        del canvas.draw_idle
+
+
 def guarded(handler: Callable[..., Any]) -> Callable[..., Any]:
     """Show any error of a widget handler in the window instead of raising it."""
 
@@ -90,19 +102,35 @@ def guarded(handler: Callable[..., Any]) -> Callable[..., Any]:
 
 
 class _OptionGroup:
-    """The option widgets of one method in one slot (created when first shown)."""
+    """The option widgets of one method in one slot, a page of them created when first
+    shown (``make(number, spec)`` builds the widget of option ``number``)."""
 
-    def __init__(self, specs: tuple[OptionSpec, ...], widgets: list[Field | CycleButton]) -> None:
+    def __init__(
+        self,
+        specs: tuple[OptionSpec, ...],
+        make: Callable[[int, OptionSpec], Field | CycleButton],
+    ) -> None:
         self.specs = specs
-        self.widgets = widgets
+        self.make = make
+        self.widgets: dict[int, Field | CycleButton] = {}
 
     @property
     def pages(self) -> int:
-        return max(1, -(-len(self.widgets) // OPTIONS_PER_PAGE))
+        return max(1, -(-len(self.specs) // OPTIONS_PER_PAGE))
 
-    def set_visible(self, visible: bool, page: int = 0) -> None:
-        for number, widget in enumerate(self.widgets):
-            widget.set_visible(visible and number // OPTIONS_PER_PAGE == page)
+    def page(self, page: int) -> list[tuple[OptionSpec, Field | CycleButton]]:
+        """The (spec, widget) pairs of ``page``, creating the widgets if needed."""
+        numbers = range(
+            page * OPTIONS_PER_PAGE, min((page + 1) * OPTIONS_PER_PAGE, len(self.specs))
+        )
+        for number in numbers:
+            if number not in self.widgets:
+                self.widgets[number] = self.make(number, self.specs[number])
+        return [(self.specs[n], self.widgets[n]) for n in numbers]
+
+    def hide(self) -> None:
+        for widget in self.widgets.values():
+            widget.set_visible(False)
 
 
 class App:
@@ -134,7 +162,8 @@ class App:
         self._groups: dict[tuple[int, str], _OptionGroup] = {}
         self._last_tick = 0.0
         self._moving_slider = False
-        self._build()
+        with _drawing_deferred(figure.canvas):
+            self._build()
         for widget in self._drawing_widgets():
             widget.drawon = interactive
         self.time_slider.drawon = False  # drawn with the playback frames (see _refresh)
@@ -602,11 +631,13 @@ class App:
         slot = self._options_slot
         method = self.settings.methods[slot]
         for group in self._groups.values():
-            group.set_visible(False)
+            group.hide()
         group = self._option_group(slot, method)
         pages = group.pages
         self._options_page = min(self._options_page, pages - 1)
-        group.set_visible(True, self._options_page)
+        shown = group.page(self._options_page)
+        for _, widget in shown:
+            widget.set_visible(True)
         self.options_title.set_text(f"Options of {SLOTS[slot]}: {method}")
         self.options_slot_button.show(SLOTS[slot])
         self.options_page_button.values = list(range(1, pages + 1))
@@ -614,7 +645,7 @@ class App:
         self.options_page_button.show(self._options_page + 1)
         self.options_page_button.set_visible(pages > 1)
         changed = dict(self.settings.options[slot])
-        for spec, widget in zip(group.specs, group.widgets):
+        for spec, widget in shown:
             value = changed.get(spec.name, spec.default)
             if isinstance(widget, CycleButton):
                 widget.show(value)
@@ -625,13 +656,13 @@ class App:
             if not group.specs
             else "blank number field: automatic value (None); Enter applies a field"
         )
+        self._redraw()
 
     def _option_group(self, slot: int, method: str) -> _OptionGroup:
         key = (slot, method)
         if key not in self._groups:
-            specs = method_options(method)
-            widgets = [self._option_widget(slot, n, spec) for n, spec in enumerate(specs)]
-            self._groups[key] = _OptionGroup(specs, widgets)
+            make = functools.partial(self._option_widget, slot)
+            self._groups[key] = _OptionGroup(method_options(method), make)
         return self._groups[key]
 
     def _option_widget(self, slot: int, number: int, spec: OptionSpec) -> Field | CycleButton:
