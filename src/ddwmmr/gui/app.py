@@ -998,6 +998,9 @@ class App:
         """Export button: the run's animation as GIF or MP4."""
         folder = self._export_folder()
         self.say(f"writing {fmt} ...")
+        if self.interactive:  # show the message before the export blocks the window
+            self.figure.canvas.draw()
+            self.figure.canvas.flush_events()
         obstacles = self._obstacles(self.run_settings)
         path = export.write_animation(self.results, self.labels(), obstacles, folder, fmt)
         self.say(f"wrote {path}")

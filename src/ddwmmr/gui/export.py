@@ -16,12 +16,13 @@ from __future__ import annotations
 
 import io
 import tempfile
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 from matplotlib import animation as mpl_animation
 from matplotlib.figure import Figure
+from PIL import Image
 
 from ddwmmr.errors import ParameterError
 from ddwmmr.sim.result import write_atomic
@@ -86,7 +87,8 @@ def write_animation(
 ) -> Path:
     """``animation.<fmt>``: the view (robot, paths, plots) at ``frames`` evenly spaced times.
 
-    Drawn by the window's own :class:`ddwmmr.gui.view.RunView` in a separate figure.
+    Drawn by the window's own :class:`ddwmmr.gui.view.RunView` in a separate figure;
+    a run shorter than ``frames`` recorded instants gives one frame per instant.
     """
     from ddwmmr.gui.view import animation_figure
 
@@ -99,18 +101,58 @@ def write_animation(
         )
     figure, view = animation_figure(dpi)
     view.set_runs(results, labels, obstacles)
-    last = view.last_index
-    indices = [round(last * i / max(frames - 1, 1)) for i in range(max(frames, 1))]
-
-    def draw(frame: int):
-        view.show_index(indices[frame])
-        return []
-
-    movie = mpl_animation.FuncAnimation(figure, draw, frames=len(indices), blit=False)
-    writer = mpl_animation.writers[ANIMATION_WRITERS[fmt]](fps=fps)
+    indices = frame_indices(view.last_index, frames)
     path = unique_path(folder / f"animation.{fmt}")
+    if fmt == "gif":
+        images = list(_blitted_frames(figure, view, indices))
+        # One palette for all frames, from the last (it has every trail and colour).
+        palette = images[-1].quantize(colors=128, method=Image.Quantize.FASTOCTREE)
+        images = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in images]
+        buffer = io.BytesIO()
+        images[0].save(
+            buffer,
+            format="GIF",
+            save_all=True,
+            append_images=images[1:],
+            duration=round(1000 / fps),
+            loop=0,
+        )
+        write_atomic(path, buffer.getvalue())
+        return path
+    writer = mpl_animation.writers[ANIMATION_WRITERS[fmt]](fps=fps)
     with tempfile.TemporaryDirectory() as scratch:
         temporary = Path(scratch) / path.name
-        movie.save(temporary, writer=writer, dpi=dpi)
+        with writer.saving(figure, str(temporary), dpi):
+            for index in indices:
+                view.show_index(index)
+                writer.grab_frame()
         write_atomic(path, temporary.read_bytes())
     return path
+
+
+def _blitted_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterator[Image.Image]:
+    """RGB images of the view at ``indices``: the still parts are rendered once, then
+    every frame redraws only the moving artists on that background (several times faster
+    than full renders, which spend most of their time on the axes' ticks). The legends
+    belong to the background, placed for the whole run."""
+    canvas = figure.canvas
+    view.show_index(view.last_index)
+    for artist in view.dynamic_artists(legends=False):
+        artist.set_animated(True)
+    canvas.draw()
+    background = canvas.copy_from_bbox(figure.bbox)
+    size = canvas.get_width_height()
+    for index in indices:
+        view.show_index(index)
+        canvas.restore_region(background)
+        for artist in view.dynamic_artists(legends=False):
+            figure.draw_artist(artist)
+        yield Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert(
+            "RGB"
+        )
+
+
+def frame_indices(last: int, frames: int) -> list[int]:
+    """Up to ``frames`` distinct recorded indices from 0 to ``last``, evenly spread."""
+    count = max(min(frames, last + 1), 1)
+    return sorted({round(last * i / max(count - 1, 1)) for i in range(count)})

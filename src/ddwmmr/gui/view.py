@@ -25,11 +25,11 @@ from ddwmmr.reports.plots import robot_outline, wheel_outlines
 
 #: Plot axes of the view, top to bottom: key -> y-axis label.
 PLOTS = {
-    "position": "position error (m)",
-    "orientation": "orientation error (rad)",
-    "wheels": "wheel speed (rad/s)",
+    "position": "position\nerror (m)",
+    "orientation": "orientation\nerror (rad)",
+    "wheels": "wheel speed\n(rad/s)",
     "stability": "stability S",
-    "manipulability": "manipulability",
+    "manipulability": "manipulability\neta",
 }
 #: Colours of run A and run B: (end effector and plot lines, arm).
 PALETTE = (("tab:blue", "tab:orange"), ("tab:red", "tab:green"))
@@ -108,8 +108,8 @@ class RunView:
         robot = results[0].robot
         self._fit_path(np.r_[xs, period[:, 0]], np.r_[ys, period[:, 1]], robot.base_length)
         self._fit_plots(results)
-        for ax in self.plot_axes.values():
-            ax.legend(loc="best", fontsize=6, ncol=2, framealpha=0.7)
+        for key in ("position", "wheels", "stability"):
+            self.plot_axes[key].legend(loc="best", fontsize=6, ncol=3, framealpha=0.7)
         self.path_ax.legend(
             loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=3, fontsize=6.5, frameon=False
         )
@@ -117,14 +117,20 @@ class RunView:
             cursor.set_visible(True)
         self.show(0.0)
 
-    def dynamic_artists(self) -> list[Any]:
-        """The artists :meth:`show_index` changes (for blitting)."""
+    def dynamic_artists(self, legends: bool = True) -> list[Any]:
+        """The artists :meth:`show_index` changes (for blitting), in drawing order.
+
+        ``legends``: include the legends, so that they stay above the moving lines.
+        """
         artists: list[Any] = [self._target, self.path_ax.title, *self._cursors]
         for run in self.runs:
             artists += [run.ee_trail, run.base_trail, run.footprint, *run.wheels]
             artists += [run.heading, run.arm, run.payload]
             artists += [line for lines in run.lines.values() for line in lines]
-        return artists
+        if legends:  # on top of the lines, as in a full render
+            boxes = [ax.get_legend() for ax in (self.path_ax, *self.plot_axes.values())]
+            artists += [box for box in boxes if box is not None]
+        return sorted(artists, key=lambda artist: artist.get_zorder())
 
     @property
     def duration(self) -> float:
@@ -250,13 +256,15 @@ class RunView:
         style = {"color": color, "lw": 1.0}
         plot = self.plot_axes
         run.lines["position"] = plot["position"].plot([], [], label=label, **style)
-        run.lines["orientation"] = plot["orientation"].plot([], [], label=label, **style)
+        # Colours name the runs in the position legend; the other plots use the same ones.
+        run.lines["orientation"] = plot["orientation"].plot([], [], **style)
+        first = number == 0
         run.lines["wheels"] = [
-            *plot["wheels"].plot([], [], label=f"{label} left", **style),
-            *plot["wheels"].plot([], [], ls="--", label=f"{label} right", **style),
+            *plot["wheels"].plot([], [], label="left" if first else None, **style),
+            *plot["wheels"].plot([], [], ls="--", label="right" if first else None, **style),
         ]
-        run.lines["stability"] = plot["stability"].plot([], [], label=f"{label} S", **style)
-        run.lines["manipulability"] = plot["manipulability"].plot([], [], label=label, **style)
+        run.lines["stability"] = plot["stability"].plot([], [], **style)
+        run.lines["manipulability"] = plot["manipulability"].plot([], [], **style)
         floor = result.summary.get("stability_min")
         if floor:
             line = plot["stability"].axhline(
