@@ -45,7 +45,6 @@ def click_radio(buttons, label, taken=True):
     """Click the radio button labelled ``label`` (``taken``: the app keeps the choice)."""
     ax = buttons.ax
     canvas = ax.figure.canvas
-    canvas.draw()  # radio hit-testing measures the labels
     (text,) = [t for t in buttons.labels if t.get_text() == label]
     x0, y0, x1, y1 = text.get_window_extent().extents
     x, y = (x0 + x1) / 2, (y0 + y1) / 2
@@ -358,3 +357,14 @@ def test_blitted_frames_match_a_full_render():
         moved = np.abs(blitted[region] - start[region]).max(axis=2)
         assert np.mean(moved > 32) > 0.001, ax.get_ylabel()  # the frame did change
     assert fast.view.runs[0].footprint.get_animated()
+
+
+def test_docs_page_snippet_runs(capsys):
+    """The python block of docs/gui.md runs and prints the same number twice."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "gui.md").read_text()
+    (block,) = [part.split("```")[0] for part in text.split("```python")[1:]]
+    exec(compile(block, "docs/gui.md", "exec"), {})
+    printed = capsys.readouterr().out.split()
+    assert len(printed) == 2 and float(printed[0]) == pytest.approx(float(printed[1]))

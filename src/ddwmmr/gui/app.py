@@ -80,11 +80,15 @@ PAYLOAD_RANGE = (0.0, 5.0)
 def _drawing_deferred(canvas: Any) -> Iterator[None]:
     """Hold back the redraws widgets request while they are built (a Slider draws itself
     when created; on Agg each request is a full render)."""
+    own = canvas.__dict__.get("draw_idle")  # an instance-level override stays
     canvas.draw_idle = lambda *args, **kwargs: None
     try:
         yield
     finally:
-        del canvas.draw_idle
+        if own is None:
+            del canvas.draw_idle
+        else:
+            canvas.draw_idle = own
 
 
 def guarded(handler: Callable[..., Any]) -> Callable[..., Any]:
@@ -418,6 +422,7 @@ class App:
             len(SPEEDS) - 1,
             valinit=SPEEDS.index(DEFAULT_SPEED),
             valstep=1,
+            initcolor="none",
         )
         self.speed_slider.label.set_fontsize(FONT)
         self.speed_slider.valtext.set_fontsize(FONT)
@@ -440,7 +445,9 @@ class App:
             transform=self.progress_ax.transAxes,
         )
         self.time_ax = panel_axes(self.figure, (0.42, 0.045, 0.52, 0.025))
-        self.time_slider = Slider(self.time_ax, "time", 0.0, 1.0, valinit=0.0, valfmt="%.2f")
+        self.time_slider = Slider(
+            self.time_ax, "time", 0.0, 1.0, valinit=0.0, valfmt="%.2f", initcolor="none"
+        )
         self.time_slider.label.set_fontsize(FONT)
         self.time_slider.valtext.set_fontsize(FONT)
         self.time_slider.on_changed(self._on_time_slider)

@@ -184,6 +184,7 @@ def snapshot(
             raise ParameterError(message)
         raise RunFailed(message)
     app.show_index(app.view.last_index)
+    app.say(f"snapshot: final state at t = {app.view.time:.2f} s (--snapshot {Path(path).name})")
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=dpi or DPI)
     path = Path(path)
