@@ -19,7 +19,7 @@ import ddwmmr.gui.settings as gui_settings
 import ddwmmr.sim
 from ddwmmr import Robot, load_trajectory, simulate
 from ddwmmr.gui import App, Settings
-from ddwmmr.gui.app import FIGSIZE, SPEEDS
+from ddwmmr.gui.layout import FIGSIZE, SPEEDS
 from ddwmmr.gui.view import ERROR_FLOOR
 from ddwmmr.reports.plots import robot_outline
 

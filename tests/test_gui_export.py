@@ -12,8 +12,8 @@ from PIL import Image
 
 from ddwmmr.cli.track import main as track
 from ddwmmr.gui import App, Settings
-from ddwmmr.gui.app import FIGSIZE
 from ddwmmr.gui.export import animation_available
+from ddwmmr.gui.layout import FIGSIZE
 
 DURATION = 1.0
 

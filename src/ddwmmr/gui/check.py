@@ -39,8 +39,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     import matplotlib.pyplot as plt
     from PIL import ImageGrab, ImageStat
 
-    from ddwmmr.gui.app import SPEEDS, App
+    from ddwmmr.gui.app import App
     from ddwmmr.gui.cli import desktop_figure
+    from ddwmmr.gui.layout import SPEEDS
     from ddwmmr.gui.settings import Settings
 
     figure = desktop_figure()

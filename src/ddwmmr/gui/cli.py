@@ -169,7 +169,8 @@ def snapshot(
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from ddwmmr.gui.app import DPI, FIGSIZE, App
+    from ddwmmr.gui.app import App
+    from ddwmmr.gui.layout import DPI, FIGSIZE
 
     figure = Figure(figsize=FIGSIZE, dpi=DPI)
     FigureCanvasAgg(figure)
@@ -203,7 +204,7 @@ def desktop_figure():
 
     import matplotlib.pyplot as plt
 
-    from ddwmmr.gui.app import DPI, FIGSIZE
+    from ddwmmr.gui.layout import DPI, FIGSIZE
 
     probe = tkinter.Tk()  # raises TclError without a display
     probe.withdraw()
