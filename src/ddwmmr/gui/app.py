@@ -150,6 +150,8 @@ class App(PanelLayout):
         self._groups: dict[tuple[int, str], _OptionGroup] = {}
         self._last_tick = 0.0
         self._moving_slider = False
+        self.closed = False  # the desktop window was closed
+        self.frames_shown = 0  # instants drawn by show_index (playback frames)
         with _drawing_deferred(figure.canvas):
             self._build()
         for widget in self._drawing_widgets():
@@ -166,8 +168,6 @@ class App(PanelLayout):
         self._play_timer.add_callback(self._on_frame)
         self._poll_timer = figure.canvas.new_timer(interval=POLL_MS)
         self._poll_timer.add_callback(self._poll)
-        self.closed = False
-        self.frames_shown = 0  # instants drawn by show_index (playback frames)
         figure.canvas.mpl_connect("close_event", self._on_close)
 
     # ================================================================ messages
@@ -295,7 +295,7 @@ class App(PanelLayout):
             target = label
         try:
             self._try(self.settings.replace(trajectory=target, geometry={}))
-        except ParameterError:
+        except Exception:  # the list shows the setting that stays
             self._undo_radio(self.traj_radio, self.settings.trajectory)
             raise
         self._show_geometry()
@@ -330,7 +330,7 @@ class App(PanelLayout):
         method = None if label == OFF_ENTRY else label
         try:
             self._try(self.settings.with_method(slot, method))
-        except ParameterError:
+        except Exception:  # the list shows the setting that stays
             self._undo_radio(self.method_radios[slot], self.settings.methods[slot] or OFF_ENTRY)
             raise
         if method is not None:
@@ -405,7 +405,7 @@ class App(PanelLayout):
     def _on_plant(self, label: str) -> None:
         try:
             self._try(self.settings.replace(plant=label))
-        except ParameterError:
+        except Exception:  # the list shows the setting that stays
             self._undo_radio(self.plant_radio, self.settings.plant)
             raise
 
