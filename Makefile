@@ -54,3 +54,14 @@ docs-timings: $(STAMP_TEST)
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache
+
+# Real Tk window of python -m ddwmmr.gui under a virtual X display: clicks Run, types into a
+# field, plays the run back, saves a screenshot to runs/gui-check/. Needs xvfb-run.
+.PHONY: gui-check
+gui-check: $(STAMP)
+	@if command -v xvfb-run >/dev/null 2>&1; then \
+		xvfb-run -a -s "-screen 0 1920x1080x24" $(BIN)/python -m ddwmmr.gui.check runs/gui-check; \
+	else \
+		echo "gui-check skipped: xvfb-run is not installed (Debian/Ubuntu: apt install xvfb)."; \
+		echo "The window is still tested headless (Agg) by tests/test_gui*.py in make test."; \
+	fi

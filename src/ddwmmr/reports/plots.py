@@ -39,6 +39,27 @@ def robot_outline(robot: Robot, q) -> dict[str, np.ndarray]:
     return {"footprint": footprint, "arm": arm, "heading": heading}
 
 
+def wheel_outlines(robot: Robot, q, width: float | None = None) -> list[np.ndarray]:
+    """Closed polylines (world frame, m) of the left and right drive wheels at q.
+
+    Each wheel is a ``2 r x width`` rectangle along the heading, centred on the axle at
+    ``+-track_width/2`` (left first); ``width`` defaults to ``r / 2``.
+    """
+    x, y, phi = (float(v) for v in q[:3])
+    c, s = math.cos(phi), math.sin(phi)
+    r = robot.wheel_radius
+    hw = (r / 2 if width is None else width) / 2
+    local = np.array([[r, hw], [-r, hw], [-r, -hw], [r, -hw], [r, hw]])
+    rotation = np.array([[c, s], [-s, c]])
+    wheels = []
+    for side in (1.0, -1.0):  # left wheel is on the +y side of the base frame
+        centre = np.array(
+            [x - side * robot.track_width / 2 * s, y + side * robot.track_width / 2 * c]
+        )
+        wheels.append(local @ rotation + centre)
+    return wheels
+
+
 def draw_robot(ax: Axes, robot: Robot, q, color: str = "0.35", alpha: float = 0.8) -> None:
     """Draw the base footprint, heading and the two arm links at configuration q."""
     shape = robot_outline(robot, q)

@@ -1,0 +1,732 @@
+"""The simulator window: control panel, view with live plots, run/playback, export.
+
+One matplotlib figure holds everything (``App(figure)``); with the Tk backend it is a
+desktop window, with Agg it is drawn off-screen (tests, ``--snapshot``). The app never
+simulates by itself: Run builds the controllers with :func:`ddwmmr.make_controller` and
+calls :func:`ddwmmr.simulate` (through :func:`ddwmmr.gui.settings.simulate_settings`) in a
+background :class:`~ddwmmr.gui.worker.Worker`; the finished run is then played back (the
+time slider scrubs it).
+
+Every handler is guarded: a bad value shows a one-line message in the window and the
+previous valid setting stays; an unexpected error is shown the same way, never as a
+traceback that ends the app.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime
+import functools
+import textwrap
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.gui import export
+from ddwmmr.gui.layout import (
+    FILE_ENTRY,
+    OFF_ENTRY,
+    OPTIONS_PER_PAGE,
+    SPEEDS,
+    PanelLayout,
+)
+from ddwmmr.gui.options import OptionSpec, method_options
+from ddwmmr.gui.settings import (
+    SLOTS,
+    Settings,
+    build_controller,
+    build_trajectory,
+    check_geometry,
+    check_settings,
+    geometry_of,
+    simulate_settings,
+)
+from ddwmmr.gui.widgets import (
+    CycleButton,
+    Field,
+    describe_error,
+    set_radio_silently,
+)
+from ddwmmr.gui.worker import Worker
+from ddwmmr.trajectories import load_trajectory
+
+#: Playback frame and progress poll intervals (ms).
+FRAME_MS = 40
+POLL_MS = 100
+
+
+@contextlib.contextmanager
+def _drawing_deferred(canvas: Any) -> Iterator[None]:
+    """Hold back the redraws widgets request while they are built (a Slider draws itself
+    when created; on Agg each request is a full render)."""
+    own = canvas.__dict__.get("draw_idle")  # an instance-level override stays
+    canvas.draw_idle = lambda *args, **kwargs: None
+    try:
+        yield
+    finally:
+        if own is None:
+            del canvas.draw_idle
+        else:
+            canvas.draw_idle = own
+
+
+def guarded(handler: Callable[..., Any]) -> Callable[..., Any]:
+    """Show any error of a widget handler in the window instead of raising it."""
+
+    @functools.wraps(handler)
+    def wrapper(self: App, *args: Any, **kwargs: Any) -> Any:
+        try:
+            return handler(self, *args, **kwargs)
+        except Exception as exc:  # the window must survive anything a handler meets
+            self.say(describe_error(exc), error=True)
+        return None
+
+    return wrapper
+
+
+class _OptionGroup:
+    """The option widgets of one method in one slot, a page of them created when first
+    shown (``make(number, spec)`` builds the widget of option ``number``)."""
+
+    def __init__(
+        self,
+        specs: tuple[OptionSpec, ...],
+        make: Callable[[int, OptionSpec], Field | CycleButton],
+    ) -> None:
+        self.specs = specs
+        self.make = make
+        self.widgets: dict[int, Field | CycleButton] = {}
+
+    @property
+    def pages(self) -> int:
+        return max(1, -(-len(self.specs) // OPTIONS_PER_PAGE))
+
+    def page(self, page: int) -> list[tuple[OptionSpec, Field | CycleButton]]:
+        """The (spec, widget) pairs of ``page``, creating the widgets if needed."""
+        numbers = range(
+            page * OPTIONS_PER_PAGE, min((page + 1) * OPTIONS_PER_PAGE, len(self.specs))
+        )
+        for number in numbers:
+            if number not in self.widgets:
+                self.widgets[number] = self.make(number, self.specs[number])
+        return [(self.specs[n], self.widgets[n]) for n in numbers]
+
+    def hide(self) -> None:
+        for widget in self.widgets.values():
+            widget.set_visible(False)
+
+
+class App(PanelLayout):
+    """The simulator window in ``figure`` (see the module docstring).
+
+    Args:
+        figure: an empty figure with a canvas (Tk for a desktop window, Agg off-screen).
+        settings: initial settings (checked; bad ones raise :class:`ParameterError`).
+        interactive: run timers for playback and progress (a desktop window); off-screen
+            apps are advanced by :meth:`wait` and :meth:`advance`.
+    """
+
+    def __init__(
+        self, figure: Figure, settings: Settings | None = None, interactive: bool = False
+    ) -> None:
+        self.figure = figure
+        self.interactive = interactive
+        self.settings = check_settings(settings or Settings())
+        self.results: list[Any] | None = None
+        self.run_settings: Settings | None = None
+        self.worker: Worker | None = None
+        self.playing = False
+        self.message = ""
+        self.failure: tuple[str, bool] | None = None
+        self.export_dir: Path | None = None
+        self._run_stamp = ""
+        self._options_slot = 0
+        self._options_page = 0
+        self._groups: dict[tuple[int, str], _OptionGroup] = {}
+        self._last_tick = 0.0
+        self._moving_slider = False
+        self.closed = False  # the desktop window was closed
+        self.frames_shown = 0  # instants drawn by show_index (playback frames)
+        with _drawing_deferred(figure.canvas):
+            self._build()
+        for widget in self._drawing_widgets():
+            widget.drawon = interactive
+        self.time_slider.drawon = False  # drawn with the playback frames (see _refresh)
+        self._canvas = figure.canvas
+        self._blitting = interactive and figure.canvas.supports_blit
+        self._background = None
+        if self._blitting:
+            figure.canvas.mpl_connect("draw_event", self._on_full_draw)
+        self._sync_widgets()
+        self._preview()
+        self._play_timer = figure.canvas.new_timer(interval=FRAME_MS)
+        self._play_timer.add_callback(self._on_frame)
+        self._poll_timer = figure.canvas.new_timer(interval=POLL_MS)
+        self._poll_timer.add_callback(self._poll)
+        figure.canvas.mpl_connect("close_event", self._on_close)
+
+    # ================================================================ messages
+    def say(self, text: str, error: bool = False) -> None:
+        """Show ``text`` in the message area (red for errors) and redraw."""
+        self.message = text
+        wrapped = "\n".join(textwrap.wrap(text, 62)) if text else ""
+        self.message_text.set_text(("error: " if error else "") + wrapped)
+        self.message_text.set_color("tab:red" if error else "0.1")
+        self._redraw()
+
+    def _report(self, text: str) -> None:
+        self.say(text, error=True)
+
+    def _redraw(self) -> None:
+        """Redraw the whole window (soon). Off-screen (Agg) draw_idle would render at once:
+        there the figure is drawn only when saved."""
+        if self.interactive:
+            self.figure.canvas.draw_idle()
+
+    # ---------------------------------------------------------------- fast redraws
+    # Playback and progress change only a few artists (robots, trails, plot lines,
+    # cursors, time slider, progress bar). On a desktop canvas that can blit, those are
+    # "animated": a full draw leaves them out and saves the background, and every frame
+    # restores it and draws just them (matplotlib's blitting recipe).
+    def _dynamic_artists(self) -> list[Any]:
+        slider = self.time_slider
+        handle = getattr(slider, "_handle", None)  # the knob; private in matplotlib
+        extra = [slider.poly, slider.valtext, self.progress_bar, self.progress_text]
+        return [*self.view.dynamic_artists(), *extra, *([handle] if handle else [])]
+
+    def _animate(self, on: bool) -> None:
+        """Mark the dynamic artists as animated (blitting) or normal (full draws)."""
+        for artist in self._dynamic_artists():
+            artist.set_animated(on)
+
+    def _on_full_draw(self, event: Any) -> None:
+        if event.canvas is not self._canvas:  # savefig draws on a temporary canvas
+            return
+        self._background = self._canvas.copy_from_bbox(self.figure.bbox)
+        self._draw_dynamic()
+
+    def _draw_dynamic(self) -> None:
+        for artist in self._dynamic_artists():
+            self.figure.draw_artist(artist)
+
+    def _refresh(self) -> None:
+        """Show changed dynamic artists: blit them when possible, else redraw."""
+        if not self.interactive or self.closed:
+            return
+        if not self._blitting or self._background is None:
+            self._redraw()
+            return
+        canvas = self._canvas
+        self._animate(True)  # artists created since the last frame join the animation
+        canvas.restore_region(self._background)
+        self._draw_dynamic()
+        canvas.blit(self.figure.bbox)
+
+    # ================================================================ settings
+    def apply(self, settings: Settings) -> None:
+        """Replace the settings (checked first: bad ones raise ParameterError)."""
+        check_settings(settings)
+        self._set_settings(settings)
+        self._sync_widgets()
+
+    def _set_settings(self, settings: Settings) -> None:
+        """Take checked settings; a run made with other settings is dropped."""
+        changed = settings != self.settings
+        self.settings = settings
+        if changed:
+            self._cancel_worker()
+            if self.results is not None:
+                self.results = None
+                self.run_settings = None
+                self.say("settings changed: press Run")
+            self._preview()
+
+    def _try(self, settings: Settings) -> None:
+        """Take ``settings`` if they check out (ParameterError propagates to the widget)."""
+        self._set_settings(check_settings(settings))
+
+    def _sync_widgets(self) -> None:
+        """Show the current settings in every widget (without applying anything)."""
+        s = self.settings
+        names = [t.get_text() for t in self.traj_radio.labels]
+        if s.trajectory in names and s.trajectory != FILE_ENTRY:
+            set_radio_silently(self.traj_radio, s.trajectory)
+        else:
+            set_radio_silently(self.traj_radio, FILE_ENTRY)
+            self.file_field.show(s.trajectory)
+        self._show_geometry()
+        set_radio_silently(self.method_radios[0], s.methods[0])
+        set_radio_silently(self.method_radios[1], s.methods[1] or OFF_ENTRY)
+        set_radio_silently(self.plant_radio, s.plant)
+        set_radio_silently(self.integrator_radio, s.integrator)
+        events = self.payload_slider.eventson
+        self.payload_slider.eventson = False
+        self.payload_slider.set_val(s.payload)
+        self.payload_slider.eventson = events
+        self.dt_field.show("" if s.dt is None else f"{s.dt:g}")
+        self.duration_field.show("" if s.duration is None else f"{s.duration:g}")
+        self.offset_field.show(f"{s.offset[0]:g} {s.offset[1]:g}")
+        if s.methods[self._options_slot] is None:
+            self._options_slot = 0
+        self._show_options()
+
+    def _show_geometry(self) -> None:
+        own = {**geometry_of(load_trajectory(self.settings.trajectory)), **self.settings.geometry}
+        for name, field in self.geometry_fields.items():
+            value = own.get(name)
+            field.show("" if value is None else f"{value:.6g}")
+            field.set_visible(value is not None)
+
+    # ---------------------------------------------------------------- trajectory
+    @guarded
+    def _on_trajectory(self, label: str) -> None:
+        if label == FILE_ENTRY:
+            path = self.file_field.text.strip()
+            if not path:
+                self._undo_radio(self.traj_radio, self.settings.trajectory)
+                raise ParameterError("traj: type a .toml or .csv path into the file field")
+            target = path
+        else:
+            target = label
+        try:
+            self._try(self.settings.replace(trajectory=target, geometry={}))
+        except Exception:  # the list shows the setting that stays
+            self._undo_radio(self.traj_radio, self.settings.trajectory)
+            raise
+        self._show_geometry()
+        self.say(f"trajectory: {target}")
+
+    def _undo_radio(self, buttons, value: str) -> None:
+        names = [t.get_text() for t in buttons.labels]
+        set_radio_silently(buttons, value if value in names else FILE_ENTRY)
+
+    def _apply_file(self, text: str) -> str:
+        path = text.strip()
+        if not path:
+            return ""
+        self._try(self.settings.replace(trajectory=path, geometry={}))
+        set_radio_silently(self.traj_radio, FILE_ENTRY)
+        self._show_geometry()
+        self.say(f"trajectory file: {path}")
+        return path
+
+    def _apply_geometry(self, name: str, text: str) -> str:
+        try:
+            number = float(text)
+        except ValueError:
+            raise ParameterError(f"{name} must be a number (got {text!r})") from None
+        value = check_geometry(name, number)
+        self._try(self.settings.with_geometry(name, value))
+        return f"{value:.6g}"
+
+    # ---------------------------------------------------------------- methods
+    @guarded
+    def _on_method(self, slot: int, label: str) -> None:
+        method = None if label == OFF_ENTRY else label
+        try:
+            self._try(self.settings.with_method(slot, method))
+        except Exception:  # the list shows the setting that stays
+            self._undo_radio(self.method_radios[slot], self.settings.methods[slot] or OFF_ENTRY)
+            raise
+        if method is not None:
+            self._options_slot, self._options_page = slot, 0
+        elif self._options_slot == slot:
+            self._options_slot, self._options_page = 0, 0
+        self._show_options()
+        self._redraw()
+
+    def _apply_options_slot(self, slot_name: str) -> None:
+        slot = SLOTS.index(slot_name)
+        if self.settings.methods[slot] is None:
+            raise ParameterError("slot B is off: pick a method under Compare: B first")
+        self._options_slot, self._options_page = slot, 0
+        self._show_options()
+
+    def _apply_options_page(self, page: int) -> None:
+        self._options_page = page - 1
+        self._show_options()
+
+    def _show_options(self) -> None:
+        """Show the option widgets of the edited slot's method (one page of them)."""
+        slot = self._options_slot
+        method = self.settings.methods[slot]
+        for group in self._groups.values():
+            group.hide()
+        group = self._option_group(slot, method)
+        pages = group.pages
+        self._options_page = min(self._options_page, pages - 1)
+        shown = group.page(self._options_page)
+        for _, widget in shown:
+            widget.set_visible(True)
+        self.options_title.set_text(f"Options of {SLOTS[slot]}: {method}")
+        self.options_slot_button.show(SLOTS[slot])
+        self.options_page_button.values = list(range(1, pages + 1))
+        self.options_page_button.format_value = lambda page: f"{page}/{pages}"
+        self.options_page_button.show(self._options_page + 1)
+        self.options_page_button.set_visible(pages > 1)
+        changed = dict(self.settings.options[slot])
+        for spec, widget in shown:
+            value = changed.get(spec.name, spec.default)
+            if isinstance(widget, CycleButton):
+                widget.show(value)
+            else:
+                widget.show(spec.format(value))
+        self.options_note.set_text(
+            "none (this method has no options)"
+            if not group.specs
+            else "blank number field: automatic value (None); Enter applies a field"
+        )
+        self._redraw()
+
+    def _option_group(self, slot: int, method: str) -> _OptionGroup:
+        key = (slot, method)
+        if key not in self._groups:
+            make = functools.partial(self._option_widget, slot)
+            self._groups[key] = _OptionGroup(method_options(method), make)
+        return self._groups[key]
+
+    def _apply_option(self, slot: int, spec: OptionSpec, value: Any) -> None:
+        self._try(self.settings.with_option(slot, spec.name, value))
+        shown = spec.format(value) or "auto"
+        self.say(f"{SLOTS[slot]} {self.settings.methods[slot]}: {spec.name} = {shown}")
+
+    def _apply_option_text(self, slot: int, spec: OptionSpec, text: str) -> str:
+        value = spec.parse(text)
+        self._apply_option(slot, spec, value)
+        return spec.format(value)
+
+    # ---------------------------------------------------------------- simulation settings
+    @guarded
+    def _on_plant(self, label: str) -> None:
+        try:
+            self._try(self.settings.replace(plant=label))
+        except Exception:  # the list shows the setting that stays
+            self._undo_radio(self.plant_radio, self.settings.plant)
+            raise
+
+    @guarded
+    def _on_integrator(self, label: str) -> None:
+        self._try(self.settings.replace(integrator=label))
+
+    @guarded
+    def _on_payload(self, value: float) -> None:
+        self._try(self.settings.replace(payload=round(float(value), 6)))
+
+    def _apply_dt(self, text: str) -> str:
+        value = _optional_positive("dt", text)
+        self._try(self.settings.replace(dt=value))
+        return "" if value is None else f"{value:g}"
+
+    def _apply_duration(self, text: str) -> str:
+        value = _optional_positive("duration", text)
+        self._try(self.settings.replace(duration=value))
+        return "" if value is None else f"{value:g}"
+
+    def _apply_offset(self, text: str) -> str:
+        parts = text.replace(",", " ").split()
+        try:
+            values = tuple(float(p) for p in parts)
+        except ValueError:
+            raise ParameterError(f"offset must be two numbers dx dy in m (got {text!r})") from None
+        if len(values) != 2:
+            raise ParameterError(f"offset must be two numbers dx dy in m (got {text!r})")
+        self._try(self.settings.replace(offset=values))
+        return f"{values[0]:g} {values[1]:g}"
+
+    def _apply_export_dir(self, text: str) -> str:
+        if not text.strip():
+            raise ParameterError("export folder must not be empty")
+        self.export_dir = None  # the next export makes a new run folder under the new root
+        return text.strip()
+
+    # ================================================================ preview and runs
+    def _obstacles(self, settings: Settings) -> list[Any]:
+        circles: list[Any] = []
+        for slot in settings.active_slots:
+            circles += list(getattr(build_controller(settings, slot), "obstacles", ()) or ())
+        return circles
+
+    def _preview(self) -> None:
+        self.view.preview(build_trajectory(self.settings), self._obstacles(self.settings))
+        self._animate(self._blitting)
+        self.summary_text.set_text("")
+        self._set_slider_time(0.0)
+        self._set_progress(0.0, "idle")
+        self._redraw()
+
+    def labels(self) -> list[str]:
+        """Labels of the current runs: the method, or ``A-<method>``/``B-<method>`` side by side."""
+        settings = self.run_settings or self.settings
+        slots = settings.active_slots
+        if len(slots) == 1:
+            return [settings.methods[slots[0]]]
+        return [f"{SLOTS[s]}-{settings.methods[s]}" for s in slots]
+
+    @guarded
+    def run(self) -> None:
+        """Run button: simulate (if needed) and play the run from its start."""
+        worker = self.worker
+        if worker is not None and not worker.finished:
+            if worker.state == "paused":
+                worker.resume()
+                self.say("simulation resumed")
+            return
+        if self.results is not None and self.run_settings == self.settings:
+            if self.view.index >= self.view.last_index:
+                self.show_index(0)
+            self._play()
+            return
+        self._start_worker()
+
+    def _start_worker(self) -> None:
+        settings = check_settings(self.settings)
+        self.run_settings = settings
+        self.results = None
+        self.failure = None
+        self._stop()
+        self.worker = Worker(
+            lambda progress: simulate_settings(settings, progress), len(settings.active_slots)
+        )
+        self._started = time.perf_counter()
+        self.worker.start()
+        self._set_progress(0.0, "simulating 0 %")
+        self.say("simulating " + " and ".join(self.labels()) + " ...")
+        if self.interactive:
+            self._poll_timer.start()
+
+    def wait(self) -> None:
+        """Block until the current simulation ends and take its result (off-screen use)."""
+        if self.worker is not None:
+            self.worker.join()
+        self._poll()
+
+    @guarded
+    def _poll(self) -> None:
+        worker = self.worker
+        if worker is None or self.closed:
+            return
+        state, fraction = worker.state, worker.fraction
+        if state in ("running", "paused"):
+            word = "simulating" if state == "running" else "paused"
+            self._set_progress(fraction, f"{word} {100 * fraction:.0f} %")
+            self._refresh()
+            return
+        if self.interactive:
+            self._poll_timer.stop()
+        self.worker = None
+        if state == "done":
+            self._take_results(worker.result)
+        elif state == "failed":
+            self.run_settings = None
+            self.failure = (worker.error, worker.bad_input)
+            self._set_progress(0.0, "failed")
+            self.say(worker.error, error=True)
+        else:
+            self.run_settings = None
+            self._set_progress(0.0, "cancelled")
+
+    def _take_results(self, results: list[Any]) -> None:
+        elapsed = time.perf_counter() - self._started
+        self.results = results
+        self._run_stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
+        self.export_dir = None
+        self.view.set_runs(results, self.labels(), self._obstacles(self.run_settings))
+        self._animate(self._blitting)
+        steps = results[0].summary["steps"]
+        self._set_progress(1.0, f"done: {steps} steps, {elapsed:.1f} s")
+        self.summary_text.set_text(
+            "\n".join(_summary_line(label, r) for label, r in zip(self.labels(), results))
+        )
+        self.say(f"run finished ({steps} steps per method): playing; drag time to scrub")
+        self.show_index(0)
+        self._play()
+
+    def _cancel_worker(self) -> None:
+        if self.worker is not None and not self.worker.finished:
+            self.worker.cancel()
+            self.worker.join()
+            self._poll()
+
+    # ================================================================ playback
+    def _play(self) -> None:
+        self.playing = True
+        self._last_tick = time.perf_counter()
+        if self.interactive:
+            self._play_timer.start()
+
+    def _stop(self) -> None:
+        self.playing = False
+        if self.interactive:
+            self._play_timer.stop()
+
+    @guarded
+    def pause(self) -> None:
+        """Pause button: hold the simulation (while computing) or the playback."""
+        if self.worker is not None and not self.worker.finished:
+            self.worker.pause()
+            self._poll()
+            self.say("simulation paused: Run resumes it")
+            return
+        self._stop()
+        self.say(f"paused at t = {self.view.time:.2f} s")
+
+    @guarded
+    def step(self) -> None:
+        """Step button: pause and move the playback one recorded step (dt) forward."""
+        if self.results is None:
+            raise ParameterError("step: no finished run yet (press Run)")
+        self._stop()
+        self.show_index(self.view.index + 1)
+
+    @guarded
+    def reset(self) -> None:
+        """Reset button: stop any simulation and playback, back to t = 0."""
+        self._cancel_worker()
+        self._stop()
+        if self.results is not None:
+            self.show_index(0)
+        else:
+            self._preview()
+        self.say("reset to t = 0")
+
+    @property
+    def speed(self) -> float:
+        """Playback speed (simulated s per wall-clock s)."""
+        return SPEEDS[round(self.speed_slider.val)]
+
+    def _on_speed(self, position: float) -> None:
+        self.speed_slider.valtext.set_text(f"{SPEEDS[round(position)]:g} x real time")
+
+    def advance(self, wall_seconds: float) -> None:
+        """Move a playing run forward by ``speed * wall_seconds`` of simulated time."""
+        if not self.playing or self.results is None:
+            return
+        target = self.view.time + self.speed * wall_seconds
+        if target >= self.view.duration:
+            self.show_index(self.view.last_index)
+            self._stop()
+            return
+        self.show_time(target)
+
+    def _on_close(self, _event: Any) -> None:
+        """The window closes: stop the timers and any simulation."""
+        self.closed = True
+        self._play_timer.stop()
+        self._poll_timer.stop()
+        if self.worker is not None:
+            self.worker.cancel()
+
+    @guarded
+    def _on_frame(self) -> None:
+        now = time.perf_counter()
+        elapsed, self._last_tick = now - self._last_tick, now
+        self.advance(elapsed)
+
+    def show_time(self, t: float) -> int:
+        """Show the run at time ``t`` (s); returns the recorded index shown."""
+        return self.show_index(self.view.index_at(t))
+
+    def show_index(self, k: int) -> int:
+        """Show the recorded instant ``k`` of the run; returns it (clipped)."""
+        k = self.view.show_index(k)
+        self.frames_shown += 1
+        duration = self.view.duration
+        self._set_slider_time(self.view.time / duration if duration > 0 else 0.0)
+        self._refresh()
+        return k
+
+    def _set_slider_time(self, fraction: float) -> None:
+        self._moving_slider = True
+        try:
+            self.time_slider.set_val(fraction)
+        finally:
+            self._moving_slider = False
+        self.time_slider.valtext.set_text(f"{self.view.time:.2f} s")
+
+    @guarded
+    def _on_time_slider(self, fraction: float) -> None:
+        if self._moving_slider or self.results is None:
+            if self.results is None and not self._moving_slider:
+                self.time_slider.valtext.set_text("no run")
+            return
+        self._stop()
+        self.show_time(float(fraction) * self.view.duration)
+
+    def _set_progress(self, fraction: float, text: str) -> None:
+        self.progress_bar.set_width(fraction)
+        self.progress_text.set_text(text)
+
+    # ================================================================ export
+    def _export_folder(self) -> Path:
+        if self.results is None:
+            raise ParameterError("export: no finished run yet (press Run)")
+        if self.export_dir is None:
+            settings = self.run_settings
+            names = "-vs-".join(settings.methods[s] for s in settings.active_slots)
+            trajectory = Path(settings.trajectory).stem
+            root = Path(self.export_field.text.strip() or "runs/gui")
+            self.export_dir = export.run_folder(root, f"{names}-{trajectory}-{self._run_stamp}")
+        return self.export_dir
+
+    @guarded
+    def export_data(self) -> list[Path]:
+        """Export button: timeseries.csv and summary.json (the files `track` writes)."""
+        folder = self._export_folder()
+        paths = export.write_run_data(folder, self.results, self.labels())
+        self.say(f"wrote {len(paths)} files to {folder}")
+        return paths
+
+    @guarded
+    def export_png(self) -> Path:
+        """Export button: a PNG of the whole window."""
+        folder = self._export_folder()
+        self._animate(False)  # a saved figure leaves animated artists out
+        try:
+            path = export.write_window_png(self.figure, folder)
+        finally:
+            self._animate(self._blitting)
+        self.say(f"wrote {path}")
+        return path
+
+    @guarded
+    def export_animation(self, fmt: str = "gif") -> Path:
+        """Export button: the run's animation as GIF or MP4."""
+        folder = self._export_folder()
+        self.say(f"writing {fmt} ...")
+        if self.interactive:  # show the message before the export blocks the window
+            self.figure.canvas.draw()
+            self.figure.canvas.flush_events()
+        obstacles = self._obstacles(self.run_settings)
+        path = export.write_animation(self.results, self.labels(), obstacles, folder, fmt)
+        self.say(f"wrote {path}")
+        return path
+
+
+def _optional_positive(name: str, text: str) -> float | None:
+    text = text.strip()
+    if not text:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        raise ParameterError(f"{name} must be a number > 0 in s, or blank (got {text!r})") from None
+    if not (value > 0 and np.isfinite(value)):
+        raise ParameterError(f"{name} must be > 0 s, or blank (got {text})")
+    return value
+
+
+def _summary_line(label: str, result: Any) -> str:
+    s = result.summary
+    return (
+        f"{label}: RMS pos {s['rms_position_error_m']:.3g} m,"
+        f" max {s['max_position_error_m']:.3g} m,"
+        f" RMS orient {s['rms_orientation_error_rad']:.3g} rad, max wheel"
+        f" {s['max_wheel_speed_rad_s']:.3g} rad/s, min S {s['min_stability']:.3g},"
+        f" min eta {s['min_manipulability']:.2f}, saturated {s['saturated_steps']},"
+        f" fallbacks {s['fallback_steps']}"
+    )

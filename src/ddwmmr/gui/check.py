@@ -1,0 +1,140 @@
+"""``make gui-check``: open the real Tk window, drive it through real clicks, screenshot it.
+
+Run under a display (``xvfb-run -a python -m ddwmmr.gui.check OUT_DIR``, which is what
+``make gui-check`` does where ``xvfb-run`` is installed). It opens the desktop window,
+clicks Run with a Tk mouse event (so the click travels Tk -> matplotlib -> widget), lets
+the worker thread simulate and the Tk timers poll and play the run back, then grabs the
+screen area of the window (``window_screen.png``, a real X screenshot) and saves the
+figure itself (``window_figure.png``). It prints what it measured and exits 0, or 1 with
+one line saying what did not happen.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+from ddwmmr.sim.result import write_atomic
+
+#: Give up after this long (s) without the run being simulated and played back.
+TIMEOUT_S = 120.0
+#: Methods and duration of the check run (two methods: the side-by-side mode).
+CHECK_METHODS = ("clrrmc-ts", "qp")
+CHECK_DURATION_S = 6.0
+#: What the check types into the duration field (s) before it clicks Run.
+TYPED_DURATION = "5.5"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point: ``python -m ddwmmr.gui.check [OUT_DIR]``."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    out = Path(argv[0] if argv else "runs/gui-check")
+    if not os.environ.get("DISPLAY"):
+        print("gui-check: no DISPLAY; run it under xvfb-run (make gui-check)", file=sys.stderr)
+        return 1
+    import matplotlib.pyplot as plt
+    from PIL import ImageGrab, ImageStat
+
+    from ddwmmr.gui.app import App
+    from ddwmmr.gui.cli import desktop_figure
+    from ddwmmr.gui.layout import SPEEDS
+    from ddwmmr.gui.settings import Settings
+
+    figure = desktop_figure()
+    app = App(figure, Settings(methods=CHECK_METHODS, duration=CHECK_DURATION_S), interactive=True)
+    app.speed_slider.set_val(SPEEDS.index(8.0))
+    canvas = figure.canvas
+    widget = canvas.get_tk_widget()
+    window = canvas.manager.window
+    report: dict[str, object] = {"draws": 0, "failure": "timed out"}
+    canvas.mpl_connect("draw_event", lambda _e: report.__setitem__("draws", report["draws"] + 1))
+    started = time.perf_counter()
+
+    def click(ax) -> None:
+        """A real Tk mouse click at the centre of ``ax`` (Tk's y axis points down)."""
+        x0, y0, x1, y1 = ax.get_window_extent().extents
+        x, y = int((x0 + x1) / 2), int(canvas.figure.bbox.height - (y0 + y1) / 2)
+        widget.event_generate("<Motion>", x=x, y=y, warp=False)
+        widget.event_generate("<ButtonPress-1>", x=x, y=y)
+        widget.event_generate("<ButtonRelease-1>", x=x, y=y)
+
+    def type_duration() -> None:
+        # Click into the duration field, replace its text key by key, press Enter.
+        widget.focus_force()
+        click(app.duration_field.ax)
+        for _ in app.duration_field.text:
+            widget.event_generate("<KeyPress>", keysym="BackSpace")
+        for key in TYPED_DURATION:
+            widget.event_generate("<KeyPress>", keysym="period" if key == "." else key)
+        widget.event_generate("<KeyPress>", keysym="Return")
+        report["typed"] = app.settings.duration
+        window.after(300, click_run)
+
+    def click_run() -> None:
+        click(app.transport["run"].ax)
+        report["clicked"] = time.perf_counter()
+        window.after(200, watch)
+
+    def watch() -> None:
+        now = time.perf_counter()
+        if app.results is not None and "simulated" not in report:
+            report["simulated"] = now
+            report["frames_at_play"] = app.frames_shown
+        if "simulated" in report and not app.playing:
+            report["played"] = now
+            window.after(300, finish)
+            return
+        if now - started > TIMEOUT_S:
+            report["failure"] = f"no finished playback after {TIMEOUT_S:.0f} s ({app.message})"
+            plt.close(figure)
+            return
+        window.after(100, watch)
+
+    def finish() -> None:
+        window.update()
+        left, top = window.winfo_rootx(), window.winfo_rooty()
+        width, height = window.winfo_width(), window.winfo_height()
+        shot = ImageGrab.grab(
+            bbox=(left, top, left + width, top + height), xdisplay=os.environ["DISPLAY"]
+        )
+        buffer = io.BytesIO()
+        shot.save(buffer, format="PNG")
+        write_atomic(out / "window_screen.png", buffer.getvalue())
+        figure_buffer = io.BytesIO()
+        figure.savefig(figure_buffer, format="png")
+        write_atomic(out / "window_figure.png", figure_buffer.getvalue())
+        spread = ImageStat.Stat(shot.convert("L")).stddev[0]  # 0 for a blank screen
+        report["screen"] = (width, height, spread)
+        report["failure"] = "" if spread > 5 else "the screenshot is blank"
+        plt.close(figure)
+
+    window.after(800, type_duration)
+    plt.show()
+    if not report["failure"] and report.get("typed") != float(TYPED_DURATION):
+        report["failure"] = f"typing {TYPED_DURATION} into duration gave {report.get('typed')}"
+    if report["failure"]:
+        print(f"gui-check: {report['failure']}", file=sys.stderr)
+        return 1
+    playback = report["played"] - report["simulated"]
+    frames = app.frames_shown - report["frames_at_play"]
+    width, height, _ = report["screen"]
+    print(f"gui-check: window {width} x {height} px; duration typed and Run clicked via Tk")
+    print(
+        f"  simulated {app.results[0].summary['steps']} steps x {len(app.results)} methods in "
+        f"{report['simulated'] - report['clicked']:.2f} s (worker thread)"
+    )
+    print(
+        f"  playback of {app.view.duration:.1f} s at {app.speed:g}x: {playback:.2f} s wall, "
+        f"{frames} frames ({frames / max(playback, 1e-9):.1f} per s), "
+        f"{report['draws']} full redraws in all"
+    )
+    print(f"  wrote {out / 'window_screen.png'} and {out / 'window_figure.png'}")
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

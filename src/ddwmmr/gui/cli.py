@@ -1,0 +1,264 @@
+"""``python -m ddwmmr.gui``: the interactive simulator window, or its headless snapshot.
+
+Examples::
+
+    python -m ddwmmr.gui                                   # desktop window (Tk)
+    python -m ddwmmr.gui --method qp --payload 3 \
+        --option obstacles=trajectories/obstacles/ellipse_post.toml
+    python -m ddwmmr.gui --snapshot gui.png --method ats --compare clrrmc-ts --traj rectangle
+
+``--snapshot PATH`` builds the same window off-screen (Agg), runs the simulation to the
+end, draws the final state and saves the whole window (controls and plots) to PATH.
+Bad input prints one line on stderr and exits with status 2 (nothing is written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from ddwmmr.cli.common import ArgumentParser, run_main
+from ddwmmr.controllers.base import available_methods
+from ddwmmr.errors import ParameterError
+from ddwmmr.gui.options import method_options, plant_names
+from ddwmmr.gui.settings import GEOMETRY, Settings, check_geometry, check_settings
+from ddwmmr.plants.kinematic import INTEGRATORS
+from ddwmmr.sim.result import write_atomic
+from ddwmmr.trajectories import available_trajectories
+
+#: Exit status when no window can be opened or a snapshot's run fails (not bad input).
+EXIT_NO_DISPLAY = 1
+
+
+class RunFailed(RuntimeError):
+    """The simulation of a snapshot failed for a reason other than bad input."""
+
+
+def build_parser() -> ArgumentParser:
+    """The argument parser (every option sets the matching control of the window)."""
+    methods = available_methods()
+    parser = ArgumentParser(
+        prog="python -m ddwmmr.gui",
+        description=(
+            "Interactive simulator: pick a trajectory and a method, run, watch the robot and "
+            "the plots, compare two methods, export. Options preset the window's controls."
+        ),
+    )
+    parser.add_argument(
+        "--snapshot",
+        metavar="PATH",
+        help="headless: run to the end, save "
+        "the whole window as PNG to PATH and exit (no display needed)",
+    )
+    parser.add_argument(
+        "--dpi",
+        type=float,
+        default=None,
+        metavar="DPI",
+        help="resolution of the snapshot (default 100: 1600 x 1000 px)",
+    )
+    parser.add_argument(
+        "--method",
+        choices=methods,
+        default=Settings().methods[0],
+        help=f"method of slot A (default {Settings().methods[0]})",
+    )
+    parser.add_argument(
+        "--compare",
+        choices=methods,
+        metavar="METHOD",
+        help="method of slot B, shown side by side with A",
+    )
+    parser.add_argument(
+        "--traj",
+        default=Settings().trajectory,
+        metavar="NAME|FILE",
+        help=f"trajectory ({', '.join(available_trajectories())}) or a "
+        ".toml/.csv path (default ellipse)",
+    )
+    geometry = parser.add_argument_group("trajectory geometry (SPEC 2; default: the file's)")
+    for name, unit, allowed in GEOMETRY:
+        geometry.add_argument(
+            f"--{name}",
+            type=float,
+            metavar="N" if name == "N" else unit.upper(),
+            help=f"{name} in {unit} ({allowed})" if unit != "-" else f"{name} ({allowed})",
+        )
+    parser.add_argument(
+        "--option",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="option of method A (repeatable), e.g. tau=0.3, aux=sum, "
+        "stability_min=1.5, obstacles=FILE",
+    )
+    parser.add_argument(
+        "--compare-option",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="option of method B (repeatable)",
+    )
+    parser.add_argument("--plant", choices=plant_names(), default="kinematic", help="plant")
+    parser.add_argument(
+        "--payload",
+        type=float,
+        metavar="KG",
+        help=f"payload in kg (default {Settings().payload:g})",
+    )
+    parser.add_argument("--integrator", choices=INTEGRATORS, default="rk4")
+    parser.add_argument("--dt", type=float, metavar="S", help="step in s (default T/N)")
+    parser.add_argument(
+        "--duration", type=float, metavar="S", help="simulated time in s (default one period T)"
+    )
+    parser.add_argument(
+        "--offset",
+        type=float,
+        nargs=2,
+        metavar=("DX", "DY"),
+        help="initial end-effector offset in m",
+    )
+    parser.add_argument(
+        "--export", metavar="DIR", help="export folder of the window (default runs/gui)"
+    )
+    return parser
+
+
+def parse_option(method: str, text: str) -> tuple[str, object]:
+    """``NAME=VALUE`` -> (name, value) as the window's field for that option parses it."""
+    name, sep, value = text.partition("=")
+    specs = {spec.name: spec for spec in method_options(method)}
+    if not sep or not name:
+        raise ParameterError(f"option must be NAME=VALUE (got {text!r})")
+    if name not in specs:
+        known = ", ".join(specs) or "none"
+        raise ParameterError(f"option: {method} has no option {name!r} (options: {known})")
+    return name, specs[name].parse(value)
+
+
+def settings_from_arguments(args: argparse.Namespace) -> Settings:
+    """The :class:`Settings` the options describe (checked)."""
+    settings = Settings(trajectory=args.traj).with_method(0, args.method)
+    settings = settings.with_method(1, args.compare)
+    for slot, texts in ((0, args.option), (1, args.compare_option)):
+        if texts and settings.methods[slot] is None:
+            raise ParameterError("compare-option needs --compare METHOD")
+        for text in texts:
+            name, value = parse_option(settings.methods[slot], text)
+            settings = settings.with_option(slot, name, value)
+    for name, _, _ in GEOMETRY:
+        value = getattr(args, name)
+        if value is not None:
+            settings = settings.with_geometry(name, check_geometry(name, value))
+    changes: dict[str, object] = {"plant": args.plant, "integrator": args.integrator}
+    for name in ("payload", "dt", "duration"):
+        if getattr(args, name) is not None:
+            changes[name] = getattr(args, name)
+    if args.offset is not None:
+        changes["offset"] = tuple(args.offset)
+    return check_settings(settings.replace(**changes))
+
+
+def snapshot(
+    settings: Settings, path: str | Path, dpi: float | None = None, export_dir: str | None = None
+) -> Path:
+    """Build the window off-screen, run to the end, draw the final state, save it as PNG."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from ddwmmr.gui.app import App
+    from ddwmmr.gui.layout import DPI, FIGSIZE
+
+    figure = Figure(figsize=FIGSIZE, dpi=DPI)
+    FigureCanvasAgg(figure)
+    app = App(figure, settings)
+    if export_dir:
+        app.export_field.show(export_dir)
+    app.run()
+    app.wait()
+    if app.results is None:
+        message, bad_input = app.failure or ("the run did not finish", False)
+        if bad_input:
+            raise ParameterError(message)
+        raise RunFailed(message)
+    app.show_index(app.view.last_index)
+    app.say(f"snapshot: final state at t = {app.view.time:.2f} s (--snapshot {Path(path).name})")
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=dpi or DPI)
+    path = Path(path)
+    write_atomic(path, buffer.getvalue())
+    return path
+
+
+def desktop_figure():
+    """A Tk window's figure, its resolution lowered so that the window fits the screen.
+
+    The layout is in figure fractions and the fonts in points, so a lower dpi shrinks the
+    whole window evenly. Tk multiplies the dpi by its pixel ratio (``tk scaling`` against
+    the usual 96 px per inch), which the fit includes.
+    """
+    import tkinter
+
+    import matplotlib.pyplot as plt
+
+    from ddwmmr.gui.layout import DPI, FIGSIZE
+
+    probe = tkinter.Tk()  # raises TclError without a display
+    probe.withdraw()
+    try:
+        screen_width, screen_height = probe.winfo_screenwidth(), probe.winfo_screenheight()
+        ratio = float(probe.tk.call("tk", "scaling")) * 72.0 / 96.0
+    finally:
+        probe.destroy()
+    # Leave room for the toolbar, the title bar and a desktop panel.
+    dpi = min(DPI, 0.96 * screen_width / FIGSIZE[0], 0.84 * screen_height / FIGSIZE[1])
+    plt.switch_backend("TkAgg")
+    figure = plt.figure(figsize=FIGSIZE, dpi=dpi / max(ratio, 1e-3))
+    figure.canvas.manager.set_window_title("ddwmmr simulator")
+    return figure
+
+
+def open_window(settings: Settings, export_dir: str | None = None) -> int:
+    """Open the desktop window (Tk) and run its event loop until it is closed."""
+    import matplotlib.pyplot as plt
+
+    from ddwmmr.gui.app import App
+
+    try:
+        figure = desktop_figure()
+    except Exception as exc:  # no display, no Tk: say so in one line
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        print(
+            f"error: cannot open a window ({first}); use --snapshot PATH headless", file=sys.stderr
+        )
+        return EXIT_NO_DISPLAY
+    app = App(figure, settings, interactive=True)
+    if export_dir:
+        app.export_field.show(export_dir)
+    figure.ddwmmr_app = app  # keep the app (and its widgets) alive with the window
+    plt.show()
+    return 0
+
+
+def _main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    settings = settings_from_arguments(args)
+    if args.dpi is not None and not args.dpi > 0:
+        raise ParameterError(f"dpi must be > 0 (got {args.dpi:g})")
+    if args.snapshot:
+        try:
+            path = snapshot(settings, args.snapshot, args.dpi, args.export)
+        except RunFailed as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return EXIT_NO_DISPLAY
+        print(f"wrote {path}")
+        return 0
+    return open_window(settings, args.export)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; bad input prints one line on stderr and returns 2."""
+    return run_main(_main, argv)

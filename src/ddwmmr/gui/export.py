@@ -1,0 +1,158 @@
+"""Export of the app's current run: CSV/JSON, a PNG of the window, an animation.
+
+Every file is written on its own with :func:`ddwmmr.sim.result.write_atomic` (or the
+result's own ``write_csv``/``write_summary``, which use it). Nothing in the export folder
+is ever deleted or overwritten: a name that exists gets a ``-2``, ``-3``... suffix.
+
+Layout of one run's export folder (``<root>/<A>[-vs-<B>]-<trajectory>-<stamp>/``)::
+
+    timeseries.csv, summary.json     one method: the files `python -m ddwmmr.track` writes
+    A-<method>/timeseries.csv ...    side-by-side mode: one sub-folder per slot
+    window.png                       the whole window
+    animation.gif | animation.mp4    the view (paths, robot, plots) over the run
+"""
+
+from __future__ import annotations
+
+import io
+import tempfile
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+from matplotlib import animation as mpl_animation
+from matplotlib.figure import Figure
+from PIL import Image
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.sim.result import write_atomic
+
+#: Animation formats and the matplotlib writer each needs.
+ANIMATION_WRITERS = {"gif": "pillow", "mp4": "ffmpeg"}
+
+
+def unique_path(path: Path) -> Path:
+    """``path``, or ``stem-2.suffix``, ``stem-3.suffix``... whichever does not exist yet."""
+    if not path.exists():
+        return path
+    number = 2
+    while True:
+        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
+        if not candidate.exists():
+            return candidate
+        number += 1
+
+
+def run_folder(root: Path, name: str) -> Path:
+    """A folder for one run's files under ``root`` that does not exist yet."""
+    return unique_path(Path(root) / name)
+
+
+def write_run_data(folder: Path, results: Sequence[Any], labels: Sequence[str]) -> list[Path]:
+    """timeseries.csv and summary.json of every run (in a sub-folder per run when two)."""
+    written = []
+    for result, label in zip(results, labels):
+        target = folder if len(results) == 1 else folder / label
+        csv_path = unique_path(target / "timeseries.csv")
+        result.write_csv(csv_path)
+        json_path = unique_path(target / "summary.json")
+        result.write_summary(json_path)
+        written += [csv_path, json_path]
+    return written
+
+
+def write_window_png(figure: Figure, folder: Path, dpi: float | None = None) -> Path:
+    """The whole window as ``window.png``."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=dpi or figure.dpi)
+    path = unique_path(folder / "window.png")
+    write_atomic(path, buffer.getvalue())
+    return path
+
+
+def animation_available(fmt: str) -> bool:
+    """True if matplotlib can write ``fmt`` here (MP4 needs ffmpeg on PATH)."""
+    return mpl_animation.writers.is_available(ANIMATION_WRITERS[fmt])
+
+
+def write_animation(
+    results: Sequence[Any],
+    labels: Sequence[str],
+    obstacles: Sequence[Any],
+    folder: Path,
+    fmt: str = "gif",
+    frames: int = 60,
+    fps: int = 12,
+    dpi: float = 80.0,
+) -> Path:
+    """``animation.<fmt>``: the view (robot, paths, plots) at ``frames`` evenly spaced times.
+
+    Drawn by the window's own :class:`ddwmmr.gui.view.RunView` in a separate figure;
+    a run shorter than ``frames`` recorded instants gives one frame per instant.
+    """
+    from ddwmmr.gui.view import animation_figure
+
+    if fmt not in ANIMATION_WRITERS:
+        raise ParameterError(f"animation format must be one of {', '.join(ANIMATION_WRITERS)}")
+    if not animation_available(fmt):
+        raise ParameterError(
+            f"{fmt} export needs the {ANIMATION_WRITERS[fmt]} writer, which matplotlib cannot "
+            "find here (install ffmpeg on PATH, or export a GIF)"
+        )
+    figure, view = animation_figure(dpi)
+    view.set_runs(results, labels, obstacles)
+    indices = frame_indices(view.last_index, frames)
+    path = unique_path(folder / f"animation.{fmt}")
+    if fmt == "gif":
+        images = list(_blitted_frames(figure, view, indices))
+        # One palette for all frames, from the last (it has every trail and colour).
+        palette = images[-1].quantize(colors=128, method=Image.Quantize.FASTOCTREE)
+        images = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in images]
+        buffer = io.BytesIO()
+        images[0].save(
+            buffer,
+            format="GIF",
+            save_all=True,
+            append_images=images[1:],
+            duration=round(1000 / fps),
+            loop=0,
+        )
+        write_atomic(path, buffer.getvalue())
+        return path
+    writer = mpl_animation.writers[ANIMATION_WRITERS[fmt]](fps=fps)
+    with tempfile.TemporaryDirectory() as scratch:
+        temporary = Path(scratch) / path.name
+        with writer.saving(figure, str(temporary), dpi):
+            for index in indices:
+                view.show_index(index)
+                writer.grab_frame()
+        write_atomic(path, temporary.read_bytes())
+    return path
+
+
+def _blitted_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterator[Image.Image]:
+    """RGB images of the view at ``indices``: the still parts are rendered once, then
+    every frame redraws only the moving artists on that background (several times faster
+    than full renders, which spend most of their time on the axes' ticks). The legends
+    belong to the background, placed for the whole run."""
+    canvas = figure.canvas
+    view.show_index(view.last_index)
+    for artist in view.dynamic_artists(legends=False):
+        artist.set_animated(True)
+    canvas.draw()
+    background = canvas.copy_from_bbox(figure.bbox)
+    size = canvas.get_width_height()
+    for index in indices:
+        view.show_index(index)
+        canvas.restore_region(background)
+        for artist in view.dynamic_artists(legends=False):
+            figure.draw_artist(artist)
+        yield Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert(
+            "RGB"
+        )
+
+
+def frame_indices(last: int, frames: int) -> list[int]:
+    """Up to ``frames`` distinct recorded indices from 0 to ``last``, evenly spread."""
+    count = max(min(frames, last + 1), 1)
+    return sorted({round(last * i / max(count - 1, 1)) for i in range(count)})

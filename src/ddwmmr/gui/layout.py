@@ -1,0 +1,335 @@
+"""Where every control of the simulator window sits (figure fractions of a 16 x 10 in
+window) and which handler it calls.
+
+:class:`PanelLayout` builds the widgets into ``self.figure``; the handlers
+(``self._on_*``, ``self._apply_*``, ``self.run``, ``self.export_*``...) belong to
+:class:`ddwmmr.gui.app.App`, which inherits this class. Layout and behaviour are apart so
+that each reads on its own.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any
+
+from matplotlib.patches import Rectangle
+from matplotlib.widgets import Slider
+
+from ddwmmr.controllers.base import available_methods
+from ddwmmr.gui.options import OptionSpec, format_choice, plant_names
+from ddwmmr.gui.settings import GEOMETRY, SLOTS
+from ddwmmr.gui.view import RunView, add_view_axes
+from ddwmmr.gui.widgets import FONT, CycleButton, Field, button, panel_axes, radio
+from ddwmmr.plants.kinematic import INTEGRATORS
+from ddwmmr.trajectories import available_trajectories
+
+#: Window size (inches) and resolution of the window and its snapshot.
+FIGSIZE = (16.0, 10.0)
+DPI = 100
+#: Entry of the trajectory list that stands for the path typed in the file field.
+FILE_ENTRY = "file"
+#: Entry of slot B's list that switches the side-by-side mode off.
+OFF_ENTRY = "off"
+#: Playback speeds (simulated seconds per wall-clock second).
+SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
+DEFAULT_SPEED = 4.0
+#: Method options shown per page (two columns).
+OPTIONS_PER_PAGE = 12
+PAYLOAD_RANGE = (0.0, 5.0)
+
+
+class PanelLayout:
+    """Builds the window's widgets (mixed into :class:`ddwmmr.gui.app.App`)."""
+
+    figure: Any
+    settings: Any
+
+    def _build(self) -> None:
+        fig = self.figure
+        fig.text(0.012, 0.972, "ddwmmr simulator", fontsize=13, weight="bold")
+        fig.text(0.15, 0.974, "python -m ddwmmr.gui", fontsize=FONT, color="0.4")
+        self._build_trajectory()
+        self._build_methods()
+        self._build_options()
+        self._build_simulation()
+        self._build_export()
+        self._build_messages()
+        self._build_view()
+        self._build_transport()
+
+    def _drawing_widgets(self) -> list[Any]:
+        """Widgets that redraw the canvas themselves when set (radios, sliders)."""
+        return [
+            self.traj_radio,
+            *self.method_radios,
+            self.plant_radio,
+            self.integrator_radio,
+            self.payload_slider,
+            self.speed_slider,
+            self.time_slider,
+        ]
+
+    def _heading(self, x: float, y: float, text: str):
+        return self.figure.text(x, y, text, fontsize=FONT + 1.5, weight="bold", color="0.15")
+
+    def _build_trajectory(self) -> None:
+        self._heading(0.012, 0.945, "Trajectory")
+        names = [*available_trajectories(), FILE_ENTRY]
+        height = min(0.026 * len(names), 0.16)
+        self.traj_radio = radio(self.figure, (0.008, 0.935 - height, 0.12, height), names, 0)
+        self.traj_radio.on_clicked(self._on_trajectory)
+        self.file_field = Field(
+            self.figure,
+            (0.032, 0.905 - height, 0.128, 0.024),
+            "file",
+            "",
+            self._apply_file,
+            self._report,
+        )
+        self.figure.text(
+            0.012,
+            0.885 - height,
+            ".toml (ellipse/rectangle) or .csv t,x,y[,phi]",
+            fontsize=FONT - 1,
+            color="0.4",
+        )
+        self._heading(0.19, 0.945, "Geometry")
+        self.geometry_fields: dict[str, Field] = {}
+        for row, (name, unit, allowed) in enumerate(GEOMETRY):
+            label = name if unit == "-" else f"{name} ({unit})"
+            self.geometry_fields[name] = Field(
+                self.figure,
+                (0.235, 0.912 - 0.027 * row, 0.06, 0.023),
+                label,
+                "",
+                functools.partial(self._apply_geometry, name),
+                self._report,
+                hint=allowed,
+            )
+
+    def _build_methods(self) -> None:
+        methods = available_methods()
+        top = 0.72
+        self._heading(0.012, top + 0.008, "Method A")
+        self._heading(0.122, top + 0.008, "Compare: B")
+        height_a = min(0.026 * len(methods), 0.2)
+        height_b = min(0.026 * (len(methods) + 1), 0.2)
+        self.method_radios = [
+            radio(self.figure, (0.008, top - height_a, 0.11, height_a), methods, 0),
+            radio(self.figure, (0.118, top - height_b, 0.11, height_b), [OFF_ENTRY, *methods], 0),
+        ]
+        self.method_radios[0].on_clicked(functools.partial(self._on_method, 0))
+        self.method_radios[1].on_clicked(functools.partial(self._on_method, 1))
+        self._heading(0.235, top + 0.008, "Plant")
+        plants = plant_names()
+        height = 0.026 * len(plants)
+        self.plant_radio = radio(self.figure, (0.232, top - height, 0.1, height), plants, 0)
+        self.plant_radio.on_clicked(self._on_plant)
+        below = top - height - 0.02
+        self._heading(0.235, below, "Integrator")
+        height = 0.026 * len(INTEGRATORS)
+        self.integrator_radio = radio(
+            self.figure, (0.232, below - 0.008 - height, 0.1, height), list(INTEGRATORS), 0
+        )
+        self.integrator_radio.on_clicked(self._on_integrator)
+        self._methods_bottom = min(top - height_b, below - 0.008 - height)
+
+    def _build_options(self) -> None:
+        top = self._methods_bottom - 0.02
+        self._options_top = top - 0.012
+        self.options_title = self._heading(0.012, top, "Options")
+        self.options_slot_button = CycleButton(
+            self.figure,
+            (0.19, top - 0.004, 0.07, 0.022),
+            "edit",
+            list(SLOTS),
+            "A",
+            self._apply_options_slot,
+            self._report,
+        )
+        self.options_page_button = CycleButton(
+            self.figure,
+            (0.265, top - 0.004, 0.065, 0.022),
+            "page",
+            [1],
+            1,
+            self._apply_options_page,
+            self._report,
+        )
+        self.options_note = self.figure.text(
+            0.012, self._options_top - 0.03 * 6 - 0.018, "", fontsize=FONT - 1, color="0.4"
+        )
+
+    def _build_simulation(self) -> None:
+        top = self._options_top - 0.03 * 6 - 0.048
+        self._heading(0.012, top, "Simulation")
+        self.payload_ax = panel_axes(self.figure, (0.09, top - 0.03, 0.17, 0.02))
+        self.payload_slider = Slider(
+            self.payload_ax,
+            "payload (kg)",
+            *PAYLOAD_RANGE,
+            valinit=self.settings.payload,
+            valstep=0.05,
+            valfmt="%.2f kg",
+        )
+        self.payload_slider.label.set_fontsize(FONT)
+        self.payload_slider.valtext.set_fontsize(FONT)
+        self.payload_slider.on_changed(self._on_payload)
+        row = top - 0.062
+        self.dt_field = Field(
+            self.figure,
+            (0.09, row, 0.06, 0.023),
+            "dt (s)",
+            "",
+            self._apply_dt,
+            self._report,
+            hint="blank: T/N",
+        )
+        self.duration_field = Field(
+            self.figure,
+            (0.255, row, 0.05, 0.023),
+            "duration (s)",
+            "",
+            self._apply_duration,
+            self._report,
+            hint="blank: T",
+        )
+        self.offset_field = Field(
+            self.figure,
+            (0.09, row - 0.03, 0.09, 0.023),
+            "offset dx dy (m)",
+            "",
+            self._apply_offset,
+            self._report,
+            hint="start error of the end effector",
+        )
+        self._simulation_bottom = row - 0.03
+
+    def _build_export(self) -> None:
+        top = self._simulation_bottom - 0.035
+        self._heading(0.012, top, "Export")
+        self.export_field = Field(
+            self.figure,
+            (0.09, top - 0.032, 0.24, 0.023),
+            "folder",
+            "runs/gui",
+            self._apply_export_dir,
+            self._report,
+        )
+        row = top - 0.07
+        self.export_buttons = {
+            "data": button(self.figure, (0.012, row, 0.075, 0.028), "CSV + JSON", self.export_data),
+            "png": button(self.figure, (0.092, row, 0.075, 0.028), "PNG (window)", self.export_png),
+            "gif": button(
+                self.figure,
+                (0.172, row, 0.075, 0.028),
+                "GIF",
+                functools.partial(self.export_animation, "gif"),
+            ),
+            "mp4": button(
+                self.figure,
+                (0.252, row, 0.075, 0.028),
+                "MP4",
+                functools.partial(self.export_animation, "mp4"),
+            ),
+        }
+        for widget in self.export_buttons.values():
+            widget.label.set_fontsize(FONT)
+        self._export_bottom = row
+
+    def _build_messages(self) -> None:
+        bottom, top = 0.015, self._export_bottom - 0.012
+        ax = panel_axes(self.figure, (0.008, bottom, 0.325, top - bottom))
+        ax.set_xticks([])
+        ax.set_yticks([])
+        ax.set_facecolor("0.97")
+        self.message_text = ax.text(
+            0.02,
+            0.94,
+            "",
+            transform=ax.transAxes,
+            fontsize=FONT,
+            va="top",
+            ha="left",
+            family="monospace",
+        )
+
+    def _build_view(self) -> None:
+        path_ax, plot_axes = add_view_axes(
+            self.figure, (0.385, 0.33, 0.31, 0.625), (0.745, 0.265, 0.245, 0.69)
+        )
+        self.view = RunView(path_ax, plot_axes)
+        self.summary_text = self.figure.text(
+            0.385, 0.228, "", fontsize=FONT, va="top", linespacing=1.6
+        )
+
+    def _build_transport(self) -> None:
+        row = 0.1
+        self.transport = {
+            "run": button(self.figure, (0.385, row, 0.055, 0.038), "Run", self.run),
+            "pause": button(self.figure, (0.445, row, 0.055, 0.038), "Pause", self.pause),
+            "step": button(self.figure, (0.505, row, 0.055, 0.038), "Step", self.step),
+            "reset": button(self.figure, (0.565, row, 0.055, 0.038), "Reset", self.reset),
+        }
+        self.speed_ax = panel_axes(self.figure, (0.68, row + 0.01, 0.1, 0.02))
+        self.speed_slider = Slider(
+            self.speed_ax,
+            "speed",
+            0,
+            len(SPEEDS) - 1,
+            valinit=SPEEDS.index(DEFAULT_SPEED),
+            valstep=1,
+            initcolor="none",
+        )
+        self.speed_slider.label.set_fontsize(FONT)
+        self.speed_slider.valtext.set_fontsize(FONT)
+        self.speed_slider.on_changed(self._on_speed)
+        self._on_speed(self.speed_slider.val)
+        self.progress_ax = panel_axes(self.figure, (0.845, row + 0.004, 0.145, 0.03))
+        self.progress_ax.set_xlim(0, 1)
+        self.progress_ax.set_ylim(0, 1)
+        self.progress_ax.set_xticks([])
+        self.progress_ax.set_yticks([])
+        self.progress_bar = Rectangle((0, 0), 0, 1, color="tab:green", alpha=0.5)
+        self.progress_ax.add_patch(self.progress_bar)
+        self.progress_text = self.progress_ax.text(
+            0.5,
+            0.5,
+            "idle",
+            ha="center",
+            va="center",
+            fontsize=FONT,
+            transform=self.progress_ax.transAxes,
+        )
+        self.time_ax = panel_axes(self.figure, (0.42, 0.045, 0.52, 0.025))
+        self.time_slider = Slider(
+            self.time_ax, "time", 0.0, 1.0, valinit=0.0, valfmt="%.2f", initcolor="none"
+        )
+        self.time_slider.label.set_fontsize(FONT)
+        self.time_slider.valtext.set_fontsize(FONT)
+        self.time_slider.on_changed(self._on_time_slider)
+
+    def _option_widget(self, slot: int, number: int, spec: OptionSpec) -> Field | CycleButton:
+        row, column = divmod(number % OPTIONS_PER_PAGE, 2)
+        left = 0.012 + 0.163 * column
+        bottom = self._options_top - 0.03 * (row + 1)
+        apply = functools.partial(self._apply_option, slot, spec)
+        if spec.kind == "choice":
+            return CycleButton(
+                self.figure,
+                (left, bottom, 0.155, 0.024),
+                spec.label,
+                spec.choices,
+                spec.default,
+                apply,
+                self._report,
+                format_choice,
+            )
+        return Field(
+            self.figure,
+            (left + 0.092, bottom, 0.062, 0.024),
+            spec.label,
+            spec.format(spec.default),
+            lambda text: self._apply_option_text(slot, spec, text),
+            self._report,
+        )

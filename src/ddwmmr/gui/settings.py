@@ -1,0 +1,281 @@
+"""The app's settings and how they become a run of :func:`ddwmmr.simulate`.
+
+A :class:`Settings` value is everything the control panel sets. It is immutable: the app
+builds a changed copy, checks it with :func:`check_settings`, and only then replaces the
+current one, so a bad field never leaves a half-applied setting behind.
+
+Trajectory geometry ``(x0, y0, a, b, beta, N, T)`` (SPEC §2) applies to every trajectory:
+
+* parametric ones (ellipse, rectangle, their TOML files) take the values directly;
+* sampled ones (CSV files such as the figure-eight) are placed by the same numbers: their
+  samples are scaled so that the bounding box has half-extents (a, b), rotated by beta
+  and centred on (x0, y0); their times are stretched to last T. N is the resolution:
+  the step defaults to T / N like for the parametric shapes. With the file's own values
+  the file's trajectory is used unchanged.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.controllers.base import available_methods, make_controller
+from ddwmmr.errors import ParameterError, check_finite, check_int_at_least, check_positive
+from ddwmmr.gui.options import method_options, plant_keywords, plant_names
+from ddwmmr.model import Robot
+from ddwmmr.plants.kinematic import INTEGRATORS
+from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
+from ddwmmr.sim import SimulationResult, simulate
+from ddwmmr.trajectories import SampledTrajectory, load_trajectory
+
+#: Trajectory geometry parameters, in panel order, with unit and allowed range.
+GEOMETRY = (
+    ("x0", "m", "any"),
+    ("y0", "m", "any"),
+    ("a", "m", "> 0"),
+    ("b", "m", "> 0"),
+    ("beta", "rad", "any"),
+    ("N", "-", ">= 2"),
+    ("T", "s", "> 0"),
+)
+#: The two method slots: A (always on) and B (side-by-side comparison, may be off).
+SLOTS = ("A", "B")
+
+
+@dataclass(frozen=True)
+class Settings:
+    """Everything one run depends on (units: m, rad, s, kg).
+
+    Attributes:
+        trajectory: a trajectory name (``available_trajectories()``) or a file path.
+        geometry: geometry values changed from the trajectory's own (see module doc).
+        methods: method of slot A and of slot B (None: no comparison).
+        options: per slot, the method options changed from their defaults.
+        plant: plant name (see :func:`ddwmmr.gui.options.plant_names`).
+        payload: payload at the end effector (kg).
+        integrator: ``rk4`` or ``euler``.
+        dt: control step (s); None: T / N.
+        duration: simulated time (s); None: one period T.
+        offset: initial end-effector offset (dx, dy) (m).
+    """
+
+    trajectory: str = "ellipse"
+    geometry: Mapping[str, float] = field(default_factory=dict)
+    methods: tuple[str, str | None] = ("clrrmc-ts", None)
+    options: tuple[Mapping[str, Any], Mapping[str, Any]] = ({}, {})
+    plant: str = "kinematic"
+    payload: float = Robot().payload
+    integrator: str = "rk4"
+    dt: float | None = None
+    duration: float | None = None
+    offset: tuple[float, float] = DEFAULT_INITIAL_OFFSET
+
+    def replace(self, **changes: Any) -> Settings:
+        """A copy with ``changes`` applied (not yet checked)."""
+        return dataclasses.replace(self, **changes)
+
+    def with_method(self, slot: int, method: str | None) -> Settings:
+        """Slot ``slot`` (0 = A, 1 = B) switched to ``method``, with default options."""
+        methods = list(self.methods)
+        options = list(self.options)
+        if methods[slot] != method:
+            methods[slot], options[slot] = method, {}
+        return self.replace(methods=tuple(methods), options=tuple(options))
+
+    def with_option(self, slot: int, name: str, value: Any) -> Settings:
+        """Option ``name`` of slot ``slot`` set to ``value`` (its default drops the entry)."""
+        method = self.methods[slot]
+        spec = {s.name: s for s in method_options(method)}[name]
+        changed = dict(self.options[slot])
+        if value == spec.default and type(value) is type(spec.default):
+            changed.pop(name, None)
+        else:
+            changed[name] = value
+        options = list(self.options)
+        options[slot] = changed
+        return self.replace(options=tuple(options))
+
+    def with_geometry(self, name: str, value: float) -> Settings:
+        """Geometry parameter ``name`` set to ``value`` (the file's own value drops it)."""
+        changed = dict(self.geometry)
+        own = geometry_of(load_trajectory(self.trajectory))
+        if own.get(name) == value:
+            changed.pop(name, None)
+        else:
+            changed[name] = value
+        return self.replace(geometry=changed)
+
+    @property
+    def active_slots(self) -> list[int]:
+        """Indices of the slots holding a method (A, and B when comparing)."""
+        return [i for i, m in enumerate(self.methods) if m is not None]
+
+
+def geometry_of(trajectory: Any) -> dict[str, float]:
+    """The geometry values ``x0, y0, a, b, beta, N, T`` of a trajectory (see module doc).
+
+    Trajectories that are neither parametric nor sampled give only N and T.
+    """
+    if isinstance(trajectory, SampledTrajectory):
+        xy = trajectory.points[:, :2]
+        low, high = xy.min(axis=0), xy.max(axis=0)
+        centre, half = (low + high) / 2, (high - low) / 2
+        return {
+            "x0": float(centre[0]),
+            "y0": float(centre[1]),
+            "a": float(half[0]),
+            "b": float(half[1]),
+            "beta": 0.0,
+            "N": int(trajectory.samples),
+            "T": float(trajectory.duration),
+        }
+    if dataclasses.is_dataclass(trajectory) and all(
+        hasattr(trajectory, name) for name, _, _ in GEOMETRY
+    ):
+        return {name: getattr(trajectory, name) for name, _, _ in GEOMETRY}
+    values: dict[str, float] = {"T": float(trajectory.duration)}
+    if getattr(trajectory, "samples", None):
+        values["N"] = int(trajectory.samples)
+    return values
+
+
+def check_geometry(name: str, value: float) -> float | int:
+    """Validate one geometry value (ranges of :data:`GEOMETRY`)."""
+    if name == "N":
+        return check_int_at_least("N", value, 2)
+    if name in ("a", "b", "T"):
+        return check_positive(name, value)
+    return check_finite(name, value)
+
+
+def build_trajectory(settings: Settings) -> Any:
+    """The desired trajectory of ``settings`` (the loaded one placed by its geometry)."""
+    base = load_trajectory(settings.trajectory)
+    changes = {name: check_geometry(name, v) for name, v in settings.geometry.items()}
+    if not changes:
+        return base
+    if isinstance(base, SampledTrajectory):
+        return place_samples(base, {**geometry_of(base), **changes})
+    own = geometry_of(base)
+    unknown = sorted(set(changes) - set(own) - {"N"})
+    if unknown or not dataclasses.is_dataclass(base):
+        raise ParameterError(
+            f"{unknown[0] if unknown else 'geometry'}: not a parameter of {settings.trajectory}"
+        )
+    return dataclasses.replace(base, **changes)
+
+
+def place_samples(base: SampledTrajectory, geometry: Mapping[str, float]) -> SampledTrajectory:
+    """``base`` scaled to half-extents (a, b), rotated by beta about its centre, centred on
+    (x0, y0) and stretched in time to last T (a sampled orientation is turned by beta).
+
+    An axis along which the samples do not move keeps its scale (nothing to stretch).
+    """
+    own = geometry_of(base)
+    scale = np.array([geometry[k] / own[k] if own[k] > 0 else 1.0 for k in ("a", "b")])
+    c, s = math.cos(geometry["beta"]), math.sin(geometry["beta"])
+    rotation = np.array([[c, -s], [s, c]])
+    local = (base.points[:, :2] - [own["x0"], own["y0"]]) * scale
+    points = local @ rotation.T + [geometry["x0"], geometry["y0"]]
+    if base.points.shape[1] == 3:
+        points = np.column_stack([points, base.points[:, 2] + geometry["beta"]])
+    start = base.times[0]
+    times = start + (base.times - start) * (geometry["T"] / own["T"])
+    return SampledTrajectory(times, points, name=base.name)
+
+
+def control_step(settings: Settings, trajectory: Any) -> float | None:
+    """The step passed to simulate: the set dt, else T / N when N was changed for a sampled
+    trajectory (whose own resolution is its sample count), else None (simulate's T / N)."""
+    if settings.dt is not None:
+        return settings.dt
+    if isinstance(trajectory, SampledTrajectory) and "N" in settings.geometry:
+        return trajectory.duration / settings.geometry["N"]
+    return None
+
+
+def build_robot(settings: Settings) -> Robot:
+    """The default robot carrying the chosen payload."""
+    return Robot().with_payload(settings.payload)
+
+
+def build_controller(settings: Settings, slot: int) -> Any:
+    """The controller of slot ``slot``, built by :func:`make_controller`."""
+    return make_controller(
+        settings.methods[slot], build_robot(settings), **dict(settings.options[slot])
+    )
+
+
+def check_settings(settings: Settings) -> Settings:
+    """Raise :class:`ParameterError` if ``settings`` cannot be run; return them unchanged.
+
+    Everything a run needs is built once (trajectory, robot, controllers); what only the
+    simulation itself can find (e.g. dt longer than the run) shows when it runs.
+    """
+    methods = available_methods()
+    for slot in settings.active_slots:
+        if settings.methods[slot] not in methods:
+            raise ParameterError(
+                f"method: unknown method {settings.methods[slot]!r} (known: {', '.join(methods)})"
+            )
+    if settings.methods[0] is None:
+        raise ParameterError("method: slot A needs a method")
+    if settings.plant not in plant_names():
+        raise ParameterError(
+            f"plant must be one of {', '.join(plant_names())} (got {settings.plant!r})"
+        )
+    plant_keywords(settings.plant)
+    if settings.integrator not in INTEGRATORS:
+        raise ParameterError(
+            f"integrator must be one of {', '.join(INTEGRATORS)} (got {settings.integrator!r})"
+        )
+    for name in ("dt", "duration"):
+        value = getattr(settings, name)
+        if value is not None:
+            check_positive(name, value)
+    if len(settings.offset) != 2:
+        raise ParameterError("offset must be two numbers dx, dy in m")
+    for value in settings.offset:
+        check_finite("offset", value)
+    build_trajectory(settings)
+    for slot in settings.active_slots:
+        build_controller(settings, slot)
+    return settings
+
+
+def simulate_settings(
+    settings: Settings, progress: Callable[[int, int, int], None] | None = None
+) -> list[SimulationResult]:
+    """Run every active slot with :func:`ddwmmr.simulate`, A first.
+
+    ``progress(slot_index, step, steps)`` is called after every simulated step.
+    """
+    trajectory = build_trajectory(settings)
+    robot = build_robot(settings)
+    results = []
+    for index, slot in enumerate(settings.active_slots):
+        controller = build_controller(settings, slot)
+
+        def report(step: int, steps: int, index: int = index) -> None:
+            if progress is not None:
+                progress(index, step, steps)
+
+        results.append(
+            simulate(
+                robot,
+                trajectory,
+                controller,
+                dt=control_step(settings, trajectory),
+                duration=settings.duration,
+                integrator=settings.integrator,
+                initial_offset=tuple(settings.offset),
+                progress=report,
+                **plant_keywords(settings.plant),
+            )
+        )
+    return results

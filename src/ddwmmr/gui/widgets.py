@@ -1,0 +1,230 @@
+"""Small widget helpers of the control panel (matplotlib widgets, figure coordinates).
+
+* :class:`Field` - a labelled text box that applies its text through a callback; when the
+  callback raises :class:`ParameterError` the box returns to its previous text (the
+  previous valid setting stays) and the error goes to the window's message line.
+* :class:`CycleButton` - a button showing ``name: value`` that steps through a list of
+  values on every click (choices, on/off flags).
+* :func:`radio` - radio buttons with small labels.
+
+Widgets are also driven programmatically (tests, ``--snapshot``): ``Field.submit(text)``
+behaves like typing the text and pressing Enter.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.widgets import Button, RadioButtons, TextBox
+
+from ddwmmr.errors import ParameterError
+
+#: Font size of panel labels and widget texts (points).
+FONT = 8
+#: Callback receiving an error message to show in the window.
+Reporter = Callable[[str], None]
+
+
+def panel_axes(figure: Figure, rect: Sequence[float]) -> Axes:
+    """A bare axes at ``rect`` (left, bottom, width, height in figure fractions)."""
+    ax = figure.add_axes(rect)
+    ax.set_navigate(False)
+    return ax
+
+
+class QuietTextBox(TextBox):
+    """A TextBox that does not redraw the whole figure when it need not.
+
+    matplotlib's TextBox ends typing - and draws the full figure - on every click anywhere
+    and every window resize, in each box, even when nobody types in it (with 15 boxes a
+    click took seconds); and it draws the full figure on every key typed. Here ending
+    typing does nothing unless this box is being typed in, and a key schedules an idle
+    redraw instead of drawing at once.
+    """
+
+    def stop_typing(self) -> None:
+        if self.capturekeystrokes:
+            super().stop_typing()
+
+    def _rendercursor(self) -> None:  # overrides matplotlib's cursor redraw
+        canvas = self.ax.figure.canvas
+        if self.ax.figure._get_renderer() is None:
+            super()._rendercursor()
+            return
+        canvas.draw = canvas.draw_idle  # the typed key shows at the next idle redraw
+        try:
+            super()._rendercursor()
+        finally:
+            del canvas.draw
+
+
+def describe_error(exc: Exception) -> str:
+    """One line for the message area: a ParameterError's own text, else type and text."""
+    if isinstance(exc, ParameterError):
+        return str(exc).splitlines()[0]
+    text = str(exc).splitlines()[0] if str(exc) else ""
+    return f"{type(exc).__name__}: {text}".rstrip(": ")
+
+
+class Field:
+    """A labelled text box whose submitted text is applied by ``apply(text)``.
+
+    ``apply`` returns the text to show (e.g. normalised), or raises
+    :class:`ParameterError`; then the box shows its previous text again and ``report``
+    receives the message.
+    """
+
+    def __init__(
+        self,
+        figure: Figure,
+        rect: Sequence[float],
+        label: str,
+        text: str,
+        apply: Callable[[str], str | None],
+        report: Reporter,
+        hint: str = "",
+    ) -> None:
+        self.ax = panel_axes(figure, rect)
+        self.box = QuietTextBox(self.ax, label, initial=text, label_pad=0.04)
+        self.box.label.set_fontsize(FONT)
+        self.box.text_disp.set_fontsize(FONT)
+        self.box.text_disp.set_clip_on(True)  # long paths stay inside the box
+        self.hint = None
+        if hint:
+            self.hint = self.ax.text(
+                1.04,
+                0.5,
+                hint,
+                transform=self.ax.transAxes,
+                fontsize=FONT - 1,
+                color="0.35",
+                va="center",
+                ha="left",
+            )
+        self.apply = apply
+        self.report = report
+        self.valid_text = text
+        self.box.on_submit(self._submitted)
+
+    @property
+    def text(self) -> str:
+        """The text currently in the box."""
+        return self.box.text
+
+    def submit(self, text: str) -> None:
+        """Type ``text`` into the box and press Enter."""
+        self._set_silently(text)
+        self._submitted(text)
+
+    def show(self, text: str) -> None:
+        """Display ``text`` as the valid content, without applying it."""
+        self.valid_text = text
+        self._set_silently(text)
+
+    def set_visible(self, visible: bool) -> None:
+        """Show or hide the box (a hidden box ignores clicks)."""
+        self.ax.set_visible(visible)
+        self.box.set_active(visible)
+
+    def _submitted(self, text: str) -> None:
+        if text == self.valid_text:
+            return
+        try:
+            shown = self.apply(text)
+        except Exception as exc:  # the previous valid text stays; the window shows why
+            self.report(describe_error(exc))
+            self._set_silently(self.valid_text)
+            return
+        self.valid_text = text if shown is None else shown
+        if shown is not None and shown != text:
+            self._set_silently(shown)
+
+    def _set_silently(self, text: str) -> None:
+        # TextBox.set_val would show the typing cursor and redraw the whole figure.
+        self.box.text_disp.set_text(text)
+        self.box.cursor.set_visible(False)
+
+
+class CycleButton:
+    """A button labelled ``name: value`` that moves to the next of ``values`` when clicked.
+
+    ``apply(value)`` may raise :class:`ParameterError`: the value then stays where it was.
+    """
+
+    def __init__(
+        self,
+        figure: Figure,
+        rect: Sequence[float],
+        name: str,
+        values: Sequence[Any],
+        current: Any,
+        apply: Callable[[Any], None],
+        report: Reporter,
+        format_value: Callable[[Any], str] = str,
+    ) -> None:
+        self.ax = panel_axes(figure, rect)
+        self.name = name
+        self.values = list(values)
+        self.format_value = format_value
+        self.value = current
+        self.button = Button(self.ax, self._caption(current), color="0.9", hovercolor="0.97")
+        self.button.label.set_fontsize(FONT)
+        self.apply = apply
+        self.report = report
+        self.button.on_clicked(lambda _event: self.click())
+
+    def click(self) -> None:
+        """Move to the next value (what a mouse click does)."""
+        position = self.values.index(self.value) if self.value in self.values else -1
+        following = self.values[(position + 1) % len(self.values)]
+        try:
+            self.apply(following)
+        except Exception as exc:  # the value stays; the window shows why
+            self.report(describe_error(exc))
+            return
+        self.show(following)
+
+    def show(self, value: Any) -> None:
+        """Display ``value`` as the current one, without applying it."""
+        self.value = value
+        self.button.label.set_text(self._caption(value))
+
+    def set_visible(self, visible: bool) -> None:
+        """Show or hide the button (a hidden button ignores clicks)."""
+        self.ax.set_visible(visible)
+        self.button.set_active(visible)
+
+    def _caption(self, value: Any) -> str:
+        return f"{self.name}: {self.format_value(value)}"
+
+
+def radio(
+    figure: Figure, rect: Sequence[float], labels: Sequence[str], active: int
+) -> RadioButtons:
+    """Vertical radio buttons with panel-size labels and no frame."""
+    ax = panel_axes(figure, rect)
+    ax.set_frame_on(False)
+    buttons = RadioButtons(ax, list(labels), active=active, label_props={"fontsize": [FONT]})
+    return buttons
+
+
+def set_radio_silently(buttons: RadioButtons, label: str) -> None:
+    """Select ``label`` without calling the radio's callbacks."""
+    labels = [text.get_text() for text in buttons.labels]
+    events = buttons.eventson
+    buttons.eventson = False
+    try:
+        buttons.set_active(labels.index(label))
+    finally:
+        buttons.eventson = events
+
+
+def button(figure: Figure, rect: Sequence[float], label: str, action: Callable[[], None]) -> Button:
+    """A push button calling ``action()`` when clicked."""
+    widget = Button(panel_axes(figure, rect), label, color="0.88", hovercolor="0.97")
+    widget.label.set_fontsize(FONT + 1)
+    widget.on_clicked(lambda _event: action())
+    return widget

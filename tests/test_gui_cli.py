@@ -1,0 +1,255 @@
+"""``python -m ddwmmr.gui``: headless snapshots, options, bad input (one line, exit 2)."""
+
+import os
+import subprocess
+import sys
+import tkinter
+from pathlib import Path
+
+import numpy as np
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from PIL import Image
+
+import ddwmmr.gui.settings as gui_settings
+from ddwmmr import Robot, available_methods, available_trajectories, simulate
+from ddwmmr.gui import App, Settings, cli
+from ddwmmr.gui.cli import build_parser, main, settings_from_arguments
+from ddwmmr.gui.layout import FIGSIZE
+from ddwmmr.gui.settings import build_trajectory
+from ddwmmr.reports.plots import robot_outline
+
+#: Snapshot resolution of the tests (the window is 16 x 10 in): 480 x 300 px.
+DPI = "30"
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(argv):
+    """Exit status of the tool (argparse errors exit through SystemExit, like track)."""
+    try:
+        return main(argv)
+    except SystemExit as exit_:
+        return exit_.code
+
+
+def trajectory_files(tmp_path):
+    toml = tmp_path / "wide.toml"
+    toml.write_text('[trajectory]\nshape = "ellipse"\na = 2.5\nb = 1.6\nT = 45\n')
+    csv = tmp_path / "line.csv"
+    rows = [f"{0.05 * k:.2f},{1.0 + 0.01 * k:.3f},{0.05 * np.sin(0.3 * k):.4f}" for k in range(61)]
+    csv.write_text("t,x,y\n" + "\n".join(rows) + "\n")  # 3 s, a sample every 0.05 s
+    return [str(toml), str(csv)]
+
+
+def test_every_trajectory_and_method_is_offered():
+    assert {"ellipse", "rectangle", "figure8", "sideways_reach"} <= set(available_trajectories())
+    assert len(available_methods()) >= 6
+
+
+@pytest.mark.parametrize("number", range(len(available_methods())))
+def test_snapshot_for_every_method(number, tmp_path, capsys):
+    """Every method once, the trajectories in turn (every name and both file kinds)."""
+    method = available_methods()[number]
+    trajectories = [*available_trajectories(), *trajectory_files(tmp_path)]
+    trajectory = trajectories[number % len(trajectories)]
+    path = tmp_path / "shot.png"
+    status = main(
+        [
+            "--snapshot",
+            str(path),
+            "--dpi",
+            DPI,
+            "--method",
+            method,
+            "--traj",
+            trajectory,
+            "--duration",
+            "0.4",
+        ]
+    )
+    assert status == 0, capsys.readouterr().err
+    assert capsys.readouterr().out.strip() == f"wrote {path}"
+    with Image.open(path) as image:
+        assert image.size == (480, 300)
+        pixels = np.asarray(image.convert("L"), dtype=float)
+    assert pixels.std() > 20  # widgets, plots and text, not a blank page
+
+
+def test_remaining_trajectories_snapshot(tmp_path, capsys):
+    """Trajectories the method rotation above did not reach (if any), with side by side."""
+    trajectories = [*available_trajectories(), *trajectory_files(tmp_path)]
+    reached = {trajectories[n % len(trajectories)] for n in range(len(available_methods()))}
+    for trajectory in [t for t in trajectories if t not in reached] or trajectories[:1]:
+        path = tmp_path / f"{Path(trajectory).stem}.png"
+        argv = [
+            "--snapshot",
+            str(path),
+            "--dpi",
+            DPI,
+            "--traj",
+            trajectory,
+            "--method",
+            "ats",
+            "--compare",
+            "clrrmc-ts",
+            "--duration",
+            "0.4",
+        ]
+        assert main(argv) == 0, capsys.readouterr().err
+        assert path.is_file()
+
+
+def test_every_method_on_every_trajectory_draws_the_final_state(tmp_path):
+    """The window (one, reused) shows where simulate() leaves the robot, for all pairs."""
+    figure = Figure(figsize=FIGSIZE, dpi=30)
+    FigureCanvasAgg(figure)
+    app = App(figure, Settings(duration=0.2))
+    for trajectory in [*available_trajectories(), *trajectory_files(tmp_path)]:
+        for method in available_methods():
+            settings = Settings(
+                trajectory=trajectory, methods=(method, None), duration=0.3, dt=0.05
+            )
+            app.apply(settings)
+            app.run()
+            app.wait()
+            assert app.results is not None, (method, trajectory, app.message)
+            app.show_index(app.view.last_index)
+            expected = simulate(Robot(), build_trajectory(settings), method, duration=0.3, dt=0.05)
+            final = robot_outline(Robot(), expected.configurations()[-1])["footprint"]
+            np.testing.assert_allclose(app.view.runs[0].footprint.get_xy(), final, atol=1e-12)
+
+
+def test_options_reach_the_window_settings():
+    argv = [
+        "--method",
+        "qp",
+        "--compare",
+        "ats",
+        "--option",
+        "stability_min=1.5",
+        "--option",
+        "tau=0.2 0.3 0.4",
+        "--compare-option",
+        "aux=sum",
+        "--traj",
+        "rectangle",
+        "--T",
+        "30",
+        "--payload",
+        "3",
+        "--integrator",
+        "euler",
+        "--dt",
+        "0.05",
+        "--duration",
+        "2",
+        "--offset",
+        "0",
+        "0.01",
+    ]
+    settings = settings_from_arguments(build_parser().parse_args(argv))
+    assert settings == Settings(
+        trajectory="rectangle",
+        geometry={"T": 30.0},
+        methods=("qp", "ats"),
+        options=({"stability_min": 1.5, "tau": (0.2, 0.3, 0.4)}, {"aux": "sum"}),
+        payload=3.0,
+        integrator="euler",
+        dt=0.05,
+        duration=2.0,
+        offset=(0.0, 0.01),
+    )
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--method", "nope"], "invalid choice: 'nope'"),
+        (["--T", "-1"], "T must be > 0 (got -1)"),
+        (["--N", "1.5"], "N must be an integer >= 2"),
+        (["--traj", "nowhere.csv"], "traj: no such file nowhere.csv"),
+        (["--option", "bogus=1"], "has no option 'bogus'"),
+        (["--option", "tau=-1"], "tau must be > 0 s"),
+        (["--option", "tau"], "option must be NAME=VALUE"),
+        (["--compare-option", "aux=sum"], "compare-option needs --compare METHOD"),
+        (["--duration", "1", "--dt", "5"], "dt must be <= duration"),
+        (["--dpi", "0"], "dpi must be > 0"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):
+    path = tmp_path / "shot.png"
+    status = run(["--snapshot", str(path), "--dpi", DPI, *argv])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert len(err.strip().splitlines()) == 1 and message in err, err
+    assert not path.exists() and not list(tmp_path.iterdir())
+
+
+def test_not_a_trajectory_file_is_bad_input(tmp_path, capsys):
+    notes = tmp_path / "notes.toml"
+    notes.write_text("[shopping]\nmilk = 1\n")
+    status = main(["--snapshot", str(tmp_path / "shot.png"), "--traj", str(notes)])
+    err = capsys.readouterr().err
+    assert status == 2 and err.count("\n") == 1 and "needs shape" in err
+
+
+def test_a_crashing_run_exits_1_with_one_line(tmp_path, capsys, monkeypatch):
+    def broken(*args, **kwargs):
+        raise RuntimeError("solver exploded")
+
+    monkeypatch.setattr(gui_settings, "simulate", broken)
+    status = main(["--snapshot", str(tmp_path / "shot.png"), "--duration", "0.2"])
+    err = capsys.readouterr().err
+    assert status == 1 and err == "error: run failed: RuntimeError: solver exploded\n"
+    assert not list(tmp_path.iterdir())
+
+
+def test_no_display_is_one_line(monkeypatch, capsys):
+    def no_display():
+        raise tkinter.TclError("no display name and no $DISPLAY environment variable")
+
+    monkeypatch.setattr(cli, "desktop_figure", no_display)
+    assert main(["--duration", "1"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cannot open a window (no display name" in err
+    assert "--snapshot PATH" in err
+
+
+def test_module_runs_headless_as_a_process(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "MPLBACKEND")}
+    path = tmp_path / "gui.png"
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "ddwmmr.gui",
+            "--snapshot",
+            str(path),
+            "--dpi",
+            DPI,
+            "--method",
+            "clrrmc-ts",
+            "--compare",
+            "ats",
+            "--duration",
+            "0.5",
+        ],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=ROOT,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout == f"wrote {path}\n" and path.is_file()
+    bad = subprocess.run(
+        [sys.executable, "-m", "ddwmmr.gui", "--snapshot", str(tmp_path / "x.png"), "--T", "-3"],
+        capture_output=True,
+        text=True,
+        env=env,
+        cwd=ROOT,
+        timeout=300,
+    )
+    assert bad.returncode == 2 and bad.stderr == "error: T must be > 0 (got -3)\n"
+    assert not (tmp_path / "x.png").exists()

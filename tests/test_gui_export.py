@@ -1,0 +1,137 @@
+"""Export from the simulator window: the run's files as `track` writes them, a PNG of the
+window, an animation; files are written one by one and nothing is deleted or replaced."""
+
+import csv
+import json
+
+import numpy as np
+from matplotlib.backend_bases import MouseEvent
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from PIL import Image
+
+from ddwmmr.cli.track import main as track
+from ddwmmr.gui import App, Settings
+from ddwmmr.gui.export import animation_available
+from ddwmmr.gui.layout import FIGSIZE
+
+DURATION = 1.0
+
+
+def finished_app(settings, export_root):
+    figure = Figure(figsize=FIGSIZE, dpi=30)
+    FigureCanvasAgg(figure)
+    app = App(figure, settings)
+    app.export_field.submit(str(export_root))
+    app.run()
+    app.wait()
+    assert app.results is not None, app.message
+    return app
+
+
+def click(ax):
+    canvas = ax.figure.canvas
+    x, y = ax.transAxes.transform((0.5, 0.5))
+    for name in ("button_press_event", "button_release_event"):
+        canvas.callbacks.process(name, MouseEvent(name, canvas, x, y, button=1))
+
+
+def read_csv(path):
+    with path.open(newline="") as handle:
+        rows = list(csv.reader(handle))
+    return rows[0], np.array(rows[1:], dtype=float)
+
+
+def test_data_export_equals_the_track_files(tmp_path):
+    app = finished_app(Settings(methods=("clrrmc-cs", None), duration=DURATION), tmp_path / "gui")
+    click(app.export_buttons["data"].ax)
+    (folder,) = (tmp_path / "gui").iterdir()
+    assert folder.name.startswith("clrrmc-cs-ellipse-")
+    assert sorted(p.name for p in folder.iterdir()) == ["summary.json", "timeseries.csv"]
+    status = track(
+        [
+            "--method",
+            "clrrmc-cs",
+            "--traj",
+            "ellipse",
+            "--duration",
+            str(DURATION),
+            "--out",
+            str(tmp_path / "track"),
+            "--no-plots",
+            "--no-progress",
+        ]
+    )
+    assert status == 0
+    header, values = read_csv(folder / "timeseries.csv")
+    track_header, track_values = read_csv(tmp_path / "track" / "timeseries.csv")
+    assert header == track_header
+    timing = header.index("step_us")  # wall-clock time of each controller call
+    keep = [i for i in range(len(header)) if i != timing]
+    np.testing.assert_array_equal(values[:, keep], track_values[:, keep])
+    summary = json.loads((folder / "summary.json").read_text())
+    track_summary = json.loads((tmp_path / "track" / "summary.json").read_text())
+    summary.pop("median_step_us")
+    track_summary.pop("median_step_us")
+    assert summary == track_summary
+
+
+def test_exports_never_delete_or_replace_files(tmp_path):
+    root = tmp_path / "exports"
+    root.mkdir()
+    (root / "keep.txt").write_text("mine")
+    app = finished_app(Settings(methods=("ats", "pi"), duration=DURATION), root)
+    first = app.export_data()
+    csv_a = next(p for p in first if p.name == "timeseries.csv")
+    before = csv_a.read_bytes()
+    second = app.export_data()
+    assert {p.name for p in first} == {"timeseries.csv", "summary.json"}
+    assert {p.name for p in second} == {"timeseries-2.csv", "summary-2.json"}
+    assert {p.parent.name for p in first} == {"A-ats", "B-pi"}
+    assert csv_a.read_bytes() == before
+    window = app.export_png()
+    again = app.export_png()
+    assert (window.name, again.name) == ("window.png", "window-2.png")
+    with Image.open(window) as image:
+        assert image.size == (480, 300)  # 16 x 10 in at the figure's 30 dpi
+    assert (root / "keep.txt").read_text() == "mine"
+    (run_folder,) = [p for p in root.iterdir() if p.is_dir()]
+    assert run_folder.name.startswith("ats-vs-pi-ellipse-")
+    assert not [p for p in run_folder.rglob("*") if p.name.endswith(".tmp")]
+
+
+def test_gif_has_the_frames_of_the_run(tmp_path):
+    app = finished_app(Settings(methods=("clrrmc-ts", "ats"), duration=DURATION), tmp_path)
+    click(app.export_buttons["gif"].ax)
+    (path,) = tmp_path.rglob("animation.gif")
+    with Image.open(path) as movie:
+        assert movie.n_frames == 51 and movie.size == (880, 448)  # one per step; 80 dpi
+        first = np.asarray(movie.convert("L"), dtype=float)
+        movie.seek(movie.n_frames - 1)
+        last = np.asarray(movie.convert("L"), dtype=float)
+    assert np.mean(np.abs(first - last) > 30) > 0.002  # the robot moved, plots grew
+    assert app.message == f"wrote {path}"
+
+
+def test_mp4_needs_ffmpeg(tmp_path):
+    app = finished_app(Settings(methods=("ats", None), duration=DURATION), tmp_path)
+    click(app.export_buttons["mp4"].ax)
+    movies = list(tmp_path.rglob("*.mp4"))
+    if animation_available("mp4"):
+        assert len(movies) == 1 and movies[0].stat().st_size > 0
+    else:
+        assert not movies
+        assert "mp4 export needs the ffmpeg writer" in app.message
+
+
+def test_export_before_a_run_is_a_message(tmp_path):
+    figure = Figure(figsize=FIGSIZE, dpi=30)
+    FigureCanvasAgg(figure)
+    app = App(figure, Settings(duration=DURATION))
+    app.export_field.submit(str(tmp_path))
+    click(app.export_buttons["png"].ax)
+    assert app.message == "export: no finished run yet (press Run)"
+    assert not list(tmp_path.iterdir())
+    app.export_field.submit(" ")
+    assert app.message == "export folder must not be empty"
+    assert app.export_field.text == str(tmp_path)
