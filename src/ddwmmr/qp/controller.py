@@ -39,11 +39,12 @@ from ddwmmr.qp.limits import (
     WheelSpeedLimit,
     as_circles,
     footprint_clearances,
+    full_step_is_safe,
     safe_arm_scale,
     stability_terms_gradient,
 )
 from ddwmmr.qp.problem import QPProblem
-from ddwmmr.qp.solve import check_mode, make_backend, solve
+from ddwmmr.qp.solve import check_mode, make_backend, solve, solve_weighted
 from ddwmmr.qp.tasks import (
     Detour,
     EndEffectorTask,
@@ -124,6 +125,7 @@ class QPControllerCore:
         limits: Sequence[Limit] = (),
     ) -> None:
         self.robot = robot
+        self._com = robot.com_coefficients
         self.mode = check_mode(mode)
         self.solver = solver
         self.backend = self._make_backend(solver, warm_start)
@@ -210,18 +212,32 @@ class QPControllerCore:
         x = self._solve(ctx)
         if x is None:
             return self._fallback(ctx)
-        v, w, r1, r2 = x[:4].tolist()
-        scale = safe_arm_scale(
-            self.robot.com_coefficients, ctx.th1, ctx.th2, r1, r2, ctx.dt, self.stability_min
+        v, w, r1, r2, *slack = x.tolist()
+        scale = self.arm_scale(ctx, r1, r2)
+        self.last = StepInfo(
+            extra={"slack": max(map(abs, slack)) if slack else 0.0, "arm_scale": scale}
         )
-        self.last = StepInfo(extra={"slack": float(np.abs(x[4:]).max()), "arm_scale": scale})
         ctx.previous_command = (v, w)
         return np.array([v, w, r1 * scale, r2 * scale])
 
+    def arm_scale(self, ctx: StepContext, rate1: float, rate2: float) -> float:
+        """Scale of the joint rates that keeps the exact S one step ahead above the floor
+        (:func:`safe_arm_scale`); the exact look-ahead runs only when the linearised
+        margin is tight (:func:`full_step_is_safe` cannot prove scale 1)."""
+        com = self._com
+        trig = (ctx.sin_th1, ctx.cos_th1, ctx.sin_th12, ctx.cos_th12)
+        th1, th2, dt, floor = ctx.th1, ctx.th2, ctx.dt, self.stability_min
+        if full_step_is_safe(com, trig, th1, th2, rate1, rate2, dt, floor):
+            return 1.0
+        return safe_arm_scale(com, th1, th2, rate1, rate2, dt, floor)
+
     def _solve(self, ctx: StepContext) -> np.ndarray | None:
         """Build and solve this step's QP; None on failure."""
-        self.problem.build(ctx)
-        return solve(self.problem, self.backend, self.mode).x
+        problem = self.problem
+        problem.build(ctx)
+        if self.mode == "weighted":
+            return solve_weighted(problem, self.backend)
+        return solve(problem, self.backend, self.mode).x
 
     def _fallback(self, ctx: StepContext) -> np.ndarray:
         """Safe command: stop the base; move the arm up the stability gradient of every

@@ -48,7 +48,8 @@ class NaiveQPController(QPControllerCore):
         return NaiveOsqpBackend()
 
     def _solve(self, ctx: StepContext) -> np.ndarray | None:
-        """Allocate a new problem, build it, solve it."""
-        problem = QPProblem(self.tasks, self.limits)
+        """Allocate a new problem (every piece through its generic ``compute``), build it,
+        solve it."""
+        problem = QPProblem(self.tasks, self.limits, compiled=False)
         problem.build(ctx)
         return solve(problem, self.backend, self.mode).x

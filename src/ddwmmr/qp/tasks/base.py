@@ -4,16 +4,19 @@ A task asks for ``J u = e``: ``J`` (rows x 4) maps the inputs ``u = (v, w, th1do
 (m/s, rad/s, rad/s, rad/s) to some task rate, ``e`` is the rate it wants. The solver adds
 ``weight * ||J u - e||^2`` to the cost, or, for a task with ``slack = True``, turns the rows
 into equality constraints ``J u - s = e`` whose slack ``s`` is penalised by ``weight``.
-A new objective is one subclass implementing :meth:`Task.compute`.
+A new objective is one subclass implementing :meth:`Task.compute`; the built-in tasks also
+implement the optional fast path :meth:`Task.compile` (see :mod:`ddwmmr.qp.blocks`).
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 
 import numpy as np
 
 from ddwmmr.errors import check_nonnegative
+from ddwmmr.qp.blocks import TaskBlock
 from ddwmmr.qp.context import StepContext
 
 
@@ -46,3 +49,8 @@ class Task(ABC):
 
         Both arrays are views into the stacked problem: write every entry, every step.
         """
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Optional fast path: a writer filling ``block`` each step (see
+        :mod:`ddwmmr.qp.blocks`). The default, None, has :meth:`compute` called instead."""
+        return None

@@ -21,11 +21,13 @@ through where the base drives: ``th2`` is set by the shoulder-to-end-effector di
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
 from ddwmmr.errors import check_positive
 from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import Task
 
@@ -86,18 +88,41 @@ class ManipulabilityTask(Task):
         """``(weight, weight)``, or ``(0, weight)`` without the arm row."""
         return np.array([self.weight if self.arm_row else 0.0, self.weight])
 
-    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
-        """Row 0 on th2dot, row 1 on w."""
+    def values(self, ctx: StepContext) -> tuple[float, float, float, float]:
+        """The varying entries ``(J[0, 3], e[0], J[1, 1], e[1])`` (unweighted)."""
         th2 = ctx.th2
-        jac[:] = 0.0
-        jac[0, 3] = eta_squared_gradient(th2)
-        error[0] = self.gain * math.cos(th2) ** 2  # 1 - eta^2
+        arm_slope = eta_squared_gradient(th2)
+        arm_target = self.gain * math.cos(th2) ** 2  # 1 - eta^2
         gx, gy = base_gradient(ctx.L1, ctx.L2, ctx)
         vx = ctx.velocity_d[0] + 0.5 * self.base_gain * gx
         vy = ctx.velocity_d[1] + 0.5 * self.base_gain * gy
         factor = min(1.0, math.hypot(vx, vy) / FADE_SPEED)
         if factor == 0.0:
-            error[1] = 0.0
-            return
-        jac[1, 1] = factor
-        error[1] = factor * self.heading_gain * wrap_angle(math.atan2(vy, vx) - ctx.phi)
+            return arm_slope, arm_target, 0.0, 0.0
+        steer = factor * self.heading_gain * wrap_angle(math.atan2(vy, vx) - ctx.phi)
+        return arm_slope, arm_target, factor, steer
+
+    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        """Row 0 on th2dot, row 1 on w."""
+        jac[:] = 0.0
+        jac[0, 3], error[0], jac[1, 1], error[1] = self.values(ctx)
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Writer for the two weighted rows (zeros elsewhere are constant)."""
+        if overrides(self, ManipulabilityTask) or overrides(self, ManipulabilityTask, "values"):
+            return None
+        block.write_constant_rows([[0.0] * 4, [0.0] * 4])
+        jac, (target,) = block.jac, block.target_views
+        arm, steer = block.rows[0] + 3, block.rows[1] + 1
+        t0, t1 = block.targets
+        w0, w1 = block.scales
+        values = self.values
+
+        def write(ctx: StepContext) -> None:
+            arm_slope, arm_target, factor, steer_target = values(ctx)
+            jac[arm] = arm_slope * w0
+            target[t0] = arm_target * w0
+            jac[steer] = factor * w1
+            target[t1] = steer_target * w1
+
+        return write

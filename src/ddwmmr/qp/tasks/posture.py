@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ddwmmr.errors import check_nonnegative, check_positive
+from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import Task
+
+#: The rows on (w, th1dot, th2dot).
+IDENTITY_ROWS = ((0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 
 class PostureTask(Task):
@@ -46,3 +52,20 @@ class PostureTask(Task):
         error[0] = -self.gain * ctx.phi
         error[1] = -self.gain * ctx.th1
         error[2] = -self.gain * ctx.th2
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Constant rows, written once; the writer fills the three weighted targets."""
+        if overrides(self, PostureTask):
+            return None
+        block.write_constant_rows(IDENTITY_ROWS)
+        (target,) = block.target_views
+        t0, t1, t2 = block.targets
+        w0, w1, w2 = block.scales
+
+        def write(ctx: StepContext) -> None:
+            gain = self.gain
+            target[t0] = -gain * ctx.phi * w0
+            target[t1] = -gain * ctx.th1 * w1
+            target[t2] = -gain * ctx.th2 * w2
+
+        return write

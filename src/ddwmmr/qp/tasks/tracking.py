@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from ddwmmr.errors import check_positive
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import Task
 
@@ -49,8 +50,9 @@ class EndEffectorTask(Task):
         #: feedback round obstacles (same magnitude, towards the detour's aim point).
         self.detour = None
 
-    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
-        """Rows: the end-effector Jacobian; target: feed-forward + clipped feedback."""
+    def targets(self, ctx: StepContext) -> tuple[float, float, float]:
+        """Target rates ``(xE_dot, yE_dot, phiE_dot)``: feed-forward + clipped feedback
+        (m/s, m/s, rad/s); the last is 0 without orientation tracking."""
         xe, ye, phie = ctx.pose_e
         xd, yd, phid = ctx.pose_d
         vx, vy, vphi = ctx.velocity_d
@@ -65,11 +67,42 @@ class EndEffectorTask(Task):
             norm = math.hypot(fx, fy)
             if norm > self.max_speed:
                 fx, fy = fx * self.max_speed / norm, fy * self.max_speed / norm
+        if not self.track_orientation:
+            return vx + fx, vy + fy, 0.0
+        # Wrapped: a pose 2 pi away is the same orientation.
+        return vx + fx, vy + fy, vphi + self.kphi * wrap_angle(phid - phie)
+
+    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        """Rows: the end-effector Jacobian; target: feed-forward + clipped feedback."""
         jac[:] = ctx.jac_e
-        error[0], error[1] = vx + fx, vy + fy
-        if self.track_orientation:
-            # Wrapped: a pose 2 pi away is the same orientation.
-            error[2] = vphi + self.kphi * wrap_angle(phid - phie)
-        else:
+        error[0], error[1], error[2] = self.targets(ctx)
+        if not self.track_orientation:
             jac[2] = 0.0
-            error[2] = 0.0
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Writer for the slack rows: the Jacobian's varying entries and the targets.
+
+        ``track_orientation`` is read here (it fixes the phiE row); recompile after
+        changing it (:meth:`QPProblem.refresh_weights`)."""
+        if overrides(self, EndEffectorTask) or overrides(self, EndEffectorTask, "targets"):
+            return None
+        if not block.slack or any(scale != 1.0 for scale in block.scales):
+            return None
+        block.write_constant_rows([[0.0] * 4, [0.0] * 4, [0.0, 1.0, 1.0, 1.0]])
+        if not self.track_orientation:
+            block.write_constant_rows([[0.0] * 4, [0.0] * 4, [0.0] * 4])
+        jac, (lower, upper) = block.jac, block.target_views
+        r0, r1, _ = block.rows
+        t0, t1, t2 = block.targets
+        targets = self.targets
+
+        def write(ctx: StepContext) -> None:
+            dx_v, dx_w, dx_2, dy_v, dy_w, dy_2 = ctx.jac_e_rows
+            jac[r0], jac[r0 + 1], jac[r0 + 2], jac[r0 + 3] = dx_v, dx_w, dx_w, dx_2
+            jac[r1], jac[r1 + 1], jac[r1 + 2], jac[r1 + 3] = dy_v, dy_w, dy_w, dy_2
+            e0, e1, e2 = targets(ctx)
+            lower[t0] = upper[t0] = e0
+            lower[t1] = upper[t1] = e1
+            lower[t2] = upper[t2] = e2
+
+        return write
