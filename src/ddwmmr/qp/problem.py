@@ -107,6 +107,8 @@ class QPProblem:
         }
         #: The input box as Python floats, shared by the compiled limits (see LimitBlock).
         self.box = list(_OPEN_BOX)
+        #: Whether the last build left lb <= ub on every input (see box_consistent).
+        self.box_ok = True
         self.refresh_weights()
 
     # -- set-up ---------------------------------------------------------------------------
@@ -211,7 +213,7 @@ class QPProblem:
             lower, upper = self._mv["lower"], self._mv["upper"]
             lower[0], lower[1], lower[2], lower[3] = box[0], box[1], box[2], box[3]
             upper[0], upper[1], upper[2], upper[3] = box[4], box[5], box[6], box[7]
-            self._box_ok = (
+            self.box_ok = (
                 box[0] <= box[4] and box[1] <= box[5] and box[2] <= box[6] and box[3] <= box[7]
             )
         self._weighted_cost()
@@ -231,7 +233,7 @@ class QPProblem:
         u_lb, u_ub = self.lb[:NU], self.ub[:NU]
         for limit, G, low, up in self._generic_limits:
             limit.compute(ctx, G, low, up, u_lb, u_ub)
-        self._box_ok = bool(np.all(u_lb <= u_ub))
+        self.box_ok = bool(np.all(u_lb <= u_ub))
 
     def _weighted_cost(self) -> None:
         """``H_uu = Jw' Jw + floor I``, ``f_u = -Jw' ew`` (set_cost(1, 1) without scaling)."""
@@ -271,7 +273,7 @@ class QPProblem:
     def box_consistent(self) -> bool:
         """True when the input box has lb <= ub (limits can conflict in the box; the
         slack box is open, or pinned consistently by the hierarchical mode)."""
-        return self._box_ok
+        return self.box_ok
 
     def reset_slack_box(self) -> None:
         """Open the slack box again (after the hierarchical mode pinned it)."""

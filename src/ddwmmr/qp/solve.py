@@ -177,15 +177,6 @@ def make_backend(solver: str, warm_start: bool | None = None):
     return QpsolversBackend(solver, warm_start=True if warm_start is None else warm_start)
 
 
-def solve_weighted(problem: QPProblem, backend) -> np.ndarray | None:
-    """The weighted mode's single solve: ``x`` or None (inconsistent box, solver failure,
-    non-finite answer). The same as ``solve(problem, backend).x``, without the result
-    object (the controller's per-step path)."""
-    if not problem.box_consistent():
-        return None
-    return _checked(backend(problem))
-
-
 def solve(problem: QPProblem, backend, mode: str = "weighted") -> SolveResult:
     """Solve the built ``problem`` (see :meth:`QPProblem.build`) in ``mode``.
 

@@ -176,14 +176,16 @@ class StabilityLimit(Limit):
 
     def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
         """Writer for the gradient entries and the lower bounds (from the context's arm
-        trigonometry); the rest is constant."""
+        trigonometry; :meth:`lower_bound` inlined, tested against ``compute``); the rest
+        is constant. Parameters are read here: recompile after changing them."""
         if overrides(self, StabilityLimit) or overrides(self, StabilityLimit, "lower_bound"):
             return None
         block.write_constant_rows([[0.0] * 4, [0.0] * 4])
         block.write_constant_bounds((-INF, -INF), (INF, INF))
         G, lower = block.matrix, block.lower
         (lon_row, lat_row), (lon_bound, lat_bound) = block.rows, block.bounds
-        com, bound = self.com, self.lower_bound
+        com, gain, half_speed = self.com, self.gain, 0.5 * self.joint_speed
+        target = self.stability_min + self.margin
 
         def write(ctx: StepContext) -> None:
             (s_lon, g1, g2), (s_lat, h1, h2) = stability_terms_from_trig(
@@ -191,7 +193,15 @@ class StabilityLimit(Limit):
             )
             G[lon_row + 2], G[lon_row + 3] = g1, g2
             G[lat_row + 2], G[lat_row + 3] = h1, h2
-            lower[lon_bound] = bound(s_lon, g1, g2)
-            lower[lat_bound] = bound(s_lat, h1, h2)
+            if s_lon >= STABILITY_CAP:
+                lower[lon_bound] = -INF
+            else:
+                damper, achievable = -gain * (s_lon - target), half_speed * (abs(g1) + abs(g2))
+                lower[lon_bound] = achievable if achievable < damper else damper
+            if s_lat >= STABILITY_CAP:
+                lower[lat_bound] = -INF
+            else:
+                damper, achievable = -gain * (s_lat - target), half_speed * (abs(h1) + abs(h2))
+                lower[lat_bound] = achievable if achievable < damper else damper
 
         return write

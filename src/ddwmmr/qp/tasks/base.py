@@ -10,6 +10,7 @@ implement the optional fast path :meth:`Task.compile` (see :mod:`ddwmmr.qp.block
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
 
@@ -18,6 +19,33 @@ import numpy as np
 from ddwmmr.errors import check_nonnegative
 from ddwmmr.qp.blocks import TaskBlock
 from ddwmmr.qp.context import StepContext
+
+
+def bounded(value: float, limit: float) -> float:
+    """``value`` clipped to ``[-limit, limit]``; a non-finite value (an overflow of huge
+    but finite inputs) becomes its sign times ``limit`` (+-inf) or 0 (nan)."""
+    if -limit <= value <= limit:
+        return value
+    if math.isnan(value):
+        return 0.0
+    return math.copysign(limit, value)
+
+
+def bounded_pair(a: float, b: float, limit: float) -> tuple[float, float]:
+    """``(a, b)`` scaled to a norm of at most ``limit``, direction kept; infinite entries
+    (overflow) give the limiting direction, nan entries count as 0."""
+    norm = math.hypot(a, b)
+    if norm <= limit:
+        return a, b
+    if not math.isfinite(norm):
+        a, b = (0.0 if math.isnan(v) else v for v in (a, b))
+        if math.isinf(a) or math.isinf(b):  # the direction of the infinite part
+            a, b = (math.copysign(1.0, v) if math.isinf(v) else 0.0 for v in (a, b))
+        norm = math.hypot(a, b)
+        if norm <= limit:
+            return a, b
+    scale = limit / norm
+    return a * scale, b * scale
 
 
 class Task(ABC):

@@ -12,7 +12,7 @@ from ddwmmr.gains import gains_from_tau
 from ddwmmr.model.kinematics import wrap_angle
 from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
-from ddwmmr.qp.tasks.base import Task
+from ddwmmr.qp.tasks.base import Task, bounded, bounded_pair
 
 
 def feedback_gains(tau: float | Sequence[float]) -> tuple[float, float, float]:
@@ -28,7 +28,10 @@ class EndEffectorTask(Task):
     a far-away waypoint does not produce a huge demand; the feed-forward part is kept. With
     ``track_orientation=False`` the orientation row is dropped (its slack is pinned to 0).
     With a ``detour`` set, feedback that would lead through an obstacle is turned towards a
-    tangent point instead.
+    tangent point instead. ``demand_limit = (m/s, rad/s)`` bounds the whole target (norm of
+    the position part, and the orientation part): the controller sets it far above what the
+    robot can do (10x), so it only acts on absurd demands (a pose error of 1e12 m), whose
+    magnitude would otherwise swamp the solver's tolerances.
     """
 
     rows = 3
@@ -41,11 +44,17 @@ class EndEffectorTask(Task):
         tau: float | Sequence[float] = 0.5,
         track_orientation: bool = True,
         max_speed: float | None = None,
+        demand_limit: tuple[float, float] | None = None,
     ) -> None:
         super().__init__(weight)
         self.kx, self.ky, self.kphi = feedback_gains(tau)
         self.track_orientation = bool(track_orientation)
         self.max_speed = None if max_speed is None else check_positive("max_speed", max_speed)
+        self.demand_limit = (
+            None
+            if demand_limit is None
+            else tuple(check_positive("demand_limit", v) for v in demand_limit)
+        )
         #: Optional :class:`~ddwmmr.qp.tasks.avoidance.Detour`: bends the position
         #: feedback round obstacles (same magnitude, towards the detour's aim point).
         self.detour = None
@@ -67,10 +76,14 @@ class EndEffectorTask(Task):
             norm = math.hypot(fx, fy)
             if norm > self.max_speed:
                 fx, fy = fx * self.max_speed / norm, fy * self.max_speed / norm
-        if not self.track_orientation:
-            return vx + fx, vy + fy, 0.0
+        e0, e1 = vx + fx, vy + fy
         # Wrapped: a pose 2 pi away is the same orientation.
-        return vx + fx, vy + fy, vphi + self.kphi * wrap_angle(phid - phie)
+        e2 = vphi + self.kphi * wrap_angle(phid - phie) if self.track_orientation else 0.0
+        if self.demand_limit is not None:
+            linear, angular = self.demand_limit
+            e0, e1 = bounded_pair(e0, e1, linear)
+            e2 = bounded(e2, angular)
+        return e0, e1, e2
 
     def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
         """Rows: the end-effector Jacobian; target: feed-forward + clipped feedback."""
