@@ -35,6 +35,18 @@ from ddwmmr.model import Robot
 PLANAR_AXES = [True, True, False, False, False, False]
 
 
+def unavailable_reason() -> str | None:
+    """Why the reference cannot run here (None when it can): the benchmark's skip reason."""
+    try:
+        import roboticstoolbox  # noqa: F401
+    except ImportError as exc:
+        return (
+            f"roboticstoolbox-python is not installed ({exc.name or exc}); "
+            "pip install -e '.[bench]' adds it"
+        )
+    return None
+
+
 def holistic_robot(robot: Robot):
     """The ddwmmr robot as a roboticstoolbox ``Robot`` (joints ``yaw, drive, th1, th2``)."""
     from roboticstoolbox import ET, ETS, Link
