@@ -374,3 +374,49 @@ def test_naive_baseline_equals_closed_form_pseudoinverse() -> None:
             naive.command(t, q, pose, velocity), closed.command(t, q, pose, velocity), atol=1e-10
         )
         assert abs(naive.last.nonholonomic_residual) < 1e-12
+
+
+def _bench_docs():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_docs.py"
+    spec = importlib.util.spec_from_file_location("bench_docs", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_docs_tables_are_regenerated_between_their_markers(report, tmp_path):
+    bench_docs = _bench_docs()
+    docs = tmp_path / "docs"
+    docs.mkdir()
+    for name, page in (("api-table", "api.md"), ("qp-classes", "qp.md")):
+        (docs / page).write_text(
+            f"intro\n<!-- bench:{name} begin -->\nold\n<!-- bench:{name} end -->\noutro\n"
+        )
+    out = tmp_path / "bench.json"
+    write_report(report, out)
+    assert bench_docs.main([str(out), "--docs", str(docs)]) == 0
+    api = (docs / "api.md").read_text()
+    assert api.startswith("intro\n<!-- bench:api-table begin -->\nMeasured ")
+    assert format_table(report) in api and "old" not in api and api.endswith("outro\n")
+    qp = (docs / "qp.md").read_text()
+    for entry in report["qp_classes"]:
+        median = entry["rows"]["qp"]["median_us"]
+        assert f"| {entry['name']} | {entry['states']} | {median:.1f} / " in qp
+        assert f"| {entry['name']} | {entry['phases']['build']:.2f} | " in qp
+    assert bench_docs.main([str(out), "--docs", str(docs)]) == 0  # idempotent
+    assert (docs / "qp.md").read_text() == qp
+
+
+def test_committed_reference_report_matches_the_docs():
+    """docs/api.md and docs/qp.md show benchmarks/bench.json as bench_docs renders it."""
+    from pathlib import Path
+
+    bench_docs = _bench_docs()
+    root = Path(__file__).resolve().parents[1]
+    report = json.loads((root / "benchmarks" / "bench.json").read_text())
+    assert report["tool"] == TOOL
+    assert bench_docs.api_table(report) in (root / "docs" / "api.md").read_text()
+    assert bench_docs.qp_tables(report) in (root / "docs" / "qp.md").read_text()
