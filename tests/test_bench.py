@@ -420,3 +420,13 @@ def test_committed_reference_report_matches_the_docs():
     assert report["tool"] == TOOL
     assert bench_docs.api_table(report) in (root / "docs" / "api.md").read_text()
     assert bench_docs.qp_tables(report) in (root / "docs" / "qp.md").read_text()
+
+
+@pytest.mark.parametrize("case", ["under a file", "a folder"])
+def test_cli_refuses_an_unusable_out_path_before_running(tmp_path, case):
+    (tmp_path / "plain").write_text("x")
+    out = tmp_path / "plain" / "b.json" if case == "under a file" else tmp_path
+    result = _run_cli("--out", str(out), "--method", "ats", "--force", cwd=tmp_path)
+    assert result.returncode == 2 and len(result.stderr.splitlines()) == 1
+    assert result.stderr.startswith("bench: error: out: ")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain"]

@@ -911,20 +911,25 @@ def write_report(report: dict[str, Any], path: str | Path, force: bool = False) 
     """Write ``report`` to ``path`` atomically; an existing file is replaced only when it
     is a report of this tool (or with ``force``)."""
     path = Path(path)
-    if not force:
-        check_out(path)
+    check_out(path, force)
     try:
         write_atomic(path, json.dumps(report, indent=2) + "\n")
     except OSError as exc:
         raise ParameterError(f"out: cannot write {path} ({exc.strerror or exc})") from None
 
 
-def check_out(path: Path) -> None:
-    """Refuse an output path that exists and is not a report of this tool."""
-    if path.exists() and (not path.is_file() or not _is_report(path)):
+def check_out(path: Path, force: bool = False) -> None:
+    """Refuse an output path that exists and is not a report of this tool (unless
+    ``force``), or whose nearest existing parent is not a folder."""
+    if path.is_dir() or (path.exists() and not force and not _is_report(path)):
         raise ParameterError(
             f"out: {path} exists and is not a {TOOL} report (use --force to replace it)"
         )
+    parent = path.parent
+    while not parent.exists() and parent != parent.parent:
+        parent = parent.parent
+    if not parent.is_dir():
+        raise ParameterError(f"out: {parent} is not a folder")
 
 
 def read_report(path: str | Path) -> dict[str, Any]:
@@ -985,14 +990,21 @@ def build_parser() -> argparse.ArgumentParser:
         description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--repeats", type=_positive_int, default=5, help="repeats (default 5)")
     parser.add_argument(
-        "--calls", type=_positive_int, default=500, help="states per timing (default 500)"
+        "--repeats", type=_positive_int, default=5, metavar="N", help="repeats (default 5)"
+    )
+    parser.add_argument(
+        "--calls",
+        type=_positive_int,
+        default=500,
+        metavar="N",
+        help="states per timing (default 500)",
     )
     parser.add_argument(
         "--duration",
         type=_positive_float,
         default=None,
+        metavar="S",
         help="simulated time of each full run in s (default: one trajectory period)",
     )
     parser.add_argument(
@@ -1029,8 +1041,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         previous = read_report(args.compare) if args.compare else None
         out = Path(args.out)
-        if not args.force:
-            check_out(out)  # before the run: a refusal should not cost a minute
+        check_out(out, force=args.force)  # before a minute-long run
         report = run_benchmark(args.repeats, args.calls, args.duration, args.methods, progress=True)
         write_report(report, out, force=args.force)
     except ParameterError as exc:

@@ -11,8 +11,12 @@ tracking slack (see :mod:`ddwmmr.qp.problem`):
   plus a heading task for far-away targets when the orientation is not tracked.
 
 After the solve, the exact stability one step ``dt`` ahead is checked and the joint rates
-are scaled back if the linearisation was too optimistic. If the QP fails, a safe command
-is used (base stopped, arm still or moving to raise S) and counted as a fallback.
+are scaled back if the linearisation was too optimistic (the exact look-ahead runs only
+when a bound cannot prove the full step safe). If the QP fails, a safe command is used
+(base stopped, arm still or moving to raise S, every limit kept) and counted as a
+fallback. Task targets are bounded at 10x what the robot can do (:func:`demand_limits`), so
+absurd demands cannot swamp the solver's tolerances: every limit holds for every finite
+state (tests/test_qp_limits_extreme.py).
 """
 
 from __future__ import annotations

@@ -114,7 +114,7 @@ class QPProblem:
     # -- set-up ---------------------------------------------------------------------------
     def refresh_weights(self) -> None:
         """Re-read task weights and recompile the pieces (call after changing a task's
-        ``weight``)."""
+        ``weight`` or a piece's parameters: compiled writers read them here)."""
         cost = [t.row_weights() for t in self.cost_tasks]
         self.sqrt_w = np.sqrt(np.concatenate(cost)) if cost else np.zeros(0)
         level = [np.full(t.rows, 1.0 if t.primary else 0.0) for t in self.cost_tasks]
