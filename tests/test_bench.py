@@ -1,29 +1,98 @@
-"""The benchmark runs, reports every method against the naive baseline, and stays honest."""
+"""The benchmark: its statistics against hand-computed values, its state classes against
+independent definitions, its report file and its command line."""
 
 from __future__ import annotations
 
 import json
 import math
+import re
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 
-from ddwmmr import Ellipse, Robot, available_methods, make_controller
+from ddwmmr import Ellipse, ParameterError, Robot, available_methods, make_controller
 from ddwmmr.bench import (
     EXTRA_CASES,
     NAIVE_LABEL,
+    QP_CLASSES,
+    REFERENCE_LABEL,
+    TOOL,
     ExtraCase,
     NaivePseudoinverseController,
     benchmark_cases,
+    format_comparison,
     format_table,
     main,
+    record_class_states,
     record_states,
     run_benchmark,
+    summarize_times,
+    time_calls,
+    timer_overhead_ns,
+    write_report,
 )
 
-TINY = {"repeats": 1, "calls": 20, "duration": 0.4}
+TINY = {"repeats": 2, "calls": 20, "duration": 0.4}
+ROBOT3 = Robot().with_payload(3.0)
 
 
+class FakeClock:
+    """A clock (ns) that only moves when the code under test says so."""
+
+    def __init__(self) -> None:
+        self.now = 0
+
+    def __call__(self) -> int:
+        return self.now
+
+    def spend(self, ns: int) -> None:
+        self.now += ns
+
+
+# -- statistics ---------------------------------------------------------------------------
+def test_time_calls_measures_each_call_and_subtracts_the_clock_overhead():
+    clock = FakeClock()
+    costs = {0: 1000, 1: 5000, 2: 250_000}
+
+    def command(i, repeat_noise):
+        clock.spend(costs[i] + repeat_noise[0])
+
+    noise = [0]
+    calls = [(i, noise) for i in range(3)]
+
+    def next_repeat():
+        noise[0] += 100  # each repeat 100 ns slower than the last
+
+    times = time_calls(command, calls, 3, clock=clock, overhead_ns=50, between=next_repeat)
+    expected = np.array([[costs[i] + 100 * r - 50 for i in range(3)] for r in range(3)]) / 1000
+    np.testing.assert_array_equal(times, expected)
+
+
+def test_timer_overhead_is_the_median_gap_between_two_clock_reads():
+    ticks = iter(range(0, 10**9, 37))  # every read advances 37 ns
+    assert timer_overhead_ns(lambda: next(ticks), samples=101) == 37.0
+
+
+def test_percentiles_are_over_states_of_each_states_median():
+    """States cost 1..100 us; repeat 2 is disturbed on every state but the 50th, repeat 3
+    on the 50th only: each state's median is its cost, so the percentiles over states are
+    those of 1..100 (linear interpolation, by hand), untouched by the disturbances."""
+    base = np.arange(1.0, 101.0)
+    times = np.vstack([base, base + 1000.0, base.copy()])
+    times[1, 49] = 50.0
+    times[2, 49] = 5000.0
+    stats = summarize_times(times)
+    assert stats["median_us"] == 50.5
+    assert stats["p90_us"] == pytest.approx(1 + 0.9 * 99)  # 90.1
+    assert stats["p99_us"] == pytest.approx(1 + 0.99 * 99)  # 99.01
+    assert stats["max_us"] == 100.0
+    # Each repeat's own median: 1..100; 1001..1100 with 50 for 1050; 5000 for 50.
+    assert stats["repeat_medians_us"] == [50.5, 1050.0, 51.5]
+
+
+# -- the method table ---------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def report() -> dict:
     extras = (
@@ -40,49 +109,236 @@ def test_rows_cover_baseline_and_every_registered_method(report: dict) -> None:
     assert labels[0] == NAIVE_LABEL and rows[NAIVE_LABEL]["kind"] == "baseline"
     assert set(available_methods()) <= set(labels)  # every method measured exactly once
     assert len(labels) == len(set(labels))
-    assert labels[-1] == "naive-again" and rows["naive-again"]["kind"] == "extra"
+    assert rows["naive-again"]["kind"] == "extra" and rows["qp-naive"]["kind"] == "extra"
     for row in report["rows"]:
         assert (row["meets_target"] is None) == (row["kind"] != "method")
-    assert "missing" in report["skipped"]
     assert "ddwmmr.no_such_module" in report["skipped"]["missing"]
+    assert (REFERENCE_LABEL in rows) != (REFERENCE_LABEL in report["skipped"])
 
 
-def test_numbers_are_positive_and_ratios_consistent(report: dict) -> None:
+def test_numbers_are_ordered_and_ratios_consistent(report: dict) -> None:
     naive = report["rows"][0]
-    assert naive["step_ratio"] == pytest.approx(1.0)
+    assert naive["step_ratio"] == 1.0
     for row in report["rows"]:
-        assert row["step_us"] > 0 and math.isfinite(row["step_us"])
+        assert 0 < row["step_us"] <= row["step_p90_us"] <= row["step_p99_us"]
         assert row["steps_per_s"] > 0 and math.isfinite(row["steps_per_s"])
-        assert row["step_ratio"] == pytest.approx(row["step_us"] / naive["step_us"])
-        assert row["run_speedup"] == pytest.approx(row["steps_per_s"] / naive["steps_per_s"])
-        assert row["meets_target"] in (True, False, None)
+        assert row["step_ratio"] == pytest.approx(row["step_us"] / naive["step_us"], rel=1e-12)
+        assert row["run_speedup"] == pytest.approx(
+            row["steps_per_s"] / naive["steps_per_s"], rel=1e-12
+        )
+    steps = {row["label"]: row["step_us"] for row in report["rows"]}
     pairs = {pair["naive"]: pair for pair in report["pairs"]}
     assert pairs["naive-again"]["method"] == "pi"
-    steps = {row["label"]: row["step_us"] for row in report["rows"]}
     for pair in pairs.values():
         assert pair["step_ratio"] == pytest.approx(steps[pair["method"]] / steps[pair["naive"]])
 
 
-def test_table_lists_every_row(report: dict) -> None:
+def test_table_shows_the_reports_numbers(report: dict) -> None:
     table = format_table(report)
     for row in report["rows"]:
-        assert row["label"] in table
-    assert "skipped missing" in table
-
-
-def test_cli_json(capsys: pytest.CaptureFixture[str]) -> None:
-    code = main(
-        ["--json", "--repeats", "1", "--calls", "10", "--duration", "0.2", "--method", "ats"]
+        line = next(x for x in table.splitlines() if x.startswith(row["label"] + " "))
+        median, p90, p99, ratio, rate = (float(v) for v in line.split()[1:6])
+        assert median == round(row["step_us"], 2) and p90 == round(row["step_p90_us"], 2)
+        assert p99 == round(row["step_p99_us"], 2) and ratio == round(row["step_ratio"], 3)
+        assert rate == round(row["steps_per_s"])
+    assert "skipped missing: ddwmmr.no_such_module not importable" in table
+    for entry in report["qp_classes"]:
+        assert f"  {entry['name']} ({entry['states']} states" in table
+    assert re.search(
+        r"qp targets: median <= 20 us and p99 <= 40 us in every class: (ok|MISS)", table
     )
-    assert code == 0
-    data = json.loads(capsys.readouterr().out)
-    assert [row["label"] for row in data["rows"]][:2] == [NAIVE_LABEL, "ats"]
-    assert data["config"]["repeats"] == 1
 
 
-def test_cli_rejects_unknown_method(capsys: pytest.CaptureFixture[str]) -> None:
-    assert main(["--method", "nope", "--repeats", "1"]) == 2
-    assert "nope" in capsys.readouterr().err
+# -- qp state classes ----------------------------------------------------------------------
+def test_qp_classes_report_rows_phases_and_ratios(report: dict) -> None:
+    names = [entry["name"] for entry in report["qp_classes"]]
+    assert names == [c.name for c in QP_CLASSES]
+    for entry in report["qp_classes"]:
+        rows = entry["rows"]
+        assert {"qp", "qp (generic path)", "qp + user task, limit", "qp-naive"} <= set(rows)
+        assert entry["states"] == TINY["calls"]
+        for label, ratio in entry["ratios"].items():
+            assert ratio["median"] == pytest.approx(
+                rows[label]["median_us"] / rows["qp"]["median_us"]
+            )
+            assert ratio["min_over_repeats"] <= ratio["max_over_repeats"]
+        assert set(entry["phases"]) == {"build", "solve", "check", "rest"}
+        assert all(value >= 0.0 for value in entry["phases"].values())
+        assert 0.0 <= entry["exact_check_fraction"] <= 1.0
+        assert entry["meets_targets"] == (
+            rows["qp"]["median_us"] <= 20.0 and rows["qp"]["p99_us"] <= 40.0
+        )
+
+
+def _brute_clearance(robot: Robot, q, circle, n: int = 401) -> float:
+    """Footprint-to-circle distance from points sampled on the footprint's outline."""
+    hl, hw = 0.5 * robot.base_length, 0.5 * robot.base_width
+    s = np.linspace(-1.0, 1.0, n)
+    local = np.concatenate(
+        [
+            np.column_stack([s * hl, np.full(n, hw)]),
+            np.column_stack([s * hl, np.full(n, -hw)]),
+            np.column_stack([np.full(n, hl), s * hw]),
+            np.column_stack([np.full(n, -hl), s * hw]),
+        ]
+    )
+    c, si = math.cos(q[2]), math.sin(q[2])
+    x = q[0] + c * local[:, 0] - si * local[:, 1]
+    y = q[1] + si * local[:, 0] + c * local[:, 1]
+    return float(np.min(np.hypot(x - circle[0], y - circle[1])) - circle[2])
+
+
+@pytest.mark.parametrize("name", [c.name for c in QP_CLASSES])
+def test_each_class_holds_the_states_it_claims(name):
+    """Checked with independent definitions: S from Robot.stability, the shoulder margin
+    from th1, the obstacle clearance from sampled footprint points."""
+    state_class = next(c for c in QP_CLASSES if c.name == name)
+    _, calls = record_class_states(state_class, ROBOT3, 60)
+    assert len(calls) >= 20
+    for _, q, pose_d, velocity_d in calls:
+        assert q.shape == (5,) and pose_d.shape == (3,) and velocity_d.shape == (3,)
+        if name == "stability floor":
+            assert ROBOT3.stability(q)[2] < 1.25 + 0.05
+        elif name == "shoulder singularity":
+            assert math.cos(q[3]) ** 2 - math.sin(0.25) ** 2 < 0.05
+        elif name == "obstacles":
+            (circle,) = state_class.options["obstacles"]
+            assert _brute_clearance(ROBOT3, q, circle) < 0.6 + 1e-3
+
+
+def test_tracking_class_replays_the_qp_run_in_order():
+    """The tracking class is the run itself: times increase and the first call is the
+    start (RK4: four calls per step, the first at the step's time)."""
+    _, calls = record_class_states(QP_CLASSES[0], ROBOT3, 10**6)
+    times = [c[0] for c in calls]
+    assert times[0] == 0.0 and len(calls) == 4 * 2000 + 1
+    assert all(b >= a for a, b in zip(times[::4], times[4::4]))
+
+
+# -- the reference -------------------------------------------------------------------------
+def test_reference_models_the_same_robot():
+    pytest.importorskip("roboticstoolbox", reason="the bench extra is not installed")
+    from ddwmmr.qp.rtb_reference import HolisticController, planar_pose
+
+    reference = HolisticController(ROBOT3)
+    model = reference.model
+    controller = make_controller("qp", ROBOT3)
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        q = rng.uniform(-2.0, 2.0, 5)
+        model.base = planar_pose(*q[:3])
+        model.q = np.array([0.0, 0.0, q[3], q[4]])
+        pose = model.fkine(model.q).A
+        fk = ROBOT3.fk(q)
+        assert pose[:2, 3] == pytest.approx(fk[:2], abs=1e-12)
+        assert math.atan2(pose[1, 0], pose[0, 0]) == pytest.approx(
+            math.remainder(fk[2], 2 * math.pi), abs=1e-12
+        )
+        # Jacobian (toolbox: base-frame axes, columns yaw, drive, th1, th2) rotated by phi
+        # against ours (world frame, u = (v, w, th1dot, th2dot)).
+        jac = model.jacob0(model.q)[[0, 1, 5]][:, [1, 0, 2, 3]]
+        c, s = math.cos(q[2]), math.sin(q[2])
+        jac[:2] = np.array([[c, -s], [s, c]]) @ jac[:2]
+        controller.ctx.update(0.0, q, fk, np.zeros(3))
+        np.testing.assert_allclose(jac, controller.ctx.jac_e, atol=1e-12)
+    u = reference.command(0.0, q, fk + np.array([0.1, 0.0, 0.0]), np.zeros(3))
+    assert u.shape == (4,) and np.all(np.isfinite(u))
+
+
+def test_missing_reference_is_skipped_with_the_install_hint(monkeypatch):
+    monkeypatch.setitem(sys.modules, "roboticstoolbox", None)  # import now fails
+    cases, skipped = benchmark_cases(methods=["qp"])
+    assert REFERENCE_LABEL not in [c.label for c in cases]
+    assert "pip install -e '.[bench]'" in skipped[REFERENCE_LABEL]
+
+
+# -- report file and command line ----------------------------------------------------------
+def test_report_file_is_written_atomically_and_guarded(tmp_path, report):
+    out = tmp_path / "bench.json"
+    write_report(report, out)
+    data = json.loads(out.read_text())
+    assert data["tool"] == TOOL and data["rows"] == report["rows"]
+    assert [p.name for p in tmp_path.iterdir()] == ["bench.json"]  # no staging left
+    write_report(report, out)  # our own report: replaced
+    foreign = tmp_path / "notes.json"
+    foreign.write_text('{"mine": 1}')
+    with pytest.raises(ParameterError, match=r"is not a ddwmmr\.bench report"):
+        write_report(report, foreign)
+    assert foreign.read_text() == '{"mine": 1}'
+    write_report(report, foreign, force=True)
+    assert json.loads(foreign.read_text())["tool"] == TOOL
+
+
+def test_comparison_lists_old_and_new_medians(report):
+    previous = json.loads(json.dumps(report))
+    for row in previous["rows"]:
+        row["step_us"] *= 2.0
+    text = format_comparison(report, previous)
+    line = next(x for x in text.splitlines() if x.strip().startswith("pi "))
+    assert line.strip().endswith("(0.50x)")
+
+
+def test_cli_writes_the_report_and_compares(tmp_path, capsys):
+    out = tmp_path / "b.json"
+    args = ["--repeats", "1", "--calls", "10", "--duration", "0.2", "--method", "ats"]
+    assert main([*args, "--out", str(out)]) == 0
+    first = capsys.readouterr().out
+    assert "ats" in first and out.is_file()
+    assert main([*args, "--out", str(out), "--compare", str(out), "--json"]) == 0
+    printed = capsys.readouterr().out
+    data = json.loads(printed[: printed.rindex("}") + 1])
+    assert [row["label"] for row in data["rows"]] == [NAIVE_LABEL, "ats"]
+    assert data["qp_classes"] == []  # qp not selected
+    assert "median step new / old" in printed
+
+
+def _run_cli(*args: str, cwd) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "ddwmmr.bench", *args],
+        capture_output=True,
+        text=True,
+        cwd=cwd,
+        timeout=120,
+    )
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--repeats", "abc"], "argument --repeats: must be an integer >= 1 (got 'abc')"),
+        (["--repeats", "0"], "argument --repeats: must be an integer >= 1 (got '0')"),
+        (["--calls", "-3"], "argument --calls: must be an integer >= 1 (got '-3')"),
+        (["--duration", "nan"], "argument --duration: must be a number > 0 in s (got 'nan')"),
+        (["--duration", "1e"], "argument --duration: must be a number > 0 in s (got '1e')"),
+        (["--method", "nope"], "unknown method 'nope' (choose from "),
+        (["--frobnicate"], "unrecognized arguments: --frobnicate"),
+    ],
+)
+def test_cli_bad_input_is_one_line_and_exit_2(tmp_path, args, message):
+    result = _run_cli(*args, cwd=tmp_path)
+    assert result.returncode == 2
+    assert result.stdout == ""
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("bench: error: ") and message in lines[0]
+    assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+def test_cli_refuses_to_replace_a_foreign_file(tmp_path):
+    (tmp_path / "bench.json").write_text("my notes")
+    result = _run_cli("--repeats", "1", "--calls", "5", "--method", "ats", cwd=tmp_path)
+    assert result.returncode == 2 and len(result.stderr.splitlines()) == 1
+    assert "is not a ddwmmr.bench report" in result.stderr
+    assert (tmp_path / "bench.json").read_text() == "my notes"
+
+
+def test_cli_help_is_plain_text(tmp_path):
+    result = _run_cli("--help", cwd=tmp_path)
+    assert result.returncode == 0
+    assert result.stdout.startswith("usage: python -m ddwmmr.bench")
+    assert "Time every control method" in result.stdout
+    assert "``" not in result.stdout and ":func:" not in result.stdout  # no docstring dump
+    for option in ("--repeats", "--calls", "--duration", "--method", "--out", "--compare"):
+        assert option in result.stdout
 
 
 def test_extra_case_replaces_the_registered_method_of_the_same_name() -> None:
@@ -106,23 +362,71 @@ def test_selected_methods_keep_only_their_extra_cases() -> None:
     assert [c.label for c in cases] == [NAIVE_LABEL, "pi", "pi-twin"]
 
 
-def test_default_extra_cases_are_well_formed() -> None:
-    for extra in EXTRA_CASES:
-        module, _, attribute = extra.factory.partition(":")
-        assert module and attribute and extra.label
-
-
 def test_naive_baseline_equals_closed_form_pseudoinverse() -> None:
     """Away from cos(th1) = 0 the SVD pseudoinverse and the closed-form kernel agree."""
     robot, trajectory = Robot(), Ellipse()
     states = record_states(robot, trajectory, 25)
     naive = NaivePseudoinverseController(robot)
     closed = make_controller("pi", robot)
-    for t, q, pose, velocity in zip(
-        states.times, states.configurations, states.poses, states.velocities
-    ):
+    for t, q, pose, velocity in states.calls():
         assert abs(math.cos(q[3])) > 0.1
         np.testing.assert_allclose(
             naive.command(t, q, pose, velocity), closed.command(t, q, pose, velocity), atol=1e-10
         )
         assert abs(naive.last.nonholonomic_residual) < 1e-12
+
+
+def _bench_docs():
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_docs.py"
+    spec = importlib.util.spec_from_file_location("bench_docs", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_docs_tables_are_regenerated_between_their_markers(report, tmp_path):
+    bench_docs = _bench_docs()
+    docs = tmp_path / "docs"
+    docs.mkdir()
+    for name, page in (("api-table", "api.md"), ("qp-classes", "qp.md")):
+        (docs / page).write_text(
+            f"intro\n<!-- bench:{name} begin -->\nold\n<!-- bench:{name} end -->\noutro\n"
+        )
+    out = tmp_path / "bench.json"
+    write_report(report, out)
+    assert bench_docs.main([str(out), "--docs", str(docs)]) == 0
+    api = (docs / "api.md").read_text()
+    assert api.startswith("intro\n<!-- bench:api-table begin -->\nMeasured ")
+    assert format_table(report) in api and "old" not in api and api.endswith("outro\n")
+    qp = (docs / "qp.md").read_text()
+    for entry in report["qp_classes"]:
+        median = entry["rows"]["qp"]["median_us"]
+        assert f"| {entry['name']} | {entry['states']} | {median:.1f} / " in qp
+        assert f"| {entry['name']} | {entry['phases']['build']:.2f} | " in qp
+    assert bench_docs.main([str(out), "--docs", str(docs)]) == 0  # idempotent
+    assert (docs / "qp.md").read_text() == qp
+
+
+def test_committed_reference_report_matches_the_docs():
+    """docs/api.md and docs/qp.md show benchmarks/bench.json as bench_docs renders it."""
+    from pathlib import Path
+
+    bench_docs = _bench_docs()
+    root = Path(__file__).resolve().parents[1]
+    report = json.loads((root / "benchmarks" / "bench.json").read_text())
+    assert report["tool"] == TOOL
+    assert bench_docs.api_table(report) in (root / "docs" / "api.md").read_text()
+    assert bench_docs.qp_tables(report) in (root / "docs" / "qp.md").read_text()
+
+
+@pytest.mark.parametrize("case", ["under a file", "a folder"])
+def test_cli_refuses_an_unusable_out_path_before_running(tmp_path, case):
+    (tmp_path / "plain").write_text("x")
+    out = tmp_path / "plain" / "b.json" if case == "under a file" else tmp_path
+    result = _run_cli("--out", str(out), "--method", "ats", "--force", cwd=tmp_path)
+    assert result.returncode == 2 and len(result.stderr.splitlines()) == 1
+    assert result.stderr.startswith("bench: error: out: ")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["plain"]

@@ -11,8 +11,12 @@ tracking slack (see :mod:`ddwmmr.qp.problem`):
   plus a heading task for far-away targets when the orientation is not tracked.
 
 After the solve, the exact stability one step ``dt`` ahead is checked and the joint rates
-are scaled back if the linearisation was too optimistic. If the QP fails, a safe command
-is used (base stopped, arm still or moving to raise S) and counted as a fallback.
+are scaled back if the linearisation was too optimistic (the exact look-ahead runs only
+when a bound cannot prove the full step safe). If the QP fails, a safe command is used
+(base stopped, arm still or moving to raise S, every limit kept) and counted as a
+fallback. Task targets are bounded at 10x what the robot can do (:func:`demand_limits`), so
+absurd demands cannot swamp the solver's tolerances: every limit holds for every finite
+state (tests/test_qp_limits_extreme.py).
 """
 
 from __future__ import annotations
@@ -40,6 +44,7 @@ from ddwmmr.qp.limits import (
     WheelSpeedLimit,
     as_circles,
     footprint_clearances,
+    full_step_is_safe,
     safe_arm_scale,
     stability_terms_gradient,
 )
@@ -60,6 +65,25 @@ from ddwmmr.qp.tasks import (
 DEFAULT_DT = 0.02
 #: Default solver: the fastest measured (docs/qp.md, "Solvers").
 DEFAULT_SOLVER = "daqp"
+
+
+#: Factor between the demand bounds and what the robot's inputs can produce (see
+#: :func:`demand_limits`): large, so the bounds act on absurd demands only.
+DEMAND_FACTOR = 10.0
+
+
+def demand_limits(robot: Robot) -> tuple[float, float]:
+    """Bounds on the built-in tasks' target rates: ``DEMAND_FACTOR`` times the fastest
+    end-effector speed (m/s) and rate (rad/s) the robot's input limits allow.
+
+    ``|d(xE, yE)/dt| <= v_max + (L1 + L2)(w_max + th_dot_max) + L2 th_dot_max`` and
+    ``|d phiE/dt| <= w_max + 2 th_dot_max`` (wheel speed limit for v_max and w_max).
+    """
+    v_max = robot.wheel_radius * robot.wheel_speed_limit
+    w_max = 2.0 * v_max / robot.track_width
+    speed = robot.joint_speed_limit
+    linear = v_max + robot.reach * (w_max + speed) + robot.L2 * speed
+    return DEMAND_FACTOR * linear, DEMAND_FACTOR * (w_max + 2.0 * speed)
 
 
 class QPControllerCore:
@@ -125,20 +149,24 @@ class QPControllerCore:
         limits: Sequence[Limit] = (),
     ) -> None:
         self.robot = robot
+        self._com = robot.com_coefficients
         self.mode = check_mode(mode)
         self.solver = solver
         self.backend = self._make_backend(solver, warm_start)
         self.obstacles = as_circles(obstacles)
         if heading_weight is None:
             heading_weight = 0.0 if track_orientation else 1.0
-        self.tracking = EndEffectorTask(tracking_weight, tau, track_orientation, max_speed)
+        linear, angular = demand_limits(robot)
+        self.tracking = EndEffectorTask(
+            tracking_weight, tau, track_orientation, max_speed, demand_limit=(linear, angular)
+        )
         self.tasks: list[Task] = [
             self.tracking,
             ManipulabilityTask(
                 check_nonnegative("manipulability_weight", manipulability_weight),
                 arm_row=not track_orientation,
             ),
-            PostureTask(posture_weight),
+            PostureTask(posture_weight, rate_limit=angular),
             RegularizationTask(regularization_weight),
         ]
         heading = HeadingTask(heading_weight, distance=0.8 * robot.reach)
@@ -152,21 +180,24 @@ class QPControllerCore:
             joint_speed=robot.joint_speed_limit,
         )
         self.stability_min = self.stability.stability_min
-        self.limits: list[Limit] = [self.stability, WheelSpeedLimit(robot), JointLimit(robot)]
+        self.joints = JointLimit(robot)
+        self.limits: list[Limit] = [self.stability, WheelSpeedLimit(robot), self.joints]
         motion = (max_base_speed, max_yaw_rate, max_acceleration, max_yaw_acceleration)
+        self.base_motion: BaseMotionLimit | None = None
         if any(value is not None for value in motion):
-            self.limits.append(
-                BaseMotionLimit(
-                    max_base_speed if max_base_speed is not None else INF,
-                    max_yaw_rate if max_yaw_rate is not None else INF,
-                    max_acceleration,
-                    max_yaw_acceleration,
-                )
+            self.base_motion = BaseMotionLimit(
+                max_base_speed if max_base_speed is not None else INF,
+                max_yaw_rate if max_yaw_rate is not None else INF,
+                max_acceleration,
+                max_yaw_acceleration,
             )
+            self.limits.append(self.base_motion)
+        self.singularity: ShoulderSingularityLimit | None = None
         if singularity_margin is not None:
-            self.limits.append(
-                ShoulderSingularityLimit(singularity_margin, joint_speed=robot.joint_speed_limit)
+            self.singularity = ShoulderSingularityLimit(
+                singularity_margin, joint_speed=robot.joint_speed_limit
             )
+            self.limits.append(self.singularity)
         if self.obstacles:
             self.limits.append(ObstacleLimit(robot, self.obstacles, margin=obstacle_margin))
             self.tasks.append(
@@ -212,37 +243,85 @@ class QPControllerCore:
         x = self._solve(ctx)
         if x is None:
             return self._fallback(ctx)
-        v, w, r1, r2 = x[:4].tolist()
-        scale = safe_arm_scale(
-            self.robot.com_coefficients, ctx.th1, ctx.th2, r1, r2, ctx.dt, self.stability_min
+        v, w, r1, r2, *slack = x
+        scale = self.arm_scale(ctx, r1, r2)
+        self.last = StepInfo(
+            extra={"slack": max(map(abs, slack)) if slack else 0.0, "arm_scale": scale}
         )
-        self.last = StepInfo(extra={"slack": float(np.abs(x[4:]).max()), "arm_scale": scale})
         ctx.previous_command = (v, w)
         return np.array([v, w, r1 * scale, r2 * scale])
 
-    def _solve(self, ctx: StepContext) -> np.ndarray | None:
-        """Build and solve this step's QP; None on failure."""
-        self.problem.build(ctx)
-        return solve(self.problem, self.backend, self.mode).x
+    def arm_scale(self, ctx: StepContext, rate1: float, rate2: float) -> float:
+        """Scale of the joint rates that keeps the exact S one step ahead above the floor
+        (:func:`safe_arm_scale`); the exact look-ahead runs only when the linearised
+        margin is tight (:func:`full_step_is_safe` cannot prove scale 1)."""
+        com = self._com
+        trig = (ctx.sin_th1, ctx.cos_th1, ctx.sin_th12, ctx.cos_th12)
+        th1, th2, dt, floor = ctx.th1, ctx.th2, ctx.dt, self.stability_min
+        if full_step_is_safe(com, trig, th1, th2, rate1, rate2, dt, floor):
+            return 1.0
+        return safe_arm_scale(com, th1, th2, rate1, rate2, dt, floor)
+
+    def _solve(self, ctx: StepContext) -> list[float] | None:
+        """Build and solve this step's QP: the decision vector as floats, None on failure
+        (inconsistent box, solver failure, non-finite answer)."""
+        problem = self.problem
+        problem.build(ctx)
+        if self.mode != "weighted":
+            x = solve(problem, self.backend, self.mode).x
+            return None if x is None else x.tolist()
+        if not problem.box_ok:
+            return None
+        x = self.backend(problem)
+        if x is None:
+            return None
+        values = x.tolist()
+        return values if all(map(math.isfinite, values)) else None
 
     def _fallback(self, ctx: StepContext) -> np.ndarray:
-        """Safe command: stop the base; move the arm up the stability gradient of every
-        term below the floor (else hold it)."""
+        """Safe command when the QP fails; it keeps every built-in limit:
+
+        * arm: up the stability gradient of every term below the floor at half the speed
+          limit (else still), never further past a joint limit or deeper into the
+          shoulder-singularity margin, then scaled by the exact one-step stability check
+          (:func:`safe_arm_scale`: S never drops below ``min(S_min, S_now)``);
+        * base: stopped, or, with a slew limit, as close to stopped as its envelope
+          allows (a force-limited base cannot stop within one step).
+        """
         self.fallbacks += 1
+        rates = list(self._stability_ascent(ctx))
+        for joint, angle in enumerate((ctx.th1, ctx.th2)):
+            low, up = self.joints.joint_bounds(angle, joint)  # 0 is always allowed
+            rates[joint] = min(max(rates[joint], min(low, 0.0)), max(up, 0.0))
+        r1, r2 = rates
+        if self.singularity is not None:
+            slope, bound = self.singularity.values(ctx)
+            if bound > 0.0 and slope * r1 < 0.0:  # inside the margin: never deeper
+                r1 = 0.0
+        scale = safe_arm_scale(self._com, ctx.th1, ctx.th2, r1, r2, ctx.dt, self.stability_min)
+        v = w = 0.0
+        if self.base_motion is not None and ctx.previous_command is not None:
+            low_v, high_v, low_w, high_w = self.base_motion.envelope(ctx)
+            v, w = min(max(0.0, low_v), high_v), min(max(0.0, low_w), high_w)
+        self.last = StepInfo(fallback=True, extra={"slack": float("nan"), "arm_scale": scale})
+        ctx.previous_command = (v, w)
+        return np.array([v, w, r1 * scale, r2 * scale])
+
+    def _stability_ascent(self, ctx: StepContext) -> tuple[float, float]:
+        """Joint rates (rad/s) at half the speed limit up the summed unit gradients of the
+        stability terms below the damper's target (zero when none is)."""
         r1 = r2 = 0.0
         floor = self.stability_min + self.stability.margin
-        for s_i, g1, g2 in stability_terms_gradient(self.robot.com_coefficients, ctx.th1, ctx.th2):
+        for s_i, g1, g2 in stability_terms_gradient(self._com, ctx.th1, ctx.th2):
             norm = math.hypot(g1, g2)
             if s_i < floor and norm > 0.0:
                 r1 += g1 / norm
                 r2 += g2 / norm
         norm = math.hypot(r1, r2)
+        if norm == 0.0:
+            return 0.0, 0.0
         speed = 0.5 * self.robot.joint_speed_limit
-        if norm > 0.0:
-            r1, r2 = speed * r1 / norm, speed * r2 / norm
-        self.last = StepInfo(fallback=True, extra={"slack": float("nan"), "arm_scale": 1.0})
-        ctx.previous_command = (0.0, 0.0)
-        return np.array([0.0, 0.0, r1, r2])
+        return speed * r1 / norm, speed * r2 / norm
 
     # -- reporting ----------------------------------------------------------------------
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:

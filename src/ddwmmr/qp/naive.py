@@ -47,8 +47,10 @@ class NaiveQPController(QPControllerCore):
         self.solver = NaiveOsqpBackend.name
         return NaiveOsqpBackend()
 
-    def _solve(self, ctx: StepContext) -> np.ndarray | None:
-        """Allocate a new problem, build it, solve it."""
-        problem = QPProblem(self.tasks, self.limits)
+    def _solve(self, ctx: StepContext) -> list[float] | None:
+        """Allocate a new problem (every piece through its generic ``compute``), build it,
+        solve it."""
+        problem = QPProblem(self.tasks, self.limits, compiled=False)
         problem.build(ctx)
-        return solve(problem, self.backend, self.mode).x
+        x = solve(problem, self.backend, self.mode).x
+        return None if x is None else x.tolist()

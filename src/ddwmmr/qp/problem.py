@@ -9,18 +9,27 @@ Decision vector ``x = (u, s)``: the inputs ``u = (v, w, th1dot, th2dot)`` and th
 
 Rows come in order: slack-task equalities ``J u - s = e`` (lower = upper = e), then the
 limit rows. The cost of the non-slack tasks is ``sum_i w_i ||J_i u - e_i||^2``, stacked as
-``||W^(1/2) (J u - e)||^2`` so one product builds it. Nothing is allocated per step except
-inside numpy's small products.
+``||W^(1/2) (J u - e)||^2``: the problem keeps the weighted rows ``Jw = W^(1/2) J`` and
+``ew = W^(1/2) e``, so two products build the Hessian block and the gradient.
+
+Each piece is filled one of two ways (see :mod:`ddwmmr.qp.blocks`): built-in pieces are
+*compiled* once into writers that store only the entries that change, as Python floats,
+straight into memoryviews of these arrays; any other piece (a user's task or limit, or a
+subclass overriding ``compute``) is called through its generic ``compute`` on numpy views,
+and a cost task's rows are then weighted with one numpy product. Both give the same
+numbers to the last bit. Nothing is allocated per step except inside numpy's two products.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from ctypes import c_int
 
 import numpy as np
 
 from ddwmmr.errors import ParameterError
+from ddwmmr.qp.blocks import CONSTANT, LimitBlock, TaskBlock
 from ddwmmr.qp.context import NU, StepContext
 from ddwmmr.qp.limits.base import INF, Limit
 from ddwmmr.qp.tasks.base import Task
@@ -29,6 +38,15 @@ from ddwmmr.qp.tasks.base import Task
 HESSIAN_FLOOR = 1e-7
 #: DAQP's code for an equality row.
 EQUALITY = 5
+#: The input box before any limit tightens it: lower bounds, then upper bounds.
+_OPEN_BOX = (-INF,) * NU + (INF,) * NU
+
+
+def _flat(array: np.ndarray) -> memoryview:
+    """A flat, writable memoryview of a C-contiguous float array (shares its memory)."""
+    flat = array.reshape(-1)
+    assert array.size == 0 or np.shares_memory(flat, array)
+    return memoryview(flat)
 
 
 class QPProblem:
@@ -38,9 +56,14 @@ class QPProblem:
         tasks: soft objectives; those with ``slack = True`` (and cost tasks flagged
             ``primary``) form the primary level of the hierarchical mode.
         limits: hard constraints.
+        compiled: use the built-in pieces' compiled writers (default); False calls every
+            piece through its generic ``compute`` (same numbers, slower: for benchmarks
+            and tests of the generic path).
     """
 
-    def __init__(self, tasks: Sequence[Task], limits: Sequence[Limit]) -> None:
+    def __init__(
+        self, tasks: Sequence[Task], limits: Sequence[Limit], compiled: bool = True
+    ) -> None:
         for task in tasks:
             if not isinstance(task, Task):
                 raise ParameterError(f"tasks must be ddwmmr.qp.tasks.Task instances (got {task!r})")
@@ -51,13 +74,14 @@ class QPProblem:
                 )
         self.tasks = list(tasks)
         self.limits = list(limits)
+        self.compiled = bool(compiled)
         self.slack_tasks = [t for t in self.tasks if t.slack]
         self.cost_tasks = [t for t in self.tasks if not t.slack]
         self.n_slack = sum(t.rows for t in self.slack_tasks)
         self.n = n = NU + self.n_slack
         self.m_eq = self.n_slack
         self.m = m = self.m_eq + sum(limit.rows for limit in self.limits)
-        rows = sum(t.rows for t in self.cost_tasks)
+        self.cost_rows = rows = sum(t.rows for t in self.cost_tasks)
 
         self.H = np.zeros((n, n))
         self.f = np.zeros(n)
@@ -66,80 +90,180 @@ class QPProblem:
         self.upper = np.zeros(n + m)
         self.lb, self.ub = self.lower[:n], self.upper[:n]
         self.cl, self.cu = self.lower[n:], self.upper[n:]
+        self.lb.fill(-INF)
+        self.ub.fill(INF)
         self.sense = np.zeros(n + m, dtype=c_int)
         self.sense[n : n + self.m_eq] = EQUALITY
-
-        # Cost tasks: unweighted rows, then their weighted copies.
-        self.J = np.zeros((rows, NU))
-        self.e = np.zeros(rows)
+        self.C[: self.m_eq, NU:] = -np.eye(self.n_slack)
+        # Weighted cost rows (what the Hessian is built from) and, for generic cost tasks,
+        # the unweighted rows their compute() fills.
         self.Jw = np.zeros((rows, NU))
         self.ew = np.zeros(rows)
-        self._cost_views = []
-        start = 0
-        for task in self.cost_tasks:
-            self._cost_views.append(
-                (task, self.J[start : start + task.rows], self.e[start : start + task.rows])
-            )
-            start += task.rows
-
-        # Slack tasks: J u - s = e, the -I block is constant.
-        self._slack_views = []
-        start = 0
-        for task in self.slack_tasks:
-            stop = start + task.rows
-            self._slack_views.append((task, self.C[start:stop, :NU], self.cu[start:stop]))
-            start = stop
-        self.C[: self.m_eq, NU:] = -np.eye(self.n_slack)
-
-        self._limit_views = []
-        start = self.m_eq
-        for limit in self.limits:
-            stop = start + limit.rows
-            self._limit_views.append(
-                (limit, self.C[start:stop, :NU], self.cl[start:stop], self.cu[start:stop])
-            )
-            start = stop
+        self.J = np.zeros((rows, NU))
+        self.e = np.zeros(rows)
+        self._jw_t = self.Jw.T
+        self._mv = {
+            name: _flat(getattr(self, name)) for name in ("H", "C", "lower", "upper", "Jw", "ew")
+        }
+        #: The input box as Python floats, shared by the compiled limits (see LimitBlock).
+        self.box = list(_OPEN_BOX)
+        #: Whether the last build left lb <= ub on every input (see box_consistent).
+        self.box_ok = True
         self.refresh_weights()
 
+    # -- set-up ---------------------------------------------------------------------------
     def refresh_weights(self) -> None:
-        """Re-read task weights (call after changing a task's ``weight``)."""
+        """Re-read task weights and recompile the pieces (call after changing a task's
+        ``weight`` or a piece's parameters: compiled writers read them here)."""
         cost = [t.row_weights() for t in self.cost_tasks]
         self.sqrt_w = np.sqrt(np.concatenate(cost)) if cost else np.zeros(0)
         level = [np.full(t.rows, 1.0 if t.primary else 0.0) for t in self.cost_tasks]
         self.primary_rows = np.concatenate(level) if level else np.zeros(0)
         slack = [t.row_weights() for t in self.slack_tasks]
         self.slack_weights = np.concatenate(slack) if slack else np.zeros(0)
+        for i, w in enumerate(self.slack_weights.tolist()):
+            self.H[NU + i, NU + i] = 1.0 * w + HESSIAN_FLOOR  # as set_cost(primary=1) does
+        self._compile()
 
+    def _compile(self) -> None:
+        """Writers for the compiled pieces, views for the generic ones."""
+        mv, n = self._mv, self.n
+        sqrt_w = self.sqrt_w.tolist()
+        self._writers = []
+        self._generic_cost = []
+        self._generic_slack = []
+        self._generic_limits = []
+        start = 0
+        for task in self.cost_tasks:
+            stop = start + task.rows
+            block = TaskBlock(
+                jac=mv["Jw"],
+                rows=tuple(NU * r for r in range(start, stop)),
+                target_views=(mv["ew"],),
+                targets=tuple(range(start, stop)),
+                scales=tuple(sqrt_w[start:stop]),
+                slack=False,
+            )
+            if not self._add_writer(task, block):
+                self._generic_cost.append(
+                    (
+                        task,
+                        self.J[start:stop],
+                        self.e[start:stop],
+                        self.Jw[start:stop],
+                        self.ew[start:stop],
+                        self.sqrt_w[start:stop, None],
+                        self.sqrt_w[start:stop],
+                    )
+                )
+            start = stop
+        start = 0
+        for task in self.slack_tasks:
+            stop = start + task.rows
+            block = TaskBlock(
+                jac=mv["C"],
+                rows=tuple(n * r for r in range(start, stop)),
+                target_views=(mv["lower"], mv["upper"]),
+                targets=tuple(n + r for r in range(start, stop)),
+                scales=(1.0,) * task.rows,
+                slack=True,
+            )
+            if not self._add_writer(task, block):
+                self._generic_slack.append(
+                    (task, self.C[start:stop, :NU], self.cl[start:stop], self.cu[start:stop])
+                )
+            start = stop
+        start = self.m_eq
+        for limit in self.limits:
+            stop = start + limit.rows
+            block = LimitBlock(
+                matrix=mv["C"],
+                rows=tuple(n * r for r in range(start, stop)),
+                lower=mv["lower"],
+                upper=mv["upper"],
+                bounds=tuple(n + r for r in range(start, stop)),
+                box=self.box,
+            )
+            if not self._add_writer(limit, block):
+                self._generic_limits.append(
+                    (limit, self.C[start:stop, :NU], self.cl[start:stop], self.cu[start:stop])
+                )
+            start = stop
+        self._all_compiled = not (self._generic_cost or self._generic_slack or self._generic_limits)
+
+    def _add_writer(self, piece: Task | Limit, block: TaskBlock | LimitBlock) -> bool:
+        """Compile ``piece`` into ``block``; False when it has no fast path."""
+        writer = piece.compile(block) if self.compiled else None
+        if writer is None:
+            return False
+        if writer is not CONSTANT:
+            self._writers.append(writer)
+        return True
+
+    # -- per step -------------------------------------------------------------------------
     def build(self, ctx: StepContext) -> None:
         """Fill every array for this step (weighted mode: all tasks in one cost)."""
-        for task, jac, error in self._cost_views:
+        box = self.box
+        box[:] = _OPEN_BOX
+        for writer in self._writers:
+            writer(ctx)
+        if not self._all_compiled:
+            self._build_generic(ctx)
+        else:
+            lower, upper = self._mv["lower"], self._mv["upper"]
+            lower[0], lower[1], lower[2], lower[3] = box[0], box[1], box[2], box[3]
+            upper[0], upper[1], upper[2], upper[3] = box[4], box[5], box[6], box[7]
+            self.box_ok = (
+                box[0] <= box[4] and box[1] <= box[5] and box[2] <= box[6] and box[3] <= box[7]
+            )
+        self._weighted_cost()
+
+    def _build_generic(self, ctx: StepContext) -> None:
+        """The pieces without a compiled writer, through ``compute`` on numpy views."""
+        for task, jac, error, jac_w, error_w, column, sqrt_w in self._generic_cost:
             task.compute(ctx, jac, error)
-        for task, jac, error in self._slack_views:
-            task.compute(ctx, jac, error)
-        self.cl[: self.m_eq] = self.cu[: self.m_eq]
-        lb, ub = self.lb, self.ub
-        lb.fill(-INF)
-        ub.fill(INF)
-        u_lb, u_ub = lb[:NU], ub[:NU]
-        for limit, G, low, up in self._limit_views:
+            np.multiply(jac, column, out=jac_w)
+            np.multiply(error, sqrt_w, out=error_w)
+        for task, jac, low, up in self._generic_slack:
+            task.compute(ctx, jac, up)
+            low[:] = up
+        box = self.box
+        self.lb[:NU] = box[:NU]
+        self.ub[:NU] = box[NU:]
+        u_lb, u_ub = self.lb[:NU], self.ub[:NU]
+        for limit, G, low, up in self._generic_limits:
             limit.compute(ctx, G, low, up, u_lb, u_ub)
-        self.set_cost(secondary=1.0, primary=1.0)
+        self.box_ok = bool(np.all(u_lb <= u_ub))
+
+    def _weighted_cost(self) -> None:
+        """``H_uu = Jw' Jw + floor I``, ``f_u = -Jw' ew`` (set_cost(1, 1) without scaling)."""
+        H, f, jw_t = self.H, self.f, self._jw_t
+        H[:NU, :NU] = np.dot(jw_t, self.Jw)
+        f_u = f[:NU]
+        np.dot(jw_t, self.ew, out=f_u)
+        np.negative(f_u, out=f_u)
+        hess = self._mv["H"]
+        step = self.n + 1
+        for i in range(0, NU * step, step):
+            hess[i] += HESSIAN_FLOOR
 
     def set_cost(self, secondary: float, primary: float, ridge: float = 0.0) -> None:
         """Hessian and gradient with the secondary cost tasks scaled by ``secondary`` and
         the slack penalties and primary cost tasks by ``primary`` (the hierarchical mode
         runs one level at a time); ``ridge`` is added to the input block's diagonal."""
+        if secondary == primary == 1.0 and ridge == 0.0:
+            self._weighted_cost()
+            return
         if secondary == primary:
-            sqrt_w = self.sqrt_w if primary == 1.0 else self.sqrt_w * np.sqrt(primary)
+            scale = np.full(self.cost_rows, math.sqrt(primary))
         else:
-            scale = secondary + (primary - secondary) * self.primary_rows
-            sqrt_w = self.sqrt_w * np.sqrt(scale)
-        np.multiply(self.J, sqrt_w[:, None], out=self.Jw)
-        np.multiply(self.e, sqrt_w, out=self.ew)
+            scale = np.sqrt(secondary + (primary - secondary) * self.primary_rows)
+        jw = self.Jw * scale[:, None]
+        ew = self.ew * scale
         H, f = self.H, self.f
-        jw_t = self.Jw.T
-        H[:NU, :NU] = np.dot(jw_t, self.Jw)
-        f[:NU] = np.dot(jw_t, self.ew)
+        jw_t = jw.T
+        H[:NU, :NU] = np.dot(jw_t, jw)
+        f[:NU] = np.dot(jw_t, ew)
         np.negative(f[:NU], out=f[:NU])
         for i in range(NU):
             H[i, i] += HESSIAN_FLOOR + ridge
@@ -147,5 +271,11 @@ class QPProblem:
             H[NU + i, NU + i] = primary * w + HESSIAN_FLOOR
 
     def box_consistent(self) -> bool:
-        """True when every box has lb <= ub (limits can conflict in the box)."""
-        return bool(np.all(self.lb <= self.ub))
+        """True when the input box has lb <= ub (limits can conflict in the box; the
+        slack box is open, or pinned consistently by the hierarchical mode)."""
+        return self.box_ok
+
+    def reset_slack_box(self) -> None:
+        """Open the slack box again (after the hierarchical mode pinned it)."""
+        self.lb[NU:] = -INF
+        self.ub[NU:] = INF

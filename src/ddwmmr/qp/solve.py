@@ -196,14 +196,16 @@ def solve(problem: QPProblem, backend, mode: str = "weighted") -> SolveResult:
     problem.lb[problem.n - problem.n_slack :] = slack - SLACK_TOLERANCE
     problem.ub[problem.n - problem.n_slack :] = slack + SLACK_TOLERANCE
     problem.set_cost(secondary=1.0, primary=1.0)
-    second = _checked(backend(problem))
+    try:
+        second = _checked(backend(problem))
+    finally:
+        problem.reset_slack_box()
     # Level 2 can only fail numerically (level 1's answer is feasible): keep level 1.
     return SolveResult(first if second is None else second, 2)
 
 
 def _checked(x: np.ndarray | None) -> np.ndarray | None:
-    if x is None:
-        return None
-    if not all(math.isfinite(v) for v in x.tolist()):
+    """``x`` if every entry is finite, else None."""
+    if x is None or not all(map(math.isfinite, x.tolist())):
         return None
     return x

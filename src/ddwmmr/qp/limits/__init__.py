@@ -15,6 +15,7 @@ from ddwmmr.qp.limits.singularity import ShoulderSingularityLimit
 from ddwmmr.qp.limits.stability import (
     StabilityLimit,
     exact_stability,
+    full_step_is_safe,
     safe_arm_scale,
     stability_terms_gradient,
 )
@@ -34,6 +35,7 @@ __all__ = [
     "clearance_and_rate",
     "exact_stability",
     "footprint_clearances",
+    "full_step_is_safe",
     "load_obstacles",
     "safe_arm_scale",
     "stability_terms_gradient",

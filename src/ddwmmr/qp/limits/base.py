@@ -3,15 +3,18 @@
 A limit restricts the inputs ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s)
 either through general rows ``lower <= G u <= upper`` (``rows`` of them) or by tightening
 the box ``lb <= u <= ub``. A new constraint is one subclass implementing
-:meth:`Limit.compute`. Use :data:`INF` for a missing side.
+:meth:`Limit.compute`. Use :data:`INF` for a missing side. The built-in limits also
+implement the optional fast path :meth:`Limit.compile` (see :mod:`ddwmmr.qp.blocks`).
 """
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 
 import numpy as np
 
+from ddwmmr.qp.blocks import LimitBlock
 from ddwmmr.qp.context import StepContext
 
 #: "No bound": DAQP's infinity; other backends drop rows and bounds at this magnitude.
@@ -39,3 +42,8 @@ class Limit(ABC):
         ``G``/``lower``/``upper`` are views into the stacked problem: write every entry,
         every step. ``lb``/``ub`` arrive holding the bounds of earlier limits: only tighten.
         """
+
+    def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
+        """Optional fast path: a writer filling ``block`` each step (see
+        :mod:`ddwmmr.qp.blocks`). The default, None, has :meth:`compute` called instead."""
+        return None

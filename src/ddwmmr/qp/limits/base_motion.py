@@ -15,7 +15,10 @@ the slew part is skipped on the first step after a reset.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from ddwmmr.errors import check_positive
+from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import Limit
 
@@ -52,8 +55,8 @@ class BaseMotionLimit(Limit):
             else check_positive("max_yaw_acceleration", max_yaw_acceleration)
         )
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
-        """Tighten the (v, w) box; no general rows."""
+    def envelope(self, ctx: StepContext) -> tuple[float, float, float, float]:
+        """``(v_low, v_high, w_low, w_high)`` allowed this step (m/s, rad/s)."""
         low_v, high_v = -self.max_speed, self.max_speed
         low_w, high_w = -self.max_yaw_rate, self.max_yaw_rate
         previous = ctx.previous_command
@@ -66,5 +69,23 @@ class BaseMotionLimit(Limit):
                 step = self.max_yaw_acceleration * ctx.dt
                 low_w, high_w = max(low_w, w_prev - step), min(high_w, w_prev + step)
         # A previous command beyond a cap (e.g. a cap lowered mid-run) must not empty the box.
-        lb[0], ub[0] = max(lb[0], min(low_v, high_v)), min(ub[0], max(low_v, high_v))
-        lb[1], ub[1] = max(lb[1], min(low_w, high_w)), min(ub[1], max(low_w, high_w))
+        return min(low_v, high_v), max(low_v, high_v), min(low_w, high_w), max(low_w, high_w)
+
+    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+        """Tighten the (v, w) box; no general rows."""
+        low_v, high_v, low_w, high_w = self.envelope(ctx)
+        lb[0], ub[0] = max(lb[0], low_v), min(ub[0], high_v)
+        lb[1], ub[1] = max(lb[1], low_w), min(ub[1], high_w)
+
+    def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
+        """Writer tightening the Python box (no rows)."""
+        if overrides(self, BaseMotionLimit) or overrides(self, BaseMotionLimit, "envelope"):
+            return None
+        box, envelope = block.box, self.envelope
+
+        def write(ctx: StepContext) -> None:
+            low_v, high_v, low_w, high_w = envelope(ctx)
+            box[0], box[4] = max(box[0], low_v), min(box[4], high_v)
+            box[1], box[5] = max(box[1], low_w), min(box[5], high_w)
+
+        return write

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from ddwmmr.errors import check_nonnegative, check_positive
 from ddwmmr.model import Robot
+from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import Limit
 
@@ -26,16 +29,45 @@ class JointLimit(Limit):
         self.gain = check_positive("joint limit gain", gain)
         self.margin = check_nonnegative("joint limit margin", margin)
 
+    def joint_bounds(self, angle: float, joint: int) -> tuple[float, float]:
+        """``(lowest, highest)`` allowed rate (rad/s) of joint ``joint`` (0 or 1) at
+        ``angle`` (rad): the speed limit and the position dampers."""
+        speed, gain, margin = self.speed, self.gain, self.margin
+        low, high = self.limits[joint]
+        down = min(speed, gain * (angle - low - margin))  # allowed speed towards th_min
+        up = min(speed, gain * (high - margin - angle))
+        down = max(down, -0.5 * speed)  # beyond the margin: must move back, not too fast
+        up = max(up, -0.5 * speed)
+        return -down, up
+
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
         """Tighten the box on th1dot (index 2) and th2dot (index 3)."""
-        speed, gain, margin = self.speed, self.gain, self.margin
-        for index, angle, (low, high) in (
-            (2, ctx.th1, self.limits[0]),
-            (3, ctx.th2, self.limits[1]),
-        ):
-            down = min(speed, gain * (angle - low - margin))  # allowed speed towards th_min
-            up = min(speed, gain * (high - margin - angle))
-            down = max(down, -0.5 * speed)  # beyond the margin: must move back, not too fast
-            up = max(up, -0.5 * speed)
-            lb[index] = max(lb[index], -down)
+        for index, angle in ((2, ctx.th1), (3, ctx.th2)):
+            low, up = self.joint_bounds(angle, index - 2)
+            lb[index] = max(lb[index], low)
             ub[index] = min(ub[index], up)
+
+    def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
+        """Writer tightening the Python box (no rows): :meth:`joint_bounds` inlined, with
+        ``min``/``max`` as comparisons (same results, tested against ``compute``)."""
+        if overrides(self, JointLimit) or overrides(self, JointLimit, "joint_bounds"):
+            return None
+        box = block.box
+        speed, gain, margin = self.speed, self.gain, self.margin
+        back = -0.5 * speed
+        (low1, high1), (low2, high2) = self.limits
+
+        def write(ctx: StepContext) -> None:
+            for angle, low, high, i in ((ctx.th1, low1, high1, 2), (ctx.th2, low2, high2, 3)):
+                down = gain * (angle - low - margin)
+                up = gain * (high - margin - angle)
+                down = down if down < speed else speed
+                up = up if up < speed else speed
+                down = back if back > down else down
+                up = back if back > up else up
+                if -down > box[i]:
+                    box[i] = -down
+                if up < box[i + 4]:
+                    box[i + 4] = up
+
+        return write

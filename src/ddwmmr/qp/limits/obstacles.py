@@ -15,7 +15,7 @@ for every circle within ``influence`` of the footprint (a velocity damper).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -29,6 +29,7 @@ from ddwmmr.errors import (
     load_toml,
 )
 from ddwmmr.model import Robot
+from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
 
@@ -182,15 +183,34 @@ class ObstacleLimit(Limit):
         r, lw, limit = robot.wheel_radius, robot.track_width, robot.wheel_speed_limit
         self.v_max, self.w_max = r * limit, 2.0 * r * limit / lw
 
+    def row(self, ctx: StepContext, circle: Circle) -> tuple[float, float, float]:
+        """``(dd/dv, dd/dw, lower bound)`` of one circle's row (-INF when far)."""
+        d, a_v, a_w = clearance_and_rate(
+            self.half_length, self.half_width, ctx.x, ctx.y, ctx.phi, circle
+        )
+        if d >= self.influence:
+            return a_v, a_w, -INF
+        achievable = 0.25 * (abs(a_v) * self.v_max + abs(a_w) * self.w_max)
+        return a_v, a_w, min(-self.gain * (d - self.margin), achievable)
+
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
         """Rows ``[dd/dv, dd/dw, 0, 0]`` for circles within ``influence``."""
-        hl, hw = self.half_length, self.half_width
         for row, circle in enumerate(self.circles):
-            d, a_v, a_w = clearance_and_rate(hl, hw, ctx.x, ctx.y, ctx.phi, circle)
-            G[row, 0], G[row, 1], G[row, 2], G[row, 3] = a_v, a_w, 0.0, 0.0
+            G[row, 0], G[row, 1], lower[row] = self.row(ctx, circle)
+            G[row, 2] = G[row, 3] = 0.0
             upper[row] = INF
-            if d >= self.influence:
-                lower[row] = -INF
-                continue
-            achievable = 0.25 * (abs(a_v) * self.v_max + abs(a_w) * self.w_max)
-            lower[row] = min(-self.gain * (d - self.margin), achievable)
+
+    def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
+        """Writer for each circle's two rates and bound; the rest is constant."""
+        if overrides(self, ObstacleLimit) or overrides(self, ObstacleLimit, "row"):
+            return None
+        block.write_constant_rows([[0.0] * 4] * self.rows)
+        block.write_constant_bounds((-INF,) * self.rows, (INF,) * self.rows)
+        G, lower, row = block.matrix, block.lower, self.row
+        slots = list(zip(self.circles, block.rows, block.bounds))
+
+        def write(ctx: StepContext) -> None:
+            for circle, entry, bound in slots:
+                G[entry], G[entry + 1], lower[bound] = row(ctx, circle)
+
+        return write

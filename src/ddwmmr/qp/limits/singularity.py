@@ -12,8 +12,10 @@ fail there. The limit keeps ``h = cos^2 th1 - cos^2(pi/2 - margin) >= 0`` with t
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
 
@@ -38,11 +40,31 @@ class ShoulderSingularityLimit(Limit):
         self.gain = check_positive("singularity gain", gain)
         self.joint_speed = check_positive("joint speed", joint_speed)
 
+    def values(self, ctx: StepContext) -> tuple[float, float]:
+        """``(G[0, 2], lower[0])``: the row's slope on th1dot and its damper bound."""
+        slope = -math.sin(2.0 * ctx.th1)
+        achievable = 0.5 * self.joint_speed * abs(slope)
+        return slope, min(-self.gain * (ctx.cos_th1**2 - self.floor), achievable)
+
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
         """The damper row on th1dot."""
-        slope = -math.sin(2.0 * ctx.th1)
         G[0, 0] = G[0, 1] = G[0, 3] = 0.0
-        G[0, 2] = slope
+        G[0, 2], lower[0] = self.values(ctx)
         upper[0] = INF
-        achievable = 0.5 * self.joint_speed * abs(slope)
-        lower[0] = min(-self.gain * (math.cos(ctx.th1) ** 2 - self.floor), achievable)
+
+    def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
+        """Writer for the slope and the bound; the rest is constant."""
+        if overrides(self, ShoulderSingularityLimit) or overrides(
+            self, ShoulderSingularityLimit, "values"
+        ):
+            return None
+        block.write_constant_rows([[0.0] * 4])
+        block.write_constant_bounds((-INF,), (INF,))
+        G, lower = block.matrix, block.lower
+        entry, (bound,) = block.rows[0] + 2, block.bounds
+        values = self.values
+
+        def write(ctx: StepContext) -> None:
+            G[entry], lower[bound] = values(ctx)
+
+        return write

@@ -16,9 +16,11 @@ exact (nonlinear) S one control step ahead.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model.stability import STABILITY_CAP, ComCoefficients
+from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
 
@@ -30,8 +32,15 @@ def stability_terms_gradient(
 
     A capped term (``S_i >= STABILITY_CAP``) has zero gradient.
     """
-    s1, c1 = math.sin(th1), math.cos(th1)
-    s12, c12 = math.sin(th1 + th2), math.cos(th1 + th2)
+    return stability_terms_from_trig(
+        k, math.sin(th1), math.cos(th1), math.sin(th1 + th2), math.cos(th1 + th2)
+    )
+
+
+def stability_terms_from_trig(
+    k: ComCoefficients, s1: float, c1: float, s12: float, c12: float
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """:func:`stability_terms_gradient` from ``sin/cos th1`` and ``sin/cos (th1 + th2)``."""
     x_com = k.A * c1 + k.B * c12
     y_com = k.A * s1 + k.B * s12
     if abs(x_com) * STABILITY_CAP <= k.half_length:
@@ -84,6 +93,40 @@ def safe_arm_scale(
     return 0.0
 
 
+def full_step_is_safe(
+    k: ComCoefficients,
+    trig: tuple[float, float, float, float],
+    th1: float,
+    th2: float,
+    rate1: float,
+    rate2: float,
+    dt: float,
+    stability_min: float,
+) -> bool:
+    """True when a bound proves that :func:`safe_arm_scale` would return 1 (no exact
+    look-ahead needed); False means "not proven", not "unsafe".
+
+    ``trig`` is ``(sin th1, cos th1, sin(th1 + th2), cos(th1 + th2))``. With ``a = dt rate1``
+    and ``b = dt rate2`` each centre-of-mass coordinate moves by at most
+    ``delta = |A| |a| + |B| |a + b|`` in one step (``|d cos| <= 1``), and ``S_i >= S_min``
+    exactly when ``|c_i| <= h_i / S_min``. So ``|c_i| + delta + slack <= h_i / S_min`` for
+    both terms proves the exact ``S >= S_min = min(S_min, S_now)`` after the step; the slack
+    (1e-9 m per metre of lever) covers the rounding of the look-ahead's own evaluation,
+    and angles beyond 1e3 rad (where adding the step loses digits) are left to it.
+    """
+    if not (abs(th1) <= 1e3 and abs(th2) <= 1e3):
+        return False
+    s1, c1, s12, c12 = trig
+    a = dt * rate1
+    b = dt * rate2
+    lever_a, lever_b = abs(k.A), abs(k.B)
+    reach = lever_a * abs(a) + lever_b * abs(a + b) + 1e-9 * (1.0 + lever_a + lever_b)
+    return (
+        abs(k.A * c1 + k.B * c12) + reach <= k.half_length / stability_min
+        and abs(k.A * s1 + k.B * s12) + reach <= k.half_width / stability_min
+    )
+
+
 class StabilityLimit(Limit):
     """Two rows, ``dS_lon/dt`` and ``dS_lat/dt`` >= damper bound (see module docstring).
 
@@ -116,15 +159,49 @@ class StabilityLimit(Limit):
         self.margin = check_positive("stability margin", margin)
         self.joint_speed = check_positive("joint speed", joint_speed)
 
+    def lower_bound(self, s_i: float, g1: float, g2: float) -> float:
+        """The damper bound of one term's row (-INF for a capped term)."""
+        if s_i >= STABILITY_CAP:
+            return -INF
+        achievable = 0.5 * self.joint_speed * (abs(g1) + abs(g2))
+        return min(-self.gain * (s_i - (self.stability_min + self.margin)), achievable)
+
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
         """Rows ``[0, 0, dS_i/dth1, dS_i/dth2]`` with lower bound ``-gain (S_i - floor)``."""
-        target = self.stability_min + self.margin
         for row, (s_i, g1, g2) in enumerate(stability_terms_gradient(self.com, ctx.th1, ctx.th2)):
             G[row, 0] = G[row, 1] = 0.0
             G[row, 2], G[row, 3] = g1, g2
             upper[row] = INF
-            if s_i >= STABILITY_CAP:
-                lower[row] = -INF
-                continue
-            achievable = 0.5 * self.joint_speed * (abs(g1) + abs(g2))
-            lower[row] = min(-self.gain * (s_i - target), achievable)
+            lower[row] = self.lower_bound(s_i, g1, g2)
+
+    def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
+        """Writer for the gradient entries and the lower bounds (from the context's arm
+        trigonometry; :meth:`lower_bound` inlined, tested against ``compute``); the rest
+        is constant. Parameters are read here: recompile after changing them."""
+        if overrides(self, StabilityLimit) or overrides(self, StabilityLimit, "lower_bound"):
+            return None
+        block.write_constant_rows([[0.0] * 4, [0.0] * 4])
+        block.write_constant_bounds((-INF, -INF), (INF, INF))
+        G, lower = block.matrix, block.lower
+        (lon_row, lat_row), (lon_bound, lat_bound) = block.rows, block.bounds
+        com, gain, half_speed = self.com, self.gain, 0.5 * self.joint_speed
+        target = self.stability_min + self.margin
+
+        def write(ctx: StepContext) -> None:
+            (s_lon, g1, g2), (s_lat, h1, h2) = stability_terms_from_trig(
+                com, ctx.sin_th1, ctx.cos_th1, ctx.sin_th12, ctx.cos_th12
+            )
+            G[lon_row + 2], G[lon_row + 3] = g1, g2
+            G[lat_row + 2], G[lat_row + 3] = h1, h2
+            if s_lon >= STABILITY_CAP:
+                lower[lon_bound] = -INF
+            else:
+                damper, achievable = -gain * (s_lon - target), half_speed * (abs(g1) + abs(g2))
+                lower[lon_bound] = achievable if achievable < damper else damper
+            if s_lat >= STABILITY_CAP:
+                lower[lat_bound] = -INF
+            else:
+                damper, achievable = -gain * (s_lat - target), half_speed * (abs(h1) + abs(h2))
+                lower[lat_bound] = achievable if achievable < damper else damper
+
+        return write

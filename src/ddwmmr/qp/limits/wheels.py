@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from ddwmmr.model import Robot
+from ddwmmr.qp.blocks import CONSTANT, LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import Limit
 
@@ -24,3 +27,11 @@ class WheelSpeedLimit(Limit):
         for row, (a_v, a_w) in enumerate(self.rows_lr):
             G[row, 0], G[row, 1], G[row, 2], G[row, 3] = a_v, a_w, 0.0, 0.0
             lower[row], upper[row] = -self.limit, self.limit
+
+    def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
+        """Everything is constant: written once."""
+        if overrides(self, WheelSpeedLimit):
+            return None
+        block.write_constant_rows([(a_v, a_w, 0.0, 0.0) for a_v, a_w in self.rows_lr])
+        block.write_constant_bounds((-self.limit,) * 2, (self.limit,) * 2)
+        return CONSTANT

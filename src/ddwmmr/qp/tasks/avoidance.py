@@ -10,11 +10,12 @@ passing on the side the base already leans to (or the target's side when head-on
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from ddwmmr.errors import check_positive
+from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.obstacles import Circle, clearance_and_rate
 from ddwmmr.qp.tasks.base import Task
@@ -42,10 +43,9 @@ class ObstacleSteeringTask(Task):
         self.influence = check_positive("obstacle influence", influence)
         self.gain = check_positive("obstacle steering gain", gain)
 
-    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
-        """Steer by the nearest circle ahead; zero row when none is near."""
-        jac[:] = 0.0
-        error[0] = 0.0
+    def values(self, ctx: StepContext) -> tuple[float, float]:
+        """``(J[0, 1], e[0])``: 1 and the yaw-rate target (rad/s) while a circle ahead is
+        near, else zeros."""
         nearest, bearing = self.influence, None
         c, s = ctx.cos_phi, ctx.sin_phi
         for circle in self.circles:
@@ -57,10 +57,30 @@ class ObstacleSteeringTask(Task):
             if d < nearest and px > 0.0:
                 nearest, bearing = d, math.atan2(py, px)
         if bearing is None:
-            return
+            return 0.0, 0.0
         side = math.copysign(1.0, bearing) if bearing else self._target_side(ctx)
-        jac[0, 1] = 1.0
-        error[0] = self.gain * (bearing - side * 0.5 * math.pi)
+        return 1.0, self.gain * (bearing - side * 0.5 * math.pi)
+
+    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        """Steer by the nearest circle ahead; zero row when none is near."""
+        jac[:] = 0.0
+        jac[0, 1], error[0] = self.values(ctx)
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Writer for the weighted entry on w and the target."""
+        if overrides(self, ObstacleSteeringTask) or overrides(self, ObstacleSteeringTask, "values"):
+            return None
+        block.write_constant_rows([[0.0] * 4])
+        jac, (target,) = block.jac, block.target_views
+        entry, (row,), (scale,) = block.rows[0] + 1, block.targets, block.scales
+        values = self.values
+
+        def write(ctx: StepContext) -> None:
+            active, rate = values(ctx)
+            jac[entry] = active * scale
+            target[row] = rate * scale
+
+        return write
 
     @staticmethod
     def _target_side(ctx: StepContext) -> float:

@@ -4,17 +4,48 @@ A task asks for ``J u = e``: ``J`` (rows x 4) maps the inputs ``u = (v, w, th1do
 (m/s, rad/s, rad/s, rad/s) to some task rate, ``e`` is the rate it wants. The solver adds
 ``weight * ||J u - e||^2`` to the cost, or, for a task with ``slack = True``, turns the rows
 into equality constraints ``J u - s = e`` whose slack ``s`` is penalised by ``weight``.
-A new objective is one subclass implementing :meth:`Task.compute`.
+A new objective is one subclass implementing :meth:`Task.compute`; the built-in tasks also
+implement the optional fast path :meth:`Task.compile` (see :mod:`ddwmmr.qp.blocks`).
 """
 
 from __future__ import annotations
 
+import math
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 
 import numpy as np
 
 from ddwmmr.errors import check_nonnegative
+from ddwmmr.qp.blocks import TaskBlock
 from ddwmmr.qp.context import StepContext
+
+
+def bounded(value: float, limit: float) -> float:
+    """``value`` clipped to ``[-limit, limit]``; a non-finite value (an overflow of huge
+    but finite inputs) becomes its sign times ``limit`` (+-inf) or 0 (nan)."""
+    if -limit <= value <= limit:
+        return value
+    if math.isnan(value):
+        return 0.0
+    return math.copysign(limit, value)
+
+
+def bounded_pair(a: float, b: float, limit: float) -> tuple[float, float]:
+    """``(a, b)`` scaled to a norm of at most ``limit``, direction kept; infinite entries
+    (overflow) give the limiting direction, nan entries count as 0."""
+    norm = math.hypot(a, b)
+    if norm <= limit:
+        return a, b
+    if not math.isfinite(norm):
+        a, b = (0.0 if math.isnan(v) else v for v in (a, b))
+        if math.isinf(a) or math.isinf(b):  # the direction of the infinite part
+            a, b = (math.copysign(1.0, v) if math.isinf(v) else 0.0 for v in (a, b))
+        norm = math.hypot(a, b)
+        if norm <= limit:
+            return a, b
+    scale = limit / norm
+    return a * scale, b * scale
 
 
 class Task(ABC):
@@ -46,3 +77,8 @@ class Task(ABC):
 
         Both arrays are views into the stacked problem: write every entry, every step.
         """
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Optional fast path: a writer filling ``block`` each step (see
+        :mod:`ddwmmr.qp.blocks`). The default, None, has :meth:`compute` called instead."""
+        return None

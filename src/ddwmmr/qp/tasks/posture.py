@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ddwmmr.errors import check_nonnegative, check_positive
+from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
-from ddwmmr.qp.tasks.base import Task
+from ddwmmr.qp.tasks.base import Task, bounded
+
+#: The rows on (w, th1dot, th2dot).
+IDENTITY_ROWS = ((0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0), (0.0, 0.0, 0.0, 1.0))
 
 
 class PostureTask(Task):
@@ -28,8 +34,11 @@ class PostureTask(Task):
         K2: float = 0.0,
         K3: float = 0.0,
         gain: float = 1.0,
+        rate_limit: float | None = None,
     ) -> None:
         super().__init__(weight)
+        #: Bound (rad/s) of each row's target, None for none (see EndEffectorTask).
+        self.rate_limit = None if rate_limit is None else check_positive("rate_limit", rate_limit)
         self.K1 = check_nonnegative("K1", K1)
         self.K2 = check_nonnegative("K2", K2)
         self.K3 = check_nonnegative("K3", K3)
@@ -43,6 +52,33 @@ class PostureTask(Task):
         """Identity rows on (w, th1dot, th2dot), targets ``-gain * (phi, th1, th2)``."""
         jac[:] = 0.0
         jac[0, 1] = jac[1, 2] = jac[2, 3] = 1.0
-        error[0] = -self.gain * ctx.phi
-        error[1] = -self.gain * ctx.th1
-        error[2] = -self.gain * ctx.th2
+        error[0], error[1], error[2] = self.targets(ctx)
+
+    def targets(self, ctx: StepContext) -> tuple[float, float, float]:
+        """``-gain * (phi, th1, th2)`` (rad/s), each bounded by ``rate_limit``."""
+        gain, limit = self.gain, self.rate_limit
+        targets = (-gain * ctx.phi, -gain * ctx.th1, -gain * ctx.th2)
+        if limit is None:
+            return targets
+        return tuple(bounded(value, limit) for value in targets)
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Constant rows, written once; the writer fills the three weighted targets."""
+        if overrides(self, PostureTask) or overrides(self, PostureTask, "targets"):
+            return None
+        block.write_constant_rows(IDENTITY_ROWS)
+        (target,) = block.target_views
+        t0, t1, t2 = block.targets
+        w0, w1, w2 = block.scales
+
+        gain, limit = self.gain, self.rate_limit
+
+        def write(ctx: StepContext) -> None:
+            e0, e1, e2 = -gain * ctx.phi, -gain * ctx.th1, -gain * ctx.th2
+            if limit is not None:
+                e0, e1, e2 = bounded(e0, limit), bounded(e1, limit), bounded(e2, limit)
+            target[t0] = e0 * w0
+            target[t1] = e1 * w1
+            target[t2] = e2 * w2
+
+        return write

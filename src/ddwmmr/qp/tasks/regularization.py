@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from ddwmmr.errors import check_positive
+from ddwmmr.qp.blocks import CONSTANT, TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import Task
 
@@ -33,3 +36,11 @@ class RegularizationTask(Task):
         jac[:] = 0.0
         jac[0, 0] = jac[1, 1] = jac[2, 2] = jac[3, 3] = 1.0
         error[:] = 0.0
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Everything is constant: written once."""
+        if overrides(self, RegularizationTask):
+            return None
+        block.write_constant_rows(np.eye(4).tolist())
+        block.write_constant_targets([0.0] * 4)
+        return CONSTANT

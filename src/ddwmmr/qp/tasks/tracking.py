@@ -3,15 +3,16 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from ddwmmr.errors import check_positive
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
-from ddwmmr.qp.tasks.base import Task
+from ddwmmr.qp.tasks.base import Task, bounded, bounded_pair
 
 
 def feedback_gains(tau: float | Sequence[float]) -> tuple[float, float, float]:
@@ -27,7 +28,10 @@ class EndEffectorTask(Task):
     a far-away waypoint does not produce a huge demand; the feed-forward part is kept. With
     ``track_orientation=False`` the orientation row is dropped (its slack is pinned to 0).
     With a ``detour`` set, feedback that would lead through an obstacle is turned towards a
-    tangent point instead.
+    tangent point instead. ``demand_limit = (m/s, rad/s)`` bounds the whole target (norm of
+    the position part, and the orientation part): the controller sets it far above what the
+    robot can do (10x), so it only acts on absurd demands (a pose error of 1e12 m), whose
+    magnitude would otherwise swamp the solver's tolerances.
     """
 
     rows = 3
@@ -40,17 +44,24 @@ class EndEffectorTask(Task):
         tau: float | Sequence[float] = 0.5,
         track_orientation: bool = True,
         max_speed: float | None = None,
+        demand_limit: tuple[float, float] | None = None,
     ) -> None:
         super().__init__(weight)
         self.kx, self.ky, self.kphi = feedback_gains(tau)
         self.track_orientation = bool(track_orientation)
         self.max_speed = None if max_speed is None else check_positive("max_speed", max_speed)
+        self.demand_limit = (
+            None
+            if demand_limit is None
+            else tuple(check_positive("demand_limit", v) for v in demand_limit)
+        )
         #: Optional :class:`~ddwmmr.qp.tasks.avoidance.Detour`: bends the position
         #: feedback round obstacles (same magnitude, towards the detour's aim point).
         self.detour = None
 
-    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
-        """Rows: the end-effector Jacobian; target: feed-forward + clipped feedback."""
+    def targets(self, ctx: StepContext) -> tuple[float, float, float]:
+        """Target rates ``(xE_dot, yE_dot, phiE_dot)``: feed-forward + clipped feedback
+        (m/s, m/s, rad/s); the last is 0 without orientation tracking."""
         xe, ye, phie = ctx.pose_e
         xd, yd, phid = ctx.pose_d
         vx, vy, vphi = ctx.velocity_d
@@ -65,11 +76,46 @@ class EndEffectorTask(Task):
             norm = math.hypot(fx, fy)
             if norm > self.max_speed:
                 fx, fy = fx * self.max_speed / norm, fy * self.max_speed / norm
+        e0, e1 = vx + fx, vy + fy
+        # Wrapped: a pose 2 pi away is the same orientation.
+        e2 = vphi + self.kphi * wrap_angle(phid - phie) if self.track_orientation else 0.0
+        if self.demand_limit is not None:
+            linear, angular = self.demand_limit
+            e0, e1 = bounded_pair(e0, e1, linear)
+            e2 = bounded(e2, angular)
+        return e0, e1, e2
+
+    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        """Rows: the end-effector Jacobian; target: feed-forward + clipped feedback."""
         jac[:] = ctx.jac_e
-        error[0], error[1] = vx + fx, vy + fy
-        if self.track_orientation:
-            # Wrapped: a pose 2 pi away is the same orientation.
-            error[2] = vphi + self.kphi * wrap_angle(phid - phie)
-        else:
+        error[0], error[1], error[2] = self.targets(ctx)
+        if not self.track_orientation:
             jac[2] = 0.0
-            error[2] = 0.0
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Writer for the slack rows: the Jacobian's varying entries and the targets.
+
+        ``track_orientation`` is read here (it fixes the phiE row); recompile after
+        changing it (:meth:`QPProblem.refresh_weights`)."""
+        if overrides(self, EndEffectorTask) or overrides(self, EndEffectorTask, "targets"):
+            return None
+        if not block.slack or any(scale != 1.0 for scale in block.scales):
+            return None
+        block.write_constant_rows([[0.0] * 4, [0.0] * 4, [0.0, 1.0, 1.0, 1.0]])
+        if not self.track_orientation:
+            block.write_constant_rows([[0.0] * 4, [0.0] * 4, [0.0] * 4])
+        jac, (lower, upper) = block.jac, block.target_views
+        r0, r1, _ = block.rows
+        t0, t1, t2 = block.targets
+        targets = self.targets
+
+        def write(ctx: StepContext) -> None:
+            dx_v, dx_w, dx_2, dy_v, dy_w, dy_2 = ctx.jac_e_rows
+            jac[r0], jac[r0 + 1], jac[r0 + 2], jac[r0 + 3] = dx_v, dx_w, dx_w, dx_2
+            jac[r1], jac[r1 + 1], jac[r1 + 2], jac[r1 + 3] = dy_v, dy_w, dy_w, dy_2
+            e0, e1, e2 = targets(ctx)
+            lower[t0] = upper[t0] = e0
+            lower[t1] = upper[t1] = e1
+            lower[t2] = upper[t2] = e2
+
+        return write
