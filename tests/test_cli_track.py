@@ -255,3 +255,29 @@ def test_progress_off_a_terminal_is_one_line_per_phase(tmp_path, capsys):
     assert run(["--method", "pi", "--traj", "ellipse", "--duration", "2", "--no-progress",
                 "--out", str(out)]) == 0  # fmt: skip
     assert capsys.readouterr().err == ""
+
+
+def test_plant_option_runs_the_physics_plant_and_reruns_it(tmp_path, capsys):
+    """--plant mujoco: the physics keys reach summary.json and the table; the record names
+    the plant, so --rerun repeats the (deterministic) physics run bit for bit."""
+    first, second = tmp_path / "first", tmp_path / "second"
+    args = ["--method", "clrrmc-ts", "--traj", "ellipse", "--duration", "2", "--no-plots"]
+    assert run([*args, "--plant", "mujoco", "--out", str(first)]) == 0
+    printed = capsys.readouterr().out
+    assert "(mujoco plant)" in printed and "tipped over (physics)" in printed
+    summary = json.loads((first / "summary.json").read_text())
+    assert summary["plant"] == "mujoco" and summary["tipped"] is False
+    assert summary["integrator"] is None and summary["run"]["plant"] == {"name": "mujoco"}
+    assert run(["--rerun", str(first / "summary.json"), "--no-plots", "--out", str(second)]) == 0
+    assert _rows_without_timing(first / "timeseries.csv") == _rows_without_timing(
+        second / "timeseries.csv"
+    )
+
+
+def test_integrator_needs_the_kinematic_plant(tmp_path, capsys):
+    out = tmp_path / "x"
+    args = ["--method", "ats", "--traj", "ellipse", "--plant", "thesis", "--integrator", "euler"]
+    assert run([*args, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "only the kinematic plant" in err[0]
+    assert not out.exists()

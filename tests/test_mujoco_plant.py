@@ -208,8 +208,9 @@ def test_slip_is_measured_on_a_slippery_floor():
     hold(grip, np.array([1.0, 0.0, 0.0, 0.0]), 0.3)
     ice = fresh(friction=0.02)
     hold(ice, np.array([1.0, 0.0, 0.0, 0.0]), 0.3)
-    assert grip.extra_values()[-1] < 0.01
-    assert ice.extra_values()[-1] > 0.5  # the wheels spin, the base barely moves
+    slip = grip.extra_columns.index("wheel_slip_m_s")
+    assert grip.extra_values()[slip] < 0.01
+    assert ice.extra_values()[slip] > 0.5  # the wheels spin, the base barely moves
     assert ice.observe().v < 0.1
 
 
@@ -249,3 +250,14 @@ def test_summary_of_a_stable_and_of_a_tipping_hold():
     assert tipping.result["max_base_tilt_rad"] > 0.01
     for key in ("min_support_force_n", "max_wheel_slip_m_s", "min_physics_stability"):
         assert math.isfinite(tipping.result[key])
+
+
+def test_torque_use_reaches_one_when_a_motor_saturates():
+    """Asking 1 m/s from rest saturates the wheel motors (2 N m each); holding still does
+    not use the motors beyond the arm's static load."""
+    plant = fresh()
+    use = plant.extra_columns.index("torque_use")
+    hold(plant, np.zeros(4), 0.1)
+    assert plant.extra_values()[use] < 0.5
+    plant.step(0.0, np.array([1.0, 0.0, 0.0, 0.0]), DT)
+    assert plant.extra_values()[use] == pytest.approx(1.0, abs=1e-9)

@@ -32,6 +32,7 @@ from ddwmmr.cli.common import (
 from ddwmmr.controllers.base import available_methods, method_description
 from ddwmmr.controllers.presets import PRESETS
 from ddwmmr.errors import ParameterError, check_int_at_least, check_positive, check_step_count
+from ddwmmr.plants import available_plants
 from ddwmmr.progress import phase
 from ddwmmr.reports.compare import (
     DEFAULT_TRAJECTORIES,
@@ -88,17 +89,18 @@ studies (--study, default all):
   tau         closed-loop time constants {", ".join(f"{t:g}" for t in TAUS)} s: convergence
               time vs tau (sluggishness), on the ellipse and the rectangle
   dt          steps {", ".join(f"{s:g}" for s in STEP_SIZES)} s with Euler and RK4, no
-              initial offset: final error = drift, observed order of accuracy
+              initial offset: the error is the drift; its observed order of accuracy
   integrator  Euler vs RK4 at the default step, error vs time
   init        initial offsets {", ".join(f"{s:g}" for s in OFFSET_SCALES)} x the default
-              (30 mm, -30 mm): open loop keeps the offset, closed loop removes it
+              (-30 mm, -30 mm in the end effector's frame): open loop keeps the offset,
+              closed loop removes it
   corners     rectangle: error peaks at the corners alpha = k pi/2 (no extra runs)
   all | none  every study | only the comparison
 
 All runs use the same robot, start configuration (home arm pose on the trajectory start,
-end effector offset by 30 mm, -30 mm with the arm), integrator (rk4) and step (the
-trajectory's T/N). Results do not depend on --jobs; only the step latency (a wall-clock
-timing) varies. Bad input prints one line on stderr and exits with status 2.
+end effector offset by (-30, -30) mm in its start frame with the arm), integrator (rk4)
+and step (the trajectory's T/N). Results do not depend on --jobs; only the step latency
+(a wall-clock timing) varies. Bad input prints one line on stderr and exits with status 2.
 """
 
 
@@ -186,6 +188,17 @@ def build_parser() -> ArgumentParser:
         default="default",
         help="settings of the main comparison and the studies: default (the library's) or "
         "slides (the slides' auxiliary row and gains); the report ranks both either way",
+    )
+    parser.add_argument(
+        "--plant",
+        nargs="+",
+        action="extend",
+        default=[],
+        choices=[p for p in available_plants() if p != "kinematic"],
+        metavar="PLANT",
+        help="also run the main comparison on these plants (thesis: force-limited base; "
+        "mujoco: rigid-body physics) and report their errors next to the kinematic plant's, "
+        "with the reasons (lag, torque limits, slip)",
     )
     add_robot_arguments(parser)
     add_force_argument(parser)
@@ -312,6 +325,7 @@ def config_from_arguments(
         studies=parse_studies(args.study),
         command=command,
         preset=args.preset,
+        plants=tuple(dict.fromkeys(args.plant)),
     )
 
 

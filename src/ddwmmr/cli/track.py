@@ -32,6 +32,7 @@ from ddwmmr.controllers.base import available_methods, make_controller, method_d
 from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file
 from ddwmmr.model import Robot
+from ddwmmr.plants import available_plants
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
@@ -41,10 +42,11 @@ from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = "python -m ddwmmr.track"
 #: The plant every track run uses (recorded; the only one until simulate() takes others).
+#: The default plant.
 PLANT = "kinematic"
 #: Options that fix what is simulated: they come from the record with --rerun.
 RUN_OPTIONS = (
-    "method", "traj", "aux", "tau", "dt", "duration", "integrator", "offset", "robot",
+    "method", "traj", "aux", "tau", "dt", "duration", "integrator", "offset", "robot", "plant",
     "payload", "stability_min", "manipulability_weight", "obstacles", "solver", "qp_mode",
     "preset",
 )  # fmt: skip
@@ -54,6 +56,7 @@ TABLE_KEYS = (
     ("rms_position_error_m", "RMS position error (mm)"),
     ("max_position_error_m", "max position error (mm)"),
     ("final_position_error_m", "final position error (mm)"),
+    ("corner_position_error_m", "corner position error (mm)"),
     ("rms_orientation_error_rad", "RMS orientation error (rad)"),
     ("max_nonholonomic_residual_m_s", "max nonholonomic residual (m/s)"),
     ("max_wheel_speed_rad_s", "max wheel speed (rad/s)"),
@@ -64,6 +67,13 @@ TABLE_KEYS = (
     ("stability_violations", "steps with S < S_min"),
     ("qp_fallbacks", "QP fallbacks"),
     ("min_obstacle_clearance_m", "min obstacle clearance (mm)"),
+    ("max_wheel_force_n", "max wheel force (N)"),
+    ("tipped", "tipped over (physics)"),
+    ("min_edge_load_n", "min support-edge load (N)"),
+    ("min_physics_stability", "min physics stability"),
+    ("max_base_tilt_rad", "max base tilt (rad)"),
+    ("max_wheel_slip_m_s", "max wheel slip (m/s)"),
+    ("diverged", "plant diverged"),
     ("steps", "steps"),
     ("median_step_us", "median controller step (us)"),
 )
@@ -72,6 +82,7 @@ MM_KEYS = {
     "rms_position_error_m",
     "max_position_error_m",
     "final_position_error_m",
+    "corner_position_error_m",
     "min_obstacle_clearance_m",
 }
 
@@ -143,13 +154,26 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--duration", type=float, metavar="S", help="simulated time in s (default one period)"
     )
-    parser.add_argument("--integrator", choices=INTEGRATORS, help="integrator (default rk4)")
+    parser.add_argument(
+        "--plant",
+        choices=available_plants(),
+        help="what the commands drive: kinematic (default; exact kinematics), thesis (the "
+        "thesis's force-limited base through a velocity servo) or mujoco (rigid-body physics "
+        "with contacts: tip-over judged by the support forces, docs/physics.md)",
+    )
+    parser.add_argument(
+        "--integrator",
+        choices=INTEGRATORS,
+        help="integrator of the kinematic plant (default rk4; other plants integrate their "
+        "own dynamics)",
+    )
     parser.add_argument(
         "--offset",
         type=float,
         nargs=2,
         metavar=("DX", "DY"),
-        help="initial end-effector offset in m, applied with the arm (default "
+        help="initial end-effector offset in m, in the end effector's start frame (x along "
+        "its start orientation), applied with the arm (default "
         f"{DEFAULT_INITIAL_OFFSET[0]:.2f} {DEFAULT_INITIAL_OFFSET[1]:.2f})",
     )
     add_robot_arguments(parser)
@@ -208,7 +232,8 @@ def default_out(method: str, traj: str) -> Path:
 
 def format_table(summary: dict[str, Any]) -> str:
     """The summary as an aligned two-column text table (lengths in mm)."""
-    lines = [f"{summary['method']} on {summary['trajectory']}"]
+    plant = summary.get("plant", PLANT)
+    lines = [f"{summary['method']} on {summary['trajectory']} ({plant} plant)"]
     for key, label in TABLE_KEYS:
         if key in summary and summary[key] is not None:
             value = summary[key]
@@ -230,9 +255,10 @@ class RunInputs:
     trajectory_file: Path | None
     dt: float
     duration: float
-    integrator: str
+    integrator: str | None
     offset: tuple[float, float]
     label: str  # trajectory as the user named it (for the default folder name)
+    plant: str = PLANT
 
 
 def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
@@ -261,10 +287,20 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         source,
         step,
         duration,
-        args.integrator or "rk4",
+        _integrator(args.plant or PLANT, args.integrator),
         offset,
         args.traj,
+        args.plant or PLANT,
     )
+
+
+def _integrator(plant: str, integrator: str | None) -> str | None:
+    """The kinematic plant's integrator (rk4 by default); None for the other plants."""
+    if plant == PLANT:
+        return integrator or "rk4"
+    if integrator is not None:
+        raise ParameterError(f"integrator: only the kinematic plant takes one (plant {plant})")
+    return None
 
 
 def inputs_from_record(args: argparse.Namespace) -> RunInputs:
@@ -278,7 +314,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
     record = load_run_record(args.rerun)
     try:
         plant = record["plant"]["name"]
-        if plant != PLANT:
+        if plant not in available_plants():
             raise ParameterError(f"rerun: plant {plant!r} is not supported by this version")
         trajectory = provenance.trajectory_from_record(record["trajectory"])
         source = record["trajectory"].get("file")
@@ -293,6 +329,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
             record["integrator"],
             tuple(provenance.decode(record["initial_offset"])),
             record["trajectory"].get("name") or "rerun",
+            plant,
         )
     except (KeyError, TypeError, AttributeError) as exc:
         raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
@@ -323,7 +360,7 @@ def run_record(inputs: RunInputs, argv: Sequence[str] | None, rerun: str | None)
         duration=inputs.duration,
         integrator=inputs.integrator,
         initial_offset=list(inputs.offset),
-        plant={"name": PLANT},
+        plant={"name": inputs.plant},
         seed=None,  # nothing random in a track run
     )
     if rerun is not None:
@@ -350,6 +387,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
                 dt=inputs.dt,
                 duration=inputs.duration,
                 integrator=inputs.integrator,
+                plant=inputs.plant,
                 initial_offset=inputs.offset,
                 progress=lambda k, n: bar.advance(),
             )

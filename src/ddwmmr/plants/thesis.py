@@ -217,10 +217,16 @@ class ThesisPlant:
         return self._forces
 
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
-        """Peak wheel force (N) over the run."""
+        """Peak wheel force (N) and the time (s) with a wheel at its force limit."""
         left = np.abs(timeseries.get("force_left_n", np.zeros(1)))
         right = np.abs(timeseries.get("force_right_n", np.zeros(1)))
-        return {"max_wheel_force_n": float(max(np.max(left), np.max(right)))}
+        t = np.asarray(timeseries.get("t", np.zeros(1)))
+        interval = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+        at_limit = np.maximum(left, right) >= self.force_limit * (1.0 - 1e-9)
+        return {
+            "max_wheel_force_n": float(max(np.max(left), np.max(right))),
+            "actuator_saturated_time_s": float(np.sum(at_limit) * interval),
+        }
 
     # -- the model --------------------------------------------------------------------------
     def inertia(self, th1: float, th2: float) -> float:

@@ -443,3 +443,26 @@ def plot_corner_study(
     ax2.set_xlabel("alpha / (pi/2)")
     fig.tight_layout()
     return fig
+
+
+def plot_plant_errors(
+    kinematic: Series, plant: Series, colors: Mapping[str, str], plant_name: str, title: str
+) -> Figure:
+    """Position error vs time per method: kinematic plant (dashed) and ``plant`` (solid)."""
+    fig, ax = plt.subplots(figsize=(8, 4))
+    for label, ts in plant.items():
+        base = kinematic[label]
+        ax.semilogy(
+            base["t"], _floor(base["position_error_m"]), color=colors[label], ls="--", lw=0.8
+        )
+        ax.semilogy(
+            ts["t"], _floor(ts["position_error_m"]), color=colors[label], lw=1.2, label=label
+        )
+    ax.set_ylabel("position error (m, log)")
+    ax.set_xlabel("t (s)")
+    ax.set_ylim(bottom=ERROR_FLOOR / 2)
+    ax.grid(alpha=0.3, which="major")
+    ax.legend(fontsize=8, ncol=3, title=f"solid: {plant_name}, dashed: kinematic", title_fontsize=8)
+    ax.set_title(title)
+    fig.tight_layout()
+    return fig

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import Controller, make_controller
-from ddwmmr.errors import ParameterError, check_finite, check_positive
+from ddwmmr.errors import ParameterError, check_finite, check_positive, check_step_count
 from ddwmmr.model import Robot
 from ddwmmr.plants import make_plant
 from ddwmmr.plants.base import Plant
@@ -52,9 +52,12 @@ def simulate(
         duration: simulated time (s); default one trajectory period.
         integrator: ``"rk4"`` (default) or ``"euler"``; the kinematic plant's integrator
             (the other plants integrate their own dynamics and take no integrator).
-        initial_offset: end-effector offset (dx, dy) in m, applied with the arm joints to
-            the start configuration, so closed-loop convergence shows. ``(0, 0)`` starts on
-            the trajectory.
+        initial_offset: end-effector offset (dx, dy) in m in the end effector's start frame
+            (dx along the desired start orientation phiE_d(0), dy to its left), applied
+            with the arm joints to the start configuration, so closed-loop convergence
+            shows. Default (-0.03, -0.03): 30 mm behind and 30 mm to the right (on the
+            default ellipse the world offset (0.03, -0.03)). ``(0, 0)`` starts on the
+            trajectory.
         q0: explicit start configuration (overrides the construction above).
         plant: ``"kinematic"`` (default), ``"thesis"`` (force-driven base, velocity servo),
             any name of :func:`ddwmmr.plants.available_plants`, or a plant object.
@@ -82,9 +85,7 @@ def simulate(
         if quantum:  # an engine step: the nearest whole multiple of it
             dt = max(1, round(dt / quantum)) * quantum
     dt = check_positive("dt", dt)
-    if dt > duration:
-        raise ParameterError(f"dt must be <= duration ({duration:g} s) (got {dt:g})")
-    steps = max(1, round(duration / dt))
+    steps = check_step_count(duration, dt)  # within MAX_STEPS, before anything is allocated
     if q0 is None:
         offset = tuple(check_finite("initial_offset", v) for v in initial_offset)
         if len(offset) != 2:

@@ -47,6 +47,8 @@ from ddwmmr.plants.thesis import ThesisPlant, arm_step, damped_base_envelope
 #: Time (s) the robot settles on its supports in :meth:`MujocoPlant.reset` before t = 0,
 #: so that the first recorded contact forces carry the robot's weight.
 SETTLE_TIME_S = 0.2
+#: Share of a motor's torque limit counted as saturated (``torque_use``).
+TORQUE_SATURATED = 0.999
 #: Time constant (s) of the damping that holds the base still while it settles.
 SETTLE_DAMPING_TIME_S = 0.01
 #: An edge of the support polygon is unloaded when the supports off it carry less than
@@ -132,6 +134,7 @@ class MujocoPlant:
             "physics_stability",
             "base_tilt_rad",
             "wheel_slip_m_s",
+            "torque_use",
         )
         self.weight_n = float(np.sum(self.model.body_mass)) * -float(self.model.opt.gravity[2])
         self._limits = KinematicPlant(robot, "euler")
@@ -423,8 +426,14 @@ class MujocoPlant:
                 stability,
                 self.base_tilt(),
                 self.wheel_slip(),
+                self.torque_use(),
             )
         return self._cache
+
+    def torque_use(self) -> float:
+        """Largest share of its torque limit any motor uses now (1: saturated)."""
+        limits = self.model.actuator_forcerange[:, 1]
+        return float(np.max(np.abs(self.data.actuator_force) / limits))
 
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
         """Physics summary of a recorded run.
@@ -433,7 +442,8 @@ class MujocoPlant:
         ``support_lost`` (some polygon edge carried no load at some sample),
         ``unloaded_time_s`` (total time with an unloaded edge), ``min_support_force_n``,
         ``min_edge_load_n``, ``min_physics_stability``, ``max_base_tilt_rad``,
-        ``max_wheel_slip_m_s`` and ``mujoco_timestep_s``.
+        ``max_wheel_slip_m_s``, ``actuator_saturated_time_s`` (time with a motor at its
+        torque limit) and ``mujoco_timestep_s``.
         """
         t = np.asarray(timeseries["t"], dtype=float)
         edge_load = np.asarray(timeseries["min_edge_load_n"], dtype=float)
@@ -452,6 +462,9 @@ class MujocoPlant:
             "min_physics_stability": float(np.min(timeseries["physics_stability"])),
             "max_base_tilt_rad": float(np.max(timeseries["base_tilt_rad"])),
             "max_wheel_slip_m_s": float(np.max(timeseries["wheel_slip_m_s"])),
+            "actuator_saturated_time_s": float(
+                np.sum(np.asarray(timeseries["torque_use"]) >= TORQUE_SATURATED) * interval
+            ),
             "mujoco_timestep_s": self.options.timestep,
         }
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -22,6 +22,7 @@ from ddwmmr.controllers.base import make_controller
 from ddwmmr.controllers.presets import PRESETS, check_preset, preset_differences
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
+from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.progress import ProgressBar
 from ddwmmr.reports.compare.constants import (
     CORNER_TRAJECTORY,
@@ -60,6 +61,8 @@ class CompareConfig:
         command: the command line, quoted in the report so it can be reproduced.
         preset: the option preset of the main comparison and the studies (``"default"``
             or ``"slides"``); the report also ranks the methods under the other one.
+        plants: extra plants (``"thesis"``, ``"mujoco"``) on which the main comparison is
+            repeated, next to the kinematic plant (section "Plants").
     """
 
     methods: tuple[str, ...]
@@ -70,9 +73,17 @@ class CompareConfig:
     study_methods: tuple[str, ...] | None = None
     command: str = ""
     preset: str = "default"
+    plants: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         check_preset(self.preset)
+        for plant in self.plants:
+            if plant not in available_plants() or plant == "kinematic":
+                others = [p for p in available_plants() if p != "kinematic"]
+                raise ParameterError(
+                    f"plant must be one of {', '.join(others)} (the kinematic plant always "
+                    f"runs) (got {plant!r})"
+                )
         if self.study_methods is None:
             self.study_methods = tuple(m for m in self.methods if in_studies(m))
 
@@ -94,9 +105,11 @@ class RunSpec:
     method: str
     trajectory: str
     dt: float
-    integrator: str = "rk4"
+    integrator: str | None = "rk4"
     initial_offset: tuple[float, float] = DEFAULT_INITIAL_OFFSET
     options: tuple[tuple[str, Any], ...] = ()
+    #: The plant (``integrator`` is the kinematic plant's; None on the others).
+    plant: str = "kinematic"
 
     def label(self) -> str:
         """Short text such as ``ap (K3=0)``."""
@@ -126,11 +139,14 @@ class Plan:
     #: The default settings with one slides setting applied, for methods whose presets
     #: differ in more than one option (what each setting does on its own).
     preset_effects: list[RunSpec] = field(default_factory=list)
+    #: The main runs repeated on each extra plant (``--plant``), same order as ``main``.
+    plants: dict[str, list[RunSpec]] = field(default_factory=dict)
 
     def all_specs(self) -> list[RunSpec]:
         """Every distinct run, in a fixed order (so results never depend on scheduling)."""
         seen: dict[RunSpec, None] = {}
         sections = [self.main, self.alternative, self.preset_effects, self.variants]
+        sections += list(self.plants.values())
         sections += list(self.studies.values())
         for spec in (s for section in sections for s in section):
             seen.setdefault(spec, None)
@@ -214,6 +230,13 @@ def plan_runs(config: CompareConfig) -> Plan:
         for n in names
         if n in DEFAULT_TRAJECTORIES
     ]
+    plan.plants = {
+        plant: [
+            replace(spec, plant=plant, integrator=None, dt=plant_step(config, spec.dt, plant))
+            for spec in plan.main
+        ]
+        for plant in config.plants
+    }
     builders: dict[str, Callable[[CompareConfig], list[RunSpec]]] = {
         "tau": _plan_tau,
         "dt": _plan_dt,
@@ -225,6 +248,13 @@ def plan_runs(config: CompareConfig) -> Plan:
         if _study_possible(config, study):
             plan.studies[study] = builders[study](config)
     return plan
+
+
+def plant_step(config: CompareConfig, dt: float, plant: str) -> float:
+    """The main runs' step on ``plant``: the nearest whole multiple of its engine timestep
+    (a physics plant's control step must be one), else unchanged."""
+    quantum = getattr(make_plant(plant, config.robot), "timestep", None)
+    return max(1, round(dt / quantum)) * quantum if quantum else dt
 
 
 def _study_possible(config: CompareConfig, study: str) -> bool:
@@ -308,6 +338,7 @@ def run_one(task: tuple[Robot, Any, float | None, RunSpec]) -> RunOutput:
         duration=duration,
         integrator=spec.integrator,
         initial_offset=spec.initial_offset,
+        plant=spec.plant,
         **dict(spec.options),
     )
     return RunOutput(dict(result.summary), dict(result.timeseries))
@@ -344,5 +375,7 @@ def execute(
 
 
 def estimated_cost(config: CompareConfig, spec: RunSpec) -> float:
-    """Rough relative cost of a run: its number of controller calls (RK4 calls 4 a step)."""
-    return run_duration(config, spec.trajectory) / spec.dt * (4 if spec.integrator == "rk4" else 1)
+    """Rough relative cost of a run: its number of controller calls (RK4 calls 4 a step);
+    a physics step costs about as much as four."""
+    calls = 4 if spec.integrator == "rk4" or spec.plant == "mujoco" else 1
+    return run_duration(config, spec.trajectory) / spec.dt * calls

@@ -99,6 +99,8 @@ def write_report(
     _diagnosis_section(context)
     for name in config.trajectories:
         _trajectory_section(context, name)
+    for plant in plan.plants:
+        _plant_section(context, plant)
     for study in plan.studies:
         _STUDY_SECTIONS[study](context)
     _definitions_section(context)
@@ -458,6 +460,96 @@ def _trajectory_section(c: _Context, name: str) -> None:
         "method's colour, base path grey, the robot (grey footprint, black arm) at six "
         "instants labelled with their time.",
     )
+
+
+#: A tracking error this many times the kinematic plant's is explained (section "Plants").
+PLANT_GAP = 1.5
+#: Thresholds naming a cause: RMS velocity lag (m/s), wheel slip (m/s), torque-limited time.
+LAG_M_S, SLIP_M_S, SATURATED_SHARE = 0.005, 0.05, 0.01
+
+
+def _plant_section(c: _Context, plant: str) -> None:
+    """The main comparison repeated on ``plant``, next to the kinematic plant, with the
+    measured reasons for the difference (velocity lag, torque saturation, wheel slip)."""
+    c.doc.heading(f"Plant: {plant} next to the kinematic plant")
+    c.doc.paragraph(
+        f"Every method of the comparison, same trajectories, robot and start, on the {plant} "
+        "plant (its own dynamics: the commands go to velocity servos, so the base lags and "
+        "may saturate or slip) and on the kinematic plant (the command is the motion). "
+        "Lag is the RMS difference between the commanded and the measured forward speed; "
+        "'actuator-limited' the share of the run with a motor at its torque limit (or a "
+        "wheel at its force limit); slip the peak speed of a wheel's contact point over the "
+        "floor (physics only)."
+    )
+    runs = dict(zip(c.plan.main, c.plan.plants[plant]))
+    rows, reasons = [], []
+    for base_spec, spec in runs.items():
+        base, run = c.run(base_spec), c.run(spec)
+        s, k, ts = run.summary, base.summary, run.timeseries
+        lag = float(np.sqrt(np.mean((ts["v_measured"] - ts["v"]) ** 2)))
+        duration = max(float(ts["t"][-1]), 1e-12)
+        saturated = s.get("actuator_saturated_time_s", math.nan) / duration
+        slip = s.get("max_wheel_slip_m_s", math.nan)
+        ratio = s["rms_position_error_m"] / max(k["rms_position_error_m"], 1e-12)
+        rows.append(
+            [
+                spec.trajectory,
+                spec.method,
+                mm(k["rms_position_error_m"]),
+                mm(s["rms_position_error_m"]),
+                fmt(ratio),
+                mm(s["final_position_error_m"]),
+                fmt(1000.0 * lag),
+                f"{100.0 * saturated:.1f} %" if math.isfinite(saturated) else "-",
+                fmt(1000.0 * slip) if math.isfinite(slip) else "-",
+                fmt(k["min_stability"]),
+                fmt(s.get("min_physics_stability", math.nan)),
+                _tipped_text(s),
+            ]
+        )
+        if ratio > PLANT_GAP:
+            reasons.append(_plant_reason(spec, ratio, lag, saturated, slip))
+    headers = [
+        "trajectory", "method", "RMS kinematic (mm)", f"RMS {plant} (mm)", "x",
+        f"final {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)", "min S",
+        "min physics S", "tipped",
+    ]  # fmt: skip
+    c.doc.table(headers, rows)
+    c.doc.paragraph(
+        "Where the error grows by more than "
+        f"{PLANT_GAP:g}x: " + ("; ".join(reasons) if reasons else "nowhere.")
+    )
+    for name in c.config.trajectories:
+        kinematic = {s.method: c.run(s).timeseries for s in runs if s.trajectory == name}
+        on_plant = {s.method: c.run(r).timeseries for s, r in runs.items() if s.trajectory == name}
+        c.add_figure(
+            f"plant_{plant}_{name}.png",
+            plots.plot_plant_errors(
+                kinematic, on_plant, c.colors, plant, f"{name}: kinematic vs {plant} plant"
+            ),
+            f"{name}: position error per method on the {plant} plant (solid) and on the "
+            "kinematic plant (dashed).",
+        )
+
+
+def _tipped_text(summary: Mapping[str, Any]) -> str:
+    """``yes (at t s)`` / ``no`` for a physics run, ``-`` where the plant cannot tip."""
+    if "tipped" not in summary:
+        return "-"
+    return f"yes (at {summary['tip_time_s']:.2f} s)" if summary["tipped"] else "no"
+
+
+def _plant_reason(spec: RunSpec, ratio: float, lag: float, saturated: float, slip: float) -> str:
+    """One clause: which measured effect explains a method's larger error on the plant."""
+    causes = []
+    if math.isfinite(saturated) and saturated >= SATURATED_SHARE:
+        causes.append(f"actuators at their limit {100 * saturated:.1f} % of the time")
+    if lag >= LAG_M_S:
+        causes.append(f"the servos lag the command by {1000 * lag:.0f} mm/s RMS")
+    if math.isfinite(slip) and slip >= SLIP_M_S:
+        causes.append(f"the wheels slip up to {1000 * slip:.0f} mm/s")
+    because = ", ".join(causes) if causes else "no single measured cause above its threshold"
+    return f"{spec.method} on {spec.trajectory} ({fmt(ratio)}x): {because}"
 
 
 def _tau_section(c: _Context) -> None:
