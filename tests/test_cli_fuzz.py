@@ -1,4 +1,5 @@
-"""Bad input to every tool (track, compare, scenarios): one line, exit 2, nothing written.
+"""Bad input to every tool (track, compare, scenarios, bench): one line, exit 2, nothing
+written.
 
 A table of the cases issue 8 found (absurd sizes, broken files, FIFOs, output paths,
 trajectory names with ``..``, wrong TOML types) plus property tests over invalid numbers.
@@ -19,17 +20,24 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from ddwmmr.bench import main as bench_main
 from ddwmmr.cli.compare import main as compare_main
 from ddwmmr.cli.scenarios import main as scenarios_main
 from ddwmmr.cli.track import main as track_main
 from ddwmmr.errors import MAX_SCENARIOS, MAX_STEPS
 
-MAINS = {"track": track_main, "compare": compare_main, "scenarios": scenarios_main}
+MAINS = {
+    "track": track_main,
+    "compare": compare_main,
+    "scenarios": scenarios_main,
+    "bench": bench_main,
+}
 #: Arguments that make each tool's run small (the cases add the bad part).
 BASE = {
     "track": ["--method", "ats", "--traj", "ellipse", "--duration", "0.2", "--no-plots"],
     "compare": ["--methods", "pi", "--only", "ellipse", "--study", "none", "--jobs", "1"],
     "scenarios": ["--n", "1", "--time-limit", "0.2", "--jobs", "1"],
+    "bench": ["--repeats", "1", "--calls", "1", "--duration", "0.1", "--method", "pi"],
 }
 
 #: Input files the cases refer to as {name}; written into inputs/ before the snapshot.
@@ -124,8 +132,21 @@ for tool in ("track", "compare"):
 CASES += [("track", ["--traj", traj], text) for traj, text in TRAJ_CASES]
 CASES += [("compare", ["--only", traj], text) for traj, text in TRAJ_CASES[:4] + TRAJ_CASES[15:]]
 CASES += [("compare", ["--traj", traj], text) for traj, text in TRAJ_CASES[10:13]]
-for tool in MAINS:
+for tool in ("track", "compare", "scenarios"):  # tools writing a folder
     CASES += [(tool, ["--out", out], text) for out, text in OUT_CASES]
+#: bench writes one file: the same path checks, with a file's wording.
+BENCH_OUT_CASES = [
+    ("{a_file.txt}/out", "is not a folder"),
+    ("{a_file.txt}", "exists and is not a ddwmmr.bench report"),
+    ("{inputs}", "is a folder; give a file name"),
+    ("x" * 300, "is too long (300 bytes, at most 255)"),
+    (".", "is the current folder"),
+    ("..", "is the current folder or one of its parents"),
+    ("{link_to_dir}", "is a symbolic link"),
+    ("{dangling_link}", "is a symbolic link"),
+    ("{dangling_link}/out", "is a dangling symbolic link"),
+]
+CASES += [("bench", ["--out", out], text) for out, text in BENCH_OUT_CASES]
 CASES += [
     ("track", ["--duration", "1e9"], f"duration / dt must be <= {MAX_STEPS} steps"),
     ("track", ["--duration", "inf"], "duration must be a finite number"),
@@ -173,6 +194,12 @@ CASES += [
     ("scenarios", ["--seed", "-1"], "seed must be >= 0"),
     ("scenarios", ["--stability", "nan", "1"], "stability thresholds must be finite"),
     ("scenarios", ["--jobs", "0"], "jobs must be an integer in [1, 256]"),
+    ("bench", ["--repeats", "0"], "--repeats: must be an integer >= 1 (got '0')"),
+    ("bench", ["--repeats", "abc"], "--repeats: must be an integer >= 1"),
+    ("bench", ["--calls", "-1"], "--calls: must be an integer >= 1"),
+    ("bench", ["--duration", "nan"], "--duration: must be a number > 0 in s"),
+    ("bench", ["--duration", "inf"], "--duration: must be a number > 0 in s"),
+    ("bench", ["--method", "nope"], "unknown method 'nope'"),
 ]
 
 

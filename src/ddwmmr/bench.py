@@ -45,6 +45,7 @@ from ddwmmr.controllers.base import Controller, StepInfo, available_methods, mak
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import u_from_qdot
+from ddwmmr.outputs import check_output_file
 from ddwmmr.progress import ProgressBar
 from ddwmmr.sim import simulate
 from ddwmmr.sim.result import write_atomic
@@ -919,17 +920,9 @@ def write_report(report: dict[str, Any], path: str | Path, force: bool = False) 
 
 
 def check_out(path: Path, force: bool = False) -> None:
-    """Refuse an output path that exists and is not a report of this tool (unless
-    ``force``), or whose nearest existing parent is not a folder."""
-    if path.is_dir() or (path.exists() and not force and not _is_report(path)):
-        raise ParameterError(
-            f"out: {path} exists and is not a {TOOL} report (use --force to replace it)"
-        )
-    parent = path.parent
-    while not parent.exists() and parent != parent.parent:
-        parent = parent.parent
-    if not parent.is_dir():
-        raise ParameterError(f"out: {parent} is not a folder")
+    """Refuse, before the run, an output path that cannot be written or that is not a
+    report of this tool (unless ``force``): see :func:`ddwmmr.outputs.check_output_file`."""
+    check_output_file(path, TOOL, _is_report, force)
 
 
 def read_report(path: str | Path) -> dict[str, Any]:

@@ -27,7 +27,7 @@ import shutil
 import stat
 import sys
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
@@ -174,25 +174,23 @@ def _first_existing_ancestor(path: Path) -> Path:
     return Path(path.anchor or "/")  # pragma: no cover - the root always exists
 
 
-def check_output_folder(target: str | Path, tool: str, force: bool = False) -> Path:
-    """Refuse (one-line :class:`ParameterError`) an ``--out`` that may not be written.
-
-    Returns the absolute target path. Called before any simulation, so bad output paths
-    fail fast; :func:`output_folder` checks again just before it moves files into place.
-    """
+def check_output_path(target: str | Path, what: str = "folder") -> Path:
+    """Refuse (one-line :class:`ParameterError`) an ``--out`` path that cannot be written:
+    the current folder or a parent, a symbolic link (dangling too), a name too long, a
+    parent that is not a writable folder. Returns the absolute path (it may not exist)."""
     text = str(target)
     if "\0" in text:
-        raise ParameterError("out: the folder name contains a NUL byte")
+        raise ParameterError(f"out: the {what} name contains a NUL byte")
     path = Path(os.path.abspath(text or "."))
     cwd = Path.cwd()
     real = Path(os.path.realpath(path))
     if cwd in (path, real) or path in cwd.parents or real in cwd.parents:
         raise ParameterError(
-            f"out: {text or '.'} is the current folder or one of its parents; give a new folder"
+            f"out: {text or '.'} is the current folder or one of its parents; give a new {what}"
         )
     if os.path.islink(path):
         raise ParameterError(
-            f"out: {text} is a symbolic link (to {os.readlink(path)}); give a real folder"
+            f"out: {text} is a symbolic link (to {os.readlink(path)}); give a real {what}"
         )
     ancestor = _first_existing_ancestor(path.parent)
     name_max = _name_max(ancestor if ancestor.is_dir() else Path("/"))
@@ -210,6 +208,17 @@ def check_output_folder(target: str | Path, tool: str, force: bool = False) -> P
         raise ParameterError(f"out: {ancestor} is not a folder")
     if not os.access(ancestor, os.W_OK | os.X_OK):
         raise ParameterError(f"out: cannot write in {ancestor} (permission denied)")
+    return path
+
+
+def check_output_folder(target: str | Path, tool: str, force: bool = False) -> Path:
+    """Refuse (one-line :class:`ParameterError`) an ``--out`` that may not be written.
+
+    Returns the absolute target path. Called before any simulation, so bad output paths
+    fail fast; :func:`output_folder` checks again just before it moves files into place.
+    """
+    text = str(target)
+    path = check_output_path(target)
     if not os.path.lexists(path):
         return path
     if not path.is_dir():
@@ -217,6 +226,22 @@ def check_output_folder(target: str | Path, tool: str, force: bool = False) -> P
     existing = inspect(path, tool)
     if existing.kind == "foreign" and not force:
         raise ParameterError(_refusal(text, tool, existing))
+    return path
+
+
+def check_output_file(
+    target: str | Path, tool: str, is_ours: Callable[[Path], bool], force: bool = False
+) -> Path:
+    """:func:`check_output_path` for a single output file: an existing file is replaced
+    only if ``is_ours(path)`` says this tool wrote it (or with ``force``); a folder never."""
+    text = str(target)
+    path = check_output_path(target, "file")
+    if path.is_dir():
+        raise ParameterError(f"out: {text} is a folder; give a file name")
+    if path.exists() and not force and not is_ours(path):
+        raise ParameterError(
+            f"out: {text} exists and is not a {tool} report (use --force to replace it)"
+        )
     return path
 
 
