@@ -1021,7 +1021,16 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Command-line entry point: print the table (or JSON) and write the report."""
+    """Command-line entry point: print the table (or JSON) and write the report.
+
+    Ctrl-C and SIGTERM stop it with one line (exit 130 / 143), as for every tool."""
+    from ddwmmr.cli.common import run_main  # the CLI layer; bench is importable without it
+
+    return run_main(_main, argv)
+
+
+def _main(argv: Sequence[str] | None = None) -> int:
+    """The tool; bad input prints one line and returns 2."""
     args = build_parser().parse_args(argv)
     known = set(available_methods()) | {extra.label for extra in EXTRA_CASES}
     unknown = sorted(set(args.methods or ()) - known)
