@@ -62,6 +62,8 @@ PLANTS = ("thesis", "kinematic", "mujoco")
 MOVING_SPEED, MOVING_RATE = 1e-3, 1e-3
 #: Trace sampling interval for recorded scenarios (s).
 TRACE_INTERVAL = 0.05
+#: Within this distance (m) of its waypoint the end effector is traced at every step.
+FINE_TRACE_DISTANCE = 0.1
 #: Columns of the per-scenario metrics, in CSV order.
 METRICS = (
     "scenario",
@@ -212,23 +214,36 @@ class _Tally:
                 return True
         return False
 
-    def record(self, k: int, t: float, q: tuple[float, ...], state: str) -> None:
-        """Append a trace sample every ``TRACE_INTERVAL``."""
-        if self.trace is None or k % self._every:
+    def record(
+        self,
+        k: int,
+        t: float,
+        q: tuple[float, ...],
+        state: str,
+        goal: tuple[float, float] | None = None,
+    ) -> None:
+        """Append a trace sample every ``TRACE_INTERVAL``, and at every step while the end
+        effector is within ``FINE_TRACE_DISTANCE`` of its waypoint (so the trace resolves
+        the approach to the 0.01 m tolerance). ``goal`` overrides the current waypoint
+        (the sample of the step that reached it)."""
+        if self.trace is None:
             return
         x, y, phi, th1, th2 = q
         r = self.robot
+        xe = x + r.L1 * math.cos(phi + th1) + r.L2 * math.cos(phi + th1 + th2)
+        ye = y + r.L1 * math.sin(phi + th1) + r.L2 * math.sin(phi + th1 + th2)
+        goal = goal if goal is not None else self.target
+        distance = math.hypot(xe - goal[0], ye - goal[1]) if goal else 0.0
+        if k % self._every and distance >= FINE_TRACE_DISTANCE:
+            return
         tr = self.trace
         tr["t"].append(t)
         tr["x"].append(x)
         tr["y"].append(y)
         tr["phi"].append(phi)
-        xe = x + r.L1 * math.cos(phi + th1) + r.L2 * math.cos(phi + th1 + th2)
-        ye = y + r.L1 * math.sin(phi + th1) + r.L2 * math.sin(phi + th1 + th2)
         tr["xe"].append(xe)
         tr["ye"].append(ye)
-        goal = self.target
-        tr["distance"].append(math.hypot(xe - goal[0], ye - goal[1]) if goal else 0.0)
+        tr["distance"].append(distance)
         tr["state"].append(float(STATES.index(state)))
         tr["s"].append(r.stability(q)[2])
         tr["eta"].append(abs(math.sin(th2)))
@@ -296,7 +311,13 @@ class WaypointTask:
         a12 = a1 + th2
         xe = x + self._L1 * math.cos(a1) + self._L2 * math.cos(a12)
         ye = y + self._L1 * math.sin(a1) + self._L2 * math.sin(a12)
-        return self.tally.advance(xe, ye) or k == self.tally.steps
+        tally = self.tally
+        goal, index = tally.target, tally.index
+        done = tally.advance(xe, ye)
+        if tally.index != index and tally.trace is not None:  # trace the reaching sample
+            state = self.controller.state if self.has_states else MOVE_ARM
+            tally.record(k, t, (x, y, phi, th1, th2), state, goal=goal)
+        return done or k == tally.steps
 
     def reference(self, t: float, obs: Observation | None) -> tuple[np.ndarray, np.ndarray]:
         """The current waypoint as a pose (orientation 0, not tracked) at rest."""
