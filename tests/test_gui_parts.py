@@ -1,7 +1,6 @@
 """The simulator app's parts without a window: option specs from constructor signatures,
 trajectory placement, settings checks, plants, the background worker."""
 
-import inspect
 import math
 import threading
 
@@ -103,14 +102,10 @@ def test_plant_list_comes_from_the_engine_when_it_has_one(monkeypatch):
     assert plant_names() == ["kinematic", "thesis"]
 
 
-def test_plant_keyword_only_when_simulate_takes_it():
-    takes_plant = "plant" in inspect.signature(ddwmmr.sim.simulate).parameters
-    if takes_plant:
-        assert plant_keywords("kinematic") == {"plant": "kinematic"}
-    else:
-        assert plant_keywords("kinematic") == {}
-        with pytest.raises(ParameterError, match="plant must be kinematic"):
-            plant_keywords("thesis")
+def test_integrator_goes_to_the_kinematic_plant_only():
+    assert plant_keywords("kinematic", "euler") == {"plant": "kinematic", "integrator": "euler"}
+    assert plant_keywords("mujoco", "euler") == {"plant": "mujoco"}
+    assert set(plant_names()) >= {"kinematic", "thesis", "mujoco"}
 
 
 # -- trajectories --------------------------------------------------------------------

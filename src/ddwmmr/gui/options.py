@@ -216,23 +216,16 @@ def _annotation_text(parameter: inspect.Parameter) -> str:
 
 
 def plant_names() -> list[str]:
-    """Plants the app offers: ``ddwmmr.sim.available_plants()`` once the simulation
-    engine has it, else the kinematic plant only (the one place the app reads this)."""
+    """Plants the app offers: ``ddwmmr.sim.available_plants()`` (the one place the app
+    reads this, so a new plant appears by itself)."""
     from ddwmmr import sim
 
-    lister = getattr(sim, "available_plants", None)
-    return list(lister()) if callable(lister) else ["kinematic"]
+    return list(sim.available_plants())
 
 
-def plant_keywords(plant: str) -> dict[str, str]:
-    """Keyword arguments selecting ``plant`` in :func:`ddwmmr.simulate`.
-
-    Engines without a ``plant`` parameter simulate the kinematic plant only.
-    """
-    from ddwmmr.sim import simulate
-
-    if "plant" in inspect.signature(simulate).parameters:
-        return {"plant": plant}
-    if plant != "kinematic":
-        raise ParameterError(f"plant must be kinematic in this version (got {plant!r})")
-    return {}
+def plant_keywords(plant: str, integrator: str) -> dict[str, str]:
+    """Keyword arguments of :func:`ddwmmr.simulate` selecting ``plant``; the integrator
+    goes to the kinematic plant only (the others integrate their own dynamics)."""
+    if plant == "kinematic":
+        return {"plant": plant, "integrator": integrator}
+    return {"plant": plant}

@@ -229,7 +229,6 @@ def check_settings(settings: Settings) -> Settings:
         raise ParameterError(
             f"plant must be one of {', '.join(plant_names())} (got {settings.plant!r})"
         )
-    plant_keywords(settings.plant)
     if settings.integrator not in INTEGRATORS:
         raise ParameterError(
             f"integrator must be one of {', '.join(INTEGRATORS)} (got {settings.integrator!r})"
@@ -272,10 +271,9 @@ def simulate_settings(
                 controller,
                 dt=control_step(settings, trajectory),
                 duration=settings.duration,
-                integrator=settings.integrator,
                 initial_offset=tuple(settings.offset),
                 progress=report,
-                **plant_keywords(settings.plant),
+                **plant_keywords(settings.plant, settings.integrator),
             )
         )
     return results
