@@ -17,15 +17,18 @@ import math
 from dataclasses import dataclass, replace
 from typing import Protocol
 
-from ddwmmr.model import Robot
+from ddwmmr.model import Robot, stability
 
 #: Base modes of a proposal.
 DRIVE, TURN, BRAKE = "drive", "turn", "brake"
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Percept:
-    """What every behaviour sees at one control instant.
+    """What every behaviour sees at one control instant; read-only by convention.
+
+    (Not a frozen dataclass: one is built every control step, and a frozen one costs
+    1.7 us to build against 0.2 us, a seventh of a thesis-controller step.)
 
     Attributes:
         t: time (s).
@@ -91,16 +94,16 @@ def sense(
     k = robot.com_coefficients
     x_com = k.A * math.cos(th1) + k.B * math.cos(th1 + th2)
     y_com = k.A * math.sin(th1) + k.B * math.sin(th1 + th2)
-    s_lon, s_lat, s = robot.stability(q)
+    s_lon, s_lat, s = stability.margins(k, x_com, y_com)
     return Percept(
         t, x, y, phi, th1, th2, v, w, xe, ye, x_com, y_com, s_lon, s_lat, s,
         abs(math.sin(th2)), target, hold if hold is not None else (xe, ye),
     )  # fmt: skip
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Proposal:
-    """The common output of every behaviour.
+    """The common output of every behaviour; read-only by convention (see Percept).
 
     Attributes:
         mode: ``"drive"`` to the world point (bx, by), ``"turn"`` in place to the world

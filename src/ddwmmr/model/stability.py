@@ -73,6 +73,11 @@ def _ratio(half_extent: float, offset: float) -> float:
 def stability_terms(k: ComCoefficients, th1: float, th2: float) -> tuple[float, float, float]:
     """``(S_lon, S_lat, S)``, each capped at :data:`STABILITY_CAP` (dimensionless)."""
     x_com, y_com = centre_of_mass(k, th1, th2)
+    return margins(k, x_com, y_com)
+
+
+def margins(k: ComCoefficients, x_com: float, y_com: float) -> tuple[float, float, float]:
+    """``(S_lon, S_lat, S)`` for a centre of mass ``(x_com, y_com)`` (m, base frame)."""
     s_lon = _ratio(k.half_length, x_com)
     s_lat = _ratio(k.half_width, y_com)
     return s_lon, s_lat, min(s_lon, s_lat)

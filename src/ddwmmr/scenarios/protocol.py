@@ -50,6 +50,7 @@ from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.behaviours.obstacle import base_bubble
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
+from ddwmmr.model.stability import stability_terms
 from ddwmmr.plants import make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.plants.thesis import C1_DEFAULT, C2_DEFAULT
@@ -176,19 +177,22 @@ class _Tally:
             self.trace = {k: [] for k in keys}
         self._every = max(1, round(TRACE_INTERVAL / config.dt))
         self.steps = round(config.limit_for(scenario) / config.dt)
+        self._tolerance = config.tolerance
+        self._com = robot.com_coefficients
+        #: Current waypoint (m, world), None when all are reached (kept with ``index``).
+        self.target: tuple[float, float] | None = self._waypoint(0)
 
-    @property
-    def target(self) -> tuple[float, float] | None:
-        """Current waypoint, None when all are reached."""
+    def _waypoint(self, index: int) -> tuple[float, float] | None:
         w = self.scenario.waypoints
-        return w[self.index] if self.index < len(w) else None
+        return w[index] if index < len(w) else None
 
     def advance(self, xe: float, ye: float) -> bool:
         """Mark reached waypoints; True when the last one is reached."""
-        tol = self.config.tolerance
-        while (goal := self.target) is not None and math.hypot(xe - goal[0], ye - goal[1]) <= tol:
+        goal = self.target
+        while goal is not None and math.hypot(xe - goal[0], ye - goal[1]) <= self._tolerance:
             self.index += 1
-        if self.target is None:
+            goal = self.target = self._waypoint(self.index)
+        if goal is None:
             self.reason = "ok"
             return True
         return False
@@ -202,7 +206,7 @@ class _Tally:
 
     def check(self, q: tuple[float, ...]) -> bool:
         """Stability and collision after a step; True when the run has failed."""
-        s = self.robot.stability(q)[2]
+        s = stability_terms(self._com, q[3], q[4])[2]
         self.min_s = min(self.min_s, s)
         self.min_eta = min(self.min_eta, abs(math.sin(q[4])))
         if s <= 1.0:
