@@ -41,8 +41,8 @@ from ddwmmr.arbiters.state_machine import (
     STABILITY,
     STATES,
     Hysteresis,
-    StateMachineArbiter,
 )
+from ddwmmr.arbiters.factory import check_arbiter, make_arbiter
 from ddwmmr.behaviours.controller import ThesisController
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.behaviours.obstacle import base_bubble
@@ -96,6 +96,9 @@ class RunConfig:
         tolerance: waypoint tolerance (m).
         qp_stability_min, qp_max_speed: options of the ``qp`` controller.
         record: keep a trace (every ``TRACE_INTERVAL``) for plots.
+        arbiter: thesis controller's arbiter, ``"state-machine"`` or ``"competitive"``
+            (thresholds above) or an arbiter instance (``ddwmmr.arbiters.make_arbiter``).
+        arbiter_seed: noise seed of the competitive arbiter.
     """
 
     controller: str = "thesis"
@@ -109,6 +112,8 @@ class RunConfig:
     qp_stability_min: float = 1.25
     qp_max_speed: float = 1.0
     record: bool = False
+    arbiter: Any = "state-machine"
+    arbiter_seed: int = 0
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLERS:
@@ -123,6 +128,7 @@ class RunConfig:
             )
         Hysteresis(*self.stability)
         Hysteresis(*self.manipulability)
+        check_arbiter(self.arbiter, self.controller)
         check_nonnegative("payload", self.payload)
         for name in ("dt", "tolerance", "qp_stability_min", "qp_max_speed"):
             check_positive(name, getattr(self, name))
@@ -276,9 +282,7 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
 def _run_thesis(robot: Robot, scenario: Scenario, config: RunConfig) -> Outcome:
     dt = config.dt
     plant = ThesisPlant(robot)
-    arbiter = StateMachineArbiter(
-        stability=Hysteresis(*config.stability), manipulability=Hysteresis(*config.manipulability)
-    )
+    arbiter = make_arbiter(config)
     controller = ThesisController(robot, arbiter, obstacles=scenario.obstacles)
     state = ThesisState(0.0, 0.0, 0.0, *controller.default_pose)
     tally = _Tally(robot, scenario, config)
