@@ -62,9 +62,7 @@ def run(dyn, a, r, h, steps):
     ],
 )
 def test_bernoulli_step_matches_adaptive_integrator(w0, alpha, beta, tau):
-    sol = solve_ivp(
-        lambda t, w: alpha * w - beta * w**3, (0.0, tau), [w0], rtol=1e-11, atol=1e-13
-    )
+    sol = solve_ivp(lambda t, w: alpha * w - beta * w**3, (0.0, tau), [w0], rtol=1e-11, atol=1e-13)
     assert bernoulli_step(w0, alpha, beta, tau) == pytest.approx(sol.y[0, -1], rel=1e-8)
 
 
@@ -102,7 +100,8 @@ def test_winner_at_one_loser_at_zero_when_interaction_exceeds_advantage():
         for k in range(2):
             dw = np.zeros(2)
             dw[k] = eps
-            jac[:, k] = (rhs(np.add(w_star, dw), a, r, [0.1, 0.1]) - rhs(w_star, a, r, [0.1, 0.1])) / eps
+            t_const = [0.1, 0.1]
+            jac[:, k] = (rhs(np.add(w_star, dw), a, r, t_const) - rhs(w_star, a, r, t_const)) / eps
         assert np.all(np.linalg.eigvals(jac).real < 0)
         assert jac[loser, loser] == pytest.approx((a[loser] - 1.0) / 0.1, rel=1e-4)
         assert jac[winner, winner] == pytest.approx(-2.0 * a[winner] / 0.1, rel=1e-4)
@@ -194,7 +193,8 @@ def test_integration_converges_to_the_reference_at_the_controller_step(h, tolera
     assert np.max(np.abs(ours - ref)) < tolerance
     dyn.reset(case["w0"])
     final = run(dyn, case["a"], case["r"], h, round(2.0 / h))
-    assert final == pytest.approx(reference(case["w0"], case["a"], case["r"], case["t"], 2.0), abs=1e-6)
+    settled = reference(case["w0"], case["a"], case["r"], case["t"], 2.0)
+    assert final == pytest.approx(settled, abs=1e-6)
 
 
 @pytest.mark.parametrize("h", [0.02, 0.05, 0.1, 0.5])

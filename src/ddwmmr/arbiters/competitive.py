@@ -22,8 +22,10 @@ u0 h / T)`` at ``alpha = 0``). Behaviours are updated one after another in prior
 each seeing the weights already updated (Gauss-Seidel splitting). The update is exact for a
 single behaviour and for fixed points of the coupled system, never overshoots a fixed point,
 keeps ``|w| <= max(|w0|, 1)`` for any step and any advantage, and is first-order accurate in
-the coupling; explicit Euler is not usable here: near ``w = 1`` its step factor is ``1 - 2 a
-h / T``, unstable for ``h > T / a`` (0.01 s for the stability behaviour's T = 0.02 s, a = 2).
+the coupling. Explicit Euler is not usable at the controller's 0.01 s: its step factor is
+``1 - 2 a h / T`` near ``w = 1`` (-3 for stability, a up to 10, T = 0.05 s) and ``1 - (r - a)
+h / T`` for a suppressed weight (-4.5 for the objective under manipulability, r = 12,
+T = 0.02 s); it is unstable beyond -1.
 
 Noise. The additive noise is white with intensity ``noise`` (``T dw = (...) dt + noise
 dW``), drawn from a ``random.Random(seed)`` that :meth:`reset` re-seeds, so every run is
@@ -56,6 +58,8 @@ if TYPE_CHECKING:  # behaviours import the arbiter package; avoid a cycle at run
 
 #: Behaviours of the arbiter, in priority order (also the order of the weight updates).
 BEHAVIOURS = ("stability", "manipulability", "obstacle", "objective")
+#: The thesis's thresholds (Table 5.1), as for the state machine.
+THESIS_STABILITY, THESIS_MANIPULABILITY = Hysteresis(1.25, 1.60), Hysteresis(0.75, 0.90)
 #: Guard on |w| (the dynamics keep |w| <= 1; only noise can push a weight above 1).
 W_LIMIT = 1.5
 #: Weights whose square is below this are left out of the blend (not even evaluated).
@@ -106,7 +110,9 @@ class CompetitiveDynamics:
             raise ParameterError(f"w0: need {self.n} weights (got {len(w0)})")
         for i, value in enumerate(w0):
             if not (math.isfinite(value) and abs(value) <= W_LIMIT):
-                raise ParameterError(f"w0[{i}] must be in [-{W_LIMIT:g}, {W_LIMIT:g}] (got {value})")
+                raise ParameterError(
+                    f"w0[{i}] must be in [-{W_LIMIT:g}, {W_LIMIT:g}] (got {value})"
+                )
         self.w = [self._floored(float(v)) for v in w0]
         self._random = random.Random(self.seed)
 
@@ -197,11 +203,12 @@ class CompetitiveParameters:
             (``a = limit tanh(k d / limit)`` for a distance d past a threshold).
         suppression: ``r`` of a higher-priority behaviour on a lower one where the higher
             one must win outright; > ``limit`` (and > ``objective``).
+        margin: width (units of S) of the band below the stability enter threshold in which
+            stability and the task are blended; the task has stopped ``margin`` below it.
         task_suppression: (low, high) multiples of ``objective``: stability's suppression
-            of the objective and of obstacle avoidance, low (< 1: they coexist, the task
-            goes on at a reduced share) while S is at or above its enter threshold, rising
-            linearly to high (> 1: the task stops) at ``task_margin`` below it.
-        task_margin: see task_suppression (units of S).
+            of the task (objective, obstacle avoidance): ``low`` (< 1: they coexist, the task
+            goes on at a reduced share) at ``S_enter``, 1 (the task stops) at
+            ``S_enter - margin``, ``high`` at ``S_enter - 2 margin`` and below; linear between.
         stability_gain, manipulability_gain: k per unit of S and of eta.
         obstacle_gain: k per metre inside the obstacle behaviour's buffer.
         off: ``-off`` is the advantage of a behaviour that does not apply (manipulability
@@ -215,15 +222,15 @@ class CompetitiveParameters:
     objective: float = 1.0
     limit: float = 10.0
     suppression: float = 12.0
-    task_suppression: tuple[float, float] = (0.5, 3.0)
-    task_margin: float = 0.1
+    margin: float = 0.1
+    task_suppression: tuple[float, float] = (0.5, 1.5)
     stability_gain: float = 20.0
     manipulability_gain: float = 5.0
     obstacle_gain: float = 20.0
     off: float = 1.0
     time_constants: Mapping[str, float] = field(
         default_factory=lambda: {
-            "stability": 0.02,
+            "stability": 0.05,
             "manipulability": 0.1,
             "obstacle": 0.05,
             "objective": 0.02,
@@ -236,7 +243,7 @@ class CompetitiveParameters:
         for name in (
             "objective",
             "limit",
-            "task_margin",
+            "margin",
             "stability_gain",
             "manipulability_gain",
             "obstacle_gain",
@@ -281,40 +288,57 @@ class CompetitiveDynamicsArbiter:
     """Competitive dynamics over objective, manipulability, stability, obstacle avoidance.
 
     Advantages from the percept (``A = limit``, ``k`` the gains of
-    :class:`CompetitiveParameters`; ``sat(d) = A tanh(k d / A)``):
+    :class:`CompetitiveParameters`; ``sat(d) = A tanh(k d / A)``, nearly linear here):
 
-    * stability ``a_S = sat(S_exit - S)``: positive below the exit threshold;
+    * stability ``a_S = sat(S_exit - S)``;
     * manipulability ``a_M = sat(eta_exit - eta)`` while the objective reaches with the arm
       (``label == "arm"``, as the state machine only allows it then), else ``-off``;
     * obstacle avoidance ``a_B = sat(buffer - distance)`` for the obstacle in range and
       in the way (the behaviour proposes something) while the objective drives, else ``-off``;
     * objective ``a_O = objective`` while there is a waypoint.
 
-    Interactions (``r[b'][b]``, b' suppresses b): priority stability > manipulability >
-    objective, with obstacle avoidance replacing the objective's base movement:
-    ``r = suppression`` from stability onto every other behaviour, from manipulability and
-    obstacle avoidance onto the objective, from manipulability onto obstacle avoidance. The
-    thresholds' hysteresis is the bistability of the dynamics: every other behaviour
-    suppresses stability with ``h_S = sat(S_exit - S_enter)`` and the objective and obstacle
-    avoidance suppress manipulability with ``h_M = sat(eta_exit - eta_enter)``. So while the
-    task runs, stability takes over only when ``a_S > h_S``, i.e. ``S < S_enter``; once it
-    has taken over, nothing suppresses it and it stays until ``a_S < 0``, i.e.
-    ``S > S_exit`` — the state machine's thresholds, as fixed points of the dynamics. With
-    no hysteresis (enter == exit) ``h = 0`` and there is no bistable band.
+    Interactions (``r[b'][b]``, b' suppresses b), priority stability > manipulability >
+    objective, obstacle avoidance replacing the objective's base movement: ``suppression``
+    from stability onto manipulability, from manipulability onto the objective and obstacle
+    avoidance, from obstacle avoidance onto the objective; every other behaviour suppresses
+    stability with ``h_S = sat(S_exit - S_enter)``, the objective and obstacle avoidance
+    suppress manipulability with ``h_M = sat(eta_exit - eta_enter)``; stability suppresses
+    the task with ``r_T(S)`` (:meth:`task_suppression`).
+
+    What the stability thresholds become (fixed points of the two-behaviour competition
+    with the task, ``rho = h_S / a_S``, ``sigma = r_T / a_O``):
+
+    * S > S_enter: ``rho > 1``, stability is suppressed (w_S = 0) and the task runs alone;
+    * S_enter - margin < S < S_enter: stability and the task coexist at
+      ``w_S^2 = (1 - rho) / (1 - rho sigma)``, ``w_O^2 = (1 - sigma) / (1 - rho sigma)``:
+      the task goes on at a falling share while the stability behaviour turns the base; the
+      wider the hysteresis band (exit - enter), the more gradually stability comes in
+      (``rho = (S_exit - S_enter) / (S_exit - S)``);
+    * S < S_enter - margin (``sigma > 1``): the task is suppressed and stability acts alone,
+      the state machine's stability state.
+
+    So the stability behaviour is graded in a band of width ``margin`` below its enter
+    threshold instead of a bistable switch (the state machine's hysteresis exists to stop
+    chattering, which continuous weights do not have); without hysteresis (enter == exit,
+    ``rho = 0``) stability takes full weight below the threshold and the task yields as
+    sigma grows. Manipulability keeps the thesis's hysteresis as a bistable band: while the
+    task runs it takes over when ``a_M > h_M`` (eta < eta_enter) and, having suppressed the
+    objective, keeps going until ``a_M < 0`` (eta > eta_exit).
 
     Args:
         stability, manipulability: the thresholds (as for the state machine).
         parameters: tuning; default :class:`CompetitiveParameters`.
         seed: noise seed.
-        record: keep :attr:`history` (time, weights, advantages) for plots.
+        record: keep :attr:`history` (every call: time, S, dominant state, weights and
+            advantages by behaviour) for plots.
     """
 
     name = "competitive"
 
     def __init__(
         self,
-        stability: Hysteresis = Hysteresis(1.25, 1.60),
-        manipulability: Hysteresis = Hysteresis(0.75, 0.90),
+        stability: Hysteresis = THESIS_STABILITY,
+        manipulability: Hysteresis = THESIS_MANIPULABILITY,
         parameters: CompetitiveParameters | None = None,
         seed: int = 0,
         record: bool = False,
@@ -328,9 +352,7 @@ class CompetitiveDynamicsArbiter:
         )
         self.record = record
         self.history: dict[str, list] = {}
-        self._h_stability = self._saturate(
-            par.stability_gain * (stability.exit - stability.enter)
-        )
+        self._h_stability = self._saturate(par.stability_gain * (stability.exit - stability.enter))
         self._h_manipulability = self._saturate(
             par.manipulability_gain * (manipulability.exit - manipulability.enter)
         )
@@ -350,7 +372,7 @@ class CompetitiveDynamicsArbiter:
         self.state = MOVE_BASE
         self.behaviour = "objective"
         self._t = None
-        keys = ("t", "state") + tuple(f"w_{b}" for b in BEHAVIOURS)
+        keys = ("t", "s", "state", *(f"w_{b}" for b in BEHAVIOURS))
         keys += tuple(f"a_{b}" for b in BEHAVIOURS)
         self.history = {k: [] for k in keys} if self.record else {}
 
@@ -377,11 +399,19 @@ class CompetitiveDynamicsArbiter:
         return [a_stab, a_manip, a_obst, a_obj]
 
     def task_suppression(self, s: float) -> float:
-        """Stability's suppression of the objective and obstacle avoidance at stability s."""
+        """Stability's suppression of the objective and obstacle avoidance at stability s.
+
+        ``objective`` x (low at ``S_enter``, 1 at ``S_enter - margin``, high at
+        ``S_enter - 2 margin``), piecewise linear, constant outside.
+        """
         par = self.parameters
         low, high = par.task_suppression
-        depth = min(1.0, max(0.0, (self.stability.enter - s) / par.task_margin))
-        return par.objective * (low + (high - low) * depth)
+        depth = (self.stability.enter - s) / par.margin - 1.0  # -1 at enter, 0: task stops
+        if depth <= 0.0:
+            ratio = 1.0 + (1.0 - low) * max(-1.0, depth)
+        else:
+            ratio = 1.0 + (high - 1.0) * min(1.0, depth)
+        return par.objective * ratio
 
     def interactions(self, s: float) -> list[list[float]]:
         """``r[j][i]`` (j suppresses i) in :data:`BEHAVIOURS` order, at stability s."""
@@ -410,7 +440,9 @@ class CompetitiveDynamicsArbiter:
         a = self.advantages(p, objective, avoid, obstacle)
         h = 0.0 if self._t is None else max(0.0, p.t - self._t)
         self._t = p.t
-        w = self.dynamics.step(a, self.interactions(p.s), h, check=False) if h > 0.0 else self.dynamics.w
+        w = self.dynamics.w
+        if h > 0.0:
+            w = self.dynamics.step(a, self.interactions(p.s), h, check=False)
         proposals: dict[str, Proposal] = {"objective": objective}
         if avoid is not None:
             proposals["obstacle"] = avoid
@@ -428,7 +460,7 @@ class CompetitiveDynamicsArbiter:
         self.behaviour = dominant
         self.state = _state_of(dominant, objective)
         if self.record:
-            self._remember(p.t, w, a)
+            self._remember(p, w, a)
         return Blend(self.state, dominant, shares, proposals)
 
     def select(self, p: Percept, behaviours: Mapping[str, Behaviour]) -> Selection:
@@ -440,9 +472,10 @@ class CompetitiveDynamicsArbiter:
             assert proposal is not None  # fix behaviours are always on
         return Selection(blend.state, blend.behaviour, proposal)
 
-    def _remember(self, t: float, w: Sequence[float], a: Sequence[float]) -> None:
+    def _remember(self, p: Percept, w: Sequence[float], a: Sequence[float]) -> None:
         hist = self.history
-        hist["t"].append(t)
+        hist["t"].append(p.t)
+        hist["s"].append(p.s)
         hist["state"].append(self.state)
         for name, wi, ai in zip(BEHAVIOURS, w, a):
             hist[f"w_{name}"].append(wi)

@@ -22,9 +22,7 @@ def check_arbiter(arbiter: Any, controller: str = "thesis") -> None:
     """Raise :class:`ParameterError` unless ``arbiter`` is a known name or an arbiter."""
     if isinstance(arbiter, str):
         if arbiter not in ARBITERS:
-            raise ParameterError(
-                f"arbiter must be one of {', '.join(ARBITERS)} (got {arbiter!r})"
-            )
+            raise ParameterError(f"arbiter must be one of {', '.join(ARBITERS)} (got {arbiter!r})")
         if arbiter != ARBITERS[0] and controller != "thesis":
             raise ParameterError("arbiter: only the thesis controller has an arbiter")
         return

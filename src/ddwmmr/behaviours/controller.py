@@ -6,21 +6,27 @@ all see the same :class:`~ddwmmr.behaviours.base.Percept` and return the same
 mover turns the proposal into wheel forces, the arm mover into joint targets.
 
 Arbiters that blend (they have ``weigh(percept, behaviours) -> Blend``, e.g. the
-competitive-dynamics arbiter) take the blending path of :meth:`ThesisController.act`: every
-behaviour with a share is turned into wheel forces by the base mover on its own (drive, turn
-or brake, each saturated by the mixer) and into the one-step joint motion the arm servo
-would make toward its joint targets (thesis eq. 4.10: synchronised, the largest error at the
-joint speed limit); forces and motions are summed with the shares, and the joint target
-sent is the current pose plus the blended motion. The share left over when the weights do
-not add up to 1 brakes the base and holds the arm (the paper's eq. 1: no behaviour, no
-motion). A convex combination of admissible wheel forces is admissible, so the blend needs
-no second saturation; blending motions rather than joint targets makes a behaviour's share
-scale its arm speed (the servo runs at full speed toward any target, so a 5 % share of a
-target 2 rad away would otherwise move the arm at full speed); and a behaviour with share 1
-acts exactly as it does under the state machine. Hold points are per behaviour in this path: a behaviour's hold is
-latched where the end effector is when its share rises to ``ENGAGE`` and released when the
-share falls below ``RELEASE``; until then it is the current end-effector position (so a
-stability behaviour on the rise freezes the arm in proportion to its share).
+competitive-dynamics arbiter) take the blending path of :meth:`ThesisController.act`:
+
+* every behaviour with a share is turned into wheel forces by the base mover on its own
+  (drive, turn or brake, each saturated by the mixer) and into the one-step joint motion the
+  arm servo would make toward its joint targets (thesis eq. 4.10: synchronised, the larger
+  error at the joint speed limit). Forces and motions are summed with the shares; the joint
+  target sent is the current pose plus the blended motion. A convex combination of
+  admissible wheel forces is admissible, so the blend needs no second saturation; blending
+  motions rather than targets makes a share scale the arm's speed (the servo runs at full
+  speed toward any target: a 5 % share of a target 2 rad away would otherwise move the arm
+  at full speed); a behaviour with share 1 acts exactly as under the state machine.
+* the share left when the shares add up to less than 1 brakes the base and holds the arm
+  (the paper's eq. 1: commands scale with the weights; no behaviour, no motion).
+* hold points are per behaviour: latched where the end effector is when the behaviour's
+  share rises to ``ENGAGE``, released when it falls below ``RELEASE`` (until then the hold is
+  the current end-effector position). A latched hold moves with the arm motion the *other*
+  behaviours command: stability alone keeps the end effector in place while the base turns
+  under it (the thesis's stability state); blended with the objective, the end effector goes
+  on toward the waypoint at the objective's share while the base turns to face it.
+  Proposals the arbiter evaluated itself (it computes advantages from them) are used as
+  they are.
 
 The controller sees only sensor values (configuration and base velocities) and outputs
 actuator commands (wheel forces in N, joint targets in rad); which plant consumes them is

@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr.arbiters.factory import check_arbiter, make_arbiter
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
     MOVE_ARM,
@@ -42,7 +43,6 @@ from ddwmmr.arbiters.state_machine import (
     STATES,
     Hysteresis,
 )
-from ddwmmr.arbiters.factory import check_arbiter, make_arbiter
 from ddwmmr.behaviours.controller import ThesisController
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.behaviours.obstacle import base_bubble
