@@ -272,8 +272,10 @@ class Blend:
         state: state of the dominant behaviour (largest |w|), for the metrics: the
             objective reports ``move_base`` / ``move_arm`` by its label.
         behaviour: name of the dominant behaviour.
-        shares: blending share of each behaviour to use, ``w_b^2 / sum w^2`` over the
-            behaviours that have a proposal now and ``w_b^2 >= SHARE_CUTOFF``; sums to 1.
+        shares: blending share of each behaviour to use, ``w_b^2 / max(1, sum w^2)`` over
+            the behaviours that have a proposal now and ``w_b^2 >= SHARE_CUTOFF``; they sum
+            to at most 1 (the paper's eq. 1 scales commands by the weights; the controller
+            gives the rest to braking and holding the arm).
         proposals: the proposals the arbiter evaluated to compute advantages, on the
             percept it was given (the controller evaluates the others).
     """
