@@ -37,6 +37,7 @@ docs: $(STAMP)
 	MPLBACKEND=Agg $(BIN)/python docs/make_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/qp_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/make_run_figures.py
+	MPLBACKEND=Agg $(BIN)/python docs/competitive_figures.py
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache

@@ -170,7 +170,7 @@ def test_weights_stay_bounded_for_any_input(a, r, w0, t_const, h, noise):
 ARBITER_LIKE = {
     # stability, manipulability, obstacle, objective: the arbiter's time constants and
     # interactions at a moment when stability is wanted (a_S = 4 > h_S = 4 * 0.9)
-    "t": [0.02, 0.1, 0.05, 0.02],
+    "t": [0.05, 0.1, 0.05, 0.02],
     "a": [4.0, -0.5, -1.0, 1.0],
     "r": [
         [0.0, 12.0, 2.0, 2.0],
@@ -182,7 +182,7 @@ ARBITER_LIKE = {
 }
 
 
-@pytest.mark.parametrize(("h", "tolerance"), [(0.001, 0.005), (0.01, 0.05)])
+@pytest.mark.parametrize(("h", "tolerance"), [(0.001, 0.006), (0.01, 0.03)])
 def test_integration_converges_to_the_reference_at_the_controller_step(h, tolerance):
     case = ARBITER_LIKE
     duration = 0.3  # the hand-over from the objective to stability
@@ -195,6 +195,19 @@ def test_integration_converges_to_the_reference_at_the_controller_step(h, tolera
     final = run(dyn, case["a"], case["r"], h, round(2.0 / h))
     settled = reference(case["w0"], case["a"], case["r"], case["t"], 2.0)
     assert final == pytest.approx(settled, abs=1e-6)
+
+
+def test_splitting_error_is_first_order_in_the_step():
+    """Gauss-Seidel splitting: the error at the hand-over shrinks like h (measured 0.018,
+    0.0038, 0.0004 at 0.01, 0.001, 0.0001 s)."""
+    case = ARBITER_LIKE
+    ref = reference(case["w0"], case["a"], case["r"], case["t"], 0.3)
+    errors = []
+    for h in (0.001, 0.0001):
+        dyn = CompetitiveDynamics(case["t"], floor=0.0)
+        dyn.reset(case["w0"])
+        errors.append(np.max(np.abs(run(dyn, case["a"], case["r"], h, round(0.3 / h)) - ref)))
+    assert 5.0 < errors[0] / errors[1] < 15.0
 
 
 @pytest.mark.parametrize("h", [0.02, 0.05, 0.1, 0.5])
