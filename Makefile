@@ -63,6 +63,7 @@ docs: $(STAMP_TEST)
 		--method clrrmc-cs --traj figure8 --beta 0.5 --x0 0.5 --T 80 --N 4000 --compare ap
 	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --snapshot docs/figures/gui_rectangle.png \
 		--method clrrmc-ts --traj rectangle
+	MPLBACKEND=Agg $(BIN)/python docs/competitive_figures.py
 
 # The figures of measured step times (machine-dependent: they change on every run).
 docs-timings: $(STAMP_TEST)

@@ -2,10 +2,21 @@
 
 The thesis's priority state machine is :class:`StateMachineArbiter`; any object with
 ``state``, ``reset()`` and ``select(percept, behaviours) -> Selection`` (:class:`Arbiter`)
-can replace it.
+can replace it. :class:`CompetitiveDynamicsArbiter` (Ellekilde & Christensen 2009) is the
+alternative: behaviour weights under competitive dynamics, proposals blended by the weights
+(it also has ``weigh(percept, behaviours) -> Blend``, :class:`BlendingArbiter`).
+:func:`make_arbiter` builds either from a scenario configuration.
 """
 
-from ddwmmr.arbiters.base import Arbiter
+from ddwmmr.arbiters.base import Arbiter, BlendingArbiter
+from ddwmmr.arbiters.competitive import (
+    BEHAVIOURS,
+    Blend,
+    CompetitiveDynamics,
+    CompetitiveDynamicsArbiter,
+    CompetitiveParameters,
+)
+from ddwmmr.arbiters.factory import ARBITERS, check_arbiter, make_arbiter
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
     MOVE_ARM,
@@ -19,6 +30,8 @@ from ddwmmr.arbiters.state_machine import (
 )
 
 __all__ = [
+    "ARBITERS",
+    "BEHAVIOURS",
     "MANIPULABILITY",
     "MOVE_ARM",
     "MOVE_BASE",
@@ -26,7 +39,14 @@ __all__ = [
     "STABILITY",
     "STATES",
     "Arbiter",
+    "Blend",
+    "BlendingArbiter",
+    "CompetitiveDynamics",
+    "CompetitiveDynamicsArbiter",
+    "CompetitiveParameters",
     "Hysteresis",
     "Selection",
     "StateMachineArbiter",
+    "check_arbiter",
+    "make_arbiter",
 ]

@@ -4,7 +4,9 @@ The thesis's state machine (:mod:`ddwmmr.arbiters.state_machine`) is one impleme
 another (e.g. the competitive-dynamics arbiter of SPEC §6) only has to provide the same
 three members. An arbiter may evaluate any of the behaviours it is given, but it must
 return a proposal made by one of them (or a blend in the common proposal format) and name
-the state it is in, which the metrics count.
+the state it is in, which the metrics count. An arbiter that blends proposals instead of
+choosing one also provides ``weigh`` (:class:`BlendingArbiter`); the controller then uses
+its blending path.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from collections.abc import Mapping
 from typing import TYPE_CHECKING, Protocol
 
 if TYPE_CHECKING:  # behaviours import the arbiter package; avoid a cycle at run time
+    from ddwmmr.arbiters.competitive import Blend
     from ddwmmr.arbiters.state_machine import Selection
     from ddwmmr.behaviours.base import Behaviour, Percept
 
@@ -30,4 +33,14 @@ class Arbiter(Protocol):
         self, p: Percept, behaviours: Mapping[str, Behaviour]
     ) -> Selection:  # pragma: no cover - protocol
         """Choose the state and the proposal for percept p."""
+        ...
+
+
+class BlendingArbiter(Arbiter, Protocol):
+    """An arbiter that returns weights: the controller blends the behaviours' proposals."""
+
+    def weigh(
+        self, p: Percept, behaviours: Mapping[str, Behaviour]
+    ) -> Blend:  # pragma: no cover - protocol
+        """Advance to time ``p.t`` and return the state and the blending shares."""
         ...

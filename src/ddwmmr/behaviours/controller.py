@@ -5,6 +5,29 @@ all see the same :class:`~ddwmmr.behaviours.base.Percept` and return the same
 :class:`~ddwmmr.behaviours.base.Proposal`; an arbiter picks one. Low level: the PD base
 mover turns the proposal into wheel forces, the arm mover into joint targets.
 
+Arbiters that blend (they have ``weigh(percept, behaviours) -> Blend``, e.g. the
+competitive-dynamics arbiter) take the blending path of :meth:`ThesisController.act`:
+
+* every behaviour with a share is turned into wheel forces by the base mover on its own
+  (drive, turn or brake, each saturated by the mixer) and into the one-step joint motion the
+  arm servo would make toward its joint targets (thesis eq. 4.10: synchronised, the larger
+  error at the joint speed limit). Forces and motions are summed with the shares; the joint
+  target sent is the current pose plus the blended motion. A convex combination of
+  admissible wheel forces is admissible, so the blend needs no second saturation; blending
+  motions rather than targets makes a share scale the arm's speed (the servo runs at full
+  speed toward any target: a 5 % share of a target 2 rad away would otherwise move the arm
+  at full speed); a behaviour with share 1 acts exactly as under the state machine.
+* the share left when the shares add up to less than 1 brakes the base and holds the arm
+  (the paper's eq. 1: commands scale with the weights; no behaviour, no motion).
+* hold points are per behaviour: latched where the end effector is when the behaviour's
+  share rises to ``ENGAGE``, released when it falls below ``RELEASE`` (until then the hold is
+  the current end-effector position). A latched hold moves with the arm motion the *other*
+  behaviours command: stability alone keeps the end effector in place while the base turns
+  under it (the thesis's stability state); blended with the objective, the end effector goes
+  on toward the waypoint at the objective's share while the base turns to face it.
+  Proposals the arbiter evaluated itself (it computes advantages from them) are used as
+  they are.
+
 The controller sees only sensor values (configuration and base velocities) and outputs
 actuator commands (wheel forces in N, joint targets in rad); which plant consumes them is
 up to the simulation loop. It speaks the force interface of :mod:`ddwmmr.commands`:
@@ -14,13 +37,14 @@ controller, with the measured base velocity), :meth:`ThesisController.act` the p
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable
 
 import numpy as np
 
 from ddwmmr.arbiters.base import Arbiter
 from ddwmmr.arbiters.state_machine import StateMachineArbiter
-from ddwmmr.behaviours.base import Behaviour, Percept, sense
+from ddwmmr.behaviours.base import BRAKE, Behaviour, Percept, Proposal, sense
 from ddwmmr.behaviours.lowlevel import ArmMover, BaseMover, PDGains
 from ddwmmr.behaviours.manipulability import Manipulability
 from ddwmmr.behaviours.objective import Objective
@@ -31,6 +55,8 @@ from ddwmmr.model import Robot
 
 #: Actuator command: (left wheel force N, right wheel force N, th1 target rad, th2 target rad).
 Actuation = tuple[float, float, float, float]
+#: Blending path: a behaviour's hold point is latched at this share and released below RELEASE.
+ENGAGE, RELEASE = 0.1, 0.05
 
 
 class ThesisController:
@@ -74,7 +100,10 @@ class ThesisController:
         self.target: tuple[float, float] | None = None
         self.state = self.arbiter.state
         self._hold: tuple[float, float] | None = None
+        self._holds: dict[str, tuple[float, float]] = {}
+        self._t: float | None = None
         self.last_percept: Percept | None = None
+        self.last_shares: dict[str, float] = {}
 
     @property
     def default_pose(self) -> tuple[float, float]:
@@ -91,6 +120,9 @@ class ThesisController:
         self.state = self.arbiter.state
         self.target = target
         self._hold = None
+        self._holds = {}
+        self._t = None
+        self.last_shares = {}
 
     def set_target(self, target: tuple[float, float] | None) -> None:
         """Change the task point (the next waypoint), or None when the task is done."""
@@ -120,6 +152,8 @@ class ThesisController:
         self, t: float, q: tuple[float, float, float, float, float], v: float, w: float
     ) -> Actuation:
         """Actuator command for time t (s), configuration q, speed v (m/s), yaw rate w (rad/s)."""
+        if callable(getattr(self.arbiter, "weigh", None)):
+            return self._act_blended(sense(self.robot, t, q, v, w, self.target))
         p = sense(self.robot, t, q, v, w, self.target, self._hold)
         selection = self.arbiter.select(p, self.behaviours)
         proposal = selection.proposal
@@ -135,3 +169,91 @@ class ThesisController:
         f_left, f_right = self.base.wheel_forces(p, proposal)
         a1, a2 = self.arm.targets(proposal)
         return f_left, f_right, a1, a2
+
+    def _act_blended(self, p: Percept) -> Actuation:
+        """Blending path: wheel forces and joint targets averaged with the arbiter's shares."""
+        blend = self.arbiter.weigh(p, self.behaviours)  # type: ignore[attr-defined]
+        h = self.base.gains.sample_time if self._t is None else max(0.0, p.t - self._t)
+        self._t = p.t
+        reach = self.robot.joint_speed_limit * h  # the servo's largest joint step (rad)
+        # The share no behaviour claims (weights all small) brakes and holds the arm.
+        rest = max(0.0, 1.0 - sum(blend.shares.values()))
+        f_left, f_right = self.base.mix(*self.base.brake_forces(p))
+        f_left, f_right = rest * f_left, rest * f_right
+        d1 = d2 = 0.0
+        own: dict[str, tuple[float, float]] = {}
+        for name, share in blend.shares.items():
+            proposal = self._proposal(name, share, p, blend.proposals)
+            left, right = self.base.wheel_forces(p, proposal)
+            s1, s2 = servo_step(p.th1, p.th2, *self.arm.targets(proposal), reach)
+            f_left += share * left
+            f_right += share * right
+            d1 += share * s1
+            d2 += share * s2
+            own[name] = (share * s1, share * s2)
+        a1, a2 = self.arm.targets(Proposal(BRAKE, (p.th1 + d1, p.th2 + d2)))
+        self._carry_holds(p, d1, d2, own)
+        for name in list(self._holds):
+            if name not in blend.shares:
+                del self._holds[name]
+        self.state = blend.state
+        self.last_percept = p
+        self.last_shares = dict(blend.shares)
+        return f_left, f_right, a1, a2
+
+    def _carry_holds(
+        self, p: Percept, d1: float, d2: float, own: dict[str, tuple[float, float]]
+    ) -> None:
+        """Move each latched hold point with the arm motion the *other* behaviours command.
+
+        A behaviour holds the end effector against its own and the base's motion, not
+        against the arm motion of the behaviours it is blended with: with share 1 its hold
+        stays put (the thesis's stability state), with a smaller share the end effector
+        goes on toward the others' targets and the hold goes with it (first order: the
+        world-frame arm Jacobian times the others' joint motion).
+        """
+        if not self._holds:
+            return
+        r = self.robot
+        a1 = p.phi + p.th1
+        a12 = a1 + p.th2
+        s1, c1 = r.L1 * math.sin(a1), r.L1 * math.cos(a1)
+        s12, c12 = r.L2 * math.sin(a12), r.L2 * math.cos(a12)
+        for name, (hx, hy) in self._holds.items():
+            m1, m2 = own.get(name, (0.0, 0.0))
+            o1, o2 = d1 - m1, d2 - m2
+            self._holds[name] = (hx - (s1 + s12) * o1 - s12 * o2, hy + (c1 + c12) * o1 + c12 * o2)
+
+    def _proposal(self, name: str, share: float, p: Percept, evaluated) -> Proposal:
+        """Behaviour ``name``'s proposal; its own hold point is latched while it is engaged.
+
+        Proposals the arbiter evaluated (it derives advantages from them) are used as they
+        are, so the weights and the commands come from the same proposals.
+        """
+        if name in evaluated:
+            return evaluated[name]
+        hold = self._holds.get(name)
+        if hold is None and share >= ENGAGE:
+            hold = self._holds[name] = (p.xe, p.ye)
+        elif hold is not None and share < RELEASE:
+            hold = None
+            del self._holds[name]
+        proposal = self.behaviours[name].propose(p if hold is None else p.with_hold(hold))
+        assert proposal is not None  # the arbiter only shares out available proposals
+        return proposal
+
+
+def servo_step(
+    th1: float, th2: float, target1: float, target2: float, reach: float
+) -> tuple[float, float]:
+    """Joint motion (rad) of the arm servo toward a target in one step (thesis eq. 4.10).
+
+    The joint with the larger error moves by at most ``reach`` (joint speed x step), the
+    other in proportion, so both arrive together; a target within reach is met exactly.
+    """
+    e1, e2 = target1 - th1, target2 - th2
+    largest = max(abs(e1), abs(e2))
+    if largest <= reach:
+        return e1, e2
+    scale = reach / largest
+    return e1 * scale, e2 * scale

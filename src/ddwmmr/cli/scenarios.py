@@ -7,6 +7,8 @@ Examples::
     python -m ddwmmr.scenarios --stability 1.4 1.7 --out runs/high-stability
     python -m ddwmmr.scenarios --study thresholds --out runs/thresholds
     python -m ddwmmr.scenarios --study obstacles --out runs/obstacles
+    python -m ddwmmr.scenarios --arbiter competitive --out runs/competitive
+    python -m ddwmmr.scenarios --study arbiters --out runs/arbiters
     python -m ddwmmr.scenarios --executor dask --scheduler tcp://10.0.0.5:8786 --out runs/d
 """
 
@@ -23,6 +25,7 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
+from ddwmmr.arbiters import ARBITERS
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.cli import provenance
 from ddwmmr.cli.common import (
@@ -51,7 +54,7 @@ from ddwmmr.sim.result import json_safe, write_atomic
 
 #: The batch summary (holds the run record: everything needed to repeat the batch).
 MARKER = "summary.json"
-STUDIES = ("thresholds", "obstacles")
+STUDIES = ("thresholds", "obstacles", "arbiters")
 PROG = "python -m ddwmmr.scenarios"
 #: Most worker processes --jobs may ask for.
 MAX_JOBS = 256
@@ -86,6 +89,20 @@ def build_parser() -> ArgumentParser:
         choices=CONTROLLERS,
         default="thesis",
         help="controller to benchmark (default: thesis)",
+    )
+    parser.add_argument(
+        "--arbiter",
+        choices=ARBITERS,
+        default="state-machine",
+        help="thesis controller's arbiter: the thesis's 'state-machine' (default) or "
+        "'competitive' dynamics (Ellekilde & Christensen 2009; same thresholds options)",
+    )
+    parser.add_argument(
+        "--arbiter-seed",
+        type=int,
+        default=0,
+        metavar="N",
+        help="noise seed of the competitive arbiter (default: 0)",
     )
     parser.add_argument(
         "--plant",
@@ -175,7 +192,8 @@ def build_parser() -> ArgumentParser:
         "--study",
         choices=STUDIES,
         help="'thresholds': rerun thesis Tables 5.5-5.20 threshold variations; "
-        "'obstacles': thesis Table 5.21",
+        "'obstacles': thesis Table 5.21; 'arbiters': state machine vs competitive arbiter "
+        "(Table 5.2 and threshold variants side by side, weights, noise seeds and levels)",
     )
     parser.add_argument(
         "--qp-stability-min",
@@ -235,6 +253,9 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         raise ParameterError("scheduler: only used with --executor dask")
     if args.study == "thresholds" and args.controller != "thesis":
         raise ParameterError("study: the threshold study needs --controller thesis")
+    if args.study == "arbiters" and args.controller != "thesis":
+        raise ParameterError("study: the arbiter study needs --controller thesis")
+    check_nonnegative("arbiter-seed", args.arbiter_seed)
     if args.study and args.obstacles:
         raise ParameterError("study: --obstacles is implied by --study obstacles")
     for name in ("payload", "dt", "time_limit", "qp_stability_min", "qp_max_speed"):
@@ -268,6 +289,8 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         time_limit=args.time_limit,
         qp_stability_min=args.qp_stability_min,
         qp_max_speed=args.qp_max_speed,
+        arbiter=args.arbiter,
+        arbiter_seed=args.arbiter_seed,
     )
 
 
@@ -297,10 +320,13 @@ class Runner:
 
 def _title(config: RunConfig) -> str:
     s, m = config.stability, config.manipulability
-    return (
+    title = (
         f"{config.controller} controller, {config.plant} plant, payload {config.payload:g} kg, "
         f"S {s[0]:g}/{s[1]:g}, eta {m[0]:g}/{m[1]:g}"
     )
+    if config.arbiter != "state-machine":
+        title += f", {config.arbiter} arbiter"
+    return title
 
 
 def write_batch(
@@ -338,6 +364,11 @@ def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
     if config.controller == "thesis":
         for key in ("stability", "manipulability"):
             report.plot_fix_state(outcomes, key, folder / f"thesis_{key}.png", short)
+    if config.arbiter == "competitive":
+        from ddwmmr.scenarios import arbiter_study
+
+        focus_scenario = scenarios[highlight(outcomes)]
+        arbiter_study.plot_weights(focus_scenario, config, folder / "thesis_weights.png", short)
     # Re-run (deterministically) the scenarios to draw, with a trace: the first two and
     # the one to look at (the first failure, else the most fix-state transitions).
     focus = highlight(outcomes)
@@ -426,6 +457,17 @@ def _run_obstacles(args, config, runner, folder: Path) -> None:
     print(table, end="")
 
 
+def _run_arbiters(args, config, runner, folder: Path) -> None:
+    """State machine vs competitive arbiter (scenarios/arbiter_study.py)."""
+    from ddwmmr.scenarios import arbiter_study
+
+    scenarios = generate(args.n, args.seed)
+    study = arbiter_study.write_study(folder, scenarios, config, runner.run, runner.jobs)
+    study.update(seed=args.seed, config=asdict(config), run=_record(args, config))
+    write_atomic(folder / MARKER, json.dumps(json_safe(study), indent=2) + "\n")
+    print(study["table"], end="")
+
+
 def config_robot(config: RunConfig) -> Robot:
     """The robot a configuration simulates."""
     return Robot().with_payload(config.payload)
@@ -465,6 +507,8 @@ def _main(argv: Sequence[str] | None = None) -> int:
             _run_thresholds(args, config, runner, folder)
         elif args.study == "obstacles":
             _run_obstacles(args, config, runner, folder)
+        elif args.study == "arbiters":
+            _run_arbiters(args, config, runner, folder)
         else:
             _run_benchmark(args, config, runner, folder)
     print(f"wrote {out}", file=sys.stderr)

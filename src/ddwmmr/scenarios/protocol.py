@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr.arbiters.factory import check_arbiter, make_arbiter
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
     MOVE_ARM,
@@ -43,7 +44,6 @@ from ddwmmr.arbiters.state_machine import (
     STABILITY,
     STATES,
     Hysteresis,
-    StateMachineArbiter,
 )
 from ddwmmr.behaviours.controller import ThesisController
 from ddwmmr.behaviours.objective import default_pose
@@ -101,6 +101,9 @@ class RunConfig:
         tolerance: waypoint tolerance (m).
         qp_stability_min, qp_max_speed: options of the ``qp`` controller.
         record: keep a trace (every ``TRACE_INTERVAL``) for plots.
+        arbiter: thesis controller's arbiter, ``"state-machine"`` or ``"competitive"``
+            (thresholds above) or an arbiter instance (``ddwmmr.arbiters.make_arbiter``).
+        arbiter_seed: noise seed of the competitive arbiter.
     """
 
     controller: str = "thesis"
@@ -114,6 +117,8 @@ class RunConfig:
     qp_stability_min: float = 1.25
     qp_max_speed: float = 1.0
     record: bool = False
+    arbiter: Any = "state-machine"
+    arbiter_seed: int = 0
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLERS:
@@ -129,6 +134,7 @@ class RunConfig:
             )
         Hysteresis(*self.stability)
         Hysteresis(*self.manipulability)
+        check_arbiter(self.arbiter, self.controller)
         check_nonnegative("payload", self.payload)
         for name in ("dt", "tolerance", "qp_stability_min", "qp_max_speed"):
             check_positive(name, getattr(self, name))
@@ -402,11 +408,9 @@ def _envelope(plant: Plant) -> dict[str, float] | None:
 
 
 def make_thesis_controller(robot: Robot, scenario: Scenario, config: RunConfig) -> Any:
-    """The thesis behaviour controller with the state-machine arbiter of ``config``."""
-    arbiter = StateMachineArbiter(
-        stability=Hysteresis(*config.stability), manipulability=Hysteresis(*config.manipulability)
-    )
-    return ThesisController(robot, arbiter, obstacles=scenario.obstacles)
+    """The thesis behaviour controller with the arbiter of ``config`` (state machine or
+    competitive dynamics, :func:`ddwmmr.arbiters.factory.make_arbiter`)."""
+    return ThesisController(robot, make_arbiter(config), obstacles=scenario.obstacles)
 
 
 def make_qp(
