@@ -269,7 +269,7 @@ def simulate(controller, target, steps, q0=None):
     controller.reset(target)
     for k in range(steps):
         f_left, f_right, a1, a2 = controller.act(k * 0.01, state.q, state.v, state.w)
-        plant.step(state, f_left, f_right, (a1, a2), 0.01)
+        plant.advance(state, f_left, f_right, (a1, a2), 0.01)
     return state
 
 
