@@ -22,9 +22,10 @@ VELOCITY, FORCE = "velocity", "force"
 INTERFACES = (VELOCITY, FORCE)
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class WheelForces:
-    """Force-level actuation: wheel forces (N) and arm joint targets (rad).
+    """Force-level actuation: wheel forces (N) and arm joint targets (rad); read-only by
+    convention (one is made every control step; frozen would triple its cost).
 
     Attributes:
         left, right: traction force of the left / right wheel along the base heading (N).

@@ -47,9 +47,10 @@ class Hysteresis:
         return value < (self.exit if currently else self.enter)
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class Selection:
-    """The arbiter's decision: state, the behaviour that produced the proposal, proposal."""
+    """The arbiter's decision: state, the behaviour that produced the proposal, proposal
+    (read-only by convention; one is made every control step)."""
 
     state: str
     behaviour: str

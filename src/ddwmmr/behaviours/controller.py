@@ -104,6 +104,8 @@ class ThesisController:
         self._t: float | None = None
         self.last_percept: Percept | None = None
         self.last_shares: dict[str, float] = {}
+        #: An arbiter with ``weigh()`` blends the behaviours (competitive dynamics).
+        self._blending = callable(getattr(self.arbiter, "weigh", None))
 
     @property
     def default_pose(self) -> tuple[float, float]:
@@ -142,7 +144,8 @@ class ThesisController:
         ``base_velocity`` is the measured ``(v, w)`` (m/s, rad/s); ``velocity_d`` is unused
         (the behaviours work on points, not trajectories).
         """
-        self.target = (float(pose_d[0]), float(pose_d[1]))
+        x, y, _ = pose_d.tolist() if isinstance(pose_d, np.ndarray) else pose_d
+        self.target = (float(x), float(y))
         v, w = base_velocity
         q = tuple(q.tolist()) if isinstance(q, np.ndarray) else tuple(float(a) for a in q)
         f_left, f_right, a1, a2 = self.act(t, q, v, w)
@@ -152,7 +155,7 @@ class ThesisController:
         self, t: float, q: tuple[float, float, float, float, float], v: float, w: float
     ) -> Actuation:
         """Actuator command for time t (s), configuration q, speed v (m/s), yaw rate w (rad/s)."""
-        if callable(getattr(self.arbiter, "weigh", None)):
+        if self._blending:
             return self._act_blended(sense(self.robot, t, q, v, w, self.target))
         p = sense(self.robot, t, q, v, w, self.target, self._hold)
         selection = self.arbiter.select(p, self.behaviours)

@@ -27,9 +27,10 @@ import numpy as np
 Policy = Callable[[float, np.ndarray], np.ndarray]
 
 
-@dataclass(frozen=True, slots=True)
+@dataclass(slots=True)
 class Observation:
-    """The plant's measured state at one instant.
+    """The plant's measured state at one instant (read-only by convention: one is made
+    every control step, and a frozen dataclass would cost three times as much to build).
 
     Attributes:
         q: configuration ``[x, y, phi, th1, th2]`` (world frame; m, m, rad, rad, rad).

@@ -183,10 +183,12 @@ class ThesisPlant:
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
         """Joint rates clipped to the joint-speed limit; (v, w) pass (forces saturate)."""
-        v, w, r1, r2 = (float(a) for a in u)
+        v, w, r1, r2 = u.tolist() if isinstance(u, np.ndarray) else (float(a) for a in u)
         limit = self.robot.joint_speed_limit
         c1, c2 = min(limit, max(-limit, r1)), min(limit, max(-limit, r2))
-        return np.array([v, w, c1, c2]), (c1 != r1 or c2 != r2)
+        if c1 == r1 and c2 == r2 and isinstance(u, np.ndarray):
+            return u, False  # within the limits: the command as it is
+        return np.array([v, w, c1, c2]), True
 
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
         """Advance by dt under wheel forces or a velocity command (zero-order hold)."""
@@ -195,7 +197,11 @@ class ThesisPlant:
             f_left, f_right = command.left, command.right
             target = (command.th1_target, command.th2_target)
         else:
-            v, w, r1, r2 = (float(a) for a in command)
+            v, w, r1, r2 = (
+                command.tolist()
+                if isinstance(command, np.ndarray)
+                else (float(a) for a in command)
+            )
             f_left, f_right = self.servo.forces(state, v, w)
             limit = self.robot.joint_speed_limit
             r1 = min(limit, max(-limit, r1))

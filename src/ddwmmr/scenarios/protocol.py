@@ -30,6 +30,7 @@ and with an arm joint moving, > 1 mrad/s), time in and transitions into each fix
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -210,7 +211,7 @@ class _Tally:
             self.entries[state] += 1
             self.previous = state
 
-    def check(self, q: tuple[float, ...]) -> bool:
+    def check(self, q: Sequence[float]) -> bool:
         """Stability and collision after a step; True when the run has failed."""
         s = stability_terms(self._com, q[3], q[4])[2]
         self.min_s = min(self.min_s, s)
@@ -308,6 +309,8 @@ class WaypointTask:
         self.controller = controller
         self.has_states = has_states
         self._velocity_d = np.zeros(3)
+        self._goal: tuple[float, float] | None = None
+        self._pose_d = np.zeros(3)
         self._L1, self._L2 = tally.robot.L1, tally.robot.L2
 
     def start(self, obs: Observation) -> bool:
@@ -330,10 +333,13 @@ class WaypointTask:
         return done or k == tally.steps
 
     def reference(self, t: float, obs: Observation | None) -> tuple[np.ndarray, np.ndarray]:
-        """The current waypoint as a pose (orientation 0, not tracked) at rest."""
+        """The current waypoint as a pose (orientation 0, not tracked) at rest (the arrays
+        are shared between steps: read-only)."""
         goal = self.tally.target
-        assert goal is not None
-        return np.array([goal[0], goal[1], 0.0]), self._velocity_d
+        if goal is not self._goal:
+            assert goal is not None
+            self._goal, self._pose_d = goal, np.array([goal[0], goal[1], 0.0])
+        return self._pose_d, self._velocity_d
 
     def record(self, k, t, obs, command, applied, saturated, info, step_ns) -> None:
         """Count the controller's state (state machines) and trace the state at t.
@@ -356,7 +362,7 @@ class WaypointTask:
             base_moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
             self.tally.steps_base += int(base_moving)
             self.tally.steps_arm += int(max(abs(applied[2]), abs(applied[3])) > MOVING_RATE)
-        return self.tally.check(tuple(obs.q.tolist()))
+        return self.tally.check(obs.q.tolist())
 
     def controller_error(self, k: int, error: Exception) -> bool:
         """A controller failure ends the scenario with the error as its reason."""
