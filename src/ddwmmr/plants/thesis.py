@@ -198,9 +198,7 @@ class ThesisPlant:
             target = (command.th1_target, command.th2_target)
         else:
             v, w, r1, r2 = (
-                command.tolist()
-                if isinstance(command, np.ndarray)
-                else (float(a) for a in command)
+                command.tolist() if isinstance(command, np.ndarray) else (float(a) for a in command)
             )
             f_left, f_right = self.servo.forces(state, v, w)
             limit = self.robot.joint_speed_limit
