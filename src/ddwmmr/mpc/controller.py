@@ -94,7 +94,7 @@ class MPCControllerCore:
         solver: str = "rti",
         qp_solver: str = "hpipm",
         position_weight: float | None = None,
-        orientation_weight: float = 1.0,
+        orientation_weight: float = 10.0,
         input_weight: float = 0.01,
         huber: float | None = None,
         reach_speed: float = 0.05,

@@ -231,10 +231,10 @@ class ShootingOCP:
             return self.fractions[k - 1] * (horizon - self.dt)
         return float(self.lengths[k])
 
-    def _integrate(self, x, u, h):
-        """The state after h (s) under u: RK4 in equal sub-steps of at most MAX_SUBSTEP."""
-        longest = float(self.lengths.max())
-        substeps = max(1, math.ceil(longest / MAX_SUBSTEP - 1e-9))
+    def _integrate(self, x, u, h, nominal: float):
+        """The state after h (s) under u: RK4 in equal sub-steps, at most MAX_SUBSTEP long
+        at the interval's nominal length (reach mode only shortens intervals)."""
+        substeps = max(1, math.ceil(nominal / MAX_SUBSTEP - 1e-9))
         for _ in range(substeps):
             x = sym.rk4_step(self.model.rhs, x, u, h / substeps)
         return x
@@ -252,7 +252,9 @@ class ShootingOCP:
         ]
         g, lbg, ubg, ng = [], [], [], []
         for k in range(self.N):
-            x_next = self._integrate(xs[k], us[k], self._interval(nodes, k))
+            x_next = self._integrate(
+                xs[k], us[k], self._interval(nodes, k), float(self.lengths[k])
+            )
             if config.reach:
                 g.append(ca.vertcat(x_next, nodes[k][self.nxm]) - nodes[k + 1])
             else:

@@ -112,6 +112,9 @@ class GaussNewtonSQP:
             _conic_options(ocp, qp_solver),
         )
         self.last_iterations = 0
+        #: Multipliers (constraints, bounds) of the last QP: at a converged point (step
+        #: zero) they are the NLP's multipliers.
+        self.last_multipliers: tuple[Any, Any] | None = None
 
     def solve(
         self,
@@ -137,6 +140,7 @@ class GaussNewtonSQP:
             if not np.all(np.isfinite(d)):
                 raise SolverFailure(f"{self.qp_solver}: non-finite step")
             w = w + d
+            self.last_multipliers = (solution["lam_a"], solution["lam_x"])
             self.last_iterations = iteration
             if np.max(np.abs(d)) < self.tolerance:
                 break
