@@ -9,7 +9,8 @@ under piecewise-constant wheel forces and joint rates::
     minimise    sum_i T_i
     subject to  x_{k+1} = RK4(x_k, u_k, T_i / M)                 (every interval of leg i)
                 |p_E(x_end of leg i) - waypoint_i| <= tolerance   (the end effector reaches it)
-                S(q_k) >= S_min at every node (exact, as a box on the centre of mass)
+                S(q) >= S_min at every node and 3 points inside every interval (exact,
+                    as a box on the centre of mass)
                 |F_left|, |F_right| <= force limit, |th_i dot| <= joint speed,
                 joint limits, wheel speeds, x_0 = start at rest.
 
@@ -34,6 +35,9 @@ import numpy as np
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
+
+#: Points inside each shooting interval where S is checked as well as at the nodes.
+INTERIOR_CHECKS = 3
 
 
 @dataclass(frozen=True)
@@ -111,17 +115,25 @@ class MinimumTimeProblem:
         gaps = step.map(n)(X[:, :-1], U, h_row) - X[:, 1:]
         x_max, y_max = sym.stability_bounds(robot, self.stability_min)
         coms = com.map(n + 1)(X)
+        # Between nodes the joint angles move linearly (constant rates): S is also checked
+        # at INTERIOR_CHECKS points inside every interval, so it holds along the motion.
+        interior = []
+        for frac in np.arange(1, INTERIOR_CHECKS + 1) / (INTERIOR_CHECKS + 1):
+            offset = ca.repmat(frac * h_row, 2, 1) * U[2:4, :]
+            moved = ca.vertcat(X[:3, :-1], X[3:5, :-1] + offset, X[5:, :-1])
+            interior.append(ca.vec(com.map(n)(moved)))
         wheel = wheels.map(n + 1)(X)
         reach = []
         for i, (wx, wy) in enumerate(self.waypoints):
             e = fk(X[:, (i + 1) * self.M]) - ca.DM([wx, wy])
             reach.append(ca.sumsqr(e))
-        g = ca.vertcat(ca.vec(gaps), ca.vec(coms), ca.vec(wheel), *reach)
+        g = ca.vertcat(ca.vec(gaps), ca.vec(coms), *interior, ca.vec(wheel), *reach)
         limit = robot.wheel_speed_limit
+        boxes = n + 1 + INTERIOR_CHECKS * n
         self.lbg = np.concatenate(
             [
                 np.zeros(nx * n),
-                np.tile([-x_max, -y_max], n + 1),
+                np.tile([-x_max, -y_max], boxes),
                 np.full(2 * (n + 1), -limit),
                 np.zeros(self.legs),
             ]
@@ -129,7 +141,7 @@ class MinimumTimeProblem:
         self.ubg = np.concatenate(
             [
                 np.zeros(nx * n),
-                np.tile([x_max, y_max], n + 1),
+                np.tile([x_max, y_max], boxes),
                 np.full(2 * (n + 1), limit),
                 np.full(self.legs, self.tolerance**2),
             ]
@@ -266,3 +278,49 @@ def solve_minimum_time(
     if best is None:
         raise RuntimeError("minimum-time OCP: no start converged")
     return best
+
+
+def minimum_time(
+    robot: Robot,
+    waypoints: Sequence[tuple[float, float]],
+    start: Sequence[float],
+    guesses: dict[str, Guess] | None = None,
+    **options,
+) -> MinimumTime:
+    """Minimum time (s) to take the end effector through ``waypoints`` in order from the
+    ``start`` state ``[x, y, phi, th1, th2, v, w]`` under the thesis plant's force limits
+    and ``S >= stability_min``: the best local optimum over the straight-line starts and
+    ``guesses`` (see the module docstring). ``options`` go to :class:`MinimumTimeProblem`."""
+    problem = MinimumTimeProblem(robot, waypoints, start, **options)
+    return solve_minimum_time(problem, guesses)
+
+
+def verify(problem: MinimumTimeProblem, result: MinimumTime) -> dict[str, float]:
+    """Independent check of a solution by re-integrating its inputs on a fine grid.
+
+    Returns the largest waypoint miss (m, at the leg ends), the smallest S over the fine
+    grid and the largest force and joint rate used.
+    """
+    d, robot = problem.dynamics, problem.robot
+    x, u = ca.SX.sym("x", sym.NX_FORCE), ca.SX.sym("u", sym.NU_FORCE)
+    h = ca.SX.sym("h")
+    step = ca.Function("step", [x, u, h], [sym.rk4_step(d.rhs, x, u, h)])
+    state = np.asarray(result.states[0], dtype=float)
+    refine = 10
+    lowest_s, misses = math.inf, []
+    for k, command in enumerate(result.inputs):
+        length = (result.times[k + 1] - result.times[k]) / refine
+        for _ in range(refine):
+            state = np.asarray(step(state, command, length), dtype=float).ravel()
+            lowest_s = min(lowest_s, robot.stability(state[:5])[2])
+        if (k + 1) % problem.M == 0:
+            leg = (k + 1) // problem.M - 1
+            xe, ye, _ = robot.fk(state[:5])
+            wx, wy = problem.waypoints[leg]
+            misses.append(math.hypot(xe - wx, ye - wy))
+    return {
+        "max_miss_m": float(max(misses)),
+        "min_stability": float(lowest_s),
+        "max_force_n": float(np.max(np.abs(result.inputs[:, :2]))),
+        "max_joint_rate": float(np.max(np.abs(result.inputs[:, 2:]))),
+    }
