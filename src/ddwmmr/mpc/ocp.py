@@ -252,9 +252,7 @@ class ShootingOCP:
         ]
         g, lbg, ubg, ng = [], [], [], []
         for k in range(self.N):
-            x_next = self._integrate(
-                xs[k], us[k], self._interval(nodes, k), float(self.lengths[k])
-            )
+            x_next = self._integrate(xs[k], us[k], self._interval(nodes, k), float(self.lengths[k]))
             if config.reach:
                 g.append(ca.vertcat(x_next, nodes[k][self.nxm]) - nodes[k + 1])
             else:
