@@ -242,3 +242,16 @@ def test_lqr_terminal_cost_solves_the_riccati_equation(model_name):
     np.testing.assert_allclose(design.factor @ design.factor.T, P, atol=1e-9)
     K, _, _ = control.dlqr(A, B, Q, R)
     np.testing.assert_allclose(design.K, K, rtol=1e-9, atol=1e-12)
+
+
+def test_a_broken_qp_raises_solver_failure_not_nan():
+    robot = HEAVY
+    model = ThesisPrediction(robot, sym.ThesisDynamics.from_robot(robot))
+    config = OCPConfig(intervals=4, control_interval=0.01, first_interval=0.1, horizon=0.5)
+    ocp = ShootingOCP(robot, model, config)
+    x0 = np.array([0.0, 0.0, 0.0, *default_pose(robot), 0.0, 0.0])
+    guess = ocp.pack(np.tile(x0, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
+    p = ocp.parameters(np.full((ocp.N, 3), np.nan), np.zeros(4))
+    lbw, ubw = ocp.bounds(x0)
+    with pytest.raises(SolverFailure):
+        GaussNewtonSQP(ocp, "hpipm").solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)

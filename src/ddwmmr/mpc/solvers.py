@@ -130,11 +130,14 @@ class GaussNewtonSQP:
         for iteration in range(1, self.iterations + 1):
             # Two calls (data, then QP): CasADi 3.8 crashes when the HPIPM conic is
             # embedded in an MX function, so the QP is not fused with its data.
-            hessian, gradient, jac, g = self._data(w, p)
-            g = np.asarray(g, dtype=float).ravel()
-            solution = self._qp(
-                h=hessian, g=gradient, a=jac, lba=lbg - g, uba=ubg - g, lbx=lbw - w, ubx=ubw - w
-            )
+            try:
+                hessian, gradient, jac, g = self._data(w, p)
+                g = np.asarray(g, dtype=float).ravel()
+                solution = self._qp(
+                    h=hessian, g=gradient, a=jac, lba=lbg - g, uba=ubg - g, lbx=lbw - w, ubx=ubw - w
+                )
+            except RuntimeError as error:  # CasADi reports solver exceptions this way
+                raise SolverFailure(f"{self.qp_solver}: {str(error).splitlines()[-1]}") from None
             self._check()
             d = np.asarray(solution["x"], dtype=float).ravel()
             if not np.all(np.isfinite(d)):
@@ -212,7 +215,10 @@ class NLPSolver:
         args = {"x0": w0, "p": p, "lbx": lbw, "ubx": ubw, "lbg": lbg, "ubg": ubg}
         if self._lam_g is not None:
             args.update(lam_g0=self._lam_g, lam_x0=self._lam_x)
-        solution = self._solver(**args)
+        try:
+            solution = self._solver(**args)
+        except RuntimeError as error:  # CasADi reports solver exceptions this way
+            raise SolverFailure(f"{self.name}: {str(error).splitlines()[-1]}") from None
         stats = self._solver.stats()
         self.last_iterations = int(stats.get("iter_count", 0))
         if not stats.get("success", False):
