@@ -255,3 +255,20 @@ def test_a_broken_qp_raises_solver_failure_not_nan():
     lbw, ubw = ocp.bounds(x0)
     with pytest.raises(SolverFailure):
         GaussNewtonSQP(ocp, "hpipm").solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+
+
+def test_docs_page_snippet_runs():
+    """The python block of docs/mpc.md runs; the rectangle meets its tracking target
+    (<= 0.5 x clrrmc-ts's 47 mm) without a fallback and the thesis model returns forces."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "mpc.md").read_text()
+    blocks = [part.split("```", 1)[0] for part in text.split("```python\n")[1:]]
+    assert blocks
+    namespace: dict = {}
+    for block in blocks:
+        exec(compile(block, "docs/mpc.md", "exec"), namespace)
+    assert namespace["result"].summary["rms_position_error_m"] < 0.0235
+    assert namespace["result"].summary["mpc_fallbacks"] == 0
+    forces = namespace["forces"]
+    assert isinstance(forces, WheelForces) and abs(forces.left) <= 10.0
