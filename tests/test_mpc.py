@@ -272,3 +272,13 @@ def test_docs_page_snippet_runs():
     assert namespace["result"].summary["mpc_fallbacks"] == 0
     forces = namespace["forces"]
     assert isinstance(forces, WheelForces) and abs(forces.left) <= 10.0
+
+
+def test_warm_start_shift_interpolates_like_numpy(rng):
+    from ddwmmr.mpc.controller import _interpolate_rows
+
+    times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.5, 12))])
+    rows = rng.normal(size=(13, 8))
+    at = np.sort(rng.uniform(-0.2, times[-1] + 0.3, 13))
+    expected = np.column_stack([np.interp(at, times, rows[:, i]) for i in range(8)])
+    np.testing.assert_allclose(_interpolate_rows(times, rows, at), expected, atol=1e-14)

@@ -442,8 +442,8 @@ class _Problem:
             horizon = min(max(old_horizon - elapsed, ocp.config.min_horizon), ocp.config.horizon)
         old_t = ocp.node_times(old_horizon)
         new_t = ocp.node_times(horizon) + elapsed
-        xs = np.column_stack([np.interp(new_t, old_t, xs[:, i]) for i in range(ocp.nx)])
-        us = np.column_stack([np.interp(new_t[:-1], old_t[:-1], us[:, i]) for i in range(ocp.nu)])
+        xs = _interpolate_rows(old_t, xs, new_t)
+        us = _interpolate_rows(old_t[:-1], us, new_t[:-1])
         if ocp.config.reach:
             xs[:, -1] = horizon
         xs[0, : ocp.nxm] = x0
@@ -461,3 +461,14 @@ class _Problem:
         lbw, ubw = ocp.bounds(x0)
         w = solver.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
         return w, solver.last_iterations
+
+
+def _interpolate_rows(times: np.ndarray, rows: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Rows (one per time, increasing) linearly interpolated at ``at``, held beyond the ends
+    (``np.interp`` on every column at once)."""
+    at = np.clip(at, times[0], times[-1])
+    upper = np.clip(np.searchsorted(times, at, side="right"), 1, len(times) - 1)
+    lower = upper - 1
+    span = times[upper] - times[lower]
+    weight = np.where(span > 0.0, (at - times[lower]) / np.where(span > 0.0, span, 1.0), 0.0)
+    return rows[lower] + weight[:, None] * (rows[upper] - rows[lower])

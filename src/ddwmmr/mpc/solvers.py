@@ -54,7 +54,7 @@ def _conic_options(ocp: ShootingOCP, name: str) -> dict[str, Any]:
             nx=[ocp.nx] * (ocp.N + 1),
             nu=[ocp.nu] * ocp.N + [0],
             ng=list(ocp.ng),
-            hpipm={"mode": "balance", "iter_max": 30},
+            hpipm={"mode": "speed", "iter_max": 30},
         )
     elif name == "qrqp":
         options.update(print_iter=False, print_header=False, print_info=False)
