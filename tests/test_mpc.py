@@ -282,3 +282,16 @@ def test_warm_start_shift_interpolates_like_numpy(rng):
     at = np.sort(rng.uniform(-0.2, times[-1] + 0.3, 13))
     expected = np.column_stack([np.interp(at, times, rows[:, i]) for i in range(8)])
     np.testing.assert_allclose(_interpolate_rows(times, rows, at), expected, atol=1e-14)
+
+
+def test_a_stalled_waypoint_approach_restarts_cold():
+    """If the end effector does not move for 0.5 s short of the target (here: a plant that
+    ignores the commands), the controller drops its plan and starts cold."""
+    controller = make_controller("mpc", HEAVY, model="thesis", track_orientation=False, dt=0.01)
+    q = np.array([0.0, 0.0, 0.0, *default_pose(HEAVY)])
+    controller.reset(None, q)
+    for k in range(120):
+        controller.command(k * 0.01, q, np.array([1.0, 0.5, 0.0]), np.zeros(3),
+                           base_velocity=(0.0, 0.0))
+    assert controller.restarts == 2  # at 0.51 s and 1.02 s
+    assert controller.summarize({"stability": np.array([1.5])})["mpc_restarts"] == 2
