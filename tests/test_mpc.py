@@ -291,7 +291,8 @@ def test_a_stalled_waypoint_approach_restarts_cold():
     q = np.array([0.0, 0.0, 0.0, *default_pose(HEAVY)])
     controller.reset(None, q)
     for k in range(120):
-        controller.command(k * 0.01, q, np.array([1.0, 0.5, 0.0]), np.zeros(3),
-                           base_velocity=(0.0, 0.0))
+        controller.command(
+            k * 0.01, q, np.array([1.0, 0.5, 0.0]), np.zeros(3), base_velocity=(0.0, 0.0)
+        )
     assert controller.restarts == 2  # at 0.51 s and 1.02 s
     assert controller.summarize({"stability": np.array([1.5])})["mpc_restarts"] == 2
