@@ -161,6 +161,8 @@ class MPCControllerCore:
         self._problems: dict[tuple[str, float], _Problem] = {}
         self._trajectory: Any = None
         self.fallbacks = 0
+        #: Message of the last solver failure (None before any).
+        self.last_failure: str | None = None
         self.last = StepInfo()
         self._reset_memory()
 
@@ -232,8 +234,7 @@ class MPCControllerCore:
         if trajectory is not None:
             arm = (float(q0[3]), float(q0[4]))
             self._problem("tracking").design_terminal(arm)
-        if self._fallback is not None:
-            self._fallback.reset(trajectory, q0)
+        self._fallback = None  # rebuilt on the first failure with this run's dt
 
     def command(
         self,
@@ -339,7 +340,7 @@ class MPCControllerCore:
         if not np.all(np.isfinite(u)):  # pragma: no cover - the qp has its own safe command
             u = np.zeros(4)
         self.last = StepInfo(fallback=True, extra={"mpc_failure": 1.0})
-        self._reason = reason
+        self.last_failure = reason
         if self.dynamics is None:
             return u
         v, w = float(x0[5]), float(x0[6])
