@@ -296,3 +296,29 @@ def test_a_stalled_waypoint_approach_restarts_cold():
         )
     assert controller.restarts == 2  # at 0.51 s and 1.02 s
     assert controller.summarize({"stability": np.array([1.5])})["mpc_restarts"] == 2
+
+
+def test_minimum_time_of_one_waypoint_is_feasible_and_equals_the_physical_bound():
+    from scipy.optimize import brentq
+
+    from ddwmmr.mpc.min_time import MinimumTimeProblem, solve_minimum_time, verify
+
+    robot = HEAVY
+    start = [0.0, 0.0, 0.0, *default_pose(robot), 0.0, 0.0]
+    target = (3.0, 0.0)
+    problem = MinimumTimeProblem(robot, [target], start, intervals_per_leg=12)
+    result = solve_minimum_time(problem)
+    check = verify(problem, result)
+    assert result.success
+    assert check["max_miss_m"] < 0.011
+    assert check["min_stability"] > 1.245
+    assert check["max_force_n"] <= 10.0 + 1e-6 and check["max_joint_rate"] <= 2.0 + 1e-6
+    # From rest with the full 20 N the base covers at most v_top (t - tau (1 - exp(-t/tau))),
+    # tau = m/c1; the end effector is at most L1 + L2 ahead of the base. Straight ahead this
+    # bound is attainable (full force, arm stretched forwards: S_lon stays above 1.25), and
+    # the OCP finds it.
+    d = sym.ThesisDynamics.from_robot(robot)
+    tau, top = d.mass / d.c1, d.top_speed
+    needed = target[0] - robot.reach - 0.01
+    bound = brentq(lambda t: top * (t - tau * (1 - math.exp(-t / tau))) - needed, 0.0, 60.0)
+    assert result.total == pytest.approx(bound, abs=1e-3)
