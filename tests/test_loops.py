@@ -72,3 +72,51 @@ def test_simulated_position_error_decays_like_the_loop(tau: float) -> None:
     assert times[at_tau] == pytest.approx(tau)
     assert ratio[at_tau] == pytest.approx(math.exp(-1.0), rel=1e-3)
     np.testing.assert_allclose(ratio, error_response(tau, times), atol=1e-3)
+
+
+# -- the thesis plant's velocity-tracking loop -----------------------------------------------
+
+
+@pytest.mark.parametrize("bandwidth", (2.0, 10.0))
+def test_velocity_loop_is_first_order_with_the_feed_forward_making_it_exact(bandwidth):
+    from ddwmmr.sim.loops import velocity_loop, velocity_loop_summary
+
+    mass, damping = 15.0, 15.0
+    loop = velocity_loop(mass, damping, bandwidth)
+    pole = -(damping / mass + bandwidth)
+    np.testing.assert_allclose(control.poles(loop), [pole], rtol=1e-12)
+    assert float(np.real(control.dcgain(loop))) == pytest.approx(1.0, abs=1e-12)
+    times = np.linspace(0.0, 1.0, 201)
+    response = np.asarray(control.step_response(loop, times).outputs).ravel()
+    np.testing.assert_allclose(response, 1.0 - np.exp(pole * times), atol=1e-9)
+    assert velocity_loop_summary(mass, damping, bandwidth)["tau_s"] == pytest.approx(-1 / pole)
+
+
+def test_saturated_velocity_step_matches_the_thesis_plant_under_the_scenario_loop():
+    """The nonlinear python-control model of the loop and the real plant driven by the
+    scenario protocol's VelocityLoop agree; small steps follow the linear loop."""
+    from ddwmmr.plants.thesis import ThesisPlant, ThesisState
+    from ddwmmr.scenarios.protocol import VelocityLoop
+    from ddwmmr.sim.loops import saturated_velocity_step, velocity_loop
+
+    robot = Robot().with_payload(3.0)
+    plant = ThesisPlant(robot)
+    loop = VelocityLoop(plant)
+    dt, steps = 0.001, 2000
+    times = np.arange(steps + 1) * dt
+    for step in (0.05, 1.0):
+        state = ThesisState(0.0, 0.0, 0.0, 0.0, 1.5)
+        speeds = [0.0]
+        for _ in range(steps):
+            left, right = loop.forces(state, step, 0.0)
+            plant.step(state, left, right, (0.0, 1.5), dt)
+            speeds.append(state.v)
+        model = saturated_velocity_step(plant.mass, plant.c1, 10.0, 20.0, step, times)
+        np.testing.assert_allclose(model, speeds, atol=2e-3 * step + 1e-4)
+    small = saturated_velocity_step(plant.mass, plant.c1, 10.0, 20.0, 0.05, times)
+    linear = 0.05 * np.asarray(
+        control.step_response(velocity_loop(15.0, 15.0, 10.0), times).outputs
+    )
+    np.testing.assert_allclose(small, linear.ravel(), atol=1e-5)
+    large = saturated_velocity_step(plant.mass, plant.c1, 10.0, 20.0, 1.0, times)
+    assert large[200] < 0.5 * (1.0 - math.exp(-11.0 * 0.2))  # force-limited: slower

@@ -68,6 +68,7 @@ BUILTIN_MODULES = (
     "ddwmmr.controllers.resolved_rate",
     "ddwmmr.controllers.clrrmc",
     "ddwmmr.controllers.qp",
+    "ddwmmr.controllers.mpc",
 )
 _loaded = False
 

@@ -86,3 +86,59 @@ def loop_summary(tau: float) -> dict[str, float]:
         "t95_s": float(tau * np.log(20.0)),
         "t99_s": float(tau * np.log(100.0)),
     }
+
+
+# -- the thesis plant's velocity-tracking loop (qp on the thesis plant, mpc fallback) ---------
+#
+# Translation (rotation is the same with I, c2 and the torque): the base obeys
+# ``m vdot + c v = F`` and the loop commands ``F = c v_d + k m (v_d - v)`` (damping
+# feed-forward plus a proportional term of bandwidth k, 1/s), so
+#
+#     V(s) / V_d(s) = (c + k m) / (m s + c + k m)
+#
+# a first-order loop with its pole at -(c/m + k): the feed-forward makes the steady state
+# exact, k sets the speed. Large steps saturate the wheel forces (|F| <= 2 F_max), and the
+# response is then the plant's own open-loop acceleration.
+
+
+def velocity_loop(mass: float, damping: float, bandwidth: float) -> control.TransferFunction:
+    """Closed loop ``v / v_d`` of the velocity-tracking loop (kg, N s/m, 1/s), linear."""
+    plant = control.tf([1.0], [mass, damping])
+    gain = bandwidth * mass
+    return control.minreal((damping + gain) * control.feedback(plant, gain), verbose=False)
+
+
+def velocity_loop_summary(mass: float, damping: float, bandwidth: float) -> dict[str, float]:
+    """Pole (1/s), time constant and 95 % settling time (s) of :func:`velocity_loop`."""
+    loop = velocity_loop(mass, damping, bandwidth)
+    (pole,) = np.real(control.poles(loop))
+    return {
+        "pole_1_s": float(pole),
+        "tau_s": float(-1.0 / pole),
+        "t95_s": float(-np.log(20.0) / pole),
+        "dc_gain": float(np.real(control.dcgain(loop))),
+    }
+
+
+def saturated_velocity_step(
+    mass: float,
+    damping: float,
+    bandwidth: float,
+    force_limit: float,
+    step: float,
+    times: Sequence[float] | np.ndarray,
+) -> np.ndarray:
+    """Speed (m/s) after a step of the command from rest to ``step`` (m/s), with the total
+    force clipped to ``+-force_limit`` (N): a python-control nonlinear I/O system."""
+
+    def update(t, x, u, params):
+        force = damping * u[0] + bandwidth * mass * (u[0] - x[0])
+        force = min(force_limit, max(-force_limit, force))
+        return [(force - damping * x[0]) / mass]
+
+    system = control.nlsys(update, None, inputs=1, outputs=1, states=1, name="velocity_loop")
+    times = np.asarray(times, dtype=float)
+    response = control.input_output_response(
+        system, times, np.full_like(times, step), X0=[0.0], solve_ivp_kwargs={"max_step": 0.005}
+    )
+    return np.asarray(response.outputs, dtype=float).ravel()

@@ -1,0 +1,233 @@
+"""Figures and numbers of docs/mpc.md (run by hand: ~10 min on one core).
+
+    python docs/mpc_figures.py [--quick]
+
+* ``mpc_step_responses.png``: the python-control designs (CLRRMC error loops for tau, the
+  thesis plant's velocity loop linear and force-limited, the LQR terminal law);
+* ``mpc_rectangle.png``: position error on the default rectangle, mpc beside clrrmc-ts
+  and qp (the corners);
+* ``mpc_horizon.png``: the horizon study (tracking error and step time against the
+  horizon on the rectangle; scenario time against the horizon on the thesis plant).
+
+Prints every number it plots (medians over the runs; the machine may be shared).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import time
+from pathlib import Path
+
+import control
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ddwmmr import Rectangle, Robot, make_controller, simulate
+from ddwmmr.behaviours.objective import default_pose
+from ddwmmr.model import symbolic as sym
+from ddwmmr.mpc import terminal
+from ddwmmr.mpc.models import KinematicPrediction, ThesisPrediction
+from ddwmmr.mpc.ocp import OCPConfig
+from ddwmmr.plants.thesis import ThesisPlant, ThesisState
+from ddwmmr.scenarios import generate
+from ddwmmr.sim.loops import saturated_velocity_step, step_response, velocity_loop
+
+FIGURES = Path(__file__).parent / "figures"
+
+
+def step_responses() -> None:
+    robot = Robot().with_payload(3.0)
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+    times = np.linspace(0.0, 3.0, 301)
+    for tau in (0.2, 0.5, 1.0):
+        axes[0].plot(times, step_response(tau, times), label=f"tau = {tau:g} s")
+    axes[0].set(title="CLRRMC error loop K/(s+K), K = 1/tau", xlabel="t (s)", ylabel="pose / step")
+    plant = ThesisPlant(robot)
+    for k in (2.0, 5.0, 10.0):
+        linear = control.step_response(velocity_loop(plant.mass, plant.c1, k), times)
+        line = axes[1].plot(times, np.ravel(linear.outputs), "--", lw=1)[0]
+        limited = saturated_velocity_step(plant.mass, plant.c1, k, 20.0, 1.0, times)
+        axes[1].plot(times, limited, color=line.get_color(), label=f"k = {k:g} 1/s")
+        print(
+            f"velocity loop k={k:g}: linear 63 % at {1 / (1 + k):.3f} s, limited "
+            f"63 % at {times[np.argmax(limited >= 0.632)]:.2f} s (1 m/s step)"
+        )
+    axes[1].set(
+        title="thesis velocity loop, 1 m/s step\n(dashed linear, solid |F| <= 20 N)",
+        xlabel="t (s)",
+        ylabel="v (m/s)",
+    )
+    config = OCPConfig(
+        intervals=10,
+        control_interval=0.02,
+        first_interval=0.05,
+        horizon=1.0,
+        track_orientation=False,
+    )
+    for name, model in (
+        ("kinematic", KinematicPrediction(robot)),
+        ("thesis", ThesisPrediction(robot, sym.ThesisDynamics.from_robot(robot))),
+    ):
+        design = terminal.design(robot, model, config, default_pose(robot))
+        closed = control.ss(
+            design.A - design.B @ design.K,
+            np.zeros((design.A.shape[0], 1)),
+            np.eye(design.A.shape[0]),
+            0,
+            dt=True,
+        )
+        x0 = np.zeros(design.A.shape[0])
+        x0[0] = 0.05
+        response = control.initial_response(closed, np.arange(40), x0)
+        h = float(config.interval_lengths()[-1])
+        axes[2].plot(
+            np.arange(40) * h,
+            np.ravel(response.outputs[0]) * 1e3,
+            "o-",
+            ms=3,
+            label=f"{name} model",
+        )
+        print(f"LQR terminal ({name}): |poles| {np.round(np.abs(design.poles), 3)}")
+    axes[2].set(
+        title="LQR terminal law: 5 cm end-effector offset", xlabel="t (s)", ylabel="error (mm)"
+    )
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(FIGURES / "mpc_step_responses.png", dpi=120)
+
+
+def rectangle() -> None:
+    robot = Robot()
+    trajectory = Rectangle()
+    fig, ax = plt.subplots(figsize=(9, 3.6))
+    for method in ("clrrmc-ts", "qp", "mpc"):
+        integrator = "euler" if method == "mpc" else "rk4"
+        result = simulate(robot, trajectory, method, integrator=integrator)
+        ts, summary = result.timeseries, result.summary
+        ax.semilogy(
+            ts["t"],
+            np.maximum(ts["position_error_m"], 1e-6) * 1e3,
+            lw=1,
+            label=f"{method}: RMS {1e3 * summary['rms_position_error_m']:.2f} mm",
+        )
+        corners = [np.max(ts["position_error_m"][np.abs(ts["t"] - c) < 2.0]) for c in (10, 20, 30)]
+        print(
+            f"rectangle {method} ({integrator}): RMS {1e3 * summary['rms_position_error_m']:.2f} "
+            f"mm, max {1e3 * summary['max_position_error_m']:.1f} mm, corner peaks "
+            f"{np.round(np.array(corners) * 1e3, 1)} mm, orientation RMS "
+            f"{summary['rms_orientation_error_rad']:.3f} rad, median step "
+            f"{summary['median_step_us']:.0f} us"
+        )
+    for corner in (10, 20, 30):
+        ax.axvline(corner, color="grey", lw=0.5)
+    ax.set(
+        xlabel="t (s)",
+        ylabel="position error (mm)",
+        title="default rectangle (corners at 10, 20, 30 s)",
+    )
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(FIGURES / "mpc_rectangle.png", dpi=120)
+
+
+def scenario_time(options: dict, scenarios) -> tuple[float, float]:
+    """Mean scenario time (s) and median step (ms) of mpc on the thesis plant (the loop of
+    ddwmmr.scenarios.protocol, wheel forces and joint targets straight through)."""
+    robot = Robot().with_payload(3.0)
+    totals, steps = [], []
+    for scenario in scenarios:
+        controller = make_controller(
+            "mpc", robot, model="thesis", track_orientation=False, dt=0.01, **options
+        )
+        plant = ThesisPlant(robot)
+        state = ThesisState(0.0, 0.0, 0.0, *default_pose(robot))
+        controller.reset(None, np.array(state.q))
+        index, k = 0, 0
+        for k in range(6001):
+            xe, ye, _ = robot.fk(np.array(state.q))
+            while index < 5 and math.dist((xe, ye), scenario.waypoints[index]) <= 0.01:
+                index += 1
+            if index == 5:
+                break
+            target = np.array([*scenario.waypoints[index], 0.0])
+            began = time.perf_counter()
+            command = controller.command(
+                k * 0.01, np.array(state.q), target, np.zeros(3), base_velocity=(state.v, state.w)
+            )
+            steps.append(time.perf_counter() - began)
+            plant.step(
+                state, command.left, command.right, (command.th1_target, command.th2_target), 0.01
+            )
+        totals.append(k * 0.01)
+    return float(np.mean(totals)), 1e3 * float(np.median(steps))
+
+
+def horizon_study(quick: bool) -> None:
+    robot = Robot()
+    trajectory = Rectangle()
+    horizons = (0.2, 0.4, 0.7, 1.0, 1.5, 2.0, 3.0)
+    rms, step = [], []
+    for horizon in horizons:
+        intervals = max(3, min(20, round(horizon / 0.1)))
+        summary = simulate(
+            robot, trajectory, "mpc", integrator="euler", horizon=horizon, intervals=intervals
+        ).summary
+        rms.append(1e3 * summary["rms_position_error_m"])
+        step.append(summary["median_step_us"] / 1e3)
+        print(
+            f"tracking horizon {horizon:g} s ({intervals} intervals): RMS {rms[-1]:.2f} mm, "
+            f"median step {step[-1]:.2f} ms"
+        )
+    scenarios = generate(4 if quick else 8, 0)
+    reach = (2.0, 3.0, 5.0, 7.0)
+    mean_time, reach_step = [], []
+    for horizon in reach:
+        mean, median = scenario_time({"horizon": horizon}, scenarios)
+        mean_time.append(mean)
+        reach_step.append(median)
+        print(
+            f"waypoint horizon {horizon:g} s: mean time {mean:.2f} s over {len(scenarios)} "
+            f"scenarios, median step {median:.2f} ms"
+        )
+    fig, axes = plt.subplots(1, 2, figsize=(11, 3.6))
+    axes[0].plot(horizons, rms, "o-", color="C0")
+    axes[0].set(
+        xlabel="horizon (s)",
+        ylabel="RMS position error (mm)",
+        yscale="log",
+        title="tracking, default rectangle (kinematic model)",
+    )
+    twin = axes[0].twinx()
+    twin.plot(horizons, step, "s--", color="C1")
+    twin.set_ylabel("median step (ms)", color="C1")
+    axes[1].plot(reach, mean_time, "o-", color="C0")
+    axes[1].set(
+        xlabel="horizon (s)",
+        ylabel="mean scenario time (s)",
+        title=f"waypoints, thesis plant ({len(scenarios)} scenarios, 12 intervals)",
+    )
+    twin = axes[1].twinx()
+    twin.plot(reach, reach_step, "s--", color="C1")
+    twin.set_ylabel("median step (ms)", color="C1")
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(FIGURES / "mpc_horizon.png", dpi=120)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer scenarios in the study")
+    args = parser.parse_args()
+    FIGURES.mkdir(exist_ok=True)
+    step_responses()
+    rectangle()
+    horizon_study(args.quick)
+
+
+if __name__ == "__main__":
+    main()

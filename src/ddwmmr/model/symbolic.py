@@ -1,0 +1,298 @@
+"""The robot model as CasADi expressions: kinematics, stability, manipulability, dynamics.
+
+One home for every symbolic formula the optimisation-based code needs (the MPC, the
+minimum-time study). The numeric twins are :mod:`ddwmmr.model.kinematics`,
+:mod:`ddwmmr.model.stability` and :class:`ddwmmr.plants.thesis.ThesisPlant`; the tests
+check values and derivatives against them.
+
+Frames and units (SPEC §1): configuration ``q = [x, y, phi, th1, th2]`` (world frame; m, m,
+rad, rad, rad), inputs ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s, rad/s, rad/s).
+
+* **Kinematic model** ``qdot = G(q) u`` (:func:`kinematic_rhs`): the nonholonomic row holds
+  by construction.
+* **Force-level model of the thesis plant** (:class:`ThesisDynamics`, SPEC §5): state
+  ``x = [q, v, w]`` (7), inputs ``[F_left, F_right, th1dot, th2dot]`` (N, N, rad/s, rad/s)::
+
+      m vdot + c1 v = F_left + F_right
+      I(th2) wdot + c2 w = (F_right - F_left) width / 2
+
+  with the whole robot's mass ``m`` and its pose-dependent yaw inertia ``I(th2)`` (links as
+  uniform rods, payload a point mass at the end effector). The arm joints follow rate
+  commands: the plant's servo reaches a target ``th + rate dt`` in one step whenever
+  ``|rate| <= joint_speed``.
+
+Functions accept CasADi ``SX``/``MX`` (or numbers, returning ``DM``) so that one definition
+serves graph construction and evaluation.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import casadi as ca
+
+from ddwmmr.errors import check_positive
+from ddwmmr.model import Robot
+from ddwmmr.plants.thesis import (
+    C1_DEFAULT,
+    C2_DEFAULT,
+    FORCE_LIMIT_DEFAULT,
+    JOINT_SPEED_DEFAULT,
+)
+
+#: Sizes: configuration, velocity inputs, force-model state and inputs.
+NQ, NU = 5, 4
+NX_FORCE, NU_FORCE = 7, 4
+
+Symbolic = Any  # ca.SX | ca.MX | ca.DM
+
+
+def input_matrix(q: Symbolic) -> Symbolic:
+    """The 5x4 matrix ``G(q)`` of ``qdot = G(q) u`` (depends on the heading only)."""
+    phi = q[2]
+    zero, one = 0.0, 1.0
+    return ca.vertcat(
+        ca.horzcat(ca.cos(phi), zero, zero, zero),
+        ca.horzcat(ca.sin(phi), zero, zero, zero),
+        ca.horzcat(zero, one, zero, zero),
+        ca.horzcat(zero, zero, one, zero),
+        ca.horzcat(zero, zero, zero, one),
+    )
+
+
+def kinematic_rhs(q: Symbolic, u: Symbolic) -> Symbolic:
+    """Configuration rate ``qdot = G(q) u`` (5,)."""
+    phi = q[2]
+    return ca.vertcat(u[0] * ca.cos(phi), u[0] * ca.sin(phi), u[1], u[2], u[3])
+
+
+def forward_kinematics(robot: Robot, q: Symbolic) -> Symbolic:
+    """End-effector pose ``[xE, yE, phiE]`` (world frame, m and rad)."""
+    a1 = q[2] + q[3]
+    a12 = a1 + q[4]
+    return ca.vertcat(
+        q[0] + robot.L1 * ca.cos(a1) + robot.L2 * ca.cos(a12),
+        q[1] + robot.L1 * ca.sin(a1) + robot.L2 * ca.sin(a12),
+        a12,
+    )
+
+
+def centre_of_mass(robot: Robot, q: Symbolic) -> Symbolic:
+    """Arm+payload+base centre of mass ``[x_com, y_com]`` in the base frame (m)."""
+    k = robot.com_coefficients
+    th1, th12 = q[3], q[3] + q[4]
+    return ca.vertcat(
+        k.A * ca.cos(th1) + k.B * ca.cos(th12), k.A * ca.sin(th1) + k.B * ca.sin(th12)
+    )
+
+
+def stability_terms(robot: Robot, q: Symbolic) -> Symbolic:
+    """The exact, uncapped ratios ``[S_lon, S_lat] = [(length/2)/|x_com|, (width/2)/|y_com|]``.
+
+    Infinite where the corresponding moment vanishes; the numeric model caps at 10.
+    """
+    k = robot.com_coefficients
+    com = centre_of_mass(robot, q)
+    return ca.vertcat(k.half_length / ca.fabs(com[0]), k.half_width / ca.fabs(com[1]))
+
+
+def stability_bounds(robot: Robot, stability_min: float) -> tuple[float, float]:
+    """Bounds ``(x_max, y_max)`` (m) with ``S >= stability_min  <=>  |x_com| <= x_max and
+    |y_com| <= y_max``.
+
+    ``S_lon = hl/|x_com| >= S_min`` holds exactly when ``|x_com| <= hl/S_min`` (both sides
+    are positive), and likewise for the lateral term. Constraining the centre of mass
+    (:func:`centre_of_mass`) to this box is therefore the exact nonlinear condition
+    ``S >= S_min`` in a smooth form (no division, no kink of ``min`` or ``|.|``).
+    """
+    s_min = check_positive("stability_min", stability_min)
+    k = robot.com_coefficients
+    return k.half_length / s_min, k.half_width / s_min
+
+
+def manipulability(q: Symbolic) -> Symbolic:
+    """Normalised manipulability ``eta = |sin th2|`` in [0, 1] (thesis 4.1.1)."""
+    return ca.fabs(ca.sin(q[4]))
+
+
+def manipulability_squared(q: Symbolic) -> Symbolic:
+    """``eta^2 = sin^2 th2``: the same maximisers as eta, smooth everywhere."""
+    return ca.sin(q[4]) ** 2
+
+
+def wheel_speeds(robot: Robot, v: Symbolic, w: Symbolic) -> Symbolic:
+    """Wheel angular speeds ``[phidot_l, phidot_r]`` (rad/s) for base speeds v, w."""
+    r, lw = robot.wheel_radius, robot.track_width
+    return ca.vertcat((2.0 * v - lw * w) / (2.0 * r), (2.0 * v + lw * w) / (2.0 * r))
+
+
+def rk4_step(rhs, x: Symbolic, u: Symbolic, h: float | Symbolic) -> Symbolic:
+    """One classical Runge-Kutta step of ``xdot = rhs(x, u)`` with u held over h (s)."""
+    k1 = rhs(x, u)
+    k2 = rhs(x + 0.5 * h * k1, u)
+    k3 = rhs(x + 0.5 * h * k2, u)
+    k4 = rhs(x + h * k3, u)
+    return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+
+@dataclass(frozen=True)
+class ThesisDynamics:
+    """Parameters and equations of the thesis plant's force-level model (SPEC §5).
+
+    Build it with :meth:`from_robot`; the defaults are the thesis plant's constants
+    (``ddwmmr.plants.thesis``: c1 = 15 N s/m, c2 = 4 N m s/rad, 10 N per wheel, 2 rad/s).
+
+    Attributes:
+        mass: whole robot (base + links + payload) (kg).
+        c1: translational damping (N s/m); c2: rotational damping (N m s/rad).
+        force_limit: per-wheel force limit (N); joint_speed: arm servo speed (rad/s).
+        half_width: lever arm of the wheel forces (m).
+        inertia_fixed, inertia_cos: yaw inertia ``I(th2) = inertia_fixed + inertia_cos
+            cos(th2)`` about the base centre (kg m^2).
+    """
+
+    mass: float
+    c1: float
+    c2: float
+    force_limit: float
+    joint_speed: float
+    half_width: float
+    inertia_fixed: float
+    inertia_cos: float
+
+    @classmethod
+    def from_robot(
+        cls,
+        robot: Robot,
+        c1: float = C1_DEFAULT,
+        c2: float = C2_DEFAULT,
+        force_limit: float = FORCE_LIMIT_DEFAULT,
+        joint_speed: float = JOINT_SPEED_DEFAULT,
+    ) -> ThesisDynamics:
+        """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``."""
+        m1, m2 = robot.link_masses
+        mp, L1, L2 = robot.payload, robot.L1, robot.L2
+        # Yaw inertia about the base centre: each link a rod about its own centre plus the
+        # parallel-axis term of its midpoint, the payload a point at the end effector. The
+        # squared distances of link-2's midpoint and of the end effector from the base
+        # centre are L1^2 + L2^2/4 + L1 L2 cos th2 and L1^2 + L2^2 + 2 L1 L2 cos th2.
+        fixed = (
+            robot.base_inertia
+            + m1 * L1**2 / 12.0
+            + m2 * L2**2 / 12.0
+            + m1 * (L1 / 2.0) ** 2
+            + m2 * (L1**2 + L2**2 / 4.0)
+            + mp * (L1**2 + L2**2)
+        )
+        return cls(
+            mass=robot.base_mass + m1 + m2 + mp,
+            c1=check_positive("c1", c1),
+            c2=check_positive("c2", c2),
+            force_limit=check_positive("force_limit", force_limit),
+            joint_speed=check_positive("joint_speed", joint_speed),
+            half_width=0.5 * robot.base_width,
+            inertia_fixed=fixed,
+            inertia_cos=(m2 + 2.0 * mp) * L1 * L2,
+        )
+
+    # -- numbers ------------------------------------------------------------------------
+    def inertia(self, th2: Symbolic) -> Symbolic:
+        """Yaw inertia ``I(th2)`` (kg m^2); numbers in, float out."""
+        if isinstance(th2, int | float):
+            return self.inertia_fixed + self.inertia_cos * math.cos(th2)
+        return self.inertia_fixed + self.inertia_cos * ca.cos(th2)
+
+    @property
+    def top_speed(self) -> float:
+        """Steady forward speed under the full force of both wheels, ``2 F / c1`` (m/s)."""
+        return 2.0 * self.force_limit / self.c1
+
+    @property
+    def top_yaw_rate(self) -> float:
+        """Steady yaw rate under the full opposite forces, ``2 F (width/2) / c2`` (rad/s)."""
+        return 2.0 * self.force_limit * self.half_width / self.c2
+
+    # -- equations ----------------------------------------------------------------------
+    def rhs(self, x: Symbolic, u: Symbolic) -> Symbolic:
+        """State rate of ``x = [x, y, phi, th1, th2, v, w]`` under
+        ``u = [F_left, F_right, th1dot, th2dot]`` (7,)."""
+        phi, th2, v, w = x[2], x[4], x[5], x[6]
+        f_left, f_right = u[0], u[1]
+        return ca.vertcat(
+            v * ca.cos(phi),
+            v * ca.sin(phi),
+            w,
+            u[2],
+            u[3],
+            (f_left + f_right - self.c1 * v) / self.mass,
+            ((f_right - f_left) * self.half_width - self.c2 * w) / self.inertia(th2),
+        )
+
+    def velocity_envelope(self, fraction: float = 0.8) -> dict[str, float]:
+        """What a velocity command can ask of this base, as ``fraction`` of the physics.
+
+        Top speeds where the full force balances damping and accelerations from rest with
+        the largest yaw inertia (arm stretched); the same numbers as
+        :meth:`ddwmmr.plants.thesis.ThesisPlant.velocity_envelope` (tested), keyed like the
+        ``qp`` controller's options.
+        """
+        total = 2.0 * self.force_limit
+        torque = total * self.half_width
+        stretched = self.inertia(0.0)
+        return {
+            "max_base_speed": fraction * total / self.c1,
+            "max_yaw_rate": fraction * torque / self.c2,
+            "max_acceleration": fraction * total / self.mass,
+            "max_yaw_acceleration": fraction * torque / stretched,
+        }
+
+    def velocity_tracking_forces(
+        self,
+        v: float,
+        w: float,
+        v_d: float,
+        w_d: float,
+        th2: float,
+        bandwidth: float = 10.0,
+    ) -> tuple[float, float]:
+        """Left/right wheel forces (N) making the base follow a velocity command.
+
+        Damping feed-forward plus a proportional term of bandwidth ``bandwidth`` (1/s):
+        ``F = c1 v_d + k m (v_d - v)``, ``T = c2 w_d + k I (w_d - w)``; mixed with rotation
+        priority within the force limit (the velocity loop the ``qp`` controller uses on
+        this plant). Speeds in m/s and rad/s, th2 in rad.
+        """
+        total_limit = 2.0 * self.force_limit
+        f_t = self.c1 * v_d + bandwidth * self.mass * (v_d - v)
+        torque = self.c2 * w_d + bandwidth * self.inertia(float(th2)) * (w_d - w)
+        f_r = min(total_limit, max(-total_limit, torque / self.half_width))
+        room = total_limit - abs(f_r)
+        f_t = min(room, max(-room, f_t))
+        return 0.5 * f_t - 0.5 * f_r, 0.5 * f_t + 0.5 * f_r
+
+
+def casadi_functions(
+    robot: Robot, dynamics: ThesisDynamics | None = None
+) -> dict[str, ca.Function]:
+    """The expressions above as CasADi functions of q (and u / x), for evaluation and tests.
+
+    Keys: ``fk`` (q -> 3), ``com`` (q -> 2), ``stability`` (q -> [S_lon, S_lat]), ``eta``
+    (q -> 1), ``kinematic`` ((q, u) -> qdot), and with ``dynamics`` ``thesis``
+    ((x, u) -> xdot).
+    """
+    q = ca.SX.sym("q", NQ)
+    u = ca.SX.sym("u", NU)
+    functions = {
+        "fk": ca.Function("fk", [q], [forward_kinematics(robot, q)]),
+        "com": ca.Function("com", [q], [centre_of_mass(robot, q)]),
+        "stability": ca.Function("stability", [q], [stability_terms(robot, q)]),
+        "eta": ca.Function("eta", [q], [manipulability(q)]),
+        "kinematic": ca.Function("kinematic", [q, u], [kinematic_rhs(q, u)]),
+    }
+    if dynamics is not None:
+        x = ca.SX.sym("x", NX_FORCE)
+        f = ca.SX.sym("f", NU_FORCE)
+        functions["thesis"] = ca.Function("thesis", [x, f], [dynamics.rhs(x, f)])
+    return functions

@@ -1,0 +1,475 @@
+"""The nonlinear MPC controller (registered as method ``mpc`` in ddwmmr.controllers.mpc).
+
+Every control step (one call per step; the command is held over it, ``zero_order_hold``):
+
+1. the measured state (configuration, and the base velocities for the thesis model) pins
+   node 0 of the OCP (:mod:`ddwmmr.mpc.ocp`);
+2. the references of the nodes come from the trajectory's future poses (tracking), or the
+   target ``pose_d`` is to be reached as early as possible (waypoint mode, free horizon);
+3. the previous solution, shifted by the elapsed time, is the warm start; one Gauss-Newton
+   iteration (the real-time iteration, default) or a full solve updates it;
+4. the first input is applied: a velocity command (kinematic model) or wheel forces and
+   one-step joint targets (thesis model); an exact check of S one step ahead scales the
+   joint rates back if the linearisation was too optimistic.
+
+A failed solve (infeasible QP, solver error, non-finite numbers) falls back to the ``qp``
+controller's command for that step, counted in ``mpc_fallbacks``; the next step starts cold.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.commands import WheelForces
+from ddwmmr.controllers.base import StepInfo
+from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.model import Robot
+from ddwmmr.model import symbolic as sym
+from ddwmmr.mpc import terminal
+from ddwmmr.mpc.models import PredictionModel, make_model
+from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights, grid_intervals
+from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS, SolverFailure, make_solver
+from ddwmmr.qp.limits import as_circles, footprint_clearances, safe_arm_scale
+
+MODELS = ("kinematic", "thesis")
+#: Control step (s) when neither ``dt`` nor the trajectory's resolution is known.
+DEFAULT_DT = 0.02
+#: Gauss-Newton iterations of a cold start (first step, new target, after a fallback).
+COLD_ITERATIONS = 5
+#: Waypoint mode: when the end effector has not moved 1 mm (net) for this long (s) short of
+#: the target, the plan is dropped and the next step starts cold. One real-time iteration
+#: per step follows the optimum it is near; from a poor warm start that can be a
+#: stationary point far from the best plan (2 of 100 scenarios stalled before this rule).
+STALL_TIME = 0.5
+STALL_PROGRESS = 1e-3
+#: Defaults per objective: (intervals, first interval s, horizon s). Chosen by the horizon
+#: study in docs/mpc.md.
+GRID_DEFAULTS = {"tracking": (10, 0.05, 1.0), "reach": (12, 0.05, 5.0)}
+
+
+class MPCControllerCore:
+    """Nonlinear MPC: multiple shooting, hard S >= S_min, soft manipulability, preview.
+
+    Args:
+        robot: the robot (payload included).
+        model: ``"kinematic"`` (velocity commands, the kinematic plant) or ``"thesis"``
+            (wheel forces, the thesis plant's force-level dynamics; needs the measured base
+            velocities, ``base_velocity=(v, w)``).
+        stability_min: floor S_min of the tip-over margin (hard, exact at every node).
+        manipulability_weight: weight of ``cos^2 th2`` (soft).
+        obstacles: circles (``Circle`` or (x, y, radius) triples, m) or a TOML file path;
+            the base's enclosing circle keeps ``obstacle_margin`` (m) from each.
+        track_orientation: cost on the end-effector orientation (tracking).
+        horizon, intervals, first_interval: the grid (s, count, s); defaults per objective
+            in :data:`GRID_DEFAULTS`.
+        solver: ``"rti"`` (one Gauss-Newton iteration per step, default), ``"sqp"``
+            (iterated Gauss-Newton), ``"ipopt"``, ``"sqpmethod"`` or ``"fatrop"``.
+        qp_solver: QP backend of ``rti``/``sqp`` (``"hpipm"`` default).
+        position_weight, orientation_weight, input_weight: cost weights (see
+            :class:`ddwmmr.mpc.ocp.Weights`); huber: Huber scale (m) of position errors.
+        reach_speed: waypoint mode: m/s converting the distance left at the end of the
+            horizon into seconds.
+        proximal: damping of the input steps between two solves (see
+            :class:`ddwmmr.mpc.solvers.GaussNewtonSQP`).
+        stability_margin: the OCP keeps ``S >= stability_min + stability_margin``.
+        dt: control step (s); default the trajectory's ``duration / samples`` at reset,
+            else 0.02 s.
+        fallback_options: options of the ``qp`` fallback controller (merged over the
+            defaults derived from these options).
+    """
+
+    name = "mpc"
+    #: Sampled-data controller: call once per control step, hold the command over it.
+    zero_order_hold = True
+
+    def __init__(
+        self,
+        robot: Robot,
+        model: str = "kinematic",
+        stability_min: float = 1.25,
+        manipulability_weight: float = 0.5,
+        obstacles: Sequence[Any] | str = (),
+        track_orientation: bool = True,
+        horizon: float | None = None,
+        intervals: int | None = None,
+        first_interval: float | None = None,
+        solver: str = "rti",
+        qp_solver: str = "hpipm",
+        position_weight: float | None = None,
+        orientation_weight: float = 10.0,
+        input_weight: float = 0.01,
+        huber: float | None = None,
+        reach_speed: float = 0.05,
+        proximal: float = 0.01,
+        stability_margin: float = 0.01,
+        obstacle_margin: float = 0.05,
+        dt: float | None = None,
+        fallback_options: dict[str, Any] | None = None,
+    ) -> None:
+        if model not in MODELS:
+            raise ParameterError(f"model must be one of {', '.join(MODELS)} (got {model!r})")
+        if solver not in SOLVERS:
+            raise ParameterError(f"solver must be one of {', '.join(SOLVERS)} (got {solver!r})")
+        if qp_solver not in QP_SOLVERS:
+            raise ParameterError(
+                f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {qp_solver!r})"
+            )
+        self.robot = robot
+        self.model_name = model
+        self.dynamics = sym.ThesisDynamics.from_robot(robot) if model == "thesis" else None
+        self.model: PredictionModel = make_model(model, robot, self.dynamics)
+        self.interface = self.model.interface
+        self.wants_base_velocity = model == "thesis"
+        self.stability_min = check_positive("stability_min", stability_min)
+        if self.stability_min >= 10.0:
+            raise ParameterError(f"stability_min must be in (0, 10) (got {stability_min:g})")
+        self.obstacles = as_circles(obstacles)
+        self.track_orientation = bool(track_orientation)
+        self.solver_name, self.qp_solver = solver, qp_solver
+        self._dt_option = None if dt is None else check_positive("dt", dt)
+        self.dt = self._dt_option or DEFAULT_DT
+        self._grid = {
+            mode: self._grid_option(mode, horizon, intervals, first_interval, self.dt)
+            for mode in GRID_DEFAULTS
+        }
+        self._weights = {
+            mode: Weights(
+                position=check_nonnegative(
+                    "position_weight",
+                    (100.0 if mode == "tracking" else 50.0)
+                    if position_weight is None
+                    else position_weight,
+                ),
+                orientation=orientation_weight,
+                manipulability=manipulability_weight,
+                input=input_weight,
+                terminal=1.0 if mode == "tracking" else 0.0,
+            )
+            for mode in GRID_DEFAULTS
+        }
+        self.huber = None if huber is None else check_positive("huber", huber)
+        self.reach_speed = check_positive("reach_speed", reach_speed)
+        self.proximal = check_nonnegative("proximal", proximal)
+        self.stability_margin = check_nonnegative("stability_margin", stability_margin)
+        self.obstacle_margin = check_nonnegative("obstacle_margin", obstacle_margin)
+        self._fallback_options = dict(fallback_options or {})
+        self._fallback: Any = None
+        self._problems: dict[tuple[str, float], _Problem] = {}
+        self._trajectory: Any = None
+        self.fallbacks = 0
+        #: Message of the last solver failure (None before any).
+        self.last_failure: str | None = None
+        self.last = StepInfo()
+        self._reset_memory()
+
+    # -- options ----------------------------------------------------------------------------
+    @staticmethod
+    def _grid_option(mode, horizon, intervals, first_interval, dt) -> tuple[int, float, float]:
+        n0, h0, t0 = GRID_DEFAULTS[mode]
+        n = n0 if intervals is None else intervals
+        t = check_positive("horizon", t0 if horizon is None else horizon)
+        if first_interval is None:
+            # A short horizon with the default first interval: uniform intervals.
+            h = min(h0, max(t - dt, 1e-3) / max(int(n) - 1, 1))
+        else:
+            h = first_interval
+        if not t > dt:
+            raise ParameterError(f"horizon must be > the control step dt = {dt:g} s (got {t:g})")
+        grid_intervals(n, h, t)  # validates the count and the lengths (one-line errors)
+        return int(n), float(h), float(t)
+
+    def _config(self, mode: str) -> OCPConfig:
+        n, h, t = self._grid[mode]
+        reach = mode == "reach"
+        return OCPConfig(
+            intervals=n,
+            control_interval=self.dt,
+            first_interval=min(h, (t - self.dt) / (n - 1)),
+            horizon=t,
+            reach=reach,
+            min_horizon=max(0.1, 2.0 * self.dt),
+            reach_speed=self.reach_speed,
+            stability_min=self.stability_min,
+            stability_margin=self.stability_margin,
+            track_orientation=self.track_orientation and not reach,
+            huber=self.huber if self.huber is not None else (0.01 if reach else None),
+            obstacles=tuple(self.obstacles),
+            base_radius=0.5 * math.hypot(self.robot.base_length, self.robot.base_width),
+            obstacle_margin=self.obstacle_margin,
+            weights=self._weights[mode],
+        )
+
+    def _problem(self, mode: str) -> _Problem:
+        key = (mode, self.dt)
+        if key not in self._problems:
+            self._problems[key] = _Problem(self, self._config(mode))
+        return self._problems[key]
+
+    # -- controller protocol ------------------------------------------------------------
+    def _reset_memory(self) -> None:
+        self._warm: np.ndarray | None = None
+        self._warm_mode: str | None = None
+        self._warm_time = 0.0
+        self._target: tuple[float, float] | None = None
+        self._u_prev = np.zeros(self.model.nu)
+        self._predicted_velocity: tuple[float, float] = (0.0, 0.0)
+        self._anchor: tuple[float, float] | None = None
+        self._anchor_time = 0.0
+        self.restarts = 0
+
+    def reset(self, trajectory: Any, q0: np.ndarray) -> None:
+        """Forget warm starts and counters; take the control step from the trajectory."""
+        if self._dt_option is None:
+            samples = getattr(trajectory, "samples", None)
+            duration = getattr(trajectory, "duration", None)
+            self.dt = duration / samples if samples and duration else DEFAULT_DT
+        self._trajectory = trajectory
+        self.fallbacks = 0
+        self.last = StepInfo()
+        self._reset_memory()
+        if trajectory is not None:
+            arm = (float(q0[3]), float(q0[4]))
+            self._problem("tracking").design_terminal(arm)
+        self._fallback = None  # rebuilt on the first failure with this run's dt
+
+    def command(
+        self,
+        t: float,
+        q: np.ndarray,
+        pose_d: np.ndarray,
+        velocity_d: np.ndarray,
+        *,
+        base_velocity: tuple[float, float] | None = None,
+    ) -> np.ndarray | WheelForces:
+        """The command for time t (s) at configuration q: ``u = (v, w, th1dot, th2dot)``
+        (kinematic model) or :class:`WheelForces` (thesis model).
+
+        ``base_velocity = (v, w)`` (m/s, rad/s) is the measured base velocity the thesis
+        model needs; without it the previous plan's prediction is used.
+        """
+        q = np.asarray(q, dtype=float)
+        pose_d = np.asarray(pose_d, dtype=float)
+        velocity_d = np.asarray(velocity_d, dtype=float)
+        reach = self._trajectory is None and not np.any(velocity_d)
+        mode = "reach" if reach else "tracking"
+        problem = self._problem(mode)
+        if mode == "tracking" and problem.terminal_factor is None:
+            problem.design_terminal((float(q[3]), float(q[4])))
+        x0 = self._state(q, base_velocity)
+        references = self._references(problem, t, pose_d, velocity_d)
+        target = (float(pose_d[0]), float(pose_d[1]))
+        new_target = reach and self._target != target
+        cold = self._warm is None or self._warm_mode != mode or new_target
+        if reach and self._stalled(t, q, new_target) and not cold:
+            cold = True
+            self.restarts += 1
+        try:
+            w, iterations = problem.solve(
+                t, x0, references, self._u_prev, None if cold else self._warm, self._warm_time
+            )
+        except SolverFailure as failure:
+            return self._fallback_command(t, q, pose_d, velocity_d, x0, str(failure))
+        self._warm, self._warm_mode, self._warm_time = w, mode, t
+        self._target = target
+        u = problem.ocp.first_input(w)
+        self._u_prev = u
+        return self._output(problem, q, x0, u, w, iterations)
+
+    # -- pieces ---------------------------------------------------------------------------
+    def _stalled(self, t: float, q: np.ndarray, new: bool) -> bool:
+        """True (once per STALL_TIME) when the end effector has stopped short of the target."""
+        xe, ye, _ = self.robot.fk(q)
+        anchor = self._anchor
+        if new or anchor is None or math.hypot(xe - anchor[0], ye - anchor[1]) > STALL_PROGRESS:
+            self._anchor, self._anchor_time = (xe, ye), t
+            return False
+        if t - self._anchor_time > STALL_TIME:
+            self._anchor_time = t
+            return True
+        return False
+
+    def _state(self, q: np.ndarray, base_velocity: tuple[float, float] | None) -> np.ndarray:
+        if self.model_name == "kinematic":
+            return q.copy()
+        v, w = self._predicted_velocity if base_velocity is None else base_velocity
+        return np.concatenate([q, [float(v), float(w)]])
+
+    def _references(self, problem: _Problem, t: float, pose_d, velocity_d) -> np.ndarray:
+        """Reference poses of nodes 1..N (N, 3)."""
+        times = problem.ocp.node_times(problem.ocp.config.horizon)[1:]
+        if self._trajectory is not None:
+            return np.array([self._trajectory.pose(t + tau) for tau in times])
+        return pose_d[None, :] + times[:, None] * velocity_d[None, :]
+
+    def _output(self, problem, q, x0, u, w, iterations) -> np.ndarray | WheelForces:
+        k = self.robot.com_coefficients
+        th1, th2 = float(q[3]), float(q[4])
+        r1, r2 = float(u[2]), float(u[3])
+        scale = safe_arm_scale(k, th1, th2, r1, r2, self.dt, self.stability_min)
+        r1, r2 = r1 * scale, r2 * scale
+        ocp = problem.ocp
+        slack = max(float(np.max(w[s])) for s in ocp.slack_slices)
+        self.last = StepInfo(
+            extra={
+                "mpc_iterations": float(iterations),
+                "mpc_horizon_s": ocp.horizon_of(w),
+                "mpc_slack": slack,
+                "arm_scale": scale,
+            }
+        )
+        if self.model_name == "kinematic":
+            return np.array([float(u[0]), float(u[1]), r1, r2])
+        xs, _ = ocp.trajectories(w)
+        self._predicted_velocity = (float(xs[1][5]), float(xs[1][6]))
+        return WheelForces(float(u[0]), float(u[1]), th1 + r1 * self.dt, th2 + r2 * self.dt)
+
+    def _fallback_command(self, t, q, pose_d, velocity_d, x0, reason: str):
+        """The ``qp`` command for this step (counted); the next step starts cold."""
+        self.fallbacks += 1
+        self._warm = None
+        if self._fallback is None:
+            self._fallback = self._make_fallback()
+        qp = self._fallback
+        if self.dynamics is not None:
+            qp.ctx.previous_command = (float(x0[5]), float(x0[6]))
+        u = np.asarray(qp.command(t, q, pose_d, velocity_d), dtype=float)
+        if not np.all(np.isfinite(u)):  # pragma: no cover - the qp has its own safe command
+            u = np.zeros(4)
+        self.last = StepInfo(fallback=True, extra={"mpc_failure": 1.0})
+        self.last_failure = reason
+        if self.dynamics is None:
+            return u
+        v, w = float(x0[5]), float(x0[6])
+        f_left, f_right = self.dynamics.velocity_tracking_forces(v, w, u[0], u[1], float(q[4]))
+        limit = min(self.dynamics.joint_speed, self.robot.joint_speed_limit)
+        r1 = min(limit, max(-limit, float(u[2])))
+        r2 = min(limit, max(-limit, float(u[3])))
+        self._predicted_velocity = (v, w)
+        return WheelForces(f_left, f_right, float(q[3]) + r1 * self.dt, float(q[4]) + r2 * self.dt)
+
+    def _make_fallback(self) -> Any:
+        from ddwmmr.controllers.base import make_controller
+
+        options: dict[str, Any] = {
+            "stability_min": self.stability_min,
+            "track_orientation": self.track_orientation and self._trajectory is not None,
+            "obstacles": list(self.obstacles),
+            "dt": self.dt,
+        }
+        if self._trajectory is None:
+            options["max_speed"] = 1.0
+        if self.dynamics is not None:
+            options.update(self.dynamics.velocity_envelope())
+        options.update(self._fallback_options)
+        qp = make_controller("qp", self.robot, **options)
+        qp.reset(self._trajectory, np.zeros(5))
+        return qp
+
+    # -- reporting ----------------------------------------------------------------------
+    def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
+        """MPC metrics merged into the run summary (see ddwmmr.controllers.mpc)."""
+        stability = np.asarray(timeseries["stability"])
+        if "fallback" in timeseries:
+            fallbacks = int(np.sum(np.asarray(timeseries["fallback"]) > 0))
+        else:
+            fallbacks = self.fallbacks
+        clearance = None
+        if self.obstacles and all(k in timeseries for k in ("x", "y", "phi")):
+            clearance = float(
+                np.min(
+                    footprint_clearances(
+                        0.5 * self.robot.base_length,
+                        0.5 * self.robot.base_width,
+                        timeseries["x"],
+                        timeseries["y"],
+                        timeseries["phi"],
+                        self.obstacles,
+                    )
+                )
+            )
+        mode = "tracking" if self._trajectory is not None else "reach"
+        return {
+            "stability_min": self.stability_min,
+            "stability_violations": int(np.sum(stability < self.stability_min)),
+            "mpc_fallbacks": fallbacks,
+            "mpc_restarts": self.restarts,
+            "min_obstacle_clearance_m": clearance,
+            "mpc_model": self.model_name,
+            "mpc_solver": self.solver_name
+            if self.solver_name != "rti"
+            else f"rti-{self.qp_solver}",
+            "mpc_horizon_s": self._grid[mode][2],
+        }
+
+
+class _Problem:
+    """One OCP with its solvers, terminal design and warm-start shifting."""
+
+    def __init__(self, owner: MPCControllerCore, config: OCPConfig) -> None:
+        self.owner = owner
+        self.ocp = ShootingOCP(owner.robot, owner.model, config)
+        name = owner.solver_name
+        self.solver = make_solver(name, self.ocp, owner.qp_solver, proximal=owner.proximal)
+        self.cold = (
+            make_solver("sqp", self.ocp, owner.qp_solver, iterations=COLD_ITERATIONS)
+            if name == "rti"
+            else self.solver
+        )
+        self.terminal_factor: np.ndarray | None = None
+
+    def design_terminal(self, arm_pose: tuple[float, float]) -> None:
+        """LQR terminal cost at the arm pose (tracking only)."""
+        if self.ocp.config.reach:
+            return
+        design = terminal.design(self.owner.robot, self.owner.model, self.ocp.config, arm_pose)
+        self.terminal_factor = design.factor
+
+    def _initial(self, x0: np.ndarray) -> np.ndarray:
+        ocp = self.ocp
+        node = np.concatenate([x0, [ocp.config.horizon]])[: ocp.nx]
+        return ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
+
+    def _shifted(self, warm: np.ndarray, elapsed: float, x0: np.ndarray) -> tuple:
+        """The previous solution moved ``elapsed`` s forward (linear interpolation)."""
+        ocp = self.ocp
+        xs, us = ocp.trajectories(warm)
+        old_horizon = ocp.horizon_of(warm)
+        horizon = old_horizon
+        if ocp.config.reach:
+            horizon = min(max(old_horizon - elapsed, ocp.config.min_horizon), ocp.config.horizon)
+        old_t = ocp.node_times(old_horizon)
+        new_t = ocp.node_times(horizon) + elapsed
+        xs = _interpolate_rows(old_t, xs, new_t)
+        us = _interpolate_rows(old_t[:-1], us, new_t[:-1])
+        if ocp.config.reach:
+            xs[:, -1] = horizon
+        xs[0, : ocp.nxm] = x0
+        return ocp.pack(xs, us), horizon
+
+    def solve(self, t, x0, references, u_prev, warm, warm_time) -> tuple[np.ndarray, int]:
+        """Solve from the shifted warm start (or cold); returns (w, iterations)."""
+        ocp = self.ocp
+        if warm is None:
+            guess, horizon, solver = self._initial(x0), ocp.config.horizon, self.cold
+        else:
+            guess, horizon = self._shifted(warm, max(0.0, t - warm_time), x0)
+            solver = self.solver
+        p = ocp.parameters(references, u_prev, self.terminal_factor, horizon_prev=horizon)
+        lbw, ubw = ocp.bounds(x0)
+        w = solver.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+        return w, solver.last_iterations
+
+
+def _interpolate_rows(times: np.ndarray, rows: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Rows (one per time, increasing) linearly interpolated at ``at``, held beyond the ends
+    (``np.interp`` on every column at once)."""
+    at = np.clip(at, times[0], times[-1])
+    upper = np.clip(np.searchsorted(times, at, side="right"), 1, len(times) - 1)
+    lower = upper - 1
+    span = times[upper] - times[lower]
+    weight = np.where(span > 0.0, (at - times[lower]) / np.where(span > 0.0, span, 1.0), 0.0)
+    return rows[lower] + weight[:, None] * (rows[upper] - rows[lower])

@@ -1,0 +1,462 @@
+"""The receding-horizon optimal control problem, by multiple shooting (built once, solved
+every control step).
+
+Two objectives share one structure:
+
+* **tracking** (a trajectory is given): follow the previewed end-effector poses at the
+  nodes; horizon fixed;
+* **reach** (waypoint mode, only a target): reach the target as early as possible. The
+  horizon ``T`` is a decision variable (a free final time, kept as a constant extra state
+  so the stage structure survives) between ``min_horizon`` and ``horizon``: when the target
+  can be reached within ``horizon``, the plan is a minimum-time manoeuvre that passes
+  through it; when it cannot, ``T = horizon`` and the plan gets as close as it can (each
+  metre left costs ``1/reach_speed`` seconds).
+
+Grid: the first interval is the control step ``dt`` (the command is held exactly that
+long); the other ``N - 1`` grow geometrically from ``first_interval`` to fill the rest of
+the ``horizon`` (uniform when they are all ``first_interval``), scaled to fill ``T - dt``
+in reach mode: fine steps where the command is decided, coarse ones where only the
+direction of the plan matters. Each interval is integrated with RK4 in sub-steps of at most
+:data:`MAX_SUBSTEP`. Decision vector, in the stage-wise order that structure-exploiting
+solvers (HPIPM, FATROP) expect::
+
+    w = [x_0, u_0, x_1, u_1, ..., x_{N-1}, u_{N-1}, x_N]
+
+with the physical part of ``x_0`` pinned to the measured state by its bounds; ``u_k`` is
+the model's input followed by this stage's slacks ``sigma_k >= 0``. Constraints, stage by
+stage (``gap_k`` then ``path_k``)::
+
+    gap_k:   RK4(x_k, u_k, h_k) - x_{k+1} = 0                        (the prediction model)
+    path_k:  -hl/S <= x_com(q_{k+1}) +- sigma_lon,   -hw/S <= y_com(q_{k+1}) +- sigma_lat
+             |p_{k+1} - o_j|^2 + sigma_obs >= (R_j + r_base + margin)^2   (every circle j)
+             wheel speeds in +-wheel_speed_limit
+
+written through ``x_{k+1} = RK4(x_k, u_k, h_k)`` so that each row involves one stage's
+variables only. ``S = stability_min + stability_margin``; the box on the centre of mass is
+the exact condition ``S_lon, S_lat >= S`` (see :func:`ddwmmr.model.symbolic.
+stability_bounds`): the nonlinear stability margin at every node, not a linearisation.
+The slacks carry an exact L1 penalty (:data:`SLACK_WEIGHT`): whenever the constraints can
+be met they are met (a hard constraint), and a linearisation that cannot be met in one
+iteration still gives a solvable QP. Input box (forces or rates), joint-position box on
+the states.
+
+Cost: ``0.5 ||r(w, p)||^2 + c' w`` with the residual ``r`` stacked from, weighted by the
+interval lengths:
+
+* end-effector position error at the nodes (tracking; optional in reach mode)
+  ``sqrt(Wp) s(e) e``, ``e = p_E(q_k) - p_ref,k``. With a Huber scale ``delta`` the factor
+  ``s(e) = sqrt(2 / (1 + sqrt(1 + |e|^2/delta^2)))`` makes the squared residual quadratic
+  near the reference and linear far from it;
+* orientation error ``sqrt(Wo) [cos phiE - cos phi_ref, sin phiE - sin phi_ref]`` (smooth
+  through the wrap and through the rectangle's corner jumps);
+* manipulability ``sqrt(Wm) cos th2`` (soft: ``1 - eta^2 = cos^2 th2``);
+* inputs ``sqrt(Wu) u / u_scale``; at the first stage the change from the previous
+  command ``sqrt(Wdu) (u_0 - u_prev) / u_scale``;
+* terminal, tracking: ``L' z`` with ``z`` the terminal end-effector error in the terminal
+  base frame (plus the base velocities for the force model) and ``P = L L'`` the LQR
+  cost-to-go of the linearised error dynamics (:mod:`ddwmmr.mpc.terminal`);
+* terminal, reach: the Huber distance to the target, ``|e_N| / reach_speed`` seconds far
+  from it; the linear term ``c`` charges ``T`` itself (one unit per second) and the slacks.
+
+Parameters ``p``: per node ``(x, y, phi, weight)`` of the reference, the previous command,
+the terminal factor ``L`` (row-major) and the previous horizon ``T`` (reach mode).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.model import Robot
+from ddwmmr.model import symbolic as sym
+from ddwmmr.mpc.models import PredictionModel
+from ddwmmr.qp.limits.obstacles import Circle
+
+#: Value used for "no bound" in the constraint vectors.
+INF = math.inf
+#: Exact-penalty weight of a path-constraint slack (per unit of violation) and its small
+#: quadratic part (keeps the QP strictly convex). Large against every multiplier seen in
+#: practice, so a feasible linearisation is solved exactly (hard constraint).
+SLACK_WEIGHT = 1e4
+SLACK_QUADRATIC = 1.0
+#: Longest RK4 sub-step inside one shooting interval (s).
+MAX_SUBSTEP = 0.2
+#: Weight of the change of the free horizon T between two solves (1/s^2).
+HORIZON_SMOOTHING = 1.0
+
+
+@dataclass(frozen=True)
+class Weights:
+    """Cost weights (per second of horizon; positions in m, angles in rad).
+
+    Attributes:
+        position: end-effector position error at the nodes (1/(m^2 s)).
+        orientation: end-effector orientation chord error (1/s); 0 disables it.
+        manipulability: ``cos^2 th2`` (1/s).
+        input: normalised inputs (1/s).
+        input_change: change of the first input from the previous command (-).
+        terminal: scale of the LQR terminal cost (tracking) (-); 0 disables it.
+    """
+
+    position: float = 100.0
+    orientation: float = 1.0
+    manipulability: float = 0.5
+    input: float = 0.01
+    input_change: float = 0.0
+    terminal: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in (
+            "position",
+            "orientation",
+            "manipulability",
+            "input",
+            "input_change",
+            "terminal",
+        ):
+            object.__setattr__(self, name, check_nonnegative(f"{name}_weight", getattr(self, name)))
+
+
+@dataclass(frozen=True)
+class OCPConfig:
+    """What defines one OCP (the functions are rebuilt when any of it changes).
+
+    Attributes:
+        intervals: number N of shooting intervals; control_interval: the first one (the
+            control step dt, s); first_interval: the second one's length (s); horizon: their
+            sum (s), at least ``dt + (N - 1) first_interval``.
+        reach: free-final-time reach objective (waypoint mode) instead of tracking.
+        min_horizon: lower bound on the free horizon T (s); reach_speed: m/s converting
+            the distance left at T = horizon into seconds.
+        stability_min: the floor S_min; stability_margin: the OCP keeps S >= S_min + margin.
+        track_orientation: cost on the end-effector orientation.
+        huber: Huber scale (m) of the position error, None for a pure quadratic.
+        obstacles: circles kept clear of the base's enclosing circle (radius
+            ``base_radius``) by ``obstacle_margin`` (m).
+        weights: the cost weights.
+    """
+
+    intervals: int = 20
+    control_interval: float = 0.02
+    first_interval: float = 0.05
+    horizon: float = 3.0
+    reach: bool = False
+    min_horizon: float = 0.1
+    reach_speed: float = 0.5
+    stability_min: float = 1.25
+    stability_margin: float = 0.01
+    track_orientation: bool = True
+    huber: float | None = None
+    obstacles: tuple[Circle, ...] = ()
+    base_radius: float = 0.0
+    obstacle_margin: float = 0.05
+    weights: Weights = field(default_factory=Weights)
+
+    def interval_lengths(self) -> np.ndarray:
+        """The N interval lengths (s) at ``T = horizon``: dt, then ``first_interval r^k``."""
+        dt = check_positive("dt", self.control_interval)
+        rest = grid_intervals(self.intervals - 1, self.first_interval, self.horizon - dt)
+        return np.concatenate([[dt], rest])
+
+
+class ShootingOCP:
+    """The symbolic multiple-shooting problem (see module docstring) and its index maps.
+
+    Attributes:
+        w, p: decision and parameter symbols (SX); residual, g: cost residual, constraints.
+        linear_cost: the cost's linear part ``c`` (slack penalty, horizon), (nw,).
+        lbg, ubg: constraint bounds; w_lower, w_upper: decision bounds with ``x_0`` free
+            (use :meth:`bounds` to pin it); ng: path rows per stage (N+1).
+        nx, nu: node state and stage input sizes (model plus T / slacks).
+        x_slices, u_slices: where each node's model state / model input sits in w.
+        lengths: nominal interval lengths (s) at T = horizon (N,); fractions: the shares of
+            intervals 1..N-1 in ``T - dt`` (N-1,).
+        terminal_size: dimension of the tracking terminal error ``z``.
+    """
+
+    def __init__(self, robot: Robot, model: PredictionModel, config: OCPConfig) -> None:
+        self.robot = robot
+        self.model = model
+        self.config = config
+        n = config.intervals
+        self.lengths = config.interval_lengths()
+        self.dt = float(self.lengths[0])
+        self.fractions = self.lengths[1:] / self.lengths[1:].sum()
+        self.N = n
+        self.nxm, self.num = model.nx, model.nu
+        self.nx = model.nx + (1 if config.reach else 0)
+        self.ns = 2 + (1 if config.obstacles else 0)  # stability terms, obstacles
+        self.nu = model.nu + self.ns
+        self.terminal_size = (3 if config.track_orientation else 2) + (model.nx - sym.NQ)
+        self.x_slices, self.u_slices, self.slack_slices = [], [], []
+        self._node_slices = []
+        start = 0
+        for k in range(n + 1):
+            self._node_slices.append(slice(start, start + self.nx))
+            self.x_slices.append(slice(start, start + self.nxm))
+            start += self.nx
+            if k < n:
+                self.u_slices.append(slice(start, start + self.num))
+                self.slack_slices.append(slice(start + self.num, start + self.nu))
+                start += self.nu
+        self.nw = start
+        self.np = 4 * n + self.num + self.terminal_size**2 + 1
+        self.w = ca.SX.sym("w", self.nw)
+        self.p = ca.SX.sym("p", self.np)
+        self._build()
+
+    # -- construction -------------------------------------------------------------------
+    @property
+    def horizon_index(self) -> int | None:
+        """Index in w of the free horizon T of node 0 (reach mode), else None."""
+        return self.nxm if self.config.reach else None
+
+    def node_times(self, horizon: float) -> np.ndarray:
+        """Node offsets from now (s) for a horizon T (N+1,)."""
+        rest = np.cumsum(self.fractions * (horizon - self.dt))
+        return np.concatenate([[0.0, self.dt], self.dt + rest])
+
+    def _interval(self, nodes: Sequence, k: int, owner: int | None = None):
+        """Length of interval k: dt for k = 0; fixed (tracking) or a share of ``T - dt``
+        (reach, T read from node ``owner``, default k: every node carries the same T)."""
+        if k == 0:
+            return self.dt
+        if self.config.reach:
+            horizon = nodes[k if owner is None else owner][self.nxm]
+            return self.fractions[k - 1] * (horizon - self.dt)
+        return float(self.lengths[k])
+
+    def _integrate(self, x, u, h, nominal: float):
+        """The state after h (s) under u: RK4 in equal sub-steps, at most MAX_SUBSTEP long
+        at the interval's nominal length (reach mode only shortens intervals)."""
+        substeps = max(1, math.ceil(nominal / MAX_SUBSTEP - 1e-9))
+        for _ in range(substeps):
+            x = sym.rk4_step(self.model.rhs, x, u, h / substeps)
+        return x
+
+    def _build(self) -> None:
+        config, model, robot = self.config, self.model, self.robot
+        nodes = [self.w[s] for s in self._node_slices]
+        xs = [self.w[s] for s in self.x_slices]
+        us = [self.w[s] for s in self.u_slices]
+        slacks = [self.w[s] for s in self.slack_slices]
+        x_max, y_max = sym.stability_bounds(robot, config.stability_min + config.stability_margin)
+        clear = [
+            (c.x, c.y, (c.radius + config.base_radius + config.obstacle_margin) ** 2)
+            for c in config.obstacles
+        ]
+        g, lbg, ubg, ng = [], [], [], []
+        for k in range(self.N):
+            x_next = self._integrate(xs[k], us[k], self._interval(nodes, k), float(self.lengths[k]))
+            if config.reach:
+                g.append(ca.vertcat(x_next, nodes[k][self.nxm]) - nodes[k + 1])
+            else:
+                g.append(x_next - nodes[k + 1])
+            lbg.extend([0.0] * self.nx)
+            ubg.extend([0.0] * self.nx)
+            # Path rows of node k+1, written through the stage's own variables (x_k, u_k)
+            # so that each stage's slacks can relax them (see module docstring).
+            com = sym.centre_of_mass(robot, model.configuration(x_next))
+            slack = slacks[k]
+            rows = [com[0] + slack[0], com[0] - slack[0], com[1] + slack[1], com[1] - slack[1]]
+            low = [-x_max, -INF, -y_max, -INF]
+            high = [INF, x_max, INF, y_max]
+            for ox, oy, radius2 in clear:
+                rows.append((x_next[0] - ox) ** 2 + (x_next[1] - oy) ** 2 + slack[2])
+                low.append(radius2)
+                high.append(INF)
+            rows.append(model.wheel_rows(x_next, us[k]))
+            low.extend([-model.wheel_limit] * 2)
+            high.extend([model.wheel_limit] * 2)
+            g.append(ca.vertcat(*rows))
+            ng.append(len(low))
+            lbg.extend(low)
+            ubg.extend(high)
+        ng.append(0)
+        self.g = ca.vertcat(*g)
+        self.lbg, self.ubg = np.array(lbg), np.array(ubg)
+        self.ng = ng
+        self.residual = self._residual(nodes, xs, us, slacks)
+        self._bounds_and_linear_cost()
+
+    def _bounds_and_linear_cost(self) -> None:
+        config, model = self.config, self.model
+        lower, upper = np.zeros(self.nw), np.zeros(self.nw)
+        linear = np.zeros(self.nw)
+        for k, s in enumerate(self._node_slices):
+            low = np.concatenate([model.x_lower, [config.min_horizon]])[: self.nx]
+            high = np.concatenate([model.x_upper, [config.horizon]])[: self.nx]
+            if k == 0:
+                low[: self.nxm], high[: self.nxm] = -INF, INF
+            lower[s], upper[s] = low, high
+        for s in self.u_slices:
+            lower[s], upper[s] = model.u_lower, model.u_upper
+        for s in self.slack_slices:
+            lower[s], upper[s] = 0.0, INF
+            linear[s] = SLACK_WEIGHT
+        if config.reach:
+            linear[self.horizon_index] = 1.0  # one unit of cost per second of horizon
+        self.w_lower, self.w_upper = lower, upper
+        self.linear_cost = linear
+
+    def _huber_scale(self, error, delta: float | None) -> ca.SX | float:
+        if delta is None:
+            return 1.0
+        return ca.sqrt(2.0 / (1.0 + ca.sqrt(1.0 + ca.sumsqr(error) / delta**2)))
+
+    def _residual(self, nodes: Sequence, xs: Sequence, us: Sequence, slacks: Sequence) -> ca.SX:
+        config, model, robot = self.config, self.model, self.robot
+        weights, n, nu = config.weights, self.N, self.num
+        refs = ca.reshape(self.p[: 4 * n], 4, n)  # x, y, phi, weight of nodes 1..N
+        u_prev = self.p[4 * n : 4 * n + nu]
+        nz = self.terminal_size
+        factor = ca.reshape(self.p[4 * n + nu : 4 * n + nu + nz * nz], nz, nz).T  # row-major
+        horizon_prev = self.p[-1]
+        scale = np.asarray(model.u_scale, dtype=float)
+        parts = []
+        for k in range(n):
+            h_k = self._interval(nodes, k)
+            parts.append(ca.sqrt(weights.input * h_k) * us[k] / scale)
+            parts.append(math.sqrt(SLACK_QUADRATIC) * slacks[k])
+        if weights.input_change > 0.0:
+            parts.append(math.sqrt(weights.input_change) * (us[0] - u_prev) / scale)
+        pose = None
+        for k in range(1, n + 1):
+            q = model.configuration(xs[k])
+            pose = sym.forward_kinematics(robot, q)
+            ref = refs[:, k - 1]
+            # The weight of node k uses node k's own copy of T (stage-wise structure).
+            h_k = self._interval(nodes, k - 1, owner=k)
+            error = pose[:2] - ref[:2]
+            if weights.position > 0.0:
+                # Nominal (unscaled) node weights: as T shrinks near the target the nodes
+                # crowd towards now and the same weights make the approach more urgent.
+                parts.append(
+                    math.sqrt(weights.position * float(self.lengths[k - 1]))
+                    * ca.sqrt(ref[3])
+                    * self._huber_scale(error, config.huber)
+                    * error
+                )
+            if config.track_orientation and weights.orientation > 0.0:
+                parts.append(
+                    ca.sqrt(weights.orientation * h_k)
+                    * ca.vertcat(ca.cos(pose[2]) - ca.cos(ref[2]), ca.sin(pose[2]) - ca.sin(ref[2]))
+                )
+            if weights.manipulability > 0.0:
+                parts.append(ca.sqrt(weights.manipulability * h_k) * ca.cos(q[4]))
+        target = refs[:, n - 1]
+        error = pose[:2] - target[:2]
+        if config.reach:
+            # 0.5 r^2 = huber(|e|) / reach_speed: |e| / reach_speed far from the target.
+            delta = config.huber if config.huber is not None else 0.01
+            gain = 1.0 / math.sqrt(delta * config.reach_speed)
+            parts.append(gain * self._huber_scale(error, delta) * error)
+            parts.append(math.sqrt(HORIZON_SMOOTHING) * (nodes[0][self.nxm] - horizon_prev))
+        elif weights.terminal > 0.0:
+            z = self._terminal_error(xs[n], pose, target)
+            parts.append(
+                math.sqrt(weights.terminal)
+                * ca.sqrt(target[3])
+                * self._huber_scale(error, config.huber)
+                * (factor.T @ z)
+            )
+        return ca.vertcat(*parts)
+
+    def _terminal_error(self, x_n, pose, ref) -> ca.SX:
+        """End-effector error in the terminal base frame (and the base velocities)."""
+        phi = x_n[2]
+        c, s = ca.cos(phi), ca.sin(phi)
+        ex, ey = pose[0] - ref[0], pose[1] - ref[1]
+        parts = [c * ex + s * ey, -s * ex + c * ey]
+        if self.config.track_orientation:
+            parts.append(ca.sin(pose[2] - ref[2]))
+        if self.nxm > sym.NQ:
+            parts.extend([x_n[5], x_n[6]])
+        return ca.vertcat(*parts)
+
+    # -- numbers per solve ----------------------------------------------------------------
+    def parameters(
+        self,
+        references: np.ndarray,
+        u_prev: np.ndarray,
+        terminal_factor: np.ndarray | None = None,
+        node_weights: np.ndarray | None = None,
+        horizon_prev: float | None = None,
+    ) -> np.ndarray:
+        """Parameter vector: node references (N, 3), previous command (model input), ``L``
+        (tracking), node tracking weights (N,; default 1), previous horizon (reach)."""
+        n = self.N
+        block = np.ones((n, 4))
+        block[:, :3] = references
+        if node_weights is not None:
+            block[:, 3] = node_weights
+        nz = self.terminal_size
+        factor = np.eye(nz) if terminal_factor is None else terminal_factor
+        previous = self.config.horizon if horizon_prev is None else horizon_prev
+        return np.concatenate(
+            [block.ravel(), np.ravel(u_prev), np.ravel(factor), [previous]]
+        ).astype(float)
+
+    def bounds(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Decision bounds with the model state of node 0 pinned to the measured ``x0``."""
+        lower, upper = self.w_lower.copy(), self.w_upper.copy()
+        s = self.x_slices[0]
+        lower[s] = upper[s] = x0
+        return lower, upper
+
+    def first_input(self, w: np.ndarray) -> np.ndarray:
+        """``u_0`` of a solution (the model's input, without slacks)."""
+        return np.asarray(w[self.u_slices[0]], dtype=float)
+
+    def horizon_of(self, w: np.ndarray) -> float:
+        """The horizon T (s) of a solution (the fixed horizon in tracking mode)."""
+        index = self.horizon_index
+        return self.config.horizon if index is None else float(w[index])
+
+    def trajectories(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Node states (N+1, nx) and stage inputs with slacks (N, nu) of a solution."""
+        w = np.asarray(w, dtype=float).ravel()
+        nx, nu, n = self.nx, self.nu, self.N
+        xs = np.empty((n + 1, nx))
+        body = w[: n * (nx + nu)].reshape(n, nx + nu)
+        xs[:n] = body[:, :nx]
+        xs[n] = w[n * (nx + nu) :]
+        return xs, body[:, nx:].copy()
+
+    def pack(self, xs: np.ndarray, us: np.ndarray) -> np.ndarray:
+        """Inverse of :meth:`trajectories`."""
+        n = self.N
+        body = np.hstack([xs[:n], us])
+        return np.concatenate([body.ravel(), xs[n]])
+
+
+def grid_intervals(intervals: int, first: float, horizon: float) -> np.ndarray:
+    """``intervals`` lengths ``first r^k`` (s), r >= 1 chosen so that they sum to ``horizon``."""
+    n = intervals
+    if isinstance(n, bool) or not float(n).is_integer() or not 2 <= n <= 200:
+        raise ParameterError(f"intervals must be an integer in [2, 200] (got {intervals!r})")
+    n = int(n)
+    first = check_positive("first_interval", first)
+    horizon = check_positive("horizon", horizon)
+    if horizon < n * first * (1.0 - 1e-9):
+        raise ParameterError(
+            f"horizon must be >= intervals x first_interval = {n * first:g} s (got {horizon:g})"
+        )
+    if horizon <= n * first * (1.0 + 1e-12):
+        return np.full(n, horizon / n)
+    low, high = 1.0, 2.0
+    while first * (high**n - 1.0) / (high - 1.0) < horizon:
+        high *= 2.0
+    for _ in range(200):  # bisection on the geometric sum
+        ratio = 0.5 * (low + high)
+        if first * (ratio**n - 1.0) / (ratio - 1.0) < horizon:
+            low = ratio
+        else:
+            high = ratio
+    lengths = first * (0.5 * (low + high)) ** np.arange(n)
+    return lengths * (horizon / lengths.sum())

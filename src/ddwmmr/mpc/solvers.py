@@ -1,0 +1,257 @@
+"""Solvers of the MPC's OCP: Gauss-Newton SQP / real-time iteration, and CasADi's nlpsol.
+
+* :class:`GaussNewtonSQP` (names ``"rti"`` and ``"sqp"``, QP backend ``qp_solver``): the
+  cost is a sum of squares ``0.5 ||r(w)||^2 + c' w``, so the Gauss-Newton Hessian
+  ``J_r' J_r`` is a positive semi-definite, stage-wise block-diagonal matrix and every
+  iteration is one convex QP in the stage-wise OCP structure::
+
+      min_d  0.5 d' (J_r' J_r + eps I) d + (J_r' r + c)' d
+      s.t.   lbg - g(w) <= J_g d <= ubg - g(w),   lbw - w <= d <= ubw - w
+
+  followed by the full step ``w += d``. ``"rti"`` does one iteration per control step
+  (the real-time iteration: the warm start comes from the shifted previous solution, so one
+  step tracks the moving optimum); ``"sqp"`` iterates until the step is below
+  ``tolerance``. The QP data (Hessian, gradient, constraint Jacobian) are one CasADi
+  function of (w, p).
+* :class:`NLPSolver` (``"ipopt"``, ``"sqpmethod"``, ``"fatrop"``): CasADi's ``nlpsol`` on the
+  same problem with exact Hessians, warm-started with the primal guess (and the previous
+  multipliers).
+
+A failed solve raises :class:`SolverFailure`; the controller falls back to the ``qp``
+command for that step.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import casadi as ca
+import numpy as np
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.mpc.ocp import ShootingOCP
+
+#: Levenberg-Marquardt floor added to the Gauss-Newton Hessian (keeps it positive definite).
+HESSIAN_FLOOR = 1e-6
+#: QP backends reachable through ``casadi.conic`` that handle this problem.
+QP_SOLVERS = ("hpipm", "qrqp", "osqp", "daqp", "proxqp")
+#: Solver names accepted by :func:`make_solver`.
+SOLVERS = ("rti", "sqp", "ipopt", "sqpmethod", "fatrop")
+#: HPIPM return codes accepted: 0 converged, 1 iteration limit (its iterate is used, see
+#: docs/mpc.md "Solver"); 2 (minimum step) and 3 (NaN) are failures.
+HPIPM_ACCEPTED = (0, 1)
+
+
+class SolverFailure(RuntimeError):
+    """The OCP solve failed (infeasible QP, iteration failure, non-finite result)."""
+
+
+def _conic_options(ocp: ShootingOCP, name: str) -> dict[str, Any]:
+    options: dict[str, Any] = {"error_on_fail": False}
+    if name == "hpipm":
+        options.update(
+            N=ocp.N,
+            nx=[ocp.nx] * (ocp.N + 1),
+            nu=[ocp.nu] * ocp.N + [0],
+            ng=list(ocp.ng),
+            hpipm={"mode": "speed", "iter_max": 30},
+        )
+    elif name == "qrqp":
+        options.update(print_iter=False, print_header=False, print_info=False)
+    elif name == "osqp":
+        options["osqp"] = {"verbose": False, "eps_abs": 1e-6, "eps_rel": 1e-6, "max_iter": 4000}
+    return options
+
+
+class GaussNewtonSQP:
+    """Gauss-Newton SQP on a :class:`ShootingOCP`; ``iterations=1`` is the RTI scheme.
+
+    Args:
+        ocp: the problem.
+        qp_solver: a ``casadi.conic`` plugin from :data:`QP_SOLVERS`.
+        iterations: maximum SQP iterations per call.
+        tolerance: stop when ``max|d|`` falls below it.
+        proximal: weight of ``|d_u / u_scale|^2`` added to the QP (a Levenberg-Marquardt /
+            proximal term on the input steps).
+    """
+
+    def __init__(
+        self,
+        ocp: ShootingOCP,
+        qp_solver: str = "hpipm",
+        iterations: int = 1,
+        tolerance: float = 1e-6,
+        proximal: float = 0.0,
+    ) -> None:
+        if qp_solver not in QP_SOLVERS:
+            raise ParameterError(
+                f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {qp_solver!r})"
+            )
+        self.ocp = ocp
+        self.qp_solver = qp_solver
+        self.iterations = iterations
+        self.tolerance = tolerance
+        w, p = ocp.w, ocp.p
+        jr = ca.jacobian(ocp.residual, w)
+        jg = ca.jacobian(ocp.g, w)
+        diagonal = np.full(ocp.nw, HESSIAN_FLOOR)
+        scale = np.asarray(ocp.model.u_scale, dtype=float)
+        reference = float(np.max(ocp.lengths))
+        for s, length in zip(ocp.u_slices, ocp.lengths):
+            # Proximal term on the inputs, per second of interval like the cost: damps the
+            # step from the warm start, so that one iteration per control step cannot
+            # jump between two distant plans.
+            diagonal[s] += proximal * (length / reference) / scale**2
+        hessian = ca.mtimes(jr.T, jr) + ca.diag(ca.DM(diagonal))
+        gradient = ca.mtimes(jr.T, ocp.residual) + ca.DM(ocp.linear_cost)
+        self._data = ca.Function("qp_data", [w, p], [hessian, gradient, jg, ocp.g], {"cse": True})
+        self._qp = ca.conic(
+            "qp",
+            qp_solver,
+            {"h": hessian.sparsity(), "a": jg.sparsity()},
+            _conic_options(ocp, qp_solver),
+        )
+        self.last_iterations = 0
+        #: Multipliers (constraints, bounds) of the last QP: at a converged point (step
+        #: zero) they are the NLP's multipliers.
+        self.last_multipliers: tuple[Any, Any] | None = None
+
+    def solve(
+        self,
+        w0: np.ndarray,
+        p: np.ndarray,
+        lbw: np.ndarray,
+        ubw: np.ndarray,
+        lbg: np.ndarray,
+        ubg: np.ndarray,
+    ) -> np.ndarray:
+        """Iterate from ``w0``; returns the new decision vector or raises SolverFailure."""
+        w = np.asarray(w0, dtype=float)
+        for iteration in range(1, self.iterations + 1):
+            # Two calls (data, then QP): CasADi 3.8 crashes when the HPIPM conic is
+            # embedded in an MX function, so the QP is not fused with its data.
+            try:
+                hessian, gradient, jac, g = self._data(w, p)
+                g = np.asarray(g, dtype=float).ravel()
+                solution = self._qp(
+                    h=hessian, g=gradient, a=jac, lba=lbg - g, uba=ubg - g, lbx=lbw - w, ubx=ubw - w
+                )
+            except RuntimeError as error:  # CasADi reports solver exceptions this way
+                raise SolverFailure(f"{self.qp_solver}: {str(error).splitlines()[-1]}") from None
+            self._check()
+            d = np.asarray(solution["x"], dtype=float).ravel()
+            if not np.all(np.isfinite(d)):
+                raise SolverFailure(f"{self.qp_solver}: non-finite step")
+            w = w + d
+            self.last_multipliers = (solution["lam_a"], solution["lam_x"])
+            self.last_iterations = iteration
+            if np.max(np.abs(d)) < self.tolerance:
+                break
+        return w
+
+    def _check(self) -> None:
+        stats = self._qp.stats()
+        if self.qp_solver == "hpipm":
+            status = stats.get("return_status")
+            if status not in HPIPM_ACCEPTED:
+                raise SolverFailure(f"hpipm: return status {status}")
+        elif not stats.get("success", False):
+            raise SolverFailure(f"{self.qp_solver}: {stats.get('return_status')}")
+
+
+class NLPSolver:
+    """CasADi ``nlpsol`` (``ipopt``, ``sqpmethod``, ``fatrop``) on a :class:`ShootingOCP`."""
+
+    def __init__(self, ocp: ShootingOCP, name: str, options: dict[str, Any] | None = None):
+        self.ocp = ocp
+        self.name = name
+        objective = 0.5 * ca.sumsqr(ocp.residual) + ca.dot(ca.DM(ocp.linear_cost), ocp.w)
+        nlp = {"x": ocp.w, "p": ocp.p, "f": objective, "g": ocp.g}
+        opts: dict[str, Any] = {"error_on_fail": False}
+        if name == "ipopt":
+            opts.update(
+                {
+                    "print_time": False,
+                    "ipopt.print_level": 0,
+                    "ipopt.sb": "yes",
+                    "ipopt.warm_start_init_point": "yes",
+                    "ipopt.tol": 1e-6,
+                    "ipopt.max_iter": 200,
+                }
+            )
+        elif name == "sqpmethod":
+            opts.update(
+                {
+                    "qpsol": "qrqp",
+                    "qpsol_options": {"print_iter": False, "print_header": False},
+                    "print_header": False,
+                    "print_iteration": False,
+                    "print_status": False,
+                    "print_time": False,
+                    "max_iter": 50,
+                    "convexify_strategy": "regularize",
+                }
+            )
+        elif name == "fatrop":
+            opts.update(
+                {
+                    "structure_detection": "manual",
+                    "N": ocp.N,
+                    "nx": [ocp.nx] * (ocp.N + 1),
+                    "nu": [ocp.nu] * ocp.N + [0],
+                    "ng": list(ocp.ng),
+                    "print_time": False,
+                    "fatrop.print_level": 0,
+                }
+            )
+        opts.update(options or {})
+        self._solver = ca.nlpsol("mpc", name, nlp, opts)
+        self._lam_g: np.ndarray | None = None
+        self._lam_x: np.ndarray | None = None
+        self.last_iterations = 0
+
+    def solve(self, w0, p, lbw, ubw, lbg, ubg) -> np.ndarray:
+        """Solve from the primal guess ``w0``; raises SolverFailure."""
+        args = {"x0": w0, "p": p, "lbx": lbw, "ubx": ubw, "lbg": lbg, "ubg": ubg}
+        if self._lam_g is not None:
+            args.update(lam_g0=self._lam_g, lam_x0=self._lam_x)
+        try:
+            solution = self._solver(**args)
+        except RuntimeError as error:  # CasADi reports solver exceptions this way
+            raise SolverFailure(f"{self.name}: {str(error).splitlines()[-1]}") from None
+        stats = self._solver.stats()
+        self.last_iterations = int(stats.get("iter_count", 0))
+        if not stats.get("success", False):
+            raise SolverFailure(f"{self.name}: {stats.get('return_status')}")
+        w = np.asarray(solution["x"], dtype=float).ravel()
+        if not np.all(np.isfinite(w)):
+            raise SolverFailure(f"{self.name}: non-finite solution")
+        self._lam_g = np.asarray(solution["lam_g"], dtype=float).ravel()
+        self._lam_x = np.asarray(solution["lam_x"], dtype=float).ravel()
+        return w
+
+    def reset(self) -> None:
+        """Forget the multipliers of the previous solve."""
+        self._lam_g = self._lam_x = None
+
+
+def make_solver(
+    name: str,
+    ocp: ShootingOCP,
+    qp_solver: str = "hpipm",
+    *,
+    proximal: float = 0.0,
+    iterations: int | None = None,
+) -> Any:
+    """The solver ``name`` (see :data:`SOLVERS`) for ``ocp``.
+
+    ``rti`` is one Gauss-Newton iteration, ``sqp`` up to ``iterations`` (default 20);
+    ``proximal`` damps the input steps of both.
+    """
+    if name == "rti":
+        return GaussNewtonSQP(ocp, qp_solver, iterations=1, proximal=proximal)
+    if name == "sqp":
+        return GaussNewtonSQP(ocp, qp_solver, iterations=iterations or 20, proximal=proximal)
+    if name in ("ipopt", "sqpmethod", "fatrop"):
+        return NLPSolver(ocp, name)
+    raise ParameterError(f"solver must be one of {', '.join(SOLVERS)} (got {name!r})")

@@ -1,0 +1,97 @@
+"""LQR terminal cost of the MPC, designed with python-control on the linearised model.
+
+Beyond the horizon the MPC assumes the linearised end-effector error dynamics, regulated by
+the LQR law of the same stage cost; the terminal cost is that law's cost-to-go
+``z' P z``. The error ``z`` is written in the base frame (``R(-phi) (p_E - p_ref)``, plus
+the orientation error when tracked), so one design holds at every heading:
+
+* kinematic model, inputs ``u = (v, w, th1dot, th2dot)``: ``zdot = A_B(th1, th2) u`` with
+  ``A_B`` the end-effector Jacobian in the base frame (``J_E G`` at phi = 0);
+* thesis model, inputs ``(F_left, F_right, th1dot, th2dot)``, state ``z = [e, v, w]``:
+  ``edot = A_B [v, w, th1dot, th2dot]``, ``m vdot = F_l + F_r - c1 v``,
+  ``I wdot = (F_r - F_l) width/2 - c2 w``.
+
+Both are discretised with a zero-order hold over the last shooting interval h
+(``control.c2d``) and solved with ``control.dlqr`` with ``Q = h diag(Wp, Wp[, Wo], 0, 0)``
+and ``R = h Wu diag(1/u_scale^2)``: the same weights as the OCP's stage cost.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from ddwmmr.model import Robot
+from ddwmmr.model import kinematics as kin
+from ddwmmr.mpc.models import PredictionModel, ThesisPrediction
+from ddwmmr.mpc.ocp import OCPConfig
+
+#: Added to R's diagonal so the design stays well posed with a zero input weight.
+R_FLOOR = 1e-9
+
+
+@dataclass(frozen=True)
+class TerminalDesign:
+    """One LQR design: the discrete system, the weights and the results.
+
+    Attributes:
+        A, B: discretised error dynamics (nz x nz, nz x nu); Q, R: weights.
+        P: Riccati solution (cost-to-go ``z' P z``); K: gain ``u = -K z``.
+        poles: closed-loop eigenvalues (discrete, |.| < 1); factor: ``L`` with P = L L'.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    P: np.ndarray
+    K: np.ndarray
+    poles: np.ndarray
+    factor: np.ndarray
+
+
+def error_dynamics(
+    robot: Robot, model: PredictionModel, arm_pose: tuple[float, float], track_orientation: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """Continuous-time ``(A, B)`` of the terminal error ``z`` at arm pose (th1, th2) (rad)."""
+    jac = kin.end_effector_jacobian_u(robot.L1, robot.L2, [0.0, 0.0, 0.0, *arm_pose])
+    rows = 3 if track_orientation else 2
+    jac = jac[:rows]
+    if not isinstance(model, ThesisPrediction):
+        return np.zeros((rows, rows)), jac
+    d = model.dynamics
+    inertia = d.inertia(arm_pose[1])
+    nz = rows + 2
+    A = np.zeros((nz, nz))
+    B = np.zeros((nz, 4))
+    A[:rows, rows] = jac[:, 0]  # edot from v
+    A[:rows, rows + 1] = jac[:, 1]  # edot from w
+    B[:rows, 2:] = jac[:, 2:]  # edot from the joint rates
+    A[rows, rows] = -d.c1 / d.mass
+    B[rows, :2] = 1.0 / d.mass
+    A[rows + 1, rows + 1] = -d.c2 / inertia
+    B[rows + 1, 0], B[rows + 1, 1] = -d.half_width / inertia, d.half_width / inertia
+    return A, B
+
+
+def design(
+    robot: Robot, model: PredictionModel, config: OCPConfig, arm_pose: tuple[float, float]
+) -> TerminalDesign:
+    """The LQR terminal design for ``config``'s weights and interval at ``arm_pose``."""
+    A, B = error_dynamics(robot, model, arm_pose, config.track_orientation)
+    nz = A.shape[0]
+    h, weights = float(config.interval_lengths()[-1]), config.weights
+    discrete = control.c2d(control.ss(A, B, np.eye(nz), np.zeros((nz, B.shape[1]))), h)
+    Ad, Bd = np.asarray(discrete.A), np.asarray(discrete.B)
+    q = np.zeros(nz)
+    q[:2] = weights.position
+    if config.track_orientation:
+        q[2] = weights.orientation
+    Q = h * np.diag(q)
+    R = h * np.diag(weights.input / np.asarray(model.u_scale, dtype=float) ** 2 + R_FLOOR)
+    K, P, poles = control.dlqr(Ad, Bd, Q, R)
+    P = 0.5 * (P + P.T)
+    factor = np.linalg.cholesky(P + 1e-12 * np.eye(nz))
+    return TerminalDesign(Ad, Bd, Q, R, P, np.asarray(K), np.asarray(poles), factor)

@@ -1,0 +1,349 @@
+"""Method ``mpc``: registry, options, constraints along runs, fallback, determinism, solvers."""
+
+from __future__ import annotations
+
+import math
+
+import casadi as ca
+import control
+import numpy as np
+import pytest
+
+from ddwmmr import Ellipse, ParameterError, Robot, available_methods, make_controller, simulate
+from ddwmmr.behaviours.objective import default_pose
+from ddwmmr.commands import WheelForces
+from ddwmmr.model import symbolic as sym
+from ddwmmr.mpc import terminal
+from ddwmmr.mpc.models import KinematicPrediction, ThesisPrediction
+from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights, grid_intervals
+from ddwmmr.mpc.solvers import GaussNewtonSQP, NLPSolver, SolverFailure
+from ddwmmr.plants.thesis import ThesisPlant, ThesisState
+
+HEAVY = Robot().with_payload(3.0)
+
+
+def run_thesis_plant(controller, target, steps, dt=0.01, state=None):
+    """Closed loop of a force-level controller on the thesis plant (like the scenario loop).
+
+    Returns the commands and the states after each step."""
+    plant = ThesisPlant(controller.robot)
+    state = state or ThesisState(0.0, 0.0, 0.0, *default_pose(controller.robot))
+    controller.reset(None, np.array(state.q))
+    commands, states = [], []
+    for k in range(steps):
+        command = controller.command(
+            k * dt,
+            np.array(state.q),
+            np.array([*target, 0.0]),
+            np.zeros(3),
+            base_velocity=(state.v, state.w),
+        )
+        commands.append(command)
+        plant.step(state, command.left, command.right, (command.th1_target, command.th2_target), dt)
+        states.append(state.copy())
+    return commands, states
+
+
+def test_registered_with_its_interfaces():
+    assert "mpc" in available_methods()
+    kinematic = make_controller("mpc", Robot())
+    assert kinematic.interface == "velocity" and kinematic.zero_order_hold
+    assert not kinematic.wants_base_velocity
+    thesis = make_controller("mpc", HEAVY, model="thesis")
+    assert thesis.interface == "force" and thesis.wants_base_velocity
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"model": "mujoco"}, "model must be one of kinematic, thesis"),
+        ({"solver": "snopt"}, "solver must be one of rti, sqp, ipopt, sqpmethod, fatrop"),
+        ({"qp_solver": "gurobi"}, "qp_solver must be one of"),
+        ({"horizon": -1.0}, "horizon must be > 0"),
+        ({"intervals": 1}, "intervals must be an integer in [2, 200]"),
+        ({"intervals": 2.5}, "intervals must be an integer in [2, 200]"),
+        ({"horizon": 0.5, "intervals": 20, "first_interval": 0.1}, "horizon must be >="),
+        ({"stability_min": 12.0}, "stability_min must be in (0, 10)"),
+        ({"manipulability_weight": -1.0}, "manipulability_weight must be >= 0"),
+        ({"reach_speed": 0.0}, "reach_speed must be > 0"),
+        ({"dt": 0.0}, "dt must be > 0"),
+        ({"obstacles": [(1.0, 2.0)]}, "obstacles must be Circle(x, y, radius)"),
+        ({"colour": "red"}, "unknown option 'colour'"),
+    ],
+)
+def test_bad_options_are_one_line_errors(options, message):
+    with pytest.raises(ParameterError) as error:
+        make_controller("mpc", Robot(), **options)
+    assert message in str(error.value)
+    assert "\n" not in str(error.value)
+
+
+def test_tracking_run_respects_every_bound_and_beats_the_qp_on_the_ellipse():
+    robot = Robot()
+    trajectory = Ellipse(T=20.0, N=1000)
+    result = simulate(robot, trajectory, "mpc", integrator="euler", duration=6.0)
+    ts, summary = result.timeseries, result.summary
+    assert summary["mpc_fallbacks"] == 0 and summary["stability_violations"] == 0
+    assert summary["saturated_steps"] == 0  # the commands already respect the limits
+    wheels = np.maximum(np.abs(ts["wheel_left_rad_s"]), np.abs(ts["wheel_right_rad_s"]))
+    assert np.max(wheels) <= robot.wheel_speed_limit
+    assert np.max(np.abs(ts["th1dot"])) <= robot.joint_speed_limit
+    assert np.max(np.abs(ts["th2dot"])) <= robot.joint_speed_limit
+    # converges from the 3 cm initial offset: the last 3 s within 1 mm
+    late = ts["t"] >= 3.0
+    assert np.max(ts["position_error_m"][late]) < 1e-3
+    qp = simulate(robot, trajectory, "qp", integrator="euler", duration=6.0).summary
+    assert summary["rms_position_error_m"] < qp["rms_position_error_m"]
+
+
+def test_stability_floor_holds_at_every_step_when_it_binds():
+    """A target 0.6 m to the side: reaching it with the arm first (the fastest way) would
+    take S towards 1.0. The floor (1.25, kept with the 0.01 margin) binds and holds at every
+    step; forces and joint rates stay in bounds."""
+    controller = make_controller("mpc", HEAVY, model="thesis", track_orientation=False, dt=0.01)
+    commands, states = run_thesis_plant(controller, (0.3, 0.6), steps=300)
+    s = np.array([HEAVY.stability(state.q)[2] for state in states])
+    assert np.min(s) >= 1.25
+    assert np.min(s) < 1.27  # the floor is active (the fastest reach stretches the arm)
+    forces = np.array([[c.left, c.right] for c in commands])
+    assert np.max(np.abs(forces)) <= 10.0 + 1e-9
+    steps = np.diff(np.array([[st.th1, st.th2] for st in states]), axis=0)
+    assert np.max(np.abs(steps)) <= 2.0 * 0.01 + 1e-9
+    xe, ye, _ = HEAVY.fk(np.array(states[-1].q))
+    assert math.hypot(xe - 0.3, ye - 0.6) < 0.01  # and it got there
+    assert controller.fallbacks == 0
+
+
+def test_runs_are_deterministic():
+    def run():
+        controller = make_controller("mpc", HEAVY, model="thesis", track_orientation=False)
+        commands, _ = run_thesis_plant(controller, (1.5, -1.0), steps=120)
+        return np.array([[c.left, c.right, c.th1_target, c.th2_target] for c in commands])
+
+    first, second = run(), run()
+    np.testing.assert_array_equal(first, second)
+
+
+def test_solver_failure_falls_back_to_the_qp_command_and_is_counted(monkeypatch):
+    controller = make_controller("mpc", HEAVY, model="thesis", track_orientation=False, dt=0.01)
+    run_thesis_plant(controller, (2.0, 1.0), steps=5)  # builds the problem
+    problem = next(iter(controller._problems.values()))
+
+    def fail(*args, **kwargs):
+        raise SolverFailure("forced")
+
+    monkeypatch.setattr(problem.solver, "solve", fail)
+    monkeypatch.setattr(problem.cold, "solve", fail)
+    state = ThesisState(0.2, 0.1, 0.3, *default_pose(HEAVY), 0.4, 0.1)
+    command = controller.command(
+        0.0, np.array(state.q), np.array([2.0, 1.0, 0.0]), np.zeros(3), base_velocity=(0.4, 0.1)
+    )
+    assert isinstance(command, WheelForces)
+    assert controller.last.fallback and controller.fallbacks == 1
+    values = [command.left, command.right, command.th1_target, command.th2_target]
+    assert all(math.isfinite(v) for v in values)
+    # the qp's velocity command (a fresh twin, slewing from the measured velocity), through
+    # the model-based velocity loop of the plant
+    qp = controller._make_fallback()
+    qp.ctx.previous_command = (0.4, 0.1)
+    u = qp.command(0.0, np.array(state.q), np.array([2.0, 1.0, 0.0]), np.zeros(3))
+    expected = controller.dynamics.velocity_tracking_forces(0.4, 0.1, u[0], u[1], state.th2)
+    assert (command.left, command.right) == pytest.approx(expected, abs=1e-9)
+    assert abs(command.left) <= 10.0 and abs(command.right) <= 10.0
+    summary = controller.summarize({"stability": np.array([1.5, 1.6]), "fallback": np.ones(2)})
+    assert summary["mpc_fallbacks"] == 2
+
+
+def test_kinematic_fallback_returns_the_qp_velocity_command(monkeypatch):
+    robot = Robot()
+    controller = make_controller("mpc", robot, dt=0.02)
+    trajectory = Ellipse()
+    q0 = robot.base_for_end_effector(trajectory.pose(0.0), *robot.home_pose)
+    controller.reset(trajectory, q0)
+    controller.command(0.0, q0, trajectory.pose(0.0), trajectory.velocity(0.0))
+    problem = next(iter(controller._problems.values()))
+    monkeypatch.setattr(
+        problem.solver, "solve", lambda *a, **k: (_ for _ in ()).throw(SolverFailure("forced"))
+    )
+    u = controller.command(0.02, q0, trajectory.pose(0.02), trajectory.velocity(0.02))
+    reference = make_controller("qp", robot, dt=0.02)
+    reference.reset(trajectory, q0)
+    expected = reference.command(0.02, q0, trajectory.pose(0.02), trajectory.velocity(0.02))
+    np.testing.assert_allclose(u, expected, atol=1e-9)
+    assert controller.last.fallback
+
+
+def test_grid_sums_to_the_horizon_and_grows_geometrically():
+    lengths = grid_intervals(10, 0.05, 2.0)
+    assert lengths.sum() == pytest.approx(2.0)
+    ratios = lengths[1:] / lengths[:-1]
+    np.testing.assert_allclose(ratios, ratios[0], rtol=1e-9)
+    assert lengths[0] == pytest.approx(0.05, rel=1e-6) and ratios[0] > 1.0
+    np.testing.assert_allclose(grid_intervals(4, 0.25, 1.0), 0.25)
+    config = OCPConfig(intervals=5, control_interval=0.01, first_interval=0.25, horizon=1.01)
+    np.testing.assert_allclose(config.interval_lengths(), [0.01, 0.25, 0.25, 0.25, 0.25])
+
+
+@pytest.mark.parametrize("reach", [False, True])
+def test_gauss_newton_sqp_on_hpipm_converges_to_a_kkt_point_of_the_ocp(reach):
+    """Iterated to a zero step, the structured QP path (Gauss-Newton SQP on HPIPM) stops at a
+    KKT point of the NLP: stationarity with the last QP's multipliers, every constraint
+    met. IPOPT (exact Hessian) started there finds no better point than 0.2 % (the problem
+    is non-convex: both are local solutions)."""
+    robot = HEAVY
+    model = ThesisPrediction(robot, sym.ThesisDynamics.from_robot(robot))
+    config = OCPConfig(
+        intervals=8,
+        control_interval=0.01,
+        first_interval=0.1,
+        horizon=1.5,
+        reach=reach,
+        track_orientation=False,
+        huber=0.01 if reach else None,
+        weights=Weights(position=50.0, manipulability=0.5, input=0.01, terminal=0.0),
+    )
+    ocp = ShootingOCP(robot, model, config)
+    x0 = np.array([0.0, 0.0, 0.2, *default_pose(robot), 0.3, -0.1])
+    node = np.concatenate([x0, [config.horizon]])[: ocp.nx]
+    guess = ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
+    p = ocp.parameters(np.tile([0.9, 0.4, 0.0], (ocp.N, 1)), np.zeros(4))
+    lbw, ubw = ocp.bounds(x0)
+    sqp = GaussNewtonSQP(ocp, "hpipm", iterations=100, tolerance=1e-10)
+    w = sqp.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+    assert sqp.last_iterations < 100
+    objective = 0.5 * ca.sumsqr(ocp.residual) + ca.dot(ocp.linear_cost, ocp.w)
+    lam_g, lam_x = (np.array(m).ravel() for m in sqp.last_multipliers)
+    pieces = ca.Function(
+        "kkt", [ocp.w, ocp.p], [ca.gradient(objective, ocp.w), ca.jacobian(ocp.g, ocp.w), ocp.g]
+    )
+    gradient, jacobian, g = (np.array(v) for v in pieces(w, p))
+    stationarity = gradient.ravel() + jacobian.T @ lam_g + lam_x
+    assert np.max(np.abs(stationarity)) < 1e-6 * max(1.0, np.max(np.abs(gradient)))
+    assert np.all(g.ravel() >= ocp.lbg - 1e-8) and np.all(g.ravel() <= ocp.ubg + 1e-8)
+    assert np.all(w >= lbw - 1e-9) and np.all(w <= ubw + 1e-9)
+    cost = ca.Function("f", [ocp.w, ocp.p], [objective])
+    w_ipopt = NLPSolver(ocp, "ipopt").solve(w, p, lbw, ubw, ocp.lbg, ocp.ubg)
+    assert float(cost(w_ipopt, p)) >= 0.998 * float(cost(w, p))
+
+
+@pytest.mark.parametrize("model_name", ["kinematic", "thesis"])
+def test_lqr_terminal_cost_solves_the_riccati_equation(model_name):
+    robot = HEAVY
+    if model_name == "thesis":
+        model = ThesisPrediction(robot, sym.ThesisDynamics.from_robot(robot))
+    else:
+        model = KinematicPrediction(robot)
+    config = OCPConfig(intervals=10, control_interval=0.02, first_interval=0.05, horizon=1.0)
+    design = terminal.design(robot, model, config, default_pose(robot))
+    A, B, Q, R, P = design.A, design.B, design.Q, design.R, design.P
+    riccati = A.T @ P @ A - P - A.T @ P @ B @ np.linalg.solve(R + B.T @ P @ B, B.T @ P @ A) + Q
+    assert np.max(np.abs(riccati)) < 1e-8 * max(1.0, np.max(np.abs(P)))
+    assert np.all(np.abs(design.poles) < 1.0)
+    np.testing.assert_allclose(design.factor @ design.factor.T, P, atol=1e-9)
+    K, _, _ = control.dlqr(A, B, Q, R)
+    np.testing.assert_allclose(design.K, K, rtol=1e-9, atol=1e-12)
+
+
+def test_a_broken_qp_raises_solver_failure_not_nan():
+    robot = HEAVY
+    model = ThesisPrediction(robot, sym.ThesisDynamics.from_robot(robot))
+    config = OCPConfig(intervals=4, control_interval=0.01, first_interval=0.1, horizon=0.5)
+    ocp = ShootingOCP(robot, model, config)
+    x0 = np.array([0.0, 0.0, 0.0, *default_pose(robot), 0.0, 0.0])
+    guess = ocp.pack(np.tile(x0, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
+    p = ocp.parameters(np.full((ocp.N, 3), np.nan), np.zeros(4))
+    lbw, ubw = ocp.bounds(x0)
+    with pytest.raises(SolverFailure):
+        GaussNewtonSQP(ocp, "hpipm").solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+
+
+def test_docs_page_snippet_runs():
+    """The python block of docs/mpc.md runs; the rectangle meets its tracking target
+    (<= 0.5 x clrrmc-ts's 47 mm) without a fallback and the thesis model returns forces."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "docs" / "mpc.md").read_text()
+    blocks = [part.split("```", 1)[0] for part in text.split("```python\n")[1:]]
+    assert blocks
+    namespace: dict = {}
+    for block in blocks:
+        exec(compile(block, "docs/mpc.md", "exec"), namespace)
+    assert namespace["result"].summary["rms_position_error_m"] < 0.0235
+    assert namespace["result"].summary["mpc_fallbacks"] == 0
+    forces = namespace["forces"]
+    assert isinstance(forces, WheelForces) and abs(forces.left) <= 10.0
+
+
+def test_warm_start_shift_interpolates_like_numpy(rng):
+    from ddwmmr.mpc.controller import _interpolate_rows
+
+    times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.5, 12))])
+    rows = rng.normal(size=(13, 8))
+    at = np.sort(rng.uniform(-0.2, times[-1] + 0.3, 13))
+    expected = np.column_stack([np.interp(at, times, rows[:, i]) for i in range(8)])
+    np.testing.assert_allclose(_interpolate_rows(times, rows, at), expected, atol=1e-14)
+
+
+def test_a_stalled_waypoint_approach_restarts_cold():
+    """If the end effector does not move for 0.5 s short of the target (here: a plant that
+    ignores the commands), the controller drops its plan and starts cold."""
+    controller = make_controller("mpc", HEAVY, model="thesis", track_orientation=False, dt=0.01)
+    q = np.array([0.0, 0.0, 0.0, *default_pose(HEAVY)])
+    controller.reset(None, q)
+    for k in range(120):
+        controller.command(
+            k * 0.01, q, np.array([1.0, 0.5, 0.0]), np.zeros(3), base_velocity=(0.0, 0.0)
+        )
+    assert controller.restarts == 2  # at 0.51 s and 1.02 s
+    assert controller.summarize({"stability": np.array([1.5])})["mpc_restarts"] == 2
+
+
+def test_minimum_time_of_one_waypoint_is_feasible_and_equals_the_physical_bound():
+    from scipy.optimize import brentq
+
+    from ddwmmr.mpc.min_time import MinimumTimeProblem, solve_minimum_time, verify
+
+    robot = HEAVY
+    start = [0.0, 0.0, 0.0, *default_pose(robot), 0.0, 0.0]
+    target = (3.0, 0.0)
+    problem = MinimumTimeProblem(robot, [target], start, intervals_per_leg=12)
+    result = solve_minimum_time(problem)
+    check = verify(problem, result)
+    assert result.success
+    assert check["max_miss_m"] < 0.011
+    assert check["min_stability"] > 1.245
+    assert check["max_force_n"] <= 10.0 + 1e-6 and check["max_joint_rate"] <= 2.0 + 1e-6
+    # From rest with the full 20 N the base covers at most v_top (t - tau (1 - exp(-t/tau))),
+    # tau = m/c1; the end effector is at most L1 + L2 ahead of the base. Straight ahead this
+    # bound is attainable (full force, arm stretched forwards: S_lon stays above 1.25), and
+    # the OCP finds it.
+    d = sym.ThesisDynamics.from_robot(robot)
+    tau, top = d.mass / d.c1, d.top_speed
+    needed = target[0] - robot.reach - 0.01
+    bound = brentq(lambda t: top * (t - tau * (1 - math.exp(-t / tau))) - needed, 0.0, 60.0)
+    assert result.total == pytest.approx(bound, abs=1e-3)
+
+
+def test_obstacle_on_the_straight_line_is_passed_with_its_clearance():
+    """A 0.3 m post on the way to the target: the base's enclosing circle (r = 0.285 m, the
+    scenario protocol's collision test) keeps the 0.05 m margin, and the target is reached."""
+    post = (1.5, 0.05, 0.3)
+    controller = make_controller(
+        "mpc", HEAVY, model="thesis", track_orientation=False, dt=0.01, obstacles=[post]
+    )
+    _, states = run_thesis_plant(controller, (3.2, 0.0), steps=700)
+    bubble = math.hypot(0.5 * HEAVY.base_length, 0.5 * HEAVY.base_width)
+    clearance = min(math.hypot(s.x - post[0], s.y - post[1]) - post[2] - bubble for s in states)
+    assert clearance > 0.045
+    ends = [HEAVY.fk(np.array(s.q))[:2] for s in states]
+    assert min(math.hypot(x - 3.2, y) for x, y in ends) <= 0.01
+    assert controller.fallbacks == 0
+    summary = controller.summarize(
+        {
+            "stability": np.array([HEAVY.stability(s.q)[2] for s in states]),
+            "x": np.array([s.x for s in states]),
+            "y": np.array([s.y for s in states]),
+            "phi": np.array([s.phi for s in states]),
+        }
+    )
+    assert summary["min_obstacle_clearance_m"] > 0.045  # the footprint is inside the circle
