@@ -15,22 +15,20 @@ Prints every number it plots (medians over the runs; the machine may be shared).
 from __future__ import annotations
 
 import argparse
-import math
-import time
 from pathlib import Path
 
 import control
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ddwmmr import Rectangle, Robot, make_controller, simulate
+from ddwmmr import Rectangle, Robot, simulate
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc import terminal
 from ddwmmr.mpc.models import KinematicPrediction, ThesisPrediction
 from ddwmmr.mpc.ocp import OCPConfig
-from ddwmmr.plants.thesis import ThesisPlant, ThesisState
-from ddwmmr.scenarios import generate
+from ddwmmr.plants.thesis import ThesisPlant
+from ddwmmr.scenarios import RunConfig, generate, run_scenario
 from ddwmmr.sim.loops import saturated_velocity_step, step_response, velocity_loop
 
 FIGURES = Path(__file__).parent / "figures"
@@ -135,35 +133,13 @@ def rectangle() -> None:
 
 
 def scenario_time(options: dict, scenarios) -> tuple[float, float]:
-    """Mean scenario time (s) and median step (ms) of mpc on the thesis plant (the loop of
-    ddwmmr.scenarios.protocol, wheel forces and joint targets straight through)."""
-    robot = Robot().with_payload(3.0)
-    totals, steps = [], []
-    for scenario in scenarios:
-        controller = make_controller(
-            "mpc", robot, model="thesis", track_orientation=False, dt=0.01, **options
-        )
-        plant = ThesisPlant(robot)
-        state = ThesisState(0.0, 0.0, 0.0, *default_pose(robot))
-        controller.reset(None, np.array(state.q))
-        index, k = 0, 0
-        for k in range(6001):
-            xe, ye, _ = robot.fk(np.array(state.q))
-            while index < 5 and math.dist((xe, ye), scenario.waypoints[index]) <= 0.01:
-                index += 1
-            if index == 5:
-                break
-            target = np.array([*scenario.waypoints[index], 0.0])
-            began = time.perf_counter()
-            command = controller.command(
-                k * 0.01, np.array(state.q), target, np.zeros(3), base_velocity=(state.v, state.w)
-            )
-            steps.append(time.perf_counter() - began)
-            plant.step(
-                state, command.left, command.right, (command.th1_target, command.th2_target), 0.01
-            )
-        totals.append(k * 0.01)
-    return float(np.mean(totals)), 1e3 * float(np.median(steps))
+    """Mean scenario time (s) and median step (ms) of mpc on the thesis plant (the
+    scenario protocol, ``python -m ddwmmr.scenarios --controller mpc``)."""
+    config = RunConfig(controller="mpc", plant="thesis", controller_options=tuple(options.items()))
+    outcomes = [run_scenario(scenario, config) for scenario in scenarios]
+    totals = [o.metrics["time_s"] for o in outcomes]
+    steps = [o.median_step_us for o in outcomes]
+    return float(np.mean(totals)), 1e-3 * float(np.median(steps))
 
 
 def horizon_study(quick: bool) -> None:

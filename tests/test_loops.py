@@ -94,9 +94,9 @@ def test_velocity_loop_is_first_order_with_the_feed_forward_making_it_exact(band
 
 def test_saturated_velocity_step_matches_the_thesis_plant_under_the_scenario_loop():
     """The nonlinear python-control model of the loop and the real plant driven by the
-    scenario protocol's VelocityLoop agree; small steps follow the linear loop."""
+    thesis plant's VelocityServo agree; small steps follow the linear loop."""
     from ddwmmr.plants.thesis import ThesisPlant, ThesisState
-    from ddwmmr.scenarios.protocol import VelocityLoop
+    from ddwmmr.plants.thesis import VelocityServo as VelocityLoop
     from ddwmmr.sim.loops import saturated_velocity_step, velocity_loop
 
     robot = Robot().with_payload(3.0)
@@ -109,7 +109,7 @@ def test_saturated_velocity_step_matches_the_thesis_plant_under_the_scenario_loo
         speeds = [0.0]
         for _ in range(steps):
             left, right = loop.forces(state, step, 0.0)
-            plant.step(state, left, right, (0.0, 1.5), dt)
+            plant.advance(state, left, right, (0.0, 1.5), dt)
             speeds.append(state.v)
         model = saturated_velocity_step(plant.mass, plant.c1, 10.0, 20.0, step, times)
         np.testing.assert_allclose(model, speeds, atol=2e-3 * step + 1e-4)

@@ -188,7 +188,7 @@ def test_thesis_dynamics_rate_equals_the_plant_over_a_short_step(rng):
         rates = rng.uniform(-1.9, 1.9, 2)
         state = ThesisState(*q, v, w)
         before = np.array([*state.q, state.v, state.w])
-        plant.step(state, *forces, (q[3] + rates[0] * h, q[4] + rates[1] * h), h)
+        plant.advance(state, *forces, (q[3] + rates[0] * h, q[4] + rates[1] * h), h)
         after = np.array([*state.q, state.v, state.w])
         expected = np.array(rhs(before, [*forces, *rates])).ravel()
         np.testing.assert_allclose((after - before) / h, expected, rtol=1e-4, atol=1e-5)
@@ -196,7 +196,7 @@ def test_thesis_dynamics_rate_equals_the_plant_over_a_short_step(rng):
 
 @pytest.mark.parametrize("arm_moves", [False, True])
 def test_thesis_dynamics_integrated_over_a_control_step_matches_the_plant(rng, arm_moves):
-    """RK4 of the model over dt = 0.01 s equals ThesisPlant.step (which integrates v, w
+    """RK4 of the model over dt = 0.01 s equals ThesisPlant.advance (which integrates v, w
     exactly and moves along the mean heading) to the plant's own approximation error.
 
     Positions: the plant moves the travelled distance along the mean heading, the model
@@ -217,7 +217,7 @@ def test_thesis_dynamics_integrated_over_a_control_step_matches_the_plant(rng, a
         command = np.concatenate([rng.uniform(-10, 10, 2), rates])
         state = ThesisState(*q, v, w)
         before = np.array([*state.q, state.v, state.w])
-        plant.step(state, command[0], command[1], tuple(q[3:5] + 0.01 * command[2:]), 0.01)
+        plant.advance(state, command[0], command[1], tuple(q[3:5] + 0.01 * command[2:]), 0.01)
         after = np.array([*state.q, state.v, state.w])
         tolerance = np.array([2e-6, 2e-6, 1e-8, 1e-12, 1e-12, 1e-9, 1e-7])  # RK4 vs exact
         if arm_moves:
@@ -232,7 +232,7 @@ def test_thesis_dynamics_integrated_over_a_control_step_matches_the_plant(rng, a
             outs = []
             for z in (point + delta, point - delta):
                 s = ThesisState(*z[:7])
-                plant.step(s, z[7], z[8], tuple(z[3:5] + 0.01 * z[9:11]), 0.01)
+                plant.advance(s, z[7], z[8], tuple(z[3:5] + 0.01 * z[9:11]), 0.01)
                 outs.append(np.array([*s.q, s.v, s.w]))
             np.testing.assert_allclose(
                 (outs[0] - outs[1]) / 2e-6,
@@ -243,7 +243,7 @@ def test_thesis_dynamics_integrated_over_a_control_step_matches_the_plant(rng, a
 
 
 def test_velocity_tracking_forces_equal_the_scenario_velocity_loop(rng):
-    from ddwmmr.scenarios.protocol import VelocityLoop
+    from ddwmmr.plants.thesis import VelocityServo as VelocityLoop
 
     robot = Robot().with_payload(3.0)
     plant = ThesisPlant(robot)

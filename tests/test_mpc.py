@@ -39,7 +39,9 @@ def run_thesis_plant(controller, target, steps, dt=0.01, state=None):
             base_velocity=(state.v, state.w),
         )
         commands.append(command)
-        plant.step(state, command.left, command.right, (command.th1_target, command.th2_target), dt)
+        plant.advance(
+            state, command.left, command.right, (command.th1_target, command.th2_target), dt
+        )
         states.append(state.copy())
     return commands, states
 

@@ -8,10 +8,10 @@ import pytest
 from ddwmmr import Robot
 from ddwmmr.model.symbolic import ThesisDynamics
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState
+from ddwmmr.plants.thesis import VelocityServo as VelocityLoop
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF
 from ddwmmr.qp.limits.wheel_forces import WheelForceLimit
-from ddwmmr.scenarios.protocol import VelocityLoop
 
 
 def test_rows_are_the_velocity_loop_wheel_forces(rng):

@@ -33,5 +33,9 @@ from ddwmmr.mpc.controller import MPCControllerCore
 class MPCController(MPCControllerCore):
     """Nonlinear MPC: multiple shooting, hard exact S >= S_min, soft manipulability, preview."""
 
+    #: ~0.5 ms a step: ranked in the comparison, left out of its studies by default
+    #: (``--study-methods mpc`` adds it).
+    in_studies = False
+
 
 __all__ = ["MPCController"]

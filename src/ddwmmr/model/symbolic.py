@@ -35,7 +35,7 @@ import casadi as ca
 
 from ddwmmr.errors import check_positive
 from ddwmmr.model import Robot
-from ddwmmr.plants.thesis import (
+from ddwmmr.model.thesis_base import (
     C1_DEFAULT,
     C2_DEFAULT,
     FORCE_LIMIT_DEFAULT,

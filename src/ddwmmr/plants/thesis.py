@@ -32,15 +32,14 @@ import numpy as np
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces
 from ddwmmr.errors import check_positive
 from ddwmmr.model import Robot
+from ddwmmr.model.thesis_base import (  # the base's constants (controllers' models use them)
+    C1_DEFAULT,
+    C2_DEFAULT,
+    FORCE_LIMIT_DEFAULT,
+    JOINT_SPEED_DEFAULT,
+)
 from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
 
-#: Thesis Table 3.1 damping constants: translation (N s/m) and rotation (N m s/rad).
-C1_DEFAULT = 15.0
-C2_DEFAULT = 4.0
-#: Thesis Table 3.1 force limit per wheel (N).
-FORCE_LIMIT_DEFAULT = 10.0
-#: Thesis 4.4.2 maximum joint speed (rad/s).
-JOINT_SPEED_DEFAULT = 2.0
 #: Bandwidth (1/s) of the velocity servo that follows velocity commands.
 VELOCITY_BANDWIDTH = 10.0
 

@@ -49,16 +49,17 @@ from ddwmmr.arbiters.state_machine import (
 from ddwmmr.behaviours.controller import ThesisController
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.behaviours.obstacle import base_bubble
+from ddwmmr.commands import WheelForces
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_terms
+from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
 from ddwmmr.plants import make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
-from ddwmmr.plants.thesis import C1_DEFAULT, C2_DEFAULT
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.loop import run_loop
 
-CONTROLLERS = ("thesis", "qp")
+CONTROLLERS = ("thesis", "qp", "mpc")
 PLANTS = ("thesis", "kinematic", "mujoco")
 #: Motion detection thresholds for controllers without states (m/s, rad/s).
 MOVING_SPEED, MOVING_RATE = 1e-3, 1e-3
@@ -100,7 +101,10 @@ class RunConfig:
         dt: control and integration step (s).
         time_limit: s; None: 60 s, or 120 s when the scenario has obstacles.
         tolerance: waypoint tolerance (m).
-        qp_stability_min, qp_max_speed: options of the ``qp`` controller.
+        qp_stability_min, qp_max_speed: options of the ``qp`` controller (the stability
+            floor is also ``mpc``'s).
+        controller_options: further ``(name, value)`` options of the ``qp`` or ``mpc``
+            controller (e.g. ``(("horizon", 3.0),)``), over the protocol's own.
         record: keep a trace (every ``TRACE_INTERVAL``) for plots.
         arbiter: thesis controller's arbiter, ``"state-machine"`` or ``"competitive"``
             (thresholds above) or an arbiter instance (``ddwmmr.arbiters.make_arbiter``).
@@ -117,6 +121,7 @@ class RunConfig:
     tolerance: float = 0.01
     qp_stability_min: float = 1.25
     qp_max_speed: float = 1.0
+    controller_options: tuple[tuple[str, Any], ...] = ()
     record: bool = False
     arbiter: Any = "state-machine"
     arbiter_seed: int = 0
@@ -160,6 +165,9 @@ class Outcome:
 
     metrics: dict[str, Any]
     trace: dict[str, list[float]] | None = None
+    #: Median wall-clock time of one controller call (us): a timing, so not a metric (the
+    #: metrics, and scenarios.csv, are deterministic).
+    median_step_us: float | None = None
 
 
 class _Tally:
@@ -177,6 +185,7 @@ class _Tally:
         self.min_s = math.inf
         self.min_eta = math.inf
         self.reason = "timeout"
+        self.step_ns: list[int] = []  # wall-clock time of each controller call
         self.clearance = base_bubble(robot)
         self.trace: dict[str, list[float]] | None = None
         if config.record:
@@ -292,7 +301,8 @@ class _Tally:
             for key in ("manipulability", "stability", "obstacle"):
                 metrics[f"time_{key}_s"] = nan
                 metrics[f"transitions_{key}"] = nan
-        return Outcome({k: metrics[k] for k in METRICS}, self.trace)
+        median = float(np.median(self.step_ns)) / 1000.0 if self.step_ns else None
+        return Outcome({k: metrics[k] for k in METRICS}, self.trace, median)
 
 
 class WaypointTask:
@@ -347,12 +357,14 @@ class WaypointTask:
         Controllers without states are traced as moving the base when the measured base
         velocity says so (|v| > 1 mm/s or |w| > 1 mrad/s).
         """
+        self.tally.step_ns.append(step_ns)
         if self.has_states:
             state = self.controller.state
             self.tally.count(state)
         else:
             moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
             state = MOVE_BASE if moving else MOVE_ARM
+            self.tally.steps_arm += int(self._arm_rate(obs, applied) > MOVING_RATE)
         if self.tally.trace is not None:
             self.tally.record(k, t, tuple(obs.q.tolist()), state)
 
@@ -361,8 +373,16 @@ class WaypointTask:
         if not self.has_states:
             base_moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
             self.tally.steps_base += int(base_moving)
-            self.tally.steps_arm += int(max(abs(applied[2]), abs(applied[3])) > MOVING_RATE)
         return self.tally.check(obs.q.tolist())
+
+    def _arm_rate(self, obs: Observation, applied: Any) -> float:
+        """Largest commanded joint rate (rad/s): from u, or from the joint targets of a
+        force command over one step."""
+        if isinstance(applied, WheelForces):
+            _, _, _, th1, th2 = obs.q.tolist()
+            dt = self.tally.config.dt
+            return max(abs(applied.th1_target - th1), abs(applied.th2_target - th2)) / dt
+        return max(abs(applied[2]), abs(applied[3]))
 
     def controller_error(self, k: int, error: Exception) -> bool:
         """A controller failure ends the scenario with the error as its reason."""
@@ -381,6 +401,9 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
     if config.controller == "thesis":
         controller: Any = make_thesis_controller(robot, scenario, config)
         q0 = np.array([0.0, 0.0, 0.0, *controller.default_pose])
+    elif config.controller == "mpc":
+        controller = make_mpc(robot, scenario, config, plant)
+        q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
     else:
         controller = make_qp(robot, scenario, config, _envelope(plant))
         q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
@@ -419,6 +442,25 @@ def make_thesis_controller(robot: Robot, scenario: Scenario, config: RunConfig) 
     return ThesisController(robot, make_arbiter(config), obstacles=scenario.obstacles)
 
 
+def make_mpc(robot: Robot, scenario: Scenario, config: RunConfig, plant: Plant) -> Any:
+    """The registry's ``mpc`` controller for waypoint tasks: it predicts with the thesis
+    base's force-level model (wheel forces as decisions) on a plant that takes forces
+    (the thesis plant, the physics plant with the thesis damping), with the kinematic model
+    on the kinematic plant. Its stability floor is the qp's (``qp_stability_min``)."""
+    from ddwmmr.controllers import make_controller
+
+    model = "thesis" if "force" in plant.interfaces else "kinematic"
+    options = {
+        "model": model,
+        "stability_min": config.qp_stability_min,
+        "track_orientation": False,
+        "obstacles": [tuple(o) for o in scenario.obstacles],
+        "dt": config.dt,
+        **dict(config.controller_options),
+    }
+    return make_controller("mpc", robot, **options)
+
+
 def make_qp(
     robot: Robot, scenario: Scenario, config: RunConfig, envelope: dict[str, float] | None = None
 ) -> Any:
@@ -431,16 +473,16 @@ def make_qp(
 
     if "qp" not in available_methods():
         raise ParameterError("controller: the qp controller is not available in this install")
-    return make_controller(
-        "qp",
-        robot,
-        stability_min=config.qp_stability_min,
-        track_orientation=False,
-        max_speed=config.qp_max_speed,
-        obstacles=[tuple(o) for o in scenario.obstacles],
-        dt=config.dt,
+    options = {
+        "stability_min": config.qp_stability_min,
+        "track_orientation": False,
+        "max_speed": config.qp_max_speed,
+        "obstacles": [tuple(o) for o in scenario.obstacles],
+        "dt": config.dt,
         **(envelope or {}),
-    )
+        **dict(config.controller_options),
+    }
+    return make_controller("qp", robot, **options)
 
 
 __all__ = [
@@ -450,6 +492,7 @@ __all__ = [
     "Outcome",
     "RunConfig",
     "WaypointTask",
+    "make_mpc",
     "make_qp",
     "make_scenario_plant",
     "make_thesis_controller",

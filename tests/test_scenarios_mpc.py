@@ -1,0 +1,28 @@
+"""The mpc controller in the thesis protocol: the one loop, wheel forces on the thesis plant."""
+
+import pytest
+
+from ddwmmr import ParameterError
+from ddwmmr.scenarios import RunConfig, generate, run_scenario
+
+SCENARIO = generate(5, 0)[4]  # the shortest of the first five (about 14 s for mpc)
+
+
+def test_mpc_on_the_thesis_plant_beats_the_thesis_controller_and_holds_its_floor():
+    mpc = run_scenario(SCENARIO, RunConfig(controller="mpc"))
+    thesis = run_scenario(SCENARIO, RunConfig(controller="thesis"))
+    m = mpc.metrics
+    assert m["success"] and thesis.metrics["success"]
+    assert m["time_s"] <= 0.85 * thesis.metrics["time_s"]
+    # The hard floor holds at every step (1.25, with the 0.01 damper margin rounded).
+    assert m["min_stability"] >= 1.25 - 1e-6
+    assert mpc.median_step_us is not None and mpc.median_step_us > 0.0
+
+
+def test_controller_options_reach_the_controller():
+    """A 2 s horizon (default 5 s) sees the next waypoint later: a different, slower run."""
+    default = run_scenario(SCENARIO, RunConfig(controller="mpc")).metrics["time_s"]
+    short = RunConfig(controller="mpc", controller_options=(("horizon", 2.0),))
+    assert run_scenario(SCENARIO, short).metrics["time_s"] > default + 1.0
+    with pytest.raises(ParameterError, match="horizon"):
+        run_scenario(SCENARIO, RunConfig(controller="mpc", controller_options=(("horizon", -1.0),)))
