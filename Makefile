@@ -65,9 +65,11 @@ docs: $(STAMP_TEST)
 		--method clrrmc-ts --traj rectangle
 	MPLBACKEND=Agg $(BIN)/python docs/competitive_figures.py
 
-# The figures of measured step times (machine-dependent: they change on every run).
+# The figures of measured step times (machine-dependent: they change on every run), and the
+# MPC's figures (its horizon study plots step times; about 10 minutes).
 docs-timings: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python docs/qp_figures.py --timings
+	MPLBACKEND=Agg $(BIN)/python docs/mpc_figures.py
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache
