@@ -33,7 +33,7 @@ from ddwmmr.mpc import terminal
 from ddwmmr.mpc.models import PredictionModel, make_model
 from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights, grid_intervals
 from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS, SolverFailure, make_solver
-from ddwmmr.qp.limits import as_circles, footprint_clearances, safe_arm_scale
+from ddwmmr.qp.limits import as_circles, run_clearance, safe_arm_scale
 
 MODELS = ("kinematic", "thesis")
 #: Control step (s) when neither ``dt`` nor the trajectory's resolution is known.
@@ -377,20 +377,7 @@ class MPCControllerCore:
             fallbacks = int(np.sum(np.asarray(timeseries["fallback"]) > 0))
         else:
             fallbacks = self.fallbacks
-        clearance = None
-        if self.obstacles and all(k in timeseries for k in ("x", "y", "phi")):
-            clearance = float(
-                np.min(
-                    footprint_clearances(
-                        0.5 * self.robot.base_length,
-                        0.5 * self.robot.base_width,
-                        timeseries["x"],
-                        timeseries["y"],
-                        timeseries["phi"],
-                        self.obstacles,
-                    )
-                )
-            )
+        clearance = run_clearance(self.robot, self.obstacles, timeseries)
         mode = "tracking" if self._trajectory is not None else "reach"
         return {
             "stability_min": self.stability_min,

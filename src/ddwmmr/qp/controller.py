@@ -43,8 +43,8 @@ from ddwmmr.qp.limits import (
     StabilityLimit,
     WheelSpeedLimit,
     as_circles,
-    footprint_clearances,
     full_step_is_safe,
+    run_clearance,
     safe_arm_scale,
     stability_terms_gradient,
 )
@@ -327,20 +327,7 @@ class QPControllerCore:
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
         """QP metrics merged into the run summary (see module docstring of controllers.qp)."""
         stability = np.asarray(timeseries["stability"])
-        clearance = None
-        if self.obstacles:
-            clearance = float(
-                np.min(
-                    footprint_clearances(
-                        0.5 * self.robot.base_length,
-                        0.5 * self.robot.base_width,
-                        timeseries["x"],
-                        timeseries["y"],
-                        timeseries["phi"],
-                        self.obstacles,
-                    )
-                )
-            )
+        clearance = run_clearance(self.robot, self.obstacles, timeseries)
         return {
             "stability_min": self.stability_min,
             "stability_violations": int(np.sum(stability < self.stability_min)),

@@ -10,6 +10,7 @@ from ddwmmr.qp.limits.obstacles import (
     clearance_and_rate,
     footprint_clearances,
     load_obstacles,
+    run_clearance,
 )
 from ddwmmr.qp.limits.singularity import ShoulderSingularityLimit
 from ddwmmr.qp.limits.stability import (
@@ -37,6 +38,7 @@ __all__ = [
     "footprint_clearances",
     "full_step_is_safe",
     "load_obstacles",
+    "run_clearance",
     "safe_arm_scale",
     "stability_terms_gradient",
 ]

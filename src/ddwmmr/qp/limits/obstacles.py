@@ -149,6 +149,27 @@ def footprint_clearances(
     return best
 
 
+def run_clearance(
+    robot: Robot, circles: Sequence[Circle], timeseries: dict[str, np.ndarray]
+) -> float | None:
+    """Smallest footprint clearance (m) from ``circles`` over a recorded run (columns x, y,
+    phi); None without circles (the ``min_obstacle_clearance_m`` summary key)."""
+    if not circles or not all(k in timeseries for k in ("x", "y", "phi")):
+        return None
+    return float(
+        np.min(
+            footprint_clearances(
+                0.5 * robot.base_length,
+                0.5 * robot.base_width,
+                timeseries["x"],
+                timeseries["y"],
+                timeseries["phi"],
+                circles,
+            )
+        )
+    )
+
+
 class ObstacleLimit(Limit):
     """One damper row per circle: ``d_dot >= -gain (d - margin)`` when ``d < influence``.
 

@@ -10,18 +10,15 @@ passing on the side the base already leans to (or the target's side when head-on
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
-
-import numpy as np
+from collections.abc import Sequence
 
 from ddwmmr.errors import check_positive
-from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.obstacles import Circle, clearance_and_rate
-from ddwmmr.qp.tasks.base import Task
+from ddwmmr.qp.tasks.base import YawRowTask
 
 
-class ObstacleSteeringTask(Task):
+class ObstacleSteeringTask(YawRowTask):
     """One row on w, active while a circle ahead is within ``influence`` (m) of the base."""
 
     rows = 1
@@ -60,27 +57,6 @@ class ObstacleSteeringTask(Task):
             return 0.0, 0.0
         side = math.copysign(1.0, bearing) if bearing else self._target_side(ctx)
         return 1.0, self.gain * (bearing - side * 0.5 * math.pi)
-
-    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
-        """Steer by the nearest circle ahead; zero row when none is near."""
-        jac[:] = 0.0
-        jac[0, 1], error[0] = self.values(ctx)
-
-    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
-        """Writer for the weighted entry on w and the target."""
-        if overrides(self, ObstacleSteeringTask) or overrides(self, ObstacleSteeringTask, "values"):
-            return None
-        block.write_constant_rows([[0.0] * 4])
-        jac, (target,) = block.jac, block.target_views
-        entry, (row,), (scale,) = block.rows[0] + 1, block.targets, block.scales
-        values = self.values
-
-        def write(ctx: StepContext) -> None:
-            active, rate = values(ctx)
-            jac[entry] = active * scale
-            target[row] = rate * scale
-
-        return write
 
     @staticmethod
     def _target_side(ctx: StepContext) -> float:

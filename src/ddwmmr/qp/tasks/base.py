@@ -17,7 +17,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ddwmmr.errors import check_nonnegative
-from ddwmmr.qp.blocks import TaskBlock
+from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 
 
@@ -82,3 +82,47 @@ class Task(ABC):
         """Optional fast path: a writer filling ``block`` each step (see
         :mod:`ddwmmr.qp.blocks`). The default, None, has :meth:`compute` called instead."""
         return None
+
+
+class YawRowTask(Task):
+    """A one-row task on the yaw rate w: ``values(ctx) -> (factor, rate)`` gives the row
+    ``factor * w = rate`` (both already faded by the factor); :meth:`compute` and the fast
+    path (:meth:`compile`) write it."""
+
+    rows = 1
+
+    @abstractmethod
+    def values(self, ctx: StepContext) -> tuple[float, float]:
+        """``(factor, rate)`` of this step's row ``factor * w = rate`` (rad/s)."""
+
+    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        """One row on w."""
+        jac[0, 0] = jac[0, 2] = jac[0, 3] = 0.0
+        jac[0, 1], error[0] = self.values(ctx)
+
+    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
+        """Writer for the weighted entry on w and the target (None: a subclass changed
+        ``compute`` or ``values`` in a way the fast path does not know)."""
+        owner = _yaw_row_owner(type(self))
+        if overrides(self, owner) or overrides(self, owner, "values"):
+            return None
+        block.write_constant_rows([[0.0] * 4])
+        jac, (target,) = block.jac, block.target_views
+        entry, (row,), (scale,) = block.rows[0] + 1, block.targets, block.scales
+        values = self.values
+
+        def write(ctx: StepContext) -> None:
+            factor, rate = values(ctx)
+            jac[entry] = factor * scale
+            target[row] = rate * scale
+
+        return write
+
+
+def _yaw_row_owner(cls: type) -> type:
+    """The library class (first direct subclass of :class:`YawRowTask` in the MRO) whose
+    ``values`` the fast path was written for."""
+    for klass in cls.__mro__:
+        if YawRowTask in klass.__bases__:
+            return klass
+    return cls

@@ -3,18 +3,14 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-
-import numpy as np
 
 from ddwmmr.errors import check_nonnegative, check_positive
 from ddwmmr.model.kinematics import wrap_angle
-from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
-from ddwmmr.qp.tasks.base import Task
+from ddwmmr.qp.tasks.base import YawRowTask
 
 
-class HeadingTask(Task):
+class HeadingTask(YawRowTask):
     """``w = gain * wrap_angle(bearing - phi)`` while the target is farther than ``distance`` (m).
 
     ``bearing`` is the direction from the base to the desired end-effector position. Near
@@ -48,24 +44,3 @@ class HeadingTask(Task):
             ax, ay = self.detour.aim(ctx.x, ctx.y, ctx.pose_d[0], ctx.pose_d[1])
             dx, dy = ax - ctx.x, ay - ctx.y
         return factor, factor * self.gain * wrap_angle(math.atan2(dy, dx) - ctx.phi)
-
-    def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
-        """One row on w, scaled by the fade factor (zero within ``distance`` of the base)."""
-        jac[0, 0] = jac[0, 2] = jac[0, 3] = 0.0
-        jac[0, 1], error[0] = self.values(ctx)
-
-    def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
-        """Writer for the weighted entry on w and the target."""
-        if overrides(self, HeadingTask) or overrides(self, HeadingTask, "values"):
-            return None
-        block.write_constant_rows([[0.0] * 4])
-        jac, (target,) = block.jac, block.target_views
-        entry, (row,), (scale,) = block.rows[0] + 1, block.targets, block.scales
-        values = self.values
-
-        def write(ctx: StepContext) -> None:
-            factor, rate = values(ctx)
-            jac[entry] = factor * scale
-            target[row] = rate * scale
-
-        return write
