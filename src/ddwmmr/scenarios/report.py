@@ -12,7 +12,7 @@ import numpy as np
 
 from ddwmmr.arbiters.state_machine import STATES
 from ddwmmr.scenarios.generator import Scenario
-from ddwmmr.scenarios.protocol import METRICS, Outcome
+from ddwmmr.scenarios.protocol import FINE_TRACE_DISTANCE, METRICS, TRACE_INTERVAL, Outcome
 from ddwmmr.sim.result import write_atomic
 
 #: (summary key, metric column) pairs reported as mean and sample standard deviation.
@@ -295,8 +295,10 @@ def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None 
         _mark_waypoints(ax4, tr, scenario)
     if len(t) > 1:
         ax4.text(
-            0.99, 0.04, f"trace sampled every {t[1] - t[0]:.3g} s", transform=ax4.transAxes,
-            ha="right", fontsize=7, color="0.4",
+            0.99, 0.04,
+            f"trace: every {TRACE_INTERVAL:g} s, every step within "
+            f"{FINE_TRACE_DISTANCE:g} m of a waypoint",
+            transform=ax4.transAxes, ha="right", fontsize=7, color="0.4",
         )  # fmt: skip
     ax4.set(xlabel="time (s)", ylabel="end effector to\nwaypoint (m)", ylim=(1e-4, 30.0))
     ax4.legend(fontsize=8, loc="lower left", ncol=3)
