@@ -538,7 +538,9 @@ class App(PanelLayout):
         self.view.set_runs(results, self.labels(), self._obstacles(self.run_settings))
         self._animate(self._blitting)
         steps = results[0].summary["steps"]
-        self._set_progress(1.0, f"done: {steps} steps, {elapsed:.1f} s")
+        # The wall time only in a window: a snapshot is a document, the same on every run.
+        took = f", {elapsed:.1f} s" if self.interactive else ""
+        self._set_progress(1.0, f"done: {steps} steps{took}")
         self.summary_text.set_text(
             "\n".join(_summary_line(label, r) for label, r in zip(self.labels(), results))
         )
