@@ -282,3 +282,14 @@ def test_noise_kicks_a_weight_off_the_unstable_fixed_point_and_floor_keeps_it_re
 def test_bad_input_raises_parameter_error(make, message):
     with pytest.raises(ParameterError, match=message):
         make()
+
+
+def test_subnormal_advantage_changes_nothing():
+    """Found by hypothesis: a = 2.2e-313 (subnormal) with w0 = 1.0625 came out as
+    1.0625000000032 (products of subnormals keep ~35 bits); a rate below 1e-18 is no change."""
+    from ddwmmr.arbiters.competitive import bernoulli_step
+
+    assert bernoulli_step(1.0625, 2.2250738585e-313, 2.2250738585e-313, 1.0) == 1.0625
+    assert bernoulli_step(-0.5, -1e-300, 1e-300, 10.0) == -0.5
+    # just above the threshold the exact solution still moves towards sqrt(alpha/beta) = 1
+    assert bernoulli_step(1.0625, 1e-6, 1e-6, 1.0) < 1.0625

@@ -163,6 +163,10 @@ class CompetitiveDynamics:
         return math.copysign(self.floor, value) if value != 0.0 else self.floor
 
 
+#: Dimensionless rate (alpha tau, beta w^2 tau) below which a weight step changes nothing.
+NEGLIGIBLE_RATE = 1e-18
+
+
 def bernoulli_step(w0: float, alpha: float, beta: float, tau: float) -> float:
     """Exact solution of ``w' = alpha w - beta w^3`` after ``tau`` (time in units of T).
 
@@ -171,6 +175,10 @@ def bernoulli_step(w0: float, alpha: float, beta: float, tau: float) -> float:
     """
     u0 = w0 * w0
     if u0 == 0.0 or tau == 0.0:
+        return w0
+    if abs(alpha) * tau < NEGLIGIBLE_RATE and beta * u0 * tau < NEGLIGIBLE_RATE:
+        # |w| would change by a factor 1 + O(1e-18), below double precision; the formulas
+        # below would instead lose precision to subnormal products (alpha ~ 1e-313).
         return w0
     x = 2.0 * alpha * tau
     if x > 0.0:  # growth: this form cannot overflow
