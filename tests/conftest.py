@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 from hypothesis import settings
 
+from ddwmmr import Robot
+
 # Property tests draw the same examples on every run (reproducible, and CI cannot turn red
 # by drawing a new case; search wider by hand with --hypothesis-seed / HYPOTHESIS_PROFILE);
 # no deadlines: the 2-core machine is often shared.
 settings.register_profile("ddwmmr", derandomize=True, deadline=None)
 settings.register_profile("explore", deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ddwmmr"))
-
-from ddwmmr import Robot
 
 
 @pytest.fixture
