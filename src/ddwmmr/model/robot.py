@@ -31,28 +31,27 @@ from ddwmmr.model import kinematics, stability
 
 _PI = math.pi
 #: Allowed range (low, high, unit) of each scalar field; see ddwmmr.errors for the caps.
+_LENGTH, _MASS = (*LENGTH_RANGE_M, "m"), (*MASS_RANGE_KG, "kg")
+_SPEED = (*SPEED_RANGE_RAD_S, "rad/s")
 _RANGES = {
-    **{
-        name: (*LENGTH_RANGE_M, "m")
-        for name in (
-            "L1",
-            "L2",
-            "wheel_radius",
-            "track_width",
-            "base_length",
-            "base_width",
-            "base_height",
-            "arm_height",
-        )
-    },
-    "wheel_mass": (*MASS_RANGE_KG, "kg"),
-    "wheel_torque_limit": (*TORQUE_RANGE_N_M, "N m"),
-    "base_mass": (*MASS_RANGE_KG, "kg"),
-    "payload": (*MASS_RANGE_KG, "kg"),
+    "L1": _LENGTH,
+    "L2": _LENGTH,
+    "wheel_radius": _LENGTH,
+    "track_width": _LENGTH,
+    "base_length": _LENGTH,
+    "base_width": _LENGTH,
+    "base_mass": _MASS,
     "base_inertia": (*INERTIA_RANGE_KG_M2, "kg m^2"),
-    "joint_speed_limit": (*SPEED_RANGE_RAD_S, "rad/s"),
-    "wheel_speed_limit": (*SPEED_RANGE_RAD_S, "rad/s"),
+    "joint_speed_limit": _SPEED,
+    "wheel_speed_limit": _SPEED,
+    "wheel_mass": _MASS,
+    "base_height": _LENGTH,
+    "arm_height": _LENGTH,
+    "wheel_torque_limit": (*TORQUE_RANGE_N_M, "N m"),
+    "payload": _MASS,
 }
+#: Scalar fields that must be > 0 (every ranged one but the payload, which may be 0).
+_POSITIVE = tuple(name for name in _RANGES if name != "payload")
 
 
 @dataclass(frozen=True)
@@ -113,22 +112,7 @@ class Robot:
     _com: stability.ComCoefficients = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in (
-            "L1",
-            "L2",
-            "wheel_radius",
-            "track_width",
-            "base_length",
-            "base_width",
-            "base_mass",
-            "base_inertia",
-            "joint_speed_limit",
-            "wheel_speed_limit",
-            "wheel_mass",
-            "base_height",
-            "arm_height",
-            "wheel_torque_limit",
-        ):
+        for name in _POSITIVE:
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
         object.__setattr__(self, "payload", check_nonnegative("payload", self.payload))
         masses = _pair("link_masses", self.link_masses)

@@ -17,6 +17,7 @@ Joint-position limits are state bounds in both.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from typing import Any
 
 import numpy as np
@@ -27,7 +28,7 @@ from ddwmmr.model import symbolic as sym
 INF = math.inf
 
 
-class PredictionModel:
+class PredictionModel(ABC):
     """Interface: sizes, the symbolic right-hand side, bounds, rows, scaling.
 
     Attributes:
@@ -53,13 +54,13 @@ class PredictionModel:
         self.x_lower, self.x_upper = x_lower, x_upper
         self.wheel_limit = robot.wheel_speed_limit * (1.0 - 1e-6)
 
-    def rhs(self, x: Any, u: Any) -> Any:  # pragma: no cover - interface
+    @abstractmethod
+    def rhs(self, x: Any, u: Any) -> Any:
         """State rate (symbolic)."""
-        raise NotImplementedError
 
+    @abstractmethod
     def wheel_rows(self, x: Any, u: Any | None) -> Any | None:
         """Wheel speeds (rad/s) implied at a node, or None when they are not decided there."""
-        raise NotImplementedError  # pragma: no cover - interface
 
     def configuration(self, x: Any) -> Any:
         """The configuration part ``q`` of a state."""

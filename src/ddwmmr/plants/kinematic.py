@@ -128,8 +128,7 @@ class KinematicPlant:
     @staticmethod
     def derivative(q: np.ndarray, u: np.ndarray) -> np.ndarray:
         """Configuration rate ``qdot = B(phi) u``."""
-        phi = q[2]
-        return np.array([u[0] * math.cos(phi), u[0] * math.sin(phi), u[1], u[2], u[3]])
+        return np.array(_rate(float(q[2]), *(float(a) for a in u)))
 
     def integrate(
         self,
@@ -158,8 +157,7 @@ class KinematicPlant:
             u0, saturated0 = tuple(first_command.tolist()), False
         else:
             u0, saturated0 = self._saturate(th1, th2, command)
-        v, w, r1, r2 = u0
-        k1 = (v * math.cos(phi), v * math.sin(phi), w, r1, r2)
+        k1 = _rate(phi, *u0)
         state = (x, y, phi, th1, th2)
         if self.integrator == "euler":
             new = [a + dt * b for a, b in zip(state, k1)]
@@ -191,8 +189,12 @@ class KinematicPlant:
         or the held input ``held`` (zero-order hold)."""
         stage = [a + h * b for a, b in zip(state, slope)]
         if policy is None:
-            v, w, r1, r2 = held
+            u = held
         else:
-            (v, w, r1, r2), _ = self._saturate(stage[3], stage[4], policy(t, np.array(stage)))
-        phi = stage[2]
-        return (v * math.cos(phi), v * math.sin(phi), w, r1, r2)
+            u, _ = self._saturate(stage[3], stage[4], policy(t, np.array(stage)))
+        return _rate(stage[2], *u)
+
+
+def _rate(phi: float, v: float, w: float, r1: float, r2: float) -> tuple[float, ...]:
+    """``qdot = B(phi) u`` on floats: (x', y', phi', th1', th2')."""
+    return (v * math.cos(phi), v * math.sin(phi), w, r1, r2)

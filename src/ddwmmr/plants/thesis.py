@@ -204,11 +204,7 @@ class ThesisPlant:
             r1 = min(limit, max(-limit, r1))
             r2 = min(limit, max(-limit, r2))
             target = (state.th1 + r1 * dt, state.th2 + r2 * dt)
-        limit = self.force_limit
-        f_left = min(limit, max(-limit, f_left))
-        f_right = min(limit, max(-limit, f_right))
-        self._forces = (f_left, f_right)
-        self.advance(state, f_left, f_right, target, dt)
+        self._forces = self.advance(state, f_left, f_right, target, dt)
         # One sum tests all seven values: any inf or nan makes it non-finite.
         if not math.isfinite(
             state.x + state.y + state.phi + state.th1 + state.th2 + state.v + state.w
@@ -269,10 +265,11 @@ class ThesisPlant:
         f_right: float,
         arm_target: tuple[float, float],
         dt: float,
-    ) -> None:
+    ) -> tuple[float, float]:
         """Advance ``state`` in place by dt (s) under wheel forces (N) and joint targets (rad).
 
-        The inertia is evaluated at the arm pose at the start of the step.
+        The inertia is evaluated at the arm pose at the start of the step. Returns the wheel
+        forces applied, after the force limit (N).
         """
         f1 = self.clip_force(f_left)
         f2 = self.clip_force(f_right)
@@ -288,6 +285,7 @@ class ThesisPlant:
         state.th1, state.th2 = arm_step(
             state.th1, state.th2, arm_target[0], arm_target[1], self.joint_speed, dt
         )
+        return f1, f2
 
 
 class VelocityServo:

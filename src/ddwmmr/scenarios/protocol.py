@@ -400,16 +400,14 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
     plant = make_scenario_plant(robot, config)
     if config.controller == "thesis":
         controller: Any = make_thesis_controller(robot, scenario, config)
-        q0 = np.array([0.0, 0.0, 0.0, *controller.default_pose])
     elif config.controller == "mpc":
         controller = make_mpc(robot, scenario, config, plant)
-        q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
     else:
         controller = make_qp(robot, scenario, config, _envelope(plant))
-        q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
+    # Start at the origin heading +x in the thesis's default pose (the pose it drives in).
+    q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
     has_states = config.controller == "thesis"
     tally = _Tally(robot, scenario, config)
-    tally.steps = round(config.limit_for(scenario) / config.dt)
     task = WaypointTask(tally, controller, has_states)
     end = run_loop(plant, controller, task, q0, config.dt, tally.steps)
     return tally.outcome(end.samples * config.dt, end.samples, has_states=has_states)

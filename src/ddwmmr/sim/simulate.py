@@ -95,7 +95,7 @@ def simulate(
         q = np.array(q0, dtype=float)
         if q.shape != (5,) or not np.all(np.isfinite(q)):
             raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
-    task = TrackingTask(trajectory, the_plant, steps + 1)
+    task = TrackingTask(trajectory, the_plant)
     run_loop(the_plant, controller, task, q, dt, steps, progress)
     timeseries = task.timeseries(robot)
     corners = getattr(trajectory, "corner_windows", None)

@@ -55,29 +55,22 @@ COLUMNS = (
     "fallback",
     "step_us",
 )
-#: What is recorded per sample (the rest of COLUMNS is derived after the run).
-RECORDED = (
-    "t",
-    "x",
-    "y",
-    "phi",
-    "th1",
-    "th2",
-    "v",
-    "w",
-    "th1dot",
-    "th2dot",
-    "v_measured",
-    "w_measured",
-    "xE_d",
-    "yE_d",
-    "phiE_d",
-    "nonholonomic_residual_m_s",
-    "singular",
-    "saturated",
-    "fallback",
-    "step_us",
+#: Columns computed after the run by :func:`derive_columns` (vectorised).
+DERIVED = (
+    "xE",
+    "yE",
+    "phiE",
+    "position_error_m",
+    "orientation_error_rad",
+    "wheel_left_rad_s",
+    "wheel_right_rad_s",
+    "manipulability",
+    "stability_lon",
+    "stability_lat",
+    "stability",
 )
+#: What is recorded per sample, in the order of :meth:`TrackingTask.record`'s rows.
+RECORDED = tuple(name for name in COLUMNS if name not in DERIVED)
 
 
 class TrackingTask:
@@ -86,15 +79,13 @@ class TrackingTask:
     Args:
         trajectory: any object with ``pose(t)`` and ``velocity(t)`` (world frame).
         plant: the plant (for its extra columns).
-        samples: number of samples the run will record at most (steps + 1).
     """
 
-    def __init__(self, trajectory: Any, plant: Plant, samples: int) -> None:
+    def __init__(self, trajectory: Any, plant: Plant) -> None:
         self.trajectory = trajectory
         self.plant = plant
         self.rows: list[tuple[float, ...]] = []
         self.extra: list[tuple[float, ...]] = []
-        self.samples = samples
         self.diverged_at: int | None = None
         self.diverged_message = ""
         self._pose = trajectory.pose
