@@ -36,7 +36,7 @@ from ddwmmr.plants import available_plants
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
-from ddwmmr.sim.simulate import simulate
+from ddwmmr.sim.simulate import plant_integrator, simulate
 from ddwmmr.trajectories import available_trajectories, load_trajectory
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
@@ -287,20 +287,11 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         source,
         step,
         duration,
-        _integrator(args.plant or PLANT, args.integrator),
+        plant_integrator(args.plant or PLANT, args.integrator),
         offset,
         args.traj,
         args.plant or PLANT,
     )
-
-
-def _integrator(plant: str, integrator: str | None) -> str | None:
-    """The kinematic plant's integrator (rk4 by default); None for the other plants."""
-    if plant == PLANT:
-        return integrator or "rk4"
-    if integrator is not None:
-        raise ParameterError(f"integrator: only the kinematic plant takes one (plant {plant})")
-    return None
 
 
 def inputs_from_record(args: argparse.Namespace) -> RunInputs:

@@ -128,13 +128,23 @@ def _plant(
             raise ParameterError("integrator and plant_options need a plant name, not an object")
         return plant
     options = dict(options or {})
+    resolved = plant_integrator(plant, integrator)
+    if resolved is not None:
+        options.setdefault("integrator", resolved)
+    return make_plant(plant, robot, **options)
+
+
+def plant_integrator(plant: str, integrator: str | None) -> str | None:
+    """The integrator a run on the plant named ``plant`` uses: the kinematic plant's
+    (``"rk4"`` by default), None for the other plants, which integrate their own dynamics
+    (asking one for an integrator is a :class:`ParameterError`)."""
     if plant == "kinematic":
-        options.setdefault("integrator", integrator or "rk4")
-    elif integrator is not None:
+        return integrator or "rk4"
+    if integrator is not None:
         raise ParameterError(
             f"integrator: only the kinematic plant takes an integrator (plant {plant!r})"
         )
-    return make_plant(plant, robot, **options)
+    return None
 
 
 #: Share of the run's (corner-free) samples, at its end, over which the final error is
