@@ -80,10 +80,7 @@ def simulate(
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
     the_plant = _plant(plant, robot, integrator, plant_options)
     if dt is None:
-        dt = trajectory.duration / getattr(trajectory, "samples", 1000)
-        quantum = getattr(the_plant, "timestep", None)
-        if quantum:  # an engine step: the nearest whole multiple of it
-            dt = max(1, round(dt / quantum)) * quantum
+        dt = engine_multiple(trajectory.duration / getattr(trajectory, "samples", 1000), the_plant)
     dt = check_positive("dt", dt)
     steps = check_step_count(duration, dt)  # within MAX_STEPS, before anything is allocated
     if q0 is None:
@@ -132,6 +129,13 @@ def _plant(
     if resolved is not None:
         options.setdefault("integrator", resolved)
     return make_plant(plant, robot, **options)
+
+
+def engine_multiple(dt: float, plant: Plant) -> float:
+    """``dt`` (s) rounded to the nearest whole multiple (at least one) of the plant's engine
+    ``timestep``, for plants that have one (a physics engine); else ``dt`` unchanged."""
+    quantum = getattr(plant, "timestep", None)
+    return max(1, round(dt / quantum)) * quantum if quantum else dt
 
 
 def plant_integrator(plant: str, integrator: str | None) -> str | None:

@@ -39,7 +39,7 @@ from ddwmmr.resolution.reference import (
     offset_configuration,
     start_configuration,
 )
-from ddwmmr.sim.simulate import simulate
+from ddwmmr.sim.simulate import engine_multiple, simulate
 
 # -- configuration and plan ---------------------------------------------------------------
 
@@ -230,12 +230,14 @@ def plan_runs(config: CompareConfig) -> Plan:
         for n in names
         if n in DEFAULT_TRAJECTORIES
     ]
+    engines = {plant: make_plant(plant, config.robot) for plant in config.plants}
     plan.plants = {
         plant: [
-            replace(spec, plant=plant, integrator=None, dt=plant_step(config, spec.dt, plant))
+            # a physics plant's control step must be a whole multiple of its engine step
+            replace(spec, plant=plant, integrator=None, dt=engine_multiple(spec.dt, engine))
             for spec in plan.main
         ]
-        for plant in config.plants
+        for plant, engine in engines.items()
     }
     builders: dict[str, Callable[[CompareConfig], list[RunSpec]]] = {
         "tau": _plan_tau,
@@ -248,13 +250,6 @@ def plan_runs(config: CompareConfig) -> Plan:
         if _study_possible(config, study):
             plan.studies[study] = builders[study](config)
     return plan
-
-
-def plant_step(config: CompareConfig, dt: float, plant: str) -> float:
-    """The main runs' step on ``plant``: the nearest whole multiple of its engine timestep
-    (a physics plant's control step must be one), else unchanged."""
-    quantum = getattr(make_plant(plant, config.robot), "timestep", None)
-    return max(1, round(dt / quantum)) * quantum if quantum else dt
 
 
 def _study_possible(config: CompareConfig, study: str) -> bool:
