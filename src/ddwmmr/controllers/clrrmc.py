@@ -14,7 +14,7 @@ import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register
 from ddwmmr.controllers.inputs import check_inputs
-from ddwmmr.controllers.resolved_rate import check_aux
+from ddwmmr.controllers.resolved_rate import Input, check_aux
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model import Robot
@@ -58,6 +58,15 @@ class TaskSpaceController:
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Input for the desired velocity plus the pose-error correction."""
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        u, singular = self.law(t, q, pose_d, velocity_d)
+        self.last = StepInfo(singular=singular)
+        return np.array(u)
+
+    def law(
+        self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
+    ) -> tuple[Input, bool]:
+        """The control law on lists of floats: ``(u, singular)``, no validation, no state
+        change (the integrator evaluates it at its stages; see :mod:`ddwmmr.sim.loop`)."""
         x, y, phi, th1, th2 = q
         L1, L2 = self.robot.L1, self.robot.L2
         a1 = phi + th1
@@ -66,7 +75,7 @@ class TaskSpaceController:
         ye = y + L1 * math.sin(a1) + L2 * math.sin(a12)
         px, py, pphi = pose_d
         vx, vy, vphi = velocity_d
-        u, singular = kernels.ats(
+        return kernels.ats(
             L1,
             L2,
             phi,
@@ -79,8 +88,6 @@ class TaskSpaceController:
             self.threshold,
             self.damping,
         )
-        self.last = StepInfo(singular=singular)
-        return np.array(u)
 
 
 @register("clrrmc-cs")
@@ -135,14 +142,26 @@ class ConfigurationSpaceController:
         The sideways part of the commanded base velocity cannot be produced; it is reported
         in ``last.nonholonomic_residual`` (m/s).
         """
-        if self.reference is None:
-            raise RuntimeError("clrrmc-cs needs reset(trajectory, q0) before command()")
-        q, _, _ = check_inputs(t, q, pose_d, velocity_d)
-        reference = self.reference
-        q_ref, qdot_ref = reference(t)
-        qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q)]
-        c, s = math.cos(q[2]), math.sin(q[2])
+        q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        qdot, c, s = self._rates(t, q)
         self.last = StepInfo(
-            singular=reference.last_damped, nonholonomic_residual=-qdot[0] * s + qdot[1] * c
+            singular=self.reference.last_damped, nonholonomic_residual=-qdot[0] * s + qdot[1] * c
         )
         return np.array([qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4]])
+
+    def law(
+        self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
+    ) -> tuple[Input, bool]:
+        """The control law on lists of floats: ``(u, singular)``, no validation (the
+        integrator evaluates it at its stages; see :mod:`ddwmmr.sim.loop`)."""
+        qdot, c, s = self._rates(t, q)
+        return (qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4]), self.reference.last_damped
+
+    def _rates(self, t: float, q: list[float]) -> tuple[list[float], float, float]:
+        """``(qdot, cos phi, sin phi)``: reference rate plus configuration feedback."""
+        reference = self.reference
+        if reference is None:
+            raise RuntimeError("clrrmc-cs needs reset(trajectory, q0) before command()")
+        q_ref, qdot_ref = reference(t)
+        qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q)]
+        return qdot, math.cos(q[2]), math.sin(q[2])

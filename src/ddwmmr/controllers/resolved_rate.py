@@ -6,6 +6,8 @@ ignore the pose error, so an initial offset is kept (and integration errors accu
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register
@@ -15,8 +17,11 @@ from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import AUX_ROWS
 from ddwmmr.resolution import kernels
 
+#: An input ``(v, w, th1dot, th2dot)`` as floats (m/s, rad/s, rad/s, rad/s).
+Input = tuple[float, float, float, float]
 
-class _ResolvedRate:
+
+class _ResolvedRate(ABC):
     """Shared state: robot lengths, singularity handling, last step info.
 
     ``singularity_threshold`` is the smallest singular value below which the inverse is
@@ -43,9 +48,20 @@ class _ResolvedRate:
         """Nothing to prepare: open-loop methods are memoryless."""
         self.last = StepInfo()
 
-    def _finish(self, u: tuple[float, float, float, float], singular: bool) -> np.ndarray:
+    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+        """Input ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s) for the desired
+        end-effector velocity (world frame, m/s, rad/s); the arguments are validated."""
+        q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        u, singular = self.law(t, q, pose_d, velocity_d)
         self.last = StepInfo(singular=singular)
         return np.array(u)
+
+    @abstractmethod
+    def law(
+        self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
+    ) -> tuple[Input, bool]:
+        """The control law on lists of floats: ``(u, singular)``, no validation, no state
+        change (the integrator evaluates it at its stages; see :mod:`ddwmmr.sim.loop`)."""
 
 
 def check_aux(aux: str) -> str:
@@ -59,15 +75,12 @@ def check_aux(aux: str) -> str:
 class PseudoinverseController(_ResolvedRate):
     """RR-PI: pseudoinverse resolution qdot = J^# Xd_dot (open loop)."""
 
-    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+    def law(self, t, q, pose_d, velocity_d) -> tuple[Input, bool]:
         """Minimum-norm input for the desired end-effector velocity (m/s, rad/s)."""
-        q, _, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         _, _, phi, th1, th2 = q
         xd, yd, pd = velocity_d
-        return self._finish(
-            *kernels.pseudoinverse(
-                self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
-            )
+        return kernels.pseudoinverse(
+            self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
         )
 
 
@@ -79,15 +92,12 @@ class AugmentedTaskSpaceController(_ResolvedRate):
         super().__init__(robot, **kwargs)
         self.aux = check_aux(aux)
 
-    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+    def law(self, t, q, pose_d, velocity_d) -> tuple[Input, bool]:
         """Input solving the square augmented system for the desired velocity."""
-        q, _, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         _, _, phi, th1, th2 = q
         xd, yd, pd = velocity_d
-        return self._finish(
-            *kernels.ats(
-                self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.aux, self.threshold, self.damping
-            )
+        return kernels.ats(
+            self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.aux, self.threshold, self.damping
         )
 
 
@@ -103,14 +113,13 @@ class ArtificialPotentialController(_ResolvedRate):
         self.K2 = check_nonnegative("K2", K2)
         self.K3 = check_nonnegative("K3", K3)
 
-    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+    def law(self, t, q, pose_d, velocity_d) -> tuple[Input, bool]:
         """Pseudoinverse input plus the projected potential descent (K2 has no effect: th2
         cannot move without moving the end effector, so it is not in the null space)."""
-        q, _, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         _, _, phi, th1, th2 = q
         xd, yd, pd = velocity_d
         (v, w, t1, t2), singular = kernels.pseudoinverse(
             self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
         )
         k = kernels.null_space_rate(phi, th1, 2.0 * self.K3 * phi, 2.0 * self.K1 * th1)
-        return self._finish((v, w + k, t1 - k, t2), singular)
+        return (v, w + k, t1 - k, t2), singular

@@ -20,7 +20,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import control
 import numpy as np
 
 from ddwmmr.model import Robot
@@ -80,6 +79,10 @@ def design(
     robot: Robot, model: PredictionModel, config: OCPConfig, arm_pose: tuple[float, float]
 ) -> TerminalDesign:
     """The LQR terminal design for ``config``'s weights and interval at ``arm_pose``."""
+    # Imported here: python-control (with scipy.signal) takes most of a second to import,
+    # which every command-line run would otherwise pay through the method registry.
+    import control
+
     A, B = error_dynamics(robot, model, arm_pose, config.track_orientation)
     nz = A.shape[0]
     h, weights = float(config.interval_lengths()[-1]), config.weights

@@ -23,8 +23,10 @@ from typing import Any, Protocol
 
 import numpy as np
 
-#: A continuous-time control law for integrator stages: (t s, q) -> velocity command u.
-Policy = Callable[[float, np.ndarray], np.ndarray]
+#: A continuous-time control law for integrator stages: ``(t, q) -> u``, time in s, the
+#: configuration as a list of 5 floats, the velocity command as 4 numbers (a tuple of
+#: floats or an array).
+Policy = Callable[[float, list[float]], Sequence[float]]
 
 
 @dataclass(slots=True)

@@ -78,14 +78,17 @@ class KinematicPlant:
 
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
         """Advance by dt under velocity ``command`` (see :meth:`integrate`)."""
-        trusted = command is self._limited
-        q_next, u0, _ = self.integrate(
-            t, self._q, dt, policy, first_command=command, saturated=trusted
-        )
-        if not all(math.isfinite(v) for v in q_next.tolist()):
+        state = self._q.tolist()
+        if command is self._limited:  # limit() saturated this very command
+            u0 = tuple(command.tolist())
+        else:
+            u0, _ = self._saturate(state[3], state[4], command)
+        x, y, phi, th1, th2 = new = self._advance(t, state, dt, policy, u0)
+        isfinite = math.isfinite
+        if not (isfinite(x) and isfinite(y) and isfinite(phi) and isfinite(th1 + th2)):
             raise PlantDivergedError(f"kinematic plant: non-finite state at t = {t + dt:g} s")
-        self._q = q_next
-        self._v, self._w = float(u0[0]), float(u0[1])
+        self._q = np.array(new)
+        self._v, self._w = u0[0], u0[1]
 
     def extra_values(self) -> Sequence[float]:
         """No plant-specific columns."""
@@ -102,14 +105,23 @@ class KinematicPlant:
         return np.array([v, w, t1, t2]), saturated
 
     def _saturate(self, th1: float, th2: float, u) -> tuple[tuple[float, ...], bool]:
-        """:meth:`saturate` on floats (joint angles th1, th2 in rad)."""
-        v, w, t1, t2 = u.tolist() if isinstance(u, np.ndarray) else (float(a) for a in u)
-        if not (math.isfinite(v) and math.isfinite(w) and math.isfinite(t1) and math.isfinite(t2)):
+        """:meth:`saturate` on floats (joint angles th1, th2 in rad; ``u`` a tuple of
+        floats, an array or any sequence of 4 numbers)."""
+        if type(u) is tuple:
+            v, w, t1, t2 = u
+        elif isinstance(u, np.ndarray):
+            v, w, t1, t2 = u.tolist()
+        else:
+            v, w, t1, t2 = (float(a) for a in u)
+        isfinite = math.isfinite
+        if not (isfinite(v) and isfinite(w) and isfinite(t1) and isfinite(t2)):
             raise FloatingPointError(f"non-finite command u = {u}")
         saturated = False
-        # Wheel speeds (SPEC §1): (2v -+ Lw w) / (2r) = v / r -+ (Lw / 2r) w.
+        # Wheel speeds (SPEC §1): (2v -+ Lw w) / (2r) = v / r -+ (Lw / 2r) w; the faster
+        # wheel's |a| + |b| is max(|a - b|, |a + b|) to the last bit (one is a sum of the
+        # magnitudes either way).
         per_v, per_w = self._wheel
-        peak = max(abs(v * per_v - w * per_w), abs(v * per_v + w * per_w))
+        peak = abs(v * per_v) + abs(w * per_w)
         limit = self._wheel_limit
         if peak > limit:
             scale = limit / peak
@@ -117,10 +129,10 @@ class KinematicPlant:
             saturated = True
         speed = self._joint_speed
         (low1, high1), (low2, high2) = self._joint_limits
-        r1 = min(max(t1, -speed), speed)
+        r1 = t1 if -speed <= t1 <= speed else math.copysign(speed, t1)
         if (th1 >= high1 and r1 > 0) or (th1 <= low1 and r1 < 0):
             r1 = 0.0
-        r2 = min(max(t2, -speed), speed)
+        r2 = t2 if -speed <= t2 <= speed else math.copysign(speed, t2)
         if (th2 >= high2 and r2 > 0) or (th2 <= low2 and r2 < 0):
             r2 = 0.0
         return (v, w, r1, r2), saturated or r1 != t1 or r2 != t2
@@ -151,48 +163,84 @@ class KinematicPlant:
         """
         if first_command is None and policy is None:
             raise ValueError("a policy or a first_command is needed")
-        command = policy(t, q) if first_command is None else first_command
-        x, y, phi, th1, th2 = q.tolist()
+        state = q.tolist()
+        th1, th2 = state[3], state[4]
+        command = policy(t, state) if first_command is None else first_command
         if saturated and first_command is not None:
             u0, saturated0 = tuple(first_command.tolist()), False
         else:
             u0, saturated0 = self._saturate(th1, th2, command)
-        k1 = _rate(phi, *u0)
-        state = (x, y, phi, th1, th2)
-        if self.integrator == "euler":
-            new = [a + dt * b for a, b in zip(state, k1)]
-        else:
-            half = 0.5 * dt
-            k2 = self._stage(t + half, state, k1, half, policy, u0)
-            k3 = self._stage(t + half, state, k2, half, policy, u0)
-            k4 = self._stage(t + dt, state, k3, dt, policy, u0)
-            sixth = dt / 6.0
-            new = [
-                a + sixth * (b1 + 2.0 * b2 + 2.0 * b3 + b4)
-                for a, b1, b2, b3, b4 in zip(state, k1, k2, k3, k4)
-            ]
-        (low1, high1), (low2, high2) = self.robot.joint_limits
-        new[3] = min(max(new[3], low1), high1)
-        new[4] = min(max(new[4], low2), high2)
-        return np.array(new), np.array(u0), saturated0
+        return np.array(self._advance(t, state, dt, policy, u0)), np.array(u0), saturated0
 
-    def _stage(
+    def _advance(
         self,
         t: float,
-        state: tuple[float, ...],
-        slope: tuple[float, ...],
-        h: float,
+        state: list[float],
+        dt: float,
         policy: Policy | None,
-        held: tuple[float, ...],
-    ) -> tuple[float, ...]:
-        """RK4 stage derivative at ``state + h slope``: the policy's (saturated) input there,
-        or the held input ``held`` (zero-order hold)."""
-        stage = [a + h * b for a, b in zip(state, slope)]
-        if policy is None:
-            u = held
+        u0: tuple[float, ...],
+    ) -> list[float]:
+        """``state`` after dt under the integrator, ``u0`` applied first; joints clamped."""
+        if self.integrator == "euler":
+            x, y, phi, th1, th2 = state
+            v, w, r1, r2 = u0
+            new = [x + dt * (v * math.cos(phi)), y + dt * (v * math.sin(phi))]
+            new += [phi + dt * w, th1 + dt * r1, th2 + dt * r2]
         else:
-            u, _ = self._saturate(stage[3], stage[4], policy(t, np.array(stage)))
-        return _rate(stage[2], *u)
+            new = self._rk4(t, state, dt, policy, u0)
+        (low1, high1), (low2, high2) = self._joint_limits
+        new[3] = min(max(new[3], low1), high1)
+        new[4] = min(max(new[4], low2), high2)
+        return new
+
+    def _rk4(
+        self,
+        t: float,
+        state: list[float],
+        dt: float,
+        policy: Policy | None,
+        u0: tuple[float, ...],
+    ) -> list[float]:
+        """One RK4 step of ``qdot = B(phi) u`` from ``state`` with ``u0`` at the start: the
+        policy's saturated input at every later stage, or ``u0`` held (zero-order hold).
+        Written out on floats: this runs at every step of every kinematic run."""
+        x, y, phi, th1, th2 = state
+        half = 0.5 * dt
+        saturate = self._saturate
+        v1, w1, a1, b1 = u0
+        cx1, cy1 = v1 * math.cos(phi), v1 * math.sin(phi)
+        # Stage 2 at state + dt/2 k1.
+        p2, t12, t22 = phi + half * w1, th1 + half * a1, th2 + half * b1
+        if policy is None:
+            v2, w2, a2, b2 = u0
+        else:
+            stage = [x + half * cx1, y + half * cy1, p2, t12, t22]
+            (v2, w2, a2, b2), _ = saturate(t12, t22, policy(t + half, stage))
+        cx2, cy2 = v2 * math.cos(p2), v2 * math.sin(p2)
+        # Stage 3 at state + dt/2 k2.
+        p3, t13, t23 = phi + half * w2, th1 + half * a2, th2 + half * b2
+        if policy is None:
+            v3, w3, a3, b3 = u0
+        else:
+            stage = [x + half * cx2, y + half * cy2, p3, t13, t23]
+            (v3, w3, a3, b3), _ = saturate(t13, t23, policy(t + half, stage))
+        cx3, cy3 = v3 * math.cos(p3), v3 * math.sin(p3)
+        # Stage 4 at state + dt k3.
+        p4, t14, t24 = phi + dt * w3, th1 + dt * a3, th2 + dt * b3
+        if policy is None:
+            v4, w4, a4, b4 = u0
+        else:
+            stage = [x + dt * cx3, y + dt * cy3, p4, t14, t24]
+            (v4, w4, a4, b4), _ = saturate(t14, t24, policy(t + dt, stage))
+        cx4, cy4 = v4 * math.cos(p4), v4 * math.sin(p4)
+        sixth = dt / 6.0
+        return [
+            x + sixth * (cx1 + 2.0 * cx2 + 2.0 * cx3 + cx4),
+            y + sixth * (cy1 + 2.0 * cy2 + 2.0 * cy3 + cy4),
+            phi + sixth * (w1 + 2.0 * w2 + 2.0 * w3 + w4),
+            th1 + sixth * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
+            th2 + sixth * (b1 + 2.0 * b2 + 2.0 * b3 + b4),
+        ]
 
 
 def _rate(phi: float, v: float, w: float, r1: float, r2: float) -> tuple[float, ...]:

@@ -93,7 +93,7 @@ class ReferenceTrajectory:
         self.last_damped = False
         q0 = [float(v) for v in q_start]
         self._q = [q0]
-        rate, damped = self._rate(0.0, q0)
+        rate, damped = self._rate(q0, trajectory.velocity(0.0).tolist())
         self._qdot = [rate]
         self._node_damped = [damped]
         #: Per segment: was any rate evaluation that defines it damped?
@@ -102,8 +102,9 @@ class ReferenceTrajectory:
         self._coefficients: list[tuple[tuple[float, ...], ...]] = []
         self._end = -1.0  # queries up to this time need no extension
 
-    def _rate(self, t: float, q: list[float]) -> tuple[list[float], bool]:
-        xd, yd, pd = self.trajectory.velocity(t).tolist()
+    def _rate(self, q: list[float], velocity: list[float]) -> tuple[list[float], bool]:
+        """Configuration rate at q for the desired end-effector ``velocity`` (3 floats)."""
+        xd, yd, pd = velocity
         (v, w, t1, t2), singular = kernels.ats(
             self.robot.L1,
             self.robot.L2,
@@ -120,20 +121,40 @@ class ReferenceTrajectory:
         self.singular_nodes += singular
         return [v * math.cos(q[2]), v * math.sin(q[2]), w, t1, t2], singular
 
+    def _stage_velocities(self, first: int, last: int) -> list[tuple[list[float], list[float]]]:
+        """Desired velocities at ``k h + h/2`` and ``k h + h`` for steps k = first..last-1:
+        in one vectorised call when the trajectory has ``sample`` (same numbers)."""
+        h = self.step
+        sample = getattr(self.trajectory, "sample", None)
+        if sample is None:
+            velocity = self.trajectory.velocity
+            return [
+                (velocity(k * h + h / 2).tolist(), velocity(k * h + h).tolist())
+                for k in range(first, last)
+            ]
+        start = np.arange(first, last) * h
+        _, rates = sample(np.concatenate([start + h / 2, start + h]))
+        rows = rates.tolist()
+        count = last - first
+        return list(zip(rows[:count], rows[count:]))
+
     def _extend_to(self, t: float) -> None:
         h = self.step
-        while (len(self._q) - 1) * h < t + h:
-            tk = (len(self._q) - 1) * h
+        first = len(self._q) - 1
+        last = first
+        while last * h < t + h:  # the steps the loop below takes
+            last += 1
+        for middle, end in self._stage_velocities(first, last):
             q = self._q[-1]
             k1 = self._qdot[-1]
-            k2, d2 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k1)])
-            k3, d3 = self._rate(tk + h / 2, [a + h / 2 * b for a, b in zip(q, k2)])
-            k4, d4 = self._rate(tk + h, [a + h * b for a, b in zip(q, k3)])
+            k2, d2 = self._rate([a + h / 2 * b for a, b in zip(q, k1)], middle)
+            k3, d3 = self._rate([a + h / 2 * b for a, b in zip(q, k2)], middle)
+            k4, d4 = self._rate([a + h * b for a, b in zip(q, k3)], end)
             q_next = [
                 a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
                 for a, b1, b2, b3, b4 in zip(q, k1, k2, k3, k4)
             ]
-            rate_next, d_next = self._rate(tk + h, q_next)
+            rate_next, d_next = self._rate(q_next, end)
             self._segment_damped.append(self._node_damped[-1] or d2 or d3 or d4 or d_next)
             self._q.append(q_next)
             self._qdot.append(rate_next)

@@ -79,9 +79,15 @@ class TrackingTask:
     Args:
         trajectory: any object with ``pose(t)`` and ``velocity(t)`` (world frame).
         plant: the plant (for its extra columns).
+        grid: ``(dt, steps)`` of the run: when the trajectory has a vectorised
+            ``sample(times)``, the references at every sample ``k dt`` and at the RK4
+            stage times ``k dt + dt/2``, ``k dt + dt`` are computed before the run in one
+            call (the same numbers :meth:`reference` would compute one by one).
     """
 
-    def __init__(self, trajectory: Any, plant: Plant) -> None:
+    def __init__(
+        self, trajectory: Any, plant: Plant, grid: tuple[float, int] | None = None
+    ) -> None:
         self.trajectory = trajectory
         self.plant = plant
         self.rows: list[tuple[float, ...]] = []
@@ -92,6 +98,8 @@ class TrackingTask:
         self._velocity = trajectory.velocity
         # Reference cache: RK4 asks twice at t + dt/2, and the recorder again at t.
         self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+        sample = getattr(trajectory, "sample", None)
+        self._table = {} if grid is None or sample is None else _reference_table(sample, *grid)
         self._extra_values = plant.extra_values if plant.extra_columns else None
 
     # -- Task protocol ----------------------------------------------------------------------
@@ -105,7 +113,7 @@ class TrackingTask:
 
     def reference(self, t: float, obs: Observation | None) -> tuple[np.ndarray, np.ndarray]:
         """The trajectory's pose and velocity at t (s) (the arrays must not be modified)."""
-        cached = self._cache.get(t)
+        cached = self._table.get(t) or self._cache.get(t)
         if cached is None:
             if len(self._cache) > 4:
                 self._cache.clear()
@@ -163,6 +171,21 @@ class TrackingTask:
             for i, name in enumerate(self.plant.extra_columns):
                 series[name] = extra[:, i]
         return series
+
+
+def _reference_table(
+    sample: Any, dt: float, steps: int
+) -> dict[float, tuple[np.ndarray, np.ndarray]]:
+    """``{t: (pose, velocity)}`` at the times the loop and the RK4 stages ask for: ``k dt``,
+    ``k dt + dt/2`` and ``k dt + dt`` (computed as the loop and the integrator compute
+    them, so the float keys match exactly), rows of read-only arrays."""
+    start = np.arange(steps + 1) * dt
+    end = start + dt  # mostly the next start already; keep the ones rounding differently
+    times = np.concatenate([start, start + 0.5 * dt, end[np.append(end[:-1] != start[1:], True)]])
+    poses, velocities = sample(times)
+    poses.setflags(write=False)
+    velocities.setflags(write=False)
+    return dict(zip(times.tolist(), zip(poses, velocities)))
 
 
 def _force_equivalent(obs: Observation) -> list[float]:

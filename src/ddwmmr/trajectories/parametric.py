@@ -35,6 +35,25 @@ from ddwmmr.errors import (
 ORIENTATIONS = ("tangent", "constant")
 
 
+class _ArrayMath:
+    """The ``math`` functions the shapes use, on arrays (for :meth:`_Parametric.sample`).
+
+    ``atan2`` goes through ``math.atan2`` element by element: numpy's ``arctan2`` is not
+    the C library's and differs in the last bit for about one value in twelve, which would
+    make a sampled reference differ from ``pose(t)``."""
+
+    sin = staticmethod(np.sin)
+    cos = staticmethod(np.cos)
+    floor = staticmethod(np.floor)
+
+    @staticmethod
+    def atan2(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+        return np.array(list(map(math.atan2, y.tolist(), x.tolist())))
+
+
+_ARRAY_MATH = _ArrayMath()
+
+
 @dataclass(frozen=True)
 class _Parametric(ABC):
     """Shared parameters and validation of the SPEC §2 trajectories."""
@@ -83,6 +102,25 @@ class _Parametric(ABC):
         """``alphadot = 2 pi / T`` (rad/s)."""
         return 2.0 * math.pi / self.T
 
+    def sample(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Poses and velocities at many times at once: ``(poses, velocities)``, both
+        ``(len(times), 3)`` (rows as :meth:`pose` and :meth:`velocity` give them, to the
+        last bit where numpy's sin/cos are the C library's, within an ulp elsewhere)."""
+        t = np.asarray(times, dtype=float)
+        rate = self.alpha_rate
+        alpha = rate * t
+        px, py = self._shape(alpha, _ARRAY_MATH)
+        rx, ry = self._rotate(px, py)
+        if self.orientation == "tangent":
+            heading = self.beta + self._tangent(alpha, _ARRAY_MATH)
+            turn = self._tangent_rate(alpha, _ARRAY_MATH) * rate
+        else:
+            heading, turn = np.full_like(t, self.phi), np.zeros_like(t)
+        dx, dy = self._shape_derivative(alpha, _ARRAY_MATH)
+        vx, vy = self._rotate(dx * rate, dy * rate)
+        poses = np.column_stack([self.x0 + rx, self.y0 + ry, heading])
+        return poses, np.column_stack([vx, vy, np.broadcast_to(turn, t.shape)])
+
     def _rotate(self, px: float, py: float) -> tuple[float, float]:
         cb, sb = math.cos(self.beta), math.sin(self.beta)
         return cb * px - sb * py, sb * px + cb * py
@@ -106,21 +144,22 @@ class _Parametric(ABC):
         rate = self._tangent_rate(alpha) * self.alpha_rate if self.orientation == "tangent" else 0.0
         return np.array([rx, ry, rate])
 
-    # Shape-specific pieces, in the unrotated frame, as functions of alpha.
+    # Shape-specific pieces, in the unrotated frame, as functions of alpha: a float with
+    # m = math, or an array with m = _ARRAY_MATH (the same expressions, vectorised).
     @abstractmethod
-    def _shape(self, alpha: float) -> tuple[float, float]:
+    def _shape(self, alpha: float, m=math) -> tuple[float, float]:
         """Unrotated offset from the centre (m)."""
 
     @abstractmethod
-    def _shape_derivative(self, alpha: float) -> tuple[float, float]:
+    def _shape_derivative(self, alpha: float, m=math) -> tuple[float, float]:
         """d(offset)/d(alpha) (m/rad)."""
 
     @abstractmethod
-    def _tangent(self, alpha: float) -> float:
+    def _tangent(self, alpha: float, m=math) -> float:
         """Unwrapped direction of travel in the unrotated frame (rad)."""
 
     @abstractmethod
-    def _tangent_rate(self, alpha: float) -> float:
+    def _tangent_rate(self, alpha: float, m=math) -> float:
         """d(tangent)/d(alpha) (dimensionless)."""
 
 
@@ -135,22 +174,22 @@ class Ellipse(_Parametric):
 
     name: str = "ellipse"
 
-    def _shape(self, alpha: float) -> tuple[float, float]:
-        return self.a * math.cos(alpha), self.b * math.sin(alpha)
+    def _shape(self, alpha: float, m=math) -> tuple[float, float]:
+        return self.a * m.cos(alpha), self.b * m.sin(alpha)
 
-    def _shape_derivative(self, alpha: float) -> tuple[float, float]:
-        return -self.a * math.sin(alpha), self.b * math.cos(alpha)
+    def _shape_derivative(self, alpha: float, m=math) -> tuple[float, float]:
+        return -self.a * m.sin(alpha), self.b * m.cos(alpha)
 
-    def _tangent(self, alpha: float) -> float:
+    def _tangent(self, alpha: float, m=math) -> float:
         # Direction of (-a sin, b cos), measured from the radial normal (-sin, cos) at angle
         # alpha + pi/2; that offset stays in (-pi/2, pi/2), so the sum is continuous.
-        s, c = math.sin(alpha), math.cos(alpha)
-        offset = math.atan2((self.a - self.b) * s * c, self.a * s * s + self.b * c * c)
+        s, c = m.sin(alpha), m.cos(alpha)
+        offset = m.atan2((self.a - self.b) * s * c, self.a * s * s + self.b * c * c)
         return alpha + 0.5 * math.pi + offset
 
-    def _tangent_rate(self, alpha: float) -> float:
+    def _tangent_rate(self, alpha: float, m=math) -> float:
         # d(heading)/d(alpha) = (x' y'' - y' x'') / |p'|^2 = a b / (a^2 sin^2 + b^2 cos^2)
-        s, c = math.sin(alpha), math.cos(alpha)
+        s, c = m.sin(alpha), m.cos(alpha)
         return self.a * self.b / (self.a**2 * s * s + self.b**2 * c * c)
 
 
@@ -160,24 +199,24 @@ class Rectangle(_Parametric):
 
     name: str = "rectangle"
 
-    def _shape(self, alpha: float) -> tuple[float, float]:
-        c, s = math.cos(alpha), math.sin(alpha)
+    def _shape(self, alpha: float, m=math) -> tuple[float, float]:
+        c, s = m.cos(alpha), m.sin(alpha)
         return self.a * (abs(c) * c - abs(s) * s), self.b * (abs(c) * c + abs(s) * s)
 
-    def _shape_derivative(self, alpha: float) -> tuple[float, float]:
-        c, s = math.cos(alpha), math.sin(alpha)
+    def _shape_derivative(self, alpha: float, m=math) -> tuple[float, float]:
+        c, s = m.cos(alpha), m.sin(alpha)
         return (
             self.a * (-2.0 * abs(c) * s - 2.0 * abs(s) * c),
             self.b * (-2.0 * abs(c) * s + 2.0 * abs(s) * c),
         )
 
-    def _tangent(self, alpha: float) -> float:
+    def _tangent(self, alpha: float, m=math) -> float:
         # Edges run -x, -y, +x, +y in turn; at a corner the edge being entered counts.
         # The small offset keeps sampled corners (alpha = k pi/2 up to rounding) on that edge.
-        edge = math.floor(alpha / (0.5 * math.pi) + 1e-9)
+        edge = m.floor(alpha / (0.5 * math.pi) + 1e-9)
         return math.pi + 0.5 * math.pi * edge
 
-    def _tangent_rate(self, alpha: float) -> float:
+    def _tangent_rate(self, alpha: float, m=math) -> float:
         return 0.0
 
     #: Corner window length after each corner, as a share of the period T: the orientation
