@@ -72,14 +72,20 @@ def _ratio(half_extent: float, offset: float) -> float:
 
 def stability_terms(k: ComCoefficients, th1: float, th2: float) -> tuple[float, float, float]:
     """``(S_lon, S_lat, S)``, each capped at :data:`STABILITY_CAP` (dimensionless)."""
-    x_com, y_com = centre_of_mass(k, th1, th2)
-    return margins(k, x_com, y_com)
+    th12 = th1 + th2
+    return margins(
+        k, k.A * math.cos(th1) + k.B * math.cos(th12), k.A * math.sin(th1) + k.B * math.sin(th12)
+    )
 
 
 def margins(k: ComCoefficients, x_com: float, y_com: float) -> tuple[float, float, float]:
-    """``(S_lon, S_lat, S)`` for a centre of mass ``(x_com, y_com)`` (m, base frame)."""
-    s_lon = _ratio(k.half_length, x_com)
-    s_lat = _ratio(k.half_width, y_com)
+    """``(S_lon, S_lat, S)`` for a centre of mass ``(x_com, y_com)`` (m, base frame).
+
+    (:func:`_ratio` written out: this runs several times per control step.)"""
+    offset, half = abs(x_com), k.half_length
+    s_lon = STABILITY_CAP if offset * STABILITY_CAP <= half else half / offset
+    offset, half = abs(y_com), k.half_width
+    s_lat = STABILITY_CAP if offset * STABILITY_CAP <= half else half / offset
     return s_lon, s_lat, min(s_lon, s_lat)
 
 

@@ -192,6 +192,7 @@ class ThesisPlant:
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
         """Advance by dt under wheel forces or a velocity command (zero-order hold)."""
         state = self.state
+        inertia = self.inertia(state.th1, state.th2)  # once for the servo and the dynamics
         if isinstance(command, WheelForces):
             f_left, f_right = command.left, command.right
             target = (command.th1_target, command.th2_target)
@@ -199,12 +200,12 @@ class ThesisPlant:
             v, w, r1, r2 = (
                 command.tolist() if isinstance(command, np.ndarray) else (float(a) for a in command)
             )
-            f_left, f_right = self.servo.forces(state, v, w)
+            f_left, f_right = self.servo.forces(state, v, w, inertia)
             limit = self.robot.joint_speed_limit
             r1 = min(limit, max(-limit, r1))
             r2 = min(limit, max(-limit, r2))
             target = (state.th1 + r1 * dt, state.th2 + r2 * dt)
-        self._forces = self.advance(state, f_left, f_right, target, dt)
+        self._forces = self.advance(state, f_left, f_right, target, dt, inertia)
         # One sum tests all seven values: any inf or nan makes it non-finite.
         if not math.isfinite(
             state.x + state.y + state.phi + state.th1 + state.th2 + state.v + state.w
@@ -265,15 +266,19 @@ class ThesisPlant:
         f_right: float,
         arm_target: tuple[float, float],
         dt: float,
+        inertia: float | None = None,
     ) -> tuple[float, float]:
         """Advance ``state`` in place by dt (s) under wheel forces (N) and joint targets (rad).
 
-        The inertia is evaluated at the arm pose at the start of the step. Returns the wheel
+        The inertia is evaluated at the arm pose at the start of the step (``inertia``, if
+        given, is that value: :meth:`inertia` at ``state``'s arm pose). Returns the wheel
         forces applied, after the force limit (N).
         """
-        f1 = self.clip_force(f_left)
-        f2 = self.clip_force(f_right)
-        inertia = self.inertia(state.th1, state.th2)
+        limit = self.force_limit
+        f1 = min(limit, max(-limit, f_left))  # clip_force, written out
+        f2 = min(limit, max(-limit, f_right))
+        if inertia is None:
+            inertia = self.inertia(state.th1, state.th2)
         v, distance = first_order_step(state.v, f1 + f2, 1.0 / self.c1, self.mass / self.c1, dt)
         torque = (f2 - f1) * self._half_width
         w, turn = first_order_step(state.w, torque, 1.0 / self.c2, inertia / self.c2, dt)
@@ -302,12 +307,17 @@ class VelocityServo:
         self._half_width = 0.5 * plant.robot.base_width
         self._total = 2.0 * plant.force_limit
 
-    def forces(self, state: ThesisState, v_d: float, w_d: float) -> tuple[float, float]:
-        """Left/right wheel forces (N) for the desired speed (m/s) and yaw rate (rad/s)."""
+    def forces(
+        self, state: ThesisState, v_d: float, w_d: float, inertia: float | None = None
+    ) -> tuple[float, float]:
+        """Left/right wheel forces (N) for the desired speed (m/s) and yaw rate (rad/s);
+        ``inertia``, if given, is the plant's yaw inertia at ``state`` (kg m^2)."""
         p = self.plant
         k = self.bandwidth
+        if inertia is None:
+            inertia = p.inertia(state.th1, state.th2)
         f_t = p.c1 * v_d + k * p.mass * (v_d - state.v)
-        torque = p.c2 * w_d + k * p.inertia(state.th1, state.th2) * (w_d - state.w)
+        torque = p.c2 * w_d + k * inertia * (w_d - state.w)
         f_r = min(self._total, max(-self._total, torque / self._half_width))
         room = self._total - abs(f_r)
         f_t = min(room, max(-room, f_t))

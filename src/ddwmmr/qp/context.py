@@ -74,8 +74,14 @@ class StepContext:
 
     def update(self, t: float, q: np.ndarray, pose_d: np.ndarray, velocity_d: np.ndarray) -> None:
         """Refresh every shared quantity for time t (s) and configuration q."""
+        self.update_floats(t, _floats(q), _floats(pose_d), _floats(velocity_d))
+
+    def update_floats(
+        self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
+    ) -> None:
+        """:meth:`update` from lists of floats (as :func:`check_inputs` returns them)."""
         self.t = t
-        x, y, phi, th1, th2 = _floats(q)
+        x, y, phi, th1, th2 = q
         self.q = (x, y, phi, th1, th2)
         self.x, self.y, self.phi, self.th1, self.th2 = x, y, phi, th1, th2
         L1, L2 = self.L1, self.L2
@@ -89,8 +95,8 @@ class StepContext:
         self.cos_th1, self.sin_th1 = math.cos(th1), math.sin(th1)
         self.cos_th12, self.sin_th12 = math.cos(th12), math.sin(th12)
         self.pose_e = (x + L1 * c1 + L2 * c12, y + L1 * s1 + L2 * s12, a12)
-        self.pose_d = tuple(_floats(pose_d))
-        self.velocity_d = tuple(_floats(velocity_d))
+        self.pose_d = tuple(pose_d)
+        self.velocity_d = tuple(velocity_d)
         dx = -L1 * s1 - L2 * s12
         dy = L1 * c1 + L2 * c12
         self.jac_e_rows = (c, dx, -L2 * s12, s, dy, L2 * c12)

@@ -237,9 +237,8 @@ class QPControllerCore:
 
     def command(self, t: float, q: np.ndarray, pose_d: np.ndarray, velocity_d: np.ndarray):
         """Input ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s) for this step."""
-        check_inputs(t, q, pose_d, velocity_d)
         ctx = self.ctx
-        ctx.update(t, q, pose_d, velocity_d)
+        ctx.update_floats(t, *check_inputs(t, q, pose_d, velocity_d))
         x = self._solve(ctx)
         if x is None:
             return self._fallback(ctx)
