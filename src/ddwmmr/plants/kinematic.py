@@ -53,7 +53,7 @@ class KinematicPlant:
         self._wheel_limit = robot.wheel_speed_limit
         self._joint_speed = robot.joint_speed_limit
         self._joint_limits = robot.joint_limits
-        self._q = np.zeros(5)
+        self._state = [0.0] * 5  # configuration as floats (a new list every step)
         self._v = self._w = 0.0
         self._limited: np.ndarray | None = None
 
@@ -63,12 +63,12 @@ class KinematicPlant:
         q = np.array(q0, dtype=float)
         if q.shape != (5,) or not np.all(np.isfinite(q)):
             raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
-        self._q = q
+        self._state = q.tolist()
         self._v = self._w = 0.0
 
     def observe(self) -> Observation:
         """The exact state; ``v``, ``w`` are those of the last applied input (0 at rest)."""
-        return Observation(self._q.copy(), self._v, self._w)
+        return Observation(np.array(self._state), self._v, self._w)
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
         """Same as :meth:`saturate`."""
@@ -78,7 +78,7 @@ class KinematicPlant:
 
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
         """Advance by dt under velocity ``command`` (see :meth:`integrate`)."""
-        state = self._q.tolist()
+        state = self._state
         if command is self._limited:  # limit() saturated this very command
             u0 = tuple(command.tolist())
         else:
@@ -87,7 +87,7 @@ class KinematicPlant:
         isfinite = math.isfinite
         if not (isfinite(x) and isfinite(y) and isfinite(phi) and isfinite(th1 + th2)):
             raise PlantDivergedError(f"kinematic plant: non-finite state at t = {t + dt:g} s")
-        self._q = np.array(new)
+        self._state = new
         self._v, self._w = u0[0], u0[1]
 
     def extra_values(self) -> Sequence[float]:
@@ -101,7 +101,8 @@ class KinematicPlant:
     # -- the model --------------------------------------------------------------------------
     def saturate(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
         """The input the robot can actually apply at q, and whether any limit was hit."""
-        (v, w, t1, t2), saturated = self._saturate(q[3], q[4], u)
+        _, _, _, th1, th2 = q.tolist() if isinstance(q, np.ndarray) else q
+        (v, w, t1, t2), saturated = self._saturate(th1, th2, u)
         return np.array([v, w, t1, t2]), saturated
 
     def _saturate(self, th1: float, th2: float, u) -> tuple[tuple[float, ...], bool]:
