@@ -204,7 +204,9 @@ class KinematicPlant:
     ) -> list[float]:
         """One RK4 step of ``qdot = B(phi) u`` from ``state`` with ``u0`` at the start: the
         policy's saturated input at every later stage, or ``u0`` held (zero-order hold).
-        Written out on floats: this runs at every step of every kinematic run."""
+        Written out stage by stage on floats: this runs at every step of every kinematic
+        run, and a loop over the three stages costs 3-4 % of a closed-form method's whole
+        run (measured)."""
         x, y, phi, th1, th2 = state
         half = 0.5 * dt
         saturate = self._saturate
