@@ -2,6 +2,8 @@
 controllers (the simulation loop connects them) -- directly or through other modules."""
 
 import ast
+import subprocess
+import sys
 from pathlib import Path
 
 import ddwmmr
@@ -91,3 +93,18 @@ def test_the_rule_checker_follows_indirect_imports(tmp_path):
     found = reachable(sample)
     assert "ddwmmr.model.symbolic" in found and "ddwmmr.model.thesis_base" in found
     assert not any(m.startswith("ddwmmr.plants") for m in found)
+
+
+def test_the_method_registry_does_not_import_python_control():
+    """python-control (with scipy.signal) takes most of a second to import; only designing
+    an MPC terminal cost needs it, so listing or building another method must not pay it."""
+    code = (
+        "import sys; from ddwmmr import Robot, make_controller; "
+        "from ddwmmr.controllers import available_methods; "
+        "names = available_methods(); make_controller('ats', Robot()); "
+        "print('mpc' in names, 'control' in sys.modules)"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
+    )
+    assert out.stdout.split() == ["True", "False"]
