@@ -73,9 +73,61 @@ def test_data_export_equals_the_track_files(tmp_path):
     track_summary = json.loads((tmp_path / "track" / "summary.json").read_text())
     summary.pop("median_step_us")
     track_summary.pop("median_step_us")
-    # track adds the record of its command line (to --rerun it); the results are the same.
+    # Both carry the record of what ran (to --rerun it); the results are the same.
     assert track_summary.pop("run")["tool"] == "track"
+    record = summary.pop("run")
+    assert record["tool"] == "gui" and record["method"] == "clrrmc-cs"
     assert summary == track_summary
+
+
+def _rerun_equals_the_export(tmp_path, settings, names):
+    """Export the app's run, repeat every exported summary with track --rerun and compare
+    the time series (all but the wall-clock column) bit for bit."""
+    app = finished_app(settings, tmp_path / "gui")
+    written = app.export_data()
+    summaries = sorted(p for p in written if p.name == "summary.json")
+    assert len(summaries) == len(names)
+    for number, path in enumerate(summaries):
+        out = tmp_path / f"rerun-{number}"
+        assert track(["--rerun", str(path), "--out", str(out), "--no-plots", "--no-progress"]) == 0
+        header, values = read_csv(path.parent / "timeseries.csv")
+        rerun_header, rerun_values = read_csv(out / "timeseries.csv")
+        assert header == rerun_header
+        keep = [i for i, name in enumerate(header) if name != "step_us"]
+        np.testing.assert_array_equal(values[:, keep], rerun_values[:, keep])
+        record = json.loads(path.read_text())["run"]
+        assert record["method"] == names[number]
+        assert json.loads((out / "summary.json").read_text())["run"]["rerun_of"] == str(
+            path.resolve()
+        )
+    return written
+
+
+def test_exported_runs_repeat_bit_for_bit_with_track_rerun(tmp_path):
+    settings = Settings(
+        methods=("qp", "ats"),
+        options=({"stability_min": 1.3, "tau": 0.4}, {}),
+        geometry={"a": 1.8, "beta": 0.3},
+        payload=2.0,
+        offset=(0.02, -0.01),
+        duration=DURATION,
+    )
+    _rerun_equals_the_export(tmp_path, settings, ["qp", "ats"])
+
+
+def test_a_moved_sampled_trajectory_is_exported_with_the_run(tmp_path):
+    settings = Settings(
+        trajectory="figure8",
+        methods=("clrrmc-ts", None),
+        geometry={"x0": 0.5, "T": 30.0},
+        plant="thesis",
+        duration=DURATION,
+    )
+    written = _rerun_equals_the_export(tmp_path, settings, ["clrrmc-ts"])
+    (moved,) = [p for p in written if p.name == "trajectory.csv"]
+    record = json.loads(next(p for p in written if p.name == "summary.json").read_text())["run"]
+    assert record["trajectory"]["file"] == str(moved.resolve())
+    assert record["plant"] == {"name": "thesis"} and record["integrator"] is None
 
 
 def test_exports_never_delete_or_replace_files(tmp_path):

@@ -14,6 +14,7 @@ from ddwmmr.trajectories.files import (
     is_name,
     package_folder,
 )
+from ddwmmr.trajectories.sampled import csv_text
 
 
 def numeric_velocity(trajectory, t, h=1e-5):
@@ -206,3 +207,15 @@ def test_parametric_api_rejects_strings_and_booleans():
         Ellipse(a="2.0")
     with pytest.raises(ParameterError, match=r"^N must be an integer"):
         Ellipse(N=True)
+
+
+def test_csv_text_reads_back_bit_for_bit(tmp_path):
+    rng = np.random.default_rng(2)
+    times = np.cumsum(rng.uniform(0.01, 1.0, 40))
+    for columns in (2, 3):
+        points = rng.normal(0.0, 3.0, (40, columns)) / 7.0  # digits beyond short reprs
+        path = tmp_path / f"samples{columns}.csv"
+        path.write_text(csv_text(SampledTrajectory(times, points, name="x")))
+        back = read_csv(path)
+        assert back.times.tobytes() == times.tobytes()
+        assert back.points.tobytes() == points.tobytes()

@@ -44,6 +44,9 @@ PROG = "python -m ddwmmr.track"
 #: The plant every track run uses (recorded; the only one until simulate() takes others).
 #: The default plant.
 PLANT = "kinematic"
+#: Tools whose summary.json records ``--rerun`` repeats: this one and the simulator's
+#: data export (``python -m ddwmmr.gui``).
+RERUN_TOOLS = ("track", "gui")
 #: Options that fix what is simulated: they come from the record with --rerun.
 RUN_OPTIONS = (
     "method", "traj", "aux", "tau", "dt", "duration", "integrator", "offset", "robot", "plant",
@@ -334,14 +337,23 @@ def load_run_record(path: str) -> dict[str, Any]:
     except ValueError as exc:
         raise ParameterError(f"rerun: {path} is not valid JSON ({exc})") from None
     record = summary.get("run") if isinstance(summary, dict) else None
-    if not isinstance(record, dict) or record.get("tool") != "track":
-        raise ParameterError(f"rerun: {path} is not a summary.json written by {PROG}")
+    if not isinstance(record, dict) or record.get("tool") not in RERUN_TOOLS:
+        raise ParameterError(
+            f"rerun: {path} is not a summary.json written by {PROG} or exported by the simulator"
+        )
     return record
 
 
-def run_record(inputs: RunInputs, argv: Sequence[str] | None, rerun: str | None) -> dict:
-    """What summary.json["run"] holds: enough to repeat the run (``--rerun``)."""
-    record = provenance.header("track", PROG, argv)
+def run_record(
+    inputs: RunInputs,
+    argv: Sequence[str] | None,
+    rerun: str | None,
+    tool: str = "track",
+    prog: str = PROG,
+) -> dict:
+    """What summary.json["run"] holds: enough to repeat the run (``--rerun``); ``tool``
+    and ``prog`` name what wrote it (the simulator's export writes the same record)."""
+    record = provenance.header(tool, prog, argv)
     record.update(
         method=inputs.method,
         options=provenance.options_record(inputs.method, inputs.options),

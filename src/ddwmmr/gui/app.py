@@ -677,9 +677,10 @@ class App(PanelLayout):
 
     @guarded
     def export_data(self) -> list[Path]:
-        """Export button: timeseries.csv and summary.json (the files `track` writes)."""
+        """Export button: timeseries.csv and summary.json (the files `track` writes, with
+        the record `python -m ddwmmr.track --rerun` repeats)."""
         folder = self._export_folder()
-        paths = export.write_run_data(folder, self.results, self.labels())
+        paths = export.write_run_data(folder, self.results, self.labels(), self.run_settings)
         self.say(f"wrote {len(paths)} files to {folder}")
         return paths
 

@@ -6,8 +6,12 @@ is ever deleted or overwritten: a name that exists gets a ``-2``, ``-3``... suff
 
 Layout of one run's export folder (``<root>/<A>[-vs-<B>]-<trajectory>-<stamp>/``)::
 
-    timeseries.csv, summary.json     one method: the files `python -m ddwmmr.track` writes
+    timeseries.csv, summary.json     one method: the files `python -m ddwmmr.track` writes,
+                                     the summary with the record that
+                                     `python -m ddwmmr.track --rerun summary.json` repeats
     A-<method>/timeseries.csv ...    side-by-side mode: one sub-folder per slot
+    trajectory.csv                   a sampled trajectory moved by the geometry controls
+                                     (the records refer to it)
     window.png                       the whole window
     animation.gif | animation.mp4    the view (paths, robot, plots) over the run
 """
@@ -25,7 +29,15 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from ddwmmr.errors import ParameterError
+from ddwmmr.gui.settings import Settings, build_robot, build_trajectory
 from ddwmmr.sim.result import write_atomic
+from ddwmmr.sim.simulate import plant_integrator
+from ddwmmr.trajectories import SampledTrajectory
+from ddwmmr.trajectories.files import find_trajectory_file
+from ddwmmr.trajectories.sampled import csv_text
+
+#: How the export records the command that ran (the record's ``command``).
+GUI_PROG = "python -m ddwmmr.gui"
 
 #: Animation formats and the matplotlib writer each needs.
 ANIMATION_WRITERS = {"gif": "pillow", "mp4": "ffmpeg"}
@@ -48,17 +60,72 @@ def run_folder(root: Path, name: str) -> Path:
     return unique_path(Path(root) / name)
 
 
-def write_run_data(folder: Path, results: Sequence[Any], labels: Sequence[str]) -> list[Path]:
-    """timeseries.csv and summary.json of every run (in a sub-folder per run when two)."""
-    written = []
-    for result, label in zip(results, labels):
+def write_run_data(
+    folder: Path,
+    results: Sequence[Any],
+    labels: Sequence[str],
+    settings: Settings | None = None,
+) -> list[Path]:
+    """timeseries.csv and summary.json of every run (in a sub-folder per run when two).
+
+    With the ``settings`` of the runs, each summary.json carries the ``run`` record of
+    `python -m ddwmmr.track` (method and every option, robot, trajectory, step, plant), so
+    `python -m ddwmmr.track --rerun summary.json` repeats the run bit for bit."""
+    written: list[Path] = []
+    records: list[dict[str, Any] | None] = [None] * len(results)
+    if settings is not None:
+        source = trajectory_source(settings, folder, written)
+        records = [
+            run_record(settings, slot, result, source)
+            for slot, result in zip(settings.active_slots, results)
+        ]
+    for result, label, record in zip(results, labels, records):
         target = folder if len(results) == 1 else folder / label
         csv_path = unique_path(target / "timeseries.csv")
         result.write_csv(csv_path)
         json_path = unique_path(target / "summary.json")
-        result.write_summary(json_path)
+        result.write_summary(json_path, **({} if record is None else {"run": record}))
         written += [csv_path, json_path]
     return written
+
+
+def trajectory_source(settings: Settings, folder: Path, written: list[Path]) -> Path | None:
+    """The trajectory file a record should name: the loaded file, or, for a sampled
+    trajectory moved by the geometry controls, ``trajectory.csv`` written into ``folder``
+    (appended to ``written``). None for a trajectory known by name only."""
+    trajectory = build_trajectory(settings)
+    source = find_trajectory_file(settings.trajectory)
+    if isinstance(trajectory, SampledTrajectory) and settings.geometry:
+        source = unique_path(folder / "trajectory.csv")
+        write_atomic(source, csv_text(trajectory))
+        written.append(source)
+    return source
+
+
+def run_record(
+    settings: Settings, slot: int, result: Any, trajectory_file: Path | None
+) -> dict[str, Any]:
+    """The ``run`` record `python -m ddwmmr.track` writes, for slot ``slot`` of
+    ``settings`` (tool ``"gui"``); step and duration are the ones the run used."""
+    from ddwmmr.cli.track import RunInputs
+    from ddwmmr.cli.track import run_record as track_record
+
+    inputs = RunInputs(
+        method=str(settings.methods[slot]),
+        options=dict(settings.options[slot]),
+        robot=build_robot(settings),
+        trajectory=build_trajectory(settings),
+        trajectory_file=trajectory_file,
+        dt=float(result.summary["dt"]),
+        duration=float(result.summary["duration"]),
+        integrator=plant_integrator(
+            settings.plant, settings.integrator if settings.plant == "kinematic" else None
+        ),
+        offset=tuple(settings.offset),
+        label=Path(settings.trajectory).stem,
+        plant=settings.plant,
+    )
+    return track_record(inputs, argv=None, rerun=None, tool="gui", prog=GUI_PROG)
 
 
 def write_window_png(figure: Figure, folder: Path, dpi: float | None = None) -> Path:

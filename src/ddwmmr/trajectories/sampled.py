@@ -154,6 +154,16 @@ class SampledTrajectory:
         return np.array([first[0], first[1], rate])
 
 
+def csv_text(trajectory: SampledTrajectory) -> str:
+    """The CSV :func:`read_csv` reads back to the same samples, bit for bit: columns
+    t, x, y[, phi], every number with the 17 significant digits of ``repr``."""
+    keys = ["t", "x", "y", "phi"][: 1 + trajectory.points.shape[1]]
+    rows = [",".join(keys)]
+    for t, point in zip(trajectory.times.tolist(), trajectory.points.tolist()):
+        rows.append(",".join(repr(value) for value in (t, *point)))
+    return "\n".join(rows) + "\n"
+
+
 def read_csv(path: str | Path) -> SampledTrajectory:
     """Load a :class:`SampledTrajectory` from a CSV file with columns t, x, y[, phi]."""
     path = Path(path)
