@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from matplotlib import animation as mpl_animation
+from matplotlib import rcParams
 from matplotlib.figure import Figure
 from PIL import Image
 
@@ -138,8 +139,28 @@ def write_window_png(figure: Figure, folder: Path, dpi: float | None = None) -> 
 
 
 def animation_available(fmt: str) -> bool:
-    """True if matplotlib can write ``fmt`` here (MP4 needs ffmpeg on PATH)."""
-    return mpl_animation.writers.is_available(ANIMATION_WRITERS[fmt])
+    """True if matplotlib can write ``fmt`` here. MP4 needs ffmpeg: on PATH, or the copy
+    the optional ``imageio-ffmpeg`` package ships (``pip install -e '.[video]'``), which
+    is then given to matplotlib (``animation.ffmpeg_path``) unless that is set already."""
+    writer = ANIMATION_WRITERS[fmt]
+    if writer == "ffmpeg" and not mpl_animation.writers.is_available(writer):
+        _use_packaged_ffmpeg()
+    return mpl_animation.writers.is_available(writer)
+
+
+def _use_packaged_ffmpeg() -> None:
+    """Point matplotlib at imageio-ffmpeg's binary when it is installed and matplotlib's
+    ffmpeg path is still its default (a path the user chose is left alone)."""
+    if rcParams["animation.ffmpeg_path"] != "ffmpeg":
+        return
+    try:
+        import imageio_ffmpeg
+    except ImportError:
+        return
+    try:
+        rcParams["animation.ffmpeg_path"] = imageio_ffmpeg.get_ffmpeg_exe()
+    except RuntimeError:  # the package is there but its binary is not (unsupported platform)
+        return
 
 
 def write_animation(
@@ -164,7 +185,7 @@ def write_animation(
     if not animation_available(fmt):
         raise ParameterError(
             f"{fmt} export needs the {ANIMATION_WRITERS[fmt]} writer, which matplotlib cannot "
-            "find here (install ffmpeg on PATH, or export a GIF)"
+            "find here (install ffmpeg on PATH or pip install imageio-ffmpeg, or export a GIF)"
         )
     figure, view = animation_figure(dpi)
     view.set_runs(results, labels, obstacles)
