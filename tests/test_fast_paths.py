@@ -2,7 +2,7 @@
 
 * each closed-form controller's float-level ``law`` (used at RK4 stages) equals its
   validated ``command``;
-* a parametric trajectory's vectorised ``sample`` equals ``pose``/``velocity``;
+* a parametric or sampled trajectory's vectorised ``sample`` equals ``pose``/``velocity``;
 * the tracking task's precomputed reference table equals evaluating the trajectory;
 * the kinematic plant's saturation equals the textbook form (max over both wheels,
   clip of each joint rate);
@@ -24,7 +24,7 @@ from ddwmmr.plants.kinematic import KinematicPlant
 from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
 from ddwmmr.sim.simulate import max_condition_number
 from ddwmmr.sim.tracking import TrackingTask
-from ddwmmr.trajectories import Ellipse, Rectangle
+from ddwmmr.trajectories import Ellipse, Rectangle, SampledTrajectory, load_trajectory
 
 CLOSED_FORM = ("pi", "ats", "ap", "clrrmc-ts", "clrrmc-cs")
 TRAJECTORIES = (
@@ -49,6 +49,31 @@ class _Scalar:
 
     def velocity(self, t):
         return self.inner.velocity(t)
+
+
+def _sampled_trajectories():
+    rng = np.random.default_rng(8)
+    times = np.cumsum(rng.uniform(0.1, 1.0, 30))
+    still = np.repeat(rng.normal(0.0, 1.0, (10, 2)), 3, axis=0)  # stops: zero speed
+    return [
+        load_trajectory("figure8"),
+        load_trajectory("sideways_reach"),
+        SampledTrajectory(times, rng.normal(0.0, 1.0, (30, 3)), name="with-phi"),
+        SampledTrajectory(times, still, name="stops"),
+    ]
+
+
+@pytest.mark.parametrize("trajectory", _sampled_trajectories(), ids=lambda tr: tr.name)
+def test_sampled_trajectory_sample_equals_pose_and_velocity_bit_for_bit(trajectory):
+    # Before the start, across every knot, past the end (clamped), and on a fine grid.
+    times = np.concatenate(
+        [np.linspace(-1.0, trajectory.duration + 1.0, 4001), trajectory.times - trajectory.times[0]]
+    )
+    poses, velocities = trajectory.sample(times)
+    expected_p = np.array([trajectory.pose(t) for t in times.tolist()])
+    expected_v = np.array([trajectory.velocity(t) for t in times.tolist()])
+    assert poses.tobytes() == expected_p.tobytes()
+    assert velocities.tobytes() == expected_v.tobytes()
 
 
 @pytest.mark.parametrize("method", CLOSED_FORM)
