@@ -187,3 +187,17 @@ def test_clrrmc_reference_with_sampled_velocities_equals_call_by_call():
         assert q_a == pytest.approx(q_b, abs=1e-12, rel=0)
         assert rate_a == pytest.approx(rate_b, abs=1e-12, rel=0)
     assert sampled.singular_nodes == plain.singular_nodes
+
+
+def test_an_unrelated_sample_method_falls_back_to_pose_and_velocity():
+    class Odd(_Scalar):
+        def sample(self, count):  # e.g. random points: not the vectorised reference
+            return list(range(3))
+
+    robot = Robot()
+    trajectory = Ellipse(T=4.0)
+    odd = TrackingTask(Odd(trajectory), KinematicPlant(robot), grid=(0.02, 200))
+    assert odd._table == {}
+    pose, velocity = odd.reference(0.5, None)
+    assert pose.tolist() == trajectory.pose(0.5).tolist()
+    assert velocity.tolist() == trajectory.velocity(0.5).tolist()

@@ -178,11 +178,18 @@ def _reference_table(
 ) -> dict[float, tuple[np.ndarray, np.ndarray]]:
     """``{t: (pose, velocity)}`` at the times the loop and the RK4 stages ask for: ``k dt``,
     ``k dt + dt/2`` and ``k dt + dt`` (computed as the loop and the integrator compute
-    them, so the float keys match exactly), rows of read-only arrays."""
+    them, so the float keys match exactly), rows of read-only arrays; empty when
+    ``sample`` does not return two ``(len(times), 3)`` arrays (an unrelated method of that
+    name: the task then evaluates the trajectory call by call)."""
     start = np.arange(steps + 1) * dt
     end = start + dt  # mostly the next start already; keep the ones rounding differently
     times = np.concatenate([start, start + 0.5 * dt, end[np.append(end[:-1] != start[1:], True)]])
-    poses, velocities = sample(times)
+    try:
+        poses, velocities = (np.array(part, dtype=float) for part in sample(times))
+    except (TypeError, ValueError):
+        return {}  # a ``sample`` meaning something else: evaluate call by call
+    if poses.shape != (len(times), 3) or velocities.shape != poses.shape:
+        return {}
     poses.setflags(write=False)
     velocities.setflags(write=False)
     return dict(zip(times.tolist(), zip(poses, velocities)))
