@@ -91,6 +91,7 @@ class ReferenceTrajectory:
         self.damping = float(damping)
         self.singular_nodes = 0
         self.last_damped = False
+        self._L1, self._L2 = robot.L1, robot.L2
         q0 = [float(v) for v in q_start]
         self._q = [q0]
         rate, damped = self._rate(q0, trajectory.velocity(0.0).tolist())
@@ -105,21 +106,12 @@ class ReferenceTrajectory:
     def _rate(self, q: list[float], velocity: list[float]) -> tuple[list[float], bool]:
         """Configuration rate at q for the desired end-effector ``velocity`` (3 floats)."""
         xd, yd, pd = velocity
+        phi = q[2]
         (v, w, t1, t2), singular = kernels.ats(
-            self.robot.L1,
-            self.robot.L2,
-            q[2],
-            q[3],
-            q[4],
-            xd,
-            yd,
-            pd,
-            self.aux,
-            self.threshold,
-            self.damping,
+            self._L1, self._L2, phi, q[3], q[4], xd, yd, pd, self.aux, self.threshold, self.damping
         )
         self.singular_nodes += singular
-        return [v * math.cos(q[2]), v * math.sin(q[2]), w, t1, t2], singular
+        return [v * math.cos(phi), v * math.sin(phi), w, t1, t2], singular
 
     def _stage_velocities(self, first: int, last: int) -> list[tuple[list[float], list[float]]]:
         """Desired velocities at ``k h + h/2`` and ``k h + h`` for steps k = first..last-1:
@@ -144,32 +136,38 @@ class ReferenceTrajectory:
         last = first
         while last * h < t + h:  # the steps the loop below takes
             last += 1
+        rate, half, sixth = self._rate, h / 2, h / 6
+        q, k1, damped = self._q[-1], self._qdot[-1], self._node_damped[-1]
         for middle, end in self._stage_velocities(first, last):
-            q = self._q[-1]
-            k1 = self._qdot[-1]
-            k2, d2 = self._rate([a + h / 2 * b for a, b in zip(q, k1)], middle)
-            k3, d3 = self._rate([a + h / 2 * b for a, b in zip(q, k2)], middle)
-            k4, d4 = self._rate([a + h * b for a, b in zip(q, k3)], end)
+            k2, d2 = rate([a + half * b for a, b in zip(q, k1)], middle)
+            k3, d3 = rate([a + half * b for a, b in zip(q, k2)], middle)
+            k4, d4 = rate([a + h * b for a, b in zip(q, k3)], end)
             q_next = [
-                a + h / 6 * (b1 + 2 * b2 + 2 * b3 + b4)
+                a + sixth * (b1 + 2 * b2 + 2 * b3 + b4)
                 for a, b1, b2, b3, b4 in zip(q, k1, k2, k3, k4)
             ]
-            rate_next, d_next = self._rate(q_next, end)
-            self._segment_damped.append(self._node_damped[-1] or d2 or d3 or d4 or d_next)
+            rate_next, d_next = rate(q_next, end)
+            self._segment_damped.append(damped or d2 or d3 or d4 or d_next)
+            self._coefficients.append(self._cubic(q, q_next, k1, rate_next))
             self._q.append(q_next)
             self._qdot.append(rate_next)
             self._node_damped.append(d_next)
-            self._coefficients.append(self._segment(len(self._q) - 2))
+            q, k1, damped = q_next, rate_next, d_next
 
-    def _segment(self, i: int) -> tuple[tuple[float, ...], ...]:
-        """Cubic coefficients ``(c0, c1, c2, c3)`` per coordinate of segment i (in s = 0..1).
+    def _cubic(
+        self, q0: list[float], q1: list[float], rate0: list[float], rate1: list[float]
+    ) -> tuple[tuple[float, float, float, float], ...]:
+        """Cubic coefficients ``(c0, c1, c2, c3)`` per coordinate of the segment from node
+        ``(q0, rate0)`` to node ``(q1, rate1)`` (in s = 0..1).
 
         Computed once per segment while integrating, so a lookup is a polynomial evaluation.
         """
         h = self.step
         return tuple(
-            (a, h * da, 3.0 * (b - a) - h * (2.0 * da + db), 2.0 * (a - b) + h * (da + db))
-            for a, b, da, db in zip(self._q[i], self._q[i + 1], self._qdot[i], self._qdot[i + 1])
+            [
+                (a, h * da, 3.0 * (b - a) - h * (2.0 * da + db), 2.0 * (a - b) + h * (da + db))
+                for a, b, da, db in zip(q0, q1, rate0, rate1)
+            ]
         )
 
     def __call__(self, t: float) -> tuple[list[float], list[float]]:
