@@ -23,7 +23,7 @@ from ddwmmr.controllers import make_controller
 from ddwmmr.plants.kinematic import KinematicPlant
 from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
 from ddwmmr.sim.simulate import max_condition_number
-from ddwmmr.sim.tracking import TrackingTask
+from ddwmmr.sim.tracking import ReferenceBlocks, TrackingTask
 from ddwmmr.trajectories import Ellipse, Rectangle, SampledTrajectory, load_trajectory
 
 CLOSED_FORM = ("pi", "ats", "ap", "clrrmc-ts", "clrrmc-cs")
@@ -108,23 +108,29 @@ def test_sample_equals_pose_and_velocity(trajectory):
     np.testing.assert_allclose(velocities, expected_v, rtol=0.0, atol=1e-14)
 
 
-def test_reference_table_matches_the_trajectory_at_sample_and_stage_times():
+def test_reference_blocks_match_the_trajectory_at_sample_and_stage_times(monkeypatch):
+    monkeypatch.setattr(ReferenceBlocks, "BLOCK", 64)  # 1000 steps: 16 blocks
     robot = Robot()
     trajectory = Rectangle(T=10.0)
     dt, steps = 0.01, 1000  # 0.01 makes k dt + dt and (k + 1) dt differ now and then
     task = TrackingTask(trajectory, KinematicPlant(robot), grid=(dt, steps))
     plain = TrackingTask(_Scalar(trajectory), KinematicPlant(robot), grid=(dt, steps))
+    evaluated = []
+    task._pose = lambda t: evaluated.append(t) or trajectory.pose(t)
     differ = sum(k * dt + dt != (k + 1) * dt for k in range(steps))
-    assert differ > 0  # the case the table covers separately
+    assert differ > 0  # the case the blocks cover separately
     for k in range(steps):
         t = k * dt
-        for stage in (t, t + 0.5 * dt, t + dt, (k + 1) * dt):
+        for stage in (t, t + 0.5 * dt, t + dt, (k + 1) * dt):  # as the loop and RK4 ask
             pose, velocity = task.reference(stage, None)
             pose_ref, velocity_ref = plain.reference(stage, None)
             assert pose.tolist() == pytest.approx(pose_ref.tolist(), abs=1e-14, rel=0)
             assert velocity.tolist() == pytest.approx(velocity_ref.tolist(), abs=1e-14, rel=0)
-    assert len(task._table) >= 2 * (steps + 1)
-    assert not task._table[0.0][0].flags.writeable  # shared rows are read-only
+            assert not pose.flags.writeable  # shared rows are read-only
+    assert evaluated == []  # every one came from a block
+    assert len(task._table) <= 3 * 64  # one block in memory at a time
+    assert task.reference(0.123456, None)[0].tolist() == trajectory.pose(0.123456).tolist()
+    assert evaluated == [0.123456]  # off the grid: evaluated on its own
 
 
 def _textbook_saturation(robot, th1, th2, u):
@@ -197,7 +203,7 @@ def test_an_unrelated_sample_method_falls_back_to_pose_and_velocity():
     robot = Robot()
     trajectory = Ellipse(T=4.0)
     odd = TrackingTask(Odd(trajectory), KinematicPlant(robot), grid=(0.02, 200))
-    assert odd._table == {}
     pose, velocity = odd.reference(0.5, None)
+    assert not odd._blocks.enabled and odd._table == {}
     assert pose.tolist() == trajectory.pose(0.5).tolist()
     assert velocity.tolist() == trajectory.velocity(0.5).tolist()

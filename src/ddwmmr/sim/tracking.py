@@ -80,9 +80,10 @@ class TrackingTask:
         trajectory: any object with ``pose(t)`` and ``velocity(t)`` (world frame).
         plant: the plant (for its extra columns).
         grid: ``(dt, steps)`` of the run: when the trajectory has a vectorised
-            ``sample(times)``, the references at every sample ``k dt`` and at the RK4
-            stage times ``k dt + dt/2``, ``k dt + dt`` are computed before the run in one
-            call (the same numbers :meth:`reference` would compute one by one).
+            ``sample(times)``, the references at the samples ``k dt`` and at the RK4 stage
+            times ``k dt + dt/2``, ``k dt + dt`` are computed a block of steps at a time
+            (:class:`ReferenceBlocks`; the same numbers :meth:`reference` would compute
+            one by one).
     """
 
     def __init__(
@@ -99,7 +100,8 @@ class TrackingTask:
         # Reference cache: RK4 asks twice at t + dt/2, and the recorder again at t.
         self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         sample = getattr(trajectory, "sample", None)
-        self._table = {} if grid is None or sample is None else _reference_table(sample, *grid)
+        self._blocks = None if grid is None or sample is None else ReferenceBlocks(sample, *grid)
+        self._table: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         self._extra_values = plant.extra_values if plant.extra_columns else None
 
     # -- Task protocol ----------------------------------------------------------------------
@@ -113,7 +115,18 @@ class TrackingTask:
 
     def reference(self, t: float, obs: Observation | None) -> tuple[np.ndarray, np.ndarray]:
         """The trajectory's pose and velocity at t (s) (the arrays must not be modified)."""
-        cached = self._table.get(t) or self._cache.get(t)
+        cached = self._table.get(t)  # the current block of precomputed references
+        return cached if cached is not None else self._lookup(t)
+
+    def _lookup(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """A reference not in the current block: the next block, else one evaluation."""
+        blocks = self._blocks
+        if blocks is not None:
+            found = blocks.get(t)
+            self._table = blocks.table
+            if found is not None:
+                return found
+        cached = self._cache.get(t)
         if cached is None:
             if len(self._cache) > 4:
                 self._cache.clear()
@@ -173,26 +186,56 @@ class TrackingTask:
         return series
 
 
-def _reference_table(
-    sample: Any, dt: float, steps: int
-) -> dict[float, tuple[np.ndarray, np.ndarray]]:
-    """``{t: (pose, velocity)}`` at the times the loop and the RK4 stages ask for: ``k dt``,
-    ``k dt + dt/2`` and ``k dt + dt`` (computed as the loop and the integrator compute
-    them, so the float keys match exactly), rows of read-only arrays; empty when
-    ``sample`` does not return two ``(len(times), 3)`` arrays (an unrelated method of that
-    name: the task then evaluates the trajectory call by call)."""
-    start = np.arange(steps + 1) * dt
-    end = start + dt  # mostly the next start already; keep the ones rounding differently
-    times = np.concatenate([start, start + 0.5 * dt, end[np.append(end[:-1] != start[1:], True)]])
-    try:
-        poses, velocities = (np.array(part, dtype=float) for part in sample(times))
-    except (TypeError, ValueError):
-        return {}  # a ``sample`` meaning something else: evaluate call by call
-    if poses.shape != (len(times), 3) or velocities.shape != poses.shape:
-        return {}
-    poses.setflags(write=False)
-    velocities.setflags(write=False)
-    return dict(zip(times.tolist(), zip(poses, velocities)))
+class ReferenceBlocks:
+    """References at a run's sample and RK4 stage times, computed a block of steps at a
+    time through the trajectory's vectorised ``sample(times)``.
+
+    The times are ``k dt``, ``k dt + dt/2`` and ``k dt + dt``, computed as the loop and
+    the integrator compute them, so the float keys match exactly. A block of
+    :data:`BLOCK` steps costs one ``sample`` call and keeps memory bounded on long runs;
+    rows are read-only arrays. A ``sample`` that does not return two ``(len(times), 3)``
+    arrays (an unrelated method of that name) switches the blocks off: the task then
+    evaluates the trajectory call by call.
+    """
+
+    #: Steps per block.
+    BLOCK = 4096
+
+    def __init__(self, sample: Any, dt: float, steps: int) -> None:
+        self.sample, self.dt, self.steps = sample, dt, steps
+        self.enabled = True
+        self._block = -1
+        #: The current block: ``{t: (pose, velocity)}``.
+        self.table: dict[float, tuple[np.ndarray, np.ndarray]] = {}
+
+    def get(self, t: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(pose, velocity)`` at t (s), or None for a time off the grid."""
+        found = self.table.get(t)
+        if found is None and self.enabled:
+            k = int(t / self.dt + 0.25)  # the step k of k dt and k dt + dt/2 (rounding-proof)
+            block = k // self.BLOCK
+            if 0 <= k <= self.steps and block != self._block:
+                self._load(block)
+                found = self.table.get(t)
+        return found
+
+    def _load(self, block: int) -> None:
+        first = block * self.BLOCK
+        start = np.arange(first, min(first + self.BLOCK, self.steps + 1)) * self.dt
+        end = start + self.dt  # mostly the next start already: keep those rounding apart
+        following = np.append(start[1:], np.nan)
+        times = np.concatenate([start, start + 0.5 * self.dt, end[end != following]])
+        try:
+            poses, velocities = (np.array(part, dtype=float) for part in self.sample(times))
+        except (TypeError, ValueError):
+            poses = velocities = np.zeros(0)
+        if poses.shape != (len(times), 3) or velocities.shape != poses.shape:
+            self.enabled, self.table = False, {}
+            return
+        poses.setflags(write=False)
+        velocities.setflags(write=False)
+        self._block = block
+        self.table = dict(zip(times.tolist(), zip(poses, velocities)))
 
 
 def _force_equivalent(obs: Observation) -> list[float]:
