@@ -108,17 +108,7 @@ class SampledTrajectory:
         i, s, h = self._segment(t)
         p0, p1 = self.points[i], self.points[i + 1]
         m0, m1 = self._slopes[i] * h, self._slopes[i + 1] * h
-        s2, s3 = s * s, s * s * s
-        value = (
-            (2 * s3 - 3 * s2 + 1) * p0
-            + (s3 - 2 * s2 + s) * m0
-            + (-2 * s3 + 3 * s2) * p1
-            + (s3 - s2) * m1
-        )
-        first = ((6 * s2 - 6 * s) * p0 + (3 * s2 - 4 * s + 1) * m0) + (
-            (-6 * s2 + 6 * s) * p1 + (3 * s2 - 2 * s) * m1
-        )
-        second = (12 * s - 6) * p0 + (6 * s - 4) * m0 + (-12 * s + 6) * p1 + (6 * s - 2) * m1
+        value, first, second = _hermite_terms(s, p0, p1, m0, m1)
         return value, first / h, second / (h * h)
 
     def _heading_reference(self, t: float) -> float:
@@ -166,25 +156,13 @@ class SampledTrajectory:
         s = (t_abs - knots[i]) / h
         p0, p1 = self.points[i], self.points[i + 1]
         m0, m1 = self._slopes[i] * h[:, None], self._slopes[i + 1] * h[:, None]
-        s = s[:, None]
-        s2, s3 = s * s, s * s * s
-        value = (
-            (2 * s3 - 3 * s2 + 1) * p0
-            + (s3 - 2 * s2 + s) * m0
-            + (-2 * s3 + 3 * s2) * p1
-            + (s3 - s2) * m1
-        )
-        first = ((6 * s2 - 6 * s) * p0 + (3 * s2 - 4 * s + 1) * m0) + (
-            (-6 * s2 + 6 * s) * p1 + (3 * s2 - 2 * s) * m1
-        )
-        second = (12 * s - 6) * p0 + (6 * s - 4) * m0 + (-12 * s + 6) * p1 + (6 * s - 2) * m1
+        value, first, second = _hermite_terms(s[:, None], p0, p1, m0, m1)
         first = first / h[:, None]
         second = second / (h * h)[:, None]
         if self._has_phi:
             return value, first
         heading = np.array(list(map(math.atan2, first[:, 1].tolist(), first[:, 0].tolist())))
         headings = self._knot_headings()
-        s = s[:, 0]
         reference = (1 - s) * headings[i] + s * headings[i + 1]
         heading = heading + 2 * math.pi * np.round((reference - heading) / (2 * math.pi))
         speed2 = _squares(first[:, 0]) + _squares(first[:, 1])
@@ -193,6 +171,25 @@ class SampledTrajectory:
         rate = np.where(speed2 < 1e-12, 0.0, turn)
         poses = np.column_stack([value[:, 0], value[:, 1], heading])
         return poses, np.column_stack([first[:, 0], first[:, 1], rate])
+
+
+def _hermite_terms(s, p0, p1, m0, m1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cubic Hermite value and first and second derivatives with respect to s (in 0..1)
+    between points p0, p1 with tangents m0, m1 (already times the segment length): one
+    segment (``s`` a float, points of shape (d,)) or many (``s`` of shape (n, 1), points
+    (n, d)), by the same operations in the same order."""
+    s2, s3 = s * s, s * s * s
+    value = (
+        (2 * s3 - 3 * s2 + 1) * p0
+        + (s3 - 2 * s2 + s) * m0
+        + (-2 * s3 + 3 * s2) * p1
+        + (s3 - s2) * m1
+    )
+    first = ((6 * s2 - 6 * s) * p0 + (3 * s2 - 4 * s + 1) * m0) + (
+        (-6 * s2 + 6 * s) * p1 + (3 * s2 - 2 * s) * m1
+    )
+    second = (12 * s - 6) * p0 + (6 * s - 4) * m0 + (-12 * s + 6) * p1 + (6 * s - 2) * m1
+    return value, first, second
 
 
 def _squares(values: np.ndarray) -> np.ndarray:
