@@ -430,3 +430,39 @@ def test_cli_refuses_an_unusable_out_path_before_running(tmp_path, case):
     assert result.returncode == 2 and len(result.stderr.splitlines()) == 1
     assert result.stderr.startswith("bench: error: out: ")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["plain"]
+
+
+# -- scenario throughput --------------------------------------------------------------------
+def test_scenario_throughput_counts_the_simulated_time_of_every_scenario():
+    from ddwmmr.bench import SCENARIO_CONTROLLERS, time_scenarios
+    from ddwmmr.scenarios.generator import generate
+    from ddwmmr.scenarios.protocol import RunConfig, run_scenario
+
+    rows = time_scenarios(3, jobs=1)
+    assert [row["controller"] for row in rows] == list(SCENARIO_CONTROLLERS)
+    for row in rows:
+        expected = sum(
+            run_scenario(s, RunConfig(controller=row["controller"])).metrics["time_s"]
+            for s in generate(3, 0)
+        )
+        assert row["sim_time_s"] == pytest.approx(expected, rel=1e-12)
+        assert row["wall_time_s"] > 0 and row["failed"] == 0
+        assert row["sim_seconds_per_wall_second"] == pytest.approx(
+            row["sim_time_s"] / row["wall_time_s"]
+        )
+
+
+def test_cli_times_scenarios_only_when_asked_with_a_method(tmp_path, capsys):
+    out = tmp_path / "b.json"
+    args = ["--repeats", "1", "--calls", "5", "--duration", "0.1", "--method", "ats"]
+    assert main([*args, "--out", str(out), "--scenarios", "2", "--jobs", "1"]) == 0
+    printed = capsys.readouterr().out
+    data = json.loads(out.read_text())
+    assert [row["scenarios"] for row in data["scenarios"]] == [2, 2]
+    assert "scenario benchmark (2 scenarios, seed 0, 1 workers" in printed
+    assert main([*args, "--out", str(out)]) == 0  # --method alone: no scenarios
+    assert json.loads(out.read_text())["scenarios"] == []
+    with pytest.raises(SystemExit) as stop:
+        main([*args, "--out", str(out), "--scenarios", "-1"])
+    assert stop.value.code == 2
+    assert "--scenarios: must be an integer in [0, 100000]" in capsys.readouterr().err

@@ -1,7 +1,7 @@
 """Benchmark: control-step latency of every method, the qp step by state class and phase,
 full-run throughput; the report goes to ``bench.json``.
 
-Two parts (docs/api.md, "Benchmark", explains the method):
+Three parts (docs/api.md, "Benchmark", explains the method):
 
 * **methods**: the naive baseline ``naive-pinv``, every registered method and the extra
   rows of :data:`EXTRA_CASES`, each timed call by call over states recorded from a
@@ -14,7 +14,10 @@ Two parts (docs/api.md, "Benchmark", explains the method):
   path, with a user task and limit, its naive twin ``qp-naive`` and the reference a user
   would otherwise pick, roboticstoolbox-python's holistic QP step (``rtb-holistic``,
   skipped with the reason when the ``bench`` extra is not installed); plus the cost of
-  each phase of a qp step (build, solve, check) and how often the exact look-ahead ran.
+  each phase of a qp step (build, solve, check) and how often the exact look-ahead ran;
+* **scenarios**: simulated seconds per wall-clock second of the thesis benchmark's
+  scenarios with the thesis controller and with ``qp`` (:func:`time_scenarios`, on by
+  default in the command-line run without ``--method``).
 
 Targets (issue 14): qp median <= 20 us and p99 <= 40 us in every class; rtb-holistic
 at least 40x slower than qp. Timing thresholds are never unit tests: they are reported.
@@ -46,7 +49,7 @@ from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import u_from_qdot
 from ddwmmr.outputs import check_output_file
-from ddwmmr.progress import ProgressBar
+from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.sim import simulate
 from ddwmmr.sim.result import write_atomic
 from ddwmmr.trajectories import Ellipse
@@ -61,6 +64,9 @@ TARGET_RATIO = 0.25
 STEP_BUDGETS_US: dict[str, float] = {"qp": 60.0, "mpc": 2000.0}
 #: Issue 14 targets of the qp step, judged in every state class.
 QP_TARGETS = {"median_us": 20.0, "p99_us": 40.0, "reference_ratio": 40.0}
+#: Controllers of the scenario-throughput section (issue 14, target 3) and its default size.
+SCENARIO_CONTROLLERS = ("thesis", "qp")
+SCENARIO_COUNT = 100
 #: Method whose run provides the states of the method table.
 STATE_SOURCE_METHOD = "clrrmc-ts"
 #: Marker of a report written by this tool (an existing ``--out`` file must carry it).
@@ -697,6 +703,8 @@ def run_benchmark(
     trajectory: Any = None,
     qp_classes: bool | None = None,
     progress: bool = False,
+    scenarios: int = 0,
+    scenario_jobs: int | None = None,
 ) -> dict[str, Any]:
     """Measure every case; returns the report (see :func:`format_table` for the columns).
 
@@ -709,6 +717,10 @@ def run_benchmark(
         robot, trajectory: of the method table; default ``Robot()`` and ``Ellipse()``.
         qp_classes: also measure the qp state classes (default: when ``qp`` is measured).
         progress: a progress bar on stderr (terminals only).
+        scenarios: also run the first ``scenarios`` thesis benchmark scenarios (seed 0)
+            with each of :data:`SCENARIO_CONTROLLERS` and report simulated seconds per
+            wall-clock second (:func:`time_scenarios`); 0 (default) skips it.
+        scenario_jobs: worker processes for them (default: the CPUs available).
     """
     if repeats < 1 or calls < 1:
         raise ValueError("repeats and calls must be >= 1")
@@ -732,6 +744,10 @@ def run_benchmark(
             classes = _qp_classes(
                 Robot().with_payload(3.0), calls, repeats, overhead_ns, reference, bar
             )
+    throughput = []
+    if scenarios > 0:
+        with phase(f"bench: {scenarios} scenarios x {len(SCENARIO_CONTROLLERS)}", enabled=progress):
+            throughput = time_scenarios(scenarios, scenario_jobs)
     return {
         "tool": TOOL,
         "version": REPORT_VERSION,
@@ -743,8 +759,39 @@ def run_benchmark(
         "skipped": skipped,
         "qp_classes": classes,
         "qp_targets": dict(QP_TARGETS),
+        "scenarios": throughput,
         "config": _config(repeats, calls, trajectory, duration, overhead_ns),
     }
+
+
+def time_scenarios(count: int, jobs: int | None = None) -> list[dict[str, Any]]:
+    """Simulated seconds per wall-clock second of the first ``count`` scenarios (seed 0,
+    the defaults of ``python -m ddwmmr.scenarios``) for each controller of
+    :data:`SCENARIO_CONTROLLERS`, on ``jobs`` worker processes (default: the CPUs)."""
+    from ddwmmr.scenarios.executors import default_jobs, run_many
+    from ddwmmr.scenarios.generator import generate
+    from ddwmmr.scenarios.protocol import RunConfig
+
+    jobs = default_jobs() if jobs is None else jobs
+    batch = generate(count, 0)
+    rows = []
+    for controller in SCENARIO_CONTROLLERS:
+        start = time.perf_counter()
+        outcomes = run_many(batch, RunConfig(controller=controller), jobs=jobs)
+        wall = time.perf_counter() - start
+        simulated = float(sum(o.metrics["time_s"] for o in outcomes))
+        rows.append(
+            {
+                "controller": controller,
+                "scenarios": count,
+                "jobs": jobs,
+                "failed": sum(not o.metrics["success"] for o in outcomes),
+                "sim_time_s": simulated,
+                "wall_time_s": wall,
+                "sim_seconds_per_wall_second": simulated / wall,
+            }
+        )
+    return rows
 
 
 def _config(repeats: int, calls: int, trajectory: Any, duration: float, overhead: float):
@@ -814,7 +861,25 @@ def format_table(report: dict[str, Any]) -> str:
         lines.append(f"skipped {label}: {reason}")
     if report.get("qp_classes"):
         lines += ["", *format_qp_classes(report)]
+    if report.get("scenarios"):
+        lines += ["", *format_scenarios(report)]
     return "\n".join(lines)
+
+
+def format_scenarios(report: dict[str, Any]) -> list[str]:
+    """The scenario-throughput section of the table."""
+    first = report["scenarios"][0]
+    lines = [
+        f"scenario benchmark ({first['scenarios']} scenarios, seed 0, {first['jobs']} "
+        "workers; simulated s per wall s, wall time includes the worker pool)"
+    ]
+    for row in report["scenarios"]:
+        lines.append(
+            f"  {row['controller']:<8} {row['sim_seconds_per_wall_second']:>8.0f}   "
+            f"({row['sim_time_s']:.0f} simulated s in {row['wall_time_s']:.2f} s, "
+            f"{row['failed']} failed)"
+        )
+    return lines
 
 
 def format_qp_classes(report: dict[str, Any]) -> list[str]:
@@ -905,6 +970,18 @@ def format_comparison(report: dict[str, Any], previous: dict[str, Any]) -> str:
                 f"  qp, {entry['name']:<20} {old_us:>8.2f} -> {new_us:>8.2f} us "
                 f"({new_us / old_us:.2f}x)"
             )
+    old_scenarios = {row["controller"]: row for row in previous.get("scenarios", [])}
+    for row in report.get("scenarios", []):
+        old = old_scenarios.get(row["controller"])
+        if old:
+            new_rate, old_rate = (
+                row["sim_seconds_per_wall_second"],
+                old["sim_seconds_per_wall_second"],
+            )
+            lines.append(
+                f"  scenarios, {row['controller']:<14} {old_rate:>8.0f} -> {new_rate:>8.0f} "
+                f"simulated s per wall s ({new_rate / old_rate:.2f}x)"
+            )
     return "\n".join(lines)
 
 
@@ -966,6 +1043,16 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 100_000:
+        raise argparse.ArgumentTypeError(f"must be an integer in [0, 100000] (got {text!r})")
+    return value
+
+
 def _positive_float(text: str) -> float:
     try:
         value = float(text)
@@ -1016,6 +1103,21 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--compare", metavar="FILE", help="also print medians against an earlier report"
     )
+    parser.add_argument(
+        "--scenarios",
+        type=_non_negative_int,
+        default=None,
+        metavar="N",
+        help=f"also time the first N benchmark scenarios with {' and '.join(SCENARIO_CONTROLLERS)} "
+        f"(simulated s per wall s; default {SCENARIO_COUNT} without --method, else 0; 0: skip)",
+    )
+    parser.add_argument(
+        "--jobs",
+        type=_positive_int,
+        default=None,
+        metavar="N",
+        help="worker processes of the scenario timing (default: the CPUs available)",
+    )
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     return parser
 
@@ -1044,7 +1146,18 @@ def _main(argv: Sequence[str] | None = None) -> int:
         previous = read_report(args.compare) if args.compare else None
         out = Path(args.out)
         check_out(out, force=args.force)  # before a minute-long run
-        report = run_benchmark(args.repeats, args.calls, args.duration, args.methods, progress=True)
+        scenarios = args.scenarios
+        if scenarios is None:
+            scenarios = SCENARIO_COUNT if args.methods is None else 0
+        report = run_benchmark(
+            args.repeats,
+            args.calls,
+            args.duration,
+            args.methods,
+            progress=True,
+            scenarios=scenarios,
+            scenario_jobs=args.jobs,
+        )
         write_report(report, out, force=args.force)
     except ParameterError as exc:
         print(f"bench: error: {exc}", file=sys.stderr)
