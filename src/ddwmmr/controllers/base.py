@@ -45,7 +45,13 @@ class StepInfo:
 
 
 class Controller(Protocol):
-    """Structural type of every controller."""
+    """Structural type of every controller.
+
+    Optional members the simulation loop looks for (:mod:`ddwmmr.sim.loop`): ``interface``,
+    ``zero_order_hold``, ``wants_base_velocity`` and ``law(t, q, pose_d, velocity_d)``, the
+    control law on lists of floats that the integrator's stages call instead of
+    :meth:`command` (the closed-form methods have it).
+    """
 
     name: str
     last: StepInfo
