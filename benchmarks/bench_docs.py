@@ -6,7 +6,9 @@
 Each document keeps its generated part between two marker comments (``<!-- bench:NAME
 begin -->`` and ``<!-- bench:NAME end -->``): docs/api.md the full text table
 (``api-table``), docs/qp.md the qp step by state class and by phase (``qp-classes``).
-Everything outside the markers is left as it is; each file is replaced atomically.
+Everything outside the markers is left as it is; each file is replaced atomically. The
+figure docs/figures/bench.png (step latency, full-run throughput, the phases of a qp step)
+is drawn from the same report.
 """
 
 from __future__ import annotations
@@ -20,6 +22,9 @@ from typing import Any
 
 from ddwmmr.bench import PHASES, REFERENCE_LABEL, TOOL, format_table
 from ddwmmr.sim.result import write_atomic
+
+#: The simulate-throughput target of issue 14 (steps/s of a closed-form method's full run).
+RUN_TARGET = 60_000
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -79,6 +84,64 @@ def qp_tables(report: dict[str, Any]) -> str:
     return "\n".join([conditions(report), "", *latency, "", *phases])
 
 
+def plot_report(report: dict[str, Any], path: Path) -> Path:
+    """docs/figures/bench.png: control-step latency per row (median, p90 and p99 over
+    states, log scale), full-run throughput of every method, and the phases of a qp step
+    in each state class next to the reference step."""
+    import io
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    rows = report["rows"]
+    labels = [row["label"] for row in rows]
+    figure, (latency, runs, phases) = plt.subplots(
+        1, 3, figsize=(15, 4.8), gridspec_kw={"width_ratios": [1.2, 1.0, 1.1]}
+    )
+    y = range(len(rows))
+    colours = ["0.55" if row["kind"] != "method" else "tab:blue" for row in rows]
+    latency.barh(y, [row["step_us"] for row in rows], color=colours)
+    latency.scatter([row["step_p90_us"] for row in rows], y, marker="|", color="k", label="p90")
+    latency.scatter([row["step_p99_us"] for row in rows], y, marker="x", color="k", label="p99")
+    latency.set(xscale="log", xlabel="control step (us), median over states", title="Step")
+    latency.set_yticks(list(y), labels)
+    latency.invert_yaxis()
+    latency.legend(loc="upper right", fontsize=8)
+    methods = [row for row in rows if row["kind"] != "extra"]
+    runs.barh(
+        range(len(methods)), [row["steps_per_s"] / 1000 for row in methods], color="tab:green"
+    )
+    runs.axvline(RUN_TARGET / 1000, color="tab:red", ls="--", label="issue 14: 60k steps/s")
+    runs.set_yticks(range(len(methods)), [row["label"] for row in methods])
+    runs.invert_yaxis()
+    runs.set(xlabel="full simulate run (1000 steps/s)", title="Run (RK4, 2000 steps)")
+    runs.legend(loc="lower right", fontsize=8)
+    classes = [entry for entry in report.get("qp_classes", []) if "phases" in entry]
+    left = [0.0] * len(classes)
+    for phase in PHASES:
+        widths = [entry["phases"][phase] for entry in classes]
+        phases.barh(range(len(classes)), widths, left=left, label=phase)
+        left = [a + b for a, b in zip(left, widths)]
+    phases.set_yticks(range(len(classes)), [entry["name"] for entry in classes])
+    phases.invert_yaxis()
+    title = "qp step by state class"
+    reference = [entry["rows"].get(REFERENCE_LABEL, {}).get("median_us") for entry in classes]
+    if classes and all(value is not None for value in reference):
+        title += f"\n({REFERENCE_LABEL}: {min(reference):.0f}-{max(reference):.0f} us)"
+    phases.set(xlabel="qp step (us), median of each phase", title=title)
+    phases.set_xlim(0.0, 1.45 * max(left, default=1.0))
+    phases.legend(loc="center right", fontsize=8)
+    figure.suptitle(conditions(report), fontsize=8)
+    figure.tight_layout()
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=90, metadata={"Software": None})
+    plt.close(figure)
+    write_atomic(path, buffer.getvalue())
+    return path
+
+
 def replace_block(text: str, name: str, body: str) -> str:
     """``text`` with the part between the ``name`` markers replaced by ``body``."""
     pattern = re.compile(
@@ -106,6 +169,8 @@ def main(argv: list[str] | None = None) -> int:
         text = document.read_text(encoding="utf-8")
         write_atomic(document, replace_block(text, name, block))
         print(f"updated {document} ({name})")
+    figure = plot_report(report, docs / "figures" / "bench.png")
+    print(f"drew {figure}")
     return 0
 
 

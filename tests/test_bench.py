@@ -407,6 +407,8 @@ def test_docs_tables_are_regenerated_between_their_markers(report, tmp_path):
         assert f"| {entry['name']} | {entry['states']} | {median:.1f} / " in qp
         assert f"| {entry['name']} | {entry['phases']['build']:.2f} | " in qp
     assert bench_docs.main([str(out), "--docs", str(docs)]) == 0  # idempotent
+    figure = docs / "figures" / "bench.png"
+    assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and figure.stat().st_size > 10_000
     assert (docs / "qp.md").read_text() == qp
 
 
