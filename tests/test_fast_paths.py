@@ -18,7 +18,7 @@ import math
 import numpy as np
 import pytest
 
-from ddwmmr import Robot
+from ddwmmr import Robot, simulate
 from ddwmmr.controllers import make_controller
 from ddwmmr.plants.kinematic import KinematicPlant
 from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
@@ -207,3 +207,34 @@ def test_an_unrelated_sample_method_falls_back_to_pose_and_velocity():
     assert not odd._blocks.enabled and odd._table == {}
     assert pose.tolist() == trajectory.pose(0.5).tolist()
     assert velocity.tolist() == trajectory.velocity(0.5).tolist()
+
+
+def test_a_subclass_changing_command_is_not_bypassed_by_law():
+    from ddwmmr.controllers.resolved_rate import AugmentedTaskSpaceController
+    from ddwmmr.sim.loop import stage_law
+
+    calls = []
+
+    class Halved(AugmentedTaskSpaceController):
+        def command(self, t, q, pose_d, velocity_d):
+            calls.append(t)
+            return 0.5 * super().command(t, q, pose_d, velocity_d)
+
+    class OwnLaw(AugmentedTaskSpaceController):
+        def law(self, t, q, pose_d, velocity_d):
+            calls.append(t)
+            u, singular = super().law(t, q, pose_d, velocity_d)
+            return tuple(0.5 * value for value in u), singular
+
+    robot = Robot()
+    assert stage_law(Halved(robot)) is None
+    assert stage_law(OwnLaw(robot)) is not None
+    assert stage_law(make_controller("ats", robot)) is not None
+    trajectory = Ellipse(T=4.0)
+    halved = simulate(robot, trajectory, Halved(robot), duration=1.0, dt=0.02)
+    assert len(calls) == 4 * 50 + 1  # command at every RK4 stage, as the subclass asks
+    calls.clear()
+    own = simulate(robot, trajectory, OwnLaw(robot), duration=1.0, dt=0.02)
+    assert len(calls) == 4 * 50 + 1  # command calls law once a step, the stages three times
+    for name in ("x", "y", "phi", "th1", "th2"):
+        np.testing.assert_array_equal(halved.timeseries[name], own.timeseries[name])

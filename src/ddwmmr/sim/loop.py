@@ -28,7 +28,9 @@ Controller contract (class attributes, all optional):
 * ``last``: a :class:`~ddwmmr.controllers.base.StepInfo` about the last command.
 * ``law(t, q, pose_d, velocity_d) -> (u, ...)``: the control law on lists of floats, with
   no validation and no step info; when present, the integrator's stages call it instead
-  of ``command`` (same numbers, a third of the cost). ``u`` is a tuple of 4 floats.
+  of ``command`` (same numbers, a third of the cost). ``u`` is a tuple of 4 floats. A
+  subclass overriding ``command`` below the class defining ``law`` gets ``command`` at
+  the stages (:func:`stage_law`).
 """
 
 from __future__ import annotations
@@ -127,6 +129,24 @@ def check_interface(controller: Any, plant: Plant) -> str:
     return interface
 
 
+def stage_law(controller: Any) -> Callable[..., Any] | None:
+    """The controller's ``law`` if the integrator may call it at its stages, else None.
+
+    ``law`` stands for ``command`` only where ``command`` is not overridden below the class
+    that defines ``law``: a subclass that changes ``command`` (adds noise, clips, logs)
+    without a matching ``law`` has ``command`` called at every stage, as before ``law``
+    existed."""
+    law = getattr(controller, "law", None)
+    if law is None:
+        return None
+    mro = type(controller).__mro__
+    law_owner = next((c for c in mro if "law" in c.__dict__), None)
+    command_owner = next((c for c in mro if "command" in c.__dict__), None)
+    if law_owner is None or command_owner is None:
+        return law  # an instance attribute: the controller's own word
+    return law if mro.index(command_owner) >= mro.index(law_owner) else None
+
+
 def run_loop(
     plant: Plant,
     controller: Any,
@@ -149,7 +169,7 @@ def run_loop(
     clock = time.perf_counter_ns
 
     reference = task.reference
-    law = getattr(controller, "law", None)
+    law = stage_law(controller)
 
     def policy(t: float, q: list[float]) -> np.ndarray:
         """The closed-loop law at an integrator stage (not recorded)."""
