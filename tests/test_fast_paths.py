@@ -238,3 +238,21 @@ def test_a_subclass_changing_command_is_not_bypassed_by_law():
     assert len(calls) == 4 * 50 + 1  # command calls law once a step, the stages three times
     for name in ("x", "y", "phi", "th1", "th2"):
         np.testing.assert_array_equal(halved.timeseries[name], own.timeseries[name])
+
+
+def test_a_trajectory_subclass_changing_pose_is_not_bypassed_by_sample():
+    from ddwmmr.trajectories.base import sampler
+
+    class Shifted(Ellipse):
+        def pose(self, t):
+            return super().pose(t) + np.array([0.1, 0.0, 0.0])
+
+    class OwnSample(Ellipse):
+        def sample(self, times):
+            return super().sample(times)
+
+    assert sampler(Shifted()) is None and sampler(_Scalar(Ellipse())) is None
+    assert sampler(OwnSample()) is not None and sampler(Ellipse()) is not None
+    task = TrackingTask(Shifted(), KinematicPlant(Robot()), grid=(0.02, 100))
+    pose, _ = task.reference(0.5, None)
+    assert pose.tolist() == Shifted().pose(0.5).tolist()

@@ -18,6 +18,7 @@ import numpy as np
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.resolution import kernels
+from ddwmmr.trajectories.base import sampler
 
 #: Default initial end-effector offset (m) in the end effector's start frame (x along its
 #: orientation phiE, y to its left): 30 mm back and 30 mm to the right, 42.4 mm in all, so
@@ -117,7 +118,7 @@ class ReferenceTrajectory:
         """Desired velocities at ``k h + h/2`` and ``k h + h`` for steps k = first..last-1:
         in one vectorised call when the trajectory has ``sample`` (same numbers)."""
         h = self.step
-        sample = getattr(self.trajectory, "sample", None)
+        sample = sampler(self.trajectory)
         if sample is None:
             velocity = self.trajectory.velocity
             return [

@@ -20,6 +20,7 @@ from ddwmmr.commands import WheelForces
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_arrays
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+from ddwmmr.trajectories.base import sampler
 
 #: Column names of the recorded time series, in order (plant columns follow).
 COLUMNS = (
@@ -99,7 +100,7 @@ class TrackingTask:
         self._velocity = trajectory.velocity
         # Reference cache: RK4 asks twice at t + dt/2, and the recorder again at t.
         self._cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
-        sample = getattr(trajectory, "sample", None)
+        sample = sampler(trajectory)
         self._blocks = None if grid is None or sample is None else ReferenceBlocks(sample, *grid)
         self._table: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         self._extra_values = plant.extra_values if plant.extra_columns else None

@@ -7,12 +7,14 @@ A trajectory is any object with
 * ``velocity(t)`` - its time derivative ``[xEdot, yEdot, phiEdot]`` (m/s, rad/s).
 
 Optionally ``samples`` (int): the resolution N; simulation uses ``dt = duration / samples``
-when no step is given.
+when no step is given; and ``sample(times) -> (poses, velocities)``, many times in one
+vectorised call (:func:`sampler`).
 """
 
 from __future__ import annotations
 
-from typing import Protocol, runtime_checkable
+from collections.abc import Callable
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
@@ -38,3 +40,22 @@ class Trajectory(Protocol):
 def trajectory_name(trajectory: object) -> str:
     """A short human name for a trajectory (its ``name`` attribute or its class name)."""
     return str(getattr(trajectory, "name", type(trajectory).__name__.lower()))
+
+
+def sampler(trajectory: Any) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None:
+    """The trajectory's vectorised ``sample(times)``, if it may stand in for ``pose`` and
+    ``velocity``: None when it has none, or when a subclass overrides ``pose`` or
+    ``velocity`` below the class that defines ``sample`` (the parent's ``sample`` would
+    not know the change)."""
+    sample = getattr(trajectory, "sample", None)
+    if sample is None:
+        return None
+    mro = type(trajectory).__mro__
+    owner = next((c for c in mro if "sample" in c.__dict__), None)
+    if owner is None:
+        return sample  # an instance attribute: the trajectory's own word
+    for name in ("pose", "velocity"):
+        defined = next((c for c in mro if name in c.__dict__), None)
+        if defined is not None and mro.index(defined) < mro.index(owner):
+            return None
+    return sample
