@@ -1,7 +1,9 @@
 """A trajectory defined by a Python class: a sine wave driven along the x axis.
 
 Any object with ``duration``, ``pose(t)`` and ``velocity(t)`` is a trajectory; ``samples``
-(optional) sets the default step ``dt = duration / samples``. Prints only.
+(optional) sets the default step ``dt = duration / samples``, and ``sample(times)``
+(optional) gives many poses and velocities in one vectorised call, which ``simulate`` uses
+to compute a run's references in a few calls instead of one per time. Prints only.
 """
 
 from __future__ import annotations
@@ -35,10 +37,11 @@ class SineWave:
         self.speed, self.amplitude, self.period = speed, amplitude, period
         self.duration, self.samples = duration, samples
 
-    def _y(self, t: float) -> tuple[float, float, float]:
-        """Lateral offset y (m) and its first and second time derivatives (m/s, m/s^2)."""
+    def _y(self, t):
+        """Lateral offset y (m) and its first and second time derivatives (m/s, m/s^2);
+        ``t`` is a time (s) or an array of times."""
         omega = 2.0 * math.pi / self.period
-        s, c = math.sin(omega * t), math.cos(omega * t)
+        s, c = np.sin(omega * t), np.cos(omega * t)
         a = self.amplitude
         return a * s, a * omega * c, -a * omega * omega * s
 
@@ -52,6 +55,16 @@ class SineWave:
         _, ydot, yddot = self._y(t)
         turn_rate = self.speed * yddot / (self.speed**2 + ydot**2)
         return np.array([self.speed, ydot, turn_rate])
+
+    def sample(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Optional: ``(poses, velocities)`` at many times, each ``(len(times), 3)``, the
+        numbers ``pose`` and ``velocity`` give (to rounding), in one vectorised call."""
+        t = np.asarray(times, dtype=float)
+        y, ydot, yddot = self._y(t)
+        poses = np.column_stack([self.speed * t, y, np.arctan2(ydot, self.speed)])
+        turn_rate = self.speed * yddot / (self.speed**2 + ydot**2)
+        velocities = np.column_stack([np.full_like(t, self.speed), ydot, turn_rate])
+        return poses, velocities
 
 
 def main() -> None:

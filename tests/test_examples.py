@@ -174,6 +174,14 @@ def test_custom_trajectory_velocity_is_the_pose_derivative() -> None:
         np.testing.assert_allclose(wave.velocity(t), numeric, atol=1e-7)
 
 
+def test_custom_trajectory_sample_gives_pose_and_velocity() -> None:
+    wave = _load("custom_trajectory").SineWave()
+    times = np.linspace(0.0, 30.0, 301)
+    poses, velocities = wave.sample(times)
+    np.testing.assert_allclose(poses, [wave.pose(t) for t in times], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(velocities, [wave.velocity(t) for t in times], rtol=0, atol=1e-15)
+
+
 ROOT = Path(__file__).resolve().parents[1]
 #: Every page with Python snippets: README.md and docs/*.md, found automatically (a page a
 #: helper adds is tested as soon as it has a ```python block). Blocks not meant to run use
