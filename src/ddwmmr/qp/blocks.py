@@ -25,6 +25,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from ddwmmr import inheritance
+
 
 def _constant(ctx: Any) -> None:
     """Nothing to write: the rows were written at compile time."""
@@ -98,4 +100,4 @@ class LimitBlock:
 def overrides(piece: object, owner: type, name: str = "compute") -> bool:
     """True when ``piece``'s class redefines ``owner.<name>`` (then the fast path of
     ``owner`` does not describe it and the generic path must be used)."""
-    return getattr(type(piece), name) is not getattr(owner, name)
+    return inheritance.overrides(piece, owner, name)

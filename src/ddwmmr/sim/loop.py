@@ -44,6 +44,7 @@ import numpy as np
 
 from ddwmmr.commands import FORCE, VELOCITY
 from ddwmmr.errors import ParameterError
+from ddwmmr.inheritance import defining_class, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 
 #: Progress callback: (samples done, samples in all).
@@ -137,14 +138,10 @@ def stage_law(controller: Any) -> Callable[..., Any] | None:
     without a matching ``law`` has ``command`` called at every stage, as before ``law``
     existed."""
     law = getattr(controller, "law", None)
-    if law is None:
-        return None
-    mro = type(controller).__mro__
-    law_owner = next((c for c in mro if "law" in c.__dict__), None)
-    command_owner = next((c for c in mro if "command" in c.__dict__), None)
-    if law_owner is None or command_owner is None:
-        return law  # an instance attribute: the controller's own word
-    return law if mro.index(command_owner) >= mro.index(law_owner) else None
+    owner = defining_class(type(controller), "law")
+    if law is None or owner is None:
+        return law  # none, or an instance attribute: the controller's own word
+    return None if overrides(controller, owner, "command") else law
 
 
 def run_loop(

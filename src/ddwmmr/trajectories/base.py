@@ -18,6 +18,8 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
+from ddwmmr.inheritance import defining_class, overrides
+
 
 @runtime_checkable
 class Trajectory(Protocol):
@@ -48,14 +50,9 @@ def sampler(trajectory: Any) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndar
     ``velocity`` below the class that defines ``sample`` (the parent's ``sample`` would
     not know the change)."""
     sample = getattr(trajectory, "sample", None)
-    if sample is None:
+    owner = defining_class(type(trajectory), "sample")
+    if sample is None or owner is None:
+        return sample  # none, or an instance attribute: the trajectory's own word
+    if overrides(trajectory, owner, "pose") or overrides(trajectory, owner, "velocity"):
         return None
-    mro = type(trajectory).__mro__
-    owner = next((c for c in mro if "sample" in c.__dict__), None)
-    if owner is None:
-        return sample  # an instance attribute: the trajectory's own word
-    for name in ("pose", "velocity"):
-        defined = next((c for c in mro if name in c.__dict__), None)
-        if defined is not None and mro.index(defined) < mro.index(owner):
-            return None
     return sample
