@@ -64,24 +64,14 @@ def centre_of_mass(k: ComCoefficients, th1: float, th2: float) -> tuple[float, f
     )
 
 
-def _ratio(half_extent: float, offset: float) -> float:
-    if abs(offset) * STABILITY_CAP <= half_extent:
-        return STABILITY_CAP
-    return half_extent / abs(offset)
-
-
 def stability_terms(k: ComCoefficients, th1: float, th2: float) -> tuple[float, float, float]:
     """``(S_lon, S_lat, S)``, each capped at :data:`STABILITY_CAP` (dimensionless)."""
-    th12 = th1 + th2
-    return margins(
-        k, k.A * math.cos(th1) + k.B * math.cos(th12), k.A * math.sin(th1) + k.B * math.sin(th12)
-    )
+    return margins(k, *centre_of_mass(k, th1, th2))
 
 
 def margins(k: ComCoefficients, x_com: float, y_com: float) -> tuple[float, float, float]:
-    """``(S_lon, S_lat, S)`` for a centre of mass ``(x_com, y_com)`` (m, base frame).
-
-    (:func:`_ratio` written out: this runs several times per control step.)"""
+    """``(S_lon, S_lat, S)`` for a centre of mass ``(x_com, y_com)`` (m, base frame): each
+    term ``half extent / |offset|``, capped at :data:`STABILITY_CAP`."""
     offset, half = abs(x_com), k.half_length
     s_lon = STABILITY_CAP if offset * STABILITY_CAP <= half else half / offset
     offset, half = abs(y_com), k.half_width
@@ -98,8 +88,7 @@ def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[floa
     s12, c12 = math.sin(th1 + th2), math.cos(th1 + th2)
     x_com = k.A * c1 + k.B * c12
     y_com = k.A * s1 + k.B * s12
-    s_lon = _ratio(k.half_length, x_com)
-    s_lat = _ratio(k.half_width, y_com)
+    s_lon, s_lat, _ = margins(k, x_com, y_com)
     if s_lat <= s_lon:
         if s_lat >= STABILITY_CAP:
             return s_lat, 0.0, 0.0

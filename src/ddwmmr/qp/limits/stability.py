@@ -19,7 +19,7 @@ import math
 from collections.abc import Callable
 
 from ddwmmr.errors import ParameterError, check_positive
-from ddwmmr.model.stability import STABILITY_CAP, ComCoefficients
+from ddwmmr.model.stability import STABILITY_CAP, ComCoefficients, stability_terms
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
@@ -59,16 +59,9 @@ def stability_terms_from_trig(
 
 
 def exact_stability(k: ComCoefficients, th1: float, th2: float) -> float:
-    """The capped margin ``S = min(S_lon, S_lat)`` (dimensionless)."""
-    x_com = k.A * math.cos(th1) + k.B * math.cos(th1 + th2)
-    y_com = k.A * math.sin(th1) + k.B * math.sin(th1 + th2)
-    s_lon = (
-        STABILITY_CAP if abs(x_com) * STABILITY_CAP <= k.half_length else k.half_length / abs(x_com)
-    )
-    s_lat = (
-        STABILITY_CAP if abs(y_com) * STABILITY_CAP <= k.half_width else k.half_width / abs(y_com)
-    )
-    return min(s_lon, s_lat)
+    """The capped margin ``S = min(S_lon, S_lat)`` (dimensionless; the model's own
+    :func:`~ddwmmr.model.stability.stability_terms`)."""
+    return stability_terms(k, th1, th2)[2]
 
 
 def safe_arm_scale(
