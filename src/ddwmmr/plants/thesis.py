@@ -274,9 +274,8 @@ class ThesisPlant:
         given, is that value: :meth:`inertia` at ``state``'s arm pose). Returns the wheel
         forces applied, after the force limit (N).
         """
-        limit = self.force_limit
-        f1 = min(limit, max(-limit, f_left))  # clip_force, written out
-        f2 = min(limit, max(-limit, f_right))
+        f1 = self.clip_force(f_left)
+        f2 = self.clip_force(f_right)
         if inertia is None:
             inertia = self.inertia(state.th1, state.th2)
         v, distance = first_order_step(state.v, f1 + f2, 1.0 / self.c1, self.mass / self.c1, dt)

@@ -78,30 +78,13 @@ class BaseMotionLimit(Limit):
         lb[1], ub[1] = max(lb[1], low_w), min(ub[1], high_w)
 
     def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
-        """Writer tightening the Python box (no rows); parameters are read here: recompile
-        after changing them (:meth:`QPProblem.refresh_weights`)."""
+        """Writer tightening the Python box (no rows)."""
         if overrides(self, BaseMotionLimit) or overrides(self, BaseMotionLimit, "envelope"):
             return None
-        box = block.box
-        v_max, w_max = self.max_speed, self.max_yaw_rate
-        acceleration, yaw_acceleration = self.max_acceleration, self.max_yaw_acceleration
+        box, envelope = block.box, self.envelope
 
         def write(ctx: StepContext) -> None:
-            # envelope() written out (same operations in the same order): it runs every step.
-            low_v, high_v, low_w, high_w = -v_max, v_max, -w_max, w_max
-            previous = ctx.previous_command
-            if previous is not None:
-                v_prev, w_prev = previous
-                if acceleration is not None:
-                    step = acceleration * ctx.dt
-                    low_v, high_v = max(low_v, v_prev - step), min(high_v, v_prev + step)
-                if yaw_acceleration is not None:
-                    step = yaw_acceleration * ctx.dt
-                    low_w, high_w = max(low_w, w_prev - step), min(high_w, w_prev + step)
-                if low_v > high_v:  # a previous command beyond a cap: keep the box non-empty
-                    low_v, high_v = high_v, low_v
-                if low_w > high_w:
-                    low_w, high_w = high_w, low_w
+            low_v, high_v, low_w, high_w = envelope(ctx)
             box[0], box[4] = max(box[0], low_v), min(box[4], high_v)
             box[1], box[5] = max(box[1], low_w), min(box[5], high_w)
 
