@@ -30,6 +30,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from ddwmmr.errors import ParameterError
+from ddwmmr.gui.options import plant_keywords
 from ddwmmr.gui.settings import Settings, build_robot, build_trajectory
 from ddwmmr.sim.result import write_atomic
 from ddwmmr.sim.simulate import plant_integrator
@@ -75,9 +76,10 @@ def write_run_data(
     written: list[Path] = []
     records: list[dict[str, Any] | None] = [None] * len(results)
     if settings is not None:
-        source = trajectory_source(settings, folder, written)
+        trajectory = build_trajectory(settings)
+        source = trajectory_source(settings, trajectory, folder, written)
         records = [
-            run_record(settings, slot, result, source)
+            run_record(settings, slot, result, trajectory, source)
             for slot, result in zip(settings.active_slots, results)
         ]
     for result, label, record in zip(results, labels, records):
@@ -90,11 +92,13 @@ def write_run_data(
     return written
 
 
-def trajectory_source(settings: Settings, folder: Path, written: list[Path]) -> Path | None:
-    """The trajectory file a record should name: the loaded file, or, for a sampled
-    trajectory moved by the geometry controls, ``trajectory.csv`` written into ``folder``
-    (appended to ``written``). None for a trajectory known by name only."""
-    trajectory = build_trajectory(settings)
+def trajectory_source(
+    settings: Settings, trajectory: Any, folder: Path, written: list[Path]
+) -> Path | None:
+    """The file a record should name for ``trajectory`` (built from ``settings``): the
+    loaded file, or, for a sampled trajectory moved by the geometry controls,
+    ``trajectory.csv`` written into ``folder`` (appended to ``written``). None for a
+    trajectory known by name only."""
     source = find_trajectory_file(settings.trajectory)
     if isinstance(trajectory, SampledTrajectory) and settings.geometry:
         source = unique_path(folder / "trajectory.csv")
@@ -104,10 +108,11 @@ def trajectory_source(settings: Settings, folder: Path, written: list[Path]) -> 
 
 
 def run_record(
-    settings: Settings, slot: int, result: Any, trajectory_file: Path | None
+    settings: Settings, slot: int, result: Any, trajectory: Any, trajectory_file: Path | None
 ) -> dict[str, Any]:
     """The ``run`` record `python -m ddwmmr.track` writes, for slot ``slot`` of
-    ``settings`` (tool ``"gui"``); step and duration are the ones the run used."""
+    ``settings`` (tool ``"gui"``) and its built ``trajectory``; step and duration are the
+    ones the run used, the integrator the one :func:`plant_keywords` gave the run."""
     from ddwmmr.cli.track import RunInputs
     from ddwmmr.cli.track import run_record as track_record
 
@@ -115,12 +120,12 @@ def run_record(
         method=str(settings.methods[slot]),
         options=dict(settings.options[slot]),
         robot=build_robot(settings),
-        trajectory=build_trajectory(settings),
+        trajectory=trajectory,
         trajectory_file=trajectory_file,
         dt=float(result.summary["dt"]),
         duration=float(result.summary["duration"]),
         integrator=plant_integrator(
-            settings.plant, settings.integrator if settings.plant == "kinematic" else None
+            settings.plant, plant_keywords(settings.plant, settings.integrator).get("integrator")
         ),
         offset=tuple(settings.offset),
         label=Path(settings.trajectory).stem,
