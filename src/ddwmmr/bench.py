@@ -45,7 +45,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import Controller, StepInfo, available_methods, make_controller
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import MAX_SCENARIOS, ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import u_from_qdot
 from ddwmmr.outputs import check_output_file
@@ -67,6 +67,8 @@ QP_TARGETS = {"median_us": 20.0, "p99_us": 40.0, "reference_ratio": 40.0}
 #: Controllers of the scenario-throughput section (issue 14, target 3) and its default size.
 SCENARIO_CONTROLLERS = ("thesis", "qp")
 SCENARIO_COUNT = 100
+#: What the scenario section takes from the scenarios tool's summary.
+SCENARIO_KEYS = ("failed", "sim_time_s", "wall_time_s", "sim_seconds_per_wall_second")
 #: Method whose run provides the states of the method table.
 STATE_SOURCE_METHOD = "clrrmc-ts"
 #: Marker of a report written by this tool (an existing ``--out`` file must carry it).
@@ -771,6 +773,7 @@ def time_scenarios(count: int, jobs: int | None = None) -> list[dict[str, Any]]:
     from ddwmmr.scenarios.executors import default_jobs, run_many
     from ddwmmr.scenarios.generator import generate
     from ddwmmr.scenarios.protocol import RunConfig
+    from ddwmmr.scenarios.report import summarize
 
     jobs = default_jobs() if jobs is None else jobs
     batch = generate(count, 0)
@@ -778,17 +781,14 @@ def time_scenarios(count: int, jobs: int | None = None) -> list[dict[str, Any]]:
     for controller in SCENARIO_CONTROLLERS:
         start = time.perf_counter()
         outcomes = run_many(batch, RunConfig(controller=controller), jobs=jobs)
-        wall = time.perf_counter() - start
-        simulated = float(sum(o.metrics["time_s"] for o in outcomes))
+        # The numbers the scenarios tool writes to its summary.json.
+        summary = summarize(outcomes, time.perf_counter() - start)
         rows.append(
             {
                 "controller": controller,
                 "scenarios": count,
                 "jobs": jobs,
-                "failed": sum(not o.metrics["success"] for o in outcomes),
-                "sim_time_s": simulated,
-                "wall_time_s": wall,
-                "sim_seconds_per_wall_second": simulated / wall,
+                **{key: summary[key] for key in SCENARIO_KEYS},
             }
         )
     return rows
@@ -1033,24 +1033,24 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"bench: error: {message}\n")
 
 
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = 0
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 1 (got {text!r})")
-    return value
+def _integer(low: int, high: int | None = None) -> Callable[[str], int]:
+    """An argparse type: an integer >= ``low`` (and <= ``high``)."""
+    allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = low - 1
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"must be an integer {allowed} (got {text!r})")
+        return value
+
+    return parse
 
 
-def _non_negative_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if not 0 <= value <= 100_000:
-        raise argparse.ArgumentTypeError(f"must be an integer in [0, 100000] (got {text!r})")
-    return value
+_positive_int = _integer(1)
+_scenario_count = _integer(0, MAX_SCENARIOS)
 
 
 def _positive_float(text: str) -> float:
@@ -1105,7 +1105,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--scenarios",
-        type=_non_negative_int,
+        type=_scenario_count,
         default=None,
         metavar="N",
         help=f"also time the first N benchmark scenarios with {' and '.join(SCENARIO_CONTROLLERS)} "
