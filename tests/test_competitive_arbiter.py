@@ -8,6 +8,7 @@ import math
 
 import pytest
 
+from arbiter_fixtures import BASE_PERCEPT, ROBOT, behaviours
 from ddwmmr.arbiters import (
     BEHAVIOURS,
     MANIPULABILITY,
@@ -22,36 +23,10 @@ from ddwmmr.arbiters import (
     StateMachineArbiter,
     make_arbiter,
 )
-from ddwmmr.behaviours import BRAKE, DRIVE, ObstacleAvoidance, Proposal, ThesisController, sense
+from ddwmmr.behaviours import BRAKE, ObstacleAvoidance, Proposal, ThesisController
 from ddwmmr.errors import ParameterError
-from ddwmmr.model import Robot
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
-
-ROBOT = Robot().with_payload(3.0)
-BASE_PERCEPT = sense(ROBOT, 0.0, (0.0, 0.0, 0.0, -0.7, 1.57), 0.0, 0.0, (3.0, 0.0))
-
-
-class Fixed:
-    """A behaviour returning a fixed proposal (None: off)."""
-
-    def __init__(self, name: str, proposal: Proposal | None) -> None:
-        self.name = name
-        self.proposal = proposal
-
-    def propose(self, p):
-        return self.proposal
-
-
-def behaviours(objective_label: str = "arm", obstacle: bool = False):
-    found = {
-        "objective": Fixed("objective", Proposal(BRAKE, (0.0, 0.0), label=objective_label)),
-        "manipulability": Fixed("manipulability", Proposal(DRIVE, (0.1, 0.1))),
-        "stability": Fixed("stability", Proposal(DRIVE, (0.2, 0.2))),
-    }
-    if obstacle:
-        found["obstacle"] = Fixed("obstacle", Proposal(DRIVE, (0.3, 0.3)))
-    return found
 
 
 class Clock:

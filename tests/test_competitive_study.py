@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-import subprocess
-import sys
 
 import pytest
 
@@ -19,6 +17,7 @@ from ddwmmr.scenarios.arbiter_study import (
     summarize,
     table_52,
 )
+from scenarios_cli_helpers import bad_scenarios_run
 
 
 def synthetic(states, shares_of):
@@ -113,14 +112,4 @@ def test_cli_arbiter_study_writes_tables_and_figures(tmp_path, capsys):
     ],
 )
 def test_bad_arbiter_input_one_line_exit_2(tmp_path, args, message):
-    out = tmp_path / "bad"
-    result = subprocess.run(
-        [sys.executable, "-m", "ddwmmr.scenarios", *args, "--out", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    assert result.returncode == 2
-    assert message in result.stderr
-    assert len(result.stderr.strip().splitlines()) == 1
-    assert not out.exists()
+    assert message in bad_scenarios_run(tmp_path, args)

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import csv
 import json
-import subprocess
-import sys
 
 import pytest
 
 from ddwmmr.cli.scenarios import main as cli
 from ddwmmr.scenarios.protocol import METRICS
+from scenarios_cli_helpers import bad_scenarios_run
 
 SUMMARY_KEYS = {
     "n", "failed", "mean_time_s", "sd_time_s", "mean_speed_m_s", "time_base_s", "time_arm_s",
@@ -70,18 +69,7 @@ def test_obstacle_study_table(tmp_path, capsys):
     ],
 )
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, message):
-    out = tmp_path / "bad"
-    result = subprocess.run(
-        [sys.executable, "-m", "ddwmmr.scenarios", *args, "--out", str(out)],
-        capture_output=True,
-        text=True,
-        check=False,
-    )
-    assert result.returncode == 2
-    lines = result.stderr.strip().splitlines()
-    assert len(lines) == 1 and message in lines[0]
-    assert "Traceback" not in result.stderr
-    assert not out.exists() and list(tmp_path.iterdir()) == []
+    assert message in bad_scenarios_run(tmp_path, args)
 
 
 def test_refuses_to_replace_a_foreign_folder(tmp_path, capsys):

@@ -6,6 +6,7 @@ import dataclasses
 
 import pytest
 
+from arbiter_fixtures import BASE_PERCEPT, ROBOT, behaviours
 from ddwmmr.arbiters import (
     MANIPULABILITY,
     MOVE_ARM,
@@ -15,36 +16,8 @@ from ddwmmr.arbiters import (
     Hysteresis,
     StateMachineArbiter,
 )
-from ddwmmr.behaviours import BRAKE, DRIVE, Proposal, ThesisController, sense
+from ddwmmr.behaviours import ThesisController
 from ddwmmr.errors import ParameterError
-from ddwmmr.model import Robot
-
-ROBOT = Robot().with_payload(3.0)
-BASE_PERCEPT = sense(ROBOT, 0.0, (0.0, 0.0, 0.0, -0.7, 1.57), 0.0, 0.0, (3.0, 0.0))
-
-
-class Fixed:
-    """A behaviour returning a fixed proposal (None: off); counts its calls."""
-
-    def __init__(self, name: str, proposal: Proposal | None) -> None:
-        self.name = name
-        self.proposal = proposal
-        self.calls = 0
-
-    def propose(self, p):
-        self.calls += 1
-        return self.proposal
-
-
-def behaviours(objective_label: str = "arm", obstacle: bool = False):
-    found = {
-        "objective": Fixed("objective", Proposal(BRAKE, (0.0, 0.0), label=objective_label)),
-        "manipulability": Fixed("manipulability", Proposal(DRIVE, (0.1, 0.1))),
-        "stability": Fixed("stability", Proposal(DRIVE, (0.2, 0.2))),
-    }
-    if obstacle:
-        found["obstacle"] = Fixed("obstacle", Proposal(DRIVE, (0.3, 0.3)))
-    return found
 
 
 def at(s: float, eta: float):
