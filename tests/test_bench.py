@@ -33,6 +33,7 @@ from ddwmmr.bench import (
     timer_overhead_ns,
     write_report,
 )
+from footprint import outline_clearance
 
 TINY = {"repeats": 2, "calls": 20, "duration": 0.4}
 ROBOT3 = Robot().with_payload(3.0)
@@ -172,20 +173,8 @@ def test_qp_classes_report_rows_phases_and_ratios(report: dict) -> None:
 
 def _brute_clearance(robot: Robot, q, circle, n: int = 401) -> float:
     """Footprint-to-circle distance from points sampled on the footprint's outline."""
-    hl, hw = 0.5 * robot.base_length, 0.5 * robot.base_width
-    s = np.linspace(-1.0, 1.0, n)
-    local = np.concatenate(
-        [
-            np.column_stack([s * hl, np.full(n, hw)]),
-            np.column_stack([s * hl, np.full(n, -hw)]),
-            np.column_stack([np.full(n, hl), s * hw]),
-            np.column_stack([np.full(n, -hl), s * hw]),
-        ]
-    )
-    c, si = math.cos(q[2]), math.sin(q[2])
-    x = q[0] + c * local[:, 0] - si * local[:, 1]
-    y = q[1] + si * local[:, 0] + c * local[:, 1]
-    return float(np.min(np.hypot(x - circle[0], y - circle[1])) - circle[2])
+    half = (0.5 * robot.base_length, 0.5 * robot.base_width)
+    return outline_clearance(*half, (q[0], q[1], q[2]), tuple(circle), n)
 
 
 @pytest.mark.parametrize("name", [c.name for c in QP_CLASSES])

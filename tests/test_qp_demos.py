@@ -10,6 +10,7 @@ import pytest
 
 from ddwmmr import Robot, load_trajectory, simulate
 from ddwmmr.qp.limits import load_obstacles
+from footprint import footprint_outline
 
 ROBOT = Robot().with_payload(3.0)
 ROOT = Path(__file__).resolve().parents[1]
@@ -58,15 +59,7 @@ def _brute_clearance(ts: dict, circle, n: int = 1001) -> np.ndarray:
     minus the radius, negative (-1) when the centre lies inside the footprint or the
     circle reaches past the outline. Independent of ddwmmr.qp.limits.obstacles."""
     hl, hw = 0.5 * ROBOT.base_length, 0.5 * ROBOT.base_width
-    s = np.linspace(-1.0, 1.0, n)
-    outline = np.concatenate(
-        [
-            np.column_stack([s * hl, np.full(n, hw)]),
-            np.column_stack([s * hl, np.full(n, -hw)]),
-            np.column_stack([np.full(n, hl), s * hw]),
-            np.column_stack([np.full(n, -hl), s * hw]),
-        ]
-    )
+    outline = footprint_outline(hl, hw, n)
     c, si = np.cos(ts["phi"]), np.sin(ts["phi"])
     dx, dy = circle.x - ts["x"], circle.y - ts["y"]
     px, py = c * dx + si * dy, -si * dx + c * dy  # centre in the base frame

@@ -29,6 +29,7 @@ from ddwmmr.qp.tasks import (
     manipulability_gradient,
 )
 from ddwmmr.qp.tasks.manipulability import base_gradient
+from footprint import outline_clearance
 
 ROBOT = Robot().with_payload(3.0)
 ARM_POSES = [(0.3, 0.4), (1.2, 0.1), (-1.4, 0.7), (2.5, -0.9), (0.05, 1.5), (-0.8, -2.0)]
@@ -125,21 +126,8 @@ def test_joint_dampers_slow_a_joint_near_its_limit():
 
 
 def _brute_clearance(hl, hw, x, y, phi, circle, n=4001):
-    """Distance from densely sampled footprint points (edges and interior grid)."""
-    s = np.linspace(-1, 1, n)
-    edges = np.concatenate(
-        [
-            np.column_stack([s * hl, np.full(n, hw)]),
-            np.column_stack([s * hl, np.full(n, -hw)]),
-            np.column_stack([np.full(n, hl), s * hw]),
-            np.column_stack([np.full(n, -hl), s * hw]),
-        ]
-    )
-    c, si = math.cos(phi), math.sin(phi)
-    world = np.column_stack(
-        [x + c * edges[:, 0] - si * edges[:, 1], y + si * edges[:, 0] + c * edges[:, 1]]
-    )
-    return np.min(np.hypot(world[:, 0] - circle.x, world[:, 1] - circle.y)) - circle.radius
+    """Distance from densely sampled footprint outline points."""
+    return outline_clearance(hl, hw, (x, y, phi), (circle.x, circle.y, circle.radius), n)
 
 
 @pytest.mark.parametrize(
