@@ -13,6 +13,7 @@ vectorised call (:func:`sampler`).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any, Protocol, runtime_checkable
 
@@ -42,6 +43,13 @@ class Trajectory(Protocol):
 def trajectory_name(trajectory: object) -> str:
     """A short human name for a trajectory (its ``name`` attribute or its class name)."""
     return str(getattr(trajectory, "name", type(trajectory).__name__.lower()))
+
+
+def atan2_array(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Elementwise ``math.atan2`` (the C library's): numpy's ``arctan2`` differs from it in
+    the last bit for about one value in twelve, and a vectorised ``sample`` must give the
+    numbers of the scalar ``pose``."""
+    return np.array(list(map(math.atan2, np.ravel(y).tolist(), np.ravel(x).tolist())))
 
 
 def sampler(trajectory: Any) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None:

@@ -31,24 +31,19 @@ from ddwmmr.errors import (
     check_positive,
     check_range,
 )
+from ddwmmr.trajectories.base import atan2_array
 
 ORIENTATIONS = ("tangent", "constant")
 
 
 class _ArrayMath:
-    """The ``math`` functions the shapes use, on arrays (for :meth:`_Parametric.sample`).
-
-    ``atan2`` goes through ``math.atan2`` element by element: numpy's ``arctan2`` is not
-    the C library's and differs in the last bit for about one value in twelve, which would
-    make a sampled reference differ from ``pose(t)``."""
+    """The ``math`` functions the shapes use, on arrays (for :meth:`_Parametric.sample`;
+    ``atan2`` through the C library's, as :func:`~ddwmmr.trajectories.base.atan2_array`)."""
 
     sin = staticmethod(np.sin)
     cos = staticmethod(np.cos)
     floor = staticmethod(np.floor)
-
-    @staticmethod
-    def atan2(y: np.ndarray, x: np.ndarray) -> np.ndarray:
-        return np.array(list(map(math.atan2, y.tolist(), x.tolist())))
+    atan2 = staticmethod(atan2_array)
 
 
 _ARRAY_MATH = _ArrayMath()

@@ -23,6 +23,7 @@ from ddwmmr.errors import (
     ParameterError,
     read_text_file,
 )
+from ddwmmr.trajectories.base import atan2_array
 
 MAX_TIME_S = DURATION_RANGE_S[1]
 
@@ -161,7 +162,7 @@ class SampledTrajectory:
         second = second / (h * h)[:, None]
         if self._has_phi:
             return value, first
-        heading = np.array(list(map(math.atan2, first[:, 1].tolist(), first[:, 0].tolist())))
+        heading = atan2_array(first[:, 1], first[:, 0])
         headings = self._knot_headings()
         reference = (1 - s) * headings[i] + s * headings[i + 1]
         heading = heading + 2 * math.pi * np.round((reference - heading) / (2 * math.pi))
