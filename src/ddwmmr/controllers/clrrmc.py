@@ -14,7 +14,7 @@ import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register
 from ddwmmr.controllers.inputs import check_inputs
-from ddwmmr.controllers.resolved_rate import Input, check_aux
+from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model import Robot
@@ -27,7 +27,7 @@ DEFAULT_TAU = 0.5
 
 
 @register("clrrmc-ts")
-class TaskSpaceController:
+class TaskSpaceController(ResolvedRate):
     """CLRRMC-TS: qdot = J_aug^-1 [Xd_dot + K (Xd - X)], feedback on xE, yE, phiE.
 
     The orientation error ``phiE_d - phiE`` is wrapped to [-pi, pi) (one turn of the end
@@ -44,31 +44,17 @@ class TaskSpaceController:
         singularity_threshold: float = kernels.SINGULARITY_THRESHOLD,
         damping: float = kernels.MAX_DAMPING,
     ) -> None:
-        self.robot = robot
         self.kx, self.ky, self.kphi = gains_from_tau(tau, 3)
         self.aux = check_aux(aux)
-        self.threshold = check_positive("singularity_threshold", singularity_threshold)
-        self.damping = check_nonnegative("damping", damping)
-        self.last = StepInfo()
-
-    def reset(self, trajectory: object, q0: np.ndarray) -> None:
-        """Nothing to prepare: the feedback uses the measured configuration."""
-        self.last = StepInfo()
-
-    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
-        """Input for the desired velocity plus the pose-error correction."""
-        q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
-        u, singular = self.law(t, q, pose_d, velocity_d)
-        self.last = StepInfo(singular=singular)
-        return np.array(u)
+        super().__init__(robot, singularity_threshold, damping)
 
     def law(
         self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
     ) -> tuple[Input, bool]:
-        """The control law on lists of floats: ``(u, singular)``, no validation, no state
-        change (the integrator evaluates it at its stages; see :mod:`ddwmmr.sim.loop`)."""
+        """Input for the desired velocity plus the pose-error correction (see
+        :meth:`ResolvedRate.law`)."""
         x, y, phi, th1, th2 = q
-        L1, L2 = self.robot.L1, self.robot.L2
+        L1, L2 = self.L1, self.L2
         a1 = phi + th1
         a12 = a1 + th2
         xe = x + L1 * math.cos(a1) + L2 * math.cos(a12)

@@ -21,8 +21,9 @@ from ddwmmr.resolution import kernels
 Input = tuple[float, float, float, float]
 
 
-class _ResolvedRate(ABC):
-    """Shared state: robot lengths, singularity handling, last step info.
+class ResolvedRate(ABC):
+    """Shared by the resolved-rate methods (these and ``clrrmc-ts``): robot lengths,
+    singularity handling, last step info, and ``command`` as the validated ``law``.
 
     ``singularity_threshold`` is the smallest singular value below which the inverse is
     damped and ``damping`` the damping factor at the singularity (see
@@ -45,7 +46,8 @@ class _ResolvedRate(ABC):
         self.last = StepInfo()
 
     def reset(self, trajectory: object, q0: np.ndarray) -> None:
-        """Nothing to prepare: open-loop methods are memoryless."""
+        """Nothing to prepare: these methods are memoryless (the feedback, if any, uses
+        the measured configuration)."""
         self.last = StepInfo()
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
@@ -72,7 +74,7 @@ def check_aux(aux: str) -> str:
 
 
 @register("pi")
-class PseudoinverseController(_ResolvedRate):
+class PseudoinverseController(ResolvedRate):
     """RR-PI: pseudoinverse resolution qdot = J^# Xd_dot (open loop)."""
 
     def law(self, t, q, pose_d, velocity_d) -> tuple[Input, bool]:
@@ -85,7 +87,7 @@ class PseudoinverseController(_ResolvedRate):
 
 
 @register("ats")
-class AugmentedTaskSpaceController(_ResolvedRate):
+class AugmentedTaskSpaceController(ResolvedRate):
     """RR-ATS: augmented task space, one auxiliary row (aux = sum | shoulder), open loop."""
 
     def __init__(self, robot: Robot, aux: str = "shoulder", **kwargs) -> None:
@@ -102,7 +104,7 @@ class AugmentedTaskSpaceController(_ResolvedRate):
 
 
 @register("ap")
-class ArtificialPotentialController(_ResolvedRate):
+class ArtificialPotentialController(ResolvedRate):
     """RR-AP: pseudoinverse plus null-space descent of V = K1 th1^2 + K2 th2^2 + K3 phi^2."""
 
     def __init__(
