@@ -33,6 +33,7 @@ CONFIGS = {
         "max_yaw_rate": 1.2,
         "max_acceleration": 1.0,
         "max_yaw_acceleration": 3.0,
+        "speed_budget": (0.9, 1.5),
         "dt": 0.02,
     },
     "no singularity limit": {"singularity_margin": None, "manipulability_weight": 0.0},
@@ -88,7 +89,13 @@ def test_every_built_in_piece_is_compiled():
     problem = controller.problem
     assert problem._all_compiled
     names = {type(p).__name__ for p in problem.tasks + problem.limits}
-    assert {"HeadingTask", "ObstacleSteeringTask", "BaseMotionLimit", "ObstacleLimit"} <= names
+    assert {
+        "HeadingTask",
+        "ObstacleSteeringTask",
+        "BaseMotionLimit",
+        "SpeedBudgetLimit",
+        "ObstacleLimit",
+    } <= names
 
 
 class _Spin(Task):

@@ -61,6 +61,7 @@ UNITS = {
     "max_yaw_rate": "rad/s",
     "max_acceleration": "m/s2",
     "max_yaw_acceleration": "rad/s2",
+    "speed_budget": "m/s, rad/s",
     "reference_step": "s",
     "horizon": "steps",
 }

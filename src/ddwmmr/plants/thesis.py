@@ -108,7 +108,8 @@ def damped_base_envelope(
     half_width: float,
     stretched_inertia: float,
     fraction: float = 0.8,
-) -> dict[str, float]:
+    speed_budget: bool = False,
+) -> dict[str, Any]:
     """What a velocity command can ask of a damped, force-limited base, as ``fraction`` of
     the physics.
 
@@ -116,15 +117,22 @@ def damped_base_envelope(
     ``2 F (width/2) / c2`` rad/s) and accelerations from rest with the largest yaw inertia
     (arm stretched): ``2 F / m`` (m/s^2), ``2 F (width/2) / I`` (rad/s^2). ``force_limit``
     is per wheel (N). Keys match the ``qp`` controller's options.
+
+    ``speed_budget`` adds ``"speed_budget": (2 F / c1, 2 F (width/2) / c2)``, the full
+    top speeds (no fraction): in steady state each wheel's force stays within F exactly
+    when ``|v| / v_top + |w| / w_top <= 1`` (:class:`~ddwmmr.qp.limits.SpeedBudgetLimit`).
     """
     total = 2.0 * force_limit
     torque = total * half_width
-    return {
+    envelope: dict[str, Any] = {
         "max_base_speed": fraction * total / c1,
         "max_yaw_rate": fraction * torque / c2,
         "max_acceleration": fraction * total / mass,
         "max_yaw_acceleration": fraction * torque / stretched_inertia,
     }
+    if speed_budget:
+        envelope["speed_budget"] = (total / c1, torque / c2)
+    return envelope
 
 
 class ThesisPlant:
@@ -243,8 +251,12 @@ class ThesisPlant:
         tip = r.L1**2 + r.L2**2 + 2.0 * r.L1 * r.L2 * c2
         return self._inertia_fixed + m1 * 0.25 * r.L1**2 + m2 * mid2 + r.payload * tip
 
-    def velocity_envelope(self, fraction: float = 0.8) -> dict[str, float]:
-        """What a velocity command can ask of this base: :func:`damped_base_envelope`."""
+    def velocity_envelope(self, fraction: float = 0.8) -> dict[str, Any]:
+        """What a velocity command can ask of this base: :func:`damped_base_envelope`.
+
+        Without the speed budget: this plant's velocity servo mixes with rotation
+        priority, so a command at a corner of the speed box still turns (it gives up
+        speed), and the budget would only slow the ``qp`` down (docs/thesis.md)."""
         return damped_base_envelope(
             self.force_limit,
             self.c1,

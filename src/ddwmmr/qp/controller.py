@@ -40,6 +40,7 @@ from ddwmmr.qp.limits import (
     Limit,
     ObstacleLimit,
     ShoulderSingularityLimit,
+    SpeedBudgetLimit,
     StabilityLimit,
     WheelSpeedLimit,
     as_circles,
@@ -110,6 +111,9 @@ class QPControllerCore:
             base's top speeds; None (default) leaves only the wheel-speed limit.
         max_acceleration, max_yaw_acceleration: slew limits on v (m/s^2) and w (rad/s^2)
             around the previous command (one call per control step assumed); None: off.
+        speed_budget: ``(v_top, w_top)`` (m/s, rad/s): v and w share the wheels' force
+            budget, ``|v|/v_top + |w|/w_top <= 1`` (:class:`SpeedBudgetLimit`; a damped,
+            force-limited base whose wheel servos saturate one by one); None: off.
         singularity_margin: angle (rad) kept between link 1 and the base heading's normal
             (shoulder singularity, ``cos th1 = 0``); None switches the limit off.
         dt: look-ahead step of the exact stability check (s); default the trajectory's
@@ -143,6 +147,7 @@ class QPControllerCore:
         max_yaw_rate: float | None = None,
         max_acceleration: float | None = None,
         max_yaw_acceleration: float | None = None,
+        speed_budget: tuple[float, float] | None = None,
         dt: float | None = None,
         warm_start: bool | None = None,
         tasks: Sequence[Task] = (),
@@ -192,6 +197,8 @@ class QPControllerCore:
                 max_yaw_acceleration,
             )
             self.limits.append(self.base_motion)
+        if speed_budget is not None:
+            self.limits.append(SpeedBudgetLimit(speed_budget))
         self.singularity: ShoulderSingularityLimit | None = None
         if singularity_margin is not None:
             self.singularity = ShoulderSingularityLimit(

@@ -428,7 +428,7 @@ def make_scenario_plant(robot: Robot, config: RunConfig) -> Plant:
     return make_plant(config.plant, robot)
 
 
-def _envelope(plant: Plant) -> dict[str, float] | None:
+def _envelope(plant: Plant) -> dict[str, Any] | None:
     """What a velocity command can ask of a force-limited base (None: no limit)."""
     envelope = getattr(plant, "velocity_envelope", None)
     return envelope() if envelope is not None else None
@@ -460,7 +460,7 @@ def make_mpc(robot: Robot, scenario: Scenario, config: RunConfig, plant: Plant) 
 
 
 def make_qp(
-    robot: Robot, scenario: Scenario, config: RunConfig, envelope: dict[str, float] | None = None
+    robot: Robot, scenario: Scenario, config: RunConfig, envelope: dict[str, Any] | None = None
 ) -> Any:
     """The registry's ``qp`` controller configured for waypoint tasks.
 

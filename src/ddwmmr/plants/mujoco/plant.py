@@ -173,11 +173,13 @@ class MujocoPlant:
             "wheel_actuators": [ACTUATORS.index("wheel_left"), ACTUATORS.index("wheel_right")],
         }
 
-    def velocity_envelope(self, fraction: float = 0.8) -> dict[str, float] | None:
+    def velocity_envelope(self, fraction: float = 0.8) -> dict[str, Any] | None:
         """With ``base_damping``: what a velocity command can ask of the damped base
         (:func:`~ddwmmr.plants.thesis.damped_base_envelope` with the wheel force the motor
-        torque limit allows, ``wheel_torque_limit / wheel_radius``); None without damping
-        (no drag: the wheel-speed and torque limits are the whole story)."""
+        torque limit allows, ``wheel_torque_limit / wheel_radius``), with the speed budget
+        (the wheel servos saturate one by one: at a corner of the speed box the base
+        would lose its yaw and drive in loops); None without damping (no drag: the
+        wheel-speed and torque limits are the whole story)."""
         if self.base_damping is None:
             return None
         robot = self.robot
@@ -189,6 +191,7 @@ class MujocoPlant:
             0.5 * robot.base_width,
             ThesisPlant(robot).inertia(0.0, 0.0),
             fraction,
+            speed_budget=True,
         )
 
     @property

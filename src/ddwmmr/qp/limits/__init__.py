@@ -1,7 +1,7 @@
 """Hard constraints of the QP controller, one module each (see :class:`Limit`)."""
 
 from ddwmmr.qp.limits.base import INF, Limit
-from ddwmmr.qp.limits.base_motion import BaseMotionLimit
+from ddwmmr.qp.limits.base_motion import BaseMotionLimit, SpeedBudgetLimit
 from ddwmmr.qp.limits.joints import JointLimit
 from ddwmmr.qp.limits.obstacles import (
     Circle,
@@ -30,6 +30,7 @@ __all__ = [
     "Limit",
     "ObstacleLimit",
     "ShoulderSingularityLimit",
+    "SpeedBudgetLimit",
     "StabilityLimit",
     "WheelSpeedLimit",
     "as_circles",

@@ -11,14 +11,25 @@ limit keeps each command within the plant's envelope around the previous command
 
 ``v_prev, w_prev`` is the controller's previous command (``StepContext.previous_command``);
 the slew part is skipped on the first step after a reset.
+
+The caps are a box, but a damped base with a force limit per wheel cannot hold its top
+speed and its top yaw rate at once: in steady state the left and right wheel forces are
+``(c1 v -+ c2 w / (width/2)) / 2``, so both stay within the limit exactly when
+
+    |v| / v_top + |w| / w_top <= 1,    v_top = 2 F / c1,  w_top = 2 F (width/2) / c2
+
+(:class:`SpeedBudgetLimit`, two constant rows). Whether a command at a corner of the box
+does harm depends on the plant's velocity servo: wheel-speed servos that saturate each
+wheel on its own (the MuJoCo plant) lose the yaw there and the base drives in wide loops,
+a servo that gives rotation priority (the thesis plant) turns and gives up speed.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 
-from ddwmmr.errors import check_positive
-from ddwmmr.qp.blocks import LimitBlock, overrides
+from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.qp.blocks import CONSTANT, LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import Limit
 
@@ -89,3 +100,42 @@ class BaseMotionLimit(Limit):
             box[1], box[5] = max(box[1], low_w), min(box[5], high_w)
 
         return write
+
+
+class SpeedBudgetLimit(Limit):
+    """Two rows: ``v`` and ``w`` share the wheels' force budget, ``|v|/v_top + |w|/w_top <= 1``.
+
+    Args:
+        speeds: ``(v_top, w_top)``, the steady-state top speed (m/s, all the force driving)
+            and top yaw rate (rad/s, all the force turning) of the base; for a damped base
+            with force limit F per wheel ``(2 F / c1, 2 F (width/2) / c2)``
+            (:func:`ddwmmr.plants.thesis.damped_base_envelope` with ``speed_budget=True``).
+    """
+
+    rows = 2
+    name = "speed budget"
+
+    def __init__(self, speeds: tuple[float, float]) -> None:
+        if isinstance(speeds, str) or not hasattr(speeds, "__len__") or len(speeds) != 2:
+            raise ParameterError(
+                f"speed_budget must be two numbers > 0, (v_top m/s, w_top rad/s) (got {speeds!r})"
+            )
+        v_top = check_positive("speed_budget v_top", speeds[0])
+        w_top = check_positive("speed_budget w_top", speeds[1])
+        self.speeds = (v_top, w_top)
+        # |v|/v_top + |w|/w_top <= 1 is the pair of rows -1 <= v/v_top +- w/w_top <= 1.
+        self.rows_vw = ((1.0 / v_top, 1.0 / w_top), (1.0 / v_top, -1.0 / w_top))
+
+    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+        """Constant rows; written every step because the arrays are shared views."""
+        for row, (a_v, a_w) in enumerate(self.rows_vw):
+            G[row, 0], G[row, 1], G[row, 2], G[row, 3] = a_v, a_w, 0.0, 0.0
+            lower[row], upper[row] = -1.0, 1.0
+
+    def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
+        """Everything is constant: written once."""
+        if overrides(self, SpeedBudgetLimit):
+            return None
+        block.write_constant_rows([(a_v, a_w, 0.0, 0.0) for a_v, a_w in self.rows_vw])
+        block.write_constant_bounds((-1.0, -1.0), (1.0, 1.0))
+        return CONSTANT
