@@ -67,6 +67,8 @@ FILES = {
     "traj_text.csv": b"t,x,y\n0,0,0\n1,a,0\n2,2,0\n",
     "traj_huge.csv": b"t,x,y\n0,0,0\n1,1e300,0\n2,2,0\n",
     "traj_short.csv": b"t,x,y\n0,0,0\n",
+    "traj_long_row.csv": b"t,x,y\n0,0,0\n1,1,0,5\n2,2,0\n",
+    "traj_repeated_column.csv": b"t,x,y,t\n0,0,0,0\n1,1,0,1\n2,2,0,2\n",
     "obstacles_text.toml": b'[[obstacle]]\nx = "1"\ny = 0.0\nradius = 0.3\n',
     "a_file.txt": b"not a folder\n",
 }
@@ -130,6 +132,10 @@ CASES: list[tuple[str, list[str], str]] = []
 for tool in ("track", "compare"):
     CASES += [(tool, args, text) for args, text in ROBOT_CASES]
 CASES += [("track", ["--traj", traj], text) for traj, text in TRAJ_CASES]
+CASES += [
+    ("track", ["--traj", "{traj_long_row.csv}"], "data row 2 has more values than the header"),
+    ("track", ["--traj", "{traj_repeated_column.csv}"], "repeats column(s) t"),
+]
 CASES += [("compare", ["--only", traj], text) for traj, text in TRAJ_CASES[:4] + TRAJ_CASES[15:]]
 CASES += [("compare", ["--traj", traj], text) for traj, text in TRAJ_CASES[10:13]]
 for tool in ("track", "compare", "scenarios"):  # tools writing a folder
@@ -182,6 +188,11 @@ CASES += [
     ("compare", ["--jobs", "1e9"], "argument --jobs: invalid int value"),
     ("compare", ["--methods", "nope"], "unknown method 'nope'"),
     ("compare", ["--study", "nope"], "unknown study 'nope'"),
+    ("compare", ["--methods", ""], "methods: no name given"),
+    ("compare", ["--methods", ",,,"], "methods: no name given"),
+    ("compare", ["--study", ""], "study: no name given"),
+    ("compare", ["--only", ","], "only: no name given"),
+    ("compare", ["--traj", ""], "traj: no name given"),
     ("scenarios", ["--n", "1000000000"], f"n must be an integer in [1, {MAX_SCENARIOS}]"),
     ("scenarios", ["--n", "0"], "n must be an integer in [1,"),
     ("scenarios", ["--dt", "1e-7"], "time-limit / dt must be <="),
@@ -192,7 +203,7 @@ CASES += [
     ("scenarios", ["--payload", "10"], "10 kg tips the robot over in the start pose"),
     ("scenarios", ["--payload", "1e300"], "payload must be in [0, 100000] kg"),
     ("scenarios", ["--seed", "-1"], "seed must be >= 0"),
-    ("scenarios", ["--stability", "nan", "1"], "stability thresholds must be finite"),
+    ("scenarios", ["--stability", "nan", "1"], "stability thresholds must be in (0, 10]"),
     ("scenarios", ["--jobs", "0"], "jobs must be an integer in [1, 256]"),
     ("bench", ["--repeats", "0"], "--repeats: must be an integer >= 1 (got '0')"),
     ("bench", ["--repeats", "abc"], "--repeats: must be an integer >= 1"),

@@ -222,6 +222,50 @@ def test_rerun_refuses_a_changed_trajectory_file_and_extra_options(tmp_path, cap
     assert sorted(p.name for p in tmp_path.iterdir()) == ["line.csv", "run"]
 
 
+@pytest.fixture(scope="module")
+def recorded_run(tmp_path_factory) -> dict:
+    """A valid track summary.json (tests change one field of a copy)."""
+    out = tmp_path_factory.mktemp("recorded") / "run"
+    args = ["--method", "pi", "--traj", "ellipse", "--duration", "0.2", "--no-plots"]
+    assert run([*args, "--no-progress", "--out", str(out)]) == 0
+    return json.loads((out / "summary.json").read_text())
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("dt", "abc", "dt must be a number"),
+        ("dt", True, "dt must be a number"),
+        ("duration", "1s", "duration must be a number"),
+        ("method", ["pi"], "method name must be a str"),
+        ("options", [1], "options must be a dict"),
+        ("options", "x", "options must be a dict"),
+        ("integrator", None, "integrator name must be a str"),
+        ("robot", {}, "robot record lacks L1"),
+        ("initial_offset", 3, "offset must be a list"),
+    ],
+)
+def test_rerun_of_a_damaged_record_is_one_line(
+    recorded_run, tmp_path, capsys, field, value, message
+):
+    damaged = json.loads(json.dumps(recorded_run))
+    damaged["run"][field] = value
+    path = tmp_path / "summary.json"
+    path.write_text(json.dumps(damaged))
+    assert run(["--rerun", str(path), "--no-progress", "--out", str(tmp_path / "o")]) == 2
+    error = capsys.readouterr().err.strip().splitlines()
+    assert len(error) == 1 and message in error[0], error
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]
+
+
+def test_rerun_of_a_deeply_nested_file_is_one_line(tmp_path, capsys):
+    path = tmp_path / "deep.json"
+    path.write_text("[" * 100_000 + "]" * 100_000)
+    assert run(["--rerun", str(path), "--out", str(tmp_path / "o")]) == 2
+    error = capsys.readouterr().err.strip().splitlines()
+    assert len(error) == 1 and "nested too deeply" in error[0], error
+
+
 def test_errors_are_printed_in_mm(tmp_path, capsys):
     out = tmp_path / "run"
     assert run(["--method", "pi", "--traj", "ellipse", "--duration", "1", "--no-plots",

@@ -265,3 +265,31 @@ def test_scenarios_records_everything_to_rerun(made):
     assert record["config"]["time_limit"] == 0.3 and record["config"]["payload"] == 3.0
     assert record["robot"]["payload"] == 3.0 and record["plant"] == {"name": "thesis"}
     assert record["command"].startswith("python -m ddwmmr.scenarios --n 1")
+
+
+def test_an_empty_user_folder_inside_an_own_folder_is_named(made, tmp_path, capsys):
+    out = copy_of(made, "track", tmp_path)
+    (out / "notes").mkdir()
+    assert run("track", out) == 2
+    error = capsys.readouterr().err
+    assert "notes/" in error and "()" not in error
+    assert (out / "notes").is_dir() and leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("force", [False, True])
+def test_a_folder_whose_files_cannot_be_replaced_is_refused_before_the_run(
+    made, tmp_path, capsys, monkeypatch, force
+):
+    # Root writes anywhere, so the permission is denied through os.access, as for a user
+    # whose earlier output folder is read-only (chmod 500).
+    out = copy_of(made, "track", tmp_path)
+    before = snapshot(out)
+    real_access = os.access
+    monkeypatch.setattr(
+        "ddwmmr.outputs.os.access",
+        lambda path, mode: False if Path(path) == out else real_access(path, mode),
+    )
+    assert run("track", out, *(["--force"] if force else [])) == 2
+    error = capsys.readouterr().err.strip().splitlines()
+    assert len(error) == 1 and "cannot replace files in" in error[0], error
+    assert snapshot(out) == before and leftovers(tmp_path) == []

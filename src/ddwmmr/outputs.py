@@ -136,8 +136,9 @@ def inspect(target: Path, tool: str) -> Existing:
     present = sorted(e for e in entries if e in listed and e in regular)
     owner = manifest["tool"] if manifest else None
     kind = "own" if manifest and owner == tool and not foreign else "foreign"
-    if kind == "own" and _has_foreign_folders(target, present):
-        kind = "foreign"
+    folder = _foreign_folder(target, present)
+    if folder is not None:
+        kind, foreign = "foreign", sorted([*foreign, folder + "/"])
     return Existing(kind, present, foreign, owner)
 
 
@@ -148,15 +149,26 @@ def _is_regular(path: Path) -> bool:
         return False
 
 
-def _has_foreign_folders(target: Path, files: list[str]) -> bool:
-    """Empty folders (nothing listed inside) are foreign too: a user may have made them."""
+def _foreign_folder(target: Path, files: list[str]) -> str | None:
+    """A folder with nothing listed inside (relative name), else None: empty folders are
+    foreign too, a user may have made them."""
     needed = {str(PurePosixPath(f).parent) for f in files}
     for root, dirs, _ in os.walk(target):
         for name in dirs:
             rel = (Path(root) / name).relative_to(target).as_posix()
             if not any(n == rel or n.startswith(rel + "/") for n in needed):
-                return True
-    return False
+                return rel
+    return None
+
+
+def _check_replaceable(path: Path, text: str, existing: Existing) -> None:
+    """Refuse, before the run, an existing output whose files cannot be replaced: the
+    folder itself and every folder holding a listed file must be writable."""
+    folders = {path, *((path / name).parent for name in existing.listed)}
+    for folder in sorted(folders):
+        if not os.access(folder, os.W_OK | os.X_OK):
+            shown = text if folder == path else f"{text}/{folder.relative_to(path)}"
+            raise ParameterError(f"out: cannot replace files in {shown} (permission denied)")
 
 
 # -- checks before anything is written --------------------------------------------------
@@ -226,6 +238,7 @@ def check_output_folder(target: str | Path, tool: str, force: bool = False) -> P
     existing = inspect(path, tool)
     if existing.kind == "foreign" and not force:
         raise ParameterError(_refusal(text, tool, existing))
+    _check_replaceable(path, text, existing)
     return path
 
 

@@ -206,16 +206,22 @@ def build_parser() -> ArgumentParser:
     return parser
 
 
-def split_list(values: Sequence[str] | None) -> list[str]:
-    """Items of repeated and/or comma-separated option values, in order, without repeats."""
-    items = [item.strip() for value in values or [] for item in value.split(",")]
-    return list(dict.fromkeys(item for item in items if item))
+def split_list(values: Sequence[str] | None, option: str) -> list[str]:
+    """Items of repeated and/or comma-separated option values, in order, without repeats;
+    a value with no name in it (``--methods ''``, ``--only ,``) is an error."""
+    items = []
+    for value in values or []:
+        names = [item.strip() for item in value.split(",") if item.strip()]
+        if not names:
+            raise ParameterError(f"{option}: no name given (got {value!r})")
+        items.extend(names)
+    return list(dict.fromkeys(items))
 
 
 def parse_methods(values: Sequence[str] | None, option: str = "methods") -> tuple[str, ...]:
     """Validated method names (default: every registered method)."""
     known = available_methods()
-    methods = split_list(values) or known
+    methods = split_list(values, option) or known
     for method in methods:
         if method not in known:
             raise ParameterError(f"{option}: unknown method {method!r} (known: {', '.join(known)})")
@@ -224,7 +230,7 @@ def parse_methods(values: Sequence[str] | None, option: str = "methods") -> tupl
 
 def parse_studies(values: Sequence[str] | None) -> tuple[str, ...]:
     """Validated study names; ``all`` (default) and ``none`` expand."""
-    names = split_list(values) or ["all"]
+    names = split_list(values, "study") or ["all"]
     for name in names:
         if name not in (*STUDIES, "all", "none"):
             raise ParameterError(
@@ -242,8 +248,8 @@ def load_trajectories(
 
     ``sources`` (if given) receives each name's file (None for a built-in default).
     """
-    chosen = split_list(only)
-    values = [*(chosen or DEFAULT_TRAJECTORIES), *split_list(extra)]
+    chosen = split_list(only, "only")
+    values = [*(chosen or DEFAULT_TRAJECTORIES), *split_list(extra, "traj")]
     trajectories: dict[str, Any] = {}
     files: dict[str, Any] = {}
     for value in dict.fromkeys(values):

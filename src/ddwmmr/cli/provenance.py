@@ -121,8 +121,22 @@ def robot_record(robot: Robot) -> dict[str, Any]:
     return {f.name: encode(getattr(robot, f.name)) for f in dataclasses.fields(robot) if f.init}
 
 
+#: Robot fields every run record has named since records began (later fields, e.g. the
+#: physics plant's, take their defaults in older records, as the version that wrote
+#: them had no such field).
+RECORDED_ROBOT_FIELDS = (
+    "L1", "L2", "wheel_radius", "track_width", "base_length", "base_width", "base_mass",
+    "base_inertia", "link_masses", "payload", "joint_limits", "joint_speed_limit",
+    "wheel_speed_limit", "home_pose",
+)  # fmt: skip
+
+
 def robot_from_record(record: dict[str, Any]) -> Robot:
-    """The robot a :func:`robot_record` describes."""
+    """The robot a :func:`robot_record` describes; a record without one of the
+    :data:`RECORDED_ROBOT_FIELDS` is incomplete, not a request for the default."""
+    missing = [name for name in RECORDED_ROBOT_FIELDS if name not in record]
+    if missing:
+        raise ParameterError(f"rerun: the robot record lacks {', '.join(missing[:3])}")
     return Robot.from_dict(decode(record))
 
 

@@ -45,6 +45,7 @@ from ddwmmr.errors import (
     check_step_count,
 )
 from ddwmmr.model import Robot
+from ddwmmr.model.stability import STABILITY_CAP
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.executors import EXECUTORS, default_jobs, run_many
@@ -58,6 +59,19 @@ STUDIES = ("thresholds", "obstacles", "arbiters")
 PROG = "python -m ddwmmr.scenarios"
 #: Most worker processes --jobs may ask for.
 MAX_JOBS = 256
+#: Upper bound of --qp-max-speed (m/s): far above what the robot can do (base 1.5 m/s).
+MAX_QP_SPEED = 10.0
+#: --qp-* options: the controllers that take them, the allowed values and their text.
+QP_OPTIONS = {
+    "qp_stability_min": (
+        ("qp", "mpc"),
+        lambda v: 0.0 < v < STABILITY_CAP,
+        f"(0, {STABILITY_CAP:g})",
+    ),
+    "qp_max_speed": (("qp",), lambda v: 0.0 < v <= MAX_QP_SPEED, f"(0, {MAX_QP_SPEED:g}] m/s"),
+}
+#: Largest threshold: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
+THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}
 
 DESCRIPTION = """\
 Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly (seeded) in
@@ -198,16 +212,17 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--qp-stability-min",
         type=float,
-        default=1.25,
+        default=None,
         metavar="S",
-        help="qp controller's hard stability bound (default: 1.25)",
+        help="hard stability bound of the qp and mpc controllers, in (0, 10) (default: 1.25)",
     )
     parser.add_argument(
         "--qp-max-speed",
         type=float,
-        default=1.0,
+        default=None,
         metavar="M_S",
-        help="qp controller's end-effector speed limit (default: 1.0 m/s)",
+        help=f"qp controller's end-effector speed limit, in (0, {MAX_QP_SPEED:g}] m/s "
+        "(default: 1.0)",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     return parser  # fmt: skip
@@ -243,6 +258,24 @@ def max_start_payload() -> float:
     return low
 
 
+def _qp_options(args: argparse.Namespace) -> dict[str, float]:
+    """The given ``--qp-*`` options, checked, and refused for a controller without them."""
+    options = {}
+    for name, (controllers, allowed, text) in QP_OPTIONS.items():
+        value = getattr(args, name)
+        if value is None:
+            continue
+        option = name.replace("_", "-")
+        if args.controller not in controllers:
+            raise ParameterError(
+                f"{option}: only used with --controller {' or '.join(controllers)}"
+            )
+        if not (math.isfinite(value) and allowed(value)):
+            raise ParameterError(f"{option} must be in {text} (got {value:g})")
+        options[name] = value
+    return options
+
+
 def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     """Validate the options and build the run configuration (before any output exists)."""
     check_int_at_least("n", args.n, 1, MAX_SCENARIOS)
@@ -258,11 +291,11 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     check_nonnegative("arbiter-seed", args.arbiter_seed)
     if args.study and args.obstacles:
         raise ParameterError("study: --obstacles is implied by --study obstacles")
-    for name in ("payload", "dt", "time_limit", "qp_stability_min", "qp_max_speed"):
+    for name in ("dt", "time_limit"):
         value = getattr(args, name)
-        allowed_zero = name == "payload" and value == 0
-        if value is not None and not (math.isfinite(value) and value > 0) and not allowed_zero:
+        if value is not None and not (math.isfinite(value) and value > 0):
             raise ParameterError(f"{name.replace('_', '-')} must be > 0 (got {value:g})")
+    qp_options = _qp_options(args)
     if args.dt > 0.1:
         raise ParameterError(f"dt must be <= 0.1 s (got {args.dt:g})")
     check_range("payload", args.payload, *MASS_RANGE_KG, "kg")
@@ -276,8 +309,12 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     thresholds = {}
     for name in ("stability", "manipulability"):
         enter, exit_ = getattr(args, name)
-        if not (math.isfinite(enter) and math.isfinite(exit_)):
-            raise ParameterError(f"{name} thresholds must be finite (got {enter}, {exit_})")
+        high = THRESHOLD_RANGES[name]
+        for value in (enter, exit_):
+            if not (math.isfinite(value) and 0.0 < value <= high):
+                raise ParameterError(
+                    f"{name} thresholds must be in (0, {high:g}] (got {enter:g}, {exit_:g})"
+                )
         thresholds[name] = (enter, enter) if name in args.no_hysteresis else (enter, exit_)
     return RunConfig(
         controller=args.controller,
@@ -287,8 +324,7 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         manipulability=thresholds["manipulability"],
         dt=args.dt,
         time_limit=args.time_limit,
-        qp_stability_min=args.qp_stability_min,
-        qp_max_speed=args.qp_max_speed,
+        **qp_options,
         arbiter=args.arbiter,
         arbiter_seed=args.arbiter_seed,
     )

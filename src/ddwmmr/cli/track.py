@@ -307,26 +307,53 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         )
     record = load_run_record(args.rerun)
     try:
-        plant = record["plant"]["name"]
+        plant = _field(record["plant"], "name", str, "plant name")
         if plant not in available_plants():
             raise ParameterError(f"rerun: plant {plant!r} is not supported by this version")
-        trajectory = provenance.trajectory_from_record(record["trajectory"])
-        source = record["trajectory"].get("file")
+        trajectory_record = _field(record, "trajectory", dict, "trajectory")
+        trajectory = provenance.trajectory_from_record(trajectory_record)
+        source = trajectory_record.get("file")
+        offset = tuple(provenance.decode(_field(record, "initial_offset", list, "offset")))
         return RunInputs(
-            record["method"],
-            provenance.decode(record["options"]),
-            provenance.robot_from_record(record["robot"]),
+            _field(record, "method", str, "method name"),
+            provenance.decode(_field(record, "options", dict, "options")),
+            provenance.robot_from_record(_field(record, "robot", dict, "robot")),
             trajectory,
-            Path(source) if source else None,
-            float(record["dt"]),
-            float(record["duration"]),
-            record["integrator"],
-            tuple(provenance.decode(record["initial_offset"])),
-            record["trajectory"].get("name") or "rerun",
+            Path(source) if isinstance(source, str) and source else None,
+            _number(record, "dt"),
+            _number(record, "duration"),
+            _integrator(record, plant),
+            offset,
+            str(trajectory_record.get("name") or "rerun"),
             plant,
         )
-    except (KeyError, TypeError, AttributeError) as exc:
+    except (KeyError, TypeError, AttributeError, ValueError) as exc:
+        if isinstance(exc, ParameterError):
+            raise
         raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
+
+
+def _field(record: dict[str, Any], key: str, kind: type, what: str) -> Any:
+    """``record[key]`` if it is a ``kind`` (KeyError when missing, TypeError otherwise)."""
+    value = record[key]
+    if not isinstance(value, kind) or isinstance(value, bool):
+        raise TypeError(f"{key}: the {what} must be a {kind.__name__}, got {value!r:.40}")
+    return value
+
+
+def _integrator(record: dict[str, Any], plant: str) -> str | None:
+    """The recorded integrator: a name on the kinematic plant, null on the others."""
+    if plant != "kinematic" and record["integrator"] is None:
+        return None
+    return _field(record, "integrator", str, "integrator name")
+
+
+def _number(record: dict[str, Any], key: str) -> float:
+    """``record[key]`` as a float; a bool or a string is not a number here."""
+    value = record[key]
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise TypeError(f"{key} must be a number in s, got {value!r:.40}")
+    return float(value)
 
 
 def load_run_record(path: str) -> dict[str, Any]:
@@ -336,6 +363,8 @@ def load_run_record(path: str) -> dict[str, Any]:
         summary = json.loads(text)
     except ValueError as exc:
         raise ParameterError(f"rerun: {path} is not valid JSON ({exc})") from None
+    except RecursionError:
+        raise ParameterError(f"rerun: {path} is not a run record (nested too deeply)") from None
     record = summary.get("run") if isinstance(summary, dict) else None
     if not isinstance(record, dict) or record.get("tool") not in RERUN_TOOLS:
         raise ParameterError(

@@ -105,8 +105,9 @@ def _run_dask(chunks, config, jobs, scheduler, cluster_options, on_done) -> list
     else:
         try:
             client = Client(scheduler, timeout=10)
-        except (OSError, TimeoutError) as exc:
-            raise ParameterError(f"scheduler: cannot connect to {scheduler} ({exc})") from None
+        except (OSError, TimeoutError, ValueError) as exc:  # ValueError: not an address
+            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise ParameterError(f"scheduler: cannot connect to {scheduler!r} ({reason})") from None
     try:
         futures = [client.submit(run_chunk, config, c, pure=False) for c in chunks]
         index = {f.key: i for i, f in enumerate(futures)}

@@ -220,11 +220,22 @@ def read_csv(path: str | Path) -> SampledTrajectory:
             f"traj: {path} has {len(lines) - 1} rows (at most {MAX_TRAJECTORY_SAMPLES})"
         )
     try:
-        rows = list(csv.DictReader(lines))
+        reader = csv.DictReader(lines)
+        rows = list(reader)
     except csv.Error as exc:
         raise ParameterError(f"traj: {path} is not valid CSV ({exc})") from None
     if not rows:
         raise ParameterError(f"traj: {path} has no data rows")
+    header = list(reader.fieldnames or [])
+    repeated = sorted({name for name in header if header.count(name) > 1})
+    if repeated:
+        raise ParameterError(f"traj: {path} repeats column(s) {', '.join(repeated)}")
+    for number, row in enumerate(rows, start=1):
+        if None in row:  # DictReader files values beyond the header under None
+            raise ParameterError(
+                f"traj: {path} data row {number} has more values than the header's "
+                f"{len(header)} columns"
+            )
     columns = set(rows[0])
     missing = {"t", "x", "y"} - columns
     if missing:
