@@ -56,12 +56,12 @@ docs: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python docs/qp_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/make_run_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/physics_figures.py
-	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --snapshot docs/figures/gui_qp_obstacle.png \
+	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --force --snapshot docs/figures/gui_qp_obstacle.png \
 		--method qp --payload 3 --option obstacles=trajectories/obstacles/ellipse_post.toml \
 		--compare clrrmc-ts --traj ellipse
-	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --snapshot docs/figures/gui_figure8.png \
+	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --force --snapshot docs/figures/gui_figure8.png \
 		--method clrrmc-cs --traj figure8 --beta 0.5 --x0 0.5 --T 80 --N 4000 --compare ap
-	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --snapshot docs/figures/gui_rectangle.png \
+	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --force --snapshot docs/figures/gui_rectangle.png \
 		--method clrrmc-ts --traj rectangle
 	MPLBACKEND=Agg $(BIN)/python docs/competitive_figures.py
 

@@ -174,7 +174,7 @@ def test_options_reach_the_window_settings():
         (["--option", "tau"], "option must be NAME=VALUE"),
         (["--compare-option", "aux=sum"], "compare-option needs --compare METHOD"),
         (["--duration", "1", "--dt", "5"], "dt must be <= duration"),
-        (["--dpi", "0"], "dpi must be > 0"),
+        (["--dpi", "0"], "dpi must be in [10, 600] (got 0)"),
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):

@@ -36,6 +36,7 @@ from ddwmmr.gui.layout import (
     PanelLayout,
 )
 from ddwmmr.gui.options import OptionSpec, method_options
+from ddwmmr.gui.paths import check_export_root
 from ddwmmr.gui.settings import (
     SLOTS,
     Settings,
@@ -439,8 +440,7 @@ class App(PanelLayout):
         return f"{values[0]:g} {values[1]:g}"
 
     def _apply_export_dir(self, text: str) -> str:
-        if not text.strip():
-            raise ParameterError("export folder must not be empty")
+        check_export_root(text)  # a folder, or where one can be made
         self.export_dir = None  # the next export makes a new run folder under the new root
         return text.strip()
 

@@ -8,13 +8,17 @@ Examples::
     python -m ddwmmr.gui --snapshot gui.png --method ats --compare clrrmc-ts --traj rectangle
 
 ``--snapshot PATH`` builds the same window off-screen (Agg), runs the simulation to the
-end, draws the final state and saves the whole window (controls and plots) to PATH.
-Bad input prints one line on stderr and exits with status 2 (nothing is written).
+end, draws the final state and saves the whole window (controls and plots) to PATH, in the
+image format of its suffix (.png, .svg, .pdf...). An existing file is never replaced
+without ``--force``. Bad input, an output path that cannot be written included, prints one
+line on stderr and exits with status 2 before anything is built or run (nothing is
+written).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import io
 import sys
 from collections.abc import Sequence
@@ -22,8 +26,16 @@ from pathlib import Path
 
 from ddwmmr.cli.common import ArgumentParser, run_main
 from ddwmmr.controllers.base import available_methods
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, check_range
 from ddwmmr.gui.options import method_options, plant_names
+from ddwmmr.gui.paths import (
+    SNAPSHOT_FORMATS,
+    check_existing_snapshot,
+    check_export_root,
+    check_snapshot_path,
+    missing_folders,
+    snapshot_format,
+)
 from ddwmmr.gui.settings import GEOMETRY, Settings, check_geometry, check_settings
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.sim.result import write_atomic
@@ -31,6 +43,9 @@ from ddwmmr.trajectories import available_trajectories
 
 #: Exit status when no window can be opened or a snapshot's run fails (not bad input).
 EXIT_NO_DISPLAY = 1
+#: Allowed ``--dpi``: at 600 dpi the 16 x 10 in window is 9600 x 6000 px (about 0.4 GB
+#: while it is drawn; 1200 dpi needs 1.3 GB and 16 s).
+DPI_RANGE = (10.0, 600.0)
 
 
 class RunFailed(RuntimeError):
@@ -50,15 +65,23 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--snapshot",
         metavar="PATH",
-        help="headless: run to the end, save "
-        "the whole window as PNG to PATH and exit (no display needed)",
+        help="headless: run to the end, save the whole window to PATH and exit (no display "
+        "needed); the suffix picks the format: "
+        f"{', '.join('.' + f for f in SNAPSHOT_FORMATS)}",
+    )
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="with --snapshot: replace an existing file at PATH (never a folder or a "
+        "special file); without it an existing file is refused",
     )
     parser.add_argument(
         "--dpi",
         type=float,
         default=None,
         metavar="DPI",
-        help="resolution of the snapshot (default 100: 1600 x 1000 px)",
+        help=f"resolution of the snapshot, {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g} "
+        "(default 100: 1600 x 1000 px)",
     )
     parser.add_argument(
         "--method",
@@ -163,15 +186,26 @@ def settings_from_arguments(args: argparse.Namespace) -> Settings:
 
 
 def snapshot(
-    settings: Settings, path: str | Path, dpi: float | None = None, export_dir: str | None = None
+    settings: Settings,
+    path: str | Path,
+    dpi: float | None = None,
+    export_dir: str | None = None,
+    force: bool = False,
 ) -> Path:
-    """Build the window off-screen, run to the end, draw the final state, save it as PNG."""
+    """Build the window off-screen, run to the end, draw the final state, save it in the
+    format of the path's suffix. The path is checked first (:func:`check_snapshot_path`:
+    an existing file only with ``force``), and again just before the file is written."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     from ddwmmr.gui.app import App
     from ddwmmr.gui.layout import DPI, FIGSIZE
 
+    text = str(path)
+    target = check_snapshot_path(text, force)
+    fmt = snapshot_format(text)
+    if dpi is not None:
+        dpi = check_dpi(dpi)
     figure = Figure(figsize=FIGSIZE, dpi=DPI)
     FigureCanvasAgg(figure)
     app = App(figure, settings)
@@ -187,10 +221,22 @@ def snapshot(
     app.show_index(app.view.last_index)
     app.say(f"snapshot: final state at t = {app.view.time:.2f} s (--snapshot {Path(path).name})")
     buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=dpi or DPI)
-    path = Path(path)
-    write_atomic(path, buffer.getvalue())
-    return path
+    figure.savefig(buffer, format=fmt, dpi=dpi or DPI)
+    check_existing_snapshot(target, text, force)  # appeared during the run?
+    created = missing_folders(target.parent)
+    try:
+        write_atomic(target, buffer.getvalue())
+    except OSError as exc:
+        for folder in reversed(created):  # leave no empty folder behind
+            with contextlib.suppress(OSError):
+                folder.rmdir()
+        raise RunFailed(f"snapshot: cannot write {text} ({exc.strerror or exc})") from None
+    return Path(path)
+
+
+def check_dpi(dpi: float) -> float:
+    """``--dpi``: a finite number in :data:`DPI_RANGE`."""
+    return check_range("dpi", dpi, *DPI_RANGE)
 
 
 def desktop_figure():
@@ -245,12 +291,19 @@ def open_window(settings: Settings, export_dir: str | None = None) -> int:
 
 def _main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    # The output checks first: they are quick, and the settings load files.
+    if args.snapshot is not None:
+        check_snapshot_path(args.snapshot, args.force)
+    elif args.force:
+        raise ParameterError("force needs --snapshot PATH (it only lets a snapshot replace a file)")
+    if args.dpi is not None:
+        check_dpi(args.dpi)
+    if args.export is not None:
+        check_export_root(args.export)
     settings = settings_from_arguments(args)
-    if args.dpi is not None and not args.dpi > 0:
-        raise ParameterError(f"dpi must be > 0 (got {args.dpi:g})")
-    if args.snapshot:
+    if args.snapshot is not None:
         try:
-            path = snapshot(settings, args.snapshot, args.dpi, args.export)
+            path = snapshot(settings, args.snapshot, args.dpi, args.export, args.force)
         except RunFailed as exc:
             print(f"error: {exc}", file=sys.stderr)
             return EXIT_NO_DISPLAY

@@ -25,7 +25,18 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import available_methods, make_controller
-from ddwmmr.errors import ParameterError, check_finite, check_int_at_least, check_positive
+from ddwmmr.errors import (
+    DURATION_RANGE_S,
+    LENGTH_RANGE_M,
+    MAX_ANGLE_RAD,
+    MAX_COORDINATE_M,
+    MAX_TRAJECTORY_SAMPLES,
+    ParameterError,
+    check_finite,
+    check_int_at_least,
+    check_positive,
+    check_range,
+)
 from ddwmmr.gui.options import method_options, plant_keywords, plant_names
 from ddwmmr.model import Robot
 from ddwmmr.plants.kinematic import INTEGRATORS
@@ -145,12 +156,19 @@ def geometry_of(trajectory: Any) -> dict[str, float]:
 
 
 def check_geometry(name: str, value: float) -> float | int:
-    """Validate one geometry value (ranges of :data:`GEOMETRY`)."""
+    """Validate one geometry value: the signs of :data:`GEOMETRY`, then the documented caps
+    of :mod:`ddwmmr.errors` the parametric trajectories enforce, so that a sampled
+    trajectory placed by the same numbers is refused with a message naming the value."""
     if name == "N":
-        return check_int_at_least("N", value, 2)
+        check_int_at_least("N", value, 2)
+        return check_int_at_least("N", value, 2, MAX_TRAJECTORY_SAMPLES)
     if name in ("a", "b", "T"):
-        return check_positive(name, value)
-    return check_finite(name, value)
+        check_positive(name, value)
+        low, high, unit = (*DURATION_RANGE_S, "s") if name == "T" else (*LENGTH_RANGE_M, "m")
+        return check_range(name, value, low, high, unit)
+    check_finite(name, value)
+    cap, unit = (MAX_ANGLE_RAD, "rad") if name == "beta" else (MAX_COORDINATE_M, "m")
+    return check_range(name, value, -cap, cap, unit)
 
 
 def build_trajectory(settings: Settings) -> Any:

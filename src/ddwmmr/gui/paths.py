@@ -1,0 +1,138 @@
+"""Where the app writes: the ``--snapshot`` file and the export folder, checked up front.
+
+Both are checked before anything is built or simulated, so a path that cannot be written
+fails in one line (a :class:`ParameterError`, status 2) instead of after the run:
+
+* ``--snapshot PATH``: :func:`ddwmmr.outputs.check_output_path` (no symbolic link, not the
+  current folder, names not too long, the nearest existing folder writable), an image
+  suffix matplotlib writes, and never an existing file unless ``--force`` (nothing records
+  which files an earlier snapshot wrote, so any existing file may be the user's); a folder
+  or a special file is refused even then;
+* the export folder: a folder, or a path where one can be made.
+
+"Writable" is tried, not inferred from the permission bits: a file is created in the
+nearest existing folder and removed at once (``os.access`` says yes for root on a
+read-only or virtual file system such as ``/proc``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import stat
+import tempfile
+from pathlib import Path
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.outputs import check_output_path
+
+#: Suffixes (formats) ``--snapshot`` may have: what matplotlib writes by itself or through
+#: Pillow (pgf needs LaTeX; raw/rgba are headerless pixel dumps, not image files).
+SNAPSHOT_FORMATS = (
+    "png",
+    "svg",
+    "svgz",
+    "pdf",
+    "eps",
+    "ps",
+    "jpg",
+    "jpeg",
+    "tif",
+    "tiff",
+    "webp",
+    "gif",
+)
+
+
+def nearest_folder(path: Path) -> Path:
+    """``path`` if it exists, else its nearest existing ancestor."""
+    for candidate in [path, *path.parents]:
+        if os.path.lexists(candidate):
+            return candidate
+    return Path(path.anchor or "/")  # pragma: no cover - the root always exists
+
+
+def missing_folders(folder: Path) -> list[Path]:
+    """The folders above and including ``folder`` that do not exist yet, outermost first."""
+    missing = []
+    for candidate in [folder, *folder.parents]:
+        if os.path.lexists(candidate):
+            break
+        missing.append(candidate)
+    return list(reversed(missing))
+
+
+def check_writable_folder(label: str, folder: Path) -> None:
+    """Raise a one-line :class:`ParameterError` unless files can be created in ``folder``
+    (or, if it does not exist yet, in the nearest existing folder above it)."""
+    existing = nearest_folder(folder)
+    if not existing.is_dir():
+        raise ParameterError(f"{label}: {existing} is not a folder")
+    try:
+        fd, probe = tempfile.mkstemp(dir=existing, prefix=".ddwmmr-", suffix=".tmp")
+    except OSError as exc:
+        raise ParameterError(
+            f"{label}: cannot write in {existing} ({exc.strerror or exc})"
+        ) from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(probe)
+
+
+def snapshot_format(text: str) -> str:
+    """The image format of ``--snapshot`` ``text``, from its suffix (one of
+    :data:`SNAPSHOT_FORMATS`, any case)."""
+    suffix = Path(text).suffix.lower().lstrip(".")
+    if suffix not in SNAPSHOT_FORMATS:
+        got = f"got .{suffix}" if suffix else "no suffix"
+        raise ParameterError(
+            f"snapshot: {text} must end in an image suffix: .{', .'.join(SNAPSHOT_FORMATS)} ({got})"
+        )
+    return suffix
+
+
+def check_snapshot_path(text: str, force: bool = False) -> Path:
+    """The absolute ``--snapshot`` path, checked before the run (see the module doc)."""
+    if not text:
+        raise ParameterError("snapshot: the file name is empty; give e.g. --snapshot gui.png")
+    try:
+        path = check_output_path(text, "file")
+    except ParameterError as exc:  # its messages name --out; this option is --snapshot
+        raise ParameterError(f"snapshot: {str(exc).removeprefix('out: ')}") from None
+    if path.is_dir():
+        raise ParameterError(f"snapshot: {text} is a folder; give a file name such as gui.png")
+    snapshot_format(text)
+    check_existing_snapshot(path, text, force)
+    check_writable_folder("snapshot", path.parent)
+    return path
+
+
+def check_existing_snapshot(path: Path, text: str, force: bool) -> None:
+    """Refuse an existing ``path`` unless ``force``; a special file (FIFO, device...)
+    always. Called before the run and again just before the file is written."""
+    try:
+        info = os.lstat(path)
+    except FileNotFoundError:
+        return
+    except OSError as exc:
+        raise ParameterError(f"snapshot: cannot check {text} ({exc.strerror})") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise ParameterError(f"snapshot: {text} exists and is not a regular file")
+    if not force:
+        raise ParameterError(
+            f"snapshot: {text} exists; choose another file, or add --force to replace it"
+        )
+
+
+def check_export_root(text: str) -> Path:
+    """The export folder ``text`` if it is a folder or can be made (one-line error)."""
+    text = text.strip()
+    if not text:
+        raise ParameterError("export folder must not be empty")
+    if "\0" in text:
+        raise ParameterError("export: the folder name contains a NUL byte")
+    path = Path(os.path.abspath(text))
+    if os.path.lexists(path) and not path.is_dir():
+        raise ParameterError(f"export: {text} exists and is not a folder")
+    check_writable_folder("export", path)
+    return path

@@ -1,0 +1,287 @@
+"""``python -m ddwmmr.gui`` bad input: the snapshot path, --force, --dpi, --export and the
+geometry caps are checked before the window is built or anything runs; one line on stderr,
+exit status 2, the user's files untouched and nothing created."""
+
+import errno
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from PIL import Image
+
+import ddwmmr.gui.app as gui_app
+import ddwmmr.gui.settings as gui_settings
+from ddwmmr.errors import ParameterError
+from ddwmmr.gui import cli
+from ddwmmr.gui.cli import DPI_RANGE, check_dpi, main
+from ddwmmr.gui.paths import SNAPSHOT_FORMATS, check_export_root, check_snapshot_path
+
+ROOT = Path(__file__).resolve().parents[1]
+#: A fast real run: a fifth of a second, a 160 x 100 px snapshot.
+FAST = ["--duration", "0.2", "--dpi", "10"]
+USER_TEXT = b"USER\n"
+
+
+def run(argv):
+    """Exit status of the tool (argparse errors exit through SystemExit)."""
+    try:
+        return main(argv)
+    except SystemExit as exit_:
+        return exit_.code
+
+
+@pytest.fixture
+def no_window(monkeypatch):
+    """Fail the test if the window is built (a refused input must not get that far)."""
+
+    def built(*args, **kwargs):
+        raise AssertionError("the window was built: the input was not checked up front")
+
+    monkeypatch.setattr(gui_app, "App", built)
+
+
+def files_below(folder):
+    return sorted(str(p.relative_to(folder)) for p in Path(folder).rglob("*"))
+
+
+def refused(argv, capsys, *fragments):
+    """Run ``argv``: exit 2 and one stderr line holding every fragment; return the line."""
+    status = run(argv)
+    captured = capsys.readouterr()
+    assert status == 2, captured.err
+    # "error: ..." from the tool, "python -m ddwmmr.gui: error: ..." from argparse
+    assert captured.err.count("\n") == 1 and "error: " in captured.err, captured.err
+    assert "Traceback" not in captured.err and captured.out == ""
+    for fragment in fragments:
+        assert fragment in captured.err, captured.err
+    return captured.err
+
+
+# -- an existing file is never replaced without --force ---------------------------------
+@pytest.mark.parametrize("name", ["user_notes.txt", "user_pic.png", "USER.PDF"])
+def test_an_existing_file_is_refused_and_kept(name, tmp_path, capsys, no_window):
+    user = tmp_path / name
+    user.write_bytes(USER_TEXT)
+    refused(["--snapshot", str(user), *FAST], capsys, f"snapshot: {user}")
+    assert user.read_bytes() == USER_TEXT
+    assert files_below(tmp_path) == [name]
+
+
+def test_an_existing_image_file_names_force(tmp_path, capsys, no_window):
+    user = tmp_path / "user_pic.png"
+    user.write_bytes(USER_TEXT)
+    refused(["--snapshot", str(user), *FAST], capsys, "exists", "--force")
+    assert user.read_bytes() == USER_TEXT
+
+
+def test_force_does_not_allow_a_suffix_that_is_not_an_image(tmp_path, capsys, no_window):
+    user = tmp_path / "user_notes.txt"
+    user.write_bytes(USER_TEXT)
+    refused(["--snapshot", str(user), "--force", *FAST], capsys, "snapshot:", ".txt")
+    assert user.read_bytes() == USER_TEXT
+
+
+def test_force_replaces_an_existing_image_file(tmp_path, capsys):
+    user = tmp_path / "user_pic.png"
+    user.write_bytes(USER_TEXT)
+    assert run(["--snapshot", str(user), "--force", *FAST]) == 0, capsys.readouterr().err
+    assert capsys.readouterr().out == f"wrote {user}\n"
+    with Image.open(user) as image:
+        assert image.format == "PNG" and image.size == (160, 100)
+    assert files_below(tmp_path) == ["user_pic.png"]  # no temporary file left
+
+
+def test_the_suffix_picks_the_format_and_missing_folders_are_made(tmp_path, capsys):
+    path = tmp_path / "new" / "sub" / "gui.SVG"
+    assert run(["--snapshot", str(path), *FAST]) == 0, capsys.readouterr().err
+    assert path.read_bytes().lstrip().startswith(b"<?xml") and b"<svg" in path.read_bytes()
+    assert files_below(tmp_path) == ["new", "new/sub", "new/sub/gui.SVG"]
+
+
+def test_a_file_that_appears_during_the_run_is_kept(tmp_path, capsys, monkeypatch):
+    user = tmp_path / "shot.png"
+    simulate = gui_settings.simulate
+
+    def user_saves_a_file_meanwhile(*args, **kwargs):
+        if not user.exists():
+            user.write_bytes(USER_TEXT)
+        return simulate(*args, **kwargs)
+
+    monkeypatch.setattr(gui_settings, "simulate", user_saves_a_file_meanwhile)
+    refused(["--snapshot", str(user), *FAST], capsys, f"snapshot: {user} exists", "--force")
+    assert user.read_bytes() == USER_TEXT
+    assert files_below(tmp_path) == ["shot.png"]
+
+
+def test_a_failed_write_names_the_snapshot_and_leaves_nothing(tmp_path, capsys, monkeypatch):
+    path = tmp_path / "made" / "shot.png"
+
+    def disk_full(target, data):
+        Path(target).parent.mkdir(parents=True, exist_ok=True)  # as write_atomic does
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(target.parent / ".x.tmp"))
+
+    monkeypatch.setattr(cli, "write_atomic", disk_full)
+    assert run(["--snapshot", str(path), *FAST]) == 1
+    err = capsys.readouterr().err
+    assert err == f"error: snapshot: cannot write {path} ({os.strerror(errno.ENOSPC)})\n"
+    assert files_below(tmp_path) == []  # the folder made for it is gone too
+
+
+# -- paths that cannot be written: refused before the run --------------------------------
+def test_a_folder_is_refused_even_with_force(tmp_path, capsys, no_window):
+    folder = tmp_path / "pics.png"
+    folder.mkdir()
+    (folder / "mine.txt").write_bytes(USER_TEXT)
+    for extra in ([], ["--force"]):
+        refused(["--snapshot", str(folder), *extra, *FAST], capsys, "snapshot:", "is a folder")
+    assert files_below(tmp_path) == ["pics.png", "pics.png/mine.txt"]
+    assert (folder / "mine.txt").read_bytes() == USER_TEXT
+
+
+@pytest.mark.parametrize(
+    ("target", "fragment"),
+    [
+        ("user_notes.txt/x.png", "is not a folder"),
+        ("", "file name is empty"),
+        ("shot", "(no suffix)"),
+        ("shot.pgf", "(got .pgf)"),
+        ("shot.png.bak", "(got .bak)"),
+        ("x" * 300 + ".png", "too long"),
+    ],
+)
+def test_a_path_that_cannot_be_a_snapshot_is_refused(
+    target, fragment, tmp_path, capsys, monkeypatch, no_window
+):
+    (tmp_path / "user_notes.txt").write_bytes(USER_TEXT)
+    monkeypatch.chdir(tmp_path)  # relative names, as typed
+    refused(["--snapshot", target, *FAST], capsys, "snapshot:", fragment)
+    assert files_below(tmp_path) == ["user_notes.txt"]
+    assert (tmp_path / "user_notes.txt").read_bytes() == USER_TEXT
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux /proc")
+def test_a_virtual_file_system_is_refused(capsys, no_window):
+    # ../../../../proc/x.png from the audit: os.access says yes to root, writing does not.
+    refused(["--snapshot", "/proc/ddwmmr-x.png", *FAST], capsys, "snapshot: cannot write in /proc")
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root may write into a chmod 500 folder")
+def test_a_read_only_folder_is_refused(tmp_path, capsys, no_window):
+    folder = tmp_path / "locked"
+    folder.mkdir()
+    folder.chmod(0o500)
+    try:
+        refused(["--snapshot", str(folder / "x.png"), *FAST], capsys, "snapshot: cannot write in")
+        assert list(folder.iterdir()) == []
+    finally:
+        folder.chmod(0o700)
+
+
+def test_a_special_file_or_a_link_is_refused_even_with_force(tmp_path, capsys, no_window):
+    user = tmp_path / "user_notes.txt"
+    user.write_bytes(USER_TEXT)
+    link = tmp_path / "link.png"
+    link.symlink_to(user)
+    refused(["--snapshot", str(link), "--force", *FAST], capsys, "snapshot:", "symbolic link")
+    fifo = tmp_path / "pipe.png"
+    os.mkfifo(fifo)
+    refused(["--snapshot", str(fifo), "--force", *FAST], capsys, "not a regular file")
+    assert user.read_bytes() == USER_TEXT and link.is_symlink()
+    assert files_below(tmp_path) == ["link.png", "pipe.png", "user_notes.txt"]
+
+
+def test_force_without_a_snapshot_is_refused(capsys, no_window):
+    refused(["--force"], capsys, "force needs --snapshot PATH")
+
+
+# -- numbers ---------------------------------------------------------------------------
+@pytest.mark.parametrize(
+    ("dpi", "message"),
+    [
+        ("inf", "dpi must be a finite number (got inf)"),
+        ("nan", "dpi must be a finite number (got nan)"),
+        ("1e9", "dpi must be in [10, 600] (got 1e+09)"),
+        ("1e-9", "dpi must be in [10, 600] (got 1e-09)"),
+        ("0", "dpi must be in [10, 600] (got 0)"),
+        ("-100", "dpi must be in [10, 600] (got -100)"),
+        ("601", "dpi must be in [10, 600] (got 601)"),
+        ("ten", "argument --dpi: invalid float value: 'ten'"),
+    ],
+)
+def test_bad_dpi_is_refused_before_the_run(dpi, message, tmp_path, capsys, no_window):
+    path = tmp_path / "shot.png"
+    refused(["--snapshot", str(path), "--duration", "1", "--dpi", dpi], capsys, message)
+    assert files_below(tmp_path) == []
+
+
+def test_dpi_range_ends_are_allowed():
+    assert check_dpi(DPI_RANGE[0]) == 10.0 and check_dpi(DPI_RANGE[1]) == 600.0
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--traj", "figure8", "--a", "1e300"], "a must be in [1e-06, 1000] m (got 1e+300)"),
+        (["--traj", "figure8", "--x0", "1e300"], "x0 must be in [-1e+06, 1e+06] m"),
+        (["--traj", "figure8", "--beta=-1e300"], "beta must be in [-1e+06, 1e+06] rad"),
+        (["--traj", "figure8", "--T", "1e-9"], "T must be in [1e-06, 1e+09] s (got 1e-09)"),
+        (["--traj", "figure8", "--N", "2e6"], "N must be an integer in [2, 1000000]"),
+        (["--T", "-1"], "T must be > 0 (got -1)"),
+        (["--b", "inf"], "b must be a finite number (got inf)"),
+        (["--duration", "inf"], "duration must be a finite number (got inf)"),
+        (["--duration", "-1"], "duration must be > 0 (got -1)"),
+        (["--dt", "nan"], "dt must be a finite number (got nan)"),
+        (["--payload", "1e300"], "payload must be in [0, 100000] kg"),
+        (["--offset", "nan", "0"], "offset must be a finite number (got nan)"),
+    ],
+)
+def test_bad_numbers_are_refused_before_the_run(argv, message, tmp_path, capsys, no_window):
+    path = tmp_path / "shot.png"
+    refused(["--snapshot", str(path), *argv], capsys, message)
+    assert files_below(tmp_path) == []
+
+
+# -- the export folder -----------------------------------------------------------------
+def test_an_export_folder_that_cannot_be_one_is_refused(tmp_path, capsys, no_window):
+    user = tmp_path / "user_notes.txt"
+    user.write_bytes(USER_TEXT)
+    shot = tmp_path / "shot.png"
+    refused(["--snapshot", str(shot), "--export", str(user)], capsys, "export:", "not a folder")
+    refused(["--snapshot", str(shot), "--export", str(user / "sub")], capsys, "export:")
+    refused(["--snapshot", str(shot), "--export", " "], capsys, "export folder must not be empty")
+    assert files_below(tmp_path) == ["user_notes.txt"] and user.read_bytes() == USER_TEXT
+
+
+def test_the_path_checks_accept_what_can_be_written(tmp_path):
+    assert check_export_root(str(tmp_path / "a" / "b")) == tmp_path / "a" / "b"
+    assert check_export_root(str(tmp_path)) == tmp_path
+    for fmt in SNAPSHOT_FORMATS:
+        assert check_snapshot_path(str(tmp_path / f"x.{fmt}")) == tmp_path / f"x.{fmt}"
+    (tmp_path / "x.png").write_bytes(USER_TEXT)
+    assert check_snapshot_path(str(tmp_path / "x.png"), force=True) == tmp_path / "x.png"
+    with pytest.raises(ParameterError, match="exists; choose another file"):
+        check_snapshot_path(str(tmp_path / "x.png"))
+    assert files_below(tmp_path) == ["x.png"]  # the writability probe left nothing
+
+
+# -- the audit's command, as a process ----------------------------------------------------
+def test_the_audit_command_keeps_the_users_file(tmp_path):
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "MPLBACKEND")}
+    for name in ("user_notes.txt", "user_pic.png"):
+        user = tmp_path / name
+        user.write_bytes(USER_TEXT)
+        done = subprocess.run(
+            [sys.executable, "-m", "ddwmmr.gui", "--duration", "1", "--snapshot", name],
+            capture_output=True,
+            text=True,
+            env=env,
+            cwd=tmp_path,
+            timeout=300,
+        )
+        assert done.returncode == 2, done.stderr
+        assert done.stderr.count("\n") == 1 and done.stderr.startswith(f"error: snapshot: {name}")
+        assert "Traceback" not in done.stderr and done.stdout == ""
+        assert user.read_bytes() == USER_TEXT
+    assert files_below(tmp_path) == ["user_notes.txt", "user_pic.png"]
