@@ -294,9 +294,9 @@ def _run_cli(*args: str, cwd) -> subprocess.CompletedProcess:
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (["--repeats", "abc"], "argument --repeats: must be an integer >= 1 (got 'abc')"),
-        (["--repeats", "0"], "argument --repeats: must be an integer >= 1 (got '0')"),
-        (["--calls", "-3"], "argument --calls: must be an integer >= 1 (got '-3')"),
+        (["--repeats", "abc"], "argument --repeats: must be an integer in [1, 1000] (got 'abc')"),
+        (["--repeats", "0"], "argument --repeats: must be an integer in [1, 1000] (got '0')"),
+        (["--calls", "-3"], "argument --calls: must be an integer in [1, 10000] (got '-3')"),
         (["--duration", "nan"], "argument --duration: must be a number > 0 in s (got 'nan')"),
         (["--duration", "1e"], "argument --duration: must be a number > 0 in s (got '1e')"),
         (["--method", "nope"], "unknown method 'nope' (choose from "),

@@ -32,9 +32,11 @@ import json
 import math
 import os
 import platform
+import stat
 import statistics
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -45,7 +47,14 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import Controller, StepInfo, available_methods, make_controller
-from ddwmmr.errors import MAX_SCENARIOS, ParameterError
+from ddwmmr.errors import (
+    MAX_SCENARIOS,
+    MAX_STEPS,
+    ParameterError,
+    check_int_at_least,
+    check_range,
+    read_text_file,
+)
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import u_from_qdot
 from ddwmmr.outputs import check_output_file
@@ -75,6 +84,15 @@ STATE_SOURCE_METHOD = "clrrmc-ts"
 TOOL = "ddwmmr.bench"
 #: Version of the report layout.
 REPORT_VERSION = 2
+#: Most repeats (``--repeats``): each number is a median over repeats, so a thousand is
+#: far past the point where more change it; every row keeps repeats x calls timings.
+MAX_REPEATS = 1000
+#: Most states per timing (``--calls``). The method table's states come from one recorded
+#: run of 2001 states and the largest qp class holds 8001 calls: more only repeats states.
+MAX_CALLS = 10_000
+#: Most worker processes of the scenario timing (``--jobs``): the scenarios tool's cap
+#: (docs/cli.md, "Limits"); never more workers than scenarios are started.
+MAX_JOBS = 256
 #: Label of the reference row (roboticstoolbox-python's holistic QP step).
 REFERENCE_LABEL = "rtb-holistic"
 #: Factory of the reference row and the extra that installs it.
@@ -264,7 +282,7 @@ def benchmark_cases(
         else:
             extra_cases.append(BenchCase(extra.label, factory, kind="extra", pair=extra.pair))
     taken = {case.label for case in extra_cases}
-    names = available_methods() if methods is None else list(methods)
+    names = available_methods() if methods is None else list(dict.fromkeys(methods))
     cases = [BenchCase(NAIVE_LABEL, NaivePseudoinverseController, kind="baseline")]
     cases += [BenchCase(name, _method_factory(name)) for name in names if name not in taken]
     return cases + extra_cases, skipped
@@ -722,13 +740,19 @@ def run_benchmark(
         scenarios: also run the first ``scenarios`` thesis benchmark scenarios (seed 0)
             with each of :data:`SCENARIO_CONTROLLERS` and report simulated seconds per
             wall-clock second (:func:`time_scenarios`); 0 (default) skips it.
-        scenario_jobs: worker processes for them (default: the CPUs available).
+        scenario_jobs: worker processes for them (default: the CPUs available; never
+            more than ``scenarios``).
+
+    Every argument is checked before anything runs (:class:`ParameterError`, one line).
     """
-    if repeats < 1 or calls < 1:
-        raise ValueError("repeats and calls must be >= 1")
+    check_int_at_least("repeats", repeats, 1, MAX_REPEATS)
+    check_int_at_least("calls", calls, 1, MAX_CALLS)
+    check_int_at_least("scenarios", scenarios, 0, MAX_SCENARIOS)
+    if scenario_jobs is not None:
+        check_int_at_least("jobs", scenario_jobs, 1, MAX_JOBS)
     robot = robot if robot is not None else Robot()
     trajectory = trajectory if trajectory is not None else Ellipse()
-    duration = float(trajectory.duration if duration is None else duration)
+    duration = check_duration(trajectory, duration)
     cases, skipped = benchmark_cases(methods, extras)
     labels = {case.label for case in cases}
     if qp_classes is None:
@@ -766,16 +790,38 @@ def run_benchmark(
     }
 
 
+def check_duration(trajectory: Any, duration: float | None) -> float:
+    """The simulated time (s) of each full run: ``duration`` (default one period of
+    ``trajectory``) if :func:`ddwmmr.simulate` can run it at the trajectory's step, i.e.
+    from one step to :data:`ddwmmr.errors.MAX_STEPS` steps; else :class:`ParameterError`
+    (checked before the benchmark starts, not in its first full run)."""
+    if duration is None:
+        return float(trajectory.duration)
+    dt = trajectory.duration / getattr(trajectory, "samples", 1000)  # simulate's default
+    return check_range("duration", duration, dt, MAX_STEPS * dt, "s")
+
+
+def scenario_workers(count: int, jobs: int | None = None) -> int:
+    """Worker processes for ``count`` scenarios: ``jobs`` (default: the CPUs available),
+    never more than the scenarios (an idle worker only adds start-up time to the wall time)."""
+    from ddwmmr.scenarios.executors import default_jobs
+
+    jobs = default_jobs() if jobs is None else check_int_at_least("jobs", jobs, 1, MAX_JOBS)
+    return max(1, min(jobs, count))
+
+
 def time_scenarios(count: int, jobs: int | None = None) -> list[dict[str, Any]]:
     """Simulated seconds per wall-clock second of the first ``count`` scenarios (seed 0,
     the defaults of ``python -m ddwmmr.scenarios``) for each controller of
-    :data:`SCENARIO_CONTROLLERS`, on ``jobs`` worker processes (default: the CPUs)."""
-    from ddwmmr.scenarios.executors import default_jobs, run_many
+    :data:`SCENARIO_CONTROLLERS`, on ``jobs`` worker processes (default: the CPUs; at
+    most ``count``, see :func:`scenario_workers`)."""
+    from ddwmmr.scenarios.executors import run_many
     from ddwmmr.scenarios.generator import generate
     from ddwmmr.scenarios.protocol import RunConfig
     from ddwmmr.scenarios.report import summarize
 
-    jobs = default_jobs() if jobs is None else jobs
+    check_int_at_least("scenarios", count, 1, MAX_SCENARIOS)
+    jobs = scenario_workers(count, jobs)
     batch = generate(count, 0)
     rows = []
     for controller in SCENARIO_CONTROLLERS:
@@ -998,22 +1044,120 @@ def write_report(report: dict[str, Any], path: str | Path, force: bool = False) 
 
 def check_out(path: Path, force: bool = False) -> None:
     """Refuse, before the run, an output path that cannot be written or that is not a
-    report of this tool (unless ``force``): see :func:`ddwmmr.outputs.check_output_file`."""
+    report of this tool (unless ``force``): see :func:`ddwmmr.outputs.check_output_file`.
+    Something that is not a regular file (a device, a FIFO) is never replaced, not even
+    with ``force``: the report is moved into place by a rename, which would replace it."""
     check_output_file(path, TOOL, _is_report, force)
+    try:
+        info = os.stat(path)
+    except OSError:
+        return  # absent: check_output_file checked its folder
+    if not stat.S_ISREG(info.st_mode):
+        raise ParameterError(f"out: {path} exists and is not a regular file; give a file name")
+
+
+def probe_out(path: str | Path) -> None:
+    """Create and remove a temporary file where the report will go (the first existing
+    folder on the way to ``path``, missing parents are created when the report is
+    written): catches what permission bits do not show (``/proc``, a read-only mount, a
+    full disk of inodes) before a long run rather than after it."""
+    folder = Path(os.path.abspath(path)).parent
+    while not os.path.lexists(folder) and folder != folder.parent:
+        folder = folder.parent
+    try:
+        fd, name = tempfile.mkstemp(dir=folder, prefix=".ddwmmr-", suffix=".tmp")
+    except OSError as exc:
+        raise ParameterError(f"out: cannot write in {folder} ({exc.strerror or exc})") from None
+    os.close(fd)
+    Path(name).unlink(missing_ok=True)
 
 
 def read_report(path: str | Path) -> dict[str, Any]:
-    """A report written by :func:`write_report` (for ``--compare``)."""
+    """A report written by :func:`write_report` (for ``--compare``), checked to hold every
+    field :func:`format_comparison` reads; else one-line :class:`ParameterError`s naming
+    ``compare`` and what is wrong (missing, unreadable, not JSON, nested too deeply, not
+    a report of this tool, a field of the wrong type)."""
+    if not str(path):
+        raise ParameterError("compare: no file name given")
     path = Path(path)
-    if not path.is_file() or not _is_report(path):
-        raise ParameterError(f"compare: {path} is not a {TOOL} report")
-    return json.loads(path.read_text(encoding="utf-8"))
+    text = read_text_file(path, "compare")  # missing, permission, FIFO, size, UTF-8
+    try:
+        data = json.loads(text)
+    except RecursionError:
+        raise ParameterError(f"compare: {path} is not valid JSON (nested too deeply)") from None
+    except ValueError as exc:
+        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ParameterError(f"compare: {path} is not valid JSON ({message})") from None
+    if not isinstance(data, dict) or data.get("tool") != TOOL:
+        raise ParameterError(f'compare: {path} is not a {TOOL} report (no "tool": "{TOOL}")')
+    problem = _layout_problem(data)
+    if problem:
+        raise ParameterError(f"compare: {path} is not a usable {TOOL} report: {problem}")
+    return data
+
+
+def _type_name(value: Any) -> str:
+    return {dict: "an object", list: "a list", str: "a string", bool: "a boolean"}.get(
+        type(value), "null" if value is None else "a number"
+    )
+
+
+def _positive_number(value: Any) -> bool:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    try:
+        return math.isfinite(float(value)) and value > 0
+    except OverflowError:  # an integer beyond float
+        return False
+
+
+def _entries_problem(data: dict[str, Any], key: str, fields: dict[str, str]) -> str | None:
+    """What is wrong with ``data[key]`` as a list of objects with ``fields`` (name ->
+    "text" or "number"; a number must be finite and > 0); None if nothing."""
+    entries = data.get(key, [])
+    if not isinstance(entries, list):
+        return f'"{key}" must be a list (got {_type_name(entries)})'
+    for i, entry in enumerate(entries):
+        if not isinstance(entry, dict):
+            return f'"{key}"[{i}] must be an object (got {_type_name(entry)})'
+        for name, kind in fields.items():
+            value = entry.get(name)
+            if kind == "text" and not isinstance(value, str):
+                return f'"{key}"[{i}].{name} must be a string (got {_type_name(value)})'
+            if kind == "number" and not _positive_number(value):
+                got = repr(value)[:40] if isinstance(value, int | float) else _type_name(value)
+                return f'"{key}"[{i}].{name} must be a number > 0 (got {got})'
+    return None
+
+
+def _layout_problem(data: dict[str, Any]) -> str | None:
+    """The first field :func:`format_comparison` would trip over, or None."""
+    if not isinstance(data.get("config"), dict):
+        return f'"config" must be an object (got {_type_name(data.get("config"))})'
+    if "rows" not in data:
+        return 'no "rows"'
+    problem = _entries_problem(data, "rows", {"label": "text", "step_us": "number"})
+    problem = problem or _entries_problem(data, "qp_classes", {"name": "text"})
+    problem = problem or _entries_problem(
+        data, "scenarios", {"controller": "text", "sim_seconds_per_wall_second": "number"}
+    )
+    if problem:
+        return problem
+    for i, entry in enumerate(data.get("qp_classes", [])):
+        if "rows" in entry:
+            rows = entry["rows"]
+            qp = rows.get("qp") if isinstance(rows, dict) else None
+            if not isinstance(qp, dict) or not _positive_number(qp.get("median_us")):
+                return f'"qp_classes"[{i}].rows.qp.median_us must be a number > 0'
+    return None
 
 
 def _is_report(path: Path) -> bool:
+    """Whether ``path`` is a report of this tool (a regular file of at most
+    :data:`ddwmmr.errors.MAX_INPUT_BYTES` is read; a device such as /dev/zero never)."""
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError):
+        data = json.loads(read_text_file(path, "out"))
+    except (ParameterError, ValueError, RecursionError):
         return False
     return isinstance(data, dict) and data.get("tool") == TOOL
 
@@ -1049,7 +1193,9 @@ def _integer(low: int, high: int | None = None) -> Callable[[str], int]:
     return parse
 
 
-_positive_int = _integer(1)
+_repeat_count = _integer(1, MAX_REPEATS)
+_call_count = _integer(1, MAX_CALLS)
+_job_count = _integer(1, MAX_JOBS)
 _scenario_count = _integer(0, MAX_SCENARIOS)
 
 
@@ -1070,22 +1216,29 @@ def build_parser() -> argparse.ArgumentParser:
         description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
+    ellipse = Ellipse()
+    dt = ellipse.duration / ellipse.samples
     parser.add_argument(
-        "--repeats", type=_positive_int, default=5, metavar="N", help="repeats (default 5)"
+        "--repeats",
+        type=_repeat_count,
+        default=5,
+        metavar="N",
+        help=f"repeats (default 5, at most {MAX_REPEATS})",
     )
     parser.add_argument(
         "--calls",
-        type=_positive_int,
+        type=_call_count,
         default=500,
         metavar="N",
-        help="states per timing (default 500)",
+        help=f"states per timing (default 500, at most {MAX_CALLS})",
     )
     parser.add_argument(
         "--duration",
         type=_positive_float,
         default=None,
         metavar="S",
-        help="simulated time of each full run in s (default: one trajectory period)",
+        help=f"simulated time of each full run in s (default: one trajectory period, "
+        f"{ellipse.duration:g}; {dt:g} to {MAX_STEPS * dt:g}: 1 to {MAX_STEPS} steps of {dt:g} s)",
     )
     parser.add_argument(
         "--method",
@@ -1101,7 +1254,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--force", action="store_true", help="replace --out even if it is not a bench report"
     )
     parser.add_argument(
-        "--compare", metavar="FILE", help="also print medians against an earlier report"
+        "--compare",
+        metavar="FILE",
+        help="also print medians against an earlier report (read and checked before the run)",
     )
     parser.add_argument(
         "--scenarios",
@@ -1109,16 +1264,19 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="N",
         help=f"also time the first N benchmark scenarios with {' and '.join(SCENARIO_CONTROLLERS)} "
-        f"(simulated s per wall s; default {SCENARIO_COUNT} without --method, else 0; 0: skip)",
+        f"(simulated s per wall s; default {SCENARIO_COUNT} without --method, else 0; 0: skip; "
+        f"at most {MAX_SCENARIOS})",
     )
     parser.add_argument(
         "--jobs",
-        type=_positive_int,
+        type=_job_count,
         default=None,
         metavar="N",
-        help="worker processes of the scenario timing (default: the CPUs available)",
+        help=f"worker processes of the scenario timing (default: the CPUs available; at most "
+        f"{MAX_JOBS}, and never more than the scenarios)",
     )
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
+    parser.add_argument("--no-progress", action="store_true", help="no progress output on stderr")
     return parser
 
 
@@ -1143,9 +1301,12 @@ def _main(argv: Sequence[str] | None = None) -> int:
         )
         return 2
     try:
-        previous = read_report(args.compare) if args.compare else None
+        # Everything that can be checked is checked before a minute-long run.
+        previous = read_report(args.compare) if args.compare is not None else None
         out = Path(args.out)
-        check_out(out, force=args.force)  # before a minute-long run
+        check_out(out, force=args.force)
+        check_duration(Ellipse(), args.duration)
+        probe_out(out)
         scenarios = args.scenarios
         if scenarios is None:
             scenarios = SCENARIO_COUNT if args.methods is None else 0
@@ -1154,7 +1315,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
             args.calls,
             args.duration,
             args.methods,
-            progress=True,
+            progress=not args.no_progress,
             scenarios=scenarios,
             scenario_jobs=args.jobs,
         )
