@@ -325,3 +325,14 @@ def test_integrator_needs_the_kinematic_plant(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "only the kinematic plant" in err[0]
     assert not out.exists()
+
+
+def test_default_step_on_the_physics_plant_is_a_whole_engine_multiple(tmp_path):
+    # sideways_reach has 401 samples over 8 s: 0.01995 s is no multiple of MuJoCo's 0.002 s
+    # step; the README's command must run at the rounded step, as simulate() does.
+    out = tmp_path / "run"
+    args = ["--method", "qp", "--traj", "sideways_reach", "--payload", "3", "--plant", "mujoco"]
+    assert run([*args, "--duration", "0.2", "--no-plots", "--no-progress", "--out", str(out)]) == 0
+    record = json.loads((out / "summary.json").read_text())
+    assert record["dt"] == pytest.approx(0.02, abs=1e-15)
+    assert record["run"]["dt"] == record["dt"]

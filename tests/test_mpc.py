@@ -61,7 +61,7 @@ def test_registered_with_its_interfaces():
         ({"model": "mujoco"}, "model must be one of kinematic, thesis"),
         ({"solver": "snopt"}, "solver must be one of rti, sqp, ipopt, sqpmethod, fatrop"),
         ({"qp_solver": "gurobi"}, "qp_solver must be one of"),
-        ({"horizon": -1.0}, "horizon must be > 0"),
+        ({"horizon": -1.0}, "horizon must be in [0.0001, 100] s"),
         ({"intervals": 1}, "intervals must be an integer in [2, 200]"),
         ({"intervals": 2.5}, "intervals must be an integer in [2, 200]"),
         ({"horizon": 0.5, "intervals": 20, "first_interval": 0.1}, "horizon must be >="),

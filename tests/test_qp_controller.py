@@ -41,7 +41,7 @@ def test_registered_without_its_benchmark_twin():
         ({"solver": "nope"}, "solver must be one of"),
         ({"stability_min": 0.0}, "stability_min must be > 0"),
         ({"stability_min": 12.0}, "stability_min must be in"),
-        ({"manipulability_weight": -1.0}, "manipulability_weight must be >= 0"),
+        ({"manipulability_weight": -1.0}, r"manipulability_weight must be in \[0, 1e\+06\]"),
         ({"max_speed": 0.0}, "max_speed must be > 0"),
         ({"tau": -0.5}, "tau must be > 0"),
         ({"tau": (0.5, 0.5)}, "tau must be one value or 3"),

@@ -96,6 +96,21 @@ def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None 
     return number
 
 
+def check_bool(name: str, value: Any) -> bool:
+    """Return ``value`` if it is True or False (numpy's too), else raise."""
+    if not isinstance(value, bool | np.bool_):
+        raise ParameterError(f"{name} must be true or false (got {value!r:.40})")
+    return bool(value)
+
+
+def check_instance(name: str, value: Any, kind: type) -> Any:
+    """Return ``value`` if it is a ``kind`` (or a subclass), else raise
+    :class:`ParameterError` naming the parameter and the expected type."""
+    if not isinstance(value, kind):
+        raise ParameterError(f"{name} must be a {kind.__name__} (got {value!r:.60})")
+    return value
+
+
 def check_step_count(duration: float, dt: float) -> int:
     """Number of steps ``max(1, round(duration / dt))`` of a run, within :data:`MAX_STEPS`.
 

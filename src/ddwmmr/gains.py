@@ -5,7 +5,13 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+import numpy as np
+
 from ddwmmr.errors import ParameterError
+
+#: Shortest time constant (s): gains above 1e4 1/s are no feedback a 2 rad/s arm or a
+#: wheel-speed-limited base can follow, only numbers that overflow the commands.
+MIN_TAU = 1e-4
 
 
 def gains_from_tau(tau: float | Sequence[float], size: int) -> tuple[float, ...]:
@@ -13,13 +19,29 @@ def gains_from_tau(tau: float | Sequence[float], size: int) -> tuple[float, ...]
 
     ``tau = inf`` switches a channel's feedback off (gain 0).
     """
-    values = [tau] * size if isinstance(tau, int | float) else list(tau)
+    if isinstance(tau, str | bytes | bool) or tau is None:
+        raise ParameterError(
+            f"tau must be a time constant in s or {size} of them (got {tau!r:.40})"
+        )
+    if isinstance(tau, int | float | np.integer | np.floating) or np.ndim(tau) == 0:
+        values = [tau] * size
+    else:
+        values = list(tau)
     if len(values) != size:
         raise ParameterError(f"tau must be one value or {size} values in s (got {len(values)})")
+    for value in values:
+        if isinstance(value, str | bytes | bool) or value is None:
+            raise ParameterError(f"tau must be numbers in s (got {value!r:.40})")
+    try:
+        values = [float(value) for value in values]
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"tau must be numbers in s (got {values!r:.60})") from None
     gains = []
     for value in values:
-        value = float(value)
-        if math.isnan(value) or value <= 0.0:
-            raise ParameterError(f"tau must be > 0 s, or inf to disable a channel (got {value:g})")
+        if math.isnan(value) or value < MIN_TAU:
+            raise ParameterError(
+                f"tau must be > 0 s (at least {MIN_TAU:g} s), or inf to disable a channel "
+                f"(got {value:g})"
+            )
         gains.append(0.0 if math.isinf(value) else 1.0 / value)
     return tuple(gains)

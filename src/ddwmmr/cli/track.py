@@ -36,7 +36,7 @@ from ddwmmr.plants import available_plants
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
-from ddwmmr.sim.simulate import plant_integrator, simulate
+from ddwmmr.sim.simulate import default_step, plant_integrator, simulate
 from ddwmmr.trajectories import available_trajectories, load_trajectory
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
@@ -275,10 +275,8 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     # The preset's values, then the explicit options (they win): the record keeps them all.
     options = {**preset_options(args.method, args.preset or "default"), **controller_options(args)}
     duration = trajectory.duration if args.duration is None else args.duration
-    if args.dt is None:
-        step = trajectory.duration / getattr(trajectory, "samples", 1000)
-    else:
-        step = args.dt
+    plant = args.plant or PLANT
+    step = default_step(trajectory, plant, robot) if args.dt is None else args.dt
     offset = DEFAULT_INITIAL_OFFSET if args.offset is None else tuple(args.offset)
     for value in offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
@@ -290,10 +288,10 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         source,
         step,
         duration,
-        plant_integrator(args.plant or PLANT, args.integrator),
+        plant_integrator(plant, args.integrator),
         offset,
         args.traj,
-        args.plant or PLANT,
+        plant,
     )
 
 

@@ -22,7 +22,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, check_instance
 from ddwmmr.model import Robot
 
 
@@ -147,6 +147,7 @@ def make_controller(
     presets and options (see :func:`method_options`) raise :class:`ParameterError`.
     """
     cls = _registered(name)
+    robot = check_instance("robot", robot if robot is not None else Robot(), Robot)
     if preset is not None:  # preset hook: explicit options win
         from ddwmmr.controllers.presets import preset_options
 
@@ -158,4 +159,4 @@ def make_controller(
             f"method {name}: unknown option {unknown[0]!r} "
             f"(accepted: {', '.join(sorted(accepted)) or 'none'})"
         )
-    return cls(robot if robot is not None else Robot(), **options)
+    return cls(robot, **options)

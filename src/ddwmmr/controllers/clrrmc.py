@@ -15,7 +15,7 @@ import numpy as np
 from ddwmmr.controllers.base import StepInfo, register
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
-from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.errors import MAX_STEPS, ParameterError, check_positive, check_range
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import wrap_angle
@@ -24,6 +24,9 @@ from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
 
 #: Default time constant (s) of every closed-loop channel.
 DEFAULT_TAU = 0.5
+#: Range of the reference's integration step (s): finer than 0.1 ms buys nothing (the
+#: reference is RK4), coarser than 1 s does not resolve any trajectory of the library.
+MIN_REFERENCE_STEP, MAX_REFERENCE_STEP = 1e-4, 1.0
 
 
 @register("clrrmc-ts")
@@ -96,11 +99,11 @@ class ConfigurationSpaceController:
         self.robot = robot
         self.gains = gains_from_tau(tau, 5)
         self.aux = check_aux(aux)
-        if not reference_step > 0:
-            raise ParameterError(f"reference_step must be > 0 s (got {reference_step})")
-        self.reference_step = float(reference_step)
+        self.reference_step = check_range(
+            "reference_step", reference_step, MIN_REFERENCE_STEP, MAX_REFERENCE_STEP, "s"
+        )
         self.threshold = check_positive("singularity_threshold", singularity_threshold)
-        self.damping = check_nonnegative("damping", damping)
+        self.damping = kernels.check_damping(damping)
         self.reference: ReferenceTrajectory | None = None
         self.last = StepInfo()
 
@@ -110,6 +113,12 @@ class ConfigurationSpaceController:
         The reference starts at the home arm pose placed on the trajectory start, which is
         also where :func:`ddwmmr.simulate` starts before applying its initial offset.
         """
+        period = getattr(trajectory, "duration", 0.0)
+        if period / self.reference_step > MAX_STEPS:
+            raise ParameterError(
+                f"reference_step: {period:g} s / {self.reference_step:g} s is more than "
+                f"{MAX_STEPS} reference steps; use a larger reference_step"
+            )
         self.reference = ReferenceTrajectory(
             self.robot,
             trajectory,

@@ -42,7 +42,7 @@ class ResolvedRate(ABC):
         self.robot = robot
         self.L1, self.L2 = robot.L1, robot.L2
         self.threshold = check_positive("singularity_threshold", singularity_threshold)
-        self.damping = check_nonnegative("damping", damping)
+        self.damping = kernels.check_damping(damping)
         self.last = StepInfo()
 
     def reset(self, trajectory: object, q0: np.ndarray) -> None:

@@ -26,12 +26,27 @@ import numpy as np
 
 from ddwmmr.commands import WheelForces
 from ddwmmr.controllers.base import StepInfo
-from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.errors import (
+    ParameterError,
+    check_bool,
+    check_int_at_least,
+    check_nonnegative,
+    check_positive,
+    check_range,
+)
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc import terminal
 from ddwmmr.mpc.models import PredictionModel, make_model
-from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights, grid_intervals
+from ddwmmr.mpc.ocp import (
+    MAX_HORIZON,
+    MAX_INTERVALS,
+    MIN_INTERVAL,
+    OCPConfig,
+    ShootingOCP,
+    Weights,
+    grid_intervals,
+)
 from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS, SolverFailure, make_solver
 from ddwmmr.qp.limits import as_circles, run_clearance, safe_arm_scale
 
@@ -128,7 +143,7 @@ class MPCControllerCore:
         if self.stability_min >= 10.0:
             raise ParameterError(f"stability_min must be in (0, 10) (got {stability_min:g})")
         self.obstacles = as_circles(obstacles)
-        self.track_orientation = bool(track_orientation)
+        self.track_orientation = check_bool("track_orientation", track_orientation)
         self.solver_name, self.qp_solver = solver, qp_solver
         self._dt_option = None if dt is None else check_positive("dt", dt)
         self.dt = self._dt_option or DEFAULT_DT
@@ -170,8 +185,12 @@ class MPCControllerCore:
     @staticmethod
     def _grid_option(mode, horizon, intervals, first_interval, dt) -> tuple[int, float, float]:
         n0, h0, t0 = GRID_DEFAULTS[mode]
-        n = n0 if intervals is None else intervals
-        t = check_positive("horizon", t0 if horizon is None else horizon)
+        n = check_int_at_least(
+            "intervals", n0 if intervals is None else intervals, 2, MAX_INTERVALS
+        )
+        t = check_range(
+            "horizon", t0 if horizon is None else horizon, MIN_INTERVAL, MAX_HORIZON, "s"
+        )
         if first_interval is None:
             # A short horizon with the default first interval: uniform intervals.
             h = min(h0, max(t - dt, 1e-3) / max(int(n) - 1, 1))

@@ -71,7 +71,13 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.errors import (
+    ParameterError,
+    check_int_at_least,
+    check_nonnegative,
+    check_positive,
+    check_range,
+)
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.models import PredictionModel
@@ -435,14 +441,15 @@ class ShootingOCP:
         return np.concatenate([body.ravel(), xs[n]])
 
 
+#: Bounds of the shooting grid: interval count, shortest interval and longest horizon (s).
+MAX_INTERVALS, MIN_INTERVAL, MAX_HORIZON = 200, 1e-4, 100.0
+
+
 def grid_intervals(intervals: int, first: float, horizon: float) -> np.ndarray:
     """``intervals`` lengths ``first r^k`` (s), r >= 1 chosen so that they sum to ``horizon``."""
-    n = intervals
-    if isinstance(n, bool) or not float(n).is_integer() or not 2 <= n <= 200:
-        raise ParameterError(f"intervals must be an integer in [2, 200] (got {intervals!r})")
-    n = int(n)
-    first = check_positive("first_interval", first)
-    horizon = check_positive("horizon", horizon)
+    n = check_int_at_least("intervals", intervals, 2, MAX_INTERVALS)
+    first = check_range("first_interval", first, MIN_INTERVAL, MAX_HORIZON, "s")
+    horizon = check_range("horizon", horizon, MIN_INTERVAL, MAX_HORIZON, "s")
     if horizon < n * first * (1.0 - 1e-9):
         raise ParameterError(
             f"horizon must be >= intervals x first_interval = {n * first:g} s (got {horizon:g})"

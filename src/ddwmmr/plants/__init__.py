@@ -7,9 +7,11 @@ name (``available_plants()`` lists the names) for the simulation loop.
 from __future__ import annotations
 
 import importlib
+import inspect
 from typing import Any
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, check_instance
+from ddwmmr.model import Robot
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.plants.kinematic import INTEGRATORS, KinematicPlant
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState, VelocityServo
@@ -37,8 +39,18 @@ def plant_class(name: str) -> type:
 
 
 def make_plant(name: str, robot: Any, **options: Any) -> Plant:
-    """Build the plant ``name`` for ``robot`` with its keyword ``options``."""
-    return plant_class(name)(robot, **options)
+    """Build the plant ``name`` for ``robot`` with its keyword ``options``; an unknown
+    option is a :class:`ParameterError` naming the accepted ones."""
+    cls = plant_class(name)
+    check_instance("robot", robot, Robot)
+    parameters = inspect.signature(cls).parameters
+    accepted = sorted(p for p in parameters if p != "robot")
+    unknown = sorted(set(options) - set(accepted))
+    if unknown:
+        raise ParameterError(
+            f"plant {name}: unknown option {unknown[0]!r} (accepted: {', '.join(accepted)})"
+        )
+    return cls(robot, **options)
 
 
 def __getattr__(name: str) -> Any:

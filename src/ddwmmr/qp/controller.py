@@ -29,7 +29,7 @@ import numpy as np
 
 from ddwmmr.controllers.base import StepInfo
 from ddwmmr.controllers.inputs import check_inputs
-from ddwmmr.errors import check_nonnegative, check_positive
+from ddwmmr.errors import ParameterError, check_bool, check_positive, check_range
 from ddwmmr.model import Robot
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import (
@@ -64,6 +64,9 @@ from ddwmmr.qp.tasks import (
 
 #: Look-ahead step (s) when neither ``dt`` nor the trajectory's resolution is known.
 DEFAULT_DT = 0.02
+#: Largest soft-task weight: far above the tracking slack's 1e4, before the Hessian's
+#: conditioning (floor 1e-9) makes the solve meaningless.
+MAX_WEIGHT = 1e6
 #: Default solver: the fastest measured (docs/qp.md, "Solvers").
 DEFAULT_SOLVER = "daqp"
 
@@ -157,6 +160,9 @@ class QPControllerCore:
         self._com = robot.com_coefficients
         self.mode = check_mode(mode)
         self.solver = solver
+        if warm_start is not None:
+            check_bool("warm_start", warm_start)
+        check_bool("track_orientation", track_orientation)
         self.backend = self._make_backend(solver, warm_start)
         self.obstacles = as_circles(obstacles)
         if heading_weight is None:
@@ -168,7 +174,7 @@ class QPControllerCore:
         self.tasks: list[Task] = [
             self.tracking,
             ManipulabilityTask(
-                check_nonnegative("manipulability_weight", manipulability_weight),
+                check_range("manipulability_weight", manipulability_weight, 0.0, MAX_WEIGHT),
                 arm_row=not track_orientation,
             ),
             PostureTask(posture_weight, rate_limit=angular),
@@ -177,7 +183,7 @@ class QPControllerCore:
         heading = HeadingTask(heading_weight, distance=0.8 * robot.reach)
         if heading_weight > 0.0:
             self.tasks.append(heading)
-        self.tasks.extend(tasks)
+        self.tasks.extend(_pieces("tasks", tasks, Task))
         self.stability = StabilityLimit(
             robot.com_coefficients,
             stability_min,
@@ -219,7 +225,7 @@ class QPControllerCore:
             half_diagonal = 0.5 * math.hypot(robot.base_length, robot.base_width)
             detour = Detour(self.obstacles, half_diagonal + 2.0 * obstacle_margin)
             self.tracking.detour = heading.detour = detour
-        self.limits.extend(limits)
+        self.limits.extend(_pieces("limits", limits, Limit))
         self.problem = QPProblem(self.tasks, self.limits)
         self._dt_option = None if dt is None else check_positive("dt", dt)
         self.ctx = StepContext(robot, self._dt_option or DEFAULT_DT)
@@ -342,3 +348,16 @@ class QPControllerCore:
             "qp_mode": self.mode,
             "qp_solver": self.solver,
         }
+
+
+def _pieces(name: str, pieces: Any, kind: type) -> list[Any]:
+    """The user's extra tasks or limits as a list (None: none); each must be a ``kind``."""
+    items = list(pieces) if pieces is not None and hasattr(pieces, "__iter__") else None
+    if items is None and pieces is not None:
+        raise ParameterError(
+            f"{name} must be a list of {kind.__name__} objects (got {pieces!r:.40})"
+        )
+    for item in items or []:
+        if not isinstance(item, kind):
+            raise ParameterError(f"{name} must be {kind.__name__} objects (got {item!r:.40})")
+    return items or []

@@ -46,11 +46,25 @@ from __future__ import annotations
 
 import math
 
+from ddwmmr.errors import ParameterError, check_finite
+
 #: Default smallest singular value below which damping starts (``sigma0``).
 SINGULARITY_THRESHOLD = 0.05
 #: Default damping factor lambda at the singularity (``>= sigma0``: the gain bound holds).
 MAX_DAMPING = 0.05
 _SQRT2 = math.sqrt(2.0)
+
+
+def check_damping(damping: float) -> float:
+    """``damping`` as a float if it is finite and > 0, else a one-line ParameterError
+    (undamped, the inverse is unbounded at the singularity, ``cos th1 = 0``)."""
+    value = check_finite("damping", damping)
+    if not value > 0.0:
+        raise ParameterError(
+            f"damping must be > 0 (got {value:g}): undamped, the inverse is unbounded at "
+            "cos th1 = 0; a small value gives an almost undamped one"
+        )
+    return value
 
 
 def damping_squared(sigma: float, threshold: float, damping: float) -> float:

@@ -9,9 +9,15 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import Controller, make_controller
-from ddwmmr.errors import ParameterError, check_finite, check_positive, check_step_count
+from ddwmmr.errors import (
+    ParameterError,
+    check_finite,
+    check_instance,
+    check_positive,
+    check_step_count,
+)
 from ddwmmr.model import Robot
-from ddwmmr.plants import make_plant
+from ddwmmr.plants import available_plants, make_plant, plant_class
 from ddwmmr.plants.base import Plant
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
@@ -71,26 +77,41 @@ def simulate(
         state blows up, the run stops there: ``summary["diverged_at_step"]`` says where and
         the time series hold what was recorded until then.
     """
-    robot = robot if robot is not None else Robot()
+    robot = check_instance("robot", robot if robot is not None else Robot(), Robot)
+    if progress is not None and not callable(progress):
+        raise ParameterError(
+            f"progress must be a callable progress(step, steps) (got {progress!r:.40})"
+        )
     if isinstance(method, str):
         controller = make_controller(method, robot, **controller_options)
     elif controller_options:
         raise ParameterError("controller options are only accepted with a method name")
-    else:
+    elif callable(getattr(method, "command", None)):
         controller = method
+    else:
+        raise ParameterError(
+            f"method must be a method name or a controller with command() (got {method!r:.40})"
+        )
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
     the_plant = _plant(plant, robot, integrator, plant_options)
     if dt is None:
-        dt = engine_multiple(trajectory.duration / getattr(trajectory, "samples", 1000), the_plant)
+        dt = engine_multiple(resolution_step(trajectory), the_plant)
     dt = check_positive("dt", dt)
     steps = check_step_count(duration, dt)  # within MAX_STEPS, before anything is allocated
     if q0 is None:
+        if isinstance(initial_offset, str) or not hasattr(initial_offset, "__len__"):
+            raise ParameterError(
+                f"initial_offset must be two numbers dx, dy in m (got {initial_offset!r:.40})"
+            )
         offset = tuple(check_finite("initial_offset", v) for v in initial_offset)
         if len(offset) != 2:
             raise ParameterError(f"initial_offset must be two numbers dx, dy in m (got {offset})")
         q = offset_configuration(robot, start_configuration(robot, trajectory), offset)
     else:
-        q = np.array(q0, dtype=float)
+        try:
+            q = np.array(q0, dtype=float)
+        except (TypeError, ValueError):
+            q = np.full(1, np.nan)  # not numbers: the message below
         if q.shape != (5,) or not np.all(np.isfinite(q)):
             raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
     task = TrackingTask(trajectory, the_plant, grid=(dt, steps))
@@ -121,7 +142,14 @@ def _plant(
     plant: str | Plant, robot: Robot, integrator: str | None, options: dict[str, Any] | None
 ) -> Plant:
     """The plant object for ``simulate``'s ``plant``/``integrator``/``plant_options``."""
+    if options is not None and not isinstance(options, dict):
+        raise ParameterError(f"plant_options must be a dict of plant options (got {options!r:.40})")
     if not isinstance(plant, str):
+        if not callable(getattr(plant, "step", None)):
+            raise ParameterError(
+                f"plant must be a plant name ({', '.join(available_plants())}) or a plant "
+                f"object (got {plant!r:.40})"
+            )
         if integrator is not None or options:
             raise ParameterError("integrator and plant_options need a plant name, not an object")
         return plant
@@ -130,6 +158,28 @@ def _plant(
     if resolved is not None:
         options.setdefault("integrator", resolved)
     return make_plant(plant, robot, **options)
+
+
+def resolution_step(trajectory: Any) -> float:
+    """The trajectory's own step (s): ``duration / samples`` (its resolution N), or
+    ``duration / 1000``."""
+    samples = getattr(trajectory, "samples", 1000)
+    number = isinstance(samples, int | float | np.integer | np.floating)
+    if isinstance(samples, bool) or not number or not (math.isfinite(samples) and samples > 0):
+        raise ParameterError(
+            f"trajectory: samples (its resolution N) must be a number > 0 (got {samples!r:.40})"
+        )
+    return trajectory.duration / samples
+
+
+def default_step(trajectory: Any, plant: str, robot: Robot) -> float:
+    """The control step (s) ``simulate`` takes by default on the plant named ``plant``:
+    :func:`resolution_step`, rounded to the engine ``timestep`` of a physics plant (which
+    is built for it; other plants are not)."""
+    step = resolution_step(trajectory)
+    if hasattr(plant_class(plant), "timestep"):
+        step = engine_multiple(step, make_plant(plant, robot))
+    return step
 
 
 def engine_multiple(dt: float, plant: Plant) -> float:

@@ -81,8 +81,15 @@ def load_obstacles(path: str | Path) -> list[Circle]:
 
 def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> list[Circle]:
     """Normalise the ``obstacles`` option: circles, (x, y, radius) triples, or a TOML path."""
+    if obstacles is None:
+        return []
     if isinstance(obstacles, str | Path):
         return load_obstacles(obstacles)
+    if not hasattr(obstacles, "__iter__"):
+        raise ParameterError(
+            f"obstacles must be circles, (x, y, radius) triples or a TOML file "
+            f"(got {obstacles!r:.40})"
+        )
     circles = []
     for item in obstacles:
         if isinstance(item, Circle):

@@ -65,7 +65,7 @@ class Task(ABC):
     name: str = "task"
 
     def __init__(self, weight: float) -> None:
-        self.weight = check_nonnegative(f"{self.name} weight", weight)
+        self.weight = check_nonnegative(f"{self.name.replace(' ', '_')}_weight", weight)
 
     def row_weights(self) -> np.ndarray:
         """Weight of each row (cost per squared task-rate unit); default: ``weight``."""
