@@ -108,9 +108,7 @@ def test_out_of_range_numbers_are_refused_before_the_run(
 
 
 def test_caps_are_the_documented_ones():
-    from ddwmmr.cli.scenarios import MAX_JOBS as SCENARIOS_MAX_JOBS
-
-    assert MAX_JOBS == SCENARIOS_MAX_JOBS == 256  # docs/cli.md, "Limits"
+    assert MAX_JOBS == 256  # docs/cli.md, "Limits": every tool's --jobs
     assert (MAX_REPEATS, MAX_CALLS) == (1000, 10_000)
     text = build_parser().format_help()
     for words in ("at most 1000", "at most 10000", "at most 256", "0.02 to 20000"):

@@ -48,6 +48,7 @@ import numpy as np
 
 from ddwmmr.controllers.base import Controller, StepInfo, available_methods, make_controller
 from ddwmmr.errors import (
+    MAX_JOBS,
     MAX_SCENARIOS,
     MAX_STEPS,
     ParameterError,
@@ -90,9 +91,6 @@ MAX_REPEATS = 1000
 #: Most states per timing (``--calls``). The method table's states come from one recorded
 #: run of 2001 states and the largest qp class holds 8001 calls: more only repeats states.
 MAX_CALLS = 10_000
-#: Most worker processes of the scenario timing (``--jobs``): the scenarios tool's cap
-#: (docs/cli.md, "Limits"); never more workers than scenarios are started.
-MAX_JOBS = 256
 #: Label of the reference row (roboticstoolbox-python's holistic QP step).
 REFERENCE_LABEL = "rtb-holistic"
 #: Factory of the reference row and the extra that installs it.

@@ -23,6 +23,8 @@ import numpy as np
 #: Most simulation steps of one run. The recorded time series holds 29 float64 columns per
 #: step, so a run at the cap keeps about 230 MB in memory (and timeseries.csv ~500 MB).
 MAX_STEPS = 1_000_000
+#: Most worker processes any tool's --jobs may ask for (compare, scenarios, bench).
+MAX_JOBS = 256
 #: Most samples a trajectory may have: ``N`` of a parametric trajectory (the default step
 #: is T / N) and data rows of a sampled CSV trajectory.
 MAX_TRAJECTORY_SAMPLES = 1_000_000

@@ -31,7 +31,13 @@ from ddwmmr.cli.common import (
 )
 from ddwmmr.controllers.base import available_methods, method_description
 from ddwmmr.controllers.presets import PRESETS
-from ddwmmr.errors import ParameterError, check_int_at_least, check_positive, check_step_count
+from ddwmmr.errors import (
+    MAX_JOBS,
+    ParameterError,
+    check_int_at_least,
+    check_positive,
+    check_step_count,
+)
 from ddwmmr.plants import available_plants
 from ddwmmr.progress import phase
 from ddwmmr.reports.compare import (
@@ -60,8 +66,6 @@ PROG = "python -m ddwmmr.compare"
 DEFAULT_OUT = "runs/compare"
 #: Default number of worker processes: the CPUs, at most 8.
 DEFAULT_JOBS = min(os.cpu_count() or 1, 8)
-#: Most worker processes --jobs may ask for.
-MAX_JOBS = 256
 
 EPILOG_TEXT = f"""\
 outputs (in --out):

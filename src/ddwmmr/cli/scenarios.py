@@ -37,6 +37,7 @@ from ddwmmr.cli.common import (
 )
 from ddwmmr.errors import (
     MASS_RANGE_KG,
+    MAX_JOBS,
     MAX_SCENARIOS,
     ParameterError,
     check_int_at_least,
@@ -57,8 +58,6 @@ from ddwmmr.sim.result import json_safe, write_atomic
 MARKER = "summary.json"
 STUDIES = ("thresholds", "obstacles", "arbiters")
 PROG = "python -m ddwmmr.scenarios"
-#: Most worker processes --jobs may ask for.
-MAX_JOBS = 256
 #: Upper bound of --qp-max-speed (m/s): far above what the robot can do (base 1.5 m/s).
 MAX_QP_SPEED = 10.0
 #: --qp-* options: the controllers that take them, the allowed values and their text.
