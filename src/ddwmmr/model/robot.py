@@ -52,6 +52,14 @@ _RANGES = {
 }
 #: Scalar fields that must be > 0 (every ranged one but the payload, which may be 0).
 _POSITIVE = tuple(name for name in _RANGES if name != "payload")
+#: Largest distance of a caster from the base centre, in footprint half-diagonals
+#: ``hypot(base_length, base_width) / 2``: 1 reaches the corners, 2 allows outriggers.
+CASTER_REACH = 2.0
+#: Top-level tables a robot TOML may hold: its fields, at the top or under ``[robot]``.
+TOML_TABLES = ("robot",)
+#: What the configuration ``q`` and its rate ``qdot`` hold (for messages).
+_Q_ENTRIES = {"q": "[x, y, phi, th1, th2] (m, rad)", "qdot": "(m/s, rad/s)"}
+_isfinite = math.isfinite
 
 
 @dataclass(frozen=True)
@@ -69,7 +77,8 @@ class Robot:
         joint_limits: ``((th1_min, th1_max), (th2_min, th2_max))`` (rad).
         joint_speed_limit: maximum |th1dot|, |th2dot| (rad/s).
         wheel_speed_limit: maximum wheel angular speed (rad/s).
-        home_pose: default arm pose ``(th1, th2)`` (rad) used for start configurations.
+        home_pose: default arm pose ``(th1, th2)`` (rad) used for start configurations;
+            each angle within its ``joint_limits`` range.
 
     Physical fields, used by the physics plant (:class:`ddwmmr.plants.MujocoPlant`, see
     docs/physics.md) and ignored by the kinematic and thesis plants:
@@ -79,7 +88,10 @@ class Robot:
             frictionless casters. ``None`` (default) puts one at each footprint corner
             ``(+-base_length/2, +-base_width/2)``: with the wheels on the footprint's side
             edges (``track_width <= base_width``) the support polygon is then exactly the
-            footprint that the stability margin S uses (see :attr:`casters`).
+            footprint that the stability margin S uses (see :attr:`casters`). Each point
+            must lie within :data:`CASTER_REACH` times the footprint's half-diagonal of the
+            base centre (the axle midpoint): casters sit on the base or on short outriggers
+            (twice the half-diagonal is 0.57 m for the thesis base), not metres away.
         wheel_mass: mass of each drive wheel (kg), part of ``base_mass`` (so the total
             mass and S are unchanged); ``2 wheel_mass < base_mass``.
         base_height: height of the base box (m); sets its roll/pitch inertia.
@@ -115,7 +127,7 @@ class Robot:
         for name in _POSITIVE:
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
         object.__setattr__(self, "payload", check_nonnegative("payload", self.payload))
-        masses = _pair("link_masses", self.link_masses)
+        masses = _pair("link_masses", self.link_masses, "kg")
         for i, m in enumerate(masses, start=1):
             check_nonnegative(f"link_masses[{i}]", m)
         object.__setattr__(self, "link_masses", masses)
@@ -126,14 +138,16 @@ class Robot:
                 raise ParameterError(f"joint_limits[{i}] must satisfy min < max (got {pair})")
             limits.append((low, high))
         object.__setattr__(self, "joint_limits", tuple(limits))
-        home = tuple(check_finite("home_pose", v) for v in _pair("home_pose", self.home_pose))
+        home = _pair("home_pose", self.home_pose, "rad")
+        for i, (angle, (low, high)) in enumerate(zip(home, limits), start=1):
+            check_range(f"home_pose[{i}]", angle, low, high, f"rad (joint_limits[{i}])")
         object.__setattr__(self, "home_pose", home)
         if not 2.0 * self.wheel_mass < self.base_mass:
             raise ParameterError(
                 f"wheel_mass must be < base_mass / 2 = {self.base_mass / 2:g} kg (the wheels "
                 f"are part of the base) (got {self.wheel_mass:g})"
             )
-        torques = _pair("joint_torque_limits", self.joint_torque_limits)
+        torques = _pair("joint_torque_limits", self.joint_torque_limits, "N m")
         for i, torque in enumerate(torques, start=1):
             check_positive(f"joint_torque_limits[{i}]", torque)
         object.__setattr__(self, "joint_torque_limits", torques)
@@ -167,15 +181,34 @@ class Robot:
         for i, pair in enumerate(self.joint_limits, start=1):
             for value in pair:
                 check_range(f"joint_limits[{i}]", value, -MAX_ANGLE_RAD, MAX_ANGLE_RAD, "rad")
+        if self.caster_positions is not None:
+            reach = CASTER_REACH * 0.5 * math.hypot(self.base_length, self.base_width)
+            for i, (x, y) in enumerate(self.caster_positions, start=1):
+                if not math.hypot(x, y) <= reach:
+                    raise ParameterError(
+                        f"caster_positions[{i}] must lie within {reach:g} m of the base centre "
+                        f"({CASTER_REACH:g} x the footprint's half-diagonal) (got ({x:g}, {y:g}))"
+                    )
 
     # -- construction -------------------------------------------------------------------
     @classmethod
     def from_toml(cls, path: str | Path) -> Robot:
         """Load a robot from a TOML file whose keys are the field names (missing = default).
 
-        A ``[robot]`` table is accepted as well as top-level keys.
+        The fields are either all top-level keys or all in one ``[robot]`` table; with a
+        ``[robot]`` table nothing else may be in the file (another table, ``[other]``, or
+        a key outside ``[robot]`` is an error naming it), as unknown keys are.
         """
         data = load_toml(path, "robot")
+        if "robot" in data:
+            for key, value in data.items():
+                if key in TOML_TABLES:
+                    continue
+                what = f"table [{key}]" if isinstance(value, dict | list) else f"key {key!r}"
+                raise ParameterError(
+                    f"robot: {path}: unknown {what} (a robot file holds Robot fields, at the "
+                    f"top or all under one [robot] table)"
+                )
         table = data.get("robot", data)
         if not isinstance(table, dict):
             raise ParameterError(
@@ -224,23 +257,28 @@ class Robot:
         """Maximum arm reach L1 + L2 (m)."""
         return self.L1 + self.L2
 
+    # Every method taking a configuration q (5 finite numbers [x, y, phi, th1, th2]) checks
+    # it with _configuration: wrong shapes, strings and NaN/inf raise ParameterError
+    # naming q. The check costs one tolist() and one sum on the common (valid) path.
     def fk(self, q) -> np.ndarray:
         """End-effector pose ``[xE, yE, phiE]`` (world frame, m and rad) at configuration q."""
-        return np.array(kinematics.forward_kinematics(self.L1, self.L2, q))
+        return np.array(kinematics.forward_kinematics(self.L1, self.L2, _configuration(q)))
 
     def jacobian(self, q) -> np.ndarray:
         """The 4x5 Jacobian of SPEC §1 (rows xE, yE, phiE, nonholonomic constraint)."""
-        return kinematics.jacobian(self.L1, self.L2, q)
+        return kinematics.jacobian(self.L1, self.L2, _configuration(q))
 
     def augmented_jacobian(self, q, aux: str = "sum") -> np.ndarray:
         """The 5x5 augmented Jacobian (``aux`` is ``"sum"`` or ``"shoulder"``)."""
-        if aux not in kinematics.AUX_ROWS:
+        if not isinstance(aux, str) or aux not in kinematics.AUX_ROWS:
             raise ParameterError(f"aux must be one of {sorted(kinematics.AUX_ROWS)} (got {aux!r})")
-        return kinematics.augmented_jacobian(self.L1, self.L2, q, aux)
+        return kinematics.augmented_jacobian(self.L1, self.L2, _configuration(q), aux)
 
     # -- wheels ---------------------------------------------------------------------------
     def wheel_speeds_from_u(self, v: float, w: float) -> tuple[float, float]:
         """Wheel angular speeds ``(phidot_l, phidot_r)`` (rad/s) for base speeds v (m/s), w."""
+        if not (isinstance(v, float) and isinstance(w, float) and _isfinite(v + w)):
+            _check_scalars(("v", v), ("w", w))  # the slow path: names the bad one
         r, lw = self.wheel_radius, self.track_width
         return (2.0 * v - lw * w) / (2.0 * r), (2.0 * v + lw * w) / (2.0 * r)
 
@@ -250,31 +288,35 @@ class Robot:
         Only the forward part ``xdot cos(phi) + ydot sin(phi)`` of the base velocity drives
         the wheels; a sideways part cannot be produced and is ignored here.
         """
-        (v, w, _, _), _ = kinematics.u_from_qdot(float(q[2]), qdot)
+        phi = _configuration(q)[2]
+        (v, w, _, _), _ = kinematics.u_from_qdot(float(phi), _configuration(qdot, "qdot"))
         return np.array(self.wheel_speeds_from_u(v, w))
 
     def base_velocity(self, wheel_speeds) -> np.ndarray:
         """Inverse of the wheel map: ``[v, w]`` (m/s, rad/s) from ``[phidot_l, phidot_r]``."""
-        left, right = (float(s) for s in wheel_speeds)
+        left, right = _pair("wheel_speeds", wheel_speeds, "rad/s")
         r = self.wheel_radius
         return np.array([r * (left + right) / 2.0, r * (right - left) / self.track_width])
 
     # -- performance metrics ------------------------------------------------------------
     def manipulability(self, q) -> float:
         """Normalised manipulability ``eta = |sin(th2)|`` in [0, 1]."""
-        return stability.manipulability(float(q[4]))
+        return stability.manipulability(float(_configuration(q)[4]))
 
     def stability(self, q) -> tuple[float, float, float]:
         """Tip-over stability ``(S_lon, S_lat, S)``; ``S > 1`` is stable (capped at 10)."""
+        q = _configuration(q)
         return stability.stability_terms(self._com, float(q[3]), float(q[4]))
 
     def stability_gradient(self, q) -> np.ndarray:
         """Gradient of the capped stability margin S with respect to q (5,), per rad."""
+        q = _configuration(q)
         _, g1, g2 = stability.stability_gradient(self._com, float(q[3]), float(q[4]))
         return np.array([0.0, 0.0, 0.0, g1, g2])
 
     def centre_of_mass(self, q) -> np.ndarray:
         """Arm+payload+base centre of mass ``[x_com, y_com]`` in the base frame (m)."""
+        q = _configuration(q)
         return np.array(stability.centre_of_mass(self._com, float(q[3]), float(q[4])))
 
     @property
@@ -288,7 +330,8 @@ class Robot:
 
         ``pose_e = [xE, yE, phiE]``; the base heading follows from ``phiE - th1 - th2``.
         """
-        xe, ye, phie = (float(v) for v in pose_e)
+        xe, ye, phie = _triple("pose_e", pose_e)
+        _check_scalars(("th1", th1), ("th2", th2))
         phi = phie - th1 - th2
         x = xe - self.L1 * math.cos(phi + th1) - self.L2 * math.cos(phie)
         y = ye - self.L1 * math.sin(phi + th1) - self.L2 * math.sin(phie)
@@ -300,6 +343,10 @@ class Robot:
         ``elbow`` = +1 or -1 selects the elbow branch (sign of th2). Returns None when the
         point is out of reach.
         """
+        if not (isinstance(dx, float) and isinstance(dy, float) and _isfinite(dx + dy)):
+            _check_scalars(("dx", dx), ("dy", dy))
+        if elbow not in (1, -1) or isinstance(elbow, bool):
+            raise ParameterError(f"elbow must be +1 or -1 (got {elbow!r})")
         r2 = dx * dx + dy * dy
         c2 = (r2 - self.L1**2 - self.L2**2) / (2.0 * self.L1 * self.L2)
         if c2 > 1.0 + 1e-12 or c2 < -1.0 - 1e-12:
@@ -340,14 +387,97 @@ def _check_field_type(key: str, value: Any, default: Any) -> None:
         raise ParameterError(f"robot: {key} must be {wanted} (got {value!r})")
 
 
-def _pair(name: str, value) -> tuple[float, float]:
+def _pair(name: str, value, unit: str = "") -> tuple[float, float]:
+    """``value`` as two finite floats; anything else raises naming ``name`` (or the entry)."""
+    return _numbers(name, value, 2, "a pair of", unit)  # type: ignore[return-value]
+
+
+def _triple(name: str, value) -> tuple[float, float, float]:
+    return _numbers(name, value, 3, "3", "[xE, yE, phiE] (m, rad)")  # type: ignore[return-value]
+
+
+def _numbers(name: str, value, size: int, count: str, unit: str) -> tuple[float, ...]:
+    suffix = f" {unit}" if unit else ""
+    wanted = f"{name} must be {count} numbers{suffix}"
+    if isinstance(value, str | bytes | dict):
+        raise ParameterError(f"{wanted} (got {_brief(value)})")
     try:
-        items = tuple(float(v) for v in value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a pair of numbers (got {value!r})") from None
-    if len(items) != 2:
-        raise ParameterError(f"{name} must be a pair of numbers (got {value!r})")
-    return items  # type: ignore[return-value]
+        items = tuple(value)
+    except TypeError:
+        raise ParameterError(f"{wanted} (got {_brief(value)})") from None
+    if len(items) != size:
+        raise ParameterError(f"{wanted} (got {len(items)} values)")
+    return tuple(_finite(f"{name}[{i}]", v) for i, v in enumerate(items, start=1))
+
+
+def _finite(name: str, value) -> float:
+    """:func:`check_finite`, with integers too large for a float reported briefly (their
+    repr can be thousands of digits, or fail beyond Python's 4300-digit limit)."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value).bit_length() > 1024:
+        raise ParameterError(f"{name} must be a finite number (got {_brief(value)})")
+    return check_finite(name, value)
+
+
+def _brief(value) -> str:
+    """A short description of ``value`` for a message (one line, at most ~60 characters)."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value).bit_length() > 200:
+        return f"an integer of about 1e{int(abs(value).bit_length() * 0.30103)}"
+    try:
+        text = repr(value)
+    except ValueError:  # e.g. an integer beyond the 4300-digit conversion limit
+        return f"a {type(value).__name__}"
+    text = " ".join(text.split())
+    return text if len(text) <= 60 else text[:57] + "..."
+
+
+def _check_scalars(*items: tuple[str, Any]) -> None:
+    """Each ``(name, value)`` is a finite number: floats pass on one ``isfinite``; the rest
+    (ints, strings, booleans, NaN) go through :func:`_finite`, which names the bad one."""
+    for name, value in items:
+        if not (isinstance(value, float) and _isfinite(value)):
+            _finite(name, value)
+
+
+def _configuration(q, name: str = "q") -> list[float]:
+    """``q`` as a flat sequence of 5 finite numbers, or :class:`ParameterError` naming it.
+
+    It runs on every call of the public methods (per control step in some loops), so the
+    valid case is one ``tolist()`` and one sum (a sum is finite only if every term is);
+    only a failing sum (or an odd type) takes the slow path, which names the fault and
+    clears sums that merely overflowed.
+    """
+    values = q.tolist() if type(q) is np.ndarray else q
+    if type(values) is list or type(values) is tuple:
+        try:
+            if len(values) == 5 and _isfinite(sum(values)):
+                return values
+        except (TypeError, OverflowError):
+            pass
+    return _configuration_slow(q, name)
+
+
+def _configuration_slow(q, name: str) -> list[float]:
+    wanted = f"{name} must be 5 finite numbers {_Q_ENTRIES[name]}"
+    if isinstance(q, str | bytes | dict):
+        raise ParameterError(f"{wanted} (got {_brief(q)})")
+    try:
+        raw = np.asarray(q)
+        if raw.dtype.kind not in "iufO" or (
+            raw.dtype.kind == "O"
+            and not all(
+                isinstance(v, int | float | np.integer | np.floating) and not isinstance(v, bool)
+                for v in raw.ravel().tolist()
+            )
+        ):
+            raise TypeError
+        array = raw.astype(float)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"{wanted} (got {_brief(q)})") from None
+    if array.shape != (5,):
+        raise ParameterError(f"{wanted} (got shape {array.shape})")
+    if not np.all(np.isfinite(array)):
+        raise ParameterError(f"{wanted} (got {array.tolist()})")
+    return array.tolist()
 
 
 def _points(value) -> tuple[tuple[float, float], ...]:
@@ -356,21 +486,18 @@ def _points(value) -> tuple[tuple[float, float], ...]:
         items = tuple(value)
     except TypeError:
         raise ParameterError(
-            f"{name} must be a list of (x, y) pairs in m (got {value!r})"
+            f"{name} must be a list of (x, y) pairs in m (got {_brief(value)})"
         ) from None
     if not items:
         raise ParameterError(f"{name} must list at least one (x, y) pair (got {value!r})")
-    return tuple(
-        tuple(check_finite(f"{name}[{i}]", v) for v in _pair(f"{name}[{i}]", p))
-        for i, p in enumerate(items, start=1)
-    )
+    return tuple(_pair(f"{name}[{i}]", p, "m") for i, p in enumerate(items, start=1))
 
 
 def _pairs(name: str, value) -> tuple:
     try:
         items = tuple(value)
     except TypeError:
-        raise ParameterError(f"{name} must be two (min, max) pairs (got {value!r})") from None
+        raise ParameterError(f"{name} must be two (min, max) pairs (got {_brief(value)})") from None
     if len(items) != 2:
-        raise ParameterError(f"{name} must be two (min, max) pairs (got {value!r})")
-    return tuple(_pair(f"{name}[{i}]", p) for i, p in enumerate(items, start=1))
+        raise ParameterError(f"{name} must be two (min, max) pairs (got {_brief(value)})")
+    return tuple(_pair(f"{name}[{i}]", p, "rad") for i, p in enumerate(items, start=1))

@@ -31,9 +31,10 @@ from ddwmmr.errors import (
     check_positive,
     check_range,
 )
-from ddwmmr.trajectories.base import atan2_array
+from ddwmmr.trajectories.base import atan2_array, check_time
 
 ORIENTATIONS = ("tangent", "constant")
+_isfinite = math.isfinite
 
 
 class _ArrayMath:
@@ -121,7 +122,9 @@ class _Parametric(ABC):
         return cb * px - sb * py, sb * px + cb * py
 
     def pose(self, t: float) -> np.ndarray:
-        """Desired ``[xE, yE, phiE]`` at time t (s)."""
+        """Desired ``[xE, yE, phiE]`` at time t (s); t must be finite."""
+        if not (isinstance(t, float) and _isfinite(t)):
+            check_time(t)
         alpha = self.alpha_rate * t
         px, py = self._shape(alpha)
         rx, ry = self._rotate(px, py)
@@ -132,7 +135,9 @@ class _Parametric(ABC):
         return np.array([self.x0 + rx, self.y0 + ry, heading])
 
     def velocity(self, t: float) -> np.ndarray:
-        """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s)."""
+        """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s); t must be finite."""
+        if not (isinstance(t, float) and _isfinite(t)):
+            check_time(t)
         alpha = self.alpha_rate * t
         dx, dy = self._shape_derivative(alpha)
         rx, ry = self._rotate(dx * self.alpha_rate, dy * self.alpha_rate)

@@ -1,9 +1,11 @@
 """Trajectories defined by samples, interpolated smoothly (C1 cubic Hermite).
 
 CSV format (header required): ``t,x,y`` and optionally ``phi``; times in s strictly
-increasing, positions in m, angles in rad. Without ``phi`` the orientation is the direction
-of travel (unwrapped). If the first and last points coincide the path is treated as closed
-and the tangents at the ends are matched (periodic).
+increasing (spanning a duration of 1e-6 s to 1e9 s, each step at least
+:data:`MIN_STEP_FRACTION` of that duration), positions in m, angles in rad. Without
+``phi`` the orientation is the direction of travel (unwrapped). If the first and last
+points coincide the path is treated as closed and the tangents at the ends are matched
+(periodic).
 """
 
 from __future__ import annotations
@@ -23,9 +25,14 @@ from ddwmmr.errors import (
     ParameterError,
     read_text_file,
 )
-from ddwmmr.trajectories.base import atan2_array
+from ddwmmr.trajectories.base import atan2_array, check_time
 
 MAX_TIME_S = DURATION_RANGE_S[1]
+#: Smallest step between two sample times, as a share of the duration (last minus first
+#: time). Relative, so stretching a trajectory in time (the GUI's T) keeps it valid; it
+#: bounds the interpolant's speed by 1e9 x (distance / duration) instead of letting
+#: ``times = [0, 1e-300, 1]`` ask for 1e300 m/s.
+MIN_STEP_FRACTION = 1e-9
 
 
 def _tangents(times: np.ndarray, values: np.ndarray, periodic: bool) -> np.ndarray:
@@ -49,9 +56,15 @@ class SampledTrajectory:
     """End-effector trajectory through sampled points, C1 cubic Hermite interpolation.
 
     Args:
-        times: sample times (s), strictly increasing, starting anywhere.
-        points: (n, 2) positions (m) or (n, 3) poses with orientation (rad).
+        times: n >= 3 sample times (s), strictly increasing, starting anywhere, |t| <= 1e9;
+            the duration ``times[-1] - times[0]`` is in [1e-6, 1e9] s and every step is at
+            least :data:`MIN_STEP_FRACTION` times it.
+        points: (n, 2) positions (m) or (n, 3) poses with orientation (rad), each value
+            finite with magnitude <= 1e6.
         name: label used in reports.
+
+    Anything else raises :class:`~ddwmmr.errors.ParameterError` naming ``times``,
+    ``points`` or ``name``.
     """
 
     times: np.ndarray
@@ -62,25 +75,39 @@ class SampledTrajectory:
     _has_phi: bool = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        times = np.asarray(self.times, dtype=float)
-        points = np.asarray(self.points, dtype=float)
+        if not isinstance(self.name, str):
+            raise ParameterError(f"trajectory samples: name must be a string (got {self.name!r})")
+        times = _float_array("times", self.times, "sample times (s)")
+        points = _float_array("points", self.points, "an (n, 2) or (n, 3) array (m, rad)")
         if times.ndim != 1 or len(times) < 3:
-            raise ParameterError("trajectory samples: need at least 3 rows (t, x, y)")
+            raise ParameterError(
+                "trajectory samples: need at least 3 rows (t, x, y): times must be a 1-D "
+                f"sequence of at least 3 sample times (got shape {times.shape})"
+            )
         if points.ndim != 2 or points.shape[0] != len(times) or points.shape[1] not in (2, 3):
-            raise ParameterError("trajectory samples: points must be (n, 2) or (n, 3)")
-        if not (np.all(np.isfinite(times)) and np.all(np.isfinite(points))):
-            raise ParameterError("trajectory samples: every value must be a finite number")
+            raise ParameterError(
+                f"trajectory samples: points must be (n, 2) or (n, 3) with n = {len(times)} "
+                f"rows like times (got shape {points.shape})"
+            )
         if len(times) > MAX_TRAJECTORY_SAMPLES:
             raise ParameterError(
                 f"trajectory samples: at most {MAX_TRAJECTORY_SAMPLES} rows (got {len(times)})"
             )
-        if np.max(np.abs(points)) > MAX_COORDINATE_M or np.max(np.abs(times)) > MAX_TIME_S:
+        if not np.all(np.isfinite(times)):
+            raise ParameterError("trajectory samples: times must be finite numbers (s)")
+        if not np.all(np.isfinite(points)):
+            raise ParameterError("trajectory samples: points must be finite numbers (m, rad)")
+        if np.max(np.abs(points)) > MAX_COORDINATE_M:
             raise ParameterError(
-                f"trajectory samples: |x|, |y|, |phi| must be <= {MAX_COORDINATE_M:g} and "
-                f"|t| <= {MAX_TIME_S:g} s"
+                f"trajectory samples: points |x|, |y|, |phi| must be <= {MAX_COORDINATE_M:g} "
+                f"(m, rad) (got {np.max(np.abs(points)):g})"
             )
-        if np.any(np.diff(times) <= 0):
-            raise ParameterError("trajectory samples: column t must be strictly increasing")
+        if np.max(np.abs(times)) > MAX_TIME_S:
+            raise ParameterError(
+                f"trajectory samples: times |t| must be <= {MAX_TIME_S:g} s "
+                f"(got {np.max(np.abs(times)):g})"
+            )
+        _check_steps(times)
         periodic = bool(np.allclose(points[0, :2], points[-1, :2], atol=1e-9))
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "points", points)
@@ -127,6 +154,8 @@ class SampledTrajectory:
 
     def pose(self, t: float) -> np.ndarray:
         """Desired ``[xE, yE, phiE]`` at time t (s, from the first sample)."""
+        if not (isinstance(t, float) and _isfinite(t)):
+            check_time(t)
         value, first, _ = self._hermite(t)
         if self._has_phi:
             return value.copy()
@@ -137,6 +166,8 @@ class SampledTrajectory:
 
     def velocity(self, t: float) -> np.ndarray:
         """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s)."""
+        if not (isinstance(t, float) and _isfinite(t)):
+            check_time(t)
         _, first, second = self._hermite(t)
         if self._has_phi:
             return first.copy()
@@ -172,6 +203,64 @@ class SampledTrajectory:
         rate = np.where(speed2 < 1e-12, 0.0, turn)
         poses = np.column_stack([value[:, 0], value[:, 1], heading])
         return poses, np.column_stack([first[:, 0], first[:, 1], rate])
+
+
+_isfinite = math.isfinite
+
+
+def _float_array(name: str, value, what: str) -> np.ndarray:
+    """``value`` as a float array (no copy when it already is one); strings, booleans,
+    ragged rows and numbers beyond float range raise :class:`ParameterError` naming it."""
+    wanted = f"trajectory samples: {name} must be {what}, numbers only"
+    try:
+        raw = np.asarray(value)
+    except (TypeError, ValueError, OverflowError):  # ragged rows, odd objects
+        raise ParameterError(f"{wanted} (got ragged or non-numeric rows)") from None
+    kind = raw.dtype.kind
+    if kind == "O":
+        entries = raw.ravel().tolist()
+        if not all(_is_number(v) for v in entries):
+            raise ParameterError(f"{wanted} (got ragged or non-numeric rows)")
+        try:
+            return raw.astype(float)
+        except OverflowError:
+            raise ParameterError(f"{wanted} (got a value beyond float range)") from None
+    if kind not in "iuf":
+        got = {"U": "strings", "S": "bytes", "b": "booleans", "c": "complex numbers"}
+        raise ParameterError(f"{wanted} (got {got.get(kind, raw.dtype.name)})")
+    return np.asarray(raw, dtype=float)
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, int | float | np.integer | np.floating) and not isinstance(
+        value, bool | np.bool_
+    )
+
+
+def _check_steps(times: np.ndarray) -> None:
+    """Strictly increasing times spanning a documented duration, no step below
+    :data:`MIN_STEP_FRACTION` of it (the CSV's data row numbers in the message)."""
+    steps = np.diff(times)
+    if np.any(steps <= 0):
+        row = int(np.argmax(steps <= 0)) + 2
+        raise ParameterError(
+            f"trajectory samples: times (column t) must be strictly increasing (row {row}: "
+            f"{float(times[row - 2])!r} then {float(times[row - 1])!r})"
+        )
+    duration = float(times[-1] - times[0])
+    low, high = DURATION_RANGE_S
+    if not low <= duration <= high:
+        raise ParameterError(
+            f"trajectory samples: times must span a duration in [{low:g}, {high:g}] s "
+            f"(last minus first; got {duration:g} s)"
+        )
+    shortest = MIN_STEP_FRACTION * duration
+    if np.min(steps) < shortest:
+        row = int(np.argmin(steps)) + 2
+        raise ParameterError(
+            f"trajectory samples: times must step by at least {MIN_STEP_FRACTION:g} x the "
+            f"duration = {shortest:g} s (row {row}: step {steps[row - 2]:g} s)"
+        )
 
 
 def _hermite_terms(s, p0, p1, m0, m1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
