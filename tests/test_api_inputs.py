@@ -131,3 +131,11 @@ class _NoSamples(Ellipse):
 )
 def test_simulate_arguments(call, match):
     _refused(call, match)
+
+
+@pytest.mark.parametrize("value", [10**5000, 10**400, "x" * 500])
+def test_messages_stay_one_short_line_for_huge_values(value):
+    from ddwmmr.errors import check_positive
+
+    message = _refused(lambda: check_positive("L1", value), "L1 must be a number")
+    assert len(message) < 100

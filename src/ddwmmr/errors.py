@@ -143,14 +143,24 @@ def _as_float(name: str, value: float) -> float:
     # Strings and booleans are not numbers here, even though float() accepts them: a file
     # saying N = "2000" or L1 = true is a mistake worth reporting.
     if isinstance(value, bool | np.bool_ | str | bytes):
-        raise ParameterError(f"{name} must be a number (got {value!r})")
+        raise ParameterError(f"{name} must be a number (got {shown(value)})")
     try:
         number = float(value)
     except (TypeError, ValueError, OverflowError):
-        raise ParameterError(f"{name} must be a number (got {value!r})") from None
+        raise ParameterError(f"{name} must be a number (got {shown(value)})") from None
     if not math.isfinite(number):
-        raise ParameterError(f"{name} must be a finite number (got {value!r})")
+        raise ParameterError(f"{name} must be a finite number (got {shown(value)})")
     return number
+
+
+def shown(value: Any, width: int = 40) -> str:
+    """``repr(value)`` for a message, cut to ``width`` characters (an int of 5000 digits
+    has no repr at all: Python refuses to convert it)."""
+    try:
+        text = repr(value)
+    except ValueError:  # int too large to convert to str
+        return f"an integer of about {value.bit_length() * 0.30103:.0f} digits"
+    return text if len(text) <= width else text[: width - 3] + "..."
 
 
 def read_text_file(path: str | Path, label: str) -> str:
