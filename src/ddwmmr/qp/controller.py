@@ -29,7 +29,7 @@ import numpy as np
 
 from ddwmmr.controllers.base import StepInfo
 from ddwmmr.controllers.inputs import check_inputs
-from ddwmmr.errors import ParameterError, check_bool, check_positive, check_range
+from ddwmmr.errors import ParameterError, check_bool, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import (
@@ -64,9 +64,7 @@ from ddwmmr.qp.tasks import (
 
 #: Look-ahead step (s) when neither ``dt`` nor the trajectory's resolution is known.
 DEFAULT_DT = 0.02
-#: Largest soft-task weight: far above the tracking slack's 1e4, before the Hessian's
-#: conditioning (floor 1e-9) makes the solve meaningless.
-MAX_WEIGHT = 1e6
+
 #: Default solver: the fastest measured (docs/qp.md, "Solvers").
 DEFAULT_SOLVER = "daqp"
 
@@ -174,7 +172,7 @@ class QPControllerCore:
         self.tasks: list[Task] = [
             self.tracking,
             ManipulabilityTask(
-                check_range("manipulability_weight", manipulability_weight, 0.0, MAX_WEIGHT),
+                manipulability_weight,
                 arm_row=not track_orientation,
             ),
             PostureTask(posture_weight, rate_limit=angular),

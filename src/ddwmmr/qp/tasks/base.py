@@ -16,9 +16,13 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ddwmmr.errors import check_nonnegative
+from ddwmmr.errors import check_range
 from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
+
+#: Largest task weight: far above the tracking slack's 1e4, before the Hessian's
+#: conditioning (floor 1e-9) makes the solve meaningless.
+MAX_WEIGHT = 1e6
 
 
 def bounded(value: float, limit: float) -> float:
@@ -65,7 +69,7 @@ class Task(ABC):
     name: str = "task"
 
     def __init__(self, weight: float) -> None:
-        self.weight = check_nonnegative(f"{self.name.replace(' ', '_')}_weight", weight)
+        self.weight = check_range(f"{self.name.replace(' ', '_')}_weight", weight, 0.0, MAX_WEIGHT)
 
     def row_weights(self) -> np.ndarray:
         """Weight of each row (cost per squared task-rate unit); default: ``weight``."""
