@@ -9,15 +9,10 @@ import pytest
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot, kinematics, stability
 from ddwmmr.model.robot import CASTER_REACH
+from one_line import one_line
 
 ROBOT = Robot()
 Q = np.array([0.1, -0.2, 0.3, -0.3, 0.6])
-
-
-def one_line(info) -> str:
-    text = str(info.value)
-    assert "\n" not in text and len(text) < 600
-    return text
 
 
 # -- 1. numbers beyond float range -----------------------------------------------------

@@ -9,14 +9,9 @@ import pytest
 from ddwmmr.errors import ParameterError
 from ddwmmr.trajectories import Ellipse, Rectangle, SampledTrajectory, load_trajectory, read_csv
 from ddwmmr.trajectories.sampled import MIN_STEP_FRACTION
+from one_line import one_line
 
 POINTS = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]
-
-
-def one_line(info) -> str:
-    text = str(info.value)
-    assert "\n" not in text and len(text) < 600
-    return text
 
 
 # -- 4. sampled trajectories ------------------------------------------------------------
