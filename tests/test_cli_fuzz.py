@@ -178,6 +178,7 @@ CASES += [
     ("track", ["--offset", "1e300", "0"], "offset must be in [-0.65, 0.65] m"),
     ("track", ["--rerun", "{traj_N_string.toml}"], "is not valid JSON"),
     ("track", ["--rerun", "{fifo}"], "is not a regular file"),
+    ("track", ["--rerun", ""], "rerun: give the path of a summary.json"),
     ("track", ["--method", "qp", "--obstacles", "{obstacles_text.toml}"], "must be numbers"),
     ("track", ["--method", "qp", "--obstacles", "../x"], "cannot read ../x"),
     ("track", ["--method", "qp", "--obstacles", "nope"], "unknown obstacle file 'nope'"),

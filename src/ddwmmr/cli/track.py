@@ -303,6 +303,8 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         raise ParameterError(
             f"rerun: {option} cannot be combined with --rerun (the record fixes it)"
         )
+    if not args.rerun.strip():
+        raise ParameterError("rerun: give the path of a summary.json (got an empty path)")
     record = load_run_record(args.rerun)
     try:
         plant = _field(record["plant"], "name", str, "plant name")
@@ -401,7 +403,7 @@ def run_record(
 def _main(argv: Sequence[str] | None = None) -> int:
     """Run the tool; bad input raises :class:`ParameterError`."""
     args = build_parser().parse_args(argv)
-    inputs = inputs_from_record(args) if args.rerun else inputs_from_arguments(args)
+    inputs = inputs_from_record(args) if args.rerun is not None else inputs_from_arguments(args)
     steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
     controller = make_controller(inputs.method, inputs.robot, **inputs.options)
     out = Path(args.out) if args.out is not None else default_out(inputs.method, inputs.label)
