@@ -55,6 +55,7 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_range,
     read_text_file,
+    shown,
 )
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import u_from_qdot
@@ -1123,7 +1124,7 @@ def _entries_problem(data: dict[str, Any], key: str, fields: dict[str, str]) -> 
             if kind == "text" and not isinstance(value, str):
                 return f'"{key}"[{i}].{name} must be a string (got {_type_name(value)})'
             if kind == "number" and not _positive_number(value):
-                got = repr(value)[:40] if isinstance(value, int | float) else _type_name(value)
+                got = shown(value) if isinstance(value, int | float) else _type_name(value)
                 return f'"{key}"[{i}].{name} must be a number > 0 (got {got})'
     return None
 

@@ -101,7 +101,7 @@ def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None 
 def check_bool(name: str, value: Any) -> bool:
     """Return ``value`` if it is True or False (numpy's too), else raise."""
     if not isinstance(value, bool | np.bool_):
-        raise ParameterError(f"{name} must be true or false (got {value!r:.40})")
+        raise ParameterError(f"{name} must be true or false (got {shown(value)})")
     return bool(value)
 
 
@@ -109,7 +109,7 @@ def check_instance(name: str, value: Any, kind: type) -> Any:
     """Return ``value`` if it is a ``kind`` (or a subclass), else raise
     :class:`ParameterError` naming the parameter and the expected type."""
     if not isinstance(value, kind):
-        raise ParameterError(f"{name} must be a {kind.__name__} (got {value!r:.60})")
+        raise ParameterError(f"{name} must be a {kind.__name__} (got {shown(value, 60)})")
     return value
 
 
@@ -146,7 +146,9 @@ def _as_float(name: str, value: float) -> float:
         raise ParameterError(f"{name} must be a number (got {shown(value)})")
     try:
         number = float(value)
-    except (TypeError, ValueError, OverflowError):
+    except OverflowError:  # an integer beyond a float: as infinite as float("inf")
+        raise ParameterError(f"{name} must be a finite number (got {shown(value)})") from None
+    except (TypeError, ValueError):
         raise ParameterError(f"{name} must be a number (got {shown(value)})") from None
     if not math.isfinite(number):
         raise ParameterError(f"{name} must be a finite number (got {shown(value)})")
@@ -154,12 +156,16 @@ def _as_float(name: str, value: float) -> float:
 
 
 def shown(value: Any, width: int = 40) -> str:
-    """``repr(value)`` for a message, cut to ``width`` characters (an int of 5000 digits
-    has no repr at all: Python refuses to convert it)."""
+    """``value`` for a message: its repr on one line, cut to ``width`` characters; an
+    integer beyond about 1e60 as its magnitude (its repr is thousands of digits, or fails
+    beyond Python's 4300-digit limit)."""
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value).bit_length() > 200:
+        return f"an integer of about 1e{int(abs(value).bit_length() * 0.30103)}"
     try:
         text = repr(value)
-    except ValueError:  # int too large to convert to str
-        return f"an integer of about {value.bit_length() * 0.30103:.0f} digits"
+    except ValueError:  # e.g. a container holding such an integer
+        return f"a {type(value).__name__}"
+    text = " ".join(text.split())
     return text if len(text) <= width else text[: width - 3] + "..."
 
 

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 
 #: Shortest time constant (s): gains above 1e4 1/s are no feedback a 2 rad/s arm or a
 #: wheel-speed-limited base can follow, only numbers that overflow the commands.
@@ -21,7 +21,7 @@ def gains_from_tau(tau: float | Sequence[float], size: int) -> tuple[float, ...]
     """
     if isinstance(tau, str | bytes | bool) or tau is None:
         raise ParameterError(
-            f"tau must be a time constant in s or {size} of them (got {tau!r:.40})"
+            f"tau must be a time constant in s or {size} of them (got {shown(tau)})"
         )
     if isinstance(tau, int | float | np.integer | np.floating) or np.ndim(tau) == 0:
         values = [tau] * size
@@ -31,11 +31,11 @@ def gains_from_tau(tau: float | Sequence[float], size: int) -> tuple[float, ...]
         raise ParameterError(f"tau must be one value or {size} values in s (got {len(values)})")
     for value in values:
         if isinstance(value, str | bytes | bool) or value is None:
-            raise ParameterError(f"tau must be numbers in s (got {value!r:.40})")
+            raise ParameterError(f"tau must be numbers in s (got {shown(value)})")
     try:
         values = [float(value) for value in values]
     except (TypeError, ValueError, OverflowError):
-        raise ParameterError(f"tau must be numbers in s (got {values!r:.60})") from None
+        raise ParameterError(f"tau must be numbers in s (got {shown(values, 60)})") from None
     gains = []
     for value in values:
         if math.isnan(value) or value < MIN_TAU:

@@ -30,7 +30,7 @@ from ddwmmr.cli.common import (
 )
 from ddwmmr.controllers.base import available_methods, make_controller, method_description
 from ddwmmr.controllers.presets import PRESETS, preset_options
-from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file
+from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file, shown
 from ddwmmr.model import Robot
 from ddwmmr.plants import available_plants
 from ddwmmr.plants.kinematic import INTEGRATORS
@@ -337,7 +337,7 @@ def _field(record: dict[str, Any], key: str, kind: type, what: str) -> Any:
     """``record[key]`` if it is a ``kind`` (KeyError when missing, TypeError otherwise)."""
     value = record[key]
     if not isinstance(value, kind) or isinstance(value, bool):
-        raise TypeError(f"{key}: the {what} must be a {kind.__name__}, got {value!r:.40}")
+        raise TypeError(f"{key}: the {what} must be a {kind.__name__}, got {shown(value)}")
     return value
 
 
@@ -352,7 +352,7 @@ def _number(record: dict[str, Any], key: str) -> float:
     """``record[key]`` as a float; a bool or a string is not a number here."""
     value = record[key]
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise TypeError(f"{key} must be a number in s, got {value!r:.40}")
+        raise TypeError(f"{key} must be a number in s, got {shown(value)}")
     return float(value)
 
 

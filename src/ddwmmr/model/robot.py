@@ -26,6 +26,7 @@ from ddwmmr.errors import (
     check_positive,
     check_range,
     load_toml,
+    shown,
 )
 from ddwmmr.model import kinematics, stability
 
@@ -400,34 +401,14 @@ def _numbers(name: str, value, size: int, count: str, unit: str) -> tuple[float,
     suffix = f" {unit}" if unit else ""
     wanted = f"{name} must be {count} numbers{suffix}"
     if isinstance(value, str | bytes | dict):
-        raise ParameterError(f"{wanted} (got {_brief(value)})")
+        raise ParameterError(f"{wanted} (got {shown(value, 60)})")
     try:
         items = tuple(value)
     except TypeError:
-        raise ParameterError(f"{wanted} (got {_brief(value)})") from None
+        raise ParameterError(f"{wanted} (got {shown(value, 60)})") from None
     if len(items) != size:
         raise ParameterError(f"{wanted} (got {len(items)} values)")
-    return tuple(_finite(f"{name}[{i}]", v) for i, v in enumerate(items, start=1))
-
-
-def _finite(name: str, value) -> float:
-    """:func:`check_finite`, with integers too large for a float reported briefly (their
-    repr can be thousands of digits, or fail beyond Python's 4300-digit limit)."""
-    if isinstance(value, int) and not isinstance(value, bool) and abs(value).bit_length() > 1024:
-        raise ParameterError(f"{name} must be a finite number (got {_brief(value)})")
-    return check_finite(name, value)
-
-
-def _brief(value) -> str:
-    """A short description of ``value`` for a message (one line, at most ~60 characters)."""
-    if isinstance(value, int) and not isinstance(value, bool) and abs(value).bit_length() > 200:
-        return f"an integer of about 1e{int(abs(value).bit_length() * 0.30103)}"
-    try:
-        text = repr(value)
-    except ValueError:  # e.g. an integer beyond the 4300-digit conversion limit
-        return f"a {type(value).__name__}"
-    text = " ".join(text.split())
-    return text if len(text) <= 60 else text[:57] + "..."
+    return tuple(check_finite(f"{name}[{i}]", v) for i, v in enumerate(items, start=1))
 
 
 def _check_scalars(*items: tuple[str, Any]) -> None:
@@ -435,7 +416,7 @@ def _check_scalars(*items: tuple[str, Any]) -> None:
     (ints, strings, booleans, NaN) go through :func:`_finite`, which names the bad one."""
     for name, value in items:
         if not (isinstance(value, float) and _isfinite(value)):
-            _finite(name, value)
+            check_finite(name, value)
 
 
 def _configuration(q, name: str = "q") -> list[float]:
@@ -459,7 +440,7 @@ def _configuration(q, name: str = "q") -> list[float]:
 def _configuration_slow(q, name: str) -> list[float]:
     wanted = f"{name} must be 5 finite numbers {_Q_ENTRIES[name]}"
     if isinstance(q, str | bytes | dict):
-        raise ParameterError(f"{wanted} (got {_brief(q)})")
+        raise ParameterError(f"{wanted} (got {shown(q, 60)})")
     try:
         raw = np.asarray(q)
         if raw.dtype.kind not in "iufO" or (
@@ -472,7 +453,7 @@ def _configuration_slow(q, name: str) -> list[float]:
             raise TypeError
         array = raw.astype(float)
     except (TypeError, ValueError, OverflowError):
-        raise ParameterError(f"{wanted} (got {_brief(q)})") from None
+        raise ParameterError(f"{wanted} (got {shown(q, 60)})") from None
     if array.shape != (5,):
         raise ParameterError(f"{wanted} (got shape {array.shape})")
     if not np.all(np.isfinite(array)):
@@ -486,7 +467,7 @@ def _points(value) -> tuple[tuple[float, float], ...]:
         items = tuple(value)
     except TypeError:
         raise ParameterError(
-            f"{name} must be a list of (x, y) pairs in m (got {_brief(value)})"
+            f"{name} must be a list of (x, y) pairs in m (got {shown(value, 60)})"
         ) from None
     if not items:
         raise ParameterError(f"{name} must list at least one (x, y) pair (got {value!r})")
@@ -497,7 +478,9 @@ def _pairs(name: str, value) -> tuple:
     try:
         items = tuple(value)
     except TypeError:
-        raise ParameterError(f"{name} must be two (min, max) pairs (got {_brief(value)})") from None
+        raise ParameterError(
+            f"{name} must be two (min, max) pairs (got {shown(value, 60)})"
+        ) from None
     if len(items) != 2:
-        raise ParameterError(f"{name} must be two (min, max) pairs (got {_brief(value)})")
+        raise ParameterError(f"{name} must be two (min, max) pairs (got {shown(value, 60)})")
     return tuple(_pair(f"{name}[{i}]", p, "rad") for i, p in enumerate(items, start=1))

@@ -29,7 +29,7 @@ import numpy as np
 
 from ddwmmr.controllers.base import StepInfo
 from ddwmmr.controllers.inputs import check_inputs
-from ddwmmr.errors import ParameterError, check_bool, check_positive
+from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
 from ddwmmr.model import Robot
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import (
@@ -353,9 +353,9 @@ def _pieces(name: str, pieces: Any, kind: type) -> list[Any]:
     items = list(pieces) if pieces is not None and hasattr(pieces, "__iter__") else None
     if items is None and pieces is not None:
         raise ParameterError(
-            f"{name} must be a list of {kind.__name__} objects (got {pieces!r:.40})"
+            f"{name} must be a list of {kind.__name__} objects (got {shown(pieces)})"
         )
     for item in items or []:
         if not isinstance(item, kind):
-            raise ParameterError(f"{name} must be {kind.__name__} objects (got {item!r:.40})")
+            raise ParameterError(f"{name} must be {kind.__name__} objects (got {shown(item)})")
     return items or []

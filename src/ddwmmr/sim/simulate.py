@@ -15,6 +15,7 @@ from ddwmmr.errors import (
     check_instance,
     check_positive,
     check_step_count,
+    shown,
 )
 from ddwmmr.model import Robot
 from ddwmmr.plants import available_plants, make_plant, plant_class
@@ -80,7 +81,7 @@ def simulate(
     robot = check_instance("robot", robot if robot is not None else Robot(), Robot)
     if progress is not None and not callable(progress):
         raise ParameterError(
-            f"progress must be a callable progress(step, steps) (got {progress!r:.40})"
+            f"progress must be a callable progress(step, steps) (got {shown(progress)})"
         )
     if isinstance(method, str):
         controller = make_controller(method, robot, **controller_options)
@@ -90,7 +91,7 @@ def simulate(
         controller = method
     else:
         raise ParameterError(
-            f"method must be a method name or a controller with command() (got {method!r:.40})"
+            f"method must be a method name or a controller with command() (got {shown(method)})"
         )
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
     the_plant = _plant(plant, robot, integrator, plant_options)
@@ -101,7 +102,7 @@ def simulate(
     if q0 is None:
         if isinstance(initial_offset, str) or not hasattr(initial_offset, "__len__"):
             raise ParameterError(
-                f"initial_offset must be two numbers dx, dy in m (got {initial_offset!r:.40})"
+                f"initial_offset must be two numbers dx, dy in m (got {shown(initial_offset)})"
             )
         offset = tuple(check_finite("initial_offset", v) for v in initial_offset)
         if len(offset) != 2:
@@ -143,12 +144,14 @@ def _plant(
 ) -> Plant:
     """The plant object for ``simulate``'s ``plant``/``integrator``/``plant_options``."""
     if options is not None and not isinstance(options, dict):
-        raise ParameterError(f"plant_options must be a dict of plant options (got {options!r:.40})")
+        raise ParameterError(
+            f"plant_options must be a dict of plant options (got {shown(options)})"
+        )
     if not isinstance(plant, str):
         if not callable(getattr(plant, "step", None)):
             raise ParameterError(
                 f"plant must be a plant name ({', '.join(available_plants())}) or a plant "
-                f"object (got {plant!r:.40})"
+                f"object (got {shown(plant)})"
             )
         if integrator is not None or options:
             raise ParameterError("integrator and plant_options need a plant name, not an object")
@@ -167,7 +170,7 @@ def resolution_step(trajectory: Any) -> float:
     number = isinstance(samples, int | float | np.integer | np.floating)
     if isinstance(samples, bool) or not number or not (math.isfinite(samples) and samples > 0):
         raise ParameterError(
-            f"trajectory: samples (its resolution N) must be a number > 0 (got {samples!r:.40})"
+            f"trajectory: samples (its resolution N) must be a number > 0 (got {shown(samples)})"
         )
     return trajectory.duration / samples
 

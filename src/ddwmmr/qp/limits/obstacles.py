@@ -27,6 +27,7 @@ from ddwmmr.errors import (
     check_nonnegative,
     check_positive,
     load_toml,
+    shown,
 )
 from ddwmmr.model import Robot
 from ddwmmr.qp.blocks import LimitBlock, overrides
@@ -88,7 +89,7 @@ def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> li
     if not hasattr(obstacles, "__iter__"):
         raise ParameterError(
             f"obstacles must be circles, (x, y, radius) triples or a TOML file "
-            f"(got {obstacles!r:.40})"
+            f"(got {shown(obstacles)})"
         )
     circles = []
     for item in obstacles:
