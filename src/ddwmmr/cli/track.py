@@ -327,9 +327,9 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
             str(trajectory_record.get("name") or "rerun"),
             plant,
         )
+    except ParameterError:  # already one line naming what is wrong
+        raise
     except (KeyError, TypeError, AttributeError, ValueError) as exc:
-        if isinstance(exc, ParameterError):
-            raise
         raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
 
 
