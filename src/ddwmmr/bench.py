@@ -36,7 +36,6 @@ import stat
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -59,7 +58,7 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import u_from_qdot
-from ddwmmr.outputs import check_output_file
+from ddwmmr.outputs import check_output_file, check_writable
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.sim import simulate
 from ddwmmr.sim.result import write_atomic
@@ -1060,15 +1059,7 @@ def probe_out(path: str | Path) -> None:
     folder on the way to ``path``, missing parents are created when the report is
     written): catches what permission bits do not show (``/proc``, a read-only mount, a
     full disk of inodes) before a long run rather than after it."""
-    folder = Path(os.path.abspath(path)).parent
-    while not os.path.lexists(folder) and folder != folder.parent:
-        folder = folder.parent
-    try:
-        fd, name = tempfile.mkstemp(dir=folder, prefix=".ddwmmr-", suffix=".tmp")
-    except OSError as exc:
-        raise ParameterError(f"out: cannot write in {folder} ({exc.strerror or exc})") from None
-    os.close(fd)
-    Path(name).unlink(missing_ok=True)
+    check_writable("out", Path(os.path.abspath(path)).parent)
 
 
 def read_report(path: str | Path) -> dict[str, Any]:

@@ -179,11 +179,41 @@ def _name_max(folder: Path) -> int:
         return 255
 
 
-def _first_existing_ancestor(path: Path) -> Path:
+def nearest_existing(path: Path) -> Path:
+    """``path`` if it exists (a dangling link counts), else its nearest existing ancestor."""
     for candidate in [path, *path.parents]:
         if os.path.lexists(candidate):
             return candidate
     return Path(path.anchor or "/")  # pragma: no cover - the root always exists
+
+
+def missing_folders(folder: Path) -> list[Path]:
+    """The folders above and including ``folder`` that do not exist yet, outermost first."""
+    missing = []
+    for candidate in [folder, *folder.parents]:
+        if os.path.lexists(candidate):
+            break
+        missing.append(candidate)
+    return list(reversed(missing))
+
+
+def check_writable(label: str, folder: Path) -> None:
+    """Raise a one-line :class:`ParameterError` unless files can be created in ``folder``
+    (or, if it does not exist yet, in the nearest existing folder above it). Tried, not
+    inferred from permission bits: a file is created there and removed at once, which
+    catches what ``os.access`` does not show (root on ``/proc``, a read-only mount)."""
+    existing = nearest_existing(folder)
+    if not existing.is_dir():
+        raise ParameterError(f"{label}: {existing} is not a folder")
+    try:
+        fd, probe = tempfile.mkstemp(dir=existing, prefix=".ddwmmr-", suffix=".tmp")
+    except OSError as exc:
+        raise ParameterError(
+            f"{label}: cannot write in {existing} ({exc.strerror or exc})"
+        ) from None
+    os.close(fd)
+    with contextlib.suppress(OSError):
+        os.unlink(probe)
 
 
 def check_output_path(target: str | Path, what: str = "folder") -> Path:
@@ -204,7 +234,7 @@ def check_output_path(target: str | Path, what: str = "folder") -> Path:
         raise ParameterError(
             f"out: {text} is a symbolic link (to {os.readlink(path)}); give a real {what}"
         )
-    ancestor = _first_existing_ancestor(path.parent)
+    ancestor = nearest_existing(path.parent)
     name_max = _name_max(ancestor if ancestor.is_dir() else Path("/"))
     for part in path.relative_to(ancestor).parts:
         size = len(os.fsencode(part))
@@ -285,7 +315,7 @@ def output_folder(target: str | Path, tool: str, force: bool = False) -> Iterato
     try:
         staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=path.parent))
     except OSError as exc:
-        _remove_created(created)
+        remove_created(created)
         raise ParameterError(f"out: cannot write in {path.parent} ({exc.strerror})") from None
     try:
         os.chmod(staging, folder_mode())
@@ -293,27 +323,25 @@ def output_folder(target: str | Path, tool: str, force: bool = False) -> Iterato
         _commit(staging, path, tool, force, str(target))
     except BaseException:
         shutil.rmtree(staging, ignore_errors=True)
-        _remove_created(created)
+        remove_created(created)
         raise
 
 
 def _make_parents(folder: Path) -> list[Path]:
     """Create missing parent folders; return them (deepest last) so a failure can undo."""
-    missing = []
-    for candidate in [folder, *folder.parents]:
-        if os.path.lexists(candidate):
-            break
-        missing.append(candidate)
-    for candidate in reversed(missing):
+    missing = missing_folders(folder)
+    for candidate in missing:
         try:
             candidate.mkdir(mode=folder_mode())
         except OSError as exc:
-            _remove_created([m for m in missing if m != candidate and m.is_dir()])
+            remove_created([m for m in missing if m != candidate and m.is_dir()])
             raise ParameterError(f"out: cannot create {candidate} ({exc.strerror})") from None
-    return list(reversed(missing))
+    return missing
 
 
-def _remove_created(created: list[Path]) -> None:
+def remove_created(created: list[Path]) -> None:
+    """Remove the folders :func:`missing_folders` listed (outermost first) where they are
+    empty again, innermost first."""
     for folder in reversed(created):
         with contextlib.suppress(OSError):
             folder.rmdir()

@@ -18,7 +18,6 @@ written).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import io
 import sys
 from collections.abc import Sequence
@@ -33,10 +32,10 @@ from ddwmmr.gui.paths import (
     check_existing_snapshot,
     check_export_root,
     check_snapshot_path,
-    missing_folders,
     snapshot_format,
 )
 from ddwmmr.gui.settings import GEOMETRY, Settings, check_geometry, check_settings
+from ddwmmr.outputs import missing_folders, remove_created
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.sim.result import write_atomic
 from ddwmmr.trajectories import available_trajectories
@@ -227,9 +226,7 @@ def snapshot(
     try:
         write_atomic(target, buffer.getvalue())
     except OSError as exc:
-        for folder in reversed(created):  # leave no empty folder behind
-            with contextlib.suppress(OSError):
-                folder.rmdir()
+        remove_created(created)  # leave no empty folder behind
         raise RunFailed(f"snapshot: cannot write {text} ({exc.strerror or exc})") from None
     return Path(path)
 

@@ -10,21 +10,18 @@ fails in one line (a :class:`ParameterError`, status 2) instead of after the run
   or a special file is refused even then;
 * the export folder: a folder, or a path where one can be made.
 
-"Writable" is tried, not inferred from the permission bits: a file is created in the
-nearest existing folder and removed at once (``os.access`` says yes for root on a
-read-only or virtual file system such as ``/proc``).
+"Writable" is tried, not inferred from the permission bits
+(:func:`ddwmmr.outputs.check_writable`).
 """
 
 from __future__ import annotations
 
-import contextlib
 import os
 import stat
-import tempfile
 from pathlib import Path
 
 from ddwmmr.errors import ParameterError
-from ddwmmr.outputs import check_output_path
+from ddwmmr.outputs import check_output_path, check_writable
 
 #: Suffixes (formats) ``--snapshot`` may have: what matplotlib writes by itself or through
 #: Pillow (pgf needs LaTeX; raw/rgba are headerless pixel dumps, not image files).
@@ -42,41 +39,6 @@ SNAPSHOT_FORMATS = (
     "webp",
     "gif",
 )
-
-
-def nearest_folder(path: Path) -> Path:
-    """``path`` if it exists, else its nearest existing ancestor."""
-    for candidate in [path, *path.parents]:
-        if os.path.lexists(candidate):
-            return candidate
-    return Path(path.anchor or "/")  # pragma: no cover - the root always exists
-
-
-def missing_folders(folder: Path) -> list[Path]:
-    """The folders above and including ``folder`` that do not exist yet, outermost first."""
-    missing = []
-    for candidate in [folder, *folder.parents]:
-        if os.path.lexists(candidate):
-            break
-        missing.append(candidate)
-    return list(reversed(missing))
-
-
-def check_writable_folder(label: str, folder: Path) -> None:
-    """Raise a one-line :class:`ParameterError` unless files can be created in ``folder``
-    (or, if it does not exist yet, in the nearest existing folder above it)."""
-    existing = nearest_folder(folder)
-    if not existing.is_dir():
-        raise ParameterError(f"{label}: {existing} is not a folder")
-    try:
-        fd, probe = tempfile.mkstemp(dir=existing, prefix=".ddwmmr-", suffix=".tmp")
-    except OSError as exc:
-        raise ParameterError(
-            f"{label}: cannot write in {existing} ({exc.strerror or exc})"
-        ) from None
-    os.close(fd)
-    with contextlib.suppress(OSError):
-        os.unlink(probe)
 
 
 def snapshot_format(text: str) -> str:
@@ -103,7 +65,7 @@ def check_snapshot_path(text: str, force: bool = False) -> Path:
         raise ParameterError(f"snapshot: {text} is a folder; give a file name such as gui.png")
     snapshot_format(text)
     check_existing_snapshot(path, text, force)
-    check_writable_folder("snapshot", path.parent)
+    check_writable("snapshot", path.parent)
     return path
 
 
@@ -134,5 +96,5 @@ def check_export_root(text: str) -> Path:
     path = Path(os.path.abspath(text))
     if os.path.lexists(path) and not path.is_dir():
         raise ParameterError(f"export: {text} exists and is not a folder")
-    check_writable_folder("export", path)
+    check_writable("export", path)
     return path
