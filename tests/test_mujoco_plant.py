@@ -2,6 +2,7 @@
 
 import math
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -10,7 +11,13 @@ from ddwmmr import ParameterError, Robot
 from ddwmmr.commands import WheelForces
 from ddwmmr.plants.base import Observation, PlantDivergedError
 from ddwmmr.plants.mujoco import MujocoPlant
-from ddwmmr.plants.mujoco.plant import LIFT_TIME_S, TIP_TILT_RAD, UNLOADED_FRACTION, tip_time_s
+from ddwmmr.plants.mujoco.plant import (
+    LIFT_TIME_S,
+    TIP_TILT_RAD,
+    UNLOADED_FRACTION,
+    TipDetector,
+    tip_time_s,
+)
 
 DT = 0.02
 ROBOT = Robot().with_payload(3.0)
@@ -248,6 +255,10 @@ def test_summary_of_a_stable_and_of_a_tipping_hold():
     assert tipping.result["tip_time_s"] == pytest.approx(LIFT_TIME_S - DT, abs=1e-9)
     assert tipping.result["min_edge_load_n"] == 0.0
     assert tipping.result["max_base_tilt_rad"] > 0.01
+    # the plant's own verdict during the run is the recorded series' verdict
+    assert stable.tip_time is None and stable.unloaded_time_s == 0.0
+    assert tipping.tip_time == pytest.approx(tipping.result["tip_time_s"], abs=1e-12)
+    assert tipping.unloaded_time_s == pytest.approx(tipping.result["unloaded_time_s"], abs=1e-9)
     for key in ("min_support_force_n", "max_wheel_slip_m_s", "min_physics_stability"):
         assert math.isfinite(tipping.result[key])
 
@@ -261,3 +272,54 @@ def test_torque_use_reaches_one_when_a_motor_saturates():
     assert plant.extra_values()[use] < 0.5
     plant.step(0.0, np.array([1.0, 0.0, 0.0, 0.0]), DT)
     assert plant.extra_values()[use] == pytest.approx(1.0, abs=1e-9)
+
+
+def test_a_lifted_edge_tips_only_while_the_base_pivots_on():
+    """Chatter (an edge unloaded, the tilt flat) and rocking (up, then back) are not
+    tipping; a tilt growing all the while an edge is unloaded is, after LIFT_TIME_S."""
+    weight, needed = 100.0, math.ceil(LIFT_TIME_S / DT)
+    unloaded = 0.5 * UNLOADED_FRACTION * weight
+    t = np.arange(0.0, 1.0, DT)
+    load = np.full_like(t, 10.0)
+    load[10 : 10 + 3 * needed] = unloaded
+    flat = np.full_like(t, 3e-4)
+    flat[10 : 10 + 3 * needed : 2] = 2.9e-4  # contact noise: the tilt wobbles
+    assert tip_time_s(t, load, flat, weight) is None
+    rocking = np.concatenate([np.linspace(0.0, 3e-3, 10 + needed // 2), np.full(len(t), 3e-3)])
+    rocking = rocking[: len(t)].copy()
+    rocking[10 + needed // 2 :] = np.linspace(3e-3, 0.0, len(t) - 10 - needed // 2)
+    assert tip_time_s(t, load, rocking, weight) is None
+    growing = np.linspace(6e-4, 0.05, len(t))
+    assert tip_time_s(t, load, growing, weight) == pytest.approx(t[10 + needed - 1])
+    detector = TipDetector(weight, DT)
+    for k in range(len(t)):
+        detector.update(t[k], load[k], flat[k])
+    assert detector.tip_time is None
+    assert detector.unloaded(unloaded) and not detector.unloaded(UNLOADED_FRACTION * weight)
+
+
+def test_support_forces_match_a_contact_by_contact_readout():
+    """The vectorised readout against MuJoCo's contacts one at a time, while moving."""
+    plant = fresh()
+    hold(plant, np.array([0.4, 0.6, 1.0, -1.0]), 0.5)
+    model, data = plant.model, plant.data
+    names = [s.name for s in plant.supports]
+    origin = data.xpos[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "base")][:2]
+    c, s = math.cos(plant.observe().q[2]), math.sin(plant.observe().q[2])
+    forces, moments, buffer = np.zeros(len(names)), np.zeros((len(names), 2)), np.zeros(6)
+    for i in range(data.ncon):
+        contact = data.contact[i]
+        geoms = [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_GEOM, g) for g in
+                 (contact.geom1, contact.geom2)]  # fmt: skip
+        touching = [names.index(g) for g in geoms if g in names]
+        if not touching:
+            continue
+        mujoco.mj_contactForce(model, data, i, buffer)
+        dx, dy = contact.pos[0] - origin[0], contact.pos[1] - origin[1]
+        forces[touching[0]] += buffer[0]
+        moments[touching[0]] += buffer[0] * np.array([c * dx + s * dy, -s * dx + c * dy])
+    measured, points = plant.support_forces()
+    assert data.ncon >= 4 and np.sum(forces) > 100.0
+    np.testing.assert_allclose(measured, forces, rtol=0, atol=1e-9)
+    loaded = forces > 1e-12
+    np.testing.assert_allclose(points[loaded], moments[loaded] / forces[loaded, None], atol=1e-12)

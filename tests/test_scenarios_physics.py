@@ -6,8 +6,10 @@ import pytest
 
 from ddwmmr import ParameterError, Robot
 from ddwmmr.plants import MujocoPlant, ThesisPlant
+from ddwmmr.plants.mujoco import plant as mujoco_plant
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 from ddwmmr.scenarios.protocol import make_scenario_plant
+from ddwmmr.scenarios.report import format_table, summarize
 
 SCENARIO = generate(2, 0)[1]  # 25 s on the thesis plant
 
@@ -18,6 +20,10 @@ def test_one_scenario_on_the_physics_plant(controller):
     physics = run_scenario(SCENARIO, RunConfig(controller=controller, plant="mujoco")).metrics
     assert physics["success"], physics["reason"]
     assert physics["min_stability"] > 1.0
+    # judged by the contact forces too: it stayed up, and the time a lightly loaded
+    # wheel spent off the floor is reported (the thesis plant has no contacts: NaN)
+    assert 0.0 <= physics["unloaded_time_s"] < 0.5 * physics["time_s"]
+    assert math.isnan(on_thesis["unloaded_time_s"])
     # Same base damping and the same controller: the times agree to within a few seconds
     # (physics adds servo lag, contact and motor limits).
     assert abs(physics["time_s"] - on_thesis["time_s"]) < 8.0
@@ -46,3 +52,23 @@ def test_base_damping_is_validated(bad):
 def test_thesis_controller_still_refuses_the_kinematic_plant():
     with pytest.raises(ParameterError, match="thesis or mujoco"):
         RunConfig(controller="thesis", plant="kinematic")
+
+
+def test_the_physics_plant_fails_a_run_that_tips_by_its_contact_forces(monkeypatch):
+    """With a tilt threshold below the resting lean the plant says "tipped" at once:
+    the protocol stops the run on the plant's word, whatever the formula's S says."""
+    monkeypatch.setattr(mujoco_plant, "TIP_TILT_RAD", 0.0)
+    outcome = run_scenario(SCENARIO, RunConfig(plant="mujoco"))
+    metrics = outcome.metrics
+    assert not metrics["success"] and metrics["reason"] == "tipped (physics)"
+    assert metrics["sim_steps"] == 1 and metrics["min_stability"] > 1.3
+    summary = summarize([outcome], wall_time_s=1.0)
+    assert summary["tipped_physics"] == 1
+    assert "Tipped over (physics)" in format_table(summary, "t")
+
+
+def test_plants_without_physics_report_no_physics_verdict():
+    outcome = run_scenario(generate(1, 0)[0], RunConfig(time_limit=1.0))
+    summary = summarize([outcome], wall_time_s=1.0)
+    assert summary["tipped_physics"] is None and summary["mean_unloaded_time_s"] is None
+    assert "physics" not in format_table(summary, "t")

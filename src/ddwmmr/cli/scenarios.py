@@ -78,9 +78,11 @@ an 8 m x 8 m square; the end effector must reach them in order within 0.01 m in 
 (120 s with obstacles) while the tip-over stability S stays above 1. Writes scenarios.csv
 (one row per scenario), summary.json, table.txt (thesis Table 5.2 format) and figures
 (per-scenario bars as thesis Figs 5.3-5.9, paths, a state timeline) into --out, and prints
-the table. Controllers: 'thesis' (behaviour-based, state-machine arbiter) on the thesis
-force-driven plant; 'qp' (the library's QP controller) on the thesis plant through a
-velocity-tracking loop, or on the kinematic plant."""
+the table. Controllers: 'thesis' (behaviour-based, state-machine or competitive arbiter)
+sends wheel forces; 'qp' (the library's QP controller) sends velocities, followed by the
+thesis plant's velocity servo; 'mpc' (CasADi, the thesis base's force-level model) sends
+wheel forces. Plants: the thesis force-driven dynamics (default), the kinematic model
+(qp and mpc only) or the MuJoCo physics model, which judges tipping by its contact forces."""
 
 EPILOG = """\
 The default payload is 3.0 kg: with the thesis's 1.25 kg the planar arm can never tip
@@ -121,7 +123,8 @@ def build_parser() -> ArgumentParser:
         "--plant",
         choices=PLANTS,
         default="thesis",
-        help="plant: 'thesis' force-driven dynamics (default) or 'kinematic'",
+        help="plant: 'thesis' force-driven dynamics (default), 'kinematic' (qp and mpc "
+        "only) or 'mujoco' physics (tipping judged from contact forces)",
     )
     parser.add_argument(
         "--n",

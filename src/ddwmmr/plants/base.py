@@ -62,7 +62,11 @@ class Plant(Protocol):
         extra_columns: names of plant-specific time-series columns (may be empty).
 
     Optional: ``timestep`` (s), an engine step that control steps must be whole multiples
-    of (``simulate`` rounds its default step to one).
+    of (``simulate`` rounds its default step to one); ``tip_time`` (s or None), on plants
+    that judge tipping over by their own physics (contact forces): when the robot tipped
+    since the reset, None while it has not (the scenario protocol fails a run on it), and
+    with it ``unloaded_time_s``, the time (s) since the reset with an edge of the support
+    polygon unloaded.
     """
 
     name: str

@@ -2,8 +2,10 @@
 
 Success: every waypoint reached by the end effector within ``tolerance`` (0.01 m) in order
 within the time limit (60 s, 120 s with obstacles), with ``S > 1`` at every step and (with
-obstacles) the base's enclosing circle never touching an obstacle. The run stops at the
-first failure.
+obstacles) the base's enclosing circle never touching an obstacle. On a plant that judges
+tipping by its own physics (the MuJoCo plant's contact forces, ``Plant.tip_time``) the
+robot must also never tip over there (reason ``"tipped (physics)"``; ``"tipped"`` is
+``S <= 1``). The run stops at the first failure.
 
 A scenario is a :class:`WaypointTask` run by the library's one simulation loop
 (:func:`ddwmmr.sim.loop.run_loop`), which connects any controller to any plant through
@@ -24,7 +26,10 @@ Metrics (seconds unless noted): ``time_s`` (time to the last waypoint, or to the
 ``time_arm_s`` (thesis controller: time in the moving-base / moving-arm states; other
 controllers, which have no states: time with the base moving, |v| > 1 mm/s or |w| > 1 mrad/s,
 and with an arm joint moving, > 1 mrad/s), time in and transitions into each fix state
-(NaN for controllers without states), ``min_stability``, ``min_manipulability``.
+(NaN for controllers without states), ``min_stability``, ``min_manipulability``,
+``unloaded_time_s`` (physics plants, NaN elsewhere: time with an edge of the support
+polygon unloaded, ``Plant.unloaded_time_s``; a wheel chattering on a lightly loaded side
+counts).
 """
 
 from __future__ import annotations
@@ -86,6 +91,7 @@ METRICS = (
     "transitions_obstacle",
     "min_stability",
     "min_manipulability",
+    "unloaded_time_s",
     "sim_steps",
 )
 
@@ -184,6 +190,8 @@ class _Tally:
         self.steps_base = self.steps_arm = 0
         self.min_s = math.inf
         self.min_eta = math.inf
+        #: Physics plants: the plant, which judges tipping itself (``tip_time``).
+        self.physics: Any = None
         self.reason = "timeout"
         self.step_ns: list[int] = []  # wall-clock time of each controller call
         self.clearance = base_bubble(robot)
@@ -283,6 +291,7 @@ class _Tally:
             "speed_m_s": length / t if t > 0 else nan,
             "min_stability": self.min_s,
             "min_manipulability": self.min_eta,
+            "unloaded_time_s": nan if self.physics is None else self.physics.unloaded_time_s,
             "sim_steps": steps,
         }
         if has_states:
@@ -310,14 +319,18 @@ class WaypointTask:
 
     ``has_states``: the controller is the thesis state machine (its states are counted);
     otherwise base and arm motion are detected from the measured state and the command.
+    ``plant``: the run's plant; one with ``tip_time`` (physics) also judges tipping.
     """
 
     trajectory = None
 
-    def __init__(self, tally: _Tally, controller: Any, has_states: bool) -> None:
+    def __init__(
+        self, tally: _Tally, controller: Any, has_states: bool, plant: Plant | None = None
+    ) -> None:
         self.tally = tally
         self.controller = controller
         self.has_states = has_states
+        self._physics = tally.physics = plant if hasattr(plant, "tip_time") else None
         self._velocity_d = np.zeros(3)
         self._goal: tuple[float, float] | None = None
         self._pose_d = np.zeros(3)
@@ -373,7 +386,14 @@ class WaypointTask:
         if not self.has_states:
             base_moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
             self.tally.steps_base += int(base_moving)
-        return self.tally.check(obs.q.tolist())
+        return self.tally.check(obs.q.tolist()) or self._tipped_physically()
+
+    def _tipped_physically(self) -> bool:
+        """Physics plants: True (a failure) once the plant says the robot tipped over."""
+        if self._physics is None or self._physics.tip_time is None:
+            return False
+        self.tally.reason = "tipped (physics)"
+        return True
 
     def _arm_rate(self, obs: Observation, applied: Any) -> float:
         """Largest commanded joint rate (rad/s): from u, or from the joint targets of a
@@ -408,7 +428,7 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
     q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
     has_states = config.controller == "thesis"
     tally = _Tally(robot, scenario, config)
-    task = WaypointTask(tally, controller, has_states)
+    task = WaypointTask(tally, controller, has_states, plant)
     end = run_loop(plant, controller, task, q0, config.dt, tally.steps)
     return tally.outcome(end.samples * config.dt, end.samples, has_states=has_states)
 

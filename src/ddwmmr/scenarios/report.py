@@ -57,6 +57,12 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
         summary["sd_" + key] = sd
     summary["min_stability"] = float(np.min(_column(outcomes, "min_stability")))
     summary["min_manipulability"] = float(np.min(_column(outcomes, "min_manipulability")))
+    unloaded = _column(outcomes, "unloaded_time_s")  # physics plants only (else NaN)
+    physics = bool(np.any(np.isfinite(unloaded)))
+    summary["tipped_physics"] = (
+        sum(o.metrics["reason"] == "tipped (physics)" for o in outcomes) if physics else None
+    )
+    summary["mean_unloaded_time_s"] = float(np.mean(unloaded)) if physics else None
     sim_time = float(np.sum(_column(outcomes, "time_s")))
     summary["sim_time_s"] = sim_time
     summary["wall_time_s"] = wall_time_s
@@ -125,6 +131,10 @@ def format_table(summary: dict[str, Any], title: str) -> str:
     lines = [title, "-" * len(title)]
     lines += [f"{label:<{width}}  {value}" for label, value in rows]
     lines.append(f"{'Minimum stability S':<{width}}  {_fmt(summary['min_stability'])}")
+    if summary.get("tipped_physics") is not None:
+        lines.append(f"{'Tipped over (physics)':<{width}}  {summary['tipped_physics']}")
+        label = "Time with an edge unloaded (s)"
+        lines.append(f"{label:<{width}}  {_fmt(summary['mean_unloaded_time_s'])}")
     return "\n".join(lines) + "\n"
 
 

@@ -54,7 +54,7 @@ SETTLE_DAMPING_TIME_S = 0.01
 #: An edge of the support polygon is unloaded when the supports off it carry less than
 #: this fraction of the robot's weight.
 UNLOADED_FRACTION = 1e-4
-#: ``tipped``: an edge unloaded for at least this long (s) ...
+#: ``tipped``: the base pivots about an unloaded edge, tilting further, this long (s) ...
 LIFT_TIME_S = 0.1
 #: ... or the base tilted beyond this angle (rad; 5.7 deg, far beyond the contacts' own
 #: compliance: a base at rest leans at most ~6e-4 rad into its contacts).
@@ -127,6 +127,7 @@ class MujocoPlant:
         self.data = mujoco.MjData(self.model)
         self.supports = supports(robot)
         self.geometry = SupportGeometry([s.point for s in self.supports])
+        self._nominal_points = np.array([s.point for s in self.supports], dtype=float)
         self.extra_columns = (
             "min_support_force_n",
             *(f"support_force_{s.name}_n" for s in self.supports),
@@ -149,6 +150,8 @@ class MujocoPlant:
         self._warnings = 0
         self._phi = 0.0
         self._cache: tuple[float, ...] | None = None
+        self._tip = TipDetector(self.weight_n, 0.0)
+        self._unloaded_time = 0.0  # s: control steps that ended with an edge unloaded
         mass = float(np.sum(self.model.body_mass))
         inertia = mass * (robot.base_length**2 + robot.base_width**2) / 12.0 + robot.base_inertia
         # damping (N s/m, N m s/rad) for a SETTLE_DAMPING_TIME_S time constant of the base
@@ -263,6 +266,9 @@ class MujocoPlant:
         mujoco.mj_forward(model, data)
         self._phi = float(q0[2])
         self._cache = None
+        self._tip = TipDetector(self.weight_n, self._dt)
+        self._unloaded_time = 0.0
+        self._judge_tipping(0.0, 0.0)
 
     def _place(self, q: np.ndarray, z: float, keep_tilt: bool = False) -> None:
         """Set the base at (x, y, z) with heading q[2] (keeping roll/pitch if asked) and
@@ -332,6 +338,31 @@ class MujocoPlant:
         mujoco.mj_forward(self.model, self.data)
         self._phi += wrap_angle(_heading(self.data.qpos[3:7]) - self._phi)
         self._cache = None
+        self._judge_tipping(t + dt, dt)
+
+    @property
+    def tip_time(self) -> float | None:
+        """Time (s) since the reset at which the robot tipped over by the contact forces
+        (:class:`TipDetector`, judged after every control step), None if it has not."""
+        return self._tip.tip_time
+
+    @property
+    def unloaded_time_s(self) -> float:
+        """Time (s) since the reset with an edge of the support polygon unloaded: dt for
+        every control step that ended so (a wheel chattering on a lightly loaded side
+        counts)."""
+        return self._unloaded_time
+
+    def _judge_tipping(self, t: float, dt: float) -> None:
+        """Feed the tip criterion the state at t (s), which ends a step of dt (s; 0: the
+        reset's state)."""
+        # the two readings the criterion needs (the other columns cost twice as much)
+        edge_load = float(
+            np.min(self.geometry.edge_loads(self._per_support(*self._support_contacts())))
+        )
+        self._tip.update(t, edge_load, self.base_tilt())
+        if self._tip.unloaded(edge_load):
+            self._unloaded_time += dt
 
     def _velocity_controls(self, q: np.ndarray, u: np.ndarray) -> None:
         applied, _ = self.limit(q, u)
@@ -377,27 +408,43 @@ class MujocoPlant:
         """Floor normal force on each support (N) and its contact point in the base frame
         (m), in the order of :attr:`supports` (an unloaded support: 0 N at its nominal
         point)."""
-        model, data = self.model, self.data
-        forces = np.zeros(len(self.supports))
-        moments = np.zeros((len(self.supports), 2))
-        geom_support = self._ids["geom_support"]
-        base = self._ids["base"]
-        origin = data.xpos[base][:2]
+        index, normal = self._support_contacts()
+        forces = self._per_support(index, normal)
+        ox, oy = self.data.xpos[self._ids["base"]][:2].tolist()
         c, s = math.cos(self._phi), math.sin(self._phi)
-        for i in range(data.ncon):
-            contact = data.contact[i]
-            index = max(geom_support[contact.geom1], geom_support[contact.geom2])
-            if index < 0:
-                continue
-            mujoco.mj_contactForce(model, data, i, self._force_buffer)
-            force = self._force_buffer[0]
-            dx, dy = contact.pos[0] - origin[0], contact.pos[1] - origin[1]
-            forces[index] += force
-            moments[index] += force * np.array([c * dx + s * dy, -s * dx + c * dy])
-        points = np.array([s.point for s in self.supports], dtype=float)
+        moments = [[0.0, 0.0] for _ in self.supports]
+        positions = self.data.contact.pos[: len(normal), :2].tolist()
+        for support, force, (px, py) in zip(index.tolist(), normal.tolist(), positions):
+            if support >= 0:
+                dx, dy = px - ox, py - oy
+                moments[support][0] += force * (c * dx + s * dy)
+                moments[support][1] += force * (-s * dx + c * dy)
+        points = self._nominal_points.copy()
         loaded = forces > 1e-12
-        points[loaded] = moments[loaded] / forces[loaded, None]
+        points[loaded] = np.array(moments)[loaded] / forces[loaded, None]
         return forces, points
+
+    def _support_contacts(self) -> tuple[np.ndarray, np.ndarray]:
+        """For each active contact: the support it touches (-1: none) and its floor normal
+        force (N)."""
+        model, data = self.model, self.data
+        count = data.ncon
+        contacts = data.contact
+        geom_support = self._ids["geom_support"]
+        index = np.maximum(
+            geom_support[contacts.geom1[:count]], geom_support[contacts.geom2[:count]]
+        )
+        normal = np.empty(count)
+        buffer = self._force_buffer
+        for i in range(count):
+            mujoco.mj_contactForce(model, data, i, buffer)
+            normal[i] = buffer[0]
+        return index, normal
+
+    def _per_support(self, index: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        """Contact normal forces (N) summed per support."""
+        touching = index >= 0
+        return np.bincount(index[touching], weights=normal[touching], minlength=len(self.supports))
 
     def base_tilt(self) -> float:
         """Angle (rad) between the base's z axis and the vertical."""
@@ -472,32 +519,66 @@ class MujocoPlant:
         }
 
 
+class TipDetector:
+    """The tipped-over criterion of :func:`tip_time_s`, fed one sample at a time.
+
+    Args:
+        weight_n: the robot's weight (N).
+        interval: time between samples (s); 0 when there is only one sample (then only the
+            tilt can say "tipped").
+
+    :attr:`tip_time` is the time (s) of the first sample at which the criterion was met,
+    None until then; it stays set.
+    """
+
+    def __init__(self, weight_n: float, interval: float) -> None:
+        self._unloaded_below = UNLOADED_FRACTION * weight_n
+        self._needed = max(1, math.ceil(LIFT_TIME_S / interval - 1e-9)) if interval > 0 else 0
+        self._run = 0  # consecutive samples pivoting: an edge unloaded, the tilt not falling
+        self._tilt = -math.inf  # tilt of the previous sample (rad; none before the first)
+        self.tip_time: float | None = None
+
+    def unloaded(self, edge_load: float) -> bool:
+        """Whether an edge with this load (N) counts as unloaded."""
+        return edge_load < self._unloaded_below
+
+    def update(self, t: float, edge_load: float, tilt: float) -> float | None:
+        """Take the sample at t (s): smallest edge load (N) and base tilt (rad); return
+        :attr:`tip_time`."""
+        if self.tip_time is None:
+            pivoting = self.unloaded(edge_load) and tilt >= self._tilt
+            self._run = self._run + 1 if pivoting else 0
+            self._tilt = tilt
+            if tilt > TIP_TILT_RAD or 0 < self._needed <= self._run:
+                self.tip_time = t
+        return self.tip_time
+
+
 def tip_time_s(
     t: np.ndarray, edge_load: np.ndarray, tilt: np.ndarray, weight_n: float
 ) -> float | None:
     """First time (s) a recorded run counts as tipped, or None.
 
-    Tipped: some edge of the support polygon stays unloaded (the supports off it carry less
-    than :data:`UNLOADED_FRACTION` of the weight ``weight_n``, N) over consecutive samples
-    spanning at least :data:`LIFT_TIME_S` (n samples span n sample intervals), or the base
-    tilts beyond :data:`TIP_TILT_RAD`. The time returned is the sample where the criterion
+    Tipped: the base pivots about an edge of the support polygon for at least
+    :data:`LIFT_TIME_S` (consecutive samples, n samples spanning n sample intervals, at
+    which the supports off the edge carry less than :data:`UNLOADED_FRACTION` of the weight
+    ``weight_n``, N, and the tilt has not decreased since the sample before), or the base
+    tilts beyond :data:`TIP_TILT_RAD`. A wheel that merely chatters on and off the floor,
+    or a base that rocks onto an edge and back, lifts an edge without pivoting on: that is
+    ``support_lost``, not tipped. The time returned is the sample where the criterion
     is first met. ``edge_load`` is the ``min_edge_load_n`` column, ``tilt`` the
-    ``base_tilt_rad`` column.
+    ``base_tilt_rad`` column. (:class:`TipDetector` is the criterion; the plant runs one
+    during a run, :attr:`MujocoPlant.tip_time`.)
     """
-    candidates = []
-    tilted = np.flatnonzero(tilt > TIP_TILT_RAD)
-    if tilted.size:
-        candidates.append(float(t[tilted[0]]))
-    if len(t) > 1:
-        interval = float(np.median(np.diff(t)))
-        needed = max(1, math.ceil(LIFT_TIME_S / interval - 1e-9))
-        run = 0
-        for k, unloaded in enumerate(edge_load < UNLOADED_FRACTION * weight_n):
-            run = run + 1 if unloaded else 0
-            if run >= needed:
-                candidates.append(float(t[k]))
-                break
-    return min(candidates) if candidates else None
+    t = np.asarray(t, dtype=float)
+    interval = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+    detector = TipDetector(weight_n, interval)
+    for time, load, angle in zip(
+        t.tolist(), np.asarray(edge_load).tolist(), np.asarray(tilt).tolist()
+    ):
+        if detector.update(time, load, angle) is not None:
+            break
+    return detector.tip_time
 
 
 def _heading(quaternion) -> float:
