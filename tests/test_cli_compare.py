@@ -41,3 +41,20 @@ def test_make_demo_installs_only_the_runtime_dependencies():
     assert demo.returncode == 0 and test.returncode == 0
     assert "pip install --quiet -e .\n" in demo.stdout and "[test]" not in demo.stdout
     assert 'pip install --quiet -e ".[test]"' in test.stdout
+
+
+def test_run_record_holds_the_preset_its_options_and_the_plants():
+    """run.json says what ran: the preset, each method's options under it, every plant."""
+    from ddwmmr.cli.compare import run_record
+    from ddwmmr.reports.compare.plan import CompareConfig
+    from ddwmmr.trajectories import Ellipse
+
+    trajectories = {"ellipse": Ellipse()}
+    slides = CompareConfig(("ats", "pi"), trajectories, preset="slides", plants=("mujoco",))
+    record = run_record(slides, {}, [], jobs=1)
+    assert record["preset"] == "slides"
+    assert record["options"]["ats"]["aux"] == "sum"  # the slides' row, not the default
+    assert record["plants"] == ["kinematic", "mujoco"]
+    default = run_record(CompareConfig(("ats",), trajectories), {}, [], jobs=1)
+    assert default["preset"] == "default" and default["options"]["ats"]["aux"] == "shoulder"
+    assert default["plants"] == ["kinematic"]

@@ -30,7 +30,7 @@ from ddwmmr.cli.common import (
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, method_description
-from ddwmmr.controllers.presets import PRESETS
+from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import (
     MAX_JOBS,
     ParameterError,
@@ -300,7 +300,11 @@ def run_record(
     record.update(
         methods=list(config.methods),
         study_methods=list(config.study_methods or ()),
-        options={m: provenance.options_record(m, {}) for m in config.methods},
+        preset=config.preset,
+        options={
+            m: provenance.options_record(m, preset_options(m, config.preset))
+            for m in config.methods
+        },
         robot=provenance.robot_record(config.robot),
         trajectories={
             name: provenance.trajectory_record(t, sources.get(name))
@@ -309,7 +313,8 @@ def run_record(
         duration=config.duration,
         studies=list(config.studies),
         jobs=jobs,
-        plant={"name": "kinematic"},
+        plant={"name": "kinematic"},  # the main comparison; ``plants`` adds sections
+        plants=["kinematic", *config.plants],
         seed=None,  # nothing random in a comparison
     )
     return record
