@@ -85,7 +85,7 @@ outputs (in --out):
 
 ranking:
   score = RMS end-effector position error over the whole run (mm), per trajectory; lower
-  is better; within 5 % (or 0.1 mm) counts as a tie. Overall = geometric mean over the
+  is better; within 5 % plus 0.1 mm counts as a tie. Overall = geometric mean over the
   trajectories. The report states whether the slides' ranking
   CLRRMC-TS >= CLRRMC-CS >= RR-AP >= RR-ATS >= RR-PI holds, and why not where it fails.
 

@@ -14,7 +14,7 @@ Library use::
 **Ranking score** (documented in the report): the RMS end-effector position error over the
 whole run (m), per trajectory; lower is better. Every method starts from the same
 configuration with the same initial offset, so the score rewards removing the offset quickly
-and penalises drift. Scores within 5 % (or 0.1 mm) of a better one count as a tie, which is
+and penalises drift. Scores within 5 % plus 0.1 mm of a better one count as a tie, which is
 what the slides' ``>=`` allows. The overall score is the geometric mean over trajectories
 (errors span orders of magnitude, so the mean of their logarithms is the fair summary).
 

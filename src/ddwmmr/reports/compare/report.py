@@ -194,7 +194,7 @@ def _ranking_section(c: _Context, ranking: Ranking) -> None:
         "**Score**: the RMS end-effector position error over the whole run (mm), per "
         "trajectory; lower is better. All methods start with the same initial offset, so the "
         "score rewards removing it quickly and penalises drift; the orientation error is "
-        "reported in the tables but not scored. Scores within 5 % (or 0.1 mm) of a better "
+        "reported in the tables but not scored. Scores within 5 % plus 0.1 mm of a better "
         "score are a tie and share its rank (the slides' `>=` allows ties). **Overall**: the "
         "geometric mean of the per-trajectory scores (errors span orders of magnitude). The "
         f"per-trajectory rank is in brackets. Settings: preset `{c.config.preset}`."
