@@ -13,6 +13,23 @@ counter moment to the tipping moment about each footprint edge:
 
 ``S > 1`` is statically stable. Values are capped at :data:`STABILITY_CAP` where the
 tipping moment vanishes.
+
+**Dynamic margin** (:func:`zero_moment_point`, :func:`dynamic_stability`): when the robot
+accelerates, the floor's centre of pressure is not below the centre of mass but at the zero
+moment point. With the masses lumped as the model has them (base box at its centre
+``BASE_CLEARANCE_M + base_height/2`` above the floor, the wheels at their axle height, links
+and payload in the arm's plane at ``arm_height``) and the vertical accelerations and the
+bodies' roll/pitch inertia neglected, in the base frame::
+
+    x_zmp = x_com - (H a_x0 + h M (-wdot y_com - w^2 x_com - 2 w ydot_com + xddot_com)) / (M g)
+    y_zmp = y_com - (H a_y0 + h M ( wdot x_com - w^2 y_com + 2 w xdot_com + yddot_com)) / (M g)
+
+with ``(a_x0, a_y0) = (vdot, v w)`` the acceleration of the axle midpoint (base frame),
+``H = sum m_i h_i`` over all masses (kg m), ``h`` the arm height, ``M`` the total mass and
+the centre-of-mass rates and accelerations from the joint rates and accelerations.
+``S_dyn`` is ``S``'s formula at the zero moment point; at rest it is S. (The arm's own
+angular momentum about z and the wheels' gyroscopic moment, about 0.02 N m at 1.5 rad/s,
+are left out.)
 """
 
 from __future__ import annotations
@@ -24,6 +41,11 @@ import numpy as np
 
 #: Reported stability is capped here: a vanishing tipping moment gives an infinite ratio.
 STABILITY_CAP = 10.0
+#: Height of the base box's bottom above the floor (m): its mass sits at this height plus
+#: half the box (the physics plant builds the same box).
+BASE_CLEARANCE_M = 0.05
+#: Standard gravity (m/s^2), as the physics plant has it.
+GRAVITY_M_S2 = 9.81
 
 
 @dataclass(frozen=True)
@@ -99,6 +121,96 @@ def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[floa
         return s_lon, 0.0, 0.0
     factor = -s_lon / x_com
     return s_lon, factor * (-k.A * s1 - k.B * s12), factor * (-k.B * s12)
+
+
+@dataclass(frozen=True)
+class InertialTerms:
+    """Mass moments of the dynamic margin (:func:`zero_moment_point`).
+
+    Attributes:
+        height_moment: ``H = sum m_i h_i`` over every mass (kg m).
+        arm_moment: ``h M``, the arm height times the total mass (kg m): the arm's masses
+            are ``M (x_com, y_com)`` as first moments.
+        weight: ``M g`` (N).
+    """
+
+    height_moment: float
+    arm_moment: float
+    weight: float
+
+
+def inertial_terms(robot) -> InertialTerms:
+    """:class:`InertialTerms` of a :class:`~ddwmmr.model.Robot` (lumped as the module
+    docstring says)."""
+    m1, m2 = robot.link_masses
+    arm = m1 + m2 + robot.payload
+    box = robot.base_mass - 2.0 * robot.wheel_mass
+    total = robot.base_mass + arm
+    height = (
+        box * (BASE_CLEARANCE_M + 0.5 * robot.base_height)
+        + 2.0 * robot.wheel_mass * robot.wheel_radius
+        + arm * robot.arm_height
+    )
+    return InertialTerms(height, robot.arm_height * total, total * GRAVITY_M_S2)
+
+
+def zero_moment_point(
+    k: ComCoefficients,
+    terms: InertialTerms,
+    th1,
+    th2,
+    rate1,
+    rate2,
+    v,
+    w,
+    v_dot,
+    w_dot,
+    acc1=0.0,
+    acc2=0.0,
+    cos=math.cos,
+    sin=math.sin,
+):
+    """Zero moment point ``(x, y)`` in the base frame (m) at joints (rad), joint rates
+    (rad/s), forward speed v (m/s), yaw rate w (rad/s), their rates (m/s^2, rad/s^2) and
+    the joint accelerations ``acc1``, ``acc2`` (rad/s^2).
+
+    Plain arithmetic on its arguments: with ``cos=casadi.cos, sin=casadi.sin`` it builds the
+    same expression symbolically (:func:`ddwmmr.model.symbolic.zero_moment_point`).
+    """
+    th12, rate12 = th1 + th2, rate1 + rate2
+    c1, s1, c12, s12 = cos(th1), sin(th1), cos(th12), sin(th12)
+    x = k.A * c1 + k.B * c12
+    y = k.A * s1 + k.B * s12
+    x_rate = -k.A * s1 * rate1 - k.B * s12 * rate12
+    y_rate = k.A * c1 * rate1 + k.B * c12 * rate12
+    acc12 = acc1 + acc2
+    x_acc = -k.A * (c1 * rate1**2 + s1 * acc1) - k.B * (c12 * rate12**2 + s12 * acc12)
+    y_acc = -k.A * (s1 * rate1**2 - c1 * acc1) - k.B * (s12 * rate12**2 - c12 * acc12)
+    arm_x = -w_dot * y - w**2 * x - 2.0 * w * y_rate + x_acc
+    arm_y = w_dot * x - w**2 * y + 2.0 * w * x_rate + y_acc
+    return (
+        x - (terms.height_moment * v_dot + terms.arm_moment * arm_x) / terms.weight,
+        y - (terms.height_moment * v * w + terms.arm_moment * arm_y) / terms.weight,
+    )
+
+
+def dynamic_stability(
+    k: ComCoefficients,
+    terms: InertialTerms,
+    th1,
+    th2,
+    rate1,
+    rate2,
+    v,
+    w,
+    v_dot,
+    w_dot,
+    acc1=0.0,
+    acc2=0.0,
+) -> tuple[float, float, float]:
+    """``(S_lon, S_lat, S)`` at the zero moment point (capped like :func:`margins`)."""
+    point = zero_moment_point(k, terms, th1, th2, rate1, rate2, v, w, v_dot, w_dot, acc1, acc2)
+    return margins(k, *point)
 
 
 def manipulability(th2: float) -> float:

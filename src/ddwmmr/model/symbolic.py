@@ -34,7 +34,7 @@ from typing import Any
 import casadi as ca
 
 from ddwmmr.errors import check_positive
-from ddwmmr.model import Robot
+from ddwmmr.model import Robot, stability
 from ddwmmr.model.thesis_base import (
     C1_DEFAULT,
     C2_DEFAULT,
@@ -110,6 +110,31 @@ def stability_bounds(robot: Robot, stability_min: float) -> tuple[float, float]:
     s_min = check_positive("stability_min", stability_min)
     k = robot.com_coefficients
     return k.half_length / s_min, k.half_width / s_min
+
+
+def zero_moment_point(
+    robot: Robot, q: Symbolic, rates: Symbolic, v, w, v_dot, w_dot, accelerations=(0.0, 0.0)
+) -> Symbolic:
+    """Zero moment point ``[x, y]`` in the base frame (m): the formula of
+    :func:`ddwmmr.model.stability.zero_moment_point` built symbolically (joint rates
+    ``rates`` rad/s and ``accelerations`` rad/s^2, base speeds v, w and their rates)."""
+    point = stability.zero_moment_point(
+        robot.com_coefficients,
+        stability.inertial_terms(robot),
+        q[3],
+        q[4],
+        rates[0],
+        rates[1],
+        v,
+        w,
+        v_dot,
+        w_dot,
+        accelerations[0],
+        accelerations[1],
+        cos=ca.cos,
+        sin=ca.sin,
+    )
+    return ca.vertcat(*point)
 
 
 def manipulability(q: Symbolic) -> Symbolic:

@@ -46,11 +46,12 @@ import numpy as np
 
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
+from ddwmmr.model.stability import BASE_CLEARANCE_M
 
 #: Radius of the caster spheres (m).
 CASTER_RADIUS = 0.025
 #: Height of the base box's bottom above the floor (m).
-BASE_CLEARANCE = 0.05
+BASE_CLEARANCE = BASE_CLEARANCE_M
 #: Width of each drive wheel (m): only its inertia and drawing.
 WHEEL_WIDTH = 0.04
 #: Depth (m) the drive wheels reach below the casters' plane (see the module docstring).
