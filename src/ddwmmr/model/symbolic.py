@@ -176,6 +176,11 @@ class ThesisDynamics:
         half_width: lever arm of the wheel forces (m).
         inertia_fixed, inertia_cos: yaw inertia ``I(th2) = inertia_fixed + inertia_cos
             cos(th2)`` about the base centre (kg m^2).
+        shoulder_fixed, elbow_fixed: the arm's angular momentum about the base centre from
+            its own motion is ``H = a th1dot + b (th1dot + th2dot)``, ``a = shoulder_fixed +
+            k cos th2``, ``b = elbow_fixed + k cos th2``, ``k = inertia_cos / 2`` (kg m^2);
+            the thesis plant's arm has no such reaction, a physical one does
+            (:meth:`arm_yaw_reaction`).
     """
 
     mass: float
@@ -186,6 +191,8 @@ class ThesisDynamics:
     half_width: float
     inertia_fixed: float
     inertia_cos: float
+    shoulder_fixed: float = 0.0
+    elbow_fixed: float = 0.0
 
     @classmethod
     def from_robot(
@@ -220,6 +227,8 @@ class ThesisDynamics:
             half_width=0.5 * robot.base_width,
             inertia_fixed=fixed,
             inertia_cos=(m2 + 2.0 * mp) * L1 * L2,
+            shoulder_fixed=m1 * L1**2 / 3.0 + (m2 + mp) * L1**2,
+            elbow_fixed=m2 * L2**2 / 3.0 + mp * L2**2,
         )
 
     # -- numbers ------------------------------------------------------------------------
@@ -254,6 +263,32 @@ class ThesisDynamics:
             (f_left + f_right - self.c1 * v) / self.mass,
             ((f_right - f_left) * self.half_width - self.c2 * w) / self.inertia(th2),
         )
+
+    def arm_momentum(self, th2, rates) -> Symbolic:
+        """The arm's angular momentum ``H`` about the base centre from its own motion
+        (kg m^2/s) at joint rates ``rates`` (rad/s)."""
+        k = 0.5 * self.inertia_cos
+        c = math.cos(th2) if isinstance(th2, int | float) else ca.cos(th2)
+        a, b = self.shoulder_fixed + k * c, self.elbow_fixed + k * c
+        return a * rates[0] + b * (rates[0] + rates[1])
+
+    def arm_yaw_reaction(self, th2, w, rates, accelerations) -> Symbolic:
+        """Yaw acceleration (rad/s^2) the arm's own motion adds to the base's: the total
+        angular momentum ``I(th2) w + H`` about the base centre changes only by the
+        wheels' torque and the damping, so ``I wdot`` loses ``dI/dt w + dH/dt``. Joint
+        rates (rad/s) and accelerations (rad/s^2), yaw rate w (rad/s)."""
+        k = 0.5 * self.inertia_cos
+        cos2, sin2 = (math.cos, math.sin) if isinstance(th2, int | float) else (ca.cos, ca.sin)
+        c, s = cos2(th2), sin2(th2)
+        rate12 = rates[0] + rates[1]
+        a, b = self.shoulder_fixed + k * c, self.elbow_fixed + k * c
+        change = (
+            -2.0 * k * s * rates[1] * w  # dI/dt w
+            + a * accelerations[0]
+            + b * (accelerations[0] + accelerations[1])
+            - k * s * rates[1] * (rates[0] + rate12)  # da/dt th1dot + db/dt th12dot
+        )
+        return -change / self.inertia(th2)
 
     def velocity_envelope(self, fraction: float = 0.8) -> dict[str, float]:
         """What a velocity command can ask of this base, as ``fraction`` of the physics.

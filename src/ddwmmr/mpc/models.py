@@ -10,6 +10,11 @@ Two models, one interface (:class:`PredictionModel`):
   the thesis plant's force-level dynamics (:class:`ddwmmr.model.symbolic.ThesisDynamics`).
   Bounds: the force limit per wheel, joint speeds (box), wheel speeds of the predicted
   base velocity (rows).
+* :class:`LaggedArmPrediction` (``model="thesis"`` with ``arm_time_constant``): the same
+  base, and joints that follow the commanded rates through a first-order lag (state
+  ``[q, v, w, th1dot, th2dot]``, 9): the arm's accelerations, which move the centre of
+  pressure, are then part of the prediction (a velocity servo with that time constant, as
+  the physics plant's).
 
 Joint-position limits are state bounds in both.
 """
@@ -20,6 +25,7 @@ import math
 from abc import ABC, abstractmethod
 from typing import Any
 
+import casadi as ca
 import numpy as np
 
 from ddwmmr.model import Robot
@@ -65,6 +71,21 @@ class PredictionModel(ABC):
     def configuration(self, x: Any) -> Any:
         """The configuration part ``q`` of a state."""
         return x[:5]
+
+    def base_motion(self, x: Any, u: Any) -> tuple[Any, Any, Any, Any] | None:
+        """``(v, w, vdot, wdot)`` of the base at state x under input u (symbolic), None
+        when the model has no base dynamics (then no dynamic tip-over margin)."""
+        return None
+
+    def joint_motion(self, x: Any, u: Any) -> tuple[Any, Any] | None:
+        """Joint rates (rad/s) and accelerations (rad/s^2) at state x under u, or None
+        when the model holds the rates constant over an interval (the commanded ones, with
+        steps between intervals)."""
+        return None
+
+    def joint_rates(self, u: Any) -> Any:
+        """The joint rates (rad/s) an input commands."""
+        return u[2:4]
 
 
 class KinematicPrediction(PredictionModel):
@@ -116,10 +137,92 @@ class ThesisPrediction(PredictionModel):
         """Wheel speeds of the predicted base velocity (the forces do not enter)."""
         return sym.wheel_speeds(self.robot, x[5], x[6])
 
+    def base_motion(self, x: Any, u: Any) -> tuple[Any, Any, Any, Any]:
+        """Measured-state velocities and the accelerations the wheel forces give."""
+        rate = self.rhs(x, u)
+        return x[5], x[6], rate[5], rate[6]
 
-def make_model(name: str, robot: Robot, dynamics: sym.ThesisDynamics | None) -> PredictionModel:
-    """The prediction model called ``name`` (validated by the controller)."""
+
+class LaggedArmPrediction(ThesisPrediction):
+    """The thesis base with joints that follow the commanded rates with a lag ``tau``,
+    ``d(th_dot)/dt = (th_dot_cmd - th_dot) / tau``, as a physical arm does: with its
+    reaction on the base's yaw (:meth:`ThesisDynamics.arm_yaw_reaction`)."""
+
+    nx = sym.NX_FORCE + 2
+
+    def __init__(self, robot: Robot, dynamics: sym.ThesisDynamics, tau: float) -> None:
+        super().__init__(robot, dynamics)
+        self.tau = tau
+        rate = min(dynamics.joint_speed, robot.joint_speed_limit)
+        self.x_lower[7:9], self.x_upper[7:9] = -rate, rate
+
+    def rhs(self, x: Any, u: Any) -> Any:
+        rates, accelerations = self.joint_motion(x, u)
+        base = self._base_rate(x[:7], u, rates, accelerations)
+        return ca.vertcat(base, accelerations)
+
+    def _base_rate(self, x7: Any, u: Any, rates: Any, accelerations: Any) -> Any:
+        """Rate of ``[q, v, w]`` with the joints moving at ``rates``."""
+        d = self.dynamics
+        rate = d.rhs(x7, ca.vertcat(u[0], u[1], rates))
+        reaction = d.arm_yaw_reaction(x7[4], x7[6], rates, accelerations)
+        return ca.vertcat(rate[:6], rate[6] + reaction)
+
+    def joint_motion(self, x: Any, u: Any) -> tuple[Any, Any]:
+        return x[7:9], (u[2:4] - x[7:9]) / self.tau
+
+    def integrate(self, x: Any, u: Any, h: Any, substeps: int) -> Any:
+        """The state after h (s): the joints exactly (the lag is linear, and stiff for
+        RK4 at the coarse intervals: tau = 0.02 s against sub-steps up to 0.2 s), the
+        base by RK4 in ``substeps`` with the joints' exact path inside. The yaw is carried
+        as the total angular momentum ``L = I(th2) w + H`` (wheels and damping change it
+        smoothly; the arm's reaction, a short pulse when the joints' rates change, only
+        moves momentum between the arm and the base)."""
+        tau, start, command = self.tau, x[7:9], u[2:4]
+        d = self.dynamics
+
+        def arm(t):
+            decay = ca.exp(-t / tau)
+            angles = x[3:5] + command * t + (start - command) * tau * (1.0 - decay)
+            return angles, command + (start - command) * decay
+
+        def yaw_rate(angles, rates, momentum):
+            return (momentum - d.arm_momentum(angles[1], rates)) / d.inertia(angles[1])
+
+        def base_rate(t, b):
+            angles, rates = arm(t)
+            w = yaw_rate(angles, rates, b[4])
+            full = ca.vertcat(b[0], b[1], b[2], angles, b[3], w)
+            rate = d.rhs(full, ca.vertcat(u[0], u[1], rates))
+            torque = rate[6] * d.inertia(angles[1])  # (wheels - damping), N m
+            return ca.vertcat(rate[0], rate[1], rate[2], rate[5], torque)
+
+        momentum = d.inertia(x[4]) * x[6] + d.arm_momentum(x[4], start)
+        b = ca.vertcat(x[0], x[1], x[2], x[5], momentum)
+        step = h / substeps
+        for i in range(substeps):
+            t = i * step
+            k1 = base_rate(t, b)
+            k2 = base_rate(t + 0.5 * step, b + 0.5 * step * k1)
+            k3 = base_rate(t + 0.5 * step, b + 0.5 * step * k2)
+            k4 = base_rate(t + step, b + step * k3)
+            b = b + step / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        angles, rates = arm(h)
+        w = yaw_rate(angles, rates, b[4])
+        return ca.vertcat(b[0], b[1], b[2], angles, b[3], w, rates)
+
+
+def make_model(
+    name: str,
+    robot: Robot,
+    dynamics: sym.ThesisDynamics | None,
+    arm_time_constant: float | None = None,
+) -> PredictionModel:
+    """The prediction model called ``name`` (validated by the controller); a
+    ``arm_time_constant`` (s) makes the thesis model's joints lag."""
     if name == "thesis":
         assert dynamics is not None
+        if arm_time_constant is not None:
+            return LaggedArmPrediction(robot, dynamics, arm_time_constant)
         return ThesisPrediction(robot, dynamics)
     return KinematicPrediction(robot)

@@ -35,6 +35,12 @@ written through ``x_{k+1} = RK4(x_k, u_k, h_k)`` so that each row involves one s
 variables only. ``S = stability_min + stability_margin``; the box on the centre of mass is
 the exact condition ``S_lon, S_lat >= S`` (see :func:`ddwmmr.model.symbolic.
 stability_bounds`): the nonlinear stability margin at every node, not a linearisation.
+With ``dynamic_stability`` (force-level model only) the box holds the zero moment point
+instead (:func:`ddwmmr.model.stability.zero_moment_point`: the centre of pressure with the
+inertial forces of the base's acceleration, turn and the arm's motion), at both ends of
+every interval under that interval's input (so ``u_0`` itself is bounded at the measured
+state): ``S_dyn >= S``, the margin against tipping while moving, of which the static S is
+the at-rest case.
 The slacks carry an exact L1 penalty (:data:`SLACK_WEIGHT`): whenever the constraints can
 be met they are met (a hard constraint), and a linearisation that cannot be met in one
 iteration still gives a solvable QP. Input box (forces or rates), joint-position box on
@@ -140,6 +146,8 @@ class OCPConfig:
         min_horizon: lower bound on the free horizon T (s); reach_speed: m/s converting
             the distance left at T = horizon into seconds.
         stability_min: the floor S_min; stability_margin: the OCP keeps S >= S_min + margin.
+        dynamic_stability: bound the zero moment point instead of the centre of mass (the
+            model must have base dynamics).
         track_orientation: cost on the end-effector orientation.
         huber: Huber scale (m) of the position error, None for a pure quadratic.
         obstacles: circles kept clear of the base's enclosing circle (radius
@@ -156,6 +164,7 @@ class OCPConfig:
     reach_speed: float = 0.5
     stability_min: float = 1.25
     stability_margin: float = 0.01
+    dynamic_stability: bool = False
     track_orientation: bool = True
     huber: float | None = None
     obstacles: tuple[Circle, ...] = ()
@@ -198,7 +207,10 @@ class ShootingOCP:
         self.nx = model.nx + (1 if config.reach else 0)
         self.ns = 2 + (1 if config.obstacles else 0)  # stability terms, obstacles
         self.nu = model.nu + self.ns
-        self.terminal_size = (3 if config.track_orientation else 2) + (model.nx - sym.NQ)
+        # terminal error: the end-effector error, and the base velocities of a force model
+        self.terminal_size = (3 if config.track_orientation else 2) + (
+            2 if model.nx > sym.NQ else 0
+        )
         self.x_slices, self.u_slices, self.slack_slices = [], [], []
         self._node_slices = []
         start = 0
@@ -241,6 +253,9 @@ class ShootingOCP:
         """The state after h (s) under u: RK4 in equal sub-steps, at most MAX_SUBSTEP long
         at the interval's nominal length (reach mode only shortens intervals)."""
         substeps = max(1, math.ceil(nominal / MAX_SUBSTEP - 1e-9))
+        integrate = getattr(self.model, "integrate", None)
+        if integrate is not None:  # a model with its own (exact, in part) integration
+            return integrate(x, u, h, substeps)
         for _ in range(substeps):
             x = sym.rk4_step(self.model.rhs, x, u, h / substeps)
         return x
@@ -267,11 +282,13 @@ class ShootingOCP:
             ubg.extend([0.0] * self.nx)
             # Path rows of node k+1, written through the stage's own variables (x_k, u_k)
             # so that each stage's slacks can relax them (see module docstring).
-            com = sym.centre_of_mass(robot, model.configuration(x_next))
             slack = slacks[k]
-            rows = [com[0] + slack[0], com[0] - slack[0], com[1] + slack[1], com[1] - slack[1]]
-            low = [-x_max, -INF, -y_max, -INF]
-            high = [INF, x_max, INF, y_max]
+            rows, low, high = [], [], []
+            for point in self._stability_points(k, xs[k], x_next, us[k]):
+                rows += [point[0] + slack[0], point[0] - slack[0]]
+                rows += [point[1] + slack[1], point[1] - slack[1]]
+                low += [-x_max, -INF, -y_max, -INF]
+                high += [INF, x_max, INF, y_max]
             for ox, oy, radius2 in clear:
                 rows.append((x_next[0] - ox) ** 2 + (x_next[1] - oy) ** 2 + slack[2])
                 low.append(radius2)
@@ -289,6 +306,39 @@ class ShootingOCP:
         self.ng = ng
         self.residual = self._residual(nodes, xs, us, slacks)
         self._bounds_and_linear_cost()
+
+    def _stability_points(self, k: int, x_k, x_next, u_k) -> list:
+        """The points held in the stability box for stage k: the centre of mass at node
+        k+1, and (dynamic) the zero moment point at both ends of the interval under u_k. At
+        the first stage the joints accelerate from the previous command's rates within the
+        control step (the change of rates over dt), where an abrupt change of the arm's
+        motion moves the centre of pressure most."""
+        robot, model = self.robot, self.model
+        points = [sym.centre_of_mass(robot, model.configuration(x_next))]
+        if not self.config.dynamic_stability:
+            return points
+        for end, x in enumerate((x_k, x_next)):
+            motion = model.base_motion(x, u_k)
+            if motion is None:
+                raise ParameterError("dynamic_stability needs the force-level model (thesis)")
+            joints = model.joint_motion(x, u_k)
+            if joints is not None:
+                rates, accelerations = joints  # the lagged arm: its own accelerations
+            else:
+                rates, accelerations = model.joint_rates(u_k), (0.0, 0.0)
+                if k == 0 and end == 0:
+                    previous = model.joint_rates(self.p[4 * self.N : 4 * self.N + self.num])
+                    accelerations = (
+                        (rates[0] - previous[0]) / self.dt,
+                        (rates[1] - previous[1]) / self.dt,
+                    )
+            q = model.configuration(x)
+            points.append(
+                sym.zero_moment_point(
+                    robot, q, rates, *motion, (accelerations[0], accelerations[1])
+                )
+            )
+        return points
 
     def _bounds_and_linear_cost(self) -> None:
         config, model = self.config, self.model
@@ -414,6 +464,10 @@ class ShootingOCP:
         s = self.x_slices[0]
         lower[s] = upper[s] = x0
         return lower, upper
+
+    def max_slack(self, w: np.ndarray) -> float:
+        """The largest constraint slack of a solution (0: every hard row met)."""
+        return max(float(np.max(w[s])) for s in self.slack_slices)
 
     def first_input(self, w: np.ndarray) -> np.ndarray:
         """``u_0`` of a solution (the model's input, without slacks)."""

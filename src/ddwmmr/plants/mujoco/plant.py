@@ -341,6 +341,12 @@ class MujocoPlant:
         self._judge_tipping(t + dt, dt)
 
     @property
+    def joint_time_constant(self) -> float:
+        """Time constant (s) with which the joints follow their rate targets (the velocity
+        servos' ``servo_time_constant``): what a controller may model of the arm."""
+        return self.options.servo_time_constant
+
+    @property
     def tip_time(self) -> float | None:
         """Time (s) since the reset at which the robot tipped over by the contact forces
         (:class:`TipDetector`, judged after every control step), None if it has not."""
