@@ -195,22 +195,12 @@ def zero_moment_point(
 
 
 def dynamic_stability(
-    k: ComCoefficients,
-    terms: InertialTerms,
-    th1,
-    th2,
-    rate1,
-    rate2,
-    v,
-    w,
-    v_dot,
-    w_dot,
-    acc1=0.0,
-    acc2=0.0,
+    k: ComCoefficients, terms: InertialTerms, *motion: float
 ) -> tuple[float, float, float]:
-    """``(S_lon, S_lat, S)`` at the zero moment point (capped like :func:`margins`)."""
-    point = zero_moment_point(k, terms, th1, th2, rate1, rate2, v, w, v_dot, w_dot, acc1, acc2)
-    return margins(k, *point)
+    """``(S_lon, S_lat, S)`` at the zero moment point (capped like :func:`margins`);
+    ``motion`` is :func:`zero_moment_point`'s ``th1, th2, rate1, rate2, v, w, v_dot, w_dot``
+    and optionally ``acc1, acc2``."""
+    return margins(k, *zero_moment_point(k, terms, *motion))
 
 
 def manipulability(th2: float) -> float:
