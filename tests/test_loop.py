@@ -153,3 +153,22 @@ def test_kinematic_plant_observation_is_a_copy():
     assert isinstance(obs, Observation)
     obs.q[0] = 99.0
     assert plant.observe().q[0] == 0.0
+
+
+def test_the_loop_tells_sampled_data_controllers_its_step():
+    """simulate(..., dt=0.01) on a trajectory of 0.02 s resolution: the mpc plans with the
+    0.01 s the loop holds its commands (its joint targets are th + rate dt), the qp looks
+    ahead 0.01 s; an explicit dt option still wins."""
+    from ddwmmr import Robot, simulate
+    from ddwmmr.controllers import make_controller
+    from ddwmmr.trajectories import Ellipse
+
+    robot = Robot()
+    for method in ("mpc", "qp"):
+        controller = make_controller(method, robot)
+        simulate(robot, Ellipse(), controller, dt=0.01, duration=0.05)
+        step = controller.dt if method == "mpc" else controller.ctx.dt
+        assert step == 0.01, method
+        fixed = make_controller(method, robot, dt=0.03)
+        simulate(robot, Ellipse(), fixed, dt=0.01, duration=0.05)
+        assert (fixed.dt if method == "mpc" else fixed.ctx.dt) == 0.03, method

@@ -119,10 +119,16 @@ def test_a_swinging_arm_turns_a_free_base_as_the_momentum_balance_says():
     )
 
 
-def test_a_plan_stuck_on_its_slack_restarts_and_the_scenario_finishes():
-    """Scenario 10 (seed 0) on MuJoCo: after the second waypoint the plan spun the base on
+def test_a_plan_stuck_on_its_slack_restarts_and_the_scenario_finishes(monkeypatch):
+    """Scenario 10 (seed 0) on MuJoCo: after the second waypoint the plan spins the base on
     the spot with the arm stretched at the dynamic floor, every plan needing slack, until
     the time limit; restarting cold after 0.5 s of that, it reaches every waypoint."""
-    outcome = run_scenario(generate(10, 0)[9], RunConfig(controller="mpc", plant="mujoco"))
+    from ddwmmr.mpc import controller as mpc_controller
+
+    scenario, config = generate(10, 0)[9], RunConfig(controller="mpc", plant="mujoco")
+    outcome = run_scenario(scenario, config)
     assert outcome.metrics["success"], outcome.metrics["reason"]
     assert outcome.metrics["waypoints_reached"] == 5
+    monkeypatch.setattr(mpc_controller, "STALL_SLACK", math.inf)  # the rule never fires
+    stuck = run_scenario(scenario, config).metrics
+    assert stuck["reason"] == "timeout" and stuck["waypoints_reached"] == 2

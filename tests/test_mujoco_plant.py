@@ -21,6 +21,7 @@ from ddwmmr.plants.mujoco.plant import (
 
 DT = 0.02
 ROBOT = Robot().with_payload(3.0)
+RNG_TILT = np.random.default_rng(3)
 
 
 def fresh(q0=(0.0, 0.0, 0.0, -0.3, 0.6), robot=ROBOT, **engine) -> MujocoPlant:
@@ -225,13 +226,14 @@ def test_tipping_criterion_on_recorded_series():
     weight = 100.0
     unloaded = 0.5 * UNLOADED_FRACTION * weight
     t = np.arange(0.0, 1.0, DT)
-    tilt = np.zeros_like(t)
+    tilt = 1e-3 * t  # pivoting: the tilt grows 2e-5 rad per sample, 1e-4 per 0.1 s
     needed = math.ceil(LIFT_TIME_S / DT)
     load = np.full_like(t, 10.0)
     load[10 : 10 + needed - 1] = unloaded  # one sample too short
     assert tip_time_s(t, load, tilt, weight) is None
     load[10 : 10 + needed] = unloaded
     assert tip_time_s(t, load, tilt, weight) == pytest.approx(t[10 + needed - 1])
+    assert tip_time_s(t, load, 0.5 * tilt, weight) is None  # tilting, but too little
     tilt[5] = 1.01 * TIP_TILT_RAD
     assert tip_time_s(t, load, tilt, weight) == pytest.approx(t[5])
 
@@ -282,9 +284,13 @@ def test_a_lifted_edge_tips_only_while_the_base_pivots_on():
     t = np.arange(0.0, 1.0, DT)
     load = np.full_like(t, 10.0)
     load[10 : 10 + 3 * needed] = unloaded
-    flat = np.full_like(t, 3e-4)
-    flat[10 : 10 + 3 * needed : 2] = 2.9e-4  # contact noise: the tilt wobbles
+    flat = np.full_like(t, 3e-4)  # exactly flat: balanced on the edge, not pivoting
     assert tip_time_s(t, load, flat, weight) is None
+    noisy = flat + RNG_TILT.normal(0.0, 1e-6, len(t))  # contact noise on a flat tilt
+    assert tip_time_s(t, load, noisy, weight) is None
+    wobble = flat.copy()
+    wobble[10 : 10 + 3 * needed : 2] = 2.9e-4
+    assert tip_time_s(t, load, wobble, weight) is None
     rocking = np.concatenate([np.linspace(0.0, 3e-3, 10 + needed // 2), np.full(len(t), 3e-3)])
     rocking = rocking[: len(t)].copy()
     rocking[10 + needed // 2 :] = np.linspace(3e-3, 0.0, len(t) - 10 - needed // 2)
@@ -323,3 +329,15 @@ def test_support_forces_match_a_contact_by_contact_readout():
     np.testing.assert_allclose(measured, forces, rtol=0, atol=1e-9)
     loaded = forces > 1e-12
     np.testing.assert_allclose(points[loaded], moments[loaded] / forces[loaded, None], atol=1e-12)
+
+
+def test_the_lift_time_is_time_not_a_sample_count():
+    """A detector made for 0.02 s samples and fed 0.002 s ones still needs 0.1 s of
+    pivoting (not five samples), as when a run changes its step after the reset."""
+    weight = 100.0
+    detector = TipDetector(weight, 0.02)
+    t = np.arange(0.0, 0.3, 0.002)
+    for time, tilt in zip(t, 1e-3 + 1e-2 * t):
+        if detector.update(float(time), 0.0, float(tilt)) is not None:
+            break
+    assert detector.tip_time == pytest.approx(LIFT_TIME_S - 0.02, abs=1e-9)

@@ -44,13 +44,30 @@ class StepInfo:
     extra: dict[str, float] = field(default_factory=dict)
 
 
+def control_step(
+    option: float | None, loop_step: float | None, trajectory: Any, default: float
+) -> float:
+    """The control step (s) a sampled-data controller plans with: its own ``dt`` option,
+    else the step the loop holds commands for (``adopt_control_step``), else the
+    trajectory's resolution ``duration / samples``, else ``default``."""
+    if option is not None:
+        return option
+    if loop_step is not None:
+        return loop_step
+    samples = getattr(trajectory, "samples", None)
+    duration = getattr(trajectory, "duration", None)
+    return duration / samples if samples and duration else default
+
+
 class Controller(Protocol):
     """Structural type of every controller.
 
     Optional members the simulation loop looks for (:mod:`ddwmmr.sim.loop`): ``interface``,
-    ``zero_order_hold``, ``wants_base_velocity`` and ``law(t, q, pose_d, velocity_d)``, the
+    ``zero_order_hold``, ``wants_base_velocity``, ``law(t, q, pose_d, velocity_d)`` (the
     control law on lists of floats that the integrator's stages call instead of
-    :meth:`command` (the closed-form methods have it).
+    :meth:`command`; the closed-form methods have it) and ``adopt_control_step(dt)``
+    (called before :meth:`reset` with the loop's step, s: controllers whose commands
+    depend on how long they are held plan with it, see :func:`control_step`).
     """
 
     name: str

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.commands import WheelForces
-from ddwmmr.controllers.base import StepInfo
+from ddwmmr.controllers.base import StepInfo, control_step
 from ddwmmr.errors import (
     ParameterError,
     check_bool,
@@ -168,6 +168,7 @@ class MPCControllerCore:
         self.track_orientation = check_bool("track_orientation", track_orientation)
         self.solver_name, self.qp_solver = solver, qp_solver
         self._dt_option = None if dt is None else check_positive("dt", dt)
+        self._loop_step: float | None = None
         self.dt = self._dt_option or DEFAULT_DT
         self._grid = {
             mode: self._grid_option(mode, horizon, intervals, first_interval, self.dt)
@@ -271,12 +272,14 @@ class MPCControllerCore:
         self._anchor_time = 0.0
         self.restarts = 0
 
+    def adopt_control_step(self, dt: float) -> None:
+        """The loop holds each command ``dt`` (s): plan with it (the first interval, the
+        joint targets ``th + rate dt``), unless ``dt`` was given as an option."""
+        self._loop_step = dt
+
     def reset(self, trajectory: Any, q0: np.ndarray) -> None:
-        """Forget warm starts and counters; take the control step from the trajectory."""
-        if self._dt_option is None:
-            samples = getattr(trajectory, "samples", None)
-            duration = getattr(trajectory, "duration", None)
-            self.dt = duration / samples if samples and duration else DEFAULT_DT
+        """Forget warm starts and counters; take the control step (:func:`control_step`)."""
+        self.dt = control_step(self._dt_option, self._loop_step, trajectory, DEFAULT_DT)
         self._trajectory = trajectory
         self.fallbacks = 0
         self.last = StepInfo()
@@ -314,8 +317,10 @@ class MPCControllerCore:
         target = (float(pose_d[0]), float(pose_d[1]))
         new_target = reach and self._target != target
         cold = self._warm is None or self._warm_mode != mode or new_target
-        stuck = self._stalled(t, q, new_target) or self._infeasible_too_long(t)
-        if reach and stuck and not cold:
+        stuck = reach and (self._stalled(t, q, new_target) or self._infeasible_too_long(t))
+        if cold:
+            self._infeasible_since = None  # a fresh plan gets its own 0.5 s
+        elif stuck:
             cold = True
             self.restarts += 1
         try:
@@ -393,12 +398,11 @@ class MPCControllerCore:
         xs, _ = ocp.trajectories(w)
         self._predicted_velocity = (float(xs[1][5]), float(xs[1][6]))
         if self.arm_time_constant is not None:  # the joints' rates have no sensor here
-            self._remember_arm(x0, r1, r2)
+            self._remember_arm(r1, r2)
         return WheelForces(float(u[0]), float(u[1]), th1 + r1 * self.dt, th2 + r2 * self.dt)
 
-    def _remember_arm(self, x0: np.ndarray, r1: float, r2: float) -> None:
-        """The lagged rates at the next step, from this step's (in x0) and the command."""
-        self._predicted_rates = (float(x0[7]), float(x0[8]))
+    def _remember_arm(self, r1: float, r2: float) -> None:
+        """The lagged rates at the next step, from this step's and the command."""
         self._predicted_rates = self._lagged_rates(r1, r2)
 
     def _lagged_rates(self, r1: float, r2: float) -> tuple[float, float]:
@@ -431,7 +435,7 @@ class MPCControllerCore:
         r2 = min(limit, max(-limit, float(u[3])))
         self._predicted_velocity = (v, w)
         if self.arm_time_constant is not None:
-            self._remember_arm(x0, r1, r2)
+            self._remember_arm(r1, r2)
         return WheelForces(f_left, f_right, float(q[3]) + r1 * self.dt, float(q[4]) + r2 * self.dt)
 
     def _make_fallback(self) -> Any:

@@ -35,8 +35,8 @@ written through ``x_{k+1} = RK4(x_k, u_k, h_k)`` so that each row involves one s
 variables only. ``S = stability_min + stability_margin``; the box on the centre of mass is
 the exact condition ``S_lon, S_lat >= S`` (see :func:`ddwmmr.model.symbolic.
 stability_bounds`): the nonlinear stability margin at every node, not a linearisation.
-With ``dynamic_stability`` (force-level model only) the box holds the zero moment point
-instead (:func:`ddwmmr.model.stability.zero_moment_point`: the centre of pressure with the
+With ``dynamic_stability`` (force-level model only) the box also holds the zero moment
+point (:func:`ddwmmr.model.stability.zero_moment_point`: the centre of pressure with the
 inertial forces of the base's acceleration, turn and the arm's motion), at both ends of
 every interval under that interval's input (so ``u_0`` itself is bounded at the measured
 state): ``S_dyn >= S``, the margin against tipping while moving, of which the static S is
@@ -146,7 +146,7 @@ class OCPConfig:
         min_horizon: lower bound on the free horizon T (s); reach_speed: m/s converting
             the distance left at T = horizon into seconds.
         stability_min: the floor S_min; stability_margin: the OCP keeps S >= S_min + margin.
-        dynamic_stability: bound the zero moment point instead of the centre of mass (the
+        dynamic_stability: bound the zero moment point too, besides the centre of mass (the
             model must have base dynamics).
         track_orientation: cost on the end-effector orientation.
         huber: Huber scale (m) of the position error, None for a pure quadratic.

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.controllers.base import StepInfo
+from ddwmmr.controllers.base import StepInfo, control_step
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
 from ddwmmr.model import Robot
@@ -226,6 +226,7 @@ class QPControllerCore:
         self.limits.extend(_pieces("limits", limits, Limit))
         self.problem = QPProblem(self.tasks, self.limits)
         self._dt_option = None if dt is None else check_positive("dt", dt)
+        self._loop_step: float | None = None
         self.ctx = StepContext(robot, self._dt_option or DEFAULT_DT)
         self.fallbacks = 0
         self.last = StepInfo()
@@ -235,12 +236,14 @@ class QPControllerCore:
         return make_backend(solver, warm_start)
 
     # -- controller protocol ------------------------------------------------------------
+    def adopt_control_step(self, dt: float) -> None:
+        """The loop holds each command ``dt`` (s): the look-ahead step, unless ``dt`` was
+        given as an option."""
+        self._loop_step = dt
+
     def reset(self, trajectory: Any, q0: np.ndarray) -> None:
-        """Forget warm starts and counters; take the look-ahead step from the trajectory."""
-        if self._dt_option is None:
-            samples = getattr(trajectory, "samples", None)
-            duration = getattr(trajectory, "duration", None)
-            self.ctx.dt = duration / samples if samples and duration else DEFAULT_DT
+        """Forget warm starts and counters; take the look-ahead step (:func:`control_step`)."""
+        self.ctx.dt = control_step(self._dt_option, self._loop_step, trajectory, DEFAULT_DT)
         self.backend.reset()
         self.ctx.previous_command = None
         self.fallbacks = 0

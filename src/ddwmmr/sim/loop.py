@@ -26,6 +26,9 @@ Controller contract (class attributes, all optional):
 * ``wants_base_velocity``: True passes the measured ``base_velocity=(v, w)`` to
   ``command`` (force-level controllers need it).
 * ``last``: a :class:`~ddwmmr.controllers.base.StepInfo` about the last command.
+* ``adopt_control_step(dt)``: called with the loop's step (s) before ``reset``; a
+  controller whose commands depend on how long they are held (the MPC's first interval and
+  joint targets, the QP's look-ahead) plans with it unless told otherwise.
 * ``law(t, q, pose_d, velocity_d) -> (u, ...)``: the control law on lists of floats, with
   no validation and no step info; when present, the integrator's stages call it instead
   of ``command`` (same numbers, a third of the cost). ``u`` is a tuple of 4 floats. A
@@ -160,6 +163,9 @@ def run_loop(
     """
     force = check_interface(controller, plant) == FORCE
     plant.reset(q0, dt)
+    adopt = getattr(controller, "adopt_control_step", None)
+    if adopt is not None:
+        adopt(dt)
     controller.reset(task.trajectory, np.array(q0, dtype=float))
     wants_velocity = getattr(controller, "wants_base_velocity", False)
     command_of = controller.command

@@ -56,6 +56,9 @@ SETTLE_DAMPING_TIME_S = 0.01
 UNLOADED_FRACTION = 1e-4
 #: ``tipped``: the base pivots about an unloaded edge, tilting further, this long (s) ...
 LIFT_TIME_S = 0.1
+#: ... and by at least this much (rad) since it began (a flat, noisy tilt is not pivoting;
+#: a base tipping at S = 0.98 gains 9e-4 rad in its first 0.1 s) ...
+PIVOT_GROWTH_RAD = 1e-4
 #: ... or the base tilted beyond this angle (rad; 5.7 deg, far beyond the contacts' own
 #: compliance: a base at rest leans at most ~6e-4 rad into its contacts).
 TIP_TILT_RAD = 0.1
@@ -530,8 +533,9 @@ class TipDetector:
 
     Args:
         weight_n: the robot's weight (N).
-        interval: time between samples (s); 0 when there is only one sample (then only the
-            tilt can say "tipped").
+        interval: the time (s) the first sample stands for (later samples: the time since
+            the one before, so a run may change its step); 0 when there is only one sample
+            (then only the tilt can say "tipped").
 
     :attr:`tip_time` is the time (s) of the first sample at which the criterion was met,
     None until then; it stays set.
@@ -539,9 +543,11 @@ class TipDetector:
 
     def __init__(self, weight_n: float, interval: float) -> None:
         self._unloaded_below = UNLOADED_FRACTION * weight_n
-        self._needed = max(1, math.ceil(LIFT_TIME_S / interval - 1e-9)) if interval > 0 else 0
-        self._run = 0  # consecutive samples pivoting: an edge unloaded, the tilt not falling
+        self._interval = interval
+        self._t: float | None = None  # time of the previous sample (s)
         self._tilt = -math.inf  # tilt of the previous sample (rad; none before the first)
+        self._pivot_time = 0.0  # s of consecutive samples pivoting on an unloaded edge
+        self._pivot_start = 0.0  # tilt (rad) before the pivoting began
         self.tip_time: float | None = None
 
     def unloaded(self, edge_load: float) -> bool:
@@ -551,12 +557,21 @@ class TipDetector:
     def update(self, t: float, edge_load: float, tilt: float) -> float | None:
         """Take the sample at t (s): smallest edge load (N) and base tilt (rad); return
         :attr:`tip_time`."""
-        if self.tip_time is None:
-            pivoting = self.unloaded(edge_load) and tilt >= self._tilt
-            self._run = self._run + 1 if pivoting else 0
-            self._tilt = tilt
-            if tilt > TIP_TILT_RAD or 0 < self._needed <= self._run:
-                self.tip_time = t
+        if self.tip_time is not None:
+            return self.tip_time
+        step = self._interval if self._t is None else t - self._t
+        pivoting = self.unloaded(edge_load) and tilt >= self._tilt
+        if pivoting and self._pivot_time == 0.0:
+            self._pivot_start = self._tilt if self._t is not None else tilt
+        self._pivot_time = self._pivot_time + step if pivoting else 0.0
+        self._t, self._tilt = t, tilt
+        lifted = (
+            self._interval > 0.0
+            and self._pivot_time >= LIFT_TIME_S - 1e-9
+            and tilt - self._pivot_start >= PIVOT_GROWTH_RAD
+        )
+        if tilt > TIP_TILT_RAD or lifted:
+            self.tip_time = t
         return self.tip_time
 
 
@@ -568,8 +583,9 @@ def tip_time_s(
     Tipped: the base pivots about an edge of the support polygon for at least
     :data:`LIFT_TIME_S` (consecutive samples, n samples spanning n sample intervals, at
     which the supports off the edge carry less than :data:`UNLOADED_FRACTION` of the weight
-    ``weight_n``, N, and the tilt has not decreased since the sample before), or the base
-    tilts beyond :data:`TIP_TILT_RAD`. A wheel that merely chatters on and off the floor,
+    ``weight_n``, N, and the tilt has not decreased since the sample before) and has
+    tilted by :data:`PIVOT_GROWTH_RAD` since it began, or the base tilts beyond
+    :data:`TIP_TILT_RAD`. A wheel that merely chatters on and off the floor,
     or a base that rocks onto an edge and back, lifts an edge without pivoting on: that is
     ``support_lost``, not tipped. The time returned is the sample where the criterion
     is first met. ``edge_load`` is the ``min_edge_load_n`` column, ``tilt`` the
