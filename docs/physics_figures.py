@@ -188,11 +188,13 @@ def slow_sideways_reach(payload: float = 3.2, rate: float = 0.05) -> str:
     right = [i for i, s in enumerate(plant.supports) if s.point[1] < 0]
     records = []
     steps = round(th2 / rate / DT) + round(1.0 / DT)
+    column = plant.extra_columns.index  # by name: the plant's columns may grow
+    physics, tilt = column("physics_stability"), column("base_tilt_rad")
     for k in range(steps):
         obs = plant.observe()
         values = plant.extra_values()
         forces = np.array(values[1 : 1 + len(names)])
-        records.append([k * DT, robot.stability(obs.q)[2], *forces, values[-3], values[-2]])
+        records.append([k * DT, robot.stability(obs.q)[2], *forces, values[physics], values[tilt]])
         plant.step(k * DT, np.array([0.0, 0.0, 0.0, -rate if obs.q[4] > 0 else 0.0]), DT)
     data = np.array(records)
     t, s = data[:, 0], data[:, 1]
