@@ -198,7 +198,7 @@ def test_run_record_holds_everything_to_rerun(tmp_path):
     assert trajectory["type"] == "samples" and trajectory["name"] == "figure8"
     data = Path(trajectory["file"]).read_bytes()
     assert trajectory["sha256"] == hashlib.sha256(data).hexdigest()
-    assert record["dt"] == 60.0 / 241 and record["duration"] == 1.0
+    assert record["dt"] == 60.0 / 240 and record["duration"] == 1.0  # the rows' spacing
     assert record["integrator"] == "rk4" and record["initial_offset"] == list(
         DEFAULT_INITIAL_OFFSET
     )
@@ -328,8 +328,8 @@ def test_integrator_needs_the_kinematic_plant(tmp_path, capsys):
 
 
 def test_default_step_on_the_physics_plant_is_a_whole_engine_multiple(tmp_path):
-    # sideways_reach has 401 samples over 8 s: 0.01995 s is no multiple of MuJoCo's 0.002 s
-    # step; the README's command must run at the rounded step, as simulate() does.
+    # The README's command runs at a whole multiple of MuJoCo's 0.002 s step, as simulate()
+    # rounds it (sideways_reach's rows are 0.02 s apart).
     out = tmp_path / "run"
     args = ["--method", "qp", "--traj", "sideways_reach", "--payload", "3", "--plant", "mujoco"]
     assert run([*args, "--duration", "0.2", "--no-plots", "--no-progress", "--out", str(out)]) == 0

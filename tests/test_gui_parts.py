@@ -129,7 +129,7 @@ def test_sampled_file_unchanged_without_geometry():
     own = geometry_of(base)
     xy = base.points[:, :2]
     assert own["a"] == pytest.approx((xy[:, 0].max() - xy[:, 0].min()) / 2)
-    assert own["N"] == len(base.times) and own["T"] == pytest.approx(base.duration)
+    assert own["N"] == len(base.times) - 1 and own["T"] == pytest.approx(base.duration)
 
 
 def test_sampled_placement_is_the_affine_map_of_the_samples():

@@ -209,7 +209,8 @@ def place_samples(base: SampledTrajectory, geometry: Mapping[str, float]) -> Sam
 
 def control_step(settings: Settings, trajectory: Any) -> float | None:
     """The step passed to simulate: the set dt, else T / N when N was changed for a sampled
-    trajectory (whose own resolution is its sample count), else None (simulate's T / N)."""
+    trajectory (whose own resolution is its number of sample intervals), else None
+    (simulate's T / N)."""
     if settings.dt is not None:
         return settings.dt
     if isinstance(trajectory, SampledTrajectory) and "N" in settings.geometry:

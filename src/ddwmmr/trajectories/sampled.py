@@ -122,8 +122,10 @@ class SampledTrajectory:
 
     @property
     def samples(self) -> int:
-        """Number of samples."""
-        return len(self.times)
+        """Resolution N of the trajectory protocol: the number of intervals between the
+        samples (rows - 1), so that ``duration / samples`` is their spacing for evenly
+        spaced rows (the default control step)."""
+        return len(self.times) - 1
 
     def _segment(self, t: float) -> tuple[int, float, float]:
         t_abs = min(max(t + self._knots[0], self._knots[0]), self._knots[-1])
