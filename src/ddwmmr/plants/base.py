@@ -66,7 +66,8 @@ class Plant(Protocol):
     that judge tipping over by their own physics (contact forces): when the robot tipped
     since the reset, None while it has not (the scenario protocol fails a run on it), and
     with it ``unloaded_time_s``, the time (s) since the reset with an edge of the support
-    polygon unloaded.
+    polygon unloaded; ``joint_time_constant`` (s), the lag with which the joints follow
+    their rate targets (the protocol's ``mpc`` models it).
     """
 
     name: str
