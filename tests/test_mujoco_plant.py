@@ -329,6 +329,9 @@ def test_support_forces_match_a_contact_by_contact_readout():
     np.testing.assert_allclose(measured, forces, rtol=0, atol=1e-9)
     loaded = forces > 1e-12
     np.testing.assert_allclose(points[loaded], moments[loaded] / forces[loaded, None], atol=1e-12)
+    # the tip criterion's lean reading is the geometry's edge loads of those forces
+    edge_loads = plant.geometry.edge_loads(forces)
+    assert plant._min_edge_load() == pytest.approx(float(np.min(edge_loads)), abs=1e-9)
 
 
 def test_the_lift_time_is_time_not_a_sample_count():

@@ -131,6 +131,8 @@ class MujocoPlant:
         self.supports = supports(robot)
         self.geometry = SupportGeometry([s.point for s in self.supports])
         self._nominal_points = np.array([s.point for s in self.supports], dtype=float)
+        #: per polygon edge, the supports off it (their load holds that edge down)
+        self._off_edge_supports = [np.flatnonzero(row).tolist() for row in self.geometry.off_edge]
         self.extra_columns = (
             "min_support_force_n",
             *(f"support_force_{s.name}_n" for s in self.supports),
@@ -143,6 +145,7 @@ class MujocoPlant:
         self.weight_n = float(np.sum(self.model.body_mass)) * -float(self.model.opt.gravity[2])
         self._limits = KinematicPlant(robot, "euler")
         self._ids = self._lookup_ids()
+        self._geom_support = self._ids["geom_support"].tolist()
         self._kv = self.model.actuator_gainprm[:, 0].copy()
         self._wheel_mode = VELOCITY
         self._force_buffer = np.zeros(6)
@@ -365,10 +368,7 @@ class MujocoPlant:
     def _judge_tipping(self, t: float, dt: float) -> None:
         """Feed the tip criterion the state at t (s), which ends a step of dt (s; 0: the
         reset's state)."""
-        # the two readings the criterion needs (the other columns cost twice as much)
-        edge_load = float(
-            np.min(self.geometry.edge_loads(self._per_support(*self._support_contacts())))
-        )
+        edge_load = self._min_edge_load()  # with the tilt: all the criterion needs
         self._tip.update(t, edge_load, self.base_tilt())
         if self._tip.unloaded(edge_load):
             self._unloaded_time += dt
@@ -418,12 +418,12 @@ class MujocoPlant:
         (m), in the order of :attr:`supports` (an unloaded support: 0 N at its nominal
         point)."""
         index, normal = self._support_contacts()
-        forces = self._per_support(index, normal)
+        forces = np.array(self._per_support(index, normal))
         ox, oy = self.data.xpos[self._ids["base"]][:2].tolist()
         c, s = math.cos(self._phi), math.sin(self._phi)
         moments = [[0.0, 0.0] for _ in self.supports]
         positions = self.data.contact.pos[: len(normal), :2].tolist()
-        for support, force, (px, py) in zip(index.tolist(), normal.tolist(), positions):
+        for support, force, (px, py) in zip(index, normal, positions):
             if support >= 0:
                 dx, dy = px - ox, py - oy
                 moments[support][0] += force * (c * dx + s * dy)
@@ -433,27 +433,35 @@ class MujocoPlant:
         points[loaded] = np.array(moments)[loaded] / forces[loaded, None]
         return forces, points
 
-    def _support_contacts(self) -> tuple[np.ndarray, np.ndarray]:
+    def _support_contacts(self) -> tuple[list[int], list[float]]:
         """For each active contact: the support it touches (-1: none) and its floor normal
-        force (N)."""
+        force (N). (Plain lists: a handful of contacts, read after every step.)"""
         model, data = self.model, self.data
         count = data.ncon
         contacts = data.contact
-        geom_support = self._ids["geom_support"]
-        index = np.maximum(
-            geom_support[contacts.geom1[:count]], geom_support[contacts.geom2[:count]]
-        )
-        normal = np.empty(count)
+        geom_support = self._geom_support
+        pairs = zip(contacts.geom1[:count].tolist(), contacts.geom2[:count].tolist())
+        index = [max(geom_support[a], geom_support[b]) for a, b in pairs]
+        normal = []
         buffer = self._force_buffer
         for i in range(count):
             mujoco.mj_contactForce(model, data, i, buffer)
-            normal[i] = buffer[0]
+            normal.append(float(buffer[0]))
         return index, normal
 
-    def _per_support(self, index: np.ndarray, normal: np.ndarray) -> np.ndarray:
+    def _per_support(self, index: list[int], normal: list[float]) -> list[float]:
         """Contact normal forces (N) summed per support."""
-        touching = index >= 0
-        return np.bincount(index[touching], weights=normal[touching], minlength=len(self.supports))
+        loads = [0.0] * len(self.supports)
+        for support, force in zip(index, normal):
+            if support >= 0:
+                loads[support] += force
+        return loads
+
+    def _min_edge_load(self) -> float:
+        """The smallest edge load (N) now: :meth:`SupportGeometry.edge_loads` on plain
+        lists, the one reading (with the tilt) the tip criterion needs after every step."""
+        loads = self._per_support(*self._support_contacts())
+        return min(sum(loads[i] for i in off) for off in self._off_edge_supports)
 
     def base_tilt(self) -> float:
         """Angle (rad) between the base's z axis and the vertical."""
