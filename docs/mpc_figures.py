@@ -7,7 +7,9 @@
 * ``mpc_rectangle.png``: position error on the default rectangle, mpc beside clrrmc-ts
   and qp (the corners);
 * ``mpc_horizon.png``: the horizon study (tracking error and step time against the
-  horizon on the rectangle; scenario time against the horizon on the thesis plant).
+  horizon on the rectangle; scenario time against the horizon on the thesis plant);
+* ``mpc_physics_tipping.png``: scenario 7 on the MuJoCo plant, mpc with its static floor
+  only and with the dynamic margin and the lagged arm (``--physics`` makes only this one).
 
 Prints every number it plots (medians over the runs; the machine may be shared).
 """
@@ -29,6 +31,8 @@ from ddwmmr.mpc.models import KinematicPrediction, ThesisPrediction
 from ddwmmr.mpc.ocp import OCPConfig
 from ddwmmr.plants.thesis import ThesisPlant
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
+from ddwmmr.scenarios.protocol import WaypointTask, _Tally, make_mpc, make_scenario_plant
+from ddwmmr.sim.loop import run_loop
 from ddwmmr.sim.loops import saturated_velocity_step, step_response, velocity_loop
 
 FIGURES = Path(__file__).parent / "figures"
@@ -195,11 +199,86 @@ def horizon_study(quick: bool) -> None:
     fig.savefig(FIGURES / "mpc_horizon.png", dpi=120)
 
 
+def physics_run(options: tuple, duration: float = 1.5) -> tuple[np.ndarray, float | None]:
+    """Scenario 7 (seed 0) on MuJoCo for ``duration`` s, not stopped when it tips: per step
+    t, static S, S_phys (the centre of pressure's margin), the smallest edge load (N), tilt
+    (rad); and the tip time."""
+    scenario, robot = generate(7, 0)[6], Robot().with_payload(3.0)
+    config = RunConfig(
+        controller="mpc", plant="mujoco", time_limit=duration, controller_options=options
+    )
+    plant = make_scenario_plant(robot, config)
+    controller = make_mpc(robot, scenario, config, plant)
+    tally = _Tally(robot, scenario, config)
+    task = WaypointTask(tally, controller, False, plant)
+    judge, rows = task.after_step, []
+    column = plant.extra_columns.index
+    physics, edge, tilt = (
+        column(n) for n in ("physics_stability", "min_edge_load_n", "base_tilt_rad")
+    )
+
+    def record(k, t, obs, applied):
+        judge(k, t, obs, applied)  # keeps the tallies; the run goes on after a tip
+        values = plant.extra_values()
+        rows.append(
+            (t + config.dt, robot.stability(obs.q)[2], values[physics], values[edge], values[tilt])
+        )
+        return False
+
+    task.after_step = record
+    q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
+    run_loop(plant, controller, task, q0, config.dt, tally.steps)
+    return np.array(rows), plant.tip_time
+
+
+def physics_tipping() -> None:
+    """Scenario 7 on MuJoCo: the static floor lets the base pivot; the dynamic margin does not."""
+    runs = {
+        "static floor only": physics_run(
+            (("dynamic_stability", False), ("arm_time_constant", None))
+        ),
+        "dynamic margin + lagged arm (the protocol's)": physics_run(()),
+    }
+    fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
+    for (label, (rows, tip)), color in zip(runs.items(), ("tab:red", "tab:blue")):
+        t = rows[:, 0]
+        axes[0].plot(t, rows[:, 1], color=color, label=label)
+        axes[1].plot(t, rows[:, 3], color=color, label=label)
+        axes[2].plot(t, np.degrees(rows[:, 4]), color=color, label=label)
+        if tip is not None:
+            for ax in axes:
+                ax.axvline(tip, color=color, lw=0.8, ls="--")
+            axes[2].annotate(
+                f" tipped (physics) at {tip:.2f} s", (tip, 1.8), color=color, fontsize=8
+            )
+        print(
+            f"{label}: tip {tip}, max tilt {np.degrees(rows[:, 4].max()):.2f} deg, "
+            f"min edge load {rows[:, 3].min():.1f} N, min static S {rows[:, 1].min():.3f}"
+        )
+    axes[0].axhline(1.25, color="k", lw=0.7)
+    axes[0].axhline(1.0, color="0.5", lw=0.7, ls="--")
+    axes[0].set_ylim(1.0, 2.2)
+    axes[0].set_ylabel("static S (floor 1.25)")
+    axes[0].legend(fontsize=7, loc="upper center")
+    axes[1].set_ylabel("smallest edge load (N)")
+    axes[2].set_ylabel("base tilt (deg)")
+    axes[2].set_xlabel("t (s)")
+    axes[1].legend(fontsize=7)
+    axes[0].set_title("Scenario 7 on MuJoCo, mpc turning with the 3 kg payload out", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(FIGURES / "mpc_physics_tipping.png", dpi=110)
+    plt.close(fig)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer scenarios in the study")
+    parser.add_argument("--physics", action="store_true", help="only mpc_physics_tipping.png")
     args = parser.parse_args()
     FIGURES.mkdir(exist_ok=True)
+    physics_tipping()
+    if args.physics:
+        return
     step_responses()
     rectangle()
     horizon_study(args.quick)
