@@ -253,3 +253,23 @@ def test_worker_turns_errors_into_one_line():
     assert first.error == "dt must be <= duration (1 s) (got 5)"
     assert second.state == "failed" and not second.bad_input
     assert second.error == "run failed: RuntimeError: boom"
+
+
+def test_the_summary_line_says_what_the_physics_plant_judged():
+    """On the MuJoCo plant the window's summary line gives the tip-over verdict of the
+    contact forces; on the other plants it says nothing about physics."""
+    from types import SimpleNamespace
+
+    from ddwmmr.gui.app import _summary_line
+
+    base = {
+        "rms_position_error_m": 0.01, "max_position_error_m": 0.02,
+        "rms_orientation_error_rad": 0.1, "max_wheel_speed_rad_s": 5.0,
+        "min_stability": 1.3, "min_manipulability": 0.8, "saturated_steps": 0,
+        "fallback_steps": 0,
+    }  # fmt: skip
+    assert "physics" not in _summary_line("A", SimpleNamespace(summary=base))
+    tipped = {**base, "tipped": True, "tip_time_s": 1.234, "min_physics_stability": 0.0}
+    assert "TIPPED at 1.23 s (physics)" in _summary_line("A", SimpleNamespace(summary=tipped))
+    stood = {**base, "tipped": False, "tip_time_s": None, "min_physics_stability": 1.21}
+    assert "stood (physics: min S_phys 1.21)" in _summary_line("A", SimpleNamespace(summary=stood))

@@ -725,7 +725,7 @@ def _optional_positive(name: str, text: str) -> float | None:
 
 def _summary_line(label: str, result: Any) -> str:
     s = result.summary
-    return (
+    line = (
         f"{label}: RMS pos {s['rms_position_error_m']:.3g} m,"
         f" max {s['max_position_error_m']:.3g} m,"
         f" RMS orient {s['rms_orientation_error_rad']:.3g} rad, max wheel"
@@ -733,3 +733,13 @@ def _summary_line(label: str, result: Any) -> str:
         f" min eta {s['min_manipulability']:.2f}, saturated {s['saturated_steps']},"
         f" fallbacks {s['fallback_steps']}"
     )
+    return line + _physics_verdict(s)
+
+
+def _physics_verdict(summary: dict[str, Any]) -> str:
+    """The physics plant's tip-over verdict for the summary line ('' on other plants)."""
+    if "tipped" not in summary:
+        return ""
+    if summary["tipped"]:
+        return f", TIPPED at {summary['tip_time_s']:.2f} s (physics)"
+    return f", stood (physics: min S_phys {summary['min_physics_stability']:.3g})"
