@@ -26,16 +26,11 @@ import numpy as np
 
 from ddwmmr.controllers.base import available_methods, make_controller
 from ddwmmr.errors import (
-    DURATION_RANGE_S,
-    LENGTH_RANGE_M,
-    MAX_ANGLE_RAD,
-    MAX_COORDINATE_M,
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
     check_finite,
     check_int_at_least,
     check_positive,
-    check_range,
 )
 from ddwmmr.gui.options import method_options, plant_keywords, plant_names
 from ddwmmr.model import Robot
@@ -43,6 +38,7 @@ from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
 from ddwmmr.sim import SimulationResult, simulate
 from ddwmmr.trajectories import SampledTrajectory, load_trajectory
+from ddwmmr.trajectories.parametric import check_geometry_value
 
 #: Trajectory geometry parameters, in panel order, with unit and allowed range.
 GEOMETRY = (
@@ -160,15 +156,9 @@ def check_geometry(name: str, value: float) -> float | int:
     of :mod:`ddwmmr.errors` the parametric trajectories enforce, so that a sampled
     trajectory placed by the same numbers is refused with a message naming the value."""
     if name == "N":
-        check_int_at_least("N", value, 2)
+        check_int_at_least("N", value, 2)  # "N >= 2" first, as the panel shows it
         return check_int_at_least("N", value, 2, MAX_TRAJECTORY_SAMPLES)
-    if name in ("a", "b", "T"):
-        check_positive(name, value)
-        low, high, unit = (*DURATION_RANGE_S, "s") if name == "T" else (*LENGTH_RANGE_M, "m")
-        return check_range(name, value, low, high, unit)
-    check_finite(name, value)
-    cap, unit = (MAX_ANGLE_RAD, "rad") if name == "beta" else (MAX_COORDINATE_M, "m")
-    return check_range(name, value, -cap, cap, unit)
+    return check_geometry_value(name, value)
 
 
 def build_trajectory(settings: Settings) -> Any:

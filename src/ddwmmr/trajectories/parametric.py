@@ -50,6 +50,20 @@ class _ArrayMath:
 _ARRAY_MATH = _ArrayMath()
 
 
+def check_geometry_value(name: str, value: float) -> float:
+    """One continuous geometry parameter of the parametric shapes, checked: ``a``, ``b``
+    (m) and ``T`` (s) positive, ``x0``, ``y0`` (m), ``beta``, ``phi`` (rad) finite, each
+    within the documented magnitudes of :mod:`ddwmmr.errors` (no overflow, no absurd
+    allocation later). Also what the GUI checks a sampled file's placement with."""
+    if name in ("a", "b", "T"):
+        check_positive(name, value)
+        low, high, unit = (*DURATION_RANGE_S, "s") if name == "T" else (*LENGTH_RANGE_M, "m")
+        return check_range(name, value, low, high, unit)
+    check_finite(name, value)
+    cap, unit = (MAX_ANGLE_RAD, "rad") if name in ("beta", "phi") else (MAX_COORDINATE_M, "m")
+    return check_range(name, value, -cap, cap, unit)
+
+
 @dataclass(frozen=True)
 class _Parametric(ABC):
     """Shared parameters and validation of the SPEC §2 trajectories."""
@@ -65,18 +79,8 @@ class _Parametric(ABC):
     phi: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("x0", "y0", "beta", "phi"):
-            object.__setattr__(self, name, check_finite(name, getattr(self, name)))
-        for name in ("a", "b", "T"):
-            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
-        # Documented magnitudes (ddwmmr.errors): no overflow, no absurd allocation later.
-        for name in ("x0", "y0"):
-            check_range(name, getattr(self, name), -MAX_COORDINATE_M, MAX_COORDINATE_M, "m")
-        for name in ("beta", "phi"):
-            check_range(name, getattr(self, name), -MAX_ANGLE_RAD, MAX_ANGLE_RAD, "rad")
-        for name in ("a", "b"):
-            check_range(name, getattr(self, name), *LENGTH_RANGE_M, "m")
-        check_range("T", self.T, *DURATION_RANGE_S, "s")
+        for name in ("x0", "y0", "beta", "phi", "a", "b", "T"):
+            object.__setattr__(self, name, check_geometry_value(name, getattr(self, name)))
         object.__setattr__(self, "N", check_int_at_least("N", self.N, 2, MAX_TRAJECTORY_SAMPLES))
         if self.orientation not in ORIENTATIONS:
             raise ParameterError(
