@@ -130,9 +130,6 @@ class MujocoPlant:
         self.data = mujoco.MjData(self.model)
         self.supports = supports(robot)
         self.geometry = SupportGeometry([s.point for s in self.supports])
-        self._nominal_points = np.array([s.point for s in self.supports], dtype=float)
-        #: per polygon edge, the supports off it (their load holds that edge down)
-        self._off_edge_supports = [np.flatnonzero(row).tolist() for row in self.geometry.off_edge]
         self.extra_columns = (
             "min_support_force_n",
             *(f"support_force_{s.name}_n" for s in self.supports),
@@ -156,6 +153,7 @@ class MujocoPlant:
         self._warnings = 0
         self._phi = 0.0
         self._cache: tuple[float, ...] | None = None
+        self._contacts: tuple[list[int], list[float]] | None = None  # of the current state
         self._tip = TipDetector(self.weight_n, 0.0)
         self._unloaded_time = 0.0  # s: control steps that ended with an edge unloaded
         mass = float(np.sum(self.model.body_mass))
@@ -271,7 +269,7 @@ class MujocoPlant:
         data.time = 0.0
         mujoco.mj_forward(model, data)
         self._phi = float(q0[2])
-        self._cache = None
+        self._cache = self._contacts = None
         self._tip = TipDetector(self.weight_n, self._dt)
         self._unloaded_time = 0.0
         self._judge_tipping(0.0, 0.0)
@@ -343,7 +341,7 @@ class MujocoPlant:
         self._step_count += 1
         mujoco.mj_forward(self.model, self.data)
         self._phi += wrap_angle(_heading(self.data.qpos[3:7]) - self._phi)
-        self._cache = None
+        self._cache = self._contacts = None
         self._judge_tipping(t + dt, dt)
 
     @property
@@ -428,14 +426,20 @@ class MujocoPlant:
                 dx, dy = px - ox, py - oy
                 moments[support][0] += force * (c * dx + s * dy)
                 moments[support][1] += force * (-s * dx + c * dy)
-        points = self._nominal_points.copy()
+        points = self.geometry.points.copy()
         loaded = forces > 1e-12
         points[loaded] = np.array(moments)[loaded] / forces[loaded, None]
         return forces, points
 
     def _support_contacts(self) -> tuple[list[int], list[float]]:
         """For each active contact: the support it touches (-1: none) and its floor normal
-        force (N). (Plain lists: a handful of contacts, read after every step.)"""
+        force (N). (Plain lists: a handful of contacts, read once per state: the tip
+        criterion and the recorded columns share it.)"""
+        if self._contacts is None:
+            self._contacts = self._read_contacts()
+        return self._contacts
+
+    def _read_contacts(self) -> tuple[list[int], list[float]]:
         model, data = self.model, self.data
         count = data.ncon
         contacts = data.contact
@@ -458,10 +462,9 @@ class MujocoPlant:
         return loads
 
     def _min_edge_load(self) -> float:
-        """The smallest edge load (N) now: :meth:`SupportGeometry.edge_loads` on plain
-        lists, the one reading (with the tilt) the tip criterion needs after every step."""
-        loads = self._per_support(*self._support_contacts())
-        return min(sum(loads[i] for i in off) for off in self._off_edge_supports)
+        """The smallest edge load (N) now, the one reading (with the tilt) the tip
+        criterion needs after every step."""
+        return self.geometry.min_edge_load(self._per_support(*self._support_contacts()))
 
     def base_tilt(self) -> float:
         """Angle (rad) between the base's z axis and the vertical."""

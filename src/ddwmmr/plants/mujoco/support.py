@@ -58,6 +58,7 @@ class SupportGeometry:
         distances = self.distances(self.points)  # (n, k)
         #: off_edge[e, i]: support i is not on edge e (its load keeps e from pivoting)
         self.off_edge = (np.abs(distances) > ON_EDGE_TOLERANCE).T
+        self._off_edge_lists = [np.flatnonzero(row).tolist() for row in self.off_edge]
 
     def distances(self, points) -> np.ndarray:
         """Signed distances (n, k) of points (n, 2) from each edge line (inside > 0), m."""
@@ -66,6 +67,11 @@ class SupportGeometry:
     def edge_loads(self, forces: np.ndarray) -> np.ndarray:
         """Load (N) on the supports off each edge, for support forces (n,) in N."""
         return self.off_edge @ forces
+
+    def min_edge_load(self, forces: list[float]) -> float:
+        """The smallest of :meth:`edge_loads` (N), on plain lists: a handful of supports,
+        read after every control step."""
+        return min(sum(forces[i] for i in off) for off in self._off_edge_lists)
 
     def stability(self, centre_of_pressure) -> float:
         """``S_phys`` of a centre of pressure (base frame, m); see the module docstring."""
