@@ -63,6 +63,7 @@ from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.sim import simulate
 from ddwmmr.sim.result import write_atomic
 from ddwmmr.trajectories import Ellipse
+from ddwmmr.trajectories.base import resolution_step
 
 #: Label of the naive pseudoinverse baseline row.
 NAIVE_LABEL = "naive-pinv"
@@ -795,7 +796,7 @@ def check_duration(trajectory: Any, duration: float | None) -> float:
     (checked before the benchmark starts, not in its first full run)."""
     if duration is None:
         return float(trajectory.duration)
-    dt = trajectory.duration / getattr(trajectory, "samples", 1000)  # simulate's default
+    dt = resolution_step(trajectory)  # simulate's default
     return check_range("duration", duration, dt, MAX_STEPS * dt, "s")
 
 
@@ -1207,7 +1208,7 @@ def build_parser() -> argparse.ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     ellipse = Ellipse()
-    dt = ellipse.duration / ellipse.samples
+    dt = resolution_step(ellipse)
     parser.add_argument(
         "--repeats",
         type=_repeat_count,

@@ -24,6 +24,7 @@ import numpy as np
 
 from ddwmmr.errors import ParameterError, check_instance
 from ddwmmr.model import Robot
+from ddwmmr.trajectories.base import resolution_step
 
 
 @dataclass
@@ -54,9 +55,9 @@ def control_step(
         return option
     if loop_step is not None:
         return loop_step
-    samples = getattr(trajectory, "samples", None)
-    duration = getattr(trajectory, "duration", None)
-    return duration / samples if samples and duration else default
+    if getattr(trajectory, "samples", None) and getattr(trajectory, "duration", None):
+        return resolution_step(trajectory)
+    return default
 
 
 class Controller(Protocol):

@@ -28,7 +28,7 @@ from ddwmmr.resolution.reference import (
 from ddwmmr.sim.loop import run_loop
 from ddwmmr.sim.result import SimulationResult
 from ddwmmr.sim.tracking import COLUMNS, TrackingTask
-from ddwmmr.trajectories.base import trajectory_name
+from ddwmmr.trajectories.base import resolution_step, trajectory_name
 
 __all__ = ["COLUMNS", "max_condition_number", "simulate", "summarize"]
 
@@ -161,18 +161,6 @@ def _plant(
     if resolved is not None:
         options.setdefault("integrator", resolved)
     return make_plant(plant, robot, **options)
-
-
-def resolution_step(trajectory: Any) -> float:
-    """The trajectory's own step (s): ``duration / samples`` (its resolution N), or
-    ``duration / 1000``."""
-    samples = getattr(trajectory, "samples", 1000)
-    number = isinstance(samples, int | float | np.integer | np.floating)
-    if isinstance(samples, bool) or not number or not (math.isfinite(samples) and samples > 0):
-        raise ParameterError(
-            f"trajectory: samples (its resolution N) must be a number > 0 (got {shown(samples)})"
-        )
-    return trajectory.duration / samples
 
 
 def default_step(trajectory: Any, plant: str, robot: Robot) -> float:

@@ -19,7 +19,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from ddwmmr.errors import check_finite
+from ddwmmr.errors import ParameterError, check_finite, shown
 from ddwmmr.inheritance import defining_class, overrides
 
 
@@ -75,3 +75,15 @@ def sampler(trajectory: Any) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndar
     if overrides(trajectory, owner, "pose") or overrides(trajectory, owner, "velocity"):
         return None
     return sample
+
+
+def resolution_step(trajectory: Any) -> float:
+    """The trajectory's own step (s): ``duration / samples`` (its resolution N), or
+    ``duration / 1000``."""
+    samples = getattr(trajectory, "samples", 1000)
+    number = isinstance(samples, int | float | np.integer | np.floating)
+    if isinstance(samples, bool) or not number or not (math.isfinite(samples) and samples > 0):
+        raise ParameterError(
+            f"trajectory: samples (its resolution N) must be a number > 0 (got {shown(samples)})"
+        )
+    return trajectory.duration / samples

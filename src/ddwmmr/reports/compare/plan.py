@@ -40,6 +40,7 @@ from ddwmmr.resolution.reference import (
     start_configuration,
 )
 from ddwmmr.sim.simulate import engine_multiple, simulate
+from ddwmmr.trajectories.base import resolution_step
 
 # -- configuration and plan ---------------------------------------------------------------
 
@@ -154,8 +155,9 @@ class Plan:
 
 
 def default_step(trajectory: Any) -> float:
-    """The simulation's default step (s): ``duration / samples`` of the trajectory."""
-    return trajectory.duration / getattr(trajectory, "samples", 1000)
+    """The simulation's default step (s) on the kinematic plant: the trajectory's
+    :func:`~ddwmmr.trajectories.base.resolution_step`."""
+    return resolution_step(trajectory)
 
 
 def run_duration(config: CompareConfig, name: str) -> float:
