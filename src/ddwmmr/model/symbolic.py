@@ -28,6 +28,7 @@ serves graph construction and evaluation.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -162,6 +163,12 @@ def rk4_step(rhs, x: Symbolic, u: Symbolic, h: float | Symbolic) -> Symbolic:
     return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
+def _trig(value: Symbolic) -> tuple[Callable, Callable]:
+    """``(cos, sin)`` for a value: ``math``'s for a plain number (float out), CasADi's for
+    a symbol."""
+    return (math.cos, math.sin) if isinstance(value, int | float) else (ca.cos, ca.sin)
+
+
 @dataclass(frozen=True)
 class ThesisDynamics:
     """Parameters and equations of the thesis plant's force-level model (SPEC §5).
@@ -234,9 +241,7 @@ class ThesisDynamics:
     # -- numbers ------------------------------------------------------------------------
     def inertia(self, th2: Symbolic) -> Symbolic:
         """Yaw inertia ``I(th2)`` (kg m^2); numbers in, float out."""
-        if isinstance(th2, int | float):
-            return self.inertia_fixed + self.inertia_cos * math.cos(th2)
-        return self.inertia_fixed + self.inertia_cos * ca.cos(th2)
+        return self.inertia_fixed + self.inertia_cos * _trig(th2)[0](th2)
 
     @property
     def top_speed(self) -> float:
@@ -267,9 +272,7 @@ class ThesisDynamics:
     def arm_momentum(self, th2, rates) -> Symbolic:
         """The arm's angular momentum ``H`` about the base centre from its own motion
         (kg m^2/s) at joint rates ``rates`` (rad/s)."""
-        k = 0.5 * self.inertia_cos
-        c = math.cos(th2) if isinstance(th2, int | float) else ca.cos(th2)
-        a, b = self.shoulder_fixed + k * c, self.elbow_fixed + k * c
+        a, b = self._arm_levers(_trig(th2)[0](th2))
         return a * rates[0] + b * (rates[0] + rates[1])
 
     def arm_yaw_reaction(self, th2, w, rates, accelerations) -> Symbolic:
@@ -277,18 +280,23 @@ class ThesisDynamics:
         angular momentum ``I(th2) w + H`` about the base centre changes only by the
         wheels' torque and the damping, so ``I wdot`` loses ``dI/dt w + dH/dt``. Joint
         rates (rad/s) and accelerations (rad/s^2), yaw rate w (rad/s)."""
-        k = 0.5 * self.inertia_cos
-        cos2, sin2 = (math.cos, math.sin) if isinstance(th2, int | float) else (ca.cos, ca.sin)
-        c, s = cos2(th2), sin2(th2)
+        cos, sin = _trig(th2)
+        a, b = self._arm_levers(cos(th2))
+        # d(cos th2)/dt times k: the rate of a and b, half the rate of I
+        k_rate = -0.5 * self.inertia_cos * sin(th2) * rates[1]
         rate12 = rates[0] + rates[1]
-        a, b = self.shoulder_fixed + k * c, self.elbow_fixed + k * c
         change = (
-            -2.0 * k * s * rates[1] * w  # dI/dt w
+            2.0 * k_rate * w  # dI/dt w
             + a * accelerations[0]
             + b * (accelerations[0] + accelerations[1])
-            - k * s * rates[1] * (rates[0] + rate12)  # da/dt th1dot + db/dt th12dot
+            + k_rate * (rates[0] + rate12)  # da/dt th1dot + db/dt th12dot
         )
         return -change / self.inertia(th2)
+
+    def _arm_levers(self, cos2) -> tuple[Symbolic, Symbolic]:
+        """``(a, b)`` of :meth:`arm_momentum` at ``cos th2`` (kg m^2)."""
+        k = 0.5 * self.inertia_cos
+        return self.shoulder_fixed + k * cos2, self.elbow_fixed + k * cos2
 
     def velocity_envelope(self, fraction: float = 0.8) -> dict[str, float]:
         """What a velocity command can ask of this base, as ``fraction`` of the physics.
