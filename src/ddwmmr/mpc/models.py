@@ -72,6 +72,12 @@ class PredictionModel(ABC):
         """The configuration part ``q`` of a state."""
         return x[:5]
 
+    def integrate(self, x: Any, u: Any, h: Any, substeps: int) -> Any:
+        """The state after h (s) under u held: RK4 in ``substeps`` equal sub-steps."""
+        for _ in range(substeps):
+            x = sym.rk4_step(self.rhs, x, u, h / substeps)
+        return x
+
     def base_motion(self, x: Any, u: Any) -> tuple[Any, Any, Any, Any] | None:
         """``(v, w, vdot, wdot)`` of the base at state x under input u (symbolic), None
         when the model has no base dynamics (then no dynamic tip-over margin)."""

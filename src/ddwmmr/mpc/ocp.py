@@ -250,15 +250,11 @@ class ShootingOCP:
         return float(self.lengths[k])
 
     def _integrate(self, x, u, h, nominal: float):
-        """The state after h (s) under u: RK4 in equal sub-steps, at most MAX_SUBSTEP long
-        at the interval's nominal length (reach mode only shortens intervals)."""
+        """The state after h (s) under u: the model's integration (RK4, or its own) in
+        equal sub-steps, at most MAX_SUBSTEP long at the interval's nominal length (reach
+        mode only shortens intervals)."""
         substeps = max(1, math.ceil(nominal / MAX_SUBSTEP - 1e-9))
-        integrate = getattr(self.model, "integrate", None)
-        if integrate is not None:  # a model with its own (exact, in part) integration
-            return integrate(x, u, h, substeps)
-        for _ in range(substeps):
-            x = sym.rk4_step(self.model.rhs, x, u, h / substeps)
-        return x
+        return self.model.integrate(x, u, h, substeps)
 
     def _build(self) -> None:
         config, model, robot = self.config, self.model, self.robot
