@@ -330,7 +330,7 @@ class WaypointTask:
         self.tally = tally
         self.controller = controller
         self.has_states = has_states
-        self._physics = tally.physics = plant if hasattr(plant, "tip_time") else None
+        tally.physics = plant if hasattr(plant, "tip_time") else None
         self._velocity_d = np.zeros(3)
         self._goal: tuple[float, float] | None = None
         self._pose_d = np.zeros(3)
@@ -387,13 +387,13 @@ class WaypointTask:
             base_moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
             self.tally.steps_base += int(base_moving)
         failed = self.tally.check(obs.q.tolist())
-        if failed or self._physics is None:
+        if failed or self.tally.physics is None:
             return failed
         return self._tipped_physically()
 
     def _tipped_physically(self) -> bool:
         """Physics plants: True (a failure) once the plant says the robot tipped over."""
-        if self._physics.tip_time is None:
+        if self.tally.physics.tip_time is None:
             return False
         self.tally.reason = "tipped (physics)"
         return True
