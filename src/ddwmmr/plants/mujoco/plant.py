@@ -374,8 +374,29 @@ class MujocoPlant:
     def _velocity_controls(self, q: np.ndarray, u: np.ndarray) -> None:
         applied, _ = self.limit(q, u)
         self._set_wheel_mode(VELOCITY)
-        left, right = self.robot.wheel_speeds_from_u(applied[0], applied[1])
-        self.data.ctrl[:] = (left, right, applied[2], applied[3])
+        v, w = float(applied[0]), float(applied[1])
+        left, right = self.robot.wheel_speeds_from_u(v, w)
+        lead_left, lead_right = self._damping_lead(v, w)
+        self.data.ctrl[:] = (left + lead_left, right + lead_right, applied[2], applied[3])
+
+    def _damping_lead(self, v: float, w: float) -> tuple[float, float]:
+        """Wheel-speed targets' lead (rad/s) feeding the base damping forward: the wheel
+        servos then hold ``(v, w)`` in steady state.
+
+        With ``base_damping`` the base needs the wheel forces ``(c1 v -+ c2 w / (track/2))
+        / 2`` to keep moving at ``(v, w)``; a proportional servo ``kv (target - rate)``
+        would fall short by ``torque / kv`` (at v = 1 m/s, w = -1 rad/s the yaw settled
+        20 % short). Raising the target by ``torque / kv`` makes the servo apply that
+        torque at the target speed, as the thesis plant's velocity servo feeds the damping
+        forward (docs/physics.md). Zero without damping."""
+        if self.base_damping is None:
+            return 0.0, 0.0
+        c_t, c_yaw = self.base_damping
+        robot = self.robot
+        drive, turn = 0.5 * c_t * v, c_yaw * w / robot.track_width
+        kv = self._kv[self._ids["wheel_actuators"][0]]
+        scale = robot.wheel_radius / kv
+        return (drive - turn) * scale, (drive + turn) * scale
 
     def _force_controls(self, q: np.ndarray, command: WheelForces, dt: float) -> None:
         values = (command.left, command.right, command.th1_target, command.th2_target)
