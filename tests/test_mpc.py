@@ -116,6 +116,29 @@ def test_stability_floor_holds_at_every_step_when_it_binds():
     assert controller.fallbacks == 0
 
 
+def test_the_input_change_cost_starts_from_the_applied_command(monkeypatch):
+    """When the exact one-step stability check scales the joint rates down, the next
+    plan's input-change cost is measured from the rates applied, not the planned ones."""
+    from ddwmmr.mpc import controller as mpc_controller
+
+    robot = Robot()
+    controller = make_controller("mpc", robot, dt=0.02)
+    trajectory = Ellipse()
+    q0 = robot.base_for_end_effector(trajectory.pose(0.0), *robot.home_pose)
+    controller.reset(trajectory, q0)
+    planned = {}
+
+    def halve(k, th1, th2, r1, r2, dt, floor):
+        planned["rates"] = (r1, r2)
+        return 0.5
+
+    monkeypatch.setattr(mpc_controller, "safe_arm_scale", halve)
+    u = controller.command(0.0, q0, trajectory.pose(0.0), trajectory.velocity(0.0))
+    assert abs(planned["rates"][0]) > 1e-3  # the plan moves the arm
+    np.testing.assert_allclose(u[2:], 0.5 * np.array(planned["rates"]), rtol=1e-12)
+    np.testing.assert_array_equal(controller._u_prev, u)
+
+
 def test_runs_are_deterministic():
     def run():
         controller = make_controller("mpc", HEAVY, model="thesis", track_orientation=False)

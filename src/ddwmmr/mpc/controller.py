@@ -335,9 +335,7 @@ class MPCControllerCore:
             self._infeasible_since = None
         elif self._infeasible_since is None:
             self._infeasible_since = t
-        u = problem.ocp.first_input(w)
-        self._u_prev = u
-        return self._output(problem, q, x0, u, w, iterations)
+        return self._output(problem, q, x0, problem.ocp.first_input(w), w, iterations)
 
     # -- pieces ---------------------------------------------------------------------------
     def _stalled(self, t: float, q: np.ndarray, new: bool) -> bool:
@@ -383,6 +381,8 @@ class MPCControllerCore:
         r1, r2 = float(u[2]), float(u[3])
         scale = safe_arm_scale(k, th1, th2, r1, r2, self.dt, self.stability_min)
         r1, r2 = r1 * scale, r2 * scale
+        # the next plan's input-change cost starts from what was applied (rates scaled)
+        self._u_prev = np.array([float(u[0]), float(u[1]), r1, r2])
         ocp = problem.ocp
         slack = ocp.max_slack(w)
         self.last = StepInfo(
