@@ -8,10 +8,12 @@ import casadi as ca
 import numpy as np
 import pytest
 
-from ddwmmr import ParameterError, Robot
+from ddwmmr import Ellipse, ParameterError, Robot, simulate
+from ddwmmr.commands import traits_of
 from ddwmmr.controllers import make_controller
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.models import LaggedArmPrediction
+from ddwmmr.plants import MujocoPlant
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 from ddwmmr.scenarios.protocol import make_mpc, make_scenario_plant
 
@@ -59,13 +61,48 @@ def test_bad_options_are_refused(options, match):
 
 
 def test_the_physics_plant_gets_the_dynamic_margin_and_the_lagged_arm():
+    """The loop hands the mpc its plant's traits: on a plant that takes forces and judges
+    tipping by its physics, the options not given become the force-level model, the
+    dynamic margin and the plant's joint lag; options given win; other plants change
+    nothing."""
     scenario = generate(1, 0)[0]
     physics = make_scenario_plant(ROBOT, RunConfig(plant="mujoco"))
-    mpc = make_mpc(ROBOT, scenario, RunConfig(controller="mpc", plant="mujoco"), physics)
+    traits = traits_of(physics)
+    mpc = make_controller("mpc", ROBOT)
+    assert mpc.model_name == "kinematic" and mpc.interface == "velocity"  # not known yet
+    mpc.adopt_plant(traits)
+    assert (mpc.model_name, mpc.interface, mpc.wants_base_velocity) == ("thesis", "force", True)
     assert mpc.dynamic_stability and mpc.arm_time_constant == physics.joint_time_constant
+    protocol = make_mpc(ROBOT, scenario, RunConfig(controller="mpc", plant="mujoco"), physics)
+    protocol.adopt_plant(traits)
+    assert protocol.dynamic_stability and protocol.arm_time_constant == physics.joint_time_constant
+    static = make_controller("mpc", ROBOT, model="thesis", dynamic_stability=False)
+    static.adopt_plant(traits)
+    assert not static.dynamic_stability and static.arm_time_constant is None
+    kinematic = make_controller("mpc", ROBOT, model="kinematic")
+    kinematic.adopt_plant(traits)
+    assert kinematic.model_name == "kinematic" and not kinematic.dynamic_stability
     thesis = make_scenario_plant(ROBOT, RunConfig())
     plain = make_mpc(ROBOT, scenario, RunConfig(controller="mpc"), thesis)
-    assert not plain.dynamic_stability and plain.arm_time_constant is None
+    plain.adopt_plant(traits_of(thesis))
+    assert plain.model_name == "thesis" and not plain.dynamic_stability
+    assert plain.arm_time_constant is None
+    default = make_controller("mpc", ROBOT)
+    default.adopt_plant(traits_of(thesis))  # takes forces, but its tipping is the formula's
+    assert default.model_name == "kinematic"
+
+
+def test_simulate_on_the_physics_plant_runs_the_force_model_with_the_dynamic_margin():
+    """``simulate(..., plant=MujocoPlant)`` with the mpc's defaults: the loop's traits make
+    it the force-level mpc with the dynamic margin (the kinematic model there planned
+    velocity jumps the torque-limited base could not follow: on the whole ellipse a wheel
+    slipped at 1.6 m/s and an edge of the support polygon lost its load)."""
+    plant = MujocoPlant(ROBOT)
+    result = simulate(ROBOT, Ellipse(T=1.0, N=50), "mpc", plant=plant)
+    summary = result.summary
+    assert summary["mpc_model"] == "thesis" and summary["mpc_dynamic_stability"]
+    assert summary["mpc_arm_time_constant_s"] == plant.joint_time_constant
+    assert not summary["tipped"] and summary["mpc_fallbacks"] == 0
 
 
 def test_the_static_floor_tips_the_physics_plant_and_the_dynamic_margin_does_not():

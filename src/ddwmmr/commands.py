@@ -16,6 +16,7 @@ accepts one or both of two command interfaces (``Plant.interfaces``):
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 #: The command interfaces, by name.
 VELOCITY, FORCE = "velocity", "force"
@@ -41,3 +42,30 @@ class WheelForces:
 def interface_of(command: object) -> str:
     """``"force"`` for a :class:`WheelForces`, else ``"velocity"`` (an array-like u)."""
     return FORCE if isinstance(command, WheelForces) else VELOCITY
+
+
+@dataclass(frozen=True)
+class PlantTraits:
+    """What a controller may know of the plant it is about to command: plain facts, handed
+    over by the simulation loop (``adopt_plant``; the controller never sees the plant).
+
+    Attributes:
+        interfaces: the command interfaces the plant accepts (``"velocity"``, ``"force"``).
+        judges_tipping: the plant judges tipping over by its own physics (contact forces:
+            ``Plant.tip_time``).
+        joint_time_constant: the lag (s) with which its joints follow their rate targets,
+            None if they follow at once.
+    """
+
+    interfaces: tuple[str, ...]
+    judges_tipping: bool
+    joint_time_constant: float | None
+
+
+def traits_of(plant: Any) -> PlantTraits:
+    """The :class:`PlantTraits` of a plant (read from its attributes)."""
+    return PlantTraits(
+        tuple(plant.interfaces),
+        hasattr(plant, "tip_time"),
+        getattr(plant, "joint_time_constant", None),
+    )

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.commands import WheelForces
+from ddwmmr.commands import FORCE, PlantTraits, WheelForces
 from ddwmmr.controllers.base import StepInfo, control_step
 from ddwmmr.errors import (
     ParameterError,
@@ -78,7 +78,9 @@ class MPCControllerCore:
         robot: the robot (payload included).
         model: ``"kinematic"`` (velocity commands, the kinematic plant) or ``"thesis"``
             (wheel forces, the thesis plant's force-level dynamics; needs the measured base
-            velocities, ``base_velocity=(v, w)``).
+            velocities, ``base_velocity=(v, w)``); None (default): chosen for the plant the
+            loop runs it on (:meth:`adopt_plant`: ``"thesis"`` on a plant that takes wheel
+            forces and judges tipping by its physics, else ``"kinematic"``).
         stability_min: floor S_min of the tip-over margin (hard, exact at every node).
         manipulability_weight: weight of ``cos^2 th2`` (soft).
         obstacles: circles (``Circle`` or (x, y, radius) triples, m) or a TOML file path;
@@ -98,10 +100,13 @@ class MPCControllerCore:
         stability_margin: the OCP keeps ``S >= stability_min + stability_margin``.
         dynamic_stability: hold the floor on the zero moment point too, the centre of
             pressure with the inertial forces of turning and accelerating
-            (``model="thesis"`` only; docs/mpc.md), besides the static centre of mass.
+            (``model="thesis"`` only; docs/mpc.md), besides the static centre of mass; None
+            (default): on exactly when the model was chosen for a physics plant.
         arm_time_constant: the joints follow the commanded rates with this first-order lag
             (s) in the prediction (``model="thesis"`` only; the physics plant's joint
-            servos have one); None (default): they move at the commanded rates at once.
+            servos have one); None (default): that plant's lag when the model was chosen for
+            it (and ``dynamic_stability`` not given), else none: the joints move at the
+            commanded rates at once.
         dt: control step (s); default the trajectory's ``duration / samples`` at reset,
             else 0.02 s.
         fallback_options: options of the ``qp`` fallback controller (merged over the
@@ -115,7 +120,7 @@ class MPCControllerCore:
     def __init__(
         self,
         robot: Robot,
-        model: str = "kinematic",
+        model: str | None = None,
         stability_min: float = 1.25,
         manipulability_weight: float = 0.5,
         obstacles: Sequence[Any] | str = (),
@@ -132,13 +137,13 @@ class MPCControllerCore:
         reach_speed: float = 0.05,
         proximal: float = 0.01,
         stability_margin: float = 0.01,
-        dynamic_stability: bool = False,
+        dynamic_stability: bool | None = None,
         arm_time_constant: float | None = None,
         obstacle_margin: float = 0.05,
         dt: float | None = None,
         fallback_options: dict[str, Any] | None = None,
     ) -> None:
-        if model not in MODELS:
+        if model is not None and model not in MODELS:
             raise ParameterError(f"model must be one of {', '.join(MODELS)} (got {model!r})")
         if solver not in SOLVERS:
             raise ParameterError(f"solver must be one of {', '.join(SOLVERS)} (got {solver!r})")
@@ -147,20 +152,16 @@ class MPCControllerCore:
                 f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {qp_solver!r})"
             )
         self.robot = robot
-        self.model_name = model
-        self.dynamics = sym.ThesisDynamics.from_robot(robot) if model == "thesis" else None
-        self.arm_time_constant = (
+        self._model_option = model
+        self._lag_option = (
             None
             if arm_time_constant is None
             else check_range("arm_time_constant", arm_time_constant, 1e-3, 1.0, "s")
         )
-        if self.arm_time_constant is not None and model != "thesis":
-            raise ParameterError("arm_time_constant needs model='thesis'")
-        self.model: PredictionModel = make_model(
-            model, robot, self.dynamics, self.arm_time_constant
-        )
-        self.interface = self.model.interface
-        self.wants_base_velocity = model == "thesis"
+        self._dynamic_option = None
+        if dynamic_stability is not None:
+            self._dynamic_option = check_bool("dynamic_stability", dynamic_stability)
+        self._configure(*self._resolve(None))
         self.stability_min = check_positive("stability_min", stability_min)
         if self.stability_min >= 10.0:
             raise ParameterError(f"stability_min must be in (0, 10) (got {stability_min:g})")
@@ -193,16 +194,9 @@ class MPCControllerCore:
         self.reach_speed = check_positive("reach_speed", reach_speed)
         self.proximal = check_nonnegative("proximal", proximal)
         self.stability_margin = check_nonnegative("stability_margin", stability_margin)
-        self.dynamic_stability = check_bool("dynamic_stability", dynamic_stability)
-        if self.dynamic_stability and model != "thesis":
-            raise ParameterError(
-                "dynamic_stability needs model='thesis' (the kinematic model has no base "
-                "accelerations)"
-            )
         self.obstacle_margin = check_nonnegative("obstacle_margin", obstacle_margin)
         self._fallback_options = dict(fallback_options or {})
         self._fallback: Any = None
-        self._problems: dict[tuple[str, float], _Problem] = {}
         self._trajectory: Any = None
         self.fallbacks = 0
         #: Message of the last solver failure (None before any).
@@ -211,6 +205,46 @@ class MPCControllerCore:
         self._reset_memory()
 
     # -- options ----------------------------------------------------------------------------
+    def _resolve(self, plant: PlantTraits | None) -> tuple[str, bool, float | None]:
+        """``(model, dynamic_stability, arm_time_constant)``: the options given, else what
+        suits ``plant`` (None: not known yet). On a plant that takes wheel forces and judges
+        tipping by its physics: the force-level model, the floor on the dynamic margin and
+        the plant's joint lag (the static floor alone tipped 94 of 100 scenarios there,
+        docs/mpc.md); elsewhere the kinematic model, static floor, no lag."""
+        physics = plant is not None and plant.judges_tipping and FORCE in plant.interfaces
+        model = self._model_option or ("thesis" if physics else "kinematic")
+        chosen = physics and model == "thesis"
+        dynamic = self._dynamic_option if self._dynamic_option is not None else chosen
+        lag = self._lag_option
+        if lag is None and chosen and self._dynamic_option is None:
+            lag = plant.joint_time_constant  # type: ignore[union-attr]
+        return model, dynamic, lag
+
+    def _configure(self, model: str, dynamic_stability: bool, lag: float | None) -> None:
+        """Set the prediction model and its options (problems are rebuilt on demand)."""
+        if lag is not None and model != "thesis":
+            raise ParameterError("arm_time_constant needs model='thesis'")
+        if dynamic_stability and model != "thesis":
+            raise ParameterError(
+                "dynamic_stability needs model='thesis' (the kinematic model has no base "
+                "accelerations)"
+            )
+        self.model_name = model
+        self.dynamics = sym.ThesisDynamics.from_robot(self.robot) if model == "thesis" else None
+        self.arm_time_constant = lag
+        self.dynamic_stability = dynamic_stability
+        self.model: PredictionModel = make_model(model, self.robot, self.dynamics, lag)
+        self.interface = self.model.interface
+        self.wants_base_velocity = model == "thesis"
+        self._problems: dict[tuple[str, float], _Problem] = {}
+
+    def adopt_plant(self, plant: PlantTraits) -> None:
+        """The loop's plant, described (:func:`ddwmmr.commands.traits_of`): options not
+        given are chosen for it (:meth:`_resolve`), before ``reset``."""
+        choice = self._resolve(plant)
+        if choice != (self.model_name, self.dynamic_stability, self.arm_time_constant):
+            self._configure(*choice)
+
     @staticmethod
     def _grid_option(mode, horizon, intervals, first_interval, dt) -> tuple[int, float, float]:
         n0, h0, t0 = GRID_DEFAULTS[mode]

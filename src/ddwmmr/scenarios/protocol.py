@@ -469,11 +469,12 @@ def make_mpc(robot: Robot, scenario: Scenario, config: RunConfig, plant: Plant) 
     (the thesis plant, the physics plant with the thesis damping), with the kinematic model
     on the kinematic plant. Its stability floor is the qp's (``qp_stability_min``).
 
-    On a plant that judges tipping by its physics (``tip_time``) the floor holds on the
-    dynamic margin too (``dynamic_stability``: the centre of pressure of a robot that turns
-    and accelerates), with the joints lagging as that plant's servos do
-    (``arm_time_constant`` = ``plant.joint_time_constant``): the static floor alone tipped
-    the robot over in 94 of 100 scenarios (docs/mpc.md)."""
+    On a plant that judges tipping by its physics (``tip_time``) the mpc itself holds the
+    floor on the dynamic margin too (``dynamic_stability``: the centre of pressure of a
+    robot that turns and accelerates), with the joints lagging as that plant's servos do
+    (``arm_time_constant`` = ``plant.joint_time_constant``), when the loop hands it the
+    plant's traits (``adopt_plant``): the static floor alone tipped the robot over in 94 of
+    100 scenarios (docs/mpc.md)."""
     from ddwmmr.controllers import make_controller
 
     model = "thesis" if "force" in plant.interfaces else "kinematic"
@@ -484,9 +485,6 @@ def make_mpc(robot: Robot, scenario: Scenario, config: RunConfig, plant: Plant) 
         "obstacles": [tuple(o) for o in scenario.obstacles],
         "dt": config.dt,
     }
-    if model == "thesis" and hasattr(plant, "tip_time"):
-        options["dynamic_stability"] = True
-        options["arm_time_constant"] = getattr(plant, "joint_time_constant", None)
     options.update(dict(config.controller_options))
     return make_controller("mpc", robot, **options)
 

@@ -26,6 +26,10 @@ Controller contract (class attributes, all optional):
 * ``wants_base_velocity``: True passes the measured ``base_velocity=(v, w)`` to
   ``command`` (force-level controllers need it).
 * ``last``: a :class:`~ddwmmr.controllers.base.StepInfo` about the last command.
+* ``adopt_plant(traits)``: called first with the plant's
+  :class:`~ddwmmr.commands.PlantTraits` (its interfaces, whether it judges tipping by its
+  physics, its joints' lag); a controller may choose the options it was not given for
+  that plant (the ``mpc``'s force-level model and dynamic margin on the physics plant).
 * ``adopt_control_step(dt)``: called with the loop's step (s) before ``reset``; a
   controller whose commands depend on how long they are held (the MPC's first interval and
   joint targets, the QP's look-ahead) plans with it unless told otherwise.
@@ -45,7 +49,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ddwmmr.commands import FORCE, VELOCITY
+from ddwmmr.commands import FORCE, VELOCITY, traits_of
 from ddwmmr.errors import ParameterError
 from ddwmmr.inheritance import defining_class, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
@@ -161,6 +165,9 @@ def run_loop(
     The plant and the controller are reset first. See the module docstring for the
     sequence of one sample and the controller contract.
     """
+    adopt_plant = getattr(controller, "adopt_plant", None)
+    if adopt_plant is not None:
+        adopt_plant(traits_of(plant))
     force = check_interface(controller, plant) == FORCE
     plant.reset(q0, dt)
     adopt = getattr(controller, "adopt_control_step", None)
