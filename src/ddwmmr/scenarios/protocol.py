@@ -54,7 +54,7 @@ from ddwmmr.arbiters.state_machine import (
 from ddwmmr.behaviours.controller import ThesisController
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.behaviours.obstacle import base_bubble
-from ddwmmr.commands import WheelForces
+from ddwmmr.commands import WheelForces, traits_of
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_terms
@@ -330,7 +330,7 @@ class WaypointTask:
         self.tally = tally
         self.controller = controller
         self.has_states = has_states
-        tally.physics = plant if hasattr(plant, "tip_time") else None
+        tally.physics = plant if plant is not None and traits_of(plant).judges_tipping else None
         self._velocity_d = np.zeros(3)
         self._goal: tuple[float, float] | None = None
         self._pose_d = np.zeros(3)
