@@ -235,7 +235,7 @@ def physics_tipping() -> None:
     """Scenario 7 on MuJoCo: the static floor lets the base pivot; the dynamic margin does not."""
     runs = {
         "static floor only": physics_run(
-            (("dynamic_stability", False), ("arm_time_constant", None))
+            (("dynamic_stability", False), ("arm_time_constant", 0.0))
         ),
         "dynamic margin + lagged arm (the protocol's)": physics_run(()),
     }

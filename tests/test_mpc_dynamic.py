@@ -50,7 +50,7 @@ def test_the_lagged_arm_is_integrated_like_its_own_ode():
     [
         ({"model": "kinematic", "dynamic_stability": True}, "dynamic_stability"),
         ({"model": "kinematic", "arm_time_constant": 0.02}, "arm_time_constant"),
-        ({"model": "thesis", "arm_time_constant": 0.0}, "arm_time_constant"),
+        ({"model": "thesis", "arm_time_constant": 5e-4}, "arm_time_constant"),
         ({"model": "thesis", "arm_time_constant": 5.0}, "arm_time_constant"),
         ({"model": "thesis", "dynamic_stability": "yes"}, "dynamic_stability"),
     ],
@@ -76,9 +76,17 @@ def test_the_physics_plant_gets_the_dynamic_margin_and_the_lagged_arm():
     protocol = make_mpc(ROBOT, scenario, RunConfig(controller="mpc", plant="mujoco"), physics)
     protocol.adopt_plant(traits)
     assert protocol.dynamic_stability and protocol.arm_time_constant == physics.joint_time_constant
-    static = make_controller("mpc", ROBOT, model="thesis", dynamic_stability=False)
+    static = make_controller("mpc", ROBOT, dynamic_stability=False, arm_time_constant=0.0)
     static.adopt_plant(traits)
-    assert not static.dynamic_stability and static.arm_time_constant is None
+    assert static.model_name == "thesis" and not static.dynamic_stability
+    assert static.arm_time_constant is None  # 0: no lag
+    asked = make_controller("mpc", ROBOT, dynamic_stability=True)  # what it would choose
+    assert asked.model_name == "thesis"  # a force-model option implies the force model
+    asked.adopt_plant(traits)
+    assert asked.arm_time_constant == physics.joint_time_constant
+    floor_only = make_controller("mpc", ROBOT, dynamic_stability=False)
+    floor_only.adopt_plant(traits)  # the lag is the plant's all the same
+    assert floor_only.arm_time_constant == physics.joint_time_constant
     kinematic = make_controller("mpc", ROBOT, model="kinematic")
     kinematic.adopt_plant(traits)
     assert kinematic.model_name == "kinematic" and not kinematic.dynamic_stability
@@ -110,7 +118,7 @@ def test_the_static_floor_tips_the_physics_plant_and_the_dynamic_margin_does_not
     floor alone lets the outer edge take all the load within 0.6 s; holding the zero
     moment point with the lagged arm, the robot stays on all its supports."""
     scenario = generate(7, 0)[6]
-    static = (("dynamic_stability", False), ("arm_time_constant", None))
+    static = (("dynamic_stability", False), ("arm_time_constant", 0.0))
     config = RunConfig(controller="mpc", plant="mujoco", time_limit=3.0)
     tipped = run_scenario(scenario, replace(config, controller_options=static))
     assert tipped.metrics["reason"] == "tipped (physics)" and tipped.metrics["time_s"] < 0.8

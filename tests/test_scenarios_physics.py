@@ -56,12 +56,18 @@ def test_the_velocity_servos_feed_the_base_damping_forward():
     for k in range(300):
         damped.step(0.01 * k, np.array([0.8, 0.0, 0.0, 0.0]), 0.01)
     assert damped.observe().v == pytest.approx(0.8, abs=2e-3)
-    kv = float(damped.model.actuator_gainprm[0, 0])  # the wheel servo's gain (N m s/rad)
-    r = robot.wheel_radius
-    left, right = damped._damping_lead(0.8, 0.0)  # each wheel pulls half of c1 v
+    damped.reset(q0, 0.01)
+    for k in range(300):  # turning in place: the couple of the yaw damping
+        damped.step(0.01 * k, np.array([0.0, 1.0, 0.0, 0.0]), 0.01)
+    assert damped.observe().w == pytest.approx(1.0, abs=0.02)  # 0.85 without the lead
+    narrow = Robot(track_width=0.3).with_payload(3.0)  # wheels inside the 0.35 m footprint
+    plant = MujocoPlant(narrow, base_damping=(15.0, 4.0))
+    kv = float(plant.model.actuator_gainprm[0, 0])  # the wheel servo's gain (N m s/rad)
+    r = narrow.wheel_radius
+    left, right = plant._damping_lead(0.8, 0.0)  # each wheel pulls half of c1 v
     assert left == right == pytest.approx(0.5 * 15.0 * 0.8 * r / kv, rel=1e-12)
-    left, right = damped._damping_lead(0.0, 1.0)  # a wheel pair's couple of c2 w
-    assert right == pytest.approx(-left) == pytest.approx(4.0 / robot.track_width * r / kv)
+    left, right = plant._damping_lead(0.0, 1.0)  # the wheels' couple (lever track/2) of c2 w
+    assert right == pytest.approx(-left) == pytest.approx(4.0 / 0.3 * r / kv, rel=1e-12)
     assert MujocoPlant(robot)._damping_lead(0.8, 1.0) == (0.0, 0.0)  # no damping, no lead
 
 

@@ -68,7 +68,9 @@ class Controller(Protocol):
     control law on lists of floats that the integrator's stages call instead of
     :meth:`command`; the closed-form methods have it) and ``adopt_control_step(dt)``
     (called before :meth:`reset` with the loop's step, s: controllers whose commands
-    depend on how long they are held plan with it, see :func:`control_step`).
+    depend on how long they are held plan with it, see :func:`control_step`), and before
+    it ``adopt_plant(traits)`` (the plant's :class:`~ddwmmr.commands.PlantTraits`: a
+    controller may choose the options it was not given for that plant).
     """
 
     name: str

@@ -8,7 +8,7 @@ obstacle constraints likewise; manipulability is a soft cost. The previous solut
 shifted, warm-starts one Gauss-Newton iteration per step (the real-time iteration) with the
 structure-exploiting QP solver HPIPM::
 
-    make_controller("mpc", Robot())            # kinematic model (force model on MuJoCo)
+    make_controller("mpc", Robot())    # kinematic model (run on MuJoCo: the force model)
     make_controller("mpc", Robot().with_payload(3.0), model="thesis",
                     track_orientation=False)                          # wheel forces
 

@@ -80,7 +80,8 @@ class MPCControllerCore:
             (wheel forces, the thesis plant's force-level dynamics; needs the measured base
             velocities, ``base_velocity=(v, w)``); None (default): chosen for the plant the
             loop runs it on (:meth:`adopt_plant`: ``"thesis"`` on a plant that takes wheel
-            forces and judges tipping by its physics, else ``"kinematic"``).
+            forces and judges tipping by its physics, or when ``dynamic_stability`` or
+            ``arm_time_constant`` asks for it, else ``"kinematic"``).
         stability_min: floor S_min of the tip-over margin (hard, exact at every node).
         manipulability_weight: weight of ``cos^2 th2`` (soft).
         obstacles: circles (``Circle`` or (x, y, radius) triples, m) or a TOML file path;
@@ -101,12 +102,12 @@ class MPCControllerCore:
         dynamic_stability: hold the floor on the zero moment point too, the centre of
             pressure with the inertial forces of turning and accelerating
             (``model="thesis"`` only; docs/mpc.md), besides the static centre of mass; None
-            (default): on exactly when the model was chosen for a physics plant.
+            (default): on exactly when the force model runs on a physics plant.
         arm_time_constant: the joints follow the commanded rates with this first-order lag
             (s) in the prediction (``model="thesis"`` only; the physics plant's joint
-            servos have one); None (default): that plant's lag when the model was chosen for
-            it (and ``dynamic_stability`` not given), else none: the joints move at the
-            commanded rates at once.
+            servos have one); None (default): that plant's lag when the force model runs on
+            a physics plant, else none; 0: none (the joints move at the commanded rates at
+            once).
         dt: control step (s); default the trajectory's ``duration / samples`` at reset,
             else 0.02 s.
         fallback_options: options of the ``qp`` fallback controller (merged over the
@@ -153,11 +154,11 @@ class MPCControllerCore:
             )
         self.robot = robot
         self._model_option = model
-        self._lag_option = (
-            None
-            if arm_time_constant is None
-            else check_range("arm_time_constant", arm_time_constant, 1e-3, 1.0, "s")
-        )
+        self._lag_option = None  # not given; 0.0: given as "no lag"
+        if arm_time_constant is not None and arm_time_constant != 0.0:
+            check_range("arm_time_constant", arm_time_constant, 1e-3, 1.0, "s")
+        if arm_time_constant is not None:
+            self._lag_option = float(arm_time_constant)
         self._dynamic_option = None
         if dynamic_stability is not None:
             self._dynamic_option = check_bool("dynamic_stability", dynamic_stability)
@@ -210,15 +211,18 @@ class MPCControllerCore:
         suits ``plant`` (None: not known yet). On a plant that takes wheel forces and judges
         tipping by its physics: the force-level model, the floor on the dynamic margin and
         the plant's joint lag (the static floor alone tipped 94 of 100 scenarios there,
-        docs/mpc.md); elsewhere the kinematic model, static floor, no lag."""
+        docs/mpc.md; likewise for ``model="thesis"`` given there); elsewhere the kinematic
+        model (the force model when ``dynamic_stability`` or a lag is asked for), static
+        floor, no lag."""
         physics = plant is not None and plant.judges_tipping and FORCE in plant.interfaces
-        model = self._model_option or ("thesis" if physics else "kinematic")
-        chosen = physics and model == "thesis"
-        dynamic = self._dynamic_option if self._dynamic_option is not None else chosen
+        wants_force = bool(self._dynamic_option) or bool(self._lag_option)
+        model = self._model_option or ("thesis" if physics or wants_force else "kinematic")
+        suited = physics and model == "thesis"  # the force model on a physics plant
+        dynamic = self._dynamic_option if self._dynamic_option is not None else suited
         lag = self._lag_option
-        if lag is None and chosen and self._dynamic_option is None:
-            lag = plant.joint_time_constant  # type: ignore[union-attr]
-        return model, dynamic, lag
+        if lag is None:
+            lag = plant.joint_time_constant if suited else None  # type: ignore[union-attr]
+        return model, dynamic, (lag or None)
 
     def _configure(self, model: str, dynamic_stability: bool, lag: float | None) -> None:
         """Set the prediction model and its options (problems are rebuilt on demand)."""
@@ -244,6 +248,8 @@ class MPCControllerCore:
         choice = self._resolve(plant)
         if choice != (self.model_name, self.dynamic_stability, self.arm_time_constant):
             self._configure(*choice)
+            self._reset_memory()  # sized and meant for the previous model
+            self._fallback = None
 
     @staticmethod
     def _grid_option(mode, horizon, intervals, first_interval, dt) -> tuple[int, float, float]:
@@ -461,6 +467,7 @@ class MPCControllerCore:
         self.last = StepInfo(fallback=True, extra={"mpc_failure": 1.0})
         self.last_failure = reason
         if self.dynamics is None:
+            self._u_prev = u.copy()  # the command applied
             return u
         v, w = float(x0[5]), float(x0[6])
         f_left, f_right = self.dynamics.velocity_tracking_forces(v, w, u[0], u[1], float(q[4]))
@@ -468,6 +475,7 @@ class MPCControllerCore:
         r1 = min(limit, max(-limit, float(u[2])))
         r2 = min(limit, max(-limit, float(u[3])))
         self._predicted_velocity = (v, w)
+        self._u_prev = np.array([f_left, f_right, r1, r2])  # the command applied
         if self.arm_time_constant is not None:
             self._remember_arm(r1, r2)
         return WheelForces(f_left, f_right, float(q[3]) + r1 * self.dt, float(q[4]) + r2 * self.dt)

@@ -195,7 +195,7 @@ class MujocoPlant:
             self.base_damping[0],
             self.base_damping[1],
             float(np.sum(self.model.body_mass)),
-            0.5 * robot.base_width,
+            0.5 * robot.track_width,  # the wheels' lever about the base centre
             ThesisPlant(robot).inertia(0.0, 0.0),
             fraction,
             speed_budget=True,

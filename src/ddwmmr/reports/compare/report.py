@@ -474,9 +474,12 @@ def _plant_section(c: _Context, plant: str) -> None:
     c.doc.heading(f"Plant: {plant} next to the kinematic plant")
     c.doc.paragraph(
         f"Every method of the comparison, same trajectories, robot and start, on the {plant} "
-        "plant (its own dynamics: the commands go to velocity servos, so the base lags and "
-        "may saturate or slip) and on the kinematic plant (the command is the motion). "
-        "Lag is the RMS difference between the commanded and the measured forward speed; "
+        "plant (its own dynamics: velocity commands go to velocity servos, so the base lags "
+        "and may saturate or slip; a method that sends wheel forces there, as mpc does on a "
+        "plant that judges tipping by its physics, drives the motors itself) and on the "
+        "kinematic plant (the command is the motion). "
+        "Lag is the RMS difference between the commanded and the measured forward speed "
+        "('-' for wheel-force commands, which command no speed); "
         "'actuator-limited' the share of the run with a motor at its torque limit (or a "
         "wheel at its force limit); slip the peak speed of a wheel's contact point over the "
         "floor (physics only)."
@@ -486,7 +489,8 @@ def _plant_section(c: _Context, plant: str) -> None:
     for base_spec, spec in runs.items():
         base, run = c.run(base_spec), c.run(spec)
         s, k, ts = run.summary, base.summary, run.timeseries
-        lag = float(np.sqrt(np.mean((ts["v_measured"] - ts["v"]) ** 2)))
+        forces = bool(np.all(np.isnan(ts["th1dot"])))  # wheel forces: no commanded rates
+        lag = math.nan if forces else float(np.sqrt(np.mean((ts["v_measured"] - ts["v"]) ** 2)))
         duration = max(float(ts["t"][-1]), 1e-12)
         saturated = s.get("actuator_saturated_time_s", math.nan) / duration
         slip = s.get("max_wheel_slip_m_s", math.nan)
@@ -499,7 +503,7 @@ def _plant_section(c: _Context, plant: str) -> None:
                 mm(s["rms_position_error_m"]),
                 fmt(ratio),
                 mm(s["final_position_error_m"]),
-                fmt(1000.0 * lag),
+                fmt(1000.0 * lag) if math.isfinite(lag) else "-",
                 f"{100.0 * saturated:.1f} %" if math.isfinite(saturated) else "-",
                 fmt(1000.0 * slip) if math.isfinite(slip) else "-",
                 fmt(k["min_stability"]),
