@@ -13,7 +13,7 @@ from ddwmmr.commands import traits_of
 from ddwmmr.controllers import make_controller
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.models import LaggedArmPrediction
-from ddwmmr.plants import MujocoPlant
+from ddwmmr.plants import MujocoPlant, ThesisPlant
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 from ddwmmr.scenarios.protocol import make_mpc, make_scenario_plant
 
@@ -98,6 +98,29 @@ def test_the_physics_plant_gets_the_dynamic_margin_and_the_lagged_arm():
     default = make_controller("mpc", ROBOT)
     default.adopt_plant(traits_of(thesis))  # takes forces, but its tipping is the formula's
     assert default.model_name == "kinematic"
+
+
+def test_the_force_model_takes_the_plants_own_base_damping():
+    """The force model assumes the damping the plant reports: none on the bare MuJoCo base
+    (then its envelope caps no speed), the thesis damping where the plant carries it, the
+    thesis plant's own c1, c2; the thesis defaults when the plant says nothing."""
+    bare = MujocoPlant(ROBOT)
+    assert traits_of(bare).base_damping == (0.0, 0.0)
+    mpc = make_controller("mpc", ROBOT)
+    mpc.adopt_plant(traits_of(bare))
+    assert (mpc.dynamics.c1, mpc.dynamics.c2) == (0.0, 0.0)
+    envelope = mpc.dynamics.velocity_envelope()
+    assert "max_base_speed" not in envelope and "max_yaw_rate" not in envelope
+    assert envelope["max_acceleration"] == pytest.approx(0.8 * 2 * 10.0 / mpc.dynamics.mass)
+    damped = make_scenario_plant(ROBOT, RunConfig(plant="mujoco"))
+    mpc.adopt_plant(traits_of(damped))
+    assert (mpc.dynamics.c1, mpc.dynamics.c2) == (15.0, 4.0)
+    thesis = ThesisPlant(ROBOT, c1=20.0, c2=5.0)
+    forced = make_controller("mpc", ROBOT, model="thesis")
+    forced.adopt_plant(traits_of(thesis))
+    assert (forced.dynamics.c1, forced.dynamics.c2) == (20.0, 5.0)
+    unknown = make_controller("mpc", ROBOT, model="thesis")  # no plant yet
+    assert (unknown.dynamics.c1, unknown.dynamics.c2) == (15.0, 4.0)
 
 
 def test_simulate_on_the_physics_plant_runs_the_force_model_with_the_dynamic_margin():

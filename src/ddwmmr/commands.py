@@ -55,11 +55,14 @@ class PlantTraits:
             ``Plant.tip_time``).
         joint_time_constant: the lag (s) with which its joints follow their rate targets,
             None if they follow at once.
+        base_damping: the viscous damping of its base's motion, ``(c1 N s/m, c2 N m
+            s/rad)`` (``(0, 0)``: none), None when the plant does not say.
     """
 
     interfaces: tuple[str, ...]
     judges_tipping: bool
     joint_time_constant: float | None
+    base_damping: tuple[float, float] | None = None
 
 
 def traits_of(plant: Any) -> PlantTraits:
@@ -68,4 +71,5 @@ def traits_of(plant: Any) -> PlantTraits:
         tuple(plant.interfaces),
         hasattr(plant, "tip_time"),
         getattr(plant, "joint_time_constant", None),
+        getattr(plant, "damping", None),
     )

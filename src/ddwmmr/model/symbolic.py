@@ -34,7 +34,7 @@ from typing import Any
 
 import casadi as ca
 
-from ddwmmr.errors import check_positive
+from ddwmmr.errors import check_nonnegative, check_positive
 from ddwmmr.model import Robot, stability
 from ddwmmr.model.thesis_base import (
     C1_DEFAULT,
@@ -227,8 +227,8 @@ class ThesisDynamics:
         )
         return cls(
             mass=robot.base_mass + m1 + m2 + mp,
-            c1=check_positive("c1", c1),
-            c2=check_positive("c2", c2),
+            c1=check_nonnegative("c1", c1),  # 0: an undamped base (the physics plant)
+            c2=check_nonnegative("c2", c2),
             force_limit=check_positive("force_limit", force_limit),
             joint_speed=check_positive("joint_speed", joint_speed),
             half_width=0.5 * robot.base_width,
@@ -245,13 +245,16 @@ class ThesisDynamics:
 
     @property
     def top_speed(self) -> float:
-        """Steady forward speed under the full force of both wheels, ``2 F / c1`` (m/s)."""
-        return 2.0 * self.force_limit / self.c1
+        """Steady forward speed under the full force of both wheels, ``2 F / c1`` (m/s;
+        infinite without damping)."""
+        return 2.0 * self.force_limit / self.c1 if self.c1 > 0.0 else math.inf
 
     @property
     def top_yaw_rate(self) -> float:
-        """Steady yaw rate under the full opposite forces, ``2 F (width/2) / c2`` (rad/s)."""
-        return 2.0 * self.force_limit * self.half_width / self.c2
+        """Steady yaw rate under the full opposite forces, ``2 F (width/2) / c2`` (rad/s;
+        infinite without damping)."""
+        torque = 2.0 * self.force_limit * self.half_width
+        return torque / self.c2 if self.c2 > 0.0 else math.inf
 
     # -- equations ----------------------------------------------------------------------
     def rhs(self, x: Symbolic, u: Symbolic) -> Symbolic:
@@ -309,12 +312,16 @@ class ThesisDynamics:
         total = 2.0 * self.force_limit
         torque = total * self.half_width
         stretched = self.inertia(0.0)
-        return {
-            "max_base_speed": fraction * total / self.c1,
-            "max_yaw_rate": fraction * torque / self.c2,
+        envelope = {
             "max_acceleration": fraction * total / self.mass,
             "max_yaw_acceleration": fraction * torque / stretched,
         }
+        # without damping nothing caps the speeds but the wheel-speed limit
+        if self.c1 > 0.0:
+            envelope["max_base_speed"] = fraction * total / self.c1
+        if self.c2 > 0.0:
+            envelope["max_yaw_rate"] = fraction * torque / self.c2
+        return envelope
 
     def velocity_tracking_forces(
         self,

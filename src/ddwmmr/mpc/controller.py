@@ -36,6 +36,7 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
+from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
 from ddwmmr.mpc import terminal
 from ddwmmr.mpc.models import PredictionModel, make_model
 from ddwmmr.mpc.ocp import (
@@ -206,9 +207,13 @@ class MPCControllerCore:
         self._reset_memory()
 
     # -- options ----------------------------------------------------------------------------
-    def _resolve(self, plant: PlantTraits | None) -> tuple[str, bool, float | None]:
-        """``(model, dynamic_stability, arm_time_constant)``: the options given, else what
-        suits ``plant`` (None: not known yet). On a plant that takes wheel forces and judges
+    def _resolve(
+        self, plant: PlantTraits | None
+    ) -> tuple[str, bool, float | None, tuple[float, float] | None]:
+        """``(model, dynamic_stability, arm_time_constant, damping)``: the options given,
+        else what suits ``plant`` (None: not known yet); the force model's base damping is
+        the plant's when it says (else the thesis plant's c1, c2). On a plant that takes
+        wheel forces and judges
         tipping by its physics: the force-level model, the floor on the dynamic margin and
         the plant's joint lag (the static floor alone tipped 94 of 100 scenarios there,
         docs/mpc.md; likewise for ``model="thesis"`` given there); elsewhere the kinematic
@@ -222,9 +227,16 @@ class MPCControllerCore:
         lag = self._lag_option
         if lag is None:
             lag = plant.joint_time_constant if suited else None  # type: ignore[union-attr]
-        return model, dynamic, (lag or None)
+        damping = plant.base_damping if plant is not None and model == "thesis" else None
+        return model, dynamic, (lag or None), damping
 
-    def _configure(self, model: str, dynamic_stability: bool, lag: float | None) -> None:
+    def _configure(
+        self,
+        model: str,
+        dynamic_stability: bool,
+        lag: float | None,
+        damping: tuple[float, float] | None = None,
+    ) -> None:
         """Set the prediction model and its options (problems are rebuilt on demand)."""
         if lag is not None and model != "thesis":
             raise ParameterError("arm_time_constant needs model='thesis'")
@@ -234,7 +246,11 @@ class MPCControllerCore:
                 "accelerations)"
             )
         self.model_name = model
-        self.dynamics = sym.ThesisDynamics.from_robot(self.robot) if model == "thesis" else None
+        self.dynamics = None
+        if model == "thesis":
+            c1, c2 = damping if damping is not None else (C1_DEFAULT, C2_DEFAULT)
+            self.dynamics = sym.ThesisDynamics.from_robot(self.robot, c1, c2)
+        self._damping = damping
         self.arm_time_constant = lag
         self.dynamic_stability = dynamic_stability
         self.model: PredictionModel = make_model(model, self.robot, self.dynamics, lag)
@@ -246,7 +262,8 @@ class MPCControllerCore:
         """The loop's plant, described (:func:`ddwmmr.commands.traits_of`): options not
         given are chosen for it (:meth:`_resolve`), before ``reset``."""
         choice = self._resolve(plant)
-        if choice != (self.model_name, self.dynamic_stability, self.arm_time_constant):
+        current = (self.model_name, self.dynamic_stability, self.arm_time_constant, self._damping)
+        if choice != current:
             self._configure(*choice)
             self._reset_memory()  # sized and meant for the previous model
             self._fallback = None

@@ -67,7 +67,9 @@ class Plant(Protocol):
     since the reset, None while it has not (the scenario protocol fails a run on it), and
     with it ``unloaded_time_s``, the time (s) since the reset with an edge of the support
     polygon unloaded; ``joint_time_constant`` (s), the lag with which the joints follow
-    their rate targets (the protocol's ``mpc`` models it).
+    their rate targets, and ``damping``, the base's viscous damping ``(c1, c2)`` (N s/m,
+    N m s/rad): what the loop tells controllers of the plant
+    (:func:`ddwmmr.commands.traits_of`; the ``mpc`` models both).
     """
 
     name: str

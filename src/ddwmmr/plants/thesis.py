@@ -251,6 +251,11 @@ class ThesisPlant:
         tip = r.L1**2 + r.L2**2 + 2.0 * r.L1 * r.L2 * c2
         return self._inertia_fixed + m1 * 0.25 * r.L1**2 + m2 * mid2 + r.payload * tip
 
+    @property
+    def damping(self) -> tuple[float, float]:
+        """The base's viscous damping ``(c1 N s/m, c2 N m s/rad)``."""
+        return self.c1, self.c2
+
     def velocity_envelope(self, fraction: float = 0.8) -> dict[str, Any]:
         """What a velocity command can ask of this base: :func:`damped_base_envelope`.
 

@@ -180,6 +180,12 @@ class MujocoPlant:
             "wheel_actuators": [ACTUATORS.index("wheel_left"), ACTUATORS.index("wheel_right")],
         }
 
+    @property
+    def damping(self) -> tuple[float, float]:
+        """The base's viscous damping ``(c1 N s/m, c2 N m s/rad)``: ``base_damping``, or
+        ``(0, 0)`` without it (what a force-level model of this base should assume)."""
+        return self.base_damping if self.base_damping is not None else (0.0, 0.0)
+
     def velocity_envelope(self, fraction: float = 0.8) -> dict[str, Any] | None:
         """With ``base_damping``: what a velocity command can ask of the damped base
         (:func:`~ddwmmr.plants.thesis.damped_base_envelope` with the wheel force the motor
