@@ -211,14 +211,15 @@ class MPCControllerCore:
         self, plant: PlantTraits | None
     ) -> tuple[str, bool, float | None, tuple[float, float] | None]:
         """``(model, dynamic_stability, arm_time_constant, damping)``: the options given,
-        else what suits ``plant`` (None: not known yet); the force model's base damping is
-        the plant's when it says (else the thesis plant's c1, c2). On a plant that takes
-        wheel forces and judges
-        tipping by its physics: the force-level model, the floor on the dynamic margin and
-        the plant's joint lag (the static floor alone tipped 94 of 100 scenarios there,
-        docs/mpc.md; likewise for ``model="thesis"`` given there); elsewhere the kinematic
-        model (the force model when ``dynamic_stability`` or a lag is asked for), static
-        floor, no lag."""
+        else what suits ``plant`` (None: not known yet).
+
+        On a plant that takes wheel forces and judges tipping by its physics: the
+        force-level model, the floor on the dynamic margin and the plant's joint lag (the
+        static floor alone tipped 94 of 100 scenarios there, docs/mpc.md; likewise for
+        ``model="thesis"`` given there); elsewhere the kinematic model (the force model when
+        ``dynamic_stability`` or a lag is asked for), static floor, no lag. The force
+        model's base damping is the plant's when it says, else the thesis plant's c1, c2.
+        """
         physics = plant is not None and plant.judges_tipping and FORCE in plant.interfaces
         wants_force = bool(self._dynamic_option) or bool(self._lag_option)
         model = self._model_option or ("thesis" if physics or wants_force else "kinematic")
@@ -438,8 +439,6 @@ class MPCControllerCore:
         r1, r2 = float(u[2]), float(u[3])
         scale = safe_arm_scale(k, th1, th2, r1, r2, self.dt, self.stability_min)
         r1, r2 = r1 * scale, r2 * scale
-        # the next plan's input-change cost starts from what was applied (rates scaled)
-        self._u_prev = np.array([float(u[0]), float(u[1]), r1, r2])
         ocp = problem.ocp
         slack = ocp.max_slack(w)
         self.last = StepInfo(
@@ -450,24 +449,28 @@ class MPCControllerCore:
                 "arm_scale": scale,
             }
         )
-        if self.model_name == "kinematic":
-            return np.array([float(u[0]), float(u[1]), r1, r2])
-        xs, _ = ocp.trajectories(w)
-        self._predicted_velocity = (float(xs[1][5]), float(xs[1][6]))
-        if self.arm_time_constant is not None:  # the joints' rates have no sensor here
-            self._remember_arm(r1, r2)
-        return WheelForces(float(u[0]), float(u[1]), th1 + r1 * self.dt, th2 + r2 * self.dt)
+        velocity = (0.0, 0.0)
+        if self.dynamics is not None:
+            xs, _ = ocp.trajectories(w)
+            velocity = (float(xs[1][5]), float(xs[1][6]))
+        return self._apply(float(u[0]), float(u[1]), r1, r2, q, velocity)
 
-    def _remember_arm(self, r1: float, r2: float) -> None:
-        """The lagged rates at the next step, from this step's and the command."""
-        self._predicted_rates = self._lagged_rates(r1, r2)
-
-    def _lagged_rates(self, r1: float, r2: float) -> tuple[float, float]:
-        """The lagged joint rates after one step of the commanded rates (exact for the
-        first-order lag)."""
-        keep = math.exp(-self.dt / self.arm_time_constant)
-        old1, old2 = self._predicted_rates
-        return r1 + (old1 - r1) * keep, r2 + (old2 - r2) * keep
+    def _apply(
+        self, first: float, second: float, r1: float, r2: float, q, velocity: tuple[float, float]
+    ) -> np.ndarray | WheelForces:
+        """The command ``(first, second, r1, r2)`` as sent (``u``, or wheel forces with
+        one-step joint targets from ``q``), remembered for the next step: the input-change
+        cost starts from it, and the force model predicts from ``velocity`` (m/s, rad/s)
+        and the lagged joint rates (exact for the first-order lag; no sensor reports them)."""
+        self._u_prev = np.array([first, second, r1, r2])
+        if self.dynamics is None:
+            return self._u_prev.copy()
+        self._predicted_velocity = velocity
+        if self.arm_time_constant is not None:
+            keep = math.exp(-self.dt / self.arm_time_constant)
+            old1, old2 = self._predicted_rates
+            self._predicted_rates = r1 + (old1 - r1) * keep, r2 + (old2 - r2) * keep
+        return WheelForces(first, second, float(q[3]) + r1 * self.dt, float(q[4]) + r2 * self.dt)
 
     def _fallback_command(self, t, q, pose_d, velocity_d, x0, reason: str):
         """The ``qp`` command for this step (counted); the next step starts cold."""
@@ -484,18 +487,13 @@ class MPCControllerCore:
         self.last = StepInfo(fallback=True, extra={"mpc_failure": 1.0})
         self.last_failure = reason
         if self.dynamics is None:
-            self._u_prev = u.copy()  # the command applied
-            return u
+            return self._apply(*map(float, u), q, (0.0, 0.0))
         v, w = float(x0[5]), float(x0[6])
         f_left, f_right = self.dynamics.velocity_tracking_forces(v, w, u[0], u[1], float(q[4]))
         limit = min(self.dynamics.joint_speed, self.robot.joint_speed_limit)
         r1 = min(limit, max(-limit, float(u[2])))
         r2 = min(limit, max(-limit, float(u[3])))
-        self._predicted_velocity = (v, w)
-        self._u_prev = np.array([f_left, f_right, r1, r2])  # the command applied
-        if self.arm_time_constant is not None:
-            self._remember_arm(r1, r2)
-        return WheelForces(f_left, f_right, float(q[3]) + r1 * self.dt, float(q[4]) + r2 * self.dt)
+        return self._apply(float(f_left), float(f_right), r1, r2, q, (v, w))
 
     def _make_fallback(self) -> Any:
         from ddwmmr.controllers.base import make_controller

@@ -395,9 +395,7 @@ class MujocoPlant:
         20 % short). Raising the target by ``torque / kv`` makes the servo apply that
         torque at the target speed, as the thesis plant's velocity servo feeds the damping
         forward (docs/physics.md). Zero without damping."""
-        if self.base_damping is None:
-            return 0.0, 0.0
-        c_t, c_yaw = self.base_damping
+        c_t, c_yaw = self.damping
         robot = self.robot
         drive, turn = 0.5 * c_t * v, c_yaw * w / robot.track_width
         kv = self._kv[self._ids["wheel_actuators"][0]]
