@@ -53,6 +53,9 @@ def test_the_lagged_arm_is_integrated_like_its_own_ode():
         ({"model": "thesis", "arm_time_constant": 5e-4}, "arm_time_constant"),
         ({"model": "thesis", "arm_time_constant": 5.0}, "arm_time_constant"),
         ({"model": "thesis", "dynamic_stability": "yes"}, "dynamic_stability"),
+        ({"model": "kinematic", "wheel_force_limit": 5.0}, "wheel_force_limit"),
+        ({"model": "thesis", "wheel_force_limit": 0.0}, "wheel_force_limit"),
+        ({"wheel_force_limit": math.nan}, "wheel_force_limit"),
     ],
 )
 def test_bad_options_are_refused(options, match):
@@ -100,10 +103,12 @@ def test_the_physics_plant_gets_the_dynamic_margin_and_the_lagged_arm():
     assert default.model_name == "kinematic"
 
 
-def test_the_force_model_takes_the_plants_own_base_damping():
-    """The force model assumes the damping the plant reports: none on the bare MuJoCo base
-    (then its envelope caps no speed), the thesis damping where the plant carries it, the
-    thesis plant's own c1, c2; the thesis defaults when the plant says nothing."""
+def test_the_force_model_takes_the_plants_own_base():
+    """The force model assumes the base the plant reports: its damping (none on the bare
+    MuJoCo base, then its envelope caps no speed; the thesis damping where the plant
+    carries it; the thesis plant's own c1, c2), the wheels' lever (MuJoCo: half the
+    track) and on the thesis plant its ``force_limit``; the thesis plant's values when the
+    plant says nothing."""
     bare = MujocoPlant(ROBOT)
     assert traits_of(bare).base_damping == (0.0, 0.0)
     mpc = make_controller("mpc", ROBOT)
@@ -115,12 +120,47 @@ def test_the_force_model_takes_the_plants_own_base_damping():
     damped = make_scenario_plant(ROBOT, RunConfig(plant="mujoco"))
     mpc.adopt_plant(traits_of(damped))
     assert (mpc.dynamics.c1, mpc.dynamics.c2) == (15.0, 4.0)
-    thesis = ThesisPlant(ROBOT, c1=20.0, c2=5.0)
+    assert mpc.dynamics.top_speed == pytest.approx(2 * 10.0 / 15.0)
+    narrow = Robot(track_width=0.3).with_payload(3.0)  # wheels inside the 0.35 m footprint
+    on_narrow = make_controller("mpc", narrow)
+    on_narrow.adopt_plant(traits_of(MujocoPlant(narrow)))
+    assert on_narrow.dynamics.half_width == pytest.approx(0.15, rel=1e-12)
+    thesis = ThesisPlant(ROBOT, c1=20.0, c2=5.0, force_limit=7.0)
     forced = make_controller("mpc", ROBOT, model="thesis")
-    forced.adopt_plant(traits_of(thesis))
+    forced.adopt_plant(traits_of(thesis))  # the model is this plant's: its own limit
     assert (forced.dynamics.c1, forced.dynamics.c2) == (20.0, 5.0)
+    assert forced.dynamics.force_limit == 7.0
+    assert forced.dynamics.half_width == pytest.approx(0.5 * ROBOT.base_width, rel=1e-12)
     unknown = make_controller("mpc", ROBOT, model="thesis")  # no plant yet
     assert (unknown.dynamics.c1, unknown.dynamics.c2) == (15.0, 4.0)
+    assert unknown.dynamics.force_limit == 10.0
+
+
+def test_the_force_model_plans_within_the_motors_and_the_thesis_force_on_physics():
+    """On a plant that judges tipping physically the force model plans with the thesis's
+    10 N by default (the motors' 20.5 N tipped 27 of 100 scenarios), a limit asked for
+    is taken, and neither ever exceeds the plant's motors; asking for a limit implies the
+    force model."""
+    physics = traits_of(MujocoPlant(ROBOT))
+    default = make_controller("mpc", ROBOT)
+    default.adopt_plant(physics)
+    assert default.dynamics.force_limit == 10.0
+    motor_force = ROBOT.wheel_torque_limit / ROBOT.wheel_radius
+    assert physics.wheel_force_limit == pytest.approx(motor_force, rel=1e-12)
+    asked = make_controller("mpc", ROBOT, wheel_force_limit=15.0)
+    assert asked.model_name == "thesis" and asked.dynamics.force_limit == 15.0
+    asked.adopt_plant(physics)
+    assert asked.dynamics.force_limit == 15.0
+    too_much = make_controller("mpc", ROBOT, wheel_force_limit=50.0)
+    too_much.adopt_plant(physics)
+    assert too_much.dynamics.force_limit == pytest.approx(motor_force, rel=1e-12)
+    weak = Robot(wheel_torque_limit=0.5).with_payload(3.0)  # 5.1 N motors
+    on_weak = make_controller("mpc", weak)
+    on_weak.adopt_plant(traits_of(MujocoPlant(weak)))
+    assert on_weak.dynamics.force_limit == pytest.approx(0.5 / weak.wheel_radius, rel=1e-12)
+    strong_thesis = make_controller("mpc", ROBOT, wheel_force_limit=12.0)
+    strong_thesis.adopt_plant(traits_of(ThesisPlant(ROBOT)))  # its 10 N wins
+    assert strong_thesis.dynamics.force_limit == 10.0
 
 
 def test_simulate_on_the_physics_plant_runs_the_force_model_with_the_dynamic_margin():
@@ -133,6 +173,7 @@ def test_simulate_on_the_physics_plant_runs_the_force_model_with_the_dynamic_mar
     summary = result.summary
     assert summary["mpc_model"] == "thesis" and summary["mpc_dynamic_stability"]
     assert summary["mpc_arm_time_constant_s"] == plant.joint_time_constant
+    assert summary["mpc_wheel_force_limit_n"] == 10.0  # the thesis's force, within 20.5 N
     assert not summary["tipped"] and summary["mpc_fallbacks"] == 0
 
 
@@ -200,3 +241,26 @@ def test_a_plan_stuck_on_its_slack_restarts_and_the_scenario_finishes(monkeypatc
     monkeypatch.setattr(mpc_controller, "STALL_SLACK", math.inf)  # the rule never fires
     stuck = run_scenario(scenario, config).metrics
     assert stuck["reason"] == "timeout" and stuck["waypoints_reached"] == 2
+
+
+def test_the_wheel_lever_from_the_traits_turns_the_physics_base_as_it_does():
+    """Opposite wheel forces of 5 N for 0.1 s on MuJoCo bases with the wheels at the
+    footprint's edge and inside it: the yaw rate the force model predicts with the
+    plant's lever (``wheel_lever``, half the track) matches the physics within 1.5 %; the
+    footprint's half-width would overstate it by 40 % on the narrow track."""
+    from ddwmmr.commands import WheelForces
+
+    q0 = np.array([0.0, 0.0, 0.0, -0.7, 1.57])
+    for track in (0.35, 0.25):
+        robot = Robot(track_width=track).with_payload(3.0)
+        plant = MujocoPlant(robot)
+        plant.reset(q0, 0.01)
+        for k in range(10):
+            plant.step(k * 0.01, WheelForces(-5.0, 5.0, q0[3], q0[4]), 0.01)
+        lever = traits_of(plant).wheel_lever
+        assert lever == pytest.approx(0.5 * track, rel=1e-12)
+        model = sym.ThesisDynamics.from_robot(robot, 0.0, 0.0, half_width=lever)
+        predicted = 2 * 5.0 * lever / model.inertia(q0[4]) * 0.1
+        assert plant.observe().w == pytest.approx(predicted, rel=0.015)
+    footprint = sym.ThesisDynamics.from_robot(robot, 0.0, 0.0)
+    assert footprint.half_width / lever == pytest.approx(1.4, rel=1e-12)

@@ -57,12 +57,19 @@ class PlantTraits:
             None if they follow at once.
         base_damping: the viscous damping of its base's motion, ``(c1 N s/m, c2 N m
             s/rad)`` (``(0, 0)``: none), None when the plant does not say.
+        wheel_force_limit: the largest traction force (N) each wheel's motor can apply
+            (a force command beyond it is clipped), None when the plant does not say.
+        wheel_lever: the lever arm (m) of each wheel's traction force about the base
+            centre, half the distance between the wheels; None when the plant does not
+            say.
     """
 
     interfaces: tuple[str, ...]
     judges_tipping: bool
     joint_time_constant: float | None
     base_damping: tuple[float, float] | None = None
+    wheel_force_limit: float | None = None
+    wheel_lever: float | None = None
 
 
 def traits_of(plant: Any) -> PlantTraits:
@@ -72,4 +79,6 @@ def traits_of(plant: Any) -> PlantTraits:
         hasattr(plant, "tip_time"),
         getattr(plant, "joint_time_constant", None),
         getattr(plant, "damping", None),
+        getattr(plant, "wheel_force_limit", None),
+        getattr(plant, "wheel_lever", None),
     )

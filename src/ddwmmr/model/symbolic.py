@@ -209,8 +209,11 @@ class ThesisDynamics:
         c2: float = C2_DEFAULT,
         force_limit: float = FORCE_LIMIT_DEFAULT,
         joint_speed: float = JOINT_SPEED_DEFAULT,
+        half_width: float | None = None,
     ) -> ThesisDynamics:
-        """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``."""
+        """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``;
+        ``half_width`` (m) is the wheels' lever about the base centre, by default the
+        thesis plant's ``robot.base_width / 2``."""
         m1, m2 = robot.link_masses
         mp, L1, L2 = robot.payload, robot.L1, robot.L2
         # Yaw inertia about the base centre: each link a rod about its own centre plus the
@@ -231,7 +234,11 @@ class ThesisDynamics:
             c2=check_nonnegative("c2", c2),
             force_limit=check_positive("force_limit", force_limit),
             joint_speed=check_positive("joint_speed", joint_speed),
-            half_width=0.5 * robot.base_width,
+            half_width=(
+                0.5 * robot.base_width
+                if half_width is None
+                else check_positive("half_width", half_width)
+            ),
             inertia_fixed=fixed,
             inertia_cos=(m2 + 2.0 * mp) * L1 * L2,
             shoulder_fixed=m1 * L1**2 / 3.0 + (m2 + mp) * L1**2,

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -36,7 +37,7 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
-from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
+from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT, FORCE_LIMIT_DEFAULT
 from ddwmmr.mpc import terminal
 from ddwmmr.mpc.models import PredictionModel, make_model
 from ddwmmr.mpc.ocp import (
@@ -72,6 +73,52 @@ STALL_SLACK = 1e-3
 GRID_DEFAULTS = {"tracking": (10, 0.05, 1.0), "reach": (12, 0.05, 5.0)}
 
 
+@dataclass(frozen=True)
+class BaseFacts:
+    """What the force-level model takes from its plant's traits (None: the thesis plant's
+    value, ``ddwmmr.plants.thesis``).
+
+    Attributes:
+        damping: ``(c1 N s/m, c2 N m s/rad)``.
+        force_limit: each wheel's largest traction force (N).
+        lever: each wheel force's lever about the base centre (m).
+    """
+
+    damping: tuple[float, float] | None = None
+    force_limit: float | None = None
+    lever: float | None = None
+
+    @classmethod
+    def of(cls, plant: PlantTraits | None, force_limit: float | None = None) -> BaseFacts:
+        """The facts ``plant`` states (none for an unknown plant), with the wheel force
+        ``force_limit`` (N) asked for, else :func:`planned_force`, and never above the
+        plant's motors."""
+        if plant is None:
+            return cls(force_limit=force_limit)
+        motors = plant.wheel_force_limit
+        force = planned_force(plant) if force_limit is None else force_limit
+        if motors is not None and force is not None:
+            force = min(force, motors)
+        return cls(plant.base_damping, force, plant.wheel_lever)
+
+    def dynamics(self, robot: Robot) -> sym.ThesisDynamics:
+        """The force-level model of ``robot`` on a base with these facts."""
+        c1, c2 = self.damping if self.damping is not None else (C1_DEFAULT, C2_DEFAULT)
+        force = self.force_limit if self.force_limit is not None else FORCE_LIMIT_DEFAULT
+        return sym.ThesisDynamics.from_robot(robot, c1, c2, force, half_width=self.lever)
+
+
+def planned_force(plant: PlantTraits) -> float | None:
+    """The wheel force (N) the force model plans with by default on ``plant``: the plant's
+    own limit where the model is the plant's (the thesis plant), the thesis's 10 N on a
+    plant that judges tipping by its physics. On MuJoCo the motors' full 20.5 N tipped the
+    robot in 27 of 100 scenarios (the wheels lift and spin where the model has them
+    rolling; docs/mpc.md), against 2 with 10 N."""
+    if plant.judges_tipping or plant.wheel_force_limit is None:
+        return FORCE_LIMIT_DEFAULT
+    return plant.wheel_force_limit
+
+
 class MPCControllerCore:
     """Nonlinear MPC: multiple shooting, hard S >= S_min, soft manipulability, preview.
 
@@ -81,8 +128,9 @@ class MPCControllerCore:
             (wheel forces, the thesis plant's force-level dynamics; needs the measured base
             velocities, ``base_velocity=(v, w)``); None (default): chosen for the plant the
             loop runs it on (:meth:`adopt_plant`: ``"thesis"`` on a plant that takes wheel
-            forces and judges tipping by its physics, or when ``dynamic_stability`` or
-            ``arm_time_constant`` asks for it, else ``"kinematic"``).
+            forces and judges tipping by its physics, or when ``dynamic_stability``,
+            ``arm_time_constant`` or ``wheel_force_limit`` asks for it, else
+            ``"kinematic"``).
         stability_min: floor S_min of the tip-over margin (hard, exact at every node).
         manipulability_weight: weight of ``cos^2 th2`` (soft).
         obstacles: circles (``Circle`` or (x, y, radius) triples, m) or a TOML file path;
@@ -109,6 +157,10 @@ class MPCControllerCore:
             servos have one); None (default): that plant's lag when the force model runs on
             a physics plant, else none; 0: none (the joints move at the commanded rates at
             once).
+        wheel_force_limit: per-wheel traction force (N) the force model plans with
+            (``model="thesis"`` only), never above the plant's motors
+            (``PlantTraits.wheel_force_limit``); None (default): :func:`planned_force`,
+            the thesis plant's own limit there, the thesis's 10 N on a physics plant.
         dt: control step (s); default the trajectory's ``duration / samples`` at reset,
             else 0.02 s.
         fallback_options: options of the ``qp`` fallback controller (merged over the
@@ -141,6 +193,7 @@ class MPCControllerCore:
         stability_margin: float = 0.01,
         dynamic_stability: bool | None = None,
         arm_time_constant: float | None = None,
+        wheel_force_limit: float | None = None,
         obstacle_margin: float = 0.05,
         dt: float | None = None,
         fallback_options: dict[str, Any] | None = None,
@@ -160,6 +213,11 @@ class MPCControllerCore:
             check_range("arm_time_constant", arm_time_constant, 1e-3, 1.0, "s")
         if arm_time_constant is not None:
             self._lag_option = float(arm_time_constant)
+        self._force_option = None
+        if wheel_force_limit is not None:
+            self._force_option = check_range("wheel_force_limit", wheel_force_limit, 0.1, 1e4, "N")
+            if model == "kinematic":
+                raise ParameterError("wheel_force_limit needs model='thesis'")
         self._dynamic_option = None
         if dynamic_stability is not None:
             self._dynamic_option = check_bool("dynamic_stability", dynamic_stability)
@@ -207,36 +265,38 @@ class MPCControllerCore:
         self._reset_memory()
 
     # -- options ----------------------------------------------------------------------------
-    def _resolve(
-        self, plant: PlantTraits | None
-    ) -> tuple[str, bool, float | None, tuple[float, float] | None]:
-        """``(model, dynamic_stability, arm_time_constant, damping)``: the options given,
-        else what suits ``plant`` (None: not known yet).
+    def _resolve(self, plant: PlantTraits | None) -> tuple[str, bool, float | None, BaseFacts]:
+        """``(model, dynamic_stability, arm_time_constant, base)``: the options given, else
+        what suits ``plant`` (None: not known yet).
 
         On a plant that takes wheel forces and judges tipping by its physics: the
         force-level model, the floor on the dynamic margin and the plant's joint lag (the
         static floor alone tipped 94 of 100 scenarios there, docs/mpc.md; likewise for
         ``model="thesis"`` given there); elsewhere the kinematic model (the force model when
         ``dynamic_stability`` or a lag is asked for), static floor, no lag. The force
-        model's base damping is the plant's when it says, else the thesis plant's c1, c2.
+        model's base (damping, wheel force limit, wheel lever: :class:`BaseFacts`) is the
+        plant's where it says, else the thesis plant's; its wheel force is the one asked
+        for, else :func:`planned_force`, within the plant's motors.
         """
         physics = plant is not None and plant.judges_tipping and FORCE in plant.interfaces
-        wants_force = bool(self._dynamic_option) or bool(self._lag_option)
+        wants_force = (
+            bool(self._dynamic_option) or bool(self._lag_option) or self._force_option is not None
+        )
         model = self._model_option or ("thesis" if physics or wants_force else "kinematic")
         suited = physics and model == "thesis"  # the force model on a physics plant
         dynamic = self._dynamic_option if self._dynamic_option is not None else suited
         lag = self._lag_option
         if lag is None:
             lag = plant.joint_time_constant if suited else None  # type: ignore[union-attr]
-        damping = plant.base_damping if plant is not None and model == "thesis" else None
-        return model, dynamic, (lag or None), damping
+        base = BaseFacts.of(plant, self._force_option) if model == "thesis" else BaseFacts()
+        return model, dynamic, (lag or None), base
 
     def _configure(
         self,
         model: str,
         dynamic_stability: bool,
         lag: float | None,
-        damping: tuple[float, float] | None = None,
+        base: BaseFacts | None = None,
     ) -> None:
         """Set the prediction model and its options (problems are rebuilt on demand)."""
         if lag is not None and model != "thesis":
@@ -246,12 +306,12 @@ class MPCControllerCore:
                 "dynamic_stability needs model='thesis' (the kinematic model has no base "
                 "accelerations)"
             )
+        base = base or BaseFacts()
         self.model_name = model
         self.dynamics = None
         if model == "thesis":
-            c1, c2 = damping if damping is not None else (C1_DEFAULT, C2_DEFAULT)
-            self.dynamics = sym.ThesisDynamics.from_robot(self.robot, c1, c2)
-        self._damping = damping
+            self.dynamics = base.dynamics(self.robot)
+        self._base = base
         self.arm_time_constant = lag
         self.dynamic_stability = dynamic_stability
         self.model: PredictionModel = make_model(model, self.robot, self.dynamics, lag)
@@ -263,7 +323,7 @@ class MPCControllerCore:
         """The loop's plant, described (:func:`ddwmmr.commands.traits_of`): options not
         given are chosen for it (:meth:`_resolve`), before ``reset``."""
         choice = self._resolve(plant)
-        current = (self.model_name, self.dynamic_stability, self.arm_time_constant, self._damping)
+        current = (self.model_name, self.dynamic_stability, self.arm_time_constant, self._base)
         if choice != current:
             self._configure(*choice)
             self._reset_memory()  # sized and meant for the previous model
@@ -532,6 +592,7 @@ class MPCControllerCore:
             "mpc_model": self.model_name,
             "mpc_dynamic_stability": self.dynamic_stability,
             "mpc_arm_time_constant_s": self.arm_time_constant,
+            "mpc_wheel_force_limit_n": None if self.dynamics is None else self.dynamics.force_limit,
             "mpc_solver": self.solver_name
             if self.solver_name != "rti"
             else f"rti-{self.qp_solver}",

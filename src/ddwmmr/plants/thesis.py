@@ -256,6 +256,16 @@ class ThesisPlant:
         """The base's viscous damping ``(c1 N s/m, c2 N m s/rad)``."""
         return self.c1, self.c2
 
+    @property
+    def wheel_force_limit(self) -> float:
+        """Largest traction force of each wheel (N): ``force_limit``."""
+        return self.force_limit
+
+    @property
+    def wheel_lever(self) -> float:
+        """Lever arm of each wheel's force about the base centre (m): ``base_width / 2``."""
+        return self._half_width
+
     def velocity_envelope(self, fraction: float = 0.8) -> dict[str, Any]:
         """What a velocity command can ask of this base: :func:`damped_base_envelope`.
 

@@ -186,6 +186,18 @@ class MujocoPlant:
         ``(0, 0)`` without it (what a force-level model of this base should assume)."""
         return self.base_damping if self.base_damping is not None else (0.0, 0.0)
 
+    @property
+    def wheel_force_limit(self) -> float:
+        """Largest traction force of each wheel (N): the motor's torque limit over the wheel
+        radius, ``wheel_torque_limit / wheel_radius`` (a force command beyond it is
+        clipped)."""
+        return self.robot.wheel_torque_limit / self.robot.wheel_radius
+
+    @property
+    def wheel_lever(self) -> float:
+        """Lever arm of each wheel's force about the base centre (m): ``track_width / 2``."""
+        return 0.5 * self.robot.track_width
+
     def velocity_envelope(self, fraction: float = 0.8) -> dict[str, Any] | None:
         """With ``base_damping``: what a velocity command can ask of the damped base
         (:func:`~ddwmmr.plants.thesis.damped_base_envelope` with the wheel force the motor
@@ -197,11 +209,11 @@ class MujocoPlant:
             return None
         robot = self.robot
         return damped_base_envelope(
-            robot.wheel_torque_limit / robot.wheel_radius,
+            self.wheel_force_limit,
             self.base_damping[0],
             self.base_damping[1],
             float(np.sum(self.model.body_mass)),
-            0.5 * robot.track_width,  # the wheels' lever about the base centre
+            self.wheel_lever,
             ThesisPlant(robot).inertia(0.0, 0.0),
             fraction,
             speed_budget=True,
