@@ -66,6 +66,7 @@ def test_zero_order_hold_controller_is_called_once_per_sample_and_held_exactly()
     np.testing.assert_allclose(ts["x"], v / w * np.sin(w * t), rtol=0, atol=1e-9)
     np.testing.assert_allclose(ts["y"], v / w * (1 - np.cos(w * t)), rtol=0, atol=1e-9)
     assert result.summary["plant"] == "kinematic" and result.summary["integrator"] == "rk4"
+    assert result.summary["command_interface"] == "velocity"
 
 
 def test_continuous_controller_is_evaluated_at_every_rk4_stage():

@@ -172,6 +172,7 @@ def test_simulate_on_the_physics_plant_runs_the_force_model_with_the_dynamic_mar
     result = simulate(ROBOT, Ellipse(T=1.0, N=50), "mpc", plant=plant)
     summary = result.summary
     assert summary["mpc_model"] == "thesis" and summary["mpc_dynamic_stability"]
+    assert summary["command_interface"] == "force"  # chosen for this plant
     assert summary["mpc_arm_time_constant_s"] == plant.joint_time_constant
     assert summary["mpc_wheel_force_limit_n"] == 10.0  # the thesis's force, within 20.5 N
     assert not summary["tipped"] and summary["mpc_fallbacks"] == 0

@@ -8,6 +8,7 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr.commands import VELOCITY
 from ddwmmr.controllers.base import Controller, make_controller
 from ddwmmr.errors import (
     ParameterError,
@@ -126,6 +127,8 @@ def simulate(
         trajectory=trajectory_name(trajectory),
         plant=the_plant.name,
         integrator=getattr(the_plant, "integrator", None),
+        # the interface the controller spoke (the mpc chooses its own for the plant)
+        command_interface=getattr(controller, "interface", VELOCITY),
         dt=dt,
         duration=recorded_steps * dt,
         steps=recorded_steps,

@@ -15,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr.commands import FORCE
 from ddwmmr.controllers.base import method_description
 from ddwmmr.reports import compare_plots as plots
 from ddwmmr.reports.compare import advice, settings
@@ -489,7 +490,7 @@ def _plant_section(c: _Context, plant: str) -> None:
     for base_spec, spec in runs.items():
         base, run = c.run(base_spec), c.run(spec)
         s, k, ts = run.summary, base.summary, run.timeseries
-        forces = bool(np.all(np.isnan(ts["th1dot"])))  # wheel forces: no commanded rates
+        forces = s["command_interface"] == FORCE  # wheel forces command no speed
         lag = math.nan if forces else float(np.sqrt(np.mean((ts["v_measured"] - ts["v"]) ** 2)))
         duration = max(float(ts["t"][-1]), 1e-12)
         saturated = s.get("actuator_saturated_time_s", math.nan) / duration
