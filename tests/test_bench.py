@@ -297,8 +297,18 @@ def _run_cli(*args: str, cwd) -> subprocess.CompletedProcess:
         (["--repeats", "abc"], "argument --repeats: must be an integer in [1, 1000] (got 'abc')"),
         (["--repeats", "0"], "argument --repeats: must be an integer in [1, 1000] (got '0')"),
         (["--calls", "-3"], "argument --calls: must be an integer in [1, 10000] (got '-3')"),
-        (["--duration", "nan"], "argument --duration: must be a number > 0 in s (got 'nan')"),
-        (["--duration", "1e"], "argument --duration: must be a number > 0 in s (got '1e')"),
+        (
+            ["--duration", "nan"],
+            "argument --duration: must be a number in [0.02, 20000] s (got 'nan')",
+        ),
+        (
+            ["--duration", "inf"],
+            "argument --duration: must be a number in [0.02, 20000] s (got 'inf')",
+        ),
+        (
+            ["--duration", "1e"],
+            "argument --duration: must be a number in [0.02, 20000] s (got '1e')",
+        ),
         (["--method", "nope"], "unknown method 'nope' (choose from "),
         (["--frobnicate"], "unrecognized arguments: --frobnicate"),
     ],

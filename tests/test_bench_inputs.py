@@ -99,6 +99,8 @@ def refused(args: list[str], workdir: Path, capsys, monkeypatch) -> str:
         (["--duration", "1e12"], "duration must be in [0.02, 20000] s (got 1e+12)"),
         (["--duration", "1e-9"], "duration must be in [0.02, 20000] s (got 1e-09)"),
         (["--duration", "20001"], "duration must be in [0.02, 20000] s"),
+        (["--duration", "-1"], "duration must be in [0.02, 20000] s (got -1)"),
+        (["--duration=-inf"], "argument --duration: must be a number in [0.02, 20000] s"),
     ],
 )
 def test_out_of_range_numbers_are_refused_before_the_run(
@@ -251,6 +253,21 @@ def test_an_out_file_in_proc_is_refused_before_the_run(workdir, capsys, monkeypa
 def test_an_unwritable_out_is_refused_before_the_run(make, message, workdir, capsys, monkeypatch):
     target = make(workdir)
     assert message in refused(["--out", target], workdir, capsys, monkeypatch)
+
+
+@pytest.mark.parametrize("force", [[], ["--force"]])
+def test_a_device_as_out_is_refused_without_suggesting_force(force, workdir, capsys, monkeypatch):
+    """--force cannot replace a device: the message without it does not offer it."""
+    line = refused(["--out", os.devnull, *force], workdir, capsys, monkeypatch)
+    message = f"out: {os.devnull} exists and is not a regular file; give a file name"
+    assert line == f"bench: error: {message}" and "--force" not in line
+
+
+def test_method_help_lists_every_valid_name():
+    text = " ".join(build_parser().format_help().split())
+    names = "ap, ats, clrrmc-cs, clrrmc-ts, mpc, pi, qp, qp-naive, rtb-holistic"
+    assert f"one of {names} (default: all)" in text
+    assert "the naive-pinv baseline is always measured" in text
 
 
 @pytest.mark.parametrize("force", [[], ["--force"]])

@@ -101,7 +101,11 @@ def test_payload_robot_file_and_animation(tmp_path):
         (["--method", "ats", "--traj", "ellipse", "--payload", "-1"], "payload must be >= 0"),
         (["--method", "ats", "--traj", "ellipse", "--payload", "nan"], "payload must be a finite"),
         (["--method", "clrrmc-ts", "--traj", "ellipse", "--tau", "-2"], "tau must be > 0"),
-        (["--method", "pi", "--traj", "ellipse", "--aux", "sum"], "unknown option 'aux'"),
+        (
+            ["--method", "pi", "--traj", "ellipse", "--aux", "sum"],
+            "error: aux: --aux is taken only by --method ats, clrrmc-ts or clrrmc-cs "
+            "(got --method pi)\n",
+        ),
         (["--method", "ats", "--traj", "missing.toml"], "no such file"),
         (["--method", "ats", "--traj", "ellipse", "--robot", "missing.toml"], "cannot read"),
     ],
@@ -128,6 +132,58 @@ def test_refuses_to_overwrite_a_foreign_folder(tmp_path):
     (out / "notes.txt").write_text("keep me")
     assert run(["--method", "ats", "--traj", "ellipse", "--duration", "1", "--out", str(out)]) == 2
     assert (out / "notes.txt").read_text() == "keep me"
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (
+            ["--method", "mpc", "--qp-mode", "weighted"],
+            "qp-mode: --qp-mode is taken only by --method qp (got --method mpc)",
+        ),
+        (
+            ["--method", "pi", "--stability-min", "1.5"],
+            "stability-min: --stability-min is taken only by --method qp or mpc (got --method pi)",
+        ),
+        (
+            ["--method", "ats", "--obstacles", "ellipse_post"],
+            "obstacles: --obstacles is taken only by --method qp or mpc (got --method ats)",
+        ),
+        (
+            ["--method", "pi", "--tau", "0.3"],
+            "tau: --tau is taken only by --method clrrmc-ts, clrrmc-cs or qp (got --method pi)",
+        ),
+    ],
+)
+def test_an_option_the_method_does_not_take_names_the_flag(tmp_path, capsys, args, message):
+    out = tmp_path / "run"
+    assert run([*args, "--traj", "ellipse", "--duration", "0.1", "--out", str(out)]) == 2
+    assert capsys.readouterr().err == f"error: {message}\n"
+    assert not out.exists()
+
+
+def test_a_duration_shorter_than_the_default_step_names_it(tmp_path, capsys):
+    args = ["--method", "pi", "--traj", "ellipse", "--duration", "0.01"]
+    assert run([*args, "--out", str(tmp_path / "run")]) == 2
+    assert capsys.readouterr().err == (
+        "error: duration must be >= one step, 0.02 s (the trajectory's T/N; or give a "
+        "smaller --dt) (got 0.01)\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_help_states_the_controller_option_defaults(capsys):
+    with pytest.raises(SystemExit):
+        run(["--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    for words in (
+        "hard floor on the stability margin S (default 1.25) [qp, mpc]",
+        "weight of the manipulability reward (default 0.5) [qp, mpc]",
+        "drawn in path.png (default none) [qp, mpc]",
+        "(default daqp for qp, rti for mpc) [qp, mpc]",
+        "priority handling (default weighted) [qp]",
+    ):
+        assert words in text, words
 
 
 def test_help_explains_methods():
@@ -255,6 +311,25 @@ def test_rerun_of_a_damaged_record_is_one_line(
     assert run(["--rerun", str(path), "--no-progress", "--out", str(tmp_path / "o")]) == 2
     error = capsys.readouterr().err.strip().splitlines()
     assert len(error) == 1 and message in error[0], error
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]
+
+
+#: Fields of a run record (``section.field`` inside a section) a --rerun cannot do without.
+NEEDED_FIELDS = ("trajectory", "method", "dt", "plant", "initial_offset")
+NEEDED_FIELDS += ("trajectory.parameters", "plant.name")
+
+
+@pytest.mark.parametrize("field", NEEDED_FIELDS)
+def test_rerun_of_a_record_missing_a_field_names_it(recorded_run, tmp_path, capsys, field):
+    damaged = json.loads(json.dumps(recorded_run))
+    section, _, key = field.rpartition(".")
+    del (damaged["run"][section] if section else damaged["run"])[key]
+    path = tmp_path / "summary.json"
+    path.write_text(json.dumps(damaged))
+    assert run(["--rerun", str(path), "--no-progress", "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err == (
+        f"error: rerun: {path} is not a complete run record (field run.{field} is missing)\n"
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]
 
 

@@ -108,7 +108,9 @@ def test_cli_arbiter_study_writes_tables_and_figures(tmp_path, capsys):
         (["--arbiter", "vote"], "invalid choice"),
         (["--arbiter", "competitive", "--controller", "qp"], "only the thesis controller"),
         (["--study", "arbiters", "--controller", "qp"], "arbiter study needs --controller thesis"),
-        (["--arbiter-seed", "-1"], "arbiter-seed must be >= 0"),
+        (["--arbiter", "competitive", "--arbiter-seed", "-1"], "arbiter-seed must be >= 0"),
+        (["--arbiter-seed", "5"], "--arbiter-seed: only used with --arbiter competitive"),
+        (["--study", "arbiters", "--arbiter", "competitive"], "runs both arbiters"),
     ],
 )
 def test_bad_arbiter_input_one_line_exit_2(tmp_path, args, message):

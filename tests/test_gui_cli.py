@@ -174,6 +174,22 @@ def test_options_reach_the_window_settings():
         (["--option", "tau"], "option must be NAME=VALUE"),
         (["--compare-option", "aux=sum"], "compare-option needs --compare METHOD"),
         (["--duration", "1", "--dt", "5"], "dt must be <= duration"),
+        (
+            ["--N", "2", "--duration", "1"],
+            "duration must be >= one step T/N = 40 s / 2 = 20 s (got 1); raise N or duration, "
+            "lower T, or set dt",
+        ),
+        (["--traj", "figure8", "--duration", "0.1"], "one step T/N = 60 s / 240 = 0.25 s"),
+        (["--offset", "1", "1"], "offset must be in [-0.65, 0.65] m (the arm's reach) (got 1)"),
+        (["--offset", "0", "-0.7"], "offset must be in [-0.65, 0.65] m (the arm's reach)"),
+        (
+            ["--plant", "thesis", "--integrator", "euler"],
+            "error: integrator: only the kinematic plant takes an integrator (plant 'thesis')",
+        ),
+        (
+            ["--plant", "mujoco", "--integrator", "rk4"],
+            "error: integrator: only the kinematic plant takes an integrator (plant 'mujoco')",
+        ),
         (["--dpi", "0"], "dpi must be in [10, 600] (got 0)"),
     ],
 )
@@ -184,6 +200,62 @@ def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):
     assert status == 2
     assert len(err.strip().splitlines()) == 1 and message in err, err
     assert not path.exists() and not list(tmp_path.iterdir())
+
+
+def test_the_integrator_is_only_refused_when_given():
+    settings = settings_from_arguments(build_parser().parse_args(["--plant", "thesis"]))
+    assert (settings.plant, settings.integrator) == ("thesis", "rk4")
+    settings = settings_from_arguments(build_parser().parse_args(["--integrator", "euler"]))
+    assert (settings.plant, settings.integrator) == ("kinematic", "euler")
+
+
+def test_export_with_snapshot_is_refused(tmp_path, capsys):
+    path, export = tmp_path / "shot.png", tmp_path / "exports"
+    status = run(["--snapshot", str(path), "--dpi", DPI, "--export", str(export)])
+    assert status == 2
+    assert capsys.readouterr().err == (
+        "error: export: --export cannot be combined with --snapshot (it sets the folder of "
+        "the window's Export buttons; a snapshot saves only the image)\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_geometry_places_a_sampled_trajectory():
+    """--a, --x0, --N on the figure-eight (a CSV) are applied, not ignored."""
+    argv = ["--traj", "figure8", "--a", "2", "--x0", "0.5", "--N", "120"]
+    settings = settings_from_arguments(build_parser().parse_args(argv))
+    points = build_trajectory(settings).points[:, :2]
+    low, high = points.min(axis=0), points.max(axis=0)
+    np.testing.assert_allclose((high - low) / 2, [2.0, 1.5], atol=1e-12)
+    np.testing.assert_allclose((high + low) / 2, [0.5, 0.0], atol=1e-12)
+    assert gui_settings.control_step(settings, build_trajectory(settings)) == 0.5  # 60 s / 120
+    own = settings_from_arguments(build_parser().parse_args(["--traj", "figure8", "--a", "3"]))
+    assert own.geometry == {}  # the file's own a: the file's trajectory unchanged
+
+
+def test_geometry_a_sampled_trajectory_cannot_take_is_refused(tmp_path, capsys):
+    flat = tmp_path / "flat.csv"
+    flat.write_text("t,x,y\n0,0.0,1.0\n1,0.5,1.0\n2,1.0,1.0\n")  # y never changes
+    status = run(["--snapshot", str(tmp_path / "shot.png"), "--traj", str(flat), "--b", "0.5"])
+    assert status == 2
+    assert capsys.readouterr().err == (
+        f"error: b: {flat} does not move along y, so it has no b to change (leave b at its "
+        "own value, 0)\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["flat.csv"]
+
+
+def test_help_states_the_defaults(capsys):
+    assert run(["--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    for words in (
+        "--compare METHOD method of slot B, shown side by side with A (default: none",
+        "--plant {kinematic,thesis,mujoco} what the commands drive (default kinematic)",
+        "--integrator {euler,rk4} integrator of the kinematic plant (default rk4;",
+        "(default -0.03 -0.03)",
+        "not with --snapshot",
+    ):
+        assert words in text, words
 
 
 def test_not_a_trajectory_file_is_bad_input(tmp_path, capsys):

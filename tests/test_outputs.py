@@ -175,6 +175,38 @@ def test_force_never_overwrites_a_user_file(tmp_path, tool, capsys):
     assert snapshot(out) == {WRITES[tool]: b"mine"} and leftovers(tmp_path) == []
 
 
+@pytest.mark.parametrize("tool", TOOLS)
+def test_force_refuses_a_clash_with_a_user_file_before_the_run(tmp_path, tool, capsys, monkeypatch):
+    """The clash is found before anything runs (the run never starts), in one line."""
+    import importlib
+
+    module = importlib.import_module(f"ddwmmr.cli.{tool}")
+
+    def never(*args, **kwargs):
+        raise AssertionError("the run started")
+
+    monkeypatch.setattr(module, "output_folder", never)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / WRITES[tool]).write_text("mine")
+    (out / "notes.txt").write_text("mine too")
+    assert run(tool, out, "--force") == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert f"{WRITES[tool]} is not a file a ddwmmr manifest lists" in err
+    assert snapshot(out) == {WRITES[tool]: b"mine", "notes.txt": b"mine too"}
+
+
+def test_a_figure_name_is_no_clash_when_track_draws_no_figures(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "path.png").write_text("mine")
+    assert run("track", out, "--force") == 0  # --no-plots: path.png is not written
+    assert (out / "path.png").read_text() == "mine"
+    with pytest.raises(ParameterError, match=r"out/path.png is not a file a ddwmmr manifest"):
+        check_output_folder(out, "track", True, ("timeseries.csv", "*.png"))  # patterns
+
+
 # -- the module itself --------------------------------------------------------------------
 def test_manifest_entries_outside_the_folder_are_never_deleted(tmp_path):
     victim = tmp_path / "victim.txt"

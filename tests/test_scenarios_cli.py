@@ -73,7 +73,14 @@ def test_obstacle_study_table(tmp_path, capsys):
         (["--scheduler", "tcp://x:1"], "only used with --executor dask"),
         (["--jobs", "0"], "jobs must be an integer in [1, 256]"),
         (["--study", "thresholds", "--controller", "qp"], "needs --controller thesis"),
-        (["--dt", "0"], "dt must be > 0"),
+        (["--dt", "0"], "dt must be in (0, 0.1] s"),
+        (["--dt", "0.2"], "dt must be in (0, 0.1] s"),
+        (["--dt", "inf"], "dt must be in (0, 0.1] s"),
+        (["--time-limit", "nan"], "time-limit must be > 0 s"),
+        (["--controller", "qp", "--stability", "1.3", "1.6"], "--stability: only used with"),
+        (["--controller", "mpc", "--manipulability", "0.7", "0.9"], "--manipulability: only"),
+        (["--controller", "qp", "--no-hysteresis", "stability"], "--no-hysteresis: only used"),
+        (["--study", "thresholds", "--stability", "1.3", "1.6"], "runs its own thresholds"),
     ],
 )
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, message):

@@ -45,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr.cli.common import ArgumentParser
 from ddwmmr.controllers.base import Controller, StepInfo, available_methods, make_controller
 from ddwmmr.errors import (
     MAX_JOBS,
@@ -1045,14 +1046,15 @@ def check_out(path: Path, force: bool = False) -> None:
     """Refuse, before the run, an output path that cannot be written or that is not a
     report of this tool (unless ``force``): see :func:`ddwmmr.outputs.check_output_file`.
     Something that is not a regular file (a device, a FIFO) is never replaced, not even
-    with ``force``: the report is moved into place by a rename, which would replace it."""
-    check_output_file(path, TOOL, _is_report, force)
+    with ``force``: the report is moved into place by a rename, which would replace it.
+    That is said first, so that the message does not suggest ``--force``."""
     try:
         info = os.stat(path)
-    except OSError:
-        return  # absent: check_output_file checked its folder
-    if not stat.S_ISREG(info.st_mode):
+    except (OSError, ValueError):
+        info = None  # absent (check_output_file checks its folder) or not a path at all
+    if info is not None and not stat.S_ISREG(info.st_mode) and not stat.S_ISDIR(info.st_mode):
         raise ParameterError(f"out: {path} exists and is not a regular file; give a file name")
+    check_output_file(path, TOOL, _is_report, force)
 
 
 def probe_out(path: str | Path) -> None:
@@ -1161,8 +1163,9 @@ with pip install -e '.[bench]'). Prints a table and writes the report to --out.
 """
 
 
-class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (``bench: error: ...``, exit status 2)."""
+class _Parser(ArgumentParser):
+    """The tools' parser (one-line errors, negative numbers in any notation) with the
+    prefix ``bench: error: ...`` (exit status 2)."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(2, f"bench: error: {message}\n")
@@ -1190,14 +1193,27 @@ _job_count = _integer(1, MAX_JOBS)
 _scenario_count = _integer(0, MAX_SCENARIOS)
 
 
-def _positive_float(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = math.nan
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"must be a number > 0 in s (got {text!r})")
-    return value
+def _seconds(low: float, high: float) -> Callable[[str], float]:
+    """An argparse type: a finite number; the range [``low``, ``high``] s is stated when the
+    text is not one (:func:`check_duration` then checks the range itself)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(
+                f"must be a number in [{low:g}, {high:g}] s (got {text!r})"
+            )
+        return value
+
+    return parse
+
+
+def method_names() -> list[str]:
+    """What ``--method`` accepts: the registered methods and the extra rows."""
+    return sorted(set(available_methods()) | {extra.label for extra in EXTRA_CASES})
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -1225,7 +1241,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--duration",
-        type=_positive_float,
+        type=_seconds(dt, MAX_STEPS * dt),
         default=None,
         metavar="S",
         help=f"simulated time of each full run in s (default: one trajectory period, "
@@ -1236,7 +1252,8 @@ def build_parser() -> argparse.ArgumentParser:
         action="append",
         dest="methods",
         metavar="NAME",
-        help="measure only this method (and its extra rows); repeatable",
+        help=f"measure only this method (and its extra rows; the {NAIVE_LABEL} baseline is "
+        f"always measured); repeatable; one of {', '.join(method_names())} (default: all)",
     )
     parser.add_argument(
         "--out", default="bench.json", metavar="FILE", help="report file (default bench.json)"
@@ -1283,11 +1300,11 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _main(argv: Sequence[str] | None = None) -> int:
     """The tool; bad input prints one line and returns 2."""
     args = build_parser().parse_args(argv)
-    known = set(available_methods()) | {extra.label for extra in EXTRA_CASES}
-    unknown = sorted(set(args.methods or ()) - known)
+    unknown = sorted(set(args.methods or ()) - set(method_names()))
     if unknown:
+        choices = ", ".join(method_names())
         print(
-            f"bench: error: unknown method {unknown[0]!r} (choose from {', '.join(sorted(known))})",
+            f"bench: error: unknown method {unknown[0]!r} (choose from {choices})",
             file=sys.stderr,
         )
         return 2

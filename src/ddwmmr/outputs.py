@@ -21,13 +21,14 @@ usual ``022``), not the ``0600``/``0700`` of temporary files.
 from __future__ import annotations
 
 import contextlib
+import fnmatch
 import json
 import os
 import shutil
 import stat
 import sys
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
@@ -253,11 +254,16 @@ def check_output_path(target: str | Path, what: str = "folder") -> Path:
     return path
 
 
-def check_output_folder(target: str | Path, tool: str, force: bool = False) -> Path:
+def check_output_folder(
+    target: str | Path, tool: str, force: bool = False, writes: Sequence[str] = ()
+) -> Path:
     """Refuse (one-line :class:`ParameterError`) an ``--out`` that may not be written.
 
     Returns the absolute target path. Called before any simulation, so bad output paths
     fail fast; :func:`output_folder` checks again just before it moves files into place.
+    ``writes``: patterns (``fnmatch``, relative posix names) of the files the tool may
+    write; with ``force``, a file no manifest lists that matches one is refused here,
+    before the run, rather than after it (the final check stays exact).
     """
     text = str(target)
     path = check_output_path(target)
@@ -268,8 +274,20 @@ def check_output_folder(target: str | Path, tool: str, force: bool = False) -> P
     existing = inspect(path, tool)
     if existing.kind == "foreign" and not force:
         raise ParameterError(_refusal(text, tool, existing))
+    clash = next(
+        (f for f in existing.foreign if any(fnmatch.fnmatchcase(f, p) for p in writes)), None
+    )
+    if clash is not None:
+        raise ParameterError(_clash(text, clash))
     _check_replaceable(path, text, existing)
     return path
+
+
+def _clash(text: str, name: str) -> str:
+    return (
+        f"out: {text}/{name} is not a file a ddwmmr manifest lists and would be "
+        "overwritten; move it or choose another --out"
+    )
 
 
 def check_output_file(
@@ -395,10 +413,7 @@ def _merge(staging: Path, target: Path, files: list[str], existing: Existing, te
     if MANIFEST in existing.foreign:  # an unreadable manifest is not ours to overwrite
         clashes.append(MANIFEST)
     if clashes:
-        raise ParameterError(
-            f"out: {text}/{clashes[0]} is not a file a ddwmmr manifest lists and would be "
-            "overwritten; move it or choose another --out"
-        )
+        raise ParameterError(_clash(text, clashes[0]))
     for name in existing.listed:
         _unlink_regular(target / name)
     for name in [*files, MANIFEST]:

@@ -16,6 +16,7 @@ import argparse
 import contextlib
 import multiprocessing
 import os
+import re
 import signal
 import sys
 import threading
@@ -44,8 +45,21 @@ __all__ = [
 ]
 
 
+#: Arguments that are negative numbers, not option names: argparse's own pattern misses
+#: scientific notation and the IEEE words (``-3e-2``, ``-1E5``, ``-inf``), so
+#: ``--offset -3e-2 -3e-2`` was refused as "expected 2 arguments".
+NEGATIVE_NUMBER = re.compile(
+    r"^-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$|^-(inf|infinity|nan)$", re.IGNORECASE
+)
+
+
 class ArgumentParser(argparse.ArgumentParser):
-    """argparse with one-line errors: ``prog: error: message`` and exit status 2."""
+    """argparse with one-line errors: ``prog: error: message`` and exit status 2, and
+    negative numbers in any float notation taken as values (:data:`NEGATIVE_NUMBER`)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message: str) -> None:  # type: ignore[override]
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")

@@ -58,8 +58,19 @@ from ddwmmr.sim.result import json_safe, write_atomic
 MARKER = "summary.json"
 STUDIES = ("thresholds", "obstacles", "arbiters")
 PROG = "python -m ddwmmr.scenarios"
+#: The files a run may write (checked against a user's files before the run, --force).
+WRITES = (
+    "scenarios.csv",
+    "summary.json",
+    "table.txt",
+    *(f"{study}.md" for study in ("thresholds", "obstacles", "arbiters")),
+    "thesis_*.png",
+    "competitive_weights_*.png",
+)
 #: Upper bound of --qp-max-speed (m/s): far above what the robot can do (base 1.5 m/s).
 MAX_QP_SPEED = 10.0
+#: Longest control step (s): the thesis controller's gains are tuned per 0.01 s sample.
+MAX_DT = 0.1
 #: --qp-* options: the controllers that take them, the allowed values and their text.
 QP_OPTIONS = {
     "qp_stability_min": (
@@ -71,6 +82,8 @@ QP_OPTIONS = {
 }
 #: Largest threshold: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
 THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}
+#: The thesis's thresholds (enter, exit), the defaults of --stability and --manipulability.
+DEFAULT_THRESHOLDS = {"stability": (1.25, 1.60), "manipulability": (0.75, 0.90)}
 
 DESCRIPTION = """\
 Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly (seeded) in
@@ -108,16 +121,17 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--arbiter",
         choices=ARBITERS,
-        default="state-machine",
+        default=None,
         help="thesis controller's arbiter: the thesis's 'state-machine' (default) or "
         "'competitive' dynamics (Ellekilde & Christensen 2009; same thresholds options)",
     )
     parser.add_argument(
         "--arbiter-seed",
         type=int,
-        default=0,
+        default=None,
         metavar="N",
-        help="noise seed of the competitive arbiter (default: 0)",
+        help="noise seed of the competitive arbiter (--arbiter competitive or --study "
+        "arbiters; default: 0)",
     )
     parser.add_argument(
         "--plant",
@@ -152,17 +166,18 @@ def build_parser() -> ArgumentParser:
         "--stability",
         nargs=2,
         type=float,
-        default=(1.25, 1.60),
+        default=None,
         metavar=("ENTER", "EXIT"),
-        help="stability thresholds: enter below ENTER, leave at EXIT (default: 1.25 1.60)",
+        help="thesis controller's stability thresholds: enter below ENTER, leave at EXIT "
+        "(default: 1.25 1.60)",
     )
     parser.add_argument(
         "--manipulability",
         nargs=2,
         type=float,
-        default=(0.75, 0.90),
+        default=None,
         metavar=("ENTER", "EXIT"),
-        help="manipulability thresholds (default: 0.75 0.90)",
+        help="thesis controller's manipulability thresholds (default: 0.75 0.90)",
     )
     parser.add_argument(
         "--no-hysteresis",
@@ -174,7 +189,8 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--obstacles",
         action="store_true",
-        help="run thesis scenarios 1, 3, 7, 10 with two obstacles (r 0.3 m) each, 120 s limit",
+        help="run thesis scenarios 1, 3, 7, 10 (those up to --n) with two obstacles (r 0.3 m) "
+        "each, 120 s limit",
     )
     parser.add_argument(
         "--time-limit",
@@ -187,7 +203,7 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=0.01,
         metavar="S",
-        help="control and integration step in s (default: 0.01, the thesis "
+        help=f"control and integration step in s, in (0, {MAX_DT:g}] (default: 0.01, the thesis "
         "controller's sample time)",
     )
     parser.add_argument(
@@ -290,16 +306,18 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         raise ParameterError("study: the threshold study needs --controller thesis")
     if args.study == "arbiters" and args.controller != "thesis":
         raise ParameterError("study: the arbiter study needs --controller thesis")
-    check_nonnegative("arbiter-seed", args.arbiter_seed)
+    _check_thesis_options(args)
+    arbiter = args.arbiter or "state-machine"
+    arbiter_seed = 0 if args.arbiter_seed is None else args.arbiter_seed
+    check_nonnegative("arbiter-seed", arbiter_seed)
     if args.study and args.obstacles:
         raise ParameterError("study: --obstacles is implied by --study obstacles")
-    for name in ("dt", "time_limit"):
-        value = getattr(args, name)
-        if value is not None and not (math.isfinite(value) and value > 0):
-            raise ParameterError(f"{name.replace('_', '-')} must be > 0 (got {value:g})")
+    if not (math.isfinite(args.dt) and 0.0 < args.dt <= MAX_DT):
+        raise ParameterError(f"dt must be in (0, {MAX_DT:g}] s (got {args.dt:g})")
+    limit = args.time_limit
+    if limit is not None and not (math.isfinite(limit) and limit > 0):
+        raise ParameterError(f"time-limit must be > 0 s and finite (got {limit:g})")
     qp_options = _qp_options(args)
-    if args.dt > 0.1:
-        raise ParameterError(f"dt must be <= 0.1 s (got {args.dt:g})")
     check_range("payload", args.payload, *MASS_RANGE_KG, "kg")
     obstacles = args.obstacles or args.study == "obstacles"
     longest = args.time_limit if args.time_limit is not None else (120.0 if obstacles else 60.0)
@@ -310,7 +328,8 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     check_start_pose(args.payload)
     thresholds = {}
     for name in ("stability", "manipulability"):
-        enter, exit_ = getattr(args, name)
+        given = getattr(args, name)
+        enter, exit_ = DEFAULT_THRESHOLDS[name] if given is None else given
         high = THRESHOLD_RANGES[name]
         for value in (enter, exit_):
             if not (math.isfinite(value) and 0.0 < value <= high):
@@ -327,9 +346,31 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         dt=args.dt,
         time_limit=args.time_limit,
         **qp_options,
-        arbiter=args.arbiter,
-        arbiter_seed=args.arbiter_seed,
+        arbiter=arbiter,
+        arbiter_seed=arbiter_seed,
     )
+
+
+def _check_thesis_options(args: argparse.Namespace) -> None:
+    """Refuse the thesis controller's options where nothing would read them."""
+    given = [f"--{n}" for n in ("stability", "manipulability") if getattr(args, n) is not None]
+    given += ["--no-hysteresis"] if args.no_hysteresis else []
+    if given and args.controller != "thesis":
+        raise ParameterError(
+            f"{given[0]}: only used with --controller thesis (the qp and mpc hold "
+            "--qp-stability-min)"
+        )
+    if given and args.study == "thresholds":
+        raise ParameterError(
+            f"{given[0]}: the threshold study runs its own thresholds (thesis Tables "
+            "5.2-5.18); leave it out"
+        )
+    if args.arbiter is not None and args.study == "arbiters":
+        raise ParameterError("--arbiter: the arbiter study runs both arbiters; leave it out")
+    if args.arbiter_seed is not None and args.arbiter != "competitive" and args.study != "arbiters":
+        raise ParameterError(
+            "--arbiter-seed: only used with --arbiter competitive or --study arbiters"
+        )
 
 
 class Runner:
@@ -534,7 +575,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     args.argv = argv  # recorded in the summary
     config = config_from_arguments(args)
     out = Path(args.out) if args.out is not None else default_out()
-    check_output_folder(out, "scenarios", args.force)
+    check_output_folder(out, "scenarios", args.force, WRITES)
     if config.controller == "qp":
         from ddwmmr.scenarios.protocol import make_qp
 

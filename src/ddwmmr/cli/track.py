@@ -13,7 +13,7 @@ import argparse
 import datetime as dt
 import json
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -28,7 +28,12 @@ from ddwmmr.cli.common import (
     robot_from_arguments,
     run_main,
 )
-from ddwmmr.controllers.base import available_methods, make_controller, method_description
+from ddwmmr.controllers.base import (
+    available_methods,
+    make_controller,
+    method_description,
+    method_options,
+)
 from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file, shown
 from ddwmmr.model import Robot
@@ -89,7 +94,8 @@ MM_KEYS = {
     "min_obstacle_clearance_m",
 }
 
-#: CLI option -> (controller keyword, methods it applies to; None = any method accepting it).
+#: CLI option -> controller keyword; a method takes the option if its constructor has the
+#: keyword (:func:`ddwmmr.controllers.base.method_options`), any other refuses it.
 METHOD_OPTIONS = {
     "aux": "aux",
     "tau": "tau",
@@ -99,6 +105,33 @@ METHOD_OPTIONS = {
     "solver": "solver",
     "qp_mode": "mode",
 }
+
+
+def _methods_taking(keyword: str) -> list[str]:
+    """Registered methods whose options include the controller keyword ``keyword``."""
+    return [m for m in available_methods() if keyword in method_options(m)]
+
+
+def _either(names: Sequence[str]) -> str:
+    """``a``, ``a or b``, ``a, b or c``."""
+    return " or ".join([", ".join(names[:-1]), names[-1]] if len(names) > 1 else names)
+
+
+def _option_help(text: str, keyword: str) -> str:
+    """``text`` with the default of each method taking ``keyword`` and those methods."""
+    defaults = {m: _default_text(method_options(m)[keyword]) for m in _methods_taking(keyword)}
+    if len(set(defaults.values())) == 1:
+        default = next(iter(defaults.values()))
+    else:
+        default = ", ".join(f"{value} for {m}" for m, value in defaults.items())
+    return f"{text} (default {default}) [{', '.join(defaults)}]"
+
+
+def _default_text(value: Any) -> str:
+    """An option default as --help shows it (an empty sequence is none)."""
+    if isinstance(value, list | tuple) and not value:
+        return "none"
+    return f"{value:g}" if isinstance(value, float) else str(value)
 
 
 def build_parser() -> ArgumentParser:
@@ -180,24 +213,43 @@ def build_parser() -> ArgumentParser:
         f"{DEFAULT_INITIAL_OFFSET[0]:.2f} {DEFAULT_INITIAL_OFFSET[1]:.2f})",
     )
     add_robot_arguments(parser)
-    qp = parser.add_argument_group("QP controller options (--method qp)")
-    qp.add_argument("--stability-min", type=float, metavar="S", help="hard floor on S")
+    qp = parser.add_argument_group(
+        "QP and MPC controller options (in brackets: the methods taking each)"
+    )
+    qp.add_argument(
+        "--stability-min",
+        type=float,
+        metavar="S",
+        help=_option_help("hard floor on the stability margin S", "stability_min"),
+    )
     qp.add_argument(
         "--manipulability-weight",
         type=float,
         metavar="W",
-        help="weight of the manipulability reward",
+        help=_option_help("weight of the manipulability reward", "manipulability_weight"),
     )
     qp.add_argument(
         "--obstacles",
         metavar="NAME|FILE",
-        help="circles to avoid: a TOML file of [[obstacle]] tables x, y, radius (m), or the "
-        "name of a shipped one (ellipse_post); drawn in path.png",
+        help=_option_help(
+            "circles to avoid: a TOML file of [[obstacle]] tables x, y, radius (m), or the "
+            "name of a shipped one (ellipse_post); drawn in path.png",
+            "obstacles",
+        ),
     )
     qp.add_argument(
-        "--solver", help="qpsolvers backend (osqp, daqp, quadprog, proxqp, clarabel...)"
+        "--solver",
+        help=_option_help(
+            "qp: a qpsolvers backend (osqp, daqp, quadprog, proxqp, clarabel...); mpc: its "
+            "NLP solver (rti, sqp, ipopt...)",
+            "solver",
+        ),
     )
-    qp.add_argument("--qp-mode", choices=("weighted", "hierarchical"), help="priority handling")
+    qp.add_argument(
+        "--qp-mode",
+        choices=("weighted", "hierarchical"),
+        help=_option_help("priority handling", "mode"),
+    )
     out = parser.add_argument_group("output")
     out.add_argument(
         "--out", metavar="DIR", help="output folder (default runs/<method>-<traj>-<time>/)"
@@ -216,6 +268,12 @@ def controller_options(args: argparse.Namespace) -> dict[str, Any]:
         value = getattr(args, attribute)
         if value is None:
             continue
+        if keyword not in method_options(args.method):
+            flag = "--" + attribute.replace("_", "-")
+            raise ParameterError(
+                f"{flag[2:]}: {flag} is taken only by --method "
+                f"{_either(_methods_taking(keyword)) or '(none)'} (got --method {args.method})"
+            )
         if attribute == "tau" and len(value) == 1:
             value = value[0]
         if attribute == "obstacles":
@@ -277,6 +335,11 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     duration = trajectory.duration if args.duration is None else args.duration
     plant = args.plant or PLANT
     step = default_step(trajectory, plant, robot) if args.dt is None else args.dt
+    if args.dt is None and 0 < duration < step:  # the user gave --duration, not --dt
+        raise ParameterError(
+            f"duration must be >= one step, {step:g} s (the trajectory's T/N; or give a "
+            f"smaller --dt) (got {duration:g})"
+        )
     offset = DEFAULT_INITIAL_OFFSET if args.offset is None else tuple(args.offset)
     for value in offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
@@ -307,11 +370,14 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         raise ParameterError("rerun: give the path of a summary.json (got an empty path)")
     record = load_run_record(args.rerun)
     try:
-        plant = _field(record["plant"], "name", str, "plant name")
+        plant_record = _field(record, "plant", dict, "plant")
+        plant = _inside("plant", lambda: _field(plant_record, "name", str, "plant name"))
         if plant not in available_plants():
             raise ParameterError(f"rerun: plant {plant!r} is not supported by this version")
         trajectory_record = _field(record, "trajectory", dict, "trajectory")
-        trajectory = provenance.trajectory_from_record(trajectory_record)
+        trajectory = _inside(
+            "trajectory", lambda: provenance.trajectory_from_record(trajectory_record)
+        )
         source = trajectory_record.get("file")
         offset = tuple(provenance.decode(_field(record, "initial_offset", list, "offset")))
         return RunInputs(
@@ -329,8 +395,20 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         )
     except ParameterError:  # already one line naming what is wrong
         raise
-    except (KeyError, TypeError, AttributeError, ValueError) as exc:
+    except KeyError as exc:
+        raise ParameterError(
+            f"rerun: {args.rerun} is not a complete run record (field run.{exc.args[0]} is missing)"
+        ) from None
+    except (TypeError, AttributeError, ValueError) as exc:
         raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
+
+
+def _inside(section: str, read: Callable[[], Any]) -> Any:
+    """``read()``; a field it misses is named inside ``section`` (``trajectory.type``)."""
+    try:
+        return read()
+    except KeyError as exc:
+        raise KeyError(f"{section}.{exc.args[0]}") from None
 
 
 def _field(record: dict[str, Any], key: str, kind: type, what: str) -> Any:
@@ -400,6 +478,27 @@ def run_record(
     return record
 
 
+def output_names(plots: bool) -> tuple[str, ...]:
+    """The files a run writes (checked against a user's files before the run, --force)."""
+    if not plots:
+        return ("timeseries.csv", "summary.json")
+    from ddwmmr.reports.plots import FIGURE_NAMES  # matplotlib: only for runs that plot
+
+    return ("timeseries.csv", "summary.json", *FIGURE_NAMES)
+
+
+def _note_uneven_duration(duration: float, dt: float, steps: int) -> None:
+    """Say so (stderr) when the run does not last the duration asked for: ``duration`` (s)
+    is not a whole number of steps ``dt`` (s), and the run takes the nearest, ``steps``."""
+    covered = steps * dt
+    if abs(covered - duration) > 1e-9 * duration:
+        print(
+            f"track: note: duration {duration:g} s is not a whole number of steps of dt "
+            f"{dt:g} s; the run lasts {steps} steps, {covered:.6g} s",
+            file=sys.stderr,
+        )
+
+
 def _main(argv: Sequence[str] | None = None) -> int:
     """Run the tool; bad input raises :class:`ParameterError`."""
     args = build_parser().parse_args(argv)
@@ -407,9 +506,10 @@ def _main(argv: Sequence[str] | None = None) -> int:
     steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
     controller = make_controller(inputs.method, inputs.robot, **inputs.options)
     out = Path(args.out) if args.out is not None else default_out(inputs.method, inputs.label)
-    check_output_folder(out, "track", args.force)
+    check_output_folder(out, "track", args.force, output_names(not args.no_plots))
     record = run_record(inputs, argv, args.rerun)
     progress = not args.no_progress
+    _note_uneven_duration(inputs.duration, inputs.dt, steps)
     with output_folder(out, "track", args.force) as staging:
         with ProgressBar(steps, "track: steps", enabled=progress, unit="step") as bar:
             result = simulate(

@@ -34,10 +34,17 @@ from ddwmmr.gui.paths import (
     check_snapshot_path,
     snapshot_format,
 )
-from ddwmmr.gui.settings import GEOMETRY, Settings, check_geometry, check_settings
+from ddwmmr.gui.settings import (
+    GEOMETRY,
+    Settings,
+    check_geometry,
+    check_run_length,
+    check_settings,
+)
 from ddwmmr.outputs import missing_folders, remove_created
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.sim.result import write_atomic
+from ddwmmr.sim.simulate import plant_integrator
 from ddwmmr.trajectories import available_trajectories
 
 #: Exit status when no window can be opened or a snapshot's run fails (not bad input).
@@ -92,7 +99,7 @@ def build_parser() -> ArgumentParser:
         "--compare",
         choices=methods,
         metavar="METHOD",
-        help="method of slot B, shown side by side with A",
+        help="method of slot B, shown side by side with A (default: none, slot A alone)",
     )
     parser.add_argument(
         "--traj",
@@ -124,14 +131,24 @@ def build_parser() -> ArgumentParser:
         metavar="NAME=VALUE",
         help="option of method B (repeatable)",
     )
-    parser.add_argument("--plant", choices=plant_names(), default="kinematic", help="plant")
+    parser.add_argument(
+        "--plant",
+        choices=plant_names(),
+        default=Settings().plant,
+        help=f"what the commands drive (default {Settings().plant})",
+    )
     parser.add_argument(
         "--payload",
         type=float,
         metavar="KG",
         help=f"payload in kg (default {Settings().payload:g})",
     )
-    parser.add_argument("--integrator", choices=INTEGRATORS, default="rk4")
+    parser.add_argument(
+        "--integrator",
+        choices=INTEGRATORS,
+        help=f"integrator of the kinematic plant (default {Settings().integrator}; the other "
+        "plants integrate their own dynamics and refuse it)",
+    )
     parser.add_argument("--dt", type=float, metavar="S", help="step in s (default T/N)")
     parser.add_argument(
         "--duration", type=float, metavar="S", help="simulated time in s (default one period T)"
@@ -141,10 +158,14 @@ def build_parser() -> ArgumentParser:
         type=float,
         nargs=2,
         metavar=("DX", "DY"),
-        help="initial end-effector offset in m",
+        help="initial end-effector offset in m, in the end effector's start frame, each "
+        f"within the arm's reach (default {Settings().offset[0]:.2f} {Settings().offset[1]:.2f})",
     )
     parser.add_argument(
-        "--export", metavar="DIR", help="export folder of the window (default runs/gui)"
+        "--export",
+        metavar="DIR",
+        help="folder the window's Export buttons write to (default runs/gui); not with "
+        "--snapshot, which exports nothing",
     )
     return parser
 
@@ -175,20 +196,23 @@ def settings_from_arguments(args: argparse.Namespace) -> Settings:
         value = getattr(args, name)
         if value is not None:
             settings = settings.with_geometry(name, check_geometry(name, value))
-    changes: dict[str, object] = {"plant": args.plant, "integrator": args.integrator}
+    # An explicit --integrator on a plant that integrates its own dynamics is refused.
+    integrator = plant_integrator(args.plant, args.integrator) or Settings().integrator
+    changes: dict[str, object] = {"plant": args.plant, "integrator": integrator}
     for name in ("payload", "dt", "duration"):
         if getattr(args, name) is not None:
             changes[name] = getattr(args, name)
     if args.offset is not None:
         changes["offset"] = tuple(args.offset)
-    return check_settings(settings.replace(**changes))
+    settings = check_settings(settings.replace(**changes))
+    check_run_length(settings)  # before the window is built, naming --N, --T, --duration
+    return settings
 
 
 def snapshot(
     settings: Settings,
     path: str | Path,
     dpi: float | None = None,
-    export_dir: str | None = None,
     force: bool = False,
 ) -> Path:
     """Build the window off-screen, run to the end, draw the final state, save it in the
@@ -208,8 +232,6 @@ def snapshot(
     figure = Figure(figsize=FIGSIZE, dpi=DPI)
     FigureCanvasAgg(figure)
     app = App(figure, settings)
-    if export_dir:
-        app.export_field.show(export_dir)
     app.run()
     app.wait()
     if app.results is None:
@@ -297,10 +319,15 @@ def _main(argv: Sequence[str] | None = None) -> int:
         check_dpi(args.dpi)
     if args.export is not None:
         check_export_root(args.export)
+        if args.snapshot is not None:
+            raise ParameterError(
+                "export: --export cannot be combined with --snapshot (it sets the folder of "
+                "the window's Export buttons; a snapshot saves only the image)"
+            )
     settings = settings_from_arguments(args)
     if args.snapshot is not None:
         try:
-            path = snapshot(settings, args.snapshot, args.dpi, args.export, args.force)
+            path = snapshot(settings, args.snapshot, args.dpi, args.force)
         except RunFailed as exc:
             print(f"error: {exc}", file=sys.stderr)
             return EXIT_NO_DISPLAY

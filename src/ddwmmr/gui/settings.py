@@ -28,9 +28,10 @@ from ddwmmr.controllers.base import available_methods, make_controller
 from ddwmmr.errors import (
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
-    check_finite,
     check_int_at_least,
     check_positive,
+    check_range,
+    check_step_count,
 )
 from ddwmmr.gui.options import method_options, plant_keywords, plant_names
 from ddwmmr.model import Robot
@@ -38,6 +39,7 @@ from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
 from ddwmmr.sim import SimulationResult, simulate
 from ddwmmr.trajectories import SampledTrajectory, load_trajectory
+from ddwmmr.trajectories.base import resolution_step
 from ddwmmr.trajectories.parametric import check_geometry_value
 
 #: Trajectory geometry parameters, in panel order, with unit and allowed range.
@@ -168,7 +170,14 @@ def build_trajectory(settings: Settings) -> Any:
     if not changes:
         return base
     if isinstance(base, SampledTrajectory):
-        return place_samples(base, {**geometry_of(base), **changes})
+        own = geometry_of(base)
+        for name, axis in (("a", "x"), ("b", "y")):
+            if name in changes and own[name] == 0:  # nothing to scale: it would be ignored
+                raise ParameterError(
+                    f"{name}: {settings.trajectory} does not move along {axis}, so it has no "
+                    f"{name} to change (leave {name} at its own value, 0)"
+                )
+        return place_samples(base, {**own, **changes})
     own = geometry_of(base)
     unknown = sorted(set(changes) - set(own) - {"N"})
     if unknown or not dataclasses.is_dataclass(base):
@@ -248,12 +257,30 @@ def check_settings(settings: Settings) -> Settings:
             check_positive(name, value)
     if len(settings.offset) != 2:
         raise ParameterError("offset must be two numbers dx, dy in m")
+    robot = build_robot(settings)
     for value in settings.offset:
-        check_finite("offset", value)
+        check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
     build_trajectory(settings)
     for slot in settings.active_slots:
         build_controller(settings, slot)
     return settings
+
+
+def check_run_length(settings: Settings) -> int:
+    """The number of steps of a run of ``settings`` (:func:`check_step_count`), what
+    :func:`check_settings` leaves to the run; a duration shorter than the step is refused
+    naming T and N when the step is their T / N (dt not set). For the command line, which
+    refuses bad input before the window is built."""
+    trajectory = build_trajectory(settings)
+    duration = trajectory.duration if settings.duration is None else settings.duration
+    dt = control_step(settings, trajectory) or resolution_step(trajectory)
+    if settings.dt is None and dt > duration:
+        samples = trajectory.duration / dt
+        raise ParameterError(
+            f"duration must be >= one step T/N = {trajectory.duration:g} s / {samples:g} = "
+            f"{dt:g} s (got {duration:g}); raise N or duration, lower T, or set dt"
+        )
+    return check_step_count(duration, dt)
 
 
 def simulate_settings(

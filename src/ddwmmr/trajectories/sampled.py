@@ -301,6 +301,19 @@ def csv_text(trajectory: SampledTrajectory) -> str:
     return "\n".join(rows) + "\n"
 
 
+def _csv_number(path: Path, number: int, row: dict, key: str) -> float:
+    """The value of column ``key`` in data row ``number`` as a float (one-line errors)."""
+    text = row.get(key)
+    if text is None or not text.strip():
+        raise ParameterError(f"traj: {path} data row {number} has no value in column {key}")
+    try:
+        return float(text)
+    except ValueError:
+        raise ParameterError(
+            f"traj: {path} data row {number}, column {key}: {text.strip()!r} is not a number"
+        ) from None
+
+
 def read_csv(path: str | Path) -> SampledTrajectory:
     """Load a :class:`SampledTrajectory` from a CSV file with columns t, x, y[, phi]."""
     path = Path(path)
@@ -332,11 +345,12 @@ def read_csv(path: str | Path) -> SampledTrajectory:
     if missing:
         raise ParameterError(f"traj: {path} lacks column(s) {', '.join(sorted(missing))}")
     keys = ["x", "y", "phi"] if "phi" in columns else ["x", "y"]
-    try:
-        times = np.array([float(r["t"]) for r in rows])
-        points = np.array([[float(r[k]) for k in keys] for r in rows])
-    except (TypeError, ValueError):
-        raise ParameterError(f"traj: {path} has a non-numeric value") from None
+    values = [
+        [_csv_number(path, number, r, k) for k in ("t", *keys)]
+        for number, r in enumerate(rows, start=1)
+    ]
+    times = np.array([row[0] for row in values])
+    points = np.array([row[1:] for row in values])
     try:
         return SampledTrajectory(times, points, name=path.stem)
     except ParameterError as exc:
