@@ -193,6 +193,8 @@ CASES += [
     ("compare", ["--jobs", "1e9"], "argument --jobs: invalid int value"),
     ("compare", ["--methods", "nope"], "unknown method 'nope'"),
     ("compare", ["--study", "nope"], "unknown study 'nope'"),
+    ("compare", ["--study", "tau"], "study: 'none' cannot be combined with other studies"),
+    ("compare", ["--study-methods", "qp"], "study-methods: only used with a study"),
     ("compare", ["--methods", ""], "methods: no name given"),
     ("compare", ["--methods", ",,,"], "methods: no name given"),
     ("compare", ["--study", ""], "study: no name given"),

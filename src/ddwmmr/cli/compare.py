@@ -248,6 +248,11 @@ def parse_studies(values: Sequence[str] | None) -> tuple[str, ...]:
             raise ParameterError(
                 f"study: unknown study {name!r} (known: {', '.join(STUDIES)}, all, none)"
             )
+    if len(set(names)) > 1 and {"all", "none"} & set(names):
+        word = "none" if "none" in names else "all"
+        raise ParameterError(
+            f"study: {word!r} cannot be combined with other studies (got {' '.join(names)})"
+        )
     if "all" in names:
         return STUDIES
     return tuple(s for s in STUDIES if s in names)
@@ -339,13 +344,16 @@ def config_from_arguments(
     study_methods = (
         parse_methods(args.study_methods, "study-methods") if args.study_methods else None
     )
+    studies = parse_studies(args.study)
+    if study_methods is not None and not studies:
+        raise ParameterError("study-methods: only used with a study (got --study none)")
     return CompareConfig(
         methods=methods,
         study_methods=study_methods,
         trajectories=trajectories,
         robot=robot_from_arguments(args),
         duration=check_duration(args.duration, trajectories),
-        studies=parse_studies(args.study),
+        studies=studies,
         command=command,
         preset=args.preset,
         plants=tuple(dict.fromkeys(args.plant)),
