@@ -40,7 +40,11 @@ from ddwmmr.model import Robot
 from ddwmmr.plants import available_plants
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
-from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
+from ddwmmr.resolution.reference import (
+    DEFAULT_INITIAL_OFFSET,
+    offset_configuration,
+    start_configuration,
+)
 from ddwmmr.sim.simulate import default_step, plant_integrator, simulate
 from ddwmmr.trajectories import available_trajectories, load_trajectory
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
@@ -343,6 +347,7 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     offset = DEFAULT_INITIAL_OFFSET if args.offset is None else tuple(args.offset)
     for value in offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
+    _check_start_stability(robot, trajectory, offset, "payload" if args.payload is not None else "robot")
     return RunInputs(
         args.method,
         options,
@@ -356,6 +361,17 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         args.traj,
         plant,
     )
+
+
+def _check_start_stability(robot: Robot, trajectory: Any, offset, name: str) -> None:
+    """Refuse a robot (its payload, ``name``) that tips over in the run's start pose."""
+    start = offset_configuration(robot, start_configuration(robot, trajectory), offset)
+    s = robot.stability(start)[2]
+    if s <= 1.0:
+        raise ParameterError(
+            f"{name}: a {robot.payload:g} kg payload tips the robot over in this run's start "
+            f"pose (S = {s:.3g} <= 1); lighten the payload"
+        )
 
 
 def inputs_from_record(args: argparse.Namespace) -> RunInputs:
