@@ -37,27 +37,3 @@ def test_a_negative_infinite_payload_gets_the_parameters_message(capsys):
     assert track_main(["--method", "pi", "--traj", "ellipse", "--payload", "-inf"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "payload must be a finite number" in err
-
-
-def test_track_says_when_the_steps_do_not_fill_the_duration(tmp_path, capsys):
-    argv = ["--method", "pi", "--traj", "ellipse", "--no-plots", "--no-progress"]
-    assert track_main([*argv, "--dt", "0.3", "--duration", "1", "--out", str(tmp_path / "a")]) == 0
-    err = capsys.readouterr().err
-    assert "duration 1 s is not a whole number of steps of dt 0.3 s" in err
-    assert "the run lasts 3 steps, 0.9 s" in err
-    summary = json.loads((tmp_path / "a" / "summary.json").read_text())
-    assert summary["duration"] == pytest.approx(0.9, rel=1e-12)
-    assert track_main([*argv, "--dt", "0.25", "--duration", "1", "--out", str(tmp_path / "b")]) == 0
-    assert "note" not in capsys.readouterr().err
-
-
-def test_track_refuses_a_payload_that_tips_the_robot_at_the_start(tmp_path, capsys):
-    """The kinematic plant would run it (S < 1 from the first step); the run is refused
-    instead, as the scenarios tool refuses it, naming the payload and the margin."""
-    argv = ["--method", "pi", "--traj", "ellipse", "--duration", "0.2", "--no-plots"]
-    out = tmp_path / "out"
-    assert track_main([*argv, "--payload", "50", "--out", str(out)]) == 2
-    err = capsys.readouterr().err
-    assert err.count("\n") == 1 and not out.exists()
-    assert "payload: a 50 kg payload tips the robot over in this run's start pose (S = 0.45" in err
-    assert track_main([*argv, "--no-progress", "--payload", "3", "--out", str(out)]) == 0

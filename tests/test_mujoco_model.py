@@ -206,3 +206,19 @@ def test_the_model_is_generated_not_kept():
     """Changing the robot changes the MJCF: nothing is cached or hand-kept."""
     assert mjcf(Robot()) != mjcf(Robot(L1=0.4))
     assert mjcf(Robot()) == mjcf(Robot())
+
+
+def test_mujoco_builds_a_robot_with_a_tiny_track():
+    """Raising the base's roll and pitch inertia to the triangle bound was rounded below
+    it for a 1 mm track, and MuJoCo refused the model ('A + B >= C')."""
+    from ddwmmr.plants.mujoco.model import _base_inertia_diagonal
+
+    robot = Robot(track_width=0.001)
+    ixx, iyy, izz = _base_inertia_diagonal(robot)
+    assert ixx + iyy >= izz and izz == pytest.approx(0.49749, abs=1e-5)
+    assert build_model(robot).nbody > 1
+
+
+def test_a_wheel_heavier_in_yaw_than_the_base_names_the_parameters():
+    with pytest.raises(ParameterError, match=r"base_inertia must be > the wheels' own yaw"):
+        build_model(Robot(wheel_radius=10.0))

@@ -38,6 +38,7 @@ constant while the torque does not saturate).
 
 from __future__ import annotations
 
+import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 
@@ -187,9 +188,10 @@ def check_buildable(robot: Robot) -> None:
         )
     if not _base_body_yaw_inertia(robot) > 0.0:
         raise ParameterError(
-            f"base_inertia must be > the wheels' yaw inertia "
-            f"{robot.base_inertia - _base_body_yaw_inertia(robot):.4g} kg m^2 "
-            f"(got {robot.base_inertia:g})"
+            f"robot: base_inertia must be > the wheels' own yaw inertia, "
+            f"{robot.base_inertia - _base_body_yaw_inertia(robot):.4g} kg m^2 from "
+            f"wheel_mass, wheel_radius and track_width (got {robot.base_inertia:g}); raise "
+            "base_inertia or make the wheels lighter or smaller"
         )
 
 
@@ -230,6 +232,8 @@ def _base_inertia_diagonal(robot: Robot) -> tuple[float, float, float]:
     if deficit > 0.0:
         ixx, iyy = ixx + 0.5 * deficit, iyy + 0.5 * deficit
     ixx, iyy = max(ixx, iyy - izz), max(iyy, ixx - izz)
+    while ixx + iyy < izz:  # the raise above, rounded down (a tiny track): up to the bound
+        ixx = math.nextafter(ixx, math.inf)
     return ixx, iyy, izz
 
 
