@@ -310,6 +310,8 @@ def _run_cli(*args: str, cwd) -> subprocess.CompletedProcess:
             "argument --duration: must be a number in [0.02, 20000] s (got '1e')",
         ),
         (["--method", "nope"], "unknown method 'nope' (choose from "),
+        (["--method", "pi,nope"], "unknown method 'nope' (choose from "),
+        (["--method", ","], "--method: no name given"),
         (["--frobnicate"], "unrecognized arguments: --frobnicate"),
     ],
 )

@@ -47,3 +47,10 @@ def test_unknown_or_kinematic_plant_is_refused():
     for plant in ("kinematic", "nope"):
         with pytest.raises(ParameterError, match="plant must be one of"):
             CompareConfig(methods=("ats",), trajectories={"ellipse": Ellipse()}, plants=(plant,))
+
+
+def test_plants_may_be_comma_separated_like_the_methods():
+    from ddwmmr.cli.compare import parse_plants
+
+    assert parse_plants(["thesis,mujoco"]) == ("thesis", "mujoco")
+    assert parse_plants(["mujoco", "thesis,mujoco"]) == ("mujoco", "thesis")

@@ -1253,7 +1253,8 @@ def build_parser() -> argparse.ArgumentParser:
         dest="methods",
         metavar="NAME",
         help=f"measure only this method (and its extra rows; the {NAIVE_LABEL} baseline is "
-        f"always measured); repeatable; one of {', '.join(method_names())} (default: all)",
+        f"always measured); repeatable or comma separated; one of "
+        f"{', '.join(method_names())} (default: all)",
     )
     parser.add_argument(
         "--out", default="bench.json", metavar="FILE", help="report file (default bench.json)"
@@ -1300,6 +1301,14 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _main(argv: Sequence[str] | None = None) -> int:
     """The tool; bad input prints one line and returns 2."""
     args = build_parser().parse_args(argv)
+    if args.methods is not None:  # repeated and/or comma separated, as compare's --methods
+        names = [n.strip() for v in args.methods for n in v.split(",") if n.strip()]
+        if not names:
+            print(
+                f"bench: error: --method: no name given (got {args.methods[0]!r})", file=sys.stderr
+            )
+            return 2
+        args.methods = list(dict.fromkeys(names))
     unknown = sorted(set(args.methods or ()) - set(method_names()))
     if unknown:
         choices = ", ".join(method_names())

@@ -206,9 +206,9 @@ def build_parser() -> ArgumentParser:
         nargs="+",
         action="extend",
         default=[],
-        choices=[p for p in available_plants() if p != "kinematic"],
         metavar="PLANT",
-        help="also run the main comparison on these plants (thesis: force-limited base; "
+        help="also run the main comparison on these plants (space or comma separated; "
+        f"{', '.join(extra_plants())}; thesis: force-limited base; "
         "mujoco: rigid-body physics) and report their errors next to the kinematic plant's, "
         "with the reasons (lag, torque limits, slip)",
     )
@@ -228,6 +228,24 @@ def split_list(values: Sequence[str] | None, option: str) -> list[str]:
             raise ParameterError(f"{option}: no name given (got {value!r})")
         items.extend(names)
     return list(dict.fromkeys(items))
+
+
+def extra_plants() -> list[str]:
+    """The plants ``--plant`` may add next to the kinematic one."""
+    return [p for p in available_plants() if p != "kinematic"]
+
+
+def parse_plants(values: Sequence[str] | None) -> tuple[str, ...]:
+    """Validated ``--plant`` names (repeated and/or comma separated)."""
+    plants = split_list(values, "plant")
+    for name in plants:
+        if name == "kinematic":
+            raise ParameterError("plant: the kinematic plant always runs; --plant adds others")
+        if name not in extra_plants():
+            raise ParameterError(
+                f"plant: unknown plant {name!r} (one of {', '.join(extra_plants())})"
+            )
+    return tuple(plants)
 
 
 def parse_methods(values: Sequence[str] | None, option: str = "methods") -> tuple[str, ...]:
@@ -356,7 +374,7 @@ def config_from_arguments(
         studies=studies,
         command=command,
         preset=args.preset,
-        plants=tuple(dict.fromkeys(args.plant)),
+        plants=parse_plants(args.plant),
     )
 
 

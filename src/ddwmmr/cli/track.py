@@ -347,7 +347,8 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     offset = DEFAULT_INITIAL_OFFSET if args.offset is None else tuple(args.offset)
     for value in offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
-    _check_start_stability(robot, trajectory, offset, "payload" if args.payload is not None else "robot")
+    named = "payload" if args.payload is not None else "robot"
+    _check_start_stability(robot, trajectory, offset, named)
     return RunInputs(
         args.method,
         options,
