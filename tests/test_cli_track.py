@@ -435,3 +435,14 @@ def test_track_refuses_a_payload_that_tips_the_robot_at_the_start(tmp_path, caps
     assert err.count("\n") == 1 and not out.exists()
     assert "payload: a 50 kg payload tips the robot over in this run's start pose (S = 0.45" in err
     assert run([*argv, "--no-progress", "--payload", "3", "--out", str(out)]) == 0
+
+
+def test_track_refuses_an_obstacle_over_the_start_pose(tmp_path, capsys):
+    obstacles = tmp_path / "onstart.toml"
+    obstacles.write_text("[[obstacle]]\nx = 1.8\ny = -0.6\nradius = 0.5\n")
+    argv = ["--method", "qp", "--traj", "ellipse", "--duration", "0.2", "--no-plots"]
+    out = tmp_path / "out"
+    assert run([*argv, "--obstacles", str(obstacles), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and not out.exists()
+    assert "obstacles: obstacle 1 (x 1.8 m, y -0.6 m, radius 0.5 m) overlaps the robot's" in err

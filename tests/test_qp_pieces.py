@@ -281,3 +281,22 @@ def test_singularity_row_is_the_rate_of_its_margin(th1):
     assert G[0, [0, 1, 3]] == pytest.approx([0, 0, 0])
     assert lower[0] == pytest.approx(min(-5.0 * h(th1), 0.5 * 2.0 * abs(G[0, 2])))
     assert h(th1) > 0 or lower[0] > 0  # inside the margin the row pushes back out
+
+
+def test_a_start_pose_overlapping_an_obstacle_is_refused():
+    """The footprint at the origin heading 0.3 rad: a circle centred 0.1 m ahead of its
+    front edge (base_length / 2 along the heading) reaching 1 cm into it is refused with
+    the overlap, one ending 1 cm short of it passes."""
+    from ddwmmr.qp.limits.obstacles import Circle, check_start_clear
+
+    robot = Robot()
+    q = (0.0, 0.0, 0.3, 0.0, 1.0)
+    centre = 0.5 * robot.base_length + 0.1
+    x, y = centre * math.cos(0.3), centre * math.sin(0.3)
+    inside = Circle(x, y, 0.11)
+    clear = Circle(x, y, 0.09)
+    check_start_clear(robot, [clear], q)
+    with pytest.raises(
+        ParameterError, match=r"obstacle 2 \(.*\) overlaps the robot's start pose by 0.01 m"
+    ):
+        check_start_clear(robot, [clear, inside], q)

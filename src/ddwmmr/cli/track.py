@@ -348,7 +348,7 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     for value in offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
     named = "payload" if args.payload is not None else "robot"
-    _check_start_stability(robot, trajectory, offset, named)
+    _check_start(robot, trajectory, offset, named, options.get("obstacles"))
     return RunInputs(
         args.method,
         options,
@@ -364,9 +364,14 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     )
 
 
-def _check_start_stability(robot: Robot, trajectory: Any, offset, name: str) -> None:
-    """Refuse a robot (its payload, ``name``) that tips over in the run's start pose."""
+def _check_start(robot: Robot, trajectory: Any, offset, name: str, obstacles) -> None:
+    """Refuse a start pose in which the robot (its payload, ``name``) tips over or the
+    base overlaps one of ``obstacles`` ((x, y, radius) triples, m)."""
     start = offset_configuration(robot, start_configuration(robot, trajectory), offset)
+    if obstacles:
+        from ddwmmr.qp.limits.obstacles import as_circles, check_start_clear
+
+        check_start_clear(robot, as_circles(obstacles), start)
     s = robot.stability(start)[2]
     if s <= 1.0:
         raise ParameterError(

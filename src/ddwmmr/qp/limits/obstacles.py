@@ -157,6 +157,19 @@ def footprint_clearances(
     return best
 
 
+def check_start_clear(robot: Robot, circles: Sequence[Circle], q: Sequence[float]) -> None:
+    """Refuse (one-line :class:`ParameterError`) a start pose ``q`` whose base footprint
+    overlaps one of ``circles``: the run would start in a collision."""
+    half_length, half_width = 0.5 * robot.base_length, 0.5 * robot.base_width
+    for number, circle in enumerate(circles, start=1):
+        d = clearance_and_rate(half_length, half_width, q[0], q[1], q[2], circle)[0]
+        if d < 0.0:
+            raise ParameterError(
+                f"obstacles: obstacle {number} (x {circle.x:g} m, y {circle.y:g} m, radius "
+                f"{circle.radius:g} m) overlaps the robot's start pose by {-d:.3g} m; move it"
+            )
+
+
 def run_clearance(
     robot: Robot, circles: Sequence[Circle], timeseries: dict[str, np.ndarray]
 ) -> float | None:
