@@ -312,6 +312,7 @@ def _run_cli(*args: str, cwd) -> subprocess.CompletedProcess:
         (["--method", "nope"], "unknown method 'nope' (choose from "),
         (["--method", "pi,nope"], "unknown method 'nope' (choose from "),
         (["--method", ","], "--method: no name given"),
+        (["--method", "qp", "--method", ","], "--method: no name given (got ',')"),
         (["--frobnicate"], "unrecognized arguments: --frobnicate"),
     ],
 )

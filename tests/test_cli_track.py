@@ -435,6 +435,9 @@ def test_track_refuses_a_payload_that_tips_the_robot_at_the_start(tmp_path, caps
     assert err.count("\n") == 1 and not out.exists()
     assert "payload: a 50 kg payload tips the robot over in this run's start pose (S = 0.45" in err
     assert run([*argv, "--no-progress", "--payload", "3", "--out", str(out)]) == 0
+    tilted = [*argv, "--payload", "5", "--offset", "-0.6", "-0.4", "--out", str(tmp_path / "b")]
+    assert run(tilted) == 2  # 5 kg holds with the default offset, not this one
+    assert capsys.readouterr().err.endswith("lighten the payload or change --offset\n")
 
 
 def test_track_refuses_an_obstacle_over_the_start_pose(tmp_path, capsys):

@@ -204,7 +204,46 @@ def test_a_figure_name_is_no_clash_when_track_draws_no_figures(tmp_path):
     assert run("track", out, "--force") == 0  # --no-plots: path.png is not written
     assert (out / "path.png").read_text() == "mine"
     with pytest.raises(ParameterError, match=r"out/path.png is not a file a ddwmmr manifest"):
-        check_output_folder(out, "track", True, ("timeseries.csv", "*.png"))  # patterns
+        check_output_folder(out, "track", True, ("timeseries.csv", "path.png"))
+
+
+def test_force_keeps_user_files_that_only_look_like_outputs(tmp_path):
+    """Only the exact names a run writes are refused before it: a user's paths_mine.png,
+    a folder study_old/ with a figure in it, and a thesis_stability.png next to a qp batch
+    are kept."""
+    compare = tmp_path / "compare"
+    (compare / "study_old").mkdir(parents=True)
+    (compare / "paths_mine.png").write_text("mine")
+    (compare / "study_old" / "notes.png").write_text("mine")
+    assert run("compare", compare, "--force") == 0
+    assert (compare / "paths_mine.png").read_text() == "mine"
+    assert (compare / "study_old" / "notes.png").read_text() == "mine"
+    batch = tmp_path / "batch"
+    batch.mkdir()
+    (batch / "thesis_stability.png").write_text("mine")  # qp batches do not draw it
+    assert run("scenarios", batch, "--force", "--controller", "qp") == 0
+    assert (batch / "thesis_stability.png").read_text() == "mine"
+
+
+def test_force_refuses_the_animation_and_study_files_before_the_run(tmp_path, capsys, monkeypatch):
+    import ddwmmr.cli.scenarios as scenarios_cli
+    import ddwmmr.cli.track as track_cli
+
+    def never(*args, **kwargs):
+        raise AssertionError("the run started")
+
+    for module in (track_cli, scenarios_cli):
+        monkeypatch.setattr(module, "output_folder", never)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "animation.gif").write_text("mine")
+    (out / "baseline.csv").write_text("mine")
+    assert run("track", out, "--force", "--animate") == 2
+    assert "animation.gif is not a file a ddwmmr manifest lists" in capsys.readouterr().err
+    main, _ = TOOLS["scenarios"]
+    argv = ["--n", "1", "--study", "thresholds", "--no-progress", "--out", str(out), "--force"]
+    assert main(argv) == 2
+    assert "baseline.csv is not a file a ddwmmr manifest lists" in capsys.readouterr().err
 
 
 # -- the module itself --------------------------------------------------------------------

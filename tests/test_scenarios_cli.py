@@ -81,6 +81,8 @@ def test_obstacle_study_table(tmp_path, capsys):
         (["--controller", "mpc", "--manipulability", "0.7", "0.9"], "--manipulability: only"),
         (["--controller", "qp", "--no-hysteresis", "stability"], "--no-hysteresis: only used"),
         (["--study", "thresholds", "--stability", "1.3", "1.6"], "runs its own thresholds"),
+        (["--study", "arbiters", "--no-hysteresis", "stability"], "arbiter study runs its own"),
+        (["--controller", "qp", "--arbiter", "state-machine"], "only the thesis controller"),
     ],
 )
 def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, message):

@@ -1302,12 +1302,11 @@ def _main(argv: Sequence[str] | None = None) -> int:
     """The tool; bad input prints one line and returns 2."""
     args = build_parser().parse_args(argv)
     if args.methods is not None:  # repeated and/or comma separated, as compare's --methods
-        names = [n.strip() for v in args.methods for n in v.split(",") if n.strip()]
-        if not names:
-            print(
-                f"bench: error: --method: no name given (got {args.methods[0]!r})", file=sys.stderr
-            )
+        empty = next((v for v in args.methods if not v.replace(",", "").strip()), None)
+        if empty is not None:
+            print(f"bench: error: --method: no name given (got {empty!r})", file=sys.stderr)
             return 2
+        names = [n.strip() for v in args.methods for n in v.split(",") if n.strip()]
         args.methods = list(dict.fromkeys(names))
     unknown = sorted(set(args.methods or ()) - set(method_names()))
     if unknown:

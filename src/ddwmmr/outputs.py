@@ -21,7 +21,6 @@ usual ``022``), not the ``0600``/``0700`` of temporary files.
 from __future__ import annotations
 
 import contextlib
-import fnmatch
 import json
 import os
 import shutil
@@ -261,9 +260,9 @@ def check_output_folder(
 
     Returns the absolute target path. Called before any simulation, so bad output paths
     fail fast; :func:`output_folder` checks again just before it moves files into place.
-    ``writes``: patterns (``fnmatch``, relative posix names) of the files the tool may
-    write; with ``force``, a file no manifest lists that matches one is refused here,
-    before the run, rather than after it (the final check stays exact).
+    ``writes``: the names (relative, posix) of the files the run will write; with
+    ``force``, a file or folder no manifest lists under one of them is refused here, before
+    the run, rather than after it (the check after the run stays as the last guard).
     """
     text = str(target)
     path = check_output_path(target)
@@ -274,9 +273,8 @@ def check_output_folder(
     existing = inspect(path, tool)
     if existing.kind == "foreign" and not force:
         raise ParameterError(_refusal(text, tool, existing))
-    clash = next(
-        (f for f in existing.foreign if any(fnmatch.fnmatchcase(f, p) for p in writes)), None
-    )
+    names = set(writes)
+    clash = next((f for f in existing.foreign if f.rstrip("/") in names), None)
     if clash is not None:
         raise ParameterError(_clash(text, clash))
     _check_replaceable(path, text, existing)

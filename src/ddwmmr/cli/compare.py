@@ -50,6 +50,7 @@ from ddwmmr.reports.compare import (
     ReportInfo,
     default_step,
     execute,
+    output_names,
     plan_runs,
     ranking_table,
     slides_name,
@@ -63,14 +64,6 @@ from ddwmmr.trajectories import available_trajectories, load_trajectory, traject
 from ddwmmr.trajectories.files import find_trajectory_file
 
 PROG = "python -m ddwmmr.compare"
-#: The files a report may write (checked against a user's files before the run, --force).
-WRITES = (
-    "report.md",
-    "report.html",
-    "metrics.csv",
-    "run.json",
-    *(f"{kind}_*.png" for kind in ("paths", "errors", "wheels", "methods", "plant", "study")),
-)
 DEFAULT_OUT = "runs/compare"
 #: Default number of worker processes: the CPUs, at most 8.
 DEFAULT_JOBS = min(os.cpu_count() or 1, 8)
@@ -409,9 +402,10 @@ def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     jobs = check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
     out = Path(args.out)
-    check_output_folder(out, "compare", args.force, WRITES)
+    check_output_folder(out, "compare", args.force)  # the path, before anything is loaded
     sources: dict[str, Any] = {}
     config = config_from_arguments(args, argv, sources)
+    check_output_folder(out, "compare", args.force, ("run.json", *output_names(config)))
     plan = plan_runs(config)
     specs = plan.all_specs()
     check_steps(config, specs)

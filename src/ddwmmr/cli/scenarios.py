@@ -58,15 +58,6 @@ from ddwmmr.sim.result import json_safe, write_atomic
 MARKER = "summary.json"
 STUDIES = ("thresholds", "obstacles", "arbiters")
 PROG = "python -m ddwmmr.scenarios"
-#: The files a run may write (checked against a user's files before the run, --force).
-WRITES = (
-    "scenarios.csv",
-    "summary.json",
-    "table.txt",
-    *(f"{study}.md" for study in ("thresholds", "obstacles", "arbiters")),
-    "thesis_*.png",
-    "competitive_weights_*.png",
-)
 #: Upper bound of --qp-max-speed (m/s): far above what the robot can do (base 1.5 m/s).
 MAX_QP_SPEED = 10.0
 #: Longest control step (s): the thesis controller's gains are tuned per 0.01 s sample.
@@ -360,11 +351,13 @@ def _check_thesis_options(args: argparse.Namespace) -> None:
             f"{given[0]}: only used with --controller thesis (the qp and mpc hold "
             "--qp-stability-min)"
         )
-    if given and args.study == "thresholds":
+    if given and args.study in ("thresholds", "arbiters"):
         raise ParameterError(
-            f"{given[0]}: the threshold study runs its own thresholds (thesis Tables "
+            f"{given[0]}: the {args.study[:-1]} study runs its own thresholds (thesis Tables "
             "5.2-5.18); leave it out"
         )
+    if args.arbiter is not None and args.controller != "thesis":
+        raise ParameterError("--arbiter: only the thesis controller has an arbiter")
     if args.arbiter is not None and args.study == "arbiters":
         raise ParameterError("--arbiter: the arbiter study runs both arbiters; leave it out")
     if args.arbiter_seed is not None and args.arbiter != "competitive" and args.study != "arbiters":
@@ -395,6 +388,25 @@ class Runner:
                 on_done=bar.advance,
             )
         return outcomes, time.perf_counter() - start
+
+
+def output_names(args: argparse.Namespace, config: RunConfig) -> tuple[str, ...]:
+    """The files a run of ``args`` writes (checked against a user's files before the run,
+    with --force)."""
+    if args.study == "thresholds":
+        return (MARKER, "thresholds.md", *(f"{v.key}.csv" for v in studies.THRESHOLD_VARIANTS))
+    if args.study == "arbiters":
+        from ddwmmr.scenarios import arbiter_study
+
+        return (MARKER, *arbiter_study.output_names())
+    figures = ["thesis_times.png", "thesis_speed.png", "thesis_paths.png", "thesis_timeline.png"]
+    if config.controller == "thesis":
+        figures += ["thesis_stability.png", "thesis_manipulability.png"]
+    if config.arbiter == "competitive":
+        figures.append("thesis_weights.png")
+    if args.study == "obstacles":
+        figures += ["obstacles.md", "thesis_obstacle_paths.png"]
+    return (MARKER, "scenarios.csv", "table.txt", *figures)
 
 
 def _title(config: RunConfig) -> str:
@@ -575,7 +587,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     args.argv = argv  # recorded in the summary
     config = config_from_arguments(args)
     out = Path(args.out) if args.out is not None else default_out()
-    check_output_folder(out, "scenarios", args.force, WRITES)
+    check_output_folder(out, "scenarios", args.force, output_names(args, config))
     if config.controller == "qp":
         from ddwmmr.scenarios.protocol import make_qp
 

@@ -348,7 +348,7 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     for value in offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
     named = "payload" if args.payload is not None else "robot"
-    _check_start(robot, trajectory, offset, named, options.get("obstacles"))
+    _check_start(robot, trajectory, offset, named, options.get("obstacles"), args.offset)
     return RunInputs(
         args.method,
         options,
@@ -364,9 +364,12 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     )
 
 
-def _check_start(robot: Robot, trajectory: Any, offset, name: str, obstacles) -> None:
+def _check_start(
+    robot: Robot, trajectory: Any, offset, name: str, obstacles, offset_given=None
+) -> None:
     """Refuse a start pose in which the robot (its payload, ``name``) tips over or the
-    base overlaps one of ``obstacles`` ((x, y, radius) triples, m)."""
+    base overlaps one of ``obstacles`` ((x, y, radius) triples, m); ``offset_given``: the
+    ``--offset`` the user gave (None: the default), named in the message."""
     start = offset_configuration(robot, start_configuration(robot, trajectory), offset)
     if obstacles:
         from ddwmmr.qp.limits.obstacles import as_circles, check_start_clear
@@ -377,6 +380,7 @@ def _check_start(robot: Robot, trajectory: Any, offset, name: str, obstacles) ->
         raise ParameterError(
             f"{name}: a {robot.payload:g} kg payload tips the robot over in this run's start "
             f"pose (S = {s:.3g} <= 1); lighten the payload"
+            + ("" if offset_given is None else " or change --offset")
         )
 
 
@@ -500,13 +504,14 @@ def run_record(
     return record
 
 
-def output_names(plots: bool) -> tuple[str, ...]:
+def output_names(plots: bool, animate: bool) -> tuple[str, ...]:
     """The files a run writes (checked against a user's files before the run, --force)."""
+    names = ("timeseries.csv", "summary.json", *(("animation.gif",) if animate else ()))
     if not plots:
-        return ("timeseries.csv", "summary.json")
+        return names
     from ddwmmr.reports.plots import FIGURE_NAMES  # matplotlib: only for runs that plot
 
-    return ("timeseries.csv", "summary.json", *FIGURE_NAMES)
+    return (*names, *FIGURE_NAMES)
 
 
 def _note_uneven_duration(duration: float, dt: float, steps: int) -> None:
@@ -528,7 +533,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
     controller = make_controller(inputs.method, inputs.robot, **inputs.options)
     out = Path(args.out) if args.out is not None else default_out(inputs.method, inputs.label)
-    check_output_folder(out, "track", args.force, output_names(not args.no_plots))
+    check_output_folder(out, "track", args.force, output_names(not args.no_plots, args.animate))
     record = run_record(inputs, argv, args.rerun)
     progress = not args.no_progress
     _note_uneven_duration(inputs.duration, inputs.dt, steps)

@@ -68,6 +68,17 @@ TRACE_STEP = TRACE_INTERVAL
 Runner = Callable[[list[Scenario], RunConfig, str], tuple[list[Outcome], float]]
 
 
+#: Variants whose competitive weights are drawn (``competitive_weights_<key>.png``).
+WEIGHT_FIGURE_KEYS = ("baseline", "stab-1.50-1.70", "stab-nohyst-1.50")
+
+
+def output_names() -> tuple[str, ...]:
+    """The files :func:`write_study` writes (the CLI adds ``summary.json``)."""
+    runs = [f"{v.key}-{arbiter}.csv" for v in variants() for arbiter, _ in ARBITER_COLUMNS]
+    figures = [f"competitive_weights_{key}.png" for key in WEIGHT_FIGURE_KEYS]
+    return ("arbiters.md", *runs, *figures)
+
+
 def variants(keys: Sequence[str] = VARIANT_KEYS) -> list[studies.Variant]:
     """The threshold variants of the study, in the given order."""
     by_key = {v.key: v for v in studies.THRESHOLD_VARIANTS}
@@ -456,7 +467,7 @@ def write_study(
         variants_table(results),
     ]
     claims = []
-    for key in ("baseline", "stab-1.50-1.70", "stab-nohyst-1.50"):
+    for key in WEIGHT_FIGURE_KEYS:
         result = by_key[key]
         cfg = replace(
             config,

@@ -77,6 +77,21 @@ class ReportInfo:
     alternative_check: SlidesCheck | None = None
 
 
+#: The report's figures per trajectory (``<kind>_<trajectory>.png``).
+TRAJECTORY_FIGURES = ("paths", "errors", "wheels", "methods")
+
+
+def output_names(config: CompareConfig) -> tuple[str, ...]:
+    """Every file :func:`write_report` may write for ``config`` (the CLI adds
+    ``run.json``): checked against a user's files before the runs."""
+    names = ["report.html", "report.md", "metrics.csv"]
+    for name in config.trajectories:
+        names += [f"{kind}_{name}.png" for kind in TRAJECTORY_FIGURES]
+        names += [f"plant_{plant}_{name}.png" for plant in config.plants]
+    names += [f"study_{study}.png" for study in config.studies]
+    return tuple(names)
+
+
 def write_report(
     config: CompareConfig, plan: Plan, outputs: Mapping[RunSpec, RunOutput], folder: Path
 ) -> ReportInfo:
