@@ -237,7 +237,7 @@ def physics_tipping() -> None:
         "static floor only": physics_run(
             (("dynamic_stability", False), ("arm_time_constant", 0.0))
         ),
-        "dynamic margin + lagged arm (the protocol's)": physics_run(()),
+        "dynamic margin + lagged arm, bounded accelerations (the protocol's)": physics_run(()),
     }
     fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
     for (label, (rows, tip)), color in zip(runs.items(), ("tab:red", "tab:blue")):

@@ -139,7 +139,7 @@ def test_the_force_model_takes_the_plants_own_base():
 def test_the_force_model_plans_within_the_motors_and_the_thesis_force_on_physics():
     """On a plant that judges tipping physically the force model plans with the thesis's
     10 N by default (the motors' 20.5 N tipped 27 of 100 scenarios), a limit asked for
-    is taken, and neither ever exceeds the plant's motors; asking for a limit implies the
+    is taken, more than the plant's motors give is refused; asking for a limit implies the
     force model."""
     physics = traits_of(MujocoPlant(ROBOT))
     default = make_controller("mpc", ROBOT)
@@ -152,15 +152,18 @@ def test_the_force_model_plans_within_the_motors_and_the_thesis_force_on_physics
     asked.adopt_plant(physics)
     assert asked.dynamics.force_limit == 15.0
     too_much = make_controller("mpc", ROBOT, wheel_force_limit=50.0)
-    too_much.adopt_plant(physics)
-    assert too_much.dynamics.force_limit == pytest.approx(motor_force, rel=1e-12)
+    with pytest.raises(ParameterError, match=r"must be <= the plant's motors, 20.51 N"):
+        too_much.adopt_plant(physics)
+    full = make_controller("mpc", ROBOT, wheel_force_limit=motor_force)
+    full.adopt_plant(physics)
+    assert full.dynamics.force_limit == motor_force
     weak = Robot(wheel_torque_limit=0.5).with_payload(3.0)  # 5.1 N motors
     on_weak = make_controller("mpc", weak)
     on_weak.adopt_plant(traits_of(MujocoPlant(weak)))
     assert on_weak.dynamics.force_limit == pytest.approx(0.5 / weak.wheel_radius, rel=1e-12)
     strong_thesis = make_controller("mpc", ROBOT, wheel_force_limit=12.0)
-    strong_thesis.adopt_plant(traits_of(ThesisPlant(ROBOT)))  # its 10 N wins
-    assert strong_thesis.dynamics.force_limit == 10.0
+    with pytest.raises(ParameterError, match="wheel_force_limit must be <= the plant's"):
+        strong_thesis.adopt_plant(traits_of(ThesisPlant(ROBOT)))  # its 10 N motors
 
 
 def test_simulate_on_the_physics_plant_runs_the_force_model_with_the_dynamic_margin():
@@ -230,12 +233,15 @@ def test_a_swinging_arm_turns_a_free_base_as_the_momentum_balance_says():
 
 
 def test_a_plan_stuck_on_its_slack_restarts_and_the_scenario_finishes(monkeypatch):
-    """Scenario 10 (seed 0) on MuJoCo: after the second waypoint the plan spins the base on
-    the spot with the arm stretched at the dynamic floor, every plan needing slack, until
-    the time limit; restarting cold after 0.5 s of that, it reaches every waypoint."""
+    """Scenario 10 (seed 0) on MuJoCo, the mpc without its joint acceleration bound: after
+    the second waypoint the plan spins the base on the spot with the arm stretched at the
+    dynamic floor, every plan needing slack, until the time limit; restarting cold after
+    0.5 s of that, it reaches every waypoint."""
     from ddwmmr.mpc import controller as mpc_controller
 
-    scenario, config = generate(10, 0)[9], RunConfig(controller="mpc", plant="mujoco")
+    unbounded = (("joint_acceleration_limit", 0.0),)
+    config = RunConfig(controller="mpc", plant="mujoco", controller_options=unbounded)
+    scenario = generate(10, 0)[9]
     outcome = run_scenario(scenario, config)
     assert outcome.metrics["success"], outcome.metrics["reason"]
     assert outcome.metrics["waypoints_reached"] == 5
@@ -265,3 +271,53 @@ def test_the_wheel_lever_from_the_traits_turns_the_physics_base_as_it_does():
         assert plant.observe().w == pytest.approx(predicted, rel=0.015)
     footprint = sym.ThesisDynamics.from_robot(robot, 0.0, 0.0)
     assert footprint.half_width / lever == pytest.approx(1.4, rel=1e-12)
+
+
+def test_the_physics_plants_joint_acceleration_limit_is_what_its_shoulder_motor_gives():
+    """On a base too heavy to yield, a shoulder rate step with the arm stretched and 3 kg
+    at the tip accelerates at the plant's stated limit (torque limit over the stretched
+    arm's inertia, 20 N m / 1.566 kg m^2) within 2 %, while the motor is saturated."""
+    robot = Robot(base_mass=500.0, base_inertia=200.0).with_payload(3.0)
+    plant = MujocoPlant(robot)
+    shoulder, elbow = traits_of(plant).joint_acceleration_limit
+    assert shoulder == pytest.approx(20.0 / 1.5658333, rel=1e-6)
+    assert elbow == pytest.approx(10.0 / 0.3, rel=1e-9)
+    plant.reset(np.zeros(5), 0.01)
+    angles = [0.0]
+    for k in range(7):
+        plant.step(0.01 * k, np.array([0.0, 0.0, 2.0, 0.0]), 0.01)
+        angles.append(float(plant.observe().q[3]))
+    rates = np.diff(angles) / 0.01
+    accelerations = np.diff(rates[1:]) / 0.01  # after the first step's settling
+    np.testing.assert_allclose(accelerations, shoulder, rtol=0.02)
+
+
+def test_the_lagged_arm_plans_within_the_joint_acceleration_limit():
+    """The mpc takes the physics plant's limit with its lagged arm, and its first command
+    after a rate of 1.5 rad/s keeps (u - rate) / tau within it; 0 turns it off, a bad value
+    is refused, and without a lag it is refused once the plant is known."""
+    physics = traits_of(MujocoPlant(ROBOT))
+    mpc = make_controller("mpc", ROBOT, dt=0.01)
+    mpc.adopt_plant(physics)
+    assert mpc.joint_acceleration_limit == physics.joint_acceleration_limit
+    mpc.reset(None, np.zeros(5))
+    mpc._predicted_rates = (1.5, -1.0)  # the lagged joints' rates (no sensor reports them)
+    q = np.array([0.0, 0.0, 0.0, -0.7, 1.5])
+    command = mpc.command(0.0, q, np.array([2.0, -1.0, 0.0]), np.zeros(3), base_velocity=(0, 0))
+    tau = mpc.arm_time_constant
+    rates = ((command.th1_target - q[3]) / 0.01, (command.th2_target - q[4]) / 0.01)
+    for rate, start, limit in zip(rates, (1.5, -1.0), physics.joint_acceleration_limit):
+        assert abs(rate - start) / tau <= limit * (1 + 1e-6)
+    off = make_controller("mpc", ROBOT, joint_acceleration_limit=0)
+    off.adopt_plant(physics)
+    assert off.joint_acceleration_limit is None
+    given = make_controller("mpc", ROBOT, joint_acceleration_limit=(5.0, 8.0))
+    given.adopt_plant(physics)
+    assert given.joint_acceleration_limit == (5.0, 8.0) and given.model_name == "thesis"
+    with pytest.raises(ParameterError, match="joint_acceleration_limit must be in"):
+        make_controller("mpc", ROBOT, joint_acceleration_limit=1e9)
+    with pytest.raises(ParameterError, match="one number or two"):
+        make_controller("mpc", ROBOT, joint_acceleration_limit=(1.0, 2.0, 3.0))
+    unlagged = make_controller("mpc", ROBOT, joint_acceleration_limit=5.0)
+    with pytest.raises(ParameterError, match="needs the lagged arm"):
+        unlagged.adopt_plant(traits_of(ThesisPlant(ROBOT)))

@@ -62,6 +62,9 @@ class PlantTraits:
         wheel_lever: the lever arm (m) of each wheel's traction force about the base
             centre, half the distance between the wheels; None when the plant does not
             say.
+        joint_acceleration_limit: the largest angular accelerations (rad/s^2) the arm's
+            motors give the shoulder and the elbow (with the arm stretched and the payload
+            at the tip, the most they have to move), None when the plant does not say.
     """
 
     interfaces: tuple[str, ...]
@@ -70,6 +73,7 @@ class PlantTraits:
     base_damping: tuple[float, float] | None = None
     wheel_force_limit: float | None = None
     wheel_lever: float | None = None
+    joint_acceleration_limit: tuple[float, float] | None = None
 
 
 def traits_of(plant: Any) -> PlantTraits:
@@ -81,4 +85,5 @@ def traits_of(plant: Any) -> PlantTraits:
         getattr(plant, "damping", None),
         getattr(plant, "wheel_force_limit", None),
         getattr(plant, "wheel_lever", None),
+        getattr(plant, "joint_acceleration_limit", None),
     )

@@ -91,11 +91,16 @@ class BaseFacts:
     @classmethod
     def of(cls, plant: PlantTraits | None, force_limit: float | None = None) -> BaseFacts:
         """The facts ``plant`` states (none for an unknown plant), with the wheel force
-        ``force_limit`` (N) asked for, else :func:`planned_force`, and never above the
-        plant's motors."""
+        ``force_limit`` (N) asked for (refused above the plant's motors), else
+        :func:`planned_force` (at most the motors')."""
         if plant is None:
             return cls(force_limit=force_limit)
         motors = plant.wheel_force_limit
+        if force_limit is not None and motors is not None and force_limit > motors:
+            raise ParameterError(
+                f"wheel_force_limit must be <= the plant's motors, {motors:.4g} N per wheel "
+                f"(got {force_limit:g})"
+            )
         force = planned_force(plant) if force_limit is None else force_limit
         if motors is not None and force is not None:
             force = min(force, motors)
@@ -106,6 +111,25 @@ class BaseFacts:
         c1, c2 = self.damping if self.damping is not None else (C1_DEFAULT, C2_DEFAULT)
         force = self.force_limit if self.force_limit is not None else FORCE_LIMIT_DEFAULT
         return sym.ThesisDynamics.from_robot(robot, c1, c2, force, half_width=self.lever)
+
+
+def _acceleration_option(value: Any) -> tuple[float, float] | None:
+    """The ``joint_acceleration_limit`` option: None (not given), ``()`` (0: none) or
+    ``(shoulder, elbow)`` rad/s^2."""
+    if value is None:
+        return None
+    pair = value if isinstance(value, list | tuple) else (value, value)
+    if len(pair) != 2:
+        raise ParameterError(
+            f"joint_acceleration_limit must be one number or two (shoulder, elbow) in rad/s^2 "
+            f"(got {len(pair)} values)"
+        )
+    limits = tuple(float(check_nonnegative("joint_acceleration_limit", v)) for v in pair)
+    if limits == (0.0, 0.0):
+        return ()
+    for v in limits:
+        check_range("joint_acceleration_limit", v, 0.1, 1e4, "rad/s^2")
+    return limits  # type: ignore[return-value]
 
 
 def planned_force(plant: PlantTraits) -> float | None:
@@ -157,9 +181,15 @@ class MPCControllerCore:
             servos have one); None (default): that plant's lag when the force model runs on
             a physics plant, else none; 0: none (the joints move at the commanded rates at
             once).
+        joint_acceleration_limit: bound (rad/s^2) on the lagged joints' accelerations, one
+            number for both or (shoulder, elbow) (with the lagged arm only: the physics
+            plant's servos are torque-limited); None (default): that plant's
+            (``PlantTraits.joint_acceleration_limit``) when the lagged arm runs on a
+            physics plant, else none; 0: none.
         wheel_force_limit: per-wheel traction force (N) the force model plans with
-            (``model="thesis"`` only), never above the plant's motors
-            (``PlantTraits.wheel_force_limit``); None (default): :func:`planned_force`,
+            (``model="thesis"`` only), at most the plant's motors
+            (``PlantTraits.wheel_force_limit``; more is refused when the loop hands over the
+            plant's traits); None (default): :func:`planned_force`,
             the thesis plant's own limit there, the thesis's 10 N on a physics plant.
         dt: control step (s); default the trajectory's ``duration / samples`` at reset,
             else 0.02 s.
@@ -193,6 +223,7 @@ class MPCControllerCore:
         stability_margin: float = 0.01,
         dynamic_stability: bool | None = None,
         arm_time_constant: float | None = None,
+        joint_acceleration_limit: float | Sequence[float] | None = None,
         wheel_force_limit: float | None = None,
         obstacle_margin: float = 0.05,
         dt: float | None = None,
@@ -213,6 +244,7 @@ class MPCControllerCore:
             check_range("arm_time_constant", arm_time_constant, 1e-3, 1.0, "s")
         if arm_time_constant is not None:
             self._lag_option = float(arm_time_constant)
+        self._accel_option = _acceleration_option(joint_acceleration_limit)
         self._force_option = None
         if wheel_force_limit is not None:
             self._force_option = check_range("wheel_force_limit", wheel_force_limit, 0.1, 1e4, "N")
@@ -265,9 +297,11 @@ class MPCControllerCore:
         self._reset_memory()
 
     # -- options ----------------------------------------------------------------------------
-    def _resolve(self, plant: PlantTraits | None) -> tuple[str, bool, float | None, BaseFacts]:
-        """``(model, dynamic_stability, arm_time_constant, base)``: the options given, else
-        what suits ``plant`` (None: not known yet).
+    def _resolve(
+        self, plant: PlantTraits | None
+    ) -> tuple[str, bool, float | None, BaseFacts, tuple[float, float] | None]:
+        """``(model, dynamic_stability, arm_time_constant, base, joint_acceleration_limit)``:
+        the options given, else what suits ``plant`` (None: not known yet).
 
         On a plant that takes wheel forces and judges tipping by its physics: the
         force-level model, the floor on the dynamic margin and the plant's joint lag (the
@@ -276,11 +310,15 @@ class MPCControllerCore:
         ``dynamic_stability`` or a lag is asked for), static floor, no lag. The force
         model's base (damping, wheel force limit, wheel lever: :class:`BaseFacts`) is the
         plant's where it says, else the thesis plant's; its wheel force is the one asked
-        for, else :func:`planned_force`, within the plant's motors.
+        for, else :func:`planned_force`, within the plant's motors. The lagged joints'
+        accelerations are bounded as asked, else by the physics plant's motors.
         """
         physics = plant is not None and plant.judges_tipping and FORCE in plant.interfaces
         wants_force = (
-            bool(self._dynamic_option) or bool(self._lag_option) or self._force_option is not None
+            bool(self._dynamic_option)
+            or bool(self._lag_option)
+            or bool(self._accel_option)
+            or self._force_option is not None
         )
         model = self._model_option or ("thesis" if physics or wants_force else "kinematic")
         suited = physics and model == "thesis"  # the force model on a physics plant
@@ -289,7 +327,17 @@ class MPCControllerCore:
         if lag is None:
             lag = plant.joint_time_constant if suited else None  # type: ignore[union-attr]
         base = BaseFacts.of(plant, self._force_option) if model == "thesis" else BaseFacts()
-        return model, dynamic, (lag or None), base
+        accel = self._accel_option
+        if accel is None and suited:
+            accel = plant.joint_acceleration_limit  # type: ignore[union-attr]
+        if accel and not lag:
+            if plant is not None and self._accel_option:
+                raise ParameterError(
+                    "joint_acceleration_limit needs the lagged arm (arm_time_constant, or a "
+                    "physics plant's joint lag)"
+                )
+            accel = None  # the plant is not known yet (or has no lag): nothing to bound
+        return model, dynamic, (lag or None), base, (accel or None)
 
     def _configure(
         self,
@@ -297,6 +345,7 @@ class MPCControllerCore:
         dynamic_stability: bool,
         lag: float | None,
         base: BaseFacts | None = None,
+        acceleration_limit: tuple[float, float] | None = None,
     ) -> None:
         """Set the prediction model and its options (problems are rebuilt on demand)."""
         if lag is not None and model != "thesis":
@@ -313,8 +362,11 @@ class MPCControllerCore:
             self.dynamics = base.dynamics(self.robot)
         self._base = base
         self.arm_time_constant = lag
+        self.joint_acceleration_limit = acceleration_limit
         self.dynamic_stability = dynamic_stability
-        self.model: PredictionModel = make_model(model, self.robot, self.dynamics, lag)
+        self.model: PredictionModel = make_model(
+            model, self.robot, self.dynamics, lag, acceleration_limit
+        )
         self.interface = self.model.interface
         self.wants_base_velocity = model == "thesis"
         self._problems: dict[tuple[str, float], _Problem] = {}
@@ -323,7 +375,13 @@ class MPCControllerCore:
         """The loop's plant, described (:func:`ddwmmr.commands.traits_of`): options not
         given are chosen for it (:meth:`_resolve`), before ``reset``."""
         choice = self._resolve(plant)
-        current = (self.model_name, self.dynamic_stability, self.arm_time_constant, self._base)
+        current = (
+            self.model_name,
+            self.dynamic_stability,
+            self.arm_time_constant,
+            self._base,
+            self.joint_acceleration_limit,
+        )
         if choice != current:
             self._configure(*choice)
             self._reset_memory()  # sized and meant for the previous model
@@ -592,6 +650,7 @@ class MPCControllerCore:
             "mpc_model": self.model_name,
             "mpc_dynamic_stability": self.dynamic_stability,
             "mpc_arm_time_constant_s": self.arm_time_constant,
+            "mpc_joint_acceleration_limit_rad_s2": self.joint_acceleration_limit,
             "mpc_wheel_force_limit_n": None if self.dynamics is None else self.dynamics.force_limit,
             "mpc_solver": self.solver_name
             if self.solver_name != "rti"

@@ -14,7 +14,8 @@ Two models, one interface (:class:`PredictionModel`):
   base, and joints that follow the commanded rates through a first-order lag (state
   ``[q, v, w, th1dot, th2dot]``, 9): the arm's accelerations, which move the centre of
   pressure, are then part of the prediction (a velocity servo with that time constant, as
-  the physics plant's).
+  the physics plant's). With ``acceleration_limit`` the lag's accelerations are bounded
+  (rows) by what the joints' motors give, as the physics plant's torque-limited servos.
 
 Joint-position limits are state bounds in both.
 """
@@ -67,6 +68,11 @@ class PredictionModel(ABC):
     @abstractmethod
     def wheel_rows(self, x: Any, u: Any | None) -> Any | None:
         """Wheel speeds (rad/s) implied at a node, or None when they are not decided there."""
+
+    def acceleration_rows(self, x: Any, u: Any) -> tuple[Any, tuple[float, float]] | None:
+        """The joints' angular accelerations (rad/s^2) at the start of an interval from
+        state ``x`` under input ``u``, with their bounds, or None when not bounded."""
+        return None
 
     def configuration(self, x: Any) -> Any:
         """The configuration part ``q`` of a state."""
@@ -156,11 +162,25 @@ class LaggedArmPrediction(ThesisPrediction):
 
     nx = sym.NX_FORCE + 2
 
-    def __init__(self, robot: Robot, dynamics: sym.ThesisDynamics, tau: float) -> None:
+    def __init__(
+        self,
+        robot: Robot,
+        dynamics: sym.ThesisDynamics,
+        tau: float,
+        acceleration_limit: tuple[float, float] | None = None,
+    ) -> None:
         super().__init__(robot, dynamics)
         self.tau = tau
+        self.acceleration_limit = acceleration_limit
         rate = min(dynamics.joint_speed, robot.joint_speed_limit)
         self.x_lower[7:9], self.x_upper[7:9] = -rate, rate
+
+    def acceleration_rows(self, x: Any, u: Any) -> tuple[Any, tuple[float, float]] | None:
+        """``(u_rates - rates) / tau``, the lag's largest acceleration over the interval
+        (at its start: it decays from there), bounded by ``acceleration_limit``."""
+        if self.acceleration_limit is None:
+            return None
+        return self.joint_motion(x, u)[1], self.acceleration_limit
 
     def rhs(self, x: Any, u: Any) -> Any:
         rates, accelerations = self.joint_motion(x, u)
@@ -223,12 +243,14 @@ def make_model(
     robot: Robot,
     dynamics: sym.ThesisDynamics | None,
     arm_time_constant: float | None = None,
+    acceleration_limit: tuple[float, float] | None = None,
 ) -> PredictionModel:
     """The prediction model called ``name`` (validated by the controller); a
-    ``arm_time_constant`` (s) makes the thesis model's joints lag."""
+    ``arm_time_constant`` (s) makes the thesis model's joints lag, ``acceleration_limit``
+    (rad/s^2, shoulder and elbow) bounds the lag's accelerations."""
     if name == "thesis":
         assert dynamics is not None
         if arm_time_constant is not None:
-            return LaggedArmPrediction(robot, dynamics, arm_time_constant)
+            return LaggedArmPrediction(robot, dynamics, arm_time_constant, acceleration_limit)
         return ThesisPrediction(robot, dynamics)
     return KinematicPrediction(robot)

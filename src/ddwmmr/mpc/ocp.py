@@ -44,7 +44,9 @@ the at-rest case.
 The slacks carry an exact L1 penalty (:data:`SLACK_WEIGHT`): whenever the constraints can
 be met they are met (a hard constraint), and a linearisation that cannot be met in one
 iteration still gives a solvable QP. Input box (forces or rates), joint-position box on
-the states.
+the states; with the lagged arm and a joint acceleration limit, rows (without slack: the
+stage's input can always meet them) bound the lag's acceleration ``(u_rates - rates) /
+tau`` at the start of every interval, where it is largest.
 
 Cost: ``0.5 ||r(w, p)||^2 + c' w`` with the residual ``r`` stacked from, weighted by the
 interval lengths:
@@ -292,6 +294,12 @@ class ShootingOCP:
             rows.append(model.wheel_rows(x_next, us[k]))
             low.extend([-model.wheel_limit] * 2)
             high.extend([model.wheel_limit] * 2)
+            accelerations = model.acceleration_rows(xs[k], us[k])
+            if accelerations is not None:  # no slack: u_k can always meet it
+                row, limit = accelerations
+                rows.append(row)
+                low.extend([-limit[0], -limit[1]])
+                high.extend([limit[0], limit[1]])
             g.append(ca.vertcat(*rows))
             ng.append(len(low))
             lbg.extend(low)

@@ -28,9 +28,9 @@ Controller contract (class attributes, all optional):
 * ``last``: a :class:`~ddwmmr.controllers.base.StepInfo` about the last command.
 * ``adopt_plant(traits)``: called first with the plant's
   :class:`~ddwmmr.commands.PlantTraits` (its interfaces, whether it judges tipping by its
-  physics, its joints' lag, its base damping, its wheels' force limit and lever); a
-  controller may choose the options it was not given for that plant (the ``mpc``'s
-  force-level model and dynamic margin on the physics plant).
+  physics, its joints' lag and acceleration limits, its base damping, its wheels' force
+  limit and lever); a controller may choose the options it was not given for that plant
+  (the ``mpc``'s force-level model and dynamic margin on the physics plant).
 * ``adopt_control_step(dt)``: called with the loop's step (s) before ``reset``; a
   controller whose commands depend on how long they are held (the MPC's first interval and
   joint targets, the QP's look-ahead) plans with it unless told otherwise.

@@ -247,12 +247,11 @@ def _link2_inertial(robot: Robot) -> tuple[float, float, tuple[float, float, flo
     return mass, com, (axial, transverse, transverse)
 
 
-def servo_gains(robot: Robot, time_constant: float) -> tuple[float, float, float]:
-    """Velocity-servo gains ``(kv_wheel, kv_shoulder, kv_elbow)`` (N m s/rad).
+def reflected_inertias(robot: Robot) -> tuple[float, float, float]:
+    """The largest inertia (kg m^2) each motor moves: ``(wheel, shoulder, elbow)``.
 
-    Each is the joint's largest reflected inertia over ``time_constant``: a wheel carries
-    half the robot's mass at radius r (plus its own axle inertia); the shoulder and elbow
-    move the stretched arm (rods plus the payload at the tip).
+    A wheel carries half the robot's mass at radius r (plus its own axle inertia); the
+    shoulder and elbow move the stretched arm (rods plus the payload at the tip).
     """
     m1, m2 = robot.link_masses
     p, l1, l2, r = robot.payload, robot.L1, robot.L2, robot.wheel_radius
@@ -260,7 +259,13 @@ def servo_gains(robot: Robot, time_constant: float) -> tuple[float, float, float
     wheel = 0.5 * total * r * r + _wheel_inertia(robot)[0]
     shoulder = m1 * l1**2 / 3.0 + m2 * (l2**2 / 12.0 + (l1 + 0.5 * l2) ** 2) + p * (l1 + l2) ** 2
     elbow = m2 * l2**2 / 3.0 + p * l2**2
-    return wheel / time_constant, shoulder / time_constant, elbow / time_constant
+    return wheel, shoulder, elbow
+
+
+def servo_gains(robot: Robot, time_constant: float) -> tuple[float, float, float]:
+    """Velocity-servo gains ``(kv_wheel, kv_shoulder, kv_elbow)`` (N m s/rad): each joint's
+    largest reflected inertia (:func:`reflected_inertias`) over ``time_constant``."""
+    return tuple(inertia / time_constant for inertia in reflected_inertias(robot))
 
 
 def _fmt(*values: float) -> str:
@@ -478,6 +483,7 @@ __all__ = [
     "check_buildable",
     "convex_hull",
     "mjcf",
+    "reflected_inertias",
     "servo_gains",
     "support_polygon",
     "supports",

@@ -39,6 +39,7 @@ from ddwmmr.plants.mujoco.model import (
     ACTUATORS,
     EngineOptions,
     build_model,
+    reflected_inertias,
     supports,
 )
 from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
@@ -367,6 +368,16 @@ class MujocoPlant:
         """Time constant (s) with which the joints follow their rate targets (the velocity
         servos' ``servo_time_constant``): what a controller may model of the arm."""
         return self.options.servo_time_constant
+
+    @property
+    def joint_acceleration_limit(self) -> tuple[float, float]:
+        """Largest angular accelerations (rad/s^2) of the shoulder and the elbow: each
+        motor's torque limit over the inertia it moves with the arm stretched
+        (:func:`~ddwmmr.plants.mujoco.model.reflected_inertias`), what a controller may
+        model of the torque-limited servos (12.8 and 33.3 rad/s^2 with 3 kg)."""
+        _, shoulder, elbow = reflected_inertias(self.robot)
+        torque = self.robot.joint_torque_limits
+        return torque[0] / shoulder, torque[1] / elbow
 
     @property
     def tip_time(self) -> float | None:
