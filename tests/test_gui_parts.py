@@ -273,3 +273,18 @@ def test_the_summary_line_says_what_the_physics_plant_judged():
     assert "TIPPED at 1.23 s (physics)" in _summary_line("A", SimpleNamespace(summary=tipped))
     stood = {**base, "tipped": False, "tip_time_s": None, "min_physics_stability": 1.21}
     assert "stood (physics: min S_phys 1.21)" in _summary_line("A", SimpleNamespace(summary=stood))
+
+
+def test_the_mpc_options_carry_their_units():
+    """The mpc's horizon is in seconds (the field said steps), its force-model options in
+    N and rad/s^2."""
+    mpc = {spec.name: spec for spec in method_options("mpc")}
+    expected = {
+        "horizon": "s",
+        "first_interval": "s",
+        "arm_time_constant": "s",
+        "wheel_force_limit": "N",
+        "joint_acceleration_limit": "rad/s2",
+    }
+    assert {name: mpc[name].unit for name in expected} == expected
+    assert mpc["joint_acceleration_limit"].parse("5 8") == (5.0, 8.0)

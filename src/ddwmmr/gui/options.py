@@ -63,7 +63,13 @@ UNITS = {
     "max_yaw_acceleration": "rad/s2",
     "speed_budget": "m/s, rad/s",
     "reference_step": "s",
-    "horizon": "steps",
+    "horizon": "s",  # the mpc's prediction horizon
+    "first_interval": "s",
+    "arm_time_constant": "s",
+    "reach_speed": "m/s",
+    "huber": "m",
+    "wheel_force_limit": "N",
+    "joint_acceleration_limit": "rad/s2",
 }
 
 
