@@ -102,8 +102,6 @@ class BaseFacts:
                 f"(got {force_limit:g})"
             )
         force = planned_force(plant) if force_limit is None else force_limit
-        if motors is not None and force is not None:
-            force = min(force, motors)
         return cls(plant.base_damping, force, plant.wheel_lever)
 
     def dynamics(self, robot: Robot) -> sym.ThesisDynamics:
@@ -132,15 +130,17 @@ def _acceleration_option(value: Any) -> tuple[float, float] | None:
     return limits  # type: ignore[return-value]
 
 
-def planned_force(plant: PlantTraits) -> float | None:
+def planned_force(plant: PlantTraits) -> float:
     """The wheel force (N) the force model plans with by default on ``plant``: the plant's
-    own limit where the model is the plant's (the thesis plant), the thesis's 10 N on a
-    plant that judges tipping by its physics. On MuJoCo the motors' full 20.5 N tipped the
-    robot in 27 of 100 scenarios (the wheels lift and spin where the model has them
-    rolling; docs/mpc.md), against 2 with 10 N."""
-    if plant.judges_tipping or plant.wheel_force_limit is None:
+    own limit where the model is the plant's (the thesis plant), the thesis's 10 N, within
+    the motors, on a plant that judges tipping by its physics (and 10 N on a plant that
+    does not say). On MuJoCo the motors' full 20.5 N tipped the robot in 26 of 100
+    scenarios (the wheels lift and spin where the model has them rolling; docs/mpc.md),
+    against 3 with 10 N."""
+    motors = plant.wheel_force_limit
+    if motors is None:
         return FORCE_LIMIT_DEFAULT
-    return plant.wheel_force_limit
+    return min(FORCE_LIMIT_DEFAULT, motors) if plant.judges_tipping else motors
 
 
 class MPCControllerCore:
@@ -307,10 +307,11 @@ class MPCControllerCore:
         force-level model, the floor on the dynamic margin and the plant's joint lag (the
         static floor alone tipped 94 of 100 scenarios there, docs/mpc.md; likewise for
         ``model="thesis"`` given there); elsewhere the kinematic model (the force model when
-        ``dynamic_stability`` or a lag is asked for), static floor, no lag. The force
+        any force-model option is given: ``dynamic_stability``, a lag, a joint acceleration
+        bound or a wheel force), static floor, no lag. The force
         model's base (damping, wheel force limit, wheel lever: :class:`BaseFacts`) is the
         plant's where it says, else the thesis plant's; its wheel force is the one asked
-        for, else :func:`planned_force`, within the plant's motors. The lagged joints'
+        for (within the plant's motors), else :func:`planned_force`. The lagged joints'
         accelerations are bounded as asked, else by the physics plant's motors.
         """
         physics = plant is not None and plant.judges_tipping and FORCE in plant.interfaces
@@ -344,10 +345,11 @@ class MPCControllerCore:
         model: str,
         dynamic_stability: bool,
         lag: float | None,
-        base: BaseFacts | None = None,
-        acceleration_limit: tuple[float, float] | None = None,
+        base: BaseFacts,
+        acceleration_limit: tuple[float, float] | None,
     ) -> None:
-        """Set the prediction model and its options (problems are rebuilt on demand)."""
+        """Set the prediction model and its options (problems are rebuilt on demand):
+        the choice :meth:`_resolve` made, kept as ``_choice``."""
         if lag is not None and model != "thesis":
             raise ParameterError("arm_time_constant needs model='thesis'")
         if dynamic_stability and model != "thesis":
@@ -355,12 +357,11 @@ class MPCControllerCore:
                 "dynamic_stability needs model='thesis' (the kinematic model has no base "
                 "accelerations)"
             )
-        base = base or BaseFacts()
+        self._choice = (model, dynamic_stability, lag, base, acceleration_limit)
         self.model_name = model
         self.dynamics = None
         if model == "thesis":
             self.dynamics = base.dynamics(self.robot)
-        self._base = base
         self.arm_time_constant = lag
         self.joint_acceleration_limit = acceleration_limit
         self.dynamic_stability = dynamic_stability
@@ -375,14 +376,7 @@ class MPCControllerCore:
         """The loop's plant, described (:func:`ddwmmr.commands.traits_of`): options not
         given are chosen for it (:meth:`_resolve`), before ``reset``."""
         choice = self._resolve(plant)
-        current = (
-            self.model_name,
-            self.dynamic_stability,
-            self.arm_time_constant,
-            self._base,
-            self.joint_acceleration_limit,
-        )
-        if choice != current:
+        if choice != self._choice:
             self._configure(*choice)
             self._reset_memory()  # sized and meant for the previous model
             self._fallback = None
