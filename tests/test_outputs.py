@@ -364,3 +364,38 @@ def test_a_folder_whose_files_cannot_be_replaced_is_refused_before_the_run(
     error = capsys.readouterr().err.strip().splitlines()
     assert len(error) == 1 and "cannot replace files in" in error[0], error
     assert snapshot(out) == before and leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize(
+    ("tool", "extra"),
+    [
+        ("track", ["--method", "qp", "--traj", "ellipse", "--duration", "0.2", "--animate"]),
+        ("compare", ["--plant", "thesis"]),
+        ("scenarios", []),
+        ("scenarios", ["--arbiter", "competitive"]),
+    ],
+)
+def test_the_names_checked_before_the_run_are_the_files_it_writes(
+    tmp_path, tool, extra, monkeypatch
+):
+    """Every file a run writes is among the names its tool checks before the run (so a
+    user's file of that name is refused then, not after the run)."""
+    import importlib
+
+    module = importlib.import_module(f"ddwmmr.cli.{tool}")
+    checked: list[str] = []
+    real = module.check_output_folder
+
+    def spy(target, name, force=False, writes=()):
+        checked.extend(writes)
+        return real(target, name, force, writes)
+
+    monkeypatch.setattr(module, "check_output_folder", spy)
+    main, args = TOOLS[tool]
+    if tool == "track":
+        args = []  # draws its figures: the base arguments say --no-plots
+    jobs = [] if tool == "track" else ["--jobs", "1"]
+    out = tmp_path / "out"
+    assert main([*args, *extra, *FAST, *jobs, "--out", str(out)]) == 0
+    written = set(listed(out))
+    assert written and written <= set(checked), sorted(written - set(checked))
