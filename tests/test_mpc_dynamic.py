@@ -321,3 +321,81 @@ def test_the_lagged_arm_plans_within_the_joint_acceleration_limit():
     unlagged = make_controller("mpc", ROBOT, joint_acceleration_limit=5.0)
     with pytest.raises(ParameterError, match="needs the lagged arm"):
         unlagged.adopt_plant(traits_of(ThesisPlant(ROBOT)))
+
+
+def test_the_stopping_configuration_is_where_the_lagged_arm_comes_to_rest_braked_at_its_limit():
+    """Closed form ``th + rate |rate| / (2 a)`` against the lag ODE integrated in 1e-5 s
+    steps with the command leading the rate down at the limit (``u = rate -/+ a tau``) until
+    it stops: within 1e-4 rad for both joints and both signs; at rest nothing moves; a model
+    without an acceleration limit has no stopping configuration (its joints stop at once)."""
+    limits, tau = (12.8, 33.3), 0.02
+    model = LaggedArmPrediction(ROBOT, sym.ThesisDynamics.from_robot(ROBOT), tau, limits)
+    x = ca.SX.sym("x", 9)
+    stop = ca.Function("stop", [x], [model.stopping_configuration(x)])
+    for rates in ((2.0, -1.5), (-0.7, 1.9)):
+        state = np.array([0.3, -0.1, 0.5, -0.8, 1.2, 0.6, 0.2, *rates])
+        angles, moving, h = state[3:5].copy(), np.array(rates), 1e-5
+        for j in range(2):
+            while abs(moving[j]) > 0.0:
+                command = moving[j] - math.copysign(limits[j] * tau, moving[j])
+                rate = moving[j] + (command - moving[j]) * h / tau
+                if rate * moving[j] <= 0.0:  # stops within this step
+                    angles[j] += 0.5 * moving[j] * h
+                    break
+                angles[j] += 0.5 * (moving[j] + rate) * h
+                moving[j] = rate
+        q = np.asarray(stop(state)).ravel()
+        np.testing.assert_allclose(q[:3], state[:3], atol=0.0)
+        np.testing.assert_allclose(q[3:5], angles, atol=1e-4)
+    resting = np.array([0.0, 0.0, 0.0, -0.8, 1.2, 0.0, 0.0, 0.0, 0.0])
+    np.testing.assert_allclose(np.asarray(stop(resting)).ravel(), resting[:5], atol=1e-12)
+    unbounded = LaggedArmPrediction(ROBOT, sym.ThesisDynamics.from_robot(ROBOT), tau)
+    assert unbounded.stopping_configuration(x) is None
+
+
+def test_a_reach_plan_ends_where_the_arm_can_still_brake_above_the_floor():
+    """The shoulder swings at 2 rad/s towards the stability floor and the target lies just
+    before it (0.26 rad on): a minimum-time plan passes the target with the arm still
+    moving. With the joint acceleration limit the plan's last node is one from which the
+    arm, braked at that limit, stops with S >= floor + margin (converged, no slack); the
+    same plan without the limit (no such row) ends with a momentum that carries the arm
+    below the floor. S of the stopping pose from the numeric model, not the OCP's rows."""
+    from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights
+    from ddwmmr.mpc.solvers import GaussNewtonSQP
+
+    limits = (12.8, 33.3)
+    x0 = np.array([0.0, 0.0, 0.0, -2.75, 1.0, 0.0, 0.0, 2.0, 0.0])
+    target = ROBOT.fk(x0[:5] + np.array([0.0, 0.0, 0.0, 0.26, 0.0]))[:2]
+
+    def stopping_stability(acceleration_limit):
+        dynamics = sym.ThesisDynamics.from_robot(ROBOT)
+        model = LaggedArmPrediction(ROBOT, dynamics, 0.02, acceleration_limit)
+        config = OCPConfig(
+            intervals=10,
+            control_interval=0.01,
+            first_interval=0.05,
+            horizon=2.0,
+            reach=True,
+            track_orientation=False,
+            huber=0.01,
+            dynamic_stability=True,
+            weights=Weights(position=0.0, manipulability=0.0, input=0.01, terminal=0.0),
+        )
+        ocp = ShootingOCP(ROBOT, model, config)
+        node = np.concatenate([x0, [1.0]])
+        guess = ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
+        p = ocp.parameters(np.tile([*target, 0.0], (ocp.N, 1)), np.zeros(4), horizon_prev=1.0)
+        lbw, ubw = ocp.bounds(x0)
+        sqp = GaussNewtonSQP(ocp, "hpipm", iterations=200, tolerance=1e-10)
+        w = sqp.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+        assert ocp.max_slack(w) < 1e-9 and ocp.horizon_of(w) < 0.2
+        last = ocp.trajectories(w)[0][-1]
+        rates = last[7:9]
+        stop = np.concatenate(
+            [last[:3], last[3:5] + rates * np.abs(rates) / (2 * np.array(limits))]
+        )
+        return ROBOT.stability(stop)[2], np.abs(rates).max()
+
+    braked, rate = stopping_stability(limits)
+    assert braked >= 1.26 - 1e-6 and rate > 1.0  # it still passes the target moving
+    assert stopping_stability(None)[0] < 1.25

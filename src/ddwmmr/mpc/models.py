@@ -15,7 +15,9 @@ Two models, one interface (:class:`PredictionModel`):
   ``[q, v, w, th1dot, th2dot]``, 9): the arm's accelerations, which move the centre of
   pressure, are then part of the prediction (a velocity servo with that time constant, as
   the physics plant's). With ``acceleration_limit`` the lag's accelerations are bounded
-  (rows) by what the joints' motors give, as the physics plant's torque-limited servos.
+  (rows) by what the joints' motors give, as the physics plant's torque-limited servos,
+  and ``stopping_configuration`` is the pose where the joints come to rest braked at that
+  limit (the OCP holds its centre of mass in the stability box at the last node).
 
 Joint-position limits are state bounds in both.
 """
@@ -77,6 +79,11 @@ class PredictionModel(ABC):
     def configuration(self, x: Any) -> Any:
         """The configuration part ``q`` of a state."""
         return x[:5]
+
+    def stopping_configuration(self, x: Any) -> Any | None:
+        """Where the joints come to rest from state ``x`` when braked as hard as they may,
+        or None when the model's joints stop at once (rates are inputs)."""
+        return None
 
     def integrate(self, x: Any, u: Any, h: Any, substeps: int) -> Any:
         """The state after h (s) under u held: RK4 in ``substeps`` equal sub-steps."""
@@ -181,6 +188,18 @@ class LaggedArmPrediction(ThesisPrediction):
         if self.acceleration_limit is None:
             return None
         return self.joint_motion(x, u)[1], self.acceleration_limit
+
+    def stopping_configuration(self, x: Any) -> Any | None:
+        """``q`` with each joint moved on by its braking distance ``rate |rate| / (2 a)``
+        at the acceleration limit ``a`` (the lag adds nothing: the command can lead the
+        rate down at that deceleration). ``|rate|`` is smoothed by 1e-3 rad/s so the row
+        stays differentiable at rest."""
+        if self.acceleration_limit is None:
+            return None
+        rates = x[7:9]
+        limits = ca.DM(self.acceleration_limit)
+        distance = rates * ca.sqrt(rates**2 + 1e-6) / (2.0 * limits)
+        return ca.vertcat(x[:3], x[3:5] + distance)
 
     def rhs(self, x: Any, u: Any) -> Any:
         rates, accelerations = self.joint_motion(x, u)

@@ -46,7 +46,10 @@ be met they are met (a hard constraint), and a linearisation that cannot be met 
 iteration still gives a solvable QP. Input box (forces or rates), joint-position box on
 the states; with the lagged arm and a joint acceleration limit, rows (without slack: the
 stage's input can always meet them) bound the lag's acceleration ``(u_rates - rates) /
-tau`` at the start of every interval, where it is largest.
+tau`` at the start of every interval, where it is largest, and the last node holds the
+centre of mass of its *stopping pose* (each joint moved on by its braking distance at that
+limit) in the stability box too: a plan may not end in a swing the arm cannot brake before
+the floor.
 
 Cost: ``0.5 ||r(w, p)||^2 + c' w`` with the residual ``r`` stacked from, weighted by the
 interval lengths:
@@ -313,12 +316,17 @@ class ShootingOCP:
 
     def _stability_points(self, k: int, x_k, x_next, u_k) -> list:
         """The points held in the stability box for stage k: the centre of mass at node
-        k+1, and (dynamic) the zero moment point at both ends of the interval under u_k. At
+        k+1 (at the last node also that of the pose where the joints, braked at their
+        acceleration limit, come to rest), and (dynamic) the zero moment point at both ends
+        of the interval under u_k. At
         the first stage the joints accelerate from the previous command's rates within the
         control step (the change of rates over dt), where an abrupt change of the arm's
         motion moves the centre of pressure most."""
         robot, model = self.robot, self.model
         points = [sym.centre_of_mass(robot, model.configuration(x_next))]
+        stop = model.stopping_configuration(x_next) if k == self.N - 1 else None
+        if stop is not None:
+            points.append(sym.centre_of_mass(robot, stop))
         if not self.config.dynamic_stability:
             return points
         for end, x in enumerate((x_k, x_next)):
