@@ -285,6 +285,7 @@ def test_the_mpc_options_carry_their_units():
         "arm_time_constant": "s",
         "wheel_force_limit": "N",
         "joint_acceleration_limit": "rad/s2",
+        "brake_slack": "m",
     }
     assert {name: mpc[name].unit for name in expected} == expected
     assert mpc["joint_acceleration_limit"].parse("5 8") == (5.0, 8.0)

@@ -70,6 +70,7 @@ UNITS = {
     "huber": "m",
     "wheel_force_limit": "N",
     "joint_acceleration_limit": "rad/s2",
+    "brake_slack": "m",
 }
 
 

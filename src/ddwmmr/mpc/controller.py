@@ -39,6 +39,7 @@ from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT, FORCE_LIMIT_DEFAULT
 from ddwmmr.mpc import terminal
+from ddwmmr.mpc.braking import braking_input
 from ddwmmr.mpc.models import PredictionModel, make_model
 from ddwmmr.mpc.ocp import (
     MAX_HORIZON,
@@ -68,6 +69,12 @@ STALL_PROGRESS = 1e-3
 #: its hard constraints is stuck (on the physics plant: spinning on the spot with the arm
 #: stretched at the dynamic floor for 35 s, 4 of 100 scenarios, before this rule).
 STALL_SLACK = 1e-3
+#: Default ``brake_slack`` (m) where the lagged arm has a joint acceleration limit (a
+#: physics plant): a plan whose largest slack exceeds it is replaced by the braking step.
+BRAKE_SLACK = 5e-3
+#: Below this speed (m/s, rad/s: base speed, yaw rate, joint rates) the robot is at rest
+#: and the braking step is not taken.
+AT_REST = 0.05
 #: Defaults per objective: (intervals, first interval s, horizon s). Chosen by the horizon
 #: study in docs/mpc.md.
 GRID_DEFAULTS = {"tracking": (10, 0.05, 1.0), "reach": (12, 0.05, 5.0)}
@@ -191,6 +198,11 @@ class MPCControllerCore:
             (``PlantTraits.wheel_force_limit``; more is refused when the loop hands over the
             plant's traits); None (default): :func:`planned_force`,
             the thesis plant's own limit there, the thesis's 10 N on a physics plant.
+        brake_slack: when the plan needs more slack than this (m, in the stability box)
+            the step brakes instead (:func:`ddwmmr.mpc.braking.braking_input`: base and
+            arm slowed within the force and acceleration limits), counted in
+            ``mpc_brakes``; only with the lagged arm and a joint acceleration limit; None
+            (default): :data:`BRAKE_SLACK` there, else off; 0: off.
         dt: control step (s); default the trajectory's ``duration / samples`` at reset,
             else 0.02 s.
         fallback_options: options of the ``qp`` fallback controller (merged over the
@@ -225,6 +237,7 @@ class MPCControllerCore:
         arm_time_constant: float | None = None,
         joint_acceleration_limit: float | Sequence[float] | None = None,
         wheel_force_limit: float | None = None,
+        brake_slack: float | None = None,
         obstacle_margin: float = 0.05,
         dt: float | None = None,
         fallback_options: dict[str, Any] | None = None,
@@ -250,6 +263,9 @@ class MPCControllerCore:
             self._force_option = check_range("wheel_force_limit", wheel_force_limit, 0.1, 1e4, "N")
             if model == "kinematic":
                 raise ParameterError("wheel_force_limit needs model='thesis'")
+        self._brake_option = None
+        if brake_slack is not None:
+            self._brake_option = check_range("brake_slack", brake_slack, 0.0, 1.0, "m")
         self._dynamic_option = None
         if dynamic_stability is not None:
             self._dynamic_option = check_bool("dynamic_stability", dynamic_stability)
@@ -365,6 +381,8 @@ class MPCControllerCore:
         self.arm_time_constant = lag
         self.joint_acceleration_limit = acceleration_limit
         self.dynamic_stability = dynamic_stability
+        braked = acceleration_limit is not None and lag is not None and self._brake_option != 0.0
+        self.brake_slack = (self._brake_option or BRAKE_SLACK) if braked else None
         self.model: PredictionModel = make_model(
             model, self.robot, self.dynamics, lag, acceleration_limit
         )
@@ -380,6 +398,11 @@ class MPCControllerCore:
             self._configure(*choice)
             self._reset_memory()  # sized and meant for the previous model
             self._fallback = None
+        if self._brake_option and self.brake_slack is None:
+            raise ParameterError(
+                "brake_slack needs the lagged arm with a joint acceleration limit (a physics "
+                "plant, or arm_time_constant and joint_acceleration_limit)"
+            )
 
     @staticmethod
     def _grid_option(mode, horizon, intervals, first_interval, dt) -> tuple[int, float, float]:
@@ -441,6 +464,7 @@ class MPCControllerCore:
         self._anchor: tuple[float, float] | None = None
         self._anchor_time = 0.0
         self.restarts = 0
+        self.brakes = 0  # steps that braked instead of following a plan that needed slack
 
     def adopt_control_step(self, dt: float) -> None:
         """The loop holds each command ``dt`` (s): plan with it (the first interval, the
@@ -505,7 +529,16 @@ class MPCControllerCore:
             self._infeasible_since = None
         elif self._infeasible_since is None:
             self._infeasible_since = t
-        return self._output(problem, q, x0, problem.ocp.first_input(w), w, iterations)
+        u = problem.ocp.first_input(w)
+        braking = (
+            self.brake_slack is not None
+            and problem.ocp.max_slack(w) > self.brake_slack
+            and self._moving(x0)
+        )
+        if braking:
+            self.brakes += 1
+            u = self._braking_input(q, x0)
+        return self._output(problem, q, x0, u, w, iterations, braking)
 
     # -- pieces ---------------------------------------------------------------------------
     def _stalled(self, t: float, q: np.ndarray, new: bool) -> bool:
@@ -545,7 +578,30 @@ class MPCControllerCore:
             return np.array([self._trajectory.pose(t + tau) for tau in times])
         return pose_d[None, :] + times[:, None] * velocity_d[None, :]
 
-    def _output(self, problem, q, x0, u, w, iterations) -> np.ndarray | WheelForces:
+    def _moving(self, x0: np.ndarray) -> bool:
+        """True when base or arm moves faster than :data:`AT_REST` (m/s, rad/s): at rest
+        there is nothing to brake, and a plan that needs slack there (a pose at the floor)
+        must be let move the arm back."""
+        rates = self._predicted_rates
+        speed = max(abs(float(x0[5])), abs(float(x0[6])), abs(rates[0]), abs(rates[1]))
+        return speed > AT_REST
+
+    def _braking_input(self, q: np.ndarray, x0: np.ndarray) -> np.ndarray:
+        """The braking step at the measured state (force model with the lagged arm)."""
+        assert self.dynamics is not None and self.joint_acceleration_limit is not None
+        assert self.arm_time_constant is not None
+        return braking_input(
+            self.dynamics,
+            float(q[4]),
+            (float(x0[5]), float(x0[6])),
+            self._predicted_rates,
+            self.joint_acceleration_limit,
+            self.arm_time_constant,
+        )
+
+    def _output(
+        self, problem, q, x0, u, w, iterations, braking: bool = False
+    ) -> np.ndarray | WheelForces:
         k = self.robot.com_coefficients
         th1, th2 = float(q[3]), float(q[4])
         r1, r2 = float(u[2]), float(u[3])
@@ -559,6 +615,7 @@ class MPCControllerCore:
                 "mpc_horizon_s": ocp.horizon_of(w),
                 "mpc_slack": slack,
                 "arm_scale": scale,
+                "mpc_braking": float(braking),
             }
         )
         velocity = (0.0, 0.0)
@@ -640,6 +697,8 @@ class MPCControllerCore:
             "stability_violations": int(np.sum(stability < self.stability_min)),
             "mpc_fallbacks": fallbacks,
             "mpc_restarts": self.restarts,
+            "mpc_brakes": self.brakes,
+            "mpc_brake_slack_m": self.brake_slack,
             "min_obstacle_clearance_m": clearance,
             "mpc_model": self.model_name,
             "mpc_dynamic_stability": self.dynamic_stability,

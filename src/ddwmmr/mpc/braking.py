@@ -1,0 +1,64 @@
+"""The braking step: what the force-level mpc sends when its plan cannot meet its own
+stability rows.
+
+On a physics plant a plan that needs the rows' slack is one the model itself predicts to
+cross the dynamic floor; its first input is then the least bad of a bad plan, and on the
+MuJoCo plant that was what tipped the robot (full-force spins on a light wheel, every plan
+needing slack for 50 ms before the tip; docs/mpc.md, "The physics plant: tipping while
+moving"). The braking step instead sheds the motion that moves the centre of pressure:
+the base's speed and turn decay together with one time constant, within the wheel force
+limit, and each joint slows at its acceleration limit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ddwmmr.model import symbolic as sym
+
+#: Time constant (s) with which the braking step asks the base to shed v and w.
+BRAKE_TIME = 0.5
+
+
+def braking_input(
+    dynamics: sym.ThesisDynamics,
+    th2: float,
+    velocity: tuple[float, float],
+    joint_rates: tuple[float, float],
+    acceleration_limit: tuple[float, float],
+    arm_time_constant: float,
+    brake_time: float = BRAKE_TIME,
+) -> np.ndarray:
+    """The force model's input ``(F_left, F_right, th1dot, th2dot)`` (N, N, rad/s, rad/s)
+    that brakes base and arm.
+
+    Args:
+        dynamics: the force-level model (mass, yaw inertia, damping, lever, force limit).
+        th2: elbow angle (rad); the yaw inertia depends on it.
+        velocity: the base's ``(v, w)`` (m/s, rad/s), measured.
+        joint_rates: the lagged joints' present rates (rad/s).
+        acceleration_limit: the joints' acceleration limits (rad/s^2).
+        arm_time_constant: the joints' lag (s).
+        brake_time: time constant (s) of the base's braking.
+
+    The wheel forces ask for ``vdot = -v / brake_time`` and ``wdot = -w / brake_time``
+    with the damping compensated, scaled down together (so the base decelerates along its
+    present motion) until neither wheel exceeds the force limit. Each joint rate command
+    leads its rate down by ``a tau`` (the lag then decelerates it at ``a``), or to zero
+    when it is slower than that.
+    """
+    v, w = velocity
+    inertia = float(dynamics.inertia(th2))
+    push = dynamics.c1 * v - dynamics.mass * v / brake_time  # F_left + F_right, N
+    turn = (dynamics.c2 * w - inertia * w / brake_time) / dynamics.half_width  # F_r - F_l
+    left, right = 0.5 * (push - turn), 0.5 * (push + turn)
+    excess = max(abs(left), abs(right)) / dynamics.force_limit
+    if excess > 1.0:
+        left, right = left / excess, right / excess
+    rates = [
+        rate - math.copysign(min(abs(rate), limit * arm_time_constant), rate)
+        for rate, limit in zip(joint_rates, acceleration_limit)
+    ]
+    return np.array([left, right, *rates])
