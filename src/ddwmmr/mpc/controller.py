@@ -605,7 +605,9 @@ class MPCControllerCore:
         k = self.robot.com_coefficients
         th1, th2 = float(q[3]), float(q[4])
         r1, r2 = float(u[2]), float(u[3])
-        scale = safe_arm_scale(k, th1, th2, r1, r2, self.dt, self.stability_min)
+        # a braking step's rates already slow the joints at their limit: cutting them
+        # further would stop the arm at once, the jolt that tipped the robot on MuJoCo
+        scale = 1.0 if braking else safe_arm_scale(k, th1, th2, r1, r2, self.dt, self.stability_min)
         r1, r2 = r1 * scale, r2 * scale
         ocp = problem.ocp
         slack = ocp.max_slack(w)
