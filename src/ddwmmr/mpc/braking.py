@@ -7,7 +7,7 @@ MuJoCo plant that was what tipped the robot (full-force spins on a light wheel, 
 needing slack for 50 ms before the tip; docs/mpc.md, "The physics plant: tipping while
 moving"). The braking step instead sheds the motion that moves the centre of pressure:
 the base's speed and turn decay together with one time constant, within the wheel force
-limit, and each joint slows at its acceleration limit.
+limit, and each joint slows within its acceleration limit.
 """
 
 from __future__ import annotations
@@ -45,9 +45,13 @@ def braking_input(
 
     The wheel forces ask for ``vdot = -v / brake_time`` and ``wdot = -w / brake_time``
     with the damping compensated, scaled down together (so the base decelerates along its
-    present motion) until neither wheel exceeds the force limit. Each joint rate command
-    leads its rate down by ``a tau`` (the lag then decelerates it at ``a``), or to zero
-    when it is slower than that.
+    present motion) until neither wheel exceeds the force limit. The arm's reaction on the
+    yaw while it brakes is not compensated: the physics plant turns the base by it, so
+    ``w`` decays only roughly with ``brake_time`` while the joints slow. Each joint rate
+    command leads its rate down by ``a tau`` (the lag then decelerates it at ``a`` at the
+    start of the step, less as the command is held:
+    :meth:`ddwmmr.mpc.models.LaggedArmPrediction.stopping_configuration`), or to zero when
+    it is slower than that.
     """
     v, w = velocity
     inertia = float(dynamics.inertia(th2))

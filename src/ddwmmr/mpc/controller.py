@@ -30,6 +30,7 @@ from ddwmmr.controllers.base import StepInfo, control_step
 from ddwmmr.errors import (
     ParameterError,
     check_bool,
+    check_finite,
     check_int_at_least,
     check_nonnegative,
     check_positive,
@@ -198,11 +199,13 @@ class MPCControllerCore:
             (``PlantTraits.wheel_force_limit``; more is refused when the loop hands over the
             plant's traits); None (default): :func:`planned_force`,
             the thesis plant's own limit there, the thesis's 10 N on a physics plant.
-        brake_slack: when the plan needs more slack than this (m, in the stability box)
-            the step brakes instead (:func:`ddwmmr.mpc.braking.braking_input`: base and
-            arm slowed within the force and acceleration limits), counted in
-            ``mpc_brakes``; only with the lagged arm and a joint acceleration limit; None
-            (default): :data:`BRAKE_SLACK` there, else off; 0: off.
+        brake_slack: when the plan needs more slack in its stability rows than this (m,
+            in the box on the centre of mass and the zero moment point; 0 or in [1e-4, 1])
+            while the robot moves, the step brakes instead
+            (:func:`ddwmmr.mpc.braking.braking_input`: base and arm slowed within the force
+            and acceleration limits), counted in ``mpc_brakes``; only with the lagged arm
+            and a joint acceleration limit; None (default): :data:`BRAKE_SLACK` (5 mm)
+            there, else off; 0: off.
         dt: control step (s); default the trajectory's ``duration / samples`` at reset,
             else 0.02 s.
         fallback_options: options of the ``qp`` fallback controller (merged over the
@@ -265,7 +268,11 @@ class MPCControllerCore:
                 raise ParameterError("wheel_force_limit needs model='thesis'")
         self._brake_option = None
         if brake_slack is not None:
-            self._brake_option = check_range("brake_slack", brake_slack, 0.0, 1.0, "m")
+            self._brake_option = check_finite("brake_slack", brake_slack)
+            if self._brake_option != 0.0 and not 1e-4 <= self._brake_option <= 1.0:
+                raise ParameterError(
+                    f"brake_slack must be 0 (off) or in [0.0001, 1] m (got {brake_slack:g})"
+                )
         self._dynamic_option = None
         if dynamic_stability is not None:
             self._dynamic_option = check_bool("dynamic_stability", dynamic_stability)
@@ -394,15 +401,16 @@ class MPCControllerCore:
         """The loop's plant, described (:func:`ddwmmr.commands.traits_of`): options not
         given are chosen for it (:meth:`_resolve`), before ``reset``."""
         choice = self._resolve(plant)
-        if choice != self._choice:
-            self._configure(*choice)
-            self._reset_memory()  # sized and meant for the previous model
-            self._fallback = None
-        if self._brake_option and self.brake_slack is None:
+        model, _, lag, _, acceleration_limit = choice
+        if self._brake_option and not (model == "thesis" and lag and acceleration_limit):
             raise ParameterError(
                 "brake_slack needs the lagged arm with a joint acceleration limit (a physics "
                 "plant, or arm_time_constant and joint_acceleration_limit)"
             )
+        if choice != self._choice:
+            self._configure(*choice)
+            self._reset_memory()  # sized and meant for the previous model
+            self._fallback = None
 
     @staticmethod
     def _grid_option(mode, horizon, intervals, first_interval, dt) -> tuple[int, float, float]:
@@ -532,7 +540,7 @@ class MPCControllerCore:
         u = problem.ocp.first_input(w)
         braking = (
             self.brake_slack is not None
-            and problem.ocp.max_slack(w) > self.brake_slack
+            and problem.ocp.max_stability_slack(w) > self.brake_slack
             and self._moving(x0)
         )
         if braking:
@@ -599,6 +607,16 @@ class MPCControllerCore:
             self.arm_time_constant,
         )
 
+    def _braked_velocity(self, q: np.ndarray, x0: np.ndarray, u: np.ndarray) -> tuple:
+        """``(v, w)`` (m/s, rad/s) one control step after the braking forces ``u[:2]``
+        (Euler on the force model; used only when no measured velocity is given)."""
+        d = self.dynamics
+        assert d is not None
+        v, w, (left, right) = float(x0[5]), float(x0[6]), (float(u[0]), float(u[1]))
+        vdot = (left + right - d.c1 * v) / d.mass
+        wdot = ((right - left) * d.half_width - d.c2 * w) / float(d.inertia(float(q[4])))
+        return v + self.dt * vdot, w + self.dt * wdot
+
     def _output(
         self, problem, q, x0, u, w, iterations, braking: bool = False
     ) -> np.ndarray | WheelForces:
@@ -621,7 +639,9 @@ class MPCControllerCore:
             }
         )
         velocity = (0.0, 0.0)
-        if self.dynamics is not None:
+        if braking:  # the plan's prediction is not what is sent: one Euler step instead
+            velocity = self._braked_velocity(q, x0, u)
+        elif self.dynamics is not None:
             xs, _ = ocp.trajectories(w)
             velocity = (float(xs[1][5]), float(xs[1][6]))
         return self._apply(float(u[0]), float(u[1]), r1, r2, q, velocity)

@@ -191,9 +191,15 @@ class LaggedArmPrediction(ThesisPrediction):
 
     def stopping_configuration(self, x: Any) -> Any | None:
         """``q`` with each joint moved on by its braking distance ``rate |rate| / (2 a)``
-        at the acceleration limit ``a`` (the lag adds nothing: the command can lead the
-        rate down at that deceleration). ``|rate|`` is smoothed by 1e-3 rad/s so the row
-        stays differentiable at rest."""
+        at the acceleration limit ``a``: the distance when the command leads the rate down
+        at that deceleration throughout. It is optimistic for the controller's braking
+        step (:func:`ddwmmr.mpc.braking.braking_input`), whose command is held over each
+        control step, so that the lag decelerates at ``a`` only at the step's start (0.79 a
+        on average for a 10 ms step and a 20 ms lag; the arm then travels up to 1.6 times
+        as far, tested). The braking step's own distance was tried in the row and did worse
+        on the scenarios (docs/mpc.md): the row is a heuristic for a plan's last node, not
+        a guarantee. ``|rate|`` is smoothed by 1e-3 rad/s so the row stays differentiable
+        at rest."""
         if self.acceleration_limit is None:
             return None
         rates = x[7:9]

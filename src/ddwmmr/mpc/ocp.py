@@ -481,6 +481,11 @@ class ShootingOCP:
         """The largest constraint slack of a solution (0: every hard row met)."""
         return max(float(np.max(w[s])) for s in self.slack_slices)
 
+    def max_stability_slack(self, w: np.ndarray) -> float:
+        """The largest slack of the stability rows (m, in the box on the centre of mass
+        and the zero moment point; the obstacle rows' slack, in m^2, left out)."""
+        return max(float(np.max(w[s][:2])) for s in self.slack_slices)
+
     def first_input(self, w: np.ndarray) -> np.ndarray:
         """``u_0`` of a solution (the model's input, without slacks)."""
         return np.asarray(w[self.u_slices[0]], dtype=float)
