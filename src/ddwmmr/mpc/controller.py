@@ -138,6 +138,12 @@ def _acceleration_option(value: Any) -> tuple[float, float] | None:
     return limits  # type: ignore[return-value]
 
 
+def _can_brake(lag: float | None, acceleration_limit: tuple[float, float] | None) -> bool:
+    """The braking step needs the lagged arm (only the force model has one) and its joint
+    acceleration limit."""
+    return lag is not None and acceleration_limit is not None
+
+
 def planned_force(plant: PlantTraits) -> float:
     """The wheel force (N) the force model plans with by default on ``plant``: the plant's
     own limit where the model is the plant's (the thesis plant), the thesis's 10 N, within
@@ -388,7 +394,7 @@ class MPCControllerCore:
         self.arm_time_constant = lag
         self.joint_acceleration_limit = acceleration_limit
         self.dynamic_stability = dynamic_stability
-        braked = acceleration_limit is not None and lag is not None and self._brake_option != 0.0
+        braked = _can_brake(lag, acceleration_limit) and self._brake_option != 0.0
         self.brake_slack = (self._brake_option or BRAKE_SLACK) if braked else None
         self.model: PredictionModel = make_model(
             model, self.robot, self.dynamics, lag, acceleration_limit
@@ -401,8 +407,8 @@ class MPCControllerCore:
         """The loop's plant, described (:func:`ddwmmr.commands.traits_of`): options not
         given are chosen for it (:meth:`_resolve`), before ``reset``."""
         choice = self._resolve(plant)
-        model, _, lag, _, acceleration_limit = choice
-        if self._brake_option and not (model == "thesis" and lag and acceleration_limit):
+        _, _, lag, _, acceleration_limit = choice
+        if self._brake_option and not _can_brake(lag, acceleration_limit):
             raise ParameterError(
                 "brake_slack needs the lagged arm with a joint acceleration limit (a physics "
                 "plant, or arm_time_constant and joint_acceleration_limit)"
@@ -610,12 +616,10 @@ class MPCControllerCore:
     def _braked_velocity(self, q: np.ndarray, x0: np.ndarray, u: np.ndarray) -> tuple:
         """``(v, w)`` (m/s, rad/s) one control step after the braking forces ``u[:2]``
         (Euler on the force model; used only when no measured velocity is given)."""
-        d = self.dynamics
-        assert d is not None
-        v, w, (left, right) = float(x0[5]), float(x0[6]), (float(u[0]), float(u[1]))
-        vdot = (left + right - d.c1 * v) / d.mass
-        wdot = ((right - left) * d.half_width - d.c2 * w) / float(d.inertia(float(q[4])))
-        return v + self.dt * vdot, w + self.dt * wdot
+        assert self.dynamics is not None
+        state = np.concatenate([q, x0[5:7]])
+        rate = np.asarray(self.dynamics.rhs(state, np.r_[u[:2], 0.0, 0.0]), dtype=float).ravel()
+        return float(x0[5] + self.dt * rate[5]), float(x0[6] + self.dt * rate[6])
 
     def _output(
         self, problem, q, x0, u, w, iterations, braking: bool = False
