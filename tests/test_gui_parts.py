@@ -289,3 +289,18 @@ def test_the_mpc_options_carry_their_units():
     }
     assert {name: mpc[name].unit for name in expected} == expected
     assert mpc["joint_acceleration_limit"].parse("5 8") == (5.0, 8.0)
+
+
+def test_each_method_offers_its_own_solver_choices():
+    """The mpc's solver button cycles through the mpc's solvers (it showed the qp's, which
+    the mpc refuses); a mapping option (another controller's options) is not a field."""
+    from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS
+    from ddwmmr.qp.solve import installed_solvers
+
+    mpc = {spec.name: spec for spec in method_options("mpc")}
+    qp = {spec.name: spec for spec in method_options("qp")}
+    assert mpc["solver"].choices == SOLVERS and mpc["solver"].default == "rti"
+    assert mpc["qp_solver"].kind == "choice" and mpc["qp_solver"].choices == QP_SOLVERS
+    assert "mode" not in mpc and "fallback_options" not in mpc
+    assert set(qp["solver"].choices) == set(installed_solvers())
+    assert option_spec("fallback_options", None, "dict[str, Any] | None") is None

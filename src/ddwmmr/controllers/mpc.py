@@ -2,7 +2,8 @@
 
 Receding-horizon optimal control by multiple shooting: the trajectory's future poses are
 the reference (tracking), or the waypoint is reached as early as possible (waypoint mode,
-a free-final-time horizon). Tip-over stability ``S >= stability_min`` is a hard constraint
+a free-final-time horizon). Tip-over stability ``S >= stability_min + stability_margin``
+(the margin 0.01 by default) is a hard constraint
 at every node in its exact nonlinear form; wheel-speed, joint-speed, joint-limit and
 obstacle constraints likewise; manipulability is a soft cost. The previous solution,
 shifted, warm-starts one Gauss-Newton iteration per step (the real-time iteration) with the
@@ -18,9 +19,10 @@ returns :class:`ddwmmr.commands.WheelForces`. Every ``mpc`` controller is a samp
 controller (``zero_order_hold = True``): one call per control step, the command held over
 the step.
 
-``summarize`` adds to the run summary: ``stability_min``, ``stability_violations``
-(recorded steps with S < floor), ``mpc_fallbacks`` (steps that used the ``qp`` fallback),
-``min_obstacle_clearance_m``, ``mpc_model``, ``mpc_solver``, ``mpc_horizon_s``.
+``summarize`` adds to the run summary, among others, ``stability_min``,
+``stability_violations`` (recorded steps with S < floor), ``mpc_fallbacks`` (steps that
+used the ``qp`` fallback), ``mpc_brakes`` (braking steps), ``mpc_model``, ``mpc_solver``;
+the full list is in docs/mpc.md, "Options".
 """
 
 from __future__ import annotations

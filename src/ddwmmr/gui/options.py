@@ -2,8 +2,10 @@
 
 Nothing here knows a method by name: :func:`method_options` inspects the constructor of
 whatever :func:`ddwmmr.make_controller` builds, so a newly registered method shows up in
-the app with its options. The few option *names* below only add presentation (a list of
-choices, a unit) to options that any method may have.
+the app with its options. A controller class may declare the values of its closed-set
+options in ``option_choices`` (option name -> function returning the values; the qp's
+installed solvers, the mpc's solvers). The few option *names* below only add presentation
+(a list of choices, a unit) to options that any method may have.
 """
 
 from __future__ import annotations
@@ -26,24 +28,9 @@ def _aux_rows() -> list[str]:
     return list(AUX_ROWS)
 
 
-def _qp_modes() -> list[str]:
-    from ddwmmr.qp.solve import MODES
-
-    return list(MODES)
-
-
-def _qp_solvers() -> list[str]:
-    from ddwmmr.qp.solve import installed_solvers
-
-    return installed_solvers()
-
-
-#: Options with a closed set of values, shown as a button cycling through them.
-CHOICES: dict[str, Callable[[], list[str]]] = {
-    "aux": _aux_rows,
-    "mode": _qp_modes,
-    "solver": _qp_solvers,
-}
+#: Options with a closed set of values whatever the method, shown as a button cycling
+#: through them (a controller's own ``option_choices`` come first).
+CHOICES: dict[str, Callable[[], list[str]]] = {"aux": _aux_rows}
 
 #: Units shown next to known option names (SI; "-" for dimensionless ones).
 UNITS = {
@@ -176,6 +163,7 @@ def method_options(method: str) -> tuple[OptionSpec, ...]:
     (e.g. lists of user task objects) are left out.
     """
     controller_class = type(make_controller(method))
+    choices = {**CHOICES, **getattr(controller_class, "option_choices", {})}
     specs = []
     for parameter in inspect.signature(controller_class).parameters.values():
         if parameter.name == "robot" or parameter.kind in (
@@ -183,27 +171,37 @@ def method_options(method: str) -> tuple[OptionSpec, ...]:
             inspect.Parameter.VAR_KEYWORD,
         ):
             continue
-        spec = option_spec(parameter.name, parameter.default, _annotation_text(parameter))
+        spec = option_spec(parameter.name, parameter.default, _annotation_text(parameter), choices)
         if spec is not None:
             specs.append(spec)
     return tuple(specs)
 
 
-def option_spec(name: str, default: Any, annotation: str) -> OptionSpec | None:
+def option_spec(
+    name: str,
+    default: Any,
+    annotation: str,
+    choices: dict[str, Callable[[], list[Any]]] | None = None,
+) -> OptionSpec | None:
     """The :class:`OptionSpec` of one constructor parameter, or None if it is not editable.
 
-    ``annotation`` is the parameter's annotation as text (``"float | None"``...).
+    ``annotation`` is the parameter's annotation as text (``"float | None"``...);
+    ``choices`` maps closed-set option names to their values (default :data:`CHOICES`).
+    Mappings (e.g. another controller's options) cannot be typed into a field: None.
     """
+    choices = CHOICES if choices is None else choices
     if default is inspect.Parameter.empty:
         default = None
     words = set(re.findall(r"[A-Za-z_]+", annotation))
     optional = default is None or "None" in words
     unit = UNITS.get(name, "")
-    if name in CHOICES:
-        choices = tuple(CHOICES[name]())
-        if default not in choices and default is not None:
-            choices = (default, *choices)
-        return OptionSpec(name, default, "choice", choices, optional, unit=unit)
+    if name in choices:
+        values = tuple(choices[name]())
+        if default not in values and default is not None:
+            values = (default, *values)
+        return OptionSpec(name, default, "choice", values, optional, unit=unit)
+    if words & {"dict", "Mapping"} or isinstance(default, dict):
+        return None
     if isinstance(default, bool) or words == {"bool"} or words == {"bool", "None"}:
         choices = (None, True, False) if optional else (True, False)
         return OptionSpec(name, default, "choice", choices, optional, unit=unit)

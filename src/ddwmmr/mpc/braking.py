@@ -37,7 +37,8 @@ def braking_input(
     Args:
         dynamics: the force-level model (mass, yaw inertia, damping, lever, force limit).
         th2: elbow angle (rad); the yaw inertia depends on it.
-        velocity: the base's ``(v, w)`` (m/s, rad/s), measured.
+        velocity: the base's ``(v, w)`` (m/s, rad/s), measured (or the controller's own
+            prediction when the loop gives none).
         joint_rates: the lagged joints' present rates (rad/s).
         acceleration_limit: the joints' acceleration limits (rad/s^2).
         arm_time_constant: the joints' lag (s).

@@ -10,7 +10,11 @@ Every control step (one call per step; the command is held over it, ``zero_order
    iteration (the real-time iteration, default) or a full solve updates it;
 4. the first input is applied: a velocity command (kinematic model) or wheel forces and
    one-step joint targets (thesis model); an exact check of S one step ahead scales the
-   joint rates back if the linearisation was too optimistic.
+   joint rates back if the linearisation was too optimistic (not a braking step's rates,
+   which already slow the joints at their acceleration limit). On a lagged arm with a
+   joint acceleration limit (a physics plant), a plan whose stability rows need more
+   slack than ``brake_slack`` while the robot moves is replaced by the braking step
+   (:mod:`ddwmmr.mpc.braking`).
 
 A failed solve (infeasible QP, solver error, non-finite numbers) falls back to the ``qp``
 controller's command for that step, counted in ``mpc_fallbacks``; the next step starts cold.
@@ -19,9 +23,9 @@ controller's command for that step, counted in ``mpc_fallbacks``; the next step 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -71,7 +75,8 @@ STALL_PROGRESS = 1e-3
 #: stretched at the dynamic floor for 35 s, 4 of 100 scenarios, before this rule).
 STALL_SLACK = 1e-3
 #: Default ``brake_slack`` (m) where the lagged arm has a joint acceleration limit (a
-#: physics plant): a plan whose largest slack exceeds it is replaced by the braking step.
+#: physics plant): a plan whose stability rows' largest slack (m,
+#: ``ShootingOCP.max_stability_slack``) exceeds it is replaced by the braking step.
 BRAKE_SLACK = 5e-3
 #: Below this speed (m/s, rad/s: base speed, yaw rate, joint rates) the robot is at rest
 #: and the braking step is not taken.
@@ -150,7 +155,8 @@ def planned_force(plant: PlantTraits) -> float:
     the motors, on a plant that judges tipping by its physics (and 10 N on a plant that
     does not say). On MuJoCo the motors' full 20.5 N tipped the robot in 26 of 100
     scenarios (the wheels lift and spin where the model has them rolling; docs/mpc.md),
-    against 3 with 10 N."""
+    against 3 with 10 N, both before the brakeable last node and the braking step (with
+    them 10 N tips none)."""
     motors = plant.wheel_force_limit
     if motors is None:
         return FORCE_LIMIT_DEFAULT
@@ -167,8 +173,8 @@ class MPCControllerCore:
             velocities, ``base_velocity=(v, w)``); None (default): chosen for the plant the
             loop runs it on (:meth:`adopt_plant`: ``"thesis"`` on a plant that takes wheel
             forces and judges tipping by its physics, or when ``dynamic_stability``,
-            ``arm_time_constant`` or ``wheel_force_limit`` asks for it, else
-            ``"kinematic"``).
+            ``arm_time_constant``, ``joint_acceleration_limit`` or ``wheel_force_limit``
+            asks for it, else ``"kinematic"``).
         stability_min: floor S_min of the tip-over margin (hard, exact at every node).
         manipulability_weight: weight of ``cos^2 th2`` (soft).
         obstacles: circles (``Circle`` or (x, y, radius) triples, m) or a TOML file path;
@@ -212,8 +218,8 @@ class MPCControllerCore:
             and acceleration limits), counted in ``mpc_brakes``; only with the lagged arm
             and a joint acceleration limit; None (default): :data:`BRAKE_SLACK` (5 mm)
             there, else off; 0: off.
-        dt: control step (s); default the trajectory's ``duration / samples`` at reset,
-            else 0.02 s.
+        dt: control step (s); default the loop's control step (:meth:`adopt_control_step`),
+            else the trajectory's ``duration / samples`` at reset, else 0.02 s.
         fallback_options: options of the ``qp`` fallback controller (merged over the
             defaults derived from these options).
     """
@@ -221,6 +227,13 @@ class MPCControllerCore:
     name = "mpc"
     #: Sampled-data controller: call once per control step, hold the command over it.
     zero_order_hold = True
+
+    #: Options with a closed set of values, for front ends (the app shows a button cycling
+    #: through them): option name -> function returning the values.
+    option_choices: ClassVar[Mapping[str, Callable[[], list[str]]]] = {
+        "solver": lambda: list(SOLVERS),
+        "qp_solver": lambda: list(QP_SOLVERS),
+    }
 
     def __init__(
         self,
@@ -581,7 +594,8 @@ class MPCControllerCore:
         v, w = self._predicted_velocity if base_velocity is None else base_velocity
         # the lagged joints' rates: no sensor reports them, the controller carries them
         # forward from its own commands (estimating them from the measured joint motion
-        # tipped 25 of 100 scenarios on the physics plant against 6)
+        # tipped 25 of 100 scenarios on the physics plant against 6, both measured with the
+        # lagged arm alone, docs/mpc.md)
         lagged = self._predicted_rates if self.arm_time_constant is not None else ()
         return np.concatenate([q, [float(v), float(w)], lagged])
 

@@ -22,8 +22,8 @@ state (tests/test_qp_limits_extreme.py).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Callable, Mapping, Sequence
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -50,7 +50,7 @@ from ddwmmr.qp.limits import (
     stability_terms_gradient,
 )
 from ddwmmr.qp.problem import QPProblem
-from ddwmmr.qp.solve import check_mode, make_backend, solve
+from ddwmmr.qp.solve import MODES, check_mode, installed_solvers, make_backend, solve
 from ddwmmr.qp.tasks import (
     Detour,
     EndEffectorTask,
@@ -125,6 +125,13 @@ class QPControllerCore:
     """
 
     name = "qp"
+
+    #: Options with a closed set of values, for front ends (the app shows a button cycling
+    #: through them): option name -> function returning the values.
+    option_choices: ClassVar[Mapping[str, Callable[[], list[str]]]] = {
+        "solver": installed_solvers,
+        "mode": lambda: list(MODES),
+    }
 
     def __init__(
         self,
