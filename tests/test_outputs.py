@@ -19,7 +19,13 @@ from ddwmmr.cli.compare import main as compare_main
 from ddwmmr.cli.scenarios import main as scenarios_main
 from ddwmmr.cli.track import main as track_main
 from ddwmmr.errors import ParameterError
-from ddwmmr.outputs import MANIFEST, STAGING_PREFIX, check_output_folder, output_folder
+from ddwmmr.outputs import (
+    MANIFEST,
+    STAGING_PREFIX,
+    check_output_folder,
+    first_free,
+    output_folder,
+)
 
 TOOLS = {
     "track": (
@@ -268,6 +274,52 @@ def test_error_in_the_block_removes_staging_and_created_parents(tmp_path):
         assert staging.name.startswith(STAGING_PREFIX)
         raise RuntimeError
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_fresh_folder_never_replaces_one_that_appeared_during_the_run(tmp_path):
+    """Two runs with the same default (time-stamped) name: the later one goes to -2, and a
+    third that finishes together with a second still gets its own (-3)."""
+    target = tmp_path / "runs" / "ats-ellipse-20261201-120000"
+    first = output_folder(target, "x", fresh=True)
+    second = output_folder(target, "x", fresh=True)  # both looked before either finished
+    third = output_folder(target, "x", fresh=True)
+    for n, writer in enumerate((first, second, third), start=1):
+        with writer as staging:
+            (staging / "r.txt").write_text(f"run {n}")
+    names = [w.path.name for w in (first, second, third)]
+    assert names == [target.name, f"{target.name}-2", f"{target.name}-3"]
+    assert [(w.path / "r.txt").read_text() for w in (first, second, third)] == [
+        "run 1",
+        "run 2",
+        "run 3",
+    ]
+    assert first_free(target) == target.with_name(f"{target.name}-4")
+    assert leftovers(target.parent) == []
+
+
+def test_a_fresh_run_that_fails_leaves_nothing(tmp_path):
+    target = tmp_path / "runs" / "scenarios-20261201-120000"
+    with pytest.raises(RuntimeError), output_folder(target, "x", fresh=True) as staging:
+        (staging / "f.txt").write_text("half")
+        raise RuntimeError
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("tool", ["track", "scenarios"])
+def test_default_output_names_are_never_reused(tmp_path, monkeypatch, tool, capsys):
+    """Without --out, runs within the same second wrote to the same folder: the later
+    replaced the earlier (here every run gets the same stamp)."""
+    stamped = Path("runs") / f"{tool}-20261201-120000"
+    monkeypatch.setattr(f"ddwmmr.cli.{tool}.default_out", lambda *names: stamped)
+    monkeypatch.chdir(tmp_path)
+    main, args = TOOLS[tool]
+    jobs = [] if tool == "track" else ["--jobs", "1"]
+    for _ in range(3):
+        assert main([*args, *FAST, *jobs]) == 0
+    folders = sorted(p.name for p in (tmp_path / "runs").iterdir())
+    assert len(folders) == 3 and folders[1:] == [f"{folders[0]}-2", f"{folders[0]}-3"]
+    said = capsys.readouterr()
+    assert f"wrote runs/{folders[0]}-3" in said.out + said.err
 
 
 def test_keyboard_interrupt_removes_staging(tmp_path):

@@ -10,6 +10,8 @@ Every tool (track, compare, scenarios) writes its results through :func:`output_
 * an existing ``--out`` is replaced only if it is empty, or if its manifest names the same
   tool and it holds nothing but the files that manifest lists. Anything else is refused
   with one line (a :class:`ParameterError`);
+* a default, time-stamped ``--out`` (``fresh``) never replaces anything: two runs started
+  within the same second, or finishing together, each get their own folder (``-2``...);
 * ``force=True`` (``--force``) also writes into a folder another tool or the user made,
   and even then deletes only the files its manifest lists: a file no manifest lists always
   survives (a new file that would overwrite it is refused).
@@ -27,7 +29,7 @@ import shutil
 import stat
 import sys
 import tempfile
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
@@ -317,30 +319,82 @@ def _refusal(text: str, tool: str, existing: Existing) -> str:
 
 
 # -- the staging folder -------------------------------------------------------------------
-@contextlib.contextmanager
-def output_folder(target: str | Path, tool: str, force: bool = False) -> Iterator[Path]:
-    """Yield a staging folder whose files replace or join ``target`` if the block succeeds.
+def first_free(path: str | Path) -> Path:
+    """``path``, or ``stem-2.suffix``, ``stem-3.suffix``... whichever does not exist yet (a
+    default, time-stamped output name: runs started within the same second get their own)."""
+    path = Path(path)
+    number = 1
+    candidate = path
+    while os.path.lexists(candidate):
+        number += 1
+        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
+    return candidate
+
+
+class OutputFolder:
+    """What :func:`output_folder` returns: a context manager whose ``with`` block gets the
+    staging folder, and whose :attr:`path` is where the files went once it has run."""
+
+    def __init__(self, target: str | Path, tool: str, force: bool, fresh: bool) -> None:
+        self._text = str(target)
+        self.tool, self.force, self.fresh = tool, force, fresh
+        #: Absolute path of the output folder (after a ``fresh`` commit, the numbered
+        #: sibling the files went to if the target had appeared meanwhile).
+        self.path = check_output_folder(target, tool, force)
+        self._staging: Path | None = None
+        self._created: list[Path] = []
+
+    def __enter__(self) -> Path:
+        self._created = _make_parents(self.path.parent)
+        try:
+            staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=self.path.parent))
+        except OSError as exc:
+            remove_created(self._created)
+            raise ParameterError(
+                f"out: cannot write in {self.path.parent} ({exc.strerror})"
+            ) from None
+        self._staging = staging
+        try:
+            os.chmod(staging, folder_mode())
+        except BaseException:
+            self._discard()
+            raise
+        return staging
+
+    def __exit__(self, exc_type, exc, traceback) -> bool:
+        if exc_type is None:
+            try:
+                self.path = _commit(
+                    self._staging, self.path, self.tool, self.force, self._text, self.fresh
+                )
+                return False
+            except BaseException:
+                self._discard()
+                raise
+        self._discard()
+        return False  # the block's exception goes on
+
+    def _discard(self) -> None:
+        if self._staging is not None:
+            shutil.rmtree(self._staging, ignore_errors=True)
+        remove_created(self._created)
+
+
+def output_folder(
+    target: str | Path, tool: str, force: bool = False, fresh: bool = False
+) -> OutputFolder:
+    """A context manager yielding a staging folder whose files replace or join ``target``
+    if the block succeeds.
 
     On success a manifest listing every staged file is added and the files are moved into
     ``target`` (see the module docstring for when an existing folder may be replaced). On
     any exception (Ctrl-C and SIGTERM included) the staging folder, and any parent folder
-    created for it, is removed and nothing else is touched.
+    created for it, is removed and nothing else is touched. ``fresh`` (a default,
+    time-stamped name the user did not choose): an existing folder is never replaced, not
+    even an earlier run of the same tool; if ``target`` appeared during the run, the files
+    go to the first free ``target-2``, ``target-3``... (the returned object's ``path``).
     """
-    path = check_output_folder(target, tool, force)
-    created = _make_parents(path.parent)
-    try:
-        staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=path.parent))
-    except OSError as exc:
-        remove_created(created)
-        raise ParameterError(f"out: cannot write in {path.parent} ({exc.strerror})") from None
-    try:
-        os.chmod(staging, folder_mode())
-        yield staging
-        _commit(staging, path, tool, force, str(target))
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        remove_created(created)
-        raise
+    return OutputFolder(target, tool, force, fresh)
 
 
 def _make_parents(folder: Path) -> list[Path]:
@@ -363,13 +417,19 @@ def remove_created(created: list[Path]) -> None:
             folder.rmdir()
 
 
-def _commit(staging: Path, target: Path, tool: str, force: bool, text: str) -> None:
+def _commit(
+    staging: Path, target: Path, tool: str, force: bool, text: str, fresh: bool = False
+) -> Path:
+    """Move the staged files into ``target`` (or, ``fresh``, a free sibling); returns the
+    folder they went to."""
     files = _entries(staging)
     manifest = {"tool": tool, "version": package_version(), "files": files}
     _write_manifest(staging, manifest)
+    if fresh:
+        return _commit_fresh(staging, target)
     if not os.path.lexists(target):
         os.rename(staging, target)
-        return
+        return target
     if os.path.islink(target) or not target.is_dir():
         raise ParameterError(f"out: {text} changed during the run and is not a folder any more")
     existing = inspect(target, tool)
@@ -379,6 +439,26 @@ def _commit(staging: Path, target: Path, tool: str, force: bool, text: str) -> N
         _merge(staging, target, files, existing, text)
     else:
         raise ParameterError(_refusal(text, tool, existing))
+    return target
+
+
+def _commit_fresh(staging: Path, target: Path) -> Path:
+    """Rename ``staging`` to the first of ``target``, ``target-2``... that nobody holds:
+    each candidate is taken with an exclusive ``mkdir`` (so two runs finishing together
+    cannot take the same one), then the staging folder replaces that empty folder."""
+    while True:
+        candidate = first_free(target)
+        try:
+            os.mkdir(candidate, folder_mode())
+        except FileExistsError:
+            continue  # taken between the look and the mkdir: the next one
+        try:
+            os.rename(staging, candidate)  # onto our own empty folder
+        except BaseException:
+            with contextlib.suppress(OSError):
+                candidate.rmdir()
+            raise
+        return candidate
 
 
 def _write_manifest(folder: Path, manifest: dict) -> None:

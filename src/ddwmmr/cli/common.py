@@ -24,7 +24,7 @@ from collections.abc import Callable, Iterator, Sequence
 
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
-from ddwmmr.outputs import check_output_folder, output_folder
+from ddwmmr.outputs import check_output_folder, first_free, output_folder
 
 #: Exit status for bad input (argparse uses the same).
 EXIT_USAGE = 2
@@ -39,6 +39,7 @@ __all__ = [
     "add_force_argument",
     "add_robot_arguments",
     "check_output_folder",
+    "first_free",
     "output_folder",
     "robot_from_arguments",
     "run_main",

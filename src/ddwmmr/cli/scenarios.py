@@ -32,6 +32,7 @@ from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
     check_output_folder,
+    first_free,
     output_folder,
     run_main,
 )
@@ -586,14 +587,16 @@ def _main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     args.argv = argv  # recorded in the summary
     config = config_from_arguments(args)
-    out = Path(args.out) if args.out is not None else default_out()
+    fresh = args.out is None  # a default name: never replaces an earlier run
+    out = first_free(default_out()) if fresh else Path(args.out)
     check_output_folder(out, "scenarios", args.force, output_names(args, config))
     if config.controller == "qp":
         from ddwmmr.scenarios.protocol import make_qp
 
         make_qp(config_robot(config), generate(1, 0)[0], config)  # fail early, before output
     runner = Runner(args)
-    with output_folder(out, "scenarios", args.force) as folder:
+    writer = output_folder(out, "scenarios", args.force, fresh)
+    with writer as folder:
         if args.study == "thresholds":
             _run_thresholds(args, config, runner, folder)
         elif args.study == "obstacles":
@@ -602,7 +605,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
             _run_arbiters(args, config, runner, folder)
         else:
             _run_benchmark(args, config, runner, folder)
-    print(f"wrote {out}", file=sys.stderr)
+    print(f"wrote {out.with_name(writer.path.name)}", file=sys.stderr)
     return 0
 
 

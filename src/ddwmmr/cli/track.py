@@ -24,6 +24,7 @@ from ddwmmr.cli.common import (
     add_force_argument,
     add_robot_arguments,
     check_output_folder,
+    first_free,
     output_folder,
     robot_from_arguments,
     run_main,
@@ -532,12 +533,14 @@ def _main(argv: Sequence[str] | None = None) -> int:
     inputs = inputs_from_record(args) if args.rerun is not None else inputs_from_arguments(args)
     steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
     controller = make_controller(inputs.method, inputs.robot, **inputs.options)
-    out = Path(args.out) if args.out is not None else default_out(inputs.method, inputs.label)
+    fresh = args.out is None  # a default name: never replaces an earlier run
+    out = first_free(default_out(inputs.method, inputs.label)) if fresh else Path(args.out)
     check_output_folder(out, "track", args.force, output_names(not args.no_plots, args.animate))
     record = run_record(inputs, argv, args.rerun)
     progress = not args.no_progress
     _note_uneven_duration(inputs.duration, inputs.dt, steps)
-    with output_folder(out, "track", args.force) as staging:
+    writer = output_folder(out, "track", args.force, fresh)
+    with writer as staging:
         with ProgressBar(steps, "track: steps", enabled=progress, unit="step") as bar:
             result = simulate(
                 inputs.robot,
@@ -568,7 +571,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
                 progress=progress,
             )
     print(format_table(result.summary))
-    print(f"wrote {out}/")
+    print(f"wrote {out.with_name(writer.path.name)}/")
     return 0
 
 

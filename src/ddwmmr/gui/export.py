@@ -32,6 +32,7 @@ from PIL import Image
 from ddwmmr.errors import ParameterError
 from ddwmmr.gui.options import plant_keywords
 from ddwmmr.gui.settings import Settings, build_robot, build_trajectory
+from ddwmmr.outputs import first_free
 from ddwmmr.sim.result import write_atomic
 from ddwmmr.sim.simulate import plant_integrator
 from ddwmmr.trajectories import SampledTrajectory
@@ -45,21 +46,9 @@ GUI_PROG = "python -m ddwmmr.gui"
 ANIMATION_WRITERS = {"gif": "pillow", "mp4": "ffmpeg"}
 
 
-def unique_path(path: Path) -> Path:
-    """``path``, or ``stem-2.suffix``, ``stem-3.suffix``... whichever does not exist yet."""
-    if not path.exists():
-        return path
-    number = 2
-    while True:
-        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
-        if not candidate.exists():
-            return candidate
-        number += 1
-
-
 def run_folder(root: Path, name: str) -> Path:
     """A folder for one run's files under ``root`` that does not exist yet."""
-    return unique_path(Path(root) / name)
+    return first_free(Path(root) / name)
 
 
 def write_run_data(
@@ -84,9 +73,9 @@ def write_run_data(
         ]
     for result, label, record in zip(results, labels, records):
         target = folder if len(results) == 1 else folder / label
-        csv_path = unique_path(target / "timeseries.csv")
+        csv_path = first_free(target / "timeseries.csv")
         result.write_csv(csv_path)
-        json_path = unique_path(target / "summary.json")
+        json_path = first_free(target / "summary.json")
         result.write_summary(json_path, **({} if record is None else {"run": record}))
         written += [csv_path, json_path]
     return written
@@ -101,7 +90,7 @@ def trajectory_source(
     trajectory known by name only."""
     source = find_trajectory_file(settings.trajectory)
     if isinstance(trajectory, SampledTrajectory) and settings.geometry:
-        source = unique_path(folder / "trajectory.csv")
+        source = first_free(folder / "trajectory.csv")
         write_atomic(source, csv_text(trajectory))
         written.append(source)
     return source
@@ -138,7 +127,7 @@ def write_window_png(figure: Figure, folder: Path, dpi: float | None = None) -> 
     """The whole window as ``window.png``."""
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=dpi or figure.dpi)
-    path = unique_path(folder / "window.png")
+    path = first_free(folder / "window.png")
     write_atomic(path, buffer.getvalue())
     return path
 
@@ -195,7 +184,7 @@ def write_animation(
     figure, view = animation_figure(dpi)
     view.set_runs(results, labels, obstacles)
     indices = frame_indices(view.last_index, frames)
-    path = unique_path(folder / f"animation.{fmt}")
+    path = first_free(folder / f"animation.{fmt}")
     if fmt == "gif":
         images = list(_blitted_frames(figure, view, indices))
         # One palette for all frames, from the last (it has every trail and colour).
