@@ -372,3 +372,28 @@ def test_obstacle_on_the_straight_line_is_passed_with_its_clearance():
         }
     )
     assert summary["min_obstacle_clearance_m"] > 0.045  # the footprint is inside the circle
+
+
+def test_controllers_on_the_same_problem_share_it_and_run_as_if_fresh():
+    """The OCP and its compiled QP are built once per (robot, model, grid, options) and
+    shared; a run on the shared problem, after another problem's run, repeats a run on a
+    freshly built one to the last bit."""
+    from ddwmmr.mpc import controller as core
+    from ddwmmr.mpc import solvers
+
+    trajectory = Ellipse(T=20.0, N=1000)
+
+    def run(**options):
+        result = simulate(Robot(), trajectory, "mpc", duration=0.4, **options)
+        return np.column_stack([result.timeseries[c] for c in ("xE", "yE", "v", "w", "th1dot")])
+
+    core._OCPS.clear()
+    fresh = run()
+    (ocp,) = core._OCPS.values()
+    compiled = solvers._COMPILED[ocp]
+    other = run(stability_min=1.4)  # a different problem: built apart
+    assert len(core._OCPS) == 2 and not np.array_equal(other, fresh)
+    shared = run()
+    assert len(core._OCPS) == 2 and ocp in core._OCPS.values()
+    assert solvers._COMPILED[ocp] is compiled  # no new QP functions either
+    np.testing.assert_array_equal(shared, fresh)

@@ -23,6 +23,7 @@ command for that step.
 
 from __future__ import annotations
 
+import weakref
 from typing import Any
 
 import casadi as ca
@@ -91,26 +92,7 @@ class GaussNewtonSQP:
         self.qp_solver = qp_solver
         self.iterations = iterations
         self.tolerance = tolerance
-        w, p = ocp.w, ocp.p
-        jr = ca.jacobian(ocp.residual, w)
-        jg = ca.jacobian(ocp.g, w)
-        diagonal = np.full(ocp.nw, HESSIAN_FLOOR)
-        scale = np.asarray(ocp.model.u_scale, dtype=float)
-        reference = float(np.max(ocp.lengths))
-        for s, length in zip(ocp.u_slices, ocp.lengths):
-            # Proximal term on the inputs, per second of interval like the cost: damps the
-            # step from the warm start, so that one iteration per control step cannot
-            # jump between two distant plans.
-            diagonal[s] += proximal * (length / reference) / scale**2
-        hessian = ca.mtimes(jr.T, jr) + ca.diag(ca.DM(diagonal))
-        gradient = ca.mtimes(jr.T, ocp.residual) + ca.DM(ocp.linear_cost)
-        self._data = ca.Function("qp_data", [w, p], [hessian, gradient, jg, ocp.g], {"cse": True})
-        self._qp = ca.conic(
-            "qp",
-            qp_solver,
-            {"h": hessian.sparsity(), "a": jg.sparsity()},
-            _conic_options(ocp, qp_solver),
-        )
+        self._data, self._qp = _compiled_qp(ocp, qp_solver, proximal)
         self.last_iterations = 0
         #: Multipliers (constraints, bounds) of the last QP: at a converged point (step
         #: zero) they are the NLP's multipliers.
@@ -157,6 +139,51 @@ class GaussNewtonSQP:
                 raise SolverFailure(f"hpipm: return status {status}")
         elif not stats.get("success", False):
             raise SolverFailure(f"{self.qp_solver}: {stats.get('return_status')}")
+
+
+#: The QP data function and the QP solver of each (OCP, backend, proximal weight), shared
+#: by every solver on that OCP: building them (the Jacobians, the CSE'd function, the
+#: conic) is most of the OCP's set-up cost (:func:`ddwmmr.mpc.controller._shared_ocp`),
+#: and neither keeps anything from one call to the next that a later call reads (a run on
+#: a shared one repeats a fresh one to the last bit, tests/test_mpc.py).
+_COMPILED: weakref.WeakKeyDictionary[ShootingOCP, dict[tuple[str, float], tuple[Any, Any]]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def _compiled_qp(ocp: ShootingOCP, qp_solver: str, proximal: float) -> tuple[Any, Any]:
+    """``(qp_data, qp)`` of :class:`GaussNewtonSQP` on ``ocp``, built once (see
+    :data:`_COMPILED`)."""
+    per_ocp = _COMPILED.setdefault(ocp, {})
+    key = (qp_solver, float(proximal))
+    if key not in per_ocp:
+        per_ocp[key] = _build_qp(ocp, qp_solver, proximal)
+    return per_ocp[key]
+
+
+def _build_qp(ocp: ShootingOCP, qp_solver: str, proximal: float) -> tuple[Any, Any]:
+    """The Gauss-Newton QP's data as one CasADi function of (w, p), and its conic."""
+    w, p = ocp.w, ocp.p
+    jr = ca.jacobian(ocp.residual, w)
+    jg = ca.jacobian(ocp.g, w)
+    diagonal = np.full(ocp.nw, HESSIAN_FLOOR)
+    scale = np.asarray(ocp.model.u_scale, dtype=float)
+    reference = float(np.max(ocp.lengths))
+    for s, length in zip(ocp.u_slices, ocp.lengths):
+        # Proximal term on the inputs, per second of interval like the cost: damps the
+        # step from the warm start, so that one iteration per control step cannot
+        # jump between two distant plans.
+        diagonal[s] += proximal * (length / reference) / scale**2
+    hessian = ca.mtimes(jr.T, jr) + ca.diag(ca.DM(diagonal))
+    gradient = ca.mtimes(jr.T, ocp.residual) + ca.DM(ocp.linear_cost)
+    data = ca.Function("qp_data", [w, p], [hessian, gradient, jg, ocp.g], {"cse": True})
+    qp = ca.conic(
+        "qp",
+        qp_solver,
+        {"h": hessian.sparsity(), "a": jg.sparsity()},
+        _conic_options(ocp, qp_solver),
+    )
+    return data, qp
 
 
 class NLPSolver:
