@@ -9,7 +9,14 @@ import sys
 
 import numpy as np
 
-from ddwmmr import Ellipse, Robot, available_methods, make_controller, simulate
+from ddwmmr import (
+    Ellipse,
+    ParameterError,
+    Robot,
+    available_methods,
+    make_controller,
+    simulate,
+)
 
 KEYS = (
     "rms_position_error_m",
@@ -43,4 +50,8 @@ def main(method: str = "clrrmc-ts") -> None:
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:2])
+    try:
+        main(*sys.argv[1:2])
+    except ParameterError as error:  # e.g. an unknown method: one line, exit 2, like the tools
+        print(f"error: {error}", file=sys.stderr)
+        sys.exit(2)

@@ -141,3 +141,65 @@ def test_messages_stay_one_short_line_for_huge_values(make):
     match = "L1 must be a number" if isinstance(value, str) else "L1 must be a finite number"
     message = _refused(lambda: check_positive("L1", value), match)
     assert len(message) < 100
+
+
+# -- a newcomer audit's cases: what track refused, the API and the other tools accepted ----
+
+
+def test_a_start_in_which_the_robot_has_tipped_over_is_named():
+    """check_start, which track, compare and the app call before a run; simulate itself
+    runs it (a design study sees min S < 1)."""
+    from ddwmmr.resolution.reference import start_configuration
+    from ddwmmr.sim.simulate import check_start
+
+    heavy = Robot().with_payload(20.0)
+    start = start_configuration(heavy, Ellipse())
+    message = _refused(lambda: check_start(heavy, start), r"payload tips the robot over")
+    assert "S = 0.551 <= 1" in message and message.startswith("start:")
+    check_start(Robot().with_payload(3.0), start)  # upright: nothing to say
+    assert simulate(heavy, Ellipse(), "ats", duration=0.1).summary["min_stability"] < 1.0
+
+
+def test_a_start_inside_an_obstacle_is_named():
+    # The default ellipse starts with the base at about (1.6, 0): a 0.5 m circle at (2, 0)
+    # overlaps it.
+    from ddwmmr.resolution.reference import start_configuration
+    from ddwmmr.sim.simulate import check_start
+
+    start = start_configuration(Robot(), Ellipse())
+    _refused(
+        lambda: check_start(Robot(), start, [(2.0, 0.0, 0.5)]),
+        r"obstacles: obstacle 1 .* overlaps the robot's start pose by",
+    )
+    check_start(Robot(), start, [(5.0, 0.0, 0.5)])
+
+
+@pytest.mark.parametrize(
+    ("trajectory", "match"),
+    [
+        (None, r"trajectory must have duration \(s\), pose\(t\) and velocity\(t\)"),
+        ("ellipse", r"not its name 'ellipse' \(ddwmmr.load_trajectory\('ellipse'\)"),
+        (type("NoVelocity", (), {"duration": 1.0, "pose": lambda self, t: None})(), "velocity"),
+    ],
+)
+def test_simulate_names_what_a_trajectory_needs(trajectory, match):
+    _refused(lambda: simulate(Robot(), trajectory, "ats"), match)
+
+
+@pytest.mark.parametrize(
+    ("circle", "match"),
+    [
+        ("x = 1e9\ny = 0.0\nradius = 0.3", r"obstacle x must be in \[-1e\+06, 1e\+06\] m"),
+        ("x = 5.0\ny = -2e6\nradius = 0.3", r"obstacle y must be in \[-1e\+06, 1e\+06\] m"),
+        ("x = 5.0\ny = 0.0\nradius = 5000.0", r"obstacle radius must be in \[1e-06, 1000\] m"),
+        ("x = 5.0\ny = 0.0\nradius = 1e-9", r"obstacle radius must be in \[1e-06, 1000\] m"),
+    ],
+)
+def test_obstacle_files_keep_the_documented_limits(tmp_path, circle, match):
+    from ddwmmr.qp.limits.obstacles import load_obstacles
+
+    path = tmp_path / "o.toml"
+    path.write_text(f"[[obstacle]]\n{circle}\n")
+    _refused(lambda: load_obstacles(path), r"obstacles: .*o.toml: obstacle 1: " + match)
+    path.write_text("[[obstacle]]\nx = 1e6\ny = -1e6\nradius = 1000.0\n")
+    assert load_obstacles(path)[0].radius == 1000.0  # the limits themselves are allowed

@@ -70,6 +70,10 @@ FILES = {
     "traj_short.csv": b"t,x,y\n0,0,0\n",
     "traj_long_row.csv": b"t,x,y\n0,0,0\n1,1,0,5\n2,2,0\n",
     "traj_repeated_column.csv": b"t,x,y,t\n0,0,0,0\n1,1,0,1\n2,2,0,2\n",
+    "traj_blank_columns.csv": b"garbage,,\n1,2,3\n",
+    "obstacle_at_start.toml": b"[[obstacle]]\nx = 2.0\ny = 0.0\nradius = 0.5\n",
+    "obstacle_far.toml": b"[[obstacle]]\nx = 1e9\ny = 0.0\nradius = 0.3\n",
+    "obstacle_huge.toml": b"[[obstacle]]\nx = 5.0\ny = 0.0\nradius = 5000.0\n",
     "obstacles_text.toml": b'[[obstacle]]\nx = "1"\ny = 0.0\nradius = 0.3\n',
     "a_file.txt": b"not a folder\n",
 }
@@ -136,7 +140,14 @@ for tool in ("track", "compare"):
 CASES += [("track", ["--traj", traj], text) for traj, text in TRAJ_CASES]
 CASES += [
     ("track", ["--traj", "{traj_long_row.csv}"], "data row 2 has more values than the header"),
-    ("track", ["--traj", "{traj_repeated_column.csv}"], "repeats column(s) t"),
+    ("track", ["--traj", "{traj_repeated_column.csv}"], "repeats column(s) t; needs a header"),
+    ("track", ["--traj", "{traj_blank_columns.csv}"], "has a blank column name (column 2)"),
+    # a payload that tips the robot in the start pose: refused by every tool, as by track
+    ("track", ["--payload", "20"], "a 20 kg payload tips the robot over in this run's start"),
+    ("compare", ["--payload", "50"], "a 50 kg payload tips the robot over in this run's start"),
+    ("track", ["--method", "qp", "--obstacles", "{obstacle_at_start.toml}"], "overlaps the rob"),
+    ("track", ["--method", "qp", "--obstacles", "{obstacle_far.toml}"], "obstacle x must be in"),
+    ("track", ["--method", "qp", "--obstacles", "{obstacle_huge.toml}"], "radius must be in"),
 ]
 CASES += [("compare", ["--only", traj], text) for traj, text in TRAJ_CASES[:4] + TRAJ_CASES[15:]]
 CASES += [("compare", ["--traj", traj], text) for traj, text in TRAJ_CASES[10:13]]

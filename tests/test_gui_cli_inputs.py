@@ -285,3 +285,23 @@ def test_the_audit_command_keeps_the_users_file(tmp_path):
         assert "Traceback" not in done.stderr and done.stdout == ""
         assert user.read_bytes() == USER_TEXT
     assert files_below(tmp_path) == ["user_notes.txt", "user_pic.png"]
+
+
+def test_a_run_that_starts_tipped_or_in_an_obstacle_is_refused(tmp_path, capsys, no_window):
+    """What track refuses, the window's settings refuse too (it ran them before)."""
+    snap = str(tmp_path / "s.png")
+    refused(
+        ["--snapshot", snap, *FAST, "--payload", "20"],
+        capsys,
+        "payload: a 20 kg payload tips the robot over",
+        "S = 0.57 <= 1",
+    )
+    obstacles = tmp_path / "start.toml"
+    obstacles.write_text("[[obstacle]]\nx = 2.0\ny = 0.0\nradius = 0.5\n")
+    refused(
+        ["--snapshot", snap, *FAST, "--method", "qp", "--option", f"obstacles={obstacles}"],
+        capsys,
+        "obstacles: obstacle 1",
+        "overlaps the robot's start pose by 0.104 m",
+    )
+    assert files_below(tmp_path) == ["start.toml"]

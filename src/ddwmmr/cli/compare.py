@@ -59,7 +59,9 @@ from ddwmmr.reports.compare import (
     write_report,
 )
 from ddwmmr.reports.compare.plan import run_duration
+from ddwmmr.resolution.reference import offset_configuration, start_configuration
 from ddwmmr.sim.result import json_safe, write_atomic
+from ddwmmr.sim.simulate import check_start
 from ddwmmr.trajectories import available_trajectories, load_trajectory, trajectory_name
 from ddwmmr.trajectories.files import find_trajectory_file
 
@@ -307,11 +309,18 @@ def check_duration(duration: float | None, trajectories: dict[str, Any]) -> floa
     return duration
 
 
-def check_steps(config: CompareConfig, specs: Sequence[Any]) -> None:
-    """Every planned run within the step cap (:data:`ddwmmr.errors.MAX_STEPS`)."""
+def check_runs(config: CompareConfig, specs: Sequence[Any]) -> None:
+    """Every planned run within the step cap (:data:`ddwmmr.errors.MAX_STEPS`), and
+    starting upright and clear of its obstacles (:func:`ddwmmr.sim.simulate.check_start`,
+    as ``track`` refuses it), before any run."""
     for spec in specs:
         try:
             check_step_count(run_duration(config, spec.trajectory), spec.dt)
+            trajectory = config.trajectories[spec.trajectory]
+            start = start_configuration(config.robot, trajectory)
+            start = offset_configuration(config.robot, start, spec.initial_offset)
+            obstacles = dict(spec.options).get("obstacles") or ()
+            check_start(config.robot, start, obstacles, "payload", "lighten the payload")
         except ParameterError as exc:
             raise ParameterError(f"{exc} (run {spec.label()} on {spec.trajectory})") from None
 
@@ -408,7 +417,7 @@ def _main(argv: Sequence[str] | None) -> int:
     check_output_folder(out, "compare", args.force, ("run.json", *output_names(config)))
     plan = plan_runs(config)
     specs = plan.all_specs()
-    check_steps(config, specs)
+    check_runs(config, specs)
     record = run_record(config, sources, argv, jobs)
     progress = not args.no_progress
     start = time.perf_counter()

@@ -46,7 +46,7 @@ from ddwmmr.resolution.reference import (
     offset_configuration,
     start_configuration,
 )
-from ddwmmr.sim.simulate import default_step, plant_integrator, simulate
+from ddwmmr.sim.simulate import check_start, default_step, plant_integrator, simulate
 from ddwmmr.trajectories import available_trajectories, load_trajectory
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
@@ -181,8 +181,8 @@ def build_parser() -> ArgumentParser:
         nargs="+",
         metavar="S",
         help="closed-loop time constant(s) in s, K = 1/tau: one value, or 3 (x, y, phi) for "
-        "clrrmc-ts, 5 (x, y, phi, th1, th2) for clrrmc-cs; inf disables a channel "
-        "(default 0.5)",
+        "clrrmc-ts and qp (its tracking task), 5 (x, y, phi, th1, th2) for clrrmc-cs; inf "
+        "disables a channel (default 0.5) [clrrmc-ts, clrrmc-cs, qp]",
     )
     parser.add_argument(
         "--preset",
@@ -372,17 +372,8 @@ def _check_start(
     base overlaps one of ``obstacles`` ((x, y, radius) triples, m); ``offset_given``: the
     ``--offset`` the user gave (None: the default), named in the message."""
     start = offset_configuration(robot, start_configuration(robot, trajectory), offset)
-    if obstacles:
-        from ddwmmr.qp.limits.obstacles import as_circles, check_start_clear
-
-        check_start_clear(robot, as_circles(obstacles), start)
-    s = robot.stability(start)[2]
-    if s <= 1.0:
-        raise ParameterError(
-            f"{name}: a {robot.payload:g} kg payload tips the robot over in this run's start "
-            f"pose (S = {s:.3g} <= 1); lighten the payload"
-            + ("" if offset_given is None else " or change --offset")
-        )
+    remedy = "lighten the payload" + ("" if offset_given is None else " or change --offset")
+    check_start(robot, start, obstacles or (), name, remedy)
 
 
 def inputs_from_record(args: argparse.Namespace) -> RunInputs:

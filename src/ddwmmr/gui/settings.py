@@ -36,8 +36,13 @@ from ddwmmr.errors import (
 from ddwmmr.gui.options import method_options, plant_keywords, plant_names
 from ddwmmr.model import Robot
 from ddwmmr.plants.kinematic import INTEGRATORS
-from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
+from ddwmmr.resolution.reference import (
+    DEFAULT_INITIAL_OFFSET,
+    offset_configuration,
+    start_configuration,
+)
 from ddwmmr.sim import SimulationResult, simulate
+from ddwmmr.sim.simulate import check_start
 from ddwmmr.trajectories import SampledTrajectory, load_trajectory
 from ddwmmr.trajectories.base import resolution_step
 from ddwmmr.trajectories.parametric import check_geometry_value
@@ -260,9 +265,11 @@ def check_settings(settings: Settings) -> Settings:
     robot = build_robot(settings)
     for value in settings.offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
-    build_trajectory(settings)
+    trajectory = build_trajectory(settings)
+    start = offset_configuration(robot, start_configuration(robot, trajectory), settings.offset)
     for slot in settings.active_slots:
-        build_controller(settings, slot)
+        controller = build_controller(settings, slot)
+        check_start(robot, start, getattr(controller, "obstacles", ()), "payload", "lighten it")
     return settings
 
 

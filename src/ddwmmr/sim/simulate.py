@@ -34,6 +34,55 @@ from ddwmmr.trajectories.base import resolution_step, trajectory_name
 __all__ = ["COLUMNS", "max_condition_number", "simulate", "summarize"]
 
 
+def check_trajectory(trajectory: Any) -> None:
+    """Refuse (one-line :class:`ParameterError`) what is not a trajectory: it needs
+    ``duration`` (s), ``pose(t)`` and ``velocity(t)``."""
+    if isinstance(trajectory, str):
+        raise ParameterError(
+            f"trajectory must be a trajectory object, not its name {trajectory!r} "
+            f"(ddwmmr.load_trajectory({trajectory!r}) builds one)"
+        )
+    missing = [
+        name
+        for name in ("duration", "pose", "velocity")
+        if not hasattr(trajectory, name)
+        or (name != "duration" and not callable(getattr(trajectory, name)))
+    ]
+    if missing:
+        raise ParameterError(
+            "trajectory must have duration (s), pose(t) and velocity(t) "
+            f"(got {shown(trajectory)}, without {', '.join(missing)})"
+        )
+
+
+def check_start(
+    robot: Robot,
+    q: Sequence[float],
+    obstacles: Sequence[Any] = (),
+    name: str = "start",
+    remedy: str = "lighten the payload or change the start (q0, initial_offset)",
+) -> None:
+    """Refuse (one-line :class:`ParameterError`) a start configuration ``q`` (x, y m, phi
+    rad, th1, th2 rad) in which the robot has already tipped over (static S <= 1: the
+    centre of mass outside the support polygon) or its base overlaps one of the
+    ``obstacles`` (circles or (x, y, radius) triples, m). ``name`` and ``remedy`` word the
+    message (a command line names its own option).
+
+    The command-line tools and the app refuse such a run as bad input; :func:`simulate`
+    runs it (a design study may want to see ``min_stability`` below 1, as
+    examples/own_robot.py does)."""
+    if obstacles:
+        from ddwmmr.qp.limits.obstacles import as_circles, check_start_clear
+
+        check_start_clear(robot, as_circles(obstacles), q)
+    s = robot.stability(np.asarray(q, dtype=float))[2]
+    if s <= 1.0:
+        raise ParameterError(
+            f"{name}: a {robot.payload:g} kg payload tips the robot over in this run's start "
+            f"pose (S = {s:.3g} <= 1); {remedy}"
+        )
+
+
 def simulate(
     robot: Robot | None,
     trajectory: Any,
@@ -94,6 +143,7 @@ def simulate(
         raise ParameterError(
             f"method must be a method name or a controller with command() (got {shown(method)})"
         )
+    check_trajectory(trajectory)
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
     the_plant = _plant(plant, robot, integrator, plant_options)
     if dt is None:

@@ -331,9 +331,17 @@ def read_csv(path: str | Path) -> SampledTrajectory:
     if not rows:
         raise ParameterError(f"traj: {path} has no data rows")
     header = list(reader.fieldnames or [])
+    expected = "a header line t,x,y or t,x,y,phi"
+    if any(not name.strip() for name in header):
+        blank = next(i for i, name in enumerate(header, start=1) if not name.strip())
+        raise ParameterError(
+            f"traj: {path} has a blank column name (column {blank}); needs {expected}"
+        )
     repeated = sorted({name for name in header if header.count(name) > 1})
     if repeated:
-        raise ParameterError(f"traj: {path} repeats column(s) {', '.join(repeated)}")
+        raise ParameterError(
+            f"traj: {path} repeats column(s) {', '.join(repeated)}; needs {expected}"
+        )
     for number, row in enumerate(rows, start=1):
         if None in row:  # DictReader files values beyond the header under None
             raise ParameterError(
@@ -343,7 +351,9 @@ def read_csv(path: str | Path) -> SampledTrajectory:
     columns = set(rows[0])
     missing = {"t", "x", "y"} - columns
     if missing:
-        raise ParameterError(f"traj: {path} lacks column(s) {', '.join(sorted(missing))}")
+        raise ParameterError(
+            f"traj: {path} lacks column(s) {', '.join(sorted(missing))}; needs {expected}"
+        )
     keys = ["x", "y", "phi"] if "phi" in columns else ["x", "y"]
     values = [
         [_csv_number(path, number, r, k) for k in ("t", *keys)]

@@ -22,10 +22,13 @@ from pathlib import Path
 import numpy as np
 
 from ddwmmr.errors import (
+    LENGTH_RANGE_M,
+    MAX_COORDINATE_M,
     ParameterError,
     check_finite,
     check_nonnegative,
     check_positive,
+    check_range,
     load_toml,
     shown,
 )
@@ -74,6 +77,10 @@ def load_obstacles(path: str | Path) -> list[Circle]:
         ):
             raise ParameterError(f"obstacles: {path}: obstacle {i}: x, y, radius must be numbers")
         try:
+            # The command-line limits (docs/cli.md, "Limits"), as for trajectory files.
+            for key in ("x", "y"):
+                check_range(f"obstacle {key}", table[key], -MAX_COORDINATE_M, MAX_COORDINATE_M, "m")
+            check_range("obstacle radius", table["radius"], *LENGTH_RANGE_M, "m")
             circles.append(Circle(table["x"], table["y"], table["radius"]))
         except ParameterError as exc:
             raise ParameterError(f"obstacles: {path}: obstacle {i}: {exc}") from None
