@@ -476,7 +476,7 @@ def make_mpc(robot: Robot, scenario: Scenario, config: RunConfig, plant: Plant) 
     its motors allow (``joint_acceleration_limit``), braking instead of following a plan
     that needs slack (``brake_slack``), when the loop hands it the plant's traits
     (``adopt_plant``): the static floor alone tipped the robot over in 94 of 100
-    scenarios, all of it in none of 200 (docs/mpc.md)."""
+    scenarios, all of it in none of 400 (docs/mpc.md)."""
     from ddwmmr.controllers import make_controller
 
     model = "thesis" if "force" in plant.interfaces else "kinematic"
