@@ -397,3 +397,20 @@ def test_controllers_on_the_same_problem_share_it_and_run_as_if_fresh():
     assert len(core._OCPS) == 2 and ocp in core._OCPS.values()
     assert solvers._COMPILED[ocp] is compiled  # no new QP functions either
     np.testing.assert_array_equal(shared, fresh)
+
+
+def test_the_shared_problem_is_not_shared_across_threads():
+    """A solver reads its QP's statistics after each call: two threads on one compiled QP
+    could read each other's. Each thread builds its own."""
+    import threading
+
+    from ddwmmr.mpc import controller as core
+
+    trajectory = Ellipse(T=20.0, N=1000)
+    core._OCPS.clear()
+    simulate(Robot(), trajectory, "mpc", duration=0.1)
+    worker = threading.Thread(target=lambda: simulate(Robot(), trajectory, "mpc", duration=0.1))
+    worker.start()
+    worker.join()
+    first, second = core._OCPS.values()
+    assert first is not second and first.config == second.config

@@ -23,6 +23,7 @@ controller's command for that step, counted in ``mpc_fallbacks``; the next step 
 from __future__ import annotations
 
 import math
+import threading
 from collections import OrderedDict
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -767,8 +768,10 @@ def _shared_ocp(
     controller that asks for the same one. Building it and its solvers' QP functions took
     0.5 s per benchmark scenario on the thesis plant and 1.5 s on the physics plant (9
     states; both measured on the 2-core machine under load), now 0.02-0.04 s after the
-    first; the OCP is symbolic and keeps no state of a run."""
-    key = (robot, choice, config)
+    first; the OCP is symbolic and keeps no state of a run. Shared within a thread only:
+    a solver reads its QP's statistics after the call, which another thread's call on the
+    same function could replace."""
+    key = (threading.get_ident(), robot, choice, config)
     ocp = _OCPS.get(key)
     if ocp is None:
         ocp = _OCPS[key] = ShootingOCP(robot, model, config)
