@@ -155,7 +155,7 @@ def test_a_start_in_which_the_robot_has_tipped_over_is_named():
     heavy = Robot().with_payload(20.0)
     start = start_configuration(heavy, Ellipse())
     message = _refused(lambda: check_start(heavy, start), r"payload tips the robot over")
-    assert "S = 0.551 <= 1" in message and message.startswith("start:")
+    assert "S = 0.551 <= 1" in message and message.startswith("payload:")
     check_start(Robot().with_payload(3.0), start)  # upright: nothing to say
     assert simulate(heavy, Ellipse(), "ats", duration=0.1).summary["min_stability"] < 1.0
 

@@ -141,7 +141,11 @@ CASES += [("track", ["--traj", traj], text) for traj, text in TRAJ_CASES]
 CASES += [
     ("track", ["--traj", "{traj_long_row.csv}"], "data row 2 has more values than the header"),
     ("track", ["--traj", "{traj_repeated_column.csv}"], "repeats column(s) t; needs a header"),
-    ("track", ["--traj", "{traj_blank_columns.csv}"], "has a blank column name (column 2)"),
+    (
+        "track",
+        ["--traj", "{traj_blank_columns.csv}"],
+        "has a blank column name over values (column 2)",
+    ),
     # a payload that tips the robot in the start pose: refused by every tool, as by track
     ("track", ["--payload", "20"], "a 20 kg payload tips the robot over in this run's start"),
     ("compare", ["--payload", "50"], "a 50 kg payload tips the robot over in this run's start"),

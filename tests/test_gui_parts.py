@@ -299,8 +299,10 @@ def test_each_method_offers_its_own_solver_choices():
 
     mpc = {spec.name: spec for spec in method_options("mpc")}
     qp = {spec.name: spec for spec in method_options("qp")}
-    assert mpc["solver"].choices == SOLVERS and mpc["solver"].default == "rti"
+    assert mpc["solver"].choices == SOLVERS and mpc["solver"].default == "rti"  # all here
     assert mpc["qp_solver"].kind == "choice" and mpc["qp_solver"].choices == QP_SOLVERS
-    assert "mode" not in mpc and "fallback_options" not in mpc
+    assert mpc["model"].choices == (None, "kinematic", "thesis")  # None shows as "auto"
+    assert mpc["model"].parse("auto") is None and mpc["model"].parse("thesis") == "thesis"
+    assert "fallback_options" not in mpc
     assert set(qp["solver"].choices) == set(installed_solvers())
     assert option_spec("fallback_options", None, "dict[str, Any] | None") is None

@@ -374,7 +374,8 @@ def test_obstacle_on_the_straight_line_is_passed_with_its_clearance():
     assert summary["min_obstacle_clearance_m"] > 0.045  # the footprint is inside the circle
 
 
-def test_controllers_on_the_same_problem_share_it_and_run_as_if_fresh():
+@pytest.mark.parametrize("qp_solver", ["hpipm", "osqp"])
+def test_controllers_on_the_same_problem_share_it_and_run_as_if_fresh(qp_solver):
     """The OCP and its compiled QP are built once per (robot, model, grid, options) and
     shared; a run on the shared problem, after another problem's run, repeats a run on a
     freshly built one to the last bit."""
@@ -384,15 +385,15 @@ def test_controllers_on_the_same_problem_share_it_and_run_as_if_fresh():
     trajectory = Ellipse(T=20.0, N=1000)
 
     def run(**options):
-        result = simulate(Robot(), trajectory, "mpc", duration=0.4, **options)
+        result = simulate(Robot(), trajectory, "mpc", duration=0.4, qp_solver=qp_solver, **options)
         return np.column_stack([result.timeseries[c] for c in ("xE", "yE", "v", "w", "th1dot")])
 
     core._OCPS.clear()
     fresh = run()
     (ocp,) = core._OCPS.values()
     compiled = solvers._COMPILED[ocp]
-    other = run(stability_min=1.4)  # a different problem: built apart
-    assert len(core._OCPS) == 2 and not np.array_equal(other, fresh)
+    run(stability_min=1.4)  # a different problem (in between): built apart
+    assert sorted(o.config.stability_min for o in core._OCPS.values()) == [1.25, 1.4]
     shared = run()
     assert len(core._OCPS) == 2 and ocp in core._OCPS.values()
     assert solvers._COMPILED[ocp] is compiled  # no new QP functions either
@@ -414,3 +415,20 @@ def test_the_shared_problem_is_not_shared_across_threads():
     worker.join()
     first, second = core._OCPS.values()
     assert first is not second and first.config == second.config
+
+
+def test_a_plant_that_states_its_facts_in_lists_still_runs():
+    """The shared problem is keyed by the plant's facts: a plant that gives its damping as
+    a list (unhashable) gets them as a tuple of floats (ddwmmr.commands.traits_of)."""
+
+    class ListedPlant(ThesisPlant):
+        @property
+        def damping(self):
+            return list(super().damping)
+
+    robot = Robot()
+    result = simulate(
+        robot, Ellipse(T=20.0, N=1000), "mpc", duration=0.1, plant=ListedPlant(robot),
+        model="thesis",
+    )  # fmt: skip
+    assert result.summary["mpc_model"] == "thesis" and result.summary["mpc_fallbacks"] == 0

@@ -297,6 +297,75 @@ def test_a_fresh_folder_never_replaces_one_that_appeared_during_the_run(tmp_path
     assert leftovers(target.parent) == []
 
 
+def test_a_fresh_commit_takes_the_next_name_when_its_own_is_taken_meanwhile(tmp_path, monkeypatch):
+    """Between the look for a free name and the mkdir another run takes it: the commit
+    goes on to the next free one (the FileExistsError branch)."""
+    import ddwmmr.outputs as outputs
+
+    target = tmp_path / "runs" / "my.track-20261201"  # a dot in the name: -2 at the end
+    real = outputs.first_free
+    taken = []
+
+    def racing(path, folder=False):
+        free = real(path, folder)
+        if not taken:  # the first answer: another run makes that folder now
+            free.mkdir(parents=True)
+            (free / "theirs.txt").write_text("theirs")
+            taken.append(free)
+        return free
+
+    writer = output_folder(target, "x", fresh=True)
+    monkeypatch.setattr(outputs, "first_free", racing)
+    with writer as staging:
+        (staging / "r.txt").write_text("mine")
+    assert taken == [target] and writer.path == target.with_name(f"{target.name}-2")
+    assert (target / "theirs.txt").read_text() == "theirs"
+    assert (writer.path / "r.txt").read_text() == "mine"
+
+
+def test_an_interrupt_just_after_the_fresh_mkdir_leaves_nothing(tmp_path, monkeypatch):
+    target = tmp_path / "runs" / "track-20261201"
+    real_mkdir = os.mkdir
+
+    def interrupted(path, mode=0o777):
+        real_mkdir(path, mode)
+        if Path(path) == target:
+            raise KeyboardInterrupt
+
+    writer = output_folder(target, "x", fresh=True)
+    with pytest.raises(KeyboardInterrupt), writer as staging:
+        (staging / "r.txt").write_text("half")
+        monkeypatch.setattr(os, "mkdir", interrupted)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_parent_another_run_makes_at_the_same_moment_is_used(tmp_path, monkeypatch):
+    import ddwmmr.outputs as outputs
+
+    runs = tmp_path / "runs"
+    real = outputs.missing_folders
+
+    def late(folder):
+        missing = real(folder)
+        runs.mkdir()  # the other run, between the look and our mkdir
+        return missing
+
+    monkeypatch.setattr(outputs, "missing_folders", late)
+    writer = output_folder(runs / "scenarios-1", "x", fresh=True)
+    with writer as staging:
+        (staging / "r.txt").write_text("mine")
+    assert (runs / "scenarios-1" / "r.txt").read_text() == "mine"
+
+
+def test_an_output_folder_is_one_with_block(tmp_path):
+    writer = output_folder(tmp_path / "out", "x")
+    with writer as staging:
+        (staging / "r.txt").write_text("first")
+    with pytest.raises(RuntimeError, match="one with-block only"), writer:
+        pass
+    assert (tmp_path / "out" / "r.txt").read_text() == "first"
+
+
 def test_a_fresh_run_that_fails_leaves_nothing(tmp_path):
     target = tmp_path / "runs" / "scenarios-20261201-120000"
     with pytest.raises(RuntimeError), output_folder(target, "x", fresh=True) as staging:

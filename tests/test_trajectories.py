@@ -126,6 +126,20 @@ def test_csv_errors(tmp_path):
         load_trajectory("nope")
 
 
+def test_csv_with_a_trailing_comma_reads_as_without_it(tmp_path):
+    """A spreadsheet's export ends every line with a comma: an unnamed, empty column that is
+    left out. An unnamed column with values is refused, naming the header it needs."""
+    plain, trailing = tmp_path / "plain.csv", tmp_path / "trailing.csv"
+    plain.write_text("t,x,y\n0,0,0\n1,1,0.5\n2,2,0\n")
+    trailing.write_text("t,x,y,\n0,0,0,\n1,1,0.5,\n2,2,0,\n")
+    a, b = read_csv(plain), read_csv(trailing)
+    for t in (0.0, 0.7, 2.0):
+        np.testing.assert_array_equal(a.pose(t), b.pose(t))
+    trailing.write_text("t,x,y,\n0,0,0,7\n1,1,0.5,7\n2,2,0,7\n")
+    with pytest.raises(ParameterError, match=r"blank column name over values \(column 4\); needs"):
+        read_csv(trailing)
+
+
 # -- shipped files, names and paths (issue 8) ---------------------------------------------
 PROJECT_FOLDER = Path(__file__).resolve().parents[1] / "trajectories"
 

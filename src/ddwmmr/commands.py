@@ -77,13 +77,21 @@ class PlantTraits:
 
 
 def traits_of(plant: Any) -> PlantTraits:
-    """The :class:`PlantTraits` of a plant (read from its attributes)."""
+    """The :class:`PlantTraits` of a plant (read from its attributes; pairs as tuples of
+    floats, whatever sequence the plant gives, so the traits are hashable)."""
+
+    def pair(value: Any) -> tuple[float, ...] | None:
+        return None if value is None else tuple(float(v) for v in value)
+
+    def number(value: Any) -> float | None:
+        return None if value is None else float(value)
+
     return PlantTraits(
         tuple(plant.interfaces),
         hasattr(plant, "tip_time"),
-        getattr(plant, "joint_time_constant", None),
-        getattr(plant, "damping", None),
-        getattr(plant, "wheel_force_limit", None),
-        getattr(plant, "wheel_lever", None),
-        getattr(plant, "joint_acceleration_limit", None),
+        number(getattr(plant, "joint_time_constant", None)),
+        pair(getattr(plant, "damping", None)),  # type: ignore[arg-type]
+        number(getattr(plant, "wheel_force_limit", None)),
+        number(getattr(plant, "wheel_lever", None)),
+        pair(getattr(plant, "joint_acceleration_limit", None)),  # type: ignore[arg-type]
     )

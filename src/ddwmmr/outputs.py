@@ -319,15 +319,17 @@ def _refusal(text: str, tool: str, existing: Existing) -> str:
 
 
 # -- the staging folder -------------------------------------------------------------------
-def first_free(path: str | Path) -> Path:
-    """``path``, or ``stem-2.suffix``, ``stem-3.suffix``... whichever does not exist yet (a
-    default, time-stamped output name: runs started within the same second get their own)."""
+def first_free(path: str | Path, folder: bool = False) -> Path:
+    """``path``, or ``stem-2.suffix``, ``stem-3.suffix``... (a ``folder``: ``name-2``,
+    ``name-3``..., dots and all) whichever does not exist yet (a default, time-stamped
+    output name: runs started within the same second get their own)."""
     path = Path(path)
     number = 1
     candidate = path
     while os.path.lexists(candidate):
         number += 1
-        candidate = path.with_name(f"{path.stem}-{number}{path.suffix}")
+        name = f"{path.name}-{number}" if folder else f"{path.stem}-{number}{path.suffix}"
+        candidate = path.with_name(name)
     return candidate
 
 
@@ -340,19 +342,34 @@ class OutputFolder:
         self.tool, self.force, self.fresh = tool, force, fresh
         #: Absolute path of the output folder (after a ``fresh`` commit, the numbered
         #: sibling the files went to if the target had appeared meanwhile).
-        self.path = check_output_folder(target, tool, force)
+        if fresh:  # a default name: only where it goes must be writable, nothing replaced
+            self.path = check_output_path(first_free(target, folder=True))
+        else:
+            self.path = check_output_folder(target, tool, force)
         self._staging: Path | None = None
         self._created: list[Path] = []
+        self._entered = False
 
     def __enter__(self) -> Path:
-        self._created = _make_parents(self.path.parent)
-        try:
-            staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=self.path.parent))
-        except OSError as exc:
-            remove_created(self._created)
-            raise ParameterError(
-                f"out: cannot write in {self.path.parent} ({exc.strerror})"
-            ) from None
+        if self._entered:
+            raise RuntimeError("an OutputFolder is used for one with-block only")
+        self._entered = True
+        for attempt in range(2):
+            self._created = _make_parents(self.path.parent)
+            try:
+                staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=self.path.parent))
+                break
+            except FileNotFoundError:
+                # another run removed the empty parent it had made: make it again, once
+                if attempt == 1:
+                    raise ParameterError(
+                        f"out: cannot write in {self.path.parent} (it keeps disappearing)"
+                    ) from None
+            except OSError as exc:
+                remove_created(self._created)
+                raise ParameterError(
+                    f"out: cannot write in {self.path.parent} ({exc.strerror})"
+                ) from None
         self._staging = staging
         try:
             os.chmod(staging, folder_mode())
@@ -377,6 +394,7 @@ class OutputFolder:
     def _discard(self) -> None:
         if self._staging is not None:
             shutil.rmtree(self._staging, ignore_errors=True)
+            self._staging = None
         remove_created(self._created)
 
 
@@ -398,15 +416,22 @@ def output_folder(
 
 
 def _make_parents(folder: Path) -> list[Path]:
-    """Create missing parent folders; return them (deepest last) so a failure can undo."""
-    missing = missing_folders(folder)
-    for candidate in missing:
+    """Create missing parent folders; return those this call made (deepest last) so a
+    failure can undo them. A folder another run makes meanwhile is used, not recorded."""
+    made: list[Path] = []
+    for candidate in missing_folders(folder):
         try:
             candidate.mkdir(mode=folder_mode())
+        except FileExistsError:
+            if candidate.is_dir():
+                continue  # made by another run at the same moment: theirs, use it
+            remove_created(made)
+            raise ParameterError(f"out: {candidate} exists and is not a folder") from None
         except OSError as exc:
-            remove_created([m for m in missing if m != candidate and m.is_dir()])
+            remove_created(made)
             raise ParameterError(f"out: cannot create {candidate} ({exc.strerror})") from None
-    return missing
+        made.append(candidate)
+    return made
 
 
 def remove_created(created: list[Path]) -> None:
@@ -447,16 +472,20 @@ def _commit_fresh(staging: Path, target: Path) -> Path:
     each candidate is taken with an exclusive ``mkdir`` (so two runs finishing together
     cannot take the same one), then the staging folder replaces that empty folder."""
     while True:
-        candidate = first_free(target)
+        candidate = first_free(target, folder=True)
         try:
             os.mkdir(candidate, folder_mode())
         except FileExistsError:
             continue  # taken between the look and the mkdir: the next one
+        except BaseException:  # Ctrl-C just after the mkdir: do not leave it behind
+            with contextlib.suppress(OSError):
+                candidate.rmdir()
+            raise
         try:
             os.rename(staging, candidate)  # onto our own empty folder
         except BaseException:
             with contextlib.suppress(OSError):
-                candidate.rmdir()
+                candidate.rmdir()  # only if still empty: after the rename it holds the run
             raise
         return candidate
 

@@ -320,7 +320,7 @@ def check_runs(config: CompareConfig, specs: Sequence[Any]) -> None:
             start = start_configuration(config.robot, trajectory)
             start = offset_configuration(config.robot, start, spec.initial_offset)
             obstacles = dict(spec.options).get("obstacles") or ()
-            check_start(config.robot, start, obstacles, "payload", "lighten the payload")
+            check_start(config.robot, start, obstacles, "payload", None)
         except ParameterError as exc:
             raise ParameterError(f"{exc} (run {spec.label()} on {spec.trajectory})") from None
 

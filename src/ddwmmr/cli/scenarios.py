@@ -588,7 +588,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     args.argv = argv  # recorded in the summary
     config = config_from_arguments(args)
     fresh = args.out is None  # a default name: never replaces an earlier run
-    out = first_free(default_out()) if fresh else Path(args.out)
+    out = first_free(default_out(), folder=True) if fresh else Path(args.out)
     check_output_folder(out, "scenarios", args.force, output_names(args, config))
     if config.controller == "qp":
         from ddwmmr.scenarios.protocol import make_qp

@@ -349,7 +349,7 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     for value in offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
     named = "payload" if args.payload is not None else "robot"
-    _check_start(robot, trajectory, offset, named, options.get("obstacles"), args.offset)
+    _check_start(robot, trajectory, offset, named, options.get("obstacles"))
     return RunInputs(
         args.method,
         options,
@@ -365,15 +365,11 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     )
 
 
-def _check_start(
-    robot: Robot, trajectory: Any, offset, name: str, obstacles, offset_given=None
-) -> None:
+def _check_start(robot: Robot, trajectory: Any, offset, name: str, obstacles) -> None:
     """Refuse a start pose in which the robot (its payload, ``name``) tips over or the
-    base overlaps one of ``obstacles`` ((x, y, radius) triples, m); ``offset_given``: the
-    ``--offset`` the user gave (None: the default), named in the message."""
+    base overlaps one of ``obstacles`` ((x, y, radius) triples, m)."""
     start = offset_configuration(robot, start_configuration(robot, trajectory), offset)
-    remedy = "lighten the payload" + ("" if offset_given is None else " or change --offset")
-    check_start(robot, start, obstacles or (), name, remedy)
+    check_start(robot, start, obstacles or (), name, "--offset")
 
 
 def inputs_from_record(args: argparse.Namespace) -> RunInputs:
@@ -525,7 +521,11 @@ def _main(argv: Sequence[str] | None = None) -> int:
     steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
     controller = make_controller(inputs.method, inputs.robot, **inputs.options)
     fresh = args.out is None  # a default name: never replaces an earlier run
-    out = first_free(default_out(inputs.method, inputs.label)) if fresh else Path(args.out)
+    out = (
+        first_free(default_out(inputs.method, inputs.label), folder=True)
+        if fresh
+        else Path(args.out)
+    )
     check_output_folder(out, "track", args.force, output_names(not args.no_plots, args.animate))
     record = run_record(inputs, argv, args.rerun)
     progress = not args.no_progress

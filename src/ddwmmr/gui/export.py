@@ -48,7 +48,7 @@ ANIMATION_WRITERS = {"gif": "pillow", "mp4": "ffmpeg"}
 
 def run_folder(root: Path, name: str) -> Path:
     """A folder for one run's files under ``root`` that does not exist yet."""
-    return first_free(Path(root) / name)
+    return first_free(Path(root) / name, folder=True)
 
 
 def write_run_data(

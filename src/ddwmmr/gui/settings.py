@@ -269,7 +269,7 @@ def check_settings(settings: Settings) -> Settings:
     start = offset_configuration(robot, start_configuration(robot, trajectory), settings.offset)
     for slot in settings.active_slots:
         controller = build_controller(settings, slot)
-        check_start(robot, start, getattr(controller, "obstacles", ()), "payload", "lighten it")
+        check_start(robot, start, getattr(controller, "obstacles", ()), "payload", "the offset")
     return settings
 
 

@@ -57,7 +57,14 @@ from ddwmmr.mpc.ocp import (
     Weights,
     grid_intervals,
 )
-from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS, SolverFailure, make_solver
+from ddwmmr.mpc.solvers import (
+    QP_SOLVERS,
+    SOLVERS,
+    SolverFailure,
+    installed_qp_solvers,
+    installed_solvers,
+    make_solver,
+)
 from ddwmmr.qp.limits import as_circles, run_clearance, safe_arm_scale
 
 MODELS = ("kinematic", "thesis")
@@ -232,9 +239,10 @@ class MPCControllerCore:
 
     #: Options with a closed set of values, for front ends (the app shows a button cycling
     #: through them): option name -> function returning the values.
-    option_choices: ClassVar[Mapping[str, Callable[[], list[str]]]] = {
-        "solver": lambda: list(SOLVERS),
-        "qp_solver": lambda: list(QP_SOLVERS),
+    option_choices: ClassVar[Mapping[str, Callable[[], list[Any]]]] = {
+        "model": lambda: [None, *MODELS],  # None: chosen for the plant
+        "solver": installed_solvers,
+        "qp_solver": installed_qp_solvers,
     }
 
     def __init__(
@@ -758,6 +766,7 @@ class MPCControllerCore:
 #: worker's scenarios share them).
 SHARED_OCPS = 8
 _OCPS: OrderedDict[tuple, ShootingOCP] = OrderedDict()
+_OCPS_LOCK = threading.Lock()
 
 
 def _shared_ocp(
@@ -772,13 +781,20 @@ def _shared_ocp(
     a solver reads its QP's statistics after the call, which another thread's call on the
     same function could replace."""
     key = (threading.get_ident(), robot, choice, config)
-    ocp = _OCPS.get(key)
-    if ocp is None:
-        ocp = _OCPS[key] = ShootingOCP(robot, model, config)
+    try:
+        hash(key)
+    except TypeError:  # an unhashable option from somewhere: build it, do not share
+        return ShootingOCP(robot, model, config)
+    with _OCPS_LOCK:
+        ocp = _OCPS.get(key)
+        if ocp is not None:
+            _OCPS.move_to_end(key)
+            return ocp
+    ocp = ShootingOCP(robot, model, config)  # outside the lock: it takes a while
+    with _OCPS_LOCK:
+        _OCPS[key] = ocp
         if len(_OCPS) > SHARED_OCPS:
             _OCPS.popitem(last=False)
-    else:
-        _OCPS.move_to_end(key)
     return ocp
 
 

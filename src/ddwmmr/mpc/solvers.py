@@ -43,6 +43,16 @@ SOLVERS = ("rti", "sqp", "ipopt", "sqpmethod", "fatrop")
 HPIPM_ACCEPTED = (0, 1)
 
 
+def installed_solvers() -> list[str]:
+    """The names of :data:`SOLVERS` this CasADi build has (the Gauss-Newton ones always)."""
+    return [n for n in SOLVERS if n in ("rti", "sqp") or ca.has_nlpsol(n)]
+
+
+def installed_qp_solvers() -> list[str]:
+    """The names of :data:`QP_SOLVERS` this CasADi build has."""
+    return [n for n in QP_SOLVERS if ca.has_conic(n)]
+
+
 class SolverFailure(RuntimeError):
     """The OCP solve failed (infeasible QP, iteration failure, non-finite result)."""
 

@@ -59,14 +59,15 @@ def check_start(
     robot: Robot,
     q: Sequence[float],
     obstacles: Sequence[Any] = (),
-    name: str = "start",
-    remedy: str = "lighten the payload or change the start (q0, initial_offset)",
+    name: str = "payload",
+    start: str | None = "the start (q0, initial_offset)",
 ) -> None:
     """Refuse (one-line :class:`ParameterError`) a start configuration ``q`` (x, y m, phi
     rad, th1, th2 rad) in which the robot has already tipped over (static S <= 1: the
     centre of mass outside the support polygon) or its base overlaps one of the
-    ``obstacles`` (circles or (x, y, radius) triples, m). ``name`` and ``remedy`` word the
-    message (a command line names its own option).
+    ``obstacles`` (circles or (x, y, radius) triples, m). ``name`` (what holds the
+    payload) and ``start`` (what sets the start pose; None: nothing the user sets) word
+    the message: a command line names its own options.
 
     The command-line tools and the app refuse such a run as bad input; :func:`simulate`
     runs it (a design study may want to see ``min_stability`` below 1, as
@@ -76,11 +77,19 @@ def check_start(
 
         check_start_clear(robot, as_circles(obstacles), q)
     s = robot.stability(np.asarray(q, dtype=float))[2]
-    if s <= 1.0:
+    if s > 1.0:
+        return
+    if robot.payload > 0.0:
         raise ParameterError(
             f"{name}: a {robot.payload:g} kg payload tips the robot over in this run's start "
-            f"pose (S = {s:.3g} <= 1); {remedy}"
+            f"pose (S = {s:.3g} <= 1); lighten the payload"
+            + ("" if start is None else f" or change {start}")
         )
+    raise ParameterError(
+        f"robot: the robot tips over in this run's start pose without a payload (S = {s:.3g}"
+        f" <= 1: its masses put the centre of mass outside the wheels); change the robot"
+        + ("" if start is None else f" or {start}")
+    )
 
 
 def simulate(

@@ -332,11 +332,20 @@ def read_csv(path: str | Path) -> SampledTrajectory:
         raise ParameterError(f"traj: {path} has no data rows")
     header = list(reader.fieldnames or [])
     expected = "a header line t,x,y or t,x,y,phi"
-    if any(not name.strip() for name in header):
-        blank = next(i for i, name in enumerate(header, start=1) if not name.strip())
-        raise ParameterError(
-            f"traj: {path} has a blank column name (column {blank}); needs {expected}"
-        )
+    blank = [i for i, name in enumerate(header) if not name.strip()]
+    if blank:
+        # A trailing comma (a spreadsheet's export) gives an unnamed, empty column: it is
+        # left out. An unnamed column holding values is a header that lost its names.
+        records = list(csv.reader(lines))[1:]
+        if any(i < len(r) and r[i].strip() for r in records for i in blank):
+            raise ParameterError(
+                f"traj: {path} has a blank column name over values (column {blank[0] + 1}); "
+                f"needs {expected}"
+            )
+        for row in rows:
+            for name in {header[i] for i in blank}:
+                row.pop(name, None)
+        header = [name for name in header if name.strip()]
     repeated = sorted({name for name in header if header.count(name) > 1})
     if repeated:
         raise ParameterError(
