@@ -143,8 +143,9 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--out",
         metavar="DIR",
-        help="output folder (default: runs/scenarios-<time>/; replaced only if it holds "
-        "nothing but a previous scenarios run)",
+        help="output folder (default: runs/scenarios-<time>/, never replacing anything: "
+        "-2, -3... when taken; a folder given here is replaced only if it holds nothing but "
+        "a previous scenarios run)",
     )
     add_force_argument(parser)
     parser.add_argument(

@@ -257,7 +257,10 @@ def build_parser() -> ArgumentParser:
     )
     out = parser.add_argument_group("output")
     out.add_argument(
-        "--out", metavar="DIR", help="output folder (default runs/<method>-<traj>-<time>/)"
+        "--out",
+        metavar="DIR",
+        help="output folder (default runs/<method>-<traj>-<time>/, never replacing anything: "
+        "-2, -3... when taken)",
     )
     add_force_argument(out)
     out.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
