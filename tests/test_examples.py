@@ -28,6 +28,7 @@ EXPECTED = {
     "custom_trajectory.py": ("ats", "clrrmc-ts", "final"),
     "compare_aux.py": ("rectangle  sum", "ellipse    shoulder"),
     "own_robot.py": ("default (thesis)", "long arm (TOML)", "would tip over"),
+    "physics_tipping.py": ("static floor only", "TIPPED", "dynamic margin (default)"),
 }
 
 
@@ -157,6 +158,23 @@ def test_own_robot_numbers(printed) -> None:
     assert stability["default, 3 kg payload"] < stability["default (thesis)"]
     assert stability["long arm, 6 kg payload"] <= 1.0 < stability["long arm (TOML)"]
     assert "would tip over" in lines[3] and "would tip over" not in "".join(lines[:3])
+
+
+def test_physics_tipping_numbers(printed) -> None:
+    """The static floor alone tips within the first second although its static S stays
+    above 1.2; with the arm's lag and the braking step the run finishes but an edge is
+    unloaded longer than with the dynamic margin too (the default)."""
+    row = re.compile(
+        r"(TIPPED|ok)\s+at\s+([\d.]+) s, waypoints (\d)/5, static S >= ([\d.]+), "
+        r"an edge unloaded ([\d.]+) s"
+    )
+    rows = [row.search(line) for line in printed["physics_tipping.py"].splitlines()[1:]]
+    (static, lagged, default) = [
+        (m[1], float(m[2]), int(m[3]), float(m[4]), float(m[5])) for m in rows
+    ]
+    assert static[0] == "TIPPED" and static[1] < 1.0 and static[2] == 0 and static[3] > 1.2
+    assert lagged[:1] == default[:1] == ("ok",) and lagged[2] == default[2] == 5
+    assert default[4] < 0.5 * lagged[4]  # the dynamic margin keeps the wheels loaded
 
 
 def _load(name: str):
