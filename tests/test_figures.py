@@ -78,3 +78,21 @@ def test_table_rows_without_time_do_not_divide_by_zero():
     assert outcome.metrics["time_s"] == 0.0 and outcome.metrics["reason"] == "tipped"
     rows = dict(report.table_rows(report.summarize([outcome, outcome], 0.0)))
     assert rows["Time spent moving base (s)"] == "0 (n/a) (0)"
+
+
+def test_the_mean_time_has_its_95_percent_confidence_interval():
+    """ci95_time_s = 1.96 sd / sqrt(n) over the scenarios' times, printed with the table;
+    none for a single scenario."""
+    import dataclasses
+    import statistics
+
+    base = run_scenario(generate(1, 0)[0], RunConfig(time_limit=0.3))
+    times = [3.0, 5.0, 4.0, 8.0]
+    outcomes = [dataclasses.replace(base, metrics={**base.metrics, "time_s": t}) for t in times]
+    summary = report.summarize(outcomes, 1.0)
+    expected = 1.959964 * statistics.stdev(times) / math.sqrt(len(times))
+    assert summary["ci95_time_s"] == pytest.approx(expected, rel=1e-12)  # 2.12 s
+    assert "Mean time, 95 % CI (s)" in report.format_table(summary, "t")
+    assert "5 +- 2.12" in report.format_table(summary, "t")
+    single = report.summarize(outcomes[:1], 1.0)
+    assert math.isnan(single["ci95_time_s"]) and "95 % CI" not in report.format_table(single, "t")

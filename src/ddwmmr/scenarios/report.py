@@ -34,6 +34,10 @@ def _column(outcomes: Sequence[Outcome], key: str) -> np.ndarray:
     return np.array([float(o.metrics[key]) for o in outcomes])
 
 
+#: Two-sided 95 % quantile of the normal distribution (the mean time's confidence interval).
+Z95 = 1.959964
+
+
 def _mean_sd(values: np.ndarray) -> tuple[float, float]:
     if values.size == 0 or np.all(np.isnan(values)):
         return math.nan, math.nan
@@ -45,7 +49,10 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
     """Batch summary: failures, mean and sd of every metric, minimum stability, speed.
 
     Means are over all scenarios (a failed scenario counts with the time at which it
-    stopped); ``sd_*`` are sample standard deviations (n - 1).
+    stopped); ``sd_*`` are sample standard deviations (n - 1). ``ci95_time_s`` is the
+    half-width (s) of the mean time's 95 % confidence interval over the scenarios,
+    ``1.96 sd / sqrt(n)`` (normal approximation; NaN for one scenario): two runs whose mean
+    times differ by less than that have not measured a difference.
     """
     failed = [o.metrics for o in outcomes if not o.metrics["success"]]
     summary: dict[str, Any] = {"n": len(outcomes), "failed": len(failed)}
@@ -55,6 +62,8 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
         name = "mean_speed_m_s" if key == "speed_m_s" else name
         summary[name] = mean
         summary["sd_" + key] = sd
+    n = len(outcomes)
+    summary["ci95_time_s"] = Z95 * summary["sd_time_s"] / math.sqrt(n) if n > 1 else math.nan
     summary["min_stability"] = float(np.min(_column(outcomes, "min_stability")))
     summary["min_manipulability"] = float(np.min(_column(outcomes, "min_manipulability")))
     unloaded = _column(outcomes, "unloaded_time_s")  # physics plants only (else NaN)
@@ -131,6 +140,10 @@ def format_table(summary: dict[str, Any], title: str) -> str:
     lines = [title, "-" * len(title)]
     lines += [f"{label:<{width}}  {value}" for label, value in rows]
     lines.append(f"{'Minimum stability S':<{width}}  {_fmt(summary['min_stability'])}")
+    ci = summary.get("ci95_time_s")
+    if ci is not None and math.isfinite(ci):
+        label = "Mean time, 95 % CI (s)"
+        lines.append(f"{label:<{width}}  {_fmt(summary['mean_time_s'])} +- {_fmt(ci)}")
     if summary.get("tipped_physics") is not None:
         lines.append(f"{'Tipped over (physics)':<{width}}  {summary['tipped_physics']}")
         label = "Time with an edge unloaded (s)"
