@@ -5,7 +5,8 @@ MuJoCo plant, where tipping is judged by the contact forces, with the ``mpc`` th
 
 1. the static stability floor alone (``S >= 1.25`` on the centre of mass, no arm lag, no
    braking step): turning fast with the payload out moves the centre of pressure onto one
-   edge and the base pivots, although the static S never falls below its floor;
+   edge and the base pivots, while the static S is still 1.23 (near its floor: the plan's
+   arm model is not the servos');
 2. the same floor, with the arm's servo lag, its motors' acceleration limit and the braking
    step (what a physics plant gives the mpc by itself), but without the dynamic margin;
 3. the default on this plant: also the floor on the dynamic margin (the zero moment point).

@@ -58,6 +58,7 @@ from ddwmmr.reports.compare import (
     text_table,
     write_report,
 )
+from ddwmmr.reports.compare.constants import TIE_ABSOLUTE_M, TIE_RELATIVE
 from ddwmmr.reports.compare.plan import run_duration
 from ddwmmr.resolution.reference import offset_configuration, start_configuration
 from ddwmmr.sim.result import json_safe, write_atomic
@@ -388,7 +389,9 @@ def format_summary(info: ReportInfo, out: Path, runs: int, seconds: float, jobs:
         f"in {seconds:.1f} s ({jobs} job{'s' if jobs > 1 else ''}).",
         "",
         "Ranking: RMS end-effector position error over the run (mm), lower is better; "
-        "per-trajectory rank in brackets; overall = geometric mean.",
+        "per-trajectory rank in brackets; overall = geometric mean; scores within "
+        f"{100 * TIE_RELATIVE:g} % plus {1000 * TIE_ABSOLUTE_M:g} mm of a better one share "
+        "its rank.",
         text_table(*ranking_table(ranking)),
         "",
         slides_verdict(check),
