@@ -520,3 +520,38 @@ def test_the_names_checked_before_the_run_are_the_files_it_writes(
     assert main([*args, *extra, *FAST, *jobs, "--out", str(out)]) == 0
     written = set(listed(out))
     assert written and written <= set(checked), sorted(written - set(checked))
+
+
+def _commit_together(target: str, number: int, barrier, results) -> None:
+    """One run (a process) writing into the default name ``target`` at the same moment as
+    the others; puts where its files went on ``results``."""
+    writer = output_folder(target, "x", fresh=True)
+    with writer as staging:
+        (staging / "r.txt").write_text(f"run {number}")
+        barrier.wait()  # every run commits at once
+    results.put(str(writer.path))
+
+
+def test_runs_finishing_at_the_same_moment_each_keep_their_folder(tmp_path):
+    """Four processes with the same default name, none of whose folders exist yet (not even
+    runs/), committing at once: four folders, each run's file in its own."""
+    import multiprocessing
+
+    context = multiprocessing.get_context("fork")
+    target = str(tmp_path / "runs" / "track-20261201-120000")
+    barrier, results = context.Barrier(4), context.Queue()
+    runs = [
+        context.Process(target=_commit_together, args=(target, n, barrier, results))
+        for n in range(4)
+    ]
+    for run_ in runs:
+        run_.start()
+    paths = [results.get(timeout=60) for _ in runs]
+    for run_ in runs:
+        run_.join(timeout=60)
+        assert run_.exitcode == 0
+    assert len(set(paths)) == 4
+    contents = sorted(Path(p, "r.txt").read_text() for p in paths)
+    assert contents == [f"run {n}" for n in range(4)]
+    assert sorted(Path(p).name for p in paths)[0] == Path(target).name
+    assert leftovers(tmp_path / "runs") == []
