@@ -26,3 +26,31 @@ def test_controller_options_reach_the_controller():
     assert run_scenario(SCENARIO, short).metrics["time_s"] > default + 1.0
     with pytest.raises(ParameterError, match="horizon"):
         run_scenario(SCENARIO, RunConfig(controller="mpc", controller_options=(("horizon", -1.0),)))
+
+
+def test_fallback_steps_are_counted_in_the_scenario_metrics(monkeypatch):
+    """Every 25th solve fails (as HPIPM's 'minimum step' does on the physics plant): the
+    scenario says how many commands were the qp fallback's, and the summary adds them up."""
+    import math
+
+    from ddwmmr.mpc import solvers
+    from ddwmmr.scenarios import report
+
+    real = solvers.GaussNewtonSQP.solve
+    calls = {"n": 0}
+
+    def failing(self, *args):
+        calls["n"] += 1
+        if calls["n"] % 25 == 0:
+            raise solvers.SolverFailure("hpipm: return status 2")
+        return real(self, *args)
+
+    monkeypatch.setattr(solvers.GaussNewtonSQP, "solve", failing)
+    config = RunConfig(controller="mpc", time_limit=2.0)
+    metrics = run_scenario(SCENARIO, config).metrics
+    assert metrics["sim_steps"] == 200 and metrics["fallback_steps"] == 200 // 25
+    thesis = run_scenario(SCENARIO, RunConfig(time_limit=0.5)).metrics
+    assert math.isnan(thesis["fallback_steps"])  # the state machine has no fallback
+    summary = report.summarize([run_scenario(SCENARIO, config)] * 2, 1.0)
+    assert summary["fallback_steps"] == 16 and summary["fallback_share"] == 16 / 400
+    assert "Steps with a fallback command" in report.format_table(summary, "t")

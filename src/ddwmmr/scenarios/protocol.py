@@ -29,7 +29,8 @@ and with an arm joint moving, > 1 mrad/s), time in and transitions into each fix
 (NaN for controllers without states), ``min_stability``, ``min_manipulability``,
 ``unloaded_time_s`` (physics plants, NaN elsewhere: time with an edge of the support
 polygon unloaded, ``Plant.unloaded_time_s``; a wheel chattering on a lightly loaded side
-counts).
+counts), ``sim_steps`` and ``fallback_steps`` (steps whose command was the controller's safe
+fallback after a failed solve, ``StepInfo.fallback``; NaN for the thesis controller).
 """
 
 from __future__ import annotations
@@ -93,6 +94,9 @@ METRICS = (
     "min_manipulability",
     "unloaded_time_s",
     "sim_steps",
+    # Steps whose command was a safe fallback (a failed solve: the qp's stop, the mpc's
+    # qp command); NaN for the thesis controller, which has none.
+    "fallback_steps",
 )
 
 
@@ -188,6 +192,7 @@ class _Tally:
         self.entries = dict.fromkeys(STATES, 0)
         self.previous: str | None = None
         self.steps_base = self.steps_arm = 0
+        self.fallback_steps = 0
         self.min_s = math.inf
         self.min_eta = math.inf
         #: Physics plants: the plant, which judges tipping itself (``tip_time``).
@@ -293,6 +298,7 @@ class _Tally:
             "min_manipulability": self.min_eta,
             "unloaded_time_s": nan if self.physics is None else self.physics.unloaded_time_s,
             "sim_steps": steps,
+            "fallback_steps": nan if has_states else self.fallback_steps,
         }
         if has_states:
             metrics["time_base_s"] = self.steps_in[MOVE_BASE] * dt
@@ -378,6 +384,7 @@ class WaypointTask:
             moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
             state = MOVE_BASE if moving else MOVE_ARM
             self.tally.steps_arm += int(self._arm_rate(obs, applied) > MOVING_RATE)
+            self.tally.fallback_steps += int(getattr(info, "fallback", False))
         if self.tally.trace is not None:
             self.tally.record(k, t, tuple(obs.q.tolist()), state)
 

@@ -53,6 +53,8 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
     half-width (s) of the mean time's 95 % confidence interval over the scenarios,
     ``1.96 sd / sqrt(n)`` (normal approximation; NaN for one scenario): two runs whose mean
     times differ by less than that have not measured a difference.
+    ``fallback_steps`` (and ``fallback_share`` of all steps): the steps whose command was
+    the controller's safe fallback after a failed solve; None for the thesis controller.
     """
     failed = [o.metrics for o in outcomes if not o.metrics["success"]]
     summary: dict[str, Any] = {"n": len(outcomes), "failed": len(failed)}
@@ -62,6 +64,11 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
         name = "mean_speed_m_s" if key == "speed_m_s" else name
         summary[name] = mean
         summary["sd_" + key] = sd
+    fallbacks = _column(outcomes, "fallback_steps")
+    known = bool(np.any(np.isfinite(fallbacks)))
+    summary["fallback_steps"] = int(np.nansum(fallbacks)) if known else None
+    steps = float(np.sum(_column(outcomes, "sim_steps")))
+    summary["fallback_share"] = float(np.nansum(fallbacks)) / steps if known and steps else None
     n = len(outcomes)
     summary["ci95_time_s"] = Z95 * summary["sd_time_s"] / math.sqrt(n) if n > 1 else math.nan
     summary["min_stability"] = float(np.min(_column(outcomes, "min_stability")))
@@ -140,6 +147,10 @@ def format_table(summary: dict[str, Any], title: str) -> str:
     lines = [title, "-" * len(title)]
     lines += [f"{label:<{width}}  {value}" for label, value in rows]
     lines.append(f"{'Minimum stability S':<{width}}  {_fmt(summary['min_stability'])}")
+    if summary.get("fallback_steps") is not None:
+        label = "Steps with a fallback command"
+        share = summary["fallback_share"] or 0.0
+        lines.append(f"{label:<{width}}  {summary['fallback_steps']} ({_fmt(100 * share)} %)")
     ci = summary.get("ci95_time_s")
     if ci is not None and math.isfinite(ci):
         label = "Mean time, 95 % CI (s)"
