@@ -60,7 +60,7 @@ from ddwmmr.reports.compare import (
 )
 from ddwmmr.reports.compare.constants import TIE_ABSOLUTE_M, TIE_RELATIVE
 from ddwmmr.reports.compare.plan import run_duration
-from ddwmmr.resolution.reference import offset_configuration, start_configuration
+from ddwmmr.resolution.reference import initial_configuration
 from ddwmmr.sim.result import json_safe, write_atomic
 from ddwmmr.sim.simulate import check_start
 from ddwmmr.trajectories import available_trajectories, load_trajectory, trajectory_name
@@ -318,8 +318,7 @@ def check_runs(config: CompareConfig, specs: Sequence[Any]) -> None:
         try:
             check_step_count(run_duration(config, spec.trajectory), spec.dt)
             trajectory = config.trajectories[spec.trajectory]
-            start = start_configuration(config.robot, trajectory)
-            start = offset_configuration(config.robot, start, spec.initial_offset)
+            start = initial_configuration(config.robot, trajectory, spec.initial_offset)
             obstacles = dict(spec.options).get("obstacles") or ()
             check_start(config.robot, start, obstacles, "payload", None)
         except ParameterError as exc:

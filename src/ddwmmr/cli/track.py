@@ -43,8 +43,7 @@ from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
-    offset_configuration,
-    start_configuration,
+    initial_configuration,
 )
 from ddwmmr.sim.simulate import check_start, default_step, plant_integrator, simulate
 from ddwmmr.trajectories import available_trajectories, load_trajectory
@@ -352,7 +351,9 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     for value in offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
     named = "payload" if args.payload is not None else "robot"
-    _check_start(robot, trajectory, offset, named, options.get("obstacles"))
+    # a start that tips the robot or sits in an obstacle is bad input
+    start = initial_configuration(robot, trajectory, offset)
+    check_start(robot, start, options.get("obstacles") or (), named, "--offset")
     return RunInputs(
         args.method,
         options,
@@ -366,13 +367,6 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         args.traj,
         plant,
     )
-
-
-def _check_start(robot: Robot, trajectory: Any, offset, name: str, obstacles) -> None:
-    """Refuse a start pose in which the robot (its payload, ``name``) tips over or the
-    base overlaps one of ``obstacles`` ((x, y, radius) triples, m)."""
-    start = offset_configuration(robot, start_configuration(robot, trajectory), offset)
-    check_start(robot, start, obstacles or (), name, "--offset")
 
 
 def inputs_from_record(args: argparse.Namespace) -> RunInputs:

@@ -38,8 +38,7 @@ from ddwmmr.model import Robot
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
-    offset_configuration,
-    start_configuration,
+    initial_configuration,
 )
 from ddwmmr.sim import SimulationResult, simulate
 from ddwmmr.sim.simulate import check_start
@@ -266,7 +265,7 @@ def check_settings(settings: Settings) -> Settings:
     for value in settings.offset:
         check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
     trajectory = build_trajectory(settings)
-    start = offset_configuration(robot, start_configuration(robot, trajectory), settings.offset)
+    start = initial_configuration(robot, trajectory, settings.offset)
     for slot in settings.active_slots:
         controller = build_controller(settings, slot)
         check_start(robot, start, getattr(controller, "obstacles", ()), "payload", "the offset")

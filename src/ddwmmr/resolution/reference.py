@@ -34,6 +34,12 @@ def start_configuration(robot: Robot, trajectory) -> np.ndarray:
     return robot.base_for_end_effector(trajectory.pose(0.0), *robot.home_pose)
 
 
+def initial_configuration(robot: Robot, trajectory, offset) -> np.ndarray:
+    """A run's start: :func:`start_configuration` with the end effector moved by ``offset``
+    (dx, dy) m in its frame (:func:`offset_configuration`)."""
+    return offset_configuration(robot, start_configuration(robot, trajectory), offset)
+
+
 def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
     """``q`` with the arm joints changed so the end effector moves by ``offset`` (dx, dy) m.
 

@@ -23,8 +23,7 @@ from ddwmmr.plants import available_plants, make_plant, plant_class
 from ddwmmr.plants.base import Plant
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
-    offset_configuration,
-    start_configuration,
+    initial_configuration,
 )
 from ddwmmr.sim.loop import run_loop
 from ddwmmr.sim.result import SimulationResult
@@ -167,7 +166,7 @@ def simulate(
         offset = tuple(check_finite("initial_offset", v) for v in initial_offset)
         if len(offset) != 2:
             raise ParameterError(f"initial_offset must be two numbers dx, dy in m (got {offset})")
-        q = offset_configuration(robot, start_configuration(robot, trajectory), offset)
+        q = initial_configuration(robot, trajectory, offset)
     else:
         try:
             q = np.array(q0, dtype=float)
