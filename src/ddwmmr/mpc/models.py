@@ -46,12 +46,15 @@ class PredictionModel(ABC):
         interface: command interface of the controller using it (``"velocity"``/``"force"``).
         u_lower, u_upper: input box (nu,); x_lower, x_upper: state box (nx,).
         u_scale: typical input magnitudes (nu,) used to normalise the input cost.
+        joints_stop_at_once: the joint rates are inputs, so the joints can halt within any
+            interval and a node inside the joint box can always keep the next inside it.
     """
 
     name = "model"
     nx = 0
     nu = 0
     interface = "velocity"
+    joints_stop_at_once = True
 
     def __init__(self, robot: Robot) -> None:
         self.robot = robot
@@ -168,6 +171,8 @@ class LaggedArmPrediction(ThesisPrediction):
     reaction on the base's yaw (:meth:`ThesisDynamics.arm_yaw_reaction`)."""
 
     nx = sym.NX_FORCE + 2
+    #: a joint moving towards its limit needs its braking distance to stop
+    joints_stop_at_once = False
 
     def __init__(
         self,

@@ -29,6 +29,7 @@ stage (``gap_k`` then ``path_k``)::
     gap_k:   RK4(x_k, u_k, h_k) - x_{k+1} = 0                        (the prediction model)
     path_k:  -hl/S <= x_com(q_{k+1}) +- sigma_lon,   -hw/S <= y_com(q_{k+1}) +- sigma_lat
              |p_{k+1} - o_j|^2 + sigma_obs >= (R_j + r_base + margin)^2   (every circle j)
+             th_lo <= th_{k+1} +- sigma_joint <= th_hi    (lagged joints, see below)
              wheel speeds in +-wheel_speed_limit
 
 written through ``x_{k+1} = RK4(x_k, u_k, h_k)`` so that each row involves one stage's
@@ -44,12 +45,17 @@ the at-rest case.
 The slacks carry an exact L1 penalty (:data:`SLACK_WEIGHT`): whenever the constraints can
 be met they are met (a hard constraint), and a linearisation that cannot be met in one
 iteration still gives a solvable QP. Input box (forces or rates), joint-position box on
-the states; with the lagged arm and a joint acceleration limit, rows (without slack: the
-stage's input can always meet them) bound the lag's acceleration ``(u_rates - rates) /
-tau`` at the start of every interval, where it is largest, and the last node holds the
-centre of mass of its *stopping pose* (each joint moved on by its braking distance at that
-limit) in the stability box too: a plan may not end in a swing the arm cannot brake before
-the floor.
+the states. Where the joints lag their commands (``joints_stop_at_once`` false: the
+physical arm) the joint box is a path row with its own slack instead: a joint turning
+towards its limit needs its braking distance to stop, and MuJoCo lets a joint overrun its
+range by a few mrad, so the next node can be out of the box's reach. With the box as
+bounds such a QP is infeasible and HPIPM gave up on it (return status 2, 2.4 % of the
+steps of the MuJoCo benchmark). With the lagged arm and a joint acceleration limit, rows
+(without slack: the stage's input can always meet them) bound the lag's acceleration
+``(u_rates - rates) / tau`` at the start of every interval, where it is largest, and the
+last node holds the centre of mass of its *stopping pose* (each joint moved on by its
+braking distance at that limit) in the stability box too: a plan may not end in a swing
+the arm cannot brake before the floor.
 
 Cost: ``0.5 ||r(w, p)||^2 + c' w`` with the residual ``r`` stacked from, weighted by the
 interval lengths:
@@ -210,7 +216,10 @@ class ShootingOCP:
         self.N = n
         self.nxm, self.num = model.nx, model.nu
         self.nx = model.nx + (1 if config.reach else 0)
-        self.ns = 2 + (1 if config.obstacles else 0)  # stability terms, obstacles
+        #: the joint box is a slackened path row, not a bound (see the module docstring)
+        self.soft_joints = not model.joints_stop_at_once
+        # slacks: stability terms, obstacles, joints
+        self.ns = 2 + (1 if config.obstacles else 0) + (1 if self.soft_joints else 0)
         self.nu = model.nu + self.ns
         # terminal error: the end-effector error, and the base velocities of a force model
         self.terminal_size = (3 if config.track_orientation else 2) + (
@@ -294,6 +303,12 @@ class ShootingOCP:
                 rows.append((x_next[0] - ox) ** 2 + (x_next[1] - oy) ** 2 + slack[2])
                 low.append(radius2)
                 high.append(INF)
+            if self.soft_joints:
+                joints = model.configuration(x_next)[3:5]
+                for joint, (lo, hi) in zip((joints[0], joints[1]), robot.joint_limits):
+                    rows += [joint + slack[-1], joint - slack[-1]]
+                    low += [lo, -INF]
+                    high += [INF, hi]
             rows.append(model.wheel_rows(x_next, us[k]))
             low.extend([-model.wheel_limit] * 2)
             high.extend([model.wheel_limit] * 2)
@@ -361,6 +376,8 @@ class ShootingOCP:
             high = np.concatenate([model.x_upper, [config.horizon]])[: self.nx]
             if k == 0:
                 low[: self.nxm], high[: self.nxm] = -INF, INF
+            elif self.soft_joints:  # a path row of the stage before holds them
+                low[3:5], high[3:5] = -INF, INF
             lower[s], upper[s] = low, high
         for s in self.u_slices:
             lower[s], upper[s] = model.u_lower, model.u_upper
@@ -478,8 +495,18 @@ class ShootingOCP:
         return lower, upper
 
     def max_slack(self, w: np.ndarray) -> float:
-        """The largest constraint slack of a solution (0: every hard row met)."""
-        return max(float(np.max(w[s])) for s in self.slack_slices)
+        """The largest slack of the stability and obstacle rows of a solution (0: all
+        met). The joint box's slack is left out: it is the measured joint past its limit
+        (MuJoCo lets a joint overrun its range by a few mrad) or its braking distance,
+        which no restart of the plan changes (:meth:`max_joint_slack`)."""
+        rows = self.ns - (1 if self.soft_joints else 0)
+        return max(float(np.max(w[s][:rows])) for s in self.slack_slices)
+
+    def max_joint_slack(self, w: np.ndarray) -> float:
+        """The largest slack of the joint box (rad; 0 where the box is bounds)."""
+        if not self.soft_joints:
+            return 0.0
+        return max(float(w[s][-1]) for s in self.slack_slices)
 
     def max_stability_slack(self, w: np.ndarray) -> float:
         """The largest slack of the stability rows (m, in the box on the centre of mass
