@@ -425,24 +425,34 @@ def test_a_reach_plan_ends_where_the_arm_can_still_brake_above_the_floor():
     assert stopping_stability(None)[0] < 1.25
 
 
-def _shoulder_at_its_limit_qp(soft: bool):
+def _shoulder_at_its_limit_qp(soft: bool, reach: bool = False, obstacles: tuple = ()):
     """One tracking QP of the lagged arm (the MuJoCo plant's model) whose measured shoulder
     is 2 mrad past its +pi limit and still turning outwards at 1 rad/s: no plan keeps
     node 1 inside the box (the command may lead the rate down by at most 12.8 rad/s^2 times
     the 0.02 s lag at the start of each interval).
     ``soft``: the joint box as the OCP builds it for this model (a slackened row); else as
-    bounds, as it was. Returns (ocp, solution or the SolverFailure)."""
+    bounds, as it was. ``reach``: the free-horizon layout (one more node state);
+    ``obstacles``: circles (one more slack, before the joints'). Returns (ocp, solution or
+    the SolverFailure)."""
     from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP
     from ddwmmr.mpc.solvers import GaussNewtonSQP, SolverFailure
 
     model = LaggedArmPrediction(ROBOT, sym.ThesisDynamics.from_robot(ROBOT), 0.02, (12.8, 33.3))
     model.joints_stop_at_once = not soft
-    config = OCPConfig(intervals=10, control_interval=0.01, first_interval=0.05, horizon=1.0)
+    config = OCPConfig(
+        intervals=10,
+        control_interval=0.01,
+        first_interval=0.05,
+        horizon=1.0,
+        reach=reach,
+        obstacles=obstacles,
+    )
     ocp = ShootingOCP(ROBOT, model, config)
     x0 = np.array([0.0, 0.0, 0.0, math.pi + 0.002, 1.0, 0.0, 0.0, 1.0, 0.0])
     pose = ROBOT.fk(x0[:5])
-    guess = ocp.pack(np.tile(x0, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
-    p = ocp.parameters(np.tile(pose, (ocp.N, 1)), np.zeros(4))
+    node = np.concatenate([x0, [1.0]]) if reach else x0
+    guess = ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
+    p = ocp.parameters(np.tile(pose, (ocp.N, 1)), np.zeros(4), horizon_prev=1.0)
     lbw, ubw = ocp.bounds(x0)
     try:
         return ocp, GaussNewtonSQP(ocp, "hpipm", iterations=5).solve(
@@ -452,13 +462,19 @@ def _shoulder_at_its_limit_qp(soft: bool):
         return ocp, failure
 
 
-def test_a_joint_past_its_limit_is_brought_back_by_the_slackened_joint_box():
+@pytest.mark.parametrize("layout", ["tracking", "reach, far obstacle"])
+def test_a_joint_past_its_limit_is_brought_back_by_the_slackened_joint_box(layout):
     """The lagged arm's joint box is a row with a slack: a QP whose measured shoulder has
     overrun its limit (MuJoCo lets a joint pass its range by a few mrad) and cannot stop
     at once is solved; the slack is the plan's largest overrun, and the plan brakes the
     shoulder and turns it back inside. With the box as bounds HPIPM fails on it (its
-    return status 2, the mpc's fallback steps on MuJoCo before)."""
-    ocp, w = _shoulder_at_its_limit_qp(soft=True)
+    return status 2, the mpc's fallback steps on MuJoCo before). The elbow, which has its
+    own slack, stays inside its box."""
+    from ddwmmr.mpc.solvers import SolverFailure
+    from ddwmmr.qp.limits.obstacles import Circle
+
+    options = {} if layout == "tracking" else {"reach": True, "obstacles": (Circle(9, 9, 0.1),)}
+    ocp, w = _shoulder_at_its_limit_qp(soft=True, **options)
     assert isinstance(w, np.ndarray) and np.all(np.isfinite(w))
     overrun = ocp.max_joint_slack(w)
     states = ocp.trajectories(w)[0]
@@ -467,10 +483,35 @@ def test_a_joint_past_its_limit_is_brought_back_by_the_slackened_joint_box():
     assert shoulder.max() - math.pi == pytest.approx(overrun, abs=1e-6)
     assert np.all(np.diff(states[:5, 7]) < 0)  # braking from the start
     assert shoulder[-1] <= math.pi + 1e-6  # back inside by the end of the plan
+    assert np.all(states[:, 4] <= math.pi + 1e-6)
+    assert max(w[s][-1] for s in ocp.slack_slices) < 1e-6  # the elbow's slack
     assert ocp.max_slack(w) < 1e-6  # the stability rows need none: the joint is all it is
-    hard_ocp, failure = _shoulder_at_its_limit_qp(soft=False)
-    assert hard_ocp.ns == ocp.ns - 1 and hard_ocp.max_joint_slack(np.zeros(hard_ocp.nw)) == 0.0
-    assert "status 2" in str(failure)
+    hard_ocp, failure = _shoulder_at_its_limit_qp(soft=False, **options)
+    assert hard_ocp.ns == ocp.ns - 2 and hard_ocp.max_joint_slack(np.zeros(hard_ocp.nw)) == 0.0
+    assert isinstance(failure, SolverFailure) and "status 2" in str(failure)
+
+
+def test_each_joint_has_its_own_slack():
+    """While the shoulder is past its limit the elbow may not pass its own for free: an
+    elbow whose reference lies 0.3 rad beyond its limit stops at the limit (a slack shared
+    by the joints let it overrun by the shoulder's 0.09 rad)."""
+    from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP
+    from ddwmmr.mpc.solvers import GaussNewtonSQP
+
+    dynamics = sym.ThesisDynamics.from_robot(ROBOT)
+    model = LaggedArmPrediction(ROBOT, dynamics, 0.02, (12.8, 33.3))
+    config = OCPConfig(intervals=10, control_interval=0.01, first_interval=0.05, horizon=1.0)
+    ocp = ShootingOCP(ROBOT, model, config)
+    x0 = np.array([0.0, 0.0, 0.0, math.pi + 0.002, math.pi - 0.3, 0.0, 0.0, 1.0, 0.0])
+    beyond = ROBOT.fk(np.r_[x0[:4], math.pi + 0.3])
+    guess = ocp.pack(np.tile(x0, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
+    p = ocp.parameters(np.tile(beyond, (ocp.N, 1)), np.zeros(4))
+    lbw, ubw = ocp.bounds(x0)
+    w = GaussNewtonSQP(ocp, "hpipm", iterations=5).solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+    states = ocp.trajectories(w)[0]
+    assert ocp.max_joint_slack(w) > 0.01  # the shoulder's overrun
+    assert states[:, 4].max() <= math.pi + 1e-5
+    assert states[:, 4].max() > math.pi - 0.01  # it goes to the limit, towards the reference
 
 
 def test_models_whose_joints_stop_at_once_keep_the_joint_box_as_bounds():
@@ -489,6 +530,8 @@ def test_models_whose_joints_stop_at_once_keep_the_joint_box_as_bounds():
         for s in ocp.x_slices[1:]:
             np.testing.assert_array_equal(ocp.w_lower[s][3:5], [-math.pi, -math.pi])
             np.testing.assert_array_equal(ocp.w_upper[s][3:5], [math.pi, math.pi])
-    lagged = ShootingOCP(ROBOT, LaggedArmPrediction(ROBOT, model.dynamics, 0.02), config)
-    assert lagged.soft_joints and lagged.ns == 3
-    assert np.all(np.isinf(lagged.w_lower[lagged.x_slices[1]][3:5]))
+    dynamics = sym.ThesisDynamics.from_robot(ROBOT)
+    lagged = ShootingOCP(ROBOT, LaggedArmPrediction(ROBOT, dynamics, 0.02), config)
+    assert lagged.soft_joints and lagged.ns == 4
+    for s in lagged.x_slices[1:]:
+        assert np.all(np.isinf(lagged.w_lower[s][3:5])) and np.all(np.isinf(lagged.w_upper[s][3:5]))

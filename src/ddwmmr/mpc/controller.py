@@ -79,7 +79,8 @@ COLD_ITERATIONS = 5
 STALL_TIME = 0.5
 STALL_PROGRESS = 1e-3
 #: ... and likewise when every plan for this long needed the constraints' slack (largest
-#: slack above this, in the rows' units, m for the stability box): a plan that cannot meet
+#: slack above this, in the rows' units, m for the stability box; the joint box's slack
+#: left out, ``ShootingOCP.max_slack``): a plan that cannot meet
 #: its hard constraints is stuck (on the physics plant: spinning on the spot with the arm
 #: stretched at the dynamic floor for 35 s, 4 of 100 scenarios, before this rule).
 STALL_SLACK = 1e-3
@@ -662,6 +663,7 @@ class MPCControllerCore:
                 "mpc_iterations": float(iterations),
                 "mpc_horizon_s": ocp.horizon_of(w),
                 "mpc_slack": slack,
+                "mpc_joint_slack": ocp.max_joint_slack(w),
                 "arm_scale": scale,
                 "mpc_braking": float(braking),
             }

@@ -1,6 +1,6 @@
 """Prediction models of the MPC: what it integrates over the horizon and what it may command.
 
-Two models, one interface (:class:`PredictionModel`):
+Three models, one interface (:class:`PredictionModel`):
 
 * :class:`KinematicPrediction` (``model="kinematic"``): state ``q`` (5), inputs
   ``u = (v, w, th1dot, th2dot)``; the velocity command is applied as it is (the kinematic
@@ -19,7 +19,9 @@ Two models, one interface (:class:`PredictionModel`):
   and ``stopping_configuration`` is the pose where the joints come to rest braked at that
   limit (the OCP holds its centre of mass in the stability box at the last node).
 
-Joint-position limits are state bounds in both.
+Joint-position limits are state bounds of the models; the OCP holds them as bounds of the
+nodes where the joints stop at once (``joints_stop_at_once``) and as slackened rows for the
+lagged arm (:mod:`ddwmmr.mpc.ocp`).
 """
 
 from __future__ import annotations

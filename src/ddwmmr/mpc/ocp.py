@@ -29,7 +29,7 @@ stage (``gap_k`` then ``path_k``)::
     gap_k:   RK4(x_k, u_k, h_k) - x_{k+1} = 0                        (the prediction model)
     path_k:  -hl/S <= x_com(q_{k+1}) +- sigma_lon,   -hw/S <= y_com(q_{k+1}) +- sigma_lat
              |p_{k+1} - o_j|^2 + sigma_obs >= (R_j + r_base + margin)^2   (every circle j)
-             th_lo <= th_{k+1} +- sigma_joint <= th_hi    (lagged joints, see below)
+             th_lo <= th_i,{k+1} +- sigma_i <= th_hi   (each lagged joint i, see below)
              wheel speeds in +-wheel_speed_limit
 
 written through ``x_{k+1} = RK4(x_k, u_k, h_k)`` so that each row involves one stage's
@@ -218,8 +218,9 @@ class ShootingOCP:
         self.nx = model.nx + (1 if config.reach else 0)
         #: the joint box is a slackened path row, not a bound (see the module docstring)
         self.soft_joints = not model.joints_stop_at_once
-        # slacks: stability terms, obstacles, joints
-        self.ns = 2 + (1 if config.obstacles else 0) + (1 if self.soft_joints else 0)
+        # slacks: stability terms, obstacles, one per joint (a shared one would let the
+        # elbow pass its limit for free while the shoulder is past its own)
+        self.ns = 2 + (1 if config.obstacles else 0) + (2 if self.soft_joints else 0)
         self.nu = model.nu + self.ns
         # terminal error: the end-effector error, and the base velocities of a force model
         self.terminal_size = (3 if config.track_orientation else 2) + (
@@ -305,8 +306,9 @@ class ShootingOCP:
                 high.append(INF)
             if self.soft_joints:
                 joints = model.configuration(x_next)[3:5]
-                for joint, (lo, hi) in zip((joints[0], joints[1]), robot.joint_limits):
-                    rows += [joint + slack[-1], joint - slack[-1]]
+                for i, (lo, hi) in enumerate(robot.joint_limits):
+                    sigma = slack[self.ns - 2 + i]
+                    rows += [joints[i] + sigma, joints[i] - sigma]
                     low += [lo, -INF]
                     high += [INF, hi]
             rows.append(model.wheel_rows(x_next, us[k]))
@@ -499,14 +501,15 @@ class ShootingOCP:
         met). The joint box's slack is left out: it is the measured joint past its limit
         (MuJoCo lets a joint overrun its range by a few mrad) or its braking distance,
         which no restart of the plan changes (:meth:`max_joint_slack`)."""
-        rows = self.ns - (1 if self.soft_joints else 0)
+        rows = self.ns - (2 if self.soft_joints else 0)
         return max(float(np.max(w[s][:rows])) for s in self.slack_slices)
 
     def max_joint_slack(self, w: np.ndarray) -> float:
-        """The largest slack of the joint box (rad; 0 where the box is bounds)."""
+        """The largest slack of the joint box (rad, either joint; 0 where the box is
+        bounds)."""
         if not self.soft_joints:
             return 0.0
-        return max(float(w[s][-1]) for s in self.slack_slices)
+        return max(float(np.max(w[s][-2:])) for s in self.slack_slices)
 
     def max_stability_slack(self, w: np.ndarray) -> float:
         """The largest slack of the stability rows (m, in the box on the centre of mass
