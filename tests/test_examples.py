@@ -174,7 +174,7 @@ def test_physics_tipping_numbers(printed) -> None:
     ]
     assert static[0] == "TIPPED" and static[1] < 1.0 and static[2] == 0 and static[3] > 1.2
     assert lagged[:1] == default[:1] == ("ok",) and lagged[2] == default[2] == 5
-    # the dynamic margin keeps the wheels loaded (1.27 s unloaded against 2.46 s)
+    # the dynamic margin keeps the wheels loaded (1.11 s unloaded against 2.55 s)
     assert default[4] < 0.6 * lagged[4]
 
 

@@ -323,6 +323,29 @@ def test_a_stalled_waypoint_approach_restarts_cold():
     assert controller.summarize({"stability": np.array([1.5])})["mpc_restarts"] == 2
 
 
+@pytest.mark.parametrize("rule", ["on", "off"])
+def test_plans_that_need_slack_for_half_a_second_restart_cold(monkeypatch, rule):
+    """A plant that holds the arm stretched below the stability floor (S 1.15 against
+    1.25) while the base creeps on (the end effector moves, so the stall rule stays
+    quiet): every plan needs slack, and after 0.5 s of that the controller drops its plan
+    and starts cold, once per 0.5 s; with the slack rule off it never does."""
+    from ddwmmr.mpc import controller as mpc_controller
+
+    if rule == "off":
+        monkeypatch.setattr(mpc_controller, "STALL_SLACK", math.inf)
+    controller = make_controller("mpc", HEAVY, model="thesis", track_orientation=False, dt=0.01)
+    q = np.array([0.0, 0.0, 0.0, -1.2, 0.3])
+    assert HEAVY.stability(q)[2] == pytest.approx(1.146, abs=1e-3)
+    controller.reset(None, q)
+    for k in range(120):
+        q[0] = 0.002 * k  # 2 mm per step
+        controller.command(
+            k * 0.01, q, np.array([5.0, 3.0, 0.0]), np.zeros(3), base_velocity=(0.2, 0.0)
+        )
+        assert controller.last.extra["mpc_slack"] > 1e-3  # this plan needed slack
+    assert controller.restarts == (2 if rule == "on" else 0)  # at 0.51 s and 1.02 s
+
+
 def test_minimum_time_of_one_waypoint_is_feasible_and_equals_the_physical_bound():
     from scipy.optimize import brentq
 
