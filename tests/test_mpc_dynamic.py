@@ -406,15 +406,18 @@ def test_a_reach_plan_ends_where_the_arm_can_still_brake_above_the_floor():
     assert stopping_stability(None)[0] < 1.25
 
 
-def _shoulder_at_its_limit_qp(soft: bool, reach: bool = False, obstacles: tuple = ()):
+def _shoulder_at_its_limit_qp(
+    soft: bool, reach: bool = False, obstacles: tuple = (), elbow: float = 1.0, reference=None
+):
     """One tracking QP of the lagged arm (the MuJoCo plant's model) whose measured shoulder
     is 2 mrad past its +pi limit and still turning outwards at 1 rad/s: no plan keeps
     node 1 inside the box (the command may lead the rate down by at most 12.8 rad/s^2 times
     the 0.02 s lag at the start of each interval).
     ``soft``: the joint box as the OCP builds it for this model (a slackened row); else as
     bounds, as it was. ``reach``: the free-horizon layout (one more node state);
-    ``obstacles``: circles (one more slack, before the joints'). Returns (ocp, solution or
-    the SolverFailure)."""
+    ``obstacles``: circles (one more slack, before the joints'); ``elbow``: its angle (rad);
+    ``reference``: the end effector's (x, y, phi) at every node, default where it is now.
+    Returns (ocp, solution or the SolverFailure)."""
     from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP
     from ddwmmr.mpc.solvers import GaussNewtonSQP, SolverFailure
 
@@ -429,8 +432,8 @@ def _shoulder_at_its_limit_qp(soft: bool, reach: bool = False, obstacles: tuple 
         obstacles=obstacles,
     )
     ocp = ShootingOCP(ROBOT, model, config)
-    x0 = np.array([0.0, 0.0, 0.0, math.pi + 0.002, 1.0, 0.0, 0.0, 1.0, 0.0])
-    pose = ROBOT.fk(x0[:5])
+    x0 = np.array([0.0, 0.0, 0.0, math.pi + 0.002, elbow, 0.0, 0.0, 1.0, 0.0])
+    pose = ROBOT.fk(x0[:5]) if reference is None else reference
     node = np.concatenate([x0, [1.0]]) if reach else x0
     guess = ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
     p = ocp.parameters(np.tile(pose, (ocp.N, 1)), np.zeros(4), horizon_prev=1.0)
@@ -476,19 +479,8 @@ def test_each_joint_has_its_own_slack():
     """While the shoulder is past its limit the elbow may not pass its own for free: an
     elbow whose reference lies 0.3 rad beyond its limit stops at the limit (a slack shared
     by the joints let it overrun by the shoulder's 0.09 rad)."""
-    from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP
-    from ddwmmr.mpc.solvers import GaussNewtonSQP
-
-    dynamics = sym.ThesisDynamics.from_robot(ROBOT)
-    model = LaggedArmPrediction(ROBOT, dynamics, 0.02, (12.8, 33.3))
-    config = OCPConfig(intervals=10, control_interval=0.01, first_interval=0.05, horizon=1.0)
-    ocp = ShootingOCP(ROBOT, model, config)
-    x0 = np.array([0.0, 0.0, 0.0, math.pi + 0.002, math.pi - 0.3, 0.0, 0.0, 1.0, 0.0])
-    beyond = ROBOT.fk(np.r_[x0[:4], math.pi + 0.3])
-    guess = ocp.pack(np.tile(x0, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
-    p = ocp.parameters(np.tile(beyond, (ocp.N, 1)), np.zeros(4))
-    lbw, ubw = ocp.bounds(x0)
-    w = GaussNewtonSQP(ocp, "hpipm", iterations=5).solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+    beyond = ROBOT.fk(np.array([0.0, 0.0, 0.0, math.pi + 0.002, math.pi + 0.3]))
+    ocp, w = _shoulder_at_its_limit_qp(soft=True, elbow=math.pi - 0.3, reference=beyond)
     states = ocp.trajectories(w)[0]
     assert ocp.max_joint_slack(w) > 0.01  # the shoulder's overrun
     assert states[:, 4].max() <= math.pi + 1e-5
