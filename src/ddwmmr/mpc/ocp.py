@@ -489,6 +489,13 @@ class ShootingOCP:
             [block.ravel(), np.ravel(u_prev), np.ravel(factor), [previous]]
         ).astype(float)
 
+    def gap_rows(self) -> np.ndarray:
+        """Mask of the rows of ``g`` that are shooting gaps (each stage's first ``nx``)."""
+        mask = []
+        for k in range(self.N):
+            mask += [True] * self.nx + [False] * self.ng[k]
+        return np.array(mask)
+
     def bounds(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Decision bounds with the model state of node 0 pinned to the measured ``x0``."""
         lower, upper = self.w_lower.copy(), self.w_upper.copy()
