@@ -26,7 +26,7 @@ with the physical part of ``x_0`` pinned to the measured state by its bounds; ``
 the model's input followed by this stage's slacks ``sigma_k >= 0``. Constraints, stage by
 stage (``gap_k`` then ``path_k``)::
 
-    gap_k:   RK4(x_k, u_k, h_k) - x_{k+1} = 0                        (the prediction model)
+    gap_k:   x_{k+1} - RK4(x_k, u_k, h_k) = 0                        (the prediction model)
     path_k:  -hl/S <= x_com(q_{k+1}) +- sigma_lon,   -hw/S <= y_com(q_{k+1}) +- sigma_lat
              |p_{k+1} - o_j|^2 + sigma_obs >= (R_j + r_base + margin)^2   (every circle j)
              th_lo <= th_i,{k+1} +- sigma_i <= th_hi   (each lagged joint i, see below)
@@ -221,6 +221,9 @@ class ShootingOCP:
         # slacks: stability terms, obstacles, one per joint (a shared one would let the
         # elbow pass its limit for free while the shoulder is past its own)
         self.ns = 2 + (1 if config.obstacles else 0) + (2 if self.soft_joints else 0)
+        #: where in a stage's slacks the joints' are, after all others (empty where the
+        #: box is bounds)
+        self.joint_slacks = slice(self.ns - 2 if self.soft_joints else self.ns, self.ns)
         self.nu = model.nu + self.ns
         # terminal error: the end-effector error, and the base velocities of a force model
         self.terminal_size = (3 if config.track_orientation else 2) + (
@@ -285,10 +288,12 @@ class ShootingOCP:
         g, lbg, ubg, ng = [], [], [], []
         for k in range(self.N):
             x_next = self._integrate(xs[k], us[k], self._interval(nodes, k), float(self.lengths[k]))
+            # the gap as x_{k+1} - F(x_k, u_k): the only form FATROP's structure detection
+            # takes (F - x_{k+1} raised inside FATROP at every solve); HPIPM takes either
             if config.reach:
-                g.append(ca.vertcat(x_next, nodes[k][self.nxm]) - nodes[k + 1])
+                g.append(nodes[k + 1] - ca.vertcat(x_next, nodes[k][self.nxm]))
             else:
-                g.append(x_next - nodes[k + 1])
+                g.append(nodes[k + 1] - x_next)
             lbg.extend([0.0] * self.nx)
             ubg.extend([0.0] * self.nx)
             # Path rows of node k+1, written through the stage's own variables (x_k, u_k)
@@ -307,7 +312,7 @@ class ShootingOCP:
             if self.soft_joints:
                 joints = model.configuration(x_next)[3:5]
                 for i, (lo, hi) in enumerate(robot.joint_limits):
-                    sigma = slack[self.ns - 2 + i]
+                    sigma = slack[self.joint_slacks.start + i]
                     rows += [joints[i] + sigma, joints[i] - sigma]
                     low += [lo, -INF]
                     high += [INF, hi]
@@ -489,13 +494,6 @@ class ShootingOCP:
             [block.ravel(), np.ravel(u_prev), np.ravel(factor), [previous]]
         ).astype(float)
 
-    def gap_rows(self) -> np.ndarray:
-        """Mask of the rows of ``g`` that are shooting gaps (each stage's first ``nx``)."""
-        mask = []
-        for k in range(self.N):
-            mask += [True] * self.nx + [False] * self.ng[k]
-        return np.array(mask)
-
     def bounds(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Decision bounds with the model state of node 0 pinned to the measured ``x0``."""
         lower, upper = self.w_lower.copy(), self.w_upper.copy()
@@ -508,7 +506,7 @@ class ShootingOCP:
         met). The joint box's slack is left out: it is the measured joint past its limit
         (MuJoCo lets a joint overrun its range by a few mrad) or its braking distance,
         which no restart of the plan changes (:meth:`max_joint_slack`)."""
-        rows = self.ns - (2 if self.soft_joints else 0)
+        rows = self.joint_slacks.start
         return max(float(np.max(w[s][:rows])) for s in self.slack_slices)
 
     def max_joint_slack(self, w: np.ndarray) -> float:
@@ -516,7 +514,7 @@ class ShootingOCP:
         bounds)."""
         if not self.soft_joints:
             return 0.0
-        return max(float(np.max(w[s][-2:])) for s in self.slack_slices)
+        return max(float(np.max(w[s][self.joint_slacks])) for s in self.slack_slices)
 
     def max_stability_slack(self, w: np.ndarray) -> float:
         """The largest slack of the stability rows (m, in the box on the centre of mass

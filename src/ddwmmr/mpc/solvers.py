@@ -203,13 +203,7 @@ class NLPSolver:
         self.ocp = ocp
         self.name = name
         objective = 0.5 * ca.sumsqr(ocp.residual) + ca.dot(ca.DM(ocp.linear_cost), ocp.w)
-        g = ocp.g
-        if name == "fatrop":
-            # FATROP's structure detection takes the gaps only as x_{k+1} - F(x_k, u_k);
-            # the OCP writes F - x_{k+1} (every solve raised inside FATROP). The gap rows'
-            # bounds are 0, so negating them changes nothing else.
-            g = ca.DM(np.where(ocp.gap_rows(), -1.0, 1.0)) * g
-        nlp = {"x": ocp.w, "p": ocp.p, "f": objective, "g": g}
+        nlp = {"x": ocp.w, "p": ocp.p, "f": objective, "g": ocp.g}
         opts: dict[str, Any] = {"error_on_fail": False}
         if name == "ipopt":
             opts.update(
