@@ -156,6 +156,62 @@ def test_kinematic_plant_observation_is_a_copy():
     assert plant.observe().q[0] == 0.0
 
 
+def test_observation_gives_the_configuration_as_floats_and_as_an_array():
+    """A plant may measure q as floats or as an array; both views hold the same numbers,
+    the array is built once, on first use, and changing it leaves the floats alone."""
+    values = (0.5, -1.25, 0.3, -0.7, 1.5)
+    from_floats = Observation(values, 0.2, -0.1)
+    assert from_floats.values is values
+    q = from_floats.q
+    assert isinstance(q, np.ndarray) and q.dtype == np.float64
+    assert q.tolist() == list(values) and from_floats.q is q
+    from_array = Observation(np.array(values), 0.2, -0.1)
+    assert from_array.values == values
+    assert all(type(value) is float for value in from_array.values)
+    q[0] = 99.0
+    assert from_floats.values[0] == 0.5
+    assert (from_floats.v, from_floats.w) == (0.2, -0.1)
+
+
+class FloatStateController(ConstantController):
+    """Takes q as a tuple of floats (the loop's float_state contract)."""
+
+    float_state = True
+
+    def __init__(self, u) -> None:
+        super().__init__(u, zero_order_hold=True, wants_velocity=True)
+        self.states: list[object] = []
+
+    def command(self, t, q, pose_d, velocity_d, base_velocity=None):
+        self.states.append(q)
+        return super().command(t, q, pose_d, velocity_d, base_velocity)
+
+
+@pytest.mark.parametrize("plant", ["kinematic", "thesis"])
+def test_the_loop_passes_floats_to_controllers_that_take_them(plant):
+    """float_state = True: every call gets the measured q as a tuple of 5 floats, the same
+    numbers a plain controller gets as an array."""
+    u = [0.2, 0.1, 0.3, -0.2]
+    floats = FloatStateController(u)
+    plain = ConstantController(u, zero_order_hold=True)
+    plain.states = []
+    plain_command = plain.command
+
+    def remember(t, q, pose_d, velocity_d, base_velocity=None):
+        plain.states.append(q.copy())
+        return plain_command(t, q, pose_d, velocity_d, base_velocity)
+
+    plain.command = remember
+    for controller in (floats, plain):
+        simulate(ROBOT, Ellipse(), controller, dt=0.05, duration=1.0, plant=plant)
+    assert len(floats.states) == len(plain.states) == 21
+    for got, want in zip(floats.states, plain.states):
+        assert type(got) is tuple and all(type(value) is float for value in got)
+        assert isinstance(want, np.ndarray)
+        assert list(got) == want.tolist()
+    assert floats.states[-1] != floats.states[0]  # the robot moved
+
+
 def test_the_loop_tells_sampled_data_controllers_its_step():
     """simulate(..., dt=0.01) on a trajectory of 0.02 s resolution: the mpc plans with the
     0.01 s the loop holds its commands (its joint targets are th + rate dt), the qp looks

@@ -76,6 +76,7 @@ class ThesisController:
     interface = FORCE
     wants_base_velocity = True
     zero_order_hold = True
+    float_state = True
 
     def __init__(
         self,
@@ -147,7 +148,8 @@ class ThesisController:
         x, y, _ = pose_d.tolist() if isinstance(pose_d, np.ndarray) else pose_d
         self.target = (float(x), float(y))
         v, w = base_velocity
-        q = tuple(q.tolist()) if isinstance(q, np.ndarray) else tuple(float(a) for a in q)
+        if type(q) is not tuple:  # the loop passes a tuple of floats (float_state)
+            q = tuple(q.tolist()) if isinstance(q, np.ndarray) else tuple(float(a) for a in q)
         f_left, f_right, a1, a2 = self.act(t, q, v, w)
         return WheelForces(f_left, f_right, a1, a2)
 

@@ -18,7 +18,6 @@ other plant holds the command over the step (zero-order hold) and ignores it.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -29,20 +28,49 @@ import numpy as np
 Policy = Callable[[float, list[float]], Sequence[float]]
 
 
-@dataclass(slots=True)
 class Observation:
     """The plant's measured state at one instant (read-only by convention: one is made
-    every control step, and a frozen dataclass would cost three times as much to build).
+    every control step).
 
     Attributes:
-        q: configuration ``[x, y, phi, th1, th2]`` (world frame; m, m, rad, rad, rad).
+        q: configuration ``[x, y, phi, th1, th2]`` as an array (world frame; m, m, rad,
+            rad, rad).
+        values: the same configuration as a tuple of 5 Python floats.
         v: forward speed of the base along its heading (m/s).
         w: yaw rate of the base (rad/s).
+
+    A plant may give ``q`` either way: as an array, or as a tuple of floats (cheaper for a
+    plant whose state is floats: the array is then built only if someone reads ``q``).
     """
 
-    q: np.ndarray
-    v: float
-    w: float
+    __slots__ = ("_q", "_values", "v", "w")
+
+    def __init__(self, q: np.ndarray | tuple[float, ...], v: float, w: float) -> None:
+        if type(q) is tuple:
+            self._q, self._values = None, q
+        else:
+            self._q, self._values = q, None
+        self.v = v
+        self.w = w
+
+    @property
+    def q(self) -> np.ndarray:
+        """Configuration as a float array (built once, on first use)."""
+        q = self._q
+        if q is None:
+            q = self._q = np.array(self._values, dtype=float)
+        return q
+
+    @property
+    def values(self) -> tuple[float, ...]:
+        """Configuration as a tuple of Python floats (converted once, on first use)."""
+        values = self._values
+        if values is None:
+            values = self._values = tuple(np.asarray(self._q, dtype=float).tolist())
+        return values
+
+    def __repr__(self) -> str:
+        return f"Observation(q={list(self.values)!r}, v={self.v!r}, w={self.w!r})"
 
 
 class PlantDivergedError(RuntimeError):

@@ -68,7 +68,7 @@ class KinematicPlant:
 
     def observe(self) -> Observation:
         """The exact state; ``v``, ``w`` are those of the last applied input (0 at rest)."""
-        return Observation(np.array(self._state), self._v, self._w)
+        return Observation(tuple(self._state), self._v, self._w)
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
         """Same as :meth:`saturate`."""

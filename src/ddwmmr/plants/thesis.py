@@ -186,7 +186,7 @@ class ThesisPlant:
     def observe(self) -> Observation:
         """Configuration and base velocities, exactly."""
         s = self.state
-        return Observation(np.array(s.q), s.v, s.w)
+        return Observation((s.x, s.y, s.phi, s.th1, s.th2), s.v, s.w)
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
         """Joint rates clipped to the joint-speed limit; (v, w) pass (forces saturate)."""

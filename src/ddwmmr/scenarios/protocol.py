@@ -344,11 +344,11 @@ class WaypointTask:
 
     def start(self, obs: Observation) -> bool:
         """A payload too heavy for the start pose fails at once."""
-        return self.tally.check(tuple(obs.q.tolist()))
+        return self.tally.check(obs.values)
 
     def finished(self, k: int, t: float, obs: Observation) -> bool:
         """Every waypoint reached, or the time limit (checked before commanding)."""
-        x, y, phi, th1, th2 = obs.q.tolist()
+        x, y, phi, th1, th2 = obs.values
         a1 = phi + th1
         a12 = a1 + th2
         xe = x + self._L1 * math.cos(a1) + self._L2 * math.cos(a12)
@@ -386,14 +386,14 @@ class WaypointTask:
             self.tally.steps_arm += int(self._arm_rate(obs, applied) > MOVING_RATE)
             self.tally.fallback_steps += int(getattr(info, "fallback", False))
         if self.tally.trace is not None:
-            self.tally.record(k, t, tuple(obs.q.tolist()), state)
+            self.tally.record(k, t, obs.values, state)
 
     def after_step(self, k: int, t: float, obs: Observation, applied: Any) -> bool:
         """Motion tallies (stateless controllers), then stability and collision."""
         if not self.has_states:
             base_moving = abs(obs.v) > MOVING_SPEED or abs(obs.w) > MOVING_RATE
             self.tally.steps_base += int(base_moving)
-        failed = self.tally.check(obs.q.tolist())
+        failed = self.tally.check(obs.values)
         if failed or self.tally.physics is None:
             return failed
         return self._tipped_physically()
@@ -409,7 +409,7 @@ class WaypointTask:
         """Largest commanded joint rate (rad/s): from u, or from the joint targets of a
         force command over one step."""
         if isinstance(applied, WheelForces):
-            _, _, _, th1, th2 = obs.q.tolist()
+            _, _, _, th1, th2 = obs.values
             dt = self.tally.config.dt
             return max(abs(applied.th1_target - th1), abs(applied.th2_target - th2)) / dt
         return max(abs(applied[2]), abs(applied[3]))

@@ -25,6 +25,9 @@ Controller contract (class attributes, all optional):
   control law at its stages (the closed loop integrated as one ODE).
 * ``wants_base_velocity``: True passes the measured ``base_velocity=(v, w)`` to
   ``command`` (force-level controllers need it).
+* ``float_state``: True when ``command`` takes the configuration ``q`` as a tuple of 5
+  floats (:attr:`~ddwmmr.plants.base.Observation.values`) instead of an array: the loop
+  then passes the floats, and a plant that measures floats never builds an array.
 * ``last``: a :class:`~ddwmmr.controllers.base.StepInfo` about the last command.
 * ``adopt_plant(traits)``: called first with the plant's
   :class:`~ddwmmr.commands.PlantTraits` (its interfaces, whether it judges tipping by its
@@ -176,6 +179,7 @@ def run_loop(
         adopt(dt)
     controller.reset(task.trajectory, np.array(q0, dtype=float))
     wants_velocity = getattr(controller, "wants_base_velocity", False)
+    float_state = getattr(controller, "float_state", False)
     command_of = controller.command
     clock = time.perf_counter_ns
 
@@ -205,11 +209,12 @@ def run_loop(
             return LoopEnd(k, "finished")
         pose_d, velocity_d = task.reference(t, obs)
         try:
+            q = obs.values if float_state else obs.q
             start = clock()
             if wants_velocity:
-                command = command_of(t, obs.q, pose_d, velocity_d, base_velocity=(obs.v, obs.w))
+                command = command_of(t, q, pose_d, velocity_d, base_velocity=(obs.v, obs.w))
             else:
-                command = command_of(t, obs.q, pose_d, velocity_d)
+                command = command_of(t, q, pose_d, velocity_d)
             elapsed = clock() - start
         except Exception as error:
             if task.controller_error(k, error):

@@ -143,7 +143,7 @@ class TrackingTask:
         self.rows.append(
             (
                 t,
-                *obs.q.tolist(),
+                *obs.values,
                 *u,
                 obs.v,
                 obs.w,
