@@ -171,6 +171,18 @@ class ThesisPlant:
         self.mass = robot.base_mass + m1 + m2 + robot.payload
         # Pose-independent part of the yaw inertia: base plus each link about its own centre.
         self._inertia_fixed = robot.base_inertia + (m1 * robot.L1**2 + m2 * robot.L2**2) / 12.0
+        L1, L2 = robot.L1, robot.L2
+        # inertia(th2) = A + m2 (B + C cos th2) + payload (D + E cos th2): the constants of
+        # the formula in inertia(), grouped as Python evaluates it (the same bits).
+        self._inertia_terms = (
+            self._inertia_fixed + m1 * 0.25 * L1**2,
+            m2,
+            L1**2 + 0.25 * L2**2,
+            L1 * L2,
+            robot.payload,
+            L1**2 + L2**2,
+            2.0 * L1 * L2,
+        )
         self._half_width = 0.5 * robot.base_width
         self.servo = VelocityServo(self, velocity_bandwidth)
         self.state = ThesisState()
@@ -243,13 +255,11 @@ class ThesisPlant:
         Links are uniform rods (parallel-axis term at their midpoints), the payload a point
         mass at the end effector; the arm lies horizontally (SPEC §1).
         """
-        r = self.robot
-        m1, m2 = r.link_masses
+        # base and links about their centres, link 1's midpoint, then link 2's midpoint and
+        # the end effector at squared distances B + C cos th2 and D + E cos th2
+        fixed, m2, B, C, payload, D, E = self._inertia_terms
         c2 = math.cos(th2)
-        # squared distances from the base centre of link-2 midpoint and end effector
-        mid2 = r.L1**2 + 0.25 * r.L2**2 + r.L1 * r.L2 * c2
-        tip = r.L1**2 + r.L2**2 + 2.0 * r.L1 * r.L2 * c2
-        return self._inertia_fixed + m1 * 0.25 * r.L1**2 + m2 * mid2 + r.payload * tip
+        return fixed + m2 * (B + C * c2) + payload * (D + E * c2)
 
     @property
     def damping(self) -> tuple[float, float]:
