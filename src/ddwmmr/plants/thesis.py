@@ -169,13 +169,13 @@ class ThesisPlant:
         self.joint_speed = check_positive("joint_speed", joint_speed)
         m1, m2 = robot.link_masses
         self.mass = robot.base_mass + m1 + m2 + robot.payload
-        # Pose-independent part of the yaw inertia: base plus each link about its own centre.
-        self._inertia_fixed = robot.base_inertia + (m1 * robot.L1**2 + m2 * robot.L2**2) / 12.0
         L1, L2 = robot.L1, robot.L2
+        # Pose-independent part of the yaw inertia: base plus each link about its own centre.
+        fixed = robot.base_inertia + (m1 * L1**2 + m2 * L2**2) / 12.0
         # inertia(th2) = A + m2 (B + C cos th2) + payload (D + E cos th2): the constants of
         # the formula in inertia(), grouped as Python evaluates it (the same bits).
         self._inertia_terms = (
-            self._inertia_fixed + m1 * 0.25 * L1**2,
+            fixed + m1 * 0.25 * L1**2,
             m2,
             L1**2 + 0.25 * L2**2,
             L1 * L2,
@@ -198,7 +198,7 @@ class ThesisPlant:
     def observe(self) -> Observation:
         """Configuration and base velocities, exactly."""
         s = self.state
-        return Observation((s.x, s.y, s.phi, s.th1, s.th2), s.v, s.w)
+        return Observation(s.q, s.v, s.w)
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
         """Joint rates clipped to the joint-speed limit; (v, w) pass (forces saturate)."""
