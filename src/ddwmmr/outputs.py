@@ -33,6 +33,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
+from ddwmmr._version import __version__
 from ddwmmr.errors import ParameterError
 
 #: Name of the manifest file each tool writes into its output folder.
@@ -66,8 +67,6 @@ def folder_mode() -> int:
 
 def package_version() -> str:
     """The installed ddwmmr version."""
-    from ddwmmr import __version__
-
     return __version__
 
 
