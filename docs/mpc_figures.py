@@ -32,8 +32,8 @@ from ddwmmr.mpc.ocp import OCPConfig
 from ddwmmr.plants.thesis import ThesisPlant
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 from ddwmmr.scenarios.protocol import WaypointTask, _Tally, make_mpc, make_scenario_plant
+from ddwmmr.sim.error_dynamics import saturated_velocity_step, step_response, velocity_loop
 from ddwmmr.sim.loop import run_loop
-from ddwmmr.sim.loops import saturated_velocity_step, step_response, velocity_loop
 
 FIGURES = Path(__file__).parent / "figures"
 

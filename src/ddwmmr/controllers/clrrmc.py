@@ -2,7 +2,7 @@
 
 Gains are given as time constants ``tau`` (s): ``K = 1/tau``. The error dynamics are then
 ``e_dot + K e = 0``, i.e. each error decays as ``exp(-t / tau)`` while the plant follows the
-command (see ``ddwmmr.sim.loops.error_loop`` for the python-control model).
+command (see ``ddwmmr.sim.error_dynamics.error_loop`` for the python-control model).
 """
 
 from __future__ import annotations
