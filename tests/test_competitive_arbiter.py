@@ -23,10 +23,11 @@ from ddwmmr.arbiters import (
     StateMachineArbiter,
     make_arbiter,
 )
-from ddwmmr.behaviours import BRAKE, ObstacleAvoidance, Proposal, ThesisController
+from ddwmmr.behaviours import BRAKE, ObstacleAvoidance, Proposal
 from ddwmmr.errors import ParameterError
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
+from ddwmmr.thesis_controller import ThesisController
 
 
 class Clock:

@@ -40,7 +40,6 @@ import math
 import random
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
@@ -51,10 +50,8 @@ from ddwmmr.arbiters.state_machine import (
     Hysteresis,
     Selection,
 )
+from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
-
-if TYPE_CHECKING:  # behaviours import the arbiter package; avoid a cycle at run time
-    from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
 
 #: Behaviours of the arbiter, in priority order (also the order of the weight updates).
 BEHAVIOURS = ("stability", "manipulability", "obstacle", "objective")

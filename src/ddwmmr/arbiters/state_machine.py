@@ -16,12 +16,9 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
+from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
 from ddwmmr.errors import ParameterError
-
-if TYPE_CHECKING:  # behaviours import the arbiter package; avoid a cycle at run time
-    from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
 
 MOVE_BASE, MOVE_ARM = "move_base", "move_arm"
 MANIPULABILITY, STABILITY, OBSTACLE = "manipulability", "stability", "obstacle"

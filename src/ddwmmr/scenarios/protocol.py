@@ -52,7 +52,6 @@ from ddwmmr.arbiters.state_machine import (
     STATES,
     Hysteresis,
 )
-from ddwmmr.behaviours.controller import ThesisController
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.behaviours.obstacle import base_bubble
 from ddwmmr.commands import WheelForces, traits_of
@@ -64,6 +63,7 @@ from ddwmmr.plants import make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.loop import run_loop
+from ddwmmr.thesis_controller import ThesisController
 
 CONTROLLERS = ("thesis", "qp", "mpc")
 PLANTS = ("thesis", "kinematic", "mujoco")
