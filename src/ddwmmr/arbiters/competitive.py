@@ -52,6 +52,7 @@ from ddwmmr.arbiters.state_machine import (
 )
 from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.registry import register_arbiter
 
 #: Behaviours of the arbiter, in priority order (also the order of the weight updates).
 BEHAVIOURS = ("stability", "manipulability", "obstacle", "objective")
@@ -291,6 +292,7 @@ class Blend:
     proposals: Mapping[str, Proposal]
 
 
+@register_arbiter("competitive")
 class CompetitiveDynamicsArbiter:
     """Competitive dynamics over objective, manipulability, stability, obstacle avoidance.
 
@@ -339,8 +341,6 @@ class CompetitiveDynamicsArbiter:
         record: keep :attr:`history` (every call: time, S, dominant state, weights and
             advantages by behaviour) for plots.
     """
-
-    name = "competitive"
 
     def __init__(
         self,

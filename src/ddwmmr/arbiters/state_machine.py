@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
 from ddwmmr.errors import ParameterError
+from ddwmmr.registry import register_arbiter
 
 MOVE_BASE, MOVE_ARM = "move_base", "move_arm"
 MANIPULABILITY, STABILITY, OBSTACLE = "manipulability", "stability", "obstacle"
@@ -54,10 +55,9 @@ class Selection:
     proposal: Proposal
 
 
+@register_arbiter("state-machine")
 class StateMachineArbiter:
     """Priority state machine with hysteresis thresholds (thesis 4.3)."""
-
-    name = "state-machine"
 
     def __init__(
         self,

@@ -25,7 +25,7 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.arbiters import ARBITERS
+from ddwmmr.arbiters import DEFAULT_ARBITER, arbiter_description, available_arbiters
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.cli import provenance
 from ddwmmr.cli.common import (
@@ -36,6 +36,7 @@ from ddwmmr.cli.common import (
     output_folder,
     run_main,
 )
+from ddwmmr.controllers import method_description
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
@@ -48,11 +49,20 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_CAP
+from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.executors import EXECUTORS, default_jobs, run_many
 from ddwmmr.scenarios.generator import Scenario, generate
-from ddwmmr.scenarios.protocol import CONTROLLERS, PLANTS, Outcome, RunConfig, run_scenario
+from ddwmmr.scenarios.protocol import (
+    Outcome,
+    RunConfig,
+    make_scenario_controller,
+    make_scenario_plant,
+    plants_for,
+    run_scenario,
+    scenario_controllers,
+)
 from ddwmmr.sim.result import json_safe, write_atomic
 
 #: The batch summary (holds the run record: everything needed to repeat the batch).
@@ -83,11 +93,8 @@ an 8 m x 8 m square; the end effector must reach them in order within 0.01 m in 
 (120 s with obstacles) while the tip-over stability S stays above 1. Writes scenarios.csv
 (one row per scenario), summary.json, table.txt (thesis Table 5.2 format) and figures
 (per-scenario bars as thesis Figs 5.3-5.9, paths, a state timeline) into --out, and prints
-the table. Controllers: 'thesis' (behaviour-based, state-machine or competitive arbiter)
-sends wheel forces; 'qp' (the library's QP controller) sends velocities, followed by the
-thesis plant's velocity servo; 'mpc' (CasADi, the thesis base's force-level model) sends
-wheel forces. Plants: the thesis force-driven dynamics (default), the kinematic model
-(qp and mpc only) or the MuJoCo physics model, which judges tipping by its contact forces."""
+the table. The controllers are the registered ones that do this waypoint task, the plants
+the registered ones; --help lists both, each controller with the plants it can command."""
 
 EPILOG = """\
 The default payload is 3.0 kg: with the thesis's 1.25 kg the planar arm can never tip
@@ -106,16 +113,22 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--controller",
-        choices=CONTROLLERS,
+        choices=scenario_controllers(),
         default="thesis",
-        help="controller to benchmark (default: thesis)",
+        help="controller to benchmark (default: thesis): "
+        + "; ".join(
+            f"{name}: {method_description(name).rstrip('.')} (plants: "
+            f"{', '.join(plants_for(name))})"
+            for name in scenario_controllers()
+        ),
     )
     parser.add_argument(
         "--arbiter",
-        choices=ARBITERS,
+        choices=available_arbiters(),
         default=None,
-        help="thesis controller's arbiter: the thesis's 'state-machine' (default) or "
-        "'competitive' dynamics (Ellekilde & Christensen 2009; same thresholds options)",
+        help=f"thesis controller's arbiter (default: {DEFAULT_ARBITER}; the same thresholds "
+        "options for each): "
+        + "; ".join(f"{a}: {arbiter_description(a).rstrip('.')}" for a in available_arbiters()),
     )
     parser.add_argument(
         "--arbiter-seed",
@@ -127,10 +140,11 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--plant",
-        choices=PLANTS,
+        choices=available_plants(),
         default="thesis",
-        help="plant: 'thesis' force-driven dynamics (default), 'kinematic' (qp and mpc "
-        "only) or 'mujoco' physics (tipping judged from contact forces)",
+        help="plant (default: thesis): "
+        + "; ".join(f"{p}: {plant_description(p).rstrip('.')}" for p in available_plants())
+        + "; a physics plant judges tipping from its contact forces",
     )
     parser.add_argument(
         "--n",
@@ -300,7 +314,7 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     if args.study == "arbiters" and args.controller != "thesis":
         raise ParameterError("study: the arbiter study needs --controller thesis")
     _check_thesis_options(args)
-    arbiter = args.arbiter or "state-machine"
+    arbiter = args.arbiter or DEFAULT_ARBITER
     arbiter_seed = 0 if args.arbiter_seed is None else args.arbiter_seed
     check_nonnegative("arbiter-seed", arbiter_seed)
     if args.study and args.obstacles:
@@ -591,10 +605,10 @@ def _main(argv: Sequence[str] | None = None) -> int:
     fresh = args.out is None  # a default name: never replaces an earlier run
     out = first_free(default_out(), folder=True) if fresh else Path(args.out)
     check_output_folder(out, "scenarios", args.force, output_names(args, config))
-    if config.controller == "qp":
-        from ddwmmr.scenarios.protocol import make_qp
-
-        make_qp(config_robot(config), generate(1, 0)[0], config)  # fail early, before output
+    if config.controller == "qp":  # its options are checked by building it, before output
+        robot = config_robot(config)
+        plant = make_scenario_plant(robot, config)
+        make_scenario_controller(robot, generate(1, 0)[0], config, plant)
     runner = Runner(args)
     writer = output_folder(out, "scenarios", args.force, fresh)
     with writer as folder:

@@ -38,7 +38,7 @@ from ddwmmr.controllers.base import (
 from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file, shown
 from ddwmmr.model import Robot
-from ddwmmr.plants import available_plants
+from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.resolution.reference import (
@@ -197,9 +197,8 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--plant",
         choices=available_plants(),
-        help="what the commands drive: kinematic (default; exact kinematics), thesis (the "
-        "thesis's force-limited base through a velocity servo) or mujoco (rigid-body physics "
-        "with contacts: tip-over judged by the support forces, docs/physics.md)",
+        help=f"what the commands drive (default {PLANT}): "
+        + "; ".join(f"{p}: {plant_description(p).rstrip('.')}" for p in available_plants()),
     )
     parser.add_argument(
         "--integrator",

@@ -3,19 +3,27 @@
 from ddwmmr.controllers.base import (
     Controller,
     StepInfo,
+    WaypointRun,
+    available_controllers,
     available_methods,
+    controller_class,
     make_controller,
     method_description,
     method_options,
     register,
+    register_controller,
 )
 
 __all__ = [
     "Controller",
     "StepInfo",
+    "WaypointRun",
+    "available_controllers",
     "available_methods",
+    "controller_class",
     "make_controller",
     "method_description",
     "method_options",
     "register",
+    "register_controller",
 ]

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ddwmmr.controllers.base import StepInfo, register
+from ddwmmr.controllers.base import StepInfo, register_controller
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
 from ddwmmr.errors import MAX_STEPS, ParameterError, check_positive, check_range
@@ -29,7 +29,7 @@ DEFAULT_TAU = 0.5
 MIN_REFERENCE_STEP, MAX_REFERENCE_STEP = 1e-4, 1.0
 
 
-@register("clrrmc-ts")
+@register_controller("clrrmc-ts")
 class TaskSpaceController(ResolvedRate):
     """CLRRMC-TS: qdot = J_aug^-1 [Xd_dot + K (Xd - X)], feedback on xE, yE, phiE.
 
@@ -79,7 +79,7 @@ class TaskSpaceController(ResolvedRate):
         )
 
 
-@register("clrrmc-cs")
+@register_controller("clrrmc-cs")
 class ConfigurationSpaceController:
     """CLRRMC-CS: qdot = qdot_d + K (q_d - q) around an ATS reference q_d(t).
 

@@ -26,19 +26,18 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.commands import VELOCITY
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
+from ddwmmr.registry import register_plant
 
 INTEGRATORS = ("euler", "rk4")
 
 
+@register_plant("kinematic", interfaces=("velocity",))
 class KinematicPlant:
     """Kinematic model of the differential-drive mobile manipulator (velocity interface)."""
 
-    name = "kinematic"
-    interfaces = (VELOCITY,)
     extra_columns: tuple[str, ...] = ()
 
     def __init__(self, robot: Robot, integrator: str = "rk4") -> None:

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.commands import FORCE, VELOCITY, WheelForces
+from ddwmmr.commands import WheelForces
 from ddwmmr.errors import check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.thesis_base import (  # the base's constants (controllers' models use them)
@@ -39,6 +39,7 @@ from ddwmmr.model.thesis_base import (  # the base's constants (controllers' mod
     JOINT_SPEED_DEFAULT,
 )
 from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
+from ddwmmr.registry import register_plant
 
 #: Bandwidth (1/s) of the velocity servo that follows velocity commands.
 VELOCITY_BANDWIDTH = 10.0
@@ -135,6 +136,7 @@ def damped_base_envelope(
     return envelope
 
 
+@register_plant("thesis", interfaces=("force", "velocity"))
 class ThesisPlant:
     """Force-driven base dynamics with the arm pseudo-controller (thesis ch. 3 and 4.4.2).
 
@@ -149,8 +151,6 @@ class ThesisPlant:
     sample (N), ``force_left_n`` and ``force_right_n``.
     """
 
-    name = "thesis"
-    interfaces = (FORCE, VELOCITY)
     extra_columns = ("force_left_n", "force_right_n")
 
     def __init__(

@@ -44,6 +44,7 @@ from ddwmmr.plants.mujoco.model import (
 )
 from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
 from ddwmmr.plants.thesis import ThesisPlant, arm_step, damped_base_envelope
+from ddwmmr.registry import register_plant
 
 #: Time (s) the robot settles on its supports in :meth:`MujocoPlant.reset` before t = 0,
 #: so that the first recorded contact forces carry the robot's weight.
@@ -83,6 +84,7 @@ _WARNINGS = (
 )
 
 
+@register_plant("mujoco", interfaces=("velocity", "force"))
 class MujocoPlant:
     """The robot simulated by MuJoCo (rigid bodies, contacts, friction, motor limits).
 
@@ -102,9 +104,6 @@ class MujocoPlant:
     Raises:
         ParameterError: for a robot or option MuJoCo cannot build (one line).
     """
-
-    name = "mujoco"
-    interfaces = ("velocity", "force")
 
     def __init__(
         self,
