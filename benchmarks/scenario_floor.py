@@ -204,7 +204,7 @@ def _src_folder(text: str) -> str:
 
 
 def main() -> None:
-    from ddwmmr.bench import _integer
+    from ddwmmr.cli.bench import _integer
     from ddwmmr.cli.common import ArgumentParser
 
     parser = ArgumentParser(prog="scenario_floor", description=__doc__.split("\n\n")[0])

@@ -20,7 +20,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ddwmmr.bench import main as bench_main
+from ddwmmr.cli.bench import main as bench_main
 from ddwmmr.cli.compare import main as compare_main
 from ddwmmr.cli.scenarios import main as scenarios_main
 from ddwmmr.cli.track import main as track_main
