@@ -13,9 +13,9 @@ from PIL import Image
 
 import ddwmmr.gui.app as gui_app
 import ddwmmr.gui.settings as gui_settings
+from ddwmmr.cli import gui as cli
+from ddwmmr.cli.gui import DPI_RANGE, check_dpi, main
 from ddwmmr.errors import ParameterError
-from ddwmmr.gui import cli
-from ddwmmr.gui.cli import DPI_RANGE, check_dpi, main
 from ddwmmr.gui.paths import SNAPSHOT_FORMATS, check_export_root, check_snapshot_path
 
 ROOT = Path(__file__).resolve().parents[1]
