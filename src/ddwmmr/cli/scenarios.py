@@ -25,9 +25,9 @@ from dataclasses import asdict, replace
 from pathlib import Path
 from typing import Any
 
+from ddwmmr import provenance
 from ddwmmr.arbiters import DEFAULT_ARBITER, arbiter_description, available_arbiters
 from ddwmmr.behaviours.objective import default_pose
-from ddwmmr.cli import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,

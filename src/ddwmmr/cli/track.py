@@ -14,11 +14,10 @@ import datetime as dt
 import json
 import sys
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.cli import provenance
+from ddwmmr import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
@@ -37,10 +36,10 @@ from ddwmmr.controllers.base import (
 )
 from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file, shown
-from ddwmmr.model import Robot
 from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
+from ddwmmr.provenance import RunInputs, run_record
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     initial_configuration,
@@ -311,23 +310,6 @@ def format_table(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-@dataclass
-class RunInputs:
-    """Everything a track run simulates (from the options, or from a --rerun record)."""
-
-    method: str
-    options: dict[str, Any]
-    robot: Robot
-    trajectory: Any
-    trajectory_file: Path | None
-    dt: float
-    duration: float
-    integrator: str | None
-    offset: tuple[float, float]
-    label: str  # trajectory as the user named it (for the default folder name)
-    plant: str = PLANT
-
-
 def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     """Validated inputs from the command-line options."""
     if args.method is None or args.traj is None:
@@ -461,33 +443,6 @@ def load_run_record(path: str) -> dict[str, Any]:
     return record
 
 
-def run_record(
-    inputs: RunInputs,
-    argv: Sequence[str] | None,
-    rerun: str | None,
-    tool: str = "track",
-    prog: str = PROG,
-) -> dict:
-    """What summary.json["run"] holds: enough to repeat the run (``--rerun``); ``tool``
-    and ``prog`` name what wrote it (the simulator's export writes the same record)."""
-    record = provenance.header(tool, prog, argv)
-    record.update(
-        method=inputs.method,
-        options=provenance.options_record(inputs.method, inputs.options),
-        robot=provenance.robot_record(inputs.robot),
-        trajectory=provenance.trajectory_record(inputs.trajectory, inputs.trajectory_file),
-        dt=inputs.dt,
-        duration=inputs.duration,
-        integrator=inputs.integrator,
-        initial_offset=list(inputs.offset),
-        plant={"name": inputs.plant},
-        seed=None,  # nothing random in a track run
-    )
-    if rerun is not None:
-        record["rerun_of"] = str(Path(rerun).resolve())
-    return record
-
-
 def output_names(plots: bool, animate: bool) -> tuple[str, ...]:
     """The files a run writes (checked against a user's files before the run, --force)."""
     names = ("timeseries.csv", "summary.json", *(("animation.gif",) if animate else ()))
@@ -523,7 +478,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         else Path(args.out)
     )
     check_output_folder(out, "track", args.force, output_names(not args.no_plots, args.animate))
-    record = run_record(inputs, argv, args.rerun)
+    record = run_record(inputs, argv, args.rerun, tool="track", prog=PROG)
     progress = not args.no_progress
     _note_uneven_duration(inputs.duration, inputs.dt, steps)
     writer = output_folder(out, "track", args.force, fresh)
