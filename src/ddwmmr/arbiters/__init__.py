@@ -35,6 +35,7 @@ from ddwmmr.arbiters.state_machine import (
     Selection,
     StateMachineArbiter,
 )
+from ddwmmr.registry import register_arbiter
 
 __all__ = [
     "BEHAVIOURS",
@@ -58,4 +59,5 @@ __all__ = [
     "available_arbiters",
     "check_arbiter",
     "make_arbiter",
+    "register_arbiter",
 ]
