@@ -150,7 +150,9 @@ class Registry:
                 f"{self.decorator}({name!r}): unknown trait {unknown[0]!r} "
                 f"(known: {', '.join(self.defaults) or 'none'})"
             )
-        return {key: given.get(key, default) for key, default in self.defaults.items()}
+        resolved = {key: given.get(key, default) for key, default in self.defaults.items()}
+        # Lists become tuples: traits are compared and filtered as tuples.
+        return {k: tuple(v) if isinstance(v, list) else v for k, v in resolved.items()}
 
     def _add(self, cls: type, name: str, traits: dict[str, Any], description: str | None) -> None:
         entry = self._entries.get(name)
@@ -249,31 +251,42 @@ register_arbiter = ARBITERS.register
 _LOCK = threading.RLock()
 _SEQUENCE = count()
 _discovered = False
+_discovering = False
 
 
 def discover() -> None:
     """Find every plug-in once per process (see the module docstring): read the built-in
     modules' decorators from source, then import the modules of the ``ddwmmr.plugins``
-    entry points and of ``DDWMMR_PLUGINS``."""
-    global _discovered
+    entry points and of ``DDWMMR_PLUGINS``. Other threads wait for it; within the thread
+    that runs it (a plug-in module asking a registry on import) it returns at once."""
+    global _discovered, _discovering
     if _discovered:
         return
     with _LOCK:
-        if _discovered:
+        if _discovered or _discovering:
             return
-        _discovered = True
-        for index, module in enumerate(BUILTIN_MODULES):
-            for line, decorator, name, traits, qualname, doc in _read_source(module):
-                registry = _REGISTRIES[decorator]
-                description = traits.pop("description", None)
-                resolved = registry._traits(name, traits)
-                entry = registry._entries.get(name)
-                if entry is None:
-                    text = description if description is not None else _first_line(doc)
-                    entry = registry._entries[name] = Entry(name, text, resolved, module, qualname)
-                entry.order = (0, index, line)
-        for module in _plugin_modules():
-            _import_plugin(module)
+        _discovering = True
+        try:
+            _read_builtins()
+            for module in _plugin_modules():
+                _import_plugin(module)
+            _discovered = True  # a failure leaves it False: the next query fails alike
+        finally:
+            _discovering = False
+
+
+def _read_builtins() -> None:
+    """Entries for the built-in plug-ins, read from source, in listing order."""
+    for index, module in enumerate(BUILTIN_MODULES):
+        for line, decorator, name, traits, qualname, doc in _read_source(module):
+            registry = _REGISTRIES[decorator]
+            description = traits.pop("description", None)
+            resolved = registry._traits(name, traits)
+            entry = registry._entries.get(name)
+            if entry is None:
+                text = description if description is not None else _first_line(doc)
+                entry = registry._entries[name] = Entry(name, text, resolved, module, qualname)
+            entry.order = (0, index, line)
 
 
 def _read_source(module: str) -> list[tuple[int, str, str, dict[str, Any], str, str | None]]:
