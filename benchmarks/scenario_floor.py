@@ -204,7 +204,10 @@ def _src_folder(text: str) -> str:
 
 
 def main() -> None:
-    from ddwmmr.cli.bench import _integer
+    try:
+        from ddwmmr.cli.bench import _integer
+    except ImportError:  # a --reference-src checkout from before ddwmmr.cli.bench
+        from ddwmmr.bench import _integer
     from ddwmmr.cli.common import ArgumentParser
 
     parser = ArgumentParser(prog="scenario_floor", description=__doc__.split("\n\n")[0])
