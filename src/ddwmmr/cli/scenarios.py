@@ -36,7 +36,7 @@ from ddwmmr.cli.common import (
     output_folder,
     run_main,
 )
-from ddwmmr.controllers import method_description
+from ddwmmr.controllers import controller_traits, method_description
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
@@ -362,7 +362,8 @@ def _check_thesis_options(args: argparse.Namespace) -> None:
     """Refuse the thesis controller's options where nothing would read them."""
     given = [f"--{n}" for n in ("stability", "manipulability") if getattr(args, n) is not None]
     given += ["--no-hysteresis"] if args.no_hysteresis else []
-    if given and args.controller != "thesis":
+    arbitrated = controller_traits(args.controller)["arbiter"]  # thresholds are its arbiter's
+    if given and not arbitrated:
         raise ParameterError(
             f"{given[0]}: only used with --controller thesis (the qp and mpc hold "
             "--qp-stability-min)"
@@ -372,7 +373,7 @@ def _check_thesis_options(args: argparse.Namespace) -> None:
             f"{given[0]}: the {args.study[:-1]} study runs its own thresholds (thesis Tables "
             "5.2-5.18); leave it out"
         )
-    if args.arbiter is not None and args.controller != "thesis":
+    if args.arbiter is not None and not arbitrated:
         raise ParameterError("--arbiter: only the thesis controller has an arbiter")
     if args.arbiter is not None and args.study == "arbiters":
         raise ParameterError("--arbiter: the arbiter study runs both arbiters; leave it out")
@@ -416,7 +417,7 @@ def output_names(args: argparse.Namespace, config: RunConfig) -> tuple[str, ...]
 
         return (MARKER, *arbiter_study.output_names())
     figures = ["thesis_times.png", "thesis_speed.png", "thesis_paths.png", "thesis_timeline.png"]
-    if config.controller == "thesis":
+    if controller_traits(config.controller)["arbiter"]:  # time in its fix states
         figures += ["thesis_stability.png", "thesis_manipulability.png"]
     if config.arbiter == "competitive":
         figures.append("thesis_weights.png")
@@ -468,7 +469,7 @@ def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
     short = f"{config.controller} / {config.plant}"
     report.plot_state_times(outcomes, folder / "thesis_times.png", f"{short}: time per state")
     report.plot_speeds(outcomes, folder / "thesis_speed.png", short)
-    if config.controller == "thesis":
+    if controller_traits(config.controller)["arbiter"]:
         for key in ("stability", "manipulability"):
             report.plot_fix_state(outcomes, key, folder / f"thesis_{key}.png", short)
     if config.arbiter == "competitive":

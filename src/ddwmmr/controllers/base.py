@@ -143,6 +143,12 @@ def method_description(name: str) -> str:
     return CONTROLLERS.describe(name)
 
 
+def controller_traits(name: str) -> dict[str, Any]:
+    """The registered traits of controller ``name`` (``tasks``, ``interfaces``,
+    ``arbiter``; see :mod:`ddwmmr.registry`)."""
+    return CONTROLLERS.traits(name)
+
+
 def controller_class(name: str) -> type:
     """The class registered as ``name``; an unknown name is a :class:`ParameterError`."""
     return CONTROLLERS.load(name)

@@ -59,6 +59,7 @@ from ddwmmr.controllers.base import (
     WaypointRun,
     available_controllers,
     controller_class,
+    controller_traits,
     make_controller,
 )
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
@@ -67,7 +68,7 @@ from ddwmmr.model.stability import stability_terms
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
 from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
-from ddwmmr.registry import CONTROLLERS, PLANTS
+from ddwmmr.registry import PLANTS
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.loop import run_loop
 
@@ -155,7 +156,7 @@ class RunConfig:
         accepted = plants_for(self.controller)
         if self.plant not in accepted:
             sends = " or ".join(
-                SENDS.get(i, i) for i in CONTROLLERS.traits(self.controller)["interfaces"]
+                SENDS.get(i, i) for i in controller_traits(self.controller)["interfaces"]
             )
             raise ParameterError(
                 f"plant: the {self.controller} controller outputs {sends} and needs a plant "
@@ -445,7 +446,7 @@ def scenario_controllers() -> list[str]:
 
 def plants_for(controller: str) -> list[str]:
     """The registered plants that take a command interface ``controller`` can send."""
-    interfaces = CONTROLLERS.traits(controller)["interfaces"]
+    interfaces = controller_traits(controller)["interfaces"]
     return [p for p in available_plants() if set(interfaces) & set(PLANTS.traits(p)["interfaces"])]
 
 
@@ -457,7 +458,7 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
     # Start at the origin heading +x in the thesis's default pose (the pose it drives in).
     q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
     # A controller with an arbiter reports the arbiter's state; the others have none.
-    has_states = CONTROLLERS.traits(config.controller)["arbiter"]
+    has_states = controller_traits(config.controller)["arbiter"]
     tally = _Tally(robot, scenario, config)
     task = WaypointTask(tally, controller, has_states, plant)
     end = run_loop(plant, controller, task, q0, config.dt, tally.steps)
