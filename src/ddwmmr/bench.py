@@ -59,6 +59,7 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import u_from_qdot
+from ddwmmr.model.stability import STABILITY_FLOOR
 from ddwmmr.outputs import check_output_file, check_writable
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.sim import simulate
@@ -415,7 +416,7 @@ def _near_floor(robot: Robot, options: dict[str, Any], call: tuple) -> bool:
     from ddwmmr.qp.limits import exact_stability
 
     q = call[1]
-    floor = options.get("stability_min", 1.25)
+    floor = options.get("stability_min", STABILITY_FLOOR)
     return exact_stability(robot.com_coefficients, float(q[3]), float(q[4])) < floor + 0.05
 
 

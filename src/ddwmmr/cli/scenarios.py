@@ -21,11 +21,12 @@ import math
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import asdict, replace
+from dataclasses import asdict, astuple, replace
 from pathlib import Path
 from typing import Any
 
 from ddwmmr.arbiters import ARBITERS
+from ddwmmr.arbiters.state_machine import THESIS_MANIPULABILITY, THESIS_STABILITY
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.cli import provenance
 from ddwmmr.cli.common import (
@@ -47,7 +48,7 @@ from ddwmmr.errors import (
     check_step_count,
 )
 from ddwmmr.model import Robot
-from ddwmmr.model.stability import STABILITY_CAP
+from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR, valid_stability_floor
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.executors import EXECUTORS, default_jobs, run_many
@@ -67,7 +68,7 @@ MAX_DT = 0.1
 QP_OPTIONS = {
     "qp_stability_min": (
         ("qp", "mpc"),
-        lambda v: 0.0 < v < STABILITY_CAP,
+        valid_stability_floor,
         f"(0, {STABILITY_CAP:g})",
     ),
     "qp_max_speed": (("qp",), lambda v: 0.0 < v <= MAX_QP_SPEED, f"(0, {MAX_QP_SPEED:g}] m/s"),
@@ -75,7 +76,10 @@ QP_OPTIONS = {
 #: Largest threshold: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
 THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}
 #: The thesis's thresholds (enter, exit), the defaults of --stability and --manipulability.
-DEFAULT_THRESHOLDS = {"stability": (1.25, 1.60), "manipulability": (0.75, 0.90)}
+DEFAULT_THRESHOLDS = {
+    "stability": astuple(THESIS_STABILITY),
+    "manipulability": astuple(THESIS_MANIPULABILITY),
+}
 
 DESCRIPTION = """\
 Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly (seeded) in
@@ -162,7 +166,7 @@ def build_parser() -> ArgumentParser:
         default=None,
         metavar=("ENTER", "EXIT"),
         help="thesis controller's stability thresholds: enter below ENTER, leave at EXIT "
-        "(default: 1.25 1.60)",
+        f"(default: {THESIS_STABILITY.enter:.2f} {THESIS_STABILITY.exit:.2f})",
     )
     parser.add_argument(
         "--manipulability",
@@ -170,7 +174,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar=("ENTER", "EXIT"),
-        help="thesis controller's manipulability thresholds (default: 0.75 0.90)",
+        help="thesis controller's manipulability thresholds "
+        f"(default: {THESIS_MANIPULABILITY.enter:.2f} {THESIS_MANIPULABILITY.exit:.2f})",
     )
     parser.add_argument(
         "--no-hysteresis",
@@ -225,7 +230,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar="S",
-        help="hard stability bound of the qp and mpc controllers, in (0, 10) (default: 1.25)",
+        help=f"hard stability bound of the qp and mpc controllers, in (0, {STABILITY_CAP:g}) "
+        f"(default: {STABILITY_FLOOR:g})",
     )
     parser.add_argument(
         "--qp-max-speed",

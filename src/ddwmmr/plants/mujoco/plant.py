@@ -43,7 +43,7 @@ from ddwmmr.plants.mujoco.model import (
     supports,
 )
 from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
-from ddwmmr.plants.thesis import ThesisPlant, arm_step, damped_base_envelope
+from ddwmmr.plants.thesis import arm_step, damped_base_envelope
 
 #: Time (s) the robot settles on its supports in :meth:`MujocoPlant.reset` before t = 0,
 #: so that the first recorded contact forces carry the robot's weight.
@@ -215,7 +215,7 @@ class MujocoPlant:
             self.base_damping[1],
             float(np.sum(self.model.body_mass)),
             self.wheel_lever,
-            ThesisPlant(robot).inertia(0.0, 0.0),
+            robot.yaw_inertia.at(0.0),
             fraction,
             speed_budget=True,
         )

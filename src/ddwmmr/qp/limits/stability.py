@@ -18,8 +18,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from ddwmmr.errors import ParameterError, check_positive
-from ddwmmr.model.stability import STABILITY_CAP, ComCoefficients, stability_terms
+from ddwmmr.errors import check_positive
+from ddwmmr.model.stability import (
+    STABILITY_CAP,
+    STABILITY_FLOOR,
+    ComCoefficients,
+    check_stability_floor,
+    stability_terms,
+)
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
@@ -137,17 +143,13 @@ class StabilityLimit(Limit):
     def __init__(
         self,
         robot_com: ComCoefficients,
-        stability_min: float = 1.25,
+        stability_min: float = STABILITY_FLOOR,
         gain: float = 5.0,
         margin: float = 0.01,
         joint_speed: float = 2.0,
     ) -> None:
         self.com = robot_com
-        self.stability_min = check_positive("stability_min", stability_min)
-        if self.stability_min >= STABILITY_CAP:
-            raise ParameterError(
-                f"stability_min must be in (0, {STABILITY_CAP:g}) (got {stability_min:g})"
-            )
+        self.stability_min = check_stability_floor(stability_min)
         self.gain = check_positive("stability gain", gain)
         self.margin = check_positive("stability margin", margin)
         self.joint_speed = check_positive("joint speed", joint_speed)
