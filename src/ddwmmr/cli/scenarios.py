@@ -37,6 +37,7 @@ from ddwmmr.cli.common import (
     output_folder,
     run_main,
 )
+from ddwmmr.commands import traits_of
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
@@ -53,7 +54,15 @@ from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.executors import EXECUTORS, default_jobs, run_many
 from ddwmmr.scenarios.generator import Scenario, generate
-from ddwmmr.scenarios.protocol import CONTROLLERS, PLANTS, Outcome, RunConfig, run_scenario
+from ddwmmr.scenarios.protocol import (
+    CONTROLLERS,
+    PLANTS,
+    Outcome,
+    RunConfig,
+    make_mpc,
+    make_scenario_plant,
+    run_scenario,
+)
 from ddwmmr.sim.result import json_safe, write_atomic
 
 #: The batch summary (holds the run record: everything needed to repeat the batch).
@@ -504,6 +513,8 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         scenarios = studies.obstacle_scenarios(scenarios)
     outcomes, wall = runner.run(scenarios, config, "scenarios")
     extra = {"seed": args.seed, "run": _record(args, config)}
+    if config.controller == "mpc":
+        extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
@@ -511,6 +522,19 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         f"({runner.jobs} {args.executor} workers)",
         file=sys.stderr,
     )
+
+
+def mpc_options(config: RunConfig, scenario: Scenario) -> dict[str, Any]:
+    """The ``mpc``'s options as the batch's runs use them, whole: resolved for the batch's
+    plant (:meth:`~ddwmmr.mpc.options.MPCOptions.adopt_plant`), in waypoint mode, without
+    the obstacles (each scenario's own); ``summary.json["controller_options"]``."""
+    robot = config_robot(config)
+    plant = make_scenario_plant(robot, config)
+    controller = make_mpc(robot, scenario, config, plant)
+    controller.adopt_plant(traits_of(plant))
+    record = controller.resolved.record("reach", config.dt)
+    del record["obstacles"]
+    return record
 
 
 def _run_thresholds(args, config, runner, folder: Path) -> None:
