@@ -21,12 +21,13 @@ import math
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import asdict, replace
+from dataclasses import asdict, astuple, replace
 from pathlib import Path
 from typing import Any
 
 from ddwmmr import provenance
 from ddwmmr.arbiters import DEFAULT_ARBITER, arbiter_description, available_arbiters
+from ddwmmr.arbiters.state_machine import THESIS_MANIPULABILITY, THESIS_STABILITY
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.cli.common import (
     ArgumentParser,
@@ -36,6 +37,7 @@ from ddwmmr.cli.common import (
     output_folder,
     run_main,
 )
+from ddwmmr.commands import traits_of
 from ddwmmr.controllers import controller_traits, method_description
 from ddwmmr.errors import (
     MASS_RANGE_KG,
@@ -48,7 +50,7 @@ from ddwmmr.errors import (
     check_step_count,
 )
 from ddwmmr.model import Robot
-from ddwmmr.model.stability import STABILITY_CAP
+from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR, valid_stability_floor
 from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
@@ -77,7 +79,7 @@ MAX_DT = 0.1
 QP_OPTIONS = {
     "qp_stability_min": (
         ("qp", "mpc"),
-        lambda v: 0.0 < v < STABILITY_CAP,
+        valid_stability_floor,
         f"(0, {STABILITY_CAP:g})",
     ),
     "qp_max_speed": (("qp",), lambda v: 0.0 < v <= MAX_QP_SPEED, f"(0, {MAX_QP_SPEED:g}] m/s"),
@@ -85,7 +87,10 @@ QP_OPTIONS = {
 #: Largest threshold: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
 THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}
 #: The thesis's thresholds (enter, exit), the defaults of --stability and --manipulability.
-DEFAULT_THRESHOLDS = {"stability": (1.25, 1.60), "manipulability": (0.75, 0.90)}
+DEFAULT_THRESHOLDS = {
+    "stability": astuple(THESIS_STABILITY),
+    "manipulability": astuple(THESIS_MANIPULABILITY),
+}
 
 DESCRIPTION = """\
 Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly (seeded) in
@@ -176,7 +181,7 @@ def build_parser() -> ArgumentParser:
         default=None,
         metavar=("ENTER", "EXIT"),
         help="thesis controller's stability thresholds: enter below ENTER, leave at EXIT "
-        "(default: 1.25 1.60)",
+        f"(default: {THESIS_STABILITY.enter:.2f} {THESIS_STABILITY.exit:.2f})",
     )
     parser.add_argument(
         "--manipulability",
@@ -184,7 +189,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar=("ENTER", "EXIT"),
-        help="thesis controller's manipulability thresholds (default: 0.75 0.90)",
+        help="thesis controller's manipulability thresholds "
+        f"(default: {THESIS_MANIPULABILITY.enter:.2f} {THESIS_MANIPULABILITY.exit:.2f})",
     )
     parser.add_argument(
         "--no-hysteresis",
@@ -239,7 +245,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar="S",
-        help="hard stability bound of the qp and mpc controllers, in (0, 10) (default: 1.25)",
+        help=f"hard stability bound of the qp and mpc controllers, in (0, {STABILITY_CAP:g}) "
+        f"(default: {STABILITY_FLOOR:g})",
     )
     parser.add_argument(
         "--qp-max-speed",
@@ -513,6 +520,8 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         scenarios = studies.obstacle_scenarios(scenarios)
     outcomes, wall = runner.run(scenarios, config, "scenarios")
     extra = {"seed": args.seed, "run": _record(args, config)}
+    if config.controller == "mpc":
+        extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
@@ -520,6 +529,19 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         f"({runner.jobs} {args.executor} workers)",
         file=sys.stderr,
     )
+
+
+def mpc_options(config: RunConfig, scenario: Scenario) -> dict[str, Any]:
+    """The ``mpc``'s options as the batch's runs use them, whole: resolved for the batch's
+    plant (:meth:`~ddwmmr.mpc.options.MPCOptions.adopt_plant`), in waypoint mode, without
+    the obstacles (each scenario's own); ``summary.json["controller_options"]``."""
+    robot = config_robot(config)
+    plant = make_scenario_plant(robot, config)
+    controller = make_scenario_controller(robot, scenario, config, plant)
+    controller.adopt_plant(traits_of(plant))
+    record = controller.resolved.record("reach", config.dt)
+    del record["obstacles"]
+    return record
 
 
 def _run_thresholds(args, config, runner, folder: Path) -> None:

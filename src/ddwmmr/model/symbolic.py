@@ -214,22 +214,9 @@ class ThesisDynamics:
         """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``;
         ``half_width`` (m) is the wheels' lever about the base centre, by default the
         thesis plant's ``robot.base_width / 2``."""
-        m1, m2 = robot.link_masses
-        mp, L1, L2 = robot.payload, robot.L1, robot.L2
-        # Yaw inertia about the base centre: each link a rod about its own centre plus the
-        # parallel-axis term of its midpoint, the payload a point at the end effector. The
-        # squared distances of link-2's midpoint and of the end effector from the base
-        # centre are L1^2 + L2^2/4 + L1 L2 cos th2 and L1^2 + L2^2 + 2 L1 L2 cos th2.
-        fixed = (
-            robot.base_inertia
-            + m1 * L1**2 / 12.0
-            + m2 * L2**2 / 12.0
-            + m1 * (L1 / 2.0) ** 2
-            + m2 * (L1**2 + L2**2 / 4.0)
-            + mp * (L1**2 + L2**2)
-        )
+        inertia = robot.yaw_inertia  # the collected form I(th2) = fixed + cos * cos th2
         return cls(
-            mass=robot.base_mass + m1 + m2 + mp,
+            mass=robot.total_mass,
             c1=check_nonnegative("c1", c1),  # 0: an undamped base (the physics plant)
             c2=check_nonnegative("c2", c2),
             force_limit=check_positive("force_limit", force_limit),
@@ -239,10 +226,10 @@ class ThesisDynamics:
                 if half_width is None
                 else check_positive("half_width", half_width)
             ),
-            inertia_fixed=fixed,
-            inertia_cos=(m2 + 2.0 * mp) * L1 * L2,
-            shoulder_fixed=m1 * L1**2 / 3.0 + (m2 + mp) * L1**2,
-            elbow_fixed=m2 * L2**2 / 3.0 + mp * L2**2,
+            inertia_fixed=inertia.fixed,
+            inertia_cos=inertia.cos,
+            shoulder_fixed=inertia.shoulder,
+            elbow_fixed=inertia.elbow,
         )
 
     # -- numbers ------------------------------------------------------------------------

@@ -223,7 +223,7 @@ def _base_inertia_diagonal(robot: Robot) -> tuple[float, float, float]:
     The box values are raised where needed so that the triangle inequalities hold (a real
     body); the yaw value is never changed.
     """
-    mass = robot.base_mass - 2.0 * robot.wheel_mass
+    mass = robot.base_body_mass
     length, width, height = robot.base_length, robot.base_width, robot.base_height
     ixx = mass * (width**2 + height**2) / 12.0
     iyy = mass * (length**2 + height**2) / 12.0
@@ -255,11 +255,9 @@ def reflected_inertias(robot: Robot) -> tuple[float, float, float]:
     """
     m1, m2 = robot.link_masses
     p, l1, l2, r = robot.payload, robot.L1, robot.L2, robot.wheel_radius
-    total = robot.base_mass + m1 + m2 + p
-    wheel = 0.5 * total * r * r + _wheel_inertia(robot)[0]
+    wheel = 0.5 * robot.total_mass * r * r + _wheel_inertia(robot)[0]
     shoulder = m1 * l1**2 / 3.0 + m2 * (l2**2 / 12.0 + (l1 + 0.5 * l2) ** 2) + p * (l1 + l2) ** 2
-    elbow = m2 * l2**2 / 3.0 + p * l2**2
-    return wheel, shoulder, elbow
+    return wheel, shoulder, robot.yaw_inertia.elbow
 
 
 def servo_gains(robot: Robot, time_constant: float) -> tuple[float, float, float]:
@@ -317,7 +315,7 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
     base = _sub(world, "body", name="base", pos=_fmt(0, 0, r))
     _sub(base, "freejoint", name="base")
     box_z = BASE_CLEARANCE + 0.5 * robot.base_height - r
-    base_mass = robot.base_mass - 2.0 * robot.wheel_mass
+    base_mass = robot.base_body_mass
     _sub(
         base,
         "inertial",
