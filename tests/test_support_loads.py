@@ -1,8 +1,9 @@
 """Edge loads of the support polygon (model/support_loads.py): at rest against the static
 margin S, in motion against the moment balance of the lumped masses from first principles,
-the CasADi twin against the numeric one."""
+the CasADi twin against the numeric one, and (tests below) against MuJoCo's contact forces."""
 
 import math
+import sys
 
 import casadi as ca
 import numpy as np
@@ -208,3 +209,144 @@ def test_a_robot_with_its_own_casters():
         polygon = model.polygon
         distances = polygon.distances([(x, y)])[0]
         assert loads == pytest.approx(model.weight * distances / polygon.depths, abs=1e-9)
+
+
+# -- against MuJoCo's contact forces -------------------------------------------------------
+def _study():
+    import importlib.util
+    from pathlib import Path
+
+    script = Path(__file__).resolve().parents[1] / "docs" / "support_loads.py"
+    spec = importlib.util.spec_from_file_location("support_loads_study", script)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # its dataclasses look their module up
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def study():
+    return _study()
+
+
+@pytest.fixture(scope="module")
+def turn(study):
+    return study.fast_turn()
+
+
+def test_the_recording_plant_runs_as_the_plant_does(study):
+    from ddwmmr.plants.mujoco import MujocoPlant
+
+    plants = [
+        MujocoPlant(ROBOT, base_damping=study.DAMPING),
+        study.RecordingPlant(ROBOT, base_damping=study.DAMPING),
+    ]
+    for plant in plants:
+        plant.reset(np.array([0.0, 0.0, 0.0, *study.TURN_POSE]), study.TURN_DT)
+        for k in range(200):
+            t = k * study.TURN_DT
+            applied, _ = plant.limit(plant.observe().q, study.turn_command(t))
+            plant.step(t, applied, study.TURN_DT)
+    assert np.array_equal(plants[0].data.qpos, plants[1].data.qpos)
+    assert plants[0].unloaded_time_s == plants[1].unloaded_time_s
+
+
+def test_replays_repeat_the_run(study, turn):
+    """The recorded actuator controls replayed open loop give the same run bit for bit; a
+    stretch replayed from the recorded engine state gives the same contact forces (the
+    solver's warm start aside, to 1e-9 N)."""
+    run = {"record": turn, "mode": "velocity"}
+    again = study.replay(run, q0=np.array([0.0, 0.0, 0.0, *study.TURN_POSE]))
+    assert np.array_equal(again["off"], turn["off"])
+    assert np.array_equal(again["measured_inside"], turn["measured_inside"])
+    stretch = study.replay_from(turn, 300, 50, "velocity")
+    assert np.max(np.abs(stretch["measured_inside"] - turn["measured_inside"][300:350])) < 1e-9
+
+
+def test_the_model_predicts_mujocos_edge_loads_in_a_fast_turn(study, turn):
+    """The fast turn with the payload out (docs/physics.md, "Support loads while moving"):
+    per edge, the model with the measured motion against the contact forces, both
+    averaged over each control step. Measured: median 0.6-1.4 N, 95th percentile 6-9 N
+    (the weight is 147 N); the static model (the weight at the centre of mass) is off by
+    3-4.5 N in the median and 12-17 N at the 95th percentile."""
+    errors = study.prediction_errors(turn)
+    model, static = np.abs(errors["mean"]), np.abs(errors["static"])
+    assert np.all(np.median(model, axis=0) <= 2.0), np.median(model, axis=0)
+    assert np.all(np.percentile(model, 95, axis=0) <= 11.0), np.percentile(model, 95, axis=0)
+    assert np.all(np.median(model, axis=0) <= 0.5 * np.median(static, axis=0))
+    # the run is dynamic: the light side's measured load swings by more than 40 N, and the
+    # model sees it unloaded where the static load never falls below the S floor's 14.7 N
+    light = study.EDGES.index("left")
+    measured = turn["measured_inside"].mean(axis=1)[:, light]
+    assert measured.max() - measured.min() > 40.0
+    assert study.static_loads(turn["motion"])[:, light].min() > 14.0
+    assert study.predicted_loads(turn["motion"])[:, light].min() < 2.0
+
+
+def test_front_and_back_errors_are_the_plants_damping_at_the_axle(study, turn):
+    """The plant applies the base damping c1 v at the base's frame, the axle's height r,
+    not at the floor: a pitch moment c1 v r the robot's model does not have, ``c1 r /
+    (base_length)`` = 3.25 N per m/s on the front and back edges (measured: 3.0)."""
+    errors = study.prediction_errors(turn)["mean"]
+    v = turn["v"]
+    expected = study.DAMPING[0] * ROBOT.wheel_radius / ROBOT.base_length
+    for edge, sign in (("front", -1.0), ("back", 1.0)):
+        slope = np.polyfit(v, errors[:, study.EDGES.index(edge)], 1)[0]
+        assert sign * slope == pytest.approx(expected, rel=0.15)
+
+
+def test_the_load_parts_sum_to_the_dynamic_loads(study):
+    motions = _motions(50)
+    parts = study.load_parts(motions)
+    total = sum(parts.values())
+    dynamic = study.predicted_loads(motions) - study.static_loads(motions)
+    assert np.max(np.abs(total - dynamic)) <= 1e-9 * MODEL.weight
+    # each part alone: a pure forward acceleration is all "forward acceleration"
+    still = np.zeros((1, 10))
+    still[0, :2] = (0.4, 1.1)
+    pushed = still.copy()
+    pushed[0, 6] = 2.0
+    alone = study.load_parts(pushed)
+    expected = study.predicted_loads(pushed) - study.predicted_loads(still)
+    assert alone["forward acceleration"] == pytest.approx(expected, abs=1e-12)
+    assert all(np.all(alone[p] == 0.0) for p in study.PARTS if p != "forward acceleration")
+
+
+def test_each_unloaded_step_gets_one_cause(study):
+    """Four unloaded steps built to be static, inertial (the arm), a lift and chatter, and
+    one loaded step that is not counted."""
+    weight, substeps = MODEL.weight, 5
+    right = study.EDGES.index("right")
+
+    def step(th2, acc1, measured_mean):
+        motion = np.zeros((substeps, 10))
+        motion[:, 0], motion[:, 1], motion[:, 4] = -0.5 * math.pi, th2, acc1
+        measured = np.full((substeps, 4), 70.0)
+        measured[:, right] = measured_mean
+        off = np.full(4, 70.0)
+        off[right] = 0.0  # the plant's reading at the step's end: unloaded
+        return motion, measured, off
+
+    rows = [
+        step(0.0, 0.0, 0.0),  # arm stretched to the right: static S = 1
+        step(1.2, 60.0, 0.0),  # folded, S 1.34, but the shoulder accelerates hard
+        step(1.2, 0.0, 0.0),  # folded, still: the side carried nothing all step
+        step(1.2, 0.0, 20.0),  # folded, still: 20 N on average, nothing at the end
+    ]
+    loaded = step(1.2, 0.0, 20.0)
+    rows.append((loaded[0], loaded[1], np.full(4, 70.0)))
+    record = {
+        "motion_inside": np.array([r[0] for r in rows]),
+        "measured_inside": np.array([r[1] for r in rows]),
+        "off": np.array([r[2] for r in rows]),
+        "motion": np.array([r[0][-1] for r in rows]),
+    }
+    attribution = study.Attribution()
+    study.classify(record, study.DELTA_SHARE * weight, attribution)
+    dt = study.SCENARIO_DT
+    assert attribution.steps == 5
+    assert attribution.unloaded == pytest.approx(
+        {"static": dt, "inertial": dt, "lift": dt, "chatter": dt}
+    )
+    assert attribution.parts["arm acceleration"] == pytest.approx(dt)
+    assert attribution.edges["right"] == pytest.approx(4 * dt)
