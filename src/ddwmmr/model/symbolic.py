@@ -2,7 +2,8 @@
 
 One home for every symbolic formula the optimisation-based code needs (the MPC, the
 minimum-time study). The numeric twins are :mod:`ddwmmr.model.kinematics`,
-:mod:`ddwmmr.model.stability` and :class:`ddwmmr.plants.thesis.ThesisPlant`; the tests
+:mod:`ddwmmr.model.stability`, :mod:`ddwmmr.model.support_loads` and
+:class:`ddwmmr.plants.thesis.ThesisPlant`; the tests
 check values and derivatives against them.
 
 Frames and units (SPEC §1): configuration ``q = [x, y, phi, th1, th2]`` (world frame; m, m,
@@ -36,6 +37,7 @@ import casadi as ca
 
 from ddwmmr.errors import check_nonnegative, check_positive
 from ddwmmr.model import Robot, stability
+from ddwmmr.model.support_loads import EdgeLoadModel
 from ddwmmr.model.thesis_base import (
     C1_DEFAULT,
     C2_DEFAULT,
@@ -136,6 +138,34 @@ def zero_moment_point(
         sin=ca.sin,
     )
     return ca.vertcat(*point)
+
+
+def edge_loads(
+    robot: Robot,
+    q: Symbolic,
+    rates: Symbolic,
+    accelerations: Symbolic,
+    base_acceleration: Symbolic,
+    w: Symbolic,
+    w_dot: Symbolic,
+) -> Symbolic:
+    """Normal loads (N) on the edges of the support polygon, one per edge: the formula of
+    :meth:`ddwmmr.model.support_loads.EdgeLoadModel.loads` built symbolically (joint
+    rates rad/s and accelerations rad/s^2, the axle midpoint's acceleration ``(a_x, a_y)``
+    m/s^2 in the base frame, the yaw rate and its rate)."""
+    model = EdgeLoadModel.from_robot(robot)
+    loads = model.loads(
+        q[3],
+        q[4],
+        (rates[0], rates[1]),
+        (accelerations[0], accelerations[1]),
+        (base_acceleration[0], base_acceleration[1]),
+        w,
+        w_dot,
+        cos=ca.cos,
+        sin=ca.sin,
+    )
+    return ca.vertcat(*loads)
 
 
 def manipulability(q: Symbolic) -> Symbolic:

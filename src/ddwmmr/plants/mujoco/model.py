@@ -48,6 +48,7 @@ import numpy as np
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import BASE_CLEARANCE_M
+from ddwmmr.model.support_loads import convex_hull
 
 #: Radius of the caster spheres (m).
 CASTER_RADIUS = 0.025
@@ -135,31 +136,6 @@ def supports(robot: Robot) -> tuple[Support, ...]:
         names = [f"caster_{i}" for i in range(1, len(robot.casters) + 1)]
     casters = tuple(Support(n, tuple(p), "caster") for n, p in zip(names, robot.casters))
     return wheels + casters
-
-
-def convex_hull(points) -> np.ndarray:
-    """Vertices (k, 2) of the convex hull of 2-D points, counter-clockwise (monotone chain).
-
-    Points on an edge are dropped; fewer than 3 non-collinear points give a degenerate hull
-    (fewer than 3 vertices).
-    """
-    pts = sorted({(float(x), float(y)) for x, y in points})
-    if len(pts) < 3:
-        return np.array(pts, dtype=float).reshape(-1, 2)
-
-    def cross(o, a, b) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    def chain(seq):
-        out: list[tuple[float, float]] = []
-        for p in seq:
-            while len(out) >= 2 and cross(out[-2], out[-1], p) <= 1e-12:
-                out.pop()
-            out.append(p)
-        return out
-
-    lower, upper = chain(pts), chain(reversed(pts))
-    return np.array(lower[:-1] + upper[:-1], dtype=float)
 
 
 def support_polygon(robot: Robot) -> np.ndarray:
