@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from typing import Any
 
 from ddwmmr.errors import ParameterError
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import Outcome, RunConfig, run_scenario
+from ddwmmr.workers import process_pool
 
 EXECUTORS = ("local", "dask")
 #: One task = (configuration, scenarios) -> outcomes.
@@ -81,7 +82,7 @@ def run_many(
 
 def _run_pool(chunks, config, jobs, on_done) -> list[list[Outcome]]:
     results: list[list[Outcome] | None] = [None] * len(chunks)
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
+    with process_pool(jobs) as pool:
         futures = {pool.submit(run_chunk, config, c): i for i, c in enumerate(chunks)}
         for future in as_completed(futures):
             i = futures[future]
