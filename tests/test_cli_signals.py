@@ -176,3 +176,25 @@ def test_pool_workers_end_with_their_parent(tmp_path, mechanism):
         for pid in workers:
             if alive(pid):
                 os.kill(pid, signal.SIGKILL)
+
+
+def test_the_next_run_removes_a_killed_runs_staging_folder(tmp_path):
+    process = start("track", tmp_path)
+    try:
+        wait_for(lambda: staging(tmp_path) or process.poll() is not None)
+        left = staging(tmp_path)
+        process.kill()
+        process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert [p.name for p in staging(tmp_path)] == [p.name for p in left]  # nobody cleaned up
+    again = subprocess.run(
+        [sys.executable, "-m", "ddwmmr.track", "--method", "ats", "--traj", "ellipse",
+         "--duration", "0.2", "--no-plots", "--no-progress", "--out", str(tmp_path / "out")],
+        cwd=tmp_path, capture_output=True, text=True, timeout=120,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+    )  # fmt: skip
+    assert again.returncode == 0, again.stderr
+    notes = [line for line in again.stderr.splitlines() if line.startswith("note: removed")]
+    assert len(notes) == 1 and left[0].name in notes[0], again.stderr
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]
