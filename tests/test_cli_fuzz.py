@@ -238,6 +238,19 @@ CASES += [
     ("bench", ["--method", "nope"], "unknown method 'nope'"),
 ]
 
+#: Dask scheduler options (the addresses of servers the tests start: see below).
+DASK = ["--executor", "dask", "--connect-timeout", "1", "--scheduler"]
+CASES += [
+    ("scenarios", ["--connect-timeout", "5"], "connect-timeout: only used with --scheduler"),
+    ("scenarios", [*DASK[:2], "--connect-timeout", "0", "--scheduler", "tcp://127.0.0.1:1"],
+     "connect-timeout must be in (0, 600] s"),
+    ("scenarios", [*DASK[:2], "--connect-timeout", "nan", "--scheduler", "tcp://127.0.0.1:1"],
+     "connect-timeout must be a finite number"),
+    ("scenarios", [*DASK[:2], "--connect-timeout", "1e9", "--scheduler", "tcp://127.0.0.1:1"],
+     "connect-timeout must be in (0, 600] s"),
+    ("scenarios", [*DASK, "tcp://127.0.0.1:1"], "no Dask scheduler answered"),
+]  # fmt: skip
+
 
 @pytest.fixture
 def workdir(tmp_path, monkeypatch) -> dict[str, str]:
@@ -394,3 +407,84 @@ def test_as_a_module_one_line_and_no_traceback(workdir, tool, args):
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
     assert not Path("runs").exists()
+
+
+# -- Dask scheduler addresses: servers on 127.0.0.1 that are not Dask schedulers ------------
+class _Listeners:
+    """TCP servers on 127.0.0.1 (ephemeral ports): one that accepts and never answers, an
+    HTTP server, and two that answer garbage (a huge frame length, a bad header)."""
+
+    def __init__(self) -> None:
+        import http.server
+        import socket
+        import threading
+
+        self._sockets: list[socket.socket] = []
+        self._held: list[socket.socket] = []
+        self.silent = self._serve(lambda conn: self._held.append(conn))
+        self.ascii = self._serve(lambda conn: conn.sendall(b"1" * 4096))  # 3.07 EiB frame
+        self.binary = self._serve(lambda conn: conn.sendall(b"\xff" * 64 + b"garbage" * 64))
+
+        class Quiet(http.server.SimpleHTTPRequestHandler):
+            def log_message(self, *args) -> None:  # the tool's stderr is under test
+                pass
+
+        self._http = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Quiet)
+        threading.Thread(target=self._http.serve_forever, daemon=True).start()
+        self.http = self._http.server_address[1]
+
+    def _serve(self, answer) -> int:
+        import socket
+        import threading
+
+        server = socket.create_server(("127.0.0.1", 0))
+        self._sockets.append(server)
+
+        def accept() -> None:
+            while True:
+                try:
+                    conn, _ = server.accept()
+                    answer(conn)
+                except OSError:
+                    return
+
+        threading.Thread(target=accept, daemon=True).start()
+        return server.getsockname()[1]
+
+    def close(self) -> None:
+        self._http.shutdown()
+        self._http.server_close()
+        for sock in self._sockets + self._held:
+            sock.close()
+
+
+@pytest.fixture(scope="module")
+def listeners():
+    servers = _Listeners()
+    yield servers
+    servers.close()
+
+
+SCHEDULER_CASES = [
+    ("tcp://127.0.0.1:{silent}", "no Dask scheduler answered at 'tcp://127.0.0.1:"),
+    ("tcp://127.0.0.1:{http}", "no Dask scheduler answered"),
+    ("tcp://127.0.0.1:{ascii}", "cannot connect to 'tcp://127.0.0.1:"),
+    ("tcp://127.0.0.1:{binary}", "cannot connect to 'tcp://127.0.0.1:"),
+    ("tls://127.0.0.1:{silent}", "cannot connect to 'tls://127.0.0.1:"),
+    ("ucx://127.0.0.1:{silent}", "cannot connect to 'ucx://127.0.0.1:"),
+    ("http://127.0.0.1:{http}", "unknown address scheme 'http'"),
+    ("127.0.0.1", "missing port number"),
+]
+
+
+@pytest.mark.parametrize(("address", "text"), SCHEDULER_CASES, ids=[a for a, _ in SCHEDULER_CASES])
+def test_a_scheduler_address_that_is_not_a_scheduler(workdir, listeners, capsys, address, text):
+    """Checked before the output exists, within --connect-timeout: one line, exit 2."""
+    cwd = Path.cwd()
+    before = tree(cwd)
+    ports = {"silent": listeners.silent, "http": listeners.http,
+             "ascii": listeners.ascii, "binary": listeners.binary}  # fmt: skip
+    status, err = run_bad("scenarios", [*DASK, address.format(**ports)], capsys)
+    assert status == 2, err
+    assert len(err.strip().splitlines()) == 1 and text in err, err
+    assert tree(cwd) == before

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import logging
 import multiprocessing
 import os
 import re
@@ -93,7 +94,11 @@ class Terminated(BaseException):
 
 
 def stop_workers(timeout: float = 2.0) -> None:
-    """Stop the worker processes this process started (process pools, Dask's nannies)."""
+    """Stop the worker processes this process started (process pools, Dask's nannies).
+
+    Dask's scheduler and nannies in this process would log each lost worker: the tool
+    says one line for the stop, so their logs are silenced first."""
+    logging.getLogger("distributed").setLevel(logging.CRITICAL + 1)
     children = multiprocessing.active_children()
     for child in children:
         child.terminate()
