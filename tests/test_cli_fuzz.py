@@ -76,7 +76,18 @@ FILES = {
     "obstacle_huge.toml": b"[[obstacle]]\nx = 5.0\ny = 0.0\nradius = 5000.0\n",
     "obstacles_text.toml": b'[[obstacle]]\nx = "1"\ny = 0.0\nradius = 0.3\n',
     "a_file.txt": b"not a folder\n",
+    # 10 kB of nested arrays, inline tables nested 500 deep: the parser recurses per level
+    "robot_deep_array.toml": b"L1 = " + b"[" * 5000 + b"]" * 5000 + b"\n",
+    "robot_deep_tables.toml": b"L1 = " + b"{a = " * 500 + b"1" + b"}" * 500 + b"\n",
+    "robot_deep_parsed.toml": b"L1 = " + b"[" * 100 + b"]" * 100 + b"\n",  # parses, too deep
+    "traj_deep.toml": b'shape = "ellipse"\na = ' + b"[" * 5000 + b"]" * 5000 + b"\n",
+    "obstacles_deep.toml": b"[[obstacle]]\nx = 1.0\ny = 0.0\nradius = "
+    + b"{r = " * 500
+    + b"0.3"
+    + b"}" * 500
+    + b"\n",
 }
+TOO_DEEP = "nests arrays or tables more than 32 levels deep"
 
 # (tool, arguments, text the one line must contain)
 ROBOT_CASES = [
@@ -91,6 +102,9 @@ ROBOT_CASES = [
     (["--robot", "{robot_payload_nan.toml}"], "payload must be a finite number"),
     (["--robot", "{robot_unknown.toml}"], "unknown parameter 'arm_length'"),
     (["--robot", "{robot_bad.toml}"], "is not valid TOML"),
+    (["--robot", "{robot_deep_array.toml}"], TOO_DEEP),
+    (["--robot", "{robot_deep_tables.toml}"], TOO_DEEP),
+    (["--robot", "{robot_deep_parsed.toml}"], TOO_DEEP),
     (["--robot", "{fifo}"], "is not a regular file"),
     (["--robot", "{inputs}"], "is not a regular file"),
     (["--robot", "missing.toml"], "cannot read missing.toml"),
@@ -121,6 +135,7 @@ TRAJ_CASES = [
     ("sub/figure8", "neither a trajectory name"),
     ("nowhere", "unknown trajectory 'nowhere'"),
     ("missing.csv", "no such file missing.csv"),
+    ("{traj_deep.toml}", TOO_DEEP),
 ]
 OUT_CASES = [
     ("{a_file.txt}/out", "is not a folder"),
@@ -152,6 +167,7 @@ CASES += [
     ("track", ["--method", "qp", "--obstacles", "{obstacle_at_start.toml}"], "overlaps the rob"),
     ("track", ["--method", "qp", "--obstacles", "{obstacle_far.toml}"], "obstacle x must be in"),
     ("track", ["--method", "qp", "--obstacles", "{obstacle_huge.toml}"], "radius must be in"),
+    ("track", ["--method", "qp", "--obstacles", "{obstacles_deep.toml}"], TOO_DEEP),
 ]
 CASES += [("compare", ["--only", traj], text) for traj, text in TRAJ_CASES[:4] + TRAJ_CASES[15:]]
 CASES += [("compare", ["--traj", traj], text) for traj, text in TRAJ_CASES[10:13]]
