@@ -504,3 +504,57 @@ def test_a_scheduler_address_that_is_not_a_scheduler(workdir, listeners, capsys,
     assert status == 2, err
     assert len(err.strip().splitlines()) == 1 and text in err, err
     assert tree(cwd) == before
+
+
+# -- tampered --rerun records: a rerun passes the checks of a fresh run --------------------
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory) -> dict:
+    """A valid track summary.json of a qp run (cases change one field of a copy)."""
+    import json
+
+    out = tmp_path_factory.mktemp("recorded") / "run"
+    args = ["--method", "qp", "--traj", "ellipse", "--duration", "0.2", "--no-plots"]
+    assert track_main([*args, "--no-progress", "--out", str(out)]) == 0
+    return json.loads((out / "summary.json").read_text())
+
+
+RERUN_CASES = [
+    # (field of the run record, value, text of the one line)
+    ("dt", 10**400, "dt must be a finite number (got an integer of about 1e400)"),
+    ("duration", 10**400, "duration must be a finite number (got an integer of about 1e400)"),
+    ("dt", -0.1, "dt must be > 0"),
+    ("duration", 1e12, "duration / dt must be <="),
+    ("robot.payload", 20, "a 20 kg payload tips the robot over in this run's start pose"),
+    ("options.obstacles", [[2.0, 0.0, 0.5]], "overlaps the robot's start pose by 0.104 m"),
+    ("options.obstacles", [[1e9, 0.0, 0.3]], "obstacle x must be in [-1e+06, 1e+06] m"),
+    ("options.obstacles", [[5.0, 0.0, 5000.0]], "obstacle radius must be in"),
+    ("initial_offset", [5.0, 0.0], "offset must be in [-0.65, 0.65] m"),
+    ("initial_offset", [0.0, 0.0, 0.0], "offset must be two numbers"),
+    ("integrator", "bogus", "integrator must be one of euler, rk4 (got 'bogus')"),
+    ("trajectory.parameters.a", 1e300, "a must be in [1e-06, 1000] m"),
+]
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "text"), RERUN_CASES, ids=[f"{f}={str(v)[:20]}" for f, v, _ in RERUN_CASES]
+)
+def test_a_tampered_rerun_record_is_refused_as_a_fresh_run(
+    workdir, recorded, capsys, field, value, text
+):
+    import json
+
+    tampered = json.loads(json.dumps(recorded))
+    *sections, key = field.split(".")
+    holder = tampered["run"]
+    for section in sections:
+        holder = holder[section]
+    holder[key] = value
+    path = Path(workdir["inputs"]) / "summary.json"
+    path.write_text(json.dumps(tampered))
+    before = tree(Path.cwd())
+    status, err = run_bad("track", ["--rerun", str(path)], capsys)
+    assert status == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: rerun: {path}: "), err
+    assert text in lines[0], err
+    assert tree(Path.cwd()) == before
