@@ -15,6 +15,7 @@ Examples::
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime as dt
 import json
 import math
@@ -54,7 +55,15 @@ from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR, valid_stabili
 from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
-from ddwmmr.scenarios.executors import EXECUTORS, default_jobs, run_many
+from ddwmmr.scenarios.executors import (
+    CONNECT_TIMEOUT,
+    EXECUTORS,
+    MAX_CONNECT_TIMEOUT,
+    DaskWorkers,
+    check_connect_timeout,
+    default_jobs,
+    run_many,
+)
 from ddwmmr.scenarios.generator import Scenario, generate
 from ddwmmr.scenarios.protocol import (
     Outcome,
@@ -234,6 +243,14 @@ def build_parser() -> ArgumentParser:
         help="Dask scheduler address (with --executor dask; default: start a LocalCluster)",
     )
     parser.add_argument(
+        "--connect-timeout",
+        type=float,
+        metavar="S",
+        help=f"with --scheduler: seconds the scheduler has to answer, and then to have a "
+        f"worker, in (0, {MAX_CONNECT_TIMEOUT:g}] (default: {CONNECT_TIMEOUT:g}); checked "
+        "before anything is written",
+    )
+    parser.add_argument(
         "--study",
         choices=STUDIES,
         help="'thresholds': rerun thesis Tables 5.5-5.20 threshold variations; "
@@ -316,6 +333,10 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
     if args.scheduler and args.executor != "dask":
         raise ParameterError("scheduler: only used with --executor dask")
+    if args.connect_timeout is not None:
+        if not args.scheduler:
+            raise ParameterError("connect-timeout: only used with --scheduler")
+        check_connect_timeout(args.connect_timeout)
     if args.study == "thresholds" and args.controller != "thesis":
         raise ParameterError("study: the threshold study needs --controller thesis")
     if args.study == "arbiters" and args.controller != "thesis":
@@ -391,13 +412,34 @@ def _check_thesis_options(args: argparse.Namespace) -> None:
 
 
 class Runner:
-    """Runs batches with the chosen executor, a progress bar and timing."""
+    """Runs batches with the chosen executor, a progress bar and timing.
+
+    A context manager: with ``--executor dask`` the ``with`` block holds one client for
+    every batch, connected (or its LocalCluster started) on entry, before any output
+    exists, so a scheduler that is not there fails with one line and leaves nothing.
+    """
 
     def __init__(self, args: argparse.Namespace) -> None:
-        self.jobs = args.jobs or default_jobs()
+        # never more workers than the largest batch has scenarios
+        self.jobs = min(args.jobs or default_jobs(), largest_batch(args))
         self.executor = args.executor
         self.scheduler = args.scheduler
+        self.connect_timeout = args.connect_timeout or CONNECT_TIMEOUT
         self.progress = not args.no_progress
+        self._client: Any = None
+        self._held = contextlib.ExitStack()
+
+    def __enter__(self) -> Runner:
+        if self.executor == "dask":
+            workers = DaskWorkers(self.jobs, self.scheduler, self.connect_timeout)
+            label = "connecting to Dask" if self.scheduler else "starting Dask workers"
+            with phase(label, enabled=self.progress):
+                self._client = self._held.enter_context(workers)
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self._client = None
+        self._held.close()
 
     def run(self, scenarios: list[Scenario], config: RunConfig, label: str):
         """Outcomes in scenario order and the wall time (s)."""
@@ -408,10 +450,15 @@ class Runner:
                 config,
                 jobs=self.jobs,
                 executor=self.executor,
-                scheduler=self.scheduler,
+                client=self._client,
                 on_done=bar.advance,
             )
         return outcomes, time.perf_counter() - start
+
+
+def largest_batch(args: argparse.Namespace) -> int:
+    """Scenarios in the largest batch a run of ``args`` sends to the workers."""
+    return max(args.n, 10) if args.study == "obstacles" else args.n
 
 
 def output_names(args: argparse.Namespace, config: RunConfig) -> tuple[str, ...]:
@@ -526,7 +573,7 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
-        f"({runner.jobs} {args.executor} workers)",
+        f"({runner.jobs} {args.executor} worker{'s' * (runner.jobs != 1)})",
         file=sys.stderr,
     )
 
@@ -632,9 +679,8 @@ def _main(argv: Sequence[str] | None = None) -> int:
         robot = config_robot(config)
         plant = make_scenario_plant(robot, config)
         make_scenario_controller(robot, generate(1, 0)[0], config, plant)
-    runner = Runner(args)
     writer = output_folder(out, "scenarios", args.force, fresh)
-    with writer as folder:
+    with Runner(args) as runner, writer as folder:  # workers first, then the output
         if args.study == "thresholds":
             _run_thresholds(args, config, runner, folder)
         elif args.study == "obstacles":

@@ -127,8 +127,8 @@ class ConfigurationSpaceController:
             self.reference_step,
             self.threshold,
             self.damping,
+            horizon=period,  # one period up front
         )
-        self.reference(getattr(trajectory, "duration", 0.0))  # precompute one period
         self.last = StepInfo()
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
