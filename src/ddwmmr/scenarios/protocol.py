@@ -1,4 +1,4 @@
-"""The scenario protocol (thesis 5.1, SPEC §5): run one scenario, judge it, measure it.
+"""The scenario protocol (thesis 5.1): run one scenario, judge it, measure it.
 
 Success: every waypoint reached by the end effector within ``tolerance`` (0.01 m) in order
 within the time limit (60 s, 120 s with obstacles), with ``S > 1`` at every step and (with

@@ -4,7 +4,7 @@ Implements the :class:`~ddwmmr.plants.base.Plant` interface. Commands:
 
 * **velocity** ``u = (v, w, th1dot, th2dot)``: limited like the kinematic plant (wheel
   speed, joint rate and joint position limits), then turned into wheel speed targets
-  (SPEC §1 wheel map) and joint rate targets for the velocity servos of the model. The
+  (docs/theory.md, "Wheels") and joint rate targets for the velocity servos of the model. The
   servos' torques are clipped at the robot's motor limits, the wheels grip the floor
   through friction: the base may lag, slip or saturate, and the controller sees it.
 * **force** :class:`~ddwmmr.commands.WheelForces`: each wheel force F (N) is applied as
