@@ -3,10 +3,10 @@
 The code cites the project's own documentation as ``(docs/theory.md, "Tip-over stability")``
 (a section's title, with or without its number, or a paragraph's bold run-in title) or as
 ``docs/theory.md#tip-over-stability`` (a heading's GitHub anchor). This test reads every
-such citation in ``src/`` and in the trajectory files, and every ``page.md#anchor`` link
-between the docs pages, and checks it against the headings of ``docs/*.md``. It also checks
-that nothing cites the original specification or the seed material, which are not part of
-the repository.
+such citation in ``src/``, the trajectory files and the docs pages (there also as a link,
+``[page.md](page.md), "Title"``), and every ``page.md#anchor`` link between the pages, and
+checks it against the headings of ``docs/*.md``. It also checks that nothing cites the
+original specification or the seed material, which are not part of the repository.
 """
 
 from __future__ import annotations
@@ -18,12 +18,14 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 DOCS = ROOT / "docs"
-CITING = (ROOT / "src", ROOT / "trajectories")
+CITING = (ROOT / "src", ROOT / "trajectories", DOCS)
 SUFFIXES = {".py", ".toml", ".csv", ".md"}
 
-#: ``docs/page.md`` then ``#anchor``, or ``, "Title"`` (more titles joined by ``and``).
+#: ``docs/page.md`` (or a link to it, ``[...](page.md)``) then ``#anchor``, or ``, "Title"``
+#: (more titles joined by ``and``).
 CITATION = re.compile(
-    r'docs/(?P<page>[\w-]+\.md)(?:#(?P<anchor>[\w-]+)|,?\s*(?P<titles>"[^"\n]+"(?:\s+and\s+"[^"\n]+")*))'
+    r"(?:docs/|\]\()(?P<page>[\w-]+\.md)\)?"
+    r'(?:#(?P<anchor>[\w-]+)|,?\s*(?P<titles>"[^"\n]+"(?:\s+and\s+"[^"\n]+")*))'
 )
 #: Markdown links between docs pages: ``(page.md#anchor)`` or ``(#anchor)``.
 LINK = re.compile(r"\]\((?P<page>[\w-]+\.md)?#(?P<anchor>[\w-]+)\)")
