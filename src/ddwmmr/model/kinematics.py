@@ -48,7 +48,10 @@ def _arm_rates(L1: float, L2: float, q) -> tuple[float, float, float, float, flo
 
 
 def jacobian(L1: float, L2: float, q) -> np.ndarray:
-    """The 4x5 task Jacobian: rows xE, yE, phiE and the nonholonomic constraint (docs/theory.md)."""
+    """The 4x5 task Jacobian: rows xE, yE, phiE and the nonholonomic constraint.
+
+    docs/theory.md, "Configuration, forward kinematics, Jacobian".
+    """
     phi, dx, dy, dx2, dy2 = _arm_rates(L1, L2, q)
     return np.array(
         [

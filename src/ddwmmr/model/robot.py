@@ -285,7 +285,10 @@ class Robot:
         return np.array(kinematics.forward_kinematics(self.L1, self.L2, _configuration(q)))
 
     def jacobian(self, q) -> np.ndarray:
-        """The 4x5 Jacobian: rows xE, yE, phiE, nonholonomic constraint (docs/theory.md)."""
+        """The 4x5 Jacobian: rows xE, yE, phiE, nonholonomic constraint.
+
+        docs/theory.md, "Configuration, forward kinematics, Jacobian".
+        """
         return kinematics.jacobian(self.L1, self.L2, _configuration(q))
 
     def augmented_jacobian(self, q, aux: str = "sum") -> np.ndarray:

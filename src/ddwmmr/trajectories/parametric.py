@@ -173,7 +173,7 @@ class Ellipse(_Parametric):
 
     The smallest radius of curvature, b^2/a = 1.1 m, exceeds the arm reach (0.65 m): with a
     tighter ellipse the base cannot follow a tangent-oriented end effector without driving
-    the shoulder into its singularity (see docs/theory.md).
+    the shoulder into its singularity (docs/theory.md, "Trajectories").
     """
 
     name: str = "ellipse"

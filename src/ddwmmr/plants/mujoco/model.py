@@ -23,10 +23,10 @@ Bodies (all masses and inertias explicit, ``inertiafromgeom="false"``):
   (then it spins on frictionless casters). The offset is the contacts' own static sink,
   so the tilt it adds at tipping (offset / half-width, 3e-4 rad) is negligible.
 * ``link1`` (hinge about z at the base centre, ``arm_height`` above the floor) and
-  ``link2`` (hinge at ``L1`` along link 1): uniform rods, mass at the midpoint as
-  docs/theory.md has it for S. The payload is a point mass at the end effector (``L2`` along
-  link 2), folded into link 2's inertial (so ``body_mass`` of link 2 is ``m2 + payload``). The arm
-  never collides.
+  ``link2`` (hinge at ``L1`` along link 1): uniform rods, mass at the midpoint as S has it
+  (docs/theory.md, "Tip-over stability"). The payload is a point mass at the end effector
+  (``L2`` along link 2), folded into link 2's inertial (so ``body_mass`` of link 2 is
+  ``m2 + payload``). The arm never collides.
 * the floor: an infinite plane with sliding friction ``friction`` (wheels grip, casters
   are frictionless through ``condim=1`` and a higher contact priority).
 
