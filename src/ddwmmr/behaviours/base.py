@@ -27,8 +27,8 @@ DRIVE, TURN, BRAKE = "drive", "turn", "brake"
 class Percept:
     """What every behaviour sees at one control instant; read-only by convention.
 
-    (Not a frozen dataclass: one is built every control step, and a frozen one costs
-    1.7 us to build against 0.2 us, a seventh of a thesis-controller step.)
+    (Not a frozen dataclass: one is built every control step, and a frozen one is several
+    times dearer to build; docs/thesis.md, "Speed and scale-out".)
 
     Attributes:
         t: time (s).
