@@ -5,7 +5,8 @@ Run from the repository root::
     MPLBACKEND=Agg .venv/bin/python docs/qp_figures.py
 
 Writes ``docs/figures/qp_*.png`` and prints the tables quoted in docs/qp.md (markdown).
-Every run uses the 3 kg payload (SPEC §1: a full sideways stretch is then exactly S = 1).
+Every run uses the 3 kg payload (docs/theory.md, "Tip-over stability": a full sideways
+stretch is then exactly S = 1).
 """
 
 from __future__ import annotations
@@ -182,7 +183,7 @@ def obstacle() -> str:
 def modes() -> str:
     """Weighted against hierarchical when a secondary task fights tracking (ellipse).
 
-    The SPEC §3 potential V = th1^2 + 0.25 th2^2 + 0.66 phi^2 added as a user task: its th2
+    The ap potential V = th1^2 + 0.25 th2^2 + 0.66 phi^2 added as a user task: its th2
     row can only be met by moving the end effector, so its weight sets how much tracking
     the weighted mode gives up; the hierarchical mode gives up none.
     """
@@ -200,9 +201,9 @@ def modes() -> str:
             rows.append([mode, f"{weight:g}", f"{errors[-1]:.2f}", f"{etas[-1]:.3f}"])
         ax_e.loglog(weights, errors, marker, label=mode)
         ax_m.semilogx(weights, etas, marker, label=mode)
-    ax_e.set_xlabel("weight of the SPEC §3 potential task")
+    ax_e.set_xlabel("weight of the ap potential task")
     ax_e.set_ylabel("RMS position error (mm)")
-    ax_m.set_xlabel("weight of the SPEC §3 potential task")
+    ax_m.set_xlabel("weight of the ap potential task")
     ax_m.set_ylabel("mean eta")
     ax_e.legend()
     fig.tight_layout()

@@ -1,6 +1,6 @@
 """Support loads on the physics plant: the edge-load model against MuJoCo, and where the
 optimisers' unloaded time comes from (docs/physics.md, "Support loads while moving" and
-"Why an edge goes unloaded").
+"Why an edge goes unloaded: the optimisers on the scenarios").
 
 Run from the repository root::
 

@@ -110,7 +110,7 @@ def build_parser() -> ArgumentParser:
         help=f"trajectory ({', '.join(available_trajectories())}) or a "
         ".toml/.csv path (default ellipse)",
     )
-    geometry = parser.add_argument_group("trajectory geometry (SPEC 2; default: the file's)")
+    geometry = parser.add_argument_group("trajectory geometry (default: the file's)")
     for name, unit, allowed in GEOMETRY:
         geometry.add_argument(
             f"--{name}",

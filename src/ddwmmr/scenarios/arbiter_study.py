@@ -1,6 +1,7 @@
 """Side-by-side study: the thesis's state machine against the competitive-dynamics arbiter.
 
-Same scenarios, same behaviours, same plant; only the arbiter differs (issue 13, SPEC §6).
+Same scenarios, same behaviours, same plant; only the arbiter differs (docs/thesis.md,
+"Results: state machine and competitive arbiter side by side").
 Three parts, each a function the CLI (``--study arbiters``) and ``docs/competitive_figures.py``
 call:
 
