@@ -1,0 +1,200 @@
+"""Figures show their data: nothing under a legend or a label, axes that hold what they
+draw, no text off the canvas (tests/figure_checks.py), for the track and compare figures
+and the legend placement they use."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.transforms import Bbox
+
+from ddwmmr import Robot, load_trajectory, simulate
+from ddwmmr.reports import compare_plots, plots
+from ddwmmr.reports.legends import covers_data, place_legend
+from figure_checks import assert_figure_shows_its_data, figure_problems, segments_crossing
+
+# -- the check itself -------------------------------------------------------------------
+
+
+def test_segments_crossing_counts_segments_through_a_box():
+    box = Bbox.from_extents(0, 0, 10, 10)
+    assert segments_crossing(box, np.array([[-5.0, 5.0], [15.0, 5.0]])) == 1  # no vertex in
+    assert segments_crossing(box, np.array([[-5.0, 20.0], [15.0, 20.0]])) == 0
+    assert segments_crossing(box, np.array([[5.0, 5.0]])) == 1
+    assert segments_crossing(box, np.array([[0.0, 0.0], [np.nan, np.nan], [5.0, -1.0]])) == 0
+
+
+def test_the_check_finds_a_legend_on_a_line_a_cut_line_and_text_off_the_canvas():
+    fig, ax = plt.subplots(figsize=(4, 3))
+    t = np.linspace(0, 1, 50)
+    ax.plot(t, np.ones_like(t), label="flat")
+    ax.set_ylim(0.99, 1.01)  # the line runs through the middle, where the legend goes
+    ax.legend(loc="center")
+    assert any("legend covers" in p for p in figure_problems(fig))
+    ax.set_ylim(0.0, 0.5)  # the line is now above the axes
+    assert any("outside the axes" in p for p in figure_problems(fig))
+    ax.set_ylim(0.0, 2.0)
+    ax.legend(loc="lower right")
+    assert figure_problems(fig) == []
+    fig.text(0.95, 0.5, "a long caption that cannot fit")
+    assert any("runs off the figure" in p for p in figure_problems(fig))
+    plt.close(fig)
+
+
+def test_the_check_finds_a_label_on_a_line_and_labels_on_each_other():
+    fig, ax = plt.subplots(figsize=(4, 3))
+    ax.plot([0, 1], [0, 1])
+    ax.annotate("on the line", (0.5, 0.5))
+    ax.annotate("A", (0.1, 0.8))
+    ax.annotate("B", (0.1, 0.8))
+    problems = figure_problems(fig)
+    assert any("'on the line' covers" in p for p in problems)
+    assert any("'A' overlaps label 'B'" in p for p in problems)
+    plt.close(fig)
+
+
+def test_place_legend_finds_a_free_corner_or_makes_room():
+    fig, ax = plt.subplots(figsize=(4, 3))
+    t = np.linspace(0, 10, 200)
+    ax.plot(t, np.sin(t), label="sin")
+    ax.plot(t, np.cos(t), label="cos")
+    ax.set_ylim(-1.05, 1.05)  # every corner has data under it at this size
+    legend = place_legend(ax)
+    assert not covers_data(ax, legend)
+    assert ax.get_ylim()[1] > 1.05  # it raised the top to make room
+    assert_figure_shows_its_data(fig)
+    plt.close(fig)
+
+
+# -- track figures ----------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def rectangle_run():
+    return simulate(None, load_trajectory("rectangle"), "clrrmc-ts")
+
+
+@pytest.mark.parametrize("make", [plots.plot_errors, plots.plot_rates, plots.plot_metrics])
+def test_track_time_figures_show_their_data(rectangle_run, make):
+    fig = make(rectangle_run)
+    assert_figure_shows_its_data(fig)
+    plt.close(fig)
+
+
+def test_track_path_holds_every_robot_and_names_their_times(rectangle_run):
+    fig = plots.plot_path(rectangle_run, obstacles=[(0.0, 0.0, 0.4)])
+    assert_figure_shows_its_data(fig)
+    texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    # Six instants on a closed path: the last is not drawn over the first.
+    times = [t for t in texts if t.startswith("robot at t = ")]
+    t = rectangle_run.timeseries["t"]  # 2001 samples over 40 s: every 2000/6th one
+    expected = t[np.round(np.arange(6) * (len(t) - 1) / 6).astype(int)]
+    assert times == [f"robot at t = {x:.3g} s" for x in expected]
+    assert "desired end effector" in texts and "obstacle" in texts
+    plt.close(fig)
+
+
+def test_rates_put_the_base_yaw_rate_apart_and_name_the_limits(rectangle_run):
+    fig = plots.plot_rates(rectangle_run)
+    joints, base, wheels = fig.axes
+    assert [line.get_label() for line in base.lines] == ["w (base yaw rate)"]
+    assert "w" not in " ".join(line.get_label() for line in joints.lines).split()
+    robot = rectangle_run.robot
+    joint_labels = [t.get_text() for t in joints.get_legend().get_texts()]
+    wheel_labels = [t.get_text() for t in wheels.get_legend().get_texts()]
+    assert f"joint limit +-{robot.joint_speed_limit:g} rad/s" in joint_labels
+    assert f"wheel limit +-{robot.wheel_speed_limit:g} rad/s" in wheel_labels
+    # The yaw rate reaches -3 rad/s, beyond the joint limit: it is not on that axis.
+    assert np.min(rectangle_run.timeseries["w"]) < -robot.joint_speed_limit
+    plt.close(fig)
+
+
+# -- compare figures --------------------------------------------------------------------
+
+METHODS = ("pi", "ats", "ap", "clrrmc-ts")
+
+
+@pytest.fixture(scope="module")
+def compare_series():
+    """Full-period runs on both trajectories: pi and ap leave the path (their panels must
+    widen), ats keeps its offset, clrrmc-ts tracks."""
+    return {
+        name: {m: simulate(None, load_trajectory(name), m).timeseries for m in METHODS}
+        for name in ("ellipse", "rectangle")
+    }
+
+
+@pytest.mark.parametrize("name", ["ellipse", "rectangle"])
+def test_compare_trajectory_figures_show_their_data(compare_series, name):
+    series = compare_series[name]
+    colors = compare_plots.method_colors(list(series))
+    robot = Robot()
+    figures = {
+        "paths": compare_plots.plot_paths(
+            series, colors, name, [("A", 0.0, 0.13), ("B", 10, None)]
+        ),
+        "errors": compare_plots.plot_errors(series, colors, name),
+        "wheels": compare_plots.plot_wheels(series, colors, robot.wheel_speed_limit, name),
+        "methods": compare_plots.plot_small_multiples(series, colors, robot, name),
+    }
+    for kind, fig in figures.items():
+        zooms = fig.axes[1:] if kind == "paths" else ()
+        problems = figure_problems(fig, cropped=zooms)
+        assert not problems, (kind, problems[:5])
+        plt.close(fig)
+
+
+def test_every_wheel_panel_has_its_time_axis_and_the_limit_is_named(compare_series):
+    series = compare_series["rectangle"]
+    fig = compare_plots.plot_wheels(series, compare_plots.method_colors(list(series)), 15.0, "r")
+    fig.canvas.draw()
+    for ax in [a for a in fig.axes if a.get_visible()]:
+        assert ax.get_xlabel() == "t (s)"
+        assert any(label.get_visible() and label.get_text() for label in ax.get_xticklabels())
+    legend_texts = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "limit +-15 rad/s (dotted)" in legend_texts
+    plt.close(fig)
+
+
+def test_small_multiples_draw_every_instant_inside_its_panel(compare_series):
+    series = compare_series["rectangle"]
+    robot = Robot()
+    fig = compare_plots.plot_small_multiples(
+        series, compare_plots.method_colors(METHODS), robot, "r"
+    )
+    ap = fig.axes[METHODS.index("ap")]
+    x_low, x_high = ap.get_xlim()
+    # ap leaves the frame of the desired rectangle (x within +-2 m, +-3.2 m with the
+    # margin): its panel widened to hold its whole path.
+    assert np.max(series["ap"]["xE"]) > 3.5
+    xs = np.concatenate([line.get_xdata() for line in ap.lines])
+    assert x_low <= np.min(xs) and np.max(xs) <= x_high
+    assert_figure_shows_its_data(fig)
+    plt.close(fig)
+
+
+def test_coinciding_groups_pair_lines_within_the_factor():
+    lines = {
+        "a": [1.0, 2.0, 3.0],
+        "b": [1.1, 2.1, 3.2],  # within 15 % of a everywhere
+        "c": [1.0, 2.0, 4.0],  # 33 % off a at the last point
+        "d": [1e-3, 1e-4, 1e-5],
+        "e": [1.05e-3, 0.95e-4, 1.1e-5],
+    }
+    assert compare_plots.coinciding_groups(lines) == [["a", "b"], ["d", "e"]]
+
+
+def test_dt_study_names_the_lines_lying_on_each_other():
+    steps = (0.01, 0.02, 0.04)
+    drift = {
+        "pi": {"euler": dict.fromkeys(steps, 3.0), "rk4": dict.fromkeys(steps, 3.1)},
+        "ats": {"euler": {s: 0.2 * s for s in steps}, "rk4": {s: 1e-3 * s**4 for s in steps}},
+    }
+    fig = compare_plots.plot_dt_study(drift, compare_plots.method_colors(["pi", "ats"]))
+    legend = fig.axes[0].get_legend()
+    assert "pi (euler) = pi (rk4)" in legend.get_title().get_text()
+    widths = {line.get_label(): line.get_linewidth() for line in fig.axes[0].lines}
+    assert widths["pi (euler)"] > widths["pi (rk4)"]  # wide under thin: both visible
+    assert_figure_shows_its_data(fig)
+    plt.close(fig)
