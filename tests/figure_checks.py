@@ -40,10 +40,14 @@ def figure_problems(
     fig: Figure,
     cropped: Iterable[Axes] = (),
     ignore: Callable[[Artist], bool] = lambda artist: False,
+    only: Iterable[Axes] | None = None,
 ) -> list[str]:
     """Every violation of the rules above in ``fig`` (empty: the figure shows its data).
 
     Args:
+        only: check the data of these axes only (default all); a window's widgets, whose
+            labels sit beside their boxes on purpose, are left out this way. The texts of
+            the whole figure are still checked against the canvas.
         cropped: axes that deliberately show only part of their data (zoom panels): their
             data may leave them; legends and labels must still not cover it.
         ignore: artists that are neither data nor labels (a playback cursor...).
@@ -53,7 +57,7 @@ def figure_problems(
     cropped = set(cropped)
     problems: list[str] = []
     everything: list[tuple[Bbox, list[tuple[str, np.ndarray]]]] = []  # per axes: box, data
-    for ax in fig.axes:
+    for ax in fig.axes if only is None else list(only):
         if not ax.get_visible():
             continue
         name = _axes_name(ax)

@@ -4,6 +4,8 @@ and the legend placement they use."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
@@ -198,3 +200,100 @@ def test_dt_study_names_the_lines_lying_on_each_other():
     assert widths["pi (euler)"] > widths["pi (rk4)"]  # wide under thin: both visible
     assert_figure_shows_its_data(fig)
     plt.close(fig)
+
+
+# -- the GUI ----------------------------------------------------------------------------
+
+
+def _window(*argv: str):
+    """The simulator window off-screen (as ``--snapshot`` builds it), run to the end and
+    shown at its last instant."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from ddwmmr.cli.gui import build_parser, settings_from_arguments
+    from ddwmmr.gui.app import App
+    from ddwmmr.gui.layout import DPI, FIGSIZE
+
+    settings = settings_from_arguments(build_parser().parse_args(list(argv)))
+    figure = Figure(figsize=FIGSIZE, dpi=DPI)
+    FigureCanvasAgg(figure)
+    app = App(figure, settings)
+    app.run()
+    app.wait()
+    app.show_index(app.view.last_index)
+    return app
+
+
+def _view_problems(app) -> list[str]:
+    view = app.view
+    cursors = set(view._cursors)  # the playback cursor sweeps under everything
+    return figure_problems(
+        app.figure,
+        ignore=lambda artist: artist in cursors,
+        only=[view.path_ax, *view.plot_axes.values(), app.message_text.axes],
+    )
+
+
+def test_gui_view_shows_both_runs_and_no_legend_on_them():
+    post = Path(__file__).resolve().parent.parent / "trajectories/obstacles/ellipse_post.toml"
+    app = _window(
+        "--method", "qp", "--payload", "3", "--option", f"obstacles={post}",
+        "--compare", "clrrmc-ts", "--traj", "ellipse", "--duration", "20",
+    )  # fmt: skip
+    assert _view_problems(app) == []
+    a, b = app.view.runs
+    # B is drawn over A, thinner: where the two coincide A shows on both sides of B.
+    assert a.ee_trail.get_linewidth() > 2 * b.ee_trail.get_linewidth()
+    assert a.ee_trail.get_zorder() <= b.ee_trail.get_zorder()
+    # Tick labels at least 10 px high at the window's resolution.
+    for ax in [app.view.path_ax, *app.view.plot_axes.values()]:
+        for label in ax.get_yticklabels() + ax.get_xticklabels():
+            assert label.get_fontsize() * app.figure.dpi / 72 >= 10.0
+
+
+def test_gui_summary_of_a_physics_run_fits_the_window_and_names_the_folder(tmp_path, monkeypatch):
+    from ddwmmr.cli.gui import build_parser, settings_from_arguments, snapshot
+    from ddwmmr.gui.app import App
+
+    said: list[str] = []
+    original = App.say
+    monkeypatch.setattr(
+        App, "say", lambda self, text, error=False: (said.append(text), original(self, text, error))
+    )
+    settings = settings_from_arguments(
+        build_parser().parse_args(
+            ["--method", "qp", "--compare", "clrrmc-ts", "--plant", "mujoco", "--duration", "2"]
+        )
+    )
+    path = tmp_path / "shots" / "mujoco.png"
+    snapshot(settings, path)
+    assert said[-1].endswith(f"(--snapshot {path})")
+    app = _window(
+        "--method", "qp", "--compare", "clrrmc-ts", "--plant", "mujoco", "--duration", "2"
+    )
+    assert "stood (physics" in app.summary_text.get_text()
+    assert _view_problems(app) == []  # the summary is checked against the canvas too
+    right = app.summary_text.get_window_extent(app.figure.canvas.get_renderer()).x1
+    assert right <= app.figure.bbox.width
+
+
+def test_wrap_to_width_breaks_at_commas_within_the_room():
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from ddwmmr.gui.widgets import wrap_to_width
+
+    figure = Figure(figsize=(6, 2), dpi=100)
+    FigureCanvasAgg(figure)
+    text = figure.text(0.1, 0.9, "", fontsize=8)
+    line = ", ".join(f"item {i} = {i * 1.5:g} units" for i in range(12))
+    wrapped = wrap_to_width(line, text, 0.9)
+    renderer = figure.canvas.get_renderer()
+    room = 0.8 * 600
+    lines = wrapped.split("\n")
+    assert len(lines) > 1
+    for piece in lines:
+        text.set_text(piece)
+        assert text.get_window_extent(renderer).width <= room
+    assert " ".join(piece.strip() for piece in lines) == line

@@ -21,6 +21,7 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon
 from matplotlib.ticker import NullFormatter
 
+from ddwmmr.reports.legends import place_legend
 from ddwmmr.reports.plots import robot_outline, wheel_outlines
 
 #: Plot axes of the view, top to bottom: key -> y-axis label.
@@ -33,6 +34,14 @@ PLOTS = {
 }
 #: Colours of run A and run B: (end effector and plot lines, arm).
 PALETTE = (("tab:blue", "tab:orange"), ("tab:red", "tab:green"))
+#: Widths of run A's and run B's lines (end-effector trail, plot lines): B is drawn on
+#: top of A, thinner, so that A stays visible where the two coincide.
+TRAIL_WIDTHS = (3.0, 1.3)
+PLOT_WIDTHS = (2.0, 0.9)
+#: Font sizes (points) of the tick labels and axis labels of the view: at the window's
+#: 100 dpi, 8 pt is 11 px.
+TICK_SIZE = 8
+LABEL_SIZE = 8
 #: Floor of the logarithmic position-error plot (m), as in the track figures.
 ERROR_FLOOR = 1e-9
 #: Samples of a desired path drawn before any run.
@@ -108,11 +117,14 @@ class RunView:
         robot = results[0].robot
         self._fit_path(np.r_[xs, period[:, 0]], np.r_[ys, period[:, 1]], robot.base_length)
         self._fit_plots(results)
-        for key in ("position", "wheels", "stability"):
-            self.plot_axes[key].legend(loc="best", fontsize=6, ncol=3, framealpha=0.7)
         self.path_ax.legend(
-            loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=3, fontsize=6.5, frameon=False
+            loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=3, fontsize=7.5, frameon=False
         )
+        # The legends go where the whole runs leave room (raising a plot's top if needed),
+        # placed once: they do not move during playback.
+        self.show_index(self.last_index)
+        for key in ("position", "wheels", "stability"):
+            place_legend(self.plot_axes[key], fontsize=7, ncol=3, framealpha=0.8)
         for cursor in self._cursors:
             cursor.set_visible(True)
         self.show(0.0)
@@ -183,20 +195,20 @@ class RunView:
     def _style_axes(self) -> None:
         ax = self.path_ax
         ax.set_aspect("equal", adjustable="box")
-        ax.set_xlabel("x (m)", fontsize=8)
-        ax.set_ylabel("y (m)", fontsize=8)
-        ax.tick_params(labelsize=7)
+        ax.set_xlabel("x (m)", fontsize=LABEL_SIZE)
+        ax.set_ylabel("y (m)", fontsize=LABEL_SIZE)
+        ax.tick_params(labelsize=TICK_SIZE)
         ax.grid(alpha=0.3)
         keys = list(self.plot_axes)
         for key, plot in self.plot_axes.items():
-            plot.set_ylabel(PLOTS[key], fontsize=7)
-            plot.tick_params(labelsize=6)
+            plot.set_ylabel(PLOTS[key], fontsize=LABEL_SIZE)
+            plot.tick_params(labelsize=TICK_SIZE)
             if key != "position":
                 plot.ticklabel_format(axis="y", useOffset=False)
             plot.grid(alpha=0.3, which="both")
             if key != keys[-1]:
                 plot.tick_params(labelbottom=False)
-        self.plot_axes[keys[-1]].set_xlabel("t (s)", fontsize=8)
+        self.plot_axes[keys[-1]].set_xlabel("t (s)", fontsize=LABEL_SIZE)
         self.plot_axes["position"].set_yscale("log")
         self.plot_axes["position"].yaxis.set_minor_formatter(NullFormatter())
 
@@ -237,7 +249,9 @@ class RunView:
         ax = self.path_ax
         color, arm_color = PALETTE[number]
         robot = result.robot
-        (ee_trail,) = ax.plot([], [], color=color, lw=1.5, label=f"{label}: end effector")
+        (ee_trail,) = ax.plot(
+            [], [], color=color, lw=TRAIL_WIDTHS[number], label=f"{label}: end effector"
+        )
         (base_trail,) = ax.plot(
             [], [], color=color, lw=0.8, alpha=0.5, ls=":", label=f"{label}: base"
         )
@@ -253,7 +267,7 @@ class RunView:
         run = _RunArtists(
             result, label, ee_trail, base_trail, footprint, wheels, heading, arm, payload
         )
-        style = {"color": color, "lw": 1.0}
+        style = {"color": color, "lw": PLOT_WIDTHS[number]}
         plot = self.plot_axes
         run.lines["position"] = plot["position"].plot([], [], label=label, **style)
         # Colours name the runs in the position legend; the other plots use the same ones.
