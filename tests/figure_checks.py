@@ -108,7 +108,10 @@ def data_polylines(
         if len(xy) == 0:
             continue
         display = line.get_transform().transform(xy)
-        found.append((_artist_name(line), display))
+        if line.get_linestyle() in ("None", "", " ", "none"):  # markers only: no segments
+            found += [(_artist_name(line), point[None, :]) for point in display]
+        else:
+            found.append((_artist_name(line), display))
     for collection in ax.collections:
         if not isinstance(collection, PathCollection) or not collection.get_visible():
             continue

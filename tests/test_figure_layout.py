@@ -297,3 +297,33 @@ def test_wrap_to_width_breaks_at_commas_within_the_room():
         text.set_text(piece)
         assert text.get_window_extent(renderer).width <= room
     assert " ".join(piece.strip() for piece in lines) == line
+
+
+# -- scenario figures -------------------------------------------------------------------
+
+
+def test_scenario_figures_show_their_data(tmp_path, monkeypatch):
+    """Every figure `scenarios` draws, on three scenarios (one with the obstacle study's
+    two obstacles), state machine and competitive arbiter."""
+    from ddwmmr.cli.scenarios import _draw_figures
+    from ddwmmr.scenarios import report
+    from ddwmmr.scenarios.generator import generate
+    from ddwmmr.scenarios.protocol import RunConfig, run_scenario
+    from ddwmmr.scenarios.studies import obstacle_scenarios
+
+    problems: dict[str, list[str]] = {}
+
+    def check(fig, path):
+        fig.tight_layout()
+        problems[Path(path).name] = figure_problems(fig)
+        plt.close(fig)
+
+    monkeypatch.setattr(report, "_save", check)
+    scenarios = generate(3, 0)
+    scenarios[0] = obstacle_scenarios(generate(10, 0))[0]
+    for arbiter in ("state-machine", "competitive"):
+        config = RunConfig(arbiter=arbiter)
+        outcomes = [run_scenario(s, config) for s in scenarios]
+        _draw_figures(tmp_path, scenarios, outcomes, config)
+    assert {"thesis_paths.png", "thesis_timeline.png", "thesis_weights.png"} <= set(problems)
+    assert {name: found for name, found in problems.items() if found} == {}

@@ -72,7 +72,13 @@ def covers_data(ax: Axes, legend: Legend) -> bool:
     ax.apply_aspect()  # an equal-aspect axes takes its final box only when drawn
     box = legend.get_window_extent(renderer).padded(CLEARANCE_PX)
     for line in ax.lines:
-        if line.get_visible() and _crosses(line.get_transform(), line.get_xydata(), box):
+        if not line.get_visible():
+            continue
+        if line.get_linestyle() in ("None", "", " ", "none"):  # markers only: the points
+            points = line.get_transform().transform(line.get_xydata())
+            if len(points) and np.any(box.contains_points(points)):
+                return True
+        elif _crosses(line.get_transform(), line.get_xydata(), box):
             return True
     for collection in ax.collections:
         if isinstance(collection, PathCollection) and collection.get_visible():
