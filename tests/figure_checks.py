@@ -21,6 +21,7 @@ a tolerance of :data:`TOLERANCE_PX` absorbs antialiasing and line caps.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
+from pathlib import Path
 
 import numpy as np
 from matplotlib.artist import Artist
@@ -274,3 +275,28 @@ def _artist_name(artist: Artist) -> str:
     return (
         f"{type(artist).__name__} {label!r}" if not label.startswith("_") else type(artist).__name__
     )
+
+
+class SavedFigures:
+    """Every figure saved while installed (``Figure.savefig`` patched through pytest's
+    ``monkeypatch``): its name and :func:`figure_problems`, checked just before it is
+    written. Scripts that save by themselves (the docs figure scripts, an animation's
+    frames) are checked this way without changing them."""
+
+    def __init__(self, monkeypatch, **check) -> None:
+        self.problems: dict[str, list[str]] = {}
+        original = Figure.savefig
+        saved = self
+
+        def savefig(fig: Figure, fname, *args, **kwargs):
+            name = fname.name if isinstance(fname, Path) else str(fname)
+            name = name if isinstance(fname, (str, Path)) else "frame"  # a buffer
+            key = name if name not in saved.problems else f"{name}#{len(saved.problems)}"
+            saved.problems[key] = figure_problems(fig, **check)
+            return original(fig, fname, *args, **kwargs)
+
+        monkeypatch.setattr(Figure, "savefig", savefig)
+
+    def failing(self) -> dict[str, list[str]]:
+        """The saved figures with problems (name -> the first five)."""
+        return {name: found[:5] for name, found in self.problems.items() if found}

@@ -1,0 +1,80 @@
+"""The figure scripts of docs/ make figures that show their data (tests/figure_checks.py):
+every figure of docs/make_figures.py and docs/qp_figures.py (but its timed one), the
+physics figures that take seconds, and the frames of a physics run's animation."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+from figure_checks import SavedFigures
+
+DOCS = Path(__file__).resolve().parent.parent / "docs"
+
+
+def docs_script(name: str, tmp_path: Path, monkeypatch):
+    """Import ``docs/<name>.py`` as a module writing its figures to ``tmp_path``."""
+    spec = importlib.util.spec_from_file_location(f"docs_{name}", DOCS / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    monkeypatch.setattr(module, "FIGURES", tmp_path)
+    return module
+
+
+def test_theory_figures(tmp_path, monkeypatch):
+    saved = SavedFigures(monkeypatch)
+    script = docs_script("make_figures", tmp_path, monkeypatch)
+    script.main()
+    assert len(saved.problems) == 6
+    assert saved.failing() == {}
+
+
+@pytest.mark.parametrize(
+    "function", ["sideways_reach", "ellipse_manipulability", "obstacle", "modes", "waypoints"]
+)
+def test_qp_figures(function, tmp_path, monkeypatch):
+    saved = SavedFigures(monkeypatch)
+    script = docs_script("qp_figures", tmp_path, monkeypatch)
+    getattr(script, function)()
+    assert len(saved.problems) == 1
+    assert saved.failing() == {}
+
+
+@pytest.fixture(scope="module")
+def tipping_runs():
+    """ats and clrrmc-ts reaching sideways with 4 kg on the physics plant: both tip."""
+    from ddwmmr import Robot, load_trajectory, simulate
+
+    trajectory = load_trajectory("sideways_reach")
+    robot = Robot().with_payload(4.0)
+    q0 = robot.base_for_end_effector(trajectory.pose(0.0), 1.0, 1.6)
+    return {
+        (4.0, method): simulate(
+            robot, trajectory, method, plant="mujoco", q0=q0, dt=0.02, duration=2.0
+        )
+        for method in ("ats", "clrrmc-ts")
+    }
+
+
+def test_physics_runs_figure_with_runs_that_tip(tipping_runs, tmp_path, monkeypatch):
+    assert all(run.summary["tipped"] for run in tipping_runs.values())
+    saved = SavedFigures(monkeypatch)
+    script = docs_script("physics_figures", tmp_path, monkeypatch)
+    script._plot_reach_runs(tipping_runs, (4.0,))
+    assert list(saved.problems) == ["physics_sideways_runs.png"]
+    assert saved.failing() == {}
+
+
+def test_physics_animation_frames(tipping_runs, tmp_path, monkeypatch):
+    from ddwmmr.plants.mujoco import MujocoPlant
+    from ddwmmr.reports.physics_plots import save_physics_animation
+
+    result = tipping_runs[4.0, "clrrmc-ts"]
+    plant = MujocoPlant(result.robot)
+    saved = SavedFigures(monkeypatch)
+    points = [s.point for s in plant.supports]
+    save_physics_animation(result, points, plant.weight_n, tmp_path / "tip.gif", frames=6)
+    assert len(saved.problems) >= 6  # every frame is checked as it is grabbed
+    assert saved.failing() == {}
