@@ -78,3 +78,19 @@ def test_physics_animation_frames(tipping_runs, tmp_path, monkeypatch):
     save_physics_animation(result, points, plant.weight_n, tmp_path / "tip.gif", frames=6)
     assert len(saved.problems) >= 6  # every frame is checked as it is grabbed
     assert saved.failing() == {}
+
+
+def test_benchmark_figure(tmp_path, monkeypatch):
+    """docs/figures/bench.png from the committed benchmarks/bench.json."""
+    import json
+
+    spec = importlib.util.spec_from_file_location(
+        "bench_docs", DOCS.parent / "benchmarks" / "bench_docs.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    report = json.loads((DOCS.parent / "benchmarks" / "bench.json").read_text())
+    saved = SavedFigures(monkeypatch)
+    module.plot_report(report, tmp_path / "bench.png")
+    assert len(saved.problems) == 1
+    assert saved.failing() == {}
