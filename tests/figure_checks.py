@@ -8,7 +8,8 @@ physics, the docs scripts, the GUI):
   (footprints, obstacles) and every text placed inside an axes lies inside that axes
   (the axes fit what is drawn); zoom panels are exempt through ``cropped``;
 - no legend box is crossed by a data line (segments, not only vertices, so a horizontal
-  limit line under a legend counts) nor covers a scatter point;
+  limit line under a legend counts) nor covers a scatter point or a data patch (bar,
+  footprint, obstacle: its bounding box);
 - no text inside an axes (annotations, labels of drawn objects) is crossed by a data line
   or overlaps another such text;
 - no text of the figure (titles, axis and tick labels, legends, annotations) runs off
@@ -70,7 +71,9 @@ def figure_problems(
             problems += _patches_outside(name, ax, box, ignore)
         legend = ax.get_legend()
         if legend is not None and legend.get_visible():
-            problems += _covered(f"{name}: legend", legend.get_window_extent(renderer), polylines)
+            extent = legend.get_window_extent(renderer)
+            problems += _covered(f"{name}: legend", extent, polylines)
+            problems += _patches_covered(f"{name}: legend", extent, ax, ignore)
         labels = [t for t in ax.texts if _shown(t) and not ignore(t)]
         problems += _labels(name, labels, box, polylines, renderer, ax not in cropped)
     for legend in fig.legends:
@@ -193,6 +196,19 @@ def _patches_outside(name: str, ax: Axes, box: Bbox, ignore: Callable[[Artist], 
             extent.y1 <= grown.y1
         ):
             problems.append(f"{name}: patch {_artist_name(patch)} is cut by the axes")
+    return problems
+
+
+def _patches_covered(what: str, box: Bbox, ax: Axes, ignore: Callable[[Artist], bool]) -> list[str]:
+    """Data patches (bars, footprints, obstacles) that ``box`` overlaps."""
+    problems = []
+    for patch in ax.patches:
+        if not patch.get_visible() or ignore(patch):
+            continue
+        if patch.get_transform().contains_branch(ax.transAxes):
+            continue
+        if _overlap(box, patch.get_window_extent()):
+            problems.append(f"{what} covers patch {_artist_name(patch)}")
     return problems
 
 

@@ -38,6 +38,9 @@ PALETTE = (("tab:blue", "tab:orange"), ("tab:red", "tab:green"))
 #: top of A, thinner, so that A stays visible where the two coincide.
 TRAIL_WIDTHS = (3.0, 1.3)
 PLOT_WIDTHS = (2.0, 0.9)
+#: Drawing order in the top view: trails (2), the desired path, then the robots.
+DESIRED_ZORDER = 2.5
+ROBOT_ZORDER = 3.0
 #: Font sizes (points) of the tick labels and axis labels of the view: at the window's
 #: 100 dpi, 8 pt is 11 px.
 TICK_SIZE = 8
@@ -83,7 +86,11 @@ class RunView:
             ax.axvline(0.0, color="0.4", lw=0.8, visible=False) for ax in plot_axes.values()
         ]
         (self._period,) = path_ax.plot([], [], color="0.7", lw=0.8, label="desired, one period")
-        (self._desired,) = path_ax.plot([], [], "k--", lw=1, label="desired end effector")
+        # Over the end-effector trails (thin, dashed: visible where a run follows it),
+        # under the robots.
+        (self._desired,) = path_ax.plot(
+            [], [], "k--", lw=0.9, label="desired end effector", zorder=DESIRED_ZORDER
+        )
         (self._target,) = path_ax.plot([], [], "kx", ms=6, mew=1.2, label="desired now")
         self._style_axes()
 
@@ -134,7 +141,8 @@ class RunView:
 
         ``legends``: include the legends, so that they stay above the moving lines.
         """
-        artists: list[Any] = [self._target, self.path_ax.title, *self._cursors]
+        # The desired path is drawn over the moving trails, so it moves with them.
+        artists: list[Any] = [self._desired, self._target, self.path_ax.title, *self._cursors]
         for run in self.runs:
             artists += [run.ee_trail, run.base_trail, run.footprint, *run.wheels]
             artists += [run.heading, run.arm, run.payload]
@@ -260,10 +268,15 @@ class RunView:
         wheels = [Polygon(np.zeros((5, 2)), closed=True, fc="0.15", ec="0.15") for _ in range(2)]
         for wheel in wheels:
             ax.add_patch(wheel)
-        (heading,) = ax.plot([], [], color="0.2", lw=1.2)
-        (arm,) = ax.plot([], [], color=arm_color, lw=2.2, marker="o", ms=3, solid_capstyle="round")
+        (heading,) = ax.plot([], [], color="0.2", lw=1.2, zorder=ROBOT_ZORDER)
+        (arm,) = ax.plot(
+            [], [], color=arm_color, lw=2.2, marker="o", ms=3, solid_capstyle="round",
+            zorder=ROBOT_ZORDER,
+        )  # fmt: skip
         size = 4 + 3 * float(np.sqrt(robot.payload))
-        (payload,) = ax.plot([], [], "s", color="0.1", ms=size, mfc=arm_color, alpha=0.9)
+        (payload,) = ax.plot(
+            [], [], "s", color="0.1", ms=size, mfc=arm_color, alpha=0.9, zorder=ROBOT_ZORDER
+        )
         run = _RunArtists(
             result, label, ee_trail, base_trail, footprint, wheels, heading, arm, payload
         )

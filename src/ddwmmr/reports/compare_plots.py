@@ -109,8 +109,9 @@ def plot_paths(
 ) -> Figure:
     """End-effector paths of every method on the desired path, with zoom panels.
 
-    The desired path is drawn first (thin, dashed) and the methods on top of it from wide
-    to thin lines, so methods that follow the path, or each other, stay visible.
+    The methods are drawn from wide to thin lines, so methods that follow each other stay
+    visible, and the desired path over them, thin and dashed, so it shows where they
+    follow it.
 
     Args:
         zooms: ``(label, t, half_width)`` per zoom panel: the region around the desired
@@ -150,8 +151,9 @@ def _draw_paths(
     ax: Axes, series: Series, colors: Mapping[str, str], mark_time: float | None = None
 ) -> None:
     reference = next(iter(series.values()))
+    # The desired path over the methods, thin and dashed: visible where they follow it.
     ax.plot(
-        reference["xE_d"], reference["yE_d"], "--", color="k", lw=0.9, label="desired", zorder=1
+        reference["xE_d"], reference["yE_d"], "--", color="k", lw=0.9, label="desired", zorder=3
     )
     for width, (label, ts) in zip(_line_widths(len(series)), series.items()):
         ax.plot(ts["xE"], ts["yE"], color=colors[label], lw=width, label=label, alpha=0.9)

@@ -443,8 +443,9 @@ def _trajectory_section(c: _Context, name: str) -> None:
     c.add_figure(
         f"paths_{name}.png",
         plots.plot_paths(series, colors, f"{name}: end-effector paths", zooms),
-        f"{name}: end-effector paths over the desired path (thin dashed, drawn first; the "
-        "methods from wide to thin lines on top, so coinciding ones stay visible). The main "
+        f"{name}: end-effector paths and the desired path (thin dashed, drawn over the "
+        "methods, which go from wide to thin lines so that coinciding ones stay visible). "
+        "The main "
         "frame holds the desired path plus 0.5 m and every method's whole path (a method "
         "that drifts away widens it). Zoom "
         "A: the start, where the closed-loop methods remove the initial offset and the "
