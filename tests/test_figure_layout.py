@@ -176,6 +176,34 @@ def test_small_multiples_draw_every_instant_inside_its_panel(compare_series):
     plt.close(fig)
 
 
+def test_compare_study_and_plant_figures_show_their_data(compare_series):
+    """The study figures and the plant figure on curves of the real runs (the studies
+    only change which runs feed them)."""
+    series = compare_series["ellipse"]
+    colors = compare_plots.method_colors(METHODS)
+    t = series["ats"]["t"]
+    error = {m: series[m]["position_error_m"] for m in METHODS}
+    taus = (0.1, 0.3, 1.0, 3.0)
+    curves = {m: {tau: (t, 0.04 * np.exp(-t / tau)) for tau in taus} for m in METHODS[3:]}
+    convergence = {m: {tau: 3.0 * tau for tau in taus} for m in METHODS[3:]}
+    offsets = (0.0, 0.02, 0.04, 0.08)
+    final = {m: {x: max(error[m][-1], x if m == "ats" else 0.0) for x in offsets} for m in METHODS}
+    integrator = {m: {"euler": (t, error[m] + 1e-4), "rk4": (t, error[m])} for m in METHODS}
+    quarter = 10.0
+    rectangle = compare_series["rectangle"]
+    figures = [
+        compare_plots.plot_tau_study(curves, convergence, -np.log(0.05), colors),
+        compare_plots.plot_integrator_study(integrator, colors, 0.02),
+        compare_plots.plot_init_study(final, {x: (t, error["clrrmc-ts"] + x) for x in offsets},
+                                      "clrrmc-ts", colors),
+        compare_plots.plot_corner_study(rectangle, colors, quarter, [10.0, 20.0, 30.0]),
+        compare_plots.plot_plant_errors(series, rectangle, colors, "thesis", "plants"),
+    ]  # fmt: skip
+    for fig in figures:
+        assert_figure_shows_its_data(fig)
+        plt.close(fig)
+
+
 def test_coinciding_groups_pair_lines_within_the_factor():
     lines = {
         "a": [1.0, 2.0, 3.0],

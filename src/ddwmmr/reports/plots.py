@@ -62,14 +62,6 @@ def wheel_outlines(robot: Robot, q, width: float | None = None) -> list[np.ndarr
     return wheels
 
 
-def draw_robot(ax: Axes, robot: Robot, q, color: str = "0.35", alpha: float = 0.8) -> None:
-    """Draw the base footprint, heading and the two arm links at configuration q."""
-    shape = robot_outline(robot, q)
-    ax.plot(*shape["footprint"].T, color=color, lw=0.8, alpha=alpha)
-    ax.plot(*shape["heading"].T, color=color, lw=0.8, alpha=alpha)
-    ax.plot(*shape["arm"].T, color="tab:orange", lw=1.4, alpha=alpha, marker="o", ms=2)
-
-
 def snapshot_indices(ts: dict[str, np.ndarray], count: int) -> np.ndarray:
     """``count`` evenly spaced sample indices of a run, first and last included; on a
     closed path (end effector desired back at its start) the last is left out, since it
