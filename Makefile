@@ -60,6 +60,7 @@ docs: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python docs/qp_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/make_run_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/physics_figures.py
+	MPLBACKEND=Agg $(BIN)/python docs/support_loads.py validate plot
 	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --force --snapshot docs/figures/gui_qp_obstacle.png \
 		--method qp --payload 3 --option obstacles=trajectories/obstacles/ellipse_post.toml \
 		--compare clrrmc-ts --traj ellipse

@@ -28,7 +28,16 @@ CONTROLLER_SIDE = (
 LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     (
         "foundation",
-        ("_version", "errors", "inheritance", "commands", "gains", "progress", "outputs"),
+        (
+            "_version",
+            "errors",
+            "inheritance",
+            "commands",
+            "gains",
+            "progress",
+            "outputs",
+            "workers",
+        ),
     ),
     ("registry", ("registry",)),
     ("model", ("model", "trajectories")),

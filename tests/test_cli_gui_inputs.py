@@ -305,3 +305,15 @@ def test_a_run_that_starts_tipped_or_in_an_obstacle_is_refused(tmp_path, capsys,
         "overlaps the robot's start pose by 0.104 m",
     )
     assert files_below(tmp_path) == ["start.toml"]
+
+
+def test_a_deeply_nested_obstacle_file_is_refused(tmp_path, capsys, no_window):
+    obstacles = tmp_path / "deep.toml"
+    obstacles.write_text("[[obstacle]]\nx = 2.0\ny = 0.0\nradius = " + "[" * 5000 + "]" * 5000)
+    refused(
+        ["--snapshot", str(tmp_path / "s.png"), *FAST, "--method", "qp",
+         "--option", f"obstacles={obstacles}"],
+        capsys,
+        f"obstacles: {obstacles} nests arrays or tables more than 32 levels deep",
+    )  # fmt: skip
+    assert files_below(tmp_path) == ["deep.toml"]

@@ -47,6 +47,8 @@ from ddwmmr.arbiters.state_machine import (
     MOVE_BASE,
     OBSTACLE,
     STABILITY,
+    THESIS_MANIPULABILITY,
+    THESIS_STABILITY,
     Hysteresis,
     Selection,
 )
@@ -56,8 +58,6 @@ from ddwmmr.registry import register_arbiter
 
 #: Behaviours of the arbiter, in priority order (also the order of the weight updates).
 BEHAVIOURS = ("stability", "manipulability", "obstacle", "objective")
-#: The thesis's thresholds (Table 5.1), as for the state machine.
-THESIS_STABILITY, THESIS_MANIPULABILITY = Hysteresis(1.25, 1.60), Hysteresis(0.75, 0.90)
 #: Guard on |w| (the dynamics keep |w| <= 1; only noise can push a weight above 1).
 W_LIMIT = 1.5
 #: Weights whose square is below this are left out of the blend (not even evaluated).

@@ -45,6 +45,11 @@ class Hysteresis:
         return value < (self.exit if currently else self.enter)
 
 
+#: The thesis's thresholds (Table 5.1): S enter 1.25 / exit 1.60, eta enter 0.75 / exit 0.90.
+THESIS_STABILITY = Hysteresis(1.25, 1.60)
+THESIS_MANIPULABILITY = Hysteresis(0.75, 0.90)
+
+
 @dataclass(slots=True)
 class Selection:
     """The arbiter's decision: state, the behaviour that produced the proposal, proposal
@@ -61,8 +66,8 @@ class StateMachineArbiter:
 
     def __init__(
         self,
-        stability: Hysteresis = Hysteresis(1.25, 1.60),
-        manipulability: Hysteresis = Hysteresis(0.75, 0.90),
+        stability: Hysteresis = THESIS_STABILITY,
+        manipulability: Hysteresis = THESIS_MANIPULABILITY,
     ) -> None:
         self.stability = stability
         self.manipulability = manipulability

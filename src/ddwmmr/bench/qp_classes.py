@@ -19,6 +19,7 @@ from ddwmmr.errors import (
     ParameterError,
 )
 from ddwmmr.model import Robot
+from ddwmmr.model.stability import STABILITY_FLOOR
 from ddwmmr.progress import ProgressBar
 from ddwmmr.sim import simulate
 
@@ -53,7 +54,7 @@ def _near_floor(robot: Robot, options: dict[str, Any], call: tuple) -> bool:
     from ddwmmr.qp.limits import exact_stability
 
     q = call[1]
-    floor = options.get("stability_min", 1.25)
+    floor = options.get("stability_min", STABILITY_FLOOR)
     return exact_stability(robot.com_coefficients, float(q[3]), float(q[4])) < floor + 0.05
 
 

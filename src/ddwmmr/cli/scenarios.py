@@ -15,18 +15,20 @@ Examples::
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime as dt
 import json
 import math
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import asdict, replace
+from dataclasses import asdict, astuple, replace
 from pathlib import Path
 from typing import Any
 
 from ddwmmr import provenance
 from ddwmmr.arbiters import DEFAULT_ARBITER, arbiter_description, available_arbiters
+from ddwmmr.arbiters.state_machine import THESIS_MANIPULABILITY, THESIS_STABILITY
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.cli.common import (
     ArgumentParser,
@@ -36,6 +38,7 @@ from ddwmmr.cli.common import (
     output_folder,
     run_main,
 )
+from ddwmmr.commands import traits_of
 from ddwmmr.controllers import controller_traits, method_description
 from ddwmmr.errors import (
     MASS_RANGE_KG,
@@ -48,11 +51,19 @@ from ddwmmr.errors import (
     check_step_count,
 )
 from ddwmmr.model import Robot
-from ddwmmr.model.stability import STABILITY_CAP
+from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR, valid_stability_floor
 from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
-from ddwmmr.scenarios.executors import EXECUTORS, default_jobs, run_many
+from ddwmmr.scenarios.executors import (
+    CONNECT_TIMEOUT,
+    EXECUTORS,
+    MAX_CONNECT_TIMEOUT,
+    DaskWorkers,
+    check_connect_timeout,
+    default_jobs,
+    run_many,
+)
 from ddwmmr.scenarios.generator import Scenario, generate
 from ddwmmr.scenarios.protocol import (
     Outcome,
@@ -77,7 +88,7 @@ MAX_DT = 0.1
 QP_OPTIONS = {
     "qp_stability_min": (
         ("qp", "mpc"),
-        lambda v: 0.0 < v < STABILITY_CAP,
+        valid_stability_floor,
         f"(0, {STABILITY_CAP:g})",
     ),
     "qp_max_speed": (("qp",), lambda v: 0.0 < v <= MAX_QP_SPEED, f"(0, {MAX_QP_SPEED:g}] m/s"),
@@ -85,7 +96,10 @@ QP_OPTIONS = {
 #: Largest threshold: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
 THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}
 #: The thesis's thresholds (enter, exit), the defaults of --stability and --manipulability.
-DEFAULT_THRESHOLDS = {"stability": (1.25, 1.60), "manipulability": (0.75, 0.90)}
+DEFAULT_THRESHOLDS = {
+    "stability": astuple(THESIS_STABILITY),
+    "manipulability": astuple(THESIS_MANIPULABILITY),
+}
 
 DESCRIPTION = """\
 Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly (seeded) in
@@ -176,7 +190,7 @@ def build_parser() -> ArgumentParser:
         default=None,
         metavar=("ENTER", "EXIT"),
         help="thesis controller's stability thresholds: enter below ENTER, leave at EXIT "
-        "(default: 1.25 1.60)",
+        f"(default: {THESIS_STABILITY.enter:.2f} {THESIS_STABILITY.exit:.2f})",
     )
     parser.add_argument(
         "--manipulability",
@@ -184,7 +198,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar=("ENTER", "EXIT"),
-        help="thesis controller's manipulability thresholds (default: 0.75 0.90)",
+        help="thesis controller's manipulability thresholds "
+        f"(default: {THESIS_MANIPULABILITY.enter:.2f} {THESIS_MANIPULABILITY.exit:.2f})",
     )
     parser.add_argument(
         "--no-hysteresis",
@@ -228,6 +243,14 @@ def build_parser() -> ArgumentParser:
         help="Dask scheduler address (with --executor dask; default: start a LocalCluster)",
     )
     parser.add_argument(
+        "--connect-timeout",
+        type=float,
+        metavar="S",
+        help=f"with --scheduler: seconds the scheduler has to answer, and then to have a "
+        f"worker, in (0, {MAX_CONNECT_TIMEOUT:g}] (default: {CONNECT_TIMEOUT:g}); checked "
+        "before anything is written",
+    )
+    parser.add_argument(
         "--study",
         choices=STUDIES,
         help="'thresholds': rerun thesis Tables 5.5-5.20 threshold variations; "
@@ -239,7 +262,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar="S",
-        help="hard stability bound of the qp and mpc controllers, in (0, 10) (default: 1.25)",
+        help=f"hard stability bound of the qp and mpc controllers, in (0, {STABILITY_CAP:g}) "
+        f"(default: {STABILITY_FLOOR:g})",
     )
     parser.add_argument(
         "--qp-max-speed",
@@ -309,6 +333,10 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
     if args.scheduler and args.executor != "dask":
         raise ParameterError("scheduler: only used with --executor dask")
+    if args.connect_timeout is not None:
+        if not args.scheduler:
+            raise ParameterError("connect-timeout: only used with --scheduler")
+        check_connect_timeout(args.connect_timeout)
     if args.study == "thresholds" and args.controller != "thesis":
         raise ParameterError("study: the threshold study needs --controller thesis")
     if args.study == "arbiters" and args.controller != "thesis":
@@ -384,13 +412,34 @@ def _check_thesis_options(args: argparse.Namespace) -> None:
 
 
 class Runner:
-    """Runs batches with the chosen executor, a progress bar and timing."""
+    """Runs batches with the chosen executor, a progress bar and timing.
+
+    A context manager: with ``--executor dask`` the ``with`` block holds one client for
+    every batch, connected (or its LocalCluster started) on entry, before any output
+    exists, so a scheduler that is not there fails with one line and leaves nothing.
+    """
 
     def __init__(self, args: argparse.Namespace) -> None:
-        self.jobs = args.jobs or default_jobs()
+        # never more workers than the largest batch has scenarios
+        self.jobs = min(args.jobs or default_jobs(), largest_batch(args))
         self.executor = args.executor
         self.scheduler = args.scheduler
+        self.connect_timeout = args.connect_timeout or CONNECT_TIMEOUT
         self.progress = not args.no_progress
+        self._client: Any = None
+        self._held = contextlib.ExitStack()
+
+    def __enter__(self) -> Runner:
+        if self.executor == "dask":
+            workers = DaskWorkers(self.jobs, self.scheduler, self.connect_timeout)
+            label = "connecting to Dask" if self.scheduler else "starting Dask workers"
+            with phase(label, enabled=self.progress):
+                self._client = self._held.enter_context(workers)
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self._client = None
+        self._held.close()
 
     def run(self, scenarios: list[Scenario], config: RunConfig, label: str):
         """Outcomes in scenario order and the wall time (s)."""
@@ -401,10 +450,15 @@ class Runner:
                 config,
                 jobs=self.jobs,
                 executor=self.executor,
-                scheduler=self.scheduler,
+                client=self._client,
                 on_done=bar.advance,
             )
         return outcomes, time.perf_counter() - start
+
+
+def largest_batch(args: argparse.Namespace) -> int:
+    """Scenarios in the largest batch a run of ``args`` sends to the workers."""
+    return max(args.n, 10) if args.study == "obstacles" else args.n
 
 
 def output_names(args: argparse.Namespace, config: RunConfig) -> tuple[str, ...]:
@@ -513,13 +567,28 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         scenarios = studies.obstacle_scenarios(scenarios)
     outcomes, wall = runner.run(scenarios, config, "scenarios")
     extra = {"seed": args.seed, "run": _record(args, config)}
+    if config.controller == "mpc":
+        extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
-        f"({runner.jobs} {args.executor} workers)",
+        f"({runner.jobs} {args.executor} worker{'s' * (runner.jobs != 1)})",
         file=sys.stderr,
     )
+
+
+def mpc_options(config: RunConfig, scenario: Scenario) -> dict[str, Any]:
+    """The ``mpc``'s options as the batch's runs use them, whole: resolved for the batch's
+    plant (:meth:`~ddwmmr.mpc.options.MPCOptions.adopt_plant`), in waypoint mode, without
+    the obstacles (each scenario's own); ``summary.json["controller_options"]``."""
+    robot = config_robot(config)
+    plant = make_scenario_plant(robot, config)
+    controller = make_scenario_controller(robot, scenario, config, plant)
+    controller.adopt_plant(traits_of(plant))
+    record = controller.resolved.record("reach", config.dt)
+    del record["obstacles"]
+    return record
 
 
 def _run_thresholds(args, config, runner, folder: Path) -> None:
@@ -610,9 +679,8 @@ def _main(argv: Sequence[str] | None = None) -> int:
         robot = config_robot(config)
         plant = make_scenario_plant(robot, config)
         make_scenario_controller(robot, generate(1, 0)[0], config, plant)
-    runner = Runner(args)
     writer = output_folder(out, "scenarios", args.force, fresh)
-    with writer as folder:
+    with Runner(args) as runner, writer as folder:  # workers first, then the output
         if args.study == "thresholds":
             _run_thresholds(args, config, runner, folder)
         elif args.study == "obstacles":

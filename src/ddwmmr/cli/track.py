@@ -35,7 +35,14 @@ from ddwmmr.controllers.base import (
     method_options,
 )
 from ddwmmr.controllers.presets import PRESETS, preset_options
-from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file, shown
+from ddwmmr.errors import (
+    ParameterError,
+    check_finite,
+    check_range,
+    check_step_count,
+    read_text_file,
+    shown,
+)
 from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
@@ -329,13 +336,7 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
             f"smaller --dt) (got {duration:g})"
         )
     offset = DEFAULT_INITIAL_OFFSET if args.offset is None else tuple(args.offset)
-    for value in offset:
-        check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
-    named = "payload" if args.payload is not None else "robot"
-    # a start that tips the robot or sits in an obstacle is bad input
-    start = initial_configuration(robot, trajectory, offset)
-    check_start(robot, start, options.get("obstacles") or (), named, "--offset")
-    return RunInputs(
+    inputs = RunInputs(
         args.method,
         options,
         robot,
@@ -348,6 +349,39 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         args.traj,
         plant,
     )
+    return check_run(inputs, "payload" if args.payload is not None else "robot", "--offset")
+
+
+def check_run(inputs: RunInputs, holder: str, start: str) -> RunInputs:
+    """``inputs`` if a run of them is within what the tool accepts, else a one-line
+    :class:`ParameterError`: the checks every run passes, from options or from a record
+    (``--rerun``), which is only as trustworthy as the file it was read from.
+
+    The step count (duration, dt: finite, > 0, at most MAX_STEPS steps), the integrator
+    for the plant, the offset within the arm's reach, obstacles within the command-line
+    limits, and a start that neither tips the robot (S > 1) nor overlaps an obstacle.
+    ``holder`` (what holds the payload) and ``start`` (what sets the start pose) word the
+    tipping message."""
+    check_step_count(inputs.duration, inputs.dt)
+    plant_integrator(inputs.plant, inputs.integrator)
+    if inputs.integrator is not None and inputs.integrator not in INTEGRATORS:
+        raise ParameterError(
+            f"integrator must be one of {', '.join(INTEGRATORS)} (got {shown(inputs.integrator)})"
+        )
+    robot = inputs.robot
+    if len(inputs.offset) != 2:
+        raise ParameterError(f"offset must be two numbers dx dy in m (got {shown(inputs.offset)})")
+    for value in inputs.offset:
+        check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
+    obstacles = inputs.options.get("obstacles") or ()
+    if obstacles:
+        from ddwmmr.qp.limits.obstacles import as_circles, within_limits
+
+        obstacles = [within_limits(c.x, c.y, c.radius) for c in as_circles(obstacles)]
+    # a start that tips the robot or sits in an obstacle is bad input
+    q0 = initial_configuration(robot, inputs.trajectory, inputs.offset)
+    check_start(robot, q0, obstacles, holder, start)
+    return inputs
 
 
 def inputs_from_record(args: argparse.Namespace) -> RunInputs:
@@ -372,7 +406,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         )
         source = trajectory_record.get("file")
         offset = tuple(provenance.decode(_field(record, "initial_offset", list, "offset")))
-        return RunInputs(
+        inputs = RunInputs(
             _field(record, "method", str, "method name"),
             provenance.decode(_field(record, "options", dict, "options")),
             provenance.robot_from_record(_field(record, "robot", dict, "robot")),
@@ -385,8 +419,12 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
             str(trajectory_record.get("name") or "rerun"),
             plant,
         )
-    except ParameterError:  # already one line naming what is wrong
-        raise
+        return check_run(inputs, "payload", "the recorded initial_offset")
+    except ParameterError as exc:  # one line naming what is wrong: say where it was read
+        text = str(exc)
+        raise ParameterError(
+            text if text.startswith("rerun:") else f"rerun: {args.rerun}: {text}"
+        ) from None
     except KeyError as exc:
         raise ParameterError(
             f"rerun: {args.rerun} is not a complete run record (field run.{exc.args[0]} is missing)"
@@ -419,11 +457,12 @@ def _integrator(record: dict[str, Any], plant: str) -> str | None:
 
 
 def _number(record: dict[str, Any], key: str) -> float:
-    """``record[key]`` as a float; a bool or a string is not a number here."""
+    """``record[key]`` as a finite float; a bool or a string is not a number here, and an
+    integer too large for a float (JSON has no limit) is a ParameterError naming ``key``."""
     value = record[key]
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise TypeError(f"{key} must be a number in s, got {shown(value)}")
-    return float(value)
+    return check_finite(key, value)
 
 
 def load_run_record(path: str) -> dict[str, Any]:

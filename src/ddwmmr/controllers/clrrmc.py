@@ -127,8 +127,8 @@ class ConfigurationSpaceController:
             self.reference_step,
             self.threshold,
             self.damping,
+            horizon=period,  # one period up front
         )
-        self.reference(getattr(trajectory, "duration", 0.0))  # precompute one period
         self.last = StepInfo()
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
@@ -138,25 +138,26 @@ class ConfigurationSpaceController:
         in ``last.nonholonomic_residual`` (m/s).
         """
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
-        qdot, c, s = self._rates(t, q)
-        self.last = StepInfo(
-            singular=self.reference.last_damped, nonholonomic_residual=-qdot[0] * s + qdot[1] * c
-        )
-        return np.array([qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4]])
+        u, residual = self._input(t, q)
+        self.last = StepInfo(singular=self.reference.last_damped, nonholonomic_residual=residual)
+        return np.array(u)
 
     def law(
         self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
     ) -> tuple[Input, bool]:
         """The control law on lists of floats: ``(u, singular)``, no validation (the
         integrator evaluates it at its stages; see :mod:`ddwmmr.sim.loop`)."""
-        qdot, c, s = self._rates(t, q)
-        return (qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4]), self.reference.last_damped
+        u, _ = self._input(t, q)
+        return u, self.reference.last_damped
 
-    def _rates(self, t: float, q: list[float]) -> tuple[list[float], float, float]:
-        """``(qdot, cos phi, sin phi)``: reference rate plus configuration feedback."""
+    def _input(self, t: float, q: list[float]) -> tuple[Input, float]:
+        """``(u, residual)``: the reference rate plus configuration feedback, projected on
+        the inputs, and its sideways base part (m/s) that the drive cannot produce."""
         reference = self.reference
         if reference is None:
             raise RuntimeError("clrrmc-cs needs reset(trajectory, q0) before command()")
         q_ref, qdot_ref = reference(t)
         qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q)]
-        return qdot, math.cos(q[2]), math.sin(q[2])
+        c, s = math.cos(q[2]), math.sin(q[2])
+        u = (qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4])
+        return u, -qdot[0] * s + qdot[1] * c

@@ -35,6 +35,7 @@ import numpy as np
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
+from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
 
 #: Points inside each shooting interval where S is checked as well as at the nodes.
 INTERIOR_CHECKS = 3
@@ -82,7 +83,7 @@ class MinimumTimeProblem:
         start: Sequence[float],
         dynamics: sym.ThesisDynamics | None = None,
         intervals_per_leg: int = 30,
-        stability_min: float = 1.25,
+        stability_min: float = STABILITY_FLOOR,
         tolerance: float = 0.01,
     ) -> None:
         if intervals_per_leg < 2:
@@ -94,7 +95,7 @@ class MinimumTimeProblem:
         self.M = int(intervals_per_leg)
         self.legs = len(self.waypoints)
         self.tolerance = check_positive("tolerance", tolerance)
-        self.stability_min = check_positive("stability_min", stability_min)
+        self.stability_min = check_stability_floor(stability_min)
         self._build()
 
     def _build(self) -> None:

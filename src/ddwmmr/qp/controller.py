@@ -44,6 +44,7 @@ from ddwmmr.controllers.base import StepInfo, WaypointRun, control_step, registe
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
 from ddwmmr.model import Robot
+from ddwmmr.model.stability import STABILITY_FLOOR
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import (
     INF,
@@ -148,7 +149,7 @@ class QPController:
     def __init__(
         self,
         robot: Robot,
-        stability_min: float = 1.25,
+        stability_min: float = STABILITY_FLOOR,
         manipulability_weight: float = 0.5,
         obstacles: Sequence[Circle | Sequence[float]] | str = (),
         solver: str = DEFAULT_SOLVER,

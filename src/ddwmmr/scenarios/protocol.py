@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 from typing import Any
 
 import numpy as np
@@ -50,6 +50,8 @@ from ddwmmr.arbiters.state_machine import (
     OBSTACLE,
     STABILITY,
     STATES,
+    THESIS_MANIPULABILITY,
+    THESIS_STABILITY,
     Hysteresis,
 )
 from ddwmmr.behaviours.objective import default_pose
@@ -64,7 +66,7 @@ from ddwmmr.controllers.base import (
 )
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
-from ddwmmr.model.stability import stability_terms
+from ddwmmr.model.stability import STABILITY_FLOOR, stability_terms
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
 from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
@@ -134,12 +136,12 @@ class RunConfig:
     controller: str = "thesis"
     plant: str = "thesis"
     payload: float = 3.0
-    stability: tuple[float, float] = (1.25, 1.60)
-    manipulability: tuple[float, float] = (0.75, 0.90)
+    stability: tuple[float, float] = astuple(THESIS_STABILITY)
+    manipulability: tuple[float, float] = astuple(THESIS_MANIPULABILITY)
     dt: float = 0.01
     time_limit: float | None = None
     tolerance: float = 0.01
-    qp_stability_min: float = 1.25
+    qp_stability_min: float = STABILITY_FLOOR
     qp_max_speed: float = 1.0
     controller_options: tuple[tuple[str, Any], ...] = ()
     record: bool = False
