@@ -97,6 +97,30 @@ def test_track_path_holds_every_robot_and_names_their_times(rectangle_run):
     plt.close(fig)
 
 
+def test_path_of_a_reach_on_the_spot_draws_robots_apart():
+    """qp's sideways reach hardly moves the base (its six evenly spaced instants lie within
+    0.45 m): the path keeps the first instant and those whose base lies outside every
+    drawn footprint, each named with its time."""
+    result = simulate(Robot().with_payload(3.0), load_trajectory("sideways_reach"), "qp")
+    ts = result.timeseries
+    spacing = plots.footprint_spacing(result.robot)
+    assert spacing == pytest.approx(0.5 * np.hypot(0.45, 0.35))
+    evenly = plots.snapshot_indices(ts, 6)
+    kept = plots.snapshot_indices(ts, 6, spacing)
+    assert len(evenly) == 6 and kept[0] == 0 and 2 <= len(kept) < 6
+    assert set(kept) <= set(evenly)
+    for i, a in enumerate(kept):
+        for b in kept[i + 1 :]:
+            assert np.hypot(ts["x"][a] - ts["x"][b], ts["y"][a] - ts["y"][b]) >= spacing
+    fig = plots.plot_path(result)
+    assert_figure_shows_its_data(fig)
+    texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert [t for t in texts if t.startswith("robot at")] == [
+        f"robot at t = {ts['t'][k]:.3g} s" for k in kept
+    ]
+    plt.close(fig)
+
+
 def test_rates_put_the_base_yaw_rate_apart_and_name_the_limits(rectangle_run):
     fig = plots.plot_rates(rectangle_run)
     joints, base, wheels = fig.axes

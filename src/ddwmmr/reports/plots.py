@@ -62,12 +62,33 @@ def wheel_outlines(robot: Robot, q, width: float | None = None) -> list[np.ndarr
     return wheels
 
 
-def snapshot_indices(ts: dict[str, np.ndarray], count: int) -> np.ndarray:
-    """``count`` evenly spaced sample indices of a run, first and last included; on a
-    closed path (end effector desired back at its start) the last is left out, since it
-    would be drawn over the first."""
+def snapshot_indices(ts: dict[str, np.ndarray], count: int, spacing: float = 0.0) -> np.ndarray:
+    """Up to ``count`` evenly spaced sample indices of a run, first and last included; on
+    a closed path (end effector desired back at its start) the last is left out, since it
+    would be drawn over the first. With ``spacing`` (m), an instant whose base lies closer
+    than that to an instant already kept is left out too: a base that hardly moves (a
+    reach on the spot) shows a few robots apart rather than a tangle of footprints."""
     closed = math.hypot(ts["xE_d"][-1] - ts["xE_d"][0], ts["yE_d"][-1] - ts["yE_d"][0]) < 1e-3
-    return np.linspace(0, len(ts["t"]) - 1, count + closed)[:count].round().astype(int)
+    candidates = np.linspace(0, len(ts["t"]) - 1, count + closed)[:count].round().astype(int)
+    # The first and the last instant first: where the run starts and ends matters most.
+    ends = [candidates[0]] if closed or count < 2 else [candidates[0], candidates[-1]]
+    kept: list[int] = []
+    for k in [*ends, *(k for k in candidates if k not in ends)]:
+        if (
+            all(
+                math.hypot(ts["x"][k] - ts["x"][j], ts["y"][k] - ts["y"][j]) >= spacing
+                for j in kept
+            )
+            or k in ends
+        ):
+            kept.append(int(k))
+    return np.array(sorted(kept), dtype=int)
+
+
+def footprint_spacing(robot: Robot) -> float:
+    """Distance (m) between two bases beyond which neither lies inside the other's
+    footprint, whatever their headings: half the footprint's diagonal."""
+    return 0.5 * math.hypot(robot.base_length, robot.base_width)
 
 
 def snapshot_colors(count: int) -> list:
@@ -147,14 +168,15 @@ def break_wraps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 
 def plot_path(result, ax: Axes | None = None, snapshots: int = 6, obstacles=None) -> Figure:
-    """Desired vs actual end-effector path, base path, the robot at ``snapshots`` times
-    (one colour per time, named in the legend) and the obstacles (``(x, y, radius)``
+    """Desired vs actual end-effector path, base path, the robot at up to ``snapshots``
+    times, no base inside another's footprint (one colour per time, named in the legend; see
+    :func:`snapshot_indices`) and the obstacles (``(x, y, radius)``
     circles, m) if any. The axes hold everything drawn; the legend sits beside them."""
     ts = result.timeseries
     own_figure = ax is None
     fig, ax = _axes(ax, figsize=(8.6, 5.6))
     draw_obstacles(ax, obstacles)
-    indices = snapshot_indices(ts, snapshots)
+    indices = snapshot_indices(ts, snapshots, footprint_spacing(result.robot))
     robots = draw_snapshots(ax, result.robot, ts, indices, lw=0.9)
     # The desired path on top of the actual one, dashed: visible where they coincide.
     ax.plot(ts["xE"], ts["yE"], color="tab:blue", lw=2.2, alpha=0.8, label="actual end effector")
