@@ -1,10 +1,14 @@
 """The figure scripts of docs/ make figures that show their data (tests/figure_checks.py):
 every figure of docs/make_figures.py and docs/qp_figures.py (but its timed one), the
-physics figures that take seconds, and the frames of a physics run's animation."""
+physics figures that take seconds, the frames of a physics run's animation, the
+support-load figures (attribution from the committed numbers, validation on a short run)
+and the benchmark figure."""
 
 from __future__ import annotations
 
 import importlib.util
+import json
+import sys
 from pathlib import Path
 
 import pytest
@@ -18,6 +22,7 @@ def docs_script(name: str, tmp_path: Path, monkeypatch):
     """Import ``docs/<name>.py`` as a module writing its figures to ``tmp_path``."""
     spec = importlib.util.spec_from_file_location(f"docs_{name}", DOCS / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, spec.name, module)  # dataclasses look their module up
     spec.loader.exec_module(module)
     monkeypatch.setattr(module, "FIGURES", tmp_path)
     return module
@@ -82,8 +87,6 @@ def test_physics_animation_frames(tipping_runs, tmp_path, monkeypatch):
 
 def test_benchmark_figure(tmp_path, monkeypatch):
     """docs/figures/bench.png from the committed benchmarks/bench.json."""
-    import json
-
     spec = importlib.util.spec_from_file_location(
         "bench_docs", DOCS.parent / "benchmarks" / "bench_docs.py"
     )
@@ -93,4 +96,20 @@ def test_benchmark_figure(tmp_path, monkeypatch):
     saved = SavedFigures(monkeypatch)
     module.plot_report(report, tmp_path / "bench.png")
     assert len(saved.problems) == 1
+    assert saved.failing() == {}
+
+
+def test_support_load_figures(tmp_path, monkeypatch):
+    """The attribution figures from the committed docs/support_loads.json; the validation
+    figure on a 2 s fast turn (its full runs take minutes)."""
+    script = docs_script("support_loads", tmp_path, monkeypatch)
+    numbers = json.loads((DOCS / "support_loads.json").read_text())
+    saved = SavedFigures(monkeypatch)
+    script.draw_attribution(numbers["attribution"])
+    script.validation_figure({"fast turn": script.fast_turn(duration=2.0)}, tmp_path / "v.png")
+    assert list(saved.problems) == [
+        "support_attribution_qp.png",
+        "support_attribution_mpc.png",
+        "v.png",
+    ]
     assert saved.failing() == {}
