@@ -14,7 +14,12 @@ from matplotlib.transforms import Bbox
 from ddwmmr import Robot, load_trajectory, simulate
 from ddwmmr.reports import compare_plots, plots
 from ddwmmr.reports.legends import covers_data, place_legend
-from figure_checks import assert_figure_shows_its_data, figure_problems, segments_crossing
+from figure_checks import (
+    SavedFigures,
+    assert_figure_shows_its_data,
+    figure_problems,
+    segments_crossing,
+)
 
 # -- the check itself -------------------------------------------------------------------
 
@@ -134,6 +139,14 @@ def test_rates_put_the_base_yaw_rate_apart_and_name_the_limits(rectangle_run):
     # The yaw rate reaches -3 rad/s, beyond the joint limit: it is not on that axis.
     assert np.min(rectangle_run.timeseries["w"]) < -robot.joint_speed_limit
     plt.close(fig)
+
+
+def test_track_animation_frames_show_the_robot(rectangle_run, tmp_path, monkeypatch):
+    """Every frame of ``track --gif`` is checked as it is grabbed."""
+    saved = SavedFigures(monkeypatch)
+    plots.save_animation(rectangle_run, tmp_path / "animation.gif", frames=6)
+    assert len(saved.problems) >= 6
+    assert saved.failing() == {}
 
 
 # -- compare figures --------------------------------------------------------------------
@@ -302,6 +315,22 @@ def test_gui_view_shows_both_runs_and_no_legend_on_them():
     for ax in [app.view.path_ax, *app.view.plot_axes.values()]:
         for label in ax.get_yticklabels() + ax.get_xticklabels():
             assert label.get_fontsize() * app.figure.dpi / 72 >= 10.0
+
+
+def test_gui_animation_frames_show_both_runs():
+    """The figure of the GUI's GIF/MP4 export (the view alone) at six instants."""
+    from ddwmmr.gui.export import frame_indices
+    from ddwmmr.gui.view import animation_figure
+
+    trajectory = load_trajectory("ellipse")
+    results = [simulate(None, trajectory, m, duration=10.0) for m in ("qp", "ap")]
+    figure, view = animation_figure()
+    view.set_runs(results, ["A-qp", "B-ap"], [])
+    cursors = set(view._cursors)
+    for index in frame_indices(view.last_index, 6):
+        view.show_index(index)
+        problems = figure_problems(figure, ignore=lambda artist: artist in cursors)
+        assert problems == [], (index, problems[:5])
 
 
 def test_gui_summary_of_a_physics_run_fits_the_window_and_names_the_folder(tmp_path, monkeypatch):

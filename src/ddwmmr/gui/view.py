@@ -125,7 +125,11 @@ class RunView:
         self._fit_path(np.r_[xs, period[:, 0]], np.r_[ys, period[:, 1]], robot.base_length)
         self._fit_plots(results)
         self.path_ax.legend(
-            loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=3, fontsize=7.5, frameon=False
+            loc="upper center",
+            bbox_to_anchor=(0.5, self._below_x_axis()),
+            ncol=3,
+            fontsize=7.5,
+            frameon=False,
         )
         # The legends go where the whole runs leave room (raising a plot's top if needed),
         # placed once: they do not move during playback.
@@ -135,6 +139,15 @@ class RunView:
         for cursor in self._cursors:
             cursor.set_visible(True)
         self.show(0.0)
+
+    def _below_x_axis(self) -> float:
+        """Where the top view's legend starts (axes fraction, negative: under the axes):
+        0.07 below, or lower if the tick labels and the x label reach further down (a
+        short axes, as in the exported animation), so that the legend never covers them."""
+        renderer = self.path_ax.figure.canvas.get_renderer()
+        bottom = self.path_ax.xaxis.get_tightbbox(renderer).y0
+        reached = self.path_ax.transAxes.inverted().transform((0.0, bottom))[1]
+        return min(-0.07, reached - 0.01)
 
     def dynamic_artists(self, legends: bool = True) -> list[Any]:
         """The artists :meth:`show_index` changes (for blitting), in drawing order.
@@ -411,5 +424,6 @@ def animation_figure(dpi: float = 80.0) -> tuple[Figure, RunView]:
 
     figure = Figure(figsize=(11.0, 5.6), dpi=dpi)
     FigureCanvasAgg(figure)
-    path_ax, plot_axes = add_view_axes(figure, (0.06, 0.09, 0.46, 0.84), (0.62, 0.09, 0.36, 0.86))
+    # The top view leaves room under it for its x label and its legend (three rows).
+    path_ax, plot_axes = add_view_axes(figure, (0.06, 0.2, 0.46, 0.73), (0.62, 0.09, 0.36, 0.86))
     return figure, RunView(path_ax, plot_axes)
