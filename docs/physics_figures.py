@@ -143,8 +143,10 @@ def tipping_map() -> str:
             tipped[i, j] = hold_pose(robot, direction, 0.0)["tipped"]
             margins[i, j] = robot.stability([0, 0, 0, direction, 0.0])[2]
             disagreements += int(tipped[i, j] != (margins[i, j] <= 1.0))
-    fine_d = np.linspace(-math.pi, math.pi, 361)
-    fine_p = np.linspace(0.5, 8.0, 301)
+    # The map reaches half a grid step beyond the outer poses: their marks are whole.
+    half_d, half_p = 0.5 * (directions[1] - directions[0]), 0.5 * (payloads[1] - payloads[0])
+    fine_d = np.linspace(-math.pi - half_d, math.pi + half_d, 373)
+    fine_p = np.linspace(0.5 - half_p, 8.0 + half_p, 321)
     grid = np.array(
         [[Robot().with_payload(p).stability([0, 0, 0, d, 0])[2] for d in fine_d] for p in fine_p]
     )

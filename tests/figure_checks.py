@@ -6,7 +6,8 @@ physics, the docs scripts, the GUI):
 
 - every point of every data line and scatter, every patch drawn in data coordinates
   (footprints, obstacles) and every text placed inside an axes lies inside that axes
-  (the axes fit what is drawn); zoom panels are exempt through ``cropped``;
+  (the axes fit what is drawn), markers whole (not halved by the edge); zoom panels are
+  exempt through ``cropped``;
 - no legend box is crossed by a data line (segments, not only vertices, so a horizontal
   limit line under a legend counts) nor covers a scatter point or a data patch (bar,
   footprint, obstacle: its bounding box);
@@ -68,6 +69,7 @@ def figure_problems(
         everything.append((box, [(f"{name}: {label}", xy) for label, xy in polylines]))
         if ax not in cropped:
             problems += _outside(name, box, polylines)
+            problems += _markers_cut(name, ax, box, ignore)
             problems += _patches_outside(name, ax, box, ignore)
         legend = ax.get_legend()
         if legend is not None and legend.get_visible():
@@ -177,6 +179,44 @@ def _outside(name: str, box: Bbox, polylines: list[tuple[str, np.ndarray]]) -> l
         )
         if np.any(out):
             problems.append(f"{name}: {label} has {int(out.sum())} points outside the axes")
+    return problems
+
+
+def _markers_cut(name: str, ax: Axes, box: Bbox, ignore: Callable[[Artist], bool]) -> list[str]:
+    """Markers (of lines and scatters) whole inside the axes, not halved by its edge."""
+    scale = ax.figure.dpi / 72.0
+    problems = []
+    found: list[tuple[Artist, np.ndarray, np.ndarray]] = []  # artist, centres, radii (px)
+    for line in ax.lines:
+        if not line.get_visible() or ignore(line) or line.get_marker() in (None, "", "None", " "):
+            continue
+        xy = np.column_stack(
+            [
+                np.asarray(line.get_xdata(orig=False), float),
+                np.asarray(line.get_ydata(orig=False), float),
+            ]
+        )
+        centres = line.get_transform().transform(xy) if len(xy) else np.empty((0, 2))
+        found.append((line, centres, np.full(len(centres), 0.5 * line.get_markersize() * scale)))
+    for collection in ax.collections:
+        if not isinstance(collection, PathCollection) or not collection.get_visible():
+            continue
+        if ignore(collection) or len(collection.get_offsets()) == 0:
+            continue
+        centres = collection.get_offset_transform().transform(collection.get_offsets())
+        sizes = np.resize(np.asarray(collection.get_sizes(), float), len(centres))
+        found.append((collection, centres, 0.5 * np.sqrt(sizes) * scale))
+    for artist, centres, radii in found:
+        keep = np.all(np.isfinite(centres), axis=1)
+        centres, radii = centres[keep], radii[keep] - TOLERANCE_PX
+        cut = (
+            (centres[:, 0] - radii < box.x0)
+            | (centres[:, 0] + radii > box.x1)
+            | (centres[:, 1] - radii < box.y0)
+            | (centres[:, 1] + radii > box.y1)
+        )
+        if np.any(cut):
+            problems.append(f"{name}: {_artist_name(artist)} has {int(cut.sum())} markers cut")
     return problems
 
 

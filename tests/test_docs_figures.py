@@ -47,6 +47,23 @@ def test_qp_figures(function, tmp_path, monkeypatch):
     assert saved.failing() == {}
 
 
+def test_physics_tipping_map(tmp_path, monkeypatch):
+    """The tipping map's layout (its 400 MuJoCo holds take minutes): each hold is judged
+    by the kinematic S instead, which MuJoCo matches on this grid (docs/physics.md)."""
+    from ddwmmr import Robot
+
+    script = docs_script("physics_figures", tmp_path, monkeypatch)
+
+    def hold_pose(robot: Robot, th1: float, th2: float, **_) -> dict:
+        return {"tipped": robot.stability([0.0, 0.0, 0.0, th1, th2])[2] <= 1.0}
+
+    monkeypatch.setattr(script, "hold_pose", hold_pose)
+    saved = SavedFigures(monkeypatch)
+    assert script.tipping_map().endswith("0 where MuJoCo disagrees with S <= 1")
+    assert list(saved.problems) == ["physics_tipping_map.png"]
+    assert saved.failing() == {}
+
+
 @pytest.fixture(scope="module")
 def tipping_runs():
     """ats and clrrmc-ts reaching sideways with 4 kg on the physics plant: both tip."""
