@@ -267,6 +267,26 @@ def test_dt_study_names_the_lines_lying_on_each_other():
     plt.close(fig)
 
 
+def test_init_study_names_the_methods_lying_on_each_other():
+    offsets = (0.0, 0.02, 0.04)
+    final = {
+        "pi": dict.fromkeys(offsets, 3.0),
+        "ap": dict.fromkeys(offsets, 3.2),  # within 15 % of pi: on the same spot
+        "ats": {x: max(x, 1e-11) for x in offsets},
+    }
+    t = np.linspace(0.0, 10.0, 50)
+    curves = {x: (t, (x + 1e-3) * np.exp(-t)) for x in offsets}
+    fig = compare_plots.plot_init_study(
+        final, curves, "ats", compare_plots.method_colors(list(final))
+    )
+    left = fig.axes[0]
+    assert "pi = ap" in left.get_legend().get_title().get_text()
+    widths = {line.get_label(): line.get_linewidth() for line in left.lines}
+    assert widths["pi"] > widths["ap"]  # wide under thin: both visible
+    assert_figure_shows_its_data(fig)
+    plt.close(fig)
+
+
 # -- the GUI ----------------------------------------------------------------------------
 
 

@@ -352,18 +352,24 @@ def plot_tau_study(
     return fig
 
 
+#: Two lines of the initial-offset study coincide when they are this close (px) at every
+#: offset: about two line widths at the figure's resolution.
+COINCIDE_PX = 4.0
+
 #: Two lines of the step-size study coincide on the plot when they are within this
 #: factor of each other at every step (a few line widths on its log axis).
 COINCIDE_FACTOR = 1.15
 
 
-def coinciding_groups(lines: Mapping[str, Sequence[float]]) -> list[list[str]]:
+def coinciding_groups(
+    lines: Mapping[str, Sequence[float]], factor: float = COINCIDE_FACTOR
+) -> list[list[str]]:
     """Groups (of two or more names, in the given order) of lines whose values agree
-    within :data:`COINCIDE_FACTOR` at every point: drawn on a log axis they lie on each
-    other. Each line belongs to at most one group (the first that it matches)."""
+    within ``factor`` at every point: drawn on a log axis they lie on each other. Each
+    line belongs to at most one group (the first that it matches)."""
     names = list(lines)
     logs = {n: np.log(np.maximum(np.asarray(lines[n], float), ERROR_FLOOR)) for n in names}
-    limit = math.log(COINCIDE_FACTOR)
+    limit = math.log(factor)
     groups: list[list[str]] = []
     placed: set[str] = set()
     for i, name in enumerate(names):
@@ -378,6 +384,26 @@ def coinciding_groups(lines: Mapping[str, Sequence[float]]) -> list[list[str]]:
             groups.append(group)
             placed.update(group)
     return groups
+
+
+def coinciding_looks(
+    lines: Mapping[str, Sequence[float]], factor: float = COINCIDE_FACTOR
+) -> tuple[dict[str, tuple[float, str]], list[list[str]]]:
+    """Line width and marker of every line in a :func:`coinciding_groups` group (from
+    wide to thin, a different marker each, so that each stays visible), and the groups."""
+    groups = coinciding_groups(lines, factor)
+    look: dict[str, tuple[float, str]] = {}
+    for group in groups:
+        for width, marker, name in zip(_line_widths(len(group)), "os^D", group):
+            look[name] = (width + 0.6, marker)
+    return look, groups
+
+
+def coinciding_note(groups: list[list[str]]) -> str | None:
+    """A legend title naming the lines that lie on each other (None: there are none)."""
+    if not groups:
+        return None
+    return "lying on each other\n(wide to thin):\n" + "\n".join(" = ".join(g) for g in groups)
 
 
 def plot_dt_study(
@@ -399,11 +425,7 @@ def plot_dt_study(
         for method, by_integrator in drift.items()
         for integrator, values in by_integrator.items()
     }
-    groups = coinciding_groups(lines)
-    look: dict[str, tuple[float, str]] = {}
-    for group in groups:
-        for width, marker, name in zip(_line_widths(len(group)), "os^D", group):
-            look[name] = (width + 0.6, marker)
+    look, groups = coinciding_looks(lines)
     for method, by_integrator in drift.items():
         for integrator, values in by_integrator.items():
             name = f"{method} ({integrator})"
@@ -424,12 +446,7 @@ def plot_dt_study(
     ax.set_ylabel("largest position error (m)")
     ax.set_title("drift vs step size: Euler (solid) is first order, RK4 (dashed) fourth")
     ax.grid(alpha=0.3, which="both")
-    note = (
-        "lying on each other\n(wide to thin):\n" + "\n".join(" = ".join(g) for g in groups)
-        if groups
-        else None
-    )
-    legend_beside(ax, fontsize=8, title=note, title_fontsize=8, alignment="left")
+    legend_beside(ax, fontsize=8, title=coinciding_note(groups), title_fontsize=8, alignment="left")
     fig.tight_layout()
     return fig
 
@@ -469,16 +486,21 @@ def plot_init_study(
     colors: Mapping[str, str],
 ) -> Figure:
     """Initial-offset sweep: final error vs initial offset, and one method's error curves.
+    Methods whose final errors lie on each other are drawn from wide to thin and named in
+    the legend's title (:func:`coinciding_looks`).
 
     Args:
         final: method -> initial offset (m) -> final position error (m).
         curves: initial offset (m) -> (t, position error) for ``curve_method``.
     """
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    drawn = {}
     for method, values in final.items():
         xs = sorted(values)
         errors = [max(values[x], ERROR_FLOOR) for x in xs]
-        ax1.plot([1000 * x for x in xs], errors, "o-", color=colors[method], label=method)
+        (drawn[method],) = ax1.plot(
+            [1000 * x for x in xs], errors, "o-", color=colors[method], label=method
+        )
     ax1.set_yscale("log")
     ax1.set_xlabel("initial end-effector offset (mm)")
     ax1.set_ylabel("final position error (m, log)")
@@ -495,9 +517,23 @@ def plot_init_study(
     ax2.set_ylabel("position error (m, log)")
     ax2.set_title(f"{curve_method}: error vs time per initial offset")
     ax2.grid(alpha=0.3)
+    legend_beside(ax1, fontsize=8)
     fig.tight_layout()
-    place_legend(ax1, fontsize=8)
+    # Lines within a few pixels of each other at every offset lie on each other here.
+    low, high = ax1.get_ylim()
+    pixels_per_decade = ax1.get_window_extent().height / math.log10(high / low)
+    factor = 10 ** (COINCIDE_PX / pixels_per_decade)
+    look, groups = coinciding_looks(
+        {m: [v[x] for x in sorted(v)] for m, v in final.items()}, factor
+    )
+    for method, (width, marker) in look.items():
+        line = drawn[method]
+        line.set(lw=width, marker=marker, ms=4 + width, mfc="none")
+    legend_beside(
+        ax1, fontsize=8, title=coinciding_note(groups), title_fontsize=8, alignment="left"
+    )
     place_legend(ax2, fontsize=8)
+    fig.tight_layout()
     return fig
 
 
