@@ -221,7 +221,8 @@ def slow_sideways_reach(payload: float = 3.2, rate: float = 0.05) -> str:
     fell = int(np.argmax(data[:, -1] > TIP_TILT_RAD))
     # Until the base has tilted 1 degree: the margins of a falling robot mean nothing, and
     # its growing tilt would flatten the margins' curves.
-    tilted = int(np.argmax(np.degrees(data[:, -1]) > 1.0))
+    leaning = np.degrees(data[:, -1]) > 1.0
+    tilted = int(np.argmax(leaning)) if np.any(leaning) else len(t) - 1
     shown = t <= t[tilted]
     ax2.plot(t[shown], s[shown], label="kinematic S")
     ax2.plot(t[shown], data[shown, -2], label="S_phys (centre of pressure)", lw=0.8)

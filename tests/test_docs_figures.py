@@ -64,6 +64,16 @@ def test_physics_tipping_map(tmp_path, monkeypatch):
     assert saved.failing() == {}
 
 
+def test_physics_slow_reach_figure(tmp_path, monkeypatch):
+    """physics_sideways_forces.png on a faster unfolding (0.4 rad/s: 250 steps instead of
+    1650): the same figure, its layout checked."""
+    script = docs_script("physics_figures", tmp_path, monkeypatch)
+    saved = SavedFigures(monkeypatch)
+    script.slow_sideways_reach(rate=0.4)
+    assert list(saved.problems) == ["physics_sideways_forces.png"]
+    assert saved.failing() == {}
+
+
 @pytest.fixture(scope="module")
 def tipping_runs():
     """ats and clrrmc-ts reaching sideways with 4 kg on the physics plant: both tip."""
