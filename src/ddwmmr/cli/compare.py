@@ -63,6 +63,7 @@ from ddwmmr.reports.compare.plan import run_duration
 from ddwmmr.resolution.reference import initial_configuration
 from ddwmmr.sim.result import json_safe, write_atomic
 from ddwmmr.sim.simulate import check_start
+from ddwmmr.sim.verdict import explain
 from ddwmmr.trajectories import available_trajectories, load_trajectory, trajectory_name
 from ddwmmr.trajectories.files import find_trajectory_file
 
@@ -380,8 +381,35 @@ def config_from_arguments(
     )
 
 
-def format_summary(info: ReportInfo, out: Path, runs: int, seconds: float, jobs: int) -> str:
-    """The short console summary: ranking table, slides verdict, where the files went."""
+def not_tracked(plan: Any, outputs: dict[Any, Any]) -> list[str]:
+    """Console lines for the main runs that did not track (:mod:`ddwmmr.sim.verdict`):
+    one per run saying what went wrong, then each likely cause once."""
+    lines, causes = [], {}
+    for spec in plan.main:
+        found, what, cause = explain(outputs[spec].summary)
+        if found:
+            lines.append(f"  {spec.method} on {spec.trajectory}: {what}")
+            causes.setdefault(cause, []).append(spec.method)
+    if not lines:
+        return ['Every run tracked (see docs/cli.md, "Verdict").']
+    head = f'Did not track ({len(lines)} of {len(plan.main)} runs; see docs/cli.md, "Verdict"):'
+    tail = [
+        f"  likely cause ({', '.join(dict.fromkeys(methods))}): {cause}"
+        for cause, methods in causes.items()
+    ]
+    return [head, *lines, *tail]
+
+
+def format_summary(
+    info: ReportInfo,
+    out: Path,
+    runs: int,
+    seconds: float,
+    jobs: int,
+    failures: Sequence[str] = (),
+) -> str:
+    """The short console summary: ranking table, slides verdict, the runs that did not
+    track (``failures``, from :func:`not_tracked`), where the files went."""
     ranking, check = info.ranking, info.check
     lines = [
         f"Compared {len(ranking.overall)} methods on {', '.join(ranking.scores)}: {runs} runs "
@@ -400,6 +428,8 @@ def format_summary(info: ReportInfo, out: Path, runs: int, seconds: float, jobs:
         for method in dict.fromkeys(v.expected_better for v in found):
             worse = [slides_name(v.expected_worse) for v in found if v.expected_better == method]
             lines.append(f"  {name}: {slides_name(method)} scores worse than {', '.join(worse)}")
+    if failures:
+        lines += ["", *failures]
     figures = sum(name.endswith(".png") for name in info.files)
     lines += [
         "",
@@ -429,7 +459,7 @@ def _main(argv: Sequence[str] | None) -> int:
             info = write_report(config, plan, outputs, staging)
             write_atomic(staging / "run.json", json.dumps(json_safe(record), indent=2) + "\n")
     seconds = time.perf_counter() - start
-    print(format_summary(info, out, len(specs), seconds, jobs))
+    print(format_summary(info, out, len(specs), seconds, jobs, not_tracked(plan, outputs)))
     return 0
 
 

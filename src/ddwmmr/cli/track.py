@@ -13,6 +13,7 @@ import argparse
 import datetime as dt
 import json
 import sys
+import textwrap
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -304,7 +305,8 @@ def default_out(method: str, traj: str) -> Path:
 
 
 def format_table(summary: dict[str, Any]) -> str:
-    """The summary as an aligned two-column text table (lengths in mm)."""
+    """The summary as an aligned two-column text table (lengths in mm), then the run's
+    verdict (:mod:`ddwmmr.sim.verdict`)."""
     plant = summary.get("plant", PLANT)
     lines = [f"{summary['method']} on {summary['trajectory']} ({plant} plant)"]
     for key, label in TABLE_KEYS:
@@ -314,6 +316,8 @@ def format_table(summary: dict[str, Any]) -> str:
                 value = 1000.0 * value
             text = f"{value:.6g}" if isinstance(value, float) else str(value)
             lines.append(f"  {label:<36} {text}")
+    if "verdict" in summary:
+        lines.append(textwrap.fill(f"verdict: {summary['verdict']}", 100, subsequent_indent="  "))
     return "\n".join(lines)
 
 
