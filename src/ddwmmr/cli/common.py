@@ -45,9 +45,11 @@ __all__ = [
     "ArgumentParser",
     "Terminated",
     "add_force_argument",
+    "add_option_argument",
     "add_robot_arguments",
     "check_output_folder",
     "first_free",
+    "method_options_text",
     "output_folder",
     "robot_from_arguments",
     "run_main",
@@ -179,6 +181,33 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
         type=float,
         metavar="KG",
         help="payload at the end effector in kg (default: the robot's, 1.25 for Robot())",
+    )
+
+
+def add_option_argument(
+    parser: argparse.ArgumentParser | argparse._ArgumentGroup, applies_to: str
+) -> None:
+    """``--option NAME=VALUE`` (repeatable): any option of the method(s), parsed and
+    checked as the simulator's fields are (:func:`ddwmmr.controllers.option_specs.
+    parse_option`); ``applies_to`` says which method(s) take it."""
+    parser.add_argument(
+        "--option",
+        action="append",
+        metavar="NAME=VALUE",
+        help=f"an option of {applies_to} (repeatable), e.g. horizon=2, aux=sum, "
+        "tau=0.5,0.5,inf, obstacles=FILE; each method's options are listed at the end, "
+        "the common ones also have a flag of their own",
+    )
+
+
+def method_options_text(methods: Sequence[str]) -> str:
+    """``--help``'s list of each method's options (``--option NAME=VALUE``), one line per
+    method: ``  qp: stability_min, manipulability_weight, ...``."""
+    from ddwmmr.controllers.option_specs import option_names
+
+    lines = [f"  {m}: {', '.join(option_names(m)) or '(none)'}" for m in methods]
+    return "options of each method (--option NAME=VALUE; docs/api.md, Controllers):\n" + (
+        "\n".join(lines)
     )
 
 

@@ -14,6 +14,7 @@ import argparse
 import json
 import os
 import sys
+import textwrap
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -23,13 +24,16 @@ from ddwmmr import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
+    add_option_argument,
     add_robot_arguments,
     check_output_folder,
+    method_options_text,
     output_folder,
     robot_from_arguments,
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, method_description
+from ddwmmr.controllers.option_specs import option_names, parse_options
 from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import (
     MAX_JOBS,
@@ -37,6 +41,7 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_positive,
     check_step_count,
+    did_you_mean,
 )
 from ddwmmr.plants import available_plants
 from ddwmmr.progress import phase
@@ -65,7 +70,7 @@ from ddwmmr.sim.result import json_safe, write_atomic
 from ddwmmr.sim.simulate import check_start
 from ddwmmr.sim.verdict import explain
 from ddwmmr.trajectories import available_trajectories, load_trajectory, trajectory_name
-from ddwmmr.trajectories.files import find_trajectory_file
+from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = "python -m ddwmmr.compare"
 DEFAULT_OUT = "runs/compare"
@@ -114,9 +119,14 @@ and step (the trajectory's T/N). Results do not depend on --jobs; only the step 
 
 
 def epilog() -> str:
-    """The ``--help`` text after the options: outputs, ranking, studies, methods."""
+    """The ``--help`` text after the options: outputs, ranking, studies, methods and their
+    options."""
     methods = "\n".join(f"  {m:<10}  {method_description(m)}" for m in available_methods())
-    return f"{EPILOG_TEXT}\nmethods:\n{methods}"
+    options = "\n".join(
+        textwrap.fill(line, 88, subsequent_indent="    ")
+        for line in method_options_text(available_methods()).splitlines()
+    )
+    return f"{EPILOG_TEXT}\nmethods:\n{methods}\n\n{options}"
 
 
 def build_parser() -> ArgumentParser:
@@ -209,10 +219,65 @@ def build_parser() -> ArgumentParser:
         "mujoco: rigid-body physics) and report their errors next to the kinematic plant's, "
         "with the reasons (lag, torque limits, slip)",
     )
+    add_option_argument(
+        parser,
+        "the compared methods: NAME=VALUE goes to every method taking NAME, METHOD:NAME=VALUE "
+        "to that one; over the preset, in every run of the method (a study's own setting, "
+        "such as the swept tau, still wins there)",
+    )
+    parser.add_argument(
+        "--horizon",
+        type=float,
+        metavar="S",
+        help="prediction horizon in s of the methods taking one (mpc; docs/mpc.md); the same "
+        "as --option horizon=S",
+    )
     add_robot_arguments(parser)
     add_force_argument(parser)
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     return parser
+
+
+def parse_method_options(
+    texts: Sequence[str] | None, methods: Sequence[str], horizon: float | None = None
+) -> dict[str, dict[str, Any]]:
+    """The user's options per compared method, from ``--option [METHOD:]NAME=VALUE`` and
+    ``--horizon`` (checked as the simulator's fields are; values made hashable)."""
+    texts = [*(texts or ()), *(() if horizon is None else (f"horizon={horizon!r}",))]
+    chosen: dict[str, list[str]] = {m: [] for m in methods}
+    for text in texts:
+        target, colon, rest = text.partition(":")
+        if colon and "=" not in target:  # METHOD:NAME=VALUE
+            if target not in chosen:
+                raise ParameterError(
+                    f"option: {target!r} is not a compared method{did_you_mean(target, chosen)}"
+                    f" (compared: {', '.join(methods)}; got {text!r})"
+                )
+            chosen[target].append(rest)
+            continue
+        name = text.partition("=")[0].strip()
+        takers = [m for m in methods if name in option_names(m)]
+        if not takers:
+            if "=" not in text:
+                raise ParameterError(f"option must be [METHOD:]NAME=VALUE (got {text!r})")
+            known = sorted({n for m in methods for n in option_names(m)})
+            taken = "; ".join(f"{m}: {', '.join(option_names(m))}" for m in methods)
+            raise ParameterError(
+                f"option: no compared method takes {name!r}{did_you_mean(name, known)} ({taken})"
+            )
+        for method in takers:
+            chosen[method].append(text)
+    options = {}
+    for method, given in chosen.items():
+        parsed = parse_options(method, given)
+        if "obstacles" in parsed and parsed["obstacles"] is not None:
+            from ddwmmr.qp.limits.obstacles import load_obstacles
+
+            circles = load_obstacles(find_obstacle_file(parsed["obstacles"]))
+            parsed["obstacles"] = tuple((c.x, c.y, c.radius) for c in circles)
+        if parsed:
+            options[method] = parsed
+    return options
 
 
 def split_list(values: Sequence[str] | None, option: str) -> list[str]:
@@ -336,7 +401,9 @@ def run_record(
         study_methods=list(config.study_methods or ()),
         preset=config.preset,
         options={
-            m: provenance.options_record(m, preset_options(m, config.preset))
+            m: provenance.options_record(
+                m, {**preset_options(m, config.preset), **config.options.get(m, {})}
+            )
             for m in config.methods
         },
         robot=provenance.robot_record(config.robot),
@@ -378,6 +445,7 @@ def config_from_arguments(
         command=command,
         preset=args.preset,
         plants=parse_plants(args.plant),
+        options=parse_method_options(args.option, methods, args.horizon),
     )
 
 

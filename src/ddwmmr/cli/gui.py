@@ -28,7 +28,7 @@ from ddwmmr.cli.common import ArgumentParser, run_main
 from ddwmmr.controllers.base import available_methods
 from ddwmmr.errors import ParameterError, check_range
 from ddwmmr.gui.layout import desktop_figure
-from ddwmmr.gui.options import method_options, plant_names
+from ddwmmr.gui.options import parse_option, plant_names
 from ddwmmr.gui.paths import (
     SNAPSHOT_FORMATS,
     check_existing_snapshot,
@@ -172,18 +172,6 @@ def build_parser() -> ArgumentParser:
     return parser
 
 
-def parse_option(method: str, text: str) -> tuple[str, object]:
-    """``NAME=VALUE`` -> (name, value) as the window's field for that option parses it."""
-    name, sep, value = text.partition("=")
-    specs = {spec.name: spec for spec in method_options(method)}
-    if not sep or not name:
-        raise ParameterError(f"option must be NAME=VALUE (got {text!r})")
-    if name not in specs:
-        known = ", ".join(specs) or "none"
-        raise ParameterError(f"option: {method} has no option {name!r} (options: {known})")
-    return name, specs[name].parse(value)
-
-
 def settings_from_arguments(args: argparse.Namespace) -> Settings:
     """The :class:`Settings` the options describe (checked)."""
     settings = Settings(trajectory=args.traj).with_method(0, args.method)
@@ -191,8 +179,9 @@ def settings_from_arguments(args: argparse.Namespace) -> Settings:
     for slot, texts in ((0, args.option), (1, args.compare_option)):
         if texts and settings.methods[slot] is None:
             raise ParameterError("compare-option needs --compare METHOD")
+        what = ("option", "compare-option")[slot]
         for text in texts:
-            name, value = parse_option(settings.methods[slot], text)
+            name, value = parse_option(settings.methods[slot], text, what)
             settings = settings.with_option(slot, name, value)
     for name, _, _ in GEOMETRY:
         value = getattr(args, name)

@@ -22,9 +22,11 @@ from ddwmmr import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
+    add_option_argument,
     add_robot_arguments,
     check_output_folder,
     first_free,
+    method_options_text,
     output_folder,
     robot_from_arguments,
     run_main,
@@ -35,6 +37,7 @@ from ddwmmr.controllers.base import (
     method_description,
     method_options,
 )
+from ddwmmr.controllers.option_specs import parse_options
 from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import (
     ParameterError,
@@ -67,7 +70,7 @@ RERUN_TOOLS = ("track", "gui")
 RUN_OPTIONS = (
     "method", "traj", "aux", "tau", "dt", "duration", "integrator", "offset", "robot", "plant",
     "payload", "stability_min", "manipulability_weight", "obstacles", "solver", "qp_mode",
-    "preset",
+    "preset", "horizon", "option",
 )  # fmt: skip
 
 #: Keys printed in the summary table, with their labels; errors in mm (as in compare).
@@ -115,6 +118,7 @@ METHOD_OPTIONS = {
     "obstacles": "obstacles",
     "solver": "solver",
     "qp_mode": "mode",
+    "horizon": "horizon",
 }
 
 
@@ -145,6 +149,20 @@ def _default_text(value: Any) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
+class _Formatter(argparse.HelpFormatter):
+    """Help as argparse wraps it, except the epilog's lines after the first paragraph (the
+    options of each method), kept one method per line."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        first, _, rest = text.partition("\n\n")
+        filled = super()._fill_text(first, width, indent)
+        lines = [
+            textwrap.fill(line, width, initial_indent=indent, subsequent_indent=indent + "    ")
+            for line in rest.splitlines()
+        ]
+        return "\n\n".join([filled, "\n".join(lines)]) if rest else filled
+
+
 def build_parser() -> ArgumentParser:
     """The argument parser (also used to render docs/cli.md)."""
     methods = available_methods()
@@ -158,7 +176,8 @@ def build_parser() -> ArgumentParser:
             "(errors in mm). summary.json records everything needed to repeat the run: "
             f"`{PROG} --rerun DIR/summary.json` reproduces it bit for bit."
         ),
-        epilog=f"Methods - {method_help}.",
+        epilog=f"Methods - {method_help}.\n\n{method_options_text(methods)}",
+        formatter_class=_Formatter,
     )
     parser.add_argument(
         "--method", choices=methods, help="control method (required unless --rerun)"
@@ -260,6 +279,13 @@ def build_parser() -> ArgumentParser:
         choices=("weighted", "hierarchical"),
         help=_option_help("priority handling", "mode"),
     )
+    qp.add_argument(
+        "--horizon",
+        type=float,
+        metavar="S",
+        help=_option_help("prediction horizon in s (docs/mpc.md, Options)", "horizon"),
+    )
+    add_option_argument(qp, "--method (every option, not only those with a flag)")
     out = parser.add_argument_group("output")
     out.add_argument(
         "--out",
@@ -275,7 +301,8 @@ def build_parser() -> ArgumentParser:
 
 
 def controller_options(args: argparse.Namespace) -> dict[str, Any]:
-    """Controller keyword arguments from the CLI options that were given."""
+    """Controller keyword arguments from the CLI options that were given: the named flags
+    and ``--option NAME=VALUE`` (one option may not be given both ways)."""
     options: dict[str, Any] = {}
     for attribute, keyword in METHOD_OPTIONS.items():
         value = getattr(args, attribute)
@@ -289,12 +316,18 @@ def controller_options(args: argparse.Namespace) -> dict[str, Any]:
             )
         if attribute == "tau" and len(value) == 1:
             value = value[0]
-        if attribute == "obstacles":
-            from ddwmmr.qp.limits.obstacles import load_obstacles
-
-            circles = load_obstacles(find_obstacle_file(value))
-            value = [(c.x, c.y, c.radius) for c in circles]  # plain numbers: recordable
         options[keyword] = value
+    flags = {keyword: attribute for attribute, keyword in METHOD_OPTIONS.items()}
+    for name, value in parse_options(args.method, args.option).items():
+        if name in options:
+            flag = "--" + flags[name].replace("_", "-")
+            raise ParameterError(f"option: {name} is given both as {flag} and as --option")
+        options[name] = value
+    if isinstance(options.get("obstacles"), str):  # a name or a file: the circles
+        from ddwmmr.qp.limits.obstacles import load_obstacles
+
+        circles = load_obstacles(find_obstacle_file(options["obstacles"]))
+        options["obstacles"] = [(c.x, c.y, c.radius) for c in circles]  # plain: recordable
     return options
 
 
