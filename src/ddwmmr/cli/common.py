@@ -24,9 +24,9 @@ import sys
 import threading
 from collections.abc import Callable, Iterator, Sequence
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, did_you_mean
 from ddwmmr.model import Robot
-from ddwmmr.outputs import check_output_folder, first_free, output_folder
+from ddwmmr.outputs import check_output_folder, first_free, output_folder, package_version
 
 #: Exit status for bad input (argparse uses the same).
 EXIT_USAGE = 2
@@ -64,16 +64,41 @@ NEGATIVE_NUMBER = re.compile(
 )
 
 
+#: argparse's message for options it does not know (``--methd x``).
+UNRECOGNISED = "unrecognized arguments: "
+
+
 class ArgumentParser(argparse.ArgumentParser):
     """argparse with one-line errors: ``prog: error: message`` and exit status 2, and
-    negative numbers in any float notation taken as values (:data:`NEGATIVE_NUMBER`)."""
+    negative numbers in any float notation taken as values (:data:`NEGATIVE_NUMBER`);
+    ``--version``; a mistyped option gets the closest one (``--methd``: "did you mean
+    --method?")."""
+
+    #: What starts an error line (None: the parser's ``prog``).
+    error_prefix: str | None = None
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
+        if self.add_help:
+            self.add_argument("--version", action="version", version=f"ddwmmr {package_version()}")
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+        prefix = self.prog if self.error_prefix is None else self.error_prefix
+        self.exit(EXIT_USAGE, f"{prefix}: error: {self._with_suggestions(message)}\n")
+
+    def _with_suggestions(self, message: str) -> str:
+        """``message``, with the closest known option after each unknown one."""
+        if not message.startswith(UNRECOGNISED):
+            return message
+        known = [o for o in self._option_string_actions if o.startswith("--")]
+        words = [
+            f"{word}{did_you_mean(word.split('=')[0], known)}"
+            if word.startswith("--") and not NEGATIVE_NUMBER.match(word)
+            else word
+            for word in message[len(UNRECOGNISED) :].split()
+        ]
+        return UNRECOGNISED + " ".join(words)
 
 
 class Terminated(BaseException):

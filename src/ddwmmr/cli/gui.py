@@ -11,7 +11,8 @@ Examples::
 ``--snapshot PATH`` builds the same window off-screen (Agg), runs the simulation to the
 end, draws the final state and saves the whole window (controls and plots) to PATH, in the
 image format of its suffix (.png, .svg, .pdf...). An existing file is never replaced
-without ``--force``. Bad input, an output path that cannot be written included, prints one
+without ``--force``, unless an earlier snapshot wrote it (its metadata says so: .png,
+.svg, .pdf, .eps, .ps). Bad input, an output path that cannot be written included, prints one
 line on stderr and exits with status 2 before anything is built or run (nothing is
 written).
 """
@@ -35,6 +36,7 @@ from ddwmmr.gui.paths import (
     check_export_root,
     check_snapshot_path,
     snapshot_format,
+    snapshot_metadata,
 )
 from ddwmmr.gui.settings import (
     GEOMETRY,
@@ -81,7 +83,8 @@ def build_parser() -> ArgumentParser:
         "--force",
         action="store_true",
         help="with --snapshot: replace an existing file at PATH (never a folder or a "
-        "special file); without it an existing file is refused",
+        "special file); without it an existing file is refused unless an earlier snapshot "
+        "wrote it (.png, .svg, .pdf, .eps, .ps carry a mark saying so)",
     )
     parser.add_argument(
         "--dpi",
@@ -233,7 +236,7 @@ def snapshot(
     app.show_index(app.view.last_index)
     app.say(f"snapshot: final state at t = {app.view.time:.2f} s (--snapshot {Path(path).name})")
     buffer = io.BytesIO()
-    figure.savefig(buffer, format=fmt, dpi=dpi or DPI)
+    figure.savefig(buffer, format=fmt, dpi=dpi or DPI, metadata=snapshot_metadata(fmt))
     check_existing_snapshot(target, text, force)  # appeared during the run?
     created = missing_folders(target.parent)
     try:
