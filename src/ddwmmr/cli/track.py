@@ -216,7 +216,14 @@ def build_parser() -> ArgumentParser:
         "settings: aux sum, no orientation feedback for clrrmc-ts); explicit options "
         "override it",
     )
-    parser.add_argument("--dt", type=float, metavar="S", help="step in s (default T/N)")
+    parser.add_argument(
+        "--dt",
+        type=float,
+        metavar="S",
+        help="control and integration step in s (default: T/N of a parametric trajectory, "
+        "0.02 s for the shipped ones; for a CSV the rows' spacing, made no coarser than "
+        "0.02 s, as in the API; on mujoco a whole number of engine steps)",
+    )
     parser.add_argument(
         "--duration", type=float, metavar="S", help="simulated time in s (default one period)"
     )
