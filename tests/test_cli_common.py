@@ -94,3 +94,14 @@ def test_pip_install_s_build_folder_is_ignored():
         assert done.returncode == 0, path
     done = subprocess.run(["git", "-C", str(ROOT), "check-ignore", "-q", "src/ddwmmr/build.py"])
     assert done.returncode == 1  # only the top-level folders
+
+
+def test_cli_md_says_how_to_run_before_its_first_command():
+    """docs/cli.md's commands fail with the system Python unless the venv is used: the
+    page says how, once, before any command."""
+    text = (ROOT / "docs" / "cli.md").read_text()
+    blocks = text.split("```sh\n")[1:]
+    assert blocks[0].startswith(".venv/bin/python -m ddwmmr.")  # the first command shown
+    assert blocks[1].startswith("source .venv/bin/activate")
+    assert text.index("source .venv/bin/activate") < text.index("## What every tool does")
+    assert text.count("source .venv/bin/activate") == 1  # once, at the top
