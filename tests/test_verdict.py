@@ -111,6 +111,15 @@ def test_the_singular_cause_names_the_slides_row_only_with_it():
     assert "pi and ap" in verdict({**singular, "aux": "shoulder"})["verdict"]
 
 
+def test_the_singularity_is_the_cause_from_a_quarter_of_the_run():
+    """ap on the rectangle: 990 of 2000 steps singular (not most of the run), then 4.7 m
+    off with the arm stretched: the singularity is named, not the folded arm."""
+    far = {**CLEAN, "final_position_error_m": 4.7, "min_manipulability": 0.0}
+    assert "cos th1 = 0" in verdict({**far, "singular_steps": 990})["verdict"]
+    assert "cos th1 = 0" in verdict({**far, "singular_steps": 501})["verdict"]
+    assert "joint limit" in verdict({**far, "singular_steps": 500})["verdict"]
+
+
 def test_compare_lists_the_runs_that_did_not_track():
     from ddwmmr.cli.compare import not_tracked
 
@@ -126,7 +135,7 @@ def test_compare_lists_the_runs_that_did_not_track():
     assert lines[0].startswith("Did not track (2 of 3 runs")
     assert lines[1] == "  pi on rectangle: singular (damped) 1272 of 2000 steps"
     assert lines[2] == "  ap on rectangle: RMS error 3900 mm (limit 84.85 mm)"
-    assert len(lines) == 5 and lines[3].startswith("  likely cause (pi): ")
+    assert len(lines) == 4 and lines[3].startswith("  likely cause (pi, ap): the resolution")
     assert not_tracked(SimpleNamespace(main=specs[:1]), _ById(outputs)) == [
         'Every run tracked (see docs/cli.md, "Verdict").'
     ]

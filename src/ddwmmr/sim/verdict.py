@@ -47,6 +47,9 @@ TRACKED = "tracked"
 #: Share of the steps above which singular (damped) or saturated steps mean the run did
 #: not track: "most of the run".
 MOST_OF_RUN = 0.5
+#: Share of singular steps above which the singularity is named as the likely cause of a
+#: failure, even when they are not most of the run (ap on the rectangle: 990 of 2000).
+SINGULAR_CAUSE = 0.25
 #: End-effector position error (m) above which a run did not track (final or RMS)...
 ERROR_LIMIT_M = 0.05
 #: ... unless the initial offset times this is larger: the limit an open-loop method,
@@ -139,7 +142,8 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return DIVERGED
     if "tipped_over" in found or "tipped_at_start" in found:
         return TIPPED
-    if "singular_most_of_run" in found:
+    steps = summary.get("steps") or 0
+    if steps and summary.get("singular_steps", 0) > SINGULAR_CAUSE * steps:
         return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
     min_manipulability = summary.get("min_manipulability")
     if min_manipulability is not None and float(min_manipulability) < 1e-6:
