@@ -210,18 +210,19 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def add_option_argument(
-    parser: argparse.ArgumentParser | argparse._ArgumentGroup, applies_to: str
+    parser: argparse.ArgumentParser | argparse._ArgumentGroup,
+    what: str,
+    examples: str = "horizon=2, aux=sum, tau=0.5,0.5,inf, obstacles=FILE",
 ) -> None:
     """``--option NAME=VALUE`` (repeatable): any option of the method(s), parsed and
     checked as the simulator's fields are (:func:`ddwmmr.controllers.option_specs.
-    parse_option`); ``applies_to`` says which method(s) take it."""
+    parse_option`); ``what`` says what it sets (the help's first sentence), ``examples`` a few."""
     parser.add_argument(
         "--option",
         action="append",
         metavar="NAME=VALUE",
-        help=f"an option of {applies_to} (repeatable), e.g. horizon=2, aux=sum, "
-        "tau=0.5,0.5,inf, obstacles=FILE; each method's options are listed at the end, "
-        "the common ones also have a flag of their own",
+        help=f"{what}; repeatable, e.g. {examples}. The options of each method are listed "
+        "at the end; the common ones also have a flag of their own",
     )
 
 

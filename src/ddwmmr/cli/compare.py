@@ -221,9 +221,9 @@ def build_parser() -> ArgumentParser:
     )
     add_option_argument(
         parser,
-        "the compared methods: NAME=VALUE goes to every method taking NAME, METHOD:NAME=VALUE "
-        "to that one; over the preset, in every run of the method (a study's own setting, "
-        "such as the swept tau, still wins there)",
+        "an option of the compared methods: NAME=VALUE for every method taking NAME, "
+        "METHOD:NAME=VALUE for that one; over the preset in every run of the method, except "
+        "where a study sets it (the swept tau)",
     )
     parser.add_argument(
         "--horizon",

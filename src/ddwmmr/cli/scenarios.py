@@ -295,9 +295,9 @@ def build_parser() -> ArgumentParser:
     )
     add_option_argument(
         parser,
-        "--controller (every option it takes but those the protocol sets: "
-        + ", ".join(f"{k} ({v})" for k, v in PROTOCOL_OPTIONS.items())
-        + ")",
+        "an option of --controller, except those the protocol sets: "
+        + ", ".join(f"{k} ({v})" for k, v in PROTOCOL_OPTIONS.items()),
+        "adjust=0.3 (thesis), tau=0.3 (qp), intervals=8 (mpc)",
     )
     parser.add_argument(
         "--horizon",

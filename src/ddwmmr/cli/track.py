@@ -292,7 +292,7 @@ def build_parser() -> ArgumentParser:
         metavar="S",
         help=_option_help("prediction horizon in s (docs/mpc.md, Options)", "horizon"),
     )
-    add_option_argument(qp, "--method (every option, not only those with a flag)")
+    add_option_argument(qp, "any option of --method, not only those with a flag")
     out = parser.add_argument_group("output")
     out.add_argument(
         "--out",
