@@ -105,3 +105,18 @@ def test_cli_md_says_how_to_run_before_its_first_command():
     assert blocks[1].startswith("source .venv/bin/activate")
     assert text.index("source .venv/bin/activate") < text.index("## What every tool does")
     assert text.count("source .venv/bin/activate") == 1  # once, at the top
+
+
+def test_readme_tools_table_gives_each_tool_s_time():
+    """Each main tool's row in the README's table says how long it takes on 2 cores."""
+    text = (ROOT / "README.md").read_text()
+    header = next(line for line in text.splitlines() if line.startswith("| tool ("))
+    assert "time, 2 cores" in header
+    column = header.split(" | ").index("time, 2 cores (see below)")
+    for tool in ("track", "compare", "scenarios", "gui"):
+        row = next(
+            line for line in text.splitlines() if line.startswith(f"| `python -m ddwmmr.{tool}`")
+        )
+        cell = row.split(" | ")[column]
+        assert any(unit in cell for unit in (" s ", " s", " min")), (tool, cell)
+    assert "`make test` (the whole suite)" in text
