@@ -56,6 +56,7 @@ from ddwmmr.gui.widgets import (
     wrap_to_width,
 )
 from ddwmmr.gui.worker import Worker
+from ddwmmr.sim.verdict import short_verdict
 from ddwmmr.trajectories import load_trajectory
 
 #: Playback frame and progress poll intervals (ms).
@@ -726,9 +727,11 @@ def _optional_positive(name: str, text: str) -> float | None:
 
 
 def _summary_line(label: str, result: Any) -> str:
+    """One method's line of the summary: its verdict first (docs/cli.md, "Verdict"), then
+    the metrics."""
     s = result.summary
     line = (
-        f"{label}: RMS pos {s['rms_position_error_m']:.3g} m,"
+        f"{label}: {short_verdict(s)}; RMS pos {s['rms_position_error_m']:.3g} m,"
         f" max {s['max_position_error_m']:.3g} m,"
         f" RMS orient {s['rms_orientation_error_rad']:.3g} rad, max wheel"
         f" {s['max_wheel_speed_rad_s']:.3g} rad/s, min S {s['min_stability']:.3g},"

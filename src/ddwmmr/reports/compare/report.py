@@ -409,6 +409,13 @@ def _observations(c: _Context, ranking: Ranking) -> list[str]:
     return notes
 
 
+def tracked(reasons: Any) -> str:
+    """Table cell of a run's ``verdict_reasons``: yes, or no with the reason codes."""
+    if not isinstance(reasons, list | tuple):
+        return "n/a"
+    return "yes" if not reasons else "no: " + ", ".join(reasons)
+
+
 METRIC_COLUMNS = (
     ("RMS pos (mm)", "rms_position_error_m", mm),
     ("max pos (mm)", "max_position_error_m", mm),
@@ -422,6 +429,7 @@ METRIC_COLUMNS = (
     ("singular steps", "singular_steps", fmt),
     ("saturated steps", "saturated_steps", fmt),
     ("step latency (us)", "median_step_us", fmt),
+    ("tracked? (docs/cli.md, Verdict)", "verdict_reasons", tracked),
 )
 
 
