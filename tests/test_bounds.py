@@ -343,3 +343,26 @@ def test_tool_refuses_a_folder_it_did_not_write(tmp_path, capsys):
     assert tool.main(["--scenarios", "1", "--out", str(out)]) == 2
     assert "holds files no ddwmmr bounds run wrote" in capsys.readouterr().err
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_lower_only_leaves_the_best_known_time_to_a_later_run(tmp_path, monkeypatch):
+    from ddwmmr.cli import bounds as tool
+
+    jobs = []
+
+    def recorded(job):
+        jobs.append((job.scenario.index + 1, job.need_best, job.need_lower))
+        return _fake_solve(job)
+
+    monkeypatch.setattr(batch, "solve", recorded)
+    out = tmp_path / "b"
+    args = ["--scenarios", "1-2", "--jobs", "1", "--out", str(out), "--no-progress"]
+    assert tool.main([*args, "--lower-only"]) == 0
+    assert jobs == [(1, False, True), (2, False, True)]
+    lines = (out / "bounds.csv").read_text().splitlines()
+    assert lines[1] == "1,11.0,nan,0,nan,False"
+    assert math.isnan(float(json.loads((out / "summary.json").read_text())["mean_width"]))
+    # the full run then searches only the best-known times, the lower bounds come cached
+    assert tool.main(args) == 0
+    assert jobs[2:] == [(1, True, False), (2, True, False)]
+    assert (out / "bounds.csv").read_text().splitlines()[2] == "2,12.0,14.0,3,0.5,True"

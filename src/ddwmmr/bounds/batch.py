@@ -190,6 +190,7 @@ def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
     best = np.array([r["best_known_s"] if r["replay_ok"] else math.nan for r in rows], dtype=float)
     both = np.isfinite(lower) & np.isfinite(best)
     width = best[both] / lower[both]
+    spread = np.array([r["spread_s"] for r in rows], dtype=float)
     return {
         "scenarios": len(rows),
         "replay_ok": int(sum(bool(r["replay_ok"]) for r in rows)),
@@ -198,7 +199,7 @@ def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "mean_width": float(width.mean()) if width.size else math.nan,
         "max_width": float(width.max()) if width.size else math.nan,
         "min_width": float(width.min()) if width.size else math.nan,
-        "mean_spread_s": float(np.nanmean([r["spread_s"] for r in rows])) if rows else math.nan,
+        "mean_spread_s": float(np.nanmean(spread)) if np.isfinite(spread).any() else math.nan,
         "lower_method": LOWER_VERSION,
         "best_method": BEST_VERSION,
     }

@@ -70,17 +70,18 @@ class Settings:
     tight_margin_m: float = 0.0003
 
 
-#: A light search (tests, quick looks): fewer starts, no controller runs.
+#: A lighter search (about half the CPU): fewer starts on a coarser screening grid, the
+#: mpc's run the only controller start; still certified on 60 intervals.
 QUICK = Settings(
     coarse=6,
     fine=16,
-    final=30,
-    refine=1,
+    final=60,
+    refine=2,
     elbow_top=2,
     turn_top=1,
     arm_top=1,
     continuation_top=1,
-    controllers=(),
+    controllers=("mpc",),
 )
 
 
