@@ -2,6 +2,7 @@
 #   make demo   creates .venv, installs the package (runtime dependencies only), runs the
 #               main job (writes runs/demo/)
 #   make test   creates .venv, installs with the test extras, runs the suite
+#   make lint   ruff check and ruff format --check (CI runs make lint test)
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
@@ -30,13 +31,15 @@ demo: $(STAMP_RUN)
 test: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python -m pytest
 
+LINTED := src tests examples benchmarks docs/*.py
+
 lint: $(STAMP_TEST)
-	$(BIN)/ruff check src tests examples docs/*.py
-	$(BIN)/ruff format --check src tests examples docs/*.py
+	$(BIN)/ruff check $(LINTED)
+	$(BIN)/ruff format --check $(LINTED)
 
 format: $(STAMP_TEST)
-	$(BIN)/ruff format src tests examples docs/*.py
-	$(BIN)/ruff check --fix src tests examples docs/*.py
+	$(BIN)/ruff format $(LINTED)
+	$(BIN)/ruff check --fix $(LINTED)
 
 # The benchmark with its reference row (roboticstoolbox-python, the bench extra); writes
 # benchmarks/bench.json and regenerates the tables of docs/api.md and docs/qp.md from it.
@@ -56,6 +59,7 @@ docs: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python docs/qp_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/make_run_figures.py
 	MPLBACKEND=Agg $(BIN)/python docs/physics_figures.py
+	MPLBACKEND=Agg $(BIN)/python docs/support_loads.py validate plot
 	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --force --snapshot docs/figures/gui_qp_obstacle.png \
 		--method qp --payload 3 --option obstacles=trajectories/obstacles/ellipse_post.toml \
 		--compare clrrmc-ts --traj ellipse

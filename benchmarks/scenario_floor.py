@@ -60,6 +60,23 @@ def run_library(controller: str, scenarios, time_limit: float | None = None) -> 
     return [run_scenario(s, config).metrics["sim_steps"] for s in scenarios]
 
 
+def _scenario_controller_factory():
+    """``make(robot, scenario, config, plant)``: the protocol's controller of a run, from
+    this checkout or from a ``--reference-src`` one that predates
+    ``make_scenario_controller`` (one builder per controller there)."""
+    from ddwmmr.scenarios import protocol
+
+    if hasattr(protocol, "make_scenario_controller"):
+        return protocol.make_scenario_controller
+
+    def make(robot, scenario, config, plant):
+        if config.controller == "thesis":
+            return protocol.make_thesis_controller(robot, scenario, config)
+        return protocol.make_qp(robot, scenario, config, protocol._envelope(plant))
+
+    return make
+
+
 def run_bare(
     controller: str, scenarios, time_limit: float | None = None, checked: bool = False
 ) -> list[int]:
@@ -69,14 +86,9 @@ def run_bare(
 
     from ddwmmr.behaviours.objective import default_pose
     from ddwmmr.model import Robot
-    from ddwmmr.scenarios.protocol import (
-        RunConfig,
-        _envelope,
-        _Tally,
-        make_qp,
-        make_scenario_plant,
-        make_thesis_controller,
-    )
+    from ddwmmr.scenarios.protocol import RunConfig, _Tally, make_scenario_plant
+
+    make_controller = _scenario_controller_factory()
 
     config = RunConfig(controller=controller, time_limit=time_limit)
     robot = Robot().with_payload(config.payload)
@@ -86,10 +98,8 @@ def run_bare(
         plant = make_scenario_plant(robot, config)
         q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
         plant.reset(q0, DT)
-        if controller == "thesis":
-            agent = make_thesis_controller(robot, scenario, config)
-        else:
-            agent = make_qp(robot, scenario, config, _envelope(plant))
+        agent = make_controller(robot, scenario, config, plant)
+        if controller != "thesis":
             agent.adopt_control_step(DT)
         agent.reset(None, q0)
         tally = _Tally(robot, scenario, config)
@@ -194,7 +204,10 @@ def _src_folder(text: str) -> str:
 
 
 def main() -> None:
-    from ddwmmr.bench import _integer
+    try:
+        from ddwmmr.cli.bench import _integer
+    except ImportError:  # a --reference-src checkout from before ddwmmr.cli.bench
+        from ddwmmr.bench import _integer
     from ddwmmr.cli.common import ArgumentParser
 
     parser = ArgumentParser(prog="scenario_floor", description=__doc__.split("\n\n")[0])

@@ -21,7 +21,7 @@ from matplotlib.figure import Figure
 
 from ddwmmr import Ellipse, Rectangle, Robot, simulate
 from ddwmmr.resolution import kernels
-from ddwmmr.sim.loops import closed_form_step, error_response, step_response
+from ddwmmr.sim.error_dynamics import closed_form_step, error_response, step_response
 
 FIGURES = Path(__file__).resolve().parent / "figures"
 GRID = np.linspace(-math.pi, math.pi, 241)  # joint-angle grid (rad)

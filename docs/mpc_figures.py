@@ -31,9 +31,14 @@ from ddwmmr.mpc.models import KinematicPrediction, ThesisPrediction
 from ddwmmr.mpc.ocp import OCPConfig
 from ddwmmr.plants.thesis import ThesisPlant
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
-from ddwmmr.scenarios.protocol import WaypointTask, _Tally, make_mpc, make_scenario_plant
+from ddwmmr.scenarios.protocol import (
+    WaypointTask,
+    _Tally,
+    make_scenario_controller,
+    make_scenario_plant,
+)
+from ddwmmr.sim.error_dynamics import saturated_velocity_step, step_response, velocity_loop
 from ddwmmr.sim.loop import run_loop
-from ddwmmr.sim.loops import saturated_velocity_step, step_response, velocity_loop
 
 FIGURES = Path(__file__).parent / "figures"
 
@@ -208,7 +213,7 @@ def physics_run(options: tuple, duration: float = 1.5) -> tuple[np.ndarray, floa
         controller="mpc", plant="mujoco", time_limit=duration, controller_options=options
     )
     plant = make_scenario_plant(robot, config)
-    controller = make_mpc(robot, scenario, config, plant)
+    controller = make_scenario_controller(robot, scenario, config, plant)
     tally = _Tally(robot, scenario, config)
     task = WaypointTask(tally, controller, False, plant)
     judge, rows = task.after_step, []

@@ -25,8 +25,8 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon
 
 from ddwmmr import Robot, load_trajectory, simulate
-from ddwmmr.controllers.qp import QPController
 from ddwmmr.plants.kinematic import KinematicPlant
+from ddwmmr.qp.controller import QPController
 from ddwmmr.qp.limits import footprint_clearances, load_obstacles
 from ddwmmr.qp.naive import NaiveQPController
 from ddwmmr.qp.tasks import PostureTask

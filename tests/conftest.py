@@ -25,6 +25,22 @@ def robot() -> Robot:
 
 
 @pytest.fixture
+def registered():
+    """``registered(registry, name, cls, **traits)``: register ``cls`` under ``name`` in a
+    registry of :mod:`ddwmmr.registry` for this test only (removed afterwards)."""
+    added = []
+
+    def register(registry, name, cls, **traits):
+        registry.register(name, **traits)(cls)
+        added.append((registry, name))
+        return cls
+
+    yield register
+    for registry, name in added:
+        registry.unregister(name)
+
+
+@pytest.fixture
 def rng() -> np.random.Generator:
     """A seeded random generator: tests are reproducible."""
     return np.random.default_rng(12345)

@@ -24,7 +24,6 @@ from ddwmmr.bench import (
     benchmark_cases,
     format_comparison,
     format_table,
-    main,
     record_class_states,
     record_states,
     run_benchmark,
@@ -33,6 +32,7 @@ from ddwmmr.bench import (
     timer_overhead_ns,
     write_report,
 )
+from ddwmmr.cli.bench import main
 from footprint import outline_clearance
 
 TINY = {"repeats": 2, "calls": 20, "duration": 0.4}

@@ -13,22 +13,24 @@ from pathlib import Path
 
 import pytest
 
-from ddwmmr import ParameterError, bench
+from ddwmmr import ParameterError
 from ddwmmr.bench import (
     MAX_CALLS,
-    MAX_JOBS,
     MAX_REPEATS,
     SCENARIO_KEYS,
     TOOL,
     benchmark_cases,
-    build_parser,
     format_comparison,
-    main,
     read_report,
     run_benchmark,
     scenario_workers,
     time_scenarios,
 )
+from ddwmmr.bench import report as bench_report
+from ddwmmr.bench import run as bench_run
+from ddwmmr.cli import bench as bench_cli
+from ddwmmr.cli.bench import build_parser, main
+from ddwmmr.errors import MAX_JOBS
 
 #: The smallest run: one method, one repeat, five states, 1 s runs, no scenarios.
 SMALL = ["--method", "pi", "--repeats", "1", "--calls", "5", "--duration", "1", "--scenarios", "0"]
@@ -62,7 +64,7 @@ def refused(args: list[str], workdir: Path, capsys, monkeypatch) -> str:
     def no_run(*_, **__):
         raise AssertionError("the benchmark ran before the input was checked")
 
-    monkeypatch.setattr(bench, "run_benchmark", no_run)
+    monkeypatch.setattr(bench_cli, "run_benchmark", no_run)
     extra = [] if "--out" in args else ["--out", "out.json"]
     before = tree(workdir)
     status, out, err = run_main([*SMALL, *args, *extra], capsys)
@@ -122,7 +124,7 @@ def test_run_benchmark_checks_its_arguments_before_running(monkeypatch):
     def no_states(*_, **__):
         raise AssertionError("states recorded before the arguments were checked")
 
-    monkeypatch.setattr(bench, "record_states", no_states)
+    monkeypatch.setattr(bench_run, "record_states", no_states)
     cases = [
         ({"repeats": 0}, r"repeats must be an integer in \[1, 1000\]"),
         ({"repeats": 10**15}, r"repeats must be an integer in \[1, 1000\]"),
@@ -316,7 +318,7 @@ def test_a_failed_write_leaves_nothing_and_says_one_line(workdir, capsys, monkey
     def disk_full(path, data):
         raise OSError(errno.ENOSPC, "No space left on device")
 
-    monkeypatch.setattr(bench, "write_atomic", disk_full)
+    monkeypatch.setattr(bench_report, "write_atomic", disk_full)
     status, out, err = run_main([*SMALL, "--out", "b.json"], capsys)
     line = "bench: error: out: cannot write b.json (No space left on device)"
     assert status == 2 and out == ""

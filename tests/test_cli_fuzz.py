@@ -20,7 +20,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from ddwmmr.bench import main as bench_main
+from ddwmmr.cli.bench import main as bench_main
 from ddwmmr.cli.compare import main as compare_main
 from ddwmmr.cli.scenarios import main as scenarios_main
 from ddwmmr.cli.track import main as track_main
@@ -76,7 +76,18 @@ FILES = {
     "obstacle_huge.toml": b"[[obstacle]]\nx = 5.0\ny = 0.0\nradius = 5000.0\n",
     "obstacles_text.toml": b'[[obstacle]]\nx = "1"\ny = 0.0\nradius = 0.3\n',
     "a_file.txt": b"not a folder\n",
+    # 10 kB of nested arrays, inline tables nested 500 deep: the parser recurses per level
+    "robot_deep_array.toml": b"L1 = " + b"[" * 5000 + b"]" * 5000 + b"\n",
+    "robot_deep_tables.toml": b"L1 = " + b"{a = " * 500 + b"1" + b"}" * 500 + b"\n",
+    "robot_deep_parsed.toml": b"L1 = " + b"[" * 100 + b"]" * 100 + b"\n",  # parses, too deep
+    "traj_deep.toml": b'shape = "ellipse"\na = ' + b"[" * 5000 + b"]" * 5000 + b"\n",
+    "obstacles_deep.toml": b"[[obstacle]]\nx = 1.0\ny = 0.0\nradius = "
+    + b"{r = " * 500
+    + b"0.3"
+    + b"}" * 500
+    + b"\n",
 }
+TOO_DEEP = "nests arrays or tables more than 32 levels deep"
 
 # (tool, arguments, text the one line must contain)
 ROBOT_CASES = [
@@ -91,6 +102,9 @@ ROBOT_CASES = [
     (["--robot", "{robot_payload_nan.toml}"], "payload must be a finite number"),
     (["--robot", "{robot_unknown.toml}"], "unknown parameter 'arm_length'"),
     (["--robot", "{robot_bad.toml}"], "is not valid TOML"),
+    (["--robot", "{robot_deep_array.toml}"], TOO_DEEP),
+    (["--robot", "{robot_deep_tables.toml}"], TOO_DEEP),
+    (["--robot", "{robot_deep_parsed.toml}"], TOO_DEEP),
     (["--robot", "{fifo}"], "is not a regular file"),
     (["--robot", "{inputs}"], "is not a regular file"),
     (["--robot", "missing.toml"], "cannot read missing.toml"),
@@ -121,6 +135,7 @@ TRAJ_CASES = [
     ("sub/figure8", "neither a trajectory name"),
     ("nowhere", "unknown trajectory 'nowhere'"),
     ("missing.csv", "no such file missing.csv"),
+    ("{traj_deep.toml}", TOO_DEEP),
 ]
 OUT_CASES = [
     ("{a_file.txt}/out", "is not a folder"),
@@ -152,6 +167,7 @@ CASES += [
     ("track", ["--method", "qp", "--obstacles", "{obstacle_at_start.toml}"], "overlaps the rob"),
     ("track", ["--method", "qp", "--obstacles", "{obstacle_far.toml}"], "obstacle x must be in"),
     ("track", ["--method", "qp", "--obstacles", "{obstacle_huge.toml}"], "radius must be in"),
+    ("track", ["--method", "qp", "--obstacles", "{obstacles_deep.toml}"], TOO_DEEP),
 ]
 CASES += [("compare", ["--only", traj], text) for traj, text in TRAJ_CASES[:4] + TRAJ_CASES[15:]]
 CASES += [("compare", ["--traj", traj], text) for traj, text in TRAJ_CASES[10:13]]
@@ -237,6 +253,19 @@ CASES += [
     ("bench", ["--duration", "inf"], "--duration: must be a number in [0.02, 20000] s"),
     ("bench", ["--method", "nope"], "unknown method 'nope'"),
 ]
+
+#: Dask scheduler options (the addresses of servers the tests start: see below).
+DASK = ["--executor", "dask", "--connect-timeout", "1", "--scheduler"]
+CASES += [
+    ("scenarios", ["--connect-timeout", "5"], "connect-timeout: only used with --scheduler"),
+    ("scenarios", [*DASK[:2], "--connect-timeout", "0", "--scheduler", "tcp://127.0.0.1:1"],
+     "connect-timeout must be in (0, 600] s"),
+    ("scenarios", [*DASK[:2], "--connect-timeout", "nan", "--scheduler", "tcp://127.0.0.1:1"],
+     "connect-timeout must be a finite number"),
+    ("scenarios", [*DASK[:2], "--connect-timeout", "1e9", "--scheduler", "tcp://127.0.0.1:1"],
+     "connect-timeout must be in (0, 600] s"),
+    ("scenarios", [*DASK, "tcp://127.0.0.1:1"], "no Dask scheduler answered"),
+]  # fmt: skip
 
 
 @pytest.fixture
@@ -394,3 +423,138 @@ def test_as_a_module_one_line_and_no_traceback(workdir, tool, args):
     assert done.returncode == 2
     assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
     assert not Path("runs").exists()
+
+
+# -- Dask scheduler addresses: servers on 127.0.0.1 that are not Dask schedulers ------------
+class _Listeners:
+    """TCP servers on 127.0.0.1 (ephemeral ports): one that accepts and never answers, an
+    HTTP server, and two that answer garbage (a huge frame length, a bad header)."""
+
+    def __init__(self) -> None:
+        import http.server
+        import socket
+        import threading
+
+        self._sockets: list[socket.socket] = []
+        self._held: list[socket.socket] = []
+        self.silent = self._serve(lambda conn: self._held.append(conn))
+        self.ascii = self._serve(lambda conn: conn.sendall(b"1" * 4096))  # 3.07 EiB frame
+        self.binary = self._serve(lambda conn: conn.sendall(b"\xff" * 64 + b"garbage" * 64))
+
+        class Quiet(http.server.SimpleHTTPRequestHandler):
+            def log_message(self, *args) -> None:  # the tool's stderr is under test
+                pass
+
+        self._http = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Quiet)
+        threading.Thread(target=self._http.serve_forever, daemon=True).start()
+        self.http = self._http.server_address[1]
+
+    def _serve(self, answer) -> int:
+        import socket
+        import threading
+
+        server = socket.create_server(("127.0.0.1", 0))
+        self._sockets.append(server)
+
+        def accept() -> None:
+            while True:
+                try:
+                    conn, _ = server.accept()
+                    answer(conn)
+                except OSError:
+                    return
+
+        threading.Thread(target=accept, daemon=True).start()
+        return server.getsockname()[1]
+
+    def close(self) -> None:
+        self._http.shutdown()
+        self._http.server_close()
+        for sock in self._sockets + self._held:
+            sock.close()
+
+
+@pytest.fixture(scope="module")
+def listeners():
+    servers = _Listeners()
+    yield servers
+    servers.close()
+
+
+SCHEDULER_CASES = [
+    ("tcp://127.0.0.1:{silent}", "no Dask scheduler answered at 'tcp://127.0.0.1:"),
+    ("tcp://127.0.0.1:{http}", "no Dask scheduler answered"),
+    ("tcp://127.0.0.1:{ascii}", "cannot connect to 'tcp://127.0.0.1:"),
+    ("tcp://127.0.0.1:{binary}", "cannot connect to 'tcp://127.0.0.1:"),
+    ("tls://127.0.0.1:{silent}", "cannot connect to 'tls://127.0.0.1:"),
+    ("ucx://127.0.0.1:{silent}", "cannot connect to 'ucx://127.0.0.1:"),
+    ("http://127.0.0.1:{http}", "unknown address scheme 'http'"),
+    ("127.0.0.1", "missing port number"),
+]
+
+
+@pytest.mark.parametrize(("address", "text"), SCHEDULER_CASES, ids=[a for a, _ in SCHEDULER_CASES])
+def test_a_scheduler_address_that_is_not_a_scheduler(workdir, listeners, capsys, address, text):
+    """Checked before the output exists, within --connect-timeout: one line, exit 2."""
+    cwd = Path.cwd()
+    before = tree(cwd)
+    ports = {"silent": listeners.silent, "http": listeners.http,
+             "ascii": listeners.ascii, "binary": listeners.binary}  # fmt: skip
+    status, err = run_bad("scenarios", [*DASK, address.format(**ports)], capsys)
+    assert status == 2, err
+    assert len(err.strip().splitlines()) == 1 and text in err, err
+    assert tree(cwd) == before
+
+
+# -- tampered --rerun records: a rerun passes the checks of a fresh run --------------------
+@pytest.fixture(scope="module")
+def recorded(tmp_path_factory) -> dict:
+    """A valid track summary.json of a qp run (cases change one field of a copy)."""
+    import json
+
+    out = tmp_path_factory.mktemp("recorded") / "run"
+    args = ["--method", "qp", "--traj", "ellipse", "--duration", "0.2", "--no-plots"]
+    assert track_main([*args, "--no-progress", "--out", str(out)]) == 0
+    return json.loads((out / "summary.json").read_text())
+
+
+RERUN_CASES = [
+    # (field of the run record, value, text of the one line)
+    ("dt", 10**400, "dt must be a finite number (got an integer of about 1e400)"),
+    ("duration", 10**400, "duration must be a finite number (got an integer of about 1e400)"),
+    ("dt", -0.1, "dt must be > 0"),
+    ("duration", 1e12, "duration / dt must be <="),
+    ("robot.payload", 20, "a 20 kg payload tips the robot over in this run's start pose"),
+    ("options.obstacles", [[2.0, 0.0, 0.5]], "overlaps the robot's start pose by 0.104 m"),
+    ("options.obstacles", [[1e9, 0.0, 0.3]], "obstacle x must be in [-1e+06, 1e+06] m"),
+    ("options.obstacles", [[5.0, 0.0, 5000.0]], "obstacle radius must be in"),
+    ("initial_offset", [5.0, 0.0], "offset must be in [-0.65, 0.65] m"),
+    ("initial_offset", [0.0, 0.0, 0.0], "offset must be two numbers"),
+    ("integrator", "bogus", "integrator must be one of euler, rk4 (got 'bogus')"),
+    ("trajectory.parameters.a", 1e300, "a must be in [1e-06, 1000] m"),
+]
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "text"), RERUN_CASES, ids=[f"{f}={str(v)[:20]}" for f, v, _ in RERUN_CASES]
+)
+def test_a_tampered_rerun_record_is_refused_as_a_fresh_run(
+    workdir, recorded, capsys, field, value, text
+):
+    import json
+
+    tampered = json.loads(json.dumps(recorded))
+    *sections, key = field.split(".")
+    holder = tampered["run"]
+    for section in sections:
+        holder = holder[section]
+    holder[key] = value
+    path = Path(workdir["inputs"]) / "summary.json"
+    path.write_text(json.dumps(tampered))
+    before = tree(Path.cwd())
+    status, err = run_bad("track", ["--rerun", str(path)], capsys)
+    assert status == 2, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"error: rerun: {path}: "), err
+    assert text in lines[0], err
+    assert tree(Path.cwd()) == before

@@ -1,4 +1,5 @@
-"""Ctrl-C and SIGTERM: one line, exit 130 / 143, staging removed, worker processes stopped.
+"""Ctrl-C, SIGTERM, SIGHUP, SIGQUIT: one line, exit 128 + the signal, staging removed,
+worker processes stopped; SIGKILL of a tool: its workers end with it.
 
 The tools run as a user runs them (``python -m``, a subprocess); the signal is sent once
 the staging folder exists (and, with ``--jobs 2``, once the worker processes run).
@@ -77,6 +78,10 @@ def staging(folder: Path) -> list[Path]:
         ("track", signal.SIGTERM, 143, "terminated"),
         ("scenarios", signal.SIGTERM, 143, "terminated"),
         ("compare", signal.SIGINT, 130, "interrupted"),
+        ("track", signal.SIGHUP, 129, "terminated (SIGHUP)"),
+        ("track", signal.SIGQUIT, 131, "terminated (SIGQUIT)"),
+        ("compare", signal.SIGHUP, 129, "terminated (SIGHUP)"),
+        ("scenarios", signal.SIGQUIT, 131, "terminated (SIGQUIT)"),
     ],
 )
 def test_signal_stops_cleanly(tmp_path, tool, signum, status, word):
@@ -117,3 +122,79 @@ def test_ctrl_c_on_the_whole_process_group(tmp_path):
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
     assert list(tmp_path.iterdir()) == []
     wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
+
+
+@pytest.mark.parametrize("tool", ["compare", "scenarios"])
+def test_workers_end_with_a_killed_tool(tmp_path, tool):
+    """``kill -9`` of the tool: nothing can clean up in it, but its workers end too."""
+    process = start(tool, tmp_path)
+    try:
+        wait_for(lambda: len(children(process.pid)) >= 2 or process.poll() is not None)
+        workers = children(process.pid)
+        time.sleep(0.3)
+        assert process.poll() is None, process.stderr.read()
+        process.kill()
+        process.communicate(timeout=60)
+        wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
+    finally:
+        for pid in workers:
+            if alive(pid):  # do not leave them to the next test
+                os.kill(pid, signal.SIGKILL)
+
+
+POOL_SCRIPT = """
+import os, sys, time
+import ddwmmr.workers as workers
+if sys.argv[1] == "watchdog only":
+    workers._ask_kernel_for_death_signal = lambda: False
+with workers.process_pool(2) as pool:
+    list(pool.map(time.sleep, [0.2, 0.2]))  # both workers started
+    print("ready", flush=True)
+    time.sleep(120)
+"""
+
+
+@pytest.mark.parametrize("mechanism", ["both", "watchdog only"])
+def test_pool_workers_end_with_their_parent(tmp_path, mechanism):
+    """Each mechanism alone ends the workers: the kernel's parent-death signal (Linux) and
+    the watchdog thread on the parent's sentinel (every platform)."""
+    process = subprocess.Popen(
+        [sys.executable, "-c", POOL_SCRIPT, mechanism],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    workers: set[int] = set()
+    try:
+        assert process.stdout.readline().strip() == "ready"
+        workers = children(process.pid)
+        assert len(workers) == 2
+        process.kill()
+        process.wait(timeout=60)
+        wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
+    finally:
+        process.kill()
+        for pid in workers:
+            if alive(pid):
+                os.kill(pid, signal.SIGKILL)
+
+
+def test_the_next_run_removes_a_killed_runs_staging_folder(tmp_path):
+    process = start("track", tmp_path)
+    try:
+        wait_for(lambda: staging(tmp_path) or process.poll() is not None)
+        left = staging(tmp_path)
+        process.kill()
+        process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert [p.name for p in staging(tmp_path)] == [p.name for p in left]  # nobody cleaned up
+    again = subprocess.run(
+        [sys.executable, "-m", "ddwmmr.track", "--method", "ats", "--traj", "ellipse",
+         "--duration", "0.2", "--no-plots", "--no-progress", "--out", str(tmp_path / "out")],
+        cwd=tmp_path, capture_output=True, text=True, timeout=120,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+    )  # fmt: skip
+    assert again.returncode == 0, again.stderr
+    notes = [line for line in again.stderr.splitlines() if line.startswith("note: removed")]
+    assert len(notes) == 1 and left[0].name in notes[0], again.stderr
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]

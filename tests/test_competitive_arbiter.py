@@ -23,10 +23,11 @@ from ddwmmr.arbiters import (
     StateMachineArbiter,
     make_arbiter,
 )
-from ddwmmr.behaviours import BRAKE, ObstacleAvoidance, Proposal, ThesisController
+from ddwmmr.behaviours import BRAKE, ObstacleAvoidance, Proposal
 from ddwmmr.errors import ParameterError
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
+from ddwmmr.thesis_controller import ThesisController
 
 
 class Clock:
@@ -120,7 +121,7 @@ def test_stability_comes_in_gradually_below_enter_and_stops_the_task_at_the_marg
 
 
 def test_stability_sequence_under_changing_stability():
-    """The state machine's enter/exit sequence of test_thesis_arbiter, continuously."""
+    """The state machine's enter/exit sequence of test_state_machine, continuously."""
     clock = Clock(CompetitiveDynamicsArbiter(parameters=QUIET), behaviours())
     assert clock.hold(2.0, s=1.30).state == MOVE_ARM  # above enter: the task alone
     assert clock.hold(0.5, s=1.05).state == STABILITY  # far below: stability alone

@@ -178,9 +178,9 @@ def test_side_by_side_overlays_two_methods_with_their_own_options():
     assert app.settings.methods == ("clrrmc-ts", None) and app.results is None
 
 
-def test_method_list_and_option_widgets_follow_the_registry(monkeypatch):
-    from ddwmmr.controllers import base
+def test_method_list_and_option_widgets_follow_the_registry(registered):
     from ddwmmr.gui.options import method_options
+    from ddwmmr.registry import CONTROLLERS
 
     class Horizon:
         """Test method: holds still; remembers its horizon."""
@@ -200,9 +200,7 @@ def test_method_list_and_option_widgets_follow_the_registry(monkeypatch):
         def command(self, t, q, pose_d, velocity_d):
             return np.zeros(4)
 
-    monkeypatch.setitem(base._REGISTRY, "hold-test", Horizon)
-    monkeypatch.setitem(base._DESCRIPTIONS, "hold-test", "test")
-    Horizon.name = "hold-test"
+    registered(CONTROLLERS, "hold-test", Horizon, description="test")
     method_options.cache_clear()
     try:
         app = new_app(Settings(duration=0.2))

@@ -67,8 +67,8 @@ def test_option_kinds_follow_defaults_and_annotations():
     assert option_spec("flag", True, "bool").format(False) == "off"
 
 
-def test_a_newly_registered_method_brings_its_options(monkeypatch):
-    from ddwmmr.controllers import base
+def test_a_newly_registered_method_brings_its_options(registered):
+    from ddwmmr.registry import CONTROLLERS
 
     class Horizon:
         """Test method with an MPC-like horizon."""
@@ -76,8 +76,7 @@ def test_a_newly_registered_method_brings_its_options(monkeypatch):
         def __init__(self, robot, horizon: int = 10, weight: float = 1.0, **kwargs):
             self.robot, self.horizon, self.weight = robot, horizon, weight
 
-    monkeypatch.setitem(base._REGISTRY, "mpc-test", Horizon)
-    monkeypatch.setitem(base._DESCRIPTIONS, "mpc-test", "test")
+    registered(CONTROLLERS, "mpc-test", Horizon, description="test")
     method_options.cache_clear()
     try:
         specs = method_options("mpc-test")

@@ -107,3 +107,31 @@ def test_int_checks_refuse_huge_floats_and_text():
     for bad in ("3", True, math.inf, 2.5):
         with pytest.raises(ParameterError, match="n must be an integer"):
             check_int_at_least("n", bad, 1)
+
+
+@pytest.mark.parametrize(
+    "value",
+    ["[" * 5000 + "]" * 5000, "{a = " * 500 + "1" + "}" * 500, "[" * 40 + "]" * 40],
+    ids=["arrays 5000 deep", "inline tables 500 deep", "arrays 40 deep"],
+)
+def test_deeply_nested_toml_is_a_parameter_error_naming_the_file(tmp_path, value):
+    from ddwmmr.trajectories import load_trajectory
+
+    robot, trajectory = tmp_path / "robot.toml", tmp_path / "traj.toml"
+    robot.write_text(f"L1 = {value}\n")
+    trajectory.write_text(f'shape = "ellipse"\na = {value}\n')
+    with pytest.raises(ParameterError, match=f"robot: {robot} nests arrays or tables more"):
+        Robot.from_toml(robot)
+    with pytest.raises(ParameterError, match=f"traj: {trajectory} nests arrays or tables more"):
+        load_trajectory(trajectory)
+
+
+def test_nesting_depth_counts_lists_and_tables_without_recursion():
+    from ddwmmr.errors import nesting_depth
+
+    deep: list = []
+    for _ in range(100_000):  # far beyond the recursion limit
+        deep = [deep]
+    assert nesting_depth(deep) == 100_001
+    assert nesting_depth({"obstacle": [{"x": 1.0, "y": [0.0]}]}) == 4
+    assert nesting_depth(3.0) == 0

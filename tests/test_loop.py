@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from ddwmmr import Ellipse, ParameterError, Robot, simulate
-from ddwmmr.behaviours import ThesisController
 from ddwmmr.commands import WheelForces
 from ddwmmr.controllers import StepInfo
 from ddwmmr.plants import (
@@ -20,6 +19,7 @@ from ddwmmr.plants import (
     make_plant,
 )
 from ddwmmr.plants.base import Observation
+from ddwmmr.thesis_controller import ThesisController
 
 ROBOT = Robot()
 

@@ -12,7 +12,7 @@ import pytest
 
 from ddwmmr import Ellipse, ParameterError, Robot
 from ddwmmr.controllers import available_methods, make_controller, method_options
-from ddwmmr.controllers import base as registry
+from ddwmmr.registry import CONTROLLERS
 
 #: Options each resolution method documents (docs/theory.md, docs/cli.md), written out here
 #: independently of the code that discovers them.
@@ -57,7 +57,7 @@ def test_unknown_option_lists_the_accepted_ones():
         make_controller("ats", tau=1.0)
 
 
-def test_mro_walk_most_derived_default_wins(monkeypatch):
+def test_mro_walk_most_derived_default_wins(registered):
     class Parent:
         def __init__(self, robot, a=1.0, b=2.0, *args):
             self.a, self.b = a, b
@@ -67,7 +67,7 @@ def test_mro_walk_most_derived_default_wins(monkeypatch):
             super().__init__(robot, b=b, **kwargs)
             self.c = c
 
-    monkeypatch.setitem(registry._REGISTRY, "tmp-child", Child)
+    registered(CONTROLLERS, "tmp-child", Child)
     assert method_options("tmp-child") == {"c": 3.0, "b": 5.0, "a": 1.0}
     assert make_controller("tmp-child", a=7.0).a == 7.0
     with pytest.raises(ParameterError, match="unknown option 'kwargs'"):

@@ -14,6 +14,7 @@ from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.commands import WheelForces
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc import terminal
+from ddwmmr.mpc.fallback import make_fallback
 from ddwmmr.mpc.models import KinematicPrediction, ThesisPrediction
 from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights, grid_intervals
 from ddwmmr.mpc.solvers import GaussNewtonSQP, NLPSolver, SolverFailure
@@ -169,7 +170,7 @@ def test_solver_failure_falls_back_to_the_qp_command_and_is_counted(monkeypatch)
     assert all(math.isfinite(v) for v in values)
     # the qp's velocity command (a fresh twin, slewing from the measured velocity), through
     # the model-based velocity loop of the plant
-    qp = controller._make_fallback()
+    qp = make_fallback(HEAVY, controller.options, None, controller.dt, controller.dynamics)
     qp.ctx.previous_command = (0.4, 0.1)
     u = qp.command(0.0, np.array(state.q), np.array([2.0, 1.0, 0.0]), np.zeros(3))
     expected = controller.dynamics.velocity_tracking_forces(0.4, 0.1, u[0], u[1], state.th2)
@@ -300,13 +301,13 @@ def test_docs_page_snippet_runs():
 
 
 def test_warm_start_shift_interpolates_like_numpy(rng):
-    from ddwmmr.mpc.controller import _interpolate_rows
+    from ddwmmr.mpc.problem import interpolate_rows
 
     times = np.concatenate([[0.0], np.cumsum(rng.uniform(0.01, 0.5, 12))])
     rows = rng.normal(size=(13, 8))
     at = np.sort(rng.uniform(-0.2, times[-1] + 0.3, 13))
     expected = np.column_stack([np.interp(at, times, rows[:, i]) for i in range(8)])
-    np.testing.assert_allclose(_interpolate_rows(times, rows, at), expected, atol=1e-14)
+    np.testing.assert_allclose(interpolate_rows(times, rows, at), expected, atol=1e-14)
 
 
 def test_a_stalled_waypoint_approach_restarts_cold():
@@ -329,10 +330,10 @@ def test_plans_that_need_slack_for_half_a_second_restart_cold(monkeypatch, rule)
     1.25) while the base creeps on (the end effector moves, so the stall rule stays
     quiet): every plan needs slack, and after 0.5 s of that the controller drops its plan
     and starts cold, once per 0.5 s; with the slack rule off it never does."""
-    from ddwmmr.mpc import controller as mpc_controller
+    from ddwmmr.mpc import stall
 
     if rule == "off":
-        monkeypatch.setattr(mpc_controller, "STALL_SLACK", math.inf)
+        monkeypatch.setattr(stall, "STALL_SLACK", math.inf)
     controller = make_controller("mpc", HEAVY, model="thesis", track_orientation=False, dt=0.01)
     q = np.array([0.0, 0.0, 0.0, -1.2, 0.3])
     assert HEAVY.stability(q)[2] == pytest.approx(1.146, abs=1e-3)
@@ -402,7 +403,7 @@ def test_controllers_on_the_same_problem_share_it_and_run_as_if_fresh(qp_solver)
     """The OCP and its compiled QP are built once per (robot, model, grid, options) and
     shared; a run on the shared problem, after another problem's run, repeats a run on a
     freshly built one to the last bit."""
-    from ddwmmr.mpc import controller as core
+    from ddwmmr.mpc import cache as core
     from ddwmmr.mpc import solvers
 
     trajectory = Ellipse(T=20.0, N=1000)
@@ -428,7 +429,7 @@ def test_the_shared_problem_is_not_shared_across_threads():
     could read each other's. Each thread builds its own."""
     import threading
 
-    from ddwmmr.mpc import controller as core
+    from ddwmmr.mpc import cache as core
 
     trajectory = Ellipse(T=20.0, N=1000)
     core._OCPS.clear()

@@ -10,8 +10,7 @@ from ddwmmr import ParameterError, Robot
 from ddwmmr.commands import WheelForces, traits_of
 from ddwmmr.controllers import make_controller
 from ddwmmr.model import symbolic as sym
-from ddwmmr.mpc.braking import BRAKE_TIME, braking_input
-from ddwmmr.mpc.controller import BRAKE_SLACK
+from ddwmmr.mpc.braking import BRAKE_SLACK, BRAKE_TIME, braking_input
 from ddwmmr.plants import MujocoPlant, ThesisPlant
 from ddwmmr.plants.thesis import ThesisState
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
@@ -88,10 +87,10 @@ def test_brake_slack_is_on_where_the_lagged_arm_has_its_acceleration_limit():
             make_controller("mpc", ROBOT, brake_slack=bad)
     with pytest.raises(ParameterError, match="brake_slack must be a finite number"):
         make_controller("mpc", ROBOT, brake_slack=math.nan)
-    before = asked._choice
+    before = asked.resolved
     with pytest.raises(ParameterError):
         asked.adopt_plant(traits_of(ThesisPlant(ROBOT)))
-    assert asked._choice == before  # refused before anything changed
+    assert asked.resolved is before  # refused before anything changed
 
 
 def test_a_plan_that_needs_slack_is_replaced_by_the_braking_step():

@@ -15,7 +15,7 @@ from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.models import LaggedArmPrediction
 from ddwmmr.plants import MujocoPlant, ThesisPlant
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
-from ddwmmr.scenarios.protocol import make_mpc, make_scenario_plant
+from ddwmmr.scenarios.protocol import make_scenario_controller, make_scenario_plant
 
 ROBOT = Robot().with_payload(3.0)
 
@@ -76,7 +76,8 @@ def test_the_physics_plant_gets_the_dynamic_margin_and_the_lagged_arm():
     mpc.adopt_plant(traits)
     assert (mpc.model_name, mpc.interface, mpc.wants_base_velocity) == ("thesis", "force", True)
     assert mpc.dynamic_stability and mpc.arm_time_constant == physics.joint_time_constant
-    protocol = make_mpc(ROBOT, scenario, RunConfig(controller="mpc", plant="mujoco"), physics)
+    config = RunConfig(controller="mpc", plant="mujoco")
+    protocol = make_scenario_controller(ROBOT, scenario, config, physics)
     protocol.adopt_plant(traits)
     assert protocol.dynamic_stability and protocol.arm_time_constant == physics.joint_time_constant
     static = make_controller("mpc", ROBOT, dynamic_stability=False, arm_time_constant=0.0)
@@ -94,7 +95,7 @@ def test_the_physics_plant_gets_the_dynamic_margin_and_the_lagged_arm():
     kinematic.adopt_plant(traits)
     assert kinematic.model_name == "kinematic" and not kinematic.dynamic_stability
     thesis = make_scenario_plant(ROBOT, RunConfig())
-    plain = make_mpc(ROBOT, scenario, RunConfig(controller="mpc"), thesis)
+    plain = make_scenario_controller(ROBOT, scenario, RunConfig(controller="mpc"), thesis)
     plain.adopt_plant(traits_of(thesis))
     assert plain.model_name == "thesis" and not plain.dynamic_stability
     assert plain.arm_time_constant is None

@@ -20,11 +20,13 @@ from ddwmmr.cli.scenarios import main as scenarios_main
 from ddwmmr.cli.track import main as track_main
 from ddwmmr.errors import ParameterError
 from ddwmmr.outputs import (
+    KEPT_PREFIX,
     MANIFEST,
     STAGING_PREFIX,
     check_output_folder,
     first_free,
     output_folder,
+    owner_token,
 )
 
 TOOLS = {
@@ -274,6 +276,52 @@ def test_error_in_the_block_removes_staging_and_created_parents(tmp_path):
         assert staging.name.startswith(STAGING_PREFIX)
         raise RuntimeError
     assert list(tmp_path.iterdir()) == []
+
+
+def _dead_pid() -> int:
+    """The id of a process that has just ended (and was reaped)."""
+    import subprocess
+    import sys
+
+    child = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)  # fmt: skip
+    return int(child.stdout)
+
+
+def test_stale_folders_of_ended_runs_are_removed_with_one_line(tmp_path, capsys):
+    host, pid, start = owner_token().rsplit("-", 2)
+    other_start = int(start) + 1  # this process id with another start: an id reused
+    dead = [
+        f"{STAGING_PREFIX}{host}-{_dead_pid()}-0-abcd1234",
+        f"{STAGING_PREFIX}{host}-{pid}-{other_start}-efgh5678",
+    ]
+    kept = [
+        f"{STAGING_PREFIX}{owner_token()}-live0000",  # a run of this very process
+        f"{STAGING_PREFIX}elsewhere-{_dead_pid()}-0-abcd1234",  # another host's run
+        ".ddwmmr-staging-unparsable",  # no owner in the name: never guessed
+    ]
+    for name in dead + kept:
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "timeseries.csv").write_text("half")
+    old = tmp_path / f".ddwmmr-old-{host}-{_dead_pid()}-0-oldfold1"
+    (old / "plots").mkdir(parents=True)
+    for name in ("summary.json", "plots/a.png", "mine.txt"):
+        (old / name).write_text("x")
+    (old / MANIFEST).write_text(
+        json.dumps({"tool": "track", "files": ["summary.json", "plots/a.png"]})
+    )
+    with output_folder(tmp_path / "out", "track") as staging:
+        (staging / "r.txt").write_text("new")
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("note: removed 2 folders left in"), err
+    aside = [p for p in tmp_path.iterdir() if p.name.startswith(KEPT_PREFIX)]
+    assert len(aside) == 1 and err[0].endswith(f"; kept files no manifest lists in {aside[0].name}")
+    # The replace's leftovers: a user's file, kept under a name no later run sweeps.
+    assert snapshot(aside[0]) == {"mine.txt": b"x"}
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([*kept, aside[0].name, "out"])
+    with output_folder(tmp_path / "out", "track") as staging:
+        (staging / "r.txt").write_text("again")
+    assert capsys.readouterr().err == ""  # nothing left to say
 
 
 def test_a_fresh_folder_never_replaces_one_that_appeared_during_the_run(tmp_path):

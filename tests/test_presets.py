@@ -23,9 +23,8 @@ def test_slides_preset_is_the_slides_configuration():
 
 
 def test_default_preset_is_the_constructors_defaults():
-    base._load_builtins()
     for method, options in presets.DEFAULT.items():
-        signature = inspect.signature(base._REGISTRY[method])
+        signature = inspect.signature(base.controller_class(method))
         for key, value in options.items():
             assert signature.parameters[key].default == value, (method, key)
 

@@ -10,8 +10,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from ddwmmr import ParameterError, Robot, available_methods, make_controller
-from ddwmmr.controllers.qp import QPController
 from ddwmmr.plants.kinematic import KinematicPlant
+from ddwmmr.qp.controller import QPController
 from ddwmmr.qp.limits import Circle, Limit, exact_stability, stability_terms_gradient
 from ddwmmr.qp.naive import NaiveQPController
 from ddwmmr.qp.tasks import Task

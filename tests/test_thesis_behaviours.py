@@ -15,12 +15,12 @@ from ddwmmr.behaviours import (
     Objective,
     ObstacleAvoidance,
     Stability,
-    ThesisController,
     default_pose,
     sense,
 )
 from ddwmmr.model import Robot
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState
+from ddwmmr.thesis_controller import ThesisController
 
 ROBOT = Robot().with_payload(3.0)
 

@@ -7,6 +7,7 @@ Quick use::
     print(result.summary["rms_position_error_m"])
 """
 
+from ddwmmr._version import __version__
 from ddwmmr.controllers import available_methods, make_controller, register
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
@@ -19,8 +20,6 @@ from ddwmmr.trajectories import (
     load_trajectory,
 )
 
-__version__ = "0.1.0"
-
 __all__ = [
     "Ellipse",
     "ParameterError",
@@ -28,6 +27,7 @@ __all__ = [
     "Robot",
     "SampledTrajectory",
     "SimulationResult",
+    "__version__",
     "available_methods",
     "available_trajectories",
     "load_trajectory",

@@ -32,6 +32,10 @@ MAX_TRAJECTORY_SAMPLES = 1_000_000
 MAX_SCENARIOS = 100_000
 #: Largest input file read (robot/trajectory/obstacle TOML, trajectory CSV), bytes.
 MAX_INPUT_BYTES = 64 * 1024 * 1024
+#: Deepest nesting of arrays and tables in a TOML input (ddwmmr's own files use at most
+#: four levels). The parser recurses per level: a deeper file is refused, not parsed into
+#: a RecursionError here or in whatever walks the values later.
+MAX_TOML_DEPTH = 32
 #: Allowed range of every length (m): robot links, wheel radius, track width, footprint,
 #: trajectory semi-axes. A micrometre to a kilometre covers any mobile manipulator.
 LENGTH_RANGE_M = (1e-6, 1e3)
@@ -203,14 +207,39 @@ def read_text_file(path: str | Path, label: str) -> str:
 
 
 def load_toml(path: str | Path, label: str) -> dict:
-    """Parse a TOML file; unreadable or invalid files raise :class:`ParameterError`.
+    """Parse a TOML file; unreadable, invalid or too deeply nested files (more than
+    :data:`MAX_TOML_DEPTH` levels of arrays and tables) raise :class:`ParameterError`.
 
-    ``label`` names the option in the message (``robot``, ``traj``, ``obstacles``).
+    The one place every TOML input is read (robot, trajectory, obstacles, from every tool
+    and the API). ``label`` names the option in the message (``robot``, ``traj``,
+    ``obstacles``).
     """
     path = Path(path)
     text = read_text_file(path, label)
+    too_deep = ParameterError(
+        f"{label}: {path} nests arrays or tables more than {MAX_TOML_DEPTH} levels deep"
+    )
     try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         message = str(exc).splitlines()[0]
         raise ParameterError(f"{label}: {path} is not valid TOML ({message})") from None
+    except RecursionError:
+        raise too_deep from None
+    if nesting_depth(data) > MAX_TOML_DEPTH:
+        raise too_deep
+    return data
+
+
+def nesting_depth(value: Any) -> int:
+    """Levels of lists and dicts in ``value`` (0 for a scalar), counted without recursion."""
+    deepest = 0
+    pending = [(value, 0)]
+    while pending:
+        item, depth = pending.pop()
+        if isinstance(item, dict):
+            item = list(item.values())
+        if isinstance(item, list):
+            deepest = max(deepest, depth + 1)
+            pending.extend((child, depth + 1) for child in item)
+    return deepest

@@ -5,6 +5,10 @@ Every tool (track, compare, scenarios) writes its results through :func:`output_
 * the files are written into a hidden staging folder next to ``--out`` and moved into place
   only when the run succeeded; the staging folder is removed on any error, Ctrl-C or
   SIGTERM (:mod:`ddwmmr.cli.common` turns SIGTERM into an exception so this happens);
+* a run killed outright (SIGKILL, a power cut) cannot clean up: its staging folder and
+  the folder of an earlier output it was replacing carry its host, process id and start
+  time in their names (:func:`owner_token`), and the next run writing in the same folder
+  removes those whose process is gone (:func:`remove_stale`), saying so in one line;
 * a folder written by a tool carries a manifest, :data:`MANIFEST`, naming the tool, the
   package version and every file written;
 * an existing ``--out`` is replaced only if it is empty, or if its manifest names the same
@@ -28,7 +32,9 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import shutil
+import socket
 import stat
 import sys
 import tempfile
@@ -36,12 +42,19 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
+from ddwmmr._version import __version__
 from ddwmmr.errors import ParameterError
 
 #: Name of the manifest file each tool writes into its output folder.
 MANIFEST = ".ddwmmr-manifest.json"
 STAGING_PREFIX = ".ddwmmr-staging-"
 _OLD_PREFIX = ".ddwmmr-old-"
+#: Where the files of an old folder that no manifest lists are kept (a user's files).
+KEPT_PREFIX = ".ddwmmr-kept-"
+#: A staging or old folder's name: prefix, owner (host, process id, start time), random.
+_OWNED_NAME = re.compile(
+    r"^\.ddwmmr-(?P<kind>staging|old)-(?P<host>.+)-(?P<pid>\d+)-(?P<start>\d+)-[^-]+$"
+)
 
 
 # -- permissions ------------------------------------------------------------------------
@@ -69,8 +82,6 @@ def folder_mode() -> int:
 
 def package_version() -> str:
     """The installed ddwmmr version."""
-    from ddwmmr import __version__
-
     return __version__
 
 
@@ -321,6 +332,122 @@ def _refusal(text: str, tool: str, existing: Existing) -> str:
     )
 
 
+# -- who owns a staging folder ---------------------------------------------------------
+def _host() -> str:
+    """This machine's name, reduced to letters, digits, dots and dashes (at most 64)."""
+    return re.sub(r"[^A-Za-z0-9.-]", "_", socket.gethostname())[:64] or "host"
+
+
+def _process_start(pid: int) -> int:
+    """When process ``pid`` started, in clock ticks since boot (Linux), or 0 if unknown;
+    with the process id it names one process, even after the id is reused."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return int(fields[19])
+    except (OSError, IndexError, ValueError):
+        return 0
+
+
+def owner_token() -> str:
+    """``host-pid-start`` of this process, put in the names of its staging folders."""
+    return f"{_host()}-{os.getpid()}-{_process_start(os.getpid())}"
+
+
+def _running(pid: int, start: int) -> bool:
+    """Whether the process ``pid`` that started at ``start`` (0: unknown) still runs.
+    In doubt (another user's process, a platform without these checks): True."""
+    if os.name != "posix":
+        return True  # os.kill(pid, 0) would end the process on Windows
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        pass  # it exists, another user's
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return True
+    if state == "Z":
+        return False  # ended, not yet reaped
+    return not start or _process_start(pid) in (0, start)
+
+
+def stale_folders(folder: Path) -> list[Path]:
+    """Staging and old folders in ``folder`` left by runs on this host that have ended."""
+    try:
+        names = sorted(os.listdir(folder))
+    except OSError:
+        return []
+    host = _host()
+    found = []
+    for name in names:
+        match = _OWNED_NAME.match(name)
+        if match is None or match["host"] != host:
+            continue
+        path = folder / name
+        if os.path.islink(path) or not path.is_dir():
+            continue
+        if not _running(int(match["pid"]), int(match["start"])):
+            found.append(path)
+    return found
+
+
+def remove_stale(folder: Path) -> list[Path]:
+    """Remove :func:`stale_folders` of ``folder`` and say so in one line on stderr.
+
+    A staging folder holds only an unfinished run's files: it goes whole. An old folder
+    holds an earlier output being replaced: only the files its manifest lists (and the
+    manifest) go, as the replace would have done; anything else in it is kept. Returns the
+    folders removed."""
+    removed, kept = [], []
+    for path in stale_folders(folder):
+        if path.name.startswith(STAGING_PREFIX):
+            shutil.rmtree(path, ignore_errors=True)
+        else:
+            manifest = read_manifest(path)
+            for name in [*(manifest["files"] if manifest else []), MANIFEST]:
+                with contextlib.suppress(OSError):
+                    _unlink_regular(path / name)
+            _prune_empty(path)
+        if os.path.lexists(path):
+            kept.append(_set_aside(path))  # a user's files: kept, under a name never swept
+        else:
+            removed.append(path)
+    if removed or kept:
+        count = len(removed)
+        line = f"note: removed {count} folder{'s' * (count != 1)} left in {folder} by runs "
+        line += f"that were killed{_listed(removed)}"
+        if kept:
+            line += f"; kept files no manifest lists in {_listed(kept).strip(' ()')}"
+        _say(line)
+    return removed
+
+
+def _set_aside(path: Path) -> Path:
+    """Rename ``path`` (an old folder holding files no manifest lists) to a free
+    ``.ddwmmr-kept-*`` name, which carries no owner; returns where it went (``path`` if
+    the rename failed)."""
+    with contextlib.suppress(OSError):
+        aside = Path(tempfile.mkdtemp(prefix=KEPT_PREFIX, dir=path.parent))
+        aside.rmdir()
+        os.rename(path, aside)
+        return aside
+    return path
+
+
+def _listed(paths: list[Path]) -> str:
+    """`` (a, b, ...)``: the first two names of ``paths``, or nothing."""
+    if not paths:
+        return ""
+    return " (" + ", ".join(p.name for p in paths[:2]) + (", ...)" if len(paths) > 2 else ")")
+
+
+def _say(line: str) -> None:
+    with contextlib.suppress(OSError):
+        print(line, file=sys.stderr)
+
+
 # -- the staging folder -------------------------------------------------------------------
 def first_free(path: str | Path, folder: bool = False) -> Path:
     """``path``, or ``stem-2.suffix``, ``stem-3.suffix``... (a ``folder``: ``name-2``,
@@ -357,10 +484,12 @@ class OutputFolder:
         if self._entered:
             raise RuntimeError("an OutputFolder is used for one with-block only")
         self._entered = True
+        remove_stale(self.path.parent)
+        prefix = f"{STAGING_PREFIX}{owner_token()}-"
         for attempt in range(2):
             self._created = _make_parents(self.path.parent)
             try:
-                staging = Path(tempfile.mkdtemp(prefix=STAGING_PREFIX, dir=self.path.parent))
+                staging = Path(tempfile.mkdtemp(prefix=prefix, dir=self.path.parent))
                 break
             except FileNotFoundError:
                 # another run removed the empty parent it had made: make it again, once
@@ -531,7 +660,7 @@ def _write_manifest(folder: Path, manifest: dict) -> None:
 
 def _swap(staging: Path, target: Path, existing: Existing) -> None:
     """Replace ``target`` (empty, or only this tool's listed files) by ``staging``."""
-    old = Path(tempfile.mkdtemp(prefix=_OLD_PREFIX, dir=target.parent))
+    old = Path(tempfile.mkdtemp(prefix=f"{_OLD_PREFIX}{owner_token()}-", dir=target.parent))
     old.rmdir()
     os.rename(target, old)
     try:
@@ -543,7 +672,7 @@ def _swap(staging: Path, target: Path, existing: Existing) -> None:
         _unlink_regular(old / name)
     _prune_empty(old)
     if old.exists():  # something appeared meanwhile: keep it, say where
-        print(f"warning: kept unexpected files of the old {target} in {old}", file=sys.stderr)
+        _say(f"warning: kept unexpected files of the old {target} in {_set_aside(old)}")
 
 
 def _merge(staging: Path, target: Path, files: list[str], existing: Existing, text: str) -> None:

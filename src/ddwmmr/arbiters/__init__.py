@@ -5,7 +5,8 @@ The thesis's priority state machine is :class:`StateMachineArbiter`; any object 
 can replace it. :class:`CompetitiveDynamicsArbiter` (Ellekilde & Christensen 2009) is the
 alternative: behaviour weights under competitive dynamics, proposals blended by the weights
 (it also has ``weigh(percept, behaviours) -> Blend``, :class:`BlendingArbiter`).
-:func:`make_arbiter` builds either from a scenario configuration.
+:func:`make_arbiter` builds a registered one (:func:`available_arbiters`) from a scenario
+configuration.
 """
 
 from ddwmmr.arbiters.base import Arbiter, BlendingArbiter
@@ -16,7 +17,13 @@ from ddwmmr.arbiters.competitive import (
     CompetitiveDynamicsArbiter,
     CompetitiveParameters,
 )
-from ddwmmr.arbiters.factory import ARBITERS, check_arbiter, make_arbiter
+from ddwmmr.arbiters.factory import (
+    DEFAULT_ARBITER,
+    arbiter_description,
+    available_arbiters,
+    check_arbiter,
+    make_arbiter,
+)
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
     MOVE_ARM,
@@ -28,10 +35,11 @@ from ddwmmr.arbiters.state_machine import (
     Selection,
     StateMachineArbiter,
 )
+from ddwmmr.registry import register_arbiter
 
 __all__ = [
-    "ARBITERS",
     "BEHAVIOURS",
+    "DEFAULT_ARBITER",
     "MANIPULABILITY",
     "MOVE_ARM",
     "MOVE_BASE",
@@ -47,6 +55,9 @@ __all__ = [
     "Hysteresis",
     "Selection",
     "StateMachineArbiter",
+    "arbiter_description",
+    "available_arbiters",
     "check_arbiter",
     "make_arbiter",
+    "register_arbiter",
 ]

@@ -14,10 +14,11 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Protocol
 
-if TYPE_CHECKING:  # behaviours import the arbiter package; avoid a cycle at run time
+from ddwmmr.behaviours.base import Behaviour, Percept
+
+if TYPE_CHECKING:  # the decisions are defined beside the arbiters that make them
     from ddwmmr.arbiters.competitive import Blend
     from ddwmmr.arbiters.state_machine import Selection
-    from ddwmmr.behaviours.base import Behaviour, Percept
 
 
 class Arbiter(Protocol):

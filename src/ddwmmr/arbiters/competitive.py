@@ -40,7 +40,6 @@ import math
 import random
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
@@ -48,18 +47,17 @@ from ddwmmr.arbiters.state_machine import (
     MOVE_BASE,
     OBSTACLE,
     STABILITY,
+    THESIS_MANIPULABILITY,
+    THESIS_STABILITY,
     Hysteresis,
     Selection,
 )
+from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
-
-if TYPE_CHECKING:  # behaviours import the arbiter package; avoid a cycle at run time
-    from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
+from ddwmmr.registry import register_arbiter
 
 #: Behaviours of the arbiter, in priority order (also the order of the weight updates).
 BEHAVIOURS = ("stability", "manipulability", "obstacle", "objective")
-#: The thesis's thresholds (Table 5.1), as for the state machine.
-THESIS_STABILITY, THESIS_MANIPULABILITY = Hysteresis(1.25, 1.60), Hysteresis(0.75, 0.90)
 #: Guard on |w| (the dynamics keep |w| <= 1; only noise can push a weight above 1).
 W_LIMIT = 1.5
 #: Weights whose square is below this are left out of the blend (not even evaluated).
@@ -294,6 +292,7 @@ class Blend:
     proposals: Mapping[str, Proposal]
 
 
+@register_arbiter("competitive")
 class CompetitiveDynamicsArbiter:
     """Competitive dynamics over objective, manipulability, stability, obstacle avoidance.
 
@@ -342,8 +341,6 @@ class CompetitiveDynamicsArbiter:
         record: keep :attr:`history` (every call: time, S, dominant state, weights and
             advantages by behaviour) for plots.
     """
-
-    name = "competitive"
 
     def __init__(
         self,

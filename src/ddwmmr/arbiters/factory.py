@@ -1,37 +1,54 @@
 """Building an arbiter from a run configuration (the scenario protocol's ``arbiter`` field).
 
-``config.arbiter`` is a name in :data:`ARBITERS` (the configuration's ``stability`` and
-``manipulability`` thresholds and ``arbiter_seed`` are used) or an arbiter instance, used as
-it is with its own thresholds (``reset()`` is called before every run, so an instance can be
-reused; one that records keeps the history of the last run).
+``config.arbiter`` is a registered arbiter name (:func:`available_arbiters`; the
+configuration's ``stability`` and ``manipulability`` thresholds and ``arbiter_seed`` are
+used) or an arbiter instance, used as it is with its own thresholds (``reset()`` is called
+before every run, so an instance can be reused; one that records keeps the history of the
+last run). An arbiter class is registered with :func:`ddwmmr.registry.register_arbiter`
+and built as ``cls(stability=Hysteresis, manipulability=Hysteresis)``, plus
+``seed=config.arbiter_seed`` when its constructor takes a ``seed``.
 """
 
 from __future__ import annotations
 
+import inspect
 from typing import Any
 
-from ddwmmr.arbiters.competitive import CompetitiveDynamicsArbiter
-from ddwmmr.arbiters.state_machine import Hysteresis, StateMachineArbiter
+from ddwmmr.arbiters.state_machine import Hysteresis
 from ddwmmr.errors import ParameterError
+from ddwmmr.registry import ARBITERS, CONTROLLERS
 
-#: Arbiter names accepted by ``RunConfig.arbiter`` and ``--arbiter``.
-ARBITERS = ("state-machine", "competitive")
+#: The arbiter a run uses when it names none.
+DEFAULT_ARBITER = "state-machine"
+
+
+def available_arbiters() -> list[str]:
+    """Registered arbiter names (``RunConfig.arbiter``, ``--arbiter``), in listing order."""
+    return ARBITERS.names()
+
+
+def arbiter_description(name: str) -> str:
+    """First docstring line of a registered arbiter."""
+    return ARBITERS.describe(name)
 
 
 def check_arbiter(arbiter: Any, controller: str = "thesis") -> None:
-    """Raise :class:`ParameterError` unless ``arbiter`` is a known name or an arbiter."""
+    """Raise :class:`ParameterError` unless ``arbiter`` is a registered name or an arbiter,
+    and ``controller`` takes one (anything but the default name needs a controller
+    registered with ``arbiter=True``)."""
+    takes = CONTROLLERS.names(arbiter=True)
+    refusal = f"arbiter: only the {' or '.join(takes)} controller has an arbiter"
     if isinstance(arbiter, str):
-        if arbiter not in ARBITERS:
-            raise ParameterError(f"arbiter must be one of {', '.join(ARBITERS)} (got {arbiter!r})")
-        if arbiter != ARBITERS[0] and controller != "thesis":
-            raise ParameterError("arbiter: only the thesis controller has an arbiter")
+        ARBITERS.entry(arbiter)  # an unknown name: one line naming the known ones
+        if arbiter != DEFAULT_ARBITER and controller not in takes:
+            raise ParameterError(refusal)
         return
     if not all(callable(getattr(arbiter, m, None)) for m in ("reset", "select")):
         raise ParameterError(
             "arbiter: need a name or an object with reset() and select() (ddwmmr.arbiters.Arbiter)"
         )
-    if controller != "thesis":
-        raise ParameterError("arbiter: only the thesis controller has an arbiter")
+    if controller not in takes:
+        raise ParameterError(refusal)
 
 
 def make_arbiter(config: Any) -> Any:
@@ -39,9 +56,11 @@ def make_arbiter(config: Any) -> Any:
     arbiter = config.arbiter
     if not isinstance(arbiter, str):
         return arbiter
-    stability = Hysteresis(*config.stability)
-    manipulability = Hysteresis(*config.manipulability)
-    if arbiter == "competitive":
-        return CompetitiveDynamicsArbiter(stability, manipulability, seed=config.arbiter_seed)
-    check_arbiter(arbiter)
-    return StateMachineArbiter(stability=stability, manipulability=manipulability)
+    cls = ARBITERS.load(arbiter)
+    options: dict[str, Any] = {
+        "stability": Hysteresis(*config.stability),
+        "manipulability": Hysteresis(*config.manipulability),
+    }
+    if "seed" in inspect.signature(cls).parameters:
+        options["seed"] = config.arbiter_seed
+    return cls(**options)

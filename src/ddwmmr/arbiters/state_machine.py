@@ -16,12 +16,10 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
+from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
 from ddwmmr.errors import ParameterError
-
-if TYPE_CHECKING:  # behaviours import the arbiter package; avoid a cycle at run time
-    from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
+from ddwmmr.registry import register_arbiter
 
 MOVE_BASE, MOVE_ARM = "move_base", "move_arm"
 MANIPULABILITY, STABILITY, OBSTACLE = "manipulability", "stability", "obstacle"
@@ -47,6 +45,11 @@ class Hysteresis:
         return value < (self.exit if currently else self.enter)
 
 
+#: The thesis's thresholds (Table 5.1): S enter 1.25 / exit 1.60, eta enter 0.75 / exit 0.90.
+THESIS_STABILITY = Hysteresis(1.25, 1.60)
+THESIS_MANIPULABILITY = Hysteresis(0.75, 0.90)
+
+
 @dataclass(slots=True)
 class Selection:
     """The arbiter's decision: state, the behaviour that produced the proposal, proposal
@@ -57,15 +60,14 @@ class Selection:
     proposal: Proposal
 
 
+@register_arbiter("state-machine")
 class StateMachineArbiter:
     """Priority state machine with hysteresis thresholds (thesis 4.3)."""
 
-    name = "state-machine"
-
     def __init__(
         self,
-        stability: Hysteresis = Hysteresis(1.25, 1.60),
-        manipulability: Hysteresis = Hysteresis(0.75, 0.90),
+        stability: Hysteresis = THESIS_STABILITY,
+        manipulability: Hysteresis = THESIS_MANIPULABILITY,
     ) -> None:
         self.stability = stability
         self.manipulability = manipulability

@@ -1,7 +1,7 @@
-"""High-level behaviours of the thesis controller and the controller that assembles them."""
+"""High-level behaviours of the thesis controller and its low-level movers (the controller
+that assembles them with an arbiter is :mod:`ddwmmr.thesis_controller`)."""
 
 from ddwmmr.behaviours.base import BRAKE, DRIVE, TURN, Behaviour, Percept, Proposal, sense
-from ddwmmr.behaviours.controller import ThesisController
 from ddwmmr.behaviours.lowlevel import ArmMover, BaseMover, PDGains
 from ddwmmr.behaviours.manipulability import Manipulability
 from ddwmmr.behaviours.objective import Objective, default_pose
@@ -22,7 +22,6 @@ __all__ = [
     "Percept",
     "Proposal",
     "Stability",
-    "ThesisController",
     "default_pose",
     "sense",
 ]

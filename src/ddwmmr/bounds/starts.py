@@ -210,10 +210,8 @@ def controller_guess(scenario, controller: str, payload: float = 3.0, dt: float 
     from ddwmmr.behaviours.objective import default_pose
     from ddwmmr.scenarios.protocol import (
         RunConfig,
-        make_mpc,
-        make_qp,
+        make_scenario_controller,
         make_scenario_plant,
-        make_thesis_controller,
     )
     from ddwmmr.sim.loop import run_loop
 
@@ -222,13 +220,7 @@ def controller_guess(scenario, controller: str, payload: float = 3.0, dt: float 
     config = RunConfig(controller=kind, plant="thesis", payload=payload, dt=dt, arbiter=arbiter)
     robot = Robot().with_payload(payload)
     plant = make_scenario_plant(robot, config)
-    if kind == "thesis":
-        ctl = make_thesis_controller(robot, scenario, config)
-    elif kind == "mpc":
-        ctl = make_mpc(robot, scenario, config, plant)
-    else:
-        envelope = plant.velocity_envelope()
-        ctl = make_qp(robot, scenario, config, envelope)
+    ctl = make_scenario_controller(robot, scenario, config, plant)
     task = RecordingTask(robot, plant, scenario.waypoints, dt, config.tolerance)
     q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
     run_loop(plant, ctl, task, q0, dt, round(config.limit_for(scenario) / dt))

@@ -20,9 +20,9 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, replace
 from pathlib import Path
 
+from ddwmmr import provenance
 from ddwmmr.bounds import batch
 from ddwmmr.bounds.search import QUICK, Settings
-from ddwmmr.cli import provenance
 from ddwmmr.cli.common import ArgumentParser, add_force_argument, output_folder, run_main
 from ddwmmr.errors import (
     MASS_RANGE_KG,

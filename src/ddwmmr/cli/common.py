@@ -4,9 +4,10 @@ Every tool's ``main(argv)`` runs through :func:`run_main`, which gives the tools
 behaviour for everything that is not a result:
 
 * bad input (:class:`ParameterError`): one line ``error: ...`` on stderr, status 2;
-* Ctrl-C (SIGINT): one line, status 130; SIGTERM: one line, status 143 (128 + the signal
-  number, the shell convention). Both first stop the tool's worker processes and unwind
-  the stack, so the output folder's staging copy is removed (:mod:`ddwmmr.outputs`);
+* Ctrl-C (SIGINT): one line, status 130; SIGTERM, SIGHUP (terminal closed) and SIGQUIT
+  (Ctrl-\\): one line, status 143, 129 and 131 (128 + the signal number, the shell
+  convention). Each first stops the tool's worker processes and unwinds the stack, so the
+  output folder's staging copy is removed (:mod:`ddwmmr.outputs`);
 * an operating-system error while writing (disk full...): one line, status 1.
 """
 
@@ -14,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import logging
 import multiprocessing
 import os
 import re
@@ -31,6 +33,12 @@ EXIT_USAGE = 2
 #: Exit statuses after SIGINT (Ctrl-C) and SIGTERM: 128 + the signal number.
 EXIT_INTERRUPTED = 128 + signal.SIGINT
 EXIT_TERMINATED = 128 + signal.SIGTERM
+#: Signals that stop a tool as SIGTERM does (those this platform has): a closed terminal
+#: (SIGHUP) and Ctrl-\ (SIGQUIT) would otherwise end it without a word, or with a core
+#: dump, and leave its workers and staging folder behind.
+STOP_SIGNALS = tuple(
+    getattr(signal, name) for name in ("SIGTERM", "SIGHUP", "SIGQUIT") if hasattr(signal, name)
+)
 
 __all__ = [
     "EXIT_USAGE",
@@ -67,11 +75,30 @@ class ArgumentParser(argparse.ArgumentParser):
 
 
 class Terminated(BaseException):
-    """SIGTERM arrived: raised in the main thread so that cleanup code runs."""
+    """SIGTERM (or another of :data:`STOP_SIGNALS`) arrived: raised in the main thread so
+    that cleanup code runs."""
+
+    def __init__(self, signum: int = signal.SIGTERM) -> None:
+        super().__init__(signum)
+        self.signum = int(signum)
+
+    @property
+    def status(self) -> int:
+        """Exit status: 128 + the signal number."""
+        return 128 + self.signum
+
+    @property
+    def name(self) -> str:
+        """The signal's name, e.g. ``SIGHUP``."""
+        return signal.Signals(self.signum).name
 
 
 def stop_workers(timeout: float = 2.0) -> None:
-    """Stop the worker processes this process started (process pools, Dask's nannies)."""
+    """Stop the worker processes this process started (process pools, Dask's nannies).
+
+    Dask's scheduler and nannies in this process would log each lost worker: the tool
+    says one line for the stop, so their logs are silenced first."""
+    logging.getLogger("distributed").setLevel(logging.CRITICAL + 1)
     children = multiprocessing.active_children()
     for child in children:
         child.terminate()
@@ -83,28 +110,31 @@ def stop_workers(timeout: float = 2.0) -> None:
 
 @contextlib.contextmanager
 def interruptible() -> Iterator[None]:
-    """Turn SIGINT and SIGTERM into exceptions raised after the workers are stopped.
+    """Turn SIGINT and :data:`STOP_SIGNALS` into exceptions raised after the workers are
+    stopped.
 
-    Forked workers inherit the handler: there it ignores SIGINT (a Ctrl-C reaches the
-    whole process group, and the parent stops the workers itself, so they print no
-    traceback) and exits at once on SIGTERM (the parent's :func:`stop_workers`).
+    Forked workers inherit the handler: there it ignores SIGINT, SIGHUP and SIGQUIT (a
+    Ctrl-C, a Ctrl-\\ or a closed terminal reaches the whole process group, and the parent
+    stops the workers itself, so they print no traceback) and exits at once on SIGTERM
+    (the parent's :func:`stop_workers`).
     """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     owner = os.getpid()
+    handled = (signal.SIGINT, *STOP_SIGNALS)
 
     def handle(signum: int, frame: object) -> None:
         if os.getpid() != owner:
             if signum == signal.SIGTERM:
                 os._exit(EXIT_TERMINATED)
             return
-        for number in (signal.SIGINT, signal.SIGTERM):  # one signal is enough
+        for number in handled:  # one signal is enough
             signal.signal(number, signal.SIG_IGN)
         stop_workers()
-        raise KeyboardInterrupt if signum == signal.SIGINT else Terminated
+        raise KeyboardInterrupt if signum == signal.SIGINT else Terminated(signum)
 
-    previous = {s: signal.signal(s, handle) for s in (signal.SIGINT, signal.SIGTERM)}
+    previous = {s: signal.signal(s, handle) for s in handled}
     try:
         yield
     finally:
@@ -123,9 +153,9 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
     except KeyboardInterrupt:
         _say("interrupted (Ctrl-C): stopped; unfinished output removed")
         return EXIT_INTERRUPTED
-    except Terminated:
-        _say("terminated (SIGTERM): stopped; unfinished output removed")
-        return EXIT_TERMINATED
+    except Terminated as stop:
+        _say(f"terminated ({stop.name}): stopped; unfinished output removed")
+        return stop.status
     except BrokenPipeError:  # e.g. output piped into head: nothing left to say
         return 1
     except OSError as exc:

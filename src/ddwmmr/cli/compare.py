@@ -19,7 +19,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.cli import provenance
+from ddwmmr import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,

@@ -15,19 +15,21 @@ Examples::
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime as dt
 import json
 import math
 import sys
 import time
 from collections.abc import Sequence
-from dataclasses import asdict, replace
+from dataclasses import asdict, astuple, replace
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.arbiters import ARBITERS
+from ddwmmr import provenance
+from ddwmmr.arbiters import DEFAULT_ARBITER, arbiter_description, available_arbiters
+from ddwmmr.arbiters.state_machine import THESIS_MANIPULABILITY, THESIS_STABILITY
 from ddwmmr.behaviours.objective import default_pose
-from ddwmmr.cli import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
@@ -36,6 +38,8 @@ from ddwmmr.cli.common import (
     output_folder,
     run_main,
 )
+from ddwmmr.commands import traits_of
+from ddwmmr.controllers import controller_traits, method_description
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
@@ -47,12 +51,29 @@ from ddwmmr.errors import (
     check_step_count,
 )
 from ddwmmr.model import Robot
-from ddwmmr.model.stability import STABILITY_CAP
+from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR, valid_stability_floor
+from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
-from ddwmmr.scenarios.executors import EXECUTORS, default_jobs, run_many
+from ddwmmr.scenarios.executors import (
+    CONNECT_TIMEOUT,
+    EXECUTORS,
+    MAX_CONNECT_TIMEOUT,
+    DaskWorkers,
+    check_connect_timeout,
+    default_jobs,
+    run_many,
+)
 from ddwmmr.scenarios.generator import Scenario, generate
-from ddwmmr.scenarios.protocol import CONTROLLERS, PLANTS, Outcome, RunConfig, run_scenario
+from ddwmmr.scenarios.protocol import (
+    Outcome,
+    RunConfig,
+    make_scenario_controller,
+    make_scenario_plant,
+    plants_for,
+    run_scenario,
+    scenario_controllers,
+)
 from ddwmmr.sim.result import json_safe, write_atomic
 
 #: The batch summary (holds the run record: everything needed to repeat the batch).
@@ -67,7 +88,7 @@ MAX_DT = 0.1
 QP_OPTIONS = {
     "qp_stability_min": (
         ("qp", "mpc"),
-        lambda v: 0.0 < v < STABILITY_CAP,
+        valid_stability_floor,
         f"(0, {STABILITY_CAP:g})",
     ),
     "qp_max_speed": (("qp",), lambda v: 0.0 < v <= MAX_QP_SPEED, f"(0, {MAX_QP_SPEED:g}] m/s"),
@@ -75,7 +96,10 @@ QP_OPTIONS = {
 #: Largest threshold: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
 THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}
 #: The thesis's thresholds (enter, exit), the defaults of --stability and --manipulability.
-DEFAULT_THRESHOLDS = {"stability": (1.25, 1.60), "manipulability": (0.75, 0.90)}
+DEFAULT_THRESHOLDS = {
+    "stability": astuple(THESIS_STABILITY),
+    "manipulability": astuple(THESIS_MANIPULABILITY),
+}
 
 DESCRIPTION = """\
 Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly (seeded) in
@@ -83,11 +107,8 @@ an 8 m x 8 m square; the end effector must reach them in order within 0.01 m in 
 (120 s with obstacles) while the tip-over stability S stays above 1. Writes scenarios.csv
 (one row per scenario), summary.json, table.txt (thesis Table 5.2 format) and figures
 (per-scenario bars as thesis Figs 5.3-5.9, paths, a state timeline) into --out, and prints
-the table. Controllers: 'thesis' (behaviour-based, state-machine or competitive arbiter)
-sends wheel forces; 'qp' (the library's QP controller) sends velocities, followed by the
-thesis plant's velocity servo; 'mpc' (CasADi, the thesis base's force-level model) sends
-wheel forces. Plants: the thesis force-driven dynamics (default), the kinematic model
-(qp and mpc only) or the MuJoCo physics model, which judges tipping by its contact forces."""
+the table. The controllers are the registered ones that do this waypoint task, the plants
+the registered ones; --help lists both, each controller with the plants it can command."""
 
 EPILOG = """\
 The default payload is 3.0 kg: with the thesis's 1.25 kg the planar arm can never tip
@@ -106,16 +127,22 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--controller",
-        choices=CONTROLLERS,
+        choices=scenario_controllers(),
         default="thesis",
-        help="controller to benchmark (default: thesis)",
+        help="controller to benchmark (default: thesis): "
+        + "; ".join(
+            f"{name}: {method_description(name).rstrip('.')} (plants: "
+            f"{', '.join(plants_for(name))})"
+            for name in scenario_controllers()
+        ),
     )
     parser.add_argument(
         "--arbiter",
-        choices=ARBITERS,
+        choices=available_arbiters(),
         default=None,
-        help="thesis controller's arbiter: the thesis's 'state-machine' (default) or "
-        "'competitive' dynamics (Ellekilde & Christensen 2009; same thresholds options)",
+        help=f"thesis controller's arbiter (default: {DEFAULT_ARBITER}; the same thresholds "
+        "options for each): "
+        + "; ".join(f"{a}: {arbiter_description(a).rstrip('.')}" for a in available_arbiters()),
     )
     parser.add_argument(
         "--arbiter-seed",
@@ -127,10 +154,11 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--plant",
-        choices=PLANTS,
+        choices=available_plants(),
         default="thesis",
-        help="plant: 'thesis' force-driven dynamics (default), 'kinematic' (qp and mpc "
-        "only) or 'mujoco' physics (tipping judged from contact forces)",
+        help="plant (default: thesis): "
+        + "; ".join(f"{p}: {plant_description(p).rstrip('.')}" for p in available_plants())
+        + "; a physics plant judges tipping from its contact forces",
     )
     parser.add_argument(
         "--n",
@@ -162,7 +190,7 @@ def build_parser() -> ArgumentParser:
         default=None,
         metavar=("ENTER", "EXIT"),
         help="thesis controller's stability thresholds: enter below ENTER, leave at EXIT "
-        "(default: 1.25 1.60)",
+        f"(default: {THESIS_STABILITY.enter:.2f} {THESIS_STABILITY.exit:.2f})",
     )
     parser.add_argument(
         "--manipulability",
@@ -170,7 +198,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar=("ENTER", "EXIT"),
-        help="thesis controller's manipulability thresholds (default: 0.75 0.90)",
+        help="thesis controller's manipulability thresholds "
+        f"(default: {THESIS_MANIPULABILITY.enter:.2f} {THESIS_MANIPULABILITY.exit:.2f})",
     )
     parser.add_argument(
         "--no-hysteresis",
@@ -214,6 +243,14 @@ def build_parser() -> ArgumentParser:
         help="Dask scheduler address (with --executor dask; default: start a LocalCluster)",
     )
     parser.add_argument(
+        "--connect-timeout",
+        type=float,
+        metavar="S",
+        help=f"with --scheduler: seconds the scheduler has to answer, and then to have a "
+        f"worker, in (0, {MAX_CONNECT_TIMEOUT:g}] (default: {CONNECT_TIMEOUT:g}); checked "
+        "before anything is written",
+    )
+    parser.add_argument(
         "--study",
         choices=STUDIES,
         help="'thresholds': rerun thesis Tables 5.5-5.20 threshold variations; "
@@ -225,7 +262,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar="S",
-        help="hard stability bound of the qp and mpc controllers, in (0, 10) (default: 1.25)",
+        help=f"hard stability bound of the qp and mpc controllers, in (0, {STABILITY_CAP:g}) "
+        f"(default: {STABILITY_FLOOR:g})",
     )
     parser.add_argument(
         "--qp-max-speed",
@@ -301,12 +339,16 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
     if args.scheduler and args.executor != "dask":
         raise ParameterError("scheduler: only used with --executor dask")
+    if args.connect_timeout is not None:
+        if not args.scheduler:
+            raise ParameterError("connect-timeout: only used with --scheduler")
+        check_connect_timeout(args.connect_timeout)
     if args.study == "thresholds" and args.controller != "thesis":
         raise ParameterError("study: the threshold study needs --controller thesis")
     if args.study == "arbiters" and args.controller != "thesis":
         raise ParameterError("study: the arbiter study needs --controller thesis")
     _check_thesis_options(args)
-    arbiter = args.arbiter or "state-machine"
+    arbiter = args.arbiter or DEFAULT_ARBITER
     arbiter_seed = 0 if args.arbiter_seed is None else args.arbiter_seed
     check_nonnegative("arbiter-seed", arbiter_seed)
     if args.study and args.obstacles:
@@ -354,7 +396,8 @@ def _check_thesis_options(args: argparse.Namespace) -> None:
     """Refuse the thesis controller's options where nothing would read them."""
     given = [f"--{n}" for n in ("stability", "manipulability") if getattr(args, n) is not None]
     given += ["--no-hysteresis"] if args.no_hysteresis else []
-    if given and args.controller != "thesis":
+    arbitrated = controller_traits(args.controller)["arbiter"]  # thresholds are its arbiter's
+    if given and not arbitrated:
         raise ParameterError(
             f"{given[0]}: only used with --controller thesis (the qp and mpc hold "
             "--qp-stability-min)"
@@ -364,7 +407,7 @@ def _check_thesis_options(args: argparse.Namespace) -> None:
             f"{given[0]}: the {args.study[:-1]} study runs its own thresholds (thesis Tables "
             "5.2-5.18); leave it out"
         )
-    if args.arbiter is not None and args.controller != "thesis":
+    if args.arbiter is not None and not arbitrated:
         raise ParameterError("--arbiter: only the thesis controller has an arbiter")
     if args.arbiter is not None and args.study == "arbiters":
         raise ParameterError("--arbiter: the arbiter study runs both arbiters; leave it out")
@@ -375,13 +418,34 @@ def _check_thesis_options(args: argparse.Namespace) -> None:
 
 
 class Runner:
-    """Runs batches with the chosen executor, a progress bar and timing."""
+    """Runs batches with the chosen executor, a progress bar and timing.
+
+    A context manager: with ``--executor dask`` the ``with`` block holds one client for
+    every batch, connected (or its LocalCluster started) on entry, before any output
+    exists, so a scheduler that is not there fails with one line and leaves nothing.
+    """
 
     def __init__(self, args: argparse.Namespace) -> None:
-        self.jobs = args.jobs or default_jobs()
+        # never more workers than the largest batch has scenarios
+        self.jobs = min(args.jobs or default_jobs(), largest_batch(args))
         self.executor = args.executor
         self.scheduler = args.scheduler
+        self.connect_timeout = args.connect_timeout or CONNECT_TIMEOUT
         self.progress = not args.no_progress
+        self._client: Any = None
+        self._held = contextlib.ExitStack()
+
+    def __enter__(self) -> Runner:
+        if self.executor == "dask":
+            workers = DaskWorkers(self.jobs, self.scheduler, self.connect_timeout)
+            label = "connecting to Dask" if self.scheduler else "starting Dask workers"
+            with phase(label, enabled=self.progress):
+                self._client = self._held.enter_context(workers)
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self._client = None
+        self._held.close()
 
     def run(self, scenarios: list[Scenario], config: RunConfig, label: str):
         """Outcomes in scenario order and the wall time (s)."""
@@ -392,10 +456,15 @@ class Runner:
                 config,
                 jobs=self.jobs,
                 executor=self.executor,
-                scheduler=self.scheduler,
+                client=self._client,
                 on_done=bar.advance,
             )
         return outcomes, time.perf_counter() - start
+
+
+def largest_batch(args: argparse.Namespace) -> int:
+    """Scenarios in the largest batch a run of ``args`` sends to the workers."""
+    return max(args.n, 10) if args.study == "obstacles" else args.n
 
 
 def output_names(args: argparse.Namespace, config: RunConfig) -> tuple[str, ...]:
@@ -408,7 +477,7 @@ def output_names(args: argparse.Namespace, config: RunConfig) -> tuple[str, ...]
 
         return (MARKER, *arbiter_study.output_names())
     figures = ["thesis_times.png", "thesis_speed.png", "thesis_paths.png", "thesis_timeline.png"]
-    if config.controller == "thesis":
+    if controller_traits(config.controller)["arbiter"]:  # time in its fix states
         figures += ["thesis_stability.png", "thesis_manipulability.png"]
     if config.arbiter == "competitive":
         figures.append("thesis_weights.png")
@@ -460,7 +529,7 @@ def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
     short = f"{config.controller} / {config.plant}"
     report.plot_state_times(outcomes, folder / "thesis_times.png", f"{short}: time per state")
     report.plot_speeds(outcomes, folder / "thesis_speed.png", short)
-    if config.controller == "thesis":
+    if controller_traits(config.controller)["arbiter"]:
         for key in ("stability", "manipulability"):
             report.plot_fix_state(outcomes, key, folder / f"thesis_{key}.png", short)
     if config.arbiter == "competitive":
@@ -506,6 +575,8 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     extra = {"seed": args.seed, "run": _record(args, config)}
     if args.bounds_table is not None:
         extra["bracket"] = {"bounds": args.bounds, **report.bracket(outcomes, args.bounds_table)}
+    if config.controller == "mpc":
+        extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     if args.bounds_table is not None:
         b = summary["bracket"]
@@ -516,9 +587,22 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
-        f"({runner.jobs} {args.executor} workers)",
+        f"({runner.jobs} {args.executor} worker{'s' * (runner.jobs != 1)})",
         file=sys.stderr,
     )
+
+
+def mpc_options(config: RunConfig, scenario: Scenario) -> dict[str, Any]:
+    """The ``mpc``'s options as the batch's runs use them, whole: resolved for the batch's
+    plant (:meth:`~ddwmmr.mpc.options.MPCOptions.adopt_plant`), in waypoint mode, without
+    the obstacles (each scenario's own); ``summary.json["controller_options"]``."""
+    robot = config_robot(config)
+    plant = make_scenario_plant(robot, config)
+    controller = make_scenario_controller(robot, scenario, config, plant)
+    controller.adopt_plant(traits_of(plant))
+    record = controller.resolved.record("reach", config.dt)
+    del record["obstacles"]
+    return record
 
 
 def _run_thresholds(args, config, runner, folder: Path) -> None:
@@ -617,13 +701,12 @@ def _main(argv: Sequence[str] | None = None) -> int:
     fresh = args.out is None  # a default name: never replaces an earlier run
     out = first_free(default_out(), folder=True) if fresh else Path(args.out)
     check_output_folder(out, "scenarios", args.force, output_names(args, config))
-    if config.controller == "qp":
-        from ddwmmr.scenarios.protocol import make_qp
-
-        make_qp(config_robot(config), generate(1, 0)[0], config)  # fail early, before output
-    runner = Runner(args)
+    if config.controller == "qp":  # its options are checked by building it, before output
+        robot = config_robot(config)
+        plant = make_scenario_plant(robot, config)
+        make_scenario_controller(robot, generate(1, 0)[0], config, plant)
     writer = output_folder(out, "scenarios", args.force, fresh)
-    with writer as folder:
+    with Runner(args) as runner, writer as folder:  # workers first, then the output
         if args.study == "thresholds":
             _run_thresholds(args, config, runner, folder)
         elif args.study == "obstacles":

@@ -14,11 +14,10 @@ import datetime as dt
 import json
 import sys
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.cli import provenance
+from ddwmmr import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
@@ -36,11 +35,18 @@ from ddwmmr.controllers.base import (
     method_options,
 )
 from ddwmmr.controllers.presets import PRESETS, preset_options
-from ddwmmr.errors import ParameterError, check_range, check_step_count, read_text_file, shown
-from ddwmmr.model import Robot
-from ddwmmr.plants import available_plants
+from ddwmmr.errors import (
+    ParameterError,
+    check_finite,
+    check_range,
+    check_step_count,
+    read_text_file,
+    shown,
+)
+from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
+from ddwmmr.provenance import RunInputs, run_record
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     initial_configuration,
@@ -197,9 +203,8 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--plant",
         choices=available_plants(),
-        help="what the commands drive: kinematic (default; exact kinematics), thesis (the "
-        "thesis's force-limited base through a velocity servo) or mujoco (rigid-body physics "
-        "with contacts: tip-over judged by the support forces, docs/physics.md)",
+        help=f"what the commands drive (default {PLANT}): "
+        + "; ".join(f"{p}: {plant_description(p).rstrip('.')}" for p in available_plants()),
     )
     parser.add_argument(
         "--integrator",
@@ -312,23 +317,6 @@ def format_table(summary: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
-@dataclass
-class RunInputs:
-    """Everything a track run simulates (from the options, or from a --rerun record)."""
-
-    method: str
-    options: dict[str, Any]
-    robot: Robot
-    trajectory: Any
-    trajectory_file: Path | None
-    dt: float
-    duration: float
-    integrator: str | None
-    offset: tuple[float, float]
-    label: str  # trajectory as the user named it (for the default folder name)
-    plant: str = PLANT
-
-
 def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     """Validated inputs from the command-line options."""
     if args.method is None or args.traj is None:
@@ -348,13 +336,7 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
             f"smaller --dt) (got {duration:g})"
         )
     offset = DEFAULT_INITIAL_OFFSET if args.offset is None else tuple(args.offset)
-    for value in offset:
-        check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
-    named = "payload" if args.payload is not None else "robot"
-    # a start that tips the robot or sits in an obstacle is bad input
-    start = initial_configuration(robot, trajectory, offset)
-    check_start(robot, start, options.get("obstacles") or (), named, "--offset")
-    return RunInputs(
+    inputs = RunInputs(
         args.method,
         options,
         robot,
@@ -367,6 +349,39 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         args.traj,
         plant,
     )
+    return check_run(inputs, "payload" if args.payload is not None else "robot", "--offset")
+
+
+def check_run(inputs: RunInputs, holder: str, start: str) -> RunInputs:
+    """``inputs`` if a run of them is within what the tool accepts, else a one-line
+    :class:`ParameterError`: the checks every run passes, from options or from a record
+    (``--rerun``), which is only as trustworthy as the file it was read from.
+
+    The step count (duration, dt: finite, > 0, at most MAX_STEPS steps), the integrator
+    for the plant, the offset within the arm's reach, obstacles within the command-line
+    limits, and a start that neither tips the robot (S > 1) nor overlaps an obstacle.
+    ``holder`` (what holds the payload) and ``start`` (what sets the start pose) word the
+    tipping message."""
+    check_step_count(inputs.duration, inputs.dt)
+    plant_integrator(inputs.plant, inputs.integrator)
+    if inputs.integrator is not None and inputs.integrator not in INTEGRATORS:
+        raise ParameterError(
+            f"integrator must be one of {', '.join(INTEGRATORS)} (got {shown(inputs.integrator)})"
+        )
+    robot = inputs.robot
+    if len(inputs.offset) != 2:
+        raise ParameterError(f"offset must be two numbers dx dy in m (got {shown(inputs.offset)})")
+    for value in inputs.offset:
+        check_range("offset", value, -robot.reach, robot.reach, "m (the arm's reach)")
+    obstacles = inputs.options.get("obstacles") or ()
+    if obstacles:
+        from ddwmmr.qp.limits.obstacles import as_circles, within_limits
+
+        obstacles = [within_limits(c.x, c.y, c.radius) for c in as_circles(obstacles)]
+    # a start that tips the robot or sits in an obstacle is bad input
+    q0 = initial_configuration(robot, inputs.trajectory, inputs.offset)
+    check_start(robot, q0, obstacles, holder, start)
+    return inputs
 
 
 def inputs_from_record(args: argparse.Namespace) -> RunInputs:
@@ -391,7 +406,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         )
         source = trajectory_record.get("file")
         offset = tuple(provenance.decode(_field(record, "initial_offset", list, "offset")))
-        return RunInputs(
+        inputs = RunInputs(
             _field(record, "method", str, "method name"),
             provenance.decode(_field(record, "options", dict, "options")),
             provenance.robot_from_record(_field(record, "robot", dict, "robot")),
@@ -404,8 +419,12 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
             str(trajectory_record.get("name") or "rerun"),
             plant,
         )
-    except ParameterError:  # already one line naming what is wrong
-        raise
+        return check_run(inputs, "payload", "the recorded initial_offset")
+    except ParameterError as exc:  # one line naming what is wrong: say where it was read
+        text = str(exc)
+        raise ParameterError(
+            text if text.startswith("rerun:") else f"rerun: {args.rerun}: {text}"
+        ) from None
     except KeyError as exc:
         raise ParameterError(
             f"rerun: {args.rerun} is not a complete run record (field run.{exc.args[0]} is missing)"
@@ -438,11 +457,12 @@ def _integrator(record: dict[str, Any], plant: str) -> str | None:
 
 
 def _number(record: dict[str, Any], key: str) -> float:
-    """``record[key]`` as a float; a bool or a string is not a number here."""
+    """``record[key]`` as a finite float; a bool or a string is not a number here, and an
+    integer too large for a float (JSON has no limit) is a ParameterError naming ``key``."""
     value = record[key]
     if isinstance(value, bool) or not isinstance(value, int | float):
         raise TypeError(f"{key} must be a number in s, got {shown(value)}")
-    return float(value)
+    return check_finite(key, value)
 
 
 def load_run_record(path: str) -> dict[str, Any]:
@@ -459,33 +479,6 @@ def load_run_record(path: str) -> dict[str, Any]:
         raise ParameterError(
             f"rerun: {path} is not a summary.json written by {PROG} or exported by the simulator"
         )
-    return record
-
-
-def run_record(
-    inputs: RunInputs,
-    argv: Sequence[str] | None,
-    rerun: str | None,
-    tool: str = "track",
-    prog: str = PROG,
-) -> dict:
-    """What summary.json["run"] holds: enough to repeat the run (``--rerun``); ``tool``
-    and ``prog`` name what wrote it (the simulator's export writes the same record)."""
-    record = provenance.header(tool, prog, argv)
-    record.update(
-        method=inputs.method,
-        options=provenance.options_record(inputs.method, inputs.options),
-        robot=provenance.robot_record(inputs.robot),
-        trajectory=provenance.trajectory_record(inputs.trajectory, inputs.trajectory_file),
-        dt=inputs.dt,
-        duration=inputs.duration,
-        integrator=inputs.integrator,
-        initial_offset=list(inputs.offset),
-        plant={"name": inputs.plant},
-        seed=None,  # nothing random in a track run
-    )
-    if rerun is not None:
-        record["rerun_of"] = str(Path(rerun).resolve())
     return record
 
 
@@ -524,7 +517,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         else Path(args.out)
     )
     check_output_folder(out, "track", args.force, output_names(not args.no_plots, args.animate))
-    record = run_record(inputs, argv, args.rerun)
+    record = run_record(inputs, argv, args.rerun, tool="track", prog=PROG)
     progress = not args.no_progress
     _note_uneven_duration(inputs.duration, inputs.dt, steps)
     writer = output_folder(out, "track", args.force, fresh)

@@ -9,12 +9,12 @@ input command ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s)::
     controller.last                           # StepInfo of that command
 
 Controllers never see the plant: the simulation loop (``ddwmmr.sim``) connects them.
-A new method is one class decorated with :func:`register`.
+A new controller is one class decorated with :func:`register_controller` (the registry is
+:data:`ddwmmr.registry.CONTROLLERS`).
 """
 
 from __future__ import annotations
 
-import importlib
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -22,8 +22,10 @@ from typing import Any, Protocol
 
 import numpy as np
 
+from ddwmmr.commands import PlantTraits
 from ddwmmr.errors import ParameterError, check_instance
 from ddwmmr.model import Robot
+from ddwmmr.registry import CONTROLLERS
 from ddwmmr.trajectories.base import resolution_step
 
 
@@ -87,55 +89,69 @@ class Controller(Protocol):
         ...
 
 
-_REGISTRY: dict[str, Callable[..., Controller]] = {}
-_DESCRIPTIONS: dict[str, str] = {}
-#: Modules that register the built-in methods (imported on first registry use).
-BUILTIN_MODULES = (
-    "ddwmmr.controllers.resolved_rate",
-    "ddwmmr.controllers.clrrmc",
-    "ddwmmr.controllers.qp",
-    "ddwmmr.controllers.mpc",
-)
-_loaded = False
+@dataclass(frozen=True)
+class WaypointRun:
+    """What a controller of the waypoint task learns of the run it is built for (the
+    scenario protocol, :mod:`ddwmmr.scenarios.protocol`): plain data, never the plant.
+
+    A controller registered with ``tasks`` including ``"waypoints"`` provides the class
+    method ``waypoint_options(run: WaypointRun) -> dict``: the options the protocol builds
+    it with (``make_controller(name, robot, **options)``).
+
+    Attributes:
+        scenario: the scenario (``waypoints``, and ``obstacles`` as (x, y, radius) in m).
+        config: the run configuration (:class:`ddwmmr.scenarios.RunConfig`: ``dt`` in s,
+            ``qp_stability_min``, ``qp_max_speed`` in m/s, ``controller_options``, the
+            arbiter and its thresholds).
+        plant: the traits of the plant it will command.
+        velocity_envelope: options that keep a velocity command within what the plant's
+            force-limited base can follow (the plant's ``velocity_envelope()``), None when
+            the plant has no such limit.
+    """
+
+    scenario: Any
+    config: Any
+    plant: PlantTraits
+    velocity_envelope: dict[str, Any] | None = None
+
+
+#: Registers a controller class: ``@register_controller(name, tasks=..., interfaces=...,
+#: arbiter=...)`` (see :mod:`ddwmmr.registry`).
+register_controller = CONTROLLERS.register
 
 
 def register(name: str) -> Callable[[type], type]:
-    """Class decorator adding a controller class to the registry under ``name``."""
-
-    def decorate(cls: type) -> type:
-        _REGISTRY[name] = cls
-        _DESCRIPTIONS[name] = (inspect.getdoc(cls) or "").splitlines()[0]
-        cls.name = name
-        return cls
-
-    return decorate
+    """Class decorator adding a trajectory-tracking controller under ``name``: the short
+    form of :func:`register_controller` with its default traits."""
+    return CONTROLLERS.register(name)
 
 
-def _load_builtins() -> None:
-    global _loaded
-    if not _loaded:
-        _loaded = True
-        for module in BUILTIN_MODULES:
-            importlib.import_module(module)
+def available_controllers(task: str | None = None) -> list[str]:
+    """Registered controller names in listing order; ``task`` (``"tracking"`` or
+    ``"waypoints"``) keeps those that do it."""
+    return CONTROLLERS.names() if task is None else CONTROLLERS.names(tasks=task)
 
 
 def available_methods() -> list[str]:
-    """Registered method names, in registration order."""
-    _load_builtins()
-    return list(_REGISTRY)
+    """The methods that track trajectories (``simulate``, ``track``, ``compare``,
+    ``bench``, the GUI), in listing order."""
+    return available_controllers("tracking")
 
 
 def method_description(name: str) -> str:
-    """First docstring line of a registered method."""
-    _load_builtins()
-    return _DESCRIPTIONS[name]
+    """First docstring line of a registered controller."""
+    return CONTROLLERS.describe(name)
 
 
-def _registered(name: str) -> Callable[..., Controller]:
-    _load_builtins()
-    if name not in _REGISTRY:
-        raise ParameterError(f"method: unknown method {name!r} (known: {', '.join(_REGISTRY)})")
-    return _REGISTRY[name]
+def controller_traits(name: str) -> dict[str, Any]:
+    """The registered traits of controller ``name`` (``tasks``, ``interfaces``,
+    ``arbiter``; see :mod:`ddwmmr.registry`)."""
+    return CONTROLLERS.traits(name)
+
+
+def controller_class(name: str) -> type:
+    """The class registered as ``name``; an unknown name is a :class:`ParameterError`."""
+    return CONTROLLERS.load(name)
 
 
 def method_options(name: str) -> dict[str, Any]:
@@ -146,7 +162,7 @@ def method_options(name: str) -> dict[str, Any]:
     ``self``, ``robot``, ``*args`` and ``**kwargs``: what ``make_controller`` accepts.
     """
     options: dict[str, Any] = {}
-    for klass in inspect.getmro(_registered(name)):
+    for klass in inspect.getmro(controller_class(name)):
         init = klass.__dict__.get("__init__")
         if init is None or klass is object:
             continue
@@ -166,7 +182,7 @@ def make_controller(
     supplies option values; explicit ``options`` override them. Unknown method names,
     presets and options (see :func:`method_options`) raise :class:`ParameterError`.
     """
-    cls = _registered(name)
+    cls = controller_class(name)
     robot = check_instance("robot", robot if robot is not None else Robot(), Robot)
     if preset is not None:  # preset hook: explicit options win
         from ddwmmr.controllers.presets import preset_options

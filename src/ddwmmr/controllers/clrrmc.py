@@ -2,7 +2,7 @@
 
 Gains are given as time constants ``tau`` (s): ``K = 1/tau``. The error dynamics are then
 ``e_dot + K e = 0``, i.e. each error decays as ``exp(-t / tau)`` while the plant follows the
-command (see ``ddwmmr.sim.loops.error_loop`` for the python-control model).
+command (see ``ddwmmr.sim.error_dynamics.error_loop`` for the python-control model).
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ddwmmr.controllers.base import StepInfo, register
+from ddwmmr.controllers.base import StepInfo, register_controller
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
 from ddwmmr.errors import MAX_STEPS, ParameterError, check_positive, check_range
@@ -29,7 +29,7 @@ DEFAULT_TAU = 0.5
 MIN_REFERENCE_STEP, MAX_REFERENCE_STEP = 1e-4, 1.0
 
 
-@register("clrrmc-ts")
+@register_controller("clrrmc-ts")
 class TaskSpaceController(ResolvedRate):
     """CLRRMC-TS: qdot = J_aug^-1 [Xd_dot + K (Xd - X)], feedback on xE, yE, phiE.
 
@@ -79,7 +79,7 @@ class TaskSpaceController(ResolvedRate):
         )
 
 
-@register("clrrmc-cs")
+@register_controller("clrrmc-cs")
 class ConfigurationSpaceController:
     """CLRRMC-CS: qdot = qdot_d + K (q_d - q) around an ATS reference q_d(t).
 
@@ -127,8 +127,8 @@ class ConfigurationSpaceController:
             self.reference_step,
             self.threshold,
             self.damping,
+            horizon=period,  # one period up front
         )
-        self.reference(getattr(trajectory, "duration", 0.0))  # precompute one period
         self.last = StepInfo()
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
@@ -138,25 +138,26 @@ class ConfigurationSpaceController:
         in ``last.nonholonomic_residual`` (m/s).
         """
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
-        qdot, c, s = self._rates(t, q)
-        self.last = StepInfo(
-            singular=self.reference.last_damped, nonholonomic_residual=-qdot[0] * s + qdot[1] * c
-        )
-        return np.array([qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4]])
+        u, residual = self._input(t, q)
+        self.last = StepInfo(singular=self.reference.last_damped, nonholonomic_residual=residual)
+        return np.array(u)
 
     def law(
         self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
     ) -> tuple[Input, bool]:
         """The control law on lists of floats: ``(u, singular)``, no validation (the
         integrator evaluates it at its stages; see :mod:`ddwmmr.sim.loop`)."""
-        qdot, c, s = self._rates(t, q)
-        return (qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4]), self.reference.last_damped
+        u, _ = self._input(t, q)
+        return u, self.reference.last_damped
 
-    def _rates(self, t: float, q: list[float]) -> tuple[list[float], float, float]:
-        """``(qdot, cos phi, sin phi)``: reference rate plus configuration feedback."""
+    def _input(self, t: float, q: list[float]) -> tuple[Input, float]:
+        """``(u, residual)``: the reference rate plus configuration feedback, projected on
+        the inputs, and its sideways base part (m/s) that the drive cannot produce."""
         reference = self.reference
         if reference is None:
             raise RuntimeError("clrrmc-cs needs reset(trajectory, q0) before command()")
         q_ref, qdot_ref = reference(t)
         qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q)]
-        return qdot, math.cos(q[2]), math.sin(q[2])
+        c, s = math.cos(q[2]), math.sin(q[2])
+        u = (qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4])
+        return u, -qdot[0] * s + qdot[1] * c

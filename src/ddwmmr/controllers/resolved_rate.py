@@ -10,7 +10,7 @@ from abc import ABC, abstractmethod
 
 import numpy as np
 
-from ddwmmr.controllers.base import StepInfo, register
+from ddwmmr.controllers.base import StepInfo, register_controller
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
@@ -73,7 +73,7 @@ def check_aux(aux: str) -> str:
     return aux
 
 
-@register("pi")
+@register_controller("pi")
 class PseudoinverseController(ResolvedRate):
     """RR-PI: pseudoinverse resolution qdot = J^# Xd_dot (open loop)."""
 
@@ -86,7 +86,7 @@ class PseudoinverseController(ResolvedRate):
         )
 
 
-@register("ats")
+@register_controller("ats")
 class AugmentedTaskSpaceController(ResolvedRate):
     """RR-ATS: augmented task space, one auxiliary row (aux = sum | shoulder), open loop."""
 
@@ -103,7 +103,7 @@ class AugmentedTaskSpaceController(ResolvedRate):
         )
 
 
-@register("ap")
+@register_controller("ap")
 class ArtificialPotentialController(ResolvedRate):
     """RR-AP: pseudoinverse plus null-space descent of V = K1 th1^2 + K2 th2^2 + K3 phi^2."""
 

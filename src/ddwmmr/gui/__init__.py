@@ -1,4 +1,5 @@
-"""Interactive simulator: ``python -m ddwmmr.gui`` (matplotlib widgets, Tk on a desktop).
+"""Interactive simulator: ``python -m ddwmmr.gui`` (matplotlib widgets, Tk on a desktop; its
+command line is :mod:`ddwmmr.cli.gui`).
 
 One window with a control panel (trajectory and its geometry, methods A and B with their
 own options, plant, payload, integrator, dt), run/pause/step/reset, a time slider and a
@@ -19,7 +20,6 @@ Off-screen use (tests, documentation)::
 """
 
 from ddwmmr.gui.app import App
-from ddwmmr.gui.cli import main
 from ddwmmr.gui.settings import Settings
 
-__all__ = ["App", "Settings", "main"]
+__all__ = ["App", "Settings"]

@@ -1,7 +1,8 @@
-"""``python -m ddwmmr.gui``: see :mod:`ddwmmr.gui.cli`."""
+"""``python -m ddwmmr.gui``: see :mod:`ddwmmr.cli.gui`."""
 
 import sys
 
-from ddwmmr.gui.cli import main
+from ddwmmr.cli.gui import main
 
-sys.exit(main())
+if __name__ == "__main__":
+    sys.exit(main())

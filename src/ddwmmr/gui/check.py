@@ -40,8 +40,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from PIL import ImageGrab, ImageStat
 
     from ddwmmr.gui.app import App
-    from ddwmmr.gui.cli import desktop_figure
-    from ddwmmr.gui.layout import SPEEDS
+    from ddwmmr.gui.layout import SPEEDS, desktop_figure
     from ddwmmr.gui.settings import Settings
 
     figure = desktop_figure()

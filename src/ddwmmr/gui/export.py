@@ -29,6 +29,7 @@ from matplotlib import rcParams
 from matplotlib.figure import Figure
 from PIL import Image
 
+from ddwmmr import provenance
 from ddwmmr.errors import ParameterError
 from ddwmmr.gui.options import plant_keywords
 from ddwmmr.gui.settings import Settings, build_robot, build_trajectory
@@ -102,10 +103,7 @@ def run_record(
     """The ``run`` record `python -m ddwmmr.track` writes, for slot ``slot`` of
     ``settings`` (tool ``"gui"``) and its built ``trajectory``; step and duration are the
     ones the run used, the integrator the one :func:`plant_keywords` gave the run."""
-    from ddwmmr.cli.track import RunInputs
-    from ddwmmr.cli.track import run_record as track_record
-
-    inputs = RunInputs(
+    inputs = provenance.RunInputs(
         method=str(settings.methods[slot]),
         options=dict(settings.options[slot]),
         robot=build_robot(settings),
@@ -120,7 +118,7 @@ def run_record(
         label=Path(settings.trajectory).stem,
         plant=settings.plant,
     )
-    return track_record(inputs, argv=None, rerun=None, tool="gui", prog=GUI_PROG)
+    return provenance.run_record(inputs, argv=None, rerun=None, tool="gui", prog=GUI_PROG)
 
 
 def write_window_png(figure: Figure, folder: Path, dpi: float | None = None) -> Path:

@@ -333,3 +333,29 @@ class PanelLayout:
             lambda text: self._apply_option_text(slot, spec, text),
             self._report,
         )
+
+
+def desktop_figure():
+    """A Tk window's figure, its resolution lowered so that the window fits the screen.
+
+    The layout is in figure fractions and the fonts in points, so a lower dpi shrinks the
+    whole window evenly. Tk multiplies the dpi by its pixel ratio (``tk scaling`` against
+    the usual 96 px per inch), which the fit includes.
+    """
+    import tkinter
+
+    import matplotlib.pyplot as plt
+
+    probe = tkinter.Tk()  # raises TclError without a display
+    probe.withdraw()
+    try:
+        screen_width, screen_height = probe.winfo_screenwidth(), probe.winfo_screenheight()
+        ratio = float(probe.tk.call("tk", "scaling")) * 72.0 / 96.0
+    finally:
+        probe.destroy()
+    # Leave room for the toolbar, the title bar and a desktop panel.
+    dpi = min(DPI, 0.96 * screen_width / FIGSIZE[0], 0.84 * screen_height / FIGSIZE[1])
+    plt.switch_backend("TkAgg")
+    figure = plt.figure(figsize=FIGSIZE, dpi=dpi / max(ratio, 1e-3))
+    figure.canvas.manager.set_window_title("ddwmmr simulator")
+    return figure

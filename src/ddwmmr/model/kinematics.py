@@ -38,17 +38,22 @@ def forward_kinematics(L1: float, L2: float, q) -> tuple[float, float, float]:
     )
 
 
-def jacobian(L1: float, L2: float, q) -> np.ndarray:
-    """The 4x5 task Jacobian of SPEC §1: rows xE, yE, phiE and the nonholonomic constraint."""
+def _arm_rates(L1: float, L2: float, q) -> tuple[float, float, float, float, float]:
+    """``(phi, dx, dy, dx2, dy2)``: the heading and the end effector's rates (world frame,
+    m/rad) per unit of shoulder (and heading) rate, ``(dx, dy)``, and of elbow rate."""
     _, _, phi, th1, th2 = (float(v) for v in q)
     s1, c1 = math.sin(phi + th1), math.cos(phi + th1)
     s12, c12 = math.sin(phi + th1 + th2), math.cos(phi + th1 + th2)
-    dx = -L1 * s1 - L2 * s12
-    dy = L1 * c1 + L2 * c12
+    return phi, -L1 * s1 - L2 * s12, L1 * c1 + L2 * c12, -L2 * s12, L2 * c12
+
+
+def jacobian(L1: float, L2: float, q) -> np.ndarray:
+    """The 4x5 task Jacobian of SPEC §1: rows xE, yE, phiE and the nonholonomic constraint."""
+    phi, dx, dy, dx2, dy2 = _arm_rates(L1, L2, q)
     return np.array(
         [
-            [1.0, 0.0, dx, dx, -L2 * s12],
-            [0.0, 1.0, dy, dy, L2 * c12],
+            [1.0, 0.0, dx, dx, dx2],
+            [0.0, 1.0, dy, dy, dy2],
             [0.0, 0.0, 1.0, 1.0, 1.0],
             [-math.sin(phi), math.cos(phi), 0.0, 0.0, 0.0],
         ]
@@ -100,15 +105,11 @@ def u_from_qdot(phi: float, qdot) -> tuple[np.ndarray, float]:
 
 def end_effector_jacobian_u(L1: float, L2: float, q) -> np.ndarray:
     """The 3x4 Jacobian ``A = J_E B`` mapping inputs u to end-effector rates."""
-    _, _, phi, th1, th2 = (float(v) for v in q)
-    s1, c1 = math.sin(phi + th1), math.cos(phi + th1)
-    s12, c12 = math.sin(phi + th1 + th2), math.cos(phi + th1 + th2)
-    dx = -L1 * s1 - L2 * s12
-    dy = L1 * c1 + L2 * c12
+    phi, dx, dy, dx2, dy2 = _arm_rates(L1, L2, q)
     return np.array(
         [
-            [math.cos(phi), dx, dx, -L2 * s12],
-            [math.sin(phi), dy, dy, L2 * c12],
+            [math.cos(phi), dx, dx, dx2],
+            [math.sin(phi), dy, dy, dy2],
             [0.0, 1.0, 1.0, 1.0],
         ]
     )

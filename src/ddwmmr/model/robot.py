@@ -29,6 +29,7 @@ from ddwmmr.errors import (
     shown,
 )
 from ddwmmr.model import kinematics, stability
+from ddwmmr.model.mass import YawInertia, total_mass
 
 _PI = math.pi
 #: Allowed range (low, high, unit) of each scalar field; see ddwmmr.errors for the caps.
@@ -251,6 +252,24 @@ class Robot:
             return self.caster_positions
         hl, hw = 0.5 * self.base_length, 0.5 * self.base_width
         return ((hl, hw), (hl, -hw), (-hl, hw), (-hl, -hw))
+
+    # -- mass properties ------------------------------------------------------------------
+    @property
+    def total_mass(self) -> float:
+        """Whole robot's mass (kg): base (wheels included), both links and the payload."""
+        m1, m2 = self.link_masses
+        return total_mass(self.base_mass, m1, m2, self.payload)
+
+    @property
+    def base_body_mass(self) -> float:
+        """Mass of the base without its two drive wheels (kg): ``base_mass - 2 wheel_mass``."""
+        return self.base_mass - 2.0 * self.wheel_mass
+
+    @property
+    def yaw_inertia(self) -> YawInertia:
+        """Yaw inertia about the base centre as a function of the elbow angle
+        (:class:`~ddwmmr.model.mass.YawInertia`: ``robot.yaw_inertia.at(th2)``, kg m^2)."""
+        return YawInertia.of(self)
 
     # -- kinematics -----------------------------------------------------------------------
     @property

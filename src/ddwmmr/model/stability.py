@@ -39,13 +39,34 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.model.mass import total_mass
+
 #: Reported stability is capped here: a vanishing tipping moment gives an infinite ratio.
 STABILITY_CAP = 10.0
+#: Default hard floor S_min on S of the controllers that hold one (``qp``, ``mpc``, the
+#: minimum-time study): a quarter above tipping, the thesis's stability threshold.
+STABILITY_FLOOR = 1.25
 #: Height of the base box's bottom above the floor (m): its mass sits at this height plus
 #: half the box (the physics plant builds the same box).
 BASE_CLEARANCE_M = 0.05
 #: Standard gravity (m/s^2), as the physics plant has it.
 GRAVITY_M_S2 = 9.81
+
+
+def valid_stability_floor(value: float) -> bool:
+    """Whether ``value`` can be a floor on S: in ``(0, STABILITY_CAP)`` (S is capped
+    there, so a floor at the cap could never be met)."""
+    return 0.0 < value < STABILITY_CAP
+
+
+def check_stability_floor(value: float, name: str = "stability_min") -> float:
+    """``value`` as a floor on S (float, :func:`valid_stability_floor`), or
+    :class:`~ddwmmr.errors.ParameterError` naming ``name``."""
+    floor = check_positive(name, value)
+    if not valid_stability_floor(floor):
+        raise ParameterError(f"{name} must be in (0, {STABILITY_CAP:g}) (got {floor:g})")
+    return floor
 
 
 @dataclass(frozen=True)
@@ -69,7 +90,7 @@ def com_coefficients(
     base_width: float,
 ) -> ComCoefficients:
     """Precompute the centre-of-mass coefficients for :func:`stability_terms`."""
-    total = base_mass + m1 + m2 + payload
+    total = total_mass(base_mass, m1, m2, payload)
     return ComCoefficients(
         A=(0.5 * m1 + m2 + payload) * L1 / total,
         B=(0.5 * m2 + payload) * L2 / total,
@@ -144,8 +165,8 @@ def inertial_terms(robot) -> InertialTerms:
     docstring says)."""
     m1, m2 = robot.link_masses
     arm = m1 + m2 + robot.payload
-    box = robot.base_mass - 2.0 * robot.wheel_mass
-    total = robot.base_mass + arm
+    box = robot.base_body_mass
+    total = robot.total_mass
     height = (
         box * (BASE_CLEARANCE_M + 0.5 * robot.base_height)
         + 2.0 * robot.wheel_mass * robot.wheel_radius

@@ -2,7 +2,8 @@
 
 One home for every symbolic formula the optimisation-based code needs (the MPC, the
 minimum-time study). The numeric twins are :mod:`ddwmmr.model.kinematics`,
-:mod:`ddwmmr.model.stability` and :class:`ddwmmr.plants.thesis.ThesisPlant`; the tests
+:mod:`ddwmmr.model.stability`, :mod:`ddwmmr.model.support_loads` and
+:class:`ddwmmr.plants.thesis.ThesisPlant`; the tests
 check values and derivatives against them.
 
 Frames and units (SPEC §1): configuration ``q = [x, y, phi, th1, th2]`` (world frame; m, m,
@@ -36,6 +37,7 @@ import casadi as ca
 
 from ddwmmr.errors import check_nonnegative, check_positive
 from ddwmmr.model import Robot, stability
+from ddwmmr.model.support_loads import EdgeLoadModel
 from ddwmmr.model.thesis_base import (
     C1_DEFAULT,
     C2_DEFAULT,
@@ -138,6 +140,34 @@ def zero_moment_point(
     return ca.vertcat(*point)
 
 
+def edge_loads(
+    robot: Robot,
+    q: Symbolic,
+    rates: Symbolic,
+    accelerations: Symbolic,
+    base_acceleration: Symbolic,
+    w: Symbolic,
+    w_dot: Symbolic,
+) -> Symbolic:
+    """Normal loads (N) on the edges of the support polygon, one per edge: the formula of
+    :meth:`ddwmmr.model.support_loads.EdgeLoadModel.loads` built symbolically (joint
+    rates rad/s and accelerations rad/s^2, the axle midpoint's acceleration ``(a_x, a_y)``
+    m/s^2 in the base frame, the yaw rate and its rate)."""
+    model = EdgeLoadModel.from_robot(robot)
+    loads = model.loads(
+        q[3],
+        q[4],
+        (rates[0], rates[1]),
+        (accelerations[0], accelerations[1]),
+        (base_acceleration[0], base_acceleration[1]),
+        w,
+        w_dot,
+        cos=ca.cos,
+        sin=ca.sin,
+    )
+    return ca.vertcat(*loads)
+
+
 def manipulability(q: Symbolic) -> Symbolic:
     """Normalised manipulability ``eta = |sin th2|`` in [0, 1] (thesis 4.1.1)."""
     return ca.fabs(ca.sin(q[4]))
@@ -214,22 +244,9 @@ class ThesisDynamics:
         """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``;
         ``half_width`` (m) is the wheels' lever about the base centre, by default the
         thesis plant's ``robot.base_width / 2``."""
-        m1, m2 = robot.link_masses
-        mp, L1, L2 = robot.payload, robot.L1, robot.L2
-        # Yaw inertia about the base centre: each link a rod about its own centre plus the
-        # parallel-axis term of its midpoint, the payload a point at the end effector. The
-        # squared distances of link-2's midpoint and of the end effector from the base
-        # centre are L1^2 + L2^2/4 + L1 L2 cos th2 and L1^2 + L2^2 + 2 L1 L2 cos th2.
-        fixed = (
-            robot.base_inertia
-            + m1 * L1**2 / 12.0
-            + m2 * L2**2 / 12.0
-            + m1 * (L1 / 2.0) ** 2
-            + m2 * (L1**2 + L2**2 / 4.0)
-            + mp * (L1**2 + L2**2)
-        )
+        inertia = robot.yaw_inertia  # the collected form I(th2) = fixed + cos * cos th2
         return cls(
-            mass=robot.base_mass + m1 + m2 + mp,
+            mass=robot.total_mass,
             c1=check_nonnegative("c1", c1),  # 0: an undamped base (the physics plant)
             c2=check_nonnegative("c2", c2),
             force_limit=check_positive("force_limit", force_limit),
@@ -239,10 +256,10 @@ class ThesisDynamics:
                 if half_width is None
                 else check_positive("half_width", half_width)
             ),
-            inertia_fixed=fixed,
-            inertia_cos=(m2 + 2.0 * mp) * L1 * L2,
-            shoulder_fixed=m1 * L1**2 / 3.0 + (m2 + mp) * L1**2,
-            elbow_fixed=m2 * L2**2 / 3.0 + mp * L2**2,
+            inertia_fixed=inertia.fixed,
+            inertia_cos=inertia.cos,
+            shoulder_fixed=inertia.shoulder,
+            elbow_fixed=inertia.elbow,
         )
 
     # -- numbers ------------------------------------------------------------------------

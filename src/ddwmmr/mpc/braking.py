@@ -20,6 +20,42 @@ from ddwmmr.model import symbolic as sym
 
 #: Time constant (s) with which the braking step asks the base to shed v and w.
 BRAKE_TIME = 0.5
+#: Default ``brake_slack`` (m) where the lagged arm has a joint acceleration limit (a
+#: physics plant): a plan whose stability rows' largest slack (m,
+#: ``ShootingOCP.max_stability_slack``) exceeds it is replaced by the braking step.
+BRAKE_SLACK = 5e-3
+#: Below this speed (m/s, rad/s: base speed, yaw rate, joint rates) the robot is at rest
+#: and the braking step is not taken.
+AT_REST = 0.05
+
+
+def should_brake(
+    brake_slack: float | None,
+    stability_slack: float,
+    velocity: tuple[float, float],
+    joint_rates: tuple[float, float],
+) -> bool:
+    """Whether the step brakes: braking is on (``brake_slack`` m, None: off), the plan's
+    stability rows need more slack than that, and the robot moves (base ``velocity`` m/s,
+    rad/s or the lagged ``joint_rates`` rad/s faster than :data:`AT_REST`): at rest there
+    is nothing to brake, and a plan that needs slack there (a pose at the floor) must be
+    let move the arm back."""
+    if brake_slack is None or not stability_slack > brake_slack:
+        return False
+    speed = max(abs(velocity[0]), abs(velocity[1]), abs(joint_rates[0]), abs(joint_rates[1]))
+    return speed > AT_REST
+
+
+def braked_velocity(
+    dynamics: sym.ThesisDynamics,
+    state: np.ndarray,
+    forces: tuple[float, float],
+    dt: float,
+) -> tuple[float, float]:
+    """``(v, w)`` (m/s, rad/s) ``dt`` (s) after the braking ``forces`` (N) from the force
+    model's ``state`` ``[q, v, w]`` (one Euler step; the joints held)."""
+    rate = np.asarray(dynamics.rhs(state, np.r_[forces, 0.0, 0.0]), dtype=float).ravel()
+    return float(state[5] + dt * rate[5]), float(state[6] + dt * rate[6])
 
 
 def braking_input(

@@ -47,6 +47,7 @@ import numpy as np
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
+from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
 
 #: Points inside each shooting interval where S is checked as well as at the nodes.
 INTERIOR_CHECKS = 3
@@ -313,7 +314,7 @@ class MinimumTimeProblem(FreeTimeOCP):
         start: Sequence[float],
         dynamics: sym.ThesisDynamics | None = None,
         intervals_per_leg: int = 30,
-        stability_min: float = 1.25,
+        stability_min: float = STABILITY_FLOOR,
         tolerance: float = 0.01,
         ipopt_options: dict | None = None,
     ) -> None:
@@ -325,7 +326,7 @@ class MinimumTimeProblem(FreeTimeOCP):
         self.dynamics = dynamics or sym.ThesisDynamics.from_robot(robot)
         self.waypoints = [tuple(map(float, w)) for w in waypoints]
         self.tolerance = check_positive("tolerance", tolerance)
-        self.stability_min = check_positive("stability_min", stability_min)
+        self.stability_min = check_stability_floor(stability_min)
         ends = [self._waypoint_end(w) for w in self.waypoints]
         super().__init__(
             thesis_model(robot, self.dynamics, stability_min),

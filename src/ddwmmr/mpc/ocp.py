@@ -97,6 +97,7 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
+from ddwmmr.model.stability import STABILITY_FLOOR
 from ddwmmr.mpc.models import PredictionModel
 from ddwmmr.qp.limits.obstacles import Circle
 
@@ -173,7 +174,7 @@ class OCPConfig:
     reach: bool = False
     min_horizon: float = 0.1
     reach_speed: float = 0.5
-    stability_min: float = 1.25
+    stability_min: float = STABILITY_FLOOR
     stability_margin: float = 0.01
     dynamic_stability: bool = False
     track_orientation: bool = True

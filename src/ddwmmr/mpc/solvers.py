@@ -153,7 +153,7 @@ class GaussNewtonSQP:
 
 #: The QP data function and the QP solver of each (OCP, backend, proximal weight), shared
 #: by every solver on that OCP: building them (the Jacobians, the CSE'd function, the
-#: conic) is most of the OCP's set-up cost (:func:`ddwmmr.mpc.controller._shared_ocp`),
+#: conic) is most of the OCP's set-up cost (:func:`ddwmmr.mpc.cache.shared_ocp`),
 #: and neither keeps anything from one call to the next that a later call reads (a run on
 #: a shared one repeats a fresh one to the last bit, tests/test_mpc.py).
 _COMPILED: weakref.WeakKeyDictionary[ShootingOCP, dict[tuple[str, float], tuple[Any, Any]]] = (

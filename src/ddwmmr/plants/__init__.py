@@ -1,12 +1,14 @@
 """Plants: what the controllers' commands act on (kinematic model, thesis dynamics, MuJoCo).
 
-Every plant implements :class:`ddwmmr.plants.base.Plant`; :func:`make_plant` builds one by
-name (``available_plants()`` lists the names) for the simulation loop.
+Every plant implements :class:`ddwmmr.plants.base.Plant` and registers itself with
+:func:`ddwmmr.registry.register_plant`; :func:`make_plant` builds one by name
+(``available_plants()`` lists the names) for the simulation loop. A plant's module is
+imported when it is first built (importing mujoco takes ~0.4 s, which every other user of
+the package, such as CLI start-up or kinematic runs, should not pay).
 """
 
 from __future__ import annotations
 
-import importlib
 import inspect
 from typing import Any
 
@@ -15,27 +17,23 @@ from ddwmmr.model import Robot
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.plants.kinematic import INTEGRATORS, KinematicPlant
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState, VelocityServo
-
-#: Plant name -> "module:class" (imported on first use: importing mujoco takes ~0.4 s, which
-#: every other user of the package, such as CLI start-up or kinematic runs, should not pay).
-PLANT_CLASSES = {
-    "kinematic": "ddwmmr.plants.kinematic:KinematicPlant",
-    "thesis": "ddwmmr.plants.thesis:ThesisPlant",
-    "mujoco": "ddwmmr.plants.mujoco:MujocoPlant",
-}
+from ddwmmr.registry import PLANTS, register_plant
 
 
-def available_plants() -> list[str]:
-    """Names accepted by :func:`make_plant` (and by ``simulate(..., plant=...)``)."""
-    return list(PLANT_CLASSES)
+def available_plants(interface: str | None = None) -> list[str]:
+    """Names accepted by :func:`make_plant` (and by ``simulate(..., plant=...)``), in
+    listing order; ``interface`` (``"velocity"`` or ``"force"``) keeps those that take it."""
+    return PLANTS.names() if interface is None else PLANTS.names(interfaces=interface)
+
+
+def plant_description(name: str) -> str:
+    """First docstring line of a registered plant."""
+    return PLANTS.describe(name)
 
 
 def plant_class(name: str) -> type:
     """The class registered under ``name``."""
-    if name not in PLANT_CLASSES:
-        raise ParameterError(f"plant must be one of {', '.join(PLANT_CLASSES)} (got {name!r})")
-    module, _, attribute = PLANT_CLASSES[name].partition(":")
-    return getattr(importlib.import_module(module), attribute)
+    return PLANTS.load(name)
 
 
 def make_plant(name: str, robot: Any, **options: Any) -> Plant:
@@ -62,7 +60,6 @@ def __getattr__(name: str) -> Any:
 
 __all__ = [
     "INTEGRATORS",
-    "PLANT_CLASSES",
     "KinematicPlant",
     "MujocoPlant",
     "Observation",
@@ -74,4 +71,6 @@ __all__ = [
     "available_plants",
     "make_plant",
     "plant_class",
+    "plant_description",
+    "register_plant",
 ]

@@ -26,19 +26,18 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.commands import VELOCITY
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
+from ddwmmr.registry import register_plant
 
 INTEGRATORS = ("euler", "rk4")
 
 
+@register_plant("kinematic", interfaces=("velocity",))
 class KinematicPlant:
     """Kinematic model of the differential-drive mobile manipulator (velocity interface)."""
 
-    name = "kinematic"
-    interfaces = (VELOCITY,)
     extra_columns: tuple[str, ...] = ()
 
     def __init__(self, robot: Robot, integrator: str = "rk4") -> None:
@@ -204,45 +203,35 @@ class KinematicPlant:
     ) -> list[float]:
         """One RK4 step of ``qdot = B(phi) u`` from ``state`` with ``u0`` at the start: the
         policy's saturated input at every later stage, or ``u0`` held (zero-order hold).
-        Written out stage by stage on floats: this runs at every step of every kinematic
-        run, and a loop over the three stages costs 3-4 % of a closed-form method's whole
-        run (measured)."""
+
+        The stage rates ``k1..k4`` are summed as ``k1 + 2 k2 + 2 k3 + k4`` while the stages
+        run (the same operations in the same order as the sum written out)."""
         x, y, phi, th1, th2 = state
-        half = 0.5 * dt
-        saturate = self._saturate
-        v1, w1, a1, b1 = u0
-        cx1, cy1 = v1 * math.cos(phi), v1 * math.sin(phi)
-        # Stage 2 at state + dt/2 k1.
-        p2, t12, t22 = phi + half * w1, th1 + half * a1, th2 + half * b1
-        if policy is None:
-            v2, w2, a2, b2 = u0
-        else:
-            stage = [x + half * cx1, y + half * cy1, p2, t12, t22]
-            (v2, w2, a2, b2), _ = saturate(t12, t22, policy(t + half, stage))
-        cx2, cy2 = v2 * math.cos(p2), v2 * math.sin(p2)
-        # Stage 3 at state + dt/2 k2.
-        p3, t13, t23 = phi + half * w2, th1 + half * a2, th2 + half * b2
-        if policy is None:
-            v3, w3, a3, b3 = u0
-        else:
-            stage = [x + half * cx2, y + half * cy2, p3, t13, t23]
-            (v3, w3, a3, b3), _ = saturate(t13, t23, policy(t + half, stage))
-        cx3, cy3 = v3 * math.cos(p3), v3 * math.sin(p3)
-        # Stage 4 at state + dt k3.
-        p4, t14, t24 = phi + dt * w3, th1 + dt * a3, th2 + dt * b3
-        if policy is None:
-            v4, w4, a4, b4 = u0
-        else:
-            stage = [x + dt * cx3, y + dt * cy3, p4, t14, t24]
-            (v4, w4, a4, b4), _ = saturate(t14, t24, policy(t + dt, stage))
-        cx4, cy4 = v4 * math.cos(p4), v4 * math.sin(p4)
+        cos, sin = math.cos, math.sin
+        v, w, r1, r2 = u0
+        cx, cy = v * cos(phi), v * sin(phi)  # k1
+        sx, sy, sp, s1, s2 = cx, cy, w, r1, r2  # the weighted sum of the stage rates
+        for h, weight in ((0.5 * dt, 2.0), (0.5 * dt, 2.0), (dt, 1.0)):
+            # the next stage at state + h k (k: the stage before)
+            p, t1, t2 = phi + h * w, th1 + h * r1, th2 + h * r2
+            if policy is None:
+                v, w, r1, r2 = u0
+            else:
+                stage = [x + h * cx, y + h * cy, p, t1, t2]
+                (v, w, r1, r2), _ = self._saturate(t1, t2, policy(t + h, stage))
+            cx, cy = v * cos(p), v * sin(p)
+            sx += weight * cx
+            sy += weight * cy
+            sp += weight * w
+            s1 += weight * r1
+            s2 += weight * r2
         sixth = dt / 6.0
         return [
-            x + sixth * (cx1 + 2.0 * cx2 + 2.0 * cx3 + cx4),
-            y + sixth * (cy1 + 2.0 * cy2 + 2.0 * cy3 + cy4),
-            phi + sixth * (w1 + 2.0 * w2 + 2.0 * w3 + w4),
-            th1 + sixth * (a1 + 2.0 * a2 + 2.0 * a3 + a4),
-            th2 + sixth * (b1 + 2.0 * b2 + 2.0 * b3 + b4),
+            x + sixth * sx,
+            y + sixth * sy,
+            phi + sixth * sp,
+            th1 + sixth * s1,
+            th2 + sixth * s2,
         ]
 
 

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.commands import FORCE, VELOCITY, WheelForces
+from ddwmmr.commands import WheelForces
 from ddwmmr.errors import check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.thesis_base import (  # the base's constants (controllers' models use them)
@@ -39,6 +39,7 @@ from ddwmmr.model.thesis_base import (  # the base's constants (controllers' mod
     JOINT_SPEED_DEFAULT,
 )
 from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
+from ddwmmr.registry import register_plant
 
 #: Bandwidth (1/s) of the velocity servo that follows velocity commands.
 VELOCITY_BANDWIDTH = 10.0
@@ -135,6 +136,7 @@ def damped_base_envelope(
     return envelope
 
 
+@register_plant("thesis", interfaces=("force", "velocity"))
 class ThesisPlant:
     """Force-driven base dynamics with the arm pseudo-controller (thesis ch. 3 and 4.4.2).
 
@@ -149,8 +151,6 @@ class ThesisPlant:
     sample (N), ``force_left_n`` and ``force_right_n``.
     """
 
-    name = "thesis"
-    interfaces = (FORCE, VELOCITY)
     extra_columns = ("force_left_n", "force_right_n")
 
     def __init__(
@@ -167,22 +167,8 @@ class ThesisPlant:
         self.c2 = check_positive("c2", c2)
         self.force_limit = check_positive("force_limit", force_limit)
         self.joint_speed = check_positive("joint_speed", joint_speed)
-        m1, m2 = robot.link_masses
-        self.mass = robot.base_mass + m1 + m2 + robot.payload
-        L1, L2 = robot.L1, robot.L2
-        # Pose-independent part of the yaw inertia: base plus each link about its own centre.
-        fixed = robot.base_inertia + (m1 * L1**2 + m2 * L2**2) / 12.0
-        # inertia(th2) = A + m2 (B + C cos th2) + payload (D + E cos th2): the constants of
-        # the formula in inertia(), grouped as Python evaluates it (the same bits).
-        self._inertia_terms = (
-            fixed + m1 * 0.25 * L1**2,
-            m2,
-            L1**2 + 0.25 * L2**2,
-            L1 * L2,
-            robot.payload,
-            L1**2 + L2**2,
-            2.0 * L1 * L2,
-        )
+        self.mass = robot.total_mass
+        self._yaw_inertia = robot.yaw_inertia.at
         self._half_width = 0.5 * robot.base_width
         self.servo = VelocityServo(self, velocity_bandwidth)
         self.state = ThesisState()
@@ -253,13 +239,10 @@ class ThesisPlant:
         """Yaw inertia of the whole robot about the base centre at arm pose (th1, th2) (kg m^2).
 
         Links are uniform rods (parallel-axis term at their midpoints), the payload a point
-        mass at the end effector; the arm lies horizontally (SPEC §1).
+        mass at the end effector; the arm lies horizontally (SPEC §1). The formula is
+        :class:`ddwmmr.model.mass.YawInertia`'s.
         """
-        # base and links about their centres, link 1's midpoint, then link 2's midpoint and
-        # the end effector at squared distances B + C cos th2 and D + E cos th2
-        fixed, m2, B, C, payload, D, E = self._inertia_terms
-        c2 = math.cos(th2)
-        return fixed + m2 * (B + C * c2) + payload * (D + E * c2)
+        return self._yaw_inertia(th2)
 
     @property
     def damping(self) -> tuple[float, float]:

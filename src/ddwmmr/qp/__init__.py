@@ -3,7 +3,7 @@
 Layout (modelled on mink / pink): :mod:`ddwmmr.qp.tasks` holds soft objectives,
 :mod:`ddwmmr.qp.limits` hard constraints; :class:`QPProblem` stacks them into
 preallocated arrays and :func:`solve` hands them to a qpsolvers backend. The controller
-using them is method ``qp`` (:mod:`ddwmmr.controllers.qp`).
+using them is method ``qp`` (:mod:`ddwmmr.qp.controller`).
 """
 
 from ddwmmr.qp.context import NU, StepContext

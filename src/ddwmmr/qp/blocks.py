@@ -17,6 +17,11 @@ item write costs about a third of a numpy scalar write, and nothing is allocated
 
 A built-in piece whose ``compute`` a subclass overrides falls back to the generic path
 (see :func:`overrides`), so a subclass never has its ``compute`` silently bypassed.
+
+Each built-in piece writes its formula once, in one method on floats (``values``,
+``targets``, ``joint_bounds``, ``lower_bound``, ``envelope``, ``row``); ``compute`` and the
+writer both call it and differ only in where they store the numbers (docs/api.md, "Fast
+paths", has what the compiled path buys).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The QP task-priority controller (registered as method ``qp`` in ddwmmr.controllers.qp).
+"""The QP task-priority controller, registered as method ``qp`` (docs/qp.md).
 
 Every control step solves one small QP over ``u = (v, w, th1dot, th2dot)`` plus the
 tracking slack (see :mod:`ddwmmr.qp.problem`):
@@ -17,6 +17,19 @@ when a bound cannot prove the full step safe). If the QP fails, a safe command i
 fallback. Task targets are bounded at 10x what the robot can do (:func:`demand_limits`), so
 absurd demands cannot swamp the solver's tolerances: every limit holds for every finite
 state (tests/test_qp_limits_extreme.py).
+
+Built by name::
+
+    make_controller("qp", Robot().with_payload(3.0), stability_min=1.25,
+                    obstacles=load_obstacles("trajectories/obstacles/ellipse_post.toml"))
+
+``summarize`` adds to the run summary: ``stability_min`` (the floor), ``stability_violations``
+(recorded steps with S < floor), ``qp_fallbacks`` (recorded steps that used the safe
+command), ``min_obstacle_clearance_m`` (base footprint vs circles; None without obstacles),
+``qp_mode`` and ``qp_solver``.
+
+Its benchmark twin, :class:`ddwmmr.qp.naive.NaiveQPController`, is deliberately not a
+registered method: it is a baseline for ``python -m ddwmmr.bench``, not a method to compare.
 """
 
 from __future__ import annotations
@@ -27,10 +40,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ddwmmr.controllers.base import StepInfo, control_step
+from ddwmmr.controllers.base import StepInfo, WaypointRun, control_step, register_controller
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
 from ddwmmr.model import Robot
+from ddwmmr.model.stability import STABILITY_FLOOR
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import (
     INF,
@@ -88,7 +102,8 @@ def demand_limits(robot: Robot) -> tuple[float, float]:
     return DEMAND_FACTOR * linear, DEMAND_FACTOR * (w_max + 2.0 * speed)
 
 
-class QPControllerCore:
+@register_controller("qp", tasks=("tracking", "waypoints"))
+class QPController:
     """QP task priorities: hard stability/limits, tracking with slack, soft manipulability.
 
     Args:
@@ -124,8 +139,6 @@ class QPControllerCore:
         tasks, limits: extra user-defined :class:`Task`/:class:`Limit` objects.
     """
 
-    name = "qp"
-
     #: Options with a closed set of values, for front ends (the app shows a button cycling
     #: through them): option name -> function returning the values.
     option_choices: ClassVar[Mapping[str, Callable[[], list[str]]]] = {
@@ -136,7 +149,7 @@ class QPControllerCore:
     def __init__(
         self,
         robot: Robot,
-        stability_min: float = 1.25,
+        stability_min: float = STABILITY_FLOOR,
         manipulability_weight: float = 0.5,
         obstacles: Sequence[Circle | Sequence[float]] | str = (),
         solver: str = DEFAULT_SOLVER,
@@ -345,7 +358,7 @@ class QPControllerCore:
 
     # -- reporting ----------------------------------------------------------------------
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
-        """QP metrics merged into the run summary (see module docstring of controllers.qp)."""
+        """QP metrics merged into the run summary (see the module docstring)."""
         stability = np.asarray(timeseries["stability"])
         clearance = run_clearance(self.robot, self.obstacles, timeseries)
         return {
@@ -355,6 +368,24 @@ class QPControllerCore:
             "min_obstacle_clearance_m": clearance,
             "qp_mode": self.mode,
             "qp_solver": self.solver,
+        }
+
+    # -- the scenario protocol's waypoint task -------------------------------------------
+    @classmethod
+    def waypoint_options(cls, run: WaypointRun) -> dict[str, Any]:
+        """The options of a waypoint-task run: the protocol's stability floor and
+        end-effector speed, position only, the scenario's obstacles, its control step; the
+        plant's velocity envelope (what a force-limited base can follow), then the run's
+        own ``controller_options`` over all of these."""
+        config = run.config
+        return {
+            "stability_min": config.qp_stability_min,
+            "track_orientation": False,
+            "max_speed": config.qp_max_speed,
+            "obstacles": [tuple(o) for o in run.scenario.obstacles],
+            "dt": config.dt,
+            **(run.velocity_envelope or {}),
+            **dict(config.controller_options),
         }
 
 

@@ -1,7 +1,7 @@
 """The same QP built naively, for benchmarks: fresh dense arrays and a fresh OSQP setup
 through :func:`qpsolvers.solve_qp` every step.
 
-Same tasks, limits, modes and safety logic as :class:`~ddwmmr.qp.controller.QPControllerCore`;
+Same tasks, limits, modes and safety logic as :class:`~ddwmmr.qp.controller.QPController`;
 only problem construction and solving differ, so timing the two side by side measures
 what preallocation and the direct DAQP call save. Not a registered method: the benchmark
 builds it by import path.
@@ -15,7 +15,7 @@ import numpy as np
 import qpsolvers
 
 from ddwmmr.qp.context import StepContext
-from ddwmmr.qp.controller import QPControllerCore
+from ddwmmr.qp.controller import QPController
 from ddwmmr.qp.problem import QPProblem
 from ddwmmr.qp.solve import solve, to_standard_form
 
@@ -37,7 +37,7 @@ class NaiveOsqpBackend:
         return None if x is None else np.asarray(x)
 
 
-class NaiveQPController(QPControllerCore):
+class NaiveQPController(QPController):
     """QP task priorities built naively (fresh arrays + OSQP setup each step); for benches."""
 
     name = "qp-naive"

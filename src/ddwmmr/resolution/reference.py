@@ -66,13 +66,70 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
     )
 
 
+#: Most RK4 steps one lookup integrates past the end of the reference. A lookup further
+#: ahead integrates the distance in this many equal steps instead (each longer than
+#: ``step``), so its cost does not grow with the distance. A simulation looks up at least
+#: once per control step ``dt`` (the RK4 plant every half step), so this happens only for
+#: a ``dt`` of more than 256 reference steps (2.56 s at the default step), and then the
+#: reference is still integrated 256 times finer than the loop moves the robot.
+MAX_LOOKUP_STEPS = 256
+
+
+class _Piece:
+    """Consecutive reference segments on one uniform grid.
+
+    Segment ``k`` spans ``origin + k step .. origin + (k + 1) step`` (s). The first
+    ``dropped`` segments were discarded; ``coefficients`` and ``damped`` hold segments
+    ``dropped, dropped + 1, ...``.
+    """
+
+    __slots__ = ("coefficients", "damped", "dropped", "origin", "step")
+
+    def __init__(self, origin: float, step: float) -> None:
+        self.origin = origin
+        self.step = step
+        self.dropped = 0
+        self.coefficients: list[tuple[tuple[float, float, float, float], ...]] = []
+        self.damped: list[bool] = []
+
+    @property
+    def count(self) -> int:
+        """Segments integrated on this grid, dropped ones included."""
+        return self.dropped + len(self.coefficients)
+
+    @property
+    def end(self) -> float:
+        """Time (s) of the piece's last node."""
+        return self.origin + self.count * self.step
+
+    def index(self, t: float) -> int:
+        """Segment holding time t (s); the first or the last one for a t outside."""
+        return max(0, min(int((t - self.origin) / self.step), self.count - 1))
+
+    def drop_before(self, index: int) -> None:
+        """Discard the segments before ``index``."""
+        surplus = index - self.dropped
+        if surplus > 0:
+            del self.coefficients[:surplus]
+            del self.damped[:surplus]
+            self.dropped = index
+
+
 class ReferenceTrajectory:
     """Reference configurations ``q_d(t)`` and rates ``qdot_d(t)`` for a task trajectory.
 
     Integrated with classical RK4 at step ``step`` (s) through the augmented task space
     resolution with auxiliary row ``aux`` (damped as in :func:`kernels.ats` with
-    ``threshold`` and ``damping``); extended lazily when queried past its end. Lookups are
-    cubic Hermite (fourth-order accurate, like the integrator).
+    ``threshold`` and ``damping``): up front to ``horizon`` (s; every step of it, the
+    caller bounds it), then lazily when a lookup goes past the end. Lookups are cubic
+    Hermite (fourth-order accurate, like the integrator).
+
+    The time a lookup takes and the memory kept do not grow with t. A lookup more than
+    :data:`MAX_LOOKUP_STEPS` steps past the end integrates that distance in
+    :data:`MAX_LOOKUP_STEPS` longer steps, and the integration goes on at ``step`` from
+    there. Only the segments from the previous lookup on are kept; a lookup before them
+    (time going backwards, which no simulation loop does) integrates afresh from t = 0,
+    giving the numbers of a new reference.
 
     Attributes:
         singular_nodes: number of rate evaluations (nodes and RK4 stages) that were damped.
@@ -89,6 +146,7 @@ class ReferenceTrajectory:
         step: float = 0.01,
         threshold: float = kernels.SINGULARITY_THRESHOLD,
         damping: float = kernels.MAX_DAMPING,
+        horizon: float | None = None,
     ) -> None:
         self.robot = robot
         self.trajectory = trajectory
@@ -96,19 +154,27 @@ class ReferenceTrajectory:
         self.step = float(step)
         self.threshold = float(threshold)
         self.damping = float(damping)
+        self.horizon = None if horizon is None else float(horizon)
         self.singular_nodes = 0
         self.last_damped = False
         self._L1, self._L2 = robot.L1, robot.L2
         q0 = [float(v) for v in q_start]
-        self._q = [q0]
         rate, damped = self._rate(q0, trajectory.velocity(0.0).tolist())
-        self._qdot = [rate]
-        self._node_damped = [damped]
-        #: Per segment: was any rate evaluation that defines it damped?
-        self._segment_damped: list[bool] = []
-        #: Cubic coefficients of each segment, appended as the reference is integrated.
-        self._coefficients: list[tuple[tuple[float, ...], ...]] = []
+        self._start_node = (q0, rate, damped)
+        self._restart()
+
+    def _restart(self) -> None:
+        """Back to the start node, integrated up to ``horizon``."""
+        self._pieces = [_Piece(0.0, self.step)]
+        #: The last node: configuration, rate, whether that rate was damped.
+        self._node = self._start_node
         self._end = -1.0  # queries up to this time need no extension
+        self._window_start = -math.inf  # lookups before this time need a restart
+        self._last_lookup = 0.0
+        if self.horizon is not None:
+            piece = self._pieces[0]
+            self._integrate(piece, self._fine_end(piece, self.horizon, None))
+            self._end = piece.origin + (piece.count - 1) * piece.step
 
     def _rate(self, q: list[float], velocity: list[float]) -> tuple[list[float], bool]:
         """Configuration rate at q for the desired end-effector ``velocity`` (3 floats)."""
@@ -120,32 +186,73 @@ class ReferenceTrajectory:
         self.singular_nodes += singular
         return [v * math.cos(phi), v * math.sin(phi), w, t1, t2], singular
 
-    def _stage_velocities(self, first: int, last: int) -> list[tuple[list[float], list[float]]]:
-        """Desired velocities at ``k h + h/2`` and ``k h + h`` for steps k = first..last-1:
-        in one vectorised call when the trajectory has ``sample`` (same numbers)."""
-        h = self.step
+    def _stage_velocities(
+        self, piece: _Piece, first: int, last: int
+    ) -> list[tuple[list[float], list[float]]]:
+        """Desired velocities at ``origin + k h + h/2`` and ``origin + k h + h`` for the
+        piece's steps k = first..last-1: in one vectorised call when the trajectory has
+        ``sample`` (same numbers)."""
+        origin, h = piece.origin, piece.step
         sample = sampler(self.trajectory)
         if sample is None:
             velocity = self.trajectory.velocity
             return [
-                (velocity(k * h + h / 2).tolist(), velocity(k * h + h).tolist())
+                (velocity(origin + k * h + h / 2).tolist(), velocity(origin + k * h + h).tolist())
                 for k in range(first, last)
             ]
-        start = np.arange(first, last) * h
+        start = origin + np.arange(first, last) * h
         _, rates = sample(np.concatenate([start + h / 2, start + h]))
         rows = rates.tolist()
         count = last - first
         return list(zip(rows[:count], rows[count:]))
 
-    def _extend_to(self, t: float) -> None:
-        h = self.step
-        first = len(self._q) - 1
-        last = first
-        while last * h < t + h:  # the steps the loop below takes
+    @staticmethod
+    def _fine_end(piece: _Piece, t: float, limit: int | None) -> int | None:
+        """Node index up to which ``piece`` must be integrated for a lookup at t: the first
+        node at or after ``t + step``, if within ``limit`` steps of its end, else None."""
+        origin, h, first = piece.origin, piece.step, piece.count
+        target = t + h
+        if limit is not None and (target - origin) / h - first > limit + 2:
+            return None
+        last = max(first, int((target - origin) / h) - 2)
+        while origin + last * h < target:  # the exact rule, from just below it
             last += 1
+        return last if limit is None or last - first <= limit else None
+
+    def _extend_to(self, t: float) -> None:
+        """Integrate up to a lookup at t beyond ``_end``."""
+        self._drop_before_last_lookup()
+        piece = self._pieces[-1]
+        if piece.step != self.step:  # after a long stride, on at ``step`` from its end
+            piece = _Piece(piece.end, self.step)
+        last = self._fine_end(piece, t, MAX_LOOKUP_STEPS)
+        if last is None:
+            start = self._pieces[-1].end
+            piece = _Piece(start, (t - start) / MAX_LOOKUP_STEPS)
+            last, end = MAX_LOOKUP_STEPS, t
+        else:
+            end = piece.origin + (last - 1) * piece.step
+        if piece is not self._pieces[-1]:
+            self._pieces.append(piece)
+        self._integrate(piece, last)
+        self._end = end
+
+    def _drop_before_last_lookup(self) -> None:
+        """Discard the segments before the one of the last lookup."""
+        piece = self._piece_at(self._last_lookup)
+        while self._pieces[0] is not piece:
+            del self._pieces[0]
+        piece.drop_before(piece.index(self._last_lookup))
+        if len(self._pieces) > 1 or piece.dropped or piece.origin > 0.0:
+            self._window_start = piece.origin + piece.dropped * piece.step
+
+    def _integrate(self, piece: _Piece, last: int) -> None:
+        """RK4 steps on the piece's grid from its last node to node ``last``."""
+        h = piece.step
         rate, half, sixth = self._rate, h / 2, h / 6
-        q, k1, damped = self._q[-1], self._qdot[-1], self._node_damped[-1]
-        for middle, end in self._stage_velocities(first, last):
+        q, k1, damped = self._node
+        coefficients, segment_damped = piece.coefficients, piece.damped
+        for middle, end in self._stage_velocities(piece, piece.count, last):
             k2, d2 = rate([a + half * b for a, b in zip(q, k1)], middle)
             k3, d3 = rate([a + half * b for a, b in zip(q, k2)], middle)
             k4, d4 = rate([a + h * b for a, b in zip(q, k3)], end)
@@ -154,22 +261,20 @@ class ReferenceTrajectory:
                 for a, b1, b2, b3, b4 in zip(q, k1, k2, k3, k4)
             ]
             rate_next, d_next = rate(q_next, end)
-            self._segment_damped.append(damped or d2 or d3 or d4 or d_next)
-            self._coefficients.append(self._cubic(q, q_next, k1, rate_next))
-            self._q.append(q_next)
-            self._qdot.append(rate_next)
-            self._node_damped.append(d_next)
+            segment_damped.append(damped or d2 or d3 or d4 or d_next)
+            coefficients.append(self._cubic(h, q, q_next, k1, rate_next))
             q, k1, damped = q_next, rate_next, d_next
+        self._node = (q, k1, damped)
 
+    @staticmethod
     def _cubic(
-        self, q0: list[float], q1: list[float], rate0: list[float], rate1: list[float]
+        h: float, q0: list[float], q1: list[float], rate0: list[float], rate1: list[float]
     ) -> tuple[tuple[float, float, float, float], ...]:
-        """Cubic coefficients ``(c0, c1, c2, c3)`` per coordinate of the segment from node
-        ``(q0, rate0)`` to node ``(q1, rate1)`` (in s = 0..1).
+        """Cubic coefficients ``(c0, c1, c2, c3)`` per coordinate of the segment of length
+        ``h`` (s) from node ``(q0, rate0)`` to node ``(q1, rate1)`` (in s = 0..1).
 
         Computed once per segment while integrating, so a lookup is a polynomial evaluation.
         """
-        h = self.step
         return tuple(
             [
                 (a, h * da, 3.0 * (b - a) - h * (2.0 * da + db), 2.0 * (a - b) + h * (da + db))
@@ -177,17 +282,32 @@ class ReferenceTrajectory:
             ]
         )
 
+    def _piece_at(self, t: float) -> _Piece:
+        """The kept piece whose grid holds time t (s)."""
+        pieces = self._pieces
+        for piece in reversed(pieces):
+            if t >= piece.origin:
+                return piece
+        return pieces[0]
+
     def __call__(self, t: float) -> tuple[list[float], list[float]]:
         """``(q_d, qdot_d)`` at time t >= 0 (s), as lists of 5 floats."""
         if t > self._end:
             self._extend_to(t)
-            self._end = (len(self._q) - 2) * self.step
-        h = self.step
-        i = min(int(t / h), len(self._q) - 2)
-        self.last_damped = self._segment_damped[i]
-        s = t / h - i
+        piece = self._piece_at(t)
+        i = piece.index(t)
+        if t < self._window_start or i < piece.dropped:
+            self._restart()
+            if t > self._end:
+                self._extend_to(t)
+            piece = self._piece_at(t)
+            i = piece.index(t)
+        self._last_lookup = t
+        self.last_damped = piece.damped[i - piece.dropped]
+        h = piece.step
+        s = (t - piece.origin) / h - i
         position, rate = [], []
-        for c0, c1, c2, c3 in self._coefficients[i]:
+        for c0, c1, c2, c3 in piece.coefficients[i - piece.dropped]:
             position.append(c0 + s * (c1 + s * (c2 + s * c3)))
             rate.append((c1 + s * (2.0 * c2 + 3.0 * s * c3)) / h)
         return position, rate

@@ -25,7 +25,6 @@ import io
 import itertools
 import math
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -41,6 +40,7 @@ from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import TRACE_INTERVAL, Outcome, RunConfig, run_scenario
 from ddwmmr.sim.result import write_atomic
+from ddwmmr.workers import process_pool
 
 #: The two arbiters, in column order, with their labels.
 ARBITER_COLUMNS = (("state-machine", "state machine"), ("competitive", "competitive"))
@@ -278,7 +278,7 @@ def weight_statistics(
     items = [(s, config) for s in scenarios]
     if jobs <= 1:
         return [_statistics_of(item) for item in items]
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
+    with process_pool(jobs) as pool:
         return list(pool.map(_statistics_of, items, chunksize=max(1, len(items) // (4 * jobs))))
 
 

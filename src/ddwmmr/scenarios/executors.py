@@ -8,16 +8,24 @@ keep the per-task overhead small next to a scenario's ~30 ms.
 
 from __future__ import annotations
 
+import asyncio
+import contextlib
 import os
-from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+import signal
+import threading
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import as_completed
 from typing import Any
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, check_finite
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import Outcome, RunConfig, run_scenario
+from ddwmmr.workers import process_pool
 
 EXECUTORS = ("local", "dask")
+#: Seconds a Dask scheduler has to answer, and then to have a worker (``--connect-timeout``).
+CONNECT_TIMEOUT = 10.0
+MAX_CONNECT_TIMEOUT = 600.0
 #: One task = (configuration, scenarios) -> outcomes.
 Task = tuple[RunConfig, tuple[Scenario, ...]]
 
@@ -50,24 +58,34 @@ def run_many(
     jobs: int = 1,
     executor: str = "local",
     scheduler: str | None = None,
+    connect_timeout: float = CONNECT_TIMEOUT,
     cluster_options: dict[str, Any] | None = None,
+    client: Any = None,
     on_done: Callable[[int], None] | None = None,
 ) -> list[Outcome]:
     """Run ``scenarios`` under ``config``; outcomes in scenario order.
 
     Args:
-        jobs: worker processes (local) or LocalCluster workers (dask without scheduler).
+        jobs: worker processes (local) or LocalCluster workers (dask without scheduler);
+            never more than there are scenarios.
         executor: ``"local"`` (process pool; in-process when jobs == 1) or ``"dask"``.
         scheduler: address of a running Dask scheduler (``tcp://host:8786``); without it
             a LocalCluster is started and closed.
+        connect_timeout: seconds a scheduler has to answer (see :func:`check_scheduler`).
         cluster_options: extra LocalCluster keyword arguments (tests: processes=False).
+        client: a connected Dask client to use (:class:`DaskWorkers`) instead of
+            connecting, or starting a cluster, for this call.
         on_done: called with the number of scenarios finished by each completed chunk.
     """
     if executor not in EXECUTORS:
         raise ParameterError(f"executor must be one of {', '.join(EXECUTORS)} (got {executor!r})")
+    jobs = max(1, min(jobs, len(scenarios)))
     chunks = _chunks(scenarios, jobs)
-    if executor == "dask":
-        results = _run_dask(chunks, config, jobs, scheduler, cluster_options or {}, on_done)
+    if executor == "dask" and client is not None:
+        results = _run_dask(chunks, config, client, on_done)
+    elif executor == "dask":
+        with DaskWorkers(jobs, scheduler, connect_timeout, cluster_options) as own:
+            results = _run_dask(chunks, config, own, on_done)
     elif jobs == 1:
         results = []
         for chunk in chunks:
@@ -81,7 +99,7 @@ def run_many(
 
 def _run_pool(chunks, config, jobs, on_done) -> list[list[Outcome]]:
     results: list[list[Outcome] | None] = [None] * len(chunks)
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
+    with process_pool(jobs) as pool:
         futures = {pool.submit(run_chunk, config, c): i for i, c in enumerate(chunks)}
         for future in as_completed(futures):
             i = futures[future]
@@ -91,37 +109,175 @@ def _run_pool(chunks, config, jobs, on_done) -> list[list[Outcome]]:
     return results  # type: ignore[return-value]
 
 
-def _run_dask(chunks, config, jobs, scheduler, cluster_options, on_done) -> list[list[Outcome]]:
+def _run_dask(chunks, config, client, on_done) -> list[list[Outcome]]:
+    from dask.distributed import as_completed as dask_completed
+
+    futures = [client.submit(run_chunk, config, c, pure=False) for c in chunks]
+    index = {f.key: i for i, f in enumerate(futures)}
+    results: list[list[Outcome] | None] = [None] * len(chunks)
+    for future in dask_completed(futures):
+        i = index[future.key]
+        results[i] = future.result()
+        if on_done is not None:
+            on_done(len(chunks[i]))
+    return results  # type: ignore[return-value]
+
+
+# -- Dask -----------------------------------------------------------------------------------
+def _import_distributed():
     try:
-        from dask.distributed import Client, LocalCluster
-        from dask.distributed import as_completed as dask_completed
+        import distributed
     except ImportError:  # pragma: no cover - dask is an optional extra
         raise ParameterError(
             "executor: dask is not installed (pip install 'dask[distributed]')"
         ) from None
-    cluster = None
-    if scheduler is None:
-        options = {"n_workers": jobs, "threads_per_worker": 1, "dashboard_address": None}
-        options.update(cluster_options)
-        cluster = LocalCluster(**options)
-        client = Client(cluster)
-    else:
+    return distributed
+
+
+def check_connect_timeout(seconds: float) -> float:
+    """``seconds`` as a float if in (0, :data:`MAX_CONNECT_TIMEOUT`], else a one-line
+    :class:`ParameterError` naming connect-timeout."""
+    value = check_finite("connect-timeout", seconds)
+    if not 0.0 < value <= MAX_CONNECT_TIMEOUT:
+        raise ParameterError(
+            f"connect-timeout must be in (0, {MAX_CONNECT_TIMEOUT:g}] s (got {value:g})"
+        )
+    return value
+
+
+def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
+    """Raise a one-line :class:`ParameterError` unless a Dask scheduler answers at
+    ``address`` within ``timeout`` s.
+
+    Asks it who it is (Dask's ``identity`` call) under one deadline for the connection,
+    the handshake and the answer: Dask's own connect waits for the handshake without a
+    limit, so a listener that never answers (or an HTTP server) would hang it, and an
+    address answering garbage, or a scheme it cannot use (``tls://`` without TLS
+    settings, ``ucx://`` without UCX), fails with an exception of any type.
+    """
+    _import_distributed()
+    outcome: dict[str, Any] = {}
+
+    def probe() -> None:
         try:
-            client = Client(scheduler, timeout=10)
-        except (OSError, TimeoutError, ValueError) as exc:  # ValueError: not an address
-            reason = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise ParameterError(f"scheduler: cannot connect to {scheduler!r} ({reason})") from None
+            outcome["reply"] = asyncio.run(asyncio.wait_for(_identity(address), timeout))
+        except BaseException as exc:  # handed to the caller's thread
+            outcome["error"] = exc
+
+    thread = threading.Thread(target=probe, name="ddwmmr-scheduler-probe", daemon=True)
+    thread.start()
+    thread.join(timeout + 5.0)  # the deadline above ends it; this is a backstop
+    error = outcome.get("error")
+    if thread.is_alive() or isinstance(error, TimeoutError):
+        raise ParameterError(
+            f"scheduler: no Dask scheduler answered at {address!r} within {timeout:g} s "
+            "(--connect-timeout)"
+        )
+    if error is not None:
+        reason = _first_line(error)
+        raise ParameterError(f"scheduler: cannot connect to {address!r} ({reason})")
+    reply = outcome.get("reply")
+    if not (isinstance(reply, dict) and reply.get("type") == "Scheduler"):
+        raise ParameterError(f"scheduler: {address!r} answered, but not as a Dask scheduler")
+
+
+async def _identity(address: str) -> Any:
+    """What the server at ``address`` says it is (a dict; ``type`` is ``Scheduler``)."""
+    from distributed.comm import connect
+
+    comm = await connect(address)
     try:
-        futures = [client.submit(run_chunk, config, c, pure=False) for c in chunks]
-        index = {f.key: i for i, f in enumerate(futures)}
-        results: list[list[Outcome] | None] = [None] * len(chunks)
-        for future in dask_completed(futures):
-            i = index[future.key]
-            results[i] = future.result()
-            if on_done is not None:
-                on_done(len(chunks[i]))
-        return results  # type: ignore[return-value]
+        await comm.write({"op": "identity", "reply": True})
+        return await comm.read()
     finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+        comm.abort()
+
+
+def _first_line(error: BaseException) -> str:
+    text = str(error).strip()
+    line = text.splitlines()[0] if text else ""
+    return f"{type(error).__name__}: {line}" if line else type(error).__name__
+
+
+#: Signals a terminal sends to a whole process group (Ctrl-C, a closed terminal, Ctrl-\\).
+_TERMINAL_SIGNALS = tuple(
+    getattr(signal, name) for name in ("SIGINT", "SIGHUP", "SIGQUIT") if hasattr(signal, name)
+)
+
+
+@contextlib.contextmanager
+def _terminal_signals_blocked() -> Iterator[None]:
+    """Block :data:`_TERMINAL_SIGNALS` in this thread for the block (POSIX).
+
+    Threads started in the block, and processes they start (a LocalCluster's event loop,
+    its worker processes and multiprocessing's resource tracker), keep the blocked mask:
+    a Ctrl-C or a closed terminal then reaches only this process, which stops them
+    itself, instead of killing them half-way with messages of their own. Signals arriving
+    meanwhile are delivered here when the block ends."""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, _TERMINAL_SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+class DaskWorkers:
+    """A connected Dask client for the ``with`` block: to the scheduler at ``scheduler``
+    (checked first, :func:`check_scheduler`, then given ``connect_timeout`` s for a worker
+    to be there), or to a LocalCluster of ``jobs`` single-threaded workers started for
+    the block. Every failure to get there is a one-line :class:`ParameterError`."""
+
+    def __init__(
+        self,
+        jobs: int,
+        scheduler: str | None = None,
+        connect_timeout: float = CONNECT_TIMEOUT,
+        cluster_options: dict[str, Any] | None = None,
+    ) -> None:
+        self.jobs = jobs
+        self.scheduler = scheduler
+        self.connect_timeout = check_connect_timeout(connect_timeout)
+        self.cluster_options = cluster_options or {}
+        self._cluster: Any = None
+        self._client: Any = None
+
+    def __enter__(self) -> Any:
+        distributed = _import_distributed()
+        if self.scheduler is None:
+            options = {"n_workers": self.jobs, "threads_per_worker": 1, "dashboard_address": None}
+            options.update(self.cluster_options)
+            with _terminal_signals_blocked():  # inherited by the cluster's threads and workers
+                self._cluster = distributed.LocalCluster(**options)
+                self._client = distributed.Client(self._cluster)
+            return self._client
+        check_scheduler(self.scheduler, self.connect_timeout)
+        try:
+            self._client = distributed.Client(self.scheduler, timeout=self.connect_timeout)
+            self._client.wait_for_workers(1, timeout=self.connect_timeout)
+        except TimeoutError:
+            self.close()
+            raise ParameterError(
+                f"scheduler: the Dask scheduler at {self.scheduler!r} has no worker "
+                f"(none joined within {self.connect_timeout:g} s)"
+            ) from None
+        except (OSError, ValueError) as exc:
+            self.close()
+            raise ParameterError(
+                f"scheduler: cannot connect to {self.scheduler!r} ({_first_line(exc)})"
+            ) from None
+        return self._client
+
+    def __exit__(self, *exc_info: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Close the client and the cluster started for it (if any)."""
+        if self._client is not None:
+            self._client.close()
+            self._client = None
+        if self._cluster is not None:
+            self._cluster.close()
+            self._cluster = None

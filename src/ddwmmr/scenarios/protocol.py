@@ -37,12 +37,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 from typing import Any
 
 import numpy as np
 
-from ddwmmr.arbiters.factory import check_arbiter, make_arbiter
+from ddwmmr.arbiters.factory import check_arbiter
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
     MOVE_ARM,
@@ -50,23 +50,32 @@ from ddwmmr.arbiters.state_machine import (
     OBSTACLE,
     STABILITY,
     STATES,
+    THESIS_MANIPULABILITY,
+    THESIS_STABILITY,
     Hysteresis,
 )
-from ddwmmr.behaviours.controller import ThesisController
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.behaviours.obstacle import base_bubble
-from ddwmmr.commands import WheelForces, traits_of
+from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
+from ddwmmr.controllers.base import (
+    WaypointRun,
+    available_controllers,
+    controller_class,
+    controller_traits,
+    make_controller,
+)
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
-from ddwmmr.model.stability import stability_terms
+from ddwmmr.model.stability import STABILITY_FLOOR, stability_terms
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
-from ddwmmr.plants import make_plant
+from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+from ddwmmr.registry import PLANTS
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.loop import run_loop
 
-CONTROLLERS = ("thesis", "qp", "mpc")
-PLANTS = ("thesis", "kinematic", "mujoco")
+#: What each command interface sends, for the messages.
+SENDS = {FORCE: "wheel forces", VELOCITY: "velocity commands"}
 #: Motion detection thresholds for controllers without states (m/s, rad/s).
 MOVING_SPEED, MOVING_RATE = 1e-3, 1e-3
 #: Trace sampling interval for recorded scenarios (s).
@@ -105,7 +114,9 @@ class RunConfig:
     """How to run scenarios (picklable: it travels to worker processes).
 
     Attributes:
-        controller: ``"thesis"`` or ``"qp"``; plant: ``"thesis"`` or ``"kinematic"``.
+        controller: a registered controller of the waypoint task
+            (:func:`scenario_controllers`); plant: a registered plant it can command
+            (:func:`plants_for`).
         payload: end-effector payload (kg); 3.0 by default (see docs/thesis.md).
         stability, manipulability: (enter, exit) thresholds; exit == enter: no hysteresis.
         dt: control and integration step (s).
@@ -116,20 +127,21 @@ class RunConfig:
         controller_options: further ``(name, value)`` options of the ``qp`` or ``mpc``
             controller (e.g. ``(("horizon", 3.0),)``), over the protocol's own.
         record: keep a trace (every ``TRACE_INTERVAL``) for plots.
-        arbiter: thesis controller's arbiter, ``"state-machine"`` or ``"competitive"``
-            (thresholds above) or an arbiter instance (``ddwmmr.arbiters.make_arbiter``).
+        arbiter: thesis controller's arbiter, a registered name
+            (``ddwmmr.arbiters.available_arbiters()``: ``"state-machine"``, ``"competitive"``;
+            thresholds above) or an arbiter instance (``ddwmmr.arbiters.make_arbiter``).
         arbiter_seed: noise seed of the competitive arbiter.
     """
 
     controller: str = "thesis"
     plant: str = "thesis"
     payload: float = 3.0
-    stability: tuple[float, float] = (1.25, 1.60)
-    manipulability: tuple[float, float] = (0.75, 0.90)
+    stability: tuple[float, float] = astuple(THESIS_STABILITY)
+    manipulability: tuple[float, float] = astuple(THESIS_MANIPULABILITY)
     dt: float = 0.01
     time_limit: float | None = None
     tolerance: float = 0.01
-    qp_stability_min: float = 1.25
+    qp_stability_min: float = STABILITY_FLOOR
     qp_max_speed: float = 1.0
     controller_options: tuple[tuple[str, Any], ...] = ()
     record: bool = False
@@ -137,16 +149,20 @@ class RunConfig:
     arbiter_seed: int = 0
 
     def __post_init__(self) -> None:
-        if self.controller not in CONTROLLERS:
+        controllers = scenario_controllers()
+        if self.controller not in controllers:
             raise ParameterError(
-                f"controller must be one of {', '.join(CONTROLLERS)} (got {self.controller!r})"
+                f"controller must be one of {', '.join(controllers)} (got {self.controller!r})"
             )
-        if self.plant not in PLANTS:
-            raise ParameterError(f"plant must be one of {', '.join(PLANTS)} (got {self.plant!r})")
-        if self.controller == "thesis" and self.plant == "kinematic":
+        PLANTS.entry(self.plant)  # an unknown name: one line naming the known ones
+        accepted = plants_for(self.controller)
+        if self.plant not in accepted:
+            sends = " or ".join(
+                SENDS.get(i, i) for i in controller_traits(self.controller)["interfaces"]
+            )
             raise ParameterError(
-                "plant: the thesis controller outputs wheel forces and needs a plant that "
-                "takes them (thesis or mujoco)"
+                f"plant: the {self.controller} controller outputs {sends} and needs a plant "
+                f"that takes them ({' or '.join(accepted)})"
             )
         Hysteresis(*self.stability)
         Hysteresis(*self.manipulability)
@@ -424,19 +440,27 @@ class WaypointTask:
         self.tally.reason = "diverged"
 
 
+def scenario_controllers() -> list[str]:
+    """The registered controllers that do the waypoint task (``RunConfig.controller``,
+    ``--controller``), in listing order."""
+    return available_controllers("waypoints")
+
+
+def plants_for(controller: str) -> list[str]:
+    """The registered plants that take a command interface ``controller`` can send."""
+    interfaces = controller_traits(controller)["interfaces"]
+    return [p for p in available_plants() if set(interfaces) & set(PLANTS.traits(p)["interfaces"])]
+
+
 def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
     """Run one scenario under ``config`` and return its outcome."""
     robot = Robot().with_payload(config.payload)
     plant = make_scenario_plant(robot, config)
-    if config.controller == "thesis":
-        controller: Any = make_thesis_controller(robot, scenario, config)
-    elif config.controller == "mpc":
-        controller = make_mpc(robot, scenario, config, plant)
-    else:
-        controller = make_qp(robot, scenario, config, _envelope(plant))
+    controller = make_scenario_controller(robot, scenario, config, plant)
     # Start at the origin heading +x in the thesis's default pose (the pose it drives in).
     q0 = np.array([0.0, 0.0, 0.0, *default_pose(robot)])
-    has_states = config.controller == "thesis"
+    # A controller with an arbiter reports the arbiter's state; the others have none.
+    has_states = controller_traits(config.controller)["arbiter"]
     tally = _Tally(robot, scenario, config)
     task = WaypointTask(tally, controller, has_states, plant)
     end = run_loop(plant, controller, task, q0, config.dt, tally.steps)
@@ -458,80 +482,31 @@ def make_scenario_plant(robot: Robot, config: RunConfig) -> Plant:
     return make_plant(config.plant, robot)
 
 
+def make_scenario_controller(
+    robot: Robot, scenario: Scenario, config: RunConfig, plant: Plant
+) -> Any:
+    """The registered controller ``config.controller`` built for a waypoint-task run of
+    ``scenario`` on ``plant``, with the options its ``waypoint_options`` asks for (it sees
+    the plant's traits and velocity envelope, never the plant)."""
+    run = WaypointRun(scenario, config, traits_of(plant), _envelope(plant))
+    options = controller_class(config.controller).waypoint_options(run)
+    return make_controller(config.controller, robot, **options)
+
+
 def _envelope(plant: Plant) -> dict[str, Any] | None:
     """What a velocity command can ask of a force-limited base (None: no limit)."""
     envelope = getattr(plant, "velocity_envelope", None)
     return envelope() if envelope is not None else None
 
 
-def make_thesis_controller(robot: Robot, scenario: Scenario, config: RunConfig) -> Any:
-    """The thesis behaviour controller with the arbiter of ``config`` (state machine or
-    competitive dynamics, :func:`ddwmmr.arbiters.factory.make_arbiter`)."""
-    return ThesisController(robot, make_arbiter(config), obstacles=scenario.obstacles)
-
-
-def make_mpc(robot: Robot, scenario: Scenario, config: RunConfig, plant: Plant) -> Any:
-    """The registry's ``mpc`` controller for waypoint tasks: it predicts with the thesis
-    base's force-level model (wheel forces as decisions) on a plant that takes forces
-    (the thesis plant, the physics plant with the thesis damping), with the kinematic model
-    on the kinematic plant. Its stability floor is the qp's (``qp_stability_min``).
-
-    On a plant that judges tipping by its physics (``tip_time``) the mpc itself holds the
-    floor on the dynamic margin too (``dynamic_stability``: the centre of pressure of a
-    robot that turns and accelerates), with the joints lagging as that plant's servos do
-    (``arm_time_constant`` = ``plant.joint_time_constant``) and accelerating no faster than
-    its motors allow (``joint_acceleration_limit``), braking instead of following a plan
-    that needs slack (``brake_slack``), when the loop hands it the plant's traits
-    (``adopt_plant``): the static floor alone tipped the robot over in 94 of 100
-    scenarios, all of it in none of 400 (docs/mpc.md)."""
-    from ddwmmr.controllers import make_controller
-
-    model = "thesis" if "force" in plant.interfaces else "kinematic"
-    options: dict[str, Any] = {
-        "model": model,
-        "stability_min": config.qp_stability_min,
-        "track_orientation": False,
-        "obstacles": [tuple(o) for o in scenario.obstacles],
-        "dt": config.dt,
-    }
-    options.update(dict(config.controller_options))
-    return make_controller("mpc", robot, **options)
-
-
-def make_qp(
-    robot: Robot, scenario: Scenario, config: RunConfig, envelope: dict[str, Any] | None = None
-) -> Any:
-    """The registry's ``qp`` controller configured for waypoint tasks.
-
-    ``envelope`` (the plant's :meth:`ThesisPlant.velocity_envelope`) keeps the commanded
-    (v, w) within what a force-limited base can follow.
-    """
-    from ddwmmr.controllers import available_methods, make_controller
-
-    if "qp" not in available_methods():
-        raise ParameterError("controller: the qp controller is not available in this install")
-    options = {
-        "stability_min": config.qp_stability_min,
-        "track_orientation": False,
-        "max_speed": config.qp_max_speed,
-        "obstacles": [tuple(o) for o in scenario.obstacles],
-        "dt": config.dt,
-        **(envelope or {}),
-        **dict(config.controller_options),
-    }
-    return make_controller("qp", robot, **options)
-
-
 __all__ = [
-    "CONTROLLERS",
     "METRICS",
-    "PLANTS",
     "Outcome",
     "RunConfig",
     "WaypointTask",
-    "make_mpc",
-    "make_qp",
+    "make_scenario_controller",
     "make_scenario_plant",
-    "make_thesis_controller",
+    "plants_for",
     "run_scenario",
+    "scenario_controllers",
 ]

@@ -8,9 +8,10 @@ speed, base, arm, time_manip, trans_manip, time_stab, trans_stab (None: not publ
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import astuple, dataclass
 from typing import Any
 
+from ddwmmr.arbiters.state_machine import THESIS_MANIPULABILITY, THESIS_STABILITY
 from ddwmmr.scenarios.generator import Scenario, place_obstacles
 
 
@@ -34,7 +35,7 @@ def _row(failed, time=None, sd=None, speed=None, base=None, arm=None, tm=None, n
     }  # fmt: skip
 
 
-B_S, B_M = (1.25, 1.60), (0.75, 0.90)
+B_S, B_M = astuple(THESIS_STABILITY), astuple(THESIS_MANIPULABILITY)
 #: Thesis Tables 5.1/5.2, 5.5/5.6, 5.9/5.10, 5.11/5.12, 5.13/5.14, 5.17/5.18, 5.19/5.20.
 THRESHOLD_VARIANTS = (
     Variant("baseline", "Baseline", "5.2", B_S, B_M,

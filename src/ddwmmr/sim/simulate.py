@@ -9,7 +9,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.commands import VELOCITY
-from ddwmmr.controllers.base import Controller, make_controller
+from ddwmmr.controllers.base import Controller, available_methods, make_controller
 from ddwmmr.errors import (
     ParameterError,
     check_finite,
@@ -21,6 +21,7 @@ from ddwmmr.errors import (
 from ddwmmr.model import Robot
 from ddwmmr.plants import available_plants, make_plant, plant_class
 from ddwmmr.plants.base import Plant
+from ddwmmr.registry import CONTROLLERS
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     initial_configuration,
@@ -142,6 +143,7 @@ def simulate(
             f"progress must be a callable progress(step, steps) (got {shown(progress)})"
         )
     if isinstance(method, str):
+        check_tracks(method)
         controller = make_controller(method, robot, **controller_options)
     elif controller_options:
         raise ParameterError("controller options are only accepted with a method name")
@@ -198,6 +200,18 @@ def simulate(
     if hasattr(controller, "summarize"):
         summary.update(controller.summarize(timeseries))
     return SimulationResult(timeseries, summary, robot, trajectory, controller)
+
+
+def check_tracks(method: str) -> None:
+    """Raise :class:`ParameterError` unless ``method`` names a registered controller that
+    tracks trajectories (``tasks`` includes ``"tracking"``; an unknown name is refused
+    naming the known ones)."""
+    tasks = CONTROLLERS.traits(method)["tasks"]
+    if "tracking" not in tasks:
+        raise ParameterError(
+            f"method: the {method} controller does not track trajectories (it does: "
+            f"{', '.join(tasks)}; tracking: {', '.join(available_methods())})"
+        )
 
 
 def _plant(

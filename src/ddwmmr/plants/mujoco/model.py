@@ -48,6 +48,7 @@ import numpy as np
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import BASE_CLEARANCE_M
+from ddwmmr.model.support_loads import convex_hull
 
 #: Radius of the caster spheres (m).
 CASTER_RADIUS = 0.025
@@ -137,31 +138,6 @@ def supports(robot: Robot) -> tuple[Support, ...]:
     return wheels + casters
 
 
-def convex_hull(points) -> np.ndarray:
-    """Vertices (k, 2) of the convex hull of 2-D points, counter-clockwise (monotone chain).
-
-    Points on an edge are dropped; fewer than 3 non-collinear points give a degenerate hull
-    (fewer than 3 vertices).
-    """
-    pts = sorted({(float(x), float(y)) for x, y in points})
-    if len(pts) < 3:
-        return np.array(pts, dtype=float).reshape(-1, 2)
-
-    def cross(o, a, b) -> float:
-        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-
-    def chain(seq):
-        out: list[tuple[float, float]] = []
-        for p in seq:
-            while len(out) >= 2 and cross(out[-2], out[-1], p) <= 1e-12:
-                out.pop()
-            out.append(p)
-        return out
-
-    lower, upper = chain(pts), chain(reversed(pts))
-    return np.array(lower[:-1] + upper[:-1], dtype=float)
-
-
 def support_polygon(robot: Robot) -> np.ndarray:
     """Convex hull (k, 2) of all support points in the base frame (m), counter-clockwise."""
     return convex_hull([s.point for s in supports(robot)])
@@ -223,7 +199,7 @@ def _base_inertia_diagonal(robot: Robot) -> tuple[float, float, float]:
     The box values are raised where needed so that the triangle inequalities hold (a real
     body); the yaw value is never changed.
     """
-    mass = robot.base_mass - 2.0 * robot.wheel_mass
+    mass = robot.base_body_mass
     length, width, height = robot.base_length, robot.base_width, robot.base_height
     ixx = mass * (width**2 + height**2) / 12.0
     iyy = mass * (length**2 + height**2) / 12.0
@@ -255,11 +231,9 @@ def reflected_inertias(robot: Robot) -> tuple[float, float, float]:
     """
     m1, m2 = robot.link_masses
     p, l1, l2, r = robot.payload, robot.L1, robot.L2, robot.wheel_radius
-    total = robot.base_mass + m1 + m2 + p
-    wheel = 0.5 * total * r * r + _wheel_inertia(robot)[0]
+    wheel = 0.5 * robot.total_mass * r * r + _wheel_inertia(robot)[0]
     shoulder = m1 * l1**2 / 3.0 + m2 * (l2**2 / 12.0 + (l1 + 0.5 * l2) ** 2) + p * (l1 + l2) ** 2
-    elbow = m2 * l2**2 / 3.0 + p * l2**2
-    return wheel, shoulder, elbow
+    return wheel, shoulder, robot.yaw_inertia.elbow
 
 
 def servo_gains(robot: Robot, time_constant: float) -> tuple[float, float, float]:
@@ -317,7 +291,7 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
     base = _sub(world, "body", name="base", pos=_fmt(0, 0, r))
     _sub(base, "freejoint", name="base")
     box_z = BASE_CLEARANCE + 0.5 * robot.base_height - r
-    base_mass = robot.base_mass - 2.0 * robot.wheel_mass
+    base_mass = robot.base_body_mass
     _sub(
         base,
         "inertial",

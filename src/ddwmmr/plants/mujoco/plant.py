@@ -43,7 +43,8 @@ from ddwmmr.plants.mujoco.model import (
     supports,
 )
 from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
-from ddwmmr.plants.thesis import ThesisPlant, arm_step, damped_base_envelope
+from ddwmmr.plants.thesis import arm_step, damped_base_envelope
+from ddwmmr.registry import register_plant
 
 #: Time (s) the robot settles on its supports in :meth:`MujocoPlant.reset` before t = 0,
 #: so that the first recorded contact forces carry the robot's weight.
@@ -83,6 +84,7 @@ _WARNINGS = (
 )
 
 
+@register_plant("mujoco", interfaces=("velocity", "force"))
 class MujocoPlant:
     """The robot simulated by MuJoCo (rigid bodies, contacts, friction, motor limits).
 
@@ -102,9 +104,6 @@ class MujocoPlant:
     Raises:
         ParameterError: for a robot or option MuJoCo cannot build (one line).
     """
-
-    name = "mujoco"
-    interfaces = ("velocity", "force")
 
     def __init__(
         self,
@@ -215,7 +214,7 @@ class MujocoPlant:
             self.base_damping[1],
             float(np.sum(self.model.body_mass)),
             self.wheel_lever,
-            ThesisPlant(robot).inertia(0.0, 0.0),
+            robot.yaw_inertia.at(0.0),
             fraction,
             speed_budget=True,
         )

@@ -31,13 +31,19 @@ class JointLimit(Limit):
 
     def joint_bounds(self, angle: float, joint: int) -> tuple[float, float]:
         """``(lowest, highest)`` allowed rate (rad/s) of joint ``joint`` (0 or 1) at
-        ``angle`` (rad): the speed limit and the position dampers."""
+        ``angle`` (rad): the speed limit and the position dampers.
+
+        Written with comparisons, not ``min``/``max`` (the same results, NaN included;
+        it runs twice in every qp step)."""
         speed, gain, margin = self.speed, self.gain, self.margin
         low, high = self.limits[joint]
-        down = min(speed, gain * (angle - low - margin))  # allowed speed towards th_min
-        up = min(speed, gain * (high - margin - angle))
-        down = max(down, -0.5 * speed)  # beyond the margin: must move back, not too fast
-        up = max(up, -0.5 * speed)
+        down = gain * (angle - low - margin)  # allowed speed towards th_min
+        up = gain * (high - margin - angle)
+        down = down if down < speed else speed
+        up = up if up < speed else speed
+        back = -0.5 * speed  # beyond the margin: must move back, not too fast
+        down = back if back > down else down
+        up = back if back > up else up
         return -down, up
 
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
@@ -48,26 +54,21 @@ class JointLimit(Limit):
             ub[index] = min(ub[index], up)
 
     def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
-        """Writer tightening the Python box (no rows): :meth:`joint_bounds` inlined, with
-        ``min``/``max`` as comparisons (same results, tested against ``compute``)."""
+        """Writer tightening the Python box (no rows) with :meth:`joint_bounds`."""
         if overrides(self, JointLimit) or overrides(self, JointLimit, "joint_bounds"):
             return None
-        box = block.box
-        speed, gain, margin = self.speed, self.gain, self.margin
-        back = -0.5 * speed
-        (low1, high1), (low2, high2) = self.limits
+        box, bounds = block.box, self.joint_bounds
 
         def write(ctx: StepContext) -> None:
-            for angle, low, high, i in ((ctx.th1, low1, high1, 2), (ctx.th2, low2, high2, 3)):
-                down = gain * (angle - low - margin)
-                up = gain * (high - margin - angle)
-                down = down if down < speed else speed
-                up = up if up < speed else speed
-                down = back if back > down else down
-                up = back if back > up else up
-                if -down > box[i]:
-                    box[i] = -down
-                if up < box[i + 4]:
-                    box[i + 4] = up
+            low, up = bounds(ctx.th1, 0)
+            if low > box[2]:
+                box[2] = low
+            if up < box[6]:
+                box[6] = up
+            low, up = bounds(ctx.th2, 1)
+            if low > box[3]:
+                box[3] = low
+            if up < box[7]:
+                box[7] = up
 
         return write

@@ -77,14 +77,21 @@ def load_obstacles(path: str | Path) -> list[Circle]:
         ):
             raise ParameterError(f"obstacles: {path}: obstacle {i}: x, y, radius must be numbers")
         try:
-            # The command-line limits (docs/cli.md, "Limits"), as for trajectory files.
-            for key in ("x", "y"):
-                check_range(f"obstacle {key}", table[key], -MAX_COORDINATE_M, MAX_COORDINATE_M, "m")
-            check_range("obstacle radius", table["radius"], *LENGTH_RANGE_M, "m")
-            circles.append(Circle(table["x"], table["y"], table["radius"]))
+            circles.append(within_limits(table["x"], table["y"], table["radius"]))
         except ParameterError as exc:
             raise ParameterError(f"obstacles: {path}: obstacle {i}: {exc}") from None
     return circles
+
+
+def within_limits(x: float, y: float, radius: float) -> Circle:
+    """The circle (m) if it is within the command-line limits (docs/cli.md, "Limits"; as
+    for trajectory files): centre within +-MAX_COORDINATE_M, radius in LENGTH_RANGE_M,
+    else a one-line :class:`ParameterError`. Obstacle files and recorded runs pass it
+    alike."""
+    check_range("obstacle x", x, -MAX_COORDINATE_M, MAX_COORDINATE_M, "m")
+    check_range("obstacle y", y, -MAX_COORDINATE_M, MAX_COORDINATE_M, "m")
+    check_range("obstacle radius", radius, *LENGTH_RANGE_M, "m")
+    return Circle(x, y, radius)
 
 
 def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> list[Circle]:

@@ -18,8 +18,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 
-from ddwmmr.errors import ParameterError, check_positive
-from ddwmmr.model.stability import STABILITY_CAP, ComCoefficients, stability_terms
+from ddwmmr.errors import check_positive
+from ddwmmr.model.stability import (
+    STABILITY_CAP,
+    STABILITY_FLOOR,
+    ComCoefficients,
+    check_stability_floor,
+    stability_terms,
+)
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
@@ -137,17 +143,13 @@ class StabilityLimit(Limit):
     def __init__(
         self,
         robot_com: ComCoefficients,
-        stability_min: float = 1.25,
+        stability_min: float = STABILITY_FLOOR,
         gain: float = 5.0,
         margin: float = 0.01,
         joint_speed: float = 2.0,
     ) -> None:
         self.com = robot_com
-        self.stability_min = check_positive("stability_min", stability_min)
-        if self.stability_min >= STABILITY_CAP:
-            raise ParameterError(
-                f"stability_min must be in (0, {STABILITY_CAP:g}) (got {stability_min:g})"
-            )
+        self.stability_min = check_stability_floor(stability_min)
         self.gain = check_positive("stability gain", gain)
         self.margin = check_positive("stability margin", margin)
         self.joint_speed = check_positive("joint speed", joint_speed)
@@ -157,7 +159,8 @@ class StabilityLimit(Limit):
         if s_i >= STABILITY_CAP:
             return -INF
         achievable = 0.5 * self.joint_speed * (abs(g1) + abs(g2))
-        return min(-self.gain * (s_i - (self.stability_min + self.margin)), achievable)
+        damper = -self.gain * (s_i - (self.stability_min + self.margin))
+        return achievable if achievable < damper else damper  # min(damper, achievable)
 
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
         """Rows ``[0, 0, dS_i/dth1, dS_i/dth2]`` with lower bound ``-gain (S_i - floor)``."""
@@ -168,17 +171,16 @@ class StabilityLimit(Limit):
             lower[row] = self.lower_bound(s_i, g1, g2)
 
     def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
-        """Writer for the gradient entries and the lower bounds (from the context's arm
-        trigonometry; :meth:`lower_bound` inlined, tested against ``compute``); the rest
-        is constant. Parameters are read here: recompile after changing them."""
+        """Writer for the gradient entries and the lower bounds (the gradient from the
+        context's arm trigonometry, the bounds from :meth:`lower_bound`); the rest is
+        constant."""
         if overrides(self, StabilityLimit) or overrides(self, StabilityLimit, "lower_bound"):
             return None
         block.write_constant_rows([[0.0] * 4, [0.0] * 4])
         block.write_constant_bounds((-INF, -INF), (INF, INF))
         G, lower = block.matrix, block.lower
         (lon_row, lat_row), (lon_bound, lat_bound) = block.rows, block.bounds
-        com, gain, half_speed = self.com, self.gain, 0.5 * self.joint_speed
-        target = self.stability_min + self.margin
+        com, bound = self.com, self.lower_bound
 
         def write(ctx: StepContext) -> None:
             (s_lon, g1, g2), (s_lat, h1, h2) = stability_terms_from_trig(
@@ -186,15 +188,7 @@ class StabilityLimit(Limit):
             )
             G[lon_row + 2], G[lon_row + 3] = g1, g2
             G[lat_row + 2], G[lat_row + 3] = h1, h2
-            if s_lon >= STABILITY_CAP:
-                lower[lon_bound] = -INF
-            else:
-                damper, achievable = -gain * (s_lon - target), half_speed * (abs(g1) + abs(g2))
-                lower[lon_bound] = achievable if achievable < damper else damper
-            if s_lat >= STABILITY_CAP:
-                lower[lat_bound] = -INF
-            else:
-                damper, achievable = -gain * (s_lat - target), half_speed * (abs(h1) + abs(h2))
-                lower[lat_bound] = achievable if achievable < damper else damper
+            lower[lon_bound] = bound(s_lon, g1, g2)
+            lower[lat_bound] = bound(s_lat, h1, h2)
 
         return write

@@ -94,13 +94,19 @@ class ManipulabilityTask(Task):
         arm_slope = eta_squared_gradient(th2)
         arm_target = self.gain * math.cos(th2) ** 2  # 1 - eta^2
         gx, gy = base_gradient(ctx.L1, ctx.L2, ctx)
-        vx = ctx.velocity_d[0] + 0.5 * self.base_gain * gx
-        vy = ctx.velocity_d[1] + 0.5 * self.base_gain * gy
-        factor = min(1.0, math.hypot(vx, vy) / FADE_SPEED)
-        if factor == 0.0:
+        half_base_gain = 0.5 * self.base_gain
+        vx = ctx.velocity_d[0] + half_base_gain * gx
+        vy = ctx.velocity_d[1] + half_base_gain * gy
+        fade = math.hypot(vx, vy) / FADE_SPEED
+        fade = fade if fade < 1.0 else 1.0  # min(1, fade), without a call
+        if fade == 0.0:
             return arm_slope, arm_target, 0.0, 0.0
-        steer = factor * self.heading_gain * wrap_angle(math.atan2(vy, vx) - ctx.phi)
-        return arm_slope, arm_target, factor, steer
+        return (
+            arm_slope,
+            arm_target,
+            fade,
+            fade * self.heading_gain * wrap_angle(math.atan2(vy, vx) - ctx.phi),
+        )
 
     def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
         """Row 0 on th2dot, row 1 on w."""
@@ -108,9 +114,8 @@ class ManipulabilityTask(Task):
         jac[0, 3], error[0], jac[1, 1], error[1] = self.values(ctx)
 
     def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
-        """Writer for the two weighted rows (zeros elsewhere are constant): :meth:`values`
-        inlined, same operations in the same order (tested against ``compute``). The
-        gains are read here: recompile after changing them (``refresh_weights``)."""
+        """Writer for the two weighted rows from :meth:`values` (zeros elsewhere are
+        constant)."""
         if overrides(self, ManipulabilityTask) or overrides(self, ManipulabilityTask, "values"):
             return None
         block.write_constant_rows([[0.0] * 4, [0.0] * 4])
@@ -118,38 +123,13 @@ class ManipulabilityTask(Task):
         arm, steer = block.rows[0] + 3, block.rows[1] + 1
         t0, t1 = block.targets
         w0, w1 = block.scales
-        gain, heading_gain = self.gain, self.heading_gain
-        half_base_gain = 0.5 * self.base_gain
-        cos, sin, hypot, atan2, pi, two_pi = (
-            math.cos,
-            math.sin,
-            math.hypot,
-            math.atan2,
-            math.pi,
-            2.0 * math.pi,
-        )
+        values = self.values
 
         def write(ctx: StepContext) -> None:
-            th2 = ctx.th2
-            c2 = cos(th2)
-            jac[arm] = sin(2.0 * th2) * w0
-            target[t0] = gain * c2**2 * w0
-            dx, dy = ctx.pose_e[0] - ctx.x, ctx.pose_e[1] - ctx.y  # base_gradient
-            if hypot(dx, dy) == 0.0:
-                gx = gy = 0.0
-            else:
-                factor = 2.0 * c2 / (ctx.L1 * ctx.L2)
-                gx, gy = factor * dx, factor * dy
-            vx = ctx.velocity_d[0] + half_base_gain * gx
-            vy = ctx.velocity_d[1] + half_base_gain * gy
-            fade = hypot(vx, vy) / FADE_SPEED
-            fade = fade if fade < 1.0 else 1.0
-            if fade == 0.0:
-                jac[steer] = 0.0 * w1
-                target[t1] = 0.0 * w1
-                return
+            arm_slope, arm_target, fade, turn = values(ctx)
+            jac[arm] = arm_slope * w0
+            target[t0] = arm_target * w0
             jac[steer] = fade * w1
-            turn = (atan2(vy, vx) - ctx.phi + pi) % two_pi - pi  # wrap_angle
-            target[t1] = fade * heading_gain * turn * w1
+            target[t1] = turn * w1
 
         return write

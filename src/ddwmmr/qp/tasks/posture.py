@@ -57,10 +57,10 @@ class PostureTask(Task):
     def targets(self, ctx: StepContext) -> tuple[float, float, float]:
         """``-gain * (phi, th1, th2)`` (rad/s), each bounded by ``rate_limit``."""
         gain, limit = self.gain, self.rate_limit
-        targets = (-gain * ctx.phi, -gain * ctx.th1, -gain * ctx.th2)
+        e0, e1, e2 = -gain * ctx.phi, -gain * ctx.th1, -gain * ctx.th2
         if limit is None:
-            return targets
-        return tuple(bounded(value, limit) for value in targets)
+            return e0, e1, e2
+        return bounded(e0, limit), bounded(e1, limit), bounded(e2, limit)
 
     def compile(self, block: TaskBlock) -> Callable[[StepContext], None] | None:
         """Constant rows, written once; the writer fills the three weighted targets."""
@@ -70,13 +70,10 @@ class PostureTask(Task):
         (target,) = block.target_views
         t0, t1, t2 = block.targets
         w0, w1, w2 = block.scales
-
-        gain, limit = self.gain, self.rate_limit
+        targets = self.targets
 
         def write(ctx: StepContext) -> None:
-            e0, e1, e2 = -gain * ctx.phi, -gain * ctx.th1, -gain * ctx.th2
-            if limit is not None:
-                e0, e1, e2 = bounded(e0, limit), bounded(e1, limit), bounded(e2, limit)
+            e0, e1, e2 = targets(ctx)
             target[t0] = e0 * w0
             target[t1] = e1 * w1
             target[t2] = e2 * w2

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -41,6 +41,7 @@ from ddwmmr.resolution.reference import (
 )
 from ddwmmr.sim.simulate import engine_multiple, simulate
 from ddwmmr.trajectories.base import resolution_step
+from ddwmmr.workers import process_pool
 
 # -- configuration and plan ---------------------------------------------------------------
 
@@ -359,7 +360,7 @@ def execute(
                 outputs[spec] = run_one(task)
                 bar.advance()
         else:
-            with ProcessPoolExecutor(max_workers=jobs) as pool:
+            with process_pool(jobs) as pool:
                 futures = {pool.submit(run_one, task): spec for spec, task in zip(queue, tasks)}
                 try:
                     for future in as_completed(futures):

@@ -13,9 +13,9 @@ from PIL import Image
 
 import ddwmmr.gui.app as gui_app
 import ddwmmr.gui.settings as gui_settings
+from ddwmmr.cli import gui as cli
+from ddwmmr.cli.gui import DPI_RANGE, check_dpi, main
 from ddwmmr.errors import ParameterError
-from ddwmmr.gui import cli
-from ddwmmr.gui.cli import DPI_RANGE, check_dpi, main
 from ddwmmr.gui.paths import SNAPSHOT_FORMATS, check_export_root, check_snapshot_path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -305,3 +305,15 @@ def test_a_run_that_starts_tipped_or_in_an_obstacle_is_refused(tmp_path, capsys,
         "overlaps the robot's start pose by 0.104 m",
     )
     assert files_below(tmp_path) == ["start.toml"]
+
+
+def test_a_deeply_nested_obstacle_file_is_refused(tmp_path, capsys, no_window):
+    obstacles = tmp_path / "deep.toml"
+    obstacles.write_text("[[obstacle]]\nx = 2.0\ny = 0.0\nradius = " + "[" * 5000 + "]" * 5000)
+    refused(
+        ["--snapshot", str(tmp_path / "s.png"), *FAST, "--method", "qp",
+         "--option", f"obstacles={obstacles}"],
+        capsys,
+        f"obstacles: {obstacles} nests arrays or tables more than 32 levels deep",
+    )  # fmt: skip
+    assert files_below(tmp_path) == ["deep.toml"]

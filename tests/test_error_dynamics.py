@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from ddwmmr import Ellipse, Robot, simulate
-from ddwmmr.sim.loops import (
+from ddwmmr.sim.error_dynamics import (
     closed_form_step,
     error_loop,
     error_loops,
@@ -79,7 +79,7 @@ def test_simulated_position_error_decays_like_the_loop(tau: float) -> None:
 
 @pytest.mark.parametrize("bandwidth", (2.0, 10.0))
 def test_velocity_loop_is_first_order_with_the_feed_forward_making_it_exact(bandwidth):
-    from ddwmmr.sim.loops import velocity_loop, velocity_loop_summary
+    from ddwmmr.sim.error_dynamics import velocity_loop, velocity_loop_summary
 
     mass, damping = 15.0, 15.0
     loop = velocity_loop(mass, damping, bandwidth)
@@ -97,7 +97,7 @@ def test_saturated_velocity_step_matches_the_thesis_plant_under_the_scenario_loo
     thesis plant's VelocityServo agree; small steps follow the linear loop."""
     from ddwmmr.plants.thesis import ThesisPlant, ThesisState
     from ddwmmr.plants.thesis import VelocityServo as VelocityLoop
-    from ddwmmr.sim.loops import saturated_velocity_step, velocity_loop
+    from ddwmmr.sim.error_dynamics import saturated_velocity_step, velocity_loop
 
     robot = Robot().with_payload(3.0)
     plant = ThesisPlant(robot)

@@ -16,8 +16,8 @@ from ddwmmr.arbiters import (
     Hysteresis,
     StateMachineArbiter,
 )
-from ddwmmr.behaviours import ThesisController
 from ddwmmr.errors import ParameterError
+from ddwmmr.thesis_controller import ThesisController
 
 
 def at(s: float, eta: float):

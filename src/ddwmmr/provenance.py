@@ -6,7 +6,9 @@ a git checkout, the exact command line and working folder, and the tool's inputs
 method and every option with its default filled in, the robot (all fields), the
 trajectory (its parameters, or its file's path and SHA-256), step, integrator, offset,
 plant and seed. Values are JSON: tuples become lists, non-finite floats the strings
-``"inf"``, ``"-inf"``, ``"nan"`` (:func:`decode` turns them back).
+``"inf"``, ``"-inf"``, ``"nan"`` (:func:`decode` turns them back). The record of a
+tracking run (:class:`RunInputs`, :func:`run_record`) is written by ``track`` and by the
+simulator's data export alike, and read back by ``track --rerun``.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import shlex
 import subprocess
 import sys
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -180,3 +183,47 @@ def trajectory_from_record(record: dict[str, Any]) -> Any:
             )
         return read_csv(path)
     raise ParameterError(f"rerun: cannot rebuild a trajectory of type {kind!r}")
+
+
+@dataclass
+class RunInputs:
+    """Everything a tracking run simulates (from a tool's options, or from a record)."""
+
+    method: str
+    options: dict[str, Any]
+    robot: Robot
+    trajectory: Any
+    trajectory_file: Path | None
+    dt: float
+    duration: float
+    integrator: str | None
+    offset: tuple[float, float]
+    label: str  # trajectory as the user named it (for the default folder name)
+    plant: str
+
+
+def run_record(
+    inputs: RunInputs,
+    argv: Sequence[str] | None,
+    rerun: str | None,
+    tool: str,
+    prog: str,
+) -> dict:
+    """What summary.json["run"] holds: enough to repeat the run (``--rerun``); ``tool``
+    and ``prog`` name what wrote it (the simulator's export writes the same record)."""
+    record = header(tool, prog, argv)
+    record.update(
+        method=inputs.method,
+        options=options_record(inputs.method, inputs.options),
+        robot=robot_record(inputs.robot),
+        trajectory=trajectory_record(inputs.trajectory, inputs.trajectory_file),
+        dt=inputs.dt,
+        duration=inputs.duration,
+        integrator=inputs.integrator,
+        initial_offset=list(inputs.offset),
+        plant={"name": inputs.plant},
+        seed=None,  # nothing random in a track run
+    )
+    if rerun is not None:
+        record["rerun_of"] = str(Path(rerun).resolve())
+    return record

@@ -1,4 +1,5 @@
-"""``python -m ddwmmr.gui``: the interactive simulator window, or its headless snapshot.
+"""``python -m ddwmmr.gui`` (console script ``ddwmmr-gui``): the interactive simulator
+window, or its headless snapshot.
 
 Examples::
 
@@ -26,6 +27,7 @@ from pathlib import Path
 from ddwmmr.cli.common import ArgumentParser, run_main
 from ddwmmr.controllers.base import available_methods
 from ddwmmr.errors import ParameterError, check_range
+from ddwmmr.gui.layout import desktop_figure
 from ddwmmr.gui.options import method_options, plant_names
 from ddwmmr.gui.paths import (
     SNAPSHOT_FORMATS,
@@ -256,34 +258,6 @@ def snapshot(
 def check_dpi(dpi: float) -> float:
     """``--dpi``: a finite number in :data:`DPI_RANGE`."""
     return check_range("dpi", dpi, *DPI_RANGE)
-
-
-def desktop_figure():
-    """A Tk window's figure, its resolution lowered so that the window fits the screen.
-
-    The layout is in figure fractions and the fonts in points, so a lower dpi shrinks the
-    whole window evenly. Tk multiplies the dpi by its pixel ratio (``tk scaling`` against
-    the usual 96 px per inch), which the fit includes.
-    """
-    import tkinter
-
-    import matplotlib.pyplot as plt
-
-    from ddwmmr.gui.layout import DPI, FIGSIZE
-
-    probe = tkinter.Tk()  # raises TclError without a display
-    probe.withdraw()
-    try:
-        screen_width, screen_height = probe.winfo_screenwidth(), probe.winfo_screenheight()
-        ratio = float(probe.tk.call("tk", "scaling")) * 72.0 / 96.0
-    finally:
-        probe.destroy()
-    # Leave room for the toolbar, the title bar and a desktop panel.
-    dpi = min(DPI, 0.96 * screen_width / FIGSIZE[0], 0.84 * screen_height / FIGSIZE[1])
-    plt.switch_backend("TkAgg")
-    figure = plt.figure(figsize=FIGSIZE, dpi=dpi / max(ratio, 1e-3))
-    figure.canvas.manager.set_window_title("ddwmmr simulator")
-    return figure
 
 
 def open_window(settings: Settings, export_dir: str | None = None) -> int:

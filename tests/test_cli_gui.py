@@ -14,8 +14,9 @@ from PIL import Image
 
 import ddwmmr.gui.settings as gui_settings
 from ddwmmr import Robot, available_methods, available_trajectories, simulate
-from ddwmmr.gui import App, Settings, cli
-from ddwmmr.gui.cli import build_parser, main, settings_from_arguments
+from ddwmmr.cli import gui as cli
+from ddwmmr.cli.gui import build_parser, main, settings_from_arguments
+from ddwmmr.gui import App, Settings
 from ddwmmr.gui.layout import FIGSIZE
 from ddwmmr.gui.settings import build_trajectory
 from ddwmmr.reports.plots import robot_outline

@@ -39,10 +39,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
+from typing import Any
 
 import numpy as np
 
 from ddwmmr.arbiters.base import Arbiter
+from ddwmmr.arbiters.factory import make_arbiter
 from ddwmmr.arbiters.state_machine import StateMachineArbiter
 from ddwmmr.behaviours.base import BRAKE, Behaviour, Percept, Proposal, sense
 from ddwmmr.behaviours.lowlevel import ArmMover, BaseMover, PDGains
@@ -51,6 +53,7 @@ from ddwmmr.behaviours.objective import Objective
 from ddwmmr.behaviours.obstacle import ObstacleAvoidance
 from ddwmmr.behaviours.stability import Stability
 from ddwmmr.commands import FORCE, WheelForces
+from ddwmmr.controllers.base import WaypointRun, register_controller
 from ddwmmr.model import Robot
 
 #: Actuator command: (left wheel force N, right wheel force N, th1 target rad, th2 target rad).
@@ -59,8 +62,9 @@ Actuation = tuple[float, float, float, float]
 ENGAGE, RELEASE = 0.1, 0.05
 
 
+@register_controller("thesis", tasks=("waypoints",), interfaces=("force",), arbiter=True)
 class ThesisController:
-    """Behaviours + arbiter + low-level controllers (thesis Fig 4.1).
+    """Thesis behaviour-based control: behaviours + arbiter + low-level controllers (Fig 4.1).
 
     Args:
         robot: the robot (geometry for IK and metrics).
@@ -71,7 +75,6 @@ class ThesisController:
         adjust: base displacement target of the manipulability/stability behaviours (m).
     """
 
-    name = "thesis"
     #: Loop contract: wheel forces out, measured (v, w) in, one call per control step.
     interface = FORCE
     wants_base_velocity = True
@@ -107,6 +110,13 @@ class ThesisController:
         self.last_shares: dict[str, float] = {}
         #: An arbiter with ``weigh()`` blends the behaviours (competitive dynamics).
         self._blending = callable(getattr(self.arbiter, "weigh", None))
+
+    @classmethod
+    def waypoint_options(cls, run: WaypointRun) -> dict[str, Any]:
+        """The options of a waypoint-task run: the arbiter the run configuration asks for
+        (state machine or competitive dynamics, :func:`ddwmmr.arbiters.make_arbiter`) and
+        the scenario's obstacles."""
+        return {"arbiter": make_arbiter(run.config), "obstacles": run.scenario.obstacles}
 
     @property
     def default_pose(self) -> tuple[float, float]:

@@ -1,0 +1,302 @@
+"""The report: its text tables, its comparison with an earlier report, its file (written
+atomically, read back and checked)."""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import stat
+from pathlib import Path
+from typing import Any
+
+from ddwmmr.bench.methods import REFERENCE_LABEL
+from ddwmmr.errors import (
+    ParameterError,
+    read_text_file,
+    shown,
+)
+from ddwmmr.outputs import check_output_file, check_writable
+from ddwmmr.sim.result import write_atomic
+
+#: Marker of a report written by this tool (an existing ``--out`` file must carry it).
+TOOL = "ddwmmr.bench"
+#: Version of the report layout.
+REPORT_VERSION = 2
+
+
+def format_table(report: dict[str, Any]) -> str:
+    """A readable text table of :func:`run_benchmark`'s report."""
+    config = report["config"]
+    lines = [
+        f"ddwmmr bench: {config['trajectory']}, {config['calls']} states per timing, "
+        f"{config['run_duration_s']:g} s runs ({config['integrator']}), {config['repeats']} "
+        "repeats; step times in us over states (median of each state's repeats)",
+        f"{'method':<14} {'median':>8} {'p90':>8} {'p99':>8} {'vs naive':>9} {'steps/s':>9} "
+        f"{'run x naive':>11}  target",
+    ]
+    for row in report["rows"]:
+        verdict = {True: "ok", False: "MISS", None: "-"}[row["meets_target"]]
+        lines.append(
+            f"{row['label']:<14} {row['step_us']:>8.2f} {row['step_p90_us']:>8.2f} "
+            f"{row['step_p99_us']:>8.2f} {row['step_ratio']:>9.3f} {row['steps_per_s']:>9.0f} "
+            f"{row['run_speedup']:>11.2f}  {verdict}"
+        )
+    lines.append(
+        f"target: step <= {report['target_step_ratio']:g} x {report['baseline']} step "
+        "('vs naive' = step / naive step; 'run x naive' = steps/s / naive steps/s)"
+    )
+    for label, budget in report["step_budgets_us"].items():
+        lines.append(f"target for {label}: step <= {budget:g} us (absolute budget)")
+    for pair in report["pairs"]:
+        lines.append(f"{pair['method']} / {pair['naive']} step ratio: {pair['step_ratio']:.3f}")
+    for label, reason in report["skipped"].items():
+        lines.append(f"skipped {label}: {reason}")
+    if report.get("qp_classes"):
+        lines += ["", *format_qp_classes(report)]
+    if report.get("scenarios"):
+        lines += ["", *format_scenarios(report)]
+    return "\n".join(lines)
+
+
+def format_scenarios(report: dict[str, Any]) -> list[str]:
+    """The scenario-throughput section of the table."""
+    first = report["scenarios"][0]
+    lines = [
+        f"scenario benchmark ({first['scenarios']} scenarios, seed 0, {first['jobs']} "
+        "workers; simulated s per wall s, wall time includes the worker pool)"
+    ]
+    for row in report["scenarios"]:
+        lines.append(
+            f"  {row['controller']:<8} {row['sim_seconds_per_wall_second']:>8.0f}   "
+            f"({row['sim_time_s']:.0f} simulated s in {row['wall_time_s']:.2f} s, "
+            f"{row['failed']} failed)"
+        )
+    return lines
+
+
+def format_qp_classes(report: dict[str, Any]) -> list[str]:
+    """The qp state-class section of the table."""
+    lines = [
+        "qp step by state class (3 kg payload; states recorded from qp runs; us: "
+        "median / p90 / p99 over states)"
+    ]
+    for entry in report["qp_classes"]:
+        if "skipped" in entry:
+            lines.append(f"  {entry['name']}: skipped ({entry['skipped']})")
+            continue
+        lines.append(
+            f"  {entry['name']} ({entry['states']} states, exact look-ahead in "
+            f"{100 * entry['exact_check_fraction']:.1f} %)"
+        )
+        for label, stats in entry["rows"].items():
+            ratio = entry["ratios"].get(label)
+            versus = (
+                ""
+                if ratio is None
+                else (
+                    f"  {ratio['median']:7.1f}x qp (repeats {ratio['min_over_repeats']:.1f}"
+                    f"-{ratio['max_over_repeats']:.1f})"
+                )
+            )
+            lines.append(
+                f"    {label:<22} {stats['median_us']:>8.2f} {stats['p90_us']:>8.2f} "
+                f"{stats['p99_us']:>8.2f}{versus}"
+            )
+        phases = entry["phases"]
+        lines.append(
+            "    qp phases (median): "
+            + ", ".join(
+                f"{name} {phases[name]:.2f}" for name in ("build", "solve", "check", "rest")
+            )
+        )
+    lines.append(format_qp_verdict(report))
+    return lines
+
+
+def format_qp_verdict(report: dict[str, Any]) -> str:
+    """One line: the issue 14 targets, met or missed, in every measured class."""
+    targets = report["qp_targets"]
+    measured = [e for e in report["qp_classes"] if "skipped" not in e]
+    if not measured:
+        return "qp targets: no class measured"
+    worst_median = max(e["rows"]["qp"]["median_us"] for e in measured)
+    worst_p99 = max(e["rows"]["qp"]["p99_us"] for e in measured)
+    ok = worst_median <= targets["median_us"] and worst_p99 <= targets["p99_us"]
+    text = (
+        f"qp targets: median <= {targets['median_us']:g} us and p99 <= {targets['p99_us']:g} us"
+        f" in every class: {'ok' if ok else 'MISS'} (worst {worst_median:.2f} / {worst_p99:.2f})"
+    )
+    ratios = [e["ratios"][REFERENCE_LABEL] for e in measured if REFERENCE_LABEL in e["ratios"]]
+    if ratios:
+        lowest = min(r["min_over_repeats"] for r in ratios)
+        verdict = "ok" if lowest >= targets["reference_ratio"] else "MISS"
+        text += (
+            f"; {REFERENCE_LABEL} / qp >= {targets['reference_ratio']:g}: {verdict} "
+            f"(lowest over classes and repeats {lowest:.1f})"
+        )
+    else:
+        text += f"; {REFERENCE_LABEL}: not measured"
+    return text
+
+
+def format_comparison(report: dict[str, Any], previous: dict[str, Any]) -> str:
+    """Median step of each row and qp class against a previous report (new / old)."""
+    lines = [
+        f"against {previous['config'].get('timestamp', '?')} "
+        f"(commit {previous['config'].get('git_commit') or '?'}): median step new / old"
+    ]
+    old_rows = {row["label"]: row for row in previous.get("rows", [])}
+    for row in report["rows"]:
+        old = old_rows.get(row["label"])
+        if old:
+            lines.append(
+                f"  {row['label']:<14} {old['step_us']:>8.2f} -> {row['step_us']:>8.2f} us "
+                f"({row['step_us'] / old['step_us']:.2f}x)"
+            )
+    old_classes = {e["name"]: e for e in previous.get("qp_classes", []) if "rows" in e}
+    for entry in report.get("qp_classes", []):
+        old = old_classes.get(entry["name"])
+        if old and "rows" in entry:
+            new_us, old_us = entry["rows"]["qp"]["median_us"], old["rows"]["qp"]["median_us"]
+            lines.append(
+                f"  qp, {entry['name']:<20} {old_us:>8.2f} -> {new_us:>8.2f} us "
+                f"({new_us / old_us:.2f}x)"
+            )
+    old_scenarios = {row["controller"]: row for row in previous.get("scenarios", [])}
+    for row in report.get("scenarios", []):
+        old = old_scenarios.get(row["controller"])
+        if old:
+            new_rate, old_rate = (
+                row["sim_seconds_per_wall_second"],
+                old["sim_seconds_per_wall_second"],
+            )
+            lines.append(
+                f"  scenarios, {row['controller']:<14} {old_rate:>8.0f} -> {new_rate:>8.0f} "
+                f"simulated s per wall s ({new_rate / old_rate:.2f}x)"
+            )
+    return "\n".join(lines)
+
+
+def write_report(report: dict[str, Any], path: str | Path, force: bool = False) -> None:
+    """Write ``report`` to ``path`` atomically; an existing file is replaced only when it
+    is a report of this tool (or with ``force``)."""
+    path = Path(path)
+    check_out(path, force)
+    try:
+        write_atomic(path, json.dumps(report, indent=2) + "\n")
+    except OSError as exc:
+        raise ParameterError(f"out: cannot write {path} ({exc.strerror or exc})") from None
+
+
+def check_out(path: Path, force: bool = False) -> None:
+    """Refuse, before the run, an output path that cannot be written or that is not a
+    report of this tool (unless ``force``): see :func:`ddwmmr.outputs.check_output_file`.
+    Something that is not a regular file (a device, a FIFO) is never replaced, not even
+    with ``force``: the report is moved into place by a rename, which would replace it.
+    That is said first, so that the message does not suggest ``--force``."""
+    try:
+        info = os.stat(path)
+    except (OSError, ValueError):
+        info = None  # absent (check_output_file checks its folder) or not a path at all
+    if info is not None and not stat.S_ISREG(info.st_mode) and not stat.S_ISDIR(info.st_mode):
+        raise ParameterError(f"out: {path} exists and is not a regular file; give a file name")
+    check_output_file(path, TOOL, _is_report, force)
+
+
+def probe_out(path: str | Path) -> None:
+    """Create and remove a temporary file where the report will go (the first existing
+    folder on the way to ``path``, missing parents are created when the report is
+    written): catches what permission bits do not show (``/proc``, a read-only mount, a
+    full disk of inodes) before a long run rather than after it."""
+    check_writable("out", Path(os.path.abspath(path)).parent)
+
+
+def read_report(path: str | Path) -> dict[str, Any]:
+    """A report written by :func:`write_report` (for ``--compare``), checked to hold every
+    field :func:`format_comparison` reads; else one-line :class:`ParameterError`s naming
+    ``compare`` and what is wrong (missing, unreadable, not JSON, nested too deeply, not
+    a report of this tool, a field of the wrong type)."""
+    if not str(path):
+        raise ParameterError("compare: no file name given")
+    path = Path(path)
+    text = read_text_file(path, "compare")  # missing, permission, FIFO, size, UTF-8
+    try:
+        data = json.loads(text)
+    except RecursionError:
+        raise ParameterError(f"compare: {path} is not valid JSON (nested too deeply)") from None
+    except ValueError as exc:
+        message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ParameterError(f"compare: {path} is not valid JSON ({message})") from None
+    if not isinstance(data, dict) or data.get("tool") != TOOL:
+        raise ParameterError(f'compare: {path} is not a {TOOL} report (no "tool": "{TOOL}")')
+    problem = _layout_problem(data)
+    if problem:
+        raise ParameterError(f"compare: {path} is not a usable {TOOL} report: {problem}")
+    return data
+
+
+def _type_name(value: Any) -> str:
+    return {dict: "an object", list: "a list", str: "a string", bool: "a boolean"}.get(
+        type(value), "null" if value is None else "a number"
+    )
+
+
+def _positive_number(value: Any) -> bool:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return False
+    try:
+        return math.isfinite(float(value)) and value > 0
+    except OverflowError:  # an integer beyond float
+        return False
+
+
+def _entries_problem(data: dict[str, Any], key: str, fields: dict[str, str]) -> str | None:
+    """What is wrong with ``data[key]`` as a list of objects with ``fields`` (name ->
+    "text" or "number"; a number must be finite and > 0); None if nothing."""
+    entries = data.get(key, [])
+    if not isinstance(entries, list):
+        return f'"{key}" must be a list (got {_type_name(entries)})'
+    for i, entry in enumerate(entries):
+        if not isinstance(entry, dict):
+            return f'"{key}"[{i}] must be an object (got {_type_name(entry)})'
+        for name, kind in fields.items():
+            value = entry.get(name)
+            if kind == "text" and not isinstance(value, str):
+                return f'"{key}"[{i}].{name} must be a string (got {_type_name(value)})'
+            if kind == "number" and not _positive_number(value):
+                got = shown(value) if isinstance(value, int | float) else _type_name(value)
+                return f'"{key}"[{i}].{name} must be a number > 0 (got {got})'
+    return None
+
+
+def _layout_problem(data: dict[str, Any]) -> str | None:
+    """The first field :func:`format_comparison` would trip over, or None."""
+    if not isinstance(data.get("config"), dict):
+        return f'"config" must be an object (got {_type_name(data.get("config"))})'
+    if "rows" not in data:
+        return 'no "rows"'
+    problem = _entries_problem(data, "rows", {"label": "text", "step_us": "number"})
+    problem = problem or _entries_problem(data, "qp_classes", {"name": "text"})
+    problem = problem or _entries_problem(
+        data, "scenarios", {"controller": "text", "sim_seconds_per_wall_second": "number"}
+    )
+    if problem:
+        return problem
+    for i, entry in enumerate(data.get("qp_classes", [])):
+        if "rows" in entry:
+            rows = entry["rows"]
+            qp = rows.get("qp") if isinstance(rows, dict) else None
+            if not isinstance(qp, dict) or not _positive_number(qp.get("median_us")):
+                return f'"qp_classes"[{i}].rows.qp.median_us must be a number > 0'
+    return None
+
+
+def _is_report(path: Path) -> bool:
+    """Whether ``path`` is a report of this tool (a regular file of at most
+    :data:`ddwmmr.errors.MAX_INPUT_BYTES` is read; a device such as /dev/zero never)."""
+    try:
+        data = json.loads(read_text_file(path, "out"))
+    except (ParameterError, ValueError, RecursionError):
+        return False
+    return isinstance(data, dict) and data.get("tool") == TOOL

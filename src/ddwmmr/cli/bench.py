@@ -1,0 +1,219 @@
+"""``python -m ddwmmr.bench`` (console script ``ddwmmr-bench``): the benchmark's command
+line (:mod:`ddwmmr.bench` measures; docs/api.md, "Benchmark", explains the method)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from ddwmmr.bench.baseline import NAIVE_LABEL
+from ddwmmr.bench.methods import EXTRA_CASES
+from ddwmmr.bench.report import (
+    check_out,
+    format_comparison,
+    format_table,
+    probe_out,
+    read_report,
+    write_report,
+)
+from ddwmmr.bench.run import MAX_CALLS, MAX_REPEATS, check_duration, run_benchmark
+from ddwmmr.bench.scenarios import SCENARIO_CONTROLLERS, SCENARIO_COUNT
+from ddwmmr.cli.common import ArgumentParser, run_main
+from ddwmmr.controllers.base import available_methods
+from ddwmmr.errors import MAX_JOBS, MAX_SCENARIOS, MAX_STEPS, ParameterError
+from ddwmmr.trajectories import Ellipse
+from ddwmmr.trajectories.base import resolution_step
+
+DESCRIPTION = """\
+Time every control method step by step and in full runs, and the qp step by state class
+and phase against its naive twin and roboticstoolbox-python's holistic QP step (install
+with pip install -e '.[bench]'). Prints a table and writes the report to --out.
+"""
+
+
+class _Parser(ArgumentParser):
+    """The tools' parser (one-line errors, negative numbers in any notation) with the
+    prefix ``bench: error: ...`` (exit status 2)."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(2, f"bench: error: {message}\n")
+
+
+def _integer(low: int, high: int | None = None) -> Callable[[str], int]:
+    """An argparse type: an integer >= ``low`` (and <= ``high``)."""
+    allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = low - 1
+        if value < low or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"must be an integer {allowed} (got {text!r})")
+        return value
+
+    return parse
+
+
+_repeat_count = _integer(1, MAX_REPEATS)
+_call_count = _integer(1, MAX_CALLS)
+_job_count = _integer(1, MAX_JOBS)
+_scenario_count = _integer(0, MAX_SCENARIOS)
+
+
+def _seconds(low: float, high: float) -> Callable[[str], float]:
+    """An argparse type: a finite number; the range [``low``, ``high``] s is stated when the
+    text is not one (:func:`check_duration` then checks the range itself)."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not math.isfinite(value):
+            raise argparse.ArgumentTypeError(
+                f"must be a number in [{low:g}, {high:g}] s (got {text!r})"
+            )
+        return value
+
+    return parse
+
+
+def method_names() -> list[str]:
+    """What ``--method`` accepts: the registered methods and the extra rows."""
+    return sorted(set(available_methods()) | {extra.label for extra in EXTRA_CASES})
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``python -m ddwmmr.bench`` argument parser."""
+    parser = _Parser(
+        prog="python -m ddwmmr.bench",
+        description=DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    ellipse = Ellipse()
+    dt = resolution_step(ellipse)
+    parser.add_argument(
+        "--repeats",
+        type=_repeat_count,
+        default=5,
+        metavar="N",
+        help=f"repeats (default 5, at most {MAX_REPEATS})",
+    )
+    parser.add_argument(
+        "--calls",
+        type=_call_count,
+        default=500,
+        metavar="N",
+        help=f"states per timing (default 500, at most {MAX_CALLS})",
+    )
+    parser.add_argument(
+        "--duration",
+        type=_seconds(dt, MAX_STEPS * dt),
+        default=None,
+        metavar="S",
+        help=f"simulated time of each full run in s (default: one trajectory period, "
+        f"{ellipse.duration:g}; {dt:g} to {MAX_STEPS * dt:g}: 1 to {MAX_STEPS} steps of {dt:g} s)",
+    )
+    parser.add_argument(
+        "--method",
+        action="append",
+        dest="methods",
+        metavar="NAME",
+        help=f"measure only this method (and its extra rows; the {NAIVE_LABEL} baseline is "
+        f"always measured); repeatable or comma separated; one of "
+        f"{', '.join(method_names())} (default: all)",
+    )
+    parser.add_argument(
+        "--out", default="bench.json", metavar="FILE", help="report file (default bench.json)"
+    )
+    parser.add_argument(
+        "--force", action="store_true", help="replace --out even if it is not a bench report"
+    )
+    parser.add_argument(
+        "--compare",
+        metavar="FILE",
+        help="also print medians against an earlier report (read and checked before the run)",
+    )
+    parser.add_argument(
+        "--scenarios",
+        type=_scenario_count,
+        default=None,
+        metavar="N",
+        help=f"also time the first N benchmark scenarios with {' and '.join(SCENARIO_CONTROLLERS)} "
+        f"(simulated s per wall s; default {SCENARIO_COUNT} without --method, else 0; 0: skip; "
+        f"at most {MAX_SCENARIOS})",
+    )
+    parser.add_argument(
+        "--jobs",
+        type=_job_count,
+        default=None,
+        metavar="N",
+        help=f"worker processes of the scenario timing (default: the CPUs available; at most "
+        f"{MAX_JOBS}, and never more than the scenarios)",
+    )
+    parser.add_argument("--json", action="store_true", help="print the report as JSON")
+    parser.add_argument("--no-progress", action="store_true", help="no progress output on stderr")
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command-line entry point: print the table (or JSON) and write the report.
+
+    Ctrl-C and SIGTERM stop it with one line (exit 130 / 143), as for every tool."""
+    return run_main(_main, argv)
+
+
+def _main(argv: Sequence[str] | None = None) -> int:
+    """The tool; bad input prints one line and returns 2."""
+    args = build_parser().parse_args(argv)
+    if args.methods is not None:  # repeated and/or comma separated, as compare's --methods
+        empty = next((v for v in args.methods if not v.replace(",", "").strip()), None)
+        if empty is not None:
+            print(f"bench: error: --method: no name given (got {empty!r})", file=sys.stderr)
+            return 2
+        names = [n.strip() for v in args.methods for n in v.split(",") if n.strip()]
+        args.methods = list(dict.fromkeys(names))
+    unknown = sorted(set(args.methods or ()) - set(method_names()))
+    if unknown:
+        choices = ", ".join(method_names())
+        print(
+            f"bench: error: unknown method {unknown[0]!r} (choose from {choices})",
+            file=sys.stderr,
+        )
+        return 2
+    try:
+        # Everything that can be checked is checked before a minute-long run.
+        previous = read_report(args.compare) if args.compare is not None else None
+        out = Path(args.out)
+        check_out(out, force=args.force)
+        check_duration(Ellipse(), args.duration)
+        probe_out(out)
+        scenarios = args.scenarios
+        if scenarios is None:
+            scenarios = SCENARIO_COUNT if args.methods is None else 0
+        report = run_benchmark(
+            args.repeats,
+            args.calls,
+            args.duration,
+            args.methods,
+            progress=not args.no_progress,
+            scenarios=scenarios,
+            scenario_jobs=args.jobs,
+        )
+        write_report(report, out, force=args.force)
+    except ParameterError as exc:
+        print(f"bench: error: {exc}", file=sys.stderr)
+        return 2
+    print(json.dumps(report, indent=2) if args.json else format_table(report))
+    if previous is not None:
+        print(format_comparison(report, previous))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

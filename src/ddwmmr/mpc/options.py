@@ -1,0 +1,421 @@
+"""The ``mpc``'s options: one frozen :class:`MPCOptions`, checked when made, resolved
+against the plant's traits in one place (:meth:`MPCOptions.adopt_plant`).
+
+Options documented as "None: chosen for the plant" are filled in by
+:meth:`MPCOptions.adopt_plant`, once with no plant when the controller is built and again
+with the loop's plant (``adopt_plant(traits)`` of the controller protocol); the result is
+the options the controller runs with, every one of them a value, and the run's summary
+prints it whole (``mpc_options``, :meth:`MPCOptions.record`). The grid's and the cost's
+"None: per objective" options are filled in for the objective a run uses
+(:meth:`MPCOptions.grid`, :meth:`MPCOptions.weights`).
+"""
+
+from __future__ import annotations
+
+import copy
+import inspect
+from collections.abc import Sequence
+from dataclasses import dataclass, fields
+from typing import Any
+
+from ddwmmr.commands import FORCE, PlantTraits
+from ddwmmr.errors import (
+    ParameterError,
+    check_bool,
+    check_finite,
+    check_int_at_least,
+    check_nonnegative,
+    check_positive,
+    check_range,
+)
+from ddwmmr.model import Robot
+from ddwmmr.model import symbolic as sym
+from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
+from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT, FORCE_LIMIT_DEFAULT
+from ddwmmr.mpc.braking import BRAKE_SLACK
+from ddwmmr.mpc.ocp import MAX_HORIZON, MAX_INTERVALS, MIN_INTERVAL, Weights, grid_intervals
+from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS
+from ddwmmr.qp.limits import as_circles
+
+MODELS = ("kinematic", "thesis")
+#: Control step (s) when neither ``dt`` nor the trajectory's resolution is known.
+DEFAULT_DT = 0.02
+#: Defaults per objective: (intervals, first interval s, horizon s). Chosen by the horizon
+#: study in docs/mpc.md.
+GRID_DEFAULTS = {"tracking": (10, 0.05, 1.0), "reach": (12, 0.05, 5.0)}
+#: Default position weight per objective (1/(m^2 s)).
+POSITION_WEIGHTS = {"tracking": 100.0, "reach": 50.0}
+#: Huber scale (m) of the position error in waypoint mode when ``huber`` is not given.
+REACH_HUBER = 0.01
+
+
+@dataclass(frozen=True)
+class BaseFacts:
+    """What the force-level model takes from its plant's traits (None: the thesis plant's
+    value, ``ddwmmr.plants.thesis``).
+
+    Attributes:
+        damping: ``(c1 N s/m, c2 N m s/rad)``.
+        force_limit: each wheel's largest traction force (N).
+        lever: each wheel force's lever about the base centre (m).
+    """
+
+    damping: tuple[float, float] | None = None
+    force_limit: float | None = None
+    lever: float | None = None
+
+    @classmethod
+    def of(cls, plant: PlantTraits | None, force_limit: float | None) -> BaseFacts:
+        """The facts ``plant`` states (none for an unknown plant) with the wheel force
+        ``force_limit`` (N) the model plans with."""
+        if plant is None:
+            return cls(force_limit=force_limit)
+        return cls(plant.base_damping, force_limit, plant.wheel_lever)
+
+    def dynamics(self, robot: Robot) -> sym.ThesisDynamics:
+        """The force-level model of ``robot`` on a base with these facts."""
+        c1, c2 = self.damping if self.damping is not None else (C1_DEFAULT, C2_DEFAULT)
+        force = self.force_limit if self.force_limit is not None else FORCE_LIMIT_DEFAULT
+        return sym.ThesisDynamics.from_robot(robot, c1, c2, force, half_width=self.lever)
+
+
+def planned_force(plant: PlantTraits | None) -> float:
+    """The wheel force (N) the force model plans with by default on ``plant``: the plant's
+    own limit where the model is the plant's (the thesis plant), the thesis's 10 N, within
+    the motors, on a plant that judges tipping by its physics (and 10 N on a plant that
+    does not say, or before the plant is known). On MuJoCo the motors' full 20.5 N tipped
+    the robot in 26 of 100 scenarios (the wheels lift and spin where the model has them
+    rolling; docs/mpc.md), against 3 with 10 N, both before the brakeable last node and the
+    braking step (with them 10 N tips none)."""
+    motors = None if plant is None else plant.wheel_force_limit
+    if motors is None:
+        return FORCE_LIMIT_DEFAULT
+    return min(FORCE_LIMIT_DEFAULT, motors) if plant.judges_tipping else motors  # type: ignore[union-attr]
+
+
+@dataclass(frozen=True)
+class MPCOptions:
+    """Options of the nonlinear MPC (method ``mpc``), each checked when the object is made.
+
+    Attributes:
+        model: ``"kinematic"`` (velocity commands, the kinematic plant) or ``"thesis"``
+            (wheel forces, the thesis plant's force-level dynamics; needs the measured base
+            velocities, ``base_velocity=(v, w)``); None (default): chosen for the plant
+            (:meth:`adopt_plant`: ``"thesis"`` on a plant that takes wheel forces and
+            judges tipping by its physics, or when ``dynamic_stability``,
+            ``arm_time_constant``, ``joint_acceleration_limit`` or ``wheel_force_limit``
+            asks for it, else ``"kinematic"``).
+        stability_min: floor S_min of the tip-over margin (hard, exact at every node).
+        manipulability_weight: weight of ``cos^2 th2`` (soft).
+        obstacles: circles (``Circle`` or (x, y, radius) triples, m) or a TOML file path,
+            kept as a tuple of circles; the base's enclosing circle keeps
+            ``obstacle_margin`` (m) from each.
+        track_orientation: cost on the end-effector orientation (tracking).
+        horizon, intervals, first_interval: the grid (s, count, s); None: per objective,
+            :data:`GRID_DEFAULTS` (:meth:`grid`).
+        solver: ``"rti"`` (one Gauss-Newton iteration per step, default), ``"sqp"``
+            (iterated Gauss-Newton), ``"ipopt"``, ``"sqpmethod"`` or ``"fatrop"``.
+        qp_solver: QP backend of ``rti``/``sqp`` (``"hpipm"`` default).
+        position_weight, orientation_weight, input_weight: cost weights (see
+            :class:`ddwmmr.mpc.ocp.Weights`; position None: per objective,
+            :data:`POSITION_WEIGHTS`); huber: Huber scale (m) of position errors (None:
+            :data:`REACH_HUBER` in waypoint mode, none when tracking).
+        reach_speed: waypoint mode: m/s converting the distance left at the end of the
+            horizon into seconds.
+        proximal: damping of the input steps between two solves (see
+            :class:`ddwmmr.mpc.solvers.GaussNewtonSQP`).
+        stability_margin: the OCP keeps ``S >= stability_min + stability_margin``.
+        dynamic_stability: hold the floor on the zero moment point too, the centre of
+            pressure with the inertial forces of turning and accelerating
+            (``model="thesis"`` only; docs/mpc.md), besides the static centre of mass; None
+            (default): on exactly when the force model runs on a physics plant.
+        arm_time_constant: the joints follow the commanded rates with this first-order lag
+            (s) in the prediction (``model="thesis"`` only; the physics plant's joint
+            servos have one); None (default): that plant's lag when the force model runs on
+            a physics plant, else none; 0: none (the joints move at the commanded rates at
+            once).
+        joint_acceleration_limit: bound (rad/s^2) on the lagged joints' accelerations, one
+            number for both or (shoulder, elbow), kept as the pair (with the lagged arm
+            only: the physics plant's servos are torque-limited); None (default): that
+            plant's (``PlantTraits.joint_acceleration_limit``) when the lagged arm runs on
+            a physics plant, else none; 0 (kept as ``()``): none.
+        wheel_force_limit: per-wheel traction force (N) the force model plans with
+            (``model="thesis"`` only), at most the plant's motors
+            (``PlantTraits.wheel_force_limit``; more is refused when the loop hands over the
+            plant's traits); None (default): :func:`planned_force`, the thesis plant's own
+            limit there, the thesis's 10 N on a physics plant.
+        brake_slack: when the plan needs more slack in its stability rows than this (m,
+            in the box on the centre of mass and the zero moment point; 0 or in [1e-4, 1])
+            while the robot moves, the step brakes instead
+            (:func:`ddwmmr.mpc.braking.braking_input`: base and arm slowed within the force
+            and acceleration limits), counted in ``mpc_brakes``; only with the lagged arm
+            and a joint acceleration limit; None (default): :data:`BRAKE_SLACK` (5 mm)
+            there, else off; 0: off.
+        obstacle_margin: clearance (m) of the base's enclosing circle from each obstacle.
+        dt: control step (s); None (default): the loop's control step
+            (``adopt_control_step``), else the trajectory's ``duration / samples`` at
+            reset, else :data:`DEFAULT_DT`.
+        fallback_options: options of the ``qp`` fallback controller (merged over the
+            defaults derived from these options).
+    """
+
+    model: str | None = None
+    stability_min: float = STABILITY_FLOOR
+    manipulability_weight: float = 0.5
+    obstacles: Sequence[Any] | str = ()
+    track_orientation: bool = True
+    horizon: float | None = None
+    intervals: int | None = None
+    first_interval: float | None = None
+    solver: str = "rti"
+    qp_solver: str = "hpipm"
+    position_weight: float | None = None
+    orientation_weight: float = 10.0
+    input_weight: float = 0.01
+    huber: float | None = None
+    reach_speed: float = 0.05
+    proximal: float = 0.01
+    stability_margin: float = 0.01
+    dynamic_stability: bool | None = None
+    arm_time_constant: float | None = None
+    joint_acceleration_limit: float | Sequence[float] | None = None
+    wheel_force_limit: float | None = None
+    brake_slack: float | None = None
+    obstacle_margin: float = 0.05
+    dt: float | None = None
+    fallback_options: dict[str, Any] | None = None
+
+    def __post_init__(self) -> None:
+        model, solver, qp_solver = self.model, self.solver, self.qp_solver
+        if model is not None and model not in MODELS:
+            raise ParameterError(f"model must be one of {', '.join(MODELS)} (got {model!r})")
+        if solver not in SOLVERS:
+            raise ParameterError(f"solver must be one of {', '.join(SOLVERS)} (got {solver!r})")
+        if qp_solver not in QP_SOLVERS:
+            raise ParameterError(
+                f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {qp_solver!r})"
+            )
+        lag = self.arm_time_constant
+        if lag is not None and lag != 0.0:
+            check_range("arm_time_constant", lag, 1e-3, 1.0, "s")
+        self._set("arm_time_constant", None if lag is None else float(lag))
+        self._set("joint_acceleration_limit", _acceleration_option(self.joint_acceleration_limit))
+        if self.wheel_force_limit is not None:
+            force = check_range("wheel_force_limit", self.wheel_force_limit, 0.1, 1e4, "N")
+            self._set("wheel_force_limit", force)
+            if model == "kinematic":
+                raise ParameterError("wheel_force_limit needs model='thesis'")
+        if self.brake_slack is not None:
+            brake = check_finite("brake_slack", self.brake_slack)
+            if brake != 0.0 and not 1e-4 <= brake <= 1.0:
+                raise ParameterError(
+                    f"brake_slack must be 0 (off) or in [0.0001, 1] m (got {self.brake_slack:g})"
+                )
+            self._set("brake_slack", brake)
+        if self.dynamic_stability is not None:
+            self._set("dynamic_stability", check_bool("dynamic_stability", self.dynamic_stability))
+        self.adopt_plant(None)  # the combinations that need the force model, plant aside
+        self._set("stability_min", check_stability_floor(self.stability_min))
+        self._set("obstacles", tuple(as_circles(self.obstacles)))
+        self._set("track_orientation", check_bool("track_orientation", self.track_orientation))
+        if self.dt is not None:
+            self._set("dt", check_positive("dt", self.dt))
+        for mode in GRID_DEFAULTS:
+            self.grid(mode)
+            self.weights(mode)
+        for name, check in (
+            ("huber", check_positive),
+            ("reach_speed", check_positive),
+            ("proximal", check_nonnegative),
+            ("stability_margin", check_nonnegative),
+            ("obstacle_margin", check_nonnegative),
+        ):
+            value = getattr(self, name)
+            if value is not None:
+                self._set(name, check(name, value))
+        self._set("fallback_options", dict(self.fallback_options or {}))
+
+    def _set(self, name: str, value: Any) -> None:
+        object.__setattr__(self, name, value)
+
+    # -- resolution ---------------------------------------------------------------------
+    def adopt_plant(self, plant: PlantTraits | None) -> MPCOptions:
+        """These options with every "None: chosen for the plant" filled in for ``plant``
+        (None: not known yet; combinations that need the plant are then let pass).
+
+        On a plant that takes wheel forces and judges tipping by its physics: the
+        force-level model, the floor on the dynamic margin and the plant's joint lag (the
+        static floor alone tipped 94 of 100 scenarios there, docs/mpc.md; likewise for
+        ``model="thesis"`` given there); elsewhere the kinematic model (the force model
+        when any force-model option is given: ``dynamic_stability``, a lag, a joint
+        acceleration bound or a wheel force), static floor, no lag. The force model's wheel
+        force is the one asked for (within the plant's motors), else
+        :func:`planned_force`. The lagged joints' accelerations are bounded as asked, else
+        by the physics plant's motors; the braking step is on (``brake_slack``) where the
+        lagged arm has that bound.
+
+        In the result ``arm_time_constant`` 0, ``joint_acceleration_limit`` ``()`` and
+        ``brake_slack`` 0 mean none, and ``wheel_force_limit`` is None for the kinematic
+        model (which has no wheel forces).
+        """
+        physics = plant is not None and plant.judges_tipping and FORCE in plant.interfaces
+        wants_force = (
+            bool(self.dynamic_stability)
+            or bool(self.arm_time_constant)
+            or bool(self.joint_acceleration_limit)
+            or self.wheel_force_limit is not None
+        )
+        model = self.model or ("thesis" if physics or wants_force else "kinematic")
+        suited = physics and model == "thesis"  # the force model on a physics plant
+        dynamic = self.dynamic_stability if self.dynamic_stability is not None else suited
+        lag = self.arm_time_constant
+        if lag is None:
+            lag = plant.joint_time_constant if suited else None  # type: ignore[union-attr]
+        accel = self.joint_acceleration_limit
+        if accel is None and suited:
+            accel = plant.joint_acceleration_limit  # type: ignore[union-attr]
+        if accel and not lag:
+            if plant is not None and self.joint_acceleration_limit:
+                raise ParameterError(
+                    "joint_acceleration_limit needs the lagged arm (arm_time_constant, or a "
+                    "physics plant's joint lag)"
+                )
+            accel = None  # the plant is not known yet (or has no lag): nothing to bound
+        if lag and model != "thesis":
+            raise ParameterError("arm_time_constant needs model='thesis'")
+        if dynamic and model != "thesis":
+            raise ParameterError(
+                "dynamic_stability needs model='thesis' (the kinematic model has no base "
+                "accelerations)"
+            )
+        force = self._planned_force(plant) if model == "thesis" else None
+        brakeable = bool(lag) and bool(accel)  # the braking step needs both
+        if self.brake_slack and not brakeable and plant is not None:
+            raise ParameterError(
+                "brake_slack needs the lagged arm with a joint acceleration limit (a physics "
+                "plant, or arm_time_constant and joint_acceleration_limit)"
+            )
+        braked = brakeable and self.brake_slack != 0.0
+        resolved = copy.copy(self)  # values taken from the plant are not options to check
+        for name, value in (
+            ("model", model),
+            ("dynamic_stability", dynamic),
+            ("arm_time_constant", lag or 0.0),
+            ("joint_acceleration_limit", accel or ()),
+            ("wheel_force_limit", force),
+            ("brake_slack", (self.brake_slack or BRAKE_SLACK) if braked else 0.0),
+        ):
+            resolved._set(name, value)
+        return resolved
+
+    def _planned_force(self, plant: PlantTraits | None) -> float:
+        """The wheel force (N) asked for, refused above the plant's motors, else
+        :func:`planned_force`."""
+        force = self.wheel_force_limit
+        if force is None:
+            return planned_force(plant)
+        motors = None if plant is None else plant.wheel_force_limit
+        if motors is not None and force > motors:
+            raise ParameterError(
+                f"wheel_force_limit must be <= the plant's motors, {motors:.4g} N per wheel "
+                f"(got {force:g})"
+            )
+        return force
+
+    def grid(self, mode: str) -> tuple[int, float, float]:
+        """``(intervals, first interval s, horizon s)`` of objective ``mode``
+        (``"tracking"`` or ``"reach"``), the options given else :data:`GRID_DEFAULTS`; a
+        short horizon with the default first interval gets uniform intervals. Checked
+        against the control step ``dt`` (else :data:`DEFAULT_DT`)."""
+        dt = self.dt or DEFAULT_DT
+        n0, h0, t0 = GRID_DEFAULTS[mode]
+        intervals, horizon = self.intervals, self.horizon
+        n = check_int_at_least(
+            "intervals", n0 if intervals is None else intervals, 2, MAX_INTERVALS
+        )
+        t = check_range(
+            "horizon", t0 if horizon is None else horizon, MIN_INTERVAL, MAX_HORIZON, "s"
+        )
+        if self.first_interval is None:
+            h = min(h0, max(t - dt, 1e-3) / max(int(n) - 1, 1))
+        else:
+            h = self.first_interval
+        if not t > dt:
+            raise ParameterError(f"horizon must be > the control step dt = {dt:g} s (got {t:g})")
+        grid_intervals(n, h, t)  # validates the count and the lengths (one-line errors)
+        return int(n), float(h), float(t)
+
+    def weights(self, mode: str) -> Weights:
+        """The cost weights of objective ``mode`` (the terminal cost only when tracking)."""
+        position = self.position_weight
+        return Weights(
+            position=check_nonnegative(
+                "position_weight", POSITION_WEIGHTS[mode] if position is None else position
+            ),
+            orientation=self.orientation_weight,
+            manipulability=self.manipulability_weight,
+            input=self.input_weight,
+            terminal=1.0 if mode == "tracking" else 0.0,
+        )
+
+    def huber_scale(self, mode: str) -> float | None:
+        """Huber scale (m) of objective ``mode``: ``huber``, else :data:`REACH_HUBER` in
+        waypoint mode and none when tracking."""
+        if self.huber is not None:
+            return self.huber
+        return REACH_HUBER if mode == "reach" else None
+
+    # -- reporting ----------------------------------------------------------------------
+    def record(self, mode: str, dt: float) -> dict[str, Any]:
+        """Every option with the value a run of objective ``mode`` at control step ``dt``
+        (s) uses (the grid, the position weight and the Huber scale of that objective), in
+        plain types for the run's summary."""
+        values = {f.name: getattr(self, f.name) for f in fields(self)}
+        intervals, first, horizon = self.grid(mode)
+        values.update(
+            intervals=intervals,
+            first_interval=min(first, (horizon - dt) / (intervals - 1)),
+            horizon=horizon,
+            position_weight=self.weights(mode).position,
+            huber=self.huber_scale(mode),
+            dt=dt,
+            obstacles=[(c.x, c.y, c.radius) for c in self.obstacles],  # type: ignore[union-attr]
+            joint_acceleration_limit=list(self.joint_acceleration_limit or ()),  # type: ignore[arg-type]
+        )
+        return values
+
+
+def _acceleration_option(value: Any) -> tuple[float, float] | tuple[()] | None:
+    """The ``joint_acceleration_limit`` option: None (not given), ``()`` (0: none) or
+    ``(shoulder, elbow)`` rad/s^2."""
+    if value is None or (isinstance(value, tuple) and not value):
+        return value
+    pair = value if isinstance(value, list | tuple) else (value, value)
+    if len(pair) != 2:
+        raise ParameterError(
+            f"joint_acceleration_limit must be one number or two (shoulder, elbow) in rad/s^2 "
+            f"(got {len(pair)} values)"
+        )
+    limits = tuple(float(check_nonnegative("joint_acceleration_limit", v)) for v in pair)
+    if limits == (0.0, 0.0):
+        return ()
+    for v in limits:
+        check_range("joint_acceleration_limit", v, 0.1, 1e4, "rad/s^2")
+    return limits  # type: ignore[return-value]
+
+
+def options_signature() -> inspect.Signature:
+    """The signature ``(self, robot, *, <every option with its default>)`` of the
+    controller's constructor: what :func:`ddwmmr.controllers.base.method_options` and the
+    app read (each option's default and annotation, as :class:`MPCOptions` has them)."""
+    keyword = inspect.Parameter.KEYWORD_ONLY
+    positional = inspect.Parameter.POSITIONAL_OR_KEYWORD
+    parameters = [
+        inspect.Parameter("self", positional),
+        inspect.Parameter("robot", positional, annotation="Robot"),
+    ]
+    parameters += [
+        inspect.Parameter(f.name, keyword, default=f.default, annotation=f.type)
+        for f in fields(MPCOptions)
+    ]
+    return inspect.Signature(parameters)

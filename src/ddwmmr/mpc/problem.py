@@ -1,0 +1,102 @@
+"""One OCP of the ``mpc`` controller with its solvers, terminal cost and warm-start shift."""
+
+from __future__ import annotations
+
+from collections.abc import Hashable
+
+import numpy as np
+
+from ddwmmr.model import Robot
+from ddwmmr.mpc import terminal
+from ddwmmr.mpc.cache import shared_ocp
+from ddwmmr.mpc.models import PredictionModel
+from ddwmmr.mpc.ocp import OCPConfig
+from ddwmmr.mpc.solvers import make_solver
+
+#: Gauss-Newton iterations of a cold start (first step, new target, after a fallback).
+COLD_ITERATIONS = 5
+
+
+class Problem:
+    """One OCP (:func:`ddwmmr.mpc.cache.shared_ocp`) with its solvers, terminal design and
+    warm-start shifting.
+
+    Args:
+        robot, choice, model, config: what the OCP is built from (see
+            :func:`~ddwmmr.mpc.cache.shared_ocp`).
+        solver, qp_solver, proximal: the ``mpc``'s solver options; a real-time iteration
+            (``"rti"``) starts cold with :data:`COLD_ITERATIONS` Gauss-Newton iterations.
+    """
+
+    def __init__(
+        self,
+        robot: Robot,
+        choice: Hashable,
+        model: PredictionModel,
+        config: OCPConfig,
+        solver: str,
+        qp_solver: str,
+        proximal: float,
+    ) -> None:
+        self.robot, self.model = robot, model
+        self.ocp = shared_ocp(robot, choice, model, config)
+        self.solver = make_solver(solver, self.ocp, qp_solver, proximal=proximal)
+        self.cold = (
+            make_solver("sqp", self.ocp, qp_solver, iterations=COLD_ITERATIONS)
+            if solver == "rti"
+            else self.solver
+        )
+        self.terminal_factor: np.ndarray | None = None
+
+    def design_terminal(self, arm_pose: tuple[float, float]) -> None:
+        """LQR terminal cost at the arm pose (tracking only)."""
+        if self.ocp.config.reach:
+            return
+        design = terminal.design(self.robot, self.model, self.ocp.config, arm_pose)
+        self.terminal_factor = design.factor
+
+    def _initial(self, x0: np.ndarray) -> np.ndarray:
+        ocp = self.ocp
+        node = np.concatenate([x0, [ocp.config.horizon]])[: ocp.nx]
+        return ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
+
+    def _shifted(self, warm: np.ndarray, elapsed: float, x0: np.ndarray) -> tuple:
+        """The previous solution moved ``elapsed`` s forward (linear interpolation)."""
+        ocp = self.ocp
+        xs, us = ocp.trajectories(warm)
+        old_horizon = ocp.horizon_of(warm)
+        horizon = old_horizon
+        if ocp.config.reach:
+            horizon = min(max(old_horizon - elapsed, ocp.config.min_horizon), ocp.config.horizon)
+        old_t = ocp.node_times(old_horizon)
+        new_t = ocp.node_times(horizon) + elapsed
+        xs = interpolate_rows(old_t, xs, new_t)
+        us = interpolate_rows(old_t[:-1], us, new_t[:-1])
+        if ocp.config.reach:
+            xs[:, -1] = horizon
+        xs[0, : ocp.nxm] = x0
+        return ocp.pack(xs, us), horizon
+
+    def solve(self, t, x0, references, u_prev, warm, warm_time) -> tuple[np.ndarray, int]:
+        """Solve from the shifted warm start (or cold); returns (w, iterations)."""
+        ocp = self.ocp
+        if warm is None:
+            guess, horizon, solver = self._initial(x0), ocp.config.horizon, self.cold
+        else:
+            guess, horizon = self._shifted(warm, max(0.0, t - warm_time), x0)
+            solver = self.solver
+        p = ocp.parameters(references, u_prev, self.terminal_factor, horizon_prev=horizon)
+        lbw, ubw = ocp.bounds(x0)
+        w = solver.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+        return w, solver.last_iterations
+
+
+def interpolate_rows(times: np.ndarray, rows: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """Rows (one per time, increasing) linearly interpolated at ``at``, held beyond the ends
+    (``np.interp`` on every column at once)."""
+    at = np.clip(at, times[0], times[-1])
+    upper = np.clip(np.searchsorted(times, at, side="right"), 1, len(times) - 1)
+    lower = upper - 1
+    span = times[upper] - times[lower]
+    weight = np.where(span > 0.0, (at - times[lower]) / np.where(span > 0.0, span, 1.0), 0.0)
+    return rows[lower] + weight[:, None] * (rows[upper] - rows[lower])

@@ -1,0 +1,353 @@
+"""Plug-in registries: the controllers, plants and arbiters every tool finds by name.
+
+A plug-in is one class in one file, registered by its kind's decorator right above it::
+
+    from ddwmmr.registry import register_controller
+
+    @register_controller("p-only")
+    class ProportionalOnly:
+        \"\"\"Task-space P control without feed-forward.\"\"\"  # the description
+        ...
+
+The name, the first line of the class docstring (its description) and the traits given to
+the decorator are what the tools list: ``track``, ``compare``, ``scenarios`` and ``bench``
+take their choices and their ``--help`` from here, and so does the GUI.
+:func:`ddwmmr.make_controller`, :func:`ddwmmr.plants.make_plant` and
+:func:`ddwmmr.arbiters.make_arbiter` build a plug-in by name. The decorators and their
+traits:
+
+* :func:`register_controller` (``tasks``: ``"tracking"``, following a trajectory, and/or
+  ``"waypoints"``, the scenario protocol's waypoint task, for which the class provides
+  ``waypoint_options(run)``, see :class:`ddwmmr.controllers.base.WaypointRun`;
+  ``interfaces``: the command interfaces it can send, ``"velocity"`` and/or ``"force"``;
+  ``arbiter``: True when it takes an ``arbiter`` option and reports the arbiter's state);
+* :func:`register_plant` (``interfaces``: the command interfaces it accepts; the decorator
+  sets the class attribute of that name);
+* :func:`register_arbiter` (no traits; built as ``cls(stability=..., manipulability=...)``,
+  plus ``seed=`` when its constructor takes one).
+
+Every decorator sets the class attribute ``name``. Where plug-ins come from:
+
+* built in: the modules of :data:`BUILTIN_MODULES`, in that order (the order of every
+  listing). Their decorators and docstrings are read from the source, without importing
+  the module: a module is imported when one of its plug-ins is built or its class is asked
+  for (importing the MuJoCo plant takes about 0.4 s, which listing the plants must not
+  cost). Their decorators therefore take literal arguments only;
+* other installed packages: the modules their ``ddwmmr.plugins`` entry points name;
+* one-file plug-ins: the modules named in the environment variable ``DDWMMR_PLUGINS``
+  (comma separated, importable from ``sys.path``);
+* any module imported before a registry is asked (registration happens on import).
+
+Entry points and ``DDWMMR_PLUGINS`` are imported the first time a registry is asked.
+"""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import inspect
+import os
+import threading
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from itertools import count
+from pathlib import Path
+from typing import Any
+
+from ddwmmr.errors import ParameterError
+
+#: The built-in plug-in modules, in listing order.
+BUILTIN_MODULES = (
+    "ddwmmr.thesis_controller",
+    "ddwmmr.controllers.resolved_rate",
+    "ddwmmr.controllers.clrrmc",
+    "ddwmmr.qp.controller",
+    "ddwmmr.mpc.controller",
+    "ddwmmr.plants.kinematic",
+    "ddwmmr.plants.thesis",
+    "ddwmmr.plants.mujoco.plant",
+    "ddwmmr.arbiters.state_machine",
+    "ddwmmr.arbiters.competitive",
+)
+#: Environment variable naming plug-in modules to import (comma separated).
+PLUGINS_VARIABLE = "DDWMMR_PLUGINS"
+#: Entry-point group of plug-in modules of other packages.
+ENTRY_POINT_GROUP = "ddwmmr.plugins"
+_PACKAGE = Path(__file__).parent
+
+
+@dataclass
+class Entry:
+    """One registered plug-in.
+
+    Attributes:
+        name: what the tools and the factories call it.
+        description: first line of its class docstring ("" without one).
+        traits: the decorator's keyword arguments over the kind's defaults.
+        module, qualname: where its class is defined.
+        cls: the class, None until its module is imported.
+    """
+
+    name: str
+    description: str
+    traits: dict[str, Any]
+    module: str
+    qualname: str
+    cls: type | None = None
+    order: tuple[int, int, int] = field(default=(1, 0, 0), repr=False)
+
+
+class Registry:
+    """The plug-ins of one kind, by name, in listing order.
+
+    Args:
+        kind: ``"controller"``, ``"plant"`` or ``"arbiter"`` (the decorator is
+            ``register_<kind>``).
+        label: the parameter named in errors (``"method"``, ``"plant"``, ``"arbiter"``).
+        defaults: the traits a decorator may give, with their defaults.
+        unknown: the one-line error for an unknown name, formatted with ``name`` and
+            ``known`` (the registered names, comma separated).
+        sets: traits the decorator also sets as class attributes.
+    """
+
+    def __init__(
+        self,
+        kind: str,
+        label: str,
+        defaults: Mapping[str, Any],
+        unknown: str,
+        sets: tuple[str, ...] = (),
+    ) -> None:
+        self.kind = kind
+        self.label = label
+        self.decorator = f"register_{kind}"
+        self.defaults = dict(defaults)
+        self.unknown = unknown
+        self.sets = sets
+        self._entries: dict[str, Entry] = {}
+
+    # -- registration -----------------------------------------------------------------
+    def register(self, name: str, **traits: Any) -> Callable[[type], type]:
+        """Class decorator: register the class under ``name`` with ``traits`` (see the
+        module docstring; ``description=`` overrides the docstring's first line)."""
+        description = traits.pop("description", None)
+        resolved = self._traits(name, traits)
+
+        def decorate(cls: type) -> type:
+            cls.name = name  # type: ignore[attr-defined]
+            for trait in self.sets:
+                setattr(cls, trait, resolved[trait])
+            with _LOCK:
+                self._add(cls, name, resolved, description)
+            return cls
+
+        return decorate
+
+    def _traits(self, name: str, given: Mapping[str, Any]) -> dict[str, Any]:
+        unknown = sorted(set(given) - set(self.defaults))
+        if unknown:
+            raise TypeError(
+                f"{self.decorator}({name!r}): unknown trait {unknown[0]!r} "
+                f"(known: {', '.join(self.defaults) or 'none'})"
+            )
+        resolved = {key: given.get(key, default) for key, default in self.defaults.items()}
+        # Lists become tuples: traits are compared and filtered as tuples.
+        return {k: tuple(v) if isinstance(v, list) else v for k, v in resolved.items()}
+
+    def _add(self, cls: type, name: str, traits: dict[str, Any], description: str | None) -> None:
+        entry = self._entries.get(name)
+        if entry is not None and (entry.module, entry.qualname) == (
+            cls.__module__,
+            cls.__qualname__,
+        ):
+            entry.cls = cls  # a built-in read from source, now imported (or reloaded)
+            return
+        if entry is not None:
+            raise ParameterError(
+                f"{self.label}: {name!r} is registered twice ({entry.module}.{entry.qualname} "
+                f"and {cls.__module__}.{cls.__qualname__})"
+            )
+        text = description if description is not None else _first_line(cls.__doc__)
+        self._entries[name] = Entry(
+            name, text, traits, cls.__module__, cls.__qualname__, cls, (1, next(_SEQUENCE), 0)
+        )
+
+    def unregister(self, name: str) -> None:
+        """Remove ``name`` (a plug-in registered for a while, e.g. by a test)."""
+        with _LOCK:
+            self._entries.pop(name, None)
+
+    # -- queries ----------------------------------------------------------------------
+    def names(self, **traits: Any) -> list[str]:
+        """Registered names in listing order; ``traits`` filter them: a trait whose value
+        is a tuple must contain the given value, any other must equal it."""
+        discover()
+        entries = sorted(self._entries.values(), key=lambda e: e.order)
+        return [e.name for e in entries if all(_has(e.traits, k, v) for k, v in traits.items())]
+
+    def entry(self, name: str) -> Entry:
+        """The entry of ``name``; an unknown name is a one-line :class:`ParameterError`
+        naming the registered ones."""
+        discover()
+        entry = self._entries.get(name) if isinstance(name, str) else None
+        if entry is None:
+            known = ", ".join(self.names())
+            raise ParameterError(self.unknown.format(name=name, known=known))
+        return entry
+
+    def load(self, name: str) -> type:
+        """The class registered as ``name`` (its module imported on first use)."""
+        entry = self.entry(name)
+        if entry.cls is None:
+            importlib.import_module(entry.module)
+            if entry.cls is None:  # the module did not register what its source says
+                raise RuntimeError(f"{entry.module} did not register {self.kind} {name!r}")
+        return entry.cls
+
+    def describe(self, name: str) -> str:
+        """The description of ``name`` (the first line of its class docstring)."""
+        return self.entry(name).description
+
+    def traits(self, name: str) -> dict[str, Any]:
+        """The traits of ``name`` (a copy)."""
+        return dict(self.entry(name).traits)
+
+
+def _has(traits: Mapping[str, Any], key: str, value: Any) -> bool:
+    have = traits[key]
+    return value in have if isinstance(have, tuple) else have == value
+
+
+def _first_line(doc: str | None) -> str:
+    lines = inspect.cleandoc(doc or "").splitlines()
+    return lines[0] if lines else ""
+
+
+#: The three registries (see the module docstring for their traits).
+CONTROLLERS = Registry(
+    "controller",
+    "method",
+    {"tasks": ("tracking",), "interfaces": ("velocity",), "arbiter": False},
+    "method: unknown method {name!r} (known: {known})",
+)
+PLANTS = Registry(
+    "plant",
+    "plant",
+    {"interfaces": ("velocity",)},
+    "plant must be one of {known} (got {name!r})",
+    sets=("interfaces",),
+)
+ARBITERS = Registry(
+    "arbiter",
+    "arbiter",
+    {},
+    "arbiter must be one of {known} (got {name!r})",
+)
+_REGISTRIES = {r.decorator: r for r in (CONTROLLERS, PLANTS, ARBITERS)}
+register_controller = CONTROLLERS.register
+register_plant = PLANTS.register
+register_arbiter = ARBITERS.register
+
+_LOCK = threading.RLock()
+_SEQUENCE = count()
+_discovered = False
+_discovering = False
+
+
+def discover() -> None:
+    """Find every plug-in once per process (see the module docstring): read the built-in
+    modules' decorators from source, then import the modules of the ``ddwmmr.plugins``
+    entry points and of ``DDWMMR_PLUGINS``. Other threads wait for it; within the thread
+    that runs it (a plug-in module asking a registry on import) it returns at once."""
+    global _discovered, _discovering
+    if _discovered:
+        return
+    with _LOCK:
+        if _discovered or _discovering:
+            return
+        _discovering = True
+        try:
+            _read_builtins()
+            for module in _plugin_modules():
+                _import_plugin(module)
+            _discovered = True  # a failure leaves it False: the next query fails alike
+        finally:
+            _discovering = False
+
+
+def _read_builtins() -> None:
+    """Entries for the built-in plug-ins, read from source, in listing order."""
+    for index, module in enumerate(BUILTIN_MODULES):
+        for line, decorator, name, traits, qualname, doc in _read_source(module):
+            registry = _REGISTRIES[decorator]
+            description = traits.pop("description", None)
+            resolved = registry._traits(name, traits)
+            entry = registry._entries.get(name)
+            if entry is None:
+                text = description if description is not None else _first_line(doc)
+                entry = registry._entries[name] = Entry(name, text, resolved, module, qualname)
+            entry.order = (0, index, line)
+
+
+def _read_source(module: str) -> list[tuple[int, str, str, dict[str, Any], str, str | None]]:
+    """``(line, decorator, name, traits, class name, docstring)`` of every registered class
+    of a built-in module, read from its file (the module is not imported)."""
+    path = _PACKAGE.joinpath(*module.split(".")[1:]).with_suffix(".py")
+    tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+    found = []
+    for node in tree.body:
+        if not isinstance(node, ast.ClassDef):
+            continue
+        for decorator in node.decorator_list:
+            if not isinstance(decorator, ast.Call):
+                continue
+            function = decorator.func
+            called = getattr(function, "id", None) or getattr(function, "attr", None)
+            if called not in _REGISTRIES:
+                continue
+            try:
+                (name,) = (ast.literal_eval(a) for a in decorator.args)
+                traits = {k.arg: ast.literal_eval(k.value) for k in decorator.keywords}
+            except ValueError:
+                raise TypeError(
+                    f"{path}:{decorator.lineno}: @{called}(...) takes literal arguments only "
+                    "(the registry reads built-in plug-ins from their source)"
+                ) from None
+            doc = ast.get_docstring(node)
+            found.append((node.lineno, called, name, traits, node.name, doc))
+    return found
+
+
+def _plugin_modules() -> list[str]:
+    """The modules named by the entry points and by ``DDWMMR_PLUGINS``."""
+    from importlib.metadata import entry_points  # ~50 ms to import: only when asked
+
+    modules = [point.value.partition(":")[0] for point in entry_points(group=ENTRY_POINT_GROUP)]
+    text = os.environ.get(PLUGINS_VARIABLE, "")
+    modules += [name.strip() for name in text.split(",") if name.strip()]
+    return list(dict.fromkeys(modules))
+
+
+def _import_plugin(module: str) -> None:
+    try:
+        importlib.import_module(module)
+    except ImportError as exc:
+        raise ParameterError(
+            f"{PLUGINS_VARIABLE}: cannot import plug-in module {module!r} ({exc})"
+        ) from None
+
+
+__all__ = [
+    "ARBITERS",
+    "BUILTIN_MODULES",
+    "CONTROLLERS",
+    "ENTRY_POINT_GROUP",
+    "PLANTS",
+    "PLUGINS_VARIABLE",
+    "Entry",
+    "Registry",
+    "discover",
+    "register_arbiter",
+    "register_controller",
+    "register_plant",
+]

@@ -1,0 +1,75 @@
+"""Worker process pools whose workers die with the process that started them.
+
+A pool's workers wait on a pipe for work. If their parent is killed outright (SIGKILL, a
+crash, an out-of-memory kill), nothing tells them to stop, and they would stay, orphaned,
+until the machine restarts. Every worker of :func:`process_pool` therefore runs
+:func:`die_with_parent` first:
+
+* on Linux the kernel sends it SIGKILL when its parent exits (``prctl(PR_SET_PDEATHSIG)``),
+  even while it is busy in C code;
+* on every platform a daemon thread waits on the parent's sentinel
+  (:func:`multiprocessing.parent_process`, closed by the operating system when the parent
+  ends) and ends the worker at once.
+
+Workers only compute and return results: they write no files, so ending them can leave
+nothing half-written.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import ctypes.util
+import multiprocessing
+import multiprocessing.connection
+import os
+import signal
+import sys
+import threading
+from concurrent.futures import ProcessPoolExecutor
+
+#: ``prctl`` option that asks for a signal when the parent exits (linux/prctl.h).
+PR_SET_PDEATHSIG = 1
+#: Exit status of a worker that outlived its parent (the parent is gone: nobody reads it).
+EXIT_ORPHANED = 1
+
+
+def process_pool(jobs: int) -> ProcessPoolExecutor:
+    """A pool of ``jobs`` worker processes that end when this process ends, however."""
+    return ProcessPoolExecutor(
+        max_workers=jobs, initializer=die_with_parent, initargs=(os.getpid(),)
+    )
+
+
+def die_with_parent(parent_pid: int) -> None:
+    """End this process when the process ``parent_pid`` that started it ends.
+
+    Runs first in every worker (a pool initializer). If the parent has already gone by
+    then, the worker ends here.
+    """
+    _ask_kernel_for_death_signal()
+    if os.getppid() != parent_pid:  # gone before the request above took effect
+        os._exit(EXIT_ORPHANED)
+    parent = multiprocessing.parent_process()
+    if parent is not None and parent.sentinel is not None:
+        watchdog = threading.Thread(
+            target=_exit_when_ready, args=(parent.sentinel,), name="ddwmmr-parent-watchdog"
+        )
+        watchdog.daemon = True
+        watchdog.start()
+
+
+def _ask_kernel_for_death_signal() -> bool:
+    """Linux: SIGKILL this process when its parent exits. False where unavailable."""
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        return libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+    except (OSError, AttributeError):  # no libc or no prctl: the watchdog still runs
+        return False
+
+
+def _exit_when_ready(sentinel: int) -> None:
+    """Block until the parent's sentinel is ready (the parent ended), then exit."""
+    multiprocessing.connection.wait([sentinel])
+    os._exit(EXIT_ORPHANED)

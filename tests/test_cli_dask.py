@@ -1,0 +1,103 @@
+"""``scenarios --executor dask``: schedulers the tests start on 127.0.0.1, worker counts,
+and signals (one line, Dask's own log lines silenced).
+
+Addresses that are not Dask schedulers (silent listeners, HTTP, garbage, tls/ucx without
+their setup): tests/test_cli_fuzz.py.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from ddwmmr.cli.scenarios import main as cli
+from ddwmmr.scenarios import executors
+from test_cli_signals import alive, children, staging, wait_for
+
+distributed = pytest.importorskip("distributed")
+FAST = ["--n", "2", "--time-limit", "3", "--no-progress", "--executor", "dask"]
+
+
+def test_a_scheduler_without_workers_is_refused_before_the_output(tmp_path, capsys):
+    with distributed.LocalCluster(
+        n_workers=0, processes=False, dashboard_address=None, protocol="tcp", host="127.0.0.1"
+    ) as cluster:
+        # 3 s: the scheduler must answer within it, even on a loaded machine
+        args = ["--scheduler", cluster.scheduler_address, "--connect-timeout", "3"]
+        status = cli([*FAST, *args, "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert err.strip() == (
+        f"error: scheduler: the Dask scheduler at {cluster.scheduler_address!r} has no "
+        "worker (none joined within 3 s)"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_scheduler_with_a_worker_runs_the_batch(tmp_path, capsys):
+    with distributed.LocalCluster(
+        n_workers=1, processes=False, dashboard_address=None, protocol="tcp", host="127.0.0.1"
+    ) as cluster:
+        status = cli(
+            [*FAST, "--scheduler", cluster.scheduler_address, "--out", str(tmp_path / "o")]
+        )
+    assert status == 0, capsys.readouterr().err
+    assert (tmp_path / "o" / "scenarios.csv").read_text().count("\n") == 3
+
+
+def test_workers_are_capped_to_the_scenarios(tmp_path, capsys, monkeypatch):
+    """``--jobs 256 --n 1`` starts one worker, not 256."""
+    started = []
+
+    class Recording(distributed.LocalCluster):
+        def __init__(self, **options):
+            started.append(options["n_workers"])
+            super().__init__(**{**options, "processes": False})
+
+    monkeypatch.setattr(distributed, "LocalCluster", Recording)
+    args = ["--n", "1", "--time-limit", "3", "--no-progress", "--executor", "dask"]
+    assert cli([*args, "--jobs", "256", "--out", str(tmp_path / "o")]) == 0
+    assert started == [1]
+    assert "(1 dask worker)" in capsys.readouterr().err
+    assert executors.run_many([], None, jobs=8) == []  # nothing to run: no worker at all
+
+
+@pytest.mark.parametrize(
+    ("signum", "status", "group"),
+    [(signal.SIGTERM, 143, False), (signal.SIGHUP, 129, True)],
+)
+def test_a_signal_during_a_dask_run_says_one_line(tmp_path, signum, status, group):
+    """SIGTERM to the tool, or a closed terminal's SIGHUP to its whole process group: the
+    scheduler and nannies in the tool would log every lost worker, the workers and
+    multiprocessing's resource tracker would die with messages of their own."""
+    process = subprocess.Popen(
+        [sys.executable, "-m", "ddwmmr.scenarios", "--n", "400", "--jobs", "2",
+         "--no-progress", "--executor", "dask", "--out", str(tmp_path / "out")],
+        cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        env={**os.environ, "MPLBACKEND": "Agg"}, start_new_session=True,
+    )  # fmt: skip
+    workers: set[int] = set()
+    try:
+        # two Dask workers and the resource tracker, then the batch under way
+        wait_for(lambda: len(children(process.pid)) >= 3 or process.poll() is not None)
+        wait_for(lambda: staging(tmp_path) or process.poll() is not None)
+        workers = children(process.pid)
+        time.sleep(0.5)
+        assert process.poll() is None, process.stderr.read()
+        if group:
+            os.killpg(process.pid, signum)
+        else:
+            process.send_signal(signum)
+        _, err = process.communicate(timeout=60)
+    finally:
+        process.kill()
+    assert process.returncode == status, err
+    assert len(err.strip().splitlines()) == 1 and "terminated" in err, err
+    assert list(Path(tmp_path).iterdir()) == []
+    wait_for(lambda: not any(alive(pid) for pid in workers), timeout=20)
