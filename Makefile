@@ -68,6 +68,7 @@ docs: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --force --snapshot docs/figures/gui_rectangle.png \
 		--method clrrmc-ts --traj rectangle
 	MPLBACKEND=Agg $(BIN)/python docs/competitive_figures.py
+	MPLBACKEND=Agg $(BIN)/python docs/bounds_figures.py
 
 # The figures of measured step times (machine-dependent: they change on every run), and the
 # MPC's figures (its horizon study plots step times; about 10 minutes).
