@@ -69,6 +69,7 @@ docs: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --force --snapshot docs/figures/gui_rectangle.png \
 		--method clrrmc-ts --traj rectangle
 	MPLBACKEND=Agg $(BIN)/python docs/competitive_figures.py
+	MPLBACKEND=Agg $(BIN)/python docs/bounds_figures.py
 
 # The documentation site: docs/*.md plus the API reference generated from the docstrings
 # (mkdocs.yml), built into site/ in strict mode (a broken link or anchor fails the build).

@@ -10,6 +10,7 @@ TOOLS = (
     ("ddwmmr.compare", "ddwmmr-compare", "every method on the same trajectories: HTML report"),
     ("ddwmmr.scenarios", "ddwmmr-scenarios", "the thesis's 100-scenario waypoint benchmark"),
     ("ddwmmr.bench", "ddwmmr-bench", "per-step latency and throughput of the controllers"),
+    ("ddwmmr.bounds", "ddwmmr-bounds", "the scenarios' minimum time, bracketed from both sides"),
     ("ddwmmr.gui", "ddwmmr-gui", "interactive simulator window (headless: --snapshot)"),
 )
 
@@ -39,7 +40,7 @@ def main(argv: list[str] | None = None) -> int:
     if arguments and arguments[0] not in ("-h", "--help"):
         print(
             f"python -m ddwmmr: error: no tool {arguments[0]!r}; run python -m ddwmmr.<tool> "
-            "(track, compare, scenarios, bench, gui)",
+            "(track, compare, scenarios, bench, bounds, gui)",
             file=sys.stderr,
         )
         return 2

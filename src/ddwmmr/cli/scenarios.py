@@ -305,6 +305,12 @@ def build_parser() -> ArgumentParser:
         metavar="S",
         help="mpc's prediction horizon in s (docs/mpc.md); the same as --option horizon=S",
     )
+    parser.add_argument(
+        "--bounds",
+        metavar="FILE",
+        help="a bounds.csv of python -m ddwmmr.bounds (same seed): the summary gives the "
+        "mean ratio of each scenario's time to its lower bound and best-known time",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     return parser  # fmt: skip
 
@@ -619,9 +625,17 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         scenarios = studies.obstacle_scenarios(scenarios)
     outcomes, wall = runner.run(scenarios, config, "scenarios")
     extra = {"seed": args.seed, "run": _record(args, config)}
+    if args.bounds_table is not None:
+        extra["bracket"] = {"bounds": args.bounds, **report.bracket(outcomes, args.bounds_table)}
     if config.controller == "mpc":
         extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
+    if args.bounds_table is not None:
+        b = summary["bracket"]
+        print(
+            f"mean ratio to the lower bound {b['mean_ratio_to_lower_bound']:.3f}, to the "
+            f"best-known time {b['mean_ratio_to_best_known']:.3f} ({args.bounds})"
+        )
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
@@ -719,11 +733,23 @@ def _record(args: argparse.Namespace, config: RunConfig) -> dict[str, Any]:
     return record
 
 
+def _bounds_table(args: argparse.Namespace, config: RunConfig):
+    """``--bounds``: the file's ``{scenario: (lower, best)}``, checked against the run."""
+    if args.bounds is None:
+        return None
+    from ddwmmr.bounds.batch import read_bounds_file
+
+    if args.study or args.obstacles:
+        raise ParameterError("bounds: only for the benchmark without a study or obstacles")
+    return read_bounds_file(args.bounds, args.seed, config.payload)
+
+
 def _main(argv: Sequence[str] | None = None) -> int:
     """Run the tool; bad input raises :class:`ParameterError`."""
     args = build_parser().parse_args(argv)
     args.argv = argv  # recorded in the summary
     config = config_from_arguments(args)
+    args.bounds_table = _bounds_table(args, config)
     fresh = args.out is None  # a default name: never replaces an earlier run
     out = first_free(default_out(), folder=True) if fresh else Path(args.out)
     check_output_folder(out, "scenarios", args.force, output_names(args, config))

@@ -45,6 +45,27 @@ def _mean_sd(values: np.ndarray) -> tuple[float, float]:
     return float(np.mean(values)), sd
 
 
+def bracket(outcomes: Sequence[Outcome], bounds: dict[int, tuple[float, float]]) -> dict:
+    """Each successful scenario's time over both ends of its physical-limit bracket
+    (``bounds``: ``{scenario: (lower_bound_s, best_known_s)}``, ``python -m
+    ddwmmr.bounds``): the mean ratios to the lower bound and to the best-known time, over
+    the scenarios that have the end (NaN if none)."""
+    to_lower, to_best = [], []
+    for o in outcomes:
+        m = o.metrics
+        lower, best = bounds.get(m["scenario"], (math.nan, math.nan))
+        if m["success"] and math.isfinite(lower) and lower > 0:
+            to_lower.append(m["time_s"] / lower)
+        if m["success"] and math.isfinite(best) and best > 0:
+            to_best.append(m["time_s"] / best)
+    return {
+        "mean_ratio_to_lower_bound": float(np.mean(to_lower)) if to_lower else math.nan,
+        "mean_ratio_to_best_known": float(np.mean(to_best)) if to_best else math.nan,
+        "scenarios_with_lower_bound": len(to_lower),
+        "scenarios_with_best_known": len(to_best),
+    }
+
+
 def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]:
     """Batch summary: failures, mean and sd of every metric, minimum stability, speed.
 
