@@ -14,7 +14,7 @@ from ddwmmr.controllers.base import StepInfo, register_controller
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
 from ddwmmr.model import Robot
-from ddwmmr.model.kinematics import AUX_ROWS
+from ddwmmr.model.kinematics import AUX_ROWS, whole_turns
 from ddwmmr.resolution import kernels
 
 #: An input ``(v, w, th1dot, th2dot)`` as floats (m/s, rad/s, rad/s, rad/s).
@@ -114,6 +114,15 @@ class ArtificialPotentialController(ResolvedRate):
         self.K1 = check_nonnegative("K1", K1)
         self.K2 = check_nonnegative("K2", K2)
         self.K3 = check_nonnegative("K3", K3)
+        self._turns = (0.0, 0.0)
+
+    def reset(self, trajectory: object, q0: np.ndarray) -> None:
+        """Count phi and th1 of the potential from the start's own turn: the whole turns
+        in ``q0``'s phi and th1 (beyond (-pi, pi]) are subtracted for the run, so a start
+        given whole turns apart is the same physical pose and gives the same run (a start
+        within (-pi, pi] subtracts nothing)."""
+        super().reset(trajectory, q0)
+        self._turns = (whole_turns(float(q0[2])), whole_turns(float(q0[3])))
 
     def law(self, t, q, pose_d, velocity_d) -> tuple[Input, bool]:
         """Pseudoinverse input plus the projected potential descent (K2 has no effect: th2
@@ -123,5 +132,8 @@ class ArtificialPotentialController(ResolvedRate):
         (v, w, t1, t2), singular = kernels.pseudoinverse(
             self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
         )
-        k = kernels.null_space_rate(phi, th1, 2.0 * self.K3 * phi, 2.0 * self.K1 * th1)
+        phi_turns, th1_turns = self._turns
+        k = kernels.null_space_rate(
+            phi, th1, 2.0 * self.K3 * (phi - phi_turns), 2.0 * self.K1 * (th1 - th1_turns)
+        )
         return (v, w + k, t1 - k, t2), singular

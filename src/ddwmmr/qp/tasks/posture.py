@@ -55,9 +55,13 @@ class PostureTask(Task):
         error[0], error[1], error[2] = self.targets(ctx)
 
     def targets(self, ctx: StepContext) -> tuple[float, float, float]:
-        """``-gain * (phi, th1, th2)`` (rad/s), each bounded by ``rate_limit``."""
+        """``-gain * (phi, th1, th2)`` (rad/s), each bounded by ``rate_limit``; the angles
+        count from the start's own turn (``ctx.start_turns``)."""
         gain, limit = self.gain, self.rate_limit
-        e0, e1, e2 = -gain * ctx.phi, -gain * ctx.th1, -gain * ctx.th2
+        turns_phi, turns_1, turns_2 = ctx.start_turns
+        e0 = -gain * (ctx.phi - turns_phi)
+        e1 = -gain * (ctx.th1 - turns_1)
+        e2 = -gain * (ctx.th2 - turns_2)
         if limit is None:
             return e0, e1, e2
         return bounded(e0, limit), bounded(e1, limit), bounded(e2, limit)
