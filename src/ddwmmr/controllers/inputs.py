@@ -2,14 +2,18 @@
 
 A NaN or an infinity in the configuration, the desired pose, the desired velocity or the
 time would otherwise come out of the closed-form methods as a NaN/inf command without a
-word (and the QP would count a fallback). :func:`check_inputs` turns it into a one-line
-:class:`~ddwmmr.errors.ParameterError` (a ``ValueError``) that names the argument.
+word (and the QP would count a fallback); so would a finite value too large for the
+arithmetic (``q = [1.7e308, ...]`` gave ``u = [-inf, inf, 0, -inf]``). :func:`check_inputs`
+turns either into a one-line :class:`~ddwmmr.errors.ParameterError` (a ``ValueError``)
+that names the argument: every entry of ``q``, ``pose_d`` and ``velocity_d`` must be
+finite with magnitude at most :data:`MAX_INPUT_MAGNITUDE`. With it and the gains capped
+(:data:`ddwmmr.gains.MAX_GAIN`) every method's command is finite.
 
-It runs every control step, so the common case (everything finite) is one sum over the
-values: a sum is finite only if every term is finite. Only when it is not (or when the
-arguments are not flat numeric sequences) does the slow path look at each argument, which
-also clears sums that merely overflowed. It returns the arguments as lists of floats, which
-the closed-form controllers work with anyway (one conversion instead of two).
+It runs every control step, so the common case is one sum and a min and a max over the
+values: a sum is finite only if every term is finite. Only when the check fails (or when
+the arguments are not flat numeric sequences) does the slow path look at each argument,
+which also clears sums that merely overflowed. It returns the arguments as lists of
+floats, which the closed-form controllers work with anyway (one conversion instead of two).
 """
 
 from __future__ import annotations
@@ -28,6 +32,11 @@ _ARGUMENTS = (
     ("velocity_d", 3, "[xEdot, yEdot, phiEdot] (m/s, rad/s)"),
 )
 
+
+#: Largest magnitude of any entry of q, pose_d, velocity_d (m, rad, m/s, rad/s): a
+#: thousand times the largest trajectory coordinate or heading a file may hold (1e6), far
+#: from where squares and products of the entries overflow.
+MAX_INPUT_MAGNITUDE = 1e9
 
 Lists = tuple[list[float], list[float], list[float]]
 _isfinite = math.isfinite
@@ -48,7 +57,14 @@ def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
     try:
         ql, pl, vl = q.tolist(), pose_d.tolist(), velocity_d.tolist()
         values = ql + pl + vl
-        if len(values) == 11 and len(ql) == 5 and len(pl) == 3 and _isfinite(sum(values, t)):
+        if (
+            len(values) == 11
+            and len(ql) == 5
+            and len(pl) == 3
+            and _isfinite(sum(values, t))
+            and min(values) >= -MAX_INPUT_MAGNITUDE
+            and max(values) <= MAX_INPUT_MAGNITUDE
+        ):
             return ql, pl, vl
     except (AttributeError, TypeError):
         pass
@@ -80,4 +96,9 @@ def _check_each(t: Any, q: Any, pose_d: Any, velocity_d: Any) -> None:
         if not np.all(np.isfinite(array)):
             raise ParameterError(
                 f"{name} must be {size} finite numbers {entries} (got {array.tolist()})"
+            )
+        if np.max(np.abs(array)) > MAX_INPUT_MAGNITUDE:
+            raise ParameterError(
+                f"{name} must be {size} numbers {entries} of magnitude at most "
+                f"{MAX_INPUT_MAGNITUDE:g} (got {array.tolist()})"
             )

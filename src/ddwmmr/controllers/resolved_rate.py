@@ -12,7 +12,8 @@ import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register_controller
 from ddwmmr.controllers.inputs import check_inputs
-from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import AUX_ROWS, whole_turns
 from ddwmmr.resolution import kernels
@@ -111,9 +112,9 @@ class ArtificialPotentialController(ResolvedRate):
         self, robot: Robot, K1: float = 1.0, K2: float = 0.25, K3: float = 0.66, **kwargs
     ) -> None:
         super().__init__(robot, **kwargs)
-        self.K1 = check_nonnegative("K1", K1)
-        self.K2 = check_nonnegative("K2", K2)
-        self.K3 = check_nonnegative("K3", K3)
+        self.K1 = check_gain("K1", K1, zero=True)
+        self.K2 = check_gain("K2", K2, zero=True)
+        self.K3 = check_gain("K3", K3, zero=True)
         self._turns = (0.0, 0.0)
 
     def reset(self, trajectory: object, q0: np.ndarray) -> None:

@@ -32,6 +32,7 @@ from ddwmmr.errors import (
     load_toml,
     shown,
 )
+from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
@@ -235,7 +236,7 @@ class ObstacleLimit(Limit):
             raise ParameterError(
                 f"obstacle influence must be > margin ({margin:g} m) (got {influence:g})"
             )
-        self.gain = check_positive("obstacle gain", gain)
+        self.gain = check_gain("obstacle gain", gain)
         r, lw, limit = robot.wheel_radius, robot.track_width, robot.wheel_speed_limit
         self.v_max, self.w_max = r * limit, 2.0 * r * limit / lw
 
