@@ -178,7 +178,8 @@ def read_text_file(path: str | Path, label: str) -> str:
 
     The file is checked with ``os.stat`` before it is opened, so a FIFO, a device or a
     folder is refused instead of blocking or failing; files above :data:`MAX_INPUT_BYTES`
-    are refused too. ``label`` names the option in the message.
+    are refused too. ``label`` names the option in the message. A UTF-8 byte-order mark at
+    the start is not part of the text.
     """
     path = Path(path)
     try:
@@ -198,7 +199,7 @@ def read_text_file(path: str | Path, label: str) -> str:
     except OSError as exc:
         raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
     try:
-        return data.decode("utf-8")
+        return data.decode("utf-8-sig")  # a leading byte-order mark (some editors') dropped
     except UnicodeDecodeError as exc:
         raise ParameterError(
             f"{label}: {path} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
