@@ -99,12 +99,23 @@ class DaqpBackend:
         return x
 
 
+#: Solvers given sparse matrices although they take dense ones: ProxQP's dense backend, in
+#: the AVX2/AVX-512 builds proxsuite loads on such CPUs, returns results that differ in
+#: the last bits from call to call on the same problem (its vectorised loops depend on
+#: where its workspace lands in memory), so a run was not repeatable; its sparse backend
+#: is (see docs/qp.md, Solvers).
+SPARSE_FOR_REPEATABILITY = frozenset({"proxqp"})
+
+
 class QpsolversBackend:
-    """Any qpsolvers backend through :func:`qpsolvers.solve_qp` (sparse where it wants)."""
+    """Any qpsolvers backend through :func:`qpsolvers.solve_qp` (sparse where it wants,
+    and for :data:`SPARSE_FOR_REPEATABILITY`)."""
 
     def __init__(self, solver: str, warm_start: bool = True) -> None:
         self.name = self.solver = check_solver(solver)
-        self.sparse = solver in qpsolvers.sparse_solvers and solver not in qpsolvers.dense_solvers
+        self.sparse = solver in SPARSE_FOR_REPEATABILITY or (
+            solver in qpsolvers.sparse_solvers and solver not in qpsolvers.dense_solvers
+        )
         self.warm_start = warm_start
         self._previous: np.ndarray | None = None
 
