@@ -77,6 +77,10 @@ FILES = {
     "traj_underscore.csv": b"t,x,y\n0,2,0\n1_0,2,1\n20,2,2\n",
     "traj_arabic_digit.csv": "t,x,y\n0,2,0\n\u0661,2,1\n2,2,2\n".encode(),
     "traj_hash_header.csv": b"# t,x,y\n0,2,0\n1,2,1\n2,2,2\n",
+    # 10 MB strings: each echoed whole in the one line before
+    "traj_huge_orientation.toml": b'shape = "ellipse"\norientation = "' + b"x" * 10**7 + b'"\n',
+    "traj_huge_key.toml": b'shape = "ellipse"\n' + b"k" * 10**7 + b" = 1\n",
+    "robot_huge_string.toml": b'L1 = "' + b"x" * 10**7 + b'"\n',
     "obstacle_at_start.toml": b"[[obstacle]]\nx = 2.0\ny = 0.0\nradius = 0.5\n",
     "obstacle_far.toml": b"[[obstacle]]\nx = 1e9\ny = 0.0\nradius = 0.3\n",
     "obstacle_huge.toml": b"[[obstacle]]\nx = 5.0\ny = 0.0\nradius = 5000.0\n",
@@ -173,6 +177,9 @@ CASES += [
     ("track", ["--traj", "{traj_arabic_digit.csv}"], "data row 2, column t: '\u0661' is not a"),
     ("track", ["--traj", "{traj_hash_header.csv}"], "has no header line (its first line that"),
     ("compare", ["--only", "{traj_Phi.csv}"], "unknown column(s) 'Phi'"),
+    ("track", ["--traj", "{traj_huge_orientation.toml}"], "(got 'xxxxxxxxxxxxxxxxxxxxxxx"),
+    ("track", ["--traj", "{traj_huge_key.toml}"], "unknown key 'kkkkkkkkkkkkkkkkkkkkkkkk"),
+    ("track", ["--robot", "{robot_huge_string.toml}"], "L1 must be a number (got 'xxxxxxx"),
     # a payload that tips the robot in the start pose: refused by every tool, as by track
     ("track", ["--payload", "20"], "a 20 kg payload tips the robot over in this run's start"),
     ("compare", ["--payload", "50"], "a 50 kg payload tips the robot over in this run's start"),
@@ -343,6 +350,7 @@ def test_bad_input_one_line_exit_2_nothing_written(workdir, tool, args, text, ca
     assert len(lines) == 1, err
     assert "Traceback" not in err
     assert expand([text], workdir)[0] in lines[0]
+    assert len(lines[0]) < 2000  # echoed values are cut (a 10 MB string came out whole)
     assert tree(cwd) == before
 
 

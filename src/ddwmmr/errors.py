@@ -95,10 +95,10 @@ def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None 
         and float(value).is_integer()
     )
     if isinstance(value, bool | np.bool_) or not integral:
-        raise ParameterError(f"{name} must be an integer {allowed} (got {value!r})")
+        raise ParameterError(f"{name} must be an integer {allowed} (got {shown(value)})")
     number = int(value)
     if number < minimum or (maximum is not None and number > maximum):
-        raise ParameterError(f"{name} must be an integer {allowed} (got {value!r})")
+        raise ParameterError(f"{name} must be an integer {allowed} (got {shown(value)})")
     return number
 
 
@@ -139,7 +139,7 @@ def check_step_count(duration: float, dt: float) -> int:
 def check_number_type(name: str, value: Any) -> Any:
     """Reject values read from a file that are not numbers (strings, booleans, tables)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ParameterError(f"{name} must be a number (got {value!r})")
+        raise ParameterError(f"{name} must be a number (got {shown(value)})")
     return value
 
 
@@ -187,7 +187,7 @@ def read_text_file(path: str | Path, label: str) -> str:
     except OSError as exc:
         raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
     except ValueError:  # e.g. an embedded NUL byte
-        raise ParameterError(f"{label}: invalid file name {str(path)!r}") from None
+        raise ParameterError(f"{label}: invalid file name {shown(str(path))}") from None
     if not stat.S_ISREG(info.st_mode):
         raise ParameterError(f"{label}: {path} is not a regular file")
     if info.st_size > MAX_INPUT_BYTES:

@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import method_options
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import package_version
 from ddwmmr.trajectories.files import SHAPES, file_sha256
@@ -182,7 +182,7 @@ def trajectory_from_record(record: dict[str, Any]) -> Any:
                 f"rerun: the trajectory file {path} changed since the run (SHA-256 differs)"
             )
         return read_csv(path)
-    raise ParameterError(f"rerun: cannot rebuild a trajectory of type {kind!r}")
+    raise ParameterError(f"rerun: cannot rebuild a trajectory of type {shown(kind)}")
 
 
 @dataclass

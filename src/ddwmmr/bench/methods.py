@@ -15,6 +15,7 @@ import numpy as np
 from ddwmmr.bench.baseline import NAIVE_LABEL, NaivePseudoinverseController
 from ddwmmr.bench.timing import summarize_times, time_calls
 from ddwmmr.controllers.base import Controller, available_methods, make_controller
+from ddwmmr.errors import shown
 from ddwmmr.model import Robot
 from ddwmmr.progress import ProgressBar
 from ddwmmr.sim import simulate
@@ -101,7 +102,7 @@ def extra_factory(case: ExtraCase) -> Callable[[Robot], Controller] | str:
         return f"{module_name} not importable ({exc})"
     target = getattr(module, attribute, None)
     if target is None:
-        return f"{module_name} has no attribute {attribute!r}"
+        return f"{module_name} has no attribute {shown(attribute)}"
     reason = getattr(module, "unavailable_reason", lambda: None)()
     if reason:
         return reason

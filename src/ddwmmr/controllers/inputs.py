@@ -23,7 +23,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 
 #: (argument, expected length, what its entries are) of ``command(t, q, pose_d, velocity_d)``.
 _ARGUMENTS = (
@@ -81,9 +81,9 @@ def _check_each(t: Any, q: Any, pose_d: Any, velocity_d: Any) -> None:
     try:
         time = float(t)
     except (TypeError, ValueError):
-        raise ParameterError(f"t must be a finite time in s (got {t!r})") from None
+        raise ParameterError(f"t must be a finite time in s (got {shown(t)})") from None
     if not math.isfinite(time):
-        raise ParameterError(f"t must be a finite time in s (got {time!r})")
+        raise ParameterError(f"t must be a finite time in s (got {shown(time)})")
     for (name, size, entries), value in zip(_ARGUMENTS, (q, pose_d, velocity_d)):
         try:
             array = np.asarray(value, dtype=float)

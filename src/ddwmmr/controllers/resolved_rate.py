@@ -12,7 +12,7 @@ import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register_controller
 from ddwmmr.controllers.inputs import check_inputs
-from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.errors import ParameterError, check_positive, shown
 from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import AUX_ROWS, whole_turns
@@ -70,7 +70,7 @@ class ResolvedRate(ABC):
 def check_aux(aux: str) -> str:
     """Validate the auxiliary constraint name of the augmented task space."""
     if aux not in AUX_ROWS:
-        raise ParameterError(f"aux must be one of {', '.join(AUX_ROWS)} (got {aux!r})")
+        raise ParameterError(f"aux must be one of {', '.join(AUX_ROWS)} (got {shown(aux)})")
     return aux
 
 

@@ -19,7 +19,7 @@ from functools import cache
 from typing import Any
 
 from ddwmmr.controllers.base import make_controller
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 
 
 def _aux_rows() -> list[str]:
@@ -110,7 +110,7 @@ class OptionSpec:
                 if text == format_choice(choice):
                     return choice
             allowed = ", ".join(format_choice(c) for c in self.choices)
-            raise ParameterError(f"{self.name} must be one of {allowed} (got {text!r})")
+            raise ParameterError(f"{self.name} must be one of {allowed} (got {shown(text)})")
         if not text:
             if self.optional:
                 return None
@@ -125,17 +125,17 @@ class OptionSpec:
         try:
             numbers = [float(part) for part in re.split(r"[\s,]+", text) if part]
         except ValueError:
-            raise ParameterError(f"{self.name} must be a number (got {text!r})") from None
+            raise ParameterError(f"{self.name} must be a number (got {shown(text)})") from None
         if any(math.isnan(v) for v in numbers):
-            raise ParameterError(f"{self.name} must be a number (got {text!r})")
+            raise ParameterError(f"{self.name} must be a number (got {shown(text)})")
         if len(numbers) > 1:
             if not self.several:
-                raise ParameterError(f"{self.name} takes one number (got {text!r})")
+                raise ParameterError(f"{self.name} takes one number (got {shown(text)})")
             return tuple(numbers)
         (value,) = numbers
         if isinstance(self.default, int) and not isinstance(self.default, bool):
             if not value.is_integer():
-                raise ParameterError(f"{self.name} must be an integer (got {text!r})")
+                raise ParameterError(f"{self.name} must be an integer (got {shown(text)})")
             return int(value)
         return value
 

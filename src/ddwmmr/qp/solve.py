@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import qpsolvers
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.qp.limits.base import INF
 from ddwmmr.qp.problem import QPProblem
 
@@ -39,7 +39,7 @@ _BIG = 0.5 * INF
 def check_mode(mode: str) -> str:
     """Validate the ``mode`` option."""
     if mode not in MODES:
-        raise ParameterError(f"mode must be one of {', '.join(MODES)} (got {mode!r})")
+        raise ParameterError(f"mode must be one of {', '.join(MODES)} (got {shown(mode)})")
     return mode
 
 
@@ -47,7 +47,7 @@ def check_solver(solver: str) -> str:
     """Validate the ``solver`` option against the installed qpsolvers backends."""
     if solver not in qpsolvers.available_solvers:
         raise ParameterError(
-            f"solver must be one of {', '.join(qpsolvers.available_solvers)} (got {solver!r})"
+            f"solver must be one of {', '.join(qpsolvers.available_solvers)} (got {shown(solver)})"
         )
     return solver
 
@@ -177,7 +177,7 @@ def make_backend(solver: str, warm_start: bool | None = None):
     if solver not in installed:
         raise ParameterError(
             f"solver must be one of the installed QP solvers: {', '.join(installed)} "
-            f"(got {solver!r})"
+            f"(got {shown(solver)})"
         )
     if solver == "daqp":
         return DaqpBackend(warm_start=bool(warm_start))

@@ -35,7 +35,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.errors import ParameterError, check_number_type, load_toml
+from ddwmmr.errors import ParameterError, check_number_type, load_toml, shown
 from ddwmmr.trajectories.parametric import Ellipse, Rectangle
 from ddwmmr.trajectories.sampled import read_csv
 
@@ -87,7 +87,7 @@ def find_trajectory_file(name_or_path: str | Path) -> Path | None:
         if path.suffix not in SUFFIXES:
             known = ", ".join(available_trajectories())
             raise ParameterError(
-                f"traj: {text!r} is neither a trajectory name ({known}) nor a .toml/.csv path"
+                f"traj: {shown(text)} is neither a trajectory name ({known}) nor a .toml/.csv path"
             )
         if not os.path.lexists(path):
             raise ParameterError(f"traj: no such file {path}")
@@ -100,7 +100,7 @@ def find_trajectory_file(name_or_path: str | Path) -> Path | None:
     if text in SHAPES:
         return None
     raise ParameterError(
-        f"traj: unknown trajectory {text!r} "
+        f"traj: unknown trajectory {shown(text)} "
         f"(known: {', '.join(available_trajectories())}; or give a .toml/.csv path)"
     )
 
@@ -124,7 +124,7 @@ def find_obstacle_file(name_or_path: str | Path) -> Path:
             return candidate
     known = sorted({p.stem for f in trajectory_folders() for p in (f / "obstacles").glob("*.toml")})
     raise ParameterError(
-        f"obstacles: unknown obstacle file {text!r} (known: {', '.join(known) or 'none'}; "
+        f"obstacles: unknown obstacle file {shown(text)} (known: {', '.join(known) or 'none'}; "
         "or give a .toml path)"
     )
 
@@ -165,7 +165,7 @@ def read_toml(path: str | Path, **overrides):
     unknown = sorted(set(table) - set(known))
     if unknown:
         raise ParameterError(
-            f"traj: {path}: unknown key {unknown[0]!r} (known: shape, {', '.join(known)})"
+            f"traj: {path}: unknown key {shown(unknown[0])} (known: shape, {', '.join(known)})"
         )
     _check_types(path, table)
     try:
@@ -180,7 +180,7 @@ def _check_types(path: Path, table: dict[str, Any]) -> None:
     for key, value in table.items():
         if key in _STRING_KEYS:
             if not isinstance(value, str):
-                raise ParameterError(f"traj: {path}: {key} must be a string (got {value!r})")
+                raise ParameterError(f"traj: {path}: {key} must be a string (got {shown(value)})")
         else:
             try:
                 check_number_type(key, value)

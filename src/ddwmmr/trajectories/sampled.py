@@ -77,7 +77,9 @@ class SampledTrajectory:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
-            raise ParameterError(f"trajectory samples: name must be a string (got {self.name!r})")
+            raise ParameterError(
+                f"trajectory samples: name must be a string (got {shown(self.name)})"
+            )
         times = _float_array("times", self.times, "sample times (s)")
         points = _float_array("points", self.points, "an (n, 2) or (n, 3) array (m, rad)")
         if times.ndim != 1 or len(times) < 3:
@@ -248,7 +250,7 @@ def _check_steps(times: np.ndarray) -> None:
         row = int(np.argmax(steps <= 0)) + 2
         raise ParameterError(
             f"trajectory samples: times (column t) must be strictly increasing (row {row}: "
-            f"{float(times[row - 2])!r} then {float(times[row - 1])!r})"
+            f"{shown(float(times[row - 2]))} then {shown(float(times[row - 1]))})"
         )
     duration = float(times[-1] - times[0])
     low, high = DURATION_RANGE_S
@@ -320,7 +322,7 @@ def _csv_number(path: Path, number: int, row: dict, key: str) -> float:
         return float(text)
     except ValueError:
         raise ParameterError(
-            f"traj: {path} data row {number}, column {key}: {text.strip()!r} is not a number"
+            f"traj: {path} data row {number}, column {key}: {shown(text.strip())} is not a number"
         ) from None
 
 

@@ -61,7 +61,7 @@ def load_obstacles(path: str | Path) -> list[Circle]:
     unknown = sorted(set(data) - {"obstacle"})
     if unknown:
         raise ParameterError(
-            f"obstacles: {path}: unknown key {unknown[0]!r} (expected [[obstacle]])"
+            f"obstacles: {path}: unknown key {shown(unknown[0])} (expected [[obstacle]])"
         )
     if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables or [None]):
         raise ParameterError(f"obstacles: {path} needs [[obstacle]] tables with x, y, radius in m")
@@ -115,7 +115,8 @@ def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> li
             x, y, radius = item
         except (TypeError, ValueError):
             raise ParameterError(
-                f"obstacles must be Circle(x, y, radius) or (x, y, radius) triples (got {item!r})"
+                f"obstacles must be Circle(x, y, radius) or (x, y, radius) triples"
+                f" (got {shown(item)})"
             ) from None
         circles.append(Circle(x, y, radius))
     return circles
