@@ -135,7 +135,13 @@ def benchmark_cases(
     taken = {case.label for case in extra_cases}
     names = available_methods() if methods is None else list(dict.fromkeys(methods))
     cases = [BenchCase(NAIVE_LABEL, NaivePseudoinverseController, kind="baseline")]
-    cases += [BenchCase(name, _method_factory(name)) for name in names if name not in taken]
+    # an extra row's label is never a method of its own: a skipped one (its package is
+    # not installed) stays skipped, with its reason, instead of an "unknown method"
+    cases += [
+        BenchCase(name, _method_factory(name))
+        for name in names
+        if name not in taken and name not in skipped
+    ]
     return cases + extra_cases, skipped
 
 
