@@ -175,8 +175,11 @@ def trajectory_from_record(record: dict[str, Any]) -> Any:
         return SHAPES[kind](**decode(record["parameters"]))
     if kind == "samples":
         path = Path(record["file"])
-        if not path.is_file():
+        if not path.exists():
             raise ParameterError(f"rerun: the trajectory file {path} is gone")
+        if not path.is_file():  # checked before hashing: a FIFO would block the read
+            now = "a folder" if path.is_dir() else "not a regular file"
+            raise ParameterError(f"rerun: the trajectory file {path} is now {now}")
         if file_sha256(path) != record["sha256"]:
             raise ParameterError(
                 f"rerun: the trajectory file {path} changed since the run (SHA-256 differs)"

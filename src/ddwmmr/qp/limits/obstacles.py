@@ -37,6 +37,7 @@ from ddwmmr.model import Robot
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
+from ddwmmr.trajectories.files import find_obstacle_file
 
 
 @dataclass(frozen=True)
@@ -96,11 +97,13 @@ def within_limits(x: float, y: float, radius: float) -> Circle:
 
 
 def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> list[Circle]:
-    """Normalise the ``obstacles`` option: circles, (x, y, radius) triples, or a TOML path."""
+    """Normalise the ``obstacles`` option: circles, (x, y, radius) triples, or a TOML file:
+    a path, or a shipped or folder name such as ``ellipse_post`` looked up as ``track
+    --obstacles`` does (:func:`~ddwmmr.trajectories.files.find_obstacle_file`)."""
     if obstacles is None:
         return []
     if isinstance(obstacles, str | Path):
-        return load_obstacles(obstacles)
+        return load_obstacles(find_obstacle_file(obstacles))
     if not hasattr(obstacles, "__iter__"):
         raise ParameterError(
             f"obstacles must be circles, (x, y, radius) triples or a TOML file "
