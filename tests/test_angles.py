@@ -113,3 +113,11 @@ def test_track_accepts_a_large_rotation_in_a_trajectory_file(tmp_path, monkeypat
     assert track_main([*args, "--no-plots", "--no-progress", "--out", "out"]) == 0, (
         capsys.readouterr().err
     )
+
+
+def test_gui_accepts_a_large_rotation(tmp_path, monkeypatch, capsys):
+    from ddwmmr.cli.gui import main as gui_main
+
+    monkeypatch.chdir(tmp_path)
+    args = ["--snapshot", "s.png", "--duration", "0.2", "--dpi", "10", "--beta", "1e5"]
+    assert gui_main([*args, "--method", "clrrmc-ts"]) == 0, capsys.readouterr().err
