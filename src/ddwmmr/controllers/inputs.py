@@ -9,11 +9,13 @@ that names the argument: every entry of ``q``, ``pose_d`` and ``velocity_d`` mus
 finite with magnitude at most :data:`MAX_INPUT_MAGNITUDE`. With it and the gains capped
 (:data:`ddwmmr.gains.MAX_GAIN`) every method's command is finite.
 
-It runs every control step, so the common case is one sum and a min and a max over the
-values: a sum is finite only if every term is finite. Only when the check fails (or when
-the arguments are not flat numeric sequences) does the slow path look at each argument,
-which also clears sums that merely overflowed. It returns the arguments as lists of
-floats, which the closed-form controllers work with anyway (one conversion instead of two).
+It runs every control step, so the common case is one ``math.hypot`` over the values (as
+cheap as their sum): their norm is at most the bound only if every entry is finite and
+within it (a NaN makes the norm NaN, an infinity infinite). Only when the check fails (or
+when the arguments are not flat numeric sequences) does the slow path look at each
+argument, which also clears entries whose norm merely exceeds the bound. It returns the
+arguments as lists of floats, which the closed-form controllers work with anyway (one
+conversion instead of two).
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ MAX_INPUT_MAGNITUDE = 1e9
 
 Lists = tuple[list[float], list[float], list[float]]
 _isfinite = math.isfinite
+_hypot = math.hypot
 
 
 def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
@@ -61,9 +64,8 @@ def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
             len(values) == 11
             and len(ql) == 5
             and len(pl) == 3
-            and _isfinite(sum(values, t))
-            and min(values) >= -MAX_INPUT_MAGNITUDE
-            and max(values) <= MAX_INPUT_MAGNITUDE
+            and _isfinite(t)
+            and _hypot(*values) <= MAX_INPUT_MAGNITUDE
         ):
             return ql, pl, vl
     except (AttributeError, TypeError):
