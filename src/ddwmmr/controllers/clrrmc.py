@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register_controller
-from ddwmmr.controllers.inputs import check_inputs
+from ddwmmr.controllers.inputs import check_command, check_inputs
 from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
 from ddwmmr.errors import MAX_STEPS, ParameterError, check_positive, check_range
 from ddwmmr.gains import gains_from_tau
@@ -141,6 +141,7 @@ class ConfigurationSpaceController:
         """
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         u, residual = self._input(t, q)
+        check_command(u, q, pose_d)
         self.last = StepInfo(singular=self.reference.last_damped, nonholonomic_residual=residual)
         return np.array(u)
 

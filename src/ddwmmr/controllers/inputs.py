@@ -1,21 +1,20 @@
-"""Validation of the arguments of ``Controller.command`` shared by every method.
+"""Validation of the arguments of ``Controller.command`` shared by every method, and of
+the closed-form methods' result.
 
 A NaN or an infinity in the configuration, the desired pose, the desired velocity or the
 time would otherwise come out of the closed-form methods as a NaN/inf command without a
-word (and the QP would count a fallback); so would a finite value too large for the
-arithmetic (``q = [1.7e308, ...]`` gave ``u = [-inf, inf, 0, -inf]``). :func:`check_inputs`
-turns either into a one-line :class:`~ddwmmr.errors.ParameterError` (a ``ValueError``)
-that names the argument: every entry of ``q``, ``pose_d`` and ``velocity_d`` must be
-finite with magnitude at most :data:`MAX_INPUT_MAGNITUDE`. With it and the gains capped
-(:data:`ddwmmr.gains.MAX_GAIN`) every method's command is finite.
+word (and the QP would count a fallback). :func:`check_inputs` turns it into a one-line
+:class:`~ddwmmr.errors.ParameterError` (a ``ValueError``) that names the argument. Finite
+values too large for the arithmetic (``q = [1.7e308, ...]`` gave ``clrrmc-ts`` the command
+``[-inf, inf, 0, -inf]``) are the same error from :func:`check_command`, which the
+closed-form methods apply to their result; ``qp`` and ``mpc`` keep every limit and return
+a finite command at any finite state (tests/test_qp_limits_extreme.py).
 
-It runs every control step, so the common case is one ``math.hypot`` over the values (as
-cheap as their sum): their norm is at most the bound only if every entry is finite and
-within it (a NaN makes the norm NaN, an infinity infinite). Only when the check fails (or
-when the arguments are not flat numeric sequences) does the slow path look at each
-argument, which also clears entries whose norm merely exceeds the bound. It returns the
-arguments as lists of floats, which the closed-form controllers work with anyway (one
-conversion instead of two).
+It runs every control step, so the common case (everything finite) is one sum over the
+values: a sum is finite only if every term is finite. Only when it is not (or when the
+arguments are not flat numeric sequences) does the slow path look at each argument, which
+also clears sums that merely overflowed. It returns the arguments as lists of floats, which
+the closed-form controllers work with anyway (one conversion instead of two).
 """
 
 from __future__ import annotations
@@ -35,14 +34,8 @@ _ARGUMENTS = (
 )
 
 
-#: Largest magnitude of any entry of q, pose_d, velocity_d (m, rad, m/s, rad/s): a
-#: thousand times the largest trajectory coordinate or heading a file may hold (1e6), far
-#: from where squares and products of the entries overflow.
-MAX_INPUT_MAGNITUDE = 1e9
-
 Lists = tuple[list[float], list[float], list[float]]
 _isfinite = math.isfinite
-_hypot = math.hypot
 
 
 def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
@@ -60,13 +53,7 @@ def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
     try:
         ql, pl, vl = q.tolist(), pose_d.tolist(), velocity_d.tolist()
         values = ql + pl + vl
-        if (
-            len(values) == 11
-            and len(ql) == 5
-            and len(pl) == 3
-            and _isfinite(t)
-            and _hypot(*values) <= MAX_INPUT_MAGNITUDE
-        ):
+        if len(values) == 11 and len(ql) == 5 and len(pl) == 3 and _isfinite(sum(values, t)):
             return ql, pl, vl
     except (AttributeError, TypeError):
         pass
@@ -99,8 +86,13 @@ def _check_each(t: Any, q: Any, pose_d: Any, velocity_d: Any) -> None:
             raise ParameterError(
                 f"{name} must be {size} finite numbers {entries} (got {array.tolist()})"
             )
-        if np.max(np.abs(array)) > MAX_INPUT_MAGNITUDE:
-            raise ParameterError(
-                f"{name} must be {size} numbers {entries} of magnitude at most "
-                f"{MAX_INPUT_MAGNITUDE:g} (got {array.tolist()})"
-            )
+
+
+def check_command(u: tuple[float, ...], q: list[float], pose_d: list[float]) -> None:
+    """Raise :class:`ParameterError` if a closed-form command ``u`` is not finite although
+    its (validated, finite) arguments were: they are too large for the arithmetic."""
+    if not _isfinite(sum(u)):
+        raise ParameterError(
+            f"q, pose_d: too large for the command to be finite (q = {shown(q, 80)}, "
+            f"pose_d = {shown(pose_d, 60)})"
+        )

@@ -11,7 +11,7 @@ from abc import ABC, abstractmethod
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register_controller
-from ddwmmr.controllers.inputs import check_inputs
+from ddwmmr.controllers.inputs import check_command, check_inputs
 from ddwmmr.errors import ParameterError, check_positive, shown
 from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
@@ -56,6 +56,7 @@ class ResolvedRate(ABC):
         end-effector velocity (world frame, m/s, rad/s); the arguments are validated."""
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         u, singular = self.law(t, q, pose_d, velocity_d)
+        check_command(u, q, pose_d)
         self.last = StepInfo(singular=singular)
         return np.array(u)
 
