@@ -40,7 +40,7 @@ def read_metrics(path):
 
 def rms_error_from_configurations(ts, trajectory):
     """RMS end-effector position error (m) recomputed from the recorded configurations with
-    the forward kinematics of SPEC §1 and the trajectory's own desired positions."""
+    the forward kinematics of docs/theory.md and the trajectory's own desired positions."""
     a1 = ts["phi"] + ts["th1"]
     xe = ts["x"] + L1 * np.cos(a1) + L2 * np.cos(a1 + ts["th2"])
     ye = ts["y"] + L1 * np.sin(a1) + L2 * np.sin(a1 + ts["th2"])

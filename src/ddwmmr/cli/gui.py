@@ -110,7 +110,7 @@ def build_parser() -> ArgumentParser:
         help=f"trajectory ({', '.join(available_trajectories())}) or a "
         ".toml/.csv path (default ellipse)",
     )
-    geometry = parser.add_argument_group("trajectory geometry (SPEC 2; default: the file's)")
+    geometry = parser.add_argument_group("trajectory geometry (default: the file's)")
     for name, unit, allowed in GEOMETRY:
         geometry.add_argument(
             f"--{name}",
@@ -242,7 +242,7 @@ def snapshot(
             raise ParameterError(message)
         raise RunFailed(message)
     app.show_index(app.view.last_index)
-    app.say(f"snapshot: final state at t = {app.view.time:.2f} s (--snapshot {Path(path).name})")
+    app.say(f"snapshot: final state at t = {app.view.time:.2f} s (--snapshot {path})")
     buffer = io.BytesIO()
     figure.savefig(buffer, format=fmt, dpi=dpi or DPI)
     check_existing_snapshot(target, text, force)  # appeared during the run?

@@ -118,7 +118,7 @@ output behind."""
 
 
 def build_parser() -> ArgumentParser:
-    """The argument parser (also used to render --help in the docs)."""
+    """The ``python -m ddwmmr.scenarios`` argument parser."""
     parser = ArgumentParser(
         prog=PROG,
         description=DESCRIPTION,

@@ -56,8 +56,7 @@ from ddwmmr.trajectories import available_trajectories, load_trajectory
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = "python -m ddwmmr.track"
-#: The plant every track run uses (recorded; the only one until simulate() takes others).
-#: The default plant.
+#: The default plant (``--plant``), and the plant of a record that names none.
 PLANT = "kinematic"
 #: Tools whose summary.json records ``--rerun`` repeats: this one and the simulator's
 #: data export (``python -m ddwmmr.gui``).
@@ -145,7 +144,7 @@ def _default_text(value: Any) -> str:
 
 
 def build_parser() -> ArgumentParser:
-    """The argument parser (also used to render docs/cli.md)."""
+    """The argument parser; docs/cli.md documents each option (tests/test_cli_docs.py)."""
     methods = available_methods()
     method_help = "; ".join(f"{m}: {method_description(m).rstrip('.')}" for m in methods)
     parser = ArgumentParser(

@@ -33,6 +33,7 @@ from ddwmmr.gui.layout import (
     OFF_ENTRY,
     OPTIONS_PER_PAGE,
     SPEEDS,
+    SUMMARY_RIGHT,
     PanelLayout,
 )
 from ddwmmr.gui.options import OptionSpec, method_options
@@ -52,6 +53,7 @@ from ddwmmr.gui.widgets import (
     Field,
     describe_error,
     set_radio_silently,
+    wrap_to_width,
 )
 from ddwmmr.gui.worker import Worker
 from ddwmmr.trajectories import load_trajectory
@@ -175,7 +177,7 @@ class App(PanelLayout):
     def say(self, text: str, error: bool = False) -> None:
         """Show ``text`` in the message area (red for errors) and redraw."""
         self.message = text
-        wrapped = "\n".join(textwrap.wrap(text, 62)) if text else ""
+        wrapped = "\n".join(textwrap.wrap(text, 62, break_on_hyphens=False)) if text else ""
         self.message_text.set_text(("error: " if error else "") + wrapped)
         self.message_text.set_color("tab:red" if error else "0.1")
         self._redraw()
@@ -543,9 +545,9 @@ class App(PanelLayout):
         # The wall time only in a window: a snapshot is a document, the same on every run.
         took = f", {elapsed:.1f} s" if self.interactive else ""
         self._set_progress(1.0, f"done: {steps} steps{took}")
-        self.summary_text.set_text(
-            "\n".join(_summary_line(label, r) for label, r in zip(self.labels(), results))
-        )
+        summary = "\n".join(_summary_line(label, r) for label, r in zip(self.labels(), results))
+        # Wrapped to the window: a physics run's line is longer than the view is wide.
+        self.summary_text.set_text(wrap_to_width(summary, self.summary_text, SUMMARY_RIGHT))
         self.say(f"run finished ({steps} steps per method): playing; drag time to scrub")
         self.show_index(0)
         self._play()

@@ -4,7 +4,8 @@ A :class:`Settings` value is everything the control panel sets. It is immutable:
 builds a changed copy, checks it with :func:`check_settings`, and only then replaces the
 current one, so a bad field never leaves a half-applied setting behind.
 
-Trajectory geometry ``(x0, y0, a, b, beta, N, T)`` (SPEC §2) applies to every trajectory:
+Trajectory geometry ``(x0, y0, a, b, beta, N, T)`` (docs/theory.md, "Trajectories") applies
+to every trajectory:
 
 * parametric ones (ellipse, rectangle, their TOML files) take the values directly;
 * sampled ones (CSV files such as the figure-eight) are placed by the same numbers: their
