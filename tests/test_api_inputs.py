@@ -11,7 +11,10 @@ import pytest
 
 from ddwmmr import Robot, make_controller, simulate
 from ddwmmr.errors import ParameterError
+from ddwmmr.gains import MAX_GAIN
 from ddwmmr.plants import make_plant
+from ddwmmr.qp.limits import JointLimit
+from ddwmmr.qp.tasks import HeadingTask, PostureTask
 from ddwmmr.trajectories import Ellipse
 
 
@@ -204,3 +207,64 @@ def test_obstacle_files_keep_the_documented_limits(tmp_path, circle, match):
     _refused(lambda: load_obstacles(path), r"obstacles: .*o.toml: obstacle 1: " + match)
     path.write_text("[[obstacle]]\nx = 1e6\ny = -1e6\nradius = 1000.0\n")
     assert load_obstacles(path)[0].radius == 1000.0  # the limits themselves are allowed
+
+
+ALL_METHODS = ["pi", "ats", "ap", "clrrmc-cs", "clrrmc-ts", "qp", "mpc"]
+
+
+class _TurnsNaN(Ellipse):
+    """A custom trajectory whose pose turns NaN after 0.5 s (between two samples)."""
+
+    def pose(self, t):
+        pose = super().pose(t)
+        return pose * math.nan if t > 0.5 else pose
+
+
+@pytest.mark.parametrize("method", ALL_METHODS)
+def test_a_reference_turning_nan_mid_run_is_one_error_for_every_method(method):
+    # clrrmc-ts's integrator stages met it first: FloatingPointError from the plant
+    _refused(lambda: simulate(Robot(), _TurnsNaN(), method, duration=1.0), "^pose_d must be")
+
+
+@pytest.mark.parametrize("method", ALL_METHODS)
+def test_a_finite_but_absurd_configuration_never_gives_an_infinite_command(method):
+    # clrrmc-ts returned [-inf, inf, 0, -inf]; qp and mpc keep their limits at any finite
+    # state (tests/test_qp_limits_extreme.py), the closed-loop closed-form ones refuse it
+    q = np.array([1.7e308, 0.0, 0.3, -0.3, 0.6])
+    controller = make_controller(method, Robot())
+    trajectory = Ellipse()
+    controller.reset(trajectory, q)
+    call = lambda: controller.command(0.0, q, trajectory.pose(0.0), trajectory.velocity(0.0))  # noqa: E731
+    if method not in ("clrrmc-ts", "clrrmc-cs"):  # the open-loop ones do not use x, y
+        assert np.all(np.isfinite(call()))
+    else:
+        _refused(call, "^q, pose_d: too large for the command to be finite")
+
+
+@pytest.mark.parametrize(
+    ("method", "option"),
+    [
+        ("ap", "K1"),
+        ("ap", "K2"),
+        ("ap", "K3"),
+        ("qp", "stability_gain"),
+    ],
+)
+def test_every_gain_is_capped(method, option):
+    # ap with K3 = 1e300 commanded 1.3e300 rad/s
+    name = option.replace("_", "[_ ]")
+    _refused(lambda: make_controller(method, Robot(), **{option: 1e300}), f"{name} must be <=")
+    make_controller(method, Robot(), **{option: MAX_GAIN})  # the cap itself is a gain
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda gain: PostureTask(gain=gain),
+        lambda gain: PostureTask(K3=gain),
+        lambda gain: JointLimit(Robot(), gain=gain),
+        lambda gain: HeadingTask(gain=gain),
+    ],
+)
+def test_qp_piece_gains_are_capped(make):
+    _refused(lambda: make(1e300), "must be <= 10000 1/s")

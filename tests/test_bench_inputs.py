@@ -328,3 +328,14 @@ def test_a_failed_write_leaves_nothing_and_says_one_line(workdir, capsys, monkey
     assert status == 2 and out == ""
     assert err == line + "\n"
     assert tree(workdir) == []
+
+
+def test_an_extra_row_that_cannot_load_is_skipped_not_an_unknown_method():
+    # bench --method rtb-holistic said "unknown method" when roboticstoolbox was missing,
+    # though --help lists the name
+    from ddwmmr.bench.methods import ExtraCase, benchmark_cases
+
+    missing = ExtraCase("extra-row", "ddwmmr_no_such_module:Controller", pair="qp")
+    cases, skipped = benchmark_cases(["extra-row"], (missing,))
+    assert [case.label for case in cases] == ["naive-pinv"]
+    assert "not importable" in skipped["extra-row"]

@@ -71,6 +71,16 @@ FILES = {
     "traj_long_row.csv": b"t,x,y\n0,0,0\n1,1,0,5\n2,2,0\n",
     "traj_repeated_column.csv": b"t,x,y,t\n0,0,0,0\n1,1,0,1\n2,2,0,2\n",
     "traj_blank_columns.csv": b"garbage,,\n1,2,3\n",
+    # columns that were silently ignored (the run was that of t,x,y), numbers misread
+    "traj_Phi.csv": b"t,x,y,Phi\n0,2,0,0\n1,2,1,0\n2,2,2,0\n",
+    "traj_theta.csv": b"t,x,y,theta\n0,2,0,0\n1,2,1,0\n2,2,2,0\n",
+    "traj_underscore.csv": b"t,x,y\n0,2,0\n1_0,2,1\n20,2,2\n",
+    "traj_arabic_digit.csv": "t,x,y\n0,2,0\n\u0661,2,1\n2,2,2\n".encode(),
+    "traj_hash_header.csv": b"# t,x,y\n0,2,0\n1,2,1\n2,2,2\n",
+    # 10 MB strings: each echoed whole in the one line before
+    "traj_huge_orientation.toml": b'shape = "ellipse"\norientation = "' + b"x" * 10**7 + b'"\n',
+    "traj_huge_key.toml": b'shape = "ellipse"\n' + b"k" * 10**7 + b" = 1\n",
+    "robot_huge_string.toml": b'L1 = "' + b"x" * 10**7 + b'"\n',
     "obstacle_at_start.toml": b"[[obstacle]]\nx = 2.0\ny = 0.0\nradius = 0.5\n",
     "obstacle_far.toml": b"[[obstacle]]\nx = 1e9\ny = 0.0\nradius = 0.3\n",
     "obstacle_huge.toml": b"[[obstacle]]\nx = 5.0\ny = 0.0\nradius = 5000.0\n",
@@ -161,6 +171,15 @@ CASES += [
         ["--traj", "{traj_blank_columns.csv}"],
         "has a blank column name over values (column 2)",
     ),
+    ("track", ["--traj", "{traj_Phi.csv}"], "unknown column(s) 'Phi' (accepted: t, x, y, phi"),
+    ("track", ["--traj", "{traj_theta.csv}"], "unknown column(s) 'theta' (accepted: t, x, y"),
+    ("track", ["--traj", "{traj_underscore.csv}"], "column t: '1_0' is not a number"),
+    ("track", ["--traj", "{traj_arabic_digit.csv}"], "data row 2, column t: '\u0661' is not a"),
+    ("track", ["--traj", "{traj_hash_header.csv}"], "has no header line (its first line that"),
+    ("compare", ["--only", "{traj_Phi.csv}"], "unknown column(s) 'Phi'"),
+    ("track", ["--traj", "{traj_huge_orientation.toml}"], "(got 'xxxxxxxxxxxxxxxxxxxxxxx"),
+    ("track", ["--traj", "{traj_huge_key.toml}"], "unknown key 'kkkkkkkkkkkkkkkkkkkkkkkk"),
+    ("track", ["--robot", "{robot_huge_string.toml}"], "L1 must be a number (got 'xxxxxxx"),
     # a payload that tips the robot in the start pose: refused by every tool, as by track
     ("track", ["--payload", "20"], "a 20 kg payload tips the robot over in this run's start"),
     ("compare", ["--payload", "50"], "a 50 kg payload tips the robot over in this run's start"),
@@ -331,6 +350,7 @@ def test_bad_input_one_line_exit_2_nothing_written(workdir, tool, args, text, ca
     assert len(lines) == 1, err
     assert "Traceback" not in err
     assert expand([text], workdir)[0] in lines[0]
+    assert len(lines[0]) < 2000  # echoed values are cut (a 10 MB string came out whole)
     assert tree(cwd) == before
 
 

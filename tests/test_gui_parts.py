@@ -186,7 +186,7 @@ def test_check_settings_names_the_bad_value(tmp_path):
         check_settings(Settings(methods=("clrrmc-ts", None), options=({"tau": -1.0}, {})))
     note = tmp_path / "note.csv"
     note.write_text("hello,world\n1,2\n")
-    with pytest.raises(ParameterError, match=r"traj: .* lacks column"):
+    with pytest.raises(ParameterError, match=r"traj: .* unknown column\(s\) 'hello', 'world'"):
         check_settings(Settings(trajectory=str(note)))
 
 

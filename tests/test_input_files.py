@@ -135,3 +135,19 @@ def test_nesting_depth_counts_lists_and_tables_without_recursion():
     assert nesting_depth(deep) == 100_001
     assert nesting_depth({"obstacle": [{"x": 1.0, "y": [0.0]}]}) == 4
     assert nesting_depth(3.0) == 0
+
+
+def test_a_byte_order_mark_is_not_part_of_the_text(tmp_path):
+    # a CSV saved with a BOM said "lacks column(s) t" (the first name was "\ufefft")
+    from ddwmmr.trajectories import load_trajectory
+
+    rows = "t,x,y\n0,2,0\n1,2.1,0.1\n2,2.2,0.25\n"
+    (tmp_path / "plain.csv").write_text(rows)
+    (tmp_path / "marked.csv").write_bytes(b"\xef\xbb\xbf" + rows.encode())
+    plain = load_trajectory(str(tmp_path / "plain.csv"))
+    marked = load_trajectory(str(tmp_path / "marked.csv"))
+    assert marked.times.tolist() == plain.times.tolist()
+    assert marked.points.tolist() == plain.points.tolist()
+    (tmp_path / "robot.toml").write_bytes(b"\xef\xbb\xbfL1 = 0.4\n")
+    assert Robot.from_toml(tmp_path / "robot.toml").L1 == 0.4
+    assert read_text_file(tmp_path / "robot.toml", "robot") == "L1 = 0.4\n"

@@ -603,3 +603,29 @@ def test_runs_finishing_at_the_same_moment_each_keep_their_folder(tmp_path):
     assert contents == [f"run {n}" for n in range(4)]
     assert sorted(Path(p).name for p in paths)[0] == Path(target).name
     assert leftovers(tmp_path / "runs") == []
+
+
+def test_a_default_track_folder_taken_meanwhile_is_numbered_from_the_default(tmp_path, monkeypatch):
+    """The default name existed, so the run aimed at name-2; another run took name-2
+    meanwhile: this one goes to name-3 (it went to name-2-2, and one more to name-2-2-2)."""
+    import ddwmmr.cli.track as track
+
+    monkeypatch.chdir(tmp_path)
+    base = Path("runs") / "ats-ellipse-20261201-120000"
+    base.mkdir(parents=True)
+    monkeypatch.setattr(track, "default_out", lambda method, traj: base)
+    real_simulate = track.simulate
+
+    def racing(*args, **kwargs):
+        Path(f"{base}-2").mkdir()  # another default run finished first
+        return real_simulate(*args, **kwargs)
+
+    monkeypatch.setattr(track, "simulate", racing)
+    args = ["--method", "ats", "--traj", "ellipse", "--duration", "0.1", "--no-plots"]
+    assert track.main([*args, "--no-progress"]) == 0
+    assert sorted(p.name for p in base.parent.iterdir()) == [
+        base.name,
+        f"{base.name}-2",
+        f"{base.name}-3",
+    ]
+    assert (base.parent / f"{base.name}-3" / "summary.json").is_file()

@@ -97,10 +97,10 @@ def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None 
         and float(value).is_integer()
     )
     if isinstance(value, bool | np.bool_) or not integral:
-        raise ParameterError(f"{name} must be an integer {allowed} (got {value!r})")
+        raise ParameterError(f"{name} must be an integer {allowed} (got {shown(value)})")
     number = int(value)
     if number < minimum or (maximum is not None and number > maximum):
-        raise ParameterError(f"{name} must be an integer {allowed} (got {value!r})")
+        raise ParameterError(f"{name} must be an integer {allowed} (got {shown(value)})")
     return number
 
 
@@ -141,7 +141,7 @@ def check_step_count(duration: float, dt: float) -> int:
 def check_number_type(name: str, value: Any) -> Any:
     """Reject values read from a file that are not numbers (strings, booleans, tables)."""
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise ParameterError(f"{name} must be a number (got {value!r})")
+        raise ParameterError(f"{name} must be a number (got {shown(value)})")
     return value
 
 
@@ -180,7 +180,8 @@ def read_text_file(path: str | Path, label: str) -> str:
 
     The file is checked with ``os.stat`` before it is opened, so a FIFO, a device or a
     folder is refused instead of blocking or failing; files above :data:`MAX_INPUT_BYTES`
-    are refused too. ``label`` names the option in the message.
+    are refused too. ``label`` names the option in the message. A UTF-8 byte-order mark at
+    the start is not part of the text.
     """
     path = Path(path)
     try:
@@ -188,7 +189,7 @@ def read_text_file(path: str | Path, label: str) -> str:
     except OSError as exc:
         raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
     except ValueError:  # e.g. an embedded NUL byte
-        raise ParameterError(f"{label}: invalid file name {str(path)!r}") from None
+        raise ParameterError(f"{label}: invalid file name {shown(str(path))}") from None
     if not stat.S_ISREG(info.st_mode):
         raise ParameterError(f"{label}: {path} is not a regular file")
     if info.st_size > MAX_INPUT_BYTES:
@@ -200,7 +201,7 @@ def read_text_file(path: str | Path, label: str) -> str:
     except OSError as exc:
         raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
     try:
-        return data.decode("utf-8")
+        return data.decode("utf-8-sig")  # a leading byte-order mark (some editors') dropped
     except UnicodeDecodeError as exc:
         raise ParameterError(
             f"{label}: {path} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "

@@ -7,11 +7,25 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, check_nonnegative, check_positive, shown
 
 #: Shortest time constant (s): gains above 1e4 1/s are no feedback a 2 rad/s arm or a
 #: wheel-speed-limited base can follow, only numbers that overflow the commands.
 MIN_TAU = 1e-4
+#: Largest gain (1/s) of any controller: the feedback gains ``1/tau``, the potential gains
+#: K1..K3 of ``ap`` and of the QP posture task, the QP's limit and task gains. The same
+#: bound as MIN_TAU: more is no feedback the robot can follow, only commands that overflow
+#: (``ap`` with K3 = 1e300 commanded 1.3e300 rad/s).
+MAX_GAIN = 1.0 / MIN_TAU
+
+
+def check_gain(name: str, value: float, zero: bool = False) -> float:
+    """``value`` as a float if it is a gain in (0, MAX_GAIN] 1/s ([0, MAX_GAIN] with
+    ``zero``: a gain that may switch its term off), else :class:`ParameterError`."""
+    value = check_nonnegative(name, value) if zero else check_positive(name, value)
+    if value > MAX_GAIN:
+        raise ParameterError(f"{name} must be <= {MAX_GAIN:g} 1/s (got {value:g})")
+    return value
 
 
 def gains_from_tau(tau: float | Sequence[float], size: int) -> tuple[float, ...]:

@@ -472,6 +472,9 @@ class OutputFolder:
         self.tool, self.force, self.fresh = tool, force, fresh
         #: Absolute path of the output folder (after a ``fresh`` commit, the numbered
         #: sibling the files went to if the target had appeared meanwhile).
+        #: The name a ``fresh`` commit numbers from (``target``, ``target-2``...): always
+        #: the unnumbered default, so runs racing for it never make ``target-2-2``.
+        self._base = Path(target)
         if fresh:  # a default name: only where it goes must be writable, nothing replaced
             self.path = check_output_path(first_free(target, folder=True))
         else:
@@ -513,8 +516,9 @@ class OutputFolder:
     def __exit__(self, exc_type, exc, traceback) -> bool:
         if exc_type is None:
             try:
+                target = self._base if self.fresh else self.path
                 self.path = _commit(
-                    self._staging, self.path, self.tool, self.force, self._text, self.fresh
+                    self._staging, target, self.tool, self.force, self._text, self.fresh
                 )
                 return False
             except BaseException:

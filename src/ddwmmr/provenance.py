@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import method_options
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import package_version
 from ddwmmr.trajectories.files import SHAPES, file_sha256
@@ -181,14 +181,17 @@ def trajectory_from_record(record: dict[str, Any]) -> Any:
         return SHAPES[kind](**decode(record["parameters"]))
     if kind == "samples":
         path = Path(record["file"])
-        if not path.is_file():
+        if not path.exists():
             raise ParameterError(f"rerun: the trajectory file {path} is gone")
+        if not path.is_file():  # checked before hashing: a FIFO would block the read
+            now = "a folder" if path.is_dir() else "not a regular file"
+            raise ParameterError(f"rerun: the trajectory file {path} is now {now}")
         if file_sha256(path) != record["sha256"]:
             raise ParameterError(
                 f"rerun: the trajectory file {path} changed since the run (SHA-256 differs)"
             )
         return read_csv(path)
-    raise ParameterError(f"rerun: cannot rebuild a trajectory of type {kind!r}")
+    raise ParameterError(f"rerun: cannot rebuild a trajectory of type {shown(kind)}")
 
 
 @dataclass

@@ -54,7 +54,7 @@ from itertools import count
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 
 #: The built-in plug-in modules, in listing order.
 BUILTIN_MODULES = (
@@ -105,7 +105,8 @@ class Registry:
             ``register_<kind>``).
         label: the parameter named in errors (``"method"``, ``"plant"``, ``"arbiter"``).
         defaults: the traits a decorator may give, with their defaults.
-        unknown: the one-line error for an unknown name, formatted with ``name`` and
+        unknown: the one-line error for an unknown name, formatted with ``name`` (as
+            :func:`~ddwmmr.errors.shown` echoes it) and
             ``known`` (the registered names, comma separated).
         sets: traits the decorator also sets as class attributes.
     """
@@ -192,7 +193,7 @@ class Registry:
         entry = self._entries.get(name) if isinstance(name, str) else None
         if entry is None:
             known = ", ".join(self.names())
-            raise ParameterError(self.unknown.format(name=name, known=known))
+            raise ParameterError(self.unknown.format(name=shown(name), known=known))
         return entry
 
     def load(self, name: str) -> type:
@@ -228,20 +229,20 @@ CONTROLLERS = Registry(
     "controller",
     "method",
     {"tasks": ("tracking",), "interfaces": ("velocity",), "arbiter": False},
-    "method: unknown method {name!r} (known: {known})",
+    "method: unknown method {name} (known: {known})",
 )
 PLANTS = Registry(
     "plant",
     "plant",
     {"interfaces": ("velocity",)},
-    "plant must be one of {known} (got {name!r})",
+    "plant must be one of {known} (got {name})",
     sets=("interfaces",),
 )
 ARBITERS = Registry(
     "arbiter",
     "arbiter",
     {},
-    "arbiter must be one of {known} (got {name!r})",
+    "arbiter must be one of {known} (got {name})",
 )
 _REGISTRIES = {r.decorator: r for r in (CONTROLLERS, PLANTS, ARBITERS)}
 register_controller = CONTROLLERS.register

@@ -33,6 +33,7 @@ import math
 from dataclasses import dataclass
 
 from ddwmmr.behaviours.base import BRAKE, DRIVE, TURN, Percept, Proposal
+from ddwmmr.errors import shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import wrap_angle
 
@@ -103,7 +104,7 @@ class BaseMover:
         elif proposal.mode == BRAKE:
             f_t, f_r = self.brake_forces(p)
         else:
-            raise ValueError(f"unknown base mode {proposal.mode!r}")
+            raise ValueError(f"unknown base mode {shown(proposal.mode)}")
         return self.mix(f_t, f_r)
 
 

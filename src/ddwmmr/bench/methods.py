@@ -15,6 +15,7 @@ import numpy as np
 from ddwmmr.bench.baseline import NAIVE_LABEL, NaivePseudoinverseController
 from ddwmmr.bench.timing import summarize_times, time_calls
 from ddwmmr.controllers.base import Controller, available_methods, make_controller
+from ddwmmr.errors import shown
 from ddwmmr.model import Robot
 from ddwmmr.progress import ProgressBar
 from ddwmmr.sim import simulate
@@ -101,7 +102,7 @@ def extra_factory(case: ExtraCase) -> Callable[[Robot], Controller] | str:
         return f"{module_name} not importable ({exc})"
     target = getattr(module, attribute, None)
     if target is None:
-        return f"{module_name} has no attribute {attribute!r}"
+        return f"{module_name} has no attribute {shown(attribute)}"
     reason = getattr(module, "unavailable_reason", lambda: None)()
     if reason:
         return reason
@@ -134,7 +135,13 @@ def benchmark_cases(
     taken = {case.label for case in extra_cases}
     names = available_methods() if methods is None else list(dict.fromkeys(methods))
     cases = [BenchCase(NAIVE_LABEL, NaivePseudoinverseController, kind="baseline")]
-    cases += [BenchCase(name, _method_factory(name)) for name in names if name not in taken]
+    # an extra row's label is never a method of its own: a skipped one (its package is
+    # not installed) stays skipped, with its reason, instead of an "unknown method"
+    cases += [
+        BenchCase(name, _method_factory(name))
+        for name in names
+        if name not in taken and name not in skipped
+    ]
     return cases + extra_cases, skipped
 
 

@@ -64,7 +64,7 @@ from ddwmmr.reports.compare import (
     write_report,
 )
 from ddwmmr.reports.compare.constants import TIE_ABSOLUTE_M, TIE_RELATIVE
-from ddwmmr.reports.compare.plan import run_duration
+from ddwmmr.reports.compare.plan import report_name, run_duration
 from ddwmmr.resolution.reference import initial_configuration
 from ddwmmr.sim.result import json_safe, write_atomic
 from ddwmmr.sim.simulate import check_start
@@ -351,7 +351,7 @@ def load_trajectories(
     files: dict[str, Any] = {}
     for value in dict.fromkeys(values):
         trajectory = load_trajectory(value)
-        name = base = trajectory_name(trajectory)
+        name = base = report_name(trajectory_name(trajectory))  # names files: made safe
         suffix = 2
         while name in trajectories:  # two files with the same stem: keep both
             name, suffix = f"{base}-{suffix}", suffix + 1

@@ -751,13 +751,14 @@ def _main(argv: Sequence[str] | None = None) -> int:
     config = config_from_arguments(args)
     args.bounds_table = _bounds_table(args, config)
     fresh = args.out is None  # a default name: never replaces an earlier run
-    out = first_free(default_out(), folder=True) if fresh else Path(args.out)
+    base = default_out() if fresh else Path(args.out)
+    out = first_free(base, folder=True) if fresh else base
     check_output_folder(out, "scenarios", args.force, output_names(args, config))
     if config.controller == "qp":  # its options are checked by building it, before output
         robot = config_robot(config)
         plant = make_scenario_plant(robot, config)
         make_scenario_controller(robot, generate(1, 0)[0], config, plant)
-    writer = output_folder(out, "scenarios", args.force, fresh)
+    writer = output_folder(base, "scenarios", args.force, fresh)  # numbers from base if fresh
     with Runner(args) as runner, writer as folder:  # workers first, then the output
         if args.study == "thresholds":
             _run_thresholds(args, config, runner, folder)

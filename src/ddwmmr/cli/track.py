@@ -554,16 +554,13 @@ def _main(argv: Sequence[str] | None = None) -> int:
     steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
     controller = make_controller(inputs.method, inputs.robot, **inputs.options)
     fresh = args.out is None  # a default name: never replaces an earlier run
-    out = (
-        first_free(default_out(inputs.method, inputs.label), folder=True)
-        if fresh
-        else Path(args.out)
-    )
+    base = default_out(inputs.method, inputs.label) if fresh else Path(args.out)
+    out = first_free(base, folder=True) if fresh else base
     check_output_folder(out, "track", args.force, output_names(not args.no_plots, args.animate))
     record = run_record(inputs, argv, args.rerun, tool="track", prog=PROG)
     progress = not args.no_progress
     _note_uneven_duration(inputs.duration, inputs.dt, steps)
-    writer = output_folder(out, "track", args.force, fresh)
+    writer = output_folder(base, "track", args.force, fresh)  # numbers from base if fresh
     with writer as staging:
         with ProgressBar(steps, "track: steps", enabled=progress, unit="step") as bar:
             result = simulate(

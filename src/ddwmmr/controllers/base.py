@@ -23,7 +23,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ddwmmr.commands import PlantTraits
-from ddwmmr.errors import ParameterError, check_instance
+from ddwmmr.errors import ParameterError, check_instance, shown
 from ddwmmr.model import Robot
 from ddwmmr.registry import CONTROLLERS
 from ddwmmr.trajectories.base import resolution_step
@@ -198,7 +198,7 @@ def make_controller(
     unknown = sorted(set(options) - accepted)
     if unknown:
         raise ParameterError(
-            f"method {name}: unknown option {unknown[0]!r} "
+            f"method {name}: unknown option {shown(unknown[0])} "
             f"(accepted: {', '.join(sorted(accepted)) or 'none'})"
         )
     return cls(robot, **options)

@@ -13,12 +13,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register_controller
-from ddwmmr.controllers.inputs import check_inputs
+from ddwmmr.controllers.inputs import check_command, check_inputs
 from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
 from ddwmmr.errors import MAX_STEPS, ParameterError, check_positive, check_range
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model import Robot
-from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.model.kinematics import principal_angle, wrap_angle
 from ddwmmr.resolution import kernels
 from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
 
@@ -84,7 +84,9 @@ class ConfigurationSpaceController:
     """CLRRMC-CS: qdot = qdot_d + K (q_d - q) around an ATS reference q_d(t).
 
     A step counts as singular (``last.singular``) when the reference segment it looks up
-    was integrated with damping (the reference passed near cos th1 = 0 there).
+    was integrated with damping (the reference passed near cos th1 = 0 there). The errors
+    of phi, th1 and th2 are taken in (-pi, pi] (:func:`principal_angle`): a configuration
+    whole turns away from the reference is no error.
     """
 
     def __init__(
@@ -139,6 +141,7 @@ class ConfigurationSpaceController:
         """
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         u, residual = self._input(t, q)
+        check_command(u, q, pose_d)
         self.last = StepInfo(singular=self.reference.last_damped, nonholonomic_residual=residual)
         return np.array(u)
 
@@ -157,7 +160,11 @@ class ConfigurationSpaceController:
         if reference is None:
             raise RuntimeError("clrrmc-cs needs reset(trajectory, q0) before command()")
         q_ref, qdot_ref = reference(t)
-        qdot = [d + k * (r - a) for d, k, r, a in zip(qdot_ref, self.gains, q_ref, q)]
+        error = [r - a for r, a in zip(q_ref, q)]
+        # whole turns of phi, th1 or th2 are no error: a start given one turn apart is the
+        # same physical pose (and the same run)
+        error[2:] = [principal_angle(e) for e in error[2:]]
+        qdot = [d + k * e for d, k, e in zip(qdot_ref, self.gains, error)]
         c, s = math.cos(q[2]), math.sin(q[2])
         u = (qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4])
         return u, -qdot[0] * s + qdot[1] * c

@@ -1,9 +1,14 @@
-"""Validation of the arguments of ``Controller.command`` shared by every method.
+"""Validation of the arguments of ``Controller.command`` shared by every method, and of
+the closed-form methods' result.
 
 A NaN or an infinity in the configuration, the desired pose, the desired velocity or the
 time would otherwise come out of the closed-form methods as a NaN/inf command without a
 word (and the QP would count a fallback). :func:`check_inputs` turns it into a one-line
-:class:`~ddwmmr.errors.ParameterError` (a ``ValueError``) that names the argument.
+:class:`~ddwmmr.errors.ParameterError` (a ``ValueError``) that names the argument. Finite
+values too large for the arithmetic (``q = [1.7e308, ...]`` gave ``clrrmc-ts`` the command
+``[-inf, inf, 0, -inf]``) are the same error from :func:`check_command`, which the
+closed-form methods apply to their result; ``qp`` and ``mpc`` keep every limit and return
+a finite command at any finite state (tests/test_qp_limits_extreme.py).
 
 It runs every control step, so the common case (everything finite) is one sum over the
 values: a sum is finite only if every term is finite. Only when it is not (or when the
@@ -19,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 
 #: (argument, expected length, what its entries are) of ``command(t, q, pose_d, velocity_d)``.
 _ARGUMENTS = (
@@ -65,9 +70,9 @@ def _check_each(t: Any, q: Any, pose_d: Any, velocity_d: Any) -> None:
     try:
         time = float(t)
     except (TypeError, ValueError):
-        raise ParameterError(f"t must be a finite time in s (got {t!r})") from None
+        raise ParameterError(f"t must be a finite time in s (got {shown(t)})") from None
     if not math.isfinite(time):
-        raise ParameterError(f"t must be a finite time in s (got {time!r})")
+        raise ParameterError(f"t must be a finite time in s (got {shown(time)})")
     for (name, size, entries), value in zip(_ARGUMENTS, (q, pose_d, velocity_d)):
         try:
             array = np.asarray(value, dtype=float)
@@ -81,3 +86,13 @@ def _check_each(t: Any, q: Any, pose_d: Any, velocity_d: Any) -> None:
             raise ParameterError(
                 f"{name} must be {size} finite numbers {entries} (got {array.tolist()})"
             )
+
+
+def check_command(u: tuple[float, ...], q: list[float], pose_d: list[float]) -> None:
+    """Raise :class:`ParameterError` if a closed-form command ``u`` is not finite although
+    its (validated, finite) arguments were: they are too large for the arithmetic."""
+    if not _isfinite(sum(u)):
+        raise ParameterError(
+            f"q, pose_d: too large for the command to be finite (q = {shown(q, 80)}, "
+            f"pose_d = {shown(pose_d, 60)})"
+        )

@@ -22,7 +22,7 @@ from typing import Any
 
 from ddwmmr.controllers.base import controller_class as registered_class
 from ddwmmr.controllers.base import method_parameters
-from ddwmmr.errors import ParameterError, did_you_mean
+from ddwmmr.errors import ParameterError, did_you_mean, shown
 
 __all__ = [
     "CHOICES",
@@ -125,7 +125,7 @@ class OptionSpec:
                 if text == format_choice(choice):
                     return choice
             allowed = ", ".join(format_choice(c) for c in self.choices)
-            raise ParameterError(f"{self.name} must be one of {allowed} (got {text!r})")
+            raise ParameterError(f"{self.name} must be one of {allowed} (got {shown(text)})")
         if not text:
             if self.optional:
                 return None
@@ -140,17 +140,17 @@ class OptionSpec:
         try:
             numbers = [float(part) for part in re.split(r"[\s,]+", text) if part]
         except ValueError:
-            raise ParameterError(f"{self.name} must be a number (got {text!r})") from None
+            raise ParameterError(f"{self.name} must be a number (got {shown(text)})") from None
         if any(math.isnan(v) for v in numbers):
-            raise ParameterError(f"{self.name} must be a number (got {text!r})")
+            raise ParameterError(f"{self.name} must be a number (got {shown(text)})")
         if len(numbers) > 1:
             if not self.several:
-                raise ParameterError(f"{self.name} takes one number (got {text!r})")
+                raise ParameterError(f"{self.name} takes one number (got {shown(text)})")
             return tuple(numbers)
         (value,) = numbers
         if isinstance(self.default, int) and not isinstance(self.default, bool):
             if not value.is_integer():
-                raise ParameterError(f"{self.name} must be an integer (got {text!r})")
+                raise ParameterError(f"{self.name} must be an integer (got {shown(text)})")
             return int(value)
         return value
 
@@ -255,7 +255,7 @@ def parse_option(method: str, text: str, what: str = "option") -> tuple[str, Any
     name, sep, value = text.partition("=")
     name = name.strip()
     if not sep or not name:
-        raise ParameterError(f"{what} must be NAME=VALUE (got {text!r})")
+        raise ParameterError(f"{what} must be NAME=VALUE (got {shown(text)})")
     specs = {spec.name: spec for spec in option_specs(method)}
     if name not in specs:
         known = ", ".join(specs) or "none"
@@ -272,6 +272,6 @@ def parse_options(method: str, texts: Sequence[str] | None, what: str = "option"
     for text in texts or ():
         name, value = parse_option(method, text, what)
         if name in options:
-            raise ParameterError(f"{what}: {name} given twice (got {text!r})")
+            raise ParameterError(f"{what}: {name} given twice (got {shown(text)})")
         options[name] = value
     return options

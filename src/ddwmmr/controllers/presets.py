@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 
 #: Preset names, the default first.
 PRESETS = ("default", "slides")
@@ -61,7 +61,7 @@ _TABLES = {"default": DEFAULT, "slides": SLIDES}
 def check_preset(preset: str) -> str:
     """Validate a preset name."""
     if preset not in _TABLES:
-        raise ParameterError(f"preset must be one of {', '.join(PRESETS)} (got {preset!r})")
+        raise ParameterError(f"preset must be one of {', '.join(PRESETS)} (got {shown(preset)})")
     return preset
 
 

@@ -11,10 +11,11 @@ from abc import ABC, abstractmethod
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register_controller
-from ddwmmr.controllers.inputs import check_inputs
-from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.controllers.inputs import check_command, check_inputs
+from ddwmmr.errors import ParameterError, check_positive, shown
+from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
-from ddwmmr.model.kinematics import AUX_ROWS
+from ddwmmr.model.kinematics import AUX_ROWS, whole_turns
 from ddwmmr.resolution import kernels
 
 #: An input ``(v, w, th1dot, th2dot)`` as floats (m/s, rad/s, rad/s, rad/s).
@@ -55,6 +56,7 @@ class ResolvedRate(ABC):
         end-effector velocity (world frame, m/s, rad/s); the arguments are validated."""
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         u, singular = self.law(t, q, pose_d, velocity_d)
+        check_command(u, q, pose_d)
         self.last = StepInfo(singular=singular)
         return np.array(u)
 
@@ -69,7 +71,7 @@ class ResolvedRate(ABC):
 def check_aux(aux: str) -> str:
     """Validate the auxiliary constraint name of the augmented task space."""
     if aux not in AUX_ROWS:
-        raise ParameterError(f"aux must be one of {', '.join(AUX_ROWS)} (got {aux!r})")
+        raise ParameterError(f"aux must be one of {', '.join(AUX_ROWS)} (got {shown(aux)})")
     return aux
 
 
@@ -111,9 +113,18 @@ class ArtificialPotentialController(ResolvedRate):
         self, robot: Robot, K1: float = 1.0, K2: float = 0.25, K3: float = 0.66, **kwargs
     ) -> None:
         super().__init__(robot, **kwargs)
-        self.K1 = check_nonnegative("K1", K1)
-        self.K2 = check_nonnegative("K2", K2)
-        self.K3 = check_nonnegative("K3", K3)
+        self.K1 = check_gain("K1", K1, zero=True)
+        self.K2 = check_gain("K2", K2, zero=True)
+        self.K3 = check_gain("K3", K3, zero=True)
+        self._turns = (0.0, 0.0)
+
+    def reset(self, trajectory: object, q0: np.ndarray) -> None:
+        """Count phi and th1 of the potential from the start's own turn: the whole turns
+        in ``q0``'s phi and th1 (beyond (-pi, pi]) are subtracted for the run, so a start
+        given whole turns apart is the same physical pose and gives the same run (a start
+        within (-pi, pi] subtracts nothing)."""
+        super().reset(trajectory, q0)
+        self._turns = (whole_turns(float(q0[2])), whole_turns(float(q0[3])))
 
     def law(self, t, q, pose_d, velocity_d) -> tuple[Input, bool]:
         """Pseudoinverse input plus the projected potential descent (K2 has no effect: th2
@@ -123,5 +134,8 @@ class ArtificialPotentialController(ResolvedRate):
         (v, w, t1, t2), singular = kernels.pseudoinverse(
             self.L1, self.L2, phi, th1, th2, xd, yd, pd, self.threshold, self.damping
         )
-        k = kernels.null_space_rate(phi, th1, 2.0 * self.K3 * phi, 2.0 * self.K1 * th1)
+        phi_turns, th1_turns = self._turns
+        k = kernels.null_space_rate(
+            phi, th1, 2.0 * self.K3 * (phi - phi_turns), 2.0 * self.K1 * (th1 - th1_turns)
+        )
         return (v, w + k, t1 - k, t2), singular

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.gui import export
 from ddwmmr.gui.layout import (
     FILE_ENTRY,
@@ -323,7 +323,7 @@ class App(PanelLayout):
         try:
             number = float(text)
         except ValueError:
-            raise ParameterError(f"{name} must be a number (got {text!r})") from None
+            raise ParameterError(f"{name} must be a number (got {shown(text)})") from None
         value = check_geometry(name, number)
         self._try(self.settings.with_geometry(name, value))
         return f"{value:.6g}"
@@ -436,9 +436,11 @@ class App(PanelLayout):
         try:
             values = tuple(float(p) for p in parts)
         except ValueError:
-            raise ParameterError(f"offset must be two numbers dx dy in m (got {text!r})") from None
+            raise ParameterError(
+                f"offset must be two numbers dx dy in m (got {shown(text)})"
+            ) from None
         if len(values) != 2:
-            raise ParameterError(f"offset must be two numbers dx dy in m (got {text!r})")
+            raise ParameterError(f"offset must be two numbers dx dy in m (got {shown(text)})")
         self._try(self.settings.replace(offset=values))
         return f"{values[0]:g} {values[1]:g}"
 
@@ -720,7 +722,9 @@ def _optional_positive(name: str, text: str) -> float | None:
     try:
         value = float(text)
     except ValueError:
-        raise ParameterError(f"{name} must be a number > 0 in s, or blank (got {text!r})") from None
+        raise ParameterError(
+            f"{name} must be a number > 0 in s, or blank (got {shown(text)})"
+        ) from None
     if not (value > 0 and np.isfinite(value)):
         raise ParameterError(f"{name} must be > 0 s, or blank (got {text})")
     return value

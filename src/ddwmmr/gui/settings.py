@@ -33,6 +33,7 @@ from ddwmmr.errors import (
     check_positive,
     check_range,
     check_step_count,
+    shown,
 )
 from ddwmmr.gui.options import method_options, plant_keywords, plant_names
 from ddwmmr.model import Robot
@@ -246,17 +247,18 @@ def check_settings(settings: Settings) -> Settings:
     for slot in settings.active_slots:
         if settings.methods[slot] not in methods:
             raise ParameterError(
-                f"method: unknown method {settings.methods[slot]!r} (known: {', '.join(methods)})"
+                f"method: unknown method {shown(settings.methods[slot])}"
+                f" (known: {', '.join(methods)})"
             )
     if settings.methods[0] is None:
         raise ParameterError("method: slot A needs a method")
     if settings.plant not in plant_names():
         raise ParameterError(
-            f"plant must be one of {', '.join(plant_names())} (got {settings.plant!r})"
+            f"plant must be one of {', '.join(plant_names())} (got {shown(settings.plant)})"
         )
     if settings.integrator not in INTEGRATORS:
         raise ParameterError(
-            f"integrator must be one of {', '.join(INTEGRATORS)} (got {settings.integrator!r})"
+            f"integrator must be one of {', '.join(INTEGRATORS)} (got {shown(settings.integrator)})"
         )
     for name in ("dt", "duration"):
         value = getattr(settings, name)

@@ -22,8 +22,37 @@ U_NAMES = ("v", "w", "th1dot", "th2dot")
 
 
 def wrap_angle(angle: float) -> float:
-    """Angle wrapped to [-pi, pi) (rad)."""
+    """Angle wrapped to [-pi, pi) (rad), as ``(angle + pi) mod 2 pi - pi``.
+
+    The laws that have always wrapped their orientation error with this formula keep it
+    (its rounding is part of their recorded results); an error that was not wrapped
+    before is wrapped with :func:`principal_angle`, which leaves an angle already in
+    range untouched.
+    """
     return (angle + math.pi) % (2.0 * math.pi) - math.pi
+
+
+_TWO_PI = 2.0 * math.pi
+
+
+def principal_angle(angle: float) -> float:
+    """The same direction as ``angle`` in (-pi, pi] (rad).
+
+    An angle already in (-pi, pi] is returned unchanged, bit for bit; any other is reduced
+    by the exact floating-point remainder of 2 pi, so whole turns are removed without the
+    rounding of adding and subtracting pi (1e6 rad keeps all its significant digits).
+    """
+    if -math.pi < angle <= math.pi:
+        return angle
+    reduced = math.remainder(angle, _TWO_PI)
+    return math.pi if reduced <= -math.pi else reduced
+
+
+def whole_turns(angle: float) -> float:
+    """``angle - principal_angle(angle)`` (rad): the whole turns in ``angle``, exactly 0.0
+    for an angle in (-pi, pi]. A potential on a continuous angle counts the angle from its
+    start's own turn by subtracting this, taken once at the start."""
+    return angle - principal_angle(angle)
 
 
 def forward_kinematics(L1: float, L2: float, q) -> tuple[float, float, float]:

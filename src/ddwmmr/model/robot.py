@@ -206,16 +206,16 @@ class Robot:
             for key, value in data.items():
                 if key in TOML_TABLES:
                     continue
-                what = f"table [{key}]" if isinstance(value, dict | list) else f"key {key!r}"
+                what = f"table [{key}]" if isinstance(value, dict | list) else f"key {shown(key)}"
                 raise ParameterError(
                     f"robot: {path}: unknown {what} (a robot file holds Robot fields, at the "
                     f"top or all under one [robot] table)"
                 )
         table = data.get("robot", data)
         if not isinstance(table, dict):
+            got = "an array of tables [[robot]]" if isinstance(table, list) else shown(table)
             raise ParameterError(
-                f"robot: {path}: [robot] must be one table of Robot fields "
-                f"(got {'an array of tables [[robot]]' if isinstance(table, list) else table!r})"
+                f"robot: {path}: [robot] must be one table of Robot fields (got {got})"
             )
         try:
             return cls.from_dict(table)
@@ -228,12 +228,12 @@ class Robot:
         record); unknown keys and values of the wrong type (``L1 = "0.3"``, ``L1 = true``,
         a number where a pair is expected) are errors naming the key."""
         if not isinstance(data, dict):
-            raise ParameterError(f"robot: expected a table of Robot fields (got {data!r})")
+            raise ParameterError(f"robot: expected a table of Robot fields (got {shown(data)})")
         known = {f.name: f for f in fields(cls) if f.init}
         unknown = sorted(set(data) - set(known))
         if unknown:
             raise ParameterError(
-                f"robot: unknown parameter {unknown[0]!r} (known: {', '.join(sorted(known))})"
+                f"robot: unknown parameter {shown(unknown[0])} (known: {', '.join(sorted(known))})"
             )
         for key, value in data.items():
             _check_field_type(key, value, known[key].default)
@@ -294,7 +294,9 @@ class Robot:
     def augmented_jacobian(self, q, aux: str = "sum") -> np.ndarray:
         """The 5x5 augmented Jacobian (``aux`` is ``"sum"`` or ``"shoulder"``)."""
         if not isinstance(aux, str) or aux not in kinematics.AUX_ROWS:
-            raise ParameterError(f"aux must be one of {sorted(kinematics.AUX_ROWS)} (got {aux!r})")
+            raise ParameterError(
+                f"aux must be one of {sorted(kinematics.AUX_ROWS)} (got {shown(aux)})"
+            )
         return kinematics.augmented_jacobian(self.L1, self.L2, _configuration(q), aux)
 
     # -- wheels ---------------------------------------------------------------------------
@@ -369,7 +371,7 @@ class Robot:
         if not (isinstance(dx, float) and isinstance(dy, float) and _isfinite(dx + dy)):
             _check_scalars(("dx", dx), ("dy", dy))
         if elbow not in (1, -1) or isinstance(elbow, bool):
-            raise ParameterError(f"elbow must be +1 or -1 (got {elbow!r})")
+            raise ParameterError(f"elbow must be +1 or -1 (got {shown(elbow)})")
         r2 = dx * dx + dy * dy
         c2 = (r2 - self.L1**2 - self.L2**2) / (2.0 * self.L1 * self.L2)
         if c2 > 1.0 + 1e-12 or c2 < -1.0 - 1e-12:
@@ -407,7 +409,7 @@ def _check_field_type(key: str, value: Any, default: Any) -> None:
     else:
         return
     if not ok:
-        raise ParameterError(f"robot: {key} must be {wanted} (got {value!r})")
+        raise ParameterError(f"robot: {key} must be {wanted} (got {shown(value)})")
 
 
 def _pair(name: str, value, unit: str = "") -> tuple[float, float]:
@@ -492,7 +494,7 @@ def _points(value) -> tuple[tuple[float, float], ...]:
             f"{name} must be a list of (x, y) pairs in m (got {shown(value, 60)})"
         ) from None
     if not items:
-        raise ParameterError(f"{name} must list at least one (x, y) pair (got {value!r})")
+        raise ParameterError(f"{name} must list at least one (x, y) pair (got {shown(value)})")
     return tuple(_pair(f"{name}[{i}]", p, "m") for i, p in enumerate(items, start=1))
 
 

@@ -50,6 +50,7 @@ import numpy as np
 
 from ddwmmr.commands import FORCE, PlantTraits, WheelForces
 from ddwmmr.controllers.base import StepInfo, WaypointRun, control_step, register_controller
+from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.mpc.braking import braked_velocity, braking_input, should_brake
@@ -257,9 +258,9 @@ class MPCController:
         ``base_velocity = (v, w)`` (m/s, rad/s) is the measured base velocity the thesis
         model needs; without it the previous plan's prediction is used.
         """
-        q = np.asarray(q, dtype=float)
-        pose_d = np.asarray(pose_d, dtype=float)
-        velocity_d = np.asarray(velocity_d, dtype=float)
+        q, pose_d, velocity_d = (
+            np.array(values) for values in check_inputs(t, q, pose_d, velocity_d)
+        )
         reach = self._trajectory is None and not np.any(velocity_d)
         mode = "reach" if reach else "tracking"
         problem = self._problem(mode)

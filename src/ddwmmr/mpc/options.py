@@ -27,6 +27,7 @@ from ddwmmr.errors import (
     check_nonnegative,
     check_positive,
     check_range,
+    shown,
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
@@ -186,12 +187,14 @@ class MPCOptions:
     def __post_init__(self) -> None:
         model, solver, qp_solver = self.model, self.solver, self.qp_solver
         if model is not None and model not in MODELS:
-            raise ParameterError(f"model must be one of {', '.join(MODELS)} (got {model!r})")
+            raise ParameterError(f"model must be one of {', '.join(MODELS)} (got {shown(model)})")
         if solver not in SOLVERS:
-            raise ParameterError(f"solver must be one of {', '.join(SOLVERS)} (got {solver!r})")
+            raise ParameterError(
+                f"solver must be one of {', '.join(SOLVERS)} (got {shown(solver)})"
+            )
         if qp_solver not in QP_SOLVERS:
             raise ParameterError(
-                f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {qp_solver!r})"
+                f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {shown(qp_solver)})"
             )
         lag = self.arm_time_constant
         if lag is not None and lag != 0.0:

@@ -29,7 +29,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.mpc.ocp import ShootingOCP
 
 #: Levenberg-Marquardt floor added to the Gauss-Newton Hessian (keeps it positive definite).
@@ -96,7 +96,7 @@ class GaussNewtonSQP:
     ) -> None:
         if qp_solver not in QP_SOLVERS:
             raise ParameterError(
-                f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {qp_solver!r})"
+                f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {shown(qp_solver)})"
             )
         self.ocp = ocp
         self.qp_solver = qp_solver
@@ -291,4 +291,4 @@ def make_solver(
         return GaussNewtonSQP(ocp, qp_solver, iterations=iterations or 20, proximal=proximal)
     if name in ("ipopt", "sqpmethod", "fatrop"):
         return NLPSolver(ocp, name)
-    raise ParameterError(f"solver must be one of {', '.join(SOLVERS)} (got {name!r})")
+    raise ParameterError(f"solver must be one of {', '.join(SOLVERS)} (got {shown(name)})")

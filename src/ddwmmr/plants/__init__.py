@@ -12,7 +12,7 @@ from __future__ import annotations
 import inspect
 from typing import Any
 
-from ddwmmr.errors import ParameterError, check_instance
+from ddwmmr.errors import ParameterError, check_instance, shown
 from ddwmmr.model import Robot
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.plants.kinematic import INTEGRATORS, KinematicPlant
@@ -46,7 +46,7 @@ def make_plant(name: str, robot: Any, **options: Any) -> Plant:
     unknown = sorted(set(options) - set(accepted))
     if unknown:
         raise ParameterError(
-            f"plant {name}: unknown option {unknown[0]!r} (accepted: {', '.join(accepted)})"
+            f"plant {name}: unknown option {shown(unknown[0])} (accepted: {', '.join(accepted)})"
         )
     return cls(robot, **options)
 

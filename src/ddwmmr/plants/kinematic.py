@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
 from ddwmmr.registry import register_plant
@@ -43,7 +43,7 @@ class KinematicPlant:
     def __init__(self, robot: Robot, integrator: str = "rk4") -> None:
         if integrator not in INTEGRATORS:
             raise ParameterError(
-                f"integrator must be one of {', '.join(INTEGRATORS)} (got {integrator!r})"
+                f"integrator must be one of {', '.join(INTEGRATORS)} (got {shown(integrator)})"
             )
         self.robot = robot
         self.integrator = integrator

@@ -46,6 +46,10 @@ class StepContext:
         dt: control step (s) used for one-step look-ahead checks.
         previous_command: ``(v, w)`` of the controller's previous command, None after a
             reset (kept by the controller, read by slew limits).
+        start_turns: whole turns (rad) of the start's ``(phi, th1, th2)``
+            (:func:`~ddwmmr.model.kinematics.whole_turns`, set at reset): potentials count
+            the angles from the start's own turn, so a start whole turns apart is the same
+            run. ``(0.0, 0.0, 0.0)`` for a start within (-pi, pi].
     """
 
     def __init__(self, robot: Robot, dt: float) -> None:
@@ -60,6 +64,7 @@ class StepContext:
         self.q = (0.0, 0.0, 0.0, 0.0, 0.0)
         self.x = self.y = self.phi = self.th1 = self.th2 = 0.0
         self.previous_command: tuple[float, float] | None = None
+        self.start_turns = (0.0, 0.0, 0.0)
 
     @property
     def jac_e(self) -> np.ndarray:

@@ -44,6 +44,7 @@ from ddwmmr.controllers.base import StepInfo, WaypointRun, control_step, registe
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import whole_turns
 from ddwmmr.model.stability import STABILITY_FLOOR
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import (
@@ -266,6 +267,7 @@ class QPController:
         self.ctx.dt = control_step(self._dt_option, self._loop_step, trajectory, DEFAULT_DT)
         self.backend.reset()
         self.ctx.previous_command = None
+        self.ctx.start_turns = tuple(whole_turns(float(angle)) for angle in q0[2:5])
         self.fallbacks = 0
         self.last = StepInfo()
 

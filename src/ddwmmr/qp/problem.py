@@ -28,7 +28,7 @@ from ctypes import c_int
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, TaskBlock
 from ddwmmr.qp.context import NU, StepContext
 from ddwmmr.qp.limits.base import INF, Limit
@@ -66,11 +66,13 @@ class QPProblem:
     ) -> None:
         for task in tasks:
             if not isinstance(task, Task):
-                raise ParameterError(f"tasks must be ddwmmr.qp.tasks.Task instances (got {task!r})")
+                raise ParameterError(
+                    f"tasks must be ddwmmr.qp.tasks.Task instances (got {shown(task)})"
+                )
         for limit in limits:
             if not isinstance(limit, Limit):
                 raise ParameterError(
-                    f"limits must be ddwmmr.qp.limits.Limit instances (got {limit!r})"
+                    f"limits must be ddwmmr.qp.limits.Limit instances (got {shown(limit)})"
                 )
         self.tasks = list(tasks)
         self.limits = list(limits)

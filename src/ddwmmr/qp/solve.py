@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 import qpsolvers
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.qp.limits.base import INF
 from ddwmmr.qp.problem import QPProblem
 
@@ -39,7 +39,7 @@ _BIG = 0.5 * INF
 def check_mode(mode: str) -> str:
     """Validate the ``mode`` option."""
     if mode not in MODES:
-        raise ParameterError(f"mode must be one of {', '.join(MODES)} (got {mode!r})")
+        raise ParameterError(f"mode must be one of {', '.join(MODES)} (got {shown(mode)})")
     return mode
 
 
@@ -47,7 +47,7 @@ def check_solver(solver: str) -> str:
     """Validate the ``solver`` option against the installed qpsolvers backends."""
     if solver not in qpsolvers.available_solvers:
         raise ParameterError(
-            f"solver must be one of {', '.join(qpsolvers.available_solvers)} (got {solver!r})"
+            f"solver must be one of {', '.join(qpsolvers.available_solvers)} (got {shown(solver)})"
         )
     return solver
 
@@ -99,12 +99,23 @@ class DaqpBackend:
         return x
 
 
+#: Solvers given sparse matrices although they take dense ones: ProxQP's dense backend, in
+#: the AVX2/AVX-512 builds proxsuite loads on such CPUs, returns results that differ in
+#: the last bits from call to call on the same problem (its vectorised loops depend on
+#: where its workspace lands in memory), so a run was not repeatable; its sparse backend
+#: is (see docs/qp.md, Solvers).
+SPARSE_FOR_REPEATABILITY = frozenset({"proxqp"})
+
+
 class QpsolversBackend:
-    """Any qpsolvers backend through :func:`qpsolvers.solve_qp` (sparse where it wants)."""
+    """Any qpsolvers backend through :func:`qpsolvers.solve_qp` (sparse where it wants,
+    and for :data:`SPARSE_FOR_REPEATABILITY`)."""
 
     def __init__(self, solver: str, warm_start: bool = True) -> None:
         self.name = self.solver = check_solver(solver)
-        self.sparse = solver in qpsolvers.sparse_solvers and solver not in qpsolvers.dense_solvers
+        self.sparse = solver in SPARSE_FOR_REPEATABILITY or (
+            solver in qpsolvers.sparse_solvers and solver not in qpsolvers.dense_solvers
+        )
         self.warm_start = warm_start
         self._previous: np.ndarray | None = None
 
@@ -166,7 +177,7 @@ def make_backend(solver: str, warm_start: bool | None = None):
     if solver not in installed:
         raise ParameterError(
             f"solver must be one of the installed QP solvers: {', '.join(installed)} "
-            f"(got {solver!r})"
+            f"(got {shown(solver)})"
         )
     if solver == "daqp":
         return DaqpBackend(warm_start=bool(warm_start))

@@ -17,6 +17,7 @@ import numpy as np
 
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import principal_angle
 from ddwmmr.resolution import kernels
 from ddwmmr.trajectories.base import sampler
 
@@ -30,8 +31,14 @@ DEFAULT_INITIAL_OFFSET = (-0.03, -0.03)
 
 def start_configuration(robot: Robot, trajectory) -> np.ndarray:
     """Configuration with the robot's ``home_pose`` arm whose end effector is at the start
-    pose ``trajectory.pose(0)`` (position and orientation)."""
-    return robot.base_for_end_effector(trajectory.pose(0.0), *robot.home_pose)
+    pose ``trajectory.pose(0)`` (position and orientation).
+
+    The start orientation is taken in (-pi, pi] (:func:`principal_angle`, the identity for
+    one already there): whole turns are the same pose, and a heading of 1e5 rad would
+    leave the base heading too few significant digits to place the end effector to 1e-12 m.
+    """
+    x_e, y_e, phi_e = (float(v) for v in trajectory.pose(0.0))
+    return robot.base_for_end_effector((x_e, y_e, principal_angle(phi_e)), *robot.home_pose)
 
 
 def initial_configuration(robot: Robot, trajectory, offset) -> np.ndarray:

@@ -17,7 +17,7 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import as_completed
 from typing import Any
 
-from ddwmmr.errors import ParameterError, check_finite
+from ddwmmr.errors import ParameterError, check_finite, shown
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import Outcome, RunConfig, run_scenario
 from ddwmmr.workers import process_pool
@@ -78,7 +78,9 @@ def run_many(
         on_done: called with the number of scenarios finished by each completed chunk.
     """
     if executor not in EXECUTORS:
-        raise ParameterError(f"executor must be one of {', '.join(EXECUTORS)} (got {executor!r})")
+        raise ParameterError(
+            f"executor must be one of {', '.join(EXECUTORS)} (got {shown(executor)})"
+        )
     jobs = max(1, min(jobs, len(scenarios)))
     chunks = _chunks(scenarios, jobs)
     if executor == "dask" and client is not None:
@@ -170,15 +172,15 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
     error = outcome.get("error")
     if thread.is_alive() or isinstance(error, TimeoutError):
         raise ParameterError(
-            f"scheduler: no Dask scheduler answered at {address!r} within {timeout:g} s "
+            f"scheduler: no Dask scheduler answered at {shown(address)} within {timeout:g} s "
             "(--connect-timeout)"
         )
     if error is not None:
         reason = _first_line(error)
-        raise ParameterError(f"scheduler: cannot connect to {address!r} ({reason})")
+        raise ParameterError(f"scheduler: cannot connect to {shown(address)} ({reason})")
     reply = outcome.get("reply")
     if not (isinstance(reply, dict) and reply.get("type") == "Scheduler"):
-        raise ParameterError(f"scheduler: {address!r} answered, but not as a Dask scheduler")
+        raise ParameterError(f"scheduler: {shown(address)} answered, but not as a Dask scheduler")
 
 
 async def _identity(address: str) -> Any:
@@ -260,13 +262,13 @@ class DaskWorkers:
         except TimeoutError:
             self.close()
             raise ParameterError(
-                f"scheduler: the Dask scheduler at {self.scheduler!r} has no worker "
+                f"scheduler: the Dask scheduler at {shown(self.scheduler)} has no worker "
                 f"(none joined within {self.connect_timeout:g} s)"
             ) from None
         except (OSError, ValueError) as exc:
             self.close()
             raise ParameterError(
-                f"scheduler: cannot connect to {self.scheduler!r} ({_first_line(exc)})"
+                f"scheduler: cannot connect to {shown(self.scheduler)} ({_first_line(exc)})"
             ) from None
         return self._client
 

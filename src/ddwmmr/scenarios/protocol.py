@@ -59,7 +59,7 @@ from ddwmmr.controllers.base import (
     controller_traits,
     make_controller,
 )
-from ddwmmr.errors import ParameterError, check_nonnegative, check_positive
+from ddwmmr.errors import ParameterError, check_nonnegative, check_positive, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_FLOOR, stability_terms
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
@@ -147,7 +147,7 @@ class RunConfig:
         controllers = scenario_controllers()
         if self.controller not in controllers:
             raise ParameterError(
-                f"controller must be one of {', '.join(controllers)} (got {self.controller!r})"
+                f"controller must be one of {', '.join(controllers)} (got {shown(self.controller)})"
             )
         PLANTS.entry(self.plant)  # an unknown name: one line naming the known ones
         accepted = plants_for(self.controller)

@@ -49,6 +49,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from math import isfinite
 from typing import Any, Protocol
 
 import numpy as np
@@ -193,9 +194,14 @@ def run_loop(
 
     def law_policy(t: float, q: list[float]) -> tuple[float, ...]:
         """The same through the controller's float-level ``law`` (no validation, no step
-        info: stage states are the integrator's own finite floats)."""
+        info: stage states are the integrator's own finite floats). A non-finite input
+        goes through ``command``, whose validation names the argument that made it (a
+        reference that turned NaN between samples is the same ParameterError as at one)."""
         pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
-        return law(t, q, pose_d.tolist(), velocity_d.tolist())[0]
+        u = law(t, q, pose_d.tolist(), velocity_d.tolist())[0]
+        if isfinite(u[0] + u[1] + u[2] + u[3]):
+            return u
+        return command_of(t, np.array(q), pose_d, velocity_d)
 
     stage_policy = None
     if not (force or getattr(controller, "zero_order_hold", False)):

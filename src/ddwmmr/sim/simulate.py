@@ -41,8 +41,8 @@ def check_trajectory(trajectory: Any) -> None:
     ``duration`` (s), ``pose(t)`` and ``velocity(t)``."""
     if isinstance(trajectory, str):
         raise ParameterError(
-            f"trajectory must be a trajectory object, not its name {trajectory!r} "
-            f"(ddwmmr.load_trajectory({trajectory!r}) builds one)"
+            f"trajectory must be a trajectory object, not its name {shown(trajectory)} "
+            f"(ddwmmr.load_trajectory({shown(trajectory)}) builds one)"
         )
     missing = [
         name
@@ -323,7 +323,7 @@ def plant_integrator(plant: str, integrator: str | None) -> str | None:
         return integrator or "rk4"
     if integrator is not None:
         raise ParameterError(
-            f"integrator: only the kinematic plant takes an integrator (plant {plant!r})"
+            f"integrator: only the kinematic plant takes an integrator (plant {shown(plant)})"
         )
     return None
 

@@ -30,12 +30,13 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+from collections.abc import Iterable
 from dataclasses import fields
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.errors import ParameterError, check_number_type, load_toml
+from ddwmmr.errors import ParameterError, check_number_type, load_toml, shown
 from ddwmmr.trajectories.parametric import Ellipse, Rectangle
 from ddwmmr.trajectories.sampled import read_csv
 
@@ -70,9 +71,22 @@ def available_trajectories() -> list[str]:
     for folder in trajectory_folders():
         if folder.is_dir():
             names.update(
-                p.stem for p in folder.iterdir() if p.suffix in SUFFIXES and is_name(p.stem)
+                p.stem
+                for p in folder.iterdir()
+                if p.suffix in SUFFIXES and is_name(p.stem) and p.is_file()
             )
     return sorted(names)
+
+
+def _named_file(candidates: Iterable[Path]) -> Path | None:
+    """The first candidate that is there and not a folder: a regular file, or a FIFO, a
+    socket or a dangling link, which reading then refuses as not a regular file (skipping
+    them said "unknown trajectory 'fifo'" while listing fifo among the known names, which
+    list regular files only)."""
+    for candidate in candidates:
+        if candidate.is_file() or (os.path.lexists(candidate) and not candidate.is_dir()):
+            return candidate
+    return None
 
 
 def find_trajectory_file(name_or_path: str | Path) -> Path | None:
@@ -87,20 +101,18 @@ def find_trajectory_file(name_or_path: str | Path) -> Path | None:
         if path.suffix not in SUFFIXES:
             known = ", ".join(available_trajectories())
             raise ParameterError(
-                f"traj: {text!r} is neither a trajectory name ({known}) nor a .toml/.csv path"
+                f"traj: {shown(text)} is neither a trajectory name ({known}) nor a .toml/.csv path"
             )
         if not os.path.lexists(path):
             raise ParameterError(f"traj: no such file {path}")
         return path
-    for folder in trajectory_folders():
-        for suffix in SUFFIXES:
-            candidate = folder / f"{text}{suffix}"
-            if candidate.is_file():
-                return candidate
+    found = _named_file(f / f"{text}{suffix}" for f in trajectory_folders() for suffix in SUFFIXES)
+    if found is not None:
+        return found
     if text in SHAPES:
         return None
     raise ParameterError(
-        f"traj: unknown trajectory {text!r} "
+        f"traj: unknown trajectory {shown(text)} "
         f"(known: {', '.join(available_trajectories())}; or give a .toml/.csv path)"
     )
 
@@ -118,13 +130,19 @@ def find_obstacle_file(name_or_path: str | Path) -> Path:
     text = str(name_or_path)
     if not is_name(text):
         return Path(text)
-    for folder in trajectory_folders():
-        candidate = folder / "obstacles" / f"{text}.toml"
-        if candidate.is_file():
-            return candidate
-    known = sorted({p.stem for f in trajectory_folders() for p in (f / "obstacles").glob("*.toml")})
+    found = _named_file(folder / "obstacles" / f"{text}.toml" for folder in trajectory_folders())
+    if found is not None:
+        return found
+    known = sorted(
+        {
+            p.stem
+            for f in trajectory_folders()
+            for p in (f / "obstacles").glob("*.toml")
+            if p.is_file()
+        }
+    )
     raise ParameterError(
-        f"obstacles: unknown obstacle file {text!r} (known: {', '.join(known) or 'none'}; "
+        f"obstacles: unknown obstacle file {shown(text)} (known: {', '.join(known) or 'none'}; "
         "or give a .toml path)"
     )
 
@@ -165,7 +183,7 @@ def read_toml(path: str | Path, **overrides):
     unknown = sorted(set(table) - set(known))
     if unknown:
         raise ParameterError(
-            f"traj: {path}: unknown key {unknown[0]!r} (known: shape, {', '.join(known)})"
+            f"traj: {path}: unknown key {shown(unknown[0])} (known: shape, {', '.join(known)})"
         )
     _check_types(path, table)
     try:
@@ -180,7 +198,7 @@ def _check_types(path: Path, table: dict[str, Any]) -> None:
     for key, value in table.items():
         if key in _STRING_KEYS:
             if not isinstance(value, str):
-                raise ParameterError(f"traj: {path}: {key} must be a string (got {value!r})")
+                raise ParameterError(f"traj: {path}: {key} must be a string (got {shown(value)})")
         else:
             try:
                 check_number_type(key, value)

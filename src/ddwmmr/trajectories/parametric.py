@@ -30,6 +30,7 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_positive,
     check_range,
+    shown,
 )
 from ddwmmr.trajectories.base import atan2_array, check_time
 
@@ -84,7 +85,8 @@ class _Parametric(ABC):
         object.__setattr__(self, "N", check_int_at_least("N", self.N, 2, MAX_TRAJECTORY_SAMPLES))
         if self.orientation not in ORIENTATIONS:
             raise ParameterError(
-                f"orientation must be one of {', '.join(ORIENTATIONS)} (got {self.orientation!r})"
+                f"orientation must be one of {', '.join(ORIENTATIONS)}"
+                f" (got {shown(self.orientation)})"
             )
 
     @property

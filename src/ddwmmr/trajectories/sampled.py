@@ -24,6 +24,7 @@ from ddwmmr.errors import (
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
     read_text_file,
+    shown,
 )
 from ddwmmr.trajectories.base import atan2_array, check_time
 
@@ -79,7 +80,9 @@ class SampledTrajectory:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
-            raise ParameterError(f"trajectory samples: name must be a string (got {self.name!r})")
+            raise ParameterError(
+                f"trajectory samples: name must be a string (got {shown(self.name)})"
+            )
         times = _float_array("times", self.times, "sample times (s)")
         points = _float_array("points", self.points, "an (n, 2) or (n, 3) array (m, rad)")
         if times.ndim != 1 or len(times) < 3:
@@ -260,7 +263,7 @@ def _check_steps(times: np.ndarray) -> None:
         row = int(np.argmax(steps <= 0)) + 2
         raise ParameterError(
             f"trajectory samples: times (column t) must be strictly increasing (row {row}: "
-            f"{float(times[row - 2])!r} then {float(times[row - 1])!r})"
+            f"{shown(float(times[row - 2]))} then {shown(float(times[row - 1]))})"
         )
     duration = float(times[-1] - times[0])
     low, high = DURATION_RANGE_S
@@ -314,17 +317,35 @@ def csv_text(trajectory: SampledTrajectory) -> str:
     return "\n".join(rows) + "\n"
 
 
+#: The columns a trajectory CSV may have, in order.
+CSV_COLUMNS = ("t", "x", "y", "phi")
+
+
 def _csv_number(path: Path, number: int, row: dict, key: str) -> float:
-    """The value of column ``key`` in data row ``number`` as a float (one-line errors)."""
+    """The value of column ``key`` in data row ``number`` as a float (one-line errors).
+
+    Python's ``float`` also reads ``1_0`` as 10 and non-ASCII digits; a CSV number is
+    plain ASCII without underscores."""
     text = row.get(key)
     if text is None or not text.strip():
         raise ParameterError(f"traj: {path} data row {number} has no value in column {key}")
     try:
+        if "_" in text or not text.isascii():
+            raise ValueError(text)
         return float(text)
     except ValueError:
         raise ParameterError(
-            f"traj: {path} data row {number}, column {key}: {text.strip()!r} is not a number"
+            f"traj: {path} data row {number}, column {key}: {shown(text.strip())} is not a number"
         ) from None
+
+
+def _is_number_text(text: str) -> bool:
+    """Whether a header field reads as a number (a data line taken for the header)."""
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
 
 
 def read_csv(path: str | Path) -> SampledTrajectory:
@@ -359,6 +380,12 @@ def read_csv(path: str | Path) -> SampledTrajectory:
             for name in {header[i] for i in blank}:
                 row.pop(name, None)
         header = [name for name in header if name.strip()]
+    if header and all(_is_number_text(name) for name in header):
+        raise ParameterError(
+            f"traj: {path} has no header line (its first line that does not start with # "
+            f"holds numbers: {shown(','.join(header), 40)}); needs {expected} "
+            "(a line starting with # is a comment)"
+        )
     repeated = sorted({name for name in header if header.count(name) > 1})
     if repeated:
         raise ParameterError(
@@ -370,6 +397,12 @@ def read_csv(path: str | Path) -> SampledTrajectory:
                 f"traj: {path} data row {number} has more values than the header's "
                 f"{len(header)} columns"
             )
+    unknown = [name for name in header if name not in CSV_COLUMNS]
+    if unknown:
+        raise ParameterError(
+            f"traj: {path} has unknown column(s) {', '.join(shown(n, 40) for n in unknown)} "
+            f"(accepted: {', '.join(CSV_COLUMNS)}, lower case); needs {expected}"
+        )
     columns = set(rows[0])
     missing = {"t", "x", "y"} - columns
     if missing:

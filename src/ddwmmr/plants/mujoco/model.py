@@ -45,7 +45,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.errors import ParameterError, check_positive, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import BASE_CLEARANCE_M
 from ddwmmr.model.support_loads import convex_hull
@@ -112,7 +112,7 @@ class EngineOptions:
         for name in ("timestep", "friction", "servo_time_constant", "contact_time_constant"):
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
         if self.cone not in CONES:
-            raise ParameterError(f"cone must be one of {', '.join(CONES)} (got {self.cone!r})")
+            raise ParameterError(f"cone must be one of {', '.join(CONES)} (got {shown(self.cone)})")
         if self.contact_time_constant < 2.0 * self.timestep:
             raise ParameterError(
                 f"contact_time_constant must be >= 2 timesteps = {2 * self.timestep:g} s "

@@ -30,7 +30,7 @@ import mujoco
 import numpy as np
 
 from ddwmmr.commands import VELOCITY, WheelForces, interface_of
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import wrap_angle
 from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
@@ -234,12 +234,12 @@ class MujocoPlant:
         try:
             ratio = float(dt) / h
         except (TypeError, ValueError):
-            raise ParameterError(f"dt must be a number (got {dt!r})") from None
+            raise ParameterError(f"dt must be a number (got {shown(dt)})") from None
         substeps = round(ratio) if math.isfinite(ratio) else 0
         if substeps < 1 or abs(substeps * h - dt) > 1e-9 * max(1.0, abs(dt)):
             raise ParameterError(
                 f"dt must be a whole multiple of the MuJoCo timestep {h:g} s "
-                f"({self.control_step_choices()}, ...) (got {dt!r})"
+                f"({self.control_step_choices()}, ...) (got {shown(dt)})"
             )
         return substeps
 
@@ -679,9 +679,9 @@ def _check_damping(value: tuple[float, float] | None) -> tuple[float, float] | N
         c_t, c_yaw = (float(v) for v in value)
     except (TypeError, ValueError):
         raise ParameterError(
-            f"base_damping must be (N s/m, N m s/rad), two numbers >= 0 (got {value!r})"
+            f"base_damping must be (N s/m, N m s/rad), two numbers >= 0 (got {shown(value)})"
         ) from None
     for name, number in (("base_damping[1]", c_t), ("base_damping[2]", c_yaw)):
         if not (math.isfinite(number) and number >= 0.0):
-            raise ParameterError(f"{name} must be a finite number >= 0 (got {number!r})")
+            raise ParameterError(f"{name} must be a finite number >= 0 (got {shown(number)})")
     return c_t, c_yaw

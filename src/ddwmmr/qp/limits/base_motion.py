@@ -28,7 +28,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.errors import ParameterError, check_positive, shown
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import Limit
@@ -118,7 +118,8 @@ class SpeedBudgetLimit(Limit):
     def __init__(self, speeds: tuple[float, float]) -> None:
         if isinstance(speeds, str) or not hasattr(speeds, "__len__") or len(speeds) != 2:
             raise ParameterError(
-                f"speed_budget must be two numbers > 0, (v_top m/s, w_top rad/s) (got {speeds!r})"
+                f"speed_budget must be two numbers > 0, (v_top m/s, w_top rad/s)"
+                f" (got {shown(speeds)})"
             )
         v_top = check_positive("speed_budget v_top", speeds[0])
         w_top = check_positive("speed_budget w_top", speeds[1])

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from ddwmmr.errors import check_nonnegative, check_positive
+from ddwmmr.errors import check_nonnegative
+from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
@@ -26,7 +27,7 @@ class JointLimit(Limit):
     def __init__(self, robot: Robot, gain: float = 5.0, margin: float = 0.02) -> None:
         self.limits = robot.joint_limits
         self.speed = robot.joint_speed_limit * (1.0 - 1e-6)
-        self.gain = check_positive("joint limit gain", gain)
+        self.gain = check_gain("joint limit gain", gain)
         self.margin = check_nonnegative("joint limit margin", margin)
 
     def joint_bounds(self, angle: float, joint: int) -> tuple[float, float]:

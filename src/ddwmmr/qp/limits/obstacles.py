@@ -32,10 +32,12 @@ from ddwmmr.errors import (
     load_toml,
     shown,
 )
+from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
+from ddwmmr.trajectories.files import find_obstacle_file
 
 
 @dataclass(frozen=True)
@@ -60,7 +62,7 @@ def load_obstacles(path: str | Path) -> list[Circle]:
     unknown = sorted(set(data) - {"obstacle"})
     if unknown:
         raise ParameterError(
-            f"obstacles: {path}: unknown key {unknown[0]!r} (expected [[obstacle]])"
+            f"obstacles: {path}: unknown key {shown(unknown[0])} (expected [[obstacle]])"
         )
     if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables or [None]):
         raise ParameterError(f"obstacles: {path} needs [[obstacle]] tables with x, y, radius in m")
@@ -95,11 +97,13 @@ def within_limits(x: float, y: float, radius: float) -> Circle:
 
 
 def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> list[Circle]:
-    """Normalise the ``obstacles`` option: circles, (x, y, radius) triples, or a TOML path."""
+    """Normalise the ``obstacles`` option: circles, (x, y, radius) triples, or a TOML file:
+    a path, or a shipped or folder name such as ``ellipse_post`` looked up as ``track
+    --obstacles`` does (:func:`~ddwmmr.trajectories.files.find_obstacle_file`)."""
     if obstacles is None:
         return []
     if isinstance(obstacles, str | Path):
-        return load_obstacles(obstacles)
+        return load_obstacles(find_obstacle_file(obstacles))
     if not hasattr(obstacles, "__iter__"):
         raise ParameterError(
             f"obstacles must be circles, (x, y, radius) triples or a TOML file "
@@ -114,7 +118,8 @@ def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> li
             x, y, radius = item
         except (TypeError, ValueError):
             raise ParameterError(
-                f"obstacles must be Circle(x, y, radius) or (x, y, radius) triples (got {item!r})"
+                f"obstacles must be Circle(x, y, radius) or (x, y, radius) triples"
+                f" (got {shown(item)})"
             ) from None
         circles.append(Circle(x, y, radius))
     return circles
@@ -235,7 +240,7 @@ class ObstacleLimit(Limit):
             raise ParameterError(
                 f"obstacle influence must be > margin ({margin:g} m) (got {influence:g})"
             )
-        self.gain = check_positive("obstacle gain", gain)
+        self.gain = check_gain("obstacle gain", gain)
         r, lw, limit = robot.wheel_radius, robot.track_width, robot.wheel_speed_limit
         self.v_max, self.w_max = r * limit, 2.0 * r * limit / lw
 

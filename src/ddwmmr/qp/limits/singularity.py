@@ -16,6 +16,7 @@ import math
 from collections.abc import Callable
 
 from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.gains import check_gain
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
@@ -38,7 +39,7 @@ class ShoulderSingularityLimit(Limit):
         if self.margin >= 0.5 * math.pi:
             raise ParameterError(f"singularity_margin must be in (0, pi/2) rad (got {margin:g})")
         self.floor = math.sin(self.margin) ** 2
-        self.gain = check_positive("singularity gain", gain)
+        self.gain = check_gain("singularity gain", gain)
         self.joint_speed = check_positive("joint speed", joint_speed)
 
     def values(self, ctx: StepContext) -> tuple[float, float]:

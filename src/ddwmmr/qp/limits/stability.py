@@ -20,6 +20,7 @@ import math
 from collections.abc import Callable
 
 from ddwmmr.errors import check_positive
+from ddwmmr.gains import check_gain
 from ddwmmr.model.stability import (
     STABILITY_CAP,
     STABILITY_FLOOR,
@@ -151,7 +152,7 @@ class StabilityLimit(Limit):
     ) -> None:
         self.com = robot_com
         self.stability_min = check_stability_floor(stability_min)
-        self.gain = check_positive("stability gain", gain)
+        self.gain = check_gain("stability gain", gain)
         self.margin = check_positive("stability margin", margin)
         self.joint_speed = check_positive("joint speed", joint_speed)
 

@@ -13,6 +13,7 @@ import math
 from collections.abc import Sequence
 
 from ddwmmr.errors import check_positive
+from ddwmmr.gains import check_gain
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.obstacles import Circle, clearance_and_rate
 from ddwmmr.qp.tasks.base import YawRowTask
@@ -38,7 +39,7 @@ class ObstacleSteeringTask(YawRowTask):
         self.circles = list(circles)
         self.half_length, self.half_width = half_length, half_width
         self.influence = check_positive("obstacle influence", influence)
-        self.gain = check_positive("obstacle steering gain", gain)
+        self.gain = check_gain("obstacle steering gain", gain)
 
     def values(self, ctx: StepContext) -> tuple[float, float]:
         """``(J[0, 1], e[0])``: 1 and the yaw-rate target (rad/s) while a circle ahead is

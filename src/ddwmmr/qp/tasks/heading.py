@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from ddwmmr.errors import check_nonnegative, check_positive
+from ddwmmr.gains import check_gain
 from ddwmmr.model.kinematics import wrap_angle
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import YawRowTask
@@ -28,7 +29,7 @@ class HeadingTask(YawRowTask):
         self, weight: float = 1.0, gain: float = 2.0, distance: float = 0.8, fade: float = 0.3
     ) -> None:
         super().__init__(weight)
-        self.gain = check_positive("heading gain", gain)
+        self.gain = check_gain("heading gain", gain)
         self.distance = check_nonnegative("heading distance", distance)
         self.fade = check_positive("heading fade", fade)
         #: Optional :class:`~ddwmmr.qp.tasks.avoidance.Detour` for the bearing.

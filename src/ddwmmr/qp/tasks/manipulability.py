@@ -25,7 +25,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ddwmmr.errors import check_positive
+from ddwmmr.gains import check_gain
 from ddwmmr.model.kinematics import wrap_angle
 from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
@@ -80,9 +80,9 @@ class ManipulabilityTask(Task):
     ) -> None:
         super().__init__(weight)
         self.arm_row = bool(arm_row)
-        self.gain = check_positive("manipulability gain", gain)
-        self.base_gain = check_positive("manipulability base_gain", base_gain)
-        self.heading_gain = check_positive("manipulability heading_gain", heading_gain)
+        self.gain = check_gain("manipulability gain", gain)
+        self.base_gain = check_gain("manipulability base_gain", base_gain)
+        self.heading_gain = check_gain("manipulability heading_gain", heading_gain)
 
     def row_weights(self) -> np.ndarray:
         """``(weight, weight)``, or ``(0, weight)`` without the arm row."""

@@ -9,7 +9,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ddwmmr.errors import check_nonnegative, check_positive
+from ddwmmr.errors import check_positive
+from ddwmmr.gains import check_gain
 from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import Task, bounded
@@ -42,10 +43,10 @@ class PostureTask(Task):
         super().__init__(weight)
         #: Bound (rad/s) of each row's target, None for none (see EndEffectorTask).
         self.rate_limit = None if rate_limit is None else check_positive("rate_limit", rate_limit)
-        self.K1 = check_nonnegative("K1", K1)
-        self.K2 = check_nonnegative("K2", K2)
-        self.K3 = check_nonnegative("K3", K3)
-        self.gain = check_positive("posture gain", gain)
+        self.K1 = check_gain("K1", K1, zero=True)
+        self.K2 = check_gain("K2", K2, zero=True)
+        self.K3 = check_gain("K3", K3, zero=True)
+        self.gain = check_gain("posture gain", gain)
 
     def row_weights(self) -> np.ndarray:
         """``weight * (K3, K1, K2)`` for the rows (w, th1dot, th2dot)."""
@@ -58,9 +59,13 @@ class PostureTask(Task):
         error[0], error[1], error[2] = self.targets(ctx)
 
     def targets(self, ctx: StepContext) -> tuple[float, float, float]:
-        """``-gain * (phi, th1, th2)`` (rad/s), each bounded by ``rate_limit``."""
+        """``-gain * (phi, th1, th2)`` (rad/s), each bounded by ``rate_limit``; the angles
+        count from the start's own turn (``ctx.start_turns``)."""
         gain, limit = self.gain, self.rate_limit
-        e0, e1, e2 = -gain * ctx.phi, -gain * ctx.th1, -gain * ctx.th2
+        turns_phi, turns_1, turns_2 = ctx.start_turns
+        e0 = -gain * (ctx.phi - turns_phi)
+        e1 = -gain * (ctx.th1 - turns_1)
+        e2 = -gain * (ctx.th2 - turns_2)
         if limit is None:
             return e0, e1, e2
         return bounded(e0, limit), bounded(e1, limit), bounded(e2, limit)

@@ -76,7 +76,7 @@ class Document:
 
     def to_markdown(self) -> str:
         """Markdown text; figures are linked by relative file name."""
-        parts = [f"# {self.title}"]
+        parts = [f"# {_md_inline(self.title)}"]
         for kind, data in self.blocks:
             parts.append(_MARKDOWN[kind](data))
         return "\n\n".join(parts) + "\n"
@@ -89,22 +89,44 @@ class Document:
         return _HTML_PAGE.format(title=html.escape(self.title), body="\n".join(body))
 
 
+#: Where Markdown would start raw HTML: ``<`` before a tag name, ``/``, ``!`` or ``?``.
+_MD_TAG = re.compile(r"<(?=[A-Za-z/!?])")
+#: A backquoted code span of the inline markup (its text is shown as it is).
+_MD_CODE = re.compile(r"(`[^`]*`)")
+_LINE_BREAK = re.compile(r"\r\n|[\r\n\v\f\x85\u2028\u2029]")
+
+
+def _md_inline(text: str) -> str:
+    """Markdown for one block's text, as :func:`_inline` is its HTML: a name holding
+    ``<img ...>`` shows as text (``&lt;img``, outside code spans, where Markdown would
+    pass raw HTML through) and a line break becomes a space (it would end a table row or
+    a heading, or start a block)."""
+    text = _LINE_BREAK.sub(" ", text)
+    parts = _MD_CODE.split(text)
+    return "".join(p if i % 2 else _MD_TAG.sub("&lt;", p) for i, p in enumerate(parts))
+
+
 def _md_table(data: tuple[list[str], list[list[str]]]) -> str:
     headers, rows = data
     lines = [
-        "| " + " | ".join(headers) + " |",
+        "| " + " | ".join(_md_cell(h) for h in headers) + " |",
         "|" + "|".join([":---"] + ["---:"] * (len(headers) - 1)) + "|",
     ]
-    lines += ["| " + " | ".join(cell.replace("|", "\\|") for cell in row) + " |" for row in rows]
+    lines += ["| " + " | ".join(_md_cell(cell) for cell in row) + " |" for row in rows]
     return "\n".join(lines)
 
 
+def _md_cell(text: str) -> str:
+    """A table cell: :func:`_md_inline` with ``|`` escaped."""
+    return _md_inline(text).replace("|", "\\|")
+
+
 _MARKDOWN: dict[str, Callable[[Any], str]] = {
-    "heading": lambda d: "#" * d[0] + " " + d[1],
-    "paragraph": lambda d: d,
-    "bullets": lambda d: "\n".join(f"- {item}" for item in d),
+    "heading": lambda d: "#" * d[0] + " " + _md_inline(d[1]),
+    "paragraph": _md_inline,
+    "bullets": lambda d: "\n".join(f"- {_md_inline(item)}" for item in d),
     "table": _md_table,
-    "figure": lambda d: f"![{d[1]}]({d[0]})\n\n*{d[1]}*",
+    "figure": lambda d: f"![{_md_inline(d[1])}]({d[0]})\n\n*{_md_inline(d[1])}*",
 }
 
 

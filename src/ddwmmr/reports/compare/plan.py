@@ -11,6 +11,7 @@ method's default, so a method the presets treat alike runs once and serves both 
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Sequence
 from concurrent.futures import as_completed
 from dataclasses import dataclass, field, replace
@@ -20,7 +21,7 @@ import numpy as np
 
 from ddwmmr.controllers.base import make_controller
 from ddwmmr.controllers.presets import PRESETS, check_preset, preset_differences
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.progress import ProgressBar
@@ -44,6 +45,39 @@ from ddwmmr.trajectories.base import resolution_step
 from ddwmmr.workers import process_pool
 
 # -- configuration and plan ---------------------------------------------------------------
+
+#: Longest trajectory name of a report: it becomes part of file names such as
+#: ``plant_mujoco_<name>.png``, which must stay well under the 255 bytes a file name has.
+MAX_REPORT_NAME = 100
+#: A report name: letters, digits, ``_``, ``-`` and inner dots (a file name on any system,
+#: a Markdown link target, no path).
+_REPORT_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+
+
+def report_name(name: str) -> str:
+    """``name`` made a report name: every character other than a letter, a digit, ``_``,
+    ``-`` or ``.`` becomes ``_`` (a leading dot too, and ``..`` becomes ``__``), cut to
+    :data:`MAX_REPORT_NAME` characters; a valid one is returned unchanged."""
+    safe = re.sub(r"[^A-Za-z0-9_.-]", "_", str(name)).replace("..", "__")
+    safe = "_" + safe[1:] if safe[:1] in (".", "-", "") else safe
+    return safe[:MAX_REPORT_NAME]
+
+
+def check_report_name(name: Any) -> str:
+    """``name`` if it is a report name (:func:`report_name` leaves it as it is), else
+    :class:`ParameterError` before any run (it names files the report writes)."""
+    if not (
+        isinstance(name, str)
+        and len(name) <= MAX_REPORT_NAME
+        and _REPORT_NAME.fullmatch(name)
+        and ".." not in name
+    ):
+        raise ParameterError(
+            f"trajectory name {shown(name)} cannot name the report's files: use letters, "
+            f"digits, _, - and inner dots, at most {MAX_REPORT_NAME} characters "
+            f"(e.g. {report_name(str(name))[:40]!r})"
+        )
+    return name
 
 
 @dataclass
@@ -83,6 +117,8 @@ class CompareConfig:
 
     def __post_init__(self) -> None:
         check_preset(self.preset)
+        for name in self.trajectories:
+            check_report_name(name)
         for plant in self.plants:
             if plant not in available_plants() or plant == "kinematic":
                 others = [p for p in available_plants() if p != "kinematic"]
