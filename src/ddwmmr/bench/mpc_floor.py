@@ -256,9 +256,10 @@ def measure_mpc_floor(
     default trajectories tracked on the kinematic plant with the default ``mpc``, and the
     first ``scenarios`` thesis-benchmark scenarios (seed 0) with ``mpc`` on the thesis
     plant, run one after the other."""
-    from ddwmmr import Robot, simulate
+    from ddwmmr.model import Robot
     from ddwmmr.scenarios.generator import generate
     from ddwmmr.scenarios.protocol import RunConfig, run_scenario
+    from ddwmmr.sim import simulate
     from ddwmmr.trajectories import Ellipse, Rectangle
 
     trajectories = {"rectangle": Rectangle, "ellipse": Ellipse}
