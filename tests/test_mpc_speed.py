@@ -65,35 +65,3 @@ def test_buffered_qp_steps_equal_the_keyword_call_at_every_iteration(qp_solver):
         steps += np.max(np.abs(expected)) > 1e-9
         w = buffered
     assert steps >= 3  # the iterations moved: the comparison covered real steps
-
-
-def test_a_new_target_is_planned_from_the_shifted_plan_in_one_qp():
-    """The first step of a run starts cold (several QPs); a new target does not: its step
-    is one QP from the previous plan stretched over the whole horizon, and the robot then
-    heads for the new target."""
-    from ddwmmr import make_controller
-    from ddwmmr.plants.thesis import ThesisPlant, ThesisState
-
-    controller = make_controller("mpc", HEAVY, model="thesis", track_orientation=False, dt=0.01)
-    plant = ThesisPlant(HEAVY)
-    state = ThesisState(0.0, 0.0, 0.0, *default_pose(HEAVY))
-    controller.reset(None, np.array(state.q))
-    iterations, distances = [], []
-    for k in range(160):
-        target = (1.0, 0.5) if k < 60 else (0.0, 1.5)
-        command = controller.command(
-            k * 0.01,
-            np.array(state.q),
-            np.array([*target, 0.0]),
-            np.zeros(3),
-            base_velocity=(state.v, state.w),
-        )
-        iterations.append(controller.last.extra["mpc_iterations"])
-        plant.advance(
-            state, command.left, command.right, (command.th1_target, command.th2_target), 0.01
-        )
-        end_effector = HEAVY.fk(np.array(state.q))[:2]
-        distances.append(float(np.hypot(*(end_effector - np.array(target)))))
-    assert iterations[0] > 1 and iterations[60] == 1
-    assert max(iterations[1:]) == 1 and controller.restarts == 0
-    assert distances[-1] < distances[60] - 0.1

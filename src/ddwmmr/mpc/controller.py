@@ -6,10 +6,8 @@ Every control step (one call per step; the command is held over it, ``zero_order
    node 0 of the OCP (:mod:`ddwmmr.mpc.ocp`);
 2. the references of the nodes come from the trajectory's future poses (tracking), or the
    target ``pose_d`` is to be reached as early as possible (waypoint mode, free horizon);
-3. the previous solution, shifted by the elapsed time, is the warm start (for a new
-   target, stretched over the whole horizon); one Gauss-Newton iteration (the real-time
-   iteration, default) or a full solve updates it: every step but the first of a run (and
-   a restart) costs one QP;
+3. the previous solution, shifted by the elapsed time, is the warm start; one Gauss-Newton
+   iteration (the real-time iteration, default) or a full solve updates it;
 4. the first input is applied: a velocity command (kinematic model) or wheel forces and
    one-step joint targets (thesis model); an exact check of S one step ahead scales the
    joint rates back if the linearisation was too optimistic (not a braking step's rates,
@@ -271,23 +269,16 @@ class MPCController:
         references = self._references(problem, t, pose_d, velocity_d)
         target = (float(pose_d[0]), float(pose_d[1]))
         new_target = reach and self._target != target
-        # a new target starts from the shifted plan (one QP, like any step), not cold
-        cold = self._warm is None or self._warm_mode != mode
+        cold = self._warm is None or self._warm_mode != mode or new_target
         stuck = reach and self._stall.stuck(t, tuple(self.robot.fk(q)[:2]), new_target)
-        if cold or new_target:
+        if cold:
             self._stall.fresh_plan()
-        if stuck and not cold:
+        elif stuck:
             cold = True
             self.restarts += 1
         try:
             w, iterations = problem.solve(
-                t,
-                x0,
-                references,
-                self._u_prev,
-                None if cold else self._warm,
-                self._warm_time,
-                retarget=new_target,
+                t, x0, references, self._u_prev, None if cold else self._warm, self._warm_time
             )
         except SolverFailure as failure:
             return self._fallback_command(t, q, pose_d, velocity_d, x0, str(failure))

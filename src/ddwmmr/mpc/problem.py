@@ -13,7 +13,7 @@ from ddwmmr.mpc.models import PredictionModel
 from ddwmmr.mpc.ocp import OCPConfig
 from ddwmmr.mpc.solvers import make_solver
 
-#: Gauss-Newton iterations of a cold start (first step, restart, after a fallback).
+#: Gauss-Newton iterations of a cold start (first step, new target, after a fallback).
 COLD_ITERATIONS = 5
 
 
@@ -60,18 +60,13 @@ class Problem:
         node = np.concatenate([x0, [ocp.config.horizon]])[: ocp.nx]
         return ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
 
-    def _shifted(
-        self, warm: np.ndarray, elapsed: float, x0: np.ndarray, retarget: bool = False
-    ) -> tuple:
-        """The previous solution moved ``elapsed`` s forward (linear interpolation); with
-        ``retarget`` (a new target) stretched over the whole horizon, held at its end."""
+    def _shifted(self, warm: np.ndarray, elapsed: float, x0: np.ndarray) -> tuple:
+        """The previous solution moved ``elapsed`` s forward (linear interpolation)."""
         ocp = self.ocp
         xs, us = ocp.trajectories(warm)
         old_horizon = ocp.horizon_of(warm)
         horizon = old_horizon
-        if retarget:
-            horizon = ocp.config.horizon
-        elif ocp.config.reach:
+        if ocp.config.reach:
             horizon = min(max(old_horizon - elapsed, ocp.config.min_horizon), ocp.config.horizon)
         old_t = ocp.node_times(old_horizon)
         new_t = ocp.node_times(horizon) + elapsed
@@ -82,19 +77,13 @@ class Problem:
         xs[0, : ocp.nxm] = x0
         return ocp.pack(xs, us), horizon
 
-    def solve(
-        self, t, x0, references, u_prev, warm, warm_time, retarget: bool = False
-    ) -> tuple[np.ndarray, int]:
-        """Solve from the shifted warm start (or cold); returns (w, iterations).
-
-        ``retarget``: the target changed; the warm start is the shifted plan over the
-        whole horizon, solved like any other step (one real-time iteration: a bounded
-        step, where a cold start takes :data:`COLD_ITERATIONS`)."""
+    def solve(self, t, x0, references, u_prev, warm, warm_time) -> tuple[np.ndarray, int]:
+        """Solve from the shifted warm start (or cold); returns (w, iterations)."""
         ocp = self.ocp
         if warm is None:
             guess, horizon, solver = self._initial(x0), ocp.config.horizon, self.cold
         else:
-            guess, horizon = self._shifted(warm, max(0.0, t - warm_time), x0, retarget)
+            guess, horizon = self._shifted(warm, max(0.0, t - warm_time), x0)
             solver = self.solver
         p = ocp.parameters(references, u_prev, self.terminal_factor, horizon_prev=horizon)
         lbw, ubw = ocp.bounds(x0)
