@@ -74,6 +74,73 @@ def _conic_options(ocp: ShootingOCP, name: str) -> dict[str, Any]:
     return options
 
 
+class QPBuffers:
+    """The QP data function and the conic of a :class:`GaussNewtonSQP`, evaluated on numpy
+    arrays bound once (``casadi.Function.buffer``): each call reads its inputs from and
+    writes its outputs to these arrays, with no conversion to and from CasADi matrices
+    (that conversion cost a third of the time around HPIPM, docs/mpc.md "Where an MPC
+    step's time goes").
+
+    Inputs: :attr:`w`, :attr:`p` of the data function; :attr:`lba`, :attr:`uba`,
+    :attr:`lbx`, :attr:`ubx` of the QP (its Hessian, gradient and Jacobian are the data
+    function's outputs, bound as they are: same sparsity). Outputs: :attr:`g` (the
+    constraints at ``w``), :attr:`step` (the QP's solution), :attr:`lam_a`, :attr:`lam_x`.
+    The QP's statistics (:meth:`qp_stats`) are those of its last call.
+    """
+
+    def __init__(self, data: ca.Function, qp: ca.Function) -> None:
+        def zeros(count: int) -> np.ndarray:
+            return np.zeros(count, dtype=float)
+
+        self.w, self.p = zeros(data.nnz_in(0)), zeros(data.nnz_in(1))
+        self.hessian, self.gradient = zeros(data.nnz_out(0)), zeros(data.nnz_out(1))
+        self.jacobian, self.g = zeros(data.nnz_out(2)), zeros(data.nnz_out(3))
+        ng, nw = self.g.size, self.w.size
+        self.lba, self.uba, self.lbx, self.ubx = zeros(ng), zeros(ng), zeros(nw), zeros(nw)
+        self.step, self.lam_a, self.lam_x = zeros(nw), zeros(ng), zeros(nw)
+        self._data, self.evaluate_data = data.buffer()
+        for i, array in enumerate((self.w, self.p)):
+            self._data.set_arg(i, memoryview(array))
+        for i, array in enumerate((self.hessian, self.gradient, self.jacobian, self.g)):
+            self._data.set_res(i, memoryview(array))
+        self._qp_function = qp
+        inputs = {"h": self.hessian, "g": self.gradient, "a": self.jacobian}
+        inputs.update(lba=self.lba, uba=self.uba, lbx=self.lbx, ubx=self.ubx)
+        # the initial guesses as the keyword call leaves them: zeros
+        inputs.update({n: zeros(qp.nnz_in(n)) for n in qp.name_in() if n not in inputs})
+        for name, array in inputs.items():
+            if qp.nnz_in(name) != array.size:
+                raise ValueError(f"QP input {name}: {qp.nnz_in(name)} nonzeros, data {array.size}")
+        self._qp_inputs = [(qp.index_in(n), memoryview(a)) for n, a in inputs.items()]
+        outputs = (("x", self.step), ("lam_a", self.lam_a), ("lam_x", self.lam_x))
+        self._qp_outputs = [(qp.index_out(n), memoryview(a)) for n, a in outputs]
+        self._last_stats: dict[str, Any] = {}
+
+    def solve_qp(self) -> None:
+        """Solve the QP of the bound arrays into :attr:`step`, :attr:`lam_a`, :attr:`lam_x`.
+
+        A fresh buffer each call, released after it: the conic's work vectors carry values
+        from one call into the next on a reused buffer (HPIPM then returned other steps
+        than the keyword call, and status 2 on the second), fresh ones start at zero as
+        the keyword call's do; released, the next call checks out the same memory.
+        """
+        buffer, solve = self._qp_function.buffer()
+        for index, view in self._qp_inputs:
+            buffer.set_arg(index, view)
+        for index, view in self._qp_outputs:
+            buffer.set_res(index, view)
+        self.step.fill(0.0)
+        self.lam_a.fill(0.0)
+        self.lam_x.fill(0.0)
+        solve()
+        self._last_stats = buffer.stats()
+
+    def qp_stats(self) -> dict[str, Any]:
+        """The conic's statistics after its last call (the times and call counts in them
+        add up over the calls on the same conic)."""
+        return self._last_stats
+
+
 class GaussNewtonSQP:
     """Gauss-Newton SQP on a :class:`ShootingOCP`; ``iterations=1`` is the RTI scheme.
 
@@ -102,7 +169,7 @@ class GaussNewtonSQP:
         self.qp_solver = qp_solver
         self.iterations = iterations
         self.tolerance = tolerance
-        self._data, self._qp = _compiled_qp(ocp, qp_solver, proximal)
+        self._qp_buffers = QPBuffers(*_compiled_qp(ocp, qp_solver, proximal))
         self.last_iterations = 0
         #: Multipliers (constraints, bounds) of the last QP: at a converged point (step
         #: zero) they are the NLP's multipliers.
@@ -119,30 +186,34 @@ class GaussNewtonSQP:
     ) -> np.ndarray:
         """Iterate from ``w0``; returns the new decision vector or raises SolverFailure."""
         w = np.asarray(w0, dtype=float)
+        buffers = self._qp_buffers
         for iteration in range(1, self.iterations + 1):
             # Two calls (data, then QP): CasADi 3.8 crashes when the HPIPM conic is
             # embedded in an MX function, so the QP is not fused with its data.
             try:
-                hessian, gradient, jac, g = self._data(w, p)
-                g = np.asarray(g, dtype=float).ravel()
-                solution = self._qp(
-                    h=hessian, g=gradient, a=jac, lba=lbg - g, uba=ubg - g, lbx=lbw - w, ubx=ubw - w
-                )
+                buffers.w[:] = w
+                buffers.p[:] = p
+                buffers.evaluate_data()
+                np.subtract(lbg, buffers.g, out=buffers.lba)
+                np.subtract(ubg, buffers.g, out=buffers.uba)
+                np.subtract(lbw, w, out=buffers.lbx)
+                np.subtract(ubw, w, out=buffers.ubx)
+                buffers.solve_qp()
             except RuntimeError as error:  # CasADi reports solver exceptions this way
                 raise SolverFailure(f"{self.qp_solver}: {str(error).splitlines()[-1]}") from None
             self._check()
-            d = np.asarray(solution["x"], dtype=float).ravel()
+            d = buffers.step
             if not np.all(np.isfinite(d)):
                 raise SolverFailure(f"{self.qp_solver}: non-finite step")
             w = w + d
-            self.last_multipliers = (solution["lam_a"], solution["lam_x"])
+            self.last_multipliers = (buffers.lam_a.copy(), buffers.lam_x.copy())
             self.last_iterations = iteration
             if np.max(np.abs(d)) < self.tolerance:
                 break
         return w
 
     def _check(self) -> None:
-        stats = self._qp.stats()
+        stats = self._qp_buffers.qp_stats()
         if self.qp_solver == "hpipm":
             status = stats.get("return_status")
             if status not in HPIPM_ACCEPTED:
@@ -185,8 +256,9 @@ def _build_qp(ocp: ShootingOCP, qp_solver: str, proximal: float) -> tuple[Any, A
         # jump between two distant plans.
         diagonal[s] += proximal * (length / reference) / scale**2
     hessian = ca.mtimes(jr.T, jr) + ca.diag(ca.DM(diagonal))
-    gradient = ca.mtimes(jr.T, ocp.residual) + ca.DM(ocp.linear_cost)
-    data = ca.Function("qp_data", [w, p], [hessian, gradient, jg, ocp.g], {"cse": True})
+    # dense vectors: their nonzeros are the QP's gradient and the bounds' offsets as they are
+    gradient = ca.densify(ca.mtimes(jr.T, ocp.residual) + ca.DM(ocp.linear_cost))
+    data = ca.Function("qp_data", [w, p], [hessian, gradient, jg, ca.densify(ocp.g)], {"cse": True})
     qp = ca.conic(
         "qp",
         qp_solver,
