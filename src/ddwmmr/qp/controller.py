@@ -28,7 +28,9 @@ Built by name::
 command), ``min_obstacle_clearance_m`` (base footprint vs circles; None without obstacles),
 ``qp_mode``, ``qp_solver`` and ``min_predicted_edge_load_n`` (the least edge load, N, the
 edge-load limit predicted for a command sent; None where that limit is off) and
-``min_edge_load_floor_n`` (its floor, N; None where off).
+``min_edge_load_floor_n`` (its floor, N; None where off), ``edge_load_relaxed_steps`` (steps
+whose edge rows conflicted with the other limits and were dropped for that step's solve;
+the QP fallback runs only if that solve fails too).
 
 Its benchmark twin, :class:`ddwmmr.qp.naive.NaiveQPController`, is deliberately not a
 registered method: it is a baseline for ``python -m ddwmmr.bench``, not a method to compare.
@@ -259,6 +261,7 @@ class QPController:
         self.min_edge_load = None if min_edge_load is None else check_min_edge_load(min_edge_load)
         self.edge_loads: EdgeLoadLimit | None = None  # set by adopt_plant
         self.min_predicted_edge_load: float | None = None
+        self.edge_relaxed_steps = 0  # steps whose edge rows gave way to the other limits
         self.problem = QPProblem(self.tasks, self.limits)
         self._dt_option = None if dt is None else check_positive("dt", dt)
         self._loop_step: float | None = None
@@ -307,6 +310,7 @@ class QPController:
         self.fallbacks = 0
         self.last = StepInfo()
         self.min_predicted_edge_load = None
+        self.edge_relaxed_steps = 0
         if self.edge_loads is not None:
             self.edge_loads.reset()
 
@@ -327,26 +331,36 @@ class QPController:
             measured = base_velocity if base_velocity is not None else ctx.previous_command
             self.edge_loads.observe(*(measured or (0.0, 0.0)))
         x = self._solve(ctx)
+        relaxed = x is None and self.edge_loads is not None
+        if relaxed:  # the edge rows conflict with the other limits: they give way
+            self.edge_loads.active = False
+            try:
+                x = self._solve(ctx)
+            finally:
+                self.edge_loads.active = True
+            self.edge_relaxed_steps += 1
         if x is None:
-            return self._edge_prediction(ctx, self._fallback(ctx))
+            return self._edge_prediction(ctx, self._fallback(ctx), relaxed)
         v, w, r1, r2, *slack = x
         scale = self.arm_scale(ctx, r1, r2)
         self.last = StepInfo(
             extra={"slack": max(map(abs, slack)) if slack else 0.0, "arm_scale": scale}
         )
         ctx.previous_command = (v, w)
-        return self._edge_prediction(ctx, np.array([v, w, r1 * scale, r2 * scale]))
+        return self._edge_prediction(ctx, np.array([v, w, r1 * scale, r2 * scale]), relaxed)
 
-    def _edge_prediction(self, ctx: StepContext, command: np.ndarray) -> np.ndarray:
-        """With the edge-load limit: the least predicted edge load of ``command`` into
-        the step's info (``min_predicted_edge_load_n``) and the run's minimum, and the
-        joints' rate estimate moved on; ``command`` unchanged."""
+    def _edge_prediction(self, ctx: StepContext, command: np.ndarray, relaxed: bool) -> np.ndarray:
+        """With the edge-load limit: the least predicted edge load of ``command`` and
+        whether the rows gave way (``relaxed``) into the step's info
+        (``min_predicted_edge_load_n``, ``edge_load_relaxed``) and the run's minimum, and
+        the joints' rate estimate moved on; ``command`` unchanged."""
         limit = self.edge_loads
         if limit is None:
             return command
         values = command.tolist()
         least = min(limit.predict(values))
         self.last.extra["min_predicted_edge_load_n"] = least
+        self.last.extra["edge_load_relaxed"] = float(relaxed)
         if self.min_predicted_edge_load is None or least < self.min_predicted_edge_load:
             self.min_predicted_edge_load = least
         limit.advance(values, ctx.dt)
@@ -438,6 +452,7 @@ class QPController:
             "qp_solver": self.solver,
             "min_predicted_edge_load_n": self.min_predicted_edge_load,
             "min_edge_load_floor_n": None if self.edge_loads is None else self.edge_loads.floor_n,
+            "edge_load_relaxed_steps": self.edge_relaxed_steps,
         }
 
     # -- the scenario protocol's waypoint task -------------------------------------------

@@ -22,6 +22,11 @@ The bound is capped at half of what the input box can reach for the row (as the 
 limit's), so the row alone is always feasible: an edge that a disturbance took below its
 floor must be pushed back up at least that fast.
 
+When the rows conflict with the other limits (no command meets them all: the QP has no
+solution) the controller solves the step again with :attr:`EdgeLoadLimit.active` off (the
+rows open, the joints' window too) and says so: the edge floor gives way before the hard
+limits and before the QP's fallback.
+
 The lag model holds while the servos do not saturate. With the motors' acceleration limits
 ``a`` (``PlantTraits.joint_acceleration_limit``) the limit also keeps each joint's command
 within ``rate +- a tau`` (the servo's torque at the step's start, ``(u - rate)/tau`` times
@@ -72,6 +77,8 @@ class EdgeLoadLimit(Limit):
         self.time_constant = check_positive("joint_time_constant", time_constant)
         self.rows = len(self.model.polygon.depths)
         self.acceleration_limit = acceleration_limit
+        #: False opens every row and the joints' window (a step whose rows conflict)
+        self.active = True
         polygon, weight = self.model.polygon, self.model.weight
         origin = edge_loads_at(polygon, weight, 0.0, 0.0)
         # dL_e / d(centre of pressure): the edge loads are affine in it
@@ -175,11 +182,12 @@ class EdgeLoadLimit(Limit):
         """Rows ``G_e`` with the lower bound of :meth:`capped`."""
         rows, floors = self.rows_and_floors(ctx)
         box = [*map(float, lb), *map(float, ub)]
-        self.tighten(box, self.joint_window())
-        lb[:], ub[:] = box[:4], box[4:]
+        if self.active:
+            self.tighten(box, self.joint_window())
+            lb[:], ub[:] = box[:4], box[4:]
         for e, (row, floor) in enumerate(zip(rows, floors)):
             G[e, 0], G[e, 1], G[e, 2], G[e, 3] = row
-            lower[e] = self.capped(row, floor, box)
+            lower[e] = self.capped(row, floor, box) if self.active else -INF
             upper[e] = INF
 
     def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
@@ -192,12 +200,14 @@ class EdgeLoadLimit(Limit):
         tighten, window = self.tighten, self.joint_window
 
         def write(ctx: StepContext) -> None:
-            tighten(box, window())
+            active = self.active
+            if active:
+                tighten(box, window())
             rows, floors = values(ctx)
             for e, (row, floor) in enumerate(zip(rows, floors)):
                 start = starts[e]
                 matrix[start], matrix[start + 1] = row[0], row[1]
                 matrix[start + 2], matrix[start + 3] = row[2], row[3]
-                lower[bounds[e]] = capped(row, floor, box)
+                lower[bounds[e]] = capped(row, floor, box) if active else -INF
 
         return write
