@@ -145,6 +145,21 @@ def edge_names(normals) -> list[str]:
     return names
 
 
+def edge_load_series(timeseries: dict[str, np.ndarray], robot) -> tuple[list[str], np.ndarray]:
+    """The measured load (N) on the supports off each edge of the robot's support polygon
+    at every sample, (samples, edges), from a physics run's ``support_force_<name>_n``
+    columns (in :func:`~ddwmmr.model.support_loads.support_points` order), with the
+    edges' names (:func:`edge_names`)."""
+    from ddwmmr.model.support_loads import support_points, support_polygon
+
+    forces = np.column_stack(
+        [timeseries[f"support_force_{n}_n"] for n in support_names(timeseries)]
+    )
+    polygon = support_polygon(robot)
+    off = polygon.off_edge(support_points(robot)).astype(float)  # (edges, supports)
+    return edge_names(polygon.normals), forces @ off.T
+
+
 def plot_support_loads(result, floor_n: float | None = None):
     """Figure: the load on the supports off each edge of the support polygon (N; the edge
     the base would pivot about when it reaches 0) with the optimisers' floor, and the
@@ -153,13 +168,8 @@ def plot_support_loads(result, floor_n: float | None = None):
     ``result`` is a physics run (the plant's ``support_force_<name>_n`` and
     ``base_tilt_rad`` columns); ``floor_n`` (N) defaults to the run summary's
     ``min_edge_load_floor_n`` (None: not drawn)."""
-    from ddwmmr.model.support_loads import support_points, support_polygon
-
     ts, robot = result.timeseries, result.robot
-    forces = np.column_stack([ts[f"support_force_{n}_n"] for n in support_names(ts)])
-    polygon = support_polygon(robot)
-    off = polygon.off_edge(support_points(robot)).astype(float)  # (edges, supports)
-    loads = forces @ off.T
+    names, loads = edge_load_series(ts, robot)
     weight = robot.total_mass * 9.81
     if floor_n is None:
         floor_n = result.summary.get("min_edge_load_floor_n")
@@ -172,7 +182,7 @@ def plot_support_loads(result, floor_n: float | None = None):
         if np.any(unloaded):
             shade = {"color": "tab:red", "alpha": 0.15, "lw": 0, "step": "mid"}
             ax.fill_between(t, 0, 1, where=unloaded, transform=ax.get_xaxis_transform(), **shade)
-    for j, name in enumerate(edge_names(polygon.normals)):
+    for j, name in enumerate(names):
         ax_load.plot(t, loads[:, j], lw=0.8, label=f"{name} edge")
     if floor_n is not None:
         ax_load.axhline(floor_n, color="k", ls="--", lw=0.9, label=f"floor {floor_n:.1f} N")
