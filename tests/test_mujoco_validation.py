@@ -18,8 +18,11 @@ _spec = importlib.util.spec_from_file_location("physics_figures", SCRIPT)
 figures = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(figures)
 
-#: Documented agreement (docs/physics.md): MuJoCo tips at S in [1, 1 + 0.002].
-TOLERANCE = 2e-3
+#: Documented agreement (docs/physics.md): MuJoCo tips at S in [1, 1 + 0.01]. The base
+#: leans into its compliant tyres towards the loaded edge, which moves the centre of mass
+#: outwards by its height times the lean (S_tip - 1 measured 0.0032 to 0.0078; with rigid
+#: wheels 0.0002 to 0.0008).
+TOLERANCE = 1e-2
 
 
 @pytest.mark.parametrize("direction", [0.0, 0.25 * math.pi, 0.5 * math.pi, -0.75 * math.pi])
