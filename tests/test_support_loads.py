@@ -238,7 +238,7 @@ def test_the_recording_plant_runs_as_the_plant_does(study):
     from ddwmmr.plants.mujoco import MujocoPlant
 
     plants = [
-        MujocoPlant(ROBOT, base_damping=study.DAMPING),
+        MujocoPlant(ROBOT, base_damping=study.DAMPING, **study.PHASE_A_ENGINE),
         study.RecordingPlant(ROBOT, base_damping=study.DAMPING),
     ]
     for plant in plants:
