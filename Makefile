@@ -2,7 +2,8 @@
 #   make demo   creates .venv, installs the package (runtime dependencies only), runs the
 #               main job (writes runs/demo/)
 #   make test   creates .venv, installs with the test extras, runs the suite
-#   make lint   ruff check and ruff format --check (CI runs make lint test)
+#   make lint   ruff check and ruff format --check (CI runs make lint test docs-site)
+#   make docs-site  the HTML documentation site in site/ (MkDocs, strict; the docs extra)
 PYTHON ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
@@ -11,7 +12,7 @@ BIN := $(VENV)/bin
 STAMP_RUN := $(VENV)/.installed-run
 STAMP_TEST := $(VENV)/.installed-test
 
-.PHONY: demo test lint format bench docs docs-timings clean gui-check
+.PHONY: demo test lint format bench docs docs-site docs-timings clean gui-check
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -68,6 +69,18 @@ docs: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.gui --force --snapshot docs/figures/gui_rectangle.png \
 		--method clrrmc-ts --traj rectangle
 	MPLBACKEND=Agg $(BIN)/python docs/competitive_figures.py
+	MPLBACKEND=Agg $(BIN)/python docs/bounds_figures.py
+
+# The documentation site: docs/*.md plus the API reference generated from the docstrings
+# (mkdocs.yml), built into site/ in strict mode (a broken link or anchor fails the build).
+STAMP_DOCS := $(VENV)/.installed-docs
+
+$(STAMP_DOCS): pyproject.toml | $(BIN)/python
+	$(BIN)/python -m pip install --quiet -e ".[docs]"
+	touch $(STAMP_DOCS) $(STAMP_RUN)
+
+docs-site: $(STAMP_DOCS)
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
 
 # The figures of measured step times (machine-dependent: they change on every run), and the
 # MPC's figures (its horizon study plots step times; about 10 minutes).
@@ -76,7 +89,7 @@ docs-timings: $(STAMP_TEST)
 	MPLBACKEND=Agg $(BIN)/python docs/mpc_figures.py
 
 clean:
-	rm -rf $(VENV) runs .pytest_cache .ruff_cache
+	rm -rf $(VENV) runs site .pytest_cache .ruff_cache
 
 # Real Tk window of python -m ddwmmr.gui under a virtual X display: clicks Run, types into a
 # field, plays the run back, saves a screenshot to runs/gui-check/. Needs xvfb-run.

@@ -210,7 +210,8 @@ def _draw_robot(ax: Axes, robot: Robot, q, color: str = "0.3", labels: bool = Fa
         return
     ax.annotate("", xy=(x + 0.45 * c, y + 0.45 * s), xytext=(x, y), arrowprops={"arrowstyle": "->"})
     ax.text(x + 0.47 * c, y + 0.47 * s, "heading φ", fontsize=8)
-    ax.text(*(0.5 * (np.array([x, y]) + elbow) + [0.0, 0.03]), "L1, θ1", fontsize=8)
+    # Left of the first link, inside the footprint, clear of the link and the base edge.
+    ax.text(*(0.5 * (np.array([x, y]) + elbow) - [0.05, 0.03]), "L1, θ1", fontsize=8, ha="right")
     ax.text(*(0.5 * (elbow + tip) + [0.02, 0.0]), "L2, θ2", fontsize=8)
     ax.text(*(tip + np.array([0.02, 0.02])), "E (xE, yE, φE)", fontsize=8)
     ax.text(x - 0.1, y - 0.08, "(x, y)", fontsize=8)

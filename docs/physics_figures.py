@@ -29,6 +29,7 @@ import numpy as np
 from ddwmmr import Ellipse, Robot, load_trajectory, simulate
 from ddwmmr.plants.mujoco import MujocoPlant
 from ddwmmr.plants.mujoco.plant import TIP_TILT_RAD, UNLOADED_FRACTION
+from ddwmmr.reports.legends import place_legend
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     offset_configuration,
@@ -142,8 +143,10 @@ def tipping_map() -> str:
             tipped[i, j] = hold_pose(robot, direction, 0.0)["tipped"]
             margins[i, j] = robot.stability([0, 0, 0, direction, 0.0])[2]
             disagreements += int(tipped[i, j] != (margins[i, j] <= 1.0))
-    fine_d = np.linspace(-math.pi, math.pi, 361)
-    fine_p = np.linspace(0.5, 8.0, 301)
+    # The map reaches half a grid step beyond the outer poses: their marks are whole.
+    half_d, half_p = 0.5 * (directions[1] - directions[0]), 0.5 * (payloads[1] - payloads[0])
+    fine_d = np.linspace(-math.pi - half_d, math.pi + half_d, 373)
+    fine_p = np.linspace(0.5 - half_p, 8.0 + half_p, 321)
     grid = np.array(
         [[Robot().with_payload(p).stability([0, 0, 0, d, 0])[2] for d in fine_d] for p in fine_p]
     )
@@ -171,7 +174,8 @@ def tipping_map() -> str:
     ax.set_xlabel("direction of the stretched arm th1 (deg, 0 = forward, 90 = left)")
     ax.set_ylabel("payload (kg)")
     ax.set_title("Static holds: MuJoCo tipping vs the kinematic S = 1 line (red)")
-    ax.legend(loc="lower right", fontsize=8)
+    # Below the map: every spot inside it holds a pose.
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8)
     fig.tight_layout()
     fig.savefig(FIGURES / "physics_tipping_map.png", dpi=110)
     plt.close(fig)
@@ -209,23 +213,30 @@ def slow_sideways_reach(payload: float = 3.2, rate: float = 0.05) -> str:
         ax1.plot(s, forces[:, i], lw=0.8, label=names[i])
     ax1.plot(s, right_load, color="k", label="right side total")
     ax1.plot(s, closed_form, "r--", label="statics: W (1 - 1/S) / 2")
-    ax1.set_xlim(2.0, 0.95)
+    ax1.set_xlim(s.max() + 0.02, s.min() - 0.02)  # S decreases left to right
     ax1.set_xlabel("kinematic S (decreasing as the arm unfolds)")
     ax1.set_ylabel("floor normal force (N)")
     ax1.set_title(f"Slow sideways reach, payload {payload:g} kg", fontsize=10)
     ax1.legend(fontsize=8)
-    ax2.plot(t, s, label="kinematic S")
-    ax2.plot(t, data[:, -2], label="S_phys (centre of pressure)", lw=0.8)
-    ax2.plot(t, 1.0 + np.degrees(data[:, -1]), color="0.5", lw=0.8, label="1 + tilt (deg)")
+    fell = int(np.argmax(data[:, -1] > TIP_TILT_RAD))
+    # Until the base has tilted 1 degree: the margins of a falling robot mean nothing, and
+    # its growing tilt would flatten the margins' curves.
+    leaning = np.degrees(data[:, -1]) > 1.0
+    tilted = int(np.argmax(leaning)) if np.any(leaning) else len(t) - 1
+    shown = t <= t[tilted]
+    ax2.plot(t[shown], s[shown], label="kinematic S")
+    ax2.plot(t[shown], data[shown, -2], label="S_phys (centre of pressure)", lw=0.8)
+    tilt_deg = 1.0 + np.degrees(data[shown, -1])
+    ax2.plot(t[shown], tilt_deg, color="0.5", lw=0.8, label="1 + tilt (deg)")
     ax2.axhline(1.0, color="tab:red", ls="--", lw=0.8)
-    ax2.set_ylim(0.9, 2.0)
-    ax2.set_xlabel("t (s)")
-    ax2.legend(fontsize=8)
+    ax2.set_xlabel(f"t (s), until the base has tilted 1 deg ({t[tilted]:.1f} s)")
+    fig.tight_layout()
+    place_legend(ax1, fontsize=8)
+    place_legend(ax2, fontsize=8)
     fig.tight_layout()
     fig.savefig(FIGURES / "physics_sideways_forces.png", dpi=110)
     plt.close(fig)
     first_unloaded = int(np.argmax(right_load < UNLOADED_FRACTION * weight))
-    fell = int(np.argmax(data[:, -1] > TIP_TILT_RAD))
     return (
         f"payload {payload:g} kg, th2 unfolding at {rate:g} rad/s: right-side load against "
         f"W (1 - 1/S) / 2 while S > 1.001: largest difference {worst:.3f} N (weight "
@@ -283,8 +294,14 @@ def sideways_reach_runs(payloads=(3.0, 3.5, 4.0)) -> tuple[str, dict]:
     return _table(header, rows), runs
 
 
+#: Line widths of the sideways-reach runs (methods not listed: 1.4).
+REACH_WIDTHS = {"ats": 3.0, "clrrmc-ts": 1.4}
+
+
 def _plot_reach_runs(runs: dict, payloads) -> None:
-    fig, axes = plt.subplots(2, len(payloads), figsize=(4.2 * len(payloads), 6), sharex=True)
+    fig, axes = plt.subplots(
+        2, len(payloads), figsize=(4.2 * len(payloads), 6), sharex=True, squeeze=False
+    )
     for col, payload in enumerate(payloads):
         ax_s, ax_f = axes[0, col], axes[1, col]
         for (p, method), result in runs.items():
@@ -295,26 +312,29 @@ def _plot_reach_runs(runs: dict, payloads) -> None:
             if result.summary["tipped"]:  # a fallen robot's margins mean nothing: cut
                 shown = ts["t"] <= result.summary["tip_time_s"] + 0.3
             t = ts["t"][shown]
-            (line,) = ax_s.plot(t, ts["stability"][shown], label=f"{method} S")
+            # ats and clrrmc-ts coincide: the first drawn is wider, so both show.
+            width = REACH_WIDTHS.get(method, 1.4)
+            (line,) = ax_s.plot(t, ts["stability"][shown], lw=width, label=f"{method} S")
             colour = line.get_color()
             ax_s.plot(t, ts["physics_stability"][shown], ":", color=colour, lw=1)
-            ax_f.plot(t, ts["min_edge_load_n"][shown], color=colour, label=method)
+            ax_f.plot(t, ts["min_edge_load_n"][shown], color=colour, lw=width, label=method)
             if result.summary["tipped"]:
-                ax_s.axvline(result.summary["tip_time_s"], color=colour, lw=0.8)
-                ax_s.annotate(
-                    "tipped", (result.summary["tip_time_s"], 0.85), color=colour, fontsize=8
+                tip = result.summary["tip_time_s"]
+                ax_s.axvline(
+                    tip, color=colour, lw=0.8, ls="-.", label=f"{method} tipped {tip:.1f} s"
                 )
         ax_s.axhline(1.0, color="tab:red", ls="--", lw=0.8)
         ax_s.axhline(1.25, color="k", lw=0.6)
-        ax_s.set_ylim(0.8, 2.0)
+        ax_s.set_ylim(bottom=min(0.8, ax_s.get_ylim()[0]))
         ax_s.set_title(f"payload {payload:g} kg (solid S, dotted S_phys)", fontsize=9)
         ax_f.set_xlabel("t (s)")
         ax_f.set_ylim(bottom=-1.0)
         if col == 0:
             ax_s.set_ylabel("stability margin")
             ax_f.set_ylabel("min edge load (N)")
-            ax_s.legend(fontsize=7)
     fig.tight_layout()
+    for ax_s in axes[0]:
+        place_legend(ax_s, fontsize=7)
     fig.savefig(FIGURES / "physics_sideways_runs.png", dpi=110)
     plt.close(fig)
 
@@ -375,22 +395,24 @@ def tracking_reasons() -> str:
             ]
         )
     fig, ax = plt.subplots(figsize=(7.5, 4))
+    floor = 1e-4  # the kinematic plant converges to 1e-12 m: floored, said in its label
     ax.semilogy(
         kinematic.timeseries["t"],
-        kinematic.timeseries["position_error_m"],
+        np.maximum(kinematic.timeseries["position_error_m"], floor),
         "k",
-        label="kinematic plant",
+        label=f"kinematic plant (floored at {1000 * floor:g} mm)",
     )
-    for label, result in results.items():
+    # Wide to thin: runs that coincide (the default and stronger motors) stay visible.
+    for width, (label, result) in zip(np.linspace(2.8, 0.9, len(results)), results.items()):
         ax.semilogy(
-            result.timeseries["t"], result.timeseries["position_error_m"], lw=0.9, label=label
+            result.timeseries["t"], result.timeseries["position_error_m"], lw=width, label=label
         )
     ax.set_xlabel("t (s)")
     ax.set_ylabel("end-effector position error (m)")
-    ax.set_ylim(1e-4, 0.1)
+    ax.set_ylim(0.5 * floor, 0.1)
     ax.set_title("clrrmc-ts on the ellipse, payload 3 kg, dt 0.02 s", fontsize=10)
-    ax.legend(fontsize=7)
     fig.tight_layout()
+    place_legend(ax, fontsize=7)
     fig.savefig(FIGURES / "physics_tracking.png", dpi=110)
     plt.close(fig)
     header = [

@@ -5,7 +5,8 @@ Run from the repository root::
     MPLBACKEND=Agg .venv/bin/python docs/qp_figures.py
 
 Writes ``docs/figures/qp_*.png`` and prints the tables quoted in docs/qp.md (markdown).
-Every run uses the 3 kg payload (SPEC §1: a full sideways stretch is then exactly S = 1).
+Every run uses the 3 kg payload (docs/theory.md, "Tip-over stability": a full sideways
+stretch is then exactly S = 1).
 """
 
 from __future__ import annotations
@@ -30,11 +31,18 @@ from ddwmmr.qp.controller import QPController
 from ddwmmr.qp.limits import footprint_clearances, load_obstacles
 from ddwmmr.qp.naive import NaiveQPController
 from ddwmmr.qp.tasks import PostureTask
+from ddwmmr.reports.legends import legend_beside
 
 ROOT = Path(__file__).resolve().parents[1]
 FIGURES = ROOT / "docs" / "figures"
 ROBOT = Robot().with_payload(3.0)
 FLOOR = 1.25
+
+
+def wide_to_thin(count: int) -> list[float]:
+    """Line widths from wide to thin: runs that coincide (ats and clrrmc-ts, qp's two
+    modes) stay visible, each a thinner stroke on the previous one."""
+    return list(np.linspace(3.6, 1.0, count))
 
 
 def _table(header: list[str], rows: list[list[str]]) -> str:
@@ -70,23 +78,23 @@ def sideways_reach() -> str:
         ("qp (weighted)", "qp", {}),
         ("qp (hierarchical)", "qp", {"mode": "hierarchical"}),
     ]
-    fig, (ax_s, ax_e) = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
+    fig, (ax_s, ax_e) = plt.subplots(2, 1, figsize=(9.5, 6.5), sharex=True)
     rows = []
-    for label, method, options in runs:
+    for width, (label, method, options) in zip(wide_to_thin(len(runs)), runs):
         result = simulate(ROBOT, trajectory, method, q0=q0, **options)
         ts = result.timeseries
         rows.append(_row(label, result.summary, ts["stability"]))
         style = "-" if method == "qp" else "--"
-        ax_s.plot(ts["t"], ts["stability"], style, label=label)
-        ax_e.semilogy(ts["t"], np.maximum(ts["position_error_m"], 1e-7), style, label=label)
+        ax_s.plot(ts["t"], ts["stability"], style, lw=width, label=label)
+        error = np.maximum(ts["position_error_m"], 1e-7)
+        ax_e.semilogy(ts["t"], error, style, lw=width, label=label)
     ax_s.axhline(FLOOR, color="k", lw=0.8)
     ax_s.axhline(1.0, color="r", lw=0.8)
     ax_s.set_ylabel("stability margin S")
-    ax_s.set_ylim(0.95, 1.6)
-    ax_s.legend(ncol=4, fontsize=8)
     ax_s.set_title("Sideways reach, 3 kg payload: floor S_min = 1.25 (black), tipping (red)")
     ax_e.set_ylabel("position error (m)")
     ax_e.set_xlabel("t (s)")
+    legend_beside(ax_s, fontsize=8)
     fig.tight_layout()
     fig.savefig(FIGURES / "qp_sideways_reach.png", dpi=110)
     plt.close(fig)
@@ -102,16 +110,16 @@ def ellipse_manipulability() -> str:
     runs.append(
         ("qp hierarchical, weight 1", "qp", {"mode": "hierarchical", "manipulability_weight": 1.0})
     )
-    fig, (ax_m, ax_e) = plt.subplots(2, 1, figsize=(8, 6.5), sharex=True)
+    fig, (ax_m, ax_e) = plt.subplots(2, 1, figsize=(9.5, 6.5), sharex=True)
     rows = []
-    for label, method, options in runs:
+    for width, (label, method, options) in zip(wide_to_thin(len(runs)), runs):
         result = simulate(ROBOT, trajectory, method, **options)
         ts = result.timeseries
         rows.append(_row(label, result.summary, ts["stability"]))
-        ax_m.plot(ts["t"], ts["manipulability"], label=label)
-        ax_e.semilogy(ts["t"], np.maximum(ts["position_error_m"], 1e-7), label=label)
+        ax_m.plot(ts["t"], ts["manipulability"], lw=width, label=label)
+        ax_e.semilogy(ts["t"], np.maximum(ts["position_error_m"], 1e-7), lw=width, label=label)
     ax_m.set_ylabel("manipulability eta = |sin th2|")
-    ax_m.legend(ncol=2, fontsize=8)
+    legend_beside(ax_m, fontsize=8)
     ax_m.set_title("Default ellipse, 3 kg payload, 3 cm initial offset")
     ax_e.set_ylabel("position error (m)")
     ax_e.set_xlabel("t (s)")
@@ -139,7 +147,8 @@ def obstacle() -> str:
         results[mode] = simulate(ROBOT, trajectory, "qp", obstacles=circles, mode=mode)
     fig, ax = plt.subplots(figsize=(8, 6.5))
     ts = free.timeseries
-    ax.plot(ts["xE_d"], ts["yE_d"], "k:", lw=0.8, label="desired end effector")
+    # Over qp's end-effector path, which lies on it.
+    ax.plot(ts["xE_d"], ts["yE_d"], "k:", lw=0.9, label="desired end effector", zorder=3)
     ax.plot(ts["x"], ts["y"], "C1--", label="clrrmc-ts base")
     qp = results["weighted"].timeseries
     ax.plot(qp["x"], qp["y"], "C0-", label="qp base")
@@ -149,9 +158,9 @@ def obstacle() -> str:
         _footprint(ax, qp["x"][k], qp["y"][k], qp["phi"][k], "C0")
     for circle in circles:
         ax.add_patch(CirclePatch((circle.x, circle.y), circle.radius, color="r", alpha=0.5))
-    ax.set_aspect("equal")
-    ax.set_xlim(-2.3, 2.3)
-    ax.set_ylim(-1.8, 1.8)
+    ax.set_aspect("equal")  # limits from everything drawn (matplotlib's autoscale)
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
     ax.legend(fontsize=8, loc="center")
     ax.set_title("Post on the base's path (footprints every 0.5 s near it)")
     fig.tight_layout()
@@ -182,7 +191,7 @@ def obstacle() -> str:
 def modes() -> str:
     """Weighted against hierarchical when a secondary task fights tracking (ellipse).
 
-    The SPEC §3 potential V = th1^2 + 0.25 th2^2 + 0.66 phi^2 added as a user task: its th2
+    The ap potential V = th1^2 + 0.25 th2^2 + 0.66 phi^2 added as a user task: its th2
     row can only be met by moving the end effector, so its weight sets how much tracking
     the weighted mode gives up; the hierarchical mode gives up none.
     """
@@ -200,9 +209,9 @@ def modes() -> str:
             rows.append([mode, f"{weight:g}", f"{errors[-1]:.2f}", f"{etas[-1]:.3f}"])
         ax_e.loglog(weights, errors, marker, label=mode)
         ax_m.semilogx(weights, etas, marker, label=mode)
-    ax_e.set_xlabel("weight of the SPEC §3 potential task")
+    ax_e.set_xlabel("weight of the ap potential task")
     ax_e.set_ylabel("RMS position error (mm)")
-    ax_m.set_xlabel("weight of the SPEC §3 potential task")
+    ax_m.set_xlabel("weight of the ap potential task")
     ax_m.set_ylabel("mean eta")
     ax_e.legend()
     fig.tight_layout()

@@ -1,6 +1,6 @@
 """Support loads on the physics plant: the edge-load model against MuJoCo, and where the
 optimisers' unloaded time comes from (docs/physics.md, "Support loads while moving" and
-"Why an edge goes unloaded").
+"Why an edge goes unloaded: the optimisers on the scenarios").
 
 Run from the repository root::
 
@@ -984,9 +984,13 @@ def _trace(ax, window: dict[str, Any]) -> None:
     ends = np.array(window["step_end_t"])
     marks = np.array(window["step_end_unloaded"])
     ax.plot(ends[marks], np.zeros(marks.sum()), "kv", ms=4, label="control step ends unloaded")
-    ax.set_xlim(t[0], t[-1])
-    top = max(max(window[k]) for k, *_ in styles if window.get(k) is not None)
-    ax.set_ylim(-0.05 * top, 1.35 * top)
+    # The axes hold every curve (the model may predict a negative load) and every mark.
+    drawn = [window[k] for k, *_ in styles if window.get(k) is not None]
+    top, bottom = max(max(v) for v in drawn), min(0.0, min(min(v) for v in drawn))
+    start, end = min(t[0], *ends[marks]), max(t[-1], *ends[marks])
+    pad = 0.01 * (end - start)
+    ax.set_xlim(start - pad, end + pad)
+    ax.set_ylim(bottom - 0.05 * (top - bottom), top + 0.35 * (top - bottom))
     ax.set_xlabel("t (s)")
     ax.set_ylabel(f"load off the {window['edge']} edge (N)")
     ax.set_title(
@@ -1027,6 +1031,7 @@ def validation_figure(records: dict[str, dict[str, np.ndarray]], path: Path) -> 
         ax.set_ylabel("edge load, mean over each control step (N)")
         ax.legend(fontsize=7, loc="upper right", ncol=3)
     ax = axes.flat[-1]
+    smallest = 1e-3  # % of the weight: the axis reaches down to the smallest error drawn
     for (run, record), colour in zip(records.items(), ("#1f77b4", "#ff7f0e", "#2ca02c")):
         errors = prediction_errors(record)
         for kind, style in (("mean", "-"), ("static", ":")):
@@ -1034,8 +1039,10 @@ def validation_figure(records: dict[str, dict[str, np.ndarray]], path: Path) -> 
             share = np.arange(1, len(values) + 1) / len(values)
             label = f"{run}, {'model' if kind == 'mean' else 'static'}"
             ax.plot(values, share, color=colour, ls=style, label=label)
+            if np.any(values > 0):
+                smallest = min(smallest, values[values > 0][0])
     ax.set_xscale("log")
-    ax.set_xlim(1e-3, 100)
+    ax.set_xlim(10 ** np.floor(np.log10(smallest)), 100)
     ax.set_ylim(0, 1.02)
     ax.set_xlabel("|predicted - measured| edge load, step mean (% of the weight)")
     ax.set_ylabel("share of steps x edges")

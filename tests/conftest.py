@@ -20,7 +20,7 @@ settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ddwmmr"))
 
 @pytest.fixture
 def robot() -> Robot:
-    """The thesis robot of SPEC §1 (payload 1.25 kg)."""
+    """The thesis robot (docs/theory.md, "Model"; payload 1.25 kg)."""
     return Robot()
 
 

@@ -51,7 +51,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("simulation", ("sim",)),
     ("records and reports", ("provenance", "reports")),
     ("scenarios", ("scenarios",)),
-    ("benchmark", ("bench",)),
+    ("benchmark", ("bench", "bounds")),
     ("gui", ("gui",)),
     ("command lines", ("cli",)),
     ("entry points", ("", "__main__", "track", "compare")),

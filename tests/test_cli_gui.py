@@ -180,7 +180,7 @@ def test_options_reach_the_window_settings():
             "duration must be >= one step T/N = 40 s / 2 = 20 s (got 1); raise N or duration, "
             "lower T, or set dt",
         ),
-        (["--traj", "figure8", "--duration", "0.1"], "one step T/N = 60 s / 240 = 0.25 s"),
+        (["--traj", "figure8", "--duration", "0.01"], "one step T/N = 60 s / 3000 = 0.02 s"),
         (["--offset", "1", "1"], "offset must be in [-0.65, 0.65] m (the arm's reach) (got 1)"),
         (["--offset", "0", "-0.7"], "offset must be in [-0.65, 0.65] m (the arm's reach)"),
         (

@@ -93,6 +93,39 @@ def test_force_replaces_an_existing_image_file(tmp_path, capsys):
     assert files_below(tmp_path) == ["user_pic.png"]  # no temporary file left
 
 
+@pytest.mark.parametrize("name", ["shot.png", "shot.svg", "shot.pdf", "shot.eps"])
+def test_a_rerun_replaces_its_own_snapshot(name, tmp_path, capsys):
+    """A file a snapshot wrote carries a mark in its metadata: the rerun may replace it."""
+    path = tmp_path / name
+    assert run(["--snapshot", str(path), *FAST]) == 0
+    capsys.readouterr()
+    first = path.read_bytes()
+    assert run(["--snapshot", str(path), *FAST, "--method", "ats"]) == 0, capsys.readouterr().err
+    assert capsys.readouterr().out == f"wrote {path}\n"
+    assert path.read_bytes() != first and files_below(tmp_path) == [name]
+
+
+def test_the_snapshot_mark_is_in_the_png_metadata_and_nowhere_else(tmp_path, capsys):
+    from ddwmmr.gui.paths import SNAPSHOT_MARK, written_by_snapshot
+
+    path = tmp_path / "shot.png"
+    assert run(["--snapshot", str(path), *FAST]) == 0
+    with Image.open(path) as image:
+        assert image.info["Software"] == SNAPSHOT_MARK
+    assert written_by_snapshot(path, "png")
+    # a user's PNG, even one naming the mark outside a PNG, or a JPEG snapshot: not ours
+    user = tmp_path / "user.png"
+    Image.new("RGB", (4, 4)).save(user, pnginfo=None)
+    assert not written_by_snapshot(user, "png")
+    text = tmp_path / "notes.png"
+    text.write_text(SNAPSHOT_MARK)
+    assert not written_by_snapshot(text, "png")
+    jpeg = tmp_path / "shot.jpg"
+    assert run(["--snapshot", str(jpeg), *FAST]) == 0
+    capsys.readouterr()
+    refused(["--snapshot", str(jpeg), *FAST], capsys, "a .jpg file cannot show", "--force")
+
+
 def test_the_suffix_picks_the_format_and_missing_folders_are_made(tmp_path, capsys):
     path = tmp_path / "new" / "sub" / "gui.SVG"
     assert run(["--snapshot", str(path), *FAST]) == 0, capsys.readouterr().err
@@ -261,7 +294,7 @@ def test_the_path_checks_accept_what_can_be_written(tmp_path):
         assert check_snapshot_path(str(tmp_path / f"x.{fmt}")) == tmp_path / f"x.{fmt}"
     (tmp_path / "x.png").write_bytes(USER_TEXT)
     assert check_snapshot_path(str(tmp_path / "x.png"), force=True) == tmp_path / "x.png"
-    with pytest.raises(ParameterError, match="exists; choose another file"):
+    with pytest.raises(ParameterError, match="exists and no snapshot wrote it; choose another"):
         check_snapshot_path(str(tmp_path / "x.png"))
     assert files_below(tmp_path) == ["x.png"]  # the writability probe left nothing
 

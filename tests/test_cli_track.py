@@ -255,7 +255,8 @@ def test_run_record_holds_everything_to_rerun(tmp_path):
     assert trajectory["type"] == "samples" and trajectory["name"] == "figure8"
     data = Path(trajectory["file"]).read_bytes()
     assert trajectory["sha256"] == hashlib.sha256(data).hexdigest()
-    assert record["dt"] == 60.0 / 240 and record["duration"] == 1.0  # the rows' spacing
+    # the rows are 0.25 s apart: the default step is no coarser than 0.02 s
+    assert record["dt"] == 60.0 / 3000 and record["duration"] == 1.0
     assert record["integrator"] == "rk4" and record["initial_offset"] == list(
         DEFAULT_INITIAL_OFFSET
     )

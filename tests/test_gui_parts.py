@@ -29,7 +29,8 @@ def test_every_method_offers_the_options_its_constructor_takes():
         names = [spec.name for spec in method_options(method)]
         assert "robot" not in names
         assert len(names) == len(set(names))
-    assert [s.name for s in method_options("ats")] == ["aux"]
+    # the class's own options, then its parents' (the resolved-rate base's damping)
+    assert [s.name for s in method_options("ats")] == ["aux", "singularity_threshold", "damping"]
     assert {"tau", "aux"} <= {s.name for s in method_options("clrrmc-ts")}
     assert {"tau", "aux", "reference_step"} <= {s.name for s in method_options("clrrmc-cs")}
     qp = {s.name: s for s in method_options("qp")}
@@ -128,7 +129,9 @@ def test_sampled_file_unchanged_without_geometry():
     own = geometry_of(base)
     xy = base.points[:, :2]
     assert own["a"] == pytest.approx((xy[:, 0].max() - xy[:, 0].min()) / 2)
-    assert own["N"] == len(base.times) - 1 and own["T"] == pytest.approx(base.duration)
+    # N: the run's steps at the default step (rows 0.25 s apart, steps of 0.02 s)
+    assert own["N"] == round(base.duration / 0.02) == 3000
+    assert own["T"] == pytest.approx(base.duration)
 
 
 def test_sampled_placement_is_the_affine_map_of_the_samples():

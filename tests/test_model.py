@@ -1,4 +1,4 @@
-"""Robot model: kinematics, Jacobian, wheels, manipulability, stability (SPEC §1)."""
+"""Robot model: kinematics, Jacobian, wheels, manipulability, stability (docs/theory.md)."""
 
 import math
 
@@ -88,7 +88,8 @@ def test_manipulability(robot):
 
 
 def test_stability_spec_figures():
-    # SPEC §1: full sideways stretch gives S = 1.0 with 3 kg and S = 1.56 with 1.25 kg.
+    # docs/theory.md, "Tip-over stability": full sideways stretch gives S = 1.0 with 3 kg
+    # and S = 1.56 with 1.25 kg.
     sideways = [0, 0, 0, math.pi / 2, 0.0]
     assert Robot().with_payload(3.0).stability(sideways)[2] == pytest.approx(1.0)
     assert Robot().stability(sideways)[2] == pytest.approx(1.559, abs=1e-3)

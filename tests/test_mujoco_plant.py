@@ -61,7 +61,7 @@ def test_reset_places_the_robot_at_rest_at_q0():
 @pytest.mark.parametrize("pose", [(-0.3, 0.6), (1.0, 1.6), (math.pi / 2, 0.3), (2.5, -1.0)])
 def test_floor_carries_the_weight_and_the_centre_of_pressure_gives_s(pose):
     """At rest: the normal forces sum to the weight and their centre of pressure is the
-    centre of mass, so S_phys equals the kinematic S (the S of SPEC §1)."""
+    centre of mass, so S_phys equals the kinematic S (docs/theory.md, "Tip-over stability")."""
     plant = fresh((0.4, 0.2, 0.9, *pose))
     values = dict(zip(plant.extra_columns, plant.extra_values()))
     forces = [values[f"support_force_{s.name}_n"] for s in plant.supports]

@@ -1,4 +1,4 @@
-"""Presets: the slides' settings (seed 004) against the library's defaults (issue 9.1)."""
+"""Presets: the slides' settings against the library's defaults."""
 
 import inspect
 import math

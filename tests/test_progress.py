@@ -33,6 +33,30 @@ def test_long_phase_prints_a_line_now_and_then(monkeypatch):
     assert stream.getvalue().splitlines()[-1].startswith("runs: 3/3 done in ")
 
 
+def test_off_a_terminal_the_progress_lines_carry_an_eta(monkeypatch):
+    """40 of 100 items in 177 s: 60 more at that rate take 265.5 s."""
+    clock = iter([1000.0, 1177.0, 1177.0, 1500.0])
+    monkeypatch.setattr(progress.time, "perf_counter", lambda: next(clock))
+    monkeypatch.setattr(progress, "LOG_INTERVAL_S", 30.0)
+    stream = io.StringIO()
+    with ProgressBar(100, "scenarios", stream=stream) as bar:
+        bar.advance(40)
+    lines = stream.getvalue().splitlines()
+    assert lines[0] == "scenarios: 40/100 after 177 s, ETA 4 min 26 s"
+
+
+def test_eta_and_durations():
+    assert progress.eta(177.0, 40, 100) == 177.0 * 60 / 40
+    assert progress.eta(5.0, 0, 10) == float("inf")
+    assert [progress._duration(s) for s in (4.4, 59.6, 265.5, 3725.0, float("inf"))] == [
+        "4 s",
+        "1 min 00 s",
+        "4 min 26 s",
+        "1 h 02 min",
+        "unknown",
+    ]
+
+
 def test_terminal_gets_a_tqdm_bar():
     stream = Terminal()
     with ProgressBar(4, "compare: runs", stream=stream, unit="run") as bar:

@@ -1,5 +1,5 @@
-"""The docs/qp.md demonstrations, with a 3 kg payload (SPEC §1: a full sideways stretch
-then reaches S = 1 exactly)."""
+"""The docs/qp.md demonstrations, with a 3 kg payload (docs/theory.md, "Tip-over stability":
+a full sideways stretch then reaches S = 1 exactly)."""
 
 from __future__ import annotations
 

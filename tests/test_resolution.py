@@ -1,9 +1,9 @@
-"""Resolution kernels against second formulations of SPEC §3 and the damping bound.
+"""Resolution kernels against second formulations of docs/theory.md and the damping bound.
 
 The references here do not use the library's model: the Jacobian is built by complex-step
-differentiation (exact to rounding) of the forward kinematics written below from SPEC §1,
+differentiation (exact to rounding) of the forward kinematics written below from docs/theory.md,
 the nonholonomic row
-and the auxiliary rows are the SPEC's literals, and the damped solutions are computed
+and the auxiliary rows are the documented literals, and the damped solutions are computed
 from an SVD of the matrices assembled from that Jacobian.
 """
 
@@ -17,17 +17,17 @@ from hypothesis import strategies as st
 from ddwmmr import ParameterError, Rectangle, Robot, make_controller, simulate
 from ddwmmr.resolution import kernels
 
-L1, L2 = 0.35, 0.30  # the default robot (SPEC §1)
+L1, L2 = 0.35, 0.30  # the default robot (docs/theory.md)
 #: The documented damping threshold sigma0 and the documented bounds (kernels docstring,
 #: docs/theory.md section 4): |u| <= C |Xdot|.
 SIGMA0 = 0.05
 PI_BOUND = 1.0 / SIGMA0
 ATS_BOUND = 2.0 * math.sqrt(1.0 + (L1 + L2) ** 2) / SIGMA0 + 1.0
-AUX_ROWS = {"sum": [0, 0, 0, 1, 1], "shoulder": [0, 0, 0, 1, 0]}  # SPEC §3
+AUX_ROWS = {"sum": [0, 0, 0, 1, 1], "shoulder": [0, 0, 0, 1, 0]}  # docs/theory.md, "Methods"
 
 
 def fk(q):
-    """End-effector pose from SPEC §1, written independently of the library (accepts
+    """End-effector pose from docs/theory.md, written independently of the library (accepts
     complex q for the complex step)."""
     x, y, phi, th1, th2 = q
     return np.array(
@@ -49,7 +49,7 @@ def jacobian(q, h=1e-30):
 
 
 def input_matrix(phi):
-    """B(phi) of SPEC §1: qdot = B u."""
+    """B(phi) of docs/theory.md, "Input form": qdot = B u."""
     B = np.zeros((5, 4))
     B[0, 0], B[1, 0] = math.cos(phi), math.sin(phi)
     B[2:, 1:] = np.eye(3)

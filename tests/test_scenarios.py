@@ -81,7 +81,10 @@ def test_stability_at_or_below_one_fails():
 
 
 def test_payload_choice_thesis_payload_never_tips_3kg_can():
-    """SPEC §1: with 1.25 kg min S over all arm poses is 1.56; with 3.0 kg it reaches 1.0."""
+    """With 1.25 kg min S over all arm poses is 1.56; with 3.0 kg it reaches 1.0.
+
+    docs/theory.md, "Tip-over stability".
+    """
     grid = np.linspace(-math.pi, math.pi, 181)
     light = Robot().with_payload(1.25)
     worst_light = min(light.stability((0, 0, 0, a, b))[2] for a in grid for b in grid)

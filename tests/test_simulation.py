@@ -1,4 +1,4 @@
-"""Closed- and open-loop tracking on the kinematic plant (SPEC §3–4, slides' observations).
+"""Closed- and open-loop tracking on the kinematic plant (docs/theory.md, slides' observations).
 
 The measured behaviour documented in docs/theory.md ("Measured behaviour") is asserted here.
 """
@@ -50,7 +50,7 @@ def test_pseudoinverse_reaches_the_shoulder_singularity_on_the_ellipse():
 
 @pytest.mark.parametrize("traj", [Ellipse(), Rectangle()])
 def test_task_space_error_decays_as_exp_minus_t_over_tau(traj):
-    # Error dynamics Xe_dot + K Xe = 0 (SPEC §4): e(t) = e(0) exp(-t/tau) while nothing
+    # Error dynamics Xe_dot + K Xe = 0 (docs/theory.md): e(t) = e(0) exp(-t/tau) while nothing
     # saturates (measured to 2.4e-6 relative with RK4 at dt = 0.02 s).
     tau = 0.5
     ts = simulate(Robot(), traj, "clrrmc-ts", duration=3.0, tau=tau).timeseries
@@ -64,7 +64,7 @@ def test_task_space_error_decays_as_exp_minus_t_over_tau(traj):
 
 @pytest.mark.parametrize("traj", [Ellipse(), Rectangle()])
 def test_configuration_space_error_decays_as_exp_minus_t_over_tau(traj):
-    # qe_dot + K qe = 0 (SPEC §4) for clrrmc-cs, in configuration space: q_d - q against
+    # qe_dot + K qe = 0 (docs/theory.md) for clrrmc-cs, in configuration space: q_d - q against
     # the controller's own reference q_d(t).
     tau = 0.5
     result = simulate(Robot(), traj, "clrrmc-cs", duration=3.0, tau=tau)

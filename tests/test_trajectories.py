@@ -1,4 +1,4 @@
-"""Trajectories: shapes, derivatives, orientation, files (SPEC §2)."""
+"""Trajectories: shapes, derivatives, orientation, files (docs/theory.md, "Trajectories")."""
 
 import math
 from pathlib import Path

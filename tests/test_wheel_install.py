@@ -8,6 +8,7 @@ environment; ddwmmr itself must come from the wheel (asserted).
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -82,7 +83,9 @@ def test_installed_package_runs_a_named_trajectory(installed, tmp_path):
         cwd=tmp_path, env=env,
     )  # fmt: skip
     assert "ats on figure8" in done.stdout
-    assert (out / "summary.json").is_file()
+    record = json.loads((out / "summary.json").read_text())["run"]
+    assert record["git"] is None  # and it says why
+    assert record["git_note"] == "installed package, not a git checkout: no commit to record"
     done = _run(
         [sys.executable, "-m", "ddwmmr.track", "--method", "qp", "--traj", "ellipse",
          "--obstacles", "ellipse_post", "--duration", "0.5", "--no-plots", "--no-progress",

@@ -11,10 +11,12 @@ allocation or overflow, and are checked before anything is allocated.
 
 from __future__ import annotations
 
+import difflib
 import math
 import os
 import stat
 import tomllib
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -243,3 +245,11 @@ def nesting_depth(value: Any) -> int:
             deepest = max(deepest, depth + 1)
             pending.extend((child, depth + 1) for child in item)
     return deepest
+
+
+def did_you_mean(word: str, known: Iterable[str], prefix: str = "") -> str:
+    """`` (did you mean PREFIXNAME?)`` for the name in ``known`` closest to ``word``, or
+    ``""`` when none is close (difflib's similarity ratio >= 0.6): the one wording of the
+    suggestion every tool makes for a mistyped name."""
+    close = difflib.get_close_matches(word, list(known), n=1)
+    return f" (did you mean {prefix}{close[0]}?)" if close else ""

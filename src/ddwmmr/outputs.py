@@ -16,6 +16,9 @@ Every tool (track, compare, scenarios) writes its results through :func:`output_
   with one line (a :class:`ParameterError`);
 * a default, time-stamped ``--out`` (``fresh``) never replaces anything: two runs started
   within the same second, or finishing together, each get their own folder (``-2``...);
+* a tool that keeps a cache inside its output folder while it runs (so an interrupted run
+  resumes, ``python -m ddwmmr.bounds``) writes those files in place and lists them with
+  :func:`list_in_manifest`: the folder stays this tool's own between runs;
 * ``force=True`` (``--force``) also writes into a folder another tool or the user made,
   and even then deletes only the files its manifest lists: a file no manifest lists always
   survives (a new file that would overwrite it is refused).
@@ -617,6 +620,36 @@ def _commit_fresh(staging: Path, target: Path) -> Path:
                 candidate.rmdir()  # only if still empty: after the rename it holds the run
             raise
         return candidate
+
+
+def list_in_manifest(folder: str | Path, tool: str, names: Sequence[str]) -> None:
+    """Add ``names`` (relative, posix) to the manifest of ``folder``, a folder of ``tool``
+    (made here if absent; an empty folder gets a new manifest). Refuses (one-line
+    :class:`ParameterError`) a folder that is not this tool's own."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True, mode=folder_mode())
+    existing = inspect(folder, tool)
+    fresh = [n for n in names if n not in existing.listed]
+    other_tool = existing.tool is not None and existing.tool != tool
+    parents = {str(PurePosixPath(n).parent) + "/" for n in fresh}
+    strangers = set(existing.foreign) - set(fresh) - parents
+    if other_tool or (existing.kind == "foreign" and strangers):
+        raise ParameterError(_refusal(str(folder), tool, existing))
+    if not all(_safe_relative(n) for n in names):
+        raise ParameterError(f"out: unsafe file names for {folder}: {list(names)}")
+    files = sorted({*existing.listed, *names})
+    manifest = {"tool": tool, "version": package_version(), "files": files}
+    payload = json.dumps(manifest, indent=2) + "\n"
+    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".ddwmmr-", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            os.fchmod(handle.fileno(), file_mode())
+            handle.write(payload)
+        os.replace(tmp, folder / MANIFEST)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
 
 
 def _write_manifest(folder: Path, manifest: dict) -> None:

@@ -3,7 +3,9 @@
 * On a terminal, :class:`ProgressBar` draws a tqdm bar (rate, elapsed time, ETA).
 * When stderr is not a terminal (``make demo | tee``, CI logs), a bar would print control
   characters, so a :class:`ProgressBar` prints one short line when it finishes (and one
-  every :data:`LOG_INTERVAL_S` of a long phase), e.g. ``compare: runs 120/120 in 41.3 s``.
+  every :data:`LOG_INTERVAL_S` of a long phase, with the time left at the rate so far:
+  ``scenarios: 40/100 after 177 s, ETA 4 min 26 s``), e.g. ``compare: runs 120/120 done
+  in 41.3 s``.
 * :func:`phase` marks a long step without a known count (report writing, GIF encoding):
   a line when it starts on a terminal, and one line with its duration when it ends
   (elsewhere only for phases of :data:`QUIET_PHASE_S` or more).
@@ -25,6 +27,26 @@ from tqdm import tqdm
 LOG_INTERVAL_S = 30.0
 #: Phases shorter than this (s) print nothing when stderr is not a terminal.
 QUIET_PHASE_S = 1.0
+
+
+def eta(elapsed: float, done: int, total: int) -> float:
+    """Seconds left when ``done`` of ``total`` items took ``elapsed`` seconds, at the rate
+    so far (what tqdm's bar shows on a terminal)."""
+    return elapsed * (total - done) / done if done else float("inf")
+
+
+def _duration(seconds: float) -> str:
+    """``42 s``, ``3 min 05 s``, ``1 h 02 min``: a duration as a person reads it."""
+    if seconds != seconds or seconds == float("inf"):
+        return "unknown"
+    whole = round(seconds)
+    if whole < 60:
+        return f"{whole} s"
+    minutes, secs = divmod(whole, 60)
+    if minutes < 60:
+        return f"{minutes} min {secs:02d} s"
+    hours, minutes = divmod(minutes, 60)
+    return f"{hours} h {minutes:02d} min"
 
 
 def _is_terminal(stream: TextIO) -> bool:
@@ -79,7 +101,11 @@ class ProgressBar:
             now = time.perf_counter()
             if now - self._last_line >= LOG_INTERVAL_S:
                 self._last_line = now
-                self._line(f"{self.done}/{self.total} after {now - self._start:.0f} s")
+                elapsed = now - self._start
+                self._line(
+                    f"{self.done}/{self.total} after {elapsed:.0f} s, "
+                    f"ETA {_duration(eta(elapsed, self.done, self.total))}"
+                )
 
     def _line(self, text: str) -> None:
         self.stream.write(f"{self.label}: {text}\n" if self.label else f"{text}\n")

@@ -67,22 +67,28 @@ def decode(value: Any) -> Any:
     return value
 
 
-def git_state() -> dict[str, Any] | None:
-    """``{"commit", "dirty"}`` of the source checkout this package runs from, else None.
+#: ``git_note`` when the package is not ``<top>/src/ddwmmr`` of a git work tree.
+NOT_A_CHECKOUT = "installed package, not a git checkout: no commit to record"
+
+
+def git_record() -> dict[str, Any]:
+    """``{"git": {"commit", "dirty"}}`` of the source checkout this package runs from, or
+    ``{"git": None, "git_note": why}``.
 
     Only when the package is ``<top>/src/ddwmmr`` of a git work tree (an editable
-    install); an installed wheel has no commit to report.
+    install) is there a commit: an installed wheel has none (:data:`NOT_A_CHECKOUT`), and
+    a checkout where git cannot run says so.
     """
-    package = Path(__file__).resolve().parents[1]
+    package = Path(__file__).resolve().parent  # this module sits in the package itself
     top = package.parents[1]
     if package != top / "src" / "ddwmmr" or not (top / ".git").exists():
-        return None
+        return {"git": None, "git_note": NOT_A_CHECKOUT}
     try:
         commit = _git(top, "rev-parse", "HEAD")
         status = _git(top, "status", "--porcelain", "--untracked-files=no")
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return {"commit": commit, "dirty": bool(status)}
+    except (OSError, subprocess.SubprocessError) as exc:
+        return {"git": None, "git_note": f"a git checkout, but git could not run ({exc})"}
+    return {"git": {"commit": commit, "dirty": bool(status)}}
 
 
 def _git(top: Path, *arguments: str) -> str:
@@ -112,7 +118,7 @@ def header(tool: str, prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
         "record_version": RECORD_VERSION,
         "tool": tool,
         "version": package_version(),
-        "git": git_state(),
+        **git_record(),
         "python": sys.version.split()[0],
         "numpy": np.__version__,
         **command_record(prog, argv),

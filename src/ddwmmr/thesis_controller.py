@@ -115,8 +115,12 @@ class ThesisController:
     def waypoint_options(cls, run: WaypointRun) -> dict[str, Any]:
         """The options of a waypoint-task run: the arbiter the run configuration asks for
         (state machine or competitive dynamics, :func:`ddwmmr.arbiters.make_arbiter`) and
-        the scenario's obstacles."""
-        return {"arbiter": make_arbiter(run.config), "obstacles": run.scenario.obstacles}
+        the scenario's obstacles, then the run's own ``controller_options``."""
+        return {
+            "arbiter": make_arbiter(run.config),
+            "obstacles": run.scenario.obstacles,
+            **dict(run.config.controller_options),
+        }
 
     @property
     def default_pose(self) -> tuple[float, float]:

@@ -1,10 +1,10 @@
 """The arbiter interface: what the thesis controller needs from any arbiter.
 
 The thesis's state machine (:mod:`ddwmmr.arbiters.state_machine`) is one implementation;
-another (e.g. the competitive-dynamics arbiter of SPEC §6) only has to provide the same
-three members. An arbiter may evaluate any of the behaviours it is given, but it must
-return a proposal made by one of them (or a blend in the common proposal format) and name
-the state it is in, which the metrics count. An arbiter that blends proposals instead of
+another (e.g. the competitive-dynamics arbiter, docs/thesis.md, "The dynamics") only has to
+provide the same three members. An arbiter may evaluate any of the behaviours it is given,
+but it must return a proposal made by one of them (or a blend in the common proposal format)
+and name the state it is in, which the metrics count. An arbiter that blends proposals instead of
 choosing one also provides ``weigh`` (:class:`BlendingArbiter`); the controller then uses
 its blending path.
 """

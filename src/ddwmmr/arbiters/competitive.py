@@ -1,4 +1,4 @@
-"""Competitive-dynamics arbiter (Ellekilde & Christensen 2009, seed 003; SPEC §6).
+"""Competitive-dynamics arbiter (Ellekilde & Christensen 2009; docs/thesis.md, "The dynamics").
 
 Instead of a state machine, every behaviour b has a weight ``w_b`` that evolves by the
 paper's eq. (3) (after Large, Christensen & Bajcsy 1999)::

@@ -27,8 +27,8 @@ DRIVE, TURN, BRAKE = "drive", "turn", "brake"
 class Percept:
     """What every behaviour sees at one control instant; read-only by convention.
 
-    (Not a frozen dataclass: one is built every control step, and a frozen one costs
-    1.7 us to build against 0.2 us, a seventh of a thesis-controller step.)
+    (Not a frozen dataclass: one is built every control step, and a frozen one is several
+    times dearer to build; docs/thesis.md, "Speed and scale-out".)
 
     Attributes:
         t: time (s).
@@ -36,7 +36,7 @@ class Percept:
         th1, th2: arm joints (rad); v: forward speed (m/s); w: yaw rate (rad/s).
         xe, ye: end effector (m, world).
         x_com, y_com: arm+payload+base centre of mass in the base frame (m).
-        s_lon, s_lat, s: stability margins (SPEC §1; > 1 is stable).
+        s_lon, s_lat, s: stability margins (docs/theory.md, "Tip-over stability"; > 1 is stable).
         eta: normalised manipulability ``|sin th2|``.
         target: current task point for the end effector (m, world), or None when done.
         hold: end-effector position latched when the current arbiter state was entered

@@ -19,7 +19,7 @@ Three parts (docs/api.md, "Benchmark", explains the method):
   scenarios with the thesis controller and with ``qp`` (:func:`time_scenarios`, on by
   default in the command-line run without ``--method``).
 
-Targets (issue 14): qp median <= 20 us and p99 <= 40 us in every class; rtb-holistic
+Targets (docs/api.md, "Benchmark"): qp median <= 20 us and p99 <= 40 us in every class; rtb-holistic
 at least 40x slower than qp. Timing thresholds are never unit tests: they are reported.
 
 The package, by concern: :mod:`~ddwmmr.bench.baseline` (the naive row),

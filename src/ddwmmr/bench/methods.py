@@ -22,8 +22,8 @@ from ddwmmr.sim import simulate
 #: Target: every method's median step at most this fraction of the naive step.
 TARGET_RATIO = 0.25
 #: Absolute step budgets (us) replacing the ratio target for methods that solve an
-#: optimisation every step (``qp``: issue 3's budget, ``mpc``: issue 11's 2 ms; issue 14's
-#: qp targets are judged per state class, see :data:`QP_TARGETS`).
+#: optimisation every step (docs/api.md, "Benchmark"; the qp step's stricter targets are
+#: judged per state class, see :data:`ddwmmr.bench.qp_classes.QP_TARGETS`).
 STEP_BUDGETS_US: dict[str, float] = {"qp": 60.0, "mpc": 2000.0}
 #: Method whose run provides the states of the method table.
 STATE_SOURCE_METHOD = "clrrmc-ts"

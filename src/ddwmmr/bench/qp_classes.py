@@ -23,7 +23,7 @@ from ddwmmr.model.stability import STABILITY_FLOOR
 from ddwmmr.progress import ProgressBar
 from ddwmmr.sim import simulate
 
-#: Issue 14 targets of the qp step, judged in every state class.
+#: Targets of the qp step, judged in every state class (docs/api.md, "Benchmark").
 QP_TARGETS = {"median_us": 20.0, "p99_us": 40.0, "reference_ratio": 40.0}
 
 

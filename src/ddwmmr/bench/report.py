@@ -115,7 +115,7 @@ def format_qp_classes(report: dict[str, Any]) -> list[str]:
 
 
 def format_qp_verdict(report: dict[str, Any]) -> str:
-    """One line: the issue 14 targets, met or missed, in every measured class."""
+    """One line: the qp step's targets (``report["qp_targets"]``), met or missed, per class."""
     targets = report["qp_targets"]
     measured = [e for e in report["qp_classes"] if "skipped" not in e]
     if not measured:

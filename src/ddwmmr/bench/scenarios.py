@@ -12,7 +12,7 @@ from ddwmmr.errors import (
     check_int_at_least,
 )
 
-#: Controllers of the scenario-throughput section (issue 14, target 3) and its default size.
+#: Controllers of the scenario-throughput section and its default size.
 SCENARIO_CONTROLLERS = ("thesis", "qp")
 SCENARIO_COUNT = 100
 #: What the scenario section takes from the scenarios tool's summary.

@@ -39,8 +39,7 @@ class _Parser(ArgumentParser):
     """The tools' parser (one-line errors, negative numbers in any notation) with the
     prefix ``bench: error: ...`` (exit status 2)."""
 
-    def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(2, f"bench: error: {message}\n")
+    error_prefix = "bench"
 
 
 def _integer(low: int, high: int | None = None) -> Callable[[str], int]:

@@ -24,9 +24,9 @@ import sys
 import threading
 from collections.abc import Callable, Iterator, Sequence
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, did_you_mean
 from ddwmmr.model import Robot
-from ddwmmr.outputs import check_output_folder, first_free, output_folder
+from ddwmmr.outputs import check_output_folder, first_free, output_folder, package_version
 
 #: Exit status for bad input (argparse uses the same).
 EXIT_USAGE = 2
@@ -45,9 +45,11 @@ __all__ = [
     "ArgumentParser",
     "Terminated",
     "add_force_argument",
+    "add_option_argument",
     "add_robot_arguments",
     "check_output_folder",
     "first_free",
+    "method_options_text",
     "output_folder",
     "robot_from_arguments",
     "run_main",
@@ -62,16 +64,41 @@ NEGATIVE_NUMBER = re.compile(
 )
 
 
+#: argparse's message for options it does not know (``--methd x``).
+UNRECOGNISED = "unrecognized arguments: "
+
+
 class ArgumentParser(argparse.ArgumentParser):
     """argparse with one-line errors: ``prog: error: message`` and exit status 2, and
-    negative numbers in any float notation taken as values (:data:`NEGATIVE_NUMBER`)."""
+    negative numbers in any float notation taken as values (:data:`NEGATIVE_NUMBER`);
+    ``--version``; a mistyped option gets the closest one (``--methd``: "did you mean
+    --method?")."""
+
+    #: What starts an error line (None: the parser's ``prog``).
+    error_prefix: str | None = None
 
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
+        if self.add_help:
+            self.add_argument("--version", action="version", version=f"ddwmmr {package_version()}")
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+        prefix = self.prog if self.error_prefix is None else self.error_prefix
+        self.exit(EXIT_USAGE, f"{prefix}: error: {self._with_suggestions(message)}\n")
+
+    def _with_suggestions(self, message: str) -> str:
+        """``message``, with the closest known option after each unknown one."""
+        if not message.startswith(UNRECOGNISED):
+            return message
+        known = [o for o in self._option_string_actions if o.startswith("--")]
+        words = [
+            f"{word}{did_you_mean(word.split('=')[0], known)}"
+            if word.startswith("--") and not NEGATIVE_NUMBER.match(word)
+            else word
+            for word in message[len(UNRECOGNISED) :].split()
+        ]
+        return UNRECOGNISED + " ".join(words)
 
 
 class Terminated(BaseException):
@@ -179,6 +206,34 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
         type=float,
         metavar="KG",
         help="payload at the end effector in kg (default: the robot's, 1.25 for Robot())",
+    )
+
+
+def add_option_argument(
+    parser: argparse.ArgumentParser | argparse._ArgumentGroup,
+    what: str,
+    examples: str = "horizon=2, aux=sum, tau=0.5,0.5,inf, obstacles=FILE",
+) -> None:
+    """``--option NAME=VALUE`` (repeatable): any option of the method(s), parsed and
+    checked as the simulator's fields are (:func:`ddwmmr.controllers.option_specs.
+    parse_option`); ``what`` says what it sets (the help's first sentence), ``examples`` a few."""
+    parser.add_argument(
+        "--option",
+        action="append",
+        metavar="NAME=VALUE",
+        help=f"{what}; repeatable, e.g. {examples}. The options of each method are listed "
+        "at the end; the common ones also have a flag of their own",
+    )
+
+
+def method_options_text(methods: Sequence[str]) -> str:
+    """``--help``'s list of each method's options (``--option NAME=VALUE``), one line per
+    method: ``  qp: stability_min, manipulability_weight, ...``."""
+    from ddwmmr.controllers.option_specs import option_names
+
+    lines = [f"  {m}: {', '.join(option_names(m)) or '(none)'}" for m in methods]
+    return "options of each method (--option NAME=VALUE; docs/api.md, Controllers):\n" + (
+        "\n".join(lines)
     )
 
 

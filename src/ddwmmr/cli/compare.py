@@ -14,6 +14,7 @@ import argparse
 import json
 import os
 import sys
+import textwrap
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -23,13 +24,16 @@ from ddwmmr import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
+    add_option_argument,
     add_robot_arguments,
     check_output_folder,
+    method_options_text,
     output_folder,
     robot_from_arguments,
     run_main,
 )
 from ddwmmr.controllers.base import available_methods, method_description
+from ddwmmr.controllers.option_specs import option_names, parse_options
 from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import (
     MAX_JOBS,
@@ -37,6 +41,7 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_positive,
     check_step_count,
+    did_you_mean,
 )
 from ddwmmr.plants import available_plants
 from ddwmmr.progress import phase
@@ -63,8 +68,9 @@ from ddwmmr.reports.compare.plan import run_duration
 from ddwmmr.resolution.reference import initial_configuration
 from ddwmmr.sim.result import json_safe, write_atomic
 from ddwmmr.sim.simulate import check_start
+from ddwmmr.sim.verdict import explain
 from ddwmmr.trajectories import available_trajectories, load_trajectory, trajectory_name
-from ddwmmr.trajectories.files import find_trajectory_file
+from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = "python -m ddwmmr.compare"
 DEFAULT_OUT = "runs/compare"
@@ -113,9 +119,14 @@ and step (the trajectory's T/N). Results do not depend on --jobs; only the step 
 
 
 def epilog() -> str:
-    """The ``--help`` text after the options: outputs, ranking, studies, methods."""
+    """The ``--help`` text after the options: outputs, ranking, studies, methods and their
+    options."""
     methods = "\n".join(f"  {m:<10}  {method_description(m)}" for m in available_methods())
-    return f"{EPILOG_TEXT}\nmethods:\n{methods}"
+    options = "\n".join(
+        textwrap.fill(line, 88, subsequent_indent="    ")
+        for line in method_options_text(available_methods()).splitlines()
+    )
+    return f"{EPILOG_TEXT}\nmethods:\n{methods}\n\n{options}"
 
 
 def build_parser() -> ArgumentParser:
@@ -208,10 +219,65 @@ def build_parser() -> ArgumentParser:
         "mujoco: rigid-body physics) and report their errors next to the kinematic plant's, "
         "with the reasons (lag, torque limits, slip)",
     )
+    add_option_argument(
+        parser,
+        "an option of the compared methods: NAME=VALUE for every method taking NAME, "
+        "METHOD:NAME=VALUE for that one; over the preset in every run of the method, except "
+        "where a study sets it (the swept tau)",
+    )
+    parser.add_argument(
+        "--horizon",
+        type=float,
+        metavar="S",
+        help="prediction horizon in s of the methods taking one (mpc; docs/mpc.md); the same "
+        "as --option horizon=S",
+    )
     add_robot_arguments(parser)
     add_force_argument(parser)
     parser.add_argument("--no-progress", action="store_true", help="no progress bar on stderr")
     return parser
+
+
+def parse_method_options(
+    texts: Sequence[str] | None, methods: Sequence[str], horizon: float | None = None
+) -> dict[str, dict[str, Any]]:
+    """The user's options per compared method, from ``--option [METHOD:]NAME=VALUE`` and
+    ``--horizon`` (checked as the simulator's fields are; values made hashable)."""
+    texts = [*(texts or ()), *(() if horizon is None else (f"horizon={horizon!r}",))]
+    chosen: dict[str, list[str]] = {m: [] for m in methods}
+    for text in texts:
+        target, colon, rest = text.partition(":")
+        if colon and "=" not in target:  # METHOD:NAME=VALUE
+            if target not in chosen:
+                raise ParameterError(
+                    f"option: {target!r} is not a compared method{did_you_mean(target, chosen)}"
+                    f" (compared: {', '.join(methods)}; got {text!r})"
+                )
+            chosen[target].append(rest)
+            continue
+        name = text.partition("=")[0].strip()
+        takers = [m for m in methods if name in option_names(m)]
+        if not takers:
+            if "=" not in text:
+                raise ParameterError(f"option must be [METHOD:]NAME=VALUE (got {text!r})")
+            known = sorted({n for m in methods for n in option_names(m)})
+            taken = "; ".join(f"{m}: {', '.join(option_names(m))}" for m in methods)
+            raise ParameterError(
+                f"option: no compared method takes {name!r}{did_you_mean(name, known)} ({taken})"
+            )
+        for method in takers:
+            chosen[method].append(text)
+    options = {}
+    for method, given in chosen.items():
+        parsed = parse_options(method, given)
+        if "obstacles" in parsed and parsed["obstacles"] is not None:
+            from ddwmmr.qp.limits.obstacles import load_obstacles
+
+            circles = load_obstacles(find_obstacle_file(parsed["obstacles"]))
+            parsed["obstacles"] = tuple((c.x, c.y, c.radius) for c in circles)
+        if parsed:
+            options[method] = parsed
+    return options
 
 
 def split_list(values: Sequence[str] | None, option: str) -> list[str]:
@@ -335,7 +401,9 @@ def run_record(
         study_methods=list(config.study_methods or ()),
         preset=config.preset,
         options={
-            m: provenance.options_record(m, preset_options(m, config.preset))
+            m: provenance.options_record(
+                m, {**preset_options(m, config.preset), **config.options.get(m, {})}
+            )
             for m in config.methods
         },
         robot=provenance.robot_record(config.robot),
@@ -377,11 +445,39 @@ def config_from_arguments(
         command=command,
         preset=args.preset,
         plants=parse_plants(args.plant),
+        options=parse_method_options(args.option, methods, args.horizon),
     )
 
 
-def format_summary(info: ReportInfo, out: Path, runs: int, seconds: float, jobs: int) -> str:
-    """The short console summary: ranking table, slides verdict, where the files went."""
+def not_tracked(plan: Any, outputs: dict[Any, Any]) -> list[str]:
+    """Console lines for the main runs that did not track (:mod:`ddwmmr.sim.verdict`):
+    one per run saying what went wrong, then each likely cause once."""
+    lines, causes = [], {}
+    for spec in plan.main:
+        found, what, cause = explain(outputs[spec].summary)
+        if found:
+            lines.append(f"  {spec.method} on {spec.trajectory}: {what}")
+            causes.setdefault(cause, []).append(spec.method)
+    if not lines:
+        return ['Every run tracked (see docs/cli.md, "Verdict").']
+    head = f'Did not track ({len(lines)} of {len(plan.main)} runs; see docs/cli.md, "Verdict"):'
+    tail = [
+        f"  likely cause ({', '.join(dict.fromkeys(methods))}): {cause}"
+        for cause, methods in causes.items()
+    ]
+    return [head, *lines, *tail]
+
+
+def format_summary(
+    info: ReportInfo,
+    out: Path,
+    runs: int,
+    seconds: float,
+    jobs: int,
+    failures: Sequence[str] = (),
+) -> str:
+    """The short console summary: ranking table, slides verdict, the runs that did not
+    track (``failures``, from :func:`not_tracked`), where the files went."""
     ranking, check = info.ranking, info.check
     lines = [
         f"Compared {len(ranking.overall)} methods on {', '.join(ranking.scores)}: {runs} runs "
@@ -400,6 +496,8 @@ def format_summary(info: ReportInfo, out: Path, runs: int, seconds: float, jobs:
         for method in dict.fromkeys(v.expected_better for v in found):
             worse = [slides_name(v.expected_worse) for v in found if v.expected_better == method]
             lines.append(f"  {name}: {slides_name(method)} scores worse than {', '.join(worse)}")
+    if failures:
+        lines += ["", *failures]
     figures = sum(name.endswith(".png") for name in info.files)
     lines += [
         "",
@@ -429,7 +527,7 @@ def _main(argv: Sequence[str] | None) -> int:
             info = write_report(config, plan, outputs, staging)
             write_atomic(staging / "run.json", json.dumps(json_safe(record), indent=2) + "\n")
     seconds = time.perf_counter() - start
-    print(format_summary(info, out, len(specs), seconds, jobs))
+    print(format_summary(info, out, len(specs), seconds, jobs, not_tracked(plan, outputs)))
     return 0
 
 

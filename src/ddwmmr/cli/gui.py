@@ -11,7 +11,8 @@ Examples::
 ``--snapshot PATH`` builds the same window off-screen (Agg), runs the simulation to the
 end, draws the final state and saves the whole window (controls and plots) to PATH, in the
 image format of its suffix (.png, .svg, .pdf...). An existing file is never replaced
-without ``--force``. Bad input, an output path that cannot be written included, prints one
+without ``--force``, unless an earlier snapshot wrote it (its metadata says so: .png,
+.svg, .pdf, .eps, .ps). Bad input, an output path that cannot be written included, prints one
 line on stderr and exits with status 2 before anything is built or run (nothing is
 written).
 """
@@ -28,13 +29,14 @@ from ddwmmr.cli.common import ArgumentParser, run_main
 from ddwmmr.controllers.base import available_methods
 from ddwmmr.errors import ParameterError, check_range
 from ddwmmr.gui.layout import desktop_figure
-from ddwmmr.gui.options import method_options, plant_names
+from ddwmmr.gui.options import parse_option, plant_names
 from ddwmmr.gui.paths import (
     SNAPSHOT_FORMATS,
     check_existing_snapshot,
     check_export_root,
     check_snapshot_path,
     snapshot_format,
+    snapshot_metadata,
 )
 from ddwmmr.gui.settings import (
     GEOMETRY,
@@ -81,7 +83,8 @@ def build_parser() -> ArgumentParser:
         "--force",
         action="store_true",
         help="with --snapshot: replace an existing file at PATH (never a folder or a "
-        "special file); without it an existing file is refused",
+        "special file); without it an existing file is refused unless an earlier snapshot "
+        "wrote it (.png, .svg, .pdf, .eps, .ps carry a mark saying so)",
     )
     parser.add_argument(
         "--dpi",
@@ -110,7 +113,7 @@ def build_parser() -> ArgumentParser:
         help=f"trajectory ({', '.join(available_trajectories())}) or a "
         ".toml/.csv path (default ellipse)",
     )
-    geometry = parser.add_argument_group("trajectory geometry (SPEC 2; default: the file's)")
+    geometry = parser.add_argument_group("trajectory geometry (default: the file's)")
     for name, unit, allowed in GEOMETRY:
         geometry.add_argument(
             f"--{name}",
@@ -172,18 +175,6 @@ def build_parser() -> ArgumentParser:
     return parser
 
 
-def parse_option(method: str, text: str) -> tuple[str, object]:
-    """``NAME=VALUE`` -> (name, value) as the window's field for that option parses it."""
-    name, sep, value = text.partition("=")
-    specs = {spec.name: spec for spec in method_options(method)}
-    if not sep or not name:
-        raise ParameterError(f"option must be NAME=VALUE (got {text!r})")
-    if name not in specs:
-        known = ", ".join(specs) or "none"
-        raise ParameterError(f"option: {method} has no option {name!r} (options: {known})")
-    return name, specs[name].parse(value)
-
-
 def settings_from_arguments(args: argparse.Namespace) -> Settings:
     """The :class:`Settings` the options describe (checked)."""
     settings = Settings(trajectory=args.traj).with_method(0, args.method)
@@ -191,8 +182,9 @@ def settings_from_arguments(args: argparse.Namespace) -> Settings:
     for slot, texts in ((0, args.option), (1, args.compare_option)):
         if texts and settings.methods[slot] is None:
             raise ParameterError("compare-option needs --compare METHOD")
+        what = ("option", "compare-option")[slot]
         for text in texts:
-            name, value = parse_option(settings.methods[slot], text)
+            name, value = parse_option(settings.methods[slot], text, what)
             settings = settings.with_option(slot, name, value)
     for name, _, _ in GEOMETRY:
         value = getattr(args, name)
@@ -242,9 +234,9 @@ def snapshot(
             raise ParameterError(message)
         raise RunFailed(message)
     app.show_index(app.view.last_index)
-    app.say(f"snapshot: final state at t = {app.view.time:.2f} s (--snapshot {Path(path).name})")
+    app.say(f"snapshot: final state at t = {app.view.time:.2f} s (--snapshot {path})")
     buffer = io.BytesIO()
-    figure.savefig(buffer, format=fmt, dpi=dpi or DPI)
+    figure.savefig(buffer, format=fmt, dpi=dpi or DPI, metadata=snapshot_metadata(fmt))
     check_existing_snapshot(target, text, force)  # appeared during the run?
     created = missing_folders(target.parent)
     try:

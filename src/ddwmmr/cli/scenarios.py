@@ -20,6 +20,7 @@ import datetime as dt
 import json
 import math
 import sys
+import textwrap
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, astuple, replace
@@ -33,13 +34,16 @@ from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
+    add_option_argument,
     check_output_folder,
     first_free,
+    method_options_text,
     output_folder,
     run_main,
 )
 from ddwmmr.commands import traits_of
 from ddwmmr.controllers import controller_traits, method_description
+from ddwmmr.controllers.option_specs import parse_options
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
@@ -93,6 +97,14 @@ QP_OPTIONS = {
     ),
     "qp_max_speed": (("qp",), lambda v: 0.0 < v <= MAX_QP_SPEED, f"(0, {MAX_QP_SPEED:g}] m/s"),
 }
+#: Controller options the protocol sets itself, and what sets them instead of --option.
+PROTOCOL_OPTIONS = {
+    "obstacles": "each scenario's own, --obstacles",
+    "dt": "--dt",
+    "stability_min": "--qp-stability-min",
+    "max_speed": "--qp-max-speed",
+    "arbiter": "--arbiter",
+}
 #: Largest threshold: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
 THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}
 #: The thesis's thresholds (enter, exit), the defaults of --stability and --manipulability.
@@ -117,12 +129,20 @@ any --executor and --jobs. Bad input prints one line and exits with status 2, le
 output behind."""
 
 
+def _options_epilog() -> str:
+    """The options of each scenario controller, one per line (wrapped)."""
+    text = method_options_text(scenario_controllers())
+    return "\n".join(
+        textwrap.fill(line, 88, subsequent_indent="    ") for line in text.splitlines()
+    )
+
+
 def build_parser() -> ArgumentParser:
-    """The argument parser (also used to render --help in the docs)."""
+    """The ``python -m ddwmmr.scenarios`` argument parser."""
     parser = ArgumentParser(
         prog=PROG,
         description=DESCRIPTION,
-        epilog=EPILOG,
+        epilog=f"{EPILOG}\n\n{_options_epilog()}",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
@@ -273,6 +293,24 @@ def build_parser() -> ArgumentParser:
         help=f"qp controller's end-effector speed limit, in (0, {MAX_QP_SPEED:g}] m/s "
         "(default: 1.0)",
     )
+    add_option_argument(
+        parser,
+        "an option of --controller, except those the protocol sets: "
+        + ", ".join(f"{k} ({v})" for k, v in PROTOCOL_OPTIONS.items()),
+        "adjust=0.3 (thesis), tau=0.3 (qp), intervals=8 (mpc)",
+    )
+    parser.add_argument(
+        "--horizon",
+        type=float,
+        metavar="S",
+        help="mpc's prediction horizon in s (docs/mpc.md); the same as --option horizon=S",
+    )
+    parser.add_argument(
+        "--bounds",
+        metavar="FILE",
+        help="a bounds.csv of python -m ddwmmr.bounds (same seed): the summary gives the "
+        "mean ratio of each scenario's time to its lower bound and best-known time",
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     return parser  # fmt: skip
 
@@ -323,6 +361,25 @@ def _qp_options(args: argparse.Namespace) -> dict[str, float]:
             raise ParameterError(f"{option} must be in {text} (got {value:g})")
         options[name] = value
     return options
+
+
+def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, Any], ...]:
+    """``--option NAME=VALUE`` and ``--horizon`` as ``RunConfig.controller_options``:
+    parsed and checked as the simulator's fields are; the options the protocol sets
+    (:data:`PROTOCOL_OPTIONS`) are refused, naming what sets them."""
+    texts = [
+        *(args.option or ()),
+        *(() if args.horizon is None else (f"horizon={args.horizon!r}",)),
+    ]
+    for text in texts:
+        name = text.partition("=")[0].strip()
+        if name in PROTOCOL_OPTIONS:
+            raise ParameterError(
+                f"option: the scenarios set {name} themselves ({PROTOCOL_OPTIONS[name]}; got "
+                f"{text!r})"
+            )
+    options = parse_options(args.controller, texts)
+    return tuple((name, tuple(v) if isinstance(v, list) else v) for name, v in options.items())
 
 
 def config_from_arguments(args: argparse.Namespace) -> RunConfig:
@@ -383,6 +440,7 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         **qp_options,
         arbiter=arbiter,
         arbiter_seed=arbiter_seed,
+        controller_options=scenario_controller_options(args),
     )
 
 
@@ -567,9 +625,17 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         scenarios = studies.obstacle_scenarios(scenarios)
     outcomes, wall = runner.run(scenarios, config, "scenarios")
     extra = {"seed": args.seed, "run": _record(args, config)}
+    if args.bounds_table is not None:
+        extra["bracket"] = {"bounds": args.bounds, **report.bracket(outcomes, args.bounds_table)}
     if config.controller == "mpc":
         extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
+    if args.bounds_table is not None:
+        b = summary["bracket"]
+        print(
+            f"mean ratio to the lower bound {b['mean_ratio_to_lower_bound']:.3f}, to the "
+            f"best-known time {b['mean_ratio_to_best_known']:.3f} ({args.bounds})"
+        )
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
@@ -667,11 +733,23 @@ def _record(args: argparse.Namespace, config: RunConfig) -> dict[str, Any]:
     return record
 
 
+def _bounds_table(args: argparse.Namespace, config: RunConfig):
+    """``--bounds``: the file's ``{scenario: (lower, best)}``, checked against the run."""
+    if args.bounds is None:
+        return None
+    from ddwmmr.bounds.batch import read_bounds_file
+
+    if args.study or args.obstacles:
+        raise ParameterError("bounds: only for the benchmark without a study or obstacles")
+    return read_bounds_file(args.bounds, args.seed, config.payload)
+
+
 def _main(argv: Sequence[str] | None = None) -> int:
     """Run the tool; bad input raises :class:`ParameterError`."""
     args = build_parser().parse_args(argv)
     args.argv = argv  # recorded in the summary
     config = config_from_arguments(args)
+    args.bounds_table = _bounds_table(args, config)
     fresh = args.out is None  # a default name: never replaces an earlier run
     out = first_free(default_out(), folder=True) if fresh else Path(args.out)
     check_output_folder(out, "scenarios", args.force, output_names(args, config))

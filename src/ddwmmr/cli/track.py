@@ -13,6 +13,7 @@ import argparse
 import datetime as dt
 import json
 import sys
+import textwrap
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -21,9 +22,11 @@ from ddwmmr import provenance
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
+    add_option_argument,
     add_robot_arguments,
     check_output_folder,
     first_free,
+    method_options_text,
     output_folder,
     robot_from_arguments,
     run_main,
@@ -34,6 +37,7 @@ from ddwmmr.controllers.base import (
     method_description,
     method_options,
 )
+from ddwmmr.controllers.option_specs import parse_options
 from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import (
     ParameterError,
@@ -57,8 +61,7 @@ from ddwmmr.trajectories import available_trajectories, load_trajectory
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = "python -m ddwmmr.track"
-#: The plant every track run uses (recorded; the only one until simulate() takes others).
-#: The default plant.
+#: The default plant (``--plant``), and the plant of a record that names none.
 PLANT = "kinematic"
 #: Tools whose summary.json records ``--rerun`` repeats: this one and the simulator's
 #: data export (``python -m ddwmmr.gui``).
@@ -67,7 +70,7 @@ RERUN_TOOLS = ("track", "gui")
 RUN_OPTIONS = (
     "method", "traj", "aux", "tau", "dt", "duration", "integrator", "offset", "robot", "plant",
     "payload", "stability_min", "manipulability_weight", "obstacles", "solver", "qp_mode",
-    "preset",
+    "preset", "horizon", "option",
 )  # fmt: skip
 
 #: Keys printed in the summary table, with their labels; errors in mm (as in compare).
@@ -115,6 +118,7 @@ METHOD_OPTIONS = {
     "obstacles": "obstacles",
     "solver": "solver",
     "qp_mode": "mode",
+    "horizon": "horizon",
 }
 
 
@@ -145,8 +149,22 @@ def _default_text(value: Any) -> str:
     return f"{value:g}" if isinstance(value, float) else str(value)
 
 
+class _Formatter(argparse.HelpFormatter):
+    """Help as argparse wraps it, except the epilog's lines after the first paragraph (the
+    options of each method), kept one method per line."""
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        first, _, rest = text.partition("\n\n")
+        filled = super()._fill_text(first, width, indent)
+        lines = [
+            textwrap.fill(line, width, initial_indent=indent, subsequent_indent=indent + "    ")
+            for line in rest.splitlines()
+        ]
+        return "\n\n".join([filled, "\n".join(lines)]) if rest else filled
+
+
 def build_parser() -> ArgumentParser:
-    """The argument parser (also used to render docs/cli.md)."""
+    """The argument parser; docs/cli.md documents each option (tests/test_cli_docs.py)."""
     methods = available_methods()
     method_help = "; ".join(f"{m}: {method_description(m).rstrip('.')}" for m in methods)
     parser = ArgumentParser(
@@ -158,7 +176,8 @@ def build_parser() -> ArgumentParser:
             "(errors in mm). summary.json records everything needed to repeat the run: "
             f"`{PROG} --rerun DIR/summary.json` reproduces it bit for bit."
         ),
-        epilog=f"Methods - {method_help}.",
+        epilog=f"Methods - {method_help}.\n\n{method_options_text(methods)}",
+        formatter_class=_Formatter,
     )
     parser.add_argument(
         "--method", choices=methods, help="control method (required unless --rerun)"
@@ -197,7 +216,14 @@ def build_parser() -> ArgumentParser:
         "settings: aux sum, no orientation feedback for clrrmc-ts); explicit options "
         "override it",
     )
-    parser.add_argument("--dt", type=float, metavar="S", help="step in s (default T/N)")
+    parser.add_argument(
+        "--dt",
+        type=float,
+        metavar="S",
+        help="control and integration step in s (default: T/N of a parametric trajectory, "
+        "0.02 s for the shipped ones; for a CSV the rows' spacing, made no coarser than "
+        "0.02 s, as in the API; on mujoco a whole number of engine steps)",
+    )
     parser.add_argument(
         "--duration", type=float, metavar="S", help="simulated time in s (default one period)"
     )
@@ -260,6 +286,13 @@ def build_parser() -> ArgumentParser:
         choices=("weighted", "hierarchical"),
         help=_option_help("priority handling", "mode"),
     )
+    qp.add_argument(
+        "--horizon",
+        type=float,
+        metavar="S",
+        help=_option_help("prediction horizon in s (docs/mpc.md, Options)", "horizon"),
+    )
+    add_option_argument(qp, "any option of --method, not only those with a flag")
     out = parser.add_argument_group("output")
     out.add_argument(
         "--out",
@@ -275,7 +308,8 @@ def build_parser() -> ArgumentParser:
 
 
 def controller_options(args: argparse.Namespace) -> dict[str, Any]:
-    """Controller keyword arguments from the CLI options that were given."""
+    """Controller keyword arguments from the CLI options that were given: the named flags
+    and ``--option NAME=VALUE`` (one option may not be given both ways)."""
     options: dict[str, Any] = {}
     for attribute, keyword in METHOD_OPTIONS.items():
         value = getattr(args, attribute)
@@ -289,12 +323,18 @@ def controller_options(args: argparse.Namespace) -> dict[str, Any]:
             )
         if attribute == "tau" and len(value) == 1:
             value = value[0]
-        if attribute == "obstacles":
-            from ddwmmr.qp.limits.obstacles import load_obstacles
-
-            circles = load_obstacles(find_obstacle_file(value))
-            value = [(c.x, c.y, c.radius) for c in circles]  # plain numbers: recordable
         options[keyword] = value
+    flags = {keyword: attribute for attribute, keyword in METHOD_OPTIONS.items()}
+    for name, value in parse_options(args.method, args.option).items():
+        if name in options:
+            flag = "--" + flags[name].replace("_", "-")
+            raise ParameterError(f"option: {name} is given both as {flag} and as --option")
+        options[name] = value
+    if isinstance(options.get("obstacles"), str):  # a name or a file: the circles
+        from ddwmmr.qp.limits.obstacles import load_obstacles
+
+        circles = load_obstacles(find_obstacle_file(options["obstacles"]))
+        options["obstacles"] = [(c.x, c.y, c.radius) for c in circles]  # plain: recordable
     return options
 
 
@@ -305,7 +345,8 @@ def default_out(method: str, traj: str) -> Path:
 
 
 def format_table(summary: dict[str, Any]) -> str:
-    """The summary as an aligned two-column text table (lengths in mm)."""
+    """The summary as an aligned two-column text table (lengths in mm), then the run's
+    verdict (:mod:`ddwmmr.sim.verdict`)."""
     plant = summary.get("plant", PLANT)
     lines = [f"{summary['method']} on {summary['trajectory']} ({plant} plant)"]
     for key, label in TABLE_KEYS:
@@ -315,6 +356,8 @@ def format_table(summary: dict[str, Any]) -> str:
                 value = 1000.0 * value
             text = f"{value:.6g}" if isinstance(value, float) else str(value)
             lines.append(f"  {label:<36} {text}")
+    if "verdict" in summary:
+        lines.append(textwrap.fill(f"verdict: {summary['verdict']}", 100, subsequent_indent="  "))
     return "\n".join(lines)
 
 

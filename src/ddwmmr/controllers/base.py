@@ -161,7 +161,13 @@ def method_options(name: str) -> dict[str, Any]:
     its parents (the MRO, most derived first: a subclass's default wins), without
     ``self``, ``robot``, ``*args`` and ``**kwargs``: what ``make_controller`` accepts.
     """
-    options: dict[str, Any] = {}
+    return {option: p.default for option, p in method_parameters(name).items()}
+
+
+def method_parameters(name: str) -> dict[str, inspect.Parameter]:
+    """The parameters behind :func:`method_options` (name -> ``inspect.Parameter``, with
+    the annotation of the class that sets the default)."""
+    parameters: dict[str, inspect.Parameter] = {}
     for klass in inspect.getmro(controller_class(name)):
         init = klass.__dict__.get("__init__")
         if init is None or klass is object:
@@ -169,8 +175,8 @@ def method_options(name: str) -> dict[str, Any]:
         for parameter in list(inspect.signature(init).parameters.values())[1:]:
             variadic = parameter.kind in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD)
             if not variadic and parameter.name != "robot":
-                options.setdefault(parameter.name, parameter.default)
-    return options
+                parameters.setdefault(parameter.name, parameter)
+    return parameters
 
 
 def make_controller(

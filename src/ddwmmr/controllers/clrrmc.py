@@ -1,4 +1,4 @@
-"""Closed-loop resolved-rate motion control (SPEC §4): ``clrrmc-cs`` and ``clrrmc-ts``.
+"""Closed-loop resolved-rate motion control: ``clrrmc-cs`` and ``clrrmc-ts``.
 
 Gains are given as time constants ``tau`` (s): ``K = 1/tau``. The error dynamics are then
 ``e_dot + K e = 0``, i.e. each error decays as ``exp(-t / tau)`` while the plant follows the

@@ -2,14 +2,16 @@
 
 ``make_controller(name, robot, preset="slides", **options)`` starts from the preset's
 options for ``name`` and lets explicit ``options`` override them. ``"default"`` is the
-library's own choice (the constructors' defaults, SPEC §3-4); ``"slides"`` reproduces the
-settings of the DDWMMR simulator slides (seed 004, "Redundancy Resolution" and
-"Closed-Loop Resolved Rate Motion Control" pages). Each entry cites where it comes from.
+library's own choice (the constructors' defaults); ``"slides"`` reproduces the
+settings of the DDWMMR simulator slides (Samak & Samak, "Redundancy Resolution" and
+"Closed-Loop Resolved Rate Motion Control" pages). Each entry cites where it comes from;
+docs/theory.md, "The slides' settings and ours", measures what each difference buys.
 
 Settings the slides do not give keep the library's value in both presets: the time
 constants (the slides write ``K_i = 1/tau_i`` without numbers; we use 0.5 s), the damping
 near the singularity (the slides invert ``J_aug`` and take ``J^#`` undamped; an undamped
-inverse is unbounded at ``cos th1 = 0``, so SPEC §1 requires protection in every preset),
+inverse is unbounded at ``cos th1 = 0``, so every preset damps it; docs/theory.md,
+"Singularities and damping"),
 and the run itself (integrator, step, initial offset: simulation settings, not method
 settings). Methods the slides do not describe (``qp`` and later ones) have no entry: every
 preset gives them their defaults.
@@ -32,12 +34,12 @@ SLIDES: dict[str, dict[str, Any]] = {
     # "Augmented task-space method 1": th1dot + th2dot = 0, row [0 0 0 1 1]; the slides'
     # CLRRMC pages use the same row (method 2, th1dot = 0, is our default).
     "ats": {"aux": "sum"},
-    # "Artificial potential method": V = 0.66 phi^2 + th1^2 + 0.25 th2^2 (SPEC §3 defaults).
+    # "Artificial potential method": V = 0.66 phi^2 + th1^2 + 0.25 th2^2 (also our default).
     "ap": {"K1": 1.0, "K2": 0.25, "K3": 0.66},
     # "CLRRMC (config space)": J_aug with the row [0 0 0 1 1] builds qdot_d = J^-1 Xd_dot.
     "clrrmc-cs": {"aux": "sum"},
     # "CLRRMC (task space)": J_aug with the row [0 0 0 1 1] and K = diag(K1, K2, 0, 0, 0):
-    # no orientation feedback (SPEC §4: "slides use K3 = 0"), i.e. tau_phi = inf.
+    # no orientation feedback (the slides use K3 = 0), i.e. tau_phi = inf.
     "clrrmc-ts": {"aux": "sum", "tau": (0.5, 0.5, math.inf)},
 }
 

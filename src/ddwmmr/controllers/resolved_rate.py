@@ -1,4 +1,4 @@
-"""Open-loop redundancy resolution controllers (SPEC §3): ``pi``, ``ats``, ``ap``.
+"""Open-loop redundancy resolution controllers: ``pi``, ``ats``, ``ap``.
 
 They feed the desired end-effector velocity forward through an inverse of the Jacobian and
 ignore the pose error, so an initial offset is kept (and integration errors accumulate).

@@ -33,6 +33,7 @@ from ddwmmr.gui.layout import (
     OFF_ENTRY,
     OPTIONS_PER_PAGE,
     SPEEDS,
+    SUMMARY_RIGHT,
     PanelLayout,
 )
 from ddwmmr.gui.options import OptionSpec, method_options
@@ -52,8 +53,10 @@ from ddwmmr.gui.widgets import (
     Field,
     describe_error,
     set_radio_silently,
+    wrap_to_width,
 )
 from ddwmmr.gui.worker import Worker
+from ddwmmr.sim.verdict import short_verdict
 from ddwmmr.trajectories import load_trajectory
 
 #: Playback frame and progress poll intervals (ms).
@@ -175,7 +178,7 @@ class App(PanelLayout):
     def say(self, text: str, error: bool = False) -> None:
         """Show ``text`` in the message area (red for errors) and redraw."""
         self.message = text
-        wrapped = "\n".join(textwrap.wrap(text, 62)) if text else ""
+        wrapped = "\n".join(textwrap.wrap(text, 62, break_on_hyphens=False)) if text else ""
         self.message_text.set_text(("error: " if error else "") + wrapped)
         self.message_text.set_color("tab:red" if error else "0.1")
         self._redraw()
@@ -541,9 +544,9 @@ class App(PanelLayout):
         # The wall time only in a window: a snapshot is a document, the same on every run.
         took = f", {elapsed:.1f} s" if self.interactive else ""
         self._set_progress(1.0, f"done: {steps} steps{took}")
-        self.summary_text.set_text(
-            "\n".join(_summary_line(label, r) for label, r in zip(self.labels(), results))
-        )
+        summary = "\n".join(_summary_line(label, r) for label, r in zip(self.labels(), results))
+        # Wrapped to the window: a physics run's line is longer than the view is wide.
+        self.summary_text.set_text(wrap_to_width(summary, self.summary_text, SUMMARY_RIGHT))
         self.say(f"run finished ({steps} steps per method): playing; drag time to scrub")
         self.show_index(0)
         self._play()
@@ -724,9 +727,11 @@ def _optional_positive(name: str, text: str) -> float | None:
 
 
 def _summary_line(label: str, result: Any) -> str:
+    """One method's line of the summary: its verdict first (docs/cli.md, "Verdict"), then
+    the metrics."""
     s = result.summary
     line = (
-        f"{label}: RMS pos {s['rms_position_error_m']:.3g} m,"
+        f"{label}: {short_verdict(s)}; RMS pos {s['rms_position_error_m']:.3g} m,"
         f" max {s['max_position_error_m']:.3g} m,"
         f" RMS orient {s['rms_orientation_error_rad']:.3g} rad, max wheel"
         f" {s['max_wheel_speed_rad_s']:.3g} rad/s, min S {s['min_stability']:.3g},"

@@ -33,6 +33,8 @@ OFF_ENTRY = "off"
 #: Playback speeds (simulated seconds per wall-clock second).
 SPEEDS = (0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0)
 DEFAULT_SPEED = 4.0
+#: Right end (figure fraction) of the runs' summary lines under the view.
+SUMMARY_RIGHT = 0.99
 #: Method options shown per page (two columns).
 OPTIONS_PER_PAGE = 12
 PAYLOAD_RANGE = (0.0, 5.0)
@@ -260,7 +262,7 @@ class PanelLayout:
         )
         self.view = RunView(path_ax, plot_axes)
         self.summary_text = self.figure.text(
-            0.385, 0.228, "", fontsize=FONT, va="top", linespacing=1.6
+            0.385, 0.228, "", fontsize=FONT, va="top", linespacing=1.4
         )
 
     def _build_transport(self) -> None:

@@ -5,9 +5,11 @@ fails in one line (a :class:`ParameterError`, status 2) instead of after the run
 
 * ``--snapshot PATH``: :func:`ddwmmr.outputs.check_output_path` (no symbolic link, not the
   current folder, names not too long, the nearest existing folder writable), an image
-  suffix matplotlib writes, and never an existing file unless ``--force`` (nothing records
-  which files an earlier snapshot wrote, so any existing file may be the user's); a folder
-  or a special file is refused even then;
+  suffix matplotlib writes, and never an existing file unless ``--force`` or an earlier
+  snapshot wrote it: a snapshot in a format with metadata (:data:`MARKED_FORMATS`) carries
+  :data:`SNAPSHOT_MARK` (:func:`snapshot_metadata`), so a rerun may replace its own file
+  (:func:`written_by_snapshot`) and no other; a folder or a special file is refused even
+  with ``--force``;
 * the export folder: a folder, or a path where one can be made.
 
 "Writable" is tried, not inferred from the permission bits
@@ -41,6 +43,46 @@ SNAPSHOT_FORMATS = (
 )
 
 
+#: What a snapshot writes into its file's metadata, and looks for before replacing a file
+#: (no parentheses: PDF strings would escape them).
+SNAPSHOT_MARK = "ddwmmr simulator snapshot: python -m ddwmmr.gui --snapshot"
+#: Formats whose metadata matplotlib writes as plain text, with the key holding the mark
+#: and how such a file starts (or, for SVG, what its first KiB holds).
+MARKED_FORMATS = {
+    "png": ("Software", b"\x89PNG\r\n\x1a\n"),
+    "pdf": ("Creator", b"%PDF"),
+    "svg": ("Creator", b"<svg"),
+    "eps": ("Creator", b"%!PS"),
+    "ps": ("Creator", b"%!PS"),
+}
+#: Largest file read to look for the mark (a snapshot is far smaller).
+MARK_SCAN_BYTES = 64 * 1024 * 1024
+
+
+def snapshot_metadata(fmt: str) -> dict[str, str] | None:
+    """The ``metadata`` of ``savefig`` for a snapshot in format ``fmt`` (None: the format
+    has none, and its file cannot be recognised later)."""
+    if fmt not in MARKED_FORMATS:
+        return None
+    return {MARKED_FORMATS[fmt][0]: SNAPSHOT_MARK}
+
+
+def written_by_snapshot(path: Path, fmt: str) -> bool:
+    """Whether the file at ``path`` is a ``fmt`` file an earlier snapshot wrote (it has
+    the format's signature and :data:`SNAPSHOT_MARK` in its metadata)."""
+    if fmt not in MARKED_FORMATS:
+        return False
+    signature = MARKED_FORMATS[fmt][1]
+    try:
+        with open(path, "rb") as file:
+            data = file.read(MARK_SCAN_BYTES)
+    except OSError:
+        return False
+    head = data[:1024] if fmt == "svg" else data[: len(signature)]
+    found = signature in head if fmt == "svg" else head == signature
+    return found and SNAPSHOT_MARK.encode() in data
+
+
 def snapshot_format(text: str) -> str:
     """The image format of ``--snapshot`` ``text``, from its suffix (one of
     :data:`SNAPSHOT_FORMATS`, any case)."""
@@ -70,8 +112,9 @@ def check_snapshot_path(text: str, force: bool = False) -> Path:
 
 
 def check_existing_snapshot(path: Path, text: str, force: bool) -> None:
-    """Refuse an existing ``path`` unless ``force``; a special file (FIFO, device...)
-    always. Called before the run and again just before the file is written."""
+    """Refuse an existing ``path`` unless ``force`` or an earlier snapshot wrote it
+    (:func:`written_by_snapshot`); a special file (FIFO, device...) always. Called before
+    the run and again just before the file is written."""
     try:
         info = os.lstat(path)
     except FileNotFoundError:
@@ -80,10 +123,18 @@ def check_existing_snapshot(path: Path, text: str, force: bool) -> None:
         raise ParameterError(f"snapshot: cannot check {text} ({exc.strerror})") from None
     if not stat.S_ISREG(info.st_mode):
         raise ParameterError(f"snapshot: {text} exists and is not a regular file")
-    if not force:
-        raise ParameterError(
-            f"snapshot: {text} exists; choose another file, or add --force to replace it"
-        )
+    fmt = snapshot_format(text)
+    if force or written_by_snapshot(path, fmt):
+        return
+    why = (
+        "no snapshot wrote it"
+        if fmt in MARKED_FORMATS
+        else f"a .{fmt} file cannot show that a snapshot wrote it: .{', .'.join(MARKED_FORMATS)}"
+        " can"
+    )
+    raise ParameterError(
+        f"snapshot: {text} exists and {why}; choose another file, or add --force to replace it"
+    )
 
 
 def check_export_root(text: str) -> Path:

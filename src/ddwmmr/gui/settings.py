@@ -4,7 +4,8 @@ A :class:`Settings` value is everything the control panel sets. It is immutable:
 builds a changed copy, checks it with :func:`check_settings`, and only then replaces the
 current one, so a bad field never leaves a half-applied setting behind.
 
-Trajectory geometry ``(x0, y0, a, b, beta, N, T)`` (SPEC §2) applies to every trajectory:
+Trajectory geometry ``(x0, y0, a, b, beta, N, T)`` (docs/theory.md, "Trajectories") applies
+to every trajectory:
 
 * parametric ones (ellipse, rectangle, their TOML files) take the values directly;
 * sampled ones (CSV files such as the figure-eight) are placed by the same numbers: their
@@ -144,7 +145,9 @@ def geometry_of(trajectory: Any) -> dict[str, float]:
             "a": float(half[0]),
             "b": float(half[1]),
             "beta": 0.0,
-            "N": int(trajectory.samples),
+            # steps per run at the default step (the rows' spacing, made no coarser
+            # than SampledTrajectory.default_step allows): N = T / dt as for the others
+            "N": round(trajectory.duration / trajectory.default_step),
             "T": float(trajectory.duration),
         }
     if dataclasses.is_dataclass(trajectory) and all(
@@ -212,8 +215,8 @@ def place_samples(base: SampledTrajectory, geometry: Mapping[str, float]) -> Sam
 
 def control_step(settings: Settings, trajectory: Any) -> float | None:
     """The step passed to simulate: the set dt, else T / N when N was changed for a sampled
-    trajectory (whose own resolution is its number of sample intervals), else None
-    (simulate's T / N)."""
+    trajectory (whose own step is its ``default_step``), else None (simulate's default,
+    :func:`resolution_step`)."""
     if settings.dt is not None:
         return settings.dt
     if isinstance(trajectory, SampledTrajectory) and "N" in settings.geometry:

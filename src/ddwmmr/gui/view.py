@@ -21,6 +21,7 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon
 from matplotlib.ticker import NullFormatter
 
+from ddwmmr.reports.legends import place_legend
 from ddwmmr.reports.plots import robot_outline, wheel_outlines
 
 #: Plot axes of the view, top to bottom: key -> y-axis label.
@@ -33,6 +34,17 @@ PLOTS = {
 }
 #: Colours of run A and run B: (end effector and plot lines, arm).
 PALETTE = (("tab:blue", "tab:orange"), ("tab:red", "tab:green"))
+#: Widths of run A's and run B's lines (end-effector trail, plot lines): B is drawn on
+#: top of A, thinner, so that A stays visible where the two coincide.
+TRAIL_WIDTHS = (3.0, 1.3)
+PLOT_WIDTHS = (2.0, 0.9)
+#: Drawing order in the top view: trails (2), the desired path, then the robots.
+DESIRED_ZORDER = 2.5
+ROBOT_ZORDER = 3.0
+#: Font sizes (points) of the tick labels and axis labels of the view: at the window's
+#: 100 dpi, 8 pt is 11 px.
+TICK_SIZE = 8
+LABEL_SIZE = 8
 #: Floor of the logarithmic position-error plot (m), as in the track figures.
 ERROR_FLOOR = 1e-9
 #: Samples of a desired path drawn before any run.
@@ -74,7 +86,11 @@ class RunView:
             ax.axvline(0.0, color="0.4", lw=0.8, visible=False) for ax in plot_axes.values()
         ]
         (self._period,) = path_ax.plot([], [], color="0.7", lw=0.8, label="desired, one period")
-        (self._desired,) = path_ax.plot([], [], "k--", lw=1, label="desired end effector")
+        # Over the end-effector trails (thin, dashed: visible where a run follows it),
+        # under the robots.
+        (self._desired,) = path_ax.plot(
+            [], [], "k--", lw=0.9, label="desired end effector", zorder=DESIRED_ZORDER
+        )
         (self._target,) = path_ax.plot([], [], "kx", ms=6, mew=1.2, label="desired now")
         self._style_axes()
 
@@ -108,21 +124,38 @@ class RunView:
         robot = results[0].robot
         self._fit_path(np.r_[xs, period[:, 0]], np.r_[ys, period[:, 1]], robot.base_length)
         self._fit_plots(results)
-        for key in ("position", "wheels", "stability"):
-            self.plot_axes[key].legend(loc="best", fontsize=6, ncol=3, framealpha=0.7)
         self.path_ax.legend(
-            loc="upper center", bbox_to_anchor=(0.5, -0.07), ncol=3, fontsize=6.5, frameon=False
+            loc="upper center",
+            bbox_to_anchor=(0.5, self._below_x_axis()),
+            ncol=3,
+            fontsize=7.5,
+            frameon=False,
         )
+        # The legends go where the whole runs leave room (raising a plot's top if needed),
+        # placed once: they do not move during playback.
+        self.show_index(self.last_index)
+        for key in ("position", "wheels", "stability"):
+            place_legend(self.plot_axes[key], fontsize=7, ncol=3, framealpha=0.8)
         for cursor in self._cursors:
             cursor.set_visible(True)
         self.show(0.0)
+
+    def _below_x_axis(self) -> float:
+        """Where the top view's legend starts (axes fraction, negative: under the axes):
+        0.07 below, or lower if the tick labels and the x label reach further down (a
+        short axes, as in the exported animation), so that the legend never covers them."""
+        renderer = self.path_ax.figure.canvas.get_renderer()
+        bottom = self.path_ax.xaxis.get_tightbbox(renderer).y0
+        reached = self.path_ax.transAxes.inverted().transform((0.0, bottom))[1]
+        return min(-0.07, reached - 0.01)
 
     def dynamic_artists(self, legends: bool = True) -> list[Any]:
         """The artists :meth:`show_index` changes (for blitting), in drawing order.
 
         ``legends``: include the legends, so that they stay above the moving lines.
         """
-        artists: list[Any] = [self._target, self.path_ax.title, *self._cursors]
+        # The desired path is drawn over the moving trails, so it moves with them.
+        artists: list[Any] = [self._desired, self._target, self.path_ax.title, *self._cursors]
         for run in self.runs:
             artists += [run.ee_trail, run.base_trail, run.footprint, *run.wheels]
             artists += [run.heading, run.arm, run.payload]
@@ -183,20 +216,20 @@ class RunView:
     def _style_axes(self) -> None:
         ax = self.path_ax
         ax.set_aspect("equal", adjustable="box")
-        ax.set_xlabel("x (m)", fontsize=8)
-        ax.set_ylabel("y (m)", fontsize=8)
-        ax.tick_params(labelsize=7)
+        ax.set_xlabel("x (m)", fontsize=LABEL_SIZE)
+        ax.set_ylabel("y (m)", fontsize=LABEL_SIZE)
+        ax.tick_params(labelsize=TICK_SIZE)
         ax.grid(alpha=0.3)
         keys = list(self.plot_axes)
         for key, plot in self.plot_axes.items():
-            plot.set_ylabel(PLOTS[key], fontsize=7)
-            plot.tick_params(labelsize=6)
+            plot.set_ylabel(PLOTS[key], fontsize=LABEL_SIZE)
+            plot.tick_params(labelsize=TICK_SIZE)
             if key != "position":
                 plot.ticklabel_format(axis="y", useOffset=False)
             plot.grid(alpha=0.3, which="both")
             if key != keys[-1]:
                 plot.tick_params(labelbottom=False)
-        self.plot_axes[keys[-1]].set_xlabel("t (s)", fontsize=8)
+        self.plot_axes[keys[-1]].set_xlabel("t (s)", fontsize=LABEL_SIZE)
         self.plot_axes["position"].set_yscale("log")
         self.plot_axes["position"].yaxis.set_minor_formatter(NullFormatter())
 
@@ -237,7 +270,9 @@ class RunView:
         ax = self.path_ax
         color, arm_color = PALETTE[number]
         robot = result.robot
-        (ee_trail,) = ax.plot([], [], color=color, lw=1.5, label=f"{label}: end effector")
+        (ee_trail,) = ax.plot(
+            [], [], color=color, lw=TRAIL_WIDTHS[number], label=f"{label}: end effector"
+        )
         (base_trail,) = ax.plot(
             [], [], color=color, lw=0.8, alpha=0.5, ls=":", label=f"{label}: base"
         )
@@ -246,14 +281,19 @@ class RunView:
         wheels = [Polygon(np.zeros((5, 2)), closed=True, fc="0.15", ec="0.15") for _ in range(2)]
         for wheel in wheels:
             ax.add_patch(wheel)
-        (heading,) = ax.plot([], [], color="0.2", lw=1.2)
-        (arm,) = ax.plot([], [], color=arm_color, lw=2.2, marker="o", ms=3, solid_capstyle="round")
+        (heading,) = ax.plot([], [], color="0.2", lw=1.2, zorder=ROBOT_ZORDER)
+        (arm,) = ax.plot(
+            [], [], color=arm_color, lw=2.2, marker="o", ms=3, solid_capstyle="round",
+            zorder=ROBOT_ZORDER,
+        )  # fmt: skip
         size = 4 + 3 * float(np.sqrt(robot.payload))
-        (payload,) = ax.plot([], [], "s", color="0.1", ms=size, mfc=arm_color, alpha=0.9)
+        (payload,) = ax.plot(
+            [], [], "s", color="0.1", ms=size, mfc=arm_color, alpha=0.9, zorder=ROBOT_ZORDER
+        )
         run = _RunArtists(
             result, label, ee_trail, base_trail, footprint, wheels, heading, arm, payload
         )
-        style = {"color": color, "lw": 1.0}
+        style = {"color": color, "lw": PLOT_WIDTHS[number]}
         plot = self.plot_axes
         run.lines["position"] = plot["position"].plot([], [], label=label, **style)
         # Colours name the runs in the position legend; the other plots use the same ones.
@@ -384,5 +424,6 @@ def animation_figure(dpi: float = 80.0) -> tuple[Figure, RunView]:
 
     figure = Figure(figsize=(11.0, 5.6), dpi=dpi)
     FigureCanvasAgg(figure)
-    path_ax, plot_axes = add_view_axes(figure, (0.06, 0.09, 0.46, 0.84), (0.62, 0.09, 0.36, 0.86))
+    # The top view leaves room under it for its x label and its legend (three rows).
+    path_ax, plot_axes = add_view_axes(figure, (0.06, 0.2, 0.46, 0.73), (0.62, 0.09, 0.36, 0.86))
     return figure, RunView(path_ax, plot_axes)

@@ -6,6 +6,7 @@
 * :class:`CycleButton` - a button showing ``name: value`` that steps through a list of
   values on every click (choices, on/off flags).
 * :func:`radio` - radio buttons with small labels.
+* :func:`wrap_to_width` - a text broken at its commas to fit a width on the canvas.
 
 Widgets are also driven programmatically (tests, ``--snapshot``): ``Field.submit(text)``
 behaves like typing the text and pressing Enter.
@@ -18,6 +19,7 @@ from typing import Any
 
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 from matplotlib.widgets import Button, RadioButtons, TextBox
 
 from ddwmmr.errors import ParameterError
@@ -228,3 +230,32 @@ def button(figure: Figure, rect: Sequence[float], label: str, action: Callable[[
     widget.label.set_fontsize(FONT + 1)
     widget.on_clicked(lambda _event: action())
     return widget
+
+
+def wrap_to_width(text: str, artist: Text, right: float, indent: str = "    ") -> str:
+    """``text`` broken after its commas into lines that, in the font of ``artist`` (a
+    figure text), end left of the figure fraction ``right``; continuation lines are
+    indented. Lines of ``text`` are wrapped one by one; a piece wider than the room on
+    its own keeps a line of its own."""
+    figure = artist.get_figure()
+    renderer = figure.canvas.get_renderer()
+    font = artist.get_fontproperties()
+    left = artist.get_transform().transform(artist.get_position())[0]
+    room = right * figure.bbox.width - left
+
+    def width(candidate: str) -> float:
+        return renderer.get_text_width_height_descent(candidate, font, ismath=False)[0]
+
+    wrapped: list[str] = []
+    for line in text.split("\n"):
+        pieces = line.split(", ")
+        current = pieces[0]
+        for piece in pieces[1:]:
+            candidate = f"{current}, {piece}"
+            if width(candidate + ",") <= room:
+                current = candidate
+            else:
+                wrapped.append(current + ",")
+                current = indent + piece
+        wrapped.append(current)
+    return "\n".join(wrapped)

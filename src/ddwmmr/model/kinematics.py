@@ -1,4 +1,4 @@
-"""Kinematics of the planar differential-drive mobile manipulator (SPEC §1).
+"""Kinematics of the planar differential-drive mobile manipulator (docs/theory.md, "Model").
 
 Configuration ``q = [x, y, phi, th1, th2]`` in the world frame (metres, radians): base
 position at the wheel-axle midpoint (where the arm is mounted), base heading, then the arm
@@ -48,7 +48,10 @@ def _arm_rates(L1: float, L2: float, q) -> tuple[float, float, float, float, flo
 
 
 def jacobian(L1: float, L2: float, q) -> np.ndarray:
-    """The 4x5 task Jacobian of SPEC §1: rows xE, yE, phiE and the nonholonomic constraint."""
+    """The 4x5 task Jacobian: rows xE, yE, phiE and the nonholonomic constraint.
+
+    docs/theory.md, "Configuration, forward kinematics, Jacobian".
+    """
     phi, dx, dy, dx2, dy2 = _arm_rates(L1, L2, q)
     return np.array(
         [
@@ -60,7 +63,7 @@ def jacobian(L1: float, L2: float, q) -> np.ndarray:
     )
 
 
-#: Auxiliary rows of the augmented task space method (SPEC §3).
+#: Auxiliary rows of the augmented task space method (docs/theory.md, "Methods").
 AUX_ROWS = {
     "sum": (0.0, 0.0, 0.0, 1.0, 1.0),  # th1dot + th2dot = 0
     "shoulder": (0.0, 0.0, 0.0, 1.0, 0.0),  # th1dot = 0

@@ -4,10 +4,10 @@ The one home of these formulas; the plants, the symbolic model and the stability
 read them from here (:attr:`ddwmmr.model.Robot.total_mass`,
 :attr:`ddwmmr.model.Robot.yaw_inertia`).
 
-The arm lies horizontally in its plane (docs/theory.md): each link is a uniform rod of its
-mass, the payload a point mass at the end effector, the base a body of ``base_mass`` (the
-wheels included) with yaw inertia ``base_inertia`` about the base centre (the axle
-midpoint, where the shoulder is mounted). About that vertical axis::
+The arm lies horizontally in its plane (docs/theory.md, "Tip-over stability"): each link
+is a uniform rod of its mass, the payload a point mass at the end effector, the base a body
+of ``base_mass`` (the wheels included) with yaw inertia ``base_inertia`` about the base
+centre (the axle midpoint, where the shoulder is mounted). About that vertical axis::
 
     I(th2) = base_inertia + m1 L1^2 / 12 + m2 L2^2 / 12           (own inertias)
              + m1 (L1 / 2)^2 + m2 d2(th2)^2 + mp de(th2)^2          (parallel axis)

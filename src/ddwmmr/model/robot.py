@@ -1,7 +1,7 @@
 """The robot description: :class:`Robot`, a validated frozen dataclass.
 
-``Robot()`` is the thesis robot of SPEC §1 (thesis Tables 3.1/3.2, planar arm). Units are SI
-throughout: metres, kilograms, radians, seconds.
+``Robot()`` is the thesis robot (thesis Tables 3.1/3.2, planar arm; docs/theory.md, "Model").
+Units are SI throughout: metres, kilograms, radians, seconds.
 """
 
 from __future__ import annotations
@@ -285,7 +285,10 @@ class Robot:
         return np.array(kinematics.forward_kinematics(self.L1, self.L2, _configuration(q)))
 
     def jacobian(self, q) -> np.ndarray:
-        """The 4x5 Jacobian of SPEC §1 (rows xE, yE, phiE, nonholonomic constraint)."""
+        """The 4x5 Jacobian: rows xE, yE, phiE, nonholonomic constraint.
+
+        docs/theory.md, "Configuration, forward kinematics, Jacobian".
+        """
         return kinematics.jacobian(self.L1, self.L2, _configuration(q))
 
     def augmented_jacobian(self, q, aux: str = "sum") -> np.ndarray:

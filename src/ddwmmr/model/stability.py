@@ -1,4 +1,6 @@
-"""Static tip-over stability and manipulability of the planar arm (SPEC §1, thesis 4.1).
+"""Static tip-over stability and manipulability of the planar arm (thesis 4.1).
+
+The formulas: docs/theory.md, "Tip-over stability" and "Manipulability".
 
 The arm is horizontal and mounted at the base centre. In the base frame the combined centre
 of mass of links (their midpoints) and payload (at the end effector) is

@@ -6,13 +6,15 @@ minimum-time study). The numeric twins are :mod:`ddwmmr.model.kinematics`,
 :class:`ddwmmr.plants.thesis.ThesisPlant`; the tests
 check values and derivatives against them.
 
-Frames and units (SPEC §1): configuration ``q = [x, y, phi, th1, th2]`` (world frame; m, m,
-rad, rad, rad), inputs ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s, rad/s, rad/s).
+Frames and units (docs/theory.md, "Model"): configuration ``q = [x, y, phi, th1, th2]``
+(world frame; m, m, rad, rad, rad), inputs ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s,
+rad/s, rad/s).
 
 * **Kinematic model** ``qdot = G(q) u`` (:func:`kinematic_rhs`): the nonholonomic row holds
   by construction.
-* **Force-level model of the thesis plant** (:class:`ThesisDynamics`, SPEC §5): state
-  ``x = [q, v, w]`` (7), inputs ``[F_left, F_right, th1dot, th2dot]`` (N, N, rad/s, rad/s)::
+* **Force-level model of the thesis plant** (:class:`ThesisDynamics`; docs/thesis.md,
+  "What is simulated"): state ``x = [q, v, w]`` (7), inputs ``[F_left, F_right, th1dot,
+  th2dot]`` (N, N, rad/s, rad/s)::
 
       m vdot + c1 v = F_left + F_right
       I(th2) wdot + c2 w = (F_right - F_left) width / 2
@@ -201,7 +203,9 @@ def _trig(value: Symbolic) -> tuple[Callable, Callable]:
 
 @dataclass(frozen=True)
 class ThesisDynamics:
-    """Parameters and equations of the thesis plant's force-level model (SPEC §5).
+    """Parameters and equations of the thesis plant's force-level model.
+
+    The model: docs/thesis.md, "What is simulated".
 
     Build it with :meth:`from_robot`; the defaults are the thesis plant's constants
     (``ddwmmr.plants.thesis``: c1 = 15 N s/m, c2 = 4 N m s/rad, 10 N per wheel, 2 rad/s).

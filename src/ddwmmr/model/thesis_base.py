@@ -1,4 +1,4 @@
-"""Physical constants of the thesis's base (thesis Table 3.1, 4.4.2, SPEC §5).
+"""Physical constants of the thesis's base (thesis Table 3.1, 4.4.2).
 
 They describe the robot, not a simulator: the thesis plant (:mod:`ddwmmr.plants.thesis`)
 simulates with them, the physics plant can add the same drive damping, and the MPC's

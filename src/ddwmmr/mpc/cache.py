@@ -1,9 +1,8 @@
 """The OCPs the ``mpc`` controllers share: built once per problem and thread, kept a while.
 
-Building an OCP and its solvers' QP functions took 0.5 s per benchmark scenario on the
-thesis plant and 1.5 s on the physics plant (9 states; both measured on the 2-core machine
-under load), 0.02-0.04 s after the first once shared (docs/mpc.md). The OCP is symbolic
-and keeps no state of a run, so every controller that asks for the same one may use it.
+Building an OCP and its solvers' QP functions costs more than a short scenario's steps
+(docs/mpc.md, "Integration notes"). The OCP is symbolic and keeps no state of a run, so
+every controller that asks for the same one may use it.
 """
 
 from __future__ import annotations

@@ -307,9 +307,8 @@ class MPCController:
             return q.copy()
         v, w = self._predicted_velocity if base_velocity is None else base_velocity
         # the lagged joints' rates: no sensor reports them, the controller carries them
-        # forward from its own commands (estimating them from the measured joint motion
-        # tipped 25 of 100 scenarios on the physics plant against 6, both measured with the
-        # lagged arm alone, docs/mpc.md)
+        # forward from its own commands (why not from the measured joint motion:
+        # docs/mpc.md, "Formulation")
         lagged = self._predicted_rates if self.arm_time_constant is not None else ()
         return np.concatenate([q, [float(v), float(w)], lagged])
 
@@ -452,8 +451,8 @@ class MPCController:
         servos do (``arm_time_constant`` = ``plant.joint_time_constant``) and accelerating
         no faster than its motors allow (``joint_acceleration_limit``), braking instead of
         following a plan that needs slack (``brake_slack``), when the loop hands it the
-        plant's traits (``adopt_plant``): the static floor alone tipped the robot over in
-        94 of 100 scenarios, all of it in none of 400 (docs/mpc.md)."""
+        plant's traits (``adopt_plant``; why each is needed: docs/mpc.md, "The physics plant:
+        tipping while moving")."""
         config = run.config
         options: dict[str, Any] = {
             "model": "thesis" if FORCE in run.plant.interfaces else "kinematic",

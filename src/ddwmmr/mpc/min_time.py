@@ -1,33 +1,45 @@
 """The physical limit of a scenario: minimum time under the thesis plant's force limits.
 
-A free-final-time optimal control problem over the scenario's waypoints, solved offline
-with CasADi/IPOPT. Leg ``i`` (start or waypoint ``i-1`` -> waypoint ``i``) has its own
-duration ``T_i`` and ``M`` shooting intervals of length ``T_i / M``; the thesis plant's
-force-level model (:class:`~ddwmmr.model.symbolic.ThesisDynamics`) is integrated with RK4
-under piecewise-constant wheel forces and joint rates::
+Two layers:
 
-    minimise    sum_i T_i
-    subject to  x_{k+1} = RK4(x_k, u_k, T_i / M)                 (every interval of leg i)
-                |p_E(x_end of leg i) - waypoint_i| <= tolerance   (the end effector reaches it)
-                S(q) >= S_min at every node and 3 points inside every interval (exact,
-                    as a box on the centre of mass)
-                |F_left|, |F_right| <= force limit, |th_i dot| <= joint speed,
-                joint limits, wheel speeds, x_0 = start at rest.
+* :class:`FreeTimeOCP`, a free-final-time optimal control problem of any model given as
+  an ODE with box bounds (:class:`ShootingModel`), solved offline with CasADi/IPOPT. The
+  horizon is cut into legs; leg ``i`` has its own duration ``T_i`` and ``M`` shooting
+  intervals of length ``T_i / M``, the model is integrated by RK4 under piecewise-constant
+  inputs, and each leg ends on a constraint of its own (a waypoint, a goal pose)::
+
+      minimise    sum_i T_i  (+ 1e-6 |u / u_max|^2, a tie-breaker)
+      subject to  x_{k+1} = RK4(x_k, u_k, T_i / M)            (every interval of leg i)
+                  lower <= end_i(x at the end of leg i) <= upper
+                  node rows at every node, interval rows in every interval, state and
+                  input boxes, x_0 = start.
+
+* :class:`MinimumTimeProblem`, that problem for the thesis scenarios: the thesis plant's
+  force-level model (:class:`~ddwmmr.model.symbolic.ThesisDynamics`, wheel forces and
+  joint rates as inputs), one leg per waypoint::
+
+      |p_E(x_end of leg i) - waypoint_i| <= tolerance   (the end effector reaches it)
+      S(q) >= S_min at every node and 3 points inside every interval (exact, as a box on
+          the centre of mass)
+      |F_left|, |F_right| <= force limit, |th_i dot| <= joint speed,
+      joint limits, wheel speeds, x_0 = start at rest.
 
 The arm's reach is part of the problem (the end effector, not the base, must reach each
 waypoint). The problem is non-convex (heading, elbow branch), so IPOPT returns a local
 optimum: the time of a feasible trajectory of the model, i.e. an upper bound on the true
-minimum. Started from the trajectories of the controllers being compared (and from a
-straight-line guess), it is never worse than any of them; ``solve_minimum_time`` keeps the
-best of its starts.
+minimum. :mod:`ddwmmr.bounds` runs it from many starts (and brackets it from below);
+``solve_minimum_time`` keeps the best of the straight-line starts and any given.
+The same :class:`FreeTimeOCP` solves the bounded-wheel-speed differential drive whose
+time-optimal paths are known in closed form (:mod:`ddwmmr.bounds.diffdrive`), the check
+that the transcription finds true optima.
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
@@ -39,12 +51,51 @@ from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
 
 #: Points inside each shooting interval where S is checked as well as at the nodes.
 INTERIOR_CHECKS = 3
+#: Leg durations (s) the solver may choose from.
+LEG_TIME_RANGE = (0.05, 120.0)
+
+Rows = Callable[..., ca.SX]
+
+
+@dataclass(frozen=True)
+class ShootingModel:
+    """A model for :class:`FreeTimeOCP`: ``xdot = rhs(x, u)`` with its bounds.
+
+    Attributes:
+        nx, nu: state and input sizes.
+        rhs: ``(x, u) -> xdot`` on CasADi SX.
+        u_lower, u_upper: input box (nu,); x_lower, x_upper: state box (nx,), +-inf free.
+        node_rows: ``x -> rows`` held at every node within ``node_bounds``, or None.
+        interval_rows: ``(x_k, u_k, h) -> rows`` held in every interval within
+            ``interval_bounds`` (e.g. a constraint between the nodes), or None.
+    """
+
+    nx: int
+    nu: int
+    rhs: Rows
+    u_lower: np.ndarray
+    u_upper: np.ndarray
+    x_lower: np.ndarray
+    x_upper: np.ndarray
+    node_rows: Rows | None = None
+    node_bounds: tuple[np.ndarray, np.ndarray] | None = None
+    interval_rows: Rows | None = None
+    interval_bounds: tuple[np.ndarray, np.ndarray] | None = None
+
+
+@dataclass(frozen=True)
+class LegEnd:
+    """The constraint ending a leg: ``lower <= rows(x) <= upper`` at its last node."""
+
+    rows: Rows
+    lower: np.ndarray
+    upper: np.ndarray
 
 
 @dataclass(frozen=True)
 class Guess:
-    """A trajectory to start from: node times (s), states (n, 7), inputs (n, 4), and the
-    times (s) at which each waypoint was reached."""
+    """A trajectory to start from: node times (s), states (n, nx), inputs (n, nu), and the
+    times (s) at which each leg ended (each waypoint was reached)."""
 
     times: np.ndarray
     states: np.ndarray
@@ -54,7 +105,9 @@ class Guess:
 
 @dataclass(frozen=True)
 class MinimumTime:
-    """Result: total time (s), leg durations (s), success flag, node times/states/inputs."""
+    """Result: total time (s), leg durations (s), success flag, node times/states/inputs
+    (inputs held over the interval that starts at the node), the start's label and the
+    IPOPT status."""
 
     total: float
     legs: np.ndarray
@@ -63,9 +116,186 @@ class MinimumTime:
     states: np.ndarray
     inputs: np.ndarray
     start: str
+    status: str = field(default="")
+
+    def as_guess(self) -> Guess:
+        """This solution as a start for another problem (e.g. a finer grid)."""
+        return Guess(self.times, self.states, self.inputs, np.cumsum(self.legs))
 
 
-class MinimumTimeProblem:
+class FreeTimeOCP:
+    """A multiple-shooting NLP with one free duration per leg (see the module docstring).
+
+    Args:
+        model: the ODE and its bounds.
+        start: the initial state (nx,).
+        ends: the constraint closing each leg, in order.
+        intervals_per_leg: M (>= 2).
+        leg_time_range: bounds (s) on each leg's duration.
+        ipopt_options: extra IPOPT options (``"max_iter"``, ``"tol"``, ...).
+    """
+
+    def __init__(
+        self,
+        model: ShootingModel,
+        start: Sequence[float],
+        ends: Sequence[LegEnd],
+        intervals_per_leg: int = 30,
+        leg_time_range: tuple[float, float] = LEG_TIME_RANGE,
+        ipopt_options: dict | None = None,
+    ) -> None:
+        if int(intervals_per_leg) != intervals_per_leg or intervals_per_leg < 2:
+            raise ParameterError(
+                f"intervals_per_leg must be an integer >= 2 (got {intervals_per_leg})"
+            )
+        if not ends:
+            raise ParameterError("ends: at least one leg is needed")
+        self.model = model
+        self.start = np.asarray(start, dtype=float)
+        if self.start.shape != (model.nx,):
+            raise ParameterError(f"start must hold {model.nx} numbers (got {self.start.shape})")
+        self.ends = list(ends)
+        self.M = int(intervals_per_leg)
+        self.legs = len(self.ends)
+        self.n = self.legs * self.M
+        self.leg_time_range = leg_time_range
+        self._build(ipopt_options or {})
+
+    # -- construction -------------------------------------------------------------------
+    def _build(self, extra: dict) -> None:
+        m, n = self.model, self.n
+        nx, nu = m.nx, m.nu
+        X = ca.MX.sym("X", nx, n + 1)
+        U = ca.MX.sym("U", nu, n)
+        T = ca.MX.sym("T", self.legs)
+        xs, us, hs = ca.SX.sym("x", nx), ca.SX.sym("u", nu), ca.SX.sym("h")
+        step = ca.Function("step", [xs, us, hs], [sym.rk4_step(m.rhs, xs, us, hs)])
+        h_row = ca.reshape(ca.repmat(T.T / self.M, self.M, 1), 1, n)  # leg-major
+        rows = [ca.vec(step.map(n)(X[:, :-1], U, h_row) - X[:, 1:])]
+        lower, upper = [np.zeros(nx * n)], [np.zeros(nx * n)]
+        self.node_slice = self.interval_slice = slice(0, 0)
+        if m.node_rows is not None:
+            node = ca.Function("node", [xs], [m.node_rows(xs)])
+            rows.append(ca.vec(node.map(n + 1)(X)))
+            lower.append(np.tile(m.node_bounds[0], n + 1))
+            upper.append(np.tile(m.node_bounds[1], n + 1))
+            self.node_slice = _next_slice(lower)
+        if m.interval_rows is not None:
+            between = ca.Function("between", [xs, us, hs], [m.interval_rows(xs, us, hs)])
+            rows.append(ca.vec(between.map(n)(X[:, :-1], U, h_row)))
+            lower.append(np.tile(m.interval_bounds[0], n))
+            upper.append(np.tile(m.interval_bounds[1], n))
+            self.interval_slice = _next_slice(lower)
+        for i, end in enumerate(self.ends):
+            rows.append(end.rows(X[:, (i + 1) * self.M]))
+            lower.append(np.atleast_1d(np.asarray(end.lower, dtype=float)))
+            upper.append(np.atleast_1d(np.asarray(end.upper, dtype=float)))
+        self.lbg, self.ubg = np.concatenate(lower), np.concatenate(upper)
+        first_end = self.lbg.size - sum(np.atleast_1d(e.lower).size for e in self.ends)
+        self.end_slice = slice(first_end, self.lbg.size)
+        scale = np.maximum(np.abs(m.u_lower), np.abs(m.u_upper))
+        scale[scale == 0.0] = 1.0
+        regular = 1e-6 * ca.sumsqr(U / ca.DM(scale))
+        nlp = {
+            "x": ca.vertcat(ca.vec(X), ca.vec(U), T),
+            "f": ca.sum1(T) + regular,
+            "g": ca.vertcat(*rows),
+        }
+        options = {
+            "print_time": False,
+            "ipopt.print_level": 0,
+            "ipopt.sb": "yes",
+            "ipopt.max_iter": 3000,
+            "ipopt.tol": 1e-7,
+            "error_on_fail": False,
+            # evaluate on scalar expressions: ~30 % less CPU per iteration than MX here
+            "expand": True,
+        }
+        options.update({f"ipopt.{k}": v for k, v in extra.items()})
+        self.solver = ca.nlpsol("min_time", "ipopt", nlp, options)
+        lower_x = np.tile(m.x_lower[:, None], (1, n + 1)).astype(float)
+        upper_x = np.tile(m.x_upper[:, None], (1, n + 1)).astype(float)
+        lower_x[:, 0] = upper_x[:, 0] = self.start
+        lo_t, hi_t = self.leg_time_range
+        self.lbw = np.concatenate(
+            [
+                lower_x.ravel(order="F"),
+                np.tile(m.u_lower, n),
+                np.full(self.legs, lo_t),
+            ]
+        )
+        self.ubw = np.concatenate(
+            [
+                upper_x.ravel(order="F"),
+                np.tile(m.u_upper, n),
+                np.full(self.legs, hi_t),
+            ]
+        )
+
+    # -- starts ---------------------------------------------------------------------------
+    def initial(self, guess: Guess) -> np.ndarray:
+        """The decision vector of ``guess`` on this grid (states and inputs interpolated at
+        the nodes, leg durations from its arrival times), clipped to the bounds."""
+        nx, nu = self.model.nx, self.model.nu
+        arrivals = np.asarray(guess.arrivals, dtype=float)[: self.legs]
+        legs = np.maximum(np.diff(np.concatenate([[0.0], arrivals])), self.leg_time_range[0])
+        arrivals = np.cumsum(legs)
+        node_times = np.concatenate(
+            [t0 + legs[i] * np.arange(self.M) / self.M for i, t0 in enumerate(arrivals - legs)]
+            + [[arrivals[-1]]]
+        )
+        states = np.column_stack(
+            [np.interp(node_times, guess.times, guess.states[:, i]) for i in range(nx)]
+        )
+        states[0] = self.start
+        times_u = guess.times[: len(guess.inputs)]
+        inputs = np.column_stack(
+            [np.interp(node_times[:-1], times_u, guess.inputs[:, i]) for i in range(nu)]
+        )
+        w0 = np.concatenate([states.ravel(), inputs.ravel(), legs])
+        return np.clip(w0, self.lbw, self.ubw)
+
+    # -- solve --------------------------------------------------------------------------
+    def solve(
+        self,
+        guess: Guess,
+        label: str = "guess",
+        lbg: np.ndarray | None = None,
+        ubg: np.ndarray | None = None,
+    ) -> MinimumTime:
+        """Solve from one initial guess (``lbg``/``ubg``: other row bounds, e.g. a looser
+        tolerance for a continuation step; default: the problem's own)."""
+        return self._solve(self.initial(guess), label, lbg, ubg)
+
+    def _solve(self, w0, label, lbg=None, ubg=None) -> MinimumTime:
+        solution = self.solver(
+            x0=w0,
+            lbx=self.lbw,
+            ubx=self.ubw,
+            lbg=self.lbg if lbg is None else lbg,
+            ubg=self.ubg if ubg is None else ubg,
+        )
+        stats = self.solver.stats()
+        success = bool(stats.get("success", False))
+        w = np.asarray(solution["x"], dtype=float).ravel()
+        nx, nu, n = self.model.nx, self.model.nu, self.n
+        states = w[: nx * (n + 1)].reshape(n + 1, nx)
+        inputs = w[nx * (n + 1) : nx * (n + 1) + nu * n].reshape(n, nu)
+        legs = w[-self.legs :]
+        node_times = np.concatenate([[0.0], np.cumsum(np.repeat(legs / self.M, self.M))])
+        return MinimumTime(
+            float(legs.sum()),
+            legs,
+            success,
+            node_times,
+            states,
+            inputs,
+            label,
+            str(stats.get("return_status", "")),
+        )
+
+
+class MinimumTimeProblem(FreeTimeOCP):
     """The NLP for one set of waypoints (build once per scenario, solve from several starts).
 
     Args:
@@ -74,6 +304,7 @@ class MinimumTimeProblem:
         start: start state ``[x, y, phi, th1, th2, v, w]`` (at rest).
         intervals_per_leg: M.
         stability_min: floor on S; tolerance: waypoint radius (m).
+        ipopt_options: extra IPOPT options.
     """
 
     def __init__(
@@ -85,102 +316,49 @@ class MinimumTimeProblem:
         intervals_per_leg: int = 30,
         stability_min: float = STABILITY_FLOOR,
         tolerance: float = 0.01,
+        ipopt_options: dict | None = None,
     ) -> None:
-        if intervals_per_leg < 2:
-            raise ParameterError(f"intervals_per_leg must be >= 2 (got {intervals_per_leg})")
+        if int(intervals_per_leg) != intervals_per_leg or intervals_per_leg < 2:
+            raise ParameterError(
+                f"intervals_per_leg must be an integer >= 2 (got {intervals_per_leg})"
+            )
         self.robot = robot
         self.dynamics = dynamics or sym.ThesisDynamics.from_robot(robot)
         self.waypoints = [tuple(map(float, w)) for w in waypoints]
-        self.start = np.asarray(start, dtype=float)
-        self.M = int(intervals_per_leg)
-        self.legs = len(self.waypoints)
         self.tolerance = check_positive("tolerance", tolerance)
         self.stability_min = check_stability_floor(stability_min)
-        self._build()
+        ends = [self._waypoint_end(w) for w in self.waypoints]
+        super().__init__(
+            thesis_model(robot, self.dynamics, stability_min),
+            start,
+            ends,
+            intervals_per_leg,
+            ipopt_options=ipopt_options,
+        )
 
-    def _build(self) -> None:
-        nx, nu = sym.NX_FORCE, sym.NU_FORCE
-        n = self.legs * self.M
-        d, robot = self.dynamics, self.robot
-        X = ca.MX.sym("X", nx, n + 1)
-        U = ca.MX.sym("U", nu, n)
-        T = ca.MX.sym("T", self.legs)
-        xs, us = ca.SX.sym("x", nx), ca.SX.sym("u", nu)
-        hs = ca.SX.sym("h")
-        step = ca.Function("step", [xs, us, hs], [sym.rk4_step(d.rhs, xs, us, hs)])
-        com = ca.Function("com", [xs], [sym.centre_of_mass(robot, xs[:5])])
-        fk = ca.Function("fk", [xs], [sym.forward_kinematics(robot, xs[:5])[:2]])
-        wheels = ca.Function("wheels", [xs], [sym.wheel_speeds(robot, xs[5], xs[6])])
-        h_all = ca.repmat(T.T / self.M, self.M, 1)  # (M, legs): interval lengths, leg-major
-        h_row = ca.reshape(h_all, 1, n)
-        gaps = step.map(n)(X[:, :-1], U, h_row) - X[:, 1:]
-        x_max, y_max = sym.stability_bounds(robot, self.stability_min)
-        coms = com.map(n + 1)(X)
-        # Between nodes the joint angles move linearly (constant rates): S is also checked
-        # at INTERIOR_CHECKS points inside every interval, so it holds along the motion.
-        interior = []
-        for frac in np.arange(1, INTERIOR_CHECKS + 1) / (INTERIOR_CHECKS + 1):
-            offset = ca.repmat(frac * h_row, 2, 1) * U[2:4, :]
-            moved = ca.vertcat(X[:3, :-1], X[3:5, :-1] + offset, X[5:, :-1])
-            interior.append(ca.vec(com.map(n)(moved)))
-        wheel = wheels.map(n + 1)(X)
-        reach = []
-        for i, (wx, wy) in enumerate(self.waypoints):
-            e = fk(X[:, (i + 1) * self.M]) - ca.DM([wx, wy])
-            reach.append(ca.sumsqr(e))
-        g = ca.vertcat(ca.vec(gaps), ca.vec(coms), *interior, ca.vec(wheel), *reach)
-        limit = robot.wheel_speed_limit
-        boxes = n + 1 + INTERIOR_CHECKS * n
-        self.lbg = np.concatenate(
-            [
-                np.zeros(nx * n),
-                np.tile([-x_max, -y_max], boxes),
-                np.full(2 * (n + 1), -limit),
-                np.zeros(self.legs),
-            ]
-        )
-        self.ubg = np.concatenate(
-            [
-                np.zeros(nx * n),
-                np.tile([x_max, y_max], boxes),
-                np.full(2 * (n + 1), limit),
-                np.full(self.legs, self.tolerance**2),
-            ]
-        )
-        w = ca.vertcat(ca.vec(X), ca.vec(U), T)
-        self._X, self._U, self._T = X, U, T
-        self.n = n
-        regular = 1e-6 * ca.sumsqr(U / ca.DM([d.force_limit, d.force_limit, 1.0, 1.0]))
-        nlp = {"x": w, "f": ca.sum1(T) + regular, "g": g}
-        self.solver = ca.nlpsol(
-            "min_time",
-            "ipopt",
-            nlp,
-            {
-                "print_time": False,
-                "ipopt.print_level": 0,
-                "ipopt.sb": "yes",
-                "ipopt.max_iter": 3000,
-                "ipopt.tol": 1e-7,
-                "error_on_fail": False,
-            },
-        )
-        lower_x = np.full((nx, n + 1), -np.inf)
-        upper_x = np.full((nx, n + 1), np.inf)
-        (lo1, hi1), (lo2, hi2) = robot.joint_limits
-        lower_x[3], upper_x[3] = lo1, hi1
-        lower_x[4], upper_x[4] = lo2, hi2
-        lower_x[:, 0] = upper_x[:, 0] = self.start
-        rate = min(d.joint_speed, robot.joint_speed_limit)
-        u_lim = np.array([d.force_limit, d.force_limit, rate, rate])
-        lower_u = np.tile(-u_lim[:, None], (1, n))
-        upper_u = np.tile(u_lim[:, None], (1, n))
-        self.lbw = np.concatenate(
-            [lower_x.ravel(order="F"), lower_u.ravel(order="F"), np.full(self.legs, 0.05)]
-        )
-        self.ubw = np.concatenate(
-            [upper_x.ravel(order="F"), upper_u.ravel(order="F"), np.full(self.legs, 120.0)]
-        )
+    def _waypoint_end(self, waypoint: tuple[float, float]) -> LegEnd:
+        robot = self.robot
+
+        def rows(x):
+            return ca.sumsqr(sym.forward_kinematics(robot, x[:5])[:2] - ca.DM(waypoint))
+
+        return LegEnd(rows, np.zeros(1), np.array([self.tolerance**2]))
+
+    def row_bounds(
+        self, stability_min: float | None = None, tolerance: float | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``(lbg, ubg)`` with another S floor and/or waypoint tolerance (m): the rows of a
+        continuation step (the problem's own values where None)."""
+        lbg, ubg = self.lbg.copy(), self.ubg.copy()
+        if stability_min is not None:
+            other = thesis_model(self.robot, self.dynamics, stability_min)
+            lbg[self.node_slice] = np.tile(other.node_bounds[0], self.n + 1)
+            ubg[self.node_slice] = np.tile(other.node_bounds[1], self.n + 1)
+            lbg[self.interval_slice] = np.tile(other.interval_bounds[0], self.n)
+            ubg[self.interval_slice] = np.tile(other.interval_bounds[1], self.n)
+        if tolerance is not None:
+            ubg[self.end_slice] = check_positive("tolerance", tolerance) ** 2
+        return lbg, ubg
 
     # -- initial guesses ----------------------------------------------------------------
     def straight_line_guess(
@@ -223,37 +401,56 @@ class MinimumTimeProblem:
         return Guess(times, states, np.zeros((len(times), sym.NU_FORCE)), np.array(arrivals))
 
     def _initial(self, guess: Guess) -> np.ndarray:
-        arrivals = np.asarray(guess.arrivals, dtype=float)[: self.legs]
-        legs = np.diff(np.concatenate([[0.0], arrivals]))
-        node_times = np.concatenate(
-            [t0 + legs[i] * np.arange(self.M) / self.M for i, t0 in enumerate(arrivals - legs)]
-            + [[arrivals[-1]]]
-        )
-        states = np.column_stack(
-            [np.interp(node_times, guess.times, guess.states[:, i]) for i in range(sym.NX_FORCE)]
-        )
-        states[0] = self.start
-        inputs = np.column_stack(
-            [
-                np.interp(node_times[:-1], guess.times, guess.inputs[:, i])
-                for i in range(sym.NU_FORCE)
-            ]
-        )
-        return np.concatenate([states.T.ravel(order="F"), inputs.T.ravel(order="F"), legs])
+        """Kept for callers of the earlier API: :meth:`initial`."""
+        return self.initial(guess)
 
-    # -- solve --------------------------------------------------------------------------
-    def solve(self, guess: Guess, label: str = "guess") -> MinimumTime:
-        """Solve from one initial guess."""
-        w0 = np.clip(self._initial(guess), self.lbw, self.ubw)
-        solution = self.solver(x0=w0, lbx=self.lbw, ubx=self.ubw, lbg=self.lbg, ubg=self.ubg)
-        success = bool(self.solver.stats().get("success", False))
-        w = np.asarray(solution["x"], dtype=float).ravel()
-        nx, nu, n = sym.NX_FORCE, sym.NU_FORCE, self.n
-        states = w[: nx * (n + 1)].reshape(n + 1, nx)
-        inputs = w[nx * (n + 1) : nx * (n + 1) + nu * n].reshape(n, nu)
-        legs = w[-self.legs :]
-        node_times = np.concatenate([[0.0], np.cumsum(np.repeat(legs / self.M, self.M))])
-        return MinimumTime(float(legs.sum()), legs, success, node_times, states, inputs, label)
+
+def _next_slice(blocks: list[np.ndarray]) -> slice:
+    """The rows of the last block of ``blocks`` in their concatenation."""
+    end = sum(b.size for b in blocks)
+    return slice(end - blocks[-1].size, end)
+
+
+def thesis_model(robot: Robot, dynamics: sym.ThesisDynamics, stability_min: float) -> ShootingModel:
+    """The thesis plant's force-level model with its limits as a :class:`ShootingModel`.
+
+    Node rows: the centre of mass in the box of ``S >= stability_min`` and the wheel
+    speeds; interval rows: the centre of mass at ``INTERIOR_CHECKS`` points inside the
+    interval, where the joints have moved linearly (constant rates).
+    """
+    limit = robot.wheel_speed_limit
+    x_max, y_max = sym.stability_bounds(robot, stability_min)
+
+    def node_rows(x):
+        return ca.vertcat(sym.centre_of_mass(robot, x[:5]), sym.wheel_speeds(robot, x[5], x[6]))
+
+    def interval_rows(x, u, h):
+        points = []
+        for frac in np.arange(1, INTERIOR_CHECKS + 1) / (INTERIOR_CHECKS + 1):
+            moved = ca.vertcat(x[:3], x[3:5] + frac * h * u[2:4])
+            points.append(sym.centre_of_mass(robot, moved))
+        return ca.vertcat(*points)
+
+    box = np.array([x_max, y_max])
+    rate = min(dynamics.joint_speed, robot.joint_speed_limit)
+    (lo1, hi1), (lo2, hi2) = robot.joint_limits
+    inf = np.inf
+    return ShootingModel(
+        nx=sym.NX_FORCE,
+        nu=sym.NU_FORCE,
+        rhs=dynamics.rhs,
+        u_lower=-np.array([dynamics.force_limit, dynamics.force_limit, rate, rate]),
+        u_upper=np.array([dynamics.force_limit, dynamics.force_limit, rate, rate]),
+        x_lower=np.array([-inf, -inf, -inf, lo1, lo2, -inf, -inf]),
+        x_upper=np.array([inf, inf, inf, hi1, hi2, inf, inf]),
+        node_rows=node_rows,
+        node_bounds=(
+            np.concatenate([-box, [-limit, -limit]]),
+            np.concatenate([box, [limit, limit]]),
+        ),
+        interval_rows=interval_rows,
+        interval_bounds=(np.tile(-box, INTERIOR_CHECKS), np.tile(box, INTERIOR_CHECKS)),
+    )
 
 
 def solve_minimum_time(

@@ -54,8 +54,8 @@ the states. Where the joints lag their commands (``joints_stop_at_once`` false: 
 physical arm) the joint box is a path row with its own slack instead: a joint turning
 towards its limit needs its braking distance to stop, and MuJoCo lets a joint overrun its
 range by a few mrad, so the next node can be out of the box's reach. With the box as
-bounds such a QP is infeasible and HPIPM gave up on it (return status 2, 2.4 % of the
-steps of the MuJoCo benchmark). With the lagged arm and a joint acceleration limit, rows
+bounds such a QP is infeasible and HPIPM gives up on it (docs/mpc.md, "The joint box as a
+row with a slack"). With the lagged arm and a joint acceleration limit, rows
 (without slack: the stage's input can always meet them) bound the lag's acceleration
 ``(u_rates - rates) / tau`` at the start of every interval, where it is largest, and the
 last node holds the centre of mass of its *stopping pose* (each joint moved on by its

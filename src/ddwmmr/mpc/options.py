@@ -84,10 +84,8 @@ def planned_force(plant: PlantTraits | None) -> float:
     """The wheel force (N) the force model plans with by default on ``plant``: the plant's
     own limit where the model is the plant's (the thesis plant), the thesis's 10 N, within
     the motors, on a plant that judges tipping by its physics (and 10 N on a plant that
-    does not say, or before the plant is known). On MuJoCo the motors' full 20.5 N tipped
-    the robot in 26 of 100 scenarios (the wheels lift and spin where the model has them
-    rolling; docs/mpc.md), against 3 with 10 N, both before the brakeable last node and the
-    braking step (with them 10 N tips none)."""
+    does not say, or before the plant is known). Why not the motors' full force there:
+    docs/mpc.md, "The physics plant: tipping while moving"."""
     motors = None if plant is None else plant.wheel_force_limit
     if motors is None:
         return FORCE_LIMIT_DEFAULT
@@ -251,9 +249,9 @@ class MPCOptions:
         (None: not known yet; combinations that need the plant are then let pass).
 
         On a plant that takes wheel forces and judges tipping by its physics: the
-        force-level model, the floor on the dynamic margin and the plant's joint lag (the
-        static floor alone tipped 94 of 100 scenarios there, docs/mpc.md; likewise for
-        ``model="thesis"`` given there); elsewhere the kinematic model (the force model
+        force-level model, the floor on the dynamic margin and the plant's joint lag (docs/mpc.md,
+        "The physics plant: tipping while moving"; likewise for ``model="thesis"`` given
+        there); elsewhere the kinematic model (the force model
         when any force-model option is given: ``dynamic_stability``, a lag, a joint
         acceleration bound or a wheel force), static floor, no lag. The force model's wheel
         force is the one asked for (within the plant's motors), else

@@ -39,7 +39,7 @@ QP_SOLVERS = ("hpipm", "qrqp", "osqp", "daqp", "proxqp")
 #: Solver names accepted by :func:`make_solver`.
 SOLVERS = ("rti", "sqp", "ipopt", "sqpmethod", "fatrop")
 #: HPIPM return codes accepted: 0 converged, 1 iteration limit (its iterate is used, see
-#: docs/mpc.md "Solver"); 2 (minimum step) and 3 (NaN) are failures.
+#: docs/mpc.md, "Solver choice (measured)"); 2 (minimum step) and 3 (NaN) are failures.
 HPIPM_ACCEPTED = (0, 1)
 
 

@@ -5,12 +5,14 @@ that can be a stationary point far from the best plan. Two rules drop the plan (
 at most once per :data:`STALL_TIME`):
 
 * the end effector has not moved :data:`STALL_PROGRESS` (net) for :data:`STALL_TIME` short
-  of the target (2 of 100 scenarios stalled before this rule);
+  of the target;
 * every plan for :data:`STALL_TIME` needed the constraints' slack (largest slack above
   :data:`STALL_SLACK`, in the rows' units, m for the stability box; the joint box's slack
   left out, ``ShootingOCP.max_slack``): a plan that cannot meet its hard constraints is
   stuck (on the physics plant: spinning on the spot with the arm stretched at the dynamic
-  floor for 35 s, 4 of 100 scenarios, before this rule).
+  floor).
+
+Why each rule: docs/mpc.md, "Formulation".
 """
 
 from __future__ import annotations

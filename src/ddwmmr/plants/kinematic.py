@@ -117,7 +117,8 @@ class KinematicPlant:
         if not (isfinite(v) and isfinite(w) and isfinite(t1) and isfinite(t2)):
             raise FloatingPointError(f"non-finite command u = {u}")
         saturated = False
-        # Wheel speeds (SPEC §1): (2v -+ Lw w) / (2r) = v / r -+ (Lw / 2r) w; the faster
+        # Wheel speeds (docs/theory.md, "Wheels"):
+        # (2v -+ Lw w) / (2r) = v / r -+ (Lw / 2r) w; the faster
         # wheel's |a| + |b| is max(|a - b|, |a + b|) to the last bit (one is a sum of the
         # magnitudes either way).
         per_v, per_w = self._wheel

@@ -1,6 +1,7 @@
 """The thesis plant: force-driven differential-drive base plus a rate-limited arm servo.
 
-Base (thesis eqs 3.1-3.4, SPEC §5), along the base heading (robot frame R) and about z::
+Base (thesis eqs 3.1-3.4; docs/thesis.md, "What is simulated"), along the base heading
+(robot frame R) and about z::
 
     m xddot_R + c1 xdot_R = F,      F = F1 + F2                (N, m/s)
     I thddot  + c2 thdot  = T,      T = (F2 - F1) width / 2    (N m, rad/s)
@@ -239,8 +240,8 @@ class ThesisPlant:
         """Yaw inertia of the whole robot about the base centre at arm pose (th1, th2) (kg m^2).
 
         Links are uniform rods (parallel-axis term at their midpoints), the payload a point
-        mass at the end effector; the arm lies horizontally (SPEC §1). The formula is
-        :class:`ddwmmr.model.mass.YawInertia`'s.
+        mass at the end effector; the arm lies horizontally (docs/theory.md, "Tip-over
+        stability"). The formula is :class:`ddwmmr.model.mass.YawInertia`'s.
         """
         return self._yaw_inertia(th2)
 

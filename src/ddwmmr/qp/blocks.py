@@ -1,11 +1,11 @@
 """Where a task or limit writes in the stacked problem: the compiled (fast) path.
 
-Every task and limit has a generic :meth:`compute` that fills numpy views (easy to write,
-about 1-3 us per piece per step). The built-in pieces also implement ``compile(block)``:
-called once when the :class:`~ddwmmr.qp.problem.QPProblem` is built, it writes the rows'
-constant entries and returns a *writer* ``writer(ctx)`` that fills only what changes, as
-Python floats, straight into flat ``memoryview`` s of the problem's arrays (a memoryview
-item write costs about a third of a numpy scalar write, and nothing is allocated).
+Every task and limit has a generic :meth:`compute` that fills numpy views (easy to write;
+its cost per piece and step: docs/qp.md, "Architecture"). The built-in pieces also implement
+``compile(block)``: called once when the :class:`~ddwmmr.qp.problem.QPProblem` is built, it
+writes the rows' constant entries and returns a *writer* ``writer(ctx)`` that fills only
+what changes, as Python floats, straight into flat ``memoryview`` s of the problem's arrays
+(cheaper per write than numpy, and nothing is allocated).
 
 ``compile`` returns:
 

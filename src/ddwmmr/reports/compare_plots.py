@@ -21,6 +21,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
 from ddwmmr.model import Robot
+from ddwmmr.reports.legends import legend_beside, place_legend
 
 #: Errors are clipped to this floor (m) on log axes: converged runs reach ~1e-12 m.
 ERROR_FLOOR = 1e-12
@@ -66,12 +67,15 @@ def _grid_shape(count: int) -> tuple[int, int]:
     return math.ceil(max(count, 1) / columns), columns
 
 
-def _path_limits(ax: Axes, ts: Mapping[str, np.ndarray], margin: float) -> None:
-    """Frame the desired path plus ``margin`` (m): runs that diverge leave the frame."""
-    x, y = ts["xE_d"], ts["yE_d"]
-    ax.set_xlim(x.min() - margin, x.max() + margin)
-    ax.set_ylim(y.min() - margin, y.max() + margin)
-    ax.set_aspect("equal", adjustable="box")
+def _path_limits(ax: Axes, series: Series, margin: float) -> None:
+    """Frame the desired path plus ``margin`` (m), grown to hold every method's path."""
+    from ddwmmr.reports.plots import fit_equal
+
+    reference = next(iter(series.values()))
+    x0, y0 = reference["xE_d"], reference["yE_d"]
+    xs = np.r_[x0.min() - margin, x0.max() + margin, *[ts["xE"] for ts in series.values()]]
+    ys = np.r_[y0.min() - margin, y0.max() + margin, *[ts["yE"] for ts in series.values()]]
+    fit_equal(ax, xs, ys, 0.05)
 
 
 def zoom_window(
@@ -105,8 +109,9 @@ def plot_paths(
 ) -> Figure:
     """End-effector paths of every method on the desired path, with zoom panels.
 
-    The desired path is drawn first (thin, dashed) and the methods on top of it from wide
-    to thin lines, so methods that follow the path, or each other, stay visible.
+    The methods are drawn from wide to thin lines, so methods that follow each other stay
+    visible, and the desired path over them, thin and dashed, so it shows where they
+    follow it.
 
     Args:
         zooms: ``(label, t, half_width)`` per zoom panel: the region around the desired
@@ -117,12 +122,10 @@ def plot_paths(
     grid = fig.add_gridspec(max(len(zooms), 1), 2, width_ratios=(1.5, 1))
     ax = fig.add_subplot(grid[:, 0])
     _draw_paths(ax, series, colors)
-    reference = next(iter(series.values()))
-    _path_limits(ax, reference, 0.5)
+    _path_limits(ax, series, 0.5)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_title(title)
-    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=4)
     for row, (label, t_center, half_width) in enumerate(zooms):
         cx, cy, h = zoom_window(series, t_center, half_width)
         zoom = fig.add_subplot(grid[row, 1])
@@ -138,7 +141,9 @@ def plot_paths(
             Rectangle((cx - h, cy - h), 2 * h, 2 * h, fill=False, color="0.3", lw=0.9, zorder=6)
         )
         ax.annotate(label, (cx + h, cy + h), fontsize=9, color="0.2", zorder=6)
-    fig.tight_layout()
+    handles, labels = ax.get_legend_handles_labels()
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    fig.legend(handles, labels, loc="lower center", ncol=len(labels), fontsize=8, frameon=False)
     return fig
 
 
@@ -146,8 +151,9 @@ def _draw_paths(
     ax: Axes, series: Series, colors: Mapping[str, str], mark_time: float | None = None
 ) -> None:
     reference = next(iter(series.values()))
+    # The desired path over the methods, thin and dashed: visible where they follow it.
     ax.plot(
-        reference["xE_d"], reference["yE_d"], "--", color="k", lw=0.9, label="desired", zorder=1
+        reference["xE_d"], reference["yE_d"], "--", color="k", lw=0.9, label="desired", zorder=3
     )
     for width, (label, ts) in zip(_line_widths(len(series)), series.items()):
         ax.plot(ts["xE"], ts["yE"], color=colors[label], lw=width, label=label, alpha=0.9)
@@ -163,19 +169,19 @@ def _draw_paths(
 
 def plot_errors(series: Series, colors: Mapping[str, str], title: str) -> Figure:
     """Position error (log scale) and orientation error vs time for every method."""
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     for label, ts in series.items():
         ax1.semilogy(ts["t"], _floor(ts["position_error_m"]), color=colors[label], label=label)
         ax2.plot(*break_wraps(ts["t"], ts["orientation_error_rad"]), color=colors[label], lw=1)
     ax1.set_ylabel("position error (m, log)")
     ax1.set_ylim(bottom=ERROR_FLOOR / 2)
     ax1.grid(alpha=0.3, which="major")
-    ax1.legend(fontsize=8, ncol=3)
     ax1.set_title(title)
     ax2.set_ylabel("orientation error (rad, wrapped)")
     _pi_ticks(ax2)
     ax2.set_xlabel("t (s)")
     ax2.grid(alpha=0.3)
+    legend_beside(ax1, fontsize=8)
     fig.tight_layout()
     return fig
 
@@ -187,27 +193,41 @@ def _pi_ticks(ax: Axes) -> None:
 
 
 def plot_wheels(series: Series, colors: Mapping[str, str], limit: float, title: str) -> Figure:
-    """Small multiples: left and right wheel speeds (rad/s) per method, with the limit."""
+    """Small multiples: left and right wheel speeds (rad/s) per method, with the limit;
+    every panel has its time axis labelled, one legend (above the panels) names the
+    styles."""
     rows, columns = _grid_shape(len(series))
     fig, axes = plt.subplots(
-        rows, columns, figsize=(4 * columns, 2.6 * rows), sharex=True, sharey=True, squeeze=False
+        rows, columns, figsize=(4 * columns, 2.7 * rows + 0.6), sharey=True, squeeze=False
     )
     for ax, (label, ts) in zip(axes.flat, series.items()):
-        ax.plot(ts["t"], ts["wheel_left_rad_s"], color=colors[label], lw=1, label="left")
-        ax.plot(ts["t"], ts["wheel_right_rad_s"], color=colors[label], lw=1, ls="--", label="right")
+        ax.plot(ts["t"], ts["wheel_left_rad_s"], color=colors[label], lw=1)
+        ax.plot(ts["t"], ts["wheel_right_rad_s"], color=colors[label], lw=1, ls="--")
         for sign in (-1.0, 1.0):
-            ax.axhline(sign * limit, color="0.5", ls=":", lw=0.8)
-        ax.set_title(label, fontsize=9)
+            ax.axhline(sign * limit, color="0.4", ls=":", lw=1)
+        ax.set_title(label, fontsize=9, color=colors[label])
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="lower right")
+        ax.set_xlabel("t (s)", fontsize=8)
+        ax.tick_params(labelsize=8, labelleft=True)
     for ax in axes.flat[len(series) :]:
         ax.set_visible(False)
     for ax in axes[:, 0]:
         ax.set_ylabel("wheel speed (rad/s)")
-    for ax in axes[-1, :]:
-        ax.set_xlabel("t (s)")
+    styles = [
+        plt.Line2D([], [], color="0.2", lw=1, label="left wheel (solid)"),
+        plt.Line2D([], [], color="0.2", lw=1, ls="--", label="right wheel (dashed)"),
+        plt.Line2D([], [], color="0.4", lw=1, ls=":", label=f"limit +-{limit:g} rad/s (dotted)"),
+    ]
     fig.suptitle(title)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.45 / fig.get_figheight()))
+    fig.legend(
+        handles=styles,
+        loc="upper right",
+        ncol=3,
+        fontsize=8,
+        frameon=False,
+        bbox_to_anchor=(1.0, 1.0 - 0.3 / fig.get_figheight()),
+    )
     return fig
 
 
@@ -215,34 +235,32 @@ def plot_small_multiples(
     series: Series, colors: Mapping[str, str], robot: Robot, title: str, snapshots: int = 6
 ) -> Figure:
     """One panel per method: desired and actual end-effector path, base path, and the robot
-    (footprint grey, arm black: no method's colour) at ``snapshots`` instants, each labelled
-    with its time."""
-    from ddwmmr.reports.plots import robot_outline
+    at ``snapshots`` instants, one colour per instant (named in the figure's legend: no
+    text next to the robots, which would cover the paths). Each panel holds everything it
+    draws: the frame of the desired path, grown for a method that leaves it."""
+    from ddwmmr.reports.plots import draw_snapshots, fit_equal, outline_points, snapshot_indices
 
     rows, columns = _grid_shape(len(series))
     fig, axes = plt.subplots(rows, columns, figsize=(4.4 * columns, 4.2 * rows), squeeze=False)
+    handles: list = []
     for ax, (label, ts) in zip(axes.flat, series.items()):
-        # On a closed path the last instant would be drawn over the first: leave it out.
-        closed = math.hypot(ts["xE_d"][-1] - ts["xE_d"][0], ts["yE_d"][-1] - ts["yE_d"][0]) < 1e-3
-        instants = np.linspace(0, len(ts["t"]) - 1, snapshots + closed)[:snapshots]
-        ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=0.9)
+        indices = snapshot_indices(ts, snapshots)
+        handles = draw_snapshots(ax, robot, ts, indices, lw=0.8)
         ax.plot(ts["x"], ts["y"], color="0.6", lw=0.9)
-        ax.plot(ts["xE"], ts["yE"], color=colors[label], lw=1.6)
-        q = np.column_stack([ts[k] for k in ("x", "y", "phi", "th1", "th2")])
-        for k in instants.round().astype(int):
-            shape = robot_outline(robot, q[k])
-            ax.plot(*shape["footprint"].T, color="0.45", lw=0.8)
-            ax.plot(*shape["heading"].T, color="0.45", lw=0.8)
-            ax.plot(*shape["arm"].T, color="k", lw=1.3, marker="o", ms=2)
-            ax.annotate(
-                f"{ts['t'][k]:.3g} s",
-                shape["footprint"][0],
-                fontsize=6.5,
-                color="0.25",
-                xytext=(2, 2),
-                textcoords="offset points",
-            )
-        _path_limits(ax, ts, robot.reach + 0.4)
+        ax.plot(ts["xE"], ts["yE"], color=colors[label], lw=2.0, alpha=0.85)
+        ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=0.9)
+        outline = outline_points(robot, ts, indices)
+        frame = robot.reach + 0.4
+        fit_equal(
+            ax,
+            np.r_[
+                ts["xE_d"].min() - frame, ts["xE_d"].max() + frame, ts["xE"], ts["x"], outline[:, 0]
+            ],
+            np.r_[
+                ts["yE_d"].min() - frame, ts["yE_d"].max() + frame, ts["yE"], ts["y"], outline[:, 1]
+            ],
+            0.1,
+        )
         ax.set_title(label, fontsize=9, color=colors[label])
         ax.tick_params(labelsize=7)
         ax.set_xlabel("x (m)", fontsize=8)
@@ -251,10 +269,26 @@ def plot_small_multiples(
     for ax in axes.flat[len(series) :]:
         ax.set_visible(False)
     fig.suptitle(
-        f"{title}: dashed desired, colour end effector, grey base path; robot (black arm) "
-        f"at {snapshots} instants, labelled with t"
+        f"{title}: dashed desired, colour end effector, grey base path; "
+        f"the robot at {snapshots} instants"
     )
-    fig.tight_layout()
+    empty = rows * columns - len(series)
+    if empty:  # the legend in the free panels of the last row
+        fig.tight_layout()
+        corner = axes.flat[len(series)].get_position()
+        fig.legend(
+            handles=handles,
+            loc="upper left",
+            bbox_to_anchor=(corner.x0, corner.y1),
+            fontsize=9,
+            title="robot colour: time",
+            title_fontsize=9,
+        )
+    else:
+        fig.tight_layout(rect=(0, 0.06, 1, 1))
+        fig.legend(
+            handles=handles, loc="lower center", ncol=len(handles), fontsize=9, frameon=False
+        )
     return fig
 
 
@@ -288,7 +322,6 @@ def plot_tau_study(
     ax1.set_ylabel("position error (m, log)")
     ax1.set_title(f"{first}: error vs time")
     ax1.set_ylim(bottom=ERROR_FLOOR / 2)
-    ax1.legend(fontsize=8)
     ax1.grid(alpha=0.3)
     markers = "osD^vP*X"
     count = len(convergence)
@@ -312,10 +345,65 @@ def plot_tau_study(
     ax2.set_xlabel("tau (s) (methods offset by a few % to stay visible)")
     ax2.set_ylabel("convergence time / tau")
     ax2.set_title("convergence time is proportional to tau")
-    ax2.legend(fontsize=8)
     ax2.grid(alpha=0.3, which="both")
     fig.tight_layout()
+    place_legend(ax1, fontsize=8)
+    place_legend(ax2, fontsize=8)
     return fig
+
+
+#: Two lines of the initial-offset study coincide when they are this close (px) at every
+#: offset: about two line widths at the figure's resolution.
+COINCIDE_PX = 4.0
+
+#: Two lines of the step-size study coincide on the plot when they are within this
+#: factor of each other at every step (a few line widths on its log axis).
+COINCIDE_FACTOR = 1.15
+
+
+def coinciding_groups(
+    lines: Mapping[str, Sequence[float]], factor: float = COINCIDE_FACTOR
+) -> list[list[str]]:
+    """Groups (of two or more names, in the given order) of lines whose values agree
+    within ``factor`` at every point: drawn on a log axis they lie on each other. Each
+    line belongs to at most one group (the first that it matches)."""
+    names = list(lines)
+    logs = {n: np.log(np.maximum(np.asarray(lines[n], float), ERROR_FLOOR)) for n in names}
+    limit = math.log(factor)
+    groups: list[list[str]] = []
+    placed: set[str] = set()
+    for i, name in enumerate(names):
+        if name in placed:
+            continue
+        group = [name]
+        for other in names[i + 1 :]:
+            same_shape = other not in placed and logs[other].shape == logs[name].shape
+            if same_shape and np.max(np.abs(logs[other] - logs[name])) <= limit:
+                group.append(other)
+        if len(group) > 1:
+            groups.append(group)
+            placed.update(group)
+    return groups
+
+
+def coinciding_looks(
+    lines: Mapping[str, Sequence[float]], factor: float = COINCIDE_FACTOR
+) -> tuple[dict[str, tuple[float, str]], list[list[str]]]:
+    """Line width and marker of every line in a :func:`coinciding_groups` group (from
+    wide to thin, a different marker each, so that each stays visible), and the groups."""
+    groups = coinciding_groups(lines, factor)
+    look: dict[str, tuple[float, str]] = {}
+    for group in groups:
+        for width, marker, name in zip(_line_widths(len(group)), "os^D", group):
+            look[name] = (width + 0.6, marker)
+    return look, groups
+
+
+def coinciding_note(groups: list[list[str]]) -> str | None:
+    """A legend title naming the lines that lie on each other (None: there are none)."""
+    if not groups:
+        return None
+    return "lying on each other\n(wide to thin):\n" + "\n".join(" = ".join(g) for g in groups)
 
 
 def plot_dt_study(
@@ -323,28 +411,42 @@ def plot_dt_study(
 ) -> Figure:
     """Step-size sweep: final position error vs dt (log-log), Euler solid, RK4 dashed.
 
+    Lines that lie on each other (:func:`coinciding_groups`) are drawn from wide to thin
+    with different markers, so each stays visible, and the legend names them.
+
     Args:
         drift: method -> integrator -> dt (s) -> final position error (m).
     """
-    fig, ax = plt.subplots(figsize=(8, 5))
+    fig, ax = plt.subplots(figsize=(10, 5))
     styles = {"euler": "-", "rk4": "--"}
+    steps = sorted({x for by in drift.values() for values in by.values() for x in values})
+    lines = {
+        f"{method} ({integrator})": [values.get(x, math.nan) for x in steps]
+        for method, by_integrator in drift.items()
+        for integrator, values in by_integrator.items()
+    }
+    look, groups = coinciding_looks(lines)
     for method, by_integrator in drift.items():
         for integrator, values in by_integrator.items():
+            name = f"{method} ({integrator})"
+            width, marker = look.get(name, (1.4, "o"))
             xs = sorted(values)
             ax.loglog(
                 xs,
                 [max(values[x], ERROR_FLOOR) for x in xs],
                 styles.get(integrator, "-."),
-                marker="o",
-                ms=3,
+                marker=marker,
+                ms=3 + width,
+                mfc="none" if name in look else colors[method],
+                lw=width,
                 color=colors[method],
-                label=f"{method} ({integrator})",
+                label=name,
             )
     ax.set_xlabel("step dt (s)")
     ax.set_ylabel("largest position error (m)")
     ax.set_title("drift vs step size: Euler (solid) is first order, RK4 (dashed) fourth")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize=7, ncol=2)
+    legend_beside(ax, fontsize=8, title=coinciding_note(groups), title_fontsize=8, alignment="left")
     fig.tight_layout()
     return fig
 
@@ -360,7 +462,7 @@ def plot_integrator_study(
         curves: method -> integrator -> (t, position error) arrays.
         dt: the step (s), for the title.
     """
-    fig, ax = plt.subplots(figsize=(8, 5))
+    fig, ax = plt.subplots(figsize=(9.5, 5))
     styles = {"euler": "-", "rk4": "--"}
     for method, by_integrator in curves.items():
         for integrator, (t, e) in by_integrator.items():
@@ -372,7 +474,7 @@ def plot_integrator_study(
     ax.set_ylim(bottom=ERROR_FLOOR / 2)
     ax.set_title(f"Euler (solid) vs RK4 (dashed) at dt = {dt:g} s")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, ncol=2)
+    legend_beside(ax, fontsize=8)
     fig.tight_layout()
     return fig
 
@@ -384,22 +486,26 @@ def plot_init_study(
     colors: Mapping[str, str],
 ) -> Figure:
     """Initial-offset sweep: final error vs initial offset, and one method's error curves.
+    Methods whose final errors lie on each other are drawn from wide to thin and named in
+    the legend's title (:func:`coinciding_looks`).
 
     Args:
         final: method -> initial offset (m) -> final position error (m).
         curves: initial offset (m) -> (t, position error) for ``curve_method``.
     """
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    drawn = {}
     for method, values in final.items():
         xs = sorted(values)
         errors = [max(values[x], ERROR_FLOOR) for x in xs]
-        ax1.plot([1000 * x for x in xs], errors, "o-", color=colors[method], label=method)
+        (drawn[method],) = ax1.plot(
+            [1000 * x for x in xs], errors, "o-", color=colors[method], label=method
+        )
     ax1.set_yscale("log")
     ax1.set_xlabel("initial end-effector offset (mm)")
     ax1.set_ylabel("final position error (m, log)")
     ax1.set_title("open loop keeps the offset, closed loop removes it")
     ax1.grid(alpha=0.3, which="both")
-    ax1.legend(fontsize=8)
     cmap = plt.get_cmap("viridis")
     offsets = sorted(curves)
     for i, offset in enumerate(offsets):
@@ -411,7 +517,22 @@ def plot_init_study(
     ax2.set_ylabel("position error (m, log)")
     ax2.set_title(f"{curve_method}: error vs time per initial offset")
     ax2.grid(alpha=0.3)
-    ax2.legend(fontsize=8)
+    legend_beside(ax1, fontsize=8)
+    fig.tight_layout()
+    # Lines within a few pixels of each other at every offset lie on each other here.
+    low, high = ax1.get_ylim()
+    pixels_per_decade = ax1.get_window_extent().height / math.log10(high / low)
+    factor = 10 ** (COINCIDE_PX / pixels_per_decade)
+    look, groups = coinciding_looks(
+        {m: [v[x] for x in sorted(v)] for m, v in final.items()}, factor
+    )
+    for method, (width, marker) in look.items():
+        line = drawn[method]
+        line.set(lw=width, marker=marker, ms=4 + width, mfc="none")
+    legend_beside(
+        ax1, fontsize=8, title=coinciding_note(groups), title_fontsize=8, alignment="left"
+    )
+    place_legend(ax2, fontsize=8)
     fig.tight_layout()
     return fig
 
@@ -425,7 +546,7 @@ def plot_corner_study(
         quarter: time (s) per quarter period T/4, i.e. per pi/2 of alpha.
         corners: corner times (s), alpha = k pi/2.
     """
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
     for label, ts in series.items():
         x = ts["t"] / quarter
         ax1.semilogy(x, _floor(ts["position_error_m"]), color=colors[label], lw=1.1, label=label)
@@ -437,10 +558,10 @@ def plot_corner_study(
     ax1.set_ylim(bottom=ERROR_FLOOR / 2)
     ax1.set_ylabel("position error (m, log)")
     ax1.set_title("rectangle: errors peak at the corners (dotted, alpha = k pi/2)")
-    ax1.legend(fontsize=8, ncol=3)
     _pi_ticks(ax2)
     ax2.set_ylabel("orientation error (rad, wrapped)")
     ax2.set_xlabel("alpha / (pi/2)")
+    legend_beside(ax1, fontsize=8)
     fig.tight_layout()
     return fig
 
@@ -449,7 +570,7 @@ def plot_plant_errors(
     kinematic: Series, plant: Series, colors: Mapping[str, str], plant_name: str, title: str
 ) -> Figure:
     """Position error vs time per method: kinematic plant (dashed) and ``plant`` (solid)."""
-    fig, ax = plt.subplots(figsize=(8, 4))
+    fig, ax = plt.subplots(figsize=(9, 4))
     for label, ts in plant.items():
         base = kinematic[label]
         ax.semilogy(
@@ -462,7 +583,7 @@ def plot_plant_errors(
     ax.set_xlabel("t (s)")
     ax.set_ylim(bottom=ERROR_FLOOR / 2)
     ax.grid(alpha=0.3, which="major")
-    ax.legend(fontsize=8, ncol=3, title=f"solid: {plant_name}, dashed: kinematic", title_fontsize=8)
     ax.set_title(title)
+    legend_beside(ax, fontsize=8, title=f"solid: {plant_name}\ndashed: kinematic", title_fontsize=8)
     fig.tight_layout()
     return fig

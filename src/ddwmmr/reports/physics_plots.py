@@ -91,13 +91,30 @@ def save_physics_animation(
     ax_s.set_ylim(0.0, 2.0)
     if tip_time is not None:
         ax_s.axvline(tip_time, color="tab:red", lw=0.8)
-        ax_s.annotate(" tipped", (tip_time, 1.85), color="tab:red", fontsize=8)
+        ax_s.annotate(
+            "tipped",
+            (tip_time, 1.85),
+            xytext=(4, 0),
+            textcoords="offset points",
+            va="center",
+            color="tab:red",
+            fontsize=8,
+        )
     ax_s.set_xlabel("t (s)")
     ax_s.set_ylabel("stability margin")
     tilt_axis = ax_s.twinx()
-    tilt_axis.plot(ts["t"], np.degrees(ts["base_tilt_rad"]), color="0.5", lw=0.8)
+    (tilt,) = tilt_axis.plot(ts["t"], np.degrees(ts["base_tilt_rad"]), color="0.5", lw=0.8)
     tilt_axis.set_ylabel("base tilt (deg, grey)")
-    ax_s.legend(loc="lower left", fontsize=8)
+    handles, labels = ax_s.get_legend_handles_labels()
+    # Below the plot: the two axes' lines fill it.
+    ax_s.legend(
+        [*handles, tilt],
+        [*labels, "base tilt (right axis)"],
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.18),
+        ncol=3,
+        fontsize=8,
+    )
     cursor = ax_s.axvline(0.0, color="k", lw=0.8)
     (footprint,) = ax.plot([], [], color="0.3")
     (arm,) = ax.plot([], [], color="tab:orange", lw=2, marker="o", ms=3)

@@ -16,8 +16,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from ddwmmr.model import Robot
+from ddwmmr.reports.legends import legend_beside, place_legend
 
 FIGURE_NAMES = ("path.png", "errors.png", "rates.png", "metrics.png")
 #: PNG text chunks: none (not even the matplotlib version), so equal runs give
@@ -60,12 +62,76 @@ def wheel_outlines(robot: Robot, q, width: float | None = None) -> list[np.ndarr
     return wheels
 
 
-def draw_robot(ax: Axes, robot: Robot, q, color: str = "0.35", alpha: float = 0.8) -> None:
-    """Draw the base footprint, heading and the two arm links at configuration q."""
-    shape = robot_outline(robot, q)
-    ax.plot(*shape["footprint"].T, color=color, lw=0.8, alpha=alpha)
-    ax.plot(*shape["heading"].T, color=color, lw=0.8, alpha=alpha)
-    ax.plot(*shape["arm"].T, color="tab:orange", lw=1.4, alpha=alpha, marker="o", ms=2)
+def snapshot_indices(ts: dict[str, np.ndarray], count: int, spacing: float = 0.0) -> np.ndarray:
+    """Up to ``count`` evenly spaced sample indices of a run, first and last included; on
+    a closed path (end effector desired back at its start) the last is left out, since it
+    would be drawn over the first. With ``spacing`` (m), an instant whose base lies closer
+    than that to an instant already kept is left out too: a base that hardly moves (a
+    reach on the spot) shows a few robots apart rather than a tangle of footprints."""
+    closed = math.hypot(ts["xE_d"][-1] - ts["xE_d"][0], ts["yE_d"][-1] - ts["yE_d"][0]) < 1e-3
+    candidates = np.linspace(0, len(ts["t"]) - 1, count + closed)[:count].round().astype(int)
+    # The first and the last instant first: where the run starts and ends matters most.
+    ends = [candidates[0]] if closed or count < 2 else [candidates[0], candidates[-1]]
+    kept: list[int] = []
+    for k in [*ends, *(k for k in candidates if k not in ends)]:
+        if (
+            all(
+                math.hypot(ts["x"][k] - ts["x"][j], ts["y"][k] - ts["y"][j]) >= spacing
+                for j in kept
+            )
+            or k in ends
+        ):
+            kept.append(int(k))
+    return np.array(sorted(kept), dtype=int)
+
+
+def footprint_spacing(robot: Robot) -> float:
+    """Distance (m) between two bases beyond which neither lies inside the other's
+    footprint, whatever their headings: half the footprint's diagonal."""
+    return 0.5 * math.hypot(robot.base_length, robot.base_width)
+
+
+def snapshot_colors(count: int) -> list:
+    """One colour per drawn instant, dark (first) to light (last): viridis up to 0.85,
+    whose light end still reads on white."""
+    cmap = plt.get_cmap("viridis")
+    return [cmap(0.85 * i / max(count - 1, 1)) for i in range(count)]
+
+
+def draw_snapshots(
+    ax: Axes, robot: Robot, ts: dict[str, np.ndarray], indices, lw: float = 1.0
+) -> list[Line2D]:
+    """The robot (footprint, heading, arm) at the samples ``indices`` of the time series
+    ``ts``, each instant in its own colour (:func:`snapshot_colors`); returns one legend
+    handle per instant, labelled with its time. Times are told by colour, not by text
+    next to the robots, so that no label covers a path."""
+    q = np.column_stack([ts[k] for k in ("x", "y", "phi", "th1", "th2")])
+    handles = []
+    for k, color in zip(indices, snapshot_colors(len(indices))):
+        shape = robot_outline(robot, q[k])
+        ax.plot(*shape["footprint"].T, color=color, lw=lw)
+        ax.plot(*shape["heading"].T, color=color, lw=lw)
+        ax.plot(*shape["arm"].T, color=color, lw=1.5 * lw, marker="o", ms=2.5)
+        handles.append(Line2D([], [], color=color, lw=2, label=f"robot at t = {ts['t'][k]:.3g} s"))
+    return handles
+
+
+def outline_points(robot: Robot, ts: dict[str, np.ndarray], indices) -> np.ndarray:
+    """Every vertex of the robot outlines drawn at ``indices`` (world frame, m), to fit
+    the axes around them."""
+    q = np.column_stack([ts[k] for k in ("x", "y", "phi", "th1", "th2")])
+    shapes = [robot_outline(robot, q[k]) for k in indices]
+    return np.concatenate([np.r_[s["footprint"], s["arm"]] for s in shapes]).reshape(-1, 2)
+
+
+def fit_equal(ax: Axes, xs: np.ndarray, ys: np.ndarray, margin: float) -> None:
+    """Equal-scale limits holding every finite point of ``xs``, ``ys`` plus ``margin``
+    (m); the axes box shrinks to the limits' shape."""
+    xs, ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
+    xs, ys = xs[np.isfinite(xs)], ys[np.isfinite(ys)]
+    ax.set_xlim(xs.min() - margin, xs.max() + margin)
+    ax.set_ylim(ys.min() - margin, ys.max() + margin)
+    ax.set_aspect("equal", adjustable="box")
 
 
 def circles_of(obstacles) -> list[tuple[float, float, float]]:
@@ -101,25 +167,52 @@ def break_wraps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return np.insert(t, jumps, np.nan), np.insert(angle, jumps, np.nan)
 
 
-def plot_path(result, ax: Axes | None = None, snapshots: int = 8, obstacles=None) -> Figure:
-    """Desired vs actual end-effector path, base path, the robot at ``snapshots`` times and
-    the obstacles (``(x, y, radius)`` circles, m) if any."""
+def plot_path(result, ax: Axes | None = None, snapshots: int = 6, obstacles=None) -> Figure:
+    """Desired vs actual end-effector path, base path, the robot at up to ``snapshots``
+    times, no base inside another's footprint (one colour per time, named in the legend; see
+    :func:`snapshot_indices`) and the obstacles (``(x, y, radius)``
+    circles, m) if any. The axes hold everything drawn; the legend sits beside them."""
     ts = result.timeseries
-    fig, ax = _axes(ax, figsize=(6.5, 5.5))
+    own_figure = ax is None
+    fig, ax = _axes(ax, figsize=(8.6, 5.6))
     draw_obstacles(ax, obstacles)
+    indices = snapshot_indices(ts, snapshots, footprint_spacing(result.robot))
+    robots = draw_snapshots(ax, result.robot, ts, indices, lw=0.9)
+    # The desired path on top of the actual one, dashed: visible where they coincide.
+    ax.plot(ts["xE"], ts["yE"], color="tab:blue", lw=2.2, alpha=0.8, label="actual end effector")
     ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=1, label="desired end effector")
-    ax.plot(ts["xE"], ts["yE"], color="tab:blue", lw=1.5, label="actual end effector")
-    ax.plot(ts["x"], ts["y"], color="tab:green", lw=1, label="base (axle midpoint)")
-    q = result.configurations()
-    for k in np.linspace(0, len(q) - 1, snapshots).astype(int):
-        draw_robot(ax, result.robot, q[k])
+    ax.plot(ts["x"], ts["y"], color="0.45", lw=1, label="base (axle midpoint)")
     ax.plot(ts["xE"][0], ts["yE"][0], "o", color="tab:blue", ms=5, label="start")
-    ax.set_aspect("equal", adjustable="datalim")
+    outline = outline_points(result.robot, ts, indices)
+    circles = np.array(circles_of(obstacles)).reshape(-1, 3)
+    fit_equal(
+        ax,
+        np.r_[
+            ts["xE"],
+            ts["xE_d"],
+            ts["x"],
+            outline[:, 0],
+            circles[:, 0] - circles[:, 2],
+            circles[:, 0] + circles[:, 2],
+        ],
+        np.r_[
+            ts["yE"],
+            ts["yE_d"],
+            ts["y"],
+            outline[:, 1],
+            circles[:, 1] - circles[:, 2],
+            circles[:, 1] + circles[:, 2],
+        ],
+        0.15,
+    )
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_title(_title(result, "paths"))
-    ax.legend(loc="best", fontsize=8)
+    handles, _ = ax.get_legend_handles_labels()
+    legend_beside(ax, handles=[*handles, *robots], fontsize=8)
     ax.grid(alpha=0.3)
+    if own_figure:
+        fig.subplots_adjust(left=0.09, right=0.73, bottom=0.09, top=0.93)  # legend: right
     return fig
 
 
@@ -140,28 +233,40 @@ def plot_errors(result) -> Figure:
 
 
 def plot_rates(result) -> Figure:
-    """Joint rates and wheel speeds vs time, with the robot's limits."""
+    """Arm joint rates, base yaw rate and wheel speeds vs time (rad/s), each on its own
+    axis, with the robot's limits drawn and named (the base yaw rate has no limit of its
+    own: the wheel limit bounds it)."""
     ts, robot = result.timeseries, result.robot
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    fig, (ax1, ax2, ax3) = plt.subplots(3, 1, figsize=(8.6, 6.4), sharex=True)
     ax1.plot(ts["t"], ts["th1dot"], label="th1dot")
     ax1.plot(ts["t"], ts["th2dot"], label="th2dot")
-    ax1.plot(ts["t"], ts["w"], label="w (base yaw)", lw=0.8)
-    for sign in (-1, 1):
-        ax1.axhline(sign * robot.joint_speed_limit, color="0.5", ls=":", lw=0.8)
-    ax1.set_ylabel("rate (rad/s)")
-    ax1.legend(fontsize=8, ncol=3)
-    ax1.grid(alpha=0.3)
-    ax2.plot(ts["t"], ts["wheel_left_rad_s"], label="left wheel")
-    ax2.plot(ts["t"], ts["wheel_right_rad_s"], label="right wheel")
-    for sign in (-1, 1):
-        ax2.axhline(sign * robot.wheel_speed_limit, color="0.5", ls=":", lw=0.8)
-    ax2.set_ylabel("wheel speed (rad/s)")
-    ax2.set_xlabel("t (s)")
-    ax2.legend(fontsize=8)
-    ax2.grid(alpha=0.3)
+    _limit_lines(ax1, robot.joint_speed_limit, "joint limit")
+    ax1.set_ylabel("arm joint rate\n(rad/s)")
+    ax2.plot(ts["t"], ts["w"], color="tab:green", label="w (base yaw rate)")
+    ax2.set_ylabel("base yaw rate\n(rad/s)")
+    ax3.plot(ts["t"], ts["wheel_left_rad_s"], label="left wheel")
+    ax3.plot(ts["t"], ts["wheel_right_rad_s"], ls="--", label="right wheel")
+    _limit_lines(ax3, robot.wheel_speed_limit, "wheel limit")
+    ax3.set_ylabel("wheel speed\n(rad/s)")
+    ax3.set_xlabel("t (s)")
     ax1.set_title(_title(result, "rates"))
+    for ax in (ax1, ax2, ax3):
+        ax.grid(alpha=0.3)
+        legend_beside(ax, fontsize=8)
     fig.tight_layout()
     return fig
+
+
+def _limit_lines(ax: Axes, limit: float, name: str) -> None:
+    """Dotted lines at +-limit with one legend entry naming the value."""
+    for sign in (-1, 1):
+        ax.axhline(
+            sign * limit,
+            color="0.4",
+            ls=":",
+            lw=1,
+            label=f"{name} +-{limit:g} rad/s" if sign > 0 else None,
+        )
 
 
 def plot_metrics(result) -> Figure:
@@ -176,13 +281,15 @@ def plot_metrics(result) -> Figure:
     ax2.axhline(1.0, color="tab:red", ls="--", lw=1, label="tip-over (S = 1)")
     stability_min = result.summary.get("stability_min")
     if stability_min:
-        ax2.axhline(stability_min, color="tab:orange", ls=":", lw=1, label="S_min")
+        ax2.axhline(
+            stability_min, color="tab:orange", ls=":", lw=1, label=f"S_min = {stability_min:g}"
+        )
     ax2.set_ylabel("stability S")
     ax2.set_xlabel("t (s)")
-    ax2.legend(fontsize=8)
     ax2.grid(alpha=0.3)
     ax1.set_title(_title(result, "performance metrics"))
     fig.tight_layout()
+    place_legend(ax2, fontsize=8)
     return fig
 
 

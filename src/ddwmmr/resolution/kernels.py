@@ -1,7 +1,8 @@
-"""Closed-form redundancy-resolution kernels (SPEC §3), in input form.
+"""Closed-form redundancy-resolution kernels, in input form.
 
 All kernels return ``u = (v, w, th1dot, th2dot)`` and a flag telling whether damping was
-applied. They work in the input form ``qdot = B(phi) u`` (SPEC §1), which satisfies the
+applied. They work in the input form ``qdot = B(phi) u`` (docs/theory.md, "Input form"),
+which satisfies the
 nonholonomic row of J exactly; three facts make them cheap (all tested against the matrix
 formulations in ``tests/test_resolution.py``):
 

@@ -6,7 +6,7 @@
   not depend on which way the trajectory starts.
 * :class:`ReferenceTrajectory` integrates ``q_d(t)`` from the desired task trajectory
   through the augmented task space resolution (RK4 on a fine grid, cubic Hermite lookup):
-  the configuration-space reference of CLRRMC-CS (SPEC §4).
+  the configuration-space reference of CLRRMC-CS (docs/theory.md, "Methods").
 """
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
 """Side-by-side study: the thesis's state machine against the competitive-dynamics arbiter.
 
-Same scenarios, same behaviours, same plant; only the arbiter differs (issue 13, SPEC §6).
+Same scenarios, same behaviours, same plant; only the arbiter differs (docs/thesis.md,
+"Results: state machine and competitive arbiter side by side").
 Three parts, each a function the CLI (``--study arbiters``) and ``docs/competitive_figures.py``
 call:
 
@@ -21,7 +22,6 @@ the competitive arbiter's changes of dominant behaviour into a fix behaviour.
 
 from __future__ import annotations
 
-import io
 import itertools
 import math
 from collections.abc import Callable, Sequence
@@ -392,6 +392,8 @@ def plot_weights(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    from ddwmmr.reports.legends import place_legend
+
     fig, axes = plt.subplots(rows, 1, figsize=(10, 2.5 * rows), sharex=True, squeeze=False)
     ax = axes[0, 0]
     colours = {"stability": "C3", "manipulability": "C2", "obstacle": "C4", "objective": "C0"}
@@ -407,7 +409,6 @@ def plot_weights(
         title=f"{title}: scenario {m['scenario']}, competitive arbiter "
         f"({m['reason']}, {m['time_s']:.1f} s)",
     )
-    ax.legend(loc="center right", fontsize=8, ncol=4)
     s_axis = axes[rows - 1, 0]
     s_axis.plot(history["t"], history["s"], color="k", lw=1.0, label="S, competitive")
     if compare_state_machine:
@@ -426,12 +427,10 @@ def plot_weights(
     if exit_ != enter:
         s_axis.axhline(exit_, color="k", lw=0.6, ls=":", label=f"exit {exit_:g}")
     s_axis.set(xlabel="time (s)", ylabel="stability S")
-    s_axis.legend(fontsize=8, ncol=4, loc="upper right")
-    buffer = io.BytesIO()
     fig.tight_layout()
-    fig.savefig(buffer, format="png", dpi=110)
-    plt.close(fig)
-    write_atomic(path, buffer.getvalue())
+    place_legend(ax, fontsize=8, ncol=4)
+    place_legend(s_axis, fontsize=8, ncol=4)
+    report._save(fig, path)
     return history_statistics(history)
 
 

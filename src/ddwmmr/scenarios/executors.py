@@ -44,9 +44,9 @@ def default_jobs() -> int:
 
 
 def _chunks(scenarios: Sequence[Scenario], jobs: int) -> list[tuple[Scenario, ...]]:
-    # 16 chunks per worker: the last ones to finish are short, so no worker idles long
-    # (measured 2-3 % faster than 4 per worker on 2 cores; 3 thesis scenarios still take
-    # about 70 ms against about 1 ms of task overhead).
+    # 16 chunks per worker: the last ones to finish are short, so no worker idles long, and
+    # a chunk still outlasts its task overhead many times (docs/thesis.md, "Speed and
+    # scale-out").
     size = max(1, len(scenarios) // (16 * jobs))
     return [tuple(scenarios[i : i + size]) for i in range(0, len(scenarios), size)]
 

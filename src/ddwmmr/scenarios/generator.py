@@ -1,4 +1,4 @@
-"""Seeded scenario generator (thesis 5.1, SPEC §5).
+"""Seeded scenario generator (thesis 5.1; docs/thesis.md, "What is simulated").
 
 A scenario is 5 waypoints drawn uniformly in the 8 m x 8 m square centred on the origin,
 reached in order by the end effector, the base starting at the origin heading +x. The

@@ -1,4 +1,4 @@
-"""The scenario protocol (thesis 5.1, SPEC §5): run one scenario, judge it, measure it.
+"""The scenario protocol (thesis 5.1): run one scenario, judge it, measure it.
 
 Success: every waypoint reached by the end effector within ``tolerance`` (0.01 m) in order
 within the time limit (60 s, 120 s with obstacles), with ``S > 1`` at every step and (with
@@ -9,17 +9,12 @@ robot must also never tip over there (reason ``"tipped (physics)"``; ``"tipped"`
 
 A scenario is a :class:`WaypointTask` run by the library's one simulation loop
 (:func:`ddwmmr.sim.loop.run_loop`), which connects any controller to any plant through
-the plant interface (controllers never import plants and plants never import controllers):
-
-* thesis controller (force interface: wheel forces and joint targets) on the thesis
-  plant, straight through. It has no kinematic-plant run: the kinematic plant is the
-  thesis plant's massless limit (``v = F / c1``), where its brake (P 100 > c1 = 15)
-  becomes an unstable algebraic loop;
-* ``qp`` controller (velocity interface ``u = (v, w, th1dot, th2dot)``) on the thesis
-  plant, whose velocity servo (feed-forward of the damping plus a proportional term,
-  :class:`ddwmmr.plants.thesis.VelocityServo`) turns (v, w) into wheel forces and joint
-  rates into one-step joint targets; or on the kinematic plant directly (Euler, one
-  controller call per step).
+the plant interface (controllers never import plants and plants never import controllers).
+The registry decides which take part (:mod:`ddwmmr.registry`): every controller registered
+for the ``"waypoints"`` task (:func:`scenario_controllers`), on every registered plant that
+accepts a command interface it sends (:func:`plants_for`); any other pair is refused with
+one line. docs/thesis.md, "What is simulated", describes the pairs and why some are left
+out.
 
 Metrics (seconds unless noted): ``time_s`` (time to the last waypoint, or to the failure),
 ``speed_m_s`` (straight-line length start -> waypoints / ``time_s``), ``time_base_s`` and

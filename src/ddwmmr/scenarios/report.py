@@ -45,6 +45,27 @@ def _mean_sd(values: np.ndarray) -> tuple[float, float]:
     return float(np.mean(values)), sd
 
 
+def bracket(outcomes: Sequence[Outcome], bounds: dict[int, tuple[float, float]]) -> dict:
+    """Each successful scenario's time over both ends of its physical-limit bracket
+    (``bounds``: ``{scenario: (lower_bound_s, best_known_s)}``, ``python -m
+    ddwmmr.bounds``): the mean ratios to the lower bound and to the best-known time, over
+    the scenarios that have the end (NaN if none)."""
+    to_lower, to_best = [], []
+    for o in outcomes:
+        m = o.metrics
+        lower, best = bounds.get(m["scenario"], (math.nan, math.nan))
+        if m["success"] and math.isfinite(lower) and lower > 0:
+            to_lower.append(m["time_s"] / lower)
+        if m["success"] and math.isfinite(best) and best > 0:
+            to_best.append(m["time_s"] / best)
+    return {
+        "mean_ratio_to_lower_bound": float(np.mean(to_lower)) if to_lower else math.nan,
+        "mean_ratio_to_best_known": float(np.mean(to_best)) if to_best else math.nan,
+        "scenarios_with_lower_bound": len(to_lower),
+        "scenarios_with_best_known": len(to_best),
+    }
+
+
 def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]:
     """Batch summary: failures, mean and sd of every metric, minimum stability, speed.
 
@@ -298,6 +319,8 @@ def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None 
     """Controller state, stability, manipulability and the distance to the current waypoint
     over time for one scenario (thesis Fig 5.17); with ``scenario``, the instants at which
     each waypoint was reached are marked."""
+    from ddwmmr.reports.legends import legend_beside
+
     tr = outcome.trace or {}
     t = tr.get("t", [])
     fig, axes = _figure(4, 1, height=2.2)
@@ -317,29 +340,28 @@ def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None 
     ax2.axhline(1.0, color="tab:red", lw=0.8, ls="--", label="S = 1 (tips over)")
     top = max(3.0, 1.05 * max(tr.get("s", [0.0]), default=0.0))
     ax2.set(ylim=(0.0, top), ylabel="stability S (-)")
-    ax2.legend(fontsize=8, ncol=2, loc="upper right")
     ax3 = axes[2, 0]
     ax3.plot(t, tr.get("eta", []), color="tab:purple", label="manipulability eta = |sin th2|")
     ax3.set(ylim=(0.0, 1.05), ylabel="manipulability\neta (-)")
-    ax3.legend(fontsize=8, loc="lower right")
     ax4 = axes[3, 0]
     ax4.semilogy(t, np.maximum(tr.get("distance", []), 1e-4), label="distance")
     ax4.axhline(0.01, color="k", lw=0.6, ls="--", label="tolerance 0.01 m")
     if scenario is not None:
         _mark_waypoints(ax4, tr, scenario)
-    if len(t) > 1:
-        ax4.text(
-            0.99, 0.04,
-            f"trace: every {TRACE_INTERVAL:g} s, every step within "
-            f"{FINE_TRACE_DISTANCE:g} m of a waypoint",
-            transform=ax4.transAxes, ha="right", fontsize=7, color="0.4",
-        )  # fmt: skip
-    ax4.set(xlabel="time (s)", ylabel="end effector to\nwaypoint (m)", ylim=(1e-4, 30.0))
-    ax4.legend(fontsize=8, loc="lower left", ncol=3)
+    sampling = (
+        f" (trace: every {TRACE_INTERVAL:g} s, every step within {FINE_TRACE_DISTANCE:g} m "
+        "of a waypoint)"
+        if len(t) > 1
+        else ""
+    )
+    ax4.set(xlabel=f"time (s){sampling}", ylabel="end effector to\nwaypoint (m)", ylim=(1e-4, 30.0))
     for axis in (ax, ax2, ax3):
         axis.sharex(ax4)
         axis.grid(alpha=0.3)
     ax4.grid(alpha=0.3)
+    # Beside the panels: the waypoint marks span the whole height of the last one.
+    for axis in (ax2, ax3, ax4):
+        legend_beside(axis, fontsize=8)
     _save(fig, path)
 
 

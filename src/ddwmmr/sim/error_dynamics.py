@@ -11,7 +11,7 @@ through the gain ``K = 1/tau`` (1/s)::
 
 The step response ``1 - exp(-t/tau)`` is how the measured pose approaches a step in the
 desired pose; the tracking error ``e = r - y`` of an initial offset decays as
-``exp(-t/tau)`` (SPEC §4: ``e_dot + K e = 0``).
+``exp(-t/tau)`` (``e_dot + K e = 0``; docs/theory.md, "Error dynamics and python-control").
 """
 
 from __future__ import annotations

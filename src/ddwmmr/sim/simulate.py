@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -29,6 +30,7 @@ from ddwmmr.resolution.reference import (
 from ddwmmr.sim.loop import run_loop
 from ddwmmr.sim.result import SimulationResult
 from ddwmmr.sim.tracking import COLUMNS, TrackingTask
+from ddwmmr.sim.verdict import verdict
 from ddwmmr.trajectories.base import resolution_step, trajectory_name
 
 __all__ = ["COLUMNS", "max_condition_number", "simulate", "summarize"]
@@ -70,26 +72,50 @@ def check_start(
     the message: a command line names its own options.
 
     The command-line tools and the app refuse such a run as bad input; :func:`simulate`
-    runs it (a design study may want to see ``min_stability`` below 1, as
-    examples/own_robot.py does)."""
+    warns and runs it (a design study may want to see ``min_stability`` below 1, as
+    examples/own_robot.py does), or refuses it with ``tipped_start="refuse"``."""
     if obstacles:
         from ddwmmr.qp.limits.obstacles import as_circles, check_start_clear
 
         check_start_clear(robot, as_circles(obstacles), q)
-    s = robot.stability(np.asarray(q, dtype=float))[2]
+    message = tipping_message(robot, q, name, start)
+    if message is not None:
+        raise ParameterError(message)
+
+
+def start_stability(robot: Robot, q: Sequence[float]) -> float:
+    """The static tip-over stability margin S of configuration ``q`` (S <= 1: tipped)."""
+    return float(robot.stability(np.asarray(q, dtype=float))[2])
+
+
+def tipping_message(
+    robot: Robot,
+    q: Sequence[float],
+    name: str = "payload",
+    start: str | None = "the start (q0, initial_offset)",
+) -> str | None:
+    """None if the robot stands in configuration ``q`` (static S > 1), else the one line
+    saying that it has tipped over, naming S and the payload (see :func:`check_start`
+    for ``name`` and ``start``): the one wording of the tools' refusal and the API's
+    warning."""
+    s = start_stability(robot, q)
     if s > 1.0:
-        return
+        return None
     if robot.payload > 0.0:
-        raise ParameterError(
+        return (
             f"{name}: a {robot.payload:g} kg payload tips the robot over in this run's start "
             f"pose (S = {s:.3g} <= 1); lighten the payload"
             + ("" if start is None else f" or change {start}")
         )
-    raise ParameterError(
+    return (
         f"robot: the robot tips over in this run's start pose without a payload (S = {s:.3g}"
         f" <= 1: its masses put the centre of mass outside the wheels); change the robot"
         + ("" if start is None else f" or {start}")
     )
+
+
+#: What :func:`simulate` does with a start in which the robot has tipped over.
+TIPPED_START = ("warn", "refuse", "allow")
 
 
 def simulate(
@@ -105,6 +131,7 @@ def simulate(
     plant: str | Plant = "kinematic",
     plant_options: dict[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
+    tipped_start: str = "warn",
     **controller_options: Any,
 ) -> SimulationResult:
     """Simulate ``method`` tracking ``trajectory`` on a plant.
@@ -130,12 +157,18 @@ def simulate(
             any name of :func:`ddwmmr.plants.available_plants`, or a plant object.
         plant_options: keyword options of the named plant.
         progress: optional callback ``progress(step, steps)``.
+        tipped_start: a start in which the robot has already tipped over (static S <= 1,
+            e.g. a heavy payload; the command-line tools refuse it): ``"warn"`` (default)
+            runs it after a :class:`UserWarning` naming S and the payload, ``"refuse"``
+            raises :class:`ParameterError`, ``"allow"`` runs it silently. Either way the
+            summary records ``start_stability`` and ``start_tipped``.
         **controller_options: passed to :func:`make_controller` when ``method`` is a name.
 
     Returns:
         A :class:`SimulationResult` with ``.timeseries`` and ``.summary``. If the plant's
         state blows up, the run stops there: ``summary["diverged_at_step"]`` says where and
-        the time series hold what was recorded until then.
+        the time series hold what was recorded until then. ``summary["verdict"]`` says
+        whether the run tracked (:mod:`ddwmmr.sim.verdict`).
     """
     robot = check_instance("robot", robot if robot is not None else Robot(), Robot)
     if progress is not None and not callable(progress):
@@ -176,6 +209,7 @@ def simulate(
             q = np.full(1, np.nan)  # not numbers: the message below
         if q.shape != (5,) or not np.all(np.isfinite(q)):
             raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
+    tipped = _tipped_start(robot, q, tipped_start)
     task = TrackingTask(trajectory, the_plant, grid=(dt, steps))
     run_loop(the_plant, controller, task, q, dt, steps, progress)
     timeseries = task.timeseries(robot)
@@ -199,7 +233,33 @@ def simulate(
     summary.update(the_plant.summarize(timeseries))
     if hasattr(controller, "summarize"):
         summary.update(controller.summarize(timeseries))
+    if getattr(controller, "aux", None) is not None:
+        summary["aux"] = controller.aux  # the verdict's likely cause names the slides' row
+    summary.update(start_stability=start_stability(robot, q), start_tipped=tipped)
+    summary.update(verdict(summary))
     return SimulationResult(timeseries, summary, robot, trajectory, controller)
+
+
+def _tipped_start(robot: Robot, q: np.ndarray, policy: str) -> bool:
+    """Whether the robot has tipped over in the start ``q``; warns or refuses as
+    ``policy`` (one of :data:`TIPPED_START`, see :func:`simulate`) says."""
+    if policy not in TIPPED_START:
+        raise ParameterError(
+            f"tipped_start must be one of {', '.join(TIPPED_START)} (got {shown(policy)})"
+        )
+    message = tipping_message(robot, q)
+    if message is None:
+        return False
+    if policy == "refuse":
+        raise ParameterError(message)
+    if policy == "warn":
+        warnings.warn(
+            f"{message}; simulating anyway (summary['start_tipped'] is True; "
+            'tipped_start="refuse" refuses, "allow" silences this)',
+            UserWarning,
+            stacklevel=3,
+        )
+    return True
 
 
 def check_tracks(method: str) -> None:

@@ -78,8 +78,13 @@ def sampler(trajectory: Any) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndar
 
 
 def resolution_step(trajectory: Any) -> float:
-    """The trajectory's own step (s): ``duration / samples`` (its resolution N), or
-    ``duration / 1000``."""
+    """The trajectory's own step (s), the default control step of every tool and of
+    :func:`ddwmmr.simulate`: its ``default_step`` if it has one (a sampled trajectory:
+    :meth:`SampledTrajectory.default_step`), else ``duration / samples`` (its resolution
+    N), or ``duration / 1000``."""
+    own = getattr(trajectory, "default_step", None)
+    if own is not None:
+        return float(own)
     samples = getattr(trajectory, "samples", 1000)
     number = isinstance(samples, int | float | np.integer | np.floating)
     if isinstance(samples, bool) or not number or not (math.isfinite(samples) and samples > 0):

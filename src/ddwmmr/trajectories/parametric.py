@@ -1,4 +1,4 @@
-"""Elliptical and rectangular end-effector trajectories (SPEC §2).
+"""Elliptical and rectangular end-effector trajectories (docs/theory.md, "Trajectories").
 
 Both are parametrised by ``(x0, y0, a, b, beta, N, T)``: centre (m), semi-axes (m), rotation
 (rad), number of samples per period and period (s). With ``alpha = 2 pi t / T``:
@@ -66,7 +66,7 @@ def check_geometry_value(name: str, value: float) -> float:
 
 @dataclass(frozen=True)
 class _Parametric(ABC):
-    """Shared parameters and validation of the SPEC §2 trajectories."""
+    """Shared parameters and validation of the parametric trajectories."""
 
     x0: float = 0.0
     y0: float = 0.0
@@ -169,11 +169,11 @@ class _Parametric(ABC):
 
 @dataclass(frozen=True)
 class Ellipse(_Parametric):
-    """Elliptical trajectory (SPEC §2). Defaults: 2.0 m x 1.5 m semi-axes, 40 s period.
+    """Elliptical trajectory. Defaults: 2.0 m x 1.5 m semi-axes, 40 s period.
 
     The smallest radius of curvature, b^2/a = 1.1 m, exceeds the arm reach (0.65 m): with a
     tighter ellipse the base cannot follow a tangent-oriented end effector without driving
-    the shoulder into its singularity (see docs/theory.md).
+    the shoulder into its singularity (docs/theory.md, "Trajectories").
     """
 
     name: str = "ellipse"
@@ -199,7 +199,7 @@ class Ellipse(_Parametric):
 
 @dataclass(frozen=True)
 class Rectangle(_Parametric):
-    """Rectangular trajectory (SPEC §2): corners at alpha = k pi/2, non-uniform timing."""
+    """Rectangular trajectory: corners at alpha = k pi/2, non-uniform timing."""
 
     name: str = "rectangle"
 

@@ -33,6 +33,9 @@ MAX_TIME_S = DURATION_RANGE_S[1]
 #: bounds the interpolant's speed by 1e9 x (distance / duration) instead of letting
 #: ``times = [0, 1e-300, 1]`` ask for 1e300 m/s.
 MIN_STEP_FRACTION = 1e-9
+#: Longest default control step (s) of a sampled trajectory: that of the shipped ellipse
+#: and rectangle (40 s / 2000 samples).
+MAX_DEFAULT_STEP_S = 0.02
 
 
 def _tangents(times: np.ndarray, values: np.ndarray, periodic: bool) -> np.ndarray:
@@ -124,8 +127,18 @@ class SampledTrajectory:
     def samples(self) -> int:
         """Resolution N of the trajectory protocol: the number of intervals between the
         samples (rows - 1), so that ``duration / samples`` is their spacing for evenly
-        spaced rows (the default control step)."""
+        spaced rows."""
         return len(self.times) - 1
+
+    @property
+    def default_step(self) -> float:
+        """The default control step (s): the rows' spacing ``duration / samples``, made
+        finer where it exceeds :data:`MAX_DEFAULT_STEP_S` (``duration / n`` for the
+        fewest whole steps ``n`` no longer than it). The rows are data, often far apart
+        (0.5 s for a path recorded at 2 Hz); the step is a control choice, the same in
+        every tool and the API."""
+        steps = max(self.samples, math.ceil(self.duration / MAX_DEFAULT_STEP_S - 1e-9))
+        return self.duration / steps
 
     def _segment(self, t: float) -> tuple[int, float, float]:
         t_abs = min(max(t + self._knots[0], self._knots[0]), self._knots[-1])

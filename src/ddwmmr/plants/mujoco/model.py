@@ -11,9 +11,9 @@ Bodies (all masses and inertias explicit, ``inertiafromgeom="false"``):
   damping, rolling resistance) then acts on the floor, where a real robot's does, and
   puts no pitch moment on the base. Mass ``base_mass - 2 wheel_mass`` at the box
   centre; yaw inertia chosen so that base + wheels have ``base_inertia`` about the axle
-  midpoint (SPEC §1). Roll/pitch inertias are those of a uniform box (raised if needed to
-  be physically consistent). The frictionless casters are spheres of radius
-  :data:`CASTER_RADIUS` on this body, touching the floor at :attr:`Robot.casters`.
+  midpoint (docs/theory.md, "Tip-over stability"). Roll/pitch inertias are those of a
+  uniform box (raised if needed to be physically consistent). The frictionless casters are
+  spheres of radius :data:`CASTER_RADIUS` on this body, touching the floor at :attr:`Robot.casters`.
 * ``wheel_left`` / ``wheel_right`` (hinge about the base's y axis) at ``(0, +-Lw/2)``:
   mass ``wheel_mass`` each (a disc of width :data:`WHEEL_WIDTH`); their floor contact is a
   sphere of radius ``wheel_radius`` (one contact point straight below the axle, on the
@@ -28,10 +28,10 @@ Bodies (all masses and inertias explicit, ``inertiafromgeom="false"``):
   (then it spins on frictionless casters). The offset is the contacts' own static sink,
   so the tilt it adds at tipping (offset / half-width, 3e-4 rad) is negligible.
 * ``link1`` (hinge about z at the base centre, ``arm_height`` above the floor) and
-  ``link2`` (hinge at ``L1`` along link 1): uniform rods, mass at the midpoint as SPEC §1
-  has it for S. The payload is a point mass at the end effector (``L2`` along link 2),
-  folded into link 2's inertial (so ``body_mass`` of link 2 is ``m2 + payload``). The arm
-  never collides.
+  ``link2`` (hinge at ``L1`` along link 1): uniform rods, mass at the midpoint as S has it
+  (docs/theory.md, "Tip-over stability"). The payload is a point mass at the end effector
+  (``L2`` along link 2), folded into link 2's inertial (so ``body_mass`` of link 2 is
+  ``m2 + payload``). The arm never collides.
 * the floor: an infinite plane with sliding friction ``friction`` (wheels grip, casters
   are frictionless through ``condim=1`` and a higher contact priority).
 

@@ -4,7 +4,7 @@ Implements the :class:`~ddwmmr.plants.base.Plant` interface. Commands:
 
 * **velocity** ``u = (v, w, th1dot, th2dot)``: limited like the kinematic plant (wheel
   speed, joint rate and joint position limits), then turned into wheel speed targets
-  (SPEC §1 wheel map) and joint rate targets for the velocity servos of the model. The
+  (docs/theory.md, "Wheels") and joint rate targets for the velocity servos of the model. The
   servos' torques are clipped at the robot's motor limits, the wheels grip the floor
   through friction: the base may lag, slip or saturate, and the controller sees it.
 * **force** :class:`~ddwmmr.commands.WheelForces`: each wheel force F (N) is applied as
@@ -427,12 +427,12 @@ class MujocoPlant:
         """Wheel-speed targets' lead (rad/s) feeding the base damping forward: the wheel
         servos then hold ``(v, w)`` in steady state.
 
-        With ``base_damping`` the base needs the wheel forces ``(c1 v -+ c2 w / (track/2))
-        / 2`` to keep moving at ``(v, w)``; a proportional servo ``kv (target - rate)``
-        would fall short by ``torque / kv`` (at v = 1 m/s, w = -1 rad/s the yaw settled
-        20 % short). Raising the target by ``torque / kv`` makes the servo apply that
-        torque at the target speed, as the thesis plant's velocity servo feeds the damping
-        forward (docs/physics.md). Zero without damping."""
+        With ``base_damping`` the base needs the wheel forces ``(c1 v -+ c2 w / (track/2)) /
+        2`` to keep moving at ``(v, w)``; a proportional servo ``kv (target - rate)`` would
+        fall short by ``torque / kv`` (measured: docs/physics.md, "The plant"). Raising the
+        target by ``torque / kv`` makes the servo apply that torque at the target speed, as
+        the thesis plant's velocity servo feeds the damping forward (docs/physics.md). Zero
+        without damping."""
         c_t, c_yaw = self.damping
         robot = self.robot
         drive, turn = 0.5 * c_t * v, c_yaw * w / robot.track_width

@@ -7,7 +7,8 @@ frame on the floor). Forces are floor normal forces in N.
 Definitions (docs/physics.md, "Tip-over from the contact forces"):
 
 * **support polygon**: convex hull of the nominal support points (wheels and casters).
-  With the default casters it is the footprint ``base_length x base_width`` of SPEC §1.
+  With the default casters it is the footprint ``base_length x base_width``
+  (docs/theory.md, "Tip-over stability").
 * **centre of pressure** ``c``: the force-weighted mean of the contact points. At rest it
   is the projection of the centre of mass (the floor carries the weight); when the robot
   accelerates it moves with the inertial forces (the zero-moment point).

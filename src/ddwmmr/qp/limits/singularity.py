@@ -1,10 +1,11 @@
 """Shoulder singularity: keep the first link away from perpendicular to the heading.
 
 With the arm mounted on the base's rotation centre, the inputs reach the end-effector pose
-through ``(v, w + th1dot, th2dot)``, a 3x3 map with determinant ``-L1 cos th1`` (SPEC §1,
-the augmented Jacobians' singularity). Near ``th1 = +-pi/2`` a tracked end effector can no
-longer be moved along the heading's normal without huge rates: the QP would let tracking
-fail there. The limit keeps ``h = cos^2 th1 - cos^2(pi/2 - margin) >= 0`` with the damper
+through ``(v, w + th1dot, th2dot)``, a 3x3 map with determinant ``-L1 cos th1``
+(docs/theory.md, "Singularities and damping": the augmented Jacobians' singularity). Near
+``th1 = +-pi/2`` a tracked end effector can no longer be moved along the heading's normal
+without huge rates: the QP would let tracking fail there. The limit keeps
+``h = cos^2 th1 - cos^2(pi/2 - margin) >= 0`` with the damper
 
     dh/dt = -sin(2 th1) th1dot >= -gain h.
 """

@@ -1,4 +1,4 @@
-"""Tip-over stability ``S >= S_min`` as a velocity damper with the exact gradient (SPEC §1).
+"""Tip-over stability ``S >= S_min`` as a velocity damper with the exact gradient.
 
 ``S = min(S_lon, S_lat)`` with ``S_lon = hl / |x_com|`` and ``S_lat = hw / |y_com|``, so
 ``S >= S_min`` holds exactly when both terms do. Each term is smooth where it is below the
@@ -10,7 +10,8 @@ limit constrains each term separately (no kink at the switch between them):
 Above ``S_min + margin`` the term may fall at most exponentially towards the floor; below
 it, the term must rise. The right-hand side is capped at half of what the joint-speed box
 can deliver, so the row alone is always feasible. :func:`safe_arm_scale` then checks the
-exact (nonlinear) S one control step ahead.
+exact (nonlinear) S one control step ahead. The formulation: docs/theory.md, "The QP
+controller".
 """
 
 from __future__ import annotations

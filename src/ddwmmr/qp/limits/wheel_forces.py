@@ -1,7 +1,8 @@
 """Wheel-force limit: the velocity command must be reachable within the force limit.
 
-For a force-driven base (the thesis plant, SPEC §5) tracked by the velocity loop
-``F = c1 v_d + k m (v_d - v)``, ``T = c2 w_d + k I (w_d - w)`` (``F_r = T / (width/2)``),
+For a force-driven base (the thesis plant, docs/thesis.md, "What is simulated") tracked by
+the velocity loop ``F = c1 v_d + k m (v_d - v)``, ``T = c2 w_d + k I (w_d - w)``
+(``F_r = T / (width/2)``),
 the wheel forces ``F_l = (F - F_r)/2`` and ``F_r' = (F + F_r)/2`` are affine in the
 command ``(v_d, w_d)``. Keeping both within ``+-force_limit`` is the plant's real envelope,
 a polytope that couples translation and rotation, instead of separate boxes on speed and

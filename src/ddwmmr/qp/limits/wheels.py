@@ -1,4 +1,7 @@
-"""Wheel-speed limits: ``|phidot_l|, |phidot_r| <= wheel_speed_limit`` (SPEC §1 wheel map)."""
+"""Wheel-speed limits: ``|phidot_l|, |phidot_r| <= wheel_speed_limit``.
+
+The wheel map: docs/theory.md, "Wheels".
+"""
 
 from __future__ import annotations
 

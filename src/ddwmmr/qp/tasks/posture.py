@@ -1,4 +1,7 @@
-"""Posture / artificial potential ``V = K1 th1^2 + K2 th2^2 + K3 phi^2`` (SPEC §3)."""
+"""Posture / artificial potential ``V = K1 th1^2 + K2 th2^2 + K3 phi^2``.
+
+The potential of the ``ap`` method (docs/theory.md, "Methods").
+"""
 
 from __future__ import annotations
 

@@ -65,6 +65,9 @@ class CompareConfig:
             or ``"slides"``); the report also ranks the methods under the other one.
         plants: extra plants (``"thesis"``, ``"mujoco"``) on which the main comparison is
             repeated, next to the kinematic plant (section "Plants").
+        options: method -> the user's options of that method (``--option``), over the
+            preset's values in every run of it; a study's own setting (e.g. the swept
+            tau) still wins in that study. Values must be hashable (tuples, not lists).
     """
 
     methods: tuple[str, ...]
@@ -76,6 +79,7 @@ class CompareConfig:
     command: str = ""
     preset: str = "default"
     plants: tuple[str, ...] = ()
+    options: dict[str, dict[str, Any]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         check_preset(self.preset)
@@ -178,9 +182,11 @@ def main_spec(
 ) -> RunSpec:
     """The comparison's standard run of ``method`` on ``name`` with ``changes`` applied.
 
-    ``preset`` defaults to the config's; ``options`` in ``changes`` override its values.
+    ``preset`` defaults to the config's; the config's ``options`` of the method override
+    its values, and ``options`` in ``changes`` override both.
     """
     options = dict(preset_changes(method, config.preset if preset is None else preset))
+    options.update(config.options.get(method, {}))
     options.update(changes.pop("options", ()))
     spec = {"dt": default_step(config.trajectories[name]), **changes}
     return RunSpec(method, name, options=tuple(options.items()), **spec)

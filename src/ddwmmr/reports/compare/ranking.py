@@ -49,10 +49,13 @@ def metrics_csv(rows: Sequence[Mapping[str, Any]]) -> str:
 
 
 def _csv_value(value: Any) -> str:
-    """Exact text of a summary value: floats by repr (round-trips), None as empty."""
+    """Exact text of a summary value: floats by repr (round-trips), None as empty, a list
+    of names (``verdict_reasons``) space separated."""
     value = json_safe(value)
     if value is None:
         return ""
+    if isinstance(value, list | tuple):
+        return " ".join(str(item) for item in value)
     return repr(value) if isinstance(value, float) else str(value)
 
 

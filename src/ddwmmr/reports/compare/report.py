@@ -409,6 +409,13 @@ def _observations(c: _Context, ranking: Ranking) -> list[str]:
     return notes
 
 
+def tracked(reasons: Any) -> str:
+    """Table cell of a run's ``verdict_reasons``: yes, or no with the reason codes."""
+    if not isinstance(reasons, list | tuple):
+        return "n/a"
+    return "yes" if not reasons else "no: " + ", ".join(reasons)
+
+
 METRIC_COLUMNS = (
     ("RMS pos (mm)", "rms_position_error_m", mm),
     ("max pos (mm)", "max_position_error_m", mm),
@@ -422,6 +429,7 @@ METRIC_COLUMNS = (
     ("singular steps", "singular_steps", fmt),
     ("saturated steps", "saturated_steps", fmt),
     ("step latency (us)", "median_step_us", fmt),
+    ("tracked? (docs/cli.md, Verdict)", "verdict_reasons", tracked),
 )
 
 
@@ -443,9 +451,11 @@ def _trajectory_section(c: _Context, name: str) -> None:
     c.add_figure(
         f"paths_{name}.png",
         plots.plot_paths(series, colors, f"{name}: end-effector paths", zooms),
-        f"{name}: end-effector paths over the desired path (thin dashed, drawn first; the "
-        "methods from wide to thin lines on top, so coinciding ones stay visible). The main "
-        "frame is the desired path plus 0.5 m, so a method that drifts away leaves it. Zoom "
+        f"{name}: end-effector paths and the desired path (thin dashed, drawn over the "
+        "methods, which go from wide to thin lines so that coinciding ones stay visible). "
+        "The main "
+        "frame holds the desired path plus 0.5 m and every method's whole path (a method "
+        "that drifts away widens it). Zoom "
         "A: the start, where the closed-loop methods remove the initial offset and the "
         "open-loop ones keep it"
         + (
@@ -467,14 +477,16 @@ def _trajectory_section(c: _Context, name: str) -> None:
     c.add_figure(
         f"wheels_{name}.png",
         plots.plot_wheels(series, colors, c.config.robot.wheel_speed_limit, f"{name}: wheels"),
-        f"{name}: left (solid) and right (dashed) wheel speeds per method; dotted: the limit.",
+        f"{name}: left (solid) and right (dashed) wheel speeds per method; dotted: the limit "
+        f"+-{c.config.robot.wheel_speed_limit:g} rad/s.",
     )
     c.add_figure(
         f"methods_{name}.png",
         plots.plot_small_multiples(series, colors, c.config.robot, name),
         f"{name}: one panel per method (axes in m): desired path dashed, end effector in the "
-        "method's colour, base path grey, the robot (grey footprint, black arm) at six "
-        "instants labelled with their time.",
+        "method's colour, base path grey, the robot (footprint and arm) at six instants, one "
+        "colour per instant from dark (start) to light, named in the legend. Each panel "
+        "holds everything it draws: a method that leaves the desired path gets a wider frame.",
     )
 
 
@@ -722,7 +734,9 @@ def _dt_section(c: _Context) -> None:
     c.add_figure(
         "study_dt.png",
         plots.plot_dt_study(drift, c.colors),
-        "Largest position error vs step size, Euler (solid) and RK4 (dashed), log-log.",
+        "Largest position error vs step size, Euler (solid) and RK4 (dashed), log-log. "
+        "Lines within 15 % of each other at every step lie on each other: they are drawn "
+        "from wide to thin with open markers, and the legend's title names them.",
     )
 
 

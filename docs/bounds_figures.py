@@ -1,0 +1,186 @@
+"""The physical limit, bracketed: docs/mpc.md's tables and docs/figures/bounds_ratios.png.
+
+Data (committed, in docs/bounds/):
+
+* ``bounds_seed{S}.csv``: ``python -m ddwmmr.bounds --seed S ...``'s bounds.csv;
+* ``controllers_seed{S}.csv``: each controller's time per scenario on the thesis plant
+  (``python -m ddwmmr.scenarios --controller X --n 100 --seed S``; the competitive arbiter
+  is ``--controller thesis --arbiter competitive``), NaN where a scenario failed.
+
+``python docs/bounds_figures.py`` redraws the figure from them and rewrites the block
+between the ``bounds-table`` markers of docs/mpc.md; ``--collect SEED DIR`` first builds
+``controllers_seed{SEED}.csv`` from four scenario runs ``DIR/{thesis,competitive,qp,mpc}-sSEED``
+(their scenarios.csv), ``--bounds SEED CSV`` first copies a bounds run's bounds.csv to
+``bounds_seed{SEED}.csv``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import shutil
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+
+DOCS = Path(__file__).resolve().parent
+DATA = DOCS / "bounds"
+FIGURE = DOCS / "figures" / "bounds_ratios.png"
+PAGE = DOCS / "mpc.md"
+BEGIN, END = "<!-- bounds-table:begin -->", "<!-- bounds-table:end -->"
+CONTROLLERS = {
+    "thesis": "thesis controller",
+    "competitive": "thesis controller, competitive arbiter",
+    "qp": "qp",
+    "mpc": "mpc",
+}
+SEEDS = (0, 1)
+
+
+def read_bounds(seed: int) -> dict[int, tuple[float, float]]:
+    """``{scenario: (lower, best)}``; best NaN where the replay failed or was not run."""
+    out = {}
+    with open(DATA / f"bounds_seed{seed}.csv", newline="") as handle:
+        for row in csv.DictReader(handle):
+            best = float(row["best_known_s"]) if row["replay_ok"] == "True" else math.nan
+            out[int(row["scenario"])] = (float(row["lower_bound_s"]), best)
+    return out
+
+
+def read_controllers(seed: int) -> dict[str, dict[int, float]]:
+    times: dict[str, dict[int, float]] = {name: {} for name in CONTROLLERS}
+    with open(DATA / f"controllers_seed{seed}.csv", newline="") as handle:
+        for row in csv.DictReader(handle):
+            for name in CONTROLLERS:
+                times[name][int(row["scenario"])] = float(row[name])
+    return times
+
+
+def collect(seed: int, folder: Path) -> None:
+    """controllers_seed{seed}.csv from four scenario runs in ``folder``."""
+    columns: dict[str, dict[int, float]] = {}
+    for name in CONTROLLERS:
+        with open(folder / f"{name}-s{seed}" / "scenarios.csv", newline="") as handle:
+            rows = list(csv.DictReader(handle))
+        columns[name] = {
+            int(r["scenario"]): round(float(r["time_s"]), 3) if r["success"] == "true" else math.nan
+            for r in rows
+        }
+    scenarios = sorted(columns["thesis"])
+    with open(DATA / f"controllers_seed{seed}.csv", "w", newline="") as handle:
+        writer = csv.writer(handle, lineterminator="\n")
+        writer.writerow(["scenario", *CONTROLLERS])
+        for s in scenarios:
+            writer.writerow([s, *(repr(columns[n][s]) for n in CONTROLLERS)])
+
+
+def ratios(seed: int) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per controller: scenarios, time / best known, time / lower bound."""
+    bounds = read_bounds(seed)
+    times = read_controllers(seed)
+    out = {}
+    for name, by_scenario in times.items():
+        scenarios = np.array([s for s in sorted(by_scenario) if s in bounds])
+        t = np.array([by_scenario[s] for s in scenarios])
+        lower = np.array([bounds[s][0] for s in scenarios])
+        best = np.array([bounds[s][1] for s in scenarios])
+        out[name] = (scenarios, t / best, t / lower)
+    return out
+
+
+def table(seed: int) -> list[str]:
+    bounds = read_bounds(seed)
+    with open(DATA / f"bounds_seed{seed}.csv", newline="") as handle:
+        starts = sorted({int(row["starts"]) for row in csv.DictReader(handle)})
+    lower = np.array([v[0] for v in bounds.values()])
+    best = np.array([v[1] for v in bounds.values()])
+    both = np.isfinite(best)
+    width = best[both] / lower[both]
+    count = str(starts[0]) if len(starts) == 1 else f"{starts[0]}-{starts[-1]}"
+    lines = [
+        f"**Seed {seed}**: scenarios {min(bounds)}-{max(bounds)} ({len(bounds)} of 100; "
+        f"{count} starts each, best-known times replayed for {int(both.sum())}): lower bound "
+        f"{lower.mean():.2f} s, best known {np.nanmean(best):.2f} s, bracket width (best known "
+        f"/ lower bound) mean **{width.mean():.3f}** (min {width.min():.3f}, max "
+        f"{width.max():.3f}).",
+        "",
+        "| controller (thesis plant) | mean time (s) | / best known: mean (least) "
+        "| / lower bound: mean (least) |",
+        "| --- | --- | --- | --- |",
+    ]
+    times = read_controllers(seed)
+    for name, (scenarios, to_best, to_lower) in ratios(seed).items():
+        t = np.array([times[name][s] for s in scenarios])
+        lines.append(
+            f"| {CONTROLLERS[name]} | {np.nanmean(t):.2f} | {np.nanmean(to_best):.3f} "
+            f"({np.nanmin(to_best):.3f}) | {np.nanmean(to_lower):.3f} ({np.nanmin(to_lower):.3f}) |"
+        )
+    return lines
+
+
+def figure() -> None:
+    fig, axes = plt.subplots(2, 1, figsize=(10, 7), sharex=True)
+    style = {
+        "thesis": ("tab:blue", "o"),
+        "competitive": ("tab:cyan", "v"),
+        "qp": ("tab:orange", "s"),
+        "mpc": ("tab:green", "D"),
+    }
+    data = ratios(0)
+    bounds = read_bounds(0)
+    for name, (scenarios, to_best, to_lower) in data.items():
+        color, marker = style[name]
+        for ax, values in zip(axes, (to_best, to_lower)):
+            ax.plot(scenarios, values, marker, color=color, ms=3.5, label=CONTROLLERS[name])
+    scenarios = np.array(sorted(bounds))
+    width = np.array([bounds[s][1] / bounds[s][0] for s in scenarios])
+    axes[1].plot(scenarios, width, "-", color="black", lw=1.0, label="best known / lower bound")
+    for ax, title in zip(
+        axes, ("time / best-known minimum time", "time / lower bound (the physical limit)")
+    ):
+        ax.axhline(1.0, color="grey", lw=0.8)
+        ax.set_ylabel(title)
+        ax.grid(alpha=0.3)
+        top = max(
+            np.nanmax(np.concatenate([v[1 if ax is axes[0] else 2] for v in data.values()])), 1.0
+        )
+        ax.set_ylim(0.9, 1.05 * top)
+    axes[1].set_xlabel("scenario (seed 0)")
+    axes[1].set_xlim(0, scenarios.max() + 1)
+    handles, labels = axes[1].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="upper center", ncol=5, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0, 1, 0.95))
+    fig.savefig(FIGURE, dpi=110)
+    plt.close(fig)
+
+
+def rewrite_page() -> None:
+    block = [BEGIN, *[line for seed in SEEDS for line in [*table(seed), ""]][:-1], END]
+    text = PAGE.read_text()
+    head, rest = text.split(BEGIN, 1)
+    _, tail = rest.split(END, 1)
+    PAGE.write_text(head + "\n".join(block) + tail)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--collect", nargs=2, metavar=("SEED", "DIR"), action="append")
+    parser.add_argument("--bounds", nargs=2, metavar=("SEED", "CSV"), action="append")
+    args = parser.parse_args()
+    for seed, path in args.bounds or []:
+        shutil.copyfile(path, DATA / f"bounds_seed{int(seed)}.csv")
+    for seed, folder in args.collect or []:
+        collect(int(seed), Path(folder))
+    figure()
+    rewrite_page()
+    for seed in SEEDS:
+        print("\n".join(table(seed)) + "\n")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,205 @@
+"""Both ends of the bracket for a batch of scenarios, cached per scenario.
+
+Each scenario's results are kept in ``<folder>/cache/`` as soon as they are known:
+``scenario-NNN-best.json`` (the best-known time and how it was found) with the winning
+trajectory in ``scenario-NNN-best.npz``, and ``scenario-NNN-lower.json`` (the lower
+bound). A cached result is used again when its key (the scenario's waypoints, payload,
+S floor, tolerance and the method's settings) matches, so an interrupted batch resumes
+where it stopped and a changed method recomputes only its own part.
+"""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import io
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ddwmmr.bounds.lower import budget_bound
+from ddwmmr.bounds.search import Settings, best_known
+from ddwmmr.errors import ParameterError
+from ddwmmr.model import Robot
+from ddwmmr.scenarios.generator import Scenario
+from ddwmmr.sim.result import json_safe, write_atomic
+
+#: Version of each method's results: a change invalidates the cached results of that part.
+LOWER_VERSION = "budget-1"
+BEST_VERSION = "multistart-1"
+#: Columns of bounds.csv.
+COLUMNS = ("scenario", "lower_bound_s", "best_known_s", "starts", "spread_s", "replay_ok")
+CACHE = "cache"
+
+
+@dataclasses.dataclass(frozen=True)
+class Job:
+    """One scenario to bracket (picklable)."""
+
+    scenario: Scenario
+    payload: float
+    settings: Settings
+    need_best: bool
+    need_lower: bool
+
+
+def keys(scenario: Scenario, payload: float, settings: Settings) -> dict[str, dict]:
+    """The cache keys of a scenario's two parts."""
+    common = {
+        "waypoints": [list(w) for w in scenario.waypoints],
+        "payload": payload,
+        "tolerance": settings.tolerance,
+    }
+    return {
+        "best": {**common, "version": BEST_VERSION, "settings": dataclasses.asdict(settings)},
+        "lower": {**common, "version": LOWER_VERSION},
+    }
+
+
+def cache_names(index: int) -> dict[str, str]:
+    """Cache file names (relative to the output folder) of scenario ``index`` (1-based)."""
+    stem = f"{CACHE}/scenario-{index:03d}"
+    return {
+        "best": f"{stem}-best.json",
+        "trajectory": f"{stem}-best.npz",
+        "lower": f"{stem}-lower.json",
+    }
+
+
+def read_cached(folder: Path, scenario: Scenario, payload: float, settings: Settings):
+    """The cached (best, lower) records of a scenario, each None if absent or stale."""
+    names = cache_names(scenario.index + 1)
+    wanted = keys(scenario, payload, settings)
+    out = {}
+    for part in ("best", "lower"):
+        path = folder / names[part]
+        try:
+            record = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            record = None
+        if not isinstance(record, dict) or record.get("key") != json_safe(wanted[part]):
+            record = None
+        out[part] = record
+    return out["best"], out["lower"]
+
+
+def solve(job: Job) -> dict[str, Any]:
+    """Run the parts a job needs (in a worker process); records and the trajectory."""
+    robot = Robot().with_payload(job.payload)
+    wanted = keys(job.scenario, job.payload, job.settings)
+    out: dict[str, Any] = {"index": job.scenario.index + 1}
+    if job.need_lower:
+        bound = budget_bound(
+            robot, job.scenario.waypoints, tolerance=job.settings.tolerance, cell=0.05, arcs=144
+        )
+        out["lower"] = {
+            "key": wanted["lower"],
+            "lower_bound_s": bound.value,
+            "cells": bound.cells,
+            "arcs": bound.arcs,
+            "wall_s": bound.wall_s,
+        }
+    if job.need_best:
+        found = best_known(robot, job.scenario, job.settings)
+        out["best"] = {"key": wanted["best"], **found.record()}
+        if found.solution is not None:
+            s = found.solution
+            out["trajectory"] = {
+                "times": s.times,
+                "states": s.states,
+                "inputs": s.inputs,
+                "legs": s.legs,
+            }
+    return out
+
+
+def store(folder: Path, result: dict[str, Any]) -> list[str]:
+    """Write a solved job's records into the cache; returns the names written."""
+    names = cache_names(result["index"])
+    written = []
+    for part in ("best", "lower"):
+        if part in result:
+            write_atomic(folder / names[part], json.dumps(json_safe(result[part]), indent=1) + "\n")
+            written.append(names[part])
+    if "trajectory" in result:
+        buffer = io.BytesIO()
+        np.savez(buffer, **result["trajectory"])
+        write_atomic(folder / names["trajectory"], buffer.getvalue())
+        written.append(names["trajectory"])
+    return written
+
+
+def row(index: int, best: dict | None, lower: dict | None) -> dict[str, Any]:
+    """One line of bounds.csv."""
+    best = best or {}
+    return {
+        "scenario": index,
+        "lower_bound_s": (lower or {}).get("lower_bound_s", math.nan),
+        "best_known_s": best.get("best_known_s", math.nan),
+        "starts": best.get("starts", 0),
+        "spread_s": best.get("spread_s", math.nan),
+        "replay_ok": bool(best.get("replay_ok", False)),
+    }
+
+
+def bounds_csv(rows: list[dict[str, Any]]) -> str:
+    """bounds.csv text: one row per scenario (times in s, floats in full precision)."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    for r in rows:
+        writer.writerow({k: (repr(float(v)) if isinstance(v, float) else v) for k, v in r.items()})
+    return buffer.getvalue()
+
+
+def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
+    """``{scenario: (lower_bound_s, best_known_s)}`` from a bounds.csv (1-based scenarios;
+    rows whose replay failed have no best-known time: NaN)."""
+    out = {}
+    with open(path, newline="", encoding="utf-8") as handle:
+        for r in csv.DictReader(handle):
+            best = float(r["best_known_s"]) if r["replay_ok"] == "True" else math.nan
+            out[int(r["scenario"])] = (float(r["lower_bound_s"]), best)
+    return out
+
+
+def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, tuple[float, float]]:
+    """:func:`read_bounds` of a bounds tool's output, refused (one-line
+    :class:`ParameterError`) when unreadable or made for another seed or payload (its
+    summary.json beside it says which)."""
+    path = Path(path)
+    try:
+        table = read_bounds(path)
+        summary = json.loads((path.parent / "summary.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError, KeyError) as exc:
+        raise ParameterError(f"bounds: cannot read {path} and its summary.json ({exc})") from None
+    if summary.get("seed") != seed or summary.get("payload") != payload:
+        raise ParameterError(
+            f"bounds: {path} is for seed {summary.get('seed')}, payload "
+            f"{summary.get('payload')} kg, not seed {seed}, payload {payload:g} kg"
+        )
+    return table
+
+
+def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """Means of both ends, of the bracket's width (best known / lower bound) and counts."""
+    lower = np.array([r["lower_bound_s"] for r in rows], dtype=float)
+    best = np.array([r["best_known_s"] if r["replay_ok"] else math.nan for r in rows], dtype=float)
+    both = np.isfinite(lower) & np.isfinite(best)
+    width = best[both] / lower[both]
+    spread = np.array([r["spread_s"] for r in rows], dtype=float)
+    return {
+        "scenarios": len(rows),
+        "replay_ok": int(sum(bool(r["replay_ok"]) for r in rows)),
+        "mean_lower_bound_s": float(np.nanmean(lower)) if np.isfinite(lower).any() else math.nan,
+        "mean_best_known_s": float(np.nanmean(best)) if np.isfinite(best).any() else math.nan,
+        "mean_width": float(width.mean()) if width.size else math.nan,
+        "max_width": float(width.max()) if width.size else math.nan,
+        "min_width": float(width.min()) if width.size else math.nan,
+        "mean_spread_s": float(np.nanmean(spread)) if np.isfinite(spread).any() else math.nan,
+        "lower_method": LOWER_VERSION,
+        "best_method": BEST_VERSION,
+    }

@@ -1,0 +1,254 @@
+"""The best-known minimum time of a scenario: a systematic multistart of the OCP.
+
+One scenario (:func:`best_known`):
+
+1. **screen** on a coarse grid (:data:`Settings.coarse` intervals per leg) from every start
+   of :func:`ddwmmr.bounds.starts.all_patterns` (each leg forwards or backwards: 32
+   starts on one elbow branch, the best of them on the other too), then, for the best
+   patterns, each leg's turn the long way round and the arm stretched ahead instead of
+   held; the controllers' own runs on the thesis plant (thesis controller, ``qp``,
+   ``mpc``); the straight-line starts of :func:`ddwmmr.mpc.min_time.solve_minimum_time`;
+   and a continuation for the best ones (solved first with ``S >= 1`` and a 5 cm
+   tolerance, then tightened);
+2. **refine** the best distinct screened optima on the fine grid (:data:`Settings.fine`);
+3. **certify** the best on a finer grid (:data:`Settings.final`) with a margin on the
+   waypoint tolerance and on S, and replay it open-loop on the thesis plant
+   (:mod:`ddwmmr.bounds.replay`); the next best is tried if a replay fails; a certified
+   solution is solved once more with smaller margins and kept if that replays too.
+
+The result is the replayed time: a trajectory the plant itself drives, so an upper bound on
+the true minimum. ``spread_s`` is the range of the screened local optima.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from ddwmmr.behaviours.objective import default_pose
+from ddwmmr.bounds.replay import replay
+from ddwmmr.bounds.starts import all_patterns, controller_guess, pattern_guess, turn_variants
+from ddwmmr.model import Robot
+from ddwmmr.mpc.min_time import Guess, MinimumTime, MinimumTimeProblem
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How hard :func:`best_known` looks.
+
+    Attributes:
+        coarse, fine, final: intervals per leg of the screening, refining and certifying
+            grids.
+        refine: distinct screened optima refined; elbow_top, turn_top, arm_top,
+            continuation_top: best patterns also tried on the other elbow branch, with
+            turn variants, with the arm stretched ahead, continued.
+        controllers: controllers whose runs are starts.
+        stability_min: the S floor; tolerance: waypoint radius (m); margin_s, margin_m:
+            margins on both in the certifying solve (the replay must hold the floor and
+            reach within the tolerance); tight_margin_s, tight_margin_m: the smaller
+            margins tried next from a certified solution (kept if it replays too).
+    """
+
+    coarse: int = 8
+    fine: int = 24
+    final: int = 60
+    refine: int = 4
+    elbow_top: int = 6
+    turn_top: int = 2
+    arm_top: int = 2
+    continuation_top: int = 2
+    controllers: tuple[str, ...] = ("thesis", "qp", "mpc")
+    stability_min: float = 1.25
+    tolerance: float = 0.01
+    margin_s: float = 0.0005
+    margin_m: float = 0.001
+    tight_margin_s: float = 0.0001
+    tight_margin_m: float = 0.0003
+
+
+#: A lighter search (about half the CPU): fewer starts on a coarser screening grid, the
+#: mpc's run the only controller start; still certified on 60 intervals.
+QUICK = Settings(
+    coarse=6,
+    fine=16,
+    final=60,
+    refine=2,
+    elbow_top=2,
+    turn_top=1,
+    arm_top=1,
+    continuation_top=1,
+    controllers=("mpc",),
+)
+
+
+@dataclass
+class Found:
+    """The best-known time of one scenario and how it was found."""
+
+    best_s: float
+    replay_ok: bool
+    start: str
+    starts: int
+    spread_s: float
+    screened: dict[str, float] = field(default_factory=dict)
+    refined: dict[str, float] = field(default_factory=dict)
+    ocp_s: float = math.nan
+    min_stability: float = math.nan
+    wall_s: float = 0.0
+    solution: MinimumTime | None = None
+
+    def record(self) -> dict:
+        """JSON-ready summary (no trajectory)."""
+        return {
+            "best_known_s": self.best_s,
+            "replay_ok": self.replay_ok,
+            "start": self.start,
+            "starts": self.starts,
+            "spread_s": self.spread_s,
+            "ocp_s": self.ocp_s,
+            "min_stability": self.min_stability,
+            "wall_s": self.wall_s,
+            "screened": self.screened,
+            "refined": self.refined,
+        }
+
+
+def start_state(robot: Robot) -> np.ndarray:
+    """The scenarios' start: at the origin heading +x, at rest, in the default pose."""
+    return np.array([0.0, 0.0, 0.0, *default_pose(robot), 0.0, 0.0])
+
+
+def best_known(
+    robot: Robot,
+    scenario,
+    settings: Settings = Settings(),
+    log: Callable[[str], None] | None = None,
+) -> Found:
+    """The best-known minimum time (s) of ``scenario`` (module docstring)."""
+    began = time.perf_counter()
+    say = log or (lambda message: None)
+    waypoints = list(scenario.waypoints)
+    start = start_state(robot)
+    s = settings
+
+    def problem(intervals: int, margin_s: float = 0.0, margin_m: float = 0.0):
+        return MinimumTimeProblem(
+            robot,
+            waypoints,
+            start,
+            intervals_per_leg=intervals,
+            stability_min=s.stability_min + margin_s,
+            tolerance=s.tolerance - margin_m,
+        )
+
+    coarse = problem(s.coarse)
+    screened: dict[str, MinimumTime] = {}
+
+    def screen(label: str, guess: Guess, lbg=None, ubg=None) -> None:
+        result = coarse.solve(guess, label, lbg, ubg)
+        if result.success:
+            screened[label] = result
+
+    patterns = [p for p in all_patterns(len(waypoints)) if p.elbow > 0]
+    for pattern in patterns:
+        screen(pattern.label, pattern_guess(robot, start, waypoints, pattern))
+    ranked = _ranked_patterns(screened, patterns)
+    other_elbow = [replace(p, elbow=-p.elbow) for p in ranked[: s.elbow_top]]
+    for pattern in other_elbow:
+        screen(pattern.label, pattern_guess(robot, start, waypoints, pattern))
+    ranked = _ranked_patterns(screened, patterns + other_elbow)
+    for pattern in ranked[: s.turn_top]:
+        for variant in turn_variants(pattern):
+            screen(variant.label, pattern_guess(robot, start, waypoints, variant))
+    for pattern in ranked[: s.arm_top]:
+        ahead = replace(pattern, arm="ahead")
+        screen(ahead.label, pattern_guess(robot, start, waypoints, ahead))
+    for name in s.controllers:
+        guess = controller_guess(scenario, name, payload=robot.payload)
+        if guess is not None:
+            screen(f"controller-{name}", guess)
+    for reverse in ("never", "turn"):
+        for elbow in (1.0, -1.0):
+            label = f"straight-{reverse}-{'up' if elbow > 0 else 'down'}"
+            screen(label, coarse.straight_line_guess(reverse=reverse, elbow=elbow))
+    loose = coarse.row_bounds(stability_min=1.0, tolerance=0.05)
+    for label in _best(screened, s.continuation_top):
+        relaxed = coarse.solve(screened[label].as_guess(), label, *loose)
+        if relaxed.success:
+            screen(f"continued-{label}", relaxed.as_guess())
+    starts = len(patterns) + len(other_elbow) + min(s.turn_top, len(ranked)) * len(waypoints)
+    starts += min(s.arm_top, len(ranked)) + len(s.controllers) + 4 + s.continuation_top
+    say(f"screened {len(screened)} of {starts} starts")
+
+    fine = problem(s.fine)
+    refined: dict[str, MinimumTime] = {}
+    for label in _distinct(screened, s.refine):
+        result = fine.solve(screened[label].as_guess(), label)
+        if result.success:
+            refined[label] = result
+    best_refined = min((r.total for r in refined.values()), default=math.inf)
+    say(f"refined {len(refined)}: best {best_refined:.3f} s")
+
+    final = problem(s.final, s.margin_s, s.margin_m)
+    found = None
+    for label in _best(refined, len(refined)):
+        certified = final.solve(refined[label].as_guess(), label)
+        if not certified.success:
+            continue
+        check = replay(robot, certified, waypoints, s.stability_min, s.tolerance)
+        say(f"certify {label}: {certified.total:.3f} s, replay {check.ok} {check.time_s:.3f} s")
+        if check.ok:
+            found = (certified, check)
+            break
+    if found is not None:
+        tight = problem(s.final, s.tight_margin_s, s.tight_margin_m)
+        closer = tight.solve(found[0].as_guess(), found[0].start)
+        if closer.success:
+            check = replay(robot, closer, waypoints, s.stability_min, s.tolerance)
+            say(f"tighter margins: {closer.total:.3f} s, replay {check.ok} {check.time_s:.3f} s")
+            if check.ok and check.time_s < found[1].time_s:
+                found = (closer, check)
+    times = [r.total for r in screened.values()]
+    spread = max(times) - min(times) if times else math.nan
+    base = Found(
+        math.inf,
+        False,
+        "",
+        starts,
+        spread,
+        {k: v.total for k, v in screened.items()},
+        {k: v.total for k, v in refined.items()},
+    )
+    if found is not None:
+        certified, check = found
+        base.best_s, base.replay_ok, base.start = check.time_s, True, certified.start
+        base.ocp_s, base.min_stability = certified.total, check.min_stability
+        base.solution = certified
+    base.wall_s = time.perf_counter() - began
+    return base
+
+
+def _best(results: dict[str, MinimumTime], count: int) -> list[str]:
+    return sorted(results, key=lambda k: results[k].total)[:count]
+
+
+def _distinct(results: dict[str, MinimumTime], count: int, gap: float = 1e-3) -> list[str]:
+    """The ``count`` best labels whose times differ by more than ``gap`` (s) from each
+    other (one per local optimum)."""
+    chosen: list[str] = []
+    for label in _best(results, len(results)):
+        if all(abs(results[label].total - results[c].total) > gap for c in chosen):
+            chosen.append(label)
+        if len(chosen) == count:
+            break
+    return chosen
+
+
+def _ranked_patterns(results: dict[str, MinimumTime], patterns) -> list:
+    """Patterns in the order of their screened times (converged ones only)."""
+    by_label = {p.label: p for p in patterns}
+    return [by_label[k] for k in _best(results, len(results)) if k in by_label]

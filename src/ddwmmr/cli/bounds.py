@@ -1,0 +1,260 @@
+"""``python -m ddwmmr.bounds``: the physical limit of the thesis scenarios, bracketed.
+
+Examples::
+
+    python -m ddwmmr.bounds --seed 0 --scenarios 1-100 --jobs 2 --out runs/bounds-seed0
+    python -m ddwmmr.bounds --scenarios 1,3,7-9 --out runs/bounds-few
+    python -m ddwmmr.scenarios --controller mpc --bounds runs/bounds-seed0/bounds.csv
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime as dt
+import json
+import math
+import sys
+import time
+from collections.abc import Sequence
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, replace
+from pathlib import Path
+
+from ddwmmr import provenance
+from ddwmmr.bounds import batch
+from ddwmmr.bounds.search import QUICK, Settings
+from ddwmmr.cli.common import ArgumentParser, add_force_argument, output_folder, run_main
+from ddwmmr.errors import (
+    MASS_RANGE_KG,
+    MAX_JOBS,
+    MAX_SCENARIOS,
+    ParameterError,
+    check_int_at_least,
+    check_nonnegative,
+    check_range,
+)
+from ddwmmr.model.stability import STABILITY_CAP
+from ddwmmr.outputs import check_output_folder, first_free, inspect, list_in_manifest
+from ddwmmr.progress import ProgressBar
+from ddwmmr.scenarios.executors import default_jobs
+from ddwmmr.scenarios.generator import generate
+from ddwmmr.sim.result import json_safe, write_atomic
+
+PROG = "python -m ddwmmr.bounds"
+TOOL = "bounds"
+MARKER = "summary.json"
+
+DESCRIPTION = """\
+Bracket the minimum time of the thesis scenarios (5 waypoints, 0.01 m, the thesis plant's
+force limits, S >= 1.25, start at rest in the default pose): a best-known time, a
+systematic multistart of the minimum-time OCP replayed open-loop on the thesis plant, and a
+true lower bound, a relaxation solved to global optimality (docs/mpc.md, "The physical
+limit, bracketed"). Writes bounds.csv (scenario, lower_bound_s, best_known_s, starts,
+spread_s, replay_ok) and summary.json into --out, and prints the means. Results are cached
+per scenario in --out/cache as they come: an interrupted run started again with the same
+--out resumes. A scenario takes about 1-3 minutes on one core."""
+
+EPILOG = """\
+Bad input prints one line and exits with status 2, leaving no output behind. The scenario
+tool compares a controller with both ends: python -m ddwmmr.scenarios ... --bounds
+DIR/bounds.csv."""
+
+
+def build_parser() -> ArgumentParser:
+    parser = ArgumentParser(
+        prog=PROG,
+        description=DESCRIPTION,
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    parser.add_argument("--seed", type=int, default=0, help="generator seed (default: 0)")
+    parser.add_argument(
+        "--scenarios",
+        default="1-100",
+        metavar="LIST",
+        help="scenarios, numbered from 1: '1-100', '7', '1,3,7-9' (default: 1-100)",
+    )
+    parser.add_argument(
+        "--jobs", type=int, metavar="N", help="worker processes (default: the CPUs available)"
+    )
+    parser.add_argument(
+        "--out",
+        metavar="DIR",
+        help="output folder (default: runs/bounds-<time>/); an earlier bounds run's folder "
+        "is resumed from its cache and replaced",
+    )
+    add_force_argument(parser)
+    parser.add_argument(
+        "--payload", type=float, default=3.0, metavar="KG", help="payload in kg (default: 3.0)"
+    )
+    parser.add_argument(
+        "--stability-min",
+        type=float,
+        default=1.25,
+        metavar="S",
+        help="floor on S of the best-known trajectories, in [1, 10) (default: 1.25; the "
+        "lower bound holds for any floor)",
+    )
+    parser.add_argument(
+        "--quick",
+        action="store_true",
+        help="a lighter multistart (about half the CPU: fewer starts, a coarser screening "
+        "grid, the mpc's run the only controller start)",
+    )
+    parser.add_argument(
+        "--lower-only",
+        action="store_true",
+        help="compute only the lower bounds (seconds per scenario); best-known times are "
+        "taken from the cache where there (same settings), else left empty",
+    )
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    return parser
+
+
+def parse_scenarios(text: str) -> list[int]:
+    """'1-100', '7', '1,3,7-9' -> sorted distinct scenario numbers (1-based)."""
+    chosen: set[int] = set()
+    for part in str(text).split(","):
+        part = part.strip()
+        try:
+            if "-" in part:
+                first, last = (int(v) for v in part.split("-", 1))
+            else:
+                first = last = int(part)
+        except ValueError:
+            raise ParameterError(
+                f"scenarios must be numbers or ranges like 1-100 or 1,3,7-9 (got {text!r})"
+            ) from None
+        if not 1 <= first <= last <= MAX_SCENARIOS:
+            raise ParameterError(
+                f"scenarios must lie in 1-{MAX_SCENARIOS} with first <= last (got {part!r})"
+            )
+        chosen.update(range(first, last + 1))
+    return sorted(chosen)
+
+
+def _settings(args: argparse.Namespace) -> Settings:
+    check_range("payload", args.payload, *MASS_RANGE_KG, "kg")
+    floor = args.stability_min
+    if not (math.isfinite(floor) and 1.0 <= floor < STABILITY_CAP):
+        raise ParameterError(f"stability-min must be in [1, {STABILITY_CAP:g}) (got {floor:g})")
+    base = QUICK if args.quick else Settings()
+    return replace(base, stability_min=floor)
+
+
+def _main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    check_nonnegative("seed", args.seed)
+    numbers = parse_scenarios(args.scenarios)
+    jobs = (
+        default_jobs() if args.jobs is None else check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
+    )
+    settings = _settings(args)
+    from ddwmmr.scenarios.protocol import RunConfig
+
+    RunConfig(payload=args.payload)  # the payload's own checks, before any output
+    if args.out is None:
+        stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+        out = first_free(Path("runs") / f"bounds-{stamp}", folder=True)
+    else:
+        out = Path(args.out)
+    names = (MARKER, "bounds.csv")
+    target = check_output_folder(out, TOOL, args.force, names)
+    if target.exists() and inspect(target, TOOL).kind == "foreign" and args.force:
+        raise ParameterError(
+            f"out: {out} holds files no bounds run wrote; the cache needs a folder of its own"
+        )
+    scenarios = {
+        s.index + 1: s for s in generate(max(numbers), args.seed) if s.index + 1 in numbers
+    }
+    began = time.perf_counter()
+    records = _solve_all(
+        target, scenarios, args.payload, settings, jobs, not args.no_progress, args.lower_only
+    )
+    rows = [batch.row(i, *records[i]) for i in numbers]
+    summary = batch.summarize(rows)
+    summary.update(
+        seed=args.seed,
+        payload=args.payload,
+        settings=asdict(settings),
+        wall_time_s=time.perf_counter() - began,
+        run=_record(args, settings, jobs),
+    )
+    with output_folder(target, TOOL, args.force) as staging:
+        for index in numbers:
+            for name in batch.cache_names(index).values():
+                if (target / name).exists():
+                    write_atomic(staging / name, (target / name).read_bytes())
+        write_atomic(staging / "bounds.csv", batch.bounds_csv(rows))
+        write_atomic(staging / MARKER, json.dumps(json_safe(summary), indent=2) + "\n")
+    print(
+        f"{len(rows)} scenarios: lower bound {summary['mean_lower_bound_s']:.2f} s, best known "
+        f"{summary['mean_best_known_s']:.2f} s (replayed {summary['replay_ok']}), bracket "
+        f"width {summary['mean_width']:.3f} (mean of best known / lower bound)"
+    )
+    print(f"wrote {target}", file=sys.stderr)
+    return 0
+
+
+def _solve_all(
+    folder: Path,
+    scenarios: dict,
+    payload: float,
+    settings: Settings,
+    jobs: int,
+    progress: bool,
+    lower_only: bool = False,
+):
+    """Every scenario's (best, lower) records: cached ones read, the others solved (in
+    ``jobs`` processes) and cached as they finish (``lower_only``: no best-known search)."""
+    records, pending = {}, []
+    for index, scenario in scenarios.items():
+        best, lower = batch.read_cached(folder, scenario, payload, settings)
+        records[index] = (best, lower)
+        need_best = best is None and not lower_only
+        if need_best or lower is None:
+            pending.append(batch.Job(scenario, payload, settings, need_best, lower is None))
+    with ProgressBar(len(scenarios), "bounds: scenarios", enabled=progress, unit="scenario") as bar:
+        bar.advance(len(scenarios) - len(pending))
+        if jobs == 1 or len(pending) <= 1:
+            for job in pending:
+                _keep(folder, records, batch.solve(job))
+                bar.advance()
+        else:
+            with ProcessPoolExecutor(max_workers=min(jobs, len(pending))) as pool:
+                futures = [pool.submit(batch.solve, job) for job in pending]
+                for future in as_completed(futures):
+                    _keep(folder, records, future.result())
+                    bar.advance()
+    return records
+
+
+def _keep(folder: Path, records: dict, result: dict) -> None:
+    """Cache a solved scenario (listed in the folder's manifest: the folder stays this
+    tool's own, so a later run resumes from it)."""
+    written = batch.store(folder, result)
+    list_in_manifest(folder, TOOL, written)
+    index = result["index"]
+    best, lower = records[index]
+    records[index] = (result.get("best", best), result.get("lower", lower))
+
+
+def _record(args: argparse.Namespace, settings: Settings, jobs: int) -> dict:
+    record = provenance.header(TOOL, PROG, args.argv if hasattr(args, "argv") else None)
+    record.update(
+        seed=args.seed,
+        scenarios=args.scenarios,
+        payload=args.payload,
+        settings=provenance.encode(settings),
+        jobs=jobs,
+    )
+    return record
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; bad input prints one line on stderr and returns 2."""
+    return run_main(_main, argv)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

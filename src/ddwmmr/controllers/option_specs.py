@@ -1,0 +1,277 @@
+"""Method options as text: what each registered method's options are, and how a text
+``NAME=VALUE`` becomes an option value (the simulator's fields, every tool's
+``--option NAME=VALUE``).
+
+Nothing here knows a method by name: :func:`option_specs` inspects the constructor of
+the class registered for the method, so a newly registered method shows up with its
+options. A controller class may declare the values of its closed-set options in
+``option_choices`` (option name -> function returning the values; the qp's installed
+solvers, the mpc's solvers). The few option *names* below only add presentation (a list
+of choices, a unit) to options that any method may have.
+"""
+
+from __future__ import annotations
+
+import inspect
+import math
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from functools import cache
+from typing import Any
+
+from ddwmmr.controllers.base import controller_class as registered_class
+from ddwmmr.controllers.base import method_parameters
+from ddwmmr.errors import ParameterError, did_you_mean
+
+__all__ = [
+    "CHOICES",
+    "UNITS",
+    "OptionSpec",
+    "format_choice",
+    "option_names",
+    "option_spec",
+    "option_specs",
+    "parse_option",
+    "parse_options",
+]
+
+
+def _aux_rows() -> list[str]:
+    from ddwmmr.model.kinematics import AUX_ROWS
+
+    return list(AUX_ROWS)
+
+
+#: Options with a closed set of values whatever the method, shown as a button cycling
+#: through them (a controller's own ``option_choices`` come first).
+CHOICES: dict[str, Callable[[], list[str]]] = {"aux": _aux_rows}
+
+#: Units shown next to known option names (SI; "-" for dimensionless ones).
+UNITS = {
+    "tau": "s",
+    "dt": "s",
+    "stability_min": "-",
+    "stability_gain": "1/s",
+    "manipulability_weight": "-",
+    "obstacles": "TOML file",
+    "obstacle_margin": "m",
+    "singularity_margin": "rad",
+    "singularity_threshold": "-",
+    "max_speed": "m/s",
+    "max_base_speed": "m/s",
+    "max_yaw_rate": "rad/s",
+    "max_acceleration": "m/s2",
+    "max_yaw_acceleration": "rad/s2",
+    "speed_budget": "m/s, rad/s",
+    "reference_step": "s",
+    "horizon": "s",  # the mpc's prediction horizon
+    "first_interval": "s",
+    "arm_time_constant": "s",
+    "reach_speed": "m/s",
+    "huber": "m",
+    "wheel_force_limit": "N",
+    "joint_acceleration_limit": "rad/s2",
+    "brake_slack": "m",
+}
+
+
+@dataclass(frozen=True)
+class OptionSpec:
+    """One constructor option of a method, as the app edits it.
+
+    Attributes:
+        name: keyword of the constructor.
+        default: its default value.
+        kind: ``"choice"`` (a button cycling through ``choices``), ``"number"`` (a text
+            field holding one number, or several when ``several`` is set) or ``"text"``
+            (a text field, e.g. a file path).
+        choices: the values of a ``"choice"`` option.
+        optional: a blank field means None (the method's automatic value).
+        several: the option accepts a sequence of numbers (e.g. one tau per channel).
+        unit: unit shown in the label ("" if unknown).
+    """
+
+    name: str
+    default: Any
+    kind: str
+    choices: tuple[Any, ...] = ()
+    optional: bool = False
+    several: bool = False
+    unit: str = ""
+
+    @property
+    def label(self) -> str:
+        """Field label: the name, with the unit when known."""
+        return f"{self.name} ({self.unit})" if self.unit else self.name
+
+    def format(self, value: Any) -> str:
+        """Text shown for ``value`` (a field's content or a button's label part)."""
+        if self.kind == "choice":
+            return format_choice(value)
+        if value is None:
+            return ""
+        if isinstance(value, list | tuple):
+            return " ".join(_format_number(v) for v in value)
+        if isinstance(value, float | int) and not isinstance(value, bool):
+            return _format_number(value)
+        return str(value)
+
+    def parse(self, text: str) -> Any:
+        """The option value a field's ``text`` stands for; bad text raises ParameterError."""
+        text = text.strip()
+        if self.kind == "choice":
+            for choice in self.choices:
+                if text == format_choice(choice):
+                    return choice
+            allowed = ", ".join(format_choice(c) for c in self.choices)
+            raise ParameterError(f"{self.name} must be one of {allowed} (got {text!r})")
+        if not text:
+            if self.optional:
+                return None
+            if self.kind == "text":
+                return self.default
+            raise ParameterError(f"{self.name} needs a number")
+        if self.kind == "text":
+            return text
+        return self._parse_numbers(text)
+
+    def _parse_numbers(self, text: str) -> float | int | tuple[float, ...]:
+        try:
+            numbers = [float(part) for part in re.split(r"[\s,]+", text) if part]
+        except ValueError:
+            raise ParameterError(f"{self.name} must be a number (got {text!r})") from None
+        if any(math.isnan(v) for v in numbers):
+            raise ParameterError(f"{self.name} must be a number (got {text!r})")
+        if len(numbers) > 1:
+            if not self.several:
+                raise ParameterError(f"{self.name} takes one number (got {text!r})")
+            return tuple(numbers)
+        (value,) = numbers
+        if isinstance(self.default, int) and not isinstance(self.default, bool):
+            if not value.is_integer():
+                raise ParameterError(f"{self.name} must be an integer (got {text!r})")
+            return int(value)
+        return value
+
+
+def format_choice(value: Any) -> str:
+    """Button text of a choice: on/off for booleans, auto for None."""
+    if value is None:
+        return "auto"
+    if isinstance(value, bool):
+        return "on" if value else "off"
+    return str(value)
+
+
+def _format_number(value: float) -> str:
+    return f"{value:g}"
+
+
+@cache
+def option_specs(method: str) -> tuple[OptionSpec, ...]:
+    """Editable options of a registered method, in :func:`method_parameters` order.
+
+    The options are those ``make_controller`` accepts (:func:`ddwmmr.controllers.
+    method_options`: the keyword parameters of the registered class's ``__init__`` and its
+    parents', except ``robot``). Options whose type cannot be typed into a field (e.g.
+    lists of user task objects, a mapping of another controller's options) are left out:
+    the API alone sets them.
+    """
+    return tuple(_specs(method, _choices(method)))
+
+
+def _choices(method: str) -> dict[str, Callable[[], list[Any]]]:
+    """The closed-set options of ``method``: :data:`CHOICES`, then the class's own."""
+    return {**CHOICES, **getattr(registered_class(method), "option_choices", {})}
+
+
+def _specs(method: str, choices: dict[str, Callable[[], list[Any]]]) -> list[OptionSpec]:
+    specs = []
+    for parameter in method_parameters(method).values():
+        spec = option_spec(parameter.name, parameter.default, _annotation_text(parameter), choices)
+        if spec is not None:
+            specs.append(spec)
+    return specs
+
+
+def option_spec(
+    name: str,
+    default: Any,
+    annotation: str,
+    choices: dict[str, Callable[[], list[Any]]] | None = None,
+) -> OptionSpec | None:
+    """The :class:`OptionSpec` of one constructor parameter, or None if it is not editable.
+
+    ``annotation`` is the parameter's annotation as text (``"float | None"``...);
+    ``choices`` maps closed-set option names to their values (default :data:`CHOICES`).
+    Mappings (e.g. another controller's options) cannot be typed into a field: None.
+    """
+    choices = CHOICES if choices is None else choices
+    if default is inspect.Parameter.empty:
+        default = None
+    words = set(re.findall(r"[A-Za-z_]+", annotation))
+    optional = default is None or "None" in words
+    unit = UNITS.get(name, "")
+    if name in choices:
+        values = tuple(choices[name]())
+        if default not in values and default is not None:
+            values = (default, *values)
+        return OptionSpec(name, default, "choice", values, optional, unit=unit)
+    if words & {"dict", "Mapping"} or isinstance(default, dict):
+        return None
+    if isinstance(default, bool) or words == {"bool"} or words == {"bool", "None"}:
+        choices = (None, True, False) if optional else (True, False)
+        return OptionSpec(name, default, "choice", choices, optional, unit=unit)
+    numeric = isinstance(default, int | float) or (default is None and words & {"float", "int"})
+    if numeric and not words & {"str", "Path"}:
+        several = bool(words & {"Sequence", "tuple", "list"})
+        return OptionSpec(name, default, "number", (), optional, several, unit)
+    if words & {"str", "Path"} or isinstance(default, str):
+        return OptionSpec(name, default, "text", (), optional, unit=unit)
+    return None
+
+
+def _annotation_text(parameter: inspect.Parameter) -> str:
+    annotation = parameter.annotation
+    if annotation is inspect.Parameter.empty:
+        return ""
+    return annotation if isinstance(annotation, str) else inspect.formatannotation(annotation)
+
+
+def option_names(method: str) -> tuple[str, ...]:
+    """The names of :func:`option_specs` of ``method``, without listing any choice's values
+    (no solver is imported): what ``--help`` lists."""
+    unlisted = {name: list for name in _choices(method)}
+    return tuple(spec.name for spec in _specs(method, unlisted))
+
+
+def parse_option(method: str, text: str, what: str = "option") -> tuple[str, Any]:
+    """``NAME=VALUE`` -> (name, value) for ``method``, parsed as the simulator's field
+    for that option parses it. A text without ``=`` or a name the method does not take (the
+    message lists the names it takes, and the closest one) is a one-line
+    :class:`ParameterError` starting with ``what`` (the command-line option); a bad value
+    one naming the option."""
+    name, sep, value = text.partition("=")
+    name = name.strip()
+    if not sep or not name:
+        raise ParameterError(f"{what} must be NAME=VALUE (got {text!r})")
+    specs = {spec.name: spec for spec in option_specs(method)}
+    if name not in specs:
+        known = ", ".join(specs) or "none"
+        raise ParameterError(
+            f"{what}: {method} has no option {name!r}{did_you_mean(name, specs)} (options: {known})"
+        )
+    return name, specs[name].parse(value)
+
+
+def parse_options(method: str, texts: Sequence[str] | None, what: str = "option") -> dict:
+    """``{name: value}`` of several ``NAME=VALUE`` texts for ``method`` (see
+    :func:`parse_option`); a name given twice is refused."""
+    options: dict[str, Any] = {}
+    for text in texts or ():
+        name, value = parse_option(method, text, what)
+        if name in options:
+            raise ParameterError(f"{what}: {name} given twice (got {text!r})")
+        options[name] = value
+    return options

@@ -1,0 +1,192 @@
+"""Whether a run tracked its trajectory: one verdict, computed from a run's summary.
+
+Every tool reports it the same way (``track``'s table, ``compare``'s console summary and
+report, the simulator's summary line, :attr:`SimulationResult.summary`): the summary keys
+
+* ``verdict``: ``"tracked"``, or ``"did not track: <what went wrong>; likely cause:
+  <why> (see docs/...)"``;
+* ``verdict_reasons``: the machine-readable codes of what went wrong (an empty list when
+  it tracked), each one of :data:`REASONS`.
+
+A run did not track when any of these holds (thresholds documented in docs/cli.md,
+"Verdict"):
+
+* ``diverged``: the plant's state blew up (``diverged`` in the summary);
+* ``tipped_over``: a physics plant recorded the robot tipping over;
+* ``tipped_at_start``: the robot had already tipped over in the start pose (static
+  S <= 1, ``start_tipped``; the command-line tools refuse such a run, the API warns);
+* ``singular_most_of_run``: more than :data:`MOST_OF_RUN` of the steps were damped at the
+  shoulder singularity (``singular_steps``);
+* ``saturated_most_of_run``: more than :data:`MOST_OF_RUN` of the steps had commands
+  clipped at a rate limit (``saturated_steps``);
+* ``final_error_above_limit`` / ``rms_error_above_limit``: the final (settled) or the RMS
+  end-effector position error exceeds :func:`error_limit`: :data:`ERROR_LIMIT_M`, or
+  :data:`OFFSET_FACTOR` times the run's initial offset if that is larger (an open-loop
+  method keeps its initial offset by design, and tracks with it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+__all__ = [
+    "ERROR_LIMIT_M",
+    "MOST_OF_RUN",
+    "OFFSET_FACTOR",
+    "REASONS",
+    "TRACKED",
+    "error_limit",
+    "explain",
+    "short_verdict",
+    "verdict",
+]
+
+#: The verdict of a run that tracked.
+TRACKED = "tracked"
+#: Share of the steps above which singular (damped) or saturated steps mean the run did
+#: not track: "most of the run".
+MOST_OF_RUN = 0.5
+#: Share of singular steps above which the singularity is named as the likely cause of a
+#: failure, even when they are not most of the run (ap on the rectangle: 990 of 2000).
+SINGULAR_CAUSE = 0.25
+#: End-effector position error (m) above which a run did not track (final or RMS)...
+ERROR_LIMIT_M = 0.05
+#: ... unless the initial offset times this is larger: the limit an open-loop method,
+#: which keeps the initial offset (docs/comparing.md), stays within while it tracks.
+OFFSET_FACTOR = 2.0
+
+#: Reason code -> what it says in the verdict.
+REASONS = {
+    "diverged": "the plant diverged",
+    "tipped_over": "the robot tipped over (physics)",
+    "tipped_at_start": "the robot tips over in its start pose (S = {start_stability:.3g})",
+    "singular_most_of_run": "singular (damped) {singular_steps} of {steps} steps",
+    "saturated_most_of_run": "saturated {saturated_steps} of {steps} steps",
+    "final_error_above_limit": "final error {final_mm:.4g} mm (limit {limit_mm:.4g} mm)",
+    "rms_error_above_limit": "RMS error {rms_mm:.4g} mm (limit {limit_mm:.4g} mm)",
+}
+
+SLIDES_ROW = (
+    "the auxiliary row th1dot + th2dot = 0 (aux sum, the slides' setting) stops the base "
+    "turning where the desired orientation is constant and drags the shoulder into "
+    "cos th1 = 0; aux shoulder (the default) avoids it "
+    """(see docs/comparing.md, "The slides' settings and ours")"""
+)
+SINGULAR_DRIFT = (
+    "the resolution drives the shoulder into its singularity cos th1 = 0 (pi and ap do on "
+    """these trajectories; see docs/comparing.md, "Does the slides' ranking hold?")"""
+)
+FOLDED_ARM = (
+    "the arm folded to a joint limit (min manipulability 0): a resolution that only "
+    "integrates Xd_dot (ats, clrrmc-cs) loses the orientation steps at corners "
+    """(see docs/comparing.md, "Does the slides' ranking hold?")"""
+)
+SATURATION = (
+    "the commands asked for more than the wheel and joint rate limits allow: a larger "
+    'tau, a slower trajectory or a smaller dt (see docs/comparing.md, "Studies")'
+)
+NO_CONVERGENCE = (
+    "the error did not converge: an open-loop method (pi, ats, ap) never removes it; for "
+    "a closed-loop one check tau, dt and the integrator "
+    '(see docs/comparing.md, "Studies")'
+)
+DIVERGED = (
+    'the step is too large for the plant or a command was unbounded (see docs/api.md, "Simulation")'
+)
+TIPPED = (
+    "the payload or the accelerations put the centre of pressure outside the wheels: a "
+    "lighter payload, another start pose or a stability floor (stability_min; see "
+    'docs/physics.md, "Tip-over from the contact forces")'
+)
+
+
+def error_limit(summary: Mapping[str, Any]) -> float:
+    """The position-error limit (m) of the run ``summary`` describes:
+    max(:data:`ERROR_LIMIT_M`, :data:`OFFSET_FACTOR` x ``initial_offset_m``)."""
+    offset = summary.get("initial_offset_m") or 0.0
+    return max(ERROR_LIMIT_M, OFFSET_FACTOR * float(offset))
+
+
+def reasons(summary: Mapping[str, Any]) -> list[str]:
+    """The codes (keys of :data:`REASONS`) of what went wrong in the run, in that order."""
+    found = []
+    if summary.get("diverged"):
+        found.append("diverged")
+    if summary.get("tipped"):
+        found.append("tipped_over")
+    if summary.get("start_tipped"):
+        found.append("tipped_at_start")
+    steps = summary.get("steps") or 0
+    if steps and summary.get("singular_steps", 0) > MOST_OF_RUN * steps:
+        found.append("singular_most_of_run")
+    if steps and summary.get("saturated_steps", 0) > MOST_OF_RUN * steps:
+        found.append("saturated_most_of_run")
+    limit = error_limit(summary)
+    if _above(summary.get("final_position_error_m"), limit):
+        found.append("final_error_above_limit")
+    if _above(summary.get("rms_position_error_m"), limit):
+        found.append("rms_error_above_limit")
+    return found
+
+
+def _above(value: Any, limit: float) -> bool:
+    """``value`` exceeds ``limit``; NaN (a run that blew up) counts as above."""
+    if value is None:
+        return False
+    value = float(value)
+    return not value <= limit
+
+
+def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
+    """The most likely cause of the failures ``found`` (reason codes), from the summary."""
+    if "diverged" in found:
+        return DIVERGED
+    if "tipped_over" in found or "tipped_at_start" in found:
+        return TIPPED
+    steps = summary.get("steps") or 0
+    if steps and summary.get("singular_steps", 0) > SINGULAR_CAUSE * steps:
+        return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
+    min_manipulability = summary.get("min_manipulability")
+    if min_manipulability is not None and float(min_manipulability) < 1e-6:
+        return FOLDED_ARM
+    if "saturated_most_of_run" in found:
+        return SATURATION
+    return NO_CONVERGENCE
+
+
+def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
+    """``(codes, what, cause)`` of a run's ``summary``: the reason codes, what went wrong
+    in words and its likely cause (both ``""`` when the run tracked)."""
+    found = reasons(summary)
+    if not found:
+        return found, "", ""
+    values = {
+        "steps": summary.get("steps"),
+        "singular_steps": summary.get("singular_steps"),
+        "saturated_steps": summary.get("saturated_steps"),
+        "final_mm": 1000.0 * float(summary.get("final_position_error_m") or 0.0),
+        "rms_mm": 1000.0 * float(summary.get("rms_position_error_m") or 0.0),
+        "limit_mm": 1000.0 * error_limit(summary),
+        "start_stability": summary.get("start_stability", float("nan")),
+    }
+    what = ", ".join(REASONS[code].format(**values) for code in found)
+    return found, what, likely_cause(summary, found)
+
+
+def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
+    """The verdict keys of a run's ``summary`` (the keys :func:`ddwmmr.simulate` writes):
+    ``{"verdict": str, "verdict_reasons": list[str]}`` (see the module docstring)."""
+    found, what, cause = explain(summary)
+    if not found:
+        return {"verdict": TRACKED, "verdict_reasons": []}
+    return {"verdict": f"did not track: {what}; likely cause: {cause}", "verdict_reasons": found}
+
+
+def short_verdict(summary: Mapping[str, Any]) -> str:
+    """A few words for a crowded line: ``tracked`` or ``DID NOT TRACK (codes)``, from the
+    summary's verdict keys (computed if missing)."""
+    found = summary.get("verdict_reasons")
+    if found is None:
+        found = verdict(summary)["verdict_reasons"]
+    return TRACKED if not found else f"DID NOT TRACK ({', '.join(found)})"

@@ -1,0 +1,368 @@
+"""The physical limit, bracketed (ddwmmr.bounds): the OCP against Balkcom and Mason's closed
+form, the lower bound against independent minimisations and the best-known times, the
+open-loop replay on the thesis plant, and the tool."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq, minimize
+
+from ddwmmr import Robot
+from ddwmmr.bounds import batch, diffdrive
+from ddwmmr.bounds.lower import Prices, budget_bound, circular
+from ddwmmr.bounds.replay import replay
+from ddwmmr.bounds.search import Settings, best_known, start_state
+from ddwmmr.bounds.starts import Pattern, controller_guess, pattern_guess
+from ddwmmr.model import symbolic as sym
+from ddwmmr.mpc.min_time import MinimumTimeProblem
+from ddwmmr.scenarios import generate
+from ddwmmr.scenarios.generator import Scenario
+
+HEAVY = Robot().with_payload(3.0)
+#: The thesis robot's wheels: radius (m), half-track (m), top wheel speed (rad/s).
+WHEELS = {"wheel_radius": 0.0975, "half_track": 0.175, "wheel_speed": 15.0}
+#: A light multistart for tests: the 32 direction patterns on a coarse grid, one refined.
+LIGHT = Settings(
+    coarse=5,
+    fine=12,
+    final=40,
+    refine=1,
+    elbow_top=0,
+    turn_top=0,
+    arm_top=0,
+    continuation_top=0,
+    controllers=(),
+)
+
+
+# -- Balkcom and Mason ------------------------------------------------------------------
+def test_closed_form_of_the_one_action_and_turn_drive_turn_families():
+    r, b, u = WHEELS.values()
+    speed, rate = r * u, r * u / b
+    # straight ahead: one straight segment at full wheel speed
+    assert diffdrive.optimal_time((0, 0, 0), (2.0, 0, 0), **WHEELS) == pytest.approx(2.0 / speed)
+    # a turn in place
+    turn = diffdrive.optimal_time((0, 0, 0), (0, 0, 1.2), **WHEELS)
+    assert turn == pytest.approx(1.2 / rate)
+    # backwards is as fast as forwards
+    back = diffdrive.optimal_time((0, 0, 0), (-1.5, 0, 0), **WHEELS)
+    assert back == pytest.approx(1.5 / speed)
+    # far goal at 45 degrees, same heading: turn, drive, turn back
+    far = diffdrive.optimal_time((0, 0, 0), (3.0, 3.0, 0), **WHEELS)
+    assert far == pytest.approx(math.hypot(3, 3) / speed + 0.5 * math.pi / rate)
+
+
+@pytest.mark.parametrize(
+    "goal",
+    [
+        (2.0, 0.0, 0.0),
+        (0.0, 0.0, 0.5 * math.pi),
+        (1.0, 1.0, 0.0),
+        (1.5, -0.8, 2.0),
+        (0.3, 0.2, -2.5),
+    ],
+)
+def test_the_ocp_finds_balkcom_and_masons_minimum_time(goal):
+    """The transcription the best-known times come from, on the one problem whose optimum
+    is known in closed form: within 1 % (the last two goals need two straight segments)."""
+    exact = diffdrive.optimal_time((0.0, 0.0, 0.0), goal, **WHEELS)
+    found = diffdrive.ocp_time((0.0, 0.0, 0.0), goal, **WHEELS)
+    assert found == pytest.approx(exact, rel=0.01)
+
+
+def test_two_straight_segments_beat_one_where_the_goal_is_beside_the_heading():
+    """Goal (1.5, -0.8) facing 2 rad: the best path with one straight segment is 16 %
+    slower than Balkcom and Mason's optimum, which has two."""
+    goal = (1.5, -0.8, 2.0)
+    line = math.atan2(goal[1], goal[0])
+    one = min(
+        math.hypot(*goal[:2]) + circular(0.0, h) + circular(h, goal[2])
+        for h in (line, line + math.pi)
+    )
+    best = diffdrive.optimal_time((0, 0, 0), goal)
+    assert one / best == pytest.approx(1.166, abs=0.002)
+
+
+# -- the lower bound --------------------------------------------------------------------
+def _relaxation_one_waypoint(w, prices):
+    """The lower bound's relaxed problem for one waypoint, minimised independently: base
+    point p = w + rho (cos a, sin a), heading X; cost 0.75 |p| / cos(beta) + 0.72 |X|."""
+
+    def cost(z):
+        rho, a, x = min(abs(z[0]), prices.reach), z[1], z[2]
+        p = np.array(w) + rho * np.array([math.cos(a), math.sin(a)])
+        length = float(np.hypot(*p))
+        line = circular(x, math.atan2(p[1], p[0]))
+        beta = min(line, math.pi - line)
+        if beta >= 0.5 * math.pi - 1e-9:
+            return math.inf
+        return prices.drive * length / math.cos(beta) + prices.turn * float(circular(0.0, x))
+
+    grid = [
+        (rho, a, x)
+        for rho in np.linspace(0.0, prices.reach, 5)
+        for a in np.linspace(-math.pi, math.pi, 24, endpoint=False)
+        for x in np.linspace(-math.pi, math.pi, 36, endpoint=False)
+    ]
+    starts = sorted(grid, key=cost)[:8]
+    return min(minimize(cost, s, method="Nelder-Mead", options={"xatol": 1e-9}).fun for s in starts)
+
+
+@pytest.mark.parametrize("waypoint", [(3.0, 0.0), (1.0, 2.5), (-2.0, -0.5)])
+def test_lower_bound_matches_an_independent_minimisation_of_its_relaxation(waypoint):
+    """One waypoint: the dynamic programme over cells is never above the continuous
+    minimum of the same relaxation, and closes in on it as the cells shrink."""
+    prices = Prices.from_robot(HEAVY)
+    exact = _relaxation_one_waypoint(waypoint, prices)
+    coarse = budget_bound(HEAVY, [waypoint], cell=0.05, arcs=180).value
+    fine = budget_bound(HEAVY, [waypoint], cell=0.01, arcs=900).value
+    assert coarse <= exact + 1e-9 and fine <= exact + 1e-9
+    assert exact - coarse < 0.1
+    assert exact - fine < 0.025
+
+
+def test_turn_transform_is_the_brute_force_minimum():
+    from ddwmmr.bounds.lower import turn_transform
+
+    rng = np.random.default_rng(3)
+    cost = rng.uniform(0.0, 2.0, size=(5, 40))
+    cost[1, :] = np.inf
+    cost[1, 7] = 0.3
+    step = 0.05
+    index = np.arange(40)
+    d = np.abs(index[:, None] - index[None, :])
+    d = np.minimum(d, 40 - d)
+    brute = np.min(cost[:, :, None] + step * np.maximum(0, d - 1)[None, :, :], axis=1)
+    assert np.allclose(turn_transform(cost, step), brute)
+
+
+def test_lower_bound_is_below_the_analytic_time_straight_ahead():
+    """3 m straight ahead, one waypoint: from rest with full force the base covers at most
+    v_top (t - tau (1 - e^{-t/tau})) (tests/test_mpc.py); the bound is below that time and
+    equals the driving price times the distance to the reach disc."""
+    d = sym.ThesisDynamics.from_robot(HEAVY)
+    tau, top = d.mass / d.c1, d.top_speed
+    needed = 3.0 - HEAVY.reach - 0.01
+    fastest = brentq(lambda t: top * (t - tau * (1 - math.exp(-t / tau))) - needed, 0.0, 60.0)
+    bound = budget_bound(HEAVY, [(3.0, 0.0)]).value
+    assert bound <= fastest
+    assert bound == pytest.approx(Prices.from_robot(HEAVY).drive * needed, abs=0.04)
+
+
+def test_lower_bound_prices_are_the_wheels_force_budget():
+    p = Prices.from_robot(HEAVY)
+    d = sym.ThesisDynamics.from_robot(HEAVY)
+    assert p.drive == pytest.approx(15.0 / 20.0)  # c1 / (2 F): one metre at top speed
+    k = d.inertia_cos * 2.0  # the yaw inertia changes at most this fast (elbow at 2 rad/s)
+    assert p.turn == pytest.approx((4.0 - k) / (20.0 * 0.175))
+    assert p.reach == pytest.approx(0.66)
+
+
+@pytest.mark.parametrize("waypoints", [((2.0, 1.5), (-0.5, 2.0)), generate(1, 0)[0].waypoints[:3]])
+def test_lower_bound_is_never_above_the_best_known_time(waypoints):
+    """The relaxation on a coarse grid against a light multistart's replayed time (a
+    two-waypoint task and the first three waypoints of scenario 1 of seed 0)."""
+    scenario = Scenario(0, tuple(waypoints))
+    found = best_known(HEAVY, scenario, LIGHT)
+    assert found.replay_ok
+    bound = budget_bound(HEAVY, waypoints, cell=0.1, arcs=60).value
+    assert 0.0 < bound <= found.best_s
+    assert found.best_s / bound < 3.0  # not vacuous
+
+
+# -- the best-known side ----------------------------------------------------------------
+def test_replay_on_the_thesis_plant_reaches_what_the_ocp_reaches():
+    """A certified solution (margins on the tolerance and S) replays on the plant within
+    1 ms of the OCP's time; judged against a waypoint 2 cm away, or a floor above its
+    lowest S, it fails."""
+    start = start_state(HEAVY)
+    target = [(2.0, 1.0)]
+    problem = MinimumTimeProblem(
+        HEAVY, target, start, intervals_per_leg=40, stability_min=1.2505, tolerance=0.009
+    )
+    result = problem.solve(problem.straight_line_guess())
+    assert result.success
+    check = replay(HEAVY, result, target)
+    assert check.ok and check.reached == 1
+    assert check.time_s == pytest.approx(result.total, abs=1e-3)
+    assert check.min_stability >= 1.25
+    moved = replay(HEAVY, result, [(2.0, 1.02)])
+    assert not moved.ok and moved.reached == 0 and moved.closest_m[0] > 0.01
+    assert not replay(HEAVY, result, target, stability_min=check.min_stability + 0.01).ok
+
+
+def test_pattern_guess_follows_its_pattern():
+    waypoints = [(2.0, 0.0), (2.0, 2.0)]
+    start = start_state(HEAVY)
+    guess = pattern_guess(HEAVY, start, waypoints, Pattern((1, -1), (False, False), -1))
+    leg1 = guess.times < guess.arrivals[0] - 0.6
+    # forwards along +x, stopping 0.4 m short at (1.6, 0), then backwards towards (2, 2)
+    assert np.all(guess.states[leg1, 5] >= -1e-9) and np.all(guess.states[leg1, 2] == 0.0)
+    backwards = math.atan2(2.0, 0.4) - math.pi
+    assert guess.states[-1, 2] == pytest.approx(backwards)
+    assert np.hypot(*(guess.states[-1, :2] - (2.0, 2.0))) == pytest.approx(0.4)
+    assert np.all(guess.states[:, 4] < 0)  # the other elbow branch
+    long = pattern_guess(HEAVY, start, waypoints, Pattern((1, -1), (False, True), -1))
+    assert long.states[-1, 2] == pytest.approx(guess.states[-1, 2] + 2.0 * math.pi)
+
+
+def test_controller_run_as_a_start_reaches_every_waypoint():
+    scenario = generate(1, 0)[0]
+    guess = controller_guess(scenario, "thesis")
+    assert guess is not None and len(guess.arrivals) == 5
+    assert guess.states.shape == (len(guess.times), 7)
+    assert guess.inputs.shape == (len(guess.times) - 1, 4)
+    assert np.all(np.abs(guess.inputs[:, :2]) <= 10.0 + 1e-9)
+    end = HEAVY.fk(guess.states[-1, :5])[:2]
+    assert math.dist(end, scenario.waypoints[-1]) <= 0.01
+
+
+def test_continuation_bounds_change_only_their_rows():
+    problem = MinimumTimeProblem(HEAVY, [(2.0, 1.0)], start_state(HEAVY), intervals_per_leg=4)
+    lbg, ubg = problem.row_bounds(stability_min=1.0, tolerance=0.05)
+    changed = np.flatnonzero((lbg != problem.lbg) | (ubg != problem.ubg))
+    com = set(range(problem.interval_slice.start, problem.interval_slice.stop))
+    nodes = range(problem.node_slice.start, problem.node_slice.stop)
+    com |= {i for i in nodes if (i - problem.node_slice.start) % 4 < 2}  # x, y of the CoM
+    assert set(changed) == com | set(range(problem.end_slice.start, problem.end_slice.stop))
+    assert ubg[problem.end_slice][0] == pytest.approx(0.05**2)
+
+
+# -- the tool -----------------------------------------------------------------------------
+def _fake_solve(job):
+    """Stand-in for batch.solve: the plumbing without the optimisation."""
+    wanted = batch.keys(job.scenario, job.payload, job.settings)
+    index = job.scenario.index + 1
+    out = {"index": index}
+    if job.need_lower:
+        out["lower"] = {"key": wanted["lower"], "lower_bound_s": 10.0 + index}
+    if job.need_best:
+        out["best"] = {
+            "key": wanted["best"],
+            "best_known_s": 12.0 + index,
+            "replay_ok": True,
+            "starts": 3,
+            "spread_s": 0.5,
+        }
+    return out
+
+
+def test_tool_writes_the_table_and_resumes_from_its_cache(tmp_path, monkeypatch, capsys):
+    from ddwmmr.cli import bounds as tool
+
+    calls = []
+
+    def counted(job):
+        calls.append(job.scenario.index + 1)
+        return _fake_solve(job)
+
+    monkeypatch.setattr(batch, "solve", counted)
+    out = tmp_path / "b"
+    args = ["--scenarios", "2-3", "--jobs", "1", "--out", str(out), "--no-progress"]
+    assert tool.main(args) == 0
+    assert calls == [2, 3]
+    lines = (out / "bounds.csv").read_text().splitlines()
+    assert lines[0] == ",".join(batch.COLUMNS)
+    assert lines[1] == "2,12.0,14.0,3,0.5,True"
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["mean_width"] == pytest.approx((14 / 12 + 15 / 13) / 2)
+    assert summary["seed"] == 0 and summary["payload"] == 3.0
+    assert (out / "cache" / "scenario-003-lower.json").exists()
+    # again, one more scenario: only the new one is solved, the others come from the cache
+    assert tool.main(["--scenarios", "1-3", *args[2:]]) == 0
+    assert calls == [2, 3, 1]
+    assert len((out / "bounds.csv").read_text().splitlines()) == 4
+    assert "bracket width" in capsys.readouterr().out
+
+
+def test_scenario_tool_gives_ratios_to_both_ends(tmp_path, monkeypatch):
+    from ddwmmr.cli import bounds as tool
+    from ddwmmr.cli import scenarios as scenarios_tool
+
+    monkeypatch.setattr(batch, "solve", _fake_solve)
+    out = tmp_path / "b"
+    assert tool.main(["--scenarios", "1-2", "--jobs", "1", "--out", str(out), "--no-progress"]) == 0
+    runs = tmp_path / "s"
+    args = ["--n", "2", "--jobs", "1", "--no-progress", "--out", str(runs)]
+    assert scenarios_tool.main([*args, "--bounds", str(out / "bounds.csv")]) == 0
+    summary = json.loads((runs / "summary.json").read_text())
+    times = [
+        float(line.split(",")[4]) for line in (runs / "scenarios.csv").read_text().splitlines()[1:]
+    ]
+    assert summary["bracket"]["mean_ratio_to_lower_bound"] == pytest.approx(
+        np.mean([times[0] / 11.0, times[1] / 12.0])
+    )
+    assert summary["bracket"]["mean_ratio_to_best_known"] == pytest.approx(
+        np.mean([times[0] / 13.0, times[1] / 14.0])
+    )
+    other = tmp_path / "s1"
+    code = scenarios_tool.main(
+        ["--seed", "1", *args[:-1], str(other), "--bounds", str(out / "bounds.csv")]
+    )
+    assert code == 2 and not other.exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--scenarios", "0"], "scenarios must lie in"),
+        (["--scenarios", "5-2"], "first <= last"),
+        (["--scenarios", "one"], "scenarios must be numbers"),
+        (["--jobs", "0"], "jobs"),
+        (["--stability-min", "0.5"], "stability-min must be in"),
+        (["--payload", "-1"], "payload"),
+        (["--seed", "-1"], "seed"),
+    ],
+)
+def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path, args, message):
+    out = tmp_path / "bad"
+    result = subprocess.run(
+        [sys.executable, "-m", "ddwmmr.bounds", *args, "--out", str(out)],
+        capture_output=True,
+        text=True,
+        check=False,
+    )
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0] and "Traceback" not in result.stderr
+    assert not out.exists()
+
+
+def test_tool_refuses_a_folder_it_did_not_write(tmp_path, capsys):
+    from ddwmmr.cli import bounds as tool
+
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "notes.txt").write_text("keep")
+    assert tool.main(["--scenarios", "1", "--out", str(out)]) == 2
+    assert "holds files no ddwmmr bounds run wrote" in capsys.readouterr().err
+    assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
+
+
+def test_lower_only_leaves_the_best_known_time_to_a_later_run(tmp_path, monkeypatch):
+    from ddwmmr.cli import bounds as tool
+
+    jobs = []
+
+    def recorded(job):
+        jobs.append((job.scenario.index + 1, job.need_best, job.need_lower))
+        return _fake_solve(job)
+
+    monkeypatch.setattr(batch, "solve", recorded)
+    out = tmp_path / "b"
+    args = ["--scenarios", "1-2", "--jobs", "1", "--out", str(out), "--no-progress"]
+    assert tool.main([*args, "--lower-only"]) == 0
+    assert jobs == [(1, False, True), (2, False, True)]
+    lines = (out / "bounds.csv").read_text().splitlines()
+    assert lines[1] == "1,11.0,nan,0,nan,False"
+    assert math.isnan(float(json.loads((out / "summary.json").read_text())["mean_width"]))
+    # the full run then searches only the best-known times, the lower bounds come cached
+    assert tool.main(args) == 0
+    assert jobs[2:] == [(1, True, False), (2, True, False)]
+    assert (out / "bounds.csv").read_text().splitlines()[2] == "2,12.0,14.0,3,0.5,True"

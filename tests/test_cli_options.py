@@ -1,0 +1,158 @@
+"""Every method's every option from the command lines: ``--option NAME=VALUE`` on track,
+compare and scenarios (parsed as the simulator's fields are), and the named flags."""
+
+import json
+
+import pytest
+
+from ddwmmr.cli.compare import build_parser as compare_parser
+from ddwmmr.cli.compare import parse_method_options
+from ddwmmr.cli.scenarios import build_parser as scenarios_parser
+from ddwmmr.cli.scenarios import config_from_arguments
+from ddwmmr.cli.track import build_parser as track_parser
+from ddwmmr.cli.track import controller_options
+from ddwmmr.cli.track import main as track
+from ddwmmr.controllers import available_methods, method_options
+from ddwmmr.controllers.option_specs import option_names, option_specs
+from ddwmmr.errors import ParameterError
+
+#: Options only the API can set: Python objects no text stands for (stated here, so a
+#: new option that the command line cannot reach fails the test below).
+API_ONLY = {"qp": {"tasks", "limits"}, "mpc": {"fallback_options"}}
+
+
+@pytest.mark.parametrize("method", available_methods())
+def test_every_option_of_every_method_is_reachable_from_track(method):
+    """Each option's default, written as text, parses back to itself through --option."""
+    assert set(method_options(method)) - set(option_names(method)) == API_ONLY.get(method, set())
+    for spec in option_specs(method):
+        text = spec.format(spec.default)
+        argv = ["--method", method, "--traj", "ellipse", "--option", f"{spec.name}={text}"]
+        options = controller_options(track_parser().parse_args(argv))
+        assert options == {spec.name: spec.default}, spec.name
+
+
+def test_the_mpc_horizon_from_a_flag_and_from_option_is_the_same_run(tmp_path):
+    runs = {}
+    for label, extra in (("flag", ["--horizon", "2"]), ("option", ["--option", "horizon=2"])):
+        out = tmp_path / label
+        argv = ["--method", "mpc", "--traj", "ellipse", "--duration", "0.2", "--no-plots"]
+        assert track([*argv, "--no-progress", "--out", str(out), *extra]) == 0
+        runs[label] = json.loads((out / "summary.json").read_text())
+    assert runs["flag"]["mpc_horizon_s"] == runs["option"]["mpc_horizon_s"] == 2.0
+    assert runs["flag"]["run"]["options"]["horizon"] == 2.0
+    assert runs["flag"]["rms_position_error_m"] == runs["option"]["rms_position_error_m"]
+
+
+def test_a_tuple_option_matches_its_flag():
+    base = ["--method", "clrrmc-ts", "--traj", "rectangle"]
+    by_flag = controller_options(track_parser().parse_args([*base, "--tau", "0.5", "0.5", "inf"]))
+    by_text = controller_options(track_parser().parse_args([*base, "--option", "tau=0.5,0.5,inf"]))
+    assert by_flag == {"tau": [0.5, 0.5, float("inf")]}
+    assert tuple(by_flag["tau"]) == by_text["tau"] == (0.5, 0.5, float("inf"))
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (
+            ["--option", "horizn=2"],
+            "error: option: mpc has no option 'horizn' (did you mean horizon?) (options: model, ",
+        ),
+        (["--option", "horizon"], "error: option must be NAME=VALUE (got 'horizon')"),
+        (["--option", "horizon=soon"], "error: horizon must be a number (got 'soon')"),
+        (
+            ["--horizon", "2", "--option", "horizon=3"],
+            "error: option: horizon is given both as --horizon and as --option",
+        ),
+    ],
+)
+def test_a_wrong_option_is_one_line_naming_the_accepted_ones(tmp_path, capsys, extra, message):
+    out = tmp_path / "out"
+    argv = ["--method", "mpc", "--traj", "ellipse", "--no-plots", "--out", str(out), *extra]
+    assert track(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(message) and err.count("\n") == 1 and not out.exists()
+
+
+def test_the_horizon_flag_is_refused_by_a_method_without_one(tmp_path, capsys):
+    assert track(["--method", "ats", "--traj", "ellipse", "--horizon", "2"]) == 2
+    assert "horizon: --horizon is taken only by --method mpc" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("parser", [track_parser, compare_parser, scenarios_parser])
+def test_help_lists_the_options_of_each_method(parser):
+    text = parser().format_help()
+    assert "--option NAME=VALUE" in text and "--horizon S" in text
+    assert "options of each method (--option NAME=VALUE" in text
+    assert "  mpc: model, stability_min, manipulability_weight" in text
+    if parser is not scenarios_parser:
+        assert "  ats: aux, singularity_threshold, damping" in text
+
+
+def test_compare_options_go_to_the_methods_that_take_them():
+    methods = ("pi", "clrrmc-ts", "mpc")
+    options = parse_method_options(["tau=0.3", "pi:damping=0.1"], methods, horizon=2.0)
+    assert options == {"pi": {"damping": 0.1}, "clrrmc-ts": {"tau": 0.3}, "mpc": {"horizon": 2.0}}
+    with pytest.raises(ParameterError, match=r"^option: no compared method takes 'tua' \(did yo"):
+        parse_method_options(["tua=0.3"], methods)
+    with pytest.raises(ParameterError, match=r"^option: 'qp' is not a compared method"):
+        parse_method_options(["qp:tau=0.3"], methods)
+    with pytest.raises(ParameterError, match=r"^option: pi has no option 'tau'"):
+        parse_method_options(["pi:tau=0.3"], methods)
+
+
+def test_compare_runs_carry_the_options_except_where_a_study_sets_its_own():
+    from ddwmmr.reports.compare.plan import CompareConfig, plan_runs
+    from ddwmmr.trajectories import load_trajectory
+
+    config = CompareConfig(
+        methods=("clrrmc-ts",),
+        trajectories={"ellipse": load_trajectory("ellipse")},
+        studies=("tau",),
+        options={"clrrmc-ts": {"tau": 0.3, "damping": 0.1}},
+    )
+    plan = plan_runs(config)
+    assert dict(plan.main[0].options) == {"tau": 0.3, "damping": 0.1}
+    swept = {dict(spec.options)["tau"] for spec in plan.studies["tau"]}
+    assert 0.3 not in swept or len(swept) > 1  # the study's own values win there
+    assert all(dict(spec.options)["damping"] == 0.1 for spec in plan.studies["tau"])
+
+
+def test_compare_records_the_options(tmp_path):
+    from ddwmmr.cli.compare import main as compare
+
+    out = tmp_path / "report"
+    argv = ["--methods", "pi", "clrrmc-ts", "--study", "none", "--duration", "0.5", "--jobs", "1"]
+    argv += ["--option", "tau=0.3", "--option", "pi:damping=0.1", "--no-progress"]
+    assert compare([*argv, "--out", str(out)]) == 0
+    record = json.loads((out / "run.json").read_text())
+    assert record["options"]["clrrmc-ts"]["tau"] == 0.3
+    assert record["options"]["pi"]["damping"] == 0.1
+
+
+def test_scenarios_pass_options_to_the_controller_and_refuse_the_protocol_s():
+    config = config_from_arguments(scenarios_parser().parse_args(["--option", "adjust=0.3"]))
+    assert config.controller_options == (("adjust", 0.3),)
+    argv = ["--controller", "mpc", "--plant", "kinematic", "--horizon", "1.5"]
+    assert config_from_arguments(scenarios_parser().parse_args(argv)).controller_options == (
+        ("horizon", 1.5),
+    )
+    with pytest.raises(ParameterError, match=r"^option: the scenarios set dt themselves \(--dt"):
+        config_from_arguments(scenarios_parser().parse_args(["--option", "dt=0.02"]))
+    with pytest.raises(ParameterError, match=r"^option: thesis has no option 'horizon'"):
+        config_from_arguments(scenarios_parser().parse_args(["--horizon", "2"]))
+
+
+def test_the_thesis_controller_takes_the_batch_s_options():
+    from ddwmmr.cli.scenarios import config_from_arguments as configure
+    from ddwmmr.model import Robot
+    from ddwmmr.scenarios.generator import generate
+    from ddwmmr.scenarios.protocol import make_scenario_controller, make_scenario_plant
+
+    config = configure(scenarios_parser().parse_args(["--option", "adjust=0.3"]))
+    scenario = generate(1, seed=0)[0]
+    robot = Robot().with_payload(config.payload)
+    plant = make_scenario_plant(robot, config)
+    controller = make_scenario_controller(robot, scenario, config, plant)
+    assert controller.behaviours["stability"].adjust == 0.3

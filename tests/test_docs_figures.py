@@ -1,0 +1,142 @@
+"""The figure scripts of docs/ make figures that show their data (tests/figure_checks.py):
+every figure of docs/make_figures.py and docs/qp_figures.py (but its timed one), the
+physics figures that take seconds, the frames of a physics run's animation, the
+support-load figures (attribution from the committed numbers, validation on a short run)
+and the benchmark figure."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+from figure_checks import SavedFigures
+
+DOCS = Path(__file__).resolve().parent.parent / "docs"
+
+
+def docs_script(name: str, tmp_path: Path, monkeypatch):
+    """Import ``docs/<name>.py`` as a module writing its figures to ``tmp_path``."""
+    spec = importlib.util.spec_from_file_location(f"docs_{name}", DOCS / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    monkeypatch.setitem(sys.modules, spec.name, module)  # dataclasses look their module up
+    spec.loader.exec_module(module)
+    monkeypatch.setattr(module, "FIGURES", tmp_path)
+    return module
+
+
+def test_theory_figures(tmp_path, monkeypatch):
+    saved = SavedFigures(monkeypatch)
+    script = docs_script("make_figures", tmp_path, monkeypatch)
+    script.main()
+    assert len(saved.problems) == 6
+    assert saved.failing() == {}
+
+
+@pytest.mark.parametrize(
+    "function", ["sideways_reach", "ellipse_manipulability", "obstacle", "modes", "waypoints"]
+)
+def test_qp_figures(function, tmp_path, monkeypatch):
+    saved = SavedFigures(monkeypatch)
+    script = docs_script("qp_figures", tmp_path, monkeypatch)
+    getattr(script, function)()
+    assert len(saved.problems) == 1
+    assert saved.failing() == {}
+
+
+def test_physics_tipping_map(tmp_path, monkeypatch):
+    """The tipping map's layout (its 400 MuJoCo holds take minutes): each hold is judged
+    by the kinematic S instead, which MuJoCo matches on this grid (docs/physics.md)."""
+    from ddwmmr import Robot
+
+    script = docs_script("physics_figures", tmp_path, monkeypatch)
+
+    def hold_pose(robot: Robot, th1: float, th2: float, **_) -> dict:
+        return {"tipped": robot.stability([0.0, 0.0, 0.0, th1, th2])[2] <= 1.0}
+
+    monkeypatch.setattr(script, "hold_pose", hold_pose)
+    saved = SavedFigures(monkeypatch)
+    assert script.tipping_map().endswith("0 where MuJoCo disagrees with S <= 1")
+    assert list(saved.problems) == ["physics_tipping_map.png"]
+    assert saved.failing() == {}
+
+
+def test_physics_slow_reach_figure(tmp_path, monkeypatch):
+    """physics_sideways_forces.png on a faster unfolding (0.4 rad/s: 250 steps instead of
+    1650): the same figure, its layout checked."""
+    script = docs_script("physics_figures", tmp_path, monkeypatch)
+    saved = SavedFigures(monkeypatch)
+    script.slow_sideways_reach(rate=0.4)
+    assert list(saved.problems) == ["physics_sideways_forces.png"]
+    assert saved.failing() == {}
+
+
+@pytest.fixture(scope="module")
+def tipping_runs():
+    """ats and clrrmc-ts reaching sideways with 4 kg on the physics plant: both tip."""
+    from ddwmmr import Robot, load_trajectory, simulate
+
+    trajectory = load_trajectory("sideways_reach")
+    robot = Robot().with_payload(4.0)
+    q0 = robot.base_for_end_effector(trajectory.pose(0.0), 1.0, 1.6)
+    return {
+        (4.0, method): simulate(
+            robot, trajectory, method, plant="mujoco", q0=q0, dt=0.02, duration=2.0
+        )
+        for method in ("ats", "clrrmc-ts")
+    }
+
+
+def test_physics_runs_figure_with_runs_that_tip(tipping_runs, tmp_path, monkeypatch):
+    assert all(run.summary["tipped"] for run in tipping_runs.values())
+    saved = SavedFigures(monkeypatch)
+    script = docs_script("physics_figures", tmp_path, monkeypatch)
+    script._plot_reach_runs(tipping_runs, (4.0,))
+    assert list(saved.problems) == ["physics_sideways_runs.png"]
+    assert saved.failing() == {}
+
+
+def test_physics_animation_frames(tipping_runs, tmp_path, monkeypatch):
+    from ddwmmr.plants.mujoco import MujocoPlant
+    from ddwmmr.reports.physics_plots import save_physics_animation
+
+    result = tipping_runs[4.0, "clrrmc-ts"]
+    plant = MujocoPlant(result.robot)
+    saved = SavedFigures(monkeypatch)
+    points = [s.point for s in plant.supports]
+    save_physics_animation(result, points, plant.weight_n, tmp_path / "tip.gif", frames=6)
+    assert len(saved.problems) >= 6  # every frame is checked as it is grabbed
+    assert saved.failing() == {}
+
+
+def test_benchmark_figure(tmp_path, monkeypatch):
+    """docs/figures/bench.png from the committed benchmarks/bench.json."""
+    spec = importlib.util.spec_from_file_location(
+        "bench_docs", DOCS.parent / "benchmarks" / "bench_docs.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    report = json.loads((DOCS.parent / "benchmarks" / "bench.json").read_text())
+    saved = SavedFigures(monkeypatch)
+    module.plot_report(report, tmp_path / "bench.png")
+    assert len(saved.problems) == 1
+    assert saved.failing() == {}
+
+
+def test_support_load_figures(tmp_path, monkeypatch):
+    """The attribution figures from the committed docs/support_loads.json; the validation
+    figure on a 2 s fast turn (its full runs take minutes)."""
+    script = docs_script("support_loads", tmp_path, monkeypatch)
+    numbers = json.loads((DOCS / "support_loads.json").read_text())
+    saved = SavedFigures(monkeypatch)
+    script.draw_attribution(numbers["attribution"])
+    script.validation_figure({"fast turn": script.fast_turn(duration=2.0)}, tmp_path / "v.png")
+    assert list(saved.problems) == [
+        "support_attribution_qp.png",
+        "support_attribution_mpc.png",
+        "v.png",
+    ]
+    assert saved.failing() == {}
