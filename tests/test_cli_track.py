@@ -1,5 +1,6 @@
 """``python -m ddwmmr.track``: outputs, summary keys, bad input (exit 2, nothing left)."""
 
+import csv
 import dataclasses
 import hashlib
 import json
@@ -450,3 +451,25 @@ def test_track_refuses_an_obstacle_over_the_start_pose(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and not out.exists()
     assert "obstacles: obstacle 1 (x 1.8 m, y -0.6 m, radius 0.5 m) overlaps the robot's" in err
+
+
+def test_a_physics_run_draws_its_support_loads(tmp_path):
+    """--plant mujoco writes support_loads.png beside the other figures (not on other
+    plants); the edges' loads it draws are the plant's: their least is min_edge_load_n."""
+    from ddwmmr.reports.physics_plots import SUPPORT_LOADS_FIGURE, edge_load_series
+
+    out = tmp_path / "run"
+    args = ["--method", "qp", "--traj", "sideways_reach", "--payload", "3", "--duration", "1"]
+    assert run([*args, "--plant", "mujoco", "--no-progress", "--out", str(out)]) == 0
+    assert (out / SUPPORT_LOADS_FIGURE).stat().st_size > 10_000
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["min_edge_load_floor_n"] == pytest.approx(0.1 * 15.0 * 9.81)
+    with open(out / "timeseries.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    series = {k: np.array([float(r[k]) for r in rows]) for k in rows[0]}
+    names, loads = edge_load_series(series, Robot().with_payload(3.0))
+    assert sorted(names) == ["back", "front", "left", "right"]
+    assert loads.min(axis=1) == pytest.approx(series["min_edge_load_n"], abs=1e-9)
+    kinematic = tmp_path / "kinematic"
+    assert run([*args, "--no-progress", "--out", str(kinematic)]) == 0
+    assert not (kinematic / SUPPORT_LOADS_FIGURE).exists()

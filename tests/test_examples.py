@@ -28,7 +28,7 @@ EXPECTED = {
     "custom_trajectory.py": ("ats", "clrrmc-ts", "final"),
     "compare_aux.py": ("rectangle  sum", "ellipse    shoulder"),
     "own_robot.py": ("default (thesis)", "long arm (TOML)", "would tip over"),
-    "physics_tipping.py": ("static floor only", "TIPPED", "dynamic margin (default)"),
+    "physics_tipping.py": ("static floor only", "TIPPED", "every edge loaded (default)"),
 }
 
 
@@ -163,7 +163,7 @@ def test_own_robot_numbers(printed) -> None:
 def test_physics_tipping_numbers(printed) -> None:
     """The static floor alone tips within the first second although its static S stays
     above 1.2; with the arm's lag and the braking step the run finishes but an edge is
-    unloaded longer than with the dynamic margin too (the default)."""
+    unloaded longer than with the edge-load rows too (the default)."""
     row = re.compile(
         r"(TIPPED|ok)\s+at\s+([\d.]+) s, waypoints (\d)/5, static S >= ([\d.]+), "
         r"an edge unloaded ([\d.]+) s"
@@ -174,7 +174,7 @@ def test_physics_tipping_numbers(printed) -> None:
     ]
     assert static[0] == "TIPPED" and static[1] < 1.0 and static[2] == 0 and static[3] > 1.2
     assert lagged[:1] == default[:1] == ("ok",) and lagged[2] == default[2] == 5
-    # the dynamic margin keeps the wheels loaded (1.11 s unloaded against 2.55 s)
+    # the edge-load rows keep the wheels loaded (0.02 s unloaded against 2.27 s)
     assert default[4] < 0.6 * lagged[4]
 
 

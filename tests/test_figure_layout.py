@@ -428,3 +428,17 @@ def test_scenario_figures_show_their_data(tmp_path, monkeypatch):
         _draw_figures(tmp_path, scenarios, outcomes, config)
     assert {"thesis_paths.png", "thesis_timeline.png", "thesis_weights.png"} <= set(problems)
     assert {name: found for name, found in problems.items() if found} == {}
+
+
+def test_support_loads_figure_shows_its_data():
+    """The physics track figure: each edge's load, the floor and the tilt, nothing under
+    the legend or off the canvas."""
+    from ddwmmr.reports.physics_plots import plot_support_loads
+
+    traj = load_trajectory("sideways_reach")
+    robot = Robot().with_payload(3.0)
+    q0 = robot.base_for_end_effector(traj.pose(0.0), 1.0, 1.6)
+    run = simulate(robot, traj, "qp", plant="mujoco", q0=q0, dt=0.02, duration=2.0)
+    fig = plot_support_loads(run)
+    assert_figure_shows_its_data(fig)
+    plt.close(fig)

@@ -61,8 +61,9 @@ def test_end_effector_and_link_lengths_follow_forward_kinematics(robot, rng):
         shoulder = data.xpos[body_id(model, "link1")]
         assert np.linalg.norm(elbow - shoulder) == pytest.approx(robot.L1, abs=1e-12)
         assert shoulder[:2] == pytest.approx(q[:2], abs=1e-12)  # arm at the axle midpoint
+        # the base frame sits on the floor (its damping acts there): the arm at arm_height
         assert shoulder[2] - data.xpos[body_id(model, "base")][2] == pytest.approx(
-            robot.arm_height - robot.wheel_radius, abs=1e-12
+            robot.arm_height, abs=1e-12
         )
 
 
@@ -108,11 +109,11 @@ def test_support_polygon_is_the_footprint(robot):
         lowest[support.name] = centre[2] - model.geom_size[geom][0]
         assert centre[:2] == pytest.approx(support.point, abs=1e-12)
         points.append(centre[:2])
-    # the casters touch the floor plane when the base is at wheel height, the wheels reach
-    # WHEEL_PRELOAD_DEPTH below it
+    # the casters touch the floor plane when the base frame is on it, the wheels (their
+    # tyres at the nominal deflection) reach WHEEL_PRELOAD_DEPTH below it
     for name, z in lowest.items():
         expected = -WHEEL_PRELOAD_DEPTH if name.startswith("wheel") else 0.0
-        assert z - (base_z - robot.wheel_radius) == pytest.approx(expected, abs=1e-12)
+        assert z - base_z == pytest.approx(expected, abs=1e-12)
     hl, hw = robot.base_length / 2, robot.base_width / 2
     corners = sorted([(hl, hw), (-hl, hw), (-hl, -hw), (hl, -hw)])
     compiled = sorted(tuple(p) for p in convex_hull(points).tolist())  # from the model

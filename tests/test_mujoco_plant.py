@@ -68,8 +68,10 @@ def test_floor_carries_the_weight_and_the_centre_of_pressure_gives_s(pose):
     assert sum(forces) == pytest.approx(plant.weight_n, rel=1e-4)
     assert values["min_support_force_n"] == min(forces)
     s = ROBOT.stability([0, 0, 0, *pose])[2]
-    assert values["physics_stability"] == pytest.approx(s, rel=2e-3)
-    assert values["base_tilt_rad"] < 1e-3
+    # the base leans into its compliant tyres (3.3 mrad at most here), which moves the centre of
+    # mass by up to arm_height x tilt (1 mm) towards the loaded edge: 0.4 % of S here
+    assert values["physics_stability"] == pytest.approx(s, rel=5e-3)
+    assert values["base_tilt_rad"] < 4e-3
     assert values["wheel_slip_m_s"] < 1e-6
 
 
@@ -82,8 +84,12 @@ def test_load_on_the_far_side_follows_statics(payload):
     values = dict(zip(plant.extra_columns, plant.extra_values()))
     right = sum(values[f"support_force_{s.name}_n"] for s in plant.supports if s.point[1] < 0)
     s = robot.stability([0, 0, 0, math.pi / 2, 0.0])[2]
-    # within 0.05 N (3e-4 of the weight): the base leans ~1e-4 rad into its contacts
-    assert right == pytest.approx(0.5 * plant.weight_n * (1.0 - 1.0 / s), abs=0.05)
+    # The base leans into its tyres by the measured tilt, which moves the centre of mass
+    # (at most arm_height up) by height x tilt towards the loaded edge: that much less on the
+    # far side, W h tilt / width (0.3 N at 2.95 kg), plus 0.05 N of the contacts' own.
+    lean = plant.weight_n * robot.arm_height * plant.base_tilt() / robot.base_width
+    statics = 0.5 * plant.weight_n * (1.0 - 1.0 / s)
+    assert statics - lean - 0.05 <= right <= statics + 0.05
     assert values["min_edge_load_n"] == pytest.approx(right, abs=1e-9)
 
 

@@ -51,6 +51,7 @@ from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.provenance import RunInputs, run_record
+from ddwmmr.registry import PLANTS
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     initial_configuration,
@@ -525,14 +526,16 @@ def load_run_record(path: str) -> dict[str, Any]:
     return record
 
 
-def output_names(plots: bool, animate: bool) -> tuple[str, ...]:
-    """The files a run writes (checked against a user's files before the run, --force)."""
+def output_names(plots: bool, animate: bool, physics: bool = False) -> tuple[str, ...]:
+    """The files a run writes (checked against a user's files before the run, --force);
+    ``physics``: on a plant that judges tipping by its contact forces (support_loads.png)."""
     names = ("timeseries.csv", "summary.json", *(("animation.gif",) if animate else ()))
     if not plots:
         return names
+    from ddwmmr.reports.physics_plots import SUPPORT_LOADS_FIGURE
     from ddwmmr.reports.plots import FIGURE_NAMES  # matplotlib: only for runs that plot
 
-    return (*names, *FIGURE_NAMES)
+    return (*names, *FIGURE_NAMES, *((SUPPORT_LOADS_FIGURE,) if physics else ()))
 
 
 def _note_uneven_duration(duration: float, dt: float, steps: int) -> None:
@@ -556,7 +559,9 @@ def _main(argv: Sequence[str] | None = None) -> int:
     fresh = args.out is None  # a default name: never replaces an earlier run
     base = default_out(inputs.method, inputs.label) if fresh else Path(args.out)
     out = first_free(base, folder=True) if fresh else base
-    check_output_folder(out, "track", args.force, output_names(not args.no_plots, args.animate))
+    physics = hasattr(PLANTS.load(inputs.plant), "tip_time")  # judges tipping: support loads
+    names = output_names(not args.no_plots, args.animate, physics)
+    check_output_folder(out, "track", args.force, names)
     record = run_record(inputs, argv, args.rerun, tool="track", prog=PROG)
     progress = not args.no_progress
     _note_uneven_duration(inputs.duration, inputs.dt, steps)
@@ -582,6 +587,13 @@ def _main(argv: Sequence[str] | None = None) -> int:
 
             with phase("track: figures", enabled=progress):
                 save_run_figures(result, staging, obstacles=inputs.options.get("obstacles"))
+                if "base_tilt_rad" in result.timeseries:  # a physics plant's run
+                    from ddwmmr.reports.physics_plots import (
+                        SUPPORT_LOADS_FIGURE,
+                        save_support_loads,
+                    )
+
+                    save_support_loads(result, staging / SUPPORT_LOADS_FIGURE)
         if args.animate:
             from ddwmmr.reports.plots import save_animation
 

@@ -53,6 +53,7 @@ from ddwmmr.controllers.base import StepInfo, WaypointRun, control_step, registe
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
+from ddwmmr.model.stability import GRAVITY_M_S2
 from ddwmmr.mpc.braking import braked_velocity, braking_input, should_brake
 from ddwmmr.mpc.fallback import fallback_input, make_fallback
 from ddwmmr.mpc.models import PredictionModel, make_model
@@ -190,6 +191,7 @@ class MPCController:
             stability_min=options.stability_min,
             stability_margin=options.stability_margin,
             dynamic_stability=self.dynamic_stability,
+            min_edge_load=options.min_edge_load,
             track_orientation=options.track_orientation and not reach,
             huber=options.huber_scale(mode),
             obstacles=tuple(options.obstacles),
@@ -225,6 +227,8 @@ class MPCController:
         self._stall = StallWatch()
         self.restarts = 0
         self.brakes = 0  # steps that braked instead of following a plan that needed slack
+        #: the least edge load (N) a plan predicted for its command (dynamic_stability)
+        self.min_predicted_edge_load: float | None = None
 
     def adopt_control_step(self, dt: float) -> None:
         """The loop holds each command ``dt`` (s): plan with it (the first interval, the
@@ -351,6 +355,11 @@ class MPCController:
                 "mpc_braking": float(braking),
             }
         )
+        if ocp.first_edge_loads is not None and not braking:
+            least = float(ocp.first_edge_loads(w, problem.last_parameters).full().min())
+            self.last.extra["min_predicted_edge_load_n"] = least
+            if self.min_predicted_edge_load is None or least < self.min_predicted_edge_load:
+                self.min_predicted_edge_load = least
         velocity = (0.0, 0.0)
         if braking:  # the plan's prediction is not what is sent: one Euler step instead
             assert self.dynamics is not None
@@ -415,6 +424,12 @@ class MPCController:
             "min_obstacle_clearance_m": clearance,
             "mpc_model": self.model_name,
             "mpc_dynamic_stability": self.dynamic_stability,
+            "min_predicted_edge_load_n": self.min_predicted_edge_load,
+            "min_edge_load_floor_n": (
+                self.resolved.min_edge_load * self.robot.total_mass * GRAVITY_M_S2
+                if self.dynamic_stability
+                else None
+            ),
             "mpc_arm_time_constant_s": self.arm_time_constant,
             "mpc_joint_acceleration_limit_rad_s2": self.joint_acceleration_limit,
             "mpc_wheel_force_limit_n": None if self.dynamics is None else self.dynamics.force_limit,

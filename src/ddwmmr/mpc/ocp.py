@@ -36,12 +36,17 @@ written through ``x_{k+1} = RK4(x_k, u_k, h_k)`` so that each row involves one s
 variables only. ``S = stability_min + stability_margin``; the box on the centre of mass is
 the exact condition ``S_lon, S_lat >= S`` (see :func:`ddwmmr.model.symbolic.
 stability_bounds`): the nonlinear stability margin at every node, not a linearisation.
-With ``dynamic_stability`` (force-level model only) the box also holds the zero moment
-point (:func:`ddwmmr.model.stability.zero_moment_point`: the centre of pressure with the
-inertial forces of the base's acceleration, turn and the arm's motion), at both ends of
-every interval under that interval's input (so ``u_0`` itself is bounded at the measured
-state): ``S_dyn >= S``, the margin against tipping while moving, of which the static S is
-the at-rest case.
+With ``dynamic_stability`` (force-level model only) every edge e of the support polygon
+keeps a least normal load, at both ends of every interval under that interval's input (so
+``u_0`` itself is bounded at the measured state)::
+
+    d_e(c) + sigma >= min_edge_load D_e,    d_e(c) = L_e D_e / W
+
+with ``L_e`` the edge load of the motion (:func:`ddwmmr.model.symbolic.edge_loads`: the
+centre of pressure ``c`` with the inertial forces of the base's acceleration, turn and the
+arm's motion), ``D_e`` the polygon's depth behind e and ``W`` the weight: the row in
+metres, the centre of pressure's distance from the edge line, so that it shares the
+stability terms' slacks (and their braking threshold).
 The slacks carry an exact L1 penalty (:data:`SLACK_WEIGHT`): whenever the constraints can
 be met they are met (a hard constraint), and a linearisation that cannot be met in one
 iteration still gives a solvable QP. Input box (forces or rates), joint-position box on
@@ -97,7 +102,8 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
-from ddwmmr.model.stability import STABILITY_FLOOR
+from ddwmmr.model.stability import GRAVITY_M_S2, STABILITY_FLOOR
+from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, EdgeLoadModel
 from ddwmmr.mpc.models import PredictionModel
 from ddwmmr.qp.limits.obstacles import Circle
 
@@ -158,8 +164,9 @@ class OCPConfig:
         min_horizon: lower bound on the free horizon T (s); reach_speed: m/s converting
             the distance left at T = horizon into seconds.
         stability_min: the floor S_min; stability_margin: the OCP keeps S >= S_min + margin.
-        dynamic_stability: bound the zero moment point too, besides the centre of mass (the
-            model must have base dynamics).
+        dynamic_stability: keep every edge of the support polygon loaded while moving,
+            besides the static box on the centre of mass (the model must have base
+            dynamics); min_edge_load: that least load as a share of the weight.
         track_orientation: cost on the end-effector orientation.
         huber: Huber scale (m) of the position error, None for a pure quadratic.
         obstacles: circles kept clear of the base's enclosing circle (radius
@@ -177,6 +184,7 @@ class OCPConfig:
     stability_min: float = STABILITY_FLOOR
     stability_margin: float = 0.01
     dynamic_stability: bool = False
+    min_edge_load: float = DEFAULT_MIN_EDGE_LOAD
     track_orientation: bool = True
     huber: float | None = None
     obstacles: tuple[Circle, ...] = ()
@@ -287,6 +295,7 @@ class ShootingOCP:
             for c in config.obstacles
         ]
         g, lbg, ubg, ng = [], [], [], []
+        self._first_loads: list = []  # the first interval's edge loads (N), both ends
         for k in range(self.N):
             x_next = self._integrate(xs[k], us[k], self._interval(nodes, k), float(self.lengths[k]))
             # the gap as x_{k+1} - F(x_k, u_k): the only form FATROP's structure detection
@@ -301,11 +310,15 @@ class ShootingOCP:
             # so that each stage's slacks can relax them (see module docstring).
             slack = slacks[k]
             rows, low, high = [], [], []
-            for point in self._stability_points(k, xs[k], x_next, us[k]):
+            for point in self._stability_points(k, x_next):
                 rows += [point[0] + slack[0], point[0] - slack[0]]
                 rows += [point[1] + slack[1], point[1] - slack[1]]
                 low += [-x_max, -INF, -y_max, -INF]
                 high += [INF, x_max, INF, y_max]
+            for distance, index, floor in self._edge_rows(k, xs[k], x_next, us[k]):
+                rows.append(distance + slack[index])
+                low.append(floor)
+                high.append(INF)
             for ox, oy, radius2 in clear:
                 rows.append((x_next[0] - ox) ** 2 + (x_next[1] - oy) ** 2 + slack[2])
                 low.append(radius2)
@@ -331,31 +344,49 @@ class ShootingOCP:
             lbg.extend(low)
             ubg.extend(high)
         ng.append(0)
+        #: the edge loads (N) the plan predicts at both ends of its first interval (the
+        #: command's step), a function of (w, p); None without dynamic_stability
+        self.first_edge_loads = (
+            ca.Function("first_edge_loads", [self.w, self.p], [ca.vertcat(*self._first_loads)])
+            if self._first_loads
+            else None
+        )
         self.g = ca.vertcat(*g)
         self.lbg, self.ubg = np.array(lbg), np.array(ubg)
         self.ng = ng
         self.residual = self._residual(nodes, xs, us, slacks)
         self._bounds_and_linear_cost()
 
-    def _stability_points(self, k: int, x_k, x_next, u_k) -> list:
+    def _stability_points(self, k: int, x_next) -> list:
         """The points held in the stability box for stage k: the centre of mass at node
-        k+1 (at the last node also that of the pose where the joints, braked at their
-        acceleration limit, come to rest), and (dynamic) the zero moment point at both ends
-        of the interval under u_k. At
-        the first stage the joints accelerate from the previous command's rates within the
-        control step (the change of rates over dt), where an abrupt change of the arm's
-        motion moves the centre of pressure most."""
+        k+1, and at the last node also that of the pose where the joints, braked at their
+        acceleration limit, come to rest."""
         robot, model = self.robot, self.model
         points = [sym.centre_of_mass(robot, model.configuration(x_next))]
         stop = model.stopping_configuration(x_next) if k == self.N - 1 else None
         if stop is not None:
             points.append(sym.centre_of_mass(robot, stop))
+        return points
+
+    def _edge_rows(self, k: int, x_k, x_next, u_k) -> list:
+        """(dynamic) Each edge's centre-of-pressure distance ``d_e = L_e D_e / W`` (m,
+        :func:`ddwmmr.model.symbolic.edge_loads`) at both ends of interval k under u_k,
+        as ``(expression, slack index, lower bound min_edge_load D_e)``: the edge's slack
+        is the stability term's whose direction its normal is closest to. At the first
+        stage without a joint lag the joints accelerate from the previous command's rates
+        within the control step (the change of rates over dt), where an abrupt change of
+        the arm's motion moves the centre of pressure most."""
         if not self.config.dynamic_stability:
-            return points
+            return []
+        robot, model = self.robot, self.model
+        polygon = EdgeLoadModel.from_robot(robot).polygon
+        weight = robot.total_mass * GRAVITY_M_S2
+        rows = []
         for end, x in enumerate((x_k, x_next)):
             motion = model.base_motion(x, u_k)
             if motion is None:
                 raise ParameterError("dynamic_stability needs the force-level model (thesis)")
+            v, w, v_dot, w_dot = motion
             joints = model.joint_motion(x, u_k)
             if joints is not None:
                 rates, accelerations = joints  # the lagged arm: its own accelerations
@@ -367,13 +398,16 @@ class ShootingOCP:
                         (rates[0] - previous[0]) / self.dt,
                         (rates[1] - previous[1]) / self.dt,
                     )
-            q = model.configuration(x)
-            points.append(
-                sym.zero_moment_point(
-                    robot, q, rates, *motion, (accelerations[0], accelerations[1])
-                )
+            loads = sym.edge_loads(
+                robot, model.configuration(x), rates, accelerations, (v_dot, v * w), w, w_dot
             )
-        return points
+            for e, (normal, depth) in enumerate(zip(polygon.normals, polygon.depths)):
+                slack = 0 if abs(normal[0]) >= abs(normal[1]) else 1
+                lever = float(depth) / weight
+                rows.append((loads[e] * lever, slack, self.config.min_edge_load * float(depth)))
+                if k == 0:
+                    self._first_loads.append(loads[e])
+        return rows
 
     def _bounds_and_linear_cost(self) -> None:
         config, model = self.config, self.model

@@ -32,6 +32,7 @@ from ddwmmr.errors import (
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
+from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, check_min_edge_load
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT, FORCE_LIMIT_DEFAULT
 from ddwmmr.mpc.braking import BRAKE_SLACK
 from ddwmmr.mpc.ocp import MAX_HORIZON, MAX_INTERVALS, MIN_INTERVAL, Weights, grid_intervals
@@ -124,10 +125,14 @@ class MPCOptions:
         proximal: damping of the input steps between two solves (see
             :class:`ddwmmr.mpc.solvers.GaussNewtonSQP`).
         stability_margin: the OCP keeps ``S >= stability_min + stability_margin``.
-        dynamic_stability: hold the floor on the zero moment point too, the centre of
-            pressure with the inertial forces of turning and accelerating
-            (``model="thesis"`` only; docs/mpc.md), besides the static centre of mass; None
-            (default): on exactly when the force model runs on a physics plant.
+        dynamic_stability: keep every edge of the support polygon loaded while moving (at
+            least ``min_edge_load``; the edge loads of the force model with the inertial
+            forces of turning, accelerating and the arm's motion, ``model="thesis"`` only;
+            docs/mpc.md), besides the static floor on the centre of mass; None (default):
+            on exactly when the force model runs on a physics plant.
+        min_edge_load: with ``dynamic_stability``, the least load every edge keeps, as a
+            share of the weight in [0, 0.5) (default 0.1: 14.7 N with 3 kg, the static
+            floor S 1.25's own side-edge load).
         arm_time_constant: the joints follow the commanded rates with this first-order lag
             (s) in the prediction (``model="thesis"`` only; the physics plant's joint
             servos have one); None (default): that plant's lag when the force model runs on
@@ -176,6 +181,7 @@ class MPCOptions:
     proximal: float = 0.01
     stability_margin: float = 0.01
     dynamic_stability: bool | None = None
+    min_edge_load: float = DEFAULT_MIN_EDGE_LOAD
     arm_time_constant: float | None = None
     joint_acceleration_limit: float | Sequence[float] | None = None
     wheel_force_limit: float | None = None
@@ -215,6 +221,7 @@ class MPCOptions:
             self._set("brake_slack", brake)
         if self.dynamic_stability is not None:
             self._set("dynamic_stability", check_bool("dynamic_stability", self.dynamic_stability))
+        self._set("min_edge_load", check_min_edge_load(self.min_edge_load))
         self.adopt_plant(None)  # the combinations that need the force model, plant aside
         self._set("stability_min", check_stability_floor(self.stability_min))
         self._set("obstacles", tuple(as_circles(self.obstacles)))

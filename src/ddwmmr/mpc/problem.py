@@ -47,6 +47,8 @@ class Problem:
             else self.solver
         )
         self.terminal_factor: np.ndarray | None = None
+        #: the parameters of the last solve (the plan's predictions are functions of them)
+        self.last_parameters: np.ndarray | None = None
 
     def design_terminal(self, arm_pose: tuple[float, float]) -> None:
         """LQR terminal cost at the arm pose (tracking only)."""
@@ -86,6 +88,7 @@ class Problem:
             guess, horizon = self._shifted(warm, max(0.0, t - warm_time), x0)
             solver = self.solver
         p = ocp.parameters(references, u_prev, self.terminal_factor, horizon_prev=horizon)
+        self.last_parameters = p
         lbw, ubw = ocp.bounds(x0)
         w = solver.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
         return w, solver.last_iterations

@@ -26,7 +26,11 @@ Built by name::
 ``summarize`` adds to the run summary: ``stability_min`` (the floor), ``stability_violations``
 (recorded steps with S < floor), ``qp_fallbacks`` (recorded steps that used the safe
 command), ``min_obstacle_clearance_m`` (base footprint vs circles; None without obstacles),
-``qp_mode`` and ``qp_solver``.
+``qp_mode``, ``qp_solver`` and ``min_predicted_edge_load_n`` (the least edge load, N, the
+edge-load limit predicted for a command sent; None where that limit is off) and
+``min_edge_load_floor_n`` (its floor, N; None where off), ``edge_load_relaxed_steps`` (steps
+whose edge rows conflicted with the other limits and were dropped for that step's solve;
+the QP fallback runs only if that solve fails too).
 
 Its benchmark twin, :class:`ddwmmr.qp.naive.NaiveQPController`, is deliberately not a
 registered method: it is a baseline for ``python -m ddwmmr.bench``, not a method to compare.
@@ -40,12 +44,14 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ddwmmr.commands import PlantTraits
 from ddwmmr.controllers.base import StepInfo, WaypointRun, control_step, register_controller
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import whole_turns
 from ddwmmr.model.stability import STABILITY_FLOOR
+from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, check_min_edge_load
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import (
     INF,
@@ -64,6 +70,7 @@ from ddwmmr.qp.limits import (
     safe_arm_scale,
     stability_terms_gradient,
 )
+from ddwmmr.qp.limits.edge_loads import EdgeLoadLimit
 from ddwmmr.qp.problem import QPProblem
 from ddwmmr.qp.solve import MODES, check_mode, installed_solvers, make_backend, solve
 from ddwmmr.qp.tasks import (
@@ -133,6 +140,12 @@ class QPController:
             force-limited base whose wheel servos saturate one by one); None: off.
         singularity_margin: angle (rad) kept between link 1 and the base heading's normal
             (shoulder singularity, ``cos th1 = 0``); None switches the limit off.
+        min_edge_load: least load every edge of the support polygon keeps, as a share of
+            the weight in [0, 0.5) (default 0.1: 14.7 N with 3 kg, the static floor S 1.25's
+            own side-edge load), predicted from the command through the servos' lag
+            (:class:`~ddwmmr.qp.limits.edge_loads.EdgeLoadLimit`); on a plant that judges
+            tipping by its physics and reports its joints' lag (MuJoCo), where the inertial
+            loads it predicts are real; None: off.
         dt: look-ahead step of the exact stability check (s); default the trajectory's
             ``duration / samples`` at reset, else 0.02 s.
         warm_start: pass the previous solution to the solver (default: on for the
@@ -170,6 +183,7 @@ class QPController:
         max_acceleration: float | None = None,
         max_yaw_acceleration: float | None = None,
         speed_budget: tuple[float, float] | None = None,
+        min_edge_load: float | None = DEFAULT_MIN_EDGE_LOAD,
         dt: float | None = None,
         warm_start: bool | None = None,
         tasks: Sequence[Task] = (),
@@ -245,6 +259,10 @@ class QPController:
             detour = Detour(self.obstacles, half_diagonal + 2.0 * obstacle_margin)
             self.tracking.detour = heading.detour = detour
         self.limits.extend(_pieces("limits", limits, Limit))
+        self.min_edge_load = None if min_edge_load is None else check_min_edge_load(min_edge_load)
+        self.edge_loads: EdgeLoadLimit | None = None  # set by adopt_plant
+        self.min_predicted_edge_load: float | None = None
+        self.edge_relaxed_steps = 0  # steps whose edge rows gave way to the other limits
         self.problem = QPProblem(self.tasks, self.limits)
         self._dt_option = None if dt is None else check_positive("dt", dt)
         self._loop_step: float | None = None
@@ -257,6 +275,29 @@ class QPController:
         return make_backend(solver, warm_start)
 
     # -- controller protocol ------------------------------------------------------------
+    @property
+    def wants_base_velocity(self) -> bool:
+        """The edge-load limit needs the measured ``(v, w)`` (``base_velocity``)."""
+        return self.edge_loads is not None
+
+    def adopt_plant(self, plant: PlantTraits) -> None:
+        """The loop's plant, described: the edge-load limit is on where the plant judges
+        tipping by its physics and its joints lag (``min_edge_load`` not None)."""
+        physics = plant.judges_tipping and plant.joint_time_constant
+        wanted = self.min_edge_load is not None and bool(physics)
+        if self.edge_loads is not None:
+            self.limits.remove(self.edge_loads)
+            self.edge_loads = None
+        if wanted:
+            self.edge_loads = EdgeLoadLimit(
+                self.robot,
+                self.min_edge_load,
+                plant.joint_time_constant,
+                plant.joint_acceleration_limit,
+            )
+            self.limits.append(self.edge_loads)
+        self.problem = QPProblem(self.tasks, self.limits)
+
     def adopt_control_step(self, dt: float) -> None:
         """The loop holds each command ``dt`` (s): the look-ahead step, unless ``dt`` was
         given as an option."""
@@ -270,21 +311,62 @@ class QPController:
         self.ctx.start_turns = tuple(whole_turns(float(angle)) for angle in q0[2:5])
         self.fallbacks = 0
         self.last = StepInfo()
+        self.min_predicted_edge_load = None
+        self.edge_relaxed_steps = 0
+        if self.edge_loads is not None:
+            self.edge_loads.reset()
 
-    def command(self, t: float, q: np.ndarray, pose_d: np.ndarray, velocity_d: np.ndarray):
-        """Input ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s) for this step."""
+    def command(
+        self,
+        t: float,
+        q: np.ndarray,
+        pose_d: np.ndarray,
+        velocity_d: np.ndarray,
+        base_velocity: Sequence[float] | None = None,
+    ):
+        """Input ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s) for this step;
+        ``base_velocity``: the measured ``(v, w)`` (the edge-load limit's; else the
+        previous command's)."""
         ctx = self.ctx
         ctx.update_floats(t, *check_inputs(t, q, pose_d, velocity_d))
+        if self.edge_loads is not None:
+            measured = base_velocity if base_velocity is not None else ctx.previous_command
+            self.edge_loads.observe(*(measured or (0.0, 0.0)))
         x = self._solve(ctx)
+        relaxed = x is None and self.edge_loads is not None
+        if relaxed:  # the edge rows conflict with the other limits: they give way
+            self.edge_loads.active = False
+            try:
+                x = self._solve(ctx)
+            finally:
+                self.edge_loads.active = True
+            self.edge_relaxed_steps += 1
         if x is None:
-            return self._fallback(ctx)
+            return self._edge_prediction(ctx, self._fallback(ctx), relaxed)
         v, w, r1, r2, *slack = x
         scale = self.arm_scale(ctx, r1, r2)
         self.last = StepInfo(
             extra={"slack": max(map(abs, slack)) if slack else 0.0, "arm_scale": scale}
         )
         ctx.previous_command = (v, w)
-        return np.array([v, w, r1 * scale, r2 * scale])
+        return self._edge_prediction(ctx, np.array([v, w, r1 * scale, r2 * scale]), relaxed)
+
+    def _edge_prediction(self, ctx: StepContext, command: np.ndarray, relaxed: bool) -> np.ndarray:
+        """With the edge-load limit: the least predicted edge load of ``command`` and
+        whether the rows gave way (``relaxed``) into the step's info
+        (``min_predicted_edge_load_n``, ``edge_load_relaxed``) and the run's minimum, and
+        the joints' rate estimate moved on; ``command`` unchanged."""
+        limit = self.edge_loads
+        if limit is None:
+            return command
+        values = command.tolist()
+        least = min(limit.predict(values))
+        self.last.extra["min_predicted_edge_load_n"] = least
+        self.last.extra["edge_load_relaxed"] = float(relaxed)
+        if self.min_predicted_edge_load is None or least < self.min_predicted_edge_load:
+            self.min_predicted_edge_load = least
+        limit.advance(values, ctx.dt)
+        return command
 
     def arm_scale(self, ctx: StepContext, rate1: float, rate2: float) -> float:
         """Scale of the joint rates that keeps the exact S one step ahead above the floor
@@ -370,6 +452,9 @@ class QPController:
             "min_obstacle_clearance_m": clearance,
             "qp_mode": self.mode,
             "qp_solver": self.solver,
+            "min_predicted_edge_load_n": self.min_predicted_edge_load,
+            "min_edge_load_floor_n": None if self.edge_loads is None else self.edge_loads.floor_n,
+            "edge_load_relaxed_steps": self.edge_relaxed_steps,
         }
 
     # -- the scenario protocol's waypoint task -------------------------------------------

@@ -143,3 +143,88 @@ def save_physics_animation(
     animation.save(path, writer=PillowWriter(fps=fps))
     plt.close(fig)
     return path
+
+
+#: File name of the support-load figure a physics ``track`` run writes.
+SUPPORT_LOADS_FIGURE = "support_loads.png"
+#: An edge counts as unloaded (shaded) below this share of the weight (the plant's).
+_UNLOADED_SHARE = 1e-4
+
+
+def edge_names(normals) -> list[str]:
+    """A name per support-polygon edge from its inward normal (base frame): ``front``,
+    ``back``, ``left``, ``right`` for an edge facing that way, else ``edge <i>``."""
+    names = []
+    for i, (nx, ny) in enumerate(np.asarray(normals, dtype=float), start=1):
+        facing = {(-1, 0): "front", (1, 0): "back", (0, -1): "left", (0, 1): "right"}
+        key = (round(nx), round(ny)) if max(abs(nx), abs(ny)) > 0.999 else None
+        names.append(facing.get(key, f"edge {i}"))  # type: ignore[arg-type]
+    return names
+
+
+def edge_load_series(timeseries: dict[str, np.ndarray], robot) -> tuple[list[str], np.ndarray]:
+    """The measured load (N) on the supports off each edge of the robot's support polygon
+    at every sample, (samples, edges), from a physics run's ``support_force_<name>_n``
+    columns (in :func:`~ddwmmr.model.support_loads.support_points` order), with the
+    edges' names (:func:`edge_names`)."""
+    from ddwmmr.model.support_loads import support_points, support_polygon
+
+    forces = np.column_stack(
+        [timeseries[f"support_force_{n}_n"] for n in support_names(timeseries)]
+    )
+    polygon = support_polygon(robot)
+    off = polygon.off_edge(support_points(robot)).astype(float)  # (edges, supports)
+    return edge_names(polygon.normals), forces @ off.T
+
+
+def plot_support_loads(result, floor_n: float | None = None):
+    """Figure: the load on the supports off each edge of the support polygon (N; the edge
+    the base would pivot about when it reaches 0) with the optimisers' floor, and the
+    base's tilt (mrad), against time. Steps with an edge unloaded are shaded.
+
+    ``result`` is a physics run (the plant's ``support_force_<name>_n`` and
+    ``base_tilt_rad`` columns); ``floor_n`` (N) defaults to the run summary's
+    ``min_edge_load_floor_n`` (None: not drawn)."""
+    ts, robot = result.timeseries, result.robot
+    names, loads = edge_load_series(ts, robot)
+    weight = robot.total_mass * 9.81
+    if floor_n is None:
+        floor_n = result.summary.get("min_edge_load_floor_n")
+    t = ts["t"]
+    fig, (ax_load, ax_tilt) = plt.subplots(
+        2, 1, figsize=(7.5, 5.2), sharex=True, gridspec_kw={"height_ratios": [2.2, 1]}
+    )
+    unloaded = np.min(loads, axis=1) < _UNLOADED_SHARE * weight
+    for ax in (ax_load, ax_tilt):
+        if np.any(unloaded):
+            shade = {"color": "tab:red", "alpha": 0.15, "lw": 0, "step": "mid"}
+            ax.fill_between(t, 0, 1, where=unloaded, transform=ax.get_xaxis_transform(), **shade)
+    for j, name in enumerate(names):
+        ax_load.plot(t, loads[:, j], lw=0.8, label=f"{name} edge")
+    if floor_n is not None:
+        ax_load.axhline(floor_n, color="k", ls="--", lw=0.9, label=f"floor {floor_n:.1f} N")
+    ax_load.axhline(0.0, color="0.4", lw=0.6)
+    top = float(np.max(loads)) if loads.size else 1.0
+    ax_load.set_ylim(-0.03 * top, 1.05 * top)
+    ax_load.set_ylabel("load off the edge (N)")
+    ax_load.set_title(
+        f"support loads: unloaded {result.summary.get('unloaded_time_s', 0.0):.2f} s "
+        "(shaded), least edge load per edge"
+    )
+    ax_load.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
+    ax_tilt.plot(t, 1e3 * ts["base_tilt_rad"], color="0.3", lw=0.8)
+    ax_tilt.set_ylabel("base tilt (mrad)")
+    ax_tilt.set_xlabel("t (s)")
+    ax_tilt.set_xlim(float(t[0]), float(t[-1]))
+    fig.tight_layout()
+    return fig
+
+
+def save_support_loads(result, path: str | Path, floor_n: float | None = None) -> Path:
+    """Write :func:`plot_support_loads` to ``path`` (PNG)."""
+    from ddwmmr.reports.plots import PNG_METADATA
+
+    fig = plot_support_loads(result, floor_n)
+    fig.savefig(path, dpi=110, metadata=PNG_METADATA)
+    plt.close(fig)
+    return Path(path)

@@ -6,8 +6,10 @@ every time, so it cannot drift from ``Robot``. World frame: z up, floor at z = 0
 Bodies (all masses and inertias explicit, ``inertiafromgeom="false"``):
 
 * ``base`` (free joint): the base box, ``base_length x base_width x base_height``, bottom
-  :data:`BASE_CLEARANCE` above the floor. Body frame at the axle midpoint at wheel-centre
-  height (the point q's ``(x, y)`` names). Mass ``base_mass - 2 wheel_mass`` at the box
+  :data:`BASE_CLEARANCE` above the floor. Body frame on the floor under the axle midpoint
+  (the point q's ``(x, y)`` names): the free joint's translational damping (the base
+  damping, rolling resistance) then acts on the floor, where a real robot's does, and
+  puts no pitch moment on the base. Mass ``base_mass - 2 wheel_mass`` at the box
   centre; yaw inertia chosen so that base + wheels have ``base_inertia`` about the axle
   midpoint (docs/theory.md, "Tip-over stability"). Roll/pitch inertias are those of a
   uniform box (raised if needed to be physically consistent). The frictionless casters are
@@ -15,7 +17,10 @@ Bodies (all masses and inertias explicit, ``inertiafromgeom="false"``):
 * ``wheel_left`` / ``wheel_right`` (hinge about the base's y axis) at ``(0, +-Lw/2)``:
   mass ``wheel_mass`` each (a disc of width :data:`WHEEL_WIDTH`); their floor contact is a
   sphere of radius ``wheel_radius`` (one contact point straight below the axle, on the
-  support polygon's side edge), drawn as a cylinder. The wheels reach
+  support polygon's side edge), drawn as a cylinder. With ``tyre_stiffness`` (the default)
+  each wheel hangs on a vertical spring-damper, its rubber tyre's radial compliance in
+  series with the floor contact (:data:`TYRE_DAMPING_RATIO`), preloaded so that each tyre
+  carries :data:`TYRE_SHARE` of the weight at its nominal height. The wheels reach
   :data:`WHEEL_PRELOAD_DEPTH` below the casters' plane (casters mounted a hair high, as
   on real platforms), so they stay pressed on the floor wherever statics allows: six
   rigid supports on a plane share the load in a way statics leaves open, and left to the
@@ -67,7 +72,17 @@ DEFAULT_TIMESTEP = 0.002
 DEFAULT_FRICTION = 1.0
 DEFAULT_SERVO_TIME_CONSTANT = 0.02
 DEFAULT_CONTACT_TIME_CONSTANT = 0.01
+DEFAULT_CONE = "elliptic"
 CONES = ("pyramidal", "elliptic")
+#: Radial stiffness (N/m) of each drive wheel's tyre: a small robot's solid rubber tyre
+#: deflects about 1 mm under the ~50 N a drive wheel carries (docs/physics.md, "The
+#: model, generated from Robot").
+DEFAULT_TYRE_STIFFNESS = 5e4
+#: Damping ratio of the tyre's radial spring (rubber's hysteresis), on the mass it carries.
+TYRE_DAMPING_RATIO = 0.3
+#: Share of the robot's weight each tyre carries at rest at its nominal height (the
+#: casters the rest): the spring's preload.
+TYRE_SHARE = 1.0 / 3.0
 #: Actuator order in the model (and in ``MjData.ctrl``).
 ACTUATORS = ("wheel_left", "wheel_right", "shoulder", "elbow")
 
@@ -96,21 +111,32 @@ class EngineOptions:
         timestep: engine step (s); the control step must be a whole multiple of it.
         friction: sliding friction coefficient between the wheels and the floor.
         servo_time_constant: time constant of the velocity servos (s), sets their gains.
-        cone: friction cone, ``"pyramidal"`` (MuJoCo's default) or ``"elliptic"``.
+        cone: friction cone, ``"elliptic"`` (default: MuJoCo's exact Coulomb cone) or
+            ``"pyramidal"`` (MuJoCo's default, four facets; a lightly loaded slipping
+            wheel chatters on and off the floor under it, docs/physics.md).
         contact_time_constant: time constant of the contacts' soft constraint (s, MuJoCo's
             ``solref[0]``, critically damped): smaller is stiffer (less sinking and
             tilting under load) and needs a smaller timestep (at least 2 timesteps).
+        tyre_stiffness: radial stiffness of each drive wheel's tyre (N/m, > 0), or 0 for
+            a rigid wheel (the contact's own compliance only).
     """
 
     timestep: float = DEFAULT_TIMESTEP
     friction: float = DEFAULT_FRICTION
     servo_time_constant: float = DEFAULT_SERVO_TIME_CONSTANT
-    cone: str = "pyramidal"
+    cone: str = DEFAULT_CONE
     contact_time_constant: float = DEFAULT_CONTACT_TIME_CONSTANT
+    tyre_stiffness: float = DEFAULT_TYRE_STIFFNESS
 
     def __post_init__(self) -> None:
         for name in ("timestep", "friction", "servo_time_constant", "contact_time_constant"):
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
+        stiffness = self.tyre_stiffness
+        if not (isinstance(stiffness, int | float) and math.isfinite(stiffness) and stiffness >= 0):
+            raise ParameterError(
+                f"tyre_stiffness must be >= 0 N/m (0: rigid wheels) (got {stiffness!r})"
+            )
+        object.__setattr__(self, "tyre_stiffness", float(stiffness))
         if self.cone not in CONES:
             raise ParameterError(f"cone must be one of {', '.join(CONES)} (got {shown(self.cone)})")
         if self.contact_time_constant < 2.0 * self.timestep:
@@ -288,9 +314,9 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
         condim=3,
         rgba="0.75 0.78 0.8 1",
     )
-    base = _sub(world, "body", name="base", pos=_fmt(0, 0, r))
+    base = _sub(world, "body", name="base", pos=_fmt(0, 0, 0))
     _sub(base, "freejoint", name="base")
-    box_z = BASE_CLEARANCE + 0.5 * robot.base_height - r
+    box_z = BASE_CLEARANCE + 0.5 * robot.base_height
     base_mass = robot.base_body_mass
     _sub(
         base,
@@ -316,7 +342,7 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
                 name=support.name,
                 type="sphere",
                 size=f"{CASTER_RADIUS:.17g}",
-                pos=_fmt(*support.point, CASTER_RADIUS - r),
+                pos=_fmt(*support.point, CASTER_RADIUS),
                 condim=1,
                 priority=1,
                 rgba="0.2 0.2 0.2 1",
@@ -326,8 +352,10 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
         if support.kind != "wheel":
             continue
         wheel = _sub(
-            base, "body", name=support.name, pos=_fmt(*support.point, -WHEEL_PRELOAD_DEPTH)
+            base, "body", name=support.name, pos=_fmt(*support.point, r - WHEEL_PRELOAD_DEPTH)
         )
+        if options.tyre_stiffness > 0.0:
+            _tyre(wheel, robot, options.tyre_stiffness, f"tyre_{support.name.split('_')[1]}")
         _sub(wheel, "joint", name=support.name, type="hinge", axis="0 1 0")
         _sub(
             wheel,
@@ -362,10 +390,30 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+def _tyre(wheel: ET.Element, robot: Robot, stiffness: float, name: str) -> None:
+    """The tyre's radial compliance: a vertical slide joint between the base and the
+    wheel, a spring of ``stiffness`` (N/m) preloaded to carry :data:`TYRE_SHARE` of the
+    weight at the wheel's nominal height, damped at :data:`TYRE_DAMPING_RATIO` of the
+    mass that share is."""
+    mass = robot.total_mass
+    preload = TYRE_SHARE * mass * 9.81
+    damping = 2.0 * TYRE_DAMPING_RATIO * math.sqrt(stiffness * TYRE_SHARE * mass)
+    _sub(
+        wheel,
+        "joint",
+        name=name,
+        type="slide",
+        axis="0 0 1",
+        stiffness=f"{stiffness:.17g}",
+        damping=f"{damping:.17g}",
+        springref=f"{-preload / stiffness:.17g}",
+    )
+
+
 def _arm(base: ET.Element, robot: Robot) -> None:
     (low1, high1), (low2, high2) = robot.joint_limits
     m1 = robot.link_masses[0]
-    link1 = _sub(base, "body", name="link1", pos=_fmt(0, 0, robot.arm_height - robot.wheel_radius))
+    link1 = _sub(base, "body", name="link1", pos=_fmt(0, 0, robot.arm_height))
     _sub(link1, "joint", name="shoulder", type="hinge", axis="0 0 1", range=_fmt(low1, high1))
     _sub(
         link1,

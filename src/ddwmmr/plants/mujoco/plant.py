@@ -37,6 +37,7 @@ from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
 from ddwmmr.plants.kinematic import KinematicPlant
 from ddwmmr.plants.mujoco.model import (
     ACTUATORS,
+    TYRE_DAMPING_RATIO,
     EngineOptions,
     build_model,
     reflected_inertias,
@@ -47,8 +48,10 @@ from ddwmmr.plants.thesis import arm_step, damped_base_envelope
 from ddwmmr.registry import register_plant
 
 #: Time (s) the robot settles on its supports in :meth:`MujocoPlant.reset` before t = 0,
-#: so that the first recorded contact forces carry the robot's weight.
-SETTLE_TIME_S = 0.2
+#: so that the first recorded contact forces carry the robot's weight (on its tyres: after
+#: 0.2 s the floor still carried 0.1 % more than the weight as the base bounced on them,
+#: after 0.5 s 1e-5).
+SETTLE_TIME_S = 0.5
 #: Share of a motor's torque limit counted as saturated (``torque_use``).
 TORQUE_SATURATED = 0.999
 #: Time constant (s) of the damping that holds the base still while it settles.
@@ -93,8 +96,10 @@ class MujocoPlant:
         timestep: engine step (s), default 0.002 (docs/physics.md, "Settings").
         friction: wheel-floor sliding friction coefficient.
         servo_time_constant: response time of the velocity servos (s).
-        cone: MuJoCo friction cone, ``"pyramidal"`` or ``"elliptic"``.
+        cone: MuJoCo friction cone, ``"elliptic"`` (default, Coulomb's) or ``"pyramidal"``.
         contact_time_constant: stiffness of the contacts as a time constant (s).
+        tyre_stiffness: radial stiffness of each drive wheel's tyre (N/m; default 5e4,
+            0 for rigid wheels).
         base_damping: ``(c_translation N s/m, c_yaw N m s/rad)`` viscous damping of the
             base's horizontal and yaw motion (the thesis plant's c1, c2: rolling resistance
             and drive friction as the thesis models them); None (default): none, the
@@ -115,6 +120,7 @@ class MujocoPlant:
         cone: str | None = None,
         contact_time_constant: float | None = None,
         base_damping: tuple[float, float] | None = None,
+        tyre_stiffness: float | None = None,
     ) -> None:
         self.base_damping = _check_damping(base_damping)
         given = {
@@ -123,6 +129,7 @@ class MujocoPlant:
             "servo_time_constant": servo_time_constant,
             "cone": cone,
             "contact_time_constant": contact_time_constant,
+            "tyre_stiffness": tyre_stiffness,
         }
         self.options = EngineOptions(**{k: v for k, v in given.items() if v is not None})
         self.robot = robot
@@ -178,6 +185,11 @@ class MujocoPlant:
             "shoulder_qpos": model.jnt_qposadr[find(mujoco.mjtObj.mjOBJ_JOINT, "shoulder")],
             "elbow_qpos": model.jnt_qposadr[find(mujoco.mjtObj.mjOBJ_JOINT, "elbow")],
             "wheel_actuators": [ACTUATORS.index("wheel_left"), ACTUATORS.index("wheel_right")],
+            "tyre_dofs": [
+                int(model.jnt_dofadr[j])
+                for j in (find(mujoco.mjtObj.mjOBJ_JOINT, n) for n in ("tyre_left", "tyre_right"))
+                if j >= 0
+            ],
         }
 
     @property
@@ -265,7 +277,7 @@ class MujocoPlant:
         model, data = self.model, self.data
         mujoco.mj_resetData(model, data)
         self._set_wheel_mode(VELOCITY)
-        self._place(q0, z=self.robot.wheel_radius)
+        self._place(q0, z=0.0)  # the base frame sits on the floor (model.py)
         mujoco.mj_forward(model, data)
         data.ctrl[:] = 0.0
         # Settle with the base's six degrees of freedom heavily damped, so that it sinks
@@ -273,7 +285,11 @@ class MujocoPlant:
         # otherwise rock onto its edge and back).
         self._warnings = self._warning_count()
         model.dof_damping[0:6] = self._settle_damping
+        tyres = self._ids["tyre_dofs"]
+        running = model.dof_damping[tyres].copy()
+        model.dof_damping[tyres] = running / TYRE_DAMPING_RATIO  # critically damped meanwhile
         mujoco.mj_step(model, data, max(1, round(SETTLE_TIME_S / model.opt.timestep)))
+        model.dof_damping[tyres] = running
         model.dof_damping[0:6] = 0.0
         if self.base_damping is not None:
             # free joint: dofs 0-2 translate in the world frame, 3-5 rotate in the body's
