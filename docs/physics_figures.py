@@ -555,7 +555,12 @@ def main(which: list[str]) -> None:
         "settings": settings_study,
         "speed": speed,
     }
-    selected = which or [*jobs, "runs"]
+    known = [*jobs, "runs"]
+    unknown = [name for name in which if name not in known and name not in ("-h", "--help")]
+    if unknown or not set(which).isdisjoint({"-h", "--help"}):
+        print(f"usage: physics_figures.py [{' '.join(known)}] (none: all)", file=sys.stderr)
+        raise SystemExit(0 if not unknown else 2)
+    selected = which or known
     for name in selected:
         if name == "runs":
             table, runs = sideways_reach_runs()
