@@ -253,8 +253,13 @@ def physics_tipping() -> None:
         if tip is not None:
             for ax in axes:
                 ax.axvline(tip, color=color, lw=0.8, ls="--")
+            # left of the tip line, above the tilt that is still small before it
             axes[2].annotate(
-                f" tipped (physics) at {tip:.2f} s", (tip, 1.8), color=color, fontsize=8
+                f"tipped (physics) at {tip:.2f} s ",
+                (tip, 2.5),
+                color=color,
+                fontsize=8,
+                ha="right",
             )
         print(
             f"{label}: tip {tip}, max tilt {np.degrees(rows[:, 4].max()):.2f} deg, "
@@ -264,13 +269,14 @@ def physics_tipping() -> None:
     axes[0].axhline(1.0, color="0.5", lw=0.7, ls="--")
     axes[0].set_ylim(1.0, 2.2)
     axes[0].set_ylabel("static S (floor 1.25)")
-    axes[0].legend(fontsize=7, loc="upper center")
     axes[1].set_ylabel("smallest edge load (N)")
     axes[2].set_ylabel("base tilt (deg)")
     axes[2].set_xlabel("t (s)")
-    axes[1].legend(fontsize=7)
     axes[0].set_title("Scenario 7 on MuJoCo, mpc turning with the 3 kg payload out", fontsize=10)
-    fig.tight_layout()
+    # one legend under the panels: inside them it would cover the curves
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.04, 1, 1))
     fig.savefig(FIGURES / "mpc_physics_tipping.png", dpi=110)
     plt.close(fig)
 
