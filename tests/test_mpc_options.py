@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
 import pytest
 
 from ddwmmr import Ellipse, ParameterError, Robot, make_controller, simulate
@@ -46,6 +47,8 @@ def test_every_option_is_listed_with_its_default():
         ({"model": "kinematic", "arm_time_constant": 0.05}, "arm_time_constant needs model"),
         ({"horizon": 0.01}, "horizon must be > the control step"),
         ({"joint_acceleration_limit": (1.0, 2.0, 3.0)}, "one number or two"),
+        ({"cold_iterations": 0}, r"cold_iterations must be an integer in \[1, 20\]"),
+        ({"cold_iterations": 2.5}, r"cold_iterations must be an integer in \[1, 20\]"),
     ],
 )
 def test_bad_options_are_refused_when_the_object_is_made(options, match):
@@ -110,3 +113,17 @@ def test_the_scenario_tool_records_the_options_its_runs_use():
     assert set(record) == set(FIELDS) - {"obstacles"}
     assert (record["model"], record["track_orientation"], record["dt"]) == ("thesis", False, 0.01)
     assert record["horizon"] == GRID_DEFAULTS["reach"][2] and record["huber"] == 0.01
+
+
+@pytest.mark.parametrize("cold_iterations", [1, 2, 5])
+def test_a_cold_start_takes_at_most_cold_iterations_qps_and_later_steps_one(cold_iterations):
+    """A new target starts cold: that step solves ``cold_iterations`` QPs from the
+    standing guess (while the plan still moves, as it does 1.5 m from the target), every
+    later step of the real-time iteration one; the next new target starts cold again."""
+    controller = make_controller("mpc", ROBOT, cold_iterations=cold_iterations, dt=0.05)
+    q = np.array([0.0, 0.0, 0.0, 0.3, 1.2])
+    qps = []
+    for k, target in enumerate([(1.5, 0.8)] * 4 + [(-1.0, 1.5)] * 3):
+        controller.command(0.05 * k, q, np.array([*target, 0.0]), np.zeros(3))
+        qps.append(controller.last.extra["mpc_iterations"])
+    assert qps == [cold_iterations, 1, 1, 1, cold_iterations, 1, 1]

@@ -212,6 +212,7 @@ class MPCController:
                 options.solver,
                 options.qp_solver,
                 options.proximal,
+                options.cold_iterations,
             )
         return self._problems[key]
 

@@ -36,6 +36,7 @@ from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, check_min_edge_loa
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT, FORCE_LIMIT_DEFAULT
 from ddwmmr.mpc.braking import BRAKE_SLACK
 from ddwmmr.mpc.ocp import MAX_HORIZON, MAX_INTERVALS, MIN_INTERVAL, Weights, grid_intervals
+from ddwmmr.mpc.problem import COLD_ITERATIONS
 from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS
 from ddwmmr.qp.limits import as_circles
 
@@ -116,6 +117,11 @@ class MPCOptions:
         solver: ``"rti"`` (one Gauss-Newton iteration per step, default), ``"sqp"``
             (iterated Gauss-Newton), ``"ipopt"``, ``"sqpmethod"`` or ``"fatrop"``.
         qp_solver: QP backend of ``rti``/``sqp`` (``"hpipm"`` default).
+        cold_iterations: Gauss-Newton iterations (one QP each) of a cold start with
+            ``solver="rti"`` (the first step, a new waypoint, after a fallback or a stall),
+            in [1, 20]; the later steps refine the plan one iteration each, so fewer bound
+            the slowest step at the cost of a rougher first plan (docs/mpc.md, "Where an
+            MPC step's time goes").
         position_weight, orientation_weight, input_weight: cost weights (see
             :class:`ddwmmr.mpc.ocp.Weights`; position None: per objective,
             :data:`POSITION_WEIGHTS`); huber: Huber scale (m) of position errors (None:
@@ -173,6 +179,7 @@ class MPCOptions:
     first_interval: float | None = None
     solver: str = "rti"
     qp_solver: str = "hpipm"
+    cold_iterations: int = COLD_ITERATIONS
     position_weight: float | None = None
     orientation_weight: float = 10.0
     input_weight: float = 0.01
@@ -202,6 +209,9 @@ class MPCOptions:
             raise ParameterError(
                 f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {shown(qp_solver)})"
             )
+        self._set(
+            "cold_iterations", check_int_at_least("cold_iterations", self.cold_iterations, 1, 20)
+        )
         lag = self.arm_time_constant
         if lag is not None and lag != 0.0:
             check_range("arm_time_constant", lag, 1e-3, 1.0, "s")

@@ -25,7 +25,8 @@ class Problem:
         robot, choice, model, config: what the OCP is built from (see
             :func:`~ddwmmr.mpc.cache.shared_ocp`).
         solver, qp_solver, proximal: the ``mpc``'s solver options; a real-time iteration
-            (``"rti"``) starts cold with :data:`COLD_ITERATIONS` Gauss-Newton iterations.
+            (``"rti"``) starts cold with ``cold_iterations`` Gauss-Newton iterations
+            (default :data:`COLD_ITERATIONS`).
     """
 
     def __init__(
@@ -37,12 +38,13 @@ class Problem:
         solver: str,
         qp_solver: str,
         proximal: float,
+        cold_iterations: int = COLD_ITERATIONS,
     ) -> None:
         self.robot, self.model = robot, model
         self.ocp = shared_ocp(robot, choice, model, config)
         self.solver = make_solver(solver, self.ocp, qp_solver, proximal=proximal)
         self.cold = (
-            make_solver("sqp", self.ocp, qp_solver, iterations=COLD_ITERATIONS)
+            make_solver("sqp", self.ocp, qp_solver, iterations=cold_iterations)
             if solver == "rti"
             else self.solver
         )
