@@ -231,7 +231,8 @@ class LaggedArmPrediction(ThesisPrediction):
         a shoulder swinging at 2 rad/s with the payload out turns the base at about
         1 rad/s once it stops, which the wheels' few N m take most of a second to shed.
         The wheels' torque and the damping while the arm brakes (about 0.15 s) are left
-        out, and so is the change of v: the state the arm's braking leaves the base in."""
+        out, and so is the change of v: the state the arm's braking leaves the base in
+        (why: docs/mpc.md, "The last node with the arm braked to rest")."""
         stop = self.stopping_configuration(x)
         if stop is None:
             return None

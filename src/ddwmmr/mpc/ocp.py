@@ -61,10 +61,10 @@ row with a slack"). With the lagged arm and a joint acceleration limit, rows
 last node holds the centre of mass of its *stopping pose* (each joint moved on by its
 braking distance at that limit) in the stability box too: a plan may not end in a swing
 the arm cannot brake before the floor. With ``dynamic_stability`` the last node also keeps
-every edge loaded once the arm has braked to rest (:meth:`~ddwmmr.mpc.models.
-PredictionModel.stopped_arm_motion`): the arm's angular momentum then turns the base, and
-that turn's sideways acceleration ``v w`` must leave each edge ``min_edge_load`` (the same
-rows and slacks as the path's edge rows).
+every edge loaded once the arm has braked to rest (the model's ``stopped_arm_motion``):
+the arm's angular momentum then turns the base, and that turn's sideways acceleration
+``v w`` must leave each edge ``min_edge_load`` (the same rows and slacks as the path's
+edge rows).
 
 Cost: ``0.5 ||r(w, p)||^2 + c' w`` with the residual ``r`` stacked from, weighted by the
 interval lengths:
