@@ -175,8 +175,9 @@ def test_the_mpc_bounds_every_edge_in_metres_with_the_stability_slacks():
     model = LaggedArmPrediction(ROBOT, dynamics, TAU, (12.8, 33.3))
     config = OCPConfig(intervals=3, horizon=1.0, dynamic_stability=True, min_edge_load=0.2)
     ocp = ShootingOCP(ROBOT, model, config)
-    # every edge at both ends of each of the 3 intervals, its floor 0.2 D_e in metres
-    expected = sorted(0.2 * d for d in MODEL.polygon.depths.tolist() * 2 * 3)
+    # every edge at both ends of each of the 3 intervals and once more at the last node
+    # with the arm braked to rest, its floor 0.2 D_e in metres
+    expected = sorted(0.2 * d for d in MODEL.polygon.depths.tolist() * (2 * 3 + 1))
     assert sorted(ocp.lbg[ocp.lbg > 0.0].tolist()) == pytest.approx(expected)
     static = ShootingOCP(ROBOT, model, OCPConfig(intervals=3, horizon=1.0))
     assert static.first_edge_loads is None

@@ -403,7 +403,9 @@ def test_a_reach_plan_ends_where_the_arm_can_still_brake_above_the_floor():
         return ROBOT.stability(stop)[2], np.abs(rates).max()
 
     braked, rate = stopping_stability(limits)
-    assert braked >= 1.26 - 1e-6 and rate > 1.0  # it still passes the target moving
+    # it still passes the target moving (slower than 1 rad/s since the last node also
+    # keeps every edge loaded under the turn the braked arm's momentum gives the base)
+    assert braked >= 1.26 - 1e-6 and rate > 0.5
     assert stopping_stability(None)[0] < 1.25
 
 

@@ -17,7 +17,9 @@ Three models, one interface (:class:`PredictionModel`):
   the physics plant's). With ``acceleration_limit`` the lag's accelerations are bounded
   (rows) by what the joints' motors give, as the physics plant's torque-limited servos,
   and ``stopping_configuration`` is the pose where the joints come to rest braked at that
-  limit (the OCP holds its centre of mass in the stability box at the last node).
+  limit (the OCP holds its centre of mass in the stability box at the last node), and
+  ``stopped_arm_motion`` the base's motion once the arm rests there (the yaw the arm's
+  angular momentum leaves it with; the OCP keeps every edge loaded under it).
 
 Joint-position limits are state bounds of the models; the OCP holds them as bounds of the
 nodes where the joints stop at once (``joints_stop_at_once``) and as slackened rows for the
@@ -88,6 +90,11 @@ class PredictionModel(ABC):
     def stopping_configuration(self, x: Any) -> Any | None:
         """Where the joints come to rest from state ``x`` when braked as hard as they may,
         or None when the model's joints stop at once (rates are inputs)."""
+        return None
+
+    def stopped_arm_motion(self, x: Any) -> tuple[Any, Any, Any] | None:
+        """``(q, v, w)`` when the joints have come to rest from state ``x``, or None when
+        the model's joints stop at once (rates are inputs) or have no braking bound."""
         return None
 
     def integrate(self, x: Any, u: Any, h: Any, substeps: int) -> Any:
@@ -213,6 +220,25 @@ class LaggedArmPrediction(ThesisPrediction):
         limits = ca.DM(self.acceleration_limit)
         distance = rates * ca.sqrt(rates**2 + 1e-6) / (2.0 * limits)
         return ca.vertcat(x[:3], x[3:5] + distance)
+
+    def stopped_arm_motion(self, x: Any) -> tuple[Any, Any, Any] | None:
+        """``(q, v, w)`` once the joints have braked to rest from state ``x``: ``q`` the
+        stopping pose (:meth:`stopping_configuration`), ``v`` the base's speed now (m/s)
+        and ``w`` the yaw rate (rad/s) the arm's angular momentum leaves the base with.
+        Braking the arm moves its momentum ``H`` into the base (the total ``I(th2) w + H``
+        about the base centre changes only by the wheels' torque and the damping,
+        :meth:`ThesisDynamics.arm_yaw_reaction`), so ``w = (I(th2) w + H) / I(th2_stop)``:
+        a shoulder swinging at 2 rad/s with the payload out turns the base at about
+        1 rad/s once it stops, which the wheels' few N m take most of a second to shed.
+        The wheels' torque and the damping while the arm brakes (about 0.15 s) are left
+        out, and so is the change of v: the state the arm's braking leaves the base in
+        (why: docs/mpc.md, "The last node with the arm braked to rest")."""
+        stop = self.stopping_configuration(x)
+        if stop is None:
+            return None
+        d = self.dynamics
+        momentum = d.inertia(x[4]) * x[6] + d.arm_momentum(x[4], x[7:9])
+        return stop, x[5], momentum / d.inertia(stop[4])
 
     def rhs(self, x: Any, u: Any) -> Any:
         rates, accelerations = self.joint_motion(x, u)

@@ -60,7 +60,11 @@ row with a slack"). With the lagged arm and a joint acceleration limit, rows
 ``(u_rates - rates) / tau`` at the start of every interval, where it is largest, and the
 last node holds the centre of mass of its *stopping pose* (each joint moved on by its
 braking distance at that limit) in the stability box too: a plan may not end in a swing
-the arm cannot brake before the floor.
+the arm cannot brake before the floor. With ``dynamic_stability`` the last node also keeps
+every edge loaded once the arm has braked to rest (the model's ``stopped_arm_motion``):
+the arm's angular momentum then turns the base, and that turn's sideways acceleration
+``v w`` must leave each edge ``min_edge_load`` (the same rows and slacks as the path's
+edge rows).
 
 Cost: ``0.5 ||r(w, p)||^2 + c' w`` with the residual ``r`` stacked from, weighted by the
 interval lengths:
@@ -407,6 +411,16 @@ class ShootingOCP:
                 rows.append((loads[e] * lever, slack, self.config.min_edge_load * float(depth)))
                 if k == 0:
                     self._first_loads.append(loads[e])
+        stopped = model.stopped_arm_motion(x_next) if k == self.N - 1 else None
+        if stopped is not None:
+            # the last node's arm braked to rest: its momentum turns the base, and the
+            # turn's sideways acceleration v w must leave every edge loaded too
+            q_stop, v, w = stopped
+            loads = sym.edge_loads(robot, q_stop, (0.0, 0.0), (0.0, 0.0), (0.0, v * w), w, 0.0)
+            for e, (normal, depth) in enumerate(zip(polygon.normals, polygon.depths)):
+                slack = 0 if abs(normal[0]) >= abs(normal[1]) else 1
+                lever = float(depth) / weight
+                rows.append((loads[e] * lever, slack, self.config.min_edge_load * float(depth)))
         return rows
 
     def _bounds_and_linear_cost(self) -> None:
