@@ -202,3 +202,39 @@ def test_export_before_a_run_is_a_message(tmp_path):
     app.export_field.submit(" ")
     assert app.message == "export folder must not be empty"
     assert app.export_field.text == str(tmp_path)
+
+
+def test_support_loads_button_draws_the_track_panel_of_a_physics_run(tmp_path):
+    """A MuJoCo run's Support loads button writes support_loads.png, drawn by the function
+    that draws track's figure: each edge's measured load (N) with the floor the optimiser
+    held, and the base's tilt (mrad), the same numbers as the run's time series."""
+    from ddwmmr.reports.physics_plots import draw_support_loads, edge_load_series
+
+    settings = Settings(methods=("qp", None), plant="mujoco", duration=DURATION, payload=3.0)
+    app = finished_app(settings, tmp_path / "gui")
+    click(app.export_buttons["loads"].ax)
+    (folder,) = (tmp_path / "gui").iterdir()
+    with Image.open(folder / "support_loads.png") as image:
+        assert image.size == (825, 572)  # 7.5 x 5.2 in at 110 dpi, as track's
+    (result,) = app.results
+    figure = draw_support_loads(Figure(), result)
+    ax_load, ax_tilt = figure.axes
+    names, loads = edge_load_series(result.timeseries, result.robot)
+    edges = [line for line in ax_load.lines if line.get_label().endswith(" edge")]
+    assert [line.get_label() for line in edges] == [f"{name} edge" for name in names]
+    for j, line in enumerate(edges):
+        np.testing.assert_allclose(line.get_ydata(), loads[:, j])
+    assert loads.min() > 14.0  # the qp kept every edge loaded on this short run
+    floor = result.summary["min_edge_load_floor_n"]
+    assert floor == pytest.approx(0.1 * result.robot.total_mass * 9.81)
+    (floor_line,) = [line for line in ax_load.lines if line.get_label().startswith("floor")]
+    assert floor_line.get_ydata()[0] == pytest.approx(floor)
+    (tilt,) = ax_tilt.lines
+    np.testing.assert_allclose(tilt.get_ydata(), 1e3 * result.timeseries["base_tilt_rad"])
+
+
+def test_support_loads_of_a_run_without_physics_is_a_message(tmp_path):
+    app = finished_app(Settings(methods=("clrrmc-cs", None), duration=DURATION), tmp_path / "gui")
+    click(app.export_buttons["loads"].ax)
+    assert "only a run on a physics plant measures them (plant: mujoco)" in app.message
+    assert not any((tmp_path / "gui").rglob("*.png"))

@@ -702,6 +702,31 @@ class App(PanelLayout):
         return path
 
     @guarded
+    def export_support_loads(self) -> list[Path]:
+        """Support loads button: each physics run's support-load panel (every edge's load
+        with the optimisers' floor, the base's tilt; the figure a physics ``track`` run
+        writes) as ``support_loads.png``, and on the desktop in a window of its own."""
+        folder = self._export_folder()
+        written = export.write_support_loads(folder, self.results, self.labels())
+        if self.interactive:
+            self._show_support_loads()
+        self.say(f"wrote {', '.join(str(path) for path, _ in written)}")
+        return [path for path, _ in written]
+
+    def _show_support_loads(self) -> None:
+        """The physics runs' support-load panels, each in a desktop window of its own."""
+        import matplotlib.pyplot as plt
+
+        from ddwmmr.reports import physics_plots as pp
+
+        for result, label in zip(self.results, self.labels()):
+            if pp.is_physics_run(result):
+                window = plt.figure(figsize=pp.SUPPORT_LOADS_FIGSIZE, num=f"support loads: {label}")
+                window.clear()
+                pp.draw_support_loads(window, result)
+                window.show()
+
+    @guarded
     def export_animation(self, fmt: str = "gif") -> Path:
         """Export button: the run's animation as GIF or MP4."""
         folder = self._export_folder()

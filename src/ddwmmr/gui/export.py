@@ -13,6 +13,8 @@ Layout of one run's export folder (``<root>/<A>[-vs-<B>]-<trajectory>-<stamp>/``
     trajectory.csv                   a sampled trajectory moved by the geometry controls
                                      (the records refer to it)
     window.png                       the whole window
+    support_loads.png                a physics run's support loads and base tilt (the
+                                     figure `track` writes; A-<method>/ per slot)
     animation.gif | animation.mp4    the view (paths, robot, plots) over the run
 """
 
@@ -119,6 +121,37 @@ def run_record(
         plant=settings.plant,
     )
     return provenance.run_record(inputs, argv=None, rerun=None, tool="gui", prog=GUI_PROG)
+
+
+def write_support_loads(
+    folder: Path, results: Sequence[Any], labels: Sequence[str]
+) -> list[tuple[Path, Figure]]:
+    """``support_loads.png`` of every physics run (in a sub-folder per run when two): the
+    support-load panel of :func:`ddwmmr.reports.physics_plots.draw_support_loads`, the
+    figure a physics ``track`` run writes. Returns each file with its figure (drawn on a
+    canvas of its own, never the window's). ParameterError when no run is a physics run."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+    from ddwmmr.reports import physics_plots as pp
+    from ddwmmr.reports.plots import PNG_METADATA
+
+    physics = [(r, label) for r, label in zip(results, labels) if pp.is_physics_run(r)]
+    if not physics:
+        raise ParameterError(
+            "support loads: only a run on a physics plant measures them (plant: mujoco)"
+        )
+    written = []
+    for result, label in physics:
+        figure = Figure(figsize=pp.SUPPORT_LOADS_FIGSIZE)
+        FigureCanvasAgg(figure)
+        pp.draw_support_loads(figure, result)
+        buffer = io.BytesIO()
+        figure.savefig(buffer, format="png", dpi=pp.SUPPORT_LOADS_DPI, metadata=PNG_METADATA)
+        target = folder if len(results) == 1 else folder / label
+        path = first_free(target / pp.SUPPORT_LOADS_FIGURE)
+        write_atomic(path, buffer.getvalue())
+        written.append((path, figure))
+    return written
 
 
 def write_window_png(figure: Figure, folder: Path, dpi: float | None = None) -> Path:

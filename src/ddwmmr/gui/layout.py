@@ -219,21 +219,20 @@ class PanelLayout:
             self._report,
         )
         row = top - 0.07
+        # (x, width) of each button on the row: the animation formats' short labels
+        # leave room for the physics runs' support-load panel
+        places = {"data": (0.012, 0.07), "png": (0.086, 0.07), "gif": (0.16, 0.045)}
+        places.update(mp4=(0.209, 0.045), loads=(0.258, 0.07))
+        actions = {
+            "data": ("CSV + JSON", self.export_data),
+            "png": ("PNG (window)", self.export_png),
+            "gif": ("GIF", functools.partial(self.export_animation, "gif")),
+            "mp4": ("MP4", functools.partial(self.export_animation, "mp4")),
+            "loads": ("Support loads", self.export_support_loads),
+        }
         self.export_buttons = {
-            "data": button(self.figure, (0.012, row, 0.075, 0.028), "CSV + JSON", self.export_data),
-            "png": button(self.figure, (0.092, row, 0.075, 0.028), "PNG (window)", self.export_png),
-            "gif": button(
-                self.figure,
-                (0.172, row, 0.075, 0.028),
-                "GIF",
-                functools.partial(self.export_animation, "gif"),
-            ),
-            "mp4": button(
-                self.figure,
-                (0.252, row, 0.075, 0.028),
-                "MP4",
-                functools.partial(self.export_animation, "mp4"),
-            ),
+            key: button(self.figure, (x, row, width, 0.028), *actions[key])
+            for key, (x, width) in places.items()
         }
         for widget in self.export_buttons.values():
             widget.label.set_fontsize(FONT)

@@ -17,6 +17,7 @@ matplotlib.use("Agg")  # files only: never needs a screen
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 
 from ddwmmr.reports.plots import robot_outline
 
@@ -177,23 +178,40 @@ def edge_load_series(timeseries: dict[str, np.ndarray], robot) -> tuple[list[str
     return edge_names(polygon.normals), forces @ off.T
 
 
+#: Size (inches) and resolution (dots per inch) of the support-load figure.
+SUPPORT_LOADS_FIGSIZE = (7.5, 5.2)
+SUPPORT_LOADS_DPI = 110
+
+
+def is_physics_run(result) -> bool:
+    """True when ``result`` was recorded on a plant that measures its support forces (the
+    ``support_force_<name>_n`` and ``base_tilt_rad`` columns of a physics plant)."""
+    ts = result.timeseries
+    return bool(support_names(ts)) and "base_tilt_rad" in ts
+
+
 def plot_support_loads(result, floor_n: float | None = None):
     """Figure: the load on the supports off each edge of the support polygon (N; the edge
     the base would pivot about when it reaches 0) with the optimisers' floor, and the
-    base's tilt (mrad), against time. Steps with an edge unloaded are shaded.
+    base's tilt (mrad), against time (:func:`draw_support_loads` on a new pyplot figure)."""
+    return draw_support_loads(plt.figure(figsize=SUPPORT_LOADS_FIGSIZE), result, floor_n)
 
-    ``result`` is a physics run (the plant's ``support_force_<name>_n`` and
-    ``base_tilt_rad`` columns); ``floor_n`` (N) defaults to the run summary's
-    ``min_edge_load_floor_n`` (None: not drawn)."""
+
+def draw_support_loads(fig: Figure, result, floor_n: float | None = None) -> Figure:
+    """Draw the support-load panel into ``fig`` (empty; any canvas: the track figure and
+    the simulator's window both use it): each edge's load (N) with the optimisers' floor
+    above, the base's tilt (mrad) below, against time; steps with an edge unloaded are
+    shaded.
+
+    ``result`` is a physics run (:func:`is_physics_run`); ``floor_n`` (N) defaults to the
+    run summary's ``min_edge_load_floor_n`` (None: not drawn)."""
     ts, robot = result.timeseries, result.robot
     names, loads = edge_load_series(ts, robot)
     weight = robot.total_mass * 9.81
     if floor_n is None:
         floor_n = result.summary.get("min_edge_load_floor_n")
     t = ts["t"]
-    fig, (ax_load, ax_tilt) = plt.subplots(
-        2, 1, figsize=(7.5, 5.2), sharex=True, gridspec_kw={"height_ratios": [2.2, 1]}
-    )
+    ax_load, ax_tilt = fig.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
     unloaded = np.min(loads, axis=1) < _UNLOADED_SHARE * weight
     for ax in (ax_load, ax_tilt):
         if np.any(unloaded):
@@ -225,6 +243,6 @@ def save_support_loads(result, path: str | Path, floor_n: float | None = None) -
     from ddwmmr.reports.plots import PNG_METADATA
 
     fig = plot_support_loads(result, floor_n)
-    fig.savefig(path, dpi=110, metadata=PNG_METADATA)
+    fig.savefig(path, dpi=SUPPORT_LOADS_DPI, metadata=PNG_METADATA)
     plt.close(fig)
     return Path(path)
