@@ -174,6 +174,9 @@ def test_lower_bound_is_never_above_the_best_known_time(waypoints):
     bound = budget_bound(HEAVY, waypoints, cell=0.1, arcs=60).value
     assert 0.0 < bound <= found.best_s
     assert found.best_s / bound < 3.0  # not vacuous
+    # the straight-line starts are solved on the fine grid whatever their coarse rank
+    straight = {f"fine-straight-{r}-{e}" for r in ("never", "turn") for e in ("up", "down")}
+    assert straight <= set(found.refined)
 
 
 # -- the best-known side ----------------------------------------------------------------

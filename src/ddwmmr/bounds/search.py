@@ -190,6 +190,15 @@ def best_known(
         result = fine.solve(screened[label].as_guess(), label)
         if result.success:
             refined[label] = result
+    # The straight-line starts solved on the fine grid as well, whatever their coarse
+    # rank: screened on 8 intervals per leg they can rank low and still refine to the
+    # best optimum (their coarse solutions turn too early to leave the grid room).
+    for reverse in ("never", "turn"):
+        for elbow in (1.0, -1.0):
+            label = f"fine-straight-{reverse}-{'up' if elbow > 0 else 'down'}"
+            result = fine.solve(fine.straight_line_guess(reverse=reverse, elbow=elbow), label)
+            if result.success:
+                refined[label] = result
     best_refined = min((r.total for r in refined.values()), default=math.inf)
     say(f"refined {len(refined)}: best {best_refined:.3f} s")
 
