@@ -16,6 +16,7 @@ from ddwmmr.mpc.models import LaggedArmPrediction
 from ddwmmr.plants import MujocoPlant, ThesisPlant
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 from ddwmmr.scenarios.protocol import make_scenario_controller, make_scenario_plant
+from mpc_plans import converged_reach_plan
 
 ROBOT = Robot().with_payload(3.0)
 
@@ -366,9 +367,6 @@ def test_a_reach_plan_ends_where_the_arm_can_still_brake_above_the_floor():
     arm, braked at that limit, stops with S >= floor + margin (converged, no slack); the
     same plan without the limit (no such row) ends with a momentum that carries the arm
     below the floor. S of the stopping pose from the numeric model, not the OCP's rows."""
-    from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights
-    from ddwmmr.mpc.solvers import GaussNewtonSQP
-
     limits = (12.8, 33.3)
     x0 = np.array([0.0, 0.0, 0.0, -2.75, 1.0, 0.0, 0.0, 2.0, 0.0])
     target = ROBOT.fk(x0[:5] + np.array([0.0, 0.0, 0.0, 0.26, 0.0]))[:2]
@@ -376,24 +374,7 @@ def test_a_reach_plan_ends_where_the_arm_can_still_brake_above_the_floor():
     def stopping_stability(acceleration_limit):
         dynamics = sym.ThesisDynamics.from_robot(ROBOT)
         model = LaggedArmPrediction(ROBOT, dynamics, 0.02, acceleration_limit)
-        config = OCPConfig(
-            intervals=10,
-            control_interval=0.01,
-            first_interval=0.05,
-            horizon=2.0,
-            reach=True,
-            track_orientation=False,
-            huber=0.01,
-            dynamic_stability=True,
-            weights=Weights(position=0.0, manipulability=0.0, input=0.01, terminal=0.0),
-        )
-        ocp = ShootingOCP(ROBOT, model, config)
-        node = np.concatenate([x0, [1.0]])
-        guess = ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
-        p = ocp.parameters(np.tile([*target, 0.0], (ocp.N, 1)), np.zeros(4), horizon_prev=1.0)
-        lbw, ubw = ocp.bounds(x0)
-        sqp = GaussNewtonSQP(ocp, "hpipm", iterations=200, tolerance=1e-10)
-        w = sqp.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+        ocp, w = converged_reach_plan(ROBOT, model, x0, target)
         assert ocp.max_slack(w) < 1e-9 and ocp.horizon_of(w) < 0.2
         last = ocp.trajectories(w)[0][-1]
         rates = last[7:9]

@@ -14,9 +14,8 @@ from ddwmmr.model import symbolic as sym
 from ddwmmr.model.stability import GRAVITY_M_S2
 from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, EdgeLoadModel
 from ddwmmr.mpc.models import LaggedArmPrediction, ThesisPrediction
-from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights
-from ddwmmr.mpc.solvers import GaussNewtonSQP
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
+from mpc_plans import converged_reach_plan
 
 ROBOT = Robot().with_payload(3.0)
 LIMITS = (12.8, 33.3)  # the physics plant's joint acceleration limits with 3 kg (rad/s^2)
@@ -74,24 +73,7 @@ def _reach_plan_end(with_row: bool) -> tuple[float, np.ndarray, float]:
     coast = ca.Function("coast", [x, u], [model.integrate(x, u, 0.2, 20)])
     ahead = np.asarray(coast(x0, np.array([0.0, 0.0, -2.0, -2.0]))).ravel()
     target = ROBOT.fk(ahead[:5])[:2]
-    config = OCPConfig(
-        intervals=10,
-        control_interval=0.01,
-        first_interval=0.05,
-        horizon=2.0,
-        reach=True,
-        track_orientation=False,
-        huber=0.01,
-        dynamic_stability=True,
-        weights=Weights(position=0.0, manipulability=0.0, input=0.01, terminal=0.0),
-    )
-    ocp = ShootingOCP(ROBOT, model, config)
-    node = np.concatenate([x0, [1.0]])
-    guess = ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
-    p = ocp.parameters(np.tile([*target, 0.0], (ocp.N, 1)), np.zeros(4), horizon_prev=1.0)
-    lbw, ubw = ocp.bounds(x0)
-    sqp = GaussNewtonSQP(ocp, "hpipm", iterations=200, tolerance=1e-10)
-    w = sqp.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
+    ocp, w = converged_reach_plan(ROBOT, model, x0, target)
     last = ocp.trajectories(w)[0][-1]
     rates = last[7:9]
     stop = last[3:5] + rates * np.abs(rates) / (2.0 * np.array(LIMITS))
