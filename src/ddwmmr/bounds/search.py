@@ -171,10 +171,8 @@ def best_known(
         guess = controller_guess(scenario, name, payload=robot.payload)
         if guess is not None:
             screen(f"controller-{name}", guess)
-    for reverse in ("never", "turn"):
-        for elbow in (1.0, -1.0):
-            label = f"straight-{reverse}-{'up' if elbow > 0 else 'down'}"
-            screen(label, coarse.straight_line_guess(reverse=reverse, elbow=elbow))
+    for label, reverse, elbow in _straight_starts():
+        screen(label, coarse.straight_line_guess(reverse=reverse, elbow=elbow))
     loose = coarse.row_bounds(stability_min=1.0, tolerance=0.05)
     for label in _best(screened, s.continuation_top):
         relaxed = coarse.solve(screened[label].as_guess(), label, *loose)
@@ -193,12 +191,10 @@ def best_known(
     # The straight-line starts solved on the fine grid as well, whatever their coarse
     # rank: screened on 8 intervals per leg they can rank low and still refine to the
     # best optimum (their coarse solutions turn too early to leave the grid room).
-    for reverse in ("never", "turn"):
-        for elbow in (1.0, -1.0):
-            label = f"fine-straight-{reverse}-{'up' if elbow > 0 else 'down'}"
-            result = fine.solve(fine.straight_line_guess(reverse=reverse, elbow=elbow), label)
-            if result.success:
-                refined[label] = result
+    for label, reverse, elbow in _straight_starts():
+        result = fine.solve(fine.straight_line_guess(reverse=reverse, elbow=elbow), label)
+        if result.success:
+            refined[f"fine-{label}"] = result
     best_refined = min((r.total for r in refined.values()), default=math.inf)
     say(f"refined {len(refined)}: best {best_refined:.3f} s")
 
@@ -239,6 +235,17 @@ def best_known(
         base.solution = certified
     base.wall_s = time.perf_counter() - began
     return base
+
+
+def _straight_starts() -> list[tuple[str, str, float]]:
+    """``(label, reverse, elbow)`` of the four straight-line starts
+    (:meth:`~ddwmmr.mpc.min_time.MinimumTimeProblem.straight_line_guess`): never or at a
+    turn reversing, elbow up (+1) or down (-1)."""
+    return [
+        (f"straight-{reverse}-{'up' if elbow > 0 else 'down'}", reverse, elbow)
+        for reverse in ("never", "turn")
+        for elbow in (1.0, -1.0)
+    ]
 
 
 def _best(results: dict[str, MinimumTime], count: int) -> list[str]:

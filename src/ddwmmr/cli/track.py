@@ -587,13 +587,11 @@ def _main(argv: Sequence[str] | None = None) -> int:
 
             with phase("track: figures", enabled=progress):
                 save_run_figures(result, staging, obstacles=inputs.options.get("obstacles"))
-                if "base_tilt_rad" in result.timeseries:  # a physics plant's run
-                    from ddwmmr.reports.physics_plots import (
-                        SUPPORT_LOADS_FIGURE,
-                        save_support_loads,
-                    )
+                from ddwmmr.reports import physics_plots
 
-                    save_support_loads(result, staging / SUPPORT_LOADS_FIGURE)
+                if physics_plots.is_physics_run(result):
+                    figure = staging / physics_plots.SUPPORT_LOADS_FIGURE
+                    physics_plots.save_support_loads(result, figure)
         if args.animate:
             from ddwmmr.reports.plots import save_animation
 

@@ -710,8 +710,8 @@ class App(PanelLayout):
         written = export.write_support_loads(folder, self.results, self.labels())
         if self.interactive:
             self._show_support_loads()
-        self.say(f"wrote {', '.join(str(path) for path, _ in written)}")
-        return [path for path, _ in written]
+        self.say(f"wrote {', '.join(str(path) for path in written)}")
+        return written
 
     def _show_support_loads(self) -> None:
         """The physics runs' support-load panels, each in a desktop window of its own."""

@@ -75,7 +75,7 @@ def write_run_data(
             for slot, result in zip(settings.active_slots, results)
         ]
     for result, label, record in zip(results, labels, records):
-        target = folder if len(results) == 1 else folder / label
+        target = slot_folder(folder, results, label)
         csv_path = first_free(target / "timeseries.csv")
         result.write_csv(csv_path)
         json_path = first_free(target / "summary.json")
@@ -123,13 +123,17 @@ def run_record(
     return provenance.run_record(inputs, argv=None, rerun=None, tool="gui", prog=GUI_PROG)
 
 
-def write_support_loads(
-    folder: Path, results: Sequence[Any], labels: Sequence[str]
-) -> list[tuple[Path, Figure]]:
-    """``support_loads.png`` of every physics run (in a sub-folder per run when two): the
-    support-load panel of :func:`ddwmmr.reports.physics_plots.draw_support_loads`, the
-    figure a physics ``track`` run writes. Returns each file with its figure (drawn on a
-    canvas of its own, never the window's). ParameterError when no run is a physics run."""
+def slot_folder(folder: Path, results: Sequence[Any], label: str) -> Path:
+    """Where the files of run ``label`` go: ``folder`` itself for one run, its sub-folder
+    ``label`` side by side."""
+    return folder if len(results) == 1 else folder / label
+
+
+def write_support_loads(folder: Path, results: Sequence[Any], labels: Sequence[str]) -> list[Path]:
+    """``support_loads.png`` of every physics run (:func:`slot_folder`): the support-load
+    panel of :func:`ddwmmr.reports.physics_plots.draw_support_loads`, the figure a physics
+    ``track`` run writes, drawn on a canvas of its own (never the window's).
+    ParameterError when no run is a physics run."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     from ddwmmr.reports import physics_plots as pp
@@ -147,10 +151,9 @@ def write_support_loads(
         pp.draw_support_loads(figure, result)
         buffer = io.BytesIO()
         figure.savefig(buffer, format="png", dpi=pp.SUPPORT_LOADS_DPI, metadata=PNG_METADATA)
-        target = folder if len(results) == 1 else folder / label
-        path = first_free(target / pp.SUPPORT_LOADS_FIGURE)
+        path = first_free(slot_folder(folder, results, label) / pp.SUPPORT_LOADS_FIGURE)
         write_atomic(path, buffer.getvalue())
-        written.append((path, figure))
+        written.append(path)
     return written
 
 

@@ -93,6 +93,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import casadi as ca
 import numpy as np
@@ -405,22 +406,28 @@ class ShootingOCP:
             loads = sym.edge_loads(
                 robot, model.configuration(x), rates, accelerations, (v_dot, v * w), w, w_dot
             )
-            for e, (normal, depth) in enumerate(zip(polygon.normals, polygon.depths)):
-                slack = 0 if abs(normal[0]) >= abs(normal[1]) else 1
-                lever = float(depth) / weight
-                rows.append((loads[e] * lever, slack, self.config.min_edge_load * float(depth)))
-                if k == 0:
-                    self._first_loads.append(loads[e])
+            rows += self._edge_load_rows(polygon, loads, weight)
+            if k == 0:
+                self._first_loads += [loads[e] for e in range(len(polygon.depths))]
         stopped = model.stopped_arm_motion(x_next) if k == self.N - 1 else None
         if stopped is not None:
             # the last node's arm braked to rest: its momentum turns the base, and the
             # turn's sideways acceleration v w must leave every edge loaded too
             q_stop, v, w = stopped
             loads = sym.edge_loads(robot, q_stop, (0.0, 0.0), (0.0, 0.0), (0.0, v * w), w, 0.0)
-            for e, (normal, depth) in enumerate(zip(polygon.normals, polygon.depths)):
-                slack = 0 if abs(normal[0]) >= abs(normal[1]) else 1
-                lever = float(depth) / weight
-                rows.append((loads[e] * lever, slack, self.config.min_edge_load * float(depth)))
+            rows += self._edge_load_rows(polygon, loads, weight)
+        return rows
+
+    def _edge_load_rows(self, polygon, loads, weight: float) -> list[tuple[Any, int, float]]:
+        """One ``(expression, slack index, lower bound)`` row per edge of ``polygon``: the
+        edge's load ``loads[e]`` (N) scaled by ``depth / weight`` (m, the centre of mass's
+        margin it is worth) at least ``min_edge_load * depth``; the slack of the
+        longitudinal (0) or lateral (1) stability box by the edge's normal."""
+        rows = []
+        for e, (normal, depth) in enumerate(zip(polygon.normals, polygon.depths)):
+            slack = 0 if abs(normal[0]) >= abs(normal[1]) else 1
+            lever = float(depth) / weight
+            rows.append((loads[e] * lever, slack, self.config.min_edge_load * float(depth)))
         return rows
 
     def _bounds_and_linear_cost(self) -> None:
