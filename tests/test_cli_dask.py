@@ -7,6 +7,7 @@ their setup): tests/test_cli_fuzz.py.
 
 from __future__ import annotations
 
+import logging
 import os
 import signal
 import subprocess
@@ -16,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from ddwmmr.cli import common
 from ddwmmr.cli.scenarios import main as cli
 from ddwmmr.scenarios import executors
 from test_cli_signals import alive, children, staging, wait_for
@@ -66,6 +68,20 @@ def test_workers_are_capped_to_the_scenarios(tmp_path, capsys, monkeypatch):
     assert started == [1]
     assert "(1 dask worker)" in capsys.readouterr().err
     assert executors.run_many([], None, jobs=8) == []  # nothing to run: no worker at all
+
+
+def test_stopping_the_workers_silences_every_dask_logger():
+    """Dask's configuration gives ``distributed.client`` a level of its own, so a level
+    on the ``distributed`` logger does not reach it: its "Couldn't gather" warning once
+    came out beside the tool's one line."""
+    client_log = logging.getLogger("distributed.client")
+    assert client_log.isEnabledFor(logging.WARNING)  # Dask's default, or this proves nothing
+    try:
+        common.stop_workers()
+        for name in ("distributed", "distributed.client", "distributed.nanny", "tornado"):
+            assert not logging.getLogger(name).isEnabledFor(logging.CRITICAL), name
+    finally:
+        logging.disable(logging.NOTSET)
 
 
 @pytest.mark.parametrize(

@@ -123,9 +123,11 @@ class Terminated(BaseException):
 def stop_workers(timeout: float = 2.0) -> None:
     """Stop the worker processes this process started (process pools, Dask's nannies).
 
-    Dask's scheduler and nannies in this process would log each lost worker: the tool
-    says one line for the stop, so their logs are silenced first."""
-    logging.getLogger("distributed").setLevel(logging.CRITICAL + 1)
+    Dask's scheduler, client and nannies in this process would log each lost worker and
+    each lost result: the tool says one line for the stop, so every log in the process is
+    silenced first. (Raising the level of the ``distributed`` logger alone is not enough:
+    Dask's configuration gives ``distributed.client`` a level of its own.)"""
+    logging.disable(logging.CRITICAL)
     children = multiprocessing.active_children()
     for child in children:
         child.terminate()
