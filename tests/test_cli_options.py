@@ -18,7 +18,8 @@ from ddwmmr.errors import ParameterError
 
 #: Options only the API can set: Python objects no text stands for (stated here, so a
 #: new option that the command line cannot reach fails the test below).
-API_ONLY = {"qp": {"tasks", "limits"}, "mpc": {"fallback_options"}}
+# route: a list of points, filled in by the scenario protocol (`--option lookahead=on`)
+API_ONLY = {"qp": {"tasks", "limits"}, "mpc": {"fallback_options", "route"}}
 
 
 @pytest.mark.parametrize("method", available_methods())

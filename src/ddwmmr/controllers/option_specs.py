@@ -73,6 +73,7 @@ UNITS = {
     "wheel_force_limit": "N",
     "joint_acceleration_limit": "rad/s2",
     "brake_slack": "m",
+    "lookahead_horizon": "s",
 }
 
 

@@ -68,7 +68,7 @@ from ddwmmr.mpc.options import (
 )
 from ddwmmr.mpc.problem import Problem
 from ddwmmr.mpc.solvers import SolverFailure, installed_qp_solvers, installed_solvers
-from ddwmmr.mpc.stall import StallWatch
+from ddwmmr.mpc.stall import STALL_TIME, StallWatch
 from ddwmmr.qp.limits import run_clearance, safe_arm_scale
 
 
@@ -177,8 +177,11 @@ class MPCController:
         self._fallback = None
 
     def _config(self, mode: str) -> OCPConfig:
-        n, h, t = self._grid[mode]
-        reach = mode == "reach"
+        """The OCP of objective ``mode``: ``"tracking"``, ``"reach"`` (one target) or
+        ``"reach2"`` (through the target to the next one, the reach grid twice)."""
+        reach = mode != "tracking"
+        base = "reach" if reach else mode
+        n, h, t = self._grid[base]
         options = self.options
         return OCPConfig(
             intervals=n,
@@ -186,6 +189,9 @@ class MPCController:
             first_interval=min(h, (t - self.dt) / (n - 1)),
             horizon=t,
             reach=reach,
+            second_leg_intervals=n if mode == "reach2" else 0,
+            second_leg_weight=options.lookahead_weight,
+            second_leg_horizon=options.lookahead_horizon,
             min_horizon=max(0.1, 2.0 * self.dt),
             reach_speed=options.reach_speed,
             stability_min=options.stability_min,
@@ -193,11 +199,11 @@ class MPCController:
             dynamic_stability=self.dynamic_stability,
             min_edge_load=options.min_edge_load,
             track_orientation=options.track_orientation and not reach,
-            huber=options.huber_scale(mode),
+            huber=options.huber_scale(base),
             obstacles=tuple(options.obstacles),
             base_radius=0.5 * math.hypot(self.robot.base_length, self.robot.base_width),
             obstacle_margin=options.obstacle_margin,
-            weights=self._weights[mode],
+            weights=self._weights[base],
         )
 
     def _problem(self, mode: str) -> Problem:
@@ -222,6 +228,10 @@ class MPCController:
         self._warm_mode: str | None = None
         self._warm_time = 0.0
         self._target: tuple[float, float] | None = None
+        self._route_index = 0  # where in ``route`` the current target was found
+        self._following: tuple[float, float] | None = None  # the plan's second target
+        self._single_target: tuple[float, float] | None = None  # lookahead dropped there
+        self._arriving_since: float | None = None  # plans at the shortest horizon since
         self._u_prev = np.zeros(self.model.nu)
         self._predicted_velocity: tuple[float, float] = (0.0, 0.0)
         self._predicted_rates: tuple[float, float] = (0.0, 0.0)  # the lagged arm's
@@ -267,29 +277,46 @@ class MPCController:
             np.array(values) for values in check_inputs(t, q, pose_d, velocity_d)
         )
         reach = self._trajectory is None and not np.any(velocity_d)
-        mode = "reach" if reach else "tracking"
+        target = (float(pose_d[0]), float(pose_d[1]))
+        new_target = reach and self._target != target
+        stuck = reach and self._stall.stuck(t, tuple(self.robot.fk(q)[:2]), new_target)
+        if (stuck or self._overdue(t)) and self._warm_mode == "reach2" and not new_target:
+            # a plan through this target to the next stalled short of it: one target at a
+            # time until it is reached
+            self._single_target = target
+            self.restarts += 1
+        following = self._next_target(target) if reach and target != self._single_target else None
+        mode = "tracking" if not reach else "reach" if following is None else "reach2"
         problem = self._problem(mode)
         if mode == "tracking" and problem.terminal_factor is None:
             problem.design_terminal((float(q[3]), float(q[4])))
         x0 = self._state(q, base_velocity)
-        references = self._references(problem, t, pose_d, velocity_d)
-        target = (float(pose_d[0]), float(pose_d[1]))
-        new_target = reach and self._target != target
+        references = self._references(problem, t, pose_d, velocity_d, following)
+        # the plan that went through the reached target already plans the next leg
+        handover = new_target and self._warm_mode == "reach2" and self._following == target
         cold = self._warm is None or self._warm_mode != mode or new_target
-        stuck = reach and self._stall.stuck(t, tuple(self.robot.fk(q)[:2]), new_target)
         if cold:
             self._stall.fresh_plan()
         elif stuck:
             cold = True
             self.restarts += 1
+        source = self._problem("reach2").ocp if handover and self._warm is not None else None
+        warm = self._warm if not cold or source is not None else None
         try:
             w, iterations = problem.solve(
-                t, x0, references, self._u_prev, None if cold else self._warm, self._warm_time
+                t, x0, references, self._u_prev, warm, self._warm_time, source
             )
         except SolverFailure as failure:
             return self._fallback_command(t, q, pose_d, velocity_d, x0, str(failure))
         self._warm, self._warm_mode, self._warm_time = w, mode, t
-        self._target = target
+        self._target, self._following = target, following
+        # "there at the shortest horizon" (within a millisecond: the QP's tolerance)
+        shortest = problem.ocp.config.min_horizon + 1e-3
+        arriving = mode == "reach2" and problem.ocp.horizon_of(w) <= shortest
+        if not arriving or new_target:
+            self._arriving_since = t if arriving else None
+        elif self._arriving_since is None:
+            self._arriving_since = t
         self._stall.plan_slack(t, problem.ocp.max_slack(w))
         u = problem.ocp.first_input(w)
         braking = self.brake_slack is not None and should_brake(
@@ -314,12 +341,39 @@ class MPCController:
         lagged = self._predicted_rates if self.arm_time_constant is not None else ()
         return np.concatenate([q, [float(v), float(w)], lagged])
 
-    def _references(self, problem: Problem, t: float, pose_d, velocity_d) -> np.ndarray:
-        """Reference poses of nodes 1..N (N, 3)."""
-        times = problem.ocp.node_times(problem.ocp.config.horizon)[1:]
+    def _references(
+        self, problem: Problem, t: float, pose_d, velocity_d, following=None
+    ) -> np.ndarray:
+        """Reference poses of nodes 1..N (N, 3); with a ``following`` target (x, y) the
+        second leg's nodes aim at it."""
+        ocp = problem.ocp
+        times = ocp.node_times(ocp.config.horizon)[1:]
         if self._trajectory is not None:
             return np.array([self._trajectory.pose(t + tau) for tau in times])
-        return pose_d[None, :] + times[:, None] * velocity_d[None, :]
+        references = pose_d[None, :] + times[:, None] * velocity_d[None, :]
+        if following is not None:
+            references[ocp.split :] = (following[0], following[1], 0.0)
+        return references
+
+    def _overdue(self, t: float) -> bool:
+        """True when the plans through the target to the next have said "there at the
+        shortest horizon" for longer than :data:`~ddwmmr.mpc.stall.STALL_TIME` (s) without
+        the target being reached: the exact-S guard holds back what they plan."""
+        since = self._arriving_since
+        return since is not None and t - since > STALL_TIME
+
+    def _next_target(self, target: tuple[float, float]) -> tuple[float, float] | None:
+        """With ``lookahead``: the waypoint of ``route`` after ``target`` (searched from
+        the last one found, so a route may pass a point twice), None at the route's end
+        or when ``target`` is not on it."""
+        route = self.options.route
+        if not self.options.lookahead or not route:
+            return None
+        for index in range(self._route_index, len(route)):
+            if math.dist(route[index], target) <= 1e-9:
+                self._route_index = index
+                return tuple(route[index + 1]) if index + 1 < len(route) else None
+        return None
 
     def _braking_input(self, q: np.ndarray, x0: np.ndarray) -> np.ndarray:
         """The braking step at the measured state (force model with the lagged arm)."""
@@ -464,6 +518,8 @@ class MPCController:
             "dt": config.dt,
         }
         options.update(dict(config.controller_options))
+        if options.get("lookahead") and not options.get("route"):
+            options["route"] = [tuple(w) for w in run.scenario.waypoints]
         return options
 
 

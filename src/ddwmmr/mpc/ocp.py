@@ -11,13 +11,20 @@ Two objectives share one structure:
   can be reached within ``horizon``, the plan is a minimum-time manoeuvre that passes
   through it; when it cannot, ``T = horizon`` and the plan gets as close as it can (each
   metre left costs ``1/reach_speed`` seconds).
+* **reach through** (waypoint mode with the next target known, ``second_leg_intervals >
+  0``): two legs of free duration, ``T1`` to the current target (its reach cost at the
+  leg's last node) and ``T2`` from there to the next one (its reach cost at the last
+  node, and ``T2`` charged, both scaled by ``second_leg_weight``): the plan arrives at the
+  current target moving the way the next leg wants (docs/mpc.md, "Planning through the
+  next waypoint").
 
 Grid: the first interval is the control step ``dt`` (the command is held exactly that
 long); the other ``N - 1`` grow geometrically from ``first_interval`` to fill the rest of
 the ``horizon`` (uniform when they are all ``first_interval``), scaled to fill ``T - dt``
 in reach mode: fine steps where the command is decided, coarse ones where only the
-direction of the plan matters. Each interval is integrated with RK4 in sub-steps of at most
-:data:`MAX_SUBSTEP`. Decision vector, in the stage-wise order that structure-exploiting
+direction of the plan matters; a second leg's intervals are equal shares of ``T2``.
+Each interval is integrated with RK4 in sub-steps of at most :data:`MAX_SUBSTEP`.
+Decision vector, in the stage-wise order that structure-exploiting
 solvers (HPIPM, FATROP) expect::
 
     w = [x_0, u_0, x_1, u_1, ..., x_{N-1}, u_{N-1}, x_N]
@@ -166,6 +173,10 @@ class OCPConfig:
             control step dt, s); first_interval: the second one's length (s); horizon: their
             sum (s), at least ``dt + (N - 1) first_interval``.
         reach: free-final-time reach objective (waypoint mode) instead of tracking.
+        second_leg_intervals: reach mode: intervals of a second leg of free duration to
+            the next target (0: none), each an equal share of it, at most
+            ``second_leg_horizon`` (s) long in all; second_leg_weight: the weight of that
+            leg's time and reach cost against the first leg's (1: the total time).
         min_horizon: lower bound on the free horizon T (s); reach_speed: m/s converting
             the distance left at T = horizon into seconds.
         stability_min: the floor S_min; stability_margin: the OCP keeps S >= S_min + margin.
@@ -184,6 +195,9 @@ class OCPConfig:
     first_interval: float = 0.05
     horizon: float = 3.0
     reach: bool = False
+    second_leg_intervals: int = 0
+    second_leg_weight: float = 1.0
+    second_leg_horizon: float = 12.0
     min_horizon: float = 0.1
     reach_speed: float = 0.5
     stability_min: float = STABILITY_FLOOR
@@ -197,11 +211,26 @@ class OCPConfig:
     obstacle_margin: float = 0.05
     weights: Weights = field(default_factory=Weights)
 
+    @property
+    def legs(self) -> int:
+        """Legs of free duration: 2 with a second leg (reach mode), else 1."""
+        return 2 if self.reach and self.second_leg_intervals > 0 else 1
+
     def interval_lengths(self) -> np.ndarray:
-        """The N interval lengths (s) at ``T = horizon``: dt, then ``first_interval r^k``."""
+        """The interval lengths (s) at ``T = horizon`` (and ``T2 = second_leg_horizon``):
+        dt, then ``first_interval r^k``; then the second leg's equal shares."""
         dt = check_positive("dt", self.control_interval)
         rest = grid_intervals(self.intervals - 1, self.first_interval, self.horizon - dt)
-        return np.concatenate([[dt], rest])
+        count = self.second_leg_intervals if self.legs == 2 else 0
+        second = np.full(count, self.second_leg_horizon / max(count, 1))
+        return np.concatenate([[dt], rest, second])
+
+    def longest_horizons(self) -> list[float]:
+        """The upper bounds (s) of the free horizons: ``[]`` tracking, ``[horizon]`` or
+        ``[horizon, second_leg_horizon]``."""
+        if not self.reach:
+            return []
+        return [self.horizon, self.second_leg_horizon][: self.legs]
 
 
 class ShootingOCP:
@@ -223,13 +252,19 @@ class ShootingOCP:
         self.robot = robot
         self.model = model
         self.config = config
-        n = config.intervals
         self.lengths = config.interval_lengths()
+        #: intervals of the first leg (all of them with one leg), and in all
+        self.split = config.intervals
+        n = self.N = len(self.lengths)
         self.dt = float(self.lengths[0])
-        self.fractions = self.lengths[1:] / self.lengths[1:].sum()
-        self.N = n
+        first = self.lengths[1 : self.split]
+        self.fractions = first / first.sum()
+        #: the second leg's intervals as shares of ``T2`` (empty with one leg)
+        self.second_fractions = self.lengths[self.split :] / config.second_leg_horizon
         self.nxm, self.num = model.nx, model.nu
-        self.nx = model.nx + (1 if config.reach else 0)
+        #: the free horizons carried as constant states (none when tracking)
+        self.n_horizons = config.legs if config.reach else 0
+        self.nx = model.nx + self.n_horizons
         #: the joint box is a slackened path row, not a bound (see the module docstring)
         self.soft_joints = not model.joints_stop_at_once
         # slacks: stability terms, obstacles, one per joint (a shared one would let the
@@ -266,19 +301,25 @@ class ShootingOCP:
         """Index in w of the free horizon T of node 0 (reach mode), else None."""
         return self.nxm if self.config.reach else None
 
-    def node_times(self, horizon: float) -> np.ndarray:
-        """Node offsets from now (s) for a horizon T (N+1,)."""
+    def node_times(self, horizon: float, second: float | None = None) -> np.ndarray:
+        """Node offsets from now (s) for a horizon T (N+1,), the second leg (if any)
+        ``second`` s long after it (default: its longest)."""
         rest = np.cumsum(self.fractions * (horizon - self.dt))
-        return np.concatenate([[0.0, self.dt], self.dt + rest])
+        first = np.concatenate([[0.0, self.dt], self.dt + rest])
+        leg = self.config.second_leg_horizon if second is None else second
+        return np.concatenate([first, horizon + np.cumsum(self.second_fractions * leg)])
 
     def _interval(self, nodes: Sequence, k: int, owner: int | None = None):
         """Length of interval k: dt for k = 0; fixed (tracking) or a share of ``T - dt``
-        (reach, T read from node ``owner``, default k: every node carries the same T)."""
+        (reach, T read from node ``owner``, default k: every node carries the same T), or
+        of ``T2`` on a second leg."""
         if k == 0:
             return self.dt
         if self.config.reach:
-            horizon = nodes[k if owner is None else owner][self.nxm]
-            return self.fractions[k - 1] * (horizon - self.dt)
+            node = nodes[k if owner is None else owner]
+            if k >= self.split:
+                return self.second_fractions[k - self.split] * node[self.nxm + 1]
+            return self.fractions[k - 1] * (node[self.nxm] - self.dt)
         return float(self.lengths[k])
 
     def _integrate(self, x, u, h, nominal: float):
@@ -306,7 +347,7 @@ class ShootingOCP:
             # the gap as x_{k+1} - F(x_k, u_k): the only form FATROP's structure detection
             # takes (F - x_{k+1} raised inside FATROP at every solve); HPIPM takes either
             if config.reach:
-                g.append(nodes[k + 1] - ca.vertcat(x_next, nodes[k][self.nxm]))
+                g.append(nodes[k + 1] - ca.vertcat(x_next, nodes[k][self.nxm :]))
             else:
                 g.append(nodes[k + 1] - x_next)
             lbg.extend([0.0] * self.nx)
@@ -435,8 +476,8 @@ class ShootingOCP:
         lower, upper = np.zeros(self.nw), np.zeros(self.nw)
         linear = np.zeros(self.nw)
         for k, s in enumerate(self._node_slices):
-            low = np.concatenate([model.x_lower, [config.min_horizon]])[: self.nx]
-            high = np.concatenate([model.x_upper, [config.horizon]])[: self.nx]
+            low = np.concatenate([model.x_lower, [config.min_horizon] * self.n_horizons])
+            high = np.concatenate([model.x_upper, config.longest_horizons()])
             if k == 0:
                 low[: self.nxm], high[: self.nxm] = -INF, INF
             elif self.soft_joints:  # a path row of the stage before holds them
@@ -449,6 +490,8 @@ class ShootingOCP:
             linear[s] = SLACK_WEIGHT
         if config.reach:
             linear[self.horizon_index] = 1.0  # one unit of cost per second of horizon
+        if config.legs == 2:
+            linear[self.nxm + 1] = config.second_leg_weight
         self.w_lower, self.w_upper = lower, upper
         self.linear_cost = linear
 
@@ -500,10 +543,9 @@ class ShootingOCP:
         target = refs[:, n - 1]
         error = pose[:2] - target[:2]
         if config.reach:
-            # 0.5 r^2 = huber(|e|) / reach_speed: |e| / reach_speed far from the target.
-            delta = config.huber if config.huber is not None else 0.01
-            gain = 1.0 / math.sqrt(delta * config.reach_speed)
-            parts.append(gain * self._huber_scale(error, delta) * error)
+            parts.append(self._reach_cost(xs[self.split], refs[:, self.split - 1], 1.0))
+            if config.legs == 2:
+                parts.append(self._reach_cost(xs[n], target, config.second_leg_weight))
             parts.append(math.sqrt(HORIZON_SMOOTHING) * (nodes[0][self.nxm] - horizon_prev))
         elif weights.terminal > 0.0:
             z = self._terminal_error(xs[n], pose, target)
@@ -514,6 +556,16 @@ class ShootingOCP:
                 * (factor.T @ z)
             )
         return ca.vertcat(*parts)
+
+    def _reach_cost(self, x, target, weight: float) -> ca.SX:
+        """The residual of a leg's reach cost at its last node's state ``x``:
+        ``0.5 r^2 = weight huber(|e|) / reach_speed``, ``weight |e| / reach_speed`` seconds
+        far from ``target``."""
+        config = self.config
+        error = sym.forward_kinematics(self.robot, self.model.configuration(x))[:2] - target[:2]
+        delta = config.huber if config.huber is not None else 0.01
+        gain = math.sqrt(weight) / math.sqrt(delta * config.reach_speed)
+        return gain * self._huber_scale(error, delta) * error
 
     def _terminal_error(self, x_n, pose, ref) -> ca.SX:
         """End-effector error in the terminal base frame (and the base velocities)."""
@@ -582,9 +634,14 @@ class ShootingOCP:
         return np.asarray(w[self.u_slices[0]], dtype=float)
 
     def horizon_of(self, w: np.ndarray) -> float:
-        """The horizon T (s) of a solution (the fixed horizon in tracking mode)."""
+        """The horizon T (s) of a solution (the fixed horizon in tracking mode; the first
+        leg's with two)."""
         index = self.horizon_index
         return self.config.horizon if index is None else float(w[index])
+
+    def second_leg_of(self, w: np.ndarray) -> float | None:
+        """The second leg's duration ``T2`` (s) of a solution, None with one leg."""
+        return float(w[self.nxm + 1]) if self.config.legs == 2 else None
 
     def trajectories(self, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Node states (N+1, nx) and stage inputs with slacks (N, nu) of a solution."""

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import copy
 import inspect
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
 from typing import Any
@@ -128,6 +129,17 @@ class MPCOptions:
             :data:`REACH_HUBER` in waypoint mode, none when tracking).
         reach_speed: waypoint mode: m/s converting the distance left at the end of the
             horizon into seconds.
+        lookahead: waypoint mode: plan through the current target to the next one of
+            ``route`` (two legs of free duration, each at most ``horizon``), so that the
+            robot arrives moving the way the next leg wants; off (default): one target at
+            a time (docs/mpc.md, "Planning through the next waypoint").
+        lookahead_weight: the second leg's time and reach cost against the first's, in
+            [0, 1] (default 0.5; 1: the plan minimises the time of both legs, but where the
+            second leg cannot reach its target that ties with giving up the first).
+        lookahead_horizon: the second leg's longest duration (s), with as many intervals
+            as the first leg.
+        route: the task's waypoints ``(x, y)`` in order (m, world) that ``lookahead``
+            looks along; the scenario protocol fills it in with ``lookahead``.
         proximal: damping of the input steps between two solves (see
             :class:`ddwmmr.mpc.solvers.GaussNewtonSQP`).
         stability_margin: the OCP keeps ``S >= stability_min + stability_margin``.
@@ -185,6 +197,10 @@ class MPCOptions:
     input_weight: float = 0.01
     huber: float | None = None
     reach_speed: float = 0.05
+    lookahead: bool = False
+    lookahead_weight: float = 0.5
+    lookahead_horizon: float = 12.0
+    route: Sequence[Sequence[float]] = ()
     proximal: float = 0.01
     stability_margin: float = 0.01
     dynamic_stability: bool | None = None
@@ -236,6 +252,15 @@ class MPCOptions:
         self._set("stability_min", check_stability_floor(self.stability_min))
         self._set("obstacles", tuple(as_circles(self.obstacles)))
         self._set("track_orientation", check_bool("track_orientation", self.track_orientation))
+        self._set("lookahead", check_bool("lookahead", self.lookahead))
+        self._set(
+            "lookahead_weight", check_range("lookahead_weight", self.lookahead_weight, 0.0, 1.0)
+        )
+        self._set("route", _route_option(self.route))
+        self._set(
+            "lookahead_horizon",
+            check_range("lookahead_horizon", self.lookahead_horizon, 0.5, MAX_HORIZON, "s"),
+        )
         if self.dt is not None:
             self._set("dt", check_positive("dt", self.dt))
         for mode in GRID_DEFAULTS:
@@ -401,6 +426,18 @@ class MPCOptions:
             joint_acceleration_limit=list(self.joint_acceleration_limit or ()),  # type: ignore[arg-type]
         )
         return values
+
+
+def _route_option(value: Any) -> tuple[tuple[float, float], ...]:
+    """The ``route`` option: points ``(x, y)`` (m), kept as a tuple of float pairs."""
+    try:
+        points = [tuple(float(c) for c in point) for point in value]
+    except (TypeError, ValueError):
+        raise ParameterError("route must be a list of (x, y) points in m") from None
+    for point in points:
+        if len(point) != 2 or not all(math.isfinite(c) for c in point):
+            raise ParameterError(f"route must be a list of finite (x, y) points in m (got {point})")
+    return tuple(points)  # type: ignore[return-value]
 
 
 def _acceleration_option(value: Any) -> tuple[float, float] | tuple[()] | None:

@@ -10,7 +10,7 @@ from ddwmmr.model import Robot
 from ddwmmr.mpc import terminal
 from ddwmmr.mpc.cache import shared_ocp
 from ddwmmr.mpc.models import PredictionModel
-from ddwmmr.mpc.ocp import OCPConfig
+from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP
 from ddwmmr.mpc.solvers import make_solver
 
 #: Gauss-Newton iterations of a cold start (first step, new target, after a fallback).
@@ -61,34 +61,51 @@ class Problem:
 
     def _initial(self, x0: np.ndarray) -> np.ndarray:
         ocp = self.ocp
-        node = np.concatenate([x0, [ocp.config.horizon]])[: ocp.nx]
+        node = np.concatenate([x0, ocp.config.longest_horizons()])
         return ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
 
-    def _shifted(self, warm: np.ndarray, elapsed: float, x0: np.ndarray) -> tuple:
-        """The previous solution moved ``elapsed`` s forward (linear interpolation)."""
+    def _shifted(
+        self, warm: np.ndarray, elapsed: float, x0: np.ndarray, source: ShootingOCP | None = None
+    ) -> tuple:
+        """The previous solution moved ``elapsed`` s forward (linear interpolation).
+
+        ``source``: the two-leg OCP the solution came from when its first target was just
+        reached (the hand-over to the next target): its second leg becomes this OCP's
+        first, held at its end beyond; a new second leg starts at its longest."""
         ocp = self.ocp
-        xs, us = ocp.trajectories(warm)
-        old_horizon = ocp.horizon_of(warm)
+        handover = source is not None
+        source = source or ocp
+        old_xs, us = source.trajectories(warm)
+        old_horizon, second = source.horizon_of(warm), source.second_leg_of(warm)
+        old_t = source.node_times(old_horizon, second)
         horizon = old_horizon
+        if handover:
+            horizon, second = old_horizon + (second or 0.0), None
         if ocp.config.reach:
-            horizon = min(max(old_horizon - elapsed, ocp.config.min_horizon), ocp.config.horizon)
-        old_t = ocp.node_times(old_horizon)
-        new_t = ocp.node_times(horizon) + elapsed
-        xs = interpolate_rows(old_t, xs, new_t)
+            horizon = min(max(horizon - elapsed, ocp.config.min_horizon), ocp.config.horizon)
+        new_t = ocp.node_times(horizon, second) + elapsed
+        xs = np.empty((ocp.N + 1, ocp.nx))
+        xs[:, : ocp.nxm] = interpolate_rows(old_t, old_xs[:, : ocp.nxm], new_t)
         us = interpolate_rows(old_t[:-1], us, new_t[:-1])
         if ocp.config.reach:
-            xs[:, -1] = horizon
+            xs[:, ocp.nxm] = horizon
+        if ocp.n_horizons == 2:
+            xs[:, ocp.nxm + 1] = ocp.config.second_leg_horizon if second is None else second
         xs[0, : ocp.nxm] = x0
         return ocp.pack(xs, us), horizon
 
-    def solve(self, t, x0, references, u_prev, warm, warm_time) -> tuple[np.ndarray, int]:
-        """Solve from the shifted warm start (or cold); returns (w, iterations)."""
+    def solve(
+        self, t, x0, references, u_prev, warm, warm_time, source: ShootingOCP | None = None
+    ) -> tuple[np.ndarray, int]:
+        """Solve from the shifted warm start (or cold); returns (w, iterations). With a
+        ``source`` (a hand-over, :meth:`_shifted`) the shifted plan starts the cold
+        start's iterations."""
         ocp = self.ocp
         if warm is None:
             guess, horizon, solver = self._initial(x0), ocp.config.horizon, self.cold
         else:
-            guess, horizon = self._shifted(warm, max(0.0, t - warm_time), x0)
-            solver = self.solver
+            guess, horizon = self._shifted(warm, max(0.0, t - warm_time), x0, source)
+            solver = self.solver if source is None else self.cold
         p = ocp.parameters(references, u_prev, self.terminal_factor, horizon_prev=horizon)
         self.last_parameters = p
         lbw, ubw = ocp.bounds(x0)
