@@ -9,9 +9,10 @@ Data (committed, in docs/bounds/):
 
 ``python docs/bounds_figures.py`` redraws the figure from them and rewrites the block
 between the ``bounds-table`` markers of docs/mpc.md; ``--collect SEED DIR`` first builds
-``controllers_seed{SEED}.csv`` from four scenario runs ``DIR/{thesis,competitive,qp,mpc}-sSEED``
-(their scenarios.csv), ``--bounds SEED CSV`` first copies a bounds run's bounds.csv to
-``bounds_seed{SEED}.csv``.
+``controllers_seed{SEED}.csv`` from five scenario runs
+``DIR/{thesis,competitive,qp,mpc,mpc-lookahead}-sSEED`` (their scenarios.csv; the last is
+``--controller mpc --option lookahead=on``), ``--bounds SEED CSV`` first copies a bounds
+run's bounds.csv to ``bounds_seed{SEED}.csv``.
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ CONTROLLERS = {
     "competitive": "thesis controller, competitive arbiter",
     "qp": "qp",
     "mpc": "mpc",
+    "mpc-lookahead": "mpc, lookahead",
 }
 SEEDS = (0, 1)
 
@@ -62,7 +64,7 @@ def read_controllers(seed: int) -> dict[str, dict[int, float]]:
 
 
 def collect(seed: int, folder: Path) -> None:
-    """controllers_seed{seed}.csv from four scenario runs in ``folder``."""
+    """controllers_seed{seed}.csv from five scenario runs in ``folder``."""
     columns: dict[str, dict[int, float]] = {}
     for name in CONTROLLERS:
         with open(folder / f"{name}-s{seed}" / "scenarios.csv", newline="") as handle:
@@ -130,6 +132,7 @@ def figure() -> None:
         "competitive": ("tab:cyan", "v"),
         "qp": ("tab:orange", "s"),
         "mpc": ("tab:green", "D"),
+        "mpc-lookahead": ("tab:red", "^"),
     }
     data = ratios(0)
     bounds = read_bounds(0)

@@ -4,6 +4,7 @@ open-loop replay on the thesis plant, and the tool."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import subprocess
@@ -17,7 +18,7 @@ from ddwmmr import Robot
 from ddwmmr.bounds import batch, diffdrive
 from ddwmmr.bounds.lower import Prices, budget_bound, circular
 from ddwmmr.bounds.replay import replay
-from ddwmmr.bounds.search import Settings, best_known, start_state
+from ddwmmr.bounds.search import Settings, _faster_run, best_known, start_state
 from ddwmmr.bounds.starts import Pattern, controller_guess, pattern_guess
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.min_time import MinimumTimeProblem
@@ -224,6 +225,28 @@ def test_controller_run_as_a_start_reaches_every_waypoint():
     assert np.all(np.abs(guess.inputs[:, :2]) <= 10.0 + 1e-9)
     end = HEAVY.fk(guess.states[-1, :5])[:2]
     assert math.dist(end, scenario.waypoints[-1]) <= 0.01
+
+
+def test_a_controller_run_that_replays_faster_becomes_the_best_known():
+    """The run's recorded forces and joint rates, replayed open loop at the run's own step,
+    reach every waypoint with S held at the run's time: it beats no certified solution and
+    a slower one, not a faster one; a run cut short of the last waypoint never counts."""
+    scenario = generate(2, 0)[1]
+    run = controller_guess(scenario, "mpc")
+    assert run is not None
+    settings = Settings()
+    found = _faster_run(HEAVY, {"mpc": run}, scenario.waypoints, settings, None)
+    assert found is not None and found[0].start == "run-mpc" and found[1].ok
+    assert found[1].time_s == pytest.approx(run.arrivals[-1], abs=1e-9)
+    slower = (found[0], dataclasses.replace(found[1], time_s=found[1].time_s + 1.0))
+    assert _faster_run(HEAVY, {"mpc": run}, scenario.waypoints, settings, slower) is not slower
+    faster = (found[0], dataclasses.replace(found[1], time_s=found[1].time_s - 1.0))
+    assert _faster_run(HEAVY, {"mpc": run}, scenario.waypoints, settings, faster) is faster
+    short = len(run.times) - 100  # one second before the last waypoint
+    cut = dataclasses.replace(
+        run, times=run.times[:short], states=run.states[:short], inputs=run.inputs[: short - 1]
+    )
+    assert _faster_run(HEAVY, {"mpc": cut}, scenario.waypoints, settings, None) is None
 
 
 def test_continuation_bounds_change_only_their_rows():

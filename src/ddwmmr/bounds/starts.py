@@ -206,7 +206,8 @@ class RecordingTask:
 def controller_guess(scenario, controller: str, payload: float = 3.0, dt: float = 0.01):
     """A start from a controller's run of ``scenario`` on the thesis plant (the scenario
     protocol's controllers: ``"thesis"``, ``"competitive"`` (the thesis controller with
-    the competitive arbiter), ``"qp"`` or ``"mpc"``); None if it did not finish."""
+    the competitive arbiter), ``"qp"``, ``"mpc"`` or ``"mpc-lookahead"`` (the mpc
+    planning through the next waypoint)); None if it did not finish."""
     from ddwmmr.behaviours.objective import default_pose
     from ddwmmr.scenarios.protocol import (
         RunConfig,
@@ -216,8 +217,16 @@ def controller_guess(scenario, controller: str, payload: float = 3.0, dt: float 
     from ddwmmr.sim.loop import run_loop
 
     arbiter = "competitive" if controller == "competitive" else "state-machine"
-    kind = "thesis" if controller == "competitive" else controller
-    config = RunConfig(controller=kind, plant="thesis", payload=payload, dt=dt, arbiter=arbiter)
+    kind = {"competitive": "thesis", "mpc-lookahead": "mpc"}.get(controller, controller)
+    options = (("lookahead", True),) if controller == "mpc-lookahead" else ()
+    config = RunConfig(
+        controller=kind,
+        plant="thesis",
+        payload=payload,
+        dt=dt,
+        arbiter=arbiter,
+        controller_options=options,
+    )
     robot = Robot().with_payload(payload)
     plant = make_scenario_plant(robot, config)
     ctl = make_scenario_controller(robot, scenario, config, plant)
