@@ -10,9 +10,11 @@ from __future__ import annotations
 import logging
 import os
 import signal
+import socket
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import pytest
@@ -68,6 +70,32 @@ def test_workers_are_capped_to_the_scenarios(tmp_path, capsys, monkeypatch):
     assert started == [1]
     assert "(1 dask worker)" in capsys.readouterr().err
     assert executors.run_many([], None, jobs=8) == []  # nothing to run: no worker at all
+
+
+def test_a_run_beside_another_cluster_says_nothing_of_ports(tmp_path, capsys, monkeypatch):
+    """Dask's scheduler serves HTTP (health routes) even without its dashboard, on 8787 by
+    default: a second run at the same time warned "Port 8787 is already in use"."""
+
+    class InProcess(distributed.LocalCluster):
+        def __init__(self, **options):
+            super().__init__(**{**options, "processes": False})
+
+    monkeypatch.setattr(distributed, "LocalCluster", InProcess)
+    taken = socket.socket()
+    try:
+        taken.bind(("", 8787))
+        taken.listen()
+    except OSError:
+        pass  # already taken by something else: the same test
+    try:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            status = cli([*FAST, "--jobs", "1", "--out", str(tmp_path / "o")])
+    finally:
+        taken.close()
+    assert status == 0, capsys.readouterr().err
+    assert not [w for w in caught if "already in use" in str(w.message)]
+    assert "8787" not in capsys.readouterr().err
 
 
 def test_stopping_the_workers_silences_every_dask_logger():

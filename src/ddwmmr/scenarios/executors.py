@@ -249,7 +249,14 @@ class DaskWorkers:
     def __enter__(self) -> Any:
         distributed = _import_distributed()
         if self.scheduler is None:
-            options = {"n_workers": self.jobs, "threads_per_worker": 1, "dashboard_address": None}
+            # No dashboard; the scheduler's HTTP server (health routes) on a free port, not
+            # 8787: with two runs at once Dask would warn that the port is taken
+            options = {
+                "n_workers": self.jobs,
+                "threads_per_worker": 1,
+                "dashboard_address": None,
+                "scheduler_kwargs": {"dashboard_address": ":0"},
+            }
             options.update(self.cluster_options)
             with _terminal_signals_blocked():  # inherited by the cluster's threads and workers
                 self._cluster = distributed.LocalCluster(**options)
