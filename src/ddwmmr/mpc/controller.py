@@ -68,7 +68,7 @@ from ddwmmr.mpc.options import (
 )
 from ddwmmr.mpc.problem import Problem
 from ddwmmr.mpc.solvers import SolverFailure, installed_qp_solvers, installed_solvers
-from ddwmmr.mpc.stall import STALL_TIME, StallWatch
+from ddwmmr.mpc.stall import StallWatch
 from ddwmmr.qp.limits import run_clearance, safe_arm_scale
 
 
@@ -231,7 +231,6 @@ class MPCController:
         self._route_index = 0  # where in ``route`` the current target was found
         self._following: tuple[float, float] | None = None  # the plan's second target
         self._single_target: tuple[float, float] | None = None  # lookahead dropped there
-        self._arriving_since: float | None = None  # plans at the shortest horizon since
         self._u_prev = np.zeros(self.model.nu)
         self._predicted_velocity: tuple[float, float] = (0.0, 0.0)
         self._predicted_rates: tuple[float, float] = (0.0, 0.0)  # the lagged arm's
@@ -280,7 +279,8 @@ class MPCController:
         target = (float(pose_d[0]), float(pose_d[1]))
         new_target = reach and self._target != target
         stuck = reach and self._stall.stuck(t, tuple(self.robot.fk(q)[:2]), new_target)
-        if (stuck or self._overdue(t)) and self._warm_mode == "reach2" and not new_target:
+        overdue = self._stall.arrival_overdue(t)
+        if (stuck or overdue) and self._warm_mode == "reach2" and not new_target:
             # a plan through this target to the next stalled short of it: one target at a
             # time until it is reached
             self._single_target = target
@@ -313,10 +313,7 @@ class MPCController:
         # "there at the shortest horizon" (within a millisecond: the QP's tolerance)
         shortest = problem.ocp.config.min_horizon + 1e-3
         arriving = mode == "reach2" and problem.ocp.horizon_of(w) <= shortest
-        if not arriving or new_target:
-            self._arriving_since = t if arriving else None
-        elif self._arriving_since is None:
-            self._arriving_since = t
+        self._stall.plan_arrival(t, arriving, new_target)
         self._stall.plan_slack(t, problem.ocp.max_slack(w))
         u = problem.ocp.first_input(w)
         braking = self.brake_slack is not None and should_brake(
@@ -354,13 +351,6 @@ class MPCController:
         if following is not None:
             references[ocp.split :] = (following[0], following[1], 0.0)
         return references
-
-    def _overdue(self, t: float) -> bool:
-        """True when the plans through the target to the next have said "there at the
-        shortest horizon" for longer than :data:`~ddwmmr.mpc.stall.STALL_TIME` (s) without
-        the target being reached: the exact-S guard holds back what they plan."""
-        since = self._arriving_since
-        return since is not None and t - since > STALL_TIME
 
     def _next_target(self, target: tuple[float, float]) -> tuple[float, float] | None:
         """With ``lookahead``: the waypoint of ``route`` after ``target`` (searched from

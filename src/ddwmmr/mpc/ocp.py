@@ -263,7 +263,7 @@ class ShootingOCP:
         self.second_fractions = self.lengths[self.split :] / config.second_leg_horizon
         self.nxm, self.num = model.nx, model.nu
         #: the free horizons carried as constant states (none when tracking)
-        self.n_horizons = config.legs if config.reach else 0
+        self.n_horizons = len(config.longest_horizons())
         self.nx = model.nx + self.n_horizons
         #: the joint box is a slackened path row, not a bound (see the module docstring)
         self.soft_joints = not model.joints_stop_at_once
@@ -516,10 +516,11 @@ class ShootingOCP:
             parts.append(math.sqrt(SLACK_QUADRATIC) * slacks[k])
         if weights.input_change > 0.0:
             parts.append(math.sqrt(weights.input_change) * (us[0] - u_prev) / scale)
-        pose = None
+        pose, poses = None, []
         for k in range(1, n + 1):
             q = model.configuration(xs[k])
             pose = sym.forward_kinematics(robot, q)
+            poses.append(pose)
             ref = refs[:, k - 1]
             # The weight of node k uses node k's own copy of T (stage-wise structure).
             h_k = self._interval(nodes, k - 1, owner=k)
@@ -543,9 +544,9 @@ class ShootingOCP:
         target = refs[:, n - 1]
         error = pose[:2] - target[:2]
         if config.reach:
-            parts.append(self._reach_cost(xs[self.split], refs[:, self.split - 1], 1.0))
+            parts.append(self._reach_cost(poses[self.split - 1], refs[:, self.split - 1], 1.0))
             if config.legs == 2:
-                parts.append(self._reach_cost(xs[n], target, config.second_leg_weight))
+                parts.append(self._reach_cost(pose, target, config.second_leg_weight))
             parts.append(math.sqrt(HORIZON_SMOOTHING) * (nodes[0][self.nxm] - horizon_prev))
         elif weights.terminal > 0.0:
             z = self._terminal_error(xs[n], pose, target)
@@ -557,12 +558,12 @@ class ShootingOCP:
             )
         return ca.vertcat(*parts)
 
-    def _reach_cost(self, x, target, weight: float) -> ca.SX:
-        """The residual of a leg's reach cost at its last node's state ``x``:
+    def _reach_cost(self, pose, target, weight: float) -> ca.SX:
+        """The residual of a leg's reach cost at its last node's end-effector ``pose``:
         ``0.5 r^2 = weight huber(|e|) / reach_speed``, ``weight |e| / reach_speed`` seconds
         far from ``target``."""
         config = self.config
-        error = sym.forward_kinematics(self.robot, self.model.configuration(x))[:2] - target[:2]
+        error = pose[:2] - target[:2]
         delta = config.huber if config.huber is not None else 0.01
         gain = math.sqrt(weight) / math.sqrt(delta * config.reach_speed)
         return gain * self._huber_scale(error, delta) * error

@@ -79,8 +79,8 @@ class Problem:
         old_horizon, second = source.horizon_of(warm), source.second_leg_of(warm)
         old_t = source.node_times(old_horizon, second)
         horizon = old_horizon
-        if handover:
-            horizon, second = old_horizon + (second or 0.0), None
+        if handover:  # the new second leg starts at its longest
+            horizon, second = old_horizon + (second or 0.0), ocp.config.second_leg_horizon
         if ocp.config.reach:
             horizon = min(max(horizon - elapsed, ocp.config.min_horizon), ocp.config.horizon)
         new_t = ocp.node_times(horizon, second) + elapsed
@@ -90,7 +90,7 @@ class Problem:
         if ocp.config.reach:
             xs[:, ocp.nxm] = horizon
         if ocp.n_horizons == 2:
-            xs[:, ocp.nxm + 1] = ocp.config.second_leg_horizon if second is None else second
+            xs[:, ocp.nxm + 1] = second
         xs[0, : ocp.nxm] = x0
         return ocp.pack(xs, us), horizon
 

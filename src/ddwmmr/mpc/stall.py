@@ -12,6 +12,10 @@ at most once per :data:`STALL_TIME`):
   stuck (on the physics plant: spinning on the spot with the arm stretched at the dynamic
   floor).
 
+A third timer serves the plans through a target to the next one (``lookahead``):
+:meth:`StallWatch.arrival_overdue` when every plan for :data:`STALL_TIME` said "there at
+the shortest horizon" without the target being reached.
+
 Why each rule: docs/mpc.md, "Formulation".
 """
 
@@ -34,6 +38,7 @@ class StallWatch:
         self._anchor: tuple[float, float] | None = None
         self._anchor_time = 0.0
         self._infeasible_since: float | None = None  # first of the plans that needed slack
+        self._arriving_since: float | None = None  # first of the plans at the shortest horizon
 
     def fresh_plan(self) -> None:
         """A cold start: its plans get their own :data:`STALL_TIME` to need slack."""
@@ -50,6 +55,20 @@ class StallWatch:
             self._infeasible_since = None
         elif self._infeasible_since is None:
             self._infeasible_since = t
+
+    def plan_arrival(self, t: float, shortest: bool, new_target: bool) -> None:
+        """The plan made at t (s) reaches its target at the shortest horizon (``shortest``);
+        ``new_target``: the target just changed."""
+        if not shortest:
+            self._arriving_since = None
+        elif new_target or self._arriving_since is None:
+            self._arriving_since = t
+
+    def arrival_overdue(self, t: float) -> bool:
+        """True when every plan for longer than :data:`STALL_TIME` (s) up to t said "there at
+        the shortest horizon" (:meth:`plan_arrival`) and the target is still ahead."""
+        since = self._arriving_since
+        return since is not None and t - since > STALL_TIME
 
     def _stalled(self, t: float, end_effector: tuple[float, float], new: bool) -> bool:
         """True (once per STALL_TIME) when the end effector has stopped short of the target."""
