@@ -101,7 +101,7 @@ def report() -> dict:
         ExtraCase("naive-again", "ddwmmr.bench:NaivePseudoinverseController", pair="pi"),
         ExtraCase("missing", "ddwmmr.no_such_module:Thing", pair="pi"),
     )
-    return run_benchmark(**TINY, extras=extras)
+    return run_benchmark(**TINY, extras=extras, floor_scenarios=1)
 
 
 def test_rows_cover_baseline_and_every_registered_method(report: dict) -> None:
@@ -115,6 +115,45 @@ def test_rows_cover_baseline_and_every_registered_method(report: dict) -> None:
         assert (row["meets_target"] is None) == (row["kind"] != "method")
     assert "ddwmmr.no_such_module" in report["skipped"]["missing"]
     assert (REFERENCE_LABEL in rows) != (REFERENCE_LABEL in report["skipped"])
+
+
+def test_the_mpc_floor_is_measured_with_mpc_and_judged_against_its_targets(report: dict):
+    from ddwmmr.bench.mpc_floor import FLOOR_TARGETS, floor_verdicts
+
+    rows = report["mpc_floor"]
+    assert [row["case"] for row in rows] == [
+        "tracking rectangle (kinematic plant)",
+        "tracking ellipse (kinematic plant)",
+        "scenarios 1-1 (thesis plant)",
+    ]
+    assert report["mpc_floor_targets"] == FLOOR_TARGETS
+    # 0.4 s at the trajectories' 0.02 s step; the scenario runs to its last waypoint
+    assert rows[0]["steps"] == rows[1]["steps"] == 21 and rows[2]["steps"] > 500
+    for row in rows:
+        assert 0 < row["hpipm_median_us"] < row["median_us"] <= row["p99_us"] <= row["max_us"]
+        assert row["p99_over_median"] == pytest.approx(row["p99_us"] / row["median_us"])
+        assert row["step_over_hpipm"] > 1.0
+    table = format_table(report).splitlines()
+    start = next(i for i, line in enumerate(table) if line.startswith("mpc step against"))
+    for row, line in zip(rows, table[start + 2 : start + 5], strict=True):
+        verdicts = floor_verdicts(row)
+        assert line.split()[-1] == ("ok" if verdicts["max_us"] else "MISS")
+        assert line.count("MISS") == sum(not met for met in verdicts.values())
+
+
+def test_floor_verdicts_hold_at_each_limit_and_miss_just_past_it():
+    from ddwmmr.bench.mpc_floor import FLOOR_TARGETS, floor_verdicts
+
+    at_limits = dict(FLOOR_TARGETS)
+    assert floor_verdicts(at_limits) == {key: True for key in FLOOR_TARGETS}
+    for key in FLOOR_TARGETS:
+        past = {**at_limits, key: at_limits[key] * (1 + 1e-9)}
+        assert floor_verdicts(past) == {k: k != key for k in FLOOR_TARGETS}
+
+
+def test_no_mpc_floor_without_mpc():
+    report = run_benchmark(repeats=1, calls=5, duration=0.1, methods=["ats"])
+    assert report["mpc_floor"] == [] and "mpc step against" not in format_table(report)
 
 
 def test_numbers_are_ordered_and_ratios_consistent(report: dict) -> None:
@@ -442,12 +481,12 @@ def test_scenario_throughput_counts_the_simulated_time_of_every_scenario():
     from ddwmmr.scenarios.generator import generate
     from ddwmmr.scenarios.protocol import RunConfig, run_scenario
 
-    rows = time_scenarios(3, jobs=1)
+    rows = time_scenarios(2, jobs=1)
     assert [row["controller"] for row in rows] == list(SCENARIO_CONTROLLERS)
     for row in rows:
         expected = sum(
             run_scenario(s, RunConfig(controller=row["controller"])).metrics["time_s"]
-            for s in generate(3, 0)
+            for s in generate(2, 0)
         )
         assert row["sim_time_s"] == pytest.approx(expected, rel=1e-12)
         assert row["wall_time_s"] > 0 and row["failed"] == 0
@@ -457,12 +496,14 @@ def test_scenario_throughput_counts_the_simulated_time_of_every_scenario():
 
 
 def test_cli_times_scenarios_only_when_asked_with_a_method(tmp_path, capsys):
+    from ddwmmr.bench import SCENARIO_CONTROLLERS
+
     out = tmp_path / "b.json"
     args = ["--repeats", "1", "--calls", "5", "--duration", "0.1", "--method", "ats"]
     assert main([*args, "--out", str(out), "--scenarios", "2", "--jobs", "1"]) == 0
     printed = capsys.readouterr().out
     data = json.loads(out.read_text())
-    assert [row["scenarios"] for row in data["scenarios"]] == [2, 2]
+    assert [row["scenarios"] for row in data["scenarios"]] == [2] * len(SCENARIO_CONTROLLERS)
     assert "scenario benchmark (2 scenarios, seed 0, 1 workers" in printed
     assert main([*args, "--out", str(out)]) == 0  # --method alone: no scenarios
     assert json.loads(out.read_text())["scenarios"] == []

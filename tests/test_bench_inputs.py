@@ -130,6 +130,7 @@ def test_run_benchmark_checks_its_arguments_before_running(monkeypatch):
         ({"repeats": 10**15}, r"repeats must be an integer in \[1, 1000\]"),
         ({"calls": 10**15}, r"calls must be an integer in \[1, 10000\]"),
         ({"scenarios": -1}, r"scenarios must be an integer in \[0, 100000\]"),
+        ({"floor_scenarios": -1}, r"floor_scenarios must be an integer in \[0, 100000\]"),
         ({"scenarios": 2, "scenario_jobs": 100_000}, r"jobs must be an integer in \[1, 256\]"),
         ({"duration": 1e12}, r"duration must be in \[0.02, 20000\] s"),
     ]
@@ -151,8 +152,8 @@ def test_never_more_workers_than_scenarios(monkeypatch):
     monkeypatch.setattr(executors, "run_many", fake_run_many)
     monkeypatch.setattr(scenario_report, "summarize", lambda o, w: dict.fromkeys(SCENARIO_KEYS, 0))
     rows = time_scenarios(2, jobs=200)
-    assert started == [(2, 2), (2, 2)]  # thesis and qp, two workers each
-    assert [row["jobs"] for row in rows] == [2, 2]
+    assert started == [(2, 2), (2, 2), (2, 2)]  # thesis, qp and mpc, two workers each
+    assert [row["jobs"] for row in rows] == [2, 2, 2]
     assert scenario_workers(100, 3) == 3
     assert 1 <= scenario_workers(1) == 1
     with pytest.raises(ParameterError, match=r"jobs must be an integer in \[1, 256\]"):

@@ -232,6 +232,7 @@ def floor_summary(log: StepLog) -> dict[str, Any]:
         "hpipm_iterations_per_qp": float(
             np.sum(table["hpipm_iterations"]) / max(1.0, float(np.sum(table["iterations"])))
         ),
+        "p99_over_median": float(np.percentile(step, 99) / np.median(step)),
         "cold_steps": int(np.sum(cold)),
         "cold_max_us": float(np.max(step[cold])) if np.any(cold) else 0.0,
         "warm_max_us": float(np.max(step[~cold])) if np.any(~cold) else 0.0,
@@ -245,6 +246,17 @@ def floor_summary(log: StepLog) -> dict[str, Any]:
 #: The tracking cases of the floor (trajectory name, simulated seconds); the scenarios'.
 FLOOR_TRACKING = (("rectangle", 40.0), ("ellipse", 40.0))
 FLOOR_SCENARIOS = 3
+
+#: The floor's targets, each a row key and its largest value: the median step at most
+#: twice HPIPM's median solve inside it, p99 at most twice the median (ratios measured in
+#: one run), and the slowest step at most 5 ms (us; the one absolute number, for a 10 ms
+#: control period with room to spare; it counts the garbage collector's pauses).
+FLOOR_TARGETS = {"step_over_hpipm": 2.0, "p99_over_median": 2.0, "max_us": 5000.0}
+
+
+def floor_verdicts(row: dict[str, Any]) -> dict[str, bool]:
+    """Which of :data:`FLOOR_TARGETS` a :func:`floor_summary` row meets."""
+    return {key: bool(row[key] <= limit) for key, limit in FLOOR_TARGETS.items()}
 
 
 def measure_mpc_floor(
@@ -278,6 +290,29 @@ def measure_mpc_floor(
         label = f"scenarios 1-{scenarios} (thesis plant)"
         rows.append({"case": label, **floor_summary(log)})
     return rows
+
+
+def format_floor_lines(rows: Sequence[dict[str, Any]]) -> list[str]:
+    """The floor as the bench table's section: per case the step's median, p99 and max
+    (us), HPIPM's median and each target's ratio with its verdict."""
+    lines = [
+        "mpc step against its HPIPM solve (thread CPU time, one run; targets: median step "
+        f"<= {FLOOR_TARGETS['step_over_hpipm']:g} x HPIPM, p99 <= "
+        f"{FLOOR_TARGETS['p99_over_median']:g} x median, max <= "
+        f"{FLOOR_TARGETS['max_us'] / 1000:g} ms)",
+        f"  {'case':<38} {'median':>7} {'p99':>7} {'max':>7} {'HPIPM':>7} "
+        f"{'step/HPIPM':>11} {'p99/median':>11} {'max':>5}",
+    ]
+    for row in rows:
+        verdict = {key: "ok" if met else "MISS" for key, met in floor_verdicts(row).items()}
+        lines.append(
+            f"  {row['case']:<38} {row['median_us']:>7.0f} {row['p99_us']:>7.0f} "
+            f"{row['max_us']:>7.0f} {row['hpipm_median_us']:>7.0f} "
+            f"{row['step_over_hpipm']:>6.2f} {verdict['step_over_hpipm']:<4} "
+            f"{row['p99_over_median']:>6.2f} {verdict['p99_over_median']:<4} "
+            f"{verdict['max_us']:>5}"
+        )
+    return lines
 
 
 def format_floor_table(rows: Sequence[dict[str, Any]]) -> str:

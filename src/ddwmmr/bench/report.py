@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from ddwmmr.bench.methods import REFERENCE_LABEL
+from ddwmmr.bench.mpc_floor import format_floor_lines
 from ddwmmr.errors import (
     ParameterError,
     read_text_file,
@@ -54,6 +55,8 @@ def format_table(report: dict[str, Any]) -> str:
         lines.append(f"skipped {label}: {reason}")
     if report.get("qp_classes"):
         lines += ["", *format_qp_classes(report)]
+    if report.get("mpc_floor"):
+        lines += ["", *format_floor_lines(report["mpc_floor"])]
     if report.get("scenarios"):
         lines += ["", *format_scenarios(report)]
     return "\n".join(lines)

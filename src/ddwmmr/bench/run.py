@@ -26,6 +26,12 @@ from ddwmmr.bench.methods import (
     pair_ratios,
     record_states,
 )
+from ddwmmr.bench.mpc_floor import (
+    FLOOR_SCENARIOS,
+    FLOOR_TARGETS,
+    FLOOR_TRACKING,
+    measure_mpc_floor,
+)
 from ddwmmr.bench.qp_classes import QP_CLASSES, QP_TARGETS, measure_qp_classes
 from ddwmmr.bench.report import REPORT_VERSION, TOOL
 from ddwmmr.bench.scenarios import SCENARIO_CONTROLLERS, time_scenarios
@@ -62,6 +68,8 @@ def run_benchmark(
     progress: bool = False,
     scenarios: int = 0,
     scenario_jobs: int | None = None,
+    mpc_floor: bool | None = None,
+    floor_scenarios: int = FLOOR_SCENARIOS,
 ) -> dict[str, Any]:
     """Measure every case; returns the report (see :func:`format_table` for the columns).
 
@@ -79,12 +87,18 @@ def run_benchmark(
             wall-clock second (:func:`time_scenarios`); 0 (default) skips it.
         scenario_jobs: worker processes for them (default: the CPUs available; never
             more than ``scenarios``).
+        mpc_floor: also measure where the ``mpc`` step's time goes against its HPIPM solve
+            (:func:`~ddwmmr.bench.mpc_floor.measure_mpc_floor`: the default rectangle
+            and ellipse tracked for ``duration`` s, and the first ``floor_scenarios``
+            scenarios on the thesis plant; default: when ``mpc`` is measured).
+        floor_scenarios: scenarios of that measurement (default 3; 0 for tracking only).
 
     Every argument is checked before anything runs (:class:`ParameterError`, one line).
     """
     check_int_at_least("repeats", repeats, 1, MAX_REPEATS)
     check_int_at_least("calls", calls, 1, MAX_CALLS)
     check_int_at_least("scenarios", scenarios, 0, MAX_SCENARIOS)
+    check_int_at_least("floor_scenarios", floor_scenarios, 0, MAX_SCENARIOS)
     if scenario_jobs is not None:
         check_int_at_least("jobs", scenario_jobs, 1, MAX_JOBS)
     robot = robot if robot is not None else Robot()
@@ -94,6 +108,8 @@ def run_benchmark(
     labels = {case.label for case in cases}
     if qp_classes is None:
         qp_classes = "qp" in labels
+    if mpc_floor is None:
+        mpc_floor = "mpc" in labels
     reference = any(case.label == REFERENCE_LABEL for case in cases) or (
         qp_classes and REFERENCE_LABEL not in skipped
     )
@@ -107,6 +123,11 @@ def run_benchmark(
             classes = measure_qp_classes(
                 Robot().with_payload(3.0), calls, repeats, overhead_ns, reference, bar
             )
+    floor = []
+    if mpc_floor:
+        with phase("bench: the mpc step against its HPIPM solve", enabled=progress):
+            tracking = [(name, duration) for name, _ in FLOOR_TRACKING]
+            floor = measure_mpc_floor(tracking, floor_scenarios)
     throughput = []
     if scenarios > 0:
         with phase(f"bench: {scenarios} scenarios x {len(SCENARIO_CONTROLLERS)}", enabled=progress):
@@ -123,6 +144,8 @@ def run_benchmark(
         "qp_classes": classes,
         "qp_targets": dict(QP_TARGETS),
         "scenarios": throughput,
+        "mpc_floor": floor,
+        "mpc_floor_targets": dict(FLOOR_TARGETS),
         "config": _config(repeats, calls, trajectory, duration, overhead_ns),
     }
 

@@ -13,7 +13,7 @@ from ddwmmr.errors import (
 )
 
 #: Controllers of the scenario-throughput section and its default size.
-SCENARIO_CONTROLLERS = ("thesis", "qp")
+SCENARIO_CONTROLLERS = ("thesis", "qp", "mpc")
 SCENARIO_COUNT = 100
 #: What the scenario section takes from the scenarios tool's summary.
 SCENARIO_KEYS = ("failed", "sim_time_s", "wall_time_s", "sim_seconds_per_wall_second")

@@ -29,9 +29,10 @@ from ddwmmr.trajectories import Ellipse
 from ddwmmr.trajectories.base import resolution_step
 
 DESCRIPTION = """\
-Time every control method step by step and in full runs, and the qp step by state class
+Time every control method step by step and in full runs, the qp step by state class
 and phase against its naive twin and roboticstoolbox-python's holistic QP step (install
-with pip install -e '.[bench]'). Prints a table and writes the report to --out.
+with pip install -e '.[bench]'), and the mpc step against the HPIPM solve inside it
+(tracking and the first scenarios). Prints a table and writes the report to --out.
 """
 
 
@@ -143,7 +144,7 @@ def build_parser() -> argparse.ArgumentParser:
         type=_scenario_count,
         default=None,
         metavar="N",
-        help=f"also time the first N benchmark scenarios with {' and '.join(SCENARIO_CONTROLLERS)} "
+        help=f"also time the first N benchmark scenarios with {', '.join(SCENARIO_CONTROLLERS)} "
         f"(simulated s per wall s; default {SCENARIO_COUNT} without --method, else 0; 0: skip; "
         f"at most {MAX_SCENARIOS})",
     )

@@ -290,6 +290,8 @@ class ShootingOCP:
                 self.slack_slices.append(slice(start + self.num, start + self.nu))
                 start += self.nu
         self.nw = start
+        #: index in w of every stage's slacks (N, ns): one fancy index reads them all
+        self.slack_index = np.array([np.arange(s.start, s.stop) for s in self.slack_slices])
         self.np = 4 * n + self.num + self.terminal_size**2 + 1
         self.w = ca.SX.sym("w", self.nw)
         self.p = ca.SX.sym("p", self.np)
@@ -615,20 +617,19 @@ class ShootingOCP:
         met). The joint box's slack is left out: it is the measured joint past its limit
         (MuJoCo lets a joint overrun its range by a few mrad) or its braking distance,
         which no restart of the plan changes (:meth:`max_joint_slack`)."""
-        rows = self.joint_slacks.start
-        return max(float(np.max(w[s][:rows])) for s in self.slack_slices)
+        return float(np.max(w[self.slack_index[:, : self.joint_slacks.start]]))
 
     def max_joint_slack(self, w: np.ndarray) -> float:
         """The largest slack of the joint box (rad, either joint; 0 where the box is
         bounds)."""
         if not self.soft_joints:
             return 0.0
-        return max(float(np.max(w[s][self.joint_slacks])) for s in self.slack_slices)
+        return float(np.max(w[self.slack_index[:, self.joint_slacks]]))
 
     def max_stability_slack(self, w: np.ndarray) -> float:
         """The largest slack of the stability rows (m, in the box on the centre of mass
         and the zero moment point; the obstacle rows' slack, in m^2, left out)."""
-        return max(float(np.max(w[s][:2])) for s in self.slack_slices)
+        return float(np.max(w[self.slack_index[:, :2]]))
 
     def first_input(self, w: np.ndarray) -> np.ndarray:
         """``u_0`` of a solution (the model's input, without slacks)."""

@@ -116,8 +116,10 @@ class Problem:
 def interpolate_rows(times: np.ndarray, rows: np.ndarray, at: np.ndarray) -> np.ndarray:
     """Rows (one per time, increasing) linearly interpolated at ``at``, held beyond the ends
     (``np.interp`` on every column at once)."""
-    at = np.clip(at, times[0], times[-1])
-    upper = np.clip(np.searchsorted(times, at, side="right"), 1, len(times) - 1)
+    # np.minimum/np.maximum rather than np.clip: the same values at a fraction of the
+    # call's overhead (this runs twice in every mpc step)
+    at = np.minimum(np.maximum(at, times[0]), times[-1])
+    upper = np.minimum(np.maximum(np.searchsorted(times, at, side="right"), 1), len(times) - 1)
     lower = upper - 1
     span = times[upper] - times[lower]
     weight = np.where(span > 0.0, (at - times[lower]) / np.where(span > 0.0, span, 1.0), 0.0)
