@@ -314,7 +314,8 @@ class MPCController:
         shortest = problem.ocp.config.min_horizon + 1e-3
         arriving = mode == "reach2" and problem.ocp.horizon_of(w) <= shortest
         self._stall.plan_arrival(t, arriving, new_target)
-        self._stall.plan_slack(t, problem.ocp.max_slack(w))
+        slack = problem.ocp.max_slack(w)
+        self._stall.plan_slack(t, slack)
         u = problem.ocp.first_input(w)
         braking = self.brake_slack is not None and should_brake(
             self.brake_slack,
@@ -325,7 +326,7 @@ class MPCController:
         if braking:
             self.brakes += 1
             u = self._braking_input(q, x0)
-        return self._output(problem, q, x0, u, w, iterations, braking)
+        return self._output(problem, q, x0, u, w, iterations, slack, braking)
 
     # -- pieces ---------------------------------------------------------------------------
     def _state(self, q: np.ndarray, base_velocity: tuple[float, float] | None) -> np.ndarray:
@@ -379,7 +380,7 @@ class MPCController:
         )
 
     def _output(
-        self, problem, q, x0, u, w, iterations, braking: bool = False
+        self, problem, q, x0, u, w, iterations, slack: float, braking: bool = False
     ) -> np.ndarray | WheelForces:
         k = self.robot.com_coefficients
         th1, th2 = float(q[3]), float(q[4])
@@ -389,7 +390,6 @@ class MPCController:
         scale = 1.0 if braking else safe_arm_scale(k, th1, th2, r1, r2, self.dt, self.stability_min)
         r1, r2 = r1 * scale, r2 * scale
         ocp = problem.ocp
-        slack = ocp.max_slack(w)
         self.last = StepInfo(
             extra={
                 "mpc_iterations": float(iterations),
