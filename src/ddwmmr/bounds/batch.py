@@ -24,6 +24,7 @@ from ddwmmr.bounds.lower import budget_bound
 from ddwmmr.bounds.search import Settings, best_known
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
+from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.result import json_safe, write_atomic
 
@@ -32,7 +33,7 @@ LOWER_VERSION = "budget-1"
 BEST_VERSION = "multistart-3"
 #: Columns of bounds.csv.
 COLUMNS = ("scenario", "lower_bound_s", "best_known_s", "starts", "spread_s", "replay_ok")
-CACHE = "cache"
+CACHE = PLAN_FOLDER
 
 
 @dataclasses.dataclass(frozen=True)
@@ -64,7 +65,7 @@ def cache_names(index: int) -> dict[str, str]:
     stem = f"{CACHE}/scenario-{index:03d}"
     return {
         "best": f"{stem}-best.json",
-        "trajectory": f"{stem}-best.npz",
+        "trajectory": f"{CACHE}/{PLAN_NAME.format(index)}",
         "lower": f"{stem}-lower.json",
     }
 

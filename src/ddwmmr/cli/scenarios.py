@@ -104,7 +104,7 @@ PROTOCOL_OPTIONS = {
     "stability_min": "--qp-stability-min",
     "max_speed": "--qp-max-speed",
     "arbiter": "--arbiter",
-    "route": "each scenario's own waypoints, with --option lookahead=on",
+    "route": "each scenario's own waypoints, with --option lookahead=on or plan=DIR",
 }
 #: Largest threshold: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
 THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}

@@ -43,6 +43,7 @@ the full list is in docs/mpc.md, "Options".
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
@@ -56,6 +57,7 @@ from ddwmmr.model import Robot
 from ddwmmr.model.stability import GRAVITY_M_S2
 from ddwmmr.mpc.braking import braked_velocity, braking_input, should_brake
 from ddwmmr.mpc.fallback import fallback_input, make_fallback
+from ddwmmr.mpc.min_time import Guess, plan_path
 from ddwmmr.mpc.models import PredictionModel, make_model
 from ddwmmr.mpc.ocp import OCPConfig
 from ddwmmr.mpc.options import (
@@ -104,6 +106,7 @@ class MPCController:
         except TypeError as error:  # an unknown keyword: name it as make_controller does
             raise ParameterError(f"method {self.name}: {error}") from None
         self.robot = robot
+        self._plan = _load_plan(self.options)
         self._configure(self.options.adopt_plant(None), None)
         self._loop_step: float | None = None
         self.dt = self.options.dt or DEFAULT_DT
@@ -164,6 +167,11 @@ class MPCController:
         self.interface = self.model.interface
         self.wants_base_velocity = model == "thesis"
         self._problems: dict[tuple[str, float], Problem] = {}
+        if self._plan is not None and self._plan.states.shape[1] != self.model.nx:
+            raise ParameterError(
+                "plan needs the force model without a joint lag (model='thesis', "
+                "arm_time_constant=0): its states are the thesis plant's"
+            )
 
     def adopt_plant(self, plant: PlantTraits) -> None:
         """The loop's plant, described (:func:`ddwmmr.commands.traits_of`): options not
@@ -301,10 +309,14 @@ class MPCController:
             cold = True
             self.restarts += 1
         source = self._problem("reach2").ocp if handover and self._warm is not None else None
+        leg = self._plan_leg(target) if reach and cold else None
+        if leg is not None:  # the offline plan's leg starts the cold start, not the hand-over
+            source = None
         warm = self._warm if not cold or source is not None else None
+        start = None if leg is None else problem.planned_start(x0, self._plan, leg)
         try:
             w, iterations = problem.solve(
-                t, x0, references, self._u_prev, warm, self._warm_time, source
+                t, x0, references, self._u_prev, warm, self._warm_time, source, start
             )
         except SolverFailure as failure:
             return self._fallback_command(t, q, pose_d, velocity_d, x0, str(failure))
@@ -353,18 +365,31 @@ class MPCController:
             references[ocp.split :] = (following[0], following[1], 0.0)
         return references
 
-    def _next_target(self, target: tuple[float, float]) -> tuple[float, float] | None:
-        """With ``lookahead``: the waypoint of ``route`` after ``target`` (searched from
-        the last one found, so a route may pass a point twice), None at the route's end
-        or when ``target`` is not on it."""
+    def _on_route(self, target: tuple[float, float]) -> int | None:
+        """Index of ``target`` in ``route``, searched from the last one found (so a route
+        may pass a point twice); None when it is not on the route."""
         route = self.options.route
-        if not self.options.lookahead or not route:
-            return None
         for index in range(self._route_index, len(route)):
             if math.dist(route[index], target) <= 1e-9:
                 self._route_index = index
-                return tuple(route[index + 1]) if index + 1 < len(route) else None
+                return index
         return None
+
+    def _next_target(self, target: tuple[float, float]) -> tuple[float, float] | None:
+        """With ``lookahead``: the waypoint of ``route`` after ``target``, None at the
+        route's end or when ``target`` is not on it."""
+        route = self.options.route
+        if not self.options.lookahead or not route:
+            return None
+        index = self._on_route(target)
+        if index is None or index + 1 >= len(route):
+            return None
+        return tuple(route[index + 1])
+
+    def _plan_leg(self, target: tuple[float, float]) -> int | None:
+        """With a ``plan``: the index of its leg that ends at ``target`` (the route's),
+        None without a plan or off the route."""
+        return None if self._plan is None else self._on_route(target)
 
     def _braking_input(self, q: np.ndarray, x0: np.ndarray) -> np.ndarray:
         """The braking step at the measured state (force model with the lagged arm)."""
@@ -498,7 +523,11 @@ class MPCController:
         no faster than its motors allow (``joint_acceleration_limit``), braking instead of
         following a plan that needs slack (``brake_slack``), when the loop hands it the
         plant's traits (``adopt_plant``; why each is needed: docs/mpc.md, "The physics plant:
-        tipping while moving")."""
+        tipping while moving").
+
+        ``route`` is the scenario's waypoints with ``lookahead`` or a ``plan``; a ``plan``
+        that is a folder (``python -m ddwmmr.bounds``'s output) becomes this scenario's
+        best-known trajectory in it (:func:`ddwmmr.mpc.min_time.plan_path`)."""
         config = run.config
         options: dict[str, Any] = {
             "model": "thesis" if FORCE in run.plant.interfaces else "kinematic",
@@ -508,9 +537,26 @@ class MPCController:
             "dt": config.dt,
         }
         options.update(dict(config.controller_options))
-        if options.get("lookahead") and not options.get("route"):
+        plan = options.get("plan")
+        # a folder is a bounds run's: this scenario's plan in it
+        if isinstance(plan, str | os.PathLike) and os.path.isdir(plan):
+            options["plan"] = str(plan_path(plan, run.scenario.index + 1))
+        if (options.get("lookahead") or plan is not None) and not options.get("route"):
             options["route"] = [tuple(w) for w in run.scenario.waypoints]
         return options
+
+
+def _load_plan(options: MPCOptions) -> Guess | None:
+    """The ``plan`` option's trajectory, with one leg per waypoint of ``route``."""
+    if options.plan is None:
+        return None
+    plan = Guess.load(options.plan)
+    if len(plan.arrivals) != len(options.route):
+        raise ParameterError(
+            f"plan {options.plan} has {len(plan.arrivals)} legs: route must list as many "
+            f"waypoints (got {len(options.route)})"
+        )
+    return plan
 
 
 def _model_choice(resolved: MPCOptions, plant: PlantTraits | None) -> tuple:

@@ -40,6 +40,7 @@ import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import casadi as ca
 import numpy as np
@@ -53,6 +54,11 @@ from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
 INTERIOR_CHECKS = 3
 #: Leg durations (s) the solver may choose from.
 LEG_TIME_RANGE = (0.05, 120.0)
+#: Where ``python -m ddwmmr.bounds`` keeps scenario number N's (from 1) best-known
+#: trajectory (``.npz``: ``times``, ``states``, ``inputs``, ``legs``): this name in the
+#: ``PLAN_FOLDER`` of its output folder.
+PLAN_NAME = "scenario-{:03d}-best.npz"
+PLAN_FOLDER = "cache"
 
 Rows = Callable[..., ca.SX]
 
@@ -101,6 +107,68 @@ class Guess:
     states: np.ndarray
     inputs: np.ndarray
     arrivals: np.ndarray
+
+    @classmethod
+    def load(cls, path: str | Path, nx: int = sym.NX_FORCE, nu: int = sym.NU_FORCE) -> Guess:
+        """A trajectory stored as ``python -m ddwmmr.bounds`` stores its best-known ones
+        (``.npz``: ``times`` (M+1,) s increasing from 0, ``states`` (M+1, nx), ``inputs``
+        (M, nu) held from each time, ``legs`` (one duration per waypoint, s, > 0)); a
+        one-line :class:`ParameterError` naming the file for anything else."""
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                arrays = {key: np.asarray(data[key], dtype=float) for key in _PLAN_SHAPES}
+        except FileNotFoundError:
+            raise ParameterError(f"plan {path}: no such file") from None
+        except (OSError, ValueError, KeyError) as error:
+            reason = error.args[0] if isinstance(error, KeyError) else type(error).__name__
+            raise ParameterError(
+                f"plan {path} must be a .npz with {', '.join(_PLAN_SHAPES)} ({reason})"
+            ) from None
+        times, states, inputs, legs = (arrays[key] for key in _PLAN_SHAPES)
+        m = len(times) - 1
+        shapes_ok = (
+            times.ndim == 1
+            and m >= 1
+            and states.shape == (m + 1, nx)
+            and inputs.shape == (m, nu)
+            and legs.ndim == 1
+            and len(legs) >= 1
+        )
+        finite = shapes_ok and all(np.all(np.isfinite(a)) for a in arrays.values())
+        if not (finite and np.all(np.diff(times) > 0.0) and np.all(legs > 0.0)):
+            raise ParameterError(
+                f"plan {path} must hold times (M+1,) increasing, states (M+1, {nx}), "
+                f"inputs (M, {nu}) and legs (> 0 s), all finite"
+            )
+        return cls(times, states, inputs, np.cumsum(legs))
+
+    def leg_samples(self, leg: int, offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """States and inputs ``offsets`` (s) after the start of leg ``leg`` (0-based: the
+        arrival at the waypoint before it), linearly interpolated, held beyond the ends."""
+        start = 0.0 if leg == 0 else float(self.arrivals[leg - 1])
+        at = np.clip(start + np.asarray(offsets, dtype=float), self.times[0], self.times[-1])
+        states = np.column_stack([np.interp(at, self.times, c) for c in self.states.T])
+        times_u = self.times[: len(self.inputs)]
+        inputs = np.column_stack([np.interp(at, times_u, c) for c in self.inputs.T])
+        return states, inputs
+
+    @property
+    def legs(self) -> np.ndarray:
+        """Each leg's duration (s)."""
+        return np.diff(np.concatenate([[0.0], self.arrivals]))
+
+
+#: The arrays of a stored plan, in order.
+_PLAN_SHAPES = ("times", "states", "inputs", "legs")
+
+
+def plan_path(folder: str | Path, scenario: int) -> Path:
+    """Scenario number ``scenario``'s (from 1) best-known trajectory in the output folder
+    of ``python -m ddwmmr.bounds`` (in its ``cache``) or in that cache folder itself."""
+    folder = Path(folder)
+    name = PLAN_NAME.format(scenario)
+    inside = folder / PLAN_FOLDER / name
+    return inside if inside.exists() or not (folder / name).exists() else folder / name
 
 
 @dataclass(frozen=True)

@@ -15,6 +15,7 @@ from __future__ import annotations
 import copy
 import inspect
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
 from typing import Any
@@ -139,7 +140,16 @@ class MPCOptions:
         lookahead_horizon: the second leg's longest duration (s), with as many intervals
             as the first leg.
         route: the task's waypoints ``(x, y)`` in order (m, world) that ``lookahead``
-            looks along; the scenario protocol fills it in with ``lookahead``.
+            and ``plan`` look along; the scenario protocol fills it in with either.
+        plan: waypoint mode: a minimum-time trajectory of the whole task, one leg per
+            waypoint of ``route`` (a ``.npz`` as ``python -m ddwmmr.bounds`` stores its
+            best-known ones, :meth:`ddwmmr.mpc.min_time.Guess.load`; in the scenario tool
+            also that tool's output folder, each scenario's own file taken from it). Every
+            cold start (a new target, a restart) starts from the plan's leg to the target
+            (and the next leg with ``lookahead``) instead of a standing guess, so the plan
+            the controller settles in has the offline plan's structure (direction of
+            travel, elbow branch, turns); None (default): no plan (docs/mpc.md,
+            "Following an offline plan's structure").
         proximal: damping of the input steps between two solves (see
             :class:`ddwmmr.mpc.solvers.GaussNewtonSQP`).
         stability_margin: the OCP keeps ``S >= stability_min + stability_margin``.
@@ -201,6 +211,7 @@ class MPCOptions:
     lookahead_weight: float = 0.5
     lookahead_horizon: float = 12.0
     route: Sequence[Sequence[float]] = ()
+    plan: str | None = None
     proximal: float = 0.01
     stability_margin: float = 0.01
     dynamic_stability: bool | None = None
@@ -257,6 +268,10 @@ class MPCOptions:
             "lookahead_weight", check_range("lookahead_weight", self.lookahead_weight, 0.0, 1.0)
         )
         self._set("route", _route_option(self.route))
+        if self.plan is not None:
+            if not isinstance(self.plan, str | os.PathLike) or not str(self.plan):
+                raise ParameterError(f"plan must be a file path (got {shown(self.plan)})")
+            self._set("plan", str(self.plan))
         self._set(
             "lookahead_horizon",
             check_range("lookahead_horizon", self.lookahead_horizon, 0.5, MAX_HORIZON, "s"),

@@ -9,6 +9,7 @@ import numpy as np
 from ddwmmr.model import Robot
 from ddwmmr.mpc import terminal
 from ddwmmr.mpc.cache import shared_ocp
+from ddwmmr.mpc.min_time import Guess
 from ddwmmr.mpc.models import PredictionModel
 from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP
 from ddwmmr.mpc.solvers import make_solver
@@ -64,6 +65,27 @@ class Problem:
         node = np.concatenate([x0, ocp.config.longest_horizons()])
         return ocp.pack(np.tile(node, (ocp.N + 1, 1)), np.zeros((ocp.N, ocp.nu)))
 
+    def planned_start(self, x0: np.ndarray, plan: Guess, leg: int) -> tuple[np.ndarray, float]:
+        """A cold start from ``plan``: its leg ``leg`` (0-based; with two legs also the
+        next, or the longest second leg after the plan's last) re-sampled at this OCP's node
+        times, each duration the plan's within the OCP's bounds, node 0 the measured
+        ``x0``, no slack. Returns ``(w, T)``, T the first leg's duration (s)."""
+        ocp, config = self.ocp, self.ocp.config
+        durations = plan.legs
+        horizon = float(np.clip(durations[leg], config.min_horizon, config.horizon))
+        second = None
+        if ocp.n_horizons == 2:
+            following = durations[leg + 1] if leg + 1 < len(durations) else np.inf
+            second = float(np.clip(following, config.min_horizon, config.second_leg_horizon))
+        states, inputs = plan.leg_samples(leg, ocp.node_times(horizon, second))
+        xs, us = np.zeros((ocp.N + 1, ocp.nx)), np.zeros((ocp.N, ocp.nu))
+        xs[:, : ocp.nxm], us[:, : ocp.num] = states, inputs[:-1]
+        xs[:, ocp.nxm] = horizon
+        if second is not None:
+            xs[:, ocp.nxm + 1] = second
+        xs[0, : ocp.nxm] = x0
+        return ocp.pack(xs, us), horizon
+
     def _shifted(
         self, warm: np.ndarray, elapsed: float, x0: np.ndarray, source: ShootingOCP | None = None
     ) -> tuple:
@@ -95,13 +117,24 @@ class Problem:
         return ocp.pack(xs, us), horizon
 
     def solve(
-        self, t, x0, references, u_prev, warm, warm_time, source: ShootingOCP | None = None
+        self,
+        t,
+        x0,
+        references,
+        u_prev,
+        warm,
+        warm_time,
+        source: ShootingOCP | None = None,
+        start: tuple[np.ndarray, float] | None = None,
     ) -> tuple[np.ndarray, int]:
         """Solve from the shifted warm start (or cold); returns (w, iterations). With a
         ``source`` (a hand-over, :meth:`_shifted`) the shifted plan starts the cold
-        start's iterations."""
+        start's iterations; without a warm start, ``start`` (``(w, T)``,
+        :meth:`planned_start`) does instead of the standing guess."""
         ocp = self.ocp
-        if warm is None:
+        if warm is None and start is not None:
+            (guess, horizon), solver = start, self.cold
+        elif warm is None:
             guess, horizon, solver = self._initial(x0), ocp.config.horizon, self.cold
         else:
             guess, horizon = self._shifted(warm, max(0.0, t - warm_time), x0, source)

@@ -1,0 +1,155 @@
+"""``plan``: an offline minimum-time trajectory of the task as the mpc's cold start (the
+file format of ``python -m ddwmmr.bounds``, its loading, the leg it hands each new target,
+and that the plan's structure is what the controller settles in)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ddwmmr import ParameterError, Robot
+from ddwmmr.commands import traits_of
+from ddwmmr.controllers.base import WaypointRun
+from ddwmmr.mpc.controller import MPCController
+from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, plan_path
+from ddwmmr.plants import ThesisPlant
+from ddwmmr.scenarios import RunConfig, generate
+
+ROBOT = Robot().with_payload(3.0)
+#: the default pose at rest: the end effector about 0.5 m ahead of the base
+START = np.array([0.0, 0.0, 0.0, 0.3, 1.2])
+BEHIND = (-1.2, 0.0)
+
+
+def straight_plan(speed: float, turn: float, duration: float = 3.0, n: int = 30) -> dict:
+    """A plan of one leg: the base at ``speed`` (m/s) along x turning at ``turn`` (rad/s),
+    the arm still, the wheel forces that drive it that way (N, left and right)."""
+    times = np.linspace(0.0, duration, n + 1)
+    states = np.zeros((n + 1, 7))
+    states[:, 0] = speed * times
+    states[:, 2] = turn * times
+    states[:, 3:5] = START[3:5]
+    states[:, 5], states[:, 6] = speed, turn
+    push, twist = 10.0 * np.sign(speed), 10.0 * np.sign(turn)
+    inputs = np.tile([push - twist, push + twist, 0.0, 0.0], (n, 1))
+    return {"times": times, "states": states, "inputs": inputs, "legs": np.array([duration])}
+
+
+def write_plan(path: Path, arrays: dict) -> Path:
+    np.savez(path, **arrays)
+    return path
+
+
+def test_a_stored_plan_loads_with_its_arrival_times_and_samples_its_legs(tmp_path):
+    arrays = straight_plan(-0.4, 0.0, duration=2.0, n=20)
+    arrays["legs"] = np.array([0.5, 1.5])
+    plan = Guess.load(write_plan(tmp_path / "plan.npz", arrays))
+    assert plan.arrivals == pytest.approx([0.5, 2.0])
+    assert plan.legs == pytest.approx([0.5, 1.5])
+    # leg 1 starts at the arrival at the first waypoint (0.5 s): x = -0.4 t
+    states, inputs = plan.leg_samples(1, np.array([0.0, 0.25, 10.0]))
+    assert states[:, 0] == pytest.approx([-0.2, -0.3, -0.8])  # held beyond the end
+    assert inputs[:, 0] == pytest.approx([-10.0] * 3)
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [
+        ({"legs": None}, r"must be a \.npz with times, states, inputs, legs \(legs is not"),
+        ({"states": np.zeros((5, 7))}, r"states \(M\+1, 7\)"),
+        ({"legs": np.array([3.0, 0.0])}, r"legs \(> 0 s\)"),
+        ({"times": np.linspace(3.0, 0.0, 31)}, "times .* increasing"),
+        ({"inputs": np.full((30, 4), np.nan)}, "all finite"),
+    ],
+)
+def test_a_bad_plan_file_is_a_one_line_error(tmp_path, change, match):
+    arrays = {**straight_plan(0.5, 0.0), **change}
+    arrays = {k: v for k, v in arrays.items() if v is not None}
+    path = write_plan(tmp_path / "plan.npz", arrays)
+    with pytest.raises(ParameterError, match=match) as error:
+        Guess.load(path)
+    assert "\n" not in str(error.value)
+
+
+def test_a_missing_or_unreadable_plan_is_a_one_line_error(tmp_path):
+    with pytest.raises(ParameterError, match=r"plan .*nowhere\.npz: no such file"):
+        Guess.load(tmp_path / "nowhere.npz")
+    (tmp_path / "text.npz").write_text("not an archive")
+    with pytest.raises(ParameterError, match=r"plan .*text.npz must be a \.npz"):
+        Guess.load(tmp_path / "text.npz")
+
+
+def test_plan_option_errors_name_the_option(tmp_path):
+    path = str(write_plan(tmp_path / "plan.npz", straight_plan(0.5, 0.0)))
+    with pytest.raises(ParameterError, match="plan must be a file path"):
+        MPCController(ROBOT, plan=3)
+    with pytest.raises(ParameterError, match=r"plan .* has 1 legs: route must list as many"):
+        MPCController(ROBOT, model="thesis", plan=path, route=[(1.0, 0.0), (2.0, 0.0)])
+    with pytest.raises(ParameterError, match="plan needs the force model"):
+        MPCController(ROBOT, model="kinematic", plan=path, route=[(1.0, 0.0)])
+
+
+def test_the_cold_start_is_the_plans_leg_on_the_ocps_nodes(tmp_path):
+    arrays = straight_plan(-0.4, 0.0, duration=4.0, n=40)
+    arrays["legs"] = np.array([1.0, 3.0])
+    path = str(write_plan(tmp_path / "plan.npz", arrays))
+    route = [(-0.9, 0.0), (-1.7, 0.0)]
+    controller = MPCController(ROBOT, model="thesis", lookahead=True, route=route, plan=path)
+    problem = controller._problem("reach2")
+    ocp = problem.ocp
+    x0 = np.array([*START, 0.0, 0.0])
+    w, horizon = problem.planned_start(x0, controller._plan, 0)
+    xs, us = ocp.trajectories(w)
+    assert horizon == pytest.approx(1.0)
+    assert xs[:, ocp.nxm] == pytest.approx(1.0)  # T1: the first leg's duration
+    assert xs[:, ocp.nxm + 1] == pytest.approx(3.0)  # T2: the next leg's
+    times = ocp.node_times(1.0, 3.0)
+    assert xs[1:, 0] == pytest.approx(-0.4 * times[1:])  # the plan's x at the node times
+    assert xs[0, : ocp.nxm] == pytest.approx(x0)  # node 0 is the measured state
+    assert us[:, :2] == pytest.approx(np.full((ocp.N, 2), -10.0))
+    assert np.all(us[:, ocp.num :] == 0.0)  # no slack
+    # the last leg: the longest second leg after the plan's end
+    _, _ = problem.planned_start(x0, controller._plan, 1)
+    w_last, _ = problem.planned_start(x0, controller._plan, 1)
+    assert ocp.second_leg_of(w_last) == pytest.approx(ocp.config.second_leg_horizon)
+
+
+def first_plan(tmp_path: Path, arrays: dict | None) -> tuple[float, float]:
+    """The first step's plan toward a waypoint behind the robot, from ``arrays`` as the
+    plan or from the standing guess: its duration T (s) and the heading it ends in (rad)."""
+    options = {"model": "thesis", "route": [BEHIND], "track_orientation": False}
+    if arrays is not None:
+        options["plan"] = str(write_plan(tmp_path / "plan.npz", arrays))
+    controller = MPCController(ROBOT, **options)
+    controller.command(0.0, START, np.array([*BEHIND, 0.0]), np.zeros(3), base_velocity=(0, 0))
+    ocp = controller._problem("reach").ocp
+    w = np.asarray(controller._warm).ravel()
+    xs, _ = ocp.trajectories(w)
+    return ocp.horizon_of(w), float(xs[-1][2])
+
+
+def test_the_plans_structure_is_the_one_the_controller_settles_in(tmp_path):
+    """A waypoint behind the robot: from the standing guess the first plan (5 cold
+    iterations) still needs the longest horizon; from a plan turning either way it
+    settles in a plan half as long that turns the way the plan does."""
+    standing, _ = first_plan(tmp_path, None)
+    left, heading_left = first_plan(tmp_path, straight_plan(0.05, 1.0))
+    right, heading_right = first_plan(tmp_path, straight_plan(0.05, -1.0))
+    assert standing == pytest.approx(5.0, abs=0.01)  # the longest horizon
+    assert max(left, right) < 0.7 * standing
+    assert heading_left > 0.1 and heading_right < -0.1
+
+
+def test_the_protocol_hands_each_scenario_its_plan_from_a_bounds_folder(tmp_path):
+    scenario = generate(2, seed=0)[1]
+    (tmp_path / PLAN_FOLDER).mkdir()
+    stored = write_plan(tmp_path / PLAN_FOLDER / PLAN_NAME.format(2), straight_plan(0.5, 0.0))
+    assert plan_path(tmp_path, 2) == stored
+    assert plan_path(tmp_path / PLAN_FOLDER, 2) == stored  # the cache folder itself
+    config = RunConfig(controller="mpc", controller_options=(("plan", str(tmp_path)),))
+    run = WaypointRun(scenario, config, traits_of(ThesisPlant(ROBOT)))
+    options = MPCController.waypoint_options(run)
+    assert options["plan"] == str(stored)
+    assert options["route"] == [tuple(w) for w in scenario.waypoints]
