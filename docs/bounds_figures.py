@@ -9,10 +9,11 @@ Data (committed, in docs/bounds/):
 
 ``python docs/bounds_figures.py`` redraws the figure from them and rewrites the block
 between the ``bounds-table`` markers of docs/mpc.md; ``--collect SEED DIR`` first builds
-``controllers_seed{SEED}.csv`` from five scenario runs
-``DIR/{thesis,competitive,qp,mpc,mpc-lookahead}-sSEED`` (their scenarios.csv; the last is
-``--controller mpc --option lookahead=on``), ``--bounds SEED CSV`` first copies a bounds
-run's bounds.csv to ``bounds_seed{SEED}.csv``.
+``controllers_seed{SEED}.csv`` from six scenario runs
+``DIR/{thesis,competitive,qp,mpc,mpc-lookahead,mpc-plan}-sSEED`` (their scenarios.csv;
+``mpc-lookahead`` is ``--controller mpc --option lookahead=on``, ``mpc-plan`` that with
+``--option plan=BOUNDS_DIR``), ``--bounds SEED CSV`` first copies a bounds run's
+bounds.csv to ``bounds_seed{SEED}.csv``.
 """
 
 from __future__ import annotations
@@ -40,6 +41,7 @@ CONTROLLERS = {
     "qp": "qp",
     "mpc": "mpc",
     "mpc-lookahead": "mpc, lookahead",
+    "mpc-plan": "mpc, lookahead, offline plan",
 }
 SEEDS = (0, 1)
 
@@ -64,7 +66,7 @@ def read_controllers(seed: int) -> dict[str, dict[int, float]]:
 
 
 def collect(seed: int, folder: Path) -> None:
-    """controllers_seed{seed}.csv from five scenario runs in ``folder``."""
+    """controllers_seed{seed}.csv from six scenario runs in ``folder``."""
     columns: dict[str, dict[int, float]] = {}
     for name in CONTROLLERS:
         with open(folder / f"{name}-s{seed}" / "scenarios.csv", newline="") as handle:
@@ -133,6 +135,7 @@ def figure() -> None:
         "qp": ("tab:orange", "s"),
         "mpc": ("tab:green", "D"),
         "mpc-lookahead": ("tab:red", "^"),
+        "mpc-plan": ("tab:purple", "x"),
     }
     data = ratios(0)
     bounds = read_bounds(0)
@@ -156,7 +159,7 @@ def figure() -> None:
     axes[1].set_xlabel("scenario (seed 0)")
     axes[1].set_xlim(0, scenarios.max() + 1)
     handles, labels = axes[1].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="upper center", ncol=5, fontsize=8, frameon=False)
+    fig.legend(handles, labels, loc="upper center", ncol=4, fontsize=8, frameon=False)
     fig.tight_layout(rect=(0, 0, 1, 0.95))
     fig.savefig(FIGURE, dpi=110)
     plt.close(fig)
