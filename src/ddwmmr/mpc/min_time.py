@@ -142,15 +142,20 @@ class Guess:
             )
         return cls(times, states, inputs, np.cumsum(legs))
 
-    def leg_samples(self, leg: int, offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """States and inputs ``offsets`` (s) after the start of leg ``leg`` (0-based: the
-        arrival at the waypoint before it), linearly interpolated, held beyond the ends."""
-        start = 0.0 if leg == 0 else float(self.arrivals[leg - 1])
-        at = np.clip(start + np.asarray(offsets, dtype=float), self.times[0], self.times[-1])
+    def sample(self, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """States and inputs at the times ``at`` (s), linearly interpolated (an input
+        between the times it starts at), held beyond the ends."""
+        at = np.asarray(at, dtype=float)
         states = np.column_stack([np.interp(at, self.times, c) for c in self.states.T])
         times_u = self.times[: len(self.inputs)]
         inputs = np.column_stack([np.interp(at, times_u, c) for c in self.inputs.T])
         return states, inputs
+
+    def leg_samples(self, leg: int, offsets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`sample` ``offsets`` (s) after the start of leg ``leg`` (0-based: the
+        arrival at the waypoint before it)."""
+        start = 0.0 if leg == 0 else float(self.arrivals[leg - 1])
+        return self.sample(start + np.asarray(offsets, dtype=float))
 
     @property
     def legs(self) -> np.ndarray:
@@ -312,14 +317,9 @@ class FreeTimeOCP:
             [t0 + legs[i] * np.arange(self.M) / self.M for i, t0 in enumerate(arrivals - legs)]
             + [[arrivals[-1]]]
         )
-        states = np.column_stack(
-            [np.interp(node_times, guess.times, guess.states[:, i]) for i in range(nx)]
-        )
+        states = guess.sample(node_times)[0][:, :nx]
         states[0] = self.start
-        times_u = guess.times[: len(guess.inputs)]
-        inputs = np.column_stack(
-            [np.interp(node_times[:-1], times_u, guess.inputs[:, i]) for i in range(nu)]
-        )
+        inputs = guess.sample(node_times[:-1])[1][:, :nu]
         w0 = np.concatenate([states.ravel(), inputs.ravel(), legs])
         return np.clip(w0, self.lbw, self.ubw)
 
