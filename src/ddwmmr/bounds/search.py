@@ -252,16 +252,24 @@ def _faster_run(robot: Robot, runs: dict[str, Guess], waypoints, s: Settings, fo
     a closed-loop run does not). At 1 ms steps a run's held commands drift: 1 mm past the
     tolerance in scenario 2 of seed 0."""
     for name, run in runs.items():
-        legs = np.diff(np.concatenate([[0.0], run.arrivals]))
-        result = MinimumTime(
-            float(run.arrivals[-1]), legs, True, run.times, run.states, run.inputs,
-            f"run-{name}",
-        )  # fmt: skip
-        step = float(run.times[1] - run.times[0])
-        check = replay(robot, result, waypoints, s.stability_min, s.tolerance, dt=step)
+        result, check = replay_run(robot, name, run, waypoints, s)
         if check.ok and (found is None or check.time_s < found[1].time_s):
             found = (result, check)
     return found
+
+
+def replay_run(robot: Robot, name: str, run: Guess, waypoints, s: Settings):
+    """``(solution, replay check)`` of a controller's recorded run
+    (:func:`~ddwmmr.bounds.starts.controller_guess`): its wheel forces and joint rates
+    replayed open loop on the thesis plant at the run's own step, checked against the
+    waypoints, the tolerance and the S floor of ``s``; the solution's start is
+    ``run-<name>``."""
+    legs = np.diff(np.concatenate([[0.0], run.arrivals]))
+    result = MinimumTime(
+        float(run.arrivals[-1]), legs, True, run.times, run.states, run.inputs, f"run-{name}"
+    )
+    step = float(run.times[1] - run.times[0])
+    return result, replay(robot, result, waypoints, s.stability_min, s.tolerance, dt=step)
 
 
 def _straight_starts() -> list[tuple[str, str, float]]:

@@ -203,11 +203,14 @@ class RecordingTask:
         )
 
 
-def controller_guess(scenario, controller: str, payload: float = 3.0, dt: float = 0.01):
+def controller_guess(
+    scenario, controller: str, payload: float = 3.0, dt: float = 0.01, options: tuple = ()
+):
     """A start from a controller's run of ``scenario`` on the thesis plant (the scenario
     protocol's controllers: ``"thesis"``, ``"competitive"`` (the thesis controller with
     the competitive arbiter), ``"qp"``, ``"mpc"`` or ``"mpc-lookahead"`` (the mpc
-    planning through the next waypoint)); None if it did not finish."""
+    planning through the next waypoint)), with the controller ``options`` (``(name,
+    value)`` pairs) besides; None if it did not finish."""
     from ddwmmr.behaviours.objective import default_pose
     from ddwmmr.scenarios.protocol import (
         RunConfig,
@@ -218,7 +221,7 @@ def controller_guess(scenario, controller: str, payload: float = 3.0, dt: float 
 
     arbiter = "competitive" if controller == "competitive" else "state-machine"
     kind = {"competitive": "thesis", "mpc-lookahead": "mpc"}.get(controller, controller)
-    options = (("lookahead", True),) if controller == "mpc-lookahead" else ()
+    options = ((("lookahead", True),) if controller == "mpc-lookahead" else ()) + tuple(options)
     config = RunConfig(
         controller=kind,
         plant="thesis",
