@@ -18,7 +18,7 @@ from ddwmmr import Robot
 from ddwmmr.bounds import batch, diffdrive
 from ddwmmr.bounds.lower import Prices, budget_bound, circular
 from ddwmmr.bounds.replay import replay
-from ddwmmr.bounds.search import Settings, _faster_run, best_known, start_state
+from ddwmmr.bounds.search import Settings, _faster_run, best_known, plan_runs, start_state
 from ddwmmr.bounds.starts import Pattern, controller_guess, pattern_guess
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.min_time import MinimumTimeProblem
@@ -39,6 +39,7 @@ LIGHT = Settings(
     arm_top=0,
     continuation_top=0,
     controllers=(),
+    guided=(("mpc-plan", ()),),
 )
 
 
@@ -247,6 +248,25 @@ def test_a_controller_run_that_replays_faster_becomes_the_best_known():
         run, times=run.times[:short], states=run.states[:short], inputs=run.inputs[: short - 1]
     )
     assert _faster_run(HEAVY, {"mpc": cut}, scenario.waypoints, settings, None) is None
+
+
+def test_the_mpc_following_the_best_found_is_a_candidate_too():
+    """Step 5: the mpc (lookahead) run with the best found as its plan, as it is and with
+    the smaller margin, recorded and checked like the controllers' runs; none without
+    ``guided``."""
+    scenario = Scenario(0, ((2.0, 1.5), (-0.5, 2.0)))
+    problem = MinimumTimeProblem(
+        HEAVY, scenario.waypoints, start_state(HEAVY), intervals_per_leg=12
+    )
+    plan = problem.solve(problem.straight_line_guess())
+    assert plan.success
+    runs = plan_runs(scenario, plan, Settings(), HEAVY.payload)
+    assert set(runs) == {"mpc-plan", "mpc-plan-margin"}
+    for run in runs.values():  # both waypoints, in a time near the plan's
+        assert len(run.arrivals) == 2 and run.arrivals[-1] < 1.3 * plan.total
+    found = _faster_run(HEAVY, runs, scenario.waypoints, Settings(), None)
+    assert found is not None and found[0].start.startswith("run-mpc-plan") and found[1].ok
+    assert plan_runs(scenario, plan, Settings(guided=()), HEAVY.payload) == {}
 
 
 def test_continuation_bounds_change_only_their_rows():

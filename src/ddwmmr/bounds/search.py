@@ -18,7 +18,11 @@ One scenario (:func:`best_known`):
    solution is solved once more with smaller margins and kept if that replays too;
 4. **the controllers' runs** count too: where a run's recorded wheel forces and joint
    rates, replayed open-loop at the run's own step, pass the same check in less time,
-   that time is the best known (``start`` ``run-<controller>``).
+   that time is the best known (``start`` ``run-<controller>``);
+5. **the plan followed**: the ``mpc`` with ``lookahead`` run with the best found so far
+   as its ``plan`` (:data:`Settings.guided`: as it is and with a smaller floor margin and
+   input cost), its runs candidates as in 4 (``run-mpc-plan``, ``run-mpc-plan-margin``):
+   the closed loop sometimes beats the plan it follows.
 
 The result is the replayed time: a trajectory the plant itself drives, so an upper bound on
 the true minimum. ``spread_s`` is the range of the screened local optima.
@@ -27,9 +31,11 @@ the true minimum. ``spread_s`` is the range of the screened local optima.
 from __future__ import annotations
 
 import math
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 
@@ -51,6 +57,9 @@ class Settings:
             continuation_top: best patterns also tried on the other elbow branch, with
             turn variants, with the arm stretched ahead, continued.
         controllers: controllers whose runs are starts.
+        guided: ``(name, mpc options)`` of the plan-following runs of step 5 (each the
+            ``mpc`` with ``lookahead`` and the best found as its ``plan``, besides these
+            options); empty: no step 5.
         stability_min: the S floor; tolerance: waypoint radius (m); margin_s, margin_m:
             margins on both in the certifying solve (the replay must hold the floor and
             reach within the tolerance); tight_margin_s, tight_margin_m: the smaller
@@ -66,6 +75,10 @@ class Settings:
     arm_top: int = 2
     continuation_top: int = 2
     controllers: tuple[str, ...] = ("thesis", "qp", "mpc", "mpc-lookahead")
+    guided: tuple[tuple[str, tuple], ...] = (
+        ("mpc-plan", ()),
+        ("mpc-plan-margin", (("stability_margin", 0.001), ("input_weight", 0.001))),
+    )
     stability_min: float = 1.25
     tolerance: float = 0.01
     margin_s: float = 0.0005
@@ -86,6 +99,7 @@ QUICK = Settings(
     arm_top=1,
     continuation_top=1,
     controllers=("mpc",),
+    guided=(("mpc-plan", ()),),
 )
 
 
@@ -224,6 +238,9 @@ def best_known(
             if check.ok and check.time_s < found[1].time_s:
                 found = (closer, check)
     found = _faster_run(robot, runs, waypoints, s, found)
+    if found is not None:
+        guided = plan_runs(scenario, found[0], s, robot.payload)
+        found = _faster_run(robot, guided, waypoints, s, found)
     times = [r.total for r in screened.values()]
     spread = max(times) - min(times) if times else math.nan
     base = Found(
@@ -242,6 +259,23 @@ def best_known(
         base.solution = certified
     base.wall_s = time.perf_counter() - began
     return base
+
+
+def plan_runs(scenario, plan: MinimumTime, s: Settings, payload: float) -> dict[str, Guess]:
+    """Step 5: the recorded runs of the ``mpc`` with ``lookahead`` following ``plan``
+    (one per :data:`Settings.guided` entry; those that did not finish left out)."""
+    runs: dict[str, Guess] = {}
+    if not s.guided:
+        return runs
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "plan.npz"
+        np.savez(path, times=plan.times, states=plan.states, inputs=plan.inputs, legs=plan.legs)
+        for name, options in s.guided:
+            extra = (("plan", str(path)), *options)
+            guess = controller_guess(scenario, "mpc-lookahead", payload=payload, options=extra)
+            if guess is not None:
+                runs[name] = guess
+    return runs
 
 
 def _faster_run(robot: Robot, runs: dict[str, Guess], waypoints, s: Settings, found):
