@@ -13,7 +13,7 @@ from ddwmmr import ParameterError, Robot
 from ddwmmr.commands import traits_of
 from ddwmmr.controllers.base import WaypointRun
 from ddwmmr.mpc.controller import MPCController
-from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, plan_path
+from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, MinimumTimeProblem, plan_path
 from ddwmmr.plants import ThesisPlant
 from ddwmmr.scenarios import RunConfig, generate
 
@@ -52,6 +52,19 @@ def test_a_stored_plan_loads_with_its_arrival_times_and_samples_its_legs(tmp_pat
     states, inputs = plan.leg_samples(1, np.array([0.0, 0.25, 10.0]))
     assert states[:, 0] == pytest.approx([-0.2, -0.3, -0.8])  # held beyond the end
     assert inputs[:, 0] == pytest.approx([-10.0] * 3)
+
+
+def test_a_solutions_stored_arrays_load_back_as_its_trajectory(tmp_path):
+    """What the bounds tool stores of a best-known solution is what a plan reads."""
+    problem = MinimumTimeProblem(
+        ROBOT, [(1.5, 0.5), (1.5, 1.5)], [*START, 0.0, 0.0], intervals_per_leg=4
+    )
+    solution = problem.solve(problem.straight_line_guess())
+    plan = Guess.load(write_plan(tmp_path / "plan.npz", solution.plan_arrays()))
+    assert np.array_equal(plan.states, solution.states)
+    assert np.array_equal(plan.inputs, solution.inputs)
+    assert plan.legs == pytest.approx(solution.legs)
+    assert plan.arrivals[-1] == pytest.approx(solution.total)
 
 
 @pytest.mark.parametrize(

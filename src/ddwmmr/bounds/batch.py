@@ -107,13 +107,7 @@ def solve(job: Job) -> dict[str, Any]:
         found = best_known(robot, job.scenario, job.settings)
         out["best"] = {"key": wanted["best"], **found.record()}
         if found.solution is not None:
-            s = found.solution
-            out["trajectory"] = {
-                "times": s.times,
-                "states": s.states,
-                "inputs": s.inputs,
-                "legs": s.legs,
-            }
+            out["trajectory"] = found.solution.plan_arrays()
     return out
 
 

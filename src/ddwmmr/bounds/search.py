@@ -269,7 +269,7 @@ def plan_runs(scenario, plan: MinimumTime, s: Settings, payload: float) -> dict[
         return runs
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "plan.npz"
-        np.savez(path, times=plan.times, states=plan.states, inputs=plan.inputs, legs=plan.legs)
+        np.savez(path, **plan.plan_arrays())
         for name, options in s.guided:
             extra = (("plan", str(path)), *options)
             guess = controller_guess(scenario, "mpc-lookahead", payload=payload, options=extra)
@@ -298,9 +298,8 @@ def replay_run(robot: Robot, name: str, run: Guess, waypoints, s: Settings):
     replayed open loop on the thesis plant at the run's own step, checked against the
     waypoints, the tolerance and the S floor of ``s``; the solution's start is
     ``run-<name>``."""
-    legs = np.diff(np.concatenate([[0.0], run.arrivals]))
     result = MinimumTime(
-        float(run.arrivals[-1]), legs, True, run.times, run.states, run.inputs, f"run-{name}"
+        float(run.arrivals[-1]), run.legs, True, run.times, run.states, run.inputs, f"run-{name}"
     )
     step = float(run.times[1] - run.times[0])
     return result, replay(robot, result, waypoints, s.stability_min, s.tolerance, dt=step)

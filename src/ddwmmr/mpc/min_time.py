@@ -116,15 +116,15 @@ class Guess:
         one-line :class:`ParameterError` naming the file for anything else."""
         try:
             with np.load(path, allow_pickle=False) as data:
-                arrays = {key: np.asarray(data[key], dtype=float) for key in _PLAN_SHAPES}
+                arrays = {key: np.asarray(data[key], dtype=float) for key in _PLAN_ARRAYS}
         except FileNotFoundError:
             raise ParameterError(f"plan {path}: no such file") from None
         except (OSError, ValueError, KeyError) as error:
             reason = error.args[0] if isinstance(error, KeyError) else type(error).__name__
             raise ParameterError(
-                f"plan {path} must be a .npz with {', '.join(_PLAN_SHAPES)} ({reason})"
+                f"plan {path} must be a .npz with {', '.join(_PLAN_ARRAYS)} ({reason})"
             ) from None
-        times, states, inputs, legs = (arrays[key] for key in _PLAN_SHAPES)
+        times, states, inputs, legs = (arrays[key] for key in _PLAN_ARRAYS)
         m = len(times) - 1
         shapes_ok = (
             times.ndim == 1
@@ -164,7 +164,7 @@ class Guess:
 
 
 #: The arrays of a stored plan, in order.
-_PLAN_SHAPES = ("times", "states", "inputs", "legs")
+_PLAN_ARRAYS = ("times", "states", "inputs", "legs")
 
 
 def plan_path(folder: str | Path, scenario: int) -> Path:
@@ -194,6 +194,11 @@ class MinimumTime:
     def as_guess(self) -> Guess:
         """This solution as a start for another problem (e.g. a finer grid)."""
         return Guess(self.times, self.states, self.inputs, np.cumsum(self.legs))
+
+    def plan_arrays(self) -> dict[str, np.ndarray]:
+        """The arrays a stored plan holds (``np.savez`` them; :meth:`Guess.load` reads
+        them back)."""
+        return {key: getattr(self, key) for key in _PLAN_ARRAYS}
 
 
 class FreeTimeOCP:
