@@ -9,10 +9,11 @@ Data (committed, in docs/bounds/):
 
 ``python docs/bounds_figures.py`` redraws the figure from them and rewrites the block
 between the ``bounds-table`` markers of docs/mpc.md; ``--collect SEED DIR`` first builds
-``controllers_seed{SEED}.csv`` from six scenario runs
-``DIR/{thesis,competitive,qp,mpc,mpc-lookahead,mpc-plan}-sSEED`` (their scenarios.csv;
-``mpc-lookahead`` is ``--controller mpc --option lookahead=on``, ``mpc-plan`` that with
-``--option plan=BOUNDS_DIR``), ``--bounds SEED CSV`` first copies a bounds run's
+``controllers_seed{SEED}.csv`` from seven scenario runs
+``DIR/{thesis,competitive,qp,mpc,mpc-lookahead,mpc-plan-cold,mpc-plan}-sSEED`` (their
+scenarios.csv; ``mpc-lookahead`` is ``--controller mpc --option lookahead=on``,
+``mpc-plan`` that with ``--option plan=BOUNDS_DIR``, ``mpc-plan-cold`` that with
+``--option plan_weight=0``), ``--bounds SEED CSV`` first copies a bounds run's
 bounds.csv to ``bounds_seed{SEED}.csv``.
 """
 
@@ -41,7 +42,8 @@ CONTROLLERS = {
     "qp": "qp",
     "mpc": "mpc",
     "mpc-lookahead": "mpc, lookahead",
-    "mpc-plan": "mpc, lookahead, offline plan",
+    "mpc-plan-cold": "mpc, lookahead, offline plan as cold starts",
+    "mpc-plan": "mpc, lookahead, offline plan, its arrivals",
 }
 SEEDS = (0, 1)
 
@@ -66,7 +68,7 @@ def read_controllers(seed: int) -> dict[str, dict[int, float]]:
 
 
 def collect(seed: int, folder: Path) -> None:
-    """controllers_seed{seed}.csv from six scenario runs in ``folder``."""
+    """controllers_seed{seed}.csv from the scenario runs in ``folder``."""
     columns: dict[str, dict[int, float]] = {}
     for name in CONTROLLERS:
         with open(folder / f"{name}-s{seed}" / "scenarios.csv", newline="") as handle:
@@ -135,6 +137,7 @@ def figure() -> None:
         "qp": ("tab:orange", "s"),
         "mpc": ("tab:green", "D"),
         "mpc-lookahead": ("tab:red", "^"),
+        "mpc-plan-cold": ("tab:pink", "+"),
         "mpc-plan": ("tab:purple", "x"),
     }
     data = ratios(0)

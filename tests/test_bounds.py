@@ -39,7 +39,7 @@ LIGHT = Settings(
     arm_top=0,
     continuation_top=0,
     controllers=(),
-    guided=(("mpc-plan", ()),),
+    guided=(("mpc-plan-arrive", ()),),
 )
 
 
@@ -251,9 +251,9 @@ def test_a_controller_run_that_replays_faster_becomes_the_best_known():
 
 
 def test_the_mpc_following_the_best_found_is_a_candidate_too():
-    """Step 5: the mpc (lookahead) run with the best found as its plan, as it is and with
-    the smaller margin, recorded and checked like the controllers' runs; none without
-    ``guided``."""
+    """Step 5: the mpc (lookahead) runs with the best found as its plan (its cold starts
+    alone, and arriving as it does; as they are and with the smaller margin), recorded
+    and checked like the controllers' runs; none without ``guided``."""
     scenario = Scenario(0, ((2.0, 1.5), (-0.5, 2.0)))
     problem = MinimumTimeProblem(
         HEAVY, scenario.waypoints, start_state(HEAVY), intervals_per_leg=12
@@ -261,7 +261,12 @@ def test_the_mpc_following_the_best_found_is_a_candidate_too():
     plan = problem.solve(problem.straight_line_guess())
     assert plan.success
     runs = plan_runs(scenario, plan, Settings(), HEAVY.payload)
-    assert set(runs) == {"mpc-plan", "mpc-plan-margin"}
+    assert set(runs) == {
+        "mpc-plan",
+        "mpc-plan-margin",
+        "mpc-plan-arrive",
+        "mpc-plan-arrive-margin",
+    }
     for run in runs.values():  # both waypoints, in a time near the plan's
         assert len(run.arrivals) == 2 and run.arrivals[-1] < 1.3 * plan.total
     found = _faster_run(HEAVY, runs, scenario.waypoints, Settings(), None)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import casadi as ca
 import numpy as np
 import pytest
 
@@ -15,7 +16,7 @@ from ddwmmr.controllers.base import WaypointRun
 from ddwmmr.mpc.controller import MPCController
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, MinimumTimeProblem, plan_path
 from ddwmmr.plants import ThesisPlant
-from ddwmmr.scenarios import RunConfig, generate
+from ddwmmr.scenarios import RunConfig, Scenario, generate, run_scenario
 
 ROBOT = Robot().with_payload(3.0)
 #: the default pose at rest: the end effector about 0.5 m ahead of the base
@@ -166,3 +167,76 @@ def test_the_protocol_hands_each_scenario_its_plan_from_a_bounds_folder(tmp_path
     options = MPCController.waypoint_options(run)
     assert options["plan"] == str(stored)
     assert options["route"] == [tuple(w) for w in scenario.waypoints]
+
+
+def test_the_arrival_term_is_the_weighted_state_error_at_the_first_legs_end(tmp_path):
+    arrays = straight_plan(-0.4, 0.3, duration=4.0, n=40)
+    arrays["legs"] = np.array([1.0, 3.0])
+    path = str(write_plan(tmp_path / "plan.npz", arrays))
+    route = [(-0.9, 0.0), (-1.7, 0.0)]
+    controller = MPCController(
+        ROBOT, model="thesis", lookahead=True, route=route, plan=path, plan_weight=3.0
+    )
+    problem = controller._problem("reach2")
+    ocp = problem.ocp
+    assert ocp.config.arrival_weight == 3.0
+    # the plan's state where its first leg ends (t = 1 s), none at the last waypoint
+    arrival = problem.planned_arrival(controller._plan, 0)
+    assert arrival[0] == pytest.approx(-0.4) and arrival[2] == pytest.approx(0.3)
+    assert problem.planned_arrival(controller._plan, 1) is None
+    x0 = np.array([*START, 0.0, 0.0])
+    w, _ = problem.planned_start(x0, controller._plan, 0)
+    xs, _ = ocp.trajectories(w)
+    cost = ca.Function("cost", [ocp.w, ocp.p], [0.5 * ca.sumsqr(ocp.residual)])
+    u_prev = np.zeros(ocp.num)
+    refs = np.tile([*route[0], 0.0], (ocp.N, 1))
+    target = arrival + np.array([0.1, -0.2, 0.5, 0.2, -0.1, 0.3, -0.4])
+    on = float(cost(w, ocp.parameters(refs, u_prev, arrival=target)))
+    off = float(cost(w, ocp.parameters(refs, u_prev)))
+    # by hand: the heading's chord, then joints and velocities (position left out)
+    end = xs[ocp.split]
+    error = np.concatenate(
+        [
+            [np.cos(end[2]) - np.cos(target[2]), np.sin(end[2]) - np.sin(target[2])],
+            end[3:7] - target[3:7],
+        ]
+    )
+    assert on - off == pytest.approx(0.5 * 3.0 * error @ error, rel=1e-9)
+    # without the weight the OCP has neither the term nor its parameters
+    plain = MPCController(
+        ROBOT, model="thesis", lookahead=True, route=route, plan=path, plan_weight=0.0
+    )
+    unplanned = MPCController(ROBOT, model="thesis", lookahead=True, route=route)
+    assert plain._problem("reach2").ocp.np == unplanned._problem("reach2").ocp.np
+    assert plain._problem("reach2").ocp.arrival_size == 0
+
+
+def test_plan_weight_must_be_nonnegative():
+    with pytest.raises(ParameterError, match=r"plan_weight must be >= 0 \(got -1\)"):
+        MPCController(ROBOT, plan_weight=-1.0)
+
+
+def test_the_controller_arrives_as_the_plan_does(tmp_path):
+    """Two waypoints on the thesis plant, a minimum-time plan of both as ``plan``: with the
+    arrival term the mpc reaches the first waypoint heading the way the plan does, and
+    sooner; with the plan as its cold starts alone it arrives about 50 degrees off."""
+    waypoints = ((2.0, 0.5), (0.0, 1.5))
+    problem = MinimumTimeProblem(ROBOT, waypoints, [*START, 0.0, 0.0], intervals_per_leg=10)
+    solution = problem.solve(problem.straight_line_guess())
+    path = write_plan(tmp_path / "plan.npz", solution.plan_arrays())
+    plan = Guess.load(path)
+    heading = float(plan.sample(plan.arrivals[:1])[0][0, 2])
+    arrivals = {}
+    for weight in (0.0, 2.0):
+        options = (("lookahead", True), ("plan", str(path)), ("plan_weight", weight))
+        outcome = run_scenario(
+            Scenario(0, waypoints),
+            RunConfig(controller="mpc", plant="thesis", record=True, controller_options=options),
+        )
+        assert outcome.metrics["success"]
+        t, phi, distance = (np.array(outcome.trace[k]) for k in ("t", "phi", "distance"))
+        reached = np.flatnonzero((distance[:-1] <= 0.0102) & (distance[1:] > 0.02))[0]
+        arrivals[weight] = (t[reached], phi[reached], outcome.metrics["time_s"])
+    assert abs(arrivals[2.0][1] - heading) < 0.2
+    assert abs(arrivals[0.0][1] - heading) > 0.5
+    assert arrivals[2.0][0] < arrivals[0.0][0] and arrivals[2.0][2] < arrivals[0.0][2]

@@ -20,9 +20,11 @@ One scenario (:func:`best_known`):
    rates, replayed open-loop at the run's own step, pass the same check in less time,
    that time is the best known (``start`` ``run-<controller>``);
 5. **the plan followed**: the ``mpc`` with ``lookahead`` run with the best found so far
-   as its ``plan`` (:data:`Settings.guided`: as it is and with a smaller floor margin and
-   input cost), its runs candidates as in 4 (``run-mpc-plan``, ``run-mpc-plan-margin``):
-   the closed loop sometimes beats the plan it follows.
+   as its ``plan`` (:data:`Settings.guided`: the plan as cold starts alone, and arriving
+   at each waypoint as the plan does, the option's default; each as it is and with a
+   smaller floor margin and input cost), its runs candidates as in 4 (``run-mpc-plan``,
+   ``run-mpc-plan-margin``, ``run-mpc-plan-arrive``, ``run-mpc-plan-arrive-margin``): the
+   closed loop sometimes beats the plan it follows.
 
 The result is the replayed time: a trajectory the plant itself drives, so an upper bound on
 the true minimum. ``spread_s`` is the range of the screened local optima.
@@ -44,6 +46,9 @@ from ddwmmr.bounds.replay import replay
 from ddwmmr.bounds.starts import all_patterns, controller_guess, pattern_guess, turn_variants
 from ddwmmr.model import Robot
 from ddwmmr.mpc.min_time import Guess, MinimumTime, MinimumTimeProblem
+
+#: The smaller floor margin and input cost of the plan-following runs' second variant.
+SMALL_MARGIN = (("stability_margin", 0.001), ("input_weight", 0.001))
 
 
 @dataclass(frozen=True)
@@ -76,8 +81,10 @@ class Settings:
     continuation_top: int = 2
     controllers: tuple[str, ...] = ("thesis", "qp", "mpc", "mpc-lookahead")
     guided: tuple[tuple[str, tuple], ...] = (
-        ("mpc-plan", ()),
-        ("mpc-plan-margin", (("stability_margin", 0.001), ("input_weight", 0.001))),
+        ("mpc-plan", (("plan_weight", 0.0),)),
+        ("mpc-plan-margin", (("plan_weight", 0.0), *SMALL_MARGIN)),
+        ("mpc-plan-arrive", ()),
+        ("mpc-plan-arrive-margin", SMALL_MARGIN),
     )
     stability_min: float = 1.25
     tolerance: float = 0.01
@@ -99,7 +106,7 @@ QUICK = Settings(
     arm_top=1,
     continuation_top=1,
     controllers=("mpc",),
-    guided=(("mpc-plan", ()),),
+    guided=(("mpc-plan-arrive", ()),),
 )
 
 

@@ -5,7 +5,9 @@ Every control step (one call per step; the command is held over it, ``zero_order
 1. the measured state (configuration, and the base velocities for the thesis model) pins
    node 0 of the OCP (:mod:`ddwmmr.mpc.ocp`);
 2. the references of the nodes come from the trajectory's future poses (tracking), or the
-   target ``pose_d`` is to be reached as early as possible (waypoint mode, free horizon);
+   target ``pose_d`` is to be reached as early as possible (waypoint mode, free horizon;
+   with a ``plan``, an offline minimum-time trajectory of the task, arriving there in the
+   plan's state, ``plan_weight``);
 3. the previous solution, shifted by the elapsed time, is the warm start; one Gauss-Newton
    iteration (the real-time iteration, default) or a full solve updates it;
 4. the first input is applied: a velocity command (kinematic model) or wheel forces and
@@ -202,6 +204,7 @@ class MPCController:
             second_leg_horizon=options.lookahead_horizon,
             min_horizon=max(0.1, 2.0 * self.dt),
             reach_speed=options.reach_speed,
+            arrival_weight=options.plan_weight if reach and self._plan is not None else 0.0,
             stability_min=options.stability_min,
             stability_margin=options.stability_margin,
             dynamic_stability=self.dynamic_stability,
@@ -309,14 +312,15 @@ class MPCController:
             cold = True
             self.restarts += 1
         source = self._problem("reach2").ocp if handover and self._warm is not None else None
-        leg = self._plan_leg(target) if reach and cold else None
-        if leg is not None:  # the offline plan's leg starts the cold start, not the hand-over
+        leg = self._plan_leg(target) if reach else None
+        if leg is not None and cold:  # the offline plan's leg starts it, not the hand-over
             source = None
         warm = self._warm if not cold or source is not None else None
-        start = None if leg is None else problem.planned_start(x0, self._plan, leg)
+        start = None if leg is None or not cold else problem.planned_start(x0, self._plan, leg)
+        arrival = None if leg is None else problem.planned_arrival(self._plan, leg)
         try:
             w, iterations = problem.solve(
-                t, x0, references, self._u_prev, warm, self._warm_time, source, start
+                t, x0, references, self._u_prev, warm, self._warm_time, source, start, arrival
             )
         except SolverFailure as failure:
             return self._fallback_command(t, q, pose_d, velocity_d, x0, str(failure))

@@ -89,10 +89,14 @@ interval lengths:
   base frame (plus the base velocities for the force model) and ``P = L L'`` the LQR
   cost-to-go of the linearised error dynamics (:mod:`ddwmmr.mpc.terminal`);
 * terminal, reach: the Huber distance to the target, ``|e_N| / reach_speed`` seconds far
-  from it; the linear term ``c`` charges ``T`` itself (one unit per second) and the slacks.
+  from it; the linear term ``c`` charges ``T`` itself (one unit per second) and the slacks;
+* arrival, reach (``arrival_weight > 0``): the first leg's last state against an arrival
+  state, ``sqrt(Wa) [cos phi - cos phi_a, sin phi - sin phi_a, x[3:] - x_a[3:]]`` (an
+  offline plan's state at the target: how the plan of the whole task arrives there).
 
 Parameters ``p``: per node ``(x, y, phi, weight)`` of the reference, the previous command,
-the terminal factor ``L`` (row-major) and the previous horizon ``T`` (reach mode).
+the terminal factor ``L`` (row-major), with an arrival term its state and 1 (on) or 0
+(off), and the previous horizon ``T`` (reach mode).
 """
 
 from __future__ import annotations
@@ -179,6 +183,10 @@ class OCPConfig:
             leg's time and reach cost against the first leg's (1: the total time).
         min_horizon: lower bound on the free horizon T (s); reach_speed: m/s converting
             the distance left at T = horizon into seconds.
+        arrival_weight: reach mode: the weight (s per squared unit) of the first leg's last
+            state against an arrival state given with the parameters (an offline plan's
+            state at the target): the heading as a chord, the joint angles (rad) and the
+            base velocities (m/s, rad/s), position left out; 0 (default): no such term.
         stability_min: the floor S_min; stability_margin: the OCP keeps S >= S_min + margin.
         dynamic_stability: keep every edge of the support polygon loaded while moving,
             besides the static box on the centre of mass (the model must have base
@@ -200,6 +208,7 @@ class OCPConfig:
     second_leg_horizon: float = 12.0
     min_horizon: float = 0.1
     reach_speed: float = 0.5
+    arrival_weight: float = 0.0
     stability_min: float = STABILITY_FLOOR
     stability_margin: float = 0.01
     dynamic_stability: bool = False
@@ -210,6 +219,11 @@ class OCPConfig:
     base_radius: float = 0.0
     obstacle_margin: float = 0.05
     weights: Weights = field(default_factory=Weights)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(
+            self, "arrival_weight", check_nonnegative("arrival_weight", self.arrival_weight)
+        )
 
     @property
     def legs(self) -> int:
@@ -292,7 +306,10 @@ class ShootingOCP:
         self.nw = start
         #: index in w of every stage's slacks (N, ns): one fancy index reads them all
         self.slack_index = np.array([np.arange(s.start, s.stop) for s in self.slack_slices])
-        self.np = 4 * n + self.num + self.terminal_size**2 + 1
+        #: the arrival state's parameters (its state, then 1 on / 0 off; none without)
+        self.arrival_size = self.nxm + 1 if config.reach and config.arrival_weight > 0 else 0
+        self._arrival_start = 4 * n + self.num + self.terminal_size**2
+        self.np = self._arrival_start + self.arrival_size + 1
         self.w = ca.SX.sym("w", self.nw)
         self.p = ca.SX.sym("p", self.np)
         self._build()
@@ -550,6 +567,8 @@ class ShootingOCP:
             if config.legs == 2:
                 parts.append(self._reach_cost(pose, target, config.second_leg_weight))
             parts.append(math.sqrt(HORIZON_SMOOTHING) * (nodes[0][self.nxm] - horizon_prev))
+            if self.arrival_size:
+                parts.append(self._arrival_cost(xs[self.split]))
         elif weights.terminal > 0.0:
             z = self._terminal_error(xs[n], pose, target)
             parts.append(
@@ -569,6 +588,16 @@ class ShootingOCP:
         delta = config.huber if config.huber is not None else 0.01
         gain = math.sqrt(weight) / math.sqrt(delta * config.reach_speed)
         return gain * self._huber_scale(error, delta) * error
+
+    def _arrival_cost(self, x) -> ca.SX:
+        """The residual of the first leg's last state ``x`` against the arrival state of
+        the parameters: ``sqrt(arrival_weight) on [cos phi - cos phi_a, sin phi - sin
+        phi_a, x[3:] - x_a[3:]]`` (joint angles, then velocities), ``on`` 1 or 0."""
+        start = self._arrival_start
+        target, on = self.p[start : start + self.nxm], self.p[start + self.nxm]
+        heading = ca.vertcat(ca.cos(x[2]) - ca.cos(target[2]), ca.sin(x[2]) - ca.sin(target[2]))
+        error = ca.vertcat(heading, x[3 : self.nxm] - target[3:])
+        return math.sqrt(self.config.arrival_weight) * on * error
 
     def _terminal_error(self, x_n, pose, ref) -> ca.SX:
         """End-effector error in the terminal base frame (and the base velocities)."""
@@ -590,9 +619,11 @@ class ShootingOCP:
         terminal_factor: np.ndarray | None = None,
         node_weights: np.ndarray | None = None,
         horizon_prev: float | None = None,
+        arrival: np.ndarray | None = None,
     ) -> np.ndarray:
         """Parameter vector: node references (N, 3), previous command (model input), ``L``
-        (tracking), node tracking weights (N,; default 1), previous horizon (reach)."""
+        (tracking), node tracking weights (N,; default 1), previous horizon (reach), the
+        arrival state (model state; None: that term off) where the OCP has one."""
         n = self.N
         block = np.ones((n, 4))
         block[:, :3] = references
@@ -601,9 +632,11 @@ class ShootingOCP:
         nz = self.terminal_size
         factor = np.eye(nz) if terminal_factor is None else terminal_factor
         previous = self.config.horizon if horizon_prev is None else horizon_prev
-        return np.concatenate(
-            [block.ravel(), np.ravel(u_prev), np.ravel(factor), [previous]]
-        ).astype(float)
+        parts = [block.ravel(), np.ravel(u_prev), np.ravel(factor)]
+        if self.arrival_size:
+            on = arrival is not None
+            parts += [np.ravel(arrival) if on else np.zeros(self.nxm), [float(on)]]
+        return np.concatenate([*parts, [previous]]).astype(float)
 
     def bounds(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Decision bounds with the model state of node 0 pinned to the measured ``x0``."""

@@ -150,6 +150,12 @@ class MPCOptions:
             the controller settles in has the offline plan's structure (direction of
             travel, elbow branch, turns); None (default): no plan (docs/mpc.md,
             "Following an offline plan's structure").
+        plan_weight: with a ``plan``: the weight (s per squared unit) of the plan's state
+            at the target (heading as a chord, joint angles in rad, base velocities in m/s
+            and rad/s) against the state the controller's plan arrives there in, so that
+            it arrives as the plan of the whole task does (not at the route's last
+            waypoint); 0: the plan only starts the cold starts (default 2; docs/mpc.md,
+            "Arriving as the plan does").
         proximal: damping of the input steps between two solves (see
             :class:`ddwmmr.mpc.solvers.GaussNewtonSQP`).
         stability_margin: the OCP keeps ``S >= stability_min + stability_margin``.
@@ -212,6 +218,7 @@ class MPCOptions:
     lookahead_horizon: float = 12.0
     route: Sequence[Sequence[float]] = ()
     plan: str | None = None
+    plan_weight: float = 2.0
     proximal: float = 0.01
     stability_margin: float = 0.01
     dynamic_stability: bool | None = None
@@ -286,6 +293,7 @@ class MPCOptions:
             ("reach_speed", check_positive),
             ("proximal", check_nonnegative),
             ("stability_margin", check_nonnegative),
+            ("plan_weight", check_nonnegative),
             ("obstacle_margin", check_nonnegative),
         ):
             value = getattr(self, name)

@@ -86,6 +86,15 @@ class Problem:
         xs[0, : ocp.nxm] = x0
         return ocp.pack(xs, us), horizon
 
+    def planned_arrival(self, plan: Guess, leg: int) -> np.ndarray | None:
+        """The state ``plan`` reaches the end of leg ``leg`` (0-based) in, for this OCP's
+        arrival term; None where the OCP has none or the leg is the plan's last (how the
+        task's last waypoint is reached does not matter)."""
+        if not self.ocp.arrival_size or leg + 1 >= len(plan.legs):
+            return None
+        states, _ = plan.sample(plan.arrivals[leg : leg + 1])
+        return states[0]
+
     def _shifted(
         self, warm: np.ndarray, elapsed: float, x0: np.ndarray, source: ShootingOCP | None = None
     ) -> tuple:
@@ -126,11 +135,13 @@ class Problem:
         warm_time,
         source: ShootingOCP | None = None,
         start: tuple[np.ndarray, float] | None = None,
+        arrival: np.ndarray | None = None,
     ) -> tuple[np.ndarray, int]:
         """Solve from the shifted warm start (or cold); returns (w, iterations). With a
         ``source`` (a hand-over, :meth:`_shifted`) the shifted plan starts the cold
         start's iterations; without a warm start, ``start`` (``(w, T)``,
-        :meth:`planned_start`) does instead of the standing guess."""
+        :meth:`planned_start`) does instead of the standing guess. ``arrival``: the state
+        the first leg's arrival term pulls towards (:meth:`planned_arrival`), None: off."""
         ocp = self.ocp
         if warm is None and start is not None:
             (guess, horizon), solver = start, self.cold
@@ -139,7 +150,9 @@ class Problem:
         else:
             guess, horizon = self._shifted(warm, max(0.0, t - warm_time), x0, source)
             solver = self.solver if source is None else self.cold
-        p = ocp.parameters(references, u_prev, self.terminal_factor, horizon_prev=horizon)
+        p = ocp.parameters(
+            references, u_prev, self.terminal_factor, horizon_prev=horizon, arrival=arrival
+        )
         self.last_parameters = p
         lbw, ubw = ocp.bounds(x0)
         w = solver.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
