@@ -4,6 +4,7 @@ and that the plan's structure is what the controller settles in)."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import casadi as ca
@@ -15,6 +16,7 @@ from ddwmmr.commands import traits_of
 from ddwmmr.controllers.base import WaypointRun
 from ddwmmr.mpc.controller import MPCController
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, MinimumTimeProblem, plan_path
+from ddwmmr.mpc.ocp import OCPConfig
 from ddwmmr.plants import ThesisPlant
 from ddwmmr.scenarios import RunConfig, Scenario, generate, run_scenario
 
@@ -41,6 +43,19 @@ def straight_plan(speed: float, turn: float, duration: float = 3.0, n: int = 30)
 def write_plan(path: Path, arrays: dict) -> Path:
     np.savez(path, **arrays)
     return path
+
+
+#: two waypoints behind the start, on the straight plans' line
+ROUTE = [(-0.9, 0.0), (-1.7, 0.0)]
+
+
+def two_leg_controller(folder: Path, turn: float = 0.0, **options) -> MPCController:
+    """The mpc (force model, ``lookahead``) on :data:`ROUTE` with a plan of two legs, 1 s
+    and 3 s, of the base reversing at 0.4 m/s while turning at ``turn`` (rad/s)."""
+    arrays = straight_plan(-0.4, turn, duration=4.0, n=40)
+    arrays["legs"] = np.array([1.0, 3.0])
+    path = str(write_plan(folder / "plan.npz", arrays))
+    return MPCController(ROBOT, model="thesis", lookahead=True, route=ROUTE, plan=path, **options)
 
 
 def test_a_stored_plan_loads_with_its_arrival_times_and_samples_its_legs(tmp_path):
@@ -106,11 +121,7 @@ def test_plan_option_errors_name_the_option(tmp_path):
 
 
 def test_the_cold_start_is_the_plans_leg_on_the_ocps_nodes(tmp_path):
-    arrays = straight_plan(-0.4, 0.0, duration=4.0, n=40)
-    arrays["legs"] = np.array([1.0, 3.0])
-    path = str(write_plan(tmp_path / "plan.npz", arrays))
-    route = [(-0.9, 0.0), (-1.7, 0.0)]
-    controller = MPCController(ROBOT, model="thesis", lookahead=True, route=route, plan=path)
+    controller = two_leg_controller(tmp_path)
     problem = controller._problem("reach2")
     ocp = problem.ocp
     x0 = np.array([*START, 0.0, 0.0])
@@ -170,13 +181,7 @@ def test_the_protocol_hands_each_scenario_its_plan_from_a_bounds_folder(tmp_path
 
 
 def test_the_arrival_term_is_the_weighted_state_error_at_the_first_legs_end(tmp_path):
-    arrays = straight_plan(-0.4, 0.3, duration=4.0, n=40)
-    arrays["legs"] = np.array([1.0, 3.0])
-    path = str(write_plan(tmp_path / "plan.npz", arrays))
-    route = [(-0.9, 0.0), (-1.7, 0.0)]
-    controller = MPCController(
-        ROBOT, model="thesis", lookahead=True, route=route, plan=path, plan_weight=3.0
-    )
+    controller = two_leg_controller(tmp_path, turn=0.3, plan_weight=3.0)
     problem = controller._problem("reach2")
     ocp = problem.ocp
     assert ocp.config.arrival_weight == 3.0
@@ -189,10 +194,15 @@ def test_the_arrival_term_is_the_weighted_state_error_at_the_first_legs_end(tmp_
     xs, _ = ocp.trajectories(w)
     cost = ca.Function("cost", [ocp.w, ocp.p], [0.5 * ca.sumsqr(ocp.residual)])
     u_prev = np.zeros(ocp.num)
-    refs = np.tile([*route[0], 0.0], (ocp.N, 1))
+    refs = np.tile([*ROUTE[0], 0.0], (ocp.N, 1))
     target = arrival + np.array([0.1, -0.2, 0.5, 0.2, -0.1, 0.3, -0.4])
-    on = float(cost(w, ocp.parameters(refs, u_prev, arrival=target)))
-    off = float(cost(w, ocp.parameters(refs, u_prev)))
+    p_on = ocp.parameters(refs, u_prev, horizon_prev=2.5, arrival=target)
+    p_off = ocp.parameters(refs, u_prev, horizon_prev=2.5)
+    assert p_on[-1] == p_off[-1] == 2.5  # the previous horizon stays last
+    block = slice(ocp._arrival_start, ocp._arrival_start + ocp.nxm)
+    assert np.array_equal(p_on[block], target) and p_on[block.stop] == 1.0
+    assert np.all(p_off[block] == 0.0) and p_off[block.stop] == 0.0
+    on, off = float(cost(w, p_on)), float(cost(w, p_off))
     # by hand: the heading's chord, then joints and velocities (position left out)
     end = xs[ocp.split]
     error = np.concatenate(
@@ -203,10 +213,8 @@ def test_the_arrival_term_is_the_weighted_state_error_at_the_first_legs_end(tmp_
     )
     assert on - off == pytest.approx(0.5 * 3.0 * error @ error, rel=1e-9)
     # without the weight the OCP has neither the term nor its parameters
-    plain = MPCController(
-        ROBOT, model="thesis", lookahead=True, route=route, plan=path, plan_weight=0.0
-    )
-    unplanned = MPCController(ROBOT, model="thesis", lookahead=True, route=route)
+    plain = two_leg_controller(tmp_path, turn=0.3, plan_weight=0.0)
+    unplanned = MPCController(ROBOT, model="thesis", lookahead=True, route=ROUTE)
     assert plain._problem("reach2").ocp.np == unplanned._problem("reach2").ocp.np
     assert plain._problem("reach2").ocp.arrival_size == 0
 
@@ -214,6 +222,24 @@ def test_the_arrival_term_is_the_weighted_state_error_at_the_first_legs_end(tmp_
 def test_plan_weight_must_be_nonnegative():
     with pytest.raises(ParameterError, match=r"plan_weight must be >= 0 \(got -1\)"):
         MPCController(ROBOT, plan_weight=-1.0)
+    with pytest.raises(ParameterError, match=r"arrival_weight must be >= 0 \(got -1\)"):
+        OCPConfig(reach=True, arrival_weight=-1.0)
+
+
+def test_every_step_of_a_leg_sends_the_plans_arrival_and_the_last_leg_none(tmp_path):
+    controller = two_leg_controller(tmp_path, turn=0.3)
+    rest = np.zeros(3)
+    for t in (0.0, 0.01, 0.02):  # a cold step, then warm ones
+        controller.command(t, START, np.array([*ROUTE[0], 0.0]), rest, base_velocity=(0, 0))
+        problem = controller._problem("reach2")
+        ocp, p = problem.ocp, problem.last_parameters
+        block = slice(ocp._arrival_start, ocp._arrival_start + ocp.nxm)
+        assert p[block] == pytest.approx(problem.planned_arrival(controller._plan, 0))
+        assert p[block.stop] == 1.0
+    controller.command(0.03, START, np.array([*ROUTE[1], 0.0]), rest, base_velocity=(0, 0))
+    last = controller._problem("reach")
+    flag = last.ocp._arrival_start + last.ocp.nxm
+    assert last.ocp.arrival_size and last.last_parameters[flag] == 0.0
 
 
 def test_the_controller_arrives_as_the_plan_does(tmp_path):
@@ -237,6 +263,10 @@ def test_the_controller_arrives_as_the_plan_does(tmp_path):
         t, phi, distance = (np.array(outcome.trace[k]) for k in ("t", "phi", "distance"))
         reached = np.flatnonzero((distance[:-1] <= 0.0102) & (distance[1:] > 0.02))[0]
         arrivals[weight] = (t[reached], phi[reached], outcome.metrics["time_s"])
-    assert abs(arrivals[2.0][1] - heading) < 0.2
-    assert abs(arrivals[0.0][1] - heading) > 0.5
+
+    def off(angle: float) -> float:  # heading difference on the circle (rad)
+        return abs(math.remainder(angle - heading, 2.0 * math.pi))
+
+    assert off(arrivals[2.0][1]) < 0.2
+    assert off(arrivals[0.0][1]) > 0.5
     assert arrivals[2.0][0] < arrivals[0.0][0] and arrivals[2.0][2] < arrivals[0.0][2]

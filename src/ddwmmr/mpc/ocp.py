@@ -183,10 +183,11 @@ class OCPConfig:
             leg's time and reach cost against the first leg's (1: the total time).
         min_horizon: lower bound on the free horizon T (s); reach_speed: m/s converting
             the distance left at T = horizon into seconds.
-        arrival_weight: reach mode: the weight (s per squared unit) of the first leg's last
-            state against an arrival state given with the parameters (an offline plan's
-            state at the target): the heading as a chord, the joint angles (rad) and the
-            base velocities (m/s, rad/s), position left out; 0 (default): no such term.
+        arrival_weight: reach mode: the weight ``Wa`` of the cost ``0.5 Wa |e|^2`` (s),
+            ``e`` the first leg's last state less an arrival state given with the
+            parameters (an offline plan's state at the target): the heading as a chord,
+            the joint angles (rad) and the base velocities (m/s, rad/s), position left
+            out; 0 (default): no such term.
         stability_min: the floor S_min; stability_margin: the OCP keeps S >= S_min + margin.
         dynamic_stability: keep every edge of the support polygon loaded while moving,
             besides the static box on the centre of mass (the model must have base
@@ -633,6 +634,8 @@ class ShootingOCP:
         factor = np.eye(nz) if terminal_factor is None else terminal_factor
         previous = self.config.horizon if horizon_prev is None else horizon_prev
         parts = [block.ravel(), np.ravel(u_prev), np.ravel(factor)]
+        if arrival is not None and np.size(arrival) != self.nxm:
+            raise ValueError(f"arrival must be a state of {self.nxm} numbers")
         if self.arrival_size:
             on = arrival is not None
             parts += [np.ravel(arrival) if on else np.zeros(self.nxm), [float(on)]]

@@ -150,12 +150,12 @@ class MPCOptions:
             the controller settles in has the offline plan's structure (direction of
             travel, elbow branch, turns); None (default): no plan (docs/mpc.md,
             "Following an offline plan's structure").
-        plan_weight: with a ``plan``: the weight (s per squared unit) of the plan's state
-            at the target (heading as a chord, joint angles in rad, base velocities in m/s
-            and rad/s) against the state the controller's plan arrives there in, so that
-            it arrives as the plan of the whole task does (not at the route's last
-            waypoint); 0: the plan only starts the cold starts (default 2; docs/mpc.md,
-            "Arriving as the plan does").
+        plan_weight: with a ``plan``: the weight ``Wa`` of the cost ``0.5 Wa |e|^2`` (s)
+            on the state the controller's plan arrives at the target in, ``e`` its
+            difference from the plan's state there (heading as a chord, joint angles in
+            rad, base velocities in m/s and rad/s), so that it arrives as the plan of the
+            whole task does; off on the plan's last leg; 0: the plan only starts the cold
+            starts (default 2; docs/mpc.md, "Arriving as the plan does").
         proximal: damping of the input steps between two solves (see
             :class:`ddwmmr.mpc.solvers.GaussNewtonSQP`).
         stability_margin: the OCP keeps ``S >= stability_min + stability_margin``.
