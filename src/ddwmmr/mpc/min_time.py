@@ -40,6 +40,7 @@ import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 
 import casadi as ca
@@ -161,6 +162,12 @@ class Guess:
     def legs(self) -> np.ndarray:
         """Each leg's duration (s)."""
         return np.diff(np.concatenate([[0.0], self.arrivals]))
+
+    @cached_property
+    def arrival_states(self) -> np.ndarray:
+        """The state at each arrival (one row per waypoint), sampled once (a controller
+        reads its target's every step)."""
+        return self.sample(self.arrivals)[0]
 
 
 #: The arrays of a stored plan, in order.

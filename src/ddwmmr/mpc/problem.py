@@ -92,8 +92,7 @@ class Problem:
         task's last waypoint is reached does not matter)."""
         if not self.ocp.arrival_size or leg + 1 >= len(plan.legs):
             return None
-        states, _ = plan.sample(plan.arrivals[leg : leg + 1])
-        return states[0]
+        return plan.arrival_states[leg]
 
     def _shifted(
         self, warm: np.ndarray, elapsed: float, x0: np.ndarray, source: ShootingOCP | None = None
