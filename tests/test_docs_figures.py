@@ -140,3 +140,20 @@ def test_support_load_figures(tmp_path, monkeypatch):
         "v.png",
     ]
     assert saved.failing() == {}
+
+
+def test_bounds_accounting_figure_and_table(tmp_path, monkeypatch):
+    """docs/figures/bounds_accounting.png and docs/mpc.md's table from the committed
+    accounting CSVs: every row's terms add up to its time (the lower bound plus the excess
+    above it standing for the path and rotation at the bound's prices)."""
+    script = docs_script("bounds_accounting", tmp_path, monkeypatch)
+    saved = SavedFigures(monkeypatch)
+    script.figure()
+    assert list(saved.problems) == ["bounds_accounting.png"]
+    assert saved.failing() == {}
+    rows = script.table()[2:]
+    assert len(rows) == len(script.SEEDS) * len(script.TRAJECTORIES)
+    for row in rows:
+        cells = [c.strip() for c in row.strip("|").split("|")]
+        time, lower, *terms = (float(c) for c in cells[1:8])
+        assert lower + sum(terms) == pytest.approx(time, abs=0.03)

@@ -13,6 +13,7 @@ was reached.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,31 +64,20 @@ def replay(
     index, arrivals = 0, []
     closest = [math.inf] * len(waypoints)
     lowest = robot.stability(np.asarray(result.states[0][:5]))[2]
-    held = [*result.inputs, result.inputs[-1]]  # the last input held 0.2 s longer
-    spans = [*np.diff(times), 0.2]
     t = 0.0
-    for (f_left, f_right, rate1, rate2), span in zip(held, spans):
-        count = max(1, math.ceil(span / dt - 1e-9))
-        step = span / count
-        for _ in range(count):
-            state = plant.state
-            command = WheelForces(
-                f_left, f_right, state.th1 + rate1 * step, state.th2 + rate2 * step
-            )
-            plant.step(t, command, step)
-            t += step
-            q = np.asarray(plant.state.q)
-            lowest = min(lowest, robot.stability(q)[2])
-            xe, ye, _ = robot.fk(q)
-            while index < len(waypoints):
-                distance = math.hypot(xe - waypoints[index][0], ye - waypoints[index][1])
-                closest[index] = min(closest[index], distance)
-                if distance > tolerance:
-                    break
-                arrivals.append(float(t))
-                index += 1
-            if index == len(waypoints):
+    for command, step in held_commands(plant, times, result.inputs, dt):
+        plant.step(t, command, step)
+        t += step
+        q = np.asarray(plant.state.q)
+        lowest = min(lowest, robot.stability(q)[2])
+        xe, ye, _ = robot.fk(q)
+        while index < len(waypoints):
+            distance = math.hypot(xe - waypoints[index][0], ye - waypoints[index][1])
+            closest[index] = min(closest[index], distance)
+            if distance > tolerance:
                 break
+            arrivals.append(float(t))
+            index += 1
         if index == len(waypoints):
             break
     done = index == len(waypoints)
@@ -100,3 +90,21 @@ def replay(
         float(lowest),
         tuple(float(c) for c in closest),
     )
+
+
+def held_commands(
+    plant: ThesisPlant, times: np.ndarray, inputs, dt: float
+) -> Iterator[tuple[WheelForces, float]]:
+    """The replay's plant commands and step lengths (s): each interval of ``times`` cut into
+    equal steps of at most ``dt``, its wheel forces held and the joint targets ``th + rate
+    step`` from ``plant``'s state at each step (read when the command is drawn); the last
+    input is held 0.2 s longer."""
+    held = [*inputs, inputs[-1]]
+    spans = [*np.diff(times), 0.2]
+    for (f_left, f_right, rate1, rate2), span in zip(held, spans):
+        count = max(1, math.ceil(span / dt - 1e-9))
+        step = span / count
+        for _ in range(count):
+            state = plant.state
+            target1, target2 = state.th1 + rate1 * step, state.th2 + rate2 * step
+            yield WheelForces(f_left, f_right, target1, target2), step
