@@ -7,7 +7,8 @@ accounting (:func:`ddwmmr.bounds.accounting.account`) of three trajectories on t
 plant (3 kg):
 
 * ``best``: the best-known trajectory, ``DIR/cache/scenario-NNN-best.npz`` of a
-  ``python -m ddwmmr.bounds --seed S`` run, replayed at 1 ms;
+  ``python -m ddwmmr.bounds --seed S`` run, replayed as the search judged it (at 1 ms; a
+  controller's run, ``start`` ``run-...`` in the ``.json`` beside it, at its own step);
 * ``mpc``: the ``mpc``'s run (the scenario protocol's, 10 ms);
 * ``mpc-plan``: the ``mpc`` with ``lookahead`` following that best-known trajectory as its
   ``plan`` (``plan_weight`` at its default).
@@ -20,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import json
 import math
 import os
 from concurrent.futures import ProcessPoolExecutor
@@ -58,21 +60,26 @@ COLUMNS = ["scenario", "trajectory", "time_s", *TERMS, "path_m", "rotation_rad"]
 def account_scenario(job: tuple[int, int, str]) -> list[dict]:
     """The three trajectories' accounting rows of one scenario (1-based ``index``)."""
     from ddwmmr.bounds.accounting import account
-    from ddwmmr.bounds.replay import replay
+    from ddwmmr.bounds.batch import cache_names
+    from ddwmmr.bounds.replay import REPLAY_DT, replay
     from ddwmmr.bounds.starts import controller_guess
     from ddwmmr.model import Robot
-    from ddwmmr.mpc.min_time import PLAN_NAME, Guess, MinimumTime
+    from ddwmmr.mpc.min_time import Guess, MinimumTime
     from ddwmmr.scenarios import generate
 
     seed, index, plans = job
     robot = Robot().with_payload(PAYLOAD)
     scenario = generate(n=index, seed=seed)[index - 1]
-    path = Path(plans) / "cache" / PLAN_NAME.format(index)
+    names = cache_names(index)
+    path = Path(plans) / names["trajectory"]
     plan = Guess.load(path)
     legs = np.diff(plan.arrivals, prepend=0.0)
     best = MinimumTime(plan.arrivals[-1], legs, True, plan.times, plan.states, plan.inputs, "")
-    done = replay(robot, best, scenario.waypoints)
-    runs = {"best": (best, done.time_s, 0.001)}
+    # replayed as the search judged it: a controller's run at its own step
+    start = json.loads((Path(plans) / names["best"]).read_text())["start"]
+    dt = float(plan.times[1] - plan.times[0]) if start.startswith("run-") else REPLAY_DT
+    done = replay(robot, best, scenario.waypoints, dt=dt)
+    runs = {"best": (best, done.time_s, dt)}
     for name, controller, options in (
         ("mpc", "mpc", ()),
         ("mpc-plan", "mpc-lookahead", (("plan", str(path)),)),

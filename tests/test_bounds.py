@@ -9,6 +9,7 @@ import json
 import math
 import subprocess
 import sys
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -272,6 +273,35 @@ def test_the_mpc_following_the_best_found_is_a_candidate_too():
     found = _faster_run(HEAVY, runs, scenario.waypoints, Settings(), None)
     assert found is not None and found[0].start.startswith("run-mpc-plan") and found[1].ok
     assert plan_runs(scenario, plan, Settings(guided=()), HEAVY.payload) == {}
+
+
+def test_step_5_follows_each_faster_run_until_none_beats_its_plan(monkeypatch):
+    """Each round follows the fastest run of the round before while it beats its plan
+    (labels from the second round on end in ``-round<k>``); a round that beats nothing ends
+    step 5, and ``guided_rounds`` caps it."""
+    from ddwmmr.bounds import search
+
+    def fake_plan_runs(scenario, plan, s, payload):
+        # each round's run is 1 s faster than its plan until the plan takes 17 s
+        return {"mpc-plan": plan.total - 1.0} if plan.total > 17.0 else {"mpc-plan": 99.0}
+
+    def fake_faster(robot, runs, waypoints, s, found):
+        name, time = next(iter(runs.items()))
+        if time >= found[1].time_s:
+            return found
+        return (SimpleNamespace(total=time, start=f"run-{name}"), SimpleNamespace(time_s=time))
+
+    monkeypatch.setattr(search, "plan_runs", fake_plan_runs)
+    monkeypatch.setattr(search, "_faster_run", fake_faster)
+    start = (SimpleNamespace(total=20.0, start="ocp"), SimpleNamespace(time_s=20.0))
+    scenario = Scenario(0, ((1.0, 0.0),))
+    said = []
+    found = search.follow_plan(HEAVY, scenario, start, Settings(), said.append)
+    assert found[1].time_s == 17.0 and found[0].start == "run-mpc-plan-round3"
+    assert len(said) == 3
+    capped = search.follow_plan(HEAVY, scenario, start, Settings(guided_rounds=2))
+    assert capped[1].time_s == 18.0 and capped[0].start == "run-mpc-plan-round2"
+    assert search.follow_plan(HEAVY, scenario, None, Settings()) is None
 
 
 def test_continuation_bounds_change_only_their_rows():

@@ -16,7 +16,9 @@ free. With ``F = F_l + F_r``, ``T = b (F_r - F_l)``, ``m vdot + c1 v = F`` and `
         + int (1 - max(|F_l|, |F_r|) / F_w)                force left unused
 
 (``P`` the base centre's path, ``Phi`` its total rotation, ``k`` the fastest the inertia
-changes). :func:`account` replays a trajectory on :class:`~ddwmmr.plants.thesis.ThesisPlant`
+changes, capped at ``c2`` as in the price; on the plant's steps, which hold the inertia over
+each step, ``int I' |w|`` is ``sum_k (I_k - I_{k-1}) |w_k|`` and the end's ``I`` the last
+step's). :func:`account` replays a trajectory on :class:`~ddwmmr.plants.thesis.ThesisPlant`
 as :func:`~ddwmmr.bounds.replay.replay` does and sums each term over the plant's exact
 steps, so the terms add up to the time to rounding.
 """

@@ -24,7 +24,9 @@ One scenario (:func:`best_known`):
    at each waypoint as the plan does, the option's default; each as it is and with a
    smaller floor margin and input cost), its runs candidates as in 4 (``run-mpc-plan``,
    ``run-mpc-plan-margin``, ``run-mpc-plan-arrive``, ``run-mpc-plan-arrive-margin``): the
-   closed loop sometimes beats the plan it follows.
+   closed loop sometimes beats the plan it follows. While a round beats it, the faster run
+   is followed in turn (at most :data:`Settings.guided_rounds` rounds; the later rounds'
+   labels end in ``-round<k>``).
 
 The result is the replayed time: a trajectory the plant itself drives, so an upper bound on
 the true minimum. ``spread_s`` is the range of the screened local optima.
@@ -64,7 +66,8 @@ class Settings:
         controllers: controllers whose runs are starts.
         guided: ``(name, mpc options)`` of the plan-following runs of step 5 (each the
             ``mpc`` with ``lookahead`` and the best found as its ``plan``, besides these
-            options); empty: no step 5.
+            options); empty: no step 5. guided_rounds: most rounds of step 5 (a round
+            follows the fastest run of the round before, if that beat its plan).
         stability_min: the S floor; tolerance: waypoint radius (m); margin_s, margin_m:
             margins on both in the certifying solve (the replay must hold the floor and
             reach within the tolerance); tight_margin_s, tight_margin_m: the smaller
@@ -86,6 +89,7 @@ class Settings:
         ("mpc-plan-arrive", ()),
         ("mpc-plan-arrive-margin", SMALL_MARGIN),
     )
+    guided_rounds: int = 8
     stability_min: float = 1.25
     tolerance: float = 0.01
     margin_s: float = 0.0005
@@ -245,9 +249,7 @@ def best_known(
             if check.ok and check.time_s < found[1].time_s:
                 found = (closer, check)
     found = _faster_run(robot, runs, waypoints, s, found)
-    if found is not None:
-        guided = plan_runs(scenario, found[0], s, robot.payload)
-        found = _faster_run(robot, guided, waypoints, s, found)
+    found = follow_plan(robot, scenario, found, s, say)
     times = [r.total for r in screened.values()]
     spread = max(times) - min(times) if times else math.nan
     base = Found(
@@ -266,6 +268,25 @@ def best_known(
         base.solution = certified
     base.wall_s = time.perf_counter() - began
     return base
+
+
+def follow_plan(robot: Robot, scenario, found, s: Settings, say=lambda message: None):
+    """Step 5: ``found`` (solution, replay) or the fastest run of the plan-following
+    ``mpc`` that beats it, following each round's winner in the next round while one
+    beats its plan (at most ``s.guided_rounds`` rounds): the closed loop can improve on
+    the trajectory it follows more than once."""
+    for round_ in range(1, s.guided_rounds + 1):
+        if found is None:
+            break
+        guided = plan_runs(scenario, found[0], s, robot.payload)
+        if round_ > 1:
+            guided = {f"{name}-round{round_}": run for name, run in guided.items()}
+        faster = _faster_run(robot, guided, list(scenario.waypoints), s, found)
+        if faster is found:
+            break
+        say(f"step 5, round {round_}: {faster[1].time_s:.3f} s ({faster[0].start})")
+        found = faster
+    return found
 
 
 def plan_runs(scenario, plan: MinimumTime, s: Settings, payload: float) -> dict[str, Guess]:
