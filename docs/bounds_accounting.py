@@ -73,8 +73,7 @@ def account_scenario(job: tuple[int, int, str]) -> list[dict]:
     names = cache_names(index)
     path = Path(plans) / names["trajectory"]
     plan = Guess.load(path)
-    legs = np.diff(plan.arrivals, prepend=0.0)
-    best = MinimumTime(plan.arrivals[-1], legs, True, plan.times, plan.states, plan.inputs, "")
+    best = MinimumTime(plan.arrivals[-1], plan.legs, True, plan.times, plan.states, plan.inputs, "")
     # replayed as the search judged it: a controller's run at its own step
     start = json.loads((Path(plans) / names["best"]).read_text())["start"]
     dt = float(plan.times[1] - plan.times[0]) if start.startswith("run-") else REPLAY_DT
