@@ -58,3 +58,18 @@ def test_run_record_holds_the_preset_its_options_and_the_plants():
     default = run_record(CompareConfig(("ats",), trajectories), {}, [], jobs=1)
     assert default["preset"] == "default" and default["options"]["ats"]["aux"] == "shoulder"
     assert default["plants"] == ["kinematic"]
+
+
+def test_a_zero_cost_weight_of_the_mpc_runs(tmp_path, capsys):
+    """position_weight=0 (documented >= 0) used to end every mpc run in a LinAlgError from
+    the terminal cost's LQR design; the run now completes (without a position cost the
+    mpc does not track: it ends further off than its 42 mm start, and compare says so)."""
+    out = tmp_path / "zero"
+    args = ["--methods", "mpc", "--only", "ellipse", "--study", "none", "--duration", "0.2"]
+    argv = [*args, "--jobs", "1", "--option", "mpc:position_weight=0", "--no-progress"]
+    assert main([*argv, "--out", str(out)]) == 0, capsys.readouterr().err
+    with (out / "metrics.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert [(r["method"], r["steps"], r["mpc_fallbacks"]) for r in rows] == [("mpc", "10", "0")]
+    assert float(rows[0]["end_position_error_m"]) > float(rows[0]["initial_offset_m"])
+    assert "mpc on ellipse" in capsys.readouterr().out  # listed among the untracked

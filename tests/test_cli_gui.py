@@ -77,6 +77,18 @@ def test_snapshot_for_every_method(number, tmp_path, capsys):
     assert pixels.std() > 20  # widgets, plots and text, not a blank page
 
 
+@pytest.mark.parametrize("option", ["position_weight=0", "orientation_weight=0"])
+def test_snapshot_of_the_mpc_with_a_zero_cost_weight(option, tmp_path, capsys):
+    """Documented >= 0: the terminal cost's LQR design used to raise LinAlgError here."""
+    path = tmp_path / "shot.png"
+    argv = ["--snapshot", str(path), "--dpi", DPI, "--method", "mpc", "--traj", "ellipse"]
+    status = main([*argv, "--duration", "0.2", "--option", option])
+    assert status == 0, capsys.readouterr().err
+    assert capsys.readouterr().out.strip() == f"wrote {path}"
+    with Image.open(path) as image:
+        assert image.size == (480, 300)
+
+
 def test_remaining_trajectories_snapshot(tmp_path, capsys):
     """Trajectories the method rotation above did not reach (if any), with side by side."""
     trajectories = [*available_trajectories(), *trajectory_files(tmp_path)]

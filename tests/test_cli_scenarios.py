@@ -141,3 +141,33 @@ def test_payload_that_tips_the_start_pose_is_refused_with_the_limit(tmp_path, ca
         s = robot.stability((0.0, 0.0, 0.0, *default_pose(robot)))[2]
         assert (s > 1.0) is stands
     assert list(tmp_path.iterdir()) == []
+
+
+def test_mpc_options_are_refused_before_any_scenario_runs(tmp_path, monkeypatch, capsys):
+    """A horizon within the control step is refused up front, one line and status 2, with
+    no worker started and nothing written (it used to fail inside the run of every
+    scenario)."""
+    import ddwmmr.cli.scenarios as tool
+
+    def no_scenario(*args, **kwargs):
+        raise AssertionError("a scenario ran")
+
+    monkeypatch.setattr(tool, "run_many", no_scenario)
+    args = ["--controller", "mpc", "--n", "2", "--dt", "0.05", "--option", "horizon=0.04"]
+    assert cli([*args, "--jobs", "1", "--no-progress", "--out", str(tmp_path / "x")]) == 2
+    assert capsys.readouterr().err == (
+        "error: horizon must be > the control step dt = 0.05 s (got 0.04)\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_mpc_with_the_fewest_intervals_runs_its_scenarios(tmp_path):
+    """intervals=2 is in the documented [2, 200]: it used to pass the options' check, fail
+    in the OCP ("intervals ... (got 1)") and end every scenario in a controller error."""
+    out = tmp_path / "two"
+    args = ["--controller", "mpc", "--n", "1", "--time-limit", "1", "--option", "intervals=2"]
+    assert cli([*args, "--jobs", "1", "--no-progress", "--out", str(out)]) == 0
+    (row,) = csv.DictReader((out / "scenarios.csv").open())
+    assert row["reason"] == "timeout" and row["sim_steps"] == "100"
+    options = json.loads((out / "summary.json").read_text())["controller_options"]
+    assert options["intervals"] == 2

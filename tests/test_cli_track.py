@@ -183,8 +183,37 @@ def test_help_states_the_controller_option_defaults(capsys):
         "drawn in path.png (default none) [qp, mpc]",
         "(default daqp for qp, rti for mpc) [qp, mpc]",
         "priority handling (default weighted) [qp]",
+        # not "(default None)": the mpc's horizons (GRID_DEFAULTS), as docs/cli.md says
+        "prediction horizon in s (docs/mpc.md, Options) (default 1 s for tracking, 5 s for "
+        "waypoints) [mpc]",
     ):
         assert words in text, words
+
+
+def test_the_horizon_help_states_is_the_one_a_run_takes(tmp_path):
+    """--help's and docs/cli.md's 1 s is the horizon a track run without --horizon
+    plans with (the table said 2.0, --help "None")."""
+    out = tmp_path / "run"
+    args = ["--method", "mpc", "--traj", "ellipse", "--duration", "0.1", "--no-plots"]
+    assert run([*args, "--out", str(out)]) == 0
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["mpc_horizon_s"] == 1.0 and summary["mpc_options"]["horizon"] == 1.0
+    table = (Path(__file__).resolve().parents[1] / "docs" / "cli.md").read_text()
+    row = next(line for line in table.splitlines() if line.startswith("| `--horizon S` |"))
+    assert row.rsplit("|", 2)[1].strip().startswith("1 s (the tracking default")
+
+
+@pytest.mark.parametrize("option", ["position_weight=0", "orientation_weight=0"])
+def test_a_zero_cost_weight_runs(tmp_path, capsys, option):
+    """Documented >= 0; a zero weight used to end in a LinAlgError traceback from the
+    terminal cost's LQR design (control.dlqr)."""
+    out = tmp_path / "run"
+    args = ["--method", "mpc", "--traj", "ellipse", "--duration", "0.2", "--no-plots"]
+    assert run([*args, "--option", option, "--out", str(out)]) == 0, capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())
+    name = option.split("=")[0]
+    assert summary["mpc_options"][name] == 0.0
+    assert summary["steps"] == 10 and summary["mpc_fallbacks"] == 0
 
 
 def test_help_explains_methods():

@@ -16,7 +16,7 @@ from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc import terminal
 from ddwmmr.mpc.fallback import make_fallback
 from ddwmmr.mpc.models import KinematicPrediction, ThesisPrediction
-from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights, grid_intervals
+from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP, Weights, grid_intervals, shooting_grid
 from ddwmmr.mpc.solvers import GaussNewtonSQP, NLPSolver, SolverFailure
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState
 
@@ -66,6 +66,12 @@ def test_registered_with_its_interfaces():
         ({"intervals": 1}, "intervals must be an integer in [2, 200]"),
         ({"intervals": 2.5}, "intervals must be an integer in [2, 200]"),
         ({"horizon": 0.5, "intervals": 20, "first_interval": 0.1}, "horizon must be >="),
+        # the OCP's own bound: dt + 9 x 0.01 = 0.14 s > 0.1 s (10 x 0.01 = 0.1 s would fit)
+        (
+            {"horizon": 0.1, "intervals": 10, "first_interval": 0.01, "dt": 0.05},
+            "horizon must be >= dt + (intervals - 1) x first_interval = 0.14 s (got 0.1)",
+        ),
+        ({"horizon": 0.05, "dt": 0.05}, "horizon must be > the control step dt = 0.05 s"),
         ({"stability_min": 12.0}, "stability_min must be in (0, 10)"),
         ({"manipulability_weight": -1.0}, "manipulability_weight must be >= 0"),
         ({"reach_speed": 0.0}, "reach_speed must be > 0"),
@@ -176,8 +182,9 @@ def test_solver_failure_falls_back_to_the_qp_command_and_is_counted(monkeypatch)
     expected = controller.dynamics.velocity_tracking_forces(0.4, 0.1, u[0], u[1], state.th2)
     assert (command.left, command.right) == pytest.approx(expected, abs=1e-9)
     assert abs(command.left) <= 10.0 and abs(command.right) <= 10.0
-    summary = controller.summarize({"stability": np.array([1.5, 1.6]), "fallback": np.ones(2)})
-    assert summary["mpc_fallbacks"] == 2
+    # 3 samples, 2 steps: the last sample's command (a fallback too) is never applied
+    summary = controller.summarize({"stability": np.array([1.5, 1.6, 1.2]), "fallback": np.ones(3)})
+    assert summary["mpc_fallbacks"] == 2 and summary["stability_violations"] == 1
 
 
 def test_kinematic_fallback_returns_the_qp_velocity_command(monkeypatch):
@@ -208,6 +215,111 @@ def test_grid_sums_to_the_horizon_and_grows_geometrically():
     np.testing.assert_allclose(grid_intervals(4, 0.25, 1.0), 0.25)
     config = OCPConfig(intervals=5, control_interval=0.01, first_interval=0.25, horizon=1.01)
     np.testing.assert_allclose(config.interval_lengths(), [0.01, 0.25, 0.25, 0.25, 0.25])
+
+
+def test_two_intervals_are_the_control_step_and_the_rest_of_the_horizon():
+    """intervals = 2, the documented minimum: dt, then one interval to the horizon (the
+    OCP used to ask its geometric grid for intervals - 1 = 1 and refuse it)."""
+    np.testing.assert_allclose(shooting_grid(2, 0.02, 0.05, 1.0), [0.02, 0.98])
+    np.testing.assert_allclose(shooting_grid(3, 0.01, 0.25, 0.51), [0.01, 0.25, 0.25])
+    with pytest.raises(ParameterError, match=r"intervals must be an integer in \[2, 200\]"):
+        shooting_grid(1, 0.02, 0.05, 1.0)
+    config = OCPConfig(intervals=2, control_interval=0.02, first_interval=0.05, horizon=1.0)
+    np.testing.assert_allclose(config.interval_lengths(), [0.02, 0.98])
+    result = simulate(Robot(), Ellipse(), "mpc", duration=0.4, intervals=2)
+    assert result.summary["steps"] == 20 and result.summary["mpc_fallbacks"] == 0
+    recorded = result.summary["mpc_options"]
+    assert recorded["intervals"] == 2 and recorded["first_interval"] == pytest.approx(0.98)
+    assert result.summary["max_position_error_m"] < 0.05  # 3 cm start offset, not lost
+
+
+@pytest.mark.parametrize(
+    ("options", "accepted"),
+    [
+        ({"intervals": 2}, True),
+        ({"intervals": 200, "horizon": 2.0}, True),
+        ({"intervals": 10, "horizon": 0.5, "first_interval": 0.05}, True),  # 0.47 s needed
+        ({"intervals": 10, "horizon": 0.46, "first_interval": 0.05}, False),
+        ({"intervals": 10, "horizon": 0.95, "first_interval": 0.1}, True),  # 0.92 s needed
+        ({"horizon": 0.03}, True),  # default first interval: 9 equal ones of 1.1 ms
+        ({"horizon": 0.02}, False),  # not beyond the control step
+    ],
+)
+def test_the_options_accept_exactly_the_grids_the_ocp_builds(options, accepted):
+    """The options' grid check is the OCP's: what MPCOptions accepts at dt = 0.02 s builds
+    (tracking), what it refuses would have failed in the OCP."""
+    if not accepted:
+        with pytest.raises(ParameterError, match="horizon must be"):
+            make_controller("mpc", Robot(), dt=0.02, **options)
+        return
+    controller = make_controller("mpc", Robot(), dt=0.02, **options)
+    config = controller._config("tracking")
+    lengths = config.interval_lengths()
+    assert len(lengths) == controller.options.grid("tracking")[0]
+    assert lengths[0] == 0.02 and lengths.sum() == pytest.approx(config.horizon)
+
+
+@pytest.mark.parametrize("model_name", ["kinematic", "thesis"])
+def test_lqr_terminal_design_leaves_out_errors_of_zero_weight(model_name):
+    """position_weight=0 or orientation_weight=0 (documented >= 0): the errors nothing
+    depends on and nothing charges are left out of the design, exactly. orientation 0 gives
+    the design without orientation tracking (padded with zeros); position 0 a cost-to-go
+    on the orientation error alone; both 0 no terminal cost. Each P still solves the full
+    Riccati equation (the least solution; a stabilising one does not exist there)."""
+    robot = HEAVY
+    if model_name == "thesis":
+        model = ThesisPrediction(robot, sym.ThesisDynamics.from_robot(robot))
+    else:
+        model = KinematicPrediction(robot)
+    pose = default_pose(robot)
+
+    def design(position, orientation, track_orientation=True):
+        config = OCPConfig(
+            intervals=10,
+            control_interval=0.02,
+            first_interval=0.05,
+            horizon=1.0,
+            track_orientation=track_orientation,
+            weights=Weights(position=position, orientation=orientation),
+        )
+        found = terminal.design(robot, model, config, pose)
+        A, B, Q, R, P = found.A, found.B, found.Q, found.R, found.P
+        gain = np.linalg.solve(R + B.T @ P @ B, B.T @ P @ A)
+        riccati = A.T @ P @ A - P - A.T @ P @ B @ gain + Q
+        assert np.max(np.abs(riccati)) < 1e-8 * max(1.0, np.max(np.abs(P)))
+        np.testing.assert_allclose(found.K, gain, atol=1e-9)  # u = -K z with that P
+        np.testing.assert_allclose(found.factor @ found.factor.T, P, atol=1e-9)
+        return found
+
+    without = design(100.0, 10.0, track_orientation=False)  # z = [ex, ey(, v, w)]
+    no_orientation = design(100.0, 0.0)  # z = [ex, ey, eo(, v, w)]
+    keep = [0, 1, *range(3, no_orientation.P.shape[0])]
+    np.testing.assert_allclose(no_orientation.P[np.ix_(keep, keep)], without.P, rtol=1e-9)
+    assert not np.any(no_orientation.P[2]) and not np.any(no_orientation.K[:, 2])
+    assert without.P[0, 0] > 10.0  # a real cost-to-go on the position (about 20)
+    no_position = design(0.0, 10.0)
+    assert not np.any(no_position.P[:2]) and not np.any(no_position.P[:, :2])
+    assert no_position.P[2, 2] > 1.0  # on the orientation error alone (about 2)
+    # the unweighted position errors are neither fed back nor moved: poles at 1
+    assert np.sum(np.isclose(np.abs(no_position.poles), 1.0)) == 2
+    assert np.all(np.abs(no_position.poles) <= 1.0 + 1e-12)
+    nothing = design(0.0, 0.0)
+    assert not np.any(nothing.P) and not np.any(nothing.K)
+
+
+@pytest.mark.parametrize("option", ["position_weight", "orientation_weight"])
+def test_tracking_runs_with_a_zero_weight(option):
+    """The terminal design used to raise LinAlgError (control.dlqr) here. Without an
+    orientation cost the position is still tracked; without a position cost it is not
+    (nothing asks for it), but the run completes without a fallback."""
+    result = simulate(Robot(), Ellipse(), "mpc", duration=0.4, **{option: 0.0})
+    summary = result.summary
+    assert summary["steps"] == 20 and summary["mpc_fallbacks"] == 0
+    assert summary["mpc_options"][option] == 0.0
+    if option == "orientation_weight":
+        assert summary["end_position_error_m"] < summary["initial_offset_m"]
+    else:
+        assert summary["end_position_error_m"] > summary["initial_offset_m"]
 
 
 @pytest.mark.parametrize("reach", [False, True])

@@ -164,9 +164,13 @@ def test_a_user_task_is_one_small_class():
 
 
 def test_summarize_reports_violations_fallbacks_and_clearance():
+    """A run of 3 steps, 4 samples: S ends below the floor after the first and the third
+    step (samples 1 and 3; the start, below it too, is no step's); the fallback commanded
+    the second step (sample 1); the last sample's, recorded but never applied, is no
+    step's."""
     controller = QPController(ROBOT, obstacles=[Circle(1.0, 0.0, 0.2)])
     ts = {
-        "stability": np.array([1.3, 1.2, 1.26, 1.1]),
+        "stability": np.array([1.1, 1.2, 1.26, 1.1]),
         "fallback": np.array([0.0, 1.0, 0.0, 1.0]),
         "x": np.zeros(4),
         "y": np.zeros(4),
@@ -175,7 +179,7 @@ def test_summarize_reports_violations_fallbacks_and_clearance():
     summary = controller.summarize(ts)
     assert summary["stability_min"] == 1.25
     assert summary["stability_violations"] == 2
-    assert summary["qp_fallbacks"] == 2
+    assert summary["qp_fallbacks"] == 1
     assert summary["min_obstacle_clearance_m"] == pytest.approx(1.0 - 0.225 - 0.2)
     assert QPController(ROBOT).summarize(ts)["min_obstacle_clearance_m"] is None
 

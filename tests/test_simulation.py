@@ -264,3 +264,28 @@ def test_plant_holds_a_given_command_without_a_policy(robot):
     np.testing.assert_allclose(q_rk4, arc, rtol=0, atol=1e-10)
     with pytest.raises(ValueError, match="a policy or a first_command is needed"):
         KinematicPlant(robot, "rk4").integrate(0.0, np.zeros(5), 0.1, None, None)
+
+
+def test_step_counts_are_of_the_runs_steps_not_its_samples():
+    """A 10-step run records 11 samples; the last sample's command is never applied and the
+    start is no step's result, so no count exceeds the 10 steps (it was 11 of 10: the
+    verdict said "saturated 11 of 10 steps", track "steps with S < S_min 11")."""
+    fast = simulate(Robot(), Ellipse(T=0.5, N=10), "clrrmc-ts")  # far beyond every rate limit
+    assert fast.summary["steps"] == 10 and len(fast.timeseries["t"]) == 11
+    assert np.all(fast.timeseries["saturated"] == 1.0)  # every sample clipped, the last too
+    assert fast.summary["saturated_steps"] == 10
+    assert "saturated 10 of 10 steps" in fast.summary["verdict"]
+    # the start pose's S is 2.18: a floor of 3 is broken before and after every step
+    for method in ("qp", "mpc"):
+        high = simulate(Robot(), Ellipse(), method, duration=0.2, stability_min=3.0).summary
+        assert high["steps"] == 10 and high["min_stability"] < 3.0
+        assert high["stability_violations"] == 10, method
+
+
+def test_the_counts_of_commands_leave_out_the_last_sample_and_of_states_the_first():
+    from ddwmmr.controllers.base import commanded_steps, step_results
+
+    flags = [0.0, 1.0, 0.0, 1.0]  # 3 steps: the command at sample 3 is never applied
+    np.testing.assert_array_equal(commanded_steps(flags), [0.0, 1.0, 0.0])
+    np.testing.assert_array_equal(step_results(flags), [1.0, 0.0, 1.0])
+    assert len(commanded_steps([0.0])) == len(step_results([0.0])) == 0  # 0 steps

@@ -24,6 +24,7 @@ from ddwmmr import provenance
 from ddwmmr.bounds import batch
 from ddwmmr.bounds.search import QUICK, Settings
 from ddwmmr.cli.common import ArgumentParser, add_force_argument, output_folder, run_main
+from ddwmmr.cli.scenarios import check_start_pose
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
@@ -34,7 +35,13 @@ from ddwmmr.errors import (
     check_range,
 )
 from ddwmmr.model.stability import STABILITY_CAP
-from ddwmmr.outputs import check_output_folder, first_free, inspect, list_in_manifest
+from ddwmmr.outputs import (
+    check_output_folder,
+    check_writable,
+    first_free,
+    inspect,
+    list_in_manifest,
+)
 from ddwmmr.progress import ProgressBar
 from ddwmmr.scenarios.executors import default_jobs
 from ddwmmr.scenarios.generator import generate
@@ -153,6 +160,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     from ddwmmr.scenarios.protocol import RunConfig
 
     RunConfig(payload=args.payload)  # the payload's own checks, before any output
+    check_start_pose(args.payload)  # the scenarios tool's refusal of a robot that tips at rest
     if args.out is None:
         stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
         out = first_free(Path("runs") / f"bounds-{stamp}", folder=True)
@@ -164,6 +172,9 @@ def _main(argv: Sequence[str] | None = None) -> int:
         raise ParameterError(
             f"out: {out} holds files no bounds run wrote; the cache needs a folder of its own"
         )
+    # Tried, not inferred from permission bits (/proc, a read-only mount): the cache is
+    # written there as scenarios finish, so an unwritable --out fails before any of them.
+    check_writable("out", target)
     scenarios = {
         s.index + 1: s for s in generate(max(numbers), args.seed) if s.index + 1 in numbers
     }

@@ -49,6 +49,7 @@ __all__ = [
     "add_robot_arguments",
     "check_output_folder",
     "first_free",
+    "horizon_defaults",
     "method_options_text",
     "output_folder",
     "robot_from_arguments",
@@ -237,6 +238,15 @@ def method_options_text(methods: Sequence[str]) -> str:
     return "options of each method (--option NAME=VALUE; docs/api.md, Controllers):\n" + (
         "\n".join(lines)
     )
+
+
+def horizon_defaults() -> tuple[float, float]:
+    """``(tracking, waypoints)``: the mpc's horizon (s) when none is given, for the
+    ``--horizon`` help of each tool (None in its signature: chosen per objective,
+    :data:`ddwmmr.mpc.options.GRID_DEFAULTS`)."""
+    from ddwmmr.mpc.options import GRID_DEFAULTS  # here: the MPC imports CasADi
+
+    return GRID_DEFAULTS["tracking"][2], GRID_DEFAULTS["reach"][2]
 
 
 def add_force_argument(parser: argparse.ArgumentParser) -> None:

@@ -27,6 +27,7 @@ from ddwmmr.cli.common import (
     add_option_argument,
     add_robot_arguments,
     check_output_folder,
+    horizon_defaults,
     method_options_text,
     output_folder,
     robot_from_arguments,
@@ -230,7 +231,7 @@ def build_parser() -> ArgumentParser:
         type=float,
         metavar="S",
         help="prediction horizon in s of the methods taking one (mpc; docs/mpc.md); the same "
-        "as --option horizon=S",
+        f"as --option horizon=S (default {horizon_defaults()[0]:g} s, the mpc's tracking one)",
     )
     add_robot_arguments(parser)
     add_force_argument(parser)

@@ -37,6 +37,7 @@ from ddwmmr.cli.common import (
     add_option_argument,
     check_output_folder,
     first_free,
+    horizon_defaults,
     method_options_text,
     output_folder,
     run_main,
@@ -304,7 +305,8 @@ def build_parser() -> ArgumentParser:
         "--horizon",
         type=float,
         metavar="S",
-        help="mpc's prediction horizon in s (docs/mpc.md); the same as --option horizon=S",
+        help="mpc's prediction horizon in s (docs/mpc.md); the same as --option horizon=S "
+        f"(default {horizon_defaults()[1]:g} s, its waypoint one)",
     )
     parser.add_argument(
         "--bounds",
@@ -755,10 +757,13 @@ def _main(argv: Sequence[str] | None = None) -> int:
     base = default_out() if fresh else Path(args.out)
     out = first_free(base, folder=True) if fresh else base
     check_output_folder(out, "scenarios", args.force, output_names(args, config))
-    if config.controller == "qp":  # its options are checked by building it, before output
+    if config.controller in ("qp", "mpc"):
+        # their options are checked by building one for the plant, before any output or
+        # worker: a bad one is one line and status 2, not an error in every scenario
         robot = config_robot(config)
         plant = make_scenario_plant(robot, config)
-        make_scenario_controller(robot, generate(1, 0)[0], config, plant)
+        controller = make_scenario_controller(robot, generate(1, 0)[0], config, plant)
+        controller.adopt_plant(traits_of(plant))
     writer = output_folder(base, "scenarios", args.force, fresh)  # numbers from base if fresh
     with Runner(args) as runner, writer as folder:  # workers first, then the output
         if args.study == "thresholds":

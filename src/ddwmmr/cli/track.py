@@ -26,6 +26,7 @@ from ddwmmr.cli.common import (
     add_robot_arguments,
     check_output_folder,
     first_free,
+    horizon_defaults,
     method_options_text,
     output_folder,
     robot_from_arguments,
@@ -132,9 +133,12 @@ def _either(names: Sequence[str]) -> str:
     return " or ".join([", ".join(names[:-1]), names[-1]] if len(names) > 1 else names)
 
 
-def _option_help(text: str, keyword: str) -> str:
-    """``text`` with the default of each method taking ``keyword`` and those methods."""
+def _option_help(text: str, keyword: str, default: str | None = None) -> str:
+    """``text`` with the default of each method taking ``keyword`` (or ``default``, for
+    an option whose signature has None: chosen when the run starts) and those methods."""
     defaults = {m: _default_text(method_options(m)[keyword]) for m in _methods_taking(keyword)}
+    if default is not None:
+        return f"{text} (default {default}) [{', '.join(defaults)}]"
     if len(set(defaults.values())) == 1:
         default = next(iter(defaults.values()))
     else:
@@ -290,7 +294,11 @@ def build_parser() -> ArgumentParser:
         "--horizon",
         type=float,
         metavar="S",
-        help=_option_help("prediction horizon in s (docs/mpc.md, Options)", "horizon"),
+        help=_option_help(
+            "prediction horizon in s (docs/mpc.md, Options)",
+            "horizon",
+            "{:g} s for tracking, {:g} s for waypoints".format(*horizon_defaults()),
+        ),
     )
     add_option_argument(qp, "any option of --method, not only those with a flag")
     out = parser.add_argument_group("output")

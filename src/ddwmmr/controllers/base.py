@@ -47,6 +47,24 @@ class StepInfo:
     extra: dict[str, float] = field(default_factory=dict)
 
 
+def commanded_steps(column: Any) -> np.ndarray:
+    """A recorded time-series column at a run's commanded steps.
+
+    A run of N steps records N + 1 samples (sample 0 the start, sample N the end); the
+    command recorded at each of the first N is held over its step, the last sample's is
+    recorded but never applied. Counts of commands (singular, saturated, fallback steps)
+    are taken over these N, so that they are counts "of N steps" (``summary["steps"]``).
+    """
+    return np.asarray(column)[:-1]
+
+
+def step_results(column: Any) -> np.ndarray:
+    """A recorded time-series column at the end of each of a run's N steps: samples 1 to
+    N of its N + 1 (the start, sample 0, is no step's result). Counts of states (steps
+    that ended with S below a floor) are taken over these N."""
+    return np.asarray(column)[1:]
+
+
 def control_step(
     option: float | None, loop_step: float | None, trajectory: Any, default: float
 ) -> float:

@@ -37,9 +37,11 @@ With ``model="thesis"`` the controller declares ``interface = "force"`` and
 returns :class:`ddwmmr.commands.WheelForces`.
 
 ``summarize`` adds to the run summary, among others, ``stability_min``,
-``stability_violations`` (recorded steps with S < floor), ``mpc_fallbacks`` (steps that
-used the ``qp`` fallback), ``mpc_brakes`` (braking steps), ``mpc_model``, ``mpc_solver``;
-the full list is in docs/mpc.md, "Options".
+``stability_violations`` (steps that ended with S < floor), ``mpc_fallbacks`` (steps that
+used the ``qp`` fallback; both of the run's ``steps``:
+:func:`~ddwmmr.controllers.base.step_results`,
+:func:`~ddwmmr.controllers.base.commanded_steps`), ``mpc_brakes`` (braking steps),
+``mpc_model``, ``mpc_solver``; the full list is in docs/mpc.md, "Options".
 """
 
 from __future__ import annotations
@@ -52,7 +54,14 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ddwmmr.commands import FORCE, PlantTraits, WheelForces
-from ddwmmr.controllers.base import StepInfo, WaypointRun, control_step, register_controller
+from ddwmmr.controllers.base import (
+    StepInfo,
+    WaypointRun,
+    commanded_steps,
+    control_step,
+    register_controller,
+    step_results,
+)
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
@@ -482,7 +491,7 @@ class MPCController:
         """MPC metrics merged into the run summary (see the module docstring)."""
         stability = np.asarray(timeseries["stability"])
         if "fallback" in timeseries:
-            fallbacks = int(np.sum(np.asarray(timeseries["fallback"]) > 0))
+            fallbacks = int(np.sum(commanded_steps(timeseries["fallback"]) > 0))
         else:
             fallbacks = self.fallbacks
         clearance = run_clearance(self.robot, self.options.obstacles, timeseries)
@@ -490,7 +499,7 @@ class MPCController:
         solver = self.options.solver
         return {
             "stability_min": self.stability_min,
-            "stability_violations": int(np.sum(stability < self.stability_min)),
+            "stability_violations": int(np.sum(step_results(stability) < self.stability_min)),
             "mpc_fallbacks": fallbacks,
             "mpc_restarts": self.restarts,
             "mpc_brakes": self.brakes,

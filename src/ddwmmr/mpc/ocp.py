@@ -233,12 +233,14 @@ class OCPConfig:
 
     def interval_lengths(self) -> np.ndarray:
         """The interval lengths (s) at ``T = horizon`` (and ``T2 = second_leg_horizon``):
-        dt, then ``first_interval r^k``; then the second leg's equal shares."""
-        dt = check_positive("dt", self.control_interval)
-        rest = grid_intervals(self.intervals - 1, self.first_interval, self.horizon - dt)
+        :func:`shooting_grid` (dt, then ``first_interval r^k``), then the second leg's
+        equal shares."""
+        first = shooting_grid(
+            self.intervals, self.control_interval, self.first_interval, self.horizon
+        )
         count = self.second_leg_intervals if self.legs == 2 else 0
         second = np.full(count, self.second_leg_horizon / max(count, 1))
-        return np.concatenate([[dt], rest, second])
+        return np.concatenate([first, second])
 
     def longest_horizons(self) -> list[float]:
         """The upper bounds (s) of the free horizons: ``[]`` tracking, ``[horizon]`` or
@@ -702,16 +704,47 @@ class ShootingOCP:
 MAX_INTERVALS, MIN_INTERVAL, MAX_HORIZON = 200, 1e-4, 100.0
 
 
-def grid_intervals(intervals: int, first: float, horizon: float) -> np.ndarray:
-    """``intervals`` lengths ``first r^k`` (s), r >= 1 chosen so that they sum to ``horizon``."""
+def shooting_grid(intervals: int, dt: float, first: float, horizon: float) -> np.ndarray:
+    """The ``intervals`` lengths (s) of the shooting grid: the control step ``dt``, then
+    ``intervals - 1`` lengths growing geometrically from ``first`` to fill the rest of
+    ``horizon`` (:func:`grid_intervals`; with ``intervals = 2`` the one length after ``dt``
+    is that whole rest, at least ``first``).
+
+    The one check of a grid, for the options (:meth:`ddwmmr.mpc.options.MPCOptions.grid`)
+    and the OCP alike: ``intervals`` an integer in [2, :data:`MAX_INTERVALS`], ``dt`` > 0,
+    ``first`` and ``horizon`` in [:data:`MIN_INTERVAL`, :data:`MAX_HORIZON`] s,
+    ``horizon > dt`` and ``horizon >= dt + (intervals - 1) first``; else a one-line
+    :class:`ParameterError` naming the parameter.
+    """
     n = check_int_at_least("intervals", intervals, 2, MAX_INTERVALS)
+    dt = check_positive("dt", dt)
+    first = check_range("first_interval", first, MIN_INTERVAL, MAX_HORIZON, "s")
+    horizon = check_range("horizon", horizon, MIN_INTERVAL, MAX_HORIZON, "s")
+    if not horizon > dt:
+        raise ParameterError(f"horizon must be > the control step dt = {dt:g} s (got {horizon:g})")
+    least = dt + (n - 1) * first
+    if horizon - dt < (n - 1) * first * (1.0 - 1e-9):
+        raise ParameterError(
+            f"horizon must be >= dt + (intervals - 1) x first_interval = {least:g} s "
+            f"(got {horizon:g})"
+        )
+    rest = horizon - dt
+    if rest <= (n - 1) * first * (1.0 + 1e-12):  # equal lengths (within rounding: no ratio)
+        return np.concatenate([[dt], np.full(n - 1, rest / (n - 1))])
+    return np.concatenate([[dt], grid_intervals(n - 1, first, rest)])
+
+
+def grid_intervals(intervals: int, first: float, horizon: float) -> np.ndarray:
+    """``intervals`` lengths ``first r^k`` (s), r >= 1 chosen so that they sum to
+    ``horizon`` (``intervals`` = 1: ``[horizon]``, which must be >= ``first``)."""
+    n = check_int_at_least("intervals", intervals, 1, MAX_INTERVALS)
     first = check_range("first_interval", first, MIN_INTERVAL, MAX_HORIZON, "s")
     horizon = check_range("horizon", horizon, MIN_INTERVAL, MAX_HORIZON, "s")
     if horizon < n * first * (1.0 - 1e-9):
         raise ParameterError(
             f"horizon must be >= intervals x first_interval = {n * first:g} s (got {horizon:g})"
         )
-    if horizon <= n * first * (1.0 + 1e-12):
+    if n == 1 or horizon <= n * first * (1.0 + 1e-12):
         return np.full(n, horizon / n)
     low, high = 1.0, 2.0
     while first * (high**n - 1.0) / (high - 1.0) < horizon:

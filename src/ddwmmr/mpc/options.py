@@ -37,7 +37,7 @@ from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
 from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, check_min_edge_load
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT, FORCE_LIMIT_DEFAULT
 from ddwmmr.mpc.braking import BRAKE_SLACK
-from ddwmmr.mpc.ocp import MAX_HORIZON, MAX_INTERVALS, MIN_INTERVAL, Weights, grid_intervals
+from ddwmmr.mpc.ocp import MAX_HORIZON, MAX_INTERVALS, MIN_INTERVAL, Weights, shooting_grid
 from ddwmmr.mpc.problem import COLD_ITERATIONS
 from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS
 from ddwmmr.qp.limits import as_circles
@@ -115,7 +115,10 @@ class MPCOptions:
             ``obstacle_margin`` (m) from each.
         track_orientation: cost on the end-effector orientation (tracking).
         horizon, intervals, first_interval: the grid (s, count, s); None: per objective,
-            :data:`GRID_DEFAULTS` (:meth:`grid`).
+            :data:`GRID_DEFAULTS` (:meth:`grid`). ``intervals`` in [2, 200]: the control
+            step dt, then ``intervals - 1`` growing geometrically from ``first_interval``
+            to fill the horizon (with 2, one interval spanning the rest of it); the
+            horizon must be at least ``dt + (intervals - 1) x first_interval``.
         solver: ``"rti"`` (one Gauss-Newton iteration per step, default), ``"sqp"``
             (iterated Gauss-Newton), ``"ipopt"``, ``"sqpmethod"`` or ``"fatrop"``.
         qp_solver: QP backend of ``rti``/``sqp`` (``"hpipm"`` default).
@@ -391,8 +394,11 @@ class MPCOptions:
     def grid(self, mode: str) -> tuple[int, float, float]:
         """``(intervals, first interval s, horizon s)`` of objective ``mode``
         (``"tracking"`` or ``"reach"``), the options given else :data:`GRID_DEFAULTS`; a
-        short horizon with the default first interval gets uniform intervals. Checked
-        against the control step ``dt`` (else :data:`DEFAULT_DT`)."""
+        short horizon with the default first interval gets uniform intervals. Checked as
+        the OCP checks its grid (:func:`ddwmmr.mpc.ocp.shooting_grid`: ``intervals`` in
+        [2, 200], ``horizon > dt`` and ``horizon >= dt + (intervals - 1) x
+        first_interval``) at the control step ``dt`` (else :data:`DEFAULT_DT`), so a grid
+        these options accept is one the OCP builds."""
         dt = self.dt or DEFAULT_DT
         n0, h0, t0 = GRID_DEFAULTS[mode]
         intervals, horizon = self.intervals, self.horizon
@@ -402,13 +408,13 @@ class MPCOptions:
         t = check_range(
             "horizon", t0 if horizon is None else horizon, MIN_INTERVAL, MAX_HORIZON, "s"
         )
-        if self.first_interval is None:
-            h = min(h0, max(t - dt, 1e-3) / max(int(n) - 1, 1))
-        else:
-            h = self.first_interval
         if not t > dt:
             raise ParameterError(f"horizon must be > the control step dt = {dt:g} s (got {t:g})")
-        grid_intervals(n, h, t)  # validates the count and the lengths (one-line errors)
+        if self.first_interval is None:
+            h = min(h0, max((t - dt) / (n - 1), MIN_INTERVAL))
+        else:
+            h = self.first_interval
+        shooting_grid(n, dt, h, t)  # the OCP's own check (one-line errors)
         return int(n), float(h), float(t)
 
     def weights(self, mode: str) -> Weights:
@@ -438,9 +444,12 @@ class MPCOptions:
         plain types for the run's summary."""
         values = {f.name: getattr(self, f.name) for f in fields(self)}
         intervals, first, horizon = self.grid(mode)
+        # the interval after dt: its length as the controller builds it (with 2 intervals,
+        # the rest of the horizon)
+        after = min(first, (horizon - dt) / (intervals - 1)) if intervals > 2 else horizon - dt
         values.update(
             intervals=intervals,
-            first_interval=min(first, (horizon - dt) / (intervals - 1)),
+            first_interval=after,
             horizon=horizon,
             position_weight=self.weights(mode).position,
             huber=self.huber_scale(mode),

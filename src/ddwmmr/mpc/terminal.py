@@ -14,6 +14,17 @@ the orientation error when tracked), so one design holds at every heading:
 Both are discretised with a zero-order hold over the last shooting interval h
 (``control.c2d``) and solved with ``control.dlqr`` with ``Q = h diag(Wp, Wp[, Wo], 0, 0)``
 and ``R = h Wu diag(1/u_scale^2)``: the same weights as the OCP's stage cost.
+
+A zero weight (``position_weight=0`` or ``orientation_weight=0``) leaves those error
+components out of the design: nothing in the error dynamics depends on an error component
+(its column of ``A`` is zero) and the stage cost does not charge it, so the LQR's
+cost-to-go does not depend on it either. The design is then made on the other components
+(exactly: ``P`` is the least positive semidefinite solution of the Riccati equation, with
+zero rows and columns for the unweighted errors, and ``K`` does not feed them back); the
+terminal cost, like the stage cost, ignores them. With no error component weighted at all
+the cost-to-go is zero (``P = 0``, ``K = 0``). This is not a regularisation: a plain
+``dlqr`` on the full error would have no stabilising solution there (an unweighted
+integrator is neither regulated nor seen by the cost).
 """
 
 from __future__ import annotations
@@ -38,7 +49,9 @@ class TerminalDesign:
     Attributes:
         A, B: discretised error dynamics (nz x nz, nz x nu); Q, R: weights.
         P: Riccati solution (cost-to-go ``z' P z``); K: gain ``u = -K z``.
-        poles: closed-loop eigenvalues (discrete, |.| < 1); factor: ``L`` with P = L L'.
+        poles: closed-loop eigenvalues of ``A - B K`` (discrete, |.| < 1, but 1 for each
+            error component a zero weight leaves out); factor: ``L`` with
+            ``L L' = P + 1e-12 I``.
     """
 
     A: np.ndarray
@@ -78,23 +91,32 @@ def error_dynamics(
 def design(
     robot: Robot, model: PredictionModel, config: OCPConfig, arm_pose: tuple[float, float]
 ) -> TerminalDesign:
-    """The LQR terminal design for ``config``'s weights and interval at ``arm_pose``."""
+    """The LQR terminal design for ``config``'s weights and interval at ``arm_pose`` (an
+    error component of zero weight is left out: module docstring)."""
     # Imported here: python-control (with scipy.signal) takes most of a second to import,
     # which every command-line run would otherwise pay through the method registry.
     import control
 
     A, B = error_dynamics(robot, model, arm_pose, config.track_orientation)
-    nz = A.shape[0]
+    nz, nu = B.shape
     h, weights = float(config.interval_lengths()[-1]), config.weights
-    discrete = control.c2d(control.ss(A, B, np.eye(nz), np.zeros((nz, B.shape[1]))), h)
+    discrete = control.c2d(control.ss(A, B, np.eye(nz), np.zeros((nz, nu))), h)
     Ad, Bd = np.asarray(discrete.A), np.asarray(discrete.B)
+    rows = 3 if config.track_orientation else 2  # the end-effector error; then (v, w)
     q = np.zeros(nz)
     q[:2] = weights.position
     if config.track_orientation:
         q[2] = weights.orientation
     Q = h * np.diag(q)
     R = h * np.diag(weights.input / np.asarray(model.u_scale, dtype=float) ** 2 + R_FLOOR)
-    K, P, poles = control.dlqr(Ad, Bd, Q, R)
-    P = 0.5 * (P + P.T)
+    # unweighted error components are left out (module docstring): nothing depends on them
+    keep = np.array([i for i in range(nz) if i >= rows or q[i] > 0.0], dtype=int)
+    P, K = np.zeros((nz, nz)), np.zeros((nu, nz))
+    if np.any(q[keep] > 0.0):
+        part = np.ix_(keep, keep)
+        K_kept, P_kept, _ = control.dlqr(Ad[part], Bd[keep], Q[part], R)
+        P[part] = 0.5 * (P_kept + P_kept.T)
+        K[:, keep] = K_kept
+    poles = np.linalg.eigvals(Ad - Bd @ K)
     factor = np.linalg.cholesky(P + 1e-12 * np.eye(nz))
     return TerminalDesign(Ad, Bd, Q, R, P, np.asarray(K), np.asarray(poles), factor)

@@ -24,13 +24,15 @@ Built by name::
                     obstacles=load_obstacles("trajectories/obstacles/ellipse_post.toml"))
 
 ``summarize`` adds to the run summary: ``stability_min`` (the floor), ``stability_violations``
-(recorded steps with S < floor), ``qp_fallbacks`` (recorded steps that used the safe
-command), ``min_obstacle_clearance_m`` (base footprint vs circles; None without obstacles),
-``qp_mode``, ``qp_solver`` and ``min_predicted_edge_load_n`` (the least edge load, N, the
-edge-load limit predicted for a command sent; None where that limit is off) and
-``min_edge_load_floor_n`` (its floor, N; None where off), ``edge_load_relaxed_steps`` (steps
-whose edge rows conflicted with the other limits and were dropped for that step's solve;
-the QP fallback runs only if that solve fails too).
+(steps that ended with S < floor), ``qp_fallbacks`` (steps that used the safe command; both
+of the run's ``steps``: :func:`~ddwmmr.controllers.base.step_results`,
+:func:`~ddwmmr.controllers.base.commanded_steps`), ``min_obstacle_clearance_m`` (base
+footprint vs circles; None without obstacles), ``qp_mode``, ``qp_solver`` and
+``min_predicted_edge_load_n`` (the least edge load, N, the edge-load limit predicted for a
+command sent; None where that limit is off) and ``min_edge_load_floor_n`` (its floor, N;
+None where off), ``edge_load_relaxed_steps`` (steps whose edge rows conflicted with the
+other limits and were dropped for that step's solve; the QP fallback runs only if that
+solve fails too).
 
 Its benchmark twin, :class:`ddwmmr.qp.naive.NaiveQPController`, is deliberately not a
 registered method: it is a baseline for ``python -m ddwmmr.bench``, not a method to compare.
@@ -45,7 +47,14 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ddwmmr.commands import PlantTraits
-from ddwmmr.controllers.base import StepInfo, WaypointRun, control_step, register_controller
+from ddwmmr.controllers.base import (
+    StepInfo,
+    WaypointRun,
+    commanded_steps,
+    control_step,
+    register_controller,
+    step_results,
+)
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
 from ddwmmr.model import Robot
@@ -447,8 +456,8 @@ class QPController:
         clearance = run_clearance(self.robot, self.obstacles, timeseries)
         return {
             "stability_min": self.stability_min,
-            "stability_violations": int(np.sum(stability < self.stability_min)),
-            "qp_fallbacks": int(np.sum(np.asarray(timeseries["fallback"]) > 0)),
+            "stability_violations": int(np.sum(step_results(stability) < self.stability_min)),
+            "qp_fallbacks": int(np.sum(commanded_steps(timeseries["fallback"]) > 0)),
             "min_obstacle_clearance_m": clearance,
             "qp_mode": self.mode,
             "qp_solver": self.solver,

@@ -10,7 +10,12 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.commands import VELOCITY
-from ddwmmr.controllers.base import Controller, available_methods, make_controller
+from ddwmmr.controllers.base import (
+    Controller,
+    available_methods,
+    commanded_steps,
+    make_controller,
+)
 from ddwmmr.errors import (
     ParameterError,
     check_finite,
@@ -345,7 +350,10 @@ def summarize(
     (``(start, end)`` times in s, e.g. :meth:`Rectangle.corner_windows`).
     ``end_position_error_m`` is the error at the last sample and
     ``corner_position_error_m`` the largest error inside the corner windows (None
-    without corners).
+    without corners). ``singular_steps``, ``saturated_steps`` and ``fallback_steps``
+    count the run's N commanded steps, not its N + 1 samples
+    (:func:`~ddwmmr.controllers.base.commanded_steps`: the last sample's command is never
+    applied), so each is at most ``summary["steps"]``.
     """
     position = ts["position_error_m"]
     orientation = ts["orientation_error_rad"]
@@ -372,9 +380,9 @@ def summarize(
         "min_manipulability": float(np.min(ts["manipulability"])),
         "mean_manipulability": float(np.mean(ts["manipulability"])),
         "min_stability": float(np.min(ts["stability"])),
-        "singular_steps": int(np.sum(ts["singular"])),
-        "saturated_steps": int(np.sum(ts["saturated"])),
-        "fallback_steps": int(np.sum(ts["fallback"])),
+        "singular_steps": int(np.sum(commanded_steps(ts["singular"]))),
+        "saturated_steps": int(np.sum(commanded_steps(ts["saturated"]))),
+        "fallback_steps": int(np.sum(commanded_steps(ts["fallback"]))),
         "max_condition_number": max_condition_number(robot, q),
         "median_step_us": float(np.median(ts["step_us"])),
     }
