@@ -4,20 +4,23 @@ open-loop replay on the thesis plant, and the tool."""
 
 from __future__ import annotations
 
+import csv
 import dataclasses
 import json
 import math
+import re
 import subprocess
 import sys
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq, minimize
+from scipy.optimize import brentq, linprog, minimize
 
 from ddwmmr import Robot
 from ddwmmr.bounds import batch, diffdrive
-from ddwmmr.bounds.lower import Prices, budget_bound, circular
+from ddwmmr.bounds.lower import Lags, Prices, budget_bound, circular, lower_bound
 from ddwmmr.bounds.replay import replay
 from ddwmmr.bounds.search import Settings, _faster_run, best_known, plan_runs, start_state
 from ddwmmr.bounds.starts import Pattern, controller_guess, pattern_guess
@@ -27,6 +30,7 @@ from ddwmmr.scenarios import generate
 from ddwmmr.scenarios.generator import Scenario
 
 HEAVY = Robot().with_payload(3.0)
+DOCS_BOUNDS = Path(__file__).resolve().parents[1] / "docs" / "bounds"
 #: The thesis robot's wheels: radius (m), half-track (m), top wheel speed (rad/s).
 WHEELS = {"wheel_radius": 0.0975, "half_track": 0.175, "wheel_speed": 15.0}
 #: A light multistart for tests: the 32 direction patterns on a coarse grid, one refined.
@@ -156,6 +160,10 @@ def test_lower_bound_is_below_the_analytic_time_straight_ahead():
     bound = budget_bound(HEAVY, [(3.0, 0.0)]).value
     assert bound <= fastest
     assert bound == pytest.approx(Prices.from_robot(HEAVY).drive * needed, abs=0.04)
+    # with the stops priced: no reversal is needed, and the one stretch ends free
+    for weight in (0.0, 0.5):
+        priced = budget_bound(HEAVY, [(3.0, 0.0)], cell=0.07, arcs=120, rotation_weight=weight)
+        assert bound < priced.value <= fastest
 
 
 def test_lower_bound_prices_are_the_wheels_force_budget():
@@ -174,12 +182,194 @@ def test_lower_bound_is_never_above_the_best_known_time(waypoints):
     scenario = Scenario(0, tuple(waypoints))
     found = best_known(HEAVY, scenario, LIGHT)
     assert found.replay_ok
-    bound = budget_bound(HEAVY, waypoints, cell=0.1, arcs=60).value
-    assert 0.0 < bound <= found.best_s
-    assert found.best_s / bound < 3.0  # not vacuous
+    for weight in (1.0, 0.4, 0.6):  # the force budget alone, and with the stops priced
+        bound = budget_bound(HEAVY, waypoints, cell=0.1, arcs=60, rotation_weight=weight).value
+        assert 0.0 < bound <= found.best_s
+        assert found.best_s / bound < 3.0  # not vacuous
     # the straight-line starts are solved on the fine grid whatever their coarse rank
     straight = {f"fine-straight-{r}-{e}" for r in ("never", "turn") for e in ("up", "down")}
     assert straight <= set(found.refined)
+
+
+# -- the stops' lag -----------------------------------------------------------------------
+def _drive_constants():
+    d = sym.ThesisDynamics.from_robot(HEAVY)
+    return d.mass / d.c1, d.top_speed
+
+
+def _bang_bang(path):
+    """Time (s) of the fastest drive of ``path`` (m) from rest to rest, simulated with the
+    exact step of ``m vdot + c1 v = F``: full force, then full reverse force, switching
+    where the braking from there ends exactly at ``path`` (found by bisection)."""
+    tau, top = _drive_constants()
+
+    def run(switch, dt=1e-4):
+        v = x = t = 0.0
+        while t < switch:  # accelerate: v -> top
+            v, x, t = top + (v - top) * math.exp(-dt / tau), x + v * dt, t + dt
+        while v > 0.0:  # brake: v -> -top, stop at rest
+            v, x, t = -top + (v + top) * math.exp(-dt / tau), x + max(v, 0.0) * dt, t + dt
+        return x, t
+
+    low, high = 0.0, path / top + 2.0 * tau
+    for _ in range(40):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if run(middle)[0] < path else (low, middle)
+    return run(high)[1]
+
+
+@pytest.mark.parametrize("path", [0.3, 1.0, 3.0, 8.0])
+def test_lag_at_weight_0_is_the_fastest_drive_between_stops(path):
+    """Weight 0 prices time alone: the rest-to-rest lag is the time-optimal drive's time
+    less ``path / v_top`` (the bang-bang drive simulated step by step), tabulated from
+    below; the free-end lag less the excess stays below the closed form ``tau (1 -
+    exp(-T / tau))`` of a drive at full force to the end."""
+    tau, top = _drive_constants()
+    lags = Lags.from_robot(HEAVY, 0.0)
+    simulated = _bang_bang(path) - path / top
+    tabulated = float(lags.at_rest(path))
+    assert tabulated <= simulated + 2e-3  # the simulation's own step
+    assert simulated - tabulated < 0.02
+    free_time = brentq(lambda t: top * (t - tau * (1.0 - math.exp(-t / tau))) - path, 0.0, 60.0)
+    assert tabulated - lags.free_excess <= free_time - path / top + 1e-9
+    assert lags.free_excess > 0.0
+
+
+def _least_cost_drive(path, weight, free_end, steps=120):
+    """``min (1 - weight) T + weight int |F| dt / (2 F_w)`` over drives of ``path`` from
+    rest (to rest unless ``free_end``), by linear programmes over piecewise-constant
+    forces at durations ``T`` in 0.05 s steps: a second formulation, from above (its
+    forces are a subset of all forces)."""
+    d = sym.ThesisDynamics.from_robot(HEAVY)
+    tau, force = d.mass / d.c1, 2.0 * d.force_limit
+    best = math.inf
+    for duration in np.arange(path / d.top_speed + 0.05, path / d.top_speed + 4.0, 0.05):
+        dt = duration / steps
+        decay = math.exp(-dt / tau)
+        gain = (1.0 - decay) / d.c1  # speed per newton held over a step
+        lift = (dt - tau * (1.0 - decay)) / d.c1  # path per newton held over a step
+        k = np.arange(steps)
+        power = decay ** np.maximum(k[:, None] - k[None, :] - 1, 0) * (k[:, None] > k[None, :])
+        speed = gain * power  # speed at the start of each step from the earlier forces
+        path_rows = lift * np.eye(steps) + tau * (1.0 - decay) * speed
+        # variables: push (>= 0) and pull (>= 0) per step; cost: their sum
+        a_eq = [np.concatenate([path_rows.sum(axis=0), -path_rows.sum(axis=0)])]
+        b_eq = [path]
+        end = gain * decay ** (steps - 1 - k)
+        if not free_end:
+            a_eq.append(np.concatenate([end, -end]))
+            b_eq.append(0.0)
+        # speed at the end of each step: v_{k+1} = decay v_k + gain F_k
+        after = gain * decay ** np.maximum(k[:, None] - k[None, :], 0) * (k[:, None] >= k[None, :])
+        a_ub = np.block([[-after, after], [np.eye(steps), np.eye(steps)]])
+        b_ub = np.concatenate([np.zeros(steps), np.full(steps, force)])
+        result = linprog(
+            np.full(2 * steps, dt / force), A_ub=a_ub, b_ub=b_ub, A_eq=np.array(a_eq), b_eq=b_eq
+        )
+        if result.status == 0:
+            best = min(best, (1.0 - weight) * duration + weight * result.fun)
+    return best - path / d.top_speed
+
+
+@pytest.mark.parametrize("weight", [0.4, 0.6])
+def test_lags_match_a_linear_programme_of_the_drive(weight):
+    """The tabulated lags (accelerate, coast, brake) against linear programmes over all
+    piecewise-constant forces: never above them, and within their grid's slack."""
+    lags = Lags.from_robot(HEAVY, weight)
+    for path in (0.5, 2.5):
+        rest = _least_cost_drive(path, weight, free_end=False)
+        free = _least_cost_drive(path, weight, free_end=True)
+        assert float(lags.at_rest(path)) <= rest + 1e-6
+        assert rest - float(lags.at_rest(path)) < 0.06
+        assert float(lags.at_rest(path)) - lags.free_excess <= free + 1e-6
+
+
+def test_pricing_the_stops_raises_the_bound_of_a_task_that_turns_back():
+    """3 m ahead, then back past the start: the force budget alone lets the base reverse
+    for free. Priced, the bound rises by more than half a second and stays below the
+    fastest reversal (rest-to-rest to the first reach disc, then from rest to the second
+    at full force), a time no trajectory that reverses can beat."""
+    tau, top = _drive_constants()
+    reach = Prices.from_robot(HEAVY).reach
+    waypoints = [(3.0, 0.0), (-0.5, 0.0)]
+    out, back = 3.0 - reach, 3.5 - 2.0 * reach
+    free_time = brentq(lambda t: top * (t - tau * (1.0 - math.exp(-t / tau))) - back, 0.0, 60.0)
+    reversal = _bang_bang(out) + free_time
+    budget = budget_bound(HEAVY, waypoints, cell=0.07, arcs=120).value
+    priced = budget_bound(HEAVY, waypoints, cell=0.07, arcs=120, rotation_weight=0.5).value
+    assert priced > budget + 0.5
+    assert priced < reversal
+
+
+def test_pricing_the_stops_stays_below_a_zigzag_of_known_time():
+    """A robot with a 2 cm arm (the base all but pinned to the waypoints) driving along a
+    line forward, back and forward again: the fastest such trajectory is two rest-to-rest
+    drives and a free-end one, a time the bound must not exceed with reversals anywhere
+    inside the legs or at the waypoints. Priced, it stays below that and rises well above
+    the force budget's, which reverses for free."""
+    tau, top = _drive_constants()
+    tiny = dataclasses.replace(HEAVY, L1=0.01, L2=0.01)
+    reach = Prices.from_robot(tiny).reach
+    waypoints = [(2.0, 0.0), (0.5, 0.0), (2.5, 0.0)]
+    first, back, last = 2.0 - reach, 1.5 - 2.0 * reach, 2.0 - 2.0 * reach
+    free_time = brentq(lambda t: top * (t - tau * (1.0 - math.exp(-t / tau))) - last, 0.0, 60.0)
+    zigzag = _bang_bang(first) + _bang_bang(back) + free_time
+    budget = budget_bound(tiny, waypoints, cell=0.05, arcs=120).value
+    priced = [
+        budget_bound(tiny, waypoints, cell=0.05, arcs=120, rotation_weight=weight).value
+        for weight in (0.0, 0.2, 0.4, 0.6)
+    ]
+    assert all(budget < value <= zigzag for value in priced)
+    assert max(priced) > budget + 1.0
+
+
+def test_a_straight_run_through_several_waypoints_is_one_stretch():
+    """Five waypoints 1 m apart straight ahead (the 2 cm arm): one drive at full force
+    from rest, no stop. The bound charges the one stretch once, so it stays below that
+    drive's analytic time (charging every leg would put it seconds above)."""
+    tau, top = _drive_constants()
+    tiny = dataclasses.replace(HEAVY, L1=0.01, L2=0.01)
+    reach = Prices.from_robot(tiny).reach
+    waypoints = [(float(x), 0.0) for x in range(1, 6)]
+    path = 5.0 - reach
+    fastest = brentq(lambda t: top * (t - tau * (1.0 - math.exp(-t / tau))) - path, 0.0, 60.0)
+    budget = budget_bound(tiny, waypoints, cell=0.05, arcs=120).value
+    for weight in (0.0, 0.5):
+        priced = budget_bound(tiny, waypoints, cell=0.05, arcs=120, rotation_weight=weight)
+        assert budget < priced.value <= fastest
+
+
+def test_weight_one_is_the_force_budget_to_the_last_bit():
+    """rotation_weight = 1 is the force budget alone: scenario 2 of seed 0 on the bounds
+    tool's grid gives the committed force-budget bound (docs/bounds/stops_seed0.csv)
+    exactly."""
+    from ddwmmr.bounds.lower import BUDGET_GRID
+
+    with open(DOCS_BOUNDS / "stops_seed0.csv", newline="") as handle:
+        committed = {int(r["scenario"]): float(r["budget_bound_s"]) for r in csv.DictReader(handle)}
+    waypoints = generate(2, 0)[1].waypoints
+    value = budget_bound(HEAVY, waypoints, cell=BUDGET_GRID[0], arcs=BUDGET_GRID[1]).value
+    assert value == committed[2]
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [({"rotation_weight": 1.5}, "rotation_weight must be in [0, 1]"), ({"arcs": 61}, "arcs")],
+)
+def test_bound_settings_are_checked(kwargs, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        budget_bound(HEAVY, [(1.0, 0.0)], **kwargs)
+
+
+def test_lower_bound_is_the_best_of_its_bounds():
+    waypoints = [(3.0, 0.0), (-0.5, 0.0)]
+    grid, stop_grid = (0.1, 60), (0.1, 60)
+    best = lower_bound(HEAVY, waypoints, grid=grid, stop_weights=(0.5,), stop_grid=stop_grid)
+    parts = [
+        budget_bound(HEAVY, waypoints, cell=0.1, arcs=60).value,
+        budget_bound(HEAVY, waypoints, cell=0.1, arcs=60, rotation_weight=0.5).value,
+    ]
+    assert best.value == max(parts)
 
 
 # -- the best-known side ----------------------------------------------------------------
@@ -426,7 +616,7 @@ def test_tool_refuses_a_folder_it_did_not_write(tmp_path, capsys):
     assert sorted(p.name for p in out.iterdir()) == ["notes.txt"]
 
 
-def test_lower_only_leaves_the_best_known_time_to_a_later_run(tmp_path, monkeypatch):
+def test_lower_only_leaves_the_best_known_time_to_a_later_run(tmp_path, monkeypatch, capsys):
     from ddwmmr.cli import bounds as tool
 
     jobs = []
@@ -443,7 +633,10 @@ def test_lower_only_leaves_the_best_known_time_to_a_later_run(tmp_path, monkeypa
     lines = (out / "bounds.csv").read_text().splitlines()
     assert lines[1] == "1,11.0,nan,0,nan,False"
     assert math.isnan(float(json.loads((out / "summary.json").read_text())["mean_width"]))
+    said = capsys.readouterr().out
+    assert "no best-known time yet" in said and "nan" not in said
     # the full run then searches only the best-known times, the lower bounds come cached
     assert tool.main(args) == 0
     assert jobs[2:] == [(1, True, False), (2, True, False)]
     assert (out / "bounds.csv").read_text().splitlines()[2] == "2,12.0,14.0,3,0.5,True"
+    assert "best known 13.50 s (replayed 2), bracket width" in capsys.readouterr().out

@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.bounds.lower import budget_bound
+from ddwmmr.bounds.lower import lower_bound
 from ddwmmr.bounds.search import Settings, best_known
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
@@ -29,7 +29,7 @@ from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.result import json_safe, write_atomic
 
 #: Version of each method's results: a change invalidates the cached results of that part.
-LOWER_VERSION = "budget-1"
+LOWER_VERSION = "budget-stops-1"
 BEST_VERSION = "multistart-6"
 #: Columns of bounds.csv.
 COLUMNS = ("scenario", "lower_bound_s", "best_known_s", "starts", "spread_s", "replay_ok")
@@ -93,9 +93,7 @@ def solve(job: Job) -> dict[str, Any]:
     wanted = keys(job.scenario, job.payload, job.settings)
     out: dict[str, Any] = {"index": job.scenario.index + 1}
     if job.need_lower:
-        bound = budget_bound(
-            robot, job.scenario.waypoints, tolerance=job.settings.tolerance, cell=0.05, arcs=144
-        )
+        bound = lower_bound(robot, job.scenario.waypoints, tolerance=job.settings.tolerance)
         out["lower"] = {
             "key": wanted["lower"],
             "lower_bound_s": bound.value,

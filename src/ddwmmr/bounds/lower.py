@@ -34,16 +34,43 @@ the cells (distance between the squares, angles less the cells' half-widths and 
 direction's spread), so the result is at most the minimum of the continuous problem:
 a lower bound on the time of every trajectory of the model and of the thesis plant
 (whose exact base steps keep both identities).
+
+The stops (docs/mpc.md, "Pricing the stops"). Cut the task at the base's reversals (``v``
+changes sign): each stretch starts at rest and, but for the last, ends at rest. In stretch
+``j`` (time ``t_j``, path ``D_j``, force spent ``U_j = int |F| / (2 F_w)``, rotation budget
+``R_j = int |T| / (2 F_w b)``) the budget gives ``t_j >= U_j + R_j``, so for any weight
+``lam`` in [0, 1] ``t_j >= (1 - lam) t_j + lam U_j + lam R_j >= D_j / v_top + lag(D_j) +
+lam R_j``, where ``D / v_top + lag(D)`` is the least ``(1 - lam) T + lam U`` of any drive
+of ``D`` from rest to rest (:class:`Lags`). Summed, with ``sum R_j >= (c2 - k) Phi / (2 F_w
+b)``::
+
+    t_f >= c1 P / (2 F_w) + lam (c2 - k) Phi / (2 F_w b) + sum_j lag(D_j).
+
+At ``lam = 1`` the lag is 0 and this is the bound above. :func:`budget_bound` with
+``rotation_weight = lam < 1`` minimises it: the programme also tracks, per leg, whether the
+base reverses in it (the heading nearest the displacement's line, as above) or not (the
+direction of travel nearest the displacement, on the full circle: a sharper geometry), and
+whether the open stretch has been charged. A leg without a reversal lies in one stretch,
+which it is at most as long as: the stretch is charged the leg's lag if it has not been. A
+leg with reversals cuts its path into ``a`` (ending the open stretch), ``m_i`` (whole
+stretches) and ``b`` (starting the next): driving them back to back is one drive of the
+leg, so ``lag(L) <= lag(a) + sum lag(m_i) + lag(b)`` (the lag grows with the path), and if
+the open stretch is uncharged the leg is charged ``lag(L)`` and the next stretch counts as
+charged; if it is charged, nothing more is (the charges are never negative). The last
+stretch ends free (``lag_free(a + b) <= lag(a) + lag_free(b)`` the same way): it is charged
+the rest-to-rest lag less the largest excess of that over the free-end lag.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
+from ddwmmr.errors import ParameterError, check_range
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 
@@ -118,13 +145,92 @@ def disc_cells(centre, radius: float, cell: float) -> tuple[np.ndarray, np.ndarr
     return x0[keep] + centre[0], y0[keep] + centre[1]
 
 
-def _drive_costs(ax, ay, a_size, bx, by, b_size, centres, half_arc, price):
-    """Least driving time (s) from each square of A to each of B for each heading arc of
-    the leg: (len(A), len(B), arcs).
+@dataclass(frozen=True)
+class Lags:
+    """What the speed's lag adds to a stretch of driving, for one weight ``lam``.
 
-    ``|dp|`` is at least the distance between the squares; ``beta`` at least the line
-    distance between the arc's centre and the direction between the squares' centres,
-    less the arc's half-width and the direction's spread over the squares."""
+    A drive of the path ``D`` along ``m vdot + c1 v = F``, ``|F| <= 2 F_w``, taking ``T``
+    and spending ``U = int |F| dt / (2 F_w)``: its cost ``(1 - lam) T + lam U`` is least
+    (Pontryagin: the switching function is monotone) when it accelerates with full force
+    for ``t1``, coasts for ``tc`` and, from rest to rest, brakes for ``t2 = tau ln(1 + (1 -
+    exp(-t1 / tau)) exp(-tc / tau))`` (``tau = m / c1``); then ``D = v_top (t1 - t2)`` and
+    the cost less ``D / v_top`` is the lag ``2 t2 + (1 - lam) tc``. To a free end it
+    coasts to the end and the lag is ``v_end tau / v_top + (1 - lam) tc``. Both lags grow
+    with ``D``; they are tabulated at paths ``D_k`` as lower bounds, each the least over
+    coast times ``tc`` in steps, on each step the lag's first term at its longer end
+    (it falls as the coast grows, for the same path) and the coast term at its shorter.
+
+    Attributes:
+        weight: ``lam``; distance: the tabulated paths (m), increasing from 0; rest: the
+            rest-to-rest lag's lower bound (s) at each; free_excess: the largest of the
+            tabulated rest-to-rest lag less the free-end lag's lower bound (s).
+    """
+
+    weight: float
+    distance: np.ndarray
+    rest: np.ndarray
+    free_excess: float
+
+    @classmethod
+    def from_robot(cls, robot: Robot, weight: float) -> Lags:
+        """The thesis plant's lags for the weight ``lam`` in [0, 1]."""
+        d = sym.ThesisDynamics.from_robot(robot)
+        if d.c1 <= 0.0:
+            raise ParameterError("c1 must be > 0 to price the stops (an undamped base)")
+        return _lags(d.mass / d.c1, d.top_speed, float(weight))
+
+    def at_rest(self, length) -> np.ndarray:
+        """A lower bound (s) on the rest-to-rest lag of any path at least ``length`` (m)
+        long: the table's value at the longest tabulated path not above it."""
+        index = np.searchsorted(self.distance, length, side="right") - 1
+        return self.rest[np.clip(index, 0, self.rest.size - 1)]
+
+
+def _accelerate_for(target, tc, tau, brakes: bool) -> np.ndarray:
+    """``t1`` (s) with ``t1 - t2 = target`` (rest to rest, ``brakes``) or ``t1 - tau (1 -
+    exp(-t1 / tau)) exp(-tc / tau) = target`` (free end), for each coast time ``tc``:
+    both sides grow with ``t1``, so bisection on ``[target, target + tau]``, returning the
+    end below (the lags it gives are then rounded down, never up)."""
+    low, high = np.full_like(tc, target), np.full_like(tc, target + tau)
+    coast = np.exp(-tc / tau)
+    for _ in range(60):
+        middle = 0.5 * (low + high)
+        speed = -np.expm1(-middle / tau) * coast
+        gone = tau * np.log1p(speed) if brakes else tau * speed
+        short = middle - gone < target
+        low, high = np.where(short, middle, low), np.where(short, high, middle)
+    return low
+
+
+@functools.lru_cache(maxsize=16)
+def _lags(tau: float, top: float, weight: float) -> Lags:
+    """:class:`Lags` for ``tau = m / c1`` (s), ``v_top`` (m/s) and ``lam``."""
+    distance = np.concatenate([np.linspace(0.0, 2.0, 201), np.linspace(2.05, 25.0, 460)])
+    limit = 12.0 * tau
+    tc = np.linspace(0.0, limit, 1201)
+    slope = 1.0 - weight
+    rest, free = np.empty_like(distance), np.empty_like(distance)
+    for k, path in enumerate(distance):
+        t1 = _accelerate_for(path / top, tc, tau, brakes=True)
+        braking = 2.0 * (t1 - path / top)  # 2 t2
+        rest[k] = min(float(np.min(braking[1:] + slope * tc[:-1])), slope * limit)
+        t1 = _accelerate_for(path / top, tc, tau, brakes=False)
+        ending = t1 - path / top  # v_end tau / v_top
+        free[k] = min(float(np.min(ending[1:] + slope * tc[:-1])), slope * limit)
+    return Lags(weight, distance, rest, float(np.max(rest - free)))
+
+
+def _path_lengths(ax, ay, a_size, bx, by, b_size, centres, half_arc, price, travel: bool):
+    """Least path (m) from each square of A to each of B for each arc of the leg, and its
+    time at ``price`` (s/m): (len(A), len(B), arcs) each; infinite where the leg cannot make
+    progress.
+
+    ``|dp|`` is at least the distance between the squares; the angle ``beta`` between the
+    displacement and the arc at least their centres' angle less the arc's half-width and
+    the direction's spread over the squares. ``travel=False``: the arcs are headings and
+    the base may drive either way along them (the angle to the displacement's line);
+    ``travel=True``: the arcs are directions of travel (the angle on the full circle,
+    infinite path from 90 degrees)."""
     dx = np.maximum(0.0, np.maximum(bx - (ax[:, None] + a_size), ax[:, None] - (bx + b_size)))
     dy = np.maximum(0.0, np.maximum(by - (ay[:, None] + a_size), ay[:, None] - (by + b_size)))
     length = np.hypot(dx, dy)
@@ -133,15 +239,67 @@ def _drive_costs(ax, ay, a_size, bx, by, b_size, centres, half_arc, price):
     centre = np.hypot(cx, cy)
     radius = (a_size + b_size) / math.sqrt(2.0)
     ratio = np.clip(radius / np.maximum(centre, 1e-300), 0.0, 1.0)
-    spread = np.where(centre > radius, np.arcsin(ratio), 0.5 * math.pi)
+    spread = np.where(centre > radius, np.arcsin(ratio), math.pi)
     direction = np.arctan2(cy, cx)
-    line = circular(centres, direction[:, :, None])
-    line = np.minimum(line, math.pi - line)  # forwards or backwards along the line
-    beta = np.clip(line - half_arc - spread[:, :, None], 0.0, 0.5 * math.pi)
-    cos = np.cos(beta)
-    with np.errstate(divide="ignore"):
-        cost = price * length[:, :, None] / cos
-    return np.where(length[:, :, None] > 0.0, cost, 0.0)
+    angle = circular(centres, direction[:, :, None])
+    if not travel:
+        angle = np.minimum(angle, math.pi - angle)  # forwards or backwards along the line
+    beta = np.maximum(angle - half_arc - spread[:, :, None], 0.0)
+    moving = length[:, :, None] > 0.0
+    possible = beta < 0.5 * math.pi
+    cos = np.where(possible, np.cos(np.minimum(beta, 0.5 * math.pi)), 1.0)
+    with np.errstate(invalid="ignore"):
+        path = np.where(moving, np.where(possible, length[:, :, None] / cos, np.inf), 0.0)
+        # the time as the force budget alone has always computed it, price * length / cos
+        drive = np.where(moving, np.where(possible, price * length[:, :, None] / cos, np.inf), 0.0)
+    return path, drive
+
+
+def opposite(cost: np.ndarray) -> np.ndarray:
+    """``min(cost[:, j], cost[:, j + arcs / 2])``: a heading and its reverse as one."""
+    return np.minimum(cost, np.roll(cost, cost.shape[1] // 2, axis=1))
+
+
+# the programme's states: (kind, charged). kind "line": the leg's heading nearest the line
+# of its displacement, the base possibly reversing in the leg; "travel": the leg's direction
+# of travel nearest its displacement, no reversal in the leg. charged: the open stretch
+# (since the last reversal) has been charged the lag of one of its legs.
+State = tuple[str, bool]
+
+
+def _entries(
+    states: dict[State, np.ndarray], turn_step: float, first: bool, kinds: tuple[str, ...]
+) -> dict[State, np.ndarray]:
+    """The least cost of entering the next leg at each of its arcs, per kind and charge,
+    the turn from the last leg's arc included (``turn_step`` per arc). Between two legs
+    without a reversal the direction of travel turns as the heading does, and headings turn
+    as headings; from a heading to a direction of travel either sign is possible
+    (``opposite``). ``first``: the states are the start's, its turn already in the cost."""
+    out: dict[State, np.ndarray] = {}
+    for (kind, charged), cost in states.items():
+        for target in kinds:
+            source = cost if kind == target else opposite(cost)
+            entry = source if first else turn_transform(source, turn_step)
+            key = (target, charged)
+            out[key] = entry if key not in out else np.minimum(out[key], entry)
+    return out
+
+
+def _leg_costs(entries, drive, charge, kind: str, stops: bool) -> dict[State, np.ndarray]:
+    """Each state's cost at the leg's end over (start cells, end cells, arcs), before the
+    least over the start cells: the entry, the drive, and the lag charged (module
+    docstring). A leg without a reversal lies in the open stretch, which is charged the
+    leg's lag unless it has been. A leg with reversals closes the open stretch and opens a
+    new one: if the open stretch was charged, nothing is and the new one opens uncharged;
+    if not, the leg's lag is charged and the new one counts as charged."""
+    uncharged = entries[(kind, False)]
+    if not stops:
+        return {(kind, False): uncharged[:, None, :] + drive}
+    charged = entries.get((kind, True), np.full_like(uncharged, np.inf))  # none at the start
+    paying = uncharged[:, None, :] + drive + charge
+    if kind == "travel":
+        return {("travel", True): np.minimum(paying, charged[:, None, :] + drive)}
+    return {("line", True): paying, ("line", False): charged[:, None, :] + drive}
 
 
 def budget_bound(
@@ -152,32 +310,95 @@ def budget_bound(
     cell: float = 0.05,
     arcs: int = 180,
     chunk: int = 24,
+    rotation_weight: float = 1.0,
 ) -> Bound:
     """A lower bound (s) on the time to take the end effector through ``waypoints`` in
     order from the base pose ``start`` (x, y, heading) at rest (module docstring).
 
-    ``cell``: side (m) of the position cells; ``arcs``: heading arcs over the circle;
-    ``chunk``: start cells per block (memory)."""
+    ``cell``: side (m) of the position cells; ``arcs``: heading arcs over the circle (an
+    even number); ``chunk``: start cells per block (memory); ``rotation_weight``: the
+    weight ``lam`` in [0, 1] of the rotation's budget against the stops' lag (1: the
+    force budget alone)."""
     began = time.perf_counter()
+    weight = check_range("rotation_weight", rotation_weight, 0.0, 1.0)
+    if arcs < 2 or arcs % 2:
+        raise ParameterError(f"arcs must be an even integer >= 2 (got {arcs})")
+    stops = weight < 1.0
+    kinds = ("line", "travel") if stops else ("line",)
     prices = Prices.from_robot(robot, tolerance)
+    lags = Lags.from_robot(robot, weight) if stops else None
     width = TWO_PI / arcs
     centres = -math.pi + width * (0.5 + np.arange(arcs))
     half = 0.5 * width
-    # layer 0: the start exactly; its heading X_0 is start[2] exactly
+    turn = weight * prices.turn
+    # layer 0: the start exactly; its heading is start[2] exactly
     ax, ay, a_size = np.array([start[0]]), np.array([start[1]]), 0.0
-    entry = (prices.turn * np.maximum(0.0, circular(start[2], centres) - half))[None, :]
-    cost = None
-    for w in waypoints:
+    heading = turn * np.maximum(0.0, circular(start[2], centres) - half)
+    states: dict[State, np.ndarray] = {("line", False): heading[None, :]}
+    for index, w in enumerate(waypoints):
+        entries = _entries(states, turn * width, index == 0, kinds)
         bx, by = disc_cells(w, prices.reach, cell)
-        cost = np.full((bx.size, arcs), np.inf)
+        states = {}
         for first in range(0, ax.size, chunk):
             rows = slice(first, first + chunk)
-            drive = _drive_costs(
-                ax[rows], ay[rows], a_size, bx, by, cell, centres, half, prices.drive
-            )
-            np.minimum(cost, np.min(entry[rows][:, None, :] + drive, axis=0), out=cost)
-        # the next leg's entry: the least over this leg's arc of the cost plus the turn
-        entry = turn_transform(cost, prices.turn * width)
+            block = {key: entry[rows] for key, entry in entries.items()}
+            for kind in kinds:
+                path, drive = _path_lengths(
+                    ax[rows],
+                    ay[rows],
+                    a_size,
+                    bx,
+                    by,
+                    cell,
+                    centres,
+                    half,
+                    prices.drive,
+                    kind == "travel",
+                )
+                charge = lags.at_rest(path) if stops else 0.0
+                for key, cost in _leg_costs(block, drive, charge, kind, stops).items():
+                    least = np.min(cost, axis=0)
+                    states[key] = least if key not in states else np.minimum(states[key], least)
         ax, ay, a_size = bx, by, cell
-    value = float(np.min(cost))
+    # the last stretch ends free: its charge was the rest-to-rest lag
+    end = lags.free_excess if stops else 0.0
+    value = min(
+        float(np.min(cost)) - (end if charged else 0.0) for (_, charged), cost in states.items()
+    )
     return Bound(value, int(ax.size), arcs, time.perf_counter() - began)
+
+
+#: The weights ``lam`` the stop-pricing bound is solved at, and its cells (m) and arcs:
+#: the bound peaks near ``lam`` = 0.4-0.6 on seed 0's scenarios 5-20, and is coarser
+#: than the force budget's own grid because it costs about five times as much per cell.
+STOP_WEIGHTS = (0.4, 0.6)
+STOP_GRID = (0.07, 120)
+#: The force budget's own cells (m) and arcs.
+BUDGET_GRID = (0.05, 144)
+
+
+def lower_bound(
+    robot: Robot,
+    waypoints,
+    tolerance: float = 0.01,
+    grid: tuple[float, int] = BUDGET_GRID,
+    stop_weights: tuple[float, ...] = STOP_WEIGHTS,
+    stop_grid: tuple[float, int] = STOP_GRID,
+) -> Bound:
+    """The best of :func:`budget_bound` on ``grid`` (cell in m, arcs) and the stop-pricing
+    bounds at ``stop_weights`` on ``stop_grid`` (s); each is a lower bound, so is their
+    greatest. ``cells`` and ``arcs`` are the winner's; the wall time is the sum."""
+    bounds = [budget_bound(robot, waypoints, tolerance=tolerance, cell=grid[0], arcs=grid[1])]
+    for weight in stop_weights:
+        bounds.append(
+            budget_bound(
+                robot,
+                waypoints,
+                tolerance=tolerance,
+                cell=stop_grid[0],
+                arcs=stop_grid[1],
+                rotation_weight=weight,
+            )
+        )
+    best = max(bounds, key=lambda bound: bound.value)
+    return Bound(best.value, best.cells, best.arcs, sum(bound.wall_s for bound in bounds))

@@ -54,12 +54,13 @@ MARKER = "summary.json"
 DESCRIPTION = """\
 Bracket the minimum time of the thesis scenarios (5 waypoints, 0.01 m, the thesis plant's
 force limits, S >= 1.25, start at rest in the default pose): a best-known time, a
-systematic multistart of the minimum-time OCP replayed open-loop on the thesis plant, and a
-true lower bound, a relaxation solved to global optimality (docs/mpc.md, "The physical
-limit, bracketed"). Writes bounds.csv (scenario, lower_bound_s, best_known_s, starts,
-spread_s, replay_ok) and summary.json into --out, and prints the means. Results are cached
-per scenario in --out/cache as they come: an interrupted run started again with the same
---out resumes. A scenario takes about 1-3 minutes on one core."""
+systematic multistart of the minimum-time OCP replayed open-loop on the thesis plant, and
+a true lower bound, the wheels' force budget with the base's stops priced, a relaxation
+solved to global optimality (docs/mpc.md, "The physical limit, bracketed"). Writes
+bounds.csv (scenario, lower_bound_s, best_known_s, starts, spread_s, replay_ok) and
+summary.json into --out, and prints the means. Results are cached per scenario in
+--out/cache as they come: an interrupted run started again with the same --out resumes. A
+scenario takes about 1-3 minutes on one core."""
 
 EPILOG = """\
 Bad input prints one line and exits with status 2, leaving no output behind. The scenario
@@ -111,8 +112,8 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--lower-only",
         action="store_true",
-        help="compute only the lower bounds (seconds per scenario); best-known times are "
-        "taken from the cache where there (same settings), else left empty",
+        help="compute only the lower bounds (about 25 s per scenario); best-known times are "
+        "taken from the cache where there (same settings), else NaN",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     return parser
@@ -198,13 +199,21 @@ def _main(argv: Sequence[str] | None = None) -> int:
                     write_atomic(staging / name, (target / name).read_bytes())
         write_atomic(staging / "bounds.csv", batch.bounds_csv(rows))
         write_atomic(staging / MARKER, json.dumps(json_safe(summary), indent=2) + "\n")
-    print(
-        f"{len(rows)} scenarios: lower bound {summary['mean_lower_bound_s']:.2f} s, best known "
-        f"{summary['mean_best_known_s']:.2f} s (replayed {summary['replay_ok']}), bracket "
-        f"width {summary['mean_width']:.3f} (mean of best known / lower bound)"
-    )
+    print(summary_line(len(rows), summary))
     print(f"wrote {target}", file=sys.stderr)
     return 0
+
+
+def summary_line(count: int, summary: dict) -> str:
+    """The one line the tool prints: the means, and the bracket where both ends are known
+    (``--lower-only`` leaves the best-known times to a later run)."""
+    line = f"{count} scenarios: lower bound {summary['mean_lower_bound_s']:.2f} s"
+    if summary["replay_ok"] == 0 or not math.isfinite(summary["mean_best_known_s"]):
+        return line + ", no best-known time yet (run without --lower-only for them)"
+    return line + (
+        f", best known {summary['mean_best_known_s']:.2f} s (replayed {summary['replay_ok']}), "
+        f"bracket width {summary['mean_width']:.3f} (mean of best known / lower bound)"
+    )
 
 
 def _solve_all(
