@@ -120,3 +120,39 @@ def test_readme_tools_table_gives_each_tool_s_time():
         cell = row.split(" | ")[column]
         assert any(unit in cell for unit in (" s ", " s", " min")), (tool, cell)
     assert "`make test` (the whole suite)" in text
+
+
+@pytest.mark.parametrize(
+    ("tool", "argv", "message"),
+    [
+        (
+            track,
+            ["--method", "pi", "--method", "ats", "--traj", "ellipse"],
+            "argument --method: given more than once (first 'pi', then 'ats'); give it once",
+        ),
+        (
+            track,
+            ["--traj", "ellipse", "--traj", "rectangle"],
+            "argument --traj: given more than once (first 'ellipse', then 'rectangle')",
+        ),
+        (scenarios, ["--n", "2", "--n", "3"], "argument --n: given more than once"),
+        (compare, ["--jobs", "1", "--jobs", "2"], "argument --jobs: given more than once"),
+        (bench, ["--repeats", "1", "--repeats", "2"], "argument --repeats: given more than"),
+    ],
+)
+def test_a_repeated_single_valued_option_is_refused(tmp_path, capsys, tool, argv, message):
+    """Audit: a repeated --traj or --method silently used the last value (a repeated
+    --option was refused); every tool's parser now refuses it, in one line, exit 2."""
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as info:
+        tool.main([*argv, "--out", str(out)])
+    assert info.value.code == 2 and not out.exists()
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and message in err and "Traceback" not in err
+
+
+def test_repeatable_options_still_repeat():
+    args = track.build_parser().parse_args(["--option", "tau=0.3", "--option", "damping=0.1"])
+    assert args.option == ["tau=0.3", "damping=0.1"]
+    args = compare.build_parser().parse_args(["--methods", "pi", "--methods", "ats"])
+    assert args.methods == ["pi", "ats"]

@@ -73,3 +73,15 @@ def test_a_zero_cost_weight_of_the_mpc_runs(tmp_path, capsys):
     assert [(r["method"], r["steps"], r["mpc_fallbacks"]) for r in rows] == [("mpc", "10", "0")]
     assert float(rows[0]["end_position_error_m"]) > float(rows[0]["initial_offset_m"])
     assert "mpc on ellipse" in capsys.readouterr().out  # listed among the untracked
+
+
+def test_a_requested_study_that_cannot_run_is_named_on_stderr(tmp_path, capsys):
+    """Audit: --study corners --only ellipse exited 0 with "studies: none" and no word."""
+    out = tmp_path / "report"
+    argv = ["--methods", "ats", "--study", "corners", "--only", "ellipse", "--duration", "0.5"]
+    assert main([*argv, "--jobs", "1", "--no-progress", "--out", str(out)]) == 0
+    err = capsys.readouterr().err
+    assert (
+        "note: study corners skipped: it needs the rectangle trajectory, which is not compared "
+        "(trajectories: ellipse)\n" in err
+    )

@@ -20,9 +20,13 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from ddwmmr.cli.bench import build_parser as bench_parser
 from ddwmmr.cli.bench import main as bench_main
+from ddwmmr.cli.compare import build_parser as compare_parser
 from ddwmmr.cli.compare import main as compare_main
+from ddwmmr.cli.scenarios import build_parser as scenarios_parser
 from ddwmmr.cli.scenarios import main as scenarios_main
+from ddwmmr.cli.track import build_parser as track_parser
 from ddwmmr.cli.track import main as track_main
 from ddwmmr.errors import MAX_SCENARIOS, MAX_STEPS
 
@@ -325,10 +329,30 @@ def expand(args: list[str], names: dict[str, str]) -> list[str]:
     return out
 
 
+def with_base(tool: str, args: list[str]) -> list[str]:
+    """BASE[tool] without the options that take one value and ``args`` gives itself: the
+    tools refuse such an option given twice."""
+    parser = {
+        "track": track_parser,
+        "compare": compare_parser,
+        "scenarios": scenarios_parser,
+        "bench": bench_parser,
+    }[tool]()
+    given = {arg.split("=")[0] for arg in args if arg.startswith("--")}
+    base, kept, i = BASE[tool], [], 0
+    while i < len(base):
+        action = parser._option_string_actions[base[i]]
+        width = 1 + (action.nargs != 0)  # BASE gives one value per option (or none)
+        if not (base[i] in given and type(action).__name__ == "_StoreOnce"):
+            kept += base[i : i + width]
+        i += width
+    return kept
+
+
 def run_bad(tool: str, args: list[str], capsys) -> tuple[int, str]:
     """Run ``tool`` with BASE + args (+ --out out unless given); status and stderr."""
     extra = [] if "--out" in args else ["--out", "out"]
-    base = [] if "--rerun" in args else BASE[tool]  # a rerun takes no simulation options
+    base = [] if "--rerun" in args else with_base(tool, args)  # a rerun takes no options
     try:
         status = MAINS[tool]([*base, *args, *extra])
     except SystemExit as exc:  # argparse's own errors
@@ -434,7 +458,7 @@ def test_any_mistyped_or_absurd_robot_value_is_refused(workdir, capsys, key, val
 )
 def test_as_a_module_one_line_and_no_traceback(workdir, tool, args):
     done = subprocess.run(
-        [sys.executable, "-m", f"ddwmmr.{tool}", *BASE[tool], *expand(args, workdir)],
+        [sys.executable, "-m", f"ddwmmr.{tool}", *with_base(tool, args), *expand(args, workdir)],
         capture_output=True,
         text=True,
         timeout=120,

@@ -233,8 +233,8 @@ def test_force_without_a_snapshot_is_refused(capsys, no_window):
 @pytest.mark.parametrize(
     ("dpi", "message"),
     [
-        ("inf", "dpi must be a finite number (got inf)"),
-        ("nan", "dpi must be a finite number (got nan)"),
+        ("inf", "dpi must be a finite number in [10, 600] (got inf)"),
+        ("nan", "dpi must be a finite number in [10, 600] (got nan)"),
         ("1e9", "dpi must be in [10, 600] (got 1e+09)"),
         ("1e-9", "dpi must be in [10, 600] (got 1e-09)"),
         ("0", "dpi must be in [10, 600] (got 0)"),
@@ -262,12 +262,12 @@ def test_dpi_range_ends_are_allowed():
         (["--traj", "figure8", "--T", "1e-9"], "T must be in [1e-06, 1e+09] s (got 1e-09)"),
         (["--traj", "figure8", "--N", "2e6"], "N must be an integer in [2, 1000000]"),
         (["--T", "-1"], "T must be > 0 (got -1)"),
-        (["--b", "inf"], "b must be a finite number (got inf)"),
-        (["--duration", "inf"], "duration must be a finite number (got inf)"),
+        (["--b", "inf"], "b must be a finite number > 0 (got inf)"),
+        (["--duration", "inf"], "duration must be a finite number > 0 (got inf)"),
         (["--duration", "-1"], "duration must be > 0 (got -1)"),
-        (["--dt", "nan"], "dt must be a finite number (got nan)"),
+        (["--dt", "nan"], "dt must be a finite number > 0 (got nan)"),
         (["--payload", "1e300"], "payload must be in [0, 100000] kg"),
-        (["--offset", "nan", "0"], "offset must be a finite number (got nan)"),
+        (["--offset", "nan", "0"], "offset must be a finite number in [-0.65, 0.65] m"),
     ],
 )
 def test_bad_numbers_are_refused_before_the_run(argv, message, tmp_path, capsys, no_window):

@@ -157,3 +157,48 @@ def test_the_thesis_controller_takes_the_batch_s_options():
     plant = make_scenario_plant(robot, config)
     controller = make_scenario_controller(robot, scenario, config, plant)
     assert controller.behaviours["stability"].adjust == 0.3
+
+
+@pytest.mark.parametrize(
+    ("method", "option", "message"),
+    [
+        ("pi", "damping=nan", "error: damping must be a finite number > 0 (got nan)"),
+        ("ats", "damping=nan", "error: damping must be a finite number > 0 (got nan)"),
+        ("qp", "speed_budget=nan", "error: speed_budget must be two numbers > 0, (v_top m/s"),
+        ("qp", "obstacle_margin=nan", "error: obstacle_margin must be a finite number >= 0"),
+        ("qp", "stability_min=nan", "error: stability_min must be a finite number > 0 (got nan)"),
+        ("mpc", "intervals=nan", "error: intervals must be an integer in [2, 200] (got nan)"),
+    ],
+)
+def test_a_nan_option_names_the_allowed_range(tmp_path, capsys, method, option, message):
+    """Audit: ``--option damping=nan`` said only "must be a number (got 'nan')"."""
+    out = tmp_path / "out"
+    argv = ["--method", method, "--traj", "ellipse", "--duration", "0.2", "--no-plots"]
+    assert track([*argv, "--out", str(out), "--option", option]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(message) and err.count("\n") == 1 and not out.exists()
+
+
+@pytest.mark.parametrize("value", ["-1", "0", "0.001", "1e9", "nan", "inf"])
+def test_scenarios_refuse_an_adjust_outside_its_range(tmp_path, capsys, value):
+    """Audit: the thesis controller took ``adjust=-1`` (drives away from the end effector)
+    and ``adjust=1e9`` (a drive target across the world)."""
+    from ddwmmr.cli.scenarios import main as scenarios
+
+    out = tmp_path / "out"
+    argv = ["--n", "1", "--no-progress", "--out", str(out), "--option", f"adjust={value}"]
+    assert scenarios(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and not out.exists()
+    assert err.startswith("error: adjust must be ") and "in [0.01, 5] m" in err
+
+
+def test_the_thesis_controller_takes_adjust_at_the_ends_of_its_range():
+    from ddwmmr.controllers import make_controller
+    from ddwmmr.thesis_controller import ADJUST_RANGE_M
+
+    assert ADJUST_RANGE_M == (0.01, 5.0)
+    for adjust in ADJUST_RANGE_M:
+        controller = make_controller("thesis", adjust=adjust)
+        assert controller.behaviours["manipulability"].adjust == adjust
+        assert controller.behaviours["stability"].adjust == adjust

@@ -171,3 +171,54 @@ def test_mpc_with_the_fewest_intervals_runs_its_scenarios(tmp_path):
     assert row["reason"] == "timeout" and row["sim_steps"] == "100"
     options = json.loads((out / "summary.json").read_text())["controller_options"]
     assert options["intervals"] == 2
+
+
+def _bounds_file(folder, header: str, rows: list[str]) -> str:
+    """A bounds.csv (with its summary.json: seed 0, the default payload) in ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "bounds.csv").write_text("\n".join([header, *rows]) + "\n")
+    (folder / "summary.json").write_text(json.dumps({"seed": 0, "payload": 3.0}))
+    return str(folder / "bounds.csv")
+
+
+BOUNDS_HEADER = "scenario,lower_bound_s,best_known_s,replay_ok"
+
+
+@pytest.mark.parametrize(
+    ("header", "rows", "message"),
+    [
+        (
+            BOUNDS_HEADER,
+            ["50,10,12,True"],
+            "covers none of the run's scenarios 1-2 (it has scenarios 50); "
+            "python -m ddwmmr.bounds --scenarios 1-2 makes them",
+        ),
+        (BOUNDS_HEADER, [], "covers none of the run's scenarios 1-2 (it has no scenario rows)"),
+        (
+            "scenario,lower,best",
+            ["1,10,12"],
+            "lacks the columns lower_bound_s, best_known_s, replay_ok (a bounds.csv of ",
+        ),
+        ("scenario,lower_bound_s,best_known_s", ["1,10,12"], "lacks the column replay_ok ("),
+    ],
+)
+def test_a_bounds_file_that_cannot_serve_the_run_is_refused(
+    tmp_path, tmp_path_factory, header, rows, message
+):
+    """Audit: a bounds file of other scenarios printed "ratio ... nan"; one with other
+    columns "cannot read ... ('replay_ok')" (a raw KeyError)."""
+    path = _bounds_file(tmp_path_factory.mktemp("bounds"), header, rows)
+    line = bad_scenarios_run(tmp_path, ["--n", "2", "--no-progress", "--bounds", path])
+    assert line.startswith(f"error: bounds: {path} {message}")
+
+
+def test_a_bounds_ratio_without_a_scenario_says_why(tmp_path, tmp_path_factory, capsys):
+    """The bounds cover the run's scenario but give it no best-known time (replay failed):
+    that ratio is explained, not printed as nan."""
+    path = _bounds_file(tmp_path_factory.mktemp("bounds"), BOUNDS_HEADER, ["1,10,12,False"])
+    assert cli(["--n", "1", "--no-progress", "--out", str(tmp_path / "r"), "--bounds", path]) == 0
+    out = capsys.readouterr().out
+    assert "nan" not in out
+    why = "to the best-known time none (no successful scenario has a best-known time in the "
+    assert why in out
+    assert "mean ratio to the lower bound " in out

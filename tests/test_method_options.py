@@ -72,3 +72,29 @@ def test_mro_walk_most_derived_default_wins(registered):
     assert make_controller("tmp-child", a=7.0).a == 7.0
     with pytest.raises(ParameterError, match="unknown option 'kwargs'"):
         make_controller("tmp-child", kwargs=1)
+
+
+@pytest.mark.parametrize("method", [*available_methods(), "thesis"])
+def test_a_non_finite_option_is_refused_naming_its_range(method):
+    """Audit: ``damping=nan`` was refused as "must be a number (got 'nan')", with no range;
+    qp's obstacle_margin took nan. Every number option of every method now refuses nan
+    (and inf, where inf is not a documented value) with the allowed range in the message."""
+    import math
+    import re
+
+    from ddwmmr.controllers.option_specs import option_specs, parse_option
+
+    range_words = re.compile(r"[<>]=? ?\d|\bin [\[(]|integer in")
+    for spec in option_specs(method):
+        if spec.kind != "number":
+            continue
+        for text in ("nan", "inf"):
+            name, value = parse_option(method, f"{spec.name}={text}")
+            if text == "inf" and spec.name == "tau":
+                continue  # inf disables a channel (documented)
+            with pytest.raises(ParameterError) as info:
+                make_controller(method, **{name: value})
+            message = str(info.value)
+            assert "\n" not in message and message.replace(" ", "_").startswith(spec.name)
+            assert range_words.search(message), (spec.name, message)
+            assert f"(got {text})" in message and not math.isfinite(float(text))

@@ -60,7 +60,7 @@ class ParameterError(ValueError):
 
 def check_positive(name: str, value: float) -> float:
     """Return ``value`` as float if it is finite and > 0, else raise :class:`ParameterError`."""
-    value = _as_float(name, value)
+    value = _as_float(name, value, "> 0")
     if not value > 0.0:
         raise ParameterError(f"{name} must be > 0 (got {value:g})")
     return value
@@ -68,22 +68,23 @@ def check_positive(name: str, value: float) -> float:
 
 def check_nonnegative(name: str, value: float) -> float:
     """Return ``value`` as float if it is finite and >= 0, else raise :class:`ParameterError`."""
-    value = _as_float(name, value)
+    value = _as_float(name, value, ">= 0")
     if not value >= 0.0:
         raise ParameterError(f"{name} must be >= 0 (got {value:g})")
     return value
 
 
-def check_finite(name: str, value: float) -> float:
-    """Return ``value`` as float if it is finite, else raise :class:`ParameterError`."""
-    return _as_float(name, value)
+def check_finite(name: str, value: float, allowed: str = "") -> float:
+    """Return ``value`` as float if it is finite, else raise :class:`ParameterError`;
+    ``allowed`` (e.g. ``"> 0"``), the range the caller checks next, completes the message."""
+    return _as_float(name, value, allowed)
 
 
 def check_range(name: str, value: float, low: float, high: float, unit: str = "") -> float:
     """Return ``value`` as float if ``low <= value <= high`` (finite), else raise."""
-    value = _as_float(name, value)
+    suffix = f" {unit}" if unit else ""
+    value = _as_float(name, value, f"in [{low:g}, {high:g}]{suffix}")
     if not low <= value <= high:
-        suffix = f" {unit}" if unit else ""
         raise ParameterError(f"{name} must be in [{low:g}, {high:g}]{suffix} (got {value:g})")
     return value
 
@@ -145,19 +146,21 @@ def check_number_type(name: str, value: Any) -> Any:
     return value
 
 
-def _as_float(name: str, value: float) -> float:
+def _as_float(name: str, value: float, allowed: str = "") -> float:
     # Strings and booleans are not numbers here, even though float() accepts them: a file
-    # saying N = "2000" or L1 = true is a mistake worth reporting.
+    # saying N = "2000" or L1 = true is a mistake worth reporting. ``allowed`` (e.g.
+    # "> 0") completes the message of a non-finite value, so that it names the range too.
+    finite = f"a finite number {allowed}" if allowed else "a finite number"
     if isinstance(value, bool | np.bool_ | str | bytes):
         raise ParameterError(f"{name} must be a number (got {shown(value)})")
     try:
         number = float(value)
     except OverflowError:  # an integer beyond a float: as infinite as float("inf")
-        raise ParameterError(f"{name} must be a finite number (got {shown(value)})") from None
+        raise ParameterError(f"{name} must be {finite} (got {shown(value)})") from None
     except (TypeError, ValueError):
         raise ParameterError(f"{name} must be a number (got {shown(value)})") from None
     if not math.isfinite(number):
-        raise ParameterError(f"{name} must be a finite number (got {shown(value)})")
+        raise ParameterError(f"{name} must be {finite} (got {shown(value)})")
     return number
 
 

@@ -54,12 +54,19 @@ from ddwmmr.behaviours.obstacle import ObstacleAvoidance
 from ddwmmr.behaviours.stability import Stability
 from ddwmmr.commands import FORCE, WheelForces
 from ddwmmr.controllers.base import WaypointRun, register_controller
+from ddwmmr.errors import check_range
 from ddwmmr.model import Robot
 
 #: Actuator command: (left wheel force N, right wheel force N, th1 target rad, th2 target rad).
 Actuation = tuple[float, float, float, float]
 #: Blending path: a behaviour's hold point is latched at this share and released below RELEASE.
 ENGAGE, RELEASE = 0.1, 0.05
+#: Allowed range (m) of ``adjust``, how far ahead of or behind the base the manipulability
+#: and stability behaviours put their drive target (the thesis: 0.5 m). 0 would stop
+#: the behaviours and a negative value reverse them (away from the end effector); below
+#: 1 cm (the scenarios' waypoint tolerance) the base hardly moves, and beyond 5 m (more
+#: than the scenarios' arena half-width, 4 m) it drives off across the arena.
+ADJUST_RANGE_M = (0.01, 5.0)
 
 
 @register_controller("thesis", tasks=("waypoints",), interfaces=("force",), arbiter=True)
@@ -72,7 +79,8 @@ class ThesisController:
             :class:`StateMachineArbiter` with its thresholds.
         obstacles: ``(x, y, radius)`` circles (m); adds the obstacle-avoidance behaviour.
         gains: PD gains (thesis Table 4.2).
-        adjust: base displacement target of the manipulability/stability behaviours (m).
+        adjust: base displacement target of the manipulability/stability behaviours (m),
+            in :data:`ADJUST_RANGE_M` (0.01 to 5 m).
     """
 
     #: Loop contract: wheel forces out, measured (v, w) in, one call per control step.
@@ -90,6 +98,7 @@ class ThesisController:
         adjust: float = 0.5,
     ) -> None:
         self.robot = robot
+        adjust = check_range("adjust", adjust, *ADJUST_RANGE_M, "m")
         self.arbiter: Arbiter = arbiter if arbiter is not None else StateMachineArbiter()
         self.behaviours: dict[str, Behaviour] = {
             "objective": Objective(robot),

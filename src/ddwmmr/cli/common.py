@@ -24,7 +24,7 @@ import sys
 import threading
 from collections.abc import Callable, Iterator, Sequence
 
-from ddwmmr.errors import ParameterError, did_you_mean
+from ddwmmr.errors import ParameterError, did_you_mean, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import check_output_folder, first_free, output_folder, package_version
 
@@ -69,11 +69,34 @@ NEGATIVE_NUMBER = re.compile(
 UNRECOGNISED = "unrecognized arguments: "
 
 
+class _StoreOnce(argparse._StoreAction):
+    """argparse's ``store``, refused when its option is given a second time in one command
+    line (argparse would keep the last value without a word)."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:  # type: ignore[override]
+        given = getattr(parser, "_given", None)
+        if given is not None:
+            if self in given:
+                name = "/".join(self.option_strings) or self.dest
+                parser.error(
+                    f"argument {name}: given more than once (first {given[self]}, then "
+                    f"{_shown_values(values)}); give it once"
+                )
+            given[self] = _shown_values(values)
+        super().__call__(parser, namespace, values, option_string)
+
+
+def _shown_values(values: object) -> str:
+    items = values if isinstance(values, list) else [values]
+    return " ".join(shown(v if isinstance(v, str | int | float) else str(v)) for v in items)
+
+
 class ArgumentParser(argparse.ArgumentParser):
     """argparse with one-line errors: ``prog: error: message`` and exit status 2, and
     negative numbers in any float notation taken as values (:data:`NEGATIVE_NUMBER`);
     ``--version``; a mistyped option gets the closest one (``--methd``: "did you mean
-    --method?")."""
+    --method?"); an option that takes one value (or one group of values) given twice is
+    refused, naming it (repeatable ones, e.g. ``--option``, use ``append``/``extend``)."""
 
     #: What starts an error line (None: the parser's ``prog``).
     error_prefix: str | None = None
@@ -81,8 +104,22 @@ class ArgumentParser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
+        self._given: dict[argparse.Action, str] | None = None
         if self.add_help:
             self.add_argument("--version", action="version", version=f"ddwmmr {package_version()}")
+
+    def add_argument(self, *args, **kwargs) -> argparse.Action:  # type: ignore[override]
+        action = super().add_argument(*args, **kwargs)
+        if type(action) is argparse._StoreAction and action.option_strings:
+            action.__class__ = _StoreOnce  # the same action, refusing a second occurrence
+        return action
+
+    def parse_known_args(self, args=None, namespace=None):  # type: ignore[override]
+        outer, self._given = self._given, {}
+        try:
+            return super().parse_known_args(args, namespace)
+        finally:
+            self._given = outer
 
     def error(self, message: str) -> None:  # type: ignore[override]
         prefix = self.prog if self.error_prefix is None else self.error_prefix

@@ -47,10 +47,12 @@ from ddwmmr.errors import (
 from ddwmmr.plants import available_plants
 from ddwmmr.progress import phase
 from ddwmmr.reports.compare import (
+    CORNER_TRAJECTORY,
     DEFAULT_TRAJECTORIES,
     OFFSET_SCALES,
     STEP_SIZES,
     STUDIES,
+    STUDY_TRAJECTORY,
     TAUS,
     CompareConfig,
     ReportInfo,
@@ -508,6 +510,19 @@ def format_summary(
     return "\n".join(lines)
 
 
+def skipped_studies(config: CompareConfig, plan: Any) -> list[str]:
+    """One stderr note per requested study the plan leaves out: the trajectory it needs is
+    not among the compared ones (``--only``/``--traj``)."""
+    compared = ", ".join(config.trajectories)
+    return [
+        f"note: study {study} skipped: it needs the "
+        f"{CORNER_TRAJECTORY if study == 'corners' else STUDY_TRAJECTORY} trajectory, which "
+        f"is not compared (trajectories: {compared})"
+        for study in config.studies
+        if study not in plan.studies
+    ]
+
+
 def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     jobs = check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
@@ -517,6 +532,9 @@ def _main(argv: Sequence[str] | None) -> int:
     config = config_from_arguments(args, argv, sources)
     check_output_folder(out, "compare", args.force, ("run.json", *output_names(config)))
     plan = plan_runs(config)
+    if args.study is not None:  # studies asked for by name: say which cannot run, and why
+        for line in skipped_studies(config, plan):
+            print(line, file=sys.stderr)
     specs = plan.all_specs()
     check_runs(config, specs)
     record = run_record(config, sources, argv, jobs)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import csv
 import datetime as dt
 import json
 import math
@@ -634,17 +635,30 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     if args.bounds_table is not None:
-        b = summary["bracket"]
-        print(
-            f"mean ratio to the lower bound {b['mean_ratio_to_lower_bound']:.3f}, to the "
-            f"best-known time {b['mean_ratio_to_best_known']:.3f} ({args.bounds})"
-        )
+        print(_bracket_line(summary["bracket"], args.bounds))
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
         f"({runner.jobs} {args.executor} worker{'s' * (runner.jobs != 1)})",
         file=sys.stderr,
     )
+
+
+def _bracket_line(b: dict[str, Any], bounds: str) -> str:
+    """The printed line of ``--bounds``: both mean ratios, each with why it is missing (no
+    successful scenario with that end of its bracket) instead of a bare nan."""
+    parts = []
+    for end, key, count in (
+        ("lower bound", "mean_ratio_to_lower_bound", "scenarios_with_lower_bound"),
+        ("best-known time", "mean_ratio_to_best_known", "scenarios_with_best_known"),
+    ):
+        ratio = b[key]
+        parts.append(
+            f"{ratio:.3f}"
+            if b[count] and math.isfinite(ratio)
+            else f"none (no successful scenario has a {end} in the file)"
+        )
+    return f"mean ratio to the lower bound {parts[0]}, to the best-known time {parts[1]} ({bounds})"
 
 
 def mpc_options(config: RunConfig, scenario: Scenario) -> dict[str, Any]:
@@ -744,7 +758,43 @@ def _bounds_table(args: argparse.Namespace, config: RunConfig):
 
     if args.study or args.obstacles:
         raise ParameterError("bounds: only for the benchmark without a study or obstacles")
-    return read_bounds_file(args.bounds, args.seed, config.payload)
+    _check_bounds_columns(Path(args.bounds))
+    table = read_bounds_file(args.bounds, args.seed, config.payload)
+    if not set(table) & set(range(1, args.n + 1)):  # scenarios are numbered from 1
+        span = "1" if args.n == 1 else f"1-{args.n}"
+        run = f"scenario{'s' * (args.n > 1)} {span}"
+        held = f"scenarios {_span(table)}" if table else "no scenario rows"
+        raise ParameterError(
+            f"bounds: {args.bounds} covers none of the run's {run} (it has {held}); "
+            f"python -m ddwmmr.bounds --scenarios {span} makes them"
+        )
+    return table
+
+
+#: Columns ``--bounds`` reads from a bounds.csv of ``python -m ddwmmr.bounds``.
+BOUNDS_COLUMNS = ("scenario", "lower_bound_s", "best_known_s", "replay_ok")
+
+
+def _check_bounds_columns(path: Path) -> None:
+    """Refuse a ``--bounds`` CSV whose header lacks a column read from it, naming them
+    (files that cannot be read at all are left to :func:`read_bounds_file`)."""
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            header = next(csv.reader(handle), [])
+    except (OSError, ValueError, csv.Error):
+        return
+    missing = [c for c in BOUNDS_COLUMNS if c not in {h.strip() for h in header}]
+    if missing:
+        raise ParameterError(
+            f"bounds: {path} lacks the column{'s' * (len(missing) > 1)} {', '.join(missing)} "
+            f"(a bounds.csv of python -m ddwmmr.bounds has {', '.join(BOUNDS_COLUMNS)})"
+        )
+
+
+def _span(table: dict[int, Any]) -> str:
+    """``first-last`` of the scenario numbers of a bounds table (``n`` if only one)."""
+    first, last = min(table), max(table)
+    return str(first) if first == last else f"{first}-{last}"
 
 
 def _main(argv: Sequence[str] | None = None) -> int:

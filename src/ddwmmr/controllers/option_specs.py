@@ -142,14 +142,14 @@ class OptionSpec:
             numbers = [float(part) for part in re.split(r"[\s,]+", text) if part]
         except ValueError:
             raise ParameterError(f"{self.name} must be a number (got {shown(text)})") from None
-        if any(math.isnan(v) for v in numbers):
-            raise ParameterError(f"{self.name} must be a number (got {shown(text)})")
         if len(numbers) > 1:
             if not self.several:
                 raise ParameterError(f"{self.name} takes one number (got {shown(text)})")
             return tuple(numbers)
         (value,) = numbers
         if isinstance(self.default, int) and not isinstance(self.default, bool):
+            if not math.isfinite(value):  # the method's check names the allowed range
+                return value
             if not value.is_integer():
                 raise ParameterError(f"{self.name} must be an integer (got {shown(text)})")
             return int(value)

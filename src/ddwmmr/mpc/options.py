@@ -260,7 +260,9 @@ class MPCOptions:
             if model == "kinematic":
                 raise ParameterError("wheel_force_limit needs model='thesis'")
         if self.brake_slack is not None:
-            brake = check_finite("brake_slack", self.brake_slack)
+            brake = check_finite(
+                "brake_slack", self.brake_slack, "equal to 0 (off) or in [0.0001, 1] m"
+            )
             if brake != 0.0 and not 1e-4 <= brake <= 1.0:
                 raise ParameterError(
                     f"brake_slack must be 0 (off) or in [0.0001, 1] m (got {self.brake_slack:g})"

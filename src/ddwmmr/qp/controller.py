@@ -56,7 +56,7 @@ from ddwmmr.controllers.base import (
     step_results,
 )
 from ddwmmr.controllers.inputs import check_inputs
-from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
+from ddwmmr.errors import ParameterError, check_bool, check_nonnegative, check_positive, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import whole_turns
 from ddwmmr.model.stability import STABILITY_FLOOR
@@ -207,6 +207,8 @@ class QPController:
         check_bool("track_orientation", track_orientation)
         self.backend = self._make_backend(solver, warm_start)
         self.obstacles = as_circles(obstacles)
+        # checked without obstacles too: a bad margin is a mistake whatever the scene
+        obstacle_margin = check_nonnegative("obstacle_margin", obstacle_margin)
         if heading_weight is None:
             heading_weight = 0.0 if track_orientation else 1.0
         linear, angular = demand_limits(robot)

@@ -59,7 +59,7 @@ _SQRT2 = math.sqrt(2.0)
 def check_damping(damping: float) -> float:
     """``damping`` as a float if it is finite and > 0, else a one-line ParameterError
     (undamped, the inverse is unbounded at the singularity, ``cos th1 = 0``)."""
-    value = check_finite("damping", damping)
+    value = check_finite("damping", damping, "> 0")
     if not value > 0.0:
         raise ParameterError(
             f"damping must be > 0 (got {value:g}): undamped, the inverse is unbounded at "
