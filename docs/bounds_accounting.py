@@ -174,10 +174,11 @@ def figure() -> None:
     labels, stacks, bounds = [], [], []
     for seed in seeds():
         means, lower = read(seed)
+        priced = stop_priced_bound(seed)
         for name, label in TRAJECTORIES.items():
             m = means[name]
             labels.append(f"seed {seed}: {label}")
-            bounds.append(stop_priced_bound(seed))
+            bounds.append(priced)
             stacks.append(
                 [
                     lower,

@@ -52,14 +52,14 @@ def parts(job: tuple[int, int]) -> dict[str, float]:
 
 
 def write_csv(path: Path, header: list[str], rows: list[dict]) -> None:
-    """Write ``rows`` to ``path`` through a temporary file (never half-written)."""
+    """Write ``rows`` to ``path`` atomically (never half-written)."""
+    from ddwmmr.sim.result import write_atomic
+
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=header)  # as python -m ddwmmr.bounds writes
     writer.writeheader()
     writer.writerows(rows)
-    temporary = path.with_suffix(".tmp")
-    temporary.write_text(buffer.getvalue())
-    temporary.replace(path)
+    write_atomic(path, buffer.getvalue())
 
 
 def set_lower_bounds(seed: int, rows: list[dict]) -> None:

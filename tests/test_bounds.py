@@ -153,10 +153,8 @@ def test_lower_bound_is_below_the_analytic_time_straight_ahead():
     """3 m straight ahead, one waypoint: from rest with full force the base covers at most
     v_top (t - tau (1 - e^{-t/tau})) (tests/test_mpc.py); the bound is below that time and
     equals the driving price times the distance to the reach disc."""
-    d = sym.ThesisDynamics.from_robot(HEAVY)
-    tau, top = d.mass / d.c1, d.top_speed
     needed = 3.0 - HEAVY.reach - 0.01
-    fastest = brentq(lambda t: top * (t - tau * (1 - math.exp(-t / tau))) - needed, 0.0, 60.0)
+    fastest = _free_end_time(needed)
     bound = budget_bound(HEAVY, [(3.0, 0.0)]).value
     assert bound <= fastest
     assert bound == pytest.approx(Prices.from_robot(HEAVY).drive * needed, abs=0.04)
@@ -197,6 +195,13 @@ def _drive_constants():
     return d.mass / d.c1, d.top_speed
 
 
+def _free_end_time(path):
+    """Time (s) of the fastest drive of ``path`` (m) from rest to a free end: full force
+    throughout, ``v_top (t - tau (1 - exp(-t / tau))) = path``."""
+    tau, top = _drive_constants()
+    return brentq(lambda t: top * (t - tau * (1.0 - math.exp(-t / tau))) - path, 0.0, 60.0)
+
+
 def _bang_bang(path):
     """Time (s) of the fastest drive of ``path`` (m) from rest to rest, simulated with the
     exact step of ``m vdot + c1 v = F``: full force, then full reverse force, switching
@@ -224,13 +229,13 @@ def test_lag_at_weight_0_is_the_fastest_drive_between_stops(path):
     less ``path / v_top`` (the bang-bang drive simulated step by step), tabulated from
     below; the free-end lag less the excess stays below the closed form ``tau (1 -
     exp(-T / tau))`` of a drive at full force to the end."""
-    tau, top = _drive_constants()
+    _, top = _drive_constants()
     lags = Lags.from_robot(HEAVY, 0.0)
     simulated = _bang_bang(path) - path / top
     tabulated = float(lags.at_rest(path))
     assert tabulated <= simulated + 2e-3  # the simulation's own step
     assert simulated - tabulated < 0.02
-    free_time = brentq(lambda t: top * (t - tau * (1.0 - math.exp(-t / tau))) - path, 0.0, 60.0)
+    free_time = _free_end_time(path)
     assert tabulated - lags.free_excess <= free_time - path / top + 1e-9
     assert lags.free_excess > 0.0
 
@@ -289,11 +294,10 @@ def test_pricing_the_stops_raises_the_bound_of_a_task_that_turns_back():
     for free. Priced, the bound rises by more than half a second and stays below the
     fastest reversal (rest-to-rest to the first reach disc, then from rest to the second
     at full force), a time no trajectory that reverses can beat."""
-    tau, top = _drive_constants()
     reach = Prices.from_robot(HEAVY).reach
     waypoints = [(3.0, 0.0), (-0.5, 0.0)]
     out, back = 3.0 - reach, 3.5 - 2.0 * reach
-    free_time = brentq(lambda t: top * (t - tau * (1.0 - math.exp(-t / tau))) - back, 0.0, 60.0)
+    free_time = _free_end_time(back)
     reversal = _bang_bang(out) + free_time
     budget = budget_bound(HEAVY, waypoints, cell=0.07, arcs=120).value
     priced = budget_bound(HEAVY, waypoints, cell=0.07, arcs=120, rotation_weight=0.5).value
@@ -307,12 +311,11 @@ def test_pricing_the_stops_stays_below_a_zigzag_of_known_time():
     drives and a free-end one, a time the bound must not exceed with reversals anywhere
     inside the legs or at the waypoints. Priced, it stays below that and rises well above
     the force budget's, which reverses for free."""
-    tau, top = _drive_constants()
     tiny = dataclasses.replace(HEAVY, L1=0.01, L2=0.01)
     reach = Prices.from_robot(tiny).reach
     waypoints = [(2.0, 0.0), (0.5, 0.0), (2.5, 0.0)]
     first, back, last = 2.0 - reach, 1.5 - 2.0 * reach, 2.0 - 2.0 * reach
-    free_time = brentq(lambda t: top * (t - tau * (1.0 - math.exp(-t / tau))) - last, 0.0, 60.0)
+    free_time = _free_end_time(last)
     zigzag = _bang_bang(first) + _bang_bang(back) + free_time
     budget = budget_bound(tiny, waypoints, cell=0.05, arcs=120).value
     priced = [
@@ -327,12 +330,11 @@ def test_a_straight_run_through_several_waypoints_is_one_stretch():
     """Five waypoints 1 m apart straight ahead (the 2 cm arm): one drive at full force
     from rest, no stop. The bound charges the one stretch once, so it stays below that
     drive's analytic time (charging every leg would put it seconds above)."""
-    tau, top = _drive_constants()
     tiny = dataclasses.replace(HEAVY, L1=0.01, L2=0.01)
     reach = Prices.from_robot(tiny).reach
     waypoints = [(float(x), 0.0) for x in range(1, 6)]
     path = 5.0 - reach
-    fastest = brentq(lambda t: top * (t - tau * (1.0 - math.exp(-t / tau))) - path, 0.0, 60.0)
+    fastest = _free_end_time(path)
     budget = budget_bound(tiny, waypoints, cell=0.05, arcs=120).value
     for weight in (0.0, 0.5):
         priced = budget_bound(tiny, waypoints, cell=0.05, arcs=120, rotation_weight=weight)

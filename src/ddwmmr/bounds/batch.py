@@ -148,12 +148,25 @@ def bounds_csv(rows: list[dict[str, Any]]) -> str:
     return buffer.getvalue()
 
 
+#: The columns :func:`read_bounds` reads from a bounds.csv (of :data:`COLUMNS`).
+READ_COLUMNS = ("scenario", "lower_bound_s", "best_known_s", "replay_ok")
+
+
 def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
     """``{scenario: (lower_bound_s, best_known_s)}`` from a bounds.csv (1-based scenarios;
-    rows whose replay failed have no best-known time: NaN)."""
+    rows whose replay failed have no best-known time: NaN); a file without one of
+    :data:`READ_COLUMNS` is refused naming them (one-line :class:`ParameterError`)."""
     out = {}
     with open(path, newline="", encoding="utf-8") as handle:
-        for r in csv.DictReader(handle):
+        reader = csv.DictReader(handle)
+        missing = [c for c in READ_COLUMNS if c not in (reader.fieldnames or ())]
+        if missing:
+            raise ParameterError(
+                f"bounds: {path} lacks the column{'s' * (len(missing) > 1)} "
+                f"{', '.join(missing)} (a bounds.csv of python -m ddwmmr.bounds has "
+                f"{', '.join(READ_COLUMNS)})"
+            )
+        for r in reader:
             best = float(r["best_known_s"]) if r["replay_ok"] == "True" else math.nan
             out[int(r["scenario"])] = (float(r["lower_bound_s"]), best)
     return out
@@ -167,6 +180,8 @@ def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, t
     try:
         table = read_bounds(path)
         summary = json.loads((path.parent / "summary.json").read_text(encoding="utf-8"))
+    except ParameterError:  # already one line naming what is wrong
+        raise
     except (OSError, ValueError, KeyError) as exc:
         raise ParameterError(f"bounds: cannot read {path} and its summary.json ({exc})") from None
     if summary.get("seed") != seed or summary.get("payload") != payload:

@@ -220,20 +220,22 @@ def _lags(tau: float, top: float, weight: float) -> Lags:
     return Lags(weight, distance, rest, float(np.max(rest - free)))
 
 
-def _path_lengths(ax, ay, a_size, bx, by, b_size, centres, half_arc, price, travel: bool):
-    """Least path (m) from each square of A to each of B for each arc of the leg, and its
-    time at ``price`` (s/m): (len(A), len(B), arcs) each; infinite where the leg cannot make
-    progress.
+def _drive_costs(
+    ax, ay, a_size, bx, by, b_size, centres, half_arc, price, travel: bool, with_path: bool
+):
+    """Least driving time (s) at ``price`` (s/m) from each square of A to each of B for each
+    arc of the leg, and (``with_path``, else None: the force budget alone needs the time
+    only) the least path (m) it stands for: (len(A), len(B), arcs) each.
 
     ``|dp|`` is at least the distance between the squares; the angle ``beta`` between the
     displacement and the arc at least their centres' angle less the arc's half-width and
     the direction's spread over the squares. ``travel=False``: the arcs are headings and
-    the base may drive either way along them (the angle to the displacement's line);
-    ``travel=True``: the arcs are directions of travel (the angle on the full circle,
-    infinite path from 90 degrees)."""
+    the base may drive either way along them (the angle to the displacement's line, at
+    most 90 degrees); ``travel=True``: the arcs are directions of travel (the angle on the
+    full circle; from 90 degrees the leg cannot make progress: infinite)."""
     dx = np.maximum(0.0, np.maximum(bx - (ax[:, None] + a_size), ax[:, None] - (bx + b_size)))
     dy = np.maximum(0.0, np.maximum(by - (ay[:, None] + a_size), ay[:, None] - (by + b_size)))
-    length = np.hypot(dx, dy)
+    length = np.hypot(dx, dy)[:, :, None]
     cx = bx + 0.5 * b_size - (ax[:, None] + 0.5 * a_size)
     cy = by + 0.5 * b_size - (ay[:, None] + 0.5 * a_size)
     centre = np.hypot(cx, cy)
@@ -244,15 +246,18 @@ def _path_lengths(ax, ay, a_size, bx, by, b_size, centres, half_arc, price, trav
     angle = circular(centres, direction[:, :, None])
     if not travel:
         angle = np.minimum(angle, math.pi - angle)  # forwards or backwards along the line
-    beta = np.maximum(angle - half_arc - spread[:, :, None], 0.0)
-    moving = length[:, :, None] > 0.0
-    possible = beta < 0.5 * math.pi
-    cos = np.where(possible, np.cos(np.minimum(beta, 0.5 * math.pi)), 1.0)
-    with np.errstate(invalid="ignore"):
-        path = np.where(moving, np.where(possible, length[:, :, None] / cos, np.inf), 0.0)
-        # the time as the force budget alone has always computed it, price * length / cos
-        drive = np.where(moving, np.where(possible, price * length[:, :, None] / cos, np.inf), 0.0)
-    return path, drive
+    beta = np.clip(angle - half_arc - spread[:, :, None], 0.0, 0.5 * math.pi)
+    cos = np.cos(beta)
+    moving = length > 0.0
+    with np.errstate(divide="ignore"):
+        drive = np.where(moving, price * length / cos, 0.0)
+        path = np.where(moving, length / cos, 0.0) if with_path else None
+    if travel:
+        blocked = moving & (beta >= 0.5 * math.pi)
+        drive[blocked] = np.inf
+        if path is not None:
+            path[blocked] = np.inf
+    return drive, path
 
 
 def opposite(cost: np.ndarray) -> np.ndarray:
@@ -343,7 +348,7 @@ def budget_bound(
             rows = slice(first, first + chunk)
             block = {key: entry[rows] for key, entry in entries.items()}
             for kind in kinds:
-                path, drive = _path_lengths(
+                drive, path = _drive_costs(
                     ax[rows],
                     ay[rows],
                     a_size,
@@ -353,7 +358,8 @@ def budget_bound(
                     centres,
                     half,
                     prices.drive,
-                    kind == "travel",
+                    travel=kind == "travel",
+                    with_path=stops,
                 )
                 charge = lags.at_rest(path) if stops else 0.0
                 for key, cost in _leg_costs(block, drive, charge, kind, stops).items():

@@ -105,14 +105,11 @@ class ArgumentParser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
         self._given: dict[argparse.Action, str] | None = None
+        # argparse's own hook: the default action, and "store", are the refusing store
+        for name in (None, "store"):
+            self.register("action", name, _StoreOnce)
         if self.add_help:
             self.add_argument("--version", action="version", version=f"ddwmmr {package_version()}")
-
-    def add_argument(self, *args, **kwargs) -> argparse.Action:  # type: ignore[override]
-        action = super().add_argument(*args, **kwargs)
-        if type(action) is argparse._StoreAction and action.option_strings:
-            action.__class__ = _StoreOnce  # the same action, refusing a second occurrence
-        return action
 
     def parse_known_args(self, args=None, namespace=None):  # type: ignore[override]
         outer, self._given = self._given, {}

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import csv
 import datetime as dt
 import json
 import math
@@ -758,7 +757,6 @@ def _bounds_table(args: argparse.Namespace, config: RunConfig):
 
     if args.study or args.obstacles:
         raise ParameterError("bounds: only for the benchmark without a study or obstacles")
-    _check_bounds_columns(Path(args.bounds))
     table = read_bounds_file(args.bounds, args.seed, config.payload)
     if not set(table) & set(range(1, args.n + 1)):  # scenarios are numbered from 1
         span = "1" if args.n == 1 else f"1-{args.n}"
@@ -769,26 +767,6 @@ def _bounds_table(args: argparse.Namespace, config: RunConfig):
             f"python -m ddwmmr.bounds --scenarios {span} makes them"
         )
     return table
-
-
-#: Columns ``--bounds`` reads from a bounds.csv of ``python -m ddwmmr.bounds``.
-BOUNDS_COLUMNS = ("scenario", "lower_bound_s", "best_known_s", "replay_ok")
-
-
-def _check_bounds_columns(path: Path) -> None:
-    """Refuse a ``--bounds`` CSV whose header lacks a column read from it, naming them
-    (files that cannot be read at all are left to :func:`read_bounds_file`)."""
-    try:
-        with open(path, newline="", encoding="utf-8") as handle:
-            header = next(csv.reader(handle), [])
-    except (OSError, ValueError, csv.Error):
-        return
-    missing = [c for c in BOUNDS_COLUMNS if c not in {h.strip() for h in header}]
-    if missing:
-        raise ParameterError(
-            f"bounds: {path} lacks the column{'s' * (len(missing) > 1)} {', '.join(missing)} "
-            f"(a bounds.csv of python -m ddwmmr.bounds has {', '.join(BOUNDS_COLUMNS)})"
-        )
 
 
 def _span(table: dict[int, Any]) -> str:

@@ -446,12 +446,10 @@ class MPCOptions:
         plain types for the run's summary."""
         values = {f.name: getattr(self, f.name) for f in fields(self)}
         intervals, first, horizon = self.grid(mode)
-        # the interval after dt: its length as the controller builds it (with 2 intervals,
-        # the rest of the horizon)
-        after = min(first, (horizon - dt) / (intervals - 1)) if intervals > 2 else horizon - dt
         values.update(
             intervals=intervals,
-            first_interval=after,
+            # the interval after dt as the controller builds it (with 2, the horizon's rest)
+            first_interval=float(shooting_grid(intervals, dt, first, horizon)[1]),
             horizon=horizon,
             position_weight=self.weights(mode).position,
             huber=self.huber_scale(mode),
