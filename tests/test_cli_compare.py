@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import csv
+import json
 import re
 import subprocess
 from pathlib import Path
+
+import pytest
 
 from ddwmmr.cli.compare import main
 
@@ -85,3 +88,25 @@ def test_a_requested_study_that_cannot_run_is_named_on_stderr(tmp_path, capsys):
         "note: study corners skipped: it needs the rectangle trajectory, which is not compared "
         "(trajectories: ellipse)\n" in err
     )
+
+
+def test_an_option_named_like_a_simulate_keyword_reaches_the_controller(tmp_path, capsys):
+    """Audit: --option qp:dt=... (the qp's look-ahead step) ended every run in a TypeError,
+    simulate() got the option and its own dt both; the option now reaches the controller,
+    as in track: the run equals the API's with the controller built with that dt."""
+    from ddwmmr import Robot, simulate
+    from ddwmmr.controllers.base import make_controller
+    from ddwmmr.trajectories import Ellipse
+
+    out = tmp_path / "qp"
+    args = ["--methods", "qp", "--only", "ellipse", "--study", "none", "--duration", "0.2"]
+    argv = [*args, "--jobs", "1", "--option", "qp:dt=0.05", "--no-progress"]
+    assert main([*argv, "--out", str(out)]) == 0, capsys.readouterr().err
+    with (out / "metrics.csv").open() as handle:
+        (row,) = list(csv.DictReader(handle))
+    record = json.loads((out / "run.json").read_text())
+    assert record["options"]["qp"]["dt"] == 0.05
+    robot = Robot()
+    expected = simulate(robot, Ellipse(), make_controller("qp", robot, dt=0.05), duration=0.2)
+    error = float(row["end_position_error_m"])
+    assert error == pytest.approx(expected.summary["end_position_error_m"], rel=1e-6, abs=1e-12)

@@ -370,16 +370,18 @@ def _plan_init(config: CompareConfig) -> list[RunSpec]:
 def run_one(task: tuple[Robot, Any, float | None, RunSpec]) -> RunOutput:
     """Simulate one :class:`RunSpec` (module level, so worker processes can run it)."""
     robot, trajectory, duration, spec = task
+    # built here, not by simulate(): a controller option may share a name with one of
+    # simulate's own keywords (the qp's and the mpc's ``dt``)
+    controller = make_controller(spec.method, robot, **dict(spec.options))
     result = simulate(
         robot,
         trajectory,
-        spec.method,
+        controller,
         dt=spec.dt,
         duration=duration,
         integrator=spec.integrator,
         initial_offset=spec.initial_offset,
         plant=spec.plant,
-        **dict(spec.options),
     )
     return RunOutput(dict(result.summary), dict(result.timeseries))
 
