@@ -227,6 +227,11 @@ CASES += [
     ("track", ["--method", "clrrmc-ts", "--tau", "1e-300"], "(at least 0.0001 s)"),
     ("track", ["--method", "qp", "--manipulability-weight", "1e300"], "in [0, 1e+06]"),
     ("track", ["--method", "clrrmc-ts", "--tau", "1", "2"], "tau must be one value or 3"),
+    # a method option's text that is no number: the method's range, as for nan (an audit's)
+    ("track", ["--option", "damping=abc"], "damping must be a finite number > 0 (got 'abc')"),
+    ("track", ["--method", "clrrmc-ts", "--option", "tau=fast"], "tau must be > 0 s (at least"),
+    ("compare", ["--option", "damping=1e"], "damping must be a finite number > 0 (got '1e')"),
+    ("scenarios", ["--option", "adjust=far"], "adjust must be a finite number in [0.01, 5] m"),
     ("track", ["--method", "pi", "--aux", "sum"], "aux: --aux is taken only by --method"),
     ("track", ["--tau", "1"], "tau: --tau is taken only by --method"),
     ("track", ["--method", "nope"], "invalid choice: 'nope'"),
@@ -454,6 +459,7 @@ def test_any_mistyped_or_absurd_robot_value_is_refused(workdir, capsys, key, val
         ("track", ["--traj", "{fifo_csv}"]),
         ("compare", ["--robot", "{fifo}"]),
         ("scenarios", ["--payload", "10"]),
+        ("track", ["--option", "damping=abc"]),
     ],
 )
 def test_as_a_module_one_line_and_no_traceback(workdir, tool, args):
@@ -564,9 +570,13 @@ def recorded(tmp_path_factory) -> dict:
 
 RERUN_CASES = [
     # (field of the run record, value, text of the one line)
-    ("dt", 10**400, "dt must be a finite number (got an integer of about 1e400)"),
-    ("duration", 10**400, "duration must be a finite number (got an integer of about 1e400)"),
+    ("dt", 10**400, "dt must be a finite number > 0 (got an integer of about 1e400)"),
+    ("duration", 10**400, "duration must be a finite number > 0 (got an integer of about 1e400)"),
     ("dt", -0.1, "dt must be > 0"),
+    # a dt that is no number: the one line of --dt's check, naming the range (an audit's)
+    ("dt", 0, "dt must be > 0 (got 0)"),
+    ("dt", "abc", "dt must be a finite number > 0 (got 'abc')"),
+    ("dt", None, "dt must be a finite number > 0 (got None)"),
     ("duration", 1e12, "duration / dt must be <="),
     ("robot.payload", 20, "a 20 kg payload tips the robot over in this run's start pose"),
     ("options.obstacles", [[2.0, 0.0, 0.5]], "overlaps the robot's start pose by 0.104 m"),

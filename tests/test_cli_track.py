@@ -4,6 +4,7 @@ import csv
 import dataclasses
 import hashlib
 import json
+import math
 import subprocess
 import sys
 from pathlib import Path
@@ -321,9 +322,9 @@ def recorded_run(tmp_path_factory) -> dict:
 @pytest.mark.parametrize(
     ("field", "value", "message"),
     [
-        ("dt", "abc", "dt must be a number"),
-        ("dt", True, "dt must be a number"),
-        ("duration", "1s", "duration must be a number"),
+        ("dt", "abc", "dt must be a finite number > 0 (got 'abc')"),
+        ("dt", True, "dt must be a finite number > 0 (got True)"),
+        ("duration", "1s", "duration must be a finite number > 0 (got '1s')"),
         ("method", ["pi"], "method name must be a str"),
         ("options", [1], "options must be a dict"),
         ("options", "x", "options must be a dict"),
@@ -343,6 +344,55 @@ def test_rerun_of_a_damaged_record_is_one_line(
     error = capsys.readouterr().err.strip().splitlines()
     assert len(error) == 1 and message in error[0], error
     assert sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [
+        (-0.01, "dt must be > 0 (got -0.01)"),
+        (0, "dt must be > 0 (got 0)"),
+        (math.nan, "dt must be a finite number > 0 (got nan)"),
+        (math.inf, "dt must be a finite number > 0 (got inf)"),
+        ("abc", "dt must be a finite number > 0 (got 'abc')"),
+        ("0.02", "dt must be a finite number > 0 (got '0.02')"),
+        (True, "dt must be a finite number > 0 (got True)"),
+        (None, "dt must be a finite number > 0 (got None)"),
+    ],
+)
+def test_rerun_of_a_record_with_a_bad_dt_names_its_range(
+    recorded_run, tmp_path, capsys, value, message
+):
+    """Audit: a summary.json whose dt was nan said "dt must be a finite number (got nan)",
+    one whose dt was text "lacks a complete run record (dt must be a number in s, got
+    'abc')": neither named the range. The recorded dt now passes the check --dt passes."""
+    damaged = json.loads(json.dumps(recorded_run))
+    damaged["run"]["dt"] = value
+    path = tmp_path / "summary.json"
+    path.write_text(json.dumps(damaged))  # nan and inf as JSON's NaN and Infinity
+    out = tmp_path / "o"
+    assert run(["--rerun", str(path), "--no-progress", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err == f"error: rerun: {path}: {message}\n" and not out.exists()
+    if isinstance(value, float | int) and not isinstance(value, bool):  # --dt takes it
+        argv = ["--method", "pi", "--traj", "ellipse", "--duration", "0.2", "--no-plots"]
+        assert run([*argv, f"--dt={value!r}", "--out", str(out)]) == 2
+        assert capsys.readouterr().err == f"error: {message}\n"  # the same words
+
+
+def test_rerun_of_a_record_with_a_bad_dt_as_a_module_is_one_line(recorded_run, tmp_path):
+    damaged = json.loads(json.dumps(recorded_run))
+    damaged["run"]["dt"] = "abc"
+    path = tmp_path / "summary.json"
+    path.write_text(json.dumps(damaged))
+    out = tmp_path / "o"
+    done = subprocess.run(
+        [sys.executable, "-m", "ddwmmr.track", "--rerun", str(path), "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2 and "Traceback" not in done.stderr and not out.exists()
+    assert done.stderr == f"error: rerun: {path}: dt must be a finite number > 0 (got 'abc')\n"
 
 
 #: Fields of a run record (``section.field`` inside a section) a --rerun cannot do without.

@@ -226,7 +226,8 @@ def test_bad_fields_show_a_message_and_keep_the_previous_value(tmp_path):
     assert "T must be > 0" in app.message and "error" in app.message_text.get_text()
     assert period.text == "20" and app.settings.geometry["T"] == 20.0
     app.geometry_fields["a"].submit("wide")
-    assert "a must be a number" in app.message and app.geometry_fields["a"].text == "2"
+    message = "a must be a finite number > 0 (got 'wide')"  # names the range
+    assert message in app.message and app.geometry_fields["a"].text == "2"
     app.geometry_fields["N"].submit("2.5")
     assert "N must be an integer >= 2" in app.message
     not_a_trajectory = tmp_path / "notes.txt"
@@ -245,6 +246,11 @@ def test_bad_fields_show_a_message_and_keep_the_previous_value(tmp_path):
     tau = dict(group.page(0))[group.specs[0]]
     tau.submit("-1")
     assert "tau must be > 0" in app.message and tau.text == "0.5"
+    tau.submit("fast")  # the method's range, as for nan (an audit's: "must be a number")
+    assert "tau must be > 0 s (at least 0.0001 s), or inf to disable a channel (got 'fast')" in (
+        app.message
+    )
+    assert tau.text == "0.5" and app.settings.options[0] == {}
     app.dt_field.submit("0")
     assert "dt must be > 0" in app.message and app.settings.dt is None
     app.offset_field.submit("0.1")

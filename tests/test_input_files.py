@@ -92,7 +92,7 @@ def test_step_count(duration, dt, steps):
         (1.0, 2.0, r"^dt must be <= duration \(1 s\)"),
         (1e9, 0.02, f"^duration / dt must be <= {MAX_STEPS} steps per run"),
         (40.0, 1e-300, "^duration / dt must be <="),
-        ("40", 0.02, "^duration must be a number"),
+        ("40", 0.02, r"^duration must be a finite number > 0 \(got '40'\)"),
     ],
 )
 def test_step_count_names_the_parameter(duration, dt, message):

@@ -98,3 +98,41 @@ def test_a_non_finite_option_is_refused_naming_its_range(method):
             assert "\n" not in message and message.replace(" ", "_").startswith(spec.name)
             assert range_words.search(message), (spec.name, message)
             assert f"(got {text})" in message and not math.isfinite(float(text))
+
+
+@pytest.mark.parametrize("method", [*available_methods(), "thesis"])
+def test_a_non_numeric_option_is_refused_naming_its_range(method):
+    """Audit: ``damping=abc`` was refused as "damping must be a number (got 'abc')", with
+    no range. The text is passed on to the method's own check, as nan is: every number
+    option of every method refuses it in the words of its nan message, quoting the text."""
+    from ddwmmr.controllers.option_specs import option_specs, parse_option
+
+    for spec in option_specs(method):
+        if spec.kind != "number":
+            continue
+        messages = []
+        for text in ("nan", "abc"):
+            name, value = parse_option(method, f"{spec.name}={text}")
+            with pytest.raises(ParameterError) as info:
+                make_controller(method, **{name: value})
+            messages.append(str(info.value))
+        refused_nan, refused_text = messages
+        assert "\n" not in refused_text and refused_text.endswith("(got 'abc')"), refused_text
+        assert refused_text == refused_nan.replace("(got nan)", "(got 'abc')"), spec.name
+
+
+def test_a_method_without_a_check_refuses_non_numeric_text_itself(registered):
+    """A method that takes the text unchecked (a plug-in) still never receives it."""
+    from ddwmmr.controllers.option_specs import parse_option
+
+    class Unchecked:
+        def __init__(self, robot, gain: float = 1.0, scale: float = 1.0):
+            self.gain = gain
+            self.scale = 2.0 * scale  # computes with it right away: a TypeError for text
+
+    registered(CONTROLLERS, "tmp-unchecked", Unchecked)
+    for option in ("gain", "scale"):
+        name, value = parse_option("tmp-unchecked", f"{option}=abc")
+        with pytest.raises(ParameterError, match=rf"^{option} must be a number \(got 'abc'\)$"):
+            make_controller("tmp-unchecked", **{name: value})
+    assert make_controller("tmp-unchecked", gain=3.0).gain == 3.0

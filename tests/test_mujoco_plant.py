@@ -189,6 +189,9 @@ def test_dt_must_be_a_multiple_of_the_engine_step():
     with pytest.raises(ParameterError, match="dt must be a whole multiple"):
         plant.step(0.0, np.zeros(4), 0.003)
     MujocoPlant(ROBOT, timestep=0.005, contact_time_constant=0.01).reset(np.zeros(5), 0.005)
+    for text in ("abc", None):  # not a number: the same message, naming the allowed steps
+        with pytest.raises(ParameterError, match=r"whole multiple .*0\.002, 0\.004.* \(got"):
+            plant.reset(np.zeros(5), text)
 
 
 def test_bad_start_configurations_are_parameter_errors():

@@ -217,7 +217,7 @@ def test_toml_values_must_have_their_type_and_range(tmp_path, text, message):
 
 
 def test_parametric_api_rejects_strings_and_booleans():
-    with pytest.raises(ParameterError, match=r"^a must be a number"):
+    with pytest.raises(ParameterError, match=r"^a must be a finite number > 0 \(got '2.0'\)"):
         Ellipse(a="2.0")
     with pytest.raises(ParameterError, match=r"^N must be an integer"):
         Ellipse(N=True)

@@ -148,20 +148,24 @@ def check_number_type(name: str, value: Any) -> Any:
 
 def _as_float(name: str, value: float, allowed: str = "") -> float:
     # Strings and booleans are not numbers here, even though float() accepts them: a file
-    # saying N = "2000" or L1 = true is a mistake worth reporting. ``allowed`` (e.g.
-    # "> 0") completes the message of a non-finite value, so that it names the range too.
-    finite = f"a finite number {allowed}" if allowed else "a finite number"
+    # saying N = "2000" or L1 = true is a mistake worth reporting. Whatever is not a finite
+    # number (text, a boolean, None, nan, inf, an integer beyond a float) gets the one
+    # message, which ``allowed`` (e.g. "> 0", the range the caller checks next) completes
+    # so that it names the range too: "dt must be a finite number > 0 (got 'abc')".
     if isinstance(value, bool | np.bool_ | str | bytes):
-        raise ParameterError(f"{name} must be a number (got {shown(value)})")
+        raise _not_finite(name, value, allowed)
     try:
         number = float(value)
-    except OverflowError:  # an integer beyond a float: as infinite as float("inf")
-        raise ParameterError(f"{name} must be {finite} (got {shown(value)})") from None
-    except (TypeError, ValueError):
-        raise ParameterError(f"{name} must be a number (got {shown(value)})") from None
+    except (OverflowError, TypeError, ValueError):  # OverflowError: as infinite as inf
+        raise _not_finite(name, value, allowed) from None
     if not math.isfinite(number):
-        raise ParameterError(f"{name} must be {finite} (got {shown(value)})")
+        raise _not_finite(name, value, allowed)
     return number
+
+
+def _not_finite(name: str, value: Any, allowed: str) -> ParameterError:
+    finite = f"a finite number {allowed}" if allowed else "a finite number"
+    return ParameterError(f"{name} must be {finite} (got {shown(value)})")
 
 
 def shown(value: Any, width: int = 40) -> str:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -17,6 +18,8 @@ MIN_TAU = 1e-4
 #: bound as MIN_TAU: more is no feedback the robot can follow, only commands that overflow
 #: (``ap`` with K3 = 1e300 commanded 1.3e300 rad/s).
 MAX_GAIN = 1.0 / MIN_TAU
+#: The values a time constant may take, as the messages word them.
+TAU_RANGE = f"> 0 s (at least {MIN_TAU:g} s), or inf to disable a channel"
 
 
 def check_gain(name: str, value: float, zero: bool = False) -> float:
@@ -31,31 +34,29 @@ def check_gain(name: str, value: float, zero: bool = False) -> float:
 def gains_from_tau(tau: float | Sequence[float], size: int) -> tuple[float, ...]:
     """Gains ``K_i = 1/tau_i`` (1/s) from one time constant or ``size`` of them (s).
 
-    ``tau = inf`` switches a channel's feedback off (gain 0).
+    ``tau = inf`` switches a channel's feedback off (gain 0). A value that is not a time
+    constant (text, a boolean, None, nan, below :data:`MIN_TAU`) is refused naming the
+    allowed range, :data:`TAU_RANGE`.
     """
-    if isinstance(tau, str | bytes | bool) or tau is None:
-        raise ParameterError(
-            f"tau must be a time constant in s or {size} of them (got {shown(tau)})"
-        )
-    if isinstance(tau, int | float | np.integer | np.floating) or np.ndim(tau) == 0:
-        values = [tau] * size
-    else:
-        values = list(tau)
+    one = isinstance(tau, str | bytes | int | float | np.integer | np.floating)
+    values = [tau] * size if one or tau is None or np.ndim(tau) == 0 else list(tau)
     if len(values) != size:
         raise ParameterError(f"tau must be one value or {size} values in s (got {len(values)})")
-    for value in values:
-        if isinstance(value, str | bytes | bool) or value is None:
-            raise ParameterError(f"tau must be numbers in s (got {shown(value)})")
-    try:
-        values = [float(value) for value in values]
-    except (TypeError, ValueError, OverflowError):
-        raise ParameterError(f"tau must be numbers in s (got {shown(values, 60)})") from None
     gains = []
     for value in values:
-        if math.isnan(value) or value < MIN_TAU:
-            raise ParameterError(
-                f"tau must be > 0 s (at least {MIN_TAU:g} s), or inf to disable a channel "
-                f"(got {value:g})"
-            )
-        gains.append(0.0 if math.isinf(value) else 1.0 / value)
+        number = _time_constant(value)
+        gains.append(0.0 if math.isinf(number) else 1.0 / number)
     return tuple(gains)
+
+
+def _time_constant(value: Any) -> float:
+    """``value`` as a float if it is a time constant (:data:`TAU_RANGE`), else raise."""
+    try:
+        if isinstance(value, str | bytes | bool | np.bool_) or value is None:
+            raise TypeError  # not a number, even where float() would read it
+        number = float(value)
+    except (TypeError, ValueError, OverflowError):
+        raise ParameterError(f"tau must be {TAU_RANGE} (got {shown(value)})") from None
+    if math.isnan(number) or number < MIN_TAU:
+        raise ParameterError(f"tau must be {TAU_RANGE} (got {number:g})")
+    return number

@@ -219,4 +219,33 @@ def make_controller(
             f"method {name}: unknown option {shown(unknown[0])} "
             f"(accepted: {', '.join(sorted(accepted)) or 'none'})"
         )
-    return cls(robot, **options)
+    texts = [(option, value) for option, value in options.items() if isinstance(value, NumberText)]
+    if not texts:
+        return cls(robot, **options)
+    try:  # the method's own check refuses the text, naming the allowed range
+        cls(robot, **options)
+    except ParameterError:
+        raise
+    except (TypeError, ValueError):  # it computed with the text unchecked: refused below
+        pass
+    option, text = texts[0]  # a method that takes the text without a word
+    raise ParameterError(f"{option} must be {text.expected} (got {shown(text)})")
+
+
+class NumberText(str):
+    """The text given for a number option that is not one number of its kind
+    (``damping=abc``, ``horizon=1.5``), as the option parser
+    (:meth:`ddwmmr.controllers.option_specs.OptionSpec.parse`) passes it on.
+
+    The method's own check refuses it as it refuses nan, naming the allowed range (the
+    range is known there only): "damping must be a finite number > 0 (got 'abc')".
+    :func:`make_controller` refuses it ("must be " + :attr:`expected`) if the method does
+    not. ``expected``: what the option takes ("a number", "one number", "an integer").
+    """
+
+    expected: str
+
+    def __new__(cls, text: str, expected: str = "a number") -> NumberText:
+        value = super().__new__(cls, text)
+        value.expected = expected
+        return value

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 from functools import cache
 from typing import Any
 
+from ddwmmr.controllers.base import NumberText, method_parameters
 from ddwmmr.controllers.base import controller_class as registered_class
-from ddwmmr.controllers.base import method_parameters
 from ddwmmr.errors import ParameterError, did_you_mean, shown
 
 __all__ = [
@@ -119,7 +119,13 @@ class OptionSpec:
         return str(value)
 
     def parse(self, text: str) -> Any:
-        """The option value a field's ``text`` stands for; bad text raises ParameterError."""
+        """The option value a field's ``text`` stands for; bad text raises ParameterError.
+
+        A number option's text that is not one number of the option's kind (``abc``, empty,
+        ``1,2`` for one number, ``1.5`` for an integer) comes back as a
+        :class:`~ddwmmr.controllers.base.NumberText`, as ``nan`` comes back as nan: the
+        method's own check (``make_controller``), the one place that knows the allowed
+        range, refuses it naming the range."""
         text = text.strip()
         if self.kind == "choice":
             for choice in self.choices:
@@ -132,26 +138,26 @@ class OptionSpec:
                 return None
             if self.kind == "text":
                 return self.default
-            raise ParameterError(f"{self.name} needs a number")
+            return NumberText(text)  # no number: the method's check names the range
         if self.kind == "text":
             return text
         return self._parse_numbers(text)
 
-    def _parse_numbers(self, text: str) -> float | int | tuple[float, ...]:
+    def _parse_numbers(self, text: str) -> float | int | tuple[float, ...] | NumberText:
         try:
             numbers = [float(part) for part in re.split(r"[\s,]+", text) if part]
-        except ValueError:
-            raise ParameterError(f"{self.name} must be a number (got {shown(text)})") from None
+        except ValueError:  # passed on, as nan is: the method's check names the range
+            return NumberText(text)
         if len(numbers) > 1:
-            if not self.several:
-                raise ParameterError(f"{self.name} takes one number (got {shown(text)})")
+            if not self.several:  # one number expected: the method's check names the range
+                return NumberText(text, "one number")
             return tuple(numbers)
         (value,) = numbers
         if isinstance(self.default, int) and not isinstance(self.default, bool):
             if not math.isfinite(value):  # the method's check names the allowed range
                 return value
-            if not value.is_integer():
-                raise ParameterError(f"{self.name} must be an integer (got {shown(text)})")
+            if not value.is_integer():  # the method's check names the allowed range
+                return NumberText(text, "an integer")
             return int(value)
         return value
 

@@ -322,7 +322,8 @@ class App(PanelLayout):
     def _apply_geometry(self, name: str, text: str) -> str:
         try:
             number = float(text)
-        except ValueError:
+        except ValueError:  # the check refuses the text naming the allowed range
+            check_geometry(name, text)
             raise ParameterError(f"{name} must be a number (got {shown(text)})") from None
         value = check_geometry(name, number)
         self._try(self.settings.with_geometry(name, value))

@@ -246,7 +246,7 @@ class MujocoPlant:
         try:
             ratio = float(dt) / h
         except (TypeError, ValueError):
-            raise ParameterError(f"dt must be a number (got {shown(dt)})") from None
+            ratio = math.nan  # not a number: refused below, naming the allowed steps
         substeps = round(ratio) if math.isfinite(ratio) else 0
         if substeps < 1 or abs(substeps * h - dt) > 1e-9 * max(1.0, abs(dt)):
             raise ParameterError(
