@@ -14,7 +14,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from ddwmmr import ParameterError, Rectangle, Robot, make_controller, simulate
+from ddwmmr import Ellipse, ParameterError, Rectangle, Robot, make_controller, simulate
 from ddwmmr.resolution import kernels
 
 L1, L2 = 0.35, 0.30  # the default robot (docs/theory.md)
@@ -165,6 +165,24 @@ def test_damped_ats_is_damped_least_squares_on_the_reduced_system(rng, aux):
     assert 10 < damped < 40  # both sides of the band edge were checked
 
 
+@pytest.mark.parametrize("threshold", [0.9, 2.0, 1e3])
+def test_a_threshold_above_every_singular_value_damps_every_state(rng, threshold):
+    """Above sqrt(T / 2) (0.75 for the default arm) sigma_min is below the threshold
+    everywhere; the kernel's test without square roots once took such states as undamped.
+    Against damped least squares by SVD, at states near and far from the singularity."""
+    states = near_singular_states(rng, 10) + random_states(rng, 10)
+    for q, xdot in states:
+        M, r, to_u = reduced_system(q, xdot, "shoulder")
+        sigma = np.linalg.svd(M, compute_uv=False)[-1]
+        lam2 = threshold**2 * (1.0 - (sigma / threshold) ** 2)
+        expected = to_u(damped_solve(M, r, lam2))
+        u, singular = kernels.ats(
+            L1, L2, *q[2:], *xdot, aux="shoulder", threshold=threshold, damping=threshold
+        )
+        assert singular
+        np.testing.assert_allclose(u, expected, atol=1e-10)
+
+
 def test_damped_pseudoinverse_is_damped_least_squares(rng):
     damped = 0
     for q, xdot in near_singular_states(rng):
@@ -310,5 +328,38 @@ def test_unknown_method_and_option_errors():
         make_controller("clrrmc-ts", robot, tau=-1.0)
     with pytest.raises(ParameterError, match="tau must be > 0"):
         make_controller("clrrmc-cs", robot, tau=float("nan"))
-    with pytest.raises(ParameterError, match="singularity_threshold must be > 0"):
+    with pytest.raises(ParameterError, match=r"^singularity_threshold must be in \[1e-06, 1000"):
         make_controller("clrrmc-cs", robot, singularity_threshold=0.0)
+
+
+@pytest.mark.parametrize("method", ["pi", "ats", "ap", "clrrmc-ts", "clrrmc-cs"])
+@pytest.mark.parametrize(
+    ("name", "value"),
+    [("singularity_threshold", 1e200), ("singularity_threshold", 1e-300), ("damping", 1e-300)],
+)
+def test_threshold_and_damping_stay_where_their_squares_are_numbers(method, name, value):
+    """Audit: sigma0 = 1e200 squared to inf, which switched the damping off (ats commanded
+    6.5e14 at a near-singular pose with singular=False); 1e-300 squared to 0. Both are
+    refused, naming the range the kernels document."""
+    ranges = {"singularity_threshold": kernels.THRESHOLD_RANGE, "damping": kernels.DAMPING_RANGE}
+    low, high = ranges[name]
+    message = f"{name} must be in [{low:g}, {high:g}] (got {value:g})"
+    with pytest.raises(ParameterError) as info:
+        make_controller(method, Robot(), **{name: value})
+    assert str(info.value) == message
+
+
+def test_the_widest_threshold_and_damping_still_bound_the_singular_command():
+    """At both ends of the ranges the ats command at the shoulder singularity is finite
+    and marked singular."""
+    q = np.array([0.0, 0.0, 0.0, math.pi / 2, 0.6])  # cos th1 = 0
+    trajectory = Ellipse()
+    for low_or_high in (0, 1):
+        threshold = kernels.THRESHOLD_RANGE[low_or_high]
+        damping = kernels.DAMPING_RANGE[low_or_high]
+        controller = make_controller(
+            "ats", Robot(), singularity_threshold=threshold, damping=damping
+        )
+        controller.reset(trajectory, q)
+        u = controller.command(0.0, q, trajectory.pose(0.0), trajectory.velocity(0.0))
+        assert np.all(np.isfinite(u)) and controller.last.singular

@@ -15,7 +15,7 @@ import numpy as np
 from ddwmmr.controllers.base import StepInfo, register_controller
 from ddwmmr.controllers.inputs import check_command, check_inputs
 from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
-from ddwmmr.errors import MAX_STEPS, ParameterError, check_positive, check_range
+from ddwmmr.errors import MAX_STEPS, ParameterError, check_range
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import principal_angle, wrap_angle
@@ -104,7 +104,7 @@ class ConfigurationSpaceController:
         self.reference_step = check_range(
             "reference_step", reference_step, MIN_REFERENCE_STEP, MAX_REFERENCE_STEP, "s"
         )
-        self.threshold = check_positive("singularity_threshold", singularity_threshold)
+        self.threshold = kernels.check_threshold(singularity_threshold)
         self.damping = kernels.check_damping(damping)
         self.reference: ReferenceTrajectory | None = None
         self.last = StepInfo()

@@ -12,7 +12,7 @@ import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register_controller
 from ddwmmr.controllers.inputs import check_command, check_inputs
-from ddwmmr.errors import ParameterError, check_positive, shown
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import AUX_ROWS, whole_turns
@@ -42,7 +42,7 @@ class ResolvedRate(ABC):
     ) -> None:
         self.robot = robot
         self.L1, self.L2 = robot.L1, robot.L2
-        self.threshold = check_positive("singularity_threshold", singularity_threshold)
+        self.threshold = kernels.check_threshold(singularity_threshold)
         self.damping = kernels.check_damping(damping)
         self.last = StepInfo()
 

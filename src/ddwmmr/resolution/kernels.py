@@ -47,25 +47,39 @@ from __future__ import annotations
 
 import math
 
-from ddwmmr.errors import ParameterError, check_finite
+from ddwmmr.errors import ParameterError, check_finite, check_range
 
 #: Default smallest singular value below which damping starts (``sigma0``).
 SINGULARITY_THRESHOLD = 0.05
 #: Default damping factor lambda at the singularity (``>= sigma0``: the gain bound holds).
 MAX_DAMPING = 0.05
+#: The values ``sigma0`` and ``lambda`` may take. Both enter squared, so they stay where
+#: the squares neither overflow nor underflow (``sigma0 = 1e200`` squared to inf and
+#: switched the damping off); 1e-6 still bounds the gain (at about 1e6 times the desired
+#: speed) and 1e3 damps wherever ``sigma < sigma0``.
+THRESHOLD_RANGE = (1e-6, 1e3)
+DAMPING_RANGE = (1e-6, 1e3)
 _SQRT2 = math.sqrt(2.0)
 
 
+def check_threshold(threshold: float) -> float:
+    """``singularity_threshold`` (``sigma0``) as a float if it is in
+    :data:`THRESHOLD_RANGE`, else a one-line ParameterError."""
+    return check_range("singularity_threshold", threshold, *THRESHOLD_RANGE)
+
+
 def check_damping(damping: float) -> float:
-    """``damping`` as a float if it is finite and > 0, else a one-line ParameterError
-    (undamped, the inverse is unbounded at the singularity, ``cos th1 = 0``)."""
-    value = check_finite("damping", damping, "> 0")
+    """``damping`` (``lambda``) as a float if it is in :data:`DAMPING_RANGE`, else a
+    one-line ParameterError (undamped, the inverse is unbounded at the singularity,
+    ``cos th1 = 0``)."""
+    low, high = DAMPING_RANGE
+    value = check_finite("damping", damping, f"in [{low:g}, {high:g}]")
     if not value > 0.0:
         raise ParameterError(
-            f"damping must be > 0 (got {value:g}): undamped, the inverse is unbounded at "
-            "cos th1 = 0; a small value gives an almost undamped one"
+            f"damping must be in [{low:g}, {high:g}] (got {value:g}): undamped, the inverse "
+            "is unbounded at cos th1 = 0; a small value gives an almost undamped one"
         )
-    return value
+    return check_range("damping", value, low, high)
 
 
 def damping_squared(sigma: float, threshold: float, damping: float) -> float:
@@ -105,12 +119,13 @@ def _sigma_min_squared_m(total: float, det2: float) -> float:
 
 def _ats_damping_squared(L1: float, cos_th1: float, threshold: float, damping: float) -> float:
     """:func:`damping_squared` of ``M`` at ``sigma = sigma_min(M)``, without the square roots
-    outside the band: ``sigma_min(M) < threshold`` exactly when
-    ``det^2 < threshold^2 (T - threshold^2)`` (``sigma_1^2 = T - sigma_min^2``)."""
+    outside the band: ``sigma_min(M) < threshold`` exactly when ``threshold^2 > T / 2`` (then
+    everywhere: ``sigma_min^2 <= T / 2``) or ``det^2 < threshold^2 (T - threshold^2)``
+    (``sigma_1^2 = T - sigma_min^2``)."""
     total = 1.0 + L1 * L1
     det2 = (L1 * cos_th1) ** 2
     threshold2 = threshold * threshold
-    if det2 >= threshold2 * (total - threshold2):
+    if 2.0 * threshold2 <= total and det2 >= threshold2 * (total - threshold2):
         return 0.0
     return damping * damping * (1.0 - _sigma_min_squared_m(total, det2) / threshold2)
 
