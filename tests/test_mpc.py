@@ -73,7 +73,12 @@ def test_registered_with_its_interfaces():
         ),
         ({"horizon": 0.05, "dt": 0.05}, "horizon must be > the control step dt = 0.05 s"),
         ({"stability_min": 12.0}, "stability_min must be in (0, 10)"),
-        ({"manipulability_weight": -1.0}, "manipulability_weight must be >= 0"),
+        ({"manipulability_weight": -1.0}, "manipulability_weight must be in [0, 1e+06] (got -1)"),
+        # capped as the qp's weights: at 1e300 the LQR terminal design failed every step
+        ({"position_weight": 1e300}, "position_weight must be in [0, 1e+06] (got 1e+300)"),
+        ({"orientation_weight": 1e300}, "orientation_weight must be in [0, 1e+06]"),
+        ({"input_weight": 1e300}, "input_weight must be in [0, 1e+06] (got 1e+300)"),
+        ({"huber": 1e300}, "huber must be in [1e-06, 1000] m (got 1e+300)"),
         ({"reach_speed": 0.0}, "reach_speed must be > 0"),
         ({"dt": 0.0}, "dt must be > 0"),
         ({"obstacles": [(1.0, 2.0)]}, "obstacles must be Circle(x, y, radius)"),

@@ -220,9 +220,9 @@ def test_the_arrival_term_is_the_weighted_state_error_at_the_first_legs_end(tmp_
 
 
 def test_plan_weight_must_be_nonnegative():
-    with pytest.raises(ParameterError, match=r"plan_weight must be >= 0 \(got -1\)"):
+    with pytest.raises(ParameterError, match=r"plan_weight must be in \[0, 1e\+06\] \(got -1\)"):
         MPCController(ROBOT, plan_weight=-1.0)
-    with pytest.raises(ParameterError, match=r"arrival_weight must be >= 0 \(got -1\)"):
+    with pytest.raises(ParameterError, match=r"arrival_weight must be in \[0, 1e\+06\] \(got -1\)"):
         OCPConfig(reach=True, arrival_weight=-1.0)
 
 

@@ -52,6 +52,10 @@ SPEED_RANGE_RAD_S = (1e-6, 1e6)
 #: Motor torque limits (N m).
 TORQUE_RANGE_N_M = (1e-6, 1e6)
 DURATION_RANGE_S = (1e-6, 1e9)
+#: Largest weight of a cost term (the qp's tasks, the mpc's costs): far above every default
+#: (the qp's tracking slack 1e4, the mpc's position 100), before the problem's conditioning
+#: makes the solve meaningless (the mpc's LQR terminal design fails at 1e300).
+MAX_COST_WEIGHT = 1e6
 
 
 class ParameterError(ValueError):

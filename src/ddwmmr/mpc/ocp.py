@@ -110,9 +110,9 @@ import casadi as ca
 import numpy as np
 
 from ddwmmr.errors import (
+    MAX_COST_WEIGHT,
     ParameterError,
     check_int_at_least,
-    check_nonnegative,
     check_positive,
     check_range,
 )
@@ -165,7 +165,8 @@ class Weights:
             "input_change",
             "terminal",
         ):
-            object.__setattr__(self, name, check_nonnegative(f"{name}_weight", getattr(self, name)))
+            weight = check_range(f"{name}_weight", getattr(self, name), 0.0, MAX_COST_WEIGHT)
+            object.__setattr__(self, name, weight)
 
 
 @dataclass(frozen=True)
@@ -223,7 +224,9 @@ class OCPConfig:
 
     def __post_init__(self) -> None:
         object.__setattr__(
-            self, "arrival_weight", check_nonnegative("arrival_weight", self.arrival_weight)
+            self,
+            "arrival_weight",
+            check_range("arrival_weight", self.arrival_weight, 0.0, MAX_COST_WEIGHT),
         )
 
     @property

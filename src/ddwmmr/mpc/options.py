@@ -22,6 +22,8 @@ from typing import Any
 
 from ddwmmr.commands import FORCE, PlantTraits
 from ddwmmr.errors import (
+    LENGTH_RANGE_M,
+    MAX_COST_WEIGHT,
     ParameterError,
     check_bool,
     check_finite,
@@ -294,11 +296,11 @@ class MPCOptions:
             self.grid(mode)
             self.weights(mode)
         for name, check in (
-            ("huber", check_positive),
+            ("huber", _check_huber),
             ("reach_speed", check_positive),
             ("proximal", check_nonnegative),
             ("stability_margin", check_nonnegative),
-            ("plan_weight", check_nonnegative),
+            ("plan_weight", _check_weight),
             ("obstacle_margin", check_nonnegative),
         ):
             value = getattr(self, name)
@@ -422,10 +424,8 @@ class MPCOptions:
     def weights(self, mode: str) -> Weights:
         """The cost weights of objective ``mode`` (the terminal cost only when tracking)."""
         position = self.position_weight
-        return Weights(
-            position=check_nonnegative(
-                "position_weight", POSITION_WEIGHTS[mode] if position is None else position
-            ),
+        return Weights(  # which checks them
+            position=POSITION_WEIGHTS[mode] if position is None else position,
             orientation=self.orientation_weight,
             manipulability=self.manipulability_weight,
             input=self.input_weight,
@@ -506,3 +506,14 @@ def options_signature() -> inspect.Signature:
         for f in fields(MPCOptions)
     ]
     return inspect.Signature(parameters)
+
+
+def _check_huber(name: str, value: float) -> float:
+    """A Huber scale (m): a length (:data:`~ddwmmr.errors.LENGTH_RANGE_M`); it is squared
+    in the cost, so 1e300 overflowed."""
+    return check_range(name, value, *LENGTH_RANGE_M, "m")
+
+
+def _check_weight(name: str, value: float) -> float:
+    """A cost weight in [0, :data:`~ddwmmr.errors.MAX_COST_WEIGHT`]."""
+    return check_range(name, value, 0.0, MAX_COST_WEIGHT)

@@ -16,13 +16,12 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ddwmmr.errors import check_range
+from ddwmmr.errors import MAX_COST_WEIGHT, check_range
 from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 
-#: Largest task weight: far above the tracking slack's 1e4, before the Hessian's
-#: conditioning (floor 1e-9) makes the solve meaningless.
-MAX_WEIGHT = 1e6
+#: Largest task weight (the Hessian's conditioning floor is 1e-9).
+MAX_WEIGHT = MAX_COST_WEIGHT
 
 
 def bounded(value: float, limit: float) -> float:
