@@ -90,14 +90,24 @@ def test_a_requested_study_that_cannot_run_is_named_on_stderr(tmp_path, capsys):
     )
 
 
-def test_an_option_named_like_a_simulate_keyword_reaches_the_controller(tmp_path, capsys):
+def test_an_option_named_like_a_simulate_keyword_reaches_the_controller(
+    tmp_path, capsys, monkeypatch
+):
     """Audit: --option qp:dt=... (the qp's look-ahead step) ended every run in a TypeError,
     simulate() got the option and its own dt both; the option now reaches the controller,
-    as in track: the run equals the API's with the controller built with that dt."""
+    as in track: the controller that ran holds it, and the run equals the API's."""
     from ddwmmr import Robot, simulate
     from ddwmmr.controllers.base import make_controller
+    from ddwmmr.reports.compare import plan
     from ddwmmr.trajectories import Ellipse
 
+    built = []
+
+    def recording(name, robot=None, **options):
+        built.append(make_controller(name, robot, **options))
+        return built[-1]
+
+    monkeypatch.setattr(plan, "make_controller", recording)  # --jobs 1: in this process
     out = tmp_path / "qp"
     args = ["--methods", "qp", "--only", "ellipse", "--study", "none", "--duration", "0.2"]
     argv = [*args, "--jobs", "1", "--option", "qp:dt=0.05", "--no-progress"]
@@ -106,6 +116,7 @@ def test_an_option_named_like_a_simulate_keyword_reaches_the_controller(tmp_path
         (row,) = list(csv.DictReader(handle))
     record = json.loads((out / "run.json").read_text())
     assert record["options"]["qp"]["dt"] == 0.05
+    assert built[-1]._dt_option == 0.05  # the run's controller, built last (run_one)
     robot = Robot()
     expected = simulate(robot, Ellipse(), make_controller("qp", robot, dt=0.05), duration=0.2)
     error = float(row["end_position_error_m"])

@@ -379,6 +379,20 @@ def test_rerun_of_a_record_with_a_bad_dt_names_its_range(
         assert capsys.readouterr().err == f"error: {message}\n"  # the same words
 
 
+def test_rerun_of_a_record_with_an_integer_duration_records_a_float(recorded_run, tmp_path):
+    """JSON's 1 for a duration reruns, and the rerun's record says 1.0 as a fresh run does
+    (the checked float, not the file's integer)."""
+    record = json.loads(json.dumps(recorded_run))
+    record["run"]["duration"] = 1
+    path = tmp_path / "summary.json"
+    path.write_text(json.dumps(record))
+    out = tmp_path / "o"
+    assert run(["--rerun", str(path), "--no-progress", "--no-plots", "--out", str(out)]) == 0
+    rerun = json.loads((out / "summary.json").read_text())["run"]
+    assert rerun["duration"] == 1.0 and isinstance(rerun["duration"], float)
+    assert isinstance(rerun["dt"], float)
+
+
 def test_rerun_of_a_record_with_a_bad_dt_as_a_module_is_one_line(recorded_run, tmp_path):
     damaged = json.loads(json.dumps(recorded_run))
     damaged["run"]["dt"] = "abc"

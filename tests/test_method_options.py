@@ -126,13 +126,25 @@ def test_a_method_without_a_check_refuses_non_numeric_text_itself(registered):
     from ddwmmr.controllers.option_specs import parse_option
 
     class Unchecked:
-        def __init__(self, robot, gain: float = 1.0, scale: float = 1.0):
+        def __init__(
+            self, robot, gain: float = 1.0, scale: float = 1.0, real: float = 0.0, steps: int = 5
+        ):
             self.gain = gain
             self.scale = 2.0 * scale  # computes with it right away: a TypeError for text
+            self.real = real.real  # an AttributeError for text
+            self.steps = steps
 
     registered(CONTROLLERS, "tmp-unchecked", Unchecked)
-    for option in ("gain", "scale"):
-        name, value = parse_option("tmp-unchecked", f"{option}=abc")
-        with pytest.raises(ParameterError, match=rf"^{option} must be a number \(got 'abc'\)$"):
+    cases = [
+        ("gain=abc", "gain must be a number (got 'abc')"),
+        ("scale=abc", "scale must be a number (got 'abc')"),
+        ("real=abc", "real must be a number (got 'abc')"),
+        ("gain=1,2", "gain must be one number (got '1,2')"),
+        ("steps=1.5", "steps must be an integer (got '1.5')"),
+    ]
+    for text, message in cases:
+        name, value = parse_option("tmp-unchecked", text)
+        with pytest.raises(ParameterError) as info:
             make_controller("tmp-unchecked", **{name: value})
+        assert str(info.value) == message
     assert make_controller("tmp-unchecked", gain=3.0).gain == 3.0

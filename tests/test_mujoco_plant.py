@@ -189,7 +189,7 @@ def test_dt_must_be_a_multiple_of_the_engine_step():
     with pytest.raises(ParameterError, match="dt must be a whole multiple"):
         plant.step(0.0, np.zeros(4), 0.003)
     MujocoPlant(ROBOT, timestep=0.005, contact_time_constant=0.01).reset(np.zeros(5), 0.005)
-    for text in ("abc", None):  # not a number: the same message, naming the allowed steps
+    for text in ("abc", None, "0.004", True):  # no number: the message naming the steps
         with pytest.raises(ParameterError, match=r"whole multiple .*0\.002, 0\.004.* \(got"):
             plant.reset(np.zeros(5), text)
 

@@ -15,6 +15,7 @@ import json
 import sys
 import textwrap
 from collections.abc import Callable, Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -412,8 +413,10 @@ def check_run(inputs: RunInputs, holder: str, start: str) -> RunInputs:
     for the plant, the offset within the arm's reach, obstacles within the command-line
     limits, and a start that neither tips the robot (S > 1) nor overlaps an obstacle.
     ``holder`` (what holds the payload) and ``start`` (what sets the start pose) word the
-    tipping message."""
+    tipping message. The result carries ``dt`` and ``duration`` as the floats checked (a
+    record may hold an integer)."""
     check_step_count(inputs.duration, inputs.dt)
+    inputs = replace(inputs, dt=float(inputs.dt), duration=float(inputs.duration))
     plant_integrator(inputs.plant, inputs.integrator)
     if inputs.integrator is not None and inputs.integrator not in INTEGRATORS:
         raise ParameterError(

@@ -204,7 +204,9 @@ def make_controller(
 
     ``preset`` (``"default"`` or ``"slides"``, see :mod:`ddwmmr.controllers.presets`)
     supplies option values; explicit ``options`` override them. Unknown method names,
-    presets and options (see :func:`method_options`) raise :class:`ParameterError`.
+    presets and options (see :func:`method_options`) raise :class:`ParameterError`, and so
+    does a :class:`NumberText` value: the method's own check words it with the allowed
+    range, and a method that would take it unchecked never receives it.
     """
     cls = controller_class(name)
     robot = check_instance("robot", robot if robot is not None else Robot(), Robot)
@@ -226,7 +228,7 @@ def make_controller(
         cls(robot, **options)
     except ParameterError:
         raise
-    except (TypeError, ValueError):  # it computed with the text unchecked: refused below
+    except Exception:  # it computed with the text unchecked (any error): refused below
         pass
     option, text = texts[0]  # a method that takes the text without a word
     raise ParameterError(f"{option} must be {text.expected} (got {shown(text)})")

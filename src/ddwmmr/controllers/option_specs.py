@@ -119,7 +119,8 @@ class OptionSpec:
         return str(value)
 
     def parse(self, text: str) -> Any:
-        """The option value a field's ``text`` stands for; bad text raises ParameterError.
+        """The option value a field's ``text`` stands for; a choice that is not one of the
+        choices raises ParameterError.
 
         A number option's text that is not one number of the option's kind (``abc``, empty,
         ``1,2`` for one number, ``1.5`` for an integer) comes back as a
@@ -257,8 +258,9 @@ def parse_option(method: str, text: str, what: str = "option") -> tuple[str, Any
     """``NAME=VALUE`` -> (name, value) for ``method``, parsed as the simulator's field
     for that option parses it. A text without ``=`` or a name the method does not take (the
     message lists the names it takes, and the closest one) is a one-line
-    :class:`ParameterError` starting with ``what`` (the command-line option); a bad value
-    one naming the option."""
+    :class:`ParameterError` starting with ``what`` (the command-line option); a bad choice
+    one naming the option. A number option's text that is no number comes back as a
+    :class:`~ddwmmr.controllers.base.NumberText` for ``make_controller`` to refuse."""
     name, sep, value = text.partition("=")
     name = name.strip()
     if not sep or not name:

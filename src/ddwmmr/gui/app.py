@@ -321,10 +321,9 @@ class App(PanelLayout):
 
     def _apply_geometry(self, name: str, text: str) -> str:
         try:
-            number = float(text)
-        except ValueError:  # the check refuses the text naming the allowed range
-            check_geometry(name, text)
-            raise ParameterError(f"{name} must be a number (got {shown(text)})") from None
+            number: float | str = float(text)
+        except ValueError:
+            number = text  # not a number: the check refuses it naming the allowed range
         value = check_geometry(name, number)
         self._try(self.settings.with_geometry(name, value))
         return f"{value:.6g}"

@@ -244,6 +244,8 @@ class MujocoPlant:
     def _check_dt(self, dt: float) -> int:
         h = self.options.timestep
         try:
+            if isinstance(dt, bool | str | bytes):
+                raise TypeError  # not a number, even where float() reads it
             ratio = float(dt) / h
         except (TypeError, ValueError):
             ratio = math.nan  # not a number: refused below, naming the allowed steps
