@@ -222,8 +222,16 @@ class _TurnsNaN(Ellipse):
 
 @pytest.mark.parametrize("method", ALL_METHODS)
 def test_a_reference_turning_nan_mid_run_is_one_error_for_every_method(method):
-    # clrrmc-ts's integrator stages met it first: FloatingPointError from the plant
-    _refused(lambda: simulate(Robot(), _TurnsNaN(), method, duration=1.0), "^pose_d must be")
+    # clrrmc-ts's integrator stages met it first: FloatingPointError from the plant. The
+    # trajectory's pose is checked where simulate takes it (the first time after 0.5 s that
+    # the method asks: an RK4 stage, or the mpc's preview), so the message names pose(t).
+    message = _refused(lambda: simulate(Robot(), _TurnsNaN(), method, duration=1.0), "^traj")
+    prefix = (
+        "trajectory pose(t) must return 3 finite numbers [xE, yE, phiE] (m, m, rad) "
+        "(got array([nan, nan, nan]) at t = "
+    )
+    assert message.startswith(prefix) and message.endswith(" s)")
+    assert 0.5 < float(message[len(prefix) : -len(" s)")]) < 1.0
 
 
 @pytest.mark.parametrize("method", ALL_METHODS)

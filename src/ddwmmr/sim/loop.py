@@ -42,6 +42,14 @@ Controller contract (class attributes, all optional):
   of ``command`` (same numbers, a third of the cost). ``u`` is a tuple of 4 floats. A
   subclass overriding ``command`` below the class defining ``law`` gets ``command`` at
   the stages (:func:`stage_law`).
+
+``reset(trajectory, q0)`` and ``command`` are required. What ``command`` returns is checked
+at every sample and integrator stage (:func:`checked_command`): 4 finite numbers (any
+sequence; the plant gets them as a float array) on the velocity interface, a
+:class:`~ddwmmr.commands.WheelForces` of finite numbers on the force interface; anything
+else is a :class:`~ddwmmr.errors.ParameterError` naming the controller's ``command`` and
+the step. At a sample it goes through ``task.controller_error`` like any error of the
+controller; at a stage it comes out of ``plant.step``.
 """
 
 from __future__ import annotations
@@ -54,8 +62,8 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ddwmmr.commands import FORCE, VELOCITY, traits_of
-from ddwmmr.errors import ParameterError
+from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.inheritance import defining_class, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 
@@ -142,6 +150,80 @@ def check_interface(controller: Any, plant: Plant) -> str:
     return interface
 
 
+#: numpy's float64: what registered controllers and trajectories return (the fast path).
+_FLOAT64 = np.dtype(float)
+
+
+def finite_values(value: Any, size: int) -> np.ndarray | None:
+    """``value`` as a float array of shape ``(size,)`` if it is a flat sequence of ``size``
+    finite numbers (a list, a tuple, a numpy array of any number type), else None. Text,
+    booleans and complex numbers are not numbers here. A float64 array is returned as it
+    is (not copied), so a run fed arrays gives the numbers it gave before the check."""
+    if type(value) is np.ndarray and value.dtype is _FLOAT64 and value.shape == (size,):
+        array = value  # the common case, no conversion
+    else:
+        array = _float_array(value)
+        if array is None or array.shape != (size,):
+            return None
+    # a sum is finite only if every term is; a sum that overflowed looks again
+    if isfinite(sum(array.tolist())) or bool(np.all(np.isfinite(array))):
+        return array
+    return None
+
+
+def _float_array(value: Any) -> np.ndarray | None:
+    """``value`` as a float array if its entries are numbers, else None."""
+    try:
+        array = np.asarray(value)
+        if array.dtype.kind not in "fiuO":  # "O": e.g. Fraction or Decimal entries
+            return None
+        return array.astype(float, copy=False)
+    except (TypeError, ValueError, OverflowError):  # None, {}, ragged, 10**400 entries
+        return None
+
+
+def checked_command(command: Any, force: bool, controller: Any, k: int, t: float) -> Any:
+    """``command``, as returned by ``controller.command`` at step ``k`` (time ``t`` s), if
+    it is a command the plant can apply: on the velocity interface 4 finite numbers
+    ``u = [v, w, th1dot, th2dot]`` (any sequence, returned as a float array:
+    :func:`finite_values`), on the force interface (``force``) a
+    :class:`~ddwmmr.commands.WheelForces` of 4 finite numbers. Anything else (NaN, None, 3
+    values, text) is a one-line :class:`ParameterError` naming the controller's command and
+    the step: a plant would otherwise fail on it deep inside, or (the thesis plant) drive
+    its wheels at full force from a NaN. Registered controllers always return a finite
+    command (they fall back), so for them this only costs a few C calls a step."""
+    if type(command) is np.ndarray and command.dtype is _FLOAT64 and command.shape == (4,):
+        # what every registered velocity controller returns: :func:`finite_values`'s test
+        # inlined, as it runs at every sample and stage
+        a, b, c, d = command.tolist()
+        if not force and isfinite(a + b + c + d):
+            return command
+    if force:
+        if isinstance(command, WheelForces):
+            fields = (command.left, command.right, command.th1_target, command.th2_target)
+            try:  # four floats, the common case: one sum (finite only if every term is)
+                finite = isfinite(sum(fields))
+            except (TypeError, OverflowError):  # text, None, an integer beyond a float
+                finite = False
+            if finite or finite_values(fields, 4) is not None:
+                return command
+        wanted = (
+            "a WheelForces(left, right, th1_target, th2_target) of 4 finite numbers "
+            "(N, N, rad, rad)"
+        )
+    else:
+        array = finite_values(command, 4)
+        if array is not None:
+            return array
+        wanted = "4 finite numbers u = [v, w, th1dot, th2dot] (m/s, rad/s, rad/s, rad/s)"
+    name = getattr(controller, "name", None)
+    name = name if isinstance(name, str) else type(controller).__name__
+    raise ParameterError(
+        f"method: {name}.command() must return {wanted} (got {shown(command, 60)} at step "
+        f"{k}, t = {t:g} s)"
+    )
+
+
 def stage_law(controller: Any) -> Callable[..., Any] | None:
     """The controller's ``law`` if the integrator may call it at its stages, else None.
 
@@ -187,21 +269,24 @@ def run_loop(
     reference = task.reference
     law = stage_law(controller)
 
+    k = 0  # the step being taken, for the message of a bad command at a stage
+
     def policy(t: float, q: list[float]) -> np.ndarray:
         """The closed-loop law at an integrator stage (not recorded)."""
         pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
-        return command_of(t, np.array(q), pose_d, velocity_d)
+        command = command_of(t, np.array(q), pose_d, velocity_d)
+        return checked_command(command, False, controller, k, t)
 
     def law_policy(t: float, q: list[float]) -> tuple[float, ...]:
         """The same through the controller's float-level ``law`` (no validation, no step
-        info: stage states are the integrator's own finite floats). A non-finite input
-        goes through ``command``, whose validation names the argument that made it (a
-        reference that turned NaN between samples is the same ParameterError as at one)."""
+        info: stage states are the integrator's own finite floats). A non-finite result
+        goes through ``command`` (:func:`policy`), whose validation names the argument that
+        made it."""
         pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
         u = law(t, q, pose_d.tolist(), velocity_d.tolist())[0]
         if isfinite(u[0] + u[1] + u[2] + u[3]):
             return u
-        return command_of(t, np.array(q), pose_d, velocity_d)
+        return policy(t, q)
 
     stage_policy = None
     if not (force or getattr(controller, "zero_order_hold", False)):
@@ -222,6 +307,7 @@ def run_loop(
             else:
                 command = command_of(t, q, pose_d, velocity_d)
             elapsed = clock() - start
+            command = checked_command(command, force, controller, k, t)
         except Exception as error:
             if task.controller_error(k, error):
                 return LoopEnd(k, "controller_error")

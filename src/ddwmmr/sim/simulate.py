@@ -34,16 +34,18 @@ from ddwmmr.resolution.reference import (
 )
 from ddwmmr.sim.loop import run_loop
 from ddwmmr.sim.result import SimulationResult
-from ddwmmr.sim.tracking import COLUMNS, TrackingTask
+from ddwmmr.sim.tracking import COLUMNS, TrackingTask, checked_trajectory
 from ddwmmr.sim.verdict import verdict
 from ddwmmr.trajectories.base import resolution_step, trajectory_name
 
 __all__ = ["COLUMNS", "max_condition_number", "simulate", "summarize"]
 
 
-def check_trajectory(trajectory: Any) -> None:
+def check_trajectory(trajectory: Any) -> Any:
     """Refuse (one-line :class:`ParameterError`) what is not a trajectory: it needs
-    ``duration`` (s), ``pose(t)`` and ``velocity(t)``."""
+    ``duration`` (s), ``pose(t)`` and ``velocity(t)``. Returns the trajectory as the run's
+    consumers use it (:func:`~ddwmmr.sim.tracking.checked_trajectory`: one written outside
+    the library has what its ``pose`` and ``velocity`` return checked at every call)."""
     if isinstance(trajectory, str):
         raise ParameterError(
             f"trajectory must be a trajectory object, not its name {shown(trajectory)} "
@@ -60,6 +62,24 @@ def check_trajectory(trajectory: Any) -> None:
             "trajectory must have duration (s), pose(t) and velocity(t) "
             f"(got {shown(trajectory)}, without {', '.join(missing)})"
         )
+    return checked_trajectory(trajectory)
+
+
+def check_controller(controller: Any) -> Any:
+    """Refuse (one-line :class:`ParameterError`) a controller object without the two
+    methods the simulation loop calls, ``reset(trajectory, q0)`` and ``command(t, q,
+    pose_d, velocity_d)`` (what ``command`` returns is checked at every step:
+    :func:`~ddwmmr.sim.loop.checked_command`); returns ``controller``."""
+    missing = [
+        name for name in ("reset", "command") if not callable(getattr(controller, name, None))
+    ]
+    if missing:
+        raise ParameterError(
+            "method must be a method name or a controller with reset(trajectory, q0) and "
+            f"command(t, q, pose_d, velocity_d) (got {shown(controller)}, without "
+            f"{' and '.join(missing)})"
+        )
+    return controller
 
 
 def check_start(
@@ -143,8 +163,14 @@ def simulate(
 
     Args:
         robot: the robot (default ``Robot()``).
-        trajectory: any object with ``duration``, ``pose(t)`` and ``velocity(t)``.
-        method: a registered method name (see ``available_methods()``) or a controller.
+        trajectory: any object with ``duration`` (s), ``pose(t)`` and ``velocity(t)``,
+            which return 3 finite numbers each (any sequence; anything else is a
+            :class:`ParameterError` naming ``pose`` or ``velocity`` and t).
+        method: a registered method name (see ``available_methods()``) or a controller
+            object with ``reset(trajectory, q0)`` and ``command(t, q, pose_d,
+            velocity_d)``, which must return 4 finite numbers ``[v, w, th1dot, th2dot]``
+            (or a ``WheelForces`` on the force interface; anything else is a
+            :class:`ParameterError` naming the step).
         dt: control/integration step (s); default ``duration / samples`` of the trajectory
             (its resolution N), or duration / 1000, rounded to a whole multiple of the
             plant's engine ``timestep`` if it has one.
@@ -185,13 +211,9 @@ def simulate(
         controller = make_controller(method, robot, **controller_options)
     elif controller_options:
         raise ParameterError("controller options are only accepted with a method name")
-    elif callable(getattr(method, "command", None)):
-        controller = method
     else:
-        raise ParameterError(
-            f"method must be a method name or a controller with command() (got {shown(method)})"
-        )
-    check_trajectory(trajectory)
+        controller = check_controller(method)
+    reference = check_trajectory(trajectory)
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
     the_plant = _plant(plant, robot, integrator, plant_options)
     if dt is None:
@@ -206,7 +228,7 @@ def simulate(
         offset = tuple(check_finite("initial_offset", v) for v in initial_offset)
         if len(offset) != 2:
             raise ParameterError(f"initial_offset must be two numbers dx, dy in m (got {offset})")
-        q = initial_configuration(robot, trajectory, offset)
+        q = initial_configuration(robot, reference, offset)
     else:
         try:
             q = np.array(q0, dtype=float)
@@ -215,7 +237,7 @@ def simulate(
         if q.shape != (5,) or not np.all(np.isfinite(q)):
             raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
     tipped = _tipped_start(robot, q, tipped_start)
-    task = TrackingTask(trajectory, the_plant, grid=(dt, steps))
+    task = TrackingTask(reference, the_plant, grid=(dt, steps))
     run_loop(the_plant, controller, task, q, dt, steps, progress)
     timeseries = task.timeseries(robot)
     corners = getattr(trajectory, "corner_windows", None)

@@ -17,10 +17,13 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.commands import WheelForces
+from ddwmmr.errors import ParameterError, shown
+from ddwmmr.inheritance import defining_class
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_arrays
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
-from ddwmmr.trajectories.base import sampler
+from ddwmmr.sim.loop import finite_values
+from ddwmmr.trajectories.base import Trajectory, sampler
 
 #: Column names of the recorded time series, in order (plant columns follow).
 COLUMNS = (
@@ -195,8 +198,8 @@ class ReferenceBlocks:
     the integrator compute them, so the float keys match exactly. A block of
     :data:`BLOCK` steps costs one ``sample`` call and keeps memory bounded on long runs;
     rows are read-only arrays. A ``sample`` that does not return two ``(len(times), 3)``
-    arrays (an unrelated method of that name) switches the blocks off: the task then
-    evaluates the trajectory call by call.
+    arrays of finite numbers (:func:`sampled_references`: an unrelated method of that name)
+    switches the blocks off: the task then evaluates the trajectory call by call.
     """
 
     #: Steps per block.
@@ -226,17 +229,127 @@ class ReferenceBlocks:
         end = start + self.dt  # mostly the next start already: keep those rounding apart
         following = np.append(start[1:], np.nan)
         times = np.concatenate([start, start + 0.5 * self.dt, end[end != following]])
-        try:
-            poses, velocities = (np.array(part, dtype=float) for part in self.sample(times))
-        except (TypeError, ValueError):
-            poses = velocities = np.zeros(0)
-        if poses.shape != (len(times), 3) or velocities.shape != poses.shape:
+        found = sampled_references(self.sample, times)
+        if found is None:
             self.enabled, self.table = False, {}
             return
+        poses, velocities = found
         poses.setflags(write=False)
         velocities.setflags(write=False)
         self._block = block
         self.table = dict(zip(times.tolist(), zip(poses, velocities)))
+
+
+def sampled_references(sample: Any, times: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """``sample(times)`` as new float arrays ``(poses, velocities)``, each of shape
+    ``(len(times), 3)``, if it returns that with finite numbers only; else None (an
+    unrelated method of that name, or one that does not give the numbers of ``pose`` and
+    ``velocity``): the caller then takes ``pose`` and ``velocity`` call by call."""
+    try:
+        poses, velocities = (np.array(part, dtype=float) for part in sample(times))
+    except (TypeError, ValueError, OverflowError):
+        return None
+    if poses.shape != (len(times), 3) or velocities.shape != poses.shape:
+        return None
+    if not (np.all(np.isfinite(poses)) and np.all(np.isfinite(velocities))):
+        return None
+    return poses, velocities
+
+
+#: What a trajectory's ``pose(t)`` and ``velocity(t)`` return (docs/api.md, "Trajectories").
+_RETURNS = {
+    "pose": "[xE, yE, phiE] (m, m, rad)",
+    "velocity": "[xEdot, yEdot, phiEdot] (m/s, m/s, rad/s)",
+}
+
+
+def reference_values(value: Any, method: str, t: float) -> np.ndarray:
+    """What the trajectory's ``method`` (``"pose"`` or ``"velocity"``) returned at time t
+    (s), as a float array of shape (3,): any sequence of 3 finite numbers (a float64 array
+    as it is); anything else (None, 2 values, text, NaN) is a one-line
+    :class:`ParameterError` naming the method and t."""
+    array = finite_values(value, 3)
+    if array is None:
+        raise ParameterError(
+            f"trajectory {method}(t) must return 3 finite numbers {_RETURNS[method]} (got "
+            f"{shown(value, 60)} at t = {t:g} s)"
+        )
+    return array
+
+
+class CheckedTrajectory:
+    """A trajectory written outside the library, as a simulation's consumers (the tracking
+    task, the controllers' ``reset``, the start configuration) see it.
+
+    ``pose(t)`` and ``velocity(t)`` return float arrays of shape (3,) whatever sequence of
+    3 finite numbers the trajectory returns (:func:`reference_values`; the same numbers,
+    so a list gives the run of the equivalent array), and refuse anything else naming
+    ``pose`` or ``velocity``. ``sample(times)``, present if the trajectory has one
+    (:func:`~ddwmmr.trajectories.base.sampler`), returns what the trajectory's returns if
+    that is what ``sample`` promises (:func:`sampled_references`), else ``pose`` and
+    ``velocity`` call by call. Every other attribute (``duration``, ``samples``, ``name``,
+    the trajectory's own) is the trajectory's; ``trajectory`` is the trajectory itself.
+    """
+
+    def __init__(self, trajectory: Any) -> None:
+        self.trajectory = trajectory
+        own = sampler(trajectory)
+        if own is not None:
+            self._own_sample: Any = own
+            # an instance attribute: sampler() takes it as the trajectory's own word
+            self.sample = self._sample
+
+    def __getattr__(self, name: str) -> Any:
+        # Only for names the wrapper lacks. Not ``sample`` (the trajectory's would bypass
+        # the check) nor dunders (copy and pickle look for them before __init__ runs).
+        trajectory = self.__dict__.get("trajectory")
+        if trajectory is None or name == "sample" or name.startswith("__"):
+            raise AttributeError(name)
+        return getattr(trajectory, name)
+
+    def pose(self, t: float) -> np.ndarray:
+        """Desired pose ``[xE, yE, phiE]`` (m, m, rad) at time t (s)."""
+        return reference_values(self.trajectory.pose(t), "pose", t)
+
+    def velocity(self, t: float) -> np.ndarray:
+        """Desired velocity ``[xEdot, yEdot, phiEdot]`` (m/s, m/s, rad/s) at time t (s)."""
+        return reference_values(self.trajectory.velocity(t), "velocity", t)
+
+    def _sample(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Poses and velocities at ``times`` (s), arrays of shape ``(len(times), 3)``."""
+        own = self._own_sample
+        if own is not None:
+            found = sampled_references(own, times)
+            if found is not None:
+                return found
+            self._own_sample = None  # not the vectorised reference: call by call from now on
+        every = np.asarray(times, dtype=float).ravel().tolist()
+        poses = np.array([self.pose(t) for t in every]).reshape(len(every), 3)
+        velocities = np.array([self.velocity(t) for t in every]).reshape(len(every), 3)
+        return poses, velocities
+
+
+#: Where the library's trajectories are defined: their ``pose`` and ``velocity`` return
+#: float arrays of 3 finite numbers by construction (their parameters are checked).
+_LIBRARY = "ddwmmr.trajectories."
+
+
+def checked_trajectory(trajectory: Any) -> Any:
+    """``trajectory`` as a simulation's consumers see it: the library's own (an
+    :class:`~ddwmmr.trajectories.Ellipse`, ``Rectangle`` or ``SampledTrajectory`` whose
+    ``pose``, ``velocity`` and ``sample`` are the library's) as it is, so that nothing is
+    added to their steps; any other in a :class:`CheckedTrajectory`."""
+    if isinstance(trajectory, CheckedTrajectory):
+        return trajectory
+    instance = getattr(trajectory, "__dict__", {})
+    for name in ("pose", "velocity", "sample"):
+        owner = defining_class(type(trajectory), name)
+        if owner is None and name == "sample":
+            continue
+        library = owner is not None and owner is not Trajectory
+        if name in instance or not (library and owner.__module__.startswith(_LIBRARY)):
+            return CheckedTrajectory(trajectory)
+    return trajectory
 
 
 def _force_equivalent(obs: Observation) -> list[float]:
