@@ -33,7 +33,7 @@ def test_generator_is_deterministic_and_prefix_stable():
 
 
 def test_generator_rejects_bad_count():
-    with pytest.raises(ParameterError, match="n must be an integer >= 1"):
+    with pytest.raises(ParameterError, match=r"n must be an integer in \[1, 100000\] \(got 0\)"):
         generate(0)
 
 

@@ -43,7 +43,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from ddwmmr._version import __version__
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 
 #: Name of the manifest file each tool writes into its output folder.
 MANIFEST = ".ddwmmr-manifest.json"
@@ -213,14 +213,65 @@ def missing_folders(folder: Path) -> list[Path]:
     return list(reversed(missing))
 
 
+def existing_folder(label: str, folder: Path) -> Path:
+    """The nearest existing folder at or above ``folder`` (where the missing ones would be
+    created from); a one-line :class:`ParameterError` if what exists there is not a folder
+    (a file, a dangling symbolic link)."""
+    existing = nearest_existing(folder)
+    if not existing.is_dir():
+        raise ParameterError(f"{label}: {existing} is not a folder")
+    return existing
+
+
+#: File types an output path may not be, with their names for a message. Every output
+#: file is moved into place by a rename, which would put a regular file where the folder,
+#: device (``/dev/null``, when running as root), FIFO or socket was.
+_NOT_FILES = (
+    (stat.S_ISDIR, "a folder"),
+    (stat.S_ISCHR, "a character device"),
+    (stat.S_ISBLK, "a block device"),
+    (stat.S_ISFIFO, "a FIFO"),
+    (stat.S_ISSOCK, "a socket"),
+)
+
+
+def check_file_target(path: object, label: str = "path") -> Path:
+    """``path`` as a :class:`~pathlib.Path` if an output file may be moved there by a rename.
+
+    It must be a non-empty ``str`` or :class:`os.PathLike` without a NUL byte, and what
+    exists there, if anything, a regular file (a symbolic link is judged by what it points
+    to): a folder, a device, a FIFO or a socket is never replaced. Anything else raises a
+    one-line :class:`ParameterError` naming ``label`` and the path; only ``os.stat`` is
+    called, nothing is created.
+    """
+    try:
+        text = os.fspath(path)  # type: ignore[arg-type]
+    except TypeError:
+        text = None
+    if not isinstance(text, str) or not text:
+        raise ParameterError(
+            f"{label} must be a file name, a non-empty str or os.PathLike (got {shown(path)})"
+        )
+    if "\0" in text:
+        raise ParameterError(f"{label}: the file name contains a NUL byte ({shown(text)})")
+    try:
+        mode = os.stat(text).st_mode
+    except OSError:
+        return Path(text)  # absent, or not reachable: creating the file reports why
+    if not stat.S_ISREG(mode):
+        kind = next((name for test, name in _NOT_FILES if test(mode)), "a special file")
+        raise ParameterError(
+            f"{label}: {text} exists and is not a regular file ({kind}); give a file name"
+        )
+    return Path(text)
+
+
 def check_writable(label: str, folder: Path) -> None:
     """Raise a one-line :class:`ParameterError` unless files can be created in ``folder``
     (or, if it does not exist yet, in the nearest existing folder above it). Tried, not
     inferred from permission bits: a file is created there and removed at once, which
     catches what ``os.access`` does not show (root on ``/proc``, a read-only mount)."""
-    existing = nearest_existing(folder)
-    if not existing.is_dir():
-        raise ParameterError(f"{label}: {existing} is not a folder")
+    existing = existing_folder(label, folder)
     try:
         fd, probe = tempfile.mkstemp(dir=existing, prefix=".ddwmmr-", suffix=".tmp")
     except OSError as exc:

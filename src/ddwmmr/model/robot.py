@@ -199,38 +199,44 @@ class Robot:
 
         The fields are either all top-level keys or all in one ``[robot]`` table; with a
         ``[robot]`` table nothing else may be in the file (another table, ``[other]``, or
-        a key outside ``[robot]`` is an error naming it), as unknown keys are.
+        a key outside ``[robot]`` is an error naming it), as unknown keys are: the file is
+        read as :meth:`from_dict` reads a mapping, each message naming the file.
         """
         data = load_toml(path, "robot")
-        if "robot" in data:
-            for key, value in data.items():
-                if key in TOML_TABLES:
-                    continue
-                what = f"table [{key}]" if isinstance(value, dict | list) else f"key {shown(key)}"
-                raise ParameterError(
-                    f"robot: {path}: unknown {what} (a robot file holds Robot fields, at the "
-                    f"top or all under one [robot] table)"
-                )
-        table = data.get("robot", data)
-        if not isinstance(table, dict):
-            got = "an array of tables [[robot]]" if isinstance(table, list) else shown(table)
-            raise ParameterError(
-                f"robot: {path}: [robot] must be one table of Robot fields (got {got})"
-            )
         try:
-            return cls.from_dict(table)
+            return cls.from_dict(data)
         except ParameterError as exc:
             raise ParameterError(f"robot: {path}: {str(exc).removeprefix('robot: ')}") from None
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Robot:
         """Build a robot from a mapping of field names to values (a TOML table, a JSON
-        record); unknown keys and values of the wrong type (``L1 = "0.3"``, ``L1 = true``,
-        a number where a pair is expected) are errors naming the key."""
+        record), missing fields taking their defaults.
+
+        The fields are either all top-level keys or all under one ``"robot"`` key (a
+        ``[robot]`` table); beside it nothing else may be in the mapping. Unknown keys and
+        values of the wrong type (``L1 = "0.3"``, ``L1 = true``, a number where a pair is
+        expected) are errors naming the key, each one line (:class:`ParameterError`).
+        """
         if not isinstance(data, dict):
             raise ParameterError(f"robot: expected a table of Robot fields (got {shown(data)})")
+        if "robot" in data:
+            for key, value in data.items():
+                if key in TOML_TABLES:
+                    continue
+                what = f"table [{key}]" if isinstance(value, dict | list) else f"key {shown(key)}"
+                raise ParameterError(
+                    f"robot: unknown {what} (Robot fields go at the top or all under one "
+                    "[robot] table)"
+                )
+            data = data["robot"]
+            if not isinstance(data, dict):
+                got = "an array of tables [[robot]]" if isinstance(data, list) else shown(data)
+                raise ParameterError(
+                    f"robot: [robot] must be one table of Robot fields (got {got})"
+                )
         known = {f.name: f for f in fields(cls) if f.init}
-        unknown = sorted(set(data) - set(known))
+        unknown = sorted(set(data) - set(known), key=str)
         if unknown:
             raise ParameterError(
                 f"robot: unknown parameter {shown(unknown[0])} (known: {', '.join(sorted(known))})"

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ddwmmr.errors import check_int_at_least
+from ddwmmr.errors import MAX_SCENARIOS, check_int_at_least
 
 #: Workspace half-width (m): waypoints lie in [-4, 4] x [-4, 4].
 HALF_SIZE = 4.0
@@ -43,8 +43,14 @@ class Scenario:
 
 
 def generate(n: int, seed: int = 0) -> list[Scenario]:
-    """``n`` scenarios of 5 waypoints uniform in the 8 m x 8 m square (seeded)."""
-    n = check_int_at_least("n", n, 1)
+    """``n`` scenarios of 5 waypoints uniform in the 8 m x 8 m square (seeded).
+
+    ``n``: an integer in [1, :data:`ddwmmr.errors.MAX_SCENARIOS`] (the scenarios tool's
+    cap); ``seed``: an integer >= 0. Anything else raises a one-line
+    :class:`~ddwmmr.errors.ParameterError`.
+    """
+    n = check_int_at_least("n", n, 1, MAX_SCENARIOS)
+    seed = check_int_at_least("seed", seed, 0)
     rng = np.random.default_rng(seed)
     points = rng.uniform(-HALF_SIZE, HALF_SIZE, size=(n, WAYPOINTS_PER_SCENARIO, 2))
     return [

@@ -59,7 +59,13 @@ from ddwmmr.controllers.base import (
     controller_traits,
     make_controller,
 )
-from ddwmmr.errors import ParameterError, check_nonnegative, check_positive, shown
+from ddwmmr.errors import (
+    ParameterError,
+    check_nonnegative,
+    check_positive,
+    check_step_count,
+    shown,
+)
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_FLOOR, stability_terms
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
@@ -73,6 +79,9 @@ from ddwmmr.sim.loop import run_loop
 SENDS = {FORCE: "wheel forces", VELOCITY: "velocity commands"}
 #: Motion detection thresholds for controllers without states (m/s, rad/s).
 MOVING_SPEED, MOVING_RATE = 1e-3, 1e-3
+#: Time limit (s) of a scenario when ``RunConfig.time_limit`` is None, and of one with
+#: obstacles (thesis 5.1).
+TIME_LIMIT_S, OBSTACLE_TIME_LIMIT_S = 60.0, 120.0
 #: Trace sampling interval for recorded scenarios (s).
 TRACE_INTERVAL = 0.05
 #: Within this distance (m) of its waypoint the end effector is traced at every step.
@@ -114,7 +123,10 @@ class RunConfig:
             (:func:`plants_for`).
         payload: end-effector payload (kg); 3.0 by default (see docs/thesis.md).
         stability, manipulability: (enter, exit) thresholds; exit == enter: no hysteresis.
-        dt: control and integration step (s).
+        dt: control and integration step (s), at most the time limit and with at most
+            :data:`ddwmmr.errors.MAX_STEPS` steps per run, as :func:`ddwmmr.simulate`
+            (with ``time_limit`` None: dt in [6e-5, 60] s, checked here, and in
+            [1.2e-4, 60] s for a scenario with obstacles, checked when it is run).
         time_limit: s; None: 60 s, or 120 s when the scenario has obstacles.
         tolerance: waypoint tolerance (m).
         qp_stability_min, qp_max_speed: options of the ``qp`` controller (the stability
@@ -167,12 +179,30 @@ class RunConfig:
             check_positive(name, getattr(self, name))
         if self.time_limit is not None:
             check_positive("time_limit", self.time_limit)
+        # Checked here rather than when a worker reaches a scenario halfway through a
+        # batch. Without a time_limit, the shorter default: dt above it would run no step
+        # at all; whether 120 s (obstacles) stays within the cap depends on the scenario,
+        # which steps_for checks when the run starts.
+        _step_count(TIME_LIMIT_S if self.time_limit is None else self.time_limit, self.dt)
 
     def limit_for(self, scenario: Scenario) -> float:
         """Time limit (s) for a scenario."""
         if self.time_limit is not None:
             return self.time_limit
-        return 120.0 if scenario.obstacles else 60.0
+        return OBSTACLE_TIME_LIMIT_S if scenario.obstacles else TIME_LIMIT_S
+
+    def steps_for(self, scenario: Scenario) -> int:
+        """Most steps of a run of ``scenario``: its time limit / ``dt``, rounded (>= 1)."""
+        return _step_count(self.limit_for(scenario), self.dt)
+
+
+def _step_count(limit: float, dt: float) -> int:
+    """:func:`ddwmmr.errors.check_step_count` of a run whose duration is its time limit,
+    the messages naming ``time_limit``."""
+    try:
+        return check_step_count(limit, dt)
+    except ParameterError as exc:
+        raise ParameterError(str(exc).replace("duration", "time_limit")) from None
 
 
 @dataclass
@@ -216,7 +246,7 @@ class _Tally:
             keys = ("t", "x", "y", "phi", "xe", "ye", "state", "s", "eta", "distance")
             self.trace = {k: [] for k in keys}
         self._every = max(1, round(TRACE_INTERVAL / config.dt))
-        self.steps = round(config.limit_for(scenario) / config.dt)
+        self.steps = config.steps_for(scenario)
         self._tolerance = config.tolerance
         self._com = robot.com_coefficients
         #: Current waypoint (m, world), None when all are reached (kept with ``index``).

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.outputs import file_mode, folder_mode
+from ddwmmr.outputs import check_file_target, existing_folder, file_mode, folder_mode
 
 
 @dataclass
@@ -38,7 +38,9 @@ class SimulationResult:
         return np.column_stack([self.timeseries[k] for k in ("x", "y", "phi", "th1", "th2")])
 
     def write_csv(self, path: str | Path) -> None:
-        """Write the time series as CSV (atomically)."""
+        """Write the time series as CSV to ``path``, atomically, with
+        :func:`write_atomic`: an existing regular file is replaced, a folder, device or
+        FIFO is refused, missing parent folders are created."""
         buffer = io.StringIO()
         writer = csv.writer(buffer)
         columns = list(self.timeseries)
@@ -48,7 +50,8 @@ class SimulationResult:
         write_atomic(path, buffer.getvalue())
 
     def write_summary(self, path: str | Path, **extra: Any) -> None:
-        """Write the summary as JSON (atomically), with ``extra`` keys (e.g. ``run``)."""
+        """Write the summary as JSON to ``path``, with ``extra`` keys (e.g. ``run``),
+        atomically, with :func:`write_atomic` (as :meth:`write_csv`)."""
         write_atomic(path, json.dumps(json_safe({**self.summary, **extra}), indent=2) + "\n")
 
 
@@ -69,13 +72,25 @@ def json_safe(value: Any) -> Any:
     return value
 
 
-def write_atomic(path: str | Path, data: str | bytes) -> None:
+def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file and an atomic rename.
+
+    ``path`` must be a non-empty ``str`` or :class:`os.PathLike`; if something exists
+    there it must be a regular file, which is replaced. A folder, a device (``/dev/null``),
+    a FIFO or a socket is refused with a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming the path before anything is created:
+    the rename would put a regular file in its place (see
+    :func:`ddwmmr.outputs.check_file_target`). Missing parent folders are created, as
+    ``mkdir -p`` would (the tools rely on it: the GUI's ``--snapshot figs/run.png``, the
+    bench's ``--out``, the per-run sub-folders of a GUI export); a path through something
+    that is not a folder is refused.
+    Failures of the write itself (permission, full disk) raise :class:`OSError`.
 
     The file gets the user's umask (``0644`` for umask 022), like any normal file, not
     the ``0600`` of the temporary file; text is written as UTF-8.
     """
-    path = Path(path)
+    path = check_file_target(path)
+    existing_folder("path", path.parent)
     path.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
     payload = data if isinstance(data, bytes) else data.encode("utf-8")
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".ddwmmr-", suffix=".tmp")
@@ -83,6 +98,9 @@ def write_atomic(path: str | Path, data: str | bytes) -> None:
         with os.fdopen(fd, "wb") as handle:
             os.fchmod(handle.fileno(), file_mode())
             handle.write(payload)
+        # Once more just before the rename: a FIFO or folder made there during the write
+        # would be replaced as well.
+        check_file_target(path)
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

@@ -24,6 +24,7 @@ from ddwmmr.errors import (
     LENGTH_RANGE_M,
     MAX_ANGLE_RAD,
     MAX_COORDINATE_M,
+    MAX_STEPS,
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
     check_finite,
@@ -230,13 +231,28 @@ class Rectangle(_Parametric):
     CORNER_SETTLE = 0.1
 
     def corner_times(self, duration: float) -> list[float]:
-        """Times (s) of the corners alpha = k pi/2, k >= 1, up to ``duration`` (inclusive)."""
+        """Times (s) of the corners alpha = k pi/2, k >= 1, up to ``duration`` (inclusive).
+
+        ``duration`` (s) must be finite and > 0, at most ``DURATION_RANGE_S[1]`` (1e9 s)
+        and at most :data:`ddwmmr.errors.MAX_STEPS` corners long (one every T / 4: no run
+        has more steps than that); else a one-line
+        :class:`~ddwmmr.errors.ParameterError`, before the list is built.
+        """
+        duration = check_positive("duration", duration)
         quarter = 0.25 * self.T
+        longest = min(DURATION_RANGE_S[1], MAX_STEPS * quarter)
+        if duration > longest:
+            raise ParameterError(
+                f"duration must be in (0, {longest:g}] s for T = {self.T:g} s (at most "
+                f"{DURATION_RANGE_S[1]:g} s and {MAX_STEPS} corners, one every T / 4) "
+                f"(got {duration:g})"
+            )
         count = int(duration / quarter + 1e-9)
         return [k * quarter for k in range(1, count + 1)]
 
     def corner_windows(self, duration: float) -> list[tuple[float, float]]:
         """``(start, end)`` (s) around each corner: from just before it (the sample at the
-        corner already sees the new orientation) to ``CORNER_SETTLE * T`` after it."""
+        corner already sees the new orientation) to ``CORNER_SETTLE * T`` after it.
+        ``duration`` as in :meth:`corner_times`."""
         lead = 1e-6 * self.T
         return [(c - lead, c + self.CORNER_SETTLE * self.T) for c in self.corner_times(duration)]
