@@ -24,6 +24,7 @@ from ddwmmr.bounds.lower import Lags, Prices, budget_bound, circular, lower_boun
 from ddwmmr.bounds.replay import replay
 from ddwmmr.bounds.search import Settings, _faster_run, best_known, plan_runs, start_state
 from ddwmmr.bounds.starts import Pattern, controller_guess, pattern_guess
+from ddwmmr.errors import ParameterError
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.min_time import MinimumTimeProblem
 from ddwmmr.scenarios import generate
@@ -642,3 +643,170 @@ def test_lower_only_leaves_the_best_known_time_to_a_later_run(tmp_path, monkeypa
     assert jobs[2:] == [(1, True, False), (2, True, False)]
     assert (out / "bounds.csv").read_text().splitlines()[2] == "2,12.0,14.0,3,0.5,True"
     assert "best known 13.50 s (replayed 2), bracket width" in capsys.readouterr().out
+
+
+# -- input checks of the lower bound --------------------------------------------------------
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"cell": 0}, "cell must be in [0.01, 0.5] m (got 0)"),
+        ({"cell": 0.001}, "cell must be in [0.01, 0.5] m (got 0.001)"),
+        ({"cell": -1}, "cell must be in [0.01, 0.5] m (got -1)"),
+        ({"cell": math.inf}, "cell must be a finite number in [0.01, 0.5] m (got inf)"),
+        ({"cell": True}, "cell must be a finite number in [0.01, 0.5] m (got True)"),
+        ({"cell": 2.5}, "cell must be in [0.01, 0.5] m (got 2.5)"),
+        ({"arcs": 10**6}, "arcs must be an even integer in [2, 1440] (got 1000000)"),
+        ({"arcs": 3}, "arcs must be an even integer in [2, 1440] (got 3)"),
+        ({"arcs": None}, "arcs must be an even integer in [2, 1440] (got None)"),
+        ({"arcs": True}, "arcs must be an even integer in [2, 1440] (got True)"),
+        ({"chunk": 2.5}, "chunk must be an integer >= 1 (got 2.5)"),
+        ({"chunk": 0}, "chunk must be an integer >= 1 (got 0)"),
+        ({"tolerance": -1}, "tolerance must be in [0, 0.1] m (got -1)"),
+        ({"tolerance": 2.5}, "tolerance must be in [0, 0.1] m (got 2.5)"),
+        ({"robot": None}, "robot must be a Robot (got None)"),
+        (
+            {"waypoints": None},
+            "waypoints must be a non-empty list of (x, y) pairs in m (got None)",
+        ),
+        (
+            {"waypoints": "abc"},
+            "waypoints must be a non-empty list of (x, y) pairs in m (got 'abc')",
+        ),
+        ({"waypoints": []}, "waypoints must be a non-empty list of (x, y) pairs in m (got [])"),
+        (
+            {"waypoints": [(1.0, 0.0), (1, 2, 3)]},
+            "waypoints[2] must be an (x, y) pair of numbers in m (got (1, 2, 3))",
+        ),
+        (
+            {"waypoints": [(math.nan, 0.0)]},
+            "waypoints[1] x must be a finite number in [-1e+06, 1e+06] m (got nan)",
+        ),
+        (
+            {"waypoints": [(0.0, math.inf)]},
+            "waypoints[1] y must be a finite number in [-1e+06, 1e+06] m (got inf)",
+        ),
+        (
+            {"waypoints": [("1", "2")]},
+            "waypoints[1] x must be a finite number in [-1e+06, 1e+06] m (got '1')",
+        ),
+        ({"waypoints": [(1e300, 0.0)]}, "waypoints[1] x must be in [-1e+06, 1e+06] m (got 1e+300)"),
+        (
+            {"start": (0.0, 0.0)},
+            "start must be (x, y, heading): 3 numbers in m, m, rad (got (0.0, 0.0))",
+        ),
+        (
+            {"start": (0.0, math.nan, 0.0)},
+            "start y must be a finite number in [-1e+06, 1e+06] m (got nan)",
+        ),
+        ({"start": (0.0, 0.0, 1e300)}, "start heading must be in [-1e+06, 1e+06] rad (got 1e+300)"),
+    ],
+)
+def test_budget_bound_refuses_bad_input_in_one_line(kwargs, message):
+    """Each fault is one ParameterError naming the parameter and its range, never an
+    internal exception (ZeroDivisionError, MemoryError, TypeError) or a silent 0 or inf."""
+    args = {"robot": HEAVY, "waypoints": [(1.0, 0.0)], **kwargs}
+    with pytest.raises(ParameterError) as caught:
+        budget_bound(args.pop("robot"), args.pop("waypoints"), **args)
+    assert str(caught.value) == message
+
+
+@pytest.mark.parametrize(
+    ("name", "inside", "outside", "message"),
+    [
+        ("tolerance", 0.1, 0.11, "tolerance must be in [0, 0.1] m (got 0.11)"),
+        ("tolerance", 0.0, -1e-9, "tolerance must be in [0, 0.1] m (got -1e-09)"),
+        ("cell", 0.5, 0.51, "cell must be in [0.01, 0.5] m (got 0.51)"),
+        ("arcs", 2, 1, "arcs must be an even integer in [2, 1440] (got 1)"),
+        ("arcs", 1440, 1442, "arcs must be an even integer in [2, 1440] (got 1442)"),
+    ],
+)
+def test_budget_bound_ranges_are_closed(name, inside, outside, message):
+    """The ends of each documented range give a bound; just beyond them, the message."""
+    kwargs = {"cell": 0.5, "arcs": 20, name: inside}
+    assert 0.0 < budget_bound(HEAVY, [(2.0, 1.0)], **kwargs).value < math.inf
+    with pytest.raises(ParameterError) as caught:
+        budget_bound(HEAVY, [(2.0, 1.0)], **{**kwargs, name: outside})
+    assert str(caught.value) == message
+
+
+def test_budget_bound_refuses_blocks_beyond_the_memory_cap_before_allocating():
+    """A grid whose blocks would exceed 2^24 values is refused up front (no MemoryError,
+    no hours of work), naming what fits: the largest chunk with several waypoints, the
+    smallest cell with one (its block starts at the start alone), and a robot whose reach
+    no allowed cell covers."""
+    two = [(1.0, 0.5), (2.0, -1.0)]
+    cap = "(blocks of at most 16777216 values)"
+    with pytest.raises(ParameterError) as caught:
+        budget_bound(HEAVY, two, cell=0.01)
+    assert str(caught.value) == (
+        f"chunk must be an integer in [1, 5] for cell = 0.01 m and arcs = 180 {cap} (got 24)"
+    )
+    with pytest.raises(ParameterError) as caught:
+        budget_bound(HEAVY, [(1.0, 0.5)], cell=0.01, arcs=1440)
+    assert str(caught.value) == (
+        "cell must be in [0.013, 0.5] m for arcs = 1440 and a reach L1 + L2 + tolerance of "
+        f"0.66 m {cap} (got 0.01)"
+    )
+    giant = Robot(L1=900.0, L2=900.0)
+    with pytest.raises(ParameterError) as caught:
+        budget_bound(giant, [(1.0, 0.5)], cell=0.5)
+    assert str(caught.value) == (
+        "robot: a reach L1 + L2 + tolerance of 1800.01 m is too long for the bound's grid "
+        "(blocks of at most 16777216 values with cell <= 0.5 m and arcs = 180)"
+    )
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"grid": (0.2,)}, "grid must be a (cell, arcs) pair (got (0.2,))"),
+        ({"grid": None}, "grid must be a (cell, arcs) pair (got None)"),
+        ({"grid": (math.nan, 20)}, "grid cell must be a finite number in [0.01, 0.5] m (got nan)"),
+        ({"stop_grid": (0.2, 21)}, "stop_grid arcs must be an even integer in [2, 1440] (got 21)"),
+        ({"stop_grid": "ab"}, "stop_grid must be a (cell, arcs) pair (got 'ab')"),
+        ({"stop_weights": (0.5, 1.5)}, "stop_weights[2] must be in [0, 1] (got 1.5)"),
+        ({"stop_weights": None}, "stop_weights must be a list of weights in [0, 1] (got None)"),
+        ({"tolerance": 2.5}, "tolerance must be in [0, 0.1] m (got 2.5)"),
+        (
+            {"waypoints": [(math.nan, 0.0)]},
+            "waypoints[1] x must be a finite number in [-1e+06, 1e+06] m (got nan)",
+        ),
+        (
+            {"grid": (0.01, 720)},
+            "grid cell must be in [0.044, 0.5] m for grid arcs = 720 and a reach L1 + L2 + "
+            "tolerance of 0.66 m (blocks of at most 16777216 values) (got 0.01)",
+        ),
+    ],
+)
+def test_lower_bound_checks_every_input_before_solving(kwargs, message, monkeypatch):
+    """The grids, the weights and the task are checked before the first bound is solved
+    (budget_bound is never reached)."""
+    from ddwmmr.bounds import lower
+
+    def unreached(*args, **kwargs):
+        raise AssertionError("a bound was solved before the inputs were checked")
+
+    monkeypatch.setattr(lower, "budget_bound", unreached)
+    args = {"waypoints": [(1.0, 0.5), (2.0, -1.0)], **kwargs}
+    with pytest.raises(ParameterError) as caught:
+        lower.lower_bound(HEAVY, args.pop("waypoints"), **args)
+    assert str(caught.value) == message
+
+
+def test_lower_bound_takes_waypoints_from_a_generator_like_a_list():
+    """The checked waypoints are what every bound is solved on: a generator, spent by the
+    first bound before, gives the list's value (where pricing the stops wins)."""
+    waypoints = [(3.0, 0.0), (-0.5, 0.0)]
+    grids = {"grid": (0.1, 60), "stop_weights": (0.5,), "stop_grid": (0.1, 60)}
+    listed = lower_bound(HEAVY, waypoints, **grids).value
+    assert listed > budget_bound(HEAVY, waypoints, cell=0.1, arcs=60).value  # the stops win
+    assert lower_bound(HEAVY, (w for w in waypoints), **grids).value == listed
+
+
+def test_lags_refuse_a_weight_outside_0_1_and_a_non_robot():
+    with pytest.raises(ParameterError) as caught:
+        Lags.from_robot(HEAVY, 1.5)
+    assert str(caught.value) == "weight must be in [0, 1] (got 1.5)"
+    with pytest.raises(ParameterError) as caught:
+        Lags.from_robot(None, 0.5)
+    assert str(caught.value) == "robot must be a Robot (got None)"

@@ -70,11 +70,42 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_range
+from ddwmmr.errors import (
+    MAX_ANGLE_RAD,
+    MAX_COORDINATE_M,
+    ParameterError,
+    check_instance,
+    check_int_at_least,
+    check_range,
+    shown,
+)
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 
 TWO_PI = 2.0 * math.pi
+
+#: Allowed waypoint tolerance (m). The bound stands for the arm reaching at most ``L1 + L2``
+#: plus this margin; up to ten times the scenarios' 1 cm it is still a margin, while one
+#: comparable to the reach turns the waypoints into regions and the bound into 0.
+TOLERANCE_RANGE_M = (0.0, 0.1)
+#: Allowed side (m) of the position cells. The cells per waypoint are about ``pi (reach /
+#: cell)^2`` (13 900 at 1 cm for the thesis arm) and the time grows as their square: below
+#: 1 cm the memory and time get out of hand for no gain (1 cm already brings the bound
+#: within a few hundredths of a second of the relaxation's continuous minimum); above
+#: 0.5 m a cell is as wide as the thesis arm's reach and the bound is close to 0. The
+#: bounds tool's grids (0.05 and 0.07 m) sit well inside. MAX_BLOCK_VALUES bounds the
+#: memory of the finer end.
+CELL_RANGE_M = (0.01, 0.5)
+#: Most heading arcs over the circle (a quarter of a degree each): the memory and time are
+#: linear in them, and finer arcs than the cells' own spread of directions gain nothing.
+MAX_ARCS = 1440
+#: Most values of one block of the programme (start cells x cells x arcs, each float64):
+#: its temporaries peak at 45-70 bytes per value, so about 1 GiB at the cap. The block's
+#: start cells are ``chunk`` (1 at the first waypoint, the start), its cells the
+#: ``(2 ceil(reach / cell))^2`` squares :func:`disc_cells` looks at.
+MAX_BLOCK_VALUES = 2**24
+#: Start cells per block by default (and always in :func:`lower_bound`).
+CHUNK = 24
 
 
 @dataclass(frozen=True)
@@ -174,10 +205,12 @@ class Lags:
     @classmethod
     def from_robot(cls, robot: Robot, weight: float) -> Lags:
         """The thesis plant's lags for the weight ``lam`` in [0, 1]."""
+        check_instance("robot", robot, Robot)
+        weight = check_range("weight", weight, 0.0, 1.0)
         d = sym.ThesisDynamics.from_robot(robot)
         if d.c1 <= 0.0:
             raise ParameterError("c1 must be > 0 to price the stops (an undamped base)")
-        return _lags(d.mass / d.c1, d.top_speed, float(weight))
+        return _lags(d.mass / d.c1, d.top_speed, weight)
 
     def at_rest(self, length) -> np.ndarray:
         """A lower bound (s) on the rest-to-rest lag of any path at least ``length`` (m)
@@ -307,6 +340,121 @@ def _leg_costs(entries, drive, charge, kind: str, stops: bool) -> dict[State, np
     return {("line", True): paying, ("line", False): charged[:, None, :] + drive}
 
 
+def _items(name: str, value, wanted: str, size: int | None = None) -> tuple:
+    """The items of the list ``value`` (``size`` of them, if given); text, a mapping, a
+    non-iterable or another length raises :class:`ParameterError` saying ``name`` must be
+    ``wanted``."""
+    refused = ParameterError(f"{name} must be {wanted} (got {shown(value, 60)})")
+    if isinstance(value, str | bytes | dict):
+        raise refused
+    try:
+        items = tuple(value)
+    except TypeError:
+        raise refused from None
+    if size is not None and len(items) != size:
+        raise refused
+    return items
+
+
+def _numbers(name: str, value, fields: tuple[tuple[str, float, str], ...], wanted: str):
+    """``value`` as one float per ``(field, cap, unit)``, each finite and within ``+-cap``."""
+    items = _items(name, value, wanted, len(fields))
+    return tuple(
+        check_range(f"{name} {field}", item, -cap, cap, unit)
+        for (field, cap, unit), item in zip(fields, items)
+    )
+
+
+_XY = (("x", MAX_COORDINATE_M, "m"), ("y", MAX_COORDINATE_M, "m"))
+_POSE = (*_XY, ("heading", MAX_ANGLE_RAD, "rad"))
+_WAYPOINTS = "a non-empty list of (x, y) pairs in m"
+
+
+def _arcs(name: str, value) -> int:
+    """``value`` as an even integer in [2, :data:`MAX_ARCS`] (:func:`opposite` pairs each
+    arc with the one half the circle away)."""
+    try:
+        arcs = check_int_at_least(name, value, 2, MAX_ARCS)
+    except ParameterError:
+        arcs = 1  # one message for every fault, its range saying "even" too
+    if arcs % 2:
+        raise ParameterError(
+            f"{name} must be an even integer in [2, {MAX_ARCS}] (got {shown(value)})"
+        )
+    return arcs
+
+
+def _check_block(
+    reach: float, grid: tuple, chunk: int, several: bool, chunk_name: str | None
+) -> None:
+    """Refuse a grid whose blocks exceed :data:`MAX_BLOCK_VALUES`, before anything is
+    allocated, naming the largest chunk or the smallest cell that fits. ``grid``: ``(cell
+    name, cell, arcs name, arcs)``; ``several``: more than one waypoint (the first leg's
+    blocks start at the start alone); ``chunk_name``: the caller's parameter that sets
+    ``chunk``, or None (fixed)."""
+    cell_name, cell, arcs_name, arcs = grid
+    squares = (2 * math.ceil(reach / cell)) ** 2
+    rows = chunk if several else 1
+
+    def values(squares: int) -> int:
+        return min(rows, squares) * squares * arcs
+
+    if values(squares) <= MAX_BLOCK_VALUES:
+        return
+    cap = f"blocks of at most {MAX_BLOCK_VALUES} values"
+    if chunk_name is not None and squares * arcs <= MAX_BLOCK_VALUES:
+        most = MAX_BLOCK_VALUES // (squares * arcs)
+        raise ParameterError(
+            f"{chunk_name} must be an integer in [1, {most}] for {cell_name} = {cell:g} m and "
+            f"{arcs_name} = {arcs} ({cap}) (got {chunk})"
+        )
+    # the most squares that fit across the disc's radius, ceil(reach / cell)
+    across = math.isqrt(MAX_BLOCK_VALUES // arcs) // 2
+    while across > 0 and values((2 * across) ** 2) > MAX_BLOCK_VALUES:
+        across -= 1
+    finest = math.ceil(1e3 * reach / across) / 1e3 if across else math.inf  # rounded up to the mm
+    if finest > CELL_RANGE_M[1]:
+        raise ParameterError(
+            f"robot: a reach L1 + L2 + tolerance of {reach:g} m is too long for the bound's "
+            f"grid ({cap} with {cell_name} <= {CELL_RANGE_M[1]:g} m and {arcs_name} = {arcs})"
+        )
+    raise ParameterError(
+        f"{cell_name} must be in [{finest:g}, {CELL_RANGE_M[1]:g}] m for {arcs_name} = {arcs} "
+        f"and a reach L1 + L2 + tolerance of {reach:g} m ({cap}) (got {cell:g})"
+    )
+
+
+def _checked(robot, waypoints, start, tolerance, grids, chunk, chunk_name: str | None):
+    """The inputs :func:`budget_bound` and :func:`lower_bound` share, checked before any
+    work: ``(waypoints, start, tolerance, grids, chunk)`` as floats and ints, or the first
+    fault as one :class:`ParameterError`. ``grids``: ``(cell name, cell, arcs name,
+    arcs)`` each; ``chunk_name``: as in :func:`_check_block`."""
+    check_instance("robot", robot, Robot)
+    items = _items("waypoints", waypoints, _WAYPOINTS)
+    if not items:
+        raise ParameterError(f"waypoints must be {_WAYPOINTS} (got {shown(waypoints)})")
+    pair = "an (x, y) pair of numbers in m"
+    points = tuple(
+        _numbers(f"waypoints[{i}]", item, _XY, pair) for i, item in enumerate(items, start=1)
+    )
+    start = _numbers("start", start, _POSE, "(x, y, heading): 3 numbers in m, m, rad")
+    tolerance = check_range("tolerance", tolerance, *TOLERANCE_RANGE_M, "m")
+    grids = [
+        (
+            cell_name,
+            check_range(cell_name, cell, *CELL_RANGE_M, "m"),
+            arcs_name,
+            _arcs(arcs_name, arcs),
+        )
+        for cell_name, cell, arcs_name, arcs in grids
+    ]
+    chunk = check_int_at_least(chunk_name or "chunk", chunk, 1)
+    reach = Prices.from_robot(robot, tolerance).reach
+    for grid in grids:
+        _check_block(reach, grid, chunk, len(points) > 1, chunk_name)
+    return points, start, tolerance, grids, chunk
+
+
 def budget_bound(
     robot: Robot,
     waypoints,
@@ -314,20 +462,39 @@ def budget_bound(
     tolerance: float = 0.01,
     cell: float = 0.05,
     arcs: int = 180,
-    chunk: int = 24,
+    chunk: int = CHUNK,
     rotation_weight: float = 1.0,
 ) -> Bound:
     """A lower bound (s) on the time to take the end effector through ``waypoints`` in
     order from the base pose ``start`` (x, y, heading) at rest (module docstring).
 
-    ``cell``: side (m) of the position cells; ``arcs``: heading arcs over the circle (an
-    even number); ``chunk``: start cells per block (memory); ``rotation_weight``: the
-    weight ``lam`` in [0, 1] of the rotation's budget against the stops' lag (1: the
-    force budget alone)."""
+    Args:
+        robot: a :class:`~ddwmmr.model.Robot`.
+        waypoints: a non-empty list of (x, y) pairs (m), each coordinate finite and within
+            +-``MAX_COORDINATE_M`` (1e6 m).
+        start: the base's (x, y, heading) in m, m, rad: x and y within +-1e6 m, the heading
+            within +-``MAX_ANGLE_RAD`` (1e6 rad).
+        tolerance: waypoint radius (m), in :data:`TOLERANCE_RANGE_M` ([0, 0.1] m).
+        cell: side (m) of the position cells, in :data:`CELL_RANGE_M` ([0.01, 0.5] m).
+        arcs: heading arcs over the circle, an even integer in [2, :data:`MAX_ARCS`].
+        chunk: start cells per block (memory), an integer >= 1.
+        rotation_weight: the weight ``lam`` in [0, 1] of the rotation's budget against the
+            stops' lag (1: the force budget alone).
+
+    A block (``chunk`` start cells, 1 with a single waypoint, x the ``(2 ceil(reach /
+    cell))^2`` squares about a waypoint x ``arcs``, ``reach = L1 + L2 + tolerance``) holds
+    at most :data:`MAX_BLOCK_VALUES` values (about 1 GiB at the peak): a finer grid is
+    refused, the message naming the largest ``chunk`` or the smallest ``cell`` that fits.
+    The time grows as the squares' square times ``arcs`` per waypoint: seconds on the
+    bounds tool's grids, hours at 1 cm. Bad input raises
+    :class:`~ddwmmr.errors.ParameterError` naming the parameter and its range.
+    """
     began = time.perf_counter()
+    waypoints, start, tolerance, grids, chunk = _checked(
+        robot, waypoints, start, tolerance, [("cell", cell, "arcs", arcs)], chunk, "chunk"
+    )
+    ((_, cell, _, arcs),) = grids
     weight = check_range("rotation_weight", rotation_weight, 0.0, 1.0)
-    if arcs < 2 or arcs % 2:
-        raise ParameterError(f"arcs must be an even integer >= 2 (got {arcs})")
     stops = weight < 1.0
     kinds = ("line", "travel") if stops else ("line",)
     prices = Prices.from_robot(robot, tolerance)
@@ -393,16 +560,38 @@ def lower_bound(
 ) -> Bound:
     """The best of :func:`budget_bound` on ``grid`` (cell in m, arcs) and the stop-pricing
     bounds at ``stop_weights`` on ``stop_grid`` (s); each is a lower bound, so is their
-    greatest. ``cells`` and ``arcs`` are the winner's; the wall time is the sum."""
-    bounds = [budget_bound(robot, waypoints, tolerance=tolerance, cell=grid[0], arcs=grid[1])]
-    for weight in stop_weights:
+    greatest. ``cells`` and ``arcs`` are the winner's; the wall time is the sum.
+
+    ``robot``, ``waypoints`` and ``tolerance`` as in :func:`budget_bound` (the start: the
+    origin, heading 0, at rest); ``grid`` and ``stop_grid`` each a (cell, arcs) pair, the
+    cell in :data:`CELL_RANGE_M` ([0.01, 0.5] m) and the arcs an even integer in [2,
+    :data:`MAX_ARCS`], with blocks of :data:`CHUNK` start cells within
+    :data:`MAX_BLOCK_VALUES`; ``stop_weights`` a list, possibly empty, of weights in
+    [0, 1]. All are checked before the first bound is solved."""
+    pairs = []
+    for name, pair in (("grid", grid), ("stop_grid", stop_grid)):
+        cell, arcs = _items(name, pair, "a (cell, arcs) pair", 2)
+        pairs.append((f"{name} cell", cell, f"{name} arcs", arcs))
+    # the checked waypoints go on: a generator would be spent by the check
+    waypoints, _, tolerance, pairs, _ = _checked(
+        robot, waypoints, (0.0, 0.0, 0.0), tolerance, pairs, CHUNK, None
+    )
+    weights = tuple(
+        check_range(f"stop_weights[{i}]", weight, 0.0, 1.0)
+        for i, weight in enumerate(
+            _items("stop_weights", stop_weights, "a list of weights in [0, 1]"), start=1
+        )
+    )
+    (_, cell, _, arcs), (_, stop_cell, _, stop_arcs) = pairs
+    bounds = [budget_bound(robot, waypoints, tolerance=tolerance, cell=cell, arcs=arcs)]
+    for weight in weights:
         bounds.append(
             budget_bound(
                 robot,
                 waypoints,
                 tolerance=tolerance,
-                cell=stop_grid[0],
-                arcs=stop_grid[1],
+                cell=stop_cell,
+                arcs=stop_arcs,
                 rotation_weight=weight,
             )
         )
