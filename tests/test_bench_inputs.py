@@ -269,7 +269,10 @@ def test_an_unwritable_out_is_refused_before_the_run(make, message, workdir, cap
 def test_a_device_as_out_is_refused_without_suggesting_force(force, workdir, capsys, monkeypatch):
     """--force cannot replace a device: the message without it does not offer it."""
     line = refused(["--out", os.devnull, *force], workdir, capsys, monkeypatch)
-    message = f"out: {os.devnull} exists and is not a regular file; give a file name"
+    message = (
+        f"out: {os.devnull} exists and is not a regular file (a character device); "
+        "give a file name"
+    )
     assert line == f"bench: error: {message}" and "--force" not in line
 
 

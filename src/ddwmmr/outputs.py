@@ -359,11 +359,14 @@ def check_output_file(
     target: str | Path, tool: str, is_ours: Callable[[Path], bool], force: bool = False
 ) -> Path:
     """:func:`check_output_path` for a single output file: an existing file is replaced
-    only if ``is_ours(path)`` says this tool wrote it (or with ``force``); a folder never."""
+    only if ``is_ours(path)`` says this tool wrote it (or with ``force``); a folder, a
+    device, a FIFO or a socket never (:func:`check_file_target`), and that is said before
+    anything that would suggest ``--force``."""
     text = str(target)
     path = check_output_path(target, "file")
     if path.is_dir():
         raise ParameterError(f"out: {text} is a folder; give a file name")
+    check_file_target(text, "out")
     if path.exists() and not force and not is_ours(path):
         raise ParameterError(
             f"out: {text} exists and is not a {tool} report (use --force to replace it)"

@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 import math
 import os
-import stat
 from pathlib import Path
 from typing import Any
 
@@ -194,16 +193,7 @@ def write_report(report: dict[str, Any], path: str | Path, force: bool = False) 
 
 def check_out(path: Path, force: bool = False) -> None:
     """Refuse, before the run, an output path that cannot be written or that is not a
-    report of this tool (unless ``force``): see :func:`ddwmmr.outputs.check_output_file`.
-    Something that is not a regular file (a device, a FIFO) is never replaced, not even
-    with ``force``: the report is moved into place by a rename, which would replace it.
-    That is said first, so that the message does not suggest ``--force``."""
-    try:
-        info = os.stat(path)
-    except (OSError, ValueError):
-        info = None  # absent (check_output_file checks its folder) or not a path at all
-    if info is not None and not stat.S_ISREG(info.st_mode) and not stat.S_ISDIR(info.st_mode):
-        raise ParameterError(f"out: {path} exists and is not a regular file; give a file name")
+    report of this tool (unless ``force``): :func:`ddwmmr.outputs.check_output_file`."""
     check_output_file(path, TOOL, _is_report, force)
 
 
