@@ -71,6 +71,8 @@ from ddwmmr.scenarios.executors import (
 )
 from ddwmmr.scenarios.generator import Scenario, generate
 from ddwmmr.scenarios.protocol import (
+    OBSTACLE_TIME_LIMIT_S,
+    TIME_LIMIT_S,
     Outcome,
     RunConfig,
     make_scenario_controller,
@@ -115,14 +117,15 @@ DEFAULT_THRESHOLDS = {
     "manipulability": astuple(THESIS_MANIPULABILITY),
 }
 
-DESCRIPTION = """\
+DESCRIPTION = f"""\
 Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly (seeded) in
-an 8 m x 8 m square; the end effector must reach them in order within 0.01 m in 60 s
-(120 s with obstacles) while the tip-over stability S stays above 1. Writes scenarios.csv
-(one row per scenario), summary.json, table.txt (thesis Table 5.2 format) and figures
-(per-scenario bars as thesis Figs 5.3-5.9, paths, a state timeline) into --out, and prints
-the table. The controllers are the registered ones that do this waypoint task, the plants
-the registered ones; --help lists both, each controller with the plants it can command."""
+an 8 m x 8 m square; the end effector must reach them in order within 0.01 m in {TIME_LIMIT_S:g} s
+({OBSTACLE_TIME_LIMIT_S:g} s with obstacles) while the tip-over stability S stays above 1.
+Writes scenarios.csv (one row per scenario), summary.json, table.txt (thesis Table 5.2
+format) and figures (per-scenario bars as thesis Figs 5.3-5.9, paths, a state timeline)
+into --out, and prints the table. The controllers are the registered ones that do this
+waypoint task, the plants the registered ones; --help lists both, each controller with the
+plants it can command."""
 
 EPILOG = """\
 The default payload is 3.0 kg: with the thesis's 1.25 kg the planar arm can never tip
@@ -234,13 +237,14 @@ def build_parser() -> ArgumentParser:
         "--obstacles",
         action="store_true",
         help="run thesis scenarios 1, 3, 7, 10 (those up to --n) with two obstacles (r 0.3 m) "
-        "each, 120 s limit",
+        f"each, {OBSTACLE_TIME_LIMIT_S:g} s limit",
     )
     parser.add_argument(
         "--time-limit",
         type=float,
         metavar="S",
-        help="time limit per scenario in s (default: 60, 120 with obstacles)",
+        help=f"time limit per scenario in s (default: {TIME_LIMIT_S:g}, "
+        f"{OBSTACLE_TIME_LIMIT_S:g} with obstacles)",
     )
     parser.add_argument(
         "--dt",
@@ -415,7 +419,11 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     qp_options = _qp_options(args)
     check_range("payload", args.payload, *MASS_RANGE_KG, "kg")
     obstacles = args.obstacles or args.study == "obstacles"
-    longest = args.time_limit if args.time_limit is not None else (120.0 if obstacles else 60.0)
+    longest = (
+        args.time_limit
+        if args.time_limit is not None
+        else (OBSTACLE_TIME_LIMIT_S if obstacles else TIME_LIMIT_S)
+    )
     try:
         check_step_count(longest, args.dt)
     except ParameterError as exc:
