@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from ddwmmr import Ellipse, Rectangle, Robot, simulate
+from ddwmmr.reports.compare import corner_times as compare_corner_times
 from ddwmmr.sim.simulate import summarize
 
 
@@ -44,6 +45,15 @@ def test_corner_times_are_the_quarter_periods():
     for t in rect.corner_times(20.0):
         x, y, _ = rect.pose(t)
         assert (abs(x), abs(y)) == pytest.approx((rect.a, rect.b), abs=1e-12)
+
+
+def test_the_compare_studies_take_the_corners_before_the_run_ends():
+    """The corner study needs a window after each corner: one at the run's end is left out."""
+    rect = Rectangle(T=20.0)
+    assert compare_corner_times(rect, 20.0) == [5.0, 10.0, 15.0]
+    assert compare_corner_times(rect, 12.0) == [5.0, 10.0]
+    assert compare_corner_times(Rectangle(T=3.0), 7.5) == [0.75 * k for k in range(1, 10)]
+    assert compare_corner_times(Ellipse(), 20.0) == []
 
 
 def test_summary_when_every_sample_is_in_a_corner_window():

@@ -257,8 +257,9 @@ def observed_order(values: Mapping[float, float]) -> float:
 
 
 def corner_times(trajectory: Any, duration: float) -> list[float]:
-    """Times (s) of the rectangle's corners alpha = k pi/2 (k >= 1) within the run."""
-    quarter = getattr(trajectory, "T", trajectory.duration) / 4.0
-    return [
-        k * quarter for k in range(1, int(duration / quarter + 1e-9) + 1) if k * quarter < duration
-    ]
+    """Times (s) of the trajectory's corners within the run, its end ``duration`` (s)
+    excluded (no window follows a corner there): the trajectory's own ``corner_times`` (a
+    :class:`~ddwmmr.trajectories.Rectangle`'s alpha = k pi/2); none for a trajectory
+    without corners."""
+    corners = getattr(trajectory, "corner_times", None)
+    return [] if corners is None else [t for t in corners(duration) if t < duration]

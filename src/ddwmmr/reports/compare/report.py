@@ -895,7 +895,7 @@ def _corners_section(c: _Context) -> None:
     corners = corner_times(trajectory, duration)
     quarter = getattr(trajectory, "T", trajectory.duration) / 4.0
     if not corners:
-        c.doc.paragraph("The run ends before the first corner.")
+        c.doc.paragraph("No corner of the trajectory falls within the run.")
         return
     series = {m: c.main(m, CORNER_TRAJECTORY).timeseries for m in c.config.methods}
     peaks = {m: corner_peaks(ts, corners, quarter, duration) for m, ts in series.items()}
