@@ -270,8 +270,7 @@ def test_a_device_as_out_is_refused_without_suggesting_force(force, workdir, cap
     """--force cannot replace a device: the message without it does not offer it."""
     line = refused(["--out", os.devnull, *force], workdir, capsys, monkeypatch)
     message = (
-        f"out: {os.devnull} exists and is not a regular file (a character device); "
-        "give a file name"
+        f"out: {os.devnull} exists and is not a regular file (a character device); give a file name"
     )
     assert line == f"bench: error: {message}" and "--force" not in line
 

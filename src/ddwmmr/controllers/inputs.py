@@ -12,9 +12,13 @@ a finite command at any finite state (tests/test_qp_limits_extreme.py).
 
 It runs every control step, so the common case (everything finite) is one sum over the
 values: a sum is finite only if every term is finite. Only when it is not (or when the
-arguments are not flat numeric sequences) does the slow path look at each argument, which
-also clears sums that merely overflowed. It returns the arguments as lists of floats, which
-the closed-form controllers work with anyway (one conversion instead of two).
+arguments are not flat numeric sequences, or hold an integer beyond a float such as
+``10**400``) does the slow path look at each argument, which also clears sums that merely
+overflowed. It returns the arguments as lists of floats, which the closed-form controllers
+work with anyway (one conversion instead of two).
+
+:func:`check_start` is the same check for the start configuration ``q0`` of
+``Controller.reset``.
 """
 
 from __future__ import annotations
@@ -55,37 +59,46 @@ def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
         values = ql + pl + vl
         if len(values) == 11 and len(ql) == 5 and len(pl) == 3 and _isfinite(sum(values, t)):
             return ql, pl, vl
-    except (AttributeError, TypeError):
+    except (AttributeError, TypeError, OverflowError):  # OverflowError: an int like 10**400
         pass
-    _check_each(t, q, pose_d, velocity_d)
-    return (
-        np.asarray(q, dtype=float).tolist(),
-        np.asarray(pose_d, dtype=float).tolist(),
-        np.asarray(velocity_d, dtype=float).tolist(),
+    _check_time(t)
+    ql, pl, vl = (
+        check_numbers(name, value, size, entries)
+        for (name, size, entries), value in zip(_ARGUMENTS, (q, pose_d, velocity_d))
     )
+    return ql, pl, vl
 
 
-def _check_each(t: Any, q: Any, pose_d: Any, velocity_d: Any) -> None:
-    """The slow path: check every argument on its own and name the bad one."""
+def check_start(q0: Any) -> list[float]:
+    """``q0``, the start configuration of ``Controller.reset``, as a list of 5 floats
+    ``[x, y, phi, th1, th2]`` (m, rad), or :class:`ParameterError` naming ``q0``."""
+    return check_numbers("q0", q0, 5, "[x, y, phi, th1, th2] (m, rad)")
+
+
+def check_numbers(name: str, value: Any, size: int, entries: str) -> list[float]:
+    """``value`` as a list of ``size`` floats if it is a flat sequence of ``size`` finite
+    numbers, else :class:`ParameterError` naming ``name`` and saying what its entries are
+    (``entries``, e.g. ``"[x, y, phi, th1, th2] (m, rad)"``)."""
+    wanted = f"{name} must be {size} finite numbers {entries}"
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an int like 10**400
+        raise ParameterError(f"{wanted} (got {shown(value, 60)})") from None
+    if array.shape != (size,):
+        raise ParameterError(f"{wanted} (got shape {array.shape})")
+    if not np.all(np.isfinite(array)):
+        raise ParameterError(f"{wanted} (got {array.tolist()})")
+    return array.tolist()
+
+
+def _check_time(t: Any) -> None:
+    """The slow path's check of the time ``t`` (s)."""
     try:
         time = float(t)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):  # OverflowError: an int like 10**400
         raise ParameterError(f"t must be a finite time in s (got {shown(t)})") from None
     if not math.isfinite(time):
         raise ParameterError(f"t must be a finite time in s (got {shown(time)})")
-    for (name, size, entries), value in zip(_ARGUMENTS, (q, pose_d, velocity_d)):
-        try:
-            array = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
-            raise ParameterError(f"{name} must be {size} finite numbers {entries}") from None
-        if array.shape != (size,):
-            raise ParameterError(
-                f"{name} must be {size} finite numbers {entries} (got shape {array.shape})"
-            )
-        if not np.all(np.isfinite(array)):
-            raise ParameterError(
-                f"{name} must be {size} finite numbers {entries} (got {array.tolist()})"
-            )
 
 
 def check_command(u: tuple[float, ...], q: list[float], pose_d: list[float]) -> None:

@@ -13,14 +13,24 @@ same way::
 Plants never see controllers. ``policy`` (optional) lets an integrator of the kinematic
 plant re-evaluate a continuous-time control law at its intermediate stages (RK4); every
 other plant holds the command over the step (zero-order hold) and ignores it.
+
+The arguments of ``reset`` and ``step`` are checked by every plant with the helpers here
+(:func:`check_configuration`, :func:`check_control_step`, :func:`check_step`): anything
+but finite numbers of the right shape is a one-line
+:class:`~ddwmmr.errors.ParameterError` naming ``q0``, ``dt``, ``t`` or ``command``, before
+the state changes.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
 import numpy as np
+
+from ddwmmr.commands import FORCE, VELOCITY, WheelForces
+from ddwmmr.errors import ParameterError, check_finite, check_positive, shown
 
 #: A continuous-time control law for integrator stages: ``(t, q) -> u``, time in s, the
 #: configuration as a list of 5 floats, the velocity command as 4 numbers (a tuple of
@@ -80,6 +90,120 @@ class PlantDivergedError(RuntimeError):
     """
 
 
+#: What each command interface takes, for messages.
+_COMMAND_FORMS = {
+    VELOCITY: "4 finite numbers u = [v, w, th1dot, th2dot] (m/s, rad/s, rad/s, rad/s)",
+    FORCE: (
+        "a WheelForces(left, right, th1_target, th2_target) of 4 finite numbers (N, N, rad, rad)"
+    ),
+}
+_FLOAT64 = np.dtype(float)
+#: Entries numpy would read as numbers that are not numbers here.
+_NOT_NUMBERS = (str, bytes, bool, np.bool_)
+_INF = math.inf
+_isfinite = math.isfinite
+
+
+def check_configuration(q0: Any, name: str = "q0") -> list[float]:
+    """``q0`` as a list of 5 floats if it is a flat sequence of 5 finite numbers
+    ``[x, y, phi, th1, th2]`` (m, m, rad, rad, rad), else :class:`ParameterError` naming
+    ``name``: the start of ``Plant.reset``."""
+    values = _floats(q0, 5)
+    if values is None or not all(map(_isfinite, values)):
+        raise ParameterError(
+            f"{name} must be 5 finite numbers [x, y, phi, th1, th2] (m, rad) (got {shown(q0, 60)})"
+        )
+    return values
+
+
+def check_control_step(dt: Any) -> float:
+    """``dt`` (s) as a float if it is a finite number > 0, else :class:`ParameterError`
+    naming ``dt``: the control step of ``Plant.reset`` and ``Plant.step``."""
+    return check_positive("dt", dt)
+
+
+def check_step(
+    t: Any, command: Any, dt: Any, interfaces: Sequence[str] = (VELOCITY,)
+) -> list[float] | WheelForces:
+    """The arguments of ``Plant.step`` checked, before anything changes.
+
+    Args:
+        t: time at the start of the step (s), a finite number.
+        command: on the ``"velocity"`` interface 4 finite numbers ``u = [v, w, th1dot,
+            th2dot]`` (m/s, rad/s, rad/s, rad/s; any flat sequence); on the ``"force"``
+            interface a :class:`~ddwmmr.commands.WheelForces` of 4 finite numbers (N, N,
+            rad, rad). Only the interfaces in ``interfaces`` are accepted.
+        dt: length of the step (s), a finite number > 0.
+
+    Returns:
+        A velocity command as a list of 4 floats, a ``WheelForces`` as it is.
+
+    Raises:
+        ParameterError: naming ``t``, ``dt`` or ``command`` and what it must be.
+
+    It runs every control step: a float64 array of shape (4,) (what the simulation loop
+    passes) or a ``WheelForces`` of floats, with a float dt (numpy's float64 too), costs
+    one ``tolist``, one sum (a sum is finite only if every term is) and the comparisons
+    of ``dt``; anything else takes the slow path, which names the fault and clears sums
+    that merely overflowed.
+    """
+    try:
+        if isinstance(dt, float) and 0.0 < dt < _INF:
+            if type(command) is np.ndarray and command.dtype is _FLOAT64:
+                # another shape than (4,) fails here: too many or too few values to unpack
+                # (ValueError), or rows that are lists, not floats (TypeError in the sum)
+                a, b, c, d = values = command.tolist()
+                if _isfinite(a + b + c + d + t) and VELOCITY in interfaces:
+                    return values
+            elif type(command) is WheelForces and FORCE in interfaces:
+                total = command.left + command.right + command.th1_target + command.th2_target
+                if _isfinite(total + t):
+                    return command
+    except (TypeError, ValueError, OverflowError):  # text, None, an int like 10**400
+        pass
+    return _check_step_slowly(t, command, dt, interfaces)
+
+
+def _check_step_slowly(
+    t: Any, command: Any, dt: Any, interfaces: Sequence[str]
+) -> list[float] | WheelForces:
+    """:func:`check_step` for any argument: name the first fault, else return as it does."""
+    check_finite("t", t, "in s")
+    check_control_step(dt)
+    forces = isinstance(command, WheelForces)
+    values = None
+    if forces and FORCE in interfaces:
+        fields = (command.left, command.right, command.th1_target, command.th2_target)
+        values = _floats(fields, 4)
+    elif not forces and VELOCITY in interfaces:
+        values = _floats(command, 4)
+    if values is not None and all(map(_isfinite, values)):
+        return command if forces else values
+    wanted = " or ".join(_COMMAND_FORMS[i] for i in (VELOCITY, FORCE) if i in interfaces)
+    message = f"command must be {wanted} (got {shown(command, 60)})"
+    raise ParameterError(message)
+
+
+def _floats(value: Any, size: int) -> list[float] | None:
+    """``value`` as a list of ``size`` floats (finite or not) if it is a flat sequence of
+    ``size`` numbers, else None. Text, booleans, None and integers beyond a float are not
+    numbers here (numpy would read ``"1.5"`` and ``True`` as ones)."""
+    if isinstance(value, str | bytes | dict):
+        return None
+    if isinstance(value, list | tuple) and any(isinstance(v, _NOT_NUMBERS) for v in value):
+        return None
+    try:
+        raw = np.asarray(value)
+        if raw.dtype.kind not in "iufO" or (
+            raw.dtype.kind == "O" and any(isinstance(v, _NOT_NUMBERS) for v in raw.flat)
+        ):
+            return None
+        array = raw.astype(float)
+    except (TypeError, ValueError, OverflowError):  # ragged, None, an int like 10**400
+        return None
+    return array.tolist() if array.shape == (size,) else None
+
+
 class Plant(Protocol):
     """Structural type of every plant.
 
@@ -108,8 +232,9 @@ class Plant(Protocol):
     def reset(self, q0: np.ndarray, dt: float) -> None:  # pragma: no cover - protocol
         """Place the robot at rest at configuration ``q0`` for a run with control step dt (s).
 
-        Raises :class:`~ddwmmr.errors.ParameterError` if dt does not suit the plant (e.g.
-        not a multiple of a physics engine's timestep).
+        Raises :class:`~ddwmmr.errors.ParameterError` if ``q0`` is not 5 finite numbers
+        (:func:`check_configuration`) or dt does not suit the plant (not finite and > 0,
+        :func:`check_control_step`; not a multiple of a physics engine's timestep).
         """
         ...
 
@@ -128,8 +253,11 @@ class Plant(Protocol):
         """Advance the state by ``dt`` (s) from time ``t`` under ``command``.
 
         ``command`` is a velocity array u or a :class:`~ddwmmr.commands.WheelForces`,
-        whichever of ``interfaces`` it belongs to. Raises :class:`PlantDivergedError` when
-        the new state is not finite.
+        whichever of ``interfaces`` it belongs to. Raises
+        :class:`~ddwmmr.errors.ParameterError` for a command of another interface, a
+        non-finite or misshapen one, a non-finite t or a dt that is not > 0
+        (:func:`check_step`), and :class:`PlantDivergedError` when the new state is not
+        finite.
         """
         ...
 

@@ -28,7 +28,14 @@ import numpy as np
 
 from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
-from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
+from ddwmmr.plants.base import (
+    Observation,
+    PlantDivergedError,
+    Policy,
+    check_configuration,
+    check_control_step,
+    check_step,
+)
 from ddwmmr.registry import register_plant
 
 INTEGRATORS = ("euler", "rk4")
@@ -58,11 +65,12 @@ class KinematicPlant:
 
     # -- Plant interface ------------------------------------------------------------------
     def reset(self, q0: np.ndarray, dt: float) -> None:
-        """Start at configuration ``q0`` at rest; any control step dt > 0 suits this plant."""
-        q = np.array(q0, dtype=float)
-        if q.shape != (5,) or not np.all(np.isfinite(q)):
-            raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
-        self._state = q.tolist()
+        """Start at configuration ``q0`` (5 finite numbers ``[x, y, phi, th1, th2]``, m and
+        rad) at rest; any control step dt > 0 (s, finite) suits this plant. Anything else
+        is a :class:`ParameterError` naming ``q0`` or ``dt``."""
+        state = check_configuration(q0)
+        check_control_step(dt)
+        self._state = state
         self._v = self._w = 0.0
 
     def observe(self) -> Observation:
@@ -76,12 +84,15 @@ class KinematicPlant:
         return applied, saturated
 
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
-        """Advance by dt under velocity ``command`` (see :meth:`integrate`)."""
+        """Advance by dt (s) from time t (s) under velocity ``command``, 4 finite numbers
+        ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s, rad/s, rad/s), see :meth:`integrate`;
+        other arguments are a :class:`ParameterError` (:func:`check_step`)."""
+        values = check_step(t, command, dt, self.interfaces)
         state = self._state
         if command is self._limited:  # limit() saturated this very command
-            u0 = tuple(command.tolist())
+            u0 = tuple(values)
         else:
-            u0, _ = self._saturate(state[3], state[4], command)
+            u0, _ = self._saturate(state[3], state[4], tuple(values))
         x, y, phi, th1, th2 = new = self._advance(t, state, dt, policy, u0)
         isfinite = math.isfinite
         if not (isfinite(x) and isfinite(y) and isfinite(phi) and isfinite(th1 + th2)):

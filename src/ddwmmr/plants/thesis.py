@@ -39,7 +39,14 @@ from ddwmmr.model.thesis_base import (  # the base's constants (controllers' mod
     FORCE_LIMIT_DEFAULT,
     JOINT_SPEED_DEFAULT,
 )
-from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
+from ddwmmr.plants.base import (
+    Observation,
+    PlantDivergedError,
+    Policy,
+    check_configuration,
+    check_control_step,
+    check_step,
+)
 from ddwmmr.registry import register_plant
 
 #: Bandwidth (1/s) of the velocity servo that follows velocity commands.
@@ -177,9 +184,12 @@ class ThesisPlant:
 
     # -- Plant interface ------------------------------------------------------------------
     def reset(self, q0: np.ndarray, dt: float) -> None:
-        """Start at rest at configuration ``q0`` (the dynamics are exact for any dt)."""
-        check_positive("dt", dt)
-        self.state = ThesisState(*(float(v) for v in q0))
+        """Start at rest at configuration ``q0`` (5 finite numbers ``[x, y, phi, th1,
+        th2]``, m and rad); the dynamics are exact for any control step dt > 0 (s, finite).
+        Anything else is a :class:`ParameterError` naming ``q0`` or ``dt``."""
+        state = check_configuration(q0)
+        check_control_step(dt)
+        self.state = ThesisState(*state)
         self._forces = (0.0, 0.0)
 
     def observe(self) -> Observation:
@@ -197,16 +207,18 @@ class ThesisPlant:
         return np.array([v, w, c1, c2]), True
 
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
-        """Advance by dt under wheel forces or a velocity command (zero-order hold)."""
+        """Advance by dt (s) from time t (s) under wheel forces (a
+        :class:`~ddwmmr.commands.WheelForces`, N and rad) or a velocity command ``u = [v, w,
+        th1dot, th2dot]`` (m/s, rad/s), held over the step; non-finite or misshapen
+        arguments are a :class:`ParameterError` (:func:`check_step`)."""
+        checked = check_step(t, command, dt, self.interfaces)
         state = self.state
         inertia = self.inertia(state.th1, state.th2)  # once for the servo and the dynamics
-        if isinstance(command, WheelForces):
-            f_left, f_right = command.left, command.right
-            target = (command.th1_target, command.th2_target)
+        if isinstance(checked, WheelForces):
+            f_left, f_right = checked.left, checked.right
+            target = (checked.th1_target, checked.th2_target)
         else:
-            v, w, r1, r2 = (
-                command.tolist() if isinstance(command, np.ndarray) else (float(a) for a in command)
-            )
+            v, w, r1, r2 = checked
             f_left, f_right = self.servo.forces(state, v, w, inertia)
             limit = self.robot.joint_speed_limit
             r1 = min(limit, max(-limit, r1))

@@ -55,7 +55,7 @@ from ddwmmr.controllers.base import (
     register_controller,
     step_results,
 )
-from ddwmmr.controllers.inputs import check_inputs
+from ddwmmr.controllers.inputs import check_inputs, check_start
 from ddwmmr.errors import ParameterError, check_bool, check_nonnegative, check_positive, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import whole_turns
@@ -315,11 +315,15 @@ class QPController:
         self._loop_step = dt
 
     def reset(self, trajectory: Any, q0: np.ndarray) -> None:
-        """Forget warm starts and counters; take the look-ahead step (:func:`control_step`)."""
+        """Forget warm starts and counters; take the look-ahead step (:func:`control_step`).
+
+        ``q0``: the start configuration, 5 finite numbers ``[x, y, phi, th1, th2]`` (m,
+        rad), else :class:`ParameterError` naming ``q0``."""
+        start = check_start(q0)
         self.ctx.dt = control_step(self._dt_option, self._loop_step, trajectory, DEFAULT_DT)
         self.backend.reset()
         self.ctx.previous_command = None
-        self.ctx.start_turns = tuple(whole_turns(float(angle)) for angle in q0[2:5])
+        self.ctx.start_turns = tuple(whole_turns(angle) for angle in start[2:5])
         self.fallbacks = 0
         self.last = StepInfo()
         self.min_predicted_edge_load = None
@@ -431,9 +435,21 @@ class QPController:
         if self.base_motion is not None and ctx.previous_command is not None:
             low_v, high_v, low_w, high_w = self.base_motion.envelope(ctx)
             v, w = min(max(0.0, low_v), high_v), min(max(0.0, low_w), high_w)
-        self.last = StepInfo(fallback=True, extra={"slack": float("nan"), "arm_scale": scale})
+        shortfall = self.tracking_shortfall(ctx, (v, w, r1, r2))
+        self.last = StepInfo(fallback=True, extra={"slack": shortfall, "arm_scale": scale})
         ctx.previous_command = (v, w)
         return np.array([v, w, r1 * scale, r2 * scale])
+
+    def tracking_shortfall(self, ctx: StepContext, u: Sequence[float]) -> float:
+        """The slack the tracking rows need for the velocity command ``u = (v, w, th1dot,
+        th2dot)`` (m/s, rad/s, rad/s, rad/s) at this step: the largest ``|J_E u - target|``
+        (m/s on the xE, yE rows, rad/s on the phiE row; 0 on a row the task does not
+        track). A QP answer's ``slack`` is this for its ``u``; a fallback step, which has
+        no answer, reports it for the fallback's command (before the arm scale, as the
+        QP's is), so ``last.extra["slack"]`` is a finite number on every step."""
+        jac, target = np.zeros((3, 4)), np.zeros(3)
+        self.tracking.compute(ctx, jac, target)
+        return float(np.max(np.abs(jac @ np.asarray(u, dtype=float) - target)))
 
     def _stability_ascent(self, ctx: StepContext) -> tuple[float, float]:
         """Joint rates (rad/s) at half the speed limit up the summed unit gradients of the

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_positive, shown
+from ddwmmr.errors import ParameterError, check_positive, check_range, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import BASE_CLEARANCE_M
 from ddwmmr.model.support_loads import convex_hull
@@ -69,6 +69,13 @@ LINK_RADIUS = 0.02
 PAYLOAD_RADIUS = 0.04
 #: Engine options with the defaults chosen by measurement (docs/physics.md, "Settings").
 DEFAULT_TIMESTEP = 0.002
+#: Allowed range of the engine ``timestep`` (s): from 10 us (the robot's settling at reset
+#: is then 50,000 engine steps, about 0.5 s of computing; at 0.1 us, about a minute) to
+#: 10 ms (already unusable for tipping, docs/physics.md, "Settings").
+TIMESTEP_RANGE_S = (1e-5, 0.01)
+#: Most engine steps in one control step: the control step ``dt`` is at most this many
+#: timesteps (20 s at the default 2 ms), so that no single ``step`` runs for minutes.
+MAX_ENGINE_STEPS_PER_CONTROL_STEP = 10_000
 DEFAULT_FRICTION = 1.0
 DEFAULT_SERVO_TIME_CONSTANT = 0.02
 DEFAULT_CONTACT_TIME_CONSTANT = 0.01
@@ -108,7 +115,8 @@ class EngineOptions:
     """MuJoCo settings of the physics plant.
 
     Attributes:
-        timestep: engine step (s); the control step must be a whole multiple of it.
+        timestep: engine step (s), in :data:`TIMESTEP_RANGE_S`; the control step must be a
+            whole multiple of it, at most :data:`MAX_ENGINE_STEPS_PER_CONTROL_STEP` of them.
         friction: sliding friction coefficient between the wheels and the floor.
         servo_time_constant: time constant of the velocity servos (s), sets their gains.
         cone: friction cone, ``"elliptic"`` (default: MuJoCo's exact Coulomb cone) or
@@ -131,6 +139,7 @@ class EngineOptions:
     def __post_init__(self) -> None:
         for name in ("timestep", "friction", "servo_time_constant", "contact_time_constant"):
             object.__setattr__(self, name, check_positive(name, getattr(self, name)))
+        check_range("timestep", self.timestep, *TIMESTEP_RANGE_S, "s")
         stiffness = self.tyre_stiffness
         if not (isinstance(stiffness, int | float) and math.isfinite(stiffness) and stiffness >= 0):
             raise ParameterError(

@@ -29,14 +29,21 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from ddwmmr.commands import VELOCITY, WheelForces, interface_of
+from ddwmmr.commands import VELOCITY, WheelForces
 from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import wrap_angle
-from ddwmmr.plants.base import Observation, PlantDivergedError, Policy
+from ddwmmr.plants.base import (
+    Observation,
+    PlantDivergedError,
+    Policy,
+    check_configuration,
+    check_step,
+)
 from ddwmmr.plants.kinematic import KinematicPlant
 from ddwmmr.plants.mujoco.model import (
     ACTUATORS,
+    MAX_ENGINE_STEPS_PER_CONTROL_STEP,
     TYRE_DAMPING_RATIO,
     EngineOptions,
     build_model,
@@ -93,7 +100,9 @@ class MujocoPlant:
 
     Args:
         robot: the robot; its MJCF model is generated from it (:mod:`.model`).
-        timestep: engine step (s), default 0.002 (docs/physics.md, "Settings").
+        timestep: engine step (s), default 0.002, in [1e-5, 0.01]
+            (:data:`~ddwmmr.plants.mujoco.model.TIMESTEP_RANGE_S`; docs/physics.md,
+            "Settings"); a control step is a whole multiple of it, at most 10,000 of them.
         friction: wheel-floor sliding friction coefficient.
         servo_time_constant: response time of the velocity servos (s).
         cone: MuJoCo friction cone, ``"elliptic"`` (default, Coulomb's) or ``"pyramidal"``.
@@ -242,18 +251,22 @@ class MujocoPlant:
         return ", ".join(f"{k * h:g}" for k in range(1, count + 1))
 
     def _check_dt(self, dt: float) -> int:
+        """The engine steps in a control step of ``dt`` (s), which must be a whole multiple
+        of the timestep, at most :data:`MAX_ENGINE_STEPS_PER_CONTROL_STEP` of them."""
         h = self.options.timestep
+        most = MAX_ENGINE_STEPS_PER_CONTROL_STEP
         try:
             if isinstance(dt, bool | str | bytes):
                 raise TypeError  # not a number, even where float() reads it
             ratio = float(dt) / h
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):  # OverflowError: an int like 10**400
             ratio = math.nan  # not a number: refused below, naming the allowed steps
         substeps = round(ratio) if math.isfinite(ratio) else 0
-        if substeps < 1 or abs(substeps * h - dt) > 1e-9 * max(1.0, abs(dt)):
+        if not 1 <= substeps <= most or abs(substeps * h - dt) > 1e-9 * max(1.0, abs(dt)):
             raise ParameterError(
-                f"dt must be a whole multiple of the MuJoCo timestep {h:g} s "
-                f"({self.control_step_choices()}, ...) (got {shown(dt)})"
+                f"dt must be a whole multiple of the MuJoCo timestep {h:g} s in "
+                f"[{h:g}, {most * h:g}] s ({self.control_step_choices()}, ...) "
+                f"(got {shown(dt)})"
             )
         return substeps
 
@@ -262,20 +275,20 @@ class MujocoPlant:
 
         The robot first settles on its supports for :data:`SETTLE_TIME_S` with the servos
         holding still; then x, y, heading and joints are put back exactly to ``q0``.
-        Raises :class:`ParameterError` if dt is not a multiple of the engine timestep or q0
-        is not 5 finite numbers with the joints inside their limits.
+        Raises :class:`ParameterError` if dt is not a whole multiple of the engine timestep
+        (at most :data:`~ddwmmr.plants.mujoco.model.MAX_ENGINE_STEPS_PER_CONTROL_STEP` of
+        them) or q0 is not 5 finite numbers (m, rad) with the joints inside their limits;
+        nothing changes then.
         """
-        self._substeps = self._check_dt(dt)
-        self._dt = float(dt)
-        q0 = np.asarray(q0, dtype=float)
-        if q0.shape != (5,) or not np.all(np.isfinite(q0)):
-            raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
+        substeps = self._check_dt(dt)
+        q0 = np.array(check_configuration(q0))
         for i, (angle, (low, high)) in enumerate(zip(q0[3:], self.robot.joint_limits), 1):
             if not low <= angle <= high:
                 raise ParameterError(
                     f"q0 joint th{i} must be within joint_limits[{i}] = [{low:g}, {high:g}] "
                     f"(got {angle:g})"
                 )
+        self._substeps, self._dt = substeps, float(dt)
         model, data = self.model, self.data
         mujoco.mj_resetData(model, data)
         self._set_wheel_mode(VELOCITY)
@@ -358,20 +371,24 @@ class MujocoPlant:
         return self._limits.saturate(np.asarray(q, dtype=float), np.asarray(u, dtype=float))
 
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
-        """Hold ``command`` for ``dt`` (s): ``dt / timestep`` engine steps (``policy`` unused).
+        """Hold ``command`` for ``dt`` (s) from time t (s): ``dt / timestep`` engine steps
+        (``policy`` unused). ``command``: ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s) or a
+        :class:`~ddwmmr.commands.WheelForces` (N, rad), finite.
 
         Raises :class:`PlantDivergedError` (naming the step) if the engine state becomes
-        invalid, :class:`ParameterError` if dt differs from the reset's control step
-        and is not a multiple of the timestep.
+        invalid, :class:`ParameterError` for a non-finite or misshapen argument
+        (:func:`~ddwmmr.plants.base.check_step`) or if dt differs from the reset's control
+        step and is not an allowed one (:meth:`_check_dt`).
         """
         if self._dt is None:
             raise RuntimeError("reset(q0, dt) must be called before step")
+        checked = check_step(t, command, dt, self.interfaces)
         substeps = self._substeps if dt == self._dt else self._check_dt(dt)
         q = self.observe().q
-        if interface_of(command) == VELOCITY:
-            self._velocity_controls(q, np.asarray(command, dtype=float))
+        if isinstance(checked, WheelForces):
+            self._force_controls(q, checked, dt)
         else:
-            self._force_controls(q, command, dt)
+            self._velocity_controls(q, np.array(checked))
         mujoco.mj_step(self.model, self.data, substeps)
         self._check_state(f"in control step {self._step_count} (t = {t:.6g} to {t + dt:.6g} s)")
         self._step_count += 1
@@ -443,9 +460,6 @@ class MujocoPlant:
         return (drive - turn) * scale, (drive + turn) * scale
 
     def _force_controls(self, q: np.ndarray, command: WheelForces, dt: float) -> None:
-        values = (command.left, command.right, command.th1_target, command.th2_target)
-        if not all(math.isfinite(float(v)) for v in values):
-            raise FloatingPointError(f"non-finite command {command}")
         self._set_wheel_mode("force")
         th1, th2 = float(q[3]), float(q[4])
         new1, new2 = arm_step(
