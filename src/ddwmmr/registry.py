@@ -26,7 +26,12 @@ traits:
 * :func:`register_arbiter` (no traits; built as ``cls(stability=..., manipulability=...)``,
   plus ``seed=`` when its constructor takes one).
 
-Every decorator sets the class attribute ``name``. Where plug-ins come from:
+Every decorator sets the class attribute ``name``. A name is what the command line types
+(``--method NAME``, ``--option NAME:KEY=VALUE``, comma-separated lists, the run folder
+``runs/NAME-...``), so it must match :data:`NAME_PATTERN`: 1 to :data:`MAX_NAME_LENGTH`
+ASCII letters, digits, ``_``, ``-`` and ``.``, not starting with ``-`` or ``.`` (no space,
+comma, colon or ``=``); any other name is refused when it is registered. Where plug-ins
+come from:
 
 * built in: the modules of :data:`BUILTIN_MODULES`, in that order (the order of every
   listing). Their decorators and docstrings are read from the source, without importing
@@ -47,6 +52,7 @@ import ast
 import importlib
 import inspect
 import os
+import re
 import threading
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -73,6 +79,17 @@ BUILTIN_MODULES = (
 PLUGINS_VARIABLE = "DDWMMR_PLUGINS"
 #: Entry-point group of plug-in modules of other packages.
 ENTRY_POINT_GROUP = "ddwmmr.plugins"
+#: Longest plug-in name (characters): it becomes part of a run folder's name.
+MAX_NAME_LENGTH = 64
+#: The plug-in names the command line can address (see the module docstring): the shell
+#: splits words at whitespace, argparse reads a value starting with ``-`` as an option,
+#: the option parsers split at ``,`` (lists), ``:`` (``METHOD:KEY=VALUE``) and ``=``, and
+#: a leading ``.`` would hide the run folder.
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
+#: The allowed form of a name, as the messages word it.
+NAME_FORM = (
+    f"1 to {MAX_NAME_LENGTH} ASCII letters, digits, '_', '-' or '.', not starting with '-' or '.'"
+)
 _PACKAGE = Path(__file__).parent
 
 
@@ -130,7 +147,10 @@ class Registry:
     # -- registration -----------------------------------------------------------------
     def register(self, name: str, **traits: Any) -> Callable[[type], type]:
         """Class decorator: register the class under ``name`` with ``traits`` (see the
-        module docstring; ``description=`` overrides the docstring's first line)."""
+        module docstring; ``description=`` overrides the docstring's first line). A name
+        the command line cannot address (not :data:`NAME_FORM`) is a
+        :class:`~ddwmmr.errors.ParameterError` naming ``name``, raised here."""
+        self.check_name(name)
         description = traits.pop("description", None)
         resolved = self._traits(name, traits)
 
@@ -143,6 +163,22 @@ class Registry:
             return cls
 
         return decorate
+
+    def check_name(self, name: Any) -> str:
+        """``name`` if the command line can address it (:data:`NAME_PATTERN`, at most
+        :data:`MAX_NAME_LENGTH` characters), else a one-line
+        :class:`~ddwmmr.errors.ParameterError` naming ``name`` and the allowed form."""
+        valid = (
+            isinstance(name, str)
+            and len(name) <= MAX_NAME_LENGTH
+            and NAME_PATTERN.fullmatch(name) is not None
+        )
+        if not valid:
+            raise ParameterError(
+                f"{self.decorator}: name must be {NAME_FORM}, so that the command line can "
+                f"address it (got {shown(name)})"
+            )
+        return name
 
     def _traits(self, name: str, given: Mapping[str, Any]) -> dict[str, Any]:
         unknown = sorted(set(given) - set(self.defaults))
@@ -281,6 +317,7 @@ def _read_builtins() -> None:
     for index, module in enumerate(BUILTIN_MODULES):
         for line, decorator, name, traits, qualname, doc in _read_source(module):
             registry = _REGISTRIES[decorator]
+            registry.check_name(name)
             description = traits.pop("description", None)
             resolved = registry._traits(name, traits)
             entry = registry._entries.get(name)
@@ -343,6 +380,9 @@ __all__ = [
     "BUILTIN_MODULES",
     "CONTROLLERS",
     "ENTRY_POINT_GROUP",
+    "MAX_NAME_LENGTH",
+    "NAME_FORM",
+    "NAME_PATTERN",
     "PLANTS",
     "PLUGINS_VARIABLE",
     "Entry",

@@ -12,6 +12,10 @@ through the gain ``K = 1/tau`` (1/s)::
 The step response ``1 - exp(-t/tau)`` is how the measured pose approaches a step in the
 desired pose; the tracking error ``e = r - y`` of an initial offset decays as
 ``exp(-t/tau)`` (``e_dot + K e = 0``; docs/theory.md, "Error dynamics and python-control").
+
+Bad input (a ``tau`` that is no time constant, a ``method`` without error loops, ``times``
+that are not what a function asks for, a negative mass) is a one-line
+:class:`~ddwmmr.errors.ParameterError` naming the parameter and the allowed range.
 """
 
 from __future__ import annotations
@@ -21,7 +25,15 @@ from collections.abc import Sequence
 import control
 import numpy as np
 
-from ddwmmr.gains import gains_from_tau
+from ddwmmr.errors import (
+    ParameterError,
+    check_finite,
+    check_nonnegative,
+    check_positive,
+    shown,
+)
+from ddwmmr.gains import MIN_TAU, check_gain, gains_from_tau
+from ddwmmr.trajectories.base import check_times
 
 #: Feedback channels of each closed-loop method, in the order of its ``tau`` values.
 CHANNELS = {
@@ -44,10 +56,11 @@ def error_loop(tau: float) -> control.TransferFunction:
 def error_loops(method: str, tau: float | Sequence[float]) -> dict[str, control.TransferFunction]:
     """One :func:`error_loop` per feedback channel of ``method`` (see :data:`CHANNELS`).
 
-    ``tau`` is one time constant (s) for every channel or one per channel.
+    ``tau`` is one time constant (s) for every channel or one per channel
+    (:data:`ddwmmr.gains.TAU_RANGE`); ``method`` one of :data:`CHANNELS`.
     """
-    if method not in CHANNELS:
-        raise ValueError(f"method must be one of {', '.join(CHANNELS)} (got {method!r})")
+    if not isinstance(method, str) or method not in CHANNELS:
+        raise ParameterError(f"method must be one of {', '.join(CHANNELS)} (got {shown(method)})")
     names = CHANNELS[method]
     gains = gains_from_tau(tau, len(names))
     taus = [np.inf if k == 0.0 else 1.0 / k for k in gains]
@@ -57,25 +70,66 @@ def error_loops(method: str, tau: float | Sequence[float]) -> dict[str, control.
 def step_response(tau: float, times: Sequence[float] | np.ndarray) -> np.ndarray:
     """Unit step response of :func:`error_loop` at ``times`` (s), computed by python-control.
 
-    ``times`` must be increasing and start at 0.
+    ``times``: at least 2 finite times, equally spaced, increasing and starting at 0 (the
+    step), as python-control simulates them (:func:`check_response_times`).
     """
-    times = np.asarray(times, dtype=float)
+    times = check_response_times(times, spaced=True)
     response = control.step_response(error_loop(tau), times)
     return np.asarray(response.outputs, dtype=float)
 
 
 def error_response(tau: float, times: Sequence[float] | np.ndarray) -> np.ndarray:
-    """Remaining fraction of an initial error at ``times`` (s): ``1 - step response``."""
+    """Remaining fraction of an initial error at ``times`` (s): ``1 - step response``
+    (``tau`` and ``times`` as in :func:`step_response`)."""
     return 1.0 - step_response(tau, times)
 
 
 def closed_form_step(tau: float, times: Sequence[float] | np.ndarray) -> np.ndarray:
-    """Analytic step response ``1 - exp(-t/tau)`` (dimensionless)."""
+    """Analytic step response ``1 - exp(-t/tau)`` (dimensionless) at ``times`` (s): one
+    time or a 1-D sequence, each finite and >= 0 (the step is at t = 0), in any order;
+    ``tau`` as in :func:`error_loop` (``inf``: no feedback, 0 throughout)."""
+    gains_from_tau(tau, 1)  # checks tau: a time constant, or inf
+    checked = check_times(times)
+    if np.any(checked < 0.0):
+        raise ParameterError(
+            f"times must be >= 0 s (the step is at t = 0) (got {float(np.min(checked)):g})"
+        )
     return 1.0 - np.exp(-np.asarray(times, dtype=float) / float(tau))
 
 
+def check_response_times(times: Sequence[float] | np.ndarray, spaced: bool) -> np.ndarray:
+    """``times`` (s) of a simulated response as a 1-D float array: at least 2 finite
+    times, strictly increasing, starting at 0 (the step); with ``spaced``, equally spaced
+    as python-control's linear simulation needs them (its test: every step within
+    ``numpy.allclose`` of the mean step). Anything else is a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming ``times``."""
+    array = check_times(times)
+    wanted = "equally spaced, increasing" if spaced else "increasing"
+    rule = f"times must be at least 2 finite times (s), {wanted} and starting at 0"
+    if array.size < 2:
+        raise ParameterError(f"{rule} (got {array.size} time{'' if array.size == 1 else 's'})")
+    if array[0] != 0.0:
+        raise ParameterError(f"{rule} (got a first time of {array[0]:g} s)")
+    steps = np.diff(array)
+    if not np.all(steps > 0.0):
+        index = int(np.argmin(steps > 0.0)) + 1
+        raise ParameterError(
+            f"{rule} (got {array[index - 1]:g} s then {array[index]:g} s at index {index})"
+        )
+    if spaced and not np.allclose(steps, (array[-1] - array[0]) / (array.size - 1)):
+        raise ParameterError(f"{rule} (got steps from {np.min(steps):g} s to {np.max(steps):g} s)")
+    return array
+
+
 def loop_summary(tau: float) -> dict[str, float]:
-    """Pole (1/s), DC gain, and the 63 % / 95 % / 99 % settling times (s) of one channel."""
+    """Pole (1/s), DC gain, and the 63 % / 95 % / 99 % settling times (s) of one channel;
+    ``tau`` (s) as in :func:`error_loop` but finite (``inf`` is no loop: no pole)."""
+    (gain,) = gains_from_tau(tau, 1)
+    if gain == 0.0:
+        raise ParameterError(
+            f"tau must be a finite time constant for a loop summary, >= {MIN_TAU:g} s (inf "
+            "is no feedback: no pole to summarise) (got inf)"
+        )
     loop = error_loop(tau)
     (pole,) = np.real(control.poles(loop))
     return {
@@ -102,14 +156,25 @@ def loop_summary(tau: float) -> dict[str, float]:
 
 
 def velocity_loop(mass: float, damping: float, bandwidth: float) -> control.TransferFunction:
-    """Closed loop ``v / v_d`` of the velocity-tracking loop (kg, N s/m, 1/s), linear."""
+    """Closed loop ``v / v_d`` of the velocity-tracking loop (kg, N s/m, 1/s), linear.
+
+    ``mass`` (kg) finite and > 0, ``damping`` (N s/m) finite and >= 0, ``bandwidth``
+    (1/s) a gain in [0, :data:`ddwmmr.gains.MAX_GAIN`] (:func:`check_velocity_loop`).
+    """
+    check_velocity_loop(mass, damping, bandwidth)
     plant = control.tf([1.0], [mass, damping])
     gain = bandwidth * mass
     return control.minreal((damping + gain) * control.feedback(plant, gain), verbose=False)
 
 
 def velocity_loop_summary(mass: float, damping: float, bandwidth: float) -> dict[str, float]:
-    """Pole (1/s), time constant and 95 % settling time (s) of :func:`velocity_loop`."""
+    """Pole (1/s), time constant and 95 % settling time (s) of :func:`velocity_loop`
+    (its arguments, with ``damping`` or ``bandwidth`` > 0: else there is no pole)."""
+    check_velocity_loop(mass, damping, bandwidth)
+    if float(damping) == 0.0 and float(bandwidth) == 0.0:
+        raise ParameterError(
+            "bandwidth must be > 0 1/s when damping is 0 (no force, no loop to summarise) (got 0)"
+        )
     loop = velocity_loop(mass, damping, bandwidth)
     (pole,) = np.real(control.poles(loop))
     return {
@@ -129,7 +194,16 @@ def saturated_velocity_step(
     times: Sequence[float] | np.ndarray,
 ) -> np.ndarray:
     """Speed (m/s) after a step of the command from rest to ``step`` (m/s), with the total
-    force clipped to ``+-force_limit`` (N): a python-control nonlinear I/O system."""
+    force clipped to ``+-force_limit`` (N): a python-control nonlinear I/O system.
+
+    ``mass``, ``damping``, ``bandwidth`` as in :func:`velocity_loop`; ``force_limit``
+    (N) finite and > 0, ``step`` finite; ``times`` (s) as :func:`check_response_times`
+    with ``spaced=False`` (the step at t = 0).
+    """
+    check_velocity_loop(mass, damping, bandwidth)
+    check_positive("force_limit", force_limit)
+    check_finite("step", step)
+    times = check_response_times(times, spaced=False)
 
     def update(t, x, u, params):
         force = damping * u[0] + bandwidth * mass * (u[0] - x[0])
@@ -137,8 +211,17 @@ def saturated_velocity_step(
         return [(force - damping * x[0]) / mass]
 
     system = control.nlsys(update, None, inputs=1, outputs=1, states=1, name="velocity_loop")
-    times = np.asarray(times, dtype=float)
     response = control.input_output_response(
         system, times, np.full_like(times, step), X0=[0.0], solve_ivp_kwargs={"max_step": 0.005}
     )
     return np.asarray(response.outputs, dtype=float).ravel()
+
+
+def check_velocity_loop(mass: float, damping: float, bandwidth: float) -> None:
+    """The arguments of :func:`velocity_loop`: ``mass`` (kg) finite and > 0, ``damping``
+    (N s/m) finite and >= 0, ``bandwidth`` (1/s) a gain in [0, 1e4]
+    (:func:`ddwmmr.gains.check_gain`); else a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming the argument."""
+    check_positive("mass", mass)
+    check_nonnegative("damping", damping)
+    check_gain("bandwidth", bandwidth, zero=True)

@@ -30,12 +30,15 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ddwmmr.errors import ParameterError, shown
+
 __all__ = [
     "ERROR_LIMIT_M",
     "MOST_OF_RUN",
     "OFFSET_FACTOR",
     "REASONS",
     "TRACKED",
+    "check_summary",
     "error_limit",
     "explain",
     "short_verdict",
@@ -101,15 +104,29 @@ TIPPED = (
 )
 
 
+def check_summary(summary: Any) -> Mapping[str, Any]:
+    """``summary`` if it is a mapping (a run's summary: :attr:`SimulationResult.summary`,
+    or a dict read from a ``summary.json``), else a one-line :class:`ParameterError`
+    naming ``summary``. Every function here taking a summary checks it first."""
+    if not isinstance(summary, Mapping):
+        raise ParameterError(
+            "summary must be a mapping of a run's summary keys (a dict such as "
+            f"SimulationResult.summary) (got {shown(summary, 60)})"
+        )
+    return summary
+
+
 def error_limit(summary: Mapping[str, Any]) -> float:
     """The position-error limit (m) of the run ``summary`` describes:
     max(:data:`ERROR_LIMIT_M`, :data:`OFFSET_FACTOR` x ``initial_offset_m``)."""
+    check_summary(summary)
     offset = summary.get("initial_offset_m") or 0.0
     return max(ERROR_LIMIT_M, OFFSET_FACTOR * float(offset))
 
 
 def reasons(summary: Mapping[str, Any]) -> list[str]:
     """The codes (keys of :data:`REASONS`) of what went wrong in the run, in that order."""
+    check_summary(summary)
     found = []
     if summary.get("diverged"):
         found.append("diverged")
@@ -140,6 +157,7 @@ def _above(value: Any, limit: float) -> bool:
 
 def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     """The most likely cause of the failures ``found`` (reason codes), from the summary."""
+    check_summary(summary)
     if "diverged" in found:
         return DIVERGED
     if "tipped_over" in found or "tipped_at_start" in found:
@@ -157,7 +175,8 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
 
 def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
     """``(codes, what, cause)`` of a run's ``summary``: the reason codes, what went wrong
-    in words and its likely cause (both ``""`` when the run tracked)."""
+    in words and its likely cause (both ``""`` when the run tracked). ``summary`` must
+    be a mapping (:func:`check_summary`)."""
     found = reasons(summary)
     if not found:
         return found, "", ""
@@ -176,7 +195,10 @@ def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
 
 def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
     """The verdict keys of a run's ``summary`` (the keys :func:`ddwmmr.simulate` writes):
-    ``{"verdict": str, "verdict_reasons": list[str]}`` (see the module docstring)."""
+    ``{"verdict": str, "verdict_reasons": list[str]}`` (see the module docstring).
+    ``summary`` must be a mapping; anything else (None, a list, a number) is a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming ``summary``."""
+    check_summary(summary)
     found, what, cause = explain(summary)
     if not found:
         return {"verdict": TRACKED, "verdict_reasons": []}
@@ -185,7 +207,8 @@ def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
 
 def short_verdict(summary: Mapping[str, Any]) -> str:
     """A few words for a crowded line: ``tracked`` or ``DID NOT TRACK (codes)``, from the
-    summary's verdict keys (computed if missing)."""
+    summary's verdict keys (computed if missing); ``summary`` as in :func:`verdict`."""
+    check_summary(summary)
     found = summary.get("verdict_reasons")
     if found is None:
         found = verdict(summary)["verdict_reasons"]

@@ -51,6 +51,45 @@ def check_time(t: Any) -> float:
     return check_finite("t", t)
 
 
+def check_times(times: Any) -> np.ndarray:
+    """``times`` (s) of a vectorised ``sample`` as a 1-D float array: one number or a 1-D
+    sequence of numbers, each finite (any sign, any order; none is fine). Anything else
+    (text, booleans, None, NaN, inf, a 2-D array) is a :class:`ParameterError` naming
+    ``times``. A float array is returned as it is (no copy)."""
+    try:
+        raw = np.asarray(times)
+    except (TypeError, ValueError, OverflowError):  # ragged rows, odd objects
+        raise _bad_times("got ragged or non-numeric values") from None
+    kind = raw.dtype.kind
+    numbers = kind in "iuf" or (
+        kind == "O"
+        and all(
+            isinstance(v, int | float | np.integer | np.floating)
+            and not isinstance(v, bool | np.bool_)
+            for v in raw.ravel().tolist()
+        )
+    )
+    if not numbers:
+        raise _bad_times(f"got {shown(times)}")
+    if raw.ndim > 1:
+        raise _bad_times(f"got an array of shape {raw.shape}")
+    try:
+        array = np.asarray(raw, dtype=float)
+    except OverflowError:  # an integer beyond float range
+        raise _bad_times("got a value beyond float range") from None
+    finite = np.isfinite(array)
+    if not np.all(finite):
+        index = int(np.argmin(finite.ravel()))
+        raise _bad_times(f"got {shown(float(array.ravel()[index]))} at index {index}")
+    return array.reshape(1) if array.ndim == 0 else array
+
+
+def _bad_times(got: str) -> ParameterError:
+    return ParameterError(
+        f"times must be a finite number or a 1-D sequence of finite numbers (s) ({got})"
+    )
+
+
 def trajectory_name(trajectory: object) -> str:
     """A short human name for a trajectory (its ``name`` attribute or its class name)."""
     return str(getattr(trajectory, "name", type(trajectory).__name__.lower()))

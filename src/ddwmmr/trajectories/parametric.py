@@ -27,13 +27,12 @@ from ddwmmr.errors import (
     MAX_STEPS,
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
-    check_finite,
     check_int_at_least,
     check_positive,
     check_range,
     shown,
 )
-from ddwmmr.trajectories.base import atan2_array, check_time
+from ddwmmr.trajectories.base import atan2_array, check_time, check_times
 
 ORIENTATIONS = ("tangent", "constant")
 _isfinite = math.isfinite
@@ -56,12 +55,16 @@ def check_geometry_value(name: str, value: float) -> float:
     """One continuous geometry parameter of the parametric shapes, checked: ``a``, ``b``
     (m) and ``T`` (s) positive, ``x0``, ``y0`` (m), ``beta``, ``phi`` (rad) finite, each
     within the documented magnitudes of :mod:`ddwmmr.errors` (no overflow, no absurd
-    allocation later). Also what the GUI checks a sampled file's placement with."""
+    allocation later). Also what the GUI checks a sampled file's placement with.
+
+    Every refusal is a one-line :class:`~ddwmmr.errors.ParameterError` naming the
+    parameter and its range, whatever the value (text, None, NaN, too large): ``a``,
+    ``b`` and ``T`` say "> 0" first (then their range, for a number beyond it), the
+    others their range, e.g. ``x0 must be a finite number in [-1e+06, 1e+06] m``."""
     if name in ("a", "b", "T"):
         check_positive(name, value)
         low, high, unit = (*DURATION_RANGE_S, "s") if name == "T" else (*LENGTH_RANGE_M, "m")
         return check_range(name, value, low, high, unit)
-    check_finite(name, value)
     cap, unit = (MAX_ANGLE_RAD, "rad") if name in ("beta", "phi") else (MAX_COORDINATE_M, "m")
     return check_range(name, value, -cap, cap, unit)
 
@@ -108,8 +111,11 @@ class _Parametric(ABC):
     def sample(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Poses and velocities at many times at once: ``(poses, velocities)``, both
         ``(len(times), 3)`` (rows as :meth:`pose` and :meth:`velocity` give them, to the
-        last bit where numpy's sin/cos are the C library's, within an ulp elsewhere)."""
-        t = np.asarray(times, dtype=float)
+        last bit where numpy's sin/cos are the C library's, within an ulp elsewhere).
+        ``times`` (s): one number or a 1-D sequence, each finite, else
+        :class:`~ddwmmr.errors.ParameterError` naming ``times``
+        (:func:`~ddwmmr.trajectories.base.check_times`)."""
+        t = check_times(times)
         rate = self.alpha_rate
         alpha = rate * t
         px, py = self._shape(alpha, _ARRAY_MATH)

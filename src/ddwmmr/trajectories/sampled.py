@@ -26,7 +26,7 @@ from ddwmmr.errors import (
     read_text_file,
     shown,
 )
-from ddwmmr.trajectories.base import atan2_array, check_time
+from ddwmmr.trajectories.base import atan2_array, check_time, check_times
 
 MAX_TIME_S = DURATION_RANGE_S[1]
 #: Smallest step between two sample times, as a share of the duration (last minus first
@@ -171,7 +171,7 @@ class SampledTrajectory:
         return cached
 
     def pose(self, t: float) -> np.ndarray:
-        """Desired ``[xE, yE, phiE]`` at time t (s, from the first sample)."""
+        """Desired ``[xE, yE, phiE]`` at time t (s, from the first sample; finite)."""
         if not (isinstance(t, float) and _isfinite(t)):
             check_time(t)
         value, first, _ = self._hermite(t)
@@ -183,7 +183,7 @@ class SampledTrajectory:
         return np.array([value[0], value[1], heading])
 
     def velocity(self, t: float) -> np.ndarray:
-        """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s)."""
+        """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s, from the first sample; finite)."""
         if not (isinstance(t, float) and _isfinite(t)):
             check_time(t)
         _, first, second = self._hermite(t)
@@ -196,11 +196,12 @@ class SampledTrajectory:
     def sample(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Poses and velocities at many times at once: ``(poses, velocities)``, both
         ``(len(times), 3)``, the numbers :meth:`pose` and :meth:`velocity` give, to the
-        last bit (the same operations on whole columns; ``atan2`` through ``math``)."""
+        last bit (the same operations on whole columns; ``atan2`` through ``math``).
+        ``times`` (s, from the first sample): one number or a 1-D sequence, each finite,
+        else :class:`~ddwmmr.errors.ParameterError` naming ``times``
+        (:func:`~ddwmmr.trajectories.base.check_times`)."""
         knots = self.times
-        t_abs = np.minimum(
-            np.maximum(np.asarray(times, dtype=float) + knots[0], knots[0]), knots[-1]
-        )
+        t_abs = np.minimum(np.maximum(check_times(times) + knots[0], knots[0]), knots[-1])
         i = np.minimum(np.searchsorted(knots, t_abs, side="right") - 1, len(knots) - 2)
         h = knots[i + 1] - knots[i]
         s = (t_abs - knots[i]) / h
