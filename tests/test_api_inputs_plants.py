@@ -76,8 +76,9 @@ def test_command_refuses_an_integer_beyond_a_float(controllers, method, argument
     assert "finite" in message
 
 
-def test_qp_reset_names_q0():
-    controller = make_controller("qp", ROBOT)
+@pytest.mark.parametrize("method", METHODS)
+def test_every_reset_names_q0(method):
+    controller = make_controller(method, ROBOT)
     for q0 in ([0.0, 0.0, HUGE, 0.0, 0.0], [0.0, 0.0, math.nan, 0.0, 0.0], [0.0, 0.0, 0.0]):
         message = _refused(lambda q0=q0: controller.reset(TRAJECTORY, q0), "^q0 must be 5")
         assert "[x, y, phi, th1, th2]" in message

@@ -13,7 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register_controller
-from ddwmmr.controllers.inputs import check_command, check_inputs
+from ddwmmr.controllers.inputs import check_command, check_inputs, check_start
 from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
 from ddwmmr.errors import MAX_STEPS, ParameterError, check_range
 from ddwmmr.gains import gains_from_tau
@@ -114,7 +114,9 @@ class ConfigurationSpaceController:
 
         The reference starts at the home arm pose placed on the trajectory start, which is
         also where :func:`ddwmmr.simulate` starts before applying its initial offset.
+        ``q0`` (5 finite numbers, m and rad) is checked but not used.
         """
+        check_start(q0)
         period = getattr(trajectory, "duration", 0.0)
         if period / self.reference_step > MAX_STEPS:
             raise ParameterError(

@@ -11,7 +11,7 @@ from abc import ABC, abstractmethod
 import numpy as np
 
 from ddwmmr.controllers.base import StepInfo, register_controller
-from ddwmmr.controllers.inputs import check_command, check_inputs
+from ddwmmr.controllers.inputs import check_command, check_inputs, check_start
 from ddwmmr.errors import ParameterError, shown
 from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
@@ -48,7 +48,9 @@ class ResolvedRate(ABC):
 
     def reset(self, trajectory: object, q0: np.ndarray) -> None:
         """Nothing to prepare: these methods are memoryless (the feedback, if any, uses
-        the measured configuration)."""
+        the measured configuration). ``q0``, the start ``[x, y, phi, th1, th2]`` (m, rad),
+        must be 5 finite numbers (:func:`~ddwmmr.controllers.inputs.check_start`)."""
+        check_start(q0)
         self.last = StepInfo()
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:

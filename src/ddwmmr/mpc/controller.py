@@ -62,7 +62,7 @@ from ddwmmr.controllers.base import (
     register_controller,
     step_results,
 )
-from ddwmmr.controllers.inputs import check_inputs
+from ddwmmr.controllers.inputs import check_inputs, check_start
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import GRAVITY_M_S2
@@ -266,7 +266,9 @@ class MPCController:
         self._loop_step = dt
 
     def reset(self, trajectory: Any, q0: np.ndarray) -> None:
-        """Forget warm starts and counters; take the control step (:func:`control_step`)."""
+        """Forget warm starts and counters; take the control step (:func:`control_step`).
+        ``q0``: the start ``[x, y, phi, th1, th2]``, 5 finite numbers (m, rad)."""
+        q0 = check_start(q0)
         self.dt = control_step(self.options.dt, self._loop_step, trajectory, DEFAULT_DT)
         self._trajectory = trajectory
         self.fallbacks = 0
