@@ -77,6 +77,16 @@ def test_command_refuses_an_integer_beyond_a_float(controllers, method, argument
 
 
 @pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("entry", ["0.3", True, None])
+def test_command_refuses_text_and_booleans_as_numbers(controllers, method, entry):
+    """numpy reads "0.3" and True as numbers; a command built from them would be a guess."""
+    args = _with_huge("q", "list")
+    args["q"][1] = entry
+    message = _refused(lambda: controllers[method].command(**args), "^q must be 5 finite")
+    assert repr(entry) in message
+
+
+@pytest.mark.parametrize("method", METHODS)
 def test_every_reset_names_q0(method):
     controller = make_controller(method, ROBOT)
     for q0 in ([0.0, 0.0, HUGE, 0.0, 0.0], [0.0, 0.0, math.nan, 0.0, 0.0], [0.0, 0.0, 0.0]):

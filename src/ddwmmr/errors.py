@@ -172,6 +172,30 @@ def _not_finite(name: str, value: Any, allowed: str) -> ParameterError:
     return ParameterError(f"{name} must be {finite} (got {shown(value)})")
 
 
+#: What is not a number to :func:`float_values`, though numpy would read it as one.
+_NOT_NUMBERS = (str, bytes, bool, np.bool_, type(None))
+
+
+def float_values(value: Any, size: int) -> list[float] | None:
+    """``value`` as a list of ``size`` floats (finite or not) if it is a flat sequence of
+    ``size`` numbers, else None. Text, booleans, None and integers beyond a float are not
+    numbers here (numpy would read ``"1.5"`` and ``True`` as ones)."""
+    if isinstance(value, str | bytes | dict):
+        return None
+    if isinstance(value, list | tuple) and any(isinstance(v, _NOT_NUMBERS) for v in value):
+        return None
+    try:
+        raw = np.asarray(value)
+        if raw.dtype.kind not in "iufO" or (
+            raw.dtype.kind == "O" and any(isinstance(v, _NOT_NUMBERS) for v in raw.flat)
+        ):
+            return None
+        array = raw.astype(float)
+    except (TypeError, ValueError, OverflowError):  # ragged, None, an int like 10**400
+        return None
+    return array.tolist() if array.shape == (size,) else None
+
+
 def shown(value: Any, width: int = 40) -> str:
     """``value`` for a message: its repr on one line, cut to ``width`` characters; an
     integer beyond about 1e60 as its magnitude (its repr is thousands of digits, or fails

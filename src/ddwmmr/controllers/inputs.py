@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, float_values, shown
 
 #: (argument, expected length, what its entries are) of ``command(t, q, pose_d, velocity_d)``.
 _ARGUMENTS = (
@@ -80,15 +80,25 @@ def check_numbers(name: str, value: Any, size: int, entries: str) -> list[float]
     numbers, else :class:`ParameterError` naming ``name`` and saying what its entries are
     (``entries``, e.g. ``"[x, y, phi, th1, th2] (m, rad)"``)."""
     wanted = f"{name} must be {size} finite numbers {entries}"
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError, OverflowError):  # OverflowError: an int like 10**400
-        raise ParameterError(f"{wanted} (got {shown(value, 60)})") from None
-    if array.shape != (size,):
-        raise ParameterError(f"{wanted} (got shape {array.shape})")
-    if not np.all(np.isfinite(array)):
-        raise ParameterError(f"{wanted} (got {array.tolist()})")
-    return array.tolist()
+    values = float_values(value, size)
+    if values is None:  # text, booleans, another length or shape, an int like 10**400
+        raise ParameterError(f"{wanted} (got {_what(value, size)})")
+    if not all(map(math.isfinite, values)):
+        raise ParameterError(f"{wanted} (got {values})")
+    return values
+
+
+def _what(value: Any, size: int) -> str:
+    """What ``value`` is, for a message: its shape if it is an array or a list of another
+    shape than ``(size,)``, else the value shown."""
+    if isinstance(value, list | tuple | np.ndarray):
+        try:
+            shape = np.shape(value)
+        except ValueError:  # ragged
+            shape = None
+        if shape is not None and shape != (size,):
+            return f"shape {shape}"
+    return shown(value, 60)
 
 
 def _check_time(t: Any) -> None:

@@ -30,7 +30,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces
-from ddwmmr.errors import ParameterError, check_finite, check_positive, shown
+from ddwmmr.errors import ParameterError, check_finite, check_positive, float_values, shown
 
 #: A continuous-time control law for integrator stages: ``(t, q) -> u``, time in s, the
 #: configuration as a list of 5 floats, the velocity command as 4 numbers (a tuple of
@@ -98,8 +98,6 @@ _COMMAND_FORMS = {
     ),
 }
 _FLOAT64 = np.dtype(float)
-#: Entries numpy would read as numbers that are not numbers here.
-_NOT_NUMBERS = (str, bytes, bool, np.bool_)
 _INF = math.inf
 _isfinite = math.isfinite
 
@@ -108,7 +106,7 @@ def check_configuration(q0: Any, name: str = "q0") -> list[float]:
     """``q0`` as a list of 5 floats if it is a flat sequence of 5 finite numbers
     ``[x, y, phi, th1, th2]`` (m, m, rad, rad, rad), else :class:`ParameterError` naming
     ``name``: the start of ``Plant.reset``."""
-    values = _floats(q0, 5)
+    values = float_values(q0, 5)
     if values is None or not all(map(_isfinite, values)):
         raise ParameterError(
             f"{name} must be 5 finite numbers [x, y, phi, th1, th2] (m, rad) (got {shown(q0, 60)})"
@@ -174,34 +172,14 @@ def _check_step_slowly(
     values = None
     if forces and FORCE in interfaces:
         fields = (command.left, command.right, command.th1_target, command.th2_target)
-        values = _floats(fields, 4)
+        values = float_values(fields, 4)
     elif not forces and VELOCITY in interfaces:
-        values = _floats(command, 4)
+        values = float_values(command, 4)
     if values is not None and all(map(_isfinite, values)):
         return command if forces else values
     wanted = " or ".join(_COMMAND_FORMS[i] for i in (VELOCITY, FORCE) if i in interfaces)
     message = f"command must be {wanted} (got {shown(command, 60)})"
     raise ParameterError(message)
-
-
-def _floats(value: Any, size: int) -> list[float] | None:
-    """``value`` as a list of ``size`` floats (finite or not) if it is a flat sequence of
-    ``size`` numbers, else None. Text, booleans, None and integers beyond a float are not
-    numbers here (numpy would read ``"1.5"`` and ``True`` as ones)."""
-    if isinstance(value, str | bytes | dict):
-        return None
-    if isinstance(value, list | tuple) and any(isinstance(v, _NOT_NUMBERS) for v in value):
-        return None
-    try:
-        raw = np.asarray(value)
-        if raw.dtype.kind not in "iufO" or (
-            raw.dtype.kind == "O" and any(isinstance(v, _NOT_NUMBERS) for v in raw.flat)
-        ):
-            return None
-        array = raw.astype(float)
-    except (TypeError, ValueError, OverflowError):  # ragged, None, an int like 10**400
-        return None
-    return array.tolist() if array.shape == (size,) else None
 
 
 class Plant(Protocol):
