@@ -179,7 +179,7 @@ def test_options_reach_the_window_settings():
     ("argv", "message"),
     [
         (["--method", "nope"], "invalid choice: 'nope'"),
-        (["--T", "-1"], "T must be > 0 (got -1)"),
+        (["--T", "-1"], "T must be in [1e-06, 1e+09] s (got -1)"),
         (["--N", "1.5"], "N must be an integer >= 2"),
         (["--traj", "nowhere.csv"], "traj: no such file nowhere.csv"),
         (["--option", "bogus=1"], "has no option 'bogus'"),
@@ -337,5 +337,5 @@ def test_module_runs_headless_as_a_process(tmp_path):
         cwd=ROOT,
         timeout=300,
     )
-    assert bad.returncode == 2 and bad.stderr == "error: T must be > 0 (got -3)\n"
+    assert bad.returncode == 2 and bad.stderr == "error: T must be in [1e-06, 1e+09] s (got -3)\n"
     assert not (tmp_path / "x.png").exists()

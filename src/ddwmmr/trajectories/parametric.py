@@ -58,11 +58,9 @@ def check_geometry_value(name: str, value: float) -> float:
     allocation later). Also what the GUI checks a sampled file's placement with.
 
     Every refusal is a one-line :class:`~ddwmmr.errors.ParameterError` naming the
-    parameter and its range, whatever the value (text, None, NaN, too large): ``a``,
-    ``b`` and ``T`` say "> 0" first (then their range, for a number beyond it), the
-    others their range, e.g. ``x0 must be a finite number in [-1e+06, 1e+06] m``."""
+    parameter and its range, whatever the value (text, None, NaN, too large, zero), e.g.
+    ``x0 must be a finite number in [-1e+06, 1e+06] m``."""
     if name in ("a", "b", "T"):
-        check_positive(name, value)
         low, high, unit = (*DURATION_RANGE_S, "s") if name == "T" else (*LENGTH_RANGE_M, "m")
         return check_range(name, value, low, high, unit)
     cap, unit = (MAX_ANGLE_RAD, "rad") if name in ("beta", "phi") else (MAX_COORDINATE_M, "m")
