@@ -39,6 +39,7 @@ LIGHT = Settings(
     coarse=5,
     fine=12,
     final=40,
+    also_final=(),
     refine=1,
     elbow_top=0,
     turn_top=0,
@@ -495,6 +496,59 @@ def test_step_5_follows_each_faster_run_until_none_beats_its_plan(monkeypatch):
     capped = search.follow_plan(HEAVY, scenario, start, Settings(guided_rounds=2))
     assert capped[1].time_s == 18.0 and capped[0].start == "run-mpc-plan-round2"
     assert search.follow_plan(HEAVY, scenario, None, Settings()) is None
+
+
+def test_certification_keeps_the_fastest_passing_replay_over_its_grids(monkeypatch):
+    """Each certifying grid can land in another local optimum: of the best refined optimum's
+    passing replays the fastest counts; a failed solve or replay is skipped, and an optimum
+    none of whose replays passes gives way to the next."""
+    from ddwmmr.bounds import search
+
+    # (solve succeeds, replay passes, replayed time) per refined optimum and grid
+    outcome = {
+        ("a", 60): (True, True, 7.61),
+        ("a", 40): (True, True, 7.39),
+        ("a", 24): (True, False, 7.0),
+        ("b", 60): (False, True, 9.0),
+    }
+
+    class Problem:
+        def __init__(self, intervals):
+            self.intervals = intervals
+
+        def solve(self, guess, label):
+            success, ok, time = outcome.get((label, self.intervals), (False, False, 0.0))
+            return SimpleNamespace(success=success, total=time, start=label, key=(ok, time))
+
+    def fake_replay(robot, result, waypoints, stability_min, tolerance):
+        ok, time = result.key
+        return SimpleNamespace(ok=ok, time_s=time if ok else math.inf)
+
+    monkeypatch.setattr(search, "replay", fake_replay)
+
+    def refined(*totals):
+        return {
+            label: SimpleNamespace(total=total, as_guess=lambda: None)
+            for label, total in zip("ab", totals)
+        }
+
+    problems = {}
+
+    def problem(intervals, margin_s, margin_m):
+        return problems.setdefault(intervals, Problem(intervals))
+
+    said = []
+    (solution, check), grid = search.certify(
+        HEAVY, refined(7.0, 8.0), [(1.0, 0.0)], Settings(), problem, said.append
+    )
+    assert (solution.start, grid, check.time_s) == ("a", 40, 7.39) and len(said) == 3
+    assert search.certify(HEAVY, refined(7.0, 8.0), [], Settings(also_final=()), problem)[1] == 60
+    outcome[("a", 60)] = outcome[("a", 40)] = (True, False, 7.5)  # none of a's passes
+    outcome[("b", 40)] = (True, True, 8.2)
+    (solution, check), grid = search.certify(HEAVY, refined(7.0, 8.0), [], Settings(), problem)
+    assert (solution.start, grid, check.time_s) == ("b", 40, 8.2)
+    outcome[("b", 40)] = (True, False, 8.2)
+    assert search.certify(HEAVY, refined(7.0, 8.0), [], Settings(), problem) == (None, 60)
 
 
 def test_continuation_bounds_change_only_their_rows():

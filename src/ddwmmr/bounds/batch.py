@@ -30,7 +30,7 @@ from ddwmmr.sim.result import json_safe, write_atomic
 
 #: Version of each method's results: a change invalidates the cached results of that part.
 LOWER_VERSION = "budget-stops-1"
-BEST_VERSION = "multistart-6"
+BEST_VERSION = "multistart-7"
 #: Columns of bounds.csv.
 COLUMNS = ("scenario", "lower_bound_s", "best_known_s", "starts", "spread_s", "replay_ok")
 CACHE = PLAN_FOLDER
