@@ -29,8 +29,11 @@ $(STAMP_TEST): pyproject.toml | $(BIN)/python
 demo: $(STAMP_RUN)
 	MPLBACKEND=Agg $(BIN)/python -m ddwmmr.compare --out runs/demo
 
+# Worker processes of the test suite (pytest-xdist): the machine class has 2 cores.
+TEST_JOBS ?= 2
+
 test: $(STAMP_TEST)
-	MPLBACKEND=Agg $(BIN)/python -m pytest
+	MPLBACKEND=Agg $(BIN)/python -m pytest -n $(TEST_JOBS)
 
 LINTED := src tests examples benchmarks docs/*.py
 
