@@ -143,6 +143,7 @@ def test_a_sample_that_is_not_the_reference_is_not_used(sample):
         (np.zeros((1, 3)), "array([[0., 0., 0.]])"),  # TypeError: only 0-dimensional...
         (["1", "0", "0"], "['1', '0', '0']"),  # text is not a number
         ([True, False, False], "[True, False, False]"),  # nor are booleans
+        ([0.5, True, 0.0], "[0.5, True, 0.0]"),  # not even among numbers
         ([math.nan, 0.0, 0.0], "[nan, 0.0, 0.0]"),  # "pose_e[1] must be a finite number"
     ],
 )
@@ -251,6 +252,7 @@ class Fixed:
         ({}, "{}"),
         (0.1, "0.1"),
         (np.array([True, False, False, False]), "array([ True, False, False, False])"),
+        ([0.1, True, 0.0, 0.0], "[0.1, True, 0.0, 0.0]"),
     ],
 )
 def test_a_command_that_is_not_4_finite_numbers_is_refused_naming_the_step(plant, out, shown):

@@ -63,7 +63,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, float_values, shown
 from ddwmmr.inheritance import defining_class, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 
@@ -157,29 +157,20 @@ _FLOAT64 = np.dtype(float)
 def finite_values(value: Any, size: int) -> np.ndarray | None:
     """``value`` as a float array of shape ``(size,)`` if it is a flat sequence of ``size``
     finite numbers (a list, a tuple, a numpy array of any number type), else None. Text,
-    booleans and complex numbers are not numbers here. A float64 array is returned as it
-    is (not copied), so a run fed arrays gives the numbers it gave before the check."""
+    booleans, None and complex numbers are not numbers here
+    (:func:`~ddwmmr.errors.float_values`). A float64 array is returned as it is (not
+    copied), so a run fed arrays gives the numbers it gave before the check."""
     if type(value) is np.ndarray and value.dtype is _FLOAT64 and value.shape == (size,):
         array = value  # the common case, no conversion
     else:
-        array = _float_array(value)
-        if array is None or array.shape != (size,):
+        values = float_values(value, size)
+        if values is None:
             return None
+        array = np.array(values)
     # a sum is finite only if every term is; a sum that overflowed looks again
     if isfinite(sum(array.tolist())) or bool(np.all(np.isfinite(array))):
         return array
     return None
-
-
-def _float_array(value: Any) -> np.ndarray | None:
-    """``value`` as a float array if its entries are numbers, else None."""
-    try:
-        array = np.asarray(value)
-        if array.dtype.kind not in "fiuO":  # "O": e.g. Fraction or Decimal entries
-            return None
-        return array.astype(float, copy=False)
-    except (TypeError, ValueError, OverflowError):  # None, {}, ragged, 10**400 entries
-        return None
 
 
 def checked_command(command: Any, force: bool, controller: Any, k: int, t: float) -> Any:
