@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.errors import ParameterError, float_values, shown
+from ddwmmr.model.kinematics import check_configuration
 
 #: (argument, expected length, what its entries are) of ``command(t, q, pose_d, velocity_d)``.
 _ARGUMENTS = (
@@ -71,8 +72,9 @@ def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
 
 def check_start(q0: Any) -> list[float]:
     """``q0``, the start configuration of ``Controller.reset``, as a list of 5 floats
-    ``[x, y, phi, th1, th2]`` (m, rad), or :class:`ParameterError` naming ``q0``."""
-    return check_numbers("q0", q0, 5, "[x, y, phi, th1, th2] (m, rad)")
+    ``[x, y, phi, th1, th2]`` (m, rad), or :class:`ParameterError` naming ``q0``
+    (:func:`~ddwmmr.model.kinematics.check_configuration`)."""
+    return check_configuration(q0)
 
 
 def check_numbers(name: str, value: Any, size: int, entries: str) -> list[float]:

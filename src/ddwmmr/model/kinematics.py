@@ -12,13 +12,29 @@ called every control step.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
+
+from ddwmmr.errors import ParameterError, float_values, shown
 
 #: Names of the configuration coordinates, in order.
 Q_NAMES = ("x", "y", "phi", "th1", "th2")
 #: Names of the input coordinates, in order.
 U_NAMES = ("v", "w", "th1dot", "th2dot")
+
+
+def check_configuration(q0: Any, name: str = "q0") -> list[float]:
+    """``q0`` as a list of 5 floats if it is a flat sequence of 5 finite numbers
+    ``[x, y, phi, th1, th2]`` (m, m, rad, rad, rad), else :class:`ParameterError` naming
+    ``name``: a start configuration (``simulate``'s ``q0``, ``Plant.reset``,
+    ``Controller.reset``)."""
+    values = float_values(q0, 5)
+    if values is None or not all(map(math.isfinite, values)):
+        raise ParameterError(
+            f"{name} must be 5 finite numbers [x, y, phi, th1, th2] (m, rad) (got {shown(q0, 60)})"
+        )
+    return values
 
 
 def wrap_angle(angle: float) -> float:

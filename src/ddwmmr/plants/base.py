@@ -15,7 +15,8 @@ plant re-evaluate a continuous-time control law at its intermediate stages (RK4)
 other plant holds the command over the step (zero-order hold) and ignores it.
 
 The arguments of ``reset`` and ``step`` are checked by every plant with the helpers here
-(:func:`check_configuration`, :func:`check_control_step`, :func:`check_step`): anything
+(:func:`check_control_step`, :func:`check_step`) and the start configuration's own check
+(:func:`~ddwmmr.model.kinematics.check_configuration`): anything
 but finite numbers of the right shape is a one-line
 :class:`~ddwmmr.errors.ParameterError` naming ``q0``, ``dt``, ``t`` or ``command``, before
 the state changes.
@@ -100,18 +101,6 @@ _COMMAND_FORMS = {
 _FLOAT64 = np.dtype(float)
 _INF = math.inf
 _isfinite = math.isfinite
-
-
-def check_configuration(q0: Any, name: str = "q0") -> list[float]:
-    """``q0`` as a list of 5 floats if it is a flat sequence of 5 finite numbers
-    ``[x, y, phi, th1, th2]`` (m, m, rad, rad, rad), else :class:`ParameterError` naming
-    ``name``: the start of ``Plant.reset``."""
-    values = float_values(q0, 5)
-    if values is None or not all(map(_isfinite, values)):
-        raise ParameterError(
-            f"{name} must be 5 finite numbers [x, y, phi, th1, th2] (m, rad) (got {shown(q0, 60)})"
-        )
-    return values
 
 
 def check_control_step(dt: Any) -> float:
@@ -211,8 +200,9 @@ class Plant(Protocol):
         """Place the robot at rest at configuration ``q0`` for a run with control step dt (s).
 
         Raises :class:`~ddwmmr.errors.ParameterError` if ``q0`` is not 5 finite numbers
-        (:func:`check_configuration`) or dt does not suit the plant (not finite and > 0,
-        :func:`check_control_step`; not a multiple of a physics engine's timestep).
+        (:func:`~ddwmmr.model.kinematics.check_configuration`) or dt does not suit the
+        plant (not finite and > 0, :func:`check_control_step`; not a multiple of a physics
+        engine's timestep).
         """
         ...
 

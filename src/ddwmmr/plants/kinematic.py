@@ -28,11 +28,11 @@ import numpy as np
 
 from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.plants.base import (
     Observation,
     PlantDivergedError,
     Policy,
-    check_configuration,
     check_control_step,
     check_step,
 )

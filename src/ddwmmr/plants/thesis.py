@@ -33,6 +33,7 @@ import numpy as np
 from ddwmmr.commands import WheelForces
 from ddwmmr.errors import check_positive
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.model.thesis_base import (  # the base's constants (controllers' models use them)
     C1_DEFAULT,
     C2_DEFAULT,
@@ -43,7 +44,6 @@ from ddwmmr.plants.base import (
     Observation,
     PlantDivergedError,
     Policy,
-    check_configuration,
     check_control_step,
     check_step,
 )

@@ -25,6 +25,7 @@ from ddwmmr.errors import (
     shown,
 )
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.plants import available_plants, make_plant, plant_class
 from ddwmmr.plants.base import Plant
 from ddwmmr.registry import CONTROLLERS
@@ -230,12 +231,7 @@ def simulate(
             raise ParameterError(f"initial_offset must be two numbers dx, dy in m (got {offset})")
         q = initial_configuration(robot, reference, offset)
     else:
-        try:
-            q = np.array(q0, dtype=float)
-        except (TypeError, ValueError):
-            q = np.full(1, np.nan)  # not numbers: the message below
-        if q.shape != (5,) or not np.all(np.isfinite(q)):
-            raise ParameterError("q0 must be 5 finite numbers [x, y, phi, th1, th2]")
+        q = np.array(check_configuration(q0))
     tipped = _tipped_start(robot, q, tipped_start)
     task = TrackingTask(reference, the_plant, grid=(dt, steps))
     run_loop(the_plant, controller, task, q, dt, steps, progress)

@@ -32,12 +32,11 @@ import numpy as np
 from ddwmmr.commands import VELOCITY, WheelForces
 from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
-from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.model.kinematics import check_configuration, wrap_angle
 from ddwmmr.plants.base import (
     Observation,
     PlantDivergedError,
     Policy,
-    check_configuration,
     check_step,
 )
 from ddwmmr.plants.kinematic import KinematicPlant
