@@ -93,6 +93,12 @@ def check_range(name: str, value: float, low: float, high: float, unit: str = ""
     return value
 
 
+def check_weight(name: str, value: float) -> float:
+    """``value`` as a float if it is a cost weight in [0, :data:`MAX_COST_WEIGHT`] (the
+    qp's tasks, the mpc's costs), else raise :class:`ParameterError`."""
+    return check_range(name, value, 0.0, MAX_COST_WEIGHT)
+
+
 def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None = None) -> int:
     """Return ``value`` as int if it is an integer >= ``minimum`` (and <= ``maximum``)."""
     allowed = f">= {minimum}" if maximum is None else f"in [{minimum}, {maximum}]"

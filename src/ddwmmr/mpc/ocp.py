@@ -110,11 +110,11 @@ import casadi as ca
 import numpy as np
 
 from ddwmmr.errors import (
-    MAX_COST_WEIGHT,
     ParameterError,
     check_int_at_least,
     check_positive,
     check_range,
+    check_weight,
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
@@ -165,8 +165,7 @@ class Weights:
             "input_change",
             "terminal",
         ):
-            weight = check_range(f"{name}_weight", getattr(self, name), 0.0, MAX_COST_WEIGHT)
-            object.__setattr__(self, name, weight)
+            object.__setattr__(self, name, check_weight(f"{name}_weight", getattr(self, name)))
 
 
 @dataclass(frozen=True)
@@ -224,9 +223,7 @@ class OCPConfig:
 
     def __post_init__(self) -> None:
         object.__setattr__(
-            self,
-            "arrival_weight",
-            check_range("arrival_weight", self.arrival_weight, 0.0, MAX_COST_WEIGHT),
+            self, "arrival_weight", check_weight("arrival_weight", self.arrival_weight)
         )
 
     @property

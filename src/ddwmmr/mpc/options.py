@@ -23,7 +23,6 @@ from typing import Any
 from ddwmmr.commands import FORCE, PlantTraits
 from ddwmmr.errors import (
     LENGTH_RANGE_M,
-    MAX_COST_WEIGHT,
     ParameterError,
     check_bool,
     check_finite,
@@ -31,6 +30,7 @@ from ddwmmr.errors import (
     check_nonnegative,
     check_positive,
     check_range,
+    check_weight,
     shown,
 )
 from ddwmmr.model import Robot
@@ -300,7 +300,7 @@ class MPCOptions:
             ("reach_speed", check_positive),
             ("proximal", check_nonnegative),
             ("stability_margin", check_nonnegative),
-            ("plan_weight", _check_weight),
+            ("plan_weight", check_weight),
             ("obstacle_margin", check_nonnegative),
         ):
             value = getattr(self, name)
@@ -512,8 +512,3 @@ def _check_huber(name: str, value: float) -> float:
     """A Huber scale (m): a length (:data:`~ddwmmr.errors.LENGTH_RANGE_M`); it is squared
     in the cost, so 1e300 overflowed."""
     return check_range(name, value, *LENGTH_RANGE_M, "m")
-
-
-def _check_weight(name: str, value: float) -> float:
-    """A cost weight in [0, :data:`~ddwmmr.errors.MAX_COST_WEIGHT`]."""
-    return check_range(name, value, 0.0, MAX_COST_WEIGHT)

@@ -16,12 +16,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from ddwmmr.errors import MAX_COST_WEIGHT, check_range
+from ddwmmr.errors import check_weight
 from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
-
-#: Largest task weight (the Hessian's conditioning floor is 1e-9).
-MAX_WEIGHT = MAX_COST_WEIGHT
 
 
 def bounded(value: float, limit: float) -> float:
@@ -68,7 +65,7 @@ class Task(ABC):
     name: str = "task"
 
     def __init__(self, weight: float) -> None:
-        self.weight = check_range(f"{self.name.replace(' ', '_')}_weight", weight, 0.0, MAX_WEIGHT)
+        self.weight = check_weight(f"{self.name.replace(' ', '_')}_weight", weight)
 
     def row_weights(self) -> np.ndarray:
         """Weight of each row (cost per squared task-rate unit); default: ``weight``."""
