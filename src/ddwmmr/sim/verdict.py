@@ -197,8 +197,8 @@ def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
     """The verdict keys of a run's ``summary`` (the keys :func:`ddwmmr.simulate` writes):
     ``{"verdict": str, "verdict_reasons": list[str]}`` (see the module docstring).
     ``summary`` must be a mapping; anything else (None, a list, a number) is a one-line
-    :class:`~ddwmmr.errors.ParameterError` naming ``summary``."""
-    check_summary(summary)
+    :class:`~ddwmmr.errors.ParameterError` naming ``summary`` (:func:`reasons` checks it
+    first)."""
     found, what, cause = explain(summary)
     if not found:
         return {"verdict": TRACKED, "verdict_reasons": []}
