@@ -105,6 +105,59 @@ def test_each_reason_at_its_threshold(changes, reasons):
     )
 
 
+@pytest.mark.parametrize(
+    ("key", "value", "shown"),
+    [
+        ("steps", "2000", "'2000'"),
+        ("singular_steps", "5", "'5'"),
+        ("saturated_steps", True, "True"),
+        ("initial_offset_m", "x", "'x'"),
+        ("final_position_error_m", "0.1", "'0.1'"),
+        ("rms_position_error_m", [1.0], "[1.0]"),
+        ("min_manipulability", "a", "'a'"),
+        ("start_stability", {"S": 0.9}, "{'S': 0.9}"),
+        ("final_position_error_m", 10**400, "an integer of about 1e400"),
+    ],
+)
+def test_a_summary_value_that_is_not_a_number_is_one_line_naming_its_key(key, value, shown):
+    summary = {**CLEAN, "start_tipped": True, "start_stability": 0.9, key: value}
+    expected = f"summary: {key} must be a number, 'nan', 'inf', '-inf' or None (got {shown})"
+    for function in (verdict, short_verdict):
+        with pytest.raises(ParameterError) as info:
+            function(summary)
+        assert str(info.value) == expected
+
+
+def test_short_verdict_refuses_reasons_that_are_not_a_list_of_codes():
+    for reasons in (5, "diverged", [1]):
+        with pytest.raises(ParameterError) as info:
+            short_verdict({**CLEAN, "verdict_reasons": reasons})
+        assert str(info.value).startswith(
+            "summary: verdict_reasons must be a list of reason codes (strings such as "
+        )
+    assert short_verdict({"verdict_reasons": ("diverged",)}) == "DID NOT TRACK (diverged)"
+
+
+def test_a_summary_read_back_from_json_keeps_its_non_finite_numbers():
+    """summary.json writes nan and inf as strings: the verdict reads them as the numbers."""
+    from ddwmmr.sim.result import json_safe
+
+    blew_up = {**CLEAN, "final_position_error_m": math.nan, "rms_position_error_m": math.inf}
+    read_back = json.loads(json.dumps(json_safe(blew_up)))
+    assert read_back["final_position_error_m"] == "nan"
+    assert verdict(read_back) == verdict(blew_up)
+    assert verdict(read_back)["verdict_reasons"] == [
+        "final_error_above_limit",
+        "rms_error_above_limit",
+    ]
+    assert (
+        verdict({**CLEAN, "min_manipulability": "-inf", "final_position_error_m": 1.0})["verdict"]
+        == verdict({**CLEAN, "min_manipulability": -math.inf, "final_position_error_m": 1.0})[
+            "verdict"
+        ]
+    )
+
+
 def test_the_singular_cause_names_the_slides_row_only_with_it():
     singular = {**CLEAN, "singular_steps": 1500}
     assert "aux sum" in verdict({**singular, "aux": "sum"})["verdict"]

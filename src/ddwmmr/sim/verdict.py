@@ -27,14 +27,19 @@ A run did not track when any of these holds (thresholds documented in docs/cli.m
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
+from numbers import Real
 from typing import Any
+
+import numpy as np
 
 from ddwmmr.errors import ParameterError, shown
 
 __all__ = [
     "ERROR_LIMIT_M",
     "MOST_OF_RUN",
+    "NUMBER_KEYS",
     "OFFSET_FACTOR",
     "REASONS",
     "TRACKED",
@@ -106,22 +111,63 @@ TIPPED = (
 
 def check_summary(summary: Any) -> Mapping[str, Any]:
     """``summary`` if it is a mapping (a run's summary: :attr:`SimulationResult.summary`,
-    or a dict read from a ``summary.json``), else a one-line :class:`ParameterError`
-    naming ``summary``. Every function here taking a summary checks it first."""
+    or a dict read from a ``summary.json``) whose keys read as numbers
+    (:data:`NUMBER_KEYS`) hold numbers, else a one-line :class:`ParameterError` naming
+    ``summary`` or the key. Every function here taking a summary checks it first."""
     if not isinstance(summary, Mapping):
         raise ParameterError(
             "summary must be a mapping of a run's summary keys (a dict such as "
             f"SimulationResult.summary) (got {shown(summary, 60)})"
         )
+    for key in NUMBER_KEYS:
+        _number(summary, key)
     return summary
+
+
+#: The summary keys the verdict reads as numbers: each must be a number, missing or None,
+#: or the string a ``summary.json`` writes for a non-finite one (``"nan"``, ``"inf"``,
+#: ``"-inf"``).
+NUMBER_KEYS = (
+    "steps",
+    "singular_steps",
+    "saturated_steps",
+    "initial_offset_m",
+    "final_position_error_m",
+    "rms_position_error_m",
+    "min_manipulability",
+    "start_stability",
+)
+#: How a ``summary.json`` spells the non-finite floats (:func:`ddwmmr.sim.result.json_safe`):
+#: a summary read back from one holds these strings where the run held the numbers.
+_NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
+
+
+def _number(summary: Mapping[str, Any], key: str) -> float | None:
+    """``summary[key]`` as a float, or None if it is missing or None. A number (Python's
+    or numpy's, not a boolean) or the spelling a ``summary.json`` gives a non-finite one
+    (``"nan"``, ``"inf"``, ``"-inf"``); anything else (text, a boolean, a list) is a
+    one-line :class:`ParameterError` naming the key."""
+    value = summary.get(key)
+    if value is None:
+        return None
+    if isinstance(value, str) and value in _NON_FINITE:
+        return _NON_FINITE[value]
+    if isinstance(value, Real) and not isinstance(value, bool | np.bool_):
+        try:
+            return float(value)
+        except OverflowError:  # an integer beyond a float
+            pass
+    raise ParameterError(
+        f"summary: {key} must be a number, 'nan', 'inf', '-inf' or None (got {shown(value)})"
+    )
 
 
 def error_limit(summary: Mapping[str, Any]) -> float:
     """The position-error limit (m) of the run ``summary`` describes:
     max(:data:`ERROR_LIMIT_M`, :data:`OFFSET_FACTOR` x ``initial_offset_m``)."""
     check_summary(summary)
-    offset = summary.get("initial_offset_m") or 0.0
-    return max(ERROR_LIMIT_M, OFFSET_FACTOR * float(offset))
+    offset = _number(summary, "initial_offset_m") or 0.0
+    return max(ERROR_LIMIT_M, OFFSET_FACTOR * offset)
 
 
 def reasons(summary: Mapping[str, Any]) -> list[str]:
@@ -134,24 +180,23 @@ def reasons(summary: Mapping[str, Any]) -> list[str]:
         found.append("tipped_over")
     if summary.get("start_tipped"):
         found.append("tipped_at_start")
-    steps = summary.get("steps") or 0
-    if steps and summary.get("singular_steps", 0) > MOST_OF_RUN * steps:
+    steps = _number(summary, "steps") or 0
+    if steps and (_number(summary, "singular_steps") or 0) > MOST_OF_RUN * steps:
         found.append("singular_most_of_run")
-    if steps and summary.get("saturated_steps", 0) > MOST_OF_RUN * steps:
+    if steps and (_number(summary, "saturated_steps") or 0) > MOST_OF_RUN * steps:
         found.append("saturated_most_of_run")
     limit = error_limit(summary)
-    if _above(summary.get("final_position_error_m"), limit):
+    if _above(_number(summary, "final_position_error_m"), limit):
         found.append("final_error_above_limit")
-    if _above(summary.get("rms_position_error_m"), limit):
+    if _above(_number(summary, "rms_position_error_m"), limit):
         found.append("rms_error_above_limit")
     return found
 
 
-def _above(value: Any, limit: float) -> bool:
+def _above(value: float | None, limit: float) -> bool:
     """``value`` exceeds ``limit``; NaN (a run that blew up) counts as above."""
     if value is None:
         return False
-    value = float(value)
     return not value <= limit
 
 
@@ -162,11 +207,11 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return DIVERGED
     if "tipped_over" in found or "tipped_at_start" in found:
         return TIPPED
-    steps = summary.get("steps") or 0
-    if steps and summary.get("singular_steps", 0) > SINGULAR_CAUSE * steps:
+    steps = _number(summary, "steps") or 0
+    if steps and (_number(summary, "singular_steps") or 0) > SINGULAR_CAUSE * steps:
         return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
-    min_manipulability = summary.get("min_manipulability")
-    if min_manipulability is not None and float(min_manipulability) < 1e-6:
+    min_manipulability = _number(summary, "min_manipulability")
+    if min_manipulability is not None and min_manipulability < 1e-6:
         return FOLDED_ARM
     if "saturated_most_of_run" in found:
         return SATURATION
@@ -176,18 +221,19 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
 def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
     """``(codes, what, cause)`` of a run's ``summary``: the reason codes, what went wrong
     in words and its likely cause (both ``""`` when the run tracked). ``summary`` must
-    be a mapping (:func:`check_summary`)."""
+    be a mapping whose :data:`NUMBER_KEYS` hold numbers (:func:`check_summary`)."""
     found = reasons(summary)
     if not found:
         return found, "", ""
+    start_stability = _number(summary, "start_stability")
     values = {
         "steps": summary.get("steps"),
         "singular_steps": summary.get("singular_steps"),
         "saturated_steps": summary.get("saturated_steps"),
-        "final_mm": 1000.0 * float(summary.get("final_position_error_m") or 0.0),
-        "rms_mm": 1000.0 * float(summary.get("rms_position_error_m") or 0.0),
+        "final_mm": 1000.0 * (_number(summary, "final_position_error_m") or 0.0),
+        "rms_mm": 1000.0 * (_number(summary, "rms_position_error_m") or 0.0),
         "limit_mm": 1000.0 * error_limit(summary),
-        "start_stability": summary.get("start_stability", float("nan")),
+        "start_stability": math.nan if start_stability is None else start_stability,
     }
     what = ", ".join(REASONS[code].format(**values) for code in found)
     return found, what, likely_cause(summary, found)
@@ -198,7 +244,11 @@ def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
     ``{"verdict": str, "verdict_reasons": list[str]}`` (see the module docstring).
     ``summary`` must be a mapping; anything else (None, a list, a number) is a one-line
     :class:`~ddwmmr.errors.ParameterError` naming ``summary`` (:func:`reasons` checks it
-    first)."""
+    first). Each key it reads as a number (:data:`NUMBER_KEYS`) must be a number, missing
+    or None, or the ``"nan"``/``"inf"``/``"-inf"`` a ``summary.json`` writes for a
+    non-finite one; anything else (text, a boolean, a list) is a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming the key, whether or not this summary's
+    verdict would read it."""
     found, what, cause = explain(summary)
     if not found:
         return {"verdict": TRACKED, "verdict_reasons": []}
@@ -207,9 +257,15 @@ def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
 
 def short_verdict(summary: Mapping[str, Any]) -> str:
     """A few words for a crowded line: ``tracked`` or ``DID NOT TRACK (codes)``, from the
-    summary's verdict keys (computed if missing); ``summary`` as in :func:`verdict`."""
+    summary's verdict keys (computed if missing); ``summary`` as in :func:`verdict`, its
+    ``verdict_reasons`` (if there) a list of reason codes (strings)."""
     check_summary(summary)
     found = summary.get("verdict_reasons")
     if found is None:
         found = verdict(summary)["verdict_reasons"]
+    elif not isinstance(found, list | tuple) or not all(isinstance(c, str) for c in found):
+        raise ParameterError(
+            "summary: verdict_reasons must be a list of reason codes (strings such as "
+            f"'rms_error_above_limit') or None (got {shown(found)})"
+        )
     return TRACKED if not found else f"DID NOT TRACK ({', '.join(found)})"
