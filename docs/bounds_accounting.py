@@ -1,8 +1,9 @@
 """Where the time goes against the force budget's bound: docs/mpc.md's accounting table and
 docs/figures/bounds_accounting.png.
 
-``python docs/bounds_accounting.py --seed S --plans DIR [--jobs N]`` writes
-``docs/bounds/accounting_seed{S}.csv``: for each of the 100 scenarios, the force-budget
+``python docs/bounds_accounting.py --seed S --plans DIR [--jobs N] [--scenarios LIST]``
+writes ``docs/bounds/accounting_seed{S}.csv`` (``--scenarios 5,60``: only those rows, as
+after ``docs/bounds_figures.py --update``): for each of the 100 scenarios, the force-budget
 accounting (:func:`ddwmmr.bounds.accounting.account`) of three trajectories on the thesis
 plant (3 kg):
 
@@ -93,18 +94,33 @@ def account_scenario(job: tuple[int, int, str]) -> list[dict]:
     return rows
 
 
-def compute(seed: int, plans: Path, jobs: int) -> None:
-    """accounting_seed{seed}.csv from the best-known trajectories in ``plans``."""
-    work = [(seed, index, str(plans)) for index in range(1, 101)]
-    with ProcessPoolExecutor(max_workers=jobs) as pool:
-        rows = [row for rows in pool.map(account_scenario, work) for row in rows]
+def compute(seed: int, plans: Path, jobs: int, scenarios: list[int] | None = None) -> None:
+    """accounting_seed{seed}.csv from the best-known trajectories in ``plans``: all 100
+    scenarios, or only the rows of ``scenarios``, the others kept as committed."""
     target = DATA / f"accounting_seed{seed}.csv"
+    work = [(seed, index, str(plans)) for index in scenarios or range(1, 101)]
+    kept = []
+    if scenarios:
+        with open(target, newline="") as handle:
+            kept = [r for r in csv.DictReader(handle) if int(r["scenario"]) not in scenarios]
+    with ProcessPoolExecutor(max_workers=jobs) as pool:
+        new = [row for rows in pool.map(account_scenario, work) for row in rows]
+    order = list(TRAJECTORIES)
+    rows = sorted(
+        [
+            *kept,
+            *(
+                {k: row[k] if k in COLUMNS[:2] else round(row[k], 6) for k in COLUMNS}
+                for row in new
+            ),
+        ],
+        key=lambda r: (int(r["scenario"]), order.index(r["trajectory"])),
+    )
     partial = target.with_suffix(".csv.part")
     with open(partial, "w", newline="") as handle:
         writer = csv.DictWriter(handle, COLUMNS, lineterminator="\n")
         writer.writeheader()
-        for row in rows:
-            writer.writerow({k: row[k] if k in COLUMNS[:2] else round(row[k], 6) for k in COLUMNS})
+        writer.writerows(rows)
     os.replace(partial, target)
 
 
@@ -221,11 +237,17 @@ def main() -> None:
     parser.add_argument("--seed", type=int, choices=SEEDS)
     parser.add_argument("--plans", type=Path, help="a python -m ddwmmr.bounds output folder")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument(
+        "--scenarios", help="with --plans: redo only these rows, e.g. 5,60 (default: all 100)"
+    )
     args = parser.parse_args()
     if (args.seed is None) != (args.plans is None):
         parser.error("--seed and --plans go together")
+    if args.scenarios and args.plans is None:
+        parser.error("--scenarios needs --seed and --plans")
     if args.seed is not None:
-        compute(args.seed, args.plans, args.jobs)
+        chosen = [int(s) for s in args.scenarios.split(",")] if args.scenarios else None
+        compute(args.seed, args.plans, args.jobs, chosen)
     figure()
     rewrite_page()
     print("\n".join(table()))

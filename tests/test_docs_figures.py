@@ -19,12 +19,16 @@ DOCS = Path(__file__).resolve().parent.parent / "docs"
 
 
 def docs_script(name: str, tmp_path: Path, monkeypatch):
-    """Import ``docs/<name>.py`` as a module writing its figures to ``tmp_path``."""
+    """Import ``docs/<name>.py`` as a module writing its figures to ``tmp_path`` (its
+    ``FIGURES`` folder, or its one ``FIGURE`` under the same name)."""
     spec = importlib.util.spec_from_file_location(f"docs_{name}", DOCS / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     monkeypatch.setitem(sys.modules, spec.name, module)  # dataclasses look their module up
     spec.loader.exec_module(module)
-    monkeypatch.setattr(module, "FIGURES", tmp_path)
+    if hasattr(module, "FIGURES"):
+        monkeypatch.setattr(module, "FIGURES", tmp_path)
+    else:
+        monkeypatch.setattr(module, "FIGURE", tmp_path / module.FIGURE.name)
     return module
 
 
@@ -157,3 +161,66 @@ def test_bounds_accounting_figure_and_table(tmp_path, monkeypatch):
         cells = [c.strip() for c in row.strip("|").split("|")]
         time, lower, *terms = (float(c) for c in cells[1:8])
         assert lower + sum(terms) == pytest.approx(time, abs=0.03)
+
+
+def test_bounds_update_keeps_the_lower_replayed_time(tmp_path, monkeypatch):
+    """docs/bounds_figures.py --update: a later bounds run's row replaces the committed
+    one only where its replayed best-known time is lower, and only those scenarios'
+    plan-following runs are redone; a failed replay never wins."""
+    script = docs_script("bounds_figures", tmp_path, monkeypatch)
+    data, later = tmp_path / "data", tmp_path / "later"
+    data.mkdir()
+    later.mkdir()
+    monkeypatch.setattr(script, "DATA", data)
+    header = "scenario,lower_bound_s,best_known_s,starts,spread_s,replay_ok\n"
+    (data / "bounds_seed0.csv").write_text(
+        header + "1,5.0,10.0,59,1.0,True\n2,5.0,9.0,59,1.0,True\n3,5.0,8.0,59,1.0,False\n"
+    )
+    (later / "bounds.csv").write_text(
+        header + "1,5.0,9.5,60,2.0,True\n2,5.0,9.25,60,2.0,True\n3,5.0,7.5,60,2.0,True\n"
+        "4,5.0,1.0,60,2.0,True\n"
+    )
+    names = ",".join(script.CONTROLLERS)
+    (data / "controllers_seed0.csv").write_text(
+        f"scenario,{names}\n" + "".join(f"{s}," + ",".join(["20.0"] * 7) + "\n" for s in (1, 2, 3))
+    )
+    calls = []
+
+    def plan_run(job):
+        calls.append(job[1:3])
+        return job[1], job[2], 11.0 + job[1]
+
+    monkeypatch.setattr(script, "plan_run", plan_run)
+    assert script.update(0, later, jobs=1) == [1, 3]
+    assert sorted(calls) == [
+        (1, "mpc-plan"),
+        (1, "mpc-plan-cold"),
+        (3, "mpc-plan"),
+        (3, "mpc-plan-cold"),
+    ]
+    bounds = script.read_bounds(0)
+    assert bounds == {1: (5.0, 9.5), 2: (5.0, 9.0), 3: (5.0, 7.5)}
+    times = script.read_controllers(0)
+    assert times["mpc-plan"] == {1: 12.0, 2: 20.0, 3: 14.0}
+    assert times["mpc-plan-cold"] == {1: 12.0, 2: 20.0, 3: 14.0}
+    assert times["mpc"] == {1: 20.0, 2: 20.0, 3: 20.0}
+    assert script.update(0, later, jobs=1) == []  # the committed rows now win or tie
+
+
+def test_bounds_ratios_figure_and_tables(tmp_path, monkeypatch):
+    """docs/figures/bounds_ratios.png and docs/mpc.md's bracket tables from the committed
+    CSVs: every controller's mean time over the best known is at least 1 and its time over
+    the lower bound at least that (the bound is below the best known in every scenario)."""
+    script = docs_script("bounds_figures", tmp_path, monkeypatch)
+    saved = SavedFigures(monkeypatch)
+    script.figure()
+    assert list(saved.problems) == ["bounds_ratios.png"]
+    assert saved.failing() == {}
+    for seed in script.SEEDS:
+        lines = script.table(seed)
+        rows = [line for line in lines if line.startswith("| ") and "---" not in line][1:]
+        assert len(rows) == len(script.CONTROLLERS)
+        for row in rows:
+            cells = [c.strip() for c in row.strip("|").split("|")]
+            to_best, to_lower = (float(c.split()[0]) for c in cells[2:4])
+            assert 1.0 <= to_best < to_lower
