@@ -166,7 +166,6 @@ def check_geometry(name: str, value: float) -> float | int:
     of :mod:`ddwmmr.errors` the parametric trajectories enforce, so that a sampled
     trajectory placed by the same numbers is refused with a message naming the value."""
     if name == "N":
-        check_int_at_least("N", value, 2)  # "N >= 2" first, as the panel shows it
         return check_int_at_least("N", value, 2, MAX_TRAJECTORY_SAMPLES)
     return check_geometry_value(name, value)
 
