@@ -268,7 +268,7 @@ def test_from_dict_reads_a_robot_table_as_from_toml_does(tmp_path):
             {"robot": [{"L1": 0.4}]},
             "robot: [robot] must be one table of Robot fields (got an array of tables [[robot]])",
         ),
-        ({"robot": {"L1": "0.4"}}, "robot: L1 must be a number (got '0.4')"),
+        ({"robot": {"L1": "0.4"}}, "robot: L1 must be a number in [1e-06, 1000] m (got '0.4')"),
     ],
 )
 def test_from_dict_robot_table_errors(data, message):

@@ -123,7 +123,7 @@ ROBOT_CASES = [
     (["--robot", "{inputs}"], "is not a regular file"),
     (["--robot", "missing.toml"], "cannot read missing.toml"),
     (["--payload", "1e300"], "payload must be in [0, 100000] kg"),
-    (["--payload", "-1"], "payload must be >= 0 (got -1)"),
+    (["--payload", "-1"], "payload must be in [0, 100000] kg (got -1)"),
     (["--payload", "nan"], "payload must be a finite number"),
 ]
 TRAJ_CASES = [
@@ -183,7 +183,11 @@ CASES += [
     ("compare", ["--only", "{traj_Phi.csv}"], "unknown column(s) 'Phi'"),
     ("track", ["--traj", "{traj_huge_orientation.toml}"], "(got 'xxxxxxxxxxxxxxxxxxxxxxx"),
     ("track", ["--traj", "{traj_huge_key.toml}"], "unknown key 'kkkkkkkkkkkkkkkkkkkkkkkk"),
-    ("track", ["--robot", "{robot_huge_string.toml}"], "L1 must be a number (got 'xxxxxxx"),
+    (
+        "track",
+        ["--robot", "{robot_huge_string.toml}"],
+        "L1 must be a number in [1e-06, 1000] m (got 'xxxxxxx",
+    ),
     # a payload that tips the robot in the start pose: refused by every tool, as by track
     ("track", ["--payload", "20"], "a 20 kg payload tips the robot over in this run's start"),
     ("compare", ["--payload", "50"], "a 50 kg payload tips the robot over in this run's start"),

@@ -100,7 +100,10 @@ def test_payload_robot_file_and_animation(tmp_path):
         (["--method", "ats", "--traj", "nowhere"], "unknown trajectory 'nowhere'"),
         (["--method", "ats", "--traj", "ellipse", "--dt", "0"], "dt must be > 0"),
         (["--method", "ats", "--traj", "ellipse", "--dt", "-0.1"], "dt must be > 0"),
-        (["--method", "ats", "--traj", "ellipse", "--payload", "-1"], "payload must be >= 0"),
+        (
+            ["--method", "ats", "--traj", "ellipse", "--payload", "-1"],
+            "payload must be in [0, 100000] kg (got -1)",
+        ),
         (["--method", "ats", "--traj", "ellipse", "--payload", "nan"], "payload must be a finite"),
         (["--method", "clrrmc-ts", "--traj", "ellipse", "--tau", "-2"], "tau must be > 0"),
         (

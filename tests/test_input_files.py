@@ -14,11 +14,11 @@ from ddwmmr.errors import MAX_STEPS, check_int_at_least, check_step_count, read_
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        ('L1 = "0.3"', "robot: .*: L1 must be a number \\(got '0.3'\\)"),
-        ("L1 = true", "L1 must be a number \\(got True\\)"),
+        ('L1 = "0.3"', r"robot: .*: L1 must be a number in \[1e-06, 1000\] m \(got '0.3'\)"),
+        ("L1 = true", r"L1 must be a number in \[1e-06, 1000\] m \(got True\)"),
         ("wheel_radius = 1e-320", r"wheel_radius must be in \[1e-06, 1000\] m"),
         ("L1 = 1e300", r"L1 must be in \[1e-06, 1000\] m"),
-        ("base_mass = 1e9", r"base_mass must be in \[0, 100000\] kg"),
+        ("base_mass = 1e9", r"base_mass must be in \(0, 100000\] kg"),
         ("link_masses = 1.0", "link_masses must be a pair of numbers"),
         ("joint_limits = [[-1, 1]]", r"joint_limits must be two \[min, max\] pairs"),
         ('home_pose = [0.1, "x"]', "home_pose must be a number"),

@@ -157,11 +157,13 @@ def test_robot_from_toml(tmp_path):
 @pytest.mark.parametrize(
     ("kwargs", "message"),
     [
-        ({"L1": -1.0}, "L1 must be > 0"),
-        ({"payload": float("nan")}, "payload must be a finite number"),
-        ({"payload": -0.1}, "payload must be >= 0"),
+        ({"L1": -1.0}, "L1 must be in [1e-06, 1000] m (got -1)"),
+        ({"payload": float("nan")}, "payload must be a finite number in [0, 100000] kg (got nan)"),
+        ({"payload": -0.1}, "payload must be in [0, 100000] kg (got -0.1)"),
+        ({"base_mass": 0.0}, "base_mass must be in (0, 100000] kg (got 0)"),
+        ({"link_masses": (1.0, -1.0)}, "link_masses[2] must be in [0, 100000] kg (got -1)"),
         ({"joint_limits": ((1.0, -1.0), (-1.0, 1.0))}, "joint_limits[1] must satisfy min < max"),
-        ({"wheel_speed_limit": 0.0}, "wheel_speed_limit must be > 0"),
+        ({"wheel_speed_limit": 0.0}, "wheel_speed_limit must be in [1e-06, 1e+06] rad/s (got 0)"),
     ],
 )
 def test_invalid_robot_parameters_name_the_parameter(kwargs, message):

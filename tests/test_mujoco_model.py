@@ -180,10 +180,13 @@ def test_robots_mujoco_cannot_build_give_one_line(options, message):
 @pytest.mark.parametrize(
     ("options", "message"),
     [
-        ({"wheel_radius": 0.0}, "wheel_radius must be > 0"),
-        ({"base_mass": 0.0}, "base_mass must be > 0"),
+        ({"wheel_radius": 0.0}, "wheel_radius must be in [1e-06, 1000] m (got 0)"),
+        ({"base_mass": 0.0}, "base_mass must be in (0, 100000] kg (got 0)"),
         ({"wheel_mass": 6.0}, "wheel_mass must be < base_mass / 2"),
-        ({"joint_torque_limits": (5.0, -1.0)}, "joint_torque_limits[2] must be > 0"),
+        (
+            {"joint_torque_limits": (5.0, -1.0)},
+            "joint_torque_limits[2] must be in [1e-06, 1e+06] N m (got -1)",
+        ),
         ({"caster_positions": []}, "caster_positions must list at least one"),
         ({"arm_height": float("nan")}, "arm_height must be a finite number"),
     ],

@@ -22,8 +22,6 @@ from ddwmmr.errors import (
     TORQUE_RANGE_N_M,
     ParameterError,
     check_finite,
-    check_nonnegative,
-    check_positive,
     check_range,
     load_toml,
     shown,
@@ -54,6 +52,29 @@ _RANGES = {
 }
 #: Scalar fields that must be > 0 (every ranged one but the payload, which may be 0).
 _POSITIVE = tuple(name for name in _RANGES if name != "payload")
+
+
+def _allowed(name: str) -> str:
+    """The whole allowed range of the scalar field ``name``, as the messages give it:
+    ``in [1e-06, 1000] m``, or ``in (0, 100000] kg`` for a mass that must be > 0."""
+    low, high, unit = _RANGES[name]
+    opening = "(" if name in _POSITIVE and low <= 0 else "["
+    return f"in {opening}{low:g}, {high:g}] {unit}"
+
+
+def _check_scalar(name: str, value: Any) -> float:
+    """``value`` as a float if it is in the allowed range of the scalar field ``name``
+    (:data:`_RANGES`; > 0 for the fields of :data:`_POSITIVE`), else a one-line
+    :class:`ParameterError` naming the field and that whole range."""
+    low, high, _ = _RANGES[name]
+    allowed = _allowed(name)
+    number = check_finite(name, value, allowed)
+    above_low = low < number if allowed.startswith("in (") else low <= number
+    if not (above_low and number <= high):
+        raise ParameterError(f"{name} must be {allowed} (got {number:g})")
+    return number
+
+
 #: Largest distance of a caster from the base centre, in footprint half-diagonals
 #: ``hypot(base_length, base_width) / 2``: 1 reaches the corners, 2 allows outriggers.
 CASTER_REACH = 2.0
@@ -126,12 +147,11 @@ class Robot:
     _com: stability.ComCoefficients = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for name in _POSITIVE:
-            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
-        object.__setattr__(self, "payload", check_nonnegative("payload", self.payload))
+        for name in _RANGES:
+            object.__setattr__(self, name, _check_scalar(name, getattr(self, name)))
         masses = _pair("link_masses", self.link_masses, "kg")
         for i, m in enumerate(masses, start=1):
-            check_nonnegative(f"link_masses[{i}]", m)
+            check_range(f"link_masses[{i}]", m, *MASS_RANGE_KG, "kg")
         object.__setattr__(self, "link_masses", masses)
         limits = []
         for i, pair in enumerate(_pairs("joint_limits", self.joint_limits), start=1):
@@ -151,7 +171,7 @@ class Robot:
             )
         torques = _pair("joint_torque_limits", self.joint_torque_limits, "N m")
         for i, torque in enumerate(torques, start=1):
-            check_positive(f"joint_torque_limits[{i}]", torque)
+            check_range(f"joint_torque_limits[{i}]", torque, *TORQUE_RANGE_N_M, "N m")
         object.__setattr__(self, "joint_torque_limits", torques)
         if self.caster_positions is not None:
             object.__setattr__(self, "caster_positions", _points(self.caster_positions))
@@ -172,14 +192,9 @@ class Robot:
         )
 
     def _check_magnitudes(self) -> None:
-        """Documented physical ranges (ddwmmr.errors): ``wheel_radius = 1e-320`` or
-        ``L1 = 1e300`` would only overflow or divide by ~0 later."""
-        for name, (low, high, unit) in _RANGES.items():
-            check_range(name, getattr(self, name), low, high, unit)
-        for i, mass in enumerate(self.link_masses, start=1):
-            check_range(f"link_masses[{i}]", mass, *MASS_RANGE_KG, "kg")
-        for i, torque in enumerate(self.joint_torque_limits, start=1):
-            check_range(f"joint_torque_limits[{i}]", torque, *TORQUE_RANGE_N_M, "N m")
+        """Documented physical ranges (ddwmmr.errors) of the joint limits and casters (the
+        scalar fields, link masses and torque limits are checked against theirs first):
+        ``joint_limits`` of 1e300 would only overflow later."""
         for i, pair in enumerate(self.joint_limits, start=1):
             for value in pair:
                 check_range(f"joint_limits[{i}]", value, -MAX_ANGLE_RAD, MAX_ANGLE_RAD, "rad")
@@ -401,7 +416,7 @@ def _check_field_type(key: str, value: Any, default: Any) -> None:
         ok, wanted = isinstance(value, bool), "true or false"
     elif isinstance(default, int | float):
         ok = isinstance(value, int | float) and not isinstance(value, bool)
-        wanted = "a number"
+        wanted = f"a number {_allowed(key)}" if key in _RANGES else "a number"
     elif isinstance(default, str):
         ok, wanted = isinstance(value, str), "a string"
     elif isinstance(default, tuple):
