@@ -216,6 +216,49 @@ def test_toml_values_must_have_their_type_and_range(tmp_path, text, message):
         load_trajectory(str(path))
 
 
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        # keys above the [trajectory] table were ignored: the default 40 s ellipse ran
+        (
+            'a = 3.0\nT = 20.0\n[trajectory]\nshape = "ellipse"\n',
+            "key 'a' outside [trajectory] (the keys go at the top or all under one "
+            "[trajectory] table)",
+        ),
+        (
+            '[trajectory]\nshape = "ellipse"\n[extra]\nq = 1\n',
+            "table [extra] outside [trajectory]",
+        ),
+        ('shape = "circle"\n', "needs shape = one of ellipse, rectangle (got 'circle')"),
+        (
+            '[traj]\nshape = "ellipse"\n',
+            "needs shape = one of ellipse, rectangle (no shape key at the top or in a "
+            "[trajectory] table)",
+        ),
+        # phi was ignored with the (default) tangent orientation
+        ('shape = "ellipse"\nphi = 1.0\n', 'phi is used only with orientation = "constant"'),
+        (
+            'shape = "ellipse"\norientation = "tangent"\nphi = 0.5\n',
+            'set orientation = "constant" or drop phi',
+        ),
+    ],
+)
+def test_toml_keys_that_would_be_ignored_are_refused(tmp_path, text, message):
+    path = tmp_path / "t.toml"
+    path.write_text(text)
+    with pytest.raises(ParameterError) as info:
+        load_trajectory(str(path))
+    assert str(info.value).startswith(f"traj: {path}") and message in str(info.value)
+    assert "\n" not in str(info.value)
+
+
+def test_toml_phi_counts_with_the_constant_orientation(tmp_path):
+    path = tmp_path / "fixed.toml"
+    path.write_text('[trajectory]\nshape = "ellipse"\norientation = "constant"\nphi = 0.5\n')
+    assert load_trajectory(str(path)) == Ellipse(orientation="constant", phi=0.5, name="fixed")
+    assert load_trajectory(str(path)).pose(3.0)[2] == 0.5
+
+
 def test_parametric_api_rejects_strings_and_booleans():
     message = r"^a must be a finite number in \[1e-06, 1000\] m \(got '2.0'\)"
     with pytest.raises(ParameterError, match=message):

@@ -163,11 +163,24 @@ def _load_file(path: Path, overrides: dict):
 def read_toml(path: str | Path, **overrides):
     """Load a parametric trajectory (ellipse or rectangle) from a TOML file.
 
-    Every value must have its documented type (numbers for lengths, angles, N and T,
-    strings for shape, orientation and name): ``N = "2000"`` is an error naming ``N``.
+    The keys are either all top-level or all in one ``[trajectory]`` table: beside that
+    table nothing else may be in the file (a key above it would be ignored). Unknown keys
+    are refused naming the first, and ``phi`` only counts with ``orientation =
+    "constant"``, so it is refused with the tangent orientation (the default) instead of
+    being ignored. Every value must have its documented type (numbers for lengths,
+    angles, N and T, strings for shape, orientation and name): ``N = "2000"`` is an error
+    naming ``N``.
     """
     path = Path(path)
     data = load_toml(path, "traj")
+    if "trajectory" in data:
+        for key, value in data.items():
+            if key != "trajectory":
+                what = f"table [{key}]" if isinstance(value, dict | list) else f"key {shown(key)}"
+                raise ParameterError(
+                    f"traj: {path}: {what} outside [trajectory] (the keys go at the top or "
+                    "all under one [trajectory] table)"
+                )
     table = data.get("trajectory", data)
     if not isinstance(table, dict):
         raise ParameterError(
@@ -176,7 +189,12 @@ def read_toml(path: str | Path, **overrides):
     table = dict(table)
     shape = table.pop("shape", None)
     if shape not in SHAPES:
-        raise ParameterError(f"traj: {path} needs shape = one of {', '.join(SHAPES)}")
+        got = (
+            "no shape key at the top or in a [trajectory] table"
+            if shape is None
+            else f"got {shown(shape)}"
+        )
+        raise ParameterError(f"traj: {path} needs shape = one of {', '.join(SHAPES)} ({got})")
     table.setdefault("name", path.stem)
     table.update(overrides)
     known = [f.name for f in fields(SHAPES[shape])]
@@ -186,6 +204,12 @@ def read_toml(path: str | Path, **overrides):
             f"traj: {path}: unknown key {shown(unknown[0])} (known: shape, {', '.join(known)})"
         )
     _check_types(path, table)
+    if "phi" in table and table.get("orientation", "tangent") == "tangent":
+        raise ParameterError(
+            f'traj: {path}: phi is used only with orientation = "constant" (the orientation '
+            'here is tangent, the direction of travel); set orientation = "constant" or '
+            "drop phi"
+        )
     try:
         return SHAPES[shape](**table)
     except TypeError as exc:
