@@ -151,3 +151,24 @@ def test_a_byte_order_mark_is_not_part_of_the_text(tmp_path):
     (tmp_path / "robot.toml").write_bytes(b"\xef\xbb\xbfL1 = 0.4\n")
     assert Robot.from_toml(tmp_path / "robot.toml").L1 == 0.4
     assert read_text_file(tmp_path / "robot.toml", "robot") == "L1 = 0.4\n"
+
+
+@pytest.mark.parametrize("path", [3, None, b"robot.toml", 2.5])
+def test_an_input_file_that_is_not_a_path_is_one_line_naming_the_option(path):
+    """Robot.from_toml(3) raised Python's TypeError from pathlib; every reader of an input
+    file now refuses what is not a str or os.PathLike with its option's name."""
+    from ddwmmr.qp.limits.obstacles import load_obstacles
+    from ddwmmr.trajectories.files import read_toml
+    from ddwmmr.trajectories.sampled import read_csv
+
+    for read, label in (
+        (Robot.from_toml, "robot"),
+        (read_toml, "traj"),
+        (read_csv, "traj"),
+        (load_obstacles, "obstacles"),
+    ):
+        with pytest.raises(ParameterError) as info:
+            read(path)
+        assert str(info.value) == (
+            f"{label}: a file path (str or os.PathLike) is needed (got {path!r})"
+        )

@@ -216,15 +216,28 @@ def shown(value: Any, width: int = 40) -> str:
     return text if len(text) <= width else text[: width - 3] + "..."
 
 
+def as_path(path: Any, label: str) -> Path:
+    """``path`` as a :class:`~pathlib.Path` if it is a ``str`` or an ``os.PathLike``
+    (what ``Path`` takes), else a one-line :class:`ParameterError` naming ``label``: an
+    input file given as a number, None or bytes is bad input, not a ``TypeError``."""
+    if isinstance(path, str | os.PathLike):
+        try:
+            return Path(path)
+        except TypeError:  # an os.PathLike whose __fspath__ gives bytes
+            pass
+    raise ParameterError(f"{label}: a file path (str or os.PathLike) is needed (got {shown(path)})")
+
+
 def read_text_file(path: str | Path, label: str) -> str:
     """The UTF-8 text of a regular file; anything else raises :class:`ParameterError`.
 
     The file is checked with ``os.stat`` before it is opened, so a FIFO, a device or a
     folder is refused instead of blocking or failing; files above :data:`MAX_INPUT_BYTES`
     are refused too. ``label`` names the option in the message. A UTF-8 byte-order mark at
-    the start is not part of the text.
+    the start is not part of the text. ``path`` must be a ``str`` or an ``os.PathLike``
+    (:func:`as_path`).
     """
-    path = Path(path)
+    path = as_path(path, label)
     try:
         info = os.stat(path)
     except OSError as exc:
@@ -258,7 +271,7 @@ def load_toml(path: str | Path, label: str) -> dict:
     and the API). ``label`` names the option in the message (``robot``, ``traj``,
     ``obstacles``).
     """
-    path = Path(path)
+    path = as_path(path, label)
     text = read_text_file(path, label)
     too_deep = ParameterError(
         f"{label}: {path} nests arrays or tables more than {MAX_TOML_DEPTH} levels deep"

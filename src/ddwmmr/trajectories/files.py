@@ -36,7 +36,7 @@ from importlib import resources
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.errors import ParameterError, check_number_type, load_toml, shown
+from ddwmmr.errors import ParameterError, as_path, check_number_type, load_toml, shown
 from ddwmmr.trajectories.parametric import Ellipse, Rectangle
 from ddwmmr.trajectories.sampled import read_csv
 
@@ -171,7 +171,7 @@ def read_toml(path: str | Path, **overrides):
     angles, N and T, strings for shape, orientation and name): ``N = "2000"`` is an error
     naming ``N``.
     """
-    path = Path(path)
+    path = as_path(path, "traj")
     data = load_toml(path, "traj")
     if "trajectory" in data:
         for key, value in data.items():

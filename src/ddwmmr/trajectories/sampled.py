@@ -23,6 +23,7 @@ from ddwmmr.errors import (
     MAX_COORDINATE_M,
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
+    as_path,
     read_text_file,
     shown,
 )
@@ -351,7 +352,7 @@ def _is_number_text(text: str) -> bool:
 
 def read_csv(path: str | Path) -> SampledTrajectory:
     """Load a :class:`SampledTrajectory` from a CSV file with columns t, x, y[, phi]."""
-    path = Path(path)
+    path = as_path(path, "traj")
     text = read_text_file(path, "traj")
     lines = [line for line in text.splitlines() if not line.startswith("#")]
     if len(lines) > MAX_TRAJECTORY_SAMPLES + 1:

@@ -25,6 +25,7 @@ from ddwmmr.errors import (
     LENGTH_RANGE_M,
     MAX_COORDINATE_M,
     ParameterError,
+    as_path,
     check_finite,
     check_nonnegative,
     check_positive,
@@ -56,7 +57,7 @@ class Circle:
 
 def load_obstacles(path: str | Path) -> list[Circle]:
     """Read circles from a TOML file of ``[[obstacle]]`` tables with x, y, radius (m)."""
-    path = Path(path)
+    path = as_path(path, "obstacles")
     data = load_toml(path, "obstacles")
     tables = data.get("obstacle")
     unknown = sorted(set(data) - {"obstacle"})
