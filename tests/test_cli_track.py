@@ -350,6 +350,29 @@ def test_rerun_of_a_damaged_record_is_one_line(
 
 
 @pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("method", "nope", "method: unknown method 'nope' (known: thesis, pi, ats, ap, "),
+        ("options", {"aux": "sum"}, "method pi: unknown option 'aux' (accepted: "),
+    ],
+)
+def test_rerun_of_a_record_with_a_bad_method_or_option_names_the_file(
+    recorded_run, tmp_path, capsys, field, value, message
+):
+    """The recorded method and options were checked only when the controller was built,
+    outside the record's check: the refusal did not say it came from the file."""
+    damaged = json.loads(json.dumps(recorded_run))
+    damaged["run"][field] = value
+    path = tmp_path / "summary.json"
+    path.write_text(json.dumps(damaged))
+    out = tmp_path / "o"
+    assert run(["--rerun", str(path), "--no-progress", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"error: rerun: {path}: {message}") and err.count("\n") == 1
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
     ("value", "message"),
     [
         (-0.01, "dt must be > 0 (got -0.01)"),

@@ -475,16 +475,20 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         )
         return check_run(inputs, "payload", "the recorded initial_offset")
     except ParameterError as exc:  # one line naming what is wrong: say where it was read
-        text = str(exc)
-        raise ParameterError(
-            text if text.startswith("rerun:") else f"rerun: {args.rerun}: {text}"
-        ) from None
+        raise _in_record(args.rerun, exc) from None
     except KeyError as exc:
         raise ParameterError(
             f"rerun: {args.rerun} is not a complete run record (field run.{exc.args[0]} is missing)"
         ) from None
     except (TypeError, AttributeError, ValueError) as exc:
         raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
+
+
+def _in_record(path: str, exc: ParameterError) -> ParameterError:
+    """``exc``, a refusal of what the record at ``path`` holds, naming that file
+    (``rerun: FILE: ...``) unless it already does."""
+    text = str(exc)
+    return ParameterError(text if text.startswith("rerun:") else f"rerun: {path}: {text}")
 
 
 def _inside(section: str, read: Callable[[], Any]) -> Any:
@@ -556,7 +560,12 @@ def _main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     inputs = inputs_from_record(args) if args.rerun is not None else inputs_from_arguments(args)
     steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
-    controller = make_controller(inputs.method, inputs.robot, **inputs.options)
+    try:
+        controller = make_controller(inputs.method, inputs.robot, **inputs.options)
+    except ParameterError as exc:  # a recorded method or option: name the record
+        if args.rerun is None:
+            raise
+        raise _in_record(args.rerun, exc) from None
     fresh = args.out is None  # a default name: never replaces an earlier run
     base = default_out(inputs.method, inputs.label) if fresh else Path(args.out)
     out = first_free(base, folder=True) if fresh else base
