@@ -242,6 +242,26 @@ def test_corner_count_and_duration_caps():
     assert Rectangle(T=20.0).corner_times(20.0) == [5.0, 10.0, 15.0, 20.0]
 
 
+def test_simulate_refuses_a_duration_with_too_many_corners_before_the_run():
+    """The rectangle's corner windows were computed for the summary, after the run: 1e5
+    steps of 1e7 s were simulated, then refused. Now no step runs."""
+    steps = []
+    with pytest.raises(ParameterError) as info:
+        simulate(
+            Robot(),
+            Rectangle(),
+            "ats",
+            duration=1e12,
+            dt=1e7,
+            progress=lambda k, n: steps.append(k),
+        )
+    assert str(info.value) == (
+        "duration must be in (0, 1e+07] s for T = 40 s (at most 1e+09 s and 1000000 "
+        "corners, one every T / 4) (got 1e+12)"
+    )
+    assert steps == []
+
+
 # -- Robot.from_dict with a [robot] table ---------------------------------------------------
 def test_from_dict_reads_a_robot_table_as_from_toml_does(tmp_path):
     nested = Robot.from_dict({"robot": {"L1": 0.4, "payload": 2.0}})

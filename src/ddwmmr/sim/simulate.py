@@ -221,6 +221,10 @@ def simulate(
         dt = engine_multiple(resolution_step(trajectory), the_plant)
     dt = check_positive("dt", dt)
     steps = check_step_count(duration, dt)  # within MAX_STEPS, before anything is allocated
+    # the rectangle's corner windows (its corner metric), before the run: a duration with
+    # more corners than they allow is refused now, not after every step has been simulated
+    corners = getattr(trajectory, "corner_windows", None)
+    windows = corners(duration) if corners is not None else ()
     if q0 is None:
         if isinstance(initial_offset, str) or not hasattr(initial_offset, "__len__"):
             raise ParameterError(
@@ -236,8 +240,7 @@ def simulate(
     task = TrackingTask(reference, the_plant, grid=(dt, steps))
     run_loop(the_plant, controller, task, q, dt, steps, progress)
     timeseries = task.timeseries(robot)
-    corners = getattr(trajectory, "corner_windows", None)
-    summary = summarize(timeseries, robot, corners(duration) if corners is not None else ())
+    summary = summarize(timeseries, robot, windows)
     recorded_steps = len(timeseries["t"]) - 1
     summary.update(
         method=getattr(controller, "name", type(controller).__name__),
