@@ -58,7 +58,16 @@ def test_obstacle_study_table(tmp_path, capsys):
     ("args", "message"),
     [
         (["--n", "0"], "n must be an integer in [1, 100000]"),
-        (["--stability", "1.6", "1.2"], "enter must be <= exit"),
+        (
+            ["--stability", "1.6", "1.2"],
+            "stability thresholds: ENTER must be <= EXIT, both in (0, 10] "
+            "(got --stability 1.6 1.2)",
+        ),
+        (
+            ["--manipulability", "0.9", "0.8"],
+            "manipulability thresholds: ENTER must be <= EXIT, both in (0, 1] "
+            "(got --manipulability 0.9 0.8)",
+        ),
         (["--controller", "nope"], "invalid choice"),
         (["--controller", "thesis", "--plant", "kinematic"], "thesis or mujoco"),
         (["--payload", "-1"], "payload must be in [0, "),

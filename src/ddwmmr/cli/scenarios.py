@@ -439,6 +439,11 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
                 raise ParameterError(
                     f"{name} thresholds must be in (0, {high:g}] (got {enter:g}, {exit_:g})"
                 )
+        if not enter <= exit_:  # named here: the state machine's check knows no option
+            raise ParameterError(
+                f"{name} thresholds: ENTER must be <= EXIT, both in (0, {high:g}] "
+                f"(got --{name} {enter:g} {exit_:g})"
+            )
         thresholds[name] = (enter, enter) if name in args.no_hysteresis else (enter, exit_)
     return RunConfig(
         controller=args.controller,
