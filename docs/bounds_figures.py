@@ -104,10 +104,12 @@ def read_rows(path: Path) -> tuple[list[str], dict[int, dict[str, str]]]:
 
 
 def write_rows(path: Path, header: list[str], rows: dict[int, dict[str, str]]) -> None:
-    """Write ``rows`` (by scenario, in order) under ``header``, atomically."""
+    """Write ``rows`` (by scenario, in order) under ``header``, atomically, with the line
+    ending the file had (the bounds tool's CSV ends its lines in CRLF, as ``csv`` does)."""
+    ending = "\r\n" if path.exists() and b"\r\n" in path.read_bytes() else "\n"
     partial = path.with_suffix(".csv.part")
     with open(partial, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, header, lineterminator="\n")
+        writer = csv.DictWriter(handle, header, lineterminator=ending)
         writer.writeheader()
         for scenario in sorted(rows):
             writer.writerow(rows[scenario])
@@ -148,6 +150,13 @@ def plan_run(job: tuple[int, int, str, str]) -> tuple[int, str, float]:
     return index, name, round(metrics["time_s"], 3) if metrics["success"] else math.nan
 
 
+#: A later best-known time replaces the committed one only if lower by more than this (s):
+#: closer, the two searches found the same optimum, and replacing it would only run the
+#: plan-following closed loop again, whose times move by tenths of a second with the
+#: plan's last digits.
+SAME_OPTIMUM_S = 1e-6
+
+
 def update(seed: int, folder: Path, jobs: int) -> list[int]:
     """Keep the lower replayed best-known time per scenario (module docstring); returns
     the scenarios whose row came from ``folder``."""
@@ -157,7 +166,7 @@ def update(seed: int, folder: Path, jobs: int) -> list[int]:
     replaced = sorted(
         s
         for s, row in later.items()
-        if s in committed and replayed_best(row) < replayed_best(committed[s])
+        if s in committed and replayed_best(row) < replayed_best(committed[s]) - SAME_OPTIMUM_S
     )
     if not replaced:
         return []

@@ -165,24 +165,29 @@ def test_bounds_accounting_figure_and_table(tmp_path, monkeypatch):
 
 def test_bounds_update_keeps_the_lower_replayed_time(tmp_path, monkeypatch):
     """docs/bounds_figures.py --update: a later bounds run's row replaces the committed
-    one only where its replayed best-known time is lower, and only those scenarios'
-    plan-following runs are redone; a failed replay never wins."""
+    one only where its replayed best-known time is lower (by more than the same optimum's
+    rounding), and only those scenarios' plan-following runs are redone; a failed replay
+    never wins."""
     script = docs_script("bounds_figures", tmp_path, monkeypatch)
     data, later = tmp_path / "data", tmp_path / "later"
     data.mkdir()
     later.mkdir()
     monkeypatch.setattr(script, "DATA", data)
     header = "scenario,lower_bound_s,best_known_s,starts,spread_s,replay_ok\n"
-    (data / "bounds_seed0.csv").write_text(
-        header + "1,5.0,10.0,59,1.0,True\n2,5.0,9.0,59,1.0,True\n3,5.0,8.0,59,1.0,False\n"
+    committed = header + (
+        "1,5.0,10.0,59,1.0,True\n2,5.0,9.0,59,1.0,True\n3,5.0,8.0,59,1.0,False\n"
+        "5,5.0,10.0,59,1.0,True\n"
     )
+    # as the bounds tool writes it: csv's CRLF line endings
+    (data / "bounds_seed0.csv").write_bytes(committed.replace("\n", "\r\n").encode())
     (later / "bounds.csv").write_text(
         header + "1,5.0,9.5,60,2.0,True\n2,5.0,9.25,60,2.0,True\n3,5.0,7.5,60,2.0,True\n"
-        "4,5.0,1.0,60,2.0,True\n"
+        "4,5.0,1.0,60,2.0,True\n5,5.0,9.9999999,60,2.0,True\n"
     )
     names = ",".join(script.CONTROLLERS)
     (data / "controllers_seed0.csv").write_text(
-        f"scenario,{names}\n" + "".join(f"{s}," + ",".join(["20.0"] * 7) + "\n" for s in (1, 2, 3))
+        f"scenario,{names}\n"
+        + "".join(f"{s}," + ",".join(["20.0"] * 7) + "\n" for s in (1, 2, 3, 5))
     )
     calls = []
 
@@ -199,11 +204,14 @@ def test_bounds_update_keeps_the_lower_replayed_time(tmp_path, monkeypatch):
         (3, "mpc-plan-cold"),
     ]
     bounds = script.read_bounds(0)
-    assert bounds == {1: (5.0, 9.5), 2: (5.0, 9.0), 3: (5.0, 7.5)}
+    # 5: 1e-7 s lower is the same optimum, kept
+    assert bounds == {1: (5.0, 9.5), 2: (5.0, 9.0), 3: (5.0, 7.5), 5: (5.0, 10.0)}
+    written = (data / "bounds_seed0.csv").read_bytes()
+    assert written.count(b"\r\n") == 5 and b"2,5.0,9.0,59,1.0,True\r\n" in written
     times = script.read_controllers(0)
-    assert times["mpc-plan"] == {1: 12.0, 2: 20.0, 3: 14.0}
-    assert times["mpc-plan-cold"] == {1: 12.0, 2: 20.0, 3: 14.0}
-    assert times["mpc"] == {1: 20.0, 2: 20.0, 3: 20.0}
+    assert times["mpc-plan"] == {1: 12.0, 2: 20.0, 3: 14.0, 5: 20.0}
+    assert times["mpc-plan-cold"] == {1: 12.0, 2: 20.0, 3: 14.0, 5: 20.0}
+    assert times["mpc"] == {1: 20.0, 2: 20.0, 3: 20.0, 5: 20.0}
     assert script.update(0, later, jobs=1) == []  # the committed rows now win or tie
 
 
