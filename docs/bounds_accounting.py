@@ -22,9 +22,9 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import json
 import math
-import os
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -33,6 +33,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+
+from ddwmmr.sim.result import write_atomic
 
 DOCS = Path(__file__).resolve().parent
 DATA = DOCS / "bounds"
@@ -116,12 +118,11 @@ def compute(seed: int, plans: Path, jobs: int, scenarios: list[int] | None = Non
         ],
         key=lambda r: (int(r["scenario"]), order.index(r["trajectory"])),
     )
-    partial = target.with_suffix(".csv.part")
-    with open(partial, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, COLUMNS, lineterminator="\n")
-        writer.writeheader()
-        writer.writerows(rows)
-    os.replace(partial, target)
+    text = io.StringIO()
+    writer = csv.DictWriter(text, COLUMNS, lineterminator="\n")
+    writer.writeheader()
+    writer.writerows(rows)
+    write_atomic(target, text.getvalue())
 
 
 def seeds() -> list[int]:

@@ -30,8 +30,8 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import math
-import os
 import shutil
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -41,6 +41,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+
+from ddwmmr.sim.result import write_atomic
 
 DOCS = Path(__file__).resolve().parent
 DATA = DOCS / "bounds"
@@ -88,12 +90,11 @@ def collect(seed: int, folder: Path) -> None:
             int(r["scenario"]): round(float(r["time_s"]), 3) if r["success"] == "true" else math.nan
             for r in rows
         }
-    scenarios = sorted(columns["thesis"])
-    with open(DATA / f"controllers_seed{seed}.csv", "w", newline="") as handle:
-        writer = csv.writer(handle, lineterminator="\n")
-        writer.writerow(["scenario", *CONTROLLERS])
-        for s in scenarios:
-            writer.writerow([s, *(repr(columns[n][s]) for n in CONTROLLERS)])
+    rows = {
+        s: {"scenario": s, **{n: repr(columns[n][s]) for n in CONTROLLERS}}
+        for s in columns["thesis"]
+    }
+    write_rows(DATA / f"controllers_seed{seed}.csv", ["scenario", *CONTROLLERS], rows)
 
 
 def read_rows(path: Path) -> tuple[list[str], dict[int, dict[str, str]]]:
@@ -107,13 +108,11 @@ def write_rows(path: Path, header: list[str], rows: dict[int, dict[str, str]]) -
     """Write ``rows`` (by scenario, in order) under ``header``, atomically, with the line
     ending the file had (the bounds tool's CSV ends its lines in CRLF, as ``csv`` does)."""
     ending = "\r\n" if path.exists() and b"\r\n" in path.read_bytes() else "\n"
-    partial = path.with_suffix(".csv.part")
-    with open(partial, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, header, lineterminator=ending)
-        writer.writeheader()
-        for scenario in sorted(rows):
-            writer.writerow(rows[scenario])
-    os.replace(partial, path)
+    text = io.StringIO()
+    writer = csv.DictWriter(text, header, lineterminator=ending)
+    writer.writeheader()
+    writer.writerows(rows[scenario] for scenario in sorted(rows))
+    write_atomic(path, text.getvalue())
 
 
 def replayed_best(row: dict[str, str]) -> float:
@@ -121,18 +120,10 @@ def replayed_best(row: dict[str, str]) -> float:
     return float(row["best_known_s"]) if row["replay_ok"] == "True" else math.inf
 
 
-#: The plan-following runs, as the scenarios tool's options (BOUNDS_DIR filled in).
-PLAN_RUNS = {
-    "mpc-plan": ("--option", "lookahead=on", "--option", "plan={}"),
-    "mpc-plan-cold": (
-        "--option",
-        "lookahead=on",
-        "--option",
-        "plan={}",
-        "--option",
-        "plan_weight=0",
-    ),
-}
+#: The plan-following runs, as the scenarios tool's options (BOUNDS_DIR filled in): the
+#: mpc with lookahead following the plan, and the same with the plan as cold starts only.
+_FOLLOW = ("--option", "lookahead=on", "--option", "plan={}")
+PLAN_RUNS = {"mpc-plan": _FOLLOW, "mpc-plan-cold": (*_FOLLOW, "--option", "plan_weight=0")}
 
 
 def plan_run(job: tuple[int, int, str, str]) -> tuple[int, str, float]:

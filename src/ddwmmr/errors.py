@@ -271,8 +271,8 @@ def load_toml(path: str | Path, label: str) -> dict:
     and the API). ``label`` names the option in the message (``robot``, ``traj``,
     ``obstacles``).
     """
-    path = as_path(path, label)
-    text = read_text_file(path, label)
+    text = read_text_file(path, label)  # refuses a path of the wrong type (as_path)
+    path = Path(path)
     too_deep = ParameterError(
         f"{label}: {path} nests arrays or tables more than {MAX_TOML_DEPTH} levels deep"
     )

@@ -54,12 +54,17 @@ _RANGES = {
 _POSITIVE = tuple(name for name in _RANGES if name != "payload")
 
 
+def _open_below(name: str) -> bool:
+    """Whether the scalar field ``name`` must be above its range's low end, not at it: a
+    field that must be > 0 (:data:`_POSITIVE`) whose range starts at 0 (a mass)."""
+    return name in _POSITIVE and _RANGES[name][0] <= 0
+
+
 def _allowed(name: str) -> str:
     """The whole allowed range of the scalar field ``name``, as the messages give it:
     ``in [1e-06, 1000] m``, or ``in (0, 100000] kg`` for a mass that must be > 0."""
     low, high, unit = _RANGES[name]
-    opening = "(" if name in _POSITIVE and low <= 0 else "["
-    return f"in {opening}{low:g}, {high:g}] {unit}"
+    return f"in {'(' if _open_below(name) else '['}{low:g}, {high:g}] {unit}"
 
 
 def _check_scalar(name: str, value: Any) -> float:
@@ -69,7 +74,7 @@ def _check_scalar(name: str, value: Any) -> float:
     low, high, _ = _RANGES[name]
     allowed = _allowed(name)
     number = check_finite(name, value, allowed)
-    above_low = low < number if allowed.startswith("in (") else low <= number
+    above_low = low < number if _open_below(name) else low <= number
     if not (above_low and number <= high):
         raise ParameterError(f"{name} must be {allowed} (got {number:g})")
     return number
