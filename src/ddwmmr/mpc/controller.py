@@ -300,7 +300,10 @@ class MPCController:
         reach = self._trajectory is None and not np.any(velocity_d)
         target = (float(pose_d[0]), float(pose_d[1]))
         new_target = reach and self._target != target
-        stuck = reach and self._stall.stuck(t, tuple(self.robot.fk(q)[:2]), new_target)
+        stuck = reach and (
+            self._stall.stuck(t, tuple(self.robot.fk(q)[:2]), new_target)
+            or self._stall.horizon_frozen(t)
+        )
         overdue = self._stall.arrival_overdue(t)
         if (stuck or overdue) and self._warm_mode == "reach2" and not new_target:
             # a plan through this target to the next stalled short of it: one target at a
@@ -339,8 +342,10 @@ class MPCController:
         self._target, self._following = target, following
         # "there at the shortest horizon" (within a millisecond: the QP's tolerance)
         shortest = problem.ocp.config.min_horizon + 1e-3
-        arriving = mode == "reach2" and problem.ocp.horizon_of(w) <= shortest
-        self._stall.plan_arrival(t, arriving, new_target)
+        horizon = problem.ocp.horizon_of(w)
+        self._stall.plan_arrival(t, mode == "reach2" and horizon <= shortest, new_target)
+        free = reach and shortest < horizon < problem.ocp.config.horizon - 1e-3
+        self._stall.plan_horizon(t, horizon, free, cold)
         slack = problem.ocp.max_slack(w)
         self._stall.plan_slack(t, slack)
         u = problem.ocp.first_input(w)

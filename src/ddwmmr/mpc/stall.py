@@ -12,7 +12,13 @@ at most once per :data:`STALL_TIME`):
   stuck (on the physics plant: spinning on the spot with the arm stretched at the dynamic
   floor).
 
-A third timer serves the plans through a target to the next one (``lookahead``):
+A third rule drops a frozen plan: every plan for :data:`STALL_TIME` promised to arrive
+in the same time (its free horizon within :data:`FROZEN_HORIZON` of the first's, strictly
+between its bounds) while the clock ran on: a plan that is being followed arrives a second
+sooner every second, so one whose arrival recedes with the clock is a stationary point the
+one iteration per step keeps returning to (:meth:`StallWatch.horizon_frozen`).
+
+A fourth timer serves the plans through a target to the next one (``lookahead``):
 :meth:`StallWatch.arrival_overdue` when every plan for :data:`STALL_TIME` said "there at
 the shortest horizon" without the target being reached.
 
@@ -29,16 +35,19 @@ STALL_TIME = 0.5
 STALL_PROGRESS = 1e-3
 #: Largest slack (rows' units) of a plan that meets its constraints.
 STALL_SLACK = 1e-3
+#: Change of the promised arrival horizon (s) below which the plans count as frozen.
+FROZEN_HORIZON = 0.05
 
 
 class StallWatch:
-    """The two rules' memory over a run (reset with the controller)."""
+    """The rules' memory over a run (reset with the controller)."""
 
     def __init__(self) -> None:
         self._anchor: tuple[float, float] | None = None
         self._anchor_time = 0.0
         self._infeasible_since: float | None = None  # first of the plans that needed slack
         self._arriving_since: float | None = None  # first of the plans at the shortest horizon
+        self._promise: tuple[float, float] | None = None  # (t, horizon) of the frozen run's first
 
     def fresh_plan(self) -> None:
         """A cold start: its plans get their own :data:`STALL_TIME` to need slack."""
@@ -63,6 +72,26 @@ class StallWatch:
             self._arriving_since = None
         elif new_target or self._arriving_since is None:
             self._arriving_since = t
+
+    def plan_horizon(self, t: float, horizon: float, free: bool, cold: bool) -> None:
+        """The plan made at t (s) promises to arrive in ``horizon`` s; ``free``: the horizon
+        lies strictly between its bounds (a plan at its longest only gets as close as it
+        can, one at its shortest is the arrival timer's); ``cold``: the plan started cold
+        (a new target, a restart)."""
+        promise = self._promise
+        if not free:
+            self._promise = None
+        elif cold or promise is None or abs(horizon - promise[1]) > FROZEN_HORIZON:
+            self._promise = (t, horizon)
+
+    def horizon_frozen(self, t: float) -> bool:
+        """True (once per :data:`STALL_TIME`) when every plan for longer than STALL_TIME (s)
+        up to t promised the same arrival horizon (:meth:`plan_horizon`)."""
+        promise = self._promise
+        if promise is None or t - promise[0] <= STALL_TIME:
+            return False
+        self._promise = None  # the next plan starts a new run
+        return True
 
     def arrival_overdue(self, t: float) -> bool:
         """True when every plan for longer than :data:`STALL_TIME` (s) up to t said "there at
