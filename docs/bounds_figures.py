@@ -23,7 +23,10 @@ miss one an earlier search found). Where the later run wins, its row replaces th
 committed one and the two plan-following runs (``mpc-plan``, ``mpc-plan-cold``) of that
 scenario are run again with its plan, through the scenarios tool's own configuration; it
 prints the scenarios replaced (``docs/bounds_accounting.py --scenarios`` then redoes their
-accounting rows).
+accounting rows). ``--rerun SEED BOUNDS_DIR NAMES`` runs the mpc columns NAMES (comma
+separated: ``mpc``, ``mpc-lookahead``, ``mpc-plan-cold``, ``mpc-plan``) of every scenario
+again, those that follow a plan with the plans in ``BOUNDS_DIR``, after a change of the
+controller.
 """
 
 from __future__ import annotations
@@ -120,21 +123,29 @@ def replayed_best(row: dict[str, str]) -> float:
     return float(row["best_known_s"]) if row["replay_ok"] == "True" else math.inf
 
 
-#: The plan-following runs, as the scenarios tool's options (BOUNDS_DIR filled in): the
-#: mpc with lookahead following the plan, and the same with the plan as cold starts only.
-_FOLLOW = ("--option", "lookahead=on", "--option", "plan={}")
-PLAN_RUNS = {"mpc-plan": _FOLLOW, "mpc-plan-cold": (*_FOLLOW, "--option", "plan_weight=0")}
+#: The mpc columns, as the scenarios tool's options (BOUNDS_DIR filled in): the mpc, with
+#: lookahead, and with lookahead following the plan, or with the plan as cold starts only.
+_LOOKAHEAD = ("--option", "lookahead=on")
+_FOLLOW = (*_LOOKAHEAD, "--option", "plan={}")
+MPC_RUNS = {
+    "mpc": (),
+    "mpc-lookahead": _LOOKAHEAD,
+    "mpc-plan-cold": (*_FOLLOW, "--option", "plan_weight=0"),
+    "mpc-plan": _FOLLOW,
+}
+#: The columns that follow a bounds run's plans.
+PLAN_RUNS = ("mpc-plan", "mpc-plan-cold")
 
 
-def plan_run(job: tuple[int, int, str, str]) -> tuple[int, str, float]:
-    """``(scenario, run name, time)``: one plan-following run of a scenario (1-based),
-    configured as ``python -m ddwmmr.scenarios --controller mpc ...`` would, rounded as
-    :func:`collect` rounds; NaN where it failed."""
+def mpc_run(job: tuple[int, int, str, str]) -> tuple[int, str, float]:
+    """``(scenario, run name, time)``: one run of an mpc column (:data:`MPC_RUNS`) in a
+    scenario (1-based), configured as ``python -m ddwmmr.scenarios --controller mpc ...``
+    would, rounded as :func:`collect` rounds; NaN where it failed."""
     from ddwmmr.cli.scenarios import build_parser, config_from_arguments
     from ddwmmr.scenarios import generate, run_scenario
 
     seed, index, name, folder = job
-    options = [part.format(folder) for part in PLAN_RUNS[name]]
+    options = [part.format(folder) for part in MPC_RUNS[name]]
     args = build_parser().parse_args(["--controller", "mpc", "--seed", str(seed), *options])
     scenario = generate(n=index, seed=seed)[index - 1]
     metrics = run_scenario(scenario, config_from_arguments(args)).metrics
@@ -161,21 +172,30 @@ def update(seed: int, folder: Path, jobs: int) -> list[int]:
     )
     if not replaced:
         return []
-    work = [(seed, s, name, str(folder.resolve())) for s in replaced for name in PLAN_RUNS]
-    if jobs == 1:
-        runs = [plan_run(job) for job in work]
-    else:
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            runs = list(pool.map(plan_run, work))
-    controllers = DATA / f"controllers_seed{seed}.csv"
-    names, times = read_rows(controllers)
-    for index, name, time_s in runs:
-        times[index][name] = repr(time_s)
     for s in replaced:
         committed[s] = {key: later[s][key] for key in header}
-    write_rows(controllers, names, times)
+    rerun(seed, folder, PLAN_RUNS, jobs, replaced)
     write_rows(target, header, committed)
     return replaced
+
+
+def rerun(
+    seed: int, folder: Path, names: tuple[str, ...], jobs: int, scenarios: list[int] | None = None
+) -> None:
+    """Run the mpc columns ``names`` (:data:`MPC_RUNS`) of ``scenarios`` (default: every
+    scenario of controllers_seed{seed}.csv) again, the plans from the bounds run in
+    ``folder``, and write their times into that file."""
+    controllers = DATA / f"controllers_seed{seed}.csv"
+    header, times = read_rows(controllers)
+    work = [(seed, s, name, str(folder.resolve())) for s in scenarios or times for name in names]
+    if jobs == 1:
+        runs = [mpc_run(job) for job in work]
+    else:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            runs = list(pool.map(mpc_run, work))
+    for index, name, time_s in runs:
+        times[index][name] = repr(time_s)
+    write_rows(controllers, header, times)
 
 
 def ratios(seed: int) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -274,13 +294,23 @@ def main() -> None:
     parser.add_argument("--collect", nargs=2, metavar=("SEED", "DIR"), action="append")
     parser.add_argument("--bounds", nargs=2, metavar=("SEED", "CSV"), action="append")
     parser.add_argument("--update", nargs=2, metavar=("SEED", "BOUNDS_DIR"), action="append")
-    parser.add_argument("--jobs", type=int, default=2, help="processes for --update's runs")
+    parser.add_argument(
+        "--rerun",
+        nargs=3,
+        metavar=("SEED", "BOUNDS_DIR", "NAMES"),
+        action="append",
+        help=f"run the comma-separated mpc columns NAMES (of {', '.join(MPC_RUNS)}) of every "
+        "scenario again, the plans from BOUNDS_DIR",
+    )
+    parser.add_argument("--jobs", type=int, default=2, help="processes for the runs")
     args = parser.parse_args()
     for seed, path in args.bounds or []:
         shutil.copyfile(path, DATA / f"bounds_seed{int(seed)}.csv")
     for seed, folder in args.update or []:
         replaced = update(int(seed), Path(folder), args.jobs)
         print(f"seed {seed}: replaced {','.join(map(str, replaced)) or 'none'}")
+    for seed, folder, names in args.rerun or []:
+        rerun(int(seed), Path(folder), tuple(names.split(",")), args.jobs)
     for seed, folder in args.collect or []:
         collect(int(seed), Path(folder))
     figure()

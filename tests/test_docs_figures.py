@@ -191,11 +191,11 @@ def test_bounds_update_keeps_the_lower_replayed_time(tmp_path, monkeypatch):
     )
     calls = []
 
-    def plan_run(job):
+    def mpc_run(job):
         calls.append(job[1:3])
         return job[1], job[2], 11.0 + job[1]
 
-    monkeypatch.setattr(script, "plan_run", plan_run)
+    monkeypatch.setattr(script, "mpc_run", mpc_run)
     assert script.update(0, later, jobs=1) == [1, 3]
     assert sorted(calls) == [
         (1, "mpc-plan"),
@@ -232,3 +232,31 @@ def test_bounds_ratios_figure_and_tables(tmp_path, monkeypatch):
             cells = [c.strip() for c in row.strip("|").split("|")]
             to_best, to_lower = (float(c.split()[0]) for c in cells[2:4])
             assert 1.0 <= to_best < to_lower
+
+
+def test_bounds_rerun_redoes_the_named_mpc_columns_of_every_scenario(tmp_path, monkeypatch):
+    """docs/bounds_figures.py --rerun: the named columns of every scenario are run again
+    (the others kept), and one real run reproduces the committed seed-0 data."""
+    script = docs_script("bounds_figures", tmp_path, monkeypatch)
+    committed = script.read_controllers(0)
+    real = script.mpc_run((0, 2, "mpc", str(tmp_path)))
+    assert real == (2, "mpc", committed["mpc"][2])
+    data = tmp_path / "data"
+    data.mkdir()
+    monkeypatch.setattr(script, "DATA", data)
+    names = ",".join(script.CONTROLLERS)
+    (data / "controllers_seed0.csv").write_text(
+        f"scenario,{names}\n" + "".join(f"{s}," + ",".join(["20.0"] * 7) + "\n" for s in (1, 2))
+    )
+    calls = []
+
+    def mpc_run(job):
+        calls.append(job[1:3])
+        return job[1], job[2], 11.0 + job[1]
+
+    monkeypatch.setattr(script, "mpc_run", mpc_run)
+    script.rerun(0, tmp_path, ("mpc", "mpc-lookahead"), jobs=1)
+    assert sorted(calls) == [(1, "mpc"), (1, "mpc-lookahead"), (2, "mpc"), (2, "mpc-lookahead")]
+    times = script.read_controllers(0)
+    assert times["mpc"] == times["mpc-lookahead"] == {1: 12.0, 2: 13.0}
+    assert times["mpc-plan"] == times["thesis"] == {1: 20.0, 2: 20.0}
