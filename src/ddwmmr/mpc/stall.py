@@ -1,8 +1,8 @@
 """When the ``mpc``'s waypoint plan is stuck and the next step should start cold.
 
 One real-time iteration per step follows the optimum it is near; from a poor warm start
-that can be a stationary point far from the best plan. Two rules drop the plan (each fires
-at most once per :data:`STALL_TIME`):
+that can be a stationary point far from the best plan. Three rules drop the plan (each
+fires at most once per :data:`STALL_TIME`):
 
 * the end effector has not moved :data:`STALL_PROGRESS` (net) for :data:`STALL_TIME` short
   of the target;
@@ -10,13 +10,11 @@ at most once per :data:`STALL_TIME`):
   :data:`STALL_SLACK`, in the rows' units, m for the stability box; the joint box's slack
   left out, ``ShootingOCP.max_slack``): a plan that cannot meet its hard constraints is
   stuck (on the physics plant: spinning on the spot with the arm stretched at the dynamic
-  floor).
-
-A third rule drops a frozen plan: every plan for :data:`STALL_TIME` promised to arrive
-in the same time (its free horizon within :data:`FROZEN_HORIZON` of the first's, strictly
-between its bounds) while the clock ran on: a plan that is being followed arrives a second
-sooner every second, so one whose arrival recedes with the clock is a stationary point the
-one iteration per step keeps returning to (:meth:`StallWatch.horizon_frozen`).
+  floor);
+* every plan for :data:`STALL_TIME` promised to arrive in the same time (its free horizon
+  within :data:`FROZEN_HORIZON` of the first's, strictly between its bounds): a plan that
+  is followed arrives a second sooner every second, so one whose arrival recedes with the
+  clock is frozen, even while the end effector moves (:meth:`StallWatch.horizon_frozen`).
 
 A fourth timer serves the plans through a target to the next one (``lookahead``):
 :meth:`StallWatch.arrival_overdue` when every plan for :data:`STALL_TIME` said "there at
@@ -29,7 +27,7 @@ from __future__ import annotations
 
 import math
 
-#: How long (s) a plan may make no progress, or need slack, before it is dropped.
+#: How long (s) a plan may make no progress, need slack or stay frozen before it is dropped.
 STALL_TIME = 0.5
 #: Net end-effector motion (m) that counts as progress.
 STALL_PROGRESS = 1e-3
