@@ -9,7 +9,8 @@ import pytest
 
 from ddwmmr.mpc import stall
 from ddwmmr.mpc.stall import STALL_TIME, StallWatch
-from ddwmmr.scenarios import RunConfig, generate, run_scenario
+from ddwmmr.scenarios import RunConfig, generate, protocol, run_scenario
+from ddwmmr.scenarios.protocol import make_scenario_controller
 
 DT = 0.01
 #: The best-known plan of scenario 25 of seed 1, as ``python -m ddwmmr.bounds --seed 1
@@ -72,3 +73,42 @@ def test_scenario_25_of_seed_1_drops_its_frozen_plan(monkeypatch):
     assert metrics["min_stability"] >= 1.25 - 1e-6
     assert metrics["time_s"] == pytest.approx(15.25, abs=0.5)  # 14.18 s the plan itself
     assert len(fired) == 1 and 12.0 < fired[0] < 13.0
+
+
+def test_a_frozen_plan_through_a_target_restarts_through_it(monkeypatch):
+    """Scenario 49 of seed 0 with ``lookahead``: a plan through a waypoint to the next one
+    freezes once; the controller starts cold in the same two-leg mode (a stall short of
+    the target would plan for it alone) and finishes in 13.85 s (16.14 s without the
+    rule, 15.99 s when it also planned for the target alone)."""
+    events: list[tuple[float, str | None]] = []
+    original = StallWatch.horizon_frozen
+
+    def counted(self, t):
+        result = original(self, t)
+        if result:
+            events.append((t, None))
+        return result
+
+    original_factory = make_scenario_controller
+
+    def recording(*args, **kwargs):
+        controller = original_factory(*args, **kwargs)
+        command = controller.command
+
+        def watched(t, *rest, **options):
+            output = command(t, *rest, **options)
+            if events and events[-1][1] is None:
+                events[-1] = (events[-1][0], controller._warm_mode)
+            return output
+
+        controller.command = watched
+        return controller
+
+    monkeypatch.setattr(stall.StallWatch, "horizon_frozen", counted)
+    monkeypatch.setattr(protocol, "make_scenario_controller", recording)
+    scenario = generate(49, seed=0)[48]
+    config = RunConfig(controller="mpc", controller_options=(("lookahead", True),))
+    metrics = run_scenario(scenario, config).metrics
+    assert metrics["success"] and metrics["min_stability"] >= 1.25 - 1e-6
+    assert [mode for _, mode in events] == ["reach2"]
+    assert metrics["time_s"] == pytest.approx(13.85, abs=0.5)

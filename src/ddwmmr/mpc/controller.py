@@ -18,10 +18,10 @@ Every control step (one call per step; the command is held over it, ``zero_order
    slack than ``brake_slack`` while the robot moves is replaced by the braking step
    (:mod:`ddwmmr.mpc.braking`).
 
-In waypoint mode a plan that makes no progress, or needs slack, for 0.5 s is dropped and
-the next step starts cold (:mod:`ddwmmr.mpc.stall`). The options are one frozen
-:class:`~ddwmmr.mpc.options.MPCOptions`, resolved for the plant in one place; the OCPs are
-shared between controllers (:mod:`ddwmmr.mpc.cache`).
+In waypoint mode a plan that makes no progress, needs slack, or promises the same arrival
+time for 0.5 s is dropped and the next step starts cold (:mod:`ddwmmr.mpc.stall`). The
+options are one frozen :class:`~ddwmmr.mpc.options.MPCOptions`, resolved for the plant in
+one place; the OCPs are shared between controllers (:mod:`ddwmmr.mpc.cache`).
 
 A failed solve (infeasible QP, solver error, non-finite numbers) falls back to the ``qp``
 controller's command for that step, counted in ``mpc_fallbacks``; the next step starts cold.
@@ -300,10 +300,10 @@ class MPCController:
         reach = self._trajectory is None and not np.any(velocity_d)
         target = (float(pose_d[0]), float(pose_d[1]))
         new_target = reach and self._target != target
-        stuck = reach and (
-            self._stall.stuck(t, tuple(self.robot.fk(q)[:2]), new_target)
-            or self._stall.horizon_frozen(t)
-        )
+        stuck = reach and self._stall.stuck(t, tuple(self.robot.fk(q)[:2]), new_target)
+        # a frozen plan restarts cold in its own mode: unlike a stall short of the target,
+        # it says nothing against planning through to the next one
+        frozen = reach and not stuck and self._stall.horizon_frozen(t)
         overdue = self._stall.arrival_overdue(t)
         if (stuck or overdue) and self._warm_mode == "reach2" and not new_target:
             # a plan through this target to the next stalled short of it: one target at a
@@ -322,7 +322,7 @@ class MPCController:
         cold = self._warm is None or self._warm_mode != mode or new_target
         if cold:
             self._stall.fresh_plan()
-        elif stuck:
+        elif stuck or frozen:
             cold = True
             self.restarts += 1
         source = self._problem("reach2").ocp if handover and self._warm is not None else None
