@@ -181,7 +181,7 @@ def test_options_reach_the_window_settings():
         (["--method", "nope"], "invalid choice: 'nope'"),
         (["--T", "-1"], "T must be in [1e-06, 1e+09] s (got -1)"),
         (["--N", "1.5"], "N must be an integer in [2, 1000000] (got 1.5)"),
-        (["--N", "1"], "N must be an integer in [2, 1000000] (got 1.0)"),
+        (["--N", "1"], "N must be an integer in [2, 1000000] (got 1)"),
         (["--traj", "nowhere.csv"], "traj: no such file nowhere.csv"),
         (["--option", "bogus=1"], "has no option 'bogus'"),
         (["--option", "tau=-1"], "tau must be > 0 s"),

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import math
 import os
+import re
 
+import numpy as np
 import pytest
 
 from ddwmmr import ParameterError, Robot
@@ -172,3 +174,11 @@ def test_an_input_file_that_is_not_a_path_is_one_line_naming_the_option(path):
         assert str(info.value) == (
             f"{label}: a file path (str or os.PathLike) is needed (got {path!r})"
         )
+
+
+def test_int_check_shows_an_integral_float_as_the_integer_it_is():
+    """A command line reads ``--N 1`` as 1.0: the refusal says "got 1"; a huge float keeps
+    its own spelling, a fraction is shown as given."""
+    for value, got in ((1.0, "1"), (np.float64(7.0), "7"), (1e300, "1e+300"), (0.5, "0.5")):
+        with pytest.raises(ParameterError, match=rf"in \[2, 5\] \(got {re.escape(got)}\)$"):
+            check_int_at_least("n", value, 2, 5)

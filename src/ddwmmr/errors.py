@@ -111,7 +111,10 @@ def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None 
         raise ParameterError(f"{name} must be an integer {allowed} (got {shown(value)})")
     number = int(value)
     if number < minimum or (maximum is not None and number > maximum):
-        raise ParameterError(f"{name} must be an integer {allowed} (got {shown(value)})")
+        # the integer it is, not its float spelling (a command line reads 1 as 1.0), unless
+        # the float's spelling is the shorter one (1e+300)
+        got = number if abs(number) < 10**15 else value
+        raise ParameterError(f"{name} must be an integer {allowed} (got {shown(got)})")
     return number
 
 
