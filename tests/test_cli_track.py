@@ -352,7 +352,7 @@ def test_rerun_of_a_damaged_record_is_one_line(
 @pytest.mark.parametrize(
     ("field", "value", "message"),
     [
-        ("method", "nope", "method: unknown method 'nope' (known: thesis, pi, ats, ap, "),
+        ("method", "nope", "method: unknown method 'nope' (tracking: pi, ats, ap, "),
         ("options", {"aux": "sum"}, "method pi: unknown option 'aux' (accepted: "),
     ],
 )

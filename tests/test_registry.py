@@ -126,6 +126,11 @@ def test_unknown_names_are_one_line_naming_the_known_ones():
             "them (thesis or mujoco)",
         ),
         (lambda: simulate(Robot(), Ellipse(), "thesis"), "does not track trajectories"),
+        # a tracking run names the methods it can take, not the thesis controller
+        (
+            lambda: simulate(Robot(), Ellipse(), "nope"),
+            "method: unknown method 'nope' (tracking: pi, ats, ap, clrrmc-ts, clrrmc-cs, qp, mpc)",
+        ),
     ]
     for call, message in cases:
         with pytest.raises(ParameterError) as error:

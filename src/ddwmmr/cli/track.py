@@ -57,7 +57,13 @@ from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     initial_configuration,
 )
-from ddwmmr.sim.simulate import check_start, default_step, plant_integrator, simulate
+from ddwmmr.sim.simulate import (
+    check_start,
+    check_tracks,
+    default_step,
+    plant_integrator,
+    simulate,
+)
 from ddwmmr.trajectories import available_trajectories, load_trajectory
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
@@ -561,6 +567,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     inputs = inputs_from_record(args) if args.rerun is not None else inputs_from_arguments(args)
     steps = check_step_count(inputs.duration, inputs.dt)  # before anything is allocated
     try:
+        check_tracks(inputs.method)  # a recorded method must track, too
         controller = make_controller(inputs.method, inputs.robot, **inputs.options)
     except ParameterError as exc:  # a recorded method or option: name the record
         if args.rerun is None:

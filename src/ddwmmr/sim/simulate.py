@@ -290,14 +290,20 @@ def _tipped_start(robot: Robot, q: np.ndarray, policy: str) -> bool:
 
 def check_tracks(method: str) -> None:
     """Raise :class:`ParameterError` unless ``method`` names a registered controller that
-    tracks trajectories (``tasks`` includes ``"tracking"``; an unknown name is refused
-    naming the known ones)."""
-    tasks = CONTROLLERS.traits(method)["tasks"]
-    if "tracking" not in tasks:
+    tracks trajectories (``tasks`` includes ``"tracking"``); a refusal names the tracking
+    ones, the only ones a tracking run can take."""
+    tracking = available_methods()
+    if method in tracking:
+        return
+    if method not in CONTROLLERS.names():
         raise ParameterError(
-            f"method: the {method} controller does not track trajectories (it does: "
-            f"{', '.join(tasks)}; tracking: {', '.join(available_methods())})"
+            f"method: unknown method {shown(method)} (tracking: {', '.join(tracking)})"
         )
+    tasks = CONTROLLERS.traits(method)["tasks"]
+    raise ParameterError(
+        f"method: the {method} controller does not track trajectories (it does: "
+        f"{', '.join(tasks)}; tracking: {', '.join(tracking)})"
+    )
 
 
 def _plant(
