@@ -79,6 +79,15 @@ def test_choices_for_the_plant():
     assert physics.arm_time_constant == physics_plant.joint_time_constant
     assert physics.joint_acceleration_limit == traits.joint_acceleration_limit
     assert physics.brake_slack == BRAKE_SLACK
+    # a frozen plan's cold start is off where the braking step is on
+    assert (alone.frozen_restart, thesis.frozen_restart, physics.frozen_restart) == (
+        True,
+        True,
+        False,
+    )
+    assert MPCOptions(frozen_restart=True).adopt_plant(traits).frozen_restart is True
+    with pytest.raises(ParameterError, match="frozen_restart must be"):
+        MPCOptions(frozen_restart="yes")
     assert physics.wheel_force_limit == planned_force(traits) == 10.0
     assert physics.adopt_plant(traits) == physics  # resolving again changes nothing
     given = MPCOptions(arm_time_constant=0, brake_slack=0, wheel_force_limit=8.0)

@@ -303,7 +303,9 @@ class MPCController:
         stuck = reach and self._stall.stuck(t, tuple(self.robot.fk(q)[:2]), new_target)
         # a frozen plan restarts cold in its own mode: unlike a stall short of the target,
         # it says nothing against planning through to the next one
-        frozen = reach and not stuck and self._stall.horizon_frozen(t)
+        frozen = (
+            reach and not stuck and self.resolved.frozen_restart and self._stall.horizon_frozen(t)
+        )
         overdue = self._stall.arrival_overdue(t)
         if (stuck or overdue) and self._warm_mode == "reach2" and not new_target:
             # a plan through this target to the next stalled short of it: one target at a

@@ -194,6 +194,12 @@ class MPCOptions:
             and acceleration limits), counted in ``mpc_brakes``; only with the lagged arm
             and a joint acceleration limit; None (default): :data:`BRAKE_SLACK` (5 mm)
             there, else off; 0: off.
+        frozen_restart: in waypoint mode, start cold when every plan for 0.5 s promised
+            the same arrival time (:mod:`ddwmmr.mpc.stall`); None (default): on, except
+            where the braking step is on (the lagged arm on a physics plant: there a cold
+            start is when the plans are most violent, and a frozen plan's cold start tipped
+            scenario 99 of seed 1; docs/mpc.md, "Seed 1's re-search finished, and a frozen
+            plan").
         obstacle_margin: clearance (m) of the base's enclosing circle from each obstacle.
         dt: control step (s); None (default): the loop's control step
             (``adopt_control_step``), else the trajectory's ``duration / samples`` at
@@ -232,6 +238,7 @@ class MPCOptions:
     joint_acceleration_limit: float | Sequence[float] | None = None
     wheel_force_limit: float | None = None
     brake_slack: float | None = None
+    frozen_restart: bool | None = None
     obstacle_margin: float = 0.05
     dt: float | None = None
     fallback_options: dict[str, Any] | None = None
@@ -272,6 +279,8 @@ class MPCOptions:
             self._set("brake_slack", brake)
         if self.dynamic_stability is not None:
             self._set("dynamic_stability", check_bool("dynamic_stability", self.dynamic_stability))
+        if self.frozen_restart is not None:
+            self._set("frozen_restart", check_bool("frozen_restart", self.frozen_restart))
         self._set("min_edge_load", check_min_edge_load(self.min_edge_load))
         self.adopt_plant(None)  # the combinations that need the force model, plant aside
         self._set("stability_min", check_stability_floor(self.stability_min))
@@ -325,7 +334,8 @@ class MPCOptions:
         force is the one asked for (within the plant's motors), else
         :func:`planned_force`. The lagged joints' accelerations are bounded as asked, else
         by the physics plant's motors; the braking step is on (``brake_slack``) where the
-        lagged arm has that bound.
+        lagged arm has that bound, and a frozen plan's cold start (``frozen_restart``)
+        everywhere else.
 
         In the result ``arm_time_constant`` 0, ``joint_acceleration_limit`` ``()`` and
         ``brake_slack`` 0 mean none, and ``wheel_force_limit`` is None for the kinematic
@@ -377,6 +387,7 @@ class MPCOptions:
             ("joint_acceleration_limit", accel or ()),
             ("wheel_force_limit", force),
             ("brake_slack", (self.brake_slack or BRAKE_SLACK) if braked else 0.0),
+            ("frozen_restart", not braked if self.frozen_restart is None else self.frozen_restart),
         ):
             resolved._set(name, value)
         return resolved
