@@ -310,7 +310,11 @@ def main() -> None:
         replaced = update(int(seed), Path(folder), args.jobs)
         print(f"seed {seed}: replaced {','.join(map(str, replaced)) or 'none'}")
     for seed, folder, names in args.rerun or []:
-        rerun(int(seed), Path(folder), tuple(names.split(",")), args.jobs)
+        columns = tuple(name.strip() for name in names.split(","))
+        unknown = [name for name in columns if name not in MPC_RUNS]
+        if unknown:  # before a hundred runs, not inside the first of them
+            parser.error(f"--rerun: unknown column {unknown[0]!r} (of {', '.join(MPC_RUNS)})")
+        rerun(int(seed), Path(folder), columns, args.jobs)
     for seed, folder in args.collect or []:
         collect(int(seed), Path(folder))
     figure()

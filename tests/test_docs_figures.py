@@ -260,3 +260,22 @@ def test_bounds_rerun_redoes_the_named_mpc_columns_of_every_scenario(tmp_path, m
     times = script.read_controllers(0)
     assert times["mpc"] == times["mpc-lookahead"] == {1: 12.0, 2: 13.0}
     assert times["mpc-plan"] == times["thesis"] == {1: 20.0, 2: 20.0}
+
+
+def test_bounds_rerun_command_line_checks_the_column_names(tmp_path, monkeypatch, capsys):
+    """--rerun SEED DIR NAMES: the names (comma separated, spaces allowed) reach rerun();
+    an unknown one is refused before any run, naming the columns."""
+    script = docs_script("bounds_figures", tmp_path, monkeypatch)
+    calls = []
+    monkeypatch.setattr(script, "rerun", lambda *args: calls.append(args))
+    for name in ("figure", "rewrite_page"):
+        monkeypatch.setattr(script, name, lambda: None)
+    monkeypatch.setattr(script, "table", lambda seed: [])
+    monkeypatch.setattr(sys, "argv", ["bounds_figures.py", "--rerun", "1", "D", "mpc, mpc-plan"])
+    script.main()
+    assert calls == [(1, Path("D"), ("mpc", "mpc-plan"), 2)]
+    monkeypatch.setattr(sys, "argv", ["bounds_figures.py", "--rerun", "1", "D", "mpc,nope"])
+    with pytest.raises(SystemExit) as exit_:
+        script.main()
+    assert exit_.value.code == 2 and "unknown column 'nope' (of mpc, " in capsys.readouterr().err
+    assert len(calls) == 1

@@ -86,6 +86,8 @@ def test_choices_for_the_plant():
         False,
     )
     assert MPCOptions(frozen_restart=True).adopt_plant(traits).frozen_restart is True
+    # without the braking step the physics plant restarts frozen plans too
+    assert MPCOptions(brake_slack=0).adopt_plant(traits).frozen_restart is True
     with pytest.raises(ParameterError, match="frozen_restart must be"):
         MPCOptions(frozen_restart="yes")
     assert physics.wheel_force_limit == planned_force(traits) == 10.0

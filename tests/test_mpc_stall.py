@@ -51,11 +51,13 @@ def test_plans_at_a_bound_of_the_horizon_or_started_cold_do_not_count():
     assert frozen_steps(np.full(120, 3.0), cold_at=range(0, 120, 40)) == []
 
 
-def test_scenario_25_of_seed_1_drops_its_frozen_plan(monkeypatch):
+@pytest.mark.parametrize("rule", [None, False])
+def test_scenario_25_of_seed_1_drops_its_frozen_plan(monkeypatch, rule):
     """Following its best-known plan, the mpc's plan for the last waypoint froze 12 s
     into the run (every plan "there in 3.913 s"); it passed 1.5 cm from the waypoint and
-    circled it for 22 s (38.6 s in all) before the rule. Now the frozen plan is dropped
-    and the next step starts cold from the plan's last leg."""
+    circled it for 22 s (38.6 s in all) before the rule, as it still does with
+    ``frozen_restart=False``. By default the frozen plan is dropped and the next step
+    starts cold from the plan's last leg."""
     fired = []
     original = StallWatch.horizon_frozen
 
@@ -66,11 +68,14 @@ def test_scenario_25_of_seed_1_drops_its_frozen_plan(monkeypatch):
 
     monkeypatch.setattr(stall.StallWatch, "horizon_frozen", counted)
     scenario = generate(25, seed=1)[24]
-    options = (("lookahead", True), ("plan", str(PLAN_25)))
+    options = (("lookahead", True), ("plan", str(PLAN_25)), ("frozen_restart", rule))
     config = RunConfig(controller="mpc", controller_options=options)
     metrics = run_scenario(scenario, config).metrics
     assert metrics["success"] and metrics["waypoints_reached"] == 5
     assert metrics["min_stability"] >= 1.25 - 1e-6
+    if rule is False:
+        assert fired == [] and metrics["time_s"] == pytest.approx(38.6, abs=0.5)
+        return
     assert metrics["time_s"] == pytest.approx(15.25, abs=0.5)  # 14.18 s the plan itself
     assert len(fired) == 1 and 12.0 < fired[0] < 13.0
 

@@ -112,8 +112,8 @@ def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None 
     number = int(value)
     if number < minimum or (maximum is not None and number > maximum):
         # the integer it is, not its float spelling (a command line reads 1 as 1.0), unless
-        # the float's spelling is the shorter one (1e+300)
-        got = number if abs(number) < 10**15 else value
+        # the float is spelt in e-notation, the shorter one (from 1e+16)
+        got = number if abs(number) < 10**16 else value
         raise ParameterError(f"{name} must be an integer {allowed} (got {shown(got)})")
     return number
 

@@ -19,7 +19,8 @@ Every control step (one call per step; the command is held over it, ``zero_order
    (:mod:`ddwmmr.mpc.braking`).
 
 In waypoint mode a plan that makes no progress, needs slack, or promises the same arrival
-time for 0.5 s is dropped and the next step starts cold (:mod:`ddwmmr.mpc.stall`). The
+time for 0.5 s (``frozen_restart``, off where the braking step runs) is dropped and the
+next step starts cold (:mod:`ddwmmr.mpc.stall`). The
 options are one frozen :class:`~ddwmmr.mpc.options.MPCOptions`, resolved for the plant in
 one place; the OCPs are shared between controllers (:mod:`ddwmmr.mpc.cache`).
 

@@ -45,14 +45,14 @@ class StallWatch:
         self._anchor_time = 0.0
         self._infeasible_since: float | None = None  # first of the plans that needed slack
         self._arriving_since: float | None = None  # first of the plans at the shortest horizon
-        self._promise: tuple[float, float] | None = None  # (t, horizon) of the frozen run's first
+        self._promise: tuple[float, float] | None = None  # (t, horizon): first of the run
 
     def fresh_plan(self) -> None:
         """A cold start: its plans get their own :data:`STALL_TIME` to need slack."""
         self._infeasible_since = None
 
     def stuck(self, t: float, end_effector: tuple[float, float], new_target: bool) -> bool:
-        """True when either rule fires at time t (s) with the end effector at
+        """True when the progress or the slack rule fires at time t (s) with the end effector at
         ``end_effector`` (m, world); ``new_target``: the target just changed."""
         return self._stalled(t, end_effector, new_target) or self._infeasible_too_long(t)
 
@@ -74,8 +74,8 @@ class StallWatch:
     def plan_horizon(self, t: float, horizon: float, free: bool, cold: bool) -> None:
         """The plan made at t (s) promises to arrive in ``horizon`` s; ``free``: the horizon
         lies strictly between its bounds (a plan at its longest only gets as close as it
-        can, one at its shortest is the arrival timer's); ``cold``: the plan started cold
-        (a new target, a restart)."""
+        can; one at its shortest is about to arrive, or is the arrival timer's through a
+        target); ``cold``: the plan started cold (a new target, a restart)."""
         promise = self._promise
         if not free:
             self._promise = None
