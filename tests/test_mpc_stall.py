@@ -10,12 +10,27 @@ import pytest
 from ddwmmr.mpc import stall
 from ddwmmr.mpc.stall import STALL_TIME, StallWatch
 from ddwmmr.scenarios import RunConfig, generate, protocol, run_scenario
-from ddwmmr.scenarios.protocol import make_scenario_controller
 
 DT = 0.01
 #: The best-known plan of scenario 25 of seed 1, as ``python -m ddwmmr.bounds --seed 1
 #: --scenarios 25`` writes it (bounds.csv's row: 14.18 s, multistart-7).
 PLAN_25 = Path(__file__).with_name("plans") / "seed1-scenario25.npz"
+
+
+def record_firings(monkeypatch) -> list[float]:
+    """The times (s) at which the rule fires in the runs that follow, as a list that fills
+    while they run (``StallWatch.horizon_frozen`` patched to note each firing)."""
+    fired: list[float] = []
+    original = StallWatch.horizon_frozen
+
+    def counted(self, t):
+        result = original(self, t)
+        if result:
+            fired.append(t)
+        return result
+
+    monkeypatch.setattr(stall.StallWatch, "horizon_frozen", counted)
+    return fired
 
 
 def frozen_steps(horizons, free=True, cold_at=()) -> list[int]:
@@ -58,15 +73,7 @@ def test_scenario_25_of_seed_1_drops_its_frozen_plan(monkeypatch, rule):
     circled it for 22 s (38.6 s in all) before the rule, as it still does with
     ``frozen_restart=False``. By default the frozen plan is dropped and the next step
     starts cold from the plan's last leg."""
-    fired = []
-    original = StallWatch.horizon_frozen
-
-    def counted(self, t):
-        result = original(self, t)
-        fired.extend([t] if result else [])
-        return result
-
-    monkeypatch.setattr(stall.StallWatch, "horizon_frozen", counted)
+    fired = record_firings(monkeypatch)
     scenario = generate(25, seed=1)[24]
     options = (("lookahead", True), ("plan", str(PLAN_25)), ("frozen_restart", rule))
     config = RunConfig(controller="mpc", controller_options=options)
@@ -85,16 +92,9 @@ def test_a_frozen_plan_through_a_target_restarts_through_it(monkeypatch):
     freezes once; the controller starts cold in the same two-leg mode (a stall short of
     the target would plan for it alone) and finishes in 13.85 s (16.14 s without the
     rule, 15.99 s when it also planned for the target alone)."""
-    events: list[tuple[float, str | None]] = []
-    original = StallWatch.horizon_frozen
-
-    def counted(self, t):
-        result = original(self, t)
-        if result:
-            events.append((t, None))
-        return result
-
-    original_factory = make_scenario_controller
+    fired = record_firings(monkeypatch)
+    modes: list[str | None] = []  # the mode of the plan made at each firing
+    original_factory = protocol.make_scenario_controller
 
     def recording(*args, **kwargs):
         controller = original_factory(*args, **kwargs)
@@ -102,18 +102,17 @@ def test_a_frozen_plan_through_a_target_restarts_through_it(monkeypatch):
 
         def watched(t, *rest, **options):
             output = command(t, *rest, **options)
-            if events and events[-1][1] is None:
-                events[-1] = (events[-1][0], controller._warm_mode)
+            if len(modes) < len(fired):
+                modes.append(controller._warm_mode)
             return output
 
         controller.command = watched
         return controller
 
-    monkeypatch.setattr(stall.StallWatch, "horizon_frozen", counted)
     monkeypatch.setattr(protocol, "make_scenario_controller", recording)
     scenario = generate(49, seed=0)[48]
     config = RunConfig(controller="mpc", controller_options=(("lookahead", True),))
     metrics = run_scenario(scenario, config).metrics
     assert metrics["success"] and metrics["min_stability"] >= 1.25 - 1e-6
-    assert [mode for _, mode in events] == ["reach2"]
+    assert len(fired) == 1 and modes == ["reach2"]
     assert metrics["time_s"] == pytest.approx(13.85, abs=0.5)

@@ -20,9 +20,9 @@ Every control step (one call per step; the command is held over it, ``zero_order
 
 In waypoint mode a plan that makes no progress, needs slack, or promises the same arrival
 time for 0.5 s (``frozen_restart``, off where the braking step runs) is dropped and the
-next step starts cold (:mod:`ddwmmr.mpc.stall`). The
-options are one frozen :class:`~ddwmmr.mpc.options.MPCOptions`, resolved for the plant in
-one place; the OCPs are shared between controllers (:mod:`ddwmmr.mpc.cache`).
+next step starts cold (:mod:`ddwmmr.mpc.stall`). The options are one frozen
+:class:`~ddwmmr.mpc.options.MPCOptions`, resolved for the plant in one place; the OCPs are
+shared between controllers (:mod:`ddwmmr.mpc.cache`).
 
 A failed solve (infeasible QP, solver error, non-finite numbers) falls back to the ``qp``
 controller's command for that step, counted in ``mpc_fallbacks``; the next step starts cold.
