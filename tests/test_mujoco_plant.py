@@ -212,6 +212,33 @@ def test_a_diverged_engine_state_names_the_step(tmp_path, monkeypatch):
     assert not (tmp_path / "MUJOCO_LOG.TXT").exists()  # the warning went to logging
 
 
+LIGHT = Robot(base_mass=1e-3, wheel_mass=1e-4, link_masses=(1e-3, 1e-3), payload=0.0)
+
+
+def test_a_robot_too_light_for_the_timestep_is_refused_at_reset(capsys):
+    with pytest.raises(ParameterError, match=r"^MuJoCo cannot settle this robot at timestep "):
+        fresh(robot=LIGHT)
+    assert capsys.readouterr().err == ""  # the engine's own warning stays in logging
+    # the message's remedy works: a shorter engine step settles the same robot
+    assert fresh(robot=LIGHT, timestep=5e-4).observe().q[3:] == pytest.approx((-0.3, 0.6))
+
+
+def test_cli_refuses_a_robot_too_light_for_the_engine_in_one_line(tmp_path, capsys):
+    from ddwmmr.cli.track import main
+
+    robot = tmp_path / "light.toml"
+    robot.write_text(
+        "base_mass = 1e-3\nwheel_mass = 1e-4\nlink_masses = [1e-3, 1e-3]\npayload = 0.0\n"
+    )
+    argv = ["--method", "clrrmc-ts", "--traj", "ellipse", "--robot", str(robot)]
+    out = tmp_path / "run"
+    status = main([*argv, "--plant", "mujoco", "--duration", "0.2", "--out", str(out)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2
+    assert len(err) == 1 and "base_mass 0.001 kg" in err[0] and "timestep" in err[0]
+    assert not out.exists()
+
+
 def test_non_finite_commands_are_refused():
     plant = fresh()
     with pytest.raises(ParameterError, match=r"^command must be "):

@@ -77,10 +77,11 @@ _LOG = logging.getLogger(__name__)
 
 
 def _log_engine_warning(message: str) -> None:
-    # The plant reads MuJoCo's warning counters itself and raises PlantDivergedError; by
+    # The plant reads MuJoCo's warning counters itself and raises with its own message; by
     # default MuJoCo would also print the warning and append it to MUJOCO_LOG.TXT in the
-    # working directory, a file nobody asked for.
-    _LOG.warning("MuJoCo: %s", message)
+    # working directory, a file nobody asked for. Info, not warning: Python's last-resort
+    # handler would print a warning beside the tools' one-line error.
+    _LOG.info("MuJoCo: %s", message)
 
 
 if mujoco.get_mju_user_warning() is None:  # leave a handler someone else installed
@@ -276,8 +277,9 @@ class MujocoPlant:
         holding still; then x, y, heading and joints are put back exactly to ``q0``.
         Raises :class:`ParameterError` if dt is not a whole multiple of the engine timestep
         (at most :data:`~ddwmmr.plants.mujoco.model.MAX_ENGINE_STEPS_PER_CONTROL_STEP` of
-        them) or q0 is not 5 finite numbers (m, rad) with the joints inside their limits;
-        nothing changes then.
+        them) or q0 is not 5 finite numbers (m, rad) with the joints inside their limits
+        (nothing changes then), and if the robot does not settle: its masses too light for
+        the engine's timestep.
         """
         substeps = self._check_dt(dt)
         q0 = np.array(check_configuration(q0))
@@ -310,7 +312,10 @@ class MujocoPlant:
             # (z is the yaw axis while the base stands); roll and pitch stay undamped.
             model.dof_damping[0] = model.dof_damping[1] = self.base_damping[0]
             model.dof_damping[5] = self.base_damping[1]
-        self._check_state("while the robot settled at reset")
+        try:
+            self._check_state("while the robot settled at reset")
+        except PlantDivergedError:
+            raise ParameterError(self._unsettled()) from None
         self._step_count = 0
         self._place(q0, z=float(data.qpos[2]), keep_tilt=True)
         data.qvel[:] = 0.0
@@ -470,6 +475,19 @@ class MujocoPlant:
             command.right * r,
             (new1 - th1) / dt,
             (new2 - th2) / dt,
+        )
+
+    def _unsettled(self) -> str:
+        """Why the robot could not settle at reset: the engine step is too long for its
+        masses (one line, naming them and the timestep's range)."""
+        r = self.robot
+        links = ", ".join(f"{m:g}" for m in r.link_masses)
+        return (
+            f"MuJoCo cannot settle this robot at timestep {self.options.timestep:g} s (its "
+            f"state diverged at reset): base_mass {r.base_mass:g} kg, wheel_mass "
+            f"{r.wheel_mass:g} kg, link_masses [{links}] kg, payload {r.payload:g} kg; a "
+            "lighter robot needs a smaller timestep, MujocoPlant(robot, timestep=...) in "
+            "[1e-05, 0.01] s, or heavier parts"
         )
 
     def _warning_count(self) -> int:
