@@ -313,6 +313,46 @@ def test_rerun_refuses_a_changed_trajectory_file_and_extra_options(tmp_path, cap
     assert sorted(p.name for p in tmp_path.iterdir()) == ["line.csv", "run"]
 
 
+@pytest.mark.parametrize("after", ["deleted", "edited", "a folder"])
+def test_rerun_of_a_toml_trajectory_needs_only_the_record(tmp_path, after):
+    traj = tmp_path / "mine.toml"
+    traj.write_text('shape = "ellipse"\na = 1.0\nb = 0.6\n')
+    first, second = tmp_path / "first", tmp_path / "second"
+    args = ["--method", "ats", "--traj", str(traj), "--duration", "0.4", "--no-plots"]
+    assert run([*args, "--out", str(first)]) == 0
+    traj.unlink()
+    if after == "edited":
+        traj.write_text('shape = "ellipse"\na = 2.0\nb = 0.6\n')
+    elif after == "a folder":
+        traj.mkdir()
+    assert run(["--rerun", str(first / "summary.json"), "--out", str(second)]) == 0
+    assert _rows_without_timing(first / "timeseries.csv") == _rows_without_timing(
+        second / "timeseries.csv"
+    )
+    one, two = (json.loads((f / "summary.json").read_text())["run"] for f in (first, second))
+    # the file as the first run read it: the new record does not hash what is there now
+    assert two["trajectory"] == one["trajectory"]
+    assert len(one["trajectory"]["sha256"]) == 64 and one["trajectory"]["type"] == "ellipse"
+
+
+def test_rerun_of_a_toml_trajectory_record_without_its_digest_is_refused(tmp_path, capsys):
+    traj = tmp_path / "mine.toml"
+    traj.write_text('shape = "ellipse"\na = 1.0\nb = 0.6\n')
+    first = tmp_path / "first"
+    args = ["--method", "ats", "--traj", str(traj), "--duration", "0.2", "--no-plots"]
+    assert run([*args, "--out", str(first)]) == 0
+    summary = json.loads((first / "summary.json").read_text())
+    del summary["run"]["trajectory"]["sha256"]
+    damaged = tmp_path / "damaged.json"
+    damaged.write_text(json.dumps(summary))
+    capsys.readouterr()
+    assert run(["--rerun", str(damaged), "--out", str(tmp_path / "b")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"error: rerun: {damaged}: the trajectory's file has no SHA-256 of 64 hex digits"
+    )
+
+
 @pytest.fixture(scope="module")
 def recorded_run(tmp_path_factory) -> dict:
     """A valid track summary.json (tests change one field of a copy)."""

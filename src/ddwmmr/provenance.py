@@ -157,12 +157,16 @@ def options_record(method: str, given: dict[str, Any]) -> dict[str, Any]:
     return encode(merged)
 
 
-def trajectory_record(trajectory: Any, source: Path | None) -> dict[str, Any]:
-    """Parameters of a parametric trajectory, or the sample file's path and SHA-256."""
+def trajectory_record(
+    trajectory: Any, source: Path | None, sha256: str | None = None
+) -> dict[str, Any]:
+    """Parameters of a parametric trajectory, and the file it was read from (path and
+    SHA-256: ``sha256`` if given, the digest recorded when it was read, else the file's
+    now)."""
     record: dict[str, Any] = {"name": str(getattr(trajectory, "name", ""))}
     if source is not None:
         record["file"] = str(Path(source).resolve())
-        record["sha256"] = file_sha256(source)
+        record["sha256"] = sha256 if sha256 is not None else file_sha256(source)
     shape = next((k for k, cls in SHAPES.items() if type(trajectory) is cls), None)
     if shape is not None:
         record["type"] = shape
@@ -209,6 +213,9 @@ class RunInputs:
     offset: tuple[float, float]
     label: str  # trajectory as the user named it (for the default folder name)
     plant: str
+    # A rerun's: the file's digest as the first run read it. Its trajectory is rebuilt
+    # from the record, so the file may since have changed or gone.
+    trajectory_sha256: str | None = None
 
 
 def run_record(
@@ -225,7 +232,9 @@ def run_record(
         method=inputs.method,
         options=options_record(inputs.method, inputs.options),
         robot=robot_record(inputs.robot),
-        trajectory=trajectory_record(inputs.trajectory, inputs.trajectory_file),
+        trajectory=trajectory_record(
+            inputs.trajectory, inputs.trajectory_file, inputs.trajectory_sha256
+        ),
         dt=inputs.dt,
         duration=inputs.duration,
         integrator=inputs.integrator,

@@ -478,6 +478,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
             offset,
             str(trajectory_record.get("name") or "rerun"),
             plant,
+            _recorded_digest(trajectory_record, source),
         )
         return check_run(inputs, "payload", "the recorded initial_offset")
     except ParameterError as exc:  # one line naming what is wrong: say where it was read
@@ -488,6 +489,16 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         ) from None
     except (TypeError, AttributeError, ValueError) as exc:
         raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
+
+
+def _recorded_digest(trajectory_record: dict, source: Any) -> str | None:
+    """The SHA-256 the record gives its trajectory file (a record naming a file must)."""
+    if not (isinstance(source, str) and source):
+        return None
+    digest = trajectory_record.get("sha256")
+    if not isinstance(digest, str) or len(digest) != 64:
+        raise ParameterError("the trajectory's file has no SHA-256 of 64 hex digits")
+    return digest
 
 
 def _in_record(path: str, exc: ParameterError) -> ParameterError:
