@@ -155,7 +155,8 @@ def test_the_default_offset_is_reachable_whichever_way_the_start_faces(beta, ori
     # Start headings all round (the ellipse rotated by beta, or a constant orientation
     # beta): the offset is in the end effector's frame, so the arm motion is the same.
     robot = Robot()
-    trajectory = Ellipse(beta=beta, orientation=orientation, phi=beta)
+    phi = beta if orientation == "constant" else 0.0  # the tangent one has no phi
+    trajectory = Ellipse(beta=beta, orientation=orientation, phi=phi)
     ts = simulate(robot, trajectory, "ats", duration=0.1).timeseries
     x_d, y_d, heading = trajectory.pose(0.0)
     dx, dy = DEFAULT_INITIAL_OFFSET

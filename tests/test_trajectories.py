@@ -40,7 +40,8 @@ def test_rectangle_corners_and_edges():
 
 @pytest.mark.parametrize("orientation", ["tangent", "constant"])
 def test_ellipse_velocity_matches_finite_differences(orientation):
-    traj = Ellipse(x0=0.5, a=2.0, b=1.2, beta=0.4, T=17.0, orientation=orientation, phi=0.3)
+    phi = 0.3 if orientation == "constant" else 0.0  # phi is refused with "tangent"
+    traj = Ellipse(x0=0.5, a=2.0, b=1.2, beta=0.4, T=17.0, orientation=orientation, phi=phi)
     for t in np.linspace(0.0, 34.0, 23):
         np.testing.assert_allclose(traj.velocity(t), numeric_velocity(traj, t), atol=1e-7)
 
@@ -277,3 +278,81 @@ def test_csv_text_reads_back_bit_for_bit(tmp_path):
         back = read_csv(path)
         assert back.times.tobytes() == times.tobytes()
         assert back.points.tobytes() == points.tobytes()
+
+
+PHI_REFUSED = (
+    'phi is used only with orientation = "constant" (the orientation here is tangent, the '
+    'direction of travel); set orientation = "constant" or drop phi'
+)
+
+
+@pytest.mark.parametrize("shape", [Ellipse, Rectangle])
+def test_phi_with_the_tangent_orientation_is_refused_as_the_files_refuse_it(shape):
+    # It was ignored: the heading stayed the direction of travel.
+    for kwargs in ({"phi": 0.5}, {"phi": -1e-9, "orientation": "tangent"}):
+        with pytest.raises(ParameterError) as info:
+            shape(**kwargs)
+        text = str(info.value)
+        assert text == f"{PHI_REFUSED} (got phi = {kwargs['phi']:g})"
+    with pytest.raises(ParameterError) as info:
+        load_trajectory(shape.name, phi=0.5)
+    assert str(info.value).endswith(f": {PHI_REFUSED}")
+
+
+@pytest.mark.parametrize("shape", [Ellipse, Rectangle])
+def test_phi_sets_the_constant_orientation(shape):
+    trajectory = shape(a=1.2, b=0.8, beta=0.3, orientation="constant", phi=0.5)
+    for t in (0.0, 3.3, 17.0, 39.9):
+        assert trajectory.pose(t)[2] == 0.5
+        assert trajectory.velocity(t)[2] == 0.0
+    poses, velocities = trajectory.sample(np.linspace(0.0, 40.0, 9))
+    assert np.all(poses[:, 2] == 0.5) and np.all(velocities[:, 2] == 0.0)
+    assert load_trajectory(shape.name, orientation="constant", phi=0.5).pose(3.3)[2] == 0.5
+
+
+def test_the_default_phi_still_goes_with_the_tangent_orientation():
+    # dataclasses.replace and a recorded run pass phi = 0 back in: that is no request.
+    import dataclasses
+
+    tangent = Ellipse(a=2.0, b=1.0, T=20.0)
+    assert Ellipse(a=2.0, b=1.0, T=20.0, phi=0.0) == tangent
+    slower = dataclasses.replace(tangent, T=40.0)
+    assert slower.pose(10.0)[2] == pytest.approx(math.pi, abs=1e-12)  # alpha = pi/2: -x
+
+
+@pytest.mark.parametrize(("name", "other"), [("ellipse", "rectangle"), ("rectangle", "ellipse")])
+def test_the_shape_of_a_file_cannot_be_overridden(name, other):
+    with pytest.raises(ParameterError) as info:
+        load_trajectory(name, shape=other)
+    text = str(info.value)
+    assert "\n" not in text and "unknown key" not in text
+    assert text.endswith(
+        f".toml: shape cannot be overridden (got {other!r}): the file sets it to {name}; "
+        "load another shape by its own name or file"
+    )
+
+
+def test_the_built_in_shapes_check_their_overrides_like_the_files(monkeypatch, tmp_path):
+    # Without ellipse.toml in any folder the name falls back to the built-in class.
+    import ddwmmr.trajectories.files as files
+
+    monkeypatch.setattr(files, "trajectory_folders", lambda: [tmp_path])
+    assert files.find_trajectory_file("ellipse") is None
+    assert load_trajectory("ellipse", T=20.0) == Ellipse(T=20.0)
+    cases = {
+        "shape": (
+            {"shape": "rectangle"},
+            "traj: ellipse: shape cannot be overridden (got 'rectangle'): the name sets it to "
+            "ellipse; load another shape by its own name or file",
+        ),
+        "unknown": (
+            {"speed": 1.0},
+            "traj: ellipse: unknown key 'speed' (known: x0, y0, a, b, beta, N, T, "
+            "orientation, phi, name)",
+        ),
+        "phi": ({"phi": 0.0}, f"traj: ellipse: {PHI_REFUSED}"),
+    }
+    for overrides, message in cases.values():
+        with pytest.raises(ParameterError) as info:
+            load_trajectory("ellipse", **overrides)
+        assert str(info.value) == message

@@ -37,7 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from ddwmmr.errors import ParameterError, as_path, check_number_type, load_toml, shown
-from ddwmmr.trajectories.parametric import Ellipse, Rectangle
+from ddwmmr.trajectories.parametric import PHI_NEEDS_CONSTANT, Ellipse, Rectangle
 from ddwmmr.trajectories.sampled import read_csv
 
 SHAPES = {"ellipse": Ellipse, "rectangle": Rectangle}
@@ -118,10 +118,18 @@ def find_trajectory_file(name_or_path: str | Path) -> Path | None:
 
 
 def load_trajectory(name_or_path: str | Path, **overrides):
-    """Resolve a trajectory name or file path; ``overrides`` replace TOML parameters."""
+    """Resolve a trajectory name or file path; ``overrides`` replace TOML parameters.
+
+    The overrides are the keyword arguments of :class:`Ellipse` / :class:`Rectangle`
+    (``x0``, ``a``, ``T``, ``orientation``, ``phi``...), checked as a file's keys are
+    (:func:`read_toml`). ``shape`` is not one: the file (or the built-in name) sets it, so
+    overriding it is refused. A sampled (CSV) trajectory takes no overrides.
+    """
     path = find_trajectory_file(name_or_path)
     if path is None:
-        return SHAPES[str(name_or_path)](**overrides)
+        name = str(name_or_path)
+        _check_overrides(name, overrides)
+        return SHAPES[name](**overrides)
     return _load_file(path, overrides)
 
 
@@ -196,6 +204,8 @@ def read_toml(path: str | Path, **overrides):
         )
         raise ParameterError(f"traj: {path} needs shape = one of {', '.join(SHAPES)} ({got})")
     table.setdefault("name", path.stem)
+    if "shape" in overrides:
+        _refuse_shape_override(f"traj: {path}", shape, "the file", overrides["shape"])
     table.update(overrides)
     known = [f.name for f in fields(SHAPES[shape])]
     unknown = sorted(set(table) - set(known))
@@ -205,17 +215,38 @@ def read_toml(path: str | Path, **overrides):
         )
     _check_types(path, table)
     if "phi" in table and table.get("orientation", "tangent") == "tangent":
-        raise ParameterError(
-            f'traj: {path}: phi is used only with orientation = "constant" (the orientation '
-            'here is tangent, the direction of travel); set orientation = "constant" or '
-            "drop phi"
-        )
+        raise ParameterError(f"traj: {path}: {PHI_NEEDS_CONSTANT}")
     try:
         return SHAPES[shape](**table)
     except TypeError as exc:
         raise ParameterError(f"traj: {path}: {exc}") from None
     except ParameterError as exc:
         raise ParameterError(f"traj: {path}: {exc}") from None
+
+
+def _refuse_shape_override(where: str, shape: str, setter: str, value: Any) -> None:
+    """Refuse ``shape`` among the overrides: the file or the name chose the class."""
+    raise ParameterError(
+        f"{where}: shape cannot be overridden (got {shown(value)}): {setter} sets it to "
+        f"{shape}; load another shape by its own name or file"
+    )
+
+
+def _check_overrides(name: str, overrides: dict[str, Any]) -> None:
+    """The overrides of a built-in shape (no file), refused as :func:`read_toml` refuses
+    a file's keys (shape, an unknown key, phi with the tangent orientation) rather than
+    by a ``TypeError`` from the class."""
+    where = f"traj: {name}"
+    if "shape" in overrides:
+        _refuse_shape_override(where, name, "the name", overrides["shape"])
+    known = [f.name for f in fields(SHAPES[name])]
+    unknown = sorted(set(overrides) - set(known))
+    if unknown:
+        raise ParameterError(
+            f"{where}: unknown key {shown(unknown[0])} (known: {', '.join(known)})"
+        )
+    if "phi" in overrides and overrides.get("orientation", "tangent") == "tangent":
+        raise ParameterError(f"{where}: {PHI_NEEDS_CONSTANT}")
 
 
 def _check_types(path: Path, table: dict[str, Any]) -> None:

@@ -35,6 +35,11 @@ from ddwmmr.errors import (
 from ddwmmr.trajectories.base import atan2_array, check_time, check_times
 
 ORIENTATIONS = ("tangent", "constant")
+#: Why ``phi`` is refused with the tangent orientation, in the API and in the file loaders.
+PHI_NEEDS_CONSTANT = (
+    'phi is used only with orientation = "constant" (the orientation here is tangent, the '
+    'direction of travel); set orientation = "constant" or drop phi'
+)
 _isfinite = math.isfinite
 
 
@@ -69,7 +74,24 @@ def check_geometry_value(name: str, value: float) -> float:
 
 @dataclass(frozen=True)
 class _Parametric(ABC):
-    """Shared parameters and validation of the parametric trajectories."""
+    """Shared parameters and validation of the parametric trajectories.
+
+    Args:
+        x0, y0: centre (m, world frame), magnitude <= 1e6.
+        a, b: semi-axes (m) along the shape's own x and y, in [1e-6, 1e3].
+        beta: rotation of the shape about its centre (rad, counter-clockwise from the
+            world x axis), magnitude <= 1e6.
+        N: samples per period, an integer in [2, 1e6].
+        T: period (s), in [1e-6, 1e9].
+        orientation: ``"tangent"`` (the direction of travel) or ``"constant"``.
+        phi: the fixed orientation (rad, world frame) of ``orientation="constant"``,
+            magnitude <= 1e6. The tangent orientation has no use for it: a ``phi`` other
+            than 0 (the default) with it raises :class:`~ddwmmr.errors.ParameterError`
+            (the message of a TOML file that sets it), instead of being ignored.
+
+    Anything else raises a one-line :class:`~ddwmmr.errors.ParameterError` naming the
+    parameter and its range.
+    """
 
     x0: float = 0.0
     y0: float = 0.0
@@ -90,6 +112,10 @@ class _Parametric(ABC):
                 f"orientation must be one of {', '.join(ORIENTATIONS)}"
                 f" (got {shown(self.orientation)})"
             )
+        # By value, not by presence: dataclasses.replace and a recorded run pass the
+        # default phi = 0 back in, and it means nothing with the tangent orientation.
+        if self.orientation == "tangent" and self.phi != 0.0:
+            raise ParameterError(f"{PHI_NEEDS_CONSTANT} (got phi = {self.phi:g})")
 
     @property
     def duration(self) -> float:

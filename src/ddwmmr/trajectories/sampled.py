@@ -2,10 +2,11 @@
 
 CSV format (header required): ``t,x,y`` and optionally ``phi``; times in s strictly
 increasing (spanning a duration of 1e-6 s to 1e9 s, each step at least
-:data:`MIN_STEP_FRACTION` of that duration), positions in m, angles in rad. Without
-``phi`` the orientation is the direction of travel (unwrapped). If the first and last
-points coincide the path is treated as closed and the tangents at the ends are matched
-(periodic).
+:data:`MIN_STEP_FRACTION` of that duration), positions in m, angles in rad. A ``phi``
+column may wrap at +-pi (as ``atan2`` writes it): it is unwrapped before interpolation
+(:func:`unwrap_phi`). Without ``phi`` the orientation is the direction of travel
+(unwrapped). If the first and last points coincide the path is treated as closed and the
+tangents at the ends are matched (periodic).
 """
 
 from __future__ import annotations
@@ -64,8 +65,13 @@ class SampledTrajectory:
         times: n >= 3 sample times (s), strictly increasing, starting anywhere, |t| <= 1e9;
             the duration ``times[-1] - times[0]`` is in [1e-6, 1e9] s and every step is at
             least :data:`MIN_STEP_FRACTION` times it.
-        points: (n, 2) positions (m) or (n, 3) poses with orientation (rad), each value
-            finite with magnitude <= 1e6.
+        points: (n, 2) positions (m) or (n, 3) poses with orientation phi (rad), world
+            frame, each value finite with magnitude <= 1e6. phi may wrap at +-pi: it is
+            unwrapped (:func:`unwrap_phi`: a step between consecutive rows larger than pi
+            in magnitude is taken the short way round, the first row kept), and
+            :attr:`points`, :meth:`pose` and :meth:`velocity` give the unwrapped,
+            continuous orientation (magnitude <= 1e6 rad after unwrapping too). A phi
+            column without such a step is kept as given, bit for bit.
         name: label used in reports.
 
     Anything else raises :class:`~ddwmmr.errors.ParameterError` naming ``times``,
@@ -115,6 +121,7 @@ class SampledTrajectory:
                 f"(got {np.max(np.abs(times)):g})"
             )
         _check_steps(times)
+        points = unwrap_phi(points)
         periodic = bool(np.allclose(points[0, :2], points[-1, :2], atol=1e-9))
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "points", points)
@@ -281,6 +288,33 @@ def _check_steps(times: np.ndarray) -> None:
             f"trajectory samples: times must step by at least {MIN_STEP_FRACTION:g} x the "
             f"duration = {shortest:g} s (row {row}: step {steps[row - 2]:g} s)"
         )
+
+
+def unwrap_phi(points: np.ndarray) -> np.ndarray:
+    """``points`` with its orientation column (the third, rad) unwrapped as
+    :func:`numpy.unwrap` does: each step between consecutive rows larger than pi in
+    magnitude is taken the short way round (whole turns added to that row and the
+    following ones), the first row kept. Interpolating the jump of a column wrapped at
+    +-pi (rows 3.1 then -3.1) would otherwise turn the end effector the long way, a
+    whole turn in one interval. ``points`` without such a step (or without a third
+    column) is returned as it is, so a continuous column keeps its exact bits (adding
+    zero turns would still turn a -0.0 into 0.0). The unwrapped angles must stay within
+    the documented 1e6 rad, else :class:`~ddwmmr.errors.ParameterError` naming ``points``."""
+    if points.shape[1] != 3:
+        return points
+    phi = points[:, 2]
+    if not np.any(np.abs(np.diff(phi)) > math.pi):
+        return points
+    unwrapped = points.copy()
+    unwrapped[:, 2] = np.unwrap(phi)
+    largest = float(np.max(np.abs(unwrapped[:, 2])))
+    if largest > MAX_COORDINATE_M:
+        raise ParameterError(
+            f"trajectory samples: points phi, unwrapped (each step between rows taken the "
+            f"short way round), must stay within |phi| <= {MAX_COORDINATE_M:g} rad "
+            f"(got {largest:g})"
+        )
+    return unwrapped
 
 
 def _hermite_terms(s, p0, p1, m0, m1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
