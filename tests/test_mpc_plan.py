@@ -5,13 +5,16 @@ and that the plan's structure is what the controller settles in)."""
 from __future__ import annotations
 
 import math
+import pickle
+import zipfile
 from pathlib import Path
 
 import casadi as ca
 import numpy as np
 import pytest
 
-from ddwmmr import ParameterError, Robot
+from ddwmmr import ParameterError, Robot, make_controller
+from ddwmmr.cli.scenarios import main as scenarios_main
 from ddwmmr.commands import traits_of
 from ddwmmr.controllers.base import WaypointRun
 from ddwmmr.mpc.controller import MPCController
@@ -19,6 +22,7 @@ from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, MinimumTimeProble
 from ddwmmr.mpc.ocp import OCPConfig
 from ddwmmr.plants import ThesisPlant
 from ddwmmr.scenarios import RunConfig, Scenario, generate, run_scenario
+from one_line import one_line
 
 ROBOT = Robot().with_payload(3.0)
 #: the default pose at rest: the end effector about 0.5 m ahead of the base
@@ -108,6 +112,65 @@ def test_a_missing_or_unreadable_plan_is_a_one_line_error(tmp_path):
     (tmp_path / "text.npz").write_text("not an archive")
     with pytest.raises(ParameterError, match=r"plan .*text.npz must be a \.npz"):
         Guess.load(tmp_path / "text.npz")
+
+
+def _damaged_plans(folder: Path) -> dict[str, Path]:
+    """Files that are no readable plan archive, by what is wrong with them."""
+    whole = write_plan(folder / "whole.npz", straight_plan(0.5, 0.0)).read_bytes()
+    files = {
+        "empty": b"",
+        "truncated": whole[: len(whole) // 2],
+        # a byte of the times' data flipped: the member's checksum fails
+        "bad checksum": whole[:200] + bytes([whole[200] ^ 0xFF]) + whole[201:],
+        "pickled": pickle.dumps({"times": [0.0, 1.0]}),
+    }
+    paths = {}
+    for name, content in files.items():
+        paths[name] = folder / f"{name.replace(' ', '-')}.npz"
+        paths[name].write_bytes(content)
+    paths["not an array"] = folder / "text-member.npz"
+    with zipfile.ZipFile(paths["not an array"], "w") as archive:
+        for key in ("times", "states", "inputs", "legs"):
+            archive.writestr(f"{key}.npy", "not an array")
+    paths["object array"] = write_plan(
+        folder / "objects.npz", {**straight_plan(0.5, 0.0), "legs": np.array([None], dtype=object)}
+    )
+    paths["compressed, damaged"] = folder / "deflated.npz"
+    np.savez_compressed(paths["compressed, damaged"], **straight_plan(0.5, 0.0))
+    deflated = bytearray(paths["compressed, damaged"].read_bytes())
+    deflated[80:120] = b"x" * 40
+    paths["compressed, damaged"].write_bytes(bytes(deflated))
+    paths["one .npy array"] = folder / "single.npy"
+    np.save(paths["one .npy array"], np.zeros(3))
+    return paths
+
+
+def test_a_damaged_plan_file_is_the_one_line_error_of_any_unreadable_plan(tmp_path):
+    """Empty and truncated files raised EOFError and zipfile.BadZipFile (a traceback in
+    the tools); every damaged file is the plan's own one-line error, through the API and
+    the controller it configures."""
+    for name, path in _damaged_plans(tmp_path).items():
+        with pytest.raises(ParameterError) as error:
+            Guess.load(path)
+        message = one_line(error)
+        assert message.startswith(
+            f"plan {path} must be a .npz with times, states, inputs, legs ("
+        ), name
+        with pytest.raises(ParameterError) as error:
+            make_controller("mpc", ROBOT, model="thesis", route=[(1.0, 0.0)], plan=str(path))
+        assert one_line(error) == message, name
+
+
+@pytest.mark.parametrize("damage", ["empty", "truncated"])
+def test_a_damaged_plan_stops_the_scenario_tool_with_one_line(tmp_path, capsys, damage):
+    path = _damaged_plans(tmp_path)[damage]
+    out = tmp_path / "run"
+    args = ["--controller", "mpc", "--n", "1", "--option", f"plan={path}"]
+    assert scenarios_main([*args, "--no-progress", "--out", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.err.startswith(f"error: plan {path} must be a .npz with times, states, ")
+    assert captured.err.count("\n") == 1 and "Traceback" not in captured.err
+    assert not out.exists()
 
 
 def test_plan_option_errors_name_the_option(tmp_path):

@@ -114,17 +114,32 @@ class Guess:
         """A trajectory stored as ``python -m ddwmmr.bounds`` stores its best-known ones
         (``.npz``: ``times`` (M+1,) s increasing from 0, ``states`` (M+1, nx), ``inputs``
         (M, nu) held from each time, ``legs`` (one duration per waypoint, s, > 0)); a
-        one-line :class:`ParameterError` naming the file for anything else."""
+        one-line :class:`ParameterError` naming the file for anything else, a file that
+        cannot be read as such an archive (empty, truncated, damaged, a single ``.npy``
+        array, pickled data, a member that is not a numeric array) included."""
+        arrays = None
+        reason = "a single array, not an archive"
         try:
-            with np.load(path, allow_pickle=False) as data:
-                arrays = {key: np.asarray(data[key], dtype=float) for key in _PLAN_ARRAYS}
+            loaded = np.load(path, allow_pickle=False)
+            if isinstance(loaded, np.lib.npyio.NpzFile):
+                with loaded:
+                    arrays = {key: np.asarray(loaded[key], dtype=float) for key in _PLAN_ARRAYS}
         except FileNotFoundError:
             raise ParameterError(f"plan {path}: no such file") from None
-        except (OSError, ValueError, KeyError) as error:
-            reason = error.args[0] if isinstance(error, KeyError) else type(error).__name__
+        except Exception as error:
+            # a damaged file fails wherever numpy, zipfile or the decompressor notices:
+            # EOFError, BadZipFile, zlib.error, RuntimeError (an encrypted member),
+            # MemoryError (a header claiming a huge shape), ValueError (pickled data, a
+            # member that is not an array), KeyError (a missing array), OSError, ...
+            reason = type(error).__name__
+            if isinstance(error, KeyError):
+                reason = error.args[0]
+            elif reason.islower():  # zlib.error
+                reason = f"{type(error).__module__}.{reason}"
+        if arrays is None:
             raise ParameterError(
                 f"plan {path} must be a .npz with {', '.join(_PLAN_ARRAYS)} ({reason})"
-            ) from None
+            )
         times, states, inputs, legs = (arrays[key] for key in _PLAN_ARRAYS)
         m = len(times) - 1
         shapes_ok = (
