@@ -699,6 +699,93 @@ def test_lower_only_leaves_the_best_known_time_to_a_later_run(tmp_path, monkeypa
     assert "best known 13.50 s (replayed 2), bracket width" in capsys.readouterr().out
 
 
+BOUNDS_HEADER = "scenario,lower_bound_s,best_known_s,starts,spread_s,replay_ok"
+
+
+def _read_rows(tmp_path, *rows: str):
+    """read_bounds of a bounds.csv of ``rows``, its path."""
+    path = tmp_path / "bounds.csv"
+    path.write_text("\n".join([BOUNDS_HEADER, *rows]) + "\n")
+    return batch.read_bounds(path), path
+
+
+def test_read_bounds_gives_the_committed_tables_as_written():
+    """docs/bounds' bounds.csv files read back number for number, every scenario."""
+    for seed in (0, 1):
+        path = DOCS_BOUNDS / f"bounds_seed{seed}.csv"
+        with path.open(newline="") as handle:
+            rows = list(csv.DictReader(handle))
+        table = batch.read_bounds(path)
+        assert sorted(table) == list(range(1, 101))
+        for r in rows:
+            expected = (float(r["lower_bound_s"]), float(r["best_known_s"]))
+            assert table[int(r["scenario"])] == expected
+
+
+def test_read_bounds_takes_nan_and_a_failed_replay_as_no_value(tmp_path):
+    """The tool's own rows without an end: nan (a --lower-only run) and replay_ok False
+    (its best_known_s is not a best-known time, whatever it holds)."""
+    table, _ = _read_rows(
+        tmp_path,
+        "1,11.0,nan,0,nan,False",
+        "2,12.0,14.0,3,0.5,True",
+        "3,nan,14.5,3,0.5,True",
+        "4,13.0,9.0,3,0.5,False",
+    )
+    assert table[2] == (12.0, 14.0)
+    assert table[1][0] == 11.0 and math.isnan(table[1][1])
+    assert math.isnan(table[3][0]) and table[3][1] == 14.5
+    assert table[4][0] == 13.0 and math.isnan(table[4][1])
+
+
+@pytest.mark.parametrize(
+    ("row", "message"),
+    [
+        ("2,0,12,3,0.5,True", "line 2 (scenario 2), column lower_bound_s: must be a time in "),
+        ("2,-5,12,3,0.5,True", "column lower_bound_s: must be a time in [1e-06, 1e+09] s, or "),
+        ("2,inf,12,3,0.5,True", "column lower_bound_s: must be a time in [1e-06, 1e+09] s, or "),
+        ("2,1e-300,12,3,0.5,True", "or nan for none (got 1e-300)"),
+        ("2,10,0,3,0.5,True", "line 2 (scenario 2), column best_known_s: must be a time in "),
+        ("2,10,-inf,3,0.5,True", "column best_known_s: must be a time in [1e-06, 1e+09] s"),
+        ("2,10,1e10,3,0.5,True", "column best_known_s: must be a time in [1e-06, 1e+09] s"),
+        ("2,10,twelve,3,0.5,True", "column best_known_s: must be a time in [1e-06, 1e+09] s, "),
+        ("2,10,,3,0.5,True", "line 2 (scenario 2) has no value in column best_known_s"),
+        ("2,10", "line 2 (scenario 2) has no value in column replay_ok"),
+        ("2,10,12,3,0.5,yes", "column replay_ok: must be True or False (got 'yes')"),
+        ("two,10,12,3,0.5,True", "line 2, column scenario: must be a whole number >= 1 (got "),
+        ("0,10,12,3,0.5,True", "line 2, column scenario: must be a whole number >= 1 (got '0')"),
+        (
+            "2,10,9.5,3,0.5,True",
+            "line 2 (scenario 2): best_known_s 9.5 s is below lower_bound_s 10 s",
+        ),
+    ],
+)
+def test_read_bounds_refuses_a_value_no_bracket_has(tmp_path, row, message):
+    """A lower bound of 0, -5 or inf read as "no lower bound" and 1e-300 as a ratio of
+    300 digits: each bad value is one line naming the file, the line and the column."""
+    with pytest.raises(ParameterError) as error:
+        _read_rows(tmp_path, row)
+    text = str(error.value)
+    assert text.startswith(f"bounds: {tmp_path / 'bounds.csv'} ")
+    assert message in text and "\n" not in text
+
+
+def test_read_bounds_refuses_a_scenario_twice_naming_the_second_line(tmp_path):
+    with pytest.raises(ParameterError, match=r"bounds\.csv line 3: scenario 1 appears twice$"):
+        _read_rows(tmp_path, "1,10,12,3,0.5,True", "1,11,12,3,0.5,True")
+
+
+def test_a_bounds_file_the_csv_reader_gives_up_on_is_one_line(tmp_path):
+    """A field beyond the csv module's size limit raised _csv.Error (a traceback)."""
+    path = tmp_path / "bounds.csv"
+    path.write_text(f"{BOUNDS_HEADER}\n1,{'9' * 200_000},12,3,0.5,True\n")
+    (tmp_path / "summary.json").write_text(json.dumps({"seed": 0, "payload": 3.0}))
+    with pytest.raises(ParameterError) as error:
+        batch.read_bounds_file(path, 0, 3.0)
+    assert str(error.value).startswith(f"bounds: cannot read {path} and its summary.json (")
+    assert "\n" not in str(error.value)
+
+
 # -- input checks of the lower bound --------------------------------------------------------
 @pytest.mark.parametrize(
     ("kwargs", "message"),

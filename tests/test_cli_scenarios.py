@@ -221,6 +221,46 @@ def test_a_bounds_file_that_cannot_serve_the_run_is_refused(
     assert line.startswith(f"error: bounds: {path} {message}")
 
 
+@pytest.mark.parametrize(
+    ("row", "message"),
+    [
+        (
+            "1,0,12,True",
+            "line 2 (scenario 1), column lower_bound_s: must be a time in [1e-06, 1e+09] s, "
+            "or nan for none (got 0)",
+        ),
+        (
+            "1,12,10,True",
+            "line 2 (scenario 1): best_known_s 10 s is below lower_bound_s 12 s",
+        ),
+    ],
+)
+def test_a_bounds_file_with_a_time_no_bracket_has_is_refused(
+    tmp_path, tmp_path_factory, row, message
+):
+    """A lower bound of 0 was read as none, and the run went on without it."""
+    path = _bounds_file(tmp_path_factory.mktemp("bounds"), BOUNDS_HEADER, [row])
+    line = bad_scenarios_run(tmp_path, ["--n", "1", "--no-progress", "--bounds", path])
+    assert line.startswith(f"error: bounds: {path} {message}")
+
+
+def test_the_bounds_ratio_to_the_smallest_time_a_file_may_hold_prints_short(
+    tmp_path, tmp_path_factory, capsys
+):
+    """1e-300 s, refused now, printed a ratio of 300 digits; at the smallest time read
+    (1e-6 s) the ratio is the scenario's time in microseconds, in a few digits."""
+    path = _bounds_file(tmp_path_factory.mktemp("bounds"), BOUNDS_HEADER, ["1,1e-6,1e-6,True"])
+    out = tmp_path / "r"
+    assert cli(["--n", "1", "--no-progress", "--out", str(out), "--bounds", path]) == 0
+    (line,) = [x for x in capsys.readouterr().out.splitlines() if x.startswith("mean ratio")]
+    (row,) = csv.DictReader((out / "scenarios.csv").open())
+    ratio = f"{float(row['time_s']) / 1e-6:.3f}"
+    assert len(ratio) < 16
+    assert line == (
+        f"mean ratio to the lower bound {ratio}, to the best-known time {ratio} ({path})"
+    )
+
+
 def test_a_bounds_ratio_without_a_scenario_says_why(tmp_path, tmp_path_factory, capsys):
     """The bounds cover the run's scenario but give it no best-known time (replay failed):
     that ratio is explained, not printed as nan."""

@@ -22,7 +22,7 @@ import numpy as np
 
 from ddwmmr.bounds.lower import lower_bound
 from ddwmmr.bounds.search import Settings, best_known
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import DURATION_RANGE_S, ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME
 from ddwmmr.scenarios.generator import Scenario
@@ -153,9 +153,18 @@ READ_COLUMNS = ("scenario", "lower_bound_s", "best_known_s", "replay_ok")
 
 
 def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
-    """``{scenario: (lower_bound_s, best_known_s)}`` from a bounds.csv (1-based scenarios;
-    rows whose replay failed have no best-known time: NaN); a file without one of
-    :data:`READ_COLUMNS` is refused naming them (one-line :class:`ParameterError`)."""
+    """``{scenario: (lower_bound_s, best_known_s)}`` from a bounds.csv (1-based scenarios).
+
+    An end the file does not give is NaN: ``nan`` in its column (as the bounds tool writes
+    an end it has not computed, e.g. the best-known times of a ``--lower-only`` run), and
+    the best-known time of a row whose replay failed (``replay_ok`` False; that column is
+    then not read). Refused with a one-line :class:`ParameterError` naming the file, the
+    line (and scenario) and the column: a file without one of :data:`READ_COLUMNS`; a
+    scenario that is not a whole number >= 1 or appears twice; a ``replay_ok`` other than
+    True or False; a time that is neither ``nan`` nor a number of seconds in
+    :data:`~ddwmmr.errors.DURATION_RANGE_S` (0, negative, inf, 1e-300); a best-known time
+    below the lower bound of its row (a lower bound is at most any time achieved).
+    """
     out = {}
     with open(path, newline="", encoding="utf-8") as handle:
         reader = csv.DictReader(handle)
@@ -167,9 +176,64 @@ def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
                 f"{', '.join(READ_COLUMNS)})"
             )
         for r in reader:
-            best = float(r["best_known_s"]) if r["replay_ok"] == "True" else math.nan
-            out[int(r["scenario"])] = (float(r["lower_bound_s"]), best)
+            where = f"bounds: {path} line {reader.line_num}"
+            scenario = _bounds_scenario(where, r)
+            if scenario in out:
+                raise ParameterError(f"{where}: scenario {scenario} appears twice")
+            where = f"{where} (scenario {scenario})"
+            replay_ok = _bounds_field(where, r, "replay_ok")
+            if replay_ok not in ("True", "False"):
+                raise ParameterError(
+                    f"{where}, column replay_ok: must be True or False (got {shown(replay_ok)})"
+                )
+            lower = _bounds_time(where, r, "lower_bound_s")
+            best = _bounds_time(where, r, "best_known_s") if replay_ok == "True" else math.nan
+            if best < lower:
+                raise ParameterError(
+                    f"{where}: best_known_s {r['best_known_s'].strip()} s is below "
+                    f"lower_bound_s {r['lower_bound_s'].strip()} s (no achieved time is below "
+                    "its lower bound)"
+                )
+            out[scenario] = (lower, best)
     return out
+
+
+def _bounds_field(where: str, row: dict, key: str) -> str:
+    """The text of column ``key`` of a bounds.csv row, refused if the row has none."""
+    text = row.get(key)
+    if text is None or not text.strip():
+        raise ParameterError(f"{where} has no value in column {key}")
+    return text.strip()
+
+
+def _bounds_scenario(where: str, row: dict) -> int:
+    """A bounds.csv row's scenario number (from 1)."""
+    text = _bounds_field(where, row, "scenario")
+    if not (text.isascii() and text.isdigit() and int(text) >= 1):
+        raise ParameterError(
+            f"{where}, column scenario: must be a whole number >= 1 (got {shown(text)})"
+        )
+    return int(text)
+
+
+def _bounds_time(where: str, row: dict, key: str) -> float:
+    """A time of a bounds.csv row (s): NaN for ``nan`` (no value), else a number in
+    :data:`~ddwmmr.errors.DURATION_RANGE_S`."""
+    text = _bounds_field(where, row, key)
+    low, high = DURATION_RANGE_S
+    try:
+        if "_" in text or not text.isascii():
+            raise ValueError(text)
+        value = float(text)
+    except ValueError:
+        value = None
+    if value is None or not (math.isnan(value) or low <= value <= high):
+        got = shown(text) if value is None else text
+        raise ParameterError(
+            f"{where}, column {key}: must be a time in [{low:g}, {high:g}] s, or nan for none "
+            f"(got {got})"
+        )
+    return value
 
 
 def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, tuple[float, float]]:
@@ -182,7 +246,7 @@ def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, t
         summary = json.loads((path.parent / "summary.json").read_text(encoding="utf-8"))
     except ParameterError:  # already one line naming what is wrong
         raise
-    except (OSError, ValueError, KeyError) as exc:
+    except (OSError, ValueError, KeyError, csv.Error) as exc:
         raise ParameterError(f"bounds: cannot read {path} and its summary.json ({exc})") from None
     if summary.get("seed") != seed or summary.get("payload") != payload:
         raise ParameterError(
