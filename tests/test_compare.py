@@ -389,3 +389,31 @@ def test_slow_methods_can_be_left_out_of_the_studies(monkeypatch):
     assert named.study_methods == ("clrrmc-cs",)
     specs = plan_runs(config).studies["init"]
     assert {s.method for s in specs} == {"ats"}
+
+
+def test_metrics_csv_names_each_trajectory_as_the_report_does(tmp_path, capsys):
+    """Two files of one stem are ``loop`` and ``loop-2`` in the report and its figures;
+    metrics.csv gave both rows the trajectory's own name, ``loop``. A name the report
+    makes safe for file names (``my loop``) is its report name there too."""
+    files = []
+    for folder, name, samples in (("a", "loop", 2000), ("b", "loop", 1000), ("c", "my loop", 500)):
+        (tmp_path / folder).mkdir()
+        files.append(tmp_path / folder / f"{name}.toml")
+        files[-1].write_text(f'[trajectory]\nshape = "ellipse"\nT = 40.0\nN = {samples}\n')
+    out = tmp_path / "report"
+    only = ["--only", "ellipse", *map(str, files)]
+    argv = ["--methods", "ats", "--study", "none", "--duration", "0.2", "--jobs", "1"]
+    assert main([*argv, *only, "--no-progress", "--out", str(out)]) == 0, capsys.readouterr()
+    with (out / "metrics.csv").open(newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    names = ["ellipse", "loop", "loop-2", "my_loop"]
+    assert [r["trajectory"] for r in rows] == names
+    # each row is its own file's run: the default step is T / N of that file
+    assert [float(r["dt"]) for r in rows] == [0.02, 0.02, 0.04, 0.08]
+    record = json.loads((out / "run.json").read_text())
+    assert list(record["trajectories"]) == names
+    assert record["trajectories"]["loop-2"]["file"] == str(files[1])
+    text = (out / "report.md").read_text()
+    for name in names:
+        assert (out / f"errors_{name}.png").exists()
+        assert f"{name} RMS (mm)" in text

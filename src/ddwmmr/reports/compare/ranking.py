@@ -27,11 +27,17 @@ from ddwmmr.sim.result import json_safe
 
 
 def metrics_rows(plan: Plan, outputs: Mapping[RunSpec, RunOutput]) -> list[dict[str, Any]]:
-    """One row per main run: ``method``, ``trajectory`` and every summary field."""
+    """One row per main run: ``method``, ``trajectory`` and every summary field, where
+    ``trajectory`` is the report's name of the trajectory (the key of
+    :attr:`CompareConfig.trajectories`, unique: ``loop`` and ``loop-2`` for two files of
+    that stem), as its tables and figure files name it, not the trajectory's own name that
+    the summary holds."""
     rows = []
     for spec in plan.main:
         summary = outputs[spec].summary
-        rows.append({"method": spec.method, "trajectory": spec.trajectory, **summary})
+        row = {"method": spec.method, "trajectory": spec.trajectory, **summary}
+        row["trajectory"] = spec.trajectory  # over the summary's, in the same column
+        rows.append(row)
     return rows
 
 
