@@ -40,7 +40,7 @@ def test_a_payload_that_tips_the_start_pose_is_refused_as_scenarios_refuses_it(
     err = capsys.readouterr().err
     assert err == (
         "error: payload: 20 kg tips the robot over in the start pose (S = 0.741 <= 1); the "
-        "start pose holds at most 9.34 kg\n"
+        "start pose holds at most 9.338 kg\n"
     )
     assert scenarios(["--payload", "20", "--out", str(tmp_path / "s")]) == 2
     assert capsys.readouterr().err == err  # the same check, the same line

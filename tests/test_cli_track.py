@@ -632,3 +632,17 @@ def test_a_physics_run_draws_its_support_loads(tmp_path):
     kinematic = tmp_path / "kinematic"
     assert run([*args, "--no-progress", "--out", str(kinematic)]) == 0
     assert not (kinematic / SUPPORT_LOADS_FIGURE).exists()
+
+
+def test_a_start_outside_the_robots_joint_limits_is_one_line(tmp_path, capsys):
+    robot = tmp_path / "narrow.toml"
+    robot.write_text("joint_limits = [[-0.31, -0.29], [0.59, 0.61]]\n")
+    out = tmp_path / "run"
+    argv = ["--method", "ats", "--traj", "ellipse", "--robot", str(robot), "--out", str(out)]
+    assert run(argv) == 2
+    assert capsys.readouterr().err == (
+        "error: the start pose: joint th1 = -0.437856 rad is outside joint_limits[1] = "
+        "[-0.31, -0.29] rad; change the robot's joint_limits or --offset\n"
+    )
+    assert not out.exists()
+    assert run([*argv, "--offset", "0", "0", "--duration", "0.2", "--no-plots"]) == 0

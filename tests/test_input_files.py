@@ -10,7 +10,14 @@ import numpy as np
 import pytest
 
 from ddwmmr import ParameterError, Robot
-from ddwmmr.errors import MAX_STEPS, check_int_at_least, check_step_count, read_text_file
+from ddwmmr.errors import (
+    MAX_STEPS,
+    check_int_at_least,
+    check_range,
+    check_step_count,
+    distinct,
+    read_text_file,
+)
 
 
 @pytest.mark.parametrize(
@@ -183,3 +190,39 @@ def test_int_check_shows_an_integral_float_as_the_integer_it_is():
     for value, got in (*cases, (1e300, "1e+300"), (0.5, "0.5")):
         with pytest.raises(ParameterError, match=rf"in \[2, 5\] \(got {re.escape(got)}\)$"):
             check_int_at_least("n", value, 2, 5)
+
+
+def test_a_refusal_never_shows_the_value_as_its_bound():
+    """``:g`` spells 0.1000000001 as 0.1: where a value differs from a bound that reads
+    the same, the refusal spells both in full."""
+    with pytest.raises(ParameterError, match=r"in \[0, 0\.1\] s \(got 0\.1000000001\)$"):
+        check_range("dt", 0.1000000001, 0.0, 0.1, "s")
+    reach = 0.35 + 0.30  # 0.6499999999999999: the arm's reach as the robot computes it
+    expected = r"in \[-0\.6499999999999999, 0\.6499999999999999\] m \(got 0\.65\)$"
+    with pytest.raises(ParameterError, match=expected):
+        check_range("offset", 0.65, -reach, reach, "m")
+    # the usual case keeps :g
+    with pytest.raises(ParameterError, match=r"in \[0, 0\.1\] s \(got 0\.2\)$"):
+        check_range("dt", 0.2, 0.0, 0.1, "s")
+    assert distinct(0.1, 0.1) == ("0.1", ["0.1"])  # equal: nothing to tell apart
+
+
+def test_a_start_outside_the_joint_limits_is_refused():
+    from ddwmmr import simulate
+    from ddwmmr.sim.simulate import check_start
+    from ddwmmr.trajectories import Ellipse
+
+    robot = Robot(joint_limits=((-1.0, 1.0), (-1.0, 1.5)))
+    assert robot.joints_outside((0, 0, 0, 1.0, -1.0)) is None  # the limits are inclusive
+    assert robot.joints_outside((0, 0, 0, 0.0, 1.6)) == (
+        "joint th2 = 1.6 rad is outside joint_limits[2] = [-1, 1.5] rad"
+    )
+    with pytest.raises(ParameterError, match=r"^q0: joint th1 = 2\.5 rad is outside "):
+        simulate(robot, Ellipse(), "clrrmc-ts", q0=(2, 0, 1.57, 2.5, 1.0))
+    # the start the offset builds: the home pose moved by the offset leaves the limits
+    narrow = Robot(joint_limits=((-0.31, -0.29), (0.59, 0.61)))
+    with pytest.raises(ParameterError, match=r"^the start pose \(initial_offset applied\): "):
+        simulate(narrow, Ellipse(), "ats", duration=0.1)
+    simulate(narrow, Ellipse(), "ats", duration=0.1, initial_offset=(0.0, 0.0))  # inside
+    with pytest.raises(ParameterError, match=r"change the robot's joint_limits or --offset$"):
+        check_start(robot, (0, 0, 0, 0.0, 1.6), start="--offset")

@@ -89,8 +89,24 @@ def check_range(name: str, value: float, low: float, high: float, unit: str = ""
     suffix = f" {unit}" if unit else ""
     value = _as_float(name, value, f"in [{low:g}, {high:g}]{suffix}")
     if not low <= value <= high:
-        raise ParameterError(f"{name} must be in [{low:g}, {high:g}]{suffix} (got {value:g})")
+        got, (lo, hi) = distinct(value, low, high)
+        raise ParameterError(f"{name} must be in [{lo}, {hi}]{suffix} (got {got})")
     return value
+
+
+def distinct(value: float, *bounds: float) -> tuple[str, list[str]]:
+    """``value`` and ``bounds`` as a refusal shows them: ``:g``, but where a bound differs
+    from the value and ``:g`` spells both alike (0.1000000001 and 0.1), each number ``:g``
+    rounds is spelt in full (``repr``), so the message never reads "must be <= 0.1 (got
+    0.1)"."""
+    got, texts = f"{value:g}", [f"{bound:g}" for bound in bounds]
+    if not any(t == got and float(b) != float(value) for t, b in zip(texts, bounds)):
+        return got, texts
+
+    def exact(number: float, text: str) -> str:
+        return text if float(text) == float(number) else repr(float(number))
+
+    return exact(value, got), [exact(b, t) for b, t in zip(bounds, texts)]
 
 
 def check_weight(name: str, value: float) -> float:

@@ -54,6 +54,7 @@ from ddwmmr.errors import (
     check_nonnegative,
     check_range,
     check_step_count,
+    distinct,
 )
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR, valid_stability_floor
@@ -335,7 +336,7 @@ def check_start_pose(payload: float) -> None:
     if s <= 1.0:
         raise ParameterError(
             f"payload: {payload:g} kg tips the robot over in the start pose (S = {s:.3g} <= 1); "
-            f"the start pose holds at most {max_start_payload():.3g} kg"
+            f"the start pose holds at most {math.floor(max_start_payload() * 1e3) / 1e3:g} kg"
         )
 
 
@@ -412,7 +413,8 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     if args.study and args.obstacles:
         raise ParameterError("study: --obstacles is implied by --study obstacles")
     if not (math.isfinite(args.dt) and 0.0 < args.dt <= MAX_DT):
-        raise ParameterError(f"dt must be in (0, {MAX_DT:g}] s (got {args.dt:g})")
+        got, (high,) = distinct(args.dt, MAX_DT)
+        raise ParameterError(f"dt must be in (0, {high}] s (got {got})")
     limit = args.time_limit
     if limit is not None and not (math.isfinite(limit) and limit > 0):
         raise ParameterError(f"time-limit must be > 0 s and finite (got {limit:g})")

@@ -23,6 +23,7 @@ from ddwmmr.errors import (
     ParameterError,
     check_finite,
     check_range,
+    distinct,
     load_toml,
     shown,
 )
@@ -302,6 +303,17 @@ class Robot:
     def reach(self) -> float:
         """Maximum arm reach L1 + L2 (m)."""
         return self.L1 + self.L2
+
+    def joints_outside(self, q) -> str | None:
+        """None if the arm joints of configuration ``q`` lie within ``joint_limits``, else
+        the phrase naming the first that does not ("joint th1 = 2.5 rad is outside
+        joint_limits[1] = [-1, 1] rad"), for a refusal to complete."""
+        angles = _configuration(q)[3:]
+        for i, (angle, (low, high)) in enumerate(zip(angles, self.joint_limits), start=1):
+            if not low <= angle <= high:
+                got, (lo, hi) = distinct(angle, low, high)
+                return f"joint th{i} = {got} rad is outside joint_limits[{i}] = [{lo}, {hi}] rad"
+        return None
 
     # Every method taking a configuration q (5 finite numbers [x, y, phi, th1, th2]) checks
     # it with _configuration: wrong shapes, strings and NaN/inf raise ParameterError

@@ -91,15 +91,20 @@ def check_start(
     start: str | None = "the start (q0, initial_offset)",
 ) -> None:
     """Refuse (one-line :class:`ParameterError`) a start configuration ``q`` (x, y m, phi
-    rad, th1, th2 rad) in which the robot has already tipped over (static S <= 1: the
-    centre of mass outside the support polygon) or its base overlaps one of the
-    ``obstacles`` (circles or (x, y, radius) triples, m). ``name`` (what holds the
-    payload) and ``start`` (what sets the start pose; None: nothing the user sets) word
-    the message: a command line names its own options.
+    rad, th1, th2 rad) with an arm joint outside the robot's ``joint_limits``, in which the
+    robot has already tipped over (static S <= 1: the centre of mass outside the support
+    polygon) or its base overlaps one of the ``obstacles`` (circles or (x, y, radius)
+    triples, m). ``name`` (what holds the payload) and ``start`` (what sets the start
+    pose; None: nothing the user sets) word the message: a command line names its own
+    options.
 
     The command-line tools and the app refuse such a run as bad input; :func:`simulate`
     warns and runs it (a design study may want to see ``min_stability`` below 1, as
     examples/own_robot.py does), or refuses it with ``tipped_start="refuse"``."""
+    outside = robot.joints_outside(q)
+    if outside is not None:
+        change = "the robot's joint_limits" + ("" if start is None else f" or {start}")
+        raise ParameterError(f"the start pose: {outside}; change {change}")
     if obstacles:
         from ddwmmr.qp.limits.obstacles import as_circles, check_start_clear
 
@@ -184,7 +189,9 @@ def simulate(
             shows. Default (-0.03, -0.03): 30 mm behind and 30 mm to the right (on the
             default ellipse the world offset (0.03, -0.03)). ``(0, 0)`` starts on the
             trajectory.
-        q0: explicit start configuration (overrides the construction above).
+        q0: explicit start configuration (overrides the construction above). Either
+            start must hold the arm joints within the robot's ``joint_limits``
+            (:class:`ParameterError` otherwise).
         plant: ``"kinematic"`` (default), ``"thesis"`` (force-driven base, velocity servo),
             any name of :func:`ddwmmr.plants.available_plants`, or a plant object.
         plant_options: keyword options of the named plant.
@@ -236,6 +243,10 @@ def simulate(
         q = initial_configuration(robot, reference, offset)
     else:
         q = np.array(check_configuration(q0))
+    outside = robot.joints_outside(q)
+    if outside is not None:  # no plant can start there: each would snap the joint inside
+        where = "q0" if q0 is not None else "the start pose (initial_offset applied)"
+        raise ParameterError(f"{where}: {outside}")
     tipped = _tipped_start(robot, q, tipped_start)
     task = TrackingTask(reference, the_plant, grid=(dt, steps))
     run_loop(the_plant, controller, task, q, dt, steps, progress)

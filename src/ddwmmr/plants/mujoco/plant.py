@@ -283,12 +283,9 @@ class MujocoPlant:
         """
         substeps = self._check_dt(dt)
         q0 = np.array(check_configuration(q0))
-        for i, (angle, (low, high)) in enumerate(zip(q0[3:], self.robot.joint_limits), 1):
-            if not low <= angle <= high:
-                raise ParameterError(
-                    f"q0 joint th{i} must be within joint_limits[{i}] = [{low:g}, {high:g}] "
-                    f"(got {angle:g})"
-                )
+        outside = self.robot.joints_outside(q0)
+        if outside is not None:
+            raise ParameterError(f"q0: {outside}")
         self._substeps, self._dt = substeps, float(dt)
         model, data = self.model, self.data
         mujoco.mj_resetData(model, data)
