@@ -190,6 +190,17 @@ def test_simulate_names_what_a_trajectory_needs(trajectory, match):
     _refused(lambda: simulate(Robot(), trajectory, "ats"), match)
 
 
+@pytest.mark.parametrize("method", ["clrrmc-cs", "clrrmc-ts", "ats", "qp", "mpc"])
+def test_a_controller_reset_with_no_trajectory_is_refused_or_harmless(method):
+    """The configuration-space controller builds its reference at reset: it names what
+    a trajectory needs (it raised AttributeError); the others do not read it there."""
+    controller = make_controller(method, Robot())
+    if method == "clrrmc-cs":
+        _refused(lambda: controller.reset(None, np.zeros(5)), match=r"^trajectory must have")
+    else:
+        controller.reset(None, np.zeros(5))
+
+
 @pytest.mark.parametrize(
     ("circle", "match"),
     [

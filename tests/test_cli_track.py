@@ -372,7 +372,10 @@ def recorded_run(tmp_path_factory) -> dict:
         ("options", [1], "options must be a dict"),
         ("options", "x", "options must be a dict"),
         ("integrator", None, "integrator name must be a str"),
-        ("robot", {}, "robot record lacks L1"),
+        ("robot", {}, "summary.json: the robot record lacks L1"),
+        ("plant", {"name": "foo"}, "summary.json: plant 'foo' is not supported by this"),
+        ("record_version", 99, "summary.json holds a run record of version 99; this version"),
+        ("record_version", "1", "summary.json holds a run record of version '1'; this"),
         ("initial_offset", 3, "offset must be a list"),
     ],
 )

@@ -145,7 +145,7 @@ def robot_from_record(record: dict[str, Any]) -> Robot:
     :data:`RECORDED_ROBOT_FIELDS` is incomplete, not a request for the default."""
     missing = [name for name in RECORDED_ROBOT_FIELDS if name not in record]
     if missing:
-        raise ParameterError(f"rerun: the robot record lacks {', '.join(missing[:3])}")
+        raise ParameterError(f"the robot record lacks {', '.join(missing[:3])}")
     return Robot.from_dict(decode(record))
 
 
@@ -186,16 +186,16 @@ def trajectory_from_record(record: dict[str, Any]) -> Any:
     if kind == "samples":
         path = Path(record["file"])
         if not path.exists():
-            raise ParameterError(f"rerun: the trajectory file {path} is gone")
+            raise ParameterError(f"the trajectory file {path} is gone")
         if not path.is_file():  # checked before hashing: a FIFO would block the read
             now = "a folder" if path.is_dir() else "not a regular file"
-            raise ParameterError(f"rerun: the trajectory file {path} is now {now}")
+            raise ParameterError(f"the trajectory file {path} is now {now}")
         if file_sha256(path) != record["sha256"]:
             raise ParameterError(
-                f"rerun: the trajectory file {path} changed since the run (SHA-256 differs)"
+                f"the trajectory file {path} changed since the run (SHA-256 differs)"
             )
         return read_csv(path)
-    raise ParameterError(f"rerun: cannot rebuild a trajectory of type {shown(kind)}")
+    raise ParameterError(f"cannot rebuild a trajectory of type {shown(kind)}")
 
 
 @dataclass

@@ -459,7 +459,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         plant_record = _field(record, "plant", dict, "plant")
         plant = _inside("plant", lambda: _field(plant_record, "name", str, "plant name"))
         if plant not in available_plants():
-            raise ParameterError(f"rerun: plant {plant!r} is not supported by this version")
+            raise ParameterError(f"plant {plant!r} is not supported by this version")
         trajectory_record = _field(record, "trajectory", dict, "trajectory")
         trajectory = _inside(
             "trajectory", lambda: provenance.trajectory_from_record(trajectory_record)
@@ -544,6 +544,12 @@ def load_run_record(path: str) -> dict[str, Any]:
     if not isinstance(record, dict) or record.get("tool") not in RERUN_TOOLS:
         raise ParameterError(
             f"rerun: {path} is not a summary.json written by {PROG} or exported by the simulator"
+        )
+    version = record.get("record_version")
+    if type(version) is not int or version != provenance.RECORD_VERSION:
+        raise ParameterError(
+            f"rerun: {path} holds a run record of version {shown(version)}; this version of "
+            f"ddwmmr reruns version {provenance.RECORD_VERSION}"
         )
     return record
 

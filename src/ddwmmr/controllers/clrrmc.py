@@ -21,6 +21,7 @@ from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import principal_angle, wrap_angle
 from ddwmmr.resolution import kernels
 from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
+from ddwmmr.trajectories.base import require_trajectory
 
 #: Default time constant (s) of every closed-loop channel.
 DEFAULT_TAU = 0.5
@@ -116,6 +117,7 @@ class ConfigurationSpaceController:
         also where :func:`ddwmmr.simulate` starts before applying its initial offset.
         ``q0`` (5 finite numbers, m and rad) is checked but not used.
         """
+        require_trajectory(trajectory)
         check_start(q0)
         period = getattr(trajectory, "duration", 0.0)
         if period / self.reference_step > MAX_STEPS:

@@ -37,7 +37,7 @@ from ddwmmr.sim.loop import run_loop
 from ddwmmr.sim.result import SimulationResult
 from ddwmmr.sim.tracking import COLUMNS, TrackingTask, checked_trajectory
 from ddwmmr.sim.verdict import verdict
-from ddwmmr.trajectories.base import resolution_step, trajectory_name
+from ddwmmr.trajectories.base import require_trajectory, resolution_step, trajectory_name
 
 __all__ = ["COLUMNS", "max_condition_number", "simulate", "summarize"]
 
@@ -47,22 +47,7 @@ def check_trajectory(trajectory: Any) -> Any:
     ``duration`` (s), ``pose(t)`` and ``velocity(t)``. Returns the trajectory as the run's
     consumers use it (:func:`~ddwmmr.sim.tracking.checked_trajectory`: one written outside
     the library has what its ``pose`` and ``velocity`` return checked at every call)."""
-    if isinstance(trajectory, str):
-        raise ParameterError(
-            f"trajectory must be a trajectory object, not its name {shown(trajectory)} "
-            f"(ddwmmr.load_trajectory({shown(trajectory)}) builds one)"
-        )
-    missing = [
-        name
-        for name in ("duration", "pose", "velocity")
-        if not hasattr(trajectory, name)
-        or (name != "duration" and not callable(getattr(trajectory, name)))
-    ]
-    if missing:
-        raise ParameterError(
-            "trajectory must have duration (s), pose(t) and velocity(t) "
-            f"(got {shown(trajectory)}, without {', '.join(missing)})"
-        )
+    require_trajectory(trajectory)
     return checked_trajectory(trajectory)
 
 

@@ -90,6 +90,27 @@ def _bad_times(got: str) -> ParameterError:
     )
 
 
+def require_trajectory(trajectory: Any) -> None:
+    """Refuse (one-line :class:`ParameterError`) what is not a trajectory: it needs
+    ``duration`` (s), ``pose(t)`` and ``velocity(t)``."""
+    if isinstance(trajectory, str):
+        raise ParameterError(
+            f"trajectory must be a trajectory object, not its name {shown(trajectory)} "
+            f"(ddwmmr.load_trajectory({shown(trajectory)}) builds one)"
+        )
+    missing = [
+        name
+        for name in ("duration", "pose", "velocity")
+        if not hasattr(trajectory, name)
+        or (name != "duration" and not callable(getattr(trajectory, name)))
+    ]
+    if missing:
+        raise ParameterError(
+            "trajectory must have duration (s), pose(t) and velocity(t) "
+            f"(got {shown(trajectory)}, without {', '.join(missing)})"
+        )
+
+
 def trajectory_name(trajectory: object) -> str:
     """A short human name for a trajectory (its ``name`` attribute or its class name)."""
     return str(getattr(trajectory, "name", type(trajectory).__name__.lower()))
