@@ -173,6 +173,24 @@ def test_the_singularity_is_the_cause_from_a_quarter_of_the_run():
     assert "joint limit" in verdict({**far, "singular_steps": 500})["verdict"]
 
 
+def test_a_start_below_the_stability_floor_is_named_as_the_cause():
+    """qp with --stability-min 9.9 from S = 2.18 ends 0.69 m off: the floor, not tau."""
+    far = {**CLEAN, "final_position_error_m": 0.69, "start_stability": 2.18}
+    below = verdict({**far, "stability_min": 9.9})["verdict"]
+    assert "starts below its stability floor (start S = 2.18 < stability_min 9.9)" in below
+    assert "check tau" in verdict({**far, "stability_min": 1.25})["verdict"]  # above it
+    assert "check tau" in verdict(far)["verdict"]  # a method without a floor
+    assert verdict({**CLEAN, "start_stability": 2.18, "stability_min": 9.9})["verdict"] == (
+        "tracked"
+    )
+
+
+def test_qp_from_below_its_floor_names_the_floor(tmp_path):
+    result = simulate(Robot(), load_trajectory("ellipse"), "qp", duration=1.0, stability_min=9.9)
+    assert result.summary["start_stability"] < 9.9
+    assert "starts below its stability floor" in result.summary["verdict"]
+
+
 def test_compare_lists_the_runs_that_did_not_track():
     from ddwmmr.cli.compare import not_tracked
 

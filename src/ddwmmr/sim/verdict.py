@@ -102,6 +102,12 @@ NO_CONVERGENCE = (
 DIVERGED = (
     'the step is too large for the plant or a command was unbounded (see docs/api.md, "Simulation")'
 )
+BELOW_FLOOR = (
+    "the run starts below its stability floor (start S = {start_stability:.3g} < "
+    "stability_min {stability_min:.3g}): tracking yields until S has risen above it, and "
+    "a floor the arm cannot reach holds it back throughout; lower stability_min or start "
+    'above it (see docs/qp.md, "Limitations")'
+)
 TIPPED = (
     "the payload or the accelerations put the centre of pressure outside the wheels: a "
     "lighter payload, another start pose or a stability floor (stability_min; see "
@@ -207,6 +213,9 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return DIVERGED
     if "tipped_over" in found or "tipped_at_start" in found:
         return TIPPED
+    start, floor = _number(summary, "start_stability"), _number(summary, "stability_min")
+    if start is not None and floor is not None and start < floor:
+        return BELOW_FLOOR.format(start_stability=start, stability_min=floor)
     steps = _number(summary, "steps") or 0
     if steps and (_number(summary, "singular_steps") or 0) > SINGULAR_CAUSE * steps:
         return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
