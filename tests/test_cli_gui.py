@@ -13,7 +13,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 import ddwmmr.gui.settings as gui_settings
-from ddwmmr import Robot, available_methods, available_trajectories, simulate
+from ddwmmr import ParameterError, Robot, available_methods, available_trajectories, simulate
 from ddwmmr.cli import gui as cli
 from ddwmmr.cli.gui import build_parser, main, settings_from_arguments
 from ddwmmr.gui import App, Settings
@@ -271,6 +271,24 @@ def test_help_states_the_defaults(capsys):
         "not with --snapshot",
     ):
         assert words in text, words
+
+
+@pytest.mark.parametrize(
+    ("name", "words", "inside", "outside"),
+    [
+        ("x0", "--x0 M centre x in m, world frame (|x0| <= 1e+06)", -1e6, 1.01e6),
+        ("a", "--a M semi-axis along the shape's own x in m, in [1e-06, 1000]", 1e-6, 1001.0),
+        ("beta", "(|beta| <= 1e+06)", 1e6, -1.01e6),
+        ("N", "--N N samples per period, an integer in [2, 1000000]", 2, 1),
+        ("T", "--T S period in s, in [1e-06, 1e+09]", 1e9, 1.1e9),
+    ],
+)
+def test_help_says_what_each_geometry_value_is_and_its_range(capsys, name, words, inside, outside):
+    assert run(["--help"]) == 0
+    assert words in " ".join(capsys.readouterr().out.split())
+    gui_settings.check_geometry(name, inside)  # the range the help states is the checked one
+    with pytest.raises(ParameterError, match=rf"^{name} must be"):
+        gui_settings.check_geometry(name, outside)
 
 
 def test_not_a_trajectory_file_is_bad_input(tmp_path, capsys):
