@@ -291,6 +291,15 @@ def test_help_says_what_each_geometry_value_is_and_its_range(capsys, name, words
         gui_settings.check_geometry(name, outside)
 
 
+def test_dpi_without_a_snapshot_is_refused_as_force_is(capsys):
+    assert main(["--dpi", "50"]) == 2
+    assert capsys.readouterr().err == (
+        "error: dpi needs --snapshot PATH (it sets the snapshot's resolution)\n"
+    )
+    assert main(["--dpi", "5000"]) == 2  # out of range is said first, with the range
+    assert "dpi must be in [10, 600]" in capsys.readouterr().err
+
+
 def test_not_a_trajectory_file_is_bad_input(tmp_path, capsys):
     notes = tmp_path / "notes.toml"
     notes.write_text("[shopping]\nmilk = 1\n")

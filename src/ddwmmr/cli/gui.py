@@ -114,7 +114,7 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar="DPI",
-        help=f"resolution of the snapshot, {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g} "
+        help=f"with --snapshot: its resolution, {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g} "
         "(default 100: 1600 x 1000 px)",
     )
     parser.add_argument(
@@ -306,6 +306,8 @@ def _main(argv: Sequence[str] | None = None) -> int:
         raise ParameterError("force needs --snapshot PATH (it only lets a snapshot replace a file)")
     if args.dpi is not None:
         check_dpi(args.dpi)
+        if args.snapshot is None:  # the window fits its own resolution to the screen
+            raise ParameterError("dpi needs --snapshot PATH (it sets the snapshot's resolution)")
     if args.export is not None:
         check_export_root(args.export)
         if args.snapshot is not None:
