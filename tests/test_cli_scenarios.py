@@ -84,6 +84,7 @@ def test_obstacle_study_table(tmp_path, capsys):
         (["--study", "thresholds", "--controller", "qp"], "needs --controller thesis"),
         (["--dt", "0"], "dt must be in (0, 0.1] s"),
         (["--dt", "0.2"], "dt must be in (0, 0.1] s"),
+        (["--dt", "0.1000000001"], "dt must be in (0, 0.1] s (got 0.1000000001)"),
         (["--dt", "inf"], "dt must be in (0, 0.1] s"),
         (["--time-limit", "nan"], "time-limit must be > 0 s"),
         (["--controller", "qp", "--stability", "1.3", "1.6"], "--stability: only used with"),

@@ -342,15 +342,19 @@ def test_rerun_of_a_toml_trajectory_record_without_its_digest_is_refused(tmp_pat
     args = ["--method", "ats", "--traj", str(traj), "--duration", "0.2", "--no-plots"]
     assert run([*args, "--out", str(first)]) == 0
     summary = json.loads((first / "summary.json").read_text())
-    del summary["run"]["trajectory"]["sha256"]
     damaged = tmp_path / "damaged.json"
-    damaged.write_text(json.dumps(summary))
-    capsys.readouterr()
-    assert run(["--rerun", str(damaged), "--out", str(tmp_path / "b")]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err == (
-        f"error: rerun: {damaged}: the trajectory's file has no SHA-256 of 64 hex digits"
-    )
+    for digest in (None, "z" * 64, "A" * 64):  # missing, not hex, not as hashlib spells it
+        trajectory = summary["run"]["trajectory"]
+        trajectory.pop("sha256", None)
+        if digest is not None:
+            trajectory["sha256"] = digest
+        damaged.write_text(json.dumps(summary))
+        capsys.readouterr()
+        assert run(["--rerun", str(damaged), "--out", str(tmp_path / "b")]) == 2
+        err = capsys.readouterr().err.strip()
+        assert err == (
+            f"error: rerun: {damaged}: the trajectory's file has no SHA-256 of 64 hex digits"
+        )
 
 
 @pytest.fixture(scope="module")

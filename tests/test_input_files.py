@@ -15,8 +15,8 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_range,
     check_step_count,
-    distinct,
     read_text_file,
+    texts_apart,
 )
 
 
@@ -204,7 +204,7 @@ def test_a_refusal_never_shows_the_value_as_its_bound():
     # the usual case keeps :g
     with pytest.raises(ParameterError, match=r"in \[0, 0\.1\] s \(got 0\.2\)$"):
         check_range("dt", 0.2, 0.0, 0.1, "s")
-    assert distinct(0.1, 0.1) == ("0.1", ["0.1"])  # equal: nothing to tell apart
+    assert texts_apart(0.1, 0.1) == ("0.1", ["0.1"])  # equal: nothing to tell apart
 
 
 def test_a_start_outside_the_joint_limits_is_refused():
@@ -226,3 +226,23 @@ def test_a_start_outside_the_joint_limits_is_refused():
     simulate(narrow, Ellipse(), "ats", duration=0.1, initial_offset=(0.0, 0.0))  # inside
     with pytest.raises(ParameterError, match=r"change the robot's joint_limits or --offset$"):
         check_start(robot, (0, 0, 0, 0.0, 1.6), start="--offset")
+
+
+def test_a_reachable_offset_is_started_within_the_joint_limits():
+    """Newton lands th1 whole turns away for a 0.25 m offset (-24.2 rad): the start turns
+    it back into the limits, the same arm pose, and the run goes ahead."""
+    from ddwmmr import simulate
+    from ddwmmr.resolution.reference import initial_configuration, offset_configuration
+    from ddwmmr.trajectories import Ellipse
+
+    robot, trajectory = Robot(), Ellipse()
+    start = initial_configuration(robot, trajectory, (-0.22, 0.11))
+    assert robot.joints_outside(start) is None
+    assert all(-math.pi <= angle <= math.pi for angle in start[3:])
+    home = initial_configuration(robot, trajectory, (0.0, 0.0))
+    moved = robot.fk(start)[:2] - robot.fk(home)[:2]
+    assert math.hypot(*moved) == pytest.approx(math.hypot(-0.22, 0.11), abs=1e-9)
+    q = np.array(home)
+    assert offset_configuration(robot, q, (0.0, 0.0)).tolist() == home.tolist()  # to the bit
+    ts = simulate(robot, trajectory, "clrrmc-ts", duration=0.2, initial_offset=(-0.22, 0.11))
+    assert ts.timeseries["th1"][0] == pytest.approx(start[3])

@@ -218,8 +218,12 @@ LIGHT = Robot(base_mass=1e-3, wheel_mass=1e-4, link_masses=(1e-3, 1e-3), payload
 
 
 def test_a_robot_too_light_for_the_timestep_is_refused_at_reset(capsys):
-    with pytest.raises(ParameterError, match=r"^MuJoCo cannot settle this robot at timestep "):
+    with pytest.raises(ParameterError, match=r"^MuJoCo cannot settle this robot at timestep ") as e:
         fresh(robot=LIGHT)
+    assert str(e.value).endswith(
+        "give it heavier parts, or (the API) a smaller MujocoPlant(robot, timestep=...) in "
+        "[1e-05, 0.01] s"
+    )
     assert capsys.readouterr().err == ""  # the engine's own warning stays in logging
     # the message's remedy works: a shorter engine step settles the same robot
     assert fresh(robot=LIGHT, timestep=5e-4).observe().q[3:] == pytest.approx((-0.3, 0.6))

@@ -153,3 +153,22 @@ def test_an_unwrapped_angle_beyond_the_documented_bound_is_refused():
     assert "\n" not in text
     assert text.startswith("trajectory samples: points phi, unwrapped")
     assert "|phi| <= 1e+06 rad" in text
+
+
+def test_a_column_beyond_pi_is_continuous_already_and_kept():
+    """Rows 0, 4, 8 rad (a fast spin sampled coarsely, written unwrapped) step by more than
+    pi, but an angle beyond pi says the column is not wrapped: it is kept as given."""
+    points = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 4.0], [2.0, 0.0, 8.0]])
+    assert unwrap_phi(points) is points
+    trajectory = SampledTrajectory(np.array([0.0, 1.0, 2.0]), points)
+    assert trajectory.points[:, 2].tolist() == [0.0, 4.0, 8.0]
+
+
+def test_an_unwrapped_column_read_back_is_not_unwrapped_again(tmp_path):
+    """csv_text writes the unwrapped heading (beyond pi): reading it back keeps it."""
+    first = circle(wrapped=True)
+    path = tmp_path / "again.csv"
+    path.write_text(csv_text(first))
+    again = read_csv(path)
+    assert np.max(np.abs(first.points[:, 2])) > math.pi
+    assert np.array_equal(again.points, first.points)

@@ -180,6 +180,9 @@ def test_a_start_below_the_stability_floor_is_named_as_the_cause():
     assert "starts below its stability floor (start S = 2.18 < stability_min 9.9)" in below
     assert "check tau" in verdict({**far, "stability_min": 1.25})["verdict"]  # above it
     assert "check tau" in verdict(far)["verdict"]  # a method without a floor
+    # a start that :g would spell as the floor itself is spelt in full
+    close = verdict({**far, "start_stability": 1.2499999, "stability_min": 1.25})["verdict"]
+    assert "(start S = 1.2499999 < stability_min 1.25)" in close
     assert verdict({**CLEAN, "start_stability": 2.18, "stability_min": 9.9})["verdict"] == (
         "tracked"
     )

@@ -89,12 +89,12 @@ def check_range(name: str, value: float, low: float, high: float, unit: str = ""
     suffix = f" {unit}" if unit else ""
     value = _as_float(name, value, f"in [{low:g}, {high:g}]{suffix}")
     if not low <= value <= high:
-        got, (lo, hi) = distinct(value, low, high)
+        got, (lo, hi) = texts_apart(value, low, high)
         raise ParameterError(f"{name} must be in [{lo}, {hi}]{suffix} (got {got})")
     return value
 
 
-def distinct(value: float, *bounds: float) -> tuple[str, list[str]]:
+def texts_apart(value: float, *bounds: float) -> tuple[str, list[str]]:
     """``value`` and ``bounds`` as a refusal shows them: ``:g``, but where a bound differs
     from the value and ``:g`` spells both alike (0.1000000001 and 0.1), each number ``:g``
     rounds is spelt in full (``repr``), so the message never reads "must be <= 0.1 (got

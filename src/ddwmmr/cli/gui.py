@@ -28,11 +28,6 @@ from pathlib import Path
 from ddwmmr.cli.common import ArgumentParser, run_main
 from ddwmmr.controllers.base import available_methods
 from ddwmmr.errors import (
-    DURATION_RANGE_S,
-    LENGTH_RANGE_M,
-    MAX_ANGLE_RAD,
-    MAX_COORDINATE_M,
-    MAX_TRAJECTORY_SAMPLES,
     ParameterError,
     check_range,
 )
@@ -48,6 +43,7 @@ from ddwmmr.gui.paths import (
 )
 from ddwmmr.gui.settings import (
     GEOMETRY,
+    GEOMETRY_HELP,
     Settings,
     check_geometry,
     check_run_length,
@@ -68,21 +64,6 @@ DPI_RANGE = (10.0, 600.0)
 
 class RunFailed(RuntimeError):
     """The simulation of a snapshot failed for a reason other than bad input."""
-
-
-#: What each trajectory-geometry option means, with the range the trajectories accept.
-GEOMETRY_HELP = {
-    "x0": f"centre x in m, world frame (|x0| <= {MAX_COORDINATE_M:g})",
-    "y0": f"centre y in m, world frame (|y0| <= {MAX_COORDINATE_M:g})",
-    "a": f"semi-axis along the shape's own x in m, in [{LENGTH_RANGE_M[0]:g}, "
-    f"{LENGTH_RANGE_M[1]:g}]",
-    "b": f"semi-axis along the shape's own y in m, in [{LENGTH_RANGE_M[0]:g}, "
-    f"{LENGTH_RANGE_M[1]:g}]",
-    "beta": f"rotation of the shape about its centre in rad, counter-clockwise "
-    f"(|beta| <= {MAX_ANGLE_RAD:g})",
-    "N": f"samples per period, an integer in [2, {MAX_TRAJECTORY_SAMPLES}]",
-    "T": f"period in s, in [{DURATION_RANGE_S[0]:g}, {DURATION_RANGE_S[1]:g}]",
-}
 
 
 def build_parser() -> ArgumentParser:

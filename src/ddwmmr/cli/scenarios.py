@@ -54,7 +54,7 @@ from ddwmmr.errors import (
     check_nonnegative,
     check_range,
     check_step_count,
-    distinct,
+    texts_apart,
 )
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR, valid_stability_floor
@@ -413,7 +413,7 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     if args.study and args.obstacles:
         raise ParameterError("study: --obstacles is implied by --study obstacles")
     if not (math.isfinite(args.dt) and 0.0 < args.dt <= MAX_DT):
-        got, (high,) = distinct(args.dt, MAX_DT)
+        got, (high,) = texts_apart(args.dt, MAX_DT)
         raise ParameterError(f"dt must be in (0, {high}] s (got {got})")
     limit = args.time_limit
     if limit is not None and not (math.isfinite(limit) and limit > 0):

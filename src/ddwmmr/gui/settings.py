@@ -27,6 +27,10 @@ import numpy as np
 
 from ddwmmr.controllers.base import available_methods, make_controller
 from ddwmmr.errors import (
+    DURATION_RANGE_S,
+    LENGTH_RANGE_M,
+    MAX_ANGLE_RAD,
+    MAX_COORDINATE_M,
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
     check_int_at_least,
@@ -58,6 +62,21 @@ GEOMETRY = (
     ("N", "-", ">= 2"),
     ("T", "s", "> 0"),
 )
+#: What each geometry value means, with the range the trajectories accept (the tool's
+#: --help; the panel's labels keep GEOMETRY's short form).
+GEOMETRY_HELP = {
+    "x0": f"centre x in m, world frame (|x0| <= {MAX_COORDINATE_M:g})",
+    "y0": f"centre y in m, world frame (|y0| <= {MAX_COORDINATE_M:g})",
+    "a": f"semi-axis along the shape's own x in m, in [{LENGTH_RANGE_M[0]:g}, "
+    f"{LENGTH_RANGE_M[1]:g}]",
+    "b": f"semi-axis along the shape's own y in m, in [{LENGTH_RANGE_M[0]:g}, "
+    f"{LENGTH_RANGE_M[1]:g}]",
+    "beta": f"rotation of the shape about its centre in rad, counter-clockwise "
+    f"(|beta| <= {MAX_ANGLE_RAD:g})",
+    "N": f"samples per period, an integer in [2, {MAX_TRAJECTORY_SAMPLES}]",
+    "T": f"period in s, in [{DURATION_RANGE_S[0]:g}, {DURATION_RANGE_S[1]:g}]",
+}
+
 #: The two method slots: A (always on) and B (side-by-side comparison, may be off).
 SLOTS = ("A", "B")
 

@@ -23,9 +23,9 @@ from ddwmmr.errors import (
     ParameterError,
     check_finite,
     check_range,
-    distinct,
     load_toml,
     shown,
+    texts_apart,
 )
 from ddwmmr.model import kinematics, stability
 from ddwmmr.model.mass import YawInertia, total_mass
@@ -311,7 +311,7 @@ class Robot:
         angles = _configuration(q)[3:]
         for i, (angle, (low, high)) in enumerate(zip(angles, self.joint_limits), start=1):
             if not low <= angle <= high:
-                got, (lo, hi) = distinct(angle, low, high)
+                got, (lo, hi) = texts_apart(angle, low, high)
                 return f"joint th{i} = {got} rad is outside joint_limits[{i}] = [{lo}, {hi}] rad"
         return None
 

@@ -38,6 +38,8 @@ from __future__ import annotations
 
 import itertools
 import math
+import zipfile
+import zlib
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -62,6 +64,24 @@ PLAN_NAME = "scenario-{:03d}-best.npz"
 PLAN_FOLDER = "cache"
 
 Rows = Callable[..., ca.SX]
+
+
+#: What reading a damaged plan archive raises: EOFError (empty), BadZipFile (truncated,
+#: bad checksum), zlib.error (damaged compressed data), RuntimeError (an encrypted
+#: member), NotImplementedError (an unknown compression), MemoryError (a header claiming
+#: a huge shape), ValueError (pickled data, a member that is not an array), KeyError (a
+#: missing array), OSError. Anything else is a bug, not a bad file, and is not caught.
+_DAMAGED_ARCHIVE = (
+    EOFError,
+    zipfile.BadZipFile,
+    zlib.error,
+    RuntimeError,
+    NotImplementedError,
+    MemoryError,
+    ValueError,
+    KeyError,
+    OSError,
+)
 
 
 @dataclass(frozen=True)
@@ -126,11 +146,8 @@ class Guess:
                     arrays = {key: np.asarray(loaded[key], dtype=float) for key in _PLAN_ARRAYS}
         except FileNotFoundError:
             raise ParameterError(f"plan {path}: no such file") from None
-        except Exception as error:
-            # a damaged file fails wherever numpy, zipfile or the decompressor notices:
-            # EOFError, BadZipFile, zlib.error, RuntimeError (an encrypted member),
-            # MemoryError (a header claiming a huge shape), ValueError (pickled data, a
-            # member that is not an array), KeyError (a missing array), OSError, ...
+        except _DAMAGED_ARCHIVE as error:
+            # a damaged file fails wherever numpy, zipfile or the decompressor notices
             reason = type(error).__name__
             if isinstance(error, KeyError):
                 reason = error.args[0]

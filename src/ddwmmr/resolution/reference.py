@@ -52,7 +52,10 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
 
     The offset is in the end effector's frame at ``q``: dx along its orientation phiE, dy
     to its left. Newton iterations on the arm's 2x2 position Jacobian; the base does not
-    move. An offset the arm cannot reach raises :class:`ParameterError`.
+    move. Newton may land a joint whole turns away from its limits (th1 = -24.2 rad for
+    an offset of 0.25 m): such a joint is turned back by whole turns into its
+    ``joint_limits`` where that fits (the same arm pose). An offset the arm cannot reach
+    raises :class:`ParameterError`.
     """
     q = np.array(q, dtype=float)
     dx, dy = (float(v) for v in offset)
@@ -62,7 +65,7 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
     for _ in range(50):
         error = target - robot.fk(q)[:2]
         if float(np.hypot(*error)) < 1e-12:
-            return q
+            return _turned_into_limits(robot, q)
         arm_jacobian = robot.jacobian(q)[:2, 3:5]
         if abs(np.linalg.det(arm_jacobian)) < 1e-9:
             break
@@ -71,6 +74,20 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
         f"initial_offset ({dx:g}, {dy:g}) m (end-effector frame) cannot be reached with the "
         "arm alone"
     )
+
+
+def _turned_into_limits(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """``q`` with each arm joint outside its ``joint_limits`` moved by the whole turns
+    that bring it inside, where some do (else left for the start check to refuse); a
+    joint inside is kept to the bit."""
+    for index, (low, high) in zip((3, 4), robot.joint_limits):
+        angle = q[index]
+        if low <= angle <= high:
+            continue
+        turned = angle - 2.0 * math.pi * round((angle - 0.5 * (low + high)) / (2.0 * math.pi))
+        if low <= turned <= high:
+            q[index] = turned
+    return q
 
 
 #: Most RK4 steps one lookup integrates past the end of the reference. A lookup further

@@ -229,7 +229,8 @@ def simulate(
     else:
         q = np.array(check_configuration(q0))
     outside = robot.joints_outside(q)
-    if outside is not None:  # no plant can start there: each would snap the joint inside
+    if outside is not None:  # the kinematic plant would snap it inside, the thesis plant
+        # run outside its limits, MuJoCo refuses it: no plant gives a meaningful run
         where = "q0" if q0 is not None else "the start pose (initial_offset applied)"
         raise ParameterError(f"{where}: {outside}")
     tipped = _tipped_start(robot, q, tipped_start)

@@ -34,7 +34,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, shown, texts_apart
 
 __all__ = [
     "ERROR_LIMIT_M",
@@ -103,8 +103,8 @@ DIVERGED = (
     'the step is too large for the plant or a command was unbounded (see docs/api.md, "Simulation")'
 )
 BELOW_FLOOR = (
-    "the run starts below its stability floor (start S = {start_stability:.3g} < "
-    "stability_min {stability_min:.3g}): tracking yields until S has risen above it, and "
+    "the run starts below its stability floor (start S = {start_stability} < "
+    "stability_min {stability_min}): tracking yields until S has risen above it, and "
     "a floor the arm cannot reach holds it back throughout; lower stability_min or start "
     'above it (see docs/qp.md, "Limitations")'
 )
@@ -215,7 +215,8 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return TIPPED
     start, floor = _number(summary, "start_stability"), _number(summary, "stability_min")
     if start is not None and floor is not None and start < floor:
-        return BELOW_FLOOR.format(start_stability=start, stability_min=floor)
+        start_text, (floor_text,) = texts_apart(start, floor)
+        return BELOW_FLOOR.format(start_stability=start_text, stability_min=floor_text)
     steps = _number(summary, "steps") or 0
     if steps and (_number(summary, "singular_steps") or 0) > SINGULAR_CAUSE * steps:
         return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT

@@ -3,10 +3,10 @@
 CSV format (header required): ``t,x,y`` and optionally ``phi``; times in s strictly
 increasing (spanning a duration of 1e-6 s to 1e9 s, each step at least
 :data:`MIN_STEP_FRACTION` of that duration), positions in m, angles in rad. A ``phi``
-column may wrap at +-pi (as ``atan2`` writes it): it is unwrapped before interpolation
-(:func:`unwrap_phi`). Without ``phi`` the orientation is the direction of travel
-(unwrapped). If the first and last points coincide the path is treated as closed and the
-tangents at the ends are matched (periodic).
+column may wrap at +-pi (as ``atan2`` writes it): a column within [-pi, pi] is unwrapped
+before interpolation (:func:`unwrap_phi`). Without ``phi`` the orientation is the
+direction of travel (unwrapped). If the first and last points coincide the path is
+treated as closed and the tangents at the ends are matched (periodic).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ import numpy as np
 
 from ddwmmr.errors import (
     DURATION_RANGE_S,
+    MAX_ANGLE_RAD,
     MAX_COORDINATE_M,
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
@@ -66,12 +67,12 @@ class SampledTrajectory:
             the duration ``times[-1] - times[0]`` is in [1e-6, 1e9] s and every step is at
             least :data:`MIN_STEP_FRACTION` times it.
         points: (n, 2) positions (m) or (n, 3) poses with orientation phi (rad), world
-            frame, each value finite with magnitude <= 1e6. phi may wrap at +-pi: it is
-            unwrapped (:func:`unwrap_phi`: a step between consecutive rows larger than pi
-            in magnitude is taken the short way round, the first row kept), and
-            :attr:`points`, :meth:`pose` and :meth:`velocity` give the unwrapped,
-            continuous orientation (magnitude <= 1e6 rad after unwrapping too). A phi
-            column without such a step is kept as given, bit for bit.
+            frame, each value finite with magnitude <= 1e6. phi may wrap at +-pi: a
+            column with every angle in [-pi, pi] and a step between consecutive rows
+            larger than pi is unwrapped (:func:`unwrap_phi`: such a step taken the short
+            way round, the first row kept), and :attr:`points`, :meth:`pose` and
+            :meth:`velocity` give the unwrapped, continuous orientation (magnitude <= 1e6
+            rad after unwrapping too). Any other phi column is kept as given, bit for bit.
         name: label used in reports.
 
     Anything else raises :class:`~ddwmmr.errors.ParameterError` naming ``times``,
@@ -296,22 +297,28 @@ def unwrap_phi(points: np.ndarray) -> np.ndarray:
     magnitude is taken the short way round (whole turns added to that row and the
     following ones), the first row kept. Interpolating the jump of a column wrapped at
     +-pi (rows 3.1 then -3.1) would otherwise turn the end effector the long way, a
-    whole turn in one interval. ``points`` without such a step (or without a third
-    column) is returned as it is, so a continuous column keeps its exact bits (adding
-    zero turns would still turn a -0.0 into 0.0). The unwrapped angles must stay within
+    whole turn in one interval. Only a column that looks wrapped is unwrapped, every
+    angle in [-pi, pi]: a column beyond that is continuous already (it may step by more
+    than pi between coarse rows on purpose), and one unwrapped here and read back is not
+    unwrapped again. Any other ``points`` (or without a third column) is returned as it
+    is, keeping its exact bits (adding zero turns would still turn a -0.0 into 0.0). The
+    unwrapped angles must stay within
     the documented 1e6 rad, else :class:`~ddwmmr.errors.ParameterError` naming ``points``."""
     if points.shape[1] != 3:
         return points
     phi = points[:, 2]
-    if not np.any(np.abs(np.diff(phi)) > math.pi):
+    # Only a column that looks wrapped, every angle in [-pi, pi]: one already continuous
+    # may step by more than pi between coarse rows on purpose (a fast spin), and an
+    # unwrapped column read back (csv_text) must not be unwrapped again.
+    if not (np.all(np.abs(phi) <= math.pi) and np.any(np.abs(np.diff(phi)) > math.pi)):
         return points
     unwrapped = points.copy()
     unwrapped[:, 2] = np.unwrap(phi)
     largest = float(np.max(np.abs(unwrapped[:, 2])))
-    if largest > MAX_COORDINATE_M:
+    if largest > MAX_ANGLE_RAD:
         raise ParameterError(
             f"trajectory samples: points phi, unwrapped (each step between rows taken the "
-            f"short way round), must stay within |phi| <= {MAX_COORDINATE_M:g} rad "
+            f"short way round), must stay within |phi| <= {MAX_ANGLE_RAD:g} rad "
             f"(got {largest:g})"
         )
     return unwrapped

@@ -43,6 +43,7 @@ from ddwmmr.plants.kinematic import KinematicPlant
 from ddwmmr.plants.mujoco.model import (
     ACTUATORS,
     MAX_ENGINE_STEPS_PER_CONTROL_STEP,
+    TIMESTEP_RANGE_S,
     TYRE_DAMPING_RATIO,
     EngineOptions,
     build_model,
@@ -479,12 +480,13 @@ class MujocoPlant:
         masses (one line, naming them and the timestep's range)."""
         r = self.robot
         links = ", ".join(f"{m:g}" for m in r.link_masses)
+        low, high = TIMESTEP_RANGE_S
         return (
             f"MuJoCo cannot settle this robot at timestep {self.options.timestep:g} s (its "
             f"state diverged at reset): base_mass {r.base_mass:g} kg, wheel_mass "
-            f"{r.wheel_mass:g} kg, link_masses [{links}] kg, payload {r.payload:g} kg; a "
-            "lighter robot needs a smaller timestep, MujocoPlant(robot, timestep=...) in "
-            "[1e-05, 0.01] s, or heavier parts"
+            f"{r.wheel_mass:g} kg, link_masses [{links}] kg, payload {r.payload:g} kg; give "
+            f"it heavier parts, or (the API) a smaller MujocoPlant(robot, timestep=...) in "
+            f"[{low:g}, {high:g}] s"
         )
 
     def _warning_count(self) -> int:
