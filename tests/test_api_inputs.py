@@ -13,8 +13,8 @@ from ddwmmr import Robot, make_controller, simulate
 from ddwmmr.errors import ParameterError
 from ddwmmr.gains import MAX_GAIN
 from ddwmmr.plants import make_plant
-from ddwmmr.qp.limits import JointLimit
-from ddwmmr.qp.tasks import HeadingTask, PostureTask
+from ddwmmr.qp.limits import JointLimit, Limit
+from ddwmmr.qp.tasks import HeadingTask, PostureTask, Task
 from ddwmmr.trajectories import Ellipse
 
 
@@ -287,3 +287,52 @@ def test_every_gain_is_capped(method, option):
 )
 def test_qp_piece_gains_are_capped(make):
     _refused(lambda: make(1e300), "must be <= 10000 1/s")
+
+
+class _NanError(Task):
+    """A user task (yaw at 0.5 rad/s) whose error turns NaN."""
+
+    name = "spin"
+
+    def compute(self, ctx, jac, error):
+        jac[:] = (0.0, 1.0, 0.0, 0.0)
+        error[0] = math.nan
+
+
+class _NanBound(Limit):
+    """A user limit whose upper bound on w turns NaN."""
+
+    name = "nan bound"
+
+    def compute(self, ctx, G, lower, upper, lb, ub):
+        ub[1] = math.nan
+
+
+class _Conflict(Limit):
+    """A user limit asking v >= 1 and v <= -1: no solution on any step."""
+
+    def compute(self, ctx, G, lower, upper, lb, ub):
+        lb[0], ub[0] = 1.0, -1.0
+
+
+@pytest.mark.parametrize("mode", ["weighted", "hierarchical"])
+def test_a_user_piece_writing_nan_is_one_line_naming_it(mode):
+    ellipse = Ellipse()
+    message = _refused(
+        lambda: simulate(Robot(), ellipse, "qp", duration=0.2, mode=mode, tasks=[_NanError(1.0)]),
+        r"^_NanError 'spin': compute\(\) wrote a non-finite value into its error at t = 0 s",
+    )
+    assert message.endswith("(they must be finite)")
+    _refused(
+        lambda: simulate(Robot(), ellipse, "qp", duration=0.2, mode=mode, limits=[_NanBound()]),
+        r"^_NanBound 'nan bound': compute\(\) wrote a non-finite value into its bounds .*"
+        r"\(they must not be NaN; \+-inf leaves a side open\)$",
+    )
+
+
+def test_limits_in_conflict_name_the_qp_fallback_as_the_cause():
+    result = simulate(Robot(), Ellipse(), "qp", duration=1.0, limits=[_Conflict()])
+    summary = result.summary
+    assert summary["qp_fallbacks"] == summary["steps"] == 50
+    assert max(abs(v) for v in result.timeseries["v"]) == 0.0  # the fallback holds still
+    assert "likely cause: the qp found no solution on 50 of 50 steps" in summary["verdict"]

@@ -42,6 +42,28 @@ EQUALITY = 5
 _OPEN_BOX = (-INF,) * NU + (INF,) * NU
 
 
+def _check_written(piece: Task | Limit, ctx: StepContext, **written) -> None:
+    """Refuse (one-line :class:`ParameterError`) what a piece's ``compute`` wrote that the
+    solver cannot take: NaN anywhere, or an infinite Jacobian, error or constraint row
+    (a bound may be infinite: an open side). Without it the solve fails on every step
+    and the controller's fallback stops the robot with no word of why."""
+    for what, value in written.items():
+        arrays = value if isinstance(value, tuple) else (value,)
+        bad = any(
+            np.isnan(a).any() if what == "bounds" else not np.isfinite(a).all() for a in arrays
+        )
+        if bad:
+            rule = (
+                "must not be NaN; +-inf leaves a side open"
+                if what == "bounds"
+                else "must be finite"
+            )
+            raise ParameterError(
+                f"{type(piece).__name__} {getattr(piece, 'name', '')!r}: compute() wrote a "
+                f"non-finite value into its {what} at t = {ctx.t:g} s (they {rule})"
+            )
+
+
 def _flat(array: np.ndarray) -> memoryview:
     """A flat, writable memoryview of a C-contiguous float array (shares its memory)."""
     flat = array.reshape(-1)
@@ -224,10 +246,12 @@ class QPProblem:
         """The pieces without a compiled writer, through ``compute`` on numpy views."""
         for task, jac, error, jac_w, error_w, column, sqrt_w in self._generic_cost:
             task.compute(ctx, jac, error)
+            _check_written(task, ctx, jacobian=jac, error=error)
             np.multiply(jac, column, out=jac_w)
             np.multiply(error, sqrt_w, out=error_w)
         for task, jac, low, up in self._generic_slack:
             task.compute(ctx, jac, up)
+            _check_written(task, ctx, jacobian=jac, error=up)
             low[:] = up
         box = self.box
         self.lb[:NU] = box[:NU]
@@ -235,6 +259,7 @@ class QPProblem:
         u_lb, u_ub = self.lb[:NU], self.ub[:NU]
         for limit, G, low, up in self._generic_limits:
             limit.compute(ctx, G, low, up, u_lb, u_ub)
+            _check_written(limit, ctx, matrix=G, bounds=(low, up, u_lb, u_ub))
         self.box_ok = bool(np.all(u_lb <= u_ub))
 
     def _weighted_cost(self) -> None:

@@ -108,6 +108,11 @@ BELOW_FLOOR = (
     "a floor the arm cannot reach holds it back throughout; lower stability_min or start "
     'above it (see docs/qp.md, "Limitations")'
 )
+QP_FALLBACK = (
+    "the qp found no solution on {qp_fallbacks} of {steps} steps and held its fallback "
+    "command: its limits conflict (a limit of your own, or a stability floor the start "
+    'cannot meet; see docs/qp.md, "Failure handling")'
+)
 TIPPED = (
     "the payload or the accelerations put the centre of pressure outside the wheels: a "
     "lighter payload, another start pose or a stability floor (stability_min; see "
@@ -142,6 +147,8 @@ NUMBER_KEYS = (
     "rms_position_error_m",
     "min_manipulability",
     "start_stability",
+    "stability_min",
+    "qp_fallbacks",
 )
 #: How a ``summary.json`` spells the non-finite floats (:func:`ddwmmr.sim.result.json_safe`):
 #: a summary read back from one holds these strings where the run held the numbers.
@@ -218,6 +225,9 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         start_text, (floor_text,) = texts_apart(start, floor)
         return BELOW_FLOOR.format(start_stability=start_text, stability_min=floor_text)
     steps = _number(summary, "steps") or 0
+    fallbacks = _number(summary, "qp_fallbacks") or 0
+    if steps and fallbacks > MOST_OF_RUN * steps:
+        return QP_FALLBACK.format(qp_fallbacks=int(fallbacks), steps=int(steps))
     if steps and (_number(summary, "singular_steps") or 0) > SINGULAR_CAUSE * steps:
         return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
     min_manipulability = _number(summary, "min_manipulability")
