@@ -336,3 +336,50 @@ def test_limits_in_conflict_name_the_qp_fallback_as_the_cause():
     assert summary["qp_fallbacks"] == summary["steps"] == 50
     assert max(abs(v) for v in result.timeseries["v"]) == 0.0  # the fallback holds still
     assert "likely cause: the qp found no solution on 50 of 50 steps" in summary["verdict"]
+
+
+class _Raises:
+    """A controller of the user's own that raises in its third step."""
+
+    name = "my-raiser"
+
+    def reset(self, trajectory, q0):
+        self.calls = 0
+
+    def command(self, t, q, pose_d, velocity_d):
+        self.calls += 1
+        if self.calls > 2:
+            raise RuntimeError("boom\n  in my controller")
+        return np.zeros(4)
+
+
+def test_a_controller_that_raises_is_one_line_naming_it_and_the_step():
+    from ddwmmr.errors import PluginError
+
+    with pytest.raises(PluginError) as error:
+        simulate(Robot(), Ellipse(), _Raises(), duration=0.5, integrator="euler")
+    assert str(error.value) == (
+        "method: my-raiser.command() raised RuntimeError: 'boom in my controller' at step 2, "
+        "t = 0.04 s"
+    )
+    assert isinstance(error.value.__cause__, RuntimeError)  # the traceback stays reachable
+
+
+def test_track_prints_a_raising_controller_in_one_line(tmp_path, capsys, registered):
+    from ddwmmr.cli.track import main
+    from ddwmmr.registry import CONTROLLERS
+
+    class Raiser(_Raises):
+        def __init__(self, robot):
+            self.robot = robot
+
+    registered(CONTROLLERS, "my-raiser", Raiser, tasks=("tracking",))
+    out = tmp_path / "run"
+    argv = ["--method", "my-raiser", "--traj", "ellipse", "--duration", "0.5", "--out", str(out)]
+    assert main([*argv, "--no-progress"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == [
+        "error: method: my-raiser.command() raised RuntimeError: 'boom in my controller' at "
+        "step 0, t = 0.01 s"  # the third call: an RK4 stage inside step 0
+    ]
+    assert not out.exists()

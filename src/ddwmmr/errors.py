@@ -62,6 +62,12 @@ class ParameterError(ValueError):
     """A parameter, option or input file is invalid (message: one line, names the parameter)."""
 
 
+class PluginError(RuntimeError):
+    """A controller from outside the library raised while the run called it (message: one
+    line naming it, what it raised, the step and the time; the exception it raised is the
+    ``__cause__``). The command-line tools print the line and exit with status 1."""
+
+
 def check_positive(name: str, value: float) -> float:
     """Return ``value`` as float if it is finite and > 0, else raise :class:`ParameterError`."""
     value = _as_float(name, value, "> 0")

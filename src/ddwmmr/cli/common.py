@@ -24,7 +24,7 @@ import sys
 import threading
 from collections.abc import Callable, Iterator, Sequence
 
-from ddwmmr.errors import ParameterError, did_you_mean, shown
+from ddwmmr.errors import ParameterError, PluginError, did_you_mean, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import check_output_folder, first_free, output_folder, package_version
 
@@ -214,6 +214,9 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
     except ParameterError as exc:
         _say(f"error: {exc}")
         return EXIT_USAGE
+    except PluginError as exc:  # a user's controller raised: its one line, not a traceback
+        _say(f"error: {exc}")
+        return 1
     except KeyboardInterrupt:
         _say("interrupted (Ctrl-C): stopped; unfinished output removed")
         return EXIT_INTERRUPTED

@@ -13,7 +13,7 @@ import threading
 from collections.abc import Callable
 from typing import Any
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, PluginError
 
 #: A job: called with a progress callback ``progress(part, step, steps)``; returns a value.
 Job = Callable[[Callable[[int, int, int], None]], Any]
@@ -116,6 +116,8 @@ class Worker:
         except ParameterError as exc:
             self.bad_input = True
             self._finish("failed", error=str(exc))
+        except PluginError as exc:  # a user's controller raised: the line says so
+            self._finish("failed", error=f"run failed: {exc}")
         except Exception as exc:  # the window shows it; the app must not die
             self._finish("failed", error=f"run failed: {type(exc).__name__}: {exc}")
         else:

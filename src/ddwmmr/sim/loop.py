@@ -63,7 +63,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
-from ddwmmr.errors import ParameterError, float_values, shown
+from ddwmmr.errors import ParameterError, PluginError, float_values, shown
 from ddwmmr.inheritance import defining_class, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 
@@ -215,6 +215,22 @@ def checked_command(command: Any, force: bool, controller: Any, k: int, t: float
     )
 
 
+def controller_raised(controller: Any, error: Exception, k: int, t: float) -> Exception:
+    """What a run raises when ``controller.command`` raised ``error`` at step ``k`` (time
+    ``t`` s): a :class:`ParameterError` (bad input, already one line naming it) or a
+    :class:`PluginError` from the library's own checks as it is, anything else wrapped in
+    a one-line :class:`PluginError` naming the controller, what it raised and where."""
+    if isinstance(error, ParameterError | PluginError):
+        return error
+    name = getattr(controller, "name", None)
+    name = name if isinstance(name, str) else type(controller).__name__
+    text = " ".join(str(error).split()) or "(no message)"
+    return PluginError(
+        f"method: {name}.command() raised {type(error).__name__}: {shown(text, 120)} at step "
+        f"{k}, t = {t:g} s"
+    )
+
+
 def stage_law(controller: Any) -> Callable[..., Any] | None:
     """The controller's ``law`` if the integrator may call it at its stages, else None.
 
@@ -265,7 +281,10 @@ def run_loop(
     def policy(t: float, q: list[float]) -> np.ndarray:
         """The closed-loop law at an integrator stage (not recorded)."""
         pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
-        command = command_of(t, np.array(q), pose_d, velocity_d)
+        try:
+            command = command_of(t, np.array(q), pose_d, velocity_d)
+        except Exception as error:
+            raise controller_raised(controller, error, k, t) from error
         return checked_command(command, False, controller, k, t)
 
     def law_policy(t: float, q: list[float]) -> tuple[float, ...]:
@@ -302,7 +321,7 @@ def run_loop(
         except Exception as error:
             if task.controller_error(k, error):
                 return LoopEnd(k, "controller_error")
-            raise
+            raise controller_raised(controller, error, k, t) from error
         info = getattr(controller, "last", _NO_INFO)
         if force:
             applied, saturated = command, False
