@@ -653,3 +653,30 @@ def test_a_start_outside_the_robots_joint_limits_is_one_line(tmp_path, capsys):
     )
     assert not out.exists()
     assert run([*argv, "--offset", "0", "0", "--duration", "0.2", "--no-plots"]) == 0
+
+
+def test_qp_mode_is_the_qps_even_where_a_plug_in_has_a_mode(tmp_path, capsys, registered):
+    from ddwmmr.registry import CONTROLLERS
+
+    class Moded:
+        """A plug-in controller with an option of its own called mode."""
+
+        def __init__(self, robot, mode="shape"):
+            self.robot, self.mode = robot, mode
+
+        def reset(self, trajectory, q0):
+            pass
+
+        def command(self, t, q, pose_d, velocity_d):
+            return np.zeros(4)
+
+    registered(CONTROLLERS, "moded", Moded, tasks=("tracking",))
+    out = str(tmp_path / "o")
+    argv = ["--method", "moded", "--traj", "ellipse", "--qp-mode", "hierarchical", "--out", out]
+    assert run(argv) == 2
+    assert capsys.readouterr().err == (
+        "error: qp-mode: --qp-mode is taken only by --method qp (got --method moded)\n"
+    )
+    with pytest.raises(SystemExit):
+        run(["--help"])
+    assert "priority handling (default weighted) [qp]\n" in capsys.readouterr().out

@@ -130,9 +130,20 @@ METHOD_OPTIONS = {
 }
 
 
-def _methods_taking(keyword: str) -> list[str]:
-    """Registered methods whose options include the controller keyword ``keyword``."""
-    return [m for m in available_methods() if keyword in method_options(m)]
+#: Flags named for one method: only it takes them, whatever other controller (a plug-in's)
+#: has a keyword of the same name (a plug-in's own ``mode`` is not the qp's).
+FLAG_METHODS = {"qp_mode": ("qp",)}
+
+
+def _methods_taking(keyword: str, attribute: str | None = None) -> list[str]:
+    """Registered methods whose options include the controller keyword ``keyword`` (and,
+    for a flag of :data:`FLAG_METHODS`, ``attribute``, only its methods)."""
+    only = FLAG_METHODS.get(attribute or "")
+    return [
+        m
+        for m in available_methods()
+        if keyword in method_options(m) and (only is None or m in only)
+    ]
 
 
 def _either(names: Sequence[str]) -> str:
@@ -140,10 +151,15 @@ def _either(names: Sequence[str]) -> str:
     return " or ".join([", ".join(names[:-1]), names[-1]] if len(names) > 1 else names)
 
 
-def _option_help(text: str, keyword: str, default: str | None = None) -> str:
+def _option_help(
+    text: str, keyword: str, default: str | None = None, attribute: str | None = None
+) -> str:
     """``text`` with the default of each method taking ``keyword`` (or ``default``, for
-    an option whose signature has None: chosen when the run starts) and those methods."""
-    defaults = {m: _default_text(method_options(m)[keyword]) for m in _methods_taking(keyword)}
+    an option whose signature has None: chosen when the run starts) and those methods
+    (``attribute``: the flag, for :data:`FLAG_METHODS`)."""
+    defaults = {
+        m: _default_text(method_options(m)[keyword]) for m in _methods_taking(keyword, attribute)
+    }
     if default is not None:
         return f"{text} (default {default}) [{', '.join(defaults)}]"
     if len(set(defaults.values())) == 1:
@@ -295,7 +311,7 @@ def build_parser() -> ArgumentParser:
     qp.add_argument(
         "--qp-mode",
         choices=("weighted", "hierarchical"),
-        help=_option_help("priority handling", "mode"),
+        help=_option_help("priority handling", "mode", attribute="qp_mode"),
     )
     qp.add_argument(
         "--horizon",
@@ -330,11 +346,12 @@ def controller_options(args: argparse.Namespace) -> dict[str, Any]:
         value = getattr(args, attribute)
         if value is None:
             continue
-        if keyword not in method_options(args.method):
+        takers = _methods_taking(keyword, attribute)
+        if args.method not in takers:
             flag = "--" + attribute.replace("_", "-")
             raise ParameterError(
                 f"{flag[2:]}: {flag} is taken only by --method "
-                f"{_either(_methods_taking(keyword)) or '(none)'} (got --method {args.method})"
+                f"{_either(takers) or '(none)'} (got --method {args.method})"
             )
         if attribute == "tau" and len(value) == 1:
             value = value[0]
