@@ -179,7 +179,8 @@ def build_parser() -> ArgumentParser:
         type=int,
         default=DEFAULT_JOBS,
         metavar="N",
-        help=f"parallel worker processes (default {DEFAULT_JOBS}: the CPUs, at most 8)",
+        help=f"parallel worker processes, 1 to {MAX_JOBS} (default {DEFAULT_JOBS}: the "
+        "CPUs, at most 8)",
     )
     parser.add_argument(
         "--study",
