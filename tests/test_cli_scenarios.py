@@ -272,3 +272,14 @@ def test_a_bounds_ratio_without_a_scenario_says_why(tmp_path, tmp_path_factory, 
     why = "to the best-known time none (no successful scenario has a best-known time in the "
     assert why in out
     assert "mean ratio to the lower bound " in out
+
+
+def test_the_console_counts_why_scenarios_did_not_finish():
+    from ddwmmr.cli.scenarios import failure_line
+
+    assert failure_line({"n": 3, "failed": 0, "failures": []}) == ""
+    failures = [{"reason": r} for r in ("timeout", "tipped", "timeout", "a", "b")]
+    assert failure_line({"n": 9, "failed": 5, "failures": failures}) == (
+        "scenarios: 5 of 9 did not finish: 'timeout' x2, 'tipped' x1, 'a' x1 and 1 more "
+        "(each in scenarios.csv)"
+    )

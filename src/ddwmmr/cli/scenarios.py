@@ -22,6 +22,7 @@ import math
 import sys
 import textwrap
 import time
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import asdict, astuple, replace
 from pathlib import Path
@@ -54,6 +55,7 @@ from ddwmmr.errors import (
     check_nonnegative,
     check_range,
     check_step_count,
+    shown,
     texts_apart,
 )
 from ddwmmr.model import Robot
@@ -588,7 +590,24 @@ def write_batch(
     _figures(folder, scenarios, outcomes, config, progress)
     write_atomic(folder / MARKER, json.dumps(json_safe(summary), indent=2) + "\n")
     print(table, end="")
+    failures = failure_line(summary)
+    if failures:
+        print(failures)
     return summary
+
+
+def failure_line(summary: dict[str, Any]) -> str:
+    """ "" if every scenario finished, else one line counting why the others did not (the
+    table's means would otherwise hide, say, a controller that raised in every one)."""
+    reasons = Counter(str(f["reason"]) for f in summary.get("failures", ()))
+    if not reasons:
+        return ""
+    listed = ", ".join(f"{shown(reason, 80)} x{count}" for reason, count in reasons.most_common(3))
+    more = f" and {len(reasons) - 3} more" if len(reasons) > 3 else ""
+    return (
+        f"scenarios: {summary['failed']} of {summary['n']} did not finish: {listed}{more} "
+        "(each in scenarios.csv)"
+    )
 
 
 def _figures(folder: Path, scenarios, outcomes, config: RunConfig, progress: bool) -> None:
