@@ -3,6 +3,7 @@ status 2, nothing written), as the other tools refuse it."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -45,3 +46,11 @@ def test_a_payload_that_tips_the_start_pose_is_refused_as_scenarios_refuses_it(
     assert scenarios(["--payload", "20", "--out", str(tmp_path / "s")]) == 2
     assert capsys.readouterr().err == err  # the same check, the same line
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_summary_line_counts_one_scenario_in_the_singular():
+    from ddwmmr.cli.bounds import summary_line
+
+    summary = {"mean_lower_bound_s": 11.0, "replay_ok": 0, "mean_best_known_s": math.nan}
+    assert summary_line(1, summary).startswith("1 scenario: lower bound 11.00 s, no best-known")
+    assert summary_line(2, summary).startswith("2 scenarios: lower bound 11.00 s")

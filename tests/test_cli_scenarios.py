@@ -283,3 +283,13 @@ def test_the_console_counts_why_scenarios_did_not_finish():
         "scenarios: 5 of 9 did not finish: 'timeout' x2, 'tipped' x1, 'a' x1 and 1 more "
         "(each in scenarios.csv)"
     )
+
+
+def test_a_bounds_file_covering_part_of_the_run_says_over_how_many(
+    tmp_path, tmp_path_factory, capsys
+):
+    path = _bounds_file(tmp_path_factory.mktemp("bounds"), BOUNDS_HEADER, ["1,10,12,True"])
+    argv = ["--n", "2", "--no-progress", "--out", str(tmp_path / "r"), "--bounds", path]
+    assert cli(argv) == 0
+    (line,) = [x for x in capsys.readouterr().out.splitlines() if x.startswith("mean ratio")]
+    assert line.count("(over 1 of 2)") == 2

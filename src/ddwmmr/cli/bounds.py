@@ -207,7 +207,8 @@ def _main(argv: Sequence[str] | None = None) -> int:
 def summary_line(count: int, summary: dict) -> str:
     """The one line the tool prints: the means, and the bracket where both ends are known
     (``--lower-only`` leaves the best-known times to a later run)."""
-    line = f"{count} scenarios: lower bound {summary['mean_lower_bound_s']:.2f} s"
+    scenarios = "1 scenario" if count == 1 else f"{count} scenarios"
+    line = f"{scenarios}: lower bound {summary['mean_lower_bound_s']:.2f} s"
     if summary["replay_ok"] == 0 or not math.isfinite(summary["mean_best_known_s"]):
         return line + ", no best-known time yet (run without --lower-only for them)"
     return line + (

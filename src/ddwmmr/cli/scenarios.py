@@ -669,7 +669,7 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     if args.bounds_table is not None:
-        print(_bracket_line(summary["bracket"], args.bounds))
+        print(_bracket_line(summary["bracket"], args.bounds, len(outcomes)))
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
@@ -678,20 +678,20 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     )
 
 
-def _bracket_line(b: dict[str, Any], bounds: str) -> str:
-    """The printed line of ``--bounds``: both mean ratios, each with why it is missing (no
-    successful scenario with that end of its bracket) instead of a bare nan."""
+def _bracket_line(b: dict[str, Any], bounds: str, n: int) -> str:
+    """The printed line of ``--bounds``: both mean ratios, each with how many of the ``n``
+    scenarios it covers when not all (failed ones, or ones the file lacks), or why it is
+    missing (no successful scenario with that end of its bracket) instead of a bare nan."""
     parts = []
     for end, key, count in (
         ("lower bound", "mean_ratio_to_lower_bound", "scenarios_with_lower_bound"),
         ("best-known time", "mean_ratio_to_best_known", "scenarios_with_best_known"),
     ):
-        ratio = b[key]
-        parts.append(
-            f"{ratio:.3f}"
-            if b[count] and math.isfinite(ratio)
-            else f"none (no successful scenario has a {end} in the file)"
-        )
+        ratio, covered = b[key], b[count]
+        if covered and math.isfinite(ratio):
+            parts.append(f"{ratio:.3f}" + (f" (over {covered} of {n})" if covered < n else ""))
+        else:
+            parts.append(f"none (no successful scenario has a {end} in the file)")
     return f"mean ratio to the lower bound {parts[0]}, to the best-known time {parts[1]} ({bounds})"
 
 
