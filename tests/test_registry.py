@@ -239,3 +239,35 @@ def test_a_plug_in_that_cannot_be_imported_is_one_line():
         "error: DDWMMR_PLUGINS: cannot import plug-in module 'no_such_plugin' "
         "(No module named 'no_such_plugin')"
     ]
+
+
+def test_an_arbiter_plug_in_without_the_thresholds_is_refused_in_one_line(registered):
+    from types import SimpleNamespace
+
+    from ddwmmr.arbiters.factory import make_arbiter
+
+    class NoThresholds:
+        def __init__(self):
+            pass
+
+        def reset(self):
+            pass
+
+        def select(self, p, behaviours):
+            return None
+
+    class Anything(NoThresholds):
+        def __init__(self, **options):
+            self.options = options
+
+    registered(ARBITERS, "no-thresholds", NoThresholds)
+    registered(ARBITERS, "anything", Anything)
+    config = SimpleNamespace(stability=(1.5, 2.0), manipulability=(0.3, 0.5), arbiter_seed=0)
+    with pytest.raises(ParameterError) as error:
+        make_arbiter(SimpleNamespace(**vars(config), arbiter="no-thresholds"))
+    assert str(error.value) == (
+        "arbiter no-thresholds: its constructor must take the keyword arguments stability "
+        "and manipulability (ddwmmr.arbiters.Hysteresis thresholds; lacks stability)"
+    )
+    made = make_arbiter(SimpleNamespace(**vars(config), arbiter="anything"))
+    assert set(made.options) == {"stability", "manipulability"}  # **options take them

@@ -61,6 +61,14 @@ def make_arbiter(config: Any) -> Any:
         "stability": Hysteresis(*config.stability),
         "manipulability": Hysteresis(*config.manipulability),
     }
-    if "seed" in inspect.signature(cls).parameters:
+    parameters = inspect.signature(cls).parameters
+    any_keyword = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters.values())
+    missing = [name for name in options if name not in parameters and not any_keyword]
+    if missing:  # a plug-in's constructor: say what the interface passes, not a TypeError
+        raise ParameterError(
+            f"arbiter {arbiter}: its constructor must take the keyword arguments stability "
+            f"and manipulability (ddwmmr.arbiters.Hysteresis thresholds; lacks {missing[0]})"
+        )
+    if "seed" in parameters:
         options["seed"] = config.arbiter_seed
     return cls(**options)
