@@ -13,6 +13,7 @@ from ddwmmr import Robot, make_controller, simulate
 from ddwmmr.errors import ParameterError
 from ddwmmr.gains import MAX_GAIN
 from ddwmmr.plants import make_plant
+from ddwmmr.plants.base import Observation
 from ddwmmr.qp.limits import JointLimit, Limit
 from ddwmmr.qp.tasks import HeadingTask, PostureTask, Task
 from ddwmmr.trajectories import Ellipse
@@ -383,3 +384,35 @@ def test_track_prints_a_raising_controller_in_one_line(tmp_path, capsys, registe
         "step 0, t = 0.01 s"  # the third call: an RK4 stage inside step 0
     ]
     assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("observed", "got"),
+    [
+        (lambda q: Observation(q[:4], 0.0, 0.0), "got Observation(q=[1.8"),  # 4 numbers
+        (lambda q: Observation(q, math.nan, 0.0), "got Observation(q=[1.8"),
+        (lambda q: tuple(q), "got (1.8"),  # not an Observation
+    ],
+)
+def test_a_plant_observing_nonsense_is_one_line_naming_it(observed, got):
+    from ddwmmr.plants.kinematic import KinematicPlant
+
+    class Odd(KinematicPlant):
+        name = "odd"
+
+        def observe(self):
+            real = super().observe()
+            return observed(tuple(real.values)) if self.steps_taken else real
+
+        def step(self, t, command, dt, policy=None):
+            self.steps_taken = True
+            super().step(t, command, dt, policy)
+
+        steps_taken = False
+
+    message = _refused(
+        lambda: simulate(Robot(), Ellipse(), "ats", duration=0.2, plant=Odd(Robot())),
+        r"^plant: odd\.observe\(\) must return an Observation\(q, v, w\) of 5 \+ 2 finite "
+        r"numbers \(got ",
+    )
+    assert got in message and "at step 1, t = 0.02 s" in message

@@ -80,6 +80,17 @@ class Observation:
             values = self._values = tuple(np.asarray(self._q, dtype=float).tolist())
         return values
 
+    def finite(self) -> bool:
+        """Whether ``q``, ``v`` and ``w`` are 5 + 2 finite numbers (one sum on the common
+        path: a plant's own state is finite unless it blew up)."""
+        try:
+            if self._values is not None:
+                return len(self._values) == 5 and math.isfinite(sum(self._values) + self.v + self.w)
+            q = np.asarray(self._q, dtype=float)
+            return q.shape == (5,) and math.isfinite(float(q.sum()) + self.v + self.w)
+        except (TypeError, ValueError, OverflowError):  # text, None, an integer too large
+            return False
+
     def __repr__(self) -> str:
         return f"Observation(q={list(self.values)!r}, v={self.v!r}, w={self.w!r})"
 

@@ -215,6 +215,23 @@ def checked_command(command: Any, force: bool, controller: Any, k: int, t: float
     )
 
 
+def checked_observation(plant: Plant, k: int, t: float) -> Observation:
+    """``plant.observe()`` at step ``k`` (time ``t`` s) if it is an :class:`Observation` of
+    finite numbers, else a one-line :class:`ParameterError` naming the plant: a plant whose
+    state blows up raises :class:`PlantDivergedError` from ``step`` (the run then stops
+    there and says so); a NaN observed would surface later as the controller's bad ``q``."""
+    obs = plant.observe()
+    if isinstance(obs, Observation) and obs.finite():
+        return obs
+    name = getattr(plant, "name", None)
+    name = name if isinstance(name, str) else type(plant).__name__
+    wanted = "an Observation(q, v, w) of 5 + 2 finite numbers"
+    raise ParameterError(
+        f"plant: {name}.observe() must return {wanted} (got {shown(obs, 80)} at step {k}, "
+        f"t = {t:g} s; a plant whose state blows up raises PlantDivergedError in step())"
+    )
+
+
 def controller_raised(controller: Any, error: Exception, k: int, t: float) -> Exception:
     """What a run raises when ``controller.command`` raised ``error`` at step ``k`` (time
     ``t`` s): a :class:`ParameterError` (bad input, already one line naming it) or a
@@ -301,7 +318,7 @@ def run_loop(
     stage_policy = None
     if not (force or getattr(controller, "zero_order_hold", False)):
         stage_policy = policy if law is None else law_policy
-    obs = plant.observe()
+    obs = checked_observation(plant, 0, 0.0)
     if task.start(obs):
         return LoopEnd(0, "start")
     for k in range(steps + 1):
@@ -335,7 +352,7 @@ def run_loop(
         except PlantDivergedError as error:
             task.diverged(k, error)
             return LoopEnd(k + 1, "diverged")
-        obs = plant.observe()
+        obs = checked_observation(plant, k + 1, t + dt)
         if task.after_step(k, t, obs, applied):
             return LoopEnd(k + 1, "failed")
         if progress is not None:
