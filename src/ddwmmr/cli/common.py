@@ -24,6 +24,7 @@ import sys
 import threading
 from collections.abc import Callable, Iterator, Sequence
 
+from ddwmmr import interrupts
 from ddwmmr.errors import ParameterError, PluginError, did_you_mean, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import check_output_folder, first_free, output_folder, package_version
@@ -196,12 +197,15 @@ def interruptible() -> Iterator[None]:
         for number in handled:  # one signal is enough
             signal.signal(number, signal.SIG_IGN)
         stop_workers()
-        raise KeyboardInterrupt if signum == signal.SIGINT else Terminated(signum)
+        stop = KeyboardInterrupt() if signum == signal.SIGINT else Terminated(signum)
+        interrupts.record(stop)  # a solver in C may swallow what is raised here
+        raise stop
 
     previous = {s: signal.signal(s, handle) for s in handled}
     try:
         yield
     finally:
+        interrupts.clear()
         for number, handler in previous.items():
             signal.signal(number, handler)
 

@@ -48,6 +48,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from ddwmmr import interrupts
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
@@ -387,6 +388,7 @@ class FreeTimeOCP:
             lbg=self.lbg if lbg is None else lbg,
             ubg=self.ubg if ubg is None else ubg,
         )
+        interrupts.raise_pending()  # IPOPT let a Ctrl-C or SIGTERM through as a warning
         stats = self.solver.stats()
         success = bool(stats.get("success", False))
         w = np.asarray(solution["x"], dtype=float).ravel()

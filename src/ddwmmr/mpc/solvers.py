@@ -29,6 +29,7 @@ from typing import Any
 import casadi as ca
 import numpy as np
 
+from ddwmmr import interrupts
 from ddwmmr.errors import ParameterError, shown
 from ddwmmr.mpc.ocp import ShootingOCP
 
@@ -327,7 +328,9 @@ class NLPSolver:
         try:
             solution = self._solver(**args)
         except RuntimeError as error:  # CasADi reports solver exceptions this way
+            interrupts.raise_pending()  # ... and an interrupt during the solve too
             raise SolverFailure(f"{self.name}: {str(error).splitlines()[-1]}") from None
+        interrupts.raise_pending()
         stats = self._solver.stats()
         self.last_iterations = int(stats.get("iter_count", 0))
         if not stats.get("success", False):
