@@ -50,6 +50,7 @@ from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
     MAX_SCENARIOS,
+    MAX_STEPS,
     ParameterError,
     check_int_at_least,
     check_nonnegative,
@@ -177,8 +178,8 @@ def build_parser() -> ArgumentParser:
         type=int,
         default=None,
         metavar="N",
-        help="noise seed of the competitive arbiter (--arbiter competitive or --study "
-        "arbiters; default: 0)",
+        help="noise seed of the competitive arbiter, an integer >= 0 (--arbiter competitive "
+        "or --study arbiters; default: 0)",
     )
     parser.add_argument(
         "--plant",
@@ -196,7 +197,9 @@ def build_parser() -> ArgumentParser:
         help=f"number of scenarios (default: 100, at most {MAX_SCENARIOS}; --study obstacles "
         "always runs the thesis's scenarios 1, 3, 7 and 10)",
     )
-    parser.add_argument("--seed", type=int, default=0, help="generator seed (default: 0)")
+    parser.add_argument(
+        "--seed", type=int, default=0, help="generator seed, an integer >= 0 (default: 0)"
+    )
     parser.add_argument(
         "--out",
         metavar="DIR",
@@ -210,7 +213,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=3.0,
         metavar="KG",
-        help="end-effector payload in kg (default: 3.0; thesis: 1.25)",
+        help="end-effector payload in kg, >= 0 and light enough that the start pose stands "
+        "(S > 1) (default: 3.0; thesis: 1.25)",
     )
     parser.add_argument(
         "--stability",
@@ -218,7 +222,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar=("ENTER", "EXIT"),
-        help="thesis controller's stability thresholds: enter below ENTER, leave at EXIT "
+        help="thesis controller's stability thresholds: enter below ENTER, leave at EXIT, "
+        f"ENTER <= EXIT, both in (0, {THRESHOLD_RANGES['stability']:g}] "
         f"(default: {THESIS_STABILITY.enter:.2f} {THESIS_STABILITY.exit:.2f})",
     )
     parser.add_argument(
@@ -227,7 +232,8 @@ def build_parser() -> ArgumentParser:
         type=float,
         default=None,
         metavar=("ENTER", "EXIT"),
-        help="thesis controller's manipulability thresholds "
+        help="thesis controller's manipulability thresholds, ENTER <= EXIT, both in "
+        f"(0, {THRESHOLD_RANGES['manipulability']:g}] "
         f"(default: {THESIS_MANIPULABILITY.enter:.2f} {THESIS_MANIPULABILITY.exit:.2f})",
     )
     parser.add_argument(
@@ -247,8 +253,8 @@ def build_parser() -> ArgumentParser:
         "--time-limit",
         type=float,
         metavar="S",
-        help=f"time limit per scenario in s (default: {TIME_LIMIT_S:g}, "
-        f"{OBSTACLE_TIME_LIMIT_S:g} with obstacles)",
+        help=f"time limit per scenario in s, > 0, at most {MAX_STEPS:g} steps of --dt (default: "
+        f"{TIME_LIMIT_S:g}, {OBSTACLE_TIME_LIMIT_S:g} with obstacles)",
     )
     parser.add_argument(
         "--dt",
@@ -259,7 +265,10 @@ def build_parser() -> ArgumentParser:
         "controller's sample time)",
     )
     parser.add_argument(
-        "--jobs", type=int, metavar="N", help="worker processes (default: the CPUs available)"
+        "--jobs",
+        type=int,
+        metavar="N",
+        help=f"worker processes, 1 to {MAX_JOBS} (default: the CPUs available)",
     )
     parser.add_argument(
         "--executor",
