@@ -326,8 +326,8 @@ def test_a_user_piece_writing_nan_is_one_line_naming_it(mode):
     assert message.endswith("(they must be finite)")
     _refused(
         lambda: simulate(Robot(), ellipse, "qp", duration=0.2, mode=mode, limits=[_NanBound()]),
-        r"^_NanBound 'nan bound': compute\(\) wrote a non-finite value into its bounds .*"
-        r"\(they must not be NaN; \+-inf leaves a side open\)$",
+        r"^limits: a compute\(\) of 'nan bound' wrote a NaN into the input box lb, ub at "
+        r"t = 0 s \(bounds must not be NaN; \+-inf leaves a side open\)$",
     )
 
 
@@ -416,3 +416,45 @@ def test_a_plant_observing_nonsense_is_one_line_naming_it(observed, got):
         r"numbers \(got ",
     )
     assert got in message and "at step 1, t = 0.02 s" in message
+
+
+class _LawRaises:
+    """A controller of the user's own whose float-level law raises at the RK4 stages."""
+
+    name = "my-law"
+
+    def reset(self, trajectory, q0):
+        pass
+
+    def command(self, t, q, pose_d, velocity_d):
+        return np.zeros(4)
+
+    def law(self, t, q, pose_d, velocity_d):
+        raise RuntimeError("boom in law")
+
+
+def test_a_raising_law_is_named_as_the_law():
+    from ddwmmr.errors import PluginError
+
+    with pytest.raises(PluginError, match=r"^method: my-law\.law\(\) raised RuntimeError: "):
+        simulate(Robot(), Ellipse(), _LawRaises(), duration=0.1)
+
+
+def test_a_bug_in_a_library_controller_keeps_its_own_traceback(monkeypatch):
+    """Only a controller from outside the library is wrapped in a PluginError: an error
+    in one of ours propagates as it is, traceback and all."""
+    from ddwmmr.qp.controller import QPController
+
+    def broken(self, ctx):
+        raise IndexError("list index out of range")
+
+    monkeypatch.setattr(QPController, "_solve", broken)
+    with pytest.raises(IndexError) as error:
+        simulate(Robot(), Ellipse(), "qp", duration=0.1)
+    assert any(frame.name == "broken" for frame in error.traceback)
+
+
+def test_a_parameter_error_from_a_controller_is_not_its_own_cause():
+    with pytest.raises(ParameterError) as error:
+        simulate(Robot(), Ellipse(), "qp", duration=0.2, tasks=[_NanError(1.0)])
+    assert error.value.__cause__ is not error.value

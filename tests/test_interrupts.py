@@ -8,7 +8,15 @@ import pytest
 
 from ddwmmr import interrupts
 from ddwmmr.bounds import diffdrive
+from ddwmmr.cli import common
 from ddwmmr.cli.common import Terminated, interruptible
+
+
+@pytest.fixture(autouse=True)
+def nothing_pending():
+    """No interrupt a test recorded outlives it (the next solve would raise it)."""
+    yield
+    interrupts.clear()
 
 
 def test_a_recorded_interrupt_is_raised_once_and_clear_drops_it():
@@ -34,7 +42,9 @@ def test_the_minimum_time_solve_raises_an_interrupt_that_came_during_it():
     assert np.isfinite(diffdrive.ocp_time((0.0, 0.0, 0.0), goal, **wheels))  # raised once
 
 
-def test_the_tools_handler_records_what_it_raises():
+def test_the_tools_handler_records_what_it_raises(monkeypatch):
+    # the handler stops the tool's workers (and silences their loggers): not this process's
+    monkeypatch.setattr(common, "stop_workers", lambda: None)
     with interruptible(), pytest.raises(Terminated):
         signal.raise_signal(signal.SIGTERM)
     # the handler recorded it too, and leaving the context dropped it
@@ -44,3 +54,21 @@ def test_the_tools_handler_records_what_it_raises():
             signal.raise_signal(signal.SIGINT)
         with pytest.raises(KeyboardInterrupt):  # what a solver would have swallowed
             interrupts.raise_pending()
+
+
+def test_a_run_stops_at_the_next_step_after_a_swallowed_interrupt():
+    """An interrupt recorded during a step (as one the mpc's QP solver swallowed would be)
+    stops the run at the start of the next step."""
+    from ddwmmr import Robot, simulate
+    from ddwmmr.trajectories import Ellipse
+
+    steps = []
+
+    def progress(k, total):
+        steps.append(k)
+        if k == 3:
+            interrupts.record(KeyboardInterrupt())
+
+    with pytest.raises(KeyboardInterrupt):
+        simulate(Robot(), Ellipse(), "ats", duration=1.0, progress=progress)
+    assert steps == [1, 2, 3]

@@ -75,7 +75,9 @@ def build_parser() -> ArgumentParser:
         epilog=EPILOG,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--seed", type=int, default=0, help="generator seed (default: 0)")
+    parser.add_argument(
+        "--seed", type=int, default=0, help="generator seed, an integer >= 0 (default: 0)"
+    )
     parser.add_argument(
         "--scenarios",
         default="1-100",
@@ -83,7 +85,10 @@ def build_parser() -> ArgumentParser:
         help="scenarios, numbered from 1: '1-100', '7', '1,3,7-9' (default: 1-100)",
     )
     parser.add_argument(
-        "--jobs", type=int, metavar="N", help="worker processes (default: the CPUs available)"
+        "--jobs",
+        type=int,
+        metavar="N",
+        help=f"worker processes, 1 to {MAX_JOBS} (default: the CPUs available)",
     )
     parser.add_argument(
         "--out",

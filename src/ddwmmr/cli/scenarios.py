@@ -253,7 +253,7 @@ def build_parser() -> ArgumentParser:
         "--time-limit",
         type=float,
         metavar="S",
-        help=f"time limit per scenario in s, > 0, at most {MAX_STEPS:g} steps of --dt (default: "
+        help=f"time limit per scenario in s, > 0, at most {MAX_STEPS:,} steps of --dt (default: "
         f"{TIME_LIMIT_S:g}, {OBSTACLE_TIME_LIMIT_S:g} with obstacles)",
     )
     parser.add_argument(

@@ -201,7 +201,9 @@ class GaussNewtonSQP:
                 np.subtract(ubw, w, out=buffers.ubx)
                 buffers.solve_qp()
             except RuntimeError as error:  # CasADi reports solver exceptions this way
+                interrupts.raise_pending()  # ... and an interrupt during the solve too
                 raise SolverFailure(f"{self.qp_solver}: {str(error).splitlines()[-1]}") from None
+            interrupts.raise_pending()
             self._check()
             d = buffers.step
             if not np.all(np.isfinite(d)):

@@ -24,6 +24,7 @@ the state changes.
 
 from __future__ import annotations
 
+import contextlib
 import math
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
@@ -85,14 +86,24 @@ class Observation:
         path: a plant's own state is finite unless it blew up)."""
         try:
             if self._values is not None:
-                return len(self._values) == 5 and math.isfinite(sum(self._values) + self.v + self.w)
-            q = np.asarray(self._q, dtype=float)
-            return q.shape == (5,) and math.isfinite(float(q.sum()) + self.v + self.w)
+                if len(self._values) == 5 and math.isfinite(sum(self._values) + self.v + self.w):
+                    return True
+            elif np.shape(self._q) == (5,):
+                with np.errstate(over="ignore", invalid="ignore"):
+                    total = float(np.sum(self._q))
+                if math.isfinite(total + self.v + self.w):
+                    return True
+            # a sum that overflows (1e308 twice) may still be of finite numbers: one by one
+            numbers = [*np.asarray(self._values or self._q, dtype=float).tolist(), self.v, self.w]
+            return len(numbers) == 7 and all(map(math.isfinite, numbers))
         except (TypeError, ValueError, OverflowError):  # text, None, an integer too large
             return False
 
     def __repr__(self) -> str:
-        return f"Observation(q={list(self.values)!r}, v={self.v!r}, w={self.w!r})"
+        q = self._values if self._values is not None else self._q
+        with contextlib.suppress(TypeError, ValueError, OverflowError):  # else as given
+            q = [float(x) for x in q]
+        return f"Observation(q={q!r}, v={self.v!r}, w={self.w!r})"
 
 
 class PlantDivergedError(RuntimeError):

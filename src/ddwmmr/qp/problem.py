@@ -42,11 +42,10 @@ EQUALITY = 5
 _OPEN_BOX = (-INF,) * NU + (INF,) * NU
 
 
-def _check_written(piece: Task | Limit, ctx: StepContext, **written) -> None:
-    """Refuse (one-line :class:`ParameterError`) what a piece's ``compute`` wrote that the
-    solver cannot take: NaN anywhere, or an infinite Jacobian, error or constraint row
-    (a bound may be infinite: an open side). Without it the solve fails on every step
-    and the controller's fallback stops the robot with no word of why."""
+def _check_written(name: str, kind: type, ctx: StepContext, **written) -> None:
+    """Refuse (one-line :class:`ParameterError`) a piece ``name`` (class ``kind``) whose
+    ``compute`` wrote NaN into any of ``written``, or an infinite value into any but its
+    ``bounds`` (an infinite bound leaves a side open)."""
     for what, value in written.items():
         arrays = value if isinstance(value, tuple) else (value,)
         bad = any(
@@ -59,8 +58,8 @@ def _check_written(piece: Task | Limit, ctx: StepContext, **written) -> None:
                 else "must be finite"
             )
             raise ParameterError(
-                f"{type(piece).__name__} {getattr(piece, 'name', '')!r}: compute() wrote a "
-                f"non-finite value into its {what} at t = {ctx.t:g} s (they {rule})"
+                f"{kind.__name__} {name!r}: compute() wrote a non-finite value into its {what} "
+                f"at t = {ctx.t:g} s (they {rule})"
             )
 
 
@@ -246,12 +245,10 @@ class QPProblem:
         """The pieces without a compiled writer, through ``compute`` on numpy views."""
         for task, jac, error, jac_w, error_w, column, sqrt_w in self._generic_cost:
             task.compute(ctx, jac, error)
-            _check_written(task, ctx, jacobian=jac, error=error)
             np.multiply(jac, column, out=jac_w)
             np.multiply(error, sqrt_w, out=error_w)
         for task, jac, low, up in self._generic_slack:
             task.compute(ctx, jac, up)
-            _check_written(task, ctx, jacobian=jac, error=up)
             low[:] = up
         box = self.box
         self.lb[:NU] = box[:NU]
@@ -259,8 +256,27 @@ class QPProblem:
         u_lb, u_ub = self.lb[:NU], self.ub[:NU]
         for limit, G, low, up in self._generic_limits:
             limit.compute(ctx, G, low, up, u_lb, u_ub)
-            _check_written(limit, ctx, matrix=G, bounds=(low, up, u_lb, u_ub))
         self.box_ok = bool(np.all(u_lb <= u_ub))
+
+    def check_generic_pieces(self, ctx: StepContext) -> None:
+        """After a failed solve: refuse (one-line :class:`ParameterError`) what a piece
+        without a compiled writer (a user's own) wrote this step that no solver takes, NaN
+        anywhere or an infinite Jacobian, error or constraint row (a bound may be
+        infinite: an open side). Without it the solve fails on every step and the
+        fallback holds the robot still with no word of why. Checked only when a solve
+        failed, so a valid run pays nothing for it."""
+        for task, jac, error, *_ in self._generic_cost:
+            _check_written(task.name, type(task), ctx, jacobian=jac, error=error)
+        for task, jac, _, up in self._generic_slack:
+            _check_written(task.name, type(task), ctx, jacobian=jac, error=up)
+        for limit, G, low, up in self._generic_limits:
+            _check_written(limit.name, type(limit), ctx, matrix=G, bounds=(low, up))
+        if self._generic_limits and np.isnan(self.lb[:NU] + self.ub[:NU]).any():
+            names = ", ".join(repr(limit.name) for limit, *_ in self._generic_limits)
+            raise ParameterError(
+                f"limits: a compute() of {names} wrote a NaN into the input box lb, ub at "
+                f"t = {ctx.t:g} s (bounds must not be NaN; +-inf leaves a side open)"
+            )
 
     def _weighted_cost(self) -> None:
         """``H_uu = Jw' Jw + floor I``, ``f_u = -Jw' ew`` (set_cost(1, 1) without scaling)."""

@@ -58,10 +58,11 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from math import isfinite
-from typing import Any, Protocol
+from typing import Any, NoReturn, Protocol
 
 import numpy as np
 
+from ddwmmr import interrupts
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
 from ddwmmr.errors import ParameterError, PluginError, float_values, shown
 from ddwmmr.inheritance import defining_class, overrides
@@ -232,20 +233,23 @@ def checked_observation(plant: Plant, k: int, t: float) -> Observation:
     )
 
 
-def controller_raised(controller: Any, error: Exception, k: int, t: float) -> Exception:
-    """What a run raises when ``controller.command`` raised ``error`` at step ``k`` (time
-    ``t`` s): a :class:`ParameterError` (bad input, already one line naming it) or a
-    :class:`PluginError` from the library's own checks as it is, anything else wrapped in
-    a one-line :class:`PluginError` naming the controller, what it raised and where."""
-    if isinstance(error, ParameterError | PluginError):
-        return error
+def raise_wrapped(controller: Any, error: Exception, k: int, t: float, method: str) -> NoReturn:
+    """Raise what a run raises when ``controller.<method>`` raised ``error`` at step ``k``
+    (time ``t`` s; called from an ``except`` block): a :class:`ParameterError` (bad input,
+    one line naming it already), a :class:`PluginError`, or anything a controller of the
+    library raised, as it is (a bug of ours keeps its traceback); anything a controller
+    from outside the library raised, wrapped in a one-line :class:`PluginError` naming it,
+    what it raised and where (``error`` its ``__cause__``)."""
+    library = type(controller).__module__.split(".")[0] == "ddwmmr"
+    if library or isinstance(error, ParameterError | PluginError):
+        raise error
     name = getattr(controller, "name", None)
     name = name if isinstance(name, str) else type(controller).__name__
     text = " ".join(str(error).split()) or "(no message)"
-    return PluginError(
-        f"method: {name}.command() raised {type(error).__name__}: {shown(text, 120)} at step "
-        f"{k}, t = {t:g} s"
-    )
+    raise PluginError(
+        f"method: {name}.{method}() raised {type(error).__name__}: {shown(text, 120)} at "
+        f"step {k}, t = {t:g} s"
+    ) from error
 
 
 def stage_law(controller: Any) -> Callable[..., Any] | None:
@@ -301,7 +305,7 @@ def run_loop(
         try:
             command = command_of(t, np.array(q), pose_d, velocity_d)
         except Exception as error:
-            raise controller_raised(controller, error, k, t) from error
+            raise_wrapped(controller, error, k, t, "command")
         return checked_command(command, False, controller, k, t)
 
     def law_policy(t: float, q: list[float]) -> tuple[float, ...]:
@@ -310,7 +314,10 @@ def run_loop(
         goes through ``command`` (:func:`policy`), whose validation names the argument that
         made it."""
         pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
-        u = law(t, q, pose_d.tolist(), velocity_d.tolist())[0]
+        try:
+            u = law(t, q, pose_d.tolist(), velocity_d.tolist())[0]
+        except Exception as error:
+            raise_wrapped(controller, error, k, t, "law")
         if isfinite(u[0] + u[1] + u[2] + u[3]):
             return u
         return policy(t, q)
@@ -323,6 +330,7 @@ def run_loop(
         return LoopEnd(0, "start")
     for k in range(steps + 1):
         t = k * dt
+        interrupts.raise_pending()  # one a solver swallowed in the last step
         if task.finished(k, t, obs):
             return LoopEnd(k, "finished")
         pose_d, velocity_d = task.reference(t, obs)
@@ -338,7 +346,7 @@ def run_loop(
         except Exception as error:
             if task.controller_error(k, error):
                 return LoopEnd(k, "controller_error")
-            raise controller_raised(controller, error, k, t) from error
+            raise_wrapped(controller, error, k, t, "command")
         info = getattr(controller, "last", _NO_INFO)
         if force:
             applied, saturated = command, False
