@@ -458,3 +458,27 @@ def test_a_parameter_error_from_a_controller_is_not_its_own_cause():
     with pytest.raises(ParameterError) as error:
         simulate(Robot(), Ellipse(), "qp", duration=0.2, tasks=[_NanError(1.0)])
     assert error.value.__cause__ is not error.value
+
+
+@pytest.mark.parametrize(
+    ("limited", "got"),
+    [
+        (lambda u: (np.array([np.nan, 0.0, 0.0, 0.0]), False), "(array([nan, 0., 0., 0.]), False)"),
+        (lambda u: (np.zeros(3), False), "(array([0., 0., 0.]), False)"),
+        (lambda u: np.zeros(4), "array([0., 0., 0., 0.])"),
+    ],
+)
+def test_a_plant_limiting_into_nonsense_is_one_line_naming_it(limited, got):
+    from ddwmmr.plants.kinematic import KinematicPlant
+
+    class Odd(KinematicPlant):
+        name = "odd"
+
+        def limit(self, q, u):
+            return limited(u)
+
+    message = _refused(
+        lambda: simulate(Robot(), Ellipse(), "ats", duration=0.2, plant=Odd(Robot())),
+        r"^plant: odd\.limit\(q, u\) must return \(u, saturated\) with u 4 finite numbers ",
+    )
+    assert f"(got {got} at step 0, t = 0 s)" in message

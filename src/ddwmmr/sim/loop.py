@@ -216,20 +216,46 @@ def checked_command(command: Any, force: bool, controller: Any, k: int, t: float
     )
 
 
+def from_library(obj: Any) -> bool:
+    """Whether ``obj``'s class is one of the library's (its plants and controllers keep
+    their own contracts; only a plug-in's output is checked at every step)."""
+    return type(obj).__module__.split(".")[0] == "ddwmmr"
+
+
+def _plant_name(plant: Any) -> str:
+    name = getattr(plant, "name", None)
+    return name if isinstance(name, str) else type(plant).__name__
+
+
 def checked_observation(plant: Plant, k: int, t: float) -> Observation:
     """``plant.observe()`` at step ``k`` (time ``t`` s) if it is an :class:`Observation` of
     finite numbers, else a one-line :class:`ParameterError` naming the plant: a plant whose
     state blows up raises :class:`PlantDivergedError` from ``step`` (the run then stops
-    there and says so); a NaN observed would surface later as the controller's bad ``q``."""
+    there and says so); a NaN observed would surface later as the controller's bad ``q``.
+    For a plug-in plant (the library's own raise PlantDivergedError themselves)."""
     obs = plant.observe()
     if isinstance(obs, Observation) and obs.finite():
         return obs
-    name = getattr(plant, "name", None)
-    name = name if isinstance(name, str) else type(plant).__name__
     wanted = "an Observation(q, v, w) of 5 + 2 finite numbers"
     raise ParameterError(
-        f"plant: {name}.observe() must return {wanted} (got {shown(obs, 80)} at step {k}, "
-        f"t = {t:g} s; a plant whose state blows up raises PlantDivergedError in step())"
+        f"plant: {_plant_name(plant)}.observe() must return {wanted} (got {shown(obs, 80)} "
+        f"at step {k}, t = {t:g} s; a plant whose state blows up raises PlantDivergedError "
+        "in step())"
+    )
+
+
+def checked_limit(plant: Plant, q: np.ndarray, command: np.ndarray, k: int, t: float):
+    """``plant.limit(q, command)`` at step ``k`` (time ``t`` s) if it is ``(u, saturated)``
+    with ``u`` 4 finite numbers (returned as a float array), else a one-line
+    :class:`ParameterError` naming the plant. For a plug-in plant."""
+    result = plant.limit(q, command)
+    if isinstance(result, tuple) and len(result) == 2:
+        applied = finite_values(result[0], 4)
+        if applied is not None:
+            return applied, bool(result[1])
+    raise ParameterError(
+        f"plant: {_plant_name(plant)}.limit(q, u) must return (u, saturated) with u 4 finite "
+        f"numbers (got {shown(result, 80)} at step {k}, t = {t:g} s)"
     )
 
 
@@ -240,8 +266,7 @@ def raise_wrapped(controller: Any, error: Exception, k: int, t: float, method: s
     library raised, as it is (a bug of ours keeps its traceback); anything a controller
     from outside the library raised, wrapped in a one-line :class:`PluginError` naming it,
     what it raised and where (``error`` its ``__cause__``)."""
-    library = type(controller).__module__.split(".")[0] == "ddwmmr"
-    if library or isinstance(error, ParameterError | PluginError):
+    if from_library(controller) or isinstance(error, ParameterError | PluginError):
         raise error
     name = getattr(controller, "name", None)
     name = name if isinstance(name, str) else type(controller).__name__
@@ -325,7 +350,8 @@ def run_loop(
     stage_policy = None
     if not (force or getattr(controller, "zero_order_hold", False)):
         stage_policy = policy if law is None else law_policy
-    obs = checked_observation(plant, 0, 0.0)
+    foreign = not from_library(plant)  # a plug-in plant: its output checked every step
+    obs = checked_observation(plant, 0, 0.0) if foreign else plant.observe()
     if task.start(obs):
         return LoopEnd(0, "start")
     for k in range(steps + 1):
@@ -351,7 +377,11 @@ def run_loop(
         if force:
             applied, saturated = command, False
         else:
-            applied, saturated = plant.limit(obs.q, command)
+            applied, saturated = (
+                checked_limit(plant, obs.q, command, k, t)
+                if foreign
+                else plant.limit(obs.q, command)
+            )
         task.record(k, t, obs, command, applied, saturated, info, elapsed)
         if k == steps:
             break
@@ -360,7 +390,7 @@ def run_loop(
         except PlantDivergedError as error:
             task.diverged(k, error)
             return LoopEnd(k + 1, "diverged")
-        obs = checked_observation(plant, k + 1, t + dt)
+        obs = checked_observation(plant, k + 1, t + dt) if foreign else plant.observe()
         if task.after_step(k, t, obs, applied):
             return LoopEnd(k + 1, "failed")
         if progress is not None:
