@@ -174,6 +174,13 @@ def finite_values(value: Any, size: int) -> np.ndarray | None:
     return None
 
 
+def name_of(obj: Any) -> str:
+    """What a message calls a controller or a plant: its ``name`` if that is a str, else
+    its class's name."""
+    name = getattr(obj, "name", None)
+    return name if isinstance(name, str) else type(obj).__name__
+
+
 def checked_command(command: Any, force: bool, controller: Any, k: int, t: float) -> Any:
     """``command``, as returned by ``controller.command`` at step ``k`` (time ``t`` s), if
     it is a command the plant can apply: on the velocity interface 4 finite numbers
@@ -208,11 +215,9 @@ def checked_command(command: Any, force: bool, controller: Any, k: int, t: float
         if array is not None:
             return array
         wanted = "4 finite numbers u = [v, w, th1dot, th2dot] (m/s, rad/s, rad/s, rad/s)"
-    name = getattr(controller, "name", None)
-    name = name if isinstance(name, str) else type(controller).__name__
     raise ParameterError(
-        f"method: {name}.command() must return {wanted} (got {shown(command, 60)} at step "
-        f"{k}, t = {t:g} s)"
+        f"method: {name_of(controller)}.command() must return {wanted} (got "
+        f"{shown(command, 60)} at step {k}, t = {t:g} s)"
     )
 
 
@@ -220,11 +225,6 @@ def from_library(obj: Any) -> bool:
     """Whether ``obj``'s class is one of the library's (its plants and controllers keep
     their own contracts; only a plug-in's output is checked at every step)."""
     return type(obj).__module__.split(".")[0] == "ddwmmr"
-
-
-def _plant_name(plant: Any) -> str:
-    name = getattr(plant, "name", None)
-    return name if isinstance(name, str) else type(plant).__name__
 
 
 def checked_observation(plant: Plant, k: int, t: float) -> Observation:
@@ -238,7 +238,7 @@ def checked_observation(plant: Plant, k: int, t: float) -> Observation:
         return obs
     wanted = "an Observation(q, v, w) of 5 + 2 finite numbers"
     raise ParameterError(
-        f"plant: {_plant_name(plant)}.observe() must return {wanted} (got {shown(obs, 80)} "
+        f"plant: {name_of(plant)}.observe() must return {wanted} (got {shown(obs, 80)} "
         f"at step {k}, t = {t:g} s; a plant whose state blows up raises PlantDivergedError "
         "in step())"
     )
@@ -254,7 +254,7 @@ def checked_limit(plant: Plant, q: np.ndarray, command: np.ndarray, k: int, t: f
         if applied is not None:
             return applied, bool(result[1])
     raise ParameterError(
-        f"plant: {_plant_name(plant)}.limit(q, u) must return (u, saturated) with u 4 finite "
+        f"plant: {name_of(plant)}.limit(q, u) must return (u, saturated) with u 4 finite "
         f"numbers (got {shown(result, 80)} at step {k}, t = {t:g} s)"
     )
 
@@ -268,12 +268,10 @@ def raise_wrapped(controller: Any, error: Exception, k: int, t: float, method: s
     what it raised and where (``error`` its ``__cause__``)."""
     if from_library(controller) or isinstance(error, ParameterError | PluginError):
         raise error
-    name = getattr(controller, "name", None)
-    name = name if isinstance(name, str) else type(controller).__name__
     text = " ".join(str(error).split()) or "(no message)"
     raise PluginError(
-        f"method: {name}.{method}() raised {type(error).__name__}: {shown(text, 120)} at "
-        f"step {k}, t = {t:g} s"
+        f"method: {name_of(controller)}.{method}() raised {type(error).__name__}: "
+        f"{shown(text, 120)} at step {k}, t = {t:g} s"
     ) from error
 
 
