@@ -27,10 +27,7 @@ from pathlib import Path
 
 from ddwmmr.cli.common import ArgumentParser, run_main
 from ddwmmr.controllers.base import available_methods
-from ddwmmr.errors import (
-    ParameterError,
-    check_range,
-)
+from ddwmmr.errors import ParameterError, check_range
 from ddwmmr.gui.layout import desktop_figure
 from ddwmmr.gui.options import parse_option, plant_names
 from ddwmmr.gui.paths import (

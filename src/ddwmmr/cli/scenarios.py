@@ -606,8 +606,8 @@ def write_batch(
 
 
 def failure_line(summary: dict[str, Any]) -> str:
-    """ "" if every scenario finished, else one line counting why the others did not (the
-    table's means would otherwise hide, say, a controller that raised in every one)."""
+    """One line counting why scenarios did not finish (the table's means would otherwise
+    hide, say, a controller that raised in every one); empty if every one finished."""
     reasons = Counter(str(f["reason"]) for f in summary.get("failures", ()))
     if not reasons:
         return ""

@@ -302,14 +302,11 @@ def unwrap_phi(points: np.ndarray) -> np.ndarray:
     than pi between coarse rows on purpose), and one unwrapped here and read back is not
     unwrapped again. Any other ``points`` (or without a third column) is returned as it
     is, keeping its exact bits (adding zero turns would still turn a -0.0 into 0.0). The
-    unwrapped angles must stay within
-    the documented 1e6 rad, else :class:`~ddwmmr.errors.ParameterError` naming ``points``."""
+    unwrapped angles must stay within the documented 1e6 rad, else
+    :class:`~ddwmmr.errors.ParameterError` naming ``points``."""
     if points.shape[1] != 3:
         return points
     phi = points[:, 2]
-    # Only a column that looks wrapped, every angle in [-pi, pi]: one already continuous
-    # may step by more than pi between coarse rows on purpose (a fast spin), and an
-    # unwrapped column read back (csv_text) must not be unwrapped again.
     if not (np.all(np.abs(phi) <= math.pi) and np.any(np.abs(np.diff(phi)) > math.pi)):
         return points
     unwrapped = points.copy()
