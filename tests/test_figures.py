@@ -96,3 +96,29 @@ def test_the_mean_time_has_its_95_percent_confidence_interval():
     assert "5 +- 2.12" in report.format_table(summary, "t")
     single = report.summarize(outcomes[:1], 1.0)
     assert math.isnan(single["ci95_time_s"]) and "95 % CI" not in report.format_table(single, "t")
+
+
+def test_figures_of_runs_over_at_t0_draw_without_warnings(tmp_path, monkeypatch):
+    """Every scenario tipping at its first instant (a payload the start cannot hold) leaves
+    empty traces: the figures say so instead of warning about singular axis limits."""
+    import warnings
+
+    scenarios = generate(2, 0)
+    config = RunConfig(payload=10.0, time_limit=1.0, record=True)
+    outcomes = [run_scenario(s, config) for s in scenarios]
+    assert [o.metrics["time_s"] for o in outcomes] == [0.0, 0.0]
+    figures = []
+    monkeypatch.setattr(report, "_save", lambda fig, path: figures.append(fig))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        report.plot_timeline(outcomes[0], tmp_path / "t.png", "thesis", scenarios[0])
+        report.plot_state_times(outcomes, tmp_path / "s.png", "thesis")
+        for fig in figures:  # the warnings come when the figure is laid out
+            fig.tight_layout()
+            fig.canvas.draw()
+    low, high = figures[0].axes[3].get_xlim()
+    assert high - low == pytest.approx(1.0)
+    texts = [t.get_text() for fig in figures for ax in fig.axes for t in ax.texts]
+    assert texts == ["the run ended at t = 0 s", "every scenario ended at t = 0"]
+    for fig in figures:
+        plt.close(fig)

@@ -254,7 +254,17 @@ def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
             ax.bar(index, values, bottom=bottom, label=label, width=0.85)
             bottom += values
     ax.set(xlabel="scenario", ylabel="time (s)", title=title)
-    ax.legend(loc="upper right", ncol=5, fontsize=8)
+    if bottom.any():
+        ax.legend(loc="upper right", ncol=5, fontsize=8)
+    else:  # no bar to name
+        ax.text(
+            0.5,
+            0.5,
+            "every scenario ended at t = 0",
+            transform=ax.transAxes,
+            ha="center",
+            va="center",
+        )
     _save(fig, path)
 
 
@@ -344,7 +354,9 @@ def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None 
     ax3.plot(t, tr.get("eta", []), color="tab:purple", label="manipulability eta = |sin th2|")
     ax3.set(ylim=(0.0, 1.05), ylabel="manipulability\neta (-)")
     ax4 = axes[3, 0]
-    ax4.semilogy(t, np.maximum(tr.get("distance", []), 1e-4), label="distance")
+    # The log scale and its range before the data: a one-instant trace cannot autoscale.
+    ax4.set(yscale="log", ylim=(1e-4, 30.0))
+    ax4.plot(t, np.maximum(tr.get("distance", []), 1e-4), label="distance")
     ax4.axhline(0.01, color="k", lw=0.6, ls="--", label="tolerance 0.01 m")
     if scenario is not None:
         _mark_waypoints(ax4, tr, scenario)
@@ -354,7 +366,19 @@ def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None 
         if len(t) > 1
         else ""
     )
-    ax4.set(xlabel=f"time (s){sampling}", ylabel="end effector to\nwaypoint (m)", ylim=(1e-4, 30.0))
+    ax4.set(xlabel=f"time (s){sampling}", ylabel="end effector to\nwaypoint (m)")
+    if not len(t) or t[-1] == t[0]:  # a run over at its first instant: give the axes a width
+        start = t[0] if len(t) else 0.0
+        ax4.set_xlim(start - 0.5, start + 0.5)
+        ax.set_ylim(-0.5, len(ax.get_yticks()) - 0.5)
+        ax.text(
+            0.5,
+            0.5,
+            f"the run ended at t = {start:g} s",
+            transform=ax.transAxes,
+            ha="center",
+            va="center",
+        )
     for axis in (ax, ax2, ax3):
         axis.sharex(ax4)
         axis.grid(alpha=0.3)
