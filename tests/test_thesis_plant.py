@@ -117,3 +117,22 @@ def test_arm_servo_inside_plant_and_no_motion_at_target():
     plant.advance(state, 0.0, 0.0, (0.3, 1.0), 0.01)
     assert (state.th1, state.th2) == pytest.approx((0.02, 1.0))
     assert arm_step(0.3, 1.0, 0.3, 1.0, 2.0, 0.01) == (0.3, 1.0)
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf])
+@pytest.mark.parametrize("index", [0, 1, 2, 3])
+def test_limit_refuses_a_non_finite_command_as_the_kinematic_plant_does(bad, index):
+    """Clipping max(-limit, nan) gave -limit: a NaN joint rate became a full-speed one."""
+    import numpy as np
+
+    from ddwmmr.plants.kinematic import KinematicPlant
+
+    q = np.array([0.0, 0.0, 0.0, *POSE])
+    u = np.array([0.1, 0.2, 0.3, 0.4])
+    u[index] = bad
+    for plant in (ThesisPlant(ROBOT), KinematicPlant(ROBOT)):
+        with pytest.raises(FloatingPointError, match="non-finite command"):
+            plant.limit(q, u)
+    huge = np.array([1e308, 1e308, 3.0, -3.0])  # finite, though their sum is not
+    applied, clipped = ThesisPlant(ROBOT).limit(q, huge)
+    assert clipped and applied.tolist() == [1e308, 1e308, 2.0, -2.0]

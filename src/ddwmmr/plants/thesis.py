@@ -198,8 +198,12 @@ class ThesisPlant:
         return Observation(s.q, s.v, s.w)
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
-        """Joint rates clipped to the joint-speed limit; (v, w) pass (forces saturate)."""
+        """Joint rates clipped to the joint-speed limit; (v, w) pass (forces saturate).
+        A non-finite ``u`` is a FloatingPointError, as for the kinematic plant (clipping
+        would turn a NaN rate into the limit)."""
         v, w, r1, r2 = u.tolist() if isinstance(u, np.ndarray) else (float(a) for a in u)
+        if not all(map(math.isfinite, (v, w, r1, r2))):
+            raise FloatingPointError(f"non-finite command u = {u}")
         limit = self.robot.joint_speed_limit
         c1, c2 = min(limit, max(-limit, r1)), min(limit, max(-limit, r2))
         if c1 == r1 and c2 == r2 and isinstance(u, np.ndarray):
