@@ -290,3 +290,21 @@ def test_the_counts_of_commands_leave_out_the_last_sample_and_of_states_the_firs
     np.testing.assert_array_equal(commanded_steps(flags), [0.0, 1.0, 0.0])
     np.testing.assert_array_equal(step_results(flags), [1.0, 0.0, 1.0])
     assert len(commanded_steps([0.0])) == len(step_results([0.0])) == 0  # 0 steps
+
+
+def test_a_controller_built_for_another_robot_is_named_in_a_warning():
+    """A qp built for the light robot keeps its floor with the wrong payload's model: on
+    the 3 kg robot the run's S falls below it. simulate says so before it runs."""
+    import warnings
+
+    from ddwmmr import make_controller
+
+    light, heavy = Robot(), Robot().with_payload(3.0)
+    trajectory = load_trajectory("sideways_reach")
+    with pytest.warns(UserWarning, match=r"another robot .*\(payload 1\.25 vs 3\.0\)"):
+        result = simulate(heavy, trajectory, make_controller("qp", light, stability_min=1.25))
+    assert result.summary["min_stability"] < 1.2  # the model mismatch shows
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the same robot: no warning
+        matched = simulate(heavy, trajectory, make_controller("qp", heavy, stability_min=1.25))
+    assert matched.summary["min_stability"] >= 1.25 - 1e-6

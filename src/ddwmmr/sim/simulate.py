@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from collections.abc import Callable, Sequence
@@ -66,6 +67,27 @@ def check_controller(controller: Any) -> Any:
             f"{' and '.join(missing)})"
         )
     return controller
+
+
+def warn_other_robot(controller: Any, robot: Robot) -> None:
+    """Warn (:class:`UserWarning`) when ``controller`` holds a ``robot`` other than the
+    simulated one: its model, e.g. its stability floor's payload, is then not the plant's.
+    That can be meant (a study of model error), so it is not refused."""
+    own = getattr(controller, "robot", None)
+    if not isinstance(own, Robot) or own == robot:
+        return
+    differ = [
+        f"{f.name} {getattr(own, f.name)!r} vs {getattr(robot, f.name)!r}"
+        for f in dataclasses.fields(Robot)
+        if f.init and getattr(own, f.name) != getattr(robot, f.name)
+    ]
+    warnings.warn(
+        f"method: the controller was built for another robot than the one simulated "
+        f"({'; '.join(differ[:3])}{'; ...' if len(differ) > 3 else ''}): its model is not "
+        "the plant's; build it with the same Robot unless that is the point",
+        UserWarning,
+        stacklevel=3,
+    )
 
 
 def check_start(
@@ -161,7 +183,9 @@ def simulate(
             object with ``reset(trajectory, q0)`` and ``command(t, q, pose_d,
             velocity_d)``, which must return 4 finite numbers ``[v, w, th1dot, th2dot]``
             (or a ``WheelForces`` on the force interface; anything else is a
-            :class:`ParameterError` naming the step).
+            :class:`ParameterError` naming the step). A controller holding another
+            ``robot`` than this one runs after a :class:`UserWarning` naming the fields
+            that differ.
         dt: control/integration step (s); default ``duration / samples`` of the trajectory
             (its resolution N), or duration / 1000, rounded to a whole multiple of the
             plant's engine ``timestep`` if it has one.
@@ -206,6 +230,7 @@ def simulate(
         raise ParameterError("controller options are only accepted with a method name")
     else:
         controller = check_controller(method)
+        warn_other_robot(controller, robot)
     reference = check_trajectory(trajectory)
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
     the_plant = _plant(plant, robot, integrator, plant_options)
