@@ -112,7 +112,7 @@ ROBOT_CASES = [
     (["--robot", "{robot_tiny_wheel.toml}"], "wheel_radius must be in [1e-06, 1000] m"),
     (["--robot", "{robot_huge_L1.toml}"], "L1 must be in"),
     (["--robot", "{robot_masses_number.toml}"], "link_masses must be a pair of numbers"),
-    (["--robot", "{robot_masses_text.toml}"], "link_masses must be a number (got 'a')"),
+    (["--robot", "{robot_masses_text.toml}"], "link_masses[2] must be a number (got 'a')"),
     (["--robot", "{robot_payload_nan.toml}"], "payload must be a finite number"),
     (["--robot", "{robot_unknown.toml}"], "unknown parameter 'arm_length'"),
     (["--robot", "{robot_bad.toml}"], "is not valid TOML"),

@@ -30,7 +30,15 @@ from ddwmmr.errors import (
         ("base_mass = 1e9", r"base_mass must be in \(0, 100000\] kg"),
         ("link_masses = 1.0", "link_masses must be a pair of numbers"),
         ("joint_limits = [[-1, 1]]", r"joint_limits must be two \[min, max\] pairs"),
-        ('home_pose = [0.1, "x"]', "home_pose must be a number"),
+        ('home_pose = [0.1, "x"]', r"home_pose\[2\] must be a number \(got 'x'\)"),
+        (
+            "joint_limits = [-1, 1]",
+            r"joint_limits must be two \[min, max\] pairs \(got \[-1, 1\]\)",
+        ),
+        ('joint_limits = "ab"', r"joint_limits must be two \[min, max\] pairs \(got 'ab'\)"),
+        ('joint_limits = [[-1, 1], [-1, "a"]]', r"joint_limits\[2\]\[2\] must be a number"),
+        ('caster_positions = "corners"', r"caster_positions must be a list of \(x, y\) pairs"),
+        ("base_mas = 10.0", r"unknown parameter 'base_mas' \(did you mean base_mass\?\)"),
         ("[[robot]]\nL1 = 0.4", r"\[robot\] must be one table .*\[\[robot\]\]"),
         ("robot = 3", r"\[robot\] must be one table"),
     ],
@@ -48,6 +56,16 @@ def test_valid_robot_toml_still_loads(tmp_path):
     robot = Robot.from_toml(path)
     assert robot.L1 == 0.4 and robot.link_masses == (1.0, 2.0)
     assert robot.joint_limits == ((-3.0, 3.0), (-2.0, 2.0))
+
+
+def test_api_robot_shapes_are_named_whole():
+    """A value of the wrong shape is refused as a whole, not one letter or number of it."""
+    with pytest.raises(ParameterError, match=r"joint_limits must be two \(min, max\) pairs"):
+        Robot(joint_limits=[-1, 1])
+    with pytest.raises(ParameterError, match=r"joint_limits must be two \(min, max\) pairs"):
+        Robot(joint_limits="ab")
+    with pytest.raises(ParameterError, match=r"caster_positions must be a list of \(x, y\)"):
+        Robot(caster_positions="corners")
 
 
 def test_api_robot_magnitudes():

@@ -23,6 +23,7 @@ from ddwmmr.errors import (
     ParameterError,
     check_finite,
     check_range,
+    did_you_mean,
     load_toml,
     shown,
     texts_apart,
@@ -260,7 +261,8 @@ class Robot:
         unknown = sorted(set(data) - set(known), key=str)
         if unknown:
             raise ParameterError(
-                f"robot: unknown parameter {shown(unknown[0])} (known: {', '.join(sorted(known))})"
+                f"robot: unknown parameter {shown(unknown[0])}"
+                f"{did_you_mean(str(unknown[0]), known)} (known: {', '.join(sorted(known))})"
             )
         for key, value in data.items():
             _check_field_type(key, value, known[key].default)
@@ -437,13 +439,14 @@ def _check_field_type(key: str, value: Any, default: Any) -> None:
     elif isinstance(default, str):
         ok, wanted = isinstance(value, str), "a string"
     elif isinstance(default, tuple):
+        nested = isinstance(default[0], tuple)
         ok = isinstance(value, list | tuple) and len(value) == len(default)
-        wanted = (
-            "a pair of numbers" if not isinstance(default[0], tuple) else "two [min, max] pairs"
-        )
+        if ok and nested:  # [-1, 1] for two pairs is the shape that is wrong, not -1
+            ok = all(isinstance(item, list | tuple) for item in value)
+        wanted = "two [min, max] pairs" if nested else "a pair of numbers"
         if ok:
-            for item, item_default in zip(value, default):
-                _check_field_type(key, item, item_default)
+            for i, (item, item_default) in enumerate(zip(value, default), start=1):
+                _check_field_type(f"{key}[{i}]", item, item_default)
     else:
         return
     if not ok:
@@ -526,6 +529,8 @@ def _configuration_slow(q, name: str) -> list[float]:
 def _points(value) -> tuple[tuple[float, float], ...]:
     name = "caster_positions"
     try:
+        if isinstance(value, str | bytes | dict):  # iterable, but not a list of points
+            raise TypeError
         items = tuple(value)
     except TypeError:
         raise ParameterError(
@@ -538,11 +543,13 @@ def _points(value) -> tuple[tuple[float, float], ...]:
 
 def _pairs(name: str, value) -> tuple:
     try:
+        if isinstance(value, str | bytes | dict):  # iterable, but not two pairs
+            raise TypeError
         items = tuple(value)
     except TypeError:
         raise ParameterError(
             f"{name} must be two (min, max) pairs (got {shown(value, 60)})"
         ) from None
-    if len(items) != 2:
+    if len(items) != 2 or any(isinstance(p, int | float) for p in items):
         raise ParameterError(f"{name} must be two (min, max) pairs (got {shown(value, 60)})")
     return tuple(_pair(f"{name}[{i}]", p, "rad") for i, p in enumerate(items, start=1))
