@@ -72,7 +72,7 @@ def test_force_limit_10_newton_per_wheel():
 def test_turning_torque_and_terminal_yaw_rate():
     plant = ThesisPlant(ROBOT)
     state = run(plant, -2.0, 2.0, 20.0)
-    torque = (2.0 - -2.0) * ROBOT.base_width / 2.0  # T = (F2 - F1) w / 2
+    torque = (2.0 - -2.0) * ROBOT.track_width / 2.0  # T = (F2 - F1) b, b = track_width / 2
     assert state.w == pytest.approx(torque / 4.0, rel=1e-9)
     assert state.v == pytest.approx(0.0, abs=1e-12)
     assert math.hypot(state.x, state.y) < 1e-12
@@ -136,3 +136,36 @@ def test_limit_refuses_a_non_finite_command_as_the_kinematic_plant_does(bad, ind
     huge = np.array([1e308, 1e308, 3.0, -3.0])  # finite, though their sum is not
     applied, clipped = ThesisPlant(ROBOT).limit(q, huge)
     assert clipped and applied.tolist() == [1e308, 1e308, 2.0, -2.0]
+
+
+def test_arm_targets_are_clipped_to_the_joint_limits():
+    """A target beyond a limit stops the joint at the limit, as the servo reaches it."""
+    from ddwmmr.commands import WheelForces
+
+    robot = Robot(joint_limits=((-1.0, 0.5), (0.2, 1.5)), home_pose=(0.0, 1.0))
+    plant = ThesisPlant(robot)
+    plant.reset([0.0, 0.0, 0.0, 0.4, 1.4], 0.01)
+    for k in range(100):  # 1 s at 2 rad/s: far enough to pass both limits unclipped
+        plant.step(k * 0.01, WheelForces(0.0, 0.0, 3.0, -3.0), 0.01)
+    assert (plant.state.th1, plant.state.th2) == (0.5, 0.2)
+    assert plant.clip_targets(-7.0, 9.0) == (-1.0, 1.5)
+    assert plant.clip_targets(0.1, 0.9) == (0.1, 0.9)  # inside: unchanged
+
+
+def test_limit_stops_a_joint_at_its_limit_and_reports_it_as_the_kinematic_plant():
+    import numpy as np
+
+    from ddwmmr.plants.kinematic import KinematicPlant
+
+    robot = Robot(joint_limits=((-1.0, 0.5), (0.2, 1.5)), home_pose=(0.0, 1.0))
+    u = np.array([0.1, 0.2, 0.7, -0.3])
+    for q, expected, clipped in (
+        ((0.0, 0.0, 0.0, 0.5, 0.2), [0.1, 0.2, 0.0, 0.0], True),  # both pushing outward
+        ((0.0, 0.0, 0.0, 0.5, 1.5), [0.1, 0.2, 0.0, -0.3], True),  # th1 at its max
+        ((0.0, 0.0, 0.0, -1.0, 0.2), [0.1, 0.2, 0.7, 0.0], True),  # th2 at its min
+        ((0.0, 0.0, 0.0, 0.0, 1.0), [0.1, 0.2, 0.7, -0.3], False),  # inside
+    ):
+        q = np.array(q)
+        for plant in (ThesisPlant(robot), KinematicPlant(robot)):
+            applied, saturated = plant.limit(q, u)
+            assert applied.tolist() == expected and saturated is clipped, type(plant).__name__

@@ -133,8 +133,14 @@ class ThesisController:
 
     @property
     def default_pose(self) -> tuple[float, float]:
-        """Arm pose held while driving (rad); scenarios start in it."""
-        return self.behaviours["objective"].pose  # type: ignore[attr-defined]
+        """Arm pose ``(th1, th2)`` (rad) held while driving; scenarios start in it.
+
+        The thesis's pose (:func:`~ddwmmr.behaviours.objective.default_pose`: best
+        manipulability, end effector straight ahead) as the arm mover sends it, clipped
+        to the robot's ``joint_limits``: the pose the arm holds, and a start every plant
+        accepts (the thesis's own robot: the thesis's pose unchanged)."""
+        pose = self.behaviours["objective"].pose  # type: ignore[attr-defined]
+        return self.arm.targets(Proposal(BRAKE, pose))
 
     def reset(self, target: tuple[float, float] | None = None, q0: object = None) -> None:
         """Start a new run toward ``target`` (m, world); ``q0`` is not needed.

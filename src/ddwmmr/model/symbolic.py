@@ -17,10 +17,11 @@ rad/s, rad/s).
   th2dot]`` (N, N, rad/s, rad/s)::
 
       m vdot + c1 v = F_left + F_right
-      I(th2) wdot + c2 w = (F_right - F_left) width / 2
+      I(th2) wdot + c2 w = (F_right - F_left) b
 
-  with the whole robot's mass ``m`` and its pose-dependent yaw inertia ``I(th2)`` (links as
-  uniform rods, payload a point mass at the end effector). The arm joints follow rate
+  with the whole robot's mass ``m``, its pose-dependent yaw inertia ``I(th2)`` (links as
+  uniform rods, payload a point mass at the end effector) and the wheels' lever about the
+  base centre ``b = track_width / 2``. The arm joints follow rate
   commands: the plant's servo reaches a target ``th + rate dt`` in one step whenever
   ``|rate| <= joint_speed``.
 
@@ -214,7 +215,8 @@ class ThesisDynamics:
         mass: whole robot (base + links + payload) (kg).
         c1: translational damping (N s/m); c2: rotational damping (N m s/rad).
         force_limit: per-wheel force limit (N); joint_speed: arm servo speed (rad/s).
-        half_width: lever arm of the wheel forces (m).
+        half_width: lever arm b of the wheel forces about the base centre (m; the thesis
+            plant's ``track_width / 2``, the wheels are that far either side).
         inertia_fixed, inertia_cos: yaw inertia ``I(th2) = inertia_fixed + inertia_cos
             cos(th2)`` about the base centre (kg m^2).
         shoulder_fixed, elbow_fixed: the arm's angular momentum about the base centre from
@@ -247,7 +249,7 @@ class ThesisDynamics:
     ) -> ThesisDynamics:
         """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``;
         ``half_width`` (m) is the wheels' lever about the base centre, by default the
-        thesis plant's ``robot.base_width / 2``."""
+        thesis plant's ``robot.track_width / 2``."""
         inertia = robot.yaw_inertia  # the collected form I(th2) = fixed + cos * cos th2
         return cls(
             mass=robot.total_mass,
@@ -256,7 +258,7 @@ class ThesisDynamics:
             force_limit=check_positive("force_limit", force_limit),
             joint_speed=check_positive("joint_speed", joint_speed),
             half_width=(
-                0.5 * robot.base_width
+                0.5 * robot.track_width
                 if half_width is None
                 else check_positive("half_width", half_width)
             ),
@@ -279,7 +281,7 @@ class ThesisDynamics:
 
     @property
     def top_yaw_rate(self) -> float:
-        """Steady yaw rate under the full opposite forces, ``2 F (width/2) / c2`` (rad/s;
+        """Steady yaw rate under the full opposite forces, ``2 F b / c2`` (rad/s;
         infinite without damping)."""
         torque = 2.0 * self.force_limit * self.half_width
         return torque / self.c2 if self.c2 > 0.0 else math.inf

@@ -116,6 +116,28 @@ _INF = math.inf
 _isfinite = math.isfinite
 
 
+def arm_rates(
+    th1: float,
+    th2: float,
+    r1: float,
+    r2: float,
+    speed: float,
+    limits: tuple[tuple[float, float], tuple[float, float]],
+) -> tuple[float, float]:
+    """The joint rates (rad/s) an arm applies at joint angles (th1, th2) (rad) for the
+    commanded rates (r1, r2): each within ``+-speed`` (rad/s), and 0 for a joint at (or
+    beyond) a limit of ``limits`` (``joint_limits``, rad) that would move further out. The
+    one joint-limit rule of the plants that take velocity commands."""
+    (low1, high1), (low2, high2) = limits
+    r1 = r1 if -speed <= r1 <= speed else math.copysign(speed, r1)
+    if (th1 >= high1 and r1 > 0) or (th1 <= low1 and r1 < 0):
+        r1 = 0.0
+    r2 = r2 if -speed <= r2 <= speed else math.copysign(speed, r2)
+    if (th2 >= high2 and r2 > 0) or (th2 <= low2 and r2 < 0):
+        r2 = 0.0
+    return r1, r2
+
+
 def check_control_step(dt: Any) -> float:
     """``dt`` (s) as a float if it is a finite number > 0, else :class:`ParameterError`
     naming ``dt``: the control step of ``Plant.reset`` and ``Plant.step``."""

@@ -33,6 +33,7 @@ from ddwmmr.plants.base import (
     Observation,
     PlantDivergedError,
     Policy,
+    arm_rates,
     check_control_step,
     check_step,
 )
@@ -139,14 +140,7 @@ class KinematicPlant:
             scale = limit / peak
             v, w = v * scale, w * scale
             saturated = True
-        speed = self._joint_speed
-        (low1, high1), (low2, high2) = self._joint_limits
-        r1 = t1 if -speed <= t1 <= speed else math.copysign(speed, t1)
-        if (th1 >= high1 and r1 > 0) or (th1 <= low1 and r1 < 0):
-            r1 = 0.0
-        r2 = t2 if -speed <= t2 <= speed else math.copysign(speed, t2)
-        if (th2 >= high2 and r2 > 0) or (th2 <= low2 and r2 < 0):
-            r2 = 0.0
+        r1, r2 = arm_rates(th1, th2, t1, t2, self._joint_speed, self._joint_limits)
         return (v, w, r1, r2), saturated or r1 != t1 or r2 != t2
 
     @staticmethod

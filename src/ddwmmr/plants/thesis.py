@@ -4,9 +4,11 @@ Base (thesis eqs 3.1-3.4; docs/thesis.md, "What is simulated"), along the base h
 (robot frame R) and about z::
 
     m xddot_R + c1 xdot_R = F,      F = F1 + F2                (N, m/s)
-    I thddot  + c2 thdot  = T,      T = (F2 - F1) width / 2    (N m, rad/s)
+    I thddot  + c2 thdot  = T,      T = (F2 - F1) b            (N m, rad/s)
 
-``F1``/``F2`` are the left/right wheel forces (N), each clipped to ``+-force_limit``. ``m``
+``F1``/``F2`` are the left/right wheel forces (N), each clipped to ``+-force_limit``; they
+act at the wheels, ``b = track_width / 2`` either side of the base centre (the wheels'
+lever; for the thesis robot ``track_width = base_width = 0.35`` m). ``m``
 is the whole robot's mass (base + links + payload) and ``I`` its yaw inertia about the base
 centre, which depends on the arm pose (links as uniform rods, payload as a point mass at
 the end effector, thesis 3.4). The forces are held constant over a step (zero-order hold)
@@ -17,8 +19,10 @@ The travelled distance is applied along the mean heading of the step (thesis eqs
 Arm: the thesis's pseudo-controller (4.4.2, eqs 4.10-4.11). Given joint targets, the joint
 with the largest error moves at ``joint_speed`` (2 rad/s) and every other joint at the
 speed scaled by its error / the largest error, so all joints arrive together; a joint never
-passes its target. The plant knows nothing about controllers: it receives wheel forces and
-joint targets from a simulation loop.
+passes its target. Targets are clipped to the robot's ``joint_limits`` (the servo stops a
+joint at its limit, as the kinematic plant does), and a start outside them is refused. The
+plant knows nothing about controllers: it receives wheel forces and joint targets from a
+simulation loop.
 """
 
 from __future__ import annotations
@@ -31,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.commands import WheelForces
-from ddwmmr.errors import check_positive
+from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.model.thesis_base import (  # the base's constants (controllers' models use them)
@@ -44,6 +48,7 @@ from ddwmmr.plants.base import (
     Observation,
     PlantDivergedError,
     Policy,
+    arm_rates,
     check_control_step,
     check_step,
 )
@@ -122,12 +127,13 @@ def damped_base_envelope(
     """What a velocity command can ask of a damped, force-limited base, as ``fraction`` of
     the physics.
 
-    Top speeds where the full force balances damping (``2 F / c1`` m/s,
-    ``2 F (width/2) / c2`` rad/s) and accelerations from rest with the largest yaw inertia
-    (arm stretched): ``2 F / m`` (m/s^2), ``2 F (width/2) / I`` (rad/s^2). ``force_limit``
-    is per wheel (N). Keys match the ``qp`` controller's options.
+    Top speeds where the full force balances damping (``2 F / c1`` m/s, ``2 F b / c2``
+    rad/s) and accelerations from rest with the largest yaw inertia (arm stretched):
+    ``2 F / m`` (m/s^2), ``2 F b / I`` (rad/s^2). ``force_limit`` F is per wheel (N),
+    ``half_width`` b the wheels' lever about the base centre (m, ``track_width / 2``).
+    Keys match the ``qp`` controller's options.
 
-    ``speed_budget`` adds ``"speed_budget": (2 F / c1, 2 F (width/2) / c2)``, the full
+    ``speed_budget`` adds ``"speed_budget": (2 F / c1, 2 F b / c2)``, the full
     top speeds (no fraction): in steady state each wheel's force stays within F exactly
     when ``|v| / v_top + |w| / w_top <= 1`` (:class:`~ddwmmr.qp.limits.SpeedBudgetLimit`).
     """
@@ -177,7 +183,8 @@ class ThesisPlant:
         self.joint_speed = check_positive("joint_speed", joint_speed)
         self.mass = robot.total_mass
         self._yaw_inertia = robot.yaw_inertia.at
-        self._half_width = 0.5 * robot.base_width
+        self._half_width = 0.5 * robot.track_width  # the wheels' lever b
+        self._joint_limits = robot.joint_limits
         self.servo = VelocityServo(self, velocity_bandwidth)
         self.state = ThesisState()
         self._forces = (0.0, 0.0)
@@ -185,10 +192,14 @@ class ThesisPlant:
     # -- Plant interface ------------------------------------------------------------------
     def reset(self, q0: np.ndarray, dt: float) -> None:
         """Start at rest at configuration ``q0`` (5 finite numbers ``[x, y, phi, th1,
-        th2]``, m and rad); the dynamics are exact for any control step dt > 0 (s, finite).
-        Anything else is a :class:`ParameterError` naming ``q0`` or ``dt``."""
+        th2]``, m and rad, the joints within the robot's ``joint_limits``); the dynamics
+        are exact for any control step dt > 0 (s, finite). Anything else is a one-line
+        :class:`ParameterError` naming ``q0`` or ``dt`` (nothing changes then)."""
         state = check_configuration(q0)
         check_control_step(dt)
+        outside = self.robot.joints_outside(state)
+        if outside is not None:
+            raise ParameterError(f"q0: {outside}")
         self.state = ThesisState(*state)
         self._forces = (0.0, 0.0)
 
@@ -198,14 +209,16 @@ class ThesisPlant:
         return Observation(s.q, s.v, s.w)
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
-        """Joint rates clipped to the joint-speed limit; (v, w) pass (forces saturate).
+        """The velocity command ``u = [v, w, th1dot, th2dot]`` as the plant applies it at
+        configuration ``q``, and whether a limit clipped it: joint rates within the
+        joint-speed limit, and 0 for a joint at a limit of ``joint_limits`` moving outward
+        (as the kinematic plant reports it); (v, w) pass (the wheel forces saturate).
         A non-finite ``u`` is a FloatingPointError, as for the kinematic plant (clipping
         would turn a NaN rate into the limit)."""
         v, w, r1, r2 = u.tolist() if isinstance(u, np.ndarray) else (float(a) for a in u)
         if not all(map(math.isfinite, (v, w, r1, r2))):
             raise FloatingPointError(f"non-finite command u = {u}")
-        limit = self.robot.joint_speed_limit
-        c1, c2 = min(limit, max(-limit, r1)), min(limit, max(-limit, r2))
+        c1, c2 = self.joint_rates(float(q[3]), float(q[4]), r1, r2)
         if c1 == r1 and c2 == r2 and isinstance(u, np.ndarray):
             return u, False  # within the limits: the command as it is
         return np.array([v, w, c1, c2]), True
@@ -213,21 +226,21 @@ class ThesisPlant:
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
         """Advance by dt (s) from time t (s) under wheel forces (a
         :class:`~ddwmmr.commands.WheelForces`, N and rad) or a velocity command ``u = [v, w,
-        th1dot, th2dot]`` (m/s, rad/s), held over the step; non-finite or misshapen
-        arguments are a :class:`ParameterError` (:func:`check_step`)."""
+        th1dot, th2dot]`` (m/s, rad/s), held over the step; the arm's targets (the given
+        ones, or ``th + rate dt`` with the rates of :meth:`joint_rates`) are clipped to the
+        joint limits. Non-finite or misshapen arguments are a :class:`ParameterError`
+        (:func:`check_step`)."""
         checked = check_step(t, command, dt, self.interfaces)
         state = self.state
         inertia = self.inertia(state.th1, state.th2)  # once for the servo and the dynamics
         if isinstance(checked, WheelForces):
             f_left, f_right = checked.left, checked.right
-            target = (checked.th1_target, checked.th2_target)
+            target = self.clip_targets(checked.th1_target, checked.th2_target)
         else:
             v, w, r1, r2 = checked
             f_left, f_right = self.servo.forces(state, v, w, inertia)
-            limit = self.robot.joint_speed_limit
-            r1 = min(limit, max(-limit, r1))
-            r2 = min(limit, max(-limit, r2))
-            target = (state.th1 + r1 * dt, state.th2 + r2 * dt)
+            r1, r2 = self.joint_rates(state.th1, state.th2, r1, r2)
+            target = self.clip_targets(state.th1 + r1 * dt, state.th2 + r2 * dt)
         self._forces = self.advance(state, f_left, f_right, target, dt, inertia)
         # One sum tests all seven values: any inf or nan makes it non-finite.
         if not math.isfinite(
@@ -273,7 +286,7 @@ class ThesisPlant:
 
     @property
     def wheel_lever(self) -> float:
-        """Lever arm of each wheel's force about the base centre (m): ``base_width / 2``."""
+        """Lever arm of each wheel's force about the base centre (m): ``track_width / 2``."""
         return self._half_width
 
     def velocity_envelope(self, fraction: float = 0.8) -> dict[str, Any]:
@@ -292,6 +305,18 @@ class ThesisPlant:
             fraction,
         )
 
+    def joint_rates(self, th1: float, th2: float, r1: float, r2: float) -> tuple[float, float]:
+        """Joint rates (rad/s) the arm applies at joint angles (th1, th2) (rad) for the
+        commanded rates (r1, r2): each within ``+-joint_speed_limit``, and 0 for a joint at
+        (or beyond) a limit of ``joint_limits`` that would move further out."""
+        return arm_rates(th1, th2, r1, r2, self.robot.joint_speed_limit, self._joint_limits)
+
+    def clip_targets(self, target1: float, target2: float) -> tuple[float, float]:
+        """Joint targets (rad) clipped to the robot's ``joint_limits``: the servo stops a
+        joint at its limit."""
+        (low1, high1), (low2, high2) = self._joint_limits
+        return min(high1, max(low1, target1)), min(high2, max(low2, target2))
+
     def clip_force(self, force: float) -> float:
         """A wheel force limited to ``+-force_limit`` (N)."""
         return min(self.force_limit, max(-self.force_limit, force))
@@ -307,9 +332,11 @@ class ThesisPlant:
     ) -> tuple[float, float]:
         """Advance ``state`` in place by dt (s) under wheel forces (N) and joint targets (rad).
 
-        The inertia is evaluated at the arm pose at the start of the step (``inertia``, if
-        given, is that value: :meth:`inertia` at ``state``'s arm pose). Returns the wheel
-        forces applied, after the force limit (N).
+        The model without the joint limits (:class:`~ddwmmr.model.symbolic.ThesisDynamics`'s
+        equations; :meth:`step` clips the targets to them first). The inertia is evaluated
+        at the arm pose at the start of the step (``inertia``, if given, is that value:
+        :meth:`inertia` at ``state``'s arm pose). Returns the wheel forces applied, after
+        the force limit (N).
         """
         f1 = self.clip_force(f_left)
         f2 = self.clip_force(f_right)
@@ -334,13 +361,14 @@ class VelocityServo:
 
     ``F = c1 v_d + k m (v_d - v)`` and ``T = c2 w_d + k I (w_d - w)`` (the damping
     feed-forward makes steady-state tracking exact; ``k`` is the loop bandwidth in 1/s),
-    ``F_r = T / (width/2)``, mixed into wheel forces with rotation priority.
+    ``F_r = T / b`` (``b = track_width / 2``, the wheels' lever), mixed into wheel forces
+    with rotation priority.
     """
 
     def __init__(self, plant: ThesisPlant, bandwidth: float = VELOCITY_BANDWIDTH) -> None:
         self.plant = plant
         self.bandwidth = check_positive("velocity_bandwidth", bandwidth)
-        self._half_width = 0.5 * plant.robot.base_width
+        self._half_width = plant.wheel_lever
         self._total = 2.0 * plant.force_limit
 
     def forces(

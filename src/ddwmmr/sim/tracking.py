@@ -6,7 +6,10 @@ input ``v, w, th1dot, th2dot``, the measured base velocities ``v_measured, w_mea
 (which lag the command on plants with dynamics), the desired pose, the controller's flags
 and timing, the plant's extra columns).
 Everything derived (end-effector pose, errors, wheel speeds, manipulability, stability) is
-computed afterwards, vectorised over the run, by :func:`derive_columns`.
+computed afterwards, vectorised over the run, by :func:`derive_columns`. The wheel speeds
+are the base's actual ones: from the measured (v, w) on a plant that takes wheel forces
+(its base has dynamics: its velocities are states that lag the command), from the applied
+command on a velocity-only plant (the kinematic model, where the command is the motion).
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.commands import WheelForces
+from ddwmmr.commands import FORCE, WheelForces
 from ddwmmr.errors import ParameterError, shown
 from ddwmmr.inheritance import defining_class
 from ddwmmr.model import Robot
@@ -179,7 +182,8 @@ class TrackingTask:
         """Every column of :data:`COLUMNS` (and the plant's), one entry per recorded sample."""
         table = np.array(self.rows, dtype=float).reshape(len(self.rows), len(RECORDED))
         recorded = {name: table[:, i] for i, name in enumerate(RECORDED)}
-        derived = derive_columns(robot, recorded)
+        measured = FORCE in self.plant.interfaces
+        derived = derive_columns(robot, recorded, measured_wheels=measured)
         series = {name: recorded[name] if name in recorded else derived[name] for name in COLUMNS}
         if self.plant.extra_columns:
             extra = np.array(self.extra, dtype=float).reshape(
@@ -357,11 +361,15 @@ def _force_equivalent(obs: Observation) -> list[float]:
     return [obs.v, obs.w, math.nan, math.nan]
 
 
-def derive_columns(robot: Robot, ts: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def derive_columns(
+    robot: Robot, ts: dict[str, np.ndarray], measured_wheels: bool = False
+) -> dict[str, np.ndarray]:
     """End-effector pose, errors, wheel speeds, manipulability and stability, vectorised.
 
     Errors: position ``|p_d - p_E|`` (m), orientation ``phiE_d - phiE`` wrapped to
-    [-pi, pi) (rad).
+    [-pi, pi) (rad). Wheel speeds (rad/s): ``(2 v -+ track_width w) / (2 wheel_radius)``
+    of the measured ``v_measured, w_measured`` with ``measured_wheels`` (a plant whose base
+    has dynamics), else of the applied ``v, w``.
     """
     phi, th1, th2 = ts["phi"], ts["th1"], ts["th2"]
     a1 = phi + th1
@@ -369,7 +377,7 @@ def derive_columns(robot: Robot, ts: dict[str, np.ndarray]) -> dict[str, np.ndar
     x_e = ts["x"] + robot.L1 * np.cos(a1) + robot.L2 * np.cos(a12)
     y_e = ts["y"] + robot.L1 * np.sin(a1) + robot.L2 * np.sin(a12)
     r, lw = robot.wheel_radius, robot.track_width
-    v, w = ts["v"], ts["w"]
+    v, w = (ts["v_measured"], ts["w_measured"]) if measured_wheels else (ts["v"], ts["w"])
     s_lon, s_lat, s = stability_arrays(robot.com_coefficients, th1, th2)
     heading_error = ts["phiE_d"] - a12
     return {
