@@ -6,7 +6,9 @@ increasing (spanning a duration of 1e-6 s to 1e9 s, each step at least
 column may wrap at +-pi (as ``atan2`` writes it): a column within [-pi, pi] is unwrapped
 before interpolation (:func:`unwrap_phi`). Without ``phi`` the orientation is the
 direction of travel (unwrapped). If the first and last points coincide the path is
-treated as closed and the tangents at the ends are matched (periodic).
+treated as closed and the tangents at the ends are matched (periodic). Outside the
+samples' time range the trajectory holds still: the pose stays at the first (before) or
+last (after) sample and the velocity is zero.
 """
 
 from __future__ import annotations
@@ -35,7 +37,8 @@ MAX_TIME_S = DURATION_RANGE_S[1]
 #: Smallest step between two sample times, as a share of the duration (last minus first
 #: time). Relative, so stretching a trajectory in time (the GUI's T) keeps it valid; it
 #: bounds the interpolant's speed by 1e9 x (distance / duration) instead of letting
-#: ``times = [0, 1e-300, 1]`` ask for 1e300 m/s.
+#: ``times = [0, 1e-300, 1]`` ask for 1e300 m/s. Also how far (the same share) past
+#: either end the velocity keeps the end's speed before the trajectory holds still.
 MIN_STEP_FRACTION = 1e-9
 #: Longest default control step (s) of a sampled trajectory: that of the shipped ellipse
 #: and rectangle (40 s / 2000 samples).
@@ -74,6 +77,14 @@ class SampledTrajectory:
             :meth:`velocity` give the unwrapped, continuous orientation (magnitude <= 1e6
             rad after unwrapping too). Any other phi column is kept as given, bit for bit.
         name: label used in reports.
+
+    Times ``t`` of :meth:`pose`, :meth:`velocity` and :meth:`sample` count from the first
+    sample (``t = 0`` at ``times[0]``). Outside ``[0, duration]`` the trajectory holds
+    still, so that the velocity stays the time derivative of the pose: the pose is that
+    of the first sample before it and of the last after it (the orientation, without a
+    phi column, the direction of travel there) and the velocity is zero. At ``t = 0`` and
+    ``t = duration``, and within :data:`MIN_STEP_FRACTION` x ``duration`` outside them
+    (the rounding of a time grid ending there), the velocity is the end's speed.
 
     Anything else raises :class:`~ddwmmr.errors.ParameterError` naming ``times``,
     ``points`` or ``name``.
@@ -152,6 +163,23 @@ class SampledTrajectory:
         steps = max(self.samples, math.ceil(self.duration / MAX_DEFAULT_STEP_S - 1e-9))
         return self.duration / steps
 
+    def _moving_range(self) -> tuple[float, float]:
+        """Absolute times (s) between which the velocity is the interpolant's: the first
+        and last sample times widened by :data:`MIN_STEP_FRACTION` of the duration, the
+        finest time the samples resolve. A time grid that ends at the last sample
+        (``k dt`` and the RK4 stage ``k dt + dt``) may overshoot it by a rounding error;
+        there the end's speed still applies, as the step integrated towards it needs."""
+        first, last = self._knots[0], self._knots[-1]
+        slack = MIN_STEP_FRACTION * (last - first)
+        return first - slack, last + slack
+
+    def _holds(self, t: float) -> bool:
+        """Whether t (s, from the first sample) is outside :meth:`_moving_range`, where
+        the trajectory holds still."""
+        low, high = self._moving_range()
+        t_abs = t + self._knots[0]
+        return t_abs < low or t_abs > high
+
     def _segment(self, t: float) -> tuple[int, float, float]:
         t_abs = min(max(t + self._knots[0], self._knots[0]), self._knots[-1])
         i = min(bisect.bisect_right(self._knots, t_abs) - 1, len(self._knots) - 2)
@@ -192,9 +220,13 @@ class SampledTrajectory:
         return np.array([value[0], value[1], heading])
 
     def velocity(self, t: float) -> np.ndarray:
-        """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s, from the first sample; finite)."""
+        """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s, from the first sample; finite):
+        zero outside ``[0, duration]`` (beyond :meth:`_moving_range`), where the pose
+        holds still."""
         if not (isinstance(t, float) and _isfinite(t)):
             check_time(t)
+        if self._holds(t):
+            return np.zeros(3)
         _, first, second = self._hermite(t)
         if self._has_phi:
             return first.copy()
@@ -210,7 +242,10 @@ class SampledTrajectory:
         else :class:`~ddwmmr.errors.ParameterError` naming ``times``
         (:func:`~ddwmmr.trajectories.base.check_times`)."""
         knots = self.times
-        t_abs = np.minimum(np.maximum(check_times(times) + knots[0], knots[0]), knots[-1])
+        t_query = check_times(times) + knots[0]
+        low, high = self._moving_range()
+        held = ((t_query < low) | (t_query > high))[:, None]
+        t_abs = np.minimum(np.maximum(t_query, knots[0]), knots[-1])
         i = np.minimum(np.searchsorted(knots, t_abs, side="right") - 1, len(knots) - 2)
         h = knots[i + 1] - knots[i]
         s = (t_abs - knots[i]) / h
@@ -220,7 +255,7 @@ class SampledTrajectory:
         first = first / h[:, None]
         second = second / (h * h)[:, None]
         if self._has_phi:
-            return value, first
+            return value, np.where(held, 0.0, first)
         heading = atan2_array(first[:, 1], first[:, 0])
         headings = self._knot_headings()
         reference = (1 - s) * headings[i] + s * headings[i + 1]
@@ -230,7 +265,7 @@ class SampledTrajectory:
             turn = (first[:, 0] * second[:, 1] - first[:, 1] * second[:, 0]) / speed2
         rate = np.where(speed2 < 1e-12, 0.0, turn)
         poses = np.column_stack([value[:, 0], value[:, 1], heading])
-        return poses, np.column_stack([first[:, 0], first[:, 1], rate])
+        return poses, np.where(held, 0.0, np.column_stack([first[:, 0], first[:, 1], rate]))
 
 
 _isfinite = math.isfinite
