@@ -28,6 +28,15 @@ from ddwmmr.trajectories.base import sampler
 #: home arm pose can always make (it moves E towards the arm mount).
 DEFAULT_INITIAL_OFFSET = (-0.03, -0.03)
 
+#: Position error (m) at which :func:`offset_configuration` accepts the arm's pose, near
+#: the origin.
+OFFSET_TOLERANCE_M = 1e-12
+#: The same as a share of the target's largest coordinate |x|, |y| (m), whose float
+#: spacing bounds the error computable there: 1e-14 is 45 to 90 spacings, where 1e-12 m
+#: alone is less than one spacing beyond 8192 m (documented coordinates reach 1e6 m).
+#: Below 100 m the absolute 1e-12 m is the larger and governs.
+OFFSET_RELATIVE_TOLERANCE = 1e-14
+
 
 def start_configuration(robot: Robot, trajectory) -> np.ndarray:
     """Configuration with the robot's ``home_pose`` arm whose end effector is at the start
@@ -52,19 +61,22 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
 
     The offset is in the end effector's frame at ``q``: dx along its orientation phiE, dy
     to its left. Newton iterations on the arm's 2x2 position Jacobian; the base does not
-    move. Newton may land a joint whole turns away from its limits (th1 = -24.2 rad for
-    an offset of 0.25 m): such a joint is turned back by whole turns into its
-    ``joint_limits`` where that fits (the same arm pose). An offset the arm cannot reach
-    raises :class:`ParameterError`.
+    move. The end effector is placed to within :data:`OFFSET_TOLERANCE_M` or
+    :data:`OFFSET_RELATIVE_TOLERANCE` times the target's largest world coordinate (m),
+    whichever is larger (float spacing grows with the coordinates). Newton may land a
+    joint whole turns away from its limits (th1 = -24.2 rad for an offset of 0.25 m):
+    such a joint is turned back by whole turns into its ``joint_limits`` where that fits
+    (the same arm pose). An offset the arm cannot reach raises :class:`ParameterError`.
     """
     q = np.array(q, dtype=float)
     dx, dy = (float(v) for v in offset)
     x_e, y_e, phi_e = robot.fk(q)
     c, s = math.cos(phi_e), math.sin(phi_e)
     target = np.array([x_e + c * dx - s * dy, y_e + s * dx + c * dy])
+    tolerance = _offset_tolerance(target)
     for _ in range(50):
         error = target - robot.fk(q)[:2]
-        if float(np.hypot(*error)) < 1e-12:
+        if float(np.hypot(*error)) < tolerance:
             return _turned_into_limits(robot, q)
         arm_jacobian = robot.jacobian(q)[:2, 3:5]
         if abs(np.linalg.det(arm_jacobian)) < 1e-9:
@@ -74,6 +86,12 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
         f"initial_offset ({dx:g}, {dy:g}) m (end-effector frame) cannot be reached with the "
         "arm alone"
     )
+
+
+def _offset_tolerance(target: np.ndarray) -> float:
+    """Accepted end-effector position error (m) for a world ``target`` (x, y) in m."""
+    scale = float(np.max(np.abs(target)))
+    return max(OFFSET_TOLERANCE_M, OFFSET_RELATIVE_TOLERANCE * scale)
 
 
 def _turned_into_limits(robot: Robot, q: np.ndarray) -> np.ndarray:
