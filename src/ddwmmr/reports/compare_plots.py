@@ -340,6 +340,8 @@ def plot_tau_study(
             label=method,
         )
     ax2.axhline(theory, color="k", ls=":", label=f"first order: {theory:.2f}")
+    if not any(math.isfinite(v) for values in convergence.values() for v in values.values()):
+        _say_none_converged(ax2, [tau for values in convergence.values() for tau in values])
     ax2.set_xscale("log")
     ax2.set_ylim(0.0, 2.0 * theory)
     ax2.set_xlabel("tau (s) (methods offset by a few % to stay visible)")
@@ -350,6 +352,24 @@ def plot_tau_study(
     place_legend(ax1, fontsize=8)
     place_legend(ax2, fontsize=8)
     return fig
+
+
+def _say_none_converged(ax: Axes, taus: Sequence[float]) -> None:
+    """Mark the convergence panel of a sweep in which no run converged (every time NaN):
+    a note below the first-order line (drawn at half the panel's height), and its tau
+    axis (log) spanning ``taus`` (s), which the NaN points, drawn nowhere, do not set."""
+    low, high = min(taus), max(taus)
+    ax.set_xlim(low / 1.5, high * 1.5)
+    ax.text(
+        0.5,
+        0.25,
+        "no run converged within the simulated time",
+        transform=ax.transAxes,
+        ha="center",
+        va="center",
+        fontsize=10,
+        color="0.3",
+    )
 
 
 #: Two lines of the initial-offset study coincide when they are this close (px) at every
