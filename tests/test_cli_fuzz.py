@@ -56,6 +56,7 @@ FILES = {
     "robot_masses_text.toml": b'link_masses = [1.0, "a"]\n',
     "robot_payload_nan.toml": b"payload = nan\n",
     "robot_unknown.toml": b"arm_length = 0.3\n",
+    "robot_caster_out.toml": b"caster_positions = [[0.1, 0.5]]\n",
     "robot_bad.toml": b"L1 = = 0.3\n",
     "traj_N_string.toml": b'shape = "ellipse"\nN = "2000"\n',
     "traj_a_string.toml": b'shape = "ellipse"\na = "2.0"\n',
@@ -115,6 +116,10 @@ ROBOT_CASES = [
     (["--robot", "{robot_masses_text.toml}"], "link_masses[2] must be a number (got 'a')"),
     (["--robot", "{robot_payload_nan.toml}"], "payload must be a finite number"),
     (["--robot", "{robot_unknown.toml}"], "unknown parameter 'arm_length'"),
+    (  # MuJoCo's own refusal, named by the file before the run
+        ["--robot", "{robot_caster_out.toml}", "--plant", "mujoco"],
+        "robot: {robot_caster_out.toml}: caster_positions: the base centre must lie strictly",
+    ),
     (["--robot", "{robot_bad.toml}"], "is not valid TOML"),
     (["--robot", "{robot_deep_array.toml}"], TOO_DEEP),
     (["--robot", "{robot_deep_tables.toml}"], TOO_DEEP),

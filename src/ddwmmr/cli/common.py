@@ -300,9 +300,18 @@ def add_force_argument(parser: argparse.ArgumentParser) -> None:
     )
 
 
-def robot_from_arguments(args: argparse.Namespace) -> Robot:
-    """The robot selected by ``--robot`` / ``--payload``."""
+def robot_from_arguments(args: argparse.Namespace, plants: Sequence[str] = ()) -> Robot:
+    """The robot selected by ``--robot`` / ``--payload``; with ``"mujoco"`` among
+    ``plants``, a robot file MuJoCo cannot build is refused naming the file (the plant
+    itself would refuse it only once the run starts, without the file's name)."""
     robot = Robot.from_toml(args.robot) if args.robot else Robot()
     if args.payload is not None:
         robot = robot.with_payload(args.payload)
+    if args.robot and "mujoco" in plants:
+        from ddwmmr.plants.mujoco.model import check_buildable  # imports the engine
+
+        try:
+            check_buildable(robot)
+        except ParameterError as exc:
+            raise ParameterError(f"robot: {args.robot}: {exc} (for the MuJoCo plant)") from None
     return robot

@@ -439,16 +439,17 @@ def config_from_arguments(
     studies = parse_studies(args.study)
     if study_methods is not None and not studies:
         raise ParameterError("study-methods: only used with a study (got --study none)")
+    plants = parse_plants(args.plant)
     return CompareConfig(
         methods=methods,
         study_methods=study_methods,
         trajectories=trajectories,
-        robot=robot_from_arguments(args),
+        robot=robot_from_arguments(args, plants),
         duration=check_duration(args.duration, trajectories),
         studies=studies,
         command=command,
         preset=args.preset,
-        plants=parse_plants(args.plant),
+        plants=plants,
         options=parse_method_options(args.option, methods, args.horizon),
     )
 

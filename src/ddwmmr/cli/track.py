@@ -398,13 +398,13 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     if args.method is None or args.traj is None:
         missing = "--method" if args.method is None else "--traj"
         raise ParameterError(f"{missing.lstrip('-')}: {missing} is required (or give --rerun)")
-    robot = robot_from_arguments(args)
+    plant = args.plant or PLANT
+    robot = robot_from_arguments(args, (plant,))
     source = find_trajectory_file(args.traj)
     trajectory = load_trajectory(args.traj)
     # The preset's values, then the explicit options (they win): the record keeps them all.
     options = {**preset_options(args.method, args.preset or "default"), **controller_options(args)}
     duration = trajectory.duration if args.duration is None else args.duration
-    plant = args.plant or PLANT
     step = default_step(trajectory, plant, robot) if args.dt is None else args.dt
     if args.dt is None and 0 < duration < step:  # the user gave --duration, not --dt
         raise ParameterError(
