@@ -375,3 +375,11 @@ def test_docs_page_snippet_runs(capsys):
     exec(compile(block, "docs/gui.md", "exec"), {})
     printed = capsys.readouterr().out.split()
     assert len(printed) == 2 and float(printed[0]) == pytest.approx(float(printed[1]))
+
+
+def test_a_payload_above_the_slider_range_widens_the_slider_to_it():
+    """--payload 5.5 stands (the start's limit is 9.338 kg) but the slider spanned 0-5 kg:
+    it showed 5.50 kg past its end. It now ends at the payload given."""
+    heavy = new_app(Settings(duration=DURATION, payload=5.5))
+    assert heavy.payload_slider.valmax == 5.5 and heavy.payload_slider.val == 5.5
+    assert new_app().payload_slider.valmax == 5.0  # the default range

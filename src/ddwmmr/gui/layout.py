@@ -166,10 +166,12 @@ class PanelLayout:
         top = self._options_top - 0.03 * 6 - 0.048
         self._heading(0.012, top, "Simulation")
         self.payload_ax = panel_axes(self.figure, (0.09, top - 0.03, 0.17, 0.02))
+        low, high = PAYLOAD_RANGE
         self.payload_slider = Slider(
             self.payload_ax,
             "payload (kg)",
-            *PAYLOAD_RANGE,
+            low,
+            max(high, self.settings.payload),  # a heavier --payload widens the slider to it
             valinit=self.settings.payload,
             valstep=0.05,
             valfmt="%.2f kg",
