@@ -253,8 +253,9 @@ def test_the_wheel_lever_from_the_traits_turns_the_physics_base_as_it_does():
         model = sym.ThesisDynamics.from_robot(robot, 0.0, 0.0, half_width=lever)
         predicted = 2 * 5.0 * lever / model.inertia(q0[4]) * 0.1
         assert plant.observe().w == pytest.approx(predicted, rel=0.015)
-    footprint = sym.ThesisDynamics.from_robot(robot, 0.0, 0.0)
-    assert footprint.half_width / lever == pytest.approx(1.4, rel=1e-12)
+    # the model's default lever is the track's too; the footprint's would be 40 % long
+    assert sym.ThesisDynamics.from_robot(robot, 0.0, 0.0).half_width == lever
+    assert 0.5 * robot.base_width / lever == pytest.approx(1.4, rel=1e-12)
 
 
 def test_the_physics_plants_joint_acceleration_limit_is_what_its_shoulder_motor_gives():
