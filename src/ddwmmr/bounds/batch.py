@@ -5,7 +5,8 @@ Each scenario's results are kept in ``<folder>/cache/`` as soon as they are know
 trajectory in ``scenario-NNN-best.npz``, and ``scenario-NNN-lower.json`` (the lower
 bound). A cached result is used again when its key (the scenario's waypoints, payload,
 S floor, tolerance and the method's settings) matches, so an interrupted batch resumes
-where it stopped and a changed method recomputes only its own part.
+where it stopped and a changed method recomputes only its own part. A run of some scenarios
+keeps the cache of the others made for the same seed and payload (:func:`reusable_cache`).
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ import dataclasses
 import io
 import json
 import math
+import re
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -22,10 +25,10 @@ import numpy as np
 
 from ddwmmr.bounds.lower import lower_bound
 from ddwmmr.bounds.search import Settings, best_known
-from ddwmmr.errors import DURATION_RANGE_S, ParameterError, shown
+from ddwmmr.errors import DURATION_RANGE_S, MAX_SCENARIOS, ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME
-from ddwmmr.scenarios.generator import Scenario
+from ddwmmr.scenarios.generator import Scenario, generate
 from ddwmmr.sim.result import json_safe, write_atomic
 
 #: Version of each method's results: a change invalidates the cached results of that part.
@@ -68,6 +71,50 @@ def cache_names(index: int) -> dict[str, str]:
         "trajectory": f"{CACHE}/{PLAN_NAME.format(index)}",
         "lower": f"{stem}-lower.json",
     }
+
+
+#: A cache file's name: its scenario number (from 1) and which part it holds.
+_CACHE_FILE = re.compile(
+    rf"^{CACHE}/scenario-(?P<index>\d{{3,}})-(?P<part>best|lower)\.(json|npz)$"
+)
+
+
+def reusable_cache(
+    folder: Path, names: Sequence[str], seed: int, payload: float
+) -> tuple[list[str], list[int]]:
+    """The cache files among ``names`` (relative to ``folder``) a run of ``seed`` and
+    ``payload`` keeps, and the scenario numbers whose cache it drops.
+
+    A scenario's record is kept when its key names that scenario's waypoints under ``seed``
+    and ``payload``: the problem the folder's summary.json names, and the one a plan read
+    from the folder (``scenarios --option plan=DIR``) is taken for. Its method settings and
+    version are not judged here: :func:`read_cached` checks the whole key before any use,
+    so a record of other settings (``--quick``) is kept for the run that has them. The
+    trajectory goes with its best record. A record for another seed or payload, unreadable,
+    or without a key is dropped, with the rest of its scenario's part.
+    """
+    matches = [(n, m) for n in names if (m := _CACHE_FILE.match(n)) is not None]
+    numbers = {int(m["index"]) for _, m in matches if 1 <= int(m["index"]) <= MAX_SCENARIOS}
+    scenarios = generate(max(numbers), seed) if numbers else []
+    kept, dropped = [], set()
+    for name, match in matches:
+        index = int(match["index"])
+        record = folder / f"{CACHE}/scenario-{match['index']}-{match['part']}.json"
+        if index in numbers and _same_problem(record, scenarios[index - 1], payload):
+            kept.append(name)
+        else:
+            dropped.add(index)
+    return sorted(kept), sorted(dropped)
+
+
+def _same_problem(path: Path, scenario: Scenario, payload: float) -> bool:
+    """Whether the cache record at ``path`` is for ``scenario``'s waypoints and ``payload``."""
+    try:
+        key = json.loads(path.read_text(encoding="utf-8"))["key"]
+        wanted = json_safe(keys(scenario, payload, Settings())["lower"])
+        return key["waypoints"] == wanted["waypoints"] and key["payload"] == wanted["payload"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
 
 
 def read_cached(folder: Path, scenario: Scenario, payload: float, settings: Settings):

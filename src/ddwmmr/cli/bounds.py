@@ -60,7 +60,9 @@ solved to global optimality (docs/mpc.md, "The physical limit, bracketed"). Writ
 bounds.csv (scenario, lower_bound_s, best_known_s, starts, spread_s, replay_ok) and
 summary.json into --out, and prints the means. Results are cached per scenario in
 --out/cache as they come: an interrupted run started again with the same --out resumes. A
-scenario takes about 1-3 minutes on one core."""
+run of some --scenarios keeps the cache of the others (of the same seed and payload), and
+its bounds.csv holds its own scenarios: --scenarios 1-100 again rebuilds the whole table
+from the cache. A scenario takes about 1-3 minutes on one core."""
 
 EPILOG = """\
 Bad input prints one line and exits with status 2, leaving no output behind. The scenario
@@ -197,16 +199,29 @@ def _main(argv: Sequence[str] | None = None) -> int:
         wall_time_s=time.perf_counter() - began,
         run=_record(args, settings, jobs),
     )
+    listed = inspect(target, TOOL).listed if target.is_dir() else []
+    kept, dropped = batch.reusable_cache(target, listed, args.seed, args.payload)
     with output_folder(target, TOOL, args.force) as staging:
-        for index in numbers:
-            for name in batch.cache_names(index).values():
-                if (target / name).exists():
-                    write_atomic(staging / name, (target / name).read_bytes())
+        for name in kept:
+            write_atomic(staging / name, (target / name).read_bytes())
         write_atomic(staging / "bounds.csv", batch.bounds_csv(rows))
         write_atomic(staging / MARKER, json.dumps(json_safe(summary), indent=2) + "\n")
+    if dropped:
+        print(_dropped_note(target, dropped, args.seed, args.payload), file=sys.stderr)
     print(summary_line(len(rows), summary))
     print(f"wrote {target}", file=sys.stderr)
     return 0
+
+
+def _dropped_note(target: Path, dropped: list[int], seed: int, payload: float) -> str:
+    """The line saying which scenarios' cache a run dropped (made for another problem)."""
+    shown = ", ".join(str(i) for i in dropped[:5]) + (", ..." if len(dropped) > 5 else "")
+    scenarios = "scenario" + "s" * (len(dropped) > 1)
+    return (
+        f"note: removed the cache of {len(dropped)} {scenarios} ({shown}) from "
+        f"{target / batch.CACHE}: made for another seed or payload than seed {seed}, "
+        f"payload {payload:g} kg (or unreadable)"
+    )
 
 
 def summary_line(count: int, summary: dict) -> str:
