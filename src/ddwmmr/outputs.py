@@ -21,7 +21,8 @@ Every tool (track, compare, scenarios) writes its results through :func:`output_
   :func:`list_in_manifest`: the folder stays this tool's own between runs;
 * ``force=True`` (``--force``) also writes into a folder another tool or the user made,
   and even then deletes only the files its manifest lists: a file no manifest lists always
-  survives (a new file that would overwrite it is refused).
+  survives (a new file that would overwrite it is refused). An interrupt while the files
+  are moved leaves the old output or the new one, each with its manifest, never a mix.
 
 Files and folders get the user's umask like any normal file (``0644``/``0755`` for the
 usual ``022``), not the ``0600``/``0700`` of temporary files.
@@ -726,28 +727,86 @@ def _swap(staging: Path, target: Path, existing: Existing) -> None:
     except BaseException:
         os.rename(old, target)  # put the old folder back before reporting the error
         raise
-    for name in [*existing.listed, MANIFEST]:
-        _unlink_regular(old / name)
-    _prune_empty(old)
-    if old.exists():  # something appeared meanwhile: keep it, say where
-        _say(f"warning: kept unexpected files of the old {target} in {_set_aside(old)}")
+    _discard_old(old, target, existing.listed)
 
 
 def _merge(staging: Path, target: Path, files: list[str], existing: Existing, text: str) -> None:
-    """``--force``: delete the listed files of ``target``, move the new ones in."""
+    """``--force``: replace the listed files of ``target`` by the staged ``files``, keeping
+    every file no manifest lists.
+
+    The old listed files go first into an old folder (with a copy of their manifest, so a
+    run killed outright is cleaned up as :func:`remove_stale` cleans after :func:`_swap`),
+    then the new manifest and the new files move in; the output is the new one once the
+    last file is in. An exception before that (Ctrl-C, SIGTERM, a full disk) moves
+    everything back, so ``target`` holds the old output again with its own manifest."""
     listed = set(existing.listed)
     clashes = [f for f in files if os.path.lexists(target / f) and f not in listed]
     if MANIFEST in existing.foreign:  # an unreadable manifest is not ours to overwrite
         clashes.append(MANIFEST)
     if clashes:
         raise ParameterError(_clash(text, clashes[0]))
-    for name in existing.listed:
-        _unlink_regular(target / name)
-    for name in [*files, MANIFEST]:
-        destination = target / name
-        destination.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
-        os.replace(staging / name, destination)
+    old = Path(tempfile.mkdtemp(prefix=f"{_OLD_PREFIX}{owner_token()}-", dir=target.parent))
+    had_manifest = os.path.lexists(target / MANIFEST)
+    moves: list[tuple[Path, Path]] = []
+    made: list[Path] = []
+    try:
+        if had_manifest:
+            shutil.copyfile(target / MANIFEST, old / MANIFEST)
+        for name in existing.listed:
+            _move(target / name, old / name, moves, [])
+        _move(staging / MANIFEST, target / MANIFEST, moves, made)
+        for name in files:
+            _move(staging / name, target / name, moves, made)
+    except BaseException:
+        _undo(moves, made)
+        if had_manifest and not os.path.lexists(target / MANIFEST):
+            os.replace(old / MANIFEST, target / MANIFEST)
+        shutil.rmtree(old, ignore_errors=True)
+        raise
     shutil.rmtree(staging, ignore_errors=True)
+    _discard_old(old, target, existing.listed)
+    for name in existing.listed:  # folders the old output alone had
+        _prune_up((target / name).parent, target)
+
+
+def _move(source: Path, destination: Path, moves: list, made: list[Path]) -> None:
+    """Rename ``source`` to ``destination``, its missing parent folders made (and added to
+    ``made``). The move is added to ``moves`` before it is done, so that an interrupt
+    arriving just after the rename is undone too (:func:`_undo` checks what happened)."""
+    for folder in missing_folders(destination.parent):
+        made.append(folder)
+        folder.mkdir(mode=folder_mode())
+    moves.append((source, destination))
+    os.replace(source, destination)
+
+
+def _undo(moves: list[tuple[Path, Path]], made: list[Path]) -> None:
+    """Reverse the renames :func:`_move` recorded that did happen, last first, then remove
+    the folders it made (where empty again)."""
+    for source, destination in reversed(moves):
+        if os.path.lexists(destination) and not os.path.lexists(source):
+            os.replace(destination, source)
+    remove_created(made)
+
+
+def _discard_old(old: Path, target: Path, listed: list[str]) -> None:
+    """Delete the replaced output in ``old`` (its listed files and manifest); anything else
+    found there is kept, set aside under a name no run sweeps, and said."""
+    for name in [*listed, MANIFEST]:
+        _unlink_regular(old / name)
+    _prune_empty(old)
+    if old.exists():  # something appeared meanwhile: keep it, say where
+        _say(f"warning: kept unexpected files of the old {target} in {_set_aside(old)}")
+
+
+def _prune_up(folder: Path, top: Path) -> None:
+    """Remove ``folder`` and its parents below ``top`` while they are empty."""
+    while folder != top and top in folder.parents:
+        try:
+            folder.rmdir()
+        except OSError:
+            return
+        folder = folder.parent
 
 
 def _unlink_regular(path: Path) -> None:
