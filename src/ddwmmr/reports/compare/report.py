@@ -615,7 +615,7 @@ def _tau_section(c: _Context) -> None:
         f"Convergence time on the {STUDY_TRAJECTORY}: when the position error last exceeds "
         f"{100 * CONVERGED_FRACTION:g} % of the initial offset; a first-order decay "
         f"exp(-t/tau) needs {theory:.2f} tau. "
-        + _tau_finding(convergence)
+        + _tau_finding(convergence, run_duration(c.config, STUDY_TRAJECTORY), theory)
         + _tau_corner_finding(methods, runs)
     )
     headers = ["method", "tau (s)", "convergence (s)", f"{theory:.2f} tau (s)"]
@@ -675,21 +675,38 @@ def _tau_corner_finding(methods: Sequence[str], runs: Mapping[tuple, RunOutput])
     )
 
 
-def _tau_finding(convergence: Mapping[str, Mapping[float, float]]) -> str:
+def _tau_finding(
+    convergence: Mapping[str, Mapping[float, float]], duration: float, theory: float
+) -> str:
+    """Each method's range of convergence times over tau. A tau it did not settle for is
+    put down to the run's ``duration`` (s) when that is shorter than a first-order decay
+    needs (``theory`` tau), else to a steady error above the threshold."""
     texts = []
     for m, values in convergence.items():
         settled = [(tau, values[tau]) for tau in sorted(values) if not math.isnan(values[tau])]
-        never = [f"{tau:g}" for tau in sorted(values) if math.isnan(values[tau])]
+        unsettled = [tau for tau in sorted(values) if math.isnan(values[tau])]
+        short = [f"{tau:g}" for tau in unsettled if duration < theory * tau]
+        never = [f"{tau:g}" for tau in unsettled if duration >= theory * tau]
+        notes = []
+        if never:
+            notes.append(
+                f"not settled for tau = {', '.join(never)} s: its steady error exceeds "
+                f"{100 * CONVERGED_FRACTION:g} % of the offset"
+            )
+        if short:
+            notes.append(
+                f"the {duration:g} s run is too short to settle for tau = {', '.join(short)} s: "
+                f"it ends before {theory:.2f} tau"
+            )
         if not settled:
-            texts.append(f"{m} never gets below {100 * CONVERGED_FRACTION:g} % of the offset")
+            what = "never gets" if not short else "does not get"
+            text = f"{m} {what} below {100 * CONVERGED_FRACTION:g} % of the offset"
+            texts.append(text + (f" ({'; '.join(notes)})" if short else ""))
             continue
         text = f"{fmt(settled[0][1])} s at tau = {settled[0][0]:g} s to {fmt(settled[-1][1])} s "
         text += f"at tau = {settled[-1][0]:g} s for {m}"
-        if never:
-            text += (
-                f" (not settled for tau = {', '.join(never)} s: its steady error exceeds "
-                f"{100 * CONVERGED_FRACTION:g} % of the offset)"
-            )
+        if notes:
+            text += f" ({'; '.join(notes)})"
         texts.append(text)
     return "Convergence time: " + "; ".join(texts) + ". Larger tau is more sluggish."
 
