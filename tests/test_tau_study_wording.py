@@ -38,7 +38,7 @@ def test_a_long_enough_run_keeps_the_steady_error_text() -> None:
 def test_both_causes_and_a_run_too_short_for_any_tau() -> None:
     convergence = {"qp": {0.1: 0.3, 0.3: math.nan, 1.0: math.nan, 3.0: math.nan}}
     assert _tau_finding(convergence, 2.0, THEORY) == (
-        "Convergence time: 0.300 s at tau = 0.1 s to 0.300 s at tau = 0.1 s for qp (not "
+        "Convergence time: 0.300 s at tau = 0.1 s for qp (not "
         "settled for tau = 0.3 s: its steady error exceeds 5 % of the offset; the 2 s run is "
         "too short to settle for tau = 1, 3 s: it ends before 3.00 tau). Larger tau is more "
         "sluggish."

@@ -703,8 +703,10 @@ def _tau_finding(
             text = f"{m} {what} below {100 * CONVERGED_FRACTION:g} % of the offset"
             texts.append(text + (f" ({'; '.join(notes)})" if short else ""))
             continue
-        text = f"{fmt(settled[0][1])} s at tau = {settled[0][0]:g} s to {fmt(settled[-1][1])} s "
-        text += f"at tau = {settled[-1][0]:g} s for {m}"
+        text = f"{fmt(settled[0][1])} s at tau = {settled[0][0]:g} s"
+        if len(settled) > 1:
+            text += f" to {fmt(settled[-1][1])} s at tau = {settled[-1][0]:g} s"
+        text += f" for {m}"
         if notes:
             text += f" ({'; '.join(notes)})"
         texts.append(text)
