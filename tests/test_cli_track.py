@@ -680,3 +680,14 @@ def test_qp_mode_is_the_qps_even_where_a_plug_in_has_a_mode(tmp_path, capsys, re
     with pytest.raises(SystemExit):
         run(["--help"])
     assert "priority handling (default weighted) [qp]\n" in capsys.readouterr().out
+
+
+def test_the_table_shows_the_mpcs_fallbacks():
+    """An mpc run whose every step fell back to its qp read 'tracked' with no line saying
+    so: the table had the qp's fallbacks only."""
+    from ddwmmr.cli.track import format_table
+
+    run = {"method": "mpc", "trajectory": "ellipse", "steps": 100}
+    lines = format_table({**run, "mpc_fallbacks": 100}).splitlines()
+    assert "  MPC fallbacks (its qp commanded)     100" in lines
+    assert not any("MPC fallbacks" in line for line in format_table(run).splitlines())

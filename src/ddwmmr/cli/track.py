@@ -96,6 +96,7 @@ TABLE_KEYS = (
     ("saturated_steps", "saturated steps"),
     ("stability_violations", "steps with S < S_min"),
     ("qp_fallbacks", "QP fallbacks"),
+    ("mpc_fallbacks", "MPC fallbacks (its qp commanded)"),
     ("min_obstacle_clearance_m", "min obstacle clearance (mm)"),
     ("max_wheel_force_n", "max wheel force (N)"),
     ("tipped", "tipped over (physics)"),
