@@ -11,6 +11,7 @@ from ddwmmr.arbiters import BEHAVIOURS
 from ddwmmr.cli.scenarios import main as cli
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 from ddwmmr.scenarios.arbiter_study import (
+    context_line,
     fix_entries,
     history_statistics,
     noisy_config,
@@ -94,12 +95,25 @@ def test_cli_arbiter_study_writes_tables_and_figures(tmp_path, capsys):
     for heading in ("Thesis Table 5.2", "Threshold variants", "Smoothness", "Noise seeds"):
         assert heading in text
     assert "Stability 1.50 with hysteresis 1.70" in text
+    assert "3 s limit; competitive arbiter seed 0 (noise study: seeds 0, 1, 2, 3, 4)." in text
     for key in ("baseline", "stab-1.50-1.70", "stab-nohyst-1.50"):
         assert (out / f"competitive_weights_{key}.png").stat().st_size > 1000
     assert (out / "baseline-competitive.csv").exists()
     summary = json.loads((out / "summary.json").read_text())
     assert summary["study"] == "arbiters" and len(summary["weights"]) == 3
     assert "| state machine | competitive |" in capsys.readouterr().out
+
+
+def test_study_context_names_scenarios_plant_limit_and_arbiter_seed():
+    config = RunConfig(plant="mujoco", payload=2.5, time_limit=30.0, arbiter_seed=7)
+    assert context_line(2, 0, config) == (
+        "2 scenarios (seed 0), mujoco plant, payload 2.5 kg, step 0.01 s, 30 s limit; "
+        "competitive arbiter seed 7 (noise study: seeds 0, 1, 2, 3, 4)."
+    )
+    assert context_line(1, None, RunConfig(), noise=False) == (
+        "1 scenario, thesis plant, payload 3 kg, step 0.01 s, 60 s limit; "
+        "competitive arbiter seed 0."
+    )
 
 
 @pytest.mark.parametrize(

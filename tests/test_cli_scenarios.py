@@ -117,6 +117,29 @@ def test_help_explains_protocol(capsys):
         assert word in text
 
 
+def test_threshold_table_states_what_ours_is_against_the_thesis():
+    """ "42 / 1" compares failures of the thesis's 100 scenarios with failures of ours:
+    the line above the table says how many ours are and how they ran."""
+    from ddwmmr.scenarios import RunConfig, studies
+
+    config = RunConfig(arbiter="competitive", arbiter_seed=3, time_limit=4.0)
+    context = studies.context_line(2, 0, config)
+    assert context == (
+        "ours: 2 scenarios (seed 0), thesis controller, thesis plant, payload 3 kg, "
+        "competitive (arbiter seed 3) arbiter, 4 s limit; the thesis: 100 scenarios, "
+        "1.25 kg payload"
+    )
+    assert studies.context_line(1, None, RunConfig()).startswith(
+        "ours: 1 scenario, thesis controller, thesis plant, payload 3 kg, state-machine "
+        "arbiter, 60 s limit;"
+    )
+    summary = {key: 0 for _, key, _ in studies.THRESHOLD_COLUMNS}
+    results = [(studies.THRESHOLD_VARIANTS[0], summary)]
+    bare = studies.threshold_table(results)
+    assert bare.startswith("| variant (thesis table) |")
+    assert studies.threshold_table(results, context) == f"{context}\n\n{bare}"
+
+
 def test_threshold_study_table_has_thesis_and_our_numbers(tmp_path, capsys):
     out = tmp_path / "thr"
     args = ["--study", "thresholds", "--n", "2", "--time-limit", "4", "--jobs", "1"]

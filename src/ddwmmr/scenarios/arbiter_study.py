@@ -38,7 +38,13 @@ from ddwmmr.arbiters.competitive import (
 from ddwmmr.arbiters.state_machine import STATES, Hysteresis
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.generator import Scenario
-from ddwmmr.scenarios.protocol import TRACE_INTERVAL, Outcome, RunConfig, run_scenario
+from ddwmmr.scenarios.protocol import (
+    TIME_LIMIT_S,
+    TRACE_INTERVAL,
+    Outcome,
+    RunConfig,
+    run_scenario,
+)
 from ddwmmr.sim.result import write_atomic
 from ddwmmr.workers import process_pool
 
@@ -435,6 +441,21 @@ def plot_weights(
 
 
 # -- the whole study -------------------------------------------------------------------------
+def context_line(n: int, seed: int | None, config: RunConfig, noise: bool = True) -> str:
+    """What the study ran: e.g. "2 scenarios (seed 0), thesis plant, payload 3 kg, step
+    0.01 s, 60 s limit; competitive arbiter seed 0 (noise study: seeds 0, 1, 2, 3, 4)."
+    (``seed`` None: not stated; the noise study's seeds only when it ran)."""
+    scenarios = f"{n} scenario{'s' * (n != 1)}" + (f" (seed {seed})" if seed is not None else "")
+    limit = config.time_limit if config.time_limit is not None else TIME_LIMIT_S
+    seeds = ", ".join(str(s) for s in NOISE_SEEDS)
+    study = f" (noise study: seeds {seeds})" if noise else ""
+    return (
+        f"{scenarios}, {config.plant} plant, payload {config.payload:g} kg, step "
+        f"{config.dt:g} s, {limit:g} s limit; competitive arbiter seed "
+        f"{config.arbiter_seed}{study}."
+    )
+
+
 def write_study(
     folder,
     scenarios: list[Scenario],
@@ -442,10 +463,12 @@ def write_study(
     run: Runner,
     jobs: int = 1,
     noise: bool = True,
+    seed: int | None = None,
 ) -> dict[str, Any]:
     """Run the study and write ``arbiters.md``, per-run CSVs and the weight figures.
 
-    Returns the JSON-ready summary (the CLI writes it as ``summary.json``).
+    ``arbiters.md`` opens with :func:`context_line` (``seed``: the scenarios' seed, None:
+    not stated). Returns the JSON-ready summary (the CLI writes it as ``summary.json``).
     """
     from pathlib import Path
 
@@ -459,7 +482,7 @@ def write_study(
     baseline = by_key["baseline"]
     sections = [
         "# State machine vs competitive dynamics\n",
-        f"{len(scenarios)} scenarios, payload {config.payload:g} kg, step {config.dt:g} s.\n",
+        context_line(len(scenarios), seed, config, noise) + "\n",
         "## Thesis Table 5.2, baseline thresholds\n",
         table_52([(label, baseline.summaries[a]) for a, label in ARBITER_COLUMNS]),
         "## Threshold variants (cells: state machine / competitive)\n",

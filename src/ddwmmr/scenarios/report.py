@@ -221,24 +221,84 @@ def _save(fig, path) -> None:
     write_atomic(path, buffer.getvalue())
 
 
+#: Hatch and legend label of the bars of scenarios that did not finish (a timeout, a tip,
+#: a collision...): their times are the instant the run stopped, not a finished scenario's.
+FAILED_HATCH = "///"
+FAILED_LABEL = "did not finish"
+#: Up to this many scenarios, every scenario number is a tick; beyond, integer ticks only.
+MAX_LABELLED_SCENARIOS = 25
+
+
+def _failed(outcomes: Sequence[Outcome]) -> np.ndarray:
+    return np.array([not o.metrics["success"] for o in outcomes], dtype=bool)
+
+
+def _bars(ax, index, values, failed: np.ndarray, **kwargs):
+    """``ax.bar`` with the bars of failed scenarios hatched (dark hatch, no outline)."""
+    bars = ax.bar(index, values, **kwargs)
+    for patch, hatched in zip(bars.patches, failed):
+        if hatched:
+            patch.set_hatch(FAILED_HATCH)
+            patch.set_edgecolor("0.1")
+            patch.set_linewidth(0.0)
+    return bars
+
+
+def _failed_handle():
+    import matplotlib.patches as patches
+
+    return patches.Patch(facecolor="white", edgecolor="0.1", hatch=FAILED_HATCH, label=FAILED_LABEL)
+
+
+def _bar_axes(
+    ax, index, failed: np.ndarray, entries: bool = False, empty: str = "0 in every scenario"
+) -> None:
+    """Scenario-number ticks, a y-axis from 0 and a legend beside the axes (never on
+    the tallest bars) naming the series (``entries``) and, if any are drawn, the hatched
+    bars. Without a bar above 0 the axis is 0..1 and says ``empty``."""
+    from matplotlib.ticker import MaxNLocator
+
+    from ddwmmr.reports.legends import legend_beside
+
+    if len(index) <= MAX_LABELLED_SCENARIOS:
+        ax.set_xticks(np.asarray(index, dtype=float), [str(int(i)) for i in index])
+    else:
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True, steps=[1, 2, 5, 10]))
+    heights = [p.get_y() + p.get_height() for p in ax.patches]
+    top = np.nanmax(heights) if heights and np.any(np.isfinite(heights)) else 0.0
+    if top > 0:
+        ax.set_ylim(bottom=0.0)
+    else:  # nothing to scale to: a unit axis from 0 rather than -0.04..0.04
+        ax.set_ylim(0.0, 1.0)
+        ax.text(0.5, 0.5, empty, transform=ax.transAxes, ha="center", va="center")
+    handles, labels = ax.get_legend_handles_labels() if entries else ([], [])
+    if failed.any() and top > 0:  # hatched bars to name
+        handles, labels = [*handles, _failed_handle()], [*labels, FAILED_LABEL]
+    if handles:
+        legend_beside(ax, handles=handles, labels=labels, fontsize=8)
+
+
 def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
     """Stacked per-scenario time in each state (thesis Figs 5.3, 5.10, 5.11).
 
     Controllers without states move base and arm together, so their times overlap: they
-    are drawn as grouped bars (total, base moving, arm moving) instead of stacked.
+    are drawn as grouped bars (total, base moving, arm moving) instead of stacked. Bars
+    of scenarios that did not finish are hatched (:data:`FAILED_HATCH`); the legend sits
+    beside the axes.
     """
     fig, ax = _figure()
     ax = ax[0, 0]
     index = np.array([o.metrics["scenario"] for o in outcomes])
+    failed = _failed(outcomes)
+    ax.set(xlabel="scenario", ylabel="time (s)", title=title)
     if np.all(np.isnan(_column(outcomes, "time_stability_s"))):
         for shift, key, label in (
             (-0.3, "time_s", "total"),
             (0.0, "time_base_s", "base moving"),
             (0.3, "time_arm_s", "arm moving"),
         ):
-            ax.bar(index + shift, _column(outcomes, key), width=0.3, label=label)
-        ax.set(xlabel="scenario", ylabel="time (s)", title=title)
-        ax.legend(loc="upper right", ncol=3, fontsize=8)
+            _bars(ax, index + shift, _column(outcomes, key), failed, width=0.3, label=label)
+        _bar_axes(ax, index, failed, entries=True)
         _save(fig, path)
         return
     bottom = np.zeros(len(outcomes))
@@ -251,45 +311,46 @@ def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
     ):
         values = np.nan_to_num(_column(outcomes, key))
         if np.any(values):
-            ax.bar(index, values, bottom=bottom, label=label, width=0.85)
+            _bars(ax, index, values, failed, bottom=bottom, label=label, width=0.85)
             bottom += values
-    ax.set(xlabel="scenario", ylabel="time (s)", title=title)
-    if bottom.any():
-        ax.legend(loc="upper right", ncol=5, fontsize=8)
-    else:  # no bar to name
-        ax.text(
-            0.5,
-            0.5,
-            "every scenario ended at t = 0",
-            transform=ax.transAxes,
-            ha="center",
-            va="center",
-        )
+    _bar_axes(ax, index, failed, entries=True, empty="every scenario ended at t = 0")
     _save(fig, path)
 
 
 def plot_speeds(outcomes: Sequence[Outcome], path, title: str) -> None:
-    """Per-scenario speed (Fig 5.4) and speed over base-moving time only (Fig 5.5)."""
+    """Per-scenario speed (Fig 5.4) and speed over base-moving time only (Fig 5.5);
+    bars of scenarios that did not finish are hatched."""
     fig, axes = _figure(2, 1)
     index = [o.metrics["scenario"] for o in outcomes]
+    failed = _failed(outcomes)
     length = _column(outcomes, "path_length_m")
-    axes[0, 0].bar(index, _column(outcomes, "speed_m_s"), width=0.85)
+    _bars(axes[0, 0], index, _column(outcomes, "speed_m_s"), failed, width=0.85)
     axes[0, 0].set(ylabel="speed (m/s)", title=f"{title}: path length / total time")
     base = _column(outcomes, "time_base_s")
     with np.errstate(divide="ignore", invalid="ignore"):
-        axes[1, 0].bar(index, np.where(base > 0, length / base, np.nan), width=0.85)
+        _bars(axes[1, 0], index, np.where(base > 0, length / base, np.nan), failed, width=0.85)
     axes[1, 0].set(xlabel="scenario", ylabel="speed (m/s)", title="path length / base-moving time")
+    _bar_axes(axes[0, 0], index, failed)
+    _bar_axes(axes[1, 0], index, np.zeros_like(failed))
     _save(fig, path)
 
 
 def plot_fix_state(outcomes: Sequence[Outcome], key: str, path, title: str) -> None:
-    """Per-scenario time in and transitions into one fix state (Figs 5.7, 5.9)."""
+    """Per-scenario time in and transitions into one fix state (Figs 5.7, 5.9); bars of
+    scenarios that did not finish are hatched."""
+    from matplotlib.ticker import MaxNLocator
+
     fig, axes = _figure(2, 1)
     index = [o.metrics["scenario"] for o in outcomes]
-    axes[0, 0].bar(index, np.nan_to_num(_column(outcomes, f"time_{key}_s")), width=0.85)
+    failed = _failed(outcomes)
+    _bars(axes[0, 0], index, np.nan_to_num(_column(outcomes, f"time_{key}_s")), failed, width=0.85)
     axes[0, 0].set(ylabel="time (s)", title=f"{title}: time in {key} state")
-    axes[1, 0].bar(index, np.nan_to_num(_column(outcomes, f"transitions_{key}")), width=0.85)
+    counts = np.nan_to_num(_column(outcomes, f"transitions_{key}"))
+    _bars(axes[1, 0], index, counts, failed, width=0.85)
     axes[1, 0].set(xlabel="scenario", ylabel="transitions", title=f"transitions into {key}")
+    _bar_axes(axes[0, 0], index, failed)
+    _bar_axes(axes[1, 0], index, np.zeros_like(failed))
+    axes[1, 0].yaxis.set_major_locator(MaxNLocator(integer=True))  # a count
     _save(fig, path)
 
 
@@ -328,7 +389,10 @@ def plot_paths(items: Sequence[tuple[Scenario, Outcome]], path, title: str) -> N
 def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None = None) -> None:
     """Controller state, stability, manipulability and the distance to the current waypoint
     over time for one scenario (thesis Fig 5.17); with ``scenario``, the instants at which
-    each waypoint was reached are marked."""
+    each waypoint was reached are marked.
+
+    The top title states the outcome (:func:`outcome_text`); a scenario that did not
+    finish has the instant it stopped marked by a red vertical in every panel."""
     from ddwmmr.reports.legends import legend_beside
 
     tr = outcome.trace or {}
@@ -341,10 +405,15 @@ def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None 
         outcome.metrics["transitions_stability"]
     ):  # no arbiter: the trace only tells whether the base moves
         ax.set_yticks([0, 1], ["base moving", "base at rest"])
-        ax.set(title=f"{title}: scenario {number} base motion", ylabel="base")
+        ax.set(ylabel="base")
+        shown_as = "base motion"
     else:
         ax.set_yticks(range(len(STATES)), [s.replace("_", " ") for s in STATES])
-        ax.set(title=f"{title}: scenario {number} controller state", ylabel="state")
+        ax.set(ylabel="state")
+        shown_as = "controller state"
+    total = len(scenario.waypoints) if scenario is not None else None
+    outcome_title = outcome_text(outcome.metrics, total)
+    ax.set_title(f"{title}: scenario {number} {shown_as}; {outcome_title}")
     ax2 = axes[1, 0]
     ax2.plot(t, tr.get("s", []), color="tab:brown", label="stability S")
     ax2.axhline(1.0, color="tab:red", lw=0.8, ls="--", label="S = 1 (tips over)")
@@ -383,10 +452,32 @@ def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None 
         axis.sharex(ax4)
         axis.grid(alpha=0.3)
     ax4.grid(alpha=0.3)
+    if not outcome.metrics["success"] and len(t) > 1:
+        for axis in (ax, ax2, ax3, ax4):
+            label = f"stopped: {_cut(outcome.metrics['reason'], 30)}" if axis is ax4 else None
+            axis.axvline(outcome.metrics["time_s"], color="tab:red", lw=1.2, label=label)
     # Beside the panels: the waypoint marks span the whole height of the last one.
     for axis in (ax2, ax3, ax4):
         legend_beside(axis, fontsize=8)
     _save(fig, path)
+
+
+def outcome_text(metrics: dict[str, Any], waypoints: int | None = None) -> str:
+    """How a scenario ended, for a title: "reached all 5 waypoints in 24.2 s", or for
+    one that did not finish "tipped (physics) at 10.3 s, 3 of 5 waypoints reached"
+    (``waypoints``: the scenario's count; None: not stated). A long reason (a
+    controller's error message) is cut to 60 characters."""
+    reached, time = metrics["waypoints_reached"], metrics["time_s"]
+    if metrics["success"]:
+        count = f"all {waypoints}" if waypoints is not None else f"all {reached}"
+        return f"reached {count} waypoints in {time:.1f} s"
+    of = f" of {waypoints}" if waypoints is not None else ""
+    return f"{_cut(metrics['reason'], 60)} at {time:.1f} s, {reached}{of} waypoints reached"
+
+
+def _cut(text: str, width: int) -> str:
+    text = " ".join(str(text).split())
+    return text if len(text) <= width else text[: width - 3] + "..."
 
 
 def _mark_waypoints(ax, trace: dict, scenario: Scenario) -> None:

@@ -13,6 +13,10 @@ from typing import Any
 
 from ddwmmr.arbiters.state_machine import THESIS_MANIPULABILITY, THESIS_STABILITY
 from ddwmmr.scenarios.generator import Scenario, place_obstacles
+from ddwmmr.scenarios.protocol import TIME_LIMIT_S, RunConfig
+
+#: Scenarios behind each of the thesis's published numbers (thesis 5.1).
+THESIS_N = 100
 
 
 @dataclass(frozen=True)
@@ -113,8 +117,26 @@ THRESHOLD_COLUMNS = (
 )
 
 
-def threshold_table(results: list[tuple[Variant, dict[str, Any]]]) -> str:
-    """Markdown table: each variant's thesis row next to ours ("thesis / ours" per cell)."""
+def context_line(n: int, seed: int | None, config: RunConfig) -> str:
+    """What "ours" in a "thesis / ours" cell is: e.g. "ours: 2 scenarios (seed 0), thesis
+    controller, thesis plant, payload 3 kg, state-machine arbiter, 60 s limit; the
+    thesis: 100 scenarios, 1.25 kg payload" (``seed`` None: not stated). A failure count
+    is out of each side's own number of scenarios."""
+    scenarios = f"{n} scenario{'s' * (n != 1)}" + (f" (seed {seed})" if seed is not None else "")
+    arbiter = config.arbiter if isinstance(config.arbiter, str) else type(config.arbiter).__name__
+    if arbiter == "competitive":
+        arbiter += f" (arbiter seed {config.arbiter_seed})"
+    limit = config.time_limit if config.time_limit is not None else TIME_LIMIT_S
+    return (
+        f"ours: {scenarios}, {config.controller} controller, {config.plant} plant, "
+        f"payload {config.payload:g} kg, {arbiter} arbiter, {limit:g} s limit; "
+        f"the thesis: {THESIS_N} scenarios, 1.25 kg payload"
+    )
+
+
+def threshold_table(results: list[tuple[Variant, dict[str, Any]]], context: str = "") -> str:
+    """Markdown table: each variant's thesis row next to ours ("thesis / ours" per cell),
+    after ``context`` (:func:`context_line`) as its own paragraph when given."""
     head = "| variant (thesis table) | S enter/exit | eta enter/exit | "
     head += " | ".join(label for _, _, label in THRESHOLD_COLUMNS) + " |"
     lines = [head, "|" + "---|" * (3 + len(THRESHOLD_COLUMNS))]
@@ -127,7 +149,8 @@ def threshold_table(results: list[tuple[Variant, dict[str, Any]]]) -> str:
         for thesis_key, our_key, _ in THRESHOLD_COLUMNS:
             cells.append(f"{_g(variant.thesis[thesis_key])} / {_g(summary[our_key])}")
         lines.append("| " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
+    table = "\n".join(lines) + "\n"
+    return f"{context}\n\n{table}" if context else table
 
 
 OBSTACLE_ROWS = (
