@@ -46,6 +46,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ddwmmr.behaviours.obstacle import base_bubble
 from ddwmmr.commands import PlantTraits
 from ddwmmr.controllers.base import (
     StepInfo,
@@ -489,15 +490,25 @@ class QPController:
     @classmethod
     def waypoint_options(cls, run: WaypointRun) -> dict[str, Any]:
         """The options of a waypoint-task run: the protocol's stability floor and
-        end-effector speed, position only, the scenario's obstacles, its control step; the
-        plant's velocity envelope (what a force-limited base can follow), then the run's
-        own ``controller_options`` over all of these."""
+        end-effector speed, position only, the scenario's obstacles as the protocol judges
+        them, its control step; the plant's velocity envelope (what a force-limited base
+        can follow), then the run's own ``controller_options`` over all of these.
+
+        The protocol judges a collision by the base's enclosing circle (radius
+        :func:`~ddwmmr.behaviours.obstacle.base_bubble`) while the qp keeps its footprint
+        rectangle clear: each circle is grown by ``base_bubble - min(base_length,
+        base_width) / 2`` (0.110 m for the protocol's robot), the least growth with which a
+        footprint clear of the grown circle keeps the enclosing circle clear of the real
+        one (level with the middle of a long side; with more room elsewhere), so the qp's
+        ``obstacle_margin`` is the enclosing circle's clearance there."""
         config = run.config
+        robot = Robot().with_payload(config.payload)  # the protocol's robot (run_scenario)
+        grow = base_bubble(robot) - 0.5 * min(robot.base_length, robot.base_width)
         return {
             "stability_min": config.qp_stability_min,
             "track_orientation": False,
             "max_speed": config.qp_max_speed,
-            "obstacles": [tuple(o) for o in run.scenario.obstacles],
+            "obstacles": [(x, y, radius + grow) for x, y, radius in run.scenario.obstacles],
             "dt": config.dt,
             **(run.velocity_envelope or {}),
             **dict(config.controller_options),

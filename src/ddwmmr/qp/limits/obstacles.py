@@ -9,7 +9,8 @@ the rectangle towards it (base frame),
     d_dot = -n_x v + (n_x p_y - n_y p_x) w
 
 (the arm does not enter). :class:`ObstacleLimit` keeps ``d_dot >= -gain (d - margin)``
-for every circle within ``influence`` of the footprint (a velocity damper).
+for every circle within ``influence`` of the footprint (a velocity damper); where no input
+changes that clearance to first order, ``d_dot >= min(that, 0)`` (:meth:`ObstacleLimit.row`).
 """
 
 from __future__ import annotations
@@ -39,6 +40,12 @@ from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
 from ddwmmr.trajectories.files import find_obstacle_file
+
+#: A circle's row is degenerate when its top clearance rate ``|dd/dv| v_max + |dd/dw|
+#: w_max`` is below this share of ``v_max``, the rate driving straight at the circle: level
+#: with the middle of a side of the footprint no input changes the clearance to first
+#: order (:meth:`ObstacleLimit.row`).
+DEGENERATE_SHARE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -246,14 +253,32 @@ class ObstacleLimit(Limit):
         self.v_max, self.w_max = r * limit, 2.0 * r * limit / lw
 
     def row(self, ctx: StepContext, circle: Circle) -> tuple[float, float, float]:
-        """``(dd/dv, dd/dw, lower bound)`` of one circle's row (-INF when far)."""
+        """``(dd/dv, dd/dw, lower bound)`` of one circle's row (-INF when far).
+
+        The lower bound is the damper's ``-gain (d - margin)`` (m/s), capped at a quarter
+        of the top clearance rate ``|dd/dv| v_max + |dd/dw| w_max`` so the row stays
+        feasible. A degenerate row, whose top clearance rate is below
+        :data:`DEGENERATE_SHARE` of ``v_max`` (a circle level with the middle of a side:
+        to first order no input moves the footprint towards or away from it), is scaled
+        to a unit gradient (the same half-plane) with the bound ``min(damper, 0)``: no
+        approach, and no demanded escape. As it was, with coefficients like 1e-8 m and a
+        positive bound, it asked for a quarter of the top yaw rate to gain 1e-8 m/s of
+        clearance, a row below the solvers' tolerances that they answered differently
+        (DAQP found no solution on every step, others spun the base or not).
+        """
         d, a_v, a_w = clearance_and_rate(
             self.half_length, self.half_width, ctx.x, ctx.y, ctx.phi, circle
         )
         if d >= self.influence:
             return a_v, a_w, -INF
-        achievable = 0.25 * (abs(a_v) * self.v_max + abs(a_w) * self.w_max)
-        return a_v, a_w, min(-self.gain * (d - self.margin), achievable)
+        damper = -self.gain * (d - self.margin)
+        reach = abs(a_v) * self.v_max + abs(a_w) * self.w_max
+        if reach < DEGENERATE_SHARE * self.v_max:
+            norm = math.hypot(a_v, a_w)
+            if norm == 0.0:  # no rate at all: the row reads 0 >= min(damper, 0)
+                return a_v, a_w, min(damper, 0.0)
+            return a_v / norm, a_w / norm, min(damper, 0.0) / norm
+        return a_v, a_w, min(damper, 0.25 * reach)
 
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
         """Rows ``[dd/dv, dd/dw, 0, 0]`` for circles within ``influence``."""
