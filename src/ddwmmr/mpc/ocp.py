@@ -714,14 +714,12 @@ def shooting_grid(intervals: int, dt: float, first: float, horizon: float) -> np
     and the OCP alike: ``intervals`` an integer in [2, :data:`MAX_INTERVALS`], ``dt`` > 0,
     ``first`` and ``horizon`` in [:data:`MIN_INTERVAL`, :data:`MAX_HORIZON`] s,
     ``horizon > dt`` and ``horizon >= dt + (intervals - 1) first``; else a one-line
-    :class:`ParameterError` naming the parameter.
+    :class:`ParameterError` naming the parameter (:func:`check_step_in_horizon` first).
     """
     n = check_int_at_least("intervals", intervals, 2, MAX_INTERVALS)
-    dt = check_positive("dt", dt)
-    first = check_range("first_interval", first, MIN_INTERVAL, MAX_HORIZON, "s")
     horizon = check_range("horizon", horizon, MIN_INTERVAL, MAX_HORIZON, "s")
-    if not horizon > dt:
-        raise ParameterError(f"horizon must be > the control step dt = {dt:g} s (got {horizon:g})")
+    dt = check_step_in_horizon(dt, horizon, n)
+    first = check_range("first_interval", first, MIN_INTERVAL, MAX_HORIZON, "s")
     least = dt + (n - 1) * first
     if horizon - dt < (n - 1) * first * (1.0 - 1e-9):
         raise ParameterError(
@@ -732,6 +730,29 @@ def shooting_grid(intervals: int, dt: float, first: float, horizon: float) -> np
     if rest <= (n - 1) * first * (1.0 + 1e-12):  # equal lengths (within rounding: no ratio)
         return np.concatenate([[dt], np.full(n - 1, rest / (n - 1))])
     return np.concatenate([[dt], grid_intervals(n - 1, first, rest)])
+
+
+def check_step_in_horizon(dt: float, horizon: float, intervals: int) -> float:
+    """The control step ``dt`` (s, > 0) if it leaves room in ``horizon`` (s) for the
+    ``intervals - 1`` later intervals of at least :data:`MIN_INTERVAL` each, else a
+    one-line :class:`ParameterError` naming ``dt``.
+
+    Checked before ``first_interval``: the controller derives that from the horizon's
+    rest, ``(horizon - dt) / (intervals - 1)`` when it is shorter, so a loop step as long
+    as the horizon would otherwise be refused as a first interval the user never set.
+    """
+    dt = check_positive("dt", dt)
+    if not horizon > dt:
+        raise ParameterError(
+            f"dt: the mpc's step must be < its horizon, {horizon:g} s (got {dt:g})"
+        )
+    if (horizon - dt) / (intervals - 1) < MIN_INTERVAL:
+        room = horizon - (intervals - 1) * MIN_INTERVAL
+        raise ParameterError(
+            f"dt: the mpc's step must leave its {intervals - 1} later intervals at least "
+            f"{MIN_INTERVAL:g} s each of its {horizon:g} s horizon, <= {room:g} s (got {dt:g})"
+        )
+    return dt
 
 
 def grid_intervals(intervals: int, first: float, horizon: float) -> np.ndarray:

@@ -39,7 +39,14 @@ from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
 from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, check_min_edge_load
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT, FORCE_LIMIT_DEFAULT
 from ddwmmr.mpc.braking import BRAKE_SLACK
-from ddwmmr.mpc.ocp import MAX_HORIZON, MAX_INTERVALS, MIN_INTERVAL, Weights, shooting_grid
+from ddwmmr.mpc.ocp import (
+    MAX_HORIZON,
+    MAX_INTERVALS,
+    MIN_INTERVAL,
+    Weights,
+    check_step_in_horizon,
+    shooting_grid,
+)
 from ddwmmr.mpc.problem import COLD_ITERATIONS
 from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS
 from ddwmmr.qp.limits import as_circles
@@ -413,7 +420,10 @@ class MPCOptions:
         the OCP checks its grid (:func:`ddwmmr.mpc.ocp.shooting_grid`: ``intervals`` in
         [2, 200], ``horizon > dt`` and ``horizon >= dt + (intervals - 1) x
         first_interval``) at the control step ``dt`` (else :data:`DEFAULT_DT`), so a grid
-        these options accept is one the OCP builds."""
+        these options accept is one the OCP builds. A step too long for the horizon names
+        the horizon when it was given, else ``dt``
+        (:func:`~ddwmmr.mpc.ocp.check_step_in_horizon`, which also refuses a loop's step
+        too long for the grid when the controller adopts it)."""
         dt = self.dt or DEFAULT_DT
         n0, h0, t0 = GRID_DEFAULTS[mode]
         intervals, horizon = self.intervals, self.horizon
@@ -423,7 +433,7 @@ class MPCOptions:
         t = check_range(
             "horizon", t0 if horizon is None else horizon, MIN_INTERVAL, MAX_HORIZON, "s"
         )
-        if not t > dt:
+        if horizon is not None and not t > dt:
             raise ParameterError(f"horizon must be > the control step dt = {dt:g} s (got {t:g})")
         if self.first_interval is None:
             h = min(h0, max((t - dt) / (n - 1), MIN_INTERVAL))
@@ -431,6 +441,16 @@ class MPCOptions:
             h = self.first_interval
         shooting_grid(n, dt, h, t)  # the OCP's own check (one-line errors)
         return int(n), float(h), float(t)
+
+    def grid_at(self, mode: str, dt: float) -> tuple[int, float, float]:
+        """``(intervals, first interval s, horizon s)`` of objective ``mode`` as a run at
+        control step ``dt`` (s) builds it: :meth:`grid` with the first interval shortened
+        to the horizon's rest, ``(horizon - dt) / (intervals - 1)``, when that is shorter;
+        a ``dt`` with no room left is refused naming ``dt``
+        (:func:`~ddwmmr.mpc.ocp.check_step_in_horizon`)."""
+        n, h, t = self.grid(mode)
+        dt = check_step_in_horizon(dt, t, n)
+        return n, min(h, (t - dt) / (n - 1)), t
 
     def weights(self, mode: str) -> Weights:
         """The cost weights of objective ``mode`` (the terminal cost only when tracking)."""
@@ -456,7 +476,7 @@ class MPCOptions:
         (s) uses (the grid, the position weight and the Huber scale of that objective), in
         plain types for the run's summary."""
         values = {f.name: getattr(self, f.name) for f in fields(self)}
-        intervals, first, horizon = self.grid(mode)
+        intervals, first, horizon = self.grid_at(mode, dt)
         values.update(
             intervals=intervals,
             # the interval after dt as the controller builds it (with 2, the horizon's rest)
