@@ -95,7 +95,10 @@ def test_cli_arbiter_study_writes_tables_and_figures(tmp_path, capsys):
     for heading in ("Thesis Table 5.2", "Threshold variants", "Smoothness", "Noise seeds"):
         assert heading in text
     assert "Stability 1.50 with hysteresis 1.70" in text
-    assert "3 s limit; competitive arbiter seed 0 (noise study: seeds 0, 1, 2, 3, 4)." in text
+    assert (
+        "2 scenarios (seed 0), thesis plant, payload 3 kg, step 0.01 s, 3 s limit; "
+        "competitive arbiter seed 0 (noise study: seeds 0, 1, 2, 3, 4)."
+    ) in text
     for key in ("baseline", "stab-1.50-1.70", "stab-nohyst-1.50"):
         assert (out / f"competitive_weights_{key}.png").stat().st_size > 1000
     assert (out / "baseline-competitive.csv").exists()

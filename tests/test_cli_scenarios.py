@@ -36,12 +36,14 @@ def test_benchmark_writes_csv_summary_table_and_figures(tmp_path, capsys):
 
 
 def test_no_hysteresis_option_sets_exit_to_enter(tmp_path):
+    """With the default thresholds, or with EXIT given equal to ENTER (a different EXIT,
+    which it would drop, is refused)."""
     out = tmp_path / "run"
-    args = [*FAST, "--out", str(out), "--stability", "1.3", "1.7", "--no-hysteresis", "stability"]
-    assert cli(args) == 0
+    args = [*FAST, "--out", str(out), "--stability", "1.3", "1.3", "--no-hysteresis", "stability"]
+    assert cli([*args, "--no-hysteresis", "manipulability"]) == 0
     config = json.loads((out / "summary.json").read_text())["config"]
     assert config["stability"] == [1.3, 1.3]
-    assert config["manipulability"] == [0.75, 0.9]
+    assert config["manipulability"] == [0.75, 0.75]
 
 
 def test_obstacle_study_table(tmp_path, capsys):
@@ -60,13 +62,11 @@ def test_obstacle_study_table(tmp_path, capsys):
         (["--n", "0"], "n must be an integer in [1, 100000]"),
         (
             ["--stability", "1.6", "1.2"],
-            "stability thresholds: ENTER must be <= EXIT, both in (0, 10] "
-            "(got --stability 1.6 1.2)",
+            "stability thresholds: ENTER must be <= EXIT, both in (0, 10] (got 1.6, 1.2)",
         ),
         (
             ["--manipulability", "0.9", "0.8"],
-            "manipulability thresholds: ENTER must be <= EXIT, both in (0, 1] "
-            "(got --manipulability 0.9 0.8)",
+            "manipulability thresholds: ENTER must be <= EXIT, both in (0, 1] (got 0.9, 0.8)",
         ),
         (["--controller", "nope"], "invalid choice"),
         (["--controller", "thesis", "--plant", "kinematic"], "thesis or mujoco"),
@@ -90,7 +90,20 @@ def test_obstacle_study_table(tmp_path, capsys):
         (["--controller", "qp", "--stability", "1.3", "1.6"], "--stability: only used with"),
         (["--controller", "mpc", "--manipulability", "0.7", "0.9"], "--manipulability: only"),
         (["--controller", "qp", "--no-hysteresis", "stability"], "--no-hysteresis: only used"),
-        (["--study", "thresholds", "--stability", "1.3", "1.6"], "runs its own thresholds"),
+        (
+            ["--study", "thresholds", "--stability", "1.3", "1.6"],
+            "runs its own thresholds (thesis Table 5.2 and Tables 5.5-5.20); leave it out",
+        ),
+        (
+            ["--no-hysteresis", "stability", "--stability", "1.2", "1.5"],
+            "error: no-hysteresis: --no-hysteresis stability leaves the state at ENTER, so "
+            "--stability 1.2 1.5 gives an EXIT it would ignore; give EXIT = ENTER "
+            "(--stability 1.2 1.2)",
+        ),
+        (
+            ["--no-hysteresis", "manipulability", "--manipulability", "0.7", "0.8"],
+            "--manipulability 0.7 0.8 gives an EXIT it would ignore",
+        ),
         (["--study", "arbiters", "--no-hysteresis", "stability"], "arbiter study runs its own"),
         (["--controller", "qp", "--arbiter", "state-machine"], "only the thesis controller"),
     ],
@@ -149,6 +162,11 @@ def test_threshold_study_table_has_thesis_and_our_numbers(tmp_path, capsys):
     assert len(lines) == 1 + 18  # header + every variant of Tables 5.5-5.20
     assert "| Baseline (5.2) | 1.25/1.6 | 0.75/0.9 | 0 / 2 | 44.9 / 4 |" in table
     assert "42 / " in table  # Table 5.12 threshold 5
+    assert table.startswith(
+        "ours: 2 scenarios (seed 0), thesis controller, thesis plant, payload 3 kg, "
+        "state-machine arbiter, 4 s limit; the thesis: 100 scenarios, 1.25 kg payload\n"
+    )
+    assert "ours: 2 scenarios (seed 0)" in capsys.readouterr().out
     summary = json.loads((out / "summary.json").read_text())
     assert len(summary["variants"]) == 18
 

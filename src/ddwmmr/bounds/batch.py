@@ -210,10 +210,11 @@ def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
     scenario that is not a whole number >= 1 or appears twice; a ``replay_ok`` other than
     True or False; a time that is neither ``nan`` nor a number of seconds in
     :data:`~ddwmmr.errors.DURATION_RANGE_S` (0, negative, inf, 1e-300); a best-known time
-    below the lower bound of its row (a lower bound is at most any time achieved).
+    below the lower bound of its row (a lower bound is at most any time achieved). A UTF-8
+    byte-order mark (a spreadsheet's "CSV UTF-8") is read as none.
     """
     out = {}
-    with open(path, newline="", encoding="utf-8") as handle:
+    with open(path, newline="", encoding="utf-8-sig") as handle:
         reader = csv.DictReader(handle)
         missing = [c for c in READ_COLUMNS if c not in (reader.fieldnames or ())]
         if missing:
@@ -286,11 +287,12 @@ def _bounds_time(where: str, row: dict, key: str) -> float:
 def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, tuple[float, float]]:
     """:func:`read_bounds` of a bounds tool's output, refused (one-line
     :class:`ParameterError`) when unreadable or made for another seed or payload (its
-    summary.json beside it says which)."""
+    summary.json beside it says which; both files may start with a UTF-8 byte-order
+    mark)."""
     path = Path(path)
     try:
         table = read_bounds(path)
-        summary = json.loads((path.parent / "summary.json").read_text(encoding="utf-8"))
+        summary = json.loads((path.parent / "summary.json").read_text(encoding="utf-8-sig"))
     except ParameterError:  # already one line naming what is wrong
         raise
     except (OSError, ValueError, KeyError, csv.Error) as exc:

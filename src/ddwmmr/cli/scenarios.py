@@ -19,11 +19,12 @@ import contextlib
 import datetime as dt
 import json
 import math
+import re
 import sys
 import textwrap
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import asdict, astuple, replace
 from pathlib import Path
 from typing import Any
@@ -55,12 +56,10 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_nonnegative,
     check_range,
-    check_step_count,
     shown,
-    texts_apart,
 )
 from ddwmmr.model import Robot
-from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR, valid_stability_floor
+from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR
 from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
@@ -75,15 +74,21 @@ from ddwmmr.scenarios.executors import (
 )
 from ddwmmr.scenarios.generator import Scenario, generate
 from ddwmmr.scenarios.protocol import (
+    MAX_DT,
+    MAX_QP_SPEED,
     OBSTACLE_TIME_LIMIT_S,
+    THRESHOLD_RANGES,
     TIME_LIMIT_S,
     Outcome,
     RunConfig,
+    check_dt,
+    check_thresholds,
     make_scenario_controller,
     make_scenario_plant,
     plants_for,
     run_scenario,
     scenario_controllers,
+    step_count,
 )
 from ddwmmr.sim.result import json_safe, write_atomic
 
@@ -91,18 +96,16 @@ from ddwmmr.sim.result import json_safe, write_atomic
 MARKER = "summary.json"
 STUDIES = ("thresholds", "obstacles", "arbiters")
 PROG = "python -m ddwmmr.scenarios"
-#: Upper bound of --qp-max-speed (m/s): far above what the robot can do (base 1.5 m/s).
-MAX_QP_SPEED = 10.0
-#: Longest control step (s): the thesis controller's gains are tuned per 0.01 s sample.
-MAX_DT = 0.1
-#: --qp-* options: the controllers that take them, the allowed values and their text.
-QP_OPTIONS = {
-    "qp_stability_min": (
-        ("qp", "mpc"),
-        valid_stability_floor,
-        f"(0, {STABILITY_CAP:g})",
-    ),
-    "qp_max_speed": (("qp",), lambda v: 0.0 < v <= MAX_QP_SPEED, f"(0, {MAX_QP_SPEED:g}] m/s"),
+#: --qp-* options (``RunConfig`` fields, which check their values): the controllers that
+#: use them.
+QP_OPTIONS = {"qp_stability_min": ("qp", "mpc"), "qp_max_speed": ("qp",)}
+#: Relative slack of the check that no scenario beats its ``--bounds`` lower bound (the
+#: bound is a solver's result, good to about its tolerance).
+LOWER_BOUND_SLACK = 1e-6
+#: ``RunConfig`` fields whose option is spelt otherwise, for its messages.
+OPTION_SPELLING = {
+    field: field.replace("_", "-")
+    for field in ("time_limit", "arbiter_seed", "qp_stability_min", "qp_max_speed")
 }
 #: Controller options the protocol sets itself, and what sets them instead of --option.
 PROTOCOL_OPTIONS = {
@@ -113,8 +116,6 @@ PROTOCOL_OPTIONS = {
     "arbiter": "--arbiter",
     "route": "each scenario's own waypoints, with --option lookahead=on or plan=DIR",
 }
-#: Largest threshold: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
-THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}
 #: The thesis's thresholds (enter, exit), the defaults of --stability and --manipulability.
 DEFAULT_THRESHOLDS = {
     "stability": astuple(THESIS_STABILITY),
@@ -241,7 +242,8 @@ def build_parser() -> ArgumentParser:
         action="append",
         default=[],
         choices=("stability", "manipulability"),
-        help="leave that fix state as soon as the metric is back above ENTER (repeatable)",
+        help="leave that fix state as soon as the metric is back above ENTER (repeatable; "
+        "refused with an EXIT other than ENTER in --stability or --manipulability)",
     )
     parser.add_argument(
         "--obstacles",
@@ -366,21 +368,32 @@ def max_start_payload() -> float:
 
 
 def _qp_options(args: argparse.Namespace) -> dict[str, float]:
-    """The given ``--qp-*`` options, checked, and refused for a controller without them."""
+    """The given ``--qp-*`` options, refused for a controller without them (their values
+    are ``RunConfig``'s to check)."""
     options = {}
-    for name, (controllers, allowed, text) in QP_OPTIONS.items():
+    for name, controllers in QP_OPTIONS.items():
         value = getattr(args, name)
         if value is None:
             continue
-        option = name.replace("_", "-")
         if args.controller not in controllers:
             raise ParameterError(
-                f"{option}: only used with --controller {' or '.join(controllers)}"
+                f"{OPTION_SPELLING[name]}: only used with --controller {' or '.join(controllers)}"
             )
-        if not (math.isfinite(value) and allowed(value)):
-            raise ParameterError(f"{option} must be in {text} (got {value:g})")
         options[name] = value
     return options
+
+
+@contextlib.contextmanager
+def _option_names() -> Iterator[None]:
+    """Re-raise a :class:`ParameterError` of the protocol's checks naming the options
+    (``time-limit``), not the ``RunConfig`` fields (``time_limit``)."""
+    try:
+        yield
+    except ParameterError as exc:
+        message = str(exc)
+        for field, option in OPTION_SPELLING.items():
+            message = re.sub(rf"\b{field}\b", option, message)
+        raise ParameterError(message) from None
 
 
 def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, Any], ...]:
@@ -419,14 +432,9 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     if args.study == "arbiters" and args.controller != "thesis":
         raise ParameterError("study: the arbiter study needs --controller thesis")
     _check_thesis_options(args)
-    arbiter = args.arbiter or DEFAULT_ARBITER
-    arbiter_seed = 0 if args.arbiter_seed is None else args.arbiter_seed
-    check_nonnegative("arbiter-seed", arbiter_seed)
     if args.study and args.obstacles:
         raise ParameterError("study: --obstacles is implied by --study obstacles")
-    if not (math.isfinite(args.dt) and 0.0 < args.dt <= MAX_DT):
-        got, (high,) = texts_apart(args.dt, MAX_DT)
-        raise ParameterError(f"dt must be in (0, {high}] s (got {got})")
+    check_dt(args.dt)
     limit = args.time_limit
     if limit is not None and not (math.isfinite(limit) and limit > 0):
         raise ParameterError(f"time-limit must be > 0 s and finite (got {limit:g})")
@@ -438,40 +446,42 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         if args.time_limit is not None
         else (OBSTACLE_TIME_LIMIT_S if obstacles else TIME_LIMIT_S)
     )
-    try:
-        check_step_count(longest, args.dt)
-    except ParameterError as exc:
-        raise ParameterError(str(exc).replace("duration", "time-limit")) from None
+    with _option_names():
+        step_count(longest, args.dt)  # 120 s with obstacles, which RunConfig cannot know
     check_start_pose(args.payload)
-    thresholds = {}
-    for name in ("stability", "manipulability"):
-        given = getattr(args, name)
-        enter, exit_ = DEFAULT_THRESHOLDS[name] if given is None else given
-        high = THRESHOLD_RANGES[name]
-        for value in (enter, exit_):
-            if not (math.isfinite(value) and 0.0 < value <= high):
-                raise ParameterError(
-                    f"{name} thresholds must be in (0, {high:g}] (got {enter:g}, {exit_:g})"
-                )
-        if not enter <= exit_:  # named here: the state machine's check knows no option
-            raise ParameterError(
-                f"{name} thresholds: ENTER must be <= EXIT, both in (0, {high:g}] "
-                f"(got --{name} {enter:g} {exit_:g})"
-            )
-        thresholds[name] = (enter, enter) if name in args.no_hysteresis else (enter, exit_)
-    return RunConfig(
-        controller=args.controller,
-        plant=args.plant,
-        payload=args.payload,
-        stability=thresholds["stability"],
-        manipulability=thresholds["manipulability"],
-        dt=args.dt,
-        time_limit=args.time_limit,
-        **qp_options,
-        arbiter=arbiter,
-        arbiter_seed=arbiter_seed,
-        controller_options=scenario_controller_options(args),
-    )
+    thresholds = {name: _thresholds(args, name) for name in ("stability", "manipulability")}
+    controller_options = scenario_controller_options(args)
+    with _option_names():
+        return RunConfig(
+            controller=args.controller,
+            plant=args.plant,
+            payload=args.payload,
+            stability=thresholds["stability"],
+            manipulability=thresholds["manipulability"],
+            dt=args.dt,
+            time_limit=args.time_limit,
+            **qp_options,
+            arbiter=args.arbiter or DEFAULT_ARBITER,
+            arbiter_seed=0 if args.arbiter_seed is None else args.arbiter_seed,
+            controller_options=controller_options,
+        )
+
+
+def _thresholds(args: argparse.Namespace, name: str) -> tuple[float, float]:
+    """``--stability`` or ``--manipulability`` (``name``) as (enter, exit), checked as
+    ``RunConfig`` checks them; ``--no-hysteresis name`` makes exit enter, and is refused
+    with a given EXIT other than ENTER (which it would silently drop)."""
+    given = getattr(args, name)
+    enter, exit_ = check_thresholds(name, DEFAULT_THRESHOLDS[name] if given is None else given)
+    if name not in args.no_hysteresis:
+        return enter, exit_
+    if given is not None and exit_ != enter:
+        raise ParameterError(
+            f"no-hysteresis: --no-hysteresis {name} leaves the state at ENTER, so --{name} "
+            f"{enter:g} {exit_:g} gives an EXIT it would ignore; give EXIT = ENTER "
+            f"(--{name} {enter:g} {enter:g})"
+        )
+    return enter, enter
 
 
 def _check_thesis_options(args: argparse.Namespace) -> None:
@@ -486,8 +496,8 @@ def _check_thesis_options(args: argparse.Namespace) -> None:
         )
     if given and args.study in ("thresholds", "arbiters"):
         raise ParameterError(
-            f"{given[0]}: the {args.study[:-1]} study runs its own thresholds (thesis Tables "
-            "5.2-5.18); leave it out"
+            f"{given[0]}: the {args.study[:-1]} study runs its own thresholds (thesis Table 5.2 "
+            "and Tables 5.5-5.20); leave it out"
         )
     if args.arbiter is not None and not arbitrated:
         raise ParameterError("--arbiter: only the thesis controller has an arbiter")
@@ -509,7 +519,7 @@ class Runner:
 
     def __init__(self, args: argparse.Namespace) -> None:
         # never more workers than the largest batch has scenarios
-        self.jobs = min(args.jobs or default_jobs(), largest_batch(args))
+        self.jobs = min(args.jobs or min(default_jobs(), MAX_JOBS), largest_batch(args))
         self.executor = args.executor
         self.scheduler = args.scheduler
         self.connect_timeout = args.connect_timeout or CONNECT_TIMEOUT
@@ -569,11 +579,18 @@ def output_names(args: argparse.Namespace, config: RunConfig) -> tuple[str, ...]
 
 
 def _title(config: RunConfig) -> str:
-    s, m = config.stability, config.manipulability
-    title = (
-        f"{config.controller} controller, {config.plant} plant, payload {config.payload:g} kg, "
-        f"S {s[0]:g}/{s[1]:g}, eta {m[0]:g}/{m[1]:g}"
-    )
+    """What the table's batch ran: controller, plant, payload and the settings that
+    controller uses: an arbiter's thresholds (S and eta, enter/exit) and arbiter, or the
+    ``qp``/``mpc``'s stability floor ``S_min`` and the ``qp``'s end-effector speed limit."""
+    title = f"{config.controller} controller, {config.plant} plant, payload {config.payload:g} kg"
+    if controller_traits(config.controller)["arbiter"]:
+        s, m = config.stability, config.manipulability
+        title += f", S {s[0]:g}/{s[1]:g}, eta {m[0]:g}/{m[1]:g}"
+    uses = {name for name, takers in QP_OPTIONS.items() if config.controller in takers}
+    if "qp_stability_min" in uses:
+        title += f", S_min {config.qp_stability_min:g}"
+    if "qp_max_speed" in uses:
+        title += f", max speed {config.qp_max_speed:g} m/s"
     if config.arbiter != "state-machine":
         title += f", {config.arbiter} arbiter"
     return title
@@ -672,13 +689,21 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         scenarios = studies.obstacle_scenarios(scenarios)
     outcomes, wall = runner.run(scenarios, config, "scenarios")
     extra = {"seed": args.seed, "run": _record(args, config)}
+    beaten: list[tuple[int, float, float]] = []
     if args.bounds_table is not None:
-        extra["bracket"] = {"bounds": args.bounds, **report.bracket(outcomes, args.bounds_table)}
+        beaten = below_lower_bound(outcomes, args.bounds_table)
+        extra["bracket"] = {
+            "bounds": args.bounds,
+            **report.bracket(outcomes, args.bounds_table),
+            "scenarios_below_lower_bound": [number for number, _, _ in beaten],
+        }
     if config.controller == "mpc":
         extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     if args.bounds_table is not None:
         print(_bracket_line(summary["bracket"], args.bounds, len(outcomes)))
+        if beaten:
+            print(_beaten_line(beaten, args.bounds), file=sys.stderr)
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
@@ -702,6 +727,39 @@ def _bracket_line(b: dict[str, Any], bounds: str, n: int) -> str:
         else:
             parts.append(f"none (no successful scenario has a {end} in the file)")
     return f"mean ratio to the lower bound {parts[0]}, to the best-known time {parts[1]} ({bounds})"
+
+
+def below_lower_bound(
+    outcomes: list[Outcome], table: dict[int, tuple[float, float]]
+) -> list[tuple[int, float, float]]:
+    """``(scenario, time_s, lower_bound_s)`` of each successful scenario that reached its
+    last waypoint before the bounds file's lower bound (by more than
+    :data:`LOWER_BOUND_SLACK`, relative): no run can, so the file is not for this task."""
+    beaten = []
+    for o in outcomes:
+        m = o.metrics
+        lower = table.get(m["scenario"], (math.nan, math.nan))[0]
+        if m["success"] and m["time_s"] * (1.0 + LOWER_BOUND_SLACK) < lower:
+            beaten.append((m["scenario"], m["time_s"], lower))
+    return beaten
+
+
+def _beaten_line(beaten: list[tuple[int, float, float]], bounds: str) -> str:
+    """The warning of ``--bounds`` when scenarios beat their lower bounds: which, and by
+    how much the first did."""
+    numbers = [str(number) for number, _, _ in beaten]
+    listed = ", ".join(numbers[:10]) + (
+        f" and {len(numbers) - 10} more" if len(numbers) > 10 else ""
+    )
+    number, time_s, lower = beaten[0]
+    first = f"scenario {number}: " if len(beaten) > 1 else ""
+    return (
+        f"scenarios: warning: {bounds} gives lower bounds above the times achieved in "
+        f"scenario{'s' * (len(beaten) > 1)} {listed} ({first}{time_s:g} s < {lower:g} s); "
+        "a lower bound holds for every run of its scenario, so the file is "
+        "not for these scenarios (other waypoints, robot or limits) or is wrong, and the "
+        "ratios to its lower bounds mean nothing"
+    )
 
 
 def mpc_options(config: RunConfig, scenario: Scenario) -> dict[str, Any]:
@@ -728,7 +786,8 @@ def _run_thresholds(args, config, runner, folder: Path) -> None:
         results.append((variant, summary))
         rows.append({"variant": variant.key, **{k: summary[k] for k in summary if k != "failures"}})
         write_atomic(folder / f"{variant.key}.csv", report.metrics_csv(outcomes))
-    table = studies.threshold_table(results)
+    context = studies.context_line(len(scenarios), args.seed, config)
+    table = studies.threshold_table(results, context)
     write_atomic(folder / "thresholds.md", table)
     total = {
         "study": "thresholds",
@@ -765,7 +824,9 @@ def _run_arbiters(args, config, runner, folder: Path) -> None:
     from ddwmmr.scenarios import arbiter_study
 
     scenarios = generate(args.n, args.seed)
-    study = arbiter_study.write_study(folder, scenarios, config, runner.run, runner.jobs)
+    study = arbiter_study.write_study(
+        folder, scenarios, config, runner.run, runner.jobs, seed=args.seed
+    )
     study.update(seed=args.seed, config=asdict(config), run=_record(args, config))
     write_atomic(folder / MARKER, json.dumps(json_safe(study), indent=2) + "\n")
     print(study["table"], end="")
@@ -834,7 +895,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         # worker: a bad one is one line and status 2, not an error in every scenario
         robot = config_robot(config)
         plant = make_scenario_plant(robot, config)
-        controller = make_scenario_controller(robot, generate(1, 0)[0], config, plant)
+        controller = make_scenario_controller(robot, generate(1, args.seed)[0], config, plant)
         controller.adopt_plant(traits_of(plant))
     writer = output_folder(base, "scenarios", args.force, fresh)  # numbers from base if fresh
     with Runner(args) as runner, writer as folder:  # workers first, then the output

@@ -17,7 +17,7 @@ from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import as_completed
 from typing import Any
 
-from ddwmmr.errors import ParameterError, check_finite, shown
+from ddwmmr.errors import MAX_JOBS, ParameterError, check_finite, check_int_at_least, shown
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import Outcome, RunConfig, run_scenario
 from ddwmmr.workers import process_pool
@@ -66,8 +66,9 @@ def run_many(
     """Run ``scenarios`` under ``config``; outcomes in scenario order.
 
     Args:
-        jobs: worker processes (local) or LocalCluster workers (dask without scheduler);
-            never more than there are scenarios.
+        jobs: worker processes (local) or LocalCluster workers (dask without scheduler),
+            an integer in [1, :data:`~ddwmmr.errors.MAX_JOBS`] (else a one-line
+            :class:`ParameterError`, as ``--jobs``); never more than there are scenarios.
         executor: ``"local"`` (process pool; in-process when jobs == 1) or ``"dask"``.
         scheduler: address of a running Dask scheduler (``tcp://host:8786``); without it
             a LocalCluster is started and closed.
@@ -81,7 +82,7 @@ def run_many(
         raise ParameterError(
             f"executor must be one of {', '.join(EXECUTORS)} (got {shown(executor)})"
         )
-    jobs = max(1, min(jobs, len(scenarios)))
+    jobs = min(check_int_at_least("jobs", jobs, 1, MAX_JOBS), max(1, len(scenarios)))
     chunks = _chunks(scenarios, jobs)
     if executor == "dask" and client is not None:
         results = _run_dask(chunks, config, client, on_done)

@@ -47,7 +47,6 @@ from ddwmmr.arbiters.state_machine import (
     STATES,
     THESIS_MANIPULABILITY,
     THESIS_STABILITY,
-    Hysteresis,
 )
 from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.behaviours.obstacle import base_bubble
@@ -60,14 +59,24 @@ from ddwmmr.controllers.base import (
     make_controller,
 )
 from ddwmmr.errors import (
+    MAX_STEPS,
     ParameterError,
+    check_finite,
+    check_int_at_least,
     check_nonnegative,
     check_positive,
     check_step_count,
+    float_values,
     shown,
+    texts_apart,
 )
 from ddwmmr.model import Robot
-from ddwmmr.model.stability import STABILITY_FLOOR, stability_terms
+from ddwmmr.model.stability import (
+    STABILITY_CAP,
+    STABILITY_FLOOR,
+    stability_terms,
+    valid_stability_floor,
+)
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
 from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
@@ -82,6 +91,17 @@ MOVING_SPEED, MOVING_RATE = 1e-3, 1e-3
 #: Time limit (s) of a scenario when ``RunConfig.time_limit`` is None, and of one with
 #: obstacles (thesis 5.1).
 TIME_LIMIT_S, OBSTACLE_TIME_LIMIT_S = 60.0, 120.0
+#: Longest control step (s): the thesis controller's gains are tuned per 0.01 s sample.
+MAX_DT = 0.1
+#: Largest threshold of each fix state: S is capped at STABILITY_CAP, eta = |sin th2| at 1.
+THRESHOLD_RANGES = {"stability": STABILITY_CAP, "manipulability": 1.0}
+#: Upper bound of ``qp_max_speed`` (m/s): far above what the robot can do (base 1.5 m/s).
+MAX_QP_SPEED = 10.0
+#: The ``qp_*`` options: a test of an allowed value and the allowed range as text.
+QP_RANGES = {
+    "qp_stability_min": (valid_stability_floor, f"(0, {STABILITY_CAP:g})"),
+    "qp_max_speed": (lambda v: 0.0 < v <= MAX_QP_SPEED, f"(0, {MAX_QP_SPEED:g}] m/s"),
+}
 #: Trace sampling interval for recorded scenarios (s).
 TRACE_INTERVAL = 0.05
 #: Within this distance (m) of its waypoint the end effector is traced at every step.
@@ -122,22 +142,31 @@ class RunConfig:
             (:func:`scenario_controllers`); plant: a registered plant it can command
             (:func:`plants_for`).
         payload: end-effector payload (kg); 3.0 by default (see docs/thesis.md).
-        stability, manipulability: (enter, exit) thresholds; exit == enter: no hysteresis.
-        dt: control and integration step (s), at most the time limit and with at most
-            :data:`ddwmmr.errors.MAX_STEPS` steps per run, as :func:`ddwmmr.simulate`
-            (with ``time_limit`` None: dt in [6e-5, 60] s, checked here, and in
-            [1.2e-4, 60] s for a scenario with obstacles, checked when it is run).
+            A payload the start pose cannot hold (S <= 1) is not refused here (the
+            command line refuses it): every scenario then fails at t = 0 as ``"tipped"``.
+        stability, manipulability: (enter, exit) thresholds, enter <= exit, both in
+            (0, 10] and (0, 1] (:data:`THRESHOLD_RANGES`, :func:`check_thresholds`);
+            exit == enter: no hysteresis.
+        dt: control and integration step (s), in (0, :data:`MAX_DT`] (:func:`check_dt`),
+            at most the time limit and with at most :data:`ddwmmr.errors.MAX_STEPS` steps
+            per run, as :func:`ddwmmr.simulate` (with ``time_limit`` None: dt >= 6e-5 s,
+            checked here, and >= 1.2e-4 s for a scenario with obstacles, checked when it
+            is run).
         time_limit: s; None: 60 s, or 120 s when the scenario has obstacles.
         tolerance: waypoint tolerance (m).
         qp_stability_min, qp_max_speed: options of the ``qp`` controller (the stability
-            floor is also ``mpc``'s).
+            floor is also ``mpc``'s), in :data:`QP_RANGES` (:func:`check_qp_option`).
         controller_options: further ``(name, value)`` options of the ``qp`` or ``mpc``
             controller (e.g. ``(("horizon", 3.0),)``), over the protocol's own.
         record: keep a trace (every ``TRACE_INTERVAL``) for plots.
         arbiter: thesis controller's arbiter, a registered name
             (``ddwmmr.arbiters.available_arbiters()``: ``"state-machine"``, ``"competitive"``;
             thresholds above) or an arbiter instance (``ddwmmr.arbiters.make_arbiter``).
-        arbiter_seed: noise seed of the competitive arbiter.
+        arbiter_seed: noise seed of the competitive arbiter, an integer >= 0.
+
+    Each field is checked on construction; a bad one raises a one-line
+    :class:`~ddwmmr.errors.ParameterError` worded as ``python -m ddwmmr.scenarios``
+    words it (which builds its configuration here, so both refuse the same values).
     """
 
     controller: str = "thesis"
@@ -171,19 +200,24 @@ class RunConfig:
                 f"plant: the {self.controller} controller outputs {sends} and needs a plant "
                 f"that takes them ({' or '.join(accepted)})"
             )
-        Hysteresis(*self.stability)
-        Hysteresis(*self.manipulability)
+        check_thresholds("stability", self.stability)
+        check_thresholds("manipulability", self.manipulability)
         check_arbiter(self.arbiter, self.controller)
+        check_nonnegative("arbiter_seed", self.arbiter_seed)
+        check_int_at_least("arbiter_seed", self.arbiter_seed, 0)
         check_nonnegative("payload", self.payload)
-        for name in ("dt", "tolerance", "qp_stability_min", "qp_max_speed"):
+        for name in ("dt", "tolerance"):
             check_positive(name, getattr(self, name))
+        for name in QP_RANGES:
+            check_qp_option(name, getattr(self, name))
         if self.time_limit is not None:
             check_positive("time_limit", self.time_limit)
         # Checked here rather than when a worker reaches a scenario halfway through a
         # batch. Without a time_limit, the shorter default: dt above it would run no step
         # at all; whether 120 s (obstacles) stays within the cap depends on the scenario,
         # which steps_for checks when the run starts.
-        _step_count(TIME_LIMIT_S if self.time_limit is None else self.time_limit, self.dt)
+        step_count(TIME_LIMIT_S if self.time_limit is None else self.time_limit, self.dt)
+        check_dt(self.dt)
 
     def limit_for(self, scenario: Scenario) -> float:
         """Time limit (s) for a scenario."""
@@ -193,16 +227,65 @@ class RunConfig:
 
     def steps_for(self, scenario: Scenario) -> int:
         """Most steps of a run of ``scenario``: its time limit / ``dt``, rounded (>= 1)."""
-        return _step_count(self.limit_for(scenario), self.dt)
+        return step_count(self.limit_for(scenario), self.dt)
 
 
-def _step_count(limit: float, dt: float) -> int:
+def step_count(limit: float, dt: float) -> int:
     """:func:`ddwmmr.errors.check_step_count` of a run whose duration is its time limit,
-    the messages naming ``time_limit``."""
+    the messages naming ``time_limit``, and a step count above the cap spelt apart from
+    the cap (10001 s / 0.01 s is not "= 1e+06" against 1000000)."""
     try:
         return check_step_count(limit, dt)
     except ParameterError as exc:
-        raise ParameterError(str(exc).replace("duration", "time_limit")) from None
+        message = str(exc).replace("duration", "time_limit")
+        if message.startswith("time_limit / dt"):  # both are finite numbers > 0 here
+            ratio = limit / dt
+            got, _ = texts_apart(ratio, MAX_STEPS)
+            message = message.replace(f"= {ratio:.3g})", f"= {got})")
+        raise ParameterError(message) from None
+
+
+def check_dt(dt: float) -> float:
+    """``dt`` if it is a control step in (0, :data:`MAX_DT`] s, else a one-line
+    :class:`ParameterError`."""
+    if not (math.isfinite(dt) and 0.0 < dt <= MAX_DT):
+        got, (high,) = texts_apart(dt, MAX_DT)
+        raise ParameterError(f"dt must be in (0, {high}] s (got {got})")
+    return dt
+
+
+def check_qp_option(name: str, value: float) -> float:
+    """``value`` if it is allowed for the ``qp_*`` option ``name`` (:data:`QP_RANGES`),
+    else a one-line :class:`ParameterError`."""
+    allowed, text = QP_RANGES[name]
+    value = check_finite(name, value, f"in {text}")
+    if not allowed(value):
+        raise ParameterError(f"{name} must be in {text} (got {value:g})")
+    return value
+
+
+def check_thresholds(name: str, thresholds: Sequence[float]) -> tuple[float, float]:
+    """``(enter, exit)`` of fix state ``name`` (``"stability"`` or ``"manipulability"``)
+    if both are in (0, :data:`THRESHOLD_RANGES` [name]] with enter <= exit, else a
+    one-line :class:`ParameterError`."""
+    high = THRESHOLD_RANGES[name]
+    values = float_values(thresholds, 2)
+    if values is None:
+        raise ParameterError(
+            f"{name} thresholds must be two numbers (ENTER, EXIT) in (0, {high:g}] "
+            f"(got {shown(thresholds)})"
+        )
+    enter, exit_ = values
+    if not all(math.isfinite(v) and 0.0 < v <= high for v in values):
+        raise ParameterError(
+            f"{name} thresholds must be in (0, {high:g}] (got {enter:g}, {exit_:g})"
+        )
+    if not enter <= exit_:
+        raise ParameterError(
+            f"{name} thresholds: ENTER must be <= EXIT, both in (0, {high:g}] "
+            f"(got {enter:g}, {exit_:g})"
+        )
+    return enter, exit_
 
 
 @dataclass
@@ -525,13 +608,19 @@ def _envelope(plant: Plant) -> dict[str, Any] | None:
 
 
 __all__ = [
+    "MAX_DT",
     "METRICS",
+    "THRESHOLD_RANGES",
     "Outcome",
     "RunConfig",
     "WaypointTask",
+    "check_dt",
+    "check_qp_option",
+    "check_thresholds",
     "make_scenario_controller",
     "make_scenario_plant",
     "plants_for",
     "run_scenario",
     "scenario_controllers",
+    "step_count",
 ]

@@ -1,0 +1,60 @@
+"""``scenarios --bounds``: a bounds file with a byte-order mark is read, and one whose
+lower bounds the run beats is named in a warning (a lower bound holds for every run)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ddwmmr.bounds.batch import read_bounds, read_bounds_file
+from ddwmmr.cli.scenarios import main as cli
+
+HEADER = "scenario,lower_bound_s,best_known_s,replay_ok"
+
+
+def _bounds(folder: Path, rows: list[str], bom: bool = False) -> Path:
+    """bounds.csv and its summary.json (seed 0, the default payload) in ``folder``."""
+    folder.mkdir(parents=True, exist_ok=True)
+    text = "\n".join([HEADER, *rows]) + "\n"
+    (folder / "bounds.csv").write_bytes(("\ufeff" if bom else "").encode() + text.encode())
+    summary = json.dumps({"seed": 0, "payload": 3.0})
+    (folder / "summary.json").write_bytes(("\ufeff" if bom else "").encode() + summary.encode())
+    return folder / "bounds.csv"
+
+
+def test_a_bounds_file_with_a_utf8_byte_order_mark_is_read(tmp_path):
+    """A spreadsheet's "CSV UTF-8" starts with a BOM: it was refused as lacking the
+    column scenario (the first column's name read as "\\ufeffscenario")."""
+    path = _bounds(tmp_path, ["1,10,12,True", "2,nan,nan,False"], bom=True)
+    plain = _bounds(tmp_path / "plain", ["1,10,12,True", "2,nan,nan,False"])
+    assert read_bounds(path).keys() == {1, 2}
+    assert read_bounds(path)[1] == (10.0, 12.0)
+    assert read_bounds_file(path, 0, 3.0)[1] == read_bounds_file(plain, 0, 3.0)[1]
+
+
+def test_a_lower_bound_above_an_achieved_time_is_warned_about(tmp_path, capsys):
+    """Scenario 1 reaches its last waypoint in about 30 s: a file giving it a lower bound
+    of 40 s printed "mean ratio to the lower bound 0.757" without comment."""
+    path = _bounds(tmp_path / "b", ["1,40,45,True", "2,1,2,True"])
+    out = tmp_path / "r"
+    assert (
+        cli(["--n", "2", "--jobs", "1", "--no-progress", "--out", str(out), "--bounds", str(path)])
+        == 0
+    )
+    err = capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())
+    (warning,) = [line for line in err.splitlines() if line.startswith("scenarios: warning")]
+    assert warning.startswith(
+        f"scenarios: warning: {path} gives lower bounds above the times achieved in scenario 1 ("
+    )
+    assert "s < 40 s); a lower bound holds for every run of its scenario" in warning
+    assert summary["bracket"]["scenarios_below_lower_bound"] == [1]
+
+
+def test_no_warning_when_the_run_is_slower_than_its_lower_bounds(tmp_path, capsys):
+    path = _bounds(tmp_path / "b", ["1,10,12,True"])
+    out = tmp_path / "r"
+    assert cli(["--n", "1", "--no-progress", "--out", str(out), "--bounds", str(path)]) == 0
+    assert "scenarios: warning" not in capsys.readouterr().err
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["bracket"]["scenarios_below_lower_bound"] == []
