@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
@@ -69,7 +69,7 @@ from ddwmmr.model import Robot
 from ddwmmr.model.stability import GRAVITY_M_S2
 from ddwmmr.mpc.braking import braked_velocity, braking_input, should_brake
 from ddwmmr.mpc.fallback import fallback_input, make_fallback
-from ddwmmr.mpc.min_time import Guess, plan_path
+from ddwmmr.mpc.min_time import Guess, PlanProblem, plan_path, plan_problem
 from ddwmmr.mpc.models import PredictionModel, make_model
 from ddwmmr.mpc.ocp import OCPConfig
 from ddwmmr.mpc.options import (
@@ -118,7 +118,7 @@ class MPCController:
         except TypeError as error:  # an unknown keyword: name it as make_controller does
             raise ParameterError(f"method {self.name}: {error}") from None
         self.robot = robot
-        self._plan = _load_plan(self.options)
+        self._plan = _load_plan(self.options, robot.payload)
         self._configure(self.options.adopt_plant(None), None)
         self._loop_step: float | None = None
         self.dt = self.options.dt or DEFAULT_DT
@@ -550,7 +550,8 @@ class MPCController:
 
         ``route`` is the scenario's waypoints with ``lookahead`` or a ``plan``; a ``plan``
         that is a folder (``python -m ddwmmr.bounds``'s output) becomes this scenario's
-        best-known trajectory in it (:func:`ddwmmr.mpc.min_time.plan_path`)."""
+        best-known trajectory in it (:func:`ddwmmr.mpc.min_time.plan_path`); building the
+        controller refuses a plan recorded for other waypoints or another payload."""
         config = run.config
         options: dict[str, Any] = {
             "model": "thesis" if FORCE in run.plant.interfaces else "kinematic",
@@ -569,8 +570,17 @@ class MPCController:
         return options
 
 
-def _load_plan(options: MPCOptions) -> Guess | None:
-    """The ``plan`` option's trajectory, with one leg per waypoint of ``route``."""
+#: How far (m) a waypoint may lie from the one a plan was recorded for: a JSON record
+#: holds the waypoints exactly, so only rounding is allowed.
+PLAN_WAYPOINT_TOLERANCE_M = 1e-9
+#: The same for the payload (kg).
+PLAN_PAYLOAD_TOLERANCE_KG = 1e-9
+
+
+def _load_plan(options: MPCOptions, payload: float) -> Guess | None:
+    """The ``plan`` option's trajectory, with one leg per waypoint of ``route``, made for
+    those waypoints and the robot's ``payload`` (kg) where its file records what it was
+    made for (:func:`~ddwmmr.mpc.min_time.plan_problem`)."""
     if options.plan is None:
         return None
     plan = Guess.load(options.plan)
@@ -579,7 +589,43 @@ def _load_plan(options: MPCOptions) -> Guess | None:
             f"plan {options.plan} has {len(plan.arrivals)} legs: route must list as many "
             f"waypoints (got {len(options.route)})"
         )
+    problem = plan_problem(options.plan)
+    if problem is not None:
+        _check_plan_problem(options.plan, problem, options.route, payload)
     return plan
+
+
+def _check_plan_problem(
+    path: str, problem: PlanProblem, route: Sequence[Sequence[float]], payload: float
+) -> None:
+    """A one-line :class:`ParameterError` naming the plan, the file recording what it was
+    made for and what differs, unless that is ``route`` (m; the scenario's waypoints in a
+    scenario run) and ``payload`` (kg)."""
+    advice = "a bounds run of the same seed and payload makes the matching plans"
+    if abs(problem.payload - payload) > PLAN_PAYLOAD_TOLERANCE_KG:
+        raise ParameterError(
+            f"plan {path} was made for a payload of {problem.payload:g} kg "
+            f"({problem.source}), the robot carries {payload:g} kg: {advice}"
+        )
+    waypoints, source = problem.waypoints, str(problem.source)
+    if waypoints is None:  # only the seed is recorded: that seed's scenario
+        from ddwmmr.scenarios.generator import generate
+
+        assert problem.scenario is not None and problem.seed is not None
+        waypoints = generate(problem.scenario, problem.seed)[-1].waypoints
+        source += f": seed {problem.seed}, scenario {problem.scenario}"
+    if len(waypoints) != len(route):
+        raise ParameterError(
+            f"plan {path} was made for {len(waypoints)} waypoints ({source}), the route "
+            f"(the scenario's) has {len(route)}: {advice}"
+        )
+    for number, (made, wanted) in enumerate(zip(waypoints, route, strict=True), start=1):
+        if math.dist(made, wanted) > PLAN_WAYPOINT_TOLERANCE_M:
+            raise ParameterError(
+                f"plan {path} was made for other waypoints than the route's (the "
+                f"scenario's): waypoint {number} is ({made[0]:.6g}, {made[1]:.6g}) m in "
+                f"{source}, ({wanted[0]:.6g}, {wanted[1]:.6g}) m on the route: {advice}"
+            )
 
 
 def _model_choice(resolved: MPCOptions, plant: PlantTraits | None) -> tuple:
