@@ -15,6 +15,8 @@ A run did not track when any of these holds (thresholds documented in docs/cli.m
 * ``tipped_over``: a physics plant recorded the robot tipping over;
 * ``tipped_at_start``: the robot had already tipped over in the start pose (static
   S <= 1, ``start_tipped``; the command-line tools refuse such a run, the API warns);
+* ``collided``: the base's footprint entered an obstacle (``min_obstacle_clearance_m`` < 0;
+  ``qp`` and ``mpc`` with obstacles);
 * ``singular_most_of_run``: more than :data:`MOST_OF_RUN` of the steps were damped at the
   shoulder singularity (``singular_steps``);
 * ``saturated_most_of_run``: more than :data:`MOST_OF_RUN` of the steps had commands
@@ -23,6 +25,11 @@ A run did not track when any of these holds (thresholds documented in docs/cli.m
   end-effector position error exceeds :func:`error_limit`: :data:`ERROR_LIMIT_M`, or
   :data:`OFFSET_FACTOR` times the run's initial offset if that is larger (an open-loop
   method keeps its initial offset by design, and tracks with it).
+
+The likely cause is read from the summary too (:func:`likely_cause`); an obstacle-avoiding
+controller (``qp``, ``mpc``: a ``min_obstacle_clearance_m``) whose base came within
+:data:`OBSTACLE_NEAR_M` of an obstacle, with no other cause in sight, is named as having
+left the trajectory to go round it.
 """
 
 from __future__ import annotations
@@ -40,6 +47,7 @@ __all__ = [
     "ERROR_LIMIT_M",
     "MOST_OF_RUN",
     "NUMBER_KEYS",
+    "OBSTACLE_NEAR_M",
     "OFFSET_FACTOR",
     "REASONS",
     "TRACKED",
@@ -63,12 +71,18 @@ ERROR_LIMIT_M = 0.05
 #: ... unless the initial offset times this is larger: the limit an open-loop method,
 #: which keeps the initial offset (docs/comparing.md), stays within while it tracks.
 OFFSET_FACTOR = 2.0
+#: Footprint clearance (m) below which an obstacle is near enough to have bent the run's
+#: path: the distance within which the qp's obstacle rows and steering act (the
+#: ``influence`` of :class:`~ddwmmr.qp.limits.obstacles.ObstacleLimit` and of
+#: :class:`~ddwmmr.qp.tasks.avoidance.ObstacleSteeringTask`).
+OBSTACLE_NEAR_M = 0.6
 
 #: Reason code -> what it says in the verdict.
 REASONS = {
     "diverged": "the plant diverged",
     "tipped_over": "the robot tipped over (physics)",
     "tipped_at_start": "the robot tips over in its start pose (S = {start_stability:.3g})",
+    "collided": "the base entered an obstacle (footprint clearance {clearance_mm:.3g} mm)",
     "singular_most_of_run": "singular (damped) {singular_steps} of {steps} steps",
     "saturated_most_of_run": "saturated {saturated_steps} of {steps} steps",
     "final_error_above_limit": "final error {final_mm:.4g} mm (limit {limit_mm:.4g} mm)",
@@ -99,6 +113,12 @@ NO_CONVERGENCE = (
     "a closed-loop one check tau, dt and the integrator "
     '(see docs/comparing.md, "Studies")'
 )
+OBSTACLE_DETOUR = (
+    "the base went round an obstacle on or near the path (closest footprint clearance "
+    "{clearance_mm:.3g} mm, under the {near_mm:.0f} mm within which the qp steers round "
+    "obstacles) and left the trajectory to keep clear of it: a trajectory clear of the "
+    'obstacles tracks (see docs/qp.md, "Obstacle on the path")'
+)
 DIVERGED = (
     'the step is too large for the plant or a command was unbounded (see docs/api.md, "Simulation")'
 )
@@ -107,6 +127,16 @@ BELOW_FLOOR = (
     "stability_min {stability_min}): tracking yields until S has risen above it, and "
     "a floor the arm cannot reach holds it back throughout; lower stability_min or start "
     'above it (see docs/qp.md, "Limitations")'
+)
+COLLIDED = (
+    "the controller's obstacle constraint gave way (the mpc's is soft, and a start within "
+    "its keep-out, the base's enclosing circle plus its margin, begins violated): start "
+    'farther from the obstacles (see docs/mpc.md, "Options")'
+)
+MPC_FALLBACK = (
+    "the mpc's solver failed on {mpc_fallbacks} of {steps} steps and its qp fallback "
+    "commanded them: the mpc's options (solver, qp_solver, grid) or limits the start "
+    'cannot meet (see docs/mpc.md, "Options")'
 )
 QP_FALLBACK = (
     "the qp found no solution on {qp_fallbacks} of {steps} steps and held its fallback "
@@ -149,6 +179,8 @@ NUMBER_KEYS = (
     "start_stability",
     "stability_min",
     "qp_fallbacks",
+    "mpc_fallbacks",
+    "min_obstacle_clearance_m",
 )
 #: How a ``summary.json`` spells the non-finite floats (:func:`ddwmmr.sim.result.json_safe`):
 #: a summary read back from one holds these strings where the run held the numbers.
@@ -193,6 +225,9 @@ def reasons(summary: Mapping[str, Any]) -> list[str]:
         found.append("tipped_over")
     if summary.get("start_tipped"):
         found.append("tipped_at_start")
+    clearance = _number(summary, "min_obstacle_clearance_m")  # None: no obstacles
+    if clearance is not None and clearance < 0.0:
+        found.append("collided")
     steps = _number(summary, "steps") or 0
     if steps and (_number(summary, "singular_steps") or 0) > MOST_OF_RUN * steps:
         found.append("singular_most_of_run")
@@ -220,6 +255,8 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return DIVERGED
     if "tipped_over" in found or "tipped_at_start" in found:
         return TIPPED
+    if "collided" in found:
+        return COLLIDED
     start, floor = _number(summary, "start_stability"), _number(summary, "stability_min")
     if start is not None and floor is not None and start < floor:
         start_text, (floor_text,) = texts_apart(start, floor)
@@ -228,6 +265,9 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     fallbacks = _number(summary, "qp_fallbacks") or 0
     if steps and fallbacks > MOST_OF_RUN * steps:
         return QP_FALLBACK.format(qp_fallbacks=int(fallbacks), steps=int(steps))
+    fallbacks = _number(summary, "mpc_fallbacks") or 0
+    if steps and fallbacks > MOST_OF_RUN * steps:
+        return MPC_FALLBACK.format(mpc_fallbacks=int(fallbacks), steps=int(steps))
     if steps and (_number(summary, "singular_steps") or 0) > SINGULAR_CAUSE * steps:
         return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
     min_manipulability = _number(summary, "min_manipulability")
@@ -235,6 +275,11 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return FOLDED_ARM
     if "saturated_most_of_run" in found:
         return SATURATION
+    clearance = _number(summary, "min_obstacle_clearance_m")  # None: no obstacles
+    if clearance is not None and clearance < OBSTACLE_NEAR_M:
+        return OBSTACLE_DETOUR.format(
+            clearance_mm=1000.0 * clearance, near_mm=1000.0 * OBSTACLE_NEAR_M
+        )
     return NO_CONVERGENCE
 
 
@@ -254,6 +299,7 @@ def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
         "rms_mm": 1000.0 * (_number(summary, "rms_position_error_m") or 0.0),
         "limit_mm": 1000.0 * error_limit(summary),
         "start_stability": math.nan if start_stability is None else start_stability,
+        "clearance_mm": 1000.0 * (_number(summary, "min_obstacle_clearance_m") or 0.0),
     }
     what = ", ".join(REASONS[code].format(**values) for code in found)
     return found, what, likely_cause(summary, found)
