@@ -201,12 +201,12 @@ class MPCController:
         ``"reach2"`` (through the target to the next one, the reach grid twice)."""
         reach = mode != "tracking"
         base = "reach" if reach else mode
-        n, h, t = self._grid[base]
         options = self.options
+        n, first, t = options.grid_at(base, self.dt)
         return OCPConfig(
             intervals=n,
             control_interval=self.dt,
-            first_interval=min(h, (t - self.dt) / (n - 1)),
+            first_interval=first,
             horizon=t,
             reach=reach,
             second_leg_intervals=n if mode == "reach2" else 0,
