@@ -608,12 +608,6 @@ def _check_plan_problem(
             f"({problem.source}), the robot carries {payload:g} kg: {advice}"
         )
     waypoints, source = problem.waypoints, str(problem.source)
-    if waypoints is None:  # only the seed is recorded: that seed's scenario
-        from ddwmmr.scenarios.generator import generate
-
-        assert problem.scenario is not None and problem.seed is not None
-        waypoints = generate(problem.scenario, problem.seed)[-1].waypoints
-        source += f": seed {problem.seed}, scenario {problem.scenario}"
     if len(waypoints) != len(route):
         raise ParameterError(
             f"plan {path} was made for {len(waypoints)} waypoints ({source}), the route "

@@ -39,7 +39,6 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import re
 import zipfile
 import zlib
 from collections.abc import Callable, Sequence
@@ -51,7 +50,7 @@ import casadi as ca
 import numpy as np
 
 from ddwmmr import interrupts
-from ddwmmr.errors import MAX_SCENARIOS, ParameterError, check_positive
+from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
@@ -65,8 +64,6 @@ LEG_TIME_RANGE = (0.05, 120.0)
 #: ``PLAN_FOLDER`` of its output folder.
 PLAN_NAME = "scenario-{:03d}-best.npz"
 PLAN_FOLDER = "cache"
-#: A stored plan's name, with its scenario number.
-_PLAN_FILE = re.compile(r"^scenario-(\d{3,})-best\.npz$")
 
 Rows = Callable[..., ca.SX]
 
@@ -223,46 +220,28 @@ def plan_path(folder: str | Path, scenario: int) -> Path:
 @dataclass(frozen=True)
 class PlanProblem:
     """What a stored plan was made for, as ``python -m ddwmmr.bounds`` recorded it:
-    ``source``, the file that says so; ``payload`` (kg); and either ``waypoints`` (m, in
-    order) or the ``seed`` and ``scenario`` number (from 1) of the generated scenario
-    (:func:`ddwmmr.scenarios.generator.generate`) whose waypoints they are."""
+    ``source``, the file that says so; ``payload`` (kg); ``waypoints`` (m, in order)."""
 
     source: Path
     payload: float
-    waypoints: tuple[tuple[float, float], ...] | None = None
-    seed: int | None = None
-    scenario: int | None = None
+    waypoints: tuple[tuple[float, float], ...]
 
 
 def plan_problem(path: str | Path) -> PlanProblem | None:
-    """The problem the plan at ``path`` was made for: from the record the bounds tool keeps
-    beside it (``scenario-NNN-best.json``, its ``key``'s ``waypoints`` and ``payload``),
-    else from the ``summary.json`` of the bounds run whose cache holds it (``seed``,
-    ``payload``; the scenario number from the plan's name). None when neither is there and
-    readable: a plan made elsewhere records nothing to check."""
-    path = Path(path)
-    record = path.with_suffix(".json")
+    """The problem the plan at ``path`` was made for, from the record the bounds tool keeps
+    beside it (``scenario-NNN-best.json``, its ``key``'s ``waypoints`` and ``payload``).
+    None when that record is not there or not readable: a plan made elsewhere records
+    nothing to check. (The bounds run's summary.json names only its seed; turning a seed
+    into waypoints is the scenario generator's, a layer above the controllers.)"""
+    record = Path(path).with_suffix(".json")
     key = _json_field(record, "key")
-    if isinstance(key, dict):
-        try:
-            waypoints = tuple((float(x), float(y)) for x, y in key["waypoints"])
-            return PlanProblem(record, float(key["payload"]), waypoints=waypoints)
-        except (KeyError, TypeError, ValueError):
-            pass  # not the bounds tool's record: try its summary
-    match = _PLAN_FILE.match(path.name)
-    if match is None or path.parent.name != PLAN_FOLDER:
+    if not isinstance(key, dict):
         return None
-    summary = path.parent.parent / "summary.json"
-    seed, payload = _json_field(summary, "seed"), _json_field(summary, "payload")
-    scenario = int(match[1])
-    if (
-        type(seed) is not int  # JSON's true is no seed
-        or seed < 0
-        or type(payload) not in (int, float)
-        or not 1 <= scenario <= MAX_SCENARIOS
-    ):
+    try:
+        waypoints = tuple((float(x), float(y)) for x, y in key["waypoints"])
+        return PlanProblem(record, float(key["payload"]), waypoints)
+    except (KeyError, TypeError, ValueError):
         return None
-    return PlanProblem(summary, float(payload), seed=seed, scenario=scenario)
 
 
 def _json_field(path: Path, name: str) -> object:
