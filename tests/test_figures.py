@@ -122,3 +122,11 @@ def test_figures_of_runs_over_at_t0_draw_without_warnings(tmp_path, monkeypatch)
     assert texts == ["the run ended at t = 0 s", "every scenario ended at t = 0"]
     for fig in figures:
         plt.close(fig)
+
+
+def test_a_summary_of_no_scenarios_is_refused_in_one_line():
+    """summarize([]) raised numpy's 'zero-size array to reduction operation minimum'."""
+    from ddwmmr.errors import ParameterError
+
+    with pytest.raises(ParameterError, match=r"^outcomes: a summary needs at least one"):
+        report.summarize([], 1.0)

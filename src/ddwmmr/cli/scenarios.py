@@ -264,7 +264,8 @@ def build_parser() -> ArgumentParser:
         default=0.01,
         metavar="S",
         help=f"control and integration step in s, in (0, {MAX_DT:g}] (default: 0.01, the thesis "
-        "controller's sample time)",
+        "controller's sample time); with --plant mujoco a whole multiple of its 0.002 s "
+        "engine step",
     )
     parser.add_argument(
         "--jobs",

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.arbiters.state_machine import STATES
+from ddwmmr.errors import ParameterError
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import FINE_TRACE_DISTANCE, METRICS, TRACE_INTERVAL, Outcome
 from ddwmmr.sim.result import write_atomic
@@ -77,6 +78,8 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
     ``fallback_steps`` (and ``fallback_share`` of all steps): the steps whose command was
     the controller's safe fallback after a failed solve; None for the thesis controller.
     """
+    if not outcomes:
+        raise ParameterError("outcomes: a summary needs at least one scenario's outcome (got 0)")
     failed = [o.metrics for o in outcomes if not o.metrics["success"]]
     summary: dict[str, Any] = {"n": len(outcomes), "failed": len(failed)}
     for key, column in AVERAGED:
