@@ -132,3 +132,16 @@ def test_a_qp_or_mpc_table_states_the_settings_they_use_not_the_thesis_threshold
         "thesis controller, thesis plant, payload 3 kg, S 1.4/1.7, eta 0.75/0.9, "
         "competitive arbiter"
     )
+
+
+def test_the_default_worker_count_is_within_what_run_many_accepts(monkeypatch):
+    """On a machine with more CPUs than MAX_JOBS the default was refused by run_many."""
+    import os
+
+    from ddwmmr.errors import MAX_JOBS
+    from ddwmmr.scenarios.executors import default_jobs
+
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: set(range(300)), raising=False)
+    assert default_jobs() == MAX_JOBS == 256
+    monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
+    assert default_jobs() == 2

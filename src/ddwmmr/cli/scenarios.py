@@ -520,7 +520,7 @@ class Runner:
 
     def __init__(self, args: argparse.Namespace) -> None:
         # never more workers than the largest batch has scenarios
-        self.jobs = min(args.jobs or min(default_jobs(), MAX_JOBS), largest_batch(args))
+        self.jobs = min(args.jobs or default_jobs(), largest_batch(args))
         self.executor = args.executor
         self.scheduler = args.scheduler
         self.connect_timeout = args.connect_timeout or CONNECT_TIMEOUT

@@ -36,11 +36,13 @@ def run_chunk(config: RunConfig, scenarios: Sequence[Scenario]) -> list[Outcome]
 
 
 def default_jobs() -> int:
-    """Worker count when none is given: the CPUs this process may use."""
+    """Worker count when none is given: the CPUs this process may use, at most
+    :data:`~ddwmmr.errors.MAX_JOBS` (what ``run_many`` and the tools accept)."""
     try:
-        return max(1, len(os.sched_getaffinity(0)))
+        cpus = len(os.sched_getaffinity(0))
     except AttributeError:  # pragma: no cover - not on Linux
-        return max(1, os.cpu_count() or 1)
+        cpus = os.cpu_count() or 1
+    return min(MAX_JOBS, max(1, cpus))
 
 
 def _chunks(scenarios: Sequence[Scenario], jobs: int) -> list[tuple[Scenario, ...]]:
