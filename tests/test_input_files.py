@@ -264,3 +264,11 @@ def test_a_reachable_offset_is_started_within_the_joint_limits():
     assert offset_configuration(robot, q, (0.0, 0.0)).tolist() == home.tolist()  # to the bit
     ts = simulate(robot, trajectory, "clrrmc-ts", duration=0.2, initial_offset=(-0.22, 0.11))
     assert ts.timeseries["th1"][0] == pytest.approx(start[3])
+
+
+def test_a_step_count_rounded_onto_the_cap_is_spelt_apart_from_it():
+    """10001 s / 0.01 s read '= 1e+06' against the cap 1000000 in every tool."""
+    with pytest.raises(ParameterError, match=re.escape("0.01 s = 1.0001e+06); use a larger")):
+        check_step_count(10001.0, 0.01)
+    with pytest.raises(ParameterError, match=re.escape("0.0001 s = 1.2e+06); use a larger")):
+        check_step_count(120.0, 1e-4)  # clearly above: three digits as before

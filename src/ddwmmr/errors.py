@@ -167,9 +167,12 @@ def check_step_count(duration: float, dt: float) -> int:
         raise ParameterError(f"dt must be <= duration ({duration:g} s) (got {dt:g})")
     ratio = duration / dt
     if not ratio <= MAX_STEPS:
+        got = f"{ratio:.3g}"
+        if not float(got) > MAX_STEPS:  # rounded onto the cap: "= 1e+06" against 1000000
+            got, _ = texts_apart(ratio, MAX_STEPS)
         raise ParameterError(
             f"duration / dt must be <= {MAX_STEPS} steps per run (got {duration:g} s / "
-            f"{dt:g} s = {ratio:.3g}); use a larger dt or a shorter duration"
+            f"{dt:g} s = {got}); use a larger dt or a shorter duration"
         )
     return max(1, round(ratio))
 
