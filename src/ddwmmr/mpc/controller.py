@@ -122,7 +122,6 @@ class MPCController:
         self._configure(self.options.adopt_plant(None), None)
         self._loop_step: float | None = None
         self.dt = self.options.dt or DEFAULT_DT
-        self._grid = {mode: self.options.grid(mode) for mode in GRID_DEFAULTS}
         self._weights = {mode: self.options.weights(mode) for mode in GRID_DEFAULTS}
         self._fallback: Any = None
         self._trajectory: Any = None
@@ -527,7 +526,7 @@ class MPCController:
             "mpc_joint_acceleration_limit_rad_s2": self.joint_acceleration_limit,
             "mpc_wheel_force_limit_n": None if self.dynamics is None else self.dynamics.force_limit,
             "mpc_solver": solver if solver != "rti" else f"rti-{self.options.qp_solver}",
-            "mpc_horizon_s": self._grid[mode][2],
+            "mpc_horizon_s": self.options.grid(mode)[2],
             "mpc_options": self.resolved.record(mode, self.dt),
         }
 
