@@ -51,11 +51,11 @@ def test_the_protocol_hands_the_route_over_only_with_lookahead():
     scenario = generate(1, seed=0)[0]
     plant = traits_of(ThesisPlant(ROBOT))
     plain = MPCController.waypoint_options(
-        WaypointRun(scenario, RunConfig(controller="mpc"), plant)
+        WaypointRun(scenario, RunConfig(controller="mpc"), plant, ROBOT)
     )
     assert "route" not in plain and "lookahead" not in plain
     config = RunConfig(controller="mpc", controller_options=(("lookahead", True),))
-    options = MPCController.waypoint_options(WaypointRun(scenario, config, plant))
+    options = MPCController.waypoint_options(WaypointRun(scenario, config, plant, ROBOT))
     assert options["route"] == [tuple(w) for w in scenario.waypoints]
 
 

@@ -237,7 +237,7 @@ def test_the_protocol_hands_each_scenario_its_plan_from_a_bounds_folder(tmp_path
     assert plan_path(tmp_path, 2) == stored
     assert plan_path(tmp_path / PLAN_FOLDER, 2) == stored  # the cache folder itself
     config = RunConfig(controller="mpc", controller_options=(("plan", str(tmp_path)),))
-    run = WaypointRun(scenario, config, traits_of(ThesisPlant(ROBOT)))
+    run = WaypointRun(scenario, config, traits_of(ThesisPlant(ROBOT)), ROBOT)
     options = MPCController.waypoint_options(run)
     assert options["plan"] == str(stored)
     assert options["route"] == [tuple(w) for w in scenario.waypoints]

@@ -24,7 +24,9 @@ KINEMATIC = PlantTraits(interfaces=("velocity",), judges_tipping=False, joint_ti
 
 def _options(scenario: Scenario) -> dict:
     config = RunConfig(controller="qp", plant="kinematic")
-    return QPController.waypoint_options(WaypointRun(scenario, config, KINEMATIC))
+    return QPController.waypoint_options(
+        WaypointRun(scenario, config, KINEMATIC, ROBOT.with_payload(config.payload))
+    )
 
 
 def test_the_circles_grow_by_the_bubble_less_the_half_width():

@@ -122,6 +122,8 @@ class WaypointRun:
             ``qp_stability_min``, ``qp_max_speed`` in m/s, ``controller_options``, the
             arbiter and its thresholds).
         plant: the traits of the plant it will command.
+        robot: the robot it is built for (the :class:`~ddwmmr.model.Robot` the protocol
+            simulates, payload included).
         velocity_envelope: options that keep a velocity command within what the plant's
             force-limited base can follow (the plant's ``velocity_envelope()``), None when
             the plant has no such limit.
@@ -130,6 +132,7 @@ class WaypointRun:
     scenario: Any
     config: Any
     plant: PlantTraits
+    robot: Any
     velocity_envelope: dict[str, Any] | None = None
 
 

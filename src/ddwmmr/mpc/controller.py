@@ -54,6 +54,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ddwmmr.behaviours.obstacle import base_bubble
 from ddwmmr.commands import FORCE, PlantTraits, WheelForces
 from ddwmmr.controllers.base import (
     StepInfo,
@@ -221,7 +222,7 @@ class MPCController:
             track_orientation=options.track_orientation and not reach,
             huber=options.huber_scale(base),
             obstacles=tuple(options.obstacles),
-            base_radius=0.5 * math.hypot(self.robot.base_length, self.robot.base_width),
+            base_radius=base_bubble(self.robot),
             obstacle_margin=options.obstacle_margin,
             weights=self._weights[base],
         )

@@ -501,8 +501,7 @@ class QPController:
         footprint clear of the grown circle keeps the enclosing circle clear of the real
         one (level with the middle of a long side; with more room elsewhere), so the qp's
         ``obstacle_margin`` is the enclosing circle's clearance there."""
-        config = run.config
-        robot = Robot().with_payload(config.payload)  # the protocol's robot (run_scenario)
+        config, robot = run.config, run.robot
         grow = base_bubble(robot) - 0.5 * min(robot.base_length, robot.base_width)
         return {
             "stability_min": config.qp_stability_min,

@@ -589,7 +589,7 @@ def make_scenario_controller(
     """The registered controller ``config.controller`` built for a waypoint-task run of
     ``scenario`` on ``plant``, with the options its ``waypoint_options`` asks for (it sees
     the plant's traits and velocity envelope, never the plant)."""
-    run = WaypointRun(scenario, config, traits_of(plant), _envelope(plant))
+    run = WaypointRun(scenario, config, traits_of(plant), robot, _envelope(plant))
     options = controller_class(config.controller).waypoint_options(run)
     return make_controller(config.controller, robot, **options)
 
