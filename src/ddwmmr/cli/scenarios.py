@@ -99,9 +99,6 @@ PROG = "python -m ddwmmr.scenarios"
 #: --qp-* options (``RunConfig`` fields, which check their values): the controllers that
 #: use them.
 QP_OPTIONS = {"qp_stability_min": ("qp", "mpc"), "qp_max_speed": ("qp",)}
-#: Relative slack of the check that no scenario beats its ``--bounds`` lower bound (the
-#: bound is a solver's result, good to about its tolerance).
-LOWER_BOUND_SLACK = 1e-6
 #: ``RunConfig`` fields whose option is spelt otherwise, for its messages.
 OPTION_SPELLING = {
     field: field.replace("_", "-")
@@ -692,12 +689,8 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     extra = {"seed": args.seed, "run": _record(args, config)}
     beaten: list[tuple[int, float, float]] = []
     if args.bounds_table is not None:
-        beaten = below_lower_bound(outcomes, args.bounds_table)
-        extra["bracket"] = {
-            "bounds": args.bounds,
-            **report.bracket(outcomes, args.bounds_table),
-            "scenarios_below_lower_bound": [number for number, _, _ in beaten],
-        }
+        beaten = report.below_lower_bound(outcomes, args.bounds_table)
+        extra["bracket"] = {"bounds": args.bounds, **report.bracket(outcomes, args.bounds_table)}
     if config.controller == "mpc":
         extra["controller_options"] = mpc_options(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
@@ -728,21 +721,6 @@ def _bracket_line(b: dict[str, Any], bounds: str, n: int) -> str:
         else:
             parts.append(f"none (no successful scenario has a {end} in the file)")
     return f"mean ratio to the lower bound {parts[0]}, to the best-known time {parts[1]} ({bounds})"
-
-
-def below_lower_bound(
-    outcomes: list[Outcome], table: dict[int, tuple[float, float]]
-) -> list[tuple[int, float, float]]:
-    """``(scenario, time_s, lower_bound_s)`` of each successful scenario that reached its
-    last waypoint before the bounds file's lower bound (by more than
-    :data:`LOWER_BOUND_SLACK`, relative): no run can, so the file is not for this task."""
-    beaten = []
-    for o in outcomes:
-        m = o.metrics
-        lower = table.get(m["scenario"], (math.nan, math.nan))[0]
-        if m["success"] and m["time_s"] * (1.0 + LOWER_BOUND_SLACK) < lower:
-            beaten.append((m["scenario"], m["time_s"], lower))
-    return beaten
 
 
 def _beaten_line(beaten: list[tuple[int, float, float]], bounds: str) -> str:

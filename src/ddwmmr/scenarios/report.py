@@ -46,11 +46,17 @@ def _mean_sd(values: np.ndarray) -> tuple[float, float]:
     return float(np.mean(values)), sd
 
 
+#: Relative slack of the check that no scenario beats its ``--bounds`` lower bound (the
+#: bound is a solver's result, good to about its tolerance).
+LOWER_BOUND_SLACK = 1e-6
+
+
 def bracket(outcomes: Sequence[Outcome], bounds: dict[int, tuple[float, float]]) -> dict:
     """Each successful scenario's time over both ends of its physical-limit bracket
     (``bounds``: ``{scenario: (lower_bound_s, best_known_s)}``, ``python -m
     ddwmmr.bounds``): the mean ratios to the lower bound and to the best-known time, over
-    the scenarios that have the end (NaN if none)."""
+    the scenarios that have the end (NaN if none), and the scenarios faster than their
+    lower bound (:func:`below_lower_bound`)."""
     to_lower, to_best = [], []
     for o in outcomes:
         m = o.metrics
@@ -64,7 +70,23 @@ def bracket(outcomes: Sequence[Outcome], bounds: dict[int, tuple[float, float]])
         "mean_ratio_to_best_known": float(np.mean(to_best)) if to_best else math.nan,
         "scenarios_with_lower_bound": len(to_lower),
         "scenarios_with_best_known": len(to_best),
+        "scenarios_below_lower_bound": [n for n, _, _ in below_lower_bound(outcomes, bounds)],
     }
+
+
+def below_lower_bound(
+    outcomes: Sequence[Outcome], table: dict[int, tuple[float, float]]
+) -> list[tuple[int, float, float]]:
+    """``(scenario, time_s, lower_bound_s)`` of each successful scenario that reached its
+    last waypoint before the bounds file's lower bound (by more than
+    :data:`LOWER_BOUND_SLACK`, relative): no run can, so the file is not for this task."""
+    beaten = []
+    for o in outcomes:
+        m = o.metrics
+        lower = table.get(m["scenario"], (math.nan, math.nan))[0]
+        if m["success"] and m["time_s"] * (1.0 + LOWER_BOUND_SLACK) < lower:
+            beaten.append((m["scenario"], m["time_s"], lower))
+    return beaten
 
 
 def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]:
