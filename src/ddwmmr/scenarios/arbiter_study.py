@@ -39,7 +39,6 @@ from ddwmmr.arbiters.state_machine import STATES, Hysteresis
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import (
-    TIME_LIMIT_S,
     TRACE_INTERVAL,
     Outcome,
     RunConfig,
@@ -445,8 +444,7 @@ def context_line(n: int, seed: int | None, config: RunConfig, noise: bool = True
     """What the study ran: e.g. "2 scenarios (seed 0), thesis plant, payload 3 kg, step
     0.01 s, 60 s limit; competitive arbiter seed 0 (noise study: seeds 0, 1, 2, 3, 4)."
     (``seed`` None: not stated; the noise study's seeds only when it ran)."""
-    scenarios = f"{n} scenario{'s' * (n != 1)}" + (f" (seed {seed})" if seed is not None else "")
-    limit = config.time_limit if config.time_limit is not None else TIME_LIMIT_S
+    scenarios, limit = studies.scenarios_and_limit(n, seed, config)
     seeds = ", ".join(str(s) for s in NOISE_SEEDS)
     study = f" (noise study: seeds {seeds})" if noise else ""
     return (

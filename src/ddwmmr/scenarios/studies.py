@@ -117,16 +117,23 @@ THRESHOLD_COLUMNS = (
 )
 
 
+def scenarios_and_limit(n: int, seed: int | None, config: RunConfig) -> tuple[str, float]:
+    """``"2 scenarios (seed 0)"`` (``seed`` None: not stated) and the run's time limit per
+    scenario (s; the protocol's default when ``config`` gives none): what a study's
+    context line says of its runs."""
+    scenarios = f"{n} scenario{'s' * (n != 1)}" + (f" (seed {seed})" if seed is not None else "")
+    return scenarios, config.time_limit if config.time_limit is not None else TIME_LIMIT_S
+
+
 def context_line(n: int, seed: int | None, config: RunConfig) -> str:
     """What "ours" in a "thesis / ours" cell is: e.g. "ours: 2 scenarios (seed 0), thesis
     controller, thesis plant, payload 3 kg, state-machine arbiter, 60 s limit; the
     thesis: 100 scenarios, 1.25 kg payload" (``seed`` None: not stated). A failure count
     is out of each side's own number of scenarios."""
-    scenarios = f"{n} scenario{'s' * (n != 1)}" + (f" (seed {seed})" if seed is not None else "")
+    scenarios, limit = scenarios_and_limit(n, seed, config)
     arbiter = config.arbiter if isinstance(config.arbiter, str) else type(config.arbiter).__name__
     if arbiter == "competitive":
         arbiter += f" (arbiter seed {config.arbiter_seed})"
-    limit = config.time_limit if config.time_limit is not None else TIME_LIMIT_S
     return (
         f"ours: {scenarios}, {config.controller} controller, {config.plant} plant, "
         f"payload {config.payload:g} kg, {arbiter} arbiter, {limit:g} s limit; "
