@@ -240,6 +240,12 @@ def shown(value: Any, width: int = 40) -> str:
         text = repr(value)
     except ValueError:  # e.g. a container holding such an integer
         return f"a {type(value).__name__}"
+    return one_line(text, width)
+
+
+def one_line(text: str, width: int) -> str:
+    """``text`` on one line (each run of whitespace one space), cut to ``width``
+    characters with "..." at the end."""
     text = " ".join(text.split())
     return text if len(text) <= width else text[: width - 3] + "..."
 

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.arbiters.state_machine import STATES
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, one_line
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import FINE_TRACE_DISTANCE, METRICS, TRACE_INTERVAL, Outcome
 from ddwmmr.sim.result import write_atomic
@@ -478,8 +478,9 @@ def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None 
         axis.grid(alpha=0.3)
     ax4.grid(alpha=0.3)
     if not outcome.metrics["success"] and len(t) > 1:
+        stopped = f"stopped: {one_line(str(outcome.metrics['reason']), 30)}"
         for axis in (ax, ax2, ax3, ax4):
-            label = f"stopped: {_cut(outcome.metrics['reason'], 30)}" if axis is ax4 else None
+            label = stopped if axis is ax4 else None
             axis.axvline(outcome.metrics["time_s"], color="tab:red", lw=1.2, label=label)
     # Beside the panels: the waypoint marks span the whole height of the last one.
     for axis in (ax2, ax3, ax4):
@@ -497,12 +498,8 @@ def outcome_text(metrics: dict[str, Any], waypoints: int | None = None) -> str:
         count = f"all {waypoints}" if waypoints is not None else f"all {reached}"
         return f"reached {count} waypoints in {time:.1f} s"
     of = f" of {waypoints}" if waypoints is not None else ""
-    return f"{_cut(metrics['reason'], 60)} at {time:.1f} s, {reached}{of} waypoints reached"
-
-
-def _cut(text: str, width: int) -> str:
-    text = " ".join(str(text).split())
-    return text if len(text) <= width else text[: width - 3] + "..."
+    reason = one_line(str(metrics["reason"]), 60)
+    return f"{reason} at {time:.1f} s, {reached}{of} waypoints reached"
 
 
 def _mark_waypoints(ax, trace: dict, scenario: Scenario) -> None:
