@@ -7,7 +7,9 @@ behaviour for everything that is not a result:
 * Ctrl-C (SIGINT): one line, status 130; SIGTERM, SIGHUP (terminal closed) and SIGQUIT
   (Ctrl-\\): one line, status 143, 129 and 131 (128 + the signal number, the shell
   convention). Each first stops the tool's worker processes and unwinds the stack, so the
-  output folder's staging copy is removed (:mod:`ddwmmr.outputs`);
+  output folder's staging copy is removed (:mod:`ddwmmr.outputs`). Before ``main`` runs
+  (the tool's imports) and after, the start guard of :mod:`ddwmmr.cli.signals` gives the
+  same line and status;
 * an operating-system error while writing (disk full...): one line, status 1.
 """
 
@@ -20,26 +22,17 @@ import multiprocessing
 import os
 import re
 import signal
-import sys
 import threading
 from collections.abc import Callable, Iterator, Sequence
 
 from ddwmmr import interrupts
+from ddwmmr.cli.signals import EXIT_INTERRUPTED, EXIT_TERMINATED, STOP_SIGNALS, say, stop_line
 from ddwmmr.errors import ParameterError, PluginError, did_you_mean, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import check_output_folder, first_free, output_folder, package_version
 
 #: Exit status for bad input (argparse uses the same).
 EXIT_USAGE = 2
-#: Exit statuses after SIGINT (Ctrl-C) and SIGTERM: 128 + the signal number.
-EXIT_INTERRUPTED = 128 + signal.SIGINT
-EXIT_TERMINATED = 128 + signal.SIGTERM
-#: Signals that stop a tool as SIGTERM does (those this platform has): a closed terminal
-#: (SIGHUP) and Ctrl-\ (SIGQUIT) would otherwise end it without a word, or with a core
-#: dump, and leave its workers and staging folder behind.
-STOP_SIGNALS = tuple(
-    getattr(signal, name) for name in ("SIGTERM", "SIGHUP", "SIGQUIT") if hasattr(signal, name)
-)
 
 __all__ = [
     "EXIT_USAGE",
@@ -216,28 +209,23 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
         with interruptible():
             return main(argv)
     except ParameterError as exc:
-        _say(f"error: {exc}")
+        say(f"error: {exc}")
         return EXIT_USAGE
     except PluginError as exc:  # a user's controller raised: its one line, not a traceback
-        _say(f"error: {exc}")
+        say(f"error: {exc}")
         return 1
     except KeyboardInterrupt:
-        _say("interrupted (Ctrl-C): stopped; unfinished output removed")
+        say(stop_line(signal.SIGINT))
         return EXIT_INTERRUPTED
     except Terminated as stop:
-        _say(f"terminated ({stop.name}): stopped; unfinished output removed")
+        say(stop_line(stop.signum))
         return stop.status
     except BrokenPipeError:  # e.g. output piped into head: nothing left to say
         return 1
     except OSError as exc:
         where = f"{exc.filename}: " if exc.filename else ""
-        _say(f"error: {where}{exc.strerror or exc}")
+        say(f"error: {where}{exc.strerror or exc}")
         return 1
-
-
-def _say(line: str) -> None:
-    with contextlib.suppress(OSError):
-        print(line, file=sys.stderr)
 
 
 def add_robot_arguments(parser: argparse.ArgumentParser) -> None:

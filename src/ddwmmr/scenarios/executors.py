@@ -15,6 +15,7 @@ import signal
 import threading
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import as_completed
+from multiprocessing import resource_tracker
 from typing import Any
 
 from ddwmmr.errors import MAX_JOBS, ParameterError, check_finite, check_int_at_least, shown
@@ -217,13 +218,21 @@ def _terminal_signals_blocked() -> Iterator[None]:
     Threads started in the block, and processes they start (a LocalCluster's event loop,
     its worker processes and multiprocessing's resource tracker), keep the blocked mask:
     a Ctrl-C or a closed terminal then reaches only this process, which stops them
-    itself, instead of killing them half-way with messages of their own. Signals arriving
-    meanwhile are delivered here when the block ends."""
+    itself, instead of killing them half-way with messages of their own (a worker still
+    importing would print a traceback). Signals arriving meanwhile are delivered here when
+    the block ends.
+
+    multiprocessing's resource tracker is started here, in the block: the first spawned
+    process would start it, and starting it unblocks SIGINT and SIGTERM in the starting
+    thread afterwards, so from the cluster's thread every worker spawned after it would
+    take Ctrl-C. Here the block is put back after it."""
     if not hasattr(signal, "pthread_sigmask"):
         yield
         return
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, _TERMINAL_SIGNALS)
     try:
+        resource_tracker.ensure_running()
+        signal.pthread_sigmask(signal.SIG_BLOCK, _TERMINAL_SIGNALS)
         yield
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
