@@ -198,3 +198,24 @@ def test_the_next_run_removes_a_killed_runs_staging_folder(tmp_path):
     notes = [line for line in again.stderr.splitlines() if line.startswith("note: removed")]
     assert len(notes) == 1 and left[0].name in notes[0], again.stderr
     assert [p.name for p in tmp_path.iterdir()] == ["out"]
+
+
+def test_a_tool_started_under_nohup_ignores_sighup(tmp_path):
+    """``nohup`` starts a tool with SIGHUP ignored: a closed terminal must not stop it,
+    while SIGTERM still does."""
+
+    def ignore_hangup() -> None:
+        signal.signal(signal.SIGHUP, signal.SIG_IGN)
+
+    proc = start("track", tmp_path, preexec_fn=ignore_hangup)
+    try:
+        wait_for(lambda: staging(tmp_path))
+        proc.send_signal(signal.SIGHUP)
+        time.sleep(1.0)
+        assert proc.poll() is None, proc.communicate()
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == 143, err
+    assert "terminated (SIGTERM)" in err

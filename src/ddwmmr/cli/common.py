@@ -169,7 +169,7 @@ def stop_workers(timeout: float = 2.0) -> None:
 @contextlib.contextmanager
 def interruptible() -> Iterator[None]:
     """Turn SIGINT and :data:`STOP_SIGNALS` into exceptions raised after the workers are
-    stopped.
+    stopped; a signal the process was started ignoring (under ``nohup``) stays ignored.
 
     Forked workers inherit the handler: there it ignores SIGINT, SIGHUP and SIGQUIT (a
     Ctrl-C, a Ctrl-\\ or a closed terminal reaches the whole process group, and the parent
@@ -180,7 +180,10 @@ def interruptible() -> Iterator[None]:
         yield
         return
     owner = os.getpid()
-    handled = (signal.SIGINT, *STOP_SIGNALS)
+    # A signal the tool was started ignoring (``nohup`` ignores SIGHUP) stays ignored.
+    handled = tuple(
+        s for s in (signal.SIGINT, *STOP_SIGNALS) if signal.getsignal(s) is not signal.SIG_IGN
+    )
 
     def handle(signum: int, frame: object) -> None:
         if os.getpid() != owner:
