@@ -175,7 +175,11 @@ def test_the_thesis_controller_takes_the_batch_s_options():
         ("ats", "damping=nan", "error: damping must be a finite number in [1e-06, 1000] (got nan)"),
         ("qp", "speed_budget=nan", "error: speed_budget must be two numbers > 0, (v_top m/s"),
         ("qp", "obstacle_margin=nan", "error: obstacle_margin must be a finite number >= 0"),
-        ("qp", "stability_min=nan", "error: stability_min must be a finite number > 0 (got nan)"),
+        (
+            "qp",
+            "stability_min=nan",
+            "error: stability_min must be a finite number in (0, 10) (got nan)",
+        ),
         ("mpc", "intervals=nan", "error: intervals must be an integer in [2, 200] (got nan)"),
     ],
 )

@@ -106,7 +106,7 @@ def test_stability_floor_default_and_range():
     assert 1.0 < STABILITY_FLOOR < STABILITY_CAP
     assert check_stability_floor(1.4) == 1.4
     assert check_stability_floor(9.99) == 9.99
-    with pytest.raises(ParameterError, match="stability_min must be > 0"):
+    with pytest.raises(ParameterError, match=r"stability_min must be in \(0, 10\) \(got 0\)"):
         check_stability_floor(0.0)
     with pytest.raises(ParameterError, match=r"floor must be in \(0, 10\) \(got 10\)"):
         check_stability_floor(STABILITY_CAP, "floor")

@@ -39,7 +39,7 @@ def test_registered_without_its_benchmark_twin():
     [
         ({"mode": "lexicographic"}, "mode must be one of weighted, hierarchical"),
         ({"solver": "nope"}, "solver must be one of"),
-        ({"stability_min": 0.0}, "stability_min must be > 0"),
+        ({"stability_min": 0.0}, r"stability_min must be in \(0, 10\) \(got 0\)"),
         ({"stability_min": 12.0}, "stability_min must be in"),
         ({"manipulability_weight": -1.0}, r"manipulability_weight must be in \[0, 1e\+06\]"),
         ({"max_speed": 0.0}, "max_speed must be > 0"),

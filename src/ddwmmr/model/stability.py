@@ -41,7 +41,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.errors import ParameterError, check_finite
 from ddwmmr.model.mass import total_mass
 
 #: Reported stability is capped here: a vanishing tipping moment gives an infinite ratio.
@@ -65,9 +65,10 @@ def valid_stability_floor(value: float) -> bool:
 def check_stability_floor(value: float, name: str = "stability_min") -> float:
     """``value`` as a floor on S (float, :func:`valid_stability_floor`), or
     :class:`~ddwmmr.errors.ParameterError` naming ``name``."""
-    floor = check_positive(name, value)
+    allowed = f"in (0, {STABILITY_CAP:g})"
+    floor = check_finite(name, value, allowed)
     if not valid_stability_floor(floor):
-        raise ParameterError(f"{name} must be in (0, {STABILITY_CAP:g}) (got {floor:g})")
+        raise ParameterError(f"{name} must be {allowed} (got {floor:g})")
     return floor
 
 

@@ -49,6 +49,7 @@ from __future__ import annotations
 
 import math
 import os
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, ClassVar
 
@@ -270,6 +271,7 @@ class MPCController:
         """Forget warm starts and counters; take the control step (:func:`control_step`).
         ``q0``: the start ``[x, y, phi, th1, th2]``, 5 finite numbers (m, rad)."""
         q0 = check_start(q0)
+        warn_start_in_keep_out(self.robot, self.options, q0)
         self.dt = control_step(self.options.dt, self._loop_step, trajectory, DEFAULT_DT)
         self._trajectory = trajectory
         self.fallbacks = 0
@@ -568,6 +570,38 @@ class MPCController:
         if (options.get("lookahead") or plan is not None) and not options.get("route"):
             options["route"] = [tuple(w) for w in run.scenario.waypoints]
         return options
+
+
+def warn_start_in_keep_out(robot: Robot, options: MPCOptions, q0: np.ndarray) -> None:
+    """Warn (:class:`UserWarning`, once) when the start ``q0`` (x, y m) puts the base inside
+    the keep-out the OCP's obstacle rows hold: its enclosing circle
+    (:func:`~ddwmmr.behaviours.obstacle.base_bubble`) less than ``obstacle_margin`` (m) from
+    a circle of ``obstacles``. The run then starts in violation of those rows (their slack
+    takes it). Warned, not refused, as the ``qp`` runs such a start too (its damper asks
+    for the clearance to grow); a footprint overlapping a circle is refused by the tools
+    (:func:`ddwmmr.sim.simulate.check_start`). The message names the circle with the least
+    clearance."""
+    bubble, margin = base_bubble(robot), options.obstacle_margin
+    inside = [
+        (math.hypot(q0[0] - c.x, q0[1] - c.y) - c.radius - bubble, number, c)
+        for number, c in enumerate(options.obstacles, start=1)  # type: ignore[arg-type]
+    ]
+    inside = [entry for entry in inside if entry[0] < margin]
+    if not inside:
+        return
+    clearance, number, circle = min(inside, key=lambda entry: entry[0])
+    more = f" (and {len(inside) - 1} more)" if len(inside) > 1 else ""
+    gap = (
+        f"overlaps it by {-clearance:.3g} m" if clearance < 0.0 else f"is {clearance:.3g} m from it"
+    )
+    warnings.warn(
+        f"obstacles: the start pose is inside the mpc's keep-out of obstacle {number} (x "
+        f"{circle.x:g} m, y {circle.y:g} m, radius {circle.radius:g} m){more}: the base's "
+        f"enclosing circle (radius {bubble:.3g} m) {gap}, within obstacle_margin {margin:g} "
+        f"m; the run starts violating its obstacle constraint",
+        UserWarning,
+        stacklevel=3,
+    )
 
 
 #: How far (m) a waypoint may lie from the one a plan was recorded for: a JSON record

@@ -32,10 +32,16 @@ from ddwmmr.errors import (
     check_range,
     check_weight,
     shown,
+    texts_apart,
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
-from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
+from ddwmmr.model.stability import (
+    STABILITY_CAP,
+    STABILITY_FLOOR,
+    check_stability_floor,
+    valid_stability_floor,
+)
 from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, check_min_edge_load
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT, FORCE_LIMIT_DEFAULT
 from ddwmmr.mpc.braking import BRAKE_SLACK
@@ -48,7 +54,7 @@ from ddwmmr.mpc.ocp import (
     shooting_grid,
 )
 from ddwmmr.mpc.problem import COLD_ITERATIONS
-from ddwmmr.mpc.solvers import QP_SOLVERS, SOLVERS
+from ddwmmr.mpc.solvers import DEFAULT_QP_SOLVER, QP_BACKED_SOLVERS, QP_SOLVERS, SOLVERS
 from ddwmmr.qp.limits import as_circles
 
 MODELS = ("kinematic", "thesis")
@@ -130,7 +136,9 @@ class MPCOptions:
             horizon must be at least ``dt + (intervals - 1) x first_interval``.
         solver: ``"rti"`` (one Gauss-Newton iteration per step, default), ``"sqp"``
             (iterated Gauss-Newton), ``"ipopt"``, ``"sqpmethod"`` or ``"fatrop"``.
-        qp_solver: QP backend of ``rti``/``sqp`` (``"hpipm"`` default).
+        qp_solver: QP backend of ``rti``/``sqp`` (``"hpipm"`` default); another with a
+            solver that takes none (``"ipopt"``, ``"sqpmethod"``, ``"fatrop"``) is refused:
+            it would have no effect, yet the run's record would show it.
         cold_iterations: Gauss-Newton iterations (one QP each) of a cold start with
             ``solver="rti"`` (the first step, a new waypoint, after a fallback or a stall),
             in [1, 20]; the later steps refine the plan one iteration each, so fewer bound
@@ -170,7 +178,9 @@ class MPCOptions:
             starts (default 2; docs/mpc.md, "Arriving as the plan does").
         proximal: damping of the input steps between two solves (see
             :class:`ddwmmr.mpc.solvers.GaussNewtonSQP`).
-        stability_margin: the OCP keeps ``S >= stability_min + stability_margin``.
+        stability_margin: the OCP keeps ``S >= stability_min + stability_margin``; >= 0,
+            and the sum below S's cap (:data:`~ddwmmr.model.stability.STABILITY_CAP`),
+            which a floor at or above it could never meet.
         dynamic_stability: keep every edge of the support polygon loaded while moving (at
             least ``min_edge_load``; the edge loads of the force model with the inertial
             forces of turning, accelerating and the arm's motion, ``model="thesis"`` only;
@@ -224,7 +234,7 @@ class MPCOptions:
     intervals: int | None = None
     first_interval: float | None = None
     solver: str = "rti"
-    qp_solver: str = "hpipm"
+    qp_solver: str = DEFAULT_QP_SOLVER
     cold_iterations: int = COLD_ITERATIONS
     position_weight: float | None = None
     orientation_weight: float = 10.0
@@ -261,6 +271,11 @@ class MPCOptions:
         if qp_solver not in QP_SOLVERS:
             raise ParameterError(
                 f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {shown(qp_solver)})"
+            )
+        if solver not in QP_BACKED_SOLVERS and qp_solver != DEFAULT_QP_SOLVER:
+            raise ParameterError(
+                f"qp_solver needs solver {' or '.join(QP_BACKED_SOLVERS)}: solver "
+                f"{shown(solver)} uses no QP backend (got qp_solver {shown(qp_solver)})"
             )
         self._set(
             "cold_iterations", check_int_at_least("cold_iterations", self.cold_iterations, 1, 20)
@@ -322,10 +337,26 @@ class MPCOptions:
             value = getattr(self, name)
             if value is not None:
                 self._set(name, check(name, value))
+        self._check_stability_target()
         self._set("fallback_options", dict(self.fallback_options or {}))
 
     def _set(self, name: str, value: Any) -> None:
         object.__setattr__(self, name, value)
+
+    def _check_stability_target(self) -> None:
+        """Refuse a ``stability_margin`` that puts the OCP's floor ``stability_min +
+        stability_margin`` at or above S's cap (a floor no S can meet,
+        :func:`~ddwmmr.model.stability.valid_stability_floor`), naming the margin's range
+        for this ``stability_min``."""
+        floor, margin = self.stability_min, self.stability_margin
+        if valid_stability_floor(floor + margin):
+            return
+        got, (room,) = texts_apart(margin, STABILITY_CAP - floor)
+        raise ParameterError(
+            f"stability_margin must be in [0, {room}) with stability_min {floor:g}: the OCP "
+            f"keeps S >= stability_min + stability_margin, and S is capped at "
+            f"{STABILITY_CAP:g} (got {got})"
+        )
 
     # -- resolution ---------------------------------------------------------------------
     def adopt_plant(self, plant: PlantTraits | None) -> MPCOptions:

@@ -37,8 +37,13 @@ from ddwmmr.mpc.ocp import ShootingOCP
 HESSIAN_FLOOR = 1e-6
 #: QP backends reachable through ``casadi.conic`` that handle this problem.
 QP_SOLVERS = ("hpipm", "qrqp", "osqp", "daqp", "proxqp")
+#: The QP backend of the Gauss-Newton solvers unless one is asked for.
+DEFAULT_QP_SOLVER = "hpipm"
 #: Solver names accepted by :func:`make_solver`.
 SOLVERS = ("rti", "sqp", "ipopt", "sqpmethod", "fatrop")
+#: The solvers of :data:`SOLVERS` that solve QPs with a ``qp_solver`` backend (the
+#: Gauss-Newton ones; the others are CasADi's ``nlpsol`` plugins, which take none).
+QP_BACKED_SOLVERS = ("rti", "sqp")
 #: HPIPM return codes accepted: 0 converged, 1 iteration limit (its iterate is used, see
 #: docs/mpc.md, "Solver choice (measured)"); 2 (minimum step) and 3 (NaN) are failures.
 HPIPM_ACCEPTED = (0, 1)
@@ -46,7 +51,7 @@ HPIPM_ACCEPTED = (0, 1)
 
 def installed_solvers() -> list[str]:
     """The names of :data:`SOLVERS` this CasADi build has (the Gauss-Newton ones always)."""
-    return [n for n in SOLVERS if n in ("rti", "sqp") or ca.has_nlpsol(n)]
+    return [n for n in SOLVERS if n in QP_BACKED_SOLVERS or ca.has_nlpsol(n)]
 
 
 def installed_qp_solvers() -> list[str]:
@@ -157,7 +162,7 @@ class GaussNewtonSQP:
     def __init__(
         self,
         ocp: ShootingOCP,
-        qp_solver: str = "hpipm",
+        qp_solver: str = DEFAULT_QP_SOLVER,
         iterations: int = 1,
         tolerance: float = 1e-6,
         proximal: float = 0.0,
@@ -352,7 +357,7 @@ class NLPSolver:
 def make_solver(
     name: str,
     ocp: ShootingOCP,
-    qp_solver: str = "hpipm",
+    qp_solver: str = DEFAULT_QP_SOLVER,
     *,
     proximal: float = 0.0,
     iterations: int | None = None,
