@@ -38,7 +38,12 @@ from ddwmmr.sim.loop import run_loop
 from ddwmmr.sim.result import SimulationResult
 from ddwmmr.sim.tracking import COLUMNS, TrackingTask, checked_trajectory
 from ddwmmr.sim.verdict import verdict
-from ddwmmr.trajectories.base import require_trajectory, resolution_step, trajectory_name
+from ddwmmr.trajectories.base import (
+    require_trajectory,
+    resolution_step,
+    sampler,
+    trajectory_name,
+)
 
 __all__ = ["COLUMNS", "max_condition_number", "simulate", "summarize"]
 
@@ -267,6 +272,7 @@ def simulate(
     summary.update(
         method=getattr(controller, "name", type(controller).__name__),
         trajectory=trajectory_name(trajectory),
+        trajectory_extent_m=trajectory_extent(reference, timeseries),
         plant=the_plant.name,
         integrator=getattr(the_plant, "integrator", None),
         # the interface the controller spoke (the mpc chooses its own for the plant)
@@ -385,6 +391,10 @@ def plant_integrator(plant: str, integrator: str | None) -> str | None:
 #: Share of the run's (corner-free) samples, at its end, over which the final error is
 #: taken: the last sample alone can sit on a transient (the rectangle ends on a corner).
 FINAL_WINDOW_FRACTION = 0.05
+#: A wheel within this share of ``wheel_speed_limit`` is at its limit
+#: (``wheel_limit_steps``): the qp and the mpc bound the wheels a hair inside the limit
+#: (1e-6 of it), and the mpc's real-time iteration ends within 1e-3 of its bound.
+WHEEL_LIMIT_TOLERANCE = 1e-3
 
 
 def summarize(
@@ -399,10 +409,15 @@ def summarize(
     (``(start, end)`` times in s, e.g. :meth:`Rectangle.corner_windows`).
     ``end_position_error_m`` is the error at the last sample and
     ``corner_position_error_m`` the largest error inside the corner windows (None
-    without corners). ``singular_steps``, ``saturated_steps`` and ``fallback_steps``
+    without corners).
+    ``singular_steps``, ``saturated_steps``, ``wheel_limit_steps`` and ``fallback_steps``
     count the run's N commanded steps, not its N + 1 samples
     (:func:`~ddwmmr.controllers.base.commanded_steps`: the last sample's command is never
-    applied), so each is at most ``summary["steps"]``.
+    applied), so each is at most ``summary["steps"]``. ``wheel_limit_steps`` counts the
+    steps with a wheel within :data:`WHEEL_LIMIT_TOLERANCE` of ``robot.wheel_speed_limit``
+    (the wheel speeds of :func:`~ddwmmr.sim.tracking.derive_columns`): a limit held,
+    whether the plant clipped the command (``saturated_steps`` counts those too) or a
+    controller kept it within the limit itself (the qp's and the mpc's bounds).
     """
     position = ts["position_error_m"]
     orientation = ts["orientation_error_rad"]
@@ -412,6 +427,8 @@ def summarize(
         in_corner |= (ts["t"] >= start) & (ts["t"] <= end)
     settled = position[~in_corner] if not np.all(in_corner) else position
     window = settled[-max(1, round(FINAL_WINDOW_FRACTION * len(settled))) :]
+    wheel_speed = np.maximum(np.abs(ts["wheel_left_rad_s"]), np.abs(ts["wheel_right_rad_s"]))
+    at_wheel_limit = wheel_speed >= robot.wheel_speed_limit * (1.0 - WHEEL_LIMIT_TOLERANCE)
     return {
         "rms_position_error_m": float(np.sqrt(np.mean(position**2))),
         "max_position_error_m": float(np.max(position)),
@@ -423,18 +440,38 @@ def summarize(
         "rms_orientation_error_rad": float(np.sqrt(np.mean(orientation**2))),
         "max_orientation_error_rad": float(np.max(np.abs(orientation))),
         "max_nonholonomic_residual_m_s": float(np.max(np.abs(ts["nonholonomic_residual_m_s"]))),
-        "max_wheel_speed_rad_s": float(
-            np.max(np.maximum(np.abs(ts["wheel_left_rad_s"]), np.abs(ts["wheel_right_rad_s"])))
-        ),
+        "max_wheel_speed_rad_s": float(np.max(wheel_speed)),
         "min_manipulability": float(np.min(ts["manipulability"])),
         "mean_manipulability": float(np.mean(ts["manipulability"])),
         "min_stability": float(np.min(ts["stability"])),
         "singular_steps": int(np.sum(commanded_steps(ts["singular"]))),
         "saturated_steps": int(np.sum(commanded_steps(ts["saturated"]))),
+        "wheel_limit_steps": int(np.sum(commanded_steps(at_wheel_limit))),
         "fallback_steps": int(np.sum(commanded_steps(ts["fallback"]))),
         "max_condition_number": max_condition_number(robot, q),
         "median_step_us": float(np.median(ts["step_us"])),
     }
+
+
+#: Samples of one trajectory duration over which :func:`trajectory_extent` takes its size.
+EXTENT_SAMPLES = 1001
+
+
+def trajectory_extent(trajectory: Any, ts: dict[str, np.ndarray]) -> float:
+    """The trajectory's size (m): the diagonal of the bounding box of its desired
+    end-effector positions, at :data:`EXTENT_SAMPLES` times over one ``duration`` and at
+    the run's samples (``xE_d``, ``yE_d``: a run longer than one duration may go beyond).
+    The whole trajectory's, not only the part a short run covers: the verdict holds the
+    errors to a share of it (:func:`ddwmmr.sim.verdict.error_limit`)."""
+    times = np.linspace(0.0, float(trajectory.duration), EXTENT_SAMPLES)
+    sample = sampler(trajectory)
+    if sample is not None:
+        poses = np.asarray(sample(times)[0], dtype=float)
+    else:
+        poses = np.array([trajectory.pose(t) for t in times.tolist()], dtype=float)
+    x = np.concatenate([poses[:, 0], ts["xE_d"]])
+    y = np.concatenate([poses[:, 1], ts["yE_d"]])
+    return float(np.hypot(np.ptp(x), np.ptp(y)))
 
 
 def max_condition_number(robot: Robot, q: np.ndarray) -> float:

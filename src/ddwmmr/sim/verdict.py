@@ -15,6 +15,9 @@ A run did not track when any of these holds (thresholds documented in docs/cli.m
 * ``tipped_over``: a physics plant recorded the robot tipping over;
 * ``tipped_at_start``: the robot had already tipped over in the start pose (static
   S <= 1, ``start_tipped``; the command-line tools refuse such a run, the API warns);
+* ``below_floor_at_start``: an ``mpc`` run (``mpc_fallbacks`` in the summary) started
+  below its own stability floor (``start_stability`` < ``stability_min``): its plans
+  broke their hard constraint from the first step, however well it tracked after;
 * ``collided``: the base's footprint entered an obstacle (``min_obstacle_clearance_m`` < 0;
   ``qp`` and ``mpc`` with obstacles);
 * ``singular_most_of_run``: more than :data:`MOST_OF_RUN` of the steps were damped at the
@@ -24,12 +27,17 @@ A run did not track when any of these holds (thresholds documented in docs/cli.m
 * ``final_error_above_limit`` / ``rms_error_above_limit``: the final (settled) or the RMS
   end-effector position error exceeds :func:`error_limit`: :data:`ERROR_LIMIT_M`, or
   :data:`OFFSET_FACTOR` times the run's initial offset if that is larger (an open-loop
-  method keeps its initial offset by design, and tracks with it).
+  method keeps its initial offset by design, and tracks with it), and never more than
+  :data:`EXTENT_FRACTION` of the trajectory's extent (``trajectory_extent_m``), or
+  :data:`EXTENT_LIMIT_FLOOR_M` if that is larger (a trajectory that barely moves).
 
 The likely cause is read from the summary too (:func:`likely_cause`); an obstacle-avoiding
 controller (``qp``, ``mpc``: a ``min_obstacle_clearance_m``) whose base came within
 :data:`OBSTACLE_NEAR_M` of an obstacle, with no other cause in sight, is named as having
-left the trajectory to go round it.
+left the trajectory to go round it. A run that held a limit the commands' clipping
+(``saturated_steps``) does not count, for more than :data:`HELD_CAUSE` of the run (a
+wheel at its speed limit: ``wheel_limit_steps``; an actuator at its limit on a plant with
+dynamics: ``actuator_saturated_time_s``), with no other cause in sight, names that limit.
 """
 
 from __future__ import annotations
@@ -41,10 +49,13 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, shown, texts_apart
+from ddwmmr.errors import ParameterError, one_line, shown, texts_apart
 
 __all__ = [
     "ERROR_LIMIT_M",
+    "EXTENT_FRACTION",
+    "EXTENT_LIMIT_FLOOR_M",
+    "HELD_CAUSE",
     "MOST_OF_RUN",
     "NUMBER_KEYS",
     "OBSTACLE_NEAR_M",
@@ -71,6 +82,17 @@ ERROR_LIMIT_M = 0.05
 #: ... unless the initial offset times this is larger: the limit an open-loop method,
 #: which keeps the initial offset (docs/comparing.md), stays within while it tracks.
 OFFSET_FACTOR = 2.0
+#: Share of the trajectory's extent (``trajectory_extent_m``) above which an error does
+#: not track, whatever the limits above allow: an end effector a fifth of the path's size
+#: away no longer follows its shape. The default runs that track stay within 0.152 of it.
+EXTENT_FRACTION = 0.2
+#: ... unless this (m) is larger: the least limit, so that a trajectory that barely moves
+#: (a held point has extent 0) is judged by 10 mm, not by zero.
+EXTENT_LIMIT_FLOOR_M = 0.01
+#: Share of the run above which a limit held without clipping (``wheel_limit_steps`` of
+#: ``steps``, ``actuator_saturated_time_s`` of ``duration``) is named as the likely cause
+#: of a failure nothing else explains.
+HELD_CAUSE = 0.005
 #: Footprint clearance (m) below which an obstacle is near enough to have bent the run's
 #: path: the distance within which the qp's obstacle rows and steering act (the
 #: ``influence`` of :class:`~ddwmmr.qp.limits.obstacles.ObstacleLimit` and of
@@ -82,11 +104,15 @@ REASONS = {
     "diverged": "the plant diverged",
     "tipped_over": "the robot tipped over (physics)",
     "tipped_at_start": "the robot tips over in its start pose (S = {start_stability:.3g})",
+    "below_floor_at_start": (
+        "the mpc started below its stability floor (start S = {start_text} < stability_min "
+        "{floor_text}), breaking its constraint from the first step"
+    ),
     "collided": "the base entered an obstacle (footprint clearance {clearance_mm:.3g} mm)",
     "singular_most_of_run": "singular (damped) {singular_steps} of {steps} steps",
     "saturated_most_of_run": "saturated {saturated_steps} of {steps} steps",
-    "final_error_above_limit": "final error {final_mm:.4g} mm (limit {limit_mm:.4g} mm)",
-    "rms_error_above_limit": "RMS error {rms_mm:.4g} mm (limit {limit_mm:.4g} mm)",
+    "final_error_above_limit": "final error {final_mm:.4g} mm ({limit})",
+    "rms_error_above_limit": "RMS error {rms_mm:.4g} mm ({limit})",
 }
 
 SLIDES_ROW = (
@@ -101,8 +127,19 @@ SINGULAR_DRIFT = (
 )
 FOLDED_ARM = (
     "the arm folded to a joint limit (min manipulability 0): a resolution that only "
-    "integrates Xd_dot (ats, clrrmc-cs) loses the orientation steps at corners "
+    "integrates Xd_dot ({methods}) loses the orientation steps at corners "
     """(see docs/comparing.md, "Does the slides' ranking hold?")"""
+)
+#: The methods whose commands only integrate Xd_dot (open loop, or ``clrrmc-cs``'s
+#: configuration reference): :data:`FOLDED_ARM`'s explanation is theirs.
+XD_DOT_INTEGRATORS = ("pi", "ats", "ap", "clrrmc-cs")
+#: The methods :data:`FOLDED_ARM` names in a run of either (the docs' explanation is of
+#: both) or in a summary that names no method.
+FOLDING_METHODS = ("ats", "clrrmc-cs")
+FOLDED_ARM_OTHER = (
+    "the arm folded to a joint limit (min manipulability 0) in this {method} run: the plant "
+    "stopped the elbow there and the end effector left the path; a smaller dt or a slower "
+    'trajectory (see docs/comparing.md, "Studies")'
 )
 SATURATION = (
     "the commands asked for more than the wheel and joint rate limits allow: a larger "
@@ -143,6 +180,13 @@ QP_FALLBACK = (
     "command: its limits conflict (a limit of your own, or a stability floor the start "
     'cannot meet; see docs/qp.md, "Failure handling")'
 )
+HELD_LIMIT = (
+    "the robot ran at a limit ({held}), where it cannot follow the trajectory any faster "
+    "(the commands' clipping, saturated_steps, does not count it): a slower trajectory, a "
+    'smaller dt or a higher limit (see docs/cli.md, "Verdict")'
+)
+#: How :data:`HELD_LIMIT` names ``actuator_saturated_time_s``, by the summary's ``plant``.
+ACTUATOR_LIMITS = {"thesis": "a wheel at its force limit", "mujoco": "a motor at its torque limit"}
 TIPPED = (
     "the payload or the accelerations put the centre of pressure outside the wheels: a "
     "lighter payload, another start pose or a stability floor (stability_min; see "
@@ -172,6 +216,10 @@ NUMBER_KEYS = (
     "steps",
     "singular_steps",
     "saturated_steps",
+    "wheel_limit_steps",
+    "actuator_saturated_time_s",
+    "duration",
+    "trajectory_extent_m",
     "initial_offset_m",
     "final_position_error_m",
     "rms_position_error_m",
@@ -209,10 +257,45 @@ def _number(summary: Mapping[str, Any], key: str) -> float | None:
 
 def error_limit(summary: Mapping[str, Any]) -> float:
     """The position-error limit (m) of the run ``summary`` describes:
-    max(:data:`ERROR_LIMIT_M`, :data:`OFFSET_FACTOR` x ``initial_offset_m``)."""
+    max(:data:`ERROR_LIMIT_M`, :data:`OFFSET_FACTOR` x ``initial_offset_m``), and at most
+    :func:`extent_limit` where the summary records the trajectory's extent."""
+    absolute, relative = _limits(summary)
+    return absolute if relative is None else min(absolute, relative)
+
+
+def _limits(summary: Mapping[str, Any]) -> tuple[float, float | None]:
+    """The two parts of :func:`error_limit` (m): the absolute one, max(ERROR_LIMIT_M,
+    OFFSET_FACTOR x offset), and :func:`extent_limit` (None without an extent)."""
     check_summary(summary)
     offset = _number(summary, "initial_offset_m") or 0.0
-    return max(ERROR_LIMIT_M, OFFSET_FACTOR * offset)
+    return max(ERROR_LIMIT_M, OFFSET_FACTOR * offset), extent_limit(summary)
+
+
+def extent_limit(summary: Mapping[str, Any]) -> float | None:
+    """The error limit (m) the trajectory's size sets: max(:data:`EXTENT_FRACTION` x
+    ``trajectory_extent_m``, :data:`EXTENT_LIMIT_FLOOR_M`); None if the summary records no
+    (or a NaN) extent, as a summary written before the key was."""
+    check_summary(summary)
+    extent = _number(summary, "trajectory_extent_m")
+    if extent is None or math.isnan(extent):
+        return None
+    return max(EXTENT_FRACTION * extent, EXTENT_LIMIT_FLOOR_M)
+
+
+def _limit_text(summary: Mapping[str, Any]) -> str:
+    """``limit 84.85 mm``; where the trajectory's extent sets it, also that extent."""
+    absolute, relative = _limits(summary)
+    if relative is None or relative >= absolute:
+        return f"limit {1000.0 * absolute:.4g} mm"
+    extent = _number(summary, "trajectory_extent_m") or 0.0
+    return f"limit {1000.0 * relative:.4g} mm for a trajectory {1000.0 * extent:.4g} mm across"
+
+
+def _started_below_floor(summary: Mapping[str, Any]) -> bool:
+    """The run started below its own stability floor (``start_stability`` <
+    ``stability_min``; False where either is missing)."""
+    start, floor = _number(summary, "start_stability"), _number(summary, "stability_min")
+    return start is not None and floor is not None and start < floor
 
 
 def reasons(summary: Mapping[str, Any]) -> list[str]:
@@ -225,6 +308,8 @@ def reasons(summary: Mapping[str, Any]) -> list[str]:
         found.append("tipped_over")
     if summary.get("start_tipped"):
         found.append("tipped_at_start")
+    if _number(summary, "mpc_fallbacks") is not None and _started_below_floor(summary):
+        found.append("below_floor_at_start")
     clearance = _number(summary, "min_obstacle_clearance_m")  # None: no obstacles
     if clearance is not None and clearance < 0.0:
         found.append("collided")
@@ -257,9 +342,8 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return TIPPED
     if "collided" in found:
         return COLLIDED
-    start, floor = _number(summary, "start_stability"), _number(summary, "stability_min")
-    if start is not None and floor is not None and start < floor:
-        start_text, (floor_text,) = texts_apart(start, floor)
+    if _started_below_floor(summary):
+        start_text, floor_text = _floor_texts(summary)
         return BELOW_FLOOR.format(start_stability=start_text, stability_min=floor_text)
     steps = _number(summary, "steps") or 0
     fallbacks = _number(summary, "qp_fallbacks") or 0
@@ -272,7 +356,7 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
     min_manipulability = _number(summary, "min_manipulability")
     if min_manipulability is not None and min_manipulability < 1e-6:
-        return FOLDED_ARM
+        return _folded_arm(summary.get("method"))
     if "saturated_most_of_run" in found:
         return SATURATION
     clearance = _number(summary, "min_obstacle_clearance_m")  # None: no obstacles
@@ -280,7 +364,51 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return OBSTACLE_DETOUR.format(
             clearance_mm=1000.0 * clearance, near_mm=1000.0 * OBSTACLE_NEAR_M
         )
+    held = held_limits(summary)
+    if held:
+        return HELD_LIMIT.format(held=" and ".join(held))
     return NO_CONVERGENCE
+
+
+def _folded_arm(method: Any) -> str:
+    """:data:`FOLDED_ARM` naming the run's ``method`` if it only integrates Xd_dot (both
+    such methods of the docs' explanation if the summary names none), else
+    :data:`FOLDED_ARM_OTHER` naming it."""
+    if method is None or method in FOLDING_METHODS:
+        return FOLDED_ARM.format(methods=", ".join(FOLDING_METHODS))
+    if method in XD_DOT_INTEGRATORS:
+        return FOLDED_ARM.format(methods=method)
+    return FOLDED_ARM_OTHER.format(method=one_line(str(method), 40))
+
+
+def held_limits(summary: Mapping[str, Any]) -> list[str]:
+    """The limits the run held for more than :data:`HELD_CAUSE` of it, in words (``"a
+    wheel at its speed limit on 342 of 400 steps"``, ``"a wheel at its force limit for
+    7.38 of 40 s"``), from ``wheel_limit_steps`` of ``steps`` and
+    ``actuator_saturated_time_s`` of ``duration``; empty where neither is recorded."""
+    check_summary(summary)
+    held = []
+    steps = _number(summary, "steps") or 0
+    at_wheel_limit = _number(summary, "wheel_limit_steps") or 0
+    if steps and at_wheel_limit > HELD_CAUSE * steps:
+        held.append(f"a wheel at its speed limit on {int(at_wheel_limit)} of {int(steps)} steps")
+    duration = _number(summary, "duration") or 0.0
+    at_actuator_limit = _number(summary, "actuator_saturated_time_s") or 0.0
+    if duration > 0.0 and at_actuator_limit > HELD_CAUSE * duration:
+        what = ACTUATOR_LIMITS.get(str(summary.get("plant")), "an actuator at its limit")
+        held.append(f"{what} for {at_actuator_limit:.3g} of {duration:.3g} s")
+    return held
+
+
+def _floor_texts(summary: Mapping[str, Any]) -> tuple[str, str]:
+    """``start_stability`` and ``stability_min`` spelt apart (:func:`texts_apart`: a start
+    just below the floor is not spelt as the floor itself); ``nan`` where missing."""
+    start = _number(summary, "start_stability")
+    floor = _number(summary, "stability_min")
+    if start is None or floor is None:
+        return "nan", "nan"
+    start_text, (floor_text,) = texts_apart(start, floor)
+    return start_text, floor_text
 
 
 def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
@@ -291,13 +419,16 @@ def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
     if not found:
         return found, "", ""
     start_stability = _number(summary, "start_stability")
+    start_text, floor_text = _floor_texts(summary)
     values = {
         "steps": summary.get("steps"),
         "singular_steps": summary.get("singular_steps"),
         "saturated_steps": summary.get("saturated_steps"),
         "final_mm": 1000.0 * (_number(summary, "final_position_error_m") or 0.0),
         "rms_mm": 1000.0 * (_number(summary, "rms_position_error_m") or 0.0),
-        "limit_mm": 1000.0 * error_limit(summary),
+        "limit": _limit_text(summary),
+        "start_text": start_text,
+        "floor_text": floor_text,
         "start_stability": math.nan if start_stability is None else start_stability,
         "clearance_mm": 1000.0 * (_number(summary, "min_obstacle_clearance_m") or 0.0),
     }
