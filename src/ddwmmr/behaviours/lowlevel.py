@@ -36,6 +36,7 @@ from ddwmmr.behaviours.base import BRAKE, DRIVE, TURN, Percept, Proposal
 from ddwmmr.errors import shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import wrap_angle
+from ddwmmr.model.robot import clamp_joints
 
 _DEG = 180.0 / math.pi
 
@@ -115,7 +116,7 @@ class ArmMover:
         self.limits = robot.joint_limits
 
     def targets(self, proposal: Proposal) -> tuple[float, float]:
-        """The proposal's joint targets within the joint limits."""
-        (lo1, hi1), (lo2, hi2) = self.limits
+        """The proposal's joint targets (rad) within the joint limits
+        (:func:`~ddwmmr.model.robot.clamp_joints`)."""
         a1, a2 = proposal.arm
-        return min(hi1, max(lo1, a1)), min(hi2, max(lo2, a2))
+        return clamp_joints(a1, a2, self.limits)

@@ -17,7 +17,7 @@ import io
 import json
 import math
 import re
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +28,7 @@ from ddwmmr.bounds.search import Settings, best_known
 from ddwmmr.errors import DURATION_RANGE_S, MAX_SCENARIOS, ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME
-from ddwmmr.scenarios.generator import Scenario, generate
+from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.result import json_safe, write_atomic
 
 #: Version of each method's results: a change invalidates the cached results of that part.
@@ -63,44 +63,76 @@ def keys(scenario: Scenario, payload: float, settings: Settings) -> dict[str, di
     }
 
 
+#: Cache file names (relative to the output folder) of each part of a scenario, with
+#: ``{:03d}`` for the scenario number (from 1): the one naming of the cache, which
+#: :func:`cache_names` builds and :func:`cache_entry` parses.
+_CACHE_NAMES = {
+    "best": f"{CACHE}/scenario-{{:03d}}-best.json",
+    "trajectory": f"{CACHE}/{PLAN_NAME}",
+    "lower": f"{CACHE}/scenario-{{:03d}}-lower.json",
+}
+#: The record a part's file goes with: the trajectory with its best-known record.
+_RECORD_OF = {"best": "best", "trajectory": "best", "lower": "lower"}
+
+
 def cache_names(index: int) -> dict[str, str]:
     """Cache file names (relative to the output folder) of scenario ``index`` (1-based)."""
-    stem = f"{CACHE}/scenario-{index:03d}"
-    return {
-        "best": f"{stem}-best.json",
-        "trajectory": f"{CACHE}/{PLAN_NAME.format(index)}",
-        "lower": f"{stem}-lower.json",
-    }
+    return {part: name.format(index) for part, name in _CACHE_NAMES.items()}
 
 
-#: A cache file's name: its scenario number (from 1) and which part it holds.
-_CACHE_FILE = re.compile(
-    rf"^{CACHE}/scenario-(?P<index>\d{{3,}})-(?P<part>best|lower)\.(json|npz)$"
-)
+def _name_pattern(name: str) -> re.Pattern[str]:
+    """The names ``name.format(n)`` gives for whole numbers n >= 0, the number in the
+    group ``index`` (``name`` holds ``{:03d}`` once)."""
+    before, after = name.split("{:03d}")
+    return re.compile(rf"{re.escape(before)}(?P<index>\d{{3,}}){re.escape(after)}")
+
+
+_CACHE_PATTERNS = {part: _name_pattern(name) for part, name in _CACHE_NAMES.items()}
+
+
+def cache_entry(name: str) -> tuple[int, str] | None:
+    """``(index, part)`` if ``name`` (relative to the output folder) is the name
+    ``cache_names(index)[part]`` for a scenario number ``index``, else None: the inverse
+    of :func:`cache_names`, by the same naming."""
+    for part, pattern in _CACHE_PATTERNS.items():
+        match = pattern.fullmatch(name)
+        if match is not None:
+            index = int(match["index"])
+            return (index, part) if cache_names(index)[part] == name else None
+    return None
+
+
+def cached_numbers(names: Sequence[str]) -> set[int]:
+    """The scenario numbers (in 1..MAX_SCENARIOS) of the cache files among ``names``."""
+    entries = (cache_entry(name) for name in names)
+    return {e[0] for e in entries if e is not None and 1 <= e[0] <= MAX_SCENARIOS}
 
 
 def reusable_cache(
-    folder: Path, names: Sequence[str], seed: int, payload: float
+    folder: Path, names: Sequence[str], scenarios: Mapping[int, Scenario], payload: float
 ) -> tuple[list[str], list[int]]:
-    """The cache files among ``names`` (relative to ``folder``) a run of ``seed`` and
-    ``payload`` keeps, and the scenario numbers whose cache it drops.
+    """The cache files among ``names`` (relative to ``folder``) a run of ``payload`` keeps,
+    and the scenario numbers whose cache it drops.
 
-    A scenario's record is kept when its key names that scenario's waypoints under ``seed``
-    and ``payload``: the problem the folder's summary.json names, and the one a plan read
+    ``scenarios`` maps scenario numbers (from 1) to the run's seed's scenarios; it must
+    hold every number of :func:`cached_numbers` of ``names`` (a number it lacks is
+    dropped). A scenario's record is kept when its key names that scenario's waypoints and
+    ``payload``: the problem the folder's summary.json names, and the one a plan read
     from the folder (``scenarios --option plan=DIR``) is taken for. Its method settings and
     version are not judged here: :func:`read_cached` checks the whole key before any use,
     so a record of other settings (``--quick``) is kept for the run that has them. The
     trajectory goes with its best record. A record for another seed or payload, unreadable,
     or without a key is dropped, with the rest of its scenario's part.
     """
-    matches = [(n, m) for n in names if (m := _CACHE_FILE.match(n)) is not None]
-    numbers = {int(m["index"]) for _, m in matches if 1 <= int(m["index"]) <= MAX_SCENARIOS}
-    scenarios = generate(max(numbers), seed) if numbers else []
     kept, dropped = [], set()
-    for name, match in matches:
-        index = int(match["index"])
-        record = folder / f"{CACHE}/scenario-{match['index']}-{match['part']}.json"
-        if index in numbers and _same_problem(record, scenarios[index - 1], payload):
+    for name in names:
+        entry = cache_entry(name)
+        if entry is None:
+            continue
+        index, part = entry
+        scenario = scenarios.get(index) if 1 <= index <= MAX_SCENARIOS else None
+        record = folder / cache_names(index)[_RECORD_OF[part]]
+        if scenario is not None and _same_problem(record, scenario, payload):
             kept.append(name)
         else:
             dropped.add(index)

@@ -183,9 +183,12 @@ def _main(argv: Sequence[str] | None = None) -> int:
     # Tried, not inferred from permission bits (/proc, a read-only mount): the cache is
     # written there as scenarios finish, so an unwritable --out fails before any of them.
     check_writable("out", target)
-    scenarios = {
-        s.index + 1: s for s in generate(max(numbers), args.seed) if s.index + 1 in numbers
-    }
+    # The seed's scenarios up to the highest number of this run or of the folder's cache:
+    # this run solves its own, the cache of the others is judged by theirs.
+    before = inspect(target, TOOL).listed if target.is_dir() else []
+    last = max([*numbers, *batch.cached_numbers(before)])
+    known = {s.index + 1: s for s in generate(last, args.seed)}
+    scenarios = {i: s for i, s in known.items() if i in numbers}
     began = time.perf_counter()
     records = _solve_all(
         target, scenarios, args.payload, settings, jobs, not args.no_progress, args.lower_only
@@ -200,7 +203,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         run=_record(args, settings, jobs),
     )
     listed = inspect(target, TOOL).listed if target.is_dir() else []
-    kept, dropped = batch.reusable_cache(target, listed, args.seed, args.payload)
+    kept, dropped = batch.reusable_cache(target, listed, known, args.payload)
     with output_folder(target, TOOL, args.force) as staging:
         for name in kept:
             write_atomic(staging / name, (target / name).read_bytes())

@@ -92,6 +92,23 @@ _Q_ENTRIES = {"q": "[x, y, phi, th1, th2] (m, rad)", "qdot": "(m/s, rad/s)"}
 _isfinite = math.isfinite
 
 
+def clamp_joints(
+    th1: float, th2: float, limits: tuple[tuple[float, float], tuple[float, float]]
+) -> tuple[float, float]:
+    """Joint angles (th1, th2) (rad) clamped to ``limits``, a robot's ``joint_limits``
+    ``((th1_min, th1_max), (th2_min, th2_max))`` (rad): an angle below its range becomes the
+    minimum, one above it the maximum, one within it (its ends included) stays as it is.
+    The one joint clamp of the plants and the arm mover.
+
+    A NaN angle is returned as NaN, not turned into a limit, so that the callers' checks
+    of a non-finite state or command still see it.
+    """
+    (low1, high1), (low2, high2) = limits
+    th1 = low1 if th1 < low1 else (high1 if th1 > high1 else th1)
+    th2 = low2 if th2 < low2 else (high2 if th2 > high2 else th2)
+    return th1, th2
+
+
 @dataclass(frozen=True)
 class Robot:
     """Planar differential-drive mobile manipulator with a two-link arm.
@@ -104,7 +121,8 @@ class Robot:
         base_mass: base mass (kg); base_inertia: base yaw inertia (kg m^2).
         link_masses: masses of link 1 and link 2 (kg), each concentrated at its midpoint.
         payload: payload mass at the end effector (kg).
-        joint_limits: ``((th1_min, th1_max), (th2_min, th2_max))`` (rad).
+        joint_limits: ``((th1_min, th1_max), (th2_min, th2_max))`` (rad); angles are
+            clamped to them by :func:`clamp_joints`.
         joint_speed_limit: maximum |th1dot|, |th2dot| (rad/s).
         wheel_speed_limit: maximum wheel angular speed (rad/s).
         home_pose: default arm pose ``(th1, th2)`` (rad) used for start configurations;

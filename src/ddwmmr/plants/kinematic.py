@@ -29,6 +29,7 @@ import numpy as np
 from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
+from ddwmmr.model.robot import clamp_joints
 from ddwmmr.plants.base import (
     Observation,
     PlantDivergedError,
@@ -194,9 +195,7 @@ class KinematicPlant:
             new += [phi + dt * w, th1 + dt * r1, th2 + dt * r2]
         else:
             new = self._rk4(t, state, dt, policy, u0)
-        (low1, high1), (low2, high2) = self._joint_limits
-        new[3] = min(max(new[3], low1), high1)
-        new[4] = min(max(new[4], low2), high2)
+        new[3], new[4] = clamp_joints(new[3], new[4], self._joint_limits)
         return new
 
     def _rk4(

@@ -38,6 +38,7 @@ from ddwmmr.commands import WheelForces
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
+from ddwmmr.model.robot import clamp_joints
 from ddwmmr.model.thesis_base import (  # the base's constants (controllers' models use them)
     C1_DEFAULT,
     C2_DEFAULT,
@@ -313,9 +314,8 @@ class ThesisPlant:
 
     def clip_targets(self, target1: float, target2: float) -> tuple[float, float]:
         """Joint targets (rad) clipped to the robot's ``joint_limits``: the servo stops a
-        joint at its limit."""
-        (low1, high1), (low2, high2) = self._joint_limits
-        return min(high1, max(low1, target1)), min(high2, max(low2, target2))
+        joint at its limit (:func:`~ddwmmr.model.robot.clamp_joints`)."""
+        return clamp_joints(target1, target2, self._joint_limits)
 
     def clip_force(self, force: float) -> float:
         """A wheel force limited to ``+-force_limit`` (N)."""

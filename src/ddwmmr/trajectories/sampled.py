@@ -96,6 +96,7 @@ class SampledTrajectory:
     _slopes: np.ndarray = field(init=False, repr=False, compare=False)
     _knots: list = field(init=False, repr=False, compare=False)
     _has_phi: bool = field(init=False, repr=False, compare=False)
+    _moving: tuple[float, float] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -140,6 +141,7 @@ class SampledTrajectory:
         object.__setattr__(self, "_has_phi", points.shape[1] == 3)
         object.__setattr__(self, "_slopes", _tangents(times, points, periodic))
         object.__setattr__(self, "_knots", times.tolist())
+        object.__setattr__(self, "_moving", _moving_range(self._knots[0], self._knots[-1]))
 
     @property
     def duration(self) -> float:
@@ -163,20 +165,10 @@ class SampledTrajectory:
         steps = max(self.samples, math.ceil(self.duration / MAX_DEFAULT_STEP_S - 1e-9))
         return self.duration / steps
 
-    def _moving_range(self) -> tuple[float, float]:
-        """Absolute times (s) between which the velocity is the interpolant's: the first
-        and last sample times widened by :data:`MIN_STEP_FRACTION` of the duration, the
-        finest time the samples resolve. A time grid that ends at the last sample
-        (``k dt`` and the RK4 stage ``k dt + dt``) may overshoot it by a rounding error;
-        there the end's speed still applies, as the step integrated towards it needs."""
-        first, last = self._knots[0], self._knots[-1]
-        slack = MIN_STEP_FRACTION * (last - first)
-        return first - slack, last + slack
-
     def _holds(self, t: float) -> bool:
-        """Whether t (s, from the first sample) is outside :meth:`_moving_range`, where
+        """Whether t (s, from the first sample) is outside :func:`_moving_range`, where
         the trajectory holds still."""
-        low, high = self._moving_range()
+        low, high = self._moving
         t_abs = t + self._knots[0]
         return t_abs < low or t_abs > high
 
@@ -221,7 +213,7 @@ class SampledTrajectory:
 
     def velocity(self, t: float) -> np.ndarray:
         """Desired ``[xEdot, yEdot, phiEdot]`` at time t (s, from the first sample; finite):
-        zero outside ``[0, duration]`` (beyond :meth:`_moving_range`), where the pose
+        zero outside ``[0, duration]`` (beyond :func:`_moving_range`), where the pose
         holds still."""
         if not (isinstance(t, float) and _isfinite(t)):
             check_time(t)
@@ -243,7 +235,7 @@ class SampledTrajectory:
         (:func:`~ddwmmr.trajectories.base.check_times`)."""
         knots = self.times
         t_query = check_times(times) + knots[0]
-        low, high = self._moving_range()
+        low, high = self._moving
         held = ((t_query < low) | (t_query > high))[:, None]
         t_abs = np.minimum(np.maximum(t_query, knots[0]), knots[-1])
         i = np.minimum(np.searchsorted(knots, t_abs, side="right") - 1, len(knots) - 2)
@@ -269,6 +261,16 @@ class SampledTrajectory:
 
 
 _isfinite = math.isfinite
+
+
+def _moving_range(first: float, last: float) -> tuple[float, float]:
+    """Absolute times (s) between which the velocity is the interpolant's: the first
+    and last sample times widened by :data:`MIN_STEP_FRACTION` of the duration, the
+    finest time the samples resolve. A time grid that ends at the last sample
+    (``k dt`` and the RK4 stage ``k dt + dt``) may overshoot it by a rounding error;
+    there the end's speed still applies, as the step integrated towards it needs."""
+    slack = MIN_STEP_FRACTION * (last - first)
+    return first - slack, last + slack
 
 
 def _float_array(name: str, value, what: str) -> np.ndarray:
