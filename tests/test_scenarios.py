@@ -95,7 +95,7 @@ def test_payload_choice_thesis_payload_never_tips_3kg_can():
 
 
 def test_run_config_validation():
-    with pytest.raises(ParameterError, match="dt must be > 0"):
+    with pytest.raises(ParameterError, match=r"dt must be in \(0, 0\.1\] s"):
         RunConfig(dt=0.0)
     with pytest.raises(ParameterError, match="controller must be one of"):
         RunConfig(controller="pid")

@@ -24,7 +24,6 @@ from ddwmmr import provenance
 from ddwmmr.bounds import batch
 from ddwmmr.bounds.search import QUICK, Settings
 from ddwmmr.cli.common import ArgumentParser, add_force_argument, output_folder, run_main
-from ddwmmr.cli.scenarios import check_start_pose
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
@@ -165,10 +164,9 @@ def _main(argv: Sequence[str] | None = None) -> int:
         default_jobs() if args.jobs is None else check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
     )
     settings = _settings(args)
-    from ddwmmr.scenarios.protocol import RunConfig
+    from ddwmmr.scenarios.protocol import check_payload
 
-    RunConfig(payload=args.payload)  # the payload's own checks, before any output
-    check_start_pose(args.payload)  # the scenarios tool's refusal of a robot that tips at rest
+    check_payload(args.payload)  # as the scenarios tool: in range, standing at the start
     if args.out is None:
         stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
         out = first_free(Path("runs") / f"bounds-{stamp}", folder=True)

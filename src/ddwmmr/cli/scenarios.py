@@ -17,7 +17,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import datetime as dt
-import json
 import math
 import re
 import sys
@@ -32,7 +31,6 @@ from typing import Any
 from ddwmmr import provenance
 from ddwmmr.arbiters import DEFAULT_ARBITER, arbiter_description, available_arbiters
 from ddwmmr.arbiters.state_machine import THESIS_MANIPULABILITY, THESIS_STABILITY
-from ddwmmr.behaviours.objective import default_pose
 from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
@@ -48,14 +46,12 @@ from ddwmmr.commands import traits_of
 from ddwmmr.controllers import controller_traits, method_description
 from ddwmmr.controllers.option_specs import parse_options
 from ddwmmr.errors import (
-    MASS_RANGE_KG,
     MAX_JOBS,
     MAX_SCENARIOS,
     MAX_STEPS,
     ParameterError,
     check_int_at_least,
     check_nonnegative,
-    check_range,
     shown,
 )
 from ddwmmr.model import Robot
@@ -82,7 +78,9 @@ from ddwmmr.scenarios.protocol import (
     Outcome,
     RunConfig,
     check_dt,
+    check_payload,
     check_thresholds,
+    check_time_limit,
     make_scenario_controller,
     make_scenario_plant,
     plants_for,
@@ -90,7 +88,7 @@ from ddwmmr.scenarios.protocol import (
     scenario_controllers,
     step_count,
 )
-from ddwmmr.sim.result import json_safe, write_atomic
+from ddwmmr.sim.result import write_atomic
 
 #: The batch summary (holds the run record: everything needed to repeat the batch).
 MARKER = "summary.json"
@@ -340,31 +338,6 @@ def default_out() -> Path:
     return Path("runs") / f"scenarios-{dt.datetime.now().strftime('%Y%m%d-%H%M%S')}"
 
 
-def check_start_pose(payload: float) -> None:
-    """Refuse a payload that already tips the robot in the scenarios' start pose (S <= 1)."""
-    robot = Robot().with_payload(payload)
-    th1, th2 = default_pose(robot)
-    s = robot.stability((0.0, 0.0, 0.0, th1, th2))[2]
-    if s <= 1.0:
-        raise ParameterError(
-            f"payload: {payload:g} kg tips the robot over in the start pose (S = {s:.3g} <= 1); "
-            f"the start pose holds at most {math.floor(max_start_payload() * 1e3) / 1e3:g} kg"
-        )
-
-
-def max_start_payload() -> float:
-    """Largest payload (kg) with S > 1 in the start pose (bisection; S falls with payload)."""
-    low, high = 0.0, MASS_RANGE_KG[1]
-    for _ in range(80):
-        middle = 0.5 * (low + high)
-        robot = Robot().with_payload(middle)
-        if robot.stability((0.0, 0.0, 0.0, *default_pose(robot)))[2] > 1.0:
-            low = middle
-        else:
-            high = middle
-    return low
-
-
 def _qp_options(args: argparse.Namespace) -> dict[str, float]:
     """The given ``--qp-*`` options, refused for a controller without them (their values
     are ``RunConfig``'s to check)."""
@@ -433,11 +406,11 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     if args.study and args.obstacles:
         raise ParameterError("study: --obstacles is implied by --study obstacles")
     check_dt(args.dt)
-    limit = args.time_limit
-    if limit is not None and not (math.isfinite(limit) and limit > 0):
-        raise ParameterError(f"time-limit must be > 0 s and finite (got {limit:g})")
+    if args.time_limit is not None:
+        with _option_names():
+            check_time_limit(args.time_limit)
     qp_options = _qp_options(args)
-    check_range("payload", args.payload, *MASS_RANGE_KG, "kg")
+    check_payload(args.payload)
     obstacles = args.obstacles or args.study == "obstacles"
     longest = (
         args.time_limit
@@ -446,7 +419,6 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     )
     with _option_names():
         step_count(longest, args.dt)  # 120 s with obstacles, which RunConfig cannot know
-    check_start_pose(args.payload)
     thresholds = {name: _thresholds(args, name) for name in ("stability", "manipulability")}
     controller_options = scenario_controller_options(args)
     with _option_names():
@@ -612,7 +584,7 @@ def write_batch(
     table = report.format_table(summary, f"Table 5.2 format: {title}")
     write_atomic(folder / "table.txt", table)
     _figures(folder, scenarios, outcomes, config, progress)
-    write_atomic(folder / MARKER, json.dumps(json_safe(summary), indent=2) + "\n")
+    write_atomic(folder / MARKER, report.summary_json(summary))
     print(table, end="")
     failures = failure_line(summary)
     if failures:
@@ -777,7 +749,7 @@ def _run_thresholds(args, config, runner, folder: Path) -> None:
         "wall_time_s": sum(s["wall_time_s"] for _, s in results),
         "run": _record(args, config),
     }
-    write_atomic(folder / MARKER, json.dumps(json_safe(total), indent=2) + "\n")
+    write_atomic(folder / MARKER, report.summary_json(total))
     print("Threshold study: cells are thesis / ours\n")
     print(table, end="")
 
@@ -807,7 +779,7 @@ def _run_arbiters(args, config, runner, folder: Path) -> None:
         folder, scenarios, config, runner.run, runner.jobs, seed=args.seed
     )
     study.update(seed=args.seed, config=asdict(config), run=_record(args, config))
-    write_atomic(folder / MARKER, json.dumps(json_safe(study), indent=2) + "\n")
+    write_atomic(folder / MARKER, report.summary_json(study))
     print(study["table"], end="")
 
 

@@ -106,7 +106,7 @@ def summarize(
     summary = report.summarize(outcomes, wall)
     entries = np.array([fix_entries(o) for o in outcomes])
     summary["fix_entries"] = float(np.mean(entries))
-    summary["sd_fix_entries"] = float(np.std(entries, ddof=1)) if entries.size > 1 else 0.0
+    summary["sd_fix_entries"] = float(np.std(entries, ddof=1)) if entries.size > 1 else math.nan
     summary["max_fix_entries"] = float(np.max(entries))
     minima = [o.metrics["min_stability"] for o in outcomes]
     summary["median_min_stability"] = float(np.median(minima))

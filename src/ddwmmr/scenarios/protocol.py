@@ -59,11 +59,13 @@ from ddwmmr.controllers.base import (
     make_controller,
 )
 from ddwmmr.errors import (
+    MASS_RANGE_KG,
     ParameterError,
     check_finite,
     check_int_at_least,
     check_nonnegative,
     check_positive,
+    check_range,
     check_step_count,
     float_values,
     shown,
@@ -140,9 +142,9 @@ class RunConfig:
         controller: a registered controller of the waypoint task
             (:func:`scenario_controllers`); plant: a registered plant it can command
             (:func:`plants_for`).
-        payload: end-effector payload (kg); 3.0 by default (see docs/thesis.md).
-            A payload the start pose cannot hold (S <= 1) is not refused here (the
-            command line refuses it): every scenario then fails at t = 0 as ``"tipped"``.
+        payload: end-effector payload (kg); 3.0 by default (see docs/thesis.md); in
+            [0, 1e5] kg and light enough that the start pose stands, S > 1
+            (:func:`check_payload`; at most 9.338 kg for the default robot).
         stability, manipulability: (enter, exit) thresholds, enter <= exit, both in
             (0, 10] and (0, 1] (:data:`THRESHOLD_RANGES`, :func:`check_thresholds`);
             exit == enter: no hysteresis.
@@ -151,7 +153,8 @@ class RunConfig:
             per run, as :func:`ddwmmr.simulate` (with ``time_limit`` None: dt >= 6e-5 s,
             checked here, and >= 1.2e-4 s for a scenario with obstacles, checked when it
             is run).
-        time_limit: s; None: 60 s, or 120 s when the scenario has obstacles.
+        time_limit: s, > 0 and finite (:func:`check_time_limit`); None: 60 s, or 120 s
+            when the scenario has obstacles.
         tolerance: waypoint tolerance (m).
         qp_stability_min, qp_max_speed: options of the ``qp`` controller (the stability
             floor is also ``mpc``'s), in :data:`QP_RANGES` (:func:`check_qp_option`).
@@ -204,19 +207,20 @@ class RunConfig:
         check_arbiter(self.arbiter, self.controller)
         check_nonnegative("arbiter_seed", self.arbiter_seed)
         check_int_at_least("arbiter_seed", self.arbiter_seed, 0)
-        check_nonnegative("payload", self.payload)
-        for name in ("dt", "tolerance"):
-            check_positive(name, getattr(self, name))
+        # In the command line's order (python -m ddwmmr.scenarios), so that a bad value
+        # gets its words there: dt's own range before the step count it makes.
+        check_dt(self.dt)
+        if self.time_limit is not None:
+            check_time_limit(self.time_limit)
         for name in QP_RANGES:
             check_qp_option(name, getattr(self, name))
-        if self.time_limit is not None:
-            check_positive("time_limit", self.time_limit)
+        check_payload(self.payload)
+        check_positive("tolerance", self.tolerance)
         # Checked here rather than when a worker reaches a scenario halfway through a
         # batch. Without a time_limit, the shorter default: dt above it would run no step
         # at all; whether 120 s (obstacles) stays within the cap depends on the scenario,
         # which steps_for checks when the run starts.
         step_count(TIME_LIMIT_S if self.time_limit is None else self.time_limit, self.dt)
-        check_dt(self.dt)
 
     def limit_for(self, scenario: Scenario) -> float:
         """Time limit (s) for a scenario."""
@@ -238,13 +242,73 @@ def step_count(limit: float, dt: float) -> int:
         raise ParameterError(str(exc).replace("duration", "time_limit")) from None
 
 
-def check_dt(dt: float) -> float:
-    """``dt`` if it is a control step in (0, :data:`MAX_DT`] s, else a one-line
-    :class:`ParameterError`."""
-    if not (math.isfinite(dt) and 0.0 < dt <= MAX_DT):
-        got, (high,) = texts_apart(dt, MAX_DT)
+def check_dt(dt: Any) -> float:
+    """``dt`` as a float if it is a control step in (0, :data:`MAX_DT`] s, else a one-line
+    :class:`ParameterError` (also for what is no number: text, a boolean, None)."""
+    value = _real(dt)
+    if value is None:
+        raise ParameterError(f"dt must be in (0, {MAX_DT:g}] s (got {shown(dt)})")
+    if not (math.isfinite(value) and 0.0 < value <= MAX_DT):
+        got, (high,) = texts_apart(value, MAX_DT)
         raise ParameterError(f"dt must be in (0, {high}] s (got {got})")
-    return dt
+    return value
+
+
+def check_time_limit(limit: Any) -> float:
+    """``limit`` as a float if it is a scenario's time limit, > 0 s and finite, else a
+    one-line :class:`ParameterError` naming ``time_limit``."""
+    value = _real(limit)
+    if value is None or not (math.isfinite(value) and value > 0.0):
+        got = shown(limit) if value is None else f"{value:g}"
+        raise ParameterError(f"time_limit must be > 0 s and finite (got {got})")
+    return value
+
+
+def _real(value: Any) -> float | None:
+    """``value`` as a float, or None if it is no number (text, a boolean, None) or an
+    integer beyond a float."""
+    if isinstance(value, bool | np.bool_ | str | bytes):
+        return None
+    try:
+        return float(value)
+    except (OverflowError, TypeError, ValueError):
+        return None
+
+
+def check_payload(payload: Any) -> float:
+    """``payload`` (kg) as a float if it is in :data:`ddwmmr.errors.MASS_RANGE_KG` and the
+    default robot carrying it stands in the scenarios' start pose (:func:`check_start_pose`),
+    else a one-line :class:`ParameterError`."""
+    value = check_range("payload", payload, *MASS_RANGE_KG, "kg")
+    check_start_pose(value)
+    return value
+
+
+def check_start_pose(payload: float) -> None:
+    """Refuse a payload (kg) that already tips the default robot over in the scenarios'
+    start pose (S <= 1): every scenario would fail at t = 0. The message names the
+    heaviest payload the pose holds (:func:`max_start_payload`)."""
+    robot = Robot().with_payload(payload)
+    th1, th2 = default_pose(robot)
+    s = robot.stability((0.0, 0.0, 0.0, th1, th2))[2]
+    if s <= 1.0:
+        raise ParameterError(
+            f"payload: {payload:g} kg tips the robot over in the start pose (S = {s:.3g} <= 1); "
+            f"the start pose holds at most {math.floor(max_start_payload() * 1e3) / 1e3:g} kg"
+        )
+
+
+def max_start_payload() -> float:
+    """Largest payload (kg) with S > 1 in the start pose (bisection; S falls with payload)."""
+    low, high = 0.0, MASS_RANGE_KG[1]
+    for _ in range(80):
+        middle = 0.5 * (low + high)
+        robot = Robot().with_payload(middle)
+        if robot.stability((0.0, 0.0, 0.0, *default_pose(robot)))[2] > 1.0:
+            low = middle
+        else:
+            high = middle
+    return low
 
 
 def check_qp_option(name: str, value: float) -> float:
@@ -608,10 +672,14 @@ __all__ = [
     "RunConfig",
     "WaypointTask",
     "check_dt",
+    "check_payload",
     "check_qp_option",
+    "check_start_pose",
     "check_thresholds",
+    "check_time_limit",
     "make_scenario_controller",
     "make_scenario_plant",
+    "max_start_payload",
     "plants_for",
     "run_scenario",
     "scenario_controllers",

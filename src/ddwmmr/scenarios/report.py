@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 from collections.abc import Sequence
 from typing import Any
@@ -11,10 +12,10 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.arbiters.state_machine import STATES
-from ddwmmr.errors import ParameterError, one_line
+from ddwmmr.errors import ParameterError, check_int_at_least, one_line
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import FINE_TRACE_DISTANCE, METRICS, TRACE_INTERVAL, Outcome
-from ddwmmr.sim.result import write_atomic
+from ddwmmr.sim.result import json_safe, write_atomic
 
 #: (summary key, metric column) pairs reported as mean and sample standard deviation.
 AVERAGED = (
@@ -35,14 +36,24 @@ def _column(outcomes: Sequence[Outcome], key: str) -> np.ndarray:
     return np.array([float(o.metrics[key]) for o in outcomes])
 
 
-#: Two-sided 95 % quantile of the normal distribution (the mean time's confidence interval).
-Z95 = 1.959964
+def t_quantile_95(dof: int) -> float:
+    """Two-sided 95 % quantile (the 0.975 quantile) of Student's t distribution with
+    ``dof`` degrees of freedom, an integer >= 1: 12.706 at 1, 2.069 at 23, 1.984 at 99,
+    falling to the normal's 1.960 as ``dof`` grows. The mean of n scenarios has n - 1."""
+    check_int_at_least("dof", dof, 1)
+    # Imported here: scipy.special takes about 0.3 s to import, paid only by a summary
+    # of two or more scenarios.
+    from scipy.special import stdtrit
+
+    return float(stdtrit(dof, 0.975))
 
 
 def _mean_sd(values: np.ndarray) -> tuple[float, float]:
+    """Mean and sample standard deviation (n - 1) of ``values``: the sd of one value is
+    undefined (NaN), and both are NaN without a value that is not NaN."""
     if values.size == 0 or np.all(np.isnan(values)):
         return math.nan, math.nan
-    sd = float(np.std(values, ddof=1)) if values.size > 1 else 0.0
+    sd = float(np.std(values, ddof=1)) if values.size > 1 else math.nan
     return float(np.mean(values)), sd
 
 
@@ -93,10 +104,12 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
     """Batch summary: failures, mean and sd of every metric, minimum stability, speed.
 
     Means are over all scenarios (a failed scenario counts with the time at which it
-    stopped); ``sd_*`` are sample standard deviations (n - 1). ``ci95_time_s`` is the
-    half-width (s) of the mean time's 95 % confidence interval over the scenarios,
-    ``1.96 sd / sqrt(n)`` (normal approximation; NaN for one scenario): two runs whose mean
-    times differ by less than that have not measured a difference.
+    stopped); ``sd_*`` are sample standard deviations (n - 1; NaN for one scenario).
+    ``ci95_time_s`` is the half-width (s) of the mean time's 95 % confidence interval over
+    the scenarios, ``t sd / sqrt(n)`` with ``t`` Student's two-sided 95 % quantile for
+    n - 1 degrees of freedom (:func:`t_quantile_95`: 4.303 at n = 3, 1.984 at n = 100;
+    NaN for one scenario): two runs whose mean times differ by less than that have not
+    measured a difference.
     ``fallback_steps`` (and ``fallback_share`` of all steps): the steps whose command was
     the controller's safe fallback after a failed solve; None for the thesis controller.
     """
@@ -116,7 +129,8 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
     steps = float(np.sum(_column(outcomes, "sim_steps")))
     summary["fallback_share"] = float(np.nansum(fallbacks)) / steps if known and steps else None
     n = len(outcomes)
-    summary["ci95_time_s"] = Z95 * summary["sd_time_s"] / math.sqrt(n) if n > 1 else math.nan
+    half_width = t_quantile_95(n - 1) * summary["sd_time_s"] / math.sqrt(n) if n > 1 else math.nan
+    summary["ci95_time_s"] = half_width
     summary["min_stability"] = float(np.min(_column(outcomes, "min_stability")))
     summary["min_manipulability"] = float(np.min(_column(outcomes, "min_manipulability")))
     unloaded = _column(outcomes, "unloaded_time_s")  # physics plants only (else NaN)
@@ -206,6 +220,26 @@ def format_table(summary: dict[str, Any], title: str) -> str:
         label = "Time with an edge unloaded (s)"
         lines.append(f"{label:<{width}}  {_fmt(summary['mean_unloaded_time_s'])}")
     return "\n".join(lines) + "\n"
+
+
+def summary_json(summary: dict[str, Any]) -> str:
+    """The text of a scenarios run's summary.json: ``summary`` as indented standard JSON
+    in which every undefined number (NaN, or a non-finite float: the mean of a metric
+    the controller has not, the sd and CI of one scenario, a ratio over no scenario) is
+    null, as the fields that do not apply already are (``fallback_steps``...). Strings,
+    such as the run record's ``"inf"`` (:mod:`ddwmmr.provenance`), are kept as they are."""
+    return json.dumps(json_safe(_undefined_as_null(summary)), indent=2, allow_nan=False) + "\n"
+
+
+def _undefined_as_null(value: Any) -> Any:
+    """``value`` with every non-finite float (numpy's too) in it replaced by None."""
+    if isinstance(value, dict):
+        return {k: _undefined_as_null(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_undefined_as_null(v) for v in value]
+    if isinstance(value, float | np.floating) and not math.isfinite(value):
+        return None
+    return value
 
 
 def metrics_csv(outcomes: Sequence[Outcome]) -> str:
