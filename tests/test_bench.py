@@ -504,7 +504,7 @@ def test_cli_times_scenarios_only_when_asked_with_a_method(tmp_path, capsys):
     printed = capsys.readouterr().out
     data = json.loads(out.read_text())
     assert [row["scenarios"] for row in data["scenarios"]] == [2] * len(SCENARIO_CONTROLLERS)
-    assert "scenario benchmark (2 scenarios, seed 0, 1 workers" in printed
+    assert "scenario benchmark (2 scenarios, seed 0, 1 worker" in printed
     assert main([*args, "--out", str(out)]) == 0  # --method alone: no scenarios
     assert json.loads(out.read_text())["scenarios"] == []
     with pytest.raises(SystemExit) as stop:

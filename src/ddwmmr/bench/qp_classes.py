@@ -321,6 +321,8 @@ def measure_qp_classes(
             "rows": rows,
             "phases": {
                 **{name: stats["median_us"] for name, stats in phase_stats.items()},
+                # medians do not add: the phases' can exceed the step's (the table shows
+                # that rest negative, see report.format_qp_phases)
                 "rest": max(total - known, 0.0),
             },
             "phase_percentiles": phase_stats,

@@ -46,7 +46,10 @@ def format_table(report: dict[str, Any]) -> str:
         f"target: step <= {report['target_step_ratio']:g} x {report['baseline']} step "
         "('vs naive' = step / naive step; 'run x naive' = steps/s / naive steps/s)"
     )
+    measured = {row["label"] for row in report["rows"]}
     for label, budget in report["step_budgets_us"].items():
+        if label not in measured:  # a budget of a method this run did not time
+            continue
         lines.append(f"target for {label}: step <= {budget:g} us (absolute budget)")
     for pair in report["pairs"]:
         lines.append(f"{pair['method']} / {pair['naive']} step ratio: {pair['step_ratio']:.3f}")
@@ -64,9 +67,11 @@ def format_table(report: dict[str, Any]) -> str:
 def format_scenarios(report: dict[str, Any]) -> list[str]:
     """The scenario-throughput section of the table."""
     first = report["scenarios"][0]
+    scenarios, jobs = first["scenarios"], first["jobs"]
     lines = [
-        f"scenario benchmark ({first['scenarios']} scenarios, seed 0, {first['jobs']} "
-        "workers; simulated s per wall s, wall time includes the worker pool)"
+        f"scenario benchmark ({scenarios} scenario{'s' if scenarios != 1 else ''}, seed 0, "
+        f"{jobs} worker{'s' if jobs != 1 else ''}; simulated s per wall s, wall time "
+        "includes the worker pool)"
     ]
     for row in report["scenarios"]:
         lines.append(
@@ -105,15 +110,27 @@ def format_qp_classes(report: dict[str, Any]) -> list[str]:
                 f"    {label:<22} {stats['median_us']:>8.2f} {stats['p90_us']:>8.2f} "
                 f"{stats['p99_us']:>8.2f}{versus}"
             )
-        phases = entry["phases"]
-        lines.append(
-            "    qp phases (median): "
-            + ", ".join(
-                f"{name} {phases[name]:.2f}" for name in ("build", "solve", "check", "rest")
-            )
-        )
+        lines.append(format_qp_phases(entry))
     lines.append(format_qp_verdict(report))
     return lines
+
+
+def format_qp_phases(entry: dict[str, Any]) -> str:
+    """One line: the median of each qp phase (us) and the rest of the step, its median
+    minus theirs. Medians do not add: when the phases' exceed the step's, the rest is
+    shown negative and said so, not as the report's ``rest`` (clamped at 0)."""
+    phases = entry["phases"]
+    step = entry["rows"]["qp"]["median_us"]
+    rest = step - sum(phases[name] for name in ("build", "solve", "check"))
+    text = "    qp phases (median): " + ", ".join(
+        f"{name} {phases[name]:.2f}" for name in ("build", "solve", "check")
+    )
+    if rest >= 0.0:
+        return f"{text}, rest {rest:.2f}"
+    return (
+        f"{text}, rest {rest:.2f} (the phase medians add up to more than the step median "
+        f"{step:.2f}: medians do not add)"
+    )
 
 
 def format_qp_verdict(report: dict[str, Any]) -> str:

@@ -304,5 +304,6 @@ def robot_from_arguments(args: argparse.Namespace, plants: Sequence[str] = ()) -
         try:
             check_buildable(robot)
         except ParameterError as exc:
-            raise ParameterError(f"robot: {args.robot}: {exc} (for the MuJoCo plant)") from None
+            # the message names the MuJoCo plant: prefixed with the file, not repeated
+            raise ParameterError(f"robot: {args.robot}: {exc}") from None
     return robot

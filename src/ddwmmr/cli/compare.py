@@ -455,17 +455,24 @@ def config_from_arguments(
 
 
 def not_tracked(plan: Any, outputs: dict[Any, Any]) -> list[str]:
-    """Console lines for the main runs that did not track (:mod:`ddwmmr.sim.verdict`):
-    one per run saying what went wrong, then each likely cause once."""
+    """Console lines for the runs that did not track (:mod:`ddwmmr.sim.verdict`), the main
+    runs and their repetitions on each ``--plant`` (named): one per run saying what went
+    wrong, then each likely cause once."""
+    judged = [(spec, spec.method, "") for spec in plan.main]
+    # a plan may leave out ``plants`` when no extra plant runs
+    for plant, specs in getattr(plan, "plants", {}).items():
+        judged += [
+            (spec, f"{spec.method} on the {plant} plant", f" ({plant} plant)") for spec in specs
+        ]
     lines, causes = [], {}
-    for spec in plan.main:
+    for spec, who, where in judged:
         found, what, cause = explain(outputs[spec].summary)
         if found:
-            lines.append(f"  {spec.method} on {spec.trajectory}: {what}")
-            causes.setdefault(cause, []).append(spec.method)
+            lines.append(f"  {spec.method} on {spec.trajectory}{where}: {what}")
+            causes.setdefault(cause, []).append(who)
     if not lines:
         return ['Every run tracked (see docs/cli.md, "Verdict").']
-    head = f'Did not track ({len(lines)} of {len(plan.main)} runs; see docs/cli.md, "Verdict"):'
+    head = f'Did not track ({len(lines)} of {len(judged)} runs; see docs/cli.md, "Verdict"):'
     tail = [
         f"  likely cause ({', '.join(dict.fromkeys(methods))}): {cause}"
         for cause, methods in causes.items()

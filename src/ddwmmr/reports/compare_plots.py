@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import matplotlib
 
@@ -27,6 +28,9 @@ from ddwmmr.reports.legends import legend_beside, place_legend
 ERROR_FLOOR = 1e-12
 #: Resolution of the saved PNGs (dots per inch).
 DPI = 100
+#: Narrowest figure of :func:`plot_small_multiples` (in): two panels' width, which holds
+#: its title and legend when one or two methods are compared.
+MIN_MULTIPLES_WIDTH_IN = 8.8
 
 Series = Mapping[str, Mapping[str, np.ndarray]]
 
@@ -48,6 +52,15 @@ def _floor(values: np.ndarray) -> np.ndarray:
     return np.maximum(np.abs(values), ERROR_FLOOR)
 
 
+def _log_bottom(series: Sequence[np.ndarray]) -> float:
+    """Bottom (m) of a log error axis drawn from ``series``: half the smallest error drawn
+    (floored at :data:`ERROR_FLOOR`), so the axis stops where the data do instead of
+    running decades below them."""
+    finite = [v[np.isfinite(v)] for v in (_floor(np.asarray(s, dtype=float)) for s in series)]
+    lowest = min((float(v.min()) for v in finite if v.size), default=ERROR_FLOOR)
+    return lowest / 2.0
+
+
 def break_wraps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(t, angle)`` with a NaN inserted wherever a wrapped angle jumps by more than pi
     between samples (a crossing of +-pi, not a real step), so the line is broken there
@@ -67,15 +80,27 @@ def _grid_shape(count: int) -> tuple[int, int]:
     return math.ceil(max(count, 1) / columns), columns
 
 
-def _path_limits(ax: Axes, series: Series, margin: float) -> None:
-    """Frame the desired path plus ``margin`` (m), grown to hold every method's path."""
+def _path_limits(ax: Axes, series: Series, margin: float, obstacles: Sequence[Any] = ()) -> None:
+    """Frame the desired path plus ``margin`` (m), grown to hold every method's path and
+    the ``obstacles``."""
     from ddwmmr.reports.plots import fit_equal
 
     reference = next(iter(series.values()))
     x0, y0 = reference["xE_d"], reference["yE_d"]
-    xs = np.r_[x0.min() - margin, x0.max() + margin, *[ts["xE"] for ts in series.values()]]
-    ys = np.r_[y0.min() - margin, y0.max() + margin, *[ts["yE"] for ts in series.values()]]
+    cx, cy = _obstacle_extent(obstacles)
+    xs = np.r_[x0.min() - margin, x0.max() + margin, cx, *[ts["xE"] for ts in series.values()]]
+    ys = np.r_[y0.min() - margin, y0.max() + margin, cy, *[ts["yE"] for ts in series.values()]]
     fit_equal(ax, xs, ys, 0.05)
+
+
+def _obstacle_extent(obstacles: Sequence[Any]) -> tuple[np.ndarray, np.ndarray]:
+    """The x and y (m) of the bounding boxes' sides of the ``obstacles`` (circles or (x, y,
+    radius) triples), so a frame fitted to them holds every disc whole."""
+    from ddwmmr.reports.plots import circles_of
+
+    circles = np.array(circles_of(obstacles)).reshape(-1, 3)
+    x, y, radius = circles.T
+    return np.r_[x - radius, x + radius], np.r_[y - radius, y + radius]
 
 
 def zoom_window(
@@ -106,6 +131,7 @@ def plot_paths(
     colors: Mapping[str, str],
     title: str,
     zooms: Sequence[tuple[str, float, float | None]] = (),
+    obstacles: Sequence[Any] = (),
 ) -> Figure:
     """End-effector paths of every method on the desired path, with zoom panels.
 
@@ -117,19 +143,21 @@ def plot_paths(
         zooms: ``(label, t, half_width)`` per zoom panel: the region around the desired
             position at time t (s), half-width in m (None: from the errors, see
             :func:`zoom_window`); each method's position at time t is marked with a dot.
+        obstacles: the runs' circular obstacles (circles or (x, y, radius) triples, m),
+            drawn as grey discs in every panel; the main frame holds them.
     """
     fig = plt.figure(figsize=(11.5, 6.8))
     grid = fig.add_gridspec(max(len(zooms), 1), 2, width_ratios=(1.5, 1))
     ax = fig.add_subplot(grid[:, 0])
-    _draw_paths(ax, series, colors)
-    _path_limits(ax, series, 0.5)
+    _draw_paths(ax, series, colors, obstacles=obstacles)
+    _path_limits(ax, series, 0.5, obstacles)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_title(title)
     for row, (label, t_center, half_width) in enumerate(zooms):
         cx, cy, h = zoom_window(series, t_center, half_width)
         zoom = fig.add_subplot(grid[row, 1])
-        _draw_paths(zoom, series, colors, mark_time=t_center)
+        _draw_paths(zoom, series, colors, mark_time=t_center, obstacles=obstacles)
         zoom.set_xlim(cx - h, cx + h)
         zoom.set_ylim(cy - h, cy + h)
         zoom.set_aspect("equal", adjustable="box")
@@ -148,8 +176,15 @@ def plot_paths(
 
 
 def _draw_paths(
-    ax: Axes, series: Series, colors: Mapping[str, str], mark_time: float | None = None
+    ax: Axes,
+    series: Series,
+    colors: Mapping[str, str],
+    mark_time: float | None = None,
+    obstacles: Sequence[Any] = (),
 ) -> None:
+    from ddwmmr.reports.plots import draw_obstacles
+
+    draw_obstacles(ax, obstacles)
     reference = next(iter(series.values()))
     # The desired path over the methods, thin and dashed: visible where they follow it.
     ax.plot(
@@ -232,18 +267,35 @@ def plot_wheels(series: Series, colors: Mapping[str, str], limit: float, title: 
 
 
 def plot_small_multiples(
-    series: Series, colors: Mapping[str, str], robot: Robot, title: str, snapshots: int = 6
+    series: Series,
+    colors: Mapping[str, str],
+    robot: Robot,
+    title: str,
+    snapshots: int = 6,
+    obstacles: Sequence[Any] = (),
 ) -> Figure:
-    """One panel per method: desired and actual end-effector path, base path, and the robot
+    """One panel per method: desired and actual end-effector path, base path, the robot
     at ``snapshots`` instants, one colour per instant (named in the figure's legend: no
-    text next to the robots, which would cover the paths). Each panel holds everything it
-    draws: the frame of the desired path, grown for a method that leaves it."""
-    from ddwmmr.reports.plots import draw_snapshots, fit_equal, outline_points, snapshot_indices
+    text next to the robots, which would cover the paths), and the runs' ``obstacles``
+    (circles or (x, y, radius) triples, m) as grey discs. Each panel holds everything it
+    draws: the frame of the desired path, grown for a method that leaves it. The figure is
+    at least :data:`MIN_MULTIPLES_WIDTH_IN` wide, so one or two panels leave room for the
+    title and legend."""
+    from ddwmmr.reports.plots import (
+        draw_obstacles,
+        draw_snapshots,
+        fit_equal,
+        outline_points,
+        snapshot_indices,
+    )
 
     rows, columns = _grid_shape(len(series))
-    fig, axes = plt.subplots(rows, columns, figsize=(4.4 * columns, 4.2 * rows), squeeze=False)
+    width = max(4.4 * columns, MIN_MULTIPLES_WIDTH_IN)
+    fig, axes = plt.subplots(rows, columns, figsize=(width, 4.2 * rows), squeeze=False)
     handles: list = []
+    cx, cy = _obstacle_extent(obstacles)
     for ax, (label, ts) in zip(axes.flat, series.items()):
+        draw_obstacles(ax, obstacles)
         indices = snapshot_indices(ts, snapshots)
         handles = draw_snapshots(ax, robot, ts, indices, lw=0.8)
         ax.plot(ts["x"], ts["y"], color="0.6", lw=0.9)
@@ -254,10 +306,20 @@ def plot_small_multiples(
         fit_equal(
             ax,
             np.r_[
-                ts["xE_d"].min() - frame, ts["xE_d"].max() + frame, ts["xE"], ts["x"], outline[:, 0]
+                ts["xE_d"].min() - frame,
+                ts["xE_d"].max() + frame,
+                ts["xE"],
+                ts["x"],
+                outline[:, 0],
+                cx,
             ],
             np.r_[
-                ts["yE_d"].min() - frame, ts["yE_d"].max() + frame, ts["yE"], ts["y"], outline[:, 1]
+                ts["yE_d"].min() - frame,
+                ts["yE_d"].max() + frame,
+                ts["yE"],
+                ts["y"],
+                outline[:, 1],
+                cy,
             ],
             0.1,
         )
@@ -285,10 +347,11 @@ def plot_small_multiples(
             title_fontsize=9,
         )
     else:
-        fig.tight_layout(rect=(0, 0.06, 1, 1))
-        fig.legend(
-            handles=handles, loc="lower center", ncol=len(handles), fontsize=9, frameon=False
-        )
+        # under three panels one row of legend entries is wider than the figure: two rows
+        ncol = len(handles) if columns >= 3 else math.ceil(len(handles) / 2)
+        legend_rows = math.ceil(len(handles) / max(ncol, 1))
+        fig.tight_layout(rect=(0, 0.06 + 0.11 * (legend_rows - 1), 1, 1))
+        fig.legend(handles=handles, loc="lower center", ncol=ncol, fontsize=9, frameon=False)
     return fig
 
 
@@ -589,10 +652,13 @@ def plot_corner_study(
 def plot_plant_errors(
     kinematic: Series, plant: Series, colors: Mapping[str, str], plant_name: str, title: str
 ) -> Figure:
-    """Position error vs time per method: kinematic plant (dashed) and ``plant`` (solid)."""
+    """Position error vs time per method: kinematic plant (dashed) and ``plant`` (solid),
+    on a log axis that ends below the smallest error drawn (:func:`_log_bottom`)."""
     fig, ax = plt.subplots(figsize=(9, 4))
+    drawn = []
     for label, ts in plant.items():
         base = kinematic[label]
+        drawn += [base["position_error_m"], ts["position_error_m"]]
         ax.semilogy(
             base["t"], _floor(base["position_error_m"]), color=colors[label], ls="--", lw=0.8
         )
@@ -601,7 +667,7 @@ def plot_plant_errors(
         )
     ax.set_ylabel("position error (m, log)")
     ax.set_xlabel("t (s)")
-    ax.set_ylim(bottom=ERROR_FLOOR / 2)
+    ax.set_ylim(bottom=_log_bottom(drawn))
     ax.grid(alpha=0.3, which="major")
     ax.set_title(title)
     legend_beside(ax, fontsize=8, title=f"solid: {plant_name}\ndashed: kinematic", title_fontsize=8)

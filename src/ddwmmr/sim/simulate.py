@@ -74,11 +74,24 @@ def check_controller(controller: Any) -> Any:
     return controller
 
 
-def warn_other_robot(controller: Any, robot: Robot) -> None:
-    """Warn (:class:`UserWarning`) when ``controller`` holds a ``robot`` other than the
-    simulated one: its model, e.g. its stability floor's payload, is then not the plant's.
-    That can be meant (a study of model error), so it is not refused."""
-    own = getattr(controller, "robot", None)
+#: What a controller or plant object built for another robot means for the run, by the
+#: parameter that passed it (see :func:`warn_other_robot`).
+_OTHER_ROBOT = {
+    "method": ("the controller", "its model is not the plant's"),
+    "plant": (
+        "the plant object",
+        "the physics runs with its robot, the summary's S and verdict with the simulated one",
+    ),
+}
+
+
+def warn_other_robot(holder: Any, robot: Robot, parameter: str = "method") -> None:
+    """Warn (:class:`UserWarning`) when ``holder``, the object passed as ``parameter``
+    (``"method"``: a controller, ``"plant"``: a plant), holds a ``robot`` other than the
+    simulated one, naming the fields that differ: a controller's model, e.g. its stability
+    floor's payload, is then not the plant's; a plant simulates other physics than the
+    summary judges. That can be meant (a study of model error), so it is not refused."""
+    own = getattr(holder, "robot", None)
     if not isinstance(own, Robot) or own == robot:
         return
     differ = [
@@ -86,10 +99,11 @@ def warn_other_robot(controller: Any, robot: Robot) -> None:
         for f in dataclasses.fields(Robot)
         if f.init and getattr(own, f.name) != getattr(robot, f.name)
     ]
+    what, meaning = _OTHER_ROBOT[parameter]
     warnings.warn(
-        f"method: the controller was built for another robot than the one simulated "
-        f"({'; '.join(differ[:3])}{'; ...' if len(differ) > 3 else ''}): its model is not "
-        "the plant's; build it with the same Robot unless that is the point",
+        f"{parameter}: {what} was built for another robot than the one simulated "
+        f"({'; '.join(differ[:3])}{'; ...' if len(differ) > 3 else ''}): {meaning}; "
+        "build it with the same Robot unless that is the point",
         UserWarning,
         stacklevel=3,
     )
@@ -207,7 +221,9 @@ def simulate(
             start must hold the arm joints within the robot's ``joint_limits``
             (:class:`ParameterError` otherwise).
         plant: ``"kinematic"`` (default), ``"thesis"`` (force-driven base, velocity servo),
-            any name of :func:`ddwmmr.plants.available_plants`, or a plant object.
+            any name of :func:`ddwmmr.plants.available_plants`, or a plant object (one
+            holding another ``robot`` than this one runs after a :class:`UserWarning`
+            naming the fields that differ).
         plant_options: keyword options of the named plant.
         progress: optional callback ``progress(step, steps)``.
         tipped_start: a start in which the robot has already tipped over (static S <= 1,
@@ -239,6 +255,8 @@ def simulate(
     reference = check_trajectory(trajectory)
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
     the_plant = _plant(plant, robot, integrator, plant_options)
+    if not isinstance(plant, str):
+        warn_other_robot(the_plant, robot, "plant")
     if dt is None:
         dt = engine_multiple(resolution_step(trajectory), the_plant)
     dt = check_positive("dt", dt)

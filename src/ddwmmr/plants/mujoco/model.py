@@ -179,7 +179,8 @@ def support_polygon(robot: Robot) -> np.ndarray:
 
 
 def check_buildable(robot: Robot) -> None:
-    """Raise :class:`ParameterError` for a robot MuJoCo cannot simulate (one line).
+    """Raise :class:`ParameterError` for a robot MuJoCo cannot simulate (one line naming
+    the field and, once, the MuJoCo plant).
 
     Moving bodies need mass (each arm link), the base centre must stand strictly inside the
     support polygon (else the robot has no stable rest), and ``base_inertia`` must exceed
@@ -195,11 +196,11 @@ def check_buildable(robot: Robot) -> None:
     if len(hull) < 3 or min(_edge_distances(hull, (0.0, 0.0))) <= 1e-9:
         raise ParameterError(
             "caster_positions: the base centre must lie strictly inside the support polygon "
-            f"of the wheels and casters (got casters {robot.casters})"
+            f"of the wheels and casters for the MuJoCo plant (got casters {robot.casters})"
         )
     if not _base_body_yaw_inertia(robot) > 0.0:
         raise ParameterError(
-            f"robot: base_inertia must be > the wheels' own yaw inertia, "
+            f"base_inertia must be > the wheels' own yaw inertia for the MuJoCo plant, "
             f"{robot.base_inertia - _base_body_yaw_inertia(robot):.4g} kg m^2 from "
             f"wheel_mass, wheel_radius and track_width (got {robot.base_inertia:g}); raise "
             "base_inertia or make the wheels lighter or smaller"

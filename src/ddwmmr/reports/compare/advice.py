@@ -37,6 +37,8 @@ class Profile:
         min_stability: smallest tip-over margin S over the runs.
         singularity: trajectory -> (``away`` | ``passes`` | ``lost``, time in s or NaN).
         min_cos_th1: smallest |cos th1| over the runs.
+        start_stability: smallest tip-over margin S of the start poses over the runs (NaN
+            if no run recorded it).
     """
 
     method: str
@@ -50,6 +52,7 @@ class Profile:
     min_stability: float
     singularity: dict[str, tuple[str, float]]
     min_cos_th1: float
+    start_stability: float = math.nan
 
     @property
     def converges(self) -> bool:
@@ -89,6 +92,10 @@ def profiles(
                 singularity=singularity,
                 min_cos_th1=min(
                     float(np.min(np.abs(np.cos(r.timeseries["th1"])))) for r in runs.values()
+                ),
+                start_stability=min(
+                    (float(s["start_stability"]) for s in summaries if "start_stability" in s),
+                    default=math.nan,
                 ),
             )
         )
@@ -150,11 +157,20 @@ def _singularity_text(p: Profile) -> str:
     return "; ".join(parts)
 
 
-def recommendations(items: Sequence[Profile], slides: Ranking | None = None) -> list[str]:
+def recommendations(
+    items: Sequence[Profile], slides: Ranking | None = None, corners_reached: bool = True
+) -> list[str]:
     """One line per use case, from the profiles (best ranked first) and the ranking under
-    the slides' settings (``slides``)."""
+    the slides' settings (``slides``). ``corners_reached``: the runs of the corner
+    trajectory reach one of its corners (else no method is named for sharp corners)."""
     lines = [_best_line("Best tracking over all trajectories", items, _overall)]
     for name, label in ((STUDY_TRAJECTORY, "Smooth paths"), (CORNER_TRAJECTORY, "Sharp corners")):
+        if name == CORNER_TRAJECTORY and not corners_reached:
+            lines.append(
+                f"**{label} (like the {name})**: not judged: the runs end before the "
+                f"{name}'s first corner."
+            )
+            continue
         if items and name in items[0].scores:
             lines.append(
                 _best_line(f"{label} (like the {name})", items, lambda p, n=name: p.scores[n])
@@ -168,18 +184,7 @@ def recommendations(items: Sequence[Profile], slides: Ranking | None = None) -> 
             f"offset, below 5 % after {fmt(fastest.settle_s)} s on the "
             f"{fastest.settle_trajectory})."
         )
-    guarded = [p for p in items if p.stability_floor is not None and p.stability_violations == 0]
-    if guarded:
-        names = ", ".join(f"`{p.method}` (S >= {fmt(p.stability_floor)})" for p in guarded)
-        lines.append(
-            f"**Tip-over stability as a hard guarantee**: {names}; no other compared method "
-            "constrains S."
-        )
-    else:
-        lines.append(
-            "**Tip-over stability as a hard guarantee**: none of the compared methods "
-            "enforces a floor on S (the `qp` method does)."
-        )
+    lines.append(_stability_line(items))
     lines.append(_singularity_line(items))
     open_loop = [p for p in items if p.open_loop and not p.converges]
     if open_loop:
@@ -197,6 +202,33 @@ def recommendations(items: Sequence[Profile], slides: Ranking | None = None) -> 
             f"best of their methods under their settings is `{best}` ({scores})."
         )
     return lines
+
+
+def _stability_line(items: Sequence[Profile]) -> str:
+    """Which compared methods keep a hard floor on S, and which enforce one but were
+    below it (a run that starts below its floor breaks it from the first step)."""
+    label = "**Tip-over stability as a hard guarantee**: "
+    floored = [p for p in items if p.stability_floor is not None]
+    if not floored:
+        return label + "none of the compared methods enforces a floor on S (`qp` and `mpc` do)."
+    kept = [p for p in floored if p.stability_violations == 0]
+    broken = [p for p in floored if p.stability_violations > 0]
+    parts = []
+    if kept:
+        parts.append(", ".join(f"`{p.method}` (S >= {fmt(p.stability_floor)})" for p in kept))
+    if broken:
+        texts = ", ".join(_broken_floor_text(p) for p in broken)
+        verb = "enforces" if len(broken) == 1 else "enforce"
+        parts.append(f"{texts} {verb} a floor but did not keep it in these runs")
+    return label + "; ".join([*parts, "no other compared method constrains S."])
+
+
+def _broken_floor_text(p: Profile) -> str:
+    """``qp`` with its floor, the steps below it and, if so, that it started below it."""
+    text = f"`{p.method}` (S >= {fmt(p.stability_floor)}, {p.stability_violations} steps below it"
+    if p.stability_floor is not None and p.start_stability < p.stability_floor:
+        text += f"; it started below it, at S = {fmt(p.start_stability)}"
+    return text + ")"
 
 
 def _overall(p: Profile) -> float:

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import as_completed
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -178,8 +178,8 @@ class Plan:
     studies: dict[str, list[RunSpec]] = field(default_factory=dict)
     #: The main runs under the other preset (same order as ``main``).
     alternative: list[RunSpec] = field(default_factory=list)
-    #: The default settings with one slides setting applied, for methods whose presets
-    #: differ in more than one option (what each setting does on its own).
+    #: The default settings with one slides setting applied, for methods whose runs under
+    #: the two presets differ in more than one setting (:func:`effect_settings`).
     preset_effects: list[RunSpec] = field(default_factory=list)
     #: The main runs repeated on each extra plant (``--plant``), same order as ``main``.
     plants: dict[str, list[RunSpec]] = field(default_factory=dict)
@@ -213,6 +213,14 @@ def preset_changes(method: str, preset: str) -> tuple[tuple[str, Any], ...]:
     return tuple((key, slides) for key, (slides, _) in preset_differences(method).items())
 
 
+def run_differences(method: str, options: Mapping[str, Any]) -> dict[str, tuple[Any, Any]]:
+    """The settings in which the runs of ``method`` under the two presets differ: name ->
+    (slides, default) for each :func:`~ddwmmr.controllers.presets.preset_differences`
+    entry that the user's ``options`` of the method (``--option``) leave unset (a setting
+    the user gives is the same in every run of the method)."""
+    return {k: v for k, v in preset_differences(method).items() if k not in options}
+
+
 def main_spec(
     config: CompareConfig, method: str, name: str, *, preset: str | None = None, **changes: Any
 ) -> RunSpec:
@@ -228,16 +236,22 @@ def main_spec(
     return RunSpec(method, name, options=tuple(options.items()), **spec)
 
 
-def effect_specs(config: CompareConfig, method: str, name: str) -> list[RunSpec]:
-    """Default settings plus one slides setting, one run per differing option (only for
-    methods whose presets differ in more than one option)."""
-    differences = preset_differences(method)
+def effect_settings(config: CompareConfig, method: str, name: str) -> list[tuple[str, RunSpec]]:
+    """(setting, run) per setting of :func:`run_differences`: the default preset and the
+    user's options with that one slides setting applied; none when the runs under the two
+    presets differ in fewer than two settings (the one setting alone is the slides run)."""
+    differences = run_differences(method, config.options.get(method, {}))
     if len(differences) < 2:
         return []
     return [
-        main_spec(config, method, name, preset="default", options=((key, slides),))
+        (key, main_spec(config, method, name, preset="default", options=((key, slides),)))
         for key, (slides, _) in differences.items()
     ]
+
+
+def effect_specs(config: CompareConfig, method: str, name: str) -> list[RunSpec]:
+    """The runs of :func:`effect_settings`."""
+    return [spec for _, spec in effect_settings(config, method, name)]
 
 
 def study_tau(config: CompareConfig, method: str, tau: float) -> float | tuple[float, ...]:

@@ -45,6 +45,7 @@ from ddwmmr.reports.compare.plan import (
     RunSpec,
     default_step,
     main_spec,
+    run_differences,
     run_duration,
     study_offsets,
     study_steps,
@@ -59,8 +60,10 @@ from ddwmmr.reports.compare.ranking import (
     metrics_csv,
     metrics_rows,
 )
+from ddwmmr.reports.plots import circles_of
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
 from ddwmmr.sim.result import write_atomic
+from ddwmmr.sim.verdict import explain
 
 # -- building the report ------------------------------------------------------------------
 
@@ -182,10 +185,43 @@ def _setup_section(c: _Context) -> None:
         f"runs: {len(c.plan.all_specs())} simulations "
         f"(studies: {', '.join(c.plan.studies) or 'none'})",
     ]
+    items += _obstacle_items(config)
     if config.command:
         items.append(f"command: `{config.command}`")
     c.doc.heading("Setup")
     c.doc.bullets(items)
+
+
+#: Caption sentence of the figures that draw the runs' obstacles.
+OBSTACLES_CAPTION = " Grey discs: the obstacles given with `--option obstacles`."
+
+
+def run_obstacles(config: CompareConfig) -> list[tuple[float, float, float]]:
+    """Every obstacle (x, y, radius) (m, world frame) any compared method was given
+    (``--option obstacles``), each once, sorted."""
+    return sorted(
+        {o for m in config.methods for o in circles_of(config.options.get(m, {}).get("obstacles"))}
+    )
+
+
+def _obstacle_items(config: CompareConfig) -> list[str]:
+    """One Setup line per set of obstacles (``--option obstacles``) and the methods that
+    avoid it: circles (x, y, radius) in m in the world frame; none without obstacles."""
+    methods: dict[tuple[tuple[float, float, float], ...], list[str]] = {}
+    for method in config.methods:
+        circles = config.options.get(method, {}).get("obstacles")
+        if circles:
+            key = tuple(circles_of(circles))
+            methods.setdefault(key, []).append(method)
+    others = [m for m in config.methods if not any(m in v for v in methods.values())]
+    verb = "ignores" if len(others) == 1 else "ignore"
+    ignore = f"; {', '.join(f'`{m}`' for m in others)} {verb} them" if others else ""
+    return [
+        "obstacles (world frame, m): "
+        + ", ".join(f"circle at ({x:g}, {y:g}) of radius {r:g}" for x, y, r in key)
+        + f", given to {', '.join(f'`{m}`' for m in names)}{ignore}"
+        for key, names in methods.items()
+    ]
 
 
 def ranking_table(ranking: Ranking) -> tuple[list[str], list[list[str]]]:
@@ -228,12 +264,21 @@ def _advice_section(c: _Context, ranking: Ranking, slides_ranking: Ranking) -> N
         "singularity cos th1 = 0 does to the run."
     )
     c.doc.table(advice.ADVICE_HEADERS, advice.advice_rows(items))
-    c.doc.bullets(advice.recommendations(items, slides_ranking))
+    c.doc.bullets(advice.recommendations(items, slides_ranking, _corners_reached(c.config)))
+
+
+def _corners_reached(config: CompareConfig) -> bool:
+    """The runs of the corner trajectory reach one of its corners; True when it is not
+    compared or does not say where its corners are (nothing to hold against its score)."""
+    trajectory = config.trajectories.get(CORNER_TRAJECTORY)
+    if getattr(trajectory, "corner_times", None) is None:
+        return True
+    return bool(corner_times(trajectory, run_duration(config, CORNER_TRAJECTORY)))
 
 
 def _presets_section(c: _Context, rankings: Mapping[str, tuple[Ranking, SlidesCheck]]) -> None:
     c.doc.heading("The slides' settings and ours")
-    rows = settings.setting_rows(c.config.methods)
+    rows = settings.setting_rows(c.config.methods, c.config.options)
     c.doc.paragraph(
         "The slides configure some methods differently from the library's defaults. Every "
         "main run is repeated with the slides' settings (`--preset slides`, "
@@ -244,7 +289,7 @@ def _presets_section(c: _Context, rankings: Mapping[str, tuple[Ranking, SlidesCh
     )
     if rows:
         c.doc.table(settings.SETTING_HEADERS, rows)
-    c.doc.paragraph("The same in both: " + "; ".join(settings.same_in_both()) + ".")
+    c.doc.paragraph("The same in both: " + "; ".join(settings.same_in_both(c.config.options)) + ".")
     if rows:
         c.doc.paragraph(
             "Results under both (errors in mm; the difference is what our setting buys). "
@@ -371,7 +416,8 @@ def _variants_table(c: _Context) -> None:
 
 def _aux_finding(c: _Context) -> str:
     """Compare ats with aux = shoulder (ours) and aux = sum (the slides') per trajectory."""
-    if "ats" not in c.config.methods:
+    ats_options = c.config.options.get("ats", {})
+    if "ats" not in c.config.methods or "aux" not in run_differences("ats", ats_options):
         return ""
     runs = settings.runs_by_preset(c.config, c.plan)
     texts = []
@@ -444,13 +490,14 @@ def _trajectory_section(c: _Context, name: str) -> None:
     colors = c.colors
     trajectory = c.config.trajectories[name]
     quarter = getattr(trajectory, "T", trajectory.duration) / 4.0
+    obstacles = run_obstacles(c.config)
     offset = math.hypot(*DEFAULT_INITIAL_OFFSET)
     zooms = [("A", 0.0, 3.0 * offset)]
     if quarter < run_duration(c.config, name):
         zooms.append(("B", quarter, None))
     c.add_figure(
         f"paths_{name}.png",
-        plots.plot_paths(series, colors, f"{name}: end-effector paths", zooms),
+        plots.plot_paths(series, colors, f"{name}: end-effector paths", zooms, obstacles=obstacles),
         f"{name}: end-effector paths and the desired path (thin dashed, drawn over the "
         "methods, which go from wide to thin lines so that coinciding ones stay visible). "
         "The main "
@@ -465,7 +512,8 @@ def _trajectory_section(c: _Context, name: str) -> None:
             if len(zooms) > 1
             else ""
         )
-        + ".",
+        + "."
+        + OBSTACLES_CAPTION * bool(obstacles),
     )
     c.add_figure(
         f"errors_{name}.png",
@@ -482,11 +530,13 @@ def _trajectory_section(c: _Context, name: str) -> None:
     )
     c.add_figure(
         f"methods_{name}.png",
-        plots.plot_small_multiples(series, colors, c.config.robot, name),
+        plots.plot_small_multiples(series, colors, c.config.robot, name, obstacles=obstacles),
         f"{name}: one panel per method (axes in m): desired path dashed, end effector in the "
         "method's colour, base path grey, the robot (footprint and arm) at six instants, one "
         "colour per instant from dark (start) to light, named in the legend. Each panel "
-        "holds everything it draws: a method that leaves the desired path gets a wider frame.",
+        "holds everything it draws: a method that leaves the desired path gets a wider frame."
+        + OBSTACLES_CAPTION
+        * bool(obstacles),
     )
 
 
@@ -537,6 +587,7 @@ def _plant_section(c: _Context, plant: str) -> None:
                 fmt(k["min_stability"]),
                 fmt(s.get("min_physics_stability", math.nan)),
                 _tipped_text(s),
+                tracked(s.get("verdict_reasons")),
             ]
         )
         if ratio > PLANT_GAP:
@@ -544,13 +595,14 @@ def _plant_section(c: _Context, plant: str) -> None:
     headers = [
         "trajectory", "method", "RMS kinematic (mm)", f"RMS {plant} (mm)", "x",
         f"final {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)", "min S",
-        "min physics S", "tipped",
+        "min physics S", "tipped", "tracked? (docs/cli.md, Verdict)",
     ]  # fmt: skip
     c.doc.table(headers, rows)
     c.doc.paragraph(
         "Where the error grows by more than "
         f"{PLANT_GAP:g}x: " + ("; ".join(reasons) if reasons else "nowhere.")
     )
+    _plant_verdicts(c, plant)
     for name in c.config.trajectories:
         kinematic = {s.method: c.run(s).timeseries for s in runs if s.trajectory == name}
         on_plant = {s.method: c.run(r).timeseries for s, r in runs.items() if s.trajectory == name}
@@ -562,6 +614,25 @@ def _plant_section(c: _Context, plant: str) -> None:
             f"{name}: position error per method on the {plant} plant (solid) and on the "
             "kinematic plant (dashed).",
         )
+
+
+def _plant_verdicts(c: _Context, plant: str) -> None:
+    """List the runs on ``plant`` that did not track, with what went wrong and its likely
+    cause (:func:`ddwmmr.sim.verdict.explain`), or say that every run tracked."""
+    specs = c.plan.plants[plant]
+    items = []
+    for spec in specs:
+        found, what, cause = explain(c.run(spec).summary)
+        if found:
+            items.append(f"**{spec.method} on {spec.trajectory}**: {what}; likely cause: {cause}")
+    if not items:
+        c.doc.paragraph(f'Every run on the {plant} plant tracked (docs/cli.md, "Verdict").')
+        return
+    c.doc.paragraph(
+        f"Did not track on the {plant} plant ({len(items)} of {len(specs)} runs; "
+        'docs/cli.md, "Verdict"):'
+    )
+    c.doc.bullets(items)
 
 
 def _tipped_text(summary: Mapping[str, Any]) -> str:
@@ -840,11 +911,13 @@ def _integrator_finding(runs: Mapping[tuple[str, str], RunOutput]) -> str:
         return ""
     ats, ts = (runs[(m, "euler")].timeseries for m in ("ats", "clrrmc-ts"))
     ats_max, ts_max = float(np.max(ats["position_error_m"])), float(np.max(ts["position_error_m"]))
-    middle = len(ats["t"]) // 2
+    middle, final = len(ats["t"]) // 2, float(ats["position_error_m"][-1])
+    # only a clear return below the worst drift is put down to the closed curve
+    back = ", where the closed curve brings part of it back" if final < 0.9 * ats_max else ""
     return (
         f"With Euler the open-loop ats drifts {mm(ats_max)} mm off at worst "
-        f"({mm(ats['position_error_m'][middle])} mm half way, {mm(ats['position_error_m'][-1])} "
-        "mm at the end, where the closed curve brings part of it back), while the feedback of "
+        f"({mm(ats['position_error_m'][middle])} mm half way, {mm(final)} "
+        f"mm at the end{back}), while the feedback of "
         f"clrrmc-ts holds it to {mm(ts_max)} mm. RK4 makes the drift negligible for both."
         + _cs_euler_finding(runs, ts_max)
     )

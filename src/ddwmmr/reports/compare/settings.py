@@ -12,9 +12,15 @@ import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-from ddwmmr.controllers.presets import preset_differences
 from ddwmmr.reports.compare.document import fmt, mm
-from ddwmmr.reports.compare.plan import CompareConfig, Plan, RunOutput, RunSpec
+from ddwmmr.reports.compare.plan import (
+    CompareConfig,
+    Plan,
+    RunOutput,
+    RunSpec,
+    effect_settings,
+    run_differences,
+)
 
 #: What each option means, for the settings table.
 OPTION_NAMES = {"aux": "auxiliary row of J_aug", "tau": "time constants (x, y, phi)"}
@@ -35,15 +41,25 @@ def value_text(key: str, value: Any) -> str:
     return fmt(value) if isinstance(value, float) else str(value)
 
 
-def setting_rows(methods: Sequence[str]) -> list[list[str]]:
-    """``[method, setting, slides, ours]`` for every option the presets set differently."""
+def setting_rows(
+    methods: Sequence[str], options: Mapping[str, Mapping[str, Any]] | None = None
+) -> list[list[str]]:
+    """``[method, setting, slides, ours]`` for every setting in which the runs of a method
+    under the two presets differ: the presets' differences less the settings the user's
+    ``options`` (method -> ``--option`` values, :attr:`CompareConfig.options`) fix in
+    every run (:func:`same_in_both` lists those)."""
     rows = []
     for method in methods:
-        for key, (slides, ours) in preset_differences(method).items():
+        for key, (slides, ours) in run_differences(method, _user(options, method)).items():
             rows.append(
                 [method, OPTION_NAMES.get(key, key), value_text(key, slides), value_text(key, ours)]
             )
     return rows
+
+
+def _user(options: Mapping[str, Mapping[str, Any]] | None, method: str) -> Mapping[str, Any]:
+    """The user's options of ``method`` (none when ``options`` is None)."""
+    return (options or {}).get(method, {})
 
 
 def runs_by_preset(config: CompareConfig, plan: Plan) -> dict[str, dict[tuple[str, str], RunSpec]]:
@@ -64,7 +80,7 @@ def result_rows(
     rows = []
     for name in config.trajectories:
         for method in config.methods:
-            if not preset_differences(method):
+            if not run_differences(method, _user(config.options, method)):
                 continue
             slides = outputs[runs["slides"][(method, name)]].summary
             ours = outputs[runs["default"][(method, name)]].summary
@@ -109,35 +125,48 @@ SETTING_HEADERS = ["method", "setting", "slides", "ours"]
 def effect_rows(
     config: CompareConfig, plan: Plan, outputs: Mapping[RunSpec, RunOutput]
 ) -> list[list[str]]:
-    """``[method, trajectory, setting, RMS with it alone, RMS ours, RMS slides]`` (mm) for
-    the methods whose presets differ in more than one option."""
+    """``[method, trajectory, setting, RMS with it alone, RMS ours, RMS slides]`` (mm) and
+    the RMS orientation errors (rad) of every run of :func:`effect_settings`, each labelled
+    by the slides setting it applies."""
     runs = runs_by_preset(config, plan)
     rows = []
-    for spec in plan.preset_effects:
-        (key, value), *_ = spec.options
-        key_pair = (spec.method, spec.trajectory)
-        alone = outputs[spec].summary
-        ours = outputs[runs["default"][key_pair]].summary
-        slides = outputs[runs["slides"][key_pair]].summary
-        rows.append(
-            [
-                spec.method,
-                spec.trajectory,
-                f"{OPTION_NAMES.get(key, key)} = {value_text(key, value)}",
-            ]
-            + [mm(s["rms_position_error_m"]) for s in (alone, ours, slides)]
-            + [fmt(s[_ORIENTATION]) for s in (alone, ours)]
-        )
+    for name in config.trajectories:
+        for method in config.methods:
+            for key, spec in effect_settings(config, method, name):
+                alone = outputs[spec].summary
+                ours = outputs[runs["default"][(method, name)]].summary
+                slides = outputs[runs["slides"][(method, name)]].summary
+                value = dict(spec.options)[key]
+                rows.append(
+                    [method, name, f"{OPTION_NAMES.get(key, key)} = {value_text(key, value)}"]
+                    + [mm(s["rms_position_error_m"]) for s in (alone, ours, slides)]
+                    + [fmt(s[_ORIENTATION]) for s in (alone, ours)]
+                )
     return rows
 
 
-def same_in_both() -> list[str]:
-    """Settings that are the same in both presets, and why (for the report's notes)."""
-    return [
+def same_in_both(options: Mapping[str, Mapping[str, Any]] | None = None) -> list[str]:
+    """Settings that are the same in both presets, and why (for the report's notes), with
+    the user's ``options`` (method -> ``--option`` values), which every run of the method
+    uses under either preset."""
+    given = {method: values for method, values in (options or {}).items() if values}
+    sets_tau = any("tau" in values for values in given.values())
+    notes = [
         "`ap`: the slides' potential V = 0.66 phi^2 + th1^2 + 0.25 th2^2 is also the "
         "library's default (the explanatory run with K3 = 0 shows what it costs)",
-        "time constants: the slides give no numbers; tau = 0.5 s in both",
+        "time constants: the slides give no numbers; tau = 0.5 s in both"
+        + (" where `--option` does not set it" if sets_tau else ""),
         "damping near cos th1 = 0: the slides invert J_aug and take J^# undamped, which is "
         "unbounded at the singularity; both presets use the same damped least squares",
         "robot, start configuration, initial offset, integrator (rk4) and step: the same runs",
     ]
+    if given:
+        notes.append(
+            "your `--option` values, over both presets in every run: "
+            + ", ".join(
+                f"`{method}` {key} = {value_text(key, value)}"
+                for method, values in given.items()
+                for key, value in values.items()
+            )
+        )
+    return notes
