@@ -206,6 +206,17 @@ def interruptible() -> Iterator[None]:
             signal.signal(number, handler)
 
 
+def forget_unhandled_interrupt() -> None:
+    """Let the status :func:`run_main` returns stand after a caught Ctrl-C.
+
+    CPython marks a KeyboardInterrupt that leaves code run by ``exec`` of a string (the
+    methods a dataclass or namedtuple generates while a module imports) as unhandled, even
+    when it is caught further up, and ends such a process by SIGINT at exit (status -2
+    for its parent) instead of with the status it returns. Each ``exec`` of a string
+    clears the mark before it runs; this one runs nothing else."""
+    exec("pass")
+
+
 def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:
     """Run ``main``: bad input, interrupts and write errors become one line on stderr."""
     try:
@@ -218,6 +229,7 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
         say(f"error: {exc}")
         return 1
     except KeyboardInterrupt:
+        forget_unhandled_interrupt()
         say(stop_line(signal.SIGINT))
         return EXIT_INTERRUPTED
     except Terminated as stop:
