@@ -6,7 +6,12 @@ import pytest
 from ddwmmr import Ellipse, Rectangle, Robot, simulate
 from ddwmmr.cli.compare import not_tracked
 from ddwmmr.reports.compare import CompareConfig, execute, mm, plan_runs, write_report
-from ddwmmr.reports.compare.advice import profiles, recommendations
+from ddwmmr.reports.compare.advice import (
+    ADVICE_HEADERS,
+    advice_rows,
+    profiles,
+    recommendations,
+)
 from ddwmmr.reports.compare.ranking import build_ranking
 
 
@@ -69,6 +74,10 @@ def test_advice_names_a_compared_method_that_broke_its_floor():
         "**Tip-over stability as a hard guarantee**: `qp` (S >= 2.50, "
         f"{steps} steps below it; it started below it, at S = 2.18) enforces a floor but "
         "did not keep it in these runs; no other compared method constrains S."
+    )
+    cell = advice_rows(items)[0][ADVICE_HEADERS.index("tip-over stability")]
+    assert cell == (
+        f"hard constraint S >= 2.50 ({steps} steps below it; started below it, at S = 2.18)"
     )
 
 

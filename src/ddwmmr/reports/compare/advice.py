@@ -137,9 +137,14 @@ def _offset_text(p: Profile) -> str:
 
 def _stability_text(p: Profile) -> str:
     if p.stability_floor is not None:
+        start = (
+            f"; started below it, at S = {fmt(p.start_stability)}"
+            if p.start_stability < p.stability_floor
+            else ""
+        )
         return (
             f"hard constraint S >= {fmt(p.stability_floor)} "
-            f"({p.stability_violations} steps below it)"
+            f"({p.stability_violations} steps below it{start})"
         )
     return f"not enforced (min S {fmt(p.min_stability)} on this robot)"
 
