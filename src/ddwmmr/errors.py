@@ -184,19 +184,25 @@ def check_number_type(name: str, value: Any) -> Any:
     return value
 
 
+def real_number(value: Any) -> float | None:
+    """``value`` as a float (finite or not), or None if it is no number: text, a boolean,
+    None, or an integer beyond a float. Strings and booleans are not numbers here, even
+    though float() accepts them: a file saying N = "2000" or L1 = true is a mistake worth
+    reporting."""
+    if isinstance(value, bool | np.bool_ | str | bytes):
+        return None
+    try:
+        return float(value)
+    except (OverflowError, TypeError, ValueError):  # OverflowError: as infinite as inf
+        return None
+
+
 def _as_float(name: str, value: float, allowed: str = "") -> float:
-    # Strings and booleans are not numbers here, even though float() accepts them: a file
-    # saying N = "2000" or L1 = true is a mistake worth reporting. Whatever is not a finite
-    # number (text, a boolean, None, nan, inf, an integer beyond a float) gets the one
+    # Whatever is not a finite number (:func:`real_number`, nan, inf) gets the one
     # message, which ``allowed`` (e.g. "> 0", the range the caller checks next) completes
     # so that it names the range too: "dt must be a finite number > 0 (got 'abc')".
-    if isinstance(value, bool | np.bool_ | str | bytes):
-        raise _not_finite(name, value, allowed)
-    try:
-        number = float(value)
-    except (OverflowError, TypeError, ValueError):  # OverflowError: as infinite as inf
-        raise _not_finite(name, value, allowed) from None
-    if not math.isfinite(number):
+    number = real_number(value)
+    if number is None or not math.isfinite(number):
         raise _not_finite(name, value, allowed)
     return number
 

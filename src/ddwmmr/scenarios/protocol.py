@@ -68,6 +68,7 @@ from ddwmmr.errors import (
     check_range,
     check_step_count,
     float_values,
+    real_number,
     shown,
     texts_apart,
 )
@@ -245,7 +246,7 @@ def step_count(limit: float, dt: float) -> int:
 def check_dt(dt: Any) -> float:
     """``dt`` as a float if it is a control step in (0, :data:`MAX_DT`] s, else a one-line
     :class:`ParameterError` (also for what is no number: text, a boolean, None)."""
-    value = _real(dt)
+    value = real_number(dt)
     if value is None:
         raise ParameterError(f"dt must be in (0, {MAX_DT:g}] s (got {shown(dt)})")
     if not (math.isfinite(value) and 0.0 < value <= MAX_DT):
@@ -257,22 +258,11 @@ def check_dt(dt: Any) -> float:
 def check_time_limit(limit: Any) -> float:
     """``limit`` as a float if it is a scenario's time limit, > 0 s and finite, else a
     one-line :class:`ParameterError` naming ``time_limit``."""
-    value = _real(limit)
+    value = real_number(limit)
     if value is None or not (math.isfinite(value) and value > 0.0):
         got = shown(limit) if value is None else f"{value:g}"
         raise ParameterError(f"time_limit must be > 0 s and finite (got {got})")
     return value
-
-
-def _real(value: Any) -> float | None:
-    """``value`` as a float, or None if it is no number (text, a boolean, None) or an
-    integer beyond a float."""
-    if isinstance(value, bool | np.bool_ | str | bytes):
-        return None
-    try:
-        return float(value)
-    except (OverflowError, TypeError, ValueError):
-        return None
 
 
 def check_payload(payload: Any) -> float:

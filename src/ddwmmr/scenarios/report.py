@@ -228,18 +228,7 @@ def summary_json(summary: dict[str, Any]) -> str:
     the controller has not, the sd and CI of one scenario, a ratio over no scenario) is
     null, as the fields that do not apply already are (``fallback_steps``...). Strings,
     such as the run record's ``"inf"`` (:mod:`ddwmmr.provenance`), are kept as they are."""
-    return json.dumps(json_safe(_undefined_as_null(summary)), indent=2, allow_nan=False) + "\n"
-
-
-def _undefined_as_null(value: Any) -> Any:
-    """``value`` with every non-finite float (numpy's too) in it replaced by None."""
-    if isinstance(value, dict):
-        return {k: _undefined_as_null(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_undefined_as_null(v) for v in value]
-    if isinstance(value, float | np.floating) and not math.isfinite(value):
-        return None
-    return value
+    return json.dumps(json_safe(summary, undefined_as_null=True), indent=2, allow_nan=False) + "\n"
 
 
 def metrics_csv(outcomes: Sequence[Outcome]) -> str:

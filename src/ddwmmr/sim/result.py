@@ -59,16 +59,17 @@ def _format(value: float) -> str:
     return repr(float(value)) if isinstance(value, float) else str(value)
 
 
-def json_safe(value: Any) -> Any:
-    """Convert numpy scalars and non-finite floats (as strings) for JSON output."""
+def json_safe(value: Any, undefined_as_null: bool = False) -> Any:
+    """Convert numpy scalars and non-finite floats for JSON output: the floats as strings
+    (``"nan"``, ``"inf"``), or as None with ``undefined_as_null``."""
     if isinstance(value, dict):
-        return {k: json_safe(v) for k, v in value.items()}
+        return {k: json_safe(v, undefined_as_null) for k, v in value.items()}
     if isinstance(value, list | tuple):
-        return [json_safe(v) for v in value]
+        return [json_safe(v, undefined_as_null) for v in value]
     if isinstance(value, np.generic):
         value = value.item()
     if isinstance(value, float) and not math.isfinite(value):
-        return str(value)
+        return None if undefined_as_null else str(value)
     return value
 
 

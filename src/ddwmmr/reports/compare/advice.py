@@ -137,11 +137,8 @@ def _offset_text(p: Profile) -> str:
 
 def _stability_text(p: Profile) -> str:
     if p.stability_floor is not None:
-        start = (
-            f"; started below it, at S = {fmt(p.start_stability)}"
-            if p.start_stability < p.stability_floor
-            else ""
-        )
+        below = _started_below(p)
+        start = f"; {below}" if below else ""
         return (
             f"hard constraint S >= {fmt(p.stability_floor)} "
             f"({p.stability_violations} steps below it{start})"
@@ -231,9 +228,16 @@ def _stability_line(items: Sequence[Profile]) -> str:
 def _broken_floor_text(p: Profile) -> str:
     """``qp`` with its floor, the steps below it and, if so, that it started below it."""
     text = f"`{p.method}` (S >= {fmt(p.stability_floor)}, {p.stability_violations} steps below it"
-    if p.stability_floor is not None and p.start_stability < p.stability_floor:
-        text += f"; it started below it, at S = {fmt(p.start_stability)}"
-    return text + ")"
+    below = _started_below(p)
+    return text + (f"; it {below}" if below else "") + ")"
+
+
+def _started_below(p: Profile) -> str:
+    """``started below it, at S = 2.18`` if a run of ``p`` started below its floor on S,
+    else ``""``."""
+    if p.stability_floor is None or not p.start_stability < p.stability_floor:
+        return ""
+    return f"started below it, at S = {fmt(p.start_stability)}"
 
 
 def _overall(p: Profile) -> float:

@@ -196,23 +196,27 @@ def _setup_section(c: _Context) -> None:
 OBSTACLES_CAPTION = " Grey discs: the obstacles given with `--option obstacles`."
 
 
+def _given_obstacles(config: CompareConfig) -> dict[str, tuple[tuple[float, float, float], ...]]:
+    """method -> the obstacles (x, y, radius) (m, world frame) it was given (``--option
+    obstacles``), for the compared methods that were given any."""
+    given = {
+        m: tuple(circles_of(config.options.get(m, {}).get("obstacles"))) for m in config.methods
+    }
+    return {m: circles for m, circles in given.items() if circles}
+
+
 def run_obstacles(config: CompareConfig) -> list[tuple[float, float, float]]:
     """Every obstacle (x, y, radius) (m, world frame) any compared method was given
     (``--option obstacles``), each once, sorted."""
-    return sorted(
-        {o for m in config.methods for o in circles_of(config.options.get(m, {}).get("obstacles"))}
-    )
+    return sorted({o for circles in _given_obstacles(config).values() for o in circles})
 
 
 def _obstacle_items(config: CompareConfig) -> list[str]:
     """One Setup line per set of obstacles (``--option obstacles``) and the methods that
     avoid it: circles (x, y, radius) in m in the world frame; none without obstacles."""
     methods: dict[tuple[tuple[float, float, float], ...], list[str]] = {}
-    for method in config.methods:
-        circles = config.options.get(method, {}).get("obstacles")
-        if circles:
-            key = tuple(circles_of(circles))
-            methods.setdefault(key, []).append(method)
+    for method, circles in _given_obstacles(config).items():
+        methods.setdefault(circles, []).append(method)
     others = [m for m in config.methods if not any(m in v for v in methods.values())]
     verb = "ignores" if len(others) == 1 else "ignore"
     ignore = f"; {', '.join(f'`{m}`' for m in others)} {verb} them" if others else ""
