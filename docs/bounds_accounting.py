@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import io
 import json
 import math
 from concurrent.futures import ProcessPoolExecutor
@@ -34,7 +33,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ddwmmr.sim.result import write_atomic
+from ddwmmr.outputs import csv_text, line_ending, write_atomic
 
 DOCS = Path(__file__).resolve().parent
 DATA = DOCS / "bounds"
@@ -118,11 +117,7 @@ def compute(seed: int, plans: Path, jobs: int, scenarios: list[int] | None = Non
         ],
         key=lambda r: (int(r["scenario"]), order.index(r["trajectory"])),
     )
-    text = io.StringIO()
-    writer = csv.DictWriter(text, COLUMNS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(rows)
-    write_atomic(target, text.getvalue())
+    write_atomic(target, csv_text(COLUMNS, rows, line_ending(target)))
 
 
 def seeds() -> list[int]:

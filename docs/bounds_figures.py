@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import io
 import math
 import shutil
 from concurrent.futures import ProcessPoolExecutor
@@ -45,7 +44,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ddwmmr.sim.result import write_atomic
+from ddwmmr.outputs import csv_text, line_ending, write_atomic
 
 DOCS = Path(__file__).resolve().parent
 DATA = DOCS / "bounds"
@@ -109,13 +108,9 @@ def read_rows(path: Path) -> tuple[list[str], dict[int, dict[str, str]]]:
 
 def write_rows(path: Path, header: list[str], rows: dict[int, dict[str, str]]) -> None:
     """Write ``rows`` (by scenario, in order) under ``header``, atomically, with the line
-    ending the file had (the bounds tool's CSV ends its lines in CRLF, as ``csv`` does)."""
-    ending = "\r\n" if path.exists() and b"\r\n" in path.read_bytes() else "\n"
-    text = io.StringIO()
-    writer = csv.DictWriter(text, header, lineterminator=ending)
-    writer.writeheader()
-    writer.writerows(rows[scenario] for scenario in sorted(rows))
-    write_atomic(path, text.getvalue())
+    ending the file had (the committed bounds CSVs end their lines in CRLF)."""
+    ordered = (rows[scenario] for scenario in sorted(rows))
+    write_atomic(path, csv_text(header, ordered, line_ending(path)))
 
 
 def replayed_best(row: dict[str, str]) -> float:

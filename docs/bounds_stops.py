@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import io
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -52,14 +51,10 @@ def parts(job: tuple[int, int]) -> dict[str, float]:
 
 
 def write_csv(path: Path, header: list[str], rows: list[dict]) -> None:
-    """Write ``rows`` to ``path`` atomically (never half-written)."""
-    from ddwmmr.sim.result import write_atomic
+    """Write ``rows`` to ``path`` atomically, with the line ending the file had."""
+    from ddwmmr.outputs import csv_text, line_ending, write_atomic
 
-    buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, fieldnames=header)  # as python -m ddwmmr.bounds writes
-    writer.writeheader()
-    writer.writerows(rows)
-    write_atomic(path, buffer.getvalue())
+    write_atomic(path, csv_text(header, rows, line_ending(path)))
 
 
 def set_lower_bounds(seed: int, rows: list[dict]) -> None:

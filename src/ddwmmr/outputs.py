@@ -31,6 +31,8 @@ usual ``022``), not the ``0600``/``0700`` of temporary files.
 from __future__ import annotations
 
 import contextlib
+import csv
+import io
 import json
 import os
 import re
@@ -39,7 +41,7 @@ import socket
 import stat
 import sys
 import tempfile
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
@@ -84,6 +86,31 @@ def folder_mode() -> int:
 def package_version() -> str:
     """The installed ddwmmr version."""
     return __version__
+
+
+# -- CSV text ------------------------------------------------------------------------------
+def line_ending(path: str | Path, default: str = "\n") -> str:
+    """The line ending of the CSV file at ``path``: ``"\\r\\n"`` if it has one, else
+    ``default`` (also when the file is absent). A file rewritten with it keeps its bytes
+    where its rows are unchanged."""
+    try:
+        return "\r\n" if b"\r\n" in Path(path).read_bytes() else default
+    except FileNotFoundError:
+        return default
+
+
+def csv_text(
+    header: Sequence[str], rows: Iterable[Mapping[str, object]], ending: str = "\n"
+) -> str:
+    """CSV text of ``rows`` (each a mapping from the names of ``header``) under
+    ``header``, in :class:`csv.DictWriter`'s dialect with ``ending`` ending every line;
+    write it with :func:`write_atomic`. A row with a name ``header``
+    lacks raises :class:`ValueError`; a missing name is written empty."""
+    buffer = io.StringIO()
+    writer = csv.DictWriter(buffer, fieldnames=list(header), lineterminator=ending)
+    writer.writeheader()
+    writer.writerows(rows)
+    return buffer.getvalue()
 
 
 # -- what is at the target ----------------------------------------------------------------
@@ -385,6 +412,42 @@ def _refusal(text: str, tool: str, existing: Existing) -> str:
         f"out: {text} {what}; choose another --out, or add --force (deletes only files a "
         "ddwmmr manifest lists)"
     )
+
+
+# -- atomic files ------------------------------------------------------------------------
+def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file and an atomic rename.
+
+    ``path`` must be a non-empty ``str`` or :class:`os.PathLike`; if something exists
+    there it must be a regular file, which is replaced. A folder, a device (``/dev/null``),
+    a FIFO or a socket is refused with a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming the path before anything is created:
+    the rename would put a regular file in its place (see
+    :func:`check_file_target`). Missing parent folders are created, as
+    ``mkdir -p`` would (the tools rely on it: the GUI's ``--snapshot figs/run.png``, the
+    bench's ``--out``, the per-run sub-folders of a GUI export); a path through something
+    that is not a folder is refused.
+    Failures of the write itself (permission, full disk) raise :class:`OSError`.
+
+    The file gets the user's umask (``0644`` for umask 022), like any normal file, not
+    the ``0600`` of the temporary file; text is written as UTF-8.
+    """
+    path = check_file_target(path)
+    existing_folder("path", path.parent)
+    path.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
+    payload = data if isinstance(data, bytes) else data.encode("utf-8")
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".ddwmmr-", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            os.fchmod(handle.fileno(), file_mode())
+            handle.write(payload)
+        # Once more just before the rename: a FIFO or folder made there during the write
+        # would be replaced as well.
+        check_file_target(path)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
 
 
 # -- who owns a staging folder ---------------------------------------------------------
@@ -698,17 +761,7 @@ def list_in_manifest(folder: str | Path, tool: str, names: Sequence[str]) -> Non
         raise ParameterError(f"out: unsafe file names for {folder}: {list(names)}")
     files = sorted({*existing.listed, *names})
     manifest = {"tool": tool, "version": package_version(), "files": files}
-    payload = json.dumps(manifest, indent=2) + "\n"
-    fd, tmp = tempfile.mkstemp(dir=folder, prefix=".ddwmmr-", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            os.fchmod(handle.fileno(), file_mode())
-            handle.write(payload)
-        os.replace(tmp, folder / MANIFEST)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
+    write_atomic(folder / MANIFEST, json.dumps(manifest, indent=2) + "\n")
 
 
 def _write_manifest(folder: Path, manifest: dict) -> None:

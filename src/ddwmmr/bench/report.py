@@ -16,8 +16,7 @@ from ddwmmr.errors import (
     read_text_file,
     shown,
 )
-from ddwmmr.outputs import check_output_file, check_writable
-from ddwmmr.sim.result import write_atomic
+from ddwmmr.outputs import check_output_file, check_writable, write_atomic
 
 #: Marker of a report written by this tool (an existing ``--out`` file must carry it).
 TOOL = "ddwmmr.bench"

@@ -46,9 +46,8 @@ from ddwmmr.gui.settings import (
     check_run_length,
     check_settings,
 )
-from ddwmmr.outputs import missing_folders, remove_created
+from ddwmmr.outputs import missing_folders, remove_created, write_atomic
 from ddwmmr.plants.kinematic import INTEGRATORS
-from ddwmmr.sim.result import write_atomic
 from ddwmmr.sim.simulate import plant_integrator
 from ddwmmr.trajectories import available_trajectories
 

@@ -56,6 +56,7 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR
+from ddwmmr.outputs import write_atomic
 from ddwmmr.plants import available_plants, plant_description
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
@@ -88,7 +89,6 @@ from ddwmmr.scenarios.protocol import (
     scenario_controllers,
     step_count,
 )
-from ddwmmr.sim.result import write_atomic
 
 #: The batch summary (holds the run record: everything needed to repeat the batch).
 MARKER = "summary.json"

@@ -18,7 +18,7 @@ import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from ddwmmr.sim.result import write_atomic
+from ddwmmr.outputs import write_atomic
 
 #: Give up after this long (s) without the run being simulated and played back.
 TIMEOUT_S = 120.0

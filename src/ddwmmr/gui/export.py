@@ -1,6 +1,6 @@
 """Export of the app's current run: CSV/JSON, a PNG of the window, an animation.
 
-Every file is written on its own with :func:`ddwmmr.sim.result.write_atomic` (or the
+Every file is written on its own with :func:`ddwmmr.outputs.write_atomic` (or the
 result's own ``write_csv``/``write_summary``, which use it). Nothing in the export folder
 is ever deleted or overwritten: a name that exists gets a ``-2``, ``-3``... suffix.
 
@@ -35,8 +35,7 @@ from ddwmmr import provenance
 from ddwmmr.errors import ParameterError
 from ddwmmr.gui.options import plant_keywords
 from ddwmmr.gui.settings import Settings, build_robot, build_trajectory
-from ddwmmr.outputs import first_free
-from ddwmmr.sim.result import write_atomic
+from ddwmmr.outputs import first_free, write_atomic
 from ddwmmr.sim.simulate import plant_integrator
 from ddwmmr.trajectories import SampledTrajectory
 from ddwmmr.trajectories.files import find_trajectory_file

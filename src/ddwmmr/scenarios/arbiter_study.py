@@ -36,6 +36,7 @@ from ddwmmr.arbiters.competitive import (
     CompetitiveParameters,
 )
 from ddwmmr.arbiters.state_machine import STATES, Hysteresis
+from ddwmmr.outputs import write_atomic
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import (
@@ -44,7 +45,6 @@ from ddwmmr.scenarios.protocol import (
     RunConfig,
     run_scenario,
 )
-from ddwmmr.sim.result import write_atomic
 from ddwmmr.workers import process_pool
 
 #: The two arbiters, in column order, with their labels.

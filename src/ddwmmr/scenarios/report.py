@@ -13,9 +13,10 @@ import numpy as np
 
 from ddwmmr.arbiters.state_machine import STATES
 from ddwmmr.errors import ParameterError, check_int_at_least, one_line
+from ddwmmr.outputs import write_atomic
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import FINE_TRACE_DISTANCE, METRICS, TRACE_INTERVAL, Outcome
-from ddwmmr.sim.result import json_safe, write_atomic
+from ddwmmr.sim.result import json_safe
 
 #: (summary key, metric column) pairs reported as mean and sample standard deviation.
 AVERAGED = (

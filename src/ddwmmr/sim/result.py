@@ -1,4 +1,4 @@
-"""Simulation results: time series, summary metrics, atomic file output."""
+"""Simulation results: time series and summary metrics, and their files."""
 
 from __future__ import annotations
 
@@ -6,15 +6,13 @@ import csv
 import io
 import json
 import math
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ddwmmr.outputs import check_file_target, existing_folder, file_mode, folder_mode
+from ddwmmr.outputs import write_atomic
 
 
 @dataclass
@@ -71,38 +69,3 @@ def json_safe(value: Any, undefined_as_null: bool = False) -> Any:
     if isinstance(value, float) and not math.isfinite(value):
         return None if undefined_as_null else str(value)
     return value
-
-
-def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file and an atomic rename.
-
-    ``path`` must be a non-empty ``str`` or :class:`os.PathLike`; if something exists
-    there it must be a regular file, which is replaced. A folder, a device (``/dev/null``),
-    a FIFO or a socket is refused with a one-line
-    :class:`~ddwmmr.errors.ParameterError` naming the path before anything is created:
-    the rename would put a regular file in its place (see
-    :func:`ddwmmr.outputs.check_file_target`). Missing parent folders are created, as
-    ``mkdir -p`` would (the tools rely on it: the GUI's ``--snapshot figs/run.png``, the
-    bench's ``--out``, the per-run sub-folders of a GUI export); a path through something
-    that is not a folder is refused.
-    Failures of the write itself (permission, full disk) raise :class:`OSError`.
-
-    The file gets the user's umask (``0644`` for umask 022), like any normal file, not
-    the ``0600`` of the temporary file; text is written as UTF-8.
-    """
-    path = check_file_target(path)
-    existing_folder("path", path.parent)
-    path.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
-    payload = data if isinstance(data, bytes) else data.encode("utf-8")
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".ddwmmr-", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            os.fchmod(handle.fileno(), file_mode())
-            handle.write(payload)
-        # Once more just before the rename: a FIFO or folder made there during the write
-        # would be replaced as well.
-        check_file_target(path)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
