@@ -11,12 +11,46 @@ numpy nor CasADi, so a command-line tool (``python -m ddwmmr.<tool>``) gets its 
 guard in place before its heavy imports start (:mod:`ddwmmr.cli.signals`).
 """
 
-import importlib
 import os
 import sys
-from typing import TYPE_CHECKING, Any
 
-from ddwmmr._version import __version__
+
+def _starting_tool() -> bool:
+    """Whether this process is one of the command-line tools starting: its own command
+    line (``sys.orig_argv``) is ``python -m ddwmmr.<tool>`` (Python is locating that module;
+    ``sys.argv[0]`` is ``"-m"`` meanwhile) or a console script ``ddwmmr-<tool>``.
+
+    A worker process a tool spawns (multiprocessing's spawn, Dask's workers) is given the
+    tool's ``sys.argv`` but has a command line of its own: it is no tool, and must not
+    say the tool's line when the tool stops it."""
+    argv = getattr(sys, "argv", None) or [""]
+    if len(argv) >= len(sys.orig_argv):
+        return False
+    word = sys.orig_argv[-len(argv)]  # the script, or -m's module, just before the arguments
+    if argv[0] == "-m":
+        name = word[word.index("m") + 1 :] if word.startswith("-") else word  # -mddwmmr.gui
+    elif word == argv[0]:
+        name = os.path.splitext(os.path.basename(word))[0]  # .../ddwmmr-track(.exe)
+    else:
+        return False
+    if not name.startswith(("ddwmmr.", "ddwmmr-")):
+        return False
+    from ddwmmr.__main__ import TOOLS
+
+    return any(name in (module, script) for module, script, _ in TOOLS)
+
+
+# Before every import Python has not made at start-up already (typing, this package's
+# own): a tool's Ctrl-C from here on is one line, not a traceback.
+if _starting_tool():
+    from ddwmmr.cli.signals import guard_start
+
+    guard_start()
+
+import importlib  # noqa: E402
+from typing import TYPE_CHECKING, Any  # noqa: E402
+
+from ddwmmr._version import __version__  # noqa: E402
 
 if TYPE_CHECKING:  # what the names are, for type checkers and IDEs; imported on use
     from ddwmmr.controllers import available_methods, make_controller, register
@@ -76,34 +110,3 @@ def __getattr__(name: str) -> Any:
 
 def __dir__() -> list[str]:
     return sorted(set(globals()) | set(__all__))
-
-
-def _starting_tool() -> bool:
-    """Whether this process is one of the command-line tools starting: its own command
-    line (``sys.orig_argv``) is ``python -m ddwmmr.<tool>`` (Python is locating that module;
-    ``sys.argv[0]`` is ``"-m"`` meanwhile) or a console script ``ddwmmr-<tool>``.
-
-    A worker process a tool spawns (multiprocessing's spawn, Dask's workers) is given the
-    tool's ``sys.argv`` but has a command line of its own: it is no tool, and must not
-    say the tool's line when the tool stops it."""
-    argv = getattr(sys, "argv", None) or [""]
-    if len(argv) >= len(sys.orig_argv):
-        return False
-    word = sys.orig_argv[-len(argv)]  # the script, or -m's module, just before the arguments
-    if argv[0] == "-m":
-        name = word[word.index("m") + 1 :] if word.startswith("-") else word  # -mddwmmr.gui
-    elif word == argv[0]:
-        name = os.path.splitext(os.path.basename(word))[0]  # .../ddwmmr-track(.exe)
-    else:
-        return False
-    if not name.startswith(("ddwmmr.", "ddwmmr-")):
-        return False
-    from ddwmmr.__main__ import TOOLS
-
-    return any(name in (module, script) for module, script, _ in TOOLS)
-
-
-if _starting_tool():
-    from ddwmmr.cli.signals import guard_start
-
-    guard_start()
