@@ -219,7 +219,7 @@ TAU_RANGE = "> 0 s (at least 0.0001 s), or inf to disable a channel"
     [
         ("track", "ats", "damping=abc", "a finite number in [1e-06, 1000]"),
         ("track", "ats", "damping=1,2", "a finite number in [1e-06, 1000]"),  # one number expected
-        ("track", "ats", "damping=", "a finite number in [1e-06, 1000]"),
+        ("track", "clrrmc-ts", "tau=", TAU_RANGE),  # an empty value names the range too
         ("track", "pi", "singularity_threshold=x", "a finite number in [1e-06, 1000]"),
         ("track", "clrrmc-ts", "tau=0.5,fast,0.5", TAU_RANGE),
         ("track", "mpc", "intervals=ten", "an integer in [2, 200]"),

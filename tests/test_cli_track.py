@@ -280,7 +280,8 @@ def test_run_record_holds_everything_to_rerun(tmp_path):
     assert record["argv"] == [*argv, "--out", str(out)]
     assert record["command"].startswith("python -m ddwmmr.track --method ats")
     # Every option with its default filled in; the robot with all its fields.
-    assert record["options"] == {"aux": "shoulder", "singularity_threshold": 0.05, "damping": 0.05}
+    # the damping options None: derived from the robot (0.05 each on this one)
+    assert record["options"] == {"aux": "shoulder", "singularity_threshold": None, "damping": None}
     assert set(record["robot"]) == {f.name for f in dataclasses.fields(Robot) if f.init}
     assert record["robot"]["payload"] == 1.25
     # A sampled trajectory: its file and hash (computed here independently).

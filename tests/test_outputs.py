@@ -490,7 +490,7 @@ def test_files_and_folders_follow_the_umask(tmp_path, mask):
 def test_compare_records_everything_to_rerun(made):
     record = json.loads((made["compare"] / "run.json").read_text())
     assert record["tool"] == "compare" and record["methods"] == ["pi"]
-    assert record["options"] == {"pi": {"singularity_threshold": 0.05, "damping": 0.05}}
+    assert record["options"] == {"pi": {"singularity_threshold": None, "damping": None}}
     assert record["robot"]["payload"] == 1.25 and record["duration"] == 0.2
     ellipse = record["trajectories"]["ellipse"]
     assert ellipse["type"] == "ellipse" and ellipse["parameters"]["a"] == 2.0

@@ -45,8 +45,8 @@ class TaskSpaceController(ResolvedRate):
         robot: Robot,
         tau: float | Sequence[float] = DEFAULT_TAU,
         aux: str = "shoulder",
-        singularity_threshold: float = kernels.SINGULARITY_THRESHOLD,
-        damping: float = kernels.MAX_DAMPING,
+        singularity_threshold: float | None = None,
+        damping: float | None = None,
     ) -> None:
         self.kx, self.ky, self.kphi = gains_from_tau(tau, 3)
         self.aux = check_aux(aux)
@@ -87,7 +87,8 @@ class ConfigurationSpaceController:
     A step counts as singular (``last.singular``) when the reference segment it looks up
     was integrated with damping (the reference passed near cos th1 = 0 there). The errors
     of phi, th1 and th2 are taken in (-pi, pi] (:func:`principal_angle`): a configuration
-    whole turns away from the reference is no error.
+    whole turns away from the reference is no error. ``singularity_threshold`` and
+    ``damping`` damp the reference as in :class:`ResolvedRate` (None: the robot's own).
     """
 
     def __init__(
@@ -96,8 +97,8 @@ class ConfigurationSpaceController:
         tau: float | Sequence[float] = DEFAULT_TAU,
         aux: str = "shoulder",
         reference_step: float = 0.01,
-        singularity_threshold: float = kernels.SINGULARITY_THRESHOLD,
-        damping: float = kernels.MAX_DAMPING,
+        singularity_threshold: float | None = None,
+        damping: float | None = None,
     ) -> None:
         self.robot = robot
         self.gains = gains_from_tau(tau, 5)
@@ -105,8 +106,9 @@ class ConfigurationSpaceController:
         self.reference_step = check_range(
             "reference_step", reference_step, MIN_REFERENCE_STEP, MAX_REFERENCE_STEP, "s"
         )
-        self.threshold = kernels.check_threshold(singularity_threshold)
-        self.damping = kernels.check_damping(damping)
+        self.threshold, self.damping = kernels.damping_options(
+            robot.L1, singularity_threshold, damping
+        )
         self.reference: ReferenceTrajectory | None = None
         self.last = StepInfo()
 

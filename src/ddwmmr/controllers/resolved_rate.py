@@ -29,7 +29,9 @@ class ResolvedRate(ABC):
     ``singularity_threshold`` is the smallest singular value below which the inverse is
     damped and ``damping`` the damping factor at the singularity (see
     :mod:`ddwmmr.resolution.kernels`: with ``damping >= singularity_threshold`` the command
-    is bounded by a documented constant times the desired speed at every state).
+    is bounded by a documented constant times the desired speed at every state). None, the
+    default, is the robot's own value (:func:`~ddwmmr.resolution.kernels.damping_options`:
+    0.05 and 0.05 on the default robot, scaled with the first link on others).
     """
 
     name = "base"
@@ -37,13 +39,14 @@ class ResolvedRate(ABC):
     def __init__(
         self,
         robot: Robot,
-        singularity_threshold: float = kernels.SINGULARITY_THRESHOLD,
-        damping: float = kernels.MAX_DAMPING,
+        singularity_threshold: float | None = None,
+        damping: float | None = None,
     ) -> None:
         self.robot = robot
         self.L1, self.L2 = robot.L1, robot.L2
-        self.threshold = kernels.check_threshold(singularity_threshold)
-        self.damping = kernels.check_damping(damping)
+        self.threshold, self.damping = kernels.damping_options(
+            robot.L1, singularity_threshold, damping
+        )
         self.last = StepInfo()
 
     def reset(self, trajectory: object, q0: np.ndarray) -> None:

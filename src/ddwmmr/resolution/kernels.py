@@ -41,6 +41,14 @@ entries of ``u`` add at most ``|z| + |phiEdot|``.) With the defaults: 20 and 48.
 default robot. The threshold is chosen from that bound; ``sigma0 = 0.05`` damps only where
 ``|cos th1| < 0.15`` for ``ats`` (``< 0.21-0.25`` for the pseudoinverse, depending on th2),
 so runs that stay away from the singularity are not changed by it.
+
+**Default per robot** (:func:`damping_options`). The singular values are absolute numbers
+of a matrix mixing m/s and rad/s, and near the singularity ``sigma_min(M) = L1 |cos th1| /
+sqrt(1 + L1^2)`` to first order: a fixed ``sigma0`` would damp a short arm almost everywhere
+and a long one hardly at all. So the default threshold and damping are the constants above
+(stated for the default robot) times :func:`robot_scale`, the ratio of that slope to the
+default robot's: ``ats`` then starts damping at ``|cos th1| = 0.151`` on every robot, and
+the default robot gets exactly 0.05 and 0.05. A given value is used as it is.
 """
 
 from __future__ import annotations
@@ -48,10 +56,13 @@ from __future__ import annotations
 import math
 
 from ddwmmr.errors import ParameterError, check_finite, check_range
+from ddwmmr.model import Robot
 
-#: Default smallest singular value below which damping starts (``sigma0``).
+#: Smallest singular value below which damping starts (``sigma0``) by default on the
+#: default robot; other robots scale it by :func:`robot_scale`.
 SINGULARITY_THRESHOLD = 0.05
-#: Default damping factor lambda at the singularity (``>= sigma0``: the gain bound holds).
+#: Damping factor lambda at the singularity by default on the default robot (``>= sigma0``:
+#: the gain bound holds); other robots scale it by :func:`robot_scale`, as the threshold.
 MAX_DAMPING = 0.05
 #: The values ``sigma0`` and ``lambda`` may take. Both enter squared, so they stay where
 #: the squares neither overflow nor underflow (``sigma0 = 1e200`` squared to inf and
@@ -80,6 +91,38 @@ def check_damping(damping: float) -> float:
             "is unbounded at cos th1 = 0; a small value gives an almost undamped one"
         )
     return check_range("damping", value, low, high)
+
+
+def robot_scale(L1: float) -> float:
+    """Factor from the default robot's damping defaults to those of a robot whose first link
+    is ``L1`` (m): the ratio of ``sigma_min(M) / |cos th1|`` at the singularity,
+    ``L1 / sqrt(1 + L1^2)``, to the default robot's (exactly 1.0 for its ``L1``)."""
+    return _singular_slope(L1) / _singular_slope(Robot.L1)
+
+
+def _singular_slope(L1: float) -> float:
+    # sigma_min(M)^2 = det^2 / T to first order in det = L1 cos th1 (T = 1 + L1^2)
+    return L1 / math.sqrt(1.0 + L1 * L1)
+
+
+def damping_options(
+    L1: float, threshold: float | None = None, damping: float | None = None
+) -> tuple[float, float]:
+    """``(threshold, damping)`` for a robot with first link ``L1`` (m), checked by
+    :func:`check_threshold` and :func:`check_damping`. None stands for the robot's default:
+    :data:`SINGULARITY_THRESHOLD` resp. :data:`MAX_DAMPING` times :func:`robot_scale`, kept
+    in :data:`THRESHOLD_RANGE` resp. :data:`DAMPING_RANGE` (a first link of micrometres
+    would fall below them)."""
+    if threshold is None:
+        threshold = _clip(SINGULARITY_THRESHOLD * robot_scale(L1), THRESHOLD_RANGE)
+    if damping is None:
+        damping = _clip(MAX_DAMPING * robot_scale(L1), DAMPING_RANGE)
+    return check_threshold(threshold), check_damping(damping)
+
+
+def _clip(value: float, bounds: tuple[float, float]) -> float:
+    low, high = bounds
+    return min(max(value, low), high)
 
 
 def damping_squared(sigma: float, threshold: float, damping: float) -> float:
