@@ -394,7 +394,8 @@ def test_slow_methods_can_be_left_out_of_the_studies(monkeypatch):
 def test_metrics_csv_names_each_trajectory_as_the_report_does(tmp_path, capsys):
     """Two files of one stem are ``loop`` and ``loop-2`` in the report and its figures;
     metrics.csv gave both rows the trajectory's own name, ``loop``. A name the report
-    makes safe for file names (``my loop``) is its report name there too."""
+    makes safe for file names (``my loop``) keeps its own name there and in the report;
+    only its figure files take the safe one (``my_loop``)."""
     files = []
     for folder, name, samples in (("a", "loop", 2000), ("b", "loop", 1000), ("c", "my loop", 500)):
         (tmp_path / folder).mkdir()
@@ -406,14 +407,15 @@ def test_metrics_csv_names_each_trajectory_as_the_report_does(tmp_path, capsys):
     assert main([*argv, *only, "--no-progress", "--out", str(out)]) == 0, capsys.readouterr()
     with (out / "metrics.csv").open(newline="") as handle:
         rows = list(csv.DictReader(handle))
-    names = ["ellipse", "loop", "loop-2", "my_loop"]
+    names = ["ellipse", "loop", "loop-2", "my loop"]
+    stems = ["ellipse", "loop", "loop-2", "my_loop"]
     assert [r["trajectory"] for r in rows] == names
     # each row is its own file's run: the default step is T / N of that file
     assert [float(r["dt"]) for r in rows] == [0.02, 0.02, 0.04, 0.08]
     record = json.loads((out / "run.json").read_text())
-    assert list(record["trajectories"]) == names
+    assert list(record["trajectories"]) == stems
     assert record["trajectories"]["loop-2"]["file"] == str(files[1])
     text = (out / "report.md").read_text()
-    for name in names:
-        assert (out / f"errors_{name}.png").exists()
+    for name, stem in zip(names, stems):
+        assert (out / f"errors_{stem}.png").exists()
         assert f"{name} RMS (mm)" in text

@@ -71,4 +71,10 @@ def test_compare_with_unsafe_trajectory_names_writes_inside_its_folder(tmp_path,
     files = sorted(p.name for p in (tmp_path / "out").iterdir())
     assert "paths_sub_______escape.png" in files
     assert f"paths_{'n' * MAX_REPORT_NAME}.png" in files
-    assert "sub/../../escape" not in (tmp_path / "out" / "report.md").read_text()
+    text = (tmp_path / "out" / "report.md").read_text()
+    # the name is shown as written, as text; every link points at a file-safe name
+    assert (
+        "sub/../../escape" in text
+        and "](sub/" not in text
+        and "](paths_sub_______escape.png)" in text
+    )

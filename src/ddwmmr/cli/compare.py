@@ -16,7 +16,7 @@ import os
 import sys
 import textwrap
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Collection, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +44,7 @@ from ddwmmr.errors import (
     check_step_count,
     did_you_mean,
 )
+from ddwmmr.outputs import write_atomic
 from ddwmmr.plants import available_plants
 from ddwmmr.progress import phase
 from ddwmmr.reports.compare import (
@@ -69,7 +70,7 @@ from ddwmmr.reports.compare import (
 from ddwmmr.reports.compare.constants import TIE_ABSOLUTE_M, TIE_RELATIVE
 from ddwmmr.reports.compare.plan import report_name, run_duration
 from ddwmmr.resolution.reference import initial_configuration
-from ddwmmr.sim.result import json_safe, write_atomic
+from ddwmmr.sim.result import json_safe
 from ddwmmr.sim.simulate import check_start
 from ddwmmr.sim.verdict import explain
 from ddwmmr.trajectories import available_trajectories, load_trajectory, trajectory_name
@@ -343,27 +344,45 @@ def parse_studies(values: Sequence[str] | None) -> tuple[str, ...]:
 
 
 def load_trajectories(
-    extra: Sequence[str], only: Sequence[str] = (), sources: dict[str, Any] | None = None
+    extra: Sequence[str],
+    only: Sequence[str] = (),
+    sources: dict[str, Any] | None = None,
+    shown: dict[str, str] | None = None,
 ) -> dict[str, Any]:
-    """Ellipse, rectangle (or the ``--only`` ones) and the ``--traj`` ones, by unique name.
+    """Ellipse, rectangle (or the ``--only`` ones) and the ``--traj`` ones, by unique
+    file-safe name (:func:`report_name`, the stem of their figure files).
 
-    ``sources`` (if given) receives each name's file (None for a built-in default).
+    ``sources`` (if given) receives each key's file (None for a built-in default);
+    ``shown`` (if given) each key's shown name: the trajectory's own name on one line (a
+    line break becomes a space, as the reports show it), ``-2``, ``-3``... appended to a
+    repeated one.
     """
     chosen = split_list(only, "only")
     values = [*(chosen or DEFAULT_TRAJECTORIES), *split_list(extra, "traj")]
     trajectories: dict[str, Any] = {}
     files: dict[str, Any] = {}
+    names: dict[str, str] = {}
     for value in dict.fromkeys(values):
         trajectory = load_trajectory(value)
-        name = base = report_name(trajectory_name(trajectory))  # names files: made safe
-        suffix = 2
-        while name in trajectories:  # two files with the same stem: keep both
-            name, suffix = f"{base}-{suffix}", suffix + 1
+        own = trajectory_name(trajectory)
+        name = unique_name(report_name(own), trajectories)  # names files: made safe
         trajectories[name] = trajectory
         files[name] = find_trajectory_file(value)
+        names[name] = unique_name(" ".join(str(own).splitlines()), names.values())
     if sources is not None:
         sources.update(files)
+    if shown is not None:
+        shown.update(names)
     return trajectories
+
+
+def unique_name(base: str, taken: Collection[str]) -> str:
+    """``base``, or ``base-2``, ``base-3``... the first not in ``taken`` (two trajectories
+    of one name: keep both)."""
+    name, suffix = base, 2
+    while name in taken:
+        name, suffix = f"{base}-{suffix}", suffix + 1
+    return name
 
 
 def check_duration(duration: float | None, trajectories: dict[str, Any]) -> float | None:
@@ -392,7 +411,8 @@ def check_runs(config: CompareConfig, specs: Sequence[Any]) -> None:
             obstacles = dict(spec.options).get("obstacles") or ()
             check_start(config.robot, start, obstacles, "payload", None)
         except ParameterError as exc:
-            raise ParameterError(f"{exc} (run {spec.label()} on {spec.trajectory})") from None
+            where = config.shown(spec.trajectory)
+            raise ParameterError(f"{exc} (run {spec.label()} on {where})") from None
 
 
 def run_record(
@@ -430,7 +450,8 @@ def config_from_arguments(
 ) -> CompareConfig:
     """Validated :class:`CompareConfig` from the parsed arguments (``sources``: see
     :func:`load_trajectories`)."""
-    trajectories = load_trajectories(args.traj, args.only, sources)
+    shown: dict[str, str] = {}
+    trajectories = load_trajectories(args.traj, args.only, sources, shown)
     command = " ".join([PROG, *(argv if argv is not None else sys.argv[1:])])
     methods = parse_methods(args.methods)
     study_methods = (
@@ -451,13 +472,15 @@ def config_from_arguments(
         preset=args.preset,
         plants=plants,
         options=parse_method_options(args.option, methods, args.horizon),
+        shown_names=shown,
     )
 
 
-def not_tracked(plan: Any, outputs: dict[Any, Any]) -> list[str]:
+def not_tracked(plan: Any, outputs: dict[Any, Any], shown: Callable[[str], str] = str) -> list[str]:
     """Console lines for the runs that did not track (:mod:`ddwmmr.sim.verdict`), the main
     runs and their repetitions on each ``--plant`` (named): one per run saying what went
-    wrong, then each likely cause once."""
+    wrong, then each likely cause once; ``shown`` gives a trajectory key's shown name
+    (:meth:`CompareConfig.shown`)."""
     judged = [(spec, spec.method, "") for spec in plan.main]
     # a plan may leave out ``plants`` when no extra plant runs
     for plant, specs in getattr(plan, "plants", {}).items():
@@ -468,7 +491,7 @@ def not_tracked(plan: Any, outputs: dict[Any, Any]) -> list[str]:
     for spec, who, where in judged:
         found, what, cause = explain(outputs[spec].summary)
         if found:
-            lines.append(f"  {spec.method} on {spec.trajectory}{where}: {what}")
+            lines.append(f"  {spec.method} on {shown(spec.trajectory)}{where}: {what}")
             causes.setdefault(cause, []).append(who)
     if not lines:
         return ['Every run tracked (see docs/cli.md, "Verdict").']
@@ -487,19 +510,22 @@ def format_summary(
     seconds: float,
     jobs: int,
     failures: Sequence[str] = (),
+    shown: Callable[[str], str] = str,
 ) -> str:
     """The short console summary: ranking table, slides verdict, the runs that did not
-    track (``failures``, from :func:`not_tracked`), where the files went."""
+    track (``failures``, from :func:`not_tracked`), where the files went; ``shown`` gives a
+    trajectory key's shown name (:meth:`CompareConfig.shown`)."""
     ranking, check = info.ranking, info.check
     lines = [
-        f"Compared {len(ranking.overall)} methods on {', '.join(ranking.scores)}: {runs} runs "
+        f"Compared {len(ranking.overall)} methods on {', '.join(map(shown, ranking.scores))}: "
+        f"{runs} runs "
         f"in {seconds:.1f} s ({jobs} job{'s' if jobs > 1 else ''}).",
         "",
         "Ranking: RMS end-effector position error over the run (mm), lower is better; "
         "per-trajectory rank in brackets; overall = geometric mean; scores within "
         f"{100 * TIE_RELATIVE:g} % plus {1000 * TIE_ABSOLUTE_M:g} mm of a better one share "
         "its rank.",
-        text_table(*ranking_table(ranking)),
+        text_table(*ranking_table(ranking, shown)),
         "",
         slides_verdict(check),
     ]
@@ -507,7 +533,9 @@ def format_summary(
         found = [v for v in check.violations if v.trajectory == name]
         for method in dict.fromkeys(v.expected_better for v in found):
             worse = [slides_name(v.expected_worse) for v in found if v.expected_better == method]
-            lines.append(f"  {name}: {slides_name(method)} scores worse than {', '.join(worse)}")
+            lines.append(
+                f"  {shown(name)}: {slides_name(method)} scores worse than {', '.join(worse)}"
+            )
     if failures:
         lines += ["", *failures]
     figures = sum(name.endswith(".png") for name in info.files)
@@ -522,7 +550,7 @@ def format_summary(
 def skipped_studies(config: CompareConfig, plan: Any) -> list[str]:
     """One stderr note per requested study the plan leaves out: the trajectory it needs is
     not among the compared ones (``--only``/``--traj``)."""
-    compared = ", ".join(config.trajectories)
+    compared = ", ".join(map(config.shown, config.trajectories))
     return [
         f"note: study {study} skipped: it needs the "
         f"{CORNER_TRAJECTORY if study == 'corners' else STUDY_TRAJECTORY} trajectory, which "
@@ -555,7 +583,8 @@ def _main(argv: Sequence[str] | None) -> int:
             info = write_report(config, plan, outputs, staging)
             write_atomic(staging / "run.json", json.dumps(json_safe(record), indent=2) + "\n")
     seconds = time.perf_counter() - start
-    print(format_summary(info, out, len(specs), seconds, jobs, not_tracked(plan, outputs)))
+    failures = not_tracked(plan, outputs, config.shown)
+    print(format_summary(info, out, len(specs), seconds, jobs, failures, config.shown))
     return 0
 
 

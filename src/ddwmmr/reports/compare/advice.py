@@ -7,7 +7,7 @@ a fixed opinion: another robot or trajectory gives other lines).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -39,6 +39,8 @@ class Profile:
         min_cos_th1: smallest |cos th1| over the runs.
         start_stability: smallest tip-over margin S of the start poses over the runs (NaN
             if no run recorded it).
+        shown: a trajectory key (of ``scores``...) -> the name the report shows
+            (:meth:`CompareConfig.shown`).
     """
 
     method: str
@@ -53,6 +55,7 @@ class Profile:
     singularity: dict[str, tuple[str, float]]
     min_cos_th1: float
     start_stability: float = math.nan
+    shown: Callable[[str], str] = str
 
     @property
     def converges(self) -> bool:
@@ -97,6 +100,7 @@ def profiles(
                     (float(s["start_stability"]) for s in summaries if "start_stability" in s),
                     default=math.nan,
                 ),
+                shown=config.shown,
             )
         )
     return result
@@ -117,7 +121,7 @@ def advice_rows(items: Sequence[Profile]) -> list[list[str]]:
     return [
         [
             p.method,
-            ", ".join(f"{n} {mm(v)}" for n, v in p.scores.items()),
+            ", ".join(f"{p.shown(n)} {mm(v)}" for n, v in p.scores.items()),
             fmt(p.step_us),
             _offset_text(p),
             _stability_text(p),
@@ -129,10 +133,11 @@ def advice_rows(items: Sequence[Profile]) -> list[list[str]]:
 
 def _offset_text(p: Profile) -> str:
     if p.converges:
-        return f"removed: below 5 % after {fmt(p.settle_s)} s on the {p.settle_trajectory}"
+        where = p.shown(p.settle_trajectory)
+        return f"removed: below 5 % after {fmt(p.settle_s)} s on the {where}"
     if p.open_loop:
         return "kept (open loop, no pose feedback)"
-    return f"not removed on the {p.settle_trajectory}"
+    return f"not removed on the {p.shown(p.settle_trajectory)}"
 
 
 def _stability_text(p: Profile) -> str:
@@ -153,9 +158,9 @@ def _singularity_text(p: Profile) -> str:
     parts = []
     for name, (outcome, time) in p.singularity.items():
         if outcome == "lost":
-            parts.append(f"{name}: reaches it at {fmt(time)} s and loses the path")
+            parts.append(f"{p.shown(name)}: reaches it at {fmt(time)} s and loses the path")
         elif outcome == "passes":
-            parts.append(f"{name}: passes it at {fmt(time)} s, keeps the path")
+            parts.append(f"{p.shown(name)}: passes it at {fmt(time)} s, keeps the path")
     return "; ".join(parts)
 
 
@@ -184,7 +189,7 @@ def recommendations(
             f"**Tightest step-time budget with feedback**: `{fastest.method}` "
             f"({fmt(fastest.step_us)} us per step on this machine; it removes the initial "
             f"offset, below 5 % after {fmt(fastest.settle_s)} s on the "
-            f"{fastest.settle_trajectory})."
+            f"{fastest.shown(fastest.settle_trajectory)})."
         )
     lines.append(_stability_line(items))
     lines.append(_singularity_line(items))
@@ -198,7 +203,8 @@ def recommendations(
     ours = [m for m in slides.order if m in SLIDES_ORDER] if slides is not None else []
     if ours:
         best = ours[0]
-        scores = ", ".join(f"{n} {mm(v[best])} mm" for n, v in slides.scores.items())
+        shown = items[0].shown if items else str
+        scores = ", ".join(f"{shown(n)} {mm(v[best])} mm" for n, v in slides.scores.items())
         lines.append(
             "**Reproducing the slides**: `--preset slides` (their auxiliary row and gains); the "
             f"best of their methods under their settings is `{best}` ({scores})."

@@ -102,6 +102,9 @@ class CompareConfig:
         options: method -> the user's options of that method (``--option``), over the
             preset's values in every run of it; a study's own setting (e.g. the swept
             tau) still wins in that study. Values must be hashable (tuples, not lists).
+        shown_names: trajectory key -> the name the reports, ``metrics.csv`` and the
+            console show for it (the trajectory's own name, any text); a key missing here
+            is shown as itself. The keys stay the file-safe names of the figure files.
     """
 
     methods: tuple[str, ...]
@@ -114,11 +117,18 @@ class CompareConfig:
     preset: str = "default"
     plants: tuple[str, ...] = ()
     options: dict[str, dict[str, Any]] = field(default_factory=dict)
+    shown_names: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         check_preset(self.preset)
         for name in self.trajectories:
             check_report_name(name)
+        for name, text in self.shown_names.items():
+            if name not in self.trajectories or not isinstance(text, str):
+                raise ParameterError(
+                    f"shown_names must map trajectory keys ({', '.join(self.trajectories)}) "
+                    f"to text (got {shown(name)}: {shown(text)})"
+                )
         for plant in self.plants:
             if plant not in available_plants() or plant == "kinematic":
                 others = [p for p in available_plants() if p != "kinematic"]
@@ -128,6 +138,10 @@ class CompareConfig:
                 )
         if self.study_methods is None:
             self.study_methods = tuple(m for m in self.methods if in_studies(m))
+
+    def shown(self, name: str) -> str:
+        """The shown name of trajectory key ``name`` (see ``shown_names``)."""
+        return self.shown_names.get(name, name)
 
     @property
     def other_preset(self) -> str:
@@ -255,11 +269,15 @@ def effect_specs(config: CompareConfig, method: str, name: str) -> list[RunSpec]
 
 
 def study_tau(config: CompareConfig, method: str, tau: float) -> float | tuple[float, ...]:
-    """The ``tau`` option of the tau sweep: ``tau`` on every channel the preset feeds back
-    (a preset channel switched off with inf stays off, e.g. the slides' K3 = 0)."""
-    preset_tau = dict(preset_changes(method, config.preset)).get("tau")
-    if isinstance(preset_tau, tuple):
-        return tuple(tau if math.isfinite(v) else v for v in preset_tau)
+    """The ``tau`` option (s) of the tau sweep: ``tau`` on every channel the compared runs
+    feed back, i.e. the preset's tau under the user's ``--option`` tau (a channel switched
+    off with inf stays off, e.g. the slides' K3 = 0), so the sweep varies the gains of the
+    controller the comparison ranks and never switches a channel on or off."""
+    compared = dict(preset_changes(method, config.preset))
+    compared.update(config.options.get(method, {}))
+    base = compared.get("tau")
+    if isinstance(base, tuple):
+        return tuple(tau if math.isfinite(v) else v for v in base)
     return tau
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 import csv
 import io
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -26,17 +26,19 @@ from ddwmmr.sim.result import json_safe
 # -- metrics and ranking ------------------------------------------------------------------
 
 
-def metrics_rows(plan: Plan, outputs: Mapping[RunSpec, RunOutput]) -> list[dict[str, Any]]:
+def metrics_rows(
+    plan: Plan, outputs: Mapping[RunSpec, RunOutput], shown: Callable[[str], str] = str
+) -> list[dict[str, Any]]:
     """One row per main run: ``method``, ``trajectory`` and every summary field, where
-    ``trajectory`` is the report's name of the trajectory (the key of
-    :attr:`CompareConfig.trajectories`, unique: ``loop`` and ``loop-2`` for two files of
-    that stem), as its tables and figure files name it, not the trajectory's own name that
-    the summary holds."""
+    ``trajectory`` is the name the report shows for the trajectory (``shown`` of its key,
+    :meth:`CompareConfig.shown`: unique, ``loop`` and ``loop-2`` for two trajectories of
+    that name), as its tables name it, not the summary's name of the run's trajectory."""
     rows = []
     for spec in plan.main:
         summary = outputs[spec].summary
-        row = {"method": spec.method, "trajectory": spec.trajectory, **summary}
-        row["trajectory"] = spec.trajectory  # over the summary's, in the same column
+        name = shown(spec.trajectory)
+        row = {"method": spec.method, "trajectory": name, **summary}
+        row["trajectory"] = name  # over the summary's, in the same column
         rows.append(row)
     return rows
 

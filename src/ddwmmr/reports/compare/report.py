@@ -17,6 +17,7 @@ import numpy as np
 
 from ddwmmr.commands import FORCE
 from ddwmmr.controllers.base import method_description
+from ddwmmr.outputs import write_atomic
 from ddwmmr.reports import compare_plots as plots
 from ddwmmr.reports.compare import advice, settings
 from ddwmmr.reports.compare.constants import (
@@ -62,7 +63,6 @@ from ddwmmr.reports.compare.ranking import (
 )
 from ddwmmr.reports.plots import circles_of
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
-from ddwmmr.sim.result import write_atomic
 from ddwmmr.sim.verdict import explain
 
 # -- building the report ------------------------------------------------------------------
@@ -100,7 +100,7 @@ def write_report(
 ) -> ReportInfo:
     """Write ``metrics.csv``, the PNG figures, ``report.md`` and ``report.html`` to ``folder``."""
     folder = Path(folder)
-    write_atomic(folder / "metrics.csv", metrics_csv(metrics_rows(plan, outputs)))
+    write_atomic(folder / "metrics.csv", metrics_csv(metrics_rows(plan, outputs, config.shown)))
     ranking = build_ranking(plan, outputs)
     check = check_slides(config, plan, outputs, ranking)
     alternative = build_ranking(plan, outputs, plan.alternative)
@@ -167,7 +167,7 @@ def _setup_section(c: _Context) -> None:
         "unless a header says otherwise."
     )
     steps = ", ".join(
-        f"{n}: dt = {default_step(t):g} s, duration = {run_duration(config, n):g} s"
+        f"{config.shown(n)}: dt = {default_step(t):g} s, duration = {run_duration(config, n):g} s"
         for n, t in config.trajectories.items()
     )
     dx, dy = DEFAULT_INITIAL_OFFSET
@@ -228,10 +228,13 @@ def _obstacle_items(config: CompareConfig) -> list[str]:
     ]
 
 
-def ranking_table(ranking: Ranking) -> tuple[list[str], list[list[str]]]:
-    """Headers and rows of the ranking table (RMS position error in mm, rank in brackets)."""
+def ranking_table(
+    ranking: Ranking, shown: Callable[[str], str] = str
+) -> tuple[list[str], list[list[str]]]:
+    """Headers and rows of the ranking table (RMS position error in mm, rank in brackets);
+    ``shown`` gives a trajectory key's shown name (:meth:`CompareConfig.shown`)."""
     names = list(ranking.scores)
-    headers = ["rank", "method", *[f"{n} RMS (mm)" for n in names], "overall (mm)"]
+    headers = ["rank", "method", *[f"{shown(n)} RMS (mm)" for n in names], "overall (mm)"]
     rows = [
         [
             str(ranking.overall_rank[m]),
@@ -255,7 +258,7 @@ def _ranking_section(c: _Context, ranking: Ranking) -> None:
         "geometric mean of the per-trajectory scores (errors span orders of magnitude). The "
         f"per-trajectory rank is in brackets. Settings: preset `{c.config.preset}`."
     )
-    c.doc.table(*ranking_table(ranking))
+    c.doc.table(*ranking_table(ranking, c.config.shown))
 
 
 def _advice_section(c: _Context, ranking: Ranking, slides_ranking: Ranking) -> None:
@@ -311,23 +314,26 @@ def _presets_section(c: _Context, rankings: Mapping[str, tuple[Ranking, SlidesCh
         ranking, check = rankings[preset]
         label = "the slides' settings" if preset == "slides" else "our settings"
         c.doc.heading(f"Ranking under {label} (preset `{preset}`)", 3)
-        c.doc.table(*ranking_table(ranking))
-        c.doc.paragraph(" ".join([slides_verdict(check), *failing_pairs(check)]))
+        c.doc.table(*ranking_table(ranking, c.config.shown))
+        shown = c.config.shown
+        c.doc.paragraph(" ".join([slides_verdict(check, shown), *failing_pairs(check, shown)]))
 
 
-def slides_verdict(check: SlidesCheck) -> str:
-    """One sentence: does the slides' ranking hold, and where not."""
+def slides_verdict(check: SlidesCheck, shown: Callable[[str], str] = str) -> str:
+    """One sentence: does the slides' ranking hold, and where not (trajectories by their
+    shown names, :meth:`CompareConfig.shown`)."""
     chain = " >= ".join(slides_name(m) for m in check.chain)
     if len(check.chain) < 2:
         return "The slides' ranking was not checked (fewer than two of its methods ran)."
     if check.holds_everywhere:
         return f"The slides' ranking {chain} holds on every trajectory (ties count as >=)."
     failing = [n for n, ok in check.holds.items() if not ok]
-    return f"The slides' ranking {chain} does NOT hold on: {', '.join(failing)}."
+    return f"The slides' ranking {chain} does NOT hold on: {', '.join(map(shown, failing))}."
 
 
-def failing_pairs(check: SlidesCheck) -> list[str]:
-    """One sentence per trajectory and method that breaks the slides' chain."""
+def failing_pairs(check: SlidesCheck, shown: Callable[[str], str] = str) -> list[str]:
+    """One sentence per trajectory (by its shown name) and method that breaks the slides'
+    chain."""
     lines = []
     for name in check.holds:
         found = [v for v in check.violations if v.trajectory == name]
@@ -339,7 +345,8 @@ def failing_pairs(check: SlidesCheck) -> list[str]:
             ]
             score = next(v.better_score for v in found if v.expected_better == method)
             lines.append(
-                f"On the {name}, {slides_name(method)} ({mm(score)} mm) scores worse than "
+                f"On the {shown(name)}, {slides_name(method)} ({mm(score)} mm) scores worse "
+                "than "
                 f"{', '.join(worse)}."
             )
     return lines
@@ -350,13 +357,13 @@ def _slides_section(c: _Context, ranking: Ranking, check: SlidesCheck) -> None:
     c.doc.paragraph(
         "The slides conclude CLRRMC-TS >= CLRRMC-CS >= RR-AP >= RR-ATS (depends on the "
         "auxiliary constraint) >= RR-PI for tracking quality. Every pair the chain implies is "
-        "tested with the score above. **" + slides_verdict(check) + "**"
+        "tested with the score above. **" + slides_verdict(check, c.config.shown) + "**"
     )
     items = []
     for name in ranking.scores:
         found = [v for v in check.violations if v.trajectory == name]
         if not found:
-            items.append(f"**{name}**: holds.")
+            items.append(f"**{c.config.shown(name)}**: holds.")
             continue
         for method in dict.fromkeys(v.expected_better for v in found):
             beaten = [v for v in found if v.expected_better == method]
@@ -365,7 +372,8 @@ def _slides_section(c: _Context, ranking: Ranking, check: SlidesCheck) -> None:
             )
             reasons = "; ".join(check.reasons[(name, method)])
             items.append(
-                f"**{name}**: {slides_name(method)} ({mm(beaten[0].better_score)} mm) scores "
+                f"**{c.config.shown(name)}**: {slides_name(method)} "
+                f"({mm(beaten[0].better_score)} mm) scores "
                 f"worse than {others}. Reason: {reasons}."
             )
     c.doc.bullets(items)
@@ -385,7 +393,7 @@ def _diagnosis_section(c: _Context) -> None:
         for m in c.config.methods:
             findings = diagnose(c.config, c.plan, c.outputs, main_spec(c.config, m, name))
             items.append(f"**{m}**: " + "; ".join(f.text for f in findings) + ".")
-        c.doc.heading(name, 3)
+        c.doc.heading(c.config.shown(name), 3)
         c.doc.bullets(items)
 
 
@@ -399,7 +407,7 @@ def _variants_table(c: _Context) -> None:
         rows.append(
             [
                 spec.label(),
-                spec.trajectory,
+                c.config.shown(spec.trajectory),
                 mm(variant["rms_position_error_m"]),
                 mm(base["rms_position_error_m"]),
                 fmt(variant["singular_steps"]),
@@ -431,7 +439,8 @@ def _aux_finding(c: _Context) -> str:
         onset = singularity_onset(slides.timeseries)
         where = "" if onset is None else ", reaching cos(th1) = 0"
         texts.append(
-            f"on the {name} aux = sum gives {mm(slides.summary['rms_position_error_m'])} mm"
+            f"on the {c.config.shown(name)} aux = sum gives "
+            f"{mm(slides.summary['rms_position_error_m'])} mm"
             f"{where} vs {mm(ours)} mm with aux = shoulder"
         )
     return "For RR-ATS, " + "; ".join(texts) + "."
@@ -447,7 +456,10 @@ def _observations(c: _Context, ranking: Ranking) -> list[str]:
     notes = []
     if kept:
         verb = "keeps" if len(kept) == 1 else "keep"
-        notes.append(f"On the {name}, {', '.join(kept)} {verb} the initial offset (open loop).")
+        notes.append(
+            f"On the {c.config.shown(name)}, {', '.join(kept)} {verb} the initial offset "
+            "(open loop)."
+        )
     if removed:
         verb = "removes" if len(removed) == 1 else "remove"
         notes.append(f"{', '.join(removed)} {verb} it (final error below 0.1 mm).")
@@ -484,7 +496,8 @@ METRIC_COLUMNS = (
 
 
 def _trajectory_section(c: _Context, name: str) -> None:
-    c.doc.heading(f"Trajectory: {name}")
+    title = c.config.shown(name)  # shown; ``name`` (file-safe) names the figure files
+    c.doc.heading(f"Trajectory: {title}")
     rows = [
         [m, *[f(c.main(m, name).summary.get(key, math.nan)) for _, key, f in METRIC_COLUMNS]]
         for m in c.config.methods
@@ -501,8 +514,10 @@ def _trajectory_section(c: _Context, name: str) -> None:
         zooms.append(("B", quarter, None))
     c.add_figure(
         f"paths_{name}.png",
-        plots.plot_paths(series, colors, f"{name}: end-effector paths", zooms, obstacles=obstacles),
-        f"{name}: end-effector paths and the desired path (thin dashed, drawn over the "
+        plots.plot_paths(
+            series, colors, f"{title}: end-effector paths", zooms, obstacles=obstacles
+        ),
+        f"{title}: end-effector paths and the desired path (thin dashed, drawn over the "
         "methods, which go from wide to thin lines so that coinciding ones stay visible). "
         "The main "
         "frame holds the desired path plus 0.5 m and every method's whole path (a method "
@@ -521,21 +536,21 @@ def _trajectory_section(c: _Context, name: str) -> None:
     )
     c.add_figure(
         f"errors_{name}.png",
-        plots.plot_errors(series, colors, f"{name}: tracking errors"),
-        f"{name}: position error (log scale, floored at 1e-12 m) and orientation error vs "
+        plots.plot_errors(series, colors, f"{title}: tracking errors"),
+        f"{title}: position error (log scale, floored at 1e-12 m) and orientation error vs "
         "time (wrapped to [-pi, pi); the line is broken where it crosses +-pi instead of "
         "jumping across the plot).",
     )
     c.add_figure(
         f"wheels_{name}.png",
-        plots.plot_wheels(series, colors, c.config.robot.wheel_speed_limit, f"{name}: wheels"),
-        f"{name}: left (solid) and right (dashed) wheel speeds per method; dotted: the limit "
+        plots.plot_wheels(series, colors, c.config.robot.wheel_speed_limit, f"{title}: wheels"),
+        f"{title}: left (solid) and right (dashed) wheel speeds per method; dotted: the limit "
         f"+-{c.config.robot.wheel_speed_limit:g} rad/s.",
     )
     c.add_figure(
         f"methods_{name}.png",
-        plots.plot_small_multiples(series, colors, c.config.robot, name, obstacles=obstacles),
-        f"{name}: one panel per method (axes in m): desired path dashed, end effector in the "
+        plots.plot_small_multiples(series, colors, c.config.robot, title, obstacles=obstacles),
+        f"{title}: one panel per method (axes in m): desired path dashed, end effector in the "
         "method's colour, base path grey, the robot (footprint and arm) at six instants, one "
         "colour per instant from dark (start) to light, named in the legend. Each panel "
         "holds everything it draws: a method that leaves the desired path gets a wider frame."
@@ -579,7 +594,7 @@ def _plant_section(c: _Context, plant: str) -> None:
         ratio = s["rms_position_error_m"] / max(k["rms_position_error_m"], 1e-12)
         rows.append(
             [
-                spec.trajectory,
+                c.config.shown(spec.trajectory),
                 spec.method,
                 mm(k["rms_position_error_m"]),
                 mm(s["rms_position_error_m"]),
@@ -595,7 +610,8 @@ def _plant_section(c: _Context, plant: str) -> None:
             ]
         )
         if ratio > PLANT_GAP:
-            reasons.append(_plant_reason(spec, ratio, lag, saturated, slip))
+            where = c.config.shown(spec.trajectory)
+            reasons.append(_plant_reason(spec, where, ratio, lag, saturated, slip))
     headers = [
         "trajectory", "method", "RMS kinematic (mm)", f"RMS {plant} (mm)", "x",
         f"final {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)", "min S",
@@ -613,10 +629,14 @@ def _plant_section(c: _Context, plant: str) -> None:
         c.add_figure(
             f"plant_{plant}_{name}.png",
             plots.plot_plant_errors(
-                kinematic, on_plant, c.colors, plant, f"{name}: kinematic vs {plant} plant"
+                kinematic,
+                on_plant,
+                c.colors,
+                plant,
+                f"{c.config.shown(name)}: kinematic vs {plant} plant",
             ),
-            f"{name}: position error per method on the {plant} plant (solid) and on the "
-            "kinematic plant (dashed).",
+            f"{c.config.shown(name)}: position error per method on the {plant} plant (solid) "
+            "and on the kinematic plant (dashed).",
         )
 
 
@@ -628,7 +648,8 @@ def _plant_verdicts(c: _Context, plant: str) -> None:
     for spec in specs:
         found, what, cause = explain(c.run(spec).summary)
         if found:
-            items.append(f"**{spec.method} on {spec.trajectory}**: {what}; likely cause: {cause}")
+            where = c.config.shown(spec.trajectory)
+            items.append(f"**{spec.method} on {where}**: {what}; likely cause: {cause}")
     if not items:
         c.doc.paragraph(f'Every run on the {plant} plant tracked (docs/cli.md, "Verdict").')
         return
@@ -646,8 +667,11 @@ def _tipped_text(summary: Mapping[str, Any]) -> str:
     return f"yes (at {summary['tip_time_s']:.2f} s)" if summary["tipped"] else "no"
 
 
-def _plant_reason(spec: RunSpec, ratio: float, lag: float, saturated: float, slip: float) -> str:
-    """One clause: which measured effect explains a method's larger error on the plant."""
+def _plant_reason(
+    spec: RunSpec, where: str, ratio: float, lag: float, saturated: float, slip: float
+) -> str:
+    """One clause: which measured effect explains a method's larger error on the plant
+    (``where``: the run's trajectory by its shown name)."""
     causes = []
     if math.isfinite(saturated) and saturated >= SATURATED_SHARE:
         causes.append(f"actuators at their limit {100 * saturated:.1f} % of the time")
@@ -656,7 +680,7 @@ def _plant_reason(spec: RunSpec, ratio: float, lag: float, saturated: float, sli
     if math.isfinite(slip) and slip >= SLIP_M_S:
         causes.append(f"the wheels slip up to {1000 * slip:.0f} mm/s")
     because = ", ".join(causes) if causes else "no single measured cause above its threshold"
-    return f"{spec.method} on {spec.trajectory} ({fmt(ratio)}x): {because}"
+    return f"{spec.method} on {where} ({fmt(ratio)}x): {because}"
 
 
 def _tau_section(c: _Context) -> None:
@@ -695,7 +719,7 @@ def _tau_section(c: _Context) -> None:
     )
     headers = ["method", "tau (s)", "convergence (s)", f"{theory:.2f} tau (s)"]
     for n in names:
-        headers += [f"RMS {n} (mm)", f"saturated steps {n}"]
+        headers += [f"RMS {c.config.shown(n)} (mm)", f"saturated steps {c.config.shown(n)}"]
     c.doc.table(headers, rows)
     c.add_figure(
         "study_tau.png",
@@ -922,9 +946,28 @@ def _integrator_finding(runs: Mapping[tuple[str, str], RunOutput]) -> str:
         f"With Euler the open-loop ats drifts {mm(ats_max)} mm off at worst "
         f"({mm(ats['position_error_m'][middle])} mm half way, {mm(final)} "
         f"mm at the end{back}), while the feedback of "
-        f"clrrmc-ts holds it to {mm(ts_max)} mm. RK4 makes the drift negligible for both."
+        f"clrrmc-ts holds it to {mm(ts_max)} mm. "
+        + _rk4_finding(runs, {"ats": ats_max, "clrrmc-ts": ts_max})
         + _cs_euler_finding(runs, ts_max)
     )
+
+
+#: RK4's largest error counts as negligible below this fraction of Euler's at the same step.
+NEGLIGIBLE_RK4_FRACTION = 0.1
+
+
+def _rk4_finding(runs: Mapping[tuple[str, str], RunOutput], euler_max: Mapping[str, float]) -> str:
+    """What RK4 measured for the methods of ``euler_max`` (method -> largest Euler error,
+    m): its largest errors in mm, called negligible only where each is below
+    :data:`NEGLIGIBLE_RK4_FRACTION` of the method's Euler error."""
+    rk4 = {m: float(np.max(runs[(m, "rk4")].timeseries["position_error_m"])) for m in euler_max}
+    measured = " and ".join(f"{mm(v)} mm for {m}" for m, v in rk4.items())
+    small = [m for m, v in rk4.items() if v < NEGLIGIBLE_RK4_FRACTION * euler_max[m]]
+    below = f"below {NEGLIGIBLE_RK4_FRACTION:g} x the method's Euler drift"
+    if len(small) == len(rk4):
+        return f"With RK4 the largest errors are {measured}: negligible (each {below})."
+    large = ", ".join(m for m in rk4 if m not in small)
+    return f"With RK4 the largest errors are {measured}: not {below} for {large}."
 
 
 def _cs_euler_finding(runs: Mapping[tuple[str, str], RunOutput], ts_max: float) -> str:

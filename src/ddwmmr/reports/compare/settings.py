@@ -85,7 +85,7 @@ def result_rows(
             slides = outputs[runs["slides"][(method, name)]].summary
             ours = outputs[runs["default"][(method, name)]].summary
             rows.append(
-                [method, name]
+                [method, config.shown(name)]
                 + [mm(s[key]) for key in _ERRORS for s in (slides, ours)]
                 + [fmt(s[_ORIENTATION]) for s in (slides, ours)]
                 + [f"{fmt(s[key])} / {fmt(o[key])}" for key in _COUNTS for s, o in [(slides, ours)]]
@@ -138,7 +138,11 @@ def effect_rows(
                 slides = outputs[runs["slides"][(method, name)]].summary
                 value = dict(spec.options)[key]
                 rows.append(
-                    [method, name, f"{OPTION_NAMES.get(key, key)} = {value_text(key, value)}"]
+                    [
+                        method,
+                        config.shown(name),
+                        f"{OPTION_NAMES.get(key, key)} = {value_text(key, value)}",
+                    ]
                     + [mm(s["rms_position_error_m"]) for s in (alone, ours, slides)]
                     + [fmt(s[_ORIENTATION]) for s in (alone, ours)]
                 )
