@@ -65,12 +65,13 @@ def _near_singularity(robot: Robot, options: dict[str, Any], call: tuple) -> boo
 
 def _near_obstacle(robot: Robot, options: dict[str, Any], call: tuple) -> bool:
     from ddwmmr.qp.limits import footprint_clearances
+    from ddwmmr.qp.limits.obstacles import INFLUENCE_M
 
     q = call[1]
     clearance = footprint_clearances(
         0.5 * robot.base_length, 0.5 * robot.base_width, q[0], q[1], q[2], options["obstacles"]
     )
-    return float(clearance) < 0.6  # within the obstacle limit's influence
+    return float(clearance) < INFLUENCE_M  # within the obstacle limit's influence
 
 
 def _reach_start(robot: Robot, trajectory: Any) -> np.ndarray:

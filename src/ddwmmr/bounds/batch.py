@@ -28,8 +28,9 @@ from ddwmmr.bounds.search import Settings, best_known
 from ddwmmr.errors import DURATION_RANGE_S, MAX_SCENARIOS, ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME
+from ddwmmr.outputs import write_atomic
 from ddwmmr.scenarios.generator import Scenario
-from ddwmmr.sim.result import json_safe, write_atomic
+from ddwmmr.sim.result import json_safe
 
 #: Version of each method's results: a change invalidates the cached results of that part.
 LOWER_VERSION = "budget-stops-1"
@@ -318,17 +319,35 @@ def _bounds_time(where: str, row: dict, key: str) -> float:
 
 def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, tuple[float, float]]:
     """:func:`read_bounds` of a bounds tool's output, refused (one-line
-    :class:`ParameterError`) when unreadable or made for another seed or payload (its
-    summary.json beside it says which; both files may start with a UTF-8 byte-order
-    mark)."""
+    :class:`ParameterError`) when ``path`` is a folder (the run's, not its bounds.csv),
+    unreadable, or made for another seed or payload (its summary.json beside it says
+    which; refused when missing or recording neither; both files may start with a UTF-8
+    byte-order mark)."""
     path = Path(path)
+    if path.is_dir():  # the folder, not the file in it (a plan=DIR takes the folder)
+        raise ParameterError(
+            f"bounds must be the bounds.csv file of a bounds run, not its folder (got {path}; "
+            f"give {path / 'bounds.csv'})"
+        )
     try:
         table = read_bounds(path)
-        summary = json.loads((path.parent / "summary.json").read_text(encoding="utf-8-sig"))
     except ParameterError:  # already one line naming what is wrong
         raise
     except (OSError, ValueError, KeyError, csv.Error) as exc:
         raise ParameterError(f"bounds: cannot read {path} and its summary.json ({exc})") from None
+    record = path.parent / "summary.json"
+    try:
+        summary = json.loads(record.read_text(encoding="utf-8-sig"))
+    except (OSError, ValueError) as exc:
+        raise ParameterError(
+            f"bounds: cannot read {record}, the bounds run's record of the seed and payload "
+            f"{path.name} is for, which must be beside it ({exc})"
+        ) from None
+    if not isinstance(summary, dict) or not {"seed", "payload"} <= summary.keys():
+        raise ParameterError(
+            f"bounds: {record} records no seed and payload (a bounds run's summary.json "
+            f"does; the one beside {path.name} must be its)"
+        )
     if summary.get("seed") != seed or summary.get("payload") != payload:
         raise ParameterError(
             f"bounds: {path} is for seed {summary.get('seed')}, payload "

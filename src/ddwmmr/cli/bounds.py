@@ -40,11 +40,12 @@ from ddwmmr.outputs import (
     first_free,
     inspect,
     list_in_manifest,
+    write_atomic,
 )
 from ddwmmr.progress import ProgressBar
 from ddwmmr.scenarios.executors import default_jobs
 from ddwmmr.scenarios.generator import generate
-from ddwmmr.sim.result import json_safe, write_atomic
+from ddwmmr.sim.result import json_safe
 
 PROG = "python -m ddwmmr.bounds"
 TOOL = "bounds"

@@ -138,7 +138,13 @@ class Guess:
         (M, nu) held from each time, ``legs`` (one duration per waypoint, s, > 0)); a
         one-line :class:`ParameterError` naming the file for anything else, a file that
         cannot be read as such an archive (empty, truncated, damaged, a single ``.npy``
-        array, pickled data, a member that is not a numeric array) included."""
+        array, pickled data, a member that is not a numeric array, a folder) included."""
+        if Path(path).is_dir():
+            raise ParameterError(
+                f"plan {path} must be a .npz file, not a folder (only the scenario tool's "
+                "--option plan=DIR takes the output folder of python -m ddwmmr.bounds, "
+                f"reading each scenario's {PLAN_FOLDER}/{PLAN_NAME.replace('{:03d}', 'NNN')})"
+            )
         arrays = None
         reason = "a single array, not an archive"
         try:
@@ -210,11 +216,49 @@ _PLAN_ARRAYS = ("times", "states", "inputs", "legs")
 
 def plan_path(folder: str | Path, scenario: int) -> Path:
     """Scenario number ``scenario``'s (from 1) best-known trajectory in the output folder
-    of ``python -m ddwmmr.bounds`` (in its ``cache``) or in that cache folder itself."""
+    of ``python -m ddwmmr.bounds`` (in its ``cache``) or in that cache folder itself; a
+    one-line :class:`ParameterError` naming ``folder``, the file expected and how to get
+    it where neither holds it (:func:`missing_plan`)."""
     folder = Path(folder)
     name = PLAN_NAME.format(scenario)
     inside = folder / PLAN_FOLDER / name
-    return inside if inside.exists() or not (folder / name).exists() else folder / name
+    if inside.exists():
+        return inside
+    if (folder / name).exists():
+        return folder / name
+    raise ParameterError(missing_plan(folder, scenario))
+
+
+def missing_plan(folder: Path, scenario: int) -> str:
+    """Why the bounds output ``folder`` holds no plan for scenario number ``scenario``
+    (from 1), and what to do: it is no bounds output folder (no ``cache``), its search
+    found no trajectory (the ``.json`` record beside the missing ``.npz``), or no run
+    into it searched this scenario (``--lower-only`` writes the lower bounds only)."""
+    cache = folder if folder.name == PLAN_FOLDER else folder / PLAN_FOLDER
+    expected = cache / PLAN_NAME.format(scenario)
+    head = f"plan {folder}: {expected} is missing"
+    if not cache.is_dir():
+        return (
+            f"{head}: plan=DIR takes the output folder of python -m ddwmmr.bounds (or its "
+            f"{PLAN_FOLDER} folder), which keeps each scenario's best-known trajectory there"
+        )
+    if expected.with_suffix(".json").exists():
+        return (
+            f"{head}: the bounds run found no trajectory for scenario {scenario} (its "
+            f"search is recorded in {expected.with_suffix('.json').name}): there is no plan "
+            "to follow, run without plan="
+        )
+    others = any(cache.glob(PLAN_NAME.replace("{:03d}", "*")))
+    what = (
+        f"best-known trajectories of other scenarios, not of scenario {scenario}"
+        if others
+        else "no best-known trajectory (lower bounds only, as a --lower-only run leaves it)"
+    )
+    return (
+        f"{head}: the folder holds {what}; run python -m ddwmmr.bounds --out "
+        f"{cache.parent} again without --lower-only, with the same --seed and --payload and "
+        f"--scenarios including {scenario} (it resumes from the cache)"
+    )
 
 
 @dataclass(frozen=True)

@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.errors import ParameterError, one_line, shown, texts_apart
+from ddwmmr.qp.limits.obstacles import INFLUENCE_M
 
 __all__ = [
     "ERROR_LIMIT_M",
@@ -94,10 +95,9 @@ EXTENT_LIMIT_FLOOR_M = 0.01
 #: of a failure nothing else explains.
 HELD_CAUSE = 0.005
 #: Footprint clearance (m) below which an obstacle is near enough to have bent the run's
-#: path: the distance within which the qp's obstacle rows and steering act (the
-#: ``influence`` of :class:`~ddwmmr.qp.limits.obstacles.ObstacleLimit` and of
-#: :class:`~ddwmmr.qp.tasks.avoidance.ObstacleSteeringTask`).
-OBSTACLE_NEAR_M = 0.6
+#: path: the distance within which the qp's obstacle rows and steering act by default
+#: (:data:`ddwmmr.qp.limits.obstacles.INFLUENCE_M`, defined there).
+OBSTACLE_NEAR_M = INFLUENCE_M
 
 #: Reason code -> what it says in the verdict.
 REASONS = {

@@ -46,6 +46,10 @@ from ddwmmr.trajectories.files import find_obstacle_file
 #: with the middle of a side of the footprint no input changes the clearance to first
 #: order (:meth:`ObstacleLimit.row`).
 DEGENERATE_SHARE = 1e-3
+#: Clearance (m) within which the qp acts on a circle by default: the ``influence`` of
+#: :class:`ObstacleLimit` (its rows switch on) and of
+#: :class:`~ddwmmr.qp.tasks.avoidance.ObstacleSteeringTask` (it steers round).
+INFLUENCE_M = 0.6
 
 
 @dataclass(frozen=True)
@@ -236,7 +240,7 @@ class ObstacleLimit(Limit):
         robot: Robot,
         circles: Sequence[Circle],
         margin: float = 0.05,
-        influence: float = 0.6,
+        influence: float = INFLUENCE_M,
         gain: float = 2.0,
     ) -> None:
         self.circles = list(circles)

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from ddwmmr.errors import check_positive
 from ddwmmr.gains import check_gain
 from ddwmmr.qp.context import StepContext
-from ddwmmr.qp.limits.obstacles import Circle, clearance_and_rate
+from ddwmmr.qp.limits.obstacles import INFLUENCE_M, Circle, clearance_and_rate
 from ddwmmr.qp.tasks.base import YawRowTask
 
 
@@ -32,7 +32,7 @@ class ObstacleSteeringTask(YawRowTask):
         half_length: float,
         half_width: float,
         weight: float = 3.0,
-        influence: float = 0.6,
+        influence: float = INFLUENCE_M,
         gain: float = 2.0,
     ) -> None:
         super().__init__(weight)
