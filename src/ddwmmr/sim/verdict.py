@@ -31,13 +31,20 @@ A run did not track when any of these holds (thresholds documented in docs/cli.m
   :data:`EXTENT_FRACTION` of the trajectory's extent (``trajectory_extent_m``), or
   :data:`EXTENT_LIMIT_FLOOR_M` if that is larger (a trajectory that barely moves).
 
-The likely cause is read from the summary too (:func:`likely_cause`); an obstacle-avoiding
-controller (``qp``, ``mpc``: a ``min_obstacle_clearance_m``) whose base came within
-:data:`OBSTACLE_NEAR_M` of an obstacle, with no other cause in sight, is named as having
-left the trajectory to go round it. A run that held a limit the commands' clipping
+The likely cause is read from the summary too (:func:`likely_cause`): the cause a user
+should fix first. After what stops or overrules a run (divergence, tipping, a collision, a
+start below the floor, solver fallbacks), commands clipped on more than
+:data:`SATURATED_CAUSE` of the steps name the trajectory as asking more than the robot can
+give, before anything the arm did (a singularity, a fold), which follows from it. An
+obstacle-avoiding controller (``qp``, ``mpc``: a ``min_obstacle_clearance_m``) whose base
+came within :data:`OBSTACLE_NEAR_M` of an obstacle, with no other cause in sight, is named
+as having left the trajectory to go round it. A run that held a limit the commands' clipping
 (``saturated_steps``) does not count, for more than :data:`HELD_CAUSE` of the run (a
 wheel at its speed limit: ``wheel_limit_steps``; an actuator at its limit on a plant with
 dynamics: ``actuator_saturated_time_s``), with no other cause in sight, names that limit.
+A run that failed on its RMS error alone, whose error never rose above its start offset
+(``max_position_error_m``), converged: the time it took to remove the offset is named,
+as on a short run or a held point (whose limit is :data:`EXTENT_LIMIT_FLOOR_M`).
 """
 
 from __future__ import annotations
@@ -75,6 +82,12 @@ TRACKED = "tracked"
 #: Share of the steps above which singular (damped) or saturated steps mean the run did
 #: not track: "most of the run".
 MOST_OF_RUN = 0.5
+#: Share of saturated steps above which saturation is named as the likely cause before
+#: anything the arm did (a singularity, a fold): commands clipped on almost every step mean
+#: the trajectory asks more than the robot can give, the first thing to fix. The default
+#: runs that fail saturate at most 0.58 of their steps (clrrmc-ts with the slides' settings
+#: on the rectangle), so their causes stay the arm's.
+SATURATED_CAUSE = 0.9
 #: Share of singular steps above which the singularity is named as the likely cause of a
 #: failure, even when they are not most of the run (ap on the rectangle: 990 of 2000).
 SINGULAR_CAUSE = 0.25
@@ -94,6 +107,10 @@ EXTENT_LIMIT_FLOOR_M = 0.01
 #: ``steps``, ``actuator_saturated_time_s`` of ``duration``) is named as the likely cause
 #: of a failure nothing else explains.
 HELD_CAUSE = 0.005
+#: Relative slack on "the error never rose above its start" (``max_position_error_m`` <=
+#: ``initial_offset_m`` x (1 + this)): the two are computed apart and may differ in their
+#: last digits.
+START_SLACK = 0.01
 #: Footprint clearance (m) below which an obstacle is near enough to have bent the run's
 #: path: the distance within which the qp's obstacle rows and steering act by default
 #: (:data:`ddwmmr.qp.limits.obstacles.INFLUENCE_M`, defined there).
@@ -144,6 +161,19 @@ FOLDED_ARM_OTHER = (
 SATURATION = (
     "the commands asked for more than the wheel and joint rate limits allow: a larger "
     'tau, a slower trajectory or a smaller dt (see docs/comparing.md, "Studies")'
+)
+SATURATED_THROUGHOUT = (
+    "the trajectory asks more than the wheel and joint rate limits allow on almost every "
+    "step (what the arm did follows from that): a slower or smaller trajectory (a sampled "
+    "one is read in m and rad: positions in mm or angles in degrees ask 1000 or 57.3 times "
+    "too much; see "
+    'docs/tutorial_custom_trajectory.md, "Before you start: what the robot can follow")'
+)
+START_TRANSIENT = (
+    "the error converged (final {final_mm:.3g} mm, within the limit) but never rose above "
+    "the start offset ({offset_mm:.3g} mm), whose removal took a large part of this "
+    "{duration}run and counts in its RMS: a longer run or a smaller start offset "
+    """(track's --duration and --offset; see docs/cli.md, "Verdict")"""
 )
 NO_CONVERGENCE = (
     "the error did not converge: an open-loop method (pi, ats, ap) never removes it; for "
@@ -221,6 +251,7 @@ NUMBER_KEYS = (
     "duration",
     "trajectory_extent_m",
     "initial_offset_m",
+    "max_position_error_m",
     "final_position_error_m",
     "rms_position_error_m",
     "min_manipulability",
@@ -352,6 +383,16 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     fallbacks = _number(summary, "mpc_fallbacks") or 0
     if steps and fallbacks > MOST_OF_RUN * steps:
         return MPC_FALLBACK.format(mpc_fallbacks=int(fallbacks), steps=int(steps))
+    if steps and (_number(summary, "saturated_steps") or 0) > SATURATED_CAUSE * steps:
+        return SATURATED_THROUGHOUT
+    return _arm_or_path_cause(summary, found)
+
+
+def _arm_or_path_cause(summary: Mapping[str, Any], found: list[str]) -> str:
+    """The rest of :func:`likely_cause`, after the causes that stop or overrule a run:
+    what the arm did, saturation, an obstacle, a limit held, the start offset, else no
+    convergence."""
+    steps = _number(summary, "steps") or 0
     if steps and (_number(summary, "singular_steps") or 0) > SINGULAR_CAUSE * steps:
         return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
     min_manipulability = _number(summary, "min_manipulability")
@@ -367,7 +408,33 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     held = held_limits(summary)
     if held:
         return HELD_LIMIT.format(held=" and ".join(held))
+    if _only_the_start_offset(summary, found):
+        return START_TRANSIENT.format(
+            final_mm=1000.0 * (_number(summary, "final_position_error_m") or 0.0),
+            offset_mm=1000.0 * (_number(summary, "initial_offset_m") or 0.0),
+            duration=_duration_text(summary),
+        )
     return NO_CONVERGENCE
+
+
+def _duration_text(summary: Mapping[str, Any]) -> str:
+    """``"2 s "``: the run's ``duration``, or ``""`` where the summary records none."""
+    duration = _number(summary, "duration")
+    return "" if duration is None or not duration > 0.0 else f"{duration:.3g} s "
+
+
+def _only_the_start_offset(summary: Mapping[str, Any], found: list[str]) -> bool:
+    """Only the RMS error failed, and the error was never larger than at the start
+    (``max_position_error_m`` within :data:`START_SLACK` of ``initial_offset_m``): the
+    error converged, and the RMS counts the time it took to remove the start offset."""
+    if found != ["rms_error_above_limit"]:
+        return False
+    largest = _number(summary, "max_position_error_m")
+    offset = _number(summary, "initial_offset_m")
+    final = _number(summary, "final_position_error_m")
+    if largest is None or offset is None or final is None or not offset > 0.0:
+        return False
+    return largest <= offset * (1.0 + START_SLACK)
 
 
 def _folded_arm(method: Any) -> str:
