@@ -7,6 +7,7 @@ Units are SI throughout: metres, kilograms, radians, seconds.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
@@ -87,6 +88,15 @@ def _check_scalar(name: str, value: Any) -> float:
 CASTER_REACH = 2.0
 #: Top-level tables a robot TOML may hold: its fields, at the top or under ``[robot]``.
 TOML_TABLES = ("robot",)
+#: Largest length (m) taken without a warning: a mobile manipulator's links, wheels and
+#: base are well below it, a length written in millimetres (a 350 mm link as 350) far above.
+#: Lengths up to LENGTH_RANGE_M's top are accepted all the same: a giant robot may be meant.
+PLAUSIBLE_LENGTH_M = 10.0
+#: Largest |angle| (rad) of a joint limit or home angle taken without a warning: one turn.
+#: Beyond it the angles were most likely written in degrees (180 for pi).
+PLAUSIBLE_ANGLE_RAD = 2.0 * _PI
+#: The scalar fields that are lengths (m).
+_LENGTHS = tuple(name for name, (_, _, unit) in _RANGES.items() if unit == "m")
 #: What the configuration ``q`` and its rate ``qdot`` hold (for messages).
 _Q_ENTRIES = {"q": "[x, y, phi, th1, th2] (m, rad)", "qdot": "(m/s, rad/s)"}
 _isfinite = math.isfinite
@@ -240,13 +250,16 @@ class Robot:
         The fields are either all top-level keys or all in one ``[robot]`` table; with a
         ``[robot]`` table nothing else may be in the file (another table, ``[other]``, or
         a key outside ``[robot]`` is an error naming it), as unknown keys are: the file is
-        read as :meth:`from_dict` reads a mapping, each message naming the file.
+        read as :meth:`from_dict` reads a mapping, each message naming the file, and so
+        are the warnings on values in a likely wrong unit (:func:`unit_doubts`).
         """
         data = load_toml(path, "robot")
         try:
-            return cls.from_dict(data)
+            robot = cls._from_mapping(data)
         except ParameterError as exc:
             raise ParameterError(f"robot: {path}: {str(exc).removeprefix('robot: ')}") from None
+        _warn_unit_doubts(robot, f"robot: {path}")
+        return robot
 
     @classmethod
     def from_dict(cls, data: dict[str, Any]) -> Robot:
@@ -257,7 +270,16 @@ class Robot:
         ``[robot]`` table); beside it nothing else may be in the mapping. Unknown keys and
         values of the wrong type (``L1 = "0.3"``, ``L1 = true``, a number where a pair is
         expected) are errors naming the key, each one line (:class:`ParameterError`).
+        Values valid but most likely in the wrong unit (millimetres, degrees) are taken
+        as given after a one-line :class:`UserWarning` each (:func:`unit_doubts`).
         """
+        robot = cls._from_mapping(data)
+        _warn_unit_doubts(robot, "robot")
+        return robot
+
+    @classmethod
+    def _from_mapping(cls, data: dict[str, Any]) -> Robot:
+        """:meth:`from_dict` without the unit warnings (the callers word them)."""
         if not isinstance(data, dict):
             raise ParameterError(f"robot: expected a table of Robot fields (got {shown(data)})")
         if "robot" in data:
@@ -440,6 +462,67 @@ class Robot:
             self.L2 * math.sin(th2), self.L1 + self.L2 * math.cos(th2)
         )
         return math.atan2(math.sin(th1), math.cos(th1)), th2
+
+
+def long_lengths(robot: Robot) -> list[str]:
+    """The length fields of ``robot`` above :data:`PLAUSIBLE_LENGTH_M`, each as it is
+    shown in messages (``"L2 = 350 m"``); empty for any robot of metre-scale lengths."""
+    return [
+        f"{name} = {getattr(robot, name):g} m"
+        for name in _LENGTHS
+        if getattr(robot, name) > PLAUSIBLE_LENGTH_M
+    ]
+
+
+def unit_doubts(robot: Robot) -> list[str]:
+    """One-line notes on the fields of ``robot`` that are valid but most likely in the
+    wrong unit, each naming the fields, their values and the likely mistake: lengths above
+    :data:`PLAUSIBLE_LENGTH_M` (millimetres), a wheel radius above the base length (the
+    wheel and the base in different units), joint limits or home angles beyond
+    :data:`PLAUSIBLE_ANGLE_RAD` in magnitude (degrees). Empty for the default robot."""
+    doubts = []
+    lengths = long_lengths(robot)
+    if lengths:
+        verb = "is" if len(lengths) == 1 else "are"
+        doubts.append(
+            f"{', '.join(lengths)} {verb} above {PLAUSIBLE_LENGTH_M:g} m, implausible for a "
+            "mobile manipulator: lengths are in metres (given in millimetres?)"
+        )
+    # a wheel twice the base's length is no design, one length in cm among metres is
+    if robot.base_length < robot.wheel_radius <= PLAUSIBLE_LENGTH_M:
+        doubts.append(
+            f"wheel_radius = {robot.wheel_radius:g} m is above base_length = "
+            f"{robot.base_length:g} m (a wheel over twice as long as the base): lengths are all "
+            "in metres (one given in centimetres or millimetres?)"
+        )
+    limits = [angle for pair in robot.joint_limits for angle in pair]
+    angles = [
+        f"{name} = {text} rad"
+        for name, values, text in (
+            ("joint_limits", limits, _shown([_shown(pair) for pair in robot.joint_limits])),
+            ("home_pose", robot.home_pose, _shown(robot.home_pose)),
+        )
+        if any(abs(angle) > PLAUSIBLE_ANGLE_RAD for angle in values)
+    ]
+    if angles:
+        doubts.append(
+            f"{', '.join(angles)} {'goes' if len(angles) == 1 else 'go'} beyond 2 pi rad (one "
+            "turn) in magnitude: angles are in radians (given in degrees?)"
+        )
+    return doubts
+
+
+def _shown(items) -> str:
+    """Numbers (``:g``) or texts as a TOML array: ``(90.0, 45.0)`` as ``[90, 45]``."""
+    return "[" + ", ".join(i if isinstance(i, str) else f"{i:g}" for i in items) + "]"
+
+
+def _warn_unit_doubts(robot: Robot, where: str) -> None:
+    """A :class:`UserWarning` per :func:`unit_doubts` note, prefixed with ``where`` (the
+    file) and pointing at the caller of ``from_toml`` / ``from_dict``: the robot is taken
+    as given (a giant robot may be meant), so the user sees why it behaves as it does."""
+    for doubt in unit_doubts(robot):
+        warnings.warn(f"{where}: {doubt}; taken as given", UserWarning, stacklevel=3)
 
 
 def _check_field_type(key: str, value: Any, default: Any) -> None:

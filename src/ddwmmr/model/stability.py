@@ -125,6 +125,14 @@ def margins(k: ComCoefficients, x_com: float, y_com: float) -> tuple[float, floa
     return s_lon, s_lat, min(s_lon, s_lat)
 
 
+def tips_in_every_pose(k: ComCoefficients) -> bool:
+    """Whether no arm pose (joint limits aside) has ``S > 1``: the centre of mass is at
+    least ``|A - B|`` from the base centre in every pose, and a point inside the footprint
+    is closer than its half-diagonal. A sufficient test, not a necessary one: False does
+    not promise that some pose stands."""
+    return abs(k.A - k.B) >= math.hypot(k.half_length, k.half_width)
+
+
 def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[float, float, float]:
     """``(S, dS/dth1, dS/dth2)`` of the capped margin ``S`` (zero gradient where capped).
 

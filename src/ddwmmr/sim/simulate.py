@@ -27,6 +27,8 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
+from ddwmmr.model.robot import long_lengths
+from ddwmmr.model.stability import tips_in_every_pose
 from ddwmmr.plants import available_plants, make_plant, plant_class
 from ddwmmr.plants.base import Plant
 from ddwmmr.registry import CONTROLLERS
@@ -152,22 +154,44 @@ def tipping_message(
     start: str | None = "the start (q0, initial_offset)",
 ) -> str | None:
     """None if the robot stands in configuration ``q`` (static S > 1), else the one line
-    saying that it has tipped over, naming S and the payload (see :func:`check_start`
-    for ``name`` and ``start``): the one wording of the tools' refusal and the API's
-    warning."""
+    saying that it has tipped over, naming S and the cause (see :func:`check_start` for
+    ``name`` and ``start``): the payload where the robot would stand without it, else the
+    arm's reach against the base, and lengths that look like millimetres
+    (:func:`~ddwmmr.model.robot.long_lengths`). The one wording of the tools' refusal and
+    the API's warning."""
     s = start_stability(robot, q)
     if s > 1.0:
         return None
-    if robot.payload > 0.0:
+    lengths = long_lengths(robot)
+    doubt = f"; its lengths may be in millimetres ({', '.join(lengths)})" if lengths else ""
+    unloaded = robot.with_payload(0.0) if robot.payload > 0.0 else robot
+    if unloaded is not robot and start_stability(unloaded, q) > 1.0:
         return (
             f"{name}: a {robot.payload:g} kg payload tips the robot over in this run's start "
             f"pose (S = {s:.3g} <= 1); lighten the payload"
             + ("" if start is None else f" or change {start}")
+            + doubt
         )
+    return _arm_tips_message(robot, q, s, start) + doubt
+
+
+def _arm_tips_message(robot: Robot, q: Sequence[float], s: float, start: str | None) -> str:
+    """:func:`tipping_message` for a robot that tips in the start pose ``q`` even without
+    its payload: the arm's reach and masses against the base's footprint are the cause,
+    and a start pose the advice only where some arm pose might stand."""
+    every = tips_in_every_pose(robot.com_coefficients)
+    x_com, y_com = robot.centre_of_mass(q)
+    without = (
+        f"even without its {robot.payload:g} kg payload" if robot.payload > 0.0 else "unloaded"
+    )
     return (
-        f"robot: the robot tips over in this run's start pose without a payload (S = {s:.3g}"
-        f" <= 1: its masses put the centre of mass outside the wheels); change the robot"
-        + ("" if start is None else f" or {start}")
+        f"robot: the robot tips over in this run's start pose (S = {s:.3g} <= 1), {without}: "
+        f"its arm (reach L1 + L2 = {robot.reach:g} m) puts the centre of mass "
+        f"{math.hypot(x_com, y_com):.3g} m from the base centre, outside the "
+        f"{robot.base_length:g} m x {robot.base_width:g} m base"
+        + (" in every arm pose" if every else "")
+        + "; change the robot"
+        + ("" if start is None or every else f" or {start}")
     )
 
 
