@@ -106,7 +106,9 @@ def test_a_continuous_phi_column_is_kept_bit_for_bit():
     phi = [-0.0, math.pi, 0.0, -math.pi, 0.0, 3.0, 0.5, 3.6]
     n = len(phi)
     points = np.column_stack([np.arange(float(n)), np.zeros(n), phi])
-    trajectory = SampledTrajectory(np.arange(float(n)), points)
+    # its heading spins 21 rad on a still path: read in radians, with the degrees warning
+    with pytest.warns(UserWarning, match="phi is read in radians"):
+        trajectory = SampledTrajectory(np.arange(float(n)), points)
     assert trajectory.points.tobytes() == points.tobytes()
     assert math.copysign(1.0, trajectory.points[0, 2]) == -1.0
     assert unwrap_phi(points) is points

@@ -15,6 +15,7 @@ command on a velocity-only plant (the kinematic model, where the command is the 
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
@@ -26,7 +27,7 @@ from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_arrays
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.sim.loop import finite_values
-from ddwmmr.trajectories.base import Trajectory, sampler
+from ddwmmr.trajectories.base import Trajectory, sampler, trajectory_name
 
 #: Column names of the recorded time series, in order (plant columns follow).
 COLUMNS = (
@@ -291,17 +292,27 @@ class CheckedTrajectory:
     ``pose`` or ``velocity``. ``sample(times)``, present if the trajectory has one
     (:func:`~ddwmmr.trajectories.base.sampler`), returns what the trajectory's returns if
     that is what ``sample`` promises (:func:`sampled_references`), else ``pose`` and
-    ``velocity`` call by call. Every other attribute (``duration``, ``samples``, ``name``,
-    the trajectory's own) is the trajectory's; ``trajectory`` is the trajectory itself.
+    ``velocity`` call by call. Two spot checks at :func:`spot_times` warn of a trajectory
+    that breaks its contract (docs/api.md, "Trajectories"): a ``sample`` whose numbers are
+    not those of ``pose`` and ``velocity`` (:func:`_sample_agrees`) is then not used, and
+    a ``velocity`` that is not the time derivative of ``pose`` (:func:`_check_derivative`)
+    is used as it is (nothing better is known). Every other attribute (``duration``,
+    ``samples``, ``name``, the trajectory's own) is the trajectory's; ``trajectory`` is
+    the trajectory itself.
     """
 
     def __init__(self, trajectory: Any) -> None:
         self.trajectory = trajectory
         own = sampler(trajectory)
+        times = spot_times(trajectory)
+        if own is not None and times is not None and not _sample_agrees(self, own, times):
+            own = None  # pose and velocity define the trajectory; sample only speeds it up
         if own is not None:
             self._own_sample: Any = own
             # an instance attribute: sampler() takes it as the trajectory's own word
             self.sample = self._sample
+        if times is not None:
+            _check_derivative(self, times[1:-1])
 
     def __getattr__(self, name: str) -> Any:
         # Only for names the wrapper lacks. Not ``sample`` (the trajectory's would bypass
@@ -331,6 +342,106 @@ class CheckedTrajectory:
         poses = np.array([self.pose(t) for t in every]).reshape(len(every), 3)
         velocities = np.array([self.velocity(t) for t in every]).reshape(len(every), 3)
         return poses, velocities
+
+
+#: Shares of the duration at which :class:`CheckedTrajectory` spot-checks a trajectory:
+#: both ends and six times between, off the simple fractions where a path's corners lie.
+SPOT_FRACTIONS = (0.0, 0.137, 0.291, 0.433, 0.577, 0.719, 0.863, 1.0)
+#: Relative and absolute tolerance of ``sample`` against ``pose`` and ``velocity`` (m,
+#: rad, m/s, rad/s): "to rounding", as the trajectory protocol asks.
+SAMPLE_TOLERANCE = 1e-9
+#: Relative tolerance of ``velocity`` against the central difference of ``pose`` over
+#: +-:data:`DIFFERENCE_STEP` x duration (whose truncation and rounding errors are far
+#: smaller): a velocity off by more than 5 % is no derivative.
+DERIVATIVE_TOLERANCE = 0.05
+#: Half-width of that central difference, as a share of the duration.
+DIFFERENCE_STEP = 1e-6
+
+
+def spot_times(trajectory: Any) -> np.ndarray | None:
+    """The times (s) :data:`SPOT_FRACTIONS` of the trajectory's ``duration``, or None when
+    the duration is not a finite number > 0 (the run refuses it with its own message)."""
+    duration = getattr(trajectory, "duration", None)
+    number = isinstance(duration, int | float | np.integer | np.floating)
+    if not number or isinstance(duration, bool) or not 0.0 < float(duration) < math.inf:
+        return None
+    return np.array(SPOT_FRACTIONS) * float(duration)
+
+
+def _sample_agrees(checked: CheckedTrajectory, sample: Any, times: np.ndarray) -> bool:
+    """Whether ``sample(times)`` gives the numbers of ``pose`` and ``velocity`` to
+    :data:`SAMPLE_TOLERANCE` (True too if it fails or returns no such arrays: the run
+    then takes pose and velocity call by call anyway, or reports the trajectory's own
+    error). On a disagreement, a one-line ``UserWarning``: the run takes ``pose`` and
+    ``velocity`` call by call, which define the trajectory (the start pose among them),
+    rather than refusing a trajectory that can still be followed, only slower."""
+    try:
+        found = sampled_references(sample, times)
+        wanted = [(checked.pose(t), checked.velocity(t)) for t in times.tolist()]
+    except Exception:  # the run meets it again and reports it as it always does
+        return True
+    if found is None:
+        return True
+    for index, (pose, velocity) in enumerate(wanted):
+        for own, what, name in (
+            (pose, found[0][index], "pose"),
+            (velocity, found[1][index], "velocity"),
+        ):
+            if not np.allclose(what, own, rtol=SAMPLE_TOLERANCE, atol=SAMPLE_TOLERANCE):
+                warnings.warn(
+                    f"trajectory {_name(checked)}: sample(times) disagrees with {name}(t) at "
+                    f"t = {times[index]:g} s ({_shown(what)} vs {_shown(own)}); simulating with "
+                    "pose(t) and velocity(t) call by call instead (slower): make sample give "
+                    "their numbers",
+                    UserWarning,
+                    stacklevel=6,  # simulate() -> check_trajectory -> checked_trajectory -> here
+                )
+                return False
+    return True
+
+
+def _check_derivative(checked: CheckedTrajectory, times: np.ndarray) -> None:
+    """Warn (one line, ``UserWarning``) when ``velocity(t)`` differs from the central
+    difference of ``pose`` by more than :data:`DERIVATIVE_TOLERANCE` of either, in some
+    component, at more than half of ``times`` (s): a velocity that is no derivative (a
+    factor, a sign, a unit). A single time may lie on a corner of the path (a rectangle's
+    heading jumps there), so one disagreement is no proof. The heading's difference is
+    wrapped to [-pi, pi) (a pose may give atan2's wrapped angle)."""
+    h = DIFFERENCE_STEP * float(checked.duration)
+    try:
+        pairs = [
+            (checked.velocity(t), checked.pose(t - h), checked.pose(t + h)) for t in times.tolist()
+        ]
+    except Exception:  # the run meets it again and reports it as it always does
+        return
+    bad = []
+    for t, (velocity, before, after) in zip(times.tolist(), pairs):
+        step = after - before
+        step[2] = (step[2] + math.pi) % (2.0 * math.pi) - math.pi
+        difference = step / (2.0 * h)
+        # rounding of the two poses, magnified by the division: far below any real speed
+        noise = 1e-6 + 1e3 * np.finfo(float).eps * (np.abs(before) + np.abs(after)) / h
+        scale = DERIVATIVE_TOLERANCE * np.maximum(np.abs(velocity), np.abs(difference))
+        if np.any(np.abs(velocity - difference) > scale + noise):
+            bad.append((t, velocity, difference))
+    if 2 * len(bad) > len(times):
+        t, velocity, difference = bad[0]
+        warnings.warn(
+            f"trajectory {_name(checked)}: velocity(t) is not the time derivative of pose(t) "
+            f"at {len(bad)} of {len(times)} checked times (t = {t:g} s: {_shown(velocity)} vs "
+            f"{_shown(difference)} from pose); the open-loop methods integrate velocity, so "
+            "the run follows another path",
+            UserWarning,
+            stacklevel=6,  # simulate() -> check_trajectory -> checked_trajectory -> here
+        )
+
+
+def _name(checked: CheckedTrajectory) -> str:
+    return trajectory_name(checked.trajectory)
+
+
+def _shown(values: np.ndarray) -> str:
+    return "[" + ", ".join(f"{value:.4g}" for value in values.tolist()) + "]"
 
 
 #: Where the library's trajectories are defined: their ``pose`` and ``velocity`` return

@@ -3,8 +3,10 @@
 CSV format (header required): ``t,x,y`` and optionally ``phi``; times in s strictly
 increasing (spanning a duration of 1e-6 s to 1e9 s, each step at least
 :data:`MIN_STEP_FRACTION` of that duration), positions in m, angles in rad. A ``phi``
-column may wrap at +-pi (as ``atan2`` writes it): a column within [-pi, pi] is unwrapped
-before interpolation (:func:`unwrap_phi`). Without ``phi`` the orientation is the
+column may wrap at +-pi (as ``atan2`` writes it): a column within [-pi, pi] (give or take
+:data:`ATAN2_ROUNDING_RAD`) is unwrapped before interpolation (:func:`unwrap_phi`). A
+``phi`` column that turns far more than the path does draws a warning: degrees read as
+radians (:func:`heading_units_warning`). Without ``phi`` the orientation is the
 direction of travel (unwrapped). If the first and last points coincide the path is
 treated as closed and the tangents at the ends are matched (periodic). Outside the
 samples' time range the trajectory holds still: the pose stays at the first (before) or
@@ -16,6 +18,7 @@ from __future__ import annotations
 import bisect
 import csv
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -40,6 +43,20 @@ MAX_TIME_S = DURATION_RANGE_S[1]
 #: ``times = [0, 1e-300, 1]`` ask for 1e300 m/s. Also how far (the same share) past
 #: either end the velocity keeps the end's speed before the trajectory holds still.
 MIN_STEP_FRACTION = 1e-9
+#: How far beyond +-pi (rad) an angle may lie and still count as ``atan2`` output for
+#: :func:`unwrap_phi`: a log that rounds atan2's pi writes 3.141593 (6 decimals, pi +
+#: 3.5e-7) or 3.142 (3 decimals, pi + 4.1e-4); a heading meant to be continuous that
+#: stays this close to +-pi and still steps by more than pi between rows is no
+#: plausible path.
+ATAN2_ROUNDING_RAD = 1e-3
+#: :func:`heading_units_warning` warns when the ``phi`` column's total turn (rad) exceeds
+#: this many times the path's own turn plus :data:`DEGREES_SLACK_RAD`: a heading in
+#: degrees turns 57.3 times the radians it means, one that follows or ignores the
+#: direction of travel turns about as much as the path or not at all.
+DEGREES_FACTOR = 10.0
+#: Turning (rad) a ``phi`` column may do beyond :data:`DEGREES_FACTOR` times the path's
+#: turn without a warning: two whole turns of the end effector on its own (a spin).
+DEGREES_SLACK_RAD = 4.0 * math.pi
 #: Longest default control step (s) of a sampled trajectory: that of the shipped ellipse
 #: and rectangle (40 s / 2000 samples).
 MAX_DEFAULT_STEP_S = 0.02
@@ -76,6 +93,9 @@ class SampledTrajectory:
             way round, the first row kept), and :attr:`points`, :meth:`pose` and
             :meth:`velocity` give the unwrapped, continuous orientation (magnitude <= 1e6
             rad after unwrapping too). Any other phi column is kept as given, bit for bit.
+            "Within [-pi, pi]" allows :data:`ATAN2_ROUNDING_RAD` of rounding (3.141593).
+            A phi column turning far more than the path (:func:`heading_units_warning`:
+            degrees, most likely) draws a ``UserWarning``.
         name: label used in reports.
 
     Times ``t`` of :meth:`pose`, :meth:`velocity` and :meth:`sample` count from the first
@@ -135,6 +155,9 @@ class SampledTrajectory:
             )
         _check_steps(times)
         points = unwrap_phi(points)
+        message = heading_units_warning(points)
+        if message is not None:
+            warnings.warn(f"trajectory {self.name}: {message}", UserWarning, stacklevel=3)
         periodic = bool(np.allclose(points[0, :2], points[-1, :2], atol=1e-9))
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "points", points)
@@ -335,7 +358,8 @@ def unwrap_phi(points: np.ndarray) -> np.ndarray:
     following ones), the first row kept. Interpolating the jump of a column wrapped at
     +-pi (rows 3.1 then -3.1) would otherwise turn the end effector the long way, a
     whole turn in one interval. Only a column that looks wrapped is unwrapped, every
-    angle in [-pi, pi]: a column beyond that is continuous already (it may step by more
+    angle in [-pi, pi] give or take :data:`ATAN2_ROUNDING_RAD` (a log's rounded pi,
+    3.141593, is atan2 output too): a column beyond that is continuous already (it may step by more
     than pi between coarse rows on purpose), and one unwrapped here and read back is not
     unwrapped again. Any other ``points`` (or without a third column) is returned as it
     is, keeping its exact bits (adding zero turns would still turn a -0.0 into 0.0). The
@@ -344,7 +368,10 @@ def unwrap_phi(points: np.ndarray) -> np.ndarray:
     if points.shape[1] != 3:
         return points
     phi = points[:, 2]
-    if not (np.all(np.abs(phi) <= math.pi) and np.any(np.abs(np.diff(phi)) > math.pi)):
+    if not (
+        np.all(np.abs(phi) <= math.pi + ATAN2_ROUNDING_RAD)
+        and np.any(np.abs(np.diff(phi)) > math.pi)
+    ):
         return points
     unwrapped = points.copy()
     unwrapped[:, 2] = np.unwrap(phi)
@@ -356,6 +383,31 @@ def unwrap_phi(points: np.ndarray) -> np.ndarray:
             f"(got {largest:g})"
         )
     return unwrapped
+
+
+def heading_units_warning(points: np.ndarray) -> str | None:
+    """One line saying the ``phi`` column (rad, already unwrapped by :func:`unwrap_phi`)
+    of ``points`` turns far more than its path plausibly does, else None (no ``phi``, or
+    a plausible one). Its total turn, the sum of the magnitudes of its steps between rows,
+    is compared with the path's: the sum of the turns (each wrapped to [-pi, pi]) between
+    the directions of consecutive non-zero moves of (x, y). More than
+    :data:`DEGREES_FACTOR` times the path's plus :data:`DEGREES_SLACK_RAD` is taken for a
+    column in degrees (a quarter circle logged 0..90 turns 90 "rad" for the path's 1.57)."""
+    if points.shape[1] != 3:
+        return None
+    heading = float(np.sum(np.abs(np.diff(points[:, 2]))))
+    moves = np.diff(points[:, :2], axis=0)
+    moves = moves[np.any(moves != 0.0, axis=1)]
+    directions = np.arctan2(moves[:, 1], moves[:, 0])
+    turns = np.mod(np.diff(directions) + math.pi, 2.0 * math.pi) - math.pi
+    path = float(np.sum(np.abs(turns)))
+    if heading <= DEGREES_FACTOR * path + DEGREES_SLACK_RAD:
+        return None
+    return (
+        f"column phi turns {heading:.3g} rad in total while the path's direction of travel "
+        f"turns {path:.3g} rad; phi is read in radians: if it holds degrees, convert it "
+        "(math.radians)"
+    )
 
 
 def _hermite_terms(s, p0, p1, m0, m1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
