@@ -357,7 +357,8 @@ def with_base(tool: str, args: list[str]) -> list[str]:
     while i < len(base):
         action = parser._option_string_actions[base[i]]
         width = 1 + (action.nargs != 0)  # BASE gives one value per option (or none)
-        if not (base[i] in given and type(action).__name__ == "_StoreOnce"):
+        scheduled = base[i] == "--jobs" and "--scheduler" in given  # refused together
+        if not scheduled and not (base[i] in given and type(action).__name__ == "_StoreOnce"):
             kept += base[i : i + width]
         i += width
     return kept

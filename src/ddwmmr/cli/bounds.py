@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import argparse
 import datetime as dt
-import json
 import math
 import sys
 import time
@@ -23,7 +22,7 @@ from pathlib import Path
 from ddwmmr import provenance
 from ddwmmr.bounds import batch
 from ddwmmr.bounds.search import QUICK, Settings
-from ddwmmr.cli.common import ArgumentParser, add_force_argument, output_folder, run_main
+from ddwmmr.cli.common import ArgumentParser, output_folder, run_main
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
@@ -35,7 +34,9 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model.stability import STABILITY_CAP
 from ddwmmr.outputs import (
+    Existing,
     check_output_folder,
+    check_output_path,
     check_writable,
     first_free,
     inspect,
@@ -45,7 +46,7 @@ from ddwmmr.outputs import (
 from ddwmmr.progress import ProgressBar
 from ddwmmr.scenarios.executors import default_jobs
 from ddwmmr.scenarios.generator import generate
-from ddwmmr.sim.result import json_safe
+from ddwmmr.scenarios.report import summary_json
 
 PROG = "python -m ddwmmr.bounds"
 TOOL = "bounds"
@@ -98,7 +99,12 @@ def build_parser() -> ArgumentParser:
         help="output folder (default: runs/bounds-<time>/); an earlier bounds run's folder "
         "is resumed from its cache and replaced",
     )
-    add_force_argument(parser)
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="accepted as the other tools accept it, and changes nothing: --out must be new, "
+        "empty or an earlier bounds run's folder (the cache needs a folder of its own)",
+    )
     parser.add_argument(
         "--payload", type=float, default=3.0, metavar="KG", help="payload in kg (default: 3.0)"
     )
@@ -173,12 +179,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         out = first_free(Path("runs") / f"bounds-{stamp}", folder=True)
     else:
         out = Path(args.out)
-    names = (MARKER, "bounds.csv")
-    target = check_output_folder(out, TOOL, args.force, names)
-    if target.exists() and inspect(target, TOOL).kind == "foreign" and args.force:
-        raise ParameterError(
-            f"out: {out} holds files no bounds run wrote; the cache needs a folder of its own"
-        )
+    target = _check_out(out, args.force)
     # Tried, not inferred from permission bits (/proc, a read-only mount): the cache is
     # written there as scenarios finish, so an unwritable --out fails before any of them.
     check_writable("out", target)
@@ -207,12 +208,37 @@ def _main(argv: Sequence[str] | None = None) -> int:
         for name in kept:
             write_atomic(staging / name, (target / name).read_bytes())
         write_atomic(staging / "bounds.csv", batch.bounds_csv(rows))
-        write_atomic(staging / MARKER, json.dumps(json_safe(summary), indent=2) + "\n")
+        write_atomic(staging / MARKER, summary_json(summary))
     if dropped:
         print(_dropped_note(target, dropped, args.seed, args.payload), file=sys.stderr)
     print(summary_line(len(rows), summary))
     print(f"wrote {target}", file=sys.stderr)
     return 0
+
+
+def _check_out(out: Path, force: bool) -> Path:
+    """:func:`check_output_folder` for this tool's ``--out``: a folder another tool or the
+    user made is refused with or without ``force`` (the cache needs a folder of its own),
+    in words that do not offer ``--force``."""
+    path = check_output_path(out)
+    if path.is_dir():
+        existing = inspect(path, TOOL)
+        if existing.kind == "foreign":
+            raise ParameterError(_foreign_refusal(out, existing))
+    return check_output_folder(out, TOOL, force, (MARKER, "bounds.csv"))
+
+
+def _foreign_refusal(out: Path, existing: Existing) -> str:
+    """Why ``out`` cannot hold a bounds run, and what to do instead."""
+    if existing.tool is not None and existing.tool != TOOL:
+        what = f"was written by ddwmmr {existing.tool}, not {TOOL}"
+    else:
+        sample = ", ".join(existing.foreign[:2]) + (", ..." if len(existing.foreign) > 2 else "")
+        what = f"holds files no ddwmmr {TOOL} run wrote ({sample})"
+    return (
+        f"out: {out} {what}; the bounds cache needs a folder of its own, so --force does "
+        "not help: choose another --out (a new folder or an earlier bounds run's)"
+    )
 
 
 def _dropped_note(target: Path, dropped: list[int], seed: int, payload: float) -> str:

@@ -266,7 +266,9 @@ def build_parser() -> ArgumentParser:
         "--jobs",
         type=int,
         metavar="N",
-        help=f"worker processes, 1 to {MAX_JOBS} (default: the CPUs available)",
+        help=f"worker processes, 1 to {MAX_JOBS} (default: the CPUs available); with "
+        "--executor dask the LocalCluster's workers; refused with --scheduler (the batch "
+        "runs on the workers the scheduler has)",
     )
     parser.add_argument(
         "--executor",
@@ -394,6 +396,11 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
         check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
     if args.scheduler and args.executor != "dask":
         raise ParameterError("scheduler: only used with --executor dask")
+    if args.scheduler and args.jobs is not None:
+        raise ParameterError(
+            "jobs: not used with --scheduler (the batch runs on the workers the scheduler "
+            "has); leave --jobs out"
+        )
     if args.connect_timeout is not None:
         if not args.scheduler:
             raise ParameterError("connect-timeout: only used with --scheduler")
@@ -485,11 +492,16 @@ class Runner:
     A context manager: with ``--executor dask`` the ``with`` block holds one client for
     every batch, connected (or its LocalCluster started) on entry, before any output
     exists, so a scheduler that is not there fails with one line and leaves nothing.
+
+    ``jobs`` is the local parallelism (the process pool, the LocalCluster's workers, the
+    arbiter study's statistics); ``workers`` the workers the batches run on: ``jobs``,
+    except with ``--scheduler``, where it is the scheduler's worker count once connected.
     """
 
     def __init__(self, args: argparse.Namespace) -> None:
         # never more workers than the largest batch has scenarios
         self.jobs = min(args.jobs or default_jobs(), largest_batch(args))
+        self.workers = self.jobs
         self.executor = args.executor
         self.scheduler = args.scheduler
         self.connect_timeout = args.connect_timeout or CONNECT_TIMEOUT
@@ -503,6 +515,8 @@ class Runner:
             label = "connecting to Dask" if self.scheduler else "starting Dask workers"
             with phase(label, enabled=self.progress):
                 self._client = self._held.enter_context(workers)
+            if self.scheduler:  # the cluster's own count, not this machine's CPUs
+                self.workers = cluster_workers(self._client)
         return self
 
     def __exit__(self, *exc_info: object) -> None:
@@ -516,12 +530,18 @@ class Runner:
             outcomes = run_many(
                 scenarios,
                 config,
-                jobs=self.jobs,
+                jobs=min(self.workers, MAX_JOBS),  # the chunking's cap, not the cluster's
                 executor=self.executor,
                 client=self._client,
                 on_done=bar.advance,
             )
         return outcomes, time.perf_counter() - start
+
+
+def cluster_workers(client: Any) -> int:
+    """Workers the Dask scheduler of ``client`` has now (at least 1: connecting waited for
+    one)."""
+    return max(1, len(client.nthreads()))
 
 
 def largest_batch(args: argparse.Namespace) -> int:
@@ -658,7 +678,7 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     if args.obstacles:
         scenarios = studies.obstacle_scenarios(scenarios)
     outcomes, wall = runner.run(scenarios, config, "scenarios")
-    extra = {"seed": args.seed, "run": _record(args, config)}
+    extra = {"seed": args.seed, "run": _record(args, config, runner.workers)}
     beaten: list[tuple[int, float, float]] = []
     if args.bounds_table is not None:
         beaten = report.below_lower_bound(outcomes, args.bounds_table)
@@ -673,7 +693,7 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     print(
         f"wall time {wall:.2f} s, {summary['sim_time_s']:.0f} simulated s, "
         f"{summary['sim_seconds_per_wall_second']:.0f} simulated s per wall s "
-        f"({runner.jobs} {args.executor} worker{'s' * (runner.jobs != 1)})",
+        f"({runner.workers} {args.executor} worker{'s' * (runner.workers != 1)})",
         file=sys.stderr,
     )
 
@@ -747,7 +767,7 @@ def _run_thresholds(args, config, runner, folder: Path) -> None:
         "config": asdict(config),
         "variants": rows,
         "wall_time_s": sum(s["wall_time_s"] for _, s in results),
-        "run": _record(args, config),
+        "run": _record(args, config, runner.workers),
     }
     write_atomic(folder / MARKER, report.summary_json(total))
     print("Threshold study: cells are thesis / ours\n")
@@ -757,7 +777,7 @@ def _run_thresholds(args, config, runner, folder: Path) -> None:
 def _run_obstacles(args, config, runner, folder: Path) -> None:
     scenarios = studies.obstacle_scenarios(generate(max(args.n, 10), args.seed))
     outcomes, wall = runner.run(scenarios, config, "obstacles")
-    extra = {"seed": args.seed, "study": "obstacles", "run": _record(args, config)}
+    extra = {"seed": args.seed, "study": "obstacles", "run": _record(args, config, runner.workers)}
     write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     table = studies.obstacle_table([o.metrics for o in outcomes])
     write_atomic(folder / "obstacles.md", table)
@@ -778,7 +798,7 @@ def _run_arbiters(args, config, runner, folder: Path) -> None:
     study = arbiter_study.write_study(
         folder, scenarios, config, runner.run, runner.jobs, seed=args.seed
     )
-    study.update(seed=args.seed, config=asdict(config), run=_record(args, config))
+    study.update(seed=args.seed, config=asdict(config), run=_record(args, config, runner.workers))
     write_atomic(folder / MARKER, report.summary_json(study))
     print(study["table"], end="")
 
@@ -788,8 +808,10 @@ def config_robot(config: RunConfig) -> Robot:
     return Robot().with_payload(config.payload)
 
 
-def _record(args: argparse.Namespace, config: RunConfig) -> dict[str, Any]:
-    """summary.json["run"]: everything needed to repeat the batch."""
+def _record(args: argparse.Namespace, config: RunConfig, workers: int) -> dict[str, Any]:
+    """summary.json["run"]: everything needed to repeat the batch, and how it ran: ``jobs``
+    is the ``--jobs`` given (None: the default), ``workers`` the workers the batch ran on
+    (:attr:`Runner.workers`)."""
     record = provenance.header("scenarios", PROG, args.argv)
     record.update(
         config=provenance.encode(asdict(config)),
@@ -801,6 +823,7 @@ def _record(args: argparse.Namespace, config: RunConfig) -> dict[str, Any]:
         plant={"name": config.plant},
         executor=args.executor,
         jobs=args.jobs,
+        workers=workers,
     )
     return record
 

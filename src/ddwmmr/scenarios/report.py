@@ -224,10 +224,10 @@ def format_table(summary: dict[str, Any], title: str) -> str:
 
 
 def summary_json(summary: dict[str, Any]) -> str:
-    """The text of a scenarios run's summary.json: ``summary`` as indented standard JSON
-    in which every undefined number (NaN, or a non-finite float: the mean of a metric
-    the controller has not, the sd and CI of one scenario, a ratio over no scenario) is
-    null, as the fields that do not apply already are (``fallback_steps``...). Strings,
+    """The text of a scenarios or bounds run's summary.json: ``summary`` as indented
+    standard JSON in which every undefined number (NaN, or a non-finite float: the mean of
+    a metric the controller has not, the sd and CI of one scenario, a ratio over no
+    scenario) is null, as the fields that do not apply already are (``fallback_steps``...). Strings,
     such as the run record's ``"inf"`` (:mod:`ddwmmr.provenance`), are kept as they are."""
     return json.dumps(json_safe(summary, undefined_as_null=True), indent=2, allow_nan=False) + "\n"
 
