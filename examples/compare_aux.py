@@ -8,6 +8,7 @@ the cos(th1) = 0 singularity; ``aux="shoulder"`` lets the base turn freely. Prin
 from __future__ import annotations
 
 from ddwmmr import Ellipse, Rectangle, Robot, simulate
+from ddwmmr.cli.common import run_script  # bad input: one line, status 2
 
 
 def main() -> None:
@@ -27,4 +28,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run_script(main)

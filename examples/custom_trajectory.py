@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from ddwmmr import Robot, simulate
+from ddwmmr.cli.common import run_script  # bad input: one line, status 2
 
 
 class SineWave:
@@ -80,4 +81,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run_script(main)

@@ -11,6 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ddwmmr import Ellipse, Robot, simulate
+from ddwmmr.cli.common import run_script  # bad input: one line, status 2
 
 ROBOT_TOML = """\
 # Field names of ddwmmr.Robot; missing fields keep their defaults (SI units).
@@ -49,4 +50,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run_script(main)

@@ -18,6 +18,7 @@ Prints only; about 15 s. The 100-scenario study is
 
 from __future__ import annotations
 
+from ddwmmr.cli.common import run_script  # bad input: one line, status 2
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 
 #: (label, mpc options) of each run, from the bare static floor to the default.
@@ -47,4 +48,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    run_script(main)

@@ -6,17 +6,18 @@ Run: ``python examples/quickstart.py [method]`` (default ``clrrmc-ts``). Prints 
 from __future__ import annotations
 
 import sys
+import textwrap
 
 import numpy as np
 
 from ddwmmr import (
     Ellipse,
-    ParameterError,
     Robot,
     available_methods,
     make_controller,
     simulate,
 )
+from ddwmmr.cli.common import run_script  # bad input: one line, status 2
 
 KEYS = (
     "rms_position_error_m",
@@ -38,6 +39,9 @@ def main(method: str = "clrrmc-ts") -> None:
     print(f"{method} on {trajectory.name} (methods: {', '.join(available_methods())})")
     for key in KEYS:
         print(f"  {key:<26} {result.summary[key]:.6g}")
+    # Whether it tracked, and if not what went wrong and why (simulate's verdict, from
+    # ddwmmr.sim.verdict), as python -m ddwmmr.track prints it.
+    print(textwrap.fill(f"verdict: {result.summary['verdict']}", 100, subsequent_indent="  "))
 
     # The same controller used directly, outside the simulator: one command u = (v, w,
     # th1dot, th2dot) in m/s and rad/s for the recorded start configuration.
@@ -50,8 +54,4 @@ def main(method: str = "clrrmc-ts") -> None:
 
 
 if __name__ == "__main__":
-    try:
-        main(*sys.argv[1:2])
-    except ParameterError as error:  # e.g. an unknown method: one line, exit 2, like the tools
-        print(f"error: {error}", file=sys.stderr)
-        sys.exit(2)
+    run_script(main, *sys.argv[1:2])

@@ -21,10 +21,16 @@ from ddwmmr.resolution.reference import (
 )
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+#: The example scripts.
 SCRIPTS = sorted(EXAMPLES.glob("*.py"))
 #: Text each example must print (scripts not listed must print something).
 EXPECTED = {
-    "quickstart.py": ("clrrmc-ts on ellipse", "rms_position_error_m", "first command u"),
+    "quickstart.py": (
+        "clrrmc-ts on ellipse",
+        "rms_position_error_m",
+        "\nverdict: tracked\n",
+        "first command u",
+    ),
     "custom_trajectory.py": ("ats", "clrrmc-ts", "final"),
     "compare_aux.py": ("rectangle  sum", "ellipse    shoulder"),
     "own_robot.py": ("default (thesis)", "long arm (TOML)", "would tip over"),

@@ -22,8 +22,10 @@ import multiprocessing
 import os
 import re
 import signal
+import sys
 import threading
 from collections.abc import Callable, Iterator, Sequence
+from typing import NoReturn
 
 from ddwmmr import interrupts
 from ddwmmr.cli.signals import EXIT_INTERRUPTED, EXIT_TERMINATED, STOP_SIGNALS, say, stop_line
@@ -241,6 +243,15 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
         where = f"{exc.filename}: " if exc.filename else ""
         say(f"error: {where}{exc.strerror or exc}")
         return 1
+
+
+def run_script(main: Callable[..., object], *arguments: str) -> NoReturn:
+    """End a user's script the way the tools end: call ``main(*arguments)`` and exit with
+    status 0 when it returns; a :class:`ParameterError` (a value the library refuses)
+    gives one line ``error: ...`` on stderr and status 2, Ctrl-C status 130, a user's
+    controller raising status 1, each without a traceback (:func:`run_main`). The
+    examples end with it."""
+    sys.exit(run_main(lambda _argv: main(*arguments) or 0, None))
 
 
 def add_robot_arguments(parser: argparse.ArgumentParser) -> None:

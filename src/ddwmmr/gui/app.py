@@ -447,6 +447,8 @@ class App(PanelLayout):
     def _apply_export_dir(self, text: str) -> str:
         check_export_root(text)  # a folder, or where one can be made
         self.export_dir = None  # the next export makes a new run folder under the new root
+        # replaces what an earlier refused folder left in the message area
+        self.say(f"export folder: {text.strip()}")
         return text.strip()
 
     # ================================================================ preview and runs

@@ -18,12 +18,13 @@ fails in one line (a :class:`ParameterError`, status 2) instead of after the run
 
 from __future__ import annotations
 
+import errno
 import os
 import stat
 from pathlib import Path
 
 from ddwmmr.errors import ParameterError
-from ddwmmr.outputs import check_output_path, check_writable
+from ddwmmr.outputs import check_output_path, check_writable, existing_folder
 
 #: Suffixes (formats) ``--snapshot`` may have: what matplotlib writes by itself or through
 #: Pillow (pgf needs LaTeX; raw/rgba are headerless pixel dumps, not image files).
@@ -147,5 +148,24 @@ def check_export_root(text: str) -> Path:
     path = Path(os.path.abspath(text))
     if os.path.lexists(path) and not path.is_dir():
         raise ParameterError(f"export: {text} exists and is not a folder")
-    check_writable("export", path)
+    existing = existing_folder("export", path)
+    try:
+        check_writable("export", path)
+    except ParameterError as exc:
+        raise ParameterError(unwritable_message(text, path, existing, exc.__context__)) from None
     return path
+
+
+def unwritable_message(text: str, path: Path, existing: Path, error: BaseException | None) -> str:
+    """Why nothing can be exported to ``text`` (absolute: ``path``): ``existing``, the
+    folder itself or the nearest one above it that exists, takes no new entries. The
+    operating system's reason (``error``) is added unless it is "No such file or
+    directory", which a file system that takes no new entries (``/proc``) gives although
+    ``existing`` is there."""
+    reason = ""
+    if isinstance(error, OSError) and error.errno != errno.ENOENT and error.strerror:
+        reason = f" ({error.strerror})"
+    refusal = f"{existing} takes no new files or folders{reason}; choose a folder elsewhere"
+    if existing == path:
+        return f"export: cannot write in {text}: {refusal}"
+    return f"export: cannot make the folder {text}: {refusal}"

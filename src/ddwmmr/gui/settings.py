@@ -79,6 +79,22 @@ GEOMETRY_HELP = {
 
 #: The two method slots: A (always on) and B (side-by-side comparison, may be off).
 SLOTS = ("A", "B")
+#: The allowed form of :attr:`Settings.methods` and :attr:`Settings.options`, for messages.
+METHODS_FORM = "a pair (A, B) of method names, B None for no comparison, e.g. ('clrrmc-ts', None)"
+OPTIONS_FORM = "a pair (A's, B's) of option mappings, e.g. ({}, {})"
+
+
+def _per_slot(name: str, value: Any, form: str) -> tuple[Any, Any]:
+    """``value`` as a tuple of one entry per slot of :data:`SLOTS`; a one-line
+    :class:`ParameterError` naming ``name`` and ``form`` for a string, a non-sequence or
+    another number of entries."""
+    if not isinstance(value, tuple | list):  # a string would be read letter by letter
+        raise ParameterError(f"{name} must be {form} (got {shown(value)})")
+    if len(value) != len(SLOTS):
+        raise ParameterError(
+            f"{name} must be {form}: {len(SLOTS)} entries (got {len(value)}: {shown(value)})"
+        )
+    return tuple(value)
 
 
 @dataclass(frozen=True)
@@ -88,8 +104,10 @@ class Settings:
     Attributes:
         trajectory: a trajectory name (``available_trajectories()``) or a file path.
         geometry: geometry values changed from the trajectory's own (see module doc).
-        methods: method of slot A and of slot B (None: no comparison).
-        options: per slot, the method options changed from their defaults.
+        methods: method of slot A and of slot B (None: no comparison), exactly two
+            entries (a tuple; a list is taken as one).
+        options: per slot (two mappings), the method options changed from their
+            defaults.
         plant: plant name (see :func:`ddwmmr.gui.options.plant_names`).
         payload: payload at the end effector (kg).
         integrator: ``rk4`` or ``euler``.
@@ -108,6 +126,12 @@ class Settings:
     dt: float | None = None
     duration: float | None = None
     offset: tuple[float, float] = DEFAULT_INITIAL_OFFSET
+
+    def __post_init__(self) -> None:
+        # Every slot index (widgets, labels, export) assumes one entry per slot: a bare
+        # string would be read letter by letter, a third entry would have no slot.
+        object.__setattr__(self, "methods", _per_slot("methods", self.methods, METHODS_FORM))
+        object.__setattr__(self, "options", _per_slot("options", self.options, OPTIONS_FORM))
 
     def replace(self, **changes: Any) -> Settings:
         """A copy with ``changes`` applied (not yet checked)."""
