@@ -197,7 +197,12 @@ def test_a_path_that_cannot_be_a_snapshot_is_refused(
 @pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux /proc")
 def test_a_virtual_file_system_is_refused(capsys, no_window):
     # ../../../../proc/x.png from the audit: os.access says yes to root, writing does not.
-    refused(["--snapshot", "/proc/ddwmmr-x.png", *FAST], capsys, "snapshot: cannot write in /proc")
+    refused(
+        ["--snapshot", "/proc/ddwmmr-x.png", *FAST],
+        capsys,
+        "snapshot: cannot write in /proc: /proc takes no new files or folders; "
+        "choose a folder elsewhere",
+    )
 
 
 @pytest.mark.skipif(os.geteuid() == 0, reason="root may write into a chmod 500 folder")

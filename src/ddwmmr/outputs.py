@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import errno
 import io
 import json
 import os
@@ -294,21 +295,37 @@ def check_file_target(path: object, label: str = "path") -> Path:
     return Path(text)
 
 
-def check_writable(label: str, folder: Path) -> None:
+def check_writable(label: str, folder: Path, name: str | None = None) -> None:
     """Raise a one-line :class:`ParameterError` unless files can be created in ``folder``
     (or, if it does not exist yet, in the nearest existing folder above it). Tried, not
     inferred from permission bits: a file is created there and removed at once, which
-    catches what ``os.access`` does not show (root on ``/proc``, a read-only mount)."""
+    catches what ``os.access`` does not show (root on ``/proc``, a read-only mount).
+    ``name``: ``folder`` as the user wrote it, for the message (default: ``folder``).
+    The :class:`OSError` of the failed try is the error's ``__cause__``."""
     existing = existing_folder(label, folder)
     try:
         fd, probe = tempfile.mkstemp(dir=existing, prefix=".ddwmmr-", suffix=".tmp")
     except OSError as exc:
-        raise ParameterError(
-            f"{label}: cannot write in {existing} ({exc.strerror or exc})"
-        ) from None
+        shown_name = str(folder) if name is None else name
+        raise ParameterError(unwritable_message(label, shown_name, folder, existing, exc)) from exc
     os.close(fd)
     with contextlib.suppress(OSError):
         os.unlink(probe)
+
+
+def unwritable_message(label: str, name: str, folder: Path, existing: Path, error: OSError) -> str:
+    """Why nothing can be created in ``folder`` (shown as ``name``): ``existing``, the
+    folder itself or the nearest one above it that exists, takes no new entries. The
+    operating system's reason (``error``) is added unless it is "No such file or
+    directory", which a file system that takes no new entries (``/proc``) gives although
+    ``existing`` is there."""
+    reason = ""
+    if error.errno != errno.ENOENT and error.strerror:
+        reason = f" ({error.strerror})"
+    refusal = f"{existing} takes no new files or folders{reason}; choose a folder elsewhere"
+    if Path(os.path.abspath(existing)) == Path(os.path.abspath(folder)):
+        return f"{label}: cannot write in {name}: {refusal}"
+    return f"{label}: cannot make the folder {name}: {refusal}"
 
 
 def check_output_path(target: str | Path, what: str = "folder") -> Path:
@@ -345,6 +362,7 @@ def check_output_path(target: str | Path, what: str = "folder") -> Path:
         raise ParameterError(f"out: {ancestor} is not a folder")
     if not os.access(ancestor, os.W_OK | os.X_OK):
         raise ParameterError(f"out: cannot write in {ancestor} (permission denied)")
+    check_writable("out", path.parent)  # what os.access does not show (root on /proc)
     return path
 
 

@@ -146,6 +146,7 @@ class App(PanelLayout):
         self.worker: Worker | None = None
         self.playing = False
         self.message = ""
+        self.message_is_error = False
         self.failure: tuple[str, bool] | None = None
         self.export_dir: Path | None = None
         self._run_stamp = ""
@@ -177,7 +178,7 @@ class App(PanelLayout):
     # ================================================================ messages
     def say(self, text: str, error: bool = False) -> None:
         """Show ``text`` in the message area (red for errors) and redraw."""
-        self.message = text
+        self.message, self.message_is_error = text, error
         wrapped = "\n".join(textwrap.wrap(text, 62, break_on_hyphens=False)) if text else ""
         self.message_text.set_text(("error: " if error else "") + wrapped)
         self.message_text.set_color("tab:red" if error else "0.1")
@@ -185,6 +186,12 @@ class App(PanelLayout):
 
     def _report(self, text: str) -> None:
         self.say(text, error=True)
+
+    def _withdraw(self, text: str) -> None:
+        """Clear the error ``text`` if the message area still shows it (a widget that
+        reported it holds a valid value again)."""
+        if self.message_is_error and self.message == text:
+            self.say("")
 
     def _redraw(self) -> None:
         """Redraw the whole window (soon). Off-screen (Agg) draw_idle would render at once:
@@ -447,7 +454,6 @@ class App(PanelLayout):
     def _apply_export_dir(self, text: str) -> str:
         check_export_root(text)  # a folder, or where one can be made
         self.export_dir = None  # the next export makes a new run folder under the new root
-        # replaces what an earlier refused folder left in the message area
         self.say(f"export folder: {text.strip()}")
         return text.strip()
 

@@ -87,6 +87,7 @@ class PanelLayout:
             "",
             self._apply_file,
             self._report,
+            self._withdraw,
         )
         self.figure.text(
             0.012,
@@ -106,6 +107,7 @@ class PanelLayout:
                 "",
                 functools.partial(self._apply_geometry, name),
                 self._report,
+                self._withdraw,
                 hint=allowed,
             )
 
@@ -148,6 +150,7 @@ class PanelLayout:
             "A",
             self._apply_options_slot,
             self._report,
+            self._withdraw,
         )
         self.options_page_button = CycleButton(
             self.figure,
@@ -157,6 +160,7 @@ class PanelLayout:
             1,
             self._apply_options_page,
             self._report,
+            self._withdraw,
         )
         self.options_note = self.figure.text(
             0.012, self._options_top - 0.03 * 6 - 0.018, "", fontsize=FONT - 1, color="0.4"
@@ -187,6 +191,7 @@ class PanelLayout:
             "",
             self._apply_dt,
             self._report,
+            self._withdraw,
             hint="blank: T/N",
         )
         self.duration_field = Field(
@@ -196,6 +201,7 @@ class PanelLayout:
             "",
             self._apply_duration,
             self._report,
+            self._withdraw,
             hint="blank: T",
         )
         self.offset_field = Field(
@@ -205,6 +211,7 @@ class PanelLayout:
             "",
             self._apply_offset,
             self._report,
+            self._withdraw,
             hint="start error of the end effector",
         )
         self._simulation_bottom = row - 0.03
@@ -219,6 +226,7 @@ class PanelLayout:
             "runs/gui",
             self._apply_export_dir,
             self._report,
+            self._withdraw,
         )
         row = top - 0.07
         # (x, width) of each button on the row: the animation formats' short labels
@@ -326,6 +334,7 @@ class PanelLayout:
                 spec.default,
                 apply,
                 self._report,
+                self._withdraw,
                 format_choice,
             )
         return Field(
@@ -335,6 +344,7 @@ class PanelLayout:
             spec.format(spec.default),
             lambda text: self._apply_option_text(slot, spec, text),
             self._report,
+            self._withdraw,
         )
 
 

@@ -12,19 +12,18 @@ fails in one line (a :class:`ParameterError`, status 2) instead of after the run
   with ``--force``;
 * the export folder: a folder, or a path where one can be made.
 
-"Writable" is tried, not inferred from the permission bits
-(:func:`ddwmmr.outputs.check_writable`).
+"Writable" is tried, not inferred from the permission bits, and refused in the wording of
+every tool (:func:`ddwmmr.outputs.check_writable`).
 """
 
 from __future__ import annotations
 
-import errno
 import os
 import stat
 from pathlib import Path
 
 from ddwmmr.errors import ParameterError
-from ddwmmr.outputs import check_output_path, check_writable, existing_folder
+from ddwmmr.outputs import check_output_path, check_writable
 
 #: Suffixes (formats) ``--snapshot`` may have: what matplotlib writes by itself or through
 #: Pillow (pgf needs LaTeX; raw/rgba are headerless pixel dumps, not image files).
@@ -108,7 +107,6 @@ def check_snapshot_path(text: str, force: bool = False) -> Path:
         raise ParameterError(f"snapshot: {text} is a folder; give a file name such as gui.png")
     snapshot_format(text)
     check_existing_snapshot(path, text, force)
-    check_writable("snapshot", path.parent)
     return path
 
 
@@ -148,24 +146,5 @@ def check_export_root(text: str) -> Path:
     path = Path(os.path.abspath(text))
     if os.path.lexists(path) and not path.is_dir():
         raise ParameterError(f"export: {text} exists and is not a folder")
-    existing = existing_folder("export", path)
-    try:
-        check_writable("export", path)
-    except ParameterError as exc:
-        raise ParameterError(unwritable_message(text, path, existing, exc.__context__)) from None
+    check_writable("export", path, text)
     return path
-
-
-def unwritable_message(text: str, path: Path, existing: Path, error: BaseException | None) -> str:
-    """Why nothing can be exported to ``text`` (absolute: ``path``): ``existing``, the
-    folder itself or the nearest one above it that exists, takes no new entries. The
-    operating system's reason (``error``) is added unless it is "No such file or
-    directory", which a file system that takes no new entries (``/proc``) gives although
-    ``existing`` is there."""
-    reason = ""
-    if isinstance(error, OSError) and error.errno != errno.ENOENT and error.strerror:
-        reason = f" ({error.strerror})"
-    refusal = f"{existing} takes no new files or folders{reason}; choose a folder elsewhere"
-    if existing == path:
-        return f"export: cannot write in {text}: {refusal}"
-    return f"export: cannot make the folder {text}: {refusal}"

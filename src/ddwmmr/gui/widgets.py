@@ -2,7 +2,9 @@
 
 * :class:`Field` - a labelled text box that applies its text through a callback; when the
   callback raises :class:`ParameterError` the box returns to its previous text (the
-  previous valid setting stays) and the error goes to the window's message line.
+  previous valid setting stays) and the error goes to the window's message line, until
+  the box accepts a valid value (:class:`ErrorOwner`: every widget takes back its own
+  error, and only its own).
 * :class:`CycleButton` - a button showing ``name: value`` that steps through a list of
   values on every click (choices, on/off flags).
 * :func:`radio` - radio buttons with small labels.
@@ -26,7 +28,8 @@ from ddwmmr.errors import ParameterError
 
 #: Font size of panel labels and widget texts (points).
 FONT = 8
-#: Callback receiving an error message to show in the window.
+#: Callback receiving an error message to show in the window (``report``), or one to
+#: take back if the window still shows it (``withdraw``).
 Reporter = Callable[[str], None]
 
 
@@ -71,12 +74,34 @@ def describe_error(exc: Exception) -> str:
     return f"{type(exc).__name__}: {text}".rstrip(": ")
 
 
-class Field:
+class ErrorOwner:
+    """The error a widget put in the message line, taken back once the widget holds a
+    valid value again: ``report(text)`` shows it, ``withdraw(text)`` clears it if the
+    window still shows that text (a message said since, by anyone, stays)."""
+
+    def __init__(self, report: Reporter, withdraw: Reporter) -> None:
+        self.report = report
+        self.withdraw = withdraw
+        self._error: str | None = None
+
+    def failed(self, exc: Exception) -> None:
+        """Show why ``exc`` refused the widget's new value."""
+        self._error = describe_error(exc)
+        self.report(self._error)
+
+    def accepted(self) -> None:
+        """The widget holds a valid value: take back its error, if any."""
+        if self._error is not None:
+            self.withdraw(self._error)
+            self._error = None
+
+
+class Field(ErrorOwner):
     """A labelled text box whose submitted text is applied by ``apply(text)``.
 
     ``apply`` returns the text to show (e.g. normalised), or raises
     :class:`ParameterError`; then the box shows its previous text again and ``report``
-    receives the message.
+    receives the message, which ``withdraw`` takes back when a valid text is submitted.
     """
 
     def __init__(
@@ -87,8 +112,10 @@ class Field:
         text: str,
         apply: Callable[[str], str | None],
         report: Reporter,
+        withdraw: Reporter,
         hint: str = "",
     ) -> None:
+        super().__init__(report, withdraw)
         self.ax = panel_axes(figure, rect)
         self.box = QuietTextBox(self.ax, label, initial=text, label_pad=0.04)
         self.box.label.set_fontsize(FONT)
@@ -107,7 +134,6 @@ class Field:
                 ha="left",
             )
         self.apply = apply
-        self.report = report
         self.valid_text = text
         self.box.on_submit(self._submitted)
 
@@ -132,17 +158,19 @@ class Field:
         self.box.set_active(visible)
 
     def _submitted(self, text: str) -> None:
-        if text == self.valid_text:
+        if text == self.valid_text:  # the valid value already applied
+            self.accepted()
             return
         try:
             shown = self.apply(text)
         except Exception as exc:  # the previous valid text stays; the window shows why
-            self.report(describe_error(exc))
+            self.failed(exc)
             self._set_silently(self.valid_text)
             return
         self.valid_text = text if shown is None else shown
         if shown is not None and shown != text:
             self._set_silently(shown)
+        self.accepted()
 
     def _set_silently(self, text: str) -> None:
         # TextBox.set_val would show the typing cursor and redraw the whole figure.
@@ -150,10 +178,11 @@ class Field:
         self.box.cursor.set_visible(False)
 
 
-class CycleButton:
+class CycleButton(ErrorOwner):
     """A button labelled ``name: value`` that moves to the next of ``values`` when clicked.
 
-    ``apply(value)`` may raise :class:`ParameterError`: the value then stays where it was.
+    ``apply(value)`` may raise :class:`ParameterError`: the value then stays where it was
+    and ``report`` shows why, until a click is accepted (``withdraw``).
     """
 
     def __init__(
@@ -165,8 +194,10 @@ class CycleButton:
         current: Any,
         apply: Callable[[Any], None],
         report: Reporter,
+        withdraw: Reporter,
         format_value: Callable[[Any], str] = str,
     ) -> None:
+        super().__init__(report, withdraw)
         self.ax = panel_axes(figure, rect)
         self.name = name
         self.values = list(values)
@@ -175,7 +206,6 @@ class CycleButton:
         self.button = Button(self.ax, self._caption(current), color="0.9", hovercolor="0.97")
         self.button.label.set_fontsize(FONT)
         self.apply = apply
-        self.report = report
         self.button.on_clicked(lambda _event: self.click())
 
     def click(self) -> None:
@@ -185,9 +215,10 @@ class CycleButton:
         try:
             self.apply(following)
         except Exception as exc:  # the value stays; the window shows why
-            self.report(describe_error(exc))
+            self.failed(exc)
             return
         self.show(following)
+        self.accepted()
 
     def show(self, value: Any) -> None:
         """Display ``value`` as the current one, without applying it."""

@@ -197,7 +197,10 @@ class Robot:
         object.__setattr__(self, "joint_limits", tuple(limits))
         home = _pair("home_pose", self.home_pose, "rad")
         for i, (angle, (low, high)) in enumerate(zip(home, limits), start=1):
-            check_range(f"home_pose[{i}]", angle, low, high, f"rad (joint_limits[{i}])")
+            try:
+                check_range(f"home_pose[{i}]", angle, low, high, f"rad (joint_limits[{i}])")
+            except ParameterError as exc:
+                raise ParameterError(f"{exc}{_degrees_hint(angle)}") from None
         object.__setattr__(self, "home_pose", home)
         if not 2.0 * self.wheel_mass < self.base_mass:
             raise ParameterError(
@@ -502,7 +505,7 @@ def unit_doubts(robot: Robot) -> list[str]:
             ("joint_limits", limits, _shown([_shown(pair) for pair in robot.joint_limits])),
             ("home_pose", robot.home_pose, _shown(robot.home_pose)),
         )
-        if any(abs(angle) > PLAUSIBLE_ANGLE_RAD for angle in values)
+        if any(plausibly_degrees(angle) for angle in values)
     ]
     if angles:
         doubts.append(
@@ -510,6 +513,22 @@ def unit_doubts(robot: Robot) -> list[str]:
             "turn) in magnitude: angles are in radians (given in degrees?)"
         )
     return doubts
+
+
+def plausibly_degrees(angle: float) -> bool:
+    """Whether a joint angle (limit or home angle) of ``angle`` rad was most likely
+    written in degrees: beyond :data:`PLAUSIBLE_ANGLE_RAD` (one turn) in magnitude."""
+    return abs(angle) > PLAUSIBLE_ANGLE_RAD
+
+
+def _degrees_hint(angle: float) -> str:
+    """What a refusal of the joint angle ``angle`` (rad) adds when it is
+    :func:`plausibly_degrees`: the radians it would be in degrees. Else empty."""
+    if not plausibly_degrees(angle):
+        return ""
+    return (
+        f"; angles are in radians (given in degrees? {angle:g} deg = {math.radians(angle):.6g} rad)"
+    )
 
 
 def _shown(items) -> str:
