@@ -343,6 +343,12 @@ class Robot:
         (:class:`~ddwmmr.model.mass.YawInertia`: ``robot.yaw_inertia.at(th2)``, kg m^2)."""
         return YawInertia.of(self)
 
+    @property
+    def motor_force_limit(self) -> float:
+        """Largest traction force (N) each wheel's motor gives: ``wheel_torque_limit /
+        wheel_radius`` (20.5 N for the default robot)."""
+        return self.wheel_torque_limit / self.wheel_radius
+
     # -- kinematics -----------------------------------------------------------------------
     @property
     def reach(self) -> float:

@@ -45,7 +45,6 @@ from ddwmmr.model.thesis_base import (
     C1_DEFAULT,
     C2_DEFAULT,
     FORCE_LIMIT_DEFAULT,
-    JOINT_SPEED_DEFAULT,
 )
 
 #: Sizes: configuration, velocity inputs, force-model state and inputs.
@@ -244,10 +243,11 @@ class ThesisDynamics:
         c1: float = C1_DEFAULT,
         c2: float = C2_DEFAULT,
         force_limit: float = FORCE_LIMIT_DEFAULT,
-        joint_speed: float = JOINT_SPEED_DEFAULT,
+        joint_speed: float | None = None,
         half_width: float | None = None,
     ) -> ThesisDynamics:
-        """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``;
+        """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``
+        (``joint_speed`` rad/s, None: the robot's ``joint_speed_limit``, as the plant's);
         ``half_width`` (m) is the wheels' lever about the base centre, by default the
         thesis plant's ``robot.track_width / 2``."""
         inertia = robot.yaw_inertia  # the collected form I(th2) = fixed + cos * cos th2
@@ -256,7 +256,9 @@ class ThesisDynamics:
             c1=check_nonnegative("c1", c1),  # 0: an undamped base (the physics plant)
             c2=check_nonnegative("c2", c2),
             force_limit=check_positive("force_limit", force_limit),
-            joint_speed=check_positive("joint_speed", joint_speed),
+            joint_speed=check_positive(
+                "joint_speed", robot.joint_speed_limit if joint_speed is None else joint_speed
+            ),
             half_width=(
                 0.5 * robot.track_width
                 if half_width is None

@@ -17,17 +17,24 @@ size only affects how often the controller acts, not the accuracy of the base mo
 The travelled distance is applied along the mean heading of the step (thesis eqs 3.5-3.7).
 
 Arm: the thesis's pseudo-controller (4.4.2, eqs 4.10-4.11). Given joint targets, the joint
-with the largest error moves at ``joint_speed`` (2 rad/s) and every other joint at the
+with the largest error moves at ``joint_speed`` (the robot's ``joint_speed_limit``, 2 rad/s
+for the thesis robot) and every other joint at the
 speed scaled by its error / the largest error, so all joints arrive together; a joint never
 passes its target. Targets are clipped to the robot's ``joint_limits`` (the servo stops a
 joint at its limit, as the kinematic plant does), and a start outside them is refused. The
 plant knows nothing about controllers: it receives wheel forces and joint targets from a
 simulation loop.
+
+Constants (:mod:`ddwmmr.model.thesis_base`): the arm servo's speed comes from the robot; the
+damping c1, c2 are the thesis model's and the per-wheel force limit (10 N) the thesis
+robot's, for any robot unless given (a robot whose wheel drive is not the thesis robot's
+gets a one-line warning naming them).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -43,7 +50,6 @@ from ddwmmr.model.thesis_base import (  # the base's constants (controllers' mod
     C1_DEFAULT,
     C2_DEFAULT,
     FORCE_LIMIT_DEFAULT,
-    JOINT_SPEED_DEFAULT,
 )
 from ddwmmr.plants.base import (
     Observation,
@@ -57,6 +63,34 @@ from ddwmmr.registry import register_plant
 
 #: Bandwidth (1/s) of the velocity servo that follows velocity commands.
 VELOCITY_BANDWIDTH = 10.0
+
+
+def _wheel_drive(robot: Robot) -> tuple[float, float]:
+    """The robot's wheel drive: ``(wheel_radius m, wheel_torque_limit N m)``."""
+    return robot.wheel_radius, robot.wheel_torque_limit
+
+
+#: The thesis robot's wheel drive (``Robot``'s defaults): the one whose force limit is the
+#: thesis's 10 N.
+_THESIS_DRIVE = _wheel_drive(Robot())
+
+
+def warn_borrowed_constants(robot: Robot, c1: float, c2: float) -> None:
+    """Warn (a one-line :class:`UserWarning`, once per message under Python's default
+    filter) when ``robot``'s wheel drive (``wheel_radius``, ``wheel_torque_limit``) is not
+    the thesis robot's, so the thesis plant's default force limit (10 N per wheel) is not
+    its own; the damping c1, c2 (N s/m, N m s/rad; the thesis model's) are named with it."""
+    if _wheel_drive(robot) == _THESIS_DRIVE:
+        return
+    motors = robot.motor_force_limit
+    warnings.warn(
+        f"thesis plant: the robot runs with the thesis robot's wheel force limit "
+        f"{FORCE_LIMIT_DEFAULT:g} N (its motors give wheel_torque_limit / wheel_radius = "
+        f"{motors:.4g} N) and the thesis model's damping c1 = {c1:g} N s/m, c2 = {c2:g} "
+        "N m s/rad (ThesisPlant's force_limit, c1, c2 set them)",
+        UserWarning,
+        stacklevel=2,
+    )
 
 
 @dataclass(slots=True)
@@ -157,9 +191,13 @@ class ThesisPlant:
 
     Args:
         robot: geometry and masses (``Robot().with_payload(3.0)`` in the benchmark).
-        c1: translational damping (N s/m); c2: rotational damping (N m s/rad).
-        force_limit: per-wheel force limit (N).
-        joint_speed: maximum joint speed of the arm servo (rad/s).
+        c1: translational damping (N s/m); c2: rotational damping (N m s/rad); the
+            thesis model's 15 and 4 by default, for any robot.
+        force_limit: per-wheel force limit (N); None: the thesis robot's 10 N, with a
+            warning (:func:`warn_borrowed_constants`) if ``robot``'s wheel drive is
+            another.
+        joint_speed: maximum joint speed of the arm servo (rad/s); None: the robot's
+            ``joint_speed_limit``.
         velocity_bandwidth: bandwidth of the velocity servo for velocity commands (1/s).
 
     Extra time-series columns: the wheel forces applied over the step that starts at the
@@ -173,14 +211,19 @@ class ThesisPlant:
         robot: Robot,
         c1: float = C1_DEFAULT,
         c2: float = C2_DEFAULT,
-        force_limit: float = FORCE_LIMIT_DEFAULT,
-        joint_speed: float = JOINT_SPEED_DEFAULT,
+        force_limit: float | None = None,
+        joint_speed: float | None = None,
         velocity_bandwidth: float = VELOCITY_BANDWIDTH,
     ) -> None:
         self.robot = robot
         self.c1 = check_positive("c1", c1)
         self.c2 = check_positive("c2", c2)
+        if force_limit is None:
+            warn_borrowed_constants(robot, self.c1, self.c2)
+            force_limit = FORCE_LIMIT_DEFAULT
         self.force_limit = check_positive("force_limit", force_limit)
+        if joint_speed is None:
+            joint_speed = robot.joint_speed_limit
         self.joint_speed = check_positive("joint_speed", joint_speed)
         self.mass = robot.total_mass
         self._yaw_inertia = robot.yaw_inertia.at

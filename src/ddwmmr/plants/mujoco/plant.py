@@ -211,9 +211,8 @@ class MujocoPlant:
     @property
     def wheel_force_limit(self) -> float:
         """Largest traction force of each wheel (N): the motor's torque limit over the wheel
-        radius, ``wheel_torque_limit / wheel_radius`` (a force command beyond it is
-        clipped)."""
-        return self.robot.wheel_torque_limit / self.robot.wheel_radius
+        radius, the robot's ``motor_force_limit`` (a force command beyond it is clipped)."""
+        return self.robot.motor_force_limit
 
     @property
     def wheel_lever(self) -> float:
