@@ -226,7 +226,7 @@ def _stability_line(items: Sequence[Profile]) -> str:
         parts.append(", ".join(f"`{p.method}` (S >= {fmt(p.stability_floor)})" for p in kept))
     if broken:
         texts = ", ".join(_broken_floor_text(p) for p in broken)
-        verb = "enforces" if len(broken) == 1 else "enforce"
+        verb = _agree(broken, "enforces", "enforce")
         parts.append(f"{texts} {verb} a floor but did not keep it in these runs")
     return label + "; ".join([*parts, "no other compared method constrains S."])
 
@@ -275,12 +275,25 @@ def _singularity_line(items: Sequence[Profile]) -> str:
     text = "**Near the shoulder singularity cos th1 = 0**: "
     parts = []
     if passes:
-        parts.append(f"{_names(passes)} pass it and keep the path")
+        parts.append(
+            f"{_names(passes)} {_agree(passes, 'passes', 'pass')} it and "
+            f"{_agree(passes, 'keeps', 'keep')} the path"
+        )
     if away:
-        parts.append(f"{_names(away)} stay away from it on these trajectories")
+        parts.append(
+            f"{_names(away)} {_agree(away, 'stays', 'stay')} away from it on these trajectories"
+        )
     if lost:
-        parts.append(f"avoid {_names(lost)}: they are driven into it and lose the path")
+        parts.append(
+            f"avoid {_names(lost)}: {_agree(lost, 'it is', 'they are')} driven into it "
+            f"and {_agree(lost, 'loses', 'lose')} the path"
+        )
     return text + "; ".join(parts) + "."
+
+
+def _agree(methods: Sequence[str], one: str, several: str) -> str:
+    """``one`` (singular verb form) for a single method, else ``several``."""
+    return one if len(methods) == 1 else several
 
 
 def _names(methods: Sequence[str]) -> str:
