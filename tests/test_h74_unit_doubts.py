@@ -114,5 +114,5 @@ def test_a_payload_alone_keeps_its_message():
     message = tipping_message(Robot(payload=30.0), [0.0] * 5, start="--offset")
     assert message == (
         "payload: a 30 kg payload tips the robot over in this run's start pose "
-        "(S = 0.468 <= 1); lighten the payload or change --offset"
+        "(S = 0.468 <= 1), which holds at most 4.764 kg; lighten the payload or change --offset"
     )

@@ -22,7 +22,7 @@ from ddwmmr.bench.report import (
 )
 from ddwmmr.bench.run import MAX_CALLS, MAX_REPEATS, check_duration, run_benchmark
 from ddwmmr.bench.scenarios import SCENARIO_CONTROLLERS, SCENARIO_COUNT
-from ddwmmr.cli.common import ArgumentParser, run_main
+from ddwmmr.cli.common import ArgumentParser, RefusedOption, run_main
 from ddwmmr.controllers.base import available_methods
 from ddwmmr.errors import MAX_JOBS, MAX_SCENARIOS, MAX_STEPS, ParameterError
 from ddwmmr.trajectories import Ellipse
@@ -155,6 +155,12 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="N",
         help=f"worker processes of the scenario timing (default: the CPUs available; at most "
         f"{MAX_JOBS}, and never more than the scenarios)",
+    )
+    parser.add_argument(
+        "--robot",
+        action=RefusedOption,
+        reason="the benchmark times the thesis robot only, as the scenario benchmark runs "
+        'it (docs/thesis.md, "What is simulated")',
     )
     parser.add_argument("--json", action="store_true", help="print the report as JSON")
     parser.add_argument("--no-progress", action="store_true", help="no progress output on stderr")

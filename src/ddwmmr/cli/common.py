@@ -254,6 +254,21 @@ def run_script(main: Callable[..., object], *arguments: str) -> NoReturn:
     sys.exit(run_main(lambda _argv: main(*arguments) or 0, None))
 
 
+class RefusedOption(argparse.Action):
+    """An option a tool does not have though another tool does (``--robot``): refused
+    with one line saying why (``reason``), exit status 2, instead of as a misspelling.
+    Hidden from ``--help``; takes an optional value so that ``--robot FILE`` is one
+    refusal."""
+
+    def __init__(self, option_strings: Sequence[str], dest: str, reason: str, **kwargs) -> None:
+        super().__init__(option_strings, dest, nargs="?", help=argparse.SUPPRESS, **kwargs)
+        self.reason = reason
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        """Refuse the option: ``parser.error`` exits with status 2."""
+        parser.error(f"{option_string}: {self.reason}")
+
+
 def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
     """``--robot FILE`` and ``--payload KG``."""
     parser.add_argument(

@@ -33,6 +33,7 @@ from ddwmmr.arbiters import DEFAULT_ARBITER, arbiter_description, available_arbi
 from ddwmmr.arbiters.state_machine import THESIS_MANIPULABILITY, THESIS_STABILITY
 from ddwmmr.cli.common import (
     ArgumentParser,
+    RefusedOption,
     add_force_argument,
     add_option_argument,
     check_output_folder,
@@ -142,6 +143,13 @@ def _options_epilog() -> str:
     )
 
 
+#: Why ``--robot`` is refused here: the protocol runs the thesis robot
+#: (:mod:`ddwmmr.scenarios.protocol`), whose payload alone can be chosen.
+THESIS_ROBOT_ONLY = (
+    'the scenario benchmark runs the thesis robot only (docs/thesis.md, "What is simulated")'
+)
+
+
 def build_parser() -> ArgumentParser:
     """The ``python -m ddwmmr.scenarios`` argument parser."""
     parser = ArgumentParser(
@@ -211,6 +219,9 @@ def build_parser() -> ArgumentParser:
         metavar="KG",
         help="end-effector payload in kg, >= 0 and light enough that the start pose stands "
         "(S > 1) (default: 3.0; thesis: 1.25)",
+    )
+    parser.add_argument(
+        "--robot", action=RefusedOption, reason=f"{THESIS_ROBOT_ONLY}; use --payload"
     )
     parser.add_argument(
         "--stability",

@@ -37,11 +37,12 @@ are left out.)
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_finite
+from ddwmmr.errors import MASS_RANGE_KG, ParameterError, check_finite
 from ddwmmr.model.mass import total_mass
 
 #: Reported stability is capped here: a vanishing tipping moment gives an infinite ratio.
@@ -70,6 +71,34 @@ def check_stability_floor(value: float, name: str = "stability_min") -> float:
     if not valid_stability_floor(floor):
         raise ParameterError(f"{name} must be {allowed} (got {floor:g})")
     return floor
+
+
+#: How :func:`warn_start_below_floor`'s line begins (a filter for it:
+#: ``warnings.filterwarnings("ignore", message=BELOW_FLOOR_WARNING)``).
+BELOW_FLOOR_WARNING = "stability_min: the start pose has S = "
+
+
+def warn_start_below_floor(method: str, robot, q0, floor: float) -> None:
+    """Warn (:class:`UserWarning`, one line) when the controller ``method``, holding the
+    floor ``floor`` on S (``stability_min``), starts ``robot`` (a
+    :class:`~ddwmmr.model.Robot`) in a configuration ``q0`` (``[x, y, phi, th1, th2]``, m
+    and rad) whose static S is below it: the run begins by breaking that constraint (the
+    ``mpc``'s verdict is "did not track", the ``qp``'s tracking yields until S is back
+    up). The line names S, the floor and a floor just below S. A start with S <= 1 has
+    tipped over and is warned about (or refused) as such instead
+    (:func:`ddwmmr.sim.simulate.tipping_message`)."""
+    s = stability_terms(robot.com_coefficients, float(q0[3]), float(q0[4]))[2]
+    if not 1.0 < s < floor:
+        return
+    lower = math.floor(s * 100.0 - 1e-9) / 100.0  # strictly below s, as a short number
+    warnings.warn(
+        f"{BELOW_FLOOR_WARNING}{s:.4g}, below the {method}'s stability "
+        f"floor stability_min = {floor:g}, which the run starts by breaking; lower the floor "
+        f"(--option stability_min={lower:g}; scenarios: --qp-stability-min {lower:g}) or "
+        f"start where S >= {floor:g}",
+        UserWarning,
+        stacklevel=3,
+    )
 
 
 @dataclass(frozen=True)
@@ -131,6 +160,34 @@ def tips_in_every_pose(k: ComCoefficients) -> bool:
     is closer than its half-diagonal. A sufficient test, not a necessary one: False does
     not promise that some pose stands."""
     return abs(k.A - k.B) >= math.hypot(k.half_length, k.half_width)
+
+
+def max_payload(robot, th1: float, th2: float) -> float:
+    """The heaviest payload (kg) with which ``robot`` (a :class:`~ddwmmr.model.Robot`)
+    stands (static S > 1) with its arm at ``th1``, ``th2`` (rad), rounded down to the gram
+    so that the payload it names stands: 0 where the robot tips even unloaded, the top of
+    :data:`~ddwmmr.errors.MASS_RANGE_KG` where it stands with that.
+
+    As the payload ``p`` grows the centre of mass moves along a line toward the end
+    effector, each coordinate ``(first moment + p e) / (M + p)`` monotonic in ``p``: the
+    payloads that stand are one interval from 0, whose end a bisection finds."""
+
+    def stands(payload: float) -> bool:
+        k = robot.with_payload(payload).com_coefficients
+        return stability_terms(k, th1, th2)[2] > 1.0
+
+    low, high = 0.0, MASS_RANGE_KG[1]
+    if not stands(low):
+        return 0.0
+    if stands(high):
+        return high
+    for _ in range(80):
+        middle = 0.5 * (low + high)
+        if stands(middle):
+            low = middle
+        else:
+            high = middle
+    return math.floor(low * 1e3) / 1e3
 
 
 def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[float, float, float]:

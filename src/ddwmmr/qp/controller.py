@@ -60,7 +60,7 @@ from ddwmmr.controllers.inputs import check_inputs, check_start
 from ddwmmr.errors import ParameterError, check_bool, check_nonnegative, check_positive, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import whole_turns
-from ddwmmr.model.stability import STABILITY_FLOOR
+from ddwmmr.model.stability import STABILITY_FLOOR, warn_start_below_floor
 from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, check_min_edge_load
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits import (
@@ -321,6 +321,7 @@ class QPController:
         ``q0``: the start configuration, 5 finite numbers ``[x, y, phi, th1, th2]`` (m,
         rad), else :class:`ParameterError` naming ``q0``."""
         start = check_start(q0)
+        warn_start_below_floor("qp", self.robot, start, self.stability_min)
         self.ctx.dt = control_step(self._dt_option, self._loop_step, trajectory, DEFAULT_DT)
         self.backend.reset()
         self.ctx.previous_command = None

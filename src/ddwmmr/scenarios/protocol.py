@@ -76,6 +76,7 @@ from ddwmmr.model import Robot
 from ddwmmr.model.stability import (
     STABILITY_CAP,
     STABILITY_FLOOR,
+    max_payload,
     stability_terms,
     valid_stability_floor,
 )
@@ -284,21 +285,15 @@ def check_start_pose(payload: float) -> None:
     if s <= 1.0:
         raise ParameterError(
             f"payload: {payload:g} kg tips the robot over in the start pose (S = {s:.3g} <= 1); "
-            f"the start pose holds at most {math.floor(max_start_payload() * 1e3) / 1e3:g} kg"
+            f"the start pose holds at most {max_start_payload():.10g} kg"
         )
 
 
 def max_start_payload() -> float:
-    """Largest payload (kg) with S > 1 in the start pose (bisection; S falls with payload)."""
-    low, high = 0.0, MASS_RANGE_KG[1]
-    for _ in range(80):
-        middle = 0.5 * (low + high)
-        robot = Robot().with_payload(middle)
-        if robot.stability((0.0, 0.0, 0.0, *default_pose(robot)))[2] > 1.0:
-            low = middle
-        else:
-            high = middle
-    return low
+    """The heaviest payload (kg, rounded down to the gram) with S > 1 in the scenarios'
+    start pose (:func:`~ddwmmr.model.stability.max_payload` of the default robot)."""
+    robot = Robot()
+    return max_payload(robot, *default_pose(robot))
 
 
 def check_qp_option(name: str, value: float) -> float:

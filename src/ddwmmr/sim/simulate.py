@@ -28,7 +28,7 @@ from ddwmmr.errors import (
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.model.robot import long_lengths
-from ddwmmr.model.stability import tips_in_every_pose
+from ddwmmr.model.stability import max_payload, tips_in_every_pose
 from ddwmmr.plants import available_plants, make_plant, plant_class
 from ddwmmr.plants.base import Plant
 from ddwmmr.registry import CONTROLLERS
@@ -155,8 +155,9 @@ def tipping_message(
 ) -> str | None:
     """None if the robot stands in configuration ``q`` (static S > 1), else the one line
     saying that it has tipped over, naming S and the cause (see :func:`check_start` for
-    ``name`` and ``start``): the payload where the robot would stand without it, else the
-    arm's reach against the base, and lengths that look like millimetres
+    ``name`` and ``start``): the payload where the robot would stand without it (with the
+    heaviest the pose holds, :func:`~ddwmmr.model.stability.max_payload`), else the arm's
+    reach against the base, and lengths that look like millimetres
     (:func:`~ddwmmr.model.robot.long_lengths`). The one wording of the tools' refusal and
     the API's warning."""
     s = start_stability(robot, q)
@@ -166,9 +167,10 @@ def tipping_message(
     doubt = f"; its lengths may be in millimetres ({', '.join(lengths)})" if lengths else ""
     unloaded = robot.with_payload(0.0) if robot.payload > 0.0 else robot
     if unloaded is not robot and start_stability(unloaded, q) > 1.0:
+        held = max_payload(robot, float(q[3]), float(q[4]))
         return (
             f"{name}: a {robot.payload:g} kg payload tips the robot over in this run's start "
-            f"pose (S = {s:.3g} <= 1); lighten the payload"
+            f"pose (S = {s:.3g} <= 1), which holds at most {held:.10g} kg; lighten the payload"
             + ("" if start is None else f" or change {start}")
             + doubt
         )
