@@ -436,9 +436,14 @@ def plant_integrator(plant: str, integrator: str | None) -> str | None:
 #: taken: the last sample alone can sit on a transient (the rectangle ends on a corner).
 FINAL_WINDOW_FRACTION = 0.05
 #: A wheel within this share of ``wheel_speed_limit`` is at its limit
-#: (``wheel_limit_steps``): the qp and the mpc bound the wheels a hair inside the limit
-#: (1e-6 of it), and the mpc's real-time iteration ends within 1e-3 of its bound.
+#: (``wheel_limit_steps``), and a joint rate within it of ``joint_speed_limit`` at its
+#: own (``joint_rate_limit_steps``): the qp and the mpc bound the rates a hair inside the
+#: limit (1e-6 of it), and the mpc's real-time iteration ends within 1e-3 of its bound.
 WHEEL_LIMIT_TOLERANCE = 1e-3
+#: A joint angle within this (rad) of an end of its ``joint_limits`` range, or beyond it,
+#: is at that position limit (``joint_limit_steps``): the plants clamp a joint to the
+#: limit itself, up to rounding.
+JOINT_LIMIT_TOLERANCE_RAD = 1e-6
 
 
 def summarize(
@@ -462,6 +467,13 @@ def summarize(
     (the wheel speeds of :func:`~ddwmmr.sim.tracking.derive_columns`): a limit held,
     whether the plant clipped the command (``saturated_steps`` counts those too) or a
     controller kept it within the limit itself (the qp's and the mpc's bounds).
+    ``joint_rate_limit_steps`` counts the steps with a joint rate (``th1dot``, ``th2dot``,
+    the commands applied) within that share of ``robot.joint_speed_limit``, the same way.
+    ``joint_limit_steps`` counts the steps with a joint angle at a position limit of
+    ``robot.joint_limits`` (within :data:`JOINT_LIMIT_TOLERANCE_RAD`), and
+    ``joint_limit_held`` names the limit held on most of them (``"th2 = 0.3 rad"``; None
+    where none was): ``saturated_steps`` counts a step the plant stopped a joint at its
+    limit just as one it clipped at a rate limit, which these tell apart.
     """
     position = ts["position_error_m"]
     orientation = ts["orientation_error_rad"]
@@ -473,6 +485,9 @@ def summarize(
     window = settled[-max(1, round(FINAL_WINDOW_FRACTION * len(settled))) :]
     wheel_speed = np.maximum(np.abs(ts["wheel_left_rad_s"]), np.abs(ts["wheel_right_rad_s"]))
     at_wheel_limit = wheel_speed >= robot.wheel_speed_limit * (1.0 - WHEEL_LIMIT_TOLERANCE)
+    joint_rate = np.maximum(np.abs(ts["th1dot"]), np.abs(ts["th2dot"]))
+    at_rate_limit = joint_rate >= robot.joint_speed_limit * (1.0 - WHEEL_LIMIT_TOLERANCE)
+    at_joint_limit, held = joint_limits_held(ts, robot)
     return {
         "rms_position_error_m": float(np.sqrt(np.mean(position**2))),
         "max_position_error_m": float(np.max(position)),
@@ -491,10 +506,33 @@ def summarize(
         "singular_steps": int(np.sum(commanded_steps(ts["singular"]))),
         "saturated_steps": int(np.sum(commanded_steps(ts["saturated"]))),
         "wheel_limit_steps": int(np.sum(commanded_steps(at_wheel_limit))),
+        "joint_rate_limit_steps": int(np.sum(commanded_steps(at_rate_limit))),
+        "joint_limit_steps": int(np.sum(commanded_steps(at_joint_limit))),
+        "joint_limit_held": held,
         "fallback_steps": int(np.sum(commanded_steps(ts["fallback"]))),
         "max_condition_number": max_condition_number(robot, q),
         "median_step_us": float(np.median(ts["step_us"])),
     }
+
+
+def joint_limits_held(ts: dict[str, np.ndarray], robot: Robot) -> tuple[np.ndarray, str | None]:
+    """Per sample, whether a joint angle (``th1``, ``th2``, rad) is at a position limit
+    of ``robot.joint_limits`` (within :data:`JOINT_LIMIT_TOLERANCE_RAD`, or beyond), and
+    the limit held on most of the commanded steps in words (``"th2 = 0.3 rad"``), None
+    where no joint reached one."""
+    at_any = np.zeros(len(ts["th1"]), dtype=bool)
+    most, held = 0, None
+    for name, (low, high) in zip(("th1", "th2"), robot.joint_limits, strict=True):
+        angle = ts[name]
+        for bound, at in (
+            (low, angle <= low + JOINT_LIMIT_TOLERANCE_RAD),
+            (high, angle >= high - JOINT_LIMIT_TOLERANCE_RAD),
+        ):
+            at_any |= at
+            count = int(np.sum(commanded_steps(at)))
+            if count > most:
+                most, held = count, f"{name} = {bound:.4g} rad"
+    return at_any, held
 
 
 #: Samples of one trajectory duration over which :func:`trajectory_extent` takes its size.

@@ -15,6 +15,10 @@ A run did not track when any of these holds (thresholds documented in docs/cli.m
 * ``tipped_over``: a physics plant recorded the robot tipping over;
 * ``tipped_at_start``: the robot had already tipped over in the start pose (static
   S <= 1, ``start_tipped``; the command-line tools refuse such a run, the API warns);
+* ``stability_below_1``: on a plant that does not judge tipping over itself (no
+  ``tipped`` in the summary: the kinematic and thesis plants), the static stability margin
+  fell to S <= 1 during the run (``min_stability``), where a real robot would have tipped
+  over; a start already tipped is ``tipped_at_start`` alone;
 * ``below_floor_at_start``: an ``mpc`` run (``mpc_fallbacks`` in the summary) started
   below its own stability floor (``start_stability`` < ``stability_min``): its plans
   broke their hard constraint from the first step, however well it tracked after;
@@ -38,13 +42,21 @@ start below the floor, solver fallbacks), commands clipped on more than
 give, before anything the arm did (a singularity, a fold), which follows from it. An
 obstacle-avoiding controller (``qp``, ``mpc``: a ``min_obstacle_clearance_m``) whose base
 came within :data:`OBSTACLE_NEAR_M` of an obstacle, with no other cause in sight, is named
-as having left the trajectory to go round it. A run that held a limit the commands' clipping
-(``saturated_steps``) does not count, for more than :data:`HELD_CAUSE` of the run (a
-wheel at its speed limit: ``wheel_limit_steps``; an actuator at its limit on a plant with
-dynamics: ``actuator_saturated_time_s``), with no other cause in sight, names that limit.
-A run that failed on its RMS error alone, whose error never rose above its start offset
-(``max_position_error_m``), converged: the time it took to remove the offset is named,
-as on a short run or a held point (whose limit is :data:`EXTENT_LIMIT_FLOOR_M`).
+as having left the trajectory to go round it. A run that would have tipped over
+(``stability_below_1``) names that first, as a physics plant's tipping is. Saturation whose
+clipped steps were mostly a joint held at a position limit (``joint_limit_steps``), not a
+rate limit, names that joint limit instead. A run that held a rate limit for more than
+:data:`HELD_CAUSE` of the run (a wheel at its speed limit: ``wheel_limit_steps``; a joint
+at its rate limit: ``joint_rate_limit_steps``; an actuator at its limit on a plant with
+dynamics: ``actuator_saturated_time_s``), with no other cause in sight, names that limit,
+and says whether the plant's clipping (``saturated_steps``) counted it. A run that failed
+on its RMS error alone (its final error within the limit) converged: if the error rose
+above its start offset (``max_position_error_m``) while a limit was held, the transient (at the
+corners, where the trajectory has them) is named with the limits held; if it never rose
+above its start offset, the time it took to remove the offset is named, as on a short run
+or a held point (whose limit is :data:`EXTENT_LIMIT_FLOOR_M`). A joint held at a position
+limit for more than :data:`HELD_CAUSE` of a run that did not converge names that joint
+limit.
 """
 
 from __future__ import annotations
@@ -121,6 +133,7 @@ REASONS = {
     "diverged": "the plant diverged",
     "tipped_over": "the robot tipped over (physics)",
     "tipped_at_start": "the robot tips over in its start pose (S = {start_stability:.3g})",
+    "stability_below_1": "the robot would have tipped over (min S = {min_stability:.3g})",
     "below_floor_at_start": (
         "the mpc started below its stability floor (start S = {start_text} < stability_min "
         "{floor_text}), breaking its constraint from the first step"
@@ -212,8 +225,25 @@ QP_FALLBACK = (
 )
 HELD_LIMIT = (
     "the robot ran at a limit ({held}), where it cannot follow the trajectory any faster "
-    "(the commands' clipping, saturated_steps, does not count it): a slower trajectory, a "
-    'smaller dt or a higher limit (see docs/cli.md, "Verdict")'
+    "({clipping}){transient}: a slower trajectory, a smaller dt or a higher limit "
+    '(see docs/cli.md, "Verdict")'
+)
+#: :data:`HELD_LIMIT`'s words on ``saturated_steps``: none
+#: clipped (the controller's own bounds or the plant's dynamics held the limit) ...
+NOT_CLIPPED = "the commands' clipping, saturated_steps, does not count it"
+#: ... or the plant clipped the commands on some steps (at a rate limit, or a joint stopped
+#: at a position limit).
+CLIPPED = "the plant clipped the commands on {saturated_steps} of {steps} steps, saturated_steps"
+#: :data:`HELD_LIMIT`'s words on a run that converged after the transient at the limit.
+HELD_TRANSIENT = (
+    "; the error converged after it (final {final_mm:.3g} mm, within the limit), but the "
+    "transient, up to {peak_mm:.3g} mm {where}, counts in the RMS"
+)
+JOINT_LIMIT = (
+    "the arm held at a joint limit ({joint}) on {joint_steps} of {steps} steps, where the "
+    "plant stops the joint and the end effector cannot reach the poses the trajectory asks "
+    "for ({clipping}): a trajectory the arm reaches within its joint_limits, or wider "
+    'joint_limits (see docs/cli.md, "Verdict")'
 )
 #: How :data:`HELD_LIMIT` names ``actuator_saturated_time_s``, by the summary's ``plant``.
 ACTUATOR_LIMITS = {"thesis": "a wheel at its force limit", "mujoco": "a motor at its torque limit"}
@@ -221,6 +251,14 @@ TIPPED = (
     "the payload or the accelerations put the centre of pressure outside the wheels: a "
     "lighter payload, another start pose or a stability floor (stability_min; see "
     'docs/physics.md, "Tip-over from the contact forces")'
+)
+
+
+WOULD_TIP = (
+    "the arm's reach and the payload put the centre of mass outside the wheels (static "
+    "S <= 1), where a real robot tips over; this plant does not simulate tipping and ran "
+    "on: a lighter payload, a trajectory nearer the base or a stability floor (qp's or "
+    'mpc\'s stability_min; see docs/cli.md, "Verdict")'
 )
 
 
@@ -247,6 +285,9 @@ NUMBER_KEYS = (
     "singular_steps",
     "saturated_steps",
     "wheel_limit_steps",
+    "joint_rate_limit_steps",
+    "joint_limit_steps",
+    "min_stability",
     "actuator_saturated_time_s",
     "duration",
     "trajectory_extent_m",
@@ -339,6 +380,8 @@ def reasons(summary: Mapping[str, Any]) -> list[str]:
         found.append("tipped_over")
     if summary.get("start_tipped"):
         found.append("tipped_at_start")
+    elif _would_have_tipped(summary):
+        found.append("stability_below_1")
     if _number(summary, "mpc_fallbacks") is not None and _started_below_floor(summary):
         found.append("below_floor_at_start")
     clearance = _number(summary, "min_obstacle_clearance_m")  # None: no obstacles
@@ -357,6 +400,15 @@ def reasons(summary: Mapping[str, Any]) -> list[str]:
     return found
 
 
+def _would_have_tipped(summary: Mapping[str, Any]) -> bool:
+    """The static stability margin fell to S <= 1 (``min_stability``) on a plant that does
+    not judge tipping over itself (no ``tipped`` key: a physics plant's own flag rules)."""
+    if "tipped" in summary:
+        return False
+    least = _number(summary, "min_stability")
+    return least is not None and least <= 1.0
+
+
 def _above(value: float | None, limit: float) -> bool:
     """``value`` exceeds ``limit``; NaN (a run that blew up) counts as above."""
     if value is None:
@@ -371,6 +423,8 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return DIVERGED
     if "tipped_over" in found or "tipped_at_start" in found:
         return TIPPED
+    if "stability_below_1" in found:
+        return WOULD_TIP
     if "collided" in found:
         return COLLIDED
     if _started_below_floor(summary):
@@ -383,7 +437,7 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     fallbacks = _number(summary, "mpc_fallbacks") or 0
     if steps and fallbacks > MOST_OF_RUN * steps:
         return MPC_FALLBACK.format(mpc_fallbacks=int(fallbacks), steps=int(steps))
-    if steps and (_number(summary, "saturated_steps") or 0) > SATURATED_CAUSE * steps:
+    if steps and _rate_clipped_steps(summary) > SATURATED_CAUSE * steps:
         return SATURATED_THROUGHOUT
     return _arm_or_path_cause(summary, found)
 
@@ -399,22 +453,121 @@ def _arm_or_path_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     if min_manipulability is not None and min_manipulability < 1e-6:
         return _folded_arm(summary.get("method"))
     if "saturated_most_of_run" in found:
-        return SATURATION
+        return SATURATION if _rate_clipped_steps(summary) > MOST_OF_RUN * steps else _joint(summary)
     clearance = _number(summary, "min_obstacle_clearance_m")  # None: no obstacles
     if clearance is not None and clearance < OBSTACLE_NEAR_M:
         return OBSTACLE_DETOUR.format(
             clearance_mm=1000.0 * clearance, near_mm=1000.0 * OBSTACLE_NEAR_M
         )
+    return _held_or_converging_cause(summary, found)
+
+
+def _held_or_converging_cause(summary: Mapping[str, Any], found: list[str]) -> str:
+    """The rest of :func:`_arm_or_path_cause`: a transient at a limit of a run that
+    converged, a rate limit held, the start offset, a joint limit held, else no
+    convergence."""
     held = held_limits(summary)
+    joint = _joint_limit_phrase(summary)
+    transient = held + ([joint] if joint else [])
+    if transient and _converged_after_a_transient(summary, found):
+        return _held_limit(summary, transient, _transient_text(summary))
     if held:
-        return HELD_LIMIT.format(held=" and ".join(held))
+        return _held_limit(summary, held, "")
     if _only_the_start_offset(summary, found):
         return START_TRANSIENT.format(
             final_mm=1000.0 * (_number(summary, "final_position_error_m") or 0.0),
             offset_mm=1000.0 * (_number(summary, "initial_offset_m") or 0.0),
             duration=_duration_text(summary),
         )
+    if joint:
+        return _joint(summary)
     return NO_CONVERGENCE
+
+
+def _rate_clipped_steps(summary: Mapping[str, Any]) -> float:
+    """The least number of steps clipped at a rate limit, where a joint held at a position
+    limit may explain the rest: the steps with a wheel or a joint at its rate limit
+    (``wheel_limit_steps``, ``joint_rate_limit_steps``), or ``saturated_steps`` less the
+    steps with a joint at a position limit (``joint_limit_steps``), whichever is more."""
+    clipped = _number(summary, "saturated_steps") or 0
+    return max(
+        clipped - (_number(summary, "joint_limit_steps") or 0),
+        _number(summary, "wheel_limit_steps") or 0,
+        _number(summary, "joint_rate_limit_steps") or 0,
+    )
+
+
+def _clipping(summary: Mapping[str, Any]) -> str:
+    """What ``saturated_steps`` says of the limits held: :data:`NOT_CLIPPED` where the
+    plant clipped no command, else :data:`CLIPPED` with its count."""
+    clipped = _number(summary, "saturated_steps") or 0
+    if not clipped > 0:
+        return NOT_CLIPPED
+    steps = _number(summary, "steps") or 0
+    return CLIPPED.format(saturated_steps=int(clipped), steps=int(steps))
+
+
+def _joint_limit_phrase(summary: Mapping[str, Any]) -> str | None:
+    """``"the arm at a joint limit (th2 = 0.3 rad) on 207 of 750 steps"`` where a joint
+    was at a position limit for more than :data:`HELD_CAUSE` of the steps, else None."""
+    steps = _number(summary, "steps") or 0
+    at_limit = _number(summary, "joint_limit_steps") or 0
+    if not (steps and at_limit > HELD_CAUSE * steps):
+        return None
+    where = _joint_name(summary)
+    return f"the arm at a joint limit ({where}) on {int(at_limit)} of {int(steps)} steps"
+
+
+def _joint_name(summary: Mapping[str, Any]) -> str:
+    """The summary's ``joint_limit_held`` on one line, ``"a joint"`` where it has none."""
+    held = summary.get("joint_limit_held")
+    return "a joint" if held is None else one_line(str(held), 40)
+
+
+def _joint(summary: Mapping[str, Any]) -> str:
+    """:data:`JOINT_LIMIT` for the summary's joint limit held."""
+    return JOINT_LIMIT.format(
+        joint=_joint_name(summary),
+        joint_steps=int(_number(summary, "joint_limit_steps") or 0),
+        steps=int(_number(summary, "steps") or 0),
+        clipping=_clipping(summary),
+    )
+
+
+def _converged_after_a_transient(summary: Mapping[str, Any], found: list[str]) -> bool:
+    """Only the RMS error failed, and the error rose above its start offset on the way
+    (``max_position_error_m`` beyond :data:`START_SLACK` of ``initial_offset_m``): the
+    run converged, and its RMS counts a transient on the way."""
+    if found != ["rms_error_above_limit"]:
+        return False
+    largest = _number(summary, "max_position_error_m")
+    offset = _number(summary, "initial_offset_m") or 0.0
+    return largest is not None and largest > offset * (1.0 + START_SLACK)
+
+
+def _held_limit(summary: Mapping[str, Any], held: list[str], transient: str) -> str:
+    """:data:`HELD_LIMIT` naming the limits ``held``, with the words on
+    ``saturated_steps`` true of this run and ``transient`` (``""`` or
+    :func:`_transient_text`) after them."""
+    return HELD_LIMIT.format(
+        held=" and ".join(held), clipping=_clipping(summary), transient=transient
+    )
+
+
+def _transient_text(summary: Mapping[str, Any]) -> str:
+    """:data:`HELD_TRANSIENT` for the summary: the final error, and the largest one with
+    where it was: at a corner where the summary's corner error is it, else during the
+    run."""
+    corner = _number(summary, "corner_position_error_m")
+    peak = _number(summary, "max_position_error_m") or 0.0
+    where = "during the run"
+    if corner is not None and corner >= peak * (1.0 - START_SLACK):
+        where = "at a corner"
+    return HELD_TRANSIENT.format(
+        final_mm=1000.0 * (_number(summary, "final_position_error_m") or 0.0),
+        peak_mm=1000.0 * peak,
+        where=where,
+    )
 
 
 def _duration_text(summary: Mapping[str, Any]) -> str:
@@ -449,10 +602,13 @@ def _folded_arm(method: Any) -> str:
 
 
 def held_limits(summary: Mapping[str, Any]) -> list[str]:
-    """The limits the run held for more than :data:`HELD_CAUSE` of it, in words (``"a
-    wheel at its speed limit on 342 of 400 steps"``, ``"a wheel at its force limit for
-    7.38 of 40 s"``), from ``wheel_limit_steps`` of ``steps`` and
-    ``actuator_saturated_time_s`` of ``duration``; empty where neither is recorded."""
+    """The rate and actuator limits the run held for more than :data:`HELD_CAUSE` of it,
+    in words (``"a wheel at its speed limit on 342 of 400 steps"``, ``"a joint at its rate
+    limit on 250 of 750 steps"``, ``"a wheel at its force limit for 7.38 of 40 s"``), from
+    ``wheel_limit_steps`` of ``steps``, ``actuator_saturated_time_s`` of ``duration`` and
+    ``joint_rate_limit_steps`` of ``steps``, in that order; empty where none is recorded. A joint
+    at a position limit (``joint_limit_steps``) is not among them: it is a pose the arm
+    cannot reach, not a speed it cannot exceed."""
     check_summary(summary)
     held = []
     steps = _number(summary, "steps") or 0
@@ -464,6 +620,9 @@ def held_limits(summary: Mapping[str, Any]) -> list[str]:
     if duration > 0.0 and at_actuator_limit > HELD_CAUSE * duration:
         what = ACTUATOR_LIMITS.get(str(summary.get("plant")), "an actuator at its limit")
         held.append(f"{what} for {at_actuator_limit:.3g} of {duration:.3g} s")
+    at_rate_limit = _number(summary, "joint_rate_limit_steps") or 0
+    if steps and at_rate_limit > HELD_CAUSE * steps:
+        held.append(f"a joint at its rate limit on {int(at_rate_limit)} of {int(steps)} steps")
     return held
 
 
@@ -486,6 +645,7 @@ def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
     if not found:
         return found, "", ""
     start_stability = _number(summary, "start_stability")
+    least_stability = _number(summary, "min_stability")
     start_text, floor_text = _floor_texts(summary)
     values = {
         "steps": summary.get("steps"),
@@ -497,6 +657,7 @@ def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
         "start_text": start_text,
         "floor_text": floor_text,
         "start_stability": math.nan if start_stability is None else start_stability,
+        "min_stability": math.nan if least_stability is None else least_stability,
         "clearance_mm": 1000.0 * (_number(summary, "min_obstacle_clearance_m") or 0.0),
     }
     what = ", ".join(REASONS[code].format(**values) for code in found)
