@@ -328,10 +328,13 @@ def unwritable_message(label: str, name: str, folder: Path, existing: Path, erro
     return f"{label}: cannot make the folder {name}: {refusal}"
 
 
-def check_output_path(target: str | Path, what: str = "folder") -> Path:
+def check_output_path(target: str | Path, what: str = "folder", probe: bool = True) -> Path:
     """Refuse (one-line :class:`ParameterError`) an ``--out`` path that cannot be written:
     the current folder or a parent, a symbolic link (dangling too), a name too long, a
-    parent that is not a writable folder. Returns the absolute path (it may not exist)."""
+    parent that is not a writable folder. Returns the absolute path (it may not exist).
+    ``probe``: also try a file in the parent (:func:`check_writable`); a caller with
+    refusals of its own passes False and probes after them, so that a refused ``--out``
+    leaves even the parent's modification time alone."""
     text = str(target)
     if "\0" in text:
         raise ParameterError(f"out: the {what} name contains a NUL byte")
@@ -362,7 +365,8 @@ def check_output_path(target: str | Path, what: str = "folder") -> Path:
         raise ParameterError(f"out: {ancestor} is not a folder")
     if not os.access(ancestor, os.W_OK | os.X_OK):
         raise ParameterError(f"out: cannot write in {ancestor} (permission denied)")
-    check_writable("out", path.parent)  # what os.access does not show (root on /proc)
+    if probe:
+        check_writable("out", path.parent)  # what os.access does not show (root on /proc)
     return path
 
 
@@ -377,10 +381,17 @@ def check_output_folder(
     ``force``, a file or folder no manifest lists under one of them is refused here, before
     the run, rather than after it (the check after the run stays as the last guard).
     """
-    text = str(target)
-    path = check_output_path(target)
-    if not os.path.lexists(path):
-        return path
+    path = check_output_path(target, probe=False)
+    if os.path.lexists(path):
+        _check_existing_folder(path, str(target), tool, force, writes)
+    check_writable("out", path.parent)
+    return path
+
+
+def _check_existing_folder(
+    path: Path, text: str, tool: str, force: bool, writes: Sequence[str]
+) -> None:
+    """The refusals of :func:`check_output_folder` for an ``--out`` that exists."""
     if not path.is_dir():
         raise ParameterError(f"out: {text} exists and is not a folder; choose another --out")
     existing = inspect(path, tool)
@@ -391,7 +402,6 @@ def check_output_folder(
     if clash is not None:
         raise ParameterError(_clash(text, clash))
     _check_replaceable(path, text, existing)
-    return path
 
 
 def _clash(text: str, name: str) -> str:
@@ -409,7 +419,7 @@ def check_output_file(
     device, a FIFO or a socket never (:func:`check_file_target`), and that is said before
     anything that would suggest ``--force``."""
     text = str(target)
-    path = check_output_path(target, "file")
+    path = check_output_path(target, "file", probe=False)
     if path.is_dir():
         raise ParameterError(f"out: {text} is a folder; give a file name")
     check_file_target(text, "out")
@@ -417,6 +427,7 @@ def check_output_file(
         raise ParameterError(
             f"out: {text} exists and is not a {tool} report (use --force to replace it)"
         )
+    check_writable("out", path.parent)
     return path
 
 

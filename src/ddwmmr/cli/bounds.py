@@ -220,7 +220,7 @@ def _check_out(out: Path, force: bool) -> Path:
     """:func:`check_output_folder` for this tool's ``--out``: a folder another tool or the
     user made is refused with or without ``force`` (the cache needs a folder of its own),
     in words that do not offer ``--force``."""
-    path = check_output_path(out)
+    path = check_output_path(out, probe=False)  # check_output_folder probes, after
     if path.is_dir():
         existing = inspect(path, TOOL)
         if existing.kind == "foreign":

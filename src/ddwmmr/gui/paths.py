@@ -100,13 +100,14 @@ def check_snapshot_path(text: str, force: bool = False) -> Path:
     if not text:
         raise ParameterError("snapshot: the file name is empty; give e.g. --snapshot gui.png")
     try:
-        path = check_output_path(text, "file")
+        path = check_output_path(text, "file", probe=False)
     except ParameterError as exc:  # its messages name --out; this option is --snapshot
         raise ParameterError(f"snapshot: {str(exc).removeprefix('out: ')}") from None
     if path.is_dir():
         raise ParameterError(f"snapshot: {text} is a folder; give a file name such as gui.png")
     snapshot_format(text)
     check_existing_snapshot(path, text, force)
+    check_writable("snapshot", path.parent)
     return path
 
 
