@@ -104,3 +104,13 @@ def test_quickstart_says_when_a_method_did_not_track(
     # the limit: twice the initial offset |(-30, -30)| mm
     assert float(found[4]) == pytest.approx(2 * 1000 * 0.03 * 2**0.5, abs=0.01)
     assert "likely cause: the resolution drives the shoulder into its singularity" in verdict
+
+
+def test_run_script_exits_0_whatever_main_returns(tmp_path) -> None:
+    script = tmp_path / "returns.py"
+    script.write_text(
+        "from ddwmmr.cli.common import run_script\n"
+        "run_script(lambda: {'rms': 1.0})\n"  # a truthy return value is no exit status
+    )
+    done = run_python([str(script)], tmp_path)
+    assert done.returncode == 0 and done.stdout == "" and done.stderr == ""

@@ -76,3 +76,12 @@ def test_given_force_limit_is_used_without_warning():
     assert messages == []
     assert plant.force_limit == 150.0
     assert plant.velocity_envelope(1.0)["max_base_speed"] == pytest.approx(300.0 / 15.0)
+
+
+def test_given_damping_is_not_called_the_thesis_models():
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        ThesisPlant(BIG, c1=5.0, c2=1.0)
+    (message,) = [str(w.message) for w in caught]
+    assert "and the given damping c1 = 5 N s/m, c2 = 1 N m s/rad" in message
+    assert "thesis model's" not in message

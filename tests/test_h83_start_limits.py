@@ -92,13 +92,12 @@ START = np.array([0.0, 0.0, 0.0, *default_pose(HEAVY)])
 BELOW = (
     "stability_min: the start pose has S = 1.148, below the {method}'s stability floor "
     "stability_min = 1.25, which the run starts by breaking; lower the floor "
-    "(--option stability_min=1.14; scenarios: --qp-stability-min 1.14) or start where "
-    "S >= 1.25"
+    "(stability_min=1.14) or start where S >= 1.25"
 )
 
 
 @pytest.mark.parametrize("method", ["qp", "mpc"])
-def test_a_start_below_the_floor_is_warned_once_at_reset(method):
+def test_a_start_below_the_floor_is_warned_at_reset(method):
     controller = make_controller(method, HEAVY)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

@@ -432,15 +432,19 @@ def check_output_file(
 
 
 def _refusal(text: str, tool: str, existing: Existing) -> str:
-    if existing.tool is not None and existing.tool != tool:
-        what = f"was written by ddwmmr {existing.tool}, not {tool}"
-    else:
-        sample = ", ".join(existing.foreign[:2]) + (", ..." if len(existing.foreign) > 2 else "")
-        what = f"holds files no ddwmmr {tool} run wrote ({sample})"
     return (
-        f"out: {text} {what}; choose another --out, or add --force (deletes only files a "
-        "ddwmmr manifest lists)"
+        f"out: {text} {foreign_contents(tool, existing)}; choose another --out, or add "
+        "--force (deletes only files a ddwmmr manifest lists)"
     )
+
+
+def foreign_contents(tool: str, existing: Existing) -> str:
+    """What makes the folder ``existing`` describes no output of ``tool``, as a predicate
+    ("was written by ddwmmr scenarios, not bounds", "holds files no ... run wrote (...)")."""
+    if existing.tool is not None and existing.tool != tool:
+        return f"was written by ddwmmr {existing.tool}, not {tool}"
+    sample = ", ".join(existing.foreign[:2]) + (", ..." if len(existing.foreign) > 2 else "")
+    return f"holds files no ddwmmr {tool} run wrote ({sample})"
 
 
 # -- atomic files ------------------------------------------------------------------------

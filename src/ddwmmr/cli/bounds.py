@@ -39,6 +39,7 @@ from ddwmmr.outputs import (
     check_output_path,
     check_writable,
     first_free,
+    foreign_contents,
     inspect,
     list_in_manifest,
     write_atomic,
@@ -230,14 +231,10 @@ def _check_out(out: Path, force: bool) -> Path:
 
 def _foreign_refusal(out: Path, existing: Existing) -> str:
     """Why ``out`` cannot hold a bounds run, and what to do instead."""
-    if existing.tool is not None and existing.tool != TOOL:
-        what = f"was written by ddwmmr {existing.tool}, not {TOOL}"
-    else:
-        sample = ", ".join(existing.foreign[:2]) + (", ..." if len(existing.foreign) > 2 else "")
-        what = f"holds files no ddwmmr {TOOL} run wrote ({sample})"
     return (
-        f"out: {out} {what}; the bounds cache needs a folder of its own, so --force does "
-        "not help: choose another --out (a new folder or an earlier bounds run's)"
+        f"out: {out} {foreign_contents(TOOL, existing)}; the bounds cache needs a folder of "
+        "its own, so --force does not help: choose another --out (a new folder or an "
+        "earlier bounds run's)"
     )
 
 

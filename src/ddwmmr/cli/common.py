@@ -250,8 +250,13 @@ def run_script(main: Callable[..., object], *arguments: str) -> NoReturn:
     status 0 when it returns; a :class:`ParameterError` (a value the library refuses)
     gives one line ``error: ...`` on stderr and status 2, Ctrl-C status 130, a user's
     controller raising status 1, each without a traceback (:func:`run_main`). The
-    examples end with it."""
-    sys.exit(run_main(lambda _argv: main(*arguments) or 0, None))
+    examples end with it. What ``main`` returns is ignored."""
+
+    def call(_argv: Sequence[str] | None) -> int:
+        main(*arguments)
+        return 0
+
+    sys.exit(run_main(call, None))
 
 
 class RefusedOption(argparse.Action):

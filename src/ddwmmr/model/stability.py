@@ -73,11 +73,6 @@ def check_stability_floor(value: float, name: str = "stability_min") -> float:
     return floor
 
 
-#: How :func:`warn_start_below_floor`'s line begins (a filter for it:
-#: ``warnings.filterwarnings("ignore", message=BELOW_FLOOR_WARNING)``).
-BELOW_FLOOR_WARNING = "stability_min: the start pose has S = "
-
-
 def warn_start_below_floor(method: str, robot, q0, floor: float) -> None:
     """Warn (:class:`UserWarning`, one line) when the controller ``method``, holding the
     floor ``floor`` on S (``stability_min``), starts ``robot`` (a
@@ -92,10 +87,9 @@ def warn_start_below_floor(method: str, robot, q0, floor: float) -> None:
         return
     lower = math.floor(s * 100.0 - 1e-9) / 100.0  # strictly below s, as a short number
     warnings.warn(
-        f"{BELOW_FLOOR_WARNING}{s:.4g}, below the {method}'s stability "
+        f"stability_min: the start pose has S = {s:.4g}, below the {method}'s stability "
         f"floor stability_min = {floor:g}, which the run starts by breaking; lower the floor "
-        f"(--option stability_min={lower:g}; scenarios: --qp-stability-min {lower:g}) or "
-        f"start where S >= {floor:g}",
+        f"(stability_min={lower:g}) or start where S >= {floor:g}",
         UserWarning,
         stacklevel=3,
     )

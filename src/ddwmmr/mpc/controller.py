@@ -68,11 +68,7 @@ from ddwmmr.controllers.base import (
 from ddwmmr.controllers.inputs import check_inputs, check_start
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
-from ddwmmr.model.stability import (
-    BELOW_FLOOR_WARNING,
-    GRAVITY_M_S2,
-    warn_start_below_floor,
-)
+from ddwmmr.model.stability import GRAVITY_M_S2, warn_start_below_floor
 from ddwmmr.mpc.braking import braked_velocity, braking_input, should_brake
 from ddwmmr.mpc.fallback import fallback_input, make_fallback
 from ddwmmr.mpc.min_time import Guess, PlanProblem, plan_path, plan_problem
@@ -493,12 +489,9 @@ class MPCController:
         self.fallbacks += 1
         self._warm = None
         if self._fallback is None:
-            with warnings.catch_warnings():
-                # its reset is at a placeholder pose, not the run's start (warned at ours)
-                warnings.filterwarnings("ignore", BELOW_FLOOR_WARNING, UserWarning)
-                self._fallback = make_fallback(
-                    self.robot, self.options, self._trajectory, self.dt, self.dynamics
-                )
+            self._fallback = make_fallback(
+                self.robot, self.options, self._trajectory, self.dt, self.dynamics
+            )
         command, velocity = fallback_input(
             self._fallback, self.robot, self.dynamics, t, q, pose_d, velocity_d, x0
         )

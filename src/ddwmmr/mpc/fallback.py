@@ -41,7 +41,7 @@ def make_fallback(
         qp_options.update(dynamics.velocity_envelope())
     qp_options.update(options.fallback_options or {})
     qp = make_controller("qp", robot, **qp_options)
-    qp.reset(trajectory, np.zeros(5))
+    qp.reset(trajectory, np.zeros(5), warn_start=False)  # a placeholder, not a start
     return qp
 
 

@@ -79,14 +79,16 @@ def warn_borrowed_constants(robot: Robot, c1: float, c2: float) -> None:
     """Warn (a one-line :class:`UserWarning`, once per message under Python's default
     filter) when ``robot``'s wheel drive (``wheel_radius``, ``wheel_torque_limit``) is not
     the thesis robot's, so the thesis plant's default force limit (10 N per wheel) is not
-    its own; the damping c1, c2 (N s/m, N m s/rad; the thesis model's) are named with it."""
+    its own; the damping c1, c2 (N s/m, N m s/rad) are named with it, as the thesis
+    model's where they are its defaults."""
     if _wheel_drive(robot) == _THESIS_DRIVE:
         return
     motors = robot.motor_force_limit
+    whose = "the thesis model's" if (c1, c2) == (C1_DEFAULT, C2_DEFAULT) else "the given"
     warnings.warn(
         f"thesis plant: the robot runs with the thesis robot's wheel force limit "
         f"{FORCE_LIMIT_DEFAULT:g} N (its motors give wheel_torque_limit / wheel_radius = "
-        f"{motors:.4g} N) and the thesis model's damping c1 = {c1:g} N s/m, c2 = {c2:g} "
+        f"{motors:.4g} N) and {whose} damping c1 = {c1:g} N s/m, c2 = {c2:g} "
         "N m s/rad (ThesisPlant's force_limit, c1, c2 set them)",
         UserWarning,
         stacklevel=2,

@@ -315,13 +315,16 @@ class QPController:
         given as an option."""
         self._loop_step = dt
 
-    def reset(self, trajectory: Any, q0: np.ndarray) -> None:
+    def reset(self, trajectory: Any, q0: np.ndarray, *, warn_start: bool = True) -> None:
         """Forget warm starts and counters; take the look-ahead step (:func:`control_step`).
 
         ``q0``: the start configuration, 5 finite numbers ``[x, y, phi, th1, th2]`` (m,
-        rad), else :class:`ParameterError` naming ``q0``."""
+        rad), else :class:`ParameterError` naming ``q0``. ``warn_start``: warn of a start
+        below ``stability_min`` (:func:`~ddwmmr.model.stability.warn_start_below_floor`);
+        False where ``q0`` is no run's start (the ``mpc``'s backup qp)."""
         start = check_start(q0)
-        warn_start_below_floor("qp", self.robot, start, self.stability_min)
+        if warn_start:
+            warn_start_below_floor("qp", self.robot, start, self.stability_min)
         self.ctx.dt = control_step(self._dt_option, self._loop_step, trajectory, DEFAULT_DT)
         self.backend.reset()
         self.ctx.previous_command = None

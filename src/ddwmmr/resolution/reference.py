@@ -162,9 +162,10 @@ class ReferenceTrajectory:
 
     Integrated with classical RK4 at step ``step`` (s) through the augmented task space
     resolution with auxiliary row ``aux`` (damped as in :func:`kernels.ats` with
-    ``threshold`` and ``damping``): up front to ``horizon`` (s; every step of it, the
-    caller bounds it), then lazily when a lookup goes past the end. Lookups are cubic
-    Hermite (fourth-order accurate, like the integrator).
+    ``threshold`` and ``damping``; None: the robot's own, :func:`kernels.damping_options`):
+    up front to ``horizon`` (s; every step of it, the caller bounds it), then lazily when
+    a lookup goes past the end. Lookups are cubic Hermite (fourth-order accurate, like the
+    integrator).
 
     The time a lookup takes and the memory kept do not grow with t. A lookup more than
     :data:`MAX_LOOKUP_STEPS` steps past the end integrates that distance in
@@ -186,16 +187,15 @@ class ReferenceTrajectory:
         q_start: np.ndarray,
         aux: str = "shoulder",
         step: float = 0.01,
-        threshold: float = kernels.SINGULARITY_THRESHOLD,
-        damping: float = kernels.MAX_DAMPING,
+        threshold: float | None = None,
+        damping: float | None = None,
         horizon: float | None = None,
     ) -> None:
         self.robot = robot
         self.trajectory = trajectory
         self.aux = aux
         self.step = float(step)
-        self.threshold = float(threshold)
-        self.damping = float(damping)
+        self.threshold, self.damping = kernels.damping_options(robot.L1, threshold, damping)
         self.horizon = None if horizon is None else float(horizon)
         self.singular_nodes = 0
         self.last_damped = False
