@@ -435,11 +435,14 @@ def plant_integrator(plant: str, integrator: str | None) -> str | None:
 #: Share of the run's (corner-free) samples, at its end, over which the final error is
 #: taken: the last sample alone can sit on a transient (the rectangle ends on a corner).
 FINAL_WINDOW_FRACTION = 0.05
-#: A wheel within this share of ``wheel_speed_limit`` is at its limit
-#: (``wheel_limit_steps``), and a joint rate within it of ``joint_speed_limit`` at its
-#: own (``joint_rate_limit_steps``): the qp and the mpc bound the rates a hair inside the
-#: limit (1e-6 of it), and the mpc's real-time iteration ends within 1e-3 of its bound.
-WHEEL_LIMIT_TOLERANCE = 1e-3
+#: A wheel speed within this share of ``wheel_speed_limit``, or a joint rate within it of
+#: ``joint_speed_limit``, is at its rate limit (``wheel_limit_steps``,
+#: ``joint_rate_limit_steps``): the qp and the mpc bound the rates a hair inside the limit
+#: (1e-6 of it), and the mpc's real-time iteration ends within 1e-3 of its bound.
+RATE_LIMIT_TOLERANCE = 1e-3
+#: The former name of :data:`RATE_LIMIT_TOLERANCE`, still imported elsewhere: remove it
+#: once no module does.
+WHEEL_LIMIT_TOLERANCE = RATE_LIMIT_TOLERANCE
 #: A joint angle within this (rad) of an end of its ``joint_limits`` range, or beyond it,
 #: is at that position limit (``joint_limit_steps``): the plants clamp a joint to the
 #: limit itself, up to rounding.
@@ -459,21 +462,10 @@ def summarize(
     ``end_position_error_m`` is the error at the last sample and
     ``corner_position_error_m`` the largest error inside the corner windows (None
     without corners).
-    ``singular_steps``, ``saturated_steps``, ``wheel_limit_steps`` and ``fallback_steps``
-    count the run's N commanded steps, not its N + 1 samples
+    ``singular_steps``, ``saturated_steps``, ``fallback_steps`` and the counts of
+    :func:`limit_counts` count the run's N commanded steps, not its N + 1 samples
     (:func:`~ddwmmr.controllers.base.commanded_steps`: the last sample's command is never
-    applied), so each is at most ``summary["steps"]``. ``wheel_limit_steps`` counts the
-    steps with a wheel within :data:`WHEEL_LIMIT_TOLERANCE` of ``robot.wheel_speed_limit``
-    (the wheel speeds of :func:`~ddwmmr.sim.tracking.derive_columns`): a limit held,
-    whether the plant clipped the command (``saturated_steps`` counts those too) or a
-    controller kept it within the limit itself (the qp's and the mpc's bounds).
-    ``joint_rate_limit_steps`` counts the steps with a joint rate (``th1dot``, ``th2dot``,
-    the commands applied) within that share of ``robot.joint_speed_limit``, the same way.
-    ``joint_limit_steps`` counts the steps with a joint angle at a position limit of
-    ``robot.joint_limits`` (within :data:`JOINT_LIMIT_TOLERANCE_RAD`), and
-    ``joint_limit_held`` names the limit held on most of them (``"th2 = 0.3 rad"``; None
-    where none was): ``saturated_steps`` counts a step the plant stopped a joint at its
-    limit just as one it clipped at a rate limit, which these tell apart.
+    applied), so each is at most ``summary["steps"]``.
     """
     position = ts["position_error_m"]
     orientation = ts["orientation_error_rad"]
@@ -483,11 +475,6 @@ def summarize(
         in_corner |= (ts["t"] >= start) & (ts["t"] <= end)
     settled = position[~in_corner] if not np.all(in_corner) else position
     window = settled[-max(1, round(FINAL_WINDOW_FRACTION * len(settled))) :]
-    wheel_speed = np.maximum(np.abs(ts["wheel_left_rad_s"]), np.abs(ts["wheel_right_rad_s"]))
-    at_wheel_limit = wheel_speed >= robot.wheel_speed_limit * (1.0 - WHEEL_LIMIT_TOLERANCE)
-    joint_rate = np.maximum(np.abs(ts["th1dot"]), np.abs(ts["th2dot"]))
-    at_rate_limit = joint_rate >= robot.joint_speed_limit * (1.0 - WHEEL_LIMIT_TOLERANCE)
-    at_joint_limit, held = joint_limits_held(ts, robot)
     return {
         "rms_position_error_m": float(np.sqrt(np.mean(position**2))),
         "max_position_error_m": float(np.max(position)),
@@ -499,20 +486,65 @@ def summarize(
         "rms_orientation_error_rad": float(np.sqrt(np.mean(orientation**2))),
         "max_orientation_error_rad": float(np.max(np.abs(orientation))),
         "max_nonholonomic_residual_m_s": float(np.max(np.abs(ts["nonholonomic_residual_m_s"]))),
-        "max_wheel_speed_rad_s": float(np.max(wheel_speed)),
+        "max_wheel_speed_rad_s": float(np.max(wheel_speeds(ts))),
         "min_manipulability": float(np.min(ts["manipulability"])),
         "mean_manipulability": float(np.mean(ts["manipulability"])),
         "min_stability": float(np.min(ts["stability"])),
         "singular_steps": int(np.sum(commanded_steps(ts["singular"]))),
         "saturated_steps": int(np.sum(commanded_steps(ts["saturated"]))),
-        "wheel_limit_steps": int(np.sum(commanded_steps(at_wheel_limit))),
-        "joint_rate_limit_steps": int(np.sum(commanded_steps(at_rate_limit))),
-        "joint_limit_steps": int(np.sum(commanded_steps(at_joint_limit))),
-        "joint_limit_held": held,
+        **limit_counts(ts, robot),
         "fallback_steps": int(np.sum(commanded_steps(ts["fallback"]))),
         "max_condition_number": max_condition_number(robot, q),
         "median_step_us": float(np.median(ts["step_us"])),
     }
+
+
+def limit_counts(ts: dict[str, np.ndarray], robot: Robot) -> dict[str, Any]:
+    """The run's commanded steps at a limit of ``robot`` (summary keys).
+
+    ``wheel_limit_steps``: a wheel speed (:func:`wheel_speeds`) within
+    :data:`RATE_LIMIT_TOLERANCE` of ``robot.wheel_speed_limit``; ``joint_rate_limit_steps``:
+    a joint rate (:func:`joint_rates`) within that share of ``robot.joint_speed_limit``.
+    Each is a rate limit held, whether the plant clipped the command (``saturated_steps``
+    counts those too) or a controller kept it within the limit itself (the qp's and the
+    mpc's bounds). ``joint_limit_steps``: a joint angle at a position limit of
+    ``robot.joint_limits`` (within :data:`JOINT_LIMIT_TOLERANCE_RAD`), and
+    ``joint_limit_held`` the limit held on most of them (``"th2 = 0.3 rad"``; None where
+    none was): ``saturated_steps`` counts a step the plant stopped a joint at its limit
+    just as one it clipped at a rate limit, which these tell apart.
+    """
+    tolerance = 1.0 - RATE_LIMIT_TOLERANCE
+    at_wheel_limit = wheel_speeds(ts) >= robot.wheel_speed_limit * tolerance
+    at_rate_limit = joint_rates(ts) >= robot.joint_speed_limit * tolerance
+    at_joint_limit, held = joint_limits_held(ts, robot)
+    return {
+        "wheel_limit_steps": int(np.sum(commanded_steps(at_wheel_limit))),
+        "joint_rate_limit_steps": int(np.sum(commanded_steps(at_rate_limit))),
+        "joint_limit_steps": int(np.sum(commanded_steps(at_joint_limit))),
+        "joint_limit_held": held,
+    }
+
+
+def wheel_speeds(ts: dict[str, np.ndarray]) -> np.ndarray:
+    """Per sample, the faster wheel's speed (rad/s, absolute): of the wheel speeds of
+    :func:`~ddwmmr.sim.tracking.derive_columns`."""
+    return np.maximum(np.abs(ts["wheel_left_rad_s"]), np.abs(ts["wheel_right_rad_s"]))
+
+
+def joint_rates(ts: dict[str, np.ndarray]) -> np.ndarray:
+    """Per sample, the faster joint's rate (rad/s, absolute) over the step the sample
+    starts: the applied command (``th1dot``, ``th2dot``) where it was a velocity command,
+    and where the controller sent wheel forces and joint targets (those columns NaN) the
+    rate the joints moved at, (th(k+1) - th(k)) / (t(k+1) - t(k)). The last sample starts
+    no step: NaN there where it is measured."""
+    commanded = np.maximum(np.abs(ts["th1dot"]), np.abs(ts["th2dot"]))
+    measured = np.full(len(commanded), np.nan)
+    if len(commanded) > 1:
+        span = np.diff(ts["t"])
+        moved = np.maximum(np.abs(np.diff(ts["th1"])), np.abs(np.diff(ts["th2"])))
+        measured[:-1] = moved / span
+    forces = np.isnan(ts["th1dot"]) | np.isnan(ts["th2dot"])
+    return np.where(forces, measured, commanded)
 
 
 def joint_limits_held(ts: dict[str, np.ndarray], robot: Robot) -> tuple[np.ndarray, str | None]:

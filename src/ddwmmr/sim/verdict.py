@@ -38,14 +38,15 @@ A run did not track when any of these holds (thresholds documented in docs/cli.m
 The likely cause is read from the summary too (:func:`likely_cause`): the cause a user
 should fix first. After what stops or overrules a run (divergence, tipping, a collision, a
 start below the floor, solver fallbacks), commands clipped on more than
-:data:`SATURATED_CAUSE` of the steps name the trajectory as asking more than the robot can
-give, before anything the arm did (a singularity, a fold), which follows from it. An
+:data:`SATURATED_CAUSE` of the steps (``saturated_steps``), with as many steps at a rate
+limit, name the trajectory as asking more than the robot can give, before anything the arm
+did (a singularity, a fold), which follows from it. An
 obstacle-avoiding controller (``qp``, ``mpc``: a ``min_obstacle_clearance_m``) whose base
 came within :data:`OBSTACLE_NEAR_M` of an obstacle, with no other cause in sight, is named
 as having left the trajectory to go round it. A run that would have tipped over
-(``stability_below_1``) names that first, as a physics plant's tipping is. Saturation whose
-clipped steps were mostly a joint held at a position limit (``joint_limit_steps``), not a
-rate limit, names that joint limit instead. A run that held a rate limit for more than
+(``stability_below_1``) names that first, as a physics plant's tipping is. Saturation for
+most of the run with more steps at a joint's position limit (``joint_limit_steps``) than
+at a rate limit names that joint limit instead. A run that held a rate limit for more than
 :data:`HELD_CAUSE` of the run (a wheel at its speed limit: ``wheel_limit_steps``; a joint
 at its rate limit: ``joint_rate_limit_steps``; an actuator at its limit on a plant with
 dynamics: ``actuator_saturated_time_s``), with no other cause in sight, names that limit,
@@ -94,11 +95,10 @@ TRACKED = "tracked"
 #: Share of the steps above which singular (damped) or saturated steps mean the run did
 #: not track: "most of the run".
 MOST_OF_RUN = 0.5
-#: Share of saturated steps above which saturation is named as the likely cause before
-#: anything the arm did (a singularity, a fold): commands clipped on almost every step mean
-#: the trajectory asks more than the robot can give, the first thing to fix. The default
-#: runs that fail saturate at most 0.58 of their steps (clrrmc-ts with the slides' settings
-#: on the rectangle), so their causes stay the arm's.
+#: Share of the steps above which commands clipped at a rate limit are named as the likely
+#: cause before anything the arm did (a singularity, a fold): commands clipped on almost
+#: every step mean the trajectory asks more than the robot can give, the first thing to
+#: fix; below it, the arm's own cause is the more specific one.
 SATURATED_CAUSE = 0.9
 #: Share of singular steps above which the singularity is named as the likely cause of a
 #: failure, even when they are not most of the run (ap on the rectangle: 990 of 2000).
@@ -437,7 +437,7 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     fallbacks = _number(summary, "mpc_fallbacks") or 0
     if steps and fallbacks > MOST_OF_RUN * steps:
         return MPC_FALLBACK.format(mpc_fallbacks=int(fallbacks), steps=int(steps))
-    if steps and _rate_clipped_steps(summary) > SATURATED_CAUSE * steps:
+    if steps and _clipped_throughout(summary, steps):
         return SATURATED_THROUGHOUT
     return _arm_or_path_cause(summary, found)
 
@@ -453,7 +453,7 @@ def _arm_or_path_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     if min_manipulability is not None and min_manipulability < 1e-6:
         return _folded_arm(summary.get("method"))
     if "saturated_most_of_run" in found:
-        return SATURATION if _rate_clipped_steps(summary) > MOST_OF_RUN * steps else _joint(summary)
+        return _joint(summary) if _mostly_at_joint_limits(summary) else SATURATION
     clearance = _number(summary, "min_obstacle_clearance_m")  # None: no obstacles
     if clearance is not None and clearance < OBSTACLE_NEAR_M:
         return OBSTACLE_DETOUR.format(
@@ -484,11 +484,29 @@ def _held_or_converging_cause(summary: Mapping[str, Any], found: list[str]) -> s
     return NO_CONVERGENCE
 
 
-def _rate_clipped_steps(summary: Mapping[str, Any]) -> float:
-    """The least number of steps clipped at a rate limit, where a joint held at a position
-    limit may explain the rest: the steps with a wheel or a joint at its rate limit
-    (``wheel_limit_steps``, ``joint_rate_limit_steps``), or ``saturated_steps`` less the
-    steps with a joint at a position limit (``joint_limit_steps``), whichever is more."""
+def _clipped_throughout(summary: Mapping[str, Any], steps: float) -> bool:
+    """The plant clipped the commands on more than :data:`SATURATED_CAUSE` of the ``steps``
+    (``saturated_steps``), and as many steps were at a rate limit
+    (:func:`_rate_limit_steps`), not a joint held at a position limit. A limit held inside
+    a controller's own bounds (``wheel_limit_steps`` of a qp or mpc) clips nothing and
+    does not count."""
+    clipped = _number(summary, "saturated_steps") or 0
+    threshold = SATURATED_CAUSE * steps
+    return clipped > threshold and _rate_limit_steps(summary) > threshold
+
+
+def _mostly_at_joint_limits(summary: Mapping[str, Any]) -> bool:
+    """More steps had a joint at a position limit (``joint_limit_steps``) than at a rate
+    limit (:func:`_rate_limit_steps`): the joint limit explains most of the clipping."""
+    return (_number(summary, "joint_limit_steps") or 0) > _rate_limit_steps(summary)
+
+
+def _rate_limit_steps(summary: Mapping[str, Any]) -> float:
+    """The least number of steps at a rate limit: the steps with a wheel or a joint at its
+    rate limit (``wheel_limit_steps``, ``joint_rate_limit_steps``: clipped by the plant or
+    held inside a controller's own bounds), or ``saturated_steps`` less the steps with a
+    joint at a position limit (``joint_limit_steps``, which may explain the rest),
+    whichever is more."""
     clipped = _number(summary, "saturated_steps") or 0
     return max(
         clipped - (_number(summary, "joint_limit_steps") or 0),
