@@ -223,6 +223,11 @@ QP_FALLBACK = (
     "command: its limits conflict (a limit of your own, or a stability floor the start "
     'cannot meet; see docs/qp.md, "Failure handling")'
 )
+CONTROLLER_FALLBACK = (
+    "{method} used its safe fallback on {fallback_steps} of {steps} steps (it said so "
+    "through StepInfo.fallback): why it could not compute a command there is its own "
+    'report (see docs/api.md, "Extending")'
+)
 HELD_LIMIT = (
     "the robot ran at a limit ({held}), where it cannot follow the trajectory any faster "
     "({clipping}){transient}: a slower trajectory, a smaller dt or a higher limit "
@@ -300,6 +305,7 @@ NUMBER_KEYS = (
     "stability_min",
     "qp_fallbacks",
     "mpc_fallbacks",
+    "fallback_steps",
     "min_obstacle_clearance_m",
 )
 #: How a ``summary.json`` spells the non-finite floats (:func:`ddwmmr.sim.result.json_safe`):
@@ -437,6 +443,14 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     fallbacks = _number(summary, "mpc_fallbacks") or 0
     if steps and fallbacks > MOST_OF_RUN * steps:
         return MPC_FALLBACK.format(mpc_fallbacks=int(fallbacks), steps=int(steps))
+    fallbacks = _number(summary, "fallback_steps") or 0
+    if steps and fallbacks > MOST_OF_RUN * steps:  # a controller of its own (the two above: 0)
+        method = summary.get("method")
+        return CONTROLLER_FALLBACK.format(
+            method=f"the controller {method}" if isinstance(method, str) else "the controller",
+            fallback_steps=int(fallbacks),
+            steps=int(steps),
+        )
     if steps and _clipped_throughout(summary, steps):
         return SATURATED_THROUGHOUT
     return _arm_or_path_cause(summary, found)
