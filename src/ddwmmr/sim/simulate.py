@@ -536,15 +536,17 @@ def joint_rates(ts: dict[str, np.ndarray]) -> np.ndarray:
     starts: the applied command (``th1dot``, ``th2dot``) where it was a velocity command,
     and where the controller sent wheel forces and joint targets (those columns NaN) the
     rate the joints moved at, (th(k+1) - th(k)) / (t(k+1) - t(k)). The last sample starts
-    no step: NaN there where it is measured."""
-    commanded = np.maximum(np.abs(ts["th1dot"]), np.abs(ts["th2dot"]))
+    no step: NaN there where it is measured. A time series without the command columns
+    is measured throughout."""
+    missing = np.full(len(ts["t"]), np.nan)
+    rate_1, rate_2 = (np.asarray(ts.get(key, missing), dtype=float) for key in ("th1dot", "th2dot"))
+    commanded = np.maximum(np.abs(rate_1), np.abs(rate_2))
     measured = np.full(len(commanded), np.nan)
     if len(commanded) > 1:
         span = np.diff(ts["t"])
         moved = np.maximum(np.abs(np.diff(ts["th1"])), np.abs(np.diff(ts["th2"])))
         measured[:-1] = moved / span
-    forces = np.isnan(ts["th1dot"]) | np.isnan(ts["th2dot"])
-    return np.where(forces, measured, commanded)
+    return np.where(np.isnan(rate_1) | np.isnan(rate_2), measured, commanded)
 
 
 def joint_limits_held(ts: dict[str, np.ndarray], robot: Robot) -> tuple[np.ndarray, str | None]:
