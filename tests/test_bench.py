@@ -138,7 +138,7 @@ def test_the_mpc_floor_is_measured_with_mpc_and_judged_against_its_targets(repor
     for row, line in zip(rows, table[start + 2 : start + 5], strict=True):
         verdicts = floor_verdicts(row)
         assert line.split()[-1] == ("ok" if verdicts["max_us"] else "MISS")
-        assert line.count("MISS") == sum(not met for met in verdicts.values())
+        assert line.count("MISS") == sum(met is False for met in verdicts.values())
 
 
 def test_floor_verdicts_hold_at_each_limit_and_miss_just_past_it():
@@ -185,7 +185,10 @@ def test_table_shows_the_reports_numbers(report: dict) -> None:
     for entry in report["qp_classes"]:
         assert f"  {entry['name']} ({entry['states']} states" in table
     assert re.search(
-        r"qp targets: median <= 20 us and p99 <= 40 us in every class: (ok|MISS)", table
+        r"qp targets \(qp's own states by class, stricter than the table's 60 us budget\): "
+        r"median <= 20 us and p99 <= 40 us in every class: (not judged|MISS) \(worst [\d.]+ / -\);"
+        r" p99 needs >= 100 states, not judged in 4 of 4 classes",
+        table,
     )
 
 
@@ -205,9 +208,9 @@ def test_qp_classes_report_rows_phases_and_ratios(report: dict) -> None:
         assert set(entry["phases"]) == {"build", "solve", "check", "rest"}
         assert all(value >= 0.0 for value in entry["phases"].values())
         assert 0.0 <= entry["exact_check_fraction"] <= 1.0
-        assert entry["meets_targets"] == (
-            rows["qp"]["median_us"] <= 20.0 and rows["qp"]["p99_us"] <= 40.0
-        )
+        median_ok = rows["qp"]["median_us"] <= 20.0
+        # TINY's 20 states are too few to judge a p99: None unless the median misses
+        assert entry["meets_targets"] == (None if median_ok else False)
 
 
 def _brute_clearance(robot: Robot, q, circle, n: int = 401) -> float:

@@ -11,6 +11,8 @@ from typing import Any
 
 from ddwmmr.bench.methods import REFERENCE_LABEL
 from ddwmmr.bench.mpc_floor import format_floor_lines
+from ddwmmr.bench.qp_classes import qp_target_verdict
+from ddwmmr.bench.timing import P99_MIN_SAMPLES, p99_judgeable
 from ddwmmr.errors import (
     ParameterError,
     read_text_file,
@@ -30,7 +32,9 @@ def format_table(report: dict[str, Any]) -> str:
     lines = [
         f"ddwmmr bench: {config['trajectory']}, {config['calls']} states per timing, "
         f"{config['run_duration_s']:g} s runs ({config['integrator']}), {config['repeats']} "
-        "repeats; step times in us over states (median of each state's repeats)",
+        "repeats",
+        format_step_clause(config),
+        format_load(config),
         f"{'method':<14} {'median':>8} {'p90':>8} {'p99':>8} {'vs naive':>9} {'steps/s':>9} "
         f"{'run x naive':>11}  target",
     ]
@@ -49,7 +53,9 @@ def format_table(report: dict[str, Any]) -> str:
     for label, budget in report["step_budgets_us"].items():
         if label not in measured:  # a budget of a method this run did not time
             continue
-        lines.append(f"target for {label}: step <= {budget:g} us (absolute budget)")
+        lines.append(
+            f"target for {label}: step <= {budget:g} us (absolute budget on the median above)"
+        )
     for pair in report["pairs"]:
         lines.append(f"{pair['method']} / {pair['naive']} step ratio: {pair['step_ratio']:.3f}")
     for label, reason in report["skipped"].items():
@@ -61,6 +67,44 @@ def format_table(report: dict[str, Any]) -> str:
     if report.get("scenarios"):
         lines += ["", *format_scenarios(report)]
     return "\n".join(lines)
+
+
+def format_step_clause(config: dict[str, Any]) -> str:
+    """One line: what the method table's step times (wall time on replayed states), and
+    that its p99 is about the maximum when the states are too few for one."""
+    source = config.get("state_source", "recorded")
+    spacing = config.get("state_spacing_s")
+    apart = f", {spacing:.2f} s apart" if spacing else ""
+    text = (
+        f"step: wall time (us) of one command call on states replayed from a {source} run"
+        f"{apart} (a warm-started method such as mpc did not predict them); per state the "
+        "median of its repeats, then median / p90 / p99 over states"
+    )
+    if not p99_judgeable(int(config["calls"])):
+        text += f" (p99 of fewer than {P99_MIN_SAMPLES} states: about their maximum)"
+    return text
+
+
+def format_load(config: dict[str, Any]) -> str:
+    """One line: the machine's 1-minute load average (at the start, when the report has
+    it, and at the end of the run) against its CPUs, and a warning when it exceeds them."""
+    cpus, end, start = (
+        config.get("cpus"),
+        config.get("load_average"),
+        config.get("load_average_start"),
+    )
+    if not end:
+        return f"load average unknown on {cpus or '?'} CPUs"
+    text = f"load average (1 min) {end[0]:.1f} at the end"
+    if start:
+        text = f"load average (1 min) {start[0]:.1f} at the start, {end[0]:.1f} at the end"
+    text += f" on {cpus or '?'} CPUs"
+    if cpus and max(end[0], start[0] if start else 0.0) > cpus:
+        text += (
+            ": more than the CPUs, so these latencies are unreliable (other jobs preempt the "
+            "timed calls)"
+        )
+    return text
 
 
 def format_scenarios(report: dict[str, Any]) -> list[str]:
@@ -92,8 +136,8 @@ def format_qp_classes(report: dict[str, Any]) -> list[str]:
             lines.append(f"  {entry['name']}: skipped ({entry['skipped']})")
             continue
         lines.append(
-            f"  {entry['name']} ({entry['states']} states, exact look-ahead in "
-            f"{100 * entry['exact_check_fraction']:.1f} %)"
+            f"  {entry['name']} ({entry['states']} states; exact stability look-ahead needed "
+            f"in {100 * entry['exact_check_fraction']:.1f} %, else the cheap bound sufficed)"
         )
         for label, stats in entry["rows"].items():
             ratio = entry["ratios"].get(label)
@@ -138,13 +182,25 @@ def format_qp_verdict(report: dict[str, Any]) -> str:
     measured = [e for e in report["qp_classes"] if "skipped" not in e]
     if not measured:
         return "qp targets: no class measured"
+    verdicts = [qp_target_verdict(e["rows"]["qp"], e["states"]) for e in measured]
     worst_median = max(e["rows"]["qp"]["median_us"] for e in measured)
-    worst_p99 = max(e["rows"]["qp"]["p99_us"] for e in measured)
-    ok = worst_median <= targets["median_us"] and worst_p99 <= targets["p99_us"]
-    text = (
-        f"qp targets: median <= {targets['median_us']:g} us and p99 <= {targets['p99_us']:g} us"
-        f" in every class: {'ok' if ok else 'MISS'} (worst {worst_median:.2f} / {worst_p99:.2f})"
+    judged = [e["rows"]["qp"]["p99_us"] for e in measured if p99_judgeable(e["states"])]
+    worst_p99 = f"{max(judged):.2f}" if judged else "-"
+    verdict = "MISS" if False in verdicts else ("not judged" if None in verdicts else "ok")
+    budget = report.get("step_budgets_us", {}).get("qp")
+    scope = "qp's own states by class" + (
+        f", stricter than the table's {budget:g} us budget" if budget is not None else ""
     )
+    text = (
+        f"qp targets ({scope}): median <= {targets['median_us']:g} us and p99 <= "
+        f"{targets['p99_us']:g} us in every class: {verdict} (worst {worst_median:.2f} / "
+        f"{worst_p99})"
+    )
+    if len(judged) < len(measured):
+        text += (
+            f"; p99 needs >= {P99_MIN_SAMPLES} states, not judged in "
+            f"{len(measured) - len(judged)} of {len(measured)} classes"
+        )
     ratios = [e["ratios"][REFERENCE_LABEL] for e in measured if REFERENCE_LABEL in e["ratios"]]
     if ratios:
         lowest = min(r["min_over_repeats"] for r in ratios)

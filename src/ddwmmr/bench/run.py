@@ -113,6 +113,7 @@ def run_benchmark(
     reference = any(case.label == REFERENCE_LABEL for case in cases) or (
         qp_classes and REFERENCE_LABEL not in skipped
     )
+    load_start = _load_average()  # before the bench's own processes add to it
     overhead_ns = timer_overhead_ns()
     states = record_states(robot, trajectory, calls)
     total = repeats * (len(cases) + (len(QP_CLASSES) if qp_classes else 0))
@@ -146,7 +147,11 @@ def run_benchmark(
         "scenarios": throughput,
         "mpc_floor": floor,
         "mpc_floor_targets": dict(FLOOR_TARGETS),
-        "config": _config(repeats, calls, trajectory, duration, overhead_ns),
+        "config": {
+            **_config(repeats, calls, trajectory, duration, overhead_ns),
+            "state_spacing_s": states.times[1] - states.times[0] if len(states) > 1 else None,
+            "load_average_start": load_start,
+        },
     }
 
 
@@ -176,10 +181,16 @@ def _config(repeats: int, calls: int, trajectory: Any, duration: float, overhead
         "machine": platform.machine(),
         "processor": platform.processor() or "unknown",
         "cpus": os.cpu_count(),
-        "load_average": list(os.getloadavg()) if hasattr(os, "getloadavg") else None,
+        "load_average": _load_average(),
         "timestamp": datetime.now(UTC).isoformat(timespec="seconds"),
         "git_commit": _git_commit(),
     }
+
+
+def _load_average() -> list[float] | None:
+    """The system's 1, 5 and 15 minute load averages (runnable processes), None where the
+    platform has none."""
+    return list(os.getloadavg()) if hasattr(os, "getloadavg") else None
 
 
 def _git_commit() -> str | None:

@@ -12,6 +12,16 @@ import numpy as np
 
 Clock = Callable[[], int]
 
+#: Fewest samples a 99th percentile is judged from: with fewer than 1 / (1 - 0.99) = 100,
+#: the interpolated p99 is (nearly) the largest sample, i.e. one preempted call.
+P99_MIN_SAMPLES = 100
+
+
+def p99_judgeable(samples: int) -> bool:
+    """Whether a 99th percentile over ``samples`` values may be judged against a target
+    (at least :data:`P99_MIN_SAMPLES`)."""
+    return samples >= P99_MIN_SAMPLES
+
 
 def timer_overhead_ns(clock: Clock = time.perf_counter_ns, samples: int = 2001) -> float:
     """Median cost (ns) of one pair of clock reads: subtracted from every timed call."""

@@ -22,6 +22,7 @@ from ddwmmr.bench.report import (
 )
 from ddwmmr.bench.run import MAX_CALLS, MAX_REPEATS, check_duration, run_benchmark
 from ddwmmr.bench.scenarios import SCENARIO_CONTROLLERS, SCENARIO_COUNT
+from ddwmmr.bench.timing import P99_MIN_SAMPLES
 from ddwmmr.cli.common import ArgumentParser, RefusedOption, run_main
 from ddwmmr.controllers.base import available_methods
 from ddwmmr.errors import MAX_JOBS, MAX_SCENARIOS, MAX_STEPS, ParameterError
@@ -109,7 +110,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=_call_count,
         default=500,
         metavar="N",
-        help=f"states per timing (default 500, at most {MAX_CALLS})",
+        help=f"states per timing (default 500, at most {MAX_CALLS}; a p99 is judged only "
+        f"over >= {P99_MIN_SAMPLES})",
     )
     parser.add_argument(
         "--duration",
