@@ -362,7 +362,6 @@ class QPController:
                 self.edge_loads.active = True
             self.edge_relaxed_steps += 1
         if x is None:
-            self.problem.check_generic_pieces(ctx)  # a user's piece that wrote NaN, named
             return self._edge_prediction(ctx, self._fallback(ctx), relaxed)
         v, w, r1, r2, *slack = x
         scale = self.arm_scale(ctx, r1, r2)

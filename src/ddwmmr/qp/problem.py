@@ -18,17 +18,20 @@ straight into memoryviews of these arrays; any other piece (a user's task or lim
 subclass overriding ``compute``) is called through its generic ``compute`` on numpy views,
 and a cost task's rows are then weighted with one numpy product. Both give the same
 numbers to the last bit. Nothing is allocated per step except inside numpy's two products.
+A user's piece (a class from outside the library) is called through a guard
+(:func:`guarded_task`, :func:`guarded_limit`) that checks what it wrote every step before
+the solve and names it in one line when it raises; the library's own pieces run unguarded.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from ctypes import c_int
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, PluginError, check_int_at_least, one_line, shown
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, TaskBlock
 from ddwmmr.qp.context import NU, StepContext
 from ddwmmr.qp.limits.base import INF, Limit
@@ -42,10 +45,44 @@ EQUALITY = 5
 _OPEN_BOX = (-INF,) * NU + (INF,) * NU
 
 
-def _check_written(name: str, kind: type, ctx: StepContext, **written) -> None:
-    """Refuse (one-line :class:`ParameterError`) a piece ``name`` (class ``kind``) whose
-    ``compute`` wrote NaN into any of ``written``, or an infinite value into any but its
-    ``bounds`` (an infinite bound leaves a side open)."""
+def piece_name(piece: Task | Limit) -> str:
+    """A task's or limit's ``name``, or its class name when it kept the base class's
+    placeholder (``"task"``, ``"limit"``)."""
+    name = getattr(piece, "name", None)
+    if not isinstance(name, str) or name in (Task.name, Limit.name):
+        return type(piece).__name__
+    return name
+
+
+def piece_label(piece: Task | Limit) -> str:
+    """How an error names a task or limit: its class and its ``name``, or the class alone
+    when it has no name of its own (:func:`piece_name`)."""
+    kind, name = type(piece).__name__, piece_name(piece)
+    return kind if name == kind else f"{kind} {name!r}"
+
+
+def _from_library(piece: Task | Limit) -> bool:
+    """Whether ``piece``'s class is one of the library's (their output needs no check)."""
+    return type(piece).__module__.split(".")[0] == "ddwmmr"
+
+
+def _raised(label: str, error: Exception, ctx: StepContext, contract: str) -> Exception:
+    """What a run raises when a user's piece ``label`` raised ``error`` in ``compute``: a
+    :class:`ParameterError` or :class:`PluginError` as it is (one line already), anything
+    else (a shape that does not broadcast, a bug) a one-line :class:`PluginError` naming
+    the piece, what it raised, the time and the arrays' shapes (``contract``)."""
+    if isinstance(error, ParameterError | PluginError):
+        return error
+    text = one_line(str(error), 120) or "(no message)"
+    return PluginError(
+        f"{label}: compute() raised {type(error).__name__}: {text} at t = {ctx.t:g} s ({contract})"
+    )
+
+
+def _refuse_written(label: str, ctx: StepContext, **written: np.ndarray | tuple) -> None:
+    """Refuse (one-line :class:`ParameterError`) the piece ``label`` whose ``compute``
+    wrote NaN into any of ``written``, or an infinite value into any but its ``bounds``
+    (an infinite bound leaves a side open)."""
     for what, value in written.items():
         arrays = value if isinstance(value, tuple) else (value,)
         bad = any(
@@ -58,9 +95,58 @@ def _check_written(name: str, kind: type, ctx: StepContext, **written) -> None:
                 else "must be finite"
             )
             raise ParameterError(
-                f"{kind.__name__} {name!r}: compute() wrote a non-finite value into its {what} "
+                f"{label}: compute() wrote a non-finite value into its {what} "
                 f"at t = {ctx.t:g} s (they {rule})"
             )
+
+
+TaskCompute = Callable[[StepContext, np.ndarray, np.ndarray], None]
+LimitCompute = Callable[
+    [StepContext, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray], None
+]
+
+
+def guarded_task(task: Task) -> TaskCompute:
+    """``task.compute``; for a user's task (a class from outside the library) wrapped so
+    that what it raises stops the run in one line naming it and the arrays' shapes."""
+    if _from_library(task):
+        return task.compute
+    label, compute, rows = piece_label(task), task.compute, task.rows
+    contract = f"it fills jac ({rows} x 4) and error ({rows},) in place: rows = {rows}"
+
+    def guarded(ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
+        try:
+            compute(ctx, jac, error)
+        except Exception as exc:
+            raise _raised(label, exc, ctx, contract) from exc
+
+    return guarded
+
+
+def guarded_limit(limit: Limit) -> LimitCompute:
+    """``limit.compute``, for a user's limit wrapped like :func:`guarded_task`."""
+    if _from_library(limit):
+        return limit.compute
+    label, compute, rows = piece_label(limit), limit.compute, limit.rows
+    contract = (
+        f"it fills G ({rows} x 4), lower and upper ({rows},) in place and only tightens "
+        f"lb, ub (4,): rows = {rows}"
+    )
+
+    def guarded(
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
+        try:
+            compute(ctx, G, lower, upper, lb, ub)
+        except Exception as exc:
+            raise _raised(label, exc, ctx, contract) from exc
+
+    return guarded
 
 
 def _flat(array: np.ndarray) -> memoryview:
@@ -90,11 +176,13 @@ class QPProblem:
                 raise ParameterError(
                     f"tasks must be ddwmmr.qp.tasks.Task instances (got {shown(task)})"
                 )
+            check_int_at_least(f"rows of {piece_label(task)}", task.rows, 0)
         for limit in limits:
             if not isinstance(limit, Limit):
                 raise ParameterError(
                     f"limits must be ddwmmr.qp.limits.Limit instances (got {shown(limit)})"
                 )
+            check_int_at_least(f"rows of {piece_label(limit)}", limit.rows, 0)
         self.tasks = list(tasks)
         self.limits = list(limits)
         self.compiled = bool(compiled)
@@ -171,6 +259,7 @@ class QPProblem:
                 self._generic_cost.append(
                     (
                         task,
+                        guarded_task(task),
                         self.J[start:stop],
                         self.e[start:stop],
                         self.Jw[start:stop],
@@ -193,7 +282,13 @@ class QPProblem:
             )
             if not self._add_writer(task, block):
                 self._generic_slack.append(
-                    (task, self.C[start:stop, :NU], self.cl[start:stop], self.cu[start:stop])
+                    (
+                        task,
+                        guarded_task(task),
+                        self.C[start:stop, :NU],
+                        self.cl[start:stop],
+                        self.cu[start:stop],
+                    )
                 )
             start = stop
         start = self.m_eq
@@ -209,10 +304,30 @@ class QPProblem:
             )
             if not self._add_writer(limit, block):
                 self._generic_limits.append(
-                    (limit, self.C[start:stop, :NU], self.cl[start:stop], self.cu[start:stop])
+                    (
+                        limit,
+                        guarded_limit(limit),
+                        self.C[start:stop, :NU],
+                        self.cl[start:stop],
+                        self.cu[start:stop],
+                    )
                 )
             start = stop
         self._all_compiled = not (self._generic_cost or self._generic_slack or self._generic_limits)
+        self._watch_generic()
+
+    def _watch_generic(self) -> None:
+        """The arrays the generic pieces write into, for :meth:`_written_ok`: those that
+        must be finite, those that must not hold NaN."""
+        finite = []
+        if self._generic_cost:
+            finite += [self.J.reshape(-1), self.e]
+        if self._generic_slack or self._generic_limits:
+            finite.append(self.C.reshape(-1))
+        if self._generic_slack:
+            finite.append(self.cu[: self.m_eq])
+        self._finite = finite
+        self._no_nan = [self.lower, self.upper] if self._generic_limits else []
 
     def _add_writer(self, piece: Task | Limit, block: TaskBlock | LimitBlock) -> bool:
         """Compile ``piece`` into ``block``; False when it has no fast path."""
@@ -243,36 +358,51 @@ class QPProblem:
 
     def _build_generic(self, ctx: StepContext) -> None:
         """The pieces without a compiled writer, through ``compute`` on numpy views."""
-        for task, jac, error, jac_w, error_w, column, sqrt_w in self._generic_cost:
-            task.compute(ctx, jac, error)
+        for _, compute, jac, error, jac_w, error_w, column, sqrt_w in self._generic_cost:
+            compute(ctx, jac, error)
             np.multiply(jac, column, out=jac_w)
             np.multiply(error, sqrt_w, out=error_w)
-        for task, jac, low, up in self._generic_slack:
-            task.compute(ctx, jac, up)
+        for _, compute, jac, low, up in self._generic_slack:
+            compute(ctx, jac, up)
             low[:] = up
         box = self.box
         self.lb[:NU] = box[:NU]
         self.ub[:NU] = box[NU:]
         u_lb, u_ub = self.lb[:NU], self.ub[:NU]
-        for limit, G, low, up in self._generic_limits:
-            limit.compute(ctx, G, low, up, u_lb, u_ub)
+        for _, compute, G, low, up in self._generic_limits:
+            compute(ctx, G, low, up, u_lb, u_ub)
         self.box_ok = bool(np.all(u_lb <= u_ub))
+        if not self._written_ok():
+            self._refuse_user_pieces(ctx)
 
-    def check_generic_pieces(self, ctx: StepContext) -> None:
-        """After a failed solve: refuse (one-line :class:`ParameterError`) what a piece
-        without a compiled writer (a user's own) wrote this step that no solver takes, NaN
-        anywhere or an infinite Jacobian, error or constraint row (a bound may be
-        infinite: an open side). Without it the solve fails on every step and the
-        fallback holds the robot still with no word of why. Checked only when a solve
-        failed, so a valid run pays nothing for it."""
-        for task, jac, error, *_ in self._generic_cost:
-            _check_written(task.name, type(task), ctx, jacobian=jac, error=error)
-        for task, jac, _, up in self._generic_slack:
-            _check_written(task.name, type(task), ctx, jacobian=jac, error=up)
-        for limit, G, low, up in self._generic_limits:
-            _check_written(limit.name, type(limit), ctx, matrix=G, bounds=(low, up))
-        if self._generic_limits and np.isnan(self.lb[:NU] + self.ub[:NU]).any():
-            names = ", ".join(repr(limit.name) for limit, *_ in self._generic_limits)
+    def _written_ok(self) -> bool:
+        """Whether the arrays the generic pieces fill hold what every solver takes: finite
+        rows and targets, no NaN bound (``+-inf`` is an open side). Checked every step
+        before the solve, not after a failure: DAQP and quadprog drop a NaN row and solve
+        without it. One dot product an array, ``x . x``: NaN only when an entry is NaN,
+        finite when every entry is finite and below 1e154 (a larger one only sends the
+        step to :meth:`_refuse_user_pieces`, which looks entry by entry)."""
+        for array in self._finite:
+            if not math.isfinite(np.dot(array, array)):
+                return False
+        return not any(math.isnan(np.dot(array, array)) for array in self._no_nan)
+
+    def _refuse_user_pieces(self, ctx: StepContext) -> None:
+        """Refuse (one-line :class:`ParameterError`) the user's piece that wrote NaN, or an
+        infinite Jacobian, error or constraint row, this step; returns when none did (a
+        library piece's non-finite value leaves the solve to fail and fall back)."""
+        for task, _, jac, error, *_ in self._generic_cost:
+            if not _from_library(task):
+                _refuse_written(piece_label(task), ctx, jacobian=jac, error=error)
+        for task, _, jac, _, up in self._generic_slack:
+            if not _from_library(task):
+                _refuse_written(piece_label(task), ctx, jacobian=jac, error=up)
+        users = [limit for limit, *_ in self._generic_limits if not _from_library(limit)]
+        for limit, _, G, low, up in self._generic_limits:
+            if not _from_library(limit):
+                _refuse_written(piece_label(limit), ctx, matrix=G, bounds=(low, up))
+        if users and np.isnan(self.lb[:NU] + self.ub[:NU]).any():
+            names = ", ".join(repr(piece_name(limit)) for limit in users)
             raise ParameterError(
                 f"limits: a compute() of {names} wrote a NaN into the input box lb, ub at "
                 f"t = {ctx.t:g} s (bounds must not be NaN; +-inf leaves a side open)"
