@@ -6,10 +6,13 @@ can replace it. :class:`CompetitiveDynamicsArbiter` (Ellekilde & Christensen 200
 alternative: behaviour weights under competitive dynamics, proposals blended by the weights
 (it also has ``weigh(percept, behaviours) -> Blend``, :class:`BlendingArbiter`).
 :func:`make_arbiter` builds a registered one (:func:`available_arbiters`) from a scenario
-configuration.
+configuration; the scenario protocol wraps a plug-in arbiter in :class:`CheckedArbiter`,
+which refuses in one line a decision naming a state outside :data:`STATES` or a behaviour
+the controller does not have.
 """
 
 from ddwmmr.arbiters.base import Arbiter, BlendingArbiter
+from ddwmmr.arbiters.checked import CheckedArbiter
 from ddwmmr.arbiters.competitive import (
     BEHAVIOURS,
     Blend,
@@ -49,6 +52,7 @@ __all__ = [
     "Arbiter",
     "Blend",
     "BlendingArbiter",
+    "CheckedArbiter",
     "CompetitiveDynamics",
     "CompetitiveDynamicsArbiter",
     "CompetitiveParameters",

@@ -4,9 +4,11 @@ The thesis's state machine (:mod:`ddwmmr.arbiters.state_machine`) is one impleme
 another (e.g. the competitive-dynamics arbiter, docs/thesis.md, "The dynamics") only has to
 provide the same three members. An arbiter may evaluate any of the behaviours it is given,
 but it must return a proposal made by one of them (or a blend in the common proposal format)
-and name the state it is in, which the metrics count. An arbiter that blends proposals instead of
-choosing one also provides ``weigh`` (:class:`BlendingArbiter`); the controller then uses
-its blending path.
+and name the state it is in, one of :data:`~ddwmmr.arbiters.STATES`, which the metrics
+count. An arbiter that blends proposals instead of choosing one also provides ``weigh``
+(:class:`BlendingArbiter`); the controller then uses its blending path. What it is given
+and what it may return: docs/thesis.md, "Writing an arbiter" (the scenario protocol checks
+a plug-in's decisions, :class:`~ddwmmr.arbiters.CheckedArbiter`).
 """
 
 from __future__ import annotations
@@ -33,7 +35,9 @@ class Arbiter(Protocol):
     def select(
         self, p: Percept, behaviours: Mapping[str, Behaviour]
     ) -> Selection:  # pragma: no cover - protocol
-        """Choose the state and the proposal for percept p."""
+        """Choose the state and the proposal for percept p; ``behaviours`` maps
+        "objective", "manipulability", "stability" (and "obstacle" with obstacles) to the
+        controller's behaviours."""
         ...
 
 

@@ -31,12 +31,13 @@ fallback after a failed solve, ``StepInfo.fallback``; NaN for the thesis control
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import astuple, dataclass
 from typing import Any
 
 import numpy as np
 
+from ddwmmr.arbiters.checked import CheckedArbiter
 from ddwmmr.arbiters.factory import check_arbiter
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
@@ -61,6 +62,7 @@ from ddwmmr.controllers.base import (
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     ParameterError,
+    PluginError,
     check_finite,
     check_int_at_least,
     check_nonnegative,
@@ -68,6 +70,7 @@ from ddwmmr.errors import (
     check_range,
     check_step_count,
     float_values,
+    one_line,
     real_number,
     shown,
     texts_apart,
@@ -83,9 +86,9 @@ from ddwmmr.model.stability import (
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
 from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
-from ddwmmr.registry import PLANTS
+from ddwmmr.registry import BUILTIN_MODULES, CONTROLLERS, PLANTS
 from ddwmmr.scenarios.generator import Scenario
-from ddwmmr.sim.loop import run_loop
+from ddwmmr.sim.loop import from_library, name_of, run_loop
 
 #: What each command interface sends, for the messages.
 SENDS = {FORCE: "wheel forces", VELOCITY: "velocity commands"}
@@ -639,8 +642,46 @@ def make_scenario_controller(
     ``scenario`` on ``plant``, with the options its ``waypoint_options`` asks for (it sees
     the plant's traits and velocity envelope, never the plant)."""
     run = WaypointRun(scenario, config, traits_of(plant), robot, _envelope(plant))
-    options = controller_class(config.controller).waypoint_options(run)
+    options = waypoint_options(config.controller, run)
+    arbiter = options.get("arbiter")
+    plug_in = arbiter is not None and not from_library(arbiter)
+    if plug_in and controller_traits(config.controller)["arbiter"]:
+        # A plug-in arbiter's decisions are checked as it makes them (the tally counts
+        # its states); the library's own are trusted and run unwrapped.
+        options["arbiter"] = CheckedArbiter(arbiter, name_of(arbiter))
     return make_controller(config.controller, robot, **options)
+
+
+def waypoint_options(controller: str, run: WaypointRun) -> dict[str, Any]:
+    """The options registered controller ``controller`` asks for on ``run`` (its
+    ``waypoint_options(run)``, a copy). A plug-in declaring the waypoint task without that
+    method, one whose method raises or returns no mapping, is refused with a one-line
+    :class:`PluginError` naming it; a ParameterError it raises (bad input) passes as it
+    is, and so does anything a built-in controller raises (a bug of ours keeps its
+    traceback)."""
+    hook = getattr(controller_class(controller), "waypoint_options", None)
+    if not callable(hook):
+        raise PluginError(
+            f"controller {controller}: declares the waypoints task but has no "
+            "waypoint_options(run) classmethod (ddwmmr.controllers.base.WaypointRun -> dict "
+            "of options)"
+        )
+    built_in = CONTROLLERS.entry(controller).module in BUILTIN_MODULES
+    try:
+        options = hook(run)
+    except Exception as error:
+        if built_in or isinstance(error, ParameterError | PluginError):
+            raise
+        text = one_line(str(error), 120) or "(no message)"
+        raise PluginError(
+            f"controller {controller}: waypoint_options(run) raised {type(error).__name__}: {text}"
+        ) from error
+    if not isinstance(options, Mapping):
+        raise PluginError(
+            f"controller {controller}: waypoint_options(run) must return a dict of options "
+            f"(got {shown(options)})"
+        )
+    return dict(options)
 
 
 def _envelope(plant: Plant) -> dict[str, Any] | None:
@@ -669,4 +710,5 @@ __all__ = [
     "run_scenario",
     "scenario_controllers",
     "step_count",
+    "waypoint_options",
 ]
