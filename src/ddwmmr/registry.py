@@ -19,8 +19,10 @@ traits:
 * :func:`register_controller` (``tasks``: ``"tracking"``, following a trajectory, and/or
   ``"waypoints"``, the scenario protocol's waypoint task, for which the class provides
   ``waypoint_options(run)``, see :class:`ddwmmr.controllers.base.WaypointRun`;
-  ``interfaces``: the command interfaces it can send, ``"velocity"`` and/or ``"force"``;
-  ``arbiter``: True when it takes an ``arbiter`` option and reports the arbiter's state);
+  ``interfaces``: the command interfaces it can send, ``"velocity"`` and/or ``"force"``
+  (the decorator sets the class attribute of that name, which the simulation loop reads:
+  :func:`ddwmmr.sim.loop.check_interface`); ``arbiter``: True when it takes an
+  ``arbiter`` option and reports the arbiter's state);
 * :func:`register_plant` (``interfaces``: the command interfaces it accepts; the decorator
   sets the class attribute of that name);
 * :func:`register_arbiter` (no traits; built as ``cls(stability=..., manipulability=...)``,
@@ -60,7 +62,7 @@ from itertools import count
 from pathlib import Path
 from typing import Any
 
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, one_line, shown
 
 #: The built-in plug-in modules, in listing order.
 BUILTIN_MODULES = (
@@ -200,13 +202,18 @@ class Registry:
             entry.cls = cls  # a built-in read from source, now imported (or reloaded)
             return
         if entry is not None:
-            raise ParameterError(
-                f"{self.label}: {name!r} is registered twice ({entry.module}.{entry.qualname} "
-                f"and {cls.__module__}.{cls.__qualname__})"
-            )
+            raise self.twice(name, entry, f"{cls.__module__}.{cls.__qualname__}")
         text = description if description is not None else _first_line(cls.__doc__)
         self._entries[name] = Entry(
             name, text, traits, cls.__module__, cls.__qualname__, cls, (1, next(_SEQUENCE), 0)
+        )
+
+    def twice(self, name: str, entry: Entry, other: str) -> ParameterError:
+        """The one-line error for ``name``, registered by ``entry`` and again by the class
+        ``other`` (its dotted path)."""
+        return ParameterError(
+            f"{self.label}: {name!r} is registered twice ({entry.module}.{entry.qualname} "
+            f"and {other})"
         )
 
     def unregister(self, name: str) -> None:
@@ -266,6 +273,7 @@ CONTROLLERS = Registry(
     "method",
     {"tasks": ("tracking",), "interfaces": ("velocity",), "arbiter": False},
     "method: unknown method {name} (known: {known})",
+    sets=("interfaces",),
 )
 PLANTS = Registry(
     "plant",
@@ -324,6 +332,10 @@ def _read_builtins() -> None:
             if entry is None:
                 text = description if description is not None else _first_line(doc)
                 entry = registry._entries[name] = Entry(name, text, resolved, module, qualname)
+            elif (entry.module, entry.qualname) != (module, qualname):
+                # a plug-in imported before the first query took a built-in's name: refused
+                # as when it comes after (:meth:`Registry._add`), never a silent replacement
+                raise registry.twice(name, entry, f"{module}.{qualname}")
             entry.order = (0, index, line)
 
 
@@ -367,12 +379,18 @@ def _plugin_modules() -> list[str]:
 
 
 def _import_plugin(module: str) -> None:
+    """Import plug-in ``module``; any failure of its import (missing, a syntax error,
+    whatever its code raises) is a one-line :class:`ParameterError` naming the module and
+    the error (its ``__cause__``). Interrupts (not an :class:`Exception`) pass."""
     try:
         importlib.import_module(module)
-    except ImportError as exc:
+    except Exception as exc:
+        text = one_line(str(exc), 200)
+        if not isinstance(exc, ImportError | ParameterError):
+            text = f"{type(exc).__name__}: {text}" if text else type(exc).__name__
         raise ParameterError(
-            f"{PLUGINS_VARIABLE}: cannot import plug-in module {module!r} ({exc})"
-        ) from None
+            f"{PLUGINS_VARIABLE}: cannot import plug-in module {module!r} ({text})"
+        ) from exc
 
 
 __all__ = [

@@ -137,7 +137,9 @@ class WaypointRun:
 
 
 #: Registers a controller class: ``@register_controller(name, tasks=..., interfaces=...,
-#: arbiter=...)`` (see :mod:`ddwmmr.registry`).
+#: arbiter=...)`` (see :mod:`ddwmmr.registry`); it sets the class attribute ``interfaces``,
+#: from which the simulation loop picks the command interface it sends (``"force"`` alone:
+#: ``command`` returns a :class:`~ddwmmr.commands.WheelForces`).
 register_controller = CONTROLLERS.register
 
 

@@ -260,7 +260,10 @@ class Plant(Protocol):
         :class:`~ddwmmr.errors.ParameterError` for a command of another interface, a
         non-finite or misshapen one, a non-finite t or a dt that is not > 0
         (:func:`check_step`), and :class:`PlantDivergedError` when the new state is not
-        finite.
+        finite. Anything else a plug-in plant (a class from outside the library) raises
+        here is wrapped by the simulation loop in a one-line
+        :class:`~ddwmmr.errors.PluginError` naming the plant, the step and the time
+        (:func:`ddwmmr.sim.loop.plant_raised`).
         """
         ...
 

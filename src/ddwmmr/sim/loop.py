@@ -18,8 +18,16 @@ fails. What differs between plants (kinematic, thesis dynamics, physics) is behi
 
 Controller contract (class attributes, all optional):
 
-* ``interface``: ``"velocity"`` (default; ``command`` returns u) or ``"force"`` (returns
-  :class:`~ddwmmr.commands.WheelForces`); the plant must accept it.
+* ``interfaces``: the command interfaces it can send, ``"velocity"`` (``command`` returns
+  u) and/or ``"force"`` (returns :class:`~ddwmmr.commands.WheelForces`); the
+  ``register_controller`` decorator sets it from its ``interfaces`` trait (default
+  ``("velocity",)``), the one place a controller declares it.
+* ``interface``: the one it sends in this run, when it chooses (the ``mpc`` sets it in
+  ``adopt_plant``, from the plant's traits); without it the loop takes the first of
+  ``interfaces`` the plant accepts and sets ``interface`` to it. An ``interface`` outside
+  the ``interfaces`` a registered controller declares still runs, with a
+  :class:`FutureWarning` (a class attribute was once the only declaration). The plant
+  must accept it (:func:`check_interface`).
 * ``zero_order_hold``: True for sampled-data controllers (MPC, the thesis controller): the
   command is held over the step. Otherwise the kinematic plant's RK4 re-evaluates the
   control law at its stages (the closed loop integrated as one ODE).
@@ -39,22 +47,35 @@ Controller contract (class attributes, all optional):
   joint targets, the QP's look-ahead) plans with it unless told otherwise.
 * ``law(t, q, pose_d, velocity_d) -> (u, ...)``: the control law on lists of floats, with
   no validation and no step info; when present, the integrator's stages call it instead
-  of ``command`` (same numbers, a third of the cost). ``u`` is a tuple of 4 floats. A
-  subclass overriding ``command`` below the class defining ``law`` gets ``command`` at
-  the stages (:func:`stage_law`).
+  of ``command`` (same numbers, a third of the cost). ``u`` is a tuple of 4 floats; any
+  other return (``u`` alone, a shorter tuple) is a one-line ParameterError naming ``law``
+  and what it must return. A subclass overriding ``command`` below the class defining
+  ``law`` gets ``command`` at the stages (:func:`stage_law`).
 
 ``reset(trajectory, q0)`` and ``command`` are required. What ``command`` returns is checked
 at every sample and integrator stage (:func:`checked_command`): 4 finite numbers (any
 sequence; the plant gets them as a float array) on the velocity interface, a
 :class:`~ddwmmr.commands.WheelForces` of finite numbers on the force interface; anything
 else is a :class:`~ddwmmr.errors.ParameterError` naming the controller's ``command`` and
-the step. At a sample it goes through ``task.controller_error`` like any error of the
-controller; at a stage it comes out of ``plant.step``.
+the step (a command of the other interface too: u from a controller that declares
+``interfaces=("force",)``, a ``WheelForces`` from a velocity one). At a sample it goes
+through ``task.controller_error`` like any error of the controller; at a stage it comes
+out of ``plant.step``.
+
+A plug-in plant (a class from outside the library) is held to its contract the same way:
+what its ``observe()`` and ``limit()`` return is checked at every step (a one-line
+ParameterError), and anything else its methods raise (but PlantDivergedError, which ends
+the run as "diverged") is wrapped in a one-line PluginError naming the plant, the method,
+the step and the time. Both go through ``task.controller_error`` (the scenario protocol
+records them as the scenario's failure; a tracking run raises them). The library's own
+plants keep their errors as they are.
 """
 
 from __future__ import annotations
 
+import contextlib
 import time
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from math import isfinite
@@ -123,7 +144,10 @@ class Task(Protocol):
         ...
 
     def controller_error(self, k: int, error: Exception) -> bool:  # pragma: no cover
-        """The controller raised at sample k; True ends the run quietly, False re-raises."""
+        """A plug-in failed at sample k: the controller raised or returned a bad command,
+        or a plug-in plant raised or broke its contract (a :class:`PluginError` or a
+        :class:`ParameterError` naming the plant); True ends the run quietly, False
+        re-raises."""
         ...
 
     def diverged(self, k: int, error: PlantDivergedError) -> None:  # pragma: no cover
@@ -136,12 +160,32 @@ class LoopEnd:
     """How a run ended: ``samples`` is the end index (time ``samples * dt``)."""
 
     samples: int
-    reason: str  # "steps", "finished", "failed", "controller_error", "diverged", "start"
+    #: "steps", "finished", "failed", "controller_error", "plant_error", "diverged", "start"
+    reason: str
 
 
 def check_interface(controller: Any, plant: Plant) -> str:
-    """The controller's command interface, if the plant accepts it."""
-    interface = getattr(controller, "interface", VELOCITY)
+    """The command interface ``controller`` sends on ``plant`` (see the module docstring):
+    its ``interface`` if it has one, else the first of its declared ``interfaces`` that the
+    plant accepts (then set as its ``interface``); a one-line :class:`ParameterError` if
+    the plant does not accept it."""
+    declared = tuple(getattr(controller, "interfaces", None) or (VELOCITY,))
+    interface = getattr(controller, "interface", None)
+    if interface is None:
+        interface = next((i for i in declared if i in plant.interfaces), declared[0])
+        # what the run records as the interface it spoke (a controller with __slots__
+        # refuses the attribute: nothing reads it then)
+        with contextlib.suppress(AttributeError):
+            controller.interface = interface
+    elif hasattr(controller, "interfaces") and interface not in declared:
+        warnings.warn(
+            f"{name_of(controller)} sends {interface} commands (its interface attribute) "
+            f"but declares interfaces={declared}: declare them with "
+            f"@register_controller(..., interfaces=...); the interface attribute alone is "
+            "deprecated",
+            FutureWarning,
+            stacklevel=3,
+        )
     if interface not in plant.interfaces:
         name = getattr(controller, "name", type(controller).__name__)
         raise ParameterError(
@@ -275,6 +319,42 @@ def raise_wrapped(controller: Any, error: Exception, k: int, t: float, method: s
     ) from error
 
 
+def bad_law(controller: Any, result: Any, k: int, t: float) -> NoReturn:
+    """Raise the one-line :class:`ParameterError` for what ``controller.law`` returned at a
+    stage of step ``k`` (time ``t`` s) when it is not ``(u, ...)`` with ``u`` 4 numbers."""
+    raise ParameterError(
+        f"method: {name_of(controller)}.law() must return (u, ...) with u 4 numbers "
+        f"(v, w, th1dot, th2dot) (got {shown(result, 60)} at step {k}, t = {t:g} s)"
+    )
+
+
+def plant_raised(plant: Plant, error: Exception, k: int, t: float, method: str) -> Exception:
+    """What a run raises when plug-in ``plant.<method>`` raised ``error`` at step ``k``
+    (time ``t`` s): a :class:`ParameterError` or :class:`PluginError` as it is (a bad
+    command at an integrator stage, or the plant's own one-line error), anything else
+    wrapped in a one-line :class:`PluginError` naming the plant, what it raised and where
+    (``error`` becomes its ``__cause__`` when raised ``from`` it)."""
+    if isinstance(error, ParameterError | PluginError):
+        return error
+    text = " ".join(str(error).split()) or "(no message)"
+    return PluginError(
+        f"plant: {name_of(plant)}.{method}() raised {type(error).__name__}: "
+        f"{shown(text, 120)} at step {k}, t = {t:g} s"
+    )
+
+
+def plant_failed(task: Task, plant: Plant, error: Exception, k: int, t: float, method: str) -> bool:
+    """Plug-in ``plant.<method>`` raised ``error`` at step ``k`` (time ``t`` s; called from
+    an ``except`` block): True if ``task.controller_error`` ends the run quietly on
+    :func:`plant_raised`'s error, else that error is raised (``error`` its cause)."""
+    wrapped = plant_raised(plant, error, k, t, method)
+    if task.controller_error(k, wrapped):
+        return True
+    if wrapped is error:
+        raise error
+    raise wrapped from error
+
+
 def stage_law(controller: Any) -> Callable[..., Any] | None:
     """The controller's ``law`` if the integrator may call it at its stages, else None.
 
@@ -338,18 +418,30 @@ def run_loop(
         made it."""
         pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
         try:
-            u = law(t, q, pose_d.tolist(), velocity_d.tolist())[0]
+            result = law(t, q, pose_d.tolist(), velocity_d.tolist())
         except Exception as error:
             raise_wrapped(controller, error, k, t, "law")
-        if isfinite(u[0] + u[1] + u[2] + u[3]):
-            return u
-        return policy(t, q)
+        try:
+            u = result[0]
+            finite = isfinite(u[0] + u[1] + u[2] + u[3]) if len(u) == 4 else None
+        except Exception:  # not (u, ...): a plain u of floats, None, text
+            finite = None
+        if finite is None:
+            bad_law(controller, result, k, t)
+        return u if finite else policy(t, q)
 
     stage_policy = None
     if not (force or getattr(controller, "zero_order_hold", False)):
         stage_policy = policy if law is None else law_policy
     foreign = not from_library(plant)  # a plug-in plant: its output checked every step
-    obs = checked_observation(plant, 0, 0.0) if foreign else plant.observe()
+    if not foreign:
+        obs = plant.observe()
+    else:
+        try:
+            obs = checked_observation(plant, 0, 0.0)
+        except Exception as error:
+            if plant_failed(task, plant, error, 0, 0.0, "observe"):
+                return LoopEnd(0, "plant_error")
     if task.start(obs):
         return LoopEnd(0, "start")
     for k in range(steps + 1):
@@ -374,12 +466,14 @@ def run_loop(
         info = getattr(controller, "last", _NO_INFO)
         if force:
             applied, saturated = command, False
+        elif foreign:
+            try:
+                applied, saturated = checked_limit(plant, obs.q, command, k, t)
+            except Exception as error:
+                if plant_failed(task, plant, error, k, t, "limit"):
+                    return LoopEnd(k, "plant_error")
         else:
-            applied, saturated = (
-                checked_limit(plant, obs.q, command, k, t)
-                if foreign
-                else plant.limit(obs.q, command)
-            )
+            applied, saturated = plant.limit(obs.q, command)
         task.record(k, t, obs, command, applied, saturated, info, elapsed)
         if k == steps:
             break
@@ -388,7 +482,19 @@ def run_loop(
         except PlantDivergedError as error:
             task.diverged(k, error)
             return LoopEnd(k + 1, "diverged")
-        obs = checked_observation(plant, k + 1, t + dt) if foreign else plant.observe()
+        except Exception as error:
+            if not foreign:
+                raise  # the library's plants: their errors as they are
+            if plant_failed(task, plant, error, k, t, "step"):
+                return LoopEnd(k + 1, "plant_error")
+        if not foreign:
+            obs = plant.observe()
+        else:
+            try:
+                obs = checked_observation(plant, k + 1, t + dt)
+            except Exception as error:
+                if plant_failed(task, plant, error, k + 1, t + dt, "observe"):
+                    return LoopEnd(k + 1, "plant_error")
         if task.after_step(k, t, obs, applied):
             return LoopEnd(k + 1, "failed")
         if progress is not None:
