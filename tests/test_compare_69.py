@@ -40,7 +40,10 @@ def test_a_toml_name_is_shown_as_written_and_files_stay_safe(tmp_path, capsys):
 
 def _output(errors_m: np.ndarray) -> RunOutput:
     t = np.linspace(0.0, 40.0, errors_m.size)
-    summary = {"max_position_error_m": float(np.max(errors_m))}
+    summary = {
+        "max_position_error_m": float(np.max(errors_m)),
+        "end_position_error_m": float(errors_m[-1]),
+    }
     return RunOutput(summary, {"t": t, "position_error_m": errors_m})
 
 

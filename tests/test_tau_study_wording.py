@@ -1,5 +1,5 @@
 """The tau study's sentence on convergence: a tau the run is too short to settle for (the
-run ends before the 3.00 tau a first-order decay needs to fall below 5 %) is said to be
+run ends before the 2.996 tau a first-order decay needs to fall below 5 %) is said to be
 that, not a steady error above 5 %; with a long enough run the text is as before."""
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ def test_a_run_shorter_than_three_tau_is_said_to_be_too_short() -> None:
     convergence = {"clrrmc-ts": {0.1: 0.3, 0.3: 0.9, 1.0: 3.0, 3.0: math.nan}}
     assert _tau_finding(convergence, 5.0, THEORY) == (
         "Convergence time: 0.300 s at tau = 0.1 s to 3.00 s at tau = 1 s for clrrmc-ts (the "
-        "5 s run is too short to settle for tau = 3 s: it ends before 3.00 tau). Larger tau "
+        "5 s run is too short to settle for tau = 3 s: it ends before 2.996 tau). Larger tau "
         "is more sluggish."
     )
 
@@ -40,13 +40,13 @@ def test_both_causes_and_a_run_too_short_for_any_tau() -> None:
     assert _tau_finding(convergence, 2.0, THEORY) == (
         "Convergence time: 0.300 s at tau = 0.1 s for qp (not "
         "settled for tau = 0.3 s: its steady error exceeds 5 % of the offset; the 2 s run is "
-        "too short to settle for tau = 1, 3 s: it ends before 3.00 tau). Larger tau is more "
+        "too short to settle for tau = 1, 3 s: it ends before 2.996 tau). Larger tau is more "
         "sluggish."
     )
     never = {"qp": dict.fromkeys((0.1, 0.3, 1.0, 3.0), math.nan)}
     assert _tau_finding(never, 0.2, THEORY) == (
         "Convergence time: qp does not get below 5 % of the offset (the 0.2 s run is too "
-        "short to settle for tau = 0.1, 0.3, 1, 3 s: it ends before 3.00 tau). Larger tau is "
+        "short to settle for tau = 0.1, 0.3, 1, 3 s: it ends before 2.996 tau). Larger tau is "
         "more sluggish."
     )
 
@@ -60,6 +60,6 @@ def test_the_report_of_a_5_s_tau_study(tmp_path) -> None:
     assert found is not None
     assert found.group(0) == (
         "Convergence time: 0.300 s at tau = 0.1 s to 3.00 s at tau = 1 s for clrrmc-ts (the "
-        "5 s run is too short to settle for tau = 3 s: it ends before 3.00 tau). Larger tau "
+        "5 s run is too short to settle for tau = 3 s: it ends before 2.996 tau). Larger tau "
         "is more sluggish."
     )

@@ -48,12 +48,10 @@ from ddwmmr.outputs import write_atomic
 from ddwmmr.plants import available_plants
 from ddwmmr.progress import phase
 from ddwmmr.reports.compare import (
-    CORNER_TRAJECTORY,
     DEFAULT_TRAJECTORIES,
     OFFSET_SCALES,
     STEP_SIZES,
     STUDIES,
-    STUDY_TRAJECTORY,
     TAUS,
     CompareConfig,
     ReportInfo,
@@ -68,7 +66,7 @@ from ddwmmr.reports.compare import (
     write_report,
 )
 from ddwmmr.reports.compare.constants import TIE_ABSOLUTE_M, TIE_RELATIVE
-from ddwmmr.reports.compare.plan import report_name, run_duration
+from ddwmmr.reports.compare.plan import report_name, run_duration, skipped_studies
 from ddwmmr.resolution.reference import initial_configuration
 from ddwmmr.sim.result import json_safe
 from ddwmmr.sim.simulate import check_start
@@ -547,16 +545,14 @@ def format_summary(
     return "\n".join(lines)
 
 
-def skipped_studies(config: CompareConfig, plan: Any) -> list[str]:
-    """One stderr note per requested study the plan leaves out: the trajectory it needs is
-    not among the compared ones (``--only``/``--traj``)."""
+def skipped_notes(config: CompareConfig, plan: Any) -> list[str]:
+    """One stderr note per requested study the plan leaves out (every study is requested
+    by default): the trajectory it needs is not among the compared ones (``--only``/``--traj``)."""
     compared = ", ".join(map(config.shown, config.trajectories))
     return [
-        f"note: study {study} skipped: it needs the "
-        f"{CORNER_TRAJECTORY if study == 'corners' else STUDY_TRAJECTORY} trajectory, which "
-        f"is not compared (trajectories: {compared})"
-        for study in config.studies
-        if study not in plan.studies
+        f"note: study {study} skipped: it needs the {needed} trajectory, which is not "
+        f"compared (trajectories: {compared})"
+        for study, needed in skipped_studies(config, plan).items()
     ]
 
 
@@ -569,9 +565,8 @@ def _main(argv: Sequence[str] | None) -> int:
     config = config_from_arguments(args, argv, sources)
     check_output_folder(out, "compare", args.force, ("run.json", *output_names(config)))
     plan = plan_runs(config)
-    if args.study is not None:  # studies asked for by name: say which cannot run, and why
-        for line in skipped_studies(config, plan):
-            print(line, file=sys.stderr)
+    for line in skipped_notes(config, plan):  # the default studies too: say which cannot run
+        print(line, file=sys.stderr)
     specs = plan.all_specs()
     check_runs(config, specs)
     record = run_record(config, sources, argv, jobs)

@@ -82,10 +82,15 @@ RUN_OPTIONS = (
 )  # fmt: skip
 
 #: Keys printed in the summary table, with their labels; errors in mm (as in compare).
+#: The labels name what docs/cli.md's summary table defines: ``final_position_error_m`` is
+#: the RMS over the run's settled end, not the last sample's error; ``saturated_steps``
+#: counts commands the plant clipped, while a limit ``qp`` or ``mpc`` holds inside its own
+#: bounds shows only in ``wheel_limit_steps`` / ``joint_rate_limit_steps``.
 TABLE_KEYS = (
     ("rms_position_error_m", "RMS position error (mm)"),
     ("max_position_error_m", "max position error (mm)"),
-    ("final_position_error_m", "final position error (mm)"),
+    ("final_position_error_m", "settled-end RMS position error (mm)"),
+    ("end_position_error_m", "position error at the end (mm)"),
     ("corner_position_error_m", "corner position error (mm)"),
     ("rms_orientation_error_rad", "RMS orientation error (rad)"),
     ("max_nonholonomic_residual_m_s", "max nonholonomic residual (m/s)"),
@@ -93,7 +98,9 @@ TABLE_KEYS = (
     ("min_manipulability", "min manipulability"),
     ("min_stability", "min stability S"),
     ("singular_steps", "singular (damped) steps"),
-    ("saturated_steps", "saturated steps"),
+    ("saturated_steps", "saturated steps (plant clipped)"),
+    ("wheel_limit_steps", "wheel at speed limit (steps)"),
+    ("joint_rate_limit_steps", "joint rate at speed limit (steps)"),
     ("stability_violations", "steps with S < S_min"),
     ("qp_fallbacks", "QP fallbacks"),
     ("mpc_fallbacks", "MPC fallbacks (its qp commanded)"),
@@ -113,6 +120,7 @@ MM_KEYS = {
     "rms_position_error_m",
     "max_position_error_m",
     "final_position_error_m",
+    "end_position_error_m",
     "corner_position_error_m",
     "min_obstacle_clearance_m",
 }

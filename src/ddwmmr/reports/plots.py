@@ -212,8 +212,34 @@ def plot_path(result, ax: Axes | None = None, snapshots: int = 6, obstacles=None
     legend_beside(ax, handles=[*handles, *robots], fontsize=8)
     ax.grid(alpha=0.3)
     if own_figure:
-        fig.subplots_adjust(left=0.09, right=0.73, bottom=0.09, top=0.93)  # legend: right
+        _fit_path_figure(fig, ax)
     return fig
+
+
+#: The path figure's width and its margins (inches): left of the axes, right of them (the
+#: legend), below and above; its height follows the data (:func:`_fit_path_figure`).
+PATH_WIDTH_IN = 8.6
+PATH_MARGINS_IN = (0.77, 2.32, 0.5, 0.39)
+#: Bounds of the path figure's height (inches): the legend's height, and a page's.
+PATH_HEIGHT_IN = (4.0, 9.0)
+
+
+def _fit_path_figure(fig: Figure, ax: Axes) -> None:
+    """Give the figure the height at which the equal-scale axes fill their width: the axes
+    box then meets the margins instead of leaving empty bands above and below (a wide
+    path) or, within :data:`PATH_HEIGHT_IN`, beside it (a tall one)."""
+    left, right, bottom, top = PATH_MARGINS_IN
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    width = PATH_WIDTH_IN - left - right
+    low, high = PATH_HEIGHT_IN
+    height = min(max(width * (y1 - y0) / (x1 - x0) + bottom + top, low), high)
+    fig.set_size_inches(PATH_WIDTH_IN, height)
+    fig.subplots_adjust(
+        left=left / PATH_WIDTH_IN,
+        right=1.0 - right / PATH_WIDTH_IN,
+        bottom=bottom / height,
+        top=1.0 - top / height,
+    )
 
 
 def plot_errors(result) -> Figure:

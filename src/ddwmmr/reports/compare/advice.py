@@ -114,6 +114,8 @@ ADVICE_HEADERS = [
     "tip-over stability",
     "shoulder singularity cos th1 = 0",
 ]
+#: Columns of the advice table holding text, left aligned (the step time is a number).
+ADVICE_TEXT = (0, 1, 3, 4, 5)
 
 
 def advice_rows(items: Sequence[Profile]) -> list[list[str]]:

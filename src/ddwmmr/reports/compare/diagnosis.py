@@ -1,9 +1,9 @@
 """Why a run scored as it did, and the measurements the studies share.
 
 :func:`diagnose` turns a run's time series into :class:`Finding` sentences (shoulder
-singularity, orientation lost at corners, joint limits, saturation, kept offset,
-convergence); :func:`convergence_time`, :func:`observed_order` and :func:`corner_times`
-serve the studies.
+singularity, orientation lost at corners, joint limits, commands the plant clipped, speed
+limits a method held itself, kept offset, convergence); :func:`convergence_time`,
+:func:`observed_order` and :func:`corner_times` serve the studies.
 """
 
 from __future__ import annotations
@@ -123,14 +123,7 @@ def diagnose(
     if outcome == "lost":
         findings.append(Finding(_singularity_reason(spec, ts, onset, plan, outputs)))
     elif outcome == "passes":
-        after = float(np.max(ts["position_error_m"][onset:]))
-        findings.append(
-            Finding(
-                f"it passes the singularity cos(th1) = 0 at t = {ts['t'][onset]:.1f} s "
-                f"without losing the path (largest error after it {mm(after)} mm)",
-                False,
-            )
-        )
+        findings.append(Finding(_passage_text(ts, summary, onset), False))
         onset = None
     jumps = orientation_jumps(ts)
     if jumps and summary["rms_orientation_error_rad"] > 0.5 and onset is None:
@@ -148,10 +141,13 @@ def diagnose(
         more = " more" if np.any(limited) else ""
         findings.append(
             Finding(
-                f"the command exceeded the wheel or joint speed limits in {count}{more} steps "
-                f"({where}), so the robot could not follow it"
+                f"the plant clipped the command at the wheel or joint speed limits in "
+                f"{count}{more} steps ({where}), so the robot could not follow it"
             )
         )
+    held = held_limits_text(summary)
+    if held:
+        findings.append(Finding(held, False))
     if keeps_offset(summary):
         findings.append(
             Finding(
@@ -165,8 +161,49 @@ def diagnose(
             Finding(f"it removes the initial offset (below 5 % after {fmt(settle)} s)", False)
         )
     if not any(f.adverse for f in findings):
-        findings.append(Finding("no singularity, saturation or orientation loss was detected"))
+        findings.append(Finding(NOTHING_ADVERSE))
     return findings
+
+
+#: The closing finding of a run without an adverse one: what was looked for and not found
+#: (a passage of cos(th1) = 0 that kept the path, or a limit a method held itself, is not
+#: among them).
+NOTHING_ADVERSE = (
+    "no path lost at the shoulder singularity, no command clipped by the plant and no "
+    "orientation lost at a corner"
+)
+
+
+def _passage_text(ts: Mapping[str, np.ndarray], summary: Mapping[str, Any], onset: int) -> str:
+    """A passage of |cos th1| < :data:`SINGULAR_COS` that kept the path: when, the largest
+    error after it (mm), and whether the method damped an inverse there."""
+    after = float(np.max(ts["position_error_m"][onset:]))
+    damped = summary.get("singular_steps") or 0
+    how = f"damped on {damped} steps" if damped else "no step damped"
+    return (
+        f"it passes the shoulder singularity cos(th1) = 0 at t = {ts['t'][onset]:.1f} s "
+        f"without losing the path (largest error after it {mm(after)} mm; {how})"
+    )
+
+
+def held_limits_text(summary: Mapping[str, Any]) -> str:
+    """A finding on the steps with a wheel at its speed limit (``wheel_limit_steps``) or a
+    joint rate at its limit (``joint_rate_limit_steps``), when either count exceeds the
+    steps the plant clipped (``saturated_steps``): a limit held inside the method's own
+    bounds (``qp``, ``mpc``), which ``saturated_steps`` does not see. Empty otherwise."""
+    clipped = summary.get("saturated_steps") or 0
+    counts = [
+        (summary.get(key) or 0, what)
+        for key, what in (
+            ("wheel_limit_steps", "a wheel at its speed limit"),
+            ("joint_rate_limit_steps", "a joint rate at its speed limit"),
+        )
+    ]
+    if all(count <= clipped for count, _ in counts):
+        return ""
+    parts = " and ".join(f"{what} on {count} steps" for count, what in counts if count)
+    clip = f"the plant clipped {clipped} steps in all" if clipped else "the plant clipped none"
+    return f"it held {parts} ({clip})"
 
 
 def _singularity_reason(

@@ -66,9 +66,12 @@ class Document:
         """A bullet list."""
         self.blocks.append(("bullets", list(items)))
 
-    def table(self, headers: Sequence[str], rows: Sequence[Sequence[str]]) -> None:
-        """A table; the first column is left aligned, the others right aligned."""
-        self.blocks.append(("table", (list(headers), [list(r) for r in rows])))
+    def table(
+        self, headers: Sequence[str], rows: Sequence[Sequence[str]], left: Sequence[int] = (0,)
+    ) -> None:
+        """A table; the columns numbered in ``left`` (from 0; text) are left aligned, the
+        others (numbers) right aligned."""
+        self.blocks.append(("table", (list(headers), [list(r) for r in rows], tuple(left))))
 
     def figure(self, filename: str, caption: str) -> None:
         """A PNG figure (file in the report folder) with its caption."""
@@ -106,11 +109,11 @@ def _md_inline(text: str) -> str:
     return "".join(p if i % 2 else _MD_TAG.sub("&lt;", p) for i, p in enumerate(parts))
 
 
-def _md_table(data: tuple[list[str], list[list[str]]]) -> str:
-    headers, rows = data
+def _md_table(data: tuple[list[str], list[list[str]], tuple[int, ...]]) -> str:
+    headers, rows, left = data
     lines = [
         "| " + " | ".join(_md_cell(h) for h in headers) + " |",
-        "|" + "|".join([":---"] + ["---:"] * (len(headers) - 1)) + "|",
+        "|" + "|".join(":---" if i in left else "---:" for i in range(len(headers))) + "|",
     ]
     lines += ["| " + " | ".join(_md_cell(cell) for cell in row) + " |" for row in rows]
     return "\n".join(lines)
@@ -137,13 +140,22 @@ def _inline(text: str) -> str:
     return re.sub(r"`(.+?)`", r"<code>\1</code>", text)
 
 
-def _html_table(data: tuple[list[str], list[list[str]]]) -> str:
-    headers, rows = data
-    head = "".join(f"<th>{_inline(h)}</th>" for h in headers)
+def _html_table(data: tuple[list[str], list[list[str]], tuple[int, ...]]) -> str:
+    headers, rows, left = data
+    head = "".join(f"<th{_html_align(i, left)}>{_inline(h)}</th>" for i, h in enumerate(headers))
     body = "".join(
-        "<tr>" + "".join(f"<td>{_inline(c)}</td>" for c in row) + "</tr>" for row in rows
+        "<tr>"
+        + "".join(f"<td{_html_align(i, left)}>{_inline(c)}</td>" for i, c in enumerate(row))
+        + "</tr>"
+        for row in rows
     )
     return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
+def _html_align(column: int, left: tuple[int, ...]) -> str:
+    """The cell attribute of a left-aligned text column; the page's style sheet already
+    left-aligns the first column and right-aligns the others."""
+    return ' style="text-align: left"' if column in left and column > 0 else ""
 
 
 def _html_figure(data: tuple[str, str], folder: Path) -> str:

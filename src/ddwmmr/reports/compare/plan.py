@@ -329,9 +329,21 @@ def plan_runs(config: CompareConfig) -> Plan:
     return plan
 
 
+def study_trajectory(study: str) -> str:
+    """The trajectory a study runs on (the corner study the rectangle, the others the
+    ellipse)."""
+    return CORNER_TRAJECTORY if study == "corners" else STUDY_TRAJECTORY
+
+
 def _study_possible(config: CompareConfig, study: str) -> bool:
-    needed = CORNER_TRAJECTORY if study == "corners" else STUDY_TRAJECTORY
-    return needed in config.trajectories
+    return study_trajectory(study) in config.trajectories
+
+
+def skipped_studies(config: CompareConfig, plan: Plan) -> dict[str, str]:
+    """Study -> the trajectory it needs, for each requested study (``config.studies``,
+    every one by default) that ``plan`` leaves out because that trajectory is not compared
+    (``--only``/``--traj``)."""
+    return {study: study_trajectory(study) for study in config.studies if study not in plan.studies}
 
 
 def tau_methods(config: CompareConfig) -> list[str]:

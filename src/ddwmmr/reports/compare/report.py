@@ -48,6 +48,7 @@ from ddwmmr.reports.compare.plan import (
     main_spec,
     run_differences,
     run_duration,
+    skipped_studies,
     study_offsets,
     study_steps,
     study_tau,
@@ -63,6 +64,7 @@ from ddwmmr.reports.compare.ranking import (
 )
 from ddwmmr.reports.plots import circles_of
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
+from ddwmmr.sim.simulate import FINAL_WINDOW_FRACTION, WHEEL_LIMIT_TOLERANCE
 from ddwmmr.sim.verdict import explain
 
 # -- building the report ------------------------------------------------------------------
@@ -183,13 +185,21 @@ def _setup_section(c: _Context) -> None:
         "methods: "
         + "; ".join(f"`{m}`: {method_description(m).rstrip('.')}" for m in config.methods),
         f"runs: {len(c.plan.all_specs())} simulations "
-        f"(studies: {', '.join(c.plan.studies) or 'none'})",
+        f"(studies: {', '.join(c.plan.studies) or 'none'}{_skipped_text(config, c.plan)})",
     ]
     items += _obstacle_items(config)
     if config.command:
         items.append(f"command: `{config.command}`")
     c.doc.heading("Setup")
     c.doc.bullets(items)
+
+
+def _skipped_text(config: CompareConfig, plan: Plan) -> str:
+    skipped = skipped_studies(config, plan)
+    return "".join(
+        f"; {study} skipped: it needs the {needed} trajectory, which is not compared"
+        for study, needed in skipped.items()
+    )
 
 
 #: Caption sentence of the figures that draw the runs' obstacles.
@@ -270,7 +280,7 @@ def _advice_section(c: _Context, ranking: Ranking, slides_ranking: Ranking) -> N
         "is removed, whether tip-over stability is a hard constraint, and what the shoulder "
         "singularity cos th1 = 0 does to the run."
     )
-    c.doc.table(advice.ADVICE_HEADERS, advice.advice_rows(items))
+    c.doc.table(advice.ADVICE_HEADERS, advice.advice_rows(items), left=advice.ADVICE_TEXT)
     c.doc.bullets(advice.recommendations(items, slides_ranking, _corners_reached(c.config)))
 
 
@@ -386,7 +396,8 @@ def _diagnosis_section(c: _Context) -> None:
     c.doc.paragraph(
         "Findings computed from each main run's time series: the shoulder singularity "
         f"(|cos th1| < {SINGULAR_COS:g}), orientation lost at the rectangle's corners, "
-        "saturated commands, a kept initial offset, or convergence."
+        "commands the plant clipped at a speed limit (saturated), speed limits a method held "
+        "inside its own bounds, a kept initial offset, or convergence."
     )
     for name in c.config.trajectories:
         items = []
@@ -411,7 +422,7 @@ def _variants_table(c: _Context) -> None:
                 mm(variant["rms_position_error_m"]),
                 mm(base["rms_position_error_m"]),
                 fmt(variant["singular_steps"]),
-                fmt(variant["saturated_steps"]),
+                limit_steps(variant),
             ]
         )
     c.doc.paragraph(
@@ -421,7 +432,7 @@ def _variants_table(c: _Context) -> None:
         "section on the slides' settings.)"
     )
     c.doc.table(
-        ["run", "trajectory", "RMS (mm)", "main run RMS (mm)", "singular steps", "saturated steps"],
+        ["run", "trajectory", "RMS (mm)", "main run RMS (mm)", "singular steps", LIMIT_STEPS],
         rows,
     )
 
@@ -462,13 +473,25 @@ def _observations(c: _Context, ranking: Ranking) -> list[str]:
         )
     if removed:
         verb = "removes" if len(removed) == 1 else "remove"
-        notes.append(f"{', '.join(removed)} {verb} it (final error below 0.1 mm).")
+        notes.append(f"{', '.join(removed)} {verb} it (settled-end RMS error below 0.1 mm).")
     outside = [m for m in c.config.methods if m not in SLIDES_ORDER]
     for m in outside:
         notes.append(
             f"`{m}` is not in the slides' chain; it ranks {ranking.overall_rank[m]} overall."
         )
     return notes
+
+
+#: Header of a cell of :func:`limit_steps`.
+LIMIT_STEPS = "saturated / wheel-limit / joint-rate-limit steps"
+
+
+def limit_steps(summary: Mapping[str, Any]) -> str:
+    """Table cell ``"saturated / wheel-limit / joint-rate-limit"`` of a run's step counts
+    (``saturated_steps``: clipped by the plant; the others: at the limit, clipped or held
+    by the method's own bounds; see the Definitions)."""
+    keys = ("saturated_steps", "wheel_limit_steps", "joint_rate_limit_steps")
+    return " / ".join(fmt(summary.get(k, math.nan)) for k in keys)
 
 
 def tracked(reasons: Any) -> str:
@@ -481,7 +504,7 @@ def tracked(reasons: Any) -> str:
 METRIC_COLUMNS = (
     ("RMS pos (mm)", "rms_position_error_m", mm),
     ("max pos (mm)", "max_position_error_m", mm),
-    ("final pos (mm)", "final_position_error_m", mm),
+    ("settled-end RMS pos (mm)", "final_position_error_m", mm),
     ("RMS orient (rad)", "rms_orientation_error_rad", fmt),
     ("max nonhol. residual (m/s)", "max_nonholonomic_residual_m_s", fmt),
     ("peak wheel (rad/s)", "max_wheel_speed_rad_s", fmt),
@@ -490,6 +513,8 @@ METRIC_COLUMNS = (
     ("min stability S", "min_stability", fmt),
     ("singular steps", "singular_steps", fmt),
     ("saturated steps", "saturated_steps", fmt),
+    ("wheel-limit steps", "wheel_limit_steps", fmt),
+    ("joint-rate-limit steps", "joint_rate_limit_steps", fmt),
     ("step latency (us)", "median_step_us", fmt),
     ("tracked? (docs/cli.md, Verdict)", "verdict_reasons", tracked),
 )
@@ -707,26 +732,33 @@ def _tau_section(c: _Context) -> None:
             row = [m, fmt(tau), fmt(convergence[m][tau]), fmt(theory * tau)]
             for n in names:
                 summary = runs[(m, n, tau)].summary
-                row += [mm(summary["rms_position_error_m"]), fmt(summary["saturated_steps"])]
+                row += [mm(summary["rms_position_error_m"]), limit_steps(summary)]
             rows.append(row)
     c.doc.paragraph(
         f"Closed-loop methods with K = 1/tau for tau in {', '.join(f'{t:g}' for t in TAUS)} s. "
         f"Convergence time on the {STUDY_TRAJECTORY}: when the position error last exceeds "
         f"{100 * CONVERGED_FRACTION:g} % of the initial offset; a first-order decay "
-        f"exp(-t/tau) needs {theory:.2f} tau. "
+        f"exp(-t/tau) needs {first_order(theory)}. "
         + _tau_finding(convergence, run_duration(c.config, STUDY_TRAJECTORY), theory)
         + _tau_corner_finding(methods, runs)
     )
-    headers = ["method", "tau (s)", "convergence (s)", f"{theory:.2f} tau (s)"]
+    headers = ["method", "tau (s)", "convergence (s)", f"{first_order(theory)} (s)"]
     for n in names:
-        headers += [f"RMS {c.config.shown(n)} (mm)", f"saturated steps {c.config.shown(n)}"]
+        headers += [f"RMS {c.config.shown(n)} (mm)", f"{LIMIT_STEPS} {c.config.shown(n)}"]
     c.doc.table(headers, rows)
     c.add_figure(
         "study_tau.png",
         plots.plot_tau_study(curves, convergence, theory, c.colors),
         "Time-constant sweep: error vs time per tau (left), convergence time / tau per method "
-        f"(right; dotted: the first-order {theory:.2f}). " + _tau_overlap(convergence),
+        f"(right; dotted: the first-order {theory:.3f}). " + _tau_overlap(convergence),
     )
+
+
+def first_order(theory: float) -> str:
+    """``"2.996 tau"``: the time a first-order decay needs to fall below the convergence
+    threshold, as a multiple of tau (``theory`` = -ln of the threshold fraction), with
+    enough digits that the table's values (``theory * tau``) agree with it."""
+    return f"{theory:.3f} tau"
 
 
 def _tau_overlap(convergence: Mapping[str, Mapping[float, float]]) -> str:
@@ -795,7 +827,7 @@ def _tau_finding(
         if short:
             notes.append(
                 f"the {duration:g} s run is too short to settle for tau = {', '.join(short)} s: "
-                f"it ends before {theory:.2f} tau"
+                f"it ends before {first_order(theory)}"
             )
         if not settled:
             what = "never gets" if not short else "does not get"
@@ -911,21 +943,24 @@ def _integrator_section(c: _Context) -> None:
     curves = {
         m: {i: _errors(runs[(m, i)]) for i in ("euler", "rk4")} for m in c.config.study_methods
     }
-    rows = []
-    for m in c.config.study_methods:
-        e, r = runs[(m, "euler")].summary, runs[(m, "rk4")].summary
-        rows.append(
-            [m]
-            + [mm(x[k]) for k in ("max_position_error_m", "rms_position_error_m") for x in (e, r)]
-            + [mm(e["final_position_error_m"])]
-        )
+    summaries = {key: run.summary for key, run in runs.items()}
+    rows = [
+        [m]
+        + [
+            mm(summaries[(m, i)][k])
+            for k in ("max_position_error_m", "rms_position_error_m")
+            for i in ("euler", "rk4")
+        ]
+        + [mm(summaries[(m, "euler")]["end_position_error_m"])]
+        for m in c.config.study_methods
+    ]
     c.doc.paragraph(
         f"{STUDY_TRAJECTORY}, dt = {dt:g} s, no initial offset. Forward Euler is the "
         "first-order Runge-Kutta method: its local error is O(dt^2) per step, RK4's O(dt^5). "
         + _integrator_finding(runs)
     )
     headers = ["method", "Euler max (mm)", "RK4 max (mm)", "Euler RMS (mm)", "RK4 RMS (mm)"]
-    c.doc.table([*headers, "Euler final (mm)"], rows)
+    c.doc.table([*headers, "Euler at the end (mm)"], rows)
     c.add_figure(
         "study_integrator.png",
         plots.plot_integrator_study(curves, c.colors, dt),
@@ -934,21 +969,28 @@ def _integrator_section(c: _Context) -> None:
 
 
 def _integrator_finding(runs: Mapping[tuple[str, str], RunOutput]) -> str:
-    """Open loop ats vs closed loop clrrmc-ts under Euler, when both ran."""
-    if ("ats", "euler") not in runs or ("clrrmc-ts", "euler") not in runs:
+    """Open loop ats vs closed loop clrrmc-ts under Euler, when both ran: each one's
+    largest error (``max_position_error_m``), and ats's half way and at the last sample
+    (``end_position_error_m``, the table's "at the end"; not the settled-end RMS)."""
+    summaries = {key: run.summary for key, run in runs.items()}
+    if ("ats", "euler") not in summaries or ("clrrmc-ts", "euler") not in summaries:
         return ""
-    ats, ts = (runs[(m, "euler")].timeseries for m in ("ats", "clrrmc-ts"))
-    ats_max, ts_max = float(np.max(ats["position_error_m"])), float(np.max(ts["position_error_m"]))
-    middle, final = len(ats["t"]) // 2, float(ats["position_error_m"][-1])
+    largest = {k: float(v["max_position_error_m"]) for k, v in summaries.items()}
+    ats_max, ts_max = largest[("ats", "euler")], largest[("clrrmc-ts", "euler")]
+    ats = runs[("ats", "euler")].timeseries
+    end = float(summaries[("ats", "euler")]["end_position_error_m"])
     # only a clear return below the worst drift is put down to the closed curve
-    back = ", where the closed curve brings part of it back" if final < 0.9 * ats_max else ""
+    back = ", where the closed curve brings part of it back" if end < 0.9 * ats_max else ""
     return (
         f"With Euler the open-loop ats drifts {mm(ats_max)} mm off at worst "
-        f"({mm(ats['position_error_m'][middle])} mm half way, {mm(final)} "
+        f"({mm(ats['position_error_m'][len(ats['t']) // 2])} mm half way, {mm(end)} "
         f"mm at the end{back}), while the feedback of "
         f"clrrmc-ts holds it to {mm(ts_max)} mm. "
-        + _rk4_finding(runs, {"ats": ats_max, "clrrmc-ts": ts_max})
-        + _cs_euler_finding(runs, ts_max)
+        + _rk4_finding(
+            {m: largest[(m, "rk4")] for m in ("ats", "clrrmc-ts")},
+            {"ats": ats_max, "clrrmc-ts": ts_max},
+        )
+        + _cs_euler_finding(summaries, ts_max)
     )
 
 
@@ -956,11 +998,11 @@ def _integrator_finding(runs: Mapping[tuple[str, str], RunOutput]) -> str:
 NEGLIGIBLE_RK4_FRACTION = 0.1
 
 
-def _rk4_finding(runs: Mapping[tuple[str, str], RunOutput], euler_max: Mapping[str, float]) -> str:
-    """What RK4 measured for the methods of ``euler_max`` (method -> largest Euler error,
-    m): its largest errors in mm, called negligible only where each is below
-    :data:`NEGLIGIBLE_RK4_FRACTION` of the method's Euler error."""
-    rk4 = {m: float(np.max(runs[(m, "rk4")].timeseries["position_error_m"])) for m in euler_max}
+def _rk4_finding(rk4: Mapping[str, float], euler_max: Mapping[str, float]) -> str:
+    """What RK4 measured: ``rk4`` and ``euler_max`` map each method to its largest
+    position error (m, ``max_position_error_m``) with RK4 and with Euler. The RK4 errors in
+    mm, called negligible only where each is below :data:`NEGLIGIBLE_RK4_FRACTION` of the
+    method's Euler error."""
     measured = " and ".join(f"{mm(v)} mm for {m}" for m, v in rk4.items())
     small = [m for m, v in rk4.items() if v < NEGLIGIBLE_RK4_FRACTION * euler_max[m]]
     below = f"below {NEGLIGIBLE_RK4_FRACTION:g} x the method's Euler drift"
@@ -970,11 +1012,11 @@ def _rk4_finding(runs: Mapping[tuple[str, str], RunOutput], euler_max: Mapping[s
     return f"With RK4 the largest errors are {measured}: not {below} for {large}."
 
 
-def _cs_euler_finding(runs: Mapping[tuple[str, str], RunOutput], ts_max: float) -> str:
+def _cs_euler_finding(summaries: Mapping[tuple[str, str], Mapping[str, Any]], ts_max: float) -> str:
     """clrrmc-cs under Euler: sideways base error its feedback cannot remove."""
-    if ("clrrmc-cs", "euler") not in runs:
+    if ("clrrmc-cs", "euler") not in summaries:
         return ""
-    summary = runs[("clrrmc-cs", "euler")].summary
+    summary = summaries[("clrrmc-cs", "euler")]
     if summary["max_position_error_m"] < 2.0 * ts_max:
         return ""
     return (
@@ -1011,7 +1053,7 @@ def _init_section(c: _Context) -> None:
     c.doc.paragraph(
         f"{STUDY_TRAJECTORY}: the end effector starts off the path by multiples of the default "
         "offset (same direction in the end effector's frame), moved with the arm; offsets the "
-        "arm cannot reach are left out. Final position error per method: an "
+        "arm cannot reach are left out. Settled-end RMS position error per method: an "
         "open-loop method ends with its offset, a closed-loop one removes it."
     )
     headers = ["method", *[f"offset {1000 * k:.1f} mm" for k in sorted(next(iter(final.values())))]]
@@ -1109,10 +1151,19 @@ def _definitions_section(c: _Context) -> None:
             "orientation error: desired minus actual phiE, wrapped to [-pi, pi) (rad)",
             "nonholonomic residual: sideways base speed a method asked for and the "
             "differential drive cannot produce (m/s)",
+            'settled-end RMS position error (`final_position_error_m`; "final" in the '
+            "verdict): RMS of the position error over the settled end of the run, the last "
+            f"{100 * FINAL_WINDOW_FRACTION:g} % of the samples outside the rectangle's corner "
+            "windows; position error at the end (`end_position_error_m`): at the last sample",
             "manipulability: |sin th2| in [0, 1]; stability S: tip-over margin, S <= 1 tips",
             "singular steps: steps with damping near a singularity (for `clrrmc-cs`: steps "
             "whose reference segment was integrated with damping); saturated steps: steps "
-            "where a wheel or joint speed limit was hit",
+            "whose command the plant clipped at a wheel or joint speed limit (or stopped at "
+            "a joint limit); wheel-limit steps, joint-rate-limit steps: steps with a wheel "
+            "speed or a joint rate within "
+            f"{100 * WHEEL_LIMIT_TOLERANCE:g} % of its limit, whether the plant clipped it "
+            "or the method held it inside its own bounds (`qp` and `mpc` bound their "
+            "commands a hair inside the limits: their limits show here, not as saturated)",
             "step latency: median wall-clock time of one controller call (us); a timing, so "
             "it varies between runs and machines",
             "`metrics.csv`: one row per method x trajectory with every `summary.json` field "

@@ -73,7 +73,7 @@ def runs_by_preset(config: CompareConfig, plan: Plan) -> dict[str, dict[tuple[st
 def result_rows(
     config: CompareConfig, plan: Plan, outputs: Mapping[RunSpec, RunOutput]
 ) -> list[list[str]]:
-    """``[method, trajectory, RMS slides, RMS ours, final slides, final ours]`` (mm) and
+    """``[method, trajectory, RMS slides, RMS ours, settled-end RMS slides, ours]`` (mm) and
     the singular / saturated steps under both, for every method whose presets differ (the
     others run once and are the same in both)."""
     runs = runs_by_preset(config, plan)
@@ -102,8 +102,8 @@ RESULT_HEADERS = [
     "trajectory",
     "RMS slides (mm)",
     "RMS ours (mm)",
-    "final slides (mm)",
-    "final ours (mm)",
+    "settled-end RMS slides (mm)",
+    "settled-end RMS ours (mm)",
     "RMS orient. slides (rad)",
     "RMS orient. ours (rad)",
     "singular steps slides / ours",
