@@ -146,11 +146,13 @@ def test_threshold_table_states_what_ours_is_against_the_thesis():
         "ours: 1 scenario, thesis controller, thesis plant, payload 3 kg, state-machine "
         "arbiter, 60 s limit;"
     )
-    summary = {key: 0 for _, key, _ in studies.THRESHOLD_COLUMNS}
+    summary = {key: 0 for _, key, _ in studies.THRESHOLD_COLUMNS} | {"n": 2}
     results = [(studies.THRESHOLD_VARIANTS[0], summary)]
     bare = studies.threshold_table(results)
     assert bare.startswith("| variant (thesis table) |")
-    assert studies.threshold_table(results, context) == f"{context}\n\n{bare}"
+    assert studies.threshold_table(results, context) == (
+        f"{studies.THRESHOLD_HEADING}\n\n{context}\n\n{studies.THRESHOLD_NOTE}\n\n{bare}"
+    )
 
 
 def test_threshold_study_table_has_thesis_and_our_numbers(tmp_path, capsys):
@@ -160,9 +162,10 @@ def test_threshold_study_table_has_thesis_and_our_numbers(tmp_path, capsys):
     table = (out / "thresholds.md").read_text()
     lines = [line for line in table.splitlines() if line.startswith("| ")]
     assert len(lines) == 1 + 18  # header + every variant of Tables 5.5-5.20
-    assert "| Baseline (5.2) | 1.25/1.6 | 0.75/0.9 | 0 / 2 | 44.9 / 4 |" in table
-    assert "42 / " in table  # Table 5.12 threshold 5
+    assert "| Baseline (5.2) | 1.25/1.6 | 0.75/0.9 | 0 of 100 / 2 of 2 | 44.9 / 4 |" in table
+    assert "42 of 100 / " in table  # Table 5.12 threshold 5
     assert table.startswith(
+        "# Threshold study (thesis Tables 5.5-5.20): cells are thesis / ours\n\n"
         "ours: 2 scenarios (seed 0), thesis controller, thesis plant, payload 3 kg, "
         "state-machine arbiter, 4 s limit; the thesis: 100 scenarios, 1.25 kg payload\n"
     )

@@ -414,8 +414,8 @@ def test_scenario_figures_show_their_data(tmp_path, monkeypatch):
 
     problems: dict[str, list[str]] = {}
 
-    def check(fig, path):
-        fig.tight_layout()
+    def check(fig, path, rect=None):
+        fig.tight_layout(rect=rect)  # as report._save lays it out
         problems[Path(path).name] = figure_problems(fig)
         plt.close(fig)
 

@@ -31,6 +31,7 @@ from typing import Any
 from ddwmmr import provenance
 from ddwmmr.arbiters import DEFAULT_ARBITER, arbiter_description, available_arbiters
 from ddwmmr.arbiters.state_machine import THESIS_MANIPULABILITY, THESIS_STABILITY
+from ddwmmr.behaviours.obstacle import base_bubble
 from ddwmmr.cli.common import (
     ArgumentParser,
     RefusedOption,
@@ -643,7 +644,7 @@ def _figures(folder: Path, scenarios, outcomes, config: RunConfig, progress: boo
 
 
 def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
-    short = f"{config.controller} / {config.plant}"
+    short = f"{config.controller} controller, {config.plant} plant"
     report.plot_state_times(outcomes, folder / "thesis_times.png", f"{short}: time per state")
     report.plot_speeds(outcomes, folder / "thesis_speed.png", short)
     if controller_traits(config.controller)["arbiter"]:
@@ -660,9 +661,60 @@ def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
     chosen = sorted({0, min(1, len(scenarios) - 1), focus})
     traced = replace(config, record=True)
     items = [(scenarios[i], run_scenario(scenarios[i], traced)) for i in chosen]
-    report.plot_paths(items, folder / "thesis_paths.png", f"{short}: paths")
+    report.plot_paths(
+        items, folder / "thesis_paths.png", paths_title(short, outcomes, chosen, focus)
+    )
     scenario, timeline = next((s, o) for (s, o) in items if s.index == scenarios[focus].index)
-    report.plot_timeline(timeline, folder / "thesis_timeline.png", short, scenario)
+    report.plot_timeline(
+        timeline, folder / "thesis_timeline.png", short, scenario, **timeline_thresholds(config)
+    )
+
+
+def paths_title(short: str, outcomes: list[Outcome], chosen: list[int], focus: int) -> str:
+    """The title of thesis_paths.png: which of how many scenarios it shows, and why (the
+    first two, and the :func:`highlight` one: the first failure, else the busiest in fix
+    states), e.g. "thesis controller, thesis plant: paths of scenarios 1, 2 (the first
+    two) and 5 (the first failure) of 6 run", or "... 1, 2 (the first two; 1: the first
+    failure) of 6 run"."""
+    number = [o.metrics["scenario"] for o in outcomes]
+    firsts = [i for i in chosen if i < 2]
+    m = outcomes[focus].metrics
+    entries = _count(m["transitions_stability"]) + _count(m["transitions_manipulability"])
+    why = "the first failure" if not m["success"] else "the most fix-state entries"
+    note = "the first two" if len(firsts) == 2 else "the first"
+    if focus in firsts and (not m["success"] or entries > 0):  # the one to look at
+        note += f"; {number[focus]}: {why}"
+    shown = ", ".join(str(number[i]) for i in firsts) + f" ({note})"
+    if focus not in firsts:
+        shown += f" and {number[focus]} ({why})"
+    plural = "s" * (len(chosen) > 1)
+    return f"{short}: paths of scenario{plural} {shown} of {len(outcomes)} run"
+
+
+def _state_lines(state: str, symbol: str, thresholds) -> list[tuple[float, str]]:
+    """Enter and exit lines of a fix state; one line where they coincide (no hysteresis)."""
+    enter, leave = thresholds
+    if enter == leave:
+        return [(enter, f"{state} state below, left above {symbol} = {enter:g}")]
+    return [
+        (enter, f"enter {state} state, {symbol} < {enter:g}"),
+        (leave, f"leave it, {symbol} >= {leave:g}"),
+    ]
+
+
+def timeline_thresholds(config: RunConfig) -> dict[str, list[tuple[float, str]]]:
+    """The thresholds the timeline's S and eta panels draw (:func:`report.plot_timeline`):
+    an arbiter's enter/exit thresholds, or the ``qp``/``mpc`` stability floor ``S_min``."""
+    if controller_traits(config.controller)["arbiter"]:
+        return {
+            "stability_lines": _state_lines("stability", "S", config.stability),
+            "manipulability_lines": _state_lines("manipulability", "eta", config.manipulability),
+        }
+    uses = {name for name, takers in QP_OPTIONS.items() if config.controller in takers}
+    if "qp_stability_min" in uses:
+        floor = config.qp_stability_min
+        return {"stability_lines": [(floor, f"floor S_min = {floor:g}")]}
+    return {}
 
 
 def highlight(outcomes: list[Outcome]) -> int:
@@ -781,7 +833,6 @@ def _run_thresholds(args, config, runner, folder: Path) -> None:
         "run": _record(args, config, runner.workers),
     }
     write_atomic(folder / MARKER, report.summary_json(total))
-    print("Threshold study: cells are thesis / ours\n")
     print(table, end="")
 
 
@@ -790,14 +841,15 @@ def _run_obstacles(args, config, runner, folder: Path) -> None:
     outcomes, wall = runner.run(scenarios, config, "obstacles")
     extra = {"seed": args.seed, "study": "obstacles", "run": _record(args, config, runner.workers)}
     write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
-    table = studies.obstacle_table([o.metrics for o in outcomes])
+    table = studies.obstacle_table([o.metrics for o in outcomes], _title(config))
     write_atomic(folder / "obstacles.md", table)
     report.plot_paths(
         [(s, run_scenario(s, replace(config, record=True))) for s in scenarios],
         folder / "thesis_obstacle_paths.png",
-        "obstacle study: paths",
+        f"obstacle study, {config.controller} controller, {config.plant} plant: paths",
+        clearance=base_bubble(config_robot(config)),
     )
-    print("\nTable 5.21 format: cells are thesis / ours\n")
+    print()
     print(table, end="")
 
 

@@ -17,7 +17,8 @@ one line. docs/thesis.md, "What is simulated", describes the pairs and why some 
 out.
 
 Metrics (seconds unless noted): ``time_s`` (time to the last waypoint, or to the failure),
-``speed_m_s`` (straight-line length start -> waypoints / ``time_s``), ``time_base_s`` and
+``speed_m_s`` (straight-line length start -> waypoints / ``time_s``; NaN for a scenario
+that did not finish), ``time_base_s`` and
 ``time_arm_s`` (thesis controller: time in the moving-base / moving-arm states; other
 controllers, which have no states: time with the base moving, |v| > 1 mm/s or |w| > 1 mrad/s,
 and with an arm joint moving, > 1 mrad/s), time in and transitions into each fix state
@@ -462,7 +463,9 @@ class _Tally:
             "waypoints_reached": self.index,
             "time_s": t,
             "path_length_m": length,
-            "speed_m_s": length / t if t > 0 else nan,
+            # thesis Table 5.2: the route over the time to its last waypoint; a run that
+            # stopped early covered only part of the route, so it has no such speed
+            "speed_m_s": length / t if t > 0 and self.reason == "ok" else nan,
             "min_stability": self.min_s,
             "min_manipulability": self.min_eta,
             "unloaded_time_s": nan if self.physics is None else self.physics.unloaded_time_s,

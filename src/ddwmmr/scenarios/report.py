@@ -6,6 +6,7 @@ import csv
 import io
 import json
 import math
+import textwrap
 from collections.abc import Sequence
 from typing import Any
 
@@ -15,7 +16,14 @@ from ddwmmr.arbiters.state_machine import STATES
 from ddwmmr.errors import ParameterError, check_int_at_least, one_line
 from ddwmmr.outputs import write_atomic
 from ddwmmr.scenarios.generator import Scenario
-from ddwmmr.scenarios.protocol import FINE_TRACE_DISTANCE, METRICS, TRACE_INTERVAL, Outcome
+from ddwmmr.scenarios.protocol import (
+    FINE_TRACE_DISTANCE,
+    METRICS,
+    MOVING_RATE,
+    MOVING_SPEED,
+    TRACE_INTERVAL,
+    Outcome,
+)
 from ddwmmr.sim.result import json_safe
 
 #: (summary key, metric column) pairs reported as mean and sample standard deviation.
@@ -105,7 +113,9 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
     """Batch summary: failures, mean and sd of every metric, minimum stability, speed.
 
     Means are over all scenarios (a failed scenario counts with the time at which it
-    stopped); ``sd_*`` are sample standard deviations (n - 1; NaN for one scenario).
+    stopped), except the speed's: ``mean_speed_m_s`` and ``sd_speed_m_s`` are over the
+    ``speed_scenarios`` that finished (``speed_m_s`` of the protocol; NaN if none did); ``sd_*``
+    are sample standard deviations (n - 1; NaN for one value).
     ``ci95_time_s`` is the half-width (s) of the mean time's 95 % confidence interval over
     the scenarios, ``t sd / sqrt(n)`` with ``t`` Student's two-sided 95 % quantile for
     n - 1 degrees of freedom (:func:`t_quantile_95`: 4.303 at n = 3, 1.984 at n = 100;
@@ -119,7 +129,11 @@ def summarize(outcomes: Sequence[Outcome], wall_time_s: float) -> dict[str, Any]
     failed = [o.metrics for o in outcomes if not o.metrics["success"]]
     summary: dict[str, Any] = {"n": len(outcomes), "failed": len(failed)}
     for key, column in AVERAGED:
-        mean, sd = _mean_sd(_column(outcomes, column))
+        values = _column(outcomes, column)
+        if key == "speed_m_s":  # finished scenarios only
+            values = values[np.isfinite(values)]
+            summary["speed_scenarios"] = int(values.size)
+        mean, sd = _mean_sd(values)
         name = "mean_time_s" if key == "time_s" else key
         name = "mean_speed_m_s" if key == "speed_m_s" else name
         summary[name] = mean
@@ -162,29 +176,58 @@ def _fmt(value: float) -> str:
     return f"{value:.3g}"
 
 
-def table_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
-    """Rows of thesis Table 5.2: label and "mean (share of time) (sd)" text."""
-    total = summary["mean_time_s"]
+def _stateless(summary: dict[str, Any]) -> bool:
+    """True for a controller without states: no time in the stability state (NaN)."""
+    value = summary["time_stability_s"]
+    return isinstance(value, float) and math.isnan(value)
 
-    def with_share(key: str) -> str:
+
+#: What a Table 5.2 cell holds (thesis Table 5.2's own layout).
+TABLE_LEGEND = (
+    "Cells: mean (share of the mean simulation time) (sample standard deviation) over the "
+    "scenarios; a failed scenario counts up to the instant it stopped, except in the speed, "
+    "which is over the finished scenarios only (the route's straight-line length over the "
+    "time to its last waypoint)."
+)
+#: Footnote of a controller without states, whose base and arm times overlap.
+OVERLAP_NOTE = (
+    "* This controller has no states: base and arm times are the times with the base moving "
+    f"(|v| > {MOVING_SPEED * 1e3:g} mm/s or |w| > {MOVING_RATE * 1e3:g} mrad/s) and with a "
+    f"joint moving (> {MOVING_RATE * 1e3:g} mrad/s); they overlap, so their shares need not "
+    "add to 100 %, and a base creeping at the end of an approach counts as moving."
+)
+
+
+def table_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
+    """Rows of thesis Table 5.2: label and "mean (share of time) (sd)" text
+    (:data:`TABLE_LEGEND`). The base and arm shares of a controller without states are
+    starred (:data:`OVERLAP_NOTE`); the speed of a batch with failures says over how many
+    finished scenarios it is."""
+    total = summary["mean_time_s"]
+    star = "*" if _stateless(summary) else ""
+
+    def with_share(key: str, mark: str = "") -> str:
         mean, sd = summary[key], summary["sd_" + key]
         if isinstance(mean, float) and math.isnan(mean):
             return "n/a"
         # Every scenario may stop at t = 0 (a payload that tips the start pose): no share.
         share = _fmt(100.0 * mean / total) + "%" if total and total > 0 else "n/a"
-        return f"{_fmt(mean)} ({share}) ({_fmt(sd)})"
+        return f"{_fmt(mean)} ({share}){mark} ({_fmt(sd)})"
 
     def plain(mean_key: str, sd_key: str) -> str:
         if isinstance(summary[mean_key], float) and math.isnan(summary[mean_key]):
             return "n/a"
         return f"{_fmt(summary[mean_key])} ({_fmt(summary[sd_key])})"
 
+    speed = plain("mean_speed_m_s", "sd_speed_m_s")
+    if summary["failed"]:
+        speed += f", over the {summary['speed_scenarios']} of {summary['n']} that finished"
     rows = [
         ("No. of failed scenarios", str(summary["failed"])),
         ("Simulation time (s)", plain("mean_time_s", "sd_time_s")),
-        ("Simulation speed (m/s)", plain("mean_speed_m_s", "sd_speed_m_s")),
-        ("Time spent moving base (s)", with_share("time_base_s")),
-        ("Time spent moving manipulator (s)", with_share("time_arm_s")),
+        ("Simulation speed (m/s)", speed),
+        ("Time spent moving base (s)", with_share("time_base_s", star)),
+        ("Time spent moving manipulator (s)", with_share("time_arm_s", star)),
         ("Time in manipulability state (s)", with_share("time_manipulability_s")),
         (
             "No. of manipulability state transitions",
@@ -198,14 +241,22 @@ def table_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
     ]
     if summary.get("time_obstacle_s", 0.0) and not math.isnan(summary["time_obstacle_s"]):
         rows.append(("Time in obstacle state (s)", with_share("time_obstacle_s")))
+        rows.append(
+            (
+                "No. of obstacle state transitions",
+                plain("transitions_obstacle", "sd_transitions_obstacle"),
+            )
+        )
     return rows
 
 
 def format_table(summary: dict[str, Any], title: str) -> str:
-    """Plain-text table in the format of thesis Table 5.2 (mean (sd))."""
+    """Plain-text table in the format of thesis Table 5.2: ``title``, the cells' legend
+    (:data:`TABLE_LEGEND`), the rows, and for a controller without states the footnote
+    on its overlapping base and arm times (:data:`OVERLAP_NOTE`)."""
     rows = table_rows(summary)
     width = max(len(label) for label, _ in rows)
-    lines = [title, "-" * len(title)]
+    lines = [title, "-" * len(title), *textwrap.wrap(TABLE_LEGEND, width=88)]
     lines += [f"{label:<{width}}  {value}" for label, value in rows]
     lines.append(f"{'Minimum stability S':<{width}}  {_fmt(summary['min_stability'])}")
     if summary.get("fallback_steps") is not None:
@@ -220,6 +271,8 @@ def format_table(summary: dict[str, Any], title: str) -> str:
         lines.append(f"{'Tipped over (physics)':<{width}}  {summary['tipped_physics']}")
         label = "Time with an edge unloaded (s)"
         lines.append(f"{label:<{width}}  {_fmt(summary['mean_unloaded_time_s'])}")
+    if _stateless(summary):
+        lines += textwrap.wrap(OVERLAP_NOTE, width=88)
     return "\n".join(lines) + "\n"
 
 
@@ -233,7 +286,9 @@ def summary_json(summary: dict[str, Any]) -> str:
 
 
 def metrics_csv(outcomes: Sequence[Outcome]) -> str:
-    """One CSV row per scenario with every metric of :data:`METRICS`."""
+    """One CSV row per scenario with every metric of :data:`METRICS`; the speed of a
+    scenario that did not finish is undefined, "nan" (``speed_m_s`` of
+    :mod:`ddwmmr.scenarios.protocol`)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(METRICS)
@@ -260,11 +315,13 @@ def _figure(rows: int = 1, cols: int = 1, height: float = 3.2):
     return plt.subplots(rows, cols, figsize=(10, height * rows), squeeze=False)
 
 
-def _save(fig, path) -> None:
+def _save(fig, path, rect: tuple[float, float, float, float] | None = None) -> None:
+    """Lay out ``fig`` (its axes within ``rect``, figure fractions; None: all of it), write
+    it to ``path`` as PNG and close it."""
     import matplotlib.pyplot as plt
 
     buffer = io.BytesIO()
-    fig.tight_layout()
+    fig.tight_layout(rect=rect)
     fig.savefig(buffer, format="png", dpi=110)
     plt.close(fig)
     write_atomic(path, buffer.getvalue())
@@ -366,21 +423,34 @@ def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
     _save(fig, path)
 
 
+#: Legend label of the marks of scenarios that did not finish in the speed figure.
+NO_SPEED_LABEL = "did not finish: no speed"
+
+
 def plot_speeds(outcomes: Sequence[Outcome], path, title: str) -> None:
-    """Per-scenario speed (Fig 5.4) and speed over base-moving time only (Fig 5.5);
-    bars of scenarios that did not finish are hatched."""
+    """Per-scenario speed (Fig 5.4) and speed over base-moving time only (Fig 5.5) of the
+    scenarios that finished (``speed_m_s`` of :mod:`ddwmmr.scenarios.protocol`); a
+    scenario that did not finish has no bar but a red cross on the axis, named in the
+    legend (:data:`NO_SPEED_LABEL`)."""
     fig, axes = _figure(2, 1)
-    index = [o.metrics["scenario"] for o in outcomes]
+    index = np.array([o.metrics["scenario"] for o in outcomes])
     failed = _failed(outcomes)
-    length = _column(outcomes, "path_length_m")
-    _bars(axes[0, 0], index, _column(outcomes, "speed_m_s"), failed, width=0.85)
-    axes[0, 0].set(ylabel="speed (m/s)", title=f"{title}: path length / total time")
+    length = np.where(failed, np.nan, _column(outcomes, "path_length_m"))
     base = _column(outcomes, "time_base_s")
     with np.errstate(divide="ignore", invalid="ignore"):
-        _bars(axes[1, 0], index, np.where(base > 0, length / base, np.nan), failed, width=0.85)
-    axes[1, 0].set(xlabel="scenario", ylabel="speed (m/s)", title="path length / base-moving time")
-    _bar_axes(axes[0, 0], index, failed)
-    _bar_axes(axes[1, 0], index, np.zeros_like(failed))
+        over_base = np.where(base > 0, length / base, np.nan)
+    panels = (
+        (_column(outcomes, "speed_m_s"), f"{title}: path length / total time"),
+        (over_base, "path length / base-moving time"),
+    )
+    for ax, (values, heading) in zip(axes[:, 0], panels):
+        _bars(ax, index, values, np.zeros_like(failed), width=0.85)
+        if failed.any():  # a cross just above the axis (axes fraction 0.04), never cut
+            ax.plot(index[failed], np.full(int(failed.sum()), 0.04), "x", color="tab:red",
+                    transform=ax.get_xaxis_transform(), label=NO_SPEED_LABEL)  # fmt: skip
+        ax.set(ylabel="speed (m/s)", title=heading)
+        _bar_axes(ax, index, np.zeros_like(failed), entries=True, empty="no scenario finished")
+    axes[1, 0].set(xlabel="scenario")
     _save(fig, path)
 
 
@@ -403,8 +473,14 @@ def plot_fix_state(outcomes: Sequence[Outcome], key: str, path, title: str) -> N
     _save(fig, path)
 
 
-def plot_paths(items: Sequence[tuple[Scenario, Outcome]], path, title: str) -> None:
-    """Base and end-effector paths with waypoints (and obstacles) of chosen scenarios."""
+def plot_paths(
+    items: Sequence[tuple[Scenario, Outcome]], path, title: str, clearance: float | None = None
+) -> None:
+    """Base and end-effector paths with waypoints (and obstacles, grey discs) of chosen
+    scenarios, under the figure title ``title``. With ``clearance`` (m, the radius of the
+    base's enclosing circle, which the protocol keeps off the obstacles), that circle is
+    drawn where the base came closest to an obstacle and each panel's title gives that
+    gap. One legend below the panels names every kind of line, mark and disc."""
     import matplotlib.patches as patches
 
     cols = min(len(items), 2)
@@ -419,26 +495,68 @@ def plot_paths(items: Sequence[tuple[Scenario, Outcome]], path, title: str) -> N
         for i, (x, y) in enumerate(scenario.waypoints, start=1):
             ax.annotate(str(i), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8)
         ax.plot([0.0], [0.0], "go", ms=5, label="start")
-        for ox, oy, radius in scenario.obstacles:
-            ax.add_patch(patches.Circle((ox, oy), radius, color="0.5", alpha=0.6))
+        for i, (ox, oy, radius) in enumerate(scenario.obstacles):
+            label = f"obstacle (r {radius:g} m)" if i == 0 else None
+            ax.add_patch(patches.Circle((ox, oy), radius, color="0.5", alpha=0.6, label=label))
         m = outcome.metrics
-        ax.set(
-            aspect="equal",
-            title=f"scenario {m['scenario']}: {m['reason']}, {m['time_s']:.1f} s",
-            xlabel="x (m)",
-            ylabel="y (m)",
-        )
-        ax.legend(fontsize=7, loc="best")
+        heading = f"scenario {m['scenario']}: {m['reason']}, {m['time_s']:.1f} s"
+        if clearance is not None and scenario.obstacles:
+            heading += (
+                f", closest gap {_closest_approach(ax, tr, scenario.obstacles, clearance):.2f} m"
+            )
+        ax.set(aspect="equal", title=heading, xlabel="x (m)", ylabel="y (m)")
     for ax in list(axes.flat)[len(items) :]:
         ax.axis("off")
     fig.suptitle(title)
-    _save(fig, path)
+    named: dict[str, Any] = {}
+    for ax in axes.flat:  # each kind once, in drawing order
+        for handle, label in zip(*ax.get_legend_handles_labels()):
+            named.setdefault(label, handle)
+    fig.legend(list(named.values()), list(named), loc="lower center", ncol=4, fontsize=8)
+    legend_rows = math.ceil(len(named) / 4)
+    _save(fig, path, rect=(0.0, 0.25 * legend_rows / fig.get_figheight(), 1.0, 1.0))
 
 
-def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None = None) -> None:
+#: A threshold line of a timeline panel: value and legend label.
+Threshold = tuple[float, str]
+#: Line styles of a panel's thresholds, in order (an enter and an exit threshold).
+THRESHOLD_STYLES = ((":", "tab:orange"), ("-.", "tab:green"))
+
+
+def _closest_approach(ax, trace: dict, obstacles, clearance: float) -> float:
+    """Draw the base's enclosing circle (radius ``clearance``, m) at the trace sample where
+    it came closest to an obstacle and return that gap (m; negative: overlapping; NaN
+    without a trace)."""
+    import matplotlib.patches as patches
+
+    x = np.asarray(trace.get("x", []), dtype=float)
+    y = np.asarray(trace.get("y", []), dtype=float)
+    if not len(obstacles) or not len(x):
+        return math.nan
+    circles = np.asarray(obstacles, dtype=float)  # (k, 3): x, y, radius
+    gaps = np.hypot(x[:, None] - circles[None, :, 0], y[:, None] - circles[None, :, 1])
+    gaps -= circles[None, :, 2] + clearance
+    k = int(np.argmin(np.min(gaps, axis=1)))
+    label = f"base's enclosing circle (r {clearance:.3g} m) where closest to an obstacle"
+    circle = patches.Circle((x[k], y[k]), clearance, fill=False, ec="tab:red", ls="--", lw=0.9)
+    circle.set_label(label)
+    ax.add_patch(circle)
+    return float(np.min(gaps[k]))
+
+
+def plot_timeline(
+    outcome: Outcome,
+    path,
+    title: str,
+    scenario: Scenario | None = None,
+    stability_lines: Sequence[Threshold] = (),
+    manipulability_lines: Sequence[Threshold] = (),
+) -> None:
     """Controller state, stability, manipulability and the distance to the current waypoint
     over time for one scenario (thesis Fig 5.17); with ``scenario``, the instants at which
-    each waypoint was reached are marked.
+    each waypoint was reached are marked, the last one's included. ``stability_lines`` and
+    ``manipulability_lines`` (up to two each, ``(value, label)``) are the thresholds the
+    controller acts on, drawn with their labels in the S and eta panels beside S = 1.
 
     The top title states the outcome (:func:`outcome_text`); a scenario that did not
     finish has the instant it stopped marked by a red vertical in every panel."""
@@ -471,13 +589,16 @@ def plot_timeline(outcome: Outcome, path, title: str, scenario: Scenario | None 
     ax3 = axes[2, 0]
     ax3.plot(t, tr.get("eta", []), color="tab:purple", label="manipulability eta = |sin th2|")
     ax3.set(ylim=(0.0, 1.05), ylabel="manipulability\neta (-)")
+    for axis, lines in ((ax2, stability_lines), (ax3, manipulability_lines)):
+        for (value, label), (style, color) in zip(lines, THRESHOLD_STYLES):
+            axis.axhline(value, color=color, lw=0.9, ls=style, label=label)
     ax4 = axes[3, 0]
     # The log scale and its range before the data: a one-instant trace cannot autoscale.
     ax4.set(yscale="log", ylim=(1e-4, 30.0))
     ax4.plot(t, np.maximum(tr.get("distance", []), 1e-4), label="distance")
     ax4.axhline(0.01, color="k", lw=0.6, ls="--", label="tolerance 0.01 m")
     if scenario is not None:
-        _mark_waypoints(ax4, tr, scenario)
+        _mark_waypoints(ax4, tr, scenario, outcome.metrics)
     sampling = (
         f" (trace: every {TRACE_INTERVAL:g} s, every step within {FINE_TRACE_DISTANCE:g} m "
         "of a waypoint)"
@@ -526,8 +647,10 @@ def outcome_text(metrics: dict[str, Any], waypoints: int | None = None) -> str:
     return f"{reason} at {time:.1f} s, {reached}{of} waypoints reached"
 
 
-def _mark_waypoints(ax, trace: dict, scenario: Scenario) -> None:
-    """Dotted verticals at the first trace sample after each waypoint was reached.
+def _mark_waypoints(ax, trace: dict, scenario: Scenario, metrics: dict[str, Any]) -> None:
+    """Dotted verticals at the first trace sample after each waypoint was reached, and
+    for a finished scenario (``metrics``' ``success``) at its end, ``time_s``: the run
+    stops on reaching the last waypoint, so no sample follows that one.
 
     The trace records the distance to the *current* waypoint; the waypoint it refers to is
     the one at exactly that distance from the end effector, so a change of that index is
@@ -544,6 +667,9 @@ def _mark_waypoints(ax, trace: dict, scenario: Scenario) -> None:
     current = np.maximum.accumulate(np.argmin(np.abs(to_each - distance[:, None]), axis=1))
     done = distance == 0.0  # after the last waypoint
     current[done] = len(points)
-    for i, k in enumerate(np.flatnonzero(np.diff(current) > 0) + 1):
+    reached = list(t[np.flatnonzero(np.diff(current) > 0) + 1])
+    if metrics["success"] and len(reached) < len(points):
+        reached.append(float(metrics["time_s"]))
+    for i, instant in enumerate(reached):
         label = "waypoint reached" if i == 0 else None
-        ax.axvline(t[k], color="tab:green", lw=0.6, ls=":", label=label)
+        ax.axvline(instant, color="tab:green", lw=0.6, ls=":", label=label)

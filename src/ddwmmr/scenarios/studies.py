@@ -141,9 +141,21 @@ def context_line(n: int, seed: int | None, config: RunConfig) -> str:
     )
 
 
+#: Heading of thresholds.md: which side of a cell is which.
+THRESHOLD_HEADING = "# Threshold study (thesis Tables 5.5-5.20): cells are thesis / ours"
+#: What the study's cells hold, below its context line.
+THRESHOLD_NOTE = (
+    "failed: k of each side's n scenarios; speed: mean over the scenarios that finished; "
+    "other columns: means over all scenarios, a failed one up to the instant it stopped; "
+    '"–": not published by the thesis.'
+)
+
+
 def threshold_table(results: list[tuple[Variant, dict[str, Any]]], context: str = "") -> str:
-    """Markdown table: each variant's thesis row next to ours ("thesis / ours" per cell),
-    after ``context`` (:func:`context_line`) as its own paragraph when given."""
+    """Markdown table: each variant's thesis row next to ours ("thesis / ours" per cell,
+    failures as "k of n" on each side: ``summary["n"]`` is ours). With ``context``
+    (:func:`context_line`) the text of thresholds.md: :data:`THRESHOLD_HEADING`, the
+    context and :data:`THRESHOLD_NOTE` as paragraphs, then the table."""
     head = "| variant (thesis table) | S enter/exit | eta enter/exit | "
     head += " | ".join(label for _, _, label in THRESHOLD_COLUMNS) + " |"
     lines = [head, "|" + "---|" * (3 + len(THRESHOLD_COLUMNS))]
@@ -154,10 +166,13 @@ def threshold_table(results: list[tuple[Variant, dict[str, Any]]], context: str 
             f"{variant.manipulability[0]:g}/{variant.manipulability[1]:g}",
         ]
         for thesis_key, our_key, _ in THRESHOLD_COLUMNS:
-            cells.append(f"{_g(variant.thesis[thesis_key])} / {_g(summary[our_key])}")
+            thesis, ours = _g(variant.thesis[thesis_key]), _g(summary[our_key])
+            if thesis_key == "failed":
+                thesis, ours = f"{thesis} of {THESIS_N}", f"{ours} of {summary['n']}"
+            cells.append(f"{thesis} / {ours}")
         lines.append("| " + " | ".join(cells) + " |")
     table = "\n".join(lines) + "\n"
-    return f"{context}\n\n{table}" if context else table
+    return f"{THRESHOLD_HEADING}\n\n{context}\n\n{THRESHOLD_NOTE}\n\n{table}" if context else table
 
 
 OBSTACLE_ROWS = (
@@ -175,8 +190,16 @@ OBSTACLE_ROWS = (
 )
 
 
-def obstacle_table(metrics: list[dict[str, Any]]) -> str:
-    """Markdown table in the layout of thesis Table 5.21 ("thesis / ours" per cell)."""
+#: Heading of obstacles.md: which side of a cell is which.
+OBSTACLE_HEADING = "# Obstacle study (thesis Table 5.21): cells are thesis / ours"
+
+
+def obstacle_table(metrics: list[dict[str, Any]], title: str = "") -> str:
+    """Markdown table in the layout of thesis Table 5.21 ("thesis / ours" per cell; the
+    speed of a scenario of ours that did not finish is undefined,
+    ``speed_m_s`` of :mod:`ddwmmr.scenarios.protocol`). With ``title`` (what ours ran, e.g.
+    "thesis controller, thesis plant, payload 3 kg"), the text of obstacles.md:
+    :data:`OBSTACLE_HEADING`, "ours: " ``title``, then the table."""
     numbers = [m["scenario"] for m in metrics]
     lines = ["| | " + " | ".join(f"scenario {n}" for n in numbers) + " |"]
     lines.append("|---|" + "---|" * len(numbers))
@@ -192,4 +215,5 @@ def obstacle_table(metrics: list[dict[str, Any]]) -> str:
                 text = f"{_g(ref)} / {_g(ours)}"
             cells.append(text)
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
-    return "\n".join(lines) + "\n"
+    table = "\n".join(lines) + "\n"
+    return f"{OBSTACLE_HEADING}\n\nours: {title}\n\n{table}" if title else table
