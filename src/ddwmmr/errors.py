@@ -249,6 +249,12 @@ def shown(value: Any, width: int = 40) -> str:
     return one_line(text, width)
 
 
+def bracketed(items: Iterable[Any], spec: str = "g") -> str:
+    """``items`` for a message as a bracketed list: numbers in format ``spec``, texts as
+    they are (``[90, 45]``, ``[[-1, 1], [0, 2]]`` from already bracketed texts)."""
+    return "[" + ", ".join(i if isinstance(i, str) else format(i, spec) for i in items) + "]"
+
+
 def one_line(text: str, width: int) -> str:
     """``text`` on one line (each run of whitespace one space), cut to ``width``
     characters with "..." at the end."""

@@ -1,4 +1,9 @@
-"""Whether a subclass changed a method that a fast path stands in for.
+"""Whether an object's class is the library's own, and whether a subclass changed a
+method that a fast path stands in for.
+
+A plug-in's output (a controller's command, a plant's state, a QP piece's rows, an
+arbiter's decision) is checked as it is produced; the library's own classes keep their
+contracts by construction and run unchecked: :func:`from_library` tells them apart.
 
 Fast paths (a QP piece's compiled writer, a controller's float-level ``law``, a
 trajectory's vectorised ``sample``) describe the methods of the class that defines them.
@@ -17,3 +22,8 @@ def defining_class(cls: type, name: str) -> type | None:
 def overrides(obj: object, owner: type, name: str) -> bool:
     """True when ``obj``'s class redefines ``owner.<name>`` below ``owner``."""
     return getattr(type(obj), name) is not getattr(owner, name)
+
+
+def from_library(obj: object) -> bool:
+    """Whether ``obj``'s class is one of the library's (defined in a ``ddwmmr`` module)."""
+    return type(obj).__module__.split(".")[0] == "ddwmmr"

@@ -22,6 +22,7 @@ from ddwmmr.errors import (
     SPEED_RANGE_RAD_S,
     TORQUE_RANGE_N_M,
     ParameterError,
+    bracketed,
     check_finite,
     check_range,
     did_you_mean,
@@ -508,8 +509,8 @@ def unit_doubts(robot: Robot) -> list[str]:
     angles = [
         f"{name} = {text} rad"
         for name, values, text in (
-            ("joint_limits", limits, _shown([_shown(pair) for pair in robot.joint_limits])),
-            ("home_pose", robot.home_pose, _shown(robot.home_pose)),
+            ("joint_limits", limits, bracketed([bracketed(pair) for pair in robot.joint_limits])),
+            ("home_pose", robot.home_pose, bracketed(robot.home_pose)),
         )
         if any(plausibly_degrees(angle) for angle in values)
     ]
@@ -535,11 +536,6 @@ def _degrees_hint(angle: float) -> str:
     return (
         f"; angles are in radians (given in degrees? {angle:g} deg = {math.radians(angle):.6g} rad)"
     )
-
-
-def _shown(items) -> str:
-    """Numbers (``:g``) or texts as a TOML array: ``(90.0, 45.0)`` as ``[90, 45]``."""
-    return "[" + ", ".join(i if isinstance(i, str) else f"{i:g}" for i in items) + "]"
 
 
 def _warn_unit_doubts(robot: Robot, where: str) -> None:

@@ -32,6 +32,7 @@ from ctypes import c_int
 import numpy as np
 
 from ddwmmr.errors import ParameterError, PluginError, check_int_at_least, one_line, shown
+from ddwmmr.inheritance import from_library
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, TaskBlock
 from ddwmmr.qp.context import NU, StepContext
 from ddwmmr.qp.limits.base import INF, Limit
@@ -59,11 +60,6 @@ def piece_label(piece: Task | Limit) -> str:
     when it has no name of its own (:func:`piece_name`)."""
     kind, name = type(piece).__name__, piece_name(piece)
     return kind if name == kind else f"{kind} {name!r}"
-
-
-def _from_library(piece: Task | Limit) -> bool:
-    """Whether ``piece``'s class is one of the library's (their output needs no check)."""
-    return type(piece).__module__.split(".")[0] == "ddwmmr"
 
 
 def _raised(label: str, error: Exception, ctx: StepContext, contract: str) -> Exception:
@@ -109,7 +105,7 @@ LimitCompute = Callable[
 def guarded_task(task: Task) -> TaskCompute:
     """``task.compute``; for a user's task (a class from outside the library) wrapped so
     that what it raises stops the run in one line naming it and the arrays' shapes."""
-    if _from_library(task):
+    if from_library(task):
         return task.compute
     label, compute, rows = piece_label(task), task.compute, task.rows
     contract = f"it fills jac ({rows} x 4) and error ({rows},) in place: rows = {rows}"
@@ -125,7 +121,7 @@ def guarded_task(task: Task) -> TaskCompute:
 
 def guarded_limit(limit: Limit) -> LimitCompute:
     """``limit.compute``, for a user's limit wrapped like :func:`guarded_task`."""
-    if _from_library(limit):
+    if from_library(limit):
         return limit.compute
     label, compute, rows = piece_label(limit), limit.compute, limit.rows
     contract = (
@@ -392,14 +388,14 @@ class QPProblem:
         infinite Jacobian, error or constraint row, this step; returns when none did (a
         library piece's non-finite value leaves the solve to fail and fall back)."""
         for task, _, jac, error, *_ in self._generic_cost:
-            if not _from_library(task):
+            if not from_library(task):
                 _refuse_written(piece_label(task), ctx, jacobian=jac, error=error)
         for task, _, jac, _, up in self._generic_slack:
-            if not _from_library(task):
+            if not from_library(task):
                 _refuse_written(piece_label(task), ctx, jacobian=jac, error=up)
-        users = [limit for limit, *_ in self._generic_limits if not _from_library(limit)]
+        users = [limit for limit, *_ in self._generic_limits if not from_library(limit)]
         for limit, _, G, low, up in self._generic_limits:
-            if not _from_library(limit):
+            if not from_library(limit):
                 _refuse_written(piece_label(limit), ctx, matrix=G, bounds=(low, up))
         if users and np.isnan(self.lb[:NU] + self.ub[:NU]).any():
             names = ", ".join(repr(piece_name(limit)) for limit in users)

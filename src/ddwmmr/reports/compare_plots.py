@@ -402,7 +402,7 @@ def plot_tau_study(
             color=colors[method],
             label=method,
         )
-    ax2.axhline(theory, color="k", ls=":", label=f"first order: {theory:.2f}")
+    ax2.axhline(theory, color="k", ls=":", label=f"first order: {theory:.3f}")
     if not any(math.isfinite(v) for values in convergence.values() for v in values.values()):
         _say_none_converged(ax2, [tau for values in convergence.values() for tau in values])
     ax2.set_xscale("log")
@@ -492,13 +492,13 @@ def coinciding_note(groups: list[list[str]]) -> str | None:
 def plot_dt_study(
     drift: Mapping[str, Mapping[str, Mapping[float, float]]], colors: Mapping[str, str]
 ) -> Figure:
-    """Step-size sweep: final position error vs dt (log-log), Euler solid, RK4 dashed.
+    """Step-size sweep: largest position error vs dt (log-log), Euler solid, RK4 dashed.
 
     Lines that lie on each other (:func:`coinciding_groups`) are drawn from wide to thin
     with different markers, so each stays visible, and the legend names them.
 
     Args:
-        drift: method -> integrator -> dt (s) -> final position error (m).
+        drift: method -> integrator -> dt (s) -> largest position error (m).
     """
     fig, ax = plt.subplots(figsize=(10, 5))
     styles = {"euler": "-", "rk4": "--"}
@@ -568,12 +568,13 @@ def plot_init_study(
     curve_method: str,
     colors: Mapping[str, str],
 ) -> Figure:
-    """Initial-offset sweep: final error vs initial offset, and one method's error curves.
-    Methods whose final errors lie on each other are drawn from wide to thin and named in
-    the legend's title (:func:`coinciding_looks`).
+    """Initial-offset sweep: settled-end RMS error vs initial offset, and one method's error
+    curves. Methods whose errors lie on each other are drawn from wide to thin and named
+    in the legend's title (:func:`coinciding_looks`).
 
     Args:
-        final: method -> initial offset (m) -> final position error (m).
+        final: method -> initial offset (m) -> settled-end RMS position error (m,
+            ``final_position_error_m``).
         curves: initial offset (m) -> (t, position error) for ``curve_method``.
     """
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
@@ -586,7 +587,7 @@ def plot_init_study(
         )
     ax1.set_yscale("log")
     ax1.set_xlabel("initial end-effector offset (mm)")
-    ax1.set_ylabel("final position error (m, log)")
+    ax1.set_ylabel("settled-end RMS position error (m, log)")
     ax1.set_title("open loop keeps the offset, closed loop removes it")
     ax1.grid(alpha=0.3, which="both")
     cmap = plt.get_cmap("viridis")

@@ -76,6 +76,7 @@ from ddwmmr.errors import (
     shown,
     texts_apart,
 )
+from ddwmmr.inheritance import from_library
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import (
     STABILITY_CAP,
@@ -89,7 +90,7 @@ from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.registry import BUILTIN_MODULES, CONTROLLERS, PLANTS
 from ddwmmr.scenarios.generator import Scenario
-from ddwmmr.sim.loop import from_library, name_of, run_loop
+from ddwmmr.sim.loop import name_of, run_loop
 
 #: What each command interface sends, for the messages.
 SENDS = {FORCE: "wheel forces", VELOCITY: "velocity commands"}

@@ -86,7 +86,7 @@ import numpy as np
 from ddwmmr import interrupts
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
 from ddwmmr.errors import ParameterError, PluginError, float_values, shown
-from ddwmmr.inheritance import defining_class, overrides
+from ddwmmr.inheritance import defining_class, from_library, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 
 #: Progress callback: (samples done, samples in all).
@@ -263,12 +263,6 @@ def checked_command(command: Any, force: bool, controller: Any, k: int, t: float
         f"method: {name_of(controller)}.command() must return {wanted} (got "
         f"{shown(command, 60)} at step {k}, t = {t:g} s)"
     )
-
-
-def from_library(obj: Any) -> bool:
-    """Whether ``obj``'s class is one of the library's (its plants and controllers keep
-    their own contracts; only a plug-in's output is checked at every step)."""
-    return type(obj).__module__.split(".")[0] == "ddwmmr"
 
 
 def checked_observation(plant: Plant, k: int, t: float) -> Observation:

@@ -440,9 +440,6 @@ FINAL_WINDOW_FRACTION = 0.05
 #: ``joint_rate_limit_steps``): the qp and the mpc bound the rates a hair inside the limit
 #: (1e-6 of it), and the mpc's real-time iteration ends within 1e-3 of its bound.
 RATE_LIMIT_TOLERANCE = 1e-3
-#: The former name of :data:`RATE_LIMIT_TOLERANCE`, still imported elsewhere: remove it
-#: once no module does.
-WHEEL_LIMIT_TOLERANCE = RATE_LIMIT_TOLERANCE
 #: A joint angle within this (rad) of an end of its ``joint_limits`` range, or beyond it,
 #: is at that position limit (``joint_limit_steps``): the plants clamp a joint to the
 #: limit itself, up to rounding.

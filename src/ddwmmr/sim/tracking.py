@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.commands import FORCE, WheelForces
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, bracketed, shown
 from ddwmmr.inheritance import defining_class
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_arrays
@@ -390,9 +390,9 @@ def _sample_agrees(checked: CheckedTrajectory, sample: Any, times: np.ndarray) -
             if not np.allclose(what, own, rtol=SAMPLE_TOLERANCE, atol=SAMPLE_TOLERANCE):
                 warnings.warn(
                     f"trajectory {_name(checked)}: sample(times) disagrees with {name}(t) at "
-                    f"t = {times[index]:g} s ({_shown(what)} vs {_shown(own)}); simulating with "
-                    "pose(t) and velocity(t) call by call instead (slower): make sample give "
-                    "their numbers",
+                    f"t = {times[index]:g} s ({_numbers(what)} vs {_numbers(own)}); simulating "
+                    "with pose(t) and velocity(t) call by call instead (slower): make sample "
+                    "give their numbers",
                     UserWarning,
                     stacklevel=6,  # simulate() -> check_trajectory -> checked_trajectory -> here
                 )
@@ -428,8 +428,8 @@ def _check_derivative(checked: CheckedTrajectory, times: np.ndarray) -> None:
         t, velocity, difference = bad[0]
         warnings.warn(
             f"trajectory {_name(checked)}: velocity(t) is not the time derivative of pose(t) "
-            f"at {len(bad)} of {len(times)} checked times (t = {t:g} s: {_shown(velocity)} vs "
-            f"{_shown(difference)} from pose); the open-loop methods integrate velocity, so "
+            f"at {len(bad)} of {len(times)} checked times (t = {t:g} s: {_numbers(velocity)} vs "
+            f"{_numbers(difference)} from pose); the open-loop methods integrate velocity, so "
             "the run follows another path",
             UserWarning,
             stacklevel=6,  # simulate() -> check_trajectory -> checked_trajectory -> here
@@ -440,8 +440,8 @@ def _name(checked: CheckedTrajectory) -> str:
     return trajectory_name(checked.trajectory)
 
 
-def _shown(values: np.ndarray) -> str:
-    return "[" + ", ".join(f"{value:.4g}" for value in values.tolist()) + "]"
+def _numbers(values: np.ndarray) -> str:
+    return bracketed(values.tolist(), ".4g")
 
 
 #: Where the library's trajectories are defined: their ``pose`` and ``velocity`` return

@@ -64,7 +64,7 @@ from ddwmmr.reports.compare.ranking import (
 )
 from ddwmmr.reports.plots import circles_of
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
-from ddwmmr.sim.simulate import FINAL_WINDOW_FRACTION, WHEEL_LIMIT_TOLERANCE
+from ddwmmr.sim.simulate import FINAL_WINDOW_FRACTION, RATE_LIMIT_TOLERANCE
 from ddwmmr.sim.verdict import explain
 
 # -- building the report ------------------------------------------------------------------
@@ -1161,7 +1161,7 @@ def _definitions_section(c: _Context) -> None:
             "whose command the plant clipped at a wheel or joint speed limit (or stopped at "
             "a joint limit); wheel-limit steps, joint-rate-limit steps: steps with a wheel "
             "speed or a joint rate within "
-            f"{100 * WHEEL_LIMIT_TOLERANCE:g} % of its limit, whether the plant clipped it "
+            f"{100 * RATE_LIMIT_TOLERANCE:g} % of its limit, whether the plant clipped it "
             "or the method held it inside its own bounds (`qp` and `mpc` bound their "
             "commands a hair inside the limits: their limits show here, not as saturated)",
             "step latency: median wall-clock time of one controller call (us); a timing, so "
