@@ -114,3 +114,21 @@ def test_a_thesis_plant_mpc_sending_wheel_forces_counts_its_joints_at_their_rate
     moved = joint_rates(ts)[:-1]
     assert np.max(moved) == pytest.approx(Robot().joint_speed_limit, rel=1e-3)
     assert limit_counts(ts, Robot())["joint_rate_limit_steps"] == 16
+
+
+# -- a controller of one's own reporting fallbacks (StepInfo.fallback) -------------------
+def test_fallbacks_of_a_plugin_controller_are_the_cause():
+    summary = {**FAILED, "method": "fb85", "steps": 500, "fallback_steps": 449}
+    assert _cause(summary).startswith(
+        "the controller fb85 used its safe fallback on 449 of 500 steps"
+    )
+
+
+def test_a_few_fallbacks_are_not_the_cause():
+    summary = {**FAILED, "method": "fb85", "steps": 500, "fallback_steps": 250}
+    assert "safe fallback" not in _cause(summary)
+
+
+def test_the_qp_keeps_its_own_fallback_cause():
+    summary = {**FAILED, "method": "qp", "steps": 500, "fallback_steps": 400, "qp_fallbacks": 400}
+    assert _cause(summary).startswith("the qp found no solution on 400 of 500 steps")
