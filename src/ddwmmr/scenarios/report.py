@@ -440,8 +440,8 @@ def plot_speeds(outcomes: Sequence[Outcome], path, title: str) -> None:
     with np.errstate(divide="ignore", invalid="ignore"):
         over_base = np.where(base > 0, length / base, np.nan)
     panels = (
-        (_column(outcomes, "speed_m_s"), f"{title}: path length / total time"),
-        (over_base, "path length / base-moving time"),
+        (_column(outcomes, "speed_m_s"), f"{title}: waypoint route length / total time"),
+        (over_base, "waypoint route length / base-moving time"),
     )
     for ax, (values, heading) in zip(axes[:, 0], panels):
         _bars(ax, index, values, np.zeros_like(failed), width=0.85)
