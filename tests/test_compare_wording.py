@@ -26,7 +26,7 @@ from ddwmmr.trajectories import load_trajectory
 def report(tmp_path_factory) -> tuple[str, str]:
     """report.md and stderr of a 2 s comparison of ats, clrrmc-ts and mpc on the ellipse
     alone, with the default studies (corners among them)."""
-    out = tmp_path_factory.mktemp("h89") / "cmp"
+    out = tmp_path_factory.mktemp("compare") / "cmp"
     argv = ["--methods", "ats,clrrmc-ts,mpc", "--only", "ellipse", "--duration", "2"]
     err = io.StringIO()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):

@@ -176,40 +176,40 @@ def _run(name: str) -> None:
 
 def test_waypoint_options_missing_or_raising_is_one_line_naming_the_controller(registered):
     """Without the check: AttributeError (no waypoint_options) and the raw ValueError."""
-    _register(registered, "h94-none", None)
+    _register(registered, "plug-none", None)
     with pytest.raises(PluginError) as missing:
-        _run("h94-none")
+        _run("plug-none")
     assert str(missing.value) == (
-        "controller h94-none: declares the waypoints task but has no waypoint_options(run) "
+        "controller plug-none: declares the waypoints task but has no waypoint_options(run) "
         "classmethod (ddwmmr.controllers.base.WaypointRun -> dict of options)"
     )
 
     def raising(cls, run):
         raise ValueError("no options\nfor you")
 
-    _register(registered, "h94-raise", raising)
+    _register(registered, "plug-raise", raising)
     with pytest.raises(PluginError) as raised:
-        _run("h94-raise")
+        _run("plug-raise")
     assert str(raised.value) == (
-        "controller h94-raise: waypoint_options(run) raised ValueError: no options for you"
+        "controller plug-raise: waypoint_options(run) raised ValueError: no options for you"
     )
     assert isinstance(raised.value.__cause__, ValueError)
 
-    _register(registered, "h94-list", lambda cls, run: [("gain", 2.0)])
-    with pytest.raises(PluginError, match=r"h94-list: waypoint_options\(run\) must return a dict"):
-        _run("h94-list")
+    _register(registered, "plug-list", lambda cls, run: [("gain", 2.0)])
+    with pytest.raises(PluginError, match=r"plug-list: waypoint_options\(run\) must return a dict"):
+        _run("plug-list")
 
 
 def test_waypoint_options_bad_input_passes_and_good_options_are_used(registered):
     def bad_input(cls, run):
         raise ParameterError("gain must be > 0 (got -1)")
 
-    _register(registered, "h94-bad", bad_input)
+    _register(registered, "plug-bad", bad_input)
     with pytest.raises(ParameterError, match=r"^gain must be > 0 \(got -1\)$"):
-        _run("h94-bad")
-    _register(registered, "h94-ok", lambda cls, run: {"gain": 2.5})
+        _run("plug-bad")
+    _register(registered, "plug-ok", lambda cls, run: {"gain": 2.5})
     outcome = run_scenario(
-        SCENARIO, RunConfig(controller="h94-ok", plant="kinematic", time_limit=0.1)
+        SCENARIO, RunConfig(controller="plug-ok", plant="kinematic", time_limit=0.1)
     )
     assert outcome.metrics["sim_steps"] == 10 and outcome.metrics["reason"] == "timeout"
 
@@ -245,3 +245,18 @@ def test_the_scenarios_tool_refuses_a_controller_without_waypoint_options(tmp_pa
         "error: controller nowo94: declares the waypoints task but has no waypoint_options(run) "
         "classmethod (ddwmmr.controllers.base.WaypointRun -> dict of options)"
     ]
+
+
+def test_an_arbiter_that_is_no_arbiter_is_refused_by_name(monkeypatch):
+    from ddwmmr import Robot
+    from ddwmmr.errors import PluginError
+    from ddwmmr.plants import make_plant
+    from ddwmmr.scenarios import RunConfig, generate, protocol
+
+    # a name where an Arbiter object belongs
+    monkeypatch.setattr(protocol, "waypoint_options", lambda c, run: {"arbiter": "mine"})
+    robot = Robot().with_payload(3.0)
+    with pytest.raises(PluginError, match="arbiter 'mine', which has no select"):
+        protocol.make_scenario_controller(
+            robot, generate(1, 0)[0], RunConfig(), make_plant("thesis", robot)
+        )

@@ -95,7 +95,7 @@ def test_the_tools_report_a_raising_plug_in_module_in_one_line_with_status_2(tmp
 class EulerPlant:
     """Kinematic Euler steps; ``misuse`` makes step ``fail_at`` raise or leave a NaN."""
 
-    name = "h93-euler"
+    name = "plug-euler"
     interfaces = ("velocity",)
     extra_columns = ()
 
@@ -135,7 +135,7 @@ def test_a_raising_plug_in_plant_stops_a_tracking_run_with_a_plugin_error():
     with pytest.raises(PluginError) as error:
         simulate(robot, Ellipse(), "ats", plant=EulerPlant(robot), duration=1.0)
     assert str(error.value) == (
-        "plant: h93-euler.step() raised OverflowError: 'math range error' at step 9, "
+        "plant: plug-euler.step() raised OverflowError: 'math range error' at step 9, "
         "t = 0.18 s"  # the default step of the kinematic plant's run: 0.02 s
     )
     assert isinstance(error.value.__cause__, OverflowError)
@@ -143,10 +143,10 @@ def test_a_raising_plug_in_plant_stops_a_tracking_run_with_a_plugin_error():
 
 @pytest.fixture
 def h93_plant():
-    """EulerPlant registered as "h93-euler" (failing as the test's RunConfig options say)."""
-    PLANTS.register("h93-euler", interfaces=("velocity",))(EulerPlant)
+    """EulerPlant registered as "plug-euler" (failing as the test's RunConfig options say)."""
+    PLANTS.register("plug-euler", interfaces=("velocity",))(EulerPlant)
     yield
-    PLANTS.unregister("h93-euler")
+    PLANTS.unregister("plug-euler")
 
 
 @pytest.mark.parametrize(
@@ -154,15 +154,15 @@ def h93_plant():
     [
         (
             "raise",
-            "PluginError: plant: h93-euler.step() raised OverflowError: 'math range error' at "
+            "PluginError: plant: plug-euler.step() raised OverflowError: 'math range error' at "
             "step 9, t = 0.09 s",
         ),
-        ("nan", "ParameterError: plant: h93-euler.observe() must return an Observation(q, v"),
+        ("nan", "ParameterError: plant: plug-euler.observe() must return an Observation(q, v"),
     ],
 )
 def test_a_failing_plug_in_plant_fails_its_scenario_only(h93_plant, monkeypatch, misuse, reason):
     monkeypatch.setattr(EulerPlant.__init__, "__defaults__", (misuse, 10))
-    config = RunConfig(controller="qp", plant="h93-euler", time_limit=2.0)
+    config = RunConfig(controller="qp", plant="plug-euler", time_limit=2.0)
     outcome = run_scenario(generate(1, 0)[0], config)
     assert reason in outcome.metrics["reason"]
     assert not outcome.metrics["success"]
@@ -189,26 +189,26 @@ class PushBase:
 def force_controllers():
     """PushBase registered by the trait alone, by the class attribute alone (legacy), and a
     velocity controller claiming the force interface."""
-    trait = CONTROLLERS.register("h93-push", interfaces=("force",))(type("Trait", (PushBase,), {}))
-    legacy = CONTROLLERS.register("h93-legacy")(type("Legacy", (PushBase,), {"interface": FORCE}))
+    trait = CONTROLLERS.register("plug-push", interfaces=("force",))(type("Trait", (PushBase,), {}))
+    legacy = CONTROLLERS.register("plug-legacy")(type("Legacy", (PushBase,), {"interface": FORCE}))
 
     class Claims(PushBase):
         def command(self, t, q, pose_d, velocity_d):
             return np.zeros(4)
 
-    CONTROLLERS.register("h93-claims", interfaces=("force",))(Claims)
+    CONTROLLERS.register("plug-claims", interfaces=("force",))(Claims)
     yield trait, legacy
-    for name in ("h93-push", "h93-legacy", "h93-claims"):
+    for name in ("plug-push", "plug-legacy", "plug-claims"):
         CONTROLLERS.unregister(name)
 
 
 def test_a_force_controller_declared_by_the_decorator_alone_runs(force_controllers):
     robot = Robot()
-    run = simulate(robot, Ellipse(), "h93-push", plant="thesis", duration=0.5)
+    run = simulate(robot, Ellipse(), "plug-push", plant="thesis", duration=0.5)
     assert run.summary["command_interface"] == FORCE
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        legacy = simulate(robot, Ellipse(), "h93-legacy", plant="thesis", duration=0.5)
+        legacy = simulate(robot, Ellipse(), "plug-legacy", plant="thesis", duration=0.5)
     # the class attribute still works (the same run), with a deprecation warning
     assert [w.category for w in caught] == [FutureWarning]
     assert "declares interfaces=('velocity',)" in str(caught[0].message)
@@ -220,9 +220,9 @@ def test_a_force_controller_declared_by_the_decorator_alone_runs(force_controlle
 
 def test_a_controller_declaring_force_but_returning_velocities_is_refused(force_controllers):
     with pytest.raises(ParameterError) as error:
-        simulate(Robot(), Ellipse(), "h93-claims", plant="thesis", duration=0.5)
+        simulate(Robot(), Ellipse(), "plug-claims", plant="thesis", duration=0.5)
     assert str(error.value) == (
-        "method: h93-claims.command() must return a WheelForces(left, right, th1_target, "
+        "method: plug-claims.command() must return a WheelForces(left, right, th1_target, "
         "th2_target) of 4 finite numbers (N, N, rad, rad) (got array([0., 0., 0., 0.]) at "
         "step 0, t = 0 s)"
     )
@@ -261,3 +261,18 @@ def test_a_malformed_law_return_is_one_line(returned, shown):
         f"method: lawful.law() must return (u, ...) with u 4 numbers (v, w, th1dot, th2dot) "
         f"(got {shown} at step 0, t = "
     )
+
+
+def test_a_controller_speaking_two_interfaces_chooses_afresh_for_each_plant():
+    """A controller object used on a velocity plant and then on a force plant speaks each
+    plant's interface: the first choice is not stored on it."""
+    from types import SimpleNamespace
+
+    from ddwmmr.sim.loop import check_interface
+
+    both = SimpleNamespace(interfaces=("velocity", "force"))
+    velocity_plant = SimpleNamespace(name="v", interfaces=("velocity",))
+    force_plant = SimpleNamespace(name="f", interfaces=("force",))
+    assert check_interface(both, velocity_plant) == "velocity"
+    assert check_interface(both, force_plant) == "force"
+    assert not hasattr(both, "interface")

@@ -240,3 +240,18 @@ def test_the_protocol_gives_a_failed_scenario_no_speed():
     failed = run_scenario(scenario, RunConfig(time_limit=2.0))  # far from its last waypoint
     assert not failed.metrics["success"] and math.isnan(failed.metrics["speed_m_s"])
     assert failed.metrics["path_length_m"] == pytest.approx(scenario.path_length())
+
+
+def test_the_timeline_draws_each_arbiters_own_thresholds():
+    from ddwmmr.cli.scenarios import timeline_thresholds
+    from ddwmmr.scenarios import RunConfig
+
+    machine = timeline_thresholds(RunConfig())
+    assert machine["stability_lines"] == [
+        (1.25, "enter stability state, S < 1.25"),
+        (1.6, "leave it, S >= 1.6"),
+    ]
+    # the competitive arbiter grades stability in below its enter threshold: no exit switch
+    competitive = timeline_thresholds(RunConfig(arbiter="competitive"))
+    assert competitive["stability_lines"] == [(1.25, "stability weighs in below S = 1.25 (graded)")]
+    assert competitive["manipulability_lines"] == machine["manipulability_lines"]

@@ -52,7 +52,7 @@ from ddwmmr.behaviours.manipulability import Manipulability
 from ddwmmr.behaviours.objective import Objective
 from ddwmmr.behaviours.obstacle import ObstacleAvoidance
 from ddwmmr.behaviours.stability import Stability
-from ddwmmr.commands import FORCE, WheelForces
+from ddwmmr.commands import WheelForces
 from ddwmmr.controllers.base import WaypointRun, register_controller
 from ddwmmr.errors import check_range
 from ddwmmr.model import Robot
@@ -83,8 +83,8 @@ class ThesisController:
             in :data:`ADJUST_RANGE_M` (0.01 to 5 m).
     """
 
-    #: Loop contract: wheel forces out, measured (v, w) in, one call per control step.
-    interface = FORCE
+    #: Loop contract: wheel forces out (its registered interfaces), measured (v, w) in, one
+    #: call per control step.
     wants_base_velocity = True
     zero_order_hold = True
     float_state = True

@@ -704,11 +704,20 @@ def _state_lines(state: str, symbol: str, thresholds) -> list[tuple[float, str]]
 
 def timeline_thresholds(config: RunConfig) -> dict[str, list[tuple[float, str]]]:
     """The thresholds the timeline's S and eta panels draw (:func:`report.plot_timeline`):
-    an arbiter's enter/exit thresholds, or the ``qp``/``mpc`` stability floor ``S_min``."""
+    an arbiter's enter/exit thresholds (the competitive arbiter grades stability in below
+    its enter threshold, with no exit switch), or the ``qp``/``mpc`` stability floor
+    ``S_min``; none for an arbiter of one's own."""
     if controller_traits(config.controller)["arbiter"]:
+        manipulability = _state_lines("manipulability", "eta", config.manipulability)
+        if config.arbiter == "competitive":
+            enter = config.stability[0]
+            graded = [(enter, f"stability weighs in below S = {enter:g} (graded)")]
+            return {"stability_lines": graded, "manipulability_lines": manipulability}
+        if config.arbiter != "state-machine":
+            return {}
         return {
             "stability_lines": _state_lines("stability", "S", config.stability),
-            "manipulability_lines": _state_lines("manipulability", "eta", config.manipulability),
+            "manipulability_lines": manipulability,
         }
     uses = {name for name, takers in QP_OPTIONS.items() if config.controller in takers}
     if "qp_stability_min" in uses:

@@ -650,6 +650,11 @@ def make_scenario_controller(
     arbiter = options.get("arbiter")
     plug_in = arbiter is not None and not from_library(arbiter)
     if plug_in and controller_traits(config.controller)["arbiter"]:
+        if not callable(getattr(arbiter, "select", None)):
+            raise PluginError(
+                f"controller {config.controller}: waypoint_options gave arbiter "
+                f"{shown(arbiter)}, which has no select(percept, behaviours) method"
+            )
         # A plug-in arbiter's decisions are checked as it makes them (the tally counts
         # its states); the library's own are trusted and run unwrapped.
         options["arbiter"] = CheckedArbiter(arbiter, name_of(arbiter))

@@ -24,10 +24,10 @@ Controller contract (class attributes, all optional):
   ``("velocity",)``), the one place a controller declares it.
 * ``interface``: the one it sends in this run, when it chooses (the ``mpc`` sets it in
   ``adopt_plant``, from the plant's traits); without it the loop takes the first of
-  ``interfaces`` the plant accepts and sets ``interface`` to it. An ``interface`` outside
-  the ``interfaces`` a registered controller declares still runs, with a
-  :class:`FutureWarning` (a class attribute was once the only declaration). The plant
-  must accept it (:func:`check_interface`).
+  ``interfaces`` the plant accepts, for each run afresh (:func:`spoken_interface`). An
+  ``interface`` outside the ``interfaces`` a registered controller declares still runs,
+  with a :class:`FutureWarning` (declare interfaces with ``register_controller``). The
+  plant must accept it (:func:`check_interface`).
 * ``zero_order_hold``: True for sampled-data controllers (MPC, the thesis controller): the
   command is held over the step. Otherwise the kinematic plant's RK4 re-evaluates the
   control law at its stages (the closed loop integrated as one ODE).
@@ -73,7 +73,6 @@ plants keep their errors as they are.
 
 from __future__ import annotations
 
-import contextlib
 import time
 import warnings
 from collections.abc import Callable
@@ -164,20 +163,26 @@ class LoopEnd:
     reason: str
 
 
+def spoken_interface(controller: Any, plant: Plant) -> str:
+    """The command interface ``controller`` speaks on ``plant``, unchecked: its
+    ``interface`` if it has one, else the first of its declared ``interfaces`` (default
+    velocity) that the plant accepts, else the first declared."""
+    interface = getattr(controller, "interface", None)
+    if interface is not None:
+        return interface
+    declared = tuple(getattr(controller, "interfaces", None) or (VELOCITY,))
+    return next((i for i in declared if i in plant.interfaces), declared[0])
+
+
 def check_interface(controller: Any, plant: Plant) -> str:
     """The command interface ``controller`` sends on ``plant`` (see the module docstring):
     its ``interface`` if it has one, else the first of its declared ``interfaces`` that the
-    plant accepts (then set as its ``interface``); a one-line :class:`ParameterError` if
-    the plant does not accept it."""
+    plant accepts (chosen afresh for every plant: nothing is stored on the controller); a
+    one-line :class:`ParameterError` if the plant does not accept it."""
     declared = tuple(getattr(controller, "interfaces", None) or (VELOCITY,))
-    interface = getattr(controller, "interface", None)
-    if interface is None:
-        interface = next((i for i in declared if i in plant.interfaces), declared[0])
-        # what the run records as the interface it spoke (a controller with __slots__
-        # refuses the attribute: nothing reads it then)
-        with contextlib.suppress(AttributeError):
-            controller.interface = interface
-    elif hasattr(controller, "interfaces") and interface not in declared:
+    interface = spoken_interface(controller, plant)
+    own = getattr(controller, "interface", None) is not None
+    if own and hasattr(controller, "interfaces") and interface not in declared:
         warnings.warn(
             f"{name_of(controller)} sends {interface} commands (its interface attribute) "
             f"but declares interfaces={declared}: declare them with "

@@ -10,7 +10,6 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.commands import VELOCITY
 from ddwmmr.controllers.base import (
     Controller,
     available_methods,
@@ -36,7 +35,7 @@ from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     initial_configuration,
 )
-from ddwmmr.sim.loop import run_loop
+from ddwmmr.sim.loop import run_loop, spoken_interface
 from ddwmmr.sim.result import SimulationResult
 from ddwmmr.sim.tracking import COLUMNS, TrackingTask, checked_trajectory
 from ddwmmr.sim.verdict import verdict
@@ -320,7 +319,7 @@ def simulate(
         plant=the_plant.name,
         integrator=getattr(the_plant, "integrator", None),
         # the interface the controller spoke (the mpc chooses its own for the plant)
-        command_interface=getattr(controller, "interface", VELOCITY),
+        command_interface=spoken_interface(controller, the_plant),
         dt=dt,
         duration=recorded_steps * dt,
         steps=recorded_steps,

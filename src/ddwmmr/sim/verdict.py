@@ -444,7 +444,8 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     if steps and fallbacks > MOST_OF_RUN * steps:
         return MPC_FALLBACK.format(mpc_fallbacks=int(fallbacks), steps=int(steps))
     fallbacks = _number(summary, "fallback_steps") or 0
-    if steps and fallbacks > MOST_OF_RUN * steps:  # a controller of its own (the two above: 0)
+    # a controller of one's own: for the qp and the mpc fallback_steps are the counts above
+    if steps and fallbacks > MOST_OF_RUN * steps:
         method = summary.get("method")
         return CONTROLLER_FALLBACK.format(
             method=f"the controller {method}" if isinstance(method, str) else "the controller",
