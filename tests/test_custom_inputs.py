@@ -344,3 +344,28 @@ def test_a_bad_command_goes_through_the_tasks_controller_error():
     end = run_loop(plant, bad, task, start_configuration(robot, trajectory), 0.02, 10)
     assert (end.samples, end.reason) == (3, "controller_error")
     assert errors == [(3, COMMAND.format(name="Fixed") + " (got None at step 3, t = 0.06 s)")]
+
+
+def test_a_controller_failing_at_an_integrator_stage_goes_through_controller_error():
+    # the error reaches the loop through the library plant's RK4 step; a task that ends a
+    # run on a controller error (the scenarios') records it instead of the batch ending
+    from ddwmmr.plants.kinematic import KinematicPlant
+    from ddwmmr.resolution.reference import start_configuration
+    from ddwmmr.sim.loop import run_loop
+    from ddwmmr.sim.tracking import TrackingTask
+
+    errors = []
+
+    class Quiet(TrackingTask):
+        def controller_error(self, k, error):
+            errors.append((k, str(error)))
+            return True
+
+    robot, trajectory = Robot(), Ellipse()
+    plant = KinematicPlant(robot)
+    task = Quiet(trajectory, plant)
+    # fine at the samples (t = k 0.02 s), None between them: only an RK4 stage sees it
+    bad = Fixed(lambda t: np.zeros(4) if abs(t / 0.02 - round(t / 0.02)) < 1e-9 else None)
+    end = run_loop(plant, bad, task, start_configuration(robot, trajectory), 0.02, 10)
+    assert (end.samples, end.reason) == (0, "controller_error")
+    assert errors == [(0, COMMAND.format(name="Fixed") + " (got None at step 0, t = 0.01 s)")]

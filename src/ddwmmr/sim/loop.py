@@ -401,14 +401,22 @@ def run_loop(
 
     k = 0  # the step being taken, for the message of a bad command at a stage
 
+    #: The controller's error at an integrator stage (it reaches the loop through the
+    #: plant's step, which is not where it arose): routed as the controller's, below.
+    stage_errors: list[Exception] = []
+
     def policy(t: float, q: list[float]) -> np.ndarray:
         """The closed-loop law at an integrator stage (not recorded)."""
         pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
         try:
-            command = command_of(t, np.array(q), pose_d, velocity_d)
+            try:
+                command = command_of(t, np.array(q), pose_d, velocity_d)
+            except Exception as error:
+                raise_wrapped(controller, error, k, t, "command")
+            return checked_command(command, False, controller, k, t)
         except Exception as error:
-            raise_wrapped(controller, error, k, t, "command")
-        return checked_command(command, False, controller, k, t)
+            stage_errors.append(error)
+            raise
 
     def law_policy(t: float, q: list[float]) -> tuple[float, ...]:
         """The same through the controller's float-level ``law`` (no validation, no step
@@ -417,16 +425,20 @@ def run_loop(
         made it."""
         pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
         try:
-            result = law(t, q, pose_d.tolist(), velocity_d.tolist())
+            try:
+                result = law(t, q, pose_d.tolist(), velocity_d.tolist())
+            except Exception as error:
+                raise_wrapped(controller, error, k, t, "law")
+            try:
+                u = result[0]
+                finite = isfinite(u[0] + u[1] + u[2] + u[3]) if len(u) == 4 else None
+            except Exception:  # not (u, ...): a plain u of floats, None, text
+                finite = None
+            if finite is None:
+                bad_law(controller, result, k, t)
         except Exception as error:
-            raise_wrapped(controller, error, k, t, "law")
-        try:
-            u = result[0]
-            finite = isfinite(u[0] + u[1] + u[2] + u[3]) if len(u) == 4 else None
-        except Exception:  # not (u, ...): a plain u of floats, None, text
-            finite = None
-        if finite is None:
-            bad_law(controller, result, k, t)
+            stage_errors.append(error)
+            raise
         return u if finite else policy(t, q)
 
     stage_policy = None
@@ -482,6 +494,10 @@ def run_loop(
             task.diverged(k, error)
             return LoopEnd(k + 1, "diverged")
         except Exception as error:
+            if stage_errors:  # the controller failed at a stage, inside the plant's step
+                if task.controller_error(k, stage_errors[-1]):
+                    return LoopEnd(k, "controller_error")
+                raise
             if not foreign:
                 raise  # the library's plants: their errors as they are
             if plant_failed(task, plant, error, k, t, "step"):
