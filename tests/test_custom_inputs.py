@@ -322,8 +322,10 @@ def test_a_controller_without_a_callable_reset_is_refused(reset):
     assert message.endswith(", without reset)")
 
 
-def test_a_bad_command_goes_through_the_tasks_controller_error():
-    # a task that ends a run on a controller error (the scenarios') gets this one too
+def _run_recording_errors(controller) -> tuple[object, list[tuple[int, str]]]:
+    """``controller`` on the kinematic plant (10 steps of 0.02 s on the ellipse) under a
+    task that ends a run on a controller error, as the scenarios' does: how the run ended
+    and the (step, message) of each error the task was given."""
     from ddwmmr.plants.kinematic import KinematicPlant
     from ddwmmr.resolution.reference import start_configuration
     from ddwmmr.sim.loop import run_loop
@@ -339,33 +341,23 @@ def test_a_bad_command_goes_through_the_tasks_controller_error():
     robot, trajectory = Robot(), Ellipse()
     plant = KinematicPlant(robot)
     task = Quiet(trajectory, plant)
+    end = run_loop(plant, controller, task, start_configuration(robot, trajectory), 0.02, 10)
+    return end, errors
+
+
+def test_a_bad_command_goes_through_the_tasks_controller_error():
     bad = Fixed(lambda t: np.zeros(4) if t < 0.05 else None)
     bad.zero_order_hold = True  # no RK4 stages: every command is a sample's
-    end = run_loop(plant, bad, task, start_configuration(robot, trajectory), 0.02, 10)
+    end, errors = _run_recording_errors(bad)
     assert (end.samples, end.reason) == (3, "controller_error")
     assert errors == [(3, COMMAND.format(name="Fixed") + " (got None at step 3, t = 0.06 s)")]
 
 
 def test_a_controller_failing_at_an_integrator_stage_goes_through_controller_error():
-    # the error reaches the loop through the library plant's RK4 step; a task that ends a
-    # run on a controller error (the scenarios') records it instead of the batch ending
-    from ddwmmr.plants.kinematic import KinematicPlant
-    from ddwmmr.resolution.reference import start_configuration
-    from ddwmmr.sim.loop import run_loop
-    from ddwmmr.sim.tracking import TrackingTask
-
-    errors = []
-
-    class Quiet(TrackingTask):
-        def controller_error(self, k, error):
-            errors.append((k, str(error)))
-            return True
-
-    robot, trajectory = Robot(), Ellipse()
-    plant = KinematicPlant(robot)
-    task = Quiet(trajectory, plant)
+    # the error reaches the loop through the library plant's RK4 step; the task records
+    # it (a scenario fails) instead of the whole batch ending
     # fine at the samples (t = k 0.02 s), None between them: only an RK4 stage sees it
     bad = Fixed(lambda t: np.zeros(4) if abs(t / 0.02 - round(t / 0.02)) < 1e-9 else None)
-    end = run_loop(plant, bad, task, start_configuration(robot, trajectory), 0.02, 10)
+    end, errors = _run_recording_errors(bad)
     assert (end.samples, end.reason) == (0, "controller_error")
     assert errors == [(0, COMMAND.format(name="Fixed") + " (got None at step 0, t = 0.01 s)")]
