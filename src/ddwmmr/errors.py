@@ -18,7 +18,7 @@ import stat
 import tomllib
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -260,6 +260,37 @@ def one_line(text: str, width: int) -> str:
     characters with "..." at the end."""
     text = " ".join(text.split())
     return text if len(text) <= width else text[: width - 3] + "..."
+
+
+def plugin_raised(call: str, error: Exception, where: str = "", quoted: bool = False) -> Exception:
+    """What a run raises when a plug-in's ``call`` (``"arbiter mine: select()"``) raised
+    ``error``: a :class:`ParameterError` or :class:`PluginError` as it is (one line
+    already), anything else a one-line :class:`PluginError` "<call> raised <type>:
+    <message><where>", the message on one line and cut to 120 characters (``quoted``: as
+    its repr). :func:`raise_plugin_error` raises it."""
+    if isinstance(error, ParameterError | PluginError):
+        return error
+    if quoted:
+        text = shown(" ".join(str(error).split()) or "(no message)", 120)
+    else:
+        text = one_line(str(error), 120) or "(no message)"
+    return PluginError(f"{call} raised {type(error).__name__}: {text}{where}")
+
+
+def raise_plugin_error(
+    call: str, error: Exception, where: str = "", quoted: bool = False
+) -> NoReturn:
+    """Raise :func:`plugin_raised`'s error (called from the ``except`` block that caught
+    ``error``), ``from error`` where it wraps it."""
+    raise_as(plugin_raised(call, error, where, quoted), error)
+
+
+def raise_as(wrapped: Exception, error: Exception) -> NoReturn:
+    """Raise ``wrapped``, the one-line error standing for ``error``: ``error`` itself as it
+    is, another ``from error``."""
+    if wrapped is error:
+        raise error
+    raise wrapped from error
 
 
 def as_path(path: Any, label: str) -> Path:

@@ -18,7 +18,7 @@ from typing import Any, NoReturn
 
 from ddwmmr.arbiters.state_machine import STATES
 from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
-from ddwmmr.errors import ParameterError, PluginError, one_line, shown
+from ddwmmr.errors import PluginError, raise_plugin_error, shown
 
 #: What ``select`` must return, for the messages.
 SELECTION_FORM = "a Selection(state, behaviour, proposal) (ddwmmr.arbiters.Selection)"
@@ -84,13 +84,8 @@ class CheckedArbiter:
     def _raised(self, method: str, error: Exception, t: float | None) -> NoReturn:
         """Re-raise what the arbiter's ``method`` raised: a ParameterError or PluginError as
         it is (one line already), anything else as a PluginError naming the arbiter."""
-        if isinstance(error, ParameterError | PluginError):
-            raise error
-        text = one_line(str(error), 120) or "(no message)"
         when = "" if t is None else f" at t = {t:g} s"
-        raise PluginError(
-            f"arbiter {self.name}: {method}() raised {type(error).__name__}: {text}{when}"
-        ) from error
+        raise_plugin_error(f"arbiter {self.name}: {method}()", error, when)
 
 
 def check_selection(

@@ -31,7 +31,12 @@ from ctypes import c_int
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, PluginError, check_int_at_least, one_line, shown
+from ddwmmr.errors import (
+    ParameterError,
+    check_int_at_least,
+    raise_plugin_error,
+    shown,
+)
 from ddwmmr.inheritance import from_library
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, TaskBlock
 from ddwmmr.qp.context import NU, StepContext
@@ -60,19 +65,6 @@ def piece_label(piece: Task | Limit) -> str:
     when it has no name of its own (:func:`piece_name`)."""
     kind, name = type(piece).__name__, piece_name(piece)
     return kind if name == kind else f"{kind} {name!r}"
-
-
-def _raised(label: str, error: Exception, ctx: StepContext, contract: str) -> Exception:
-    """What a run raises when a user's piece ``label`` raised ``error`` in ``compute``: a
-    :class:`ParameterError` or :class:`PluginError` as it is (one line already), anything
-    else (a shape that does not broadcast, a bug) a one-line :class:`PluginError` naming
-    the piece, what it raised, the time and the arrays' shapes (``contract``)."""
-    if isinstance(error, ParameterError | PluginError):
-        return error
-    text = one_line(str(error), 120) or "(no message)"
-    return PluginError(
-        f"{label}: compute() raised {type(error).__name__}: {text} at t = {ctx.t:g} s ({contract})"
-    )
 
 
 def _refuse_written(label: str, ctx: StepContext, **written: np.ndarray | tuple) -> None:
@@ -114,7 +106,7 @@ def guarded_task(task: Task) -> TaskCompute:
         try:
             compute(ctx, jac, error)
         except Exception as exc:
-            raise _raised(label, exc, ctx, contract) from exc
+            raise_plugin_error(f"{label}: compute()", exc, f" at t = {ctx.t:g} s ({contract})")
 
     return guarded
 
@@ -140,7 +132,7 @@ def guarded_limit(limit: Limit) -> LimitCompute:
         try:
             compute(ctx, G, lower, upper, lb, ub)
         except Exception as exc:
-            raise _raised(label, exc, ctx, contract) from exc
+            raise_plugin_error(f"{label}: compute()", exc, f" at t = {ctx.t:g} s ({contract})")
 
     return guarded
 

@@ -71,7 +71,7 @@ from ddwmmr.errors import (
     check_range,
     check_step_count,
     float_values,
-    one_line,
+    raise_plugin_error,
     real_number,
     shown,
     texts_apart,
@@ -679,12 +679,9 @@ def waypoint_options(controller: str, run: WaypointRun) -> dict[str, Any]:
     try:
         options = hook(run)
     except Exception as error:
-        if built_in or isinstance(error, ParameterError | PluginError):
+        if built_in:
             raise
-        text = one_line(str(error), 120) or "(no message)"
-        raise PluginError(
-            f"controller {controller}: waypoint_options(run) raised {type(error).__name__}: {text}"
-        ) from error
+        raise_plugin_error(f"controller {controller}: waypoint_options(run)", error)
     if not isinstance(options, Mapping):
         raise PluginError(
             f"controller {controller}: waypoint_options(run) must return a dict of options "

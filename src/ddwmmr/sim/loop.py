@@ -84,7 +84,14 @@ import numpy as np
 
 from ddwmmr import interrupts
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
-from ddwmmr.errors import ParameterError, PluginError, float_values, shown
+from ddwmmr.errors import (
+    ParameterError,
+    float_values,
+    plugin_raised,
+    raise_as,
+    raise_plugin_error,
+    shown,
+)
 from ddwmmr.inheritance import defining_class, from_library, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 
@@ -309,13 +316,10 @@ def raise_wrapped(controller: Any, error: Exception, k: int, t: float, method: s
     library raised, as it is (a bug of ours keeps its traceback); anything a controller
     from outside the library raised, wrapped in a one-line :class:`PluginError` naming it,
     what it raised and where (``error`` its ``__cause__``)."""
-    if from_library(controller) or isinstance(error, ParameterError | PluginError):
+    if from_library(controller):
         raise error
-    text = " ".join(str(error).split()) or "(no message)"
-    raise PluginError(
-        f"method: {name_of(controller)}.{method}() raised {type(error).__name__}: "
-        f"{shown(text, 120)} at step {k}, t = {t:g} s"
-    ) from error
+    call = f"method: {name_of(controller)}.{method}()"
+    raise_plugin_error(call, error, f" at step {k}, t = {t:g} s", quoted=True)
 
 
 def bad_law(controller: Any, result: Any, k: int, t: float) -> NoReturn:
@@ -327,31 +331,16 @@ def bad_law(controller: Any, result: Any, k: int, t: float) -> NoReturn:
     )
 
 
-def plant_raised(plant: Plant, error: Exception, k: int, t: float, method: str) -> Exception:
-    """What a run raises when plug-in ``plant.<method>`` raised ``error`` at step ``k``
-    (time ``t`` s): a :class:`ParameterError` or :class:`PluginError` as it is (a bad
-    command at an integrator stage, or the plant's own one-line error), anything else
-    wrapped in a one-line :class:`PluginError` naming the plant, what it raised and where
-    (``error`` becomes its ``__cause__`` when raised ``from`` it)."""
-    if isinstance(error, ParameterError | PluginError):
-        return error
-    text = " ".join(str(error).split()) or "(no message)"
-    return PluginError(
-        f"plant: {name_of(plant)}.{method}() raised {type(error).__name__}: "
-        f"{shown(text, 120)} at step {k}, t = {t:g} s"
-    )
-
-
-def plant_failed(task: Task, plant: Plant, error: Exception, k: int, t: float, method: str) -> bool:
+def plant_failed(task: Task, plant: Plant, error: Exception, k: int, t: float, method: str) -> None:
     """Plug-in ``plant.<method>`` raised ``error`` at step ``k`` (time ``t`` s; called from
-    an ``except`` block): True if ``task.controller_error`` ends the run quietly on
-    :func:`plant_raised`'s error, else that error is raised (``error`` its cause)."""
-    wrapped = plant_raised(plant, error, k, t, method)
-    if task.controller_error(k, wrapped):
-        return True
-    if wrapped is error:
-        raise error
-    raise wrapped from error
+    an ``except`` block): returns if ``task.controller_error`` ends the run quietly on the
+    one-line error standing for it (:func:`~ddwmmr.errors.plugin_raised`: a ParameterError
+    or PluginError as it is, anything else wrapped, naming the plant, the step and the
+    time), else raises that error (``error`` its cause)."""
+    call = f"plant: {name_of(plant)}.{method}()"
+    wrapped = plugin_raised(call, error, f" at step {k}, t = {t:g} s", quoted=True)
+    if not task.controller_error(k, wrapped):
+        raise_as(wrapped, error)
 
 
 def stage_law(controller: Any) -> Callable[..., Any] | None:
@@ -445,14 +434,21 @@ def run_loop(
     if not (force or getattr(controller, "zero_order_hold", False)):
         stage_policy = policy if law is None else law_policy
     foreign = not from_library(plant)  # a plug-in plant: its output checked every step
-    if not foreign:
-        obs = plant.observe()
-    else:
+
+    def observe(index: int, at: float) -> Observation | None:
+        """``plant.observe()`` at sample ``index`` (time ``at`` s); a plug-in plant's
+        checked, and None where its failure ended the run quietly (:func:`plant_failed`)."""
+        if not foreign:
+            return plant.observe()
         try:
-            obs = checked_observation(plant, 0, 0.0)
+            return checked_observation(plant, index, at)
         except Exception as error:
-            if plant_failed(task, plant, error, 0, 0.0, "observe"):
-                return LoopEnd(0, "plant_error")
+            plant_failed(task, plant, error, index, at, "observe")
+            return None
+
+    obs = observe(0, 0.0)
+    if obs is None:
+        return LoopEnd(0, "plant_error")
     if task.start(obs):
         return LoopEnd(0, "start")
     for k in range(steps + 1):
@@ -481,8 +477,8 @@ def run_loop(
             try:
                 applied, saturated = checked_limit(plant, obs.q, command, k, t)
             except Exception as error:
-                if plant_failed(task, plant, error, k, t, "limit"):
-                    return LoopEnd(k, "plant_error")
+                plant_failed(task, plant, error, k, t, "limit")
+                return LoopEnd(k, "plant_error")
         else:
             applied, saturated = plant.limit(obs.q, command)
         task.record(k, t, obs, command, applied, saturated, info, elapsed)
@@ -500,16 +496,11 @@ def run_loop(
                 raise
             if not foreign:
                 raise  # the library's plants: their errors as they are
-            if plant_failed(task, plant, error, k, t, "step"):
-                return LoopEnd(k + 1, "plant_error")
-        if not foreign:
-            obs = plant.observe()
-        else:
-            try:
-                obs = checked_observation(plant, k + 1, t + dt)
-            except Exception as error:
-                if plant_failed(task, plant, error, k + 1, t + dt, "observe"):
-                    return LoopEnd(k + 1, "plant_error")
+            plant_failed(task, plant, error, k, t, "step")
+            return LoopEnd(k + 1, "plant_error")
+        obs = observe(k + 1, t + dt)
+        if obs is None:
+            return LoopEnd(k + 1, "plant_error")
         if task.after_step(k, t, obs, applied):
             return LoopEnd(k + 1, "failed")
         if progress is not None:
