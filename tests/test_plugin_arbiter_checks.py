@@ -125,7 +125,7 @@ def test_a_blending_plug_in_is_checked_and_keeps_its_weigh():
 
         name = "blender94"
 
-    Blender.__module__ = "h94_plugin"  # a class from outside the library
+    Blender.__module__ = "outside_plugin"  # a class from outside the library
     assert not callable(getattr(CheckedArbiter(Delegating(), "d"), "weigh", None))
     inner = Blender()
     checked = CheckedArbiter(inner, "blender94")
@@ -166,7 +166,7 @@ class _Still:
 def _register(registered, name: str, options) -> None:
     attributes = {} if options is None else {"waypoint_options": classmethod(options)}
     cls = type(name.replace("-", "_"), (_Still,), {"__doc__": "Still.", **attributes})
-    cls.__module__ = "h94_plugin"
+    cls.__module__ = "outside_plugin"
     registered(CONTROLLERS, name, cls, tasks=("tracking", "waypoints"))
 
 
@@ -215,7 +215,7 @@ def test_waypoint_options_bad_input_passes_and_good_options_are_used(registered)
 
 
 def test_the_scenarios_tool_refuses_a_controller_without_waypoint_options(tmp_path):
-    (tmp_path / "h94_nowo.py").write_text(
+    (tmp_path / "no_waypoint_options.py").write_text(
         "import numpy as np\n"
         "from ddwmmr.controllers import StepInfo, register_controller\n\n\n"
         '@register_controller("nowo94", tasks=("tracking", "waypoints"))\n'
@@ -230,7 +230,7 @@ def test_the_scenarios_tool_refuses_a_controller_without_waypoint_options(tmp_pa
     )
     env = {
         **os.environ,
-        "DDWMMR_PLUGINS": "h94_nowo",
+        "DDWMMR_PLUGINS": "no_waypoint_options",
         "PYTHONPATH": os.pathsep.join([str(ROOT / "src"), str(tmp_path)]),
         "MPLBACKEND": "Agg",
     }

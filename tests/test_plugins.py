@@ -47,19 +47,19 @@ def test_a_plug_in_taking_a_built_in_name_before_the_first_listing_is_refused(mo
 @pytest.mark.parametrize(
     ("source", "reason"),
     [
-        ("def f(:\n    pass\n", "SyntaxError: invalid syntax (h93_bad_0.py, line 1)"),
+        ("def f(:\n    pass\n", "SyntaxError: invalid syntax (broken_plugin.py, line 1)"),
         ("raise RuntimeError('plugin config\\nmissing')\n", "RuntimeError: plugin config missing"),
         ("raise KeyError\n", "KeyError"),
     ],
 )
 def test_a_plug_in_module_that_fails_to_import_is_one_line(tmp_path, monkeypatch, source, reason):
-    (tmp_path / "h93_bad_0.py").write_text(source)
+    (tmp_path / "broken_plugin.py").write_text(source)
     monkeypatch.syspath_prepend(str(tmp_path))
-    sys.modules.pop("h93_bad_0", None)
+    sys.modules.pop("broken_plugin", None)
     with pytest.raises(ParameterError) as error:
-        _import_plugin("h93_bad_0")
+        _import_plugin("broken_plugin")
     assert str(error.value) == (
-        f"DDWMMR_PLUGINS: cannot import plug-in module 'h93_bad_0' ({reason})"
+        f"DDWMMR_PLUGINS: cannot import plug-in module 'broken_plugin' ({reason})"
     )
 
 
@@ -82,11 +82,11 @@ def _tool(module: str, plugins: str, path: Path, *args: str) -> subprocess.Compl
 
 
 def test_the_tools_report_a_raising_plug_in_module_in_one_line_with_status_2(tmp_path):
-    (tmp_path / "h93_raises.py").write_text("raise RuntimeError('plugin config missing')\n")
-    result = _tool("ddwmmr.track", "h93_raises", tmp_path, "--help")
+    (tmp_path / "raising_plugin.py").write_text("raise RuntimeError('plugin config missing')\n")
+    result = _tool("ddwmmr.track", "raising_plugin", tmp_path, "--help")
     assert result.returncode == 2 and result.stdout == ""
     assert result.stderr.splitlines() == [
-        "error: DDWMMR_PLUGINS: cannot import plug-in module 'h93_raises' "
+        "error: DDWMMR_PLUGINS: cannot import plug-in module 'raising_plugin' "
         "(RuntimeError: plugin config missing)"
     ]
 
@@ -142,7 +142,7 @@ def test_a_raising_plug_in_plant_stops_a_tracking_run_with_a_plugin_error():
 
 
 @pytest.fixture
-def h93_plant():
+def euler_plant_registered():
     """EulerPlant registered as "plug-euler" (failing as the test's RunConfig options say)."""
     PLANTS.register("plug-euler", interfaces=("velocity",))(EulerPlant)
     yield
@@ -160,7 +160,9 @@ def h93_plant():
         ("nan", "ParameterError: plant: plug-euler.observe() must return an Observation(q, v"),
     ],
 )
-def test_a_failing_plug_in_plant_fails_its_scenario_only(h93_plant, monkeypatch, misuse, reason):
+def test_a_failing_plug_in_plant_fails_its_scenario_only(
+    euler_plant_registered, monkeypatch, misuse, reason
+):
     monkeypatch.setattr(EulerPlant.__init__, "__defaults__", (misuse, 10))
     config = RunConfig(controller="qp", plant="plug-euler", time_limit=2.0)
     outcome = run_scenario(generate(1, 0)[0], config)
