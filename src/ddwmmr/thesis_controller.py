@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.arbiters.base import Arbiter
+from ddwmmr.arbiters.checked import checked_arbiter
 from ddwmmr.arbiters.factory import make_arbiter
 from ddwmmr.arbiters.state_machine import StateMachineArbiter
 from ddwmmr.behaviours.base import BRAKE, Behaviour, Percept, Proposal, sense
@@ -76,7 +77,9 @@ class ThesisController:
     Args:
         robot: the robot (geometry for IK and metrics).
         arbiter: any :class:`~ddwmmr.arbiters.Arbiter`; default the thesis's
-            :class:`StateMachineArbiter` with its thresholds.
+            :class:`StateMachineArbiter` with its thresholds. One from outside the library
+            has its decisions checked (:func:`~ddwmmr.arbiters.checked.checked_arbiter`):
+            a bad one stops the run with a one-line PluginError naming it.
         obstacles: ``(x, y, radius)`` circles (m); adds the obstacle-avoidance behaviour.
         gains: PD gains (thesis Table 4.2).
         adjust: base displacement target of the manipulability/stability behaviours (m),
@@ -99,7 +102,10 @@ class ThesisController:
     ) -> None:
         self.robot = robot
         adjust = check_range("adjust", adjust, *ADJUST_RANGE_M, "m")
-        self.arbiter: Arbiter = arbiter if arbiter is not None else StateMachineArbiter()
+        # A plug-in's decisions are checked as it makes them; the library's run unwrapped.
+        self.arbiter: Arbiter = (
+            StateMachineArbiter() if arbiter is None else checked_arbiter(arbiter)
+        )
         self.behaviours: dict[str, Behaviour] = {
             "objective": Objective(robot),
             "manipulability": Manipulability(robot, adjust),

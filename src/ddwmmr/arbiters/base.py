@@ -7,8 +7,8 @@ but it must return a proposal made by one of them (or a blend in the common prop
 and name the state it is in, one of :data:`~ddwmmr.arbiters.STATES`, which the metrics
 count. An arbiter that blends proposals instead of choosing one also provides ``weigh``
 (:class:`BlendingArbiter`); the controller then uses its blending path. What it is given
-and what it may return: docs/thesis.md, "Writing an arbiter" (the scenario protocol checks
-a plug-in's decisions, :class:`~ddwmmr.arbiters.CheckedArbiter`).
+and what it may return: docs/thesis.md, "Writing an arbiter" (the thesis controller checks
+a plug-in's decisions, :func:`~ddwmmr.arbiters.checked.checked_arbiter`).
 """
 
 from __future__ import annotations

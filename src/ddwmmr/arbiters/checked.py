@@ -1,29 +1,64 @@
 """An arbiter from outside the library, its decisions checked where they are returned.
 
 The thesis controller trusts its arbiter: the state it names is counted by the scenario
-protocol and the behaviour it names is looked up in the controller's behaviours. A plug-in
-arbiter that names a state outside :data:`~ddwmmr.arbiters.STATES`, a behaviour the
-controller does not have, or returns no decision would otherwise fail far from its cause
-(a KeyError in the protocol's tally, an AttributeError in the controller).
-:class:`CheckedArbiter` wraps it: every ``select`` (and ``weigh``) result is checked at
-once, and anything wrong, or raised, becomes a one-line :class:`~ddwmmr.errors.PluginError`
-naming the arbiter, what it returned and the allowed values (docs/thesis.md, "Writing an
-arbiter"). The library's own arbiters are not wrapped.
+protocol, the behaviour it names is looked up in the controller's behaviours, and the
+proposals and shares it returns become wheel forces and joint targets. A plug-in arbiter
+that names a state outside :data:`~ddwmmr.arbiters.STATES`, a behaviour the controller does
+not have, returns no decision, a malformed proposal or a share that is not a number in
+[0, 1] would otherwise fail far from its cause (a KeyError in the protocol's tally, an
+AttributeError in the controller) or put NaN into the commands. :class:`CheckedArbiter`
+wraps it: every ``select`` (and ``weigh``) result is checked at once, and anything wrong,
+or raised, becomes a one-line :class:`~ddwmmr.errors.PluginError` naming the arbiter, the
+field and what is allowed (docs/thesis.md, "Writing an arbiter"). :func:`checked_arbiter`
+is where that is decided: the thesis controller passes every arbiter it is given through
+it, so a plug-in is checked whether the scenario protocol or a script built the controller;
+the library's own arbiters are not wrapped.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
+from numbers import Real
 from typing import Any, NoReturn
 
 from ddwmmr.arbiters.state_machine import STATES
-from ddwmmr.behaviours.base import Behaviour, Percept, Proposal
+from ddwmmr.behaviours.base import BRAKE, DRIVE, TURN, Behaviour, Percept, Proposal
 from ddwmmr.errors import PluginError, raise_plugin_error, shown
+from ddwmmr.inheritance import from_library
 
 #: What ``select`` must return, for the messages.
 SELECTION_FORM = "a Selection(state, behaviour, proposal) (ddwmmr.arbiters.Selection)"
 #: What ``weigh`` must return, for the messages.
 BLEND_FORM = "a Blend(state, behaviour, shares, proposals) (ddwmmr.arbiters.Blend)"
+#: The modes a :class:`~ddwmmr.behaviours.base.Proposal` may have.
+MODES = (DRIVE, TURN, BRAKE)
+#: Rounding allowed on the sum of the shares (a plug-in normalising its weights to 1).
+SHARE_SUM_SLACK = 1e-9
+
+
+def checked_arbiter(arbiter: Any) -> Any:
+    """``arbiter`` as the thesis controller calls it: wrapped in :class:`CheckedArbiter`
+    when its class is from outside the library (:func:`~ddwmmr.inheritance.from_library`);
+    the library's own arbiters, and one already wrapped (``CheckedArbiter`` is the
+    library's), as they are, so their runs keep their speed and their numbers.
+
+    Raises :class:`PluginError` (one line) when a plug-in has no ``select`` method."""
+    if from_library(arbiter):
+        return arbiter
+    name = arbiter_name(arbiter)
+    if not callable(getattr(arbiter, "select", None)):
+        raise PluginError(
+            f"arbiter {name}: has no select(percept, behaviours) method "
+            "(ddwmmr.arbiters.Arbiter: state, reset(), select())"
+        )
+    return CheckedArbiter(arbiter, name)
+
+
+def arbiter_name(arbiter: Any) -> str:
+    """What a message calls ``arbiter``: its ``name`` if that is a str, else its class's."""
+    name = getattr(arbiter, "name", None)
+    return name if isinstance(name, str) else type(arbiter).__name__
 
 
 class CheckedArbiter:
@@ -93,7 +128,8 @@ def check_selection(
 ) -> None:
     """Raise a one-line :class:`PluginError` unless ``selection`` (returned by arbiter
     ``name``'s ``select`` at time ``t`` s) names a state of :data:`STATES`, a behaviour of
-    ``behaviours`` and carries a :class:`~ddwmmr.behaviours.base.Proposal`."""
+    ``behaviours`` and carries a well-formed :class:`~ddwmmr.behaviours.base.Proposal`
+    (:func:`_check_proposal`)."""
     fields = ("state", "behaviour", "proposal")
     if not all(hasattr(selection, field) for field in fields):
         _refuse(
@@ -101,24 +137,67 @@ def check_selection(
         )
     _check_state(name, "select", selection.state, t)
     _check_behaviour(name, "select", selection.behaviour, behaviours, t)
-    if not isinstance(selection.proposal, Proposal):
-        got = f"returned proposal {shown(selection.proposal)}"
-        _refuse(name, "select", got, t, "it must be a behaviour's Proposal")
+    _check_proposal(name, "select", "proposal", selection.proposal, t)
 
 
 def check_blend(name: str, blend: Any, behaviours: Mapping[str, Behaviour], t: float) -> None:
     """Raise a one-line :class:`PluginError` unless ``blend`` (returned by arbiter ``name``'s
-    ``weigh`` at time ``t`` s) names a state of :data:`STATES` and shares of behaviours of
-    ``behaviours``."""
-    fields = ("state", "shares", "proposals")
+    ``weigh`` at time ``t`` s) names a state of :data:`STATES` and a behaviour of
+    ``behaviours``, has shares of behaviours of ``behaviours`` (each a finite number in
+    [0, 1], together at most 1: the controller brakes with the rest) and proposals keyed by
+    behaviours of ``behaviours``, each a well-formed Proposal (:func:`_check_proposal`)."""
+    fields = ("state", "behaviour", "shares", "proposals")
     if not all(hasattr(blend, field) for field in fields):
         _refuse(name, "weigh", f"returned {shown(blend)}", t, f"it must return {BLEND_FORM}")
     _check_state(name, "weigh", blend.state, t)
-    if not isinstance(blend.shares, Mapping):
-        got = f"returned shares {shown(blend.shares)}"
+    _check_behaviour(name, "weigh", blend.behaviour, behaviours, t)
+    _check_shares(name, blend.shares, behaviours, t)
+    if not isinstance(blend.proposals, Mapping):
+        got = f"returned proposals {shown(blend.proposals)}"
+        _refuse(name, "weigh", got, t, "they must be a mapping behaviour -> Proposal")
+    for behaviour, proposal in blend.proposals.items():
+        _check_behaviour(name, "weigh", behaviour, behaviours, t, "proposals key")
+        _check_proposal(name, "weigh", f"proposals[{behaviour!r}]", proposal, t)
+
+
+def _check_shares(name: str, shares: Any, behaviours: Mapping[str, Behaviour], t: float) -> None:
+    if not isinstance(shares, Mapping):
+        got = f"returned shares {shown(shares)}"
         _refuse(name, "weigh", got, t, "they must be a mapping behaviour -> share")
-    for behaviour in blend.shares:
+    wanted = "each share must be a finite number in [0, 1], together at most 1"
+    for behaviour, share in shares.items():
         _check_behaviour(name, "weigh", behaviour, behaviours, t)
+        if not (_finite(share) and 0.0 <= share <= 1.0):
+            _refuse(name, "weigh", f"returned shares[{behaviour!r}] = {shown(share)}", t, wanted)
+    total = math.fsum(shares.values())
+    if total > 1.0 + SHARE_SUM_SLACK:
+        _refuse(name, "weigh", f"returned shares adding up to {total:g}", t, wanted)
+
+
+def _check_proposal(name: str, method: str, field: str, proposal: Any, t: float) -> None:
+    """Refuse ``proposal`` (arbiter ``name``'s ``method`` returned it as ``field``) unless it
+    is a Proposal with a mode of :data:`MODES`, finite ``bx``, ``by`` (m, world) and
+    ``heading`` (rad, world) and a pair of finite joint targets ``arm`` (rad)."""
+    if not isinstance(proposal, Proposal):
+        got = f"returned {field} {shown(proposal)}"
+        _refuse(name, method, got, t, "it must be a behaviour's Proposal")
+    if proposal.mode not in MODES:
+        got = f"returned {field}.mode {shown(proposal.mode)}"
+        _refuse(name, method, got, t, f"allowed: {', '.join(MODES)}")
+    for attribute in ("bx", "by", "heading"):
+        value = getattr(proposal, attribute)
+        if not _finite(value):
+            got = f"returned {field}.{attribute} = {shown(value)}"
+            _refuse(name, method, got, t, "it must be a finite number (m, or rad for heading)")
+    arm = proposal.arm
+    if not (hasattr(arm, "__len__") and len(arm) == 2 and all(map(_finite, arm))):
+        got = f"returned {field}.arm = {shown(arm)}"
+        _refuse(name, method, got, t, "it must be two finite joint targets (th1, th2) in rad")
+
+
+def _finite(value: Any) -> bool:
+    """Whether ``value`` is a finite real number (a bool is no number here)."""
+    return isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def _check_state(name: str, method: str, state: Any, t: float) -> None:
@@ -128,11 +207,16 @@ def _check_state(name: str, method: str, state: Any, t: float) -> None:
 
 
 def _check_behaviour(
-    name: str, method: str, behaviour: Any, behaviours: Mapping[str, Behaviour], t: float
+    name: str,
+    method: str,
+    behaviour: Any,
+    behaviours: Mapping[str, Behaviour],
+    t: float,
+    field: str = "behaviour",
 ) -> None:
     if not isinstance(behaviour, str) or behaviour not in behaviours:
         allowed = f"allowed: {', '.join(behaviours)} (the behaviours it was given)"
-        _refuse(name, method, f"returned behaviour {shown(behaviour)}", t, allowed)
+        _refuse(name, method, f"returned {field} {shown(behaviour)}", t, allowed)
 
 
 def _refuse(name: str, method: str, got: str, t: float, wanted: str) -> NoReturn:
