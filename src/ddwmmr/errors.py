@@ -236,6 +236,37 @@ def float_values(value: Any, size: int) -> list[float] | None:
     return array.tolist() if array.shape == (size,) else None
 
 
+#: numpy's float64: what the library's controllers and trajectories return (the fast path
+#: of :func:`finite_values`).
+_FLOAT64 = np.dtype(float)
+
+
+def finite_values(value: Any, size: int) -> np.ndarray | None:
+    """``value`` as a float array of shape ``(size,)`` if it is a flat sequence of ``size``
+    finite numbers (a list, a tuple, a numpy array of any number type), else None. Text,
+    booleans, None and complex numbers are not numbers here (:func:`float_values`). A
+    float64 array is returned as it is (not copied), so a run fed arrays gives the numbers
+    it gave before the check."""
+    if type(value) is np.ndarray and value.dtype is _FLOAT64 and value.shape == (size,):
+        array = value  # the common case, no conversion
+    else:
+        values = float_values(value, size)
+        if values is None:
+            return None
+        array = np.array(values)
+    # a sum is finite only if every term is; a sum that overflowed looks again
+    if math.isfinite(sum(array.tolist())) or bool(np.all(np.isfinite(array))):
+        return array
+    return None
+
+
+def name_of(obj: Any) -> str:
+    """What a message calls a plug-in (a controller, a plant): its ``name`` if that is a
+    str, else its class's name."""
+    name = getattr(obj, "name", None)
+    return name if isinstance(name, str) else type(obj).__name__
+
+
 def shown(value: Any, width: int = 40) -> str:
     """``value`` for a message: its repr on one line, cut to ``width`` characters; an
     integer beyond about 1e60 as its magnitude (its repr is thousands of digits, or fails

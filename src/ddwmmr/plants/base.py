@@ -263,7 +263,7 @@ class Plant(Protocol):
         finite. Anything else a plug-in plant (a class from outside the library) raises
         here is wrapped by the simulation loop in a one-line
         :class:`~ddwmmr.errors.PluginError` naming the plant, the step and the time
-        (:func:`ddwmmr.sim.loop.plant_failed`).
+        (:class:`ddwmmr.plants.checked.CheckedPlant`).
         """
         ...
 

@@ -62,8 +62,9 @@ the step (a command of the other interface too: u from a controller that declare
 through ``task.controller_error`` like any error of the controller; at a stage it comes
 out of ``plant.step``.
 
-A plug-in plant (a class from outside the library) is held to its contract the same way:
-what its ``observe()`` and ``limit()`` return is checked at every step (a one-line
+A plug-in plant (a class from outside the library) is held to its contract the same way,
+by the :class:`~ddwmmr.plants.checked.CheckedPlant` the loop puts around it: what its
+``observe()`` and ``limit()`` return is checked at every step (a one-line
 ParameterError), and anything else its methods raise (but PlantDivergedError, which ends
 the run as "diverged") is wrapped in a one-line PluginError naming the plant, the method,
 the step and the time. Both go through ``task.controller_error`` (the scenario protocol
@@ -86,14 +87,14 @@ from ddwmmr import interrupts
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
 from ddwmmr.errors import (
     ParameterError,
-    float_values,
-    plugin_raised,
-    raise_as,
+    finite_values,
+    name_of,
     raise_plugin_error,
     shown,
 )
 from ddwmmr.inheritance import defining_class, from_library, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+from ddwmmr.plants.checked import PlantFailed, checked_plant
 
 #: Progress callback: (samples done, samples in all).
 Progress = Callable[[int, int], None]
@@ -211,32 +212,6 @@ def check_interface(controller: Any, plant: Plant) -> str:
 _FLOAT64 = np.dtype(float)
 
 
-def finite_values(value: Any, size: int) -> np.ndarray | None:
-    """``value`` as a float array of shape ``(size,)`` if it is a flat sequence of ``size``
-    finite numbers (a list, a tuple, a numpy array of any number type), else None. Text,
-    booleans, None and complex numbers are not numbers here
-    (:func:`~ddwmmr.errors.float_values`). A float64 array is returned as it is (not
-    copied), so a run fed arrays gives the numbers it gave before the check."""
-    if type(value) is np.ndarray and value.dtype is _FLOAT64 and value.shape == (size,):
-        array = value  # the common case, no conversion
-    else:
-        values = float_values(value, size)
-        if values is None:
-            return None
-        array = np.array(values)
-    # a sum is finite only if every term is; a sum that overflowed looks again
-    if isfinite(sum(array.tolist())) or bool(np.all(np.isfinite(array))):
-        return array
-    return None
-
-
-def name_of(obj: Any) -> str:
-    """What a message calls a controller or a plant: its ``name`` if that is a str, else
-    its class's name."""
-    name = getattr(obj, "name", None)
-    return name if isinstance(name, str) else type(obj).__name__
-
-
 def checked_command(command: Any, force: bool, controller: Any, k: int, t: float) -> Any:
     """``command``, as returned by ``controller.command`` at step ``k`` (time ``t`` s), if
     it is a command the plant can apply: on the velocity interface 4 finite numbers
@@ -277,38 +252,6 @@ def checked_command(command: Any, force: bool, controller: Any, k: int, t: float
     )
 
 
-def checked_observation(plant: Plant, k: int, t: float) -> Observation:
-    """``plant.observe()`` at step ``k`` (time ``t`` s) if it is an :class:`Observation` of
-    finite numbers, else a one-line :class:`ParameterError` naming the plant: a plant whose
-    state blows up raises :class:`PlantDivergedError` from ``step`` (the run then stops
-    there and says so); a NaN observed would surface later as the controller's bad ``q``.
-    For a plug-in plant (the library's own raise PlantDivergedError themselves)."""
-    obs = plant.observe()
-    if isinstance(obs, Observation) and obs.finite():
-        return obs
-    wanted = "an Observation(q, v, w) of 5 + 2 finite numbers"
-    raise ParameterError(
-        f"plant: {name_of(plant)}.observe() must return {wanted} (got {shown(obs, 80)} "
-        f"at step {k}, t = {t:g} s; a plant whose state blows up raises PlantDivergedError "
-        "in step())"
-    )
-
-
-def checked_limit(plant: Plant, q: np.ndarray, command: np.ndarray, k: int, t: float):
-    """``plant.limit(q, command)`` at step ``k`` (time ``t`` s) if it is ``(u, saturated)``
-    with ``u`` 4 finite numbers (returned as a float array), else a one-line
-    :class:`ParameterError` naming the plant. For a plug-in plant."""
-    result = plant.limit(q, command)
-    if isinstance(result, tuple) and len(result) == 2:
-        applied = finite_values(result[0], 4)
-        if applied is not None:
-            return applied, bool(result[1])
-    raise ParameterError(
-        f"plant: {name_of(plant)}.limit(q, u) must return (u, saturated) with u 4 finite "
-        f"numbers (got {shown(result, 80)} at step {k}, t = {t:g} s)"
-    )
-
-
 def raise_wrapped(controller: Any, error: Exception, k: int, t: float, method: str) -> NoReturn:
     """Raise what a run raises when ``controller.<method>`` raised ``error`` at step ``k``
     (time ``t`` s; called from an ``except`` block): a :class:`ParameterError` (bad input,
@@ -329,18 +272,6 @@ def bad_law(controller: Any, result: Any, k: int, t: float) -> NoReturn:
         f"method: {name_of(controller)}.law() must return (u, ...) with u 4 numbers "
         f"(v, w, th1dot, th2dot) (got {shown(result, 60)} at step {k}, t = {t:g} s)"
     )
-
-
-def plant_failed(task: Task, plant: Plant, error: Exception, k: int, t: float, method: str) -> None:
-    """Plug-in ``plant.<method>`` raised ``error`` at step ``k`` (time ``t`` s; called from
-    an ``except`` block): returns if ``task.controller_error`` ends the run quietly on the
-    one-line error standing for it (:func:`~ddwmmr.errors.plugin_raised`: a ParameterError
-    or PluginError as it is, anything else wrapped, naming the plant, the step and the
-    time), else raises that error (``error`` its cause)."""
-    call = f"plant: {name_of(plant)}.{method}()"
-    wrapped = plugin_raised(call, error, f" at step {k}, t = {t:g} s", quoted=True)
-    if not task.controller_error(k, wrapped):
-        raise_as(wrapped, error)
 
 
 def stage_law(controller: Any) -> Callable[..., Any] | None:
@@ -371,6 +302,7 @@ def run_loop(
     The plant and the controller are reset first. See the module docstring for the
     sequence of one sample and the controller contract.
     """
+    plant = checked_plant(plant, task.controller_error)  # a plug-in's calls checked
     adopt_plant = getattr(controller, "adopt_plant", None)
     if adopt_plant is not None:
         adopt_plant(traits_of(plant))
@@ -433,76 +365,55 @@ def run_loop(
     stage_policy = None
     if not (force or getattr(controller, "zero_order_hold", False)):
         stage_policy = policy if law is None else law_policy
-    foreign = not from_library(plant)  # a plug-in plant: its output checked every step
 
-    def observe(index: int, at: float) -> Observation | None:
-        """``plant.observe()`` at sample ``index`` (time ``at`` s); a plug-in plant's
-        checked, and None where its failure ended the run quietly (:func:`plant_failed`)."""
-        if not foreign:
-            return plant.observe()
-        try:
-            return checked_observation(plant, index, at)
-        except Exception as error:
-            plant_failed(task, plant, error, index, at, "observe")
-            return None
-
-    obs = observe(0, 0.0)
-    if obs is None:
-        return LoopEnd(0, "plant_error")
-    if task.start(obs):
-        return LoopEnd(0, "start")
-    for k in range(steps + 1):
-        t = k * dt
-        interrupts.raise_pending()  # one a solver swallowed in the last step
-        if task.finished(k, t, obs):
-            return LoopEnd(k, "finished")
-        pose_d, velocity_d = task.reference(t, obs)
-        try:
-            q = obs.values if float_state else obs.q
-            start = clock()
-            if wants_velocity:
-                command = command_of(t, q, pose_d, velocity_d, base_velocity=(obs.v, obs.w))
-            else:
-                command = command_of(t, q, pose_d, velocity_d)
-            elapsed = clock() - start
-            command = checked_command(command, force, controller, k, t)
-        except Exception as error:
-            if task.controller_error(k, error):
-                return LoopEnd(k, "controller_error")
-            raise_wrapped(controller, error, k, t, "command")
-        info = getattr(controller, "last", _NO_INFO)
-        if force:
-            applied, saturated = command, False
-        elif foreign:
+    try:
+        obs = plant.observe()
+        if task.start(obs):
+            return LoopEnd(0, "start")
+        for k in range(steps + 1):
+            t = k * dt
+            interrupts.raise_pending()  # one a solver swallowed in the last step
+            if task.finished(k, t, obs):
+                return LoopEnd(k, "finished")
+            pose_d, velocity_d = task.reference(t, obs)
             try:
-                applied, saturated = checked_limit(plant, obs.q, command, k, t)
+                q = obs.values if float_state else obs.q
+                start = clock()
+                if wants_velocity:
+                    command = command_of(t, q, pose_d, velocity_d, base_velocity=(obs.v, obs.w))
+                else:
+                    command = command_of(t, q, pose_d, velocity_d)
+                elapsed = clock() - start
+                command = checked_command(command, force, controller, k, t)
             except Exception as error:
-                plant_failed(task, plant, error, k, t, "limit")
-                return LoopEnd(k, "plant_error")
-        else:
-            applied, saturated = plant.limit(obs.q, command)
-        task.record(k, t, obs, command, applied, saturated, info, elapsed)
-        if k == steps:
-            break
-        try:
-            plant.step(t, applied, dt, stage_policy)
-        except PlantDivergedError as error:
-            task.diverged(k, error)
-            return LoopEnd(k + 1, "diverged")
-        except Exception as error:
-            if stage_errors:  # the controller failed at a stage, inside the plant's step
+                if task.controller_error(k, error):
+                    return LoopEnd(k, "controller_error")
+                raise_wrapped(controller, error, k, t, "command")
+            info = getattr(controller, "last", _NO_INFO)
+            if force:
+                applied, saturated = command, False
+            else:
+                applied, saturated = plant.limit(obs.q, command)
+            task.record(k, t, obs, command, applied, saturated, info, elapsed)
+            if k == steps:
+                break
+            try:
+                plant.step(t, applied, dt, stage_policy)
+            except PlantDivergedError as error:
+                task.diverged(k, error)
+                return LoopEnd(k + 1, "diverged")
+            except Exception:
+                if not stage_errors:
+                    raise  # the plant's own (a plug-in's one line, from CheckedPlant)
+                # the controller failed at a stage, inside the plant's step: its error
                 if task.controller_error(k, stage_errors[-1]):
                     return LoopEnd(k, "controller_error")
                 raise
-            if not foreign:
-                raise  # the library's plants: their errors as they are
-            plant_failed(task, plant, error, k, t, "step")
-            return LoopEnd(k + 1, "plant_error")
-        obs = observe(k + 1, t + dt)
-        if obs is None:
-            return LoopEnd(k + 1, "plant_error")
-        if task.after_step(k, t, obs, applied):
-            return LoopEnd(k + 1, "failed")
-        if progress is not None:
-            progress(k + 1, steps)
+            obs = plant.observe()
+            if task.after_step(k, t, obs, applied):
+                return LoopEnd(k + 1, "failed")
+            if progress is not None:
+                progress(k + 1, steps)
+    except PlantFailed as failure:  # a plug-in plant failed; the task ended the run on it
+        return LoopEnd(failure.samples, "plant_error")
     return LoopEnd(steps, "steps")

@@ -21,12 +21,11 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.commands import FORCE, WheelForces
-from ddwmmr.errors import ParameterError, bracketed, shown
+from ddwmmr.errors import ParameterError, bracketed, finite_values, shown
 from ddwmmr.inheritance import defining_class
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_arrays
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
-from ddwmmr.sim.loop import finite_values
 from ddwmmr.trajectories.base import Trajectory, sampler, trajectory_name
 
 #: Column names of the recorded time series, in order (plant columns follow).
