@@ -74,8 +74,10 @@ class ResolvedRate(ABC):
 
 
 def check_aux(aux: str) -> str:
-    """Validate the auxiliary constraint name of the augmented task space."""
-    if aux not in AUX_ROWS:
+    """Validate the auxiliary constraint name of the augmented task space (one of
+    :data:`~ddwmmr.model.kinematics.AUX_ROWS`; anything else, a list too, is a
+    :class:`ParameterError`)."""
+    if not isinstance(aux, str) or aux not in AUX_ROWS:
         raise ParameterError(f"aux must be one of {', '.join(AUX_ROWS)} (got {shown(aux)})")
     return aux
 

@@ -42,7 +42,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, real_number, shown
 from ddwmmr.model.stability import (
     ComCoefficients,
     InertialTerms,
@@ -64,12 +64,12 @@ def check_min_edge_load(value: Any) -> float:
     """The ``min_edge_load`` option: a share of the robot's weight in [0, 0.5) (at rest an
     edge carries at most half the weight, with the centre of mass at the polygon's
     middle); raises :class:`~ddwmmr.errors.ParameterError` (one line) otherwise."""
-    ok = isinstance(value, int | float) and not isinstance(value, bool)
-    if not (ok and math.isfinite(value) and 0.0 <= value < 0.5):
+    share = real_number(value)  # None for text, booleans and integers beyond a float
+    if share is None or not (math.isfinite(share) and 0.0 <= share < 0.5):
         raise ParameterError(
-            f"min_edge_load must be a share of the weight in [0, 0.5) (got {value!r})"
+            f"min_edge_load must be a share of the weight in [0, 0.5) (got {shown(value)})"
         )
-    return float(value)
+    return share
 
 
 def support_points(robot) -> tuple[tuple[float, float], ...]:

@@ -51,6 +51,7 @@ import math
 import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import fields
 from typing import Any, ClassVar
 
 import numpy as np
@@ -66,7 +67,7 @@ from ddwmmr.controllers.base import (
     step_results,
 )
 from ddwmmr.controllers.inputs import check_inputs, check_start
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import GRAVITY_M_S2, warn_start_below_floor
 from ddwmmr.mpc.braking import braked_velocity, braking_input, should_brake
@@ -115,10 +116,14 @@ class MPCController:
     }
 
     def __init__(self, robot: Robot, **options: Any) -> None:
-        try:
-            self.options = MPCOptions(**options)
-        except TypeError as error:  # an unknown keyword: name it as make_controller does
-            raise ParameterError(f"method {self.name}: {error}") from None
+        accepted = [f.name for f in fields(MPCOptions)]
+        unknown = sorted(set(options) - set(accepted))
+        if unknown:  # worded as make_controller words it
+            raise ParameterError(
+                f"method {self.name}: unknown option {shown(unknown[0])} "
+                f"(accepted: {', '.join(sorted(accepted))})"
+            )
+        self.options = MPCOptions(**options)
         self.robot = robot
         self._plan = _load_plan(self.options, robot.payload)
         self._configure(self.options.adopt_plant(None), None)

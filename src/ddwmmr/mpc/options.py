@@ -16,7 +16,7 @@ import copy
 import inspect
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -221,8 +221,8 @@ class MPCOptions:
         dt: control step (s); None (default): the loop's control step
             (``adopt_control_step``), else the trajectory's ``duration / samples`` at
             reset, else :data:`DEFAULT_DT`.
-        fallback_options: options of the ``qp`` fallback controller (merged over the
-            defaults derived from these options).
+        fallback_options: options of the ``qp`` fallback controller, a dict by name
+            (merged over the defaults derived from these options; None: none).
     """
 
     model: str | None = None
@@ -326,19 +326,18 @@ class MPCOptions:
         for mode in GRID_DEFAULTS:
             self.grid(mode)
             self.weights(mode)
-        for name, check in (
-            ("huber", _check_huber),
+        if self.huber is not None:  # None: per objective (huber_scale)
+            self._set("huber", _check_huber("huber", self.huber))
+        for name, check in (  # None is no value of these: refused as any non-number
             ("reach_speed", check_positive),
             ("proximal", check_nonnegative),
             ("stability_margin", check_nonnegative),
             ("plan_weight", check_weight),
             ("obstacle_margin", check_nonnegative),
         ):
-            value = getattr(self, name)
-            if value is not None:
-                self._set(name, check(name, value))
+            self._set(name, check(name, getattr(self, name)))
         self._check_stability_target()
-        self._set("fallback_options", dict(self.fallback_options or {}))
+        self._set("fallback_options", _fallback_option(self.fallback_options))
 
     def _set(self, name: str, value: Any) -> None:
         object.__setattr__(self, name, value)
@@ -520,6 +519,18 @@ class MPCOptions:
             joint_acceleration_limit=list(self.joint_acceleration_limit or ()),  # type: ignore[arg-type]
         )
         return values
+
+
+def _fallback_option(value: Any) -> dict[str, Any]:
+    """The ``fallback_options`` option: the ``qp``'s options by name (None: none), kept as
+    a dict."""
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping) or not all(isinstance(key, str) for key in value):
+        raise ParameterError(
+            f"fallback_options must be a dict of qp options by name (got {shown(value)})"
+        )
+    return dict(value)
 
 
 def _route_option(value: Any) -> tuple[tuple[float, float], ...]:
