@@ -215,3 +215,78 @@ def test_a_selected_proposal_with_nan_is_named():
         "arbiter picker: select() returned proposal.arm = (nan, 0.0) at t = 0 s; "
         "it must be two finite joint targets (th1, th2) in rad"
     )
+
+
+# -- a share for a behaviour that proposes nothing; the state read at build and reset -------
+def test_a_share_for_a_behaviour_with_nothing_to_propose_is_one_line():
+    """Without the check: a bare AssertionError in ThesisController._proposal. The obstacle
+    lies far behind the robot, so obstacle avoidance proposes nothing."""
+    controller = ThesisController(
+        ROBOT, Weighing({"objective": 0.5, "obstacle": 0.25}), obstacles=((-3.0, -3.0, 0.2),)
+    )
+    controller.reset((3.0, 0.0))
+    assert controller.behaviours["obstacle"].propose(BASE_PERCEPT) is None
+    with pytest.raises(PluginError) as error:
+        controller.act(0.5, Q, 0.0, 0.0)
+    assert str(error.value) == (
+        "arbiter weigher: weigh() returned shares['obstacle'] = 0.25 at t = 0.5 s; obstacle "
+        "proposes nothing now (propose() returned None) and proposals has no entry for it: "
+        "share only behaviours that propose, or return their proposals"
+    )
+    # with its proposal returned, the same share is used as it is
+    drive = Proposal(DRIVE, (-0.7, 1.57), 1.0, 0.0)
+    fine = ThesisController(
+        ROBOT, Weighing({"obstacle": 1.0}, {"obstacle": drive}), obstacles=((-3.0, -3.0, 0.2),)
+    )
+    fine.reset((3.0, 0.0))
+    own = ThesisController(ROBOT, Weighing({"objective": 1.0}, {"objective": drive}))
+    own.reset((3.0, 0.0))
+    assert fine.act(0.0, Q, 0.0, 0.0) == own.act(0.0, Q, 0.0, 0.0)
+
+
+class Stating(Picking):
+    """A plug-in arbiter whose ``state`` is ``initial``, and ``after_reset`` once reset."""
+
+    def __init__(self, initial, after_reset=MOVE_BASE) -> None:
+        super().__init__()
+        self._state, self.after_reset = initial, after_reset
+
+    @property
+    def state(self):
+        return self._state
+
+    def reset(self) -> None:
+        self._state = self.after_reset
+
+
+STATE_ALLOWED = (
+    "allowed: move_base, move_arm, manipulability, stability, obstacle (ddwmmr.arbiters.STATES)"
+)
+
+
+def test_a_state_outside_states_is_refused_when_the_controller_is_built_or_reset():
+    """Without the check the state went unchecked into ``controller.state`` (the scenario
+    tally then counts a state it has no column for)."""
+    with pytest.raises(PluginError) as error:
+        ThesisController(ROBOT, Stating("dancing"))
+    assert str(error.value) == f"arbiter picker: state is 'dancing'; {STATE_ALLOWED}"
+    controller = ThesisController(ROBOT, Stating(MOVE_BASE, after_reset=None))
+    assert controller.state == MOVE_BASE
+    with pytest.raises(PluginError) as error:
+        controller.reset((3.0, 0.0))
+    assert str(error.value) == f"arbiter picker: state is None; {STATE_ALLOWED}"
+
+
+def test_checked_arbiter_is_exported_and_names_who_handed_over_a_non_arbiter():
+    from ddwmmr.arbiters import checked_arbiter
+
+    plug_in = Picking()
+    assert checked_arbiter(plug_in).arbiter is plug_in
+    own = StateMachineArbiter()
+    assert checked_arbiter(own, "controller thesis: waypoint_options") is own
+    with pytest.raises(PluginError) as error:
+        checked_arbiter("mine", "controller thesis: waypoint_options")
+    assert str(error.value) == (
+        "controller thesis: waypoint_options gave arbiter 'mine', which has no "
+        "select(percept, behaviours) method"
+    )

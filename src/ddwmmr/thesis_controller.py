@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.arbiters.base import Arbiter
-from ddwmmr.arbiters.checked import checked_arbiter
+from ddwmmr.arbiters.checked import checked_arbiter, refuse_unproposed
 from ddwmmr.arbiters.factory import make_arbiter
 from ddwmmr.arbiters.state_machine import StateMachineArbiter
 from ddwmmr.behaviours.base import BRAKE, Behaviour, Percept, Proposal, sense
@@ -55,7 +55,7 @@ from ddwmmr.behaviours.obstacle import ObstacleAvoidance
 from ddwmmr.behaviours.stability import Stability
 from ddwmmr.commands import WheelForces
 from ddwmmr.controllers.base import WaypointRun, register_controller
-from ddwmmr.errors import check_range
+from ddwmmr.errors import check_range, name_of
 from ddwmmr.model import Robot
 
 #: Actuator command: (left wheel force N, right wheel force N, th1 target rad, th2 target rad).
@@ -268,7 +268,9 @@ class ThesisController:
         """Behaviour ``name``'s proposal; its own hold point is latched while it is engaged.
 
         Proposals the arbiter evaluated (it derives advantages from them) are used as they
-        are, so the weights and the commands come from the same proposals.
+        are, so the weights and the commands come from the same proposals. A share for a
+        behaviour that proposes nothing (and no proposal for it) is a one-line PluginError
+        naming the arbiter (:func:`~ddwmmr.arbiters.checked.refuse_unproposed`).
         """
         if name in evaluated:
             return evaluated[name]
@@ -279,7 +281,8 @@ class ThesisController:
             hold = None
             del self._holds[name]
         proposal = self.behaviours[name].propose(p if hold is None else p.with_hold(hold))
-        assert proposal is not None  # the arbiter only shares out available proposals
+        if proposal is None:  # a share for a behaviour with nothing to propose
+            refuse_unproposed(name_of(self.arbiter), name, share, p.t)
         return proposal
 
 

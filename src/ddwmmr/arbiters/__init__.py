@@ -6,13 +6,15 @@ can replace it. :class:`CompetitiveDynamicsArbiter` (Ellekilde & Christensen 200
 alternative: behaviour weights under competitive dynamics, proposals blended by the weights
 (it also has ``weigh(percept, behaviours) -> Blend``, :class:`BlendingArbiter`).
 :func:`make_arbiter` builds a registered one (:func:`available_arbiters`) from a scenario
-configuration; the scenario protocol wraps a plug-in arbiter in :class:`CheckedArbiter`,
-which refuses in one line a decision naming a state outside :data:`STATES` or a behaviour
-the controller does not have.
+configuration. :func:`checked_arbiter` wraps an arbiter from outside the library in
+:class:`CheckedArbiter` (the thesis controller passes every arbiter it is given through it,
+and so does the scenario protocol for any controller that takes an arbiter), which refuses
+in one line a state outside :data:`STATES`, a behaviour the controller does not have, a
+malformed proposal or a share outside [0, 1].
 """
 
 from ddwmmr.arbiters.base import Arbiter, BlendingArbiter
-from ddwmmr.arbiters.checked import CheckedArbiter
+from ddwmmr.arbiters.checked import CheckedArbiter, checked_arbiter
 from ddwmmr.arbiters.competitive import (
     BEHAVIOURS,
     Blend,
@@ -62,6 +64,7 @@ __all__ = [
     "arbiter_description",
     "available_arbiters",
     "check_arbiter",
+    "checked_arbiter",
     "make_arbiter",
     "register_arbiter",
 ]

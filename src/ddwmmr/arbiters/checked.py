@@ -24,7 +24,7 @@ from typing import Any, NoReturn
 
 from ddwmmr.arbiters.state_machine import STATES
 from ddwmmr.behaviours.base import BRAKE, DRIVE, TURN, Behaviour, Percept, Proposal
-from ddwmmr.errors import PluginError, raise_plugin_error, shown
+from ddwmmr.errors import PluginError, name_of, raise_plugin_error, shown
 from ddwmmr.inheritance import from_library
 
 #: What ``select`` must return, for the messages.
@@ -37,28 +37,26 @@ MODES = (DRIVE, TURN, BRAKE)
 SHARE_SUM_SLACK = 1e-9
 
 
-def checked_arbiter(arbiter: Any) -> Any:
+def checked_arbiter(arbiter: Any, origin: str | None = None) -> Any:
     """``arbiter`` as the thesis controller calls it: wrapped in :class:`CheckedArbiter`
     when its class is from outside the library (:func:`~ddwmmr.inheritance.from_library`);
     the library's own arbiters, and one already wrapped (``CheckedArbiter`` is the
     library's), as they are, so their runs keep their speed and their numbers.
 
-    Raises :class:`PluginError` (one line) when a plug-in has no ``select`` method."""
+    Raises :class:`PluginError` (one line) when a plug-in has no ``select`` method; the
+    message names the arbiter, or, with ``origin`` (what handed the arbiter over, e.g.
+    ``"controller thesis: waypoint_options"``), that and what it gave."""
     if from_library(arbiter):
         return arbiter
-    name = arbiter_name(arbiter)
+    name = name_of(arbiter)
     if not callable(getattr(arbiter, "select", None)):
+        method = "select(percept, behaviours) method"
+        if origin is not None:
+            raise PluginError(f"{origin} gave arbiter {shown(arbiter)}, which has no {method}")
         raise PluginError(
-            f"arbiter {name}: has no select(percept, behaviours) method "
-            "(ddwmmr.arbiters.Arbiter: state, reset(), select())"
+            f"arbiter {name}: has no {method} (ddwmmr.arbiters.Arbiter: state, reset(), select())"
         )
     return CheckedArbiter(arbiter, name)
-
-
-def arbiter_name(arbiter: Any) -> str:
-    """What a message calls ``arbiter``: its ``name`` if that is a str, else its class's."""
-    name = getattr(arbiter, "name", None)
-    return name if isinstance(name, str) else type(arbiter).__name__
 
 
 class CheckedArbiter:
@@ -82,14 +80,22 @@ class CheckedArbiter:
 
     @property
     def state(self) -> str:
-        """The arbiter's current state (the controller reads it when built and reset)."""
+        """The arbiter's current state, one of :data:`STATES` (the controller reads it when
+        built and reset)."""
         try:
-            return self.arbiter.state
+            state = self.arbiter.state
         except AttributeError:
             raise PluginError(
                 f"arbiter {self.name}: has no attribute state (the state it is in, one of "
                 "ddwmmr.arbiters.STATES; ddwmmr.arbiters.Arbiter)"
             ) from None
+        if not (isinstance(state, str) and state in STATES):
+            # the scenario protocol counts this state from the first step on
+            raise PluginError(
+                f"arbiter {self.name}: state is {shown(state)}; allowed: {', '.join(STATES)} "
+                "(ddwmmr.arbiters.STATES)"
+            )
+        return state
 
     def reset(self) -> None:
         """Start a new run (the arbiter's ``reset()``)."""
@@ -158,6 +164,21 @@ def check_blend(name: str, blend: Any, behaviours: Mapping[str, Behaviour], t: f
     for behaviour, proposal in blend.proposals.items():
         _check_behaviour(name, "weigh", behaviour, behaviours, t, "proposals key")
         _check_proposal(name, "weigh", f"proposals[{behaviour!r}]", proposal, t)
+
+
+def refuse_unproposed(name: str, behaviour: str, share: float, t: float) -> NoReturn:
+    """Raise a one-line :class:`PluginError`: arbiter ``name``'s ``weigh`` gave ``behaviour``
+    a ``share`` at time ``t`` (s) but no proposal for it, and the behaviour proposes nothing
+    (its ``propose`` returned None: the obstacle behaviour with nothing in the way). Only
+    the controller knows, at the point of use: the behaviour is asked with its hold point."""
+    _refuse(
+        name,
+        "weigh",
+        f"returned shares[{behaviour!r}] = {share:g}",
+        t,
+        f"{behaviour} proposes nothing now (propose() returned None) and proposals has no "
+        "entry for it: share only behaviours that propose, or return their proposals",
+    )
 
 
 def _check_shares(name: str, shares: Any, behaviours: Mapping[str, Behaviour], t: float) -> None:

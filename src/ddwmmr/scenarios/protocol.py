@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.arbiters.checked import CheckedArbiter
+from ddwmmr.arbiters.checked import checked_arbiter
 from ddwmmr.arbiters.factory import check_arbiter
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
@@ -76,7 +76,6 @@ from ddwmmr.errors import (
     shown,
     texts_apart,
 )
-from ddwmmr.inheritance import from_library
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import (
     STABILITY_CAP,
@@ -90,7 +89,7 @@ from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.registry import BUILTIN_MODULES, CONTROLLERS, PLANTS
 from ddwmmr.scenarios.generator import Scenario
-from ddwmmr.sim.loop import name_of, run_loop
+from ddwmmr.sim.loop import run_loop
 
 #: What each command interface sends, for the messages.
 SENDS = {FORCE: "wheel forces", VELOCITY: "velocity commands"}
@@ -165,8 +164,9 @@ class RunConfig:
         tolerance: waypoint tolerance (m).
         qp_stability_min, qp_max_speed: options of the ``qp`` controller (the stability
             floor is also ``mpc``'s), in :data:`QP_RANGES` (:func:`check_qp_option`).
-        controller_options: further ``(name, value)`` options of the ``qp`` or ``mpc``
-            controller (e.g. ``(("horizon", 3.0),)``), over the protocol's own.
+        controller_options: further ``(name, value)`` options of the controller (e.g.
+            ``(("horizon", 3.0),)`` for the ``mpc``), over the protocol's own: a tuple (or
+            list) of pairs, each name a str given once (:func:`check_controller_options`).
         record: keep a trace (every ``TRACE_INTERVAL``) for plots.
         arbiter: thesis controller's arbiter, a registered name
             (``ddwmmr.arbiters.available_arbiters()``: ``"state-machine"``, ``"competitive"``;
@@ -223,6 +223,7 @@ class RunConfig:
             check_qp_option(name, getattr(self, name))
         check_payload(self.payload)
         check_positive("tolerance", self.tolerance)
+        check_controller_options(self.controller_options)
         # Checked here rather than when a worker reaches a scenario halfway through a
         # batch. Without a time_limit, the shorter default: dt above it would run no step
         # at all; whether 120 s (obstacles) stays within the cap depends on the scenario,
@@ -299,6 +300,26 @@ def max_start_payload() -> float:
     start pose (:func:`~ddwmmr.model.stability.max_payload` of the default robot)."""
     robot = Robot()
     return max_payload(robot, *default_pose(robot))
+
+
+def check_controller_options(options: Any) -> tuple[tuple[str, Any], ...]:
+    """``options`` as a tuple if it is ``RunConfig.controller_options``: a tuple (or list)
+    of ``(name, value)`` pairs, each name a str given once, else a one-line
+    :class:`ParameterError` (text or a dict would otherwise fail in the controller's
+    ``dict()`` of them, and a name given twice would silently keep its last value)."""
+    wanted = 'a tuple of (name, value) pairs with distinct names, e.g. (("horizon", 3.0),)'
+    if not isinstance(options, (tuple, list)):
+        raise ParameterError(f"controller_options must be {wanted} (got {shown(options)})")
+    seen: set[str] = set()
+    for pair in options:
+        if not (isinstance(pair, (tuple, list)) and len(pair) == 2 and isinstance(pair[0], str)):
+            raise ParameterError(f"controller_options must be {wanted} (got {shown(pair)})")
+        if pair[0] in seen:
+            raise ParameterError(
+                f"controller_options: {pair[0]!r} is given twice; each name once ({wanted})"
+            )
+        seen.add(pair[0])
+    return tuple(options)
 
 
 def check_qp_option(name: str, value: float) -> float:
@@ -610,7 +631,18 @@ def plants_for(controller: str) -> list[str]:
 
 
 def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
-    """Run one scenario under ``config`` and return its outcome."""
+    """Run one scenario under ``config`` and return its outcome.
+
+    A ``scenario`` that is no :class:`Scenario` or a ``config`` that is no
+    :class:`RunConfig` is refused with a one-line :class:`ParameterError`."""
+    if not isinstance(scenario, Scenario):
+        raise ParameterError(
+            f"scenario must be a Scenario (ddwmmr.scenarios.generate) (got {shown(scenario)})"
+        )
+    if not isinstance(config, RunConfig):
+        raise ParameterError(
+            f"config must be a RunConfig (ddwmmr.scenarios.RunConfig) (got {shown(config)})"
+        )
     robot = Robot().with_payload(config.payload)
     plant = make_scenario_plant(robot, config)
     controller = make_scenario_controller(robot, scenario, config, plant)
@@ -648,16 +680,11 @@ def make_scenario_controller(
     run = WaypointRun(scenario, config, traits_of(plant), robot, _envelope(plant))
     options = waypoint_options(config.controller, run)
     arbiter = options.get("arbiter")
-    plug_in = arbiter is not None and not from_library(arbiter)
-    if plug_in and controller_traits(config.controller)["arbiter"]:
-        if not callable(getattr(arbiter, "select", None)):
-            raise PluginError(
-                f"controller {config.controller}: waypoint_options gave arbiter "
-                f"{shown(arbiter)}, which has no select(percept, behaviours) method"
-            )
+    if arbiter is not None and controller_traits(config.controller)["arbiter"]:
         # A plug-in arbiter's decisions are checked as it makes them (the tally counts
-        # its states); the library's own are trusted and run unwrapped.
-        options["arbiter"] = CheckedArbiter(arbiter, name_of(arbiter))
+        # its states), whichever controller takes it; the library's own run unwrapped.
+        origin = f"controller {config.controller}: waypoint_options"
+        options["arbiter"] = checked_arbiter(arbiter, origin)
     return make_controller(config.controller, robot, **options)
 
 
@@ -703,6 +730,7 @@ __all__ = [
     "Outcome",
     "RunConfig",
     "WaypointTask",
+    "check_controller_options",
     "check_dt",
     "check_payload",
     "check_qp_option",
