@@ -18,7 +18,7 @@ from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
 from ddwmmr.errors import MAX_STEPS, ParameterError, check_range
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model import Robot
-from ddwmmr.model.kinematics import principal_angle, wrap_angle
+from ddwmmr.model.kinematics import check_angles, principal_angle, refuse_angles, wrap_angle
 from ddwmmr.resolution import kernels
 from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
 from ddwmmr.trajectories.base import require_trajectory
@@ -61,8 +61,11 @@ class TaskSpaceController(ResolvedRate):
         L1, L2 = self.L1, self.L2
         a1 = phi + th1
         a12 = a1 + th2
-        xe = x + L1 * math.cos(a1) + L2 * math.cos(a12)
-        ye = y + L1 * math.sin(a1) + L2 * math.sin(a12)
+        try:
+            xe = x + L1 * math.cos(a1) + L2 * math.cos(a12)
+            ye = y + L1 * math.sin(a1) + L2 * math.sin(a12)
+        except ValueError:  # a sum overflowed: angles out of range (kernels.ats checks them)
+            refuse_angles(phi, th1, th2)
         px, py, pphi = pose_d
         vx, vy, vphi = velocity_d
         return kernels.ats(
@@ -146,6 +149,7 @@ class ConfigurationSpaceController:
         in ``last.nonholonomic_residual`` (m/s).
         """
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        check_angles(q)
         u, residual = self._input(t, q)
         check_command(u, q, pose_d)
         self.last = StepInfo(singular=self.reference.last_damped, nonholonomic_residual=residual)

@@ -12,7 +12,7 @@ called every control step.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
@@ -24,17 +24,52 @@ Q_NAMES = ("x", "y", "phi", "th1", "th2")
 U_NAMES = ("v", "w", "th1dot", "th2dot")
 
 
+#: Largest |phi|, |th1|, |th2| (rad) of a configuration. The kinematics form the link
+#: headings phi + th1 and phi + th1 + th2, and three angles within a third of the largest
+#: float (1.8e308) always sum to a finite one; beyond, cos and sin of an overflowed sum
+#: fail. Angles that large carry no direction (past 2.8e16 rad the float spacing exceeds a
+#: turn), but the maths takes them: ``qp`` and ``mpc`` still return a finite command.
+MAX_CONFIGURATION_ANGLE_RAD = 5e307
+
+
+def angles_in_range(phi: float, th1: float, th2: float) -> bool:
+    """Whether the angles of a configuration (rad, finite floats) are each within
+    +-:data:`MAX_CONFIGURATION_ANGLE_RAD`."""
+    bound = MAX_CONFIGURATION_ANGLE_RAD
+    return -bound <= phi <= bound and -bound <= th1 <= bound and -bound <= th2 <= bound
+
+
+def refuse_angles(phi: float, th1: float, th2: float, name: str = "q") -> NoReturn:
+    """Raise the one-line :class:`ParameterError` naming ``name`` for angles outside
+    +-:data:`MAX_CONFIGURATION_ANGLE_RAD`."""
+    raise ParameterError(
+        f"{name} must be 5 finite numbers [x, y, phi, th1, th2] (m, rad) with |phi|, |th1|, "
+        f"|th2| <= {MAX_CONFIGURATION_ANGLE_RAD:g} rad "
+        f"(got phi, th1, th2 = {phi:g}, {th1:g}, {th2:g})"
+    )
+
+
+def check_angles(values: list[float], name: str = "q") -> list[float]:
+    """``values``, a configuration of 5 finite floats, if its angles phi, th1, th2 are
+    within +-:data:`MAX_CONFIGURATION_ANGLE_RAD` rad, else :class:`ParameterError` naming
+    ``name`` and that range."""
+    _, _, phi, th1, th2 = values
+    if not angles_in_range(phi, th1, th2):
+        refuse_angles(phi, th1, th2, name)
+    return values
+
+
 def check_configuration(q0: Any, name: str = "q0") -> list[float]:
     """``q0`` as a list of 5 floats if it is a flat sequence of 5 finite numbers
-    ``[x, y, phi, th1, th2]`` (m, m, rad, rad, rad), else :class:`ParameterError` naming
-    ``name``: a start configuration (``simulate``'s ``q0``, ``Plant.reset``,
-    ``Controller.reset``)."""
+    ``[x, y, phi, th1, th2]`` (m, m, rad, rad, rad) whose angles are within
+    +-:data:`MAX_CONFIGURATION_ANGLE_RAD`, else :class:`ParameterError` naming ``name``:
+    a start configuration (``simulate``'s ``q0``, ``Plant.reset``, ``Controller.reset``)."""
     values = float_values(q0, 5)
     if values is None or not all(map(math.isfinite, values)):
         raise ParameterError(
             f"{name} must be 5 finite numbers [x, y, phi, th1, th2] (m, rad) (got {shown(q0, 60)})"
         )
-    return values
+    return check_angles(values, name)
 
 
 def wrap_angle(angle: float) -> float:

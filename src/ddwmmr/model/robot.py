@@ -101,6 +101,7 @@ _LENGTHS = tuple(name for name, (_, _, unit) in _RANGES.items() if unit == "m")
 #: What the configuration ``q`` and its rate ``qdot`` hold (for messages).
 _Q_ENTRIES = {"q": "[x, y, phi, th1, th2] (m, rad)", "qdot": "(m/s, rad/s)"}
 _isfinite = math.isfinite
+_MAX_Q_ANGLE = kinematics.MAX_CONFIGURATION_ANGLE_RAD
 
 
 def clamp_joints(
@@ -368,8 +369,9 @@ class Robot:
         return None
 
     # Every method taking a configuration q (5 finite numbers [x, y, phi, th1, th2]) checks
-    # it with _configuration: wrong shapes, strings and NaN/inf raise ParameterError
-    # naming q. The check costs one tolist() and one sum on the common (valid) path.
+    # it with _configuration: wrong shapes, strings, NaN/inf and angles beyond
+    # +-MAX_CONFIGURATION_ANGLE_RAD raise ParameterError naming q. The check costs one
+    # tolist() and one sum of magnitudes on the common (valid) path.
     def fk(self, q) -> np.ndarray:
         """End-effector pose ``[xE, yE, phiE]`` (world frame, m and rad) at configuration q."""
         return np.array(kinematics.forward_kinematics(self.L1, self.L2, _configuration(q)))
@@ -607,17 +609,22 @@ def _check_scalars(*items: tuple[str, Any]) -> None:
 
 
 def _configuration(q, name: str = "q") -> list[float]:
-    """``q`` as a flat sequence of 5 finite numbers, or :class:`ParameterError` naming it.
+    """``q`` as a flat sequence of 5 finite numbers, or :class:`ParameterError` naming it;
+    for a configuration (``name`` q) the angles must also be within
+    +-:data:`~ddwmmr.model.kinematics.MAX_CONFIGURATION_ANGLE_RAD` rad
+    (:func:`~ddwmmr.model.kinematics.check_angles`), beyond which the link headings
+    ``phi + th1 + th2`` the methods form overflow.
 
     It runs on every call of the public methods (per control step in some loops), so the
-    valid case is one ``tolist()`` and one sum (a sum is finite only if every term is);
-    only a failing sum (or an odd type) takes the slow path, which names the fault and
-    clears sums that merely overflowed.
+    valid case is one ``tolist()`` and one sum of magnitudes (within the angle bound, every
+    entry is finite and within it; NaN fails the comparison); only a failing sum (or an
+    odd type) takes the slow path, which names the fault and clears values that are merely
+    large.
     """
     values = q.tolist() if type(q) is np.ndarray else q
     if type(values) is list or type(values) is tuple:
         try:
-            if len(values) == 5 and _isfinite(sum(values)):
+            if len(values) == 5 and sum(map(abs, values)) <= _MAX_Q_ANGLE:
                 return values
         except (TypeError, OverflowError):
             pass
@@ -645,7 +652,8 @@ def _configuration_slow(q, name: str) -> list[float]:
         raise ParameterError(f"{wanted} (got shape {array.shape})")
     if not np.all(np.isfinite(array)):
         raise ParameterError(f"{wanted} (got {array.tolist()})")
-    return array.tolist()
+    values = array.tolist()
+    return kinematics.check_angles(values, name) if name == "q" else values
 
 
 def _points(value) -> tuple[tuple[float, float], ...]:

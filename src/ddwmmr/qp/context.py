@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import angles_in_range, refuse_angles
 
 #: Number of inputs u = (v, w, th1dot, th2dot) (m/s, rad/s, rad/s, rad/s).
 NU = 4
@@ -84,9 +85,15 @@ class StepContext:
     def update_floats(
         self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
     ) -> None:
-        """:meth:`update` from lists of floats (as :func:`check_inputs` returns them)."""
+        """:meth:`update` from lists of floats (as :func:`check_inputs` returns them).
+
+        Angles beyond +-``MAX_CONFIGURATION_ANGLE_RAD`` (``ddwmmr.model.kinematics``) are a
+        :class:`~ddwmmr.errors.ParameterError` naming q: the link headings formed here
+        would overflow."""
         self.t = t
         x, y, phi, th1, th2 = q
+        if not angles_in_range(phi, th1, th2):  # the sums below would overflow
+            refuse_angles(phi, th1, th2)
         self.q = (x, y, phi, th1, th2)
         self.x, self.y, self.phi, self.th1, self.th2 = x, y, phi, th1, th2
         L1, L2 = self.L1, self.L2

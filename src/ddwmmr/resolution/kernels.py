@@ -57,6 +57,7 @@ import math
 
 from ddwmmr.errors import ParameterError, check_finite, check_range
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import angles_in_range, refuse_angles
 
 #: Smallest singular value below which damping starts (``sigma0``) by default on the
 #: default robot; other robots scale it by :func:`robot_scale`.
@@ -202,7 +203,12 @@ def ats(
     threshold: float = SINGULARITY_THRESHOLD,
     damping: float = MAX_DAMPING,
 ) -> tuple[tuple[float, float, float, float], bool]:
-    """Augmented task space resolution ``qdot = J_aug^-1 [Xdot; 0; 0]`` in input form."""
+    """Augmented task space resolution ``qdot = J_aug^-1 [Xdot; 0; 0]`` in input form.
+
+    Angles beyond +-``MAX_CONFIGURATION_ANGLE_RAD`` (their sums could overflow) are a
+    :class:`ParameterError` naming q."""
+    if not angles_in_range(phi, th1, th2):
+        refuse_angles(phi, th1, th2)
     c, s = math.cos(phi), math.sin(phi)
     a1 = phi + th1
     s1, c1 = math.sin(a1), math.cos(a1)
@@ -235,7 +241,11 @@ def pseudoinverse(
     threshold: float = SINGULARITY_THRESHOLD,
     damping: float = MAX_DAMPING,
 ) -> tuple[tuple[float, float, float, float], bool]:
-    """Minimum-norm resolution ``qdot = J^# [Xdot; 0]`` in input form (damped near cos th1 = 0)."""
+    """Minimum-norm resolution ``qdot = J^# [Xdot; 0]`` in input form (damped near cos th1 = 0).
+
+    Angles beyond +-``MAX_CONFIGURATION_ANGLE_RAD`` are a :class:`ParameterError` naming q."""
+    if not angles_in_range(phi, th1, th2):
+        refuse_angles(phi, th1, th2)
     c, s = math.cos(phi), math.sin(phi)
     a1 = phi + th1
     s1, c1 = math.sin(a1), math.cos(a1)

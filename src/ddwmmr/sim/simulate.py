@@ -17,10 +17,12 @@ from ddwmmr.controllers.base import (
     make_controller,
 )
 from ddwmmr.errors import (
+    MAX_COORDINATE_M,
     ParameterError,
     check_finite,
     check_instance,
     check_positive,
+    check_range,
     check_step_count,
     shown,
 )
@@ -301,6 +303,9 @@ def simulate(
         q = initial_configuration(robot, reference, offset)
     else:
         q = np.array(check_configuration(q0))
+        for i, axis in enumerate("xy"):  # the run's errors are finite within the
+            # trajectories' own bound (a position beyond it made the rms error inf)
+            check_range(f"q0 {axis}", q[i], -MAX_COORDINATE_M, MAX_COORDINATE_M, "m")
     outside = robot.joints_outside(q)
     if outside is not None:  # the kinematic plant would snap it inside, the thesis plant
         # run outside its limits, MuJoCo refuses it: no plant gives a meaningful run
