@@ -85,6 +85,7 @@ outputs (in --out):
   report.md     the same report as Markdown, linking the PNG figures next to it
   metrics.csv   one row per method x trajectory: method, trajectory and every metric of
                 the summary.json that `python -m ddwmmr.track` writes for that run
+  plant_metrics.csv  with --plant: the same for the runs on each plant (column plant)
   run.json      everything needed to repeat the comparison: methods and their options
                 with defaults, robot, trajectories (parameters or file SHA-256),
                 studies, version, git commit and the exact command line
@@ -474,17 +475,42 @@ def config_from_arguments(
     )
 
 
-def not_tracked(plan: Any, outputs: dict[Any, Any], shown: Callable[[str], str] = str) -> list[str]:
-    """Console lines for the runs that did not track (:mod:`ddwmmr.sim.verdict`), the main
-    runs and their repetitions on each ``--plant`` (named): one per run saying what went
-    wrong, then each likely cause once; ``shown`` gives a trajectory key's shown name
-    (:meth:`CompareConfig.shown`)."""
+def judged_runs(plan: Any) -> list[tuple[Any, str, str]]:
+    """The runs the console judges (:func:`not_tracked`): the main runs, then their
+    repetitions on each ``--plant``, each as ``(spec, who, where)``: the method (with the
+    plant off the kinematic one) for the likely-cause lines, and ``" (thesis plant)"`` or
+    ``""`` for the run's line. The comparison's other runs (the other preset, variants,
+    studies) feed the report's sections and are not judged on the console."""
     judged = [(spec, spec.method, "") for spec in plan.main]
     # a plan may leave out ``plants`` when no extra plant runs
     for plant, specs in getattr(plan, "plants", {}).items():
         judged += [
             (spec, f"{spec.method} on the {plant} plant", f" ({plant} plant)") for spec in specs
         ]
+    return judged
+
+
+def runs_text(plan: Any, runs: int) -> str:
+    """``"14 runs (the 12 judged below: ...; 2 for the report's other sections)"``: the
+    ``runs`` simulated, and of them the :func:`judged_runs` where they are fewer, so the
+    console's counts agree."""
+    judged = len(judged_runs(plan))
+    if judged >= runs:
+        return f"{runs} runs"
+    plants = ["kinematic", *getattr(plan, "plants", {})]
+    where = " and ".join([", ".join(plants[:-1]), plants[-1]] if len(plants) > 1 else plants)
+    return (
+        f"{runs} runs (the {judged} main runs on the {where} plant{'s' * (len(plants) > 1)}, "
+        f"judged below, and {runs - judged} for the report's other sections)"
+    )
+
+
+def not_tracked(plan: Any, outputs: dict[Any, Any], shown: Callable[[str], str] = str) -> list[str]:
+    """Console lines for the runs that did not track (:mod:`ddwmmr.sim.verdict`), the main
+    runs and their repetitions on each ``--plant`` (named): one per run saying what went
+    wrong, then each likely cause once; ``shown`` gives a trajectory key's shown name
+    (:meth:`CompareConfig.shown`)."""
+    judged = judged_runs(plan)
     lines, causes = [], {}
     for spec, who, where in judged:
         found, what, cause = explain(outputs[spec].summary)
@@ -504,19 +530,20 @@ def not_tracked(plan: Any, outputs: dict[Any, Any], shown: Callable[[str], str] 
 def format_summary(
     info: ReportInfo,
     out: Path,
-    runs: int,
+    runs: int | str,
     seconds: float,
     jobs: int,
     failures: Sequence[str] = (),
     shown: Callable[[str], str] = str,
 ) -> str:
     """The short console summary: ranking table, slides verdict, the runs that did not
-    track (``failures``, from :func:`not_tracked`), where the files went; ``shown`` gives a
-    trajectory key's shown name (:meth:`CompareConfig.shown`)."""
+    track (``failures``, from :func:`not_tracked`), where the files went; ``runs``: how
+    many ran, a number or :func:`runs_text`; ``shown`` gives a trajectory key's shown name
+    (:meth:`CompareConfig.shown`)."""
     ranking, check = info.ranking, info.check
     lines = [
         f"Compared {len(ranking.overall)} methods on {', '.join(map(shown, ranking.scores))}: "
-        f"{runs} runs "
+        f"{runs if isinstance(runs, str) else f'{runs} runs'} "
         f"in {seconds:.1f} s ({jobs} job{'s' if jobs > 1 else ''}).",
         "",
         "Ranking: RMS end-effector position error over the run (mm), lower is better; "
@@ -539,7 +566,8 @@ def format_summary(
     figures = sum(name.endswith(".png") for name in info.files)
     lines += [
         "",
-        f"Report: {out / 'report.html'} (also report.md, metrics.csv and {figures} PNG "
+        f"Report: {out / 'report.html'} (also report.md, "
+        f"{', '.join(n for n in info.files if n.endswith('.csv'))} and {figures} PNG "
         f"figures in {out}/); the reasons are in the report.",
     ]
     return "\n".join(lines)
@@ -579,7 +607,8 @@ def _main(argv: Sequence[str] | None) -> int:
             write_atomic(staging / "run.json", json.dumps(json_safe(record), indent=2) + "\n")
     seconds = time.perf_counter() - start
     failures = not_tracked(plan, outputs, config.shown)
-    print(format_summary(info, out, len(specs), seconds, jobs, failures, config.shown))
+    runs = runs_text(plan, len(specs))
+    print(format_summary(info, out, runs, seconds, jobs, failures, config.shown))
     return 0
 
 

@@ -85,7 +85,9 @@ RUN_OPTIONS = (
 #: The labels name what docs/cli.md's summary table defines: ``final_position_error_m`` is
 #: the RMS over the run's settled end, not the last sample's error; ``saturated_steps``
 #: counts commands the plant clipped, while a limit ``qp`` or ``mpc`` holds inside its own
-#: bounds shows only in ``wheel_limit_steps`` / ``joint_rate_limit_steps``.
+#: bounds shows only in ``wheel_limit_steps`` / ``joint_rate_limit_steps``. A key the
+#: run's summary lacks (or holds None) is left out: the support keys show on a plant that
+#: reports them (MuJoCo), the predicted edge load where the controller's limit is on.
 TABLE_KEYS = (
     ("rms_position_error_m", "RMS position error (mm)"),
     ("max_position_error_m", "max position error (mm)"),
@@ -107,7 +109,11 @@ TABLE_KEYS = (
     ("min_obstacle_clearance_m", "min obstacle clearance (mm)"),
     ("max_wheel_force_n", "max wheel force (N)"),
     ("tipped", "tipped over (physics)"),
+    ("support_lost", "support lost (an edge unloaded)"),
+    ("unloaded_time_s", "time with an edge unloaded (s)"),
     ("min_edge_load_n", "min support-edge load (N)"),
+    ("min_predicted_edge_load_n", "min predicted edge load (N)"),
+    ("min_edge_load_floor_n", "edge-load floor held (N)"),
     ("min_physics_stability", "min physics stability"),
     ("max_base_tilt_rad", "max base tilt (rad)"),
     ("max_wheel_slip_m_s", "max wheel slip (m/s)"),

@@ -4,7 +4,8 @@ Every tool reports it the same way (``track``'s table, ``compare``'s console sum
 report, the simulator's summary line, :attr:`SimulationResult.summary`): the summary keys
 
 * ``verdict``: ``"tracked"``, or ``"did not track: <what went wrong>; likely cause:
-  <why> (see docs/...)"``;
+  <why> (see docs/...)"``, either followed by ``"; warning: ..."`` where a physics plant
+  unloaded an edge of the support polygon (:func:`support_warning`, below);
 * ``verdict_reasons``: the machine-readable codes of what went wrong (an empty list when
   it tracked), each one of :data:`REASONS`.
 
@@ -58,6 +59,15 @@ above its start offset, the time it took to remove the offset is named, as on a 
 or a held point (whose limit is :data:`EXTENT_LIMIT_FLOOR_M`). A joint held at a position
 limit for more than :data:`HELD_CAUSE` of a run that did not converge names that joint
 limit.
+
+A run on a physics plant that saw an edge of its support polygon unloaded without tipping
+over (``support_lost``: a wheel off the ground, or the base rocking onto an edge; docs/
+physics.md, "Tip-over from the contact forces") is not a failure, as the scenario protocol
+does not fail a run on it either: its verdict, ``tracked`` or not, ends with a warning
+clause (:func:`support_warning`) saying for how long (``unloaded_time_s``) and, where the
+controller predicted its edge loads (``min_predicted_edge_load_n``), whether it predicted
+one below its own floor (``min_edge_load_floor_n``). A run that tipped over says so in its
+reasons instead.
 """
 
 from __future__ import annotations
@@ -87,6 +97,7 @@ __all__ = [
     "error_limit",
     "explain",
     "short_verdict",
+    "support_warning",
     "verdict",
 ]
 
@@ -258,6 +269,24 @@ TIPPED = (
     'docs/physics.md, "Tip-over from the contact forces")'
 )
 
+#: The warning clause of a run on a physics plant that unloaded an edge of its support
+#: polygon without tipping over (:func:`support_warning`).
+SUPPORT_LOST = (
+    "warning: an edge of the support polygon was unloaded for {unloaded_s:.3g} of "
+    "{duration_s:.3g} s (support_lost: a wheel off the ground or the base rocking onto an "
+    "edge; it did not tip over){predicted}: a higher floor (qp's and mpc's stability_min, "
+    "qp's min_edge_load) or a slower trajectory keeps the load on it "
+    '(see docs/physics.md, "Tip-over from the contact forces")'
+)
+#: :data:`SUPPORT_LOST`'s words on a controller that predicted an edge load below its floor.
+PREDICTED_BELOW_FLOOR = (
+    "; the controller predicted an edge load of {least} N, below its {floor} N floor "
+    "(min_predicted_edge_load_n, min_edge_load_floor_n)"
+)
+#: Force (N) by which a predicted edge load must fall below its floor for
+#: :data:`PREDICTED_BELOW_FLOOR`: a solver meets the floor to within its tolerance, and a
+#: load a few 1e-14 N under it held it.
+PREDICTED_SLACK_N = 1e-3
 
 WOULD_TIP = (
     "the arm's reach and the payload put the centre of mass outside the wheels (static "
@@ -307,6 +336,9 @@ NUMBER_KEYS = (
     "mpc_fallbacks",
     "fallback_steps",
     "min_obstacle_clearance_m",
+    "unloaded_time_s",
+    "min_predicted_edge_load_n",
+    "min_edge_load_floor_n",
 )
 #: How a ``summary.json`` spells the non-finite floats (:func:`ddwmmr.sim.result.json_safe`):
 #: a summary read back from one holds these strings where the run held the numbers.
@@ -697,6 +729,30 @@ def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
     return found, what, likely_cause(summary, found)
 
 
+def support_warning(summary: Mapping[str, Any]) -> str:
+    """:data:`SUPPORT_LOST` for a run whose physics plant unloaded an edge of the support
+    polygon (``support_lost`` true) and did not tip over (``tipped`` false: a tip-over is
+    a reason of its own), with :data:`PREDICTED_BELOW_FLOOR` where the controller
+    predicted an edge load (N) below its floor; ``""`` otherwise, and on every plant that
+    does not report ``support_lost``. ``summary`` as in :func:`verdict`."""
+    check_summary(summary)
+    lost = summary.get("support_lost")  # the plant's flag, a bool (None or absent: no report)
+    if not isinstance(lost, bool | np.bool_) or not lost or summary.get("tipped"):
+        return ""
+    least = _number(summary, "min_predicted_edge_load_n")
+    floor = _number(summary, "min_edge_load_floor_n")
+    predicted = ""
+    if least is not None and floor is not None and least < floor - PREDICTED_SLACK_N:
+        texts = (f"{least:.3g}", [f"{floor:.3g}"])
+        least_text, (floor_text,) = texts_apart(least, floor) if texts[0] == texts[1][0] else texts
+        predicted = PREDICTED_BELOW_FLOOR.format(least=least_text, floor=floor_text)
+    return SUPPORT_LOST.format(
+        unloaded_s=_number(summary, "unloaded_time_s") or 0.0,
+        duration_s=_number(summary, "duration") or 0.0,
+        predicted=predicted,
+    )
+
+
 def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
     """The verdict keys of a run's ``summary`` (the keys :func:`ddwmmr.simulate` writes):
     ``{"verdict": str, "verdict_reasons": list[str]}`` (see the module docstring).
@@ -708,9 +764,14 @@ def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
     :class:`~ddwmmr.errors.ParameterError` naming the key, whether or not this summary's
     verdict would read it."""
     found, what, cause = explain(summary)
+    warning = support_warning(summary)
+    tail = f"; {warning}" if warning else ""
     if not found:
-        return {"verdict": TRACKED, "verdict_reasons": []}
-    return {"verdict": f"did not track: {what}; likely cause: {cause}", "verdict_reasons": found}
+        return {"verdict": TRACKED + tail, "verdict_reasons": []}
+    return {
+        "verdict": f"did not track: {what}; likely cause: {cause}{tail}",
+        "verdict_reasons": found,
+    }
 
 
 def short_verdict(summary: Mapping[str, Any]) -> str:

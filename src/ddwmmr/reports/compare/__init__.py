@@ -98,6 +98,7 @@ from ddwmmr.reports.compare.ranking import (
     geometric_mean,
     metrics_csv,
     metrics_rows,
+    plant_metrics_rows,
     rank_with_ties,
     score,
 )
@@ -166,6 +167,7 @@ __all__ = [
     "orientation_jumps",
     "output_names",
     "plan_runs",
+    "plant_metrics_rows",
     "rank_with_ties",
     "ranking_table",
     "run_duration",

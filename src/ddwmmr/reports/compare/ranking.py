@@ -27,20 +27,38 @@ from ddwmmr.sim.result import json_safe
 
 
 def metrics_rows(
-    plan: Plan, outputs: Mapping[RunSpec, RunOutput], shown: Callable[[str], str] = str
+    plan: Plan,
+    outputs: Mapping[RunSpec, RunOutput],
+    shown: Callable[[str], str] = str,
+    specs: Sequence[RunSpec] | None = None,
 ) -> list[dict[str, Any]]:
-    """One row per main run: ``method``, ``trajectory`` and every summary field, where
-    ``trajectory`` is the name the report shows for the trajectory (``shown`` of its key,
+    """One row per main run (or per run of ``specs``: :func:`plant_metrics_rows`):
+    ``method``, ``trajectory`` and every summary field, where ``trajectory`` is the name
+    the report shows for the trajectory (``shown`` of its key,
     :meth:`CompareConfig.shown`: unique, ``loop`` and ``loop-2`` for two trajectories of
     that name), as its tables name it, not the summary's name of the run's trajectory."""
     rows = []
-    for spec in plan.main:
+    for spec in plan.main if specs is None else specs:
         summary = outputs[spec].summary
         name = shown(spec.trajectory)
         row = {"method": spec.method, "trajectory": name, **summary}
         row["trajectory"] = name  # over the summary's, in the same column
         rows.append(row)
     return rows
+
+
+def plant_metrics_rows(
+    plan: Plan, outputs: Mapping[RunSpec, RunOutput], shown: Callable[[str], str] = str
+) -> list[dict[str, Any]]:
+    """The rows of ``plant_metrics.csv``: one per main run repeated on an extra plant
+    (``--plant``), plant by plant in the plan's order, as :func:`metrics_rows` writes them
+    with the run's ``plant`` third."""
+    specs = [spec for specs in plan.plants.values() for spec in specs]
+    rows = metrics_rows(plan, outputs, shown, specs)
+    return [
+        {"method": r["method"], "trajectory": r["trajectory"], "plant": r["plant"], **r}
+        for r in rows
+    ]
 
 
 def metrics_csv(rows: Sequence[Mapping[str, Any]]) -> str:

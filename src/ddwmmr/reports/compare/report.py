@@ -61,11 +61,12 @@ from ddwmmr.reports.compare.ranking import (
     check_slides,
     metrics_csv,
     metrics_rows,
+    plant_metrics_rows,
 )
 from ddwmmr.reports.plots import circles_of
 from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
 from ddwmmr.sim.simulate import FINAL_WINDOW_FRACTION, RATE_LIMIT_TOLERANCE
-from ddwmmr.sim.verdict import explain
+from ddwmmr.sim.verdict import explain, support_warning
 
 # -- building the report ------------------------------------------------------------------
 
@@ -90,6 +91,8 @@ def output_names(config: CompareConfig) -> tuple[str, ...]:
     """Every file :func:`write_report` may write for ``config`` (the CLI adds
     ``run.json``): checked against a user's files before the runs."""
     names = ["report.html", "report.md", "metrics.csv"]
+    if config.plants:
+        names.append(PLANT_METRICS)
     for name in config.trajectories:
         names += [f"{kind}_{name}.png" for kind in TRAJECTORY_FIGURES]
         names += [f"plant_{plant}_{name}.png" for plant in config.plants]
@@ -97,12 +100,23 @@ def output_names(config: CompareConfig) -> tuple[str, ...]:
     return tuple(names)
 
 
+#: The summaries of the main runs repeated on the extra plants (``--plant``), one row per
+#: run as in ``metrics.csv``, with its ``plant``.
+PLANT_METRICS = "plant_metrics.csv"
+
+
 def write_report(
     config: CompareConfig, plan: Plan, outputs: Mapping[RunSpec, RunOutput], folder: Path
 ) -> ReportInfo:
-    """Write ``metrics.csv``, the PNG figures, ``report.md`` and ``report.html`` to ``folder``."""
+    """Write ``metrics.csv`` (and :data:`PLANT_METRICS` with extra plants), the PNG figures,
+    ``report.md`` and ``report.html`` to ``folder``."""
     folder = Path(folder)
     write_atomic(folder / "metrics.csv", metrics_csv(metrics_rows(plan, outputs, config.shown)))
+    tables = ["metrics.csv"]
+    if plan.plants:
+        rows = plant_metrics_rows(plan, outputs, config.shown)
+        write_atomic(folder / PLANT_METRICS, metrics_csv(rows))
+        tables.append(PLANT_METRICS)
     ranking = build_ranking(plan, outputs)
     check = check_slides(config, plan, outputs, ranking)
     alternative = build_ranking(plan, outputs, plan.alternative)
@@ -127,7 +141,7 @@ def write_report(
     _definitions_section(context)
     write_atomic(folder / "report.md", context.doc.to_markdown())
     write_atomic(folder / "report.html", context.doc.to_html(folder))
-    files = ["report.html", "report.md", "metrics.csv", *context.figures]
+    files = ["report.html", "report.md", *tables, *context.figures]
     return ReportInfo(ranking, check, files, alternative, alternative_check)
 
 
@@ -607,6 +621,8 @@ def _plant_section(c: _Context, plant: str) -> None:
         "floor (physics only)."
     )
     runs = dict(zip(c.plan.main, c.plan.plants[plant]))
+    # the support columns where the plant reports its support loads (MuJoCo)
+    support = any(SUPPORT_KEY in c.run(spec).summary for spec in runs.values())
     rows, reasons = [], []
     for base_spec, spec in runs.items():
         base, run = c.run(base_spec), c.run(spec)
@@ -631,6 +647,7 @@ def _plant_section(c: _Context, plant: str) -> None:
                 fmt(k["min_stability"]),
                 fmt(s.get("min_physics_stability", math.nan)),
                 _tipped_text(s),
+                *(_support_cells(s) if support else []),
                 tracked(s.get("verdict_reasons")),
             ]
         )
@@ -640,7 +657,8 @@ def _plant_section(c: _Context, plant: str) -> None:
     headers = [
         "trajectory", "method", "RMS kinematic (mm)", f"RMS {plant} (mm)", "x",
         f"final {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)", "min S",
-        "min physics S", "tipped", "tracked? (docs/cli.md, Verdict)",
+        "min physics S", "tipped", *(SUPPORT_HEADERS if support else ()),
+        "tracked? (docs/cli.md, Verdict)",
     ]  # fmt: skip
     c.doc.table(headers, rows)
     c.doc.paragraph(
@@ -667,22 +685,51 @@ def _plant_section(c: _Context, plant: str) -> None:
 
 def _plant_verdicts(c: _Context, plant: str) -> None:
     """List the runs on ``plant`` that did not track, with what went wrong and its likely
-    cause (:func:`ddwmmr.sim.verdict.explain`), or say that every run tracked."""
+    cause (:func:`ddwmmr.sim.verdict.explain`), or say that every run tracked; then the
+    runs that unloaded an edge of the support polygon, with the verdict's warning
+    (:func:`ddwmmr.sim.verdict.support_warning`)."""
     specs = c.plan.plants[plant]
-    items = []
+    items, warnings = [], []
     for spec in specs:
-        found, what, cause = explain(c.run(spec).summary)
+        summary = c.run(spec).summary
+        found, what, cause = explain(summary)
+        who = f"**{spec.method} on {c.config.shown(spec.trajectory)}**"
         if found:
-            where = c.config.shown(spec.trajectory)
-            items.append(f"**{spec.method} on {where}**: {what}; likely cause: {cause}")
+            items.append(f"{who}: {what}; likely cause: {cause}")
+        warning = support_warning(summary)
+        if warning:
+            warnings.append(f"{who}: {warning.removeprefix('warning: ')}")
     if not items:
         c.doc.paragraph(f'Every run on the {plant} plant tracked (docs/cli.md, "Verdict").')
-        return
-    c.doc.paragraph(
-        f"Did not track on the {plant} plant ({len(items)} of {len(specs)} runs; "
-        'docs/cli.md, "Verdict"):'
-    )
-    c.doc.bullets(items)
+    else:
+        c.doc.paragraph(
+            f"Did not track on the {plant} plant ({len(items)} of {len(specs)} runs; "
+            'docs/cli.md, "Verdict"):'
+        )
+        c.doc.bullets(items)
+    if warnings:
+        c.doc.paragraph(
+            f"Lost support on the {plant} plant, tracked or not ({len(warnings)} of "
+            f'{len(specs)} runs; a warning, not a failure: docs/cli.md, "Verdict"):'
+        )
+        c.doc.bullets(warnings)
+
+
+#: The summary key whose presence says the plant reports its support loads (MuJoCo).
+SUPPORT_KEY = "unloaded_time_s"
+#: The plant table's support columns (:func:`_support_cells`).
+SUPPORT_HEADERS = ("edge unloaded (s)", "min predicted edge load / floor (N)")
+
+
+def _support_cells(summary: Mapping[str, Any]) -> list[str]:
+    """The cells of :data:`SUPPORT_HEADERS`: the time with an edge of the support polygon
+    unloaded (``unloaded_time_s``), and the least edge load the controller predicted with
+    the floor it held (``min_predicted_edge_load_n``, ``min_edge_load_floor_n``; ``-``
+    where its edge-load limit is off)."""
+    least = summary.get("min_predicted_edge_load_n")
+    floor = summary.get("min_edge_load_floor_n")
+    predicted = "-" if least is None else f"{fmt(least)} / {fmt(floor)}"
+    return [fmt(summary.get(SUPPORT_KEY, math.nan)), predicted]
 
 
 def _tipped_text(summary: Mapping[str, Any]) -> str:
@@ -1167,6 +1214,11 @@ def _definitions_section(c: _Context) -> None:
             "step latency: median wall-clock time of one controller call (us); a timing, so "
             "it varies between runs and machines",
             "`metrics.csv`: one row per method x trajectory with every `summary.json` field "
-            "of the matching `python -m ddwmmr.track` run",
+            "of the matching `python -m ddwmmr.track` run"
+            + (
+                f"; `{PLANT_METRICS}`: the same for the runs on the other plants (`plant` names it)"
+                if c.plan.plants
+                else ""
+            ),
         ]
     )
