@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import logging
 import math
+import warnings
 from typing import Any
 
 import mujoco
@@ -50,7 +51,7 @@ from ddwmmr.plants.mujoco.model import (
     reflected_inertias,
     supports,
 )
-from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
+from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure, footprint_excess
 from ddwmmr.plants.thesis import arm_step, damped_base_envelope
 from ddwmmr.registry import register_plant
 
@@ -118,6 +119,10 @@ class MujocoPlant:
 
     Raises:
         ParameterError: for a robot or option MuJoCo cannot build (one line).
+
+    Warns (``UserWarning``, once per layout) when ``caster_positions`` leave a corner of
+    the footprint outside the support polygon: S then overstates the margin the robot has
+    here (:func:`~ddwmmr.plants.mujoco.support.footprint_excess`).
     """
 
     def __init__(
@@ -147,6 +152,7 @@ class MujocoPlant:
         self.data = mujoco.MjData(self.model)
         self.supports = supports(robot)
         self.geometry = SupportGeometry([s.point for s in self.supports])
+        _warn_footprint(robot, self.geometry)
         self.extra_columns = (
             "min_support_force_n",
             *(f"support_force_{s.name}_n" for s in self.supports),
@@ -706,6 +712,38 @@ def tip_time_s(
         if detector.update(time, load, angle) is not None:
             break
     return detector.tip_time
+
+
+#: A support polygon whose :func:`footprint_excess` exceeds 1 by more than this lets S
+#: overstate its margin (rounding of the polygon's own corners aside).
+FOOTPRINT_EXCESS_TOLERANCE = 1e-9
+#: Layouts (footprint, support points) :func:`_warn_footprint` has warned about in this
+#: process: a run builds its plant more than once (the default control step asks one for
+#: its engine timestep), and the solvers' ``warnings.catch_warnings`` resets Python's own
+#: memory of warnings already shown.
+_WARNED_LAYOUTS: set[tuple] = set()
+
+
+def _warn_footprint(robot: Robot, geometry: SupportGeometry) -> None:
+    """Warn once per layout (:class:`UserWarning`, one line naming ``caster_positions``)
+    when the wheels and casters do not span the footprint the stability margin S measures:
+    the robot then tips on this plant at an S above 1 (:func:`footprint_excess`), which no
+    floor on S (``stability_min``) was chosen for."""
+    com = robot.com_coefficients
+    excess = footprint_excess(geometry, com.half_length, com.half_width)
+    layout = (com.half_length, com.half_width, geometry.points.tobytes())
+    if excess <= 1.0 + FOOTPRINT_EXCESS_TOLERANCE or layout in _WARNED_LAYOUTS:
+        return
+    _WARNED_LAYOUTS.add(layout)
+    warnings.warn(
+        f"caster_positions: the wheels and casters do not span the footprint base_length x "
+        f"base_width ({robot.base_length:g} m x {robot.base_width:g} m) that the stability "
+        f"margin S measures, so on the MuJoCo plant the robot can tip at S = {excess:.3g} "
+        "(stability_min does not keep it standing); casters at or outside the footprint's "
+        "corners make S hold",
+        UserWarning,
+        stacklevel=3,
+    )
 
 
 def _heading(quaternion) -> float:

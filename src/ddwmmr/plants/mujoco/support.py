@@ -83,6 +83,20 @@ class SupportGeometry:
         return float(min(STABILITY_CAP, np.min(ratios)))
 
 
+def footprint_excess(geometry: SupportGeometry, half_length: float, half_width: float) -> float:
+    """The largest stability margin S at which the centre of mass reaches an edge of the
+    support polygon: S measures the footprint ``2 half_length x 2 half_width`` (m, centred
+    on the base centre), the base tips about the polygon's edges.
+
+    It is the largest ratio of S to ``S_phys`` over all directions, reached towards a
+    corner of the footprint: 1 when the polygon contains the footprint (S never overstates
+    it; the default casters), above 1 when a corner lies outside (2 for a diamond through
+    the footprint's edge midpoints).
+    """
+    corners = [(sx * half_length, sy * half_width) for sx in (1.0, -1.0) for sy in (1.0, -1.0)]
+    return max(1.0, max(1.0 / geometry.stability(corner) for corner in corners))
+
+
 def centre_of_pressure(points: np.ndarray, forces: np.ndarray) -> np.ndarray | None:
     """Force-weighted mean (2,) of contact points (n, 2); None if the total force is ~0."""
     total = float(np.sum(forces))
