@@ -171,6 +171,12 @@ def _resolve_options(options: dict[str, Any]) -> dict[str, Any]:
     return resolved
 
 
+#: The module the "+user" row's pieces say they come from: not a ``ddwmmr`` one, so
+#: :func:`~ddwmmr.inheritance.from_library` takes them for a user's, and the row times the
+#: guard and the per-step check of what they write that a user's pieces pay.
+USER_MODULE = "bench_user_pieces"
+
+
 class _UserSpin:
     """Factories of a user task and a user limit (generic path only) for the "+user" row."""
 
@@ -182,6 +188,7 @@ class _UserSpin:
         class SpinTask(Task):
             """A user task: yaw at 0.5 rad/s (tiny weight: timing only)."""
 
+            __module__ = USER_MODULE
             name = "spin"
 
             def compute(self, ctx, jac, error):
@@ -191,6 +198,7 @@ class _UserSpin:
         class ArmSumLimit(Limit):
             """A user limit: one row on th1dot + th2dot, never binding."""
 
+            __module__ = USER_MODULE
             rows = 1
 
             def compute(self, ctx, G, lower, upper, lb, ub):

@@ -306,16 +306,24 @@ class QPProblem:
 
     def _watch_generic(self) -> None:
         """The arrays the generic pieces write into, for :meth:`_written_ok`: those that
-        must be finite, those that must not hold NaN."""
-        finite = []
+        must be finite, those that must not hold NaN. None when every generic piece is the
+        library's (``compiled=False``): :meth:`_refuse_user_pieces` refuses only a user's,
+        so checking theirs would cost every step and never refuse."""
+        generic = (*self._generic_cost, *self._generic_slack, *self._generic_limits)
+        self._check_written = not all(from_library(piece) for piece, *_ in generic)
+        self._finite: list[np.ndarray] = []
+        self._no_nan: list[np.ndarray] = []
+        if not self._check_written:
+            return
+        finite = self._finite
         if self._generic_cost:
             finite += [self.J.reshape(-1), self.e]
         if self._generic_slack or self._generic_limits:
             finite.append(self.C.reshape(-1))
         if self._generic_slack:
             finite.append(self.cu[: self.m_eq])
-        self._finite = finite
-        self._no_nan = [self.lower, self.upper] if self._generic_limits else []
+        if self._generic_limits:
+            self._no_nan += [self.lower, self.upper]
 
     def _add_writer(self, piece: Task | Limit, block: TaskBlock | LimitBlock) -> bool:
         """Compile ``piece`` into ``block``; False when it has no fast path."""
@@ -360,7 +368,7 @@ class QPProblem:
         for _, compute, G, low, up in self._generic_limits:
             compute(ctx, G, low, up, u_lb, u_ub)
         self.box_ok = bool(np.all(u_lb <= u_ub))
-        if not self._written_ok():
+        if self._check_written and not self._written_ok():
             self._refuse_user_pieces(ctx)
 
     def _written_ok(self) -> bool:
@@ -371,9 +379,9 @@ class QPProblem:
         finite when every entry is finite and below 1e154 (a larger one only sends the
         step to :meth:`_refuse_user_pieces`, which looks entry by entry)."""
         for array in self._finite:
-            if not math.isfinite(np.dot(array, array)):
+            if not math.isfinite(array.dot(array)):
                 return False
-        return not any(math.isnan(np.dot(array, array)) for array in self._no_nan)
+        return not any(math.isnan(array.dot(array)) for array in self._no_nan)
 
     def _refuse_user_pieces(self, ctx: StepContext) -> None:
         """Refuse (one-line :class:`ParameterError`) the user's piece that wrote NaN, or an

@@ -16,12 +16,12 @@ through :func:`qpsolvers.solve_qp`, converting the problem to ``G x <= h, A x = 
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import warnings
 from dataclasses import dataclass
 
 import numpy as np
-import qpsolvers
 
 from ddwmmr.errors import ParameterError, shown
 from ddwmmr.qp.limits.base import INF
@@ -36,6 +36,15 @@ SLACK_TOLERANCE = 1e-7
 _BIG = 0.5 * INF
 
 
+def _qpsolvers():
+    """The qpsolvers package, imported on first use: it loads scipy.sparse and every
+    installed solver (several times the rest of the library), which a run that builds no
+    qpsolvers backend (any method but ``qp``, or ``qp`` on direct DAQP) does not pay."""
+    import qpsolvers
+
+    return qpsolvers
+
+
 def check_mode(mode: str) -> str:
     """Validate the ``mode`` option."""
     if mode not in MODES:
@@ -45,10 +54,9 @@ def check_mode(mode: str) -> str:
 
 def check_solver(solver: str) -> str:
     """Validate the ``solver`` option against the installed qpsolvers backends."""
-    if solver not in qpsolvers.available_solvers:
-        raise ParameterError(
-            f"solver must be one of {', '.join(qpsolvers.available_solvers)} (got {shown(solver)})"
-        )
+    available = _qpsolvers().available_solvers
+    if solver not in available:
+        raise ParameterError(f"solver must be one of {', '.join(available)} (got {shown(solver)})")
     return solver
 
 
@@ -113,6 +121,8 @@ class QpsolversBackend:
 
     def __init__(self, solver: str, warm_start: bool = True) -> None:
         self.name = self.solver = check_solver(solver)
+        qpsolvers = _qpsolvers()
+        self._solve_qp = qpsolvers.solve_qp
         self.sparse = solver in SPARSE_FOR_REPEATABILITY or (
             solver in qpsolvers.sparse_solvers and solver not in qpsolvers.dense_solvers
         )
@@ -133,7 +143,7 @@ class QpsolversBackend:
         initvals = self._previous if self.warm_start else None
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            x = qpsolvers.solve_qp(P, q, G, h, A, b, solver=self.solver, initvals=initvals)
+            x = self._solve_qp(P, q, G, h, A, b, solver=self.solver, initvals=initvals)
         if x is None or not np.all(np.isfinite(x)):
             return None
         self._previous = x
@@ -163,7 +173,7 @@ def to_standard_form(problem: QPProblem):
 def installed_solvers() -> list[str]:
     """Solver names :func:`make_backend` accepts on this machine (qpsolvers' installed
     backends, plus ``qpsolvers-daqp`` when DAQP is one of them)."""
-    names = sorted(qpsolvers.available_solvers)
+    names = sorted(_qpsolvers().available_solvers)
     return [*names, "qpsolvers-daqp"] if "daqp" in names else names
 
 
@@ -173,14 +183,14 @@ def make_backend(solver: str, warm_start: bool | None = None):
     ``"qpsolvers-daqp"`` forces DAQP through qpsolvers (for comparisons). A solver that is
     not installed raises :class:`ParameterError` naming the installed ones.
     """
+    if solver == "daqp" and importlib.util.find_spec("daqp") is not None:
+        return DaqpBackend(warm_start=bool(warm_start))
     installed = installed_solvers()
     if solver not in installed:
         raise ParameterError(
             f"solver must be one of the installed QP solvers: {', '.join(installed)} "
             f"(got {shown(solver)})"
         )
-    if solver == "daqp":
-        return DaqpBackend(warm_start=bool(warm_start))
     if solver == "qpsolvers-daqp":
         backend = QpsolversBackend("daqp", warm_start=bool(warm_start))
         backend.name = solver
