@@ -56,7 +56,7 @@ from ddwmmr.gui.widgets import (
     wrap_to_width,
 )
 from ddwmmr.gui.worker import Worker
-from ddwmmr.sim.verdict import short_verdict
+from ddwmmr.sim.verdict import lost_support, short_verdict
 from ddwmmr.trajectories import load_trajectory
 
 #: Playback frame and progress poll intervals (ms).
@@ -779,9 +779,18 @@ def _summary_line(label: str, result: Any) -> str:
 
 
 def _physics_verdict(summary: dict[str, Any]) -> str:
-    """The physics plant's tip-over verdict for the summary line ('' on other plants)."""
+    """The physics plant's tip-over verdict for the summary line ('' on other plants):
+    tipped, stood, or stood but lost support (an edge of the support polygon unloaded for
+    ``unloaded_time_s`` of ``duration`` s: the verdict's warning, :func:`lost_support`)."""
     if "tipped" not in summary:
         return ""
     if summary["tipped"]:
         return f", TIPPED at {summary['tip_time_s']:.2f} s (physics)"
-    return f", stood (physics: min S_phys {summary['min_physics_stability']:.3g})"
+    margin = f"min S_phys {summary['min_physics_stability']:.3g}"
+    if lost_support(summary):
+        unloaded, duration = summary.get("unloaded_time_s") or 0.0, summary.get("duration") or 0.0
+        return (
+            f", stood but LOST SUPPORT: an edge unloaded for {unloaded:.3g} of {duration:.3g} s"
+            f" (physics: {margin})"
+        )
+    return f", stood (physics: {margin})"

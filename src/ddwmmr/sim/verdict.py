@@ -86,16 +86,20 @@ __all__ = [
     "ERROR_LIMIT_M",
     "EXTENT_FRACTION",
     "EXTENT_LIMIT_FLOOR_M",
+    "FLAG_KEYS",
     "HELD_CAUSE",
     "MOST_OF_RUN",
+    "NON_NEGATIVE_KEYS",
     "NUMBER_KEYS",
     "OBSTACLE_NEAR_M",
     "OFFSET_FACTOR",
     "REASONS",
+    "STEP_COUNT_KEYS",
     "TRACKED",
     "check_summary",
     "error_limit",
     "explain",
+    "lost_support",
     "short_verdict",
     "support_warning",
     "verdict",
@@ -299,8 +303,12 @@ WOULD_TIP = (
 def check_summary(summary: Any) -> Mapping[str, Any]:
     """``summary`` if it is a mapping (a run's summary: :attr:`SimulationResult.summary`,
     or a dict read from a ``summary.json``) whose keys read as numbers
-    (:data:`NUMBER_KEYS`) hold numbers, else a one-line :class:`ParameterError` naming
-    ``summary`` or the key. Every function here taking a summary checks it first."""
+    (:data:`NUMBER_KEYS`) hold numbers, ``steps`` and the counts of steps
+    (:data:`STEP_COUNT_KEYS`) whole numbers from 0 (to ``steps``), the errors, lengths and
+    times (:data:`NON_NEGATIVE_KEYS`) numbers >= 0 or NaN or inf, and the flags
+    (:data:`FLAG_KEYS`) booleans; each may be missing or None. Anything else is a one-line
+    :class:`ParameterError` naming ``summary`` or the key and what it allows. Every
+    function here taking a summary checks it first."""
     if not isinstance(summary, Mapping):
         raise ParameterError(
             "summary must be a mapping of a run's summary keys (a dict such as "
@@ -308,6 +316,13 @@ def check_summary(summary: Any) -> Mapping[str, Any]:
         )
     for key in NUMBER_KEYS:
         _number(summary, key)
+    for key in FLAG_KEYS:
+        _flag(summary, key)
+    steps = _count(summary, "steps", None)
+    for key in STEP_COUNT_KEYS:
+        _count(summary, key, steps)
+    for key, unit in NON_NEGATIVE_KEYS.items():
+        _non_negative(summary, key, unit)
     return summary
 
 
@@ -340,6 +355,34 @@ NUMBER_KEYS = (
     "min_predicted_edge_load_n",
     "min_edge_load_floor_n",
 )
+#: The summary keys that count steps of the run: each a whole number from 0 to ``steps``
+#: (itself a whole number >= 0).
+STEP_COUNT_KEYS = (
+    "singular_steps",
+    "saturated_steps",
+    "wheel_limit_steps",
+    "joint_rate_limit_steps",
+    "joint_limit_steps",
+    "qp_fallbacks",
+    "mpc_fallbacks",
+    "fallback_steps",
+)
+#: The errors, lengths and times the verdict reads, with their units: each >= 0, or NaN
+#: or inf (the errors of a run that blew up).
+NON_NEGATIVE_KEYS = {
+    "duration": "s",
+    "actuator_saturated_time_s": "s",
+    "unloaded_time_s": "s",
+    "trajectory_extent_m": "m",
+    "initial_offset_m": "m",
+    "max_position_error_m": "m",
+    "final_position_error_m": "m",
+    "rms_position_error_m": "m",
+}
+#: The plant's yes-or-no keys the verdict reads: each True or False (Python's or numpy's,
+#: as a ``summary.json`` holds them too), missing or None. ``diverged`` is not one: it
+#: holds the plant's message.
+FLAG_KEYS = ("tipped", "start_tipped", "support_lost")
 #: How a ``summary.json`` spells the non-finite floats (:func:`ddwmmr.sim.result.json_safe`):
 #: a summary read back from one holds these strings where the run held the numbers.
 _NON_FINITE = {"nan": math.nan, "inf": math.inf, "-inf": -math.inf}
@@ -363,6 +406,43 @@ def _number(summary: Mapping[str, Any], key: str) -> float | None:
     raise ParameterError(
         f"summary: {key} must be a number, 'nan', 'inf', '-inf' or None (got {shown(value)})"
     )
+
+
+def _flag(summary: Mapping[str, Any], key: str) -> None:
+    """A one-line :class:`ParameterError` naming ``key`` unless ``summary[key]`` is a
+    boolean (Python's or numpy's), None or missing: text such as ``"no"`` would read as
+    true."""
+    value = summary.get(key)
+    if value is not None and not isinstance(value, bool | np.bool_):
+        raise ParameterError(f"summary: {key} must be True, False or None (got {shown(value)})")
+
+
+def _count(summary: Mapping[str, Any], key: str, steps: float | None) -> float | None:
+    """``summary[key]`` (already a number, :func:`_number`) if it is a whole number from 0
+    to ``steps`` (from 0 up, where ``steps`` is None), or None if missing; anything else
+    is a one-line :class:`ParameterError` naming ``key`` and that range."""
+    value = _number(summary, key)
+    if value is None:
+        return None
+    most = math.inf if steps is None else steps
+    upper = "" if steps is None else f" to steps = {steps:.0f}"
+    if not (math.isfinite(value) and value.is_integer() and 0 <= value <= most):
+        raise ParameterError(
+            f"summary: {key} must be a whole number of steps from 0{upper} "
+            f"(got {shown(summary.get(key))})"
+        )
+    return value
+
+
+def _non_negative(summary: Mapping[str, Any], key: str, unit: str) -> None:
+    """A one-line :class:`ParameterError` naming ``key`` where ``summary[key]`` is below 0
+    (NaN and inf pass: a run that blew up has them)."""
+    value = _number(summary, key)
+    if value is not None and value < 0.0:
+        raise ParameterError(
+            f"summary: {key} must be >= 0 {unit}, 'nan', 'inf' or None "
+            f"(got {shown(summary.get(key))})"
+        )
 
 
 def error_limit(summary: Mapping[str, Any]) -> float:
@@ -729,15 +809,22 @@ def explain(summary: Mapping[str, Any]) -> tuple[list[str], str, str]:
     return found, what, likely_cause(summary, found)
 
 
+def lost_support(summary: Mapping[str, Any]) -> bool:
+    """The run's physics plant unloaded an edge of the support polygon (``support_lost``
+    true) and the robot did not tip over (``tipped`` false: a tip-over is a reason of its
+    own): the run whose verdict ends with :func:`support_warning`. False on every plant
+    that does not report ``support_lost``. ``summary`` as in :func:`verdict`."""
+    check_summary(summary)
+    return bool(summary.get("support_lost")) and not summary.get("tipped")
+
+
 def support_warning(summary: Mapping[str, Any]) -> str:
     """:data:`SUPPORT_LOST` for a run whose physics plant unloaded an edge of the support
     polygon (``support_lost`` true) and did not tip over (``tipped`` false: a tip-over is
     a reason of its own), with :data:`PREDICTED_BELOW_FLOOR` where the controller
     predicted an edge load (N) below its floor; ``""`` otherwise, and on every plant that
     does not report ``support_lost``. ``summary`` as in :func:`verdict`."""
-    check_summary(summary)
-    lost = summary.get("support_lost")  # the plant's flag, a bool (None or absent: no report)
-    if not isinstance(lost, bool | np.bool_) or not lost or summary.get("tipped"):
+    if not lost_support(summary):
         return ""
     least = _number(summary, "min_predicted_edge_load_n")
     floor = _number(summary, "min_edge_load_floor_n")
