@@ -27,7 +27,7 @@ from ddwmmr.bounds.lower import lower_bound
 from ddwmmr.bounds.search import Settings, best_known
 from ddwmmr.errors import DURATION_RANGE_S, MAX_SCENARIOS, ParameterError, shown
 from ddwmmr.model import Robot
-from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME
+from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess
 from ddwmmr.outputs import write_atomic
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.result import json_safe
@@ -123,7 +123,9 @@ def reusable_cache(
     version are not judged here: :func:`read_cached` checks the whole key before any use,
     so a record of other settings (``--quick``) is kept for the run that has them. The
     trajectory goes with its best record. A record for another seed or payload, unreadable,
-    or without a key is dropped, with the rest of its scenario's part.
+    or without a key is dropped, with the rest of its scenario's part; so is a best-known
+    record of a replayed search whose trajectory is missing or unreadable (a plan read
+    from the folder would fail on it; a run of that scenario searches again).
     """
     kept, dropped = [], set()
     for name in names:
@@ -132,12 +134,21 @@ def reusable_cache(
             continue
         index, part = entry
         scenario = scenarios.get(index) if 1 <= index <= MAX_SCENARIOS else None
-        record = folder / cache_names(index)[_RECORD_OF[part]]
-        if scenario is not None and _same_problem(record, scenario, payload):
+        if scenario is not None and _keeps(folder, index, part, scenario, payload):
             kept.append(name)
         else:
             dropped.add(index)
     return sorted(kept), sorted(dropped)
+
+
+def _keeps(folder: Path, index: int, part: str, scenario: Scenario, payload: float) -> bool:
+    """Whether :func:`reusable_cache` keeps ``part`` of scenario ``index``'s cache."""
+    record = folder / cache_names(index)[_RECORD_OF[part]]
+    if not _same_problem(record, scenario, payload):
+        return False
+    return _RECORD_OF[part] != "best" or not _trajectory_lost(
+        folder, index, _read_object(record) or {}
+    )
 
 
 def _same_problem(path: Path, scenario: Scenario, payload: float) -> bool:
@@ -151,20 +162,92 @@ def _same_problem(path: Path, scenario: Scenario, payload: float) -> bool:
 
 
 def read_cached(folder: Path, scenario: Scenario, payload: float, settings: Settings):
-    """The cached (best, lower) records of a scenario, each None if absent or stale."""
-    names = cache_names(scenario.index + 1)
+    """The cached (best, lower) records of a scenario, each None if absent or stale.
+
+    Stale: a key other than ``keys(scenario, payload, settings)``'s; a lower bound that is
+    no time in :data:`~ddwmmr.errors.DURATION_RANGE_S` (s); a replayed best-known record
+    whose time is none or whose trajectory (``.npz``) is missing or unreadable
+    (:func:`usable_best`); and the lower bound when it is above the replayed best-known
+    time (one of them is wrong: the lower bound, deterministic and the cheaper to compute,
+    is computed again, and :func:`row` refuses the pair if it is still above).
+    """
+    index = scenario.index + 1
+    names = cache_names(index)
     wanted = keys(scenario, payload, settings)
-    out = {}
-    for part in ("best", "lower"):
-        path = folder / names[part]
-        try:
-            record = json.loads(path.read_text(encoding="utf-8"))
-        except (OSError, ValueError):
-            record = None
-        if not isinstance(record, dict) or record.get("key") != json_safe(wanted[part]):
-            record = None
-        out[part] = record
-    return out["best"], out["lower"]
+    out = {part: _keyed_record(folder / names[part], wanted[part]) for part in ("best", "lower")}
+    best, lower = out["best"], out["lower"]
+    if lower is not None and not _is_time(lower.get("lower_bound_s")):
+        lower = None
+    if best is not None and not usable_best(folder, index, best):
+        best = None
+    both = best is not None and lower is not None and best["replay_ok"] is True
+    if both and best["best_known_s"] < lower["lower_bound_s"]:
+        lower = None  # the cheaper end, computed again: :func:`row` judges the new one
+    return best, lower
+
+
+def _keyed_record(path: Path, key: dict) -> dict | None:
+    """The JSON record at ``path`` if it is an object whose ``key`` is ``key``, else None."""
+    record = _read_object(path)
+    return record if record is not None and record.get("key") == json_safe(key) else None
+
+
+def _is_time(value: object) -> bool:
+    """Whether ``value`` is a number of seconds in :data:`~ddwmmr.errors.DURATION_RANGE_S`."""
+    low, high = DURATION_RANGE_S
+    return isinstance(value, int | float) and not isinstance(value, bool) and low <= value <= high
+
+
+def usable_best(folder: Path, index: int, record: dict) -> bool:
+    """Whether scenario ``index``'s (from 1) best-known ``record`` in the cache of the
+    output folder ``folder`` can be used: a search that replayed nothing (``replay_ok``
+    False) always can; a replayed one needs a best-known time (s, in
+    :data:`~ddwmmr.errors.DURATION_RANGE_S`) and, from a search that kept one, its
+    trajectory beside it, readable (:func:`_trajectory_lost`)."""
+    replayed = record.get("replay_ok")
+    if replayed is False:
+        return True
+    if replayed is not True or not _is_time(record.get("best_known_s")):
+        return False
+    return not _trajectory_lost(folder, index, record)
+
+
+def _trajectory_lost(folder: Path, index: int, record: dict) -> bool:
+    """Whether best-known ``record`` of scenario ``index`` is of a search that kept a
+    trajectory (``replay_ok`` true and the ``start`` it came from named: :func:`solve`
+    then stores the trajectory beside it) which its ``.npz`` in the cache of ``folder``
+    no longer holds: missing, or not readable as ``--option plan=DIR`` reads it
+    (:meth:`~ddwmmr.mpc.min_time.Guess.load`: empty, truncated, damaged...)."""
+    if record.get("replay_ok") is not True or not record.get("start"):
+        return False
+    try:
+        Guess.load(folder / cache_names(index)["trajectory"])
+    except ParameterError:
+        return True
+    return False
+
+
+def other_settings(folder: Path, scenario: Scenario, payload: float, settings: Settings):
+    """The method settings (a dict, as :func:`keys` records them) of scenario
+    ``scenario``'s cached best-known record when it is for the same problem and method
+    version but other settings than ``settings`` (a ``--quick`` search, another S floor);
+    None when there is no such record."""
+    wanted = json_safe(keys(scenario, payload, settings)["best"])
+    record = _read_object(folder / cache_names(scenario.index + 1)["best"])
+    key = record.get("key") if record is not None else None
+    if not isinstance(key, dict) or key.get("settings") == wanted["settings"]:
+        return None
+    same = all(key.get(name) == wanted[name] for name in wanted if name != "settings")
+    return key.get("settings") if same and isinstance(key.get("settings"), dict) else None
+
+
+def _read_object(path: Path) -> dict | None:
+    """The JSON object at ``path``, or None if missing, unreadable or not an object."""
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return record if isinstance(record, dict) else None
 
 
 def solve(job: Job) -> dict[str, Any]:
@@ -206,9 +289,11 @@ def store(folder: Path, result: dict[str, Any]) -> list[str]:
 
 
 def row(index: int, best: dict | None, lower: dict | None) -> dict[str, Any]:
-    """One line of bounds.csv."""
+    """One line of bounds.csv; a one-line :class:`ParameterError` naming the scenario's
+    cache files when its replayed best-known time is below its lower bound (bounds.csv's
+    readers refuse such a row: no achieved time is below its lower bound)."""
     best = best or {}
-    return {
+    out = {
         "scenario": index,
         "lower_bound_s": (lower or {}).get("lower_bound_s", math.nan),
         "best_known_s": best.get("best_known_s", math.nan),
@@ -216,6 +301,15 @@ def row(index: int, best: dict | None, lower: dict | None) -> dict[str, Any]:
         "spread_s": best.get("spread_s", math.nan),
         "replay_ok": bool(best.get("replay_ok", False)),
     }
+    if out["replay_ok"] and out["best_known_s"] < out["lower_bound_s"]:
+        names = cache_names(index)
+        raise ParameterError(
+            f"bounds: scenario {index}'s best-known time {out['best_known_s']:.6g} s is below "
+            f"its lower bound {out['lower_bound_s']:.6g} s (no achieved time is below its "
+            f"lower bound): one of {names['best']}, {names['lower']} is wrong; delete both "
+            "and run again"
+        )
+    return out
 
 
 def bounds_csv(rows: list[dict[str, Any]]) -> str:
@@ -356,8 +450,23 @@ def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, t
     return table
 
 
+def bounds_floor(path: str | Path) -> float | None:
+    """The floor on S the best-known times of the bounds.csv at ``path`` hold (its
+    summary.json's ``settings.stability_min``); None when that record does not say."""
+    summary = _read_object(Path(path).parent / "summary.json")
+    settings = summary.get("settings") if summary is not None else None
+    floor = settings.get("stability_min") if isinstance(settings, dict) else None
+    return float(floor) if isinstance(floor, int | float) and not isinstance(floor, bool) else None
+
+
 def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
-    """Means of both ends, of the bracket's width (best known / lower bound) and counts."""
+    """Means of both ends, of the bracket's width (best known / lower bound) and counts.
+
+    Each mean is over the rows that have its value: ``mean_lower_bound_s`` over every row
+    with a lower bound, ``mean_best_known_s`` over the ``replay_ok`` rows; the width's,
+    and ``mean_lower_bound_bracketed_s``, over the ``bracketed`` rows, which have both
+    ends (the mean lower bound to set beside ``mean_best_known_s``).
+    """
     lower = np.array([r["lower_bound_s"] for r in rows], dtype=float)
     best = np.array([r["best_known_s"] if r["replay_ok"] else math.nan for r in rows], dtype=float)
     both = np.isfinite(lower) & np.isfinite(best)
@@ -368,6 +477,8 @@ def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
         "replay_ok": int(sum(bool(r["replay_ok"]) for r in rows)),
         "mean_lower_bound_s": float(np.nanmean(lower)) if np.isfinite(lower).any() else math.nan,
         "mean_best_known_s": float(np.nanmean(best)) if np.isfinite(best).any() else math.nan,
+        "bracketed": int(both.sum()),
+        "mean_lower_bound_bracketed_s": float(lower[both].mean()) if width.size else math.nan,
         "mean_width": float(width.mean()) if width.size else math.nan,
         "max_width": float(width.max()) if width.size else math.nan,
         "min_width": float(width.min()) if width.size else math.nan,

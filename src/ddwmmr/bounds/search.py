@@ -101,8 +101,9 @@ class Settings:
     tight_margin_m: float = 0.0003
 
 
-#: A lighter search (about half the CPU): fewer starts on a coarser screening grid, the
-#: mpc's run the only controller start; still certified on 60 intervals (only).
+#: A lighter search (46 starts instead of 59-60; its CPU time in docs/mpc.md): a coarser
+#: screening grid, the mpc's run the only controller start; still certified on 60
+#: intervals (only).
 QUICK = Settings(
     coarse=6,
     fine=16,

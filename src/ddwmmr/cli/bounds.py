@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import math
+import re
 import sys
 import time
 from collections.abc import Sequence
@@ -22,7 +23,8 @@ from pathlib import Path
 from ddwmmr import provenance
 from ddwmmr.bounds import batch
 from ddwmmr.bounds.search import QUICK, Settings
-from ddwmmr.cli.common import ArgumentParser, output_folder, run_main
+from ddwmmr.cli.common import ArgumentParser, Terminated, output_folder, run_main
+from ddwmmr.cli.signals import say
 from ddwmmr.errors import (
     MASS_RANGE_KG,
     MAX_JOBS,
@@ -31,6 +33,7 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_nonnegative,
     check_range,
+    shown,
 )
 from ddwmmr.model.stability import STABILITY_CAP
 from ddwmmr.outputs import (
@@ -48,6 +51,7 @@ from ddwmmr.progress import ProgressBar
 from ddwmmr.scenarios.executors import default_jobs
 from ddwmmr.scenarios.generator import generate
 from ddwmmr.scenarios.report import summary_json
+from ddwmmr.sim.result import json_safe
 
 PROG = "python -m ddwmmr.bounds"
 TOOL = "bounds"
@@ -64,7 +68,8 @@ summary.json into --out, and prints the means. Results are cached per scenario i
 --out/cache as they come: an interrupted run started again with the same --out resumes. A
 run of some --scenarios keeps the cache of the others (of the same seed and payload), and
 its bounds.csv holds its own scenarios: --scenarios 1-100 again rebuilds the whole table
-from the cache. A scenario takes about 1-3 minutes on one core."""
+from the cache. A scenario takes about 55 s of CPU on average, 34 s with --quick, 25 s
+with --lower-only (docs/mpc.md; the slowest took 6 minutes)."""
 
 EPILOG = """\
 Bad input prints one line and exits with status 2, leaving no output behind. The scenario
@@ -120,8 +125,9 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--quick",
         action="store_true",
-        help="a lighter multistart (about half the CPU: fewer starts, a coarser screening "
-        "grid, the mpc's run the only controller start)",
+        help="a lighter multistart (46 starts instead of 59-60, about 34 s of CPU a "
+        "scenario instead of 55: a coarser screening grid, the mpc's run the only "
+        "controller start)",
     )
     parser.add_argument(
         "--lower-only",
@@ -133,20 +139,24 @@ def build_parser() -> ArgumentParser:
     return parser
 
 
+#: One item of ``--scenarios``: a number or a range of ASCII digits, as bounds.csv's
+#: scenario column takes them (no sign, no underscore, no other script's digits).
+_ITEM = re.compile(r"(?P<first>[0-9]+)(?:-(?P<last>[0-9]+))?")
+
+
 def parse_scenarios(text: str) -> list[int]:
-    """'1-100', '7', '1,3,7-9' -> sorted distinct scenario numbers (1-based)."""
+    """'1-100', '7', '1,3,7-9' -> sorted distinct scenario numbers (1-based); spaces
+    around an item are allowed. Anything else is a one-line :class:`ParameterError`."""
     chosen: set[int] = set()
     for part in str(text).split(","):
-        part = part.strip()
-        try:
-            if "-" in part:
-                first, last = (int(v) for v in part.split("-", 1))
-            else:
-                first = last = int(part)
-        except ValueError:
+        match = _ITEM.fullmatch(part.strip())
+        if match is None:
             raise ParameterError(
-                f"scenarios must be numbers or ranges like 1-100 or 1,3,7-9 (got {text!r})"
-            ) from None
+                f"scenarios must be numbers or ranges like 1-100 or 1,3,7-9, in the digits "
+                f"0-9 (got {shown(text)})"
+            )
+        first = int(match["first"])
+        last = int(match["last"] or first)
         if not 1 <= first <= last <= MAX_SCENARIOS:
             raise ParameterError(
                 f"scenarios must lie in 1-{MAX_SCENARIOS} with first <= last (got {part!r})"
@@ -191,9 +201,13 @@ def _main(argv: Sequence[str] | None = None) -> int:
     known = {s.index + 1: s for s in generate(last, args.seed)}
     scenarios = {i: s for i, s in known.items() if i in numbers}
     began = time.perf_counter()
-    records = _solve_all(
-        target, scenarios, args.payload, settings, jobs, not args.no_progress, args.lower_only
-    )
+    try:
+        records = _solve_all(
+            target, scenarios, args.payload, settings, jobs, not args.no_progress, args.lower_only
+        )
+    except (KeyboardInterrupt, Terminated):
+        say(_kept_note(target))  # before the stop line, which says the rest is removed
+        raise
     rows = [batch.row(i, *records[i]) for i in numbers]
     summary = batch.summarize(rows)
     summary.update(
@@ -210,11 +224,20 @@ def _main(argv: Sequence[str] | None = None) -> int:
             write_atomic(staging / name, (target / name).read_bytes())
         write_atomic(staging / "bounds.csv", batch.bounds_csv(rows))
         write_atomic(staging / MARKER, summary_json(summary))
-    if dropped:
-        print(_dropped_note(target, dropped, args.seed, args.payload), file=sys.stderr)
-    print(summary_line(len(rows), summary))
+    for note in _dropped_notes(target, listed, kept, args.seed, args.payload) if dropped else []:
+        print(note, file=sys.stderr)
+    elsewhere = _other_settings(target, scenarios, records, args.payload, settings)
+    print(summary_line(len(rows), summary, elsewhere))
     print(f"wrote {target}", file=sys.stderr)
     return 0
+
+
+def _kept_note(target: Path) -> str:
+    """The line of a run stopped while solving: the finished scenarios' cache stays."""
+    return (
+        f"bounds: the cache of the scenarios finished so far is kept in "
+        f"{target / batch.CACHE}; the same command resumes from it"
+    )
 
 
 def _check_out(out: Path, force: bool) -> Path:
@@ -231,6 +254,12 @@ def _check_out(out: Path, force: bool) -> Path:
 
 def _foreign_refusal(out: Path, existing: Existing) -> str:
     """Why ``out`` cannot hold a bounds run, and what to do instead."""
+    run = out.absolute().parent
+    if out.absolute().name == batch.CACHE and inspect(run, TOOL).kind == "own":
+        return (
+            f"out: {out} is the cache folder of the bounds run in {run}, not a run's "
+            f"folder: give --out {run} to resume or extend that run"
+        )
     return (
         f"out: {out} {foreign_contents(TOOL, existing)}; the bounds cache needs a folder of "
         "its own, so --force does not help: choose another --out (a new folder or an "
@@ -238,28 +267,117 @@ def _foreign_refusal(out: Path, existing: Existing) -> str:
     )
 
 
-def _dropped_note(target: Path, dropped: list[int], seed: int, payload: float) -> str:
-    """The line saying which scenarios' cache a run dropped (made for another problem)."""
-    shown = ", ".join(str(i) for i in dropped[:5]) + (", ..." if len(dropped) > 5 else "")
+#: What a dropped part of a scenario's cache is called, and the part kept beside it.
+_PARTS = {
+    "best": ("best-known record and trajectory", "lower bound"),
+    "lower": ("lower bound", "best-known record"),
+}
+
+
+def _dropped_notes(
+    target: Path, listed: list[str], kept: list[str], seed: int, payload: float
+) -> list[str]:
+    """The lines saying which cache files of ``listed`` a run dropped (not in ``kept``):
+    whole scenarios, or the one part of a scenario whose other part was kept."""
+    kept_numbers = batch.cached_numbers(kept)
+    groups: dict[str, set[int]] = {}
+    for name in set(listed) - set(kept):
+        entry = batch.cache_entry(name)
+        if entry is None:
+            continue
+        index, part = entry
+        part = "whole" if index not in kept_numbers else "lower" if part == "lower" else "best"
+        groups.setdefault(part, set()).add(index)
+    why = f"made for another seed or payload than seed {seed}, payload {payload:g} kg"
+    notes = []
+    for part in ("whole", "best", "lower"):
+        if part in groups:
+            notes.append(_dropped_note(target, sorted(groups[part]), part, why))
+    return notes
+
+
+def _dropped_note(target: Path, dropped: list[int], part: str, why: str) -> str:
+    """One line of :func:`_dropped_notes`: ``part`` (``whole``, ``best``, ``lower``) of
+    the cache of scenarios ``dropped`` removed from ``target``, and ``why``."""
+    shown_numbers = ", ".join(str(i) for i in dropped[:5]) + (", ..." if len(dropped) > 5 else "")
     scenarios = "scenario" + "s" * (len(dropped) > 1)
-    return (
-        f"note: removed the cache of {len(dropped)} {scenarios} ({shown}) from "
-        f"{target / batch.CACHE}: made for another seed or payload than seed {seed}, "
-        f"payload {payload:g} kg (or unreadable)"
-    )
+    where = f"{len(dropped)} {scenarios} ({shown_numbers}) from {target / batch.CACHE}"
+    if part == "whole":
+        return f"note: removed the cache of {where}: {why} (or unreadable)"
+    removed, other = _PARTS[part]
+    them = "them" if len(dropped) > 1 else "it"
+    if part == "best":
+        why += ", unreadable, or its trajectory missing or damaged"
+        again = f"a run of {them} without --lower-only searches again"
+    else:
+        why += " (or unreadable)"
+        again = f"a run of {them} computes {them} again"
+    return f"note: removed the {removed} of {where}, keeping the {other}: {why}; {again}"
 
 
-def summary_line(count: int, summary: dict) -> str:
+def summary_line(count: int, summary: dict, elsewhere: str | None = None) -> str:
     """The one line the tool prints: the means, and the bracket where both ends are known
-    (``--lower-only`` leaves the best-known times to a later run)."""
+    (``--lower-only`` leaves the best-known times to a later run). Each mean says the
+    scenarios it is over when not all ``count``: the lower bound's over every scenario,
+    beside the best known and the width over the bracketed ones, with the lower bound's
+    mean over those too. ``elsewhere``: the options of other settings the cache holds
+    best-known times for (:func:`_other_settings`), named when the run has none."""
     scenarios = "1 scenario" if count == 1 else f"{count} scenarios"
     line = f"{scenarios}: lower bound {summary['mean_lower_bound_s']:.2f} s"
-    if summary["replay_ok"] == 0 or not math.isfinite(summary["mean_best_known_s"]):
+    bracketed = summary.get("bracketed", summary["replay_ok"])
+    if bracketed == 0 or not math.isfinite(summary["mean_best_known_s"]):
+        if elsewhere is not None:
+            return line + (
+                f", no best-known time with these settings (the cache holds ones of other "
+                f"settings: {elsewhere}; run with those to use them, or without --lower-only "
+                "to search)"
+            )
         return line + ", no best-known time yet (run without --lower-only for them)"
+    width = f"bracket width {summary['mean_width']:.3f} (mean of best known / lower bound)"
+    if bracketed == count:
+        return line + (
+            f", best known {summary['mean_best_known_s']:.2f} s (replayed "
+            f"{summary['replay_ok']}), {width}"
+        )
     return line + (
-        f", best known {summary['mean_best_known_s']:.2f} s (replayed {summary['replay_ok']}), "
-        f"bracket width {summary['mean_width']:.3f} (mean of best known / lower bound)"
+        f" (mean of all {count}); over the {bracketed} with a replayed best-known time: "
+        f"lower bound {summary['mean_lower_bound_bracketed_s']:.2f} s, best known "
+        f"{summary['mean_best_known_s']:.2f} s, {width}"
     )
+
+
+def _other_settings(
+    folder: Path, scenarios: dict, records: dict, payload: float, settings: Settings
+) -> str | None:
+    """The options (``--quick``, ``--stability-min S``) of the settings of the cached
+    best-known records of other settings than ``settings`` for the ``scenarios`` without
+    one of their own in ``records``; None when there are none. The first such record
+    speaks for the rest."""
+    for index, scenario in scenarios.items():
+        if records[index][0] is not None:
+            continue
+        recorded = batch.other_settings(folder, scenario, payload, settings)
+        if recorded is not None:
+            return _settings_options(recorded, settings)
+    return None
+
+
+def _settings_options(recorded: dict, settings: Settings) -> str:
+    """The options that make the method settings ``recorded`` (as a cache key holds them)
+    out of a run's ``settings`` (``--quick``, ``without --quick``, ``--stability-min S``),
+    or "other method settings" if no options do."""
+    floor = recorded.get("stability_min")
+    if not isinstance(floor, float):
+        return "other method settings"
+    for option, base in (("--quick", QUICK), ("without --quick", Settings())):
+        if json_safe(asdict(replace(base, stability_min=floor))) != recorded:
+            continue
+        same_method = replace(settings, stability_min=floor) == replace(base, stability_min=floor)
+        options = [] if same_method else [option]
+        if floor != settings.stability_min:
+            options.append(f"--stability-min {floor:g}")
+        return ", ".join(options)
+    return "other method settings"
 
 
 def _solve_all(

@@ -901,13 +901,25 @@ def _record(args: argparse.Namespace, config: RunConfig, workers: int) -> dict[s
 
 
 def _bounds_table(args: argparse.Namespace, config: RunConfig):
-    """``--bounds``: the file's ``{scenario: (lower, best)}``, checked against the run."""
+    """``--bounds``: the file's ``{scenario: (lower, best)}``, checked against the run.
+
+    Refused (one line) on another plant than the thesis plant: the lower bound prices the
+    thesis plant's model, its wheels' force budget (docs/mpc.md, "The physical limit,
+    bracketed"), which the kinematic plant does not have and MuJoCo's physics is not. A
+    ``qp`` or ``mpc`` run whose floor on S (``--qp-stability-min``) is not the bounds
+    run's gets a one-line note: its best-known times are for that floor (the lower bound
+    holds for any)."""
     if args.bounds is None:
         return None
-    from ddwmmr.bounds.batch import read_bounds_file
+    from ddwmmr.bounds.batch import bounds_floor, read_bounds_file
 
     if args.study or args.obstacles:
         raise ParameterError("bounds: only for the benchmark without a study or obstacles")
+    if config.plant != "thesis":
+        raise ParameterError(
+            f"bounds: only with --plant thesis (got {config.plant}): the lower bound prices "
+            "the thesis plant's wheel forces, so no other plant's time is bracketed by it"
+        )
     table = read_bounds_file(args.bounds, args.seed, config.payload)
     if not set(table) & set(range(1, args.n + 1)):  # scenarios are numbered from 1
         span = "1" if args.n == 1 else f"1-{args.n}"
@@ -916,6 +928,15 @@ def _bounds_table(args: argparse.Namespace, config: RunConfig):
         raise ParameterError(
             f"bounds: {args.bounds} covers none of the run's {run} (it has {held}); "
             f"python -m ddwmmr.bounds --scenarios {span} makes them"
+        )
+    floor = bounds_floor(args.bounds)
+    own = config.qp_stability_min if config.controller in QP_OPTIONS["qp_stability_min"] else None
+    if None not in (floor, own) and floor != own:
+        print(
+            f"scenarios: note: the best-known times of {args.bounds} hold S >= {floor:g}, "
+            f"this run S >= {own:g} (--qp-stability-min): its ratios to them compare "
+            "different problems (the lower bounds hold for any floor)",
+            file=sys.stderr,
         )
     return table
 
