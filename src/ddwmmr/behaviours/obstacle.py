@@ -26,6 +26,15 @@ def base_bubble(robot: Robot) -> float:
     return math.hypot(0.5 * robot.base_length, 0.5 * robot.base_width)
 
 
+def bubble_gap(x: float, y: float, obstacle: tuple[float, float, float], bubble: float) -> float:
+    """Gap (m) between the base's enclosing circle (centre ``(x, y)``, radius ``bubble``,
+    m, world frame) and the circular ``obstacle`` ``(x, y, radius)``: negative where they
+    overlap, which the scenario protocol counts as a collision. The sum of the radii is
+    formed first, so ``gap < 0`` is exactly ``distance < radius + bubble``."""
+    ox, oy, radius = obstacle
+    return math.hypot(x - ox, y - oy) - (radius + bubble)
+
+
 class ObstacleAvoidance:
     """Steer the base around circular obstacles with temporary waypoints (thesis 4.6.2)."""
 

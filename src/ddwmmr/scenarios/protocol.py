@@ -51,7 +51,7 @@ from ddwmmr.arbiters.state_machine import (
     THESIS_STABILITY,
 )
 from ddwmmr.behaviours.objective import default_pose
-from ddwmmr.behaviours.obstacle import base_bubble
+from ddwmmr.behaviours.obstacle import base_bubble, bubble_gap
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
 from ddwmmr.controllers.base import (
     WaypointRun,
@@ -433,8 +433,8 @@ class _Tally:
         if s <= 1.0:
             self.reason = "tipped"
             return True
-        for ox, oy, radius in self.scenario.obstacles:
-            if math.hypot(q[0] - ox, q[1] - oy) < radius + self.clearance:
+        for obstacle in self.scenario.obstacles:
+            if bubble_gap(q[0], q[1], obstacle, self.clearance) < 0.0:
                 self.reason = "collision"
                 return True
         return False

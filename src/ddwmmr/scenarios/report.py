@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.arbiters.state_machine import STATES
+from ddwmmr.behaviours.obstacle import bubble_gap
 from ddwmmr.errors import ParameterError, check_int_at_least, one_line
 from ddwmmr.outputs import write_atomic
 from ddwmmr.scenarios.generator import Scenario
@@ -533,9 +534,8 @@ def _closest_approach(ax, trace: dict, obstacles, clearance: float) -> float:
     y = np.asarray(trace.get("y", []), dtype=float)
     if not len(obstacles) or not len(x):
         return math.nan
-    circles = np.asarray(obstacles, dtype=float)  # (k, 3): x, y, radius
-    gaps = np.hypot(x[:, None] - circles[None, :, 0], y[:, None] - circles[None, :, 1])
-    gaps -= circles[None, :, 2] + clearance
+    # the protocol's own collision measure, sample by sample (a trace holds few samples)
+    gaps = np.array([[bubble_gap(xi, yi, o, clearance) for o in obstacles] for xi, yi in zip(x, y)])
     k = int(np.argmin(np.min(gaps, axis=1)))
     label = f"base's enclosing circle (r {clearance:.3g} m) where closest to an obstacle"
     circle = patches.Circle((x[k], y[k]), clearance, fill=False, ec="tab:red", ls="--", lw=0.9)
