@@ -200,6 +200,27 @@ def test_shares_out_of_range_or_adding_up_beyond_one_are_named():
     # a valid blend passes, rounding of shares normalised to 1 included
     thirds = {name: 1.0 / 3.0 for name in ("objective", "manipulability", "stability")}
     check_blend("mine", Blend(MOVE_BASE, "objective", thirds, {}), behaviours(), 0.0)
+    # weights normalised in float32 add up to 1 + a few 1e-8
+    import numpy as np
+
+    weights = np.array([0.6, 0.7, 0.5], dtype=np.float32)
+    names = ("objective", "manipulability", "stability")
+    float32 = dict(zip(names, (weights / weights.sum()).tolist()))
+    assert 1.0 + 1e-9 < math.fsum(float32.values()) < 1.0 + 1e-6
+    check_blend("mine", Blend(MOVE_BASE, "objective", float32, {}), behaviours(), 0.0)
+    # an excess that :g would print as 1 is spelt out
+    over = {"objective": 0.5, "stability": 0.5 + 2e-6}
+    assert _blend_error(shares=over) == (
+        "arbiter mine: weigh() returned shares adding up to 1.0000019999999998 at "
+        f"t = 0.25 s; {SHARES}"
+    )
+
+
+def test_an_integer_beyond_a_float_is_no_finite_share():
+    assert _blend_error(shares={"objective": 10**400}) == (
+        "arbiter mine: weigh() returned shares['objective'] = "
+        f"an integer of about 1e400 at t = 0.25 s; {SHARES}"
+    )
 
 
 def test_a_selected_proposal_with_nan_is_named():

@@ -138,3 +138,10 @@ def test_simulate_refuses_a_start_position_beyond_the_trajectories_bound():
 def test_simulate_runs_from_a_start_at_the_position_bound():
     result = simulate(ROBOT, Ellipse(), "ats", q0=[1e6, 0.0, 0.0, 0.3, 0.5], duration=0.1)
     assert result.configurations()[0][0] == 1e6
+
+
+@pytest.mark.parametrize("name", ["fk", "jacobian", "stability", "centre_of_mass"])
+def test_robot_methods_refuse_a_complex_configuration(name):
+    """abs() of a complex entry is real, so the magnitude bound alone would let it in."""
+    with pytest.raises(ParameterError, match=r"^q must be 5 finite numbers"):
+        getattr(Robot(), name)([0.0, 0.0, 1j, 0.0, 0.0])

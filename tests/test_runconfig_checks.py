@@ -66,3 +66,11 @@ def test_run_scenario_refuses_what_is_no_scenario_or_no_config():
     assert str(error.value) == (
         "config must be a RunConfig (ddwmmr.scenarios.RunConfig) (got {'dt': 0.01})"
     )
+
+
+def test_options_given_as_lists_are_kept_as_tuples():
+    """A list of lists is stored as a tuple of pairs, so the frozen configuration stays
+    hashable (a list inside would make hash() raise)."""
+    config = RunConfig(controller_options=[["adjust", 0.3]])
+    assert config.controller_options == (("adjust", 0.3),)
+    assert hash(config) == hash(RunConfig(controller_options=(("adjust", 0.3),)))

@@ -96,9 +96,15 @@ def test_the_good_summary_tracks() -> None:
             "summary: unloaded_time_s must be >= 0 s, 'nan', 'inf' or None (got -0.1)",
         ),
         ({"duration": -2}, "summary: duration must be >= 0 s, 'nan', 'inf' or None (got -2)"),
-        ({"start_tipped": "yes"}, "summary: start_tipped must be True, False or None (got 'yes')"),
-        ({"tipped": 1}, "summary: tipped must be True, False or None (got 1)"),
-        ({"support_lost": "no"}, "summary: support_lost must be True, False or None (got 'no')"),
+        (
+            {"start_tipped": "yes"},
+            "summary: start_tipped must be True, False (or 1, 0) or None (got 'yes')",
+        ),
+        ({"tipped": 2}, "summary: tipped must be True, False (or 1, 0) or None (got 2)"),
+        (
+            {"support_lost": "no"},
+            "summary: support_lost must be True, False (or 1, 0) or None (got 'no')",
+        ),
     ],
 )
 def test_nonsense_numbers_and_flags_are_refused_naming_the_key(
@@ -204,3 +210,34 @@ def test_the_gui_line_of_a_run_that_kept_its_support_or_tipped_is_unchanged() ->
     assert _physics_verdict(tipped) == ", TIPPED at 1.23 s (physics)"
     kinematic = {k: v for k, v in STOOD.items() if k not in ("tipped", "support_lost")}
     assert _physics_verdict(kinematic) == "" and not lost_support(kinematic)
+
+
+def test_flags_may_be_the_integers_0_and_1() -> None:
+    assert verdict({**GOOD, "tipped": 0})["verdict"] == verdict(GOOD)["verdict"]
+    assert (
+        verdict({**GOOD, "tipped": 1})["verdict_reasons"]
+        == verdict({**GOOD, "tipped": True})["verdict_reasons"]
+    )
+
+
+def test_a_plug_in_summarize_the_verdict_cannot_read_names_the_plug_in() -> None:
+    """A plug-in plant's summarize() key that no run writes stops the run with one line
+    naming the plant, not the summary alone."""
+    from ddwmmr import simulate
+    from ddwmmr.errors import ParameterError
+    from ddwmmr.model import Robot
+    from ddwmmr.plants.kinematic import KinematicPlant
+    from ddwmmr.trajectories import Ellipse
+
+    class CountingPlant(KinematicPlant):
+        name = "counting"
+
+        def summarize(self, timeseries):
+            return {**super().summarize(timeseries), "singular_steps": 10**6}
+
+    CountingPlant.__module__ = "user_plants"  # a plug-in, as from_library sees it
+    with pytest.raises(ParameterError) as info:
+        simulate(Robot(), Ellipse(), "ats", duration=0.2, plant=CountingPlant(Robot()))
+    message = str(info.value)
+    assert message.startswith("plant: counting.summarize() returned summary: singular_steps")
+    assert "\n" not in message

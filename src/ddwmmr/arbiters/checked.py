@@ -23,18 +23,17 @@ from numbers import Real
 from typing import Any, NoReturn
 
 from ddwmmr.arbiters.state_machine import STATES
-from ddwmmr.behaviours.base import BRAKE, DRIVE, TURN, Behaviour, Percept, Proposal
-from ddwmmr.errors import PluginError, name_of, raise_plugin_error, shown
+from ddwmmr.behaviours.base import PROPOSAL_MODES, Behaviour, Percept, Proposal
+from ddwmmr.errors import PluginError, name_of, raise_plugin_error, real_number, shown, texts_apart
 from ddwmmr.inheritance import from_library
 
 #: What ``select`` must return, for the messages.
 SELECTION_FORM = "a Selection(state, behaviour, proposal) (ddwmmr.arbiters.Selection)"
 #: What ``weigh`` must return, for the messages.
 BLEND_FORM = "a Blend(state, behaviour, shares, proposals) (ddwmmr.arbiters.Blend)"
-#: The modes a :class:`~ddwmmr.behaviours.base.Proposal` may have.
-MODES = (DRIVE, TURN, BRAKE)
-#: Rounding allowed on the sum of the shares (a plug-in normalising its weights to 1).
-SHARE_SUM_SLACK = 1e-9
+#: Rounding allowed on the sum of the shares: a plug-in normalising its weights to 1 in
+#: float32 arithmetic leaves a few 1e-8 (five weights: 1 + 3.7e-8).
+SHARE_SUM_SLACK = 1e-6
 
 
 def checked_arbiter(arbiter: Any, origin: str | None = None) -> Any:
@@ -192,19 +191,21 @@ def _check_shares(name: str, shares: Any, behaviours: Mapping[str, Behaviour], t
             _refuse(name, "weigh", f"returned shares[{behaviour!r}] = {shown(share)}", t, wanted)
     total = math.fsum(shares.values())
     if total > 1.0 + SHARE_SUM_SLACK:
-        _refuse(name, "weigh", f"returned shares adding up to {total:g}", t, wanted)
+        shown_total, _ = texts_apart(total, 1.0)  # never "adding up to 1 ... at most 1"
+        _refuse(name, "weigh", f"returned shares adding up to {shown_total}", t, wanted)
 
 
 def _check_proposal(name: str, method: str, field: str, proposal: Any, t: float) -> None:
     """Refuse ``proposal`` (arbiter ``name``'s ``method`` returned it as ``field``) unless it
-    is a Proposal with a mode of :data:`MODES`, finite ``bx``, ``by`` (m, world) and
+    is a Proposal with a mode of
+    :data:`~ddwmmr.behaviours.base.PROPOSAL_MODES`, finite ``bx``, ``by`` (m, world) and
     ``heading`` (rad, world) and a pair of finite joint targets ``arm`` (rad)."""
     if not isinstance(proposal, Proposal):
         got = f"returned {field} {shown(proposal)}"
         _refuse(name, method, got, t, "it must be a behaviour's Proposal")
-    if proposal.mode not in MODES:
+    if proposal.mode not in PROPOSAL_MODES:
         got = f"returned {field}.mode {shown(proposal.mode)}"
-        _refuse(name, method, got, t, f"allowed: {', '.join(MODES)}")
+        _refuse(name, method, got, t, f"allowed: {', '.join(PROPOSAL_MODES)}")
     for attribute in ("bx", "by", "heading"):
         value = getattr(proposal, attribute)
         if not _finite(value):
@@ -217,8 +218,10 @@ def _check_proposal(name: str, method: str, field: str, proposal: Any, t: float)
 
 
 def _finite(value: Any) -> bool:
-    """Whether ``value`` is a finite real number (a bool is no number here)."""
-    return isinstance(value, Real) and not isinstance(value, bool) and math.isfinite(value)
+    """Whether ``value`` is a finite real number (a bool is no number here, and an integer
+    beyond a float, such as 10**400, is not finite)."""
+    number = real_number(value) if isinstance(value, Real) else None
+    return number is not None and math.isfinite(number)
 
 
 def _check_state(name: str, method: str, state: Any, t: float) -> None:

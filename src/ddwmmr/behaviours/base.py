@@ -21,6 +21,8 @@ from ddwmmr.model import Robot, stability
 
 #: Base modes of a proposal.
 DRIVE, TURN, BRAKE = "drive", "turn", "brake"
+#: Every mode a :class:`Proposal` may have.
+PROPOSAL_MODES = (DRIVE, TURN, BRAKE)
 
 
 @dataclass(slots=True)

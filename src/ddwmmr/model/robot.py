@@ -624,7 +624,12 @@ def _configuration(q, name: str = "q") -> list[float]:
     values = q.tolist() if type(q) is np.ndarray else q
     if type(values) is list or type(values) is tuple:
         try:
-            if len(values) == 5 and sum(map(abs, values)) <= _MAX_Q_ANGLE:
+            # the sum is finite only for real numbers (a complex one raises TypeError)
+            if (
+                len(values) == 5
+                and _isfinite(sum(values))
+                and sum(map(abs, values)) <= _MAX_Q_ANGLE
+            ):
                 return values
         except (TypeError, OverflowError):
             pass

@@ -223,7 +223,10 @@ class RunConfig:
             check_qp_option(name, getattr(self, name))
         check_payload(self.payload)
         check_positive("tolerance", self.tolerance)
-        check_controller_options(self.controller_options)
+        # stored as a tuple of tuples: a frozen configuration stays hashable
+        object.__setattr__(
+            self, "controller_options", check_controller_options(self.controller_options)
+        )
         # Checked here rather than when a worker reaches a scenario halfway through a
         # batch. Without a time_limit, the shorter default: dt above it would run no step
         # at all; whether 120 s (obstacles) stays within the cap depends on the scenario,
@@ -319,7 +322,7 @@ def check_controller_options(options: Any) -> tuple[tuple[str, Any], ...]:
                 f"controller_options: {pair[0]!r} is given twice; each name once ({wanted})"
             )
         seen.add(pair[0])
-    return tuple(options)
+    return tuple((name, value) for name, value in options)
 
 
 def check_qp_option(name: str, value: float) -> float:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -24,8 +24,10 @@ from ddwmmr.errors import (
     check_positive,
     check_range,
     check_step_count,
+    name_of,
     shown,
 )
+from ddwmmr.inheritance import from_library
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.model.robot import long_lengths
@@ -40,7 +42,7 @@ from ddwmmr.resolution.reference import (
 from ddwmmr.sim.loop import run_loop, spoken_interface
 from ddwmmr.sim.result import SimulationResult
 from ddwmmr.sim.tracking import COLUMNS, TrackingTask, checked_trajectory
-from ddwmmr.sim.verdict import verdict
+from ddwmmr.sim.verdict import check_summary, verdict
 from ddwmmr.trajectories.base import (
     require_trajectory,
     resolution_step,
@@ -332,14 +334,28 @@ def simulate(
     )
     if task.diverged_at is not None:
         summary.update(diverged_at_step=task.diverged_at, diverged=task.diverged_message)
-    summary.update(the_plant.summarize(timeseries))
+    _add_plug_in_keys(summary, the_plant, "plant", the_plant.summarize(timeseries))
     if hasattr(controller, "summarize"):
-        summary.update(controller.summarize(timeseries))
+        _add_plug_in_keys(summary, controller, "method", controller.summarize(timeseries))
     if getattr(controller, "aux", None) is not None:
         summary["aux"] = controller.aux  # the verdict's likely cause names the slides' row
     summary.update(start_stability=start_stability(robot, q), start_tipped=tipped)
     summary.update(verdict(summary))
     return SimulationResult(timeseries, summary, robot, trajectory, controller)
+
+
+def _add_plug_in_keys(summary: dict, owner: Any, role: str, keys: Mapping[str, Any]) -> None:
+    """``summary`` updated with the ``keys`` that ``owner``'s ``summarize()`` returned; a
+    plug-in's keys that the verdict cannot read (:func:`check_summary`: a count above the
+    run's steps, a flag that is no boolean) are a one-line :class:`ParameterError` naming
+    the plug-in (``role`` ``"plant"`` or ``"method"``), not the summary."""
+    summary.update(keys)
+    if from_library(owner):
+        return
+    try:
+        check_summary(summary)
+    except ParameterError as error:
+        raise ParameterError(f"{role}: {name_of(owner)}.summarize() returned {error}") from None
 
 
 def _tipped_start(robot: Robot, q: np.ndarray, policy: str) -> bool:

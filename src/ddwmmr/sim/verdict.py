@@ -410,11 +410,15 @@ def _number(summary: Mapping[str, Any], key: str) -> float | None:
 
 def _flag(summary: Mapping[str, Any], key: str) -> None:
     """A one-line :class:`ParameterError` naming ``key`` unless ``summary[key]`` is a
-    boolean (Python's or numpy's), None or missing: text such as ``"no"`` would read as
-    true."""
+    boolean (Python's or numpy's), the integer 0 or 1, None or missing: text such as
+    ``"no"`` would read as true."""
     value = summary.get(key)
-    if value is not None and not isinstance(value, bool | np.bool_):
-        raise ParameterError(f"summary: {key} must be True, False or None (got {shown(value)})")
+    if value is None or isinstance(value, bool | np.bool_):
+        return
+    if not (isinstance(value, int | np.integer) and value in (0, 1)):
+        raise ParameterError(
+            f"summary: {key} must be True, False (or 1, 0) or None (got {shown(value)})"
+        )
 
 
 def _count(summary: Mapping[str, Any], key: str, steps: float | None) -> float | None:
