@@ -2,9 +2,9 @@
 behind the axle, the wheels at the sides).
 
 The edge-load model covers any polygon: on the diamond its loads are the closed form's and
-MuJoCo's contact forces. The stability margin S does not: it measures the footprint
-``base_length x base_width``, which the diamond does not contain, so S overstates the
-diamond's margin up to twice and the MuJoCo plant says so when it is built.
+MuJoCo's contact forces. So does the stability margin S, measured on the support polygon
+(tests/test_polygon_stability.py): the MuJoCo plant builds every such layout without a
+warning.
 """
 
 import math
@@ -15,25 +15,15 @@ import pytest
 
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import GRAVITY_M_S2, centre_of_mass, stability_terms
-from ddwmmr.model.support_loads import EdgeLoadModel, support_points
+from ddwmmr.model.support_loads import EdgeLoadModel
 from ddwmmr.plants.mujoco import MujocoPlant
-from ddwmmr.plants.mujoco.plant import _WARNED_LAYOUTS
-from ddwmmr.plants.mujoco.support import SupportGeometry, footprint_excess
-
-
-@pytest.fixture(autouse=True)
-def _forget_warned_layouts():
-    """Each test sees the plant's once-per-layout warning afresh."""
-    _WARNED_LAYOUTS.clear()
-    yield
-    _WARNED_LAYOUTS.clear()
-
 
 #: Half-diagonals of the diamond (m): the casters at (+-A, 0), the wheels at (0, +-B).
 A, B = 0.225, 0.175
 DIAMOND = Robot(caster_positions=((A, 0.0), (-A, 0.0)), payload=2.5)
-#: An arm pose the QP reached on the sideways reach with this robot: S = 1.78 on the
-#: footprint, while the diamond's right-front edge keeps 3 % of the weight.
+#: An arm pose the QP reached on the sideways reach with this robot when S was measured on
+#: the footprint (1.78 there): S = 1.07 on the diamond, whose right-front edge keeps 3 % of
+#: the weight.
 POSE = (-0.839, 0.948)
 
 
@@ -61,26 +51,16 @@ def test_the_diamonds_edge_loads_are_the_closed_form():
 def test_mujoco_carries_the_diamonds_edge_loads_as_the_model_says():
     """At rest in the pose, the floor's normal forces on the supports off each edge sum to
     the model's edge load within 1 N (0.45 N measured; the tyres' lean moves the centre of
-    mass by about a millimetre), although S on the footprint is 1.78."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)  # the footprint warning, tested below
-        plant = MujocoPlant(DIAMOND)
+    mass by about a millimetre), with S on the diamond 1.07."""
+    plant = MujocoPlant(DIAMOND)
     plant.reset(np.array([0.0, 0.0, 0.0, *POSE]), 0.02)
     forces, _ = plant.support_forces()
     model = EdgeLoadModel.from_robot(DIAMOND)
     points = [s.point for s in plant.supports]
     measured = model.polygon.off_edge(points) @ forces
     assert measured == pytest.approx(model.static_loads(*POSE), abs=1.0)
-    assert stability_terms(DIAMOND.com_coefficients, *POSE)[2] == pytest.approx(1.783, abs=1e-3)
+    assert stability_terms(DIAMOND.com_coefficients, *POSE)[2] == pytest.approx(1.072, abs=1e-3)
     assert min(measured) < 0.05 * DIAMOND.total_mass * GRAVITY_M_S2
-
-
-def test_s_overstates_the_diamond_up_to_twice():
-    """Towards a footprint corner (A, B) the diamond's edge ``x/A + y/B = 1`` is reached at
-    half the corner's offset: there S = 2 and the robot tips."""
-    geometry = SupportGeometry(support_points(DIAMOND))
-    assert footprint_excess(geometry, A, B) == pytest.approx(2.0, abs=1e-12)
-    assert footprint_excess(SupportGeometry(support_points(Robot())), A, B) == 1.0
 
 
 @pytest.mark.parametrize(
@@ -88,32 +68,13 @@ def test_s_overstates_the_diamond_up_to_twice():
     [
         None,  # the footprint's corners: the polygon is the footprint
         ((0.3, 0.2), (0.3, -0.2), (-0.3, 0.2), (-0.3, -0.2)),  # outriggers
+        ((A, 0.0), (-A, 0.0)),  # the diamond
+        ((A, B), (A, -B), (-A, 0.0)),  # a tricycle
+        ((A, B), (A, -B), (-0.75 * A, B), (-0.75 * A, -B)),  # a short back
     ],
 )
-def test_layouts_that_span_the_footprint_build_silently(casters):
+def test_every_layout_builds_silently(casters):
+    """S is measured on the support polygon itself: nothing to warn about."""
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         MujocoPlant(Robot(caster_positions=casters))
-
-
-@pytest.mark.parametrize(
-    ("casters", "excess"),
-    [
-        (((A, 0.0), (-A, 0.0)), "2"),
-        (((A, B), (A, -B), (-A, 0.0)), "2"),  # a tricycle: the back corners are off it
-        (((A, B), (A, -B), (-0.75 * A, B), (-0.75 * A, -B)), "1.33"),  # a short back
-    ],
-)
-def test_the_plant_warns_where_s_overstates_the_polygon(casters, excess):
-    """Once per layout: a run builds its plant twice (its default step asks one for the
-    engine's timestep) and QP solves in between reset Python's memory of shown warnings."""
-    robot = Robot(caster_positions=casters)
-    with pytest.warns(UserWarning) as caught:
-        MujocoPlant(robot)
-        with warnings.catch_warnings():
-            pass
-        MujocoPlant(robot.with_payload(2.0))
-    messages = [str(w.message) for w in caught]
-    assert len(messages) == 1 and "\n" not in messages[0]
-    assert messages[0].startswith("caster_positions: ")
-    assert f"the robot can tip at S = {excess} " in messages[0]

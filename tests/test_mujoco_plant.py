@@ -209,7 +209,7 @@ def test_a_diverged_engine_state_names_the_step(tmp_path, monkeypatch):
     plant = fresh()
     hold(plant, np.zeros(4), 3 * DT)
     plant.data.qvel[0] = 1e20  # far beyond what MuJoCo accepts: it flags a bad state
-    with pytest.raises(PlantDivergedError, match=r"in control step 3 \(t = 0.06 to 0.08 s\)"):
+    with pytest.raises(PlantDivergedError, match=r"in control step 4 \(t = 0.06 to 0.08 s\)"):
         plant.step(3 * DT, np.zeros(4), DT)
     assert not (tmp_path / "MUJOCO_LOG.TXT").exists()  # the warning went to logging
 

@@ -5,7 +5,8 @@ when the state was entered (``Percept.hold``) while the base moves under it:
 
 * lateral risk (``S_lat <= S_lon``, the centre of mass is off to the side): turn the base in
   place to face the end effector, forwards or backwards whichever is nearer (the
-  rectangular footprint is longer than wide, so this raises the counter moment);
+  support polygon is longer than wide on the default robot, so this raises the counter
+  moment);
 * longitudinal risk: drive ``adjust`` metres toward the end effector along the heading
   (forward if the centre of mass is in front, else backward), shortening the lever arm.
 """

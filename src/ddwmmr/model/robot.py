@@ -6,6 +6,7 @@ Units are SI throughout: metres, kilograms, radians, seconds.
 
 from __future__ import annotations
 
+import functools
 import math
 import warnings
 from dataclasses import dataclass, field, fields, replace
@@ -30,7 +31,7 @@ from ddwmmr.errors import (
     shown,
     texts_apart,
 )
-from ddwmmr.model import kinematics, stability
+from ddwmmr.model import kinematics, stability, support_loads
 from ddwmmr.model.mass import YawInertia, total_mass
 
 _PI = math.pi
@@ -141,17 +142,21 @@ class Robot:
             each angle within its ``joint_limits`` range.
 
     Physical fields, used by the physics plant (:class:`ddwmmr.plants.MujocoPlant`, see
-    docs/physics.md) and ignored by the kinematic and thesis plants:
+    docs/physics.md) and ignored by the kinematic and thesis plants, but for the casters,
+    whose support polygon the stability margin S is measured on everywhere:
 
     Attributes:
         caster_positions: base-frame contact points ``((x, y), ...)`` (m) of the passive,
             frictionless casters. ``None`` (default) puts one at each footprint corner
-            ``(+-base_length/2, +-base_width/2)``: with the wheels on the footprint's side
-            edges (``track_width <= base_width``) the support polygon is then exactly the
-            footprint that the stability margin S uses (see :attr:`casters`). Each point
-            must lie within :data:`CASTER_REACH` times the footprint's half-diagonal of the
-            base centre (the axle midpoint): casters sit on the base or on short outriggers
-            (twice the half-diagonal is 0.57 m for the thesis base), not metres away.
+            ``(+-base_length/2, +-base_width/2)`` (see :attr:`casters`). The convex hull of
+            the wheels' and casters' contact points is the support polygon, on which S is
+            measured (docs/theory.md, "Tip-over stability"): with the default casters and
+            the wheels within the footprint (``track_width <= base_width``) it is the
+            footprint. It must hold the base centre (the axle midpoint) strictly inside,
+            and each point must lie within :data:`CASTER_REACH` times the footprint's
+            half-diagonal of the base centre: casters sit on the base or on short
+            outriggers (twice the half-diagonal is 0.57 m for the thesis base), not metres
+            away.
         wheel_mass: mass of each drive wheel (kg), part of ``base_mass`` (so the total
             mass and S are unchanged); ``2 wheel_mass < base_mass``.
         base_height: height of the base box (m); sets its roll/pitch inertia.
@@ -228,8 +233,23 @@ class Robot:
                 self.base_mass,
                 self.base_length,
                 self.base_width,
+                self._support_edges(),
             ),
         )
+
+    def _support_edges(self) -> stability.SupportEdges:
+        """The edges of the wheels' and casters' support polygon, on which S is measured;
+        :class:`ParameterError` (one line, naming ``caster_positions``) when it does not
+        hold the base centre strictly inside (docs/theory.md, "Tip-over stability")."""
+        points = support_loads.support_points(self)
+        edges = _support_edges(points)
+        if edges is None:
+            raise ParameterError(
+                "caster_positions: the base centre must lie strictly inside the support "
+                "polygon of the wheels and casters (the stability margin S measures the "
+                f"centre of mass's offset from it) (got casters {self.casters})"
+            )
+        return edges
 
     def _check_magnitudes(self) -> None:
         """Documented physical ranges (ddwmmr.errors) of the joint limits and casters (the
@@ -421,7 +441,8 @@ class Robot:
         return stability.manipulability(float(_configuration(q)[4]))
 
     def stability(self, q) -> tuple[float, float, float]:
-        """Tip-over stability ``(S_lon, S_lat, S)``; ``S > 1`` is stable (capped at 10)."""
+        """Tip-over stability ``(S_lon, S_lat, S)`` on the support polygon; ``S > 1`` is
+        stable (capped at 10)."""
         q = _configuration(q)
         return stability.stability_terms(self._com, float(q[3]), float(q[4]))
 
@@ -659,6 +680,21 @@ def _configuration_slow(q, name: str) -> list[float]:
         raise ParameterError(f"{wanted} (got {array.tolist()})")
     values = array.tolist()
     return kinematics.check_angles(values, name) if name == "q" else values
+
+
+@functools.lru_cache(maxsize=64)
+def _support_edges(points: tuple[tuple[float, float], ...]) -> stability.SupportEdges | None:
+    """:class:`~ddwmmr.model.stability.SupportEdges` of the support points (m, base frame),
+    None when they span no polygon holding the base centre farther than
+    :data:`~ddwmmr.model.support_loads.ON_EDGE_TOLERANCE_M` from every edge. Cached: a
+    payload sweep builds many robots on one layout."""
+    try:
+        polygon = support_loads.SupportPolygon.from_points(points)
+    except ValueError:  # fewer than three points off a line
+        return None
+    if not float(np.min(-polygon.offsets)) > support_loads.ON_EDGE_TOLERANCE_M:
+        return None
+    return stability.SupportEdges.from_lines(polygon.normals, polygon.offsets, polygon.vertices)
 
 
 def _points(value) -> tuple[tuple[float, float], ...]:

@@ -9,12 +9,21 @@ of mass of links (their midpoints) and payload (at the end effector) is
 
 with ``A = (m1/2 + m2 + mp) L1 / M`` and ``B = (m2/2 + mp) L2 / M`` (the base's own centre of
 mass is at the origin and contributes nothing). The stability margin is the ratio of the
-counter moment to the tipping moment about each footprint edge:
+counter moment to the tipping moment about the edges of the support polygon (the convex
+hull of wheels and casters, which holds the base centre strictly inside): with ``n_e`` an
+edge's outward unit normal and ``d_e > 0`` its line's distance from the base centre,
 
-    S_lon = (length/2) / |x_com|,   S_lat = (width/2) / |y_com|,   S = min(S_lon, S_lat)
+    S = min over the edges e with n_e . c > 0 of  d_e / (n_e . c)
 
-``S > 1`` is statically stable. Values are capped at :data:`STABILITY_CAP` where the
-tipping moment vanishes.
+the factor by which the centre of mass c could move away from the base centre before it
+reaches an edge. ``S_lon`` is that minimum over the edges facing front or back (``|n_x| >=
+|n_y|``), ``S_lat`` over the others, ``S = min(S_lon, S_lat)``. For the rectangle ``|x| <=
+length/2, |y| <= width/2`` (the default: casters at the footprint's corners) it is
+
+    S_lon = (length/2) / |x_com|,   S_lat = (width/2) / |y_com|
+
+and this closed form is what is evaluated there. ``S > 1`` is statically stable. Values are
+capped at :data:`STABILITY_CAP` where the tipping moment vanishes.
 
 **Dynamic margin** (:func:`zero_moment_point`, :func:`dynamic_stability`): when the robot
 accelerates, the floor's centre of pressure is not below the centre of mass but at the zero
@@ -95,14 +104,87 @@ def warn_start_below_floor(method: str, robot, q0, floor: float) -> None:
     )
 
 
+#: An edge of the support polygon as S measures it, ``(n_x, n_y, d)``: its outward unit
+#: normal (base frame) and the distance ``d > 0`` (m) of its line from the base centre. The
+#: centre of mass c reaches the edge's line when ``n . c = d``.
+Edge = tuple[float, float, float]
+
+
+def is_longitudinal(n_x: float, n_y: float) -> bool:
+    """Whether an edge with normal ``(n_x, n_y)`` faces front or back (``|n_x| >= |n_y|``):
+    it belongs to ``S_lon``, else to ``S_lat``."""
+    return abs(n_x) >= abs(n_y)
+
+
+@dataclass(frozen=True)
+class SupportEdges:
+    """The edges of a support polygon that holds the base centre strictly inside, as S
+    measures them (module docstring). Build it with :meth:`from_lines`.
+
+    Attributes:
+        lon: the edges facing front or back (:func:`is_longitudinal`), ``S_lon``'s.
+        lat: the other edges, ``S_lat``'s.
+        radius: the largest distance (m) of a vertex from the base centre.
+        rectangle: ``(half_length, half_width)`` (m) when the polygon is exactly the
+            rectangle ``|x| <= half_length, |y| <= half_width`` (S's closed form), else None.
+    """
+
+    lon: tuple[Edge, ...]
+    lat: tuple[Edge, ...]
+    radius: float
+    rectangle: tuple[float, float] | None
+
+    @classmethod
+    def from_lines(cls, normals, offsets, vertices) -> SupportEdges:
+        """The edges of a convex polygon given as :class:`~ddwmmr.model.support_loads.
+        SupportPolygon` has it: inward unit normals (k, 2) and offsets (k,) with ``d_e(p) =
+        normal . p - offset`` (m, inside > 0), and its vertices (k, 2) in m.
+
+        Raises:
+            ValueError: when the base centre is not strictly inside (some ``d_e(0) <= 0``):
+                S is not defined there (docs/theory.md, "Tip-over stability").
+        """
+        edges = [(-float(n[0]), -float(n[1]), -float(o)) for n, o in zip(normals, offsets)]
+        if not all(d > 0.0 for _, _, d in edges):
+            raise ValueError("the base centre must lie strictly inside the support polygon")
+        lon = tuple(e for e in edges if is_longitudinal(e[0], e[1]))
+        lat = tuple(e for e in edges if not is_longitudinal(e[0], e[1]))
+        radius = max(math.hypot(float(x), float(y)) for x, y in vertices)
+        return cls(lon, lat, radius, _rectangle(lon, lat))
+
+
+def _rectangle(lon: tuple[Edge, ...], lat: tuple[Edge, ...]) -> tuple[float, float] | None:
+    """``(half_length, half_width)`` of edges that bound exactly ``|x| <= half_length, |y|
+    <= half_width``, else None."""
+    if len(lon) != 2 or len(lat) != 2:
+        return None
+    if sorted((n_x, n_y) for n_x, n_y, _ in lon) != [(-1.0, 0.0), (1.0, 0.0)]:
+        return None
+    if sorted((n_x, n_y) for n_x, n_y, _ in lat) != [(0.0, -1.0), (0.0, 1.0)]:
+        return None
+    if lon[0][2] != lon[1][2] or lat[0][2] != lat[1][2]:
+        return None
+    return lon[0][2], lat[0][2]
+
+
 @dataclass(frozen=True)
 class ComCoefficients:
-    """Coefficients ``A``, ``B`` (m) of the arm+payload centre of mass in the base frame."""
+    """Coefficients ``A``, ``B`` (m) of the arm+payload centre of mass in the base frame,
+    and the support polygon S is measured on.
+
+    Attributes:
+        A, B: the centre of mass's levers (m; module docstring).
+        half_length, half_width: the rectangle ``|x| <= half_length, |y| <= half_width``
+            (m) S is measured on when ``edges`` is None (closed form); the footprint's
+            half extents otherwise, which S does not use.
+        edges: the support polygon's edges when it is not such a rectangle, else None.
+    """
 
     A: float
     B: float
     half_length: float
     half_width: float
+    edges: SupportEdges | None = None
 
 
 def com_coefficients(
@@ -114,14 +196,24 @@ def com_coefficients(
     base_mass: float,
     base_length: float,
     base_width: float,
+    support: SupportEdges | None = None,
 ) -> ComCoefficients:
-    """Precompute the centre-of-mass coefficients for :func:`stability_terms`."""
+    """Precompute the centre-of-mass coefficients for :func:`stability_terms`: S on the
+    polygon ``support`` (:class:`SupportEdges`; None: the footprint ``base_length x
+    base_width``, m, centred on the base centre)."""
     total = total_mass(base_mass, m1, m2, payload)
+    half_length, half_width, edges = 0.5 * base_length, 0.5 * base_width, None
+    if support is not None:
+        if support.rectangle is None:
+            edges = support
+        else:
+            half_length, half_width = support.rectangle
     return ComCoefficients(
         A=(0.5 * m1 + m2 + payload) * L1 / total,
         B=(0.5 * m2 + payload) * L2 / total,
-        half_length=0.5 * base_length,
-        half_width=0.5 * base_width,
+        half_length=half_length,
+        half_width=half_width,
+        edges=edges,
     )
 
 
@@ -139,8 +231,10 @@ def stability_terms(k: ComCoefficients, th1: float, th2: float) -> tuple[float, 
 
 
 def margins(k: ComCoefficients, x_com: float, y_com: float) -> tuple[float, float, float]:
-    """``(S_lon, S_lat, S)`` for a centre of mass ``(x_com, y_com)`` (m, base frame): each
-    term ``half extent / |offset|``, capped at :data:`STABILITY_CAP`."""
+    """``(S_lon, S_lat, S)`` for a centre of mass ``(x_com, y_com)`` (m, base frame) on
+    ``k``'s support polygon, each capped at :data:`STABILITY_CAP` (module docstring)."""
+    if k.edges is not None:
+        return polygon_margins(k.edges, x_com, y_com)
     offset, half = abs(x_com), k.half_length
     s_lon = STABILITY_CAP if offset * STABILITY_CAP <= half else half / offset
     offset, half = abs(y_com), k.half_width
@@ -148,12 +242,42 @@ def margins(k: ComCoefficients, x_com: float, y_com: float) -> tuple[float, floa
     return s_lon, s_lat, min(s_lon, s_lat)
 
 
+def support_margins(support: SupportEdges, x: float, y: float) -> tuple[float, float, float]:
+    """:func:`margins` of a point ``(x, y)`` (m, base frame) on the polygon ``support``:
+    the rectangle's closed form where it is one."""
+    if support.rectangle is None:
+        return polygon_margins(support, x, y)
+    return margins(ComCoefficients(0.0, 0.0, *support.rectangle), x, y)
+
+
+def polygon_margins(support: SupportEdges, x: float, y: float) -> tuple[float, float, float]:
+    """``(S_lon, S_lat, S)`` of a point ``(x, y)`` (m, base frame) on any polygon: each
+    term the least ``d / (n . c)`` of its edges, capped at :data:`STABILITY_CAP`."""
+    s_lon = edge_margin(support.lon, x, y)[0]
+    s_lat = edge_margin(support.lat, x, y)[0]
+    return s_lon, s_lat, min(s_lon, s_lat)
+
+
+def edge_margin(edges: tuple[Edge, ...], x: float, y: float) -> tuple[float, Edge | None]:
+    """The least capped ratio ``d / (n . c)`` over ``edges`` at ``c = (x, y)`` (m), and the
+    edge that has it (None when capped: no edge is within :data:`STABILITY_CAP`)."""
+    least, active = STABILITY_CAP, None
+    for edge in edges:
+        reach = edge[0] * x + edge[1] * y  # n . c, the offset towards the edge (m)
+        if reach * STABILITY_CAP > edge[2]:
+            ratio = edge[2] / reach
+            if ratio < least:
+                least, active = ratio, edge
+    return least, active
+
+
 def tips_in_every_pose(k: ComCoefficients) -> bool:
     """Whether no arm pose (joint limits aside) has ``S > 1``: the centre of mass is at
-    least ``|A - B|`` from the base centre in every pose, and a point inside the footprint
-    is closer than its half-diagonal. A sufficient test, not a necessary one: False does
-    not promise that some pose stands."""
-    return abs(k.A - k.B) >= math.hypot(k.half_length, k.half_width)
+    least ``|A - B|`` from the base centre in every pose, and a point inside the support
+    polygon is closer than its farthest vertex. A sufficient test, not a necessary one:
+    False does not promise that some pose stands."""
+    radius = math.hypot(k.half_length, k.half_width) if k.edges is None else k.edges.radius
+    return abs(k.A - k.B) >= radius
 
 
 def max_payload(robot, th1: float, th2: float) -> float:
@@ -187,10 +311,14 @@ def max_payload(robot, th1: float, th2: float) -> float:
 def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[float, float, float]:
     """``(S, dS/dth1, dS/dth2)`` of the capped margin ``S`` (zero gradient where capped).
 
-    At a tie between ``S_lon`` and ``S_lat`` the lateral term's gradient is returned.
+    At a tie between ``S_lon`` and ``S_lat`` the lateral term's gradient is returned; within
+    a term, the gradient of the edge that has its minimum (:func:`edge_margin`).
     """
     s1, c1 = math.sin(th1), math.cos(th1)
     s12, c12 = math.sin(th1 + th2), math.cos(th1 + th2)
+    if k.edges is not None:
+        lon, lat = polygon_terms_gradient(k, s1, c1, s12, c12)
+        return lat if lat[0] <= lon[0] else lon
     x_com = k.A * c1 + k.B * c12
     y_com = k.A * s1 + k.B * s12
     s_lon, s_lat, _ = margins(k, x_com, y_com)
@@ -204,6 +332,29 @@ def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[floa
         return s_lon, 0.0, 0.0
     factor = -s_lon / x_com
     return s_lon, factor * (-k.A * s1 - k.B * s12), factor * (-k.B * s12)
+
+
+def polygon_terms_gradient(
+    k: ComCoefficients, s1: float, c1: float, s12: float, c12: float
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """``((S_lon, dS_lon/dth1, dS_lon/dth2), (S_lat, ...))`` (1/rad) on ``k.edges`` (not
+    None) from ``sin/cos th1`` and ``sin/cos (th1 + th2)``: each term's gradient is its
+    active edge's, ``dS/dth = -S (n . dc/dth) / (n . c)``; zero where capped."""
+    x_com = k.A * c1 + k.B * c12
+    y_com = k.A * s1 + k.B * s12
+    dx1, dy1 = -k.A * s1 - k.B * s12, k.A * c1 + k.B * c12
+    dx2, dy2 = -k.B * s12, k.B * c12
+    terms = []
+    for edges in (k.edges.lon, k.edges.lat):
+        s, edge = edge_margin(edges, x_com, y_com)
+        if edge is None:
+            terms.append((s, 0.0, 0.0))
+            continue
+        factor = -s / (edge[0] * x_com + edge[1] * y_com)
+        terms.append(
+            (s, factor * (edge[0] * dx1 + edge[1] * dy1), factor * (edge[0] * dx2 + edge[1] * dy2))
+        )
+    return terms[0], terms[1]
 
 
 @dataclass(frozen=True)
@@ -299,13 +450,27 @@ def stability_arrays(
     th2 = np.asarray(th2, dtype=float)
     x_com = k.A * np.cos(th1) + k.B * np.cos(th1 + th2)
     y_com = k.A * np.sin(th1) + k.B * np.sin(th1 + th2)
-    s_lon = _ratio_array(k.half_length, x_com)
-    s_lat = _ratio_array(k.half_width, y_com)
+    if k.edges is not None:
+        s_lon = _edge_array(k.edges.lon, x_com, y_com)
+        s_lat = _edge_array(k.edges.lat, x_com, y_com)
+    else:
+        s_lon = _ratio_array(k.half_length, x_com)
+        s_lat = _ratio_array(k.half_width, y_com)
     return s_lon, s_lat, np.minimum(s_lon, s_lat)
 
 
-def _ratio_array(half_extent: float, offset: np.ndarray) -> np.ndarray:
-    magnitude = np.abs(offset)
+def _edge_array(edges: tuple[Edge, ...], x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """:func:`edge_margin`'s value over arrays of centre-of-mass coordinates (m)."""
+    least = np.full(np.broadcast(x, y).shape, STABILITY_CAP)
+    for n_x, n_y, d in edges:
+        least = np.minimum(least, _ratio_array(d, n_x * x + n_y * y, signed=True))
+    return least
+
+
+def _ratio_array(half_extent: float, offset: np.ndarray, signed: bool = False) -> np.ndarray:
+    """``half_extent / |offset|`` capped at :data:`STABILITY_CAP` (``half_extent /
+    offset``, capped where ``offset <= 0`` too, when ``signed``)."""
+    magnitude = offset if signed else np.abs(offset)
     capped = magnitude * STABILITY_CAP <= half_extent
     with np.errstate(divide="ignore"):
         return np.where(capped, STABILITY_CAP, half_extent / np.where(capped, 1.0, magnitude))

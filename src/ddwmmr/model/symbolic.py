@@ -94,18 +94,30 @@ def centre_of_mass(robot: Robot, q: Symbolic) -> Symbolic:
 
 
 def stability_terms(robot: Robot, q: Symbolic) -> Symbolic:
-    """The exact, uncapped ratios ``[S_lon, S_lat] = [(length/2)/|x_com|, (width/2)/|y_com|]``.
+    """The exact, uncapped terms ``[S_lon, S_lat]`` of the stability margin on the
+    robot's support polygon (:mod:`ddwmmr.model.stability`): on the rectangle ``[(length/2)
+    /|x_com|, (width/2)/|y_com|]``, on another polygon each term's least ``d_e / (n_e .
+    c)`` over its edges.
 
     Infinite where the corresponding moment vanishes; the numeric model caps at 10.
     """
     k = robot.com_coefficients
     com = centre_of_mass(robot, q)
-    return ca.vertcat(k.half_length / ca.fabs(com[0]), k.half_width / ca.fabs(com[1]))
+    if k.edges is None:
+        return ca.vertcat(k.half_length / ca.fabs(com[0]), k.half_width / ca.fabs(com[1]))
+    terms = []
+    for edges in (k.edges.lon, k.edges.lat):
+        term = ca.inf
+        for n_x, n_y, d in edges:
+            reach = n_x * com[0] + n_y * com[1]
+            term = ca.fmin(term, ca.if_else(reach > 0.0, d / reach, ca.inf))
+        terms.append(term)
+    return ca.vertcat(*terms)
 
 
 def stability_bounds(robot: Robot, stability_min: float) -> tuple[float, float]:
     """Bounds ``(x_max, y_max)`` (m) with ``S >= stability_min  <=>  |x_com| <= x_max and
-    |y_com| <= y_max``.
+    |y_com| <= y_max`` on the rectangle (:func:`stability_edges` is None).
 
     ``S_lon = hl/|x_com| >= S_min`` holds exactly when ``|x_com| <= hl/S_min`` (both sides
     are positive), and likewise for the lateral term. Constraining the centre of mass
@@ -115,6 +127,29 @@ def stability_bounds(robot: Robot, stability_min: float) -> tuple[float, float]:
     s_min = check_positive("stability_min", stability_min)
     k = robot.com_coefficients
     return k.half_length / s_min, k.half_width / s_min
+
+
+def stability_edges(
+    robot: Robot, stability_min: float
+) -> tuple[tuple[float, float, float, int], ...] | None:
+    """``S >= stability_min`` on a support polygon other than the rectangle as one linear
+    row per edge: ``(n_x, n_y, bound, term)`` with ``n_x x_com + n_y y_com <= bound`` (m),
+    ``term`` 0 for an edge of ``S_lon``, 1 of ``S_lat``. None on the rectangle, whose rows
+    are :func:`stability_bounds`'s box.
+
+    ``d_e / (n_e . c) >= S_min`` holds exactly when ``n_e . c <= d_e / S_min`` (``d_e >
+    0``; an edge with ``n_e . c <= 0`` meets both), so the rows are the exact nonlinear
+    condition, as the box is on the rectangle.
+    """
+    s_min = check_positive("stability_min", stability_min)
+    edges = robot.com_coefficients.edges
+    if edges is None:
+        return None
+    return tuple(
+        (n_x, n_y, d / s_min, term)
+        for term, group in enumerate((edges.lon, edges.lat))
+        for n_x, n_y, d in group
+    )
 
 
 def zero_moment_point(

@@ -610,24 +610,39 @@ def _next_slice(blocks: list[np.ndarray]) -> slice:
 def thesis_model(robot: Robot, dynamics: sym.ThesisDynamics, stability_min: float) -> ShootingModel:
     """The thesis plant's force-level model with its limits as a :class:`ShootingModel`.
 
-    Node rows: the centre of mass in the box of ``S >= stability_min`` and the wheel
-    speeds; interval rows: the centre of mass at ``INTERIOR_CHECKS`` points inside the
-    interval, where the joints have moved linearly (constant rates).
+    Node rows: the centre of mass in the box of ``S >= stability_min`` (on a support
+    polygon other than the rectangle: its offset towards each edge below the edge's bound,
+    :func:`~ddwmmr.model.symbolic.stability_edges`) and the wheel speeds; interval rows:
+    the same stability rows at ``INTERIOR_CHECKS`` points inside the interval, where the
+    joints have moved linearly (constant rates).
     """
     limit = robot.wheel_speed_limit
     x_max, y_max = sym.stability_bounds(robot, stability_min)
+    edges = sym.stability_edges(robot, stability_min)  # None: the rectangle's box
+
+    def held(q):
+        """What the stability rows bound: the centre of mass, or its offset towards each
+        edge of the support polygon (m)."""
+        com = sym.centre_of_mass(robot, q)
+        if edges is None:
+            return com
+        return ca.vertcat(*(n_x * com[0] + n_y * com[1] for n_x, n_y, _, _ in edges))
 
     def node_rows(x):
-        return ca.vertcat(sym.centre_of_mass(robot, x[:5]), sym.wheel_speeds(robot, x[5], x[6]))
+        return ca.vertcat(held(x[:5]), sym.wheel_speeds(robot, x[5], x[6]))
 
     def interval_rows(x, u, h):
         points = []
         for frac in np.arange(1, INTERIOR_CHECKS + 1) / (INTERIOR_CHECKS + 1):
             moved = ca.vertcat(x[:3], x[3:5] + frac * h * u[2:4])
-            points.append(sym.centre_of_mass(robot, moved))
+            points.append(held(moved))
         return ca.vertcat(*points)
 
     box = np.array([x_max, y_max])
+    box_low = -box
+    if edges is not None:
+        box = np.array([bound for _, _, bound, _ in edges])
+        box_low = np.full(box.size, -np.inf)
     rate = min(dynamics.joint_speed, robot.joint_speed_limit)
     (lo1, hi1), (lo2, hi2) = robot.joint_limits
     inf = np.inf
@@ -641,11 +656,11 @@ def thesis_model(robot: Robot, dynamics: sym.ThesisDynamics, stability_min: floa
         x_upper=np.array([inf, inf, inf, hi1, hi2, inf, inf]),
         node_rows=node_rows,
         node_bounds=(
-            np.concatenate([-box, [-limit, -limit]]),
+            np.concatenate([box_low, [-limit, -limit]]),
             np.concatenate([box, [limit, limit]]),
         ),
         interval_rows=interval_rows,
-        interval_bounds=(np.tile(-box, INTERIOR_CHECKS), np.tile(box, INTERIOR_CHECKS)),
+        interval_bounds=(np.tile(box_low, INTERIOR_CHECKS), np.tile(box, INTERIOR_CHECKS)),
     )
 
 

@@ -42,7 +42,10 @@ stage (``gap_k`` then ``path_k``)::
 written through ``x_{k+1} = RK4(x_k, u_k, h_k)`` so that each row involves one stage's
 variables only. ``S = stability_min + stability_margin``; the box on the centre of mass is
 the exact condition ``S_lon, S_lat >= S`` (see :func:`ddwmmr.model.symbolic.
-stability_bounds`): the nonlinear stability margin at every node, not a linearisation.
+stability_bounds`): the nonlinear stability margin at every node, not a linearisation. On a
+support polygon other than the rectangle the box is one row per edge, ``n_e . c -
+sigma_term <= d_e / S`` (:func:`ddwmmr.model.symbolic.stability_edges`), the same exact
+condition.
 With ``dynamic_stability`` (force-level model only) every edge e of the support polygon
 keeps a least normal load, at both ends of every interval under that interval's input (so
 ``u_0`` itself is bounded at the measured state)::
@@ -118,7 +121,7 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
-from ddwmmr.model.stability import GRAVITY_M_S2, STABILITY_FLOOR
+from ddwmmr.model.stability import GRAVITY_M_S2, STABILITY_FLOOR, is_longitudinal
 from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, EdgeLoadModel
 from ddwmmr.mpc.models import PredictionModel
 from ddwmmr.qp.limits.obstacles import Circle
@@ -357,7 +360,9 @@ class ShootingOCP:
         xs = [self.w[s] for s in self.x_slices]
         us = [self.w[s] for s in self.u_slices]
         slacks = [self.w[s] for s in self.slack_slices]
-        x_max, y_max = sym.stability_bounds(robot, config.stability_min + config.stability_margin)
+        floor = config.stability_min + config.stability_margin
+        x_max, y_max = sym.stability_bounds(robot, floor)
+        edges = sym.stability_edges(robot, floor)  # None: the rectangle's box
         clear = [
             (c.x, c.y, (c.radius + config.base_radius + config.obstacle_margin) ** 2)
             for c in config.obstacles
@@ -379,6 +384,12 @@ class ShootingOCP:
             slack = slacks[k]
             rows, low, high = [], [], []
             for point in self._stability_points(k, x_next):
+                if edges is not None:
+                    for n_x, n_y, bound, term in edges:
+                        rows.append(n_x * point[0] + n_y * point[1] - slack[term])
+                        low.append(-INF)
+                        high.append(bound)
+                    continue
                 rows += [point[0] + slack[0], point[0] - slack[0]]
                 rows += [point[1] + slack[1], point[1] - slack[1]]
                 low += [-x_max, -INF, -y_max, -INF]
@@ -488,7 +499,7 @@ class ShootingOCP:
         longitudinal (0) or lateral (1) stability box by the edge's normal."""
         rows = []
         for e, (normal, depth) in enumerate(zip(polygon.normals, polygon.depths)):
-            slack = 0 if abs(normal[0]) >= abs(normal[1]) else 1
+            slack = 0 if is_longitudinal(normal[0], normal[1]) else 1
             lever = float(depth) / weight
             rows.append((loads[e] * lever, slack, self.config.min_edge_load * float(depth)))
         return rows

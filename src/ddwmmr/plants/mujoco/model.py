@@ -79,6 +79,22 @@ MAX_ENGINE_STEPS_PER_CONTROL_STEP = 10_000
 DEFAULT_FRICTION = 1.0
 DEFAULT_SERVO_TIME_CONSTANT = 0.02
 DEFAULT_CONTACT_TIME_CONSTANT = 0.01
+#: Allowed wheel-floor sliding friction: from PTFE or wet ice (~0.02) to soft rubber on a
+#: grippy floor (~2), with room either side; outside it a wheel either never grips or
+#: never slips, which no floor does.
+FRICTION_RANGE = (0.01, 5.0)
+#: Allowed servo time constant (s): a motor's velocity loop settles in milliseconds; 1 ms
+#: is faster than any electric drive, and a servo slower than 1 s no longer follows a
+#: control step's command.
+SERVO_TIME_CONSTANT_RANGE_S = (1e-3, 1.0)
+#: Allowed contact time constant (s), at least 2 timesteps besides: the contacts' static
+#: sink grows with its square (~0.05 mm at the default 10 ms); at 50 ms it is ~1 mm, the
+#: tyres' own deflection, and a softer floor is a mattress, not a floor.
+CONTACT_TIME_CONSTANT_RANGE_S = (2.0 * TIMESTEP_RANGE_S[0], 0.05)
+#: Allowed tyre stiffness (N/m), or 0 for rigid wheels: 1e4 N/m lets the default robot's
+#: tyre sink 4-5 mm under its share of the weight (a very soft tyre); 1e8 N/m, half a
+#: micrometre, is a steel wheel (stiffer than the contact itself: use 0).
+TYRE_STIFFNESS_RANGE = (1e4, 1e8)
 DEFAULT_CONE = "elliptic"
 CONES = ("pyramidal", "elliptic")
 #: Radial stiffness (N/m) of each drive wheel's tyre: a small robot's solid rubber tyre
@@ -117,16 +133,23 @@ class EngineOptions:
     Attributes:
         timestep: engine step (s), in :data:`TIMESTEP_RANGE_S`; the control step must be a
             whole multiple of it, at most :data:`MAX_ENGINE_STEPS_PER_CONTROL_STEP` of them.
-        friction: sliding friction coefficient between the wheels and the floor.
-        servo_time_constant: time constant of the velocity servos (s), sets their gains.
+        friction: sliding friction coefficient between the wheels and the floor, in
+            :data:`FRICTION_RANGE`.
+        servo_time_constant: time constant of the velocity servos (s), sets their gains;
+            in :data:`SERVO_TIME_CONSTANT_RANGE_S`.
         cone: friction cone, ``"elliptic"`` (default: MuJoCo's exact Coulomb cone) or
             ``"pyramidal"`` (MuJoCo's default, four facets; a lightly loaded slipping
             wheel chatters on and off the floor under it, docs/physics.md).
         contact_time_constant: time constant of the contacts' soft constraint (s, MuJoCo's
             ``solref[0]``, critically damped): smaller is stiffer (less sinking and
-            tilting under load) and needs a smaller timestep (at least 2 timesteps).
-        tyre_stiffness: radial stiffness of each drive wheel's tyre (N/m, > 0), or 0 for
-            a rigid wheel (the contact's own compliance only).
+            tilting under load) and needs a smaller timestep (at least 2 timesteps); in
+            :data:`CONTACT_TIME_CONSTANT_RANGE_S`.
+        tyre_stiffness: radial stiffness of each drive wheel's tyre (N/m, in
+            :data:`TYRE_STIFFNESS_RANGE`), or 0 for a rigid wheel (the contact's own
+            compliance only).
+
+    Each option outside its range (or the cone not one of :data:`CONES`) raises a one-line
+    :class:`ParameterError` naming the option and the range.
     """
 
     timestep: float = DEFAULT_TIMESTEP
@@ -137,22 +160,43 @@ class EngineOptions:
     tyre_stiffness: float = DEFAULT_TYRE_STIFFNESS
 
     def __post_init__(self) -> None:
-        for name in ("timestep", "friction", "servo_time_constant", "contact_time_constant"):
-            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
-        check_range("timestep", self.timestep, *TIMESTEP_RANGE_S, "s")
-        stiffness = self.tyre_stiffness
-        if not (isinstance(stiffness, int | float) and math.isfinite(stiffness) and stiffness >= 0):
-            raise ParameterError(
-                f"tyre_stiffness must be >= 0 N/m (0: rigid wheels) (got {stiffness!r})"
-            )
-        object.__setattr__(self, "tyre_stiffness", float(stiffness))
+        timestep = check_positive("timestep", self.timestep)
+        check_range("timestep", timestep, *TIMESTEP_RANGE_S, "s")
+        object.__setattr__(self, "timestep", timestep)
+        for name, (low, high), unit in (
+            ("friction", FRICTION_RANGE, ""),
+            ("servo_time_constant", SERVO_TIME_CONSTANT_RANGE_S, "s"),
+            ("contact_time_constant", CONTACT_TIME_CONSTANT_RANGE_S, "s"),
+        ):
+            object.__setattr__(self, name, check_range(name, getattr(self, name), low, high, unit))
+        object.__setattr__(self, "tyre_stiffness", _checked_stiffness(self.tyre_stiffness))
         if self.cone not in CONES:
             raise ParameterError(f"cone must be one of {', '.join(CONES)} (got {shown(self.cone)})")
         if self.contact_time_constant < 2.0 * self.timestep:
+            default = (
+                ", its default: set it along with the timestep"
+                if self.contact_time_constant == DEFAULT_CONTACT_TIME_CONSTANT
+                else ""
+            )
             raise ParameterError(
                 f"contact_time_constant must be >= 2 timesteps = {2 * self.timestep:g} s "
-                f"(got {self.contact_time_constant:g})"
+                f"(got {self.contact_time_constant:g}{default})"
             )
+
+
+def _checked_stiffness(stiffness: float) -> float:
+    """``tyre_stiffness`` as a float: 0 (rigid wheels) or in :data:`TYRE_STIFFNESS_RANGE`."""
+    low, high = TYRE_STIFFNESS_RANGE
+    if not (
+        isinstance(stiffness, int | float)
+        and not isinstance(stiffness, bool)
+        and (stiffness == 0 or low <= stiffness <= high)
+    ):
+        raise ParameterError(
+            f"tyre_stiffness must be 0 (rigid wheels) or in [{low:g}, {high:g}] N/m "
+            f"(got {shown(stiffness)})"
+        )
+    return float(stiffness)
 
 
 _CORNER_NAMES = ("front_left", "front_right", "back_left", "back_right")

@@ -24,14 +24,13 @@ from __future__ import annotations
 
 import logging
 import math
-import warnings
 from typing import Any
 
 import mujoco
 import numpy as np
 
 from ddwmmr.commands import VELOCITY, WheelForces
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, check_range, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration, wrap_angle
 from ddwmmr.plants.base import (
@@ -43,6 +42,7 @@ from ddwmmr.plants.base import (
 from ddwmmr.plants.kinematic import KinematicPlant
 from ddwmmr.plants.mujoco.model import (
     ACTUATORS,
+    DEFAULT_TIMESTEP,
     MAX_ENGINE_STEPS_PER_CONTROL_STEP,
     TIMESTEP_RANGE_S,
     TYRE_DAMPING_RATIO,
@@ -51,7 +51,7 @@ from ddwmmr.plants.mujoco.model import (
     reflected_inertias,
     supports,
 )
-from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure, footprint_excess
+from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
 from ddwmmr.plants.thesis import arm_step, damped_base_envelope
 from ddwmmr.registry import register_plant
 
@@ -72,6 +72,13 @@ LIFT_TIME_S = 0.1
 #: ... and by at least this much (rad) since it began (a flat, noisy tilt is not pivoting;
 #: a base tipping at S = 0.98 gains 9e-4 rad in its first 0.1 s) ...
 PIVOT_GROWTH_RAD = 1e-4
+#: ... without slowing down: the tilt rate over the last sample is at least the mean rate
+#: since the pivot began, less this share (rounding). Gravity pulls a base pivoting with
+#: its centre of mass inside the edge back, so its tilt decelerates and it rocks back onto
+#: its supports; one with the centre of mass beyond the edge, or pushed on harder than
+#: gravity pulls back, keeps accelerating (docs/physics.md, "Tip-over from the contact
+#: forces") ...
+PIVOT_RATE_TOLERANCE = 1e-6
 #: ... or the base tilted beyond this angle (rad; 5.7 deg, far beyond the contacts' own
 #: compliance: a base at rest leans at most ~6e-4 rad into its contacts).
 TIP_TILT_RAD = 0.1
@@ -93,6 +100,22 @@ _WARNINGS = (
     mujoco.mjtWarning.mjWARN_BADQACC,
     mujoco.mjtWarning.mjWARN_BADQPOS,
     mujoco.mjtWarning.mjWARN_BADQVEL,
+    mujoco.mjtWarning.mjWARN_BADCTRL,
+)
+#: A speed beyond this many times the fastest the robot's motors drive that degree of
+#: freedom is a blown-up state (:meth:`MujocoPlant._speed_bounds`): a robot within its
+#: limits stays near 1 times (the default robot's tracking runs below 1.05, a robot
+#: falling over below 10), while a state blowing up passes it within a step or two, long
+#: before it turns non-finite or the engine flags it (docs/physics.md, "The plant").
+SPEED_BOUND_FACTOR = 10.0
+#: What to do about a diverged state, for messages: the engine step is the API's option
+#: (the command-line tools run at the default 2 ms).
+_SMALLER_STEP = (
+    f"the engine step is too long for this robot's masses or stiffnesses, or a command "
+    f"drove it beyond its limits; give it heavier parts, or (the API) a smaller timestep: "
+    f"MujocoPlant(robot, timestep=...) or simulate(..., plant_options={{'timestep': ...}}) "
+    f"in [{TIMESTEP_RANGE_S[0]:g}, {TIMESTEP_RANGE_S[1]:g}] s; the command-line tools run "
+    f"at the default {DEFAULT_TIMESTEP:g} s"
 )
 
 
@@ -105,24 +128,25 @@ class MujocoPlant:
         timestep: engine step (s), default 0.002, in [1e-5, 0.01]
             (:data:`~ddwmmr.plants.mujoco.model.TIMESTEP_RANGE_S`; docs/physics.md,
             "Settings"); a control step is a whole multiple of it, at most 10,000 of them.
-        friction: wheel-floor sliding friction coefficient.
-        servo_time_constant: response time of the velocity servos (s).
+        friction: wheel-floor sliding friction coefficient, in [0.01, 5].
+        servo_time_constant: response time of the velocity servos (s), in [1e-3, 1].
         cone: MuJoCo friction cone, ``"elliptic"`` (default, Coulomb's) or ``"pyramidal"``.
-        contact_time_constant: stiffness of the contacts as a time constant (s).
+        contact_time_constant: stiffness of the contacts as a time constant (s), in
+            [2e-5, 0.05] and at least 2 timesteps.
         tyre_stiffness: radial stiffness of each drive wheel's tyre (N/m; default 5e4,
-            0 for rigid wheels).
+            in [1e4, 1e8], or 0 for rigid wheels).
         base_damping: ``(c_translation N s/m, c_yaw N m s/rad)`` viscous damping of the
             base's horizontal and yaw motion (the thesis plant's c1, c2: rolling resistance
-            and drive friction as the thesis models them); None (default): none, the
-            engine's own friction only. Force-level controllers tuned on the thesis plant
-            (its PD gains assume that damping) need it.
+            and drive friction as the thesis models them), each in [0, 1000]
+            (:data:`BASE_DAMPING_MAX`); None (default): none, the engine's own friction
+            only. Force-level controllers tuned on the thesis plant (its PD gains assume
+            that damping) need it.
+
+    The ranges are physical (:class:`~ddwmmr.plants.mujoco.model.EngineOptions`;
+    docs/physics.md, "Settings").
 
     Raises:
         ParameterError: for a robot or option MuJoCo cannot build (one line).
-
-    Warns (``UserWarning``, once per layout) when ``caster_positions`` leave a corner of
-    the footprint outside the support polygon: S then overstates the margin the robot has
-    here (:func:`~ddwmmr.plants.mujoco.support.footprint_excess`).
     """
 
     def __init__(
@@ -152,7 +176,6 @@ class MujocoPlant:
         self.data = mujoco.MjData(self.model)
         self.supports = supports(robot)
         self.geometry = SupportGeometry([s.point for s in self.supports])
-        _warn_footprint(robot, self.geometry)
         self.extra_columns = (
             "min_support_force_n",
             *(f"support_force_{s.name}_n" for s in self.supports),
@@ -174,6 +197,8 @@ class MujocoPlant:
         self._substeps = 0
         self._step_count = 0
         self._warnings = 0
+        self._bad_controls = 0  # the engine's count of rejected controls, as last seen
+        self._bounds, self._bound_names = self._speed_bounds()
         self._phi = 0.0
         self._cache: tuple[float, ...] | None = None
         self._contacts: tuple[list[int], list[float]] | None = None  # of the current state
@@ -303,6 +328,7 @@ class MujocoPlant:
         # into its contacts without bouncing or rocking (a pose close to S = 1 would
         # otherwise rock onto its edge and back).
         self._warnings = self._warning_count()
+        self._bad_controls = int(data.warning[mujoco.mjtWarning.mjWARN_BADCTRL].number)
         model.dof_damping[0:6] = self._settle_damping
         tyres = self._ids["tyre_dofs"]
         running = model.dof_damping[tyres].copy()
@@ -397,8 +423,9 @@ class MujocoPlant:
         else:
             self._velocity_controls(q, np.array(checked))
         mujoco.mj_step(self.model, self.data, substeps)
-        self._check_state(f"in control step {self._step_count} (t = {t:.6g} to {t + dt:.6g} s)")
-        self._step_count += 1
+        self._step_count += 1  # counted from 1, as the run's diverged_at_step
+        where = f"in control step {self._step_count} (t = {t:.6g} to {t + dt:.6g} s)"
+        self._check_state(where, checked)
         mujoco.mj_forward(self.model, self.data)
         self._phi += wrap_angle(_heading(self.data.qpos[3:7]) - self._phi)
         self._cache = self._contacts = None
@@ -482,33 +509,89 @@ class MujocoPlant:
 
     def _unsettled(self) -> str:
         """Why the robot could not settle at reset: the engine step is too long for its
-        masses (one line, naming them and the timestep's range)."""
-        r = self.robot
+        masses or for the stiffness of its tyres and contacts (one line, naming them and
+        the timestep's range)."""
+        r, options = self.robot, self.options
         links = ", ".join(f"{m:g}" for m in r.link_masses)
         low, high = TIMESTEP_RANGE_S
         return (
-            f"MuJoCo cannot settle this robot at timestep {self.options.timestep:g} s (its "
+            f"MuJoCo cannot settle this robot at timestep {options.timestep:g} s (its "
             f"state diverged at reset): base_mass {r.base_mass:g} kg, wheel_mass "
-            f"{r.wheel_mass:g} kg, link_masses [{links}] kg, payload {r.payload:g} kg; give "
-            f"it heavier parts, or (the API) a smaller MujocoPlant(robot, timestep=...) in "
-            f"[{low:g}, {high:g}] s"
+            f"{r.wheel_mass:g} kg, link_masses [{links}] kg, payload {r.payload:g} kg on "
+            f"tyre_stiffness {options.tyre_stiffness:g} N/m and contact_time_constant "
+            f"{options.contact_time_constant:g} s (light parts on stiff springs need a "
+            "shorter step); soften the tyres (lower tyre_stiffness, or 0 for rigid wheels) "
+            "or the contacts (a longer contact_time_constant), give it heavier parts, or "
+            f"(the API) a smaller MujocoPlant(robot, timestep=...) in [{low:g}, {high:g}] s"
         )
+
+    def _speed_bounds(self) -> tuple[np.ndarray, list[tuple[str, str]]]:
+        """Per degree of freedom (``MjData.qvel``), the largest plausible speed and what it
+        is: :data:`SPEED_BOUND_FACTOR` times the fastest the robot's motors drive it (the
+        base's velocity components: the wheels' rim speed ``wheel_speed_limit r``; its
+        angular velocity components: that rim speed over half the track, the fastest yaw;
+        the joints: ``joint_speed_limit``), with its name and unit. The wheels' spin and
+        the tyres' radial slides are unbounded: under force commands a wheel off the
+        floor spins up freely (the model has no motor speed limit), and a blow-up of
+        either moves the base."""
+        robot, model = self.robot, self.model
+        rim = robot.wheel_speed_limit * robot.wheel_radius
+        bounds = np.full(model.nv, np.inf)
+        names = [("tyre", "m/s")] * model.nv
+        bounds[0:3] = SPEED_BOUND_FACTOR * rim
+        names[0:3] = [("base speed", "m/s")] * 3
+        bounds[3:6] = SPEED_BOUND_FACTOR * rim / (0.5 * robot.track_width)
+        names[3:6] = [("base rotation rate", "rad/s")] * 3
+        for joint in ("shoulder", "elbow"):
+            dof = int(model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)])
+            bounds[dof] = SPEED_BOUND_FACTOR * robot.joint_speed_limit
+            names[dof] = (f"{joint} rate", "rad/s")
+        return bounds, names
 
     def _warning_count(self) -> int:
         return sum(int(self.data.warning[w].number) for w in _WARNINGS)
 
-    def _check_state(self, where: str) -> None:
+    def _check_state(self, where: str, command: Any = None) -> None:
         """Raise :class:`PlantDivergedError` if the engine warned of a bad state (it then
-        resets its data silently) or the state is not finite."""
+        resets its data silently) or of a bad control (it then zeroes every control), or
+        the state is not finite, or a speed is beyond its plausible bound
+        (:meth:`_speed_bounds`: the state blew up in this step, and every number after it
+        would be garbage)."""
         data = self.data
         count = self._warning_count()
-        finite = np.all(np.isfinite(data.qpos)) and np.all(np.isfinite(data.qvel))
-        if count != self._warnings or not finite:
-            self._warnings = count
-            raise PlantDivergedError(
-                f"MuJoCo state diverged {where}: non-finite or unstable accelerations "
-                "(try a smaller timestep)"
+        speeds_ok = bool(np.all(np.abs(data.qvel) <= self._bounds))  # NaN fails too
+        if count == self._warnings and speeds_ok and np.all(np.isfinite(data.qpos)):
+            return
+        self._warnings = count
+        controls = data.warning[mujoco.mjtWarning.mjWARN_BADCTRL]
+        if controls.number > self._bad_controls:
+            self._bad_controls = int(controls.number)
+            raise PlantDivergedError(self._rejected(int(controls.lastinfo), where, command))
+        excess = np.abs(data.qvel) > self._bounds
+        if speeds_ok or not np.any(excess):
+            cause = "non-finite or unstable accelerations"
+        else:
+            dof = int(np.argmax(excess))
+            name, unit = self._bound_names[dof]
+            cause = (
+                f"{name} {abs(float(data.qvel[dof])):.3g} {unit}, beyond {SPEED_BOUND_FACTOR:g} "
+                f"times the fastest the motors drive it ({self._bounds[dof]:.3g} {unit})"
             )
+        raise PlantDivergedError(f"MuJoCo state diverged {where}: {cause} ({_SMALLER_STEP})")
+
+    def _rejected(self, actuator: int, where: str, command: Any) -> str:
+        """The message for a control MuJoCo rejected (not finite or beyond ``mjMAXVAL``)."""
+        name = ACTUATORS[actuator] if 0 <= actuator < len(ACTUATORS) else "an actuator"
+        value = ""
+        if isinstance(command, WheelForces) and name.startswith("wheel"):
+            force = command.left if name == "wheel_left" else command.right
+            value = f", the torque F r = {force * self.robot.wheel_radius:g} N m of its {force:g} N"
+        return (
+            f"MuJoCo rejected the control of {name} {where}{value}: beyond the engine's limit "
+            f"{mujoco.mjMAXVAL:g} on any control, and zeroed every control (a wheel force "
+            f"command is clipped at wheel_force_limit {self.wheel_force_limit:.3g} N only "
+            "within that limit)"
+        )
 
     # -- readout ------------------------------------------------------------------------
     def support_forces(self) -> tuple[np.ndarray, np.ndarray]:
@@ -675,11 +758,15 @@ class TipDetector:
         if pivoting and self._pivot_time == 0.0:
             self._pivot_start = self._tilt if self._t is not None else tilt
         self._pivot_time = self._pivot_time + step if pivoting else 0.0
+        rise = tilt - self._tilt if self._t is not None else 0.0  # over this sample (rad)
         self._t, self._tilt = t, tilt
+        growth = tilt - self._pivot_start
         lifted = (
             self._interval > 0.0
             and self._pivot_time >= LIFT_TIME_S - 1e-9
-            and tilt - self._pivot_start >= PIVOT_GROWTH_RAD
+            and growth >= PIVOT_GROWTH_RAD
+            # not decelerating: this sample's rate at least the mean rate since it began
+            and rise * self._pivot_time >= (1.0 - PIVOT_RATE_TOLERANCE) * growth * step
         )
         if tilt > TIP_TILT_RAD or lifted:
             self.tip_time = t
@@ -714,38 +801,6 @@ def tip_time_s(
     return detector.tip_time
 
 
-#: A support polygon whose :func:`footprint_excess` exceeds 1 by more than this lets S
-#: overstate its margin (rounding of the polygon's own corners aside).
-FOOTPRINT_EXCESS_TOLERANCE = 1e-9
-#: Layouts (footprint, support points) :func:`_warn_footprint` has warned about in this
-#: process: a run builds its plant more than once (the default control step asks one for
-#: its engine timestep), and the solvers' ``warnings.catch_warnings`` resets Python's own
-#: memory of warnings already shown.
-_WARNED_LAYOUTS: set[tuple] = set()
-
-
-def _warn_footprint(robot: Robot, geometry: SupportGeometry) -> None:
-    """Warn once per layout (:class:`UserWarning`, one line naming ``caster_positions``)
-    when the wheels and casters do not span the footprint the stability margin S measures:
-    the robot then tips on this plant at an S above 1 (:func:`footprint_excess`), which no
-    floor on S (``stability_min``) was chosen for."""
-    com = robot.com_coefficients
-    excess = footprint_excess(geometry, com.half_length, com.half_width)
-    layout = (com.half_length, com.half_width, geometry.points.tobytes())
-    if excess <= 1.0 + FOOTPRINT_EXCESS_TOLERANCE or layout in _WARNED_LAYOUTS:
-        return
-    _WARNED_LAYOUTS.add(layout)
-    warnings.warn(
-        f"caster_positions: the wheels and casters do not span the footprint base_length x "
-        f"base_width ({robot.base_length:g} m x {robot.base_width:g} m) that the stability "
-        f"margin S measures, so on the MuJoCo plant the robot can tip at S = {excess:.3g} "
-        "(stability_min does not keep it standing); casters at or outside the footprint's "
-        "corners make S hold",
-        UserWarning,
-        stacklevel=3,
-    )
-
-
 def _heading(quaternion) -> float:
     """Heading (rad) of a body's x axis projected on the floor, from its quaternion."""
     w, x, y, z = (float(v) for v in quaternion)
@@ -756,8 +811,16 @@ def _yaw_quaternion(angle: float) -> np.ndarray:
     return np.array([math.cos(0.5 * angle), 0.0, 0.0, math.sin(0.5 * angle)])
 
 
+#: Largest ``base_damping`` ``(N s/m, N m s/rad)``: at 1000 N s/m the motors' full force
+#: (41 N on the default robot) drives the base at 4 cm/s, and at 1000 N m s/rad their
+#: full moment (7 N m) turns it at 0.007 rad/s: a base stuck in mud, 70 and 250 times the
+#: thesis's c1 = 15 and c2 = 4 (docs/physics.md, "The plant").
+BASE_DAMPING_MAX = (1e3, 1e3)
+
+
 def _check_damping(value: tuple[float, float] | None) -> tuple[float, float] | None:
-    """Validate the ``base_damping`` option: None or two numbers >= 0."""
+    """Validate the ``base_damping`` option: None or two numbers in [0,
+    :data:`BASE_DAMPING_MAX`]."""
     if value is None:
         return None
     try:
@@ -766,7 +829,7 @@ def _check_damping(value: tuple[float, float] | None) -> tuple[float, float] | N
         raise ParameterError(
             f"base_damping must be (N s/m, N m s/rad), two numbers >= 0 (got {shown(value)})"
         ) from None
-    for name, number in (("base_damping[1]", c_t), ("base_damping[2]", c_yaw)):
-        if not (math.isfinite(number) and number >= 0.0):
-            raise ParameterError(f"{name} must be a finite number >= 0 (got {shown(number)})")
+    high_t, high_yaw = BASE_DAMPING_MAX
+    check_range("base_damping[1]", c_t, 0.0, high_t, "N s/m")
+    check_range("base_damping[2]", c_yaw, 0.0, high_yaw, "N m s/rad")
     return c_t, c_yaw

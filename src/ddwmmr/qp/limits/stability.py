@@ -1,9 +1,12 @@
 """Tip-over stability ``S >= S_min`` as a velocity damper with the exact gradient.
 
-``S = min(S_lon, S_lat)`` with ``S_lon = hl / |x_com|`` and ``S_lat = hw / |y_com|``, so
-``S >= S_min`` holds exactly when both terms do. Each term is smooth where it is below the
-cap, with ``dS_i/dth = -S_i c_i' / c_i`` (``c_i`` the centre-of-mass coordinate), so the
-limit constrains each term separately (no kink at the switch between them):
+``S = min(S_lon, S_lat)`` on the support polygon (:mod:`ddwmmr.model.stability`): on the
+default rectangle ``S_lon = hl / |x_com|`` and ``S_lat = hw / |y_com|``, on another polygon
+each term is the least ``d_e / (n_e . c)`` of its edges. ``S >= S_min`` holds exactly when
+both terms do. Each term is smooth where it is below the cap and one edge has its minimum,
+with ``dS_i/dth = -S_i (n . dc/dth) / (n . c)`` (``n`` that edge's outward normal, ``c``
+the centre of mass; ``-S_i c_i' / c_i`` on the rectangle), so the limit constrains each
+term separately (no kink at the switch between them):
 
     dS_i/dt = g_i . (th1dot, th2dot) >= -gain (S_i - S_min - margin)
 
@@ -26,6 +29,7 @@ from ddwmmr.model.stability import (
     STABILITY_FLOOR,
     ComCoefficients,
     check_stability_floor,
+    polygon_terms_gradient,
     stability_terms,
 )
 from ddwmmr.qp.blocks import LimitBlock, overrides
@@ -49,6 +53,8 @@ def stability_terms_from_trig(
     k: ComCoefficients, s1: float, c1: float, s12: float, c12: float
 ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """:func:`stability_terms_gradient` from ``sin/cos th1`` and ``sin/cos (th1 + th2)``."""
+    if k.edges is not None:
+        return polygon_terms_gradient(k, s1, c1, s12, c12)
     x_com = k.A * c1 + k.B * c12
     y_com = k.A * s1 + k.B * s12
     if abs(x_com) * STABILITY_CAP <= k.half_length:
@@ -113,7 +119,9 @@ def full_step_is_safe(
     exactly when ``|c_i| <= h_i / S_min``. So ``|c_i| + delta + slack <= h_i / S_min`` for
     both terms proves the exact ``S >= S_min = min(S_min, S_now)`` after the step; the slack
     (1e-9 m per metre of lever) covers the rounding of the look-ahead's own evaluation,
-    and angles beyond 1e3 rad (where adding the step loses digits) are left to it.
+    and angles beyond 1e3 rad (where adding the step loses digits) are left to it. On
+    another polygon the same holds edge by edge, ``n_e . c + delta + slack <= d_e / S_min``
+    (``n_e`` a unit vector moves ``n_e . c`` by at most ``delta`` too).
     """
     if not (abs(th1) <= 1e3 and abs(th2) <= 1e3):
         return False
@@ -122,6 +130,12 @@ def full_step_is_safe(
     b = dt * rate2
     lever_a, lever_b = abs(k.A), abs(k.B)
     reach = lever_a * abs(a) + lever_b * abs(a + b) + 1e-9 * (1.0 + lever_a + lever_b)
+    if k.edges is not None:
+        x_com, y_com = k.A * c1 + k.B * c12, k.A * s1 + k.B * s12
+        return all(
+            n_x * x_com + n_y * y_com + reach <= d / stability_min
+            for n_x, n_y, d in (*k.edges.lon, *k.edges.lat)
+        )
     return (
         abs(k.A * c1 + k.B * c12) + reach <= k.half_length / stability_min
         and abs(k.A * s1 + k.B * s12) + reach <= k.half_width / stability_min
@@ -129,7 +143,8 @@ def full_step_is_safe(
 
 
 class StabilityLimit(Limit):
-    """Two rows, ``dS_lon/dt`` and ``dS_lat/dt`` >= damper bound (see module docstring).
+    """Two rows, ``dS_lon/dt`` and ``dS_lat/dt`` >= damper bound (see module docstring); on
+    a support polygon other than the rectangle each row is its term's active edge's.
 
     Args:
         robot_com: the robot's centre-of-mass coefficients (``Robot.com_coefficients``).
