@@ -459,17 +459,22 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     :func:`check_file_target`). Missing parent folders are created, as
     ``mkdir -p`` would (the tools rely on it: the GUI's ``--snapshot figs/run.png``, the
     bench's ``--out``, the per-run sub-folders of a GUI export); a path through something
-    that is not a folder is refused.
-    Failures of the write itself (permission, full disk) raise :class:`OSError`.
+    that is not a folder is refused, and so is a folder in which nothing can be created
+    (:func:`unwritable_message`: ``/proc``, a read-only mount, no permission).
+    Failures of the write itself (full disk) raise :class:`OSError`.
 
     The file gets the user's umask (``0644`` for umask 022), like any normal file, not
     the ``0600`` of the temporary file; text is written as UTF-8.
     """
     path = check_file_target(path)
-    existing_folder("path", path.parent)
-    path.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
+    existing = existing_folder("path", path.parent)
     payload = data if isinstance(data, bytes) else data.encode("utf-8")
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".ddwmmr-", suffix=".tmp")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".ddwmmr-", suffix=".tmp")
+    except OSError as exc:  # the folder takes no new entries (/proc, read-only, no permission)
+        message = unwritable_message("path", str(path.parent), path.parent, existing, exc)
+        raise ParameterError(message) from exc
     try:
         with os.fdopen(fd, "wb") as handle:
             os.fchmod(handle.fileno(), file_mode())

@@ -16,7 +16,7 @@ A new controller is one class decorated with :func:`register_controller` (the re
 from __future__ import annotations
 
 import inspect
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -202,6 +202,18 @@ def method_parameters(name: str) -> dict[str, inspect.Parameter]:
     return parameters
 
 
+def check_known_options(method: str, options: Iterable[str], accepted: Iterable[str]) -> None:
+    """Refuse (one-line :class:`ParameterError`) the first of ``options`` (names, in sorted
+    order) that method ``method`` does not accept, listing the ``accepted`` ones."""
+    known = set(accepted)
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise ParameterError(
+            f"method {method}: unknown option {shown(unknown[0])} "
+            f"(accepted: {', '.join(sorted(known)) or 'none'})"
+        )
+
+
 def make_controller(
     name: str, robot: Robot | None = None, preset: str | None = None, **options: Any
 ) -> Controller:
@@ -219,13 +231,7 @@ def make_controller(
         from ddwmmr.controllers.presets import preset_options
 
         options = {**preset_options(name, preset), **options}
-    accepted = set(method_options(name))
-    unknown = sorted(set(options) - accepted)
-    if unknown:
-        raise ParameterError(
-            f"method {name}: unknown option {shown(unknown[0])} "
-            f"(accepted: {', '.join(sorted(accepted)) or 'none'})"
-        )
+    check_known_options(name, options, method_options(name))
     texts = [(option, value) for option, value in options.items() if isinstance(value, NumberText)]
     if not texts:
         return cls(robot, **options)

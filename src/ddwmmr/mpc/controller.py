@@ -61,13 +61,14 @@ from ddwmmr.commands import FORCE, PlantTraits, WheelForces
 from ddwmmr.controllers.base import (
     StepInfo,
     WaypointRun,
+    check_known_options,
     commanded_steps,
     control_step,
     register_controller,
     step_results,
 )
 from ddwmmr.controllers.inputs import check_inputs, check_start
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import GRAVITY_M_S2, warn_start_below_floor
 from ddwmmr.mpc.braking import braked_velocity, braking_input, should_brake
@@ -116,13 +117,7 @@ class MPCController:
     }
 
     def __init__(self, robot: Robot, **options: Any) -> None:
-        accepted = [f.name for f in fields(MPCOptions)]
-        unknown = sorted(set(options) - set(accepted))
-        if unknown:  # worded as make_controller words it
-            raise ParameterError(
-                f"method {self.name}: unknown option {shown(unknown[0])} "
-                f"(accepted: {', '.join(sorted(accepted))})"
-            )
+        check_known_options(self.name, options, [f.name for f in fields(MPCOptions)])
         self.options = MPCOptions(**options)
         self.robot = robot
         self._plan = _load_plan(self.options, robot.payload)

@@ -14,12 +14,13 @@ Plants never see controllers. ``policy`` (optional) lets an integrator of the ki
 plant re-evaluate a continuous-time control law at its intermediate stages (RK4); every
 other plant holds the command over the step (zero-order hold) and ignores it.
 
-The arguments of ``reset`` and ``step`` are checked by every plant with the helpers here
-(:func:`check_control_step`, :func:`check_step`) and the start configuration's own check
+The arguments of ``reset``, ``limit`` and ``step`` are checked by every plant with the
+helpers here (:func:`check_control_step`, :func:`check_limit`, :func:`check_step`,
+:func:`check_policy`) and the start configuration's own check
 (:func:`~ddwmmr.model.kinematics.check_configuration`): anything
-but finite numbers of the right shape is a one-line
-:class:`~ddwmmr.errors.ParameterError` naming ``q0``, ``dt``, ``t`` or ``command``, before
-the state changes.
+but finite numbers of the right shape (a ``policy`` that is not callable) is a one-line
+:class:`~ddwmmr.errors.ParameterError` naming ``q0``, ``dt``, ``q``, ``u``, ``t``,
+``command`` or ``policy``, before the state changes.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ import numpy as np
 
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces
 from ddwmmr.errors import ParameterError, check_finite, check_positive, float_values, shown
+from ddwmmr.model.kinematics import check_configuration
 
 #: A continuous-time control law for integrator stages: ``(t, q) -> u``, time in s, the
 #: configuration as a list of 5 floats, the velocity command as 4 numbers (a tuple of
@@ -144,6 +146,60 @@ def check_control_step(dt: Any) -> float:
     return check_positive("dt", dt)
 
 
+def check_policy(policy: Any) -> None:
+    """Refuse (one-line :class:`ParameterError` naming ``policy``) a ``policy`` argument of
+    ``Plant.step`` that is neither None nor a callable ``(t, q) -> u`` (:data:`Policy`)."""
+    if policy is not None and not callable(policy):
+        raise ParameterError(
+            f"policy must be None or a callable (t, q) -> u (got {shown(policy, 60)})"
+        )
+
+
+def check_limit(q: Any, u: Any) -> tuple[float, float, list[float]]:
+    """The arguments of ``Plant.limit`` checked: ``(th1, th2, u)``, the joint angles of
+    ``q`` (rad) and ``u`` as a list of 4 floats.
+
+    Args:
+        q: configuration ``[x, y, phi, th1, th2]`` (m, m, rad, rad, rad), 5 finite numbers.
+        u: velocity command ``[v, w, th1dot, th2dot]`` (m/s, rad/s, rad/s, rad/s), 4 finite
+            numbers (any flat sequence).
+
+    Raises:
+        ParameterError: naming ``q`` or ``u`` and what it must be.
+
+    It runs every control step: float64 arrays of shapes (5,) and (4,) (what the simulation
+    loop passes) cost two ``tolist`` and one sum (finite only if every term is); anything
+    else takes the slow path, which names the fault and clears sums that merely overflowed.
+    """
+    try:
+        arrays = type(q) is np.ndarray and type(u) is np.ndarray
+        if arrays and q.dtype is _FLOAT64 and u.dtype is _FLOAT64:
+            x, y, phi, th1, th2 = q.tolist()  # another shape fails to unpack here
+            v, w, r1, r2 = values = u.tolist()
+            if _isfinite(x + y + phi + th1 + th2 + v + w + r1 + r2):
+                return th1, th2, values
+    except (TypeError, ValueError):  # another shape: rows that are lists, too few values
+        pass
+    return _check_limit_slowly(q, u)
+
+
+def _check_limit_slowly(q: Any, u: Any) -> tuple[float, float, list[float]]:
+    """:func:`check_limit` for any argument: name the first fault, else return as it does."""
+    configuration = float_values(q, 5)
+    if configuration is None or not all(map(_isfinite, configuration)):
+        check_configuration(q, "q")  # its message: q must be 5 finite numbers ...
+    values = float_values(u, 4)
+    if values is None or not all(map(_isfinite, values)):
+        raise ParameterError(command_refusal("u", u))
+    return configuration[3], configuration[4], values
+
+
+def command_refusal(name: str, value: Any, interfaces: Sequence[str] = (VELOCITY,)) -> str:
+    """The message refusing ``value`` as a command named ``name`` on ``interfaces``."""
+    wanted = " or ".join(_COMMAND_FORMS[i] for i in (VELOCITY, FORCE) if i in interfaces)
+    return f"{name} must be {wanted} (got {shown(value, 60)})"
+
+
 def check_step(
     t: Any, command: Any, dt: Any, interfaces: Sequence[str] = (VELOCITY,)
 ) -> list[float] | WheelForces:
@@ -201,9 +257,7 @@ def _check_step_slowly(
         values = float_values(command, 4)
     if values is not None and all(map(_isfinite, values)):
         return command if forces else values
-    wanted = " or ".join(_COMMAND_FORMS[i] for i in (VELOCITY, FORCE) if i in interfaces)
-    message = f"command must be {wanted} (got {shown(command, 60)})"
-    raise ParameterError(message)
+    raise ParameterError(command_refusal("command", command, interfaces))
 
 
 class Plant(Protocol):
@@ -247,7 +301,9 @@ class Plant(Protocol):
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:  # pragma: no cover
         """Velocity command ``u`` as the plant's actuator limits will apply it at ``q``, and
-        whether a limit was hit (recorded as the run's commanded input)."""
+        whether a limit was hit (recorded as the run's commanded input). A ``q`` that is
+        not 5 finite numbers or a ``u`` that is not 4 is a one-line
+        :class:`~ddwmmr.errors.ParameterError` naming it (:func:`check_limit`)."""
         ...
 
     def step(
@@ -259,7 +315,8 @@ class Plant(Protocol):
         whichever of ``interfaces`` it belongs to. Raises
         :class:`~ddwmmr.errors.ParameterError` for a command of another interface, a
         non-finite or misshapen one, a non-finite t or a dt that is not > 0
-        (:func:`check_step`), and :class:`PlantDivergedError` when the new state is not
+        (:func:`check_step`) or a ``policy`` that is neither None nor callable
+        (:func:`check_policy`), and :class:`PlantDivergedError` when the new state is not
         finite. Anything else a plug-in plant (a class from outside the library) raises
         here is wrapped by the simulation loop in a one-line
         :class:`~ddwmmr.errors.PluginError` naming the plant, the step and the time

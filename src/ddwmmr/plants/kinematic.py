@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, check_instance, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.model.robot import clamp_joints
@@ -36,7 +36,10 @@ from ddwmmr.plants.base import (
     Policy,
     arm_rates,
     check_control_step,
+    check_limit,
+    check_policy,
     check_step,
+    command_refusal,
 )
 from ddwmmr.registry import register_plant
 
@@ -54,7 +57,7 @@ class KinematicPlant:
             raise ParameterError(
                 f"integrator must be one of {', '.join(INTEGRATORS)} (got {shown(integrator)})"
             )
-        self.robot = robot
+        self.robot = check_instance("robot", robot, Robot)
         self.integrator = integrator
         # Constants of the saturation, read once (it runs at every integrator stage).
         self._wheel = (1.0 / robot.wheel_radius, 0.5 * robot.track_width / robot.wheel_radius)
@@ -80,7 +83,7 @@ class KinematicPlant:
         return Observation(tuple(self._state), self._v, self._w)
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
-        """Same as :meth:`saturate`."""
+        """Same as :meth:`saturate` (its arguments checked the same way)."""
         applied, saturated = self.saturate(q, u)
         self._limited = applied  # step() need not saturate this exact command again
         return applied, saturated
@@ -88,8 +91,10 @@ class KinematicPlant:
     def step(self, t: float, command: Any, dt: float, policy: Policy | None = None) -> None:
         """Advance by dt (s) from time t (s) under velocity ``command``, 4 finite numbers
         ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s, rad/s, rad/s), see :meth:`integrate`;
-        other arguments are a :class:`ParameterError` (:func:`check_step`)."""
+        other arguments are a :class:`ParameterError` (:func:`check_step`), and so is a
+        ``policy`` that is neither None nor callable (:func:`check_policy`)."""
         values = check_step(t, command, dt, self.interfaces)
+        check_policy(policy)
         state = self._state
         if command is self._limited:  # limit() saturated this very command
             u0 = tuple(values)
@@ -112,23 +117,30 @@ class KinematicPlant:
 
     # -- the model --------------------------------------------------------------------------
     def saturate(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
-        """The input the robot can actually apply at q, and whether any limit was hit."""
-        _, _, _, th1, th2 = q.tolist() if isinstance(q, np.ndarray) else q
-        (v, w, t1, t2), saturated = self._saturate(th1, th2, u)
+        """The input the robot can actually apply at configuration ``q`` (5 finite numbers,
+        m and rad) for the velocity command ``u`` (4 finite numbers, m/s and rad/s), and
+        whether any limit was hit; other arguments are a :class:`ParameterError` naming
+        ``q`` or ``u`` (:func:`check_limit`)."""
+        th1, th2, values = check_limit(q, u)
+        (v, w, t1, t2), saturated = self._saturate(th1, th2, values, checked=True)
         return np.array([v, w, t1, t2]), saturated
 
-    def _saturate(self, th1: float, th2: float, u) -> tuple[tuple[float, ...], bool]:
+    def _saturate(
+        self, th1: float, th2: float, u, checked: bool = False
+    ) -> tuple[tuple[float, ...], bool]:
         """:meth:`saturate` on floats (joint angles th1, th2 in rad; ``u`` a tuple of
-        floats, an array or any sequence of 4 numbers)."""
-        if type(u) is tuple:
+        floats, an array or any sequence of 4 numbers; a non-finite one, as from a policy
+        of :meth:`integrate`, is a :class:`ParameterError` naming ``u``). ``checked``: ``u``
+        is 4 finite floats already (:func:`check_limit`'s list)."""
+        if type(u) is tuple or checked:
             v, w, t1, t2 = u
         elif isinstance(u, np.ndarray):
             v, w, t1, t2 = u.tolist()
         else:
             v, w, t1, t2 = (float(a) for a in u)
         isfinite = math.isfinite
-        if not (isfinite(v) and isfinite(w) and isfinite(t1) and isfinite(t2)):
-            raise FloatingPointError(f"non-finite command u = {u}")
+        if not (checked or (isfinite(v) and isfinite(w) and isfinite(t1) and isfinite(t2))):
+            raise ParameterError(command_refusal("u", u))
         saturated = False
         # Wheel speeds (docs/theory.md, "Wheels"):
         # (2v -+ Lw w) / (2r) = v / r -+ (Lw / 2r) w; the faster

@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.commands import WheelForces
-from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.errors import ParameterError, check_instance, check_positive
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.model.robot import clamp_joints
@@ -57,6 +57,8 @@ from ddwmmr.plants.base import (
     Policy,
     arm_rates,
     check_control_step,
+    check_limit,
+    check_policy,
     check_step,
 )
 from ddwmmr.registry import register_plant
@@ -217,7 +219,7 @@ class ThesisPlant:
         joint_speed: float | None = None,
         velocity_bandwidth: float = VELOCITY_BANDWIDTH,
     ) -> None:
-        self.robot = robot
+        self.robot = check_instance("robot", robot, Robot)
         self.c1 = check_positive("c1", c1)
         self.c2 = check_positive("c2", c2)
         if force_limit is None:
@@ -259,12 +261,11 @@ class ThesisPlant:
         configuration ``q``, and whether a limit clipped it: joint rates within the
         joint-speed limit, and 0 for a joint at a limit of ``joint_limits`` moving outward
         (as the kinematic plant reports it); (v, w) pass (the wheel forces saturate).
-        A non-finite ``u`` is a FloatingPointError, as for the kinematic plant (clipping
-        would turn a NaN rate into the limit)."""
-        v, w, r1, r2 = u.tolist() if isinstance(u, np.ndarray) else (float(a) for a in u)
-        if not all(map(math.isfinite, (v, w, r1, r2))):
-            raise FloatingPointError(f"non-finite command u = {u}")
-        c1, c2 = self.joint_rates(float(q[3]), float(q[4]), r1, r2)
+        A ``q`` that is not 5 finite numbers or a ``u`` that is not 4 (a NaN rate, which
+        clipping would turn into the limit) is a :class:`ParameterError` naming it, as for
+        the kinematic plant (:func:`check_limit`)."""
+        th1, th2, (v, w, r1, r2) = check_limit(q, u)
+        c1, c2 = self.joint_rates(th1, th2, r1, r2)
         if c1 == r1 and c2 == r2 and isinstance(u, np.ndarray):
             return u, False  # within the limits: the command as it is
         return np.array([v, w, c1, c2]), True
@@ -275,8 +276,10 @@ class ThesisPlant:
         th1dot, th2dot]`` (m/s, rad/s), held over the step; the arm's targets (the given
         ones, or ``th + rate dt`` with the rates of :meth:`joint_rates`) are clipped to the
         joint limits. Non-finite or misshapen arguments are a :class:`ParameterError`
-        (:func:`check_step`)."""
+        (:func:`check_step`), and so is a ``policy`` that is neither None nor callable
+        (:func:`check_policy`; this plant holds the command and does not call it)."""
         checked = check_step(t, command, dt, self.interfaces)
+        check_policy(policy)
         state = self.state
         inertia = self.inertia(state.th1, state.th2)  # once for the servo and the dynamics
         if isinstance(checked, WheelForces):

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.outputs import write_atomic
 
 
@@ -49,8 +50,29 @@ class SimulationResult:
 
     def write_summary(self, path: str | Path, **extra: Any) -> None:
         """Write the summary as JSON to ``path``, with ``extra`` keys (e.g. ``run``),
-        atomically, with :func:`write_atomic` (as :meth:`write_csv`)."""
-        write_atomic(path, json.dumps(json_safe({**self.summary, **extra}), indent=2) + "\n")
+        atomically, with :func:`write_atomic` (as :meth:`write_csv`). A value JSON cannot
+        hold (an object, a set; numpy scalars and non-finite floats are converted,
+        :func:`json_safe`) is a one-line :class:`ParameterError` naming its key, before
+        anything is written."""
+        data = json_safe({**self.summary, **extra})
+        try:
+            text = json.dumps(data, indent=2)
+        except (TypeError, ValueError, RecursionError) as exc:  # ValueError: a cycle
+            raise _unserialisable(data) from exc
+        write_atomic(path, text + "\n")
+
+
+def _unserialisable(data: dict[str, Any]) -> ParameterError:
+    """The refusal naming the first key of ``data`` whose value ``json.dumps`` fails on."""
+    for key, value in data.items():
+        try:
+            json.dumps({key: value})
+        except (TypeError, ValueError, RecursionError):
+            return ParameterError(
+                f"summary: {key} must be JSON data (numbers, text, true/false, None, lists "
+                f"and dicts of them) (got {shown(value, 60)})"
+            )
+    return ParameterError("summary: the keys must be text")  # pragma: no cover
 
 
 def _format(value: float) -> str:

@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
 from ddwmmr.commands import FORCE, WheelForces
-from ddwmmr.errors import ParameterError, bracketed, finite_values, shown
+from ddwmmr.errors import ParameterError, bracketed, finite_values, raise_plugin_error, shown
 from ddwmmr.inheritance import defining_class
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_arrays
@@ -298,6 +298,12 @@ class CheckedTrajectory:
     is used as it is (nothing better is known). Every other attribute (``duration``,
     ``samples``, ``name``, the trajectory's own) is the trajectory's; ``trajectory`` is
     the trajectory itself.
+
+    Anything else the trajectory's ``pose``, ``velocity`` or ``sample`` raise becomes a
+    one-line :class:`~ddwmmr.errors.PluginError` "trajectory: <name>.<method>() raised
+    <type>: '<message>' at t = <t> s" (:func:`~ddwmmr.errors.plugin_raised`, as for a
+    plug-in controller or plant; the exception it raised is the ``__cause__``); a
+    ParameterError or PluginError it raises passes as it is.
     """
 
     def __init__(self, trajectory: Any) -> None:
@@ -323,17 +329,36 @@ class CheckedTrajectory:
 
     def pose(self, t: float) -> np.ndarray:
         """Desired pose ``[xE, yE, phiE]`` (m, m, rad) at time t (s)."""
-        return reference_values(self.trajectory.pose(t), "pose", t)
+        try:
+            value = self.trajectory.pose(t)
+        except Exception as error:
+            self._raised("pose", error, f" at t = {t:g} s")
+        return reference_values(value, "pose", t)
 
     def velocity(self, t: float) -> np.ndarray:
         """Desired velocity ``[xEdot, yEdot, phiEdot]`` (m/s, m/s, rad/s) at time t (s)."""
-        return reference_values(self.trajectory.velocity(t), "velocity", t)
+        try:
+            value = self.trajectory.velocity(t)
+        except Exception as error:
+            self._raised("velocity", error, f" at t = {t:g} s")
+        return reference_values(value, "velocity", t)
+
+    def _raised(self, method: str, error: Exception, where: str) -> NoReturn:
+        """Raise the one-line error for ``error``, raised by the trajectory's ``method``
+        (``where``: the time of the call; called from the ``except`` block)."""
+        call = f"trajectory: {trajectory_name(self.trajectory)}.{method}()"
+        raise_plugin_error(call, error, where, quoted=True)
 
     def _sample(self, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Poses and velocities at ``times`` (s), arrays of shape ``(len(times), 3)``."""
         own = self._own_sample
         if own is not None:
-            found = sampled_references(own, times)
+            try:
+                found = sampled_references(own, times)
+            except Exception as error:
+                every = np.ravel(times)
+                span = f"{every.min():g} to {every.max():g}" if every.size else "none"
+                self._raised("sample", error, f" at t = {span} s")
             if found is not None:
                 return found
             self._own_sample = None  # not the vectorised reference: call by call from now on

@@ -19,7 +19,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_finite, shown
+from ddwmmr.errors import ParameterError, check_finite, check_int_at_least, shown
 from ddwmmr.inheritance import defining_class, overrides
 
 
@@ -141,14 +141,21 @@ def resolution_step(trajectory: Any) -> float:
     """The trajectory's own step (s), the default control step of every tool and of
     :func:`ddwmmr.simulate`: its ``default_step`` if it has one (a sampled trajectory:
     :meth:`SampledTrajectory.default_step`), else ``duration / samples`` (its resolution
-    N), or ``duration / 1000``."""
+    N, an integer >= 1, else a one-line :class:`ParameterError` naming ``samples``), or
+    ``duration / 1000``."""
     own = getattr(trajectory, "default_step", None)
     if own is not None:
         return float(own)
-    samples = getattr(trajectory, "samples", 1000)
-    number = isinstance(samples, int | float | np.integer | np.floating)
-    if isinstance(samples, bool) or not number or not (math.isfinite(samples) and samples > 0):
-        raise ParameterError(
-            f"trajectory: samples (its resolution N) must be a number > 0 (got {shown(samples)})"
-        )
+    samples = check_int_at_least(
+        "trajectory: samples (its resolution N)", getattr(trajectory, "samples", 1000), 1
+    )
     return trajectory.duration / samples
+
+
+def check_name(name: Any, prefix: str = "") -> str:
+    """``name``, a trajectory's label in reports, if it is a non-empty string, else a
+    one-line :class:`ParameterError` naming ``name`` (after ``prefix``, e.g.
+    ``"trajectory samples: "``)."""
+    if not isinstance(name, str) or not name:
+        raise ParameterError(f"{prefix}name must be a string, not empty (got {shown(name)})")
+    return name

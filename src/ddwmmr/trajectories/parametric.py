@@ -32,7 +32,7 @@ from ddwmmr.errors import (
     check_range,
     shown,
 )
-from ddwmmr.trajectories.base import atan2_array, check_time, check_times
+from ddwmmr.trajectories.base import atan2_array, check_name, check_time, check_times
 
 ORIENTATIONS = ("tangent", "constant")
 #: Why ``phi`` is refused with the tangent orientation, in the API and in the file loaders.
@@ -88,6 +88,7 @@ class _Parametric(ABC):
             magnitude <= 1e6. The tangent orientation has no use for it: a ``phi`` other
             than 0 (the default) with it raises :class:`~ddwmmr.errors.ParameterError`
             (the message of a TOML file that sets it), instead of being ignored.
+        name: label used in reports (each shape's own by default), a non-empty string.
 
     Anything else raises a one-line :class:`~ddwmmr.errors.ParameterError` naming the
     parameter and its range.
@@ -104,6 +105,7 @@ class _Parametric(ABC):
     phi: float = 0.0
 
     def __post_init__(self) -> None:
+        check_name(self.name)  # each shape's field, "ellipse" or "rectangle" by default
         for name in ("x0", "y0", "beta", "phi", "a", "b", "T"):
             object.__setattr__(self, name, check_geometry_value(name, getattr(self, name)))
         object.__setattr__(self, "N", check_int_at_least("N", self.N, 2, MAX_TRAJECTORY_SAMPLES))

@@ -34,7 +34,7 @@ from ddwmmr.errors import (
     read_text_file,
     shown,
 )
-from ddwmmr.trajectories.base import atan2_array, check_time, check_times
+from ddwmmr.trajectories.base import atan2_array, check_name, check_time, check_times
 
 MAX_TIME_S = DURATION_RANGE_S[1]
 #: Smallest step between two sample times, as a share of the duration (last minus first
@@ -119,10 +119,7 @@ class SampledTrajectory:
     _moving: tuple[float, float] = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        if not isinstance(self.name, str):
-            raise ParameterError(
-                f"trajectory samples: name must be a string (got {shown(self.name)})"
-            )
+        check_name(self.name, "trajectory samples: ")
         times = _float_array("times", self.times, "sample times (s)")
         points = _float_array("points", self.points, "an (n, 2) or (n, 3) array (m, rad)")
         if times.ndim != 1 or len(times) < 3:
