@@ -164,6 +164,7 @@ class Guess:
         if arrays is None:
             raise ParameterError(
                 f"plan {path} must be a .npz with {', '.join(_PLAN_ARRAYS)} ({reason})"
+                f"{_search_again(Path(path))}"
             )
         times, states, inputs, legs = (arrays[key] for key in _PLAN_ARRAYS)
         m = len(times) - 1
@@ -229,6 +230,30 @@ def plan_path(folder: str | Path, scenario: int) -> Path:
     raise ParameterError(missing_plan(folder, scenario))
 
 
+def _kept_trajectory(record: Path) -> bool:
+    """Whether the bounds cache's best-known ``record`` (a ``.json``) says its search kept
+    a trajectory beside it (``replay_ok`` true and the ``start`` it came from named)."""
+    try:
+        found = json.loads(record.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return False
+    return isinstance(found, dict) and found.get("replay_ok") is True and bool(found.get("start"))
+
+
+def _search_again(plan: Path) -> str:
+    """For a best-known trajectory ``plan`` of a bounds run's cache that is lost (missing
+    or unreadable while its record says the search kept it): how to get it back; ``""``
+    for any other file."""
+    if plan.parent.name != PLAN_FOLDER or not _kept_trajectory(plan.with_suffix(".json")):
+        return ""
+    scenario = plan.stem.split("-")[1].lstrip("0") or "0"
+    return (
+        f": the trajectory of that bounds run is lost; run python -m ddwmmr.bounds --out "
+        f"{plan.parent.parent} --scenarios {scenario} again with the run's --seed and "
+        "--payload, without --lower-only: it searches the scenario again"
+    )
+
+
 def missing_plan(folder: Path, scenario: int) -> str:
     """Why the bounds output ``folder`` holds no plan for scenario number ``scenario``
     (from 1), and what to do: it is no bounds output folder (no ``cache``), its search
@@ -242,6 +267,8 @@ def missing_plan(folder: Path, scenario: int) -> str:
             f"{head}: plan=DIR takes the output folder of python -m ddwmmr.bounds (or its "
             f"{PLAN_FOLDER} folder), which keeps each scenario's best-known trajectory there"
         )
+    if _kept_trajectory(expected.with_suffix(".json")):
+        return f"{head}, though its search kept one{_search_again(expected)}"
     if expected.with_suffix(".json").exists():
         return (
             f"{head}: the bounds run found no trajectory for scenario {scenario} (its "

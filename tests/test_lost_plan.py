@@ -1,0 +1,54 @@
+"""A bounds run's best-known trajectory lost from its cache (deleted, or damaged) gets a
+message saying how to get it back, for plan=DIR and for the file itself."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.mpc.min_time import Guess, plan_path
+
+
+def _record(cache, kept: bool) -> None:
+    cache.mkdir(parents=True)
+    record = {"replay_ok": kept, "start": "pattern-3" if kept else None, "best_known_s": 13.2}
+    (cache / "scenario-003-best.json").write_text(json.dumps(record))
+
+
+def test_a_deleted_trajectory_says_to_search_again(tmp_path):
+    _record(tmp_path / "run" / "cache", kept=True)
+    with pytest.raises(ParameterError) as info:
+        plan_path(tmp_path / "run", 3)
+    message = str(info.value)
+    assert "is missing, though its search kept one: the trajectory of that bounds run is lost" in (
+        message
+    )
+    assert f"--out {tmp_path / 'run'} --scenarios 3 again" in message
+    assert "\n" not in message
+
+
+def test_a_search_that_kept_nothing_still_says_so(tmp_path):
+    _record(tmp_path / "run" / "cache", kept=False)
+    with pytest.raises(ParameterError, match="found no trajectory for scenario 3"):
+        plan_path(tmp_path / "run", 3)
+
+
+def test_a_damaged_trajectory_says_to_search_again(tmp_path):
+    cache = tmp_path / "run" / "cache"
+    _record(cache, kept=True)
+    (cache / "scenario-003-best.npz").write_bytes(b"PK\x03\x04xx")
+    with pytest.raises(ParameterError) as info:
+        Guess.load(plan_path(tmp_path / "run", 3))
+    message = str(info.value)
+    assert message.startswith(f"plan {cache / 'scenario-003-best.npz'} must be a .npz with")
+    assert message.endswith("without --lower-only: it searches the scenario again")
+
+
+def test_a_damaged_file_elsewhere_gets_no_bounds_advice(tmp_path):
+    path = tmp_path / "mine.npz"
+    path.write_bytes(b"PK\x03\x04xx")
+    with pytest.raises(ParameterError) as info:
+        Guess.load(path)
+    assert "bounds" not in str(info.value)
