@@ -238,14 +238,14 @@ def test_force_without_a_snapshot_is_refused(capsys, no_window):
 @pytest.mark.parametrize(
     ("dpi", "message"),
     [
-        ("inf", "dpi must be a finite number in [10, 600] (got inf)"),
-        ("nan", "dpi must be a finite number in [10, 600] (got nan)"),
-        ("1e9", "dpi must be in [10, 600] (got 1e+09)"),
-        ("1e-9", "dpi must be in [10, 600] (got 1e-09)"),
+        ("inf", "argument --dpi: must be an integer in [10, 600] (got 'inf')"),
+        ("nan", "argument --dpi: must be an integer in [10, 600] (got 'nan')"),
+        ("1e9", "argument --dpi: must be an integer in [10, 600] (got '1e9')"),
+        ("1e-9", "argument --dpi: must be an integer in [10, 600] (got '1e-9')"),
         ("0", "dpi must be in [10, 600] (got 0)"),
         ("-100", "dpi must be in [10, 600] (got -100)"),
         ("601", "dpi must be in [10, 600] (got 601)"),
-        ("ten", "argument --dpi: invalid float value: 'ten'"),
+        ("ten", "argument --dpi: must be an integer in [10, 600] (got 'ten')"),
     ],
 )
 def test_bad_dpi_is_refused_before_the_run(dpi, message, tmp_path, capsys, no_window):

@@ -150,7 +150,9 @@ def test_scenarios_pass_options_to_the_controller_and_refuse_the_protocol_s():
     )
     with pytest.raises(ParameterError, match=r"^option: the scenarios set dt themselves \(--dt"):
         config_from_arguments(scenarios_parser().parse_args(["--option", "dt=0.02"]))
-    with pytest.raises(ParameterError, match=r"^option: thesis has no option 'horizon'"):
+    with pytest.raises(
+        ParameterError, match=r"^horizon: --horizon is taken only by --controller mpc"
+    ):
         config_from_arguments(scenarios_parser().parse_args(["--horizon", "2"]))
 
 

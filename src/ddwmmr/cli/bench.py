@@ -5,9 +5,8 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 from ddwmmr.bench.baseline import NAIVE_LABEL
@@ -23,7 +22,15 @@ from ddwmmr.bench.report import (
 from ddwmmr.bench.run import MAX_CALLS, MAX_REPEATS, check_duration, run_benchmark
 from ddwmmr.bench.scenarios import SCENARIO_CONTROLLERS, SCENARIO_COUNT
 from ddwmmr.bench.timing import P99_MIN_SAMPLES
-from ddwmmr.cli.common import ArgumentParser, RefusedOption, run_main
+from ddwmmr.cli.common import (
+    ArgumentParser,
+    RefusedOption,
+    given_text,
+    integer_type,
+    number_type,
+    run_main,
+    split_names,
+)
 from ddwmmr.controllers.base import available_methods
 from ddwmmr.errors import MAX_JOBS, MAX_SCENARIOS, MAX_STEPS, ParameterError
 from ddwmmr.trajectories import Ellipse
@@ -44,44 +51,10 @@ class _Parser(ArgumentParser):
     error_prefix = "bench"
 
 
-def _integer(low: int, high: int | None = None) -> Callable[[str], int]:
-    """An argparse type: an integer >= ``low`` (and <= ``high``)."""
-    allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
-
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            value = low - 1
-        if value < low or (high is not None and value > high):
-            raise argparse.ArgumentTypeError(f"must be an integer {allowed} (got {text!r})")
-        return value
-
-    return parse
-
-
-_repeat_count = _integer(1, MAX_REPEATS)
-_call_count = _integer(1, MAX_CALLS)
-_job_count = _integer(1, MAX_JOBS)
-_scenario_count = _integer(0, MAX_SCENARIOS)
-
-
-def _seconds(low: float, high: float) -> Callable[[str], float]:
-    """An argparse type: a finite number; the range [``low``, ``high``] s is stated when the
-    text is not one (:func:`check_duration` then checks the range itself)."""
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            value = math.nan
-        if not math.isfinite(value):
-            raise argparse.ArgumentTypeError(
-                f"must be a number in [{low:g}, {high:g}] s (got {text!r})"
-            )
-        return value
-
-    return parse
+_repeat_count = integer_type(1, MAX_REPEATS)
+_call_count = integer_type(1, MAX_CALLS)
+_job_count = integer_type(1, MAX_JOBS)
+_scenario_count = integer_type(0, MAX_SCENARIOS)
 
 
 def method_names() -> list[str]:
@@ -115,7 +88,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--duration",
-        type=_seconds(dt, MAX_STEPS * dt),
+        # check_duration checks the range itself
+        type=number_type(f"in [{dt:g}, {MAX_STEPS * dt:g}] s", finite=True),
         default=None,
         metavar="S",
         help=f"simulated time of each full run in s (default: one trajectory period, "
@@ -180,12 +154,11 @@ def _main(argv: Sequence[str] | None = None) -> int:
     """The tool; bad input prints one line and returns 2."""
     args = build_parser().parse_args(argv)
     if args.methods is not None:  # repeated and/or comma separated, as compare's --methods
-        empty = next((v for v in args.methods if not v.replace(",", "").strip()), None)
-        if empty is not None:
-            print(f"bench: error: --method: no name given (got {empty!r})", file=sys.stderr)
+        try:
+            args.methods = split_names(args.methods, "--method")
+        except ParameterError as exc:
+            print(f"bench: error: {exc}", file=sys.stderr)
             return 2
-        names = [n.strip() for v in args.methods for n in v.split(",") if n.strip()]
-        args.methods = list(dict.fromkeys(names))
     unknown = sorted(set(args.methods or ()) - set(method_names()))
     if unknown:
         choices = ", ".join(method_names())
@@ -197,7 +170,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     try:
         # Everything that can be checked is checked before a minute-long run.
         previous = read_report(args.compare) if args.compare is not None else None
-        out = Path(args.out)
+        out = Path(given_text("out", args.out, "an output folder"))
         check_out(out, force=args.force)
         check_duration(Ellipse(), args.duration)
         probe_out(out)

@@ -23,7 +23,16 @@ from pathlib import Path
 from ddwmmr import provenance
 from ddwmmr.bounds import batch
 from ddwmmr.bounds.search import QUICK, Settings
-from ddwmmr.cli.common import ArgumentParser, Terminated, output_folder, run_main
+from ddwmmr.cli.common import (
+    ArgumentParser,
+    Terminated,
+    given_text,
+    integer_type,
+    number_type,
+    output_folder,
+    payload_type,
+    run_main,
+)
 from ddwmmr.cli.signals import say
 from ddwmmr.errors import (
     MASS_RANGE_KG,
@@ -85,7 +94,10 @@ def build_parser() -> ArgumentParser:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument(
-        "--seed", type=int, default=0, help="generator seed, an integer >= 0 (default: 0)"
+        "--seed",
+        type=integer_type(0, checked_later=True),
+        default=0,
+        help="generator seed, an integer >= 0 (default: 0)",
     )
     parser.add_argument(
         "--scenarios",
@@ -95,7 +107,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--jobs",
-        type=int,
+        type=integer_type(1, MAX_JOBS, checked_later=True),
         metavar="N",
         help=f"worker processes, 1 to {MAX_JOBS} (default: the CPUs available)",
     )
@@ -112,11 +124,15 @@ def build_parser() -> ArgumentParser:
         "empty or an earlier bounds run's folder (the cache needs a folder of its own)",
     )
     parser.add_argument(
-        "--payload", type=float, default=3.0, metavar="KG", help="payload in kg (default: 3.0)"
+        "--payload",
+        type=payload_type,
+        default=3.0,
+        metavar="KG",
+        help="payload in kg (default: 3.0)",
     )
     parser.add_argument(
         "--stability-min",
-        type=float,
+        type=number_type(f"in [1, {STABILITY_CAP:g})"),
         default=1.25,
         metavar="S",
         help="floor on S of the best-known trajectories, in [1, 10) (default: 1.25; the "
@@ -189,7 +205,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
         out = first_free(Path("runs") / f"bounds-{stamp}", folder=True)
     else:
-        out = Path(args.out)
+        out = Path(given_text("out", args.out, "an output folder"))
     target = _check_out(out, args.force)
     # Tried, not inferred from permission bits (/proc, a read-only mount): the cache is
     # written there as scenarios finish, so an unwritable --out fails before any of them.

@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import logging
+import math
 import multiprocessing
 import os
 import re
@@ -29,7 +30,7 @@ from typing import NoReturn
 
 from ddwmmr import interrupts
 from ddwmmr.cli.signals import EXIT_INTERRUPTED, EXIT_TERMINATED, STOP_SIGNALS, say, stop_line
-from ddwmmr.errors import ParameterError, PluginError, did_you_mean, shown
+from ddwmmr.errors import MASS_RANGE_KG, ParameterError, PluginError, did_you_mean, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import check_output_folder, first_free, output_folder, package_version
 
@@ -45,11 +46,20 @@ __all__ = [
     "add_robot_arguments",
     "check_output_folder",
     "first_free",
+    "given_text",
     "horizon_defaults",
+    "horizon_range",
+    "integer_type",
     "method_options_text",
+    "number_type",
+    "off_engine_step",
+    "offset_type",
     "output_folder",
+    "payload_type",
     "robot_from_arguments",
     "run_main",
+    "seconds_type",
+    "split_names",
 ]
 
 
@@ -63,6 +73,97 @@ NEGATIVE_NUMBER = re.compile(
 
 #: argparse's message for options it does not know (``--methd x``).
 UNRECOGNISED = "unrecognized arguments: "
+
+
+def integer_type(
+    low: int, high: int | None = None, *, checked_later: bool = False
+) -> Callable[[str], int]:
+    """An argparse ``type``: an integer >= ``low`` (and <= ``high``); anything else (a
+    fraction, ``nan``, an empty text) is refused as ``argument --n: must be an integer in
+    [low, high] (got '1.5')`` (argparse names the option; status 2). ``checked_later``:
+    the option's own check refuses an integer out of the range (in its words); here only
+    a text that is no integer is, stating the same range."""
+    allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(
+                f"must be an integer {allowed} (got {text!r})"
+            ) from None
+        if not checked_later and (value < low or (high is not None and value > high)):
+            raise argparse.ArgumentTypeError(f"must be an integer {allowed} (got {text!r})")
+        return value
+
+    return parse
+
+
+def number_type(allowed: str, finite: bool = False) -> Callable[[str], float]:
+    """An argparse ``type``: a float. A text that is none (``abc``, an empty text; with
+    ``finite``, also ``nan`` and ``inf``) is refused as ``argument --dt: must be a number
+    <allowed> (got 'abc')``; ``allowed`` states the range (``"> 0 s"``, ``"in [0, 1] m"``),
+    the one the option's own check enforces on the number, which states it alike."""
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+            finite_only = True
+        else:
+            finite_only = finite
+        if finite_only and not math.isfinite(value):
+            raise argparse.ArgumentTypeError(f"must be a number {allowed} (got {text!r})")
+        return value
+
+    return parse
+
+
+#: ``--payload KG``: the range :meth:`Robot.with_payload` checks.
+payload_type = number_type(f"in [{MASS_RANGE_KG[0]:g}, {MASS_RANGE_KG[1]:g}] kg")
+#: ``--offset DX DY`` (m): each within the arm's reach, as the start's check has it.
+offset_type = number_type(
+    f"in [-reach, reach] m, the arm's reach L1 + L2 ({Robot().reach:g} m for Robot())"
+)
+#: ``--dt`` and ``--duration`` (s) of a run, before the step count is checked.
+seconds_type = number_type("> 0 s")
+
+
+def split_names(values: Sequence[str] | None, option: str) -> list[str]:
+    """Items of repeated and/or comma-separated option values, in order, without repeats.
+    A value with no name in it (``--methods ''``, ``--only ,``) or an empty item in a list
+    (``pi,,ats``, ``pi,``) is refused naming ``option``: a name went missing there."""
+    items = []
+    for value in values or []:
+        names = [item.strip() for item in value.split(",")]
+        if not any(names):
+            raise ParameterError(f"{option}: no name given (got {value!r})")
+        if not all(names):
+            raise ParameterError(f"{option}: an empty name in the list (got {value!r})")
+        items.extend(names)
+    return list(dict.fromkeys(items))
+
+
+def off_engine_step(dt: float, plant: object) -> bool:
+    """Whether the control step ``dt`` (s) is not a whole multiple (at least one) of the
+    engine ``timestep`` of ``plant`` (a physics plant; one without a timestep takes any
+    step), with the MuJoCo plant's tolerance: checked before a run starts, so that its
+    refusal comes before any note or output."""
+    quantum = getattr(plant, "timestep", None)
+    if not quantum:
+        return False
+    steps = max(1, round(dt / quantum))
+    return abs(steps * quantum - dt) > 1e-9 * max(1.0, abs(dt))
+
+
+def given_text(option: str, value: str | None, what: str, empty: str = "path") -> str | None:
+    """``value`` unless it is an empty (or blank) text, which is refused as ``option: give
+    <what> (got an empty <empty>)``: ``--out "$DIR"`` with ``DIR`` unset must not mean the
+    current folder, nor ``--robot ""`` the default robot. None (not given) passes."""
+    if value is not None and not value.strip():
+        raise ParameterError(f"{option}: give {what} (got an empty {empty})")
+    return value
 
 
 class _StoreOnce(argparse._StoreAction):
@@ -281,7 +382,7 @@ def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument(
         "--payload",
-        type=float,
+        type=payload_type,
         metavar="KG",
         help="payload at the end effector in kg (default: the robot's, 1.25 for Robot())",
     )
@@ -324,6 +425,13 @@ def horizon_defaults() -> tuple[float, float]:
     return GRID_DEFAULTS["tracking"][2], GRID_DEFAULTS["reach"][2]
 
 
+def horizon_range() -> str:
+    """``--horizon``'s range, as the mpc checks it: ``in [0.0001, 100] s``."""
+    from ddwmmr.mpc.ocp import MAX_HORIZON, MIN_INTERVAL  # here: the MPC imports CasADi
+
+    return f"in [{MIN_INTERVAL:g}, {MAX_HORIZON:g}] s"
+
+
 def add_force_argument(parser: argparse.ArgumentParser) -> None:
     """``--force``: write into an existing folder another tool or the user made."""
     parser.add_argument(
@@ -338,10 +446,11 @@ def robot_from_arguments(args: argparse.Namespace, plants: Sequence[str] = ()) -
     """The robot selected by ``--robot`` / ``--payload``; with ``"mujoco"`` among
     ``plants``, a robot file MuJoCo cannot build is refused naming the file (the plant
     itself would refuse it only once the run starts, without the file's name)."""
-    robot = Robot.from_toml(args.robot) if args.robot else Robot()
+    given_text("robot", args.robot, "the path of a robot TOML file")
+    robot = Robot.from_toml(args.robot) if args.robot is not None else Robot()
     if args.payload is not None:
         robot = robot.with_payload(args.payload)
-    if args.robot and "mujoco" in plants:
+    if args.robot is not None and "mujoco" in plants:
         from ddwmmr.plants.mujoco.model import check_buildable  # imports the engine
 
         try:

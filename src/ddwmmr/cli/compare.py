@@ -27,11 +27,16 @@ from ddwmmr.cli.common import (
     add_option_argument,
     add_robot_arguments,
     check_output_folder,
+    given_text,
     horizon_defaults,
+    horizon_range,
+    integer_type,
     method_options_text,
+    number_type,
     output_folder,
     robot_from_arguments,
     run_main,
+    split_names,
 )
 from ddwmmr.controllers.base import available_methods, method_description
 from ddwmmr.controllers.option_specs import option_names, parse_options
@@ -176,7 +181,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--jobs",
-        type=int,
+        type=integer_type(1, MAX_JOBS, checked_later=True),
         default=DEFAULT_JOBS,
         metavar="N",
         help=f"parallel worker processes, 1 to {MAX_JOBS} (default {DEFAULT_JOBS}: the "
@@ -200,7 +205,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--duration",
-        type=float,
+        type=number_type("> 0 s"),
         metavar="S",
         help="simulated time of every run, studies included, in s (default: one period of "
         "each trajectory)",
@@ -231,7 +236,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--horizon",
-        type=float,
+        type=number_type(horizon_range()),
         metavar="S",
         help="prediction horizon in s of the methods taking one (mpc; docs/mpc.md); the same "
         f"as --option horizon=S (default {horizon_defaults()[0]:g} s, the mpc's tracking one)",
@@ -284,18 +289,6 @@ def parse_method_options(
     return options
 
 
-def split_list(values: Sequence[str] | None, option: str) -> list[str]:
-    """Items of repeated and/or comma-separated option values, in order, without repeats;
-    a value with no name in it (``--methods ''``, ``--only ,``) is an error."""
-    items = []
-    for value in values or []:
-        names = [item.strip() for item in value.split(",") if item.strip()]
-        if not names:
-            raise ParameterError(f"{option}: no name given (got {value!r})")
-        items.extend(names)
-    return list(dict.fromkeys(items))
-
-
 def extra_plants() -> list[str]:
     """The plants ``--plant`` may add next to the kinematic one."""
     return [p for p in available_plants() if p != "kinematic"]
@@ -303,7 +296,7 @@ def extra_plants() -> list[str]:
 
 def parse_plants(values: Sequence[str] | None) -> tuple[str, ...]:
     """Validated ``--plant`` names (repeated and/or comma separated)."""
-    plants = split_list(values, "plant")
+    plants = split_names(values, "plant")
     for name in plants:
         if name == "kinematic":
             raise ParameterError("plant: the kinematic plant always runs; --plant adds others")
@@ -317,7 +310,7 @@ def parse_plants(values: Sequence[str] | None) -> tuple[str, ...]:
 def parse_methods(values: Sequence[str] | None, option: str = "methods") -> tuple[str, ...]:
     """Validated method names (default: every registered method)."""
     known = available_methods()
-    methods = split_list(values, option) or known
+    methods = split_names(values, option) or known
     for method in methods:
         if method not in known:
             raise ParameterError(f"{option}: unknown method {method!r} (known: {', '.join(known)})")
@@ -326,7 +319,7 @@ def parse_methods(values: Sequence[str] | None, option: str = "methods") -> tupl
 
 def parse_studies(values: Sequence[str] | None) -> tuple[str, ...]:
     """Validated study names; ``all`` (default) and ``none`` expand."""
-    names = split_list(values, "study") or ["all"]
+    names = split_names(values, "study") or ["all"]
     for name in names:
         if name not in (*STUDIES, "all", "none"):
             raise ParameterError(
@@ -356,23 +349,37 @@ def load_trajectories(
     line break becomes a space, as the reports show it), ``-2``, ``-3``... appended to a
     repeated one.
     """
-    chosen = split_list(only, "only")
-    values = [*(chosen or DEFAULT_TRAJECTORIES), *split_list(extra, "traj")]
+    chosen = split_names(only, "only")
+    # each value with the option that gave it first, for the messages
+    values = {v: "only" for v in chosen or DEFAULT_TRAJECTORIES}
+    values.update({v: "traj" for v in split_names(extra, "traj") if v not in values})
     trajectories: dict[str, Any] = {}
     files: dict[str, Any] = {}
     names: dict[str, str] = {}
-    for value in dict.fromkeys(values):
-        trajectory = load_trajectory(value)
+    for value, option in values.items():
+        trajectory = _load(value, option)
         own = trajectory_name(trajectory)
         name = unique_name(report_name(own), trajectories)  # names files: made safe
         trajectories[name] = trajectory
-        files[name] = find_trajectory_file(value)
+        files[name] = _load(value, option, find_trajectory_file)
         names[name] = unique_name(" ".join(str(own).splitlines()), names.values())
     if sources is not None:
         sources.update(files)
     if shown is not None:
         shown.update(names)
     return trajectories
+
+
+def _load(value: str, option: str, read: Callable[[str], Any] = load_trajectory) -> Any:
+    """``read(value)``; its refusal names ``option`` (``only: unknown trajectory ...``), not
+    ``traj``, for a value of ``--only``."""
+    try:
+        return read(value)
+    except ParameterError as exc:
+        text = str(exc)
+        if option == "traj" or not text.startswith("traj: "):
+            raise
+        raise ParameterError(f"{option}: {text.removeprefix('traj: ')}") from None
 
 
 def unique_name(base: str, taken: Collection[str]) -> str:
@@ -587,7 +594,7 @@ def skipped_notes(config: CompareConfig, plan: Any) -> list[str]:
 def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     jobs = check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
-    out = Path(args.out)
+    out = Path(given_text("out", args.out, "an output folder"))
     check_output_folder(out, "compare", args.force)  # the path, before anything is loaded
     sources: dict[str, Any] = {}
     config = config_from_arguments(args, argv, sources)

@@ -25,9 +25,25 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from ddwmmr.cli.common import ArgumentParser, run_main
+from ddwmmr.cli.common import (
+    ArgumentParser,
+    integer_type,
+    number_type,
+    offset_type,
+    payload_type,
+    run_main,
+    seconds_type,
+)
 from ddwmmr.controllers.base import available_methods
-from ddwmmr.errors import ParameterError, check_range
+from ddwmmr.errors import (
+    DURATION_RANGE_S,
+    LENGTH_RANGE_M,
+    MAX_ANGLE_RAD,
+    MAX_COORDINATE_M,
+    MAX_TRAJECTORY_SAMPLES,
+    ParameterError,
+    check_range,
+)
 from ddwmmr.gui.layout import desktop_figure
 from ddwmmr.gui.options import parse_option, plant_names
 from ddwmmr.gui.paths import (
@@ -55,7 +71,19 @@ from ddwmmr.trajectories import available_trajectories
 EXIT_NO_DISPLAY = 1
 #: Allowed ``--dpi``: at 600 dpi the 16 x 10 in window is 9600 x 6000 px (about 0.4 GB
 #: while it is drawn; 1200 dpi needs 1.3 GB and 16 s).
-DPI_RANGE = (10.0, 600.0)
+DPI_RANGE = (10, 600)
+
+#: The argparse type of each geometry option: the range its check gives (its help's).
+GEOMETRY_TYPES = {
+    "x0": number_type(f"in [-{MAX_COORDINATE_M:g}, {MAX_COORDINATE_M:g}] m"),
+    "y0": number_type(f"in [-{MAX_COORDINATE_M:g}, {MAX_COORDINATE_M:g}] m"),
+    "a": number_type(f"in [{LENGTH_RANGE_M[0]:g}, {LENGTH_RANGE_M[1]:g}] m"),
+    "b": number_type(f"in [{LENGTH_RANGE_M[0]:g}, {LENGTH_RANGE_M[1]:g}] m"),
+    "beta": number_type(f"in [-{MAX_ANGLE_RAD:g}, {MAX_ANGLE_RAD:g}] rad"),
+    # a number: its check refuses 1.5 naming the value as a number, like the panel's field
+    "N": number_type(f"(an integer) in [2, {MAX_TRAJECTORY_SAMPLES}]"),
+    "T": number_type(f"in [{DURATION_RANGE_S[0]:g}, {DURATION_RANGE_S[1]:g}] s"),
+}
 
 
 class RunFailed(RuntimeError):
@@ -88,7 +116,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--dpi",
-        type=float,
+        type=integer_type(*DPI_RANGE, checked_later=True),
         default=None,
         metavar="DPI",
         help=f"with --snapshot: its resolution, {DPI_RANGE[0]:g} to {DPI_RANGE[1]:g} "
@@ -117,7 +145,7 @@ def build_parser() -> ArgumentParser:
     for name, unit, _ in GEOMETRY:
         geometry.add_argument(
             f"--{name}",
-            type=float,
+            type=GEOMETRY_TYPES[name],
             metavar="N" if name == "N" else unit.upper(),
             help=GEOMETRY_HELP[name],
         )
@@ -144,7 +172,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--payload",
-        type=float,
+        type=payload_type,
         metavar="KG",
         help=f"payload in kg (default {Settings().payload:g})",
     )
@@ -154,13 +182,16 @@ def build_parser() -> ArgumentParser:
         help=f"integrator of the kinematic plant (default {Settings().integrator}; the other "
         "plants integrate their own dynamics and refuse it)",
     )
-    parser.add_argument("--dt", type=float, metavar="S", help="step in s (default T/N)")
+    parser.add_argument("--dt", type=seconds_type, metavar="S", help="step in s (default T/N)")
     parser.add_argument(
-        "--duration", type=float, metavar="S", help="simulated time in s (default one period T)"
+        "--duration",
+        type=seconds_type,
+        metavar="S",
+        help="simulated time in s (default one period T)",
     )
     parser.add_argument(
         "--offset",
-        type=float,
+        type=offset_type,
         nargs=2,
         metavar=("DX", "DY"),
         help="initial end-effector offset in m, in the end effector's start frame, each "
@@ -177,6 +208,11 @@ def build_parser() -> ArgumentParser:
 
 def settings_from_arguments(args: argparse.Namespace) -> Settings:
     """The :class:`Settings` the options describe (checked)."""
+    if args.compare == args.method and sorted(args.compare_option) == sorted(args.option):
+        raise ParameterError(
+            f"compare: slot B would repeat slot A ({args.method}, the same options); give "
+            "another method, other --compare-option values, or leave --compare out"
+        )
     settings = Settings(trajectory=args.traj).with_method(0, args.method)
     settings = settings.with_method(1, args.compare)
     for slot, texts in ((0, args.option), (1, args.compare_option)):

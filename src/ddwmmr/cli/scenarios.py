@@ -39,14 +39,20 @@ from ddwmmr.cli.common import (
     add_option_argument,
     check_output_folder,
     first_free,
+    given_text,
     horizon_defaults,
+    horizon_range,
+    integer_type,
     method_options_text,
+    number_type,
+    off_engine_step,
     output_folder,
+    payload_type,
     run_main,
 )
 from ddwmmr.commands import traits_of
 from ddwmmr.controllers import controller_traits, method_description
-from ddwmmr.controllers.option_specs import parse_options
+from ddwmmr.controllers.option_specs import option_names, parse_options
 from ddwmmr.errors import (
     MAX_JOBS,
     MAX_SCENARIOS,
@@ -59,7 +65,7 @@ from ddwmmr.errors import (
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR
 from ddwmmr.outputs import write_atomic
-from ddwmmr.plants import available_plants, plant_description
+from ddwmmr.plants import available_plants, plant_class, plant_description
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.executors import (
@@ -180,7 +186,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--arbiter-seed",
-        type=int,
+        type=integer_type(0, checked_later=True),
         default=None,
         metavar="N",
         help="noise seed of the competitive arbiter, an integer >= 0 (--arbiter competitive "
@@ -196,14 +202,17 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--n",
-        type=int,
+        type=integer_type(1, MAX_SCENARIOS, checked_later=True),
         default=100,
         metavar="N",
         help=f"number of scenarios (default: 100, at most {MAX_SCENARIOS}; --study obstacles "
         "always runs the thesis's scenarios 1, 3, 7 and 10)",
     )
     parser.add_argument(
-        "--seed", type=int, default=0, help="generator seed, an integer >= 0 (default: 0)"
+        "--seed",
+        type=integer_type(0, checked_later=True),
+        default=0,
+        help="generator seed, an integer >= 0 (default: 0)",
     )
     parser.add_argument(
         "--out",
@@ -215,7 +224,7 @@ def build_parser() -> ArgumentParser:
     add_force_argument(parser)
     parser.add_argument(
         "--payload",
-        type=float,
+        type=payload_type,
         default=3.0,
         metavar="KG",
         help="end-effector payload in kg, >= 0 and light enough that the start pose stands "
@@ -227,7 +236,7 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--stability",
         nargs=2,
-        type=float,
+        type=number_type(f"in (0, {THRESHOLD_RANGES['stability']:g}]"),
         default=None,
         metavar=("ENTER", "EXIT"),
         help="thesis controller's stability thresholds: enter below ENTER, leave at EXIT, "
@@ -237,7 +246,7 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--manipulability",
         nargs=2,
-        type=float,
+        type=number_type(f"in (0, {THRESHOLD_RANGES['manipulability']:g}]"),
         default=None,
         metavar=("ENTER", "EXIT"),
         help="thesis controller's manipulability thresholds, ENTER <= EXIT, both in "
@@ -260,14 +269,14 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--time-limit",
-        type=float,
+        type=number_type("> 0 s"),
         metavar="S",
         help=f"time limit per scenario in s, > 0, at most {MAX_STEPS:,} steps of --dt (default: "
         f"{TIME_LIMIT_S:g}, {OBSTACLE_TIME_LIMIT_S:g} with obstacles)",
     )
     parser.add_argument(
         "--dt",
-        type=float,
+        type=number_type(f"in (0, {MAX_DT:g}] s"),
         default=0.01,
         metavar="S",
         help=f"control and integration step in s, in (0, {MAX_DT:g}] (default: 0.01, the thesis "
@@ -276,7 +285,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--jobs",
-        type=int,
+        type=integer_type(1, MAX_JOBS, checked_later=True),
         metavar="N",
         help=f"worker processes, 1 to {MAX_JOBS} (default: the CPUs available); with "
         "--executor dask the LocalCluster's workers; refused with --scheduler (the batch "
@@ -295,7 +304,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--connect-timeout",
-        type=float,
+        type=number_type(f"in (0, {MAX_CONNECT_TIMEOUT:g}] s", finite=True),
         metavar="S",
         help=f"with --scheduler: seconds the scheduler has to answer, and then to have a "
         f"worker, in (0, {MAX_CONNECT_TIMEOUT:g}] (default: {CONNECT_TIMEOUT:g}); checked "
@@ -310,7 +319,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--qp-stability-min",
-        type=float,
+        type=number_type(f"in (0, {STABILITY_CAP:g})"),
         default=None,
         metavar="S",
         help=f"hard stability bound of the qp and mpc controllers, in (0, {STABILITY_CAP:g}) "
@@ -318,7 +327,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--qp-max-speed",
-        type=float,
+        type=number_type(f"in (0, {MAX_QP_SPEED:g}] m/s"),
         default=None,
         metavar="M_S",
         help=f"qp controller's end-effector speed limit, in (0, {MAX_QP_SPEED:g}] m/s "
@@ -332,7 +341,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--horizon",
-        type=float,
+        type=number_type(horizon_range()),
         metavar="S",
         help="mpc's prediction horizon in s (docs/mpc.md); the same as --option horizon=S "
         f"(default {horizon_defaults()[1]:g} s, its waypoint one)",
@@ -385,6 +394,12 @@ def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, An
     """``--option NAME=VALUE`` and ``--horizon`` as ``RunConfig.controller_options``:
     parsed and checked as the simulator's fields are; the options the protocol sets
     (:data:`PROTOCOL_OPTIONS`) are refused, naming what sets them."""
+    if args.horizon is not None and "horizon" not in option_names(args.controller):
+        takers = [c for c in scenario_controllers() if "horizon" in option_names(c)]
+        raise ParameterError(  # worded as track's flags are
+            f"horizon: --horizon is taken only by --controller {' or '.join(takers) or '(none)'}"
+            f" (got --controller {args.controller})"
+        )
     texts = [
         *(args.option or ()),
         *(() if args.horizon is None else (f"horizon={args.horizon!r}",)),
@@ -406,15 +421,16 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     check_nonnegative("seed", args.seed)
     if args.jobs is not None:
         check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
-    if args.scheduler and args.executor != "dask":
+    given_text("scheduler", args.scheduler, "a Dask scheduler address", "address")
+    if args.scheduler is not None and args.executor != "dask":
         raise ParameterError("scheduler: only used with --executor dask")
-    if args.scheduler and args.jobs is not None:
+    if args.scheduler is not None and args.jobs is not None:
         raise ParameterError(
             "jobs: not used with --scheduler (the batch runs on the workers the scheduler "
             "has); leave --jobs out"
         )
     if args.connect_timeout is not None:
-        if not args.scheduler:
+        if args.scheduler is None:
             raise ParameterError("connect-timeout: only used with --scheduler")
         check_connect_timeout(args.connect_timeout)
     if args.study == "thresholds" and args.controller != "thesis":
@@ -453,6 +469,22 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
             arbiter=args.arbiter or DEFAULT_ARBITER,
             arbiter_seed=0 if args.arbiter_seed is None else args.arbiter_seed,
             controller_options=controller_options,
+        )
+
+
+def _check_engine_step(config: RunConfig) -> None:
+    """With a physics plant (``--plant mujoco``): ``--dt`` a whole multiple of its engine
+    step, refused naming this tool's range of dt, (0, :data:`MAX_DT`] s (the plant's own
+    message would give the longer steps the plant alone allows)."""
+    if not hasattr(plant_class(config.plant), "timestep"):
+        return
+    plant = make_scenario_plant(config_robot(config), config)
+    if off_engine_step(config.dt, plant):
+        h = plant.timestep
+        raise ParameterError(
+            f"dt must be a whole multiple of the {config.plant} plant's engine step {h:g} s in "
+            f"(0, {MAX_DT:g}] s ({', '.join(f'{k * h:g}' for k in (1, 2, 3))}, ...) "
+            f"(got {config.dt:g})"
         )
 
 
@@ -911,6 +943,7 @@ def _bounds_table(args: argparse.Namespace, config: RunConfig):
     holds for any)."""
     if args.bounds is None:
         return None
+    given_text("bounds", args.bounds, "the path of a bounds run's bounds.csv")
     from ddwmmr.bounds.batch import bounds_floor, read_bounds_file
 
     if args.study or args.obstacles:
@@ -952,9 +985,10 @@ def _main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     args.argv = argv  # recorded in the summary
     config = config_from_arguments(args)
+    _check_engine_step(config)
     args.bounds_table = _bounds_table(args, config)
     fresh = args.out is None  # a default name: never replaces an earlier run
-    base = default_out() if fresh else Path(args.out)
+    base = default_out() if fresh else Path(given_text("out", args.out, "an output folder"))
     out = first_free(base, folder=True) if fresh else base
     check_output_folder(out, "scenarios", args.force, output_names(args, config))
     if config.controller in ("qp", "mpc"):

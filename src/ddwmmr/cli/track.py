@@ -28,11 +28,17 @@ from ddwmmr.cli.common import (
     add_robot_arguments,
     check_output_folder,
     first_free,
+    given_text,
     horizon_defaults,
+    horizon_range,
     method_options_text,
+    number_type,
+    off_engine_step,
+    offset_type,
     output_folder,
     robot_from_arguments,
     run_main,
+    seconds_type,
 )
 from ddwmmr.controllers.base import (
     available_methods,
@@ -43,13 +49,16 @@ from ddwmmr.controllers.base import (
 from ddwmmr.controllers.option_specs import parse_options
 from ddwmmr.controllers.presets import PRESETS, preset_options
 from ddwmmr.errors import (
+    MAX_COST_WEIGHT,
     ParameterError,
     check_range,
     check_step_count,
     read_text_file,
     shown,
 )
-from ddwmmr.plants import available_plants, plant_description
+from ddwmmr.gains import TAU_RANGE
+from ddwmmr.model.stability import STABILITY_CAP
+from ddwmmr.plants import available_plants, make_plant, plant_class, plant_description
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.provenance import RunInputs, run_record
@@ -244,7 +253,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--tau",
-        type=float,
+        type=number_type(TAU_RANGE),
         nargs="+",
         metavar="S",
         help="closed-loop time constant(s) in s, K = 1/tau: one value, or 3 (x, y, phi) for "
@@ -260,14 +269,17 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--dt",
-        type=float,
+        type=seconds_type,
         metavar="S",
         help="control and integration step in s (default: T/N of a parametric trajectory, "
         "0.02 s for the shipped ones; for a CSV the rows' spacing, made no coarser than "
         "0.02 s, as in the API; on mujoco a whole number of engine steps)",
     )
     parser.add_argument(
-        "--duration", type=float, metavar="S", help="simulated time in s (default one period)"
+        "--duration",
+        type=seconds_type,
+        metavar="S",
+        help="simulated time in s (default one period)",
     )
     parser.add_argument(
         "--plant",
@@ -283,7 +295,7 @@ def build_parser() -> ArgumentParser:
     )
     parser.add_argument(
         "--offset",
-        type=float,
+        type=offset_type,
         nargs=2,
         metavar=("DX", "DY"),
         help="initial end-effector offset in m, in the end effector's start frame (x along "
@@ -296,13 +308,13 @@ def build_parser() -> ArgumentParser:
     )
     qp.add_argument(
         "--stability-min",
-        type=float,
+        type=number_type(f"in (0, {STABILITY_CAP:g})"),
         metavar="S",
         help=_option_help("hard floor on the stability margin S", "stability_min"),
     )
     qp.add_argument(
         "--manipulability-weight",
-        type=float,
+        type=number_type(f"in [0, {MAX_COST_WEIGHT:g}]"),
         metavar="W",
         help=_option_help("weight of the manipulability reward", "manipulability_weight"),
     )
@@ -330,7 +342,7 @@ def build_parser() -> ArgumentParser:
     )
     qp.add_argument(
         "--horizon",
-        type=float,
+        type=number_type(horizon_range()),
         metavar="S",
         help=_option_help(
             "prediction horizon in s (docs/mpc.md, Options)",
@@ -368,6 +380,8 @@ def controller_options(args: argparse.Namespace) -> dict[str, Any]:
                 f"{flag[2:]}: {flag} is taken only by --method "
                 f"{_either(takers) or '(none)'} (got --method {args.method})"
             )
+        if attribute == "obstacles":
+            given_text("obstacles", value, "a shipped obstacle name or a TOML file", "text")
         if attribute == "tau" and len(value) == 1:
             value = value[0]
         options[keyword] = value
@@ -485,8 +499,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         raise ParameterError(
             f"rerun: {option} cannot be combined with --rerun (the record fixes it)"
         )
-    if not args.rerun.strip():
-        raise ParameterError("rerun: give the path of a summary.json (got an empty path)")
+    given_text("rerun", args.rerun, "the path of a summary.json")
     record = load_run_record(args.rerun)
     try:
         plant_record = _field(record, "plant", dict, "plant")
@@ -599,6 +612,20 @@ def output_names(plots: bool, animate: bool, physics: bool = False) -> tuple[str
     return (*names, *FIGURE_NAMES, *((SUPPORT_LOADS_FIGURE,) if physics else ()))
 
 
+def check_plant_step(inputs: RunInputs) -> None:
+    """Refuse, in the plant's own words, a control step the plant of ``inputs`` will refuse
+    when the run starts (MuJoCo: not a whole number of engine steps): before the duration
+    note and the output folder, so bad input is one line."""
+    if not hasattr(plant_class(inputs.plant), "timestep"):
+        return
+    plant = make_plant(inputs.plant, inputs.robot)
+    if off_engine_step(inputs.dt, plant):
+        # reset checks the step first and refuses it before it changes anything
+        plant.reset(
+            initial_configuration(inputs.robot, inputs.trajectory, inputs.offset), inputs.dt
+        )
+
+
 def _note_uneven_duration(duration: float, dt: float, steps: int) -> None:
     """Say so (stderr) when the run does not last the duration asked for: ``duration`` (s)
     is not a whole number of steps ``dt`` (s), and the run takes the nearest, ``steps``."""
@@ -623,8 +650,13 @@ def _main(argv: Sequence[str] | None = None) -> int:
         if args.rerun is None:
             raise
         raise _in_record(args.rerun, exc) from None
+    check_plant_step(inputs)
     fresh = args.out is None  # a default name: never replaces an earlier run
-    base = default_out(inputs.method, inputs.label) if fresh else Path(args.out)
+    base = (
+        default_out(inputs.method, inputs.label)
+        if fresh
+        else Path(given_text("out", args.out, "an output folder"))
+    )
     out = first_free(base, folder=True) if fresh else base
     physics = hasattr(PLANTS.load(inputs.plant), "tip_time")  # judges tipping: support loads
     names = output_names(not args.no_plots, args.animate, physics)
