@@ -277,8 +277,11 @@ def snapshot(
     created = missing_folders(target.parent)
     try:
         write_atomic(target, buffer.getvalue())
-    except OSError as exc:
+    except ParameterError:  # the folder turned unwritable during the run: its own words
         remove_created(created)  # leave no empty folder behind
+        raise
+    except OSError as exc:
+        remove_created(created)
         raise RunFailed(f"snapshot: cannot write {text} ({exc.strerror or exc})") from None
     return Path(path)
 
