@@ -339,22 +339,37 @@ def polygon_terms_gradient(
 ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
     """``((S_lon, dS_lon/dth1, dS_lon/dth2), (S_lat, ...))`` (1/rad) on ``k.edges`` (not
     None) from ``sin/cos th1`` and ``sin/cos (th1 + th2)``: each term's gradient is its
-    active edge's, ``dS/dth = -S (n . dc/dth) / (n . c)``; zero where capped."""
+    active edge's (the first of its least, :func:`edge_gradients`); zero where capped."""
+    terms = edge_gradients(k, s1, c1, s12, c12)
+    split = len(k.edges.lon)
+    capped = (STABILITY_CAP, 0.0, 0.0)
+    lon = min(terms[:split], key=lambda term: term[0], default=capped)
+    lat = min(terms[split:], key=lambda term: term[0], default=capped)
+    return lon, lat
+
+
+def edge_gradients(
+    k: ComCoefficients, s1: float, c1: float, s12: float, c12: float
+) -> tuple[tuple[float, float, float], ...]:
+    """``(S_e, dS_e/dth1, dS_e/dth2)`` (1/rad) of every edge of ``k.edges`` (not None; the
+    ``lon`` edges, then the ``lat`` ones) from ``sin/cos th1`` and ``sin/cos (th1 + th2)``.
+    ``S = min_e S_e``. An edge the centre of mass c faces within :data:`STABILITY_CAP` has
+    ``S_e = d / (n . c)`` and ``dS_e/dth = -S_e (n . dc/dth) / (n . c)``; any other reads
+    ``(STABILITY_CAP, 0, 0)`` (capped, as :func:`edge_margin` has it)."""
     x_com = k.A * c1 + k.B * c12
     y_com = k.A * s1 + k.B * s12
-    dx1, dy1 = -k.A * s1 - k.B * s12, k.A * c1 + k.B * c12
+    dx1, dy1 = -k.A * s1 - k.B * s12, x_com
     dx2, dy2 = -k.B * s12, k.B * c12
     terms = []
-    for edges in (k.edges.lon, k.edges.lat):
-        s, edge = edge_margin(edges, x_com, y_com)
-        if edge is None:
-            terms.append((s, 0.0, 0.0))
-            continue
-        factor = -s / (edge[0] * x_com + edge[1] * y_com)
-        terms.append(
-            (s, factor * (edge[0] * dx1 + edge[1] * dy1), factor * (edge[0] * dx2 + edge[1] * dy2))
-        )
-    return terms[0], terms[1]
+    for n_x, n_y, d in (*k.edges.lon, *k.edges.lat):
+        reach = n_x * x_com + n_y * y_com  # n . c, the offset towards the edge (m)
+        s = d / reach if reach * STABILITY_CAP > d else STABILITY_CAP
+        if s < STABILITY_CAP:
+            factor = -s / reach
+            terms.append((s, factor * (n_x * dx1 + n_y * dy1), factor * (n_x * dx2 + n_y * dy2)))
+        else:
+            terms.append((STABILITY_CAP, 0.0, 0.0))
+    return tuple(terms)
 
 
 @dataclass(frozen=True)

@@ -78,9 +78,9 @@ from ddwmmr.qp.limits import (
     full_step_is_safe,
     run_clearance,
     safe_arm_scale,
-    stability_terms_gradient,
 )
 from ddwmmr.qp.limits.edge_loads import EdgeLoadLimit
+from ddwmmr.qp.limits.stability import ascent_direction, stability_rows
 from ddwmmr.qp.problem import QPProblem
 from ddwmmr.qp.solve import MODES, check_mode, installed_solvers, make_backend, solve
 from ddwmmr.qp.tasks import (
@@ -418,8 +418,9 @@ class QPController:
     def _fallback(self, ctx: StepContext) -> np.ndarray:
         """Safe command when the QP fails; it keeps every built-in limit:
 
-        * arm: up the stability gradient of every term below the floor at half the speed
-          limit (else still), never further past a joint limit or deeper into the
+        * arm: at half the speed limit along a direction raising every stability term
+          below the floor (every edge of a support polygon; :meth:`_stability_ascent`;
+          else still), never further past a joint limit or deeper into the
           shoulder-singularity margin, then scaled by the exact one-step stability check
           (:func:`safe_arm_scale`: S never drops below ``min(S_min, S_now)``);
         * base: stopped, or, with a slew limit, as close to stopped as its envelope
@@ -457,15 +458,12 @@ class QPController:
         return float(np.max(np.abs(jac @ np.asarray(u, dtype=float) - target)))
 
     def _stability_ascent(self, ctx: StepContext) -> tuple[float, float]:
-        """Joint rates (rad/s) at half the speed limit up the summed unit gradients of the
-        stability terms below the damper's target (zero when none is)."""
-        r1 = r2 = 0.0
-        floor = self.stability_min + self.stability.margin
-        for s_i, g1, g2 in stability_terms_gradient(self._com, ctx.th1, ctx.th2):
-            norm = math.hypot(g1, g2)
-            if s_i < floor and norm > 0.0:
-                r1 += g1 / norm
-                r2 += g2 / norm
+        """Joint rates (rad/s) at half the speed limit along a direction that raises every
+        stability row's term below the damper's target (:func:`ascent_direction`: on a
+        polygon every edge, so a ridge between two edges is climbed, not crossed); zero
+        when none is below it or no direction raises them all."""
+        target = self.stability_min + self.stability.margin
+        r1, r2 = ascent_direction(stability_rows(self._com, ctx.th1, ctx.th2), target)
         norm = math.hypot(r1, r2)
         if norm == 0.0:
             return 0.0, 0.0

@@ -2,17 +2,20 @@
 
 ``S = min(S_lon, S_lat)`` on the support polygon (:mod:`ddwmmr.model.stability`): on the
 default rectangle ``S_lon = hl / |x_com|`` and ``S_lat = hw / |y_com|``, on another polygon
-each term is the least ``d_e / (n_e . c)`` of its edges. ``S >= S_min`` holds exactly when
-both terms do. Each term is smooth where it is below the cap and one edge has its minimum,
-with ``dS_i/dth = -S_i (n . dc/dth) / (n . c)`` (``n`` that edge's outward normal, ``c``
-the centre of mass; ``-S_i c_i' / c_i`` on the rectangle), so the limit constrains each
-term separately (no kink at the switch between them):
+``S`` is the least ``S_e = d_e / (n_e . c)`` over its edges. ``S >= S_min`` holds exactly
+when every such term does, so the limit has one row per term: the two of the rectangle
+(each group has one edge facing the centre of mass, so they are every edge that can be
+active), every edge of another polygon (where two edges of a group meet in a ridge of S, a
+row on the active edge alone would let the other fall through the floor within a step).
+Each term is smooth below the cap, with ``dS_e/dth = -S_e (n . dc/dth) / (n . c)`` (``n``
+the edge's outward normal, ``c`` the centre of mass; ``-S_i c_i' / c_i`` on the
+rectangle), so the rows have no kink where the minimum switches between terms:
 
-    dS_i/dt = g_i . (th1dot, th2dot) >= -gain (S_i - S_min - margin)
+    dS_e/dt = g_e . (th1dot, th2dot) >= -gain (S_e - S_min - margin)
 
-Above ``S_min + margin`` the term may fall at most exponentially towards the floor; below
+Above ``S_min + margin`` a term may fall at most exponentially towards the floor; below
 it, the term must rise. The right-hand side is capped at half of what the joint-speed box
-can deliver, so the row alone is always feasible. :func:`safe_arm_scale` then checks the
+can deliver, so each row alone is always feasible. :func:`safe_arm_scale` then checks the
 exact (nonlinear) S one control step ahead. The formulation: docs/theory.md, "The QP
 controller".
 """
@@ -29,6 +32,7 @@ from ddwmmr.model.stability import (
     STABILITY_FLOOR,
     ComCoefficients,
     check_stability_floor,
+    edge_gradients,
     polygon_terms_gradient,
     stability_terms,
 )
@@ -70,6 +74,71 @@ def stability_terms_from_trig(
         f = -s_lat / y_com
         lat = (s_lat, f * (k.A * c1 + k.B * c12), f * (k.B * c12))
     return lon, lat
+
+
+def stability_rows(
+    k: ComCoefficients, th1: float, th2: float
+) -> tuple[tuple[float, float, float], ...]:
+    """``(S_e, dS_e/dth1, dS_e/dth2)`` (1/rad) of every term :class:`StabilityLimit` has a
+    row for: ``(lon, lat)`` of :func:`stability_terms_gradient` on the rectangle, every
+    edge (:func:`~ddwmmr.model.stability.edge_gradients`) on another polygon. ``S`` is
+    their least ``S_e``; a capped term has zero gradient."""
+    return stability_rows_from_trig(
+        k, math.sin(th1), math.cos(th1), math.sin(th1 + th2), math.cos(th1 + th2)
+    )
+
+
+def stability_rows_from_trig(
+    k: ComCoefficients, s1: float, c1: float, s12: float, c12: float
+) -> tuple[tuple[float, float, float], ...]:
+    """:func:`stability_rows` from ``sin/cos th1`` and ``sin/cos (th1 + th2)``."""
+    if k.edges is None:
+        return stability_terms_from_trig(k, s1, c1, s12, c12)
+    return edge_gradients(k, s1, c1, s12, c12)
+
+
+def stability_row_count(k: ComCoefficients) -> int:
+    """How many rows :func:`stability_rows` has for ``k``'s support polygon."""
+    return 2 if k.edges is None else len(k.edges.lon) + len(k.edges.lat)
+
+
+def ascent_direction(
+    terms: tuple[tuple[float, float, float], ...], target: float
+) -> tuple[float, float]:
+    """A joint-rate direction ``(d1, d2)`` (not normalised) that raises every term ``(S_e,
+    g1, g2)`` below ``target`` (``g_e . d > 0``), or ``(0, 0)`` when none is below it or no
+    direction raises them all (S is then at a local maximum of its least terms).
+
+    It is the sum of those terms' unit gradients, which raises each of two terms unless
+    their gradients are opposite (``u_1 . (u_1 + u_2) = 1 + cos`` of their angle) and
+    weighs them alike whatever their gradients' scale. When three or more terms are below
+    the target that sum may lower one; then it is the least-norm ``d`` with ``g_e . d >=
+    1`` for every such term, found among the candidates the optimum can be (one
+    constraint active: ``g_e / |g_e|^2``; two: their intersection)."""
+    gradients = [(g1, g2) for s_e, g1, g2 in terms if s_e < target and (g1 or g2)]
+    d1 = d2 = 0.0
+    for g1, g2 in gradients:
+        norm = math.hypot(g1, g2)
+        d1 += g1 / norm
+        d2 += g2 / norm
+    if all(g1 * d1 + g2 * d2 > 0.0 for g1, g2 in gradients):
+        return d1, d2
+    return _least_raising(gradients)
+
+
+def _least_raising(gradients: list[tuple[float, float]]) -> tuple[float, float]:
+    """The least-norm ``d`` with ``g . d >= 1`` for every ``g`` of ``gradients``, or ``(0,
+    0)`` when there is none (in the plane the optimum has one or two constraints active)."""
+    candidates = [(g1 / (g1 * g1 + g2 * g2), g2 / (g1 * g1 + g2 * g2)) for g1, g2 in gradients]
+    for i, (a1, a2) in enumerate(gradients):
+        for b1, b2 in gradients[i + 1 :]:
+            det = a1 * b2 - a2 * b1
+            if det != 0.0:
+                candidates.append(((b2 - a2) / det, (a1 - b1) / det))
+    feasible = [
+        d for d in candidates if all(g1 * d[0] + g2 * d[1] >= 1.0 - 1e-9 for g1, g2 in gradients)
+    ]
+    return min(feasible, key=lambda d: math.hypot(*d), default=(0.0, 0.0))
 
 
 def exact_stability(k: ComCoefficients, th1: float, th2: float) -> float:
@@ -143,8 +212,9 @@ def full_step_is_safe(
 
 
 class StabilityLimit(Limit):
-    """Two rows, ``dS_lon/dt`` and ``dS_lat/dt`` >= damper bound (see module docstring); on
-    a support polygon other than the rectangle each row is its term's active edge's.
+    """One row ``dS_e/dt >= damper bound`` per term of :func:`stability_rows` (see module
+    docstring): ``dS_lon/dt`` and ``dS_lat/dt`` on the rectangle, one per edge on another
+    support polygon.
 
     Args:
         robot_com: the robot's centre-of-mass coefficients (``Robot.com_coefficients``).
@@ -166,6 +236,7 @@ class StabilityLimit(Limit):
         joint_speed: float = 2.0,
     ) -> None:
         self.com = robot_com
+        self.rows = stability_row_count(robot_com)
         self.stability_min = check_stability_floor(stability_min)
         self.gain = check_gain("stability gain", gain)
         self.margin = check_positive("stability margin", margin)
@@ -180,8 +251,8 @@ class StabilityLimit(Limit):
         return achievable if achievable < damper else damper  # min(damper, achievable)
 
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
-        """Rows ``[0, 0, dS_i/dth1, dS_i/dth2]`` with lower bound ``-gain (S_i - floor)``."""
-        for row, (s_i, g1, g2) in enumerate(stability_terms_gradient(self.com, ctx.th1, ctx.th2)):
+        """Rows ``[0, 0, dS_e/dth1, dS_e/dth2]`` with lower bound ``-gain (S_e - floor)``."""
+        for row, (s_i, g1, g2) in enumerate(stability_rows(self.com, ctx.th1, ctx.th2)):
             G[row, 0] = G[row, 1] = 0.0
             G[row, 2], G[row, 3] = g1, g2
             upper[row] = INF
@@ -193,8 +264,10 @@ class StabilityLimit(Limit):
         constant."""
         if overrides(self, StabilityLimit) or overrides(self, StabilityLimit, "lower_bound"):
             return None
-        block.write_constant_rows([[0.0] * 4, [0.0] * 4])
-        block.write_constant_bounds((-INF, -INF), (INF, INF))
+        block.write_constant_rows([[0.0] * 4] * self.rows)
+        block.write_constant_bounds((-INF,) * self.rows, (INF,) * self.rows)
+        if self.com.edges is not None:
+            return self._polygon_writer(block)
         G, lower = block.matrix, block.lower
         (lon_row, lat_row), (lon_bound, lat_bound) = block.rows, block.bounds
         com, bound = self.com, self.lower_bound
@@ -207,5 +280,19 @@ class StabilityLimit(Limit):
             G[lat_row + 2], G[lat_row + 3] = h1, h2
             lower[lon_bound] = bound(s_lon, g1, g2)
             lower[lat_bound] = bound(s_lat, h1, h2)
+
+        return write
+
+    def _polygon_writer(self, block: LimitBlock) -> Callable[[StepContext], None]:
+        """The writer on a polygon other than the rectangle: one row per edge."""
+        G, lower = block.matrix, block.lower
+        slots = list(zip(block.rows, block.bounds))
+        com, bound = self.com, self.lower_bound
+
+        def write(ctx: StepContext) -> None:
+            terms = edge_gradients(com, ctx.sin_th1, ctx.cos_th1, ctx.sin_th12, ctx.cos_th12)
+            for (row, index), (s_e, g1, g2) in zip(slots, terms):
+                G[row + 2], G[row + 3] = g1, g2
+                lower[index] = bound(s_e, g1, g2)
 
         return write
