@@ -242,12 +242,12 @@ class Robot:
         :class:`ParameterError` (one line, naming ``caster_positions``) when it does not
         hold the base centre strictly inside (docs/theory.md, "Tip-over stability")."""
         points = support_loads.support_points(self)
-        edges = _support_edges(points)
+        edges = _edges_of_points(points)
         if edges is None:
             raise ParameterError(
                 "caster_positions: the base centre must lie strictly inside the support "
-                "polygon of the wheels and casters (the stability margin S measures the "
-                f"centre of mass's offset from it) (got casters {self.casters})"
+                "polygon of the wheels and casters, not on an edge (the stability margin S "
+                f"measures the centre of mass's offset from it) (got casters {self.casters})"
             )
         return edges
 
@@ -683,7 +683,7 @@ def _configuration_slow(q, name: str) -> list[float]:
 
 
 @functools.lru_cache(maxsize=64)
-def _support_edges(points: tuple[tuple[float, float], ...]) -> stability.SupportEdges | None:
+def _edges_of_points(points: tuple[tuple[float, float], ...]) -> stability.SupportEdges | None:
     """:class:`~ddwmmr.model.stability.SupportEdges` of the support points (m, base frame),
     None when they span no polygon holding the base centre farther than
     :data:`~ddwmmr.model.support_loads.ON_EDGE_TOLERANCE_M` from every edge. Cached: a

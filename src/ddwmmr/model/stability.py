@@ -122,8 +122,10 @@ class SupportEdges:
     measures them (module docstring). Build it with :meth:`from_lines`.
 
     Attributes:
-        lon: the edges facing front or back (:func:`is_longitudinal`), ``S_lon``'s.
-        lat: the other edges, ``S_lat``'s.
+        lon: the edges facing front or back (:func:`is_longitudinal`), ``S_lon``'s; may be
+            empty (a diamond, whose normals all have ``|n_y| > |n_x|``): ``S_lon`` is then
+            the cap, :data:`STABILITY_CAP`, in every pose.
+        lat: the other edges, ``S_lat``'s (may be empty alike).
         radius: the largest distance (m) of a vertex from the base centre.
         rectangle: ``(half_length, half_width)`` (m) when the polygon is exactly the
             rectangle ``|x| <= half_length, |y| <= half_width`` (S's closed form), else None.

@@ -115,9 +115,10 @@ def stability_terms(robot: Robot, q: Symbolic) -> Symbolic:
     return ca.vertcat(*terms)
 
 
-def stability_bounds(robot: Robot, stability_min: float) -> tuple[float, float]:
+def stability_bounds(robot: Robot, stability_min: float) -> tuple[float, float] | None:
     """Bounds ``(x_max, y_max)`` (m) with ``S >= stability_min  <=>  |x_com| <= x_max and
-    |y_com| <= y_max`` on the rectangle (:func:`stability_edges` is None).
+    |y_com| <= y_max`` on the rectangle; None on any other support polygon (then
+    :func:`stability_edges` holds the condition: the footprint's box is not S there).
 
     ``S_lon = hl/|x_com| >= S_min`` holds exactly when ``|x_com| <= hl/S_min`` (both sides
     are positive), and likewise for the lateral term. Constraining the centre of mass
@@ -126,6 +127,8 @@ def stability_bounds(robot: Robot, stability_min: float) -> tuple[float, float]:
     """
     s_min = check_positive("stability_min", stability_min)
     k = robot.com_coefficients
+    if k.edges is not None:
+        return None
     return k.half_length / s_min, k.half_width / s_min
 
 

@@ -644,8 +644,8 @@ def thesis_model(robot: Robot, dynamics: sym.ThesisDynamics, stability_min: floa
     joints have moved linearly (constant rates).
     """
     limit = robot.wheel_speed_limit
-    x_max, y_max = sym.stability_bounds(robot, stability_min)
     edges = sym.stability_edges(robot, stability_min)  # None: the rectangle's box
+    x_max, y_max = sym.stability_bounds(robot, stability_min) or (np.inf, np.inf)  # or edges
 
     def held(q):
         """What the stability rows bound: the centre of mass, or its offset towards each

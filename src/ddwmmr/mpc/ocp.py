@@ -361,8 +361,8 @@ class ShootingOCP:
         us = [self.w[s] for s in self.u_slices]
         slacks = [self.w[s] for s in self.slack_slices]
         floor = config.stability_min + config.stability_margin
-        x_max, y_max = sym.stability_bounds(robot, floor)
         edges = sym.stability_edges(robot, floor)  # None: the rectangle's box
+        x_max, y_max = sym.stability_bounds(robot, floor) or (INF, INF)  # unused with edges
         clear = [
             (c.x, c.y, (c.radius + config.base_radius + config.obstacle_margin) ** 2)
             for c in config.obstacles

@@ -278,8 +278,8 @@ TIPPED = (
 SUPPORT_LOST = (
     "warning: an edge of the support polygon was unloaded for {unloaded_s:.3g} of "
     "{duration_s:.3g} s (support_lost: a wheel off the ground or the base rocking onto an "
-    "edge; it did not tip over){predicted}: a higher floor (qp's and mpc's stability_min, "
-    "qp's min_edge_load) or a slower trajectory keeps the load on it "
+    "edge; it did not tip over){predicted}: a higher floor (qp's and mpc's stability_min "
+    "and min_edge_load) or a slower trajectory keeps the load on it "
     '(see docs/physics.md, "Tip-over from the contact forces")'
 )
 #: :data:`SUPPORT_LOST`'s words on a controller that predicted an edge load below its floor.

@@ -42,6 +42,7 @@ from ddwmmr.plants.base import (
 from ddwmmr.plants.kinematic import KinematicPlant
 from ddwmmr.plants.mujoco.model import (
     ACTUATORS,
+    BASE_CLEARANCE,
     DEFAULT_TIMESTEP,
     MAX_ENGINE_STEPS_PER_CONTROL_STEP,
     TIMESTEP_RANGE_S,
@@ -102,11 +103,13 @@ _WARNINGS = (
     mujoco.mjtWarning.mjWARN_BADQVEL,
     mujoco.mjtWarning.mjWARN_BADCTRL,
 )
-#: A speed beyond this many times the fastest the robot's motors drive that degree of
-#: freedom is a blown-up state (:meth:`MujocoPlant._speed_bounds`): a robot within its
-#: limits stays near 1 times (the default robot's tracking runs below 1.05, a robot
-#: falling over below 10), while a state blowing up passes it within a step or two, long
-#: before it turns non-finite or the engine flags it (docs/physics.md, "The plant").
+#: A speed beyond this many times both the fastest the robot's motors drive that degree
+#: of freedom and the fastest gravity moves it in a fall is a blown-up state
+#: (:meth:`MujocoPlant._speed_bounds`): a robot within its limits stays near 1 times the
+#: motors' (the default robot's tracking runs below 1.05) and a robot falling over within
+#: 1 times the fall's on its base and a few times on the joints, which whip as it lands,
+#: while a state blowing up passes both within a step or two, long before it turns
+#: non-finite or the engine flags it (docs/physics.md, "The plant").
 SPEED_BOUND_FACTOR = 10.0
 #: What to do about a diverged state, for messages: the engine step is the API's option
 #: (the command-line tools run at the default 2 ms).
@@ -198,7 +201,8 @@ class MujocoPlant:
         self._step_count = 0
         self._warnings = 0
         self._bad_controls = 0  # the engine's count of rejected controls, as last seen
-        self._bounds, self._bound_names = self._speed_bounds()
+        self._motor_bounds, self._fall_bounds, self._bound_names = self._speed_bounds()
+        self._bounds = np.maximum(self._motor_bounds, self._fall_bounds)
         self._phi = 0.0
         self._cache: tuple[float, ...] | None = None
         self._contacts: tuple[list[int], list[float]] | None = None  # of the current state
@@ -525,28 +529,48 @@ class MujocoPlant:
             f"(the API) a smaller MujocoPlant(robot, timestep=...) in [{low:g}, {high:g}] s"
         )
 
-    def _speed_bounds(self) -> tuple[np.ndarray, list[tuple[str, str]]]:
-        """Per degree of freedom (``MjData.qvel``), the largest plausible speed and what it
-        is: :data:`SPEED_BOUND_FACTOR` times the fastest the robot's motors drive it (the
-        base's velocity components: the wheels' rim speed ``wheel_speed_limit r``; its
-        angular velocity components: that rim speed over half the track, the fastest yaw;
-        the joints: ``joint_speed_limit``), with its name and unit. The wheels' spin and
-        the tyres' radial slides are unbounded: under force commands a wheel off the
-        floor spins up freely (the model has no motor speed limit), and a blow-up of
-        either moves the base."""
+    def _speed_bounds(self) -> tuple[np.ndarray, np.ndarray, list[tuple[str, str]]]:
+        """Per degree of freedom (``MjData.qvel``), two bounds on a plausible speed and
+        what it is (name, unit): :data:`SPEED_BOUND_FACTOR` times the fastest the robot's
+        motors drive it (the base's velocity components: the wheels' rim speed
+        ``wheel_speed_limit r``; its angular velocity components: that rim speed over half
+        the track, the fastest yaw; the joints: ``joint_speed_limit``), and the same factor
+        times the fastest a fall moves it (:meth:`_fall_scales`: the base's velocity its
+        fall speed, its angular velocity and the joints' rates its tip-over rate), which
+        is gravity's, not the motors' (a robot with slow motors still falls at full speed).
+        A speed is plausible within the larger. The wheels' spin and the tyres' radial
+        slides are unbounded: under force commands a wheel off the floor spins up freely
+        (the model has no motor speed limit), and a blow-up of either moves the base."""
         robot, model = self.robot, self.model
         rim = robot.wheel_speed_limit * robot.wheel_radius
-        bounds = np.full(model.nv, np.inf)
+        fall_speed, fall_rate = self._fall_scales()
+        motor = np.full(model.nv, np.inf)
+        fall = np.full(model.nv, np.inf)
         names = [("tyre", "m/s")] * model.nv
-        bounds[0:3] = SPEED_BOUND_FACTOR * rim
+        motor[0:3], fall[0:3] = rim, fall_speed
         names[0:3] = [("base speed", "m/s")] * 3
-        bounds[3:6] = SPEED_BOUND_FACTOR * rim / (0.5 * robot.track_width)
+        motor[3:6], fall[3:6] = rim / (0.5 * robot.track_width), fall_rate
         names[3:6] = [("base rotation rate", "rad/s")] * 3
         for joint in ("shoulder", "elbow"):
             dof = int(model.jnt_dofadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, joint)])
-            bounds[dof] = SPEED_BOUND_FACTOR * robot.joint_speed_limit
+            motor[dof], fall[dof] = robot.joint_speed_limit, fall_rate
             names[dof] = (f"{joint} rate", "rad/s")
-        return bounds, names
+        return SPEED_BOUND_FACTOR * motor, SPEED_BOUND_FACTOR * fall, names
+
+    def _fall_scales(self) -> tuple[float, float]:
+        """The speed (m/s) and rotation rate (rad/s) a fall gives the robot, from gravity
+        ``g`` alone: ``sqrt(2 g H)``, what a body falling from the robot's height ``H`` (the
+        higher of its base's top and its arm's plane) reaches, and ``sqrt(2 g / h_c)``,
+        the most a rigid body whose centre of mass stands ``h_c`` above the floor turns at
+        tipping over an edge on the floor (its ``h_c`` in the model's rest pose; derived in
+        docs/physics.md, "The plant")."""
+        robot, model = self.robot, self.model
+        g = -float(model.opt.gravity[2])
+        height = max(BASE_CLEARANCE + robot.base_height, robot.arm_height)
+        rest = mujoco.MjData(model)  # a scratch state: self.data stays untouched
+        mujoco.mj_forward(model, rest)
+        com_height = float(rest.subtree_com[0, 2])  # the world's subtree: the whole robot
+        return math.sqrt(2.0 * g * height), math.sqrt(2.0 * g / com_height)
 
     def _warning_count(self) -> int:
         return sum(int(self.data.warning[w].number) for w in _WARNINGS)
@@ -575,7 +599,8 @@ class MujocoPlant:
             name, unit = self._bound_names[dof]
             cause = (
                 f"{name} {abs(float(data.qvel[dof])):.3g} {unit}, beyond {SPEED_BOUND_FACTOR:g} "
-                f"times the fastest the motors drive it ({self._bounds[dof]:.3g} {unit})"
+                f"times the fastest the motors drive it ({self._motor_bounds[dof]:.3g} {unit}) "
+                f"and a fall moves it ({self._fall_bounds[dof]:.3g} {unit})"
             )
         raise PlantDivergedError(f"MuJoCo state diverged {where}: {cause} ({_SMALLER_STEP})")
 
