@@ -5,10 +5,16 @@ Every tool (track, compare, scenarios) writes its results through :func:`output_
 * the files are written into a hidden staging folder next to ``--out`` and moved into place
   only when the run succeeded; the staging folder is removed on any error, Ctrl-C or
   SIGTERM (:mod:`ddwmmr.cli.common` turns SIGTERM into an exception so this happens);
-* a run killed outright (SIGKILL, a power cut) cannot clean up: its staging folder and
-  the folder of an earlier output it was replacing carry its host, process id and start
-  time in their names (:func:`owner_token`), and the next run writing in the same folder
-  removes those whose process is gone (:func:`remove_stale`), saying so in one line;
+* the moves into ``--out`` hold the stop signals (:func:`_signals_deferred`): a signal
+  arriving then is acted on once they are done, with the new output complete in place
+  (:func:`committed_output`);
+* a run killed outright (SIGKILL) cannot clean up: its staging folder, the folder of an
+  earlier output it was replacing and its temporary files carry its host, process id and
+  start time in their names (:func:`owner_token`), and the next run writing in the same
+  folder removes those whose process is gone (:func:`remove_stale`), saying so in one
+  line, after putting back an earlier output of its own ``--out`` the killed run had
+  moved aside (:func:`_restore_killed`). Nothing is synced to disk (no ``fsync``): a power
+  cut may lose the last files written;
 * a folder written by a tool carries a manifest, :data:`MANIFEST`, naming the tool, the
   package version and every file written;
 * an existing ``--out`` is replaced only if it is empty, or if its manifest names the same
@@ -33,16 +39,19 @@ from __future__ import annotations
 import contextlib
 import csv
 import errno
+import hashlib
 import io
 import json
 import os
 import re
 import shutil
+import signal
 import socket
 import stat
 import sys
 import tempfile
-from collections.abc import Callable, Iterable, Mapping, Sequence
+import threading
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
@@ -56,9 +65,24 @@ _OLD_PREFIX = ".ddwmmr-old-"
 #: Where the files of an old folder that no manifest lists are kept (a user's files).
 KEPT_PREFIX = ".ddwmmr-kept-"
 #: A staging or old folder's name: prefix, owner (host, process id, start time), random.
+#: A temporary file's (:func:`write_atomic`) too, with ``.tmp`` at the end of its random
+#: part. An old folder's random part starts with :func:`_target_tag` of the folder it
+#: replaces, so a run can find the old output of its own ``--out`` a killed run left.
 _OWNED_NAME = re.compile(
-    r"^\.ddwmmr-(?P<kind>staging|old)-(?P<host>.+)-(?P<pid>\d+)-(?P<start>\d+)-[^-]+$"
+    r"^\.ddwmmr-(?P<kind>staging|old|tmp)-(?P<host>.+)-(?P<pid>\d+)-(?P<start>\d+)-"
+    r"(?P<random>[^-]+)$"
 )
+_TMP_PREFIX = ".ddwmmr-tmp-"
+#: The signals whose Python handlers wait while a commit moves files (the tools' stop
+#: signals: :mod:`ddwmmr.cli.signals`, which this low layer may not import).
+_DEFERRED_SIGNALS = tuple(
+    getattr(signal, name)
+    for name in ("SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT")
+    if hasattr(signal, name)
+)
+#: Attribute set on an exception (an interrupt) that arrived once the new output was in
+#: place: its value is the output folder, complete (see :func:`committed_output`).
+_COMMITTED = "ddwmmr_committed_output"
 
 
 # -- permissions ------------------------------------------------------------------------
@@ -167,10 +191,13 @@ def _entries(folder: Path) -> list[str]:
 
 
 def inspect(target: Path, tool: str) -> Existing:
-    """Classify an existing folder (see :class:`Existing`); ``target`` must be a folder."""
-    entries = [e for e in _entries(target) if e != MANIFEST]
+    """Classify an existing folder (see :class:`Existing`); ``target`` must be a folder.
+    Temporary files ended runs left (:func:`remove_stale_temp`) are not counted."""
+    entries = [
+        e for e in _entries(target) if e != MANIFEST and not _is_stale_temp(PurePosixPath(e).name)
+    ]
     has_manifest = os.path.lexists(target / MANIFEST)
-    if not entries and not has_manifest and not any(target.iterdir()):
+    if not entries and not has_manifest and all(_is_stale_temp(n) for n in _names(target)):
         return Existing("empty")
     manifest = read_manifest(target)
     listed = set(manifest["files"]) if manifest else set()
@@ -304,7 +331,7 @@ def check_writable(label: str, folder: Path, name: str | None = None) -> None:
     The :class:`OSError` of the failed try is the error's ``__cause__``."""
     existing = existing_folder(label, folder)
     try:
-        fd, probe = tempfile.mkstemp(dir=existing, prefix=".ddwmmr-", suffix=".tmp")
+        fd, probe = tempfile.mkstemp(dir=existing, prefix=temp_prefix(), suffix=".tmp")
     except OSError as exc:
         shown_name = str(folder) if name is None else name
         raise ParameterError(unwritable_message(label, shown_name, folder, existing, exc)) from exc
@@ -464,14 +491,17 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     Failures of the write itself (full disk) raise :class:`OSError`.
 
     The file gets the user's umask (``0644`` for umask 022), like any normal file, not
-    the ``0600`` of the temporary file; text is written as UTF-8.
+    the ``0600`` of the temporary file; text is written as UTF-8. The temporary file
+    carries this process's :func:`owner_token` in its name (:func:`temp_prefix`): one a
+    killed run leaves is removed by the next run (:func:`remove_stale`,
+    :func:`remove_stale_temp`) and ignored by :func:`inspect`.
     """
     path = check_file_target(path)
     existing = existing_folder("path", path.parent)
     payload = data if isinstance(data, bytes) else data.encode("utf-8")
     try:
         path.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
-        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".ddwmmr-", suffix=".tmp")
+        fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=temp_prefix(), suffix=".tmp")
     except OSError as exc:  # the folder takes no new entries (/proc, read-only, no permission)
         message = unwritable_message("path", str(path.parent), path.parent, existing, exc)
         raise ParameterError(message) from exc
@@ -486,6 +516,48 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def write_new(path: str | Path, data: str | bytes | Callable[[Path], None]) -> Path:
+    """Write a new file at ``path`` or, if that name is taken, at the first free
+    ``stem-2.suffix``, ``stem-3.suffix``... (:func:`first_free`); an existing file is
+    never replaced, not even one another process creates at the same moment. Returns the
+    path written.
+
+    ``data`` (text, written as UTF-8, or bytes) goes to a temporary file first, or
+    ``data(temporary_path)`` writes it there (e.g. a result's ``write_csv``). That file
+    then takes the free name with a hard link, which fails if the name was taken
+    meanwhile: the next name is tried. Where hard links are not supported, the name is
+    taken with an exclusive create, then the file is renamed onto it."""
+    path = Path(path)
+    temporary = path.parent / f"{temp_prefix()}{os.urandom(4).hex()}.tmp"
+    try:
+        if callable(data):
+            data(temporary)
+        else:
+            write_atomic(temporary, data)
+        while True:
+            candidate = first_free(path)
+            try:
+                os.link(temporary, candidate)
+                return candidate
+            except FileExistsError:
+                continue  # taken between the look and the link: the next one
+            except OSError:  # no hard links on this file system (FAT, some mounts)
+                if _take_name(candidate):
+                    os.replace(temporary, candidate)
+                    return candidate
+    finally:
+        temporary.unlink(missing_ok=True)
+
+
+def _take_name(path: Path) -> bool:
+    """Create ``path`` empty if nothing is there (exclusively); False if it was taken."""
+    try:
+        os.close(os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, file_mode()))
+    except FileExistsError:
+        return False
+    return True
 
 
 # -- who owns a staging folder ---------------------------------------------------------
@@ -507,6 +579,25 @@ def _process_start(pid: int) -> int:
 def owner_token() -> str:
     """``host-pid-start`` of this process, put in the names of its staging folders."""
     return f"{_host()}-{os.getpid()}-{_process_start(os.getpid())}"
+
+
+def temp_prefix() -> str:
+    """Name prefix of this process's temporary files, carrying its :func:`owner_token`."""
+    return f"{_TMP_PREFIX}{owner_token()}-"
+
+
+def _target_tag(target: Path) -> str:
+    """A short digest of ``target``'s name, put in the name of the old folder replacing it."""
+    return hashlib.sha256(os.fsencode(target.name)).hexdigest()[:8]
+
+
+def _dead_owner(name: str, kind: str) -> re.Match[str] | None:
+    """The match of ``name`` if it is a ``kind`` (staging, old, tmp) name of a run of this
+    host that has ended, else None."""
+    match = _OWNED_NAME.match(name)
+    if match is None or match["kind"] != kind or match["host"] != _host():
+        return None
+    return None if _running(int(match["pid"]), int(match["start"])) else match
 
 
 def _running(pid: int, start: int) -> bool:
@@ -535,27 +626,29 @@ def stale_folders(folder: Path) -> list[Path]:
         names = sorted(os.listdir(folder))
     except OSError:
         return []
-    host = _host()
     found = []
     for name in names:
         match = _OWNED_NAME.match(name)
-        if match is None or match["host"] != host:
-            continue
         path = folder / name
-        if os.path.islink(path) or not path.is_dir():
+        if match is None or match["kind"] == "tmp" or os.path.islink(path) or not path.is_dir():
             continue
-        if not _running(int(match["pid"]), int(match["start"])):
+        if _dead_owner(name, match["kind"]) is not None:
             found.append(path)
     return found
 
 
-def remove_stale(folder: Path) -> list[Path]:
+def remove_stale(folder: Path, target: Path | None = None) -> list[Path]:
     """Remove :func:`stale_folders` of ``folder`` and say so in one line on stderr.
 
     A staging folder holds only an unfinished run's files: it goes whole. An old folder
     holds an earlier output being replaced: only the files its manifest lists (and the
     manifest) go, as the replace would have done; anything else in it is kept. Returns the
-    folders removed."""
+    folders removed. Temporary files of ended runs (:func:`temp_prefix`) in ``folder`` go
+    too. ``target`` (an ``--out`` in ``folder``): first, if a run killed while it replaced
+    ``target`` left it absent or with listed files missing, the earlier output is put
+    back from that run's old folder (:func:`_restore_killed`), said in one line."""
+    if target is not None:
+        _restore_killed(folder, target)
     removed, kept = [], []
     for path in stale_folders(folder):
         if path.name.startswith(STAGING_PREFIX):
@@ -577,7 +670,92 @@ def remove_stale(folder: Path) -> list[Path]:
         if kept:
             line += f"; kept files no manifest lists in {_listed(kept).strip(' ()')}"
         _say(line)
+    remove_stale_temp(folder)
     return removed
+
+
+def _is_stale_temp(name: str) -> bool:
+    """Whether ``name`` is a temporary file's name (:func:`temp_prefix`) of an ended run."""
+    return name.endswith(".tmp") and _dead_owner(name, "tmp") is not None
+
+
+def remove_stale_temp(folder: Path, recursive: bool = False) -> list[Path]:
+    """Remove the temporary files ended runs left in ``folder`` (and, ``recursive``, below
+    it) and say so in one line on stderr; returns them. Only regular files whose names
+    carry the owner of a run of this host that has ended are touched."""
+    removed = []
+    for root, _, files in os.walk(folder) if recursive else [(folder, [], _names(folder))]:
+        for name in files:
+            path = Path(root) / name
+            if _is_stale_temp(name) and _is_regular(path):
+                with contextlib.suppress(OSError):
+                    path.unlink()
+                    removed.append(path)
+    if removed:
+        count = len(removed)
+        _say(
+            f"note: removed {count} temporary file{'s' * (count != 1)} left in {folder} "
+            f"by runs that were killed{_listed(removed)}"
+        )
+    return removed
+
+
+def _names(folder: Path) -> list[str]:
+    try:
+        return os.listdir(folder)
+    except OSError:
+        return []
+
+
+def _restore_killed(folder: Path, target: Path) -> Path | None:
+    """Put back the earlier output of ``target`` a killed run was replacing: from an old
+    folder of an ended run made for ``target`` (:func:`_target_tag`) holding a manifest,
+    when ``target`` is absent (killed between the two renames of :func:`_swap`) or its
+    manifest lists files it lacks (killed during :func:`_merge`). Returns the old folder
+    used, or None; says what it did in one line."""
+    tag = _target_tag(target)
+    for name in sorted(_names(folder)):
+        match = _dead_owner(name, "old")
+        old = folder / name
+        if match is None or not match["random"].startswith(tag) or os.path.islink(old):
+            continue
+        manifest = read_manifest(old)
+        if manifest is None:
+            continue
+        try:
+            if not os.path.lexists(target):
+                os.rename(old, target)  # the whole earlier folder, as _swap moved it
+            elif target.is_dir() and not os.path.islink(target) and _incomplete(target):
+                _merge_back(old, target, manifest)
+            else:
+                continue
+        except OSError:
+            continue  # left as it is: remove_stale keeps what no manifest lists
+        _say(f"note: put back the earlier output of {target} that a killed run was replacing")
+        return old
+    return None
+
+
+def _incomplete(folder: Path) -> bool:
+    """Whether ``folder``'s manifest is missing or lists a file ``folder`` lacks."""
+    manifest = read_manifest(folder)
+    return manifest is None or not all(_is_regular(folder / f) for f in manifest["files"])
+
+
+def _merge_back(old: Path, target: Path, manifest: dict) -> None:
+    """Undo a :func:`_merge` killed midway: remove the new files it had moved into
+    ``target`` (listed by ``target``'s manifest, not by the earlier ``manifest``), move
+    the earlier files back from ``old``, then the earlier manifest."""
+    current = read_manifest(target)
+    earlier = set(manifest["files"])
+    for name in sorted(set(current["files"] if current else []) - earlier):
+        _unlink_regular(target / name)
+        _prune_up((target / name).parent, target)
+    for name in sorted(earlier):
+        if _is_regular(old / name):
+            _move(old / name, target / name, [], [])
+    os.replace(old / MANIFEST, target / MANIFEST)
+    _prune_empty(old)
 
 
 def _set_aside(path: Path) -> Path:
@@ -643,7 +821,7 @@ class OutputFolder:
         if self._entered:
             raise RuntimeError("an OutputFolder is used for one with-block only")
         self._entered = True
-        remove_stale(self.path.parent)
+        remove_stale(self.path.parent, None if self.fresh else self.path)
         prefix = f"{STAGING_PREFIX}{owner_token()}-"
         for attempt in range(2):
             self._created = _make_parents(self.path.parent)
@@ -670,18 +848,28 @@ class OutputFolder:
         return staging
 
     def __exit__(self, exc_type, exc, traceback) -> bool:
-        if exc_type is None:
-            try:
+        if exc_type is not None:
+            self._discard()
+            return False  # the block's exception goes on
+        done: list[Path] = []
+        try:
+            with _signals_deferred():
                 target = self._base if self.fresh else self.path
-                self.path = _commit(
-                    self._staging, target, self.tool, self.force, self._text, self.fresh
-                )
-                return False
-            except BaseException:
-                self._discard()
+                _commit(self._staging, target, self.tool, self.force, self._text, done, self.fresh)
+        except BaseException as error:
+            if done:  # the new output is in place: it stays, and the exception says so
+                self.path, self._staging = done[0], None
+                setattr(error, _COMMITTED, done[0])
                 raise
-        self._discard()
-        return False  # the block's exception goes on
+            self._discard()
+            if isinstance(error, OSError) and not isinstance(error, ParameterError):
+                raise OSError(
+                    error.errno,
+                    f"out: cannot move the results into {self._text} ({error.strerror})",
+                ) from error
+            raise
+        self.path = done[0]
+        return False
 
     def _discard(self) -> None:
         if self._staging is not None:
@@ -705,6 +893,39 @@ def output_folder(
     go to the first free ``target-2``, ``target-3``... (the returned object's ``path``).
     """
     return OutputFolder(target, tool, force, fresh)
+
+
+def committed_output(error: BaseException) -> Path | None:
+    """The output folder an interrupt arrived too late to stop: the run's new output was
+    already complete in it (the stop came while the replaced one was being deleted).
+    None for any other exception."""
+    return getattr(error, _COMMITTED, None)
+
+
+@contextlib.contextmanager
+def _signals_deferred() -> Iterator[None]:
+    """Hold the stop signals (:data:`_DEFERRED_SIGNALS`) whose handlers are Python code
+    (the tools' :func:`ddwmmr.cli.common.interruptible`, Python's Ctrl-C) while the block
+    moves files, then run the handler of the first one that came: an output is never left
+    half moved by a signal. Outside the main thread (where handlers cannot be set)
+    nothing is held."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+    previous = {}
+    for number in _DEFERRED_SIGNALS:
+        handler = signal.getsignal(number)
+        if callable(handler):
+            previous[number] = handler
+            signal.signal(number, lambda signum, frame: held.append(signum))
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+        if held:
+            previous[held[0]](held[0], None)
 
 
 def _make_parents(folder: Path) -> list[Path]:
@@ -735,34 +956,44 @@ def remove_created(created: list[Path]) -> None:
 
 
 def _commit(
-    staging: Path, target: Path, tool: str, force: bool, text: str, fresh: bool = False
-) -> Path:
-    """Move the staged files into ``target`` (or, ``fresh``, a free sibling); returns the
-    folder they went to."""
+    staging: Path,
+    target: Path,
+    tool: str,
+    force: bool,
+    text: str,
+    done: list[Path],
+    fresh: bool = False,
+) -> None:
+    """Move the staged files into ``target`` (or, ``fresh``, a free sibling). The folder
+    they went to is appended to ``done`` as soon as the new output is complete there,
+    before the replaced one is deleted: an exception after that finds it in ``done``."""
     files = _entries(staging)
     manifest = {"tool": tool, "version": package_version(), "files": files}
     _write_manifest(staging, manifest)
     if fresh:
-        return _commit_fresh(staging, target)
+        _commit_fresh(staging, target, done)
+        return
     if not os.path.lexists(target):
         os.rename(staging, target)
-        return target
+        done.append(target)
+        return
     if os.path.islink(target) or not target.is_dir():
         raise ParameterError(f"out: {text} changed during the run and is not a folder any more")
+    remove_stale_temp(target, recursive=True)
     existing = inspect(target, tool)
     if existing.kind in ("empty", "own"):
-        _swap(staging, target, existing)
+        _swap(staging, target, existing, done)
     elif force:
-        _merge(staging, target, files, existing, text)
+        _merge(staging, target, files, existing, text, done)
     else:
         raise ParameterError(_refusal(text, tool, existing))
-    return target
 
 
-def _commit_fresh(staging: Path, target: Path) -> Path:
+def _commit_fresh(staging: Path, target: Path, done: list[Path]) -> None:
     """Rename ``staging`` to the first of ``target``, ``target-2``... that nobody holds:
     each candidate is taken with an exclusive ``mkdir`` (so two runs finishing together
-    cannot take the same one), then the staging folder replaces that empty folder."""
+    cannot take the same one), then the staging folder replaces that empty folder; see
+    :func:`_commit` for ``done``."""
     while True:
         candidate = first_free(target, folder=True)
         try:
@@ -776,10 +1007,14 @@ def _commit_fresh(staging: Path, target: Path) -> Path:
         try:
             os.rename(staging, candidate)  # onto our own empty folder
         except BaseException:
+            if not os.path.lexists(staging):  # the rename was made: the output is there
+                done.append(candidate)
+                raise
             with contextlib.suppress(OSError):
-                candidate.rmdir()  # only if still empty: after the rename it holds the run
+                candidate.rmdir()
             raise
-        return candidate
+        done.append(candidate)
+        return
 
 
 def list_in_manifest(folder: str | Path, tool: str, names: Sequence[str]) -> None:
@@ -788,6 +1023,7 @@ def list_in_manifest(folder: str | Path, tool: str, names: Sequence[str]) -> Non
     :class:`ParameterError`) a folder that is not this tool's own."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True, mode=folder_mode())
+    remove_stale_temp(folder, recursive=True)  # a killed write of an earlier run
     existing = inspect(folder, tool)
     fresh = [n for n in names if n not in existing.listed]
     other_tool = existing.tool is not None and existing.tool != tool
@@ -808,22 +1044,44 @@ def _write_manifest(folder: Path, manifest: dict) -> None:
     os.chmod(path, file_mode())
 
 
-def _swap(staging: Path, target: Path, existing: Existing) -> None:
-    """Replace ``target`` (empty, or only this tool's listed files) by ``staging``."""
-    old = Path(tempfile.mkdtemp(prefix=f"{_OLD_PREFIX}{owner_token()}-", dir=target.parent))
-    old.rmdir()
-    os.rename(target, old)
+def _old_folder(target: Path) -> Path:
+    """A new old folder for the output ``target`` replaces: owned by this process and
+    tagged with ``target``'s name (:func:`_restore_killed` finds it after a kill)."""
+    prefix = f"{_OLD_PREFIX}{owner_token()}-{_target_tag(target)}"
+    return Path(tempfile.mkdtemp(prefix=prefix, dir=target.parent))
+
+
+def _swap(staging: Path, target: Path, existing: Existing, done: list[Path]) -> None:
+    """Replace ``target`` (empty, or only this tool's listed files) by ``staging``; see
+    :func:`_commit` for ``done``.
+
+    Each rename is recorded before it is made (:func:`_move`), so an exception arriving
+    just after one is undone too: ``target`` is the old folder again, or, once the
+    staging folder is in its place, the new one (the old one is then deleted)."""
+    old = _old_folder(target)
+    moves: list[tuple[Path, Path]] = []
     try:
-        os.rename(staging, target)
+        old.rmdir()  # only its name was wanted
+        _move(target, old, moves, [])
+        _move(staging, target, moves, [])
     except BaseException:
-        os.rename(old, target)  # put the old folder back before reporting the error
+        if len(moves) == 2 and not os.path.lexists(staging):  # the new one is in place
+            done.append(target)
+            _discard_old(old, target, existing.listed)
+        else:
+            _undo(moves, [])  # put the old folder back before reporting the error
+            with contextlib.suppress(OSError):
+                old.rmdir()  # still there if the interrupt came before the first rename
         raise
+    done.append(target)
     _discard_old(old, target, existing.listed)
 
 
-def _merge(staging: Path, target: Path, files: list[str], existing: Existing, text: str) -> None:
+def _merge(
+    staging: Path, target: Path, files: list[str], existing: Existing, text: str, done: list[Path]
+) -> None:
     """``--force``: replace the listed files of ``target`` by the staged ``files``, keeping
-    every file no manifest lists.
+    every file no manifest lists; see :func:`_commit` for ``done``.
 
     The old listed files go first into an old folder (with a copy of their manifest, so a
     run killed outright is cleaned up as :func:`remove_stale` cleans after :func:`_swap`),
@@ -836,7 +1094,7 @@ def _merge(staging: Path, target: Path, files: list[str], existing: Existing, te
         clashes.append(MANIFEST)
     if clashes:
         raise ParameterError(_clash(text, clashes[0]))
-    old = Path(tempfile.mkdtemp(prefix=f"{_OLD_PREFIX}{owner_token()}-", dir=target.parent))
+    old = _old_folder(target)
     had_manifest = os.path.lexists(target / MANIFEST)
     moves: list[tuple[Path, Path]] = []
     made: list[Path] = []
@@ -854,6 +1112,7 @@ def _merge(staging: Path, target: Path, files: list[str], existing: Existing, te
             os.replace(old / MANIFEST, target / MANIFEST)
         shutil.rmtree(old, ignore_errors=True)
         raise
+    done.append(target)
     shutil.rmtree(staging, ignore_errors=True)
     _discard_old(old, target, existing.listed)
     for name in existing.listed:  # folders the old output alone had

@@ -1,8 +1,10 @@
 """Export of the app's current run: CSV/JSON, a PNG of the window, an animation.
 
-Every file is written on its own with :func:`ddwmmr.outputs.write_atomic` (or the
-result's own ``write_csv``/``write_summary``, which use it). Nothing in the export folder
-is ever deleted or overwritten: a name that exists gets a ``-2``, ``-3``... suffix.
+Every file is written on its own with :func:`ddwmmr.outputs.write_new` (its content by
+the result's own ``write_csv``/``write_summary`` where there is one). Nothing in the
+export folder is ever deleted or overwritten: a name that exists gets a ``-2``, ``-3``...
+suffix, and the name is taken atomically, so two apps exporting into the same folder at
+the same moment each keep their files; a run's folder is taken the same way.
 
 Layout of one run's export folder (``<root>/<A>[-vs-<B>]-<trajectory>-<stamp>/``)::
 
@@ -23,6 +25,7 @@ from __future__ import annotations
 import io
 import tempfile
 from collections.abc import Iterator, Sequence
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -35,7 +38,13 @@ from ddwmmr import provenance
 from ddwmmr.errors import ParameterError
 from ddwmmr.gui.options import plant_keywords
 from ddwmmr.gui.settings import Settings, build_robot, build_trajectory
-from ddwmmr.outputs import first_free, write_atomic
+from ddwmmr.outputs import (
+    first_free,
+    folder_mode,
+    nearest_existing,
+    unwritable_message,
+    write_new,
+)
 from ddwmmr.sim.simulate import plant_integrator
 from ddwmmr.trajectories import SampledTrajectory
 from ddwmmr.trajectories.files import find_trajectory_file
@@ -49,8 +58,21 @@ ANIMATION_WRITERS = {"gif": "pillow", "mp4": "ffmpeg"}
 
 
 def run_folder(root: Path, name: str) -> Path:
-    """A folder for one run's files under ``root`` that does not exist yet."""
-    return first_free(Path(root) / name, folder=True)
+    """A new folder for one run's files under ``root`` (made here, with ``root`` if
+    missing): ``name``, or the first free ``name-2``, ``name-3``... taken with an
+    exclusive ``mkdir``, so two apps exporting at the same moment get one each."""
+    while True:
+        candidate = first_free(Path(root) / name, folder=True)
+        try:
+            candidate.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
+            candidate.mkdir(mode=folder_mode())
+            return candidate
+        except FileExistsError:
+            continue  # taken between the look and the mkdir: the next one
+        except OSError as exc:
+            existing = nearest_existing(Path(root))
+            message = unwritable_message("export", str(root), Path(root), existing, exc)
+            raise ParameterError(message) from exc
 
 
 def write_run_data(
@@ -75,10 +97,9 @@ def write_run_data(
         ]
     for result, label, record in zip(results, labels, records):
         target = slot_folder(folder, results, label)
-        csv_path = first_free(target / "timeseries.csv")
-        result.write_csv(csv_path)
-        json_path = first_free(target / "summary.json")
-        result.write_summary(json_path, **({} if record is None else {"run": record}))
+        csv_path = write_new(target / "timeseries.csv", result.write_csv)
+        extra = {} if record is None else {"run": record}
+        json_path = write_new(target / "summary.json", partial(result.write_summary, **extra))
         written += [csv_path, json_path]
     return written
 
@@ -92,8 +113,7 @@ def trajectory_source(
     trajectory known by name only."""
     source = find_trajectory_file(settings.trajectory)
     if isinstance(trajectory, SampledTrajectory) and settings.geometry:
-        source = first_free(folder / "trajectory.csv")
-        write_atomic(source, csv_text(trajectory))
+        source = write_new(folder / "trajectory.csv", csv_text(trajectory))
         written.append(source)
     return source
 
@@ -150,9 +170,8 @@ def write_support_loads(folder: Path, results: Sequence[Any], labels: Sequence[s
         pp.draw_support_loads(figure, result)
         buffer = io.BytesIO()
         figure.savefig(buffer, format="png", dpi=pp.SUPPORT_LOADS_DPI, metadata=PNG_METADATA)
-        path = first_free(slot_folder(folder, results, label) / pp.SUPPORT_LOADS_FIGURE)
-        write_atomic(path, buffer.getvalue())
-        written.append(path)
+        path = slot_folder(folder, results, label) / pp.SUPPORT_LOADS_FIGURE
+        written.append(write_new(path, buffer.getvalue()))
     return written
 
 
@@ -160,9 +179,7 @@ def write_window_png(figure: Figure, folder: Path, dpi: float | None = None) -> 
     """The whole window as ``window.png``."""
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", dpi=dpi or figure.dpi)
-    path = first_free(folder / "window.png")
-    write_atomic(path, buffer.getvalue())
-    return path
+    return write_new(folder / "window.png", buffer.getvalue())
 
 
 def animation_available(fmt: str) -> bool:
@@ -217,7 +234,7 @@ def write_animation(
     figure, view = animation_figure(dpi)
     view.set_runs(results, labels, obstacles)
     indices = frame_indices(view.last_index, frames)
-    path = first_free(folder / f"animation.{fmt}")
+    path = folder / f"animation.{fmt}"
     if fmt == "gif":
         images = list(_blitted_frames(figure, view, indices))
         # One palette for all frames, from the last (it has every trail and colour).
@@ -232,8 +249,7 @@ def write_animation(
             duration=round(1000 / fps),
             loop=0,
         )
-        write_atomic(path, buffer.getvalue())
-        return path
+        return write_new(path, buffer.getvalue())
     writer = mpl_animation.writers[ANIMATION_WRITERS[fmt]](fps=fps)
     with tempfile.TemporaryDirectory() as scratch:
         temporary = Path(scratch) / path.name
@@ -241,8 +257,7 @@ def write_animation(
             for index in indices:
                 view.show_index(index)
                 writer.grab_frame()
-        write_atomic(path, temporary.read_bytes())
-    return path
+        return write_new(path, temporary.read_bytes())
 
 
 def _blitted_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterator[Image.Image]:
