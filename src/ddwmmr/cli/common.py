@@ -32,7 +32,13 @@ from ddwmmr import interrupts
 from ddwmmr.cli.signals import EXIT_INTERRUPTED, EXIT_TERMINATED, STOP_SIGNALS, say, stop_line
 from ddwmmr.errors import MASS_RANGE_KG, ParameterError, PluginError, did_you_mean, shown
 from ddwmmr.model import Robot
-from ddwmmr.outputs import check_output_folder, first_free, output_folder, package_version
+from ddwmmr.outputs import (
+    check_output_folder,
+    committed_output,
+    first_free,
+    output_folder,
+    package_version,
+)
 
 #: Exit status for bad input (argparse uses the same).
 EXIT_USAGE = 2
@@ -331,12 +337,12 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
     except PluginError as exc:  # a user's controller raised: its one line, not a traceback
         say(f"error: {exc}")
         return 1
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as stop:
         forget_unhandled_interrupt()
-        say(stop_line(signal.SIGINT))
+        say(stop_line(signal.SIGINT, committed_output(stop)))
         return EXIT_INTERRUPTED
     except Terminated as stop:
-        say(stop_line(stop.signum))
+        say(stop_line(stop.signum, committed_output(stop)))
         return stop.status
     except BrokenPipeError:  # e.g. output piped into head: nothing left to say
         return 1

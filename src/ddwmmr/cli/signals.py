@@ -17,6 +17,7 @@ import contextlib
 import os
 import signal
 import sys
+from pathlib import Path
 
 #: Exit statuses after SIGINT (Ctrl-C) and SIGTERM: 128 + the signal number.
 EXIT_INTERRUPTED = 128 + signal.SIGINT
@@ -29,11 +30,15 @@ STOP_SIGNALS = tuple(
 )
 
 
-def stop_line(signum: int) -> str:
-    """The line a tool says when signal ``signum`` stops it."""
+def stop_line(signum: int, complete: Path | None = None) -> str:
+    """The line a tool says when signal ``signum`` stops it; ``complete``: the output
+    folder the run had already finished writing when the signal came (it is kept)."""
+    what = "unfinished output removed"
+    if complete is not None:
+        what = f"the output in {complete} is complete"
     if signum == signal.SIGINT:
-        return "interrupted (Ctrl-C): stopped; unfinished output removed"
-    return f"terminated ({signal.Signals(signum).name}): stopped; unfinished output removed"
+        return f"interrupted (Ctrl-C): stopped; {what}"
+    return f"terminated ({signal.Signals(signum).name}): stopped; {what}"
 
 
 def say(line: str) -> None:
