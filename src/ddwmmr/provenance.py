@@ -2,7 +2,9 @@
 
 Every tool writes a record (``summary.json["run"]`` for track and scenarios, ``run.json``
 for compare) with the tool, the package version, the git commit of the source when it is
-a git checkout, the exact command line and working folder, and the tool's inputs in full:
+a git checkout, the exact command line and working folder, what decides the last bits of
+the numbers (the numerical libraries' versions, NumPy's and SciPy's BLAS and the CPU:
+:func:`numerics_record`), and the tool's inputs in full:
 method and every option with its default filled in, the robot (all fields), the
 trajectory (its parameters, or its file's path and SHA-256), step, integrator, offset,
 plant and seed. Values are JSON: tuples become lists, non-finite floats the strings
@@ -13,10 +15,15 @@ simulator's data export alike, and read back by ``track --rerun``.
 
 from __future__ import annotations
 
+import copy
 import dataclasses
+import functools
+import importlib
+import importlib.metadata
 import inspect
 import math
 import os
+import platform
 import shlex
 import subprocess
 import sys
@@ -28,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.controllers.base import method_options
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, one_line, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import package_version
 from ddwmmr.trajectories.files import SHAPES, file_sha256
@@ -113,7 +120,8 @@ def command_record(prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
 
 
 def header(tool: str, prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
-    """The start of every record: tool, versions, commit, command line."""
+    """The start of every record: tool, versions, commit, command line, and what decides
+    the last bits of the numbers (:func:`numerics_record`)."""
     return {
         "record_version": RECORD_VERSION,
         "tool": tool,
@@ -121,8 +129,104 @@ def header(tool: str, prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
         **git_record(),
         "python": sys.version.split()[0],
         "numpy": np.__version__,
+        **numerics_record(),
         **command_record(prog, argv),
     }
+
+
+#: The numerical libraries a run's numbers pass through (solvers, LQR design, physics),
+#: recorded with their versions where installed.
+NUMERIC_LIBRARIES = ("casadi", "scipy", "control", "daqp", "mujoco", "qpsolvers", "osqp")
+
+#: Environment variables that choose OpenBLAS's or MKL's kernels in place of the CPU's own.
+BLAS_VARIABLES = ("OPENBLAS_CORETYPE", "MKL_CBWR", "MKL_ENABLE_INSTRUCTIONS")
+
+
+def numerics_record() -> dict[str, Any]:
+    """``{"libraries", "blas", "machine"}``: what, beside the inputs, decides a run's last
+    bits. The same record on the same machine gives the same numbers bit for bit; another
+    BLAS kernel (another CPU, or one chosen by :data:`BLAS_VARIABLES`) sums in another order,
+    and the numbers then differ by rounding (docs/cli.md, "Repeating a run").
+
+    ``libraries``: ``{name: version}`` of the installed :data:`NUMERIC_LIBRARIES`;
+    ``blas``: NumPy's and SciPy's BLAS as their builds describe it (name, version,
+    configuration; None where the build does not say) and the :data:`BLAS_VARIABLES` that
+    are set; ``machine``: operating system, architecture and CPU model. Read once per
+    process, as none of it changes while a process runs, the variables aside,
+    which BLAS reads once as it loads.
+    """
+    return copy.deepcopy(_numerics())  # a copy: a caller may edit its record
+
+
+@functools.cache
+def _numerics() -> dict[str, Any]:
+    libraries = {}
+    for name in NUMERIC_LIBRARIES:
+        try:
+            libraries[name] = importlib.metadata.version(name)
+        except importlib.metadata.PackageNotFoundError:
+            continue
+    blas: dict[str, Any] = {"numpy": _blas_of("numpy"), "scipy": _blas_of("scipy")}
+    blas.update({k: os.environ[k] for k in BLAS_VARIABLES if k in os.environ})
+    machine = {"system": platform.system(), "machine": platform.machine(), "cpu": _cpu()}
+    return {"libraries": libraries, "blas": blas, "machine": machine}
+
+
+def _blas_of(package: str) -> str | None:
+    """The BLAS ``package``'s build links, as its ``show_config`` reports it, or None."""
+    try:
+        config = importlib.import_module(f"{package}.__config__").CONFIG
+        blas = config["Build Dependencies"]["blas"]
+    except (ImportError, AttributeError, KeyError, TypeError):
+        return None
+    text = blas.get("openblas configuration") or " ".join(
+        str(blas.get(k, "")) for k in ("name", "version")
+    )
+    return str(text).strip() or None
+
+
+def _cpu() -> str:
+    """The CPU's model name (``/proc/cpuinfo`` on Linux), else what :mod:`platform` says."""
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8", errors="replace") as info:
+            for line in info:
+                key, _, value = line.partition(":")
+                if key.strip() in ("model name", "Processor", "cpu model"):
+                    return value.strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def software_differences(record: dict[str, Any]) -> list[str]:
+    """What of the software and machine a ``record`` names differs from this process's:
+    ``"numpy 1.26.4 -> 2.4.6"`` per difference, over the package version, git commit,
+    Python, NumPy, the :data:`NUMERIC_LIBRARIES`, BLAS and CPU. A key the record lacks
+    (written before it was recorded) is not compared."""
+    now = header("", "", [])
+    pairs = [(k, record.get(k), now[k]) for k in ("version", "python", "numpy") if k in record]
+    if "git" in record:
+        pairs.append(("commit", _commit(record["git"]), _commit(now["git"])))
+    for section, prefix in (("libraries", ""), ("blas", "blas.")):
+        was = record.get(section)
+        if isinstance(was, dict):
+            names = [*was, *(k for k in now[section] if k not in was)]
+            pairs += [(prefix + one_line(k, 40), was.get(k), now[section].get(k)) for k in names]
+    machine = record.get("machine")
+    if isinstance(machine, dict):
+        pairs.append(("cpu", machine.get("cpu"), now["machine"]["cpu"]))
+    return [f"{k} {_shown(a)} -> {_shown(b)}" for k, a, b in pairs if a != b]
+
+
+def _commit(git: Any) -> Any:
+    return git.get("commit") if isinstance(git, dict) else None
+
+
+def _shown(value: Any) -> str:
+    """A recorded or current value for the note: a text as it is, on one line."""
+    if value is None:
+        return "none"
+    return one_line(value, 90) if isinstance(value, str) else shown(value)
 
 
 def robot_record(robot: Robot) -> dict[str, Any]:

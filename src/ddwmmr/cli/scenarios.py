@@ -18,6 +18,7 @@ import argparse
 import contextlib
 import datetime as dt
 import math
+import os
 import re
 import sys
 import textwrap
@@ -393,7 +394,9 @@ def _option_names() -> Iterator[None]:
 def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, Any], ...]:
     """``--option NAME=VALUE`` and ``--horizon`` as ``RunConfig.controller_options``:
     parsed and checked as the simulator's fields are; the options the protocol sets
-    (:data:`PROTOCOL_OPTIONS`) are refused, naming what sets them."""
+    (:data:`PROTOCOL_OPTIONS`) are refused, naming what sets them. A relative
+    ``plan=DIR`` becomes absolute here, against this process's working folder: the
+    scenarios may run in workers with another one (a Dask worker's)."""
     if args.horizon is not None and "horizon" not in option_names(args.controller):
         takers = [c for c in scenario_controllers() if "horizon" in option_names(c)]
         raise ParameterError(  # worded as track's flags are
@@ -412,6 +415,8 @@ def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, An
                 f"{text!r})"
             )
     options = parse_options(args.controller, texts)
+    if isinstance(options.get("plan"), str) and options["plan"]:  # "" is refused later
+        options["plan"] = os.path.abspath(options["plan"])
     return tuple((name, tuple(v) if isinstance(v, list) else v) for name, v in options.items())
 
 

@@ -225,7 +225,8 @@ def build_parser() -> ArgumentParser:
             "trajectory with one redundancy-resolution / control method. Writes "
             "timeseries.csv, summary.json and figures into --out and prints a summary table "
             "(errors in mm). summary.json records everything needed to repeat the run: "
-            f"`{PROG} --rerun DIR/summary.json` reproduces it bit for bit."
+            f"`{PROG} --rerun DIR/summary.json` reproduces it bit for bit on the same "
+            "machine and library build (elsewhere to rounding)."
         ),
         epilog=f"Methods - {method_help}.\n\n{method_options_text(methods)}",
         formatter_class=_Formatter,
@@ -526,7 +527,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
             plant,
             _recorded_digest(trajectory_record, source),
         )
-        return check_run(inputs, "payload", "the recorded initial_offset")
+        checked = check_run(inputs, "payload", "the recorded initial_offset")
     except ParameterError as exc:  # one line naming what is wrong: say where it was read
         raise _in_record(args.rerun, exc) from None
     except KeyError as exc:
@@ -535,6 +536,22 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         ) from None
     except (TypeError, AttributeError, ValueError) as exc:
         raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
+    _note_other_software(record)
+    return checked
+
+
+def _note_other_software(record: dict[str, Any]) -> None:
+    """Say so (one line, stderr) when the record was written by other software or on another
+    CPU than this rerun runs on (:func:`~ddwmmr.provenance.software_differences`): the rerun
+    still runs, but its numbers may then differ from the record's in the last bits."""
+    differences = provenance.software_differences(record)
+    if differences:
+        print(
+            f"track: note: the record was written with other software or on another CPU "
+            f"({', '.join(differences)}): the rerun's numbers may differ from the recorded "
+            "run's in the last bits",
+            file=sys.stderr,
+        )
 
 
 def _recorded_digest(trajectory_record: dict, source: Any) -> str | None:
