@@ -52,3 +52,15 @@ def test_a_damaged_file_elsewhere_gets_no_bounds_advice(tmp_path):
     with pytest.raises(ParameterError) as info:
         Guess.load(path)
     assert "bounds" not in str(info.value)
+
+
+def test_a_damaged_file_of_another_name_in_a_cache_folder_is_one_line(tmp_path):
+    """A user's own plan file in a folder named cache (not a bounds run's name): the
+    damaged-archive line, without bounds advice and without a traceback."""
+    cache = tmp_path / "cache"
+    cache.mkdir()
+    (cache / "best.json").write_text(json.dumps({"replay_ok": True, "start": "x"}))
+    (cache / "best.npz").write_bytes(b"PK\x03\x04xx")
+    with pytest.raises(ParameterError) as info:
+        Guess.load(cache / "best.npz")
+    assert "bounds" not in str(info.value)

@@ -240,13 +240,26 @@ def _kept_trajectory(record: Path) -> bool:
     return isinstance(found, dict) and found.get("replay_ok") is True and bool(found.get("start"))
 
 
+def _plan_number(name: str) -> int | None:
+    """The scenario number of a file named as :data:`PLAN_NAME` names a best-known
+    trajectory (``scenario-007-best.npz``: 7), else None."""
+    head, _, tail = PLAN_NAME.partition("{:03d}")
+    middle = name[len(head) : len(name) - len(tail)]
+    if not (name.startswith(head) and name.endswith(tail) and middle.isdigit()):
+        return None
+    return int(middle) if middle.isascii() else None
+
+
 def _search_again(plan: Path) -> str:
     """For a best-known trajectory ``plan`` of a bounds run's cache that is lost (missing
     or unreadable while its record says the search kept it): how to get it back; ``""``
     for any other file."""
-    if plan.parent.name != PLAN_FOLDER or not _kept_trajectory(plan.with_suffix(".json")):
+    number = _plan_number(plan.name)
+    if plan.parent.name != PLAN_FOLDER or number is None:
         return ""
-    scenario = plan.stem.split("-")[1].lstrip("0") or "0"
+    if not _kept_trajectory(plan.with_suffix(".json")):
+        return ""
+    scenario = str(number)
     return (
         f": the trajectory of that bounds run is lost; run python -m ddwmmr.bounds --out "
         f"{plan.parent.parent} --scenarios {scenario} again with the run's --seed and "
