@@ -93,3 +93,27 @@ def test_the_support_lost_warning_names_both_controllers_floors():
     assert text.startswith("warning: an edge of the support polygon was unloaded for 0.08 of 2 s")
     assert "a higher floor (qp's and mpc's stability_min and min_edge_load) or a slower" in text
     assert "qp's min_edge_load" not in text
+
+
+def test_tipping_causes_name_the_support_polygon_and_a_refusal_says_what_to_change():
+    """On a caster layout the tipping edges run through the casters: the causes say
+    'support polygon', not 'the wheels'; a refused layout says where casters must go."""
+    from ddwmmr.sim import verdict as v
+
+    for cause in (v.TIPPED, v.WOULD_TIP):
+        assert "outside the support polygon (the wheels and casters" in cause
+        assert "outside the wheels" not in cause
+    with pytest.raises(ParameterError) as info:
+        Robot(caster_positions=((0.2, 0.1), (0.2, -0.1)))
+    assert str(info.value).endswith("put casters on both sides of the wheel axle (x > 0 and x < 0)")
+
+
+def test_the_compare_reports_robot_line_names_a_caster_layout():
+    """A report of a diamond layout must not read like the default robot's."""
+    from ddwmmr.reports.compare.report import _other_fields
+
+    assert _other_fields(Robot().with_payload(3.0)) == ""
+    diamond = Robot(caster_positions=((0.225, 0.0), (-0.225, 0.0)))
+    assert _other_fields(diamond) == (
+        "; other fields than Robot()'s: caster_positions = ((0.225, 0.0), (-0.225, 0.0))"
+    )

@@ -268,8 +268,9 @@ JOINT_LIMIT = (
 #: How :data:`HELD_LIMIT` names ``actuator_saturated_time_s``, by the summary's ``plant``.
 ACTUATOR_LIMITS = {"thesis": "a wheel at its force limit", "mujoco": "a motor at its torque limit"}
 TIPPED = (
-    "the payload or the accelerations put the centre of pressure outside the wheels: a "
-    "lighter payload, another start pose or a stability floor (stability_min; see "
+    "the payload or the accelerations put the centre of pressure outside the support "
+    "polygon (the wheels and casters): a lighter payload, another start pose or a "
+    "stability floor (stability_min; see "
     'docs/physics.md, "Tip-over from the contact forces")'
 )
 
@@ -293,9 +294,10 @@ PREDICTED_BELOW_FLOOR = (
 PREDICTED_SLACK_N = 1e-3
 
 WOULD_TIP = (
-    "the arm's reach and the payload put the centre of mass outside the wheels (static "
-    "S <= 1), where a real robot tips over; this plant does not simulate tipping and ran "
-    "on: a lighter payload, a trajectory nearer the base or a stability floor (qp's or "
+    "the arm's reach and the payload put the centre of mass outside the support polygon "
+    "(the wheels and casters; static S <= 1), where a real robot tips over; this plant "
+    "does not simulate tipping and ran on: a lighter payload, a trajectory nearer the "
+    "base or a stability floor (qp's or "
     'mpc\'s stability_min; see docs/cli.md, "Verdict")'
 )
 

@@ -6,6 +6,7 @@ trajectory, one per study, definitions).
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from collections.abc import Callable, Mapping, Sequence
@@ -17,6 +18,7 @@ import numpy as np
 
 from ddwmmr.commands import FORCE
 from ddwmmr.controllers.base import method_description
+from ddwmmr.model import Robot
 from ddwmmr.outputs import write_atomic
 from ddwmmr.reports import compare_plots as plots
 from ddwmmr.reports.compare import advice, settings
@@ -192,7 +194,7 @@ def _setup_section(c: _Context) -> None:
         f"`{config.other_preset}`, see below)",
         f"robot: L1 = {robot.L1:g} m, L2 = {robot.L2:g} m, payload = {robot.payload:g} kg, "
         f"wheel speed limit = {robot.wheel_speed_limit:g} rad/s, joint speed limit = "
-        f"{robot.joint_speed_limit:g} rad/s",
+        f"{robot.joint_speed_limit:g} rad/s{_other_fields(robot)}",
         f"integrator: rk4; {steps}",
         f"initial end-effector offset: ({dx:g} m, {dy:g} m) in the end effector's start "
         f"frame (x along its start orientation), i.e. {1000 * math.hypot(dx, dy):.1f} mm",
@@ -1222,3 +1224,21 @@ def _definitions_section(c: _Context) -> None:
             ),
         ]
     )
+
+
+#: The robot fields the report's robot line always shows.
+_SHOWN_FIELDS = ("L1", "L2", "payload", "wheel_speed_limit", "joint_speed_limit")
+
+
+def _other_fields(robot: Robot) -> str:
+    """The robot's other fields that differ from ``Robot()``'s (a caster layout, a base
+    size...), for the report's robot line: ``""`` for the default robot."""
+    default = Robot()
+    differ = [
+        f"{entry.name} = {getattr(robot, entry.name)!r}"
+        for entry in dataclasses.fields(Robot)
+        if entry.init
+        and entry.name not in _SHOWN_FIELDS
+        and getattr(robot, entry.name) != getattr(default, entry.name)
+    ]
+    return f"; other fields than Robot()'s: {', '.join(differ)}" if differ else ""
