@@ -238,3 +238,137 @@ def test_two_gui_exports_at_once_keep_each_others_files(tmp_path):
     assert (first / "timeseries.csv").read_text() == "theirs\n"
     assert (first / "timeseries-2.csv").read_text() == "ours\n"
     assert _leftovers(first) == []
+
+
+@pytest.mark.parametrize("fresh", [False, True])
+@pytest.mark.parametrize(("force", "at"), [(False, 2), (True, 2), (True, 3), (True, 4)])
+def test_any_next_run_beside_it_puts_back_the_output_a_killed_run_was_replacing(
+    tmp_path, capsys, force, at, fresh
+):
+    target = tmp_path / "mine"
+    _write_run(target, "old\n")
+    if force:
+        (target / "mine.txt").write_text("mine\n")
+    child = subprocess.run([sys.executable, "-c", KILLER, str(target), str(int(force)), str(at)])
+    assert child.returncode == -signal.SIGKILL
+    capsys.readouterr()
+    # The next run writes another --out in the same folder (plain `track` into runs/).
+    with output_folder(tmp_path / "other", "track", fresh=fresh) as staging:
+        (staging / "a.csv").write_text("x\n")
+    assert (target / "a.csv").read_text() == "old\n"
+    assert not (target / "b.csv").exists()
+    assert json.loads((target / MANIFEST).read_text())["files"] == ["a.csv"]
+    assert (target / "mine.txt").exists() == force
+    assert f"put back the earlier output of {target}" in capsys.readouterr().err
+    assert _leftovers(tmp_path) == []
+
+
+def _dead_old(
+    parent: Path, target: str, files: dict[str, str], random: str, noted_at: int | None
+) -> Path:
+    """An old folder of an ended run made to replace ``parent/target``: its manifest lists
+    ``files``, those whose text is not None are there; ``noted_at``: the time (ns) of its
+    note naming ``target``, None for no note (a replace that had finished)."""
+    tag = outputs._target_tag(parent / target)
+    old = parent / f".ddwmmr-old-{outputs._host()}-{_dead_pid()}-1-{tag}{random}"
+    old.mkdir()
+    for name, text in files.items():
+        if text is not None:
+            (old / name).write_text(text)
+    manifest = {"tool": "track", "version": "0", "files": sorted(files)}
+    (old / MANIFEST).write_text(json.dumps(manifest))
+    if noted_at is not None:
+        note = old.with_name(old.name + ".target")
+        note.write_bytes(os.fsencode(target))
+        os.utime(note, ns=(noted_at, noted_at))
+    return old
+
+
+def test_the_newest_complete_old_folder_is_put_back(tmp_path, capsys):
+    # Sorted by name the older one, partly deleted, would come first.
+    _dead_old(tmp_path, "mine", {"a.csv": "older\n", "b.csv": None}, "aaaa", 10**18)
+    _dead_old(tmp_path, "mine", {"a.csv": "newer\n", "b.csv": "newer\n"}, "zzzz", 2 * 10**18)
+    target = tmp_path / "mine"
+    with output_folder(target, "track") as staging:
+        assert outputs._entries(target) == [MANIFEST, "a.csv", "b.csv"]
+        assert (target / "a.csv").read_text() == "newer\n"
+        assert (target / "b.csv").read_text() == "newer\n"
+        (staging / "a.csv").write_text("x\n")
+    assert _leftovers(tmp_path) == []
+
+
+def test_an_incomplete_old_folder_of_an_absent_output_is_kept_not_deleted(tmp_path, capsys):
+    _dead_old(tmp_path, "mine", {"a.csv": "old\n", "b.csv": None}, "aaaa", 10**18)
+    with output_folder(tmp_path / "other", "track") as staging:
+        (staging / "a.csv").write_text("x\n")
+    assert not (tmp_path / "mine").exists()
+    [kept] = _leftovers(tmp_path)
+    assert kept.startswith(outputs.KEPT_PREFIX)
+    assert (tmp_path / kept / "a.csv").read_text() == "old\n"
+    assert f"kept the incomplete earlier output of {tmp_path / 'mine'}" in capsys.readouterr().err
+
+
+def test_a_finished_replace_is_not_undone_in_an_output_merely_incomplete(tmp_path, capsys):
+    target = tmp_path / "mine"
+    _write_run(target, "new\n", names=("a.csv", "b.csv"))
+    (target / "b.csv").unlink()  # the user deleted one file of the new output
+    # Killed while deleting the replaced output: the replace had finished (no note).
+    _dead_old(tmp_path, "mine", {"a.csv": "old\n", "b.csv": "old\n"}, "aaaa", None)
+    with output_folder(target, "track") as staging:
+        assert (target / "a.csv").read_text() == "new\n"
+        assert not (target / "b.csv").exists()
+        assert "put back" not in capsys.readouterr().err
+        (staging / "a.csv").write_text("newer\n")
+    assert _leftovers(tmp_path) == []
+
+
+def _handlers(numbers):
+    return {n: signal.getsignal(n) for n in numbers}
+
+
+def test_a_signal_cutting_the_holding_short_leaves_every_handler_as_it_was(monkeypatch):
+    class Stop(Exception):
+        pass
+
+    def stop(signum, frame):
+        raise Stop
+
+    numbers = (signal.SIGINT, signal.SIGTERM)
+    saved = _handlers(numbers)
+    real = signal.getsignal
+
+    def getsignal(number):
+        if number == signal.SIGTERM:  # SIGINT is held already
+            os.kill(os.getpid(), signal.SIGTERM)
+        return real(number)
+
+    try:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        signal.signal(signal.SIGTERM, stop)
+        monkeypatch.setattr(outputs.signal, "getsignal", getsignal)
+        with pytest.raises(Stop), outputs._signals_deferred():
+            pass
+        monkeypatch.undo()
+        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+        assert signal.getsignal(signal.SIGTERM) is stop
+    finally:
+        for number, handler in saved.items():
+            signal.signal(number, handler)
+
+
+@pytest.mark.parametrize("order", [("HUP", "TERM"), ("TERM", "HUP")])
+def test_every_signal_held_during_a_commit_comes_in_the_order_it_came(order):
+    numbers = {"HUP": signal.SIGHUP, "TERM": signal.SIGTERM}
+    saved = _handlers(numbers.values())
+    came: list[str] = []
+    try:
+        for name, number in numbers.items():
+            signal.signal(number, lambda signum, frame, name=name: came.append(name))
+        with outputs._signals_deferred():
+            for name in [*order, order[0]]:  # the first one twice: it runs once
+                os.kill(os.getpid(), numbers[name])
+            assert came == []
+        assert came == list(order)
+    finally:
+        for number, handler in saved.items():
+            signal.signal(number, handler)

@@ -12,9 +12,9 @@ Every tool (track, compare, scenarios) writes its results through :func:`output_
   earlier output it was replacing and its temporary files carry its host, process id and
   start time in their names (:func:`owner_token`), and the next run writing in the same
   folder removes those whose process is gone (:func:`remove_stale`), saying so in one
-  line, after putting back an earlier output of its own ``--out`` the killed run had
-  moved aside (:func:`_restore_killed`). Nothing is synced to disk (no ``fsync``): a power
-  cut may lose the last files written;
+  line, after putting back every earlier output the killed run had moved aside, whichever
+  ``--out`` the next run writes (:func:`_restore_killed`). Nothing is synced to disk (no
+  ``fsync``): a power cut may lose the last files written;
 * a folder written by a tool carries a manifest, :data:`MANIFEST`, naming the tool, the
   package version and every file written;
 * an existing ``--out`` is replaced only if it is empty, or if its manifest names the same
@@ -39,6 +39,7 @@ from __future__ import annotations
 import contextlib
 import csv
 import errno
+import functools
 import hashlib
 import io
 import json
@@ -67,12 +68,14 @@ KEPT_PREFIX = ".ddwmmr-kept-"
 #: A staging or old folder's name: prefix, owner (host, process id, start time), random.
 #: A temporary file's (:func:`write_atomic`) too, with ``.tmp`` at the end of its random
 #: part. An old folder's random part starts with :func:`_target_tag` of the folder it
-#: replaces, so a run can find the old output of its own ``--out`` a killed run left.
+#: replaces; that folder's name is in the note beside the old folder (:func:`_target_note`).
 _OWNED_NAME = re.compile(
     r"^\.ddwmmr-(?P<kind>staging|old|tmp)-(?P<host>.+)-(?P<pid>\d+)-(?P<start>\d+)-"
     r"(?P<random>[^-]+)$"
 )
 _TMP_PREFIX = ".ddwmmr-tmp-"
+#: Added to an old folder's name: the file naming the output that folder replaces.
+_NOTE_SUFFIX = ".target"
 #: The signals whose Python handlers wait while a commit moves files (the tools' stop
 #: signals: :mod:`ddwmmr.cli.signals`, which this low layer may not import).
 _DEFERRED_SIGNALS = tuple(
@@ -591,6 +594,44 @@ def _target_tag(target: Path) -> str:
     return hashlib.sha256(os.fsencode(target.name)).hexdigest()[:8]
 
 
+def _target_note(old: Path) -> Path:
+    """The file beside the old folder ``old`` that holds the name of the output it replaces
+    (bytes, as the file system has it). It is written before the first file moves and
+    removed once the new output is complete: while it is there, the replace is unfinished."""
+    return old.with_name(old.name + _NOTE_SUFFIX)
+
+
+def _noted_target(old: Path) -> Path | None:
+    """The output the old folder ``old`` was made to replace, from its note: a name in the
+    same folder whose :func:`_target_tag` starts ``old``'s random part. None without a
+    valid note."""
+    match = _OWNED_NAME.match(old.name)
+    note = _target_note(old)
+    if match is None or not _is_regular(note):
+        return None
+    try:
+        name = os.fsdecode(note.read_bytes())
+    except OSError:
+        return None
+    if not name or "/" in name or "\0" in name or name in (".", ".."):
+        return None
+    target = old.parent / name
+    return target if match["random"].startswith(_target_tag(target)) else None
+
+
+def _drop_note(old: Path) -> None:
+    with contextlib.suppress(OSError):
+        _target_note(old).unlink(missing_ok=True)
+
+
+def _remove_stale_notes(folder: Path) -> None:
+    """Remove the notes (:func:`_target_note`) of ended runs whose old folder is gone."""
+    for name in _names(folder):
+        base = name.removesuffix(_NOTE_SUFFIX)
+        if base != name and _dead_owner(base, "old") and not os.path.lexists(folder / base):
+            _unlink_regular(folder / name)
+
+
 def _dead_owner(name: str, kind: str) -> re.Match[str] | None:
     """The match of ``name`` if it is a ``kind`` (staging, old, tmp) name of a run of this
     host that has ended, else None."""
@@ -637,22 +678,24 @@ def stale_folders(folder: Path) -> list[Path]:
     return found
 
 
-def remove_stale(folder: Path, target: Path | None = None) -> list[Path]:
+def remove_stale(folder: Path) -> list[Path]:
     """Remove :func:`stale_folders` of ``folder`` and say so in one line on stderr.
 
-    A staging folder holds only an unfinished run's files: it goes whole. An old folder
-    holds an earlier output being replaced: only the files its manifest lists (and the
-    manifest) go, as the replace would have done; anything else in it is kept. Returns the
-    folders removed. Temporary files of ended runs (:func:`temp_prefix`) in ``folder`` go
-    too. ``target`` (an ``--out`` in ``folder``): first, if a run killed while it replaced
-    ``target`` left it absent or with listed files missing, the earlier output is put
-    back from that run's old folder (:func:`_restore_killed`), said in one line."""
-    if target is not None:
-        _restore_killed(folder, target)
+    First, every earlier output a killed run was replacing in ``folder`` (whichever its
+    name) and left absent or with listed files missing is put back from that run's old
+    folder (:func:`_restore_killed`), said in one line each. Then a staging folder, which
+    holds only an unfinished run's files, goes whole. An old folder holds an earlier
+    output being replaced: only the files its manifest lists (and the manifest) go, as the
+    replace would have done; anything else in it is kept. An old folder whose output is
+    still absent is never emptied. Returns the folders removed. Temporary files of ended
+    runs (:func:`temp_prefix`) in ``folder`` go too."""
+    _restore_killed(folder)
     removed, kept = [], []
     for path in stale_folders(folder):
         if path.name.startswith(STAGING_PREFIX):
             shutil.rmtree(path, ignore_errors=True)
+        elif _output_missing(path):
+            continue  # its output could not be put back: it is kept (_restore_killed)
         else:
             manifest = read_manifest(path)
             for name in [*(manifest["files"] if manifest else []), MANIFEST]:
@@ -663,6 +706,7 @@ def remove_stale(folder: Path, target: Path | None = None) -> list[Path]:
             kept.append(_set_aside(path))  # a user's files: kept, under a name never swept
         else:
             removed.append(path)
+    _remove_stale_notes(folder)
     if removed or kept:
         count = len(removed)
         line = f"note: removed {count} folder{'s' * (count != 1)} left in {folder} by runs "
@@ -707,33 +751,79 @@ def _names(folder: Path) -> list[str]:
         return []
 
 
-def _restore_killed(folder: Path, target: Path) -> Path | None:
-    """Put back the earlier output of ``target`` a killed run was replacing: from an old
-    folder of an ended run made for ``target`` (:func:`_target_tag`) holding a manifest,
-    when ``target`` is absent (killed between the two renames of :func:`_swap`) or its
-    manifest lists files it lacks (killed during :func:`_merge`). Returns the old folder
-    used, or None; says what it did in one line."""
-    tag = _target_tag(target)
-    for name in sorted(_names(folder)):
-        match = _dead_owner(name, "old")
-        old = folder / name
-        if match is None or not match["random"].startswith(tag) or os.path.islink(old):
-            continue
-        manifest = read_manifest(old)
-        if manifest is None:
-            continue
+def _restore_killed(folder: Path) -> None:
+    """Put back the earlier outputs killed runs were replacing in ``folder``: each old
+    folder of an ended run names its output in its note (:func:`_noted_target`). An
+    output that is absent (killed between the two renames of :func:`_swap`) gets back
+    the newest such old folder holding every file its manifest lists; one whose manifest
+    lists files it lacks (killed during :func:`_merge`) gets back the earlier files from
+    the newest old folder that, with the output, still holds them all. An absent output
+    with no such old folder keeps its old folders, set aside (:func:`_set_aside`). Says
+    what it did in one line each."""
+    olds: dict[Path, list[Path]] = {}
+    for old in stale_folders(folder):
+        target = _noted_target(old)
+        if target is not None and read_manifest(old) is not None:
+            olds.setdefault(target, []).append(old)
+    for target, found in sorted(olds.items()):
+        _put_back(target, sorted(found, key=_note_age))
+
+
+def _put_back(target: Path, olds: list[Path]) -> None:
+    """Put back ``target``'s earlier output from the first usable of ``olds`` (old folders
+    of ended runs made for it, newest first); see :func:`_restore_killed`."""
+    for old in olds:
         try:
-            if not os.path.lexists(target):
-                os.rename(old, target)  # the whole earlier folder, as _swap moved it
-            elif target.is_dir() and not os.path.islink(target) and _incomplete(target):
-                _merge_back(old, target, manifest)
-            else:
-                continue
+            restored = _restore_from(old, target)
         except OSError:
             continue  # left as it is: remove_stale keeps what no manifest lists
-        _say(f"note: put back the earlier output of {target} that a killed run was replacing")
-        return old
-    return None
+        if restored:
+            _drop_note(old)
+            _say(f"note: put back the earlier output of {target} that a killed run was replacing")
+            return
+    if os.path.lexists(target):
+        return
+    for old in olds:  # nothing whole to put back: keep every part of it
+        aside = _set_aside(old)
+        if aside != old:
+            _drop_note(old)
+            _say(f"warning: kept the incomplete earlier output of {target} in {aside}")
+
+
+def _restore_from(old: Path, target: Path) -> bool:
+    """Put ``target``'s earlier output back from ``old`` if ``target`` needs it and ``old``
+    (with ``target``) holds every file of it; whether it did."""
+    manifest = read_manifest(old)
+    if manifest is None:
+        return False
+    files = manifest["files"]
+    if not os.path.lexists(target):
+        if not all(_is_regular(old / name) for name in files):
+            return False
+        os.rename(old, target)  # the whole earlier folder, as _swap moved it
+        return True
+    if os.path.islink(target) or not target.is_dir() or not _incomplete(target):
+        return False
+    if not all(_is_regular(old / name) or _is_regular(target / name) for name in files):
+        return False
+    _merge_back(old, target, manifest)
+    return True
+
+
+def _note_age(old: Path) -> tuple[int, str]:
+    """Sort key of old folders, newest first: when their notes were written."""
+    try:
+        return (-os.lstat(_target_note(old)).st_mtime_ns, old.name)
+    except OSError:
+        return (0, old.name)
+
+
+def _output_missing(old: Path) -> bool:
+    """Whether ``old`` is an old folder holding an earlier output (a manifest) whose
+    folder (:func:`_noted_target`) is absent."""
+    target = _noted_target(old)
+    missing = target is not None and not os.path.lexists(target)
+    return missing and read_manifest(old) is not None
 
 
 def _incomplete(folder: Path) -> bool:
@@ -821,7 +911,7 @@ class OutputFolder:
         if self._entered:
             raise RuntimeError("an OutputFolder is used for one with-block only")
         self._entered = True
-        remove_stale(self.path.parent, None if self.fresh else self.path)
+        remove_stale(self.path.parent)
         prefix = f"{STAGING_PREFIX}{owner_token()}-"
         for attempt in range(2):
             self._created = _make_parents(self.path.parent)
@@ -906,26 +996,39 @@ def committed_output(error: BaseException) -> Path | None:
 def _signals_deferred() -> Iterator[None]:
     """Hold the stop signals (:data:`_DEFERRED_SIGNALS`) whose handlers are Python code
     (the tools' :func:`ddwmmr.cli.common.interruptible`, Python's Ctrl-C) while the block
-    moves files, then run the handler of the first one that came: an output is never left
-    half moved by a signal. Outside the main thread (where handlers cannot be set)
-    nothing is held."""
+    moves files: an output is never left half moved by a signal. Afterwards every handler
+    is put back, even if a signal cut the setup short, and each different signal that came
+    is raised again, in the order they came (:func:`signal.raise_signal`), so its handler
+    runs as it would have, after those of the earlier ones; a handler that raises does not
+    keep the later ones from coming. Outside the main thread (where handlers cannot be
+    set) nothing is held."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     held: list[int] = []
-    previous = {}
-    for number in _DEFERRED_SIGNALS:
-        handler = signal.getsignal(number)
-        if callable(handler):
-            previous[number] = handler
-            signal.signal(number, lambda signum, frame: held.append(signum))
+    swapped: list[tuple[int, Callable[..., object]]] = []
     try:
+        for number in _DEFERRED_SIGNALS:
+            handler = signal.getsignal(number)
+            if callable(handler):
+                swapped.append((number, handler))  # first: a swap cut short is undone too
+                signal.signal(number, lambda signum, frame: held.append(signum))
         yield
     finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
-        if held:
-            previous[held[0]](held[0], None)
+        try:
+            _run_all([functools.partial(signal.signal, n, h) for n, h in swapped])
+        finally:
+            _run_all([functools.partial(signal.raise_signal, n) for n in dict.fromkeys(held)])
+
+
+def _run_all(calls: Sequence[Callable[[], object]]) -> None:
+    """Make every call of ``calls`` in order, even the ones after a call that raises (that
+    exception goes on once the later calls are made)."""
+    if calls:
+        try:
+            calls[0]()
+        finally:
+            _run_all(calls[1:])
 
 
 def _make_parents(folder: Path) -> list[Path]:
@@ -1045,10 +1148,38 @@ def _write_manifest(folder: Path, manifest: dict) -> None:
 
 
 def _old_folder(target: Path) -> Path:
-    """A new old folder for the output ``target`` replaces: owned by this process and
-    tagged with ``target``'s name (:func:`_restore_killed` finds it after a kill)."""
+    """A new old folder for the output ``target`` replaces, owned by this process and
+    tagged with ``target``'s name, and its note naming ``target`` (:func:`_target_note`):
+    any later run writing beside it puts the output back after a kill
+    (:func:`_restore_killed`)."""
     prefix = f"{_OLD_PREFIX}{owner_token()}-{_target_tag(target)}"
-    return Path(tempfile.mkdtemp(prefix=prefix, dir=target.parent))
+    old = Path(tempfile.mkdtemp(prefix=prefix, dir=target.parent))
+    try:
+        _write_note(_target_note(old), os.fsencode(target.name))
+    except BaseException:
+        with contextlib.suppress(OSError):
+            old.rmdir()
+        _drop_note(old)  # an interrupt just after its rename
+        raise
+    return old
+
+
+def _write_note(note: Path, data: bytes) -> None:
+    """Create ``note`` (a new name: exclusively) holding ``data``. No rename: the commit's
+    renames are all moves of output files. A note cut short by a kill is refused by
+    :func:`_noted_target` (its name does not match the old folder's tag), and nothing had
+    moved yet then."""
+    fd = os.open(note, os.O_CREAT | os.O_EXCL | os.O_WRONLY, file_mode())
+    with os.fdopen(fd, "wb") as handle:
+        handle.write(data)
+
+
+def _replaced(old: Path, target: Path, listed: list[str], done: list[Path]) -> None:
+    """The new output is complete in ``target``: record it in ``done``, drop ``old``'s note
+    (the replace is over) and delete the replaced output in ``old``."""
+    done.append(target)
+    _drop_note(old)
+    _discard_old(old, target, listed)
 
 
 def _swap(staging: Path, target: Path, existing: Existing, done: list[Path]) -> None:
@@ -1066,15 +1197,14 @@ def _swap(staging: Path, target: Path, existing: Existing, done: list[Path]) -> 
         _move(staging, target, moves, [])
     except BaseException:
         if len(moves) == 2 and not os.path.lexists(staging):  # the new one is in place
-            done.append(target)
-            _discard_old(old, target, existing.listed)
+            _replaced(old, target, existing.listed, done)
         else:
             _undo(moves, [])  # put the old folder back before reporting the error
             with contextlib.suppress(OSError):
                 old.rmdir()  # still there if the interrupt came before the first rename
+            _drop_note(old)
         raise
-    done.append(target)
-    _discard_old(old, target, existing.listed)
+    _replaced(old, target, existing.listed, done)
 
 
 def _merge(
@@ -1111,10 +1241,10 @@ def _merge(
         if had_manifest and not os.path.lexists(target / MANIFEST):
             os.replace(old / MANIFEST, target / MANIFEST)
         shutil.rmtree(old, ignore_errors=True)
+        _drop_note(old)
         raise
-    done.append(target)
+    _replaced(old, target, existing.listed, done)
     shutil.rmtree(staging, ignore_errors=True)
-    _discard_old(old, target, existing.listed)
     for name in existing.listed:  # folders the old output alone had
         _prune_up((target / name).parent, target)
 
