@@ -70,6 +70,7 @@ from ddwmmr.controllers.base import (
 from ddwmmr.controllers.inputs import check_inputs, check_start
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
+from ddwmmr.model.kinematics import check_angles
 from ddwmmr.model.stability import GRAVITY_M_S2, warn_start_below_floor
 from ddwmmr.mpc.braking import braked_velocity, braking_input, should_brake
 from ddwmmr.mpc.fallback import fallback_input, make_fallback
@@ -298,9 +299,9 @@ class MPCController:
         ``base_velocity = (v, w)`` (m/s, rad/s) is the measured base velocity the thesis
         model needs; without it the previous plan's prediction is used.
         """
-        q, pose_d, velocity_d = (
-            np.array(values) for values in check_inputs(t, q, pose_d, velocity_d)
-        )
+        checked = check_inputs(t, q, pose_d, velocity_d)
+        check_angles(checked[0])  # as every other method: angles whose sums overflow
+        q, pose_d, velocity_d = (np.array(values) for values in checked)
         reach = self._trajectory is None and not np.any(velocity_d)
         target = (float(pose_d[0]), float(pose_d[1]))
         new_target = reach and self._target != target
