@@ -236,9 +236,10 @@ def float_values(value: Any, size: int) -> list[float] | None:
     return array.tolist() if array.shape == (size,) else None
 
 
-#: numpy's float64: what the library's controllers and trajectories return (the fast path
-#: of :func:`finite_values`).
-_FLOAT64 = np.dtype(float)
+#: numpy's float64: what the library's controllers, trajectories and plants pass around
+#: (the fast paths of :func:`finite_values` and of the per-step checks that compare a
+#: dtype with it by identity).
+FLOAT64 = np.dtype(float)
 
 
 def finite_values(value: Any, size: int) -> np.ndarray | None:
@@ -247,7 +248,7 @@ def finite_values(value: Any, size: int) -> np.ndarray | None:
     booleans, None and complex numbers are not numbers here (:func:`float_values`). A
     float64 array is returned as it is (not copied), so a run fed arrays gives the numbers
     it gave before the check."""
-    if type(value) is np.ndarray and value.dtype is _FLOAT64 and value.shape == (size,):
+    if type(value) is np.ndarray and value.dtype is FLOAT64 and value.shape == (size,):
         array = value  # the common case, no conversion
     else:
         values = float_values(value, size)

@@ -33,7 +33,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces
-from ddwmmr.errors import ParameterError, check_finite, check_positive, float_values, shown
+from ddwmmr.errors import FLOAT64, ParameterError, check_finite, check_positive, float_values, shown
 from ddwmmr.model.kinematics import check_configuration
 
 #: A continuous-time control law for integrator stages: ``(t, q) -> u``, time in s, the
@@ -113,7 +113,6 @@ _COMMAND_FORMS = {
         "a WheelForces(left, right, th1_target, th2_target) of 4 finite numbers (N, N, rad, rad)"
     ),
 }
-_FLOAT64 = np.dtype(float)
 _INF = math.inf
 _isfinite = math.isfinite
 
@@ -173,7 +172,7 @@ def check_limit(q: Any, u: Any) -> tuple[float, float, list[float]]:
     """
     try:
         arrays = type(q) is np.ndarray and type(u) is np.ndarray
-        if arrays and q.dtype is _FLOAT64 and u.dtype is _FLOAT64:
+        if arrays and q.dtype is FLOAT64 and u.dtype is FLOAT64:
             x, y, phi, th1, th2 = q.tolist()  # another shape fails to unpack here
             v, w, r1, r2 = values = u.tolist()
             if _isfinite(x + y + phi + th1 + th2 + v + w + r1 + r2):
@@ -227,7 +226,7 @@ def check_step(
     """
     try:
         if isinstance(dt, float) and 0.0 < dt < _INF:
-            if type(command) is np.ndarray and command.dtype is _FLOAT64:
+            if type(command) is np.ndarray and command.dtype is FLOAT64:
                 # another shape than (4,) fails here: too many or too few values to unpack
                 # (ValueError), or rows that are lists, not floats (TypeError in the sum)
                 a, b, c, d = values = command.tolist()

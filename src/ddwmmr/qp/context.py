@@ -12,18 +12,17 @@ import math
 
 import numpy as np
 
+from ddwmmr.errors import FLOAT64
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import angles_in_range, refuse_angles
 
 #: Number of inputs u = (v, w, th1dot, th2dot) (m/s, rad/s, rad/s, rad/s).
 NU = 4
 
-_FLOAT64 = np.dtype(np.float64)
-
 
 def _floats(values: np.ndarray) -> list[float]:
     """``values`` as a list of Python floats (fast for a float64 array, the usual case)."""
-    if type(values) is np.ndarray and values.dtype is _FLOAT64:
+    if type(values) is np.ndarray and values.dtype is FLOAT64:
         return values.tolist()
     return np.asarray(values, dtype=float).tolist()
 

@@ -86,6 +86,7 @@ import numpy as np
 from ddwmmr import interrupts
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
 from ddwmmr.errors import (
+    FLOAT64,
     ParameterError,
     finite_values,
     name_of,
@@ -208,10 +209,6 @@ def check_interface(controller: Any, plant: Plant) -> str:
     return interface
 
 
-#: numpy's float64: what registered controllers and trajectories return (the fast path).
-_FLOAT64 = np.dtype(float)
-
-
 def checked_command(command: Any, force: bool, controller: Any, k: int, t: float) -> Any:
     """``command``, as returned by ``controller.command`` at step ``k`` (time ``t`` s), if
     it is a command the plant can apply: on the velocity interface 4 finite numbers
@@ -222,7 +219,7 @@ def checked_command(command: Any, force: bool, controller: Any, k: int, t: float
     the step: a plant would otherwise fail on it deep inside, or (the thesis plant) drive
     its wheels at full force from a NaN. Registered controllers always return a finite
     command (they fall back), so for them this only costs a few C calls a step."""
-    if type(command) is np.ndarray and command.dtype is _FLOAT64 and command.shape == (4,):
+    if type(command) is np.ndarray and command.dtype is FLOAT64 and command.shape == (4,):
         # what every registered velocity controller returns: :func:`finite_values`'s test
         # inlined, as it runs at every sample and stage
         a, b, c, d = command.tolist()
