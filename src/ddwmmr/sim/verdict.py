@@ -836,8 +836,9 @@ def support_warning(summary: Mapping[str, Any]) -> str:
     floor = _number(summary, "min_edge_load_floor_n")
     predicted = ""
     if least is not None and floor is not None and least < floor - PREDICTED_SLACK_N:
-        texts = (f"{least:.3g}", [f"{floor:.3g}"])
-        least_text, (floor_text,) = texts_apart(least, floor) if texts[0] == texts[1][0] else texts
+        least_text, floor_text = f"{least:.3g}", f"{floor:.3g}"
+        if least_text == floor_text:  # spelt alike: texts_apart spells both in full
+            least_text, (floor_text,) = texts_apart(least, floor)
         predicted = PREDICTED_BELOW_FLOOR.format(least=least_text, floor=floor_text)
     return SUPPORT_LOST.format(
         unloaded_s=_number(summary, "unloaded_time_s") or 0.0,
