@@ -9,11 +9,13 @@ A plug-in plant is held to the same contract by :class:`CheckedPlant`, which the
 * an ``observe()`` that is not an :class:`~ddwmmr.plants.base.Observation` of finite
   numbers, or a ``limit()`` that is not ``(u, saturated)`` with ``u`` 4 finite numbers, is
   a one-line ParameterError naming the plant, the step and the time;
-* anything else its ``observe()``, ``limit()`` or ``step()`` raise (but a
-  PlantDivergedError from ``step()``, which ends the run as "diverged") becomes a one-line
+* anything else its ``observe()``, ``limit()`` or ``step()`` raise becomes a one-line
   :class:`~ddwmmr.errors.PluginError` "plant: <name>.<method>() raised <type>:
   '<message>' at step <k>, t = <t> s" (:func:`~ddwmmr.errors.plugin_raised`, the message
-  quoted), the exception it raised its ``__cause__``.
+  quoted), the exception it raised its ``__cause__``; but a ParameterError or a
+  PluginError passes as it is (already one line), a PlantDivergedError from ``step()``
+  ends the run as "diverged", and whatever ``step()`` raises after the control law it
+  was given raised is the controller's error, routed as such.
 
 Each such error is handed to the run's task first (``failed``, the loop's
 ``task.controller_error``): if the task ends the run on it (the scenario protocol records
