@@ -27,7 +27,7 @@ from ddwmmr.bounds.lower import lower_bound
 from ddwmmr.bounds.search import Settings, best_known
 from ddwmmr.errors import DURATION_RANGE_S, MAX_SCENARIOS, ParameterError, shown
 from ddwmmr.model import Robot
-from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess
+from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, kept_trajectory
 from ddwmmr.outputs import write_atomic
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.result import json_safe
@@ -218,7 +218,7 @@ def _trajectory_lost(folder: Path, index: int, record: dict) -> bool:
     then stores the trajectory beside it) which its ``.npz`` in the cache of ``folder``
     no longer holds: missing, or not readable as ``--option plan=DIR`` reads it
     (:meth:`~ddwmmr.mpc.min_time.Guess.load`: empty, truncated, damaged...)."""
-    if record.get("replay_ok") is not True or not record.get("start"):
+    if not kept_trajectory(record):
         return False
     try:
         Guess.load(folder / cache_names(index)["trajectory"])

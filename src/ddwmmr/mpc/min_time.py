@@ -230,14 +230,24 @@ def plan_path(folder: str | Path, scenario: int) -> Path:
     raise ParameterError(missing_plan(folder, scenario))
 
 
+def kept_trajectory(record: object) -> bool:
+    """Whether a bounds cache's best-known ``record`` (the object of its ``.json``) is of a
+    search that kept a trajectory beside it (``replay_ok`` true and the ``start`` it came
+    from named): :func:`ddwmmr.bounds.batch.solve` then stores the trajectory as a
+    ``.npz`` of the same name."""
+    return (
+        isinstance(record, dict) and record.get("replay_ok") is True and bool(record.get("start"))
+    )
+
+
 def _kept_trajectory(record: Path) -> bool:
-    """Whether the bounds cache's best-known ``record`` (a ``.json``) says its search kept
-    a trajectory beside it (``replay_ok`` true and the ``start`` it came from named)."""
+    """:func:`kept_trajectory` of the record in the ``.json`` file ``record``; False for a
+    file that cannot be read as one."""
     try:
         found = json.loads(record.read_text(encoding="utf-8"))
     except (OSError, ValueError):
         return False
-    return isinstance(found, dict) and found.get("replay_ok") is True and bool(found.get("start"))
+    return kept_trajectory(found)
 
 
 def _plan_number(name: str) -> int | None:
