@@ -58,7 +58,6 @@ __all__ = [
     "integer_type",
     "method_options_text",
     "number_type",
-    "off_engine_step",
     "offset_type",
     "output_folder",
     "payload_type",
@@ -149,18 +148,6 @@ def split_names(values: Sequence[str] | None, option: str) -> list[str]:
             raise ParameterError(f"{option}: an empty name in the list (got {value!r})")
         items.extend(names)
     return list(dict.fromkeys(items))
-
-
-def off_engine_step(dt: float, plant: object) -> bool:
-    """Whether the control step ``dt`` (s) is not a whole multiple (at least one) of the
-    engine ``timestep`` of ``plant`` (a physics plant; one without a timestep takes any
-    step), with the MuJoCo plant's tolerance: checked before a run starts, so that its
-    refusal comes before any note or output."""
-    quantum = getattr(plant, "timestep", None)
-    if not quantum:
-        return False
-    steps = max(1, round(dt / quantum))
-    return abs(steps * quantum - dt) > 1e-9 * max(1.0, abs(dt))
 
 
 def given_text(option: str, value: str | None, what: str, empty: str = "path") -> str | None:

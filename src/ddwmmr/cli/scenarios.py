@@ -46,7 +46,6 @@ from ddwmmr.cli.common import (
     integer_type,
     method_options_text,
     number_type,
-    off_engine_step,
     output_folder,
     payload_type,
     run_main,
@@ -481,16 +480,18 @@ def _check_engine_step(config: RunConfig) -> None:
     """With a physics plant (``--plant mujoco``): ``--dt`` a whole multiple of its engine
     step, refused naming this tool's range of dt, (0, :data:`MAX_DT`] s (the plant's own
     message would give the longer steps the plant alone allows)."""
-    if not hasattr(plant_class(config.plant), "timestep"):
+    if not hasattr(plant_class(config.plant), "check_control_step"):
         return
     plant = make_scenario_plant(config_robot(config), config)
-    if off_engine_step(config.dt, plant):
+    try:
+        plant.check_control_step(config.dt)
+    except ParameterError:
         h = plant.timestep
         raise ParameterError(
             f"dt must be a whole multiple of the {config.plant} plant's engine step {h:g} s in "
             f"(0, {MAX_DT:g}] s ({', '.join(f'{k * h:g}' for k in (1, 2, 3))}, ...) "
             f"(got {config.dt:g})"
-        )
+        ) from None
 
 
 def _thresholds(args: argparse.Namespace, name: str) -> tuple[float, float]:

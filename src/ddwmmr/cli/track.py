@@ -33,7 +33,6 @@ from ddwmmr.cli.common import (
     horizon_range,
     method_options_text,
     number_type,
-    off_engine_step,
     offset_type,
     output_folder,
     robot_from_arguments,
@@ -633,14 +632,8 @@ def check_plant_step(inputs: RunInputs) -> None:
     """Refuse, in the plant's own words, a control step the plant of ``inputs`` will refuse
     when the run starts (MuJoCo: not a whole number of engine steps): before the duration
     note and the output folder, so bad input is one line."""
-    if not hasattr(plant_class(inputs.plant), "timestep"):
-        return
-    plant = make_plant(inputs.plant, inputs.robot)
-    if off_engine_step(inputs.dt, plant):
-        # reset checks the step first and refuses it before it changes anything
-        plant.reset(
-            initial_configuration(inputs.robot, inputs.trajectory, inputs.offset), inputs.dt
-        )
+    if hasattr(plant_class(inputs.plant), "check_control_step"):
+        make_plant(inputs.plant, inputs.robot).check_control_step(inputs.dt)
 
 
 def _note_uneven_duration(duration: float, dt: float, steps: int) -> None:

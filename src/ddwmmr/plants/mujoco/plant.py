@@ -285,9 +285,11 @@ class MujocoPlant:
         h = self.options.timestep
         return ", ".join(f"{k * h:g}" for k in range(1, count + 1))
 
-    def _check_dt(self, dt: float) -> int:
+    def check_control_step(self, dt: float) -> int:
         """The engine steps in a control step of ``dt`` (s), which must be a whole multiple
-        of the timestep, at most :data:`MAX_ENGINE_STEPS_PER_CONTROL_STEP` of them."""
+        of the timestep, at most :data:`MAX_ENGINE_STEPS_PER_CONTROL_STEP` of them; else a
+        one-line :class:`ParameterError` (what :meth:`reset` and :meth:`step` refuse, so a
+        tool can refuse it before a run starts)."""
         h = self.options.timestep
         most = MAX_ENGINE_STEPS_PER_CONTROL_STEP
         try:
@@ -316,7 +318,7 @@ class MujocoPlant:
         (nothing changes then), and if the robot does not settle: its masses too light for
         the engine's timestep.
         """
-        substeps = self._check_dt(dt)
+        substeps = self.check_control_step(dt)
         q0 = np.array(check_configuration(q0))
         outside = self.robot.joints_outside(q0)
         if outside is not None:
@@ -415,12 +417,12 @@ class MujocoPlant:
         Raises :class:`PlantDivergedError` (naming the step) if the engine state becomes
         invalid, :class:`ParameterError` for a non-finite or misshapen argument
         (:func:`~ddwmmr.plants.base.check_step`) or if dt differs from the reset's control
-        step and is not an allowed one (:meth:`_check_dt`).
+        step and is not an allowed one (:meth:`check_control_step`).
         """
         if self._dt is None:
             raise RuntimeError("reset(q0, dt) must be called before step")
         checked = check_step(t, command, dt, self.interfaces)
-        substeps = self._substeps if dt == self._dt else self._check_dt(dt)
+        substeps = self._substeps if dt == self._dt else self.check_control_step(dt)
         q = self.observe().q
         if isinstance(checked, WheelForces):
             self._force_controls(q, checked, dt)
