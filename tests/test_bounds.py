@@ -752,8 +752,10 @@ def test_read_bounds_takes_nan_and_a_failed_replay_as_no_value(tmp_path):
         ("2,10,,3,0.5,True", "line 2 (scenario 2) has no value in column best_known_s"),
         ("2,10", "line 2 (scenario 2) has no value in column replay_ok"),
         ("2,10,12,3,0.5,yes", "column replay_ok: must be True or False (got 'yes')"),
-        ("two,10,12,3,0.5,True", "line 2, column scenario: must be a whole number >= 1 (got "),
-        ("0,10,12,3,0.5,True", "line 2, column scenario: must be a whole number >= 1 (got '0')"),
+        ("two,10,12,3,0.5,True", "line 2, column scenario: must be a whole number in 1-100000 "),
+        ("0,10,12,3,0.5,True", "column scenario: must be a whole number in 1-100000 (got '0')"),
+        ("100001,10,12,3,0.5,True", "in 1-100000 (got '100001')"),
+        ("9" * 5000 + ",10,12,3,0.5,True", "column scenario: must be a whole number in 1-100000"),
         (
             "2,10,9.5,3,0.5,True",
             "line 2 (scenario 2): best_known_s 9.5 s is below lower_bound_s 10 s",

@@ -334,11 +334,11 @@ def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
     the best-known time of a row whose replay failed (``replay_ok`` False; that column is
     then not read). Refused with a one-line :class:`ParameterError` naming the file, the
     line (and scenario) and the column: a file without one of :data:`READ_COLUMNS`; a
-    scenario that is not a whole number >= 1 or appears twice; a ``replay_ok`` other than
-    True or False; a time that is neither ``nan`` nor a number of seconds in
-    :data:`~ddwmmr.errors.DURATION_RANGE_S` (0, negative, inf, 1e-300); a best-known time
-    below the lower bound of its row (a lower bound is at most any time achieved). A UTF-8
-    byte-order mark (a spreadsheet's "CSV UTF-8") is read as none.
+    scenario that is not a whole number in 1..``MAX_SCENARIOS`` or appears twice; a
+    ``replay_ok`` other than True or False; a time that is neither ``nan`` nor a number of
+    seconds in :data:`~ddwmmr.errors.DURATION_RANGE_S` (0, negative, inf, 1e-300); a
+    best-known time below the lower bound of its row (a lower bound is at most any time
+    achieved). A UTF-8 byte-order mark (a spreadsheet's "CSV UTF-8") is read as none.
     """
     out = {}
     with open(path, newline="", encoding="utf-8-sig") as handle:
@@ -382,13 +382,25 @@ def _bounds_field(where: str, row: dict, key: str) -> str:
 
 
 def _bounds_scenario(where: str, row: dict) -> int:
-    """A bounds.csv row's scenario number (from 1)."""
+    """A bounds.csv row's scenario number, in 1..:data:`~ddwmmr.errors.MAX_SCENARIOS`."""
     text = _bounds_field(where, row, "scenario")
-    if not (text.isascii() and text.isdigit() and int(text) >= 1):
+    number = scenario_number(text) if text.isascii() and text.isdigit() else 0
+    if not 1 <= number <= MAX_SCENARIOS:
         raise ParameterError(
-            f"{where}, column scenario: must be a whole number >= 1 (got {shown(text)})"
+            f"{where}, column scenario: must be a whole number in 1-{MAX_SCENARIOS} "
+            f"(got {shown(text)})"
         )
-    return int(text)
+    return number
+
+
+def scenario_number(digits: str) -> int:
+    """The number the ASCII ``digits`` spell, or ``MAX_SCENARIOS + 1`` when they spell more
+    digits than ``MAX_SCENARIOS`` has (compared as text: ``int`` refuses numbers of more
+    than 4300 digits, and no larger one needs converting to be out of range)."""
+    significant = digits.lstrip("0") or "0"
+    if len(significant) > len(str(MAX_SCENARIOS)):
+        return MAX_SCENARIOS + 1
+    return int(significant)
 
 
 def _bounds_time(where: str, row: dict, key: str) -> float:

@@ -171,8 +171,8 @@ def parse_scenarios(text: str) -> list[int]:
                 f"scenarios must be numbers or ranges like 1-100 or 1,3,7-9, in the digits "
                 f"0-9 (got {shown(text)})"
             )
-        first = _scenario_number(match["first"])
-        last = _scenario_number(match["last"] or match["first"])
+        first = batch.scenario_number(match["first"])
+        last = batch.scenario_number(match["last"] or match["first"])
         if not 1 <= first <= last <= MAX_SCENARIOS:
             raise ParameterError(
                 f"scenarios must lie in 1-{MAX_SCENARIOS} with first <= last "
@@ -180,16 +180,6 @@ def parse_scenarios(text: str) -> list[int]:
             )
         chosen.update(range(first, last + 1))
     return sorted(chosen)
-
-
-def _scenario_number(digits: str) -> int:
-    """The number the ASCII ``digits`` spell, or ``MAX_SCENARIOS + 1`` when they spell more
-    digits than ``MAX_SCENARIOS`` has (compared as text: ``int`` refuses numbers of more
-    than 4300 digits, and no larger one needs converting to be out of range)."""
-    significant = digits.lstrip("0") or "0"
-    if len(significant) > len(str(MAX_SCENARIOS)):
-        return MAX_SCENARIOS + 1
-    return int(significant)
 
 
 def _settings(args: argparse.Namespace) -> Settings:
