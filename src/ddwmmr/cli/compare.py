@@ -91,9 +91,10 @@ outputs (in --out):
   metrics.csv   one row per method x trajectory: method, trajectory and every metric of
                 the summary.json that `python -m ddwmmr.track` writes for that run
   plant_metrics.csv  with --plant: the same for the runs on each plant (column plant)
-  run.json      everything needed to repeat the comparison: methods and their options
-                with defaults, robot, trajectories (parameters or file SHA-256),
-                studies, version, git commit and the exact command line
+  run.json      everything needed to repeat the comparison by hand: methods and
+                their options with defaults, robot, trajectories (parameters, and a
+                file's path and SHA-256), studies, version, git commit, libraries,
+                BLAS, CPU and the exact command line
   *.png         paths, errors, wheel speeds and per-method panels per trajectory; one
                 figure per study
   The folder is built next to --out and renamed into place when complete; an existing
