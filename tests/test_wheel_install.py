@@ -13,6 +13,7 @@ import os
 import shutil
 import subprocess
 import sys
+import tarfile
 from pathlib import Path
 
 import pytest
@@ -93,3 +94,44 @@ def test_installed_package_runs_a_named_trajectory(installed, tmp_path):
         cwd=tmp_path, env=env,
     )  # fmt: skip
     assert "min obstacle clearance" in done.stdout
+
+
+def test_wheel_ships_the_type_marker(installed):
+    """PEP 561: without py.typed a user's type checker ignores the package's annotations."""
+    assert (installed / "ddwmmr" / "py.typed").is_file()
+
+
+def _project_files(folder: str) -> set[str]:
+    """The files of a project folder, as paths from the project root (no caches)."""
+    return {
+        p.relative_to(ROOT).as_posix()
+        for p in (ROOT / folder).rglob("*")
+        if p.is_file() and "__pycache__" not in p.parts and p.suffix != ".pyc"
+    }
+
+
+def test_sdist_holds_the_test_suite_and_what_it_reads(tmp_path):
+    """The source distribution holds the whole test suite (conftest, helper modules, golden
+    files, plug-ins) and the folders its tests read: built from a copy of the project."""
+    source = tmp_path / "source"
+    source.mkdir()
+    for name in ("pyproject.toml", "README.md", "LICENSE", "MANIFEST.in", "Makefile", "mkdocs.yml"):
+        shutil.copy(ROOT / name, source / name)
+    folders = ("src", "tests", "docs", "examples", "trajectories", "benchmarks")
+    for folder in folders:
+        shutil.copytree(
+            ROOT / folder,
+            source / folder,
+            ignore=shutil.ignore_patterns("__pycache__", "*.egg-info", "*.pyc"),
+        )
+    code = (
+        "import sys; from setuptools import build_meta; print(build_meta.build_sdist(sys.argv[1]))"
+    )
+    done = _run([sys.executable, "-c", code, str(tmp_path / "dist")], cwd=source)
+    archive = tmp_path / "dist" / done.stdout.split()[-1]
+    with tarfile.open(archive) as tar:
+        top = tar.getnames()[0].split("/")[0]
+        shipped = {n.split("/", 1)[1] for n in tar.getnames() if "/" in n}
+    for folder in ("tests", "docs", "examples", "trajectories"):
+        missing = _project_files(folder) - shipped
+        assert not missing, f"{top}: {sorted(missing)[:5]}"
