@@ -117,10 +117,10 @@ def test_the_summary_prints_the_options_whole():
 
 
 def test_the_scenario_tool_records_the_options_its_runs_use():
-    from ddwmmr.cli.scenarios import mpc_options
     from ddwmmr.scenarios import RunConfig, generate
+    from ddwmmr.scenarios.protocol import controller_options_record
 
-    record = mpc_options(RunConfig(controller="mpc"), generate(1, 0)[0])
+    record = controller_options_record(RunConfig(controller="mpc"), generate(1, 0)[0])
     assert set(record) == set(FIELDS) - {"obstacles"}
     assert (record["model"], record["track_orientation"], record["dt"]) == ("thesis", False, 0.01)
     assert record["horizon"] == GRID_DEFAULTS["reach"][2] and record["huber"] == 0.01

@@ -67,10 +67,16 @@ def test_a_failed_run_names_the_lost_support_and_the_broken_floor() -> None:
 
 def test_no_warning_without_support_loss_or_with_a_tip_over(lifted: dict) -> None:
     kinematic = {k: v for k, v in lifted.items() if k not in ("support_lost", "tipped")}
-    assert verdict(kinematic)["verdict"] == TRACKED
-    assert verdict({**lifted, "support_lost": False})["verdict"] == TRACKED
+    # the long-arm run starts below its floor: that warning, and no support warning
+    below_floor = (
+        f"{TRACKED}; warning: the run started below its stability floor "
+        "(start S = 1.06821 < stability_min 1.25;"
+    )
+    for summary in (kinematic, {**lifted, "support_lost": False}):
+        text = verdict(summary)["verdict"]
+        assert text.startswith(below_floor) and "unloaded" not in text
     tipped = verdict({**lifted, "tipped": True, "tip_time_s": 1.0})
-    assert tipped["verdict_reasons"] == ["tipped_over"] and "warning" not in tipped["verdict"]
+    assert tipped["verdict_reasons"] == ["tipped_over"] and "unloaded" not in tipped["verdict"]
     assert support_warning({**lifted, "support_lost": False}) == ""
 
 

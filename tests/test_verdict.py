@@ -183,8 +183,12 @@ def test_a_start_below_the_stability_floor_is_named_as_the_cause():
     # a start that :g would spell as the floor itself is spelt in full
     close = verdict({**far, "start_stability": 1.2499999, "stability_min": 1.25})["verdict"]
     assert "(start S = 1.2499999 < stability_min 1.25)" in close
-    assert verdict({**CLEAN, "start_stability": 2.18, "stability_min": 9.9})["verdict"] == (
-        "tracked"
+    # a run that tracked from below its floor: tracked, with a warning (not a reason)
+    tracked = verdict({**CLEAN, "start_stability": 2.18, "stability_min": 9.9})
+    assert tracked["verdict_reasons"] == []
+    assert tracked["verdict"].startswith(
+        "tracked; warning: the run started below its stability floor (start S = 2.18 < "
+        "stability_min 9.9;"
     )
 
 

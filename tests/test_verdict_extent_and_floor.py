@@ -190,7 +190,11 @@ def test_an_mpc_started_below_its_floor_did_not_track():
     assert verdict({**CLEAN_MPC, "stability_min": 1.25})["verdict"] == "tracked"
     # the qp's recovery from below its floor is its documented behaviour: tracked
     qp = {**CLEAN_MPC, "mpc_fallbacks": None, "qp_fallbacks": 0}
-    assert verdict(qp)["verdict"] == "tracked"
+    assert verdict(qp)["verdict_reasons"] == []
+    assert verdict(qp)["verdict"].startswith(
+        "tracked; warning: the run started below its stability floor (start S = 2.1776 < "
+        "stability_min 2.5;"
+    )
 
 
 def test_an_mpc_run_from_below_its_floor_says_so():

@@ -90,6 +90,7 @@ from ddwmmr.scenarios.protocol import (
     check_payload,
     check_thresholds,
     check_time_limit,
+    controller_options_record,
     make_scenario_controller,
     make_scenario_plant,
     plants_for,
@@ -793,8 +794,7 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     if args.bounds_table is not None:
         beaten = report.below_lower_bound(outcomes, args.bounds_table)
         extra["bracket"] = {"bounds": args.bounds, **report.bracket(outcomes, args.bounds_table)}
-    if config.controller == "mpc":
-        extra["controller_options"] = mpc_options(config, scenarios[0])
+    extra["controller_options"] = controller_options_record(config, scenarios[0])
     summary = write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     if args.bounds_table is not None:
         print(_bracket_line(summary["bracket"], args.bounds, len(outcomes)))
@@ -843,19 +843,6 @@ def _beaten_line(beaten: list[tuple[int, float, float]], bounds: str) -> str:
     )
 
 
-def mpc_options(config: RunConfig, scenario: Scenario) -> dict[str, Any]:
-    """The ``mpc``'s options as the batch's runs use them, whole: resolved for the batch's
-    plant (:meth:`~ddwmmr.mpc.options.MPCOptions.adopt_plant`), in waypoint mode, without
-    the obstacles (each scenario's own); ``summary.json["controller_options"]``."""
-    robot = config_robot(config)
-    plant = make_scenario_plant(robot, config)
-    controller = make_scenario_controller(robot, scenario, config, plant)
-    controller.adopt_plant(traits_of(plant))
-    record = controller.resolved.record("reach", config.dt)
-    del record["obstacles"]
-    return record
-
-
 def _run_thresholds(args, config, runner, folder: Path) -> None:
     scenarios = generate(args.n, args.seed)
     results = []
@@ -887,6 +874,7 @@ def _run_obstacles(args, config, runner, folder: Path) -> None:
     scenarios = studies.obstacle_scenarios(generate(max(args.n, 10), args.seed))
     outcomes, wall = runner.run(scenarios, config, "obstacles")
     extra = {"seed": args.seed, "study": "obstacles", "run": _record(args, config, runner.workers)}
+    extra["controller_options"] = controller_options_record(config, scenarios[0])
     write_batch(folder, scenarios, outcomes, config, wall, extra, runner.progress)
     table = studies.obstacle_table([o.metrics for o in outcomes], _title(config))
     write_atomic(folder / "obstacles.md", table)

@@ -38,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr import provenance
 from ddwmmr.arbiters.checked import checked_arbiter
 from ddwmmr.arbiters.factory import check_arbiter
 from ddwmmr.arbiters.state_machine import (
@@ -720,6 +721,46 @@ def waypoint_options(controller: str, run: WaypointRun) -> dict[str, Any]:
     return dict(options)
 
 
+def controller_options_record(config: RunConfig, scenario: Scenario) -> dict[str, Any]:
+    """Every option of ``config.controller`` with the value the runs of ``config`` use, as
+    a batch's ``summary.json["controller_options"]`` records it (JSON-ready,
+    :func:`ddwmmr.provenance.encode`), taken on ``scenario`` without its obstacles (each
+    scenario's own).
+
+    A controller that resolves its options for the plant (the ``mpc``: its ``resolved``
+    options, after ``adopt_plant``) records them as resolved, in the waypoint task's
+    objective (``"reach"``); any other records its ``waypoint_options`` over the defaults
+    of its constructor (:func:`ddwmmr.provenance.options_record`, where the defaults are
+    read, not restated). An option holding an object JSON has no form for (the thesis
+    controller's arbiter) is recorded as its class, ``module.Class``: a repr would carry a
+    memory address and differ from run to run. Building the controller checks the options
+    as a run would (a bad one: its one-line :class:`ParameterError`)."""
+    robot = Robot().with_payload(config.payload)
+    plant = make_scenario_plant(robot, config)
+    controller = make_scenario_controller(robot, scenario, config, plant)
+    adopt = getattr(controller, "adopt_plant", None)
+    if callable(adopt):  # as the loop does before the first step
+        adopt(traits_of(plant))
+    resolved = getattr(controller, "resolved", None)
+    if callable(getattr(resolved, "record", None)):
+        options = dict(resolved.record("reach", config.dt))
+    else:
+        run = WaypointRun(scenario, config, traits_of(plant), robot, _envelope(plant))
+        options = waypoint_options(config.controller, run)
+        options = {**provenance.options_record(config.controller, {}), **options}
+    options.pop("obstacles", None)
+    return {name: _recorded(value) for name, value in options.items()}
+
+
+def _recorded(value: Any) -> Any:
+    """``value`` JSON-ready (:func:`ddwmmr.provenance.encode`), or the class of an object
+    it has no form for (``"ddwmmr.arbiters.state_machine.StateMachineArbiter"``)."""
+    encoded = provenance.encode(value)
+    if isinstance(encoded, dict) and set(encoded) == {"repr"}:
+        return f"{type(value).__module__}.{type(value).__qualname__}"
+    return encoded
+
+
 def _envelope(plant: Plant) -> dict[str, Any] | None:
     """What a velocity command can ask of a force-limited base (None: no limit)."""
     envelope = getattr(plant, "velocity_envelope", None)
@@ -740,6 +781,7 @@ __all__ = [
     "check_start_pose",
     "check_thresholds",
     "check_time_limit",
+    "controller_options_record",
     "make_scenario_controller",
     "make_scenario_plant",
     "max_start_payload",

@@ -5,7 +5,9 @@ report, the simulator's summary line, :attr:`SimulationResult.summary`): the sum
 
 * ``verdict``: ``"tracked"``, or ``"did not track: <what went wrong>; likely cause:
   <why> (see docs/...)"``, either followed by ``"; warning: ..."`` where a physics plant
-  unloaded an edge of the support polygon (:func:`support_warning`, below);
+  unloaded an edge of the support polygon (:func:`support_warning`, below) and where the
+  run started below its stability floor without the verdict saying so already
+  (:func:`floor_warning`, below);
 * ``verdict_reasons``: the machine-readable codes of what went wrong (an empty list when
   it tracked), each one of :data:`REASONS`.
 
@@ -68,6 +70,13 @@ clause (:func:`support_warning`) saying for how long (``unloaded_time_s``) and, 
 controller predicted its edge loads (``min_predicted_edge_load_n``), whether it predicted
 one below its own floor (``min_edge_load_floor_n``). A run that tipped over says so in its
 reasons instead.
+
+A run that started below its own stability floor (``start_stability`` < ``stability_min``)
+is not a failure either where its controller may (a ``qp``: its recovery from below the
+floor is its documented behaviour, docs/qp.md, "Limitations"): where neither a reason
+(``below_floor_at_start``, an ``mpc`` run) nor the likely cause names the floor, its
+verdict ends with a warning clause (:func:`floor_warning`) giving S at the start and the
+floor, after the support warning where both apply.
 """
 
 from __future__ import annotations
@@ -99,6 +108,7 @@ __all__ = [
     "check_summary",
     "error_limit",
     "explain",
+    "floor_warning",
     "lost_support",
     "short_verdict",
     "support_warning",
@@ -292,6 +302,16 @@ PREDICTED_BELOW_FLOOR = (
 #: :data:`PREDICTED_BELOW_FLOOR`: a solver meets the floor to within its tolerance, and a
 #: load a few 1e-14 N under it held it.
 PREDICTED_SLACK_N = 1e-3
+#: The warning clause of a run that started below its own stability floor and tracked
+#: anyway, or failed for a cause that does not name the floor (:func:`floor_warning`):
+#: the protocol does not fail such a run (a ``qp``'s recovery from below its floor is its
+#: documented behaviour), but the floor it was given did not hold from the start.
+STARTED_BELOW_FLOOR = (
+    "warning: the run started below its stability floor (start S = {start} < "
+    "stability_min {floor}; start_stability, stability_min), so the floor did not hold "
+    "from the start: start above it or lower stability_min "
+    '(see docs/qp.md, "Limitations")'
+)
 
 WOULD_TIP = (
     "the arm's reach and the payload put the centre of mass outside the support polygon "
@@ -635,17 +655,28 @@ def _mostly_at_joint_limits(summary: Mapping[str, Any]) -> bool:
 
 
 def _rate_limit_steps(summary: Mapping[str, Any]) -> float:
-    """The least number of steps at a rate limit: the steps with a wheel or a joint at its
-    rate limit (``wheel_limit_steps``, ``joint_rate_limit_steps``: clipped by the plant or
-    held inside a controller's own bounds), or ``saturated_steps`` less the steps with a
-    joint at a position limit (``joint_limit_steps``, which may explain the rest),
-    whichever is more."""
+    """The least number of steps the plant clipped at a rate limit: ``saturated_steps``
+    less the steps with a joint at a position limit (``joint_limit_steps``, which may
+    explain the rest), or the steps with a wheel or a joint at its rate limit
+    (``wheel_limit_steps``, ``joint_rate_limit_steps``) if more, except in a run whose
+    controller holds those limits inside its own bounds (:func:`_bounds_own_rates`),
+    where a limit held clips nothing and the position limit is what the plant clipped."""
     clipped = _number(summary, "saturated_steps") or 0
+    beyond_joint_limits = clipped - (_number(summary, "joint_limit_steps") or 0)
+    if _bounds_own_rates(summary):
+        return beyond_joint_limits
     return max(
-        clipped - (_number(summary, "joint_limit_steps") or 0),
+        beyond_joint_limits,
         _number(summary, "wheel_limit_steps") or 0,
         _number(summary, "joint_rate_limit_steps") or 0,
     )
+
+
+def _bounds_own_rates(summary: Mapping[str, Any]) -> bool:
+    """A ``qp`` or ``mpc`` run (``qp_fallbacks`` or ``mpc_fallbacks`` in the summary):
+    its controller keeps the wheel speeds and joint rates a hair inside their limits, so
+    the plant clips no command at a rate limit."""
+    return any(_number(summary, key) is not None for key in ("qp_fallbacks", "mpc_fallbacks"))
 
 
 def _clipping(summary: Mapping[str, Any]) -> str:
@@ -847,6 +878,28 @@ def support_warning(summary: Mapping[str, Any]) -> str:
     )
 
 
+def floor_warning(
+    summary: Mapping[str, Any], found: list[str] | None = None, cause: str | None = None
+) -> str:
+    """:data:`STARTED_BELOW_FLOOR` for a run that started below its own stability floor
+    (``start_stability`` < ``stability_min``, both in the summary: a ``qp`` or ``mpc``
+    run) where its verdict does not say so already: not where it is a reason
+    (``below_floor_at_start``, an ``mpc`` run) nor where it is the likely cause
+    (:data:`BELOW_FLOOR`); ``""`` otherwise. ``found`` and ``cause`` are the run's
+    reasons and likely cause (:func:`explain`'s, computed when None); ``summary`` as in
+    :func:`verdict`."""
+    check_summary(summary)
+    if not _started_below_floor(summary):
+        return ""
+    if found is None or cause is None:
+        found, _, cause = explain(summary)
+    start_text, floor_text = _floor_texts(summary)
+    named = BELOW_FLOOR.format(start_stability=start_text, stability_min=floor_text)
+    if "below_floor_at_start" in found or cause == named:
+        return ""
+    return STARTED_BELOW_FLOOR.format(start=start_text, floor=floor_text)
+
+
 def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
     """The verdict keys of a run's ``summary`` (the keys :func:`ddwmmr.simulate` writes):
     ``{"verdict": str, "verdict_reasons": list[str]}`` (see the module docstring).
@@ -858,8 +911,8 @@ def verdict(summary: Mapping[str, Any]) -> dict[str, Any]:
     :class:`~ddwmmr.errors.ParameterError` naming the key, whether or not this summary's
     verdict would read it."""
     found, what, cause = explain(summary)
-    warning = support_warning(summary)
-    tail = f"; {warning}" if warning else ""
+    warnings = (support_warning(summary), floor_warning(summary, found, cause))
+    tail = "".join(f"; {warning}" for warning in warnings if warning)
     if not found:
         return {"verdict": TRACKED + tail, "verdict_reasons": []}
     return {
