@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from ddwmmr.bench import PHASES, REFERENCE_LABEL, TOOL, format_table
+from ddwmmr.bench.report import format_source
 from ddwmmr.sim.result import write_atomic
 
 #: The simulate-throughput target of issue 14 (steps/s of a closed-form method's full run).
@@ -35,7 +36,7 @@ def conditions(report: dict[str, Any]) -> str:
     load = config.get("load_average")
     load_text = f", load average {load[0]:.1f}" if load else ""
     return (
-        f"Measured {config.get('timestamp', '?')} (commit {config.get('git_commit') or '?'}), "
+        f"Measured {config.get('timestamp', '?')} ({format_source(config)}), "
         f"Python {config['python']}, numpy {config['numpy']}, {config['machine']}, "
         f"{config.get('cpus', '?')} CPUs shared with other jobs{load_text}; "
         f"{config['repeats']} repeats of {config['calls']} states."

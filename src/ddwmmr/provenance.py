@@ -2,11 +2,11 @@
 
 Every tool writes a record (``summary.json["run"]`` for track and scenarios, ``run.json``
 for compare) with the tool, the package version, the git commit of the source when it is
-a git checkout, the exact command line and working folder, what decides the last bits of
-the numbers (the numerical libraries' versions, NumPy's and SciPy's BLAS and the CPU:
-:func:`numerics_record`), and the tool's inputs in full:
-method and every option with its default filled in, the robot (all fields), the
-trajectory (its parameters, or its file's path and SHA-256), step, integrator, offset,
+a git checkout, a command that repeats the run and the working folder, what decides the
+last bits of the numbers (the numerical libraries' versions, NumPy's and SciPy's BLAS and
+the CPU: :func:`numerics_record`), and the tool's inputs in full: method and every option
+with its default filled in, the robot (all fields), the trajectory (its parameters, or
+its file's path and SHA-256), step, integrator, offset,
 plant and seed. Values are JSON: tuples become lists, non-finite floats the strings
 ``"inf"``, ``"-inf"``, ``"nan"`` (:func:`decode` turns them back). The record of a
 tracking run (:class:`RunInputs`, :func:`run_record`) is written by ``track`` and by the
@@ -27,6 +27,7 @@ import platform
 import shlex
 import subprocess
 import sys
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -38,7 +39,7 @@ from ddwmmr.controllers.base import method_options
 from ddwmmr.errors import ParameterError, one_line, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import package_version
-from ddwmmr.trajectories.files import SHAPES, file_sha256
+from ddwmmr.trajectories.files import SHAPES, file_sha256, is_name, package_folder
 from ddwmmr.trajectories.sampled import SampledTrajectory, read_csv
 
 #: Version of the record layout (bump when a key changes meaning).
@@ -110,7 +111,10 @@ def _git(top: Path, *arguments: str) -> str:
 
 
 def command_record(prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
-    """The exact command line (``argv`` as given, or ``sys.argv[1:]``) and working folder."""
+    """``command``: a command that repeats the run, ``prog`` (the tool's ``python -m``
+    form, also when the run was started by its console script) and the arguments;
+    ``argv``: the arguments as given (``argv``, or ``sys.argv[1:]``); ``cwd``: the
+    working folder."""
     arguments = list(argv if argv is not None else sys.argv[1:])
     return {
         "command": shlex.join([*shlex.split(prog), *arguments]),
@@ -120,8 +124,9 @@ def command_record(prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
 
 
 def header(tool: str, prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
-    """The start of every record: tool, versions, commit, command line, and what decides
-    the last bits of the numbers (:func:`numerics_record`)."""
+    """The start of every record: tool, versions, commit, the command that repeats the
+    run (:func:`command_record`), and what decides the last bits of the numbers
+    (:func:`numerics_record`)."""
     return {
         "record_version": RECORD_VERSION,
         "tool": tool,
@@ -283,23 +288,62 @@ def trajectory_record(
 
 
 def trajectory_from_record(record: dict[str, Any]) -> Any:
-    """The trajectory a :func:`trajectory_record` describes (a changed file is an error)."""
+    """The trajectory a :func:`trajectory_record` describes (a changed file is an error;
+    a gone one that the package ships is read there, with a ``UserWarning`` saying so:
+    :func:`read_trajectory_record`)."""
+    trajectory, _, note = read_trajectory_record(record)
+    if note is not None:
+        warnings.warn(note, UserWarning, stacklevel=2)
+    return trajectory
+
+
+def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Path | None, str | None]:
+    """``(trajectory, file, note)``: the trajectory a :func:`trajectory_record` describes,
+    its file (the one its samples were read from; a parametric one's as recorded, as it is
+    rebuilt from its parameters; None if the record names none) and a one-line note when
+    the samples were read from another file than the recorded one, else None.
+
+    A recorded file that is gone is replaced by the trajectory the package ships under
+    the record's name or file name (:func:`~ddwmmr.trajectories.files.package_folder`) if
+    that file's SHA-256 is the recorded one: the install path of a shipped trajectory
+    changes with the environment (another venv, machine, or checkout), its bytes do not.
+    A file whose SHA-256 differs from the record's is refused (:class:`ParameterError`).
+    """
     kind = record.get("type")
     if kind in SHAPES:
-        return SHAPES[kind](**decode(record["parameters"]))
-    if kind == "samples":
-        path = Path(record["file"])
-        if not path.exists():
-            raise ParameterError(f"the trajectory file {path} is gone")
-        if not path.is_file():  # checked before hashing: a FIFO would block the read
-            now = "a folder" if path.is_dir() else "not a regular file"
-            raise ParameterError(f"the trajectory file {path} is now {now}")
-        if file_sha256(path) != record["sha256"]:
-            raise ParameterError(
-                f"the trajectory file {path} changed since the run (SHA-256 differs)"
-            )
-        return read_csv(path)
-    raise ParameterError(f"cannot rebuild a trajectory of type {shown(kind)}")
+        source = record.get("file")
+        file = Path(source) if isinstance(source, str) and source else None
+        return SHAPES[kind](**decode(record["parameters"])), file, None
+    if kind != "samples":
+        raise ParameterError(f"cannot rebuild a trajectory of type {shown(kind)}")
+    path = Path(record["file"])
+    note = None
+    if not path.exists():
+        path = _shipped_stand_in(record, path)
+        note = (
+            f"the trajectory file {record['file']} is gone; read the one this package "
+            f"ships, {path}, which has the recorded SHA-256"
+        )
+    if not path.is_file():  # checked before hashing: a FIFO would block the read
+        now = "a folder" if path.is_dir() else "not a regular file"
+        raise ParameterError(f"the trajectory file {path} is now {now}")
+    if file_sha256(path) != record["sha256"]:
+        raise ParameterError(f"the trajectory file {path} changed since the run (SHA-256 differs)")
+    return read_csv(path), path, note
+
+
+def _shipped_stand_in(record: dict[str, Any], gone: Path) -> Path:
+    """The shipped CSV trajectory named as the record's ``name`` or its file's name whose
+    SHA-256 is the record's; else the refusal that ``gone`` is gone."""
+    differs = ""
+    for stem in sorted({str(record.get("name")), gone.name.removesuffix(".csv")}):
+        shipped = package_folder() / f"{stem}.csv"
+        if not (is_name(stem) and shipped.is_file()):  # a name never leaves the folder
+            continue
+        if file_sha256(shipped) == record["sha256"]:
+            return shipped
+        differs = f" (the package's own {shipped.name} has another SHA-256)"
+    raise ParameterError(f"the trajectory file {gone} is gone{differs}")
 
 
 @dataclass

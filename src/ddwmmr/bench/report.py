@@ -22,8 +22,9 @@ from ddwmmr.outputs import check_output_file, check_writable, write_atomic
 
 #: Marker of a report written by this tool (an existing ``--out`` file must carry it).
 TOOL = "ddwmmr.bench"
-#: Version of the report layout.
-REPORT_VERSION = 2
+#: Version of the report layout (3: ``config`` names the code by ``package_version``,
+#: ``git`` and ``git_note`` as run records do; 2 had ``git_commit``).
+REPORT_VERSION = 3
 
 
 def format_table(report: dict[str, Any]) -> str:
@@ -216,9 +217,9 @@ def format_qp_verdict(report: dict[str, Any]) -> str:
 
 def format_comparison(report: dict[str, Any], previous: dict[str, Any]) -> str:
     """Median step of each row and qp class against a previous report (new / old)."""
+    config = previous["config"]
     lines = [
-        f"against {previous['config'].get('timestamp', '?')} "
-        f"(commit {previous['config'].get('git_commit') or '?'}): median step new / old"
+        f"against {config.get('timestamp', '?')} ({format_source(config)}): median step new / old"
     ]
     old_rows = {row["label"]: row for row in previous.get("rows", [])}
     for row in report["rows"]:
@@ -250,6 +251,23 @@ def format_comparison(report: dict[str, Any], previous: dict[str, Any]) -> str:
                 f"simulated s per wall s ({new_rate / old_rate:.2f}x)"
             )
     return "\n".join(lines)
+
+
+def format_source(config: dict[str, Any]) -> str:
+    """What code a report's ``config`` was measured with: ``ddwmmr 0.1.0, commit
+    0123456789ab`` (``, dirty`` with modified tracked files; ``no commit`` from an
+    installed package, :func:`ddwmmr.provenance.git_record`), or ``commit b697be4`` from
+    a report of layout 2, whose ``git_commit`` was the short commit of any git repository
+    above the installed package (the user's own, outside a checkout)."""
+    if "git" not in config:  # layout 2
+        return f"commit {config.get('git_commit') or '?'}"
+    git = config["git"]
+    commit = git.get("commit") if isinstance(git, dict) else None
+    if isinstance(commit, str) and commit:
+        source = f"commit {commit[:12]}" + (", dirty" if git.get("dirty") else "")
+    else:
+        source = "no commit"
+    return f"ddwmmr {config.get('package_version') or '?'}, {source}"
 
 
 def write_report(report: dict[str, Any], path: str | Path, force: bool = False) -> None:

@@ -5,10 +5,8 @@ from __future__ import annotations
 
 import os
 import platform
-import subprocess
 from collections.abc import Sequence
 from datetime import UTC, datetime
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -44,7 +42,9 @@ from ddwmmr.errors import (
     check_range,
 )
 from ddwmmr.model import Robot
+from ddwmmr.outputs import package_version
 from ddwmmr.progress import ProgressBar, phase
+from ddwmmr.provenance import git_record
 from ddwmmr.trajectories import Ellipse
 from ddwmmr.trajectories.base import resolution_step
 
@@ -167,7 +167,10 @@ def check_duration(trajectory: Any, duration: float | None) -> float:
 
 
 def _config(repeats: int, calls: int, trajectory: Any, duration: float, overhead: float):
-    """Conditions of the run (to compare runs over time)."""
+    """Conditions of the run (to compare runs over time), with the package's version and
+    its source's commit as every tool's run record gives them
+    (:func:`ddwmmr.provenance.git_record`): ``package_version``, because the report's own
+    ``version`` is its layout's (:data:`~ddwmmr.bench.report.REPORT_VERSION`)."""
     return {
         "repeats": repeats,
         "calls": calls,
@@ -183,7 +186,8 @@ def _config(repeats: int, calls: int, trajectory: Any, duration: float, overhead
         "cpus": os.cpu_count(),
         "load_average": _load_average(),
         "timestamp": datetime.now(UTC).isoformat(timespec="seconds"),
-        "git_commit": _git_commit(),
+        "package_version": package_version(),
+        **git_record(),
     }
 
 
@@ -191,19 +195,3 @@ def _load_average() -> list[float] | None:
     """The system's 1, 5 and 15 minute load averages (runnable processes), None where the
     platform has none."""
     return list(os.getloadavg()) if hasattr(os, "getloadavg") else None
-
-
-def _git_commit() -> str | None:
-    """The source checkout's commit, when this is one."""
-    root = Path(__file__).resolve().parents[3]  # src/ddwmmr/bench/run.py -> the checkout
-    try:
-        out = subprocess.run(
-            ["git", "-C", str(root), "rev-parse", "--short", "HEAD"],
-            capture_output=True,
-            text=True,
-            timeout=5,
-            check=False,
-        )
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return out.stdout.strip() or None

@@ -94,7 +94,7 @@ outputs (in --out):
   run.json      everything needed to repeat the comparison by hand: methods and
                 their options with defaults, robot, trajectories (parameters, and a
                 file's path and SHA-256), studies, version, git commit, libraries,
-                BLAS, CPU and the exact command line
+                BLAS, CPU and a command that repeats it
   *.png         paths, errors, wheel speeds and per-method panels per trajectory; one
                 figure per study
   The folder is built next to --out and renamed into place when complete; an existing

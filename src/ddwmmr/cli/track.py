@@ -507,24 +507,23 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         if plant not in available_plants():
             raise ParameterError(f"plant {plant!r} is not supported by this version")
         trajectory_record = _field(record, "trajectory", dict, "trajectory")
-        trajectory = _inside(
-            "trajectory", lambda: provenance.trajectory_from_record(trajectory_record)
+        trajectory, source, file_note = _inside(
+            "trajectory", lambda: provenance.read_trajectory_record(trajectory_record)
         )
-        source = trajectory_record.get("file")
         offset = tuple(provenance.decode(_field(record, "initial_offset", list, "offset")))
         inputs = RunInputs(
             _field(record, "method", str, "method name"),
             provenance.decode(_field(record, "options", dict, "options")),
             provenance.robot_from_record(_field(record, "robot", dict, "robot")),
             trajectory,
-            Path(source) if isinstance(source, str) and source else None,
+            source,
             record["dt"],  # checked by check_run, as --dt and --duration are
             record["duration"],
             _integrator(record, plant),
             offset,
             str(trajectory_record.get("name") or "rerun"),
             plant,
-            _recorded_digest(trajectory_record, source),
+            _recorded_digest(trajectory_record, trajectory_record.get("file")),
         )
         checked = check_run(inputs, "payload", "the recorded initial_offset")
     except ParameterError as exc:  # one line naming what is wrong: say where it was read
@@ -535,6 +534,8 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         ) from None
     except (TypeError, AttributeError, ValueError) as exc:
         raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
+    if file_note is not None:
+        print(f"track: note: {file_note}", file=sys.stderr)
     _note_other_software(record)
     return checked
 
