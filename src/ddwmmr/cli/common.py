@@ -25,6 +25,7 @@ import re
 import signal
 import sys
 import threading
+import warnings
 from collections.abc import Callable, Iterator, Sequence
 from typing import NoReturn
 
@@ -313,10 +314,36 @@ def forget_unhandled_interrupt() -> None:
     exec("pass")
 
 
-def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:
-    """Run ``main``: bad input, interrupts and write errors become one line on stderr."""
+#: The package's folder: a warning issued from a file below it is the library's own.
+_PACKAGE_FOLDER = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+@contextlib.contextmanager
+def one_line_warnings() -> Iterator[None]:
+    """Show the library's own warnings as one line on stderr, ``warning: <message>``
+    (their messages name the parameter and what to change), instead of Python's default
+    form (the source file, line number and line of the library's code, which reads like a
+    traceback); any other warning is shown as Python would."""
+    previous = warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None) -> None:
+        if os.path.abspath(filename).startswith(_PACKAGE_FOLDER + os.sep):
+            say(f"warning: {' '.join(str(message).split())}")
+        else:
+            previous(message, category, filename, lineno, file, line)
+
+    warnings.showwarning = show
     try:
-        with interruptible():
+        yield
+    finally:
+        warnings.showwarning = previous
+
+
+def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:
+    """Run ``main``: bad input, interrupts and write errors become one line on stderr, and
+    the library's warnings one line each (:func:`one_line_warnings`)."""
+    try:
+        with interruptible(), one_line_warnings():
             return main(argv)
     except ParameterError as exc:
         say(f"error: {exc}")
