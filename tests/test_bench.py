@@ -280,7 +280,7 @@ def test_missing_reference_is_skipped_with_the_install_hint(monkeypatch):
     monkeypatch.setitem(sys.modules, "roboticstoolbox", None)  # import now fails
     cases, skipped = benchmark_cases(methods=["qp"])
     assert REFERENCE_LABEL not in [c.label for c in cases]
-    assert "pip install -e '.[bench]'" in skipped[REFERENCE_LABEL]
+    assert "pip install 'ddwmmr[bench]'" in skipped[REFERENCE_LABEL]
 
 
 # -- report file and command line ----------------------------------------------------------

@@ -39,8 +39,9 @@ from ddwmmr.trajectories.base import resolution_step
 DESCRIPTION = """\
 Time every control method step by step and in full runs, the qp step by state class
 and phase against its naive twin and roboticstoolbox-python's holistic QP step (install
-with pip install -e '.[bench]'), and the mpc step against the HPIPM solve inside it
-(tracking and the first scenarios). Prints a table and writes the report to --out.
+with pip install 'ddwmmr[bench]', or -e '.[bench]' in a checkout), and the mpc step
+against the HPIPM solve inside it (tracking and the first scenarios). Prints a table and
+writes the report to --out.
 """
 
 

@@ -184,7 +184,7 @@ def write_window_png(figure: Figure, folder: Path, dpi: float | None = None) -> 
 
 def animation_available(fmt: str) -> bool:
     """True if matplotlib can write ``fmt`` here. MP4 needs ffmpeg: on PATH, or the copy
-    the optional ``imageio-ffmpeg`` package ships (``pip install -e '.[video]'``), which
+    the optional ``imageio-ffmpeg`` package ships (``pip install 'ddwmmr[video]'``), which
     is then given to matplotlib (``animation.ffmpeg_path``) unless that is set already."""
     writer = ANIMATION_WRITERS[fmt]
     if writer == "ffmpeg" and not mpl_animation.writers.is_available(writer):

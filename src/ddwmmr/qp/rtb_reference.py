@@ -18,7 +18,7 @@ to a planar arm, both needed for the maths to mean anything: the manipulability 
 uses the planar translation axes only (a 2-link arm's 6x2 Jacobian has ``det(J J') = 0``),
 and ``joint_velocity_damper`` is called with keywords (its first parameter became ``q``).
 
-Not a registered method; needs ``pip install -e '.[bench]'`` (roboticstoolbox-python).
+Not a registered method; needs ``pip install 'ddwmmr[bench]'`` (roboticstoolbox-python).
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ def unavailable_reason() -> str | None:
     except ImportError as exc:
         return (
             f"roboticstoolbox-python is not installed ({exc.name or exc}); "
-            "pip install -e '.[bench]' adds it"
+            "pip install 'ddwmmr[bench]' (-e '.[bench]' in a checkout) adds it"
         )
     return None
 
