@@ -16,7 +16,7 @@ import warnings
 
 import pytest
 
-import ddwmmr.outputs as outputs_module
+import ddwmmr.outputs.atomic as atomic_module
 from ddwmmr import Ellipse, Robot, simulate
 from ddwmmr.errors import ParameterError
 from ddwmmr.scenarios import RunConfig, Scenario, generate, run_scenario
@@ -93,13 +93,13 @@ def test_a_device_is_never_replaced(result, tmp_path, monkeypatch, no_temp_file)
 
 def test_a_fifo_made_during_the_write_is_not_replaced(result, tmp_path, monkeypatch):
     target = tmp_path / "summary.json"
-    real_mode = outputs_module.file_mode
+    real_mode = atomic_module.file_mode
 
     def mode_and_fifo():  # called while the temporary file is being written
         os.mkfifo(target)
         return real_mode()
 
-    monkeypatch.setattr(outputs_module, "file_mode", mode_and_fifo)
+    monkeypatch.setattr(atomic_module, "file_mode", mode_and_fifo)
     _refused(
         lambda: result.write_summary(target),
         f"path: {target} exists and is not a regular file (a FIFO); give a file name",

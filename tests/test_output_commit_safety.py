@@ -19,7 +19,7 @@ from pathlib import Path
 import pytest
 
 from ddwmmr import outputs
-from ddwmmr.outputs import MANIFEST, output_folder
+from ddwmmr.outputs import MANIFEST, checks, commit, output_folder, owners, recovery
 
 
 def _write_run(target: Path, text: str, force: bool = False, names=("a.csv",)) -> None:
@@ -101,13 +101,13 @@ def test_a_signal_during_the_commit_waits_until_the_output_is_in(tmp_path, monke
 def test_an_interrupt_while_the_old_output_is_deleted_says_the_new_one_is_in(tmp_path, monkeypatch):
     target = tmp_path / "out"
     _write_run(target, "old\n")
-    real = outputs._discard_old
+    real = commit._discard_old
 
     def interrupted(*args):
         real(*args)
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(outputs, "_discard_old", interrupted)
+    monkeypatch.setattr(commit, "_discard_old", interrupted)
     with pytest.raises(KeyboardInterrupt) as caught:
         _write_run(target, "new\n")
     assert outputs.committed_output(caught.value) == target
@@ -126,10 +126,10 @@ def test_temporary_files_carry_their_owner_and_dead_ones_are_swept(tmp_path, mon
     monkeypatch.setattr(os, "replace", lambda a, b: names.append(Path(a).name) or real(a, b))
     outputs.write_atomic(tmp_path / "x.txt", "x")
     monkeypatch.undo()
-    match = outputs._OWNED_NAME.match(names[0])
+    match = owners._OWNED_NAME.match(names[0])
     assert match["kind"] == "tmp" and int(match["pid"]) == os.getpid()
 
-    dead = f".ddwmmr-tmp-{outputs._host()}-{_dead_pid()}-1-abcd1234.tmp"
+    dead = f".ddwmmr-tmp-{owners._host()}-{_dead_pid()}-1-abcd1234.tmp"
     target = tmp_path / "bd"
     (target / "cache").mkdir(parents=True)
     (target / "cache" / "c.json").write_text("{}")
@@ -269,8 +269,8 @@ def _dead_old(
     """An old folder of an ended run made to replace ``parent/target``: its manifest lists
     ``files``, those whose text is not None are there; ``noted_at``: the time (ns) of its
     note naming ``target``, None for no note (a replace that had finished)."""
-    tag = outputs._target_tag(parent / target)
-    old = parent / f".ddwmmr-old-{outputs._host()}-{_dead_pid()}-1-{tag}{random}"
+    tag = recovery._target_tag(parent / target)
+    old = parent / f".ddwmmr-old-{owners._host()}-{_dead_pid()}-1-{tag}{random}"
     old.mkdir()
     for name, text in files.items():
         if text is not None:
@@ -290,7 +290,7 @@ def test_the_newest_complete_old_folder_is_put_back(tmp_path, capsys):
     _dead_old(tmp_path, "mine", {"a.csv": "newer\n", "b.csv": "newer\n"}, "zzzz", 2 * 10**18)
     target = tmp_path / "mine"
     with output_folder(target, "track") as staging:
-        assert outputs._entries(target) == [MANIFEST, "a.csv", "b.csv"]
+        assert checks._entries(target) == [MANIFEST, "a.csv", "b.csv"]
         assert (target / "a.csv").read_text() == "newer\n"
         assert (target / "b.csv").read_text() == "newer\n"
         (staging / "a.csv").write_text("x\n")
@@ -345,8 +345,8 @@ def test_a_signal_cutting_the_holding_short_leaves_every_handler_as_it_was(monke
     try:
         signal.signal(signal.SIGINT, signal.default_int_handler)
         signal.signal(signal.SIGTERM, stop)
-        monkeypatch.setattr(outputs.signal, "getsignal", getsignal)
-        with pytest.raises(Stop), outputs._signals_deferred():
+        monkeypatch.setattr(commit.signal, "getsignal", getsignal)
+        with pytest.raises(Stop), commit._signals_deferred():
             pass
         monkeypatch.undo()
         assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
@@ -364,7 +364,7 @@ def test_every_signal_held_during_a_commit_comes_in_the_order_it_came(order):
     try:
         for name, number in numbers.items():
             signal.signal(number, lambda signum, frame, name=name: came.append(name))
-        with outputs._signals_deferred():
+        with commit._signals_deferred():
             for name in [*order, order[0]]:  # the first one twice: it runs once
                 os.kill(os.getpid(), numbers[name])
             assert came == []

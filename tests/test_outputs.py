@@ -348,10 +348,10 @@ def test_a_fresh_folder_never_replaces_one_that_appeared_during_the_run(tmp_path
 def test_a_fresh_commit_takes_the_next_name_when_its_own_is_taken_meanwhile(tmp_path, monkeypatch):
     """Between the look for a free name and the mkdir another run takes it: the commit
     goes on to the next free one (the FileExistsError branch)."""
-    import ddwmmr.outputs as outputs
+    from ddwmmr.outputs import commit
 
     target = tmp_path / "runs" / "my.track-20261201"  # a dot in the name: -2 at the end
-    real = outputs.first_free
+    real = commit.first_free
     taken = []
 
     def racing(path, folder=False):
@@ -363,7 +363,7 @@ def test_a_fresh_commit_takes_the_next_name_when_its_own_is_taken_meanwhile(tmp_
         return free
 
     writer = output_folder(target, "x", fresh=True)
-    monkeypatch.setattr(outputs, "first_free", racing)
+    monkeypatch.setattr(commit, "first_free", racing)
     with writer as staging:
         (staging / "r.txt").write_text("mine")
     assert taken == [target] and writer.path == target.with_name(f"{target.name}-2")
@@ -388,17 +388,17 @@ def test_an_interrupt_just_after_the_fresh_mkdir_leaves_nothing(tmp_path, monkey
 
 
 def test_a_parent_another_run_makes_at_the_same_moment_is_used(tmp_path, monkeypatch):
-    import ddwmmr.outputs as outputs
+    from ddwmmr.outputs import commit
 
     runs = tmp_path / "runs"
-    real = outputs.missing_folders
+    real = commit.missing_folders
 
     def late(folder):
         missing = real(folder)
         runs.mkdir()  # the other run, between the look and our mkdir
         return missing
 
-    monkeypatch.setattr(outputs, "missing_folders", late)
+    monkeypatch.setattr(commit, "missing_folders", late)
     writer = output_folder(runs / "scenarios-1", "x", fresh=True)
     with writer as staging:
         (staging / "r.txt").write_text("mine")
@@ -526,7 +526,7 @@ def test_a_folder_whose_files_cannot_be_replaced_is_refused_before_the_run(
     before = snapshot(out)
     real_access = os.access
     monkeypatch.setattr(
-        "ddwmmr.outputs.os.access",
+        "ddwmmr.outputs.checks.os.access",
         lambda path, mode: False if Path(path) == out else real_access(path, mode),
     )
     assert run("track", out, *(["--force"] if force else [])) == 2

@@ -11,8 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from ddwmmr import outputs
-from ddwmmr.outputs import MANIFEST, output_folder
+from ddwmmr.outputs import MANIFEST, commit, output_folder
 
 OLD = {"a.txt": "old a\n", "sub/b.txt": "old b\n", "gone.txt": "old gone\n"}
 NEW = {"a.txt": "new a\n", "sub/c.txt": "new c\n", "fresh/deep/d.txt": "new d\n"}
@@ -39,7 +38,7 @@ def _interrupt_at(monkeypatch, move: int, after: bool) -> list[int]:
     """Make rename number ``move`` (from 1) of the merge raise KeyboardInterrupt, before or
     ``after`` renaming; returns the count of renames seen, updated as they come."""
     seen = [0]
-    real_merge, real_replace, real_rename = outputs._merge, os.replace, os.rename
+    real_merge, real_replace, real_rename = commit._merge, os.replace, os.rename
 
     def flaky(real):
         def rename(source, destination, *args, **kwargs):
@@ -62,7 +61,7 @@ def _interrupt_at(monkeypatch, move: int, after: bool) -> list[int]:
             monkeypatch.setattr(os, "replace", real_replace)
             monkeypatch.setattr(os, "rename", real_rename)
 
-    monkeypatch.setattr(outputs, "_merge", merge)
+    monkeypatch.setattr(commit, "_merge", merge)
     return seen
 
 

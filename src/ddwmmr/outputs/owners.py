@@ -1,0 +1,93 @@
+"""Who owns a staging folder, an old folder or a temporary file: the names ddwmmr gives
+them carry the host, process id and start time of the run that made them
+(:func:`owner_token`), so a later run can tell whether that run has ended
+(:func:`_dead_owner`).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import socket
+from pathlib import Path
+
+STAGING_PREFIX = ".ddwmmr-staging-"
+
+
+_OLD_PREFIX = ".ddwmmr-old-"
+
+
+#: Where the files of an old folder that no manifest lists are kept (a user's files).
+KEPT_PREFIX = ".ddwmmr-kept-"
+
+
+#: A staging or old folder's name: prefix, owner (host, process id, start time), random.
+#: A temporary file's (:func:`write_atomic`) too, with ``.tmp`` at the end of its random
+#: part. An old folder's random part starts with :func:`_target_tag` of the folder it
+#: replaces; that folder's name is in the note beside the old folder (:func:`_target_note`).
+_OWNED_NAME = re.compile(
+    r"^\.ddwmmr-(?P<kind>staging|old|tmp)-(?P<host>.+)-(?P<pid>\d+)-(?P<start>\d+)-"
+    r"(?P<random>[^-]+)$"
+)
+
+
+_TMP_PREFIX = ".ddwmmr-tmp-"
+
+
+def _host() -> str:
+    """This machine's name, reduced to letters, digits, dots and dashes (at most 64)."""
+    return re.sub(r"[^A-Za-z0-9.-]", "_", socket.gethostname())[:64] or "host"
+
+
+def _process_start(pid: int) -> int:
+    """When process ``pid`` started, in clock ticks since boot (Linux), or 0 if unknown;
+    with the process id it names one process, even after the id is reused."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        return int(fields[19])
+    except (OSError, IndexError, ValueError):
+        return 0
+
+
+def owner_token() -> str:
+    """``host-pid-start`` of this process, put in the names of its staging folders."""
+    return f"{_host()}-{os.getpid()}-{_process_start(os.getpid())}"
+
+
+def temp_prefix() -> str:
+    """Name prefix of this process's temporary files, carrying its :func:`owner_token`."""
+    return f"{_TMP_PREFIX}{owner_token()}-"
+
+
+def _dead_owner(name: str, kind: str) -> re.Match[str] | None:
+    """The match of ``name`` if it is a ``kind`` (staging, old, tmp) name of a run of this
+    host that has ended, else None."""
+    match = _OWNED_NAME.match(name)
+    if match is None or match["kind"] != kind or match["host"] != _host():
+        return None
+    return None if _running(int(match["pid"]), int(match["start"])) else match
+
+
+def _running(pid: int, start: int) -> bool:
+    """Whether the process ``pid`` that started at ``start`` (0: unknown) still runs.
+    In doubt (another user's process, a platform without these checks): True."""
+    if os.name != "posix":
+        return True  # os.kill(pid, 0) would end the process on Windows
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        pass  # it exists, another user's
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (OSError, IndexError):
+        return True
+    if state == "Z":
+        return False  # ended, not yet reaped
+    return not start or _process_start(pid) in (0, start)
+
+
+def _is_stale_temp(name: str) -> bool:
+    """Whether ``name`` is a temporary file's name (:func:`temp_prefix`) of an ended run."""
+    return name.endswith(".tmp") and _dead_owner(name, "tmp") is not None
