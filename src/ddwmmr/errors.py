@@ -15,6 +15,7 @@ import difflib
 import math
 import os
 import stat
+import sys
 import tomllib
 from collections.abc import Iterable
 from pathlib import Path
@@ -166,7 +167,10 @@ def check_step_count(duration: float, dt: float) -> int:
     if dt > duration:
         raise ParameterError(f"dt must be <= duration ({duration:g} s) (got {dt:g})")
     ratio = duration / dt
-    if not ratio <= MAX_STEPS:
+    # duration and dt are each read from decimal text (half an ulp off each), and the
+    # division adds half an ulp: 600 s / 0.0006 s gives 1000000.0000000001, and round()
+    # makes exactly MAX_STEPS steps of it. A few ulps of slack admit those, no more.
+    if not ratio <= MAX_STEPS * (1.0 + 4.0 * sys.float_info.epsilon):
         got = f"{ratio:.3g}"
         if not float(got) > MAX_STEPS:  # rounded onto the cap: "= 1e+06" against 1000000
             got, _ = texts_apart(ratio, MAX_STEPS)

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -284,8 +285,9 @@ def tips_in_every_pose(k: ComCoefficients) -> bool:
 
 def max_payload(robot, th1: float, th2: float) -> float:
     """The heaviest payload (kg) with which ``robot`` (a :class:`~ddwmmr.model.Robot`)
-    stands (static S > 1) with its arm at ``th1``, ``th2`` (rad), rounded down to the gram
-    so that the payload it names stands: 0 where the robot tips even unloaded, the top of
+    stands (static S > 1) with its arm at ``th1``, ``th2`` (rad), rounded down so that the
+    payload it names stands (:func:`_round_down_payload`: to the gram from 1 kg, to four
+    significant digits below): 0 where the robot tips even unloaded, the top of
     :data:`~ddwmmr.errors.MASS_RANGE_KG` where it stands with that.
 
     As the payload ``p`` grows the centre of mass moves along a line toward the end
@@ -307,7 +309,22 @@ def max_payload(robot, th1: float, th2: float) -> float:
             low = middle
         else:
             high = middle
-    return math.floor(low * 1e3) / 1e3
+    return _round_down_payload(low, stands)
+
+
+def _round_down_payload(limit: float, stands: Callable[[float], bool]) -> float:
+    """``limit`` (kg, >= 0) rounded down to the gram, or to four significant digits where
+    that is finer (below 1 kg), so that a small robot's limit of some tenths of a gram does
+    not read 0 kg. The result is a bound a user may type back: it never exceeds ``limit``
+    and ``stands(result)`` holds (one step lower where the decimal product rounded up)."""
+    if limit <= 0.0:
+        return 0.0
+    decimals = max(3, 3 - math.floor(math.log10(limit)))
+    scale = 10.0**decimals
+    result = math.floor(limit * scale) / scale
+    if result > 0.0 and not stands(result):
+        result = (math.floor(limit * scale) - 1) / scale
+    return result
 
 
 def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[float, float, float]:

@@ -246,16 +246,51 @@ def plot_errors(result) -> Figure:
     """End-effector position error (log scale) and orientation error vs time."""
     ts = result.timeseries
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
-    ax1.semilogy(ts["t"], np.maximum(ts["position_error_m"], 1e-9), color="tab:blue")
+    position = np.maximum(ts["position_error_m"], 1e-9)
+    ax1.semilogy(ts["t"], position, color="tab:blue")
+    at_least_a_decade(ax1, position)
     ax1.set_ylabel("position error (m)")
     ax1.grid(alpha=0.3, which="both")
     ax2.plot(*break_wraps(ts["t"], ts["orientation_error_rad"]), color="tab:red")
+    at_least_a_percent(ax2, ts["orientation_error_rad"])
     ax2.set_ylabel("orientation error (rad)\nwrapped to [-pi, pi)")
     ax2.set_xlabel("t (s)")
     ax2.grid(alpha=0.3)
     ax1.set_title(_title(result, "tracking errors"))
     fig.tight_layout()
     return fig
+
+
+def at_least_a_decade(ax: Axes, values: np.ndarray) -> None:
+    """Give the log-scaled y axis of ``ax`` whole decades around ``values`` (> 0 where
+    finite) if they span less than a factor of 3. Such a span may hold only one of the
+    log ticks ``m 10^k`` (``m`` = 1..9); matplotlib then falls back to linear ticks and
+    labels each tick of a near-constant series with the same rounded number. A factor of
+    3 always holds two log ticks, so wider data keep matplotlib's limits."""
+    finite = np.asarray(values, dtype=float)
+    finite = finite[np.isfinite(finite) & (finite > 0.0)]
+    if finite.size == 0 or finite.max() >= 3.0 * finite.min():
+        return
+    low = math.floor(math.log10(finite.min()))
+    high = max(math.ceil(math.log10(finite.max())), low + 1)
+    ax.set_ylim(10.0**low, 10.0**high)
+
+
+def at_least_a_percent(ax: Axes, values: np.ndarray) -> None:
+    """Give the linear y axis of ``ax`` a span of at least 1 % of the largest magnitude of
+    ``values`` (centred on them), and tick labels without an offset: a near-constant
+    series would otherwise read as an offset such as "1e-13-2.607e-2" above ticks of
+    its last digits. Data varying by more keep matplotlib's limits."""
+    finite = np.asarray(values, dtype=float)
+    finite = finite[np.isfinite(finite)]
+    ax.ticklabel_format(axis="y", useOffset=False)
+    if finite.size == 0:
+        return
+    low, high = float(finite.min()), float(finite.max())
+    span = 0.01 * max(abs(low), abs(high))
+    if high - low < span:
+        centre = 0.5 * (low + high)
+        ax.set_ylim(centre - 0.5 * span, centre + 0.5 * span)
 
 
 def plot_rates(result) -> Figure:
