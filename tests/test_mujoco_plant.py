@@ -218,15 +218,17 @@ LIGHT = Robot(base_mass=1e-3, wheel_mass=1e-4, link_masses=(1e-3, 1e-3), payload
 
 
 def test_a_robot_too_light_for_the_timestep_is_refused_at_reset(capsys):
+    """On tyres as stiff as the default robot's (not scaled to its mass)."""
     with pytest.raises(ParameterError, match=r"^MuJoCo cannot settle this robot at timestep ") as e:
-        fresh(robot=LIGHT)
+        fresh(robot=LIGHT, tyre_stiffness=5e4)
     assert str(e.value).endswith(
         "give it heavier parts, or (the API) a smaller MujocoPlant(robot, timestep=...) in "
         "[1e-05, 0.01] s"
     )
     assert capsys.readouterr().err == ""  # the engine's own warning stays in logging
     # the message's remedy works: a shorter engine step settles the same robot
-    assert fresh(robot=LIGHT, timestep=5e-4).observe().q[3:] == pytest.approx((-0.3, 0.6))
+    settled = fresh(robot=LIGHT, timestep=5e-4, tyre_stiffness=5e4)
+    assert settled.observe().q[3:] == pytest.approx((-0.3, 0.6))
 
 
 def test_cli_refuses_a_robot_too_light_for_the_engine_in_one_line(tmp_path, capsys):

@@ -185,6 +185,14 @@ FOLDED_ARM = (
     "integrates Xd_dot ({methods}) loses the orientation steps at corners "
     """(see docs/comparing.md, "Does the slides' ranking hold?")"""
 )
+#: :data:`FOLDED_ARM` on a trajectory without corners (``corner_position_error_m`` None):
+#: what each step misses of the trajectory's turning is lost instead.
+FOLDED_ARM_NO_CORNERS = (
+    "the arm folded to a joint limit (min manipulability 0): a resolution that only "
+    "integrates Xd_dot ({methods}) loses what each step misses of the trajectory's turning "
+    "(this one has no corners): a smaller dt (this run's: {dt}) or a slower trajectory "
+    """(see docs/comparing.md, "Does the slides' ranking hold?")"""
+)
 #: The methods whose commands only integrate Xd_dot (open loop, or ``clrrmc-cs``'s
 #: configuration reference): :data:`FOLDED_ARM`'s explanation is theirs.
 XD_DOT_INTEGRATORS = ("pi", "ats", "ap", "clrrmc-cs")
@@ -283,6 +291,16 @@ TIPPED = (
     "stability floor (stability_min; see "
     'docs/physics.md, "Tip-over from the contact forces")'
 )
+#: The cause of a physics plant's tip-over by the tilt alone: no edge of the support
+#: polygon ever went unloaded (``unloaded_time_s`` 0) and the centre of pressure stayed
+#: inside it (``min_physics_stability`` > 1), so only the tip rule's angle can have fired.
+TIPPED_TILT = (
+    "the base tilted past the tip rule's angle (max_base_tilt_rad {tilt:.3g}) with every "
+    "edge of the support polygon loaded (unloaded_time_s 0, min_physics_stability "
+    "{stability:.3g} > 1): it sank into soft contacts, not the payload: stiffer tyres or "
+    "contacts (tyre_stiffness, contact_time_constant; see "
+    'docs/physics.md, "Settings")'
+)
 
 #: The warning clause of a run on a physics plant that unloaded an edge of its support
 #: polygon without tipping over (:func:`support_warning`).
@@ -376,6 +394,10 @@ NUMBER_KEYS = (
     "unloaded_time_s",
     "min_predicted_edge_load_n",
     "min_edge_load_floor_n",
+    "dt",
+    "corner_position_error_m",
+    "min_physics_stability",
+    "max_base_tilt_rad",
 )
 #: The summary keys that count steps of the run: each a whole number from 0 to ``steps``
 #: (itself a whole number >= 0).
@@ -566,7 +588,7 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     if "diverged" in found:
         return DIVERGED
     if "tipped_over" in found or "tipped_at_start" in found:
-        return TIPPED
+        return _tipped(summary)
     if "stability_below_1" in found:
         return WOULD_TIP
     if "collided" in found:
@@ -595,6 +617,18 @@ def likely_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     return _arm_or_path_cause(summary, found)
 
 
+def _tipped(summary: Mapping[str, Any]) -> str:
+    """:data:`TIPPED_TILT` for a tip-over with every edge loaded throughout and the centre
+    of pressure inside the polygon (``unloaded_time_s`` 0, ``min_physics_stability`` > 1),
+    else :data:`TIPPED`."""
+    unloaded = _number(summary, "unloaded_time_s")
+    stability = _number(summary, "min_physics_stability")
+    tilt = _number(summary, "max_base_tilt_rad")
+    if unloaded == 0.0 and stability is not None and stability > 1.0 and tilt is not None:
+        return TIPPED_TILT.format(tilt=tilt, stability=stability)
+    return TIPPED
+
+
 def _arm_or_path_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     """The rest of :func:`likely_cause`, after the causes that stop or overrule a run:
     what the arm did, saturation, an obstacle, a limit held, the start offset, else no
@@ -604,7 +638,7 @@ def _arm_or_path_cause(summary: Mapping[str, Any], found: list[str]) -> str:
         return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
     min_manipulability = _number(summary, "min_manipulability")
     if min_manipulability is not None and min_manipulability < 1e-6:
-        return _folded_arm(summary.get("method"))
+        return _folded_arm(summary)
     if "saturated_most_of_run" in found:
         return _joint(summary) if _mostly_at_joint_limits(summary) else SATURATION
     clearance = _number(summary, "min_obstacle_clearance_m")  # None: no obstacles
@@ -772,15 +806,24 @@ def _only_the_start_offset(summary: Mapping[str, Any], found: list[str]) -> bool
     return largest <= offset * (1.0 + START_SLACK)
 
 
-def _folded_arm(method: Any) -> str:
+def _folded_arm(summary: Mapping[str, Any]) -> str:
     """:data:`FOLDED_ARM` naming the run's ``method`` if it only integrates Xd_dot (both
-    such methods of the docs' explanation if the summary names none), else
+    such methods of the docs' explanation if the summary names none), or
+    :data:`FOLDED_ARM_NO_CORNERS` where the summary says the trajectory has no corners
+    (``corner_position_error_m`` present and None) and gives the step ``dt``; else
     :data:`FOLDED_ARM_OTHER` naming it."""
+    method = summary.get("method")
     if method is None or method in FOLDING_METHODS:
-        return FOLDED_ARM.format(methods=", ".join(FOLDING_METHODS))
-    if method in XD_DOT_INTEGRATORS:
-        return FOLDED_ARM.format(methods=method)
-    return FOLDED_ARM_OTHER.format(method=one_line(str(method), 40))
+        methods = ", ".join(FOLDING_METHODS)
+    elif method in XD_DOT_INTEGRATORS:
+        methods = method
+    else:
+        return FOLDED_ARM_OTHER.format(method=one_line(str(method), 40))
+    dt = _number(summary, "dt")
+    no_corners = "corner_position_error_m" in summary and summary["corner_position_error_m"] is None
+    if no_corners and dt is not None:
+        return FOLDED_ARM_NO_CORNERS.format(methods=methods, dt=f"{dt:g} s")
+    return FOLDED_ARM.format(methods=methods)
 
 
 def held_limits(summary: Mapping[str, Any]) -> list[str]:

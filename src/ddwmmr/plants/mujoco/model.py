@@ -17,18 +17,21 @@ Bodies (all masses and inertias explicit, ``inertiafromgeom="false"``):
 * ``wheel_left`` / ``wheel_right`` (hinge about the base's y axis) at ``(0, +-Lw/2)``:
   mass ``wheel_mass`` each (a disc of width :data:`WHEEL_WIDTH`); their floor contact is a
   sphere of radius ``wheel_radius`` (one contact point straight below the axle, on the
-  support polygon's side edge), drawn as a cylinder. With ``tyre_stiffness`` (the default)
-  each wheel hangs on a vertical spring-damper, its rubber tyre's radial compliance in
-  series with the floor contact (:data:`TYRE_DAMPING_RATIO`), preloaded so that each tyre
-  carries :data:`TYRE_SHARE` of the weight at its nominal height. The wheels reach
-  :data:`WHEEL_PRELOAD_DEPTH` below the casters' plane (casters mounted a hair high, as
-  on real platforms), so they stay pressed on the floor wherever statics allows: six
-  rigid supports on a plane share the load in a way statics leaves open, and left to the
-  engine's regularisation a wheel can go unloaded while the base rests on three casters
-  (then it spins on frictionless casters). The offset is the contacts' own static sink,
-  so the tilt it adds at tipping (offset / half-width, 3e-4 rad) is negligible.
+  support polygon's side edge), drawn as a cylinder; the two spheres never collide with
+  each other (wider than half the track, they overlap). With ``tyre_stiffness`` (by
+  default scaled to the robot, :func:`tyre_stiffness`) each wheel hangs on a vertical
+  spring-damper, its rubber tyre's radial compliance in series with the floor contact
+  (:data:`TYRE_DAMPING_RATIO`), preloaded so that each tyre carries :data:`TYRE_SHARE` of
+  the weight at its nominal height. The wheels reach :data:`WHEEL_PRELOAD_DEPTH` below the
+  casters' plane (casters mounted a hair high, as on real platforms), so they stay pressed
+  on the floor wherever statics allows: six rigid supports on a plane share the load in a
+  way statics leaves open, and left to the engine's regularisation a wheel can go unloaded
+  while the base rests on three casters (then it spins on frictionless casters). The
+  offset is the contacts' own static sink, so the tilt it adds at tipping (offset /
+  half-width, 3e-4 rad) is negligible.
 * ``link1`` (hinge about z at the base centre, ``arm_height`` above the floor) and
-  ``link2`` (hinge at ``L1`` along link 1): uniform rods, mass at the midpoint as S has it
+  ``link2`` (hinge at ``L1`` along link 1): uniform rods of radius :func:`link_radius`,
+  mass at the midpoint as S has it
   (docs/theory.md, "Tip-over stability"). The payload is a point mass at the end effector
   (``L2`` along link 2), folded into link 2's inertial (so ``body_mass`` of link 2 is
   ``m2 + payload``). The arm never collides.
@@ -52,6 +55,7 @@ import numpy as np
 
 from ddwmmr.errors import ParameterError, check_positive, check_range, shown
 from ddwmmr.model import Robot
+from ddwmmr.model.mass import total_mass as robot_mass
 from ddwmmr.model.stability import BASE_CLEARANCE_M
 from ddwmmr.model.support_loads import convex_hull
 
@@ -63,8 +67,12 @@ BASE_CLEARANCE = BASE_CLEARANCE_M
 WHEEL_WIDTH = 0.04
 #: Depth (m) the drive wheels reach below the casters' plane (see the module docstring).
 WHEEL_PRELOAD_DEPTH = 5e-5
-#: Radius of the arm links (m): their axial inertia and drawing.
+#: Radius of the arm links (m): their axial inertia and drawing; a link shorter than
+#: :data:`LINK_SLENDERNESS` times it gets a quarter of its length (:func:`link_radius`).
 LINK_RADIUS = 0.02
+#: Least length of a link over its radius: a rod's inertias are physical (triangle
+#: inequality) down to sqrt(3); 4 keeps the links rods.
+LINK_SLENDERNESS = 4.0
 #: Radius of the payload sphere as drawn (m); the payload itself is a point mass.
 PAYLOAD_RADIUS = 0.04
 #: Engine options with the defaults chosen by measurement (docs/physics.md, "Settings").
@@ -97,9 +105,10 @@ CONTACT_TIME_CONSTANT_RANGE_S = (2.0 * TIMESTEP_RANGE_S[0], 0.05)
 TYRE_STIFFNESS_RANGE = (1e4, 1e8)
 DEFAULT_CONE = "elliptic"
 CONES = ("pyramidal", "elliptic")
-#: Radial stiffness (N/m) of each drive wheel's tyre: a small robot's solid rubber tyre
-#: deflects about 1 mm under the ~50 N a drive wheel carries (docs/physics.md, "The
-#: model, generated from Robot").
+#: Radial stiffness (N/m) of each drive wheel's tyre on the default robot: a small robot's
+#: solid rubber tyre deflects about 1 mm under the ~50 N a drive wheel carries
+#: (docs/physics.md, "The model, generated from Robot"). Other robots get it scaled by
+#: :func:`tyre_stiffness`.
 DEFAULT_TYRE_STIFFNESS = 5e4
 #: Damping ratio of the tyre's radial spring (rubber's hysteresis), on the mass it carries.
 TYRE_DAMPING_RATIO = 0.3
@@ -146,7 +155,8 @@ class EngineOptions:
             :data:`CONTACT_TIME_CONSTANT_RANGE_S`.
         tyre_stiffness: radial stiffness of each drive wheel's tyre (N/m, in
             :data:`TYRE_STIFFNESS_RANGE`), or 0 for a rigid wheel (the contact's own
-            compliance only).
+            compliance only); None (default): :data:`DEFAULT_TYRE_STIFFNESS` scaled to the
+            robot (:func:`tyre_stiffness`).
 
     Each option outside its range (or the cone not one of :data:`CONES`) raises a one-line
     :class:`ParameterError` naming the option and the range.
@@ -157,7 +167,7 @@ class EngineOptions:
     servo_time_constant: float = DEFAULT_SERVO_TIME_CONSTANT
     cone: str = DEFAULT_CONE
     contact_time_constant: float = DEFAULT_CONTACT_TIME_CONSTANT
-    tyre_stiffness: float = DEFAULT_TYRE_STIFFNESS
+    tyre_stiffness: float | None = None
 
     def __post_init__(self) -> None:
         timestep = check_positive("timestep", self.timestep)
@@ -169,7 +179,8 @@ class EngineOptions:
             ("contact_time_constant", CONTACT_TIME_CONSTANT_RANGE_S, "s"),
         ):
             object.__setattr__(self, name, check_range(name, getattr(self, name), low, high, unit))
-        object.__setattr__(self, "tyre_stiffness", _checked_stiffness(self.tyre_stiffness))
+        if self.tyre_stiffness is not None:
+            object.__setattr__(self, "tyre_stiffness", _checked_stiffness(self.tyre_stiffness))
         if self.cone not in CONES:
             raise ParameterError(f"cone must be one of {', '.join(CONES)} (got {shown(self.cone)})")
         if self.contact_time_constant < 2.0 * self.timestep:
@@ -197,6 +208,32 @@ def _checked_stiffness(stiffness: float) -> float:
             f"(got {shown(stiffness)})"
         )
     return float(stiffness)
+
+
+def _own_mass(robot: Robot) -> float:
+    """The robot's own mass (kg): base (wheels included) and links, without the payload."""
+    return robot_mass(robot.base_mass, *robot.link_masses, 0.0)
+
+
+_DEFAULT_ROBOT = Robot()
+
+
+def tyre_stiffness(robot: Robot, options: EngineOptions) -> float:
+    """Radial stiffness (N/m) of each tyre in the model of ``robot``.
+
+    ``options.tyre_stiffness`` if given; else :data:`DEFAULT_TYRE_STIFFNESS` times the
+    robot's own mass (payload excluded: the tyre is built for the robot, not for what it
+    carries) over the default robot's, times the default robot's ``track_width`` over the
+    robot's. A load shift that is the same share of the weight then tilts the base by the
+    same angle on a robot of any size (the tip rule is an angle), and the tyre's spring
+    keeps about the default robot's natural frequency (docs/physics.md, "The model,
+    generated from Robot"). Exactly :data:`DEFAULT_TYRE_STIFFNESS` for the default robot
+    at any payload; not held to :data:`TYRE_STIFFNESS_RANGE` (the range a user may set).
+    """
+    if options.tyre_stiffness is not None:
+        return options.tyre_stiffness
+    mass_ratio = _own_mass(robot) / _own_mass(_DEFAULT_ROBOT)
+    return DEFAULT_TYRE_STIFFNESS * mass_ratio * (_DEFAULT_ROBOT.track_width / robot.track_width)
 
 
 _CORNER_NAMES = ("front_left", "front_right", "back_left", "back_right")
@@ -299,8 +336,15 @@ def _link2_inertial(robot: Robot) -> tuple[float, float, tuple[float, float, flo
     mass = m2 + p
     com = (m2 * 0.5 * length + p * length) / mass
     transverse = m2 * length**2 / 12.0 + m2 * (0.5 * length - com) ** 2 + p * (length - com) ** 2
-    axial = 0.5 * m2 * LINK_RADIUS**2
+    axial = 0.5 * m2 * link_radius(length) ** 2
     return mass, com, (axial, transverse, transverse)
+
+
+def link_radius(length: float) -> float:
+    """Radius (m) of an arm link of ``length`` m: :data:`LINK_RADIUS`, or a
+    :data:`LINK_SLENDERNESS`-th of the length for a short link (its inertias must satisfy
+    the triangle inequality: length >= sqrt(3) radius)."""
+    return min(LINK_RADIUS, length / LINK_SLENDERNESS)
 
 
 def reflected_inertias(robot: Robot) -> tuple[float, float, float]:
@@ -402,14 +446,15 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
                 rgba="0.2 0.2 0.2 1",
             )
     axle, diameter = _wheel_inertia(robot)
+    stiffness = tyre_stiffness(robot, options)
     for support in supports(robot):
         if support.kind != "wheel":
             continue
         wheel = _sub(
             base, "body", name=support.name, pos=_fmt(*support.point, r - WHEEL_PRELOAD_DEPTH)
         )
-        if options.tyre_stiffness > 0.0:
-            _tyre(wheel, robot, options.tyre_stiffness, f"tyre_{support.name.split('_')[1]}")
+        if stiffness > 0.0:
+            _tyre(wheel, robot, stiffness, f"tyre_{support.name.split('_')[1]}")
         _sub(wheel, "joint", name=support.name, type="hinge", axis="0 1 0")
         _sub(
             wheel,
@@ -439,6 +484,8 @@ def mjcf(robot: Robot, options: EngineOptions | None = None) -> str:
             conaffinity=0,
             rgba="0.1 0.1 0.1 1",
         )
+    # wheel spheres wider than half the track overlap: they must touch the floor only
+    _sub(_sub(root, "contact"), "exclude", body1="wheel_left", body2="wheel_right")
     _arm(base, robot)
     _actuators(root, robot, options)
     return ET.tostring(root, encoding="unicode")
@@ -474,7 +521,9 @@ def _arm(base: ET.Element, robot: Robot) -> None:
         "inertial",
         pos=_fmt(0.5 * robot.L1, 0, 0),
         mass=f"{m1:.17g}",
-        diaginertia=_fmt(0.5 * m1 * LINK_RADIUS**2, m1 * robot.L1**2 / 12, m1 * robot.L1**2 / 12),
+        diaginertia=_fmt(
+            0.5 * m1 * link_radius(robot.L1) ** 2, m1 * robot.L1**2 / 12, m1 * robot.L1**2 / 12
+        ),
     )
     _link_geom(link1, "link1", robot.L1)
     link2 = _sub(link1, "body", name="link2", pos=_fmt(robot.L1, 0, 0))
@@ -503,7 +552,7 @@ def _link_geom(body: ET.Element, name: str, length: float) -> None:
         name=name,
         type="capsule",
         fromto=_fmt(0, 0, 0, length, 0, 0),
-        size=f"{LINK_RADIUS:.17g}",
+        size=f"{link_radius(length):.17g}",
         contype=0,
         conaffinity=0,
         rgba="0.95 0.6 0.1 1",
@@ -558,9 +607,11 @@ __all__ = [
     "build_model",
     "check_buildable",
     "convex_hull",
+    "link_radius",
     "mjcf",
     "reflected_inertias",
     "servo_gains",
     "support_polygon",
     "supports",
+    "tyre_stiffness",
 ]

@@ -51,6 +51,7 @@ from ddwmmr.plants.mujoco.model import (
     build_model,
     reflected_inertias,
     supports,
+    tyre_stiffness,
 )
 from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
 from ddwmmr.plants.thesis import arm_step, damped_base_envelope
@@ -136,8 +137,9 @@ class MujocoPlant:
         cone: MuJoCo friction cone, ``"elliptic"`` (default, Coulomb's) or ``"pyramidal"``.
         contact_time_constant: stiffness of the contacts as a time constant (s), in
             [2e-5, 0.05] and at least 2 timesteps.
-        tyre_stiffness: radial stiffness of each drive wheel's tyre (N/m; default 5e4,
-            in [1e4, 1e8], or 0 for rigid wheels).
+        tyre_stiffness: radial stiffness of each drive wheel's tyre (N/m, in [1e4, 1e8],
+            or 0 for rigid wheels); default: 5e4 on the default robot, scaled to others
+            (:func:`~ddwmmr.plants.mujoco.model.tyre_stiffness`).
         base_damping: ``(c_translation N s/m, c_yaw N m s/rad)`` viscous damping of the
             base's horizontal and yaw motion (the thesis plant's c1, c2: rolling resistance
             and drive friction as the thesis models them), each in [0, 1000]
@@ -524,7 +526,7 @@ class MujocoPlant:
             f"MuJoCo cannot settle this robot at timestep {options.timestep:g} s (its "
             f"state diverged at reset): base_mass {r.base_mass:g} kg, wheel_mass "
             f"{r.wheel_mass:g} kg, link_masses [{links}] kg, payload {r.payload:g} kg on "
-            f"tyre_stiffness {options.tyre_stiffness:g} N/m and contact_time_constant "
+            f"tyre_stiffness {tyre_stiffness(r, options):g} N/m and contact_time_constant "
             f"{options.contact_time_constant:g} s (light parts on stiff springs need a "
             "shorter step); soften the tyres (lower tyre_stiffness, or 0 for rigid wheels) "
             "or the contacts (a longer contact_time_constant), give it heavier parts, or "
