@@ -222,8 +222,8 @@ def test_a_robot_too_light_for_the_timestep_is_refused_at_reset(capsys):
     with pytest.raises(ParameterError, match=r"^MuJoCo cannot settle this robot at timestep ") as e:
         fresh(robot=LIGHT, tyre_stiffness=5e4)
     assert str(e.value).endswith(
-        "give it heavier parts, or (the API) a smaller MujocoPlant(robot, timestep=...) in "
-        "[1e-05, 0.01] s"
+        "give it heavier parts, or a smaller MujocoPlant(robot, timestep=...) in "
+        "[1e-05, 0.01] s (track: --plant-option)"
     )
     assert capsys.readouterr().err == ""  # the engine's own warning stays in logging
     # the message's remedy works: a shorter engine step settles the same robot
@@ -240,7 +240,8 @@ def test_cli_refuses_a_robot_too_light_for_the_engine_in_one_line(tmp_path, caps
     )
     argv = ["--method", "clrrmc-ts", "--traj", "ellipse", "--robot", str(robot)]
     out = tmp_path / "run"
-    status = main([*argv, "--plant", "mujoco", "--duration", "0.2", "--out", str(out)])
+    stiff = ["--plant-option", "tyre_stiffness=50000"]  # the default robot's tyres
+    status = main([*argv, "--plant", "mujoco", *stiff, "--duration", "0.2", "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2
     assert len(err) == 1 and "base_mass 0.001 kg" in err[0] and "timestep" in err[0]

@@ -364,6 +364,14 @@ class RunInputs:
     # A rerun's: the file's digest as the first run read it. Its trajectory is rebuilt
     # from the record, so the file may since have changed or gone.
     trajectory_sha256: str | None = None
+    # The plant's constructor options that were given (the others take its defaults).
+    plant_options: dict[str, Any] = dataclasses.field(default_factory=dict)
+
+
+def plant_record(name: str, options: dict[str, Any]) -> dict[str, Any]:
+    """``{"name": name}``, with ``"options"`` (the constructor options given) when any
+    were: a run on the plant's defaults is recorded as before the options existed."""
+    return {"name": name, "options": encode(options)} if options else {"name": name}
 
 
 def run_record(
@@ -387,7 +395,7 @@ def run_record(
         duration=inputs.duration,
         integrator=inputs.integrator,
         initial_offset=list(inputs.offset),
-        plant={"name": inputs.plant},
+        plant=plant_record(inputs.plant, inputs.plant_options),
         seed=None,  # nothing random in a track run
     )
     if rerun is not None:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import inspect
 import logging
 import math
 import multiprocessing
@@ -26,8 +27,8 @@ import signal
 import sys
 import threading
 import warnings
-from collections.abc import Callable, Iterator, Sequence
-from typing import NoReturn
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from ddwmmr import interrupts
 from ddwmmr.cli.signals import EXIT_INTERRUPTED, EXIT_TERMINATED, STOP_SIGNALS, say, stop_line
@@ -41,6 +42,9 @@ from ddwmmr.outputs import (
     package_version,
 )
 
+if TYPE_CHECKING:
+    from ddwmmr.controllers.option_specs import OptionSpec
+
 #: Exit status for bad input (argparse uses the same).
 EXIT_USAGE = 2
 
@@ -50,8 +54,11 @@ __all__ = [
     "Terminated",
     "add_force_argument",
     "add_option_argument",
+    "add_plant_option_argument",
     "add_robot_arguments",
+    "built_plant",
     "check_output_folder",
+    "check_plant_option_names",
     "first_free",
     "given_text",
     "horizon_defaults",
@@ -61,7 +68,10 @@ __all__ = [
     "number_type",
     "offset_type",
     "output_folder",
+    "parse_plant_options",
     "payload_type",
+    "plant_option_specs",
+    "refuse_plant_option_argument",
     "robot_from_arguments",
     "run_main",
     "seconds_type",
@@ -459,6 +469,144 @@ def add_force_argument(parser: argparse.ArgumentParser) -> None:
         action="store_true",
         help="also write into an --out that is not this tool's earlier output; deletes only "
         "files a ddwmmr manifest lists, every other file is kept",
+    )
+
+
+#: Constructor parameters of a plant that ``--plant-option`` does not set: the robot (the
+#: tools' ``--robot``) and the kinematic plant's integrator (``--integrator``, which
+#: ``simulate`` passes to the plant itself).
+PLANT_ARGUMENTS = ("robot", "integrator")
+
+
+def plant_option_specs(plant: str) -> dict[str, OptionSpec]:
+    """The options ``--plant-option NAME=VALUE`` sets on the registered plant ``plant``
+    (name -> :class:`~ddwmmr.controllers.option_specs.OptionSpec`): the keyword parameters
+    of its constructor but :data:`PLANT_ARGUMENTS`, each read as ``--option`` reads a
+    method's option of that type (:func:`~ddwmmr.controllers.option_specs.option_spec`).
+    Imports the plant's module (MuJoCo's: about 0.4 s)."""
+    from ddwmmr.controllers.option_specs import option_spec
+    from ddwmmr.plants import plant_class
+
+    specs = {}
+    for parameter in inspect.signature(plant_class(plant)).parameters.values():
+        variadic = parameter.kind in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD)
+        if variadic or parameter.name in PLANT_ARGUMENTS:
+            continue
+        annotation = parameter.annotation
+        if annotation is inspect.Parameter.empty:
+            annotation = ""
+        elif not isinstance(annotation, str):
+            annotation = inspect.formatannotation(annotation)
+        spec = option_spec(parameter.name, parameter.default, annotation)
+        if spec is not None:
+            specs[spec.name] = spec
+    return specs
+
+
+def check_plant_option_names(plant: str, names: Iterable[str]) -> dict[str, OptionSpec]:
+    """:func:`plant_option_specs` of ``plant`` if it has every one of ``names``, else a
+    one-line :class:`ParameterError`: the kinematic plant (or any plant without options)
+    has none; another name than the plant's is named with the closest one and the list."""
+    names = list(names)
+    if not names:
+        return {}
+    specs = plant_option_specs(plant)
+    if not specs:
+        raise ParameterError(
+            f"plant-option: the {plant} plant has no options (got {shown(names[0])}"
+            + ("; --integrator sets its integrator)" if plant == "kinematic" else ")")
+        )
+    for name in names:
+        if name not in specs:
+            raise ParameterError(
+                f"plant-option: the {plant} plant has no option {name!r}"
+                f"{did_you_mean(name, specs)} (options: {', '.join(specs)})"
+            )
+    return specs
+
+
+def parse_plant_options(plant: str, texts: Sequence[str] | None) -> dict[str, Any]:
+    """``{name: value}`` of the ``--plant-option NAME=VALUE`` texts for the plant named
+    ``plant``: a name as :func:`check_plant_option_names` allows, a value read as
+    ``--option`` reads one (:meth:`~ddwmmr.controllers.option_specs.OptionSpec.parse`:
+    a number option's text that is no number is passed on for the plant's own check,
+    :func:`built_plant`); a text without ``=`` or a name given twice is refused."""
+    from ddwmmr.controllers.option_specs import split_option
+
+    pairs = [(*split_option(text, "plant-option"), text) for text in texts or ()]
+    specs = check_plant_option_names(plant, [name for name, _, _ in pairs])
+    options: dict[str, Any] = {}
+    for name, value, text in pairs:
+        if name in options:
+            raise ParameterError(f"plant-option: {name} given twice (got {shown(text)})")
+        options[name] = specs[name].parse(value)
+    return options
+
+
+def built_plant(plant: str, robot: Robot, options: dict[str, Any]) -> Any:
+    """The plant named ``plant`` built for ``robot`` with ``options``: a value it refuses
+    is its own one-line :class:`ParameterError` (``c2 must be > 0 (got -1)``), raised
+    before the run. Its warnings are left to the run's own plant, which says them once."""
+    from ddwmmr.controllers.base import NumberText
+    from ddwmmr.plants import make_plant
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        built = make_plant(plant, robot, **options)
+    for name, value in options.items():
+        if isinstance(value, NumberText):  # taken unchecked: refused as --option refuses it
+            raise ParameterError(f"{name} must be {value.expected} (got {shown(value)})")
+    return built
+
+
+class _PlantOptionAction(argparse._AppendAction):
+    """``append``, with a help text listing each plant's options, made only when the help
+    is shown: listing the MuJoCo plant's imports the engine (about 0.4 s)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        self._text = kwargs.pop("help")
+        super().__init__(*args, **kwargs)
+
+    @property
+    def help(self) -> str:  # type: ignore[override]
+        """The help: its text, then each plant's option names."""
+        from ddwmmr.plants import available_plants
+
+        lists = []
+        for plant in available_plants():
+            try:
+                names = ", ".join(plant_option_specs(plant)) or "none"
+            except (ImportError, ParameterError):
+                names = "(cannot be imported)"
+            lists.append(f"{plant}: {names}")
+        return f"{self._text} (the options of each plant: {'; '.join(lists)})"
+
+    @help.setter
+    def help(self, value: str | None) -> None:  # argparse's Action sets it
+        pass
+
+
+def refuse_plant_option_argument(parser: argparse.ArgumentParser, tool: str) -> None:
+    """``--plant-option``, refused with one line (exit status 2): ``tool`` (its name in
+    the line) runs each plant on its defaults; ``track`` sets a plant's options."""
+    parser.add_argument(
+        "--plant-option",
+        action=RefusedOption,
+        reason=f"{tool} runs each plant with its default options; python -m ddwmmr.track "
+        "--plant-option NAME=VALUE sets them",
+    )
+
+
+def add_plant_option_argument(parser: argparse.ArgumentParser | argparse._ArgumentGroup) -> None:
+    """``--plant-option NAME=VALUE`` (repeatable): a constructor option of the ``--plant``
+    (:func:`parse_plant_options`), as ``simulate(..., plant_options=...)`` sets it."""
+    parser.add_argument(
+        "--plant-option",
+        action=_PlantOptionAction,
+        metavar="NAME=VALUE",
+        help="a constructor option of --plant (repeatable), read as --option reads a "
+        "method's, e.g. c1=20, c2=2, force_limit=25 (thesis), timestep=0.001 (mujoco); a "
+        "value the plant refuses is an error",
     )
 
 

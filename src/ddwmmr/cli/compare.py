@@ -34,6 +34,7 @@ from ddwmmr.cli.common import (
     method_options_text,
     number_type,
     output_folder,
+    refuse_plant_option_argument,
     robot_from_arguments,
     run_main,
     split_names,
@@ -229,6 +230,7 @@ def build_parser() -> ArgumentParser:
         "mujoco: rigid-body physics) and report their errors next to the kinematic plant's, "
         "with the reasons (lag, torque limits, slip)",
     )
+    refuse_plant_option_argument(parser, "compare")
     add_option_argument(
         parser,
         "an option of the compared methods: NAME=VALUE for every method taking NAME, "

@@ -31,6 +31,7 @@ from ddwmmr.cli.common import (
     number_type,
     offset_type,
     payload_type,
+    refuse_plant_option_argument,
     run_main,
     seconds_type,
 )
@@ -170,6 +171,7 @@ def build_parser() -> ArgumentParser:
         default=Settings().plant,
         help=f"what the commands drive (default {Settings().plant})",
     )
+    refuse_plant_option_argument(parser, "the simulator")
     parser.add_argument(
         "--payload",
         type=payload_type,

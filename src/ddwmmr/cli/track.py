@@ -25,8 +25,11 @@ from ddwmmr.cli.common import (
     ArgumentParser,
     add_force_argument,
     add_option_argument,
+    add_plant_option_argument,
     add_robot_arguments,
+    built_plant,
     check_output_folder,
+    check_plant_option_names,
     first_free,
     given_text,
     horizon_defaults,
@@ -35,6 +38,7 @@ from ddwmmr.cli.common import (
     number_type,
     offset_type,
     output_folder,
+    parse_plant_options,
     robot_from_arguments,
     run_main,
     seconds_type,
@@ -56,6 +60,7 @@ from ddwmmr.errors import (
     shown,
 )
 from ddwmmr.gains import TAU_RANGE
+from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_CAP
 from ddwmmr.plants import available_plants, make_plant, plant_class, plant_description
 from ddwmmr.plants.kinematic import INTEGRATORS
@@ -70,10 +75,12 @@ from ddwmmr.sim.simulate import (
     check_start,
     check_tracks,
     default_step,
+    engine_multiple,
     plant_integrator,
     simulate,
 )
 from ddwmmr.trajectories import available_trajectories, load_trajectory
+from ddwmmr.trajectories.base import resolution_step
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = "python -m ddwmmr.track"
@@ -86,7 +93,7 @@ RERUN_TOOLS = ("track", "gui")
 RUN_OPTIONS = (
     "method", "traj", "aux", "tau", "dt", "duration", "integrator", "offset", "robot", "plant",
     "payload", "stability_min", "manipulability_weight", "obstacles", "solver", "qp_mode",
-    "preset", "horizon", "option",
+    "preset", "horizon", "option", "plant_option",
 )  # fmt: skip
 
 #: Keys printed in the summary table, with their labels; errors in mm (as in compare).
@@ -293,6 +300,7 @@ def build_parser() -> ArgumentParser:
         help="integrator of the kinematic plant (default rk4; other plants integrate their "
         "own dynamics)",
     )
+    add_plant_option_argument(parser)
     parser.add_argument(
         "--offset",
         type=offset_type,
@@ -433,8 +441,9 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     trajectory = load_trajectory(args.traj)
     # The preset's values, then the explicit options (they win): the record keeps them all.
     options = {**preset_options(args.method, args.preset or "default"), **controller_options(args)}
+    plant_options = parse_plant_options(plant, args.plant_option)
     duration = trajectory.duration if args.duration is None else args.duration
-    step = default_step(trajectory, plant, robot) if args.dt is None else args.dt
+    step = _default_step(trajectory, plant, robot, plant_options) if args.dt is None else args.dt
     if args.dt is None and 0 < duration < step:  # the user gave --duration, not --dt
         raise ParameterError(
             f"duration must be >= one step, {step:g} s (the trajectory's T/N; or give a "
@@ -453,8 +462,18 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         offset,
         args.traj,
         plant,
+        plant_options=plant_options,
     )
     return check_run(inputs, "payload" if args.payload is not None else "robot", "--offset")
+
+
+def _default_step(trajectory: Any, plant: str, robot: Robot, options: dict[str, Any]) -> float:
+    """The control step (s) a run takes without ``--dt``: ``simulate``'s default on the
+    plant built with the given ``options`` (a physics plant's ``timestep`` sets the step's
+    quantum), :func:`~ddwmmr.sim.simulate.default_step` on its defaults."""
+    if not options:
+        return default_step(trajectory, plant, robot)
+    return engine_multiple(resolution_step(trajectory), built_plant(plant, robot, options))
 
 
 def check_run(inputs: RunInputs, holder: str, start: str) -> RunInputs:
@@ -463,14 +482,17 @@ def check_run(inputs: RunInputs, holder: str, start: str) -> RunInputs:
     (``--rerun``), which is only as trustworthy as the file it was read from.
 
     The step count (duration, dt: finite, > 0, at most MAX_STEPS steps), the integrator
-    for the plant, the offset within the arm's reach, obstacles within the command-line
-    limits, and a start that neither tips the robot (S > 1) nor overlaps an obstacle.
+    for the plant, the plant's options (their values, in the plant's words), the offset
+    within the arm's reach, obstacles within the command-line limits, and a start that
+    neither tips the robot (S > 1) nor overlaps an obstacle.
     ``holder`` (what holds the payload) and ``start`` (what sets the start pose) word the
     tipping message. The result carries ``dt`` and ``duration`` as the floats checked (a
     record may hold an integer)."""
     check_step_count(inputs.duration, inputs.dt)
     inputs = replace(inputs, dt=float(inputs.dt), duration=float(inputs.duration))
     plant_integrator(inputs.plant, inputs.integrator)
+    if inputs.plant_options:  # a value the plant refuses: its own line, before the run
+        built_plant(inputs.plant, inputs.robot, inputs.plant_options)
     if inputs.integrator is not None and inputs.integrator not in INTEGRATORS:
         raise ParameterError(
             f"integrator must be one of {', '.join(INTEGRATORS)} (got {shown(inputs.integrator)})"
@@ -524,6 +546,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
             str(trajectory_record.get("name") or "rerun"),
             plant,
             _recorded_digest(trajectory_record, trajectory_record.get("file")),
+            _plant_options(plant_record, plant),
         )
         checked = check_run(inputs, "payload", "the recorded initial_offset")
     except ParameterError as exc:  # one line naming what is wrong: say where it was read
@@ -587,6 +610,17 @@ def _field(record: dict[str, Any], key: str, kind: type, what: str) -> Any:
     return value
 
 
+def _plant_options(plant_record: dict[str, Any], plant: str) -> dict[str, Any]:
+    """The plant's options the record gives (``plant.options``; none in a record of a run
+    on the plant's defaults), their names checked as ``--plant-option``'s are (the values
+    by the plant, :func:`check_run`)."""
+    if "options" not in plant_record:
+        return {}
+    options = provenance.decode(_field(plant_record, "options", dict, "plant options"))
+    check_plant_option_names(plant, options)
+    return options
+
+
 def _integrator(record: dict[str, Any], plant: str) -> str | None:
     """The recorded integrator: a name on the kinematic plant, null on the others."""
     if plant != "kinematic" and record["integrator"] is None:
@@ -634,7 +668,8 @@ def check_plant_step(inputs: RunInputs) -> None:
     when the run starts (MuJoCo: not a whole number of engine steps): before the duration
     note and the output folder, so bad input is one line."""
     if hasattr(plant_class(inputs.plant), "check_control_step"):
-        make_plant(inputs.plant, inputs.robot).check_control_step(inputs.dt)
+        plant = make_plant(inputs.plant, inputs.robot, **inputs.plant_options)
+        plant.check_control_step(inputs.dt)
 
 
 def _note_uneven_duration(duration: float, dt: float, steps: int) -> None:
@@ -686,6 +721,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
                 duration=inputs.duration,
                 integrator=inputs.integrator,
                 plant=inputs.plant,
+                plant_options=inputs.plant_options,
                 initial_offset=inputs.offset,
                 progress=lambda k, n: bar.advance(),
             )

@@ -261,10 +261,7 @@ def parse_option(method: str, text: str, what: str = "option") -> tuple[str, Any
     :class:`ParameterError` starting with ``what`` (the command-line option); a bad choice
     one naming the option. A number option's text that is no number comes back as a
     :class:`~ddwmmr.controllers.base.NumberText` for ``make_controller`` to refuse."""
-    name, sep, value = text.partition("=")
-    name = name.strip()
-    if not sep or not name:
-        raise ParameterError(f"{what} must be NAME=VALUE (got {shown(text)})")
+    name, value = split_option(text, what)
     specs = {spec.name: spec for spec in option_specs(method)}
     if name not in specs:
         known = ", ".join(specs) or "none"
@@ -272,6 +269,17 @@ def parse_option(method: str, text: str, what: str = "option") -> tuple[str, Any
             f"{what}: {method} has no option {name!r}{did_you_mean(name, specs)} (options: {known})"
         )
     return name, specs[name].parse(value)
+
+
+def split_option(text: str, what: str = "option") -> tuple[str, str]:
+    """``NAME=VALUE`` -> (name without surrounding spaces, the value's text); a text
+    without ``=`` or an empty name is a one-line :class:`ParameterError` starting with
+    ``what`` (the command-line option)."""
+    name, sep, value = text.partition("=")
+    name = name.strip()
+    if not sep or not name:
+        raise ParameterError(f"{what} must be NAME=VALUE (got {shown(text)})")
+    return name, value
 
 
 def parse_options(method: str, texts: Sequence[str] | None, what: str = "option") -> dict:

@@ -91,7 +91,8 @@ def warn_borrowed_constants(robot: Robot, c1: float, c2: float) -> None:
         f"thesis plant: the robot runs with the thesis robot's wheel force limit "
         f"{FORCE_LIMIT_DEFAULT:g} N (its motors give wheel_torque_limit / wheel_radius = "
         f"{motors:.4g} N) and {whose} damping c1 = {c1:g} N s/m, c2 = {c2:g} "
-        "N m s/rad (ThesisPlant's force_limit, c1, c2 set them)",
+        "N m s/rad (ThesisPlant(robot, force_limit=..., c1=..., c2=...) sets them; "
+        "track: --plant-option force_limit=...)",
         UserWarning,
         stacklevel=2,
     )

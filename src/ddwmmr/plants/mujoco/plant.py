@@ -112,14 +112,14 @@ _WARNINGS = (
 #: while a state blowing up passes both within a step or two, long before it turns
 #: non-finite or the engine flags it (docs/physics.md, "The plant").
 SPEED_BOUND_FACTOR = 10.0
-#: What to do about a diverged state, for messages: the engine step is the API's option
-#: (the command-line tools run at the default 2 ms).
+#: What to do about a diverged state, for messages: a smaller engine step (the plant's
+#: option: the API's, track's --plant-option), or heavier parts.
 _SMALLER_STEP = (
     f"the engine step is too long for this robot's masses or stiffnesses, or a command "
-    f"drove it beyond its limits; give it heavier parts, or (the API) a smaller timestep: "
+    f"drove it beyond its limits; give it heavier parts, or a smaller timestep: "
     f"MujocoPlant(robot, timestep=...) or simulate(..., plant_options={{'timestep': ...}}) "
-    f"in [{TIMESTEP_RANGE_S[0]:g}, {TIMESTEP_RANGE_S[1]:g}] s; the command-line tools run "
-    f"at the default {DEFAULT_TIMESTEP:g} s"
+    f"in [{TIMESTEP_RANGE_S[0]:g}, {TIMESTEP_RANGE_S[1]:g}] s (track: --plant-option "
+    f"timestep=...; the other tools run at the default {DEFAULT_TIMESTEP:g} s)"
 )
 
 
@@ -530,7 +530,8 @@ class MujocoPlant:
             f"{options.contact_time_constant:g} s (light parts on stiff springs need a "
             "shorter step); soften the tyres (lower tyre_stiffness, or 0 for rigid wheels) "
             "or the contacts (a longer contact_time_constant), give it heavier parts, or "
-            f"(the API) a smaller MujocoPlant(robot, timestep=...) in [{low:g}, {high:g}] s"
+            f"a smaller MujocoPlant(robot, timestep=...) in [{low:g}, {high:g}] s (track: "
+            "--plant-option)"
         )
 
     def _speed_bounds(self) -> tuple[np.ndarray, np.ndarray, list[tuple[str, str]]]:
