@@ -1,9 +1,10 @@
-"""The damping defaults follow the robot's size (docs/theory.md section 4, "Other robots").
+"""The damping follows the robot's size (docs/theory.md section 4, "Other robots").
 
-A fixed smallest-singular-value threshold damps a short arm almost everywhere: the
-singular values of the resolution's matrices shrink with the first link. The defaults are
-the robot's own, so that damping starts at the same |cos th1| on every robot; the default
-robot keeps 0.05 and 0.05 exactly, and a value given is used as it is.
+Measured in metres, a fixed smallest-singular-value threshold damps a short arm almost
+everywhere: the singular values of the resolution's matrices shrink with the first link.
+The kernels measure lengths in the robot's own unit, so damping starts at the same
+|cos th1| on every robot; the default robot keeps 0.05 and 0.05 exactly
+(tests/test_damping_invariance.py: the damped steps of scaled robots, step by step).
 """
 
 import math
@@ -47,32 +48,6 @@ def test_ats_starts_damping_at_the_default_robots_band_on_any_size(factor):
     # With a fixed 0.05 the band was |cos th1| < 0.715 at 0.2x and < 0.058 at 5x.
     assert ats_band(scaled(factor)) == pytest.approx(ATS_BAND, abs=5e-4)
     assert ats_band(DEFAULT) == pytest.approx(ATS_BAND, abs=5e-4)
-
-
-def test_the_scale_follows_the_first_links_singular_slope():
-    # L1 / sqrt(1 + L1^2) relative to the default robot's: 0.2114 at 0.2x, 2.628 at 5x.
-    small, large = make_controller("pi", scaled(0.2)), make_controller("pi", scaled(5.0))
-    assert small.threshold == pytest.approx(0.05 * 0.211379, rel=1e-5)
-    assert large.threshold == pytest.approx(0.05 * 2.62825, rel=1e-5)
-    assert (small.damping, large.damping) == (small.threshold, large.threshold)
-
-
-def test_a_given_value_is_used_as_it_is():
-    controller = make_controller("pi", scaled(0.2), singularity_threshold=0.05)
-    assert (controller.threshold, controller.damping) == pytest.approx(
-        (0.05, 0.05 * 0.211379), rel=1e-5
-    )
-    controller = make_controller("clrrmc-cs", scaled(5.0), damping=0.2)
-    assert (controller.threshold, controller.damping) == pytest.approx(
-        (0.05 * 2.62825, 0.2), rel=1e-5
-    )
-    # explicit 0.05 reproduces the fixed threshold: the small robot's band is 0.715 again
-    assert ats_band(scaled(0.2), singularity_threshold=0.05) == pytest.approx(0.7153, abs=1e-3)
-
-
-def test_a_micrometre_arm_gets_defaults_inside_the_allowed_range():
-    controller = make_controller("ats", replace(DEFAULT, L1=1e-6, L2=1e-6))
-    assert (controller.threshold, controller.damping) == (1e-6, 1e-6)
 
 
 @pytest.mark.parametrize("method", ["ats", "clrrmc-cs"])

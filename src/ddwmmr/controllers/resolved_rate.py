@@ -31,7 +31,7 @@ class ResolvedRate(ABC):
     :mod:`ddwmmr.resolution.kernels`: with ``damping >= singularity_threshold`` the command
     is bounded by a documented constant times the desired speed at every state). None, the
     default, is the robot's own value (:func:`~ddwmmr.resolution.kernels.damping_options`:
-    0.05 and 0.05 on the default robot, scaled with the first link on others).
+    0.05 and 0.05, in the robot's length unit on every robot).
     """
 
     name = "base"

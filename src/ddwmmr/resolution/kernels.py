@@ -30,8 +30,8 @@ below ``threshold``. A singular value ``s`` of the matrix is mapped to the gain
 ``s / (s^2 + lambda^2)``; with ``damping >= threshold`` (the defaults are equal) that gain
 is at most ``s / threshold^2`` inside the band and ``1 / s`` outside it, so it never exceeds
 ``1 / threshold`` at any state (no cliff at the band edge). Hence the documented bounds
-(``sigma0 = threshold``, ``|.|`` the Euclidean norm, ``Xdot = (xEdot, yEdot, phiEdot)`` in
-m/s and rad/s)::
+(``sigma0 = threshold``, ``|.|`` the Euclidean norm, ``Xdot = (xEdot, yEdot, phiEdot)``,
+lengths in the robot's own unit: m on the default robot, see "Scale invariance")::
 
     pseudoinverse:  |u| <= |Xdot| / sigma0                                 (pi_gain)
     ats:            |u| <= (2 sqrt(1 + (L1 + L2)^2) / sigma0 + 1) |Xdot|    (ats_gain)
@@ -42,13 +42,19 @@ default robot. The threshold is chosen from that bound; ``sigma0 = 0.05`` damps 
 ``|cos th1| < 0.15`` for ``ats`` (``< 0.21-0.25`` for the pseudoinverse, depending on th2),
 so runs that stay away from the singularity are not changed by it.
 
-**Default per robot** (:func:`damping_options`). The singular values are absolute numbers
-of a matrix mixing m/s and rad/s, and near the singularity ``sigma_min(M) = L1 |cos th1| /
-sqrt(1 + L1^2)`` to first order: a fixed ``sigma0`` would damp a short arm almost everywhere
-and a long one hardly at all. So the default threshold and damping are the constants above
-(stated for the default robot) times :func:`robot_scale`, the ratio of that slope to the
-default robot's: ``ats`` then starts damping at ``|cos th1| = 0.151`` on every robot, and
-the default robot gets exactly 0.05 and 0.05. A given value is used as it is.
+**Scale invariance.** The singular values are absolute numbers of matrices that mix m/s and
+rad/s, and the isotropic damping ``lambda^2 I`` weighs metres against radians: measured in
+metres, a robot scaled in every length by ``s`` (on a trajectory scaled by ``s``) would be
+damped in another band and to another solution than the default robot (no single factor
+on ``sigma0`` fixes that: the columns of ``M`` and ``A`` scale differently, and the lower
+bound for ``A`` grows looser with the links). So the kernels measure lengths in the robot's
+own unit :func:`length_unit`, ``L1 / 0.35`` m (its first link counts as the default
+robot's 0.35): they divide the lengths and the task's linear rates by it, solve, and
+multiply ``v`` by it. ``sigma``, ``sigma0``, ``lambda`` and the bounds above are then
+numbers of that unit, the same on every robot of the default proportions, and the scaled
+robot is damped on the states, and to the commands (``v`` times ``s``), of the default
+robot, to rounding. The unit of the default robot is 1 m exactly, so its numbers are
+unchanged; ``ats`` starts damping at ``|cos th1| = 0.151`` on every robot, whatever ``L2``.
 """
 
 from __future__ import annotations
@@ -59,11 +65,11 @@ from ddwmmr.errors import ParameterError, check_finite, check_range
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import angles_in_range, refuse_angles
 
-#: Smallest singular value below which damping starts (``sigma0``) by default on the
-#: default robot; other robots scale it by :func:`robot_scale`.
+#: Smallest singular value below which damping starts (``sigma0``) by default, in the
+#: robot's :func:`length_unit` (so the same band of ``|cos th1|`` on every robot size).
 SINGULARITY_THRESHOLD = 0.05
-#: Damping factor lambda at the singularity by default on the default robot (``>= sigma0``:
-#: the gain bound holds); other robots scale it by :func:`robot_scale`, as the threshold.
+#: Damping factor lambda at the singularity by default, in the robot's :func:`length_unit`
+#: (``>= sigma0``: the gain bound holds).
 MAX_DAMPING = 0.05
 #: The values ``sigma0`` and ``lambda`` may take. Both enter squared, so they stay where
 #: the squares neither overflow nor underflow (``sigma0 = 1e200`` squared to inf and
@@ -72,6 +78,9 @@ MAX_DAMPING = 0.05
 THRESHOLD_RANGE = (1e-6, 1e3)
 DAMPING_RANGE = (1e-6, 1e3)
 _SQRT2 = math.sqrt(2.0)
+#: The default robot's first link (m): one :func:`length_unit` of every robot.
+_DEFAULT_L1 = Robot.L1
+_INF = math.inf
 
 
 def check_threshold(threshold: float) -> float:
@@ -94,36 +103,40 @@ def check_damping(damping: float) -> float:
     return check_range("damping", value, low, high)
 
 
-def robot_scale(L1: float) -> float:
-    """Factor from the default robot's damping defaults to those of a robot whose first link
-    is ``L1`` (m): the ratio of ``sigma_min(M) / |cos th1|`` at the singularity,
-    ``L1 / sqrt(1 + L1^2)``, to the default robot's (exactly 1.0 for its ``L1``)."""
-    return _singular_slope(L1) / _singular_slope(Robot.L1)
+def length_unit(L1: float) -> float:
+    """The robot's length unit (m) in which the kernels measure lengths and linear rates:
+    ``L1 / Robot.L1``, so that its first link is the default robot's (exactly 1.0 for the
+    default robot). ``L1`` (m) must be finite and > 0, else a one-line ParameterError."""
+    if not 0.0 < L1 < math.inf:
+        raise ParameterError(f"L1 must be a finite length > 0 m (got {L1!r})")
+    return L1 / _DEFAULT_L1
 
 
-def _singular_slope(L1: float) -> float:
-    # sigma_min(M)^2 = det^2 / T to first order in det = L1 cos th1 (T = 1 + L1^2)
-    return L1 / math.sqrt(1.0 + L1 * L1)
+def _in_length_unit(
+    L1: float, L2: float, xdot: float, ydot: float
+) -> tuple[float, float, float, float]:
+    """``(unit, L2 / unit, xdot / unit, ydot / unit)`` with ``unit = length_unit(L1)``
+    (inlined but for the refusal: the kernels are the controllers' hot path)."""
+    unit = L1 / _DEFAULT_L1
+    if not 0.0 < unit < _INF:
+        length_unit(L1)
+    return unit, L2 / unit, xdot / unit, ydot / unit
 
 
 def damping_options(
     L1: float, threshold: float | None = None, damping: float | None = None
 ) -> tuple[float, float]:
-    """``(threshold, damping)`` for a robot with first link ``L1`` (m), checked by
-    :func:`check_threshold` and :func:`check_damping`. None stands for the robot's default:
-    :data:`SINGULARITY_THRESHOLD` resp. :data:`MAX_DAMPING` times :func:`robot_scale`, kept
-    in :data:`THRESHOLD_RANGE` resp. :data:`DAMPING_RANGE` (a first link of micrometres
-    would fall below them)."""
+    """``(threshold, damping)`` for a robot with first link ``L1`` (m, checked by
+    :func:`length_unit`), checked by :func:`check_threshold` and :func:`check_damping`.
+    None stands for the default, :data:`SINGULARITY_THRESHOLD` resp. :data:`MAX_DAMPING`:
+    both are numbers of the robot's :func:`length_unit`, so the default needs no scaling
+    and a given value means the same on every robot size."""
+    length_unit(L1)
     if threshold is None:
-        threshold = _clip(SINGULARITY_THRESHOLD * robot_scale(L1), THRESHOLD_RANGE)
+        threshold = SINGULARITY_THRESHOLD
     if damping is None:
-        damping = _clip(MAX_DAMPING * robot_scale(L1), DAMPING_RANGE)
+        damping = MAX_DAMPING
     return check_threshold(threshold), check_damping(damping)
-
-
-def _clip(value: float, bounds: tuple[float, float]) -> float:
-    low, high = bounds
-    return min(max(value, low), high)
 
 
 def damping_squared(sigma: float, threshold: float, damping: float) -> float:
@@ -138,13 +151,16 @@ def damping_squared(sigma: float, threshold: float, damping: float) -> float:
 
 
 def pi_gain(threshold: float = SINGULARITY_THRESHOLD) -> float:
-    """Bound of ``|u| / |Xdot|`` of :func:`pseudoinverse` (when damping >= threshold)."""
+    """Bound of ``|u| / |Xdot|`` of :func:`pseudoinverse` (when damping >= threshold),
+    lengths in the robot's :func:`length_unit`."""
     return 1.0 / threshold
 
 
 def ats_gain(L1: float, L2: float, threshold: float = SINGULARITY_THRESHOLD) -> float:
-    """Bound of ``|u| / |Xdot|`` of :func:`ats` (when damping >= threshold)."""
-    return 2.0 * math.sqrt(1.0 + (L1 + L2) ** 2) / threshold + 1.0
+    """Bound of ``|u| / |Xdot|`` of :func:`ats` (when damping >= threshold) for links
+    ``L1``, ``L2`` (m), lengths in the robot's :func:`length_unit`."""
+    reach = (L1 + L2) / length_unit(L1)
+    return 2.0 * math.sqrt(1.0 + reach**2) / threshold + 1.0
 
 
 def smallest_singular_value_m(L1: float, cos_th1: float) -> float:
@@ -205,27 +221,31 @@ def ats(
 ) -> tuple[tuple[float, float, float, float], bool]:
     """Augmented task space resolution ``qdot = J_aug^-1 [Xdot; 0; 0]`` in input form.
 
-    Angles beyond +-``MAX_CONFIGURATION_ANGLE_RAD`` (their sums could overflow) are a
+    Links ``L1``, ``L2`` in m (``L1 > 0``), angles in rad, ``Xdot`` in m/s and rad/s, in the
+    world frame; ``threshold`` and ``damping`` in the robot's :func:`length_unit`. Angles
+    beyond +-``MAX_CONFIGURATION_ANGLE_RAD`` (their sums could overflow) are a
     :class:`ParameterError` naming q."""
     if not angles_in_range(phi, th1, th2):
         refuse_angles(phi, th1, th2)
+    unit, l2, xdot, ydot = _in_length_unit(L1, L2, xdot, ydot)
+    l1 = _DEFAULT_L1  # L1 in its own length unit, by definition
     c, s = math.cos(phi), math.sin(phi)
     a1 = phi + th1
     s1, c1 = math.sin(a1), math.cos(a1)
     s12, c12 = math.sin(a1 + th2), math.cos(a1 + th2)
-    lam2 = _ats_damping_squared(L1, c * c1 + s * s1, threshold, damping)  # cos(a1 - phi)
-    m12, m22 = -L1 * s1, L1 * c1
+    lam2 = _ats_damping_squared(l1, c * c1 + s * s1, threshold, damping)  # cos(a1 - phi)
+    m12, m22 = -l1 * s1, l1 * c1
     if aux == "sum":
         w = phidot_e
-        r1 = xdot + (L1 * s1 + L2 * s12) * w
-        r2 = ydot - (L1 * c1 + L2 * c12) * w
+        r1 = xdot + (l1 * s1 + l2 * s12) * w
+        r2 = ydot - (l1 * c1 + l2 * c12) * w
         v, t1 = _solve2(c, m12, s, m22, r1, r2, lam2)
-        return (v, w, t1, -t1), lam2 > 0.0
+        return (v * unit, w, t1, -t1), lam2 > 0.0
     if aux == "shoulder":
-        r1 = xdot + L2 * s12 * phidot_e
-        r2 = ydot - L2 * c12 * phidot_e
+        r1 = xdot + l2 * s12 * phidot_e
+        r2 = ydot - l2 * c12 * phidot_e
         v, w = _solve2(c, m12, s, m22, r1, r2, lam2)
-        return (v, w, 0.0, phidot_e - w), lam2 > 0.0
+        return (v * unit, w, 0.0, phidot_e - w), lam2 > 0.0
     raise ValueError(f"aux must be 'sum' or 'shoulder' (got {aux!r})")
 
 
@@ -243,16 +263,20 @@ def pseudoinverse(
 ) -> tuple[tuple[float, float, float, float], bool]:
     """Minimum-norm resolution ``qdot = J^# [Xdot; 0]`` in input form (damped near cos th1 = 0).
 
-    Angles beyond +-``MAX_CONFIGURATION_ANGLE_RAD`` are a :class:`ParameterError` naming q."""
+    Units as in :func:`ats`; the minimum norm is that of ``u`` with ``v`` in the robot's
+    :func:`length_unit` per second (m/s on the default robot). Angles beyond
+    +-``MAX_CONFIGURATION_ANGLE_RAD`` are a :class:`ParameterError` naming q."""
     if not angles_in_range(phi, th1, th2):
         refuse_angles(phi, th1, th2)
+    unit, l2, xdot, ydot = _in_length_unit(L1, L2, xdot, ydot)
+    l1 = _DEFAULT_L1  # L1 in its own length unit, by definition
     c, s = math.cos(phi), math.sin(phi)
     a1 = phi + th1
     s1, c1 = math.sin(a1), math.cos(a1)
     s12, c12 = math.sin(a1 + th2), math.cos(a1 + th2)
-    dx = -L1 * s1 - L2 * s12
-    dy = L1 * c1 + L2 * c12
-    ex, ey = -L2 * s12, L2 * c12
+    dx = -l1 * s1 - l2 * s12
+    dy = l1 * c1 + l2 * c12
+    ex, ey = -l2 * s12, l2 * c12
     # Gram matrix G = A A^T of A = [[c, dx, dx, ex], [s, dy, dy, ey], [0, 1, 1, 1]].
     g11 = c * c + 2.0 * dx * dx + ex * ex
     g12 = c * s + 2.0 * dx * dy + ex * ey
@@ -261,7 +285,7 @@ def pseudoinverse(
     g23 = 2.0 * dy + ey
     # det G = 2 L1^2 cos^2 th1 and sigma_1 sigma_2 <= trace(G) / 2 give the lower bound
     # sigma_min(A) >= 2 sqrt(2) L1 |cos th1| / trace(G).
-    sigma = 2.0 * _SQRT2 * L1 * abs(c * c1 + s * s1) / (g11 + g22 + 3.0)
+    sigma = 2.0 * _SQRT2 * l1 * abs(c * c1 + s * s1) / (g11 + g22 + 3.0)
     lam2 = damping_squared(sigma, threshold, damping)
     g11 += lam2
     g22 += lam2
@@ -279,7 +303,7 @@ def pseudoinverse(
     y3 = (k13 * xdot + k23 * ydot + k33 * phidot_e) / det
     # u = A^T y
     w = dx * y1 + dy * y2 + y3
-    return (c * y1 + s * y2, w, w, ex * y1 + ey * y2 + y3), lam2 > 0.0
+    return ((c * y1 + s * y2) * unit, w, w, ex * y1 + ey * y2 + y3), lam2 > 0.0
 
 
 def null_space_rate(phi: float, th1: float, gradient_phi: float, gradient_th1: float) -> float:
