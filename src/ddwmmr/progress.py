@@ -1,14 +1,20 @@
 """Progress on stderr for long runs: a ``tqdm`` bar on a terminal, short lines elsewhere.
 
-* On a terminal, :class:`ProgressBar` draws a tqdm bar (rate, elapsed time, ETA).
+* On a terminal, :class:`ProgressBar` draws a tqdm bar (rate, elapsed time, ETA at the
+  average rate of the whole phase so far, as :func:`eta`: a rate that drifts during a run
+  moves it slowly, where tqdm's default, the rate of the last few seconds, swings with
+  every fast or slow stretch). A terminal that reports no size (0 columns: a
+  pseudo-terminal nobody sized, e.g. under ``script``) gets a bar
+  :data:`FALLBACK_COLUMNS` wide.
 * When stderr is not a terminal (``make demo | tee``, CI logs), a bar would print control
   characters, so a :class:`ProgressBar` prints one short line when it finishes (and one
   every :data:`LOG_INTERVAL_S` of a long phase, with the time left at the rate so far:
   ``scenarios: 40/100 after 177 s, ETA 4 min 26 s``), e.g. ``compare: runs 120/120 done
   in 41.3 s``.
 * :func:`phase` marks a long step without a known count (report writing, GIF encoding):
-  a line when it starts on a terminal, and one line with its duration when it ends
-  (elsewhere only for phases of :data:`QUIET_PHASE_S` or more).
+  a line when it starts on a terminal, one every :data:`LOG_INTERVAL_S` while it lasts
+  (``track: writing timeseries.csv: still running after 30 s``), and one line with its
+  duration when it ends (elsewhere only for phases of :data:`QUIET_PHASE_S` or more).
 
 ``enabled=False`` (the tools' ``--no-progress``) silences everything.
 """
@@ -16,7 +22,9 @@
 from __future__ import annotations
 
 import contextlib
+import os
 import sys
+import threading
 import time
 from collections.abc import Iterator
 from typing import TextIO
@@ -27,6 +35,10 @@ from tqdm import tqdm
 LOG_INTERVAL_S = 30.0
 #: Phases shorter than this (s) print nothing when stderr is not a terminal.
 QUIET_PHASE_S = 1.0
+#: Width (characters) and height (lines) of the bar on a terminal that reports a size of
+#: 0: tqdm would size the bar to it and print nothing at all.
+FALLBACK_COLUMNS = 80
+FALLBACK_LINES = 24
 
 
 def eta(elapsed: float, done: int, total: int) -> float:
@@ -51,6 +63,23 @@ def _duration(seconds: float) -> str:
 
 def _is_terminal(stream: TextIO) -> bool:
     return bool(getattr(stream, "isatty", lambda: False)())
+
+
+def _unsized(stream: TextIO) -> bool:
+    """Whether ``stream`` is a terminal reporting 0 columns or 0 lines (a size nobody
+    set); False when the size cannot be asked (tqdm then takes its own default)."""
+    try:
+        size = os.get_terminal_size(stream.fileno())
+    except (AttributeError, OSError, ValueError):
+        return False
+    return size.columns <= 0 or size.lines <= 0
+
+
+def _bar_size(stream: TextIO) -> dict[str, object]:
+    """tqdm's size options: follow the terminal's width, or a fixed size if it has none."""
+    if _unsized(stream):
+        return {"ncols": FALLBACK_COLUMNS, "nrows": FALLBACK_LINES, "dynamic_ncols": False}
+    return {"dynamic_ncols": True}
 
 
 class ProgressBar:
@@ -87,8 +116,9 @@ class ProgressBar:
                 unit=unit,
                 file=self.stream,
                 mininterval=0.2,
-                dynamic_ncols=True,
+                smoothing=0.0,  # the ETA at the average rate so far (see the module doc)
                 leave=True,
+                **_bar_size(self.stream),
             )
 
     def advance(self, count: int = 1) -> None:
@@ -142,8 +172,32 @@ def phase(label: str, enabled: bool = True, stream: TextIO | None = None) -> Ite
         stream.write(f"{label} ...\n")
         stream.flush()
     start = time.perf_counter()
-    yield
+    with _heartbeat(label, stream, start):
+        yield
     elapsed = time.perf_counter() - start
     if terminal or elapsed >= QUIET_PHASE_S:
         stream.write(f"{label}: done in {elapsed:.1f} s\n")
         stream.flush()
+
+
+@contextlib.contextmanager
+def _heartbeat(label: str, stream: TextIO, start: float) -> Iterator[None]:
+    """While the body runs, a line every :data:`LOG_INTERVAL_S` saying that ``label`` is
+    still running and for how long since ``start`` (a :func:`time.perf_counter` time),
+    from a background thread: a phase has no count to advance, and its work (writing a
+    file, encoding a GIF) must not have to call back."""
+    stop = threading.Event()
+
+    def beat() -> None:
+        while not stop.wait(LOG_INTERVAL_S):
+            elapsed = time.perf_counter() - start
+            stream.write(f"{label}: still running after {_duration(elapsed)}\n")
+            stream.flush()
+
+    thread = threading.Thread(target=beat, name=f"progress: {label}", daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()

@@ -9,6 +9,7 @@ import os
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
+from typing import BinaryIO
 
 from ddwmmr.errors import ParameterError
 from ddwmmr.outputs.checks import check_file_target, existing_folder, unwritable_message
@@ -16,8 +17,14 @@ from ddwmmr.outputs.files import file_mode, folder_mode
 from ddwmmr.outputs.owners import temp_prefix
 
 
-def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
+def write_atomic(
+    path: str | os.PathLike[str], data: str | bytes | Callable[[BinaryIO], None]
+) -> None:
     """Write ``data`` to ``path`` through a temporary file and an atomic rename.
+
+    ``data`` is text (written as UTF-8), bytes, or a function ``data(handle)`` that writes
+    the bytes into the temporary file's binary handle, piece by piece (a file too large
+    to build in memory first: a long run's ``timeseries.csv``).
 
     ``path`` must be a non-empty ``str`` or :class:`os.PathLike`; if something exists
     there it must be a regular file, which is replaced. A folder, a device (``/dev/null``),
@@ -32,14 +39,14 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     Failures of the write itself (full disk) raise :class:`OSError`.
 
     The file gets the user's umask (``0644`` for umask 022), like any normal file, not
-    the ``0600`` of the temporary file; text is written as UTF-8. The temporary file
+    the ``0600`` of the temporary file. The temporary file
     carries this process's :func:`owner_token` in its name (:func:`temp_prefix`): one a
     killed run leaves is removed by the next run (:func:`remove_stale`,
     :func:`remove_stale_temp`) and ignored by :func:`inspect`.
     """
     path = check_file_target(path)
     existing = existing_folder("path", path.parent)
-    payload = data if isinstance(data, bytes) else data.encode("utf-8")
+    payload = data if isinstance(data, bytes) or callable(data) else data.encode("utf-8")
     try:
         path.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=temp_prefix(), suffix=".tmp")
@@ -49,7 +56,10 @@ def write_atomic(path: str | os.PathLike[str], data: str | bytes) -> None:
     try:
         with os.fdopen(fd, "wb") as handle:
             os.fchmod(handle.fileno(), file_mode())
-            handle.write(payload)
+            if callable(payload):
+                payload(handle)
+            else:
+                handle.write(payload)
         # Once more just before the rename: a FIFO or folder made there during the write
         # would be replaced as well.
         check_file_target(path)

@@ -98,8 +98,9 @@ class TrackingTask:
     ) -> None:
         self.trajectory = trajectory
         self.plant = plant
-        self.rows: list[tuple[float, ...]] = []
-        self.extra: list[tuple[float, ...]] = []
+        capacity = 0 if grid is None else int(grid[1]) + 1
+        self.rows = RowStore(len(RECORDED), capacity)
+        self.extra = RowStore(len(plant.extra_columns), capacity if plant.extra_columns else 0)
         self.diverged_at: int | None = None
         self.diverged_message = ""
         self._pose = trajectory.pose
@@ -180,18 +181,66 @@ class TrackingTask:
     # -- results ----------------------------------------------------------------------------
     def timeseries(self, robot: Robot) -> dict[str, np.ndarray]:
         """Every column of :data:`COLUMNS` (and the plant's), one entry per recorded sample."""
-        table = np.array(self.rows, dtype=float).reshape(len(self.rows), len(RECORDED))
+        table = self.rows.array()
         recorded = {name: table[:, i] for i, name in enumerate(RECORDED)}
         measured = FORCE in self.plant.interfaces
         derived = derive_columns(robot, recorded, measured_wheels=measured)
         series = {name: recorded[name] if name in recorded else derived[name] for name in COLUMNS}
         if self.plant.extra_columns:
-            extra = np.array(self.extra, dtype=float).reshape(
-                len(self.extra), len(self.plant.extra_columns)
-            )
+            extra = self.extra.array()
             for i, name in enumerate(self.plant.extra_columns):
                 series[name] = extra[:, i]
         return series
+
+
+class RowStore:
+    """Rows of ``width`` numbers, appended one per sample, kept as one float64 array.
+
+    A tuple of Python floats costs about 35 bytes per number, an array 8: rows are
+    gathered :data:`BLOCK` at a time and converted together, by
+    ``np.array(rows, dtype=float)`` (each number as ``float`` converts it), into a table
+    allocated for ``capacity`` rows (grown when a run records more), so a long run holds
+    at most one block of tuples. Appending is a list append: the step loop pays nothing
+    more per sample.
+    """
+
+    #: Rows gathered before they are converted into the table.
+    BLOCK = 4096
+
+    def __init__(self, width: int, capacity: int = 0) -> None:
+        self.width = width
+        self._table = np.empty((max(capacity, 0), width))
+        self._count = 0
+        self._pending: list[tuple[float, ...]] = []
+
+    def __len__(self) -> int:
+        return self._count + len(self._pending)
+
+    def append(self, row: tuple[float, ...]) -> None:
+        """Add one row of ``width`` numbers."""
+        self._pending.append(row)
+        if len(self._pending) >= self.BLOCK:
+            self._flush()
+
+    def array(self) -> np.ndarray:
+        """The rows so far, an array of shape ``(len(self), width)`` (a view of the table,
+        which later appends leave unchanged)."""
+        self._flush()
+        return self._table[: self._count]
+
+    def _flush(self) -> None:
+        pending = self._pending
+        if not pending:
+            return
+        block = np.array(pending, dtype=float).reshape(len(pending), self.width)
+        end = self._count + len(pending)
+        if end > len(self._table):
+            grown = np.empty((max(end, 2 * len(self._table)), self.width))
+            grown[: self._count] = self._table[: self._count]
+            self._table = grown
+        self._table[self._count : end] = block
+        self._count = end
+        self._pending = []
 
 
 class ReferenceBlocks:
