@@ -160,7 +160,11 @@ def test_timeline_draws_the_thresholds_and_every_waypoint_arrival(drawn, tmp_pat
         "leave it, eta >= 0.9": 0.9,
     }
     assert [t.get_text() for t in axes[1].get_legend().get_texts()][-1] == "leave it, S >= 1.6"
-    marks = [ln.get_xdata()[0] for ln in axes[3].lines if ln.get_color() == "tab:green"]
+    marks = [
+        ln.get_xdata()[0]
+        for ln in axes[3].lines
+        if ln.get_linestyle() == ":" and ln.get_color() == report.WAYPOINT_COLOUR
+    ]
     assert len(marks) == 5  # all five waypoints, the last at the end of the run
     assert marks[-1] == pytest.approx(outcome.metrics["time_s"], abs=1e-9)
     assert np.all(np.diff(marks) > 0.5)  # five distinct arrivals (6.0 s ... 22.9 s)
@@ -203,11 +207,11 @@ def test_paths_title_says_which_scenarios_and_why(base):
     title = cli_scenarios.paths_title("qp controller, thesis plant", outcomes, [0, 1], 0)
     assert title == (
         "qp controller, thesis plant: paths of scenarios 1, 2 (the first two; 1: the first "
-        "failure) of 3 run"
+        "failure) of 3 scenarios run"
     )
     six = _outcomes(base, [(True, 20.0, 0.5)] * 4 + [(False, 60.0, math.nan), (True, 20.0, 0.5)])
     assert cli_scenarios.paths_title("t", six, [0, 1, 4], 4) == (
-        "t: paths of scenarios 1, 2 (the first two) and 5 (the first failure) of 6 run"
+        "t: paths of scenarios 1, 2 (the first two) and 5 (the first failure) of 6 scenarios run"
     )
 
 
@@ -229,7 +233,7 @@ def test_batch_figures_are_titled_with_controller_and_plant(tmp_path, monkeypatc
     assert lines == cli_scenarios.timeline_thresholds(RunConfig())
     assert seen["paths"] == (
         "thesis controller, thesis plant: paths of scenarios 1, 2 (the first two; 1: the "
-        "first failure) of 2 run"
+        "first failure) of 2 scenarios run"
     )
 
 

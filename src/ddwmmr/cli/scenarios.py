@@ -684,7 +684,7 @@ def _figures(folder: Path, scenarios, outcomes, config: RunConfig, progress: boo
 
 def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
     short = f"{config.controller} controller, {config.plant} plant"
-    report.plot_state_times(outcomes, folder / "thesis_times.png", f"{short}: time per state")
+    report.plot_state_times(outcomes, folder / "thesis_times.png", short)
     report.plot_speeds(outcomes, folder / "thesis_speed.png", short)
     if controller_traits(config.controller)["arbiter"]:
         for key in ("stability", "manipulability"):
@@ -713,8 +713,8 @@ def paths_title(short: str, outcomes: list[Outcome], chosen: list[int], focus: i
     """The title of thesis_paths.png: which of how many scenarios it shows, and why (the
     first two, and the :func:`highlight` one: the first failure, else the busiest in fix
     states), e.g. "thesis controller, thesis plant: paths of scenarios 1, 2 (the first
-    two) and 5 (the first failure) of 6 run", or "... 1, 2 (the first two; 1: the first
-    failure) of 6 run"."""
+    two) and 5 (the first failure) of 6 scenarios run", or "... 1, 2 (the first two; 1: the
+    first failure) of 6 scenarios run"."""
     number = [o.metrics["scenario"] for o in outcomes]
     firsts = [i for i in chosen if i < 2]
     m = outcomes[focus].metrics
@@ -727,7 +727,8 @@ def paths_title(short: str, outcomes: list[Outcome], chosen: list[int], focus: i
     if focus not in firsts:
         shown += f" and {number[focus]} ({why})"
     plural = "s" * (len(chosen) > 1)
-    return f"{short}: paths of scenario{plural} {shown} of {len(outcomes)} run"
+    ran = f"{len(outcomes)} scenario" + "s" * (len(outcomes) > 1)
+    return f"{short}: paths of scenario{plural} {shown} of {ran} run"
 
 
 def _state_lines(state: str, symbol: str, thresholds) -> list[tuple[float, str]]:

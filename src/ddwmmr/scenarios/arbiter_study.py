@@ -386,8 +386,10 @@ def plot_weights(
 ) -> dict[str, float]:
     """Behaviour weights over time for one scenario (the paper's Fig. 5 kind of plot).
 
-    Panels: |w_b| of each behaviour (competitive arbiter), the state machine's state on the
-    same scenario (if ``compare_state_machine``), and S of both runs with the thresholds.
+    Panels: the arbiter weight |w_b| of each behaviour (competitive arbiter), the state
+    machine's state on the same scenario (if ``compare_state_machine``), and S of both runs
+    with the thresholds, in the scenario figures' palette (:data:`report.BEHAVIOUR_COLOURS`,
+    :data:`report.ARBITER_COLOURS`, :data:`report.ENTER_LINE`, :data:`report.LEAVE_LINE`).
     Returns the run's :func:`history_statistics`.
     """
     outcome, history = recorded_run(scenario, config)
@@ -401,36 +403,44 @@ def plot_weights(
 
     fig, axes = plt.subplots(rows, 1, figsize=(10, 2.5 * rows), sharex=True, squeeze=False)
     ax = axes[0, 0]
-    colours = {"stability": "C3", "manipulability": "C2", "obstacle": "C4", "objective": "C0"}
     for name in BEHAVIOURS:
         values = np.abs(history[f"w_{name}"])
         if name == "obstacle" and not scenario.obstacles:
             continue
-        ax.plot(history["t"], values, lw=1.1, color=colours[name], label=name)
+        ax.plot(history["t"], values, lw=1.1, color=report.BEHAVIOUR_COLOURS[name], label=name)
     m = outcome.metrics
     ax.set(
-        ylabel="|w|",
+        ylabel="arbiter weight",
         ylim=(-0.05, 1.1),
         title=f"{title}: scenario {m['scenario']}, competitive arbiter "
         f"({m['reason']}, {m['time_s']:.1f} s)",
     )
     s_axis = axes[rows - 1, 0]
-    s_axis.plot(history["t"], history["s"], color="k", lw=1.0, label="S, competitive")
+    colours = report.ARBITER_COLOURS
+    s_axis.plot(
+        history["t"], history["s"], color=colours["competitive"], lw=1.0, label="S, competitive"
+    )
     if compare_state_machine:
         sm = run_scenario(scenario, replace(config, arbiter="state-machine", record=True))
         tr = sm.trace or {}
         ax2 = axes[1, 0]
-        ax2.step(tr.get("t", []), tr.get("state", []), where="post", color="C1")
+        ax2.step(tr.get("t", []), tr.get("state", []), where="post", color=colours["state-machine"])
         ax2.set_yticks(range(len(STATES)), [s.replace("_", " ") for s in STATES])
         ax2.set(
             title=f"state machine on the same scenario ({sm.metrics['reason']}, "
             f"{sm.metrics['time_s']:.1f} s)"
         )
-        s_axis.plot(tr.get("t", []), tr.get("s", []), color="C1", lw=1.0, label="S, state machine")
+        s_machine = colours["state-machine"]
+        s_axis.plot(
+            tr.get("t", []), tr.get("s", []), color=s_machine, lw=1.0, label="S, state machine"
+        )
     enter, exit_ = config.stability
-    s_axis.axhline(enter, color="k", lw=0.6, ls="--", label=f"enter {enter:g}")
+    (enter_colour, enter_style), (exit_colour, exit_style) = report.ENTER_LINE, report.LEAVE_LINE
+    s_axis.axhline(enter, color=enter_colour, lw=0.9, ls=enter_style, label=f"enter S < {enter:g}")
     if exit_ != enter:
-        s_axis.axhline(exit_, color="k", lw=0.6, ls=":", label=f"exit {exit_:g}")
+        s_axis.axhline(
+            exit_, color=exit_colour, lw=0.9, ls=exit_style, label=f"leave S >= {exit_:g}"
+        )
     s_axis.set(xlabel="time (s)", ylabel="stability S")
     fig.tight_layout()
     place_legend(ax, fontsize=8, ncol=4)

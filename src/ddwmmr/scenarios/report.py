@@ -307,6 +307,41 @@ def _cell(value: Any) -> str:
 
 
 # -- figures ------------------------------------------------------------------------------
+# One palette for the scenario figures (paths, timeline, times, arbiter weights): a colour
+# or line style means the same thing in each of them, and the base and the end effector
+# are drawn as in track's path figure (ddwmmr.reports.plots: end effector blue, base grey).
+BASE_COLOUR = "0.45"
+EFFECTOR_COLOUR = "tab:blue"
+STABILITY_COLOUR = "tab:brown"
+MANIPULABILITY_COLOUR = "tab:purple"
+OBSTACLE_COLOUR = "tab:olive"
+OBJECTIVE_COLOUR = "tab:pink"
+WAYPOINT_COLOUR = "k"
+#: (colour, line style) of each kind of threshold line: tip-over (S = 1), a fix state's
+#: enter threshold (also a controller's floor, ``S_min``) and its leave threshold.
+TIP_OVER_LINE = ("tab:red", "--")
+ENTER_LINE = ("tab:orange", ":")
+LEAVE_LINE = ("tab:green", "-.")
+#: Colour of each arbiter's traces where both are drawn (the arbiter study's figures).
+ARBITER_COLOURS = {"competitive": "k", "state-machine": "tab:cyan"}
+#: Colour of each time share (a metric column) in the per-scenario time bars.
+TIME_COLOURS = {
+    "time_s": "0.8",
+    "time_base_s": BASE_COLOUR,
+    "time_arm_s": EFFECTOR_COLOUR,
+    "time_manipulability_s": MANIPULABILITY_COLOUR,
+    "time_stability_s": STABILITY_COLOUR,
+    "time_obstacle_s": OBSTACLE_COLOUR,
+}
+#: Colour of each behaviour's weight (the competitive arbiter's behaviours).
+BEHAVIOUR_COLOURS = {
+    "objective": OBJECTIVE_COLOUR,
+    "stability": STABILITY_COLOUR,
+    "manipulability": MANIPULABILITY_COLOUR,
+    "obstacle": OBSTACLE_COLOUR,
+}
+
+
 def _figure(rows: int = 1, cols: int = 1, height: float = 3.2):
     import matplotlib
 
@@ -385,29 +420,44 @@ def _bar_axes(
         legend_beside(ax, handles=handles, labels=labels, fontsize=8)
 
 
+#: What :func:`plot_state_times` shows, after its subject in the title: the time in each
+#: state, or for a controller without states the total time and the (overlapping) times
+#: with the base and with the arm moving.
+STATE_TIMES_HEADING = "time per state"
+MOVING_TIMES_HEADING = "total time; time moving: base / arm"
+
+
 def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
-    """Stacked per-scenario time in each state (thesis Figs 5.3, 5.10, 5.11).
+    """Stacked per-scenario time in each state (thesis Figs 5.3, 5.10, 5.11), titled
+    ``"<title>: time per state"`` (``title``: the figure's subject, e.g. the controller
+    and plant).
 
     Controllers without states move base and arm together, so their times overlap: they
-    are drawn as grouped bars (total, base moving, arm moving) instead of stacked. Bars
-    of scenarios that did not finish are hatched (:data:`FAILED_HATCH`); the legend sits
-    beside the axes.
+    are drawn as grouped bars (total, base moving, arm moving) instead of stacked, titled
+    ``"<title>: total time; time moving: base / arm"``. Each time share has its colour
+    (:data:`TIME_COLOURS`); bars of scenarios that did not finish are hatched
+    (:data:`FAILED_HATCH`); the legend sits beside the axes.
     """
     fig, ax = _figure()
     ax = ax[0, 0]
     index = np.array([o.metrics["scenario"] for o in outcomes])
     failed = _failed(outcomes)
-    ax.set(xlabel="scenario", ylabel="time (s)", title=title)
+    ax.set(xlabel="scenario", ylabel="time (s)")
     if np.all(np.isnan(_column(outcomes, "time_stability_s"))):
+        ax.set_title(f"{title}: {MOVING_TIMES_HEADING}")
         for shift, key, label in (
             (-0.3, "time_s", "total"),
-            (0.0, "time_base_s", "base moving"),
-            (0.3, "time_arm_s", "arm moving"),
+            (0.0, "time_base_s", "moving base"),
+            (0.3, "time_arm_s", "moving arm"),
         ):
-            _bars(ax, index + shift, _column(outcomes, key), failed, width=0.3, label=label)
+            values = _column(outcomes, key)
+            _bars(
+                ax, index + shift, values, failed, width=0.3, label=label, color=TIME_COLOURS[key]
+            )
         _bar_axes(ax, index, failed, entries=True)
         _save(fig, path)
         return
+    ax.set_title(f"{title}: {STATE_TIMES_HEADING}")
     bottom = np.zeros(len(outcomes))
     for key, label in (
         ("time_base_s", "moving base"),
@@ -418,7 +468,8 @@ def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
     ):
         values = np.nan_to_num(_column(outcomes, key))
         if np.any(values):
-            _bars(ax, index, values, failed, bottom=bottom, label=label, width=0.85)
+            colour = TIME_COLOURS[key]
+            _bars(ax, index, values, failed, bottom=bottom, label=label, width=0.85, color=colour)
             bottom += values
     _bar_axes(ax, index, failed, entries=True, empty="every scenario ended at t = 0")
     _save(fig, path)
@@ -456,17 +507,20 @@ def plot_speeds(outcomes: Sequence[Outcome], path, title: str) -> None:
 
 
 def plot_fix_state(outcomes: Sequence[Outcome], key: str, path, title: str) -> None:
-    """Per-scenario time in and transitions into one fix state (Figs 5.7, 5.9); bars of
-    scenarios that did not finish are hatched."""
+    """Per-scenario time in and transitions into one fix state (Figs 5.7, 5.9), in the
+    state's colour (:data:`TIME_COLOURS`); bars of scenarios that did not finish are
+    hatched."""
     from matplotlib.ticker import MaxNLocator
 
     fig, axes = _figure(2, 1)
     index = [o.metrics["scenario"] for o in outcomes]
     failed = _failed(outcomes)
-    _bars(axes[0, 0], index, np.nan_to_num(_column(outcomes, f"time_{key}_s")), failed, width=0.85)
+    colour = TIME_COLOURS[f"time_{key}_s"]  # the state's colour in every time figure
+    times = np.nan_to_num(_column(outcomes, f"time_{key}_s"))
+    _bars(axes[0, 0], index, times, failed, width=0.85, color=colour)
     axes[0, 0].set(ylabel="time (s)", title=f"{title}: time in {key} state")
     counts = np.nan_to_num(_column(outcomes, f"transitions_{key}"))
-    _bars(axes[1, 0], index, counts, failed, width=0.85)
+    _bars(axes[1, 0], index, counts, failed, width=0.85, color=colour)
     axes[1, 0].set(xlabel="scenario", ylabel="transitions", title=f"transitions into {key}")
     _bar_axes(axes[0, 0], index, failed)
     _bar_axes(axes[1, 0], index, np.zeros_like(failed))
@@ -489,13 +543,13 @@ def plot_paths(
     fig, axes = _figure(rows, cols, height=4.6)
     for ax, (scenario, outcome) in zip(axes.flat, items):
         tr = outcome.trace or {}
-        ax.plot(tr.get("x", []), tr.get("y", []), lw=1.2, label="base")
-        ax.plot(tr.get("xe", []), tr.get("ye", []), lw=0.8, label="end effector")
+        # as track's path figure: the end effector wide, the base thin over it
+        _draw_path(ax, tr, "xe", "ye", EFFECTOR_COLOUR, "end effector", lw=2.0, alpha=0.8)
+        _draw_path(ax, tr, "x", "y", BASE_COLOUR, "base", lw=1.0)
         wx, wy = zip(*scenario.waypoints)
-        ax.plot(wx, wy, "kx", ms=8, label="waypoints")
+        ax.plot(wx, wy, "x", color=WAYPOINT_COLOUR, ms=8, label="waypoints")
         for i, (x, y) in enumerate(scenario.waypoints, start=1):
             ax.annotate(str(i), (x, y), textcoords="offset points", xytext=(4, 4), fontsize=8)
-        ax.plot([0.0], [0.0], "go", ms=5, label="start")
         for i, (ox, oy, radius) in enumerate(scenario.obstacles):
             label = f"obstacle (r {radius:g} m)" if i == 0 else None
             ax.add_patch(patches.Circle((ox, oy), radius, color="0.5", alpha=0.6, label=label))
@@ -518,10 +572,21 @@ def plot_paths(
     _save(fig, path, rect=(0.0, 0.25 * legend_rows / fig.get_figheight(), 1.0, 1.0))
 
 
+def _draw_path(
+    ax, trace: dict, x: str, y: str, colour: str, name: str, lw: float, alpha: float = 1.0
+) -> None:
+    """The trace's ``x``/``y`` path in ``colour`` (line width ``lw``, points), labelled
+    ``name``, with a dot of the same colour where it starts, labelled ``"<name> start"``."""
+    xs, ys = trace.get(x, []), trace.get(y, [])
+    ax.plot(xs, ys, color=colour, lw=lw, alpha=alpha, label=name)
+    if len(xs):
+        ax.plot(xs[:1], ys[:1], "o", color=colour, ms=5, label=f"{name} start")
+
+
 #: A threshold line of a timeline panel: value and legend label.
 Threshold = tuple[float, str]
-#: Line styles of a panel's thresholds, in order (an enter and an exit threshold).
-THRESHOLD_STYLES = ((":", "tab:orange"), ("-.", "tab:green"))
+#: (colour, line style) of a panel's thresholds, in order (an enter and an exit threshold).
+THRESHOLD_STYLES = (ENTER_LINE, LEAVE_LINE)
 
 
 def _closest_approach(ax, trace: dict, obstacles, clearance: float) -> float:
@@ -566,7 +631,7 @@ def plot_timeline(
     t = tr.get("t", [])
     fig, axes = _figure(4, 1, height=2.2)
     ax = axes[0, 0]
-    ax.step(t, tr.get("state", []), where="post")
+    ax.step(t, tr.get("state", []), where="post", color="k")
     number = outcome.metrics["scenario"]
     if isinstance(outcome.metrics["transitions_stability"], float) and math.isnan(
         outcome.metrics["transitions_stability"]
@@ -582,21 +647,24 @@ def plot_timeline(
     outcome_title = outcome_text(outcome.metrics, total)
     ax.set_title(f"{title}: scenario {number} {shown_as}; {outcome_title}")
     ax2 = axes[1, 0]
-    ax2.plot(t, tr.get("s", []), color="tab:brown", label="stability S")
-    ax2.axhline(1.0, color="tab:red", lw=0.8, ls="--", label="S = 1 (tips over)")
+    ax2.plot(t, tr.get("s", []), color=STABILITY_COLOUR, label="stability S")
+    tip_colour, tip_style = TIP_OVER_LINE
+    ax2.axhline(1.0, color=tip_colour, lw=0.8, ls=tip_style, label="S = 1 (tips over)")
     top = max(3.0, 1.05 * max(tr.get("s", [0.0]), default=0.0))
     ax2.set(ylim=(0.0, top), ylabel="stability S (-)")
     ax3 = axes[2, 0]
-    ax3.plot(t, tr.get("eta", []), color="tab:purple", label="manipulability eta = |sin th2|")
+    eta_label = "manipulability eta = |sin th2|"
+    ax3.plot(t, tr.get("eta", []), color=MANIPULABILITY_COLOUR, label=eta_label)
     ax3.set(ylim=(0.0, 1.05), ylabel="manipulability\neta (-)")
     for axis, lines in ((ax2, stability_lines), (ax3, manipulability_lines)):
-        for (value, label), (style, color) in zip(lines, THRESHOLD_STYLES):
+        for (value, label), (color, style) in zip(lines, THRESHOLD_STYLES):
             axis.axhline(value, color=color, lw=0.9, ls=style, label=label)
     ax4 = axes[3, 0]
     # The log scale and its range before the data: a one-instant trace cannot autoscale.
     ax4.set(yscale="log", ylim=(1e-4, 30.0))
-    ax4.plot(t, np.maximum(tr.get("distance", []), 1e-4), label="distance")
-    ax4.axhline(0.01, color="k", lw=0.6, ls="--", label="tolerance 0.01 m")
+    distance = np.maximum(tr.get("distance", []), 1e-4)
+    ax4.plot(t, distance, color=EFFECTOR_COLOUR, label="distance")
+    ax4.axhline(0.01, color=WAYPOINT_COLOUR, lw=0.6, ls="--", label="tolerance 0.01 m")
     if scenario is not None:
         _mark_waypoints(ax4, tr, scenario, outcome.metrics)
     sampling = (
@@ -672,4 +740,4 @@ def _mark_waypoints(ax, trace: dict, scenario: Scenario, metrics: dict[str, Any]
         reached.append(float(metrics["time_s"]))
     for i, instant in enumerate(reached):
         label = "waypoint reached" if i == 0 else None
-        ax.axvline(instant, color="tab:green", lw=0.6, ls=":", label=label)
+        ax.axvline(instant, color=WAYPOINT_COLOUR, lw=0.6, ls=":", label=label)
