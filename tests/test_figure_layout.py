@@ -93,10 +93,10 @@ def test_track_path_holds_every_robot_and_names_their_times(rectangle_run):
     fig = plots.plot_path(rectangle_run, obstacles=[(0.0, 0.0, 0.4)])
     assert_figure_shows_its_data(fig)
     texts = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-    # Six instants on a closed path: the last is not drawn over the first.
+    # Six instants, the final pose among them (drawn darkest, over the first on a closed path).
     times = [t for t in texts if t.startswith("robot at t = ")]
-    t = rectangle_run.timeseries["t"]  # 2001 samples over 40 s: every 2000/6th one
-    expected = t[np.round(np.arange(6) * (len(t) - 1) / 6).astype(int)]
+    t = rectangle_run.timeseries["t"]  # 2001 samples over 40 s: every 2000/5th one
+    expected = t[np.round(np.arange(6) * (len(t) - 1) / 5).astype(int)]
     assert times == [f"robot at t = {x:.3g} s" for x in expected]
     assert "desired end effector" in texts and "obstacle" in texts
     plt.close(fig)

@@ -22,7 +22,7 @@ from matplotlib.patches import Polygon
 from matplotlib.ticker import NullFormatter
 
 from ddwmmr.reports.legends import place_legend
-from ddwmmr.reports.plots import robot_outline, wheel_outlines
+from ddwmmr.reports.plots import ERROR_FLOOR, robot_outline, wheel_outlines
 
 #: Plot axes of the view, top to bottom: key -> y-axis label.
 PLOTS = {
@@ -45,8 +45,6 @@ ROBOT_ZORDER = 3.0
 #: 100 dpi, 8 pt is 11 px.
 TICK_SIZE = 8
 LABEL_SIZE = 8
-#: Floor of the logarithmic position-error plot (m), as in the track figures.
-ERROR_FLOOR = 1e-9
 #: Samples of a desired path drawn before any run.
 PREVIEW_SAMPLES = 400
 
@@ -386,7 +384,7 @@ class RunView:
 def plotted_series(ts: dict[str, np.ndarray], k: int) -> dict[str, list[np.ndarray]]:
     """The y data of every plot line of one run up to index ``k`` (inclusive).
 
-    Position error is floored at :data:`ERROR_FLOOR` for the log axis.
+    Position error is floored at :data:`ddwmmr.reports.plots.ERROR_FLOOR` for the log axis.
     """
     end = k + 1
     return {

@@ -23,9 +23,8 @@ from matplotlib.patches import Rectangle
 
 from ddwmmr.model import Robot
 from ddwmmr.reports.legends import legend_beside, place_legend
+from ddwmmr.reports.plots import ERROR_FLOOR  # errors are clipped to it on log axes
 
-#: Errors are clipped to this floor (m) on log axes: converged runs reach ~1e-12 m.
-ERROR_FLOOR = 1e-12
 #: Resolution of the saved PNGs (dots per inch).
 DPI = 100
 #: Narrowest figure of :func:`plot_small_multiples` (in): two panels' width, which holds

@@ -19,7 +19,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from ddwmmr.reports.plots import robot_outline
+from ddwmmr.reports.plots import robot_outline, run_title
 
 
 def support_names(timeseries: dict[str, np.ndarray]) -> list[str]:
@@ -200,8 +200,8 @@ def plot_support_loads(result, floor_n: float | None = None):
 def draw_support_loads(fig: Figure, result, floor_n: float | None = None) -> Figure:
     """Draw the support-load panel into ``fig`` (empty; any canvas: the track figure and
     the simulator's window both use it): each edge's load (N) with the optimisers' floor
-    above, the base's tilt (mrad) below, against time; steps with an edge unloaded are
-    shaded.
+    (dashed) above, the base's tilt (mrad) below, against time; steps with an edge
+    unloaded are shaded. The title names the run (:func:`~ddwmmr.reports.plots.run_title`).
 
     ``result`` is a physics run (:func:`is_physics_run`); ``floor_n`` (N) defaults to the
     run summary's ``min_edge_load_floor_n`` (None: not drawn)."""
@@ -224,10 +224,11 @@ def draw_support_loads(fig: Figure, result, floor_n: float | None = None) -> Fig
     ax_load.axhline(0.0, color="0.4", lw=0.6)
     top = float(np.max(loads)) if loads.size else 1.0
     ax_load.set_ylim(-0.03 * top, 1.05 * top)
-    ax_load.set_ylabel("load off the edge (N)")
+    ax_load.set_ylabel("load on each edge (N)")
+    unloaded_s = result.summary.get("unloaded_time_s", 0.0)
     ax_load.set_title(
-        f"support loads: unloaded {result.summary.get('unloaded_time_s', 0.0):.2f} s "
-        "(shaded), least edge load per edge"
+        run_title(result.summary, f"support loads, unloaded {unloaded_s:.2f} s (shaded)"),
+        fontsize=10,
     )
     ax_load.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, frameon=False)
     ax_tilt.plot(t, 1e3 * ts["base_tilt_rad"], color="0.3", lw=0.8)

@@ -25,6 +25,12 @@ FIGURE_NAMES = ("path.png", "errors.png", "rates.png", "metrics.png")
 #: PNG text chunks: none (not even the matplotlib version), so equal runs give
 #: byte-identical figures.
 PNG_METADATA = {"Software": None}
+#: Floor (m) of every logarithmic position-error axis (track, compare, the GUI): errors
+#: below it are drawn at it. Converged runs reach 1e-10 m and less, which stays visible.
+ERROR_FLOOR = 1e-12
+#: Grey levels (0 black, 1 white) of the first and the last robot drawn on a path: light
+#: to dark over time, a ramp no path or method line uses.
+SNAPSHOT_GREYS = (0.72, 0.08)
 
 
 def robot_outline(robot: Robot, q) -> dict[str, np.ndarray]:
@@ -63,23 +69,17 @@ def wheel_outlines(robot: Robot, q, width: float | None = None) -> list[np.ndarr
 
 
 def snapshot_indices(ts: dict[str, np.ndarray], count: int, spacing: float = 0.0) -> np.ndarray:
-    """Up to ``count`` evenly spaced sample indices of a run, first and last included; on
-    a closed path (end effector desired back at its start) the last is left out, since it
-    would be drawn over the first. With ``spacing`` (m), an instant whose base lies closer
-    than that to an instant already kept is left out too: a base that hardly moves (a
+    """Up to ``count`` evenly spaced sample indices of a run, the first and the last (the
+    final pose) always included. With ``spacing`` (m), another instant whose base lies
+    closer than that to an instant already kept is left out: a base that hardly moves (a
     reach on the spot) shows a few robots apart rather than a tangle of footprints."""
-    closed = math.hypot(ts["xE_d"][-1] - ts["xE_d"][0], ts["yE_d"][-1] - ts["yE_d"][0]) < 1e-3
-    candidates = np.linspace(0, len(ts["t"]) - 1, count + closed)[:count].round().astype(int)
+    candidates = np.linspace(0, len(ts["t"]) - 1, count).round().astype(int)
     # The first and the last instant first: where the run starts and ends matters most.
-    ends = [candidates[0]] if closed or count < 2 else [candidates[0], candidates[-1]]
-    kept: list[int] = []
-    for k in [*ends, *(k for k in candidates if k not in ends)]:
-        if (
-            all(
-                math.hypot(ts["x"][k] - ts["x"][j], ts["y"][k] - ts["y"][j]) >= spacing
-                for j in kept
-            )
-            or k in ends
+    ends = [int(candidates[0])] if count < 2 else [int(candidates[0]), int(candidates[-1])]
+    kept = list(dict.fromkeys(ends))
+    for k in candidates:
+        if k not in kept and all(
+            math.hypot(ts["x"][k] - ts["x"][j], ts["y"][k] - ts["y"][j]) >= spacing for j in kept
         ):
             kept.append(int(k))
     return np.array(sorted(kept), dtype=int)
@@ -91,11 +91,11 @@ def footprint_spacing(robot: Robot) -> float:
     return 0.5 * math.hypot(robot.base_length, robot.base_width)
 
 
-def snapshot_colors(count: int) -> list:
-    """One colour per drawn instant, dark (first) to light (last): viridis up to 0.85,
-    whose light end still reads on white."""
-    cmap = plt.get_cmap("viridis")
-    return [cmap(0.85 * i / max(count - 1, 1)) for i in range(count)]
+def snapshot_colors(count: int) -> list[str]:
+    """One grey per drawn instant, light (first) to dark (last) between the levels of
+    :data:`SNAPSHOT_GREYS`: time reads as darkening, in no hue of a path or method line."""
+    first, last = SNAPSHOT_GREYS
+    return [f"{first + (last - first) * i / max(count - 1, 1):.3f}" for i in range(count)]
 
 
 def draw_snapshots(
@@ -243,10 +243,11 @@ def _fit_path_figure(fig: Figure, ax: Axes) -> None:
 
 
 def plot_errors(result) -> Figure:
-    """End-effector position error (log scale) and orientation error vs time."""
+    """End-effector position error (log scale, floored at :data:`ERROR_FLOOR`) and
+    orientation error vs time."""
     ts = result.timeseries
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
-    position = np.maximum(ts["position_error_m"], 1e-9)
+    position = np.maximum(ts["position_error_m"], ERROR_FLOOR)
     ax1.semilogy(ts["t"], position, color="tab:blue")
     at_least_a_decade(ax1, position)
     ax1.set_ylabel("position error (m)")
@@ -296,14 +297,20 @@ def at_least_a_percent(ax: Axes, values: np.ndarray) -> None:
 def plot_rates(result) -> Figure:
     """Arm joint rates, base yaw rate and wheel speeds vs time (rad/s), each on its own
     axis, with the robot's limits drawn and named (the base yaw rate has no limit of its
-    own: the wheel limit bounds it)."""
+    own: the wheel limit bounds it). The yaw rate drawn is the one the wheel speeds come
+    from: the measured one on a plant whose base lags its command (the command then a thin
+    dashed line), else the command, which is the motion (:func:`wheels_follow_measured`)."""
     ts, robot = result.timeseries, result.robot
     fig, (ax1, ax2, ax3) = plt.subplots(3, 1, figsize=(8.6, 6.4), sharex=True)
     ax1.plot(ts["t"], ts["th1dot"], label="th1dot")
     ax1.plot(ts["t"], ts["th2dot"], label="th2dot")
     _limit_lines(ax1, robot.joint_speed_limit, "joint limit")
     ax1.set_ylabel("arm joint rate\n(rad/s)")
-    ax2.plot(ts["t"], ts["w"], color="tab:green", label="w (base yaw rate)")
+    if wheels_follow_measured(result):
+        ax2.plot(ts["t"], ts["w_measured"], color="tab:green", label="w measured")
+        ax2.plot(ts["t"], ts["w"], color="k", ls="--", lw=0.8, label="w commanded")
+    else:
+        ax2.plot(ts["t"], ts["w"], color="tab:green", label="w (base yaw rate)")
     ax2.set_ylabel("base yaw rate\n(rad/s)")
     ax3.plot(ts["t"], ts["wheel_left_rad_s"], label="left wheel")
     ax3.plot(ts["t"], ts["wheel_right_rad_s"], ls="--", label="right wheel")
@@ -316,6 +323,25 @@ def plot_rates(result) -> Figure:
         legend_beside(ax, fontsize=8)
     fig.tight_layout()
     return fig
+
+
+def wheels_follow_measured(result) -> bool:
+    """True when the run's wheel speeds are those of its measured base velocities
+    (``v_measured``, ``w_measured``: a plant whose base has dynamics) rather than of the
+    command: the yaw rate the wheels imply, ``r (right - left) / track_width`` (rad/s),
+    equals ``w_measured`` and differs from the commanded ``w`` somewhere."""
+    ts, robot = result.timeseries, result.robot
+    if "w_measured" not in ts:
+        return False
+    implied = (
+        robot.wheel_radius * (ts["wheel_right_rad_s"] - ts["wheel_left_rad_s"]) / robot.track_width
+    )
+    measured, commanded = np.asarray(ts["w_measured"]), np.asarray(ts["w"])
+    tolerance = {"rtol": 1e-9, "atol": 1e-12, "equal_nan": True}
+    return bool(
+        np.allclose(implied, measured, **tolerance)
+        and not np.allclose(measured, commanded, **tolerance)
+    )
 
 
 def _limit_lines(ax: Axes, limit: float, name: str) -> None:
@@ -434,5 +460,16 @@ def _axes(ax: Axes | None, figsize: tuple[float, float]) -> tuple[Figure, Axes]:
 
 
 def _title(result, what: str) -> str:
-    summary = result.summary
-    return f"{summary.get('method', '?')} on {summary.get('trajectory', '?')}: {what}".rstrip(": ")
+    """``"<method> on <trajectory>: <what>"``, with ``" (<plant> plant)"`` after the
+    trajectory when the run's plant is not the kinematic model."""
+    return run_title(result.summary, what)
+
+
+def run_title(summary: dict, what: str) -> str:
+    """Title of a figure of the run whose summary is ``summary``: method, trajectory, the
+    plant unless it is the kinematic model (a summary without one is kinematic), then
+    ``what`` after a colon (left out when empty)."""
+    plant = summary.get("plant") or "kinematic"
+    named = "" if plant == "kinematic" else f" ({plant} plant)"
+    head = f"{summary.get('method', '?')} on {summary.get('trajectory', '?')}{named}"
+    return f"{head}: {what}".rstrip(": ")
