@@ -58,7 +58,8 @@ def test_a_run_without_plant_options_is_recorded_as_before(tmp_path, big_robot, 
     summary = _summary(out)
     assert summary["run"]["plant"] == {"name": "thesis"}
     assert summary["max_wheel_force_n"] == pytest.approx(10.0, abs=1e-9)
-    assert "force_limit, c1, c2" in capsys.readouterr().err  # the thesis plant's warning
+    err = capsys.readouterr().err  # the thesis plant's warning names the option to set
+    assert "thesis robot's wheel force limit 10 N" in err and "--plant-option force_limit=" in err
 
 
 @pytest.mark.parametrize("options", [OPTIONS, []])
