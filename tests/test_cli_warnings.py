@@ -31,6 +31,7 @@ warnings.simplefilter("always")
 with one_line_warnings():
     warnings.warn_explicit("their\\nmessage", UserWarning, "/elsewhere/lib.py", 7)
     warnings.warn_explicit("ours\\n  split", UserWarning, kinematics.__file__, 1)
+    warnings.warn_explicit("numeric", RuntimeWarning, kinematics.__file__, 2)
 warnings.warn_explicit("after", UserWarning, kinematics.__file__, 1)
 """
 
@@ -45,4 +46,5 @@ def test_a_warning_from_outside_the_library_keeps_pythons_form():
         "message",
         "warning: ours split",
     ]
-    assert lines[3].endswith("kinematics.py:1: UserWarning: after")  # restored after
+    assert lines[3].endswith("kinematics.py:2: RuntimeWarning: numeric")  # where it arose
+    assert lines[-2].endswith("kinematics.py:1: UserWarning: after")  # restored after

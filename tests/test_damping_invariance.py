@@ -129,11 +129,12 @@ def test_the_defaults_and_a_given_value_mean_the_same_band_on_every_size(factor)
     assert ats_band(DEFAULT, singularity_threshold=0.2) == pytest.approx(0.5945, abs=1e-3)
 
 
-@pytest.mark.parametrize("L1", [0.0, -0.35, math.nan, math.inf])
+@pytest.mark.parametrize("L1", [0.0, -0.35, math.nan, math.inf, 1e-310, 1e-7, 2e3])
 def test_a_first_link_that_is_no_length_is_refused_by_the_kernels(L1):
-    with pytest.raises(ParameterError, match=r"^L1 must be a finite length > 0 m \(got "):
+    """Outside the robot's length range (1e-310 m made L2 / unit overflow to a NaN command)."""
+    with pytest.raises(ParameterError, match=r"^L1 must be a length in \[1e-06, 1000\] m \(got "):
         kernels.pseudoinverse(L1, 0.3, 0.0, 0.1, 0.2, 0.1, 0.0, 0.0)
-    with pytest.raises(ParameterError, match=r"^L1 must be a finite length > 0 m"):
+    with pytest.raises(ParameterError, match=r"^L1 must be a length in \[1e-06, 1000\] m"):
         kernels.ats(L1, 0.3, 0.0, 0.1, 0.2, 0.1, 0.0, 0.0)
-    with pytest.raises(ParameterError, match=r"^L1 must be a finite length > 0 m"):
+    with pytest.raises(ParameterError, match=r"^L1 must be a length in \[1e-06, 1000\] m"):
         kernels.damping_options(L1)

@@ -325,19 +325,22 @@ def forget_unhandled_interrupt() -> None:
 
 
 #: The package's folder: a warning issued from a file below it is the library's own.
-_PACKAGE_FOLDER = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+_PACKAGE_FOLDER = os.path.normcase(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 @contextlib.contextmanager
 def one_line_warnings() -> Iterator[None]:
-    """Show the library's own warnings as one line on stderr, ``warning: <message>``
-    (their messages name the parameter and what to change), instead of Python's default
-    form (the source file, line number and line of the library's code, which reads like a
-    traceback); any other warning is shown as Python would."""
+    """Show the library's own warnings (a :class:`UserWarning` issued from the package)
+    as one line on stderr, ``warning: <message>`` (their messages name the parameter and
+    what to change), instead of Python's default form (the source file, line number and
+    line of the library's code, which reads like a traceback); any other warning (another
+    library's, or a NumPy ``RuntimeWarning`` whose location is the clue) is shown as
+    Python would."""
     previous = warnings.showwarning
 
     def show(message, category, filename, lineno, file=None, line=None) -> None:
-        if os.path.abspath(filename).startswith(_PACKAGE_FOLDER + os.sep):
+        ours = os.path.normcase(os.path.abspath(filename)).startswith(_PACKAGE_FOLDER + os.sep)
+        if ours and issubclass(category, UserWarning):
             say(f"warning: {' '.join(str(message).split())}")
         else:
             previous(message, category, filename, lineno, file, line)

@@ -62,7 +62,6 @@ from ddwmmr.errors import (
     check_nonnegative,
     shown,
 )
-from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR
 from ddwmmr.outputs import write_atomic
 from ddwmmr.plants import available_plants, plant_class, plant_description
@@ -90,6 +89,7 @@ from ddwmmr.scenarios.protocol import (
     check_payload,
     check_thresholds,
     check_time_limit,
+    config_robot,
     controller_options_record,
     make_scenario_controller,
     make_scenario_plant,
@@ -900,11 +900,6 @@ def _run_arbiters(args, config, runner, folder: Path) -> None:
     study.update(seed=args.seed, config=asdict(config), run=_record(args, config, runner.workers))
     write_atomic(folder / MARKER, report.summary_json(study))
     print(study["table"], end="")
-
-
-def config_robot(config: RunConfig) -> Robot:
-    """The robot a configuration simulates."""
-    return Robot().with_payload(config.payload)
 
 
 def _record(args: argparse.Namespace, config: RunConfig, workers: int) -> dict[str, Any]:

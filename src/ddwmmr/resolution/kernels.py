@@ -61,7 +61,7 @@ from __future__ import annotations
 
 import math
 
-from ddwmmr.errors import ParameterError, check_finite, check_range
+from ddwmmr.errors import LENGTH_RANGE_M, ParameterError, check_finite, check_range
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import angles_in_range, refuse_angles
 
@@ -80,7 +80,8 @@ DAMPING_RANGE = (1e-6, 1e3)
 _SQRT2 = math.sqrt(2.0)
 #: The default robot's first link (m): one :func:`length_unit` of every robot.
 _DEFAULT_L1 = Robot.L1
-_INF = math.inf
+#: The range of :func:`length_unit` over the robot's ``LENGTH_RANGE_M``.
+_LOWEST_UNIT, _HIGHEST_UNIT = (length / _DEFAULT_L1 for length in LENGTH_RANGE_M)
 
 
 def check_threshold(threshold: float) -> float:
@@ -106,9 +107,11 @@ def check_damping(damping: float) -> float:
 def length_unit(L1: float) -> float:
     """The robot's length unit (m) in which the kernels measure lengths and linear rates:
     ``L1 / Robot.L1``, so that its first link is the default robot's (exactly 1.0 for the
-    default robot). ``L1`` (m) must be finite and > 0, else a one-line ParameterError."""
-    if not 0.0 < L1 < math.inf:
-        raise ParameterError(f"L1 must be a finite length > 0 m (got {L1!r})")
+    default robot). ``L1`` (m) must be in ``LENGTH_RANGE_M``, the robot's, else a one-line
+    ParameterError."""
+    low, high = LENGTH_RANGE_M
+    if not low <= L1 <= high:
+        raise ParameterError(f"L1 must be a length in [{low:g}, {high:g}] m (got {L1!r})")
     return L1 / _DEFAULT_L1
 
 
@@ -118,7 +121,7 @@ def _in_length_unit(
     """``(unit, L2 / unit, xdot / unit, ydot / unit)`` with ``unit = length_unit(L1)``
     (inlined but for the refusal: the kernels are the controllers' hot path)."""
     unit = L1 / _DEFAULT_L1
-    if not 0.0 < unit < _INF:
+    if not _LOWEST_UNIT <= unit <= _HIGHEST_UNIT:
         length_unit(L1)
     return unit, L2 / unit, xdot / unit, ydot / unit
 

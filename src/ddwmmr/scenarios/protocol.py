@@ -285,6 +285,11 @@ def check_payload(payload: Any) -> float:
     return value
 
 
+def config_robot(config: RunConfig) -> Robot:
+    """The robot a configuration simulates: the default robot with ``config.payload``."""
+    return Robot().with_payload(config.payload)
+
+
 def check_start_pose(payload: float) -> None:
     """Refuse a payload (kg) that already tips the default robot over in the scenarios'
     start pose (S <= 1): every scenario would fail at t = 0. The message names the
@@ -647,7 +652,7 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
         raise ParameterError(
             f"config must be a RunConfig (ddwmmr.scenarios.RunConfig) (got {shown(config)})"
         )
-    robot = Robot().with_payload(config.payload)
+    robot = config_robot(config)
     plant = make_scenario_plant(robot, config)
     controller = make_scenario_controller(robot, scenario, config, plant)
     # Start at the origin heading +x in the thesis's default pose (the pose it drives in).
@@ -735,7 +740,7 @@ def controller_options_record(config: RunConfig, scenario: Scenario) -> dict[str
     controller's arbiter) is recorded as its class, ``module.Class``: a repr would carry a
     memory address and differ from run to run. Building the controller checks the options
     as a run would (a bad one: its one-line :class:`ParameterError`)."""
-    robot = Robot().with_payload(config.payload)
+    robot = config_robot(config)
     plant = make_scenario_plant(robot, config)
     controller = make_scenario_controller(robot, scenario, config, plant)
     adopt = getattr(controller, "adopt_plant", None)
@@ -781,6 +786,7 @@ __all__ = [
     "check_start_pose",
     "check_thresholds",
     "check_time_limit",
+    "config_robot",
     "controller_options_record",
     "make_scenario_controller",
     "make_scenario_plant",
