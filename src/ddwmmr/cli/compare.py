@@ -65,6 +65,7 @@ from ddwmmr.reports.compare import (
     execute,
     output_names,
     plan_runs,
+    ranking_footnote,
     ranking_table,
     slides_name,
     slides_verdict,
@@ -561,6 +562,7 @@ def format_summary(
         f"{100 * TIE_RELATIVE:g} % plus {1000 * TIE_ABSOLUTE_M:g} mm of a better one share "
         "its rank.",
         text_table(*ranking_table(ranking, shown)),
+        *([footnote] if (footnote := ranking_footnote(ranking)) else []),
         "",
         slides_verdict(check),
     ]

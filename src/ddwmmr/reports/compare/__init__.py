@@ -24,7 +24,8 @@ Layout (each module imports only the ones listed above it):
 - :mod:`.plan`: configuration, run specs, the plan of runs, (parallel) execution.
 - :mod:`.document`: number formatting, the Markdown/HTML document, the console table.
 - :mod:`.diagnosis`: why a run scored as it did; measurements shared by the studies.
-- :mod:`.ranking`: ``metrics.csv``, score, ties, ranking, the slides' ranking check.
+- :mod:`.ranking`: ``metrics.csv``, score, ties, ranking (with the runs that did not
+  track), the slides' ranking check.
 - :mod:`.report`: :func:`write_report` and one builder per report section.
 
 Figures are drawn by :mod:`ddwmmr.reports.compare_plots`. Every public name of the modules
@@ -89,12 +90,15 @@ from ddwmmr.reports.compare.plan import (
     tau_methods,
 )
 from ddwmmr.reports.compare.ranking import (
+    NOT_TRACKED_MARK,
+    NOT_TRACKED_NOTE,
     Ranking,
     SlidesCheck,
     Violation,
     at_least_as_good,
     build_ranking,
     check_slides,
+    did_not_track,
     geometric_mean,
     metrics_csv,
     metrics_rows,
@@ -108,6 +112,7 @@ from ddwmmr.reports.compare.report import (
     corner_peaks,
     drift_kind,
     output_names,
+    ranking_footnote,
     ranking_table,
     slides_verdict,
     write_report,
@@ -119,6 +124,8 @@ __all__ = [
     "DEFAULT_TRAJECTORIES",
     "MARKER",
     "METRIC_COLUMNS",
+    "NOT_TRACKED_MARK",
+    "NOT_TRACKED_NOTE",
     "OFFSET_SCALES",
     "SINGULAR_COS",
     "SINGULAR_LOSS_M",
@@ -152,6 +159,7 @@ __all__ = [
     "corner_times",
     "default_step",
     "diagnose",
+    "did_not_track",
     "drift_kind",
     "estimated_cost",
     "execute",
@@ -169,6 +177,7 @@ __all__ = [
     "plan_runs",
     "plant_metrics_rows",
     "rank_with_ties",
+    "ranking_footnote",
     "ranking_table",
     "run_duration",
     "run_one",

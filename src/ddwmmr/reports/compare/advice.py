@@ -16,7 +16,12 @@ from ddwmmr.reports.compare.constants import CORNER_TRAJECTORY, SLIDES_ORDER, ST
 from ddwmmr.reports.compare.diagnosis import convergence_time, keeps_offset, singularity_outcome
 from ddwmmr.reports.compare.document import fmt, mm
 from ddwmmr.reports.compare.plan import CompareConfig, RunOutput, RunSpec, main_spec
-from ddwmmr.reports.compare.ranking import Ranking, at_least_as_good
+from ddwmmr.reports.compare.ranking import (
+    NOT_TRACKED_MARK,
+    Ranking,
+    at_least_as_good,
+    did_not_track,
+)
 
 
 @dataclass
@@ -41,6 +46,9 @@ class Profile:
             if no run recorded it).
         shown: a trajectory key (of ``scores``...) -> the name the report shows
             (:meth:`CompareConfig.shown`).
+        untracked: the method's runs that did not track (:func:`did_not_track`), each as
+            (trajectory key, plant): plant None for a main run (the kinematic plant), then
+            the runs on the extra plants (``--plant``), plant by plant.
     """
 
     method: str
@@ -56,6 +64,7 @@ class Profile:
     min_cos_th1: float
     start_stability: float = math.nan
     shown: Callable[[str], str] = str
+    untracked: tuple[tuple[str, str | None], ...] = ()
 
     @property
     def converges(self) -> bool:
@@ -64,9 +73,19 @@ class Profile:
 
 
 def profiles(
-    config: CompareConfig, outputs: Mapping[RunSpec, RunOutput], ranking: Ranking
+    config: CompareConfig,
+    outputs: Mapping[RunSpec, RunOutput],
+    ranking: Ranking,
+    plants: Mapping[str, Sequence[RunSpec]] | None = None,
 ) -> list[Profile]:
-    """One :class:`Profile` per compared method, best ranked first."""
+    """One :class:`Profile` per compared method, best ranked first; ``plants``: plant ->
+    the main runs repeated on it (``Plan.plants``), judged for :attr:`Profile.untracked`."""
+    on_plants = [
+        (s.method, s.trajectory, plant)
+        for plant, specs in (plants or {}).items()
+        for s in specs
+        if did_not_track(outputs[s].summary)
+    ]
     result = []
     names = list(config.trajectories)
     settle_on = STUDY_TRAJECTORY if STUDY_TRAJECTORY in names else names[0]
@@ -101,6 +120,10 @@ def profiles(
                     default=math.nan,
                 ),
                 shown=config.shown,
+                untracked=(
+                    *((n, None) for n in ranking.scores if not ranking.tracked(n, method)),
+                    *((n, plant) for m, n, plant in on_plants if m == method),
+                ),
             )
         )
     return result
@@ -123,7 +146,7 @@ def advice_rows(items: Sequence[Profile]) -> list[list[str]]:
     return [
         [
             p.method,
-            ", ".join(f"{p.shown(n)} {mm(v)}" for n, v in p.scores.items()),
+            ", ".join(f"{p.shown(n)} {mm(v)}{_mark(p, n)}" for n, v in p.scores.items()),
             fmt(p.step_us),
             _offset_text(p),
             _stability_text(p),
@@ -131,6 +154,16 @@ def advice_rows(items: Sequence[Profile]) -> list[list[str]]:
         ]
         for p in items
     ]
+
+
+def _mark(p: Profile, name: str) -> str:
+    """:data:`NOT_TRACKED_MARK` if ``p``'s main run on ``name`` did not track, else ``""``."""
+    return NOT_TRACKED_MARK if (name, None) in p.untracked else ""
+
+
+def marked(items: Sequence[Profile]) -> bool:
+    """A score of :func:`advice_rows` carries :data:`NOT_TRACKED_MARK`."""
+    return any(plant is None for p in items for _, plant in p.untracked)
 
 
 def _offset_text(p: Profile) -> str:
@@ -189,9 +222,9 @@ def recommendations(
         fastest = min(closed, key=lambda p: p.step_us)
         lines.append(
             f"**Tightest step-time budget with feedback**: `{fastest.method}` "
-            f"({fmt(fastest.step_us)} us per step on this machine; it removes the initial "
-            f"offset, below 5 % after {fmt(fastest.settle_s)} s on the "
-            f"{fastest.shown(fastest.settle_trajectory)})."
+            f"({fmt(fastest.step_us)} us per step, {_step_basis(fastest)}, on this machine; "
+            f"it removes the initial offset, below 5 % after {fmt(fastest.settle_s)} s on the "
+            f"{fastest.shown(fastest.settle_trajectory)})." + _caveat([fastest])
         )
     lines.append(_stability_line(items))
     lines.append(_singularity_line(items))
@@ -201,15 +234,18 @@ def recommendations(
         lines.append(
             f"**No pose measurement (feed-forward only)**: `{best.method}` (best open-loop "
             f"score, overall {mm(_overall(best))} mm; it keeps any initial offset)."
+            + _caveat([best])
         )
     ours = [m for m in slides.order if m in SLIDES_ORDER] if slides is not None else []
     if ours:
         best = ours[0]
         shown = items[0].shown if items else str
         scores = ", ".join(f"{shown(n)} {mm(v[best])} mm" for n, v in slides.scores.items())
+        failed = [(n, None) for n in slides.scores if not slides.tracked(n, best)]
         lines.append(
             "**Reproducing the slides**: `--preset slides` (their auxiliary row and gains); the "
             f"best of their methods under their settings is `{best}` ({scores})."
+            + _did_not_track([(best, failed)], shown)
         )
     return lines
 
@@ -230,7 +266,7 @@ def _stability_line(items: Sequence[Profile]) -> str:
         texts = ", ".join(_broken_floor_text(p) for p in broken)
         verb = _agree(broken, "enforces", "enforce")
         parts.append(f"{texts} {verb} a floor but did not keep it in these runs")
-    return label + "; ".join([*parts, "no other compared method constrains S."])
+    return label + "; ".join([*parts, "no other compared method constrains S."]) + _caveat(floored)
 
 
 def _broken_floor_text(p: Profile) -> str:
@@ -263,10 +299,51 @@ def _best_line(label: str, items: Sequence[Profile], key) -> str:
         text += "; tied with it within 5 % but slower per step: " + ", ".join(
             f"`{p.method}` ({mm(key(p))} mm, {fmt(p.step_us)} us)" for p in others
         )
-    return text + "."
+    return text + "." + _caveat(tied)
+
+
+def _step_basis(p: Profile) -> str:
+    """What :attr:`Profile.step_us` is a median over: ``median over both trajectories``,
+    ``median over the 3 trajectories`` or, for one, ``on the ellipse``."""
+    names = list(p.scores)
+    if len(names) == 1:
+        return f"on the {p.shown(names[0])}"
+    return "median over " + (
+        "both trajectories" if len(names) == 2 else f"the {len(names)} trajectories"
+    )
+
+
+def _caveat(named: Sequence[Profile]) -> str:
+    """The runs of the methods a line names (``named``) that did not track
+    (:attr:`Profile.untracked`), as :func:`_did_not_track` writes them."""
+    shown = named[0].shown if named else str
+    return _did_not_track([(p.method, p.untracked) for p in named], shown)
+
+
+def _did_not_track(
+    named: Sequence[tuple[str, Sequence[tuple[str, str | None]]]], shown: Callable[[str], str]
+) -> str:
+    """`` Did not track (docs/cli.md, "Verdict"): `ats` on the rectangle and the rectangle
+    (thesis plant).``: per method of ``named`` its runs, (trajectory key, plant or None
+    for the kinematic main run), that did not track; ``""`` when all tracked. ``shown``
+    gives a trajectory key's shown name."""
+    parts = [
+        f"`{method}` on "
+        + _and([f"the {shown(n)}" + (f" ({plant} plant)" if plant else "") for n, plant in runs])
+        for method, runs in named
+        if runs
+    ]
+    return f' Did not track (docs/cli.md, "Verdict"): {"; ".join(parts)}.' if parts else ""
+
+
+def _and(texts: Sequence[str]) -> str:
+    """``a``, ``a and b``, ``a, b and c``."""
+    return texts[0] if len(texts) == 1 else ", ".join(texts[:-1]) + " and " + texts[-1]
 
 
 def _singularity_line(items: Sequence[Profile]) -> str:
+    """Which methods pass the shoulder singularity, stay away from it or lose the path
+    there; the runs that did not track of the first two groups (:func:`_caveat`)."""
     lost = [p.method for p in items if any(o == "lost" for o, _ in p.singularity.values())]
     passes = [
         p.method
@@ -290,7 +367,8 @@ def _singularity_line(items: Sequence[Profile]) -> str:
             f"avoid {_names(lost)}: {_agree(lost, 'it is', 'they are')} driven into it "
             f"and {_agree(lost, 'loses', 'lose')} the path"
         )
-    return text + "; ".join(parts) + "."
+    kept = [p for p in items if p.method not in lost]
+    return text + "; ".join(parts) + "." + _caveat(kept)
 
 
 def _agree(methods: Sequence[str], one: str, several: str) -> str:

@@ -16,10 +16,12 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr.controllers.base import commanded_steps
 from ddwmmr.model import Robot
 from ddwmmr.reports.compare.constants import CONVERGED_FRACTION, SINGULAR_COS, SINGULAR_LOSS_M
 from ddwmmr.reports.compare.document import fmt, mm
 from ddwmmr.reports.compare.plan import CompareConfig, Plan, RunOutput, RunSpec
+from ddwmmr.sim.simulate import joint_limits_held
 
 # -- the reasons a run scores as it does --------------------------------------------------
 
@@ -46,14 +48,24 @@ def singularity_outcome(ts: Mapping[str, np.ndarray]) -> tuple[str, int | None]:
 def saturation_span(
     ts: Mapping[str, np.ndarray], exclude: np.ndarray | None = None
 ) -> tuple[int, float, float]:
-    """Number of saturated steps (not in ``exclude``) and the first and last such time (s)."""
-    saturated = ts["saturated"] > 0
-    if exclude is not None:
-        saturated &= ~exclude
+    """Number of saturated commanded steps (not in ``exclude``, a boolean per sample) and
+    the first and last such time (s). The steps are the run's commanded ones
+    (:func:`~ddwmmr.controllers.base.commanded_steps`: the last sample's command is never
+    applied), as the summary's ``saturated_steps`` counts them."""
+    saturated = _saturated(ts, exclude)
     hits = np.nonzero(saturated)[0]
     if not len(hits):
         return 0, math.nan, math.nan
     return len(hits), float(ts["t"][hits[0]]), float(ts["t"][hits[-1]])
+
+
+def _saturated(ts: Mapping[str, np.ndarray], exclude: np.ndarray | None) -> np.ndarray:
+    """Boolean per commanded step: the plant clipped its command, the step not in
+    ``exclude`` (a boolean per sample)."""
+    saturated = commanded_steps(ts["saturated"]) > 0
+    if exclude is not None:
+        saturated &= ~commanded_steps(exclude)
+    return saturated
 
 
 def orientation_jumps(ts: Mapping[str, np.ndarray]) -> int:
@@ -62,20 +74,25 @@ def orientation_jumps(ts: Mapping[str, np.ndarray]) -> int:
 
 
 def at_joint_limit(ts: Mapping[str, np.ndarray], robot: Robot) -> np.ndarray:
-    """Boolean per sample: th1 or th2 sits at one of the robot's joint limits."""
-    hit = np.zeros(len(ts["t"]), dtype=bool)
-    for name, (low, high) in zip(("th1", "th2"), robot.joint_limits):
-        hit |= (ts[name] <= low + 1e-6) | (ts[name] >= high - 1e-6)
-    return hit
+    """Boolean per sample: th1 or th2 sits at one of the robot's joint limits (as the
+    summary's ``joint_limit_steps`` judges it: :func:`ddwmmr.sim.simulate.joint_limits_held`)."""
+    return joint_limits_held(ts, robot)[0]
 
 
-def _joint_limit_reason(ts: Mapping[str, np.ndarray], limited: np.ndarray) -> str:
+def _joint_limit_reason(
+    ts: Mapping[str, np.ndarray], summary: Mapping[str, Any], limited: np.ndarray
+) -> str:
+    """The first joint limit reached and the commanded steps at a joint limit (the
+    summary's ``joint_limit_steps`` where it has it)."""
     first = int(np.argmax(limited))
     joint = "th2" if abs(ts["th2"][first]) >= abs(ts["th1"][first]) else "th1"
+    steps = summary.get("joint_limit_steps")
+    if steps is None:
+        steps = int(np.sum(commanded_steps(limited)))
     text = (
         f"{'the elbow' if joint == 'th2' else 'the shoulder'} {joint} ran into its joint limit "
         f"({ts[joint][first]:+.2f} rad) at t = {ts['t'][first]:.1f} s and stayed there for "
-        f"{int(np.sum(limited))} steps; the plant stops a joint at its limit, so the commanded "
+        f"{steps} steps; the plant stops a joint at its limit, so the commanded "
         "motion is not produced"
     )
     if joint == "th2":
@@ -88,7 +105,7 @@ def saturated_after_jumps(ts: Mapping[str, np.ndarray], exclude: np.ndarray) -> 
     step of the desired orientation."""
     t = ts["t"]
     jumps = t[1:][np.abs(np.diff(ts["phiE_d"])) > 1.0]
-    saturated = t[(ts["saturated"] > 0) & ~exclude]
+    saturated = commanded_steps(t)[_saturated(ts, exclude)]
     if not len(jumps) or not len(saturated):
         return False
     lag = saturated[:, None] - jumps[None, :]
@@ -129,8 +146,9 @@ def diagnose(
     if jumps and summary["rms_orientation_error_rad"] > 0.5 and onset is None:
         findings.append(Finding(_corner_reason(spec, summary, jumps)))
     limited = at_joint_limit(ts, config.robot)
-    if np.any(limited):
-        findings.append(Finding(_joint_limit_reason(ts, limited)))
+    # a limit reached at the last sample only starts no step: nothing held, nothing to say
+    if np.any(commanded_steps(limited)):
+        findings.append(Finding(_joint_limit_reason(ts, summary, limited)))
     count, first, last = saturation_span(ts, exclude=limited)
     if count:
         where = (
@@ -138,7 +156,7 @@ def diagnose(
             if saturated_after_jumps(ts, limited)
             else f"t = {first:.1f} to {last:.1f} s"
         )
-        more = " more" if np.any(limited) else ""
+        more = " more" if np.any(commanded_steps(limited)) else ""
         findings.append(
             Finding(
                 f"the plant clipped the command at the wheel or joint speed limits in "

@@ -15,13 +15,14 @@ import csv
 import io
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from ddwmmr.reports.compare.constants import SLIDES_ORDER, TIE_ABSOLUTE_M, TIE_RELATIVE
 from ddwmmr.reports.compare.diagnosis import diagnose
 from ddwmmr.reports.compare.plan import CompareConfig, Plan, RunOutput, RunSpec
 from ddwmmr.sim.result import json_safe
+from ddwmmr.sim.verdict import reasons
 
 # -- metrics and ranking ------------------------------------------------------------------
 
@@ -91,6 +92,17 @@ def score(summary: Mapping[str, Any]) -> float:
     return math.inf if math.isnan(value) else value
 
 
+def did_not_track(summary: Mapping[str, Any]) -> bool:
+    """The run did not track: its verdict found a reason (:func:`ddwmmr.sim.verdict.reasons`,
+    the codes the console's "Did not track" list and the tables' "tracked?" column give)."""
+    return bool(reasons(summary))
+
+
+#: The mark of a score whose run did not track (:func:`did_not_track`), and its footnote.
+NOT_TRACKED_MARK = "\u2020"  # a dagger
+NOT_TRACKED_NOTE = f'{NOT_TRACKED_MARK} did not track (docs/cli.md, "Verdict")'
+
+
 def at_least_as_good(a: float, b: float) -> bool:
     """Score ``a`` is better than or tied with ``b`` (see :data:`TIE_RELATIVE`)."""
     return a <= b * (1.0 + TIE_RELATIVE) + TIE_ABSOLUTE_M
@@ -116,12 +128,19 @@ def geometric_mean(values: Iterable[float]) -> float:
 
 @dataclass
 class Ranking:
-    """Scores (m) and ranks per trajectory and overall (see the module docstring)."""
+    """Scores (m) and ranks per trajectory and overall (see the module docstring);
+    ``untracked``: trajectory -> the methods whose run there did not track
+    (:func:`did_not_track`; ranked by their score all the same)."""
 
     scores: dict[str, dict[str, float]]
     ranks: dict[str, dict[str, int]]
     overall: dict[str, float]
     overall_rank: dict[str, int]
+    untracked: dict[str, frozenset[str]] = field(default_factory=dict)
+
+    def tracked(self, name: str, method: str) -> bool:
+        """``method``'s run on the trajectory ``name`` tracked (or was not judged)."""
+        return method not in self.untracked.get(name, frozenset())
 
     @property
     def order(self) -> list[str]:
@@ -135,8 +154,13 @@ def build_ranking(
     """Rank the main runs (or ``specs``, e.g. ``plan.alternative``) by :func:`score`, per
     trajectory and by geometric mean."""
     scores: dict[str, dict[str, float]] = {}
+    untracked: dict[str, set[str]] = {}
     for spec in plan.main if specs is None else specs:
-        scores.setdefault(spec.trajectory, {})[spec.method] = score(outputs[spec].summary)
+        summary = outputs[spec].summary
+        scores.setdefault(spec.trajectory, {})[spec.method] = score(summary)
+        failed = untracked.setdefault(spec.trajectory, set())
+        if did_not_track(summary):
+            failed.add(spec.method)
     methods = list(next(iter(scores.values())))
     overall = {m: geometric_mean(scores[n][m] for n in scores) for m in methods}
     return Ranking(
@@ -144,6 +168,7 @@ def build_ranking(
         ranks={n: rank_with_ties(s) for n, s in scores.items()},
         overall=overall,
         overall_rank=rank_with_ties(overall),
+        untracked={n: frozenset(m) for n, m in untracked.items()},
     )
 
 

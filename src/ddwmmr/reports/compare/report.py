@@ -57,6 +57,8 @@ from ddwmmr.reports.compare.plan import (
     tau_methods,
 )
 from ddwmmr.reports.compare.ranking import (
+    NOT_TRACKED_MARK,
+    NOT_TRACKED_NOTE,
     Ranking,
     SlidesCheck,
     build_ranking,
@@ -257,20 +259,44 @@ def _obstacle_items(config: CompareConfig) -> list[str]:
 def ranking_table(
     ranking: Ranking, shown: Callable[[str], str] = str
 ) -> tuple[list[str], list[list[str]]]:
-    """Headers and rows of the ranking table (RMS position error in mm, rank in brackets);
-    ``shown`` gives a trajectory key's shown name (:meth:`CompareConfig.shown`)."""
+    """Headers and rows of the ranking table (RMS position error in mm, rank in brackets,
+    :data:`NOT_TRACKED_MARK` after the score of a run that did not track: see
+    :func:`ranking_footnote`); ``shown`` gives a trajectory key's shown name
+    (:meth:`CompareConfig.shown`)."""
     names = list(ranking.scores)
     headers = ["rank", "method", *[f"{shown(n)} RMS (mm)" for n in names], "overall (mm)"]
     rows = [
         [
             str(ranking.overall_rank[m]),
             m,
-            *[f"{mm(ranking.scores[n][m])} ({ranking.ranks[n][m]})" for n in names],
+            *[
+                f"{mm(ranking.scores[n][m])}{_mark(ranking.tracked(n, m))} ({ranking.ranks[n][m]})"
+                for n in names
+            ],
             mm(ranking.overall[m]),
         ]
         for m in ranking.order
     ]
     return headers, rows
+
+
+def _mark(tracked: bool) -> str:
+    """:data:`NOT_TRACKED_MARK` for a run that did not track, else nothing."""
+    return "" if tracked else NOT_TRACKED_MARK
+
+
+def ranking_footnote(ranking: Ranking) -> str:
+    """The footnote under :func:`ranking_table`: :data:`NOT_TRACKED_NOTE` when a score is
+    marked, ``""`` when every ranked run tracked."""
+    return NOT_TRACKED_NOTE if any(ranking.untracked.values()) else ""
+
+
+def _ranking_table(c: _Context, ranking: Ranking) -> None:
+    """The ranking table with its footnote, if any."""
+    c.doc.table(*ranking_table(ranking, c.config.shown))
+    note = ranking_footnote(ranking)
+    if note:
+        c.doc.paragraph(note + ".")
 
 
 def _ranking_section(c: _Context, ranking: Ranking) -> None:
@@ -284,20 +310,42 @@ def _ranking_section(c: _Context, ranking: Ranking) -> None:
         "geometric mean of the per-trajectory scores (errors span orders of magnitude). The "
         f"per-trajectory rank is in brackets. Settings: preset `{c.config.preset}`."
     )
-    c.doc.table(*ranking_table(ranking, c.config.shown))
+    _ranking_table(c, ranking)
 
 
 def _advice_section(c: _Context, ranking: Ranking, slides_ranking: Ranking) -> None:
     c.doc.heading("Which method should I use?")
-    items = advice.profiles(c.config, c.outputs, ranking)
+    items = advice.profiles(c.config, c.outputs, ranking, c.plan.plants)
     c.doc.paragraph(
-        "From the main runs above: accuracy (the score), the median controller step on this "
-        "machine (a timing: it varies between runs and machines), whether the initial offset "
-        "is removed, whether tip-over stability is a hard constraint, and what the shoulder "
-        "singularity cos th1 = 0 does to the run."
+        "From the main runs above: accuracy (the score), the controller step on this "
+        "machine (the median over the trajectories of each run's median step; a timing: it "
+        "varies between runs and machines), whether the initial offset is removed, whether "
+        "tip-over stability is a hard constraint, and what the shoulder singularity "
+        "cos th1 = 0 does to the run." + _plant_scope(list(c.plan.plants))
     )
     c.doc.table(advice.ADVICE_HEADERS, advice.advice_rows(items), left=advice.ADVICE_TEXT)
+    if advice.marked(items):
+        c.doc.paragraph(NOT_TRACKED_NOTE + ".")
     c.doc.bullets(advice.recommendations(items, slides_ranking, _corners_reached(c.config)))
+
+
+def _plant_scope(plants: Sequence[str]) -> str:
+    """The advice's sentence on the runs on the extra ``plants`` (``--plant``); ``""``
+    without any."""
+    if not plants:
+        return ""
+    several = "s" * (len(plants) > 1)
+    titles = ", ".join(f'"{_plant_title(p)}"' for p in plants)
+    return (
+        " The lines below are judged on the kinematic plant; each also names the runs of its "
+        f"methods that did not track, there and on the {' and '.join(plants)} plant{several} "
+        f"(section{several} {titles})."
+    )
+
+
+def _sentence(text: str) -> str:
+    """``text`` with its first letter capitalised and a full stop."""
+    return text[:1].upper() + text[1:] + "."
 
 
 def _corners_reached(config: CompareConfig) -> bool:
@@ -340,7 +388,7 @@ def _presets_section(c: _Context, rankings: Mapping[str, tuple[Ranking, SlidesCh
         ranking, check = rankings[preset]
         label = "the slides' settings" if preset == "slides" else "our settings"
         c.doc.heading(f"Ranking under {label} (preset `{preset}`)", 3)
-        c.doc.table(*ranking_table(ranking, c.config.shown))
+        _ranking_table(c, ranking)
         shown = c.config.shown
         c.doc.paragraph(" ".join([slides_verdict(check, shown), *failing_pairs(check, shown)]))
 
@@ -606,22 +654,15 @@ PLANT_GAP = 1.5
 LAG_M_S, SLIP_M_S, SATURATED_SHARE = 0.005, 0.05, 0.01
 
 
+def _plant_title(plant: str) -> str:
+    """The heading of ``plant``'s section."""
+    return f"Plant: {plant} next to the kinematic plant"
+
+
 def _plant_section(c: _Context, plant: str) -> None:
     """The main comparison repeated on ``plant``, next to the kinematic plant, with the
     measured reasons for the difference (velocity lag, torque saturation, wheel slip)."""
-    c.doc.heading(f"Plant: {plant} next to the kinematic plant")
-    c.doc.paragraph(
-        f"Every method of the comparison, same trajectories, robot and start, on the {plant} "
-        "plant (its own dynamics: velocity commands go to velocity servos, so the base lags "
-        "and may saturate or slip; a method that sends wheel forces there, as mpc does on a "
-        "plant that judges tipping by its physics, drives the motors itself) and on the "
-        "kinematic plant (the command is the motion). "
-        "Lag is the RMS difference between the commanded and the measured forward speed "
-        "('-' for wheel-force commands, which command no speed); "
-        "'actuator-limited' the share of the run with a motor at its torque limit (or a "
-        "wheel at its force limit); slip the peak speed of a wheel's contact point over the "
-        "floor (physics only)."
-    )
+    c.doc.heading(_plant_title(plant))
     runs = dict(zip(c.plan.main, c.plan.plants[plant]))
     # the support columns where the plant reports its support loads (MuJoCo)
     support = any(SUPPORT_KEY in c.run(spec).summary for spec in runs.values())
@@ -657,11 +698,20 @@ def _plant_section(c: _Context, plant: str) -> None:
             where = c.config.shown(spec.trajectory)
             reasons.append(_plant_reason(spec, where, ratio, lag, saturated, slip))
     headers = [
-        "trajectory", "method", "RMS kinematic (mm)", f"RMS {plant} (mm)", "x",
+        "trajectory", "method", "RMS kinematic (mm)", f"RMS {plant} (mm)", RATIO_HEADER,
         f"final {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)", "min S",
         "min physics S", "tipped", *(SUPPORT_HEADERS if support else ()),
         "tracked? (docs/cli.md, Verdict)",
     ]  # fmt: skip
+    headers, rows = _filled_columns(headers, rows)
+    notes = [text.format(plant=plant) for h, text in PLANT_COLUMN_NOTES.items() if h in headers]
+    c.doc.paragraph(
+        f"Every method of the comparison, same trajectories, robot and start, on the {plant} "
+        "plant (its own dynamics: velocity commands go to velocity servos, so the base lags "
+        "and may saturate or slip; a method that sends wheel forces there, as mpc does on a "
+        "plant that judges tipping by its physics, drives the motors itself) and on the "
+        "kinematic plant (the command is the motion). " + _sentence("; ".join(notes))
+    )
     c.doc.table(headers, rows)
     c.doc.paragraph(
         "Where the error grows by more than "
@@ -683,6 +733,33 @@ def _plant_section(c: _Context, plant: str) -> None:
             f"{c.config.shown(name)}: position error per method on the {plant} plant (solid) "
             "and on the kinematic plant (dashed).",
         )
+
+
+#: The plant table's column of the RMS error on the plant over the kinematic plant's.
+RATIO_HEADER = "RMS ratio to kinematic"
+#: The plant section's note on each column it explains, written when the table has it.
+PLANT_COLUMN_NOTES = {
+    RATIO_HEADER: "the RMS ratio to kinematic is the RMS error on the {plant} plant over the "
+    "RMS error of the same run on the kinematic plant",
+    "lag (mm/s)": "lag the RMS difference between the commanded and the measured forward "
+    "speed ('-' for wheel-force commands, which command no speed)",
+    "actuator-limited": "'actuator-limited' the share of the run with a motor at its torque "
+    "limit (or a wheel at its force limit)",
+    "slip (mm/s)": "slip the peak speed of a wheel's contact point over the floor (physics only)",
+}
+#: A table cell that holds no value (:func:`fmt` of a missing one, or a column's own '-').
+EMPTY_CELLS = ("-", "n/a")
+
+
+def _filled_columns(
+    headers: Sequence[str], rows: Sequence[Sequence[str]]
+) -> tuple[list[str], list[list[str]]]:
+    """``headers`` and ``rows`` without the columns that no row fills (every cell one of
+    :data:`EMPTY_CELLS`: the plant does not measure it, e.g. slip on the thesis plant)."""
+    if not rows:
+        return list(headers), []
+    keep = [i for i in range(len(headers)) if any(r[i] not in EMPTY_CELLS for r in rows)]
+    return [headers[i] for i in keep], [[r[i] for i in keep] for r in rows]
 
 
 def _plant_verdicts(c: _Context, plant: str) -> None:
