@@ -18,6 +18,7 @@ import pytest
 from ddwmmr import Ellipse, Robot, make_controller, simulate
 from ddwmmr.errors import ParameterError
 from ddwmmr.resolution import kernels
+from test_damping_scale import ats_band
 
 DEFAULT = Robot()
 LENGTHS = (
@@ -101,19 +102,6 @@ def test_the_large_robot_of_the_probe_is_damped_only_where_the_default_one_is():
     summary = simulate(large, Ellipse(a=20.0, b=15.0), "pi", duration=5.0).summary
     assert summary["steps"] == 250
     assert summary["singular_steps"] == 0
-
-
-def ats_band(robot: Robot, **options) -> float:
-    """Largest |cos th1| at which the ats controller of ``robot`` damps (bisection on the
-    singular flag, th2 = 0.5 rad, heading 0, unit speed along x)."""
-    controller = make_controller("ats", robot, **options)
-    inside, outside = 0.0, 1.0
-    for _ in range(40):
-        middle = 0.5 * (inside + outside)
-        q = [0.0, 0.0, 0.0, math.acos(middle), 0.5]
-        _, singular = controller.law(0.0, q, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0])
-        inside, outside = (middle, outside) if singular else (inside, middle)
-    return inside
 
 
 @pytest.mark.parametrize("factor", [1e-6 / DEFAULT.L2, 0.2, 5.0])

@@ -18,43 +18,9 @@ from ddwmmr.plants.mujoco.model import (
     tyre_stiffness,
 )
 from ddwmmr.sim.verdict import TIPPED, likely_cause
+from scaled_robots import TEN_TIMES, TWENTIETH
 
-#: The default robot ten times as long, 1000 times as heavy (its motors scaled to match).
-LARGE = Robot(
-    L1=3.5,
-    L2=3.0,
-    wheel_radius=0.975,
-    track_width=3.5,
-    base_length=4.5,
-    base_width=3.5,
-    base_mass=10000.0,
-    base_inertia=50000.0,
-    link_masses=(1000.0, 1000.0),
-    payload=1250.0,
-    wheel_mass=500.0,
-    base_height=2.0,
-    arm_height=3.5,
-    wheel_torque_limit=20000.0,
-    joint_torque_limits=(200000.0, 100000.0),
-)
-#: The default robot a twentieth as long (masses scaled by length cubed).
-SMALL = Robot(
-    L1=0.0175,
-    L2=0.015,
-    wheel_radius=0.004875,
-    track_width=0.0175,
-    base_length=0.0225,
-    base_width=0.0175,
-    base_mass=0.00125,
-    base_inertia=1.5625e-07,
-    link_masses=(0.000125, 0.000125),
-    payload=0.00015625,
-    wheel_mass=6.25e-05,
-    base_height=0.01,
-    arm_height=0.0175,
-    wheel_torque_limit=1.25e-05,
-    joint_torque_limits=(0.000125, 6.25e-05),
-)
+LARGE, SMALL = TEN_TIMES, TWENTIETH
 
 
 def test_the_default_robot_keeps_its_tyre_stiffness_at_any_payload():

@@ -19,6 +19,7 @@ from ddwmmr.errors import MAX_STEPS, ParameterError, check_step_count
 from ddwmmr.model.stability import max_payload
 from ddwmmr.reports.plots import plot_errors
 from ddwmmr.sim.simulate import simulate, tipping_message
+from scaled_robots import TWENTIETH
 
 # -- the step cap ----------------------------------------------------------------------
 
@@ -38,24 +39,8 @@ def test_a_real_excess_is_still_refused(duration, dt):
 
 # -- the heaviest payload of a small robot ---------------------------------------------
 
-#: A robot at 1/40 of the default's size and 1/8000 of its masses: it holds under a gram.
-TINY = Robot(
-    L1=0.0175,
-    L2=0.015,
-    wheel_radius=0.004875,
-    track_width=0.0175,
-    base_length=0.0225,
-    base_width=0.0175,
-    base_mass=0.00125,
-    base_inertia=1.5625e-07,
-    link_masses=(0.000125, 0.000125),
-    payload=0.00015625,
-    wheel_mass=6.25e-05,
-    base_height=0.01,
-    arm_height=0.0175,
-    wheel_torque_limit=1.25e-05,
-    joint_torque_limits=(0.000125, 6.25e-05),
-)
+#: The default robot a twentieth as long (masses by the cube): it holds under a gram.
+TINY = TWENTIETH
 
 
 def _s(robot: Robot, payload: float) -> float:

@@ -1,0 +1,41 @@
+"""Robots at other sizes than the default, scaled as a physical robot scales: lengths by
+``s``, masses by ``s^3``, the base's yaw inertia by ``s^5``, torque limits by ``s^4``."""
+
+from ddwmmr import Robot
+
+#: The default robot ten times as long, 1000 times as heavy (its motors scaled to match).
+TEN_TIMES = Robot(
+    L1=3.5,
+    L2=3.0,
+    wheel_radius=0.975,
+    track_width=3.5,
+    base_length=4.5,
+    base_width=3.5,
+    base_mass=10000.0,
+    base_inertia=50000.0,
+    link_masses=(1000.0, 1000.0),
+    payload=1250.0,
+    wheel_mass=500.0,
+    base_height=2.0,
+    arm_height=3.5,
+    wheel_torque_limit=20000.0,
+    joint_torque_limits=(200000.0, 100000.0),
+)
+#: The default robot a twentieth as long (masses scaled by length cubed).
+TWENTIETH = Robot(
+    L1=0.0175,
+    L2=0.015,
+    wheel_radius=0.004875,
+    track_width=0.0175,
+    base_length=0.0225,
+    base_width=0.0175,
+    base_mass=0.00125,
+    base_inertia=1.5625e-07,
+    link_masses=(0.000125, 0.000125),
+    payload=0.00015625,
+    wheel_mass=6.25e-05,
+    base_height=0.01,
+    arm_height=0.0175,
+    wheel_torque_limit=1.25e-05,
+    joint_torque_limits=(0.000125, 6.25e-05),
+)
