@@ -146,3 +146,19 @@ def test_the_step_time_says_it_is_a_median_over_the_trajectories(thesis_report):
     assert qp.step_us == pytest.approx(float(np.median(steps)), rel=1e-12)
     line = next(x for x in recommendations(items) if x.startswith("**Tightest"))
     assert " us per step, median over both trajectories, on this machine;" in line
+
+
+def test_the_mark_prints_on_a_console_that_cannot_show_it():
+    """A latin-1 or ASCII stdout ended compare with a UnicodeEncodeError after the runs."""
+    from types import SimpleNamespace
+
+    from ddwmmr.cli.common import console_text
+
+    text = "134\u2020 (2)\n\u2020 did not track; 5 \u00b5m"
+    assert console_text(text, SimpleNamespace(encoding="utf-8")) == text
+    assert console_text(text, SimpleNamespace(encoding="latin-1")) == (
+        "134+ (2)\n+ did not track; 5 \u00b5m"
+    )
+    assert console_text(text, SimpleNamespace(encoding="ascii")) == (
+        "134+ (2)\n+ did not track; 5 ?m"
+    )

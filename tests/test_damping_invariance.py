@@ -120,9 +120,15 @@ def test_the_defaults_and_a_given_value_mean_the_same_band_on_every_size(factor)
 @pytest.mark.parametrize("L1", [0.0, -0.35, math.nan, math.inf, 1e-310, 1e-7, 2e3])
 def test_a_first_link_that_is_no_length_is_refused_by_the_kernels(L1):
     """Outside the robot's length range (1e-310 m made L2 / unit overflow to a NaN command)."""
-    with pytest.raises(ParameterError, match=r"^L1 must be a length in \[1e-06, 1000\] m \(got "):
+    with pytest.raises(
+        ParameterError, match=r"^L1 must be (a finite number )?in \[1e-06, 1000\] m \(got "
+    ):
         kernels.pseudoinverse(L1, 0.3, 0.0, 0.1, 0.2, 0.1, 0.0, 0.0)
-    with pytest.raises(ParameterError, match=r"^L1 must be a length in \[1e-06, 1000\] m"):
+    with pytest.raises(
+        ParameterError, match=r"^L1 must be (a finite number )?in \[1e-06, 1000\] m"
+    ):
         kernels.ats(L1, 0.3, 0.0, 0.1, 0.2, 0.1, 0.0, 0.0)
-    with pytest.raises(ParameterError, match=r"^L1 must be a length in \[1e-06, 1000\] m"):
+    with pytest.raises(
+        ParameterError, match=r"^L1 must be (a finite number )?in \[1e-06, 1000\] m"
+    ):
         kernels.damping_options(L1)

@@ -208,3 +208,20 @@ def test_fix_state_bars_have_the_state_colour_of_the_time_figure(runs, drawn, tm
         assert {to_rgba(p.get_facecolor()) for p in ax.patches} == {
             to_rgba(report.STABILITY_COLOUR)
         }
+
+
+def test_a_long_paths_title_is_wrapped_to_fit_its_figure(runs, drawn, tmp_path):
+    """The default batch's title (125 characters) was cut at both edges of the figure."""
+    title = (
+        "thesis controller, thesis plant: paths of scenarios 1, 2 (the first two) and 31 "
+        "(the most fix-state entries) of 100 scenarios run"
+    )
+    report.plot_paths(runs["thesis"][:1], tmp_path / "p.png", title)
+    fig = drawn[0]
+    fig.canvas.draw()
+    shown = fig._suptitle
+    assert shown.get_text().replace("\n", " ") == title and "\n" in shown.get_text()
+    box = shown.get_window_extent(fig.canvas.get_renderer())
+    assert box.x0 >= 0.0 and box.x1 <= fig.bbox.width
+    report.plot_paths(runs["thesis"][:1], tmp_path / "q.png", "t: a short title")
+    assert drawn[1]._suptitle.get_text() == "t: a short title"

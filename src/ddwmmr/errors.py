@@ -23,8 +23,9 @@ from typing import Any, NoReturn
 
 import numpy as np
 
-#: Most simulation steps of one run. The recorded time series holds 29 float64 columns per
-#: step, so a run at the cap keeps about 230 MB in memory (and timeseries.csv ~500 MB).
+#: Most simulation steps of one run. The recorded time series holds 31 float64 columns per
+#: step (kinematic plant), so a run at the cap keeps about 250 MB of it in memory (and
+#: timeseries.csv ~500 MB, written in blocks).
 MAX_STEPS = 1_000_000
 #: Most worker processes any tool's --jobs may ask for (compare, scenarios, bench).
 MAX_JOBS = 256

@@ -59,6 +59,7 @@ __all__ = [
     "built_plant",
     "check_output_folder",
     "check_plant_option_names",
+    "console_text",
     "first_free",
     "given_text",
     "horizon_defaults",
@@ -350,6 +351,29 @@ def one_line_warnings() -> Iterator[None]:
         yield
     finally:
         warnings.showwarning = previous
+
+
+#: Stand-ins for the non-ASCII marks the tools print, on a console that cannot show them.
+_ASCII_MARKS = {"\u2020": "+"}
+
+
+def console_text(text: str, stream: object = None) -> str:
+    """``text`` as ``stream`` (default ``sys.stdout``) can print it: unchanged where its
+    encoding holds every character, else with each mark of :data:`_ASCII_MARKS` replaced
+    by its ASCII stand-in and any other character the encoding lacks by ``?`` (a latin-1
+    or ASCII console would otherwise end the tool with a UnicodeEncodeError)."""
+    encoding = getattr(stream if stream is not None else sys.stdout, "encoding", None)
+    if not encoding:
+        return text
+    try:
+        text.encode(encoding)
+    except UnicodeEncodeError:
+        for mark, stand_in in _ASCII_MARKS.items():
+            text = text.replace(mark, stand_in)
+        return text.encode(encoding, errors="replace").decode(encoding)
+    except LookupError:  # an encoding Python does not know: leave the text to print's rules
+        return text
+    return text
 
 
 def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:

@@ -27,6 +27,7 @@ from ddwmmr.cli.common import (
     add_option_argument,
     add_robot_arguments,
     check_output_folder,
+    console_text,
     given_text,
     horizon_defaults,
     horizon_range,
@@ -620,7 +621,7 @@ def _main(argv: Sequence[str] | None) -> int:
     seconds = time.perf_counter() - start
     failures = not_tracked(plan, outputs, config.shown)
     runs = runs_text(plan, len(specs))
-    print(format_summary(info, out, runs, seconds, jobs, failures, config.shown))
+    print(console_text(format_summary(info, out, runs, seconds, jobs, failures, config.shown)))
     return 0
 
 

@@ -109,10 +109,7 @@ def length_unit(L1: float) -> float:
     ``L1 / Robot.L1``, so that its first link is the default robot's (exactly 1.0 for the
     default robot). ``L1`` (m) must be in ``LENGTH_RANGE_M``, the robot's, else a one-line
     ParameterError."""
-    low, high = LENGTH_RANGE_M
-    if not low <= L1 <= high:
-        raise ParameterError(f"L1 must be a length in [{low:g}, {high:g}] m (got {L1!r})")
-    return L1 / _DEFAULT_L1
+    return check_range("L1", L1, *LENGTH_RANGE_M, "m") / _DEFAULT_L1
 
 
 def _in_length_unit(

@@ -433,7 +433,7 @@ def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
     and plant).
 
     Controllers without states move base and arm together, so their times overlap: they
-    are drawn as grouped bars (total, base moving, arm moving) instead of stacked, titled
+    are drawn as grouped bars (total, moving base, moving arm) instead of stacked, titled
     ``"<title>: total time; time moving: base / arm"``. Each time share has its colour
     (:data:`TIME_COLOURS`); bars of scenarios that did not finish are hatched
     (:data:`FAILED_HATCH`); the legend sits beside the axes.
@@ -562,7 +562,7 @@ def plot_paths(
         ax.set(aspect="equal", title=heading, xlabel="x (m)", ylabel="y (m)")
     for ax in list(axes.flat)[len(items) :]:
         ax.axis("off")
-    fig.suptitle(title)
+    fig.suptitle(_fitted(title, fig))
     named: dict[str, Any] = {}
     for ax in axes.flat:  # each kind once, in drawing order
         for handle, label in zip(*ax.get_legend_handles_labels()):
@@ -607,6 +607,14 @@ def _closest_approach(ax, trace: dict, obstacles, clearance: float) -> float:
     circle.set_label(label)
     ax.add_patch(circle)
     return float(np.min(gaps[k]))
+
+
+def _fitted(title: str, fig: Any) -> str:
+    """``title`` wrapped onto as many lines as the width of ``fig`` needs at the default
+    title size (about 0.6 of the 12 pt font per character): a suptitle wider than its
+    figure is cut at both edges."""
+    width = int(fig.get_figwidth() * 72.0 / (0.6 * 12.0))
+    return "\n".join(textwrap.wrap(title, width=width)) if len(title) > width else title
 
 
 def plot_timeline(
