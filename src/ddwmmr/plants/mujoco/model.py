@@ -227,8 +227,9 @@ def tyre_stiffness(robot: Robot, options: EngineOptions) -> float:
     robot's. A load shift that is the same share of the weight then tilts the base by the
     same angle on a robot of any size (the tip rule is an angle); the tyre's natural
     frequency is then the default robot's times about ``sqrt(0.35 m / track_width)``
-    (docs/physics.md, "The model, generated from Robot"). Exactly :data:`DEFAULT_TYRE_STIFFNESS` for the default robot
-    at any payload; not held to :data:`TYRE_STIFFNESS_RANGE` (the range a user may set).
+    (docs/physics.md, "The model, generated from Robot"). Exactly
+    :data:`DEFAULT_TYRE_STIFFNESS` for the default robot at any payload; not held to
+    :data:`TYRE_STIFFNESS_RANGE` (the range a user may set).
     """
     if options.tyre_stiffness is not None:
         return options.tyre_stiffness
