@@ -153,3 +153,17 @@ def test_path_draws_the_final_pose_on_a_closed_path_in_greys():
     levels = [r for r, _, _ in greys]
     assert levels == sorted(levels, reverse=True) and levels[0] - levels[-1] > 0.5
     plt.close(fig)
+
+
+def test_snapshot_greys_skip_the_base_paths_grey():
+    """A robot drawn in the base path's 0.45 grey read as the base line (legend included)."""
+    from ddwmmr.reports import palette
+
+    low, high = palette.SNAPSHOT_SKIP
+    base = float(palette.BASE)
+    assert low < base < high
+    for count in (2, 3, 6, 10):
+        levels = [float(c) for c in plots.snapshot_colors(count)]
+        assert levels == sorted(levels, reverse=True) and len(set(levels)) == count
+        assert levels[0] == palette.SNAPSHOT_GREYS[0] and levels[-1] == pytest.approx(0.08)
+        assert all(not low < level < high for level in levels)

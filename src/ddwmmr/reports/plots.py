@@ -19,6 +19,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ddwmmr.model import Robot
+from ddwmmr.reports import palette
 from ddwmmr.reports.legends import legend_beside, place_legend
 
 FIGURE_NAMES = ("path.png", "errors.png", "rates.png", "metrics.png")
@@ -30,7 +31,6 @@ PNG_METADATA = {"Software": None}
 ERROR_FLOOR = 1e-12
 #: Grey levels (0 black, 1 white) of the first and the last robot drawn on a path: light
 #: to dark over time, a ramp no path or method line uses.
-SNAPSHOT_GREYS = (0.72, 0.08)
 
 
 def robot_outline(robot: Robot, q) -> dict[str, np.ndarray]:
@@ -92,10 +92,15 @@ def footprint_spacing(robot: Robot) -> float:
 
 
 def snapshot_colors(count: int) -> list[str]:
-    """One grey per drawn instant, light (first) to dark (last) between the levels of
-    :data:`SNAPSHOT_GREYS`: time reads as darkening, in no hue of a path or method line."""
-    first, last = SNAPSHOT_GREYS
-    return [f"{first + (last - first) * i / max(count - 1, 1):.3f}" for i in range(count)]
+    """One grey per drawn instant, light (first) to dark (last), evenly spaced over the
+    levels of :data:`~ddwmmr.reports.palette.SNAPSHOT_GREYS` without the band
+    :data:`~ddwmmr.reports.palette.SNAPSHOT_SKIP` around the base path's grey: time reads
+    as darkening, in no hue of a path or method line and not in the base's grey."""
+    first, last = palette.SNAPSHOT_GREYS
+    low, high = palette.SNAPSHOT_SKIP
+    span = (first - high) + (low - last)  # the levels used, above and below the band
+    levels = (first - span * i / max(count - 1, 1) for i in range(count))
+    return [f"{level if level >= high else level - (high - low):.3f}" for level in levels]
 
 
 def draw_snapshots(
@@ -179,10 +184,17 @@ def plot_path(result, ax: Axes | None = None, snapshots: int = 6, obstacles=None
     indices = snapshot_indices(ts, snapshots, footprint_spacing(result.robot))
     robots = draw_snapshots(ax, result.robot, ts, indices, lw=0.9)
     # The desired path on top of the actual one, dashed: visible where they coincide.
-    ax.plot(ts["xE"], ts["yE"], color="tab:blue", lw=2.2, alpha=0.8, label="actual end effector")
+    ax.plot(
+        ts["xE"],
+        ts["yE"],
+        color=palette.END_EFFECTOR,
+        lw=2.2,
+        alpha=0.8,
+        label="actual end effector",
+    )
     ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=1, label="desired end effector")
-    ax.plot(ts["x"], ts["y"], color="0.45", lw=1, label="base (axle midpoint)")
-    ax.plot(ts["xE"][0], ts["yE"][0], "o", color="tab:blue", ms=5, label="start")
+    ax.plot(ts["x"], ts["y"], color=palette.BASE, lw=1, label="base (axle midpoint)")
+    ax.plot(ts["xE"][0], ts["yE"][0], "o", color=palette.END_EFFECTOR, ms=5, label="start")
     outline = outline_points(result.robot, ts, indices)
     circles = np.array(circles_of(obstacles)).reshape(-1, 3)
     fit_equal(

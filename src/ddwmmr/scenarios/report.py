@@ -16,6 +16,7 @@ from ddwmmr.arbiters.state_machine import STATES
 from ddwmmr.behaviours.obstacle import bubble_gap
 from ddwmmr.errors import ParameterError, check_int_at_least, one_line
 from ddwmmr.outputs import write_atomic
+from ddwmmr.reports import palette
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import (
     FINE_TRACE_DISTANCE,
@@ -310,8 +311,8 @@ def _cell(value: Any) -> str:
 # One palette for the scenario figures (paths, timeline, times, arbiter weights): a colour
 # or line style means the same thing in each of them, and the base and the end effector
 # are drawn as in track's path figure (ddwmmr.reports.plots: end effector blue, base grey).
-BASE_COLOUR = "0.45"
-EFFECTOR_COLOUR = "tab:blue"
+BASE_COLOUR = palette.BASE
+EFFECTOR_COLOUR = palette.END_EFFECTOR
 STABILITY_COLOUR = "tab:brown"
 MANIPULABILITY_COLOUR = "tab:purple"
 OBSTACLE_COLOUR = "tab:olive"
@@ -562,7 +563,7 @@ def plot_paths(
         ax.set(aspect="equal", title=heading, xlabel="x (m)", ylabel="y (m)")
     for ax in list(axes.flat)[len(items) :]:
         ax.axis("off")
-    fig.suptitle(_fitted(title, fig))
+    fig.suptitle(title, fontsize=_fitting_size(title, fig))
     named: dict[str, Any] = {}
     for ax in axes.flat:  # each kind once, in drawing order
         for handle, label in zip(*ax.get_legend_handles_labels()):
@@ -609,12 +610,18 @@ def _closest_approach(ax, trace: dict, obstacles, clearance: float) -> float:
     return float(np.min(gaps[k]))
 
 
-def _fitted(title: str, fig: Any) -> str:
-    """``title`` wrapped onto as many lines as the width of ``fig`` needs at the default
-    title size (about 0.6 of the 12 pt font per character): a suptitle wider than its
-    figure is cut at both edges."""
-    width = int(fig.get_figwidth() * 72.0 / (0.6 * 12.0))
-    return "\n".join(textwrap.wrap(title, width=width)) if len(title) > width else title
+#: Largest and smallest font size (pt) of a figure title; an average character is about
+#: 0.6 of the font size wide.
+_TITLE_POINTS = (12.0, 8.0)
+
+
+def _fitting_size(title: str, fig: Any) -> float:
+    """The font size (pt) at which ``title`` fits on one line across ``fig``: the default
+    12 pt where it fits, smaller down to 8 pt for a long one (a suptitle wider than its
+    figure is cut at both edges; wrapping it instead would shrink the panels under it)."""
+    largest, smallest = _TITLE_POINTS
+    fitting = fig.get_figwidth() * 72.0 / (0.6 * max(len(title), 1))
+    return max(smallest, min(largest, fitting))
 
 
 def plot_timeline(
