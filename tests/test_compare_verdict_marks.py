@@ -80,7 +80,7 @@ def test_the_advice_names_where_a_recommended_method_did_not_track(thesis_report
     assert best.endswith(f"Did not track {VERDICT}: `qp` on the rectangle (thesis plant).")
     blind = next(x for x in lines if x.startswith("- **No pose measurement"))
     assert blind.endswith(
-        f"Did not track {VERDICT}: `ats` on the rectangle and the rectangle (thesis plant)."
+        f"Did not track {VERDICT}: `ats` on the rectangle (kinematic and thesis plants)."
     )
     assert (
         'there and on the thesis plant (section "Plant: thesis next to the kinematic plant").'
@@ -162,3 +162,18 @@ def test_the_mark_prints_on_a_console_that_cannot_show_it():
     assert console_text(text, SimpleNamespace(encoding="ascii")) == (
         "134+ (2)\n+ did not track; 5 ?m"
     )
+
+
+def test_a_caveat_names_the_settings_and_groups_plants_by_trajectory():
+    """The slides line's failures are of the slides-preset runs (the default clrrmc-ts
+    tracks the rectangle); one trajectory's kinematic and plant runs read as one place."""
+    from ddwmmr.reports.compare import advice
+
+    slides = advice._did_not_track([("clrrmc-ts", [("rectangle", None)])], str, " under x")
+    assert slides == f" Did not track under x {VERDICT}: `clrrmc-ts` on the rectangle."
+    runs = [("rectangle", None), ("ellipse", "mujoco"), ("rectangle", "thesis")]
+    assert advice._did_not_track([("ats", runs)], str) == (
+        f" Did not track {VERDICT}: `ats` on the rectangle (kinematic and thesis plants) "
+        "and the ellipse (mujoco plant)."
+    )
+    assert advice._did_not_track([("ats", [])], str) == ""

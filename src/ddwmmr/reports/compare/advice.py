@@ -245,7 +245,7 @@ def recommendations(
         lines.append(
             "**Reproducing the slides**: `--preset slides` (their auxiliary row and gains); the "
             f"best of their methods under their settings is `{best}` ({scores})."
-            + _did_not_track([(best, failed)], shown)
+            + _did_not_track([(best, failed)], shown, " under `--preset slides`")
         )
     return lines
 
@@ -321,19 +321,41 @@ def _caveat(named: Sequence[Profile]) -> str:
 
 
 def _did_not_track(
-    named: Sequence[tuple[str, Sequence[tuple[str, str | None]]]], shown: Callable[[str], str]
+    named: Sequence[tuple[str, Sequence[tuple[str, str | None]]]],
+    shown: Callable[[str], str],
+    under: str = "",
 ) -> str:
-    """`` Did not track (docs/cli.md, "Verdict"): `ats` on the rectangle and the rectangle
-    (thesis plant).``: per method of ``named`` its runs, (trajectory key, plant or None
-    for the kinematic main run), that did not track; ``""`` when all tracked. ``shown``
-    gives a trajectory key's shown name."""
+    """`` Did not track (docs/cli.md, "Verdict"): `ats` on the rectangle (kinematic and
+    thesis plants).``: per method of ``named`` its runs, (trajectory key, plant or None
+    for the kinematic main run), that did not track, grouped by trajectory; ``""`` when all
+    tracked. ``shown`` gives a trajectory key's shown name; ``under`` names the settings of
+    the runs when they are not the report's main ones (`` under `--preset slides` ``)."""
     parts = [
-        f"`{method}` on "
-        + _and([f"the {shown(n)}" + (f" ({plant} plant)" if plant else "") for n, plant in runs])
-        for method, runs in named
-        if runs
+        f"`{method}` on " + _and(_by_trajectory(runs, shown)) for method, runs in named if runs
     ]
-    return f' Did not track (docs/cli.md, "Verdict"): {"; ".join(parts)}.' if parts else ""
+    if not parts:
+        return ""
+    return f' Did not track{under} (docs/cli.md, "Verdict"): {"; ".join(parts)}.'
+
+
+def _by_trajectory(
+    runs: Sequence[tuple[str, str | None]], shown: Callable[[str], str]
+) -> list[str]:
+    """``["the rectangle (kinematic and thesis plants)", "the ellipse"]``: each trajectory
+    of ``runs`` once, with the plants its runs were on (none named: the kinematic plant
+    only)."""
+    plants: dict[str, list[str | None]] = {}
+    for name, plant in runs:
+        plants.setdefault(name, []).append(plant)
+    texts = []
+    for name, on in plants.items():
+        if on == [None]:
+            texts.append(f"the {shown(name)}")
+            continue
+        named = [plant or "kinematic" for plant in on]
+        noun = "plant" if len(named) == 1 else "plants"
+        texts.append(f"the {shown(name)} ({_and(named)} {noun})")
+    return texts
 
 
 def _and(texts: Sequence[str]) -> str:
