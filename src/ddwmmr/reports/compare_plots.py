@@ -23,7 +23,10 @@ from matplotlib.patches import Rectangle
 
 from ddwmmr.model import Robot
 from ddwmmr.reports.legends import legend_beside, place_legend
-from ddwmmr.reports.plots import ERROR_FLOOR  # errors are clipped to it on log axes
+from ddwmmr.reports.plots import (  # errors are clipped to the floor on log axes
+    ERROR_FLOOR,
+    break_wraps,
+)
 
 #: Resolution of the saved PNGs (dots per inch).
 DPI = 100
@@ -58,14 +61,6 @@ def _log_bottom(series: Sequence[np.ndarray]) -> float:
     finite = [v[np.isfinite(v)] for v in (_floor(np.asarray(s, dtype=float)) for s in series)]
     lowest = min((float(v.min()) for v in finite if v.size), default=ERROR_FLOOR)
     return lowest / 2.0
-
-
-def break_wraps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(t, angle)`` with a NaN inserted wherever a wrapped angle jumps by more than pi
-    between samples (a crossing of +-pi, not a real step), so the line is broken there
-    instead of drawing a false vertical jump across the plot."""
-    jumps = np.nonzero(np.abs(np.diff(angle)) > math.pi)[0] + 1
-    return np.insert(t.astype(float), jumps, np.nan), np.insert(angle.astype(float), jumps, np.nan)
 
 
 def _line_widths(count: int) -> list[float]:

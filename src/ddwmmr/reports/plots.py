@@ -174,7 +174,7 @@ def break_wraps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarra
 
 def plot_path(result, ax: Axes | None = None, snapshots: int = 6, obstacles=None) -> Figure:
     """Desired vs actual end-effector path, base path, the robot at up to ``snapshots``
-    times, no base inside another's footprint (one colour per time, named in the legend; see
+    times, no base inside another's footprint (one grey per time, named in the legend; see
     :func:`snapshot_indices`) and the obstacles (``(x, y, radius)``
     circles, m) if any. The axes hold everything drawn; the legend sits beside them."""
     ts = result.timeseries
