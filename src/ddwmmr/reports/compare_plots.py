@@ -269,7 +269,7 @@ def plot_small_multiples(
     obstacles: Sequence[Any] = (),
 ) -> Figure:
     """One panel per method: desired and actual end-effector path, base path, the robot
-    at ``snapshots`` instants, one colour per instant (named in the figure's legend: no
+    at ``snapshots`` instants, one grey per instant (named in the figure's legend: no
     text next to the robots, which would cover the paths), and the runs' ``obstacles``
     (circles or (x, y, radius) triples, m) as grey discs. Each panel holds everything it
     draws: the frame of the desired path, grown for a method that leaves it. The figure is

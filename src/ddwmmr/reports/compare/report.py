@@ -641,10 +641,9 @@ def _trajectory_section(c: _Context, name: str) -> None:
         plots.plot_small_multiples(series, colors, c.config.robot, title, obstacles=obstacles),
         f"{title}: one panel per method (axes in m): desired path dashed, end effector in the "
         "method's colour, base path grey, the robot (footprint and arm) at six instants, one "
-        "colour per instant from dark (start) to light, named in the legend. Each panel "
-        "holds everything it draws: a method that leaves the desired path gets a wider frame."
-        + OBSTACLES_CAPTION
-        * bool(obstacles),
+        "grey per instant from light (start) to dark (the final pose), named in the legend. "
+        "Each panel holds everything it draws: a method that leaves the desired path gets a "
+        "wider frame." + OBSTACLES_CAPTION * bool(obstacles),
     )
 
 
