@@ -60,7 +60,6 @@ from ddwmmr.errors import (
     shown,
 )
 from ddwmmr.gains import TAU_RANGE
-from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_CAP
 from ddwmmr.plants import available_plants, make_plant, plant_class, plant_description
 from ddwmmr.plants.kinematic import INTEGRATORS
@@ -75,12 +74,10 @@ from ddwmmr.sim.simulate import (
     check_start,
     check_tracks,
     default_step,
-    engine_multiple,
     plant_integrator,
     simulate,
 )
 from ddwmmr.trajectories import available_trajectories, load_trajectory
-from ddwmmr.trajectories.base import resolution_step
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = "python -m ddwmmr.track"
@@ -446,7 +443,7 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     options = {**preset_options(args.method, args.preset or "default"), **controller_options(args)}
     plant_options = parse_plant_options(plant, args.plant_option)
     duration = trajectory.duration if args.duration is None else args.duration
-    step = _default_step(trajectory, plant, robot, plant_options) if args.dt is None else args.dt
+    step = default_step(trajectory, plant, robot, plant_options) if args.dt is None else args.dt
     if args.dt is None and 0 < duration < step:  # the user gave --duration, not --dt
         raise ParameterError(
             f"duration must be >= one step, {step:g} s (the trajectory's T/N; or give a "
@@ -468,15 +465,6 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         plant_options=plant_options,
     )
     return check_run(inputs, "payload" if args.payload is not None else "robot", "--offset")
-
-
-def _default_step(trajectory: Any, plant: str, robot: Robot, options: dict[str, Any]) -> float:
-    """The control step (s) a run takes without ``--dt``: ``simulate``'s default on the
-    plant built with the given ``options`` (a physics plant's ``timestep`` sets the step's
-    quantum), :func:`~ddwmmr.sim.simulate.default_step` on its defaults."""
-    if not options:
-        return default_step(trajectory, plant, robot)
-    return engine_multiple(resolution_step(trajectory), built_plant(plant, robot, options))
 
 
 def check_run(inputs: RunInputs, holder: str, start: str) -> RunInputs:

@@ -422,13 +422,16 @@ def _plant(
     return make_plant(plant, robot, **options)
 
 
-def default_step(trajectory: Any, plant: str, robot: Robot) -> float:
-    """The control step (s) ``simulate`` takes by default on the plant named ``plant``:
+def default_step(
+    trajectory: Any, plant: str, robot: Robot, plant_options: dict[str, Any] | None = None
+) -> float:
+    """The control step (s) ``simulate`` takes by default on the plant named ``plant``
+    built with ``plant_options`` (as ``simulate(..., plant_options=...)`` builds it):
     :func:`resolution_step`, rounded to the engine ``timestep`` of a physics plant (which
     is built for it; other plants are not)."""
     step = resolution_step(trajectory)
     if hasattr(plant_class(plant), "timestep"):
-        step = engine_multiple(step, make_plant(plant, robot))
+        step = engine_multiple(step, make_plant(plant, robot, **(plant_options or {})))
     return step
 
 
