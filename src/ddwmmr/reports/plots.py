@@ -29,8 +29,6 @@ PNG_METADATA = {"Software": None}
 #: Floor (m) of every logarithmic position-error axis (track, compare, the GUI): errors
 #: below it are drawn at it. Converged runs reach 1e-10 m and less, which stays visible.
 ERROR_FLOOR = 1e-12
-#: Grey levels (0 black, 1 white) of the first and the last robot drawn on a path: light
-#: to dark over time, a ramp no path or method line uses.
 
 
 def robot_outline(robot: Robot, q) -> dict[str, np.ndarray]:
