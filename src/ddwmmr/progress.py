@@ -184,20 +184,77 @@ def phase(label: str, enabled: bool = True, stream: TextIO | None = None) -> Ite
 def _heartbeat(label: str, stream: TextIO, start: float) -> Iterator[None]:
     """While the body runs, a line every :data:`LOG_INTERVAL_S` saying that ``label`` is
     still running and for how long since ``start`` (a :func:`time.perf_counter` time),
-    from a background thread: a phase has no count to advance, and its work (writing a
-    file, encoding a GIF) must not have to call back."""
-    stop = threading.Event()
-
-    def beat() -> None:
-        while not stop.wait(LOG_INTERVAL_S):
-            elapsed = time.perf_counter() - start
-            stream.write(f"{label}: still running after {_duration(elapsed)}\n")
-            stream.flush()
-
-    thread = threading.Thread(target=beat, name=f"progress: {label}", daemon=True)
-    thread.start()
+    from a background thread (:class:`_Heartbeat`): a phase has no count to advance, and
+    its work (writing a file, encoding a GIF) must not have to call back."""
+    beat = _Heartbeat(label, stream, start)
+    beat.start()
+    _BEATING.add(beat)
     try:
         yield
     finally:
-        stop.set()
-        thread.join()
+        _BEATING.discard(beat)
+        beat.stop()
+
+
+class _Heartbeat:
+    """The thread of a phase's "still running" lines, which can stop and start again
+    without changing when its lines are due (multiples of :data:`LOG_INTERVAL_S` after
+    ``start``): it stops around every fork of this process (a process pool's workers
+    started in a phase), because a forked child gets copies of the locks other threads
+    hold, locked for good (the stream's, while a line is being written)."""
+
+    def __init__(self, label: str, stream: TextIO, start: float) -> None:
+        self.label = label
+        self.stream = stream
+        self.start_time = start
+        self._due = start + LOG_INTERVAL_S  # perf_counter time of the next line
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def start(self) -> None:
+        """Start the thread (again)."""
+        self._stop = threading.Event()
+        self._thread = threading.Thread(
+            target=self._beat, args=(self._stop,), name=f"progress: {self.label}", daemon=True
+        )
+        self._thread.start()
+
+    def stop(self) -> None:
+        """Stop the thread and wait until it has (a line being written is finished)."""
+        self._stop.set()
+        if self._thread is not None and self._thread is not threading.current_thread():
+            self._thread.join()
+        self._thread = None
+
+    def _beat(self, stop: threading.Event) -> None:
+        while not stop.wait(self._due - time.perf_counter()):
+            now = time.perf_counter()
+            self.stream.write(
+                f"{self.label}: still running after {_duration(now - self.start_time)}\n"
+            )
+            self.stream.flush()
+            # the next multiple of the interval, but not at once after a line that a stop
+            # (a fork) held back
+            self._due = max(self._due + LOG_INTERVAL_S, now + LOG_INTERVAL_S / 2)
+
+
+#: The heartbeats running now (phases may nest, or run in several threads).
+_BEATING: set[_Heartbeat] = set()
+
+
+def _pause_heartbeats() -> None:
+    for beat in list(_BEATING):
+        beat.stop()
+
+
+def _resume_heartbeats() -> None:
+    for beat in list(_BEATING):
+        beat.start()
+
+
+if hasattr(os, "register_at_fork"):  # no fork on Windows
+    os.register_at_fork(
+        before=_pause_heartbeats,
+        after_in_parent=_resume_heartbeats,
+        after_in_child=_BEATING.clear,  # the child has no such thread and runs no phase
+    )

@@ -6,13 +6,19 @@ until the machine restarts. Every worker of :func:`process_pool` therefore runs
 :func:`die_with_parent` first:
 
 * on Linux the kernel sends it SIGKILL when its parent exits (``prctl(PR_SET_PDEATHSIG)``),
-  even while it is busy in C code;
+  even while it is busy in C code (not for a worker of the ``forkserver`` start method,
+  whose parent is the fork server);
 * on every platform a daemon thread waits on the parent's sentinel
   (:func:`multiprocessing.parent_process`, closed by the operating system when the parent
   ends) and ends the worker at once.
 
 Workers only compute and return results: they write no files, so ending them can leave
 nothing half-written.
+
+A worker also shows warnings the way the process that started the pool does when that
+process's display (``warnings.showwarning``) says how (:func:`worker_display`): the tools
+show the library's warnings as one line each, and a worker that was not forked (the
+``spawn`` and ``forkserver`` start methods) starts with Python's own display.
 """
 
 from __future__ import annotations
@@ -25,7 +31,10 @@ import os
 import signal
 import sys
 import threading
+import warnings
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
+from multiprocessing.context import BaseContext
 
 #: ``prctl`` option that asks for a signal when the parent exits (linux/prctl.h).
 PR_SET_PDEATHSIG = 1
@@ -33,22 +42,54 @@ PR_SET_PDEATHSIG = 1
 EXIT_ORPHANED = 1
 
 
-def process_pool(jobs: int) -> ProcessPoolExecutor:
-    """A pool of ``jobs`` worker processes that end when this process ends, however."""
+#: Attribute of a warnings display (``warnings.showwarning``) naming the module-level
+#: function (picklable: a spawned worker imports it) that installs the same display in the
+#: process that calls it.
+IN_WORKERS = "in_workers"
+
+
+def process_pool(jobs: int, mp_context: BaseContext | None = None) -> ProcessPoolExecutor:
+    """A pool of ``jobs`` worker processes that end when this process ends, however, and
+    show warnings as this process does (:func:`worker_display`).
+
+    ``mp_context``: the :mod:`multiprocessing` context that starts the workers (default:
+    the platform's start method).
+    """
     return ProcessPoolExecutor(
-        max_workers=jobs, initializer=die_with_parent, initargs=(os.getpid(),)
+        max_workers=jobs,
+        mp_context=mp_context,
+        initializer=start_worker,
+        initargs=(os.getpid(), worker_display()),
     )
+
+
+def worker_display() -> Callable[[], None] | None:
+    """The function that installs this process's warnings display in a worker: the
+    ``in_workers`` attribute (:data:`IN_WORKERS`) of ``warnings.showwarning``, or None
+    (Python's display, or one that does not say how to reproduce it)."""
+    return getattr(warnings.showwarning, IN_WORKERS, None)
+
+
+def start_worker(parent_pid: int, display: Callable[[], None] | None) -> None:
+    """A pool worker's first step: :func:`die_with_parent`, then ``display()`` (a
+    :func:`worker_display` of the parent), if any."""
+    die_with_parent(parent_pid)
+    if display is not None:
+        display()
 
 
 def die_with_parent(parent_pid: int) -> None:
     """End this process when the process ``parent_pid`` that started it ends.
 
     Runs first in every worker (a pool initializer). If the parent has already gone by
-    then, the worker ends here.
+    then, the worker ends here. A worker that a fork server made (the ``forkserver``
+    start method) is that server's child, not ``parent_pid``'s: the kernel's signal would
+    follow the server, so only the watchdog thread watches the parent.
     """
-    _ask_kernel_for_death_signal()
-    if os.getppid() != parent_pid:  # gone before the request above took effect
-        os._exit(EXIT_ORPHANED)
+    if os.getppid() == parent_pid:  # the parent's own child (fork, spawn)
+        _ask_kernel_for_death_signal()
+        if os.getppid() != parent_pid:  # gone before the request above took effect
+            os._exit(EXIT_ORPHANED)
     parent = multiprocessing.parent_process()
     if parent is not None and parent.sentinel is not None:
         watchdog = threading.Thread(

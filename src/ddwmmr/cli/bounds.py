@@ -16,7 +16,7 @@ import re
 import sys
 import time
 from collections.abc import Sequence
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import as_completed
 from dataclasses import asdict, replace
 from pathlib import Path
 
@@ -61,6 +61,7 @@ from ddwmmr.scenarios.executors import default_jobs
 from ddwmmr.scenarios.generator import generate
 from ddwmmr.scenarios.report import summary_json
 from ddwmmr.sim.result import json_safe
+from ddwmmr.workers import process_pool
 
 PROG = "python -m ddwmmr.bounds"
 TOOL = "bounds"
@@ -422,7 +423,7 @@ def _solve_all(
                 _keep(folder, records, batch.solve(job))
                 bar.advance()
         else:
-            with ProcessPoolExecutor(max_workers=min(jobs, len(pending))) as pool:
+            with process_pool(min(jobs, len(pending))) as pool:
                 futures = [pool.submit(batch.solve, job) for job in pending]
                 for future in as_completed(futures):
                     _keep(folder, records, future.result())

@@ -41,6 +41,7 @@ from ddwmmr.outputs import (
     output_folder,
     package_version,
 )
+from ddwmmr.workers import IN_WORKERS
 
 if TYPE_CHECKING:
     from ddwmmr.controllers.option_specs import OptionSpec
@@ -336,8 +337,27 @@ def one_line_warnings() -> Iterator[None]:
     what to change), instead of Python's default form (the source file, line number and
     line of the library's code, which reads like a traceback); any other warning (another
     library's, or a NumPy ``RuntimeWarning`` whose location is the clue) is shown as
-    Python would."""
+    Python would. The worker processes of :func:`ddwmmr.workers.process_pool` started
+    meanwhile show them the same way, whatever their start method."""
     previous = warnings.showwarning
+    warnings.showwarning = _one_line_display(previous)
+    try:
+        yield
+    finally:
+        warnings.showwarning = previous
+
+
+def install_one_line_warnings() -> None:
+    """From now on, show the library's warnings in this process (a pool worker) as
+    :func:`one_line_warnings` does; nothing if they already are (a forked worker inherits
+    its parent's display)."""
+    if getattr(warnings.showwarning, IN_WORKERS, None) is not install_one_line_warnings:
+        warnings.showwarning = _one_line_display(warnings.showwarning)
+
+
+def _one_line_display(previous: Callable[..., None]) -> Callable[..., None]:
+    """The display of :func:`one_line_warnings` (a ``warnings.showwarning``), handing
+    every warning that is not the library's to ``previous``."""
 
     def show(message, category, filename, lineno, file=None, line=None) -> None:
         ours = os.path.normcase(os.path.abspath(filename)).startswith(_PACKAGE_FOLDER + os.sep)
@@ -346,11 +366,8 @@ def one_line_warnings() -> Iterator[None]:
         else:
             previous(message, category, filename, lineno, file, line)
 
-    warnings.showwarning = show
-    try:
-        yield
-    finally:
-        warnings.showwarning = previous
+    setattr(show, IN_WORKERS, install_one_line_warnings)  # how pool workers get it
+    return show
 
 
 #: Stand-ins for the non-ASCII marks the tools print, on a console that cannot show them.
