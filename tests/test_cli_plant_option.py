@@ -57,9 +57,10 @@ def test_a_run_without_plant_options_is_recorded_as_before(tmp_path, big_robot, 
     assert run([*THESIS, "--robot", big_robot, "--out", str(out)]) == 0
     summary = _summary(out)
     assert summary["run"]["plant"] == {"name": "thesis"}
-    assert summary["max_wheel_force_n"] == pytest.approx(10.0, abs=1e-9)
+    # its own force limit: the thesis's 10 N of 20.5 N motors, of its 20 N motors
+    assert summary["max_wheel_force_n"] == pytest.approx(9.75, abs=1e-9)
     err = capsys.readouterr().err  # the thesis plant's warning names the option to set
-    assert "thesis robot's wheel force limit 10 N" in err and "--plant-option force_limit=" in err
+    assert "force_limit = 9.75 N" in err and "--plant-option force_limit=" in err
 
 
 @pytest.mark.parametrize("options", [OPTIONS, []])
@@ -72,7 +73,7 @@ def test_rerun_repeats_the_plant_options(tmp_path, big_robot, options, capsys):
     assert after["run"]["plant"] == before["run"]["plant"]
     for key in ("max_wheel_force_n", "rms_position_error_m", "final_position_error_m"):
         assert after[key] == before[key]
-    assert after["max_wheel_force_n"] == pytest.approx(19.034 if options else 10.0, abs=1e-3)
+    assert after["max_wheel_force_n"] == pytest.approx(19.034 if options else 9.75, abs=1e-3)
 
 
 def test_rerun_refuses_plant_options_given_with_it(tmp_path, capsys):

@@ -1,7 +1,7 @@
 """Which of the thesis plant's constants come from the robot: the arm servo's speed is the
-robot's ``joint_speed_limit``; the force limit (10 N per wheel) and the damping c1, c2 stay
-the thesis's for every robot, with one warning line when the robot's wheel drive is not the
-thesis robot's (docs/thesis.md, "What is simulated")."""
+robot's ``joint_speed_limit``; the force limit and the damping c1, c2 are the thesis's for
+the thesis robot and derived from them for another, with one warning line when they differ
+(docs/thesis.md, "What is simulated"; tests/test_thesis_plant_scaling.py)."""
 
 from __future__ import annotations
 
@@ -60,14 +60,14 @@ def test_default_robot_keeps_the_thesis_constants_silently():
         assert (plant.force_limit, plant.c1, plant.c2, plant.joint_speed) == (10.0, 15, 4, 2)
 
 
-def test_other_wheel_drive_warns_once_naming_the_borrowed_constants():
-    """A robot with other wheel motors keeps 10 N (its motors would give 150 N) and is told
-    so in one line, once for two plants."""
+def test_other_wheel_drive_warns_once_naming_the_derived_constants():
+    """A robot with other wheel motors (150 N) gets the thesis's share of them, 10 N of
+    20.5 N: 73.125 N, and is told so in one line, once for two plants."""
     plants, messages = _built(lambda: [ThesisPlant(BIG) for _ in range(2)])
     assert len(messages) == 1 and "\n" not in messages[0]
-    for text in ("force limit 10 N", "= 150 N", "c1 = 15 N s/m", "c2 = 4 N m s/rad"):
+    for text in ("force_limit = 73.13 N", "(150 N)", "c1 = 15 N s/m", "c2 = 4 N m s/rad"):
         assert text in messages[0]
-    assert plants[0].force_limit == 10.0
+    assert plants[0].force_limit == pytest.approx(10.0 * 150.0 / (2.0 / 0.0975), rel=1e-12)
 
 
 def test_given_force_limit_is_used_without_warning():
@@ -78,10 +78,12 @@ def test_given_force_limit_is_used_without_warning():
     assert plant.velocity_envelope(1.0)["max_base_speed"] == pytest.approx(300.0 / 15.0)
 
 
-def test_given_damping_is_not_called_the_thesis_models():
+def test_given_damping_is_not_named_as_derived():
+    """c1, c2 given: only the force limit is derived and named."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        ThesisPlant(BIG, c1=5.0, c2=1.0)
+        plant = ThesisPlant(BIG, c1=5.0, c2=1.0)
     (message,) = [str(w.message) for w in caught]
-    assert "and the given damping c1 = 5 N s/m, c2 = 1 N m s/rad" in message
-    assert "thesis model's" not in message
+    assert message.startswith("thesis plant: force_limit = 73.13 N derived for this robot")
+    assert "c1 = 5" not in message and "c2 = 1" not in message
+    assert (plant.c1, plant.c2) == (5.0, 1.0)

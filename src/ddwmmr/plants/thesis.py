@@ -25,10 +25,11 @@ joint at its limit, as the kinematic plant does), and a start outside them is re
 plant knows nothing about controllers: it receives wheel forces and joint targets from a
 simulation loop.
 
-Constants (:mod:`ddwmmr.model.thesis_base`): the arm servo's speed comes from the robot; the
-damping c1, c2 are the thesis model's and the per-wheel force limit (10 N) the thesis
-robot's, for any robot unless given (a robot whose wheel drive is not the thesis robot's
-gets a one-line warning naming them).
+Constants: the arm servo's speed comes from the robot. The per-wheel force limit and the
+damping c1, c2 are the thesis model's (:mod:`ddwmmr.model.thesis_base`: 10 N, 15 N s/m,
+4 N m s/rad) for the thesis robot, and for any other robot derived from them in proportion
+to its own motors' force, own mass and own yaw inertia (:func:`robot_constants`), unless
+given; derived constants that differ from the thesis's get a one-line warning.
 """
 
 from __future__ import annotations
@@ -67,32 +68,59 @@ from ddwmmr.registry import register_plant
 VELOCITY_BANDWIDTH = 10.0
 
 
-def _wheel_drive(robot: Robot) -> tuple[float, float]:
-    """The robot's wheel drive: ``(wheel_radius m, wheel_torque_limit N m)``."""
-    return robot.wheel_radius, robot.wheel_torque_limit
+#: The thesis model's constants, measured on the thesis robot (``Robot``'s defaults).
+THESIS_CONSTANTS = {"force_limit": FORCE_LIMIT_DEFAULT, "c1": C1_DEFAULT, "c2": C2_DEFAULT}
+_UNITS = {"force_limit": "N", "c1": "N s/m", "c2": "N m s/rad"}
 
 
-#: The thesis robot's wheel drive (``Robot``'s defaults): the one whose force limit is the
-#: thesis's 10 N.
-_THESIS_DRIVE = _wheel_drive(Robot())
+def _drive_facts(robot: Robot) -> dict[str, float]:
+    """What each thesis constant is proportional to, for ``robot``: its motors' wheel force
+    (``motor_force_limit``, N), its own mass (kg) and its own yaw inertia with the arm
+    stretched (kg m^2), both without the payload."""
+    own = robot.with_payload(0.0)
+    return {
+        "force_limit": robot.motor_force_limit,
+        "c1": own.total_mass,
+        "c2": own.yaw_inertia.at(0.0),
+    }
 
 
-def warn_borrowed_constants(robot: Robot, c1: float, c2: float) -> None:
+_THESIS_FACTS = _drive_facts(Robot())
+
+
+def robot_constants(robot: Robot) -> dict[str, float]:
+    """The thesis plant's default constants for ``robot``: ``{"force_limit": N per wheel,
+    "c1": N s/m, "c2": N m s/rad}``, the thesis model's scaled by ``robot``'s own drive.
+
+    The force limit keeps the thesis's share of the motors (10 N of the thesis robot's
+    ``motor_force_limit`` 20.5 N), so the plant never gives more than ``robot``'s motors;
+    c1 keeps the translational time constant ``m / c1`` and c2 the yaw time constant
+    ``I / c2``, with the robot's own mass and its own yaw inertia at the stretched arm
+    (th2 = 0), both without the payload: the drive is built for the robot, not for what it
+    carries (docs/thesis.md, "What is simulated"). Exactly the thesis's 10, 15, 4 for a
+    robot with the thesis robot's motors, masses and inertia, at any payload.
+    """
+    facts = _drive_facts(robot)
+    return {
+        name: value * (facts[name] / _THESIS_FACTS[name])
+        for name, value in THESIS_CONSTANTS.items()
+    }
+
+
+def warn_derived_constants(robot: Robot, derived: dict[str, float]) -> None:
     """Warn (a one-line :class:`UserWarning`, once per message under Python's default
-    filter) when ``robot``'s wheel drive (``wheel_radius``, ``wheel_torque_limit``) is not
-    the thesis robot's, so the thesis plant's default force limit (10 N per wheel) is not
-    its own; the damping c1, c2 (N s/m, N m s/rad) are named with it, as the thesis
-    model's where they are its defaults."""
-    if _wheel_drive(robot) == _THESIS_DRIVE:
+    filter) when a constant in ``derived`` (name -> value, those :func:`robot_constants`
+    chose because none was given) is not the thesis model's: no one measured it on
+    ``robot``. The line names the values, the motors' force and how to set them."""
+    if all(value == THESIS_CONSTANTS[name] for name, value in derived.items()):
         return
-    motors = robot.motor_force_limit
-    whose = "the thesis model's" if (c1, c2) == (C1_DEFAULT, C2_DEFAULT) else "the given"
+    values = ", ".join(f"{name} = {value:.4g} {_UNITS[name]}" for name, value in derived.items())
     warnings.warn(
-        f"thesis plant: the robot runs with the thesis robot's wheel force limit "
-        f"{FORCE_LIMIT_DEFAULT:g} N (its motors give wheel_torque_limit / wheel_radius = "
-        f"{motors:.4g} N) and {whose} damping c1 = {c1:g} N s/m, c2 = {c2:g} "
-        "N m s/rad (ThesisPlant(robot, force_limit=..., c1=..., c2=...) sets them; "
-        "track: --plant-option force_limit=...)",
+        f"thesis plant: {values} derived for this robot from the thesis robot's "
+        f"{FORCE_LIMIT_DEFAULT:g} N, c1 = {C1_DEFAULT:g} N s/m, c2 = {C2_DEFAULT:g} N m s/rad "
+        "in proportion to its motors' force "
+        f"({robot.motor_force_limit:.4g} N), own mass and own yaw inertia (ThesisPlant(robot, "
+        "force_limit=..., c1=..., c2=...) sets them; track: --plant-option force_limit=...)",
         UserWarning,
         stacklevel=2,
     )
@@ -196,11 +224,11 @@ class ThesisPlant:
 
     Args:
         robot: geometry and masses (``Robot().with_payload(3.0)`` in the benchmark).
-        c1: translational damping (N s/m); c2: rotational damping (N m s/rad); the
-            thesis model's 15 and 4 by default, for any robot.
-        force_limit: per-wheel force limit (N); None: the thesis robot's 10 N, with a
-            warning (:func:`warn_borrowed_constants`) if ``robot``'s wheel drive is
-            another.
+        c1, c2, force_limit: translational damping (N s/m), rotational damping
+            (N m s/rad) and per-wheel force limit (N); each None: the robot's own,
+            :func:`robot_constants` (the thesis's 15, 4 and 10 for the thesis robot), with
+            a one-line warning (:func:`warn_derived_constants`) where that is not the
+            thesis's.
         joint_speed: maximum joint speed of the arm servo (rad/s); None: the robot's
             ``joint_speed_limit``.
         velocity_bandwidth: bandwidth of the velocity servo for velocity commands (1/s).
@@ -214,19 +242,22 @@ class ThesisPlant:
     def __init__(
         self,
         robot: Robot,
-        c1: float = C1_DEFAULT,
-        c2: float = C2_DEFAULT,
+        c1: float | None = None,
+        c2: float | None = None,
         force_limit: float | None = None,
         joint_speed: float | None = None,
         velocity_bandwidth: float = VELOCITY_BANDWIDTH,
     ) -> None:
         self.robot = check_instance("robot", robot, Robot)
-        self.c1 = check_positive("c1", c1)
-        self.c2 = check_positive("c2", c2)
-        if force_limit is None:
-            warn_borrowed_constants(robot, self.c1, self.c2)
-            force_limit = FORCE_LIMIT_DEFAULT
-        self.force_limit = check_positive("force_limit", force_limit)
+        given = {"force_limit": force_limit, "c1": c1, "c2": c2}
+        derived = {
+            name: value for name, value in robot_constants(robot).items() if given[name] is None
+        }
+        self.force_limit, self.c1, self.c2 = (
+            check_positive(name, derived.get(name, given[name])) for name in THESIS_CONSTANTS
+        )
+        if derived:
+            warn_derived_constants(robot, derived)
         if joint_speed is None:
             joint_speed = robot.joint_speed_limit
         self.joint_speed = check_positive("joint_speed", joint_speed)
