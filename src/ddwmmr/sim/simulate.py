@@ -35,6 +35,7 @@ from ddwmmr.model.stability import max_payload, tips_in_every_pose
 from ddwmmr.plants import available_plants, make_plant, plant_class
 from ddwmmr.plants.base import Plant
 from ddwmmr.registry import CONTROLLERS
+from ddwmmr.resolution.kernels import length_unit
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     initial_configuration,
@@ -323,6 +324,8 @@ def simulate(
         method=getattr(controller, "name", type(controller).__name__),
         trajectory=trajectory_name(trajectory),
         trajectory_extent_m=trajectory_extent(reference, timeseries),
+        # the verdict's absolute error limits are in the robot's own length unit
+        length_unit_m=length_unit(robot.L1),
         plant=the_plant.name,
         integrator=getattr(the_plant, "integrator", None),
         # the interface the controller spoke (the mpc chooses its own for the plant)

@@ -36,7 +36,12 @@ A run did not track when any of these holds (thresholds documented in docs/cli.m
   :data:`OFFSET_FACTOR` times the run's initial offset if that is larger (an open-loop
   method keeps its initial offset by design, and tracks with it), and never more than
   :data:`EXTENT_FRACTION` of the trajectory's extent (``trajectory_extent_m``), or
-  :data:`EXTENT_LIMIT_FLOOR_M` if that is larger (a trajectory that barely moves).
+  :data:`EXTENT_LIMIT_FLOOR_M` if that is larger (a trajectory that barely moves). The two
+  absolute limits are the default robot's: they are multiplied by the robot's length unit
+  (``length_unit_m``, :func:`ddwmmr.resolution.kernels.length_unit`; 1 m for the default
+  robot, and for a summary that does not record it), so that a robot scaled by s, on a
+  trajectory scaled by s, with s times the errors and offset, gets the default run's
+  verdict.
 
 The likely cause is read from the summary too (:func:`likely_cause`): the cause a user
 should fix first. After what stops or overrules a run (divergence, tipping, a collision, a
@@ -88,8 +93,9 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, one_line, shown, texts_apart
+from ddwmmr.errors import LENGTH_RANGE_M, ParameterError, one_line, shown, texts_apart
 from ddwmmr.qp.limits.obstacles import INFLUENCE_M
+from ddwmmr.resolution.kernels import length_unit
 
 __all__ = [
     "ERROR_LIMIT_M",
@@ -97,6 +103,7 @@ __all__ = [
     "EXTENT_LIMIT_FLOOR_M",
     "FLAG_KEYS",
     "HELD_CAUSE",
+    "LENGTH_UNIT_RANGE_M",
     "MOST_OF_RUN",
     "NON_NEGATIVE_KEYS",
     "NUMBER_KEYS",
@@ -128,7 +135,8 @@ SATURATED_CAUSE = 0.9
 #: Share of singular steps above which the singularity is named as the likely cause of a
 #: failure, even when they are not most of the run (ap on the rectangle: 990 of 2000).
 SINGULAR_CAUSE = 0.25
-#: End-effector position error (m) above which a run did not track (final or RMS)...
+#: End-effector position error (m) above which a run of the default robot did not track
+#: (final or RMS); another robot's is this many of its length units (``length_unit_m``)...
 ERROR_LIMIT_M = 0.05
 #: ... unless the initial offset times this is larger: the limit an open-loop method,
 #: which keeps the initial offset (docs/comparing.md), stays within while it tracks.
@@ -137,9 +145,13 @@ OFFSET_FACTOR = 2.0
 #: not track, whatever the limits above allow: an end effector a fifth of the path's size
 #: away no longer follows its shape. The default runs that track stay within 0.152 of it.
 EXTENT_FRACTION = 0.2
-#: ... unless this (m) is larger: the least limit, so that a trajectory that barely moves
-#: (a held point has extent 0) is judged by 10 mm, not by zero.
+#: ... unless this (m, of the default robot; another robot's is this many of its length
+#: units) is larger: the least limit, so that a trajectory that barely moves (a held point
+#: has extent 0) is judged by 10 mm on the default robot, not by zero.
 EXTENT_LIMIT_FLOOR_M = 0.01
+#: The values a summary's ``length_unit_m`` may take (m): the length units of the robots'
+#: first links over ``LENGTH_RANGE_M``.
+LENGTH_UNIT_RANGE_M = tuple(length_unit(length) for length in LENGTH_RANGE_M)
 #: Share of the run above which a limit held without clipping (``wheel_limit_steps`` of
 #: ``steps``, ``actuator_saturated_time_s`` of ``duration``) is named as the likely cause
 #: of a failure nothing else explains.
@@ -363,6 +375,7 @@ def check_summary(summary: Any) -> Mapping[str, Any]:
         _count(summary, key, steps)
     for key, unit in NON_NEGATIVE_KEYS.items():
         _non_negative(summary, key, unit)
+    _robot_unit(summary)
     return summary
 
 
@@ -398,6 +411,7 @@ NUMBER_KEYS = (
     "corner_position_error_m",
     "min_physics_stability",
     "max_base_tilt_rad",
+    "length_unit_m",
 )
 #: The summary keys that count steps of the run: each a whole number from 0 to ``steps``
 #: (itself a whole number >= 0).
@@ -493,40 +507,70 @@ def _non_negative(summary: Mapping[str, Any], key: str, unit: str) -> None:
         )
 
 
+def _robot_unit(summary: Mapping[str, Any]) -> float:
+    """The robot's length unit (m) the summary records (``length_unit_m``), 1.0 where it
+    records none (a summary written before the key was: judged in metres, as then). A
+    value outside :data:`LENGTH_UNIT_RANGE_M` (or NaN, inf) is a one-line
+    :class:`ParameterError` naming the key."""
+    unit = _number(summary, "length_unit_m")
+    if unit is None:
+        return 1.0
+    low, high = LENGTH_UNIT_RANGE_M
+    if not low <= unit <= high:
+        raise ParameterError(
+            f"summary: length_unit_m must be the robot's length unit in m, from {low:.4g} "
+            f"to {high:.4g} (kernels.length_unit(L1)), or None "
+            f"(got {shown(summary.get('length_unit_m'))})"
+        )
+    return unit
+
+
 def error_limit(summary: Mapping[str, Any]) -> float:
     """The position-error limit (m) of the run ``summary`` describes:
-    max(:data:`ERROR_LIMIT_M`, :data:`OFFSET_FACTOR` x ``initial_offset_m``), and at most
-    :func:`extent_limit` where the summary records the trajectory's extent."""
+    max(:data:`ERROR_LIMIT_M` x unit, :data:`OFFSET_FACTOR` x ``initial_offset_m``), and
+    at most :func:`extent_limit` where the summary records the trajectory's extent; unit is
+    the robot's length unit ``length_unit_m`` (1 where the summary records none)."""
     absolute, relative = _limits(summary)
     return absolute if relative is None else min(absolute, relative)
 
 
 def _limits(summary: Mapping[str, Any]) -> tuple[float, float | None]:
-    """The two parts of :func:`error_limit` (m): the absolute one, max(ERROR_LIMIT_M,
-    OFFSET_FACTOR x offset), and :func:`extent_limit` (None without an extent)."""
+    """The two parts of :func:`error_limit` (m): the absolute one, max(ERROR_LIMIT_M x
+    unit, OFFSET_FACTOR x offset), and :func:`extent_limit` (None without an extent)."""
     check_summary(summary)
     offset = _number(summary, "initial_offset_m") or 0.0
-    return max(ERROR_LIMIT_M, OFFSET_FACTOR * offset), extent_limit(summary)
+    absolute = max(ERROR_LIMIT_M * _robot_unit(summary), OFFSET_FACTOR * offset)
+    return absolute, extent_limit(summary)
 
 
 def extent_limit(summary: Mapping[str, Any]) -> float | None:
     """The error limit (m) the trajectory's size sets: max(:data:`EXTENT_FRACTION` x
-    ``trajectory_extent_m``, :data:`EXTENT_LIMIT_FLOOR_M`); None if the summary records no
-    (or a NaN) extent, as a summary written before the key was."""
+    ``trajectory_extent_m``, :data:`EXTENT_LIMIT_FLOOR_M` x unit), unit the robot's length
+    unit ``length_unit_m`` (1 where the summary records none); None if the summary records
+    no (or a NaN) extent, as a summary written before the key was."""
     check_summary(summary)
     extent = _number(summary, "trajectory_extent_m")
     if extent is None or math.isnan(extent):
         return None
-    return max(EXTENT_FRACTION * extent, EXTENT_LIMIT_FLOOR_M)
+    return max(EXTENT_FRACTION * extent, EXTENT_LIMIT_FLOOR_M * _robot_unit(summary))
 
 
 def _limit_text(summary: Mapping[str, Any]) -> str:
-    """``limit 84.85 mm``; where the trajectory's extent sets it, also that extent."""
+    """``limit 84.85 mm``; where the trajectory's extent sets it, also that extent
+    (``for a trajectory 2.828 mm across``); where a robot of another size than the default
+    one's (``length_unit_m`` not 1) is held to :data:`ERROR_LIMIT_M` or
+    :data:`EXTENT_LIMIT_FLOOR_M` of its length unit, also that unit."""
     absolute, relative = _limits(summary)
-    if relative is None or relative >= absolute:
-        return f"limit {1000.0 * absolute:.4g} mm"
-    extent = _number(summary, "trajectory_extent_m") or 0.0
-    return f"limit {1000.0 * relative:.4g} mm for a trajectory {1000.0 * extent:.4g} mm across"
+    limit = absolute if relative is None else min(absolute, relative)
+    what = []
+    if relative is not None and relative < absolute:
+        extent = _number(summary, "trajectory_extent_m") or 0.0
+        what.append(f"a trajectory {1000.0 * extent:.4g} mm across")
+    unit = _robot_unit(summary)
+    if unit != 1.0 and limit in (ERROR_LIMIT_M * unit, EXTENT_LIMIT_FLOOR_M * unit):
+        what.append(f"this robot's size (length_unit_m {unit:.4g})")
+    text = f"limit {1000.0 * limit:.4g} mm"
+    return f"{text} for {' and '.join(what)}" if what else text
 
 
 def _started_below_floor(summary: Mapping[str, Any]) -> bool:
