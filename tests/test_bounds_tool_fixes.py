@@ -229,7 +229,7 @@ def test_a_floor_other_than_the_bounds_runs_is_noted(bounds_csv, tmp_path, monke
     table = scenarios_tool._bounds_table(args, config)
     assert table[1] == (11.0, 13.5)
     assert capsys.readouterr().err == (
-        f"scenarios: note: the best-known times of {bounds_csv} hold S >= 1.3, this run "
+        f"note: the best-known times of {bounds_csv} hold S >= 1.3, this run "
         "S >= 1.25 (--qp-stability-min): its ratios to them compare different problems "
         "(the lower bounds hold for any floor)\n"
     )

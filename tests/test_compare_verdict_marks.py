@@ -75,13 +75,16 @@ def test_the_advice_names_where_a_recommended_method_did_not_track(thesis_report
     lines = [x for x in text.splitlines() if x.startswith("- **")]
     corners = next(x for x in lines if x.startswith("- **Sharp corners"))
     assert corners.startswith("- **Sharp corners (like the rectangle)**: `qp` (42.8 mm RMS, ")
-    assert corners.endswith(f"Did not track {VERDICT}: `qp` on the rectangle (thesis plant).")
+    assert corners.endswith("Did not track: `qp` (see above).")
     best = next(x for x in lines if x.startswith("- **Best tracking"))
     assert best.endswith(f"Did not track {VERDICT}: `qp` on the rectangle (thesis plant).")
-    blind = next(x for x in lines if x.startswith("- **No pose measurement"))
-    assert blind.endswith(
-        f"Did not track {VERDICT}: `ats` on the rectangle (kinematic and thesis plants)."
+    singularity = next(x for x in lines if x.startswith("- **Near the shoulder"))
+    assert singularity.endswith(
+        f"Did not track {VERDICT}: `ats` on the rectangle (kinematic and thesis plants); "
+        "`qp` (see above)."
     )
+    blind = next(x for x in lines if x.startswith("- **No pose measurement"))
+    assert blind.endswith("Did not track: `ats` (see above).")
     assert (
         'there and on the thesis plant (section "Plant: thesis next to the kinematic plant").'
         in text
@@ -91,8 +94,8 @@ def test_the_advice_names_where_a_recommended_method_did_not_track(thesis_report
 def test_the_advice_without_plant_runs_names_the_kinematic_failures(thesis_report):
     config, plan, outputs, _ = thesis_report
     items = profiles(config, outputs, build_ranking(plan, outputs))
-    blind = next(x for x in recommendations(items) if x.startswith("**No pose measurement"))
-    assert blind.endswith(f"Did not track {VERDICT}: `ats` on the rectangle.")
+    singularity = next(x for x in recommendations(items) if x.startswith("**Near the shoulder"))
+    assert singularity.endswith(f"Did not track {VERDICT}: `ats` on the rectangle.")
     corners = next(x for x in recommendations(items) if x.startswith("**Sharp corners"))
     assert "Did not track" not in corners
 

@@ -12,7 +12,7 @@ import pytest
 from matplotlib.transforms import Bbox
 
 from ddwmmr import Robot, load_trajectory, simulate
-from ddwmmr.reports import compare_plots, plots
+from ddwmmr.reports import compare_plots, palette, plots
 from ddwmmr.reports.legends import covers_data, place_legend
 from figure_checks import (
     SavedFigures,
@@ -167,7 +167,7 @@ def compare_series():
 @pytest.mark.parametrize("name", ["ellipse", "rectangle"])
 def test_compare_trajectory_figures_show_their_data(compare_series, name):
     series = compare_series[name]
-    colors = compare_plots.method_colors(list(series))
+    colors = palette.method_colors(list(series))
     robot = Robot()
     figures = {
         "paths": compare_plots.plot_paths(
@@ -186,7 +186,7 @@ def test_compare_trajectory_figures_show_their_data(compare_series, name):
 
 def test_every_wheel_panel_has_its_time_axis_and_the_limit_is_named(compare_series):
     series = compare_series["rectangle"]
-    fig = compare_plots.plot_wheels(series, compare_plots.method_colors(list(series)), 15.0, "r")
+    fig = compare_plots.plot_wheels(series, palette.method_colors(list(series)), 15.0, "r")
     fig.canvas.draw()
     for ax in [a for a in fig.axes if a.get_visible()]:
         assert ax.get_xlabel() == "t (s)"
@@ -199,9 +199,7 @@ def test_every_wheel_panel_has_its_time_axis_and_the_limit_is_named(compare_seri
 def test_small_multiples_draw_every_instant_inside_its_panel(compare_series):
     series = compare_series["rectangle"]
     robot = Robot()
-    fig = compare_plots.plot_small_multiples(
-        series, compare_plots.method_colors(METHODS), robot, "r"
-    )
+    fig = compare_plots.plot_small_multiples(series, palette.method_colors(METHODS), robot, "r")
     ap = fig.axes[METHODS.index("ap")]
     x_low, x_high = ap.get_xlim()
     # ap leaves the frame of the desired rectangle (x within +-2 m, +-3.2 m with the
@@ -217,7 +215,7 @@ def test_compare_study_and_plant_figures_show_their_data(compare_series):
     """The study figures and the plant figure on curves of the real runs (the studies
     only change which runs feed them)."""
     series = compare_series["ellipse"]
-    colors = compare_plots.method_colors(METHODS)
+    colors = palette.method_colors(METHODS)
     t = series["ats"]["t"]
     error = {m: series[m]["position_error_m"] for m in METHODS}
     taus = (0.1, 0.3, 1.0, 3.0)
@@ -258,7 +256,7 @@ def test_dt_study_names_the_lines_lying_on_each_other():
         "pi": {"euler": dict.fromkeys(steps, 3.0), "rk4": dict.fromkeys(steps, 3.1)},
         "ats": {"euler": {s: 0.2 * s for s in steps}, "rk4": {s: 1e-3 * s**4 for s in steps}},
     }
-    fig = compare_plots.plot_dt_study(drift, compare_plots.method_colors(["pi", "ats"]))
+    fig = compare_plots.plot_dt_study(drift, palette.method_colors(["pi", "ats"]))
     legend = fig.axes[0].get_legend()
     assert "pi (euler) = pi (rk4)" in legend.get_title().get_text()
     widths = {line.get_label(): line.get_linewidth() for line in fig.axes[0].lines}
@@ -276,9 +274,7 @@ def test_init_study_names_the_methods_lying_on_each_other():
     }
     t = np.linspace(0.0, 10.0, 50)
     curves = {x: (t, (x + 1e-3) * np.exp(-t)) for x in offsets}
-    fig = compare_plots.plot_init_study(
-        final, curves, "ats", compare_plots.method_colors(list(final))
-    )
+    fig = compare_plots.plot_init_study(final, curves, "ats", palette.method_colors(list(final)))
     left = fig.axes[0]
     assert "pi = ap" in left.get_legend().get_title().get_text()
     widths = {line.get_label(): line.get_linewidth() for line in left.lines}

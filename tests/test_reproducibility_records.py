@@ -77,7 +77,7 @@ def test_a_rerun_of_a_record_from_other_software_says_so_in_one_line_and_reruns(
         run["machine"]["cpu"] = "Intel(R) Xeon(R) CPU E5-2680"
 
     err, first, second = _rerun(tmp_path, capsys, older)
-    assert err.count("\n") == 1 and err.startswith("track: note: ")
+    assert err.count("\n") == 1 and err.startswith("note: the record was written ")
     named = ["version 0.0.9 -> ", "numpy 1.26.4 -> ", "python 3.9.18 -> ", "casadi 3.6.0 -> "]
     for text in [*named, f"commit {'0' * 40} -> ", "cpu Intel(R) Xeon(R) CPU E5-2680 -> "]:
         assert text in err, text

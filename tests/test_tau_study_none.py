@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 from matplotlib.text import Text
 
-from ddwmmr.reports import compare_plots
+from ddwmmr.reports import compare_plots, palette
 
 TAUS = (0.1, 0.3, 1.0, 3.0)
 
@@ -20,7 +20,7 @@ def _curves(methods):
 def test_no_run_converged_is_drawn_with_a_note(tmp_path) -> None:
     methods = ["clrrmc-ts", "clrrmc-cs"]
     convergence = {m: dict.fromkeys(TAUS, math.nan) for m in methods}
-    colors = compare_plots.method_colors(methods)
+    colors = palette.method_colors(methods)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         fig = compare_plots.plot_tau_study(_curves(methods), convergence, -np.log(0.05), colors)
@@ -36,7 +36,7 @@ def test_no_run_converged_is_drawn_with_a_note(tmp_path) -> None:
 def test_a_converged_run_gets_no_note() -> None:
     methods = ["clrrmc-ts"]
     convergence = {"clrrmc-ts": {0.1: 0.3, 0.3: math.nan, 1.0: math.nan, 3.0: math.nan}}
-    colors = compare_plots.method_colors(methods)
+    colors = palette.method_colors(methods)
     fig = compare_plots.plot_tau_study(_curves(methods), convergence, -np.log(0.05), colors)
     notes = [t.get_text() for t in fig.axes[1].findobj(Text)]
     assert not any("no run converged" in note for note in notes)

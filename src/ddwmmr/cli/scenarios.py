@@ -836,7 +836,7 @@ def _beaten_line(beaten: list[tuple[int, float, float]], bounds: str) -> str:
     number, time_s, lower = beaten[0]
     first = f"scenario {number}: " if len(beaten) > 1 else ""
     return (
-        f"scenarios: warning: {bounds} gives lower bounds above the times achieved in "
+        f"warning: {bounds} gives lower bounds above the times achieved in "
         f"scenario{'s' * (len(beaten) > 1)} {listed} ({first}{time_s:g} s < {lower:g} s); "
         "a lower bound holds for every run of its scenario, so the file is "
         "not for these scenarios (other waypoints, robot or limits) or is wrong, and the "
@@ -956,7 +956,7 @@ def _bounds_table(args: argparse.Namespace, config: RunConfig):
     own = config.qp_stability_min if config.controller in QP_OPTIONS["qp_stability_min"] else None
     if None not in (floor, own) and floor != own:
         print(
-            f"scenarios: note: the best-known times of {args.bounds} hold S >= {floor:g}, "
+            f"note: the best-known times of {args.bounds} hold S >= {floor:g}, "
             f"this run S >= {own:g} (--qp-stability-min): its ratios to them compare "
             "different problems (the lower bounds hold for any floor)",
             file=sys.stderr,

@@ -549,7 +549,7 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
     except (TypeError, AttributeError, ValueError) as exc:
         raise ParameterError(f"rerun: {args.rerun} lacks a complete run record ({exc})") from None
     if file_note is not None:
-        print(f"track: note: {file_note}", file=sys.stderr)
+        print(f"note: {file_note}", file=sys.stderr)
     _note_other_software(record)
     return checked
 
@@ -561,7 +561,7 @@ def _note_other_software(record: dict[str, Any]) -> None:
     differences = provenance.software_differences(record)
     if differences:
         print(
-            f"track: note: the record was written with other software or on another CPU "
+            f"note: the record was written with other software or on another CPU "
             f"({', '.join(differences)}): the rerun's numbers may differ from the recorded "
             "run's in the last bits",
             file=sys.stderr,
@@ -669,7 +669,7 @@ def _note_uneven_duration(duration: float, dt: float, steps: int) -> None:
     covered = steps * dt
     if abs(covered - duration) > 1e-9 * duration:
         print(
-            f"track: note: duration {duration:g} s is not a whole number of steps of dt "
+            f"note: duration {duration:g} s is not a whole number of steps of dt "
             f"{dt:g} s; the run lasts {steps} steps, {covered:.6g} s",
             file=sys.stderr,
         )

@@ -15,7 +15,7 @@ import numpy as np
 from ddwmmr.controllers.base import StepInfo, register_controller
 from ddwmmr.controllers.inputs import check_command, check_inputs, check_start
 from ddwmmr.controllers.resolved_rate import Input, ResolvedRate, check_aux
-from ddwmmr.errors import MAX_STEPS, ParameterError, check_range
+from ddwmmr.errors import MAX_STEPS, ParameterError, check_range, check_step_count
 from ddwmmr.gains import gains_from_tau
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_angles, principal_angle, refuse_angles, wrap_angle
@@ -125,11 +125,7 @@ class ConfigurationSpaceController:
         require_trajectory(trajectory)
         check_start(q0)
         period = getattr(trajectory, "duration", 0.0)
-        if period / self.reference_step > MAX_STEPS:
-            raise ParameterError(
-                f"reference_step: {period:g} s / {self.reference_step:g} s is more than "
-                f"{MAX_STEPS} reference steps; use a larger reference_step"
-            )
+        self._check_reference_steps(period)
         self.reference = ReferenceTrajectory(
             self.robot,
             trajectory,
@@ -141,6 +137,22 @@ class ConfigurationSpaceController:
             horizon=period,  # one period up front
         )
         self.last = StepInfo()
+
+    def _check_reference_steps(self, period: float) -> None:
+        """At most :data:`~ddwmmr.errors.MAX_STEPS` reference steps over ``period`` (s),
+        with the round-off slack of a run's step cap (:func:`~ddwmmr.errors.check_step_count`:
+        a period and step read from decimal text may land a few ulps past the cap); else a
+        one-line :class:`ParameterError` naming ``reference_step``."""
+        step = self.reference_step
+        if not period > step:  # at most one step: within the cap
+            return
+        try:
+            check_step_count(period, step)
+        except ParameterError:
+            raise ParameterError(
+                f"reference_step: {period:g} s / {step:g} s is more than "
+                f"{MAX_STEPS} reference steps; use a larger reference_step"
+            ) from None
 
     def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
         """Reference rate plus configuration-error feedback, projected on the inputs.

@@ -45,11 +45,6 @@ def save(fig: Figure, path: str | Path) -> Path:
     return path
 
 
-def method_colors(labels: Sequence[str]) -> dict[str, str]:
-    """A fixed colour per label (tab10 order), so a method looks the same in every figure."""
-    return {label: f"C{i % 10}" for i, label in enumerate(labels)}
-
-
 def _floor(values: np.ndarray) -> np.ndarray:
     return np.maximum(np.abs(values), ERROR_FLOOR)
 

@@ -204,8 +204,11 @@ def recommendations(
 ) -> list[str]:
     """One line per use case, from the profiles (best ranked first) and the ranking under
     the slides' settings (``slides``). ``corners_reached``: the runs of the corner
-    trajectory reach one of its corners (else no method is named for sharp corners)."""
-    lines = [_best_line("Best tracking over all trajectories", items, _overall)]
+    trajectory reach one of its corners (else no method is named for sharp corners). A
+    method's runs that did not track are named once, on the first line naming it; later
+    lines refer back to it (:func:`_caveat`)."""
+    given: set[str] = set()
+    lines = [_best_line("Best tracking over all trajectories", items, _overall, given)]
     for name, label in ((STUDY_TRAJECTORY, "Smooth paths"), (CORNER_TRAJECTORY, "Sharp corners")):
         if name == CORNER_TRAJECTORY and not corners_reached:
             lines.append(
@@ -215,7 +218,9 @@ def recommendations(
             continue
         if items and name in items[0].scores:
             lines.append(
-                _best_line(f"{label} (like the {name})", items, lambda p, n=name: p.scores[n])
+                _best_line(
+                    f"{label} (like the {name})", items, lambda p, n=name: p.scores[n], given
+                )
             )
     closed = [p for p in items if p.converges]
     if closed:
@@ -224,17 +229,17 @@ def recommendations(
             f"**Tightest step-time budget with feedback**: `{fastest.method}` "
             f"({fmt(fastest.step_us)} us per step, {_step_basis(fastest)}, on this machine; "
             f"it removes the initial offset, below 5 % after {fmt(fastest.settle_s)} s on the "
-            f"{fastest.shown(fastest.settle_trajectory)})." + _caveat([fastest])
+            f"{fastest.shown(fastest.settle_trajectory)})." + _caveat([fastest], given)
         )
-    lines.append(_stability_line(items))
-    lines.append(_singularity_line(items))
+    lines.append(_stability_line(items, given))
+    lines.append(_singularity_line(items, given))
     open_loop = [p for p in items if p.open_loop and not p.converges]
     if open_loop:
         best = min(open_loop, key=_overall)
         lines.append(
             f"**No pose measurement (feed-forward only)**: `{best.method}` (best open-loop "
             f"score, overall {mm(_overall(best))} mm; it keeps any initial offset)."
-            + _caveat([best])
+            + _caveat([best], given)
         )
     ours = [m for m in slides.order if m in SLIDES_ORDER] if slides is not None else []
     if ours:
@@ -250,9 +255,10 @@ def recommendations(
     return lines
 
 
-def _stability_line(items: Sequence[Profile]) -> str:
+def _stability_line(items: Sequence[Profile], given: set[str] | None = None) -> str:
     """Which compared methods keep a hard floor on S, and which enforce one but were
-    below it (a run that starts below its floor breaks it from the first step)."""
+    below it (a run that starts below its floor breaks it from the first step); ``given``
+    as :func:`_caveat` takes it."""
     label = "**Tip-over stability as a hard guarantee**: "
     floored = [p for p in items if p.stability_floor is not None]
     if not floored:
@@ -266,7 +272,8 @@ def _stability_line(items: Sequence[Profile]) -> str:
         texts = ", ".join(_broken_floor_text(p) for p in broken)
         verb = _agree(broken, "enforces", "enforce")
         parts.append(f"{texts} {verb} a floor but did not keep it in these runs")
-    return label + "; ".join([*parts, "no other compared method constrains S."]) + _caveat(floored)
+    others = "no other compared method constrains S."
+    return label + "; ".join([*parts, others]) + _caveat(floored, given)
 
 
 def _broken_floor_text(p: Profile) -> str:
@@ -289,8 +296,9 @@ def _overall(p: Profile) -> float:
     return math.exp(sum(logs) / len(logs))
 
 
-def _best_line(label: str, items: Sequence[Profile], key) -> str:
-    """The best method by ``key`` and everything tied with it; the fastest tied one first."""
+def _best_line(label: str, items: Sequence[Profile], key, given: set[str] | None = None) -> str:
+    """The best method by ``key`` and everything tied with it; the fastest tied one first;
+    ``given`` as :func:`_caveat` takes it."""
     best = min(key(p) for p in items)
     tied = sorted((p for p in items if at_least_as_good(key(p), best)), key=lambda p: p.step_us)
     first, others = tied[0], tied[1:]
@@ -299,7 +307,7 @@ def _best_line(label: str, items: Sequence[Profile], key) -> str:
         text += "; tied with it within 5 % but slower per step: " + ", ".join(
             f"`{p.method}` ({mm(key(p))} mm, {fmt(p.step_us)} us)" for p in others
         )
-    return text + "." + _caveat(tied)
+    return text + "." + _caveat(tied, given)
 
 
 def _step_basis(p: Profile) -> str:
@@ -313,29 +321,43 @@ def _step_basis(p: Profile) -> str:
     )
 
 
-def _caveat(named: Sequence[Profile]) -> str:
+def _caveat(named: Sequence[Profile], given: set[str] | None = None) -> str:
     """The runs of the methods a line names (``named``) that did not track
-    (:attr:`Profile.untracked`), as :func:`_did_not_track` writes them."""
+    (:attr:`Profile.untracked`), as :func:`_did_not_track` writes them. ``given``: the
+    methods whose runs an earlier line of the advice named; those are only referred back to
+    (`` `qp` (see above)``), and the methods named here are added to it (None: a line on
+    its own, every method's runs named)."""
     shown = named[0].shown if named else str
-    return _did_not_track([(p.method, p.untracked) for p in named], shown)
+    failed = [p for p in named if p.untracked]
+    given = set() if given is None else given
+    new = [(p.method, p.untracked) for p in failed if p.method not in given]
+    again = [p.method for p in failed if p.method in given]
+    given.update(method for method, _ in new)
+    return _did_not_track(new, shown, again=again)
 
 
 def _did_not_track(
     named: Sequence[tuple[str, Sequence[tuple[str, str | None]]]],
     shown: Callable[[str], str],
     under: str = "",
+    again: Sequence[str] = (),
 ) -> str:
     """`` Did not track (docs/cli.md, "Verdict"): `ats` on the rectangle (kinematic and
     thesis plants).``: per method of ``named`` its runs, (trajectory key, plant or None
     for the kinematic main run), that did not track, grouped by trajectory; ``""`` when all
     tracked. ``shown`` gives a trajectory key's shown name; ``under`` names the settings of
-    the runs when they are not the report's main ones (`` under `--preset slides` ``)."""
+    the runs when they are not the report's main ones (`` under `--preset slides` ``);
+    ``again``: methods whose runs that did not track an earlier line named, referred back to
+    last (`` `qp`, `mpc` (see above)``; the verdict reference was given there too)."""
     parts = [
         f"`{method}` on " + _and(_by_trajectory(runs, shown)) for method, runs in named if runs
     ]
+    where = ' (docs/cli.md, "Verdict")' if parts else ""  # else the earlier line gave it
+    if again:
+        parts.append(f"{_names(again)} (see above)")
     if not parts:
         return ""
-    return f' Did not track{under} (docs/cli.md, "Verdict"): {"; ".join(parts)}.'
+    return f" Did not track{under}{where}: {'; '.join(parts)}."
 
 
 def _by_trajectory(
@@ -363,9 +385,10 @@ def _and(texts: Sequence[str]) -> str:
     return texts[0] if len(texts) == 1 else ", ".join(texts[:-1]) + " and " + texts[-1]
 
 
-def _singularity_line(items: Sequence[Profile]) -> str:
+def _singularity_line(items: Sequence[Profile], given: set[str] | None = None) -> str:
     """Which methods pass the shoulder singularity, stay away from it or lose the path
-    there; the runs that did not track of the first two groups (:func:`_caveat`)."""
+    there; the runs that did not track of the first two groups (:func:`_caveat`, with
+    ``given``)."""
     lost = [p.method for p in items if any(o == "lost" for o, _ in p.singularity.values())]
     passes = [
         p.method
@@ -390,7 +413,7 @@ def _singularity_line(items: Sequence[Profile]) -> str:
             f"and {_agree(lost, 'loses', 'lose')} the path"
         )
     kept = [p for p in items if p.method not in lost]
-    return text + "; ".join(parts) + "." + _caveat(kept)
+    return text + "; ".join(parts) + "." + _caveat(kept, given)
 
 
 def _agree(methods: Sequence[str], one: str, several: str) -> str:

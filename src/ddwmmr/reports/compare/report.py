@@ -21,6 +21,7 @@ from ddwmmr.controllers.base import method_description
 from ddwmmr.model import Robot
 from ddwmmr.outputs import write_atomic
 from ddwmmr.reports import compare_plots as plots
+from ddwmmr.reports import palette
 from ddwmmr.reports.compare import advice, settings
 from ddwmmr.reports.compare.constants import (
     CONVERGED_FRACTION,
@@ -163,7 +164,7 @@ class _Context:
     @property
     def colors(self) -> dict[str, str]:
         methods = dict.fromkeys([*self.config.methods, *self.config.study_methods])
-        return plots.method_colors(list(methods))
+        return palette.method_colors(list(methods))
 
     def main(self, method: str, name: str) -> RunOutput:
         return self.outputs[main_spec(self.config, method, name)]
