@@ -82,6 +82,20 @@ def _bar_size(stream: TextIO) -> dict[str, object]:
     return {"dynamic_ncols": True}
 
 
+class _Bar(tqdm):
+    """tqdm's bar without tqdm's monitor thread, which would be alive while the tools'
+    process pools fork their workers (a forked child gets copies of the locks other
+    threads hold, locked for good; Python 3.12+ warns).
+
+    The monitor redraws a bar that has not been redrawn for ``maxinterval`` (10 s)
+    because tqdm skips the clock until ``miniters`` updates have come, a count it raises
+    to the most updates seen between two redraws: after a slowdown a bar would freeze.
+    Our bars set ``miniters=1`` (every update looks at the clock and redraws once
+    ``mininterval`` has passed), so the monitor has nothing to do."""
+
+    monitor_interval = 0  # a class attribute: tqdm reads it before __init__
+
+
 class ProgressBar:
     """Progress of ``total`` items: ``with ProgressBar(total, "runs") as bar: bar.advance()``.
 
@@ -110,12 +124,13 @@ class ProgressBar:
         self._last_line = self._start
         self._bar: tqdm | None = None
         if enabled and _is_terminal(self.stream):
-            self._bar = tqdm(
+            self._bar = _Bar(
                 total=self.total,
                 desc=label,
                 unit=unit,
                 file=self.stream,
                 mininterval=0.2,
+                miniters=1,  # look at the clock at every update: no monitor thread needed
                 smoothing=0.0,  # the ETA at the average rate so far (see the module doc)
                 leave=True,
                 **_bar_size(self.stream),

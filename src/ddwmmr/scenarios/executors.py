@@ -21,7 +21,7 @@ from typing import Any
 from ddwmmr.errors import MAX_JOBS, ParameterError, check_finite, check_int_at_least, shown
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import Outcome, RunConfig, run_scenario
-from ddwmmr.workers import process_pool
+from ddwmmr.workers import process_pool, worker_display
 
 EXECUTORS = ("local", "dask")
 #: Seconds a Dask scheduler has to answer, and then to have a worker (``--connect-timeout``).
@@ -238,11 +238,33 @@ def _terminal_signals_blocked() -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
+def _warnings_display_plugin(display: Callable[[], None]) -> Any:
+    """A Dask worker plugin that runs ``display`` (a :func:`ddwmmr.workers.worker_display`
+    of this process) in every worker of the cluster, those that join later (a worker
+    restarted by its nanny) included, so that the workers show warnings as this process
+    does. A LocalCluster's worker processes write to this process's stderr (they inherit
+    it through their nanny), so their warnings reach the same terminal.
+
+    Defined here, not at module level, because ``distributed`` is an optional extra
+    imported only when used; Dask pickles the class by value."""
+    from distributed.diagnostics.plugin import WorkerPlugin
+
+    class WarningsDisplay(WorkerPlugin):
+        name = "ddwmmr-warnings-display"
+
+        def setup(self, worker: Any) -> None:
+            display()
+
+    return WarningsDisplay()
+
+
 class DaskWorkers:
     """A connected Dask client for the ``with`` block: to the scheduler at ``scheduler``
     (checked first, :func:`check_scheduler`, then given ``connect_timeout`` s for a worker
     to be there), or to a LocalCluster of ``jobs`` single-threaded workers started for
-    the block. Every failure to get there is a one-line :class:`ParameterError`."""
+    the block, which show warnings as this process does (:func:`_warnings_display_plugin`;
+    a remote scheduler's workers keep their own display, and their output goes to their
+    own logs). Every failure to get there is a one-line :class:`ParameterError`."""
 
     def __init__(
         self,
@@ -273,6 +295,9 @@ class DaskWorkers:
             with _terminal_signals_blocked():  # inherited by the cluster's threads and workers
                 self._cluster = distributed.LocalCluster(**options)
                 self._client = distributed.Client(self._cluster)
+            display = worker_display()
+            if display is not None:
+                self._client.register_plugin(_warnings_display_plugin(display))
             return self._client
         check_scheduler(self.scheduler, self.connect_timeout)
         try:
