@@ -48,7 +48,10 @@ should fix first. After what stops or overrules a run (divergence, tipping, a co
 start below the floor, solver fallbacks), commands clipped on more than
 :data:`SATURATED_CAUSE` of the steps (``saturated_steps``), with as many steps at a rate
 limit, name the trajectory as asking more than the robot can give, before anything the arm
-did (a singularity, a fold), which follows from it. An
+did (a singularity, a fold), which follows from it. So does an actuator at its force or
+torque limit for more than :data:`FORCE_LIMIT_CAUSE` of the run (``actuator_saturated_time_s``
+of ``duration``): the base lags commands it cannot produce the force for and the arm
+stretches after it; the cause names the limit held and then what the arm did. An
 obstacle-avoiding controller (``qp``, ``mpc``: a ``min_obstacle_clearance_m``) whose base
 came within :data:`OBSTACLE_NEAR_M` of an obstacle, with no other cause in sight, is named
 as having left the trajectory to go round it. A run that would have tipped over
@@ -102,6 +105,7 @@ __all__ = [
     "EXTENT_FRACTION",
     "EXTENT_LIMIT_FLOOR_M",
     "FLAG_KEYS",
+    "FORCE_LIMIT_CAUSE",
     "HELD_CAUSE",
     "LENGTH_UNIT_RANGE_M",
     "MOST_OF_RUN",
@@ -135,6 +139,12 @@ SATURATED_CAUSE = 0.9
 #: Share of singular steps above which the singularity is named as the likely cause of a
 #: failure, even when they are not most of the run (ap on the rectangle: 990 of 2000).
 SINGULAR_CAUSE = 0.25
+#: Share of the run (``actuator_saturated_time_s`` of ``duration``) above which an actuator
+#: held at its force or torque limit is named as the likely cause before anything the arm
+#: did (a singularity, a fold): a base that cannot produce the force its commands need for
+#: most of the run lags them, and the arm stretches after it; no method tracks until the
+#: motors can drive the robot at the trajectory's pace.
+FORCE_LIMIT_CAUSE = 0.5
 #: End-effector position error (m) above which a run of the default robot did not track
 #: (final or RMS); another robot's is this many of its length units (``length_unit_m``)...
 ERROR_LIMIT_M = 0.05
@@ -277,6 +287,13 @@ HELD_LIMIT = (
     "the robot ran at a limit ({held}), where it cannot follow the trajectory any faster "
     "({clipping}){transient}: a slower trajectory, a smaller dt or a higher limit "
     '(see docs/cli.md, "Verdict")'
+)
+#: :data:`HELD_LIMIT`'s words on a run held at its force limit (:data:`FORCE_LIMIT_CAUSE`)
+#: whose arm would otherwise have been named (:func:`_arm_cause`): what it did, in
+#: ``{arm}``, may follow from the force limit or be the method's own.
+ARM_AFTER_FORCE_LIMIT = (
+    "; the arm {arm}, which may follow from it (the base lagged and the arm stretched after "
+    "it), so fix this first"
 )
 #: :data:`HELD_LIMIT`'s words on ``saturated_steps``: none
 #: clipped (the controller's own bounds or the plant's dynamics held the limit) ...
@@ -674,15 +691,17 @@ def _tipped(summary: Mapping[str, Any]) -> str:
 
 
 def _arm_or_path_cause(summary: Mapping[str, Any], found: list[str]) -> str:
-    """The rest of :func:`likely_cause`, after the causes that stop or overrule a run:
-    what the arm did, saturation, an obstacle, a limit held, the start offset, else no
-    convergence."""
-    steps = _number(summary, "steps") or 0
-    if steps and (_number(summary, "singular_steps") or 0) > SINGULAR_CAUSE * steps:
-        return SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
-    min_manipulability = _number(summary, "min_manipulability")
-    if min_manipulability is not None and min_manipulability < 1e-6:
-        return _folded_arm(summary)
+    """The rest of :func:`likely_cause`, after the causes that stop or overrule a run: an
+    actuator at its force limit for most of the run, what the arm did, saturation, an
+    obstacle, a limit held, the start offset, else no convergence."""
+    arm = _arm_cause(summary)
+    if _force_limited(summary):
+        words = ARM_AFTER_FORCE_LIMIT.format(arm=arm[1]) if arm else ""
+        cause = _held_cause(summary, found, words)
+        if cause is not None:
+            return cause
+    if arm:
+        return arm[0]
     if "saturated_most_of_run" in found:
         return _joint(summary) if _mostly_at_joint_limits(summary) else SATURATION
     clearance = _number(summary, "min_obstacle_clearance_m")  # None: no obstacles
@@ -693,26 +712,63 @@ def _arm_or_path_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     return _held_or_converging_cause(summary, found)
 
 
+def _arm_cause(summary: Mapping[str, Any]) -> tuple[str, str] | None:
+    """What the arm did, where it explains a failure: ``(cause, words)``, the cause
+    (:data:`SLIDES_ROW` or :data:`SINGULAR_DRIFT` for singular steps above
+    :data:`SINGULAR_CAUSE` of the run, else :func:`_folded_arm` for an arm folded to
+    ``min_manipulability`` 0) and a few words on it for :data:`ARM_AFTER_FORCE_LIMIT`;
+    None where neither holds."""
+    steps = _number(summary, "steps") or 0
+    singular = _number(summary, "singular_steps") or 0
+    if steps and singular > SINGULAR_CAUSE * steps:
+        cause = SLIDES_ROW if summary.get("aux") == "sum" else SINGULAR_DRIFT
+        return cause, f"was singular (damped) on {int(singular)} of {int(steps)} steps"
+    min_manipulability = _number(summary, "min_manipulability")
+    if min_manipulability is not None and min_manipulability < 1e-6:
+        return _folded_arm(summary), "folded to a joint limit (min manipulability 0)"
+    return None
+
+
+def _force_limited(summary: Mapping[str, Any]) -> bool:
+    """An actuator was at its force or torque limit (``actuator_saturated_time_s``, the
+    thesis and MuJoCo plants) for more than :data:`FORCE_LIMIT_CAUSE` of the run
+    (``duration``, s)."""
+    duration = _number(summary, "duration") or 0.0
+    at_limit = _number(summary, "actuator_saturated_time_s") or 0.0
+    return duration > 0.0 and at_limit > FORCE_LIMIT_CAUSE * duration
+
+
 def _held_or_converging_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     """The rest of :func:`_arm_or_path_cause`: a transient at a limit of a run that
     converged, a rate limit held, the start offset, a joint limit held, else no
     convergence."""
-    held = held_limits(summary)
-    joint = _joint_limit_phrase(summary)
-    transient = held + ([joint] if joint else [])
-    if transient and _converged_after_a_transient(summary, found):
-        return _held_limit(summary, transient, _transient_text(summary))
-    if held:
-        return _held_limit(summary, held, "")
+    held = _held_cause(summary, found)
+    if held is not None:
+        return held
     if _only_the_start_offset(summary, found):
         return START_TRANSIENT.format(
             final_mm=1000.0 * (_number(summary, "final_position_error_m") or 0.0),
             offset_mm=1000.0 * (_number(summary, "initial_offset_m") or 0.0),
             duration=_duration_text(summary),
         )
-    if joint:
+    if _joint_limit_phrase(summary):
         return _joint(summary)
     return NO_CONVERGENCE
+
+
+def _held_cause(summary: Mapping[str, Any], found: list[str], after: str = "") -> str | None:
+    """:data:`HELD_LIMIT` for a run that held a limit (:func:`held_limits`): with the
+    transient (and the joint limit held, :func:`_joint_limit_phrase`) where the run
+    converged after it, then ``after``; None where no limit was held (nor a joint limit
+    held on a run that converged after a transient)."""
+    held = held_limits(summary)
+    joint = _joint_limit_phrase(summary)
+    transient = held + ([joint] if joint else [])
+    if transient and _converged_after_a_transient(summary, found):
+        return _held_limit(summary, transient, _transient_text(summary) + after)
+    if held:
+        return _held_limit(summary, held, after)
+    return None
 
 
 def _clipped_throughout(summary: Mapping[str, Any], steps: float) -> bool:
