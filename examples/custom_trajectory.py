@@ -9,6 +9,7 @@ to compute a run's references in a few calls instead of one per time. Prints onl
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -38,7 +39,7 @@ class SineWave:
         self.speed, self.amplitude, self.period = speed, amplitude, period
         self.duration, self.samples = duration, samples
 
-    def _y(self, t):
+    def _y(self, t: float | np.ndarray) -> tuple[Any, Any, Any]:
         """Lateral offset y (m) and its first and second time derivatives (m/s, m/s^2);
         ``t`` is a time (s) or an array of times."""
         omega = 2.0 * math.pi / self.period

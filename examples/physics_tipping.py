@@ -18,11 +18,13 @@ Prints only; about 15 s. The 100-scenario study is
 
 from __future__ import annotations
 
+from typing import Any
+
 from ddwmmr.cli.common import run_script  # bad input: one line, status 2
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 
 #: (label, mpc options) of each run, from the bare static floor to the default.
-VARIANTS = (
+VARIANTS: tuple[tuple[str, dict[str, Any]], ...] = (
     ("static floor only", {"dynamic_stability": False, "arm_time_constant": 0.0}),
     ("+ arm lag, braking step", {"dynamic_stability": False}),
     ("+ every edge loaded (default)", {}),

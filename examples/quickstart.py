@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import sys
 import textwrap
+from typing import Any
 
 import numpy as np
 
@@ -47,7 +48,9 @@ def main(method: str = "clrrmc-ts") -> None:
     # th1dot, th2dot) in m/s and rad/s for the recorded start configuration.
     controller = make_controller(method, robot)
     controller.reset(trajectory, result.configurations()[0])
-    u = controller.command(
+    # Any: a velocity method's command is an array; the Controller type also admits a
+    # plug-in's list or a force method's WheelForces
+    u: Any = controller.command(
         0.0, result.configurations()[0], trajectory.pose(0.0), trajectory.velocity(0.0)
     )
     print("  first command u =", np.array2string(u, precision=4))

@@ -56,7 +56,8 @@ if TYPE_CHECKING:  # what the names are, for type checkers and IDEs; imported on
     from ddwmmr.controllers import available_methods, make_controller, register
     from ddwmmr.errors import ParameterError
     from ddwmmr.model import Robot
-    from ddwmmr.sim import SimulationResult, simulate
+    from ddwmmr.sim.result import SimulationResult
+    from ddwmmr.sim.simulate import simulate  # the function: ddwmmr.sim.simulate is a module
     from ddwmmr.trajectories import (
         Ellipse,
         Rectangle,
@@ -72,8 +73,8 @@ _EXPORTS = {
     "register": "ddwmmr.controllers",
     "ParameterError": "ddwmmr.errors",
     "Robot": "ddwmmr.model",
-    "SimulationResult": "ddwmmr.sim",
-    "simulate": "ddwmmr.sim",
+    "SimulationResult": "ddwmmr.sim.result",
+    "simulate": "ddwmmr.sim.simulate",
     "Ellipse": "ddwmmr.trajectories",
     "Rectangle": "ddwmmr.trajectories",
     "SampledTrajectory": "ddwmmr.trajectories",

@@ -60,7 +60,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from itertools import count
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from ddwmmr.errors import ParameterError, one_line, shown
 
@@ -93,6 +93,9 @@ NAME_FORM = (
     f"1 to {MAX_NAME_LENGTH} ASCII letters, digits, '_', '-' or '.', not starting with '-' or '.'"
 )
 _PACKAGE = Path(__file__).parent
+#: A plug-in class: a decorator returns the class it was given, so type checkers keep the
+#: class's own type (its constructor and members) instead of a bare ``type``.
+PluginClass = TypeVar("PluginClass", bound=type)
 
 
 @dataclass
@@ -147,7 +150,7 @@ class Registry:
         self._entries: dict[str, Entry] = {}
 
     # -- registration -----------------------------------------------------------------
-    def register(self, name: str, **traits: Any) -> Callable[[type], type]:
+    def register(self, name: str, **traits: Any) -> Callable[[PluginClass], PluginClass]:
         """Class decorator: register the class under ``name`` with ``traits`` (see the
         module docstring; ``description=`` overrides the docstring's first line). A name
         the command line cannot address (not :data:`NAME_FORM`) is a
@@ -156,7 +159,7 @@ class Registry:
         description = traits.pop("description", None)
         resolved = self._traits(name, traits)
 
-        def decorate(cls: type) -> type:
+        def decorate(cls: PluginClass) -> PluginClass:
             cls.name = name  # type: ignore[attr-defined]
             for trait in self.sets:
                 setattr(cls, trait, resolved[trait])
@@ -404,6 +407,7 @@ __all__ = [
     "PLANTS",
     "PLUGINS_VARIABLE",
     "Entry",
+    "PluginClass",
     "Registry",
     "discover",
     "register_arbiter",

@@ -21,11 +21,12 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 import numpy as np
+import numpy.typing as npt
 
-from ddwmmr.commands import PlantTraits
+from ddwmmr.commands import PlantTraits, WheelForces
 from ddwmmr.errors import ParameterError, check_instance, shown
 from ddwmmr.model import Robot
-from ddwmmr.registry import CONTROLLERS
+from ddwmmr.registry import CONTROLLERS, PluginClass
 from ddwmmr.trajectories.base import resolution_step
 
 
@@ -91,9 +92,12 @@ class Controller(Protocol):
     depend on how long they are held plan with it, see :func:`control_step`), and before
     it ``adopt_plant(traits)`` (the plant's :class:`~ddwmmr.commands.PlantTraits`: a
     controller may choose the options it was not given for that plant).
+
+    The class attributes ``name`` and ``interfaces`` that :func:`register_controller` sets
+    are not members: a controller object needs no registration to be simulated (the loop
+    reads them with defaults), and a type checker does not see what a decorator sets.
     """
 
-    name: str
     last: StepInfo
 
     def reset(self, trajectory: Any, q0: np.ndarray) -> None:  # pragma: no cover - protocol
@@ -102,8 +106,10 @@ class Controller(Protocol):
 
     def command(
         self, t: float, q: np.ndarray, pose_d: np.ndarray, velocity_d: np.ndarray
-    ) -> np.ndarray:  # pragma: no cover - protocol
-        """Input ``u = [v, w, th1dot, th2dot]`` for time t (s) and configuration q."""
+    ) -> npt.ArrayLike | WheelForces:  # pragma: no cover - protocol
+        """Input ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s, rad/s, rad/s) for time t (s)
+        and configuration q: 4 finite numbers (an array, a list, a tuple), or a
+        :class:`~ddwmmr.commands.WheelForces` from a force controller."""
         ...
 
 
@@ -143,7 +149,7 @@ class WaypointRun:
 register_controller = CONTROLLERS.register
 
 
-def register(name: str) -> Callable[[type], type]:
+def register(name: str) -> Callable[[PluginClass], PluginClass]:
     """Class decorator adding a trajectory-tracking controller under ``name``: the short
     form of :func:`register_controller` with its default traits."""
     return CONTROLLERS.register(name)

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ddwmmr.errors import (
     INERTIA_RANGE_KG_M2,
@@ -33,6 +34,7 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import kinematics, stability, support_loads
 from ddwmmr.model.mass import YawInertia, total_mass
+from ddwmmr.model.stability import ComCoefficients
 
 _PI = math.pi
 #: Allowed range (low, high, unit) of each scalar field; see ddwmmr.errors for the caps.
@@ -186,7 +188,7 @@ class Robot:
     arm_height: float = 0.35
     wheel_torque_limit: float = 2.0
     joint_torque_limits: tuple[float, float] = (20.0, 10.0)
-    _com: stability.ComCoefficients = field(init=False, repr=False, compare=False)
+    _com: ComCoefficients = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         for name in _RANGES:
@@ -378,7 +380,7 @@ class Robot:
         """Maximum arm reach L1 + L2 (m)."""
         return self.L1 + self.L2
 
-    def joints_outside(self, q) -> str | None:
+    def joints_outside(self, q: npt.ArrayLike) -> str | None:
         """None if the arm joints of configuration ``q`` lie within ``joint_limits``, else
         the phrase naming the first that does not ("joint th1 = 2.5 rad is outside
         joint_limits[1] = [-1, 1] rad"), for a refusal to complete."""
@@ -393,18 +395,18 @@ class Robot:
     # it with _configuration: wrong shapes, strings, NaN/inf and angles beyond
     # +-MAX_CONFIGURATION_ANGLE_RAD raise ParameterError naming q. The check costs one
     # tolist() and one sum of magnitudes on the common (valid) path.
-    def fk(self, q) -> np.ndarray:
+    def fk(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """End-effector pose ``[xE, yE, phiE]`` (world frame, m and rad) at configuration q."""
         return np.array(kinematics.forward_kinematics(self.L1, self.L2, _configuration(q)))
 
-    def jacobian(self, q) -> np.ndarray:
+    def jacobian(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """The 4x5 Jacobian: rows xE, yE, phiE, nonholonomic constraint.
 
         docs/theory.md, "Configuration, forward kinematics, Jacobian".
         """
         return kinematics.jacobian(self.L1, self.L2, _configuration(q))
 
-    def augmented_jacobian(self, q, aux: str = "sum") -> np.ndarray:
+    def augmented_jacobian(self, q: npt.ArrayLike, aux: str = "sum") -> npt.NDArray[np.float64]:
         """The 5x5 augmented Jacobian (``aux`` is ``"sum"`` or ``"shoulder"``)."""
         if not isinstance(aux, str) or aux not in kinematics.AUX_ROWS:
             raise ParameterError(
@@ -420,7 +422,7 @@ class Robot:
         r, lw = self.wheel_radius, self.track_width
         return (2.0 * v - lw * w) / (2.0 * r), (2.0 * v + lw * w) / (2.0 * r)
 
-    def wheel_speeds(self, q, qdot) -> np.ndarray:
+    def wheel_speeds(self, q: npt.ArrayLike, qdot: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Wheel angular speeds ``[phidot_l, phidot_r]`` (rad/s) for configuration rate qdot.
 
         Only the forward part ``xdot cos(phi) + ydot sin(phi)`` of the base velocity drives
@@ -430,41 +432,43 @@ class Robot:
         (v, w, _, _), _ = kinematics.u_from_qdot(float(phi), _configuration(qdot, "qdot"))
         return np.array(self.wheel_speeds_from_u(v, w))
 
-    def base_velocity(self, wheel_speeds) -> np.ndarray:
+    def base_velocity(self, wheel_speeds: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Inverse of the wheel map: ``[v, w]`` (m/s, rad/s) from ``[phidot_l, phidot_r]``."""
         left, right = _pair("wheel_speeds", wheel_speeds, "rad/s")
         r = self.wheel_radius
         return np.array([r * (left + right) / 2.0, r * (right - left) / self.track_width])
 
     # -- performance metrics ------------------------------------------------------------
-    def manipulability(self, q) -> float:
+    def manipulability(self, q: npt.ArrayLike) -> float:
         """Normalised manipulability ``eta = |sin(th2)|`` in [0, 1]."""
         return stability.manipulability(float(_configuration(q)[4]))
 
-    def stability(self, q) -> tuple[float, float, float]:
+    def stability(self, q: npt.ArrayLike) -> tuple[float, float, float]:
         """Tip-over stability ``(S_lon, S_lat, S)`` on the support polygon; ``S > 1`` is
         stable (capped at 10)."""
         q = _configuration(q)
         return stability.stability_terms(self._com, float(q[3]), float(q[4]))
 
-    def stability_gradient(self, q) -> np.ndarray:
+    def stability_gradient(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Gradient of the capped stability margin S with respect to q (5,), per rad."""
         q = _configuration(q)
         _, g1, g2 = stability.stability_gradient(self._com, float(q[3]), float(q[4]))
         return np.array([0.0, 0.0, 0.0, g1, g2])
 
-    def centre_of_mass(self, q) -> np.ndarray:
+    def centre_of_mass(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Arm+payload+base centre of mass ``[x_com, y_com]`` in the base frame (m)."""
         q = _configuration(q)
         return np.array(stability.centre_of_mass(self._com, float(q[3]), float(q[4])))
 
     @property
-    def com_coefficients(self) -> stability.ComCoefficients:
+    def com_coefficients(self) -> ComCoefficients:
         """Precomputed centre-of-mass coefficients (for fast inner loops)."""
         return self._com
 
     # -- inverse kinematics ---------------------------------------------------------------
-    def base_for_end_effector(self, pose_e, th1: float, th2: float) -> np.ndarray:
+    def base_for_end_effector(
+        self, pose_e: npt.ArrayLike, th1: float, th2: float
+    ) -> npt.NDArray[np.float64]:
         """The configuration with arm pose (th1, th2) that puts the end effector at ``pose_e``.
 
         ``pose_e = [xE, yE, phiE]``; the base heading follows from ``phiE - th1 - th2``.

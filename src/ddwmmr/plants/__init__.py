@@ -36,7 +36,7 @@ def plant_class(name: str) -> type:
     return PLANTS.load(name)
 
 
-def make_plant(name: str, robot: Any, **options: Any) -> Plant:
+def make_plant(name: str, robot: Robot, **options: Any) -> Plant:
     """Build the plant ``name`` for ``robot`` with its keyword ``options``; an unknown
     option is a :class:`ParameterError` naming the accepted ones."""
     cls = plant_class(name)

@@ -259,28 +259,14 @@ def _check_step_slowly(
     raise ParameterError(command_refusal("command", command, interfaces))
 
 
-class Plant(Protocol):
-    """Structural type of every plant.
-
-    Attributes:
-        name: short name used in reports (``"kinematic"``, ``"thesis"``, ``"mujoco"``).
-        interfaces: command interfaces accepted (``"velocity"``, ``"force"``).
-        robot: the :class:`~ddwmmr.model.Robot` it simulates.
-        extra_columns: names of plant-specific time-series columns (may be empty).
-
-    Optional: ``timestep`` (s), an engine step that control steps must be whole multiples
-    of (``simulate`` rounds its default step to one); ``tip_time`` (s or None), on plants
-    that judge tipping over by their own physics (contact forces): when the robot tipped
-    since the reset, None while it has not (the scenario protocol fails a run on it), and
-    with it ``unloaded_time_s``, the time (s) since the reset with an edge of the support
-    polygon unloaded; ``joint_time_constant`` (s), the lag with which the joints follow
-    their rate targets, and ``damping``, the base's viscous damping ``(c1, c2)`` (N s/m,
-    N m s/rad): what the loop tells controllers of the plant
-    (:func:`ddwmmr.commands.traits_of`; the ``mpc`` models both).
+class PlantImplementation(Protocol):
+    """What a plant class implements itself: every member of :class:`Plant` but ``name``
+    and ``interfaces``, which its :func:`~ddwmmr.registry.register_plant` decorator sets
+    on the class (a type checker does not see what a decorator sets). ``simulate(...,
+    plant=...)`` takes a plant object by this type; a plant the loop runs is a
+    :class:`Plant` (registered, or declaring both attributes itself).
     """
 
-    name: str
-    interfaces: tuple[str, ...]
     robot: Any
     extra_columns: tuple[str, ...]
 
@@ -330,3 +316,27 @@ class Plant(Protocol):
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:  # pragma: no cover
         """Plant-specific summary keys computed from a recorded run (may be empty)."""
         ...
+
+
+class Plant(PlantImplementation, Protocol):
+    """Structural type of every plant.
+
+    Attributes:
+        name: short name used in reports (``"kinematic"``, ``"thesis"``, ``"mujoco"``).
+        interfaces: command interfaces accepted (``"velocity"``, ``"force"``).
+        robot: the :class:`~ddwmmr.model.Robot` it simulates.
+        extra_columns: names of plant-specific time-series columns (may be empty).
+
+    Optional: ``timestep`` (s), an engine step that control steps must be whole multiples
+    of (``simulate`` rounds its default step to one); ``tip_time`` (s or None), on plants
+    that judge tipping over by their own physics (contact forces): when the robot tipped
+    since the reset, None while it has not (the scenario protocol fails a run on it), and
+    with it ``unloaded_time_s``, the time (s) since the reset with an edge of the support
+    polygon unloaded; ``joint_time_constant`` (s), the lag with which the joints follow
+    their rate targets, and ``damping``, the base's viscous damping ``(c1, c2)`` (N s/m,
+    N m s/rad): what the loop tells controllers of the plant
+    (:func:`ddwmmr.commands.traits_of`; the ``mpc`` models both).
+    """
+
+    name: str
+    interfaces: tuple[str, ...]

@@ -9,6 +9,7 @@ from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ddwmmr.controllers.base import (
     Controller,
@@ -33,7 +34,7 @@ from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.model.robot import long_lengths
 from ddwmmr.model.stability import max_payload, tips_in_every_pose
 from ddwmmr.plants import available_plants, make_plant, plant_class
-from ddwmmr.plants.base import Plant
+from ddwmmr.plants.base import Plant, PlantImplementation
 from ddwmmr.registry import CONTROLLERS
 from ddwmmr.resolution.kernels import length_unit
 from ddwmmr.resolution.reference import (
@@ -213,9 +214,9 @@ def simulate(
     dt: float | None = None,
     duration: float | None = None,
     integrator: str | None = None,
-    initial_offset: tuple[float, float] = DEFAULT_INITIAL_OFFSET,
-    q0: np.ndarray | None = None,
-    plant: str | Plant = "kinematic",
+    initial_offset: Sequence[float] = DEFAULT_INITIAL_OFFSET,
+    q0: npt.ArrayLike | None = None,
+    plant: str | PlantImplementation = "kinematic",
     plant_options: dict[str, Any] | None = None,
     progress: Callable[[int, int], None] | None = None,
     tipped_start: str = "warn",

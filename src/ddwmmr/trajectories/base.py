@@ -18,6 +18,7 @@ from collections.abc import Callable
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
+import numpy.typing as npt
 
 from ddwmmr.errors import ParameterError, check_finite, check_int_at_least, shown
 from ddwmmr.inheritance import defining_class, overrides
@@ -32,12 +33,14 @@ class Trajectory(Protocol):
         """Length of one run (s)."""
         ...
 
-    def pose(self, t: float) -> np.ndarray:  # pragma: no cover - protocol
-        """Desired pose ``[xE, yE, phiE]`` at time t (s)."""
+    def pose(self, t: float) -> npt.ArrayLike:  # pragma: no cover - protocol
+        """Desired pose ``[xE, yE, phiE]`` (m, m, rad) at time t (s): 3 finite numbers
+        (an array, a list, a tuple)."""
         ...
 
-    def velocity(self, t: float) -> np.ndarray:  # pragma: no cover - protocol
-        """Desired velocity ``[xEdot, yEdot, phiEdot]`` at time t (s)."""
+    def velocity(self, t: float) -> npt.ArrayLike:  # pragma: no cover - protocol
+        """Desired velocity ``[xEdot, yEdot, phiEdot]`` (m/s, m/s, rad/s) at time t (s): 3
+        finite numbers (an array, a list, a tuple)."""
         ...
 
 

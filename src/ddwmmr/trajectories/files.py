@@ -38,9 +38,9 @@ from typing import Any
 
 from ddwmmr.errors import ParameterError, as_path, check_number_type, load_toml, shown
 from ddwmmr.trajectories.parametric import PHI_NEEDS_CONSTANT, Ellipse, Rectangle
-from ddwmmr.trajectories.sampled import read_csv
+from ddwmmr.trajectories.sampled import SampledTrajectory, read_csv
 
-SHAPES = {"ellipse": Ellipse, "rectangle": Rectangle}
+SHAPES: dict[str, type[Ellipse] | type[Rectangle]] = {"ellipse": Ellipse, "rectangle": Rectangle}
 SUFFIXES = (".toml", ".csv")
 #: A trajectory or obstacle-file name: no separator, no leading dot, no "..".
 _NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]*")
@@ -117,7 +117,9 @@ def find_trajectory_file(name_or_path: str | Path) -> Path | None:
     )
 
 
-def load_trajectory(name_or_path: str | Path, **overrides):
+def load_trajectory(
+    name_or_path: str | Path, **overrides: Any
+) -> Ellipse | Rectangle | SampledTrajectory:
     """Resolve a trajectory name or file path; ``overrides`` replace TOML parameters.
 
     The overrides are the keyword arguments of :class:`Ellipse` / :class:`Rectangle`

@@ -19,10 +19,13 @@ import bisect
 import csv
 import math
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from ddwmmr.errors import (
     DURATION_RANGE_S,
@@ -60,6 +63,10 @@ DEGREES_SLACK_RAD = 4.0 * math.pi
 #: Longest default control step (s) of a sampled trajectory: that of the shipped ellipse
 #: and rectangle (40 s / 2000 samples).
 MAX_DEFAULT_STEP_S = 0.02
+#: What ``points`` takes: rows of numbers (lists, tuples, arrays) or a 2-D array. Spelled
+#: out because mypy types the docs' ``[[0, 0], [1, 0.2]]`` as ``list[object]`` against
+#: ``numpy.typing.ArrayLike`` alone (its many alternatives hide the rows' element type).
+SampleRows = Sequence[Sequence[float]] | Sequence[npt.ArrayLike] | npt.NDArray[Any]
 
 
 def _tangents(times: np.ndarray, values: np.ndarray, periodic: bool) -> np.ndarray:
@@ -117,6 +124,14 @@ class SampledTrajectory:
     _knots: list = field(init=False, repr=False, compare=False)
     _has_phi: bool = field(init=False, repr=False, compare=False)
     _moving: tuple[float, float] = field(init=False, repr=False, compare=False)
+
+    def __init__(self, times: npt.ArrayLike, points: SampleRows, name: str = "sampled") -> None:
+        # Written out (the dataclass keeps it) so that type checkers take any array-like
+        # (lists, as the docs write them); the fields hold the checked float arrays.
+        object.__setattr__(self, "times", times)
+        object.__setattr__(self, "points", points)
+        object.__setattr__(self, "name", name)
+        self.__post_init__()
 
     def __post_init__(self) -> None:
         check_name(self.name, "trajectory samples: ")
