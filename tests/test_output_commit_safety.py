@@ -15,11 +15,13 @@ import subprocess
 import sys
 import textwrap
 from pathlib import Path
+from typing import BinaryIO
 
 import pytest
 
 from ddwmmr import outputs
 from ddwmmr.outputs import MANIFEST, checks, commit, output_folder, owners, recovery
+from ddwmmr.outputs.lock import lock_file
 
 
 def _write_run(target: Path, text: str, force: bool = False, names=("a.csv",)) -> None:
@@ -179,7 +181,7 @@ def test_the_output_a_killed_run_was_replacing_is_put_back(tmp_path, capsys, for
         assert not (target / "b.csv").exists()
         assert json.loads((target / MANIFEST).read_text())["files"] == ["a.csv"]
         assert "put back the earlier output" in capsys.readouterr().err
-        ours = ".ddwmmr-staging-" + outputs.owner_token()
+        ours = (".ddwmmr-staging-" + outputs.owner_token(), lock_file(target).name)
         assert [n for n in _leftovers(tmp_path) if not n.startswith(ours)] == []
         (staging / "a.csv").write_text("newer\n")
     assert (target / "a.csv").read_text() == "newer\n"
@@ -203,9 +205,9 @@ def test_a_failed_commit_names_the_output_not_the_staging_folder(tmp_path, monke
 def test_write_new_never_replaces_a_file_made_meanwhile(tmp_path):
     wanted = tmp_path / "timeseries.csv"
 
-    def racing_write(path: Path) -> None:
+    def racing_write(handle: BinaryIO) -> None:
         wanted.write_text("theirs\n")  # another app takes the name during our write
-        outputs.write_atomic(path, "ours\n")
+        handle.write(b"ours\n")
 
     written = outputs.write_new(wanted, racing_write)
     assert written == tmp_path / "timeseries-2.csv"
@@ -219,12 +221,12 @@ class _RacingResult:
     def __init__(self, folder: Path) -> None:
         self.folder = folder
 
-    def write_csv(self, path: Path) -> None:
+    def stream_csv(self, handle: BinaryIO) -> None:
         (self.folder / "timeseries.csv").write_text("theirs\n")
-        outputs.write_atomic(path, "ours\n")
+        handle.write(b"ours\n")
 
-    def write_summary(self, path: Path, **extra) -> None:
-        outputs.write_atomic(path, "{}\n")
+    def summary_text(self, **extra) -> str:
+        return "{}\n"
 
 
 def test_two_gui_exports_at_once_keep_each_others_files(tmp_path):

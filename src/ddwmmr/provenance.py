@@ -24,6 +24,7 @@ import inspect
 import math
 import os
 import platform
+import re
 import shlex
 import subprocess
 import sys
@@ -316,7 +317,8 @@ def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Path | None, st
         return SHAPES[kind](**decode(record["parameters"])), file, None
     if kind != "samples":
         raise ParameterError(f"cannot rebuild a trajectory of type {shown(kind)}")
-    path = Path(record["file"])
+    path = Path(_recorded_file(record))
+    digest = recorded_sha256(record)
     note = None
     if not path.exists():
         path = _shipped_stand_in(record, path)
@@ -327,9 +329,37 @@ def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Path | None, st
     if not path.is_file():  # checked before hashing: a FIFO would block the read
         now = "a folder" if path.is_dir() else "not a regular file"
         raise ParameterError(f"the trajectory file {path} is now {now}")
-    if file_sha256(path) != record["sha256"]:
+    if file_sha256(path) != digest:
         raise ParameterError(f"the trajectory file {path} changed since the run (SHA-256 differs)")
     return read_csv(path), path, note
+
+
+#: A SHA-256 as :func:`~ddwmmr.trajectories.files.file_sha256` gives it.
+_SHA256 = re.compile(r"[0-9a-f]{64}")
+
+
+def recorded_sha256(record: dict[str, Any]) -> str:
+    """The SHA-256 a :func:`trajectory_record` gives its file: a string of 64 hex digits
+    (lowercase), else a one-line :class:`ParameterError` naming ``trajectory.sha256`` (a
+    :class:`KeyError` when the record lacks it). A malformed record is refused as such,
+    not as a file changed since the run."""
+    digest = record["sha256"]
+    if not isinstance(digest, str) or _SHA256.fullmatch(digest) is None:
+        raise ParameterError(
+            f"trajectory.sha256 must be a string of 64 hex digits (0-9, a-f) (got {shown(digest)})"
+        )
+    return digest
+
+
+def _recorded_file(record: dict[str, Any]) -> str:
+    """The path a samples :func:`trajectory_record` gives its file: a non-empty string,
+    else a one-line :class:`ParameterError` naming ``trajectory.file``."""
+    file = record["file"]
+    if not isinstance(file, str) or not file or "\0" in file:
+        raise ParameterError(
+            f"trajectory.file must be a file path, a non-empty string (got {shown(file)})"
+        )
+    return file
 
 
 def _shipped_stand_in(record: dict[str, Any], gone: Path) -> Path:
@@ -340,7 +370,7 @@ def _shipped_stand_in(record: dict[str, Any], gone: Path) -> Path:
         shipped = package_folder() / f"{stem}.csv"
         if not (is_name(stem) and shipped.is_file()):  # a name never leaves the folder
             continue
-        if file_sha256(shipped) == record["sha256"]:
+        if file_sha256(shipped) == recorded_sha256(record):
             return shipped
         differs = f" (the package's own {shipped.name} has another SHA-256)"
     raise ParameterError(f"the trajectory file {gone} is gone{differs}")

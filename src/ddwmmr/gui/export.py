@@ -1,7 +1,7 @@
 """Export of the app's current run: CSV/JSON, a PNG of the window, an animation.
 
 Every file is written on its own with :func:`ddwmmr.outputs.write_new` (its content by
-the result's own ``write_csv``/``write_summary`` where there is one). Nothing in the
+the result's own ``stream_csv``/``summary_text`` where there is one). Nothing in the
 export folder is ever deleted or overwritten: a name that exists gets a ``-2``, ``-3``...
 suffix, and the name is taken atomically, so two apps exporting into the same folder at
 the same moment each keep their files; a run's folder is taken the same way.
@@ -25,7 +25,6 @@ from __future__ import annotations
 import io
 import tempfile
 from collections.abc import Iterator, Sequence
-from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -97,9 +96,9 @@ def write_run_data(
         ]
     for result, label, record in zip(results, labels, records):
         target = slot_folder(folder, results, label)
-        csv_path = write_new(target / "timeseries.csv", result.write_csv)
+        csv_path = write_new(target / "timeseries.csv", result.stream_csv)
         extra = {} if record is None else {"run": record}
-        json_path = write_new(target / "summary.json", partial(result.write_summary, **extra))
+        json_path = write_new(target / "summary.json", result.summary_text(**extra))
         written += [csv_path, json_path]
     return written
 

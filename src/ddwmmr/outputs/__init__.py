@@ -13,8 +13,13 @@ Every tool (track, compare, scenarios) writes its results through :func:`output_
   start time in their names (:func:`owner_token`), and the next run writing in the same
   folder removes those whose process is gone (:func:`remove_stale`), saying so in one
   line, after putting back every earlier output the killed run had moved aside, whichever
-  ``--out`` the next run writes (:func:`_restore_killed`). Nothing is synced to disk (no
-  ``fsync``): a power cut may lose the last files written;
+  ``--out`` the next run writes (:func:`_restore_killed`);
+* every file is synced to disk (``fsync``) before the commit moves it into ``--out``, and
+  the folders after the move (:func:`sync_folder`; not on Windows): a power cut leaves the
+  earlier output or the new one, never an empty file under an output name;
+* two runs writing the same ``--out`` at once are locked out of each other
+  (:func:`output_lock`, a lock file beside ``--out``): the second is refused in one line,
+  so a folder never holds files of two runs; a killed run's lock is taken over;
 * a folder written by a tool carries a manifest, :data:`MANIFEST`, naming the tool, the
   package version and every file written;
 * an existing ``--out`` is replaced only if it is empty, or if its manifest names the same
@@ -36,7 +41,7 @@ usual ``022``), not the ``0600``/``0700`` of temporary files.
 
 from __future__ import annotations
 
-from ddwmmr.outputs.atomic import first_free, write_atomic, write_new
+from ddwmmr.outputs.atomic import first_free, sync_folder, write_atomic, write_new
 from ddwmmr.outputs.checks import (
     MANIFEST,
     Existing,
@@ -57,6 +62,7 @@ from ddwmmr.outputs.commit import (
     remove_created,
 )
 from ddwmmr.outputs.files import csv_text, file_mode, folder_mode, line_ending, package_version
+from ddwmmr.outputs.lock import output_lock
 from ddwmmr.outputs.owners import KEPT_PREFIX, STAGING_PREFIX, owner_token
 from ddwmmr.outputs.recovery import remove_stale
 
@@ -81,10 +87,12 @@ __all__ = [
     "missing_folders",
     "nearest_existing",
     "output_folder",
+    "output_lock",
     "owner_token",
     "package_version",
     "remove_created",
     "remove_stale",
+    "sync_folder",
     "unwritable_message",
     "write_atomic",
     "write_new",

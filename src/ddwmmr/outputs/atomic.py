@@ -38,6 +38,10 @@ def write_atomic(
     (:func:`unwritable_message`: ``/proc``, a read-only mount, no permission).
     Failures of the write itself (full disk) raise :class:`OSError`.
 
+    Durable: the file's bytes are synced to the disk (``fsync``) before the rename, and
+    the folder's entry after it (:func:`sync_folder`), so a power cut leaves the earlier
+    file or the new one under ``path``, never an empty one.
+
     The file gets the user's umask (``0644`` for umask 022), like any normal file, not
     the ``0600`` of the temporary file. The temporary file
     carries this process's :func:`owner_token` in its name (:func:`temp_prefix`): one a
@@ -60,6 +64,8 @@ def write_atomic(
                 payload(handle)
             else:
                 handle.write(payload)
+            handle.flush()
+            os.fsync(handle.fileno())  # the data reaches the disk before the name does
         # Once more just before the rename: a FIFO or folder made there during the write
         # would be replaced as well.
         check_file_target(path)
@@ -67,37 +73,57 @@ def write_atomic(
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+    sync_folder(path.parent)
 
 
-def write_new(path: str | Path, data: str | bytes | Callable[[Path], None]) -> Path:
+def sync_folder(folder: str | os.PathLike[str]) -> None:
+    """Flush ``folder``'s entries (a rename or a new name in it) to the disk with
+    ``fsync``, so that after a power cut the name points at the file written, not at an
+    empty one (ext4, xfs). Skipped on Windows, which cannot open a folder for it, and
+    where the file system refuses (``EINVAL`` on some network mounts): best effort."""
+    if os.name == "nt":
+        return
+    try:
+        fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass  # the file system does not sync folders; the files themselves are synced
+    finally:
+        os.close(fd)
+
+
+def write_new(path: str | Path, data: str | bytes | Callable[[BinaryIO], None]) -> Path:
     """Write a new file at ``path`` or, if that name is taken, at the first free
     ``stem-2.suffix``, ``stem-3.suffix``... (:func:`first_free`); an existing file is
     never replaced, not even one another process creates at the same moment. Returns the
     path written.
 
-    ``data`` (text, written as UTF-8, or bytes) goes to a temporary file first, or
-    ``data(temporary_path)`` writes it there (e.g. a result's ``write_csv``). That file
-    then takes the free name with a hard link, which fails if the name was taken
-    meanwhile: the next name is tried. Where hard links are not supported, the name is
-    taken with an exclusive create, then the file is renamed onto it."""
+    ``data`` is what :func:`write_atomic` takes: text (written as UTF-8), bytes, or a
+    function ``data(handle)`` writing the bytes into a binary handle piece by piece (a
+    result's ``stream_csv``). It goes to a temporary file first; that file then takes
+    the free name with a hard link, which fails if the name was taken meanwhile: the next
+    name is tried. Where hard links are not supported, the name is taken with an
+    exclusive create, then the file is renamed onto it. Durable as :func:`write_atomic`:
+    the data, then the new name, are synced to the disk."""
     path = Path(path)
     temporary = path.parent / f"{temp_prefix()}{os.urandom(4).hex()}.tmp"
     try:
-        if callable(data):
-            data(temporary)
-        else:
-            write_atomic(temporary, data)
+        write_atomic(temporary, data)
         while True:
             candidate = first_free(path)
             try:
                 os.link(temporary, candidate)
-                return candidate
             except FileExistsError:
                 continue  # taken between the look and the link: the next one
             except OSError:  # no hard links on this file system (FAT, some mounts)
-                if _take_name(candidate):
-                    os.replace(temporary, candidate)
-                    return candidate
+                if not _take_name(candidate):
+                    continue
+                os.replace(temporary, candidate)
+            sync_folder(candidate.parent)
+            return candidate
     finally:
         temporary.unlink(missing_ok=True)
 

@@ -19,7 +19,7 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path, PurePosixPath
 
 from ddwmmr.errors import ParameterError
-from ddwmmr.outputs.atomic import first_free, write_atomic
+from ddwmmr.outputs.atomic import first_free, sync_folder, write_atomic
 from ddwmmr.outputs.checks import (
     MANIFEST,
     Existing,
@@ -33,6 +33,7 @@ from ddwmmr.outputs.checks import (
     missing_folders,
 )
 from ddwmmr.outputs.files import file_mode, folder_mode, package_version
+from ddwmmr.outputs.lock import output_lock
 from ddwmmr.outputs.owners import _OLD_PREFIX, STAGING_PREFIX, owner_token
 from ddwmmr.outputs.recovery import (
     _drop_note,
@@ -81,12 +82,24 @@ class OutputFolder:
         self._staging: Path | None = None
         self._created: list[Path] = []
         self._entered = False
+        self._lock = contextlib.ExitStack()
 
     def __enter__(self) -> Path:
         if self._entered:
             raise RuntimeError("an OutputFolder is used for one with-block only")
         self._entered = True
         remove_stale(self.path.parent)
+        staging = self._make_staging()  # and the missing parents, where the lock goes
+        if not self.fresh:  # a fresh output never replaces one: nothing to lock out
+            try:
+                self._lock.enter_context(output_lock(self.path, self._text))
+            except BaseException:
+                self._discard()
+                raise
+        return staging
+
+    def _make_staging(self) -> Path:
+        """Create the staging folder (and any missing parent of ``--out``)."""
         prefix = f"{STAGING_PREFIX}{owner_token()}-"
         for attempt in range(2):
             self._created = _make_parents(self.path.parent)
@@ -113,6 +126,13 @@ class OutputFolder:
         return staging
 
     def __exit__(self, exc_type, exc, traceback) -> bool:
+        try:
+            return self._finish(exc_type)
+        finally:
+            self._lock.close()  # released however the commit ends
+
+    def _finish(self, exc_type: type[BaseException] | None) -> bool:
+        """Commit the staged files (no ``exc_type``) or discard them."""
         if exc_type is not None:
             self._discard()
             return False  # the block's exception goes on
@@ -134,12 +154,14 @@ class OutputFolder:
                 ) from error
             raise
         self.path = done[0]
+        _sync_output(self.path)
         return False
 
     def _discard(self) -> None:
         if self._staging is not None:
             shutil.rmtree(self._staging, ignore_errors=True)
             self._staging = None
+        self._lock.close()  # first: the parents made for the output go only if empty
         remove_created(self._created)
 
 
@@ -248,6 +270,7 @@ def _commit(
     files = _entries(staging)
     manifest = {"tool": tool, "version": package_version(), "files": files}
     _write_manifest(staging, manifest)
+    _sync_files(staging)
     if fresh:
         _commit_fresh(staging, target, done)
         return
@@ -314,6 +337,31 @@ def list_in_manifest(folder: str | Path, tool: str, names: Sequence[str]) -> Non
     files = sorted({*existing.listed, *names})
     manifest = {"tool": tool, "version": package_version(), "files": files}
     write_atomic(folder / MANIFEST, json.dumps(manifest, indent=2) + "\n")
+
+
+def _sync_files(folder: Path) -> None:
+    """Sync every regular file below ``folder`` to the disk (``fsync``): whatever wrote
+    it (``savefig`` too), its bytes are on the disk before the commit's renames make it
+    the output, so a power cut never leaves an empty file under an output name."""
+    for root, _, files in os.walk(folder):
+        for name in files:
+            path = Path(root) / name
+            if os.path.islink(path):
+                continue
+            fd = os.open(path, os.O_RDONLY)
+            try:
+                os.fsync(fd)
+            finally:
+                os.close(fd)
+
+
+def _sync_output(folder: Path) -> None:
+    """Sync the entries of the committed output ``folder``, of every folder below it and
+    of its parent (:func:`sync_folder`): the renames that made it the output reach the
+    disk."""
+    for root, _, _ in os.walk(folder):
+        sync_folder(root)
+    sync_folder(folder.parent)
 
 
 def _write_manifest(folder: Path, manifest: dict) -> None:

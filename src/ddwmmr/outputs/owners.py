@@ -34,6 +34,10 @@ _OWNED_NAME = re.compile(
 _TMP_PREFIX = ".ddwmmr-tmp-"
 
 
+#: The lock of an output folder, beside it (:func:`ddwmmr.outputs.lock.output_lock`).
+LOCK_PREFIX = ".ddwmmr-lock-"
+
+
 def _host() -> str:
     """This machine's name, reduced to letters, digits, dots and dashes (at most 64)."""
     return re.sub(r"[^A-Za-z0-9.-]", "_", socket.gethostname())[:64] or "host"
@@ -91,3 +95,27 @@ def _running(pid: int, start: int) -> bool:
 def _is_stale_temp(name: str) -> bool:
     """Whether ``name`` is a temporary file's name (:func:`temp_prefix`) of an ended run."""
     return name.endswith(".tmp") and _dead_owner(name, "tmp") is not None
+
+
+def lock_holder(path: Path) -> tuple[str, int, int] | None:
+    """``(host, pid, start)`` of the run holding the lock ``path`` (its text is that run's
+    :func:`owner_token`; an unreadable or cut-short one: this host, pid 0, which
+    :func:`dead_lock` counts as ended), or None if there is no lock."""
+    try:
+        token = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return None
+    except (OSError, UnicodeDecodeError):
+        token = ""
+    rest, _, start = token.rpartition("-")
+    host, _, pid = rest.rpartition("-")
+    if not (host and pid.isdigit() and start.isdigit()):
+        return (_host(), 0, 0)
+    return (host, int(pid), int(start))
+
+
+def dead_lock(holder: tuple[str, int, int]) -> bool:
+    """Whether the lock ``holder`` (:func:`lock_holder`) is of a run of this host that has
+    ended (a lock of another host's run is never taken for dead)."""
+    host, pid, start = holder
+    return host == _host() and (pid == 0 or not _running(pid, start))

@@ -21,9 +21,13 @@ from ddwmmr.outputs.files import folder_mode
 from ddwmmr.outputs.owners import (
     _OWNED_NAME,
     KEPT_PREFIX,
+    LOCK_PREFIX,
     STAGING_PREFIX,
     _dead_owner,
     _is_stale_temp,
+    dead_lock,
+    lock_holder,
+    temp_prefix,
 )
 
 #: Added to an old folder's name: the file naming the output that folder replaces.
@@ -73,6 +77,32 @@ def _remove_stale_notes(folder: Path) -> None:
             _unlink_regular(folder / name)
 
 
+def _remove_stale_locks(folder: Path) -> None:
+    """Remove the output locks (:data:`LOCK_PREFIX`) in ``folder`` of runs that have ended
+    (:func:`dead_lock`): a run killed outright cannot remove its own."""
+    for name in _names(folder):
+        path = folder / name
+        if name.startswith(LOCK_PREFIX) and _is_regular(path):
+            holder = lock_holder(path)
+            if holder is not None and dead_lock(holder):
+                drop_stale_lock(path, holder)
+
+
+def drop_stale_lock(path: Path, holder: tuple[str, int, int]) -> None:
+    """Remove the lock ``path`` of the ended run ``holder``, unless another run has taken
+    it over meanwhile (that lock is put back). The lock is first renamed to a name of this run's
+    own, so two runs taking over the same stale lock cannot remove each other's new one."""
+    aside = path.with_name(f"{temp_prefix()}{os.urandom(4).hex()}.tmp")
+    try:
+        os.rename(path, aside)
+    except FileNotFoundError:
+        return  # another run removed it
+    if lock_holder(aside) != holder:
+        with contextlib.suppress(OSError):
+            os.link(aside, path)  # a live run's lock, moved by mistake: put it back
+    aside.unlink(missing_ok=True)
+
+
 def stale_folders(folder: Path) -> list[Path]:
     """Staging and old folders in ``folder`` left by runs on this host that have ended."""
     try:
@@ -119,6 +149,7 @@ def remove_stale(folder: Path) -> list[Path]:
         else:
             removed.append(path)
     _remove_stale_notes(folder)
+    _remove_stale_locks(folder)
     if removed or kept:
         count = len(removed)
         line = f"note: removed {count} folder{'s' * (count != 1)} left in {folder} by runs "

@@ -42,7 +42,13 @@ class SimulationResult:
         FIFO is refused, missing parent folders are created. The text goes to the file
         :data:`CSV_BLOCK` rows at a time (:func:`write_csv_rows`): a million-sample run's
         half a gigabyte of text is never held whole."""
-        write_atomic(path, lambda handle: write_csv_rows(self.timeseries, handle))
+        write_atomic(path, self.stream_csv)
+
+    def stream_csv(self, handle: BinaryIO) -> None:
+        """Write the bytes of :meth:`write_csv`'s file into the binary ``handle``, piece by
+        piece (:func:`write_csv_rows`): the writer :func:`write_atomic` and
+        :func:`~ddwmmr.outputs.write_new` take."""
+        write_csv_rows(self.timeseries, handle)
 
     def write_summary(self, path: str | Path, **extra: Any) -> None:
         """Write the summary as JSON to ``path``, with ``extra`` keys (e.g. ``run``),
@@ -50,12 +56,17 @@ class SimulationResult:
         hold (an object, a set; numpy scalars and non-finite floats are converted,
         :func:`json_safe`) is a one-line :class:`ParameterError` naming its key, before
         anything is written."""
+        write_atomic(path, self.summary_text(**extra))
+
+    def summary_text(self, **extra: Any) -> str:
+        """The text of :meth:`write_summary`'s file (JSON, indented, ending in a newline),
+        with its refusals."""
         data = json_safe({**self.summary, **extra})
         try:
             text = json.dumps(data, indent=2)
         except (TypeError, ValueError, RecursionError) as exc:  # ValueError: a cycle
             raise _unserialisable(data) from exc
-        write_atomic(path, text + "\n")
+        return text + "\n"
 
 
 #: Rows of a time series formatted and written together by :func:`write_csv_rows`.

@@ -1,0 +1,99 @@
+"""One run at a time per output folder: a run writing ``--out`` holds a lock file beside
+it (:func:`output_lock`), so two runs started together on the same ``--out`` never leave
+a folder whose files come from both; the second is refused in one line. A lock a killed
+run left (its process is gone) is taken over.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.outputs.files import file_mode
+from ddwmmr.outputs.owners import (
+    LOCK_PREFIX,
+    _host,
+    dead_lock,
+    lock_holder,
+    owner_token,
+    temp_prefix,
+)
+from ddwmmr.outputs.recovery import _target_tag, drop_stale_lock
+
+
+def lock_file(target: Path) -> Path:
+    """The lock of the output folder ``target``: ``.ddwmmr-lock-<tag>`` beside it (not
+    inside: the commit renames the folder itself, and an absent ``target`` stays absent
+    until the results move in). Its text is the holder's :func:`owner_token`."""
+    return target.with_name(f"{LOCK_PREFIX}{_target_tag(target)}")
+
+
+@contextlib.contextmanager
+def output_lock(target: Path, text: str) -> Iterator[None]:
+    """Hold the lock of ``target`` (shown as ``text``) for the block; a one-line
+    :class:`ParameterError` if another live run holds it: ``out: DIR is being written by
+    another ddwmmr run (pid N)``. The lock is removed when the block ends, however it
+    ends; one whose holder has ended (same host) is taken over."""
+    path = lock_file(target)
+    token = owner_token()
+    _take(path, text, token)
+    try:
+        yield
+    finally:
+        with contextlib.suppress(OSError):
+            if path.read_text(encoding="utf-8") == token:
+                path.unlink()
+
+
+def _take(path: Path, text: str, token: str) -> None:
+    """Create the lock ``path`` holding ``token``, taking over one of an ended run."""
+    for _ in range(3):
+        if _create(path, token):
+            return
+        holder = lock_holder(path)
+        if holder is None:
+            continue  # removed meanwhile: try again
+        if dead_lock(holder):
+            drop_stale_lock(path, holder)  # a killed run's: take it over
+            continue
+        host, pid, _ = holder
+        where = "" if host == _host() else f" on {host}"
+        raise ParameterError(
+            f"out: {text} is being written by another ddwmmr run (pid {pid}{where})"
+        )
+    raise ParameterError(f"out: {text} is being written by another ddwmmr run")
+
+
+def _create(path: Path, token: str) -> bool:
+    """Make the lock whole or not at all: the token is written to a temporary file that
+    then takes the name with a hard link (fails if the name exists); where hard links are
+    not supported, an exclusive create. False if the lock exists."""
+    fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=temp_prefix(), suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as handle:
+            os.fchmod(handle.fileno(), file_mode())
+            handle.write(token)
+        try:
+            os.link(temporary, path)
+        except FileExistsError:
+            return False
+        except OSError:  # no hard links on this file system (FAT, some mounts)
+            return _create_exclusive(path, token)
+        return True
+    finally:
+        Path(temporary).unlink(missing_ok=True)
+
+
+def _create_exclusive(path: Path, token: str) -> bool:
+    """Create ``path`` holding ``token`` with an exclusive create; False if it exists."""
+    try:
+        fd = os.open(path, os.O_CREAT | os.O_EXCL | os.O_WRONLY, file_mode())
+    except FileExistsError:
+        return False
+    with os.fdopen(fd, "w", encoding="utf-8") as handle:
+        handle.write(token)
+    return True
