@@ -224,8 +224,10 @@ def tyre_stiffness(robot: Robot, options: EngineOptions) -> float:
     ``options.tyre_stiffness`` if given; else :data:`DEFAULT_TYRE_STIFFNESS` times the
     robot's own mass (payload excluded: the tyre is built for the robot, not for what it
     carries) over the default robot's, times the default robot's ``track_width`` over the
-    robot's. A load shift that is the same share of the weight then tilts the base by the
-    same angle on a robot of any size (the tip rule is an angle); the tyre's natural
+    robot's. A load shift that is the same share of the weight then tilts the base on its
+    tyres by the same angle on a robot of any size (the tip rule is an angle; the whole
+    robot's lean, casters and contact softness included, only about: docs/physics.md
+    gives the measured ratios); the tyre's natural
     frequency is then the default robot's times about ``sqrt(0.35 m / track_width)``
     (docs/physics.md, "The model, generated from Robot"). Exactly
     :data:`DEFAULT_TYRE_STIFFNESS` for the default robot at any payload; not held to
