@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import json
-import re
 import sys
 import textwrap
 from collections.abc import Callable, Sequence
@@ -572,10 +571,7 @@ def _recorded_digest(trajectory_record: dict, source: Any) -> str | None:
     """The SHA-256 the record gives its trajectory file (a record naming a file must)."""
     if not (isinstance(source, str) and source):
         return None
-    digest = trajectory_record.get("sha256")
-    if not isinstance(digest, str) or re.fullmatch(r"[0-9a-f]{64}", digest) is None:
-        raise ParameterError("the trajectory's file has no SHA-256 of 64 hex digits")
-    return digest
+    return _inside("trajectory", lambda: provenance.recorded_sha256(trajectory_record))
 
 
 def _in_record(path: str, exc: ParameterError) -> ParameterError:
