@@ -180,3 +180,12 @@ def test_robot_toml_errors(tmp_path):
     bad.write_text("L3 = 1.0\n")
     with pytest.raises(ParameterError, match="unknown parameter 'L3'"):
         Robot.from_toml(bad)
+
+
+def test_own_mass_is_the_robot_without_its_payload():
+    """``own_mass`` (what the thesis plant's damping and the MuJoCo tyres scale with) is the
+    total mass less the payload, at any payload."""
+    for payload in (0.0, 1.25, 3.0):
+        robot = Robot().with_payload(payload)
+        assert robot.own_mass == pytest.approx(robot.total_mass - payload, abs=1e-12)
+        assert robot.own_mass == Robot().own_mass

@@ -358,6 +358,13 @@ class Robot:
         return total_mass(self.base_mass, m1, m2, self.payload)
 
     @property
+    def own_mass(self) -> float:
+        """The robot's own mass (kg): base (wheels included) and both links, without the
+        payload (what its drive and tyres are built for, not what it carries)."""
+        m1, m2 = self.link_masses
+        return total_mass(self.base_mass, m1, m2, 0.0)
+
+    @property
     def base_body_mass(self) -> float:
         """Mass of the base without its two drive wheels (kg): ``base_mass - 2 wheel_mass``."""
         return self.base_mass - 2.0 * self.wheel_mass

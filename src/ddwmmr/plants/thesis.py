@@ -77,11 +77,10 @@ def _drive_facts(robot: Robot) -> dict[str, float]:
     """What each thesis constant is proportional to, for ``robot``: its motors' wheel force
     (``motor_force_limit``, N), its own mass (kg) and its own yaw inertia with the arm
     stretched (kg m^2), both without the payload."""
-    own = robot.with_payload(0.0)
     return {
         "force_limit": robot.motor_force_limit,
-        "c1": own.total_mass,
-        "c2": own.yaw_inertia.at(0.0),
+        "c1": robot.own_mass,
+        "c2": robot.with_payload(0.0).yaw_inertia.at(0.0),
     }
 
 

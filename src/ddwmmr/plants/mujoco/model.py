@@ -55,7 +55,6 @@ import numpy as np
 
 from ddwmmr.errors import ParameterError, check_positive, check_range, shown
 from ddwmmr.model import Robot
-from ddwmmr.model.mass import total_mass as robot_mass
 from ddwmmr.model.stability import BASE_CLEARANCE_M
 from ddwmmr.model.support_loads import convex_hull
 
@@ -210,11 +209,6 @@ def _checked_stiffness(stiffness: float) -> float:
     return float(stiffness)
 
 
-def _own_mass(robot: Robot) -> float:
-    """The robot's own mass (kg): base (wheels included) and links, without the payload."""
-    return robot_mass(robot.base_mass, *robot.link_masses, 0.0)
-
-
 _DEFAULT_ROBOT = Robot()
 
 
@@ -235,7 +229,7 @@ def tyre_stiffness(robot: Robot, options: EngineOptions) -> float:
     """
     if options.tyre_stiffness is not None:
         return options.tyre_stiffness
-    mass_ratio = _own_mass(robot) / _own_mass(_DEFAULT_ROBOT)
+    mass_ratio = robot.own_mass / _DEFAULT_ROBOT.own_mass
     return DEFAULT_TYRE_STIFFNESS * mass_ratio * (_DEFAULT_ROBOT.track_width / robot.track_width)
 
 
