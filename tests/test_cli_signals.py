@@ -219,3 +219,24 @@ def test_a_tool_started_under_nohup_ignores_sighup(tmp_path):
         proc.kill()
     assert proc.returncode == 143, err
     assert "terminated (SIGTERM)" in err
+
+
+def test_say_writes_a_line_in_one_write(monkeypatch):
+    """Two processes sharing stderr (pool workers warning at once) cannot glue their lines
+    together: the text and its newline go out in one write."""
+    import io
+
+    from ddwmmr.cli.signals import say
+
+    writes: list[str] = []
+
+    class Recorder(io.StringIO):
+        def write(self, text: str) -> int:
+            writes.append(text)
+            return len(text)
+
+    monkeypatch.setattr(sys, "stderr", Recorder())
+    say("warning: from a worker")
+    assert writes == ["warning: from a worker\n"]
+    monkeypatch.setattr(sys, "stderr", None)
+    say("nowhere to go")  # a missing stderr (pythonw) is not an error

@@ -42,10 +42,13 @@ def stop_line(signum: int, complete: Path | None = None) -> str:
 
 
 def say(line: str) -> None:
-    """Print ``line`` on stderr; a closed stderr (or one a signal handler interrupted in
-    the middle of a write) is not an error of its own."""
-    with contextlib.suppress(OSError, ValueError, RuntimeError):
-        print(line, file=sys.stderr, flush=True)
+    """Print ``line`` on stderr in one write; a closed or missing stderr (or one a signal
+    handler interrupted in the middle of a write) is not an error of its own."""
+    with contextlib.suppress(OSError, ValueError, RuntimeError, AttributeError):
+        # one write: print() writes the text and the newline separately, and two worker
+        # processes warning at once could then share a line
+        sys.stderr.write(line + "\n")
+        sys.stderr.flush()
 
 
 def guard_start() -> None:
