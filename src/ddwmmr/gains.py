@@ -60,3 +60,50 @@ def _time_constant(value: Any) -> float:
     if math.isnan(number) or number < MIN_TAU:
         raise ParameterError(f"tau must be {TAU_RANGE} (got {number:g})")
     return number
+
+
+#: Largest gain times control step, ``K dt``, at which the sampled loop of ``e' = -K e``
+#: still shrinks the error, by how the law reaches the plant over one step: ``"hold"``, a
+#: command held over the step (a zero-order hold, or explicit Euler): ``e+ = (1 - K dt) e``,
+#: ``|1 - x| < 1`` for ``x < 2``; ``"rk4"``, the law evaluated at the four RK4 stages:
+#: ``e+ = R(-x) e`` with ``R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24``, ``|R(-x)| < 1`` below the
+#: real root of ``x^3 - 4 x^2 + 12 x - 24``. At the limit the error no longer decays; above
+#: it, it grows every step.
+STABLE_GAIN_STEP = {"hold": 2.0, "rk4": 2.785293563405282}
+#: What each scheme of :data:`STABLE_GAIN_STEP` is, as the warning words it.
+SCHEME_WORDS = {
+    "hold": "a command held over each step (zero-order hold or Euler)",
+    "rk4": "RK4 with the control law at its stages",
+}
+#: Share of the limit from which :func:`gain_step_warning` warns: the robot's loop is
+#: nonlinear (the Jacobian turns within a step, commands saturate), and at 0.9 of the
+#: limit a held command still flips the error's sign each step, shrinking it by 0.8 only.
+GAIN_STEP_MARGIN = 0.9
+
+
+def gain_step_warning(gains: Sequence[float], dt: float, scheme: str) -> str | None:
+    """The one-line warning for feedback ``gains`` (1/s, 0 for a channel off) run at the
+    control step ``dt`` (s) under ``scheme`` (a key of :data:`STABLE_GAIN_STEP`), or None
+    while the largest ``K dt`` stays below :data:`GAIN_STEP_MARGIN` of the scheme's limit.
+    The message names tau, dt, K dt, the limit and the dt and tau that would stay below."""
+    gain = max(gains, default=0.0)
+    limit = STABLE_GAIN_STEP[scheme]
+    allowed = GAIN_STEP_MARGIN * limit
+    if not gain * dt >= allowed:
+        return None
+    tau = 1.0 / gain
+    shortest = " (the shortest)" if len({k for k in gains if k > 0.0}) > 1 else ""
+    return (
+        f"tau = {tau:g} s{shortest} with dt = {dt:g} s: K dt = {gain * dt:.3g} (K = 1/tau) is "
+        f"at or above {GAIN_STEP_MARGIN:g} of {limit:.4g}, the stability limit of "
+        f"{SCHEME_WORDS[scheme]}: the tracking error may oscillate or grow; use dt below "
+        f"{_significant(allowed / gain, math.floor):g} s or tau above "
+        f"{_significant(dt / allowed, math.ceil):g} s"
+    )
+
+
+def _significant(value: float, rounding: Any, digits: int = 3) -> float:
+    """``value`` (> 0) to ``digits`` significant digits, rounded by ``rounding``
+    (``math.floor`` or ``math.ceil``): advice that stays on the safe side of a bound."""
+    scale = 10.0 ** (digits - 1 - math.floor(math.log10(value)))
+    return rounding(value * scale) / scale

@@ -52,6 +52,12 @@ class TaskSpaceController(ResolvedRate):
         self.aux = check_aux(aux)
         super().__init__(robot, singularity_threshold, damping)
 
+    @property
+    def feedback_gains(self) -> tuple[float, float, float]:
+        """The gains K (1/s) of the xE, yE, phiE error loops ``e' = -K e`` (0: off); the
+        run checks them against its control step (:func:`ddwmmr.gains.gain_step_warning`)."""
+        return self.kx, self.ky, self.kphi
+
     def law(
         self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
     ) -> tuple[Input, bool]:
@@ -114,6 +120,12 @@ class ConfigurationSpaceController:
         )
         self.reference: ReferenceTrajectory | None = None
         self.last = StepInfo()
+
+    @property
+    def feedback_gains(self) -> tuple[float, ...]:
+        """The gains K (1/s) of the x, y, phi, th1, th2 error loops ``e' = -K e`` (0: off);
+        the run checks them against its control step (:func:`ddwmmr.gains.gain_step_warning`)."""
+        return self.gains
 
     def reset(self, trajectory: object, q0: np.ndarray) -> None:
         """Build the reference q_d(t) from :func:`start_configuration` of ``trajectory``.

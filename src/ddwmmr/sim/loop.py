@@ -31,6 +31,10 @@ Controller contract (class attributes, all optional):
 * ``zero_order_hold``: True for sampled-data controllers (MPC, the thesis controller): the
   command is held over the step. Otherwise the kinematic plant's RK4 re-evaluates the
   control law at its stages (the closed loop integrated as one ODE).
+* ``feedback_gains``: the gains K (1/s) of its ``e' = -K e`` error loops (the closed-loop
+  methods'); before a run :func:`ddwmmr.sim.simulate.simulate` warns when the largest
+  times the step reaches the discrete loop's stability limit
+  (:func:`ddwmmr.gains.gain_step_warning`).
 * ``wants_base_velocity``: True passes the measured ``base_velocity=(v, w)`` to
   ``command`` (force-level controllers need it).
 * ``float_state``: True when ``command`` takes the configuration ``q`` as a tuple of 5

@@ -28,6 +28,7 @@ from ddwmmr.errors import (
     name_of,
     shown,
 )
+from ddwmmr.gains import gain_step_warning
 from ddwmmr.inheritance import from_library
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
@@ -292,6 +293,7 @@ def simulate(
         dt = engine_multiple(resolution_step(trajectory), the_plant)
     dt = check_positive("dt", dt)
     steps = check_step_count(duration, dt)  # within MAX_STEPS, before anything is allocated
+    warn_gain_step(controller, the_plant, dt)
     # the rectangle's corner windows (its corner metric), before the run: a duration with
     # more corners than they allow is refused now, not after every step has been simulated
     corners = getattr(trajectory, "corner_windows", None)
@@ -382,6 +384,21 @@ def _tipped_start(robot: Robot, q: np.ndarray, policy: str) -> bool:
             stacklevel=3,
         )
     return True
+
+
+def warn_gain_step(controller: Any, plant: Any, dt: float) -> None:
+    """Warn (:class:`UserWarning`) when the controller's ``feedback_gains`` (1/s, those of
+    its ``e' = -K e`` loops) are too large for the control step ``dt`` (s) on ``plant``
+    (:func:`~ddwmmr.gains.gain_step_warning`): the kinematic plant's ``rk4`` evaluates the
+    law at its stages, unless the controller holds its command (``zero_order_hold``);
+    every other plant and integrator holds it over the step. Not refused: the unstable
+    run may be what the user wants to see."""
+    gains = getattr(controller, "feedback_gains", ())
+    stages = getattr(plant, "integrator", None) == "rk4"
+    scheme = "rk4" if stages and not getattr(controller, "zero_order_hold", False) else "hold"
+    message = gain_step_warning(gains, dt, scheme)
+    if message is not None:
+        warnings.warn(message, UserWarning, stacklevel=3)
 
 
 def check_tracks(method: str) -> None:
