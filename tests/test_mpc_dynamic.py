@@ -162,7 +162,8 @@ def test_the_force_model_plans_within_the_motors_and_the_thesis_force_on_physics
     weak = Robot(wheel_torque_limit=0.5).with_payload(3.0)  # 5.1 N motors
     on_weak = make_controller("mpc", weak)
     on_weak.adopt_plant(traits_of(MujocoPlant(weak)))
-    assert on_weak.dynamics.force_limit == pytest.approx(0.5 / weak.wheel_radius, rel=1e-12)
+    # the thesis's share of its motors (10 N of 20.5 N), as the thesis plant derives it
+    assert on_weak.dynamics.force_limit == pytest.approx(2.5, rel=1e-12)
     strong_thesis = make_controller("mpc", ROBOT, wheel_force_limit=12.0)
     with pytest.raises(ParameterError, match="wheel_force_limit must be <= the plant's"):
         strong_thesis.adopt_plant(traits_of(ThesisPlant(ROBOT)))  # its 10 N motors

@@ -14,6 +14,7 @@ from ddwmmr import Robot
 from ddwmmr.commands import WheelForces
 from ddwmmr.plants import make_plant
 from ddwmmr.plants.thesis import ThesisPlant
+from scaled_robots import TEN_TIMES
 
 START = np.array([0.0, 0.0, 0.0, -0.3, 0.6])
 DT = 0.1
@@ -65,8 +66,11 @@ def test_other_wheel_drive_warns_once_naming_the_derived_constants():
     20.5 N: 73.125 N, and is told so in one line, once for two plants."""
     plants, messages = _built(lambda: [ThesisPlant(BIG) for _ in range(2)])
     assert len(messages) == 1 and "\n" not in messages[0]
-    for text in ("force_limit = 73.13 N", "(150 N)", "c1 = 15 N s/m", "c2 = 4 N m s/rad"):
-        assert text in messages[0]
+    assert messages[0] == (
+        "thesis plant: force_limit = 73.13 N (the thesis's 10 N scaled by its motors' force, "
+        "150 / 20.51 N) derived for this robot (ThesisPlant(robot, force_limit=...) sets it; "
+        "track: --plant-option force_limit=...)"
+    )  # c1, c2 derived too, but the thesis's own 15 and 4: not named
     assert plants[0].force_limit == pytest.approx(10.0 * 150.0 / (2.0 / 0.0975), rel=1e-12)
 
 
@@ -84,6 +88,29 @@ def test_given_damping_is_not_named_as_derived():
         warnings.simplefilter("always")
         plant = ThesisPlant(BIG, c1=5.0, c2=1.0)
     (message,) = [str(w.message) for w in caught]
-    assert message.startswith("thesis plant: force_limit = 73.13 N derived for this robot")
-    assert "c1 = 5" not in message and "c2 = 1" not in message
+    assert message.startswith("thesis plant: force_limit = 73.13 N (the thesis's 10 N")
+    assert "c1" not in message and "c2" not in message
+    assert message.endswith("sets it; track: --plant-option force_limit=...)")
     assert (plant.c1, plant.c2) == (5.0, 1.0)
+
+
+def test_given_force_limit_names_only_the_derived_damping():
+    """``force_limit`` given to the ten-times robot: the line names c1 and c2, each with the
+    thesis's value and what it scales with, and suggests setting exactly those; not the
+    force limit the user set, nor the thesis's 10 N."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        plant = ThesisPlant(TEN_TIMES, force_limit=500.0)
+    (message,) = [str(w.message) for w in caught]
+    assert "\n" not in message
+    assert message.startswith(
+        "thesis plant: c1 = 1.5e+04 N s/m (the thesis's 15 N s/m scaled by its own mass, "
+        "1.2e+04 / 12 kg), c2 = 4e+05 N m s/rad (the thesis's 4 N m s/rad scaled by its own "
+        "yaw inertia, 7.983e+04 / 0.7983 kg m^2) derived for this robot"
+    )
+    assert message.endswith(
+        "(ThesisPlant(robot, c1=..., c2=...) sets them; track: --plant-option c1=... "
+        "--plant-option c2=...)"
+    )
+    assert "force_limit" not in message and "10 N" not in message and "motors" not in message
+    assert (plant.force_limit, plant.c1, plant.c2) == pytest.approx((500.0, 1.5e4, 4e5))

@@ -12,8 +12,17 @@ import warnings
 import pytest
 
 from ddwmmr import Ellipse, Robot, simulate
+from ddwmmr.bounds.lower import Prices
+from ddwmmr.commands import FORCE, PlantTraits
+from ddwmmr.model import symbolic as sym
+from ddwmmr.model import thesis_base
+from ddwmmr.mpc.options import MPCOptions, planned_force
+from ddwmmr.plants import thesis as thesis_plant
 from ddwmmr.plants.thesis import ThesisPlant, robot_constants
 from scaled_robots import TEN_TIMES, TWENTIETH
+
+#: 30 N m motors on 0.2 m wheels (150 N per wheel), the thesis robot's masses otherwise.
+STRONG_MOTORS = Robot(wheel_radius=0.2, wheel_torque_limit=30.0)
 
 
 def _constants(plant: ThesisPlant) -> tuple[float, float, float]:
@@ -50,6 +59,62 @@ def test_a_scaled_robot_gets_the_thesis_constants_scaled_to_it(robot, expected):
         plant = ThesisPlant(robot)
     assert _constants(plant) == pytest.approx(expected, rel=1e-12)
     assert plant.force_limit < robot.motor_force_limit  # never more than its motors
+
+
+def test_the_rule_has_one_home_in_the_model_layer():
+    """The plant uses the model layer's rule (the controllers' models may not import a
+    plant); ``ddwmmr.plants.thesis.robot_constants`` is that same function."""
+    assert thesis_plant.robot_constants is thesis_base.robot_constants
+
+
+@pytest.mark.parametrize("robot", [TEN_TIMES, TWENTIETH, STRONG_MOTORS])
+def test_the_force_level_model_is_the_plant_s_for_any_robot(robot):
+    """``ThesisDynamics.from_robot(robot)`` is the model of ``ThesisPlant(robot)``: the same
+    derived constants (it had the thesis robot's 15, 4 and 10 N for every robot)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plant = ThesisPlant(robot)
+    model = sym.ThesisDynamics.from_robot(robot)
+    assert (model.force_limit, model.c1, model.c2) == _constants(plant)
+    given = sym.ThesisDynamics.from_robot(robot, 15.0, 4.0, 10.0)  # given values still win
+    assert (given.force_limit, given.c1, given.c2) == (10.0, 15.0, 4.0)
+
+
+def test_the_default_robot_s_model_keeps_the_thesis_constants_exactly():
+    model = sym.ThesisDynamics.from_robot(Robot().with_payload(3.0))
+    assert (model.force_limit, model.c1, model.c2) == (10.0, 15.0, 4.0)
+    parameters = inspect.signature(sym.ThesisDynamics.from_robot).parameters
+    assert [parameters[name].default for name in ("c1", "c2", "force_limit")] == [None] * 3
+
+
+def test_the_lower_bound_prices_the_robot_s_own_plant():
+    """150 N motors: the plant's force limit is 73.125 N, so driving costs c1 / (2 F) =
+    15 / 146.25 s/m (it priced 15 / 20 s/m, the thesis robot's 10 N)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plant = ThesisPlant(STRONG_MOTORS)
+    assert plant.force_limit == pytest.approx(73.125, rel=1e-3)
+    prices = Prices.from_robot(STRONG_MOTORS)
+    assert prices.drive == pytest.approx(plant.c1 / (2.0 * plant.force_limit), rel=1e-12)
+    assert prices.drive == pytest.approx(15.0 / 146.25, rel=1e-3)
+
+
+def _physics_traits(motors: float) -> PlantTraits:
+    return PlantTraits((FORCE, "velocity"), True, 0.02, (0.0, 0.0), motors, 0.175)
+
+
+@pytest.mark.parametrize("robot", [Robot(), STRONG_MOTORS, TWENTIETH])
+def test_the_mpc_plans_with_the_robot_s_share_of_its_motors_on_a_physics_plant(robot):
+    """On a plant that judges tipping the force model plans with the force limit the thesis
+    plant derives for the same robot (10 N of the thesis robot's 20.5 N; 73.125 N of
+    150 N; 1.25e-3 N of a twentieth's 2.56e-3 N), not with min(10 N, motors)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        expected = ThesisPlant(robot).force_limit
+    traits = _physics_traits(robot.motor_force_limit)
+    assert planned_force(traits) == expected < robot.motor_force_limit
+    assert MPCOptions().adopt_plant(traits).wheel_force_limit == expected
+    assert planned_force(_physics_traits(Robot().motor_force_limit)) == 10.0  # exactly
 
 
 def test_given_constants_win_over_the_robot_s_own():

@@ -116,7 +116,51 @@ def test_a_converged_run_held_at_its_force_limit_keeps_its_transient():
         "a joint limit (th2 = -3.14159 rad) on 427 of 2000 steps)"
     )
     assert "; the error converged after it (final 10 mm, within the limit)" in cause
-    assert "; the arm folded to a joint limit (min manipulability 0), which may" in cause
+    assert cause.endswith(
+        "counts in the RMS; the arm folded to a joint limit (min manipulability 0) on the "
+        "way, which may follow from the force limit too (the base lagged and the arm "
+        "stretched after it): a slower trajectory, a smaller dt or a higher limit (see "
+        'docs/cli.md, "Verdict")'
+    )
+    assert "fix this first" not in cause
+
+
+#: A MuJoCo run's summary like FOLDED_ON_THESIS: a motor at its torque limit for 30 of
+#: 40 s, the wheels' motors for ``wheel_saturated_time_s`` of it.
+FOLDED_ON_MUJOCO = {**FOLDED_ON_THESIS, "plant": "mujoco", "actuator_saturated_time_s": 30.0}
+
+
+@pytest.mark.parametrize(
+    ("wheels_s", "force_named"), [(None, False), (0.0, False), (20.0, False), (30.0, True)]
+)
+def test_on_mujoco_only_the_wheels_at_their_limit_name_the_force_limit(wheels_s, force_named):
+    """MuJoCo's ``actuator_saturated_time_s`` counts the arm's motors too: the base is
+    blamed only where the wheels' motors were at their limit for most of the run
+    (``wheel_saturated_time_s``; a summary without it cannot say)."""
+    summary = dict(FOLDED_ON_MUJOCO)
+    if wheels_s is not None:
+        summary["wheel_saturated_time_s"] = wheels_s
+    cause = _cause(summary)
+    assert ("the base lagged" in cause) is force_named
+    folded = FOLDED_ARM.format(methods=", ".join(FOLDING_METHODS))
+    assert (cause == folded) is not force_named
+
+
+#: Shoulder and elbow motors of 0.03 and 0.015 N m, the wheels' 6 N m: on MuJoCo the arm's
+#: motors hold their torque limits, the wheels' never do.
+WEAK_ARM = Robot(joint_torque_limits=(0.03, 0.015), wheel_torque_limit=6.0).with_payload(1.0)
+
+
+def test_an_arm_motor_at_its_limit_on_mujoco_does_not_blame_the_base():
+    """ats on the ellipse with the weak arm: a motor at its limit for 39.3 of 40 s, the
+    wheels' for 0; the shoulder singular on 669 of 2000 steps is the cause, not the base
+    lagging (it read "a motor at its torque limit for 39.3 of 40 s ...; the arm was
+    singular ..., which may follow from it (the base lagged ...)")."""
+    summary = simulate(WEAK_ARM, load_trajectory("ellipse"), "ats", plant="mujoco").summary
+    assert summary["actuator_saturated_time_s"] == pytest.approx(39.3, abs=0.1)
+    assert summary["wheel_saturated_time_s"] == 0.0
+    assert summary["singular_steps"] == pytest.approx(669, abs=20)
+    assert _cause(summary) == SINGULAR_DRIFT
 
 
 @pytest.mark.parametrize(("method", "trajectory"), [("pi", "ellipse"), ("ap", "rectangle")])

@@ -41,11 +41,7 @@ import casadi as ca
 from ddwmmr.errors import check_nonnegative, check_positive
 from ddwmmr.model import Robot, stability
 from ddwmmr.model.support_loads import EdgeLoadModel
-from ddwmmr.model.thesis_base import (
-    C1_DEFAULT,
-    C2_DEFAULT,
-    FORCE_LIMIT_DEFAULT,
-)
+from ddwmmr.model.thesis_base import robot_constants
 
 #: Sizes: configuration, velocity inputs, force-model state and inputs.
 NQ, NU = 5, 4
@@ -245,8 +241,9 @@ class ThesisDynamics:
 
     The model: docs/thesis.md, "What is simulated".
 
-    Build it with :meth:`from_robot`; the defaults are the thesis plant's constants
-    (``ddwmmr.plants.thesis``: c1 = 15 N s/m, c2 = 4 N m s/rad, 10 N per wheel, 2 rad/s).
+    Build it with :meth:`from_robot`; the defaults are the thesis plant's constants for
+    the robot (:func:`~ddwmmr.model.thesis_base.robot_constants`; for the thesis robot
+    c1 = 15 N s/m, c2 = 4 N m s/rad, 10 N per wheel, 2 rad/s).
 
     Attributes:
         mass: whole robot (base + links + payload) (kg).
@@ -278,16 +275,22 @@ class ThesisDynamics:
     def from_robot(
         cls,
         robot: Robot,
-        c1: float = C1_DEFAULT,
-        c2: float = C2_DEFAULT,
-        force_limit: float = FORCE_LIMIT_DEFAULT,
+        c1: float | None = None,
+        c2: float | None = None,
+        force_limit: float | None = None,
         joint_speed: float | None = None,
         half_width: float | None = None,
     ) -> ThesisDynamics:
-        """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``
-        (``joint_speed`` rad/s, None: the robot's ``joint_speed_limit``, as the plant's);
-        ``half_width`` (m) is the wheels' lever about the base centre, by default the
-        thesis plant's ``robot.track_width / 2``."""
+        """The model of ``ThesisPlant(robot, c1, c2, force_limit, joint_speed)``: c1
+        (N s/m), c2 (N m s/rad) and force_limit (N per wheel) each None: the robot's own,
+        as the plant's (:func:`~ddwmmr.model.thesis_base.robot_constants`: 15, 4 and 10
+        for the thesis robot); ``joint_speed`` rad/s, None: the robot's
+        ``joint_speed_limit``, as the plant's; ``half_width`` (m) is the wheels' lever
+        about the base centre, by default the thesis plant's ``robot.track_width / 2``."""
+        own = robot_constants(robot)
+        c1 = own["c1"] if c1 is None else c1
+        c2 = own["c2"] if c2 is None else c2
+        force_limit = own["force_limit"] if force_limit is None else force_limit
         inertia = robot.yaw_inertia  # the collected form I(th2) = fixed + cos * cos th2
         return cls(
             mass=robot.total_mass,

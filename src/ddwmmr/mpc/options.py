@@ -43,7 +43,12 @@ from ddwmmr.model.stability import (
     valid_stability_floor,
 )
 from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, check_min_edge_load
-from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT, FORCE_LIMIT_DEFAULT
+from ddwmmr.model.thesis_base import (
+    C1_DEFAULT,
+    C2_DEFAULT,
+    FORCE_LIMIT_DEFAULT,
+    motors_share,
+)
 from ddwmmr.mpc.braking import BRAKE_SLACK
 from ddwmmr.mpc.ocp import (
     MAX_HORIZON,
@@ -101,14 +106,17 @@ class BaseFacts:
 
 def planned_force(plant: PlantTraits | None) -> float:
     """The wheel force (N) the force model plans with by default on ``plant``: the plant's
-    own limit where the model is the plant's (the thesis plant), the thesis's 10 N, within
-    the motors, on a plant that judges tipping by its physics (and 10 N on a plant that
-    does not say, or before the plant is known). Why not the motors' full force there:
-    docs/mpc.md, "The physics plant: tipping while moving"."""
+    own limit where the model is the plant's (the thesis plant); on a plant that judges
+    tipping by its physics, the thesis model's share of the plant's motors
+    (:func:`~ddwmmr.model.thesis_base.motors_share` of ``wheel_force_limit``: the force
+    limit the thesis plant derives for the same robot, 10 N of the thesis robot's 20.5 N,
+    always within the motors); the thesis's 10 N on a plant that does not say, or before
+    the plant is known. Why not the motors' full force there: docs/mpc.md, "The physics
+    plant: tipping while moving"."""
     motors = None if plant is None else plant.wheel_force_limit
     if motors is None:
         return FORCE_LIMIT_DEFAULT
-    return min(FORCE_LIMIT_DEFAULT, motors) if plant.judges_tipping else motors  # type: ignore[union-attr]
+    return motors_share(motors) if plant.judges_tipping else motors  # type: ignore[union-attr]
 
 
 @dataclass(frozen=True)

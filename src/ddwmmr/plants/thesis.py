@@ -48,9 +48,12 @@ from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.model.robot import clamp_joints
 from ddwmmr.model.thesis_base import (  # the base's constants (controllers' models use them)
-    C1_DEFAULT,
-    C2_DEFAULT,
-    FORCE_LIMIT_DEFAULT,
+    SCALES_WITH,
+    THESIS_CONSTANTS,
+    THESIS_FACTS,
+    UNITS,
+    drive_facts,
+    robot_constants,
 )
 from ddwmmr.plants.base import (
     Observation,
@@ -68,58 +71,29 @@ from ddwmmr.registry import register_plant
 VELOCITY_BANDWIDTH = 10.0
 
 
-#: The thesis model's constants, measured on the thesis robot (``Robot``'s defaults).
-THESIS_CONSTANTS = {"force_limit": FORCE_LIMIT_DEFAULT, "c1": C1_DEFAULT, "c2": C2_DEFAULT}
-_UNITS = {"force_limit": "N", "c1": "N s/m", "c2": "N m s/rad"}
-
-
-def _drive_facts(robot: Robot) -> dict[str, float]:
-    """What each thesis constant is proportional to, for ``robot``: its motors' wheel force
-    (``motor_force_limit``, N), its own mass (kg) and its own yaw inertia with the arm
-    stretched (kg m^2), both without the payload."""
-    return {
-        "force_limit": robot.motor_force_limit,
-        "c1": robot.own_mass,
-        "c2": robot.with_payload(0.0).yaw_inertia.at(0.0),
-    }
-
-
-_THESIS_FACTS = _drive_facts(Robot())
-
-
-def robot_constants(robot: Robot) -> dict[str, float]:
-    """The thesis plant's default constants for ``robot``: ``{"force_limit": N per wheel,
-    "c1": N s/m, "c2": N m s/rad}``, the thesis model's scaled by ``robot``'s own drive.
-
-    The force limit keeps the thesis's share of the motors (10 N of the thesis robot's
-    ``motor_force_limit`` 20.5 N), so the plant never gives more than ``robot``'s motors;
-    c1 keeps the translational time constant ``m / c1`` and c2 the yaw time constant
-    ``I / c2``, with the robot's own mass and its own yaw inertia at the stretched arm
-    (th2 = 0), both without the payload: the drive is built for the robot, not for what it
-    carries (docs/thesis.md, "What is simulated"). Exactly the thesis's 10, 15, 4 for a
-    robot with the thesis robot's motors, masses and inertia, at any payload.
-    """
-    facts = _drive_facts(robot)
-    return {
-        name: value * (facts[name] / _THESIS_FACTS[name])
-        for name, value in THESIS_CONSTANTS.items()
-    }
-
-
 def warn_derived_constants(robot: Robot, derived: dict[str, float]) -> None:
     """Warn (a one-line :class:`UserWarning`, once per message under Python's default
     filter) when a constant in ``derived`` (name -> value, those :func:`robot_constants`
     chose because none was given) is not the thesis model's: no one measured it on
-    ``robot``. The line names the values, the motors' force and how to set them."""
-    if all(value == THESIS_CONSTANTS[name] for name, value in derived.items()):
+    ``robot``. The line names each such constant (a derived one equal to the thesis's is
+    the thesis's own) with the thesis's value and what it scales with (``robot``'s and the
+    thesis robot's), and how to set exactly those."""
+    derived = {name: v for name, v in derived.items() if v != THESIS_CONSTANTS[name]}
+    if not derived:
         return
-    values = ", ".join(f"{name} = {value:.4g} {_UNITS[name]}" for name, value in derived.items())
+    facts = drive_facts(robot)
+    values = ", ".join(
+        f"{name} = {value:.4g} {UNITS[name]} (the thesis's {THESIS_CONSTANTS[name]:g} "
+        f"{UNITS[name]} scaled by {SCALES_WITH[name][0]}, {facts[name]:.4g} / "
+        f"{THESIS_FACTS[name]:.4g} {SCALES_WITH[name][1]})"
+        for name, value in derived.items()
+    )
+    keywords = ", ".join(f"{name}=..." for name in derived)
+    options = " ".join(f"--plant-option {name}=..." for name in derived)
+    them = "them" if len(derived) > 1 else "it"
     warnings.warn(
-        f"thesis plant: {values} derived for this robot from the thesis robot's "
-        f"{FORCE_LIMIT_DEFAULT:g} N, c1 = {C1_DEFAULT:g} N s/m, c2 = {C2_DEFAULT:g} N m s/rad "
-        "in proportion to its motors' force "
-        f"({robot.motor_force_limit:.4g} N), own mass and own yaw inertia (ThesisPlant(robot, "
-        "force_limit=..., c1=..., c2=...) sets them; track: --plant-option force_limit=...)",
+        f"thesis plant: {values} derived for this robot (ThesisPlant(robot, {keywords}) "
+        f"sets {them}; track: {options})",
         UserWarning,
         stacklevel=2,
     )

@@ -48,10 +48,12 @@ should fix first. After what stops or overrules a run (divergence, tipping, a co
 start below the floor, solver fallbacks), commands clipped on more than
 :data:`SATURATED_CAUSE` of the steps (``saturated_steps``), with as many steps at a rate
 limit, name the trajectory as asking more than the robot can give, before anything the arm
-did (a singularity, a fold), which follows from it. So does an actuator at its force or
-torque limit for more than :data:`FORCE_LIMIT_CAUSE` of the run (``actuator_saturated_time_s``
-of ``duration``): the base lags commands it cannot produce the force for and the arm
-stretches after it; the cause names the limit held and then what the arm did. An
+did (a singularity, a fold), which follows from it. So does a wheel at its force or
+torque limit for more than :data:`FORCE_LIMIT_CAUSE` of the run (the wheels' time at their
+limit of ``duration``: ``wheel_saturated_time_s`` on MuJoCo, whose
+``actuator_saturated_time_s`` counts the arm's motors too; ``actuator_saturated_time_s``
+elsewhere): the base lags commands it cannot produce the force for and the arm stretches
+after it; the cause names the limit held and then what the arm did. An
 obstacle-avoiding controller (``qp``, ``mpc``: a ``min_obstacle_clearance_m``) whose base
 came within :data:`OBSTACLE_NEAR_M` of an obstacle, with no other cause in sight, is named
 as having left the trajectory to go round it. A run that would have tipped over
@@ -295,6 +297,13 @@ ARM_AFTER_FORCE_LIMIT = (
     "; the arm {arm}, which may follow from it (the base lagged and the arm stretched after "
     "it), so fix this first"
 )
+#: :data:`ARM_AFTER_FORCE_LIMIT` for a run that converged after a transient
+#: (:data:`HELD_TRANSIENT` before it): the arm's part is told after the transient, with no
+#: "fix this first" after "converged".
+ARM_AFTER_FORCE_LIMIT_TRANSIENT = (
+    "; the arm {arm} on the way, which may follow from the force limit too (the base "
+    "lagged and the arm stretched after it)"
+)
 #: :data:`HELD_LIMIT`'s words on ``saturated_steps``: none
 #: clipped (the controller's own bounds or the plant's dynamics held the limit) ...
 NOT_CLIPPED = "the commands' clipping, saturated_steps, does not count it"
@@ -408,6 +417,7 @@ NUMBER_KEYS = (
     "joint_limit_steps",
     "min_stability",
     "actuator_saturated_time_s",
+    "wheel_saturated_time_s",
     "duration",
     "trajectory_extent_m",
     "initial_offset_m",
@@ -447,6 +457,7 @@ STEP_COUNT_KEYS = (
 NON_NEGATIVE_KEYS = {
     "duration": "s",
     "actuator_saturated_time_s": "s",
+    "wheel_saturated_time_s": "s",
     "unloaded_time_s": "s",
     "trajectory_extent_m": "m",
     "initial_offset_m": "m",
@@ -696,7 +707,9 @@ def _arm_or_path_cause(summary: Mapping[str, Any], found: list[str]) -> str:
     obstacle, a limit held, the start offset, else no convergence."""
     arm = _arm_cause(summary)
     if _force_limited(summary):
-        words = ARM_AFTER_FORCE_LIMIT.format(arm=arm[1]) if arm else ""
+        converged = _converged_after_a_transient(summary, found)
+        template = ARM_AFTER_FORCE_LIMIT_TRANSIENT if converged else ARM_AFTER_FORCE_LIMIT
+        words = template.format(arm=arm[1]) if arm else ""
         cause = _held_cause(summary, found, words)
         if cause is not None:
             return cause
@@ -730,12 +743,16 @@ def _arm_cause(summary: Mapping[str, Any]) -> tuple[str, str] | None:
 
 
 def _force_limited(summary: Mapping[str, Any]) -> bool:
-    """An actuator was at its force or torque limit (``actuator_saturated_time_s``, the
-    thesis and MuJoCo plants) for more than :data:`FORCE_LIMIT_CAUSE` of the run
-    (``duration``, s)."""
+    """A wheel was at its force or torque limit for more than :data:`FORCE_LIMIT_CAUSE` of
+    the run (``duration``, s): ``wheel_saturated_time_s`` where the plant records it (the
+    MuJoCo plant, whose ``actuator_saturated_time_s`` counts the arm's motors too), else
+    ``actuator_saturated_time_s`` on any plant but MuJoCo (the thesis plant's counts its
+    wheels only); a MuJoCo summary without the wheels' time never is."""
     duration = _number(summary, "duration") or 0.0
-    at_limit = _number(summary, "actuator_saturated_time_s") or 0.0
-    return duration > 0.0 and at_limit > FORCE_LIMIT_CAUSE * duration
+    at_limit = _number(summary, "wheel_saturated_time_s")
+    if at_limit is None and summary.get("plant") != "mujoco":
+        at_limit = _number(summary, "actuator_saturated_time_s")
+    return duration > 0.0 and (at_limit or 0.0) > FORCE_LIMIT_CAUSE * duration
 
 
 def _held_or_converging_cause(summary: Mapping[str, Any], found: list[str]) -> str:

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Sequence
 from typing import Any
 
 import mujoco
@@ -189,6 +190,7 @@ class MujocoPlant:
             "base_tilt_rad",
             "wheel_slip_m_s",
             "torque_use",
+            "wheel_torque_use",
         )
         self.weight_n = float(np.sum(self.model.body_mass)) * -float(self.model.opt.gravity[2])
         self._limits = KinematicPlant(robot, "euler")
@@ -710,13 +712,16 @@ class MujocoPlant:
                 self.base_tilt(),
                 self.wheel_slip(),
                 self.torque_use(),
+                self.torque_use(self._ids["wheel_actuators"]),
             )
         return self._cache
 
-    def torque_use(self) -> float:
-        """Largest share of its torque limit any motor uses now (1: saturated)."""
-        limits = self.model.actuator_forcerange[:, 1]
-        return float(np.max(np.abs(self.data.actuator_force) / limits))
+    def torque_use(self, actuators: Sequence[int] | None = None) -> float:
+        """Largest share of its torque limit any motor uses now (1: saturated); only the
+        motors of ``actuators`` (indices into the model's actuators), if given."""
+        index = slice(None) if actuators is None else list(actuators)
+        limits = self.model.actuator_forcerange[index, 1]
+        return float(np.max(np.abs(self.data.actuator_force[index]) / limits))
 
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
         """Physics summary of a recorded run.
@@ -726,7 +731,8 @@ class MujocoPlant:
         ``unloaded_time_s`` (total time with an unloaded edge), ``min_support_force_n``,
         ``min_edge_load_n``, ``min_physics_stability``, ``max_base_tilt_rad``,
         ``max_wheel_slip_m_s``, ``actuator_saturated_time_s`` (time with a motor at its
-        torque limit) and ``mujoco_timestep_s``.
+        torque limit, the arm's included), ``wheel_saturated_time_s`` (time with a wheel
+        motor at its torque limit) and ``mujoco_timestep_s``.
         """
         t = np.asarray(timeseries["t"], dtype=float)
         edge_load = np.asarray(timeseries["min_edge_load_n"], dtype=float)
@@ -735,6 +741,10 @@ class MujocoPlant:
         tip_time = tip_time_s(
             t, edge_load, np.asarray(timeseries["base_tilt_rad"], dtype=float), self.weight_n
         )
+
+        def saturated_time(column: str) -> float:
+            return float(np.sum(np.asarray(timeseries[column]) >= TORQUE_SATURATED) * interval)
+
         return {
             "tipped": tip_time is not None,
             "tip_time_s": tip_time,
@@ -745,9 +755,8 @@ class MujocoPlant:
             "min_physics_stability": float(np.min(timeseries["physics_stability"])),
             "max_base_tilt_rad": float(np.max(timeseries["base_tilt_rad"])),
             "max_wheel_slip_m_s": float(np.max(timeseries["wheel_slip_m_s"])),
-            "actuator_saturated_time_s": float(
-                np.sum(np.asarray(timeseries["torque_use"]) >= TORQUE_SATURATED) * interval
-            ),
+            "actuator_saturated_time_s": saturated_time("torque_use"),
+            "wheel_saturated_time_s": saturated_time("wheel_torque_use"),
             "mujoco_timestep_s": self.options.timestep,
         }
 
