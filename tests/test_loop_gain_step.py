@@ -88,3 +88,10 @@ def test_no_default_run_of_any_method_trajectory_or_plant_warns():
     # the default K dt: 2 1/s times 0.02 s, far inside either limit
     assert make_controller("clrrmc-ts", robot).feedback_gains == (2.0, 2.0, 2.0)
     assert default_step(Ellipse(), "kinematic", robot) == 0.02
+
+
+def test_the_qp_tracking_gain_is_checked_too():
+    """The qp's tracking task is an e' = -K e loop evaluated at RK4's stages as well."""
+    qp = make_controller("qp", Robot())
+    assert qp.feedback_gains == (2.0, 2.0, 2.0)
+    assert make_controller("qp", Robot(), track_orientation=False).feedback_gains[2] == 0.0

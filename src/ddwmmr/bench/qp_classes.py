@@ -216,7 +216,7 @@ def qp_class_cases(robot: Robot, options: dict[str, Any], reference: bool) -> di
 
     cases: dict[str, Any] = {"qp": make_controller("qp", robot, **options)}
     generic = make_controller("qp", robot, **options)
-    generic.problem = QPProblem(generic.tasks, generic.limits, compiled=False)
+    generic.problem = QPProblem(generic.tasks, generic.limits, compiled=False, unit=generic.unit)
     cases["qp (generic path)"] = generic
     tasks, limits = _UserSpin.pieces()
     cases["qp + user task, limit"] = make_controller(

@@ -34,6 +34,12 @@ None where off), ``edge_load_relaxed_steps`` (steps whose edge rows conflicted w
 other limits and were dropped for that step's solve; the QP fallback runs only if that
 solve fails too).
 
+The QP works in the robot's own length unit (:func:`~ddwmmr.resolution.kernels.length_unit`,
+exactly 1.0 m for the default robot): its ``v`` is ``v / unit``, its linear rows and
+targets are divided by the unit, and the length constants of its pieces are in it, so a
+robot scaled by a power of two solves the default robot's QP to the last bit (docs/qp.md,
+"Robot size"). Options in m or m/s stay in m or m/s.
+
 Its benchmark twin, :class:`ddwmmr.qp.naive.NaiveQPController`, is deliberately not a
 registered method: it is a baseline for ``python -m ddwmmr.bench``, not a method to compare.
 """
@@ -93,6 +99,7 @@ from ddwmmr.qp.tasks import (
     RegularizationTask,
     Task,
 )
+from ddwmmr.resolution.kernels import length_unit
 
 #: Look-ahead step (s) when neither ``dt`` nor the trajectory's resolution is known.
 DEFAULT_DT = 0.02
@@ -200,6 +207,8 @@ class QPController:
         limits: Sequence[Limit] = (),
     ) -> None:
         self.robot = robot
+        #: The robot's length unit (m) the QP measures lengths in (docs/qp.md, "Robot size").
+        self.unit = unit = length_unit(robot.L1)
         self._com = robot.com_coefficients
         self.mode = check_mode(mode)
         self.solver = solver
@@ -214,18 +223,20 @@ class QPController:
             heading_weight = 0.0 if track_orientation else 1.0
         linear, angular = demand_limits(robot)
         self.tracking = EndEffectorTask(
-            tracking_weight, tau, track_orientation, max_speed, demand_limit=(linear, angular)
+            tracking_weight,
+            tau,
+            track_orientation,
+            max_speed,
+            demand_limit=(linear, angular),
+            unit=unit,
         )
         self.tasks: list[Task] = [
             self.tracking,
-            ManipulabilityTask(
-                manipulability_weight,
-                arm_row=not track_orientation,
-            ),
+            ManipulabilityTask(manipulability_weight, arm_row=not track_orientation, unit=unit),
             PostureTask(posture_weight, rate_limit=angular),
-            RegularizationTask(regularization_weight),
+            RegularizationTask(regularization_weight, unit=unit),
         ]
-        heading = HeadingTask(heading_weight, distance=0.8 * robot.reach)
+        heading = HeadingTask(heading_weight, distance=0.8 * robot.reach, unit=unit)
         if heading_weight > 0.0:
             self.tasks.append(heading)
         self.tasks.extend(_pieces("tasks", tasks, Task))
@@ -237,7 +248,7 @@ class QPController:
         )
         self.stability_min = self.stability.stability_min
         self.joints = JointLimit(robot)
-        self.limits: list[Limit] = [self.stability, WheelSpeedLimit(robot), self.joints]
+        self.limits: list[Limit] = [self.stability, WheelSpeedLimit(robot, unit=unit), self.joints]
         motion = (max_base_speed, max_yaw_rate, max_acceleration, max_yaw_acceleration)
         self.base_motion: BaseMotionLimit | None = None
         if any(value is not None for value in motion):
@@ -246,10 +257,11 @@ class QPController:
                 max_yaw_rate if max_yaw_rate is not None else INF,
                 max_acceleration,
                 max_yaw_acceleration,
+                unit=unit,
             )
             self.limits.append(self.base_motion)
         if speed_budget is not None:
-            self.limits.append(SpeedBudgetLimit(speed_budget))
+            self.limits.append(SpeedBudgetLimit(speed_budget, unit=unit))
         self.singularity: ShoulderSingularityLimit | None = None
         if singularity_margin is not None:
             self.singularity = ShoulderSingularityLimit(
@@ -257,7 +269,9 @@ class QPController:
             )
             self.limits.append(self.singularity)
         if self.obstacles:
-            self.limits.append(ObstacleLimit(robot, self.obstacles, margin=obstacle_margin))
+            self.limits.append(
+                ObstacleLimit(robot, self.obstacles, margin=obstacle_margin, unit=unit)
+            )
             self.tasks.append(
                 ObstacleSteeringTask(
                     self.obstacles,
@@ -265,6 +279,7 @@ class QPController:
                     0.5 * robot.base_width,
                     # Steering must be able to bend tracking round a post: scale with it.
                     weight=3e-3 * self.tracking.weight,
+                    unit=unit,
                 )
             )
             half_diagonal = 0.5 * math.hypot(robot.base_length, robot.base_width)
@@ -275,7 +290,7 @@ class QPController:
         self.edge_loads: EdgeLoadLimit | None = None  # set by adopt_plant
         self.min_predicted_edge_load: float | None = None
         self.edge_relaxed_steps = 0  # steps whose edge rows gave way to the other limits
-        self.problem = QPProblem(self.tasks, self.limits)
+        self.problem = QPProblem(self.tasks, self.limits, unit=unit)
         self._dt_option = None if dt is None else check_positive("dt", dt)
         self._loop_step: float | None = None
         self.ctx = StepContext(robot, self._dt_option or DEFAULT_DT)
@@ -306,14 +321,23 @@ class QPController:
                 self.min_edge_load,
                 plant.joint_time_constant,
                 plant.joint_acceleration_limit,
+                unit=self.unit,
             )
             self.limits.append(self.edge_loads)
-        self.problem = QPProblem(self.tasks, self.limits)
+        self.problem = QPProblem(self.tasks, self.limits, unit=self.unit)
 
     def adopt_control_step(self, dt: float) -> None:
         """The loop holds each command ``dt`` (s): the look-ahead step, unless ``dt`` was
         given as an option."""
         self._loop_step = dt
+
+    @property
+    def feedback_gains(self) -> tuple[float, float, float]:
+        """The tracking task's gains (1/s) of its ``e' = -K e`` loops (x, y, phi; phi's 0
+        when the orientation is not tracked): what the simulation checks against the
+        control step (:func:`ddwmmr.gains.gain_step_warning`)."""
+        task = self.tracking
+        return task.kx, task.ky, (task.kphi if task.track_orientation else 0.0)
 
     def reset(self, trajectory: Any, q0: np.ndarray, *, warn_start: bool = True) -> None:
         """Forget warm starts and counters; take the look-ahead step (:func:`control_step`).
@@ -364,12 +388,19 @@ class QPController:
         if x is None:
             return self._edge_prediction(ctx, self._fallback(ctx), relaxed)
         v, w, r1, r2, *slack = x
+        v *= self.problem.unit
         scale = self.arm_scale(ctx, r1, r2)
-        self.last = StepInfo(
-            extra={"slack": max(map(abs, slack)) if slack else 0.0, "arm_scale": scale}
-        )
+        self.last = StepInfo(extra={"slack": self._slack_size(slack), "arm_scale": scale})
         ctx.previous_command = (v, w)
         return self._edge_prediction(ctx, np.array([v, w, r1 * scale, r2 * scale]), relaxed)
+
+    def _slack_size(self, slack: list[float]) -> float:
+        """The largest slack of an answer, the tracking rows' in m/s and rad/s (their
+        position rows are in the tracking task's unit), 0 without slack."""
+        if not slack:
+            return 0.0
+        unit = self.tracking.unit
+        return max(abs(slack[0]) * unit, abs(slack[1]) * unit, *map(abs, slack[2:]))
 
     def _edge_prediction(self, ctx: StepContext, command: np.ndarray, relaxed: bool) -> np.ndarray:
         """With the edge-load limit: the least predicted edge load of ``command`` and
@@ -454,8 +485,12 @@ class QPController:
         no answer, reports it for the fallback's command (before the arm scale, as the
         QP's is), so ``last.extra["slack"]`` is a finite number on every step."""
         jac, target = np.zeros((3, 4)), np.zeros(3)
-        self.tracking.compute(ctx, jac, target)
-        return float(np.max(np.abs(jac @ np.asarray(u, dtype=float) - target)))
+        tracking = self.tracking
+        tracking.compute(ctx, jac, target)  # position rows in the task's unit
+        v, w, r1, r2 = map(float, u)
+        residual = jac @ np.array([v / tracking.unit, w, r1, r2]) - target
+        residual[:2] *= tracking.unit
+        return float(np.max(np.abs(residual)))
 
     def _stability_ascent(self, ctx: StepContext) -> tuple[float, float]:
         """Joint rates (rad/s) at half the speed limit along a direction that raises every

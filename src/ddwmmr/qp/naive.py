@@ -50,7 +50,7 @@ class NaiveQPController(QPController):
     def _solve(self, ctx: StepContext) -> list[float] | None:
         """Allocate a new problem (every piece through its generic ``compute``), build it,
         solve it."""
-        problem = QPProblem(self.tasks, self.limits, compiled=False)
+        problem = QPProblem(self.tasks, self.limits, compiled=False, unit=self.unit)
         problem.build(ctx)
         x = solve(problem, self.backend, self.mode).x
         return None if x is None else x.tolist()

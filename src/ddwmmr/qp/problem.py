@@ -7,6 +7,13 @@ Decision vector ``x = (u, s)``: the inputs ``u = (v, w, th1dot, th2dot)`` and th
     subject to  lower[:n] <= x <= upper[:n]              (box)
                 lower[n:] <= C x <= upper[n:]            (rows)
 
+The first input is the base speed in the problem's length unit, ``v / unit`` (``unit``:
+the robot's, :func:`~ddwmmr.resolution.kernels.length_unit`; 1.0 = m/s): a robot scaled by
+a power of two then has the default robot's problem to the last bit (docs/qp.md, "Robot
+size"). A piece whose own :attr:`~ddwmmr.qp.tasks.base.Task.unit` differs (a user's piece
+works in metres) has its ``v`` column converted after its ``compute``; the box on ``v``
+too, around a limit's ``compute``.
+
 Rows come in order: slack-task equalities ``J u - s = e`` (lower = upper = e), then the
 limit rows. The cost of the non-slack tasks is ``sum_i w_i ||J_i u - e_i||^2``, stacked as
 ``||W^(1/2) (J u - e)||^2``: the problem keeps the weighted rows ``Jw = W^(1/2) J`` and
@@ -34,6 +41,7 @@ import numpy as np
 from ddwmmr.errors import (
     ParameterError,
     check_int_at_least,
+    check_positive,
     raise_plugin_error,
     shown,
 )
@@ -154,10 +162,15 @@ class QPProblem:
         compiled: use the built-in pieces' compiled writers (default); False calls every
             piece through its generic ``compute`` (same numbers, slower: for benchmarks
             and tests of the generic path).
+        unit: the length unit (m) of the decision vector's ``v`` (``x[0] = v / unit``).
     """
 
     def __init__(
-        self, tasks: Sequence[Task], limits: Sequence[Limit], compiled: bool = True
+        self,
+        tasks: Sequence[Task],
+        limits: Sequence[Limit],
+        compiled: bool = True,
+        unit: float = 1.0,
     ) -> None:
         for task in tasks:
             if not isinstance(task, Task):
@@ -174,6 +187,7 @@ class QPProblem:
         self.tasks = list(tasks)
         self.limits = list(limits)
         self.compiled = bool(compiled)
+        self.unit = check_positive("unit", unit)
         self.slack_tasks = [t for t in self.tasks if t.slack]
         self.cost_tasks = [t for t in self.tasks if not t.slack]
         self.n_slack = sum(t.rows for t in self.slack_tasks)
@@ -254,6 +268,7 @@ class QPProblem:
                         self.ew[start:stop],
                         self.sqrt_w[start:stop, None],
                         self.sqrt_w[start:stop],
+                        self._v_ratio(task),
                     )
                 )
             start = stop
@@ -276,6 +291,7 @@ class QPProblem:
                         self.C[start:stop, :NU],
                         self.cl[start:stop],
                         self.cu[start:stop],
+                        self._v_ratio(task),
                     )
                 )
             start = stop
@@ -298,6 +314,7 @@ class QPProblem:
                         self.C[start:stop, :NU],
                         self.cl[start:stop],
                         self.cu[start:stop],
+                        self._v_ratio(limit),
                     )
                 )
             start = stop
@@ -325,9 +342,17 @@ class QPProblem:
         if self._generic_limits:
             self._no_nan += [self.lower, self.upper]
 
+    def _v_ratio(self, piece: Task | Limit) -> float:
+        """``problem.unit / piece.unit``: what the piece's ``v`` column is multiplied by
+        (1.0 when they agree, or for a piece whose ``unit`` is None: no ``v`` column)."""
+        unit = getattr(piece, "unit", 1.0)
+        return 1.0 if unit is None else self.unit / unit
+
     def _add_writer(self, piece: Task | Limit, block: TaskBlock | LimitBlock) -> bool:
-        """Compile ``piece`` into ``block``; False when it has no fast path."""
-        writer = piece.compile(block) if self.compiled else None
+        """Compile ``piece`` into ``block``; False when it has no fast path (or works in
+        another length unit than the problem's)."""
+        same_unit = self._v_ratio(piece) == 1.0
+        writer = piece.compile(block) if self.compiled and same_unit else None
         if writer is None:
             return False
         if writer is not CONSTANT:
@@ -354,19 +379,32 @@ class QPProblem:
 
     def _build_generic(self, ctx: StepContext) -> None:
         """The pieces without a compiled writer, through ``compute`` on numpy views."""
-        for _, compute, jac, error, jac_w, error_w, column, sqrt_w in self._generic_cost:
+        for _, compute, jac, error, jac_w, error_w, column, sqrt_w, ratio in self._generic_cost:
             compute(ctx, jac, error)
+            if ratio != 1.0:
+                jac[:, 0] *= ratio
             np.multiply(jac, column, out=jac_w)
             np.multiply(error, sqrt_w, out=error_w)
-        for _, compute, jac, low, up in self._generic_slack:
+        for _, compute, jac, low, up, ratio in self._generic_slack:
             compute(ctx, jac, up)
+            if ratio != 1.0:
+                jac[:, 0] *= ratio
             low[:] = up
         box = self.box
         self.lb[:NU] = box[:NU]
         self.ub[:NU] = box[NU:]
         u_lb, u_ub = self.lb[:NU], self.ub[:NU]
-        for _, compute, G, low, up in self._generic_limits:
+        for _, compute, G, low, up, ratio in self._generic_limits:
+            if ratio == 1.0:
+                compute(ctx, G, low, up, u_lb, u_ub)
+                continue
+            low_v, high_v = float(u_lb[0]), float(u_ub[0])
+            u_lb[0], u_ub[0] = low_v * ratio, high_v * ratio  # in the piece's unit
             compute(ctx, G, low, up, u_lb, u_ub)
+            G[:, 0] *= ratio
+            # back to the problem's unit; an untouched side as it was (INF stays INF)
+            u_lb[0] = low_v if u_lb[0] == low_v * ratio else u_lb[0] / ratio
+            u_ub[0] = high_v if u_ub[0] == high_v * ratio else u_ub[0] / ratio
         self.box_ok = bool(np.all(u_lb <= u_ub))
         if self._check_written and not self._written_ok():
             self._refuse_user_pieces(ctx)
@@ -390,11 +428,11 @@ class QPProblem:
         for task, _, jac, error, *_ in self._generic_cost:
             if not from_library(task):
                 _refuse_written(piece_label(task), ctx, jacobian=jac, error=error)
-        for task, _, jac, _, up in self._generic_slack:
+        for task, _, jac, _, up, _ in self._generic_slack:
             if not from_library(task):
                 _refuse_written(piece_label(task), ctx, jacobian=jac, error=up)
         users = [limit for limit, *_ in self._generic_limits if not from_library(limit)]
-        for limit, _, G, low, up in self._generic_limits:
+        for limit, _, G, low, up, _ in self._generic_limits:
             if not from_library(limit):
                 _refuse_written(piece_label(limit), ctx, matrix=G, bounds=(low, up))
         if users and np.isnan(self.lb[:NU] + self.ub[:NU]).any():

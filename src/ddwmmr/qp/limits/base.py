@@ -2,9 +2,11 @@
 
 A limit restricts the inputs ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s)
 either through general rows ``lower <= G u <= upper`` (``rows`` of them) or by tightening
-the box ``lb <= u <= ub``. A new constraint is one subclass implementing
-:meth:`Limit.compute`. Use :data:`INF` for a missing side. The built-in limits also
-implement the optional fast path :meth:`Limit.compile` (see :mod:`ddwmmr.qp.blocks`).
+the box ``lb <= u <= ub``. A limit's rows may take ``v`` in a robot's own length unit
+per second (:attr:`Limit.unit`; docs/qp.md, "Robot size"). A new constraint is one
+subclass implementing :meth:`Limit.compute`. Use :data:`INF` for a missing side. The
+built-in limits also implement the optional fast path :meth:`Limit.compile` (see
+:mod:`ddwmmr.qp.blocks`).
 """
 
 from __future__ import annotations
@@ -22,10 +24,16 @@ INF = 1e30
 
 
 class Limit(ABC):
-    """A hard constraint on the inputs (rows ``lower <= G u <= upper`` and/or the box)."""
+    """A hard constraint on the inputs (rows ``lower <= G u <= upper`` and/or the box).
+
+    ``unit``: the length unit (m) in which the rows and the box take ``v`` (``v / unit``,
+    units per second); 1.0 (m/s) unless a built-in limit is given its robot's unit (see
+    :attr:`ddwmmr.qp.tasks.base.Task.unit`); None for rows that never involve ``v``.
+    """
 
     rows: int = 0
     name: str = "limit"
+    unit: float | None = 1.0
 
     @abstractmethod
     def compute(

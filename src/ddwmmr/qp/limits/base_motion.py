@@ -41,6 +41,8 @@ class BaseMotionLimit(Limit):
         max_speed: |v| cap (m/s); max_yaw_rate: |w| cap (rad/s).
         max_acceleration: |dv/dt| (m/s^2); max_yaw_acceleration: |dw/dt| (rad/s^2);
             None leaves that slew unbounded.
+        unit: the length unit (m) of the box on ``v`` (:attr:`Limit.unit`): it bounds
+            ``v / unit``; :meth:`envelope` stays in m/s.
     """
 
     rows = 0
@@ -52,7 +54,9 @@ class BaseMotionLimit(Limit):
         max_yaw_rate: float,
         max_acceleration: float | None = None,
         max_yaw_acceleration: float | None = None,
+        unit: float = 1.0,
     ) -> None:
+        self.unit = check_positive("unit", unit)
         self.max_speed = check_positive("max_base_speed", max_speed)
         self.max_yaw_rate = check_positive("max_yaw_rate", max_yaw_rate)
         self.max_acceleration = (
@@ -85,18 +89,19 @@ class BaseMotionLimit(Limit):
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
         """Tighten the (v, w) box; no general rows."""
         low_v, high_v, low_w, high_w = self.envelope(ctx)
-        lb[0], ub[0] = max(lb[0], low_v), min(ub[0], high_v)
+        unit = self.unit
+        lb[0], ub[0] = max(lb[0], low_v / unit), min(ub[0], high_v / unit)
         lb[1], ub[1] = max(lb[1], low_w), min(ub[1], high_w)
 
     def compile(self, block: LimitBlock) -> Callable[[StepContext], None] | None:
         """Writer tightening the Python box (no rows)."""
         if overrides(self, BaseMotionLimit) or overrides(self, BaseMotionLimit, "envelope"):
             return None
-        box, envelope = block.box, self.envelope
+        box, envelope, unit = block.box, self.envelope, self.unit
 
         def write(ctx: StepContext) -> None:
             low_v, high_v, low_w, high_w = envelope(ctx)
-            box[0], box[4] = max(box[0], low_v), min(box[4], high_v)
+            box[0], box[4] = max(box[0], low_v / unit), min(box[4], high_v / unit)
             box[1], box[5] = max(box[1], low_w), min(box[5], high_w)
 
         return write
@@ -110,12 +115,14 @@ class SpeedBudgetLimit(Limit):
             and top yaw rate (rad/s, all the force turning) of the base; for a damped base
             with force limit F per wheel ``(2 F / c1, 2 F (width/2) / c2)``
             (:func:`ddwmmr.plants.thesis.damped_base_envelope` with ``speed_budget=True``).
+        unit: the length unit (m) in which the rows take ``v`` (:attr:`Limit.unit`).
     """
 
     rows = 2
     name = "speed budget"
 
-    def __init__(self, speeds: tuple[float, float]) -> None:
+    def __init__(self, speeds: tuple[float, float], unit: float = 1.0) -> None:
+        self.unit = check_positive("unit", unit)
         if isinstance(speeds, str) or not hasattr(speeds, "__len__") or len(speeds) != 2:
             raise ParameterError(
                 f"speed_budget must be two numbers > 0, (v_top m/s, w_top rad/s)"
@@ -125,7 +132,7 @@ class SpeedBudgetLimit(Limit):
         w_top = check_positive("speed_budget w_top", speeds[1])
         self.speeds = (v_top, w_top)
         # |v|/v_top + |w|/w_top <= 1 is the pair of rows -1 <= v/v_top +- w/w_top <= 1.
-        self.rows_vw = ((1.0 / v_top, 1.0 / w_top), (1.0 / v_top, -1.0 / w_top))
+        self.rows_vw = ((unit / v_top, 1.0 / w_top), (unit / v_top, -1.0 / w_top))
 
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
         """Constant rows; written every step because the arrays are shared views."""

@@ -57,6 +57,8 @@ class EdgeLoadLimit(Limit):
             their targets.
         acceleration_limit: the joints' largest accelerations (rad/s^2, shoulder and
             elbow), None for none.
+        unit: the length unit (m) in which the rows take ``v`` (:attr:`Limit.unit`); the
+            loads stay in N (:meth:`rows_and_floors` and :meth:`predict` in SI).
 
     Call :meth:`observe` with the measured base velocities before each step's solve and
     :meth:`advance` with the command sent after it (the joints' rate estimate).
@@ -70,7 +72,9 @@ class EdgeLoadLimit(Limit):
         min_edge_load: float,
         time_constant: float,
         acceleration_limit: tuple[float, float] | None = None,
+        unit: float = 1.0,
     ) -> None:
+        self.unit = check_positive("unit", unit)
         self.model = EdgeLoadModel.from_robot(robot)
         self.min_edge_load = check_min_edge_load(min_edge_load)
         self.floor_n = self.min_edge_load * self.model.weight
@@ -178,9 +182,17 @@ class EdgeLoadLimit(Limit):
         reach = sum(max(g * box[j], g * box[4 + j]) for j, g in enumerate(row))
         return min(floor, 0.5 * reach)
 
+    def in_unit(self, rows: list[list[float]]) -> list[list[float]]:
+        """``rows`` (N per SI unit of u) with the ``v`` entry per ``v / unit``."""
+        unit = self.unit
+        if unit == 1.0:
+            return rows
+        return [[row[0] * unit, row[1], row[2], row[3]] for row in rows]
+
     def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
         """Rows ``G_e`` with the lower bound of :meth:`capped`."""
         rows, floors = self.rows_and_floors(ctx)
+        rows = self.in_unit(rows)
         box = [*map(float, lb), *map(float, ub)]
         if self.active:
             self.tighten(box, self.joint_window())
@@ -197,13 +209,14 @@ class EdgeLoadLimit(Limit):
         block.write_constant_bounds([-INF] * self.rows, [INF] * self.rows)
         matrix, lower, starts, bounds = block.matrix, block.lower, block.rows, block.bounds
         box, values, capped = block.box, self.rows_and_floors, self.capped
-        tighten, window = self.tighten, self.joint_window
+        tighten, window, in_unit = self.tighten, self.joint_window, self.in_unit
 
         def write(ctx: StepContext) -> None:
             active = self.active
             if active:
                 tighten(box, window())
             rows, floors = values(ctx)
+            rows = in_unit(rows)
             for e, (row, floor) in enumerate(zip(rows, floors)):
                 start = starts[e]
                 matrix[start], matrix[start + 1] = row[0], row[1]

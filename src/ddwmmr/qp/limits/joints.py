@@ -23,6 +23,7 @@ class JointLimit(Limit):
 
     rows = 0
     name = "joints"
+    unit = None  # rows on rates only: any problem's length unit
 
     def __init__(self, robot: Robot, gain: float = 5.0, margin: float = 0.02) -> None:
         self.limits = robot.joint_limits

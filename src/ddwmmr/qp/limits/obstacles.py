@@ -46,9 +46,10 @@ from ddwmmr.trajectories.files import find_obstacle_file
 #: with the middle of a side of the footprint no input changes the clearance to first
 #: order (:meth:`ObstacleLimit.row`).
 DEGENERATE_SHARE = 1e-3
-#: Clearance (m) within which the qp acts on a circle by default: the ``influence`` of
+#: Clearance within which the qp acts on a circle by default: the ``influence`` of
 #: :class:`ObstacleLimit` (its rows switch on) and of
-#: :class:`~ddwmmr.qp.tasks.avoidance.ObstacleSteeringTask` (it steers round).
+#: :class:`~ddwmmr.qp.tasks.avoidance.ObstacleSteeringTask` (it steers round), in the
+#: robot's length unit (m on the default robot; docs/qp.md, "Robot size").
 INFLUENCE_M = 0.6
 
 
@@ -229,8 +230,10 @@ class ObstacleLimit(Limit):
         robot: gives the footprint and the base speed limits (to keep rows feasible).
         circles: the obstacles.
         margin: clearance kept from every circle (m).
-        influence: rows farther than this (m) are switched off.
+        influence: rows farther than this are switched off (in ``unit``).
         gain: damper gain (1/s).
+        unit: the length unit (m) of the rows (:attr:`Limit.unit`): each row is the
+            clearance rate in units per second, with ``v`` taken as ``v / unit``.
     """
 
     name = "obstacles"
@@ -242,24 +245,28 @@ class ObstacleLimit(Limit):
         margin: float = 0.05,
         influence: float = INFLUENCE_M,
         gain: float = 2.0,
+        unit: float = 1.0,
     ) -> None:
+        self.unit = check_positive("unit", unit)
         self.circles = list(circles)
         self.rows = len(self.circles)
         self.half_length, self.half_width = 0.5 * robot.base_length, 0.5 * robot.base_width
         self.margin = check_nonnegative("obstacle margin", margin)
         self.influence = check_positive("obstacle influence", influence)
-        if self.influence <= self.margin:
+        if self.influence * unit <= self.margin:
             raise ParameterError(
-                f"obstacle influence must be > margin ({margin:g} m) (got {influence:g})"
+                f"obstacle influence must be > margin ({margin:g} m) in units of {unit:g} m"
+                f" (got {influence:g})"
             )
         self.gain = check_gain("obstacle gain", gain)
         r, lw, limit = robot.wheel_radius, robot.track_width, robot.wheel_speed_limit
         self.v_max, self.w_max = r * limit, 2.0 * r * limit / lw
 
     def row(self, ctx: StepContext, circle: Circle) -> tuple[float, float, float]:
-        """``(dd/dv, dd/dw, lower bound)`` of one circle's row (-INF when far).
+        """``(dd/dv, dd/dw, lower bound)`` of one circle's row (-INF when far), in ``unit``:
+        the clearance rate in units per second, ``v`` taken as ``v / unit``.
 
-        The lower bound is the damper's ``-gain (d - margin)`` (m/s), capped at a quarter
+        The lower bound is the damper's ``-gain (d - margin)``, capped at a quarter
         of the top clearance rate ``|dd/dv| v_max + |dd/dw| w_max`` so the row stays
         feasible. A degenerate row, whose top clearance rate is below
         :data:`DEGENERATE_SHARE` of ``v_max`` (a circle level with the middle of a side:
@@ -270,14 +277,17 @@ class ObstacleLimit(Limit):
         clearance, a row below the solvers' tolerances that they answered differently
         (DAQP found no solution on every step, others spun the base or not).
         """
+        unit = self.unit
         d, a_v, a_w = clearance_and_rate(
             self.half_length, self.half_width, ctx.x, ctx.y, ctx.phi, circle
         )
-        if d >= self.influence:
+        a_w /= unit
+        if d >= self.influence * unit:
             return a_v, a_w, -INF
-        damper = -self.gain * (d - self.margin)
-        reach = abs(a_v) * self.v_max + abs(a_w) * self.w_max
-        if reach < DEGENERATE_SHARE * self.v_max:
+        damper = -self.gain * (d - self.margin) / unit
+        v_max = self.v_max / unit
+        reach = abs(a_v) * v_max + abs(a_w) * self.w_max
+        if reach < DEGENERATE_SHARE * v_max:
             norm = math.hypot(a_v, a_w)
             if norm == 0.0:  # no rate at all: the row reads 0 >= min(damper, 0)
                 return a_v, a_w, min(damper, 0.0)

@@ -33,6 +33,7 @@ class ShoulderSingularityLimit(Limit):
 
     rows = 1
     name = "shoulder singularity"
+    unit = None  # rows on rates only: any problem's length unit
 
     def __init__(self, margin: float = 0.25, gain: float = 5.0, joint_speed: float = 2.0) -> None:
         self.margin = check_positive("singularity_margin", margin)

@@ -226,6 +226,7 @@ class StabilityLimit(Limit):
 
     rows = 2
     name = "stability"
+    unit = None  # rows on rates only: any problem's length unit
 
     def __init__(
         self,

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from ddwmmr.errors import check_positive
 from ddwmmr.model import Robot
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
@@ -14,14 +15,16 @@ from ddwmmr.qp.limits.base import Limit
 
 
 class WheelSpeedLimit(Limit):
-    """Rows ``phidot_l = (2v - Lw w)/(2r)`` and ``phidot_r = (2v + Lw w)/(2r)`` in +-limit."""
+    """Rows ``phidot_l = (2v - Lw w)/(2r)`` and ``phidot_r = (2v + Lw w)/(2r)`` in +-limit
+    (rad/s), with ``v`` taken as ``v / unit`` (``unit``: m, :attr:`Limit.unit`)."""
 
     rows = 2
     name = "wheels"
 
-    def __init__(self, robot: Robot, scale: float = 1.0) -> None:
+    def __init__(self, robot: Robot, scale: float = 1.0, unit: float = 1.0) -> None:
+        self.unit = check_positive("unit", unit)
         r, lw = robot.wheel_radius, robot.track_width
-        self.rows_lr = ((1.0 / r, -lw / (2.0 * r)), (1.0 / r, lw / (2.0 * r)))
+        self.rows_lr = ((unit / r, -lw / (2.0 * r)), (unit / r, lw / (2.0 * r)))
         # A hair inside the plant's limit so the plant never has to rescale our command.
         self.limit = robot.wheel_speed_limit * scale * (1.0 - 1e-6)
 

@@ -20,7 +20,8 @@ from ddwmmr.qp.tasks.base import YawRowTask
 
 
 class ObstacleSteeringTask(YawRowTask):
-    """One row on w, active while a circle ahead is within ``influence`` (m) of the base."""
+    """One row on w, active while a circle ahead is within ``influence`` of the base
+    (in the robot's length unit ``unit``, m: 0.6 m on the default robot)."""
 
     rows = 1
     primary = True  # in hierarchical mode it may trade tracking, like the thesis behaviour
@@ -34,8 +35,10 @@ class ObstacleSteeringTask(YawRowTask):
         weight: float = 3.0,
         influence: float = INFLUENCE_M,
         gain: float = 2.0,
+        unit: float = 1.0,
     ) -> None:
         super().__init__(weight)
+        self.unit = check_positive("unit", unit)
         self.circles = list(circles)
         self.half_length, self.half_width = half_length, half_width
         self.influence = check_positive("obstacle influence", influence)
@@ -44,7 +47,7 @@ class ObstacleSteeringTask(YawRowTask):
     def values(self, ctx: StepContext) -> tuple[float, float]:
         """``(J[0, 1], e[0])``: 1 and the yaw-rate target (rad/s) while a circle ahead is
         near, else zeros."""
-        nearest, bearing = self.influence, None
+        nearest, bearing = self.influence * self.unit, None
         c, s = ctx.cos_phi, ctx.sin_phi
         for circle in self.circles:
             d, _, _ = clearance_and_rate(

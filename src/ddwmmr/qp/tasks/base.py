@@ -4,6 +4,8 @@ A task asks for ``J u = e``: ``J`` (rows x 4) maps the inputs ``u = (v, w, th1do
 (m/s, rad/s, rad/s, rad/s) to some task rate, ``e`` is the rate it wants. The solver adds
 ``weight * ||J u - e||^2`` to the cost, or, for a task with ``slack = True``, turns the rows
 into equality constraints ``J u - s = e`` whose slack ``s`` is penalised by ``weight``.
+A task's rows may measure lengths in a robot's own length unit (:attr:`Task.unit`): its
+rows then take ``v`` in units per second (docs/qp.md, "Robot size").
 A new objective is one subclass implementing :meth:`Task.compute`; the built-in tasks also
 implement the optional fast path :meth:`Task.compile` (see :mod:`ddwmmr.qp.blocks`).
 """
@@ -57,12 +59,19 @@ class Task(ABC):
             primary, tracking level); False adds them to the cost directly.
         primary: a cost task solved at the primary level in hierarchical mode (next to
             the slack tasks) instead of in the secondary level.
+        unit: the length unit (m) of the rows: ``J`` takes ``v`` as ``v / unit`` (units
+            per second) and a linear rate is in units per second. 1.0 (metres, m/s) unless
+            a built-in task is given its robot's unit
+            (:func:`~ddwmmr.resolution.kernels.length_unit`); the problem converts a
+            task's ``v`` column to its own unit (:class:`~ddwmmr.qp.problem.QPProblem`).
+            None: the rows never involve ``v`` or a length (any problem's unit).
     """
 
     rows: int = 1
     slack: bool = False
     primary: bool = False
     name: str = "task"
+    unit: float | None = 1.0
 
     def __init__(self, weight: float) -> None:
         self.weight = check_weight(f"{self.name.replace(' ', '_')}_weight", weight)

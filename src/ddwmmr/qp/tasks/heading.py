@@ -19,16 +19,23 @@ class HeadingTask(YawRowTask):
     leaving the arm to finish the job. The fade matters: a row that switched off at once
     made the command jump as the base crossed ``distance``, and the base chattered there.
     Without it a differential drive asked to move sideways can end up parked broadside,
-    its arm stretched, making no progress.
+    its arm stretched, making no progress. ``fade`` is in the robot's length unit ``unit``
+    (m: 0.3 m on the default robot), ``distance`` in m.
     """
 
     rows = 1
     name = "heading"
 
     def __init__(
-        self, weight: float = 1.0, gain: float = 2.0, distance: float = 0.8, fade: float = 0.3
+        self,
+        weight: float = 1.0,
+        gain: float = 2.0,
+        distance: float = 0.8,
+        fade: float = 0.3,
+        unit: float = 1.0,
     ) -> None:
         super().__init__(weight)
+        self.unit = check_positive("unit", unit)
         self.gain = check_gain("heading gain", gain)
         self.distance = check_nonnegative("heading distance", distance)
         self.fade = check_positive("heading fade", fade)
@@ -38,7 +45,7 @@ class HeadingTask(YawRowTask):
     def values(self, ctx: StepContext) -> tuple[float, float]:
         """``(J[0, 1], e[0])``: the fade factor and the yaw-rate target (rad/s)."""
         dx, dy = ctx.pose_d[0] - ctx.x, ctx.pose_d[1] - ctx.y
-        factor = min(1.0, (math.hypot(dx, dy) - self.distance) / self.fade)
+        factor = min(1.0, (math.hypot(dx, dy) - self.distance) / (self.fade * self.unit))
         if factor <= 0.0:
             return 0.0, 0.0
         if self.detour is not None:

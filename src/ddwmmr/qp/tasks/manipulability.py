@@ -25,15 +25,18 @@ from collections.abc import Callable
 
 import numpy as np
 
+from ddwmmr.errors import check_positive
 from ddwmmr.gains import check_gain
 from ddwmmr.model.kinematics import wrap_angle
 from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.tasks.base import Task
 
-#: Desired base speed (m/s) at which the steering row reaches full weight; below it the row
-#: fades in proportion. Near the optimum th2 = pi/2 the ascent direction flips as cos(th2)
-#: changes sign while its size goes to zero: a row switched on at full strength there
+#: Desired base speed (robot length units per second: m/s on the default robot,
+#: :attr:`~ddwmmr.qp.tasks.base.Task.unit`) at which the steering row reaches full
+#: weight; below it the row fades in proportion. Near the optimum th2 = pi/2 the ascent
+#: direction flips as cos(th2) changes sign while its size goes to zero: a row switched
+#: on at full strength there
 #: alternated the base yaw every step (and, at dt = 0.02 s, kept the end effector ~1 cm
 #: from its target).
 FADE_SPEED = 0.05
@@ -65,6 +68,9 @@ class ManipulabilityTask(Task):
 
     ``arm_row=False`` zeroes the arm row's weight: with the orientation tracked, th2dot is
     fixed by tracking, so that row could only trade tracking accuracy for nothing.
+    ``unit`` (m): the robot's length unit, in which the steering row measures the desired
+    base velocity (its fade, :data:`FADE_SPEED`, and ``base_gain``, units^2/s); the rows
+    themselves are on rates (rad/s).
     """
 
     rows = 2
@@ -77,8 +83,10 @@ class ManipulabilityTask(Task):
         base_gain: float = 0.02,
         heading_gain: float = 2.0,
         arm_row: bool = True,
+        unit: float = 1.0,
     ) -> None:
         super().__init__(weight)
+        self.unit = check_positive("unit", unit)
         self.arm_row = bool(arm_row)
         self.gain = check_gain("manipulability gain", gain)
         self.base_gain = check_gain("manipulability base_gain", base_gain)
@@ -93,10 +101,11 @@ class ManipulabilityTask(Task):
         th2 = ctx.th2
         arm_slope = eta_squared_gradient(th2)
         arm_target = self.gain * math.cos(th2) ** 2  # 1 - eta^2
+        unit = self.unit
         gx, gy = base_gradient(ctx.L1, ctx.L2, ctx)
         half_base_gain = 0.5 * self.base_gain
-        vx = ctx.velocity_d[0] + half_base_gain * gx
-        vy = ctx.velocity_d[1] + half_base_gain * gy
+        vx = ctx.velocity_d[0] / unit + half_base_gain * (gx * unit)  # units per second
+        vy = ctx.velocity_d[1] / unit + half_base_gain * (gy * unit)
         fade = math.hypot(vx, vy) / FADE_SPEED
         fade = fade if fade < 1.0 else 1.0  # min(1, fade), without a call
         if fade == 0.0:

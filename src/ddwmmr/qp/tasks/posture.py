@@ -30,6 +30,7 @@ class PostureTask(Task):
 
     rows = 3
     name = "posture"
+    unit = None  # rows on rates only: any problem's length unit
 
     def __init__(
         self,

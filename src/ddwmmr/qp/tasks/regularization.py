@@ -15,19 +15,22 @@ from ddwmmr.qp.tasks.base import Task
 class RegularizationTask(Task):
     """``u = 0`` with weights ``weight * (1, length^2, length^2, length^2)``.
 
-    ``length`` (m) converts rates (rad/s) into end-effector speeds (m/s), so a base speed
-    and a joint rate moving the end effector equally fast cost the same.
+    ``length`` (in ``unit``, :attr:`Task.unit`: m by default) converts rates (rad/s) into
+    end-effector speeds (units per second), so a base speed and a joint rate moving the
+    end effector equally fast cost the same. Given its robot's unit, the task costs a
+    robot scaled by s as the default one: the ``v`` row takes ``v / unit``.
     """
 
     rows = 4
     name = "regularization"
 
-    def __init__(self, weight: float = 1e-3, length: float = 0.5) -> None:
+    def __init__(self, weight: float = 1e-3, length: float = 0.5, unit: float = 1.0) -> None:
         super().__init__(weight)
         self.length = check_positive("regularization length", length)
+        self.unit = check_positive("unit", unit)
 
     def row_weights(self) -> np.ndarray:
-        """Per-input weights (cost per (m/s)^2 and per (rad/s)^2)."""
+        """Per-input weights (cost per (unit/s)^2 and per (rad/s)^2)."""
         l2 = self.length**2
         return self.weight * np.array([1.0, l2, l2, l2])
 

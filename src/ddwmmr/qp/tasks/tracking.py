@@ -32,6 +32,11 @@ class EndEffectorTask(Task):
     the position part, and the orientation part): the controller sets it far above what the
     robot can do (10x), so it only acts on absurd demands (a pose error of 1e12 m), whose
     magnitude would otherwise swamp the solver's tolerances.
+
+    ``unit`` (m, :attr:`Task.unit`): the position rows are written divided by it, in units
+    per second with ``v`` in units per second, so their slack, and ``weight``, are per
+    unit per second: a robot scaled by s, given its unit, weighs its errors as the
+    default robot does. :meth:`targets` stays in m/s.
     """
 
     rows = 3
@@ -45,8 +50,10 @@ class EndEffectorTask(Task):
         track_orientation: bool = True,
         max_speed: float | None = None,
         demand_limit: tuple[float, float] | None = None,
+        unit: float = 1.0,
     ) -> None:
         super().__init__(weight)
+        self.unit = check_positive("unit", unit)
         self.kx, self.ky, self.kphi = feedback_gains(tau)
         self.track_orientation = bool(track_orientation)
         self.max_speed = None if max_speed is None else check_positive("max_speed", max_speed)
@@ -70,7 +77,7 @@ class EndEffectorTask(Task):
             ax, ay = self.detour.aim(ctx.x, ctx.y, xd, yd)
             if (ax, ay) != (xd, yd):  # blocked: same speed, towards the aim point
                 ux, uy = ax - xe, ay - ye
-                scale = math.hypot(fx, fy) / max(math.hypot(ux, uy), 1e-9)
+                scale = math.hypot(fx, fy) / max(math.hypot(ux, uy), 1e-9 * self.unit)
                 fx, fy = ux * scale, uy * scale
         if self.max_speed is not None:
             norm = math.hypot(fx, fy)
@@ -86,9 +93,14 @@ class EndEffectorTask(Task):
         return e0, e1, e2
 
     def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
-        """Rows: the end-effector Jacobian; target: feed-forward + clipped feedback."""
+        """Rows: the end-effector Jacobian; target: feed-forward + clipped feedback; the
+        position rows in ``unit`` (divided by it but for the ``v`` entry, which ``v /
+        unit`` takes)."""
+        unit = self.unit
         jac[:] = ctx.jac_e
-        error[0], error[1], error[2] = self.targets(ctx)
+        jac[:2, 1:] /= unit
+        e0, e1, error[2] = self.targets(ctx)
+        error[0], error[1] = e0 / unit, e1 / unit
         if not self.track_orientation:
             jac[2] = 0.0
 
@@ -107,15 +119,16 @@ class EndEffectorTask(Task):
         jac, (lower, upper) = block.jac, block.target_views
         r0, r1, _ = block.rows
         t0, t1, t2 = block.targets
-        targets = self.targets
+        targets, unit = self.targets, self.unit
 
         def write(ctx: StepContext) -> None:
             dx_v, dx_w, dx_2, dy_v, dy_w, dy_2 = ctx.jac_e_rows
+            dx_w, dx_2, dy_w, dy_2 = dx_w / unit, dx_2 / unit, dy_w / unit, dy_2 / unit
             jac[r0], jac[r0 + 1], jac[r0 + 2], jac[r0 + 3] = dx_v, dx_w, dx_w, dx_2
             jac[r1], jac[r1 + 1], jac[r1 + 2], jac[r1 + 3] = dy_v, dy_w, dy_w, dy_2
             e0, e1, e2 = targets(ctx)
-            lower[t0] = upper[t0] = e0
-            lower[t1] = upper[t1] = e1
+            lower[t0] = upper[t0] = e0 / unit
+            lower[t1] = upper[t1] = e1 / unit
             lower[t2] = upper[t2] = e2
 
         return write
