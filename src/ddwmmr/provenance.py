@@ -113,12 +113,16 @@ def _git(top: Path, *arguments: str) -> str:
 
 def command_record(prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
     """``command``: a command that repeats the run, ``prog`` (the tool's ``python -m``
-    form, also when the run was started by its console script) and the arguments;
+    form, also when the run was started by its console script) and the arguments, quoted
+    for this platform's shell (POSIX ``sh``; ``cmd.exe`` on Windows);
     ``argv``: the arguments as given (``argv``, or ``sys.argv[1:]``); ``cwd``: the
     working folder."""
     arguments = list(argv if argv is not None else sys.argv[1:])
+    words = [*shlex.split(prog), *arguments]
+    # cmd.exe passes single quotes on literally: Windows gets its own quoting
+    command = subprocess.list2cmdline(words) if os.name == "nt" else shlex.join(words)
     return {
-        "command": shlex.join([*shlex.split(prog), *arguments]),
+        "command": command,
         "argv": arguments,
         "cwd": os.getcwd(),
     }

@@ -40,6 +40,9 @@ from multiprocessing.context import BaseContext
 PR_SET_PDEATHSIG = 1
 #: Exit status of a worker that outlived its parent (the parent is gone: nobody reads it).
 EXIT_ORPHANED = 1
+#: Most workers a process pool may have on Windows (``WaitForMultipleObjects`` waits on at
+#: most 64 handles; :class:`~concurrent.futures.ProcessPoolExecutor` keeps 3 for itself).
+WINDOWS_MAX_WORKERS = 61
 
 
 #: Attribute of a warnings display (``warnings.showwarning``) naming the module-level
@@ -53,8 +56,11 @@ def process_pool(jobs: int, mp_context: BaseContext | None = None) -> ProcessPoo
     show warnings as this process does (:func:`worker_display`).
 
     ``mp_context``: the :mod:`multiprocessing` context that starts the workers (default:
-    the platform's start method).
+    the platform's start method). On Windows at most :data:`WINDOWS_MAX_WORKERS` workers
+    start, however many ``jobs`` asks for: the results do not depend on the count.
     """
+    if sys.platform == "win32":
+        jobs = min(jobs, WINDOWS_MAX_WORKERS)
     return ProcessPoolExecutor(
         max_workers=jobs,
         mp_context=mp_context,

@@ -24,9 +24,12 @@ EXIT_INTERRUPTED = 128 + signal.SIGINT
 EXIT_TERMINATED = 128 + signal.SIGTERM
 #: Signals that stop a tool as SIGTERM does (those this platform has): a closed terminal
 #: (SIGHUP) and Ctrl-\ (SIGQUIT) would otherwise end it without a word, or with a core
-#: dump, and leave its workers and staging folder behind.
+#: dump, and leave its workers and staging folder behind; so would Ctrl-Break (SIGBREAK,
+#: Windows).
 STOP_SIGNALS = tuple(
-    getattr(signal, name) for name in ("SIGTERM", "SIGHUP", "SIGQUIT") if hasattr(signal, name)
+    getattr(signal, name)
+    for name in ("SIGTERM", "SIGHUP", "SIGQUIT", "SIGBREAK")
+    if hasattr(signal, name)
 )
 
 

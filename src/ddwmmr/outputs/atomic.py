@@ -59,7 +59,7 @@ def write_atomic(
         raise ParameterError(message) from exc
     try:
         with os.fdopen(fd, "wb") as handle:
-            os.fchmod(handle.fileno(), file_mode())
+            set_file_mode(handle.fileno(), tmp)
             if callable(payload):
                 payload(handle)
             else:
@@ -74,6 +74,16 @@ def write_atomic(
         Path(tmp).unlink(missing_ok=True)
         raise
     sync_folder(path.parent)
+
+
+def set_file_mode(fd: int, path: str | os.PathLike[str]) -> None:
+    """Give the open file ``fd`` (at ``path``) :func:`file_mode`: through the descriptor
+    where ``os.fchmod`` exists (POSIX), else through the path (Windows before Python 3.13,
+    where the mode sets only the read-only flag)."""
+    if hasattr(os, "fchmod"):
+        os.fchmod(fd, file_mode())
+    else:
+        os.chmod(path, file_mode())
 
 
 def sync_folder(folder: str | os.PathLike[str]) -> None:

@@ -50,10 +50,11 @@ from ddwmmr.outputs.recovery import (
 )
 
 #: The signals whose Python handlers wait while a commit moves files (the tools' stop
-#: signals: :mod:`ddwmmr.cli.signals`, which this low layer may not import).
+#: signals: :mod:`ddwmmr.cli.signals`, which this low layer may not import; SIGBREAK is
+#: Windows' Ctrl-Break).
 _DEFERRED_SIGNALS = tuple(
     getattr(signal, name)
-    for name in ("SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT")
+    for name in ("SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT", "SIGBREAK")
     if hasattr(signal, name)
 )
 
@@ -294,7 +295,11 @@ def _commit_fresh(staging: Path, target: Path, done: list[Path]) -> None:
     """Rename ``staging`` to the first of ``target``, ``target-2``... that nobody holds:
     each candidate is taken with an exclusive ``mkdir`` (so two runs finishing together
     cannot take the same one), then the staging folder replaces that empty folder; see
-    :func:`_commit` for ``done``."""
+    :func:`_commit` for ``done``. On Windows, whose rename never replaces anything (and so
+    is exclusive itself), the staging folder is renamed to the candidate directly."""
+    if os.name == "nt":
+        _rename_to_free(staging, target, done)
+        return
     while True:
         candidate = first_free(target, folder=True)
         try:
@@ -313,6 +318,24 @@ def _commit_fresh(staging: Path, target: Path, done: list[Path]) -> None:
                 raise
             with contextlib.suppress(OSError):
                 candidate.rmdir()
+            raise
+        done.append(candidate)
+        return
+
+
+def _rename_to_free(staging: Path, target: Path, done: list[Path]) -> None:
+    """Rename ``staging`` to the first free of ``target``, ``target-2``... where a rename
+    refuses an existing destination (Windows): a candidate taken meanwhile fails the
+    rename, and the next one is tried; see :func:`_commit` for ``done``."""
+    while True:
+        candidate = first_free(target, folder=True)
+        try:
+            os.rename(staging, candidate)
+        except FileExistsError:
+            continue  # taken between the look and the rename: the next one
+        except BaseException:
+            if not os.path.lexists(staging):  # the rename was made: the output is there
+                done.append(candidate)
             raise
         done.append(candidate)
         return
@@ -343,12 +366,15 @@ def _sync_files(folder: Path) -> None:
     """Sync every regular file below ``folder`` to the disk (``fsync``): whatever wrote
     it (``savefig`` too), its bytes are on the disk before the commit's renames make it
     the output, so a power cut never leaves an empty file under an output name."""
+    # Windows syncs only a file opened for writing (FlushFileBuffers needs write access);
+    # POSIX syncs any, and read-only keeps a file the umask made read-only syncable.
+    flags = os.O_RDWR if os.name == "nt" else os.O_RDONLY
     for root, _, files in os.walk(folder):
         for name in files:
             path = Path(root) / name
             if os.path.islink(path):
                 continue
-            fd = os.open(path, os.O_RDONLY)
+            fd = os.open(path, flags)
             try:
                 os.fsync(fd)
             finally:

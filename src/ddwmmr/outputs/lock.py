@@ -13,6 +13,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ddwmmr.errors import ParameterError
+from ddwmmr.outputs.atomic import set_file_mode
 from ddwmmr.outputs.files import file_mode
 from ddwmmr.outputs.owners import (
     LOCK_PREFIX,
@@ -37,7 +38,9 @@ def output_lock(target: Path, text: str) -> Iterator[None]:
     """Hold the lock of ``target`` (shown as ``text``) for the block; a one-line
     :class:`ParameterError` if another live run holds it: ``out: DIR is being written by
     another ddwmmr run (pid N)``. The lock is removed when the block ends, however it
-    ends; one whose holder has ended (same host) is taken over."""
+    ends; one whose holder has ended (same host) is taken over. One of another host's run
+    (a shared folder, or this host renamed since) is never taken over: the refusal names
+    the lock file, for the user to delete once that run has ended."""
     path = lock_file(target)
     token = owner_token()
     _take(path, text, token)
@@ -61,11 +64,15 @@ def _take(path: Path, text: str, token: str) -> None:
             drop_stale_lock(path, holder)  # a killed run's: take it over
             continue
         host, pid, _ = holder
-        where = "" if host == _host() else f" on {host}"
+        if host == _host():
+            raise ParameterError(f"out: {text} is being written by another ddwmmr run (pid {pid})")
         raise ParameterError(
-            f"out: {text} is being written by another ddwmmr run (pid {pid}{where})"
+            f"out: {text} is being written by another ddwmmr run (pid {pid} on {host}); "
+            f"if that run has ended, delete {path}"
         )
-    raise ParameterError(f"out: {text} is being written by another ddwmmr run")
+    raise ParameterError(
+        f"out: {text} is being written by another ddwmmr run; if it has ended, delete {path}"
+    )
 
 
 def _create(path: Path, token: str) -> bool:
@@ -75,7 +82,7 @@ def _create(path: Path, token: str) -> bool:
     fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=temp_prefix(), suffix=".tmp")
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            os.fchmod(handle.fileno(), file_mode())
+            set_file_mode(handle.fileno(), temporary)
             handle.write(token)
         try:
             os.link(temporary, path)

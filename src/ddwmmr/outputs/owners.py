@@ -6,10 +6,13 @@ them carry the host, process id and start time of the run that made them
 
 from __future__ import annotations
 
+import ctypes
+import functools
 import os
 import re
 import socket
 from pathlib import Path
+from typing import Any
 
 STAGING_PREFIX = ".ddwmmr-staging-"
 
@@ -43,9 +46,20 @@ def _host() -> str:
     return re.sub(r"[^A-Za-z0-9.-]", "_", socket.gethostname())[:64] or "host"
 
 
+#: ``OpenProcess`` access right enough for the exit code and times (winnt.h).
+_PROCESS_QUERY_LIMITED_INFORMATION = 0x1000
+#: ``GetExitCodeProcess``'s code of a process still running (minwinbase.h).
+_STILL_ACTIVE = 259
+#: ``OpenProcess``'s error for a process id no process has (winerror.h).
+_ERROR_INVALID_PARAMETER = 87
+
+
 def _process_start(pid: int) -> int:
-    """When process ``pid`` started, in clock ticks since boot (Linux), or 0 if unknown;
-    with the process id it names one process, even after the id is reused."""
+    """When process ``pid`` started, in clock ticks since boot (Linux) or in 100 ns since
+    1601 (Windows' creation time), or 0 if unknown; with the process id it names one
+    process, even after the id is reused."""
+    if os.name == "nt":
+        return _windows_process(pid)[1]
     try:
         fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
         return int(fields[19])
@@ -75,8 +89,11 @@ def _dead_owner(name: str, kind: str) -> re.Match[str] | None:
 def _running(pid: int, start: int) -> bool:
     """Whether the process ``pid`` that started at ``start`` (0: unknown) still runs.
     In doubt (another user's process, a platform without these checks): True."""
+    if os.name == "nt":  # os.kill(pid, 0) would end the process there
+        running, started = _windows_process(pid)
+        return running and (not start or started in (0, start))
     if os.name != "posix":
-        return True  # os.kill(pid, 0) would end the process on Windows
+        return True
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -90,6 +107,43 @@ def _running(pid: int, start: int) -> bool:
     if state == "Z":
         return False  # ended, not yet reaped
     return not start or _process_start(pid) in (0, start)
+
+
+def _windows_process(pid: int) -> tuple[bool, int]:
+    """Windows: whether process ``pid`` runs, and its creation time (100 ns since 1601; 0
+    if unknown). In doubt (no access to it): running, start unknown."""
+    kernel32 = _kernel32()
+    handle = kernel32.OpenProcess(_PROCESS_QUERY_LIMITED_INFORMATION, False, pid)
+    if not handle:
+        return (_last_error() != _ERROR_INVALID_PARAMETER, 0)
+    try:
+        code = ctypes.c_ulong()
+        if not kernel32.GetExitCodeProcess(handle, ctypes.byref(code)):
+            return (True, 0)
+        # FILETIMEs (two 32-bit halves, low first) read as 64-bit integers
+        times = [ctypes.c_ulonglong() for _ in range(4)]
+        known = kernel32.GetProcessTimes(handle, *(ctypes.byref(t) for t in times))
+        return (code.value == _STILL_ACTIVE, times[0].value if known else 0)
+    finally:
+        kernel32.CloseHandle(handle)
+
+
+@functools.cache
+def _kernel32() -> Any:
+    """Windows' kernel32, with the functions :func:`_windows_process` calls typed (a
+    process handle is pointer-sized)."""
+    kernel32 = ctypes.WinDLL("kernel32", use_last_error=True)  # type: ignore[attr-defined]
+    kernel32.OpenProcess.restype = ctypes.c_void_p
+    kernel32.OpenProcess.argtypes = (ctypes.c_ulong, ctypes.c_int, ctypes.c_ulong)
+    kernel32.GetExitCodeProcess.argtypes = (ctypes.c_void_p, ctypes.c_void_p)
+    kernel32.GetProcessTimes.argtypes = (ctypes.c_void_p, *[ctypes.c_void_p] * 4)
+    kernel32.CloseHandle.argtypes = (ctypes.c_void_p,)
+    return kernel32
+
+
+def _last_error() -> int:
+    """Windows: the error code of the last kernel32 call of this thread."""
+    return ctypes.get_last_error()  # type: ignore[attr-defined]
 
 
 def _is_stale_temp(name: str) -> bool:

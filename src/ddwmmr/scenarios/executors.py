@@ -205,9 +205,12 @@ def _first_line(error: BaseException) -> str:
     return f"{type(error).__name__}: {line}" if line else type(error).__name__
 
 
-#: Signals a terminal sends to a whole process group (Ctrl-C, a closed terminal, Ctrl-\\).
+#: Signals a terminal sends to a whole process group (Ctrl-C, a closed terminal, Ctrl-\\,
+#: Windows' Ctrl-Break).
 _TERMINAL_SIGNALS = tuple(
-    getattr(signal, name) for name in ("SIGINT", "SIGHUP", "SIGQUIT") if hasattr(signal, name)
+    getattr(signal, name)
+    for name in ("SIGINT", "SIGHUP", "SIGQUIT", "SIGBREAK")
+    if hasattr(signal, name)
 )
 
 
