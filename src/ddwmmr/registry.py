@@ -360,7 +360,10 @@ def _read_source(module: str) -> list[tuple[int, str, str, dict[str, Any], str, 
                 continue
             try:
                 (name,) = (ast.literal_eval(a) for a in decorator.args)
-                traits = {k.arg: ast.literal_eval(k.value) for k in decorator.keywords}
+                named = [(k.arg, k.value) for k in decorator.keywords if k.arg is not None]
+                if len(named) < len(decorator.keywords):  # a ``**traits``: not literal
+                    raise ValueError
+                traits = {key: ast.literal_eval(value) for key, value in named}
             except ValueError:
                 raise TypeError(
                     f"{path}:{decorator.lineno}: @{called}(...) takes literal arguments only "

@@ -528,13 +528,13 @@ def budget_bound(
                     travel=kind == "travel",
                     with_path=stops,
                 )
-                charge = lags.at_rest(path) if stops else 0.0
+                charge = lags.at_rest(path) if lags is not None else 0.0
                 for key, cost in _leg_costs(block, drive, charge, kind, stops).items():
                     least = np.min(cost, axis=0)
                     states[key] = least if key not in states else np.minimum(states[key], least)
         ax, ay, a_size = bx, by, cell
     # the last stretch ends free: its charge was the rest-to-rest lag
-    end = lags.free_excess if stops else 0.0
+    end = lags.free_excess if lags is not None else 0.0
     value = min(
         float(np.min(cost)) - (end if charged else 0.0) for (_, charged), cost in states.items()
     )

@@ -174,9 +174,9 @@ class ConfigurationSpaceController:
         """
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         check_angles(q)
-        u, residual = self._input(t, q)
+        u, residual, damped = self._input(t, q)
         check_command(u, q, pose_d)
-        self.last = StepInfo(singular=self.reference.last_damped, nonholonomic_residual=residual)
+        self.last = StepInfo(singular=damped, nonholonomic_residual=residual)
         return np.array(u)
 
     def law(
@@ -184,12 +184,13 @@ class ConfigurationSpaceController:
     ) -> tuple[Input, bool]:
         """The control law on lists of floats: ``(u, singular)``, no validation (the
         integrator evaluates it at its stages; see :mod:`ddwmmr.sim.loop`)."""
-        u, _ = self._input(t, q)
-        return u, self.reference.last_damped
+        u, _, damped = self._input(t, q)
+        return u, damped
 
-    def _input(self, t: float, q: list[float]) -> tuple[Input, float]:
-        """``(u, residual)``: the reference rate plus configuration feedback, projected on
-        the inputs, and its sideways base part (m/s) that the drive cannot produce."""
+    def _input(self, t: float, q: list[float]) -> tuple[Input, float, bool]:
+        """``(u, residual, damped)``: the reference rate plus configuration feedback,
+        projected on the inputs, its sideways base part (m/s) that the drive cannot
+        produce, and whether the reference segment looked up was integrated with damping."""
         reference = self.reference
         if reference is None:
             raise RuntimeError("clrrmc-cs needs reset(trajectory, q0) before command()")
@@ -201,4 +202,4 @@ class ConfigurationSpaceController:
         qdot = [d + k * e for d, k, e in zip(qdot_ref, self.gains, error)]
         c, s = math.cos(q[2]), math.sin(q[2])
         u = (qdot[0] * c + qdot[1] * s, qdot[2], qdot[3], qdot[4])
-        return u, -qdot[0] * s + qdot[1] * c
+        return u, -qdot[0] * s + qdot[1] * c, reference.last_damped

@@ -353,14 +353,27 @@ def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[floa
     return s_lon, factor * (-k.A * s1 - k.B * s12), factor * (-k.B * s12)
 
 
+def support_edges(k: ComCoefficients) -> SupportEdges:
+    """The edges of ``k``'s support polygon: ``k.edges``, or those of the rectangle
+    ``|x| <= half_length, |y| <= half_width`` (m) when ``k`` measures S on it in closed
+    form (outward unit normals, offsets in m)."""
+    if k.edges is not None:
+        return k.edges
+    front, side = k.half_length, k.half_width
+    lon = ((1.0, 0.0, front), (-1.0, 0.0, front))
+    lat = ((0.0, 1.0, side), (0.0, -1.0, side))
+    return SupportEdges(lon, lat, math.hypot(front, side), (front, side))
+
+
 def polygon_terms_gradient(
     k: ComCoefficients, s1: float, c1: float, s12: float, c12: float
 ) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """``((S_lon, dS_lon/dth1, dS_lon/dth2), (S_lat, ...))`` (1/rad) on ``k.edges`` (not
-    None) from ``sin/cos th1`` and ``sin/cos (th1 + th2)``: each term's gradient is its
-    active edge's (the first of its least, :func:`edge_gradients`); zero where capped."""
+    """``((S_lon, dS_lon/dth1, dS_lon/dth2), (S_lat, ...))`` (1/rad) on ``k``'s support
+    polygon (:func:`support_edges`) from ``sin/cos th1`` and ``sin/cos (th1 + th2)``: each
+    term's gradient is its active edge's (the first of its least, :func:`edge_gradients`);
+    zero where capped."""
     terms = edge_gradients(k, s1, c1, s12, c12)
-    split = len(k.edges.lon)
+    split = len(support_edges(k).lon)
     capped = (STABILITY_CAP, 0.0, 0.0)
     lon = min(terms[:split], key=lambda term: term[0], default=capped)
     lat = min(terms[split:], key=lambda term: term[0], default=capped)
@@ -370,8 +383,9 @@ def polygon_terms_gradient(
 def edge_gradients(
     k: ComCoefficients, s1: float, c1: float, s12: float, c12: float
 ) -> tuple[tuple[float, float, float], ...]:
-    """``(S_e, dS_e/dth1, dS_e/dth2)`` (1/rad) of every edge of ``k.edges`` (not None; the
-    ``lon`` edges, then the ``lat`` ones) from ``sin/cos th1`` and ``sin/cos (th1 + th2)``.
+    """``(S_e, dS_e/dth1, dS_e/dth2)`` (1/rad) of every edge of ``k``'s support polygon
+    (:func:`support_edges`; the ``lon`` edges, then the ``lat`` ones) from ``sin/cos th1``
+    and ``sin/cos (th1 + th2)``.
     ``S = min_e S_e``. An edge the centre of mass c faces within :data:`STABILITY_CAP` has
     ``S_e = d / (n . c)`` and ``dS_e/dth = -S_e (n . dc/dth) / (n . c)``; any other reads
     ``(STABILITY_CAP, 0, 0)`` (capped, as :func:`edge_margin` has it)."""
@@ -379,8 +393,9 @@ def edge_gradients(
     y_com = k.A * s1 + k.B * s12
     dx1, dy1 = -k.A * s1 - k.B * s12, x_com
     dx2, dy2 = -k.B * s12, k.B * c12
+    edges = support_edges(k)
     terms = []
-    for n_x, n_y, d in (*k.edges.lon, *k.edges.lat):
+    for n_x, n_y, d in (*edges.lon, *edges.lat):
         reach = n_x * x_com + n_y * y_com  # n . c, the offset towards the edge (m)
         s = d / reach if reach * STABILITY_CAP > d else STABILITY_CAP
         if s < STABILITY_CAP:

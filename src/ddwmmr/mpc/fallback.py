@@ -9,13 +9,16 @@ model's velocity loop and its joint rates clipped to the model's joint speed.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.options import MPCOptions
+
+if TYPE_CHECKING:
+    from ddwmmr.qp.controller import QPController
 
 
 def make_fallback(
@@ -40,7 +43,9 @@ def make_fallback(
     if dynamics is not None:
         qp_options.update(dynamics.velocity_envelope())
     qp_options.update(options.fallback_options or {})
-    qp = make_controller("qp", robot, **qp_options)
+    # "qp" is the built-in QPController (the registry refuses a second class under a
+    # built-in's name), whose reset takes warn_start; Controller's reset does not have it
+    qp = cast("QPController", make_controller("qp", robot, **qp_options))
     qp.reset(trajectory, np.zeros(5), warn_start=False)  # a placeholder, not a start
     return qp
 

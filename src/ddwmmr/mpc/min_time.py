@@ -50,7 +50,7 @@ import casadi as ca
 import numpy as np
 
 from ddwmmr import interrupts
-from ddwmmr.errors import ParameterError, check_positive
+from ddwmmr.errors import ParameterError, check_positive, finite_values, shown
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
@@ -110,6 +110,11 @@ class ShootingModel:
     node_bounds: tuple[np.ndarray, np.ndarray] | None = None
     interval_rows: Rows | None = None
     interval_bounds: tuple[np.ndarray, np.ndarray] | None = None
+
+    def __post_init__(self) -> None:
+        for rows, bounds in (("node_rows", "node_bounds"), ("interval_rows", "interval_bounds")):
+            if getattr(self, rows) is not None and getattr(self, bounds) is None:
+                raise ParameterError(f"{bounds}: (lower, upper) arrays are needed with {rows}")
 
 
 @dataclass(frozen=True)
@@ -424,13 +429,13 @@ class FreeTimeOCP:
         rows = [ca.vec(step.map(n)(X[:, :-1], U, h_row) - X[:, 1:])]
         lower, upper = [np.zeros(nx * n)], [np.zeros(nx * n)]
         self.node_slice = self.interval_slice = slice(0, 0)
-        if m.node_rows is not None:
+        if m.node_rows is not None and m.node_bounds is not None:  # both or neither
             node = ca.Function("node", [xs], [m.node_rows(xs)])
             rows.append(ca.vec(node.map(n + 1)(X)))
             lower.append(np.tile(m.node_bounds[0], n + 1))
             upper.append(np.tile(m.node_bounds[1], n + 1))
             self.node_slice = _next_slice(lower)
-        if m.interval_rows is not None:
+        if m.interval_rows is not None and m.interval_bounds is not None:  # both or neither
             between = ca.Function("between", [xs, us, hs], [m.interval_rows(xs, us, hs)])
             rows.append(ca.vec(between.map(n)(X[:, :-1], U, h_row)))
             lower.append(np.tile(m.interval_bounds[0], n))
@@ -570,7 +575,7 @@ class MinimumTimeProblem(FreeTimeOCP):
             )
         self.robot = robot
         self.dynamics = dynamics or sym.ThesisDynamics.from_robot(robot)
-        self.waypoints = [tuple(map(float, w)) for w in waypoints]
+        self.waypoints = [_waypoint(i, w) for i, w in enumerate(waypoints, start=1)]
         self.tolerance = check_positive("tolerance", tolerance)
         self.stability_min = check_stability_floor(stability_min)
         ends = [self._waypoint_end(w) for w in self.waypoints]
@@ -598,10 +603,12 @@ class MinimumTimeProblem(FreeTimeOCP):
         lbg, ubg = self.lbg.copy(), self.ubg.copy()
         if stability_min is not None:
             other = thesis_model(self.robot, self.dynamics, stability_min)
-            lbg[self.node_slice] = np.tile(other.node_bounds[0], self.n + 1)
-            ubg[self.node_slice] = np.tile(other.node_bounds[1], self.n + 1)
-            lbg[self.interval_slice] = np.tile(other.interval_bounds[0], self.n)
-            ubg[self.interval_slice] = np.tile(other.interval_bounds[1], self.n)
+            for rows, bounds, count in (
+                (self.node_slice, other.node_bounds, self.n + 1),
+                (self.interval_slice, other.interval_bounds, self.n),
+            ):
+                if bounds is not None:  # thesis_model gives both
+                    lbg[rows], ubg[rows] = np.tile(bounds[0], count), np.tile(bounds[1], count)
         if tolerance is not None:
             ubg[self.end_slice] = check_positive("tolerance", tolerance) ** 2
         return lbg, ubg
@@ -655,6 +662,17 @@ def _next_slice(blocks: list[np.ndarray]) -> slice:
     """The rows of the last block of ``blocks`` in their concatenation."""
     end = sum(b.size for b in blocks)
     return slice(end - blocks[-1].size, end)
+
+
+def _waypoint(index: int, value: object) -> tuple[float, float]:
+    """Waypoint ``value`` as ``(x, y)`` floats (m, world) if it is 2 finite numbers, else a
+    :class:`ParameterError` naming ``waypoints[index]`` (from 1, as the bounds tool's)."""
+    point = finite_values(value, 2)
+    if point is None:
+        raise ParameterError(
+            f"waypoints[{index}] must be (x, y): 2 finite numbers in m (got {shown(value)})"
+        )
+    return float(point[0]), float(point[1])
 
 
 def thesis_model(robot: Robot, dynamics: sym.ThesisDynamics, stability_min: float) -> ShootingModel:

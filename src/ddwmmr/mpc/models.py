@@ -59,6 +59,10 @@ class PredictionModel(ABC):
     nu = 0
     interface = "velocity"
     joints_stop_at_once = True
+    # set by each model's __init__ (declared here for the solver code that reads them)
+    u_lower: np.ndarray
+    u_upper: np.ndarray
+    u_scale: np.ndarray
 
     def __init__(self, robot: Robot) -> None:
         self.robot = robot

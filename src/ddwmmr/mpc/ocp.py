@@ -549,7 +549,7 @@ class ShootingOCP:
             parts.append(math.sqrt(SLACK_QUADRATIC) * slacks[k])
         if weights.input_change > 0.0:
             parts.append(math.sqrt(weights.input_change) * (us[0] - u_prev) / scale)
-        pose, poses = None, []
+        poses = []
         for k in range(1, n + 1):
             q = model.configuration(xs[k])
             pose = sym.forward_kinematics(robot, q)
@@ -574,6 +574,7 @@ class ShootingOCP:
                 )
             if weights.manipulability > 0.0:
                 parts.append(ca.sqrt(weights.manipulability * h_k) * ca.cos(q[4]))
+        pose = poses[-1]  # node n's (n >= 2 intervals)
         target = refs[:, n - 1]
         error = pose[:2] - target[:2]
         if config.reach:
@@ -651,7 +652,8 @@ class ShootingOCP:
             raise ValueError(f"arrival must be a state of {self.nxm} numbers")
         if self.arrival_size:
             on = arrival is not None
-            parts += [np.ravel(arrival) if on else np.zeros(self.nxm), [float(on)]]
+            state = np.ravel(arrival) if arrival is not None else np.zeros(self.nxm)
+            parts += [state, np.array([float(on)])]
         return np.concatenate([*parts, [previous]]).astype(float)
 
     def bounds(self, x0: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

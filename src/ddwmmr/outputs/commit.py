@@ -137,11 +137,14 @@ class OutputFolder:
         if exc_type is not None:
             self._discard()
             return False  # the block's exception goes on
+        staging = self._staging
+        if staging is None:  # only a with-block that was not entered reaches this
+            raise RuntimeError("an OutputFolder commits only the with-block it entered")
         done: list[Path] = []
         try:
             with _signals_deferred():
                 target = self._base if self.fresh else self.path
-                _commit(self._staging, target, self.tool, self.force, self._text, done, self.fresh)
+                _commit(staging, target, self.tool, self.force, self._text, done, self.fresh)
         except BaseException as error:
             if done:  # the new output is in place: it stays, and the exception says so
                 self.path, self._staging = done[0], None

@@ -58,9 +58,11 @@ class Observation:
     """
 
     __slots__ = ("_q", "_values", "v", "w")
+    _q: np.ndarray | None  # one of the two is given, the other built on first use
+    _values: tuple[float, ...] | None
 
     def __init__(self, q: np.ndarray | tuple[float, ...], v: float, w: float) -> None:
-        if type(q) is tuple:
+        if isinstance(q, tuple):  # a named tuple too: ``q`` is then built as an array
             self._q, self._values = None, q
         else:
             self._q, self._values = q, None
@@ -93,7 +95,7 @@ class Observation:
             return False
 
     def __repr__(self) -> str:
-        q = self._values if self._values is not None else self._q
+        q: Any = self._values if self._values is not None else self._q
         with contextlib.suppress(TypeError, ValueError, OverflowError):  # else as given
             q = [float(x) for x in q]
         return f"Observation(q={q!r}, v={self.v!r}, w={self.w!r})"
@@ -186,7 +188,8 @@ def _check_limit_slowly(q: Any, u: Any) -> tuple[float, float, list[float]]:
     """:func:`check_limit` for any argument: name the first fault, else return as it does."""
     configuration = float_values(q, 5)
     if configuration is None or not all(map(_isfinite, configuration)):
-        check_configuration(q, "q")  # its message: q must be 5 finite numbers ...
+        # raises: its test is this one, and its message names q (5 finite numbers ...)
+        configuration = check_configuration(q, "q")
     values = float_values(u, 4)
     if values is None or not all(map(_isfinite, values)):
         raise ParameterError(command_refusal("u", u))

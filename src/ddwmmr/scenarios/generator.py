@@ -84,8 +84,9 @@ def place_obstacles(
         (ax, ay), (bx, by) = points[i], points[i + 1]
         for f in (0.5, 0.4, 0.6, 0.3, 0.7, 0.2, 0.8):
             spot = (ax + f * (bx - ax), ay + f * (by - ay))
-            near = [p for p in points if math.dist(p, spot) < keep_out]
-            near += [o for o in obstacles if math.dist(o[:2], spot) < separation]
+            near = any(math.dist(p, spot) < keep_out for p in points) or any(
+                math.dist(o[:2], spot) < separation for o in obstacles
+            )
             if not near:
                 obstacles.append((spot[0], spot[1], radius))
                 break

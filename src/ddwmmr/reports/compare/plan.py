@@ -136,8 +136,16 @@ class CompareConfig:
                     f"plant must be one of {', '.join(others)} (the kinematic plant always "
                     f"runs) (got {plant!r})"
                 )
+        self.study_methods = self.studied  # the default resolved once, here
+
+    @property
+    def studied(self) -> tuple[str, ...]:
+        """The methods the studies run: ``study_methods``, or where it is None (its
+        default, resolved at construction and again if set back to None) the compared
+        methods that run in the studies (:func:`in_studies`)."""
         if self.study_methods is None:
             self.study_methods = tuple(m for m in self.methods if in_studies(m))
+        return self.study_methods
 
     def shown(self, name: str) -> str:
         """The shown name of trajectory key ``name`` (see ``shown_names``)."""
@@ -348,7 +356,7 @@ def skipped_studies(config: CompareConfig, plan: Plan) -> dict[str, str]:
 
 def tau_methods(config: CompareConfig) -> list[str]:
     """Selected methods with a closed-loop time constant option ``tau``."""
-    return [m for m in config.study_methods if accepts_option(m, "tau", 1.0)]
+    return [m for m in config.studied if accepts_option(m, "tau", 1.0)]
 
 
 def _plan_tau(config: CompareConfig) -> list[RunSpec]:
@@ -371,7 +379,7 @@ def _plan_dt(config: CompareConfig) -> list[RunSpec]:
     # No initial offset: every error left is numerical drift.
     return [
         main_spec(config, m, STUDY_TRAJECTORY, dt=dt, integrator=i, initial_offset=(0.0, 0.0))
-        for m in config.study_methods
+        for m in config.studied
         for i in ("euler", "rk4")
         for dt in study_steps(config)
     ]
@@ -380,7 +388,7 @@ def _plan_dt(config: CompareConfig) -> list[RunSpec]:
 def _plan_integrator(config: CompareConfig) -> list[RunSpec]:
     return [
         main_spec(config, m, STUDY_TRAJECTORY, integrator=i, initial_offset=(0.0, 0.0))
-        for m in config.study_methods
+        for m in config.studied
         for i in ("euler", "rk4")
     ]
 
@@ -403,7 +411,7 @@ def study_offsets(config: CompareConfig) -> list[tuple[float, float]]:
 def _plan_init(config: CompareConfig) -> list[RunSpec]:
     return [
         main_spec(config, m, STUDY_TRAJECTORY, initial_offset=offset)
-        for m in config.study_methods
+        for m in config.studied
         for offset in study_offsets(config)
     ]
 

@@ -163,7 +163,7 @@ class _Context:
 
     @property
     def colors(self) -> dict[str, str]:
-        methods = dict.fromkeys([*self.config.methods, *self.config.study_methods])
+        methods = dict.fromkeys([*self.config.methods, *self.config.studied])
         return palette.method_colors(list(methods))
 
     def main(self, method: str, name: str) -> RunOutput:
@@ -599,7 +599,7 @@ def _trajectory_section(c: _Context, name: str) -> None:
     quarter = getattr(trajectory, "T", trajectory.duration) / 4.0
     obstacles = run_obstacles(c.config)
     offset = math.hypot(*DEFAULT_INITIAL_OFFSET)
-    zooms = [("A", 0.0, 3.0 * offset)]
+    zooms: list[tuple[str, float, float | None]] = [("A", 0.0, 3.0 * offset)]
     if quarter < run_duration(c.config, name):
         zooms.append(("B", quarter, None))
     c.add_figure(
@@ -978,7 +978,7 @@ def _dt_section(c: _Context) -> None:
         return
     drift: dict[str, dict[str, dict[float, float]]] = {}
     rows = []
-    for m in c.config.study_methods:
+    for m in c.config.studied:
         for integrator in ("euler", "rk4"):
             values = {
                 dt: c.run(
@@ -1063,12 +1063,10 @@ def _integrator_section(c: _Context) -> None:
         (m, i): c.run(
             main_spec(c.config, m, STUDY_TRAJECTORY, integrator=i, initial_offset=(0.0, 0.0))
         )
-        for m in c.config.study_methods
+        for m in c.config.studied
         for i in ("euler", "rk4")
     }
-    curves = {
-        m: {i: _errors(runs[(m, i)]) for i in ("euler", "rk4")} for m in c.config.study_methods
-    }
+    curves = {m: {i: _errors(runs[(m, i)]) for i in ("euler", "rk4")} for m in c.config.studied}
     summaries = {key: run.summary for key, run in runs.items()}
     rows = [
         [m]
@@ -1078,7 +1076,7 @@ def _integrator_section(c: _Context) -> None:
             for i in ("euler", "rk4")
         ]
         + [mm(summaries[(m, "euler")]["end_position_error_m"])]
-        for m in c.config.study_methods
+        for m in c.config.studied
     ]
     c.doc.paragraph(
         f"{STUDY_TRAJECTORY}, dt = {dt:g} s, no initial offset. Forward Euler is the "
@@ -1160,7 +1158,7 @@ def _init_section(c: _Context) -> None:
     offsets = study_offsets(c.config)
     final: dict[str, dict[float, float]] = {}
     rows = []
-    for m in c.config.study_methods:
+    for m in c.config.studied:
         values = {
             math.hypot(*o): c.run(main_spec(c.config, m, STUDY_TRAJECTORY, initial_offset=o))
             for o in offsets
@@ -1168,8 +1166,8 @@ def _init_section(c: _Context) -> None:
         final[m] = {k: r.summary["final_position_error_m"] for k, r in values.items()}
         rows.append([m, *[mm(final[m][k]) for k in sorted(final[m])]])
     # The error curves show one closed-loop method: convergence depends on the offset there.
-    closed = [m for m in SLIDES_ORDER if m.startswith("clrrmc") and m in c.config.study_methods]
-    curve_method = (closed or list(c.config.study_methods))[0]
+    closed = [m for m in SLIDES_ORDER if m.startswith("clrrmc") and m in c.config.studied]
+    curve_method = (closed or list(c.config.studied))[0]
     curves = {
         math.hypot(*o): _errors(
             c.run(main_spec(c.config, curve_method, STUDY_TRAJECTORY, initial_offset=o))
