@@ -27,17 +27,26 @@ def _warnings(method, dt, integrator=None, **options):
 
 def test_clrrmc_ts_at_two_seconds_with_rk4_warns_naming_tau_dt_the_limit_and_the_cure():
     (message,) = _warnings("clrrmc-ts", 2.0)
-    assert message.startswith("tau = 0.5 s with dt = 2 s: K dt = 4 (K = 1/tau)")
-    assert "0.9 of 2.785, the stability limit of RK4" in message
-    # 0.9 * 2.7853 / 2 = 1.2534 s (rounded down); 2 / (0.9 * 2.7853) = 0.79785 s (up)
-    assert message.endswith("use dt below 1.25 s or tau above 0.798 s")
+    assert message.startswith("tau = 0.5 s with dt = 2 s: K dt = 4 (K = 1/tau) is beyond 2.785")
+    assert "the stability limit of RK4 with the control law at its stages: the tracking " in (
+        message
+    )
+    # 0.65 * 2.7853 / 2 = 0.9052 s (rounded down); 2 / (0.65 * 2.7853) = 1.1047 s (up)
+    assert message.endswith("use dt below 0.905 s or tau above 1.11 s")
 
 
-def test_euler_at_1_1_s_warns_but_rk4_at_1_1_s_does_not():
+def test_below_the_limit_the_warning_gives_the_share_reached():
+    (message,) = _warnings("qp", 1.0)  # K dt = 2: the qp does not track the ellipse there
+    assert "K dt = 2 (K = 1/tau) is 0.72 of 2.785" in message
+    assert "the robot's runs fail from about 0.65 of it" in message
+    assert _warnings("qp", 0.9) == []  # K dt = 1.8 < 0.65 * 2.785 = 1.81: it tracks
+
+
+def test_euler_at_1_1_s_warns_but_rk4_at_0_9_s_does_not():
     (message,) = _warnings("clrrmc-ts", 1.1, "euler")
-    assert "K dt = 2.2" in message and "of 2, the stability limit of a command held" in message
-    assert message.endswith("use dt below 0.9 s or tau above 0.612 s")
-    assert _warnings("clrrmc-ts", 1.1) == []  # K dt = 2.2 < 0.9 * 2.785 = 2.507
+    assert "K dt = 2.2" in message and "beyond 2, the stability limit of a command held" in message
+    assert message.endswith("use dt below 0.65 s or tau above 0.847 s")
+    assert _warnings("clrrmc-ts", 0.9) == []  # K dt = 1.8 < 0.65 * 2.785 = 1.81
 
 
 def test_clrrmc_cs_names_its_shortest_tau_and_a_switched_off_channel_counts_nothing():
@@ -71,7 +80,7 @@ def test_the_limits_are_where_the_plants_integrator_stops_shrinking_the_error(in
     roots = np.roots([1.0 / 24.0, -1.0 / 6.0, 0.5, -1.0])
     positive = [r.real for r in roots if abs(r.imag) < 1e-12 and r.real > 0.0]
     assert STABLE_GAIN_STEP["rk4"] == pytest.approx(positive[0], rel=1e-14)
-    assert GAIN_STEP_MARGIN == 0.9
+    assert GAIN_STEP_MARGIN == 0.65
 
 
 def test_no_default_run_of_any_method_trajectory_or_plant_warns():

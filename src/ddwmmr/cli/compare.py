@@ -433,7 +433,7 @@ def run_record(
     record = provenance.header("compare", PROG, argv)
     record.update(
         methods=list(config.methods),
-        study_methods=list(config.study_methods or ()),
+        study_methods=list(config.studied),
         preset=config.preset,
         options={
             m: provenance.options_record(
