@@ -52,7 +52,7 @@ import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import fields
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -85,10 +85,12 @@ from ddwmmr.mpc.options import (
     MPCOptions,
     options_signature,
 )
-from ddwmmr.mpc.problem import Problem
+from ddwmmr.mpc.problem import Problem, robot_in_unit
 from ddwmmr.mpc.solvers import SolverFailure, installed_qp_solvers, installed_solvers
 from ddwmmr.mpc.stall import StallWatch
 from ddwmmr.qp.limits import run_clearance, safe_arm_scale
+from ddwmmr.qp.limits.obstacles import Circle
+from ddwmmr.resolution.kernels import length_unit
 
 
 @register_controller("mpc", tasks=("tracking", "waypoints"), interfaces=("velocity", "force"))
@@ -178,6 +180,14 @@ class MPCController:
         self.model: PredictionModel = make_model(
             model, self.robot, self.dynamics, lag, acceleration_limit
         )
+        # the kinematic model plans in the robot's length unit (docs/mpc.md, "Robot size")
+        self.unit = length_unit(self.robot.L1) if model == "kinematic" else 1.0
+        self._unit_robot = robot_in_unit(self.robot, self.unit)
+        self._unit_model = (
+            self.model
+            if self.unit == 1.0
+            else make_model(model, self._unit_robot, self.dynamics, lag, acceleration_limit)
+        )
         self.interface = self.model.interface
         self.wants_base_velocity = model == "thesis"
         self._problems: dict[tuple[str, float], Problem] = {}
@@ -205,6 +215,9 @@ class MPCController:
         base = "reach" if reach else mode
         options = self.options
         n, first, t = options.grid_at(base, self.dt)
+        unit = self.unit  # lengths (m) and speeds (m/s) in the robot's unit
+        huber = options.huber_scale(base, unit)
+        circles = cast("tuple[Circle, ...]", options.obstacles)  # as_circles made them
         return OCPConfig(
             intervals=n,
             control_interval=self.dt,
@@ -215,17 +228,17 @@ class MPCController:
             second_leg_weight=options.lookahead_weight,
             second_leg_horizon=options.lookahead_horizon,
             min_horizon=max(0.1, 2.0 * self.dt),
-            reach_speed=options.reach_speed,
+            reach_speed=options.reach_speed / unit,
             arrival_weight=options.plan_weight if reach and self._plan is not None else 0.0,
             stability_min=options.stability_min,
             stability_margin=options.stability_margin,
             dynamic_stability=self.dynamic_stability,
             min_edge_load=options.min_edge_load,
             track_orientation=options.track_orientation and not reach,
-            huber=options.huber_scale(base),
-            obstacles=tuple(options.obstacles),
-            base_radius=base_bubble(self.robot),
-            obstacle_margin=options.obstacle_margin,
+            huber=None if huber is None else huber / unit,
+            obstacles=tuple(_circle_in_unit(circle, unit) for circle in circles),
+            base_radius=base_bubble(self._unit_robot),
+            obstacle_margin=options.obstacle_margin / unit,
             weights=self._weights[base],
         )
 
@@ -234,14 +247,15 @@ class MPCController:
         if key not in self._problems:
             options = self.options
             self._problems[key] = Problem(
-                self.robot,
+                self._unit_robot,
                 self._choice,
-                self.model,
+                self._unit_model,
                 self._config(mode),
                 options.solver,
                 options.qp_solver,
                 options.proximal,
                 options.cold_iterations,
+                self.unit,
             )
         return self._problems[key]
 
@@ -355,10 +369,10 @@ class MPCController:
         self._stall.plan_horizon(t, horizon, free, cold)
         slack = problem.ocp.max_slack(w)
         self._stall.plan_slack(t, slack)
-        u = problem.ocp.first_input(w)
+        u = problem.first_input(w)
         braking = self.brake_slack is not None and should_brake(
             self.brake_slack,
-            problem.ocp.max_stability_slack(w),
+            problem.max_stability_slack(w),
             (float(x0[5]), float(x0[6])),
             self._predicted_rates,
         )
@@ -532,7 +546,7 @@ class MPCController:
             "mpc_wheel_force_limit_n": None if self.dynamics is None else self.dynamics.force_limit,
             "mpc_solver": solver if solver != "rti" else f"rti-{self.options.qp_solver}",
             "mpc_horizon_s": self.options.grid(mode)[2],
-            "mpc_options": self.resolved.record(mode, self.dt),
+            "mpc_options": self.resolved.record(mode, self.dt, self.unit),
         }
 
     # -- the scenario protocol's waypoint task -------------------------------------------
@@ -611,6 +625,11 @@ def warn_start_in_keep_out(robot: Robot, options: MPCOptions, q0: np.ndarray) ->
 PLAN_WAYPOINT_TOLERANCE_M = 1e-9
 #: The same for the payload (kg).
 PLAN_PAYLOAD_TOLERANCE_KG = 1e-9
+
+
+def _circle_in_unit(circle: Circle, unit: float) -> Circle:
+    """``circle`` (m) with its centre and radius in the length ``unit`` (m)."""
+    return Circle(circle.x / unit, circle.y / unit, circle.radius / unit)
 
 
 def _load_plan(options: MPCOptions, payload: float) -> Guess | None:

@@ -68,9 +68,11 @@ DEFAULT_DT = 0.02
 #: Defaults per objective: (intervals, first interval s, horizon s). Chosen by the horizon
 #: study in docs/mpc.md.
 GRID_DEFAULTS = {"tracking": (10, 0.05, 1.0), "reach": (12, 0.05, 5.0)}
-#: Default position weight per objective (1/(m^2 s)).
+#: Default position weight per objective (1/(m^2 s); per the robot's length unit squared
+#: on another robot, docs/mpc.md "Robot size").
 POSITION_WEIGHTS = {"tracking": 100.0, "reach": 50.0}
-#: Huber scale (m) of the position error in waypoint mode when ``huber`` is not given.
+#: Huber scale of the position error in waypoint mode when ``huber`` is not given, in the
+#: robot's length unit (m for the default robot; docs/mpc.md, "Robot size").
 REACH_HUBER = 0.01
 
 
@@ -501,18 +503,18 @@ class MPCOptions:
             terminal=1.0 if mode == "tracking" else 0.0,
         )
 
-    def huber_scale(self, mode: str) -> float | None:
-        """Huber scale (m) of objective ``mode``: ``huber``, else :data:`REACH_HUBER` in
-        waypoint mode and none when tracking."""
+    def huber_scale(self, mode: str, unit: float = 1.0) -> float | None:
+        """Huber scale (m) of objective ``mode``: ``huber``, else :data:`REACH_HUBER` of
+        the robot's length ``unit`` (m) in waypoint mode and none when tracking."""
         if self.huber is not None:
             return self.huber
-        return REACH_HUBER if mode == "reach" else None
+        return REACH_HUBER * unit if mode == "reach" else None
 
     # -- reporting ----------------------------------------------------------------------
-    def record(self, mode: str, dt: float) -> dict[str, Any]:
+    def record(self, mode: str, dt: float, unit: float = 1.0) -> dict[str, Any]:
         """Every option with the value a run of objective ``mode`` at control step ``dt``
-        (s) uses (the grid, the position weight and the Huber scale of that objective), in
-        plain types for the run's summary."""
+        (s) on a robot of length ``unit`` (m) uses (the grid, the position weight and the
+        Huber scale of that objective), in plain types for the run's summary."""
         values = {f.name: getattr(self, f.name) for f in fields(self)}
         intervals, first, horizon = self.grid_at(mode, dt)
         values.update(
@@ -521,7 +523,7 @@ class MPCOptions:
             first_interval=float(shooting_grid(intervals, dt, first, horizon)[1]),
             horizon=horizon,
             position_weight=self.weights(mode).position,
-            huber=self.huber_scale(mode),
+            huber=self.huber_scale(mode, unit),
             dt=dt,
             obstacles=[(c.x, c.y, c.radius) for c in self.obstacles],  # type: ignore[union-attr]
             joint_acceleration_limit=list(self.joint_acceleration_limit or ()),  # type: ignore[arg-type]

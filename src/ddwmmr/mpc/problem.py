@@ -1,12 +1,20 @@
-"""One OCP of the ``mpc`` controller with its solvers, terminal cost and warm-start shift."""
+"""One OCP of the ``mpc`` controller with its solvers, terminal cost and warm-start shift.
+
+The OCP may plan in the robot's own length unit (docs/mpc.md, "Robot size"): its robot and
+model are then the robot with every length divided by the unit, and :class:`Problem`
+converts what crosses its boundary (the measured state, the references, the previous
+command in; the command and the stability slack out) between metres and that unit.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Hashable
+from dataclasses import replace
 
 import numpy as np
 
 from ddwmmr.model import Robot
+from ddwmmr.model.robot import _LENGTHS as LENGTH_FIELDS
 from ddwmmr.mpc import terminal
 from ddwmmr.mpc.cache import shared_ocp
 from ddwmmr.mpc.min_time import Guess
@@ -28,6 +36,9 @@ class Problem:
         solver, qp_solver, proximal: the ``mpc``'s solver options; a real-time iteration
             (``"rti"``) starts cold with ``cold_iterations`` Gauss-Newton iterations
             (default :data:`COLD_ITERATIONS`).
+        unit: the length (m) the OCP measures lengths in (``robot`` and ``model`` already
+            in it, :func:`robot_in_unit`); 1.0: metres. Only the kinematic model's state
+            and input hold lengths it converts (positions, ``v``).
     """
 
     def __init__(
@@ -40,8 +51,9 @@ class Problem:
         qp_solver: str,
         proximal: float,
         cold_iterations: int = COLD_ITERATIONS,
+        unit: float = 1.0,
     ) -> None:
-        self.robot, self.model = robot, model
+        self.robot, self.model, self.unit = robot, model, unit
         self.ocp = shared_ocp(robot, choice, model, config)
         self.solver = make_solver(solver, self.ocp, qp_solver, proximal=proximal)
         self.cold = (
@@ -140,8 +152,12 @@ class Problem:
         ``source`` (a hand-over, :meth:`_shifted`) the shifted plan starts the cold
         start's iterations; without a warm start, ``start`` (``(w, T)``,
         :meth:`planned_start`) does instead of the standing guess. ``arrival``: the state
-        the first leg's arrival term pulls towards (:meth:`planned_arrival`), None: off."""
+        the first leg's arrival term pulls towards (:meth:`planned_arrival`), None: off.
+        ``x0``, ``references`` and ``u_prev`` in metres (m, m/s); ``w`` in the OCP's unit
+        (:meth:`first_input` reads the command from it)."""
         ocp = self.ocp
+        if self.unit != 1.0:
+            x0, references, u_prev = self._in_unit(x0, references, u_prev)
         if warm is None and start is not None:
             (guess, horizon), solver = start, self.cold
         elif warm is None:
@@ -156,6 +172,41 @@ class Problem:
         lbw, ubw = ocp.bounds(x0)
         w = solver.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
         return w, solver.last_iterations
+
+    def _in_unit(self, x0, references, u_prev) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The kinematic model's state, references (N, 3) and input with their positions
+        (m) and ``v`` (m/s) in the OCP's unit."""
+        x0, references = np.array(x0, dtype=float), np.array(references, dtype=float)
+        u_prev = np.array(u_prev, dtype=float)
+        x0[:2] /= self.unit
+        references[:, :2] /= self.unit
+        u_prev[0] /= self.unit
+        return x0, references, u_prev
+
+    def first_input(self, w: np.ndarray) -> np.ndarray:
+        """The model's input of a solution's first stage, ``v`` in m/s."""
+        u = self.ocp.first_input(w)
+        if self.unit != 1.0:
+            u = u.copy()  # first_input may be a view of w, the next step's warm start
+            u[0] *= self.unit
+        return u
+
+    def max_stability_slack(self, w: np.ndarray) -> float:
+        """The largest slack of a solution's stability rows (m)."""
+        return self.ocp.max_stability_slack(w) * self.unit
+
+
+def robot_in_unit(robot: Robot, unit: float) -> Robot:
+    """``robot`` with every length (m) divided by ``unit`` (m): the robot as an OCP in
+    that unit sees it (masses kept: only their ratios place the centre of mass); ``robot``
+    itself for a unit of 1.0."""
+    if unit == 1.0:
+        return robot
+    lengths = {name: getattr(robot, name) / unit for name in LENGTH_FIELDS}
+    casters = robot.caster_positions
+    if casters is not None:
+        casters = tuple((x / unit, y / unit) for x, y in casters)
+    return replace(robot, caster_positions=casters, **lengths)
 
 
 def interpolate_rows(times: np.ndarray, rows: np.ndarray, at: np.ndarray) -> np.ndarray:
