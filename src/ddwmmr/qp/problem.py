@@ -43,6 +43,7 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_positive,
     raise_plugin_error,
+    real_number,
     shown,
 )
 from ddwmmr.inheritance import from_library
@@ -73,6 +74,31 @@ def piece_label(piece: Task | Limit) -> str:
     when it has no name of its own (:func:`piece_name`)."""
     kind, name = type(piece).__name__, piece_name(piece)
     return kind if name == kind else f"{kind} {name!r}"
+
+
+def piece_unit(piece: Task | Limit) -> float | None:
+    """A piece's ``unit`` (m): a finite length > 0, or None (no ``v`` column); anything
+    else is refused in one line naming the piece."""
+    unit = getattr(piece, "unit", 1.0)
+    if unit is None:
+        return None
+    number = real_number(unit)
+    if number is None or not 0.0 < number < math.inf:
+        raise ParameterError(
+            f"{piece_label(piece)}: unit must be a finite length > 0 (m), or None for rows "
+            f"without v (got {shown(unit)})"
+        )
+    return number
+
+
+def _refuse_v(label: str, ctx: StepContext, what: str) -> None:
+    """Refuse (one-line :class:`ParameterError`) the piece ``label`` whose ``unit`` is None
+    (rows without ``v``) but whose ``compute`` did ``what`` to ``v``: the problem would
+    read that ``v`` in its own length unit, not in m/s."""
+    raise ParameterError(
+        f"{label}: unit = None (rows without v) but compute() {what} at t = {ctx.t:g} s "
+        "(declare unit = 1.0 for v in m/s, or a length in m for v in that unit per second)"
+    )
 
 
 def _refuse_written(label: str, ctx: StepContext, **written: np.ndarray | tuple) -> None:
@@ -342,16 +368,22 @@ class QPProblem:
         if self._generic_limits:
             self._no_nan += [self.lower, self.upper]
 
-    def _v_ratio(self, piece: Task | Limit) -> float:
+    def _v_ratio(self, piece: Task | Limit) -> float | None:
         """``problem.unit / piece.unit``: what the piece's ``v`` column is multiplied by
-        (1.0 when they agree, or for a piece whose ``unit`` is None: no ``v`` column)."""
-        unit = getattr(piece, "unit", 1.0)
-        return 1.0 if unit is None else self.unit / unit
+        (1.0 when they agree, or for a library piece whose ``unit`` is None); None for a
+        user's piece whose ``unit`` is None, whose ``v`` entries are checked to stay zero
+        (and the box on ``v`` untouched) every step. A bad ``unit`` is refused here, when
+        the problem is compiled."""
+        unit = piece_unit(piece)
+        if unit is None:
+            return 1.0 if from_library(piece) else None
+        return self.unit / unit
 
     def _add_writer(self, piece: Task | Limit, block: TaskBlock | LimitBlock) -> bool:
         """Compile ``piece`` into ``block``; False when it has no fast path (or works in
-        another length unit than the problem's)."""
-        same_unit = self._v_ratio(piece) == 1.0
+        another length unit than the problem's; a writer has no ``v`` column to check)."""
+        ratio = self._v_ratio(piece)
+        same_unit = ratio is None or ratio == 1.0
         writer = piece.compile(block) if self.compiled and same_unit else None
         if writer is None:
             return False
@@ -379,28 +411,34 @@ class QPProblem:
 
     def _build_generic(self, ctx: StepContext) -> None:
         """The pieces without a compiled writer, through ``compute`` on numpy views."""
-        for _, compute, jac, error, jac_w, error_w, column, sqrt_w, ratio in self._generic_cost:
+        for task, compute, jac, error, jac_w, error_w, column, sqrt_w, ratio in self._generic_cost:
             compute(ctx, jac, error)
             if ratio != 1.0:
-                jac[:, 0] *= ratio
+                self._convert_v(task, ctx, jac, ratio)
             np.multiply(jac, column, out=jac_w)
             np.multiply(error, sqrt_w, out=error_w)
-        for _, compute, jac, low, up, ratio in self._generic_slack:
+        for task, compute, jac, low, up, ratio in self._generic_slack:
             compute(ctx, jac, up)
             if ratio != 1.0:
-                jac[:, 0] *= ratio
+                self._convert_v(task, ctx, jac, ratio)
             low[:] = up
         box = self.box
         self.lb[:NU] = box[:NU]
         self.ub[:NU] = box[NU:]
         u_lb, u_ub = self.lb[:NU], self.ub[:NU]
-        for _, compute, G, low, up, ratio in self._generic_limits:
+        for limit, fill, G, low, up, ratio in self._generic_limits:
             if ratio == 1.0:
-                compute(ctx, G, low, up, u_lb, u_ub)
+                fill(ctx, G, low, up, u_lb, u_ub)
                 continue
             low_v, high_v = float(u_lb[0]), float(u_ub[0])
+            if ratio is None:  # no v column: nor a bound on v
+                fill(ctx, G, low, up, u_lb, u_ub)
+                if u_lb[0] != low_v or u_ub[0] != high_v:
+                    _refuse_v(piece_label(limit), ctx, "bounded v in lb, ub")
+                self._convert_v(limit, ctx, G, ratio)
+                continue
             u_lb[0], u_ub[0] = low_v * ratio, high_v * ratio  # in the piece's unit
-            compute(ctx, G, low, up, u_lb, u_ub)
+            fill(ctx, G, low, up, u_lb, u_ub)
             G[:, 0] *= ratio
             # back to the problem's unit; an untouched side as it was (INF stays INF)
             u_lb[0] = low_v if u_lb[0] == low_v * ratio else u_lb[0] / ratio
@@ -408,6 +446,17 @@ class QPProblem:
         self.box_ok = bool(np.all(u_lb <= u_ub))
         if self._check_written and not self._written_ok():
             self._refuse_user_pieces(ctx)
+
+    @staticmethod
+    def _convert_v(
+        piece: Task | Limit, ctx: StepContext, rows: np.ndarray, ratio: float | None
+    ) -> None:
+        """Multiply the ``v`` column of a piece's ``rows`` by ``ratio``; for None (a user's
+        piece without a ``v`` column), refuse the piece if it wrote a nonzero entry there."""
+        if ratio is not None:
+            rows[:, 0] *= ratio
+        elif any(column := rows[:, 0].tolist()):  # a list: a third of ndarray.any's cost
+            _refuse_v(piece_label(piece), ctx, f"wrote {shown(column)} into its v column")
 
     def _written_ok(self) -> bool:
         """Whether the arrays the generic pieces fill hold what every solver takes: finite

@@ -7,7 +7,7 @@
   tracking task (plus tasks flagged ``primary``) with a ridge of :data:`TIE_BREAK` times
   the largest slack weight on u to make the optimum unique; level 2 freezes that slack
   (to :data:`SLACK_TOLERANCE`) and minimises the remaining tasks in what is left. Limits
-  are hard at both levels.
+  are hard at both levels (DAQP solves both to :data:`STRICT_PRIMAL_TOL`).
 
 Backends: ``"daqp"`` calls ``daqp.solve`` directly on the preallocated arrays (its rows
 take two-sided bounds and equalities natively: no conversion). Every other name goes
@@ -30,8 +30,12 @@ from ddwmmr.qp.problem import QPProblem
 MODES = ("weighted", "hierarchical")
 #: Level-1 ridge on u relative to the slack weight in hierarchical mode (uniqueness only).
 TIE_BREAK = 1e-6
-#: Slack frozen after level 1 to within this band (m/s or rad/s).
+#: Slack frozen after level 1 to within this band (the tracking rows' units/s: the
+#: problem's length unit per second, or rad/s).
 SLACK_TOLERANCE = 1e-7
+#: DAQP's primal feasibility tolerance in hierarchical mode: its default, 1e-6, is ten
+#: times the frozen slack band, so a level-2 answer could overrun a limit by up to that.
+STRICT_PRIMAL_TOL = 1e-9
 #: Rows and bounds at least this large are treated as absent by the generic path.
 _BIG = 0.5 * INF
 
@@ -101,6 +105,25 @@ class DaqpBackend:
             x, _, flag, _ = self._solve(
                 problem.H, problem.f, problem.C, problem.upper, problem.lower, sense
             )
+        if flag <= 0:
+            return None
+        self._previous = x
+        return x
+
+    def strict(self, problem: QPProblem) -> np.ndarray | None:
+        """:meth:`__call__` with every bound and row met to :data:`STRICT_PRIMAL_TOL`."""
+        settings: dict = {"primal_tol": STRICT_PRIMAL_TOL}
+        if self.warm_start and self._previous is not None:
+            settings["primal_start"] = self._previous
+        x, _, flag, _ = self._solve(
+            problem.H,
+            problem.f,
+            problem.C,
+            problem.upper,
+            problem.lower,
+            problem.sense.copy(),  # DAQP may mark active rows in place
+            **settings,
+        )
         if flag <= 0:
             return None
         self._previous = x
@@ -208,9 +231,12 @@ def solve(problem: QPProblem, backend, mode: str = "weighted") -> SolveResult:
         return SolveResult(None, 0)
     if mode == "weighted" or problem.n_slack == 0:
         return SolveResult(_checked(backend(problem)), 1)
+    # Both levels strict: level 2 could otherwise trade the frozen slack band for a
+    # limit overrun, and level 1's answer is the step's when level 2 fails.
+    strict = getattr(backend, "strict", backend)  # a qpsolvers backend as it is
     ridge = TIE_BREAK * float(problem.slack_weights.max())
     problem.set_cost(secondary=0.0, primary=1.0, ridge=ridge)
-    first = _checked(backend(problem))
+    first = _checked(strict(problem))
     if first is None:
         return SolveResult(None, 1)
     slack = first[problem.n - problem.n_slack :]
@@ -218,7 +244,7 @@ def solve(problem: QPProblem, backend, mode: str = "weighted") -> SolveResult:
     problem.ub[problem.n - problem.n_slack :] = slack + SLACK_TOLERANCE
     problem.set_cost(secondary=1.0, primary=1.0)
     try:
-        second = _checked(backend(problem))
+        second = _checked(strict(problem))
     finally:
         problem.reset_slack_box()
     # Level 2 can only fail numerically (level 1's answer is feasible): keep level 1.

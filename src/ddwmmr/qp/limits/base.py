@@ -26,9 +26,11 @@ INF = 1e30
 class Limit(ABC):
     """A hard constraint on the inputs (rows ``lower <= G u <= upper`` and/or the box).
 
-    ``unit``: the length unit (m) in which the rows and the box take ``v`` (``v / unit``,
-    units per second); 1.0 (m/s) unless a built-in limit is given its robot's unit (see
-    :attr:`ddwmmr.qp.tasks.base.Task.unit`); None for rows that never involve ``v``.
+    ``unit``: the length (m, finite and > 0) in which the rows and the box take ``v``
+    (``v / unit``, units per second); 1.0: SI (m/s), the default, unless a built-in limit
+    is given its robot's unit (see :attr:`ddwmmr.qp.tasks.base.Task.unit`). None: no
+    ``v`` column and no bound on ``v`` (``G[:, 0]`` stays zero, ``lb[0]``, ``ub[0]``
+    untouched; a user's limit that writes there is refused).
     """
 
     rows: int = 0

@@ -59,12 +59,15 @@ class Task(ABC):
             primary, tracking level); False adds them to the cost directly.
         primary: a cost task solved at the primary level in hierarchical mode (next to
             the slack tasks) instead of in the secondary level.
-        unit: the length unit (m) of the rows: ``J`` takes ``v`` as ``v / unit`` (units
-            per second) and a linear rate is in units per second. 1.0 (metres, m/s) unless
-            a built-in task is given its robot's unit
-            (:func:`~ddwmmr.resolution.kernels.length_unit`); the problem converts a
-            task's ``v`` column to its own unit (:class:`~ddwmmr.qp.problem.QPProblem`).
-            None: the rows never involve ``v`` or a length (any problem's unit).
+        unit: the length (m, finite and > 0) in which the rows measure lengths: ``J``
+            takes ``v`` as ``v / unit`` and a linear target is in units per second.
+            1.0: SI (m/s), the default, whatever the robot's size; a built-in task is
+            given its robot's unit (:func:`~ddwmmr.resolution.kernels.length_unit`) by
+            the controller that builds it. The problem converts a task's ``v`` column to
+            its own unit (:class:`~ddwmmr.qp.problem.QPProblem`). None: no ``v`` column
+            (``jac[:, 0]`` stays zero; a user's task that writes there is refused). Any
+            other value is refused when the problem is built
+            (docs/qp.md, "A piece's length unit").
     """
 
     rows: int = 1
