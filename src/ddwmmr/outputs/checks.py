@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from ddwmmr.errors import ParameterError, shown
-from ddwmmr.outputs.owners import _is_stale_temp, temp_prefix
+from ddwmmr.outputs.owners import _is_stale_temp, ended_leftover, temp_prefix
 
 #: Name of the manifest file each tool writes into its output folder.
 MANIFEST = ".ddwmmr-manifest.json"
@@ -78,12 +78,20 @@ def _entries(folder: Path) -> list[str]:
 
 def inspect(target: Path, tool: str) -> Existing:
     """Classify an existing folder (see :class:`Existing`); ``target`` must be a folder.
-    Temporary files ended runs left (:func:`remove_stale_temp`) are not counted."""
+    What ended runs left is not counted: temporary files (:func:`remove_stale_temp`) and,
+    directly in ``target``, staging folders and locks (:func:`ended_leftover`) of runs
+    writing there, which the commit removes (:func:`remove_stale`)."""
+    left = {n for n in _names(target) if ended_leftover(target / n)}
     entries = [
-        e for e in _entries(target) if e != MANIFEST and not _is_stale_temp(PurePosixPath(e).name)
+        e
+        for e in _entries(target)
+        if e != MANIFEST
+        and not _is_stale_temp(PurePosixPath(e).name)
+        and PurePosixPath(e).parts[0] not in left
     ]
     has_manifest = os.path.lexists(target / MANIFEST)
-    if not entries and not has_manifest and all(_is_stale_temp(n) for n in _names(target)):
+    others = [n for n in _names(target) if n not in left and not _is_stale_temp(n)]
+    if not entries and not has_manifest and not others:
         return Existing("empty")
     manifest = read_manifest(target)
     listed = set(manifest["files"]) if manifest else set()
@@ -94,7 +102,7 @@ def inspect(target: Path, tool: str) -> Existing:
     present = sorted(e for e in entries if e in listed and e in regular)
     owner = manifest["tool"] if manifest else None
     kind = "own" if manifest and owner == tool and not foreign else "foreign"
-    folder = _foreign_folder(target, present)
+    folder = _foreign_folder(target, present, left)
     if folder is not None:
         kind, foreign = "foreign", sorted([*foreign, folder + "/"])
     return Existing(kind, present, foreign, owner)
@@ -107,11 +115,13 @@ def _is_regular(path: Path) -> bool:
         return False
 
 
-def _foreign_folder(target: Path, files: list[str]) -> str | None:
+def _foreign_folder(target: Path, files: list[str], skipped: set[str]) -> str | None:
     """A folder with nothing listed inside (relative name), else None: empty folders are
-    foreign too, a user may have made them."""
+    foreign too, a user may have made them. ``skipped``: names in ``target`` not looked at."""
     needed = {str(PurePosixPath(f).parent) for f in files}
     for root, dirs, _ in os.walk(target):
+        if root == os.fspath(target):
+            dirs[:] = [d for d in dirs if d not in skipped]
         for name in dirs:
             rel = (Path(root) / name).relative_to(target).as_posix()
             if not any(n == rel or n.startswith(rel + "/") for n in needed):

@@ -284,7 +284,7 @@ def _commit(
         return
     if os.path.islink(target) or not target.is_dir():
         raise ParameterError(f"out: {text} changed during the run and is not a folder any more")
-    remove_stale_temp(target, recursive=True)
+    _sweep(target)
     existing = inspect(target, tool)
     if existing.kind in ("empty", "own"):
         _swap(staging, target, existing, done)
@@ -292,6 +292,15 @@ def _commit(
         _merge(staging, target, files, existing, text, done)
     else:
         raise ParameterError(_refusal(text, tool, existing))
+
+
+def _sweep(folder: Path) -> None:
+    """Remove what ended runs left in the output ``folder`` itself, which :func:`inspect`
+    does not count as the user's: the staging folders and locks of runs writing into it
+    (:func:`remove_stale`, which also puts back an earlier output they were replacing),
+    and temporary files at any depth."""
+    remove_stale(folder)
+    remove_stale_temp(folder, recursive=True)
 
 
 def _commit_fresh(staging: Path, target: Path, done: list[Path]) -> None:
@@ -350,7 +359,7 @@ def list_in_manifest(folder: str | Path, tool: str, names: Sequence[str]) -> Non
     :class:`ParameterError`) a folder that is not this tool's own."""
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True, mode=folder_mode())
-    remove_stale_temp(folder, recursive=True)  # a killed write of an earlier run
+    _sweep(folder)  # what runs killed while writing here left
     existing = inspect(folder, tool)
     fresh = [n for n in names if n not in existing.listed]
     other_tool = existing.tool is not None and existing.tool != tool

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import sys
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -29,8 +30,37 @@ from ddwmmr.outputs.recovery import _target_tag, drop_stale_lock
 def lock_file(target: Path) -> Path:
     """The lock of the output folder ``target``: ``.ddwmmr-lock-<tag>`` beside it (not
     inside: the commit renames the folder itself, and an absent ``target`` stays absent
-    until the results move in). Its text is the holder's :func:`owner_token`."""
-    return target.with_name(f"{LOCK_PREFIX}{_target_tag(target)}")
+    until the results move in). Its text is the holder's :func:`owner_token`. Every
+    spelling of the same folder gets the same lock (:func:`_lock_tag`)."""
+    return target.with_name(f"{LOCK_PREFIX}{_lock_tag(target)}")
+
+
+def _lock_tag(target: Path) -> str:
+    """:func:`_target_tag` of ``target``'s name, case-folded where the parent's file system
+    ignores case (:func:`_case_insensitive`), so that ``Results`` and ``results`` share a
+    lock there. The name alone is enough: the lock is made in the parent folder itself, so
+    every path reaching that folder (a symbolic link, ``..``, another case, a bind mount)
+    finds the same file, where a key from the spelled or resolved parent path would not
+    (a resolved path differs between two mounts of one folder)."""
+    name = target.name.casefold() if _case_insensitive(target.parent) else target.name
+    return _target_tag(target.with_name(name))
+
+
+def _case_insensitive(folder: Path) -> bool:
+    """Whether names in ``folder`` are looked up ignoring case: a temporary file is made
+    there and looked up with its letters' case swapped (a mount of another file system,
+    FAT or a Windows share, differs from the system's default). If the file cannot be
+    made: True on Windows and macOS, whose usual file systems ignore case."""
+    try:
+        fd, probe = tempfile.mkstemp(dir=folder, prefix=temp_prefix(), suffix=".tmp")
+    except OSError:
+        return os.name == "nt" or sys.platform == "darwin"
+    os.close(fd)
+    try:
+        return os.path.lexists(os.path.join(folder, os.path.basename(probe).swapcase()))
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(probe)
 
 
 @contextlib.contextmanager

@@ -11,6 +11,7 @@ import functools
 import os
 import re
 import socket
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -173,3 +174,19 @@ def dead_lock(holder: tuple[str, int, int]) -> bool:
     ended (a lock of another host's run is never taken for dead)."""
     host, pid, start = holder
     return host == _host() and (pid == 0 or not _running(pid, start))
+
+
+def ended_leftover(path: Path) -> bool:
+    """Whether ``path`` is a staging folder (a real folder, not a link) or an output lock
+    (a regular file) that a run of this host left and that run has ended: never a user's
+    file, and removed by the next run writing beside it."""
+    try:
+        mode = os.lstat(path).st_mode
+    except OSError:
+        return False
+    if stat.S_ISDIR(mode):
+        return _dead_owner(path.name, "staging") is not None
+    if not (stat.S_ISREG(mode) and path.name.startswith(LOCK_PREFIX)):
+        return False
+    holder = lock_holder(path)
+    return holder is not None and dead_lock(holder)
