@@ -220,7 +220,7 @@ def draw_support_loads(fig: Figure, result, floor_n: float | None = None) -> Fig
     for j, name in enumerate(names):
         ax_load.plot(t, loads[:, j], lw=0.8, label=f"{name} edge")
     if floor_n is not None:
-        ax_load.axhline(floor_n, color="k", ls="--", lw=0.9, label=f"floor {floor_n:.1f} N")
+        ax_load.axhline(floor_n, color="k", ls="--", lw=0.9, label=f"floor {_newtons(floor_n)} N")
     ax_load.axhline(0.0, color="0.4", lw=0.6)
     top = float(np.max(loads)) if loads.size else 1.0
     ax_load.set_ylim(-0.03 * top, 1.05 * top)
@@ -247,3 +247,9 @@ def save_support_loads(result, path: str | Path, floor_n: float | None = None) -
     fig.savefig(path, dpi=SUPPORT_LOADS_DPI, metadata=PNG_METADATA)
     plt.close(fig)
     return Path(path)
+
+
+def _newtons(value: float) -> str:
+    """A force (N) for a legend: one decimal from 0.1 N up (``13.0``), else three
+    significant digits, so a small robot's floor is not shown as ``0.0``."""
+    return f"{value:.1f}" if abs(value) >= 0.1 else f"{value:.3g}"
