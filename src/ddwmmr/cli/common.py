@@ -650,7 +650,9 @@ def add_plant_option_argument(parser: argparse.ArgumentParser | argparse._Argume
         metavar="NAME=VALUE",
         help="a constructor option of --plant (repeatable), read as --option reads a "
         "method's, e.g. c1=20, c2=2, force_limit=25 (thesis), timestep=0.001 (mujoco); a "
-        "value the plant refuses is an error",
+        "value the plant refuses is an error; for a robot other than the thesis robot the "
+        "thesis plant's c1, c2 and force_limit default to values derived from its motors, "
+        'mass and yaw inertia (docs/thesis.md, "What is simulated")',
     )
 
 

@@ -58,7 +58,7 @@ from ddwmmr.errors import (
     read_text_file,
     shown,
 )
-from ddwmmr.gains import TAU_RANGE
+from ddwmmr.gains import GAIN_STEP_MARGIN, STABLE_GAIN_STEP, TAU_RANGE
 from ddwmmr.model.stability import STABILITY_CAP
 from ddwmmr.plants import available_plants, make_plant, plant_class, plant_description
 from ddwmmr.plants.kinematic import INTEGRATORS
@@ -82,6 +82,14 @@ from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 PROG = "python -m ddwmmr.track"
 #: The default plant (``--plant``), and the plant of a record that names none.
 PLANT = "kinematic"
+#: What ``--tau`` and ``--dt`` say of the warning :func:`ddwmmr.gains.gain_step_warning`
+#: prints before a run whose step is too coarse for its gains.
+GAIN_STEP_WARNING_HELP = (
+    f"a run whose largest K dt = dt/tau reaches {GAIN_STEP_MARGIN:g} of its loop's "
+    f"stability limit ({STABLE_GAIN_STEP['hold']:g} with commands held over the step, "
+    f"{STABLE_GAIN_STEP['rk4']:.4g} under rk4) is warned about "
+    '(docs/theory.md, "Error dynamics and python-control")'
+)
 #: Tools whose summary.json records ``--rerun`` repeats: this one and the simulator's
 #: data export (``python -m ddwmmr.gui``).
 RERUN_TOOLS = ("track", "gui")
@@ -264,7 +272,8 @@ def build_parser() -> ArgumentParser:
         metavar="S",
         help="closed-loop time constant(s) in s, K = 1/tau: one value, or 3 (x, y, phi) for "
         "clrrmc-ts and qp (its tracking task), 5 (x, y, phi, th1, th2) for clrrmc-cs; inf "
-        "disables a channel (default 0.5) [clrrmc-ts, clrrmc-cs, qp]",
+        "disables a channel (default 0.5) [clrrmc-ts, clrrmc-cs, qp]; "
+        f"{GAIN_STEP_WARNING_HELP}",
     )
     parser.add_argument(
         "--preset",
@@ -279,7 +288,8 @@ def build_parser() -> ArgumentParser:
         metavar="S",
         help="control and integration step in s (default: T/N of a parametric trajectory, "
         "0.02 s for the shipped ones; for a CSV the rows' spacing, made no coarser than "
-        "0.02 s, as in the API; on mujoco a whole number of engine steps)",
+        "0.02 s, as in the API; on mujoco a whole number of engine steps); "
+        f"{GAIN_STEP_WARNING_HELP}",
     )
     parser.add_argument(
         "--duration",
