@@ -32,8 +32,6 @@ def refusal(call) -> str:
     [
         ("proximal", ">= 0"),
         ("stability_margin", ">= 0"),
-        ("obstacle_margin", ">= 0"),
-        ("reach_speed", "> 0"),
         ("plan_weight", "in [0, 1e+06]"),
     ],
 )

@@ -340,6 +340,19 @@ class Robot:
         """A copy of this robot carrying ``payload`` kg at the end effector."""
         return replace(self, payload=payload)
 
+    def in_length_unit(self, unit: float) -> Robot:
+        """This robot with every length (m: the scalar lengths and ``caster_positions``)
+        divided by ``unit`` (m, > 0), masses, inertias and limits kept: the robot as a
+        computation measuring lengths in ``unit`` sees it (only the masses' ratios place
+        the centre of mass); this robot itself for a unit of 1.0."""
+        if unit == 1.0:
+            return self
+        lengths = {name: getattr(self, name) / unit for name in _LENGTHS}
+        casters = self.caster_positions
+        if casters is not None:
+            casters = tuple((x / unit, y / unit) for x, y in casters)
+        return replace(self, caster_positions=casters, **lengths)
+
     # -- physical layout ----------------------------------------------------------------
     @property
     def casters(self) -> tuple[tuple[float, float], ...]:

@@ -85,7 +85,7 @@ from ddwmmr.mpc.options import (
     MPCOptions,
     options_signature,
 )
-from ddwmmr.mpc.problem import Problem, robot_in_unit
+from ddwmmr.mpc.problem import Problem
 from ddwmmr.mpc.solvers import SolverFailure, installed_qp_solvers, installed_solvers
 from ddwmmr.mpc.stall import StallWatch
 from ddwmmr.qp.limits import run_clearance, safe_arm_scale
@@ -123,6 +123,9 @@ class MPCController:
         check_known_options(self.name, options, [f.name for f in fields(MPCOptions)])
         self.options = MPCOptions(**options)
         self.robot = robot
+        #: The robot's length unit (m), whatever the model: the unit of the defaults of
+        #: ``obstacle_margin`` and ``reach_speed`` (docs/mpc.md, "Robot size").
+        self.length_unit = length_unit(robot.L1)
         self._plan = _load_plan(self.options, robot.payload)
         self._configure(self.options.adopt_plant(None), None)
         self._loop_step: float | None = None
@@ -181,8 +184,8 @@ class MPCController:
             model, self.robot, self.dynamics, lag, acceleration_limit
         )
         # the kinematic model plans in the robot's length unit (docs/mpc.md, "Robot size")
-        self.unit = length_unit(self.robot.L1) if model == "kinematic" else 1.0
-        self._unit_robot = robot_in_unit(self.robot, self.unit)
+        self.unit = self.length_unit if model == "kinematic" else 1.0
+        self._unit_robot = self.robot.in_length_unit(self.unit)
         self._unit_model = (
             self.model
             if self.unit == 1.0
@@ -228,7 +231,7 @@ class MPCController:
             second_leg_weight=options.lookahead_weight,
             second_leg_horizon=options.lookahead_horizon,
             min_horizon=max(0.1, 2.0 * self.dt),
-            reach_speed=options.reach_speed / unit,
+            reach_speed=options.robot_reach_speed(self.length_unit) / unit,
             arrival_weight=options.plan_weight if reach and self._plan is not None else 0.0,
             stability_min=options.stability_min,
             stability_margin=options.stability_margin,
@@ -238,7 +241,7 @@ class MPCController:
             huber=None if huber is None else huber / unit,
             obstacles=tuple(_circle_in_unit(circle, unit) for circle in circles),
             base_radius=base_bubble(self._unit_robot),
-            obstacle_margin=options.obstacle_margin / unit,
+            obstacle_margin=options.robot_obstacle_margin(self.length_unit) / unit,
             weights=self._weights[base],
         )
 
@@ -379,7 +382,7 @@ class MPCController:
         if braking:
             self.brakes += 1
             u = self._braking_input(q, x0)
-        return self._output(problem, q, x0, u, w, iterations, slack, braking)
+        return self._output(problem, q, x0, u, w, iterations, problem.max_slack(w), braking)
 
     # -- pieces ---------------------------------------------------------------------------
     def _state(self, q: np.ndarray, base_velocity: tuple[float, float] | None) -> np.ndarray:
@@ -448,6 +451,9 @@ class MPCController:
     def _output(
         self, problem, q, x0, u, w, iterations, slack: float, braking: bool = False
     ) -> np.ndarray | WheelForces:
+        """The command of plan ``w`` (its first input ``u``), the step's info with the
+        plan's ``slack`` (m for the stability rows, m^2 for the obstacle rows,
+        :meth:`Problem.max_slack`)."""
         k = self.robot.com_coefficients
         th1, th2 = float(q[3]), float(q[4])
         r1, r2 = float(u[2]), float(u[3])
@@ -546,7 +552,7 @@ class MPCController:
             "mpc_wheel_force_limit_n": None if self.dynamics is None else self.dynamics.force_limit,
             "mpc_solver": solver if solver != "rti" else f"rti-{self.options.qp_solver}",
             "mpc_horizon_s": self.options.grid(mode)[2],
-            "mpc_options": self.resolved.record(mode, self.dt, self.unit),
+            "mpc_options": self.resolved.record(mode, self.dt, self.unit, self.length_unit),
         }
 
     # -- the scenario protocol's waypoint task -------------------------------------------
@@ -591,13 +597,15 @@ class MPCController:
 def warn_start_in_keep_out(robot: Robot, options: MPCOptions, q0: np.ndarray) -> None:
     """Warn (:class:`UserWarning`, once) when the start ``q0`` (x, y m) puts the base inside
     the keep-out the OCP's obstacle rows hold: its enclosing circle
-    (:func:`~ddwmmr.behaviours.obstacle.base_bubble`) less than ``obstacle_margin`` (m) from
+    (:func:`~ddwmmr.behaviours.obstacle.base_bubble`) less than the robot's
+    ``obstacle_margin`` (m, :meth:`MPCOptions.robot_obstacle_margin`) from
     a circle of ``obstacles``. The run then starts in violation of those rows (their slack
     takes it). Warned, not refused, as the ``qp`` runs such a start too (its damper asks
     for the clearance to grow); a footprint overlapping a circle is refused by the tools
     (:func:`ddwmmr.sim.simulate.check_start`). The message names the circle with the least
     clearance."""
-    bubble, margin = base_bubble(robot), options.obstacle_margin
+    bubble = base_bubble(robot)
+    margin = options.robot_obstacle_margin(length_unit(robot.L1))
     inside = [
         (math.hypot(q0[0] - c.x, q0[1] - c.y) - c.radius - bubble, number, c)
         for number, c in enumerate(options.obstacles, start=1)  # type: ignore[arg-type]

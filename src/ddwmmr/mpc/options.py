@@ -61,6 +61,7 @@ from ddwmmr.mpc.ocp import (
 from ddwmmr.mpc.problem import COLD_ITERATIONS
 from ddwmmr.mpc.solvers import DEFAULT_QP_SOLVER, QP_BACKED_SOLVERS, QP_SOLVERS, SOLVERS
 from ddwmmr.qp.limits import as_circles
+from ddwmmr.qp.limits.obstacles import robot_margin
 
 MODELS = ("kinematic", "thesis")
 #: Control step (s) when neither ``dt`` nor the trajectory's resolution is known.
@@ -74,6 +75,9 @@ POSITION_WEIGHTS = {"tracking": 100.0, "reach": 50.0}
 #: Huber scale of the position error in waypoint mode when ``huber`` is not given, in the
 #: robot's length unit (m for the default robot; docs/mpc.md, "Robot size").
 REACH_HUBER = 0.01
+#: ``reach_speed`` in waypoint mode when it is not given, in the robot's length unit per
+#: second (m/s for the default robot; docs/mpc.md, "Robot size").
+REACH_SPEED = 0.05
 
 
 @dataclass(frozen=True)
@@ -159,7 +163,9 @@ class MPCOptions:
             :data:`POSITION_WEIGHTS`); huber: Huber scale (m) of position errors (None:
             :data:`REACH_HUBER` in waypoint mode, none when tracking).
         reach_speed: waypoint mode: m/s converting the distance left at the end of the
-            horizon into seconds.
+            horizon into seconds; None (default): the robot's own, :data:`REACH_SPEED` of
+            its length unit per second (:meth:`robot_reach_speed`; 0.05 m/s on the default
+            robot).
         lookahead: waypoint mode: plan through the current target to the next one of
             ``route`` (two legs of free duration, each at most ``horizon``), so that the
             robot arrives moving the way the next leg wants; off (default): one target at
@@ -227,7 +233,11 @@ class MPCOptions:
             start is when the plans are most violent, and a frozen plan's cold start tipped
             scenario 99 of seed 1; docs/mpc.md, "Seed 1's re-search finished, and a frozen
             plan").
-        obstacle_margin: clearance (m) of the base's enclosing circle from each obstacle.
+        obstacle_margin: clearance (m, >= 0) of the base's enclosing circle from each
+            obstacle; None (default): the robot's own,
+            :data:`~ddwmmr.qp.limits.obstacles.MARGIN` of its length unit
+            (:meth:`robot_obstacle_margin`; 0.05 m on the default robot). No upper bound:
+            the OCP holds every circle at every node, near or far.
         dt: control step (s); None (default): the loop's control step
             (``adopt_control_step``), else the trajectory's ``duration / samples`` at
             reset, else :data:`DEFAULT_DT`.
@@ -250,7 +260,7 @@ class MPCOptions:
     orientation_weight: float = 10.0
     input_weight: float = 0.01
     huber: float | None = None
-    reach_speed: float = 0.05
+    reach_speed: float | None = None
     lookahead: bool = False
     lookahead_weight: float = 0.5
     lookahead_horizon: float = 12.0
@@ -266,7 +276,7 @@ class MPCOptions:
     wheel_force_limit: float | None = None
     brake_slack: float | None = None
     frozen_restart: bool | None = None
-    obstacle_margin: float = 0.05
+    obstacle_margin: float | None = None
     dt: float | None = None
     fallback_options: dict[str, Any] | None = None
 
@@ -339,13 +349,15 @@ class MPCOptions:
         if self.huber is not None:  # None: per objective (huber_scale)
             self._set("huber", _check_huber("huber", self.huber))
         for name, check in (  # None is no value of these: refused as any non-number
-            ("reach_speed", check_positive),
             ("proximal", check_nonnegative),
             ("stability_margin", check_nonnegative),
             ("plan_weight", check_weight),
-            ("obstacle_margin", check_nonnegative),
         ):
             self._set(name, check(name, getattr(self, name)))
+        if self.reach_speed is not None:  # None: the robot's own (robot_reach_speed)
+            self._set("reach_speed", check_positive("reach_speed", self.reach_speed))
+        if self.obstacle_margin is not None:  # None: the robot's own (robot_obstacle_margin)
+            self._set("obstacle_margin", robot_margin(self.obstacle_margin, 1.0))
         self._check_stability_target()
         self._set("fallback_options", _fallback_option(self.fallback_options))
 
@@ -510,11 +522,28 @@ class MPCOptions:
             return self.huber
         return REACH_HUBER * unit if mode == "reach" else None
 
+    def robot_obstacle_margin(self, length: float) -> float:
+        """The clearance (m) kept from every obstacle by a robot of length unit ``length``
+        (m, :func:`~ddwmmr.resolution.kernels.length_unit`, whatever the model):
+        ``obstacle_margin``, else the robot's own
+        (:func:`~ddwmmr.qp.limits.obstacles.robot_margin`, as the qp's)."""
+        return robot_margin(self.obstacle_margin, length)
+
+    def robot_reach_speed(self, length: float) -> float:
+        """The waypoint mode's ``reach_speed`` (m/s) for a robot of length unit ``length``
+        (m, whatever the model): ``reach_speed``, else :data:`REACH_SPEED` of the unit per
+        second."""
+        return REACH_SPEED * length if self.reach_speed is None else self.reach_speed
+
     # -- reporting ----------------------------------------------------------------------
-    def record(self, mode: str, dt: float, unit: float = 1.0) -> dict[str, Any]:
+    def record(
+        self, mode: str, dt: float, unit: float = 1.0, length: float = 1.0
+    ) -> dict[str, Any]:
         """Every option with the value a run of objective ``mode`` at control step ``dt``
-        (s) on a robot of length ``unit`` (m) uses (the grid, the position weight and the
-        Huber scale of that objective), in plain types for the run's summary."""
+        (s) uses: the grid, the position weight and the Huber scale of that objective (the
+        default Huber scale in the OCP's length ``unit``, m), ``obstacle_margin`` and
+        ``reach_speed`` of a robot of length unit ``length`` (m), in plain types for the
+        run's summary."""
         values = {f.name: getattr(self, f.name) for f in fields(self)}
         intervals, first, horizon = self.grid_at(mode, dt)
         values.update(
@@ -524,6 +553,8 @@ class MPCOptions:
             horizon=horizon,
             position_weight=self.weights(mode).position,
             huber=self.huber_scale(mode, unit),
+            obstacle_margin=self.robot_obstacle_margin(length),
+            reach_speed=self.robot_reach_speed(length),
             dt=dt,
             obstacles=[(c.x, c.y, c.radius) for c in self.obstacles],  # type: ignore[union-attr]
             joint_acceleration_limit=list(self.joint_acceleration_limit or ()),  # type: ignore[arg-type]

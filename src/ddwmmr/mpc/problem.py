@@ -3,18 +3,16 @@
 The OCP may plan in the robot's own length unit (docs/mpc.md, "Robot size"): its robot and
 model are then the robot with every length divided by the unit, and :class:`Problem`
 converts what crosses its boundary (the measured state, the references, the previous
-command in; the command and the stability slack out) between metres and that unit.
+command in; the command and the slacks out) between metres and that unit.
 """
 
 from __future__ import annotations
 
 from collections.abc import Hashable
-from dataclasses import replace
 
 import numpy as np
 
 from ddwmmr.model import Robot
-from ddwmmr.model.robot import _LENGTHS as LENGTH_FIELDS
 from ddwmmr.mpc import terminal
 from ddwmmr.mpc.cache import shared_ocp
 from ddwmmr.mpc.min_time import Guess
@@ -37,8 +35,8 @@ class Problem:
             (``"rti"``) starts cold with ``cold_iterations`` Gauss-Newton iterations
             (default :data:`COLD_ITERATIONS`).
         unit: the length (m) the OCP measures lengths in (``robot`` and ``model`` already
-            in it, :func:`robot_in_unit`); 1.0: metres. Only the kinematic model's state
-            and input hold lengths it converts (positions, ``v``).
+            in it, :meth:`~ddwmmr.model.Robot.in_length_unit`); 1.0: metres. Only the
+            kinematic model's state and input hold lengths it converts (positions, ``v``).
     """
 
     def __init__(
@@ -195,18 +193,17 @@ class Problem:
         """The largest slack of a solution's stability rows (m)."""
         return self.ocp.max_stability_slack(w) * self.unit
 
-
-def robot_in_unit(robot: Robot, unit: float) -> Robot:
-    """``robot`` with every length (m) divided by ``unit`` (m): the robot as an OCP in
-    that unit sees it (masses kept: only their ratios place the centre of mass); ``robot``
-    itself for a unit of 1.0."""
-    if unit == 1.0:
-        return robot
-    lengths = {name: getattr(robot, name) / unit for name in LENGTH_FIELDS}
-    casters = robot.caster_positions
-    if casters is not None:
-        casters = tuple((x / unit, y / unit) for x, y in casters)
-    return replace(robot, caster_positions=casters, **lengths)
+    def max_slack(self, w: np.ndarray) -> float:
+        """The largest slack of a solution's stability rows (m) and obstacle rows (m^2),
+        the joint box's left out (:meth:`ShootingOCP.max_slack
+        <ddwmmr.mpc.ocp.ShootingOCP.max_slack>` in the OCP's unit, which the stall rule
+        reads); the step's ``mpc_slack``."""
+        ocp, unit = self.ocp, self.unit
+        if unit == 1.0:
+            return ocp.max_slack(w)
+        obstacles = w[ocp.slack_index[:, 2 : ocp.joint_slacks.start]]
+        stability = self.max_stability_slack(w)
+        return max(stability, float(np.max(obstacles)) * unit**2) if obstacles.size else stability
 
 
 def interpolate_rows(times: np.ndarray, rows: np.ndarray, at: np.ndarray) -> np.ndarray:

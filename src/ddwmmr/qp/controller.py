@@ -63,7 +63,7 @@ from ddwmmr.controllers.base import (
     step_results,
 )
 from ddwmmr.controllers.inputs import check_inputs, check_start
-from ddwmmr.errors import ParameterError, check_bool, check_nonnegative, check_positive, shown
+from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import whole_turns
 from ddwmmr.model.stability import STABILITY_FLOOR, warn_start_below_floor
@@ -86,6 +86,7 @@ from ddwmmr.qp.limits import (
     safe_arm_scale,
 )
 from ddwmmr.qp.limits.edge_loads import EdgeLoadLimit
+from ddwmmr.qp.limits.obstacles import check_margin_in_influence, robot_margin
 from ddwmmr.qp.limits.stability import ascent_direction, stability_rows
 from ddwmmr.qp.problem import QPProblem
 from ddwmmr.qp.solve import MODES, check_mode, installed_solvers, make_backend, solve
@@ -147,7 +148,11 @@ class QPController:
         heading_weight: weight of the far-target heading task; default 1 when the
             orientation is not tracked, else 0 (off).
         stability_gain: damper gain of the stability limit (1/s).
-        obstacle_margin: clearance kept from every obstacle (m).
+        obstacle_margin: clearance kept from every obstacle (m), in [0, 0.6 unit): below
+            the obstacle influence (:data:`~ddwmmr.qp.limits.obstacles.INFLUENCE_M` of the
+            robot's length unit); None (default): the robot's own,
+            :data:`~ddwmmr.qp.limits.obstacles.MARGIN` of its length unit (0.05 m on the
+            default robot).
         max_base_speed, max_yaw_rate: caps on v (m/s) and w (rad/s), e.g. a force-limited
             base's top speeds; None (default) leaves only the wheel-speed limit.
         max_acceleration, max_yaw_acceleration: slew limits on v (m/s^2) and w (rad/s^2)
@@ -193,7 +198,7 @@ class QPController:
         regularization_weight: float = 1e-3,
         heading_weight: float | None = None,
         stability_gain: float = 5.0,
-        obstacle_margin: float = 0.05,
+        obstacle_margin: float | None = None,
         singularity_margin: float | None = 0.25,
         max_base_speed: float | None = None,
         max_yaw_rate: float | None = None,
@@ -218,7 +223,7 @@ class QPController:
         self.backend = self._make_backend(solver, warm_start)
         self.obstacles = as_circles(obstacles)
         # checked without obstacles too: a bad margin is a mistake whatever the scene
-        obstacle_margin = check_nonnegative("obstacle_margin", obstacle_margin)
+        obstacle_margin = check_margin_in_influence(robot_margin(obstacle_margin, unit), unit)
         if heading_weight is None:
             heading_weight = 0.0 if track_orientation else 1.0
         linear, angular = demand_limits(robot)

@@ -33,6 +33,7 @@ from ddwmmr.errors import (
     check_range,
     load_toml,
     shown,
+    texts_apart,
 )
 from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
@@ -51,6 +52,35 @@ DEGENERATE_SHARE = 1e-3
 #: :class:`~ddwmmr.qp.tasks.avoidance.ObstacleSteeringTask` (it steers round), in the
 #: robot's length unit (m on the default robot; docs/qp.md, "Robot size").
 INFLUENCE_M = 0.6
+#: Clearance kept from every obstacle when ``obstacle_margin`` is not given, by the qp and
+#: the mpc, in the robot's length unit (m on the default robot; docs/qp.md, "Robot size").
+MARGIN = 0.05
+
+
+def robot_margin(margin: float | None, unit: float) -> float:
+    """The ``obstacle_margin`` (m) of a robot whose length unit is ``unit`` (m,
+    :func:`~ddwmmr.resolution.kernels.length_unit`): ``margin`` as given (m, finite, >=
+    0), None for :data:`MARGIN` of the unit (the robot's own), else a one-line
+    :class:`ParameterError`. The mpc takes it as it is; the qp also needs it below its
+    obstacle influence (:func:`check_margin_in_influence`)."""
+    if margin is None:
+        return MARGIN * unit
+    return check_nonnegative("obstacle_margin", margin)
+
+
+def check_margin_in_influence(margin: float, unit: float) -> float:
+    """``margin`` (m) if it is below the qp's obstacle influence, :data:`INFLUENCE_M` of
+    the robot's length ``unit`` (m), where :class:`ObstacleLimit` switches its rows on,
+    else a one-line :class:`ParameterError` naming ``obstacle_margin`` and its range for
+    this robot: a clearance kept beyond the influence would never be acted on."""
+    influence = INFLUENCE_M * unit
+    if margin < influence:
+        return margin
+    got, (top,) = texts_apart(margin, influence)
+    raise ParameterError(
+        f"obstacle_margin must be in [0, {top}) m: below the qp's obstacle influence, "
+        f"{INFLUENCE_M:g} of the robot's length unit {unit:g} m (got {got})"
+    )
 
 
 @dataclass(frozen=True)
@@ -229,7 +259,7 @@ class ObstacleLimit(Limit):
     Args:
         robot: gives the footprint and the base speed limits (to keep rows feasible).
         circles: the obstacles.
-        margin: clearance kept from every circle (m).
+        margin: clearance kept from every circle (m); None: :data:`MARGIN` of ``unit``.
         influence: rows farther than this are switched off (in ``unit``).
         gain: damper gain (1/s).
         unit: the length unit (m) of the rows (:attr:`Limit.unit`): each row is the
@@ -242,7 +272,7 @@ class ObstacleLimit(Limit):
         self,
         robot: Robot,
         circles: Sequence[Circle],
-        margin: float = 0.05,
+        margin: float | None = None,
         influence: float = INFLUENCE_M,
         gain: float = 2.0,
         unit: float = 1.0,
@@ -251,7 +281,9 @@ class ObstacleLimit(Limit):
         self.circles = list(circles)
         self.rows = len(self.circles)
         self.half_length, self.half_width = 0.5 * robot.base_length, 0.5 * robot.base_width
-        self.margin = check_nonnegative("obstacle margin", margin)
+        self.margin = (
+            MARGIN * unit if margin is None else check_nonnegative("obstacle margin", margin)
+        )
         self.influence = check_positive("obstacle influence", influence)
         if self.influence * unit <= self.margin:
             raise ParameterError(
