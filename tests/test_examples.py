@@ -151,17 +151,19 @@ def test_compare_aux_numbers(printed) -> None:
 def test_own_robot_numbers(printed) -> None:
     lines = printed["own_robot.py"].splitlines()
     found = {line[:22].strip(): _numbers(line[22:]) for line in lines}
-    for label, reach, payload in (
-        ("default (thesis)", 0.35 + 0.30, 1.25),
-        ("default, 3 kg payload", 0.35 + 0.30, 3.0),
-        ("long arm (TOML)", 0.45 + 0.35, 2.0),
-        ("long arm, 6 kg payload", 0.45 + 0.35, 6.0),
+    for label, L1, L2, payload in (
+        ("default (thesis)", 0.35, 0.30, 1.25),
+        ("default, 3 kg payload", 0.35, 0.30, 3.0),
+        ("long arm (TOML)", 0.45, 0.35, 2.0),
+        ("long arm, 6 kg payload", 0.45, 0.35, 6.0),
     ):
         got_reach, got_payload, _, rms = found[label][:4]
-        assert got_reach == pytest.approx(reach, abs=0.005)
+        assert got_reach == pytest.approx(L1 + L2, abs=0.005)
         assert got_payload == pytest.approx(payload, abs=0.005)
-        # Closed loop on the default ellipse: the same decay for any robot (no saturation).
-        assert rms == pytest.approx(1000 * closed_loop_rms(2000, 0.02), abs=0.005)
+        # Closed loop on the default ellipse: the same decay for any robot (no saturation),
+        # from its own default offset, the default's times its length unit L1 / 0.35 m.
+        unit = L1 / 0.35
+        assert rms == pytest.approx(1000 * unit * closed_loop_rms(2000, 0.02), abs=0.005)
     stability = {label: numbers[2] for label, numbers in found.items()}
     # More payload at the end effector moves the centre of mass out: less stable.
     assert stability["default, 3 kg payload"] < stability["default (thesis)"]

@@ -75,7 +75,7 @@ from ddwmmr.reports.compare import (
 )
 from ddwmmr.reports.compare.constants import TIE_ABSOLUTE_M, TIE_RELATIVE
 from ddwmmr.reports.compare.plan import report_name, run_duration, skipped_studies
-from ddwmmr.resolution.reference import initial_configuration
+from ddwmmr.resolution.reference import default_offset, initial_configuration
 from ddwmmr.sim.result import json_safe
 from ddwmmr.sim.simulate import check_start
 from ddwmmr.sim.verdict import explain
@@ -117,15 +117,16 @@ studies (--study, default all):
   dt          steps {", ".join(f"{s:g}" for s in STEP_SIZES)} s with Euler and RK4, no
               initial offset: the error is the drift; its observed order of accuracy
   integrator  Euler vs RK4 at the default step, error vs time
-  init        initial offsets {", ".join(f"{s:g}" for s in OFFSET_SCALES)} x the default
-              (-30 mm, -30 mm in the end effector's frame): open loop keeps the offset,
-              closed loop removes it
+  init        initial offsets {", ".join(f"{s:g}" for s in OFFSET_SCALES)} x the robot's
+              default: open loop keeps the offset, closed loop removes it
   corners     rectangle: error peaks at the corners alpha = k pi/2 (no extra runs)
   all | none  every study | only the comparison
 
 All runs use the same robot, start configuration (home arm pose on the trajectory start,
-end effector offset by (-30, -30) mm in its start frame with the arm), integrator (rk4)
-and step (the trajectory's T/N). Results do not depend on --jobs; only the step latency
+end effector moved with the arm by the robot's default offset: -0.03, -0.03 times its
+length unit L1/0.35 m in its start frame, (-30, -30) mm for the default robot; for
+another offset run python -m ddwmmr.track --offset), integrator (rk4) and step (the
+trajectory's T/N). Results do not depend on --jobs; only the step latency
 (a wall-clock timing) varies. Bad input prints one line on stderr and exits with status 2.
 """
 
@@ -418,7 +419,10 @@ def check_runs(config: CompareConfig, specs: Sequence[Any]) -> None:
         try:
             check_step_count(run_duration(config, spec.trajectory), spec.dt)
             trajectory = config.trajectories[spec.trajectory]
-            start = initial_configuration(config.robot, trajectory, spec.initial_offset)
+            own = default_offset(config.robot)
+            offset = own if spec.initial_offset is None else spec.initial_offset
+            name = "the robot's default offset" if offset == own else "the study's offset"
+            start = initial_configuration(config.robot, trajectory, offset, name=name)
             obstacles = dict(spec.options).get("obstacles") or ()
             check_start(config.robot, start, obstacles, "payload", None)
         except ParameterError as exc:

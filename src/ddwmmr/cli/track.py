@@ -67,6 +67,7 @@ from ddwmmr.provenance import RunInputs, run_record
 from ddwmmr.registry import PLANTS
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
+    default_offset,
     initial_configuration,
 )
 from ddwmmr.sim.simulate import (
@@ -82,6 +83,8 @@ from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 PROG = "python -m ddwmmr.track"
 #: The default plant (``--plant``), and the plant of a record that names none.
 PLANT = "kinematic"
+#: ``--offset``'s default for the default robot, as written on the command line (m).
+_DEFAULT_OFFSET_TEXT = f"{DEFAULT_INITIAL_OFFSET[0]:.2f} {DEFAULT_INITIAL_OFFSET[1]:.2f}"
 #: What ``--tau`` and ``--dt`` say of the warning :func:`ddwmmr.gains.gain_step_warning`
 #: prints before a run whose step is too coarse for its gains.
 GAIN_STEP_WARNING_HELP = (
@@ -316,8 +319,8 @@ def build_parser() -> ArgumentParser:
         nargs=2,
         metavar=("DX", "DY"),
         help="initial end-effector offset in m, in the end effector's start frame (x along "
-        "its start orientation), applied with the arm (default "
-        f"{DEFAULT_INITIAL_OFFSET[0]:.2f} {DEFAULT_INITIAL_OFFSET[1]:.2f})",
+        f"its start orientation), applied with the arm (default {_DEFAULT_OFFSET_TEXT} times "
+        f"the robot's length unit L1/0.35 m: {_DEFAULT_OFFSET_TEXT} for the default robot)",
     )
     add_robot_arguments(parser)
     qp = parser.add_argument_group(
@@ -458,7 +461,7 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
             f"duration must be >= one step, {step:g} s (the trajectory's T/N; or give a "
             f"smaller --dt) (got {duration:g})"
         )
-    offset = DEFAULT_INITIAL_OFFSET if args.offset is None else tuple(args.offset)
+    offset = default_offset(robot) if args.offset is None else tuple(args.offset)
     inputs = RunInputs(
         args.method,
         options,
@@ -486,8 +489,8 @@ def check_run(inputs: RunInputs, holder: str, start: str) -> RunInputs:
     within the arm's reach, obstacles within the command-line limits, and a start that
     neither tips the robot (S > 1) nor overlaps an obstacle.
     ``holder`` (what holds the payload) and ``start`` (what sets the start pose) word the
-    tipping message. The result carries ``dt`` and ``duration`` as the floats checked (a
-    record may hold an integer)."""
+    tipping message; ``start`` also names the offset the arm cannot reach. The result
+    carries ``dt`` and ``duration`` as the floats checked (a record may hold an integer)."""
     check_step_count(inputs.duration, inputs.dt)
     inputs = replace(inputs, dt=float(inputs.dt), duration=float(inputs.duration))
     plant_integrator(inputs.plant, inputs.integrator)
@@ -508,7 +511,7 @@ def check_run(inputs: RunInputs, holder: str, start: str) -> RunInputs:
 
         obstacles = [within_limits(c.x, c.y, c.radius) for c in as_circles(obstacles)]
     # a start that tips the robot or sits in an obstacle is bad input
-    q0 = initial_configuration(robot, inputs.trajectory, inputs.offset)
+    q0 = initial_configuration(robot, inputs.trajectory, inputs.offset, name=start)
     check_start(robot, q0, obstacles, holder, start)
     return inputs
 

@@ -42,10 +42,7 @@ from ddwmmr.errors import (
 from ddwmmr.gui.options import method_options, plant_keywords, plant_names
 from ddwmmr.model import Robot
 from ddwmmr.plants.kinematic import INTEGRATORS
-from ddwmmr.resolution.reference import (
-    DEFAULT_INITIAL_OFFSET,
-    initial_configuration,
-)
+from ddwmmr.resolution.reference import default_offset, initial_configuration
 from ddwmmr.sim import SimulationResult, simulate
 from ddwmmr.sim.simulate import check_start
 from ddwmmr.trajectories import SampledTrajectory, load_trajectory
@@ -113,7 +110,9 @@ class Settings:
         integrator: ``rk4`` or ``euler``.
         dt: control step (s); None: T / N.
         duration: simulated time (s); None: one period T.
-        offset: initial end-effector offset (dx, dy) (m).
+        offset: initial end-effector offset (dx, dy) (m); default the robot's own
+            (:func:`~ddwmmr.resolution.reference.default_offset`; the window's robot is
+            the default one).
     """
 
     trajectory: str = "ellipse"
@@ -125,7 +124,7 @@ class Settings:
     integrator: str = "rk4"
     dt: float | None = None
     duration: float | None = None
-    offset: tuple[float, float] = DEFAULT_INITIAL_OFFSET
+    offset: tuple[float, float] = default_offset(Robot())
 
     def __post_init__(self) -> None:
         # Every slot index (widgets, labels, export) assumes one entry per slot: a bare

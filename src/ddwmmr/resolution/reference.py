@@ -3,7 +3,8 @@
 * :func:`start_configuration` places the robot's home arm pose on the trajectory start.
 * :func:`offset_configuration` moves the end effector by a small offset using the arm only;
   the offset is expressed in the end effector's frame, so whether the arm can reach it does
-  not depend on which way the trajectory starts.
+  not depend on which way the trajectory starts. :func:`default_offset` is a robot's
+  default one, :data:`DEFAULT_INITIAL_OFFSET` in its length unit.
 * :class:`ReferenceTrajectory` integrates ``q_d(t)`` from the desired task trajectory
   through the augmented task space resolution (RK4 on a fine grid, cubic Hermite lookup):
   the configuration-space reference of CLRRMC-CS (docs/theory.md, "Methods").
@@ -21,12 +22,25 @@ from ddwmmr.model.kinematics import principal_angle
 from ddwmmr.resolution import kernels
 from ddwmmr.trajectories.base import sampler
 
-#: Default initial end-effector offset (m) in the end effector's start frame (x along its
-#: orientation phiE, y to its left): 30 mm back and 30 mm to the right, 42.4 mm in all, so
-#: closed-loop convergence shows. On the default ellipse (start heading +y) this is the
-#: world offset (0.03, -0.03) m. Any start heading gives the same arm motion, which the
-#: home arm pose can always make (it moves E towards the arm mount).
+#: Default initial end-effector offset of the default robot (m; of any robot in its length
+#: unit, :func:`default_offset`) in the end effector's start frame (x along its orientation
+#: phiE, y to its left): 30 mm back and 30 mm to the right, 42.4 mm in all, so closed-loop
+#: convergence shows. On the default ellipse (start heading +y) this is the world offset
+#: (0.03, -0.03) m. Any start heading gives the same arm motion, which the home arm pose
+#: can always make (it moves E towards the arm mount).
 DEFAULT_INITIAL_OFFSET = (-0.03, -0.03)
+
+
+def default_offset(robot: Robot) -> tuple[float, float]:
+    """The robot's default initial end-effector offset (dx, dy) in m, in the end effector's
+    start frame: :data:`DEFAULT_INITIAL_OFFSET` times the robot's length unit
+    (:func:`kernels.length_unit`), so a robot scaled by s starts s times as far off as the
+    default robot, on whose steps it then runs; exactly :data:`DEFAULT_INITIAL_OFFSET` for
+    the default robot."""
+    unit = kernels.length_unit(robot.L1)
+    dx, dy = DEFAULT_INITIAL_OFFSET
+    return (dx * unit, dy * unit)
+
 
 #: Position error (m) at which :func:`offset_configuration` accepts the arm's pose, near
 #: the origin.
@@ -50,13 +64,18 @@ def start_configuration(robot: Robot, trajectory) -> np.ndarray:
     return robot.base_for_end_effector((x_e, y_e, principal_angle(phi_e)), *robot.home_pose)
 
 
-def initial_configuration(robot: Robot, trajectory, offset) -> np.ndarray:
+def initial_configuration(
+    robot: Robot, trajectory, offset, *, name: str = "initial_offset"
+) -> np.ndarray:
     """A run's start: :func:`start_configuration` with the end effector moved by ``offset``
-    (dx, dy) m in its frame (:func:`offset_configuration`)."""
-    return offset_configuration(robot, start_configuration(robot, trajectory), offset)
+    (dx, dy) m in its frame (:func:`offset_configuration`, whose refusal names the offset
+    ``name``)."""
+    return offset_configuration(robot, start_configuration(robot, trajectory), offset, name=name)
 
 
-def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
+def offset_configuration(
+    robot: Robot, q: np.ndarray, offset, *, name: str = "initial_offset"
+) -> np.ndarray:
     """``q`` with the arm joints changed so the end effector moves by ``offset`` (dx, dy) m.
 
     The offset is in the end effector's frame at ``q``: dx along its orientation phiE, dy
@@ -66,10 +85,31 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
     whichever is larger (float spacing grows with the coordinates). Newton may land a
     joint whole turns away from its limits (th1 = -24.2 rad for an offset of 0.25 m):
     such a joint is turned back by whole turns into its ``joint_limits`` where that fits
-    (the same arm pose). An offset the arm cannot reach raises :class:`ParameterError`.
+    (the same arm pose). An offset the arm cannot reach raises a one-line
+    :class:`ParameterError` naming it ``name`` (as the caller's user gives it: the API's
+    ``initial_offset``, the command line's ``--offset``) and the largest offset along the
+    same direction that it reaches, rounded down (:func:`reachable_offset`).
     """
     q = np.array(q, dtype=float)
     dx, dy = (float(v) for v in offset)
+    placed = _placed(robot, q, (dx, dy))
+    if placed is not None:
+        return placed
+    fit_x, fit_y = reachable_offset(robot, q, (dx, dy))
+    raise ParameterError(
+        f"{name} ({dx:g}, {dy:g}) m (end-effector frame) cannot be reached with the arm "
+        f"alone; along that direction it reaches ({fit_x:g}, {fit_y:g}) m"
+    )
+
+
+def _placed(robot: Robot, start: np.ndarray, offset: tuple[float, float]) -> np.ndarray | None:
+    """:func:`offset_configuration`'s result, or None for an offset out of the arm's reach.
+
+    Newton iterations from ``start``; where they fail (an iterate near a singular arm pose,
+    or bouncing near the edge of the reach) the closed-form pose
+    (:func:`_placed_in_closed_form`) is taken instead."""
+    q = start.copy()
+    dx, dy = offset
     x_e, y_e, phi_e = robot.fk(q)
     c, s = math.cos(phi_e), math.sin(phi_e)
     target = np.array([x_e + c * dx - s * dy, y_e + s * dx + c * dy])
@@ -82,10 +122,62 @@ def offset_configuration(robot: Robot, q: np.ndarray, offset) -> np.ndarray:
         if abs(np.linalg.det(arm_jacobian)) < 1e-9:
             break
         q[3:5] += np.linalg.solve(arm_jacobian, error)
-    raise ParameterError(
-        f"initial_offset ({dx:g}, {dy:g}) m (end-effector frame) cannot be reached with the "
-        "arm alone"
-    )
+    return _placed_in_closed_form(robot, start, target, tolerance)
+
+
+def _placed_in_closed_form(
+    robot: Robot, start: np.ndarray, target: np.ndarray, tolerance: float
+) -> np.ndarray | None:
+    """``start`` with the arm joints of :meth:`Robot.arm_ik` (on the start pose's elbow
+    branch) that put the end effector at the world ``target`` (m) to within ``tolerance``
+    (m), turned into the joint limits where that fits; None if it is out of reach."""
+    x, y, phi = (float(v) for v in start[:3])
+    c, s = math.cos(phi), math.sin(phi)
+    dx, dy = float(target[0]) - x, float(target[1]) - y
+    solution = robot.arm_ik(c * dx + s * dy, -s * dx + c * dy, 1 if start[4] >= 0.0 else -1)
+    if solution is None:
+        return None
+    q = start.copy()
+    q[3:5] = solution
+    if not float(np.hypot(*(target - robot.fk(q)[:2]))) < tolerance:
+        return None
+    return _turned_into_limits(robot, q)
+
+
+#: Points along the offset's direction :func:`reachable_offset` tries before it bisects
+#: (so it finds the first point the arm cannot reach, not a later boundary of its annulus).
+REACH_SCAN_POINTS = 32
+
+
+def reachable_offset(
+    robot: Robot, q: np.ndarray, offset: tuple[float, float]
+) -> tuple[float, float]:
+    """The largest multiple ``k offset`` (0 <= k <= 1; dx, dy in m, end-effector frame at
+    ``q``) up to which the arm places the end effector within its joint limits, rounded
+    down to two significant digits of its larger component: a value to suggest in place
+    of an offset it cannot reach. ``(0, 0)`` if none but the start is reached."""
+
+    def fits(k: float) -> bool:
+        placed = _placed(robot, q, (k * offset[0], k * offset[1]))
+        return placed is not None and robot.joints_outside(placed) is None
+
+    low, high = 0.0, 1.0
+    for k in np.linspace(0.0, 1.0, REACH_SCAN_POINTS + 1)[1:]:
+        if not fits(float(k)):
+            high = float(k)
+            break
+        low = float(k)
+    else:
+        return offset
+    for _ in range(40):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if fits(middle) else (low, middle)
+    largest = low * max(abs(offset[0]), abs(offset[1]))
+    if largest <= 0.0:
+        return (0.0, 0.0)
+    quantum = 10.0 ** (math.floor(math.log10(largest)) - 1)
+    k = math.floor(largest / quantum) * quantum / max(abs(offset[0]), abs(offset[1]))
+    return (k * offset[0], k * offset[1])
 
 
 def _offset_tolerance(target: np.ndarray) -> float:

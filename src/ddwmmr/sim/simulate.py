@@ -38,10 +38,7 @@ from ddwmmr.plants import available_plants, make_plant, plant_class
 from ddwmmr.plants.base import Plant, PlantImplementation
 from ddwmmr.registry import CONTROLLERS
 from ddwmmr.resolution.kernels import length_unit
-from ddwmmr.resolution.reference import (
-    DEFAULT_INITIAL_OFFSET,
-    initial_configuration,
-)
+from ddwmmr.resolution.reference import default_offset, initial_configuration
 from ddwmmr.sim.loop import run_loop, spoken_interface
 from ddwmmr.sim.result import SimulationResult
 from ddwmmr.sim.tracking import COLUMNS, TrackingTask, checked_trajectory
@@ -215,7 +212,7 @@ def simulate(
     dt: float | None = None,
     duration: float | None = None,
     integrator: str | None = None,
-    initial_offset: Sequence[float] = DEFAULT_INITIAL_OFFSET,
+    initial_offset: Sequence[float] | None = None,
     q0: npt.ArrayLike | None = None,
     plant: str | PlantImplementation = "kinematic",
     plant_options: dict[str, Any] | None = None,
@@ -246,9 +243,10 @@ def simulate(
         initial_offset: end-effector offset (dx, dy) in m in the end effector's start frame
             (dx along the desired start orientation phiE_d(0), dy to its left), applied
             with the arm joints to the start configuration, so closed-loop convergence
-            shows. Default (-0.03, -0.03): 30 mm behind and 30 mm to the right (on the
-            default ellipse the world offset (0.03, -0.03)). ``(0, 0)`` starts on the
-            trajectory.
+            shows. None (default): the robot's own (:func:`default_offset`), 0.03 of its
+            length unit ``L1 / 0.35 m`` behind and as much to the right: (-0.03, -0.03) m
+            for the default robot (on the default ellipse the world offset (0.03, -0.03)
+            m). ``(0, 0)`` starts on the trajectory.
         q0: explicit start configuration (overrides the construction above). Either
             start must hold the arm joints within the robot's ``joint_limits``
             (:class:`ParameterError` otherwise).
@@ -299,6 +297,8 @@ def simulate(
     corners = getattr(trajectory, "corner_windows", None)
     windows = corners(duration) if corners is not None else ()
     if q0 is None:
+        if initial_offset is None:
+            initial_offset = default_offset(robot)
         if isinstance(initial_offset, str) or not hasattr(initial_offset, "__len__"):
             raise ParameterError(
                 f"initial_offset must be two numbers dx, dy in m (got {shown(initial_offset)})"

@@ -27,7 +27,8 @@ TIE_ABSOLUTE_M = 1e-4
 TAUS = (0.1, 0.3, 1.0, 3.0)
 #: Steps (s) of the step-size sweep.
 STEP_SIZES = (0.01, 0.02, 0.04, 0.08, 0.16)
-#: Initial offsets of the offset sweep, as multiples of the default offset (3 cm, -3 cm).
+#: Initial offsets of the offset sweep, as multiples of the robot's default offset
+#: (:func:`ddwmmr.resolution.reference.default_offset`).
 OFFSET_SCALES = (0.0, 0.5, 1.0, 2.0, 4.0)
 #: Converged = the position error stays below this fraction of its initial value.
 CONVERGED_FRACTION = 0.05

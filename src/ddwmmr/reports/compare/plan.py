@@ -36,7 +36,7 @@ from ddwmmr.reports.compare.constants import (
     VARIANTS,
 )
 from ddwmmr.resolution.reference import (
-    DEFAULT_INITIAL_OFFSET,
+    default_offset,
     offset_configuration,
     start_configuration,
 )
@@ -164,13 +164,16 @@ def in_studies(method: str) -> bool:
 
 @dataclass(frozen=True)
 class RunSpec:
-    """One simulation: method (+ options) on a trajectory with a step, integrator, offset."""
+    """One simulation: method (+ options) on a trajectory with a step, integrator, offset
+    (dx, dy) in m in the end effector's start frame (None: the robot's default,
+    :func:`~ddwmmr.resolution.reference.default_offset`; :func:`main_spec` writes it out,
+    so equal runs have equal specs)."""
 
     method: str
     trajectory: str
     dt: float
     integrator: str | None = "rk4"
-    initial_offset: tuple[float, float] = DEFAULT_INITIAL_OFFSET
+    initial_offset: tuple[float, float] | None = None
     options: tuple[tuple[str, Any], ...] = ()
     #: The plant (``integrator`` is the kinematic plant's; None on the others).
     plant: str = "kinematic"
@@ -249,12 +252,18 @@ def main_spec(
     """The comparison's standard run of ``method`` on ``name`` with ``changes`` applied.
 
     ``preset`` defaults to the config's; the config's ``options`` of the method override
-    its values, and ``options`` in ``changes`` override both.
+    its values, and ``options`` in ``changes`` override both. The run starts at the
+    robot's default offset (:func:`~ddwmmr.resolution.reference.default_offset`) unless
+    ``changes`` give ``initial_offset``.
     """
     options = dict(preset_changes(method, config.preset if preset is None else preset))
     options.update(config.options.get(method, {}))
     options.update(changes.pop("options", ()))
-    spec = {"dt": default_step(config.trajectories[name]), **changes}
+    spec = {
+        "dt": default_step(config.trajectories[name]),
+        "initial_offset": default_offset(config.robot),
+        **changes,
+    }
     return RunSpec(method, name, options=tuple(options.items()), **spec)
 
 
@@ -394,9 +403,10 @@ def _plan_integrator(config: CompareConfig) -> list[RunSpec]:
 
 
 def study_offsets(config: CompareConfig) -> list[tuple[float, float]]:
-    """Initial offsets (dx, dy) in m of the offset sweep that the robot's arm can reach
-    from the start configuration (a small arm cannot take the largest ones)."""
-    dx, dy = DEFAULT_INITIAL_OFFSET
+    """Initial offsets (dx, dy) in m of the offset sweep, multiples of the robot's default
+    (:func:`~ddwmmr.resolution.reference.default_offset`), that its arm can reach from the
+    start configuration (an arm of other proportions may not take the largest ones)."""
+    dx, dy = default_offset(config.robot)
     start = start_configuration(config.robot, config.trajectories[STUDY_TRAJECTORY])
     offsets = []
     for scale in OFFSET_SCALES:

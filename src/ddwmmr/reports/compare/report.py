@@ -69,7 +69,7 @@ from ddwmmr.reports.compare.ranking import (
     plant_metrics_rows,
 )
 from ddwmmr.reports.plots import circles_of
-from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET
+from ddwmmr.resolution.reference import default_offset
 from ddwmmr.sim.simulate import FINAL_WINDOW_FRACTION, RATE_LIMIT_TOLERANCE
 from ddwmmr.sim.verdict import explain, support_warning
 
@@ -191,7 +191,7 @@ def _setup_section(c: _Context) -> None:
         f"{config.shown(n)}: dt = {default_step(t):g} s, duration = {run_duration(config, n):g} s"
         for n, t in config.trajectories.items()
     )
-    dx, dy = DEFAULT_INITIAL_OFFSET
+    dx, dy = default_offset(robot)
     items = [
         f"settings: preset `{config.preset}` (the report also ranks the methods under "
         f"`{config.other_preset}`, see below)",
@@ -200,7 +200,8 @@ def _setup_section(c: _Context) -> None:
         f"{robot.joint_speed_limit:g} rad/s{_other_fields(robot)}",
         f"integrator: rk4; {steps}",
         f"initial end-effector offset: ({dx:g} m, {dy:g} m) in the end effector's start "
-        f"frame (x along its start orientation), i.e. {1000 * math.hypot(dx, dy):.1f} mm",
+        f"frame (x along its start orientation), i.e. {1000 * math.hypot(dx, dy):.1f} mm: "
+        "the robot's default, in its length unit L1/0.35 m",
         "methods: "
         + "; ".join(f"`{m}`: {method_description(m).rstrip('.')}" for m in config.methods),
         f"runs: {len(c.plan.all_specs())} simulations "
@@ -598,7 +599,7 @@ def _trajectory_section(c: _Context, name: str) -> None:
     trajectory = c.config.trajectories[name]
     quarter = getattr(trajectory, "T", trajectory.duration) / 4.0
     obstacles = run_obstacles(c.config)
-    offset = math.hypot(*DEFAULT_INITIAL_OFFSET)
+    offset = math.hypot(*default_offset(c.config.robot))
     zooms: list[tuple[str, float, float | None]] = [("A", 0.0, 3.0 * offset)]
     if quarter < run_duration(c.config, name):
         zooms.append(("B", quarter, None))
