@@ -39,3 +39,20 @@ TWENTIETH = Robot(
     wheel_torque_limit=1.25e-05,
     joint_torque_limits=(0.000125, 6.25e-05),
 )
+
+
+def scaled_options(options: dict, factor: float, metre_options: tuple[str, ...]) -> dict:
+    """A controller's ``options`` for the robot scaled by ``factor``: the options named in
+    ``metre_options`` (m, m/s), the obstacles' ``(x, y, r)`` and ``speed_budget``'s linear
+    speed scaled; every other option as given."""
+    scaled = {
+        key: value * factor if key in metre_options else value for key, value in options.items()
+    }
+    if "obstacles" in options:
+        scaled["obstacles"] = [
+            (factor * x, factor * y, factor * r) for x, y, r in options["obstacles"]
+        ]
+    if "speed_budget" in options:
+        v_top, w_top = options["speed_budget"]
+        scaled["speed_budget"] = (factor * v_top, w_top)
+    return scaled

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from ddwmmr import Ellipse, Robot, make_controller, simulate
-from scaled_robots import TEN_TIMES, TWENTIETH
+from scaled_robots import TEN_TIMES, TWENTIETH, scaled_options
 from test_damping_invariance import scaled_robot
 
 ELLIPSE = Ellipse()
@@ -28,18 +28,6 @@ OFFSET = -0.03
 DURATION = 3.0
 #: Options in m or m/s, scaled with the robot below.
 METRE_OPTIONS = ("obstacle_margin", "reach_speed", "huber")
-
-
-def scaled_options(options: dict, factor: float) -> dict:
-    """``options`` for the robot scaled by ``factor``: obstacles and metre options."""
-    scaled = {
-        key: value * factor if key in METRE_OPTIONS else value for key, value in options.items()
-    }
-    if "obstacles" in options:
-        scaled["obstacles"] = [
-            (factor * x, factor * y, factor * r) for x, y, r in options["obstacles"]
-        ]
-    return scaled
 
 
 def errors(robot: Robot, factor: float, **options) -> np.ndarray:
@@ -54,7 +42,7 @@ def errors(robot: Robot, factor: float, **options) -> np.ndarray:
             "mpc",
             duration=DURATION,
             initial_offset=(factor * OFFSET, factor * OFFSET),
-            **scaled_options(options, factor),
+            **scaled_options(options, factor, METRE_OPTIONS),
         )
     series = result.timeseries
     return np.array(
@@ -119,7 +107,9 @@ def solver_calls(factor: float, options: dict, steps: int = 4) -> tuple[list, li
     commands sent."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        controller = make_controller("mpc", scaled_robot(factor), **scaled_options(options, factor))
+        controller = make_controller(
+            "mpc", scaled_robot(factor), **scaled_options(options, factor, METRE_OPTIONS)
+        )
     q, target = np.array(START), np.array(WAYPOINT)
     q[:2] *= factor
     target[:2] *= factor

@@ -22,7 +22,7 @@ from ddwmmr.commands import PlantTraits
 from ddwmmr.qp import QPProblem
 from ddwmmr.qp.limits import Limit
 from ddwmmr.qp.limits.base import INF
-from scaled_robots import TEN_TIMES, TWENTIETH
+from scaled_robots import TEN_TIMES, TWENTIETH, scaled_options
 from test_damping_invariance import scaled_robot
 
 ELLIPSE = Ellipse()
@@ -33,21 +33,6 @@ POST = (-0.2, 1.05, 0.3)
 #: Options in m or m/s, scaled with the robot below (``obstacle_margin``: the default).
 METRE_OPTIONS = ("obstacle_margin", "max_speed", "max_base_speed", "max_acceleration")
 ARRAYS = ("H", "f", "C", "lower", "upper")
-
-
-def scaled_options(options: dict, factor: float) -> dict:
-    """``options`` for the robot scaled by ``factor``: obstacles, metre options, v_top."""
-    scaled = {
-        key: value * factor if key in METRE_OPTIONS else value for key, value in options.items()
-    }
-    if "obstacles" in options:
-        scaled["obstacles"] = [
-            (factor * x, factor * y, factor * r) for x, y, r in options["obstacles"]
-        ]
-    if "speed_budget" in options:
-        v_top, w_top = options["speed_budget"]
-        scaled["speed_budget"] = (factor * v_top, w_top)
-    return scaled
 
 
 def run(robot: Robot, factor: float, dt: float | None = None, **options):
@@ -62,7 +47,7 @@ def run(robot: Robot, factor: float, dt: float | None = None, **options):
             "qp",
             initial_offset=(factor * OFFSET, factor * OFFSET),
             **step,
-            **scaled_options(options, factor),
+            **scaled_options(options, factor, METRE_OPTIONS),
         )
 
 
@@ -153,7 +138,9 @@ def built(factor: float, options: dict, compiled: bool = True) -> tuple:
     ``STATE`` scaled by ``factor`` (after a first step, for the slew limits)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        controller = make_controller("qp", scaled_robot(factor), **scaled_options(options, factor))
+        controller = make_controller(
+            "qp", scaled_robot(factor), **scaled_options(options, factor, METRE_OPTIONS)
+        )
     q, pose, velocity = (np.array(values) for values in STATE)
     for values in (q, pose, velocity):
         values[:2] *= factor

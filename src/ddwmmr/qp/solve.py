@@ -20,6 +20,7 @@ import importlib.util
 import math
 import warnings
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -90,29 +91,15 @@ class DaqpBackend:
 
     def __call__(self, problem: QPProblem) -> np.ndarray | None:
         """Solve; None when DAQP reports anything but an optimum."""
-        sense = problem.sense.copy()  # DAQP may mark active rows in place
-        if self.warm_start and self._previous is not None:
-            x, _, flag, _ = self._solve(
-                problem.H,
-                problem.f,
-                problem.C,
-                problem.upper,
-                problem.lower,
-                sense,
-                primal_start=self._previous,
-            )
-        else:
-            x, _, flag, _ = self._solve(
-                problem.H, problem.f, problem.C, problem.upper, problem.lower, sense
-            )
-        if flag <= 0:
-            return None
-        self._previous = x
-        return x
+        return self._run(problem)
 
     def strict(self, problem: QPProblem) -> np.ndarray | None:
         """:meth:`__call__` with every bound and row met to :data:`STRICT_PRIMAL_TOL`."""
-        settings: dict = {"primal_tol": STRICT_PRIMAL_TOL}
+        return self._run(problem, primal_tol=STRICT_PRIMAL_TOL)
+
+    def _run(self, problem: QPProblem, **settings: Any) -> np.ndarray | None:
+        """One DAQP solve with ``settings`` (warm-started from the last answer when
+        ``warm_start``); None when DAQP reports anything but an optimum."""
         if self.warm_start and self._previous is not None:
             settings["primal_start"] = self._previous
         x, _, flag, _ = self._solve(
