@@ -138,3 +138,12 @@ def test_a_cold_start_takes_at_most_cold_iterations_qps_and_later_steps_one(cold
         controller.command(0.05 * k, q, np.array([*target, 0.0]), np.zeros(3))
         qps.append(controller.last.extra["mpc_iterations"])
     assert qps == [cold_iterations, 1, 1, 1, cold_iterations, 1, 1]
+
+
+def test_a_large_robots_planned_wheel_force_can_be_set():
+    """The planned force's range fits robots of any size (the motors bound it per plant):
+    the ten-times robot plans 1e4 N by default and may be given more."""
+    assert MPCOptions(model="thesis", wheel_force_limit=15000.0).wheel_force_limit == 15000.0
+    assert MPCOptions(model="thesis", wheel_force_limit=0.001).wheel_force_limit == 0.001
+    with pytest.raises(ParameterError, match=r"wheel_force_limit must be in \[1e-06, 1e\+07\]"):
+        MPCOptions(model="thesis", wheel_force_limit=1e8)

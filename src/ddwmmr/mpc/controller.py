@@ -92,6 +92,12 @@ from ddwmmr.qp.limits import run_clearance, safe_arm_scale
 from ddwmmr.qp.limits.obstacles import Circle
 from ddwmmr.resolution.kernels import length_unit
 
+#: Share of the planned wheel force (``mpc_wheel_force_limit_n``) at or above which a
+#: wheel's measured force counts as held at it (``mpc_wheel_force_bound_time_s``): the
+#: solver meets its bound to within its tolerance, as the MuJoCo plant's motors count as
+#: saturated from 0.999 of their torque.
+FORCE_BOUND_SHARE = 0.999
+
 
 @register_controller("mpc", tasks=("tracking", "waypoints"), interfaces=("velocity", "force"))
 class MPCController:
@@ -550,10 +556,33 @@ class MPCController:
             "mpc_arm_time_constant_s": self.arm_time_constant,
             "mpc_joint_acceleration_limit_rad_s2": self.joint_acceleration_limit,
             "mpc_wheel_force_limit_n": None if self.dynamics is None else self.dynamics.force_limit,
+            "mpc_wheel_force_bound_time_s": self._force_bound_time(timeseries),
             "mpc_solver": solver if solver != "rti" else f"rti-{self.options.qp_solver}",
             "mpc_horizon_s": self.options.grid(mode)[2],
             "mpc_options": self.resolved.record(mode, self.dt, self.unit, self.length_unit),
         }
+
+    def _force_bound_time(self, timeseries: dict[str, np.ndarray]) -> float | None:
+        """Time (s) with a wheel's measured force at the force the model plans with
+        (``mpc_wheel_force_limit_n``, to :data:`FORCE_BOUND_SHARE`), from the plant's wheel
+        forces: the thesis plant's ``force_left_n``/``force_right_n`` (N), MuJoCo's
+        ``wheel_torque_use`` (share of the motors' torque) x ``motor_force_limit`` (N). None
+        without the force model or a plant recording wheel forces. The plant's own limit
+        may be this bound too (the thesis plant's, by default)."""
+        if self.dynamics is None:
+            return None
+        if "force_left_n" in timeseries and "force_right_n" in timeseries:
+            left = np.abs(np.asarray(timeseries["force_left_n"], dtype=float))
+            force = np.maximum(left, np.abs(np.asarray(timeseries["force_right_n"], dtype=float)))
+        elif "wheel_torque_use" in timeseries:
+            use = np.asarray(timeseries["wheel_torque_use"], dtype=float)
+            force = use * self.robot.motor_force_limit
+        else:
+            return None
+        t = np.asarray(timeseries["t"], dtype=float)
+        interval = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+        at_bound = force >= FORCE_BOUND_SHARE * self.dynamics.force_limit
+        return float(np.sum(at_bound) * interval)
 
     # -- the scenario protocol's waypoint task -------------------------------------------
     @classmethod

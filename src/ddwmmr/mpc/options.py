@@ -306,7 +306,7 @@ class MPCOptions:
         self._set("arm_time_constant", None if lag is None else float(lag))
         self._set("joint_acceleration_limit", _acceleration_option(self.joint_acceleration_limit))
         if self.wheel_force_limit is not None:
-            force = check_range("wheel_force_limit", self.wheel_force_limit, 0.1, 1e4, "N")
+            force = check_range("wheel_force_limit", self.wheel_force_limit, 1e-6, 1e7, "N")
             self._set("wheel_force_limit", force)
             if model == "kinematic":
                 raise ParameterError("wheel_force_limit needs model='thesis'")

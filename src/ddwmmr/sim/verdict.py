@@ -62,7 +62,9 @@ most of the run with more steps at a joint's position limit (``joint_limit_steps
 at a rate limit names that joint limit instead. A run that held a rate limit for more than
 :data:`HELD_CAUSE` of the run (a wheel at its speed limit: ``wheel_limit_steps``; a joint
 at its rate limit: ``joint_rate_limit_steps``; an actuator at its limit on a plant with
-dynamics: ``actuator_saturated_time_s``), with no other cause in sight, names that limit,
+dynamics: ``actuator_saturated_time_s``, for more than :data:`HELD_MIN_STEPS` steps too; a
+force-level ``mpc`` at the wheel force it plans with: ``mpc_wheel_force_bound_time_s``, beyond
+the wheels' time at the plant's limit), with no other cause in sight, names that limit,
 and says whether the plant's clipping (``saturated_steps``) counted it. A run that failed
 on its RMS error alone (its final error within the limit) converged: if the error rose
 above its start offset (``max_position_error_m``) while a limit was held, the transient (at the
@@ -109,6 +111,7 @@ __all__ = [
     "FLAG_KEYS",
     "FORCE_LIMIT_CAUSE",
     "HELD_CAUSE",
+    "HELD_MIN_STEPS",
     "LENGTH_UNIT_RANGE_M",
     "MOST_OF_RUN",
     "NON_NEGATIVE_KEYS",
@@ -168,6 +171,10 @@ LENGTH_UNIT_RANGE_M = tuple(length_unit(length) for length in LENGTH_RANGE_M)
 #: ``steps``, ``actuator_saturated_time_s`` of ``duration``) is named as the likely cause
 #: of a failure nothing else explains.
 HELD_CAUSE = 0.005
+#: ... and an actuator's (``actuator_saturated_time_s``) for more steps of ``dt`` than this: the
+#: default robot's MuJoCo runs hold a motor at its torque limit for 3 or 4 steps as they
+#: start from rest, a hold that explains no error (docs/cli.md, "Verdict").
+HELD_MIN_STEPS = 5
 #: Relative slack on "the error never rose above its start" (``max_position_error_m`` <=
 #: ``initial_offset_m`` x (1 + this)): the two are computed apart and may differ in their
 #: last digits.
@@ -245,11 +252,16 @@ START_TRANSIENT = (
     "{duration}run and counts in its RMS: a longer run or a smaller start offset "
     """(track's --duration and --offset; see docs/cli.md, "Verdict")"""
 )
-NO_CONVERGENCE = (
+#: :data:`NO_CONVERGENCE` with what to check of the run's own settings in ``{checks}``.
+NO_CONVERGENCE_CHECKS = (
     "the error did not converge: an open-loop method (pi, ats, ap) never removes it; for "
-    "a closed-loop one check tau, dt and the integrator "
+    "a closed-loop one check {checks} "
     '(see docs/comparing.md, "Studies")'
 )
+NO_CONVERGENCE = NO_CONVERGENCE_CHECKS.format(checks="tau, dt and the integrator")
+#: What :data:`NO_CONVERGENCE_CHECKS` asks to check in place of ``tau`` for a method without
+#: one (its tracking gains' options); ``tau`` for every other method.
+GAINS_OF = {"mpc": "position_weight, horizon"}
 OBSTACLE_DETOUR = (
     "the base went round an obstacle on or near the path (closest footprint clearance "
     "{clearance_mm:.3g} mm, under the {near_mm:.0f} mm within which the qp steers round "
@@ -320,6 +332,13 @@ JOINT_LIMIT = (
     "plant stops the joint and the end effector cannot reach the poses the trajectory asks "
     "for ({clipping}): a trajectory the arm reaches within its joint_limits, or wider "
     'joint_limits (see docs/cli.md, "Verdict")'
+)
+#: How :data:`HELD_LIMIT` names a force-level ``mpc`` held at the wheel force it plans with
+#: (``mpc_wheel_force_bound_time_s``; its own bound, below the plant's motors).
+PLANNED_FORCE_HELD = (
+    "a wheel at the force the mpc plans with (mpc_wheel_force_limit_n {force:.6g} N, its own "
+    "bound below the motors; --option wheel_force_limit=N raises it, never above the "
+    "motors' wheel_torque_limit / wheel_radius) for {held_s:.3g} of {duration:.3g} s"
 )
 #: How :data:`HELD_LIMIT` names ``actuator_saturated_time_s``, by the summary's ``plant``.
 ACTUATOR_LIMITS = {"thesis": "a wheel at its force limit", "mujoco": "a motor at its torque limit"}
@@ -418,6 +437,8 @@ NUMBER_KEYS = (
     "min_stability",
     "actuator_saturated_time_s",
     "wheel_saturated_time_s",
+    "mpc_wheel_force_bound_time_s",
+    "mpc_wheel_force_limit_n",
     "duration",
     "trajectory_extent_m",
     "initial_offset_m",
@@ -458,6 +479,7 @@ NON_NEGATIVE_KEYS = {
     "duration": "s",
     "actuator_saturated_time_s": "s",
     "wheel_saturated_time_s": "s",
+    "mpc_wheel_force_bound_time_s": "s",
     "unloaded_time_s": "s",
     "trajectory_extent_m": "m",
     "initial_offset_m": "m",
@@ -749,10 +771,42 @@ def _force_limited(summary: Mapping[str, Any]) -> bool:
     ``actuator_saturated_time_s`` on any plant but MuJoCo (the thesis plant's counts its
     wheels only); a MuJoCo summary without the wheels' time never is."""
     duration = _number(summary, "duration") or 0.0
+    at_limit = max(_wheel_limit_time(summary), _planned_force_time(summary))
+    return duration > 0.0 and at_limit > FORCE_LIMIT_CAUSE * duration
+
+
+def _wheel_limit_time(summary: Mapping[str, Any]) -> float:
+    """Time (s) with a wheel at the plant's force or torque limit: ``wheel_saturated_time_s``
+    where the plant records it, else ``actuator_saturated_time_s`` on any plant but MuJoCo
+    (whose counts the arm's motors too); 0 where neither applies."""
     at_limit = _number(summary, "wheel_saturated_time_s")
     if at_limit is None and summary.get("plant") != "mujoco":
         at_limit = _number(summary, "actuator_saturated_time_s")
-    return duration > 0.0 and (at_limit or 0.0) > FORCE_LIMIT_CAUSE * duration
+    return at_limit or 0.0
+
+
+def _planned_force_time(summary: Mapping[str, Any]) -> float:
+    """Time (s) a force-level ``mpc`` held a wheel at the force it plans with
+    (``mpc_wheel_force_bound_time_s``) where that is its own bound: held longer than the
+    wheels were at the plant's limit (:func:`_wheel_limit_time`) by a hold that counts
+    (:func:`_counts_as_held`); 0 otherwise (the thesis plant's limit is the mpc's bound
+    by default, and is named as the plant's)."""
+    planned = _number(summary, "mpc_wheel_force_bound_time_s") or 0.0
+    if _counts_as_held(summary, planned - _wheel_limit_time(summary), time=True):
+        return planned
+    return 0.0
+
+
+def _counts_as_held(summary: Mapping[str, Any], amount: float, time: bool = False) -> bool:
+    """A limit held for ``amount`` (steps; seconds where ``time``) counts: more than
+    :data:`HELD_CAUSE` of the run (``steps``; ``duration`` where ``time``), and a time at
+    an actuator's limit also for more than :data:`HELD_MIN_STEPS` steps of ``dt`` (where
+    the summary records it): the start from rest holds the motors for a few steps."""
+    whole = _number(summary, "duration" if time else "steps") or 0.0
+    if not (whole > 0.0 and amount > HELD_CAUSE * whole):
+        return False
+    dt = _number(summary, "dt") if time else None
+    return dt is None or not dt > 0.0 or amount / dt > HELD_MIN_STEPS * (1.0 + 1e-9)
 
 
 def _held_or_converging_cause(summary: Mapping[str, Any], found: list[str]) -> str:
@@ -770,7 +824,17 @@ def _held_or_converging_cause(summary: Mapping[str, Any], found: list[str]) -> s
         )
     if _joint_limit_phrase(summary):
         return _joint(summary)
-    return NO_CONVERGENCE
+    return NO_CONVERGENCE_CHECKS.format(checks=_convergence_checks(summary))
+
+
+def _convergence_checks(summary: Mapping[str, Any]) -> str:
+    """What :data:`NO_CONVERGENCE_CHECKS` asks to check, of what the run had: ``tau``, or
+    the gains of a method without it (:data:`GAINS_OF`), ``dt``, and ``the integrator``
+    unless the summary records the plant's as None (a plant without one: thesis, MuJoCo)."""
+    checks = [GAINS_OF.get(str(summary.get("method")), "tau"), "dt"]
+    if not ("integrator" in summary and summary["integrator"] is None):
+        checks.append("the integrator")
+    return ", ".join(checks[:-1]) + " and " + checks[-1]
 
 
 def _held_cause(summary: Mapping[str, Any], found: list[str], after: str = "") -> str | None:
@@ -955,15 +1019,19 @@ def held_limits(summary: Mapping[str, Any]) -> list[str]:
     held = []
     steps = _number(summary, "steps") or 0
     at_wheel_limit = _number(summary, "wheel_limit_steps") or 0
-    if steps and at_wheel_limit > HELD_CAUSE * steps:
+    if _counts_as_held(summary, at_wheel_limit):
         held.append(f"a wheel at its speed limit on {int(at_wheel_limit)} of {int(steps)} steps")
     duration = _number(summary, "duration") or 0.0
     at_actuator_limit = _number(summary, "actuator_saturated_time_s") or 0.0
-    if duration > 0.0 and at_actuator_limit > HELD_CAUSE * duration:
+    if _counts_as_held(summary, at_actuator_limit, time=True):
         what = ACTUATOR_LIMITS.get(str(summary.get("plant")), "an actuator at its limit")
         held.append(f"{what} for {at_actuator_limit:.3g} of {duration:.3g} s")
+    planned = _planned_force_time(summary)
+    if planned:
+        force = _number(summary, "mpc_wheel_force_limit_n") or 0.0
+        held.append(PLANNED_FORCE_HELD.format(force=force, held_s=planned, duration=duration))
     at_rate_limit = _number(summary, "joint_rate_limit_steps") or 0
-    if steps and at_rate_limit > HELD_CAUSE * steps:
+    if _counts_as_held(summary, at_rate_limit):
         held.append(f"a joint at its rate limit on {int(at_rate_limit)} of {int(steps)} steps")
     return held
 
