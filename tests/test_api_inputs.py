@@ -124,7 +124,6 @@ class _NoSamples(Ellipse):
     [
         (lambda: simulate(Robot(), Ellipse(), "ats", q0="abcde"), "q0 must be 5 finite numbers"),
         (lambda: simulate(Robot(), Ellipse(), "ats", initial_offset=5.0), "initial_offset"),
-        (lambda: simulate(Robot(), Ellipse(), "ats", initial_offset=None), "initial_offset"),
         (lambda: simulate(Robot(), Ellipse(), "ats", plant=3), "plant must be a plant name"),
         (lambda: simulate(Robot(), Ellipse(), "ats", plant=None), "plant must be a plant name"),
         (lambda: simulate(Robot(), Ellipse(), "ats", progress="x"), "progress must be a callable"),

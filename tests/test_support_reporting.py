@@ -21,13 +21,21 @@ from ddwmmr.sim.verdict import TRACKED, short_verdict, support_warning, verdict
 LONG_ARM = {"L1": 0.7, "L2": 0.6}
 #: Short enough for a test; the edge is unloaded for 0.08 s within the first 2 s.
 DURATION = 2.0
+#: The start offset of these runs (m): half the long-arm robot's own default.
+OFFSET = (-0.03, -0.03)
 
 
 def _run(duration: float = DURATION, **options: float) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         result = simulate(
-            Robot(**LONG_ARM), Ellipse(), "qp", plant="mujoco", duration=duration, **options
+            Robot(**LONG_ARM),
+            Ellipse(),
+            "qp",
+            plant="mujoco",
+            duration=duration,
+            initial_offset=OFFSET,
+            **options,
         )
     return result.summary
 
@@ -113,13 +121,14 @@ def test_compare_writes_the_plant_runs_and_their_support(tmp_path) -> None:
         (row,) = list(csv.DictReader(handle))
     assert list(row)[:3] == ["method", "trajectory", "plant"]
     assert (row["method"], row["plant"], row["support_lost"]) == ("qp", "mujoco", "True")
-    assert float(row["unloaded_time_s"]) == pytest.approx(0.08, abs=1e-9)
+    # compare starts at the robot's own default offset, twice these runs' OFFSET
+    assert float(row["unloaded_time_s"]) == pytest.approx(0.12, abs=1e-9)
     text = (tmp_path / "report.md").read_text()
     header = next(line for line in text.splitlines() if "| RMS mujoco (mm) |" in line)
     assert "| edge unloaded (s) | min predicted edge load / floor (N) |" in header
     row_line = next(line for line in text.splitlines() if line.startswith("| ellipse | qp |"))
     cells = [c.strip() for c in row_line.strip("|").split("|")]
-    assert cells[12:14] == ["0.0800", "6.49 / 13.0"]
+    assert cells[12:14] == ["0.120", "8.94 / 13.0"]
     assert "Lost support on the mujoco plant, tracked or not (1 of 1 runs" in text
     kinematic = CompareConfig(
         methods=("ats",), trajectories={"ellipse": Ellipse()}, duration=1.0, studies=()
