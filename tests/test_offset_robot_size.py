@@ -22,7 +22,11 @@ import pytest
 from ddwmmr import Ellipse, ParameterError, Robot, simulate
 from ddwmmr.cli.compare import main as compare
 from ddwmmr.cli.track import main as track
-from ddwmmr.resolution.reference import DEFAULT_INITIAL_OFFSET, default_offset
+from ddwmmr.resolution.reference import (
+    DEFAULT_INITIAL_OFFSET,
+    default_offset,
+    offset_configuration,
+)
 from scaled_robots import TWENTIETH
 from test_damping_invariance import scaled_robot
 
@@ -154,3 +158,24 @@ def test_track_help_states_the_default_in_the_robots_length_unit(capsys):
     text = " ".join(capsys.readouterr().out.split())
     default = "(default -0.03 -0.03 times the robot's length unit L1/0.35 m: -0.03 -0.03 for"
     assert f"{default} the default robot)" in text
+
+
+def test_every_offset_keeps_the_start_poses_elbow_branch():
+    """Newton converged on the other elbow for some reachable offsets (-0.64, -0.39 m put
+    th2 at -0.87 rad between two rows at +0.79 and +1.07): a placement keeps the start's
+    branch, also for a start elbow angle given past a full turn."""
+    robot = Robot()
+    start = np.array([0.0, 0.0, 0.0, *robot.home_pose])
+    for dy in np.linspace(-0.45, -0.3, 16):
+        q = offset_configuration(robot, start, (-0.64, float(dy)))
+        assert math.sin(q[4]) > 0.0, dy
+    wrapped = Robot(
+        home_pose=(-0.3, 0.6 - 2.0 * math.pi), joint_limits=((-math.pi, math.pi), (-7.0, 7.0))
+    )
+    turned = offset_configuration(
+        wrapped, np.array([0.0, 0.0, 0.0, *wrapped.home_pose]), (-0.65, -0.41)
+    )
+    assert math.sin(turned[4]) > 0.0
+    assert np.allclose(
+        wrapped.fk(turned), robot.fk(offset_configuration(robot, start, (-0.65, -0.41)))
+    )

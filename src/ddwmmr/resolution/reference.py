@@ -106,8 +106,9 @@ def _placed(robot: Robot, start: np.ndarray, offset: tuple[float, float]) -> np.
     """:func:`offset_configuration`'s result, or None for an offset out of the arm's reach.
 
     Newton iterations from ``start``; where they fail (an iterate near a singular arm pose,
-    or bouncing near the edge of the reach) the closed-form pose
-    (:func:`_placed_in_closed_form`) is taken instead."""
+    or bouncing near the edge of the reach) or converge on the other elbow branch, the
+    closed-form pose on the start's branch (:func:`_placed_in_closed_form`) is taken
+    instead, so neighbouring offsets start on one branch."""
     q = start.copy()
     dx, dy = offset
     x_e, y_e, phi_e = robot.fk(q)
@@ -117,6 +118,8 @@ def _placed(robot: Robot, start: np.ndarray, offset: tuple[float, float]) -> np.
     for _ in range(50):
         error = target - robot.fk(q)[:2]
         if float(np.hypot(*error)) < tolerance:
+            if _elbow_branch(q[4]) != _elbow_branch(start[4]):
+                break
             return _turned_into_limits(robot, q)
         arm_jacobian = robot.jacobian(q)[:2, 3:5]
         if abs(np.linalg.det(arm_jacobian)) < 1e-9:
@@ -134,7 +137,7 @@ def _placed_in_closed_form(
     x, y, phi = (float(v) for v in start[:3])
     c, s = math.cos(phi), math.sin(phi)
     dx, dy = float(target[0]) - x, float(target[1]) - y
-    solution = robot.arm_ik(c * dx + s * dy, -s * dx + c * dy, 1 if start[4] >= 0.0 else -1)
+    solution = robot.arm_ik(c * dx + s * dy, -s * dx + c * dy, _elbow_branch(start[4]))
     if solution is None:
         return None
     q = start.copy()
@@ -142,6 +145,12 @@ def _placed_in_closed_form(
     if not float(np.hypot(*(target - robot.fk(q)[:2]))) < tolerance:
         return None
     return _turned_into_limits(robot, q)
+
+
+def _elbow_branch(th2: float) -> int:
+    """The elbow branch of the elbow angle ``th2`` (rad, any wrap): +1 where ``sin th2 >=
+    0``, else -1 (:meth:`Robot.arm_ik`'s ``elbow``)."""
+    return 1 if math.sin(float(th2)) >= 0.0 else -1
 
 
 #: Points along the offset's direction :func:`reachable_offset` tries before it bisects
