@@ -17,7 +17,10 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from ddwmmr import Ellipse, Robot, make_controller, simulate
+from ddwmmr import Ellipse, ParameterError, Robot, make_controller, simulate
+from ddwmmr.cli.track import main as track_main
+from ddwmmr.mpc.fallback import make_fallback
+from ddwmmr.mpc.min_time import Guess
 from scaled_robots import TEN_TIMES, TWENTIETH, scaled_options
 from test_damping_invariance import scaled_robot
 
@@ -162,3 +165,85 @@ def test_a_scaled_robots_summary_records_the_huber_scale_in_metres():
         controller = make_controller("mpc", scaled_robot(8.0))
     assert controller.resolved.record("reach", 0.02, controller.unit)["huber"] == 0.08
     assert controller.resolved.record("tracking", 0.02, controller.unit)["huber"] is None
+
+
+def _kinematic_plan(factor: float) -> Guess:
+    """A plan of two 1 s legs for the kinematic model (states ``x, y, theta, q1, q2``,
+    inputs ``v, omega, r1, r2``) from :data:`START`, its positions and ``v`` scaled by
+    ``factor`` (m, m/s)."""
+    times = np.linspace(0.0, 2.0, 21)
+    states = np.tile(np.array(START, dtype=float), (21, 1))
+    states[:, 0] += 0.2 * times
+    states[:, 1] += 0.3 * times
+    states[:, 2] += 0.1 * times
+    inputs = np.tile([0.36, 0.1, 0.0, 0.0], (20, 1))
+    states[:, :2] *= factor
+    inputs[:, 0] *= factor
+    return Guess(times, states, inputs, np.array([1.0, 2.0]))
+
+
+def plan_solver_calls(factor: float) -> list:
+    """The solver inputs and solutions of the first waypoint step of the mpc on the robot
+    scaled by ``factor``, on a two-waypoint route with a plan scaled alike (the plan's cold
+    start and its arrival term)."""
+    route = [(factor * x, factor * y) for x, y in ((0.5, 1.3), (0.7, 1.9))]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        controller = make_controller("mpc", scaled_robot(factor), route=route)
+    # the plan option takes the force model's plans only; the OCP's conversion is what is
+    # tested here, so the plan is handed over as loading would
+    controller._plan = _kinematic_plan(factor)
+    q = np.array(START)
+    q[:2] *= factor
+    controller.reset(None, q)
+    problem = controller._problem("reach")
+    assert problem.ocp.arrival_size > 0
+    problem.cold = problem.solver = recorder = _Recorder(problem.solver)
+    controller.command(0.0, q, np.array([*route[0], 0.0]), np.zeros(3))
+    return recorder.calls
+
+
+@pytest.mark.parametrize("factor", [0.5, 8.0])
+def test_a_plan_scaled_with_the_robot_gives_the_solver_the_default_robots_problem(factor):
+    """The plan's cold start and arrival state (in the parameter vector) in the robot's
+    unit: the default robot's to the bit."""
+    reference = plan_solver_calls(1.0)
+    calls = plan_solver_calls(factor)
+    assert len(calls) == len(reference) == 1
+    for value, wanted in zip(calls[0], reference[0]):
+        np.testing.assert_array_equal(value, wanted)
+
+
+@pytest.mark.parametrize("factor", [1.0, 8.0])
+def test_the_waypoint_fallbacks_speed_limit_is_one_length_unit_per_second(factor):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        robot = scaled_robot(factor)
+        controller = make_controller("mpc", robot)
+    qp = make_fallback(robot, controller.options, None, 0.02, None)
+    assert qp.tracking.max_speed == factor  # 1 m/s on the default robot
+
+
+def test_proportions_too_far_apart_for_the_mpcs_unit_name_the_robots_own_lengths(tmp_path, capsys):
+    """L1 0.1 mm and L2 0.3 m are both valid; in the unit L1 / 0.35 L2 is 1050 units."""
+    robot = Robot(L1=0.0001, L2=0.3)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(ParameterError) as error:
+            make_controller("mpc", robot)
+        make_controller("mpc", robot, model="thesis")  # plans in metres
+    message = str(error.value)
+    assert message.startswith("mpc: the kinematic model measures lengths in the robot's ")
+    assert "L2 = 0.3 m is 1050 length units of 0.000285714 m" in message
+    assert "(got 1050)" not in message and "\n" not in message
+    path = tmp_path / "robot.toml"
+    path.write_text("L1 = 0.0001\nL2 = 0.3\n")
+    out = tmp_path / "run"
+    argv = ["--robot", str(path), "--method", "mpc", "--traj", "ellipse", "--no-progress"]
+    argv += ["--out", str(out)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert track_main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: mpc: the kinematic model measures lengths in the robot's ")
+    assert err.count("\n") == 1 and "Traceback" not in err

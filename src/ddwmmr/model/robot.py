@@ -344,10 +344,21 @@ class Robot:
         """This robot with every length (m: the scalar lengths and ``caster_positions``)
         divided by ``unit`` (m, > 0), masses, inertias and limits kept: the robot as a
         computation measuring lengths in ``unit`` sees it (only the masses' ratios place
-        the centre of mass); this robot itself for a unit of 1.0."""
+        the centre of mass); this robot itself for a unit of 1.0. A length that leaves
+        ``LENGTH_RANGE_M`` once divided is a one-line :class:`ParameterError` naming it as
+        given (m), not its quotient: the lengths too far apart for one unit."""
         if unit == 1.0:
             return self
         lengths = {name: getattr(self, name) / unit for name in _LENGTHS}
+        low, high = LENGTH_RANGE_M
+        for name, scaled in lengths.items():
+            if not low <= scaled <= high:
+                raise ParameterError(
+                    f"robot: {name} = {getattr(self, name):g} m is {scaled:g} length units of "
+                    f"{unit:g} m; in that unit lengths must be in [{low:g}, {high:g}] (from "
+                    f"{low * unit:g} to {high * unit:g} m): the robot's lengths are too far "
+                    "apart in proportion"
+                )
         casters = self.caster_positions
         if casters is not None:
             casters = tuple((x / unit, y / unit) for x, y in casters)

@@ -191,7 +191,13 @@ class MPCController:
         )
         # the kinematic model plans in the robot's length unit (docs/mpc.md, "Robot size")
         self.unit = self.length_unit if model == "kinematic" else 1.0
-        self._unit_robot = self.robot.in_length_unit(self.unit)
+        try:
+            self._unit_robot = self.robot.in_length_unit(self.unit)
+        except ParameterError as exc:
+            raise ParameterError(
+                f"mpc: the kinematic model measures lengths in the robot's length unit "
+                f"(L1 / 0.35 m): {str(exc).removeprefix('robot: ')}"
+            ) from None
         self._unit_model = (
             self.model
             if self.unit == 1.0

@@ -1,10 +1,11 @@
 """The ``mpc``'s safe command when a solve fails: the ``qp`` controller's, for that step.
 
 The ``qp`` is built on the first failure of a run (with the run's control step) from the
-``mpc``'s own options (floor, obstacles, orientation tracking; in waypoint mode a 1 m/s
-speed limit; with the force model its velocity envelope), ``fallback_options`` merged over
-them. With the force model its velocity command is turned into wheel forces by the
-model's velocity loop and its joint rates clipped to the model's joint speed.
+``mpc``'s own options (floor, obstacles, orientation tracking; in waypoint mode a speed
+limit of one of the robot's length units per second, 1 m/s for the default robot; with the
+force model its velocity envelope), ``fallback_options`` merged over them. With the force
+model its velocity command is turned into wheel forces by the model's velocity loop and its
+joint rates clipped to the model's joint speed.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.options import MPCOptions
+from ddwmmr.resolution.kernels import length_unit
 
 if TYPE_CHECKING:
     from ddwmmr.qp.controller import QPController
@@ -39,7 +41,8 @@ def make_fallback(
         "dt": dt,
     }
     if trajectory is None:
-        qp_options["max_speed"] = 1.0
+        # 1 m/s on the default robot, as fast in the robot's own length unit on another
+        qp_options["max_speed"] = 1.0 * length_unit(robot.L1)
     if dynamics is not None:
         qp_options.update(dynamics.velocity_envelope())
     qp_options.update(options.fallback_options or {})

@@ -79,7 +79,8 @@ class Problem:
         """A cold start from ``plan``: its leg ``leg`` (0-based; with two legs also the
         next, or the longest second leg after the plan's last) re-sampled at this OCP's node
         times, each duration the plan's within the OCP's bounds, node 0 the measured
-        ``x0``, no slack. Returns ``(w, T)``, T the first leg's duration (s)."""
+        ``x0``, no slack. ``x0`` and the plan in metres (m, m/s), ``w`` in the OCP's unit.
+        Returns ``(w, T)``, T the first leg's duration (s)."""
         ocp, config = self.ocp, self.ocp.config
         durations = plan.legs
         horizon = float(np.clip(durations[leg], config.min_horizon, config.horizon))
@@ -88,6 +89,9 @@ class Problem:
             following = durations[leg + 1] if leg + 1 < len(durations) else np.inf
             second = float(np.clip(following, config.min_horizon, config.second_leg_horizon))
         states, inputs = plan.leg_samples(leg, ocp.node_times(horizon, second))
+        if self.unit != 1.0:
+            x0, states = self._states_in_unit(x0), self._states_in_unit(states)
+            inputs = self._inputs_in_unit(inputs)
         xs, us = np.zeros((ocp.N + 1, ocp.nx)), np.zeros((ocp.N, ocp.nu))
         xs[:, : ocp.nxm], us[:, : ocp.num] = states, inputs[:-1]
         xs[:, ocp.nxm] = horizon
@@ -98,11 +102,13 @@ class Problem:
 
     def planned_arrival(self, plan: Guess, leg: int) -> np.ndarray | None:
         """The state ``plan`` reaches the end of leg ``leg`` (0-based) in, for this OCP's
-        arrival term; None where the OCP has none or the leg is the plan's last (how the
-        task's last waypoint is reached does not matter)."""
+        arrival term, in the OCP's unit (the plan in metres); None where the OCP has none or
+        the leg is the plan's last (how the task's last waypoint is reached does not
+        matter)."""
         if not self.ocp.arrival_size or leg + 1 >= len(plan.legs):
             return None
-        return plan.arrival_states[leg]
+        state = plan.arrival_states[leg]
+        return state if self.unit == 1.0 else self._states_in_unit(state)
 
     def _shifted(
         self, warm: np.ndarray, elapsed: float, x0: np.ndarray, source: ShootingOCP | None = None
@@ -174,12 +180,25 @@ class Problem:
     def _in_unit(self, x0, references, u_prev) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The kinematic model's state, references (N, 3) and input with their positions
         (m) and ``v`` (m/s) in the OCP's unit."""
-        x0, references = np.array(x0, dtype=float), np.array(references, dtype=float)
-        u_prev = np.array(u_prev, dtype=float)
-        x0[:2] /= self.unit
-        references[:, :2] /= self.unit
-        u_prev[0] /= self.unit
-        return x0, references, u_prev
+        return (
+            self._states_in_unit(x0),
+            self._states_in_unit(references),
+            self._inputs_in_unit(u_prev),
+        )
+
+    def _states_in_unit(self, states) -> np.ndarray:
+        """A copy of a state or rows starting with a position (m, references, states) with
+        the position in the OCP's unit."""
+        states = np.array(states, dtype=float)
+        states[..., :2] /= self.unit
+        return states
+
+    def _inputs_in_unit(self, inputs) -> np.ndarray:
+        """A copy of the kinematic model's input, or of rows of it, with ``v`` (m/s) in the
+        OCP's unit."""
+        inputs = np.array(inputs, dtype=float)
+        inputs[..., 0] /= self.unit
+        return inputs
 
     def first_input(self, w: np.ndarray) -> np.ndarray:
         """The model's input of a solution's first stage, ``v`` in m/s."""
