@@ -405,16 +405,18 @@ def _plan_integrator(config: CompareConfig) -> list[RunSpec]:
 def study_offsets(config: CompareConfig) -> list[tuple[float, float]]:
     """Initial offsets (dx, dy) in m of the offset sweep, multiples of the robot's default
     (:func:`~ddwmmr.resolution.reference.default_offset`), that its arm can reach from the
-    start configuration (an arm of other proportions may not take the largest ones)."""
+    start configuration within its joint limits (an arm of other proportions or limits may
+    not take the largest ones)."""
     dx, dy = default_offset(config.robot)
     start = start_configuration(config.robot, config.trajectories[STUDY_TRAJECTORY])
     offsets = []
     for scale in OFFSET_SCALES:
         try:
-            offset_configuration(config.robot, start, (scale * dx, scale * dy))
+            q = offset_configuration(config.robot, start, (scale * dx, scale * dy))
         except ParameterError:
             continue
-        offsets.append((scale * dx, scale * dy))
+        if config.robot.joints_outside(q) is None:  # else the run's start check refuses it
+            offsets.append((scale * dx, scale * dy))
     return offsets
 
 
