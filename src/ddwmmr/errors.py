@@ -292,6 +292,14 @@ def bracketed(items: Iterable[Any], spec: str = "g") -> str:
     return "[" + ", ".join(i if isinstance(i, str) else format(i, spec) for i in items) + "]"
 
 
+def round_significant(value: float, digits: int, rounding: Any) -> float:
+    """``value`` (> 0) to ``digits`` significant digits, rounded by ``rounding``
+    (``math.floor`` or ``math.ceil``): a value a message suggests, on the safe side of
+    the bound it was computed from."""
+    scale = 10.0 ** (digits - 1 - math.floor(math.log10(value)))
+    return rounding(value * scale) / scale
+
+
 def one_line(text: str, width: int) -> str:
     """``text`` on one line (each run of whitespace one space), cut to ``width``
     characters with "..." at the end."""

@@ -8,7 +8,13 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_nonnegative, check_positive, shown
+from ddwmmr.errors import (
+    ParameterError,
+    check_nonnegative,
+    check_positive,
+    round_significant,
+    shown,
+)
 
 #: Shortest time constant (s): gains above 1e4 1/s are no feedback a 2 rad/s arm or a
 #: wheel-speed-limited base can follow, only numbers that overflow the commands.
@@ -108,13 +114,6 @@ def gain_step_warning(gains: Sequence[float], dt: float, scheme: str) -> str | N
         what = f"the robot's runs fail from about {GAIN_STEP_MARGIN:g} of it"
     return (
         f"tau = {tau:g} s{shortest} with dt = {dt:g} s: K dt = {product:.3g} (K = 1/tau) "
-        f"{where}{what}; use dt below {_significant(allowed / gain, math.floor):g} s or tau "
-        f"above {_significant(dt / allowed, math.ceil):g} s"
+        f"{where}{what}; use dt below {round_significant(allowed / gain, 3, math.floor):g} s "
+        f"or tau above {round_significant(dt / allowed, 3, math.ceil):g} s"
     )
-
-
-def _significant(value: float, rounding: Any, digits: int = 3) -> float:
-    """``value`` (> 0) to ``digits`` significant digits, rounded by ``rounding``
-    (``math.floor`` or ``math.ceil``): advice that stays on the safe side of a bound."""
-    scale = 10.0 ** (digits - 1 - math.floor(math.log10(value)))
-    return rounding(value * scale) / scale

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, round_significant
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import principal_angle
 from ddwmmr.resolution import kernels
@@ -181,11 +181,10 @@ def reachable_offset(
     for _ in range(40):
         middle = 0.5 * (low + high)
         low, high = (middle, high) if fits(middle) else (low, middle)
-    largest = low * max(abs(offset[0]), abs(offset[1]))
-    if largest <= 0.0:
+    larger = max(abs(offset[0]), abs(offset[1]))
+    if low * larger <= 0.0:
         return (0.0, 0.0)
-    quantum = 10.0 ** (math.floor(math.log10(largest)) - 1)
-    k = math.floor(largest / quantum) * quantum / max(abs(offset[0]), abs(offset[1]))
+    k = round_significant(low * larger, 2, math.floor) / larger
     return (k * offset[0], k * offset[1])
 
 
