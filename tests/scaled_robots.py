@@ -1,6 +1,8 @@
 """Robots at other sizes than the default, scaled as a physical robot scales: lengths by
 ``s``, masses by ``s^3``, the base's yaw inertia by ``s^5``, torque limits by ``s^4``."""
 
+from dataclasses import replace
+
 from ddwmmr import Robot
 
 #: The default robot ten times as long, 1000 times as heavy (its motors scaled to match).
@@ -56,3 +58,24 @@ def scaled_options(options: dict, factor: float, metre_options: tuple[str, ...])
         v_top, w_top = options["speed_budget"]
         scaled["speed_budget"] = (factor * v_top, w_top)
     return scaled
+
+
+#: The robot's fields that are lengths, scaled by :func:`scaled_robot`.
+LENGTHS = (
+    "L1",
+    "L2",
+    "wheel_radius",
+    "track_width",
+    "base_length",
+    "base_width",
+    "base_height",
+    "arm_height",
+)
+
+
+def scaled_robot(factor: float) -> Robot:
+    """The default robot with every length ``factor`` times as long (masses kept: the
+    kinematic plant does not use them, and the tip-over measure depends on their ratios).
+    A power-of-two ``factor`` scales exactly in floating point."""
+    default = Robot()
+    return replace(default, **{name: getattr(default, name) * factor for name in LENGTHS})

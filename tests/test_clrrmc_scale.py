@@ -29,8 +29,7 @@ import numpy as np
 import pytest
 
 from ddwmmr import Ellipse, Robot, simulate
-from scaled_robots import TEN_TIMES, TWENTIETH
-from test_damping_invariance import scaled_robot
+from scaled_robots import TEN_TIMES, TWENTIETH, scaled_robot
 
 DT = 2.0
 #: Start offset (m) on the default robot, along both end-effector axes.

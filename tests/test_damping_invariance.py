@@ -18,19 +18,10 @@ import pytest
 from ddwmmr import Ellipse, Robot, make_controller, simulate
 from ddwmmr.errors import ParameterError
 from ddwmmr.resolution import kernels
+from scaled_robots import scaled_robot
 from test_damping_scale import ats_band
 
 DEFAULT = Robot()
-LENGTHS = (
-    "L1",
-    "L2",
-    "wheel_radius",
-    "track_width",
-    "base_length",
-    "base_width",
-    "base_height",
-    "arm_height",
-)
 #: The default ellipse with a constant orientation: every method below passes near the
 #: singularity on part of it (aux = sum), so the damped steps are a real pattern.
 TASK = Ellipse(orientation="constant")
@@ -43,12 +34,6 @@ METHODS = [
 ]
 #: Damped rows of the default robot on TASK (of 2001), which pin the pattern compared.
 DEFAULT_DAMPED = {"pi": 913, "ap": 1101, "ats": 687, "clrrmc-ts": 501, "clrrmc-cs": 1314}
-
-
-def scaled_robot(factor: float) -> Robot:
-    """The default robot with every length ``factor`` times as long (masses kept: the
-    kinematic plant does not use them, and the tip-over measure depends on their ratios)."""
-    return replace(DEFAULT, **{name: getattr(DEFAULT, name) * factor for name in LENGTHS})
 
 
 def run(factor: float, method: str, options: dict):

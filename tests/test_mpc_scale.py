@@ -21,8 +21,7 @@ from ddwmmr import Ellipse, ParameterError, Robot, make_controller, simulate
 from ddwmmr.cli.track import main as track_main
 from ddwmmr.mpc.fallback import make_fallback
 from ddwmmr.mpc.min_time import Guess
-from scaled_robots import TEN_TIMES, TWENTIETH, scaled_options
-from test_damping_invariance import scaled_robot
+from scaled_robots import TEN_TIMES, TWENTIETH, scaled_options, scaled_robot
 
 ELLIPSE = Ellipse()
 #: Start offset (m) on the default robot, along both end-effector axes.

@@ -20,8 +20,7 @@ import pytest
 
 from ddwmmr import Robot, make_controller
 from ddwmmr.errors import ParameterError
-from scaled_robots import TWENTIETH
-from test_damping_invariance import scaled_robot
+from scaled_robots import TWENTIETH, scaled_robot
 from test_mpc_scale import errors as mpc_errors
 from test_mpc_scale import solver_calls
 from test_qp_scale import ARRAYS, POST, built

@@ -27,8 +27,7 @@ from ddwmmr.resolution.reference import (
     default_offset,
     offset_configuration,
 )
-from scaled_robots import TWENTIETH
-from test_damping_invariance import scaled_robot
+from scaled_robots import TWENTIETH, scaled_robot
 
 #: The default robot's start error (m): its default offset's length, 42.4 mm.
 DEFAULT_START_M = math.hypot(*DEFAULT_INITIAL_OFFSET)

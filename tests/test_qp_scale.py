@@ -22,8 +22,7 @@ from ddwmmr.commands import PlantTraits
 from ddwmmr.qp import QPProblem
 from ddwmmr.qp.limits import Limit
 from ddwmmr.qp.limits.base import INF
-from scaled_robots import TEN_TIMES, TWENTIETH, scaled_options
-from test_damping_invariance import scaled_robot
+from scaled_robots import TEN_TIMES, TWENTIETH, scaled_options, scaled_robot
 
 ELLIPSE = Ellipse()
 #: Start offset (m) on the default robot, along both end-effector axes.

@@ -20,7 +20,7 @@ from ddwmmr.errors import ParameterError
 from ddwmmr.qp.limits import Limit
 from ddwmmr.qp.tasks import Task
 from ddwmmr.resolution.kernels import length_unit
-from test_damping_invariance import scaled_robot
+from scaled_robots import scaled_robot
 
 #: A start inside the default robot's workspace: (x, y, phi, th1, th2) in m, m, rad, rad, rad.
 Q0 = np.array([0.0, 0.0, 0.0, 0.3, 1.2])
