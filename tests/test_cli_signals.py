@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 
+from ddwmmr.outputs.owners import STAGING_PREFIX
+
 LONG = {
     "track": ["--method", "ats", "--traj", "ellipse", "--duration", "20000", "--no-plots"],
     "compare": ["--methods", "ats", "pi", "--only", "ellipse", "--study", "none",
@@ -68,7 +70,8 @@ def start(tool: str, folder: Path, **popen) -> subprocess.Popen:
 
 
 def staging(folder: Path) -> list[Path]:
-    return [p for p in folder.iterdir() if p.name.startswith(".ddwmmr-")]
+    """The run's staging folders in ``folder`` (not its lock, which is made first)."""
+    return [p for p in folder.iterdir() if p.name.startswith(STAGING_PREFIX)]
 
 
 @pytest.mark.parametrize(
