@@ -27,6 +27,7 @@ from ddwmmr.bounds.lower import lower_bound
 from ddwmmr.bounds.search import Settings, best_known
 from ddwmmr.errors import DURATION_RANGE_S, MAX_SCENARIOS, ParameterError, shown
 from ddwmmr.model import Robot
+from ddwmmr.model.stability import check_stability_floor
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, kept_trajectory
 from ddwmmr.outputs import write_atomic
 from ddwmmr.scenarios.generator import Scenario
@@ -464,11 +465,17 @@ def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, t
 
 def bounds_floor(path: str | Path) -> float | None:
     """The floor on S the best-known times of the bounds.csv at ``path`` hold (its
-    summary.json's ``settings.stability_min``); None when that record does not say."""
-    summary = _read_object(Path(path).parent / "summary.json")
+    summary.json's ``settings.stability_min``); None when that record holds no number
+    there. A number that is no floor on S (NaN, infinite, beyond a float, outside
+    ``(0, STABILITY_CAP)``: :func:`~ddwmmr.model.stability.check_stability_floor`) is a
+    one-line :class:`ParameterError` naming the record and the range."""
+    record = Path(path).parent / "summary.json"
+    summary = _read_object(record)
     settings = summary.get("settings") if summary is not None else None
     floor = settings.get("stability_min") if isinstance(settings, dict) else None
-    return float(floor) if isinstance(floor, int | float) and not isinstance(floor, bool) else None
+    if not isinstance(floor, int | float) or isinstance(floor, bool):
+        return None
+    return check_stability_floor(floor, f"bounds: {record}: settings.stability_min")
 
 
 def summarize(rows: list[dict[str, Any]]) -> dict[str, Any]:
