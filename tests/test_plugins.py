@@ -4,6 +4,7 @@ blows up, a force controller declared by the decorator alone, a malformed ``law`
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import os
 import subprocess
@@ -18,7 +19,6 @@ from ddwmmr import Ellipse, ParameterError, Robot, simulate
 from ddwmmr.commands import FORCE, WheelForces
 from ddwmmr.controllers import StepInfo
 from ddwmmr.errors import PluginError
-from ddwmmr.plants import Observation
 from ddwmmr.registry import CONTROLLERS, PLANTS, _import_plugin, _read_builtins
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
 
@@ -92,42 +92,43 @@ def test_the_tools_report_a_raising_plug_in_module_in_one_line_with_status_2(tmp
 
 
 # -- a plug-in plant ----------------------------------------------------------------------------
-class EulerPlant:
-    """Kinematic Euler steps; ``misuse`` makes step ``fail_at`` raise or leave a NaN."""
+def _ideal_plant() -> type:
+    """``IdealPlant`` of tests/plugins/ideal_plant.py, the one-file plant plug-in of
+    docs/api.md ("Extending"), loaded under a name of its own and its "ideal" registration
+    undone (a test of test_registry.py imports the module and registers it itself)."""
+    spec = importlib.util.spec_from_file_location(
+        "ideal_plant_for_test_plugins", ROOT / "tests" / "plugins" / "ideal_plant.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    try:
+        spec.loader.exec_module(module)
+    finally:
+        PLANTS.unregister("ideal")
+    return module.IdealPlant
+
+
+class EulerPlant(_ideal_plant()):
+    """The ideal plug-in plant (kinematic Euler steps); ``misuse`` makes step ``fail_at``
+    raise or leave a NaN."""
 
     name = "plug-euler"
     interfaces = ("velocity",)
-    extra_columns = ()
 
     def __init__(self, robot, misuse="raise", fail_at=10):
-        self.robot, self.misuse, self.fail_at = robot, misuse, fail_at
-        self.q, self.u, self.k = [0.0] * 5, (0.0,) * 4, 0
+        super().__init__(robot)
+        self.misuse, self.fail_at, self.k = misuse, fail_at, 0
 
     def reset(self, q0, dt):
-        self.q, self.u, self.k = [float(a) for a in q0], (0.0,) * 4, 0
-
-    def observe(self):
-        return Observation(tuple(self.q), self.u[0], self.u[1])
-
-    def limit(self, q, u):
-        return np.asarray(u, dtype=float), False
+        super().reset(q0, dt)
+        self.k = 0
 
     def step(self, t, command, dt, policy=None):
         self.k += 1
         if self.k == self.fail_at and self.misuse == "raise":
             raise OverflowError("math range\nerror")
-        x, y, phi, th1, th2 = self.q
-        v, w, r1, r2 = self.u = tuple(float(a) for a in command)
+        super().step(t, command, dt, policy)
         if self.k == self.fail_at and self.misuse == "nan":
-            x = math.nan
-        self.q = [x + dt * v * math.cos(phi), y + dt * v * math.sin(phi)]
-        self.q += [phi + dt * w, th1 + dt * r1, th2 + dt * r2]
-
-    def extra_values(self):
-        return ()
-
-    def summarize(self, timeseries):
-        return {}
+            self.q[0] = math.nan
 
 
 def test_a_raising_plug_in_plant_stops_a_tracking_run_with_a_plugin_error():
