@@ -195,6 +195,24 @@ def test_the_library_trajectories_are_used_as_they_are():
     assert checked.duration == Ellipse().duration and checked.samples == Ellipse().samples
 
 
+def test_a_scaled_users_trajectory_is_checked_as_the_users_own():
+    """ScaledTrajectory is the library's, but what it wraps may be a user's: its NaN is
+    refused in one line naming the time, as without the scale."""
+    from ddwmmr.sim.tracking import CheckedTrajectory, checked_trajectory
+    from ddwmmr.trajectories import ScaledTrajectory
+
+    assert checked_trajectory(ScaledTrajectory(Ellipse(), 2.0)).scale == 2.0  # as it is
+    assert isinstance(checked_trajectory(ScaledTrajectory(Circle(), 2.0)), CheckedTrajectory)
+
+    class Late(Circle):
+        def velocity(self, t):
+            return super().velocity(t) * (math.nan if t >= 0.2 else 1.0)
+
+    scaled = ScaledTrajectory(Late(), 2.0)
+    message = _refused(lambda: simulate(Robot(), scaled, "clrrmc-cs", duration=0.4))
+    assert message.startswith(f"{VELOCITY} (got array([nan, nan, nan]) at t = 0.2")
+
+
 def test_the_controller_sees_the_trajectorys_attributes_and_the_result_keeps_it():
     seen = {}
 

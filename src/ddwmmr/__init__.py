@@ -62,6 +62,7 @@ if TYPE_CHECKING:  # what the names are, for type checkers and IDEs; imported on
         Ellipse,
         Rectangle,
         SampledTrajectory,
+        ScaledTrajectory,
         available_trajectories,
         load_trajectory,
     )
@@ -78,6 +79,7 @@ _EXPORTS = {
     "Ellipse": "ddwmmr.trajectories",
     "Rectangle": "ddwmmr.trajectories",
     "SampledTrajectory": "ddwmmr.trajectories",
+    "ScaledTrajectory": "ddwmmr.trajectories",
     "available_trajectories": "ddwmmr.trajectories",
     "load_trajectory": "ddwmmr.trajectories",
 }
@@ -88,6 +90,7 @@ __all__ = [
     "Rectangle",
     "Robot",
     "SampledTrajectory",
+    "ScaledTrajectory",
     "SimulationResult",
     "__version__",
     "available_methods",

@@ -57,6 +57,7 @@ __all__ = [
     "add_option_argument",
     "add_plant_option_argument",
     "add_robot_arguments",
+    "add_traj_scale_argument",
     "built_plant",
     "check_output_folder",
     "check_plant_option_names",
@@ -73,11 +74,14 @@ __all__ = [
     "parse_plant_options",
     "payload_type",
     "plant_option_specs",
+    "read_trajectory_record",
     "refuse_plant_option_argument",
     "robot_from_arguments",
     "run_main",
+    "scaled_trajectory",
     "seconds_type",
     "split_names",
+    "trajectory_record",
 ]
 
 
@@ -673,3 +677,87 @@ def robot_from_arguments(args: argparse.Namespace, plants: Sequence[str] = ()) -
             # the message names the MuJoCo plant: prefixed with the file, not repeated
             raise ParameterError(f"robot: {args.robot}: {exc}") from None
     return robot
+
+
+#: ``--traj-scale``'s word for the robot's length unit ``L1 / 0.35 m``.
+ROBOT_SCALE = "robot"
+#: The ``type`` of a scaled trajectory's record (:func:`trajectory_record`).
+SCALED_RECORD = "scaled"
+
+
+def traj_scale_type(text: str) -> float | str:
+    """An argparse ``type`` for ``--traj-scale``: :data:`ROBOT_SCALE` or a finite number
+    (its range is checked with the robot, :func:`scaled_trajectory`)."""
+    if text.strip() == ROBOT_SCALE:
+        return ROBOT_SCALE
+    from ddwmmr.trajectories.scaled import SCALE_RANGE
+
+    low, high = SCALE_RANGE
+    return number_type(f"in [{low:g}, {high:g}] or {ROBOT_SCALE}", finite=True)(text)
+
+
+def add_traj_scale_argument(parser: argparse.ArgumentParser, which: str) -> None:
+    """``--traj-scale S|robot``: scale ``which`` (the tool's trajectories, in words) in
+    space (:func:`scaled_trajectory`)."""
+    parser.add_argument(
+        "--traj-scale",
+        type=traj_scale_type,
+        metavar="S|robot",
+        help=f"scale {which} in space by S about the world origin: positions and speeds "
+        "times S, headings, durations and steps kept (ddwmmr.ScaledTrajectory), for a robot "
+        f"of another size; {ROBOT_SCALE}: the robot's length unit L1/0.35 m (10 for a --robot "
+        "ten times the default); S in [1e-06, 1e+06] (default 1: as given); obstacles stay "
+        "in world metres; recorded with the trajectory (summary.json, run.json)",
+    )
+
+
+def scaled_trajectory(trajectory: Any, scale: float | str | None, robot: Robot) -> Any:
+    """``trajectory`` scaled by ``--traj-scale`` (a number, :data:`ROBOT_SCALE` for the
+    robot's length unit, None when not given): a
+    :class:`~ddwmmr.trajectories.ScaledTrajectory`, or ``trajectory`` itself at a factor of
+    exactly 1 (a default run stays bit for bit the same). A factor out of range is a
+    one-line :class:`ParameterError` naming ``traj-scale``."""
+    from ddwmmr.resolution.kernels import length_unit
+    from ddwmmr.trajectories.scaled import ScaledTrajectory, check_scale
+
+    if scale is None:
+        return trajectory
+    factor = length_unit(robot.L1) if scale == ROBOT_SCALE else scale
+    factor = check_scale(factor, "traj-scale")
+    return trajectory if factor == 1.0 else ScaledTrajectory(trajectory, factor)
+
+
+def trajectory_record(trajectory: Any, source: Any, sha256: str | None = None) -> dict[str, Any]:
+    """:func:`ddwmmr.provenance.trajectory_record`, also of a scaled trajectory:
+    ``{"name", "type": "scaled", "scale", "trajectory": <its base's record>}`` (a type
+    that versions without scaling refuse to rerun, rather than rerun unscaled)."""
+    from ddwmmr import provenance
+    from ddwmmr.trajectories.scaled import ScaledTrajectory
+
+    if not isinstance(trajectory, ScaledTrajectory):
+        return provenance.trajectory_record(trajectory, source, sha256)
+    return {
+        "name": trajectory.name,
+        "type": SCALED_RECORD,
+        "scale": trajectory.scale,
+        "trajectory": provenance.trajectory_record(trajectory.trajectory, source, sha256),
+    }
+
+
+def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Any, str | None, dict]:
+    """``(trajectory, file, note, base record)``: what
+    :func:`ddwmmr.provenance.read_trajectory_record` reads, of a :func:`trajectory_record`
+    of a scaled trajectory too (then rebuilt scaled; its base record is the inner one, the
+    one naming the file). A recorded scale out of range is a one-line
+    :class:`ParameterError` naming ``trajectory.scale`` (a missing field a ``KeyError``)."""
+    from ddwmmr import provenance
+    from ddwmmr.trajectories.scaled import ScaledTrajectory, check_scale
+
+    if record.get("type") != SCALED_RECORD:
+        return (*provenance.read_trajectory_record(record), record)
+    scale = check_scale(provenance.decode(record["scale"]), "trajectory.scale")
+    base = record["trajectory"]
+    if not isinstance(base, dict):
+        raise ParameterError(f"trajectory.trajectory must be a record (got {shown(base)})")
+    trajectory, file, note = provenance.read_trajectory_record(base)
+    return ScaledTrajectory(trajectory, scale), file, note, base

@@ -26,6 +26,7 @@ from ddwmmr.cli.common import (
     add_force_argument,
     add_option_argument,
     add_robot_arguments,
+    add_traj_scale_argument,
     check_output_folder,
     console_text,
     given_text,
@@ -38,7 +39,9 @@ from ddwmmr.cli.common import (
     refuse_plant_option_argument,
     robot_from_arguments,
     run_main,
+    scaled_trajectory,
     split_names,
+    trajectory_record,
 )
 from ddwmmr.controllers.base import available_methods, method_description
 from ddwmmr.controllers.option_specs import option_names, parse_options
@@ -172,6 +175,9 @@ def build_parser() -> ArgumentParser:
         metavar="NAME|FILE",
         help="compare on these trajectories instead of ellipse and rectangle (the studies "
         "need the ellipse, the corner study the rectangle: others are skipped)",
+    )
+    add_traj_scale_argument(
+        parser, "every compared trajectory (--only and --traj too; the studies run on them)"
     )
     parser.add_argument(
         "--methods",
@@ -346,14 +352,17 @@ def load_trajectories(
     only: Sequence[str] = (),
     sources: dict[str, Any] | None = None,
     shown: dict[str, str] | None = None,
+    scale: Callable[[Any], Any] | None = None,
 ) -> dict[str, Any]:
     """Ellipse, rectangle (or the ``--only`` ones) and the ``--traj`` ones, by unique
-    file-safe name (:func:`report_name`, the stem of their figure files).
+    file-safe name (:func:`report_name`, the stem of their figure files), each passed
+    through ``scale`` if given (``--traj-scale``: :func:`scaled_trajectory`).
 
     ``sources`` (if given) receives each key's file (None for a built-in default);
     ``shown`` (if given) each key's shown name: the trajectory's own name on one line (a
     line break becomes a space, as the reports show it), ``-2``, ``-3``... appended to a
-    repeated one.
+    repeated one. The key is the loaded trajectory's name (a scaled ellipse is still the
+    ``ellipse`` the studies run on), the shown name the scaled one's (``ellipse x10``).
     """
     chosen = split_names(only, "only")
     # each value with the option that gave it first, for the messages
@@ -364,8 +373,10 @@ def load_trajectories(
     names: dict[str, str] = {}
     for value, option in values.items():
         trajectory = _load(value, option)
+        name = unique_name(report_name(trajectory_name(trajectory)), trajectories)  # file-safe
+        if scale is not None:
+            trajectory = scale(trajectory)
         own = trajectory_name(trajectory)
-        name = unique_name(report_name(own), trajectories)  # names files: made safe
         trajectories[name] = trajectory
         files[name] = _load(value, option, find_trajectory_file)
         names[name] = unique_name(" ".join(str(own).splitlines()), names.values())
@@ -447,8 +458,7 @@ def run_record(
         },
         robot=provenance.robot_record(config.robot),
         trajectories={
-            name: provenance.trajectory_record(t, sources.get(name))
-            for name, t in config.trajectories.items()
+            name: trajectory_record(t, sources.get(name)) for name, t in config.trajectories.items()
         },
         duration=config.duration,
         studies=list(config.studies),
@@ -466,7 +476,15 @@ def config_from_arguments(
     """Validated :class:`CompareConfig` from the parsed arguments (``sources``: see
     :func:`load_trajectories`)."""
     shown: dict[str, str] = {}
-    trajectories = load_trajectories(args.traj, args.only, sources, shown)
+    plants = parse_plants(args.plant)
+    robot = robot_from_arguments(args, plants)
+    trajectories = load_trajectories(
+        args.traj,
+        args.only,
+        sources,
+        shown,
+        lambda trajectory: scaled_trajectory(trajectory, args.traj_scale, robot),
+    )
     command = " ".join([PROG, *(argv if argv is not None else sys.argv[1:])])
     methods = parse_methods(args.methods)
     study_methods = (
@@ -475,12 +493,11 @@ def config_from_arguments(
     studies = parse_studies(args.study)
     if study_methods is not None and not studies:
         raise ParameterError("study-methods: only used with a study (got --study none)")
-    plants = parse_plants(args.plant)
     return CompareConfig(
         methods=methods,
         study_methods=study_methods,
         trajectories=trajectories,
-        robot=robot_from_arguments(args, plants),
+        robot=robot,
         duration=check_duration(args.duration, trajectories),
         studies=studies,
         command=command,

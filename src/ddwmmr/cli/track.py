@@ -26,6 +26,7 @@ from ddwmmr.cli.common import (
     add_option_argument,
     add_plant_option_argument,
     add_robot_arguments,
+    add_traj_scale_argument,
     built_plant,
     check_output_folder,
     check_plant_option_names,
@@ -38,9 +39,12 @@ from ddwmmr.cli.common import (
     offset_type,
     output_folder,
     parse_plant_options,
+    read_trajectory_record,
     robot_from_arguments,
     run_main,
+    scaled_trajectory,
     seconds_type,
+    trajectory_record,
 )
 from ddwmmr.controllers.base import (
     available_methods,
@@ -77,7 +81,7 @@ from ddwmmr.sim.simulate import (
     plant_integrator,
     simulate,
 )
-from ddwmmr.trajectories import available_trajectories, load_trajectory
+from ddwmmr.trajectories import ScaledTrajectory, available_trajectories, load_trajectory
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = "python -m ddwmmr.track"
@@ -98,9 +102,9 @@ GAIN_STEP_WARNING_HELP = (
 RERUN_TOOLS = ("track", "gui")
 #: Options that fix what is simulated: they come from the record with --rerun.
 RUN_OPTIONS = (
-    "method", "traj", "aux", "tau", "dt", "duration", "integrator", "offset", "robot", "plant",
-    "payload", "stability_min", "manipulability_weight", "obstacles", "solver", "qp_mode",
-    "preset", "horizon", "option", "plant_option",
+    "method", "traj", "traj_scale", "aux", "tau", "dt", "duration", "integrator", "offset",
+    "robot", "plant", "payload", "stability_min", "manipulability_weight", "obstacles",
+    "solver", "qp_mode", "preset", "horizon", "option", "plant_option",
 )  # fmt: skip
 
 #: Keys printed in the summary table, with their labels; errors in mm (as in compare).
@@ -256,6 +260,7 @@ def build_parser() -> ArgumentParser:
         help=f"trajectory name ({', '.join(available_trajectories())}) or a .toml/.csv path "
         "(required unless --rerun)",
     )
+    add_traj_scale_argument(parser, "the trajectory")
     parser.add_argument(
         "--rerun",
         metavar="SUMMARY",
@@ -450,7 +455,7 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     plant = args.plant or PLANT
     robot = robot_from_arguments(args, (plant,))
     source = find_trajectory_file(args.traj)
-    trajectory = load_trajectory(args.traj)
+    trajectory = scaled_trajectory(load_trajectory(args.traj), args.traj_scale, robot)
     # The preset's values, then the explicit options (they win): the record keeps them all.
     options = {**preset_options(args.method, args.preset or "default"), **controller_options(args)}
     plant_options = parse_plant_options(plant, args.plant_option)
@@ -532,8 +537,8 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         if plant not in available_plants():
             raise ParameterError(f"plant {plant!r} is not supported by this version")
         trajectory_record = _field(record, "trajectory", dict, "trajectory")
-        trajectory, source, file_note = _inside(
-            "trajectory", lambda: provenance.read_trajectory_record(trajectory_record)
+        trajectory, source, file_note, base_record = _inside(
+            "trajectory", lambda: read_trajectory_record(trajectory_record)
         )
         offset = tuple(provenance.decode(_field(record, "initial_offset", list, "offset")))
         inputs = RunInputs(
@@ -546,9 +551,9 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
             record["duration"],
             _integrator(record, plant),
             offset,
-            str(trajectory_record.get("name") or "rerun"),
+            str(base_record.get("name") or "rerun"),
             plant,
-            _recorded_digest(trajectory_record, trajectory_record.get("file")),
+            _recorded_digest(base_record, base_record.get("file")),
             _plant_options(plant_record, plant),
         )
         checked = check_run(inputs, "payload", "the recorded initial_offset")
@@ -684,6 +689,17 @@ def _note_uneven_duration(duration: float, dt: float, steps: int) -> None:
         )
 
 
+def _note_unscaled_obstacles(options: dict[str, Any]) -> None:
+    """Say so (stderr) when a scaled trajectory's run has obstacles: they are circles in
+    world metres, which ``--traj-scale`` does not move or resize."""
+    if options.get("obstacles"):
+        print(
+            "note: --traj-scale scales the trajectory only; the obstacles stay as given, in "
+            "world metres",
+            file=sys.stderr,
+        )
+
+
 def _main(argv: Sequence[str] | None = None) -> int:
     """Run the tool; bad input raises :class:`ParameterError`."""
     args = build_parser().parse_args(argv)
@@ -708,6 +724,11 @@ def _main(argv: Sequence[str] | None = None) -> int:
     names = output_names(not args.no_plots, args.animate, physics)
     check_output_folder(out, "track", args.force, names)
     record = run_record(inputs, argv, args.rerun, tool="track", prog=PROG)
+    if isinstance(inputs.trajectory, ScaledTrajectory):  # its base's record and the factor
+        record["trajectory"] = trajectory_record(
+            inputs.trajectory, inputs.trajectory_file, inputs.trajectory_sha256
+        )
+        _note_unscaled_obstacles(inputs.options)
     progress = not args.no_progress
     _note_uneven_duration(inputs.duration, inputs.dt, steps)
     writer = output_folder(base, "track", args.force, fresh)  # numbers from base if fresh

@@ -27,6 +27,7 @@ from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_arrays
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.trajectories.base import Trajectory, sampler, trajectory_name
+from ddwmmr.trajectories.scaled import ScaledTrajectory
 
 #: Column names of the recorded time series, in order (plant columns follow).
 COLUMNS = (
@@ -526,9 +527,15 @@ def checked_trajectory(trajectory: Any) -> Any:
     """``trajectory`` as a simulation's consumers see it: the library's own (an
     :class:`~ddwmmr.trajectories.Ellipse`, ``Rectangle`` or ``SampledTrajectory`` whose
     ``pose``, ``velocity`` and ``sample`` are the library's) as it is, so that nothing is
-    added to their steps; any other in a :class:`CheckedTrajectory`."""
+    added to their steps; any other in a :class:`CheckedTrajectory`. A library wrapper of
+    another trajectory (a :class:`~ddwmmr.trajectories.ScaledTrajectory`) is the library's
+    only if what it wraps is."""
     if isinstance(trajectory, CheckedTrajectory):
         return trajectory
+    if isinstance(trajectory, ScaledTrajectory):
+        inner = trajectory.trajectory
+        if checked_trajectory(inner) is not inner:
+            return CheckedTrajectory(trajectory)
     instance = getattr(trajectory, "__dict__", {})
     for name in ("pose", "velocity", "sample"):
         owner = defining_class(type(trajectory), name)
