@@ -59,20 +59,21 @@ came within :data:`OBSTACLE_NEAR_M` of an obstacle, with no other cause in sight
 as having left the trajectory to go round it. A run that would have tipped over
 (``stability_below_1``) names that first, as a physics plant's tipping is. Saturation for
 most of the run with more steps at a joint's position limit (``joint_limit_steps``) than
-at a rate limit names that joint limit instead. A run that held a rate limit for more than
-:data:`HELD_CAUSE` of the run (a wheel at its speed limit: ``wheel_limit_steps``; a joint
+at a rate limit names that joint limit instead. A limit counts as held, whatever its kind,
+for more than :data:`HELD_CAUSE` of the run and more than :data:`HELD_MIN_STEPS` steps (a
+start from rest holds one for a few steps, which are more than HELD_CAUSE of a short run).
+A run that held a rate limit (a wheel at its speed limit: ``wheel_limit_steps``; a joint
 at its rate limit: ``joint_rate_limit_steps``; an actuator at its limit on a plant with
-dynamics: ``actuator_saturated_time_s``, for more than :data:`HELD_MIN_STEPS` steps too; a
-force-level ``mpc`` at the wheel force it plans with: ``mpc_wheel_force_bound_time_s``, beyond
-the wheels' time at the plant's limit), with no other cause in sight, names that limit,
-and says whether the plant's clipping (``saturated_steps``) counted it. A run that failed
+dynamics: ``actuator_saturated_time_s``; a force-level ``mpc`` at the wheel force it plans
+with: ``mpc_wheel_force_bound_time_s``, beyond the wheels' time at the plant's limit), with
+no other cause in sight, names that limit, and says whether the plant's clipping
+(``saturated_steps``) counted it. A run that failed
 on its RMS error alone (its final error within the limit) converged: if the error rose
 above its start offset (``max_position_error_m``) while a limit was held, the transient (at the
 corners, where the trajectory has them) is named with the limits held; if it never rose
 above its start offset, the time it took to remove the offset is named, as on a short run
 or a held point (whose limit is :data:`EXTENT_LIMIT_FLOOR_M`). A joint held at a position
-limit for more than :data:`HELD_CAUSE` of a run that did not converge names that joint
-limit.
+limit (``joint_limit_steps``) in a run that did not converge names that joint limit.
 
 A run on a physics plant that saw an edge of its support polygon unloaded without tipping
 over (``support_lost``: a wheel off the ground, or the base rocking onto an edge; docs/
@@ -171,9 +172,10 @@ LENGTH_UNIT_RANGE_M = tuple(length_unit(length) for length in LENGTH_RANGE_M)
 #: ``steps``, ``actuator_saturated_time_s`` of ``duration``) is named as the likely cause
 #: of a failure nothing else explains.
 HELD_CAUSE = 0.005
-#: ... and an actuator's (``actuator_saturated_time_s``) for more steps of ``dt`` than this: the
-#: default robot's MuJoCo runs hold a motor at its torque limit for 3 or 4 steps as they
-#: start from rest, a hold that explains no error (docs/cli.md, "Verdict").
+#: ... and for more steps than this, whatever the limit (steps of ``dt`` for a time such as
+#: ``actuator_saturated_time_s``): the default robot's MuJoCo runs hold a motor at its
+#: torque limit for 3 or 4 steps as they start from rest, a hold that explains no error
+#: and is more than HELD_CAUSE of a run shorter than 800 steps (docs/cli.md, "Verdict").
 HELD_MIN_STEPS = 5
 #: Relative slack on "the error never rose above its start" (``max_position_error_m`` <=
 #: ``initial_offset_m`` x (1 + this)): the two are computed apart and may differ in their
@@ -798,14 +800,17 @@ def _planned_force_time(summary: Mapping[str, Any]) -> float:
 
 
 def _counts_as_held(summary: Mapping[str, Any], amount: float, time: bool = False) -> bool:
-    """A limit held for ``amount`` (steps; seconds where ``time``) counts: more than
-    :data:`HELD_CAUSE` of the run (``steps``; ``duration`` where ``time``), and a time at
-    an actuator's limit also for more than :data:`HELD_MIN_STEPS` steps of ``dt`` (where
-    the summary records it): the start from rest holds the motors for a few steps."""
+    """A limit held for ``amount`` (steps; seconds where ``time``) counts, whatever its
+    kind: more than :data:`HELD_CAUSE` of the run (``steps``; ``duration`` where ``time``)
+    and more than :data:`HELD_MIN_STEPS` steps (of ``dt`` where ``time``, where the summary
+    records it): a start from rest holds a motor or a wheel at its limit for a few steps,
+    which on a short run are more than HELD_CAUSE of it."""
     whole = _number(summary, "duration" if time else "steps") or 0.0
     if not (whole > 0.0 and amount > HELD_CAUSE * whole):
         return False
-    dt = _number(summary, "dt") if time else None
+    if not time:
+        return amount > HELD_MIN_STEPS
+    dt = _number(summary, "dt")
     return dt is None or not dt > 0.0 or amount / dt > HELD_MIN_STEPS * (1.0 + 1e-9)
 
 
@@ -906,10 +911,10 @@ def _clipping(summary: Mapping[str, Any]) -> str:
 
 def _joint_limit_phrase(summary: Mapping[str, Any]) -> str | None:
     """``"the arm at a joint limit (th2 = 0.3 rad) on 207 of 750 steps"`` where a joint
-    was at a position limit for more than :data:`HELD_CAUSE` of the steps, else None."""
+    was held at a position limit (:func:`_counts_as_held`), else None."""
     steps = _number(summary, "steps") or 0
     at_limit = _number(summary, "joint_limit_steps") or 0
-    if not (steps and at_limit > HELD_CAUSE * steps):
+    if not _counts_as_held(summary, at_limit):
         return None
     where = _joint_name(summary)
     return f"the arm at a joint limit ({where}) on {int(at_limit)} of {int(steps)} steps"
@@ -1008,12 +1013,12 @@ def _folded_arm(summary: Mapping[str, Any]) -> str:
 
 
 def held_limits(summary: Mapping[str, Any]) -> list[str]:
-    """The rate and actuator limits the run held for more than :data:`HELD_CAUSE` of it,
-    in words (``"a wheel at its speed limit on 342 of 400 steps"``, ``"a joint at its rate
-    limit on 250 of 750 steps"``, ``"a wheel at its force limit for 7.38 of 40 s"``), from
+    """The rate and actuator limits the run held (:func:`_counts_as_held`), in words
+    (``"a wheel at its speed limit on 342 of 400 steps"``, ``"a joint at its rate limit on
+    250 of 750 steps"``, ``"a wheel at its force limit for 7.38 of 40 s"``), from
     ``wheel_limit_steps`` of ``steps``, ``actuator_saturated_time_s`` of ``duration`` and
-    ``joint_rate_limit_steps`` of ``steps``, in that order; empty where none is recorded. A joint
-    at a position limit (``joint_limit_steps``) is not among them: it is a pose the arm
+    ``joint_rate_limit_steps`` of ``steps``, in that order; empty where none is recorded. A
+    joint at a position limit (``joint_limit_steps``) is not among them: it is a pose the arm
     cannot reach, not a speed it cannot exceed."""
     check_summary(summary)
     held = []
