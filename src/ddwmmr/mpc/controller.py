@@ -286,7 +286,7 @@ class MPCController:
         self._u_prev = np.zeros(self.model.nu)
         self._predicted_velocity: tuple[float, float] = (0.0, 0.0)
         self._predicted_rates: tuple[float, float] = (0.0, 0.0)  # the lagged arm's
-        self._stall = StallWatch()
+        self._stall = StallWatch(self.length_unit)  # progress in the robot's size
         self.restarts = 0
         self.brakes = 0  # steps that braked instead of following a plan that needed slack
         #: the least edge load (N) a plan predicted for its command (dynamic_stability)

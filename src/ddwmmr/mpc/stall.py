@@ -4,8 +4,8 @@ One real-time iteration per step follows the optimum it is near; from a poor war
 that can be a stationary point far from the best plan. Three rules drop the plan (each
 fires at most once per :data:`STALL_TIME`):
 
-* the end effector has not moved :data:`STALL_PROGRESS` (net) for :data:`STALL_TIME` short
-  of the target;
+* the end effector has not moved :data:`STALL_PROGRESS` robot length units (net; 1 mm on
+  the default robot) for :data:`STALL_TIME` short of the target;
 * every plan for :data:`STALL_TIME` needed the constraints' slack (largest slack above
   :data:`STALL_SLACK`, in the rows' units, m for the stability box; the joint box's slack
   left out, ``ShootingOCP.max_slack``): a plan that cannot meet its hard constraints is
@@ -29,7 +29,10 @@ import math
 
 #: How long (s) a plan may make no progress, need slack or stay frozen before it is dropped.
 STALL_TIME = 0.5
-#: Net end-effector motion (m) that counts as progress.
+#: Net end-effector motion (the robot's length units, ``L1 / 0.35 m``: m on the default
+#: robot) that counts as progress: a robot s times the default's size moves s times as far
+#: in the same time, so a fixed distance would be noise on a large robot and most of a
+#: small one's motion.
 STALL_PROGRESS = 1e-3
 #: Largest slack (rows' units) of a plan that meets its constraints.
 STALL_SLACK = 1e-3
@@ -38,9 +41,12 @@ FROZEN_HORIZON = 0.05
 
 
 class StallWatch:
-    """The rules' memory over a run (reset with the controller)."""
+    """The rules' memory over a run (reset with the controller), for a robot of length unit
+    ``length_unit`` (m, ``ddwmmr.resolution.kernels.length_unit``; 1.0 for the default
+    robot): the progress rule's distance is :data:`STALL_PROGRESS` of it."""
 
-    def __init__(self) -> None:
+    def __init__(self, length_unit: float = 1.0) -> None:
+        self._progress = STALL_PROGRESS * length_unit  # m
         self._anchor: tuple[float, float] | None = None
         self._anchor_time = 0.0
         self._infeasible_since: float | None = None  # first of the plans that needed slack
@@ -101,7 +107,7 @@ class StallWatch:
         """True (once per STALL_TIME) when the end effector has stopped short of the target."""
         xe, ye = end_effector
         anchor = self._anchor
-        if new or anchor is None or math.hypot(xe - anchor[0], ye - anchor[1]) > STALL_PROGRESS:
+        if new or anchor is None or math.hypot(xe - anchor[0], ye - anchor[1]) > self._progress:
             self._anchor, self._anchor_time = (xe, ye), t
             return False
         if t - self._anchor_time > STALL_TIME:
