@@ -53,7 +53,8 @@ def test_the_package_answers_version(capsys):
         (
             "bench",
             ["--jbos", "2"],
-            "bench: error: unrecognized arguments: --jbos (did you mean --jobs?) 2\n",
+            "python -m ddwmmr.bench: error: unrecognized arguments: --jbos "
+            "(did you mean --jobs?) 2\n",
         ),
         (
             "gui",

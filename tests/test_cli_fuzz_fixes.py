@@ -109,7 +109,7 @@ def test_an_empty_scheduler_is_refused_not_the_local_pool(workdir, capsys):
         ("track", "error: out: give an output folder (got an empty path)"),
         ("compare", "error: out: give an output folder (got an empty path)"),
         ("scenarios", "error: out: give an output folder (got an empty path)"),
-        ("bench", "bench: error: out: give an output folder (got an empty path)"),
+        ("bench", "error: out: give an output folder (got an empty path)"),
     ],
 )
 def test_an_empty_out_is_refused_naming_out(tool, message, workdir, capsys):
@@ -240,7 +240,7 @@ def test_an_empty_name_inside_a_list_is_refused():
 
 def test_bench_refuses_an_empty_name_in_its_method_list(workdir, capsys):
     line = refused("bench", ["--method", "pi,,pi", "--out", "b.json"], capsys, workdir)
-    assert line == "bench: error: --method: an empty name in the list (got 'pi,,pi')"
+    assert line == "error: --method: an empty name in the list (got 'pi,,pi')"
 
 
 def test_gui_slot_b_repeating_slot_a_is_refused(workdir, capsys):

@@ -134,8 +134,8 @@ def test_scenarios_and_bench_refuse_robot_in_one_line(argv, capsys):
         bench(argv)
     assert stopped.value.code == 2
     assert capsys.readouterr().err == (
-        "bench: error: --robot: the benchmark times the thesis robot only, as the scenario "
-        'benchmark runs it (docs/thesis.md, "What is simulated")\n'
+        "python -m ddwmmr.bench: error: --robot: the benchmark times the thesis robot only, "
+        'as the scenario benchmark runs it (docs/thesis.md, "What is simulated")\n'
     )
 
 

@@ -45,13 +45,6 @@ writes the report to --out.
 """
 
 
-class _Parser(ArgumentParser):
-    """The tools' parser (one-line errors, negative numbers in any notation) with the
-    prefix ``bench: error: ...`` (exit status 2)."""
-
-    error_prefix = "bench"
-
-
 _repeat_count = integer_type(1, MAX_REPEATS)
 _call_count = integer_type(1, MAX_CALLS)
 _job_count = integer_type(1, MAX_JOBS)
@@ -65,7 +58,7 @@ def method_names() -> list[str]:
 
 def build_parser() -> argparse.ArgumentParser:
     """The ``python -m ddwmmr.bench`` argument parser."""
-    parser = _Parser(
+    parser = ArgumentParser(
         prog="python -m ddwmmr.bench",
         description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter,
@@ -152,45 +145,34 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def _main(argv: Sequence[str] | None = None) -> int:
-    """The tool; bad input prints one line and returns 2."""
+    """The tool; bad input raises :class:`ParameterError` (one line, status 2, as every
+    tool: :func:`~ddwmmr.cli.common.run_main`)."""
     args = build_parser().parse_args(argv)
     if args.methods is not None:  # repeated and/or comma separated, as compare's --methods
-        try:
-            args.methods = split_names(args.methods, "--method")
-        except ParameterError as exc:
-            print(f"bench: error: {exc}", file=sys.stderr)
-            return 2
+        args.methods = split_names(args.methods, "--method")
     unknown = sorted(set(args.methods or ()) - set(method_names()))
     if unknown:
         choices = ", ".join(method_names())
-        print(
-            f"bench: error: unknown method {unknown[0]!r} (choose from {choices})",
-            file=sys.stderr,
-        )
-        return 2
-    try:
-        # Everything that can be checked is checked before a minute-long run.
-        previous = read_report(args.compare) if args.compare is not None else None
-        out = Path(given_text("out", args.out, "an output folder"))
-        check_out(out, force=args.force)
-        check_duration(Ellipse(), args.duration)
-        probe_out(out)
-        scenarios = args.scenarios
-        if scenarios is None:
-            scenarios = SCENARIO_COUNT if args.methods is None else 0
-        report = run_benchmark(
-            args.repeats,
-            args.calls,
-            args.duration,
-            args.methods,
-            progress=not args.no_progress,
-            scenarios=scenarios,
-            scenario_jobs=args.jobs,
-        )
-        write_report(report, out, force=args.force)
-    except ParameterError as exc:
-        print(f"bench: error: {exc}", file=sys.stderr)
-        return 2
+        raise ParameterError(f"method: unknown method {unknown[0]!r} (choose from {choices})")
+    # Everything that can be checked is checked before a minute-long run.
+    previous = read_report(args.compare) if args.compare is not None else None
+    out = Path(given_text("out", args.out, "an output folder"))
+    check_out(out, force=args.force)
+    check_duration(Ellipse(), args.duration)
+    probe_out(out)
+    scenarios = args.scenarios
+    if scenarios is None:
+        scenarios = SCENARIO_COUNT if args.methods is None else 0
+    report = run_benchmark(
+        args.repeats,
+        args.calls,
+        args.duration,
+        args.methods,
+        progress=not args.no_progress,
+        scenarios=scenarios,
+        scenario_jobs=args.jobs,
+    )
+    write_report(report, out, force=args.force)
     print(json.dumps(report, indent=2) if args.json else format_table(report))
     if previous is not None:
         print(format_comparison(report, previous))
