@@ -18,13 +18,17 @@ nothing half-written.
 A worker also shows warnings the way the process that started the pool does when that
 process's display (``warnings.showwarning``) says how (:func:`worker_display`): the tools
 show the library's warnings as one line each, and a worker that was not forked (the
-``spawn`` and ``forkserver`` start methods) starts with Python's own display.
+``spawn`` and ``forkserver`` start methods) starts with Python's own display. A display
+that keeps the lines it has shown (:data:`SHOWN`) hands them on, so that a worker does not
+repeat a warning its parent has shown (one that every run gives, such as a plant's warning
+about the robot, is said once per command when the parent says it before the pool starts).
 """
 
 from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import functools
 import multiprocessing
 import multiprocessing.connection
 import os
@@ -49,6 +53,9 @@ WINDOWS_MAX_WORKERS = 61
 #: function (picklable: a spawned worker imports it) that installs the same display in the
 #: process that calls it.
 IN_WORKERS = "in_workers"
+#: Attribute of a warnings display: the set of the lines (str) it has shown, which it does
+#: not show again; a worker's display starts with its parent's (:func:`worker_display`).
+SHOWN = "shown"
 
 
 def process_pool(jobs: int, mp_context: BaseContext | None = None) -> ProcessPoolExecutor:
@@ -71,9 +78,23 @@ def process_pool(jobs: int, mp_context: BaseContext | None = None) -> ProcessPoo
 
 def worker_display() -> Callable[[], None] | None:
     """The function that installs this process's warnings display in a worker: the
-    ``in_workers`` attribute (:data:`IN_WORKERS`) of ``warnings.showwarning``, or None
-    (Python's display, or one that does not say how to reproduce it)."""
-    return getattr(warnings.showwarning, IN_WORKERS, None)
+    ``in_workers`` attribute (:data:`IN_WORKERS`) of ``warnings.showwarning``, which for a
+    display that keeps its shown lines (:data:`SHOWN`) also hands on those shown so far;
+    None for Python's display, or one that does not say how to reproduce it. Picklable,
+    for a worker that is not forked."""
+    install = getattr(warnings.showwarning, IN_WORKERS, None)
+    shown = getattr(warnings.showwarning, SHOWN, None)
+    if install is None or shown is None:
+        return install
+    return functools.partial(_install_display, install, frozenset(shown))
+
+
+def _install_display(install: Callable[[], None], shown: frozenset[str]) -> None:
+    """``install()``, then count the parent's ``shown`` lines as shown by the display it
+    installed (:data:`SHOWN`): a forked worker's display, a copy of its parent's, holds
+    them already; a worker started otherwise begins without them."""
+    install()
+    getattr(warnings.showwarning, SHOWN, set()).update(shown)
 
 
 def start_worker(parent_pid: int, display: Callable[[], None] | None) -> None:

@@ -41,7 +41,7 @@ from ddwmmr.outputs import (
     output_folder,
     package_version,
 )
-from ddwmmr.workers import IN_WORKERS
+from ddwmmr.workers import IN_WORKERS, SHOWN
 
 if TYPE_CHECKING:
     from ddwmmr.controllers.option_specs import OptionSpec
@@ -341,8 +341,10 @@ def one_line_warnings() -> Iterator[None]:
     what to change), instead of Python's default form (the source file, line number and
     line of the library's code, which reads like a traceback); any other warning (another
     library's, or a NumPy ``RuntimeWarning`` whose location is the clue) is shown as
-    Python would. The worker processes of :func:`ddwmmr.workers.process_pool` started
-    meanwhile show them the same way, whatever their start method."""
+    Python would. Each line is shown once: a warning that every run repeats (a plant's
+    about the robot) is said once per command. The worker processes of
+    :func:`ddwmmr.workers.process_pool` started meanwhile show them the same way, whatever
+    their start method, and not the lines shown before they started."""
     previous = warnings.showwarning
     warnings.showwarning = _one_line_display(previous)
     try:
@@ -363,14 +365,20 @@ def _one_line_display(previous: Callable[..., None]) -> Callable[..., None]:
     """The display of :func:`one_line_warnings` (a ``warnings.showwarning``), handing
     every warning that is not the library's to ``previous``."""
 
+    shown: set[str] = set()
+
     def show(message, category, filename, lineno, file=None, line=None) -> None:
         ours = os.path.normcase(os.path.abspath(filename)).startswith(_PACKAGE_FOLDER + os.sep)
-        if ours and issubclass(category, UserWarning):
-            say(f"warning: {' '.join(str(message).split())}")
-        else:
+        if not (ours and issubclass(category, UserWarning)):
             previous(message, category, filename, lineno, file, line)
+            return
+        text = f"warning: {' '.join(str(message).split())}"
+        if text not in shown:  # once per command, however many runs or workers repeat it
+            shown.add(text)
+            say(text)
 
     setattr(show, IN_WORKERS, install_one_line_warnings)  # how pool workers get it
+    setattr(show, SHOWN, shown)  # and the lines already shown
     return show
 
 
