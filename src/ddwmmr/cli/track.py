@@ -64,7 +64,8 @@ from ddwmmr.errors import (
 )
 from ddwmmr.gains import GAIN_STEP_MARGIN, STABLE_GAIN_STEP, TAU_RANGE
 from ddwmmr.model.stability import STABILITY_CAP
-from ddwmmr.plants import available_plants, make_plant, plant_class, plant_description
+from ddwmmr.plants import available_plants, plant_description
+from ddwmmr.plants.base import Plant
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.provenance import RunInputs, run_record
@@ -75,6 +76,7 @@ from ddwmmr.resolution.reference import (
     initial_configuration,
 )
 from ddwmmr.sim.simulate import (
+    build_plant,
     check_start,
     check_tracks,
     default_step,
@@ -668,13 +670,17 @@ def output_names(plots: bool, animate: bool, physics: bool = False) -> tuple[str
     return (*names, *FIGURE_NAMES, *((SUPPORT_LOADS_FIGURE,) if physics else ()))
 
 
-def check_plant_step(inputs: RunInputs) -> None:
-    """Refuse, in the plant's own words, a control step the plant of ``inputs`` will refuse
-    when the run starts (MuJoCo: not a whole number of engine steps): before the duration
-    note and the output folder, so bad input is one line."""
-    if hasattr(plant_class(inputs.plant), "check_control_step"):
-        plant = make_plant(inputs.plant, inputs.robot, **inputs.plant_options)
-        plant.check_control_step(inputs.dt)
+def run_plant(inputs: RunInputs) -> Plant:
+    """The plant of ``inputs``, built once as ``simulate`` builds it
+    (:func:`~ddwmmr.sim.simulate.build_plant`) and passed to it; a control step it will
+    refuse when the run starts (MuJoCo: not a whole number of engine steps) is refused now,
+    in its own words: before the duration note and the output folder, so bad input is one
+    line."""
+    plant = build_plant(inputs.plant, inputs.robot, inputs.integrator, inputs.plant_options)
+    check_control_step = getattr(plant, "check_control_step", None)
+    if check_control_step is not None:
+        check_control_step(inputs.dt)
+    return plant
 
 
 def _note_uneven_duration(duration: float, dt: float, steps: int) -> None:
@@ -712,7 +718,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         if args.rerun is None:
             raise
         raise _in_record(args.rerun, exc) from None
-    check_plant_step(inputs)
+    plant = run_plant(inputs)
     fresh = args.out is None  # a default name: never replaces an earlier run
     base = (
         default_out(inputs.method, inputs.label)
@@ -740,9 +746,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
                 controller,
                 dt=inputs.dt,
                 duration=inputs.duration,
-                integrator=inputs.integrator,
-                plant=inputs.plant,
-                plant_options=inputs.plant_options,
+                plant=plant,
                 initial_offset=inputs.offset,
                 progress=lambda k, n: bar.advance(),
             )

@@ -50,7 +50,7 @@ from ddwmmr.trajectories.base import (
     trajectory_name,
 )
 
-__all__ = ["COLUMNS", "max_condition_number", "simulate", "summarize"]
+__all__ = ["COLUMNS", "build_plant", "max_condition_number", "simulate", "summarize"]
 
 
 def check_trajectory(trajectory: Any) -> Any:
@@ -284,7 +284,7 @@ def simulate(
         warn_other_robot(controller, robot)
     reference = check_trajectory(trajectory)
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
-    the_plant = _plant(plant, robot, integrator, plant_options)
+    the_plant = build_plant(plant, robot, integrator, plant_options)
     if not isinstance(plant, str):
         warn_other_robot(the_plant, robot, "plant")
     if dt is None:
@@ -419,10 +419,16 @@ def check_tracks(method: str) -> None:
     )
 
 
-def _plant(
-    plant: str | Plant, robot: Robot, integrator: str | None, options: dict[str, Any] | None
+def build_plant(
+    plant: str | Plant,
+    robot: Robot,
+    integrator: str | None = None,
+    options: dict[str, Any] | None = None,
 ) -> Plant:
-    """The plant object for ``simulate``'s ``plant``/``integrator``/``plant_options``."""
+    """The plant object :func:`simulate` runs for its ``plant``/``integrator``/
+    ``plant_options`` (a plant object as it is, after the checks). A tool that needs the
+    run's plant before the run (to refuse a control step it will refuse) builds it here
+    and passes the object to :func:`simulate`, which then builds none."""
     if options is not None and not isinstance(options, dict):
         raise ParameterError(
             f"plant_options must be a dict of plant options (got {shown(options)})"
