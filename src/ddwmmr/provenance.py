@@ -45,6 +45,9 @@ from ddwmmr.trajectories.sampled import SampledTrajectory, read_csv
 
 #: Version of the record layout (bump when a key changes meaning).
 RECORD_VERSION = 1
+#: The command of the tracking tool: what a tracking run's record (:func:`run_record`)
+#: gives as the command that repeats it, whichever tool wrote the record.
+TRACK_PROG = "python -m ddwmmr.track"
 _NON_FINITE = {"inf": math.inf, "-inf": -math.inf, "nan": math.nan}
 
 
@@ -416,7 +419,9 @@ def run_record(
     prog: str,
 ) -> dict:
     """What summary.json["run"] holds: enough to repeat the run (``--rerun``); ``tool``
-    and ``prog`` name what wrote it (the simulator's export writes the same record)."""
+    names what wrote it, ``prog`` and ``argv`` the command that repeats it (the
+    simulator's export writes the same record, with the :data:`TRACK_PROG` arguments of
+    its settings)."""
     record = header(tool, prog, argv)
     record.update(
         method=inputs.method,

@@ -10,10 +10,11 @@ Layout of one run's export folder (``<root>/<A>[-vs-<B>]-<trajectory>-<stamp>/``
 
     timeseries.csv, summary.json     one method: the files `python -m ddwmmr.track` writes,
                                      the summary with the record that
-                                     `python -m ddwmmr.track --rerun summary.json` repeats
+                                     `python -m ddwmmr.track --rerun summary.json` repeats;
+                                     its ``command`` is the `track` command of the settings
     A-<method>/timeseries.csv ...    side-by-side mode: one sub-folder per slot
-    trajectory.csv                   a sampled trajectory moved by the geometry controls
-                                     (the records refer to it)
+    trajectory.csv | trajectory.toml a trajectory moved by the geometry controls, sampled
+                                     or parametric (the records and commands name it)
     window.png                       the whole window
     support_loads.png                a physics run's support loads and base tilt (the
                                      figure `track` writes; A-<method>/ per slot)
@@ -22,7 +23,9 @@ Layout of one run's export folder (``<root>/<A>[-vs-<B>]-<trajectory>-<stamp>/``
 
 from __future__ import annotations
 
+import dataclasses
 import io
+import json
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -35,7 +38,7 @@ from PIL import Image
 
 from ddwmmr import provenance
 from ddwmmr.errors import ParameterError
-from ddwmmr.gui.options import plant_keywords
+from ddwmmr.gui.options import format_choice, method_options, plant_keywords
 from ddwmmr.gui.settings import Settings, build_robot, build_trajectory
 from ddwmmr.outputs import (
     first_free,
@@ -46,11 +49,8 @@ from ddwmmr.outputs import (
 )
 from ddwmmr.sim.simulate import plant_integrator
 from ddwmmr.trajectories import SampledTrajectory
-from ddwmmr.trajectories.files import find_trajectory_file
+from ddwmmr.trajectories.files import SHAPES, find_trajectory_file, is_name
 from ddwmmr.trajectories.sampled import csv_text
-
-#: How the export records the command that ran (the record's ``command``).
-GUI_PROG = "python -m ddwmmr.gui"
 
 #: Animation formats and the matplotlib writer each needs.
 ANIMATION_WRITERS = {"gif": "pillow", "mp4": "ffmpeg"}
@@ -106,15 +106,37 @@ def write_run_data(
 def trajectory_source(
     settings: Settings, trajectory: Any, folder: Path, written: list[Path]
 ) -> Path | None:
-    """The file a record should name for ``trajectory`` (built from ``settings``): the
-    loaded file, or, for a sampled trajectory moved by the geometry controls,
-    ``trajectory.csv`` written into ``folder`` (appended to ``written``). None for a
+    """The file a record and its command should name for ``trajectory`` (built from
+    ``settings``): the loaded file, or, for a trajectory moved by the geometry controls,
+    the one written into ``folder`` (appended to ``written``): ``trajectory.csv`` for a
+    sampled one, ``trajectory.toml`` (:func:`toml_text`) for a parametric one. None for a
     trajectory known by name only."""
     source = find_trajectory_file(settings.trajectory)
-    if isinstance(trajectory, SampledTrajectory) and settings.geometry:
+    if not settings.geometry:
+        return source
+    if isinstance(trajectory, SampledTrajectory):
         source = write_new(folder / "trajectory.csv", csv_text(trajectory))
         written.append(source)
+    elif type(trajectory) in SHAPES.values():  # `track --traj` takes it as a file only
+        source = write_new(folder / "trajectory.toml", toml_text(trajectory))
+        written.append(source)
     return source
+
+
+def toml_text(trajectory: Any) -> str:
+    """A parametric ``trajectory`` (ellipse or rectangle) as a TOML file that
+    :func:`ddwmmr.trajectories.files.read_toml` reads back as the same trajectory: every
+    parameter, floats at full precision (``phi`` only with the constant orientation, the
+    one that takes it)."""
+    shape = next(k for k, cls in SHAPES.items() if type(trajectory) is cls)
+    lines = ["[trajectory]", f"shape = {json.dumps(shape)}"]
+    for field in dataclasses.fields(trajectory):
+        value = getattr(trajectory, field.name)
+        if field.name == "phi" and trajectory.orientation != "constant":
+            continue
+        text = json.dumps(value) if isinstance(value, str) else repr(value)
+        lines.append(f"{field.name} = {text}")
+    return "\n".join(lines) + "\n"
 
 
 def run_record(
@@ -122,7 +144,10 @@ def run_record(
 ) -> dict[str, Any]:
     """The ``run`` record `python -m ddwmmr.track` writes, for slot ``slot`` of
     ``settings`` (tool ``"gui"``) and its built ``trajectory``; step and duration are the
-    ones the run used, the integrator the one :func:`plant_keywords` gave the run."""
+    ones the run used, the integrator the one :func:`plant_keywords` gave the run.
+    Its ``command`` and ``argv`` are the `track` command that repeats the run
+    (:func:`track_arguments`); where a setting has no `track` argument, ``command_note``
+    says which, and only ``track --rerun`` repeats the run."""
     inputs = provenance.RunInputs(
         method=str(settings.methods[slot]),
         options=dict(settings.options[slot]),
@@ -138,7 +163,73 @@ def run_record(
         label=Path(settings.trajectory).stem,
         plant=settings.plant,
     )
-    return provenance.run_record(inputs, argv=None, rerun=None, tool="gui", prog=GUI_PROG)
+    argv, missing = track_arguments(settings, inputs)
+    record = provenance.run_record(
+        inputs, argv=argv, rerun=None, tool="gui", prog=provenance.TRACK_PROG
+    )
+    if missing:
+        record["command_note"] = (
+            f"the command lacks {', '.join(missing)} (no track argument gives "
+            f"{'it' if len(missing) == 1 else 'them'}); track --rerun this summary.json "
+            "repeats the run"
+        )
+    return record
+
+
+def track_arguments(
+    settings: Settings, inputs: provenance.RunInputs
+) -> tuple[list[str], list[str]]:
+    """``(argv, missing)``: the `python -m ddwmmr.track` arguments that run what
+    ``inputs`` (one slot of ``settings``) hold, every input explicit (step and
+    duration in s, offset in m, payload in kg, at full precision), and the settings no
+    argument gives (a trajectory the geometry controls moved that has no file, an option
+    value whose text `--option` would read as another value)."""
+    missing: list[str] = []
+    if inputs.trajectory_file is not None and (
+        settings.geometry or not is_name(settings.trajectory)
+    ):
+        traj = str(Path(inputs.trajectory_file).resolve())
+    else:
+        traj = settings.trajectory
+        if settings.geometry:
+            missing.append("the trajectory geometry")
+    argv = ["--method", inputs.method, "--traj", traj]
+    argv += ["--dt", repr(inputs.dt), "--duration", repr(inputs.duration)]
+    argv += ["--plant", inputs.plant]
+    if inputs.integrator is not None:
+        argv += ["--integrator", inputs.integrator]
+    argv += ["--payload", repr(float(settings.payload))]
+    argv += ["--offset", *(repr(float(v)) for v in inputs.offset)]
+    for name, value in inputs.options.items():
+        text = option_text(inputs.method, name, value)
+        if text is None:
+            missing.append(f"option {name}")
+        else:
+            argv += ["--option", f"{name}={text}"]
+    return argv, missing
+
+
+def option_text(method: str, name: str, value: Any) -> str | None:
+    """The text of ``--option NAME=TEXT`` that `track` parses as ``value`` (the
+    simulator's field parses it alike), or None when no text does."""
+    spec = {s.name: s for s in method_options(method)}.get(name)
+    if spec is None:
+        return None
+    if spec.kind == "choice":
+        text = format_choice(value)
+    elif value is None:
+        text = ""
+    elif isinstance(value, list | tuple):
+        text = ",".join(repr(float(v)) for v in value)
+    elif isinstance(value, float | int) and not isinstance(value, bool):
+        text = repr(value)
+    else:
+        text = str(value)
+    try:
+        same = provenance.encode(spec.parse(text)) == provenance.encode(value)
+    except ParameterError:
+        same = False
+    return text if same else None
 
 
 def slot_folder(folder: Path, results: Sequence[Any], label: str) -> Path:
