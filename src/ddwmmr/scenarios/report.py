@@ -184,12 +184,16 @@ def _stateless(summary: dict[str, Any]) -> bool:
     return isinstance(value, float) and math.isnan(value)
 
 
-#: What a Table 5.2 cell holds (thesis Table 5.2's own layout).
+#: What a Table 5.2 cell holds (thesis Table 5.2's own layout), and the rows that hold
+#: something else than a mean over the scenarios.
 TABLE_LEGEND = (
     "Cells: mean (share of the mean simulation time) (sample standard deviation) over the "
     "scenarios; a failed scenario counts up to the instant it stopped, except in the speed, "
     "which is over the finished scenarios only (the route's straight-line length over the "
-    "time to its last waypoint)."
+    "time to its last waypoint). Not means: the numbers of failed and tipped scenarios "
+    "(counts), the minimum stability S (the lowest of all the scenarios' runs) and the steps "
+    "with a fallback command (the total over the scenarios, and its share of all their "
+    "steps); the time with an edge unloaded is a mean without its deviation."
 )
 #: Footnote of a controller without states, whose base and arm times overlap.
 OVERLAP_NOTE = (
@@ -260,9 +264,10 @@ def format_table(summary: dict[str, Any], title: str) -> str:
     width = max(len(label) for label, _ in rows)
     lines = [title, "-" * len(title), *textwrap.wrap(TABLE_LEGEND, width=88)]
     lines += [f"{label:<{width}}  {value}" for label, value in rows]
-    lines.append(f"{'Minimum stability S':<{width}}  {_fmt(summary['min_stability'])}")
+    label = "Minimum stability S (lowest run)"
+    lines.append(f"{label:<{width}}  {_fmt(summary['min_stability'])}")
     if summary.get("fallback_steps") is not None:
-        label = "Steps with a fallback command"
+        label = "Steps with a fallback command (total)"
         share = summary["fallback_share"] or 0.0
         lines.append(f"{label:<{width}}  {summary['fallback_steps']} ({_fmt(100 * share)} %)")
     ci = summary.get("ci95_time_s")
@@ -270,8 +275,9 @@ def format_table(summary: dict[str, Any], title: str) -> str:
         label = "Mean time, 95 % CI (s)"
         lines.append(f"{label:<{width}}  {_fmt(summary['mean_time_s'])} +- {_fmt(ci)}")
     if summary.get("tipped_physics") is not None:
-        lines.append(f"{'Tipped over (physics)':<{width}}  {summary['tipped_physics']}")
-        label = "Time with an edge unloaded (s)"
+        label = "Tipped over (physics) (count)"
+        lines.append(f"{label:<{width}}  {summary['tipped_physics']}")
+        label = "Mean time with an edge unloaded (s)"
         lines.append(f"{label:<{width}}  {_fmt(summary['mean_unloaded_time_s'])}")
     if _stateless(summary):
         lines += textwrap.wrap(OVERLAP_NOTE, width=88)
@@ -287,24 +293,44 @@ def summary_json(summary: dict[str, Any]) -> str:
     return json.dumps(json_safe(summary, undefined_as_null=True), indent=2, allow_nan=False) + "\n"
 
 
+#: Metrics that are NaN where they do not apply (:mod:`ddwmmr.scenarios.protocol`): the
+#: fix states' times and transitions for a controller without states, the unloaded time
+#: off a physics plant, the fallback steps for the thesis controller.
+NOT_APPLICABLE_AS_NAN = (
+    "time_manipulability_s",
+    "transitions_manipulability",
+    "time_stability_s",
+    "transitions_stability",
+    "time_obstacle_s",
+    "transitions_obstacle",
+    "unloaded_time_s",
+    "fallback_steps",
+)
+
+
 def metrics_csv(outcomes: Sequence[Outcome]) -> str:
-    """One CSV row per scenario with every metric of :data:`METRICS`; the speed of a
-    scenario that did not finish is undefined, "nan" (``speed_m_s`` of
-    :mod:`ddwmmr.scenarios.protocol`)."""
+    """One CSV row per scenario with every metric of :data:`METRICS`, floats by ``repr``
+    (they read back exactly). A metric that does not apply (None, or NaN in a column of
+    :data:`NOT_APPLICABLE_AS_NAN`) is an empty cell, as in compare's metrics.csv, and
+    null in summary.json; the speed of a scenario that did not finish is an undefined
+    number, "nan" (``speed_m_s`` of :mod:`ddwmmr.scenarios.protocol`)."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
     writer.writerow(METRICS)
     for o in outcomes:
-        writer.writerow([_cell(o.metrics[k]) for k in METRICS])
+        writer.writerow([_cell(o.metrics[k], k in NOT_APPLICABLE_AS_NAN) for k in METRICS])
     return buffer.getvalue()
 
 
-def _cell(value: Any) -> str:
+def _cell(value: Any, nan_not_applicable: bool = False) -> str:
+    """The CSV text of one metric (see :func:`metrics_csv`)."""
+    if value is None:
+        return ""
     if isinstance(value, bool):
         return "true" if value else "false"
-    if isinstance(value, float):
-        return "nan" if math.isnan(value) else repr(value)
-    return str(value)
+    if isinstance(value, float) and math.isnan(value):
+        return "" if nan_not_applicable else "nan"
+    return repr(value) if isinstance(value, float) else str(value)
 
 
 # -- figures ------------------------------------------------------------------------------
