@@ -169,10 +169,20 @@ def input_matrix(phi: float) -> np.ndarray:
     )
 
 
+def base_motion(
+    phi: float, v: float, w: float, th1dot: float, th2dot: float
+) -> tuple[float, float, float, float, float]:
+    """``qdot = B(phi) u`` on floats: ``(xdot, ydot, phidot, th1dot, th2dot)`` (m/s, rad/s)
+    at base heading ``phi`` (rad, world) for inputs ``v`` (m/s), ``w``, ``th1dot``,
+    ``th2dot`` (rad/s); the form the integrators call at every stage."""
+    return (v * math.cos(phi), v * math.sin(phi), w, th1dot, th2dot)
+
+
 def qdot_from_u(phi: float, u) -> np.ndarray:
-    """Configuration rate ``qdot`` (5,) produced by inputs ``u = [v, w, th1dot, th2dot]``."""
+    """Configuration rate ``qdot`` (5,) produced by inputs ``u = [v, w, th1dot, th2dot]``
+    (:func:`base_motion` as an array)."""
     v, w, t1, t2 = (float(a) for a in u)
-    return np.array([v * math.cos(phi), v * math.sin(phi), w, t1, t2])
+    return np.array(base_motion(phi, v, w, t1, t2))
 
 
 def u_from_qdot(phi: float, qdot) -> tuple[np.ndarray, float]:

@@ -333,24 +333,36 @@ def stability_gradient(k: ComCoefficients, th1: float, th2: float) -> tuple[floa
     At a tie between ``S_lon`` and ``S_lat`` the lateral term's gradient is returned; within
     a term, the gradient of the edge that has its minimum (:func:`edge_margin`).
     """
-    s1, c1 = math.sin(th1), math.cos(th1)
-    s12, c12 = math.sin(th1 + th2), math.cos(th1 + th2)
+    lon, lat = stability_terms_from_trig(
+        k, math.sin(th1), math.cos(th1), math.sin(th1 + th2), math.cos(th1 + th2)
+    )
+    return lat if lat[0] <= lon[0] else lon
+
+
+def stability_terms_from_trig(
+    k: ComCoefficients, s1: float, c1: float, s12: float, c12: float
+) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """``((S_lon, dS_lon/dth1, dS_lon/dth2), (S_lat, dS_lat/dth1, dS_lat/dth2))`` (1/rad)
+    from ``sin/cos th1`` and ``sin/cos (th1 + th2)``: the terms of :func:`margins` with
+    their gradients; a capped term (``S_i >= STABILITY_CAP``) reads ``(STABILITY_CAP, 0,
+    0)``. On a polygon other than the rectangle, :func:`polygon_terms_gradient`."""
     if k.edges is not None:
-        lon, lat = polygon_terms_gradient(k, s1, c1, s12, c12)
-        return lat if lat[0] <= lon[0] else lon
+        return polygon_terms_gradient(k, s1, c1, s12, c12)
     x_com = k.A * c1 + k.B * c12
     y_com = k.A * s1 + k.B * s12
     s_lon, s_lat, _ = margins(k, x_com, y_com)
-    if s_lat <= s_lon:
-        if s_lat >= STABILITY_CAP:
-            return s_lat, 0.0, 0.0
-        # S = h / |y|  =>  dS = -S * dy / y
-        factor = -s_lat / y_com
-        return s_lat, factor * (k.A * c1 + k.B * c12), factor * (k.B * c12)
+    # S_i = h / |c_i|  =>  dS_i = -S_i dc_i / c_i; zero where capped
     if s_lon >= STABILITY_CAP:
-        return s_lon, 0.0, 0.0
-    factor = -s_lon / x_com
-    return s_lon, factor * (-k.A * s1 - k.B * s12), factor * (-k.B * s12)
+        lon = (STABILITY_CAP, 0.0, 0.0)
+    else:
+        factor = -s_lon / x_com
+        lon = (s_lon, factor * (-k.A * s1 - k.B * s12), factor * (-k.B * s12))
+    if s_lat >= STABILITY_CAP:
+        lat = (STABILITY_CAP, 0.0, 0.0)
+    else:
+        factor = -s_lat / y_com
+        lat = (s_lat, factor * x_com, factor * (k.B * c12))
+    return lon, lat
 
 
 def support_edges(k: ComCoefficients) -> SupportEdges:

@@ -28,7 +28,7 @@ import numpy as np
 
 from ddwmmr.errors import ParameterError, check_instance, shown
 from ddwmmr.model import Robot
-from ddwmmr.model.kinematics import check_configuration
+from ddwmmr.model.kinematics import base_motion, check_configuration, qdot_from_u
 from ddwmmr.model.robot import clamp_joints
 from ddwmmr.plants.base import (
     Observation,
@@ -158,8 +158,9 @@ class KinematicPlant:
 
     @staticmethod
     def derivative(q: np.ndarray, u: np.ndarray) -> np.ndarray:
-        """Configuration rate ``qdot = B(phi) u``."""
-        return np.array(_rate(float(q[2]), *(float(a) for a in u)))
+        """Configuration rate ``qdot = B(phi) u`` (:func:`~ddwmmr.model.kinematics.qdot_from_u`
+        at the heading ``q[2]``)."""
+        return qdot_from_u(float(q[2]), u)
 
     def integrate(
         self,
@@ -202,9 +203,8 @@ class KinematicPlant:
         """``state`` after dt under the integrator, ``u0`` applied first; joints clamped."""
         if self.integrator == "euler":
             x, y, phi, th1, th2 = state
-            v, w, r1, r2 = u0
-            new = [x + dt * (v * math.cos(phi)), y + dt * (v * math.sin(phi))]
-            new += [phi + dt * w, th1 + dt * r1, th2 + dt * r2]
+            dx, dy, dphi, d1, d2 = base_motion(phi, *u0)
+            new = [x + dt * dx, y + dt * dy, phi + dt * dphi, th1 + dt * d1, th2 + dt * d2]
         else:
             new = self._rk4(t, state, dt, policy, u0)
         new[3], new[4] = clamp_joints(new[3], new[4], self._joint_limits)
@@ -224,10 +224,9 @@ class KinematicPlant:
         The stage rates ``k1..k4`` are summed as ``k1 + 2 k2 + 2 k3 + k4`` while the stages
         run (the same operations in the same order as the sum written out)."""
         x, y, phi, th1, th2 = state
-        cos, sin = math.cos, math.sin
         v, w, r1, r2 = u0
-        cx, cy = v * cos(phi), v * sin(phi)  # k1
-        sx, sy, sp, s1, s2 = cx, cy, w, r1, r2  # the weighted sum of the stage rates
+        cx, cy, sp, s1, s2 = base_motion(phi, v, w, r1, r2)  # k1
+        sx, sy = cx, cy  # with sp, s1, s2: the weighted sum of the stage rates
         for h, weight in ((0.5 * dt, 2.0), (0.5 * dt, 2.0), (dt, 1.0)):
             # the next stage at state + h k (k: the stage before)
             p, t1, t2 = phi + h * w, th1 + h * r1, th2 + h * r2
@@ -236,12 +235,12 @@ class KinematicPlant:
             else:
                 stage = [x + h * cx, y + h * cy, p, t1, t2]
                 (v, w, r1, r2), _ = self._saturate(t1, t2, policy(t + h, stage))
-            cx, cy = v * cos(p), v * sin(p)
+            cx, cy, cp, c1, c2 = base_motion(p, v, w, r1, r2)
             sx += weight * cx
             sy += weight * cy
-            sp += weight * w
-            s1 += weight * r1
-            s2 += weight * r2
+            sp += weight * cp
+            s1 += weight * c1
+            s2 += weight * c2
         sixth = dt / 6.0
         return [
             x + sixth * sx,
@@ -250,8 +249,3 @@ class KinematicPlant:
             th1 + sixth * s1,
             th2 + sixth * s2,
         ]
-
-
-def _rate(phi: float, v: float, w: float, r1: float, r2: float) -> tuple[float, ...]:
-    """``qdot = B(phi) u`` on floats: (x', y', phi', th1', th2')."""
-    return (v * math.cos(phi), v * math.sin(phi), w, r1, r2)

@@ -18,7 +18,7 @@ import numpy as np
 
 from ddwmmr.errors import ParameterError, round_significant
 from ddwmmr.model import Robot
-from ddwmmr.model.kinematics import principal_angle
+from ddwmmr.model.kinematics import base_motion, principal_angle
 from ddwmmr.resolution import kernels
 from ddwmmr.trajectories.base import sampler
 
@@ -326,7 +326,7 @@ class ReferenceTrajectory:
             self._L1, self._L2, phi, q[3], q[4], xd, yd, pd, self.aux, self.threshold, self.damping
         )
         self.singular_nodes += singular
-        return [v * math.cos(phi), v * math.sin(phi), w, t1, t2], singular
+        return list(base_motion(phi, v, w, t1, t2)), singular
 
     def _stage_velocities(
         self, piece: _Piece, first: int, last: int

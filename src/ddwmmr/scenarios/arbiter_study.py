@@ -45,6 +45,7 @@ from ddwmmr.scenarios.protocol import (
     RunConfig,
     run_scenario,
 )
+from ddwmmr.scenarios.studies import table_number
 from ddwmmr.workers import process_pool
 
 #: The two arbiters, in column order, with their labels.
@@ -152,14 +153,6 @@ def compare_variants(
     return results
 
 
-def _g(value: Any) -> str:
-    if value is None or (isinstance(value, float) and math.isnan(value)):
-        return "–"
-    if isinstance(value, int):
-        return str(value)
-    return f"{value:.3g}"
-
-
 def table_52(summaries: Sequence[tuple[str, dict[str, Any]]]) -> str:
     """Thesis Table 5.2 with one column per (label, summary), plus min S and switches."""
     columns = [report.table_rows(s) for _, s in summaries]
@@ -168,13 +161,20 @@ def table_52(summaries: Sequence[tuple[str, dict[str, Any]]]) -> str:
     for i, (label, _) in enumerate(columns[0]):
         lines.append(f"| {label} | " + " | ".join(col[i][1] for col in columns) + " |")
     extra = (
-        ("Minimum stability S", lambda s: _g(s["min_stability"])),
-        ("Median over scenarios of the minimum S", lambda s: _g(s["median_min_stability"])),
-        ("Time with S below the enter threshold (s)", lambda s: _g(s["time_below_enter_s"])),
+        ("Minimum stability S", lambda s: table_number(s["min_stability"])),
+        (
+            "Median over scenarios of the minimum S",
+            lambda s: table_number(s["median_min_stability"]),
+        ),
+        (
+            "Time with S below the enter threshold (s)",
+            lambda s: table_number(s["time_below_enter_s"]),
+        ),
         (
             "Fix-state entries per scenario (sd) [max]",
             lambda s: (
-                f"{_g(s['fix_entries'])} ({_g(s['sd_fix_entries'])}) [{_g(s['max_fix_entries'])}]"
+                f"{table_number(s['fix_entries'])} ({table_number(s['sd_fix_entries'])}) "
+                f"[{table_number(s['max_fix_entries'])}]"
             ),
         ),
     )
@@ -210,7 +210,7 @@ def variants_table(results: Sequence[VariantResult]) -> str:
         ]
         for key, _ in VARIANT_COLUMNS:
             sm, comp = (result.summaries[a][key] for a, _ in ARBITER_COLUMNS)
-            cells.append(f"{_g(sm)} / {_g(comp)}")
+            cells.append(f"{table_number(sm)} / {table_number(comp)}")
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
@@ -304,12 +304,12 @@ def claims_table(rows: Sequence[tuple[str, list[dict[str, float]], dict[str, dic
         col = {k: np.array([row[k] for row in stats]) for k in stats[0]}
         sm, comp = summaries["state-machine"], summaries["competitive"]
         cells = (
-            f"{_g(sm['fix_entries'])} ({_g(sm['max_fix_entries'])}) / "
-            f"{_g(comp['fix_entries'])} ({_g(comp['max_fix_entries'])})",
-            _g(float(np.mean(col["switches"]))),
-            _g(float(np.mean(col["reversals"]))),
-            _g(float(np.max(col["max_weight_rate"]))),
-            _g(float(np.max(col["max_share_rate"]))),
+            f"{table_number(sm['fix_entries'])} ({table_number(sm['max_fix_entries'])}) / "
+            f"{table_number(comp['fix_entries'])} ({table_number(comp['max_fix_entries'])})",
+            table_number(float(np.mean(col["switches"]))),
+            table_number(float(np.mean(col["reversals"]))),
+            table_number(float(np.max(col["max_weight_rate"]))),
+            table_number(float(np.max(col["max_share_rate"]))),
         )
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
@@ -369,7 +369,8 @@ def noise_table(rows: Sequence[dict[str, Any]]) -> str:
     for r in rows:
         lines.append(
             f"| {r['label']} | {r['noise']:g} (x{r['level']:g}) | {r['seed']} | {r['failed']} | "
-            f"{_g(r['mean_time_s'])} | {_g(r['min_stability'])} | {_g(r['fix_entries'])} |"
+            f"{table_number(r['mean_time_s'])} | {table_number(r['min_stability'])} | "
+            f"{table_number(r['fix_entries'])} |"
         )
     return "\n".join(lines) + "\n"
 

@@ -96,7 +96,10 @@ def obstacle_scenarios(scenarios: list[Scenario]) -> list[Scenario]:
     return [place_obstacles(scenarios[i - 1]) for i in OBSTACLE_SCENARIOS if i <= len(scenarios)]
 
 
-def _g(value: float | None) -> str:
+def table_number(value: float | None) -> str:
+    """One cell of a study table: integers (counts) in full, other numbers to three
+    significant figures, as the thesis reports; "–" for a missing (None) or undefined (NaN)
+    value. Shared by the threshold, obstacle and arbiter study tables."""
     if value is None or (isinstance(value, float) and math.isnan(value)):
         return "–"
     if isinstance(value, int):
@@ -166,7 +169,7 @@ def threshold_table(results: list[tuple[Variant, dict[str, Any]]], context: str 
             f"{variant.manipulability[0]:g}/{variant.manipulability[1]:g}",
         ]
         for thesis_key, our_key, _ in THRESHOLD_COLUMNS:
-            thesis, ours = _g(variant.thesis[thesis_key]), _g(summary[our_key])
+            thesis, ours = table_number(variant.thesis[thesis_key]), table_number(summary[our_key])
             if thesis_key == "failed":
                 thesis, ours = f"{thesis} of {THESIS_N}", f"{ours} of {summary['n']}"
             cells.append(f"{thesis} / {ours}")
@@ -212,7 +215,7 @@ def obstacle_table(metrics: list[dict[str, Any]], title: str = "") -> str:
             else:
                 thesis = THESIS_OBSTACLES.get(m["scenario"])
                 ref = thesis[thesis_index] if thesis is not None else None
-                text = f"{_g(ref)} / {_g(ours)}"
+                text = f"{table_number(ref)} / {table_number(ours)}"
             cells.append(text)
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
     table = "\n".join(lines) + "\n"

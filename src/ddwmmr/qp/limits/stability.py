@@ -33,8 +33,8 @@ from ddwmmr.model.stability import (
     ComCoefficients,
     check_stability_floor,
     edge_gradients,
-    polygon_terms_gradient,
     stability_terms,
+    stability_terms_from_trig,
 )
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
@@ -51,29 +51,6 @@ def stability_terms_gradient(
     return stability_terms_from_trig(
         k, math.sin(th1), math.cos(th1), math.sin(th1 + th2), math.cos(th1 + th2)
     )
-
-
-def stability_terms_from_trig(
-    k: ComCoefficients, s1: float, c1: float, s12: float, c12: float
-) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
-    """:func:`stability_terms_gradient` from ``sin/cos th1`` and ``sin/cos (th1 + th2)``."""
-    if k.edges is not None:
-        return polygon_terms_gradient(k, s1, c1, s12, c12)
-    x_com = k.A * c1 + k.B * c12
-    y_com = k.A * s1 + k.B * s12
-    if abs(x_com) * STABILITY_CAP <= k.half_length:
-        lon = (STABILITY_CAP, 0.0, 0.0)
-    else:
-        s_lon = k.half_length / abs(x_com)
-        f = -s_lon / x_com
-        lon = (s_lon, f * (-k.A * s1 - k.B * s12), f * (-k.B * s12))
-    if abs(y_com) * STABILITY_CAP <= k.half_width:
-        lat = (STABILITY_CAP, 0.0, 0.0)
-    else:
-        s_lat = k.half_width / abs(y_com)
-        f = -s_lat / y_com
-        lat = (s_lat, f * (k.A * c1 + k.B * c12), f * (k.B * c12))
-    return lon, lat
 
 
 def stability_rows(
