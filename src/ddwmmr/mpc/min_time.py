@@ -50,7 +50,13 @@ import casadi as ca
 import numpy as np
 
 from ddwmmr import interrupts
-from ddwmmr.errors import ParameterError, check_positive, finite_values, shown
+from ddwmmr.errors import (
+    ParameterError,
+    check_int_at_least,
+    check_positive,
+    finite_values,
+    shown,
+)
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
@@ -399,10 +405,7 @@ class FreeTimeOCP:
         leg_time_range: tuple[float, float] = LEG_TIME_RANGE,
         ipopt_options: dict | None = None,
     ) -> None:
-        if int(intervals_per_leg) != intervals_per_leg or intervals_per_leg < 2:
-            raise ParameterError(
-                f"intervals_per_leg must be an integer >= 2 (got {intervals_per_leg})"
-            )
+        intervals_per_leg = check_int_at_least("intervals_per_leg", intervals_per_leg, 2)
         if not ends:
             raise ParameterError("ends: at least one leg is needed")
         self.model = model
@@ -410,7 +413,7 @@ class FreeTimeOCP:
         if self.start.shape != (model.nx,):
             raise ParameterError(f"start must hold {model.nx} numbers (got {self.start.shape})")
         self.ends = list(ends)
-        self.M = int(intervals_per_leg)
+        self.M = intervals_per_leg
         self.legs = len(self.ends)
         self.n = self.legs * self.M
         self.leg_time_range = leg_time_range
@@ -553,7 +556,7 @@ class MinimumTimeProblem(FreeTimeOCP):
         robot: robot with payload; dynamics: the plant model (default: thesis constants).
         waypoints: end-effector targets (m, world) in order.
         start: start state ``[x, y, phi, th1, th2, v, w]`` (at rest).
-        intervals_per_leg: M.
+        intervals_per_leg: M (>= 2; checked by :class:`FreeTimeOCP`).
         stability_min: floor on S; tolerance: waypoint radius (m).
         ipopt_options: extra IPOPT options.
     """
@@ -569,10 +572,6 @@ class MinimumTimeProblem(FreeTimeOCP):
         tolerance: float = 0.01,
         ipopt_options: dict | None = None,
     ) -> None:
-        if int(intervals_per_leg) != intervals_per_leg or intervals_per_leg < 2:
-            raise ParameterError(
-                f"intervals_per_leg must be an integer >= 2 (got {intervals_per_leg})"
-            )
         self.robot = robot
         self.dynamics = dynamics or sym.ThesisDynamics.from_robot(robot)
         self.waypoints = [_waypoint(i, w) for i, w in enumerate(waypoints, start=1)]
