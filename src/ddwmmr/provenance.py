@@ -42,6 +42,7 @@ from ddwmmr.model import Robot
 from ddwmmr.outputs import package_version
 from ddwmmr.trajectories.files import SHAPES, file_sha256, is_name, package_folder
 from ddwmmr.trajectories.sampled import SampledTrajectory, read_csv
+from ddwmmr.trajectories.scaled import ScaledTrajectory, check_scale
 
 #: Version of the record layout (bump when a key changes meaning).
 RECORD_VERSION = 1
@@ -279,7 +280,17 @@ def trajectory_record(
 ) -> dict[str, Any]:
     """Parameters of a parametric trajectory, and the file it was read from (path and
     SHA-256: ``sha256`` if given, the digest recorded when it was read, else the file's
-    now)."""
+    now). A :class:`~ddwmmr.trajectories.ScaledTrajectory` is ``{"name", "type":
+    "scaled", "scale", "trajectory": <its base's record>}`` (a type that versions without
+    scaling refuse to rebuild, rather than rebuild it unscaled); ``source`` and ``sha256``
+    are its base's."""
+    if isinstance(trajectory, ScaledTrajectory):
+        return {
+            "name": trajectory.name,
+            "type": SCALED,
+            "scale": trajectory.scale,
+            "trajectory": trajectory_record(trajectory.trajectory, source, sha256),
+        }
     record: dict[str, Any] = {"name": str(getattr(trajectory, "name", ""))}
     if source is not None:
         record["file"] = str(Path(source).resolve())
@@ -292,6 +303,22 @@ def trajectory_record(
         record["type"] = "samples"
     else:
         record["type"] = type(trajectory).__name__
+    return record
+
+
+#: The ``type`` of a scaled trajectory's record (:func:`trajectory_record`).
+SCALED = "scaled"
+
+
+def base_trajectory_record(record: dict[str, Any]) -> dict[str, Any]:
+    """The record of the trajectory a :func:`trajectory_record` scales (the one that names
+    its file and digest), ``record`` itself when it is not a scaled one's; a scaled one's
+    whose ``trajectory`` is no record is a one-line :class:`ParameterError`."""
+    while record.get("type") == SCALED:
+        base = record.get("trajectory")
+        if not isinstance(base, dict):
+            raise ParameterError(f"trajectory.trajectory must be a record (got {shown(base)})")
+        record = base
     return record
 
 
@@ -316,8 +343,15 @@ def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Path | None, st
     that file's SHA-256 is the recorded one: the install path of a shipped trajectory
     changes with the environment (another venv, machine, or checkout), its bytes do not.
     A file whose SHA-256 differs from the record's is refused (:class:`ParameterError`).
+    A scaled trajectory's record is rebuilt scaled, its file and note its base's; a
+    recorded scale out of range is a one-line :class:`ParameterError` naming
+    ``trajectory.scale``.
     """
     kind = record.get("type")
+    if kind == SCALED:
+        scale = check_scale(decode(record.get("scale")), "trajectory.scale")
+        trajectory, file, note = read_trajectory_record(base_trajectory_record(record))
+        return ScaledTrajectory(trajectory, scale), file, note
     if kind in SHAPES:
         source = record.get("file")
         file = Path(source) if isinstance(source, str) and source else None

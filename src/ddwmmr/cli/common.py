@@ -74,14 +74,12 @@ __all__ = [
     "parse_plant_options",
     "payload_type",
     "plant_option_specs",
-    "read_trajectory_record",
     "refuse_plant_option_argument",
     "robot_from_arguments",
     "run_main",
     "scaled_trajectory",
     "seconds_type",
     "split_names",
-    "trajectory_record",
 ]
 
 
@@ -689,8 +687,6 @@ def robot_from_arguments(args: argparse.Namespace, plants: Sequence[str] = ()) -
 
 #: ``--traj-scale``'s word for the robot's length unit ``L1 / 0.35 m``.
 ROBOT_SCALE = "robot"
-#: The ``type`` of a scaled trajectory's record (:func:`trajectory_record`).
-SCALED_RECORD = "scaled"
 
 
 def traj_scale_type(text: str) -> float | str:
@@ -733,39 +729,3 @@ def scaled_trajectory(trajectory: Any, scale: float | str | None, robot: Robot) 
     factor = length_unit(robot.L1) if scale == ROBOT_SCALE else scale
     factor = check_scale(factor, "traj-scale")
     return trajectory if factor == 1.0 else ScaledTrajectory(trajectory, factor)
-
-
-def trajectory_record(trajectory: Any, source: Any, sha256: str | None = None) -> dict[str, Any]:
-    """:func:`ddwmmr.provenance.trajectory_record`, also of a scaled trajectory:
-    ``{"name", "type": "scaled", "scale", "trajectory": <its base's record>}`` (a type
-    that versions without scaling refuse to rerun, rather than rerun unscaled)."""
-    from ddwmmr import provenance
-    from ddwmmr.trajectories.scaled import ScaledTrajectory
-
-    if not isinstance(trajectory, ScaledTrajectory):
-        return provenance.trajectory_record(trajectory, source, sha256)
-    return {
-        "name": trajectory.name,
-        "type": SCALED_RECORD,
-        "scale": trajectory.scale,
-        "trajectory": provenance.trajectory_record(trajectory.trajectory, source, sha256),
-    }
-
-
-def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Any, str | None, dict]:
-    """``(trajectory, file, note, base record)``: what
-    :func:`ddwmmr.provenance.read_trajectory_record` reads, of a :func:`trajectory_record`
-    of a scaled trajectory too (then rebuilt scaled; its base record is the inner one, the
-    one naming the file). A recorded scale out of range is a one-line
-    :class:`ParameterError` naming ``trajectory.scale`` (a missing field a ``KeyError``)."""
-    from ddwmmr import provenance
-    from ddwmmr.trajectories.scaled import ScaledTrajectory, check_scale
-
-    if record.get("type") != SCALED_RECORD:
-        return (*provenance.read_trajectory_record(record), record)
-    scale = check_scale(provenance.decode(record["scale"]), "trajectory.scale")
-    base = record["trajectory"]
-    if not isinstance(base, dict):
-        raise ParameterError(f"trajectory.trajectory must be a record (got {shown(base)})")
-    trajectory, file, note = provenance.read_trajectory_record(base)
-    return ScaledTrajectory(trajectory, scale), file, note, base

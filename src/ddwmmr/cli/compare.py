@@ -41,7 +41,6 @@ from ddwmmr.cli.common import (
     run_main,
     scaled_trajectory,
     split_names,
-    trajectory_record,
 )
 from ddwmmr.controllers.base import available_methods, method_description
 from ddwmmr.controllers.option_specs import option_names, parse_options
@@ -458,7 +457,8 @@ def run_record(
         },
         robot=provenance.robot_record(config.robot),
         trajectories={
-            name: trajectory_record(t, sources.get(name)) for name, t in config.trajectories.items()
+            name: provenance.trajectory_record(t, sources.get(name))
+            for name, t in config.trajectories.items()
         },
         duration=config.duration,
         studies=list(config.studies),

@@ -39,12 +39,10 @@ from ddwmmr.cli.common import (
     offset_type,
     output_folder,
     parse_plant_options,
-    read_trajectory_record,
     robot_from_arguments,
     run_main,
     scaled_trajectory,
     seconds_type,
-    trajectory_record,
 )
 from ddwmmr.controllers.base import (
     available_methods,
@@ -86,7 +84,7 @@ from ddwmmr.sim.simulate import (
 from ddwmmr.trajectories import ScaledTrajectory, available_trajectories, load_trajectory
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
-PROG = "python -m ddwmmr.track"
+PROG = provenance.TRACK_PROG
 #: The default plant (``--plant``), and the plant of a record that names none.
 PLANT = "kinematic"
 #: ``--offset``'s default for the default robot, as written on the command line (m).
@@ -539,9 +537,10 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
         if plant not in available_plants():
             raise ParameterError(f"plant {plant!r} is not supported by this version")
         trajectory_record = _field(record, "trajectory", dict, "trajectory")
-        trajectory, source, file_note, base_record = _inside(
-            "trajectory", lambda: read_trajectory_record(trajectory_record)
+        trajectory, source, file_note = _inside(
+            "trajectory", lambda: provenance.read_trajectory_record(trajectory_record)
         )
+        base_record = provenance.base_trajectory_record(trajectory_record)
         offset = tuple(provenance.decode(_field(record, "initial_offset", list, "offset")))
         inputs = RunInputs(
             _field(record, "method", str, "method name"),
@@ -730,10 +729,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     names = output_names(not args.no_plots, args.animate, physics)
     check_output_folder(out, "track", args.force, names)
     record = run_record(inputs, argv, args.rerun, tool="track", prog=PROG)
-    if isinstance(inputs.trajectory, ScaledTrajectory):  # its base's record and the factor
-        record["trajectory"] = trajectory_record(
-            inputs.trajectory, inputs.trajectory_file, inputs.trajectory_sha256
-        )
+    if isinstance(inputs.trajectory, ScaledTrajectory):
         _note_unscaled_obstacles(inputs.options)
     progress = not args.no_progress
     _note_uneven_duration(inputs.duration, inputs.dt, steps)
