@@ -76,7 +76,7 @@ from ddwmmr.reports.compare import (
     write_report,
 )
 from ddwmmr.reports.compare.constants import TIE_ABSOLUTE_M, TIE_RELATIVE
-from ddwmmr.reports.compare.plan import report_name, run_duration, skipped_studies
+from ddwmmr.reports.compare.plan import main_spec, report_name, run_duration, skipped_studies
 from ddwmmr.resolution.reference import default_offset, initial_configuration
 from ddwmmr.sim.result import json_safe
 from ddwmmr.sim.simulate import check_start
@@ -98,8 +98,9 @@ outputs (in --out):
   plant_metrics.csv  with --plant: the same for the runs on each plant (column plant)
   run.json      everything needed to repeat the comparison by hand: methods and
                 their options with defaults, robot, trajectories (parameters, and a
-                file's path and SHA-256), studies, version, git commit, libraries,
-                BLAS, CPU and a command that repeats it
+                file's path and SHA-256), step per trajectory, integrator, initial
+                offset, studies, version, git commit, libraries, BLAS, CPU and a
+                command that repeats it
   *.png         paths, errors, wheel speeds and per-method panels per trajectory; one
                 figure per study
   The folder is built next to --out and renamed into place when complete; an existing
@@ -443,8 +444,13 @@ def check_runs(config: CompareConfig, specs: Sequence[Any]) -> None:
 def run_record(
     config: CompareConfig, sources: dict[str, Any], argv: Sequence[str] | None, jobs: int
 ) -> dict[str, Any]:
-    """run.json: everything needed to repeat the comparison."""
+    """run.json: everything needed to repeat the comparison. ``dt`` (s, per trajectory),
+    ``integrator`` and ``initial_offset`` (m, in the end effector's start frame) are the
+    main comparison's on the kinematic plant, encoded as in track's record (the studies
+    sweep them; a physics plant rounds the step to its engine's)."""
     record = provenance.header("compare", PROG, argv)
+    runs = {name: main_spec(config, config.methods[0], name) for name in config.trajectories}
+    first = next(iter(runs.values()))
     record.update(
         methods=list(config.methods),
         study_methods=list(config.studied),
@@ -460,7 +466,10 @@ def run_record(
             name: provenance.trajectory_record(t, sources.get(name))
             for name, t in config.trajectories.items()
         },
+        dt={name: spec.dt for name, spec in runs.items()},
         duration=config.duration,
+        integrator=first.integrator,
+        initial_offset=list(first.initial_offset or ()),
         studies=list(config.studies),
         jobs=jobs,
         plant={"name": "kinematic"},  # the main comparison; ``plants`` adds sections

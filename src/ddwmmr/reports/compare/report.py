@@ -69,6 +69,7 @@ from ddwmmr.reports.compare.ranking import (
     plant_metrics_rows,
 )
 from ddwmmr.reports.plots import circles_of
+from ddwmmr.resolution.kernels import SINGULARITY_THRESHOLD
 from ddwmmr.resolution.reference import default_offset
 from ddwmmr.sim.simulate import FINAL_WINDOW_FRACTION, RATE_LIMIT_TOLERANCE
 from ddwmmr.sim.verdict import explain, support_warning
@@ -323,7 +324,7 @@ def _advice_section(c: _Context, ranking: Ranking, slides_ranking: Ranking) -> N
         "machine (the median over the trajectories of each run's median step; a timing: it "
         "varies between runs and machines), whether the initial offset is removed, whether "
         "tip-over stability is a hard constraint, and what the shoulder singularity "
-        "cos th1 = 0 does to the run." + _plant_scope(list(c.plan.plants))
+        f"cos th1 = 0 does to the run ({REACHED_TEXT})." + _plant_scope(list(c.plan.plants))
     )
     c.doc.table(advice.ADVICE_HEADERS, advice.advice_rows(items), left=advice.ADVICE_TEXT)
     if advice.marked(items):
@@ -461,7 +462,8 @@ def _diagnosis_section(c: _Context) -> None:
     c.doc.heading("What happened in each run")
     c.doc.paragraph(
         "Findings computed from each main run's time series: the shoulder singularity "
-        f"(|cos th1| < {SINGULAR_COS:g}), orientation lost at the rectangle's corners, "
+        f"({REACHED_TEXT}; the steps a finding calls damped are the singular steps, a wider "
+        "test: see the Definitions), orientation lost at the rectangle's corners, "
         "commands the plant clipped at a speed limit (saturated), speed limits a method held "
         "inside its own bounds, a kept initial offset, or convergence."
     )
@@ -547,6 +549,10 @@ def _observations(c: _Context, ranking: Ranking) -> list[str]:
         )
     return notes
 
+
+#: When the report counts the shoulder singularity reached (its diagnosis and advice):
+#: a narrower test than the damping that ``singular_steps`` counts.
+REACHED_TEXT = f"reached where |cos th1| < {SINGULAR_COS:g}"
 
 #: Header of a cell of :func:`limit_steps`.
 LIMIT_STEPS = "saturated / wheel-limit / joint-rate-limit steps"
@@ -700,7 +706,7 @@ def _plant_section(c: _Context, plant: str) -> None:
             reasons.append(_plant_reason(spec, where, ratio, lag, saturated, slip))
     headers = [
         "trajectory", "method", "RMS kinematic (mm)", f"RMS {plant} (mm)", RATIO_HEADER,
-        f"final {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)", "min S",
+        f"settled-end RMS {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)", "min S",
         "min physics S", "tipped", *(SUPPORT_HEADERS if support else ()),
         "tracked? (docs/cli.md, Verdict)",
     ]  # fmt: skip
@@ -1000,7 +1006,7 @@ def _dt_section(c: _Context) -> None:
             rows.append([m, integrator, *[mm(values[dt]) for dt in steps], order])
     c.doc.paragraph(
         f"{STUDY_TRAJECTORY}, no initial offset, so the largest position error of a run is "
-        "numerical drift (or a method's own failure); the final error would hide drift that "
+        "numerical drift (or a method's own failure); the error at the end would hide drift that "
         "cancels over a closed loop. The observed order is the median slope of log(error) "
         "vs log(dt) (round-off below 1e-12 m excluded): about 1 for forward Euler and 4 for "
         "RK4 where the integration error dominates. " + _dt_finding(drift)
@@ -1186,7 +1192,8 @@ def _init_section(c: _Context) -> None:
     c.add_figure(
         "study_init.png",
         plots.plot_init_study(final, curves, curve_method, c.colors),
-        "Final error vs initial offset per method, and error vs time per offset.",
+        "Settled-end RMS position error vs initial offset per method, and error vs time per "
+        "offset.",
     )
 
 
@@ -1281,8 +1288,12 @@ def _definitions_section(c: _Context) -> None:
             f"{100 * FINAL_WINDOW_FRACTION:g} % of the samples outside the rectangle's corner "
             "windows; position error at the end (`end_position_error_m`): at the last sample",
             "manipulability: |sin th2| in [0, 1]; stability S: tip-over margin, S <= 1 tips",
-            "singular steps: steps with damping near a singularity (for `clrrmc-cs`: steps "
-            "whose reference segment was integrated with damping); saturated steps: steps "
+            "singular steps: steps where the method damped its inverse, the smallest "
+            "singular value of the matrix inverted below its `singularity_threshold` "
+            f"(default {SINGULARITY_THRESHOLD:g} in the robot's length unit: on `Robot()` "
+            "|cos th1| < 0.15 to 0.25, so they begin before the singularity counts as "
+            f"reached, |cos th1| < {SINGULAR_COS:g}; for `clrrmc-cs`: steps whose reference "
+            "segment was integrated with damping); saturated steps: steps "
             "whose command the plant clipped at a wheel or joint speed limit (or stopped at "
             "a joint limit); wheel-limit steps, joint-rate-limit steps: steps with a wheel "
             "speed or a joint rate within "
