@@ -56,7 +56,8 @@ from ddwmmr.gui.widgets import (
     wrap_to_width,
 )
 from ddwmmr.gui.worker import Worker
-from ddwmmr.sim.verdict import lost_support, short_verdict
+from ddwmmr.reports.compare.report import METRIC_COLUMNS
+from ddwmmr.sim.verdict import held_limits, lost_support, short_verdict
 from ddwmmr.trajectories import load_trajectory
 
 #: Playback frame and progress poll intervals (ms).
@@ -763,19 +764,41 @@ def _optional_positive(name: str, text: str) -> float | None:
     return value
 
 
+#: The metrics of a run's summary line, as summary keys: each is written with the label and
+#: the formatting of the comparison's metric table (:data:`METRIC_COLUMNS`; errors in mm, as
+#: ``track`` and ``compare`` print them).
+SUMMARY_METRICS = (
+    "rms_position_error_m",
+    "max_position_error_m",
+    "rms_orientation_error_rad",
+    "max_wheel_speed_rad_s",
+    "min_stability",
+    "min_manipulability",
+    "saturated_steps",
+)
+
+
 def _summary_line(label: str, result: Any) -> str:
     """One method's line of the summary: its verdict first (docs/cli.md, "Verdict"), then
-    the metrics."""
+    the metrics (:data:`SUMMARY_METRICS`), the safe-fallback steps and the rate and
+    actuator limits the run held (:func:`held_limits`), which ``saturated steps`` (the
+    commands the plant clipped) does not count."""
     s = result.summary
-    line = (
-        f"{label}: {short_verdict(s)}; RMS pos {s['rms_position_error_m']:.3g} m,"
-        f" max {s['max_position_error_m']:.3g} m,"
-        f" RMS orient {s['rms_orientation_error_rad']:.3g} rad, max wheel"
-        f" {s['max_wheel_speed_rad_s']:.3g} rad/s, min S {s['min_stability']:.3g},"
-        f" min eta {s['min_manipulability']:.2f}, saturated {s['saturated_steps']},"
-        f" fallbacks {s['fallback_steps']}"
-    )
-    return line + _physics_verdict(s)
+    columns = {key: (header, write) for header, key, write in METRIC_COLUMNS}
+    metrics = [_metric(*columns[key], s.get(key)) for key in SUMMARY_METRICS]
+    line = f"{label}: {short_verdict(s)}; {', '.join(metrics)}, fallbacks {s['fallback_steps']}"
+    line += _physics_verdict(s)
+    held = held_limits(s)
+    return line + (f"; limits held: {', '.join(held)}" if held else "")
+
+
+def _metric(header: str, write: Callable[[Any], str], value: Any) -> str:
+    """``value`` written by ``write`` after its column ``header``, the header's unit (a
+    trailing ``(unit)``) moved after the number: ``RMS pos 6.83 mm``."""
+    name, bracket, unit = header.partition(" (")
+    if not bracket:
+        return f"{header} {write(value)}"
+    return f"{name} {write(value)} {unit.removesuffix(')')}"
 
 
 def _physics_verdict(summary: dict[str, Any]) -> str:

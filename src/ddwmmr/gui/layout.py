@@ -271,11 +271,11 @@ class PanelLayout:
         )
         self.view = RunView(path_ax, plot_axes)
         self.summary_text = self.figure.text(
-            0.385, 0.228, "", fontsize=FONT, va="top", linespacing=1.4
+            0.385, 0.228, "", fontsize=FONT, va="top", linespacing=1.3
         )
 
     def _build_transport(self) -> None:
-        row = 0.1
+        row = 0.07
         self.transport = {
             "run": button(self.figure, (0.385, row, 0.055, 0.038), "Run", self.run),
             "pause": button(self.figure, (0.445, row, 0.055, 0.038), "Pause", self.pause),
@@ -312,7 +312,7 @@ class PanelLayout:
             fontsize=FONT,
             transform=self.progress_ax.transAxes,
         )
-        self.time_ax = panel_axes(self.figure, (0.42, 0.045, 0.52, 0.025))
+        self.time_ax = panel_axes(self.figure, (0.42, 0.025, 0.52, 0.025))
         self.time_slider = Slider(
             self.time_ax, "time", 0.0, 1.0, valinit=0.0, valfmt="%.2f", initcolor="none"
         )
