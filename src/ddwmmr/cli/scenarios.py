@@ -62,6 +62,7 @@ from ddwmmr.errors import (
     check_nonnegative,
     shown,
 )
+from ddwmmr.model import Robot
 from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR
 from ddwmmr.outputs import write_atomic
 from ddwmmr.plants import available_plants, plant_class, plant_description
@@ -106,6 +107,9 @@ PROG = "python -m ddwmmr.scenarios"
 #: --qp-* options (``RunConfig`` fields, which check their values): the controllers that
 #: use them.
 QP_OPTIONS = {"qp_stability_min": ("qp", "mpc"), "qp_max_speed": ("qp",)}
+#: ``RunConfig`` fields only a controller with an arbiter (the thesis controller) reads:
+#: its fix states' thresholds and its arbiter.
+ARBITER_FIELDS = ("stability", "manipulability", "arbiter", "arbiter_seed")
 #: ``RunConfig`` fields whose option is spelt otherwise, for its messages.
 OPTION_SPELLING = {
     field: field.replace("_", "-")
@@ -136,11 +140,11 @@ into --out, and prints the table. The controllers are the registered ones that d
 waypoint task, the plants the registered ones; --help lists both, each controller with the
 plants it can command."""
 
-EPILOG = """\
-The default payload is 3.0 kg: with the thesis's 1.25 kg the planar arm can never tip
-(S >= 1.56), so the stability behaviour could never be needed. Results are identical for
-any --executor and --jobs. Bad input prints one line and exits with status 2, leaving no
-output behind."""
+EPILOG = f"""\
+The default payload is 3.0 kg: with the {Robot.payload:g} kg of the thesis's experiments
+(the Robot default) the planar arm can never tip (S >= 1.56), so the stability behaviour
+could never be needed. Results are identical for any --executor and --jobs. Bad input
+prints one line and exits with status 2, leaving no output behind."""
 
 
 def _options_epilog() -> str:
@@ -229,7 +233,8 @@ def build_parser() -> ArgumentParser:
         default=3.0,
         metavar="KG",
         help="end-effector payload in kg, >= 0 and light enough that the start pose stands "
-        "(S > 1) (default: 3.0; thesis: 1.25)",
+        f"(S > 1) (default: 3.0; the thesis's own experiments carried {Robot.payload:g} kg, "
+        "the Robot default that track and compare run: see below)",
     )
     parser.add_argument(
         "--robot", action=RefusedOption, reason=f"{THESIS_ROBOT_ONLY}; use --payload"
@@ -649,7 +654,7 @@ def write_batch(
     """scenarios.csv, summary.json, table.txt and the figures of one batch."""
     summary = report.summarize(outcomes, wall)
     summary.update(extra)
-    summary["config"] = asdict(config)
+    summary["config"] = config_record(config)
     title = _title(config)
     write_atomic(folder / "scenarios.csv", report.metrics_csv(outcomes))
     table = report.format_table(summary, f"Table 5.2 format: {title}")
@@ -862,7 +867,7 @@ def _run_thresholds(args, config, runner, folder: Path) -> None:
         "study": "thresholds",
         "n": len(scenarios),
         "seed": args.seed,
-        "config": asdict(config),
+        "config": config_record(config),
         "variants": rows,
         "wall_time_s": sum(s["wall_time_s"] for _, s in results),
         "run": _record(args, config, runner.workers),
@@ -897,9 +902,26 @@ def _run_arbiters(args, config, runner, folder: Path) -> None:
     study = arbiter_study.write_study(
         folder, scenarios, config, runner.run, runner.jobs, seed=args.seed
     )
-    study.update(seed=args.seed, config=asdict(config), run=_record(args, config, runner.workers))
+    study.update(
+        seed=args.seed, config=config_record(config), run=_record(args, config, runner.workers)
+    )
     write_atomic(folder / MARKER, report.summary_json(study))
     print(study["table"], end="")
+
+
+def config_record(config: RunConfig) -> dict[str, Any]:
+    """``config`` as a batch's summary.json records it (``config``, and ``run.config``):
+    its fields (``asdict``) without those its controller does not read, the thresholds
+    and arbiter of :data:`ARBITER_FIELDS` for a controller with no arbiter (``qp``,
+    ``mpc``) and a ``qp_*`` option for a controller that does not take it
+    (:data:`QP_OPTIONS`). ``RunConfig(**record)`` runs the same batch: a field left out
+    takes its default, which the controller ignores as it ignored the recorded value."""
+    record = asdict(config)
+    unused = [] if controller_traits(config.controller)["arbiter"] else list(ARBITER_FIELDS)
+    unused += [name for name, takers in QP_OPTIONS.items() if config.controller not in takers]
+    for name in unused:
+        del record[name]
+    return record
 
 
 def _record(args: argparse.Namespace, config: RunConfig, workers: int) -> dict[str, Any]:
@@ -908,7 +930,7 @@ def _record(args: argparse.Namespace, config: RunConfig, workers: int) -> dict[s
     (:attr:`Runner.workers`)."""
     record = provenance.header("scenarios", PROG, args.argv)
     record.update(
-        config=provenance.encode(asdict(config)),
+        config=provenance.encode(config_record(config)),
         n=args.n,
         seed=args.seed,
         study=args.study,
