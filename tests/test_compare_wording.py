@@ -101,7 +101,7 @@ def test_mpc_shows_the_joint_rate_limit_it_holds_and_no_contradiction(report) ->
         "it passes the shoulder singularity cos(th1) = 0 at t = 0.6 s without losing the "
         "path (largest error after it 10.3 mm; no step damped)" in bullet
     )
-    assert "it held a joint rate at its speed limit on 26 steps (the plant clipped none)" in bullet
+    assert "it held a joint at its rate limit on 26 steps (the plant clipped none)" in bullet
     assert "no singularity" not in bullet and bullet.endswith(NOTHING_ADVERSE + ".")
 
 

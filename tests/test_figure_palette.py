@@ -48,7 +48,7 @@ def test_console_names_the_joint_limit_behind_saturated_steps() -> None:
     assert lines[1:] == [
         "  saturated steps (plant clipped)      427",
         "  wheel at speed limit (steps)         0",
-        "  joint rate at speed limit (steps)    0",
+        "  joint at rate limit (steps)          0",
         "  joint at position limit (steps)      427",
         "  position limit held (most steps)     th2 = -3.142 rad",
     ]

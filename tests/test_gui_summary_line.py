@@ -64,7 +64,9 @@ def test_a_vanishing_manipulability_keeps_its_digits():
         "fallback_steps": 0, "steps": 2000, "duration": 40.0, "dt": 0.02,
     }  # fmt: skip
     line = _summary_line("pi", SimpleNamespace(summary=summary))
-    assert "RMS pos 2394 mm, max pos 4316 mm, RMS orient 1.92 rad, peak wheel 8.32 rad/s" in line
+    assert (
+        "RMS pos 2394 mm, max pos 4316 mm, RMS orient 1.92 rad, max wheel speed 8.32 rad/s" in line
+    )
     assert "min manip. 1.22e-16, saturated steps 82, fallbacks 0" in line
     assert "limits held" not in line
 

@@ -32,7 +32,7 @@ def test_console_names_the_settled_end_and_the_held_limits() -> None:
         "  position error at the end (mm)       3.13607",
         "  saturated steps (plant clipped)      0",
         "  wheel at speed limit (steps)         0",
-        "  joint rate at speed limit (steps)    145",
+        "  joint at rate limit (steps)          145",
     ]
 
 

@@ -68,6 +68,7 @@ from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.provenance import RunInputs, run_record
 from ddwmmr.registry import PLANTS
+from ddwmmr.reports.metrics import METRICS
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
     default_offset,
@@ -107,58 +108,14 @@ RUN_OPTIONS = (
     "solver", "qp_mode", "preset", "horizon", "option", "plant_option",
 )  # fmt: skip
 
-#: Keys printed in the summary table, with their labels; errors in mm (as in compare).
-#: The labels name what docs/cli.md's summary table defines: ``final_position_error_m`` is
-#: the RMS over the run's settled end, not the last sample's error; ``saturated_steps``
-#: counts commands the plant clipped, while a limit ``qp`` or ``mpc`` holds inside its own
-#: bounds shows only in ``wheel_limit_steps`` / ``joint_rate_limit_steps``. A key the
-#: run's summary lacks (or holds None) is left out: the support keys show on a plant that
-#: reports them (MuJoCo), the predicted edge load where the controller's limit is on.
-TABLE_KEYS = (
-    ("rms_position_error_m", "RMS position error (mm)"),
-    ("max_position_error_m", "max position error (mm)"),
-    ("final_position_error_m", "settled-end RMS position error (mm)"),
-    ("end_position_error_m", "position error at the end (mm)"),
-    ("corner_position_error_m", "corner position error (mm)"),
-    ("rms_orientation_error_rad", "RMS orientation error (rad)"),
-    ("max_nonholonomic_residual_m_s", "max nonholonomic residual (m/s)"),
-    ("max_wheel_speed_rad_s", "max wheel speed (rad/s)"),
-    ("min_manipulability", "min manipulability"),
-    ("min_stability", "min stability S"),
-    ("singular_steps", "singular (damped) steps"),
-    ("saturated_steps", "saturated steps (plant clipped)"),
-    ("wheel_limit_steps", "wheel at speed limit (steps)"),
-    ("joint_rate_limit_steps", "joint rate at speed limit (steps)"),
-    ("joint_limit_steps", "joint at position limit (steps)"),
-    ("joint_limit_held", "position limit held (most steps)"),
-    ("stability_violations", "steps with S < S_min"),
-    ("qp_fallbacks", "QP fallbacks"),
-    ("mpc_fallbacks", "MPC fallbacks (its qp commanded)"),
-    ("min_obstacle_clearance_m", "min obstacle clearance (mm)"),
-    ("max_wheel_force_n", "max wheel force (N)"),
-    ("actuator_saturated_time_s", "time with an actuator at limit (s)"),
-    ("tipped", "tipped over (physics)"),
-    ("support_lost", "support lost (an edge unloaded)"),
-    ("unloaded_time_s", "time with an edge unloaded (s)"),
-    ("min_edge_load_n", "min support-edge load (N)"),
-    ("min_predicted_edge_load_n", "min predicted edge load (N)"),
-    ("min_edge_load_floor_n", "edge-load floor held (N)"),
-    ("min_physics_stability", "min physics stability"),
-    ("max_base_tilt_rad", "max base tilt (rad)"),
-    ("max_wheel_slip_m_s", "max wheel slip (m/s)"),
-    ("diverged", "plant diverged"),
-    ("steps", "steps"),
-    ("median_step_us", "median controller step (us)"),
-)
-#: Summary keys shown in mm in the table (stored in m in summary.json).
-MM_KEYS = {
-    "rms_position_error_m",
-    "max_position_error_m",
-    "final_position_error_m",
-    "end_position_error_m",
-    "corner_position_error_m",
-    "min_obstacle_clearance_m",
-}
+#: Keys printed in the summary table, in order, each with its long label, unit and scale
+#: (:data:`ddwmmr.reports.metrics.METRICS`; errors in mm, as in compare): every metric but
+#: the mean manipulability, a column of compare's table only. A key the run's
+#: summary lacks (or holds None) is left out: the support keys show on a plant that reports
+#: them (MuJoCo), the predicted edge load where the controller's limit is on.
+TABLE_KEYS = tuple(key for key in METRICS if key != "mean_manipulability")
+#: Width of the table's label column: the longest label and a space, so the values align.
+LABEL_WIDTH = 36
 
 #: CLI option -> controller keyword; a method takes the option if its constructor has the
 #: keyword (:func:`ddwmmr.controllers.base.method_options`), any other refuses it.
@@ -435,13 +392,12 @@ def format_table(summary: dict[str, Any]) -> str:
     verdict (:mod:`ddwmmr.sim.verdict`)."""
     plant = summary.get("plant", PLANT)
     lines = [f"{summary['method']} on {summary['trajectory']} ({plant} plant)"]
-    for key, label in TABLE_KEYS:
-        if key in summary and summary[key] is not None:
-            value = summary[key]
-            if key in MM_KEYS:
-                value = 1000.0 * value
+    for key in TABLE_KEYS:
+        if summary.get(key) is not None:
+            metric = METRICS[key]
+            value = metric.shown(summary[key])
             text = f"{value:.6g}" if isinstance(value, float) else str(value)
-            lines.append(f"  {label:<36} {text}")
+            lines.append(f"  {metric.long_label:<{LABEL_WIDTH}} {text}")
     if "verdict" in summary:
         lines.append(textwrap.fill(f"verdict: {summary['verdict']}", 100, subsequent_indent="  "))
     return "\n".join(lines)

@@ -56,7 +56,8 @@ from ddwmmr.gui.widgets import (
     wrap_to_width,
 )
 from ddwmmr.gui.worker import Worker
-from ddwmmr.reports.compare.report import METRIC_COLUMNS
+from ddwmmr.reports.compare.document import fmt
+from ddwmmr.reports.metrics import METRICS, Metric
 from ddwmmr.sim.verdict import held_limits, lost_support, short_verdict
 from ddwmmr.trajectories import load_trajectory
 
@@ -764,9 +765,9 @@ def _optional_positive(name: str, text: str) -> float | None:
     return value
 
 
-#: The metrics of a run's summary line, as summary keys: each is written with the label and
-#: the formatting of the comparison's metric table (:data:`METRIC_COLUMNS`; errors in mm, as
-#: ``track`` and ``compare`` print them).
+#: The metrics of a run's summary line, as summary keys: each is written with its short
+#: label, unit and scale (:data:`ddwmmr.reports.metrics.METRICS`; errors in mm, as ``track``
+#: and ``compare`` print them) and 3 significant digits, as in the comparison's metric table.
 SUMMARY_METRICS = (
     "rms_position_error_m",
     "max_position_error_m",
@@ -784,21 +785,18 @@ def _summary_line(label: str, result: Any) -> str:
     actuator limits the run held (:func:`held_limits`), which ``saturated steps`` (the
     commands the plant clipped) does not count."""
     s = result.summary
-    columns = {key: (header, write) for header, key, write in METRIC_COLUMNS}
-    metrics = [_metric(*columns[key], s.get(key)) for key in SUMMARY_METRICS]
+    metrics = [_metric(METRICS[key], s.get(key)) for key in SUMMARY_METRICS]
     line = f"{label}: {short_verdict(s)}; {', '.join(metrics)}, fallbacks {s['fallback_steps']}"
     line += _physics_verdict(s)
     held = held_limits(s)
     return line + (f"; limits held: {', '.join(held)}" if held else "")
 
 
-def _metric(header: str, write: Callable[[Any], str], value: Any) -> str:
-    """``value`` written by ``write`` after its column ``header``, the header's unit (a
-    trailing ``(unit)``) moved after the number: ``RMS pos 6.83 mm``."""
-    name, bracket, unit = header.partition(" (")
-    if not bracket:
-        return f"{header} {write(value)}"
-    return f"{name} {write(value)} {unit.removesuffix(')')}"
+def _metric(metric: Metric, value: Any) -> str:
+    """``value`` (summary units) after the metric's short label, in its display unit with 3
+    significant digits, the unit after the number: ``RMS pos 6.83 mm``."""
+    text = f"{metric.name} {fmt(metric.shown(value))}"
+    return f"{text} {metric.unit}" if metric.unit else text
 
 
 def _physics_verdict(summary: dict[str, Any]) -> str:

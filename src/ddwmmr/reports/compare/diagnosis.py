@@ -214,7 +214,7 @@ def held_limits_text(summary: Mapping[str, Any]) -> str:
         (summary.get(key) or 0, what)
         for key, what in (
             ("wheel_limit_steps", "a wheel at its speed limit"),
-            ("joint_rate_limit_steps", "a joint rate at its speed limit"),
+            ("joint_rate_limit_steps", "a joint at its rate limit"),
         )
     ]
     if all(count <= clipped for count, _ in counts):

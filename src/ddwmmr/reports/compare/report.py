@@ -68,6 +68,7 @@ from ddwmmr.reports.compare.ranking import (
     metrics_rows,
     plant_metrics_rows,
 )
+from ddwmmr.reports.metrics import METRICS, Metric
 from ddwmmr.reports.plots import circles_of
 from ddwmmr.resolution.kernels import SINGULARITY_THRESHOLD
 from ddwmmr.resolution.reference import default_offset
@@ -573,21 +574,32 @@ def tracked(reasons: Any) -> str:
     return "yes" if not reasons else "no: " + ", ".join(reasons)
 
 
-METRIC_COLUMNS = (
-    ("RMS pos (mm)", "rms_position_error_m", mm),
-    ("max pos (mm)", "max_position_error_m", mm),
-    ("settled-end RMS pos (mm)", "final_position_error_m", mm),
-    ("RMS orient (rad)", "rms_orientation_error_rad", fmt),
-    ("max nonhol. residual (m/s)", "max_nonholonomic_residual_m_s", fmt),
-    ("peak wheel (rad/s)", "max_wheel_speed_rad_s", fmt),
-    ("min manip.", "min_manipulability", fmt),
-    ("mean manip.", "mean_manipulability", fmt),
-    ("min stability S", "min_stability", fmt),
-    ("singular steps", "singular_steps", fmt),
-    ("saturated steps", "saturated_steps", fmt),
-    ("wheel-limit steps", "wheel_limit_steps", fmt),
-    ("joint-rate-limit steps", "joint_rate_limit_steps", fmt),
-    ("step latency (us)", "median_step_us", fmt),
+def metric_cell(metric: Metric) -> Callable[[Any], str]:
+    """The table cell of ``metric``: its value in the display unit, 3 significant digits."""
+    return lambda value: fmt(metric.shown(value))
+
+
+#: The summary metrics of a trajectory's table, as summary keys (labels, units and scales:
+#: :data:`~ddwmmr.reports.metrics.METRICS`).
+METRIC_KEYS = (
+    "rms_position_error_m",
+    "max_position_error_m",
+    "final_position_error_m",
+    "rms_orientation_error_rad",
+    "max_nonholonomic_residual_m_s",
+    "max_wheel_speed_rad_s",
+    "min_manipulability",
+    "mean_manipulability",
+    "min_stability",
+    "singular_steps",
+    "saturated_steps",
+    "wheel_limit_steps",
+    "joint_rate_limit_steps",
+    "median_step_us",
+)
+#: A trajectory's table: (header, summary key, cell writer) per column after the method's.
+METRIC_COLUMNS: tuple[tuple[str, str, Callable[[Any], str]], ...] = (
+    *((METRICS[key].label, key, metric_cell(METRICS[key])) for key in METRIC_KEYS),
     ("tracked? (docs/cli.md, Verdict)", "verdict_reasons", tracked),
 )
 
@@ -706,8 +718,9 @@ def _plant_section(c: _Context, plant: str) -> None:
             reasons.append(_plant_reason(spec, where, ratio, lag, saturated, slip))
     headers = [
         "trajectory", "method", "RMS kinematic (mm)", f"RMS {plant} (mm)", RATIO_HEADER,
-        f"settled-end RMS {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)", "min S",
-        "min physics S", "tipped", *(SUPPORT_HEADERS if support else ()),
+        f"settled-end RMS {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)",
+        METRICS["min_stability"].label, "min physics S", "tipped",
+        *(SUPPORT_HEADERS if support else ()),
         "tracked? (docs/cli.md, Verdict)",
     ]  # fmt: skip
     headers, rows = _filled_columns(headers, rows)
@@ -1300,8 +1313,8 @@ def _definitions_section(c: _Context) -> None:
             f"{100 * RATE_LIMIT_TOLERANCE:g} % of its limit, whether the plant clipped it "
             "or the method held it inside its own bounds (`qp` and `mpc` bound their "
             "commands a hair inside the limits: their limits show here, not as saturated)",
-            "step latency: median wall-clock time of one controller call (us); a timing, so "
-            "it varies between runs and machines",
+            f"{METRICS['median_step_us'].name}: median wall-clock time of one controller "
+            "call (us); a timing, so it varies between runs and machines",
             "`metrics.csv`: one row per method x trajectory with every `summary.json` field "
             "of the matching `python -m ddwmmr.track` run"
             + (
