@@ -76,14 +76,14 @@ def covers_data(ax: Axes, legend: Legend) -> bool:
             continue
         if line.get_linestyle() in ("None", "", " ", "none"):  # markers only: the points
             points = line.get_transform().transform(line.get_xydata())
-            if len(points) and np.any(box.contains_points(points)):
+            if box.count_contains(points):
                 return True
         elif _crosses(line.get_transform(), line.get_xydata(), box):
             return True
     for collection in ax.collections:
         if isinstance(collection, PathCollection) and collection.get_visible():
             points = collection.get_offset_transform().transform(collection.get_offsets())
-            if len(points) and np.any(box.contains_points(points)):
+            if box.count_contains(points):
                 return True
     return any(
         text.get_visible() and text.get_text() and box.overlaps(text.get_window_extent(renderer))
