@@ -94,7 +94,7 @@ def _install_display(install: Callable[[], None], shown: frozenset[str]) -> None
     installed (:data:`SHOWN`): a forked worker's display, a copy of its parent's, holds
     them already; a worker started otherwise begins without them."""
     install()
-    getattr(warnings.showwarning, SHOWN, set()).update(shown)
+    getattr(warnings.showwarning, SHOWN, set[str]()).update(shown)
 
 
 def start_worker(parent_pid: int, display: Callable[[], None] | None) -> None:

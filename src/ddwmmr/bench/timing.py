@@ -61,7 +61,7 @@ def time_calls(
     return np.maximum(times - overhead_ns, 0.0) / 1000.0
 
 
-def summarize_times(times: np.ndarray) -> dict[str, float]:
+def summarize_times(times: np.ndarray) -> dict[str, Any]:
     """Median, 90th and 99th percentile over states of each state's median over the
     repeats (``times``: repeats x states, us), and the median of each repeat's median."""
     per_state = np.median(times, axis=0)

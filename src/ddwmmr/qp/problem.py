@@ -213,7 +213,7 @@ class QPProblem:
         self.tasks = list(tasks)
         self.limits = list(limits)
         self.compiled = bool(compiled)
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         self.slack_tasks = [t for t in self.tasks if t.slack]
         self.cost_tasks = [t for t in self.tasks if not t.slack]
         self.n_slack = sum(t.rows for t in self.slack_tasks)
@@ -268,7 +268,7 @@ class QPProblem:
         """Writers for the compiled pieces, views for the generic ones."""
         mv, n = self._mv, self.n
         sqrt_w = self.sqrt_w.tolist()
-        self._writers = []
+        self._writers: list[Callable[[StepContext], None]] = []
         self._generic_cost = []
         self._generic_slack = []
         self._generic_limits = []

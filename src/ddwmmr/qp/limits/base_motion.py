@@ -56,7 +56,7 @@ class BaseMotionLimit(Limit):
         max_yaw_acceleration: float | None = None,
         unit: float = 1.0,
     ) -> None:
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         self.max_speed = check_positive("max_base_speed", max_speed)
         self.max_yaw_rate = check_positive("max_yaw_rate", max_yaw_rate)
         self.max_acceleration = (
@@ -122,7 +122,7 @@ class SpeedBudgetLimit(Limit):
     name = "speed budget"
 
     def __init__(self, speeds: tuple[float, float], unit: float = 1.0) -> None:
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         if isinstance(speeds, str) or not hasattr(speeds, "__len__") or len(speeds) != 2:
             raise ParameterError(
                 f"speed_budget must be two numbers > 0, (v_top m/s, w_top rad/s)"

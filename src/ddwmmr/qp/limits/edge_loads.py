@@ -74,7 +74,7 @@ class EdgeLoadLimit(Limit):
         acceleration_limit: tuple[float, float] | None = None,
         unit: float = 1.0,
     ) -> None:
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         self.model = EdgeLoadModel.from_robot(robot)
         self.min_edge_load = check_min_edge_load(min_edge_load)
         self.floor_n = self.min_edge_load * self.model.weight

@@ -277,7 +277,7 @@ class ObstacleLimit(Limit):
         gain: float = 2.0,
         unit: float = 1.0,
     ) -> None:
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         self.circles = list(circles)
         self.rows = len(self.circles)
         self.half_length, self.half_width = 0.5 * robot.base_length, 0.5 * robot.base_width

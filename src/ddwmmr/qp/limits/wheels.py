@@ -22,7 +22,7 @@ class WheelSpeedLimit(Limit):
     name = "wheels"
 
     def __init__(self, robot: Robot, scale: float = 1.0, unit: float = 1.0) -> None:
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         r, lw = robot.wheel_radius, robot.track_width
         self.rows_lr = ((unit / r, -lw / (2.0 * r)), (unit / r, lw / (2.0 * r)))
         # A hair inside the plant's limit so the plant never has to rescale our command.

@@ -38,7 +38,7 @@ class ObstacleSteeringTask(YawRowTask):
         unit: float = 1.0,
     ) -> None:
         super().__init__(weight)
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         self.circles = list(circles)
         self.half_length, self.half_width = half_length, half_width
         self.influence = check_positive("obstacle influence", influence)

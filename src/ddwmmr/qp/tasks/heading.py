@@ -8,6 +8,7 @@ from ddwmmr.errors import check_nonnegative, check_positive
 from ddwmmr.gains import check_gain
 from ddwmmr.model.kinematics import wrap_angle
 from ddwmmr.qp.context import StepContext
+from ddwmmr.qp.tasks.avoidance import Detour
 from ddwmmr.qp.tasks.base import YawRowTask
 
 
@@ -35,12 +36,12 @@ class HeadingTask(YawRowTask):
         unit: float = 1.0,
     ) -> None:
         super().__init__(weight)
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         self.gain = check_gain("heading gain", gain)
         self.distance = check_nonnegative("heading distance", distance)
         self.fade = check_positive("heading fade", fade)
         #: Optional :class:`~ddwmmr.qp.tasks.avoidance.Detour` for the bearing.
-        self.detour = None
+        self.detour: Detour | None = None
 
     def values(self, ctx: StepContext) -> tuple[float, float]:
         """``(J[0, 1], e[0])``: the fade factor and the yaw-rate target (rad/s)."""

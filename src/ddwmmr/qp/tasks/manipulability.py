@@ -86,7 +86,7 @@ class ManipulabilityTask(Task):
         unit: float = 1.0,
     ) -> None:
         super().__init__(weight)
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         self.arm_row = bool(arm_row)
         self.gain = check_gain("manipulability gain", gain)
         self.base_gain = check_gain("manipulability base_gain", base_gain)

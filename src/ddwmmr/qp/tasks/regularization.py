@@ -27,7 +27,7 @@ class RegularizationTask(Task):
     def __init__(self, weight: float = 1e-3, length: float = 0.5, unit: float = 1.0) -> None:
         super().__init__(weight)
         self.length = check_positive("regularization length", length)
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
 
     def row_weights(self) -> np.ndarray:
         """Per-input weights (cost per (unit/s)^2 and per (rad/s)^2)."""

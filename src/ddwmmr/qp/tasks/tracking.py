@@ -12,6 +12,7 @@ from ddwmmr.gains import gains_from_tau
 from ddwmmr.model.kinematics import wrap_angle
 from ddwmmr.qp.blocks import TaskBlock, overrides
 from ddwmmr.qp.context import StepContext
+from ddwmmr.qp.tasks.avoidance import Detour
 from ddwmmr.qp.tasks.base import Task, bounded, bounded_pair
 
 
@@ -53,7 +54,7 @@ class EndEffectorTask(Task):
         unit: float = 1.0,
     ) -> None:
         super().__init__(weight)
-        self.unit = check_positive("unit", unit)
+        self.unit: float = check_positive("unit", unit)
         self.kx, self.ky, self.kphi = feedback_gains(tau)
         self.track_orientation = bool(track_orientation)
         self.max_speed = None if max_speed is None else check_positive("max_speed", max_speed)
@@ -64,7 +65,7 @@ class EndEffectorTask(Task):
         )
         #: Optional :class:`~ddwmmr.qp.tasks.avoidance.Detour`: bends the position
         #: feedback round obstacles (same magnitude, towards the detour's aim point).
-        self.detour = None
+        self.detour: Detour | None = None
 
     def targets(self, ctx: StepContext) -> tuple[float, float, float]:
         """Target rates ``(xE_dot, yE_dot, phiE_dot)``: feed-forward + clipped feedback
