@@ -19,18 +19,28 @@ from pathlib import Path
 
 import pytest
 
+from ddwmmr import interrupts
 from ddwmmr.cli import common
 from ddwmmr.cli.scenarios import main as cli
-from ddwmmr.scenarios import executors
+from ddwmmr.scenarios import RunConfig, executors, generate
 from test_cli_signals import alive, children, staging, wait_for
 
 distributed = pytest.importorskip("distributed")
 FAST = ["--n", "2", "--time-limit", "3", "--no-progress", "--executor", "dask"]
+#: The scheduler's HTTP server (health routes, served even without the dashboard) on a
+#: free port: on Dask's default 8787 a cluster of a parallel test, or any other on this
+#: machine, would collide ("Port 8787 is already in use").
+NO_FIXED_PORT = {"dashboard_address": ":0"}
 
 
 def test_a_scheduler_without_workers_is_refused_before_the_output(tmp_path, capsys):
     with distributed.LocalCluster(
-        n_workers=0, processes=False, dashboard_address=None, protocol="tcp", host="127.0.0.1"
+        n_workers=0,
+        processes=False,
+        dashboard_address=None,
+        protocol="tcp",
+        host="127.0.0.1",
+        scheduler_kwargs=NO_FIXED_PORT,
     ) as cluster:
         # 3 s: the scheduler must answer within it, even on a loaded machine
         args = ["--scheduler", cluster.scheduler_address, "--connect-timeout", "3"]
@@ -46,7 +56,12 @@ def test_a_scheduler_without_workers_is_refused_before_the_output(tmp_path, caps
 
 def test_a_scheduler_with_a_worker_runs_the_batch(tmp_path, capsys):
     with distributed.LocalCluster(
-        n_workers=1, processes=False, dashboard_address=None, protocol="tcp", host="127.0.0.1"
+        n_workers=1,
+        processes=False,
+        dashboard_address=None,
+        protocol="tcp",
+        host="127.0.0.1",
+        scheduler_kwargs=NO_FIXED_PORT,
     ) as cluster:
         status = cli(
             [*FAST, "--scheduler", cluster.scheduler_address, "--out", str(tmp_path / "o")]
@@ -120,6 +135,8 @@ def test_a_signal_during_a_dask_run_says_one_line(tmp_path, signum, status, grou
     """SIGTERM to the tool, or a closed terminal's SIGHUP to its whole process group: the
     scheduler and nannies in the tool would log every lost worker, the workers and
     multiprocessing's resource tracker would die with messages of their own."""
+    if group and signal.getsignal(signal.SIGHUP) is signal.SIG_IGN:
+        pytest.skip("started under nohup: the tool inherits SIGHUP ignored, and runs on")
     process = subprocess.Popen(
         [sys.executable, "-m", "ddwmmr.scenarios", "--n", "400", "--jobs", "2",
          "--no-progress", "--executor", "dask", "--out", str(tmp_path / "out")],
@@ -138,10 +155,38 @@ def test_a_signal_during_a_dask_run_says_one_line(tmp_path, signum, status, grou
             os.killpg(process.pid, signum)
         else:
             process.send_signal(signum)
-        _, err = process.communicate(timeout=60)
+        _, err = process.communicate(timeout=60)  # about 3 s, on a loaded machine too
+    except subprocess.TimeoutExpired:
+        process.kill()
+        pytest.fail(f"still running 60 s after the signal; stderr:\n{process.communicate()[1]}")
     finally:
         process.kill()
     assert process.returncode == status, err
     assert len(err.strip().splitlines()) == 1 and "terminated" in err, err
     assert list(Path(tmp_path).iterdir()) == []
     wait_for(lambda: not any(alive(pid) for pid in workers), timeout=20)
+
+
+@pytest.mark.parametrize(("executor", "jobs"), [("dask", 1), ("local", 2)])
+def test_a_stop_the_handler_could_not_raise_still_ends_the_run(executor, jobs):
+    """The tools' signal handler runs in the main thread wherever it is, in a garbage
+    collector's callback too (Dask registers one), which prints and drops the exception:
+    the stop it recorded must end the run after the chunk under way, not let the batch run
+    to its end (a SIGHUP once left a Dask run going with the tool's output to come)."""
+    scenarios = generate(3, 5)
+    done: list[int] = []
+
+    def finished(count: int) -> None:  # the first chunk's result: then the signal
+        done.append(count)
+        interrupts.record(common.Terminated(signal.SIGHUP))
+
+    try:
+        with pytest.raises(common.Terminated):
+            # worker processes: a worker thread would raise the recorded stop itself
+            executors.run_many(
+                scenarios, RunConfig(time_limit=3.0), jobs=jobs, executor=executor,
+                on_done=finished,
+            )  # fmt: skip
+    finally:
+        interrupts.clear()
+    assert done == [1]  # three chunks of one scenario; the stop came after the first

@@ -18,6 +18,7 @@ from concurrent.futures import as_completed
 from multiprocessing import resource_tracker
 from typing import Any
 
+from ddwmmr import interrupts
 from ddwmmr.errors import MAX_JOBS, ParameterError, check_finite, check_int_at_least, shown
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import Outcome, RunConfig, run_scenario
@@ -108,6 +109,7 @@ def _run_pool(chunks, config, jobs, on_done) -> list[list[Outcome]]:
     with process_pool(jobs) as pool:
         futures = {pool.submit(run_chunk, config, c): i for i, c in enumerate(chunks)}
         for future in as_completed(futures):
+            interrupts.raise_pending()  # the stop, not the broken pool its handler left
             i = futures[future]
             results[i] = future.result()
             if on_done is not None:
@@ -116,20 +118,44 @@ def _run_pool(chunks, config, jobs, on_done) -> list[list[Outcome]]:
 
 
 def _run_dask(chunks, config, client, on_done) -> list[list[Outcome]]:
-    from dask.distributed import as_completed as dask_completed
-
     futures = [client.submit(run_chunk, config, c, pure=False) for c in chunks]
     index = {f.key: i for i, f in enumerate(futures)}
     results: list[list[Outcome] | None] = [None] * len(chunks)
-    for future in dask_completed(futures):
+    for future, result in _dask_completed(futures):
         i = index[future.key]
-        results[i] = future.result()
+        results[i] = result
         if on_done is not None:
             on_done(len(chunks[i]))
     return results  # type: ignore[return-value]
 
 
 # -- Dask -----------------------------------------------------------------------------------
+#: Seconds between two looks for a stop while waiting for a Dask result.
+_POLL_S = 0.1
+
+
+def _dask_completed(futures: Sequence[Any]) -> Iterator[tuple[Any, Any]]:
+    """``(future, result)`` for each of ``futures`` (Dask's) in the order they complete
+    (a task's exception is raised), raising, before each and every :data:`_POLL_S` s of
+    waiting, a stop the tools' signal handler recorded (:mod:`ddwmmr.interrupts`).
+
+    The handler runs in the main thread wherever it is, a garbage collector's callback
+    included (Dask registers one), and such a callback prints and drops what it raises:
+    the batch would otherwise run to its end on the workers the nannies restart. The
+    results are fetched in Dask's thread, so that this wait never blocks on one (a
+    result on a worker the handler stopped is computed again)."""
+    from dask.distributed import as_completed as dask_completed
+
+    completed = dask_completed(futures, with_results=True)
+    while not completed.is_empty():
+        interrupts.raise_pending()
+        if completed.has_ready():
+            yield next(completed)
+            continue
+        with completed.thread_condition:
+            completed.thread_condition.wait(_POLL_S)
+
+
 def _import_distributed():
     try:
         import distributed
