@@ -18,6 +18,14 @@ settings.register_profile("explore", deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ddwmmr"))
 
 
+@pytest.fixture(autouse=True)
+def terminal_width(monkeypatch) -> None:
+    """An 80-column terminal for every test (and the tools it starts, which inherit the
+    environment): argparse wraps ``--help`` at ``$COLUMNS``, so help-text assertions would
+    depend on the width of the terminal pytest runs in. A test may set its own."""
+    monkeypatch.setenv("COLUMNS", "80")
+
+
 @pytest.fixture
 def robot() -> Robot:
     """The thesis robot (docs/theory.md, "Model"; payload 1.25 kg)."""

@@ -541,26 +541,36 @@ def listeners():
     servers.close()
 
 
+#: --connect-timeout of the cases that must time out (1 s: the test stays short), and of
+#: those that must fail at once: a garbage answer or an unusable scheme is "cannot
+#: connect", and the generous timeout keeps a stalled, loaded machine from turning it into
+#: "no Dask scheduler answered".
+TIMES_OUT, FAILS_FAST = "1", "10"
 SCHEDULER_CASES = [
-    ("tcp://127.0.0.1:{silent}", "no Dask scheduler answered at 'tcp://127.0.0.1:"),
-    ("tcp://127.0.0.1:{http}", "no Dask scheduler answered"),
-    ("tcp://127.0.0.1:{ascii}", "cannot connect to 'tcp://127.0.0.1:"),
-    ("tcp://127.0.0.1:{binary}", "cannot connect to 'tcp://127.0.0.1:"),
-    ("tls://127.0.0.1:{silent}", "cannot connect to 'tls://127.0.0.1:"),
-    ("ucx://127.0.0.1:{silent}", "cannot connect to 'ucx://127.0.0.1:"),
-    ("http://127.0.0.1:{http}", "unknown address scheme 'http'"),
-    ("127.0.0.1", "missing port number"),
+    ("tcp://127.0.0.1:{silent}", TIMES_OUT, "no Dask scheduler answered at 'tcp://127.0.0.1:"),
+    ("tcp://127.0.0.1:{http}", TIMES_OUT, "no Dask scheduler answered"),
+    ("tcp://127.0.0.1:{ascii}", FAILS_FAST, "cannot connect to 'tcp://127.0.0.1:"),
+    ("tcp://127.0.0.1:{binary}", FAILS_FAST, "cannot connect to 'tcp://127.0.0.1:"),
+    ("tls://127.0.0.1:{silent}", FAILS_FAST, "cannot connect to 'tls://127.0.0.1:"),
+    ("ucx://127.0.0.1:{silent}", FAILS_FAST, "cannot connect to 'ucx://127.0.0.1:"),
+    ("http://127.0.0.1:{http}", FAILS_FAST, "unknown address scheme 'http'"),
+    ("127.0.0.1", FAILS_FAST, "missing port number"),
 ]
 
 
-@pytest.mark.parametrize(("address", "text"), SCHEDULER_CASES, ids=[a for a, _ in SCHEDULER_CASES])
-def test_a_scheduler_address_that_is_not_a_scheduler(workdir, listeners, capsys, address, text):
+@pytest.mark.parametrize(
+    ("address", "timeout", "text"), SCHEDULER_CASES, ids=[a for a, _, _ in SCHEDULER_CASES]
+)
+def test_a_scheduler_address_that_is_not_a_scheduler(
+    workdir, listeners, capsys, address, timeout, text
+):
     """Checked before the output exists, within --connect-timeout: one line, exit 2."""
     cwd = Path.cwd()
     before = tree(cwd)
     ports = {"silent": listeners.silent, "http": listeners.http,
              "ascii": listeners.ascii, "binary": listeners.binary}  # fmt: skip
-    status, err = run_bad("scenarios", [*DASK, address.format(**ports)], capsys)
+    options = [*DASK[:2], "--connect-timeout", timeout, "--scheduler", address.format(**ports)]
+    status, err = run_bad("scenarios", options, capsys)
     assert status == 2, err
     assert len(err.strip().splitlines()) == 1 and text in err, err
     assert tree(cwd) == before

@@ -212,7 +212,8 @@ def test_a_tool_started_under_nohup_ignores_sighup(tmp_path):
 
     proc = start("track", tmp_path, preexec_fn=ignore_hangup)
     try:
-        wait_for(lambda: staging(tmp_path))
+        wait_for(lambda: staging(tmp_path) or proc.poll() is not None)
+        assert proc.poll() is None, proc.communicate()
         proc.send_signal(signal.SIGHUP)
         time.sleep(1.0)
         assert proc.poll() is None, proc.communicate()

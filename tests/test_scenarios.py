@@ -193,9 +193,13 @@ def test_dask_scheduler_address_path():
     """``--scheduler ADDRESS``: connect to a running cluster instead of starting one."""
     from dask.distributed import LocalCluster
 
+    from test_cli_dask import NO_FIXED_PORT
+
     scenarios = generate(2, 5)
     config = RunConfig(time_limit=6.0)
-    with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+    with LocalCluster(
+        n_workers=1, processes=False, dashboard_address=None, scheduler_kwargs=NO_FIXED_PORT
+    ) as cluster:
         remote = run_many(scenarios, config, executor="dask", scheduler=cluster.scheduler_address)
     assert _metrics(remote) == _metrics(run_many(scenarios, config))
 
