@@ -33,15 +33,21 @@ FAST = ["--n", "2", "--time-limit", "3", "--no-progress", "--executor", "dask"]
 NO_FIXED_PORT = {"dashboard_address": ":0"}
 
 
-def test_a_scheduler_without_workers_is_refused_before_the_output(tmp_path, capsys):
-    with distributed.LocalCluster(
-        n_workers=0,
+def local_cluster(n_workers: int):
+    """A cluster of ``n_workers`` threads in this process, reached over TCP on 127.0.0.1 (as
+    ``--scheduler`` reaches a remote one), its scheduler on a free port."""
+    return distributed.LocalCluster(
+        n_workers=n_workers,
         processes=False,
         dashboard_address=None,
         protocol="tcp",
         host="127.0.0.1",
         scheduler_kwargs=NO_FIXED_PORT,
-    ) as cluster:
+    )
+
+
+def test_a_scheduler_without_workers_is_refused_before_the_output(tmp_path, capsys):
+    with local_cluster(0) as cluster:
         # 3 s: the scheduler must answer within it, even on a loaded machine
         args = ["--scheduler", cluster.scheduler_address, "--connect-timeout", "3"]
         status = cli([*FAST, *args, "--out", str(tmp_path / "out")])
@@ -55,14 +61,7 @@ def test_a_scheduler_without_workers_is_refused_before_the_output(tmp_path, caps
 
 
 def test_a_scheduler_with_a_worker_runs_the_batch(tmp_path, capsys):
-    with distributed.LocalCluster(
-        n_workers=1,
-        processes=False,
-        dashboard_address=None,
-        protocol="tcp",
-        host="127.0.0.1",
-        scheduler_kwargs=NO_FIXED_PORT,
-    ) as cluster:
+    with local_cluster(1) as cluster:
         status = cli(
             [*FAST, "--scheduler", cluster.scheduler_address, "--out", str(tmp_path / "o")]
         )

@@ -34,18 +34,11 @@ def test_a_scheduler_run_reports_and_records_the_clusters_workers(tmp_path, caps
     """A two-worker cluster on a machine that would give one worker: the closing line
     and run.workers say 2, run.jobs stays the option's null; the rows are those of a
     local one-process run, byte for byte."""
-    distributed = pytest.importorskip("distributed")
-    from test_cli_dask import NO_FIXED_PORT
+    pytest.importorskip("distributed")
+    from test_cli_dask import local_cluster
 
     monkeypatch.setattr(scenarios_tool, "default_jobs", lambda: 1)
-    with distributed.LocalCluster(
-        n_workers=2,
-        processes=False,
-        dashboard_address=None,
-        protocol="tcp",
-        host="127.0.0.1",
-        scheduler_kwargs=NO_FIXED_PORT,
-    ) as cluster:
+    with local_cluster(2) as cluster:
         argv = [*FAST, "--n", "3", "--executor", "dask", "--scheduler", cluster.scheduler_address]
         status = scenarios_tool.main([*argv, "--out", str(tmp_path / "dask")])
     err = capsys.readouterr().err
