@@ -125,7 +125,7 @@ def test_the_plant_table_names_its_ratio_and_drops_empty_columns(thesis_report):
     _, plan, outputs, text = thesis_report
     header = _cells(text, "| trajectory | method | RMS kin")
     assert header[4] == "RMS ratio to kinematic"
-    for gone in ("x", "min physics S", "tipped", "slip (mm/s)"):
+    for gone in ("x", "min physics stability", "tipped", "slip (mm/s)"):
         assert gone not in header
     assert "lag (mm/s)" in header and "actuator-limited" in header
     row = _cells(text, "| rectangle | qp |")

@@ -274,7 +274,8 @@ def test_the_summary_line_says_what_the_physics_plant_judged():
     tipped = {**base, "tipped": True, "tip_time_s": 1.234, "min_physics_stability": 0.0}
     assert "TIPPED at 1.23 s (physics)" in _summary_line("A", SimpleNamespace(summary=tipped))
     stood = {**base, "tipped": False, "tip_time_s": None, "min_physics_stability": 1.21}
-    assert "stood (physics: min S_phys 1.21)" in _summary_line("A", SimpleNamespace(summary=stood))
+    line = _summary_line("A", SimpleNamespace(summary=stood))
+    assert "stood (physics: min physics stability 1.21)" in line
 
 
 def test_the_mpc_options_carry_their_units():

@@ -193,17 +193,18 @@ def test_the_gui_line_says_the_support_was_lost() -> None:
     lost = {**STOOD, "support_lost": True, "unloaded_time_s": 0.08}
     assert lost_support(lost) and support_warning(lost).startswith("warning: an edge")
     assert _physics_verdict(lost) == (
-        ", stood but LOST SUPPORT: an edge unloaded for 0.08 of 2 s (physics: min S_phys 1.21)"
+        ", stood but LOST SUPPORT: an edge unloaded for 0.08 of 2 s "
+        "(physics: min physics stability 1.21)"
     )
     line = _summary_line("qp", SimpleNamespace(summary=lost))
     assert line.endswith(
-        "LOST SUPPORT: an edge unloaded for 0.08 of 2 s (physics: min S_phys 1.21)"
+        "LOST SUPPORT: an edge unloaded for 0.08 of 2 s (physics: min physics stability 1.21)"
     )
     assert "stood (physics" not in line
 
 
 def test_the_gui_line_of_a_run_that_kept_its_support_or_tipped_is_unchanged() -> None:
-    assert _physics_verdict(STOOD) == ", stood (physics: min S_phys 1.21)"
+    assert _physics_verdict(STOOD) == ", stood (physics: min physics stability 1.21)"
     assert not lost_support(STOOD)
     tipped = {**STOOD, "tipped": True, "tip_time_s": 1.234, "support_lost": True}
     assert not lost_support(tipped)

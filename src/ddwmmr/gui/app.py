@@ -807,7 +807,7 @@ def _physics_verdict(summary: dict[str, Any]) -> str:
         return ""
     if summary["tipped"]:
         return f", TIPPED at {summary['tip_time_s']:.2f} s (physics)"
-    margin = f"min S_phys {summary['min_physics_stability']:.3g}"
+    margin = f"{METRICS['min_physics_stability'].label} {summary['min_physics_stability']:.3g}"
     if lost_support(summary):
         unloaded, duration = summary.get("unloaded_time_s") or 0.0, summary.get("duration") or 0.0
         return (

@@ -719,7 +719,7 @@ def _plant_section(c: _Context, plant: str) -> None:
     headers = [
         "trajectory", "method", "RMS kinematic (mm)", f"RMS {plant} (mm)", RATIO_HEADER,
         f"settled-end RMS {plant} (mm)", "lag (mm/s)", "actuator-limited", "slip (mm/s)",
-        METRICS["min_stability"].label, "min physics S", "tipped",
+        METRICS["min_stability"].label, METRICS["min_physics_stability"].label, "tipped",
         *(SUPPORT_HEADERS if support else ()),
         "tracked? (docs/cli.md, Verdict)",
     ]  # fmt: skip
