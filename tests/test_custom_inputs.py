@@ -202,7 +202,10 @@ def test_a_scaled_users_trajectory_is_checked_as_the_users_own():
     from ddwmmr.trajectories import ScaledTrajectory
 
     assert checked_trajectory(ScaledTrajectory(Ellipse(), 2.0)).scale == 2.0  # as it is
-    assert isinstance(checked_trajectory(ScaledTrajectory(Circle(), 2.0)), CheckedTrajectory)
+    checked = checked_trajectory(ScaledTrajectory(Circle(), 2.0))  # what it wraps, checked
+    assert isinstance(checked, ScaledTrajectory) and checked.scale == 2.0
+    assert isinstance(checked.trajectory, CheckedTrajectory)
+    assert checked_trajectory(checked) is checked
 
     class Late(Circle):
         def velocity(self, t):

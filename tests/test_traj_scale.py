@@ -237,3 +237,37 @@ def test_obstacles_are_not_scaled_and_a_note_says_so(tmp_path, capsys):
     assert _summary(tmp_path / "a")["run"]["options"]["obstacles"] == [[-0.2, 1.05, 0.3]]
     assert track_cli.main([*argv, "--out", str(tmp_path / "b")]) == 0
     assert "--traj-scale" not in capsys.readouterr().err
+
+
+class _OneNumberPose:
+    """A user's trajectory whose pose is one number: refused, not broadcast to three."""
+
+    duration = 1.0
+    name = "one"
+
+    def pose(self, t):
+        return [0.3]
+
+    def velocity(self, t):
+        return [0.0]
+
+
+def test_a_scaled_broken_trajectory_is_refused_as_the_unscaled_one():
+    messages = []
+    for trajectory in (_OneNumberPose(), ScaledTrajectory(_OneNumberPose(), 2.0)):
+        with pytest.raises(ParameterError) as refused:
+            simulate(Robot(), trajectory, "ats", dt=0.05, duration=0.2)
+        messages.append(str(refused.value))
+    assert messages[0] == messages[1]
+    assert messages[0].startswith("trajectory pose(t) must return 3 finite numbers")
+    assert "(got [0.3] at t = 0 s)" in messages[0]
+
+
+def test_a_nested_scaled_record_keeps_every_factor():
+    from ddwmmr import provenance
+
+    nested = ScaledTrajectory(ScaledTrajectory(load_trajectory("ellipse"), 2.0), 3.0)
+    back, _, _ = provenance.read_trajectory_record(provenance.trajectory_record(nested, None))
+    assert back.name == nested.name == "ellipse x2 x3"
+    assert back.pose(1.0).tolist() == nested.pose(1.0).tolist()
+    assert back.pose(1.0)[0] == 6.0 * load_trajectory("ellipse").pose(1.0)[0]

@@ -350,7 +350,10 @@ def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Path | None, st
     kind = record.get("type")
     if kind == SCALED:
         scale = check_scale(decode(record.get("scale")), "trajectory.scale")
-        trajectory, file, note = read_trajectory_record(base_trajectory_record(record))
+        base = record.get("trajectory")
+        if not isinstance(base, dict):
+            raise ParameterError(f"trajectory.trajectory must be a record (got {shown(base)})")
+        trajectory, file, note = read_trajectory_record(base)  # itself scaled, maybe
         return ScaledTrajectory(trajectory, scale), file, note
     if kind in SHAPES:
         source = record.get("file")

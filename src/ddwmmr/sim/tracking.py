@@ -529,13 +529,14 @@ def checked_trajectory(trajectory: Any) -> Any:
     ``pose``, ``velocity`` and ``sample`` are the library's) as it is, so that nothing is
     added to their steps; any other in a :class:`CheckedTrajectory`. A library wrapper of
     another trajectory (a :class:`~ddwmmr.trajectories.ScaledTrajectory`) is the library's
-    only if what it wraps is."""
+    only if what it wraps is; else it scales what it wraps, checked (a wrong value is
+    refused as it is without the scale, not broadcast by the scaling)."""
     if isinstance(trajectory, CheckedTrajectory):
         return trajectory
     if isinstance(trajectory, ScaledTrajectory):
         inner = trajectory.trajectory
-        if checked_trajectory(inner) is not inner:
-            return CheckedTrajectory(trajectory)
+        checked = checked_trajectory(inner)
+        return trajectory if checked is inner else ScaledTrajectory(checked, trajectory.scale)
     instance = getattr(trajectory, "__dict__", {})
     for name in ("pose", "velocity", "sample"):
         owner = defining_class(type(trajectory), name)
