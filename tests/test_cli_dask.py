@@ -189,3 +189,28 @@ def test_a_stop_the_handler_could_not_raise_still_ends_the_run(executor, jobs):
     finally:
         interrupts.clear()
     assert done == [1]  # three chunks of one scenario; the stop came after the first
+
+
+def _nap(seconds: float) -> list[float]:
+    time.sleep(seconds)
+    return [seconds]
+
+
+def test_a_cancelled_dask_task_raises_not_returns():
+    """Dask's as_completed(with_results=True) queues a cancelled future with its
+    cancellation as the result: the wait raises it, as waiting on the future does, rather
+    than hand the batch an exception object for a chunk's outcomes."""
+    from distributed import Client
+    from distributed.client import FutureCancelledError
+
+    with Client(
+        processes=False, n_workers=1, threads_per_worker=2, dashboard_address=None,
+        scheduler_kwargs=NO_FIXED_PORT,
+    ) as client:  # fmt: skip
+        futures = [client.submit(_nap, 0.1, pure=False), client.submit(_nap, 1.0, pure=False)]
+        waiting = executors._dask_completed(futures)
+        first, result = next(waiting)
+        assert first is futures[0] and result == [0.1]
+        futures[1].cancel()
+        with pytest.raises(FutureCancelledError):
+            next(waiting)

@@ -150,7 +150,10 @@ def _dask_completed(futures: Sequence[Any]) -> Iterator[tuple[Any, Any]]:
     while not completed.is_empty():
         interrupts.raise_pending()
         if completed.has_ready():
-            yield next(completed)
+            future, result = next(completed)
+            if future.status == "cancelled":  # queued with its cancellation as the result
+                future.result()  # raises it, as waiting on the future does
+            yield future, result
             continue
         with completed.thread_condition:
             completed.thread_condition.wait(_POLL_S)

@@ -173,9 +173,10 @@ LENGTH_UNIT_RANGE_M = tuple(length_unit(length) for length in LENGTH_RANGE_M)
 #: of a failure nothing else explains.
 HELD_CAUSE = 0.005
 #: ... and for more steps than this, whatever the limit (steps of ``dt`` for a time such as
-#: ``actuator_saturated_time_s``): the default robot's MuJoCo runs hold a motor at its
-#: torque limit for 3 or 4 steps as they start from rest, a hold that explains no error
-#: and is more than HELD_CAUSE of a run shorter than 800 steps (docs/cli.md, "Verdict").
+#: ``actuator_saturated_time_s``): a limit touched for a few steps explains no error of a
+#: whole run, yet is more than HELD_CAUSE of a run shorter than 800 steps; the default
+#: robot's MuJoCo runs hold a motor at its torque limit for 3 or 4 steps as they start from
+#: rest (docs/cli.md, "Verdict").
 HELD_MIN_STEPS = 5
 #: Relative slack on "the error never rose above its start" (``max_position_error_m`` <=
 #: ``initial_offset_m`` x (1 + this)): the two are computed apart and may differ in their
