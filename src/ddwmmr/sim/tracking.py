@@ -26,7 +26,7 @@ from ddwmmr.inheritance import defining_class
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_arrays
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
-from ddwmmr.trajectories.base import Trajectory, sampler, trajectory_name
+from ddwmmr.trajectories.base import Trajectory, sample_each, sampler, trajectory_name
 from ddwmmr.trajectories.scaled import ScaledTrajectory
 
 #: Column names of the recorded time series, in order (plant columns follow).
@@ -412,10 +412,7 @@ class CheckedTrajectory:
             if found is not None:
                 return found
             self._own_sample = None  # not the vectorised reference: call by call from now on
-        every = np.asarray(times, dtype=float).ravel().tolist()
-        poses = np.array([self.pose(t) for t in every]).reshape(len(every), 3)
-        velocities = np.array([self.velocity(t) for t in every]).reshape(len(every), 3)
-        return poses, velocities
+        return sample_each(self, times)
 
 
 #: Shares of the duration at which :class:`CheckedTrajectory` spot-checks a trajectory:

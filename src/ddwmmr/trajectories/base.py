@@ -140,6 +140,16 @@ def sampler(trajectory: Any) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndar
     return sample
 
 
+def sample_each(trajectory: Any, times: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Poses and velocities of ``trajectory`` at ``times`` (s, any shape, read flat), arrays
+    of shape ``(len(times), 3)``, from one ``pose`` and one ``velocity`` call per time: the
+    stand-in for a vectorised ``sample`` the trajectory lacks (:func:`sampler`)."""
+    every = np.asarray(times, dtype=float).ravel().tolist()
+    poses = np.array([trajectory.pose(t) for t in every]).reshape(len(every), 3)
+    velocities = np.array([trajectory.velocity(t) for t in every]).reshape(len(every), 3)
+    return poses, velocities
+
+
 def resolution_step(trajectory: Any) -> float:
     """The trajectory's own step (s), the default control step of every tool and of
     :func:`ddwmmr.simulate`: its ``default_step`` if it has one (a sampled trajectory:

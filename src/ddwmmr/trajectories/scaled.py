@@ -17,7 +17,13 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.errors import check_range
-from ddwmmr.trajectories.base import check_times, require_trajectory, sampler, trajectory_name
+from ddwmmr.trajectories.base import (
+    check_times,
+    require_trajectory,
+    sample_each,
+    sampler,
+    trajectory_name,
+)
 
 #: The scale factors :class:`ScaledTrajectory` takes: as far apart as the robot's length
 #: unit ``L1 / 0.35 m`` ranges over (:data:`ddwmmr.errors.LENGTH_RANGE_M`), and more.
@@ -98,10 +104,7 @@ class ScaledTrajectory:
         t = check_times(times)
         own = sampler(self.trajectory)
         if own is None:
-            every = t.tolist()
-            poses = np.array([self.pose(v) for v in every]).reshape(len(every), 3)
-            rates = np.array([self.velocity(v) for v in every]).reshape(len(every), 3)
-            return poses, rates
+            return sample_each(self, t)
         poses, rates = own(t)
         factors = self._factors
         return np.asarray(poses, dtype=float) * factors, np.asarray(rates, dtype=float) * factors
