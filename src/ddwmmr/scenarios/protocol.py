@@ -139,6 +139,19 @@ METRICS = (
     # qp command); NaN for the thesis controller, which has none.
     "fallback_steps",
 )
+#: The metrics a run's outcome holds as NaN where they do not apply: the fix
+#: states' times and transitions for a controller without states, the unloaded time off a
+#: physics plant, the fallback steps for the thesis controller.
+NOT_APPLICABLE_AS_NAN = (
+    "time_manipulability_s",
+    "transitions_manipulability",
+    "time_stability_s",
+    "transitions_stability",
+    "time_obstacle_s",
+    "transitions_obstacle",
+    "unloaded_time_s",
+    "fallback_steps",
+)
 
 
 @dataclass(frozen=True)

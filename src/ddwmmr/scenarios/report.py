@@ -23,6 +23,7 @@ from ddwmmr.scenarios.protocol import (
     METRICS,
     MOVING_RATE,
     MOVING_SPEED,
+    NOT_APPLICABLE_AS_NAN,
     TRACE_INTERVAL,
     Outcome,
 )
@@ -291,21 +292,6 @@ def summary_json(summary: dict[str, Any]) -> str:
     scenario) is null, as the fields that do not apply already are (``fallback_steps``...). Strings,
     such as the run record's ``"inf"`` (:mod:`ddwmmr.provenance`), are kept as they are."""
     return json.dumps(json_safe(summary, undefined_as_null=True), indent=2, allow_nan=False) + "\n"
-
-
-#: Metrics that are NaN where they do not apply (:mod:`ddwmmr.scenarios.protocol`): the
-#: fix states' times and transitions for a controller without states, the unloaded time
-#: off a physics plant, the fallback steps for the thesis controller.
-NOT_APPLICABLE_AS_NAN = (
-    "time_manipulability_s",
-    "transitions_manipulability",
-    "time_stability_s",
-    "transitions_stability",
-    "time_obstacle_s",
-    "transitions_obstacle",
-    "unloaded_time_s",
-    "fallback_steps",
-)
 
 
 def metrics_csv(outcomes: Sequence[Outcome]) -> str:
