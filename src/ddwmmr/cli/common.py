@@ -703,6 +703,9 @@ def traj_scale_type(text: str) -> float | str:
 def add_traj_scale_argument(parser: argparse.ArgumentParser, which: str) -> None:
     """``--traj-scale S|robot``: scale ``which`` (the tool's trajectories, in words) in
     space (:func:`scaled_trajectory`)."""
+    from ddwmmr.trajectories.scaled import SCALE_RANGE
+
+    low, high = SCALE_RANGE
     parser.add_argument(
         "--traj-scale",
         type=traj_scale_type,
@@ -710,7 +713,7 @@ def add_traj_scale_argument(parser: argparse.ArgumentParser, which: str) -> None
         help=f"scale {which} in space by S about the world origin: positions and speeds "
         "times S, headings, durations and steps kept (ddwmmr.ScaledTrajectory), for a robot "
         f"of another size; {ROBOT_SCALE}: the robot's length unit L1/0.35 m (10 for a --robot "
-        "ten times the default); S in [1e-06, 1e+06] (default 1: as given); obstacles stay "
+        f"ten times the default); S in [{low:g}, {high:g}] (default 1: as given); obstacles stay "
         "in world metres; recorded with the trajectory (summary.json, run.json)",
     )
 
