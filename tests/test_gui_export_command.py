@@ -9,11 +9,9 @@ import sys
 from pathlib import Path
 
 import pytest
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
-from ddwmmr.gui import App, Settings
-from ddwmmr.gui.layout import FIGSIZE
+from ddwmmr.gui import Settings
+from test_gui_export import finished_app
 
 #: Summary keys that hold wall-clock time (they differ from run to run).
 TIMING = {"median_step_us", "max_step_us", "mean_step_us", "p95_step_us"}
@@ -21,14 +19,7 @@ TIMING = {"median_step_us", "max_step_us", "mean_step_us", "p95_step_us"}
 
 def exported_summary(settings: Settings, root: Path) -> Path:
     """The summary.json of the window's data export of a run of ``settings``."""
-    figure = Figure(figsize=FIGSIZE, dpi=30)
-    FigureCanvasAgg(figure)
-    app = App(figure, settings)
-    app.export_field.submit(str(root))
-    app.run()
-    app.wait()
-    assert app.results is not None, app.message
-    paths = app.export_data()
+    paths = finished_app(settings, root).export_data()
     (summary,) = [p for p in paths if p.name == "summary.json"]
     return summary
 
