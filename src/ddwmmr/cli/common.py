@@ -28,6 +28,7 @@ import sys
 import threading
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from ddwmmr import interrupts
@@ -40,6 +41,7 @@ from ddwmmr.outputs import (
     first_free,
     output_folder,
     package_version,
+    recording_commits,
 )
 from ddwmmr.workers import IN_WORKERS, SHOWN
 
@@ -405,9 +407,14 @@ def console_text(text: str, stream: object = None) -> str:
 
 def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | None) -> int:
     """Run ``main``: bad input, interrupts and write errors become one line on stderr, and
-    the library's warnings one line each (:func:`one_line_warnings`)."""
+    the library's warnings one line each (:func:`one_line_warnings`).
+
+    A stop (Ctrl-C, one of :data:`STOP_SIGNALS`) exits with 128 + the signal number even
+    when it comes after ``main`` committed its output folder (while it prints its summary
+    or stops its workers); its line then says that output is complete, not removed."""
+    committed: list[Path] = []  # the output folders main completed (recording_commits)
     try:
-        with interruptible(), one_line_warnings():
+        with interruptible(), one_line_warnings(), recording_commits(committed):
             return main(argv)
     except ParameterError as exc:
         say(f"error: {exc}")
@@ -417,10 +424,10 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
         return 1
     except KeyboardInterrupt as stop:
         forget_unhandled_interrupt()
-        say(stop_line(signal.SIGINT, committed_output(stop)))
+        say(stop_line(signal.SIGINT, _complete_output(stop, committed)))
         return EXIT_INTERRUPTED
     except Terminated as stop:
-        say(stop_line(stop.signum, committed_output(stop)))
+        say(stop_line(stop.signum, _complete_output(stop, committed)))
         return stop.status
     except BrokenPipeError:  # e.g. output piped into head: nothing left to say
         return 1
@@ -428,6 +435,13 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
         where = f"{exc.filename}: " if exc.filename else ""
         say(f"error: {where}{exc.strerror or exc}")
         return 1
+
+
+def _complete_output(stop: BaseException, committed: list[Path]) -> Path | None:
+    """The output folder complete in place when ``stop`` came: the one a commit it
+    interrupted had already filled (:func:`committed_output`), else the last one committed
+    before it; None if it came before any."""
+    return committed_output(stop) or (committed[-1] if committed else None)
 
 
 def run_script(main: Callable[..., object], *arguments: str) -> NoReturn:

@@ -59,6 +59,7 @@ from ddwmmr.outputs.commit import (
     committed_output,
     list_in_manifest,
     output_folder,
+    recording_commits,
     remove_created,
 )
 from ddwmmr.outputs.files import csv_text, file_mode, folder_mode, line_ending, package_version
@@ -90,6 +91,7 @@ __all__ = [
     "output_lock",
     "owner_token",
     "package_version",
+    "recording_commits",
     "remove_created",
     "remove_stale",
     "sync_folder",

@@ -62,6 +62,9 @@ _DEFERRED_SIGNALS = tuple(
 #: Attribute set on an exception (an interrupt) that arrived once the new output was in
 #: place: its value is the output folder, complete (see :func:`committed_output`).
 _COMMITTED = "ddwmmr_committed_output"
+#: The lists :func:`recording_commits` hands out, innermost last: each commit appends the
+#: output folder it completed to every one.
+_recorders: list[list[Path]] = []
 
 
 class OutputFolder:
@@ -148,6 +151,7 @@ class OutputFolder:
         except BaseException as error:
             if done:  # the new output is in place: it stays, and the exception says so
                 self.path, self._staging = done[0], None
+                _completed(done[0])
                 setattr(error, _COMMITTED, done[0])
                 raise
             self._discard()
@@ -158,6 +162,7 @@ class OutputFolder:
                 ) from error
             raise
         self.path = done[0]
+        _completed(self.path)  # before the sync: a stop during it finds the output in place
         _sync_output(self.path)
         return False
 
@@ -191,6 +196,26 @@ def committed_output(error: BaseException) -> Path | None:
     already complete in it (the stop came while the replaced one was being deleted).
     None for any other exception."""
     return getattr(error, _COMMITTED, None)
+
+
+@contextlib.contextmanager
+def recording_commits(committed: list[Path]) -> Iterator[list[Path]]:
+    """Append to ``committed`` (and yield it) the output folder of every commit made in
+    the block, as soon as its new output is complete in place: a stop that comes after
+    a tool's commit, while it prints its summary or stops its workers, finds its output
+    there (:func:`ddwmmr.cli.common.run_main` then says that output is complete)."""
+    _recorders.append(committed)
+    try:
+        yield committed
+    finally:
+        # by identity: another block's list may be equal to this one
+        _recorders[:] = [other for other in _recorders if other is not committed]
+
+
+def _completed(folder: Path) -> None:
+    """Tell every :func:`recording_commits` block that ``folder`` holds its new output."""
+    for committed in _recorders:
+        committed.append(folder)
 
 
 @contextlib.contextmanager
