@@ -323,7 +323,7 @@ def test_quickstart_says_when_a_method_did_not_track(
     assert lines[10].startswith("verdict: did not track: singular (damped) ")
     assert lines[-1].startswith("  first command u =")
     found = re.search(
-        r"singular \(damped\) (\d+) of (\d+) steps, final error (\d+) mm \(limit ([\d.]+) mm\), "
+        r"singular \(damped\) (\d+) of (\d+) steps, settled-end RMS position error (\d+) mm \(limit ([\d.]+) mm\), "
         r"RMS error (\d+) mm",
         verdict,
     )

@@ -97,6 +97,24 @@ def test_the_labels_that_disagreed_now_read_alike() -> None:
     assert compare["min_stability"] == track["min_stability"] == gui["min_stability"]
 
 
+def test_the_verdict_names_the_settled_end_error_as_track_s_table_does() -> None:
+    """The verdict quoted the settled-end RMS as "final error"; it uses track's name."""
+    from ddwmmr import Robot, load_trajectory, simulate
+    from ddwmmr.reports.metrics import METRICS
+    from ddwmmr.sim.verdict import REASONS, SETTLED_END_ERROR
+
+    label = METRICS["final_position_error_m"]
+    assert SETTLED_END_ERROR == label.long == "settled-end RMS position error"
+    assert track_labels()["final_position_error_m"] == f"{SETTLED_END_ERROR} (mm)"
+    assert REASONS["final_error_above_limit"].startswith(f"{SETTLED_END_ERROR} {{final_mm")
+    rectangle = load_trajectory("rectangle")  # ends 361 mm off (tests/test_verdict.py)
+    run = simulate(Robot(), rectangle, "clrrmc-cs", tau=0.3, integrator="euler", dt=0.05)
+    summary = run.summary
+    assert "final_error_above_limit" in summary["verdict_reasons"]
+    assert "settled-end RMS position error 361 mm (limit 84.85 mm)" in summary["verdict"]
+    assert "final error" not in summary["verdict"]
+
+
 def test_the_words_rule_refuses_a_synonym() -> None:
     assert spells_out("RMS pos (mm)", "RMS position error (mm)")
     assert spells_out("min manip.", "min manipulability")

@@ -67,7 +67,7 @@ def test_a_failed_run_names_the_lost_support_and_the_broken_floor() -> None:
     summary = _run(3.0, stability_min=1.1)
     assert summary["unloaded_time_s"] == pytest.approx(0.12, abs=1e-9)
     assert summary["verdict_reasons"] == ["final_error_above_limit", "rms_error_above_limit"]
-    assert summary["verdict"].startswith("did not track: final error")
+    assert summary["verdict"].startswith("did not track: settled-end RMS position error")
     assert (
         "; warning: an edge of the support polygon was unloaded for 0.12 of 3 s"
         in summary["verdict"]

@@ -64,7 +64,7 @@ def test_a_run_that_ends_far_off_does_not_track():
     summary = result.summary
     assert summary["final_position_error_m"] == pytest.approx(0.361, abs=0.001)
     assert summary["verdict_reasons"] == ["final_error_above_limit", "rms_error_above_limit"]
-    assert "final error 361 mm (limit 84.85 mm)" in summary["verdict"]
+    assert "settled-end RMS position error 361 mm (limit 84.85 mm)" in summary["verdict"]
     assert "joint limit" in summary["verdict"]  # the elbow folded (min manipulability 0)
 
 
@@ -76,7 +76,7 @@ def test_the_error_limit_is_50_mm_or_twice_the_initial_offset():
     assert verdict({**CLEAN, "final_position_error_m": 0.0424})["verdict"] == "tracked"
     far = verdict({**CLEAN, "final_position_error_m": 0.090})
     assert far["verdict_reasons"] == ["final_error_above_limit"]
-    assert "final error 90 mm (limit 84.85 mm)" in far["verdict"]
+    assert "settled-end RMS position error 90 mm (limit 84.85 mm)" in far["verdict"]
     assert verdict({**CLEAN, "rms_position_error_m": 0.0849})["verdict_reasons"] == [
         "rms_error_above_limit"
     ]

@@ -118,10 +118,10 @@ def test_a_short_held_point_that_converged_is_not_said_not_to_converge(tmp_path)
     assert summary["max_position_error_m"] == pytest.approx(OFFSET, rel=1e-9)
     assert "did not converge" not in summary["verdict"]
     assert _cause(summary) == (
-        "the error converged (final 0.844 mm, within the limit) but never rose above the "
-        "start offset (42.4 mm), whose removal took a large part of this 2 s run and counts "
-        "in its RMS: a longer run or a smaller start offset (track's --duration and "
-        '--offset; see docs/cli.md, "Verdict")'
+        "the error converged (settled-end RMS position error 0.844 mm, within the limit) "
+        "but never rose above the start offset (42.4 mm), whose removal took a large part of "
+        "this 2 s run and counts in its RMS: a longer run or a smaller start offset (track's "
+        '--duration and --offset; see docs/cli.md, "Verdict")'
     )
     longer = simulate(Robot(), trajectory, "clrrmc-ts", duration=10.0).summary
     assert longer["verdict"] == "tracked"
@@ -166,7 +166,7 @@ CONVERGED = {
 def test_the_start_offset_is_named_only_when_it_alone_explains_the_rms(change, converged):
     summary = {**CONVERGED, **change}
     assert verdict(summary)["verdict_reasons"] != []
-    assert _cause(summary).startswith("the error converged (final ") is converged
+    assert _cause(summary).startswith("the error converged (settled-end RMS ") is converged
     if not converged:
         assert _cause(summary) == NO_CONVERGENCE
 

@@ -119,7 +119,8 @@ def test_the_error_limit_is_at_most_a_fifth_of_the_extent_and_at_least_10_mm():
     small = verdict({**tiny, "trajectory_extent_m": 0.002828})
     assert small["verdict_reasons"] == ["final_error_above_limit", "rms_error_above_limit"]
     assert (
-        "final error 42.4 mm (limit 10 mm for a trajectory 2.828 mm across)" in (small["verdict"])
+        "settled-end RMS position error 42.4 mm (limit 10 mm for a trajectory 2.828 mm across)"
+        in (small["verdict"])
     )
     assert error_limit({**tiny, "trajectory_extent_m": 0.2}) == pytest.approx(0.04)
     assert error_limit({**tiny, "trajectory_extent_m": 0.0}) == pytest.approx(0.01)

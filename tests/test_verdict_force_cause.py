@@ -115,7 +115,10 @@ def test_a_converged_run_held_at_its_force_limit_keeps_its_transient():
         "the robot ran at a limit (a wheel at its force limit for 30 of 40 s and the arm at "
         "a joint limit (th2 = -3.14159 rad) on 427 of 2000 steps)"
     )
-    assert "; the error converged after it (final 10 mm, within the limit)" in cause
+    assert (
+        "; the error converged after it (settled-end RMS position error 10 mm, within the limit)"
+        in cause
+    )
     assert cause.endswith(
         "counts in the RMS; the arm folded to a joint limit (min manipulability 0) on the "
         "way, which may follow from the force limit too (the base lagged and the arm "

@@ -109,7 +109,7 @@ def test_a_corner_transient_at_a_joint_rate_limit_is_not_a_failure_to_converge()
         "the robot ran at a limit (a joint at its rate limit on 31 of 750 steps)"
     )
     assert "(the plant clipped the commands on 31 of 750 steps, saturated_steps)" in cause
-    assert "final 0.178 mm, within the limit" in cause
+    assert "settled-end RMS position error 0.178 mm, within the limit" in cause
     assert "up to 729 mm at a corner" in cause
     assert "did not converge" not in cause
 

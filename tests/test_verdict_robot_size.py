@@ -85,7 +85,8 @@ def test_a_scaled_robot_gets_the_default_runs_verdict(default_runs, robot, facto
 def test_the_limit_text_names_the_robots_size():
     far = {"trajectory_extent_m": 0.25, "final_position_error_m": 0.003, "length_unit_m": 0.05}
     assert (
-        "final error 3 mm (limit 2.5 mm for this robot's size (length_unit_m 0.05))"
+        "settled-end RMS position error 3 mm "
+        "(limit 2.5 mm for this robot's size (length_unit_m 0.05))"
         in (verdict(far)["verdict"])
     )
     point = {**far, "trajectory_extent_m": 0.0}
