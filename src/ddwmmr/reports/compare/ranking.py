@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -77,10 +78,14 @@ def metrics_csv(rows: Sequence[Mapping[str, Any]]) -> str:
 
 def _csv_value(value: Any) -> str:
     """Exact text of a summary value: floats by repr (round-trips), None as empty, a list
-    of names (``verdict_reasons``) space separated."""
+    of names (``verdict_reasons``) space separated, a dict (``mpc_options``) as compact
+    JSON with sorted keys (``json.loads`` reads it back; its non-finite floats are
+    ``"nan"``/``"inf"`` strings, as in ``summary.json``)."""
     value = json_safe(value)
     if value is None:
         return ""
+    if isinstance(value, dict):
+        return json.dumps(value, sort_keys=True, separators=(",", ":"), allow_nan=False)
     if isinstance(value, list | tuple):
         return " ".join(str(item) for item in value)
     return repr(value) if isinstance(value, float) else str(value)
