@@ -249,8 +249,9 @@ class Robot:
             raise ParameterError(
                 "caster_positions: the base centre must lie strictly inside the support "
                 "polygon of the wheels and casters, not on an edge (the stability margin S "
-                f"measures the centre of mass's offset from it) (got casters {self.casters}): "
-                "put casters on both sides of the wheel axle (x > 0 and x < 0)"
+                "measures the centre of mass's offset from it) (got casters "
+                f"{shown(self.casters, 80)}): put casters on both sides of the wheel axle "
+                "(x > 0 and x < 0)"
             )
         return edges
 

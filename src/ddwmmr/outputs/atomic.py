@@ -22,9 +22,10 @@ def write_atomic(
 ) -> None:
     """Write ``data`` to ``path`` through a temporary file and an atomic rename.
 
-    ``data`` is text (written as UTF-8), bytes, or a function ``data(handle)`` that writes
-    the bytes into the temporary file's binary handle, piece by piece (a file too large
-    to build in memory first: a long run's ``timeseries.csv``).
+    ``data`` is text (written as UTF-8, a lone surrogate as its escape ``\\udcXX``),
+    bytes, or a function ``data(handle)`` that writes the bytes into the temporary file's
+    binary handle, piece by piece (a file too large to build in memory first: a long
+    run's ``timeseries.csv``).
 
     ``path`` must be a non-empty ``str`` or :class:`os.PathLike`; if something exists
     there it must be a regular file, which is replaced. A folder, a device (``/dev/null``),
@@ -36,7 +37,7 @@ def write_atomic(
     bench's ``--out``, the per-run sub-folders of a GUI export); a path through something
     that is not a folder is refused, and so is a folder in which nothing can be created
     (:func:`unwritable_message`: ``/proc``, a read-only mount, no permission).
-    Failures of the write itself (full disk) raise :class:`OSError`.
+    Failures of the write itself (full disk) raise :class:`OSError` naming ``path``.
 
     Durable: the file's bytes are synced to the disk (``fsync``) before the rename, and
     the folder's entry after it (:func:`sync_folder`), so a power cut leaves the earlier
@@ -50,7 +51,14 @@ def write_atomic(
     """
     path = check_file_target(path)
     existing = existing_folder("path", path.parent)
-    payload = data if isinstance(data, bytes) or callable(data) else data.encode("utf-8")
+    # A lone surrogate (a file name's undecodable byte, as Python reads one) has no UTF-8
+    # form: it is written as its escape, \udce9, so a report quoting that path is still
+    # written, as valid UTF-8.
+    payload = (
+        data
+        if isinstance(data, bytes) or callable(data)
+        else data.encode("utf-8", errors="backslashreplace")
+    )
     try:
         path.parent.mkdir(parents=True, exist_ok=True, mode=folder_mode())
         fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=temp_prefix(), suffix=".tmp")
@@ -70,6 +78,13 @@ def write_atomic(
         # would be replaced as well.
         check_file_target(path)
         os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        if exc.filename is not None:
+            raise
+        # A failed write (a full disk) names no file: name the one being written, so the
+        # tools' one line says where ("error: PATH: No space left on device").
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from exc
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

@@ -14,7 +14,10 @@ vectorised call (:func:`sampler`).
 from __future__ import annotations
 
 import math
+import os
+import unicodedata
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
@@ -171,4 +174,24 @@ def check_name(name: Any, prefix: str = "") -> str:
     ``"trajectory samples: "``)."""
     if not isinstance(name, str) or not name:
         raise ParameterError(f"{prefix}name must be a string, not empty (got {shown(name)})")
+    if any(unicodedata.category(c) in _UNPRINTABLE for c in name):
+        # A newline splits the report's lines; a lone surrogate (an undecodable byte of a
+        # file name) cannot be encoded, so the figures' titles fail to draw.
+        raise ParameterError(
+            f"{prefix}name must be text on one line, without control characters or lone "
+            f"surrogates (got {shown(name)})"
+        )
     return name
+
+
+#: Unicode categories a trajectory name may not hold: control characters and surrogates.
+_UNPRINTABLE = ("Cc", "Cs")
+
+
+def file_name(path: str | os.PathLike[str]) -> str:
+    """The name a trajectory file gives its trajectory: the file name without its suffix,
+    as text :func:`check_name` takes. A file name's bytes are read as UTF-8 (also when the
+    locale decoded them as ASCII: ``LC_ALL=POSIX``), any byte that is not UTF-8 as U+FFFD,
+    and a control character as ``?``: an odd file name does not make the file unusable."""
+    text = os.fsencode(Path(path).stem).decode("utf-8", errors="replace")
+    return "".join("?" if unicodedata.category(c) in _UNPRINTABLE else c for c in text)

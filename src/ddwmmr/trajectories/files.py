@@ -37,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from ddwmmr.errors import ParameterError, as_path, check_number_type, load_toml, shown
+from ddwmmr.trajectories.base import file_name
 from ddwmmr.trajectories.parametric import PHI_NEEDS_CONSTANT, Ellipse, Rectangle
 from ddwmmr.trajectories.sampled import SampledTrajectory, read_csv
 
@@ -205,7 +206,7 @@ def read_toml(path: str | Path, **overrides):
             else f"got {shown(shape)}"
         )
         raise ParameterError(f"traj: {path} needs shape = one of {', '.join(SHAPES)} ({got})")
-    table.setdefault("name", path.stem)
+    table.setdefault("name", file_name(path))
     if "shape" in overrides:
         _refuse_shape_override(f"traj: {path}", shape, "the file", overrides["shape"])
     table.update(overrides)

@@ -37,7 +37,13 @@ from ddwmmr.errors import (
     read_text_file,
     shown,
 )
-from ddwmmr.trajectories.base import atan2_array, check_name, check_time, check_times
+from ddwmmr.trajectories.base import (
+    atan2_array,
+    check_name,
+    check_time,
+    check_times,
+    file_name,
+)
 
 MAX_TIME_S = DURATION_RANGE_S[1]
 #: Smallest step between two sample times, as a share of the duration (last minus first
@@ -475,8 +481,11 @@ def _csv_number(path: Path, number: int, row: dict, key: str) -> float:
             raise ValueError(text)
         return float(text)
     except ValueError:
+        # Stripped of ASCII blanks only: str.strip would also take off a no-break space
+        # that made the value unreadable, and show a plain number.
+        value = shown(text.strip(" \t"))
         raise ParameterError(
-            f"traj: {path} data row {number}, column {key}: {shown(text.strip())} is not a number"
+            f"traj: {path} data row {number}, column {key}: {value} is not a number"
         ) from None
 
 
@@ -558,6 +567,6 @@ def read_csv(path: str | Path) -> SampledTrajectory:
     times = np.array([row[0] for row in values])
     points = np.array([row[1:] for row in values])
     try:
-        return SampledTrajectory(times, points, name=path.stem)
+        return SampledTrajectory(times, points, name=file_name(path))
     except ParameterError as exc:
         raise ParameterError(f"traj: {path}: {exc}") from None
