@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import bisect
 import csv
+import itertools
 import math
 import warnings
 from collections.abc import Sequence
@@ -498,15 +499,57 @@ def _is_number_text(text: str) -> bool:
     return True
 
 
+#: Longest line :func:`_plain_values` reads: the csv module's default field size limit,
+#: beyond which the full reader refuses the file.
+_PLAIN_LINE_LIMIT = csv.field_size_limit()
+
+
+def _plain_values(lines: list[str]) -> npt.NDArray[np.float64] | None:
+    """The values of a plain CSV trajectory, one row per data line, read without the csv
+    module: a header of exactly ``t,x,y`` or ``t,x,y,phi`` and data lines of ASCII numbers
+    with no quote, underscore or blank line, each with one value per column. None for
+    anything else, which the full reader then reads or refuses, naming what is wrong:
+    the result here is what it gives (the same ``float`` of the same fields), in a
+    fraction of its time and memory (a million rows: dictionaries of strings, about
+    1 GB, against the numbers alone)."""
+    if not lines or lines[0] not in ("t,x,y", "t,x,y,phi"):
+        return None
+    columns = lines[0].count(",") + 1
+    flat: list[float] = []
+    try:
+        for line in itertools.islice(lines, 1, None):
+            if (
+                line.count(",") != columns - 1
+                or len(line) > _PLAIN_LINE_LIMIT
+                or not line.isascii()
+                or "_" in line
+                or '"' in line
+            ):
+                return None
+            flat.extend(map(float, line.split(",")))
+    except ValueError:  # an empty or unreadable value: the full reader names it
+        return None
+    if not flat:
+        return None
+    return np.array(flat, dtype=float).reshape(-1, columns)
+
+
 def read_csv(path: str | Path) -> SampledTrajectory:
     """Load a :class:`SampledTrajectory` from a CSV file with columns t, x, y[, phi]."""
     path = as_path(path, "traj")
-    text = read_text_file(path, "traj")
-    lines = [line for line in text.splitlines() if not line.startswith("#")]
+    # The text is dropped once split: a large file is held once, as its lines.
+    lines = [line for line in read_text_file(path, "traj").splitlines() if not line.startswith("#")]
     if len(lines) > MAX_TRAJECTORY_SAMPLES + 1:
         raise ParameterError(
             f"traj: {path} has {len(lines) - 1} rows (at most {MAX_TRAJECTORY_SAMPLES})"
         )
+    plain = _plain_values(lines)
+    if plain is not None:
+        try:
+            times, points = np.ascontiguousarray(plain[:, 0]), np.ascontiguousarray(plain[:, 1:])
+            return SampledTrajectory(times, points, name=file_name(path))
+        except ParameterError as exc:
+            raise ParameterError(f"traj: {path}: {exc}") from None
     try:
         reader = csv.DictReader(lines)
         rows = list(reader)
