@@ -86,8 +86,7 @@ def test_the_limit_text_names_the_robots_size():
     far = {"trajectory_extent_m": 0.25, "final_position_error_m": 0.003, "length_unit_m": 0.05}
     assert (
         "settled-end RMS position error 3 mm "
-        "(limit 2.5 mm for this robot's size (length_unit_m 0.05))"
-        in (verdict(far)["verdict"])
+        "(limit 2.5 mm for this robot's size (length_unit_m 0.05))" in (verdict(far)["verdict"])
     )
     point = {**far, "trajectory_extent_m": 0.0}
     assert (
