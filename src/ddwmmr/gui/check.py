@@ -62,7 +62,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         widget.event_generate("<ButtonRelease-1>", x=x, y=y)
 
     def type_duration() -> None:
-        # Click into the duration field, replace its text key by key, press Enter.
+        # Click into the duration field, replace its text key by key, press Enter. Tk drops
+        # the events sent to a canvas not mapped yet (later than 0.8 s on a loaded machine).
+        if not widget.winfo_viewable() and time.perf_counter() - started < TIMEOUT_S:
+            window.after(100, type_duration)
+            return
         widget.focus_force()
         click(app.duration_field.ax)
         for _ in app.duration_field.text:
