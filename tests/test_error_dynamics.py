@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import control
 import numpy as np
@@ -54,6 +55,27 @@ def test_summary_and_channels() -> None:
     assert list(error_loops("clrrmc-cs", 0.3)) == ["x", "y", "phi", "th1", "th2"]
     with pytest.raises(ValueError):
         error_loops("pi", 0.5)
+
+
+def test_feedback_off_gives_zeros_without_simulating_a_static_system(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # tau = inf makes the loop the static gain 0; python-control 0.10.2 simulates a static
+    # system by assigning ndarray.shape, deprecated from NumPy 2.5 (Python 3.12+ installs
+    # it), so the answer must not come from control.step_response.
+    def refuse(*args: object, **kwargs: object) -> None:
+        raise AssertionError("control.step_response called for the static loop")
+
+    monkeypatch.setattr(control, "step_response", refuse)
+    times = np.linspace(0.0, 2.0, 5)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)
+        response = step_response(math.inf, times)
+        remaining = error_response(math.inf, times)
+    assert response.shape == (5,)
+    assert response.dtype == np.float64
+    np.testing.assert_array_equal(response, np.zeros(5))
+    np.testing.assert_array_equal(remaining, np.ones(5))  # the error never decays
 
 
 @pytest.mark.parametrize("tau", (0.2, 0.5, 1.0))

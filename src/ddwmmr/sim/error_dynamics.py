@@ -71,9 +71,16 @@ def step_response(tau: float, times: Sequence[float] | np.ndarray) -> np.ndarray
     """Unit step response of :func:`error_loop` at ``times`` (s), computed by python-control.
 
     ``times``: at least 2 finite times, equally spaced, increasing and starting at 0 (the
-    step), as python-control simulates them (:func:`check_response_times`).
+    step), as python-control simulates them (:func:`check_response_times`). ``tau = inf``
+    (feedback off) gives zeros at every time.
     """
     times = check_response_times(times, spaced=True)
+    (gain,) = gains_from_tau(tau, 1)
+    if gain == 0.0:
+        # The loop is the static gain 0. python-control 0.10.2 simulates a static system by
+        # assigning ndarray.shape, deprecated from NumPy 2.5 (the NumPy that Python 3.12+
+        # installs), so the answer is given here rather than through it.
+        return np.zeros(times.size)
     response = control.step_response(error_loop(tau), times)
     return np.asarray(response.outputs, dtype=float)
 
