@@ -22,6 +22,7 @@ from ddwmmr.outputs.owners import (
     dead_lock,
     lock_holder,
     owner_token,
+    read_lock,
     temp_prefix,
 )
 from ddwmmr.outputs.recovery import _target_tag, drop_stale_lock
@@ -77,8 +78,8 @@ def output_lock(target: Path, text: str) -> Iterator[None]:
     try:
         yield
     finally:
-        with contextlib.suppress(OSError):
-            if path.read_text(encoding="utf-8") == token:
+        with contextlib.suppress(OSError, ParameterError):
+            if read_lock(path) == token:
                 path.unlink()
 
 

@@ -15,6 +15,8 @@ import stat
 from pathlib import Path
 from typing import Any
 
+from ddwmmr.errors import ParameterError
+
 STAGING_PREFIX = ".ddwmmr-staging-"
 
 
@@ -152,16 +154,71 @@ def _is_stale_temp(name: str) -> bool:
     return name.endswith(".tmp") and _dead_owner(name, "tmp") is not None
 
 
+#: Most bytes of a lock file read: its token is a host name, a process id and a time.
+_LOCK_BYTES = 4096
+
+#: What a file type is called in a message.
+_KINDS = {
+    stat.S_IFDIR: "a folder",
+    stat.S_IFIFO: "a FIFO",
+    stat.S_IFLNK: "a symbolic link",
+    stat.S_IFCHR: "a device",
+    stat.S_IFBLK: "a device",
+    stat.S_IFSOCK: "a socket",
+}
+
+
+def read_lock(path: Path) -> str | None:
+    """The text of the output lock ``path`` (its first :data:`_LOCK_BYTES` bytes, a byte
+    that is not UTF-8 as U+FFFD; ``""`` if it cannot be read), None if nothing is there.
+
+    Anything at ``path`` that is not a regular file raises a one-line
+    :class:`ParameterError` naming it: reading a FIFO would wait for ever and ``/dev/zero``
+    would fill the memory, and a folder is no run's lock, to be moved aside as a killed
+    run's. The file is opened without following a link and without waiting (a FIFO
+    swapped in after the check)."""
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return None
+    except OSError:
+        return ""
+    if not stat.S_ISREG(mode):
+        _not_a_lock(path, mode)
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOFOLLOW", 0)
+    try:
+        fd = os.open(path, flags)
+    except FileNotFoundError:
+        return None
+    except OSError:
+        return ""
+    with os.fdopen(fd, "rb") as handle:
+        mode = os.fstat(handle.fileno()).st_mode
+        if not stat.S_ISREG(mode):
+            _not_a_lock(path, mode)
+        try:
+            data = handle.read(_LOCK_BYTES)
+        except OSError:
+            return ""
+    return data.decode("utf-8", errors="replace")
+
+
+def _not_a_lock(path: Path, mode: int) -> None:
+    kind = _KINDS.get(stat.S_IFMT(mode), "not a regular file")
+    raise ParameterError(
+        f"out: {path}, the name of the output folder's lock, is {kind}, not a lock file a "
+        "ddwmmr run wrote; remove it or choose another --out"
+    )
+
+
 def lock_holder(path: Path) -> tuple[str, int, int] | None:
     """``(host, pid, start)`` of the run holding the lock ``path`` (its text is that run's
     :func:`owner_token`; an unreadable or cut-short one: this host, pid 0, which
-    :func:`dead_lock` counts as ended), or None if there is no lock."""
-    try:
-        token = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
+    :func:`dead_lock` counts as ended), or None if there is no lock. Something there that
+    is not a regular file is refused (:func:`read_lock`)."""
+    token = read_lock(path)
+    if token is None:
         return None
-    except (OSError, UnicodeDecodeError):
-        token = ""
     rest, _, start = token.rpartition("-")
     host, _, pid = rest.rpartition("-")
     if not (host and pid.isdigit() and start.isdigit()):
