@@ -414,7 +414,12 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
     or stops its workers); its line then says that output is complete, not removed."""
     committed: list[Path] = []  # the output folders main completed (recording_commits)
     try:
-        with interruptible(), one_line_warnings(), recording_commits(committed):
+        with (
+            interruptible(),
+            one_line_warnings(),
+            recording_commits(committed),
+            printable_stdout(),
+        ):
             return main(argv)
     except ParameterError as exc:
         say(f"error: {exc}")
@@ -435,6 +440,25 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
         where = f"{exc.filename}: " if exc.filename else ""
         say(f"error: {where}{exc.strerror or exc}")
         return 1
+
+
+@contextlib.contextmanager
+def printable_stdout() -> Iterator[None]:
+    """While the tool runs, ``sys.stdout`` writes a character its encoding lacks as ``?``
+    (as :func:`console_text` does) instead of raising: a trajectory name or an output
+    path outside an ASCII or latin-1 console's characters would otherwise end the tool
+    with a UnicodeEncodeError traceback after its output was written. stderr needs
+    nothing: Python opens it with ``errors="backslashreplace"``. Restored afterwards."""
+    stream = sys.stdout
+    strict = getattr(stream, "errors", None) == "strict" and hasattr(stream, "reconfigure")
+    if strict:
+        stream.reconfigure(errors="replace")
+    try:
+        yield
+    finally:
+        if strict:
+            with contextlib.suppress(OSError, ValueError):  # closed or broken meanwhile
+                stream.reconfigure(errors="strict")
 
 
 def _complete_output(stop: BaseException, committed: list[Path]) -> Path | None:

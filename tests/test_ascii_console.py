@@ -1,0 +1,32 @@
+"""A tool on an ASCII console (``PYTHONIOENCODING=ascii``, ``LANG=C`` on an old system):
+a trajectory name or an output folder outside ASCII is printed with ``?`` for what the
+console cannot show, and the run ends with status 0, not a UnicodeEncodeError traceback
+after its output was written."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+
+def test_track_prints_a_non_ascii_name_and_folder_on_an_ascii_console(tmp_path: Path) -> None:
+    trajectory = tmp_path / "ovale.toml"
+    trajectory.write_text('shape = "ellipse"\nname = "ovale \u00e9"\n', encoding="utf-8")
+    out = tmp_path / "sortie \u00fc"
+    env = {**os.environ, "PYTHONIOENCODING": "ascii", "MPLBACKEND": "Agg"}
+    command = ["-m", "ddwmmr.track", "--method", "pi", "--traj", str(trajectory)]
+    command += ["--duration", "0.5", "--no-plots", "--out", str(out)]
+    done = subprocess.run(
+        [sys.executable, *command],
+        capture_output=True,
+        env=env,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr.decode("ascii", "replace")
+    stdout = done.stdout.decode("ascii")
+    assert "pi on ovale ? (kinematic plant)" in stdout
+    assert f"wrote {tmp_path / 'sortie ?'}/" in stdout
+    assert "Traceback" not in done.stderr.decode("ascii", "replace")
+    assert (out / "summary.json").is_file()
