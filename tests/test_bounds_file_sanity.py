@@ -58,3 +58,29 @@ def test_no_warning_when_the_run_is_slower_than_its_lower_bounds(tmp_path, capsy
     assert "gives lower bounds above" not in capsys.readouterr().err
     summary = json.loads((out / "summary.json").read_text())
     assert summary["bracket"]["scenarios_below_lower_bound"] == []
+
+
+def test_a_fifo_or_a_device_as_bounds_file_is_refused_in_one_line(tmp_path):
+    """A FIFO named as the bounds file (or as the summary.json beside it) blocked the run
+    until killed; a UTF-16 file gave the codec's own error. Each is one line now."""
+    import os
+
+    import pytest
+
+    from ddwmmr.errors import ParameterError
+
+    fifo = tmp_path / "fifo" / "bounds.csv"
+    fifo.parent.mkdir()
+    os.mkfifo(fifo)
+    with pytest.raises(ParameterError, match=r"^bounds: .*bounds\.csv is not a regular file$"):
+        read_bounds_file(fifo, 0, 3.0)
+    path = _bounds(tmp_path / "record", ["1,10,12,True"])
+    (path.parent / "summary.json").unlink()
+    os.mkfifo(path.parent / "summary.json")
+    with pytest.raises(ParameterError, match=r"summary\.json is not a regular file"):
+        read_bounds_file(path, 0, 3.0)
+    wide = tmp_path / "wide" / "bounds.csv"
+    wide.parent.mkdir()
+    wide.write_text(HEADER + "\n1,10,12,True\n", encoding="utf-16")
+    with pytest.raises(ParameterError, match=r"is not UTF-8 text \(byte 0xff at offset 0\)"):
+        read_bounds(wide)

@@ -25,7 +25,7 @@ import numpy as np
 
 from ddwmmr.bounds.lower import lower_bound
 from ddwmmr.bounds.search import Settings, best_known
-from ddwmmr.errors import DURATION_RANGE_S, MAX_SCENARIOS, ParameterError, shown
+from ddwmmr.errors import DURATION_RANGE_S, MAX_SCENARIOS, ParameterError, read_text_file, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import check_stability_floor
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, kept_trajectory
@@ -243,9 +243,10 @@ def other_settings(folder: Path, scenario: Scenario, payload: float, settings: S
 
 
 def _read_object(path: Path) -> dict | None:
-    """The JSON object at ``path``, or None if missing, unreadable or not an object."""
+    """The JSON object at ``path``, or None if missing, unreadable, not a regular file or
+    not an object."""
     try:
-        record = json.loads(path.read_text(encoding="utf-8"))
+        record = json.loads(read_text_file(path, "bounds"))
     except (OSError, ValueError):
         return None
     return record if isinstance(record, dict) else None
@@ -342,35 +343,37 @@ def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
     achieved). A UTF-8 byte-order mark (a spreadsheet's "CSV UTF-8") is read as none.
     """
     out = {}
-    with open(path, newline="", encoding="utf-8-sig") as handle:
-        reader = csv.DictReader(handle)
-        missing = [c for c in READ_COLUMNS if c not in (reader.fieldnames or ())]
-        if missing:
+    # read_text_file refuses a FIFO or a device (which would block) and text that is not
+    # UTF-8 in one line; the csv module then reads the text as it would the file.
+    text = read_text_file(path, "bounds")
+    reader = csv.DictReader(io.StringIO(text, newline=""))
+    missing = [c for c in READ_COLUMNS if c not in (reader.fieldnames or ())]
+    if missing:
+        raise ParameterError(
+            f"bounds: {path} lacks the column{'s' * (len(missing) > 1)} "
+            f"{', '.join(missing)} (a bounds.csv of python -m ddwmmr.bounds has "
+            f"{', '.join(READ_COLUMNS)})"
+        )
+    for r in reader:
+        where = f"bounds: {path} line {reader.line_num}"
+        scenario = _bounds_scenario(where, r)
+        if scenario in out:
+            raise ParameterError(f"{where}: scenario {scenario} appears twice")
+        where = f"{where} (scenario {scenario})"
+        replay_ok = _bounds_field(where, r, "replay_ok")
+        if replay_ok not in ("True", "False"):
             raise ParameterError(
-                f"bounds: {path} lacks the column{'s' * (len(missing) > 1)} "
-                f"{', '.join(missing)} (a bounds.csv of python -m ddwmmr.bounds has "
-                f"{', '.join(READ_COLUMNS)})"
+                f"{where}, column replay_ok: must be True or False (got {shown(replay_ok)})"
             )
-        for r in reader:
-            where = f"bounds: {path} line {reader.line_num}"
-            scenario = _bounds_scenario(where, r)
-            if scenario in out:
-                raise ParameterError(f"{where}: scenario {scenario} appears twice")
-            where = f"{where} (scenario {scenario})"
-            replay_ok = _bounds_field(where, r, "replay_ok")
-            if replay_ok not in ("True", "False"):
-                raise ParameterError(
-                    f"{where}, column replay_ok: must be True or False (got {shown(replay_ok)})"
-                )
-            lower = _bounds_time(where, r, "lower_bound_s")
-            best = _bounds_time(where, r, "best_known_s") if replay_ok == "True" else math.nan
-            if best < lower:
-                raise ParameterError(
-                    f"{where}: best_known_s {r['best_known_s'].strip()} s is below "
-                    f"lower_bound_s {r['lower_bound_s'].strip()} s (no achieved time is below "
-                    "its lower bound)"
-                )
-            out[scenario] = (lower, best)
+        lower = _bounds_time(where, r, "lower_bound_s")
+        best = _bounds_time(where, r, "best_known_s") if replay_ok == "True" else math.nan
+        if best < lower:
+            raise ParameterError(
+                f"{where}: best_known_s {r['best_known_s'].strip()} s is below "
+                f"lower_bound_s {r['lower_bound_s'].strip()} s (no achieved time is below "
+                "its lower bound)"
+            )
+        out[scenario] = (lower, best)
     return out
 
 
@@ -444,7 +447,7 @@ def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, t
         raise ParameterError(f"bounds: cannot read {path} and its summary.json ({exc})") from None
     record = path.parent / "summary.json"
     try:
-        summary = json.loads(record.read_text(encoding="utf-8-sig"))
+        summary = json.loads(read_text_file(record, "bounds"))
     except (OSError, ValueError) as exc:
         raise ParameterError(
             f"bounds: cannot read {record}, the bounds run's record of the seed and payload "
