@@ -249,7 +249,11 @@ CASES += [
     ("track", ["--rerun", "{traj_N_string.toml}"], "is not valid JSON"),
     ("track", ["--rerun", "{fifo}"], "is not a regular file"),
     ("track", ["--rerun", ""], "rerun: give the path of a summary.json"),
-    ("track", ["--method", "qp", "--obstacles", "{obstacles_text.toml}"], "must be numbers"),
+    (
+        "track",
+        ["--method", "qp", "--obstacles", "{obstacles_text.toml}"],
+        "x must be a number in m (got '1')",
+    ),
     ("track", ["--method", "qp", "--obstacles", "../x"], "cannot read ../x"),
     ("track", ["--method", "qp", "--obstacles", "nope"], "unknown obstacle file 'nope'"),
     ("compare", ["--duration", "1e9"], "duration / dt must be <="),

@@ -101,6 +101,7 @@ from typing import Any
 
 import numpy as np
 
+from ddwmmr.controllers.option_specs import option_names
 from ddwmmr.errors import LENGTH_RANGE_M, ParameterError, one_line, shown, texts_apart
 from ddwmmr.qp.limits.obstacles import INFLUENCE_M
 from ddwmmr.resolution.kernels import length_unit
@@ -271,6 +272,8 @@ NO_CONVERGENCE = NO_CONVERGENCE_CHECKS.format(checks="tau, dt and the integrator
 #: What :data:`NO_CONVERGENCE_CHECKS` asks to check in place of ``tau`` for a method without
 #: one (its tracking gains' options); ``tau`` for every other method.
 GAINS_OF = {"mpc": "position_weight, horizon"}
+#: The methods :data:`NO_CONVERGENCE_CHECKS` names as open-loop.
+OPEN_LOOP_METHODS = ("pi", "ats", "ap")
 OBSTACLE_DETOUR = (
     "the base went round an obstacle on or near the path (closest footprint clearance "
     "{clearance_mm:.3g} mm, under the {near_mm:.0f} mm within which the qp steers round "
@@ -843,10 +846,25 @@ def _convergence_checks(summary: Mapping[str, Any]) -> str:
     """What :data:`NO_CONVERGENCE_CHECKS` asks to check, of what the run had: ``tau``, or
     the gains of a method without it (:data:`GAINS_OF`), ``dt``, and ``the integrator``
     unless the summary records the plant's as None (a plant without one: thesis, MuJoCo)."""
-    checks = [GAINS_OF.get(str(summary.get("method")), "tau"), "dt"]
+    checks = [_gains_of(str(summary.get("method"))), "dt"]
     if not ("integrator" in summary and summary["integrator"] is None):
         checks.append("the integrator")
     return ", ".join(checks[:-1]) + " and " + checks[-1]
+
+
+def _gains_of(method: str) -> str:
+    """What sets how fast ``method`` removes an error: ``tau``, :data:`GAINS_OF`'s entry,
+    or for a plug-in method without ``tau`` its own options (a method the registry does
+    not know is taken to have ``tau``)."""
+    if method in GAINS_OF:
+        return GAINS_OF[method]
+    try:
+        names = option_names(method)
+    except ParameterError:
+        return "tau"
+    if "tau" in names or method in OPEN_LOOP_METHODS or not names:
+        return "tau"
+    return f"its options ({', '.join(names)})"
 
 
 def _held_cause(summary: Mapping[str, Any], found: list[str], after: str = "") -> str | None:

@@ -117,10 +117,13 @@ def load_obstacles(path: str | Path) -> list[Circle]:
                 f"obstacles: {path}: obstacle {i} needs exactly x, y, radius in m "
                 f"(got {sorted(keys)})"
             )
-        if not all(
-            isinstance(table[k], int | float) and not isinstance(table[k], bool) for k in keys
-        ):
-            raise ParameterError(f"obstacles: {path}: obstacle {i}: x, y, radius must be numbers")
+        for key in ("x", "y", "radius"):
+            value = table[key]
+            if not isinstance(value, int | float) or isinstance(value, bool):
+                raise ParameterError(
+                    f"obstacles: {path}: obstacle {i}: {key} must be a number in m "
+                    f"(got {shown(value)})"
+                )
         try:
             circles.append(within_limits(table["x"], table["y"], table["radius"]))
         except ParameterError as exc:
