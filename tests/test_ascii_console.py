@@ -30,3 +30,27 @@ def test_track_prints_a_non_ascii_name_and_folder_on_an_ascii_console(tmp_path: 
     assert f"wrote {tmp_path / 'sortie ?'}/" in stdout
     assert "Traceback" not in done.stderr.decode("ascii", "replace")
     assert (out / "summary.json").is_file()
+
+
+def test_track_on_an_ascii_locale_without_utf8_mode_keeps_a_file_names_byte(
+    tmp_path: Path,
+) -> None:
+    """``LC_ALL=POSIX PYTHONUTF8=0``: stdout is ASCII with ``surrogateescape``, which writes
+    a file name's undecodable byte back but raises on any other non-ASCII character."""
+    trajectory = tmp_path / "ovale.toml"
+    trajectory.write_text('shape = "ellipse"\nname = "ovale \u00e9"\n', encoding="utf-8")
+    out = tmp_path / os.fsdecode(b"sortie\xe9")  # a byte that is not UTF-8
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONIOENCODING", "LANG")}
+    env.update(LC_ALL="POSIX", PYTHONUTF8="0", PYTHONCOERCECLOCALE="0", MPLBACKEND="Agg")
+    command = ["-m", "ddwmmr.track", "--method", "pi", "--traj", str(trajectory)]
+    command += ["--duration", "0.5", "--no-plots", "--out", str(out)]
+    done = subprocess.run(
+        [sys.executable, *command],
+        capture_output=True,
+        env=env,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr.decode("ascii", "replace")
+    assert b"pi on ovale ? (kinematic plant)" in done.stdout
+    assert b"wrote " + os.fsencode(tmp_path) + b"/sortie\xe9/" in done.stdout
+    assert (out / "summary.json").is_file()

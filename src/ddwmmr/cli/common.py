@@ -16,6 +16,7 @@ behaviour for everything that is not a result:
 from __future__ import annotations
 
 import argparse
+import codecs
 import contextlib
 import inspect
 import logging
@@ -442,23 +443,48 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
         return 1
 
 
+#: The error handler :func:`printable_stdout` gives ``sys.stdout`` in place of each one
+#: that raises on a character the encoding lacks.
+_PRINTABLE_ERRORS = {"strict": "replace", "surrogateescape": "ddwmmr.surrogateescape_or_replace"}
+
+
+def _surrogateescape_or_replace(error: UnicodeError) -> tuple[bytes, int]:
+    """Encoding error handler: a lone surrogate U+DC80-U+DCFF (a file name's undecodable
+    byte, as ``surrogateescape`` reads it) as that byte again, as ``surrogateescape``
+    writes it; any other character the encoding lacks as ``?``, as ``replace`` does."""
+    if not isinstance(error, UnicodeEncodeError):
+        raise error
+    lacking = error.object[error.start : error.end]
+    replaced = bytes(ord(c) - 0xDC00 if 0xDC80 <= ord(c) <= 0xDCFF else ord("?") for c in lacking)
+    return replaced, error.end
+
+
+codecs.register_error(_PRINTABLE_ERRORS["surrogateescape"], _surrogateescape_or_replace)
+
+
 @contextlib.contextmanager
 def printable_stdout() -> Iterator[None]:
     """While the tool runs, ``sys.stdout`` writes a character its encoding lacks as ``?``
     (as :func:`console_text` does) instead of raising: a trajectory name or an output
     path outside an ASCII or latin-1 console's characters would otherwise end the tool
-    with a UnicodeEncodeError traceback after its output was written. stderr needs
-    nothing: Python opens it with ``errors="backslashreplace"``. Restored afterwards."""
+    with a UnicodeEncodeError traceback after its output was written. A stream whose
+    handler is ``strict`` (``PYTHONIOENCODING=ascii``, a latin-1 locale) gets ``replace``;
+    one whose handler is ``surrogateescape`` (an ASCII locale without UTF-8 mode:
+    ``LC_ALL=POSIX PYTHONUTF8=0``) still writes a file name's undecodable byte as that
+    byte (:func:`_surrogateescape_or_replace`). stderr needs nothing: Python opens it with
+    ``errors="backslashreplace"``. The stream's own handler is restored afterwards."""
     stream = sys.stdout
-    strict = getattr(stream, "errors", None) == "strict" and hasattr(stream, "reconfigure")
-    if strict:
-        stream.reconfigure(errors="replace")
+    errors = getattr(stream, "errors", None)
+    reconfigurable = isinstance(errors, str) and hasattr(stream, "reconfigure")
+    printable = _PRINTABLE_ERRORS.get(errors) if reconfigurable else None
+    if printable is not None:
+        stream.reconfigure(errors=printable)
     try:
         yield
     finally:
-        if strict:
+        if printable is not None:
             with contextlib.suppress(OSError, ValueError):  # closed or broken meanwhile
-                stream.reconfigure(errors="strict")
+                stream.reconfigure(errors=errors)
 
 
 def _complete_output(stop: BaseException, committed: list[Path]) -> Path | None:
