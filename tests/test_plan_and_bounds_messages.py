@@ -122,8 +122,26 @@ def test_a_missing_summary_is_named_alone(tmp_path):
     with pytest.raises(ParameterError) as error:
         read_bounds_file(path, 0, 3.0)
     text = str(error.value)
-    assert text.startswith(f"bounds: cannot read {tmp_path / 'summary.json'}, the bounds run's")
-    assert f"cannot read {path}" not in text
+    assert text == (
+        f"bounds: cannot read {tmp_path / 'summary.json'} (No such file or directory); it is "
+        "the bounds run's record of the seed and payload bounds.csv is for, which must be "
+        "beside it"
+    )
+
+
+def test_a_summary_that_is_not_utf8_is_named_once(tmp_path):
+    """The reading's own line, once: it was quoted inside 'cannot read ... (...)'."""
+    path = tmp_path / "bounds.csv"
+    path.write_text(BOUNDS_CSV)
+    (tmp_path / "summary.json").write_bytes(b'\xff{"seed": 0}')
+    with pytest.raises(ParameterError) as error:
+        read_bounds_file(path, 0, 3.0)
+    text = str(error.value)
+    assert text.startswith(
+        f"bounds: {tmp_path / 'summary.json'} is not UTF-8 text (byte 0xff at offset 0); it is "
+        "the bounds run's record of the seed and payload bounds.csv is for"
+    )
+    assert text.count(str(tmp_path / "summary.json")) == 1
 
 
 @pytest.mark.parametrize("record", [[1, 2], {"seed": 0}, "text"])

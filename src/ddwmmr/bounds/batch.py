@@ -446,12 +446,16 @@ def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, t
     except (OSError, ValueError, KeyError, csv.Error) as exc:
         raise ParameterError(f"bounds: cannot read {path} and its summary.json ({exc})") from None
     record = path.parent / "summary.json"
+    beside = f"the bounds run's record of the seed and payload {path.name} is for"
     try:
-        summary = json.loads(read_text_file(record, "bounds"))
-    except (OSError, ValueError) as exc:
+        text = read_text_file(record, "bounds")
+    except ParameterError as exc:  # one line naming the file and what is wrong with it
+        raise ParameterError(f"{exc}; it is {beside}, which must be beside it") from None
+    try:
+        summary = json.loads(text)
+    except ValueError as exc:
         raise ParameterError(
-            f"bounds: cannot read {record}, the bounds run's record of the seed and payload "
-            f"{path.name} is for, which must be beside it ({exc})"
+            f"bounds: cannot read {record}, {beside}, which must be beside it ({exc})"
         ) from None
     if not isinstance(summary, dict) or not {"seed", "payload"} <= summary.keys():
         raise ParameterError(
