@@ -262,18 +262,18 @@ START_TRANSIENT = (
     "{duration}run and counts in its RMS: a longer run or a smaller start offset "
     """(track's --duration and --offset; see docs/cli.md, "Verdict")"""
 )
+#: The methods :data:`NO_CONVERGENCE_CHECKS` names as open-loop.
+OPEN_LOOP_METHODS = ("pi", "ats", "ap")
 #: :data:`NO_CONVERGENCE` with what to check of the run's own settings in ``{checks}``.
 NO_CONVERGENCE_CHECKS = (
-    "the error did not converge: an open-loop method (pi, ats, ap) never removes it; for "
-    "a closed-loop one check {checks} "
+    f"the error did not converge: an open-loop method ({', '.join(OPEN_LOOP_METHODS)}) "
+    "never removes it; for a closed-loop one check {checks} "
     '(see docs/comparing.md, "Studies")'
 )
 NO_CONVERGENCE = NO_CONVERGENCE_CHECKS.format(checks="tau, dt and the integrator")
 #: What :data:`NO_CONVERGENCE_CHECKS` asks to check in place of ``tau`` for a method without
 #: one (its tracking gains' options); ``tau`` for every other method.
 GAINS_OF = {"mpc": "position_weight, horizon"}
-#: The methods :data:`NO_CONVERGENCE_CHECKS` names as open-loop.
-OPEN_LOOP_METHODS = ("pi", "ats", "ap")
 OBSTACLE_DETOUR = (
     "the base went round an obstacle on or near the path (closest footprint clearance "
     "{clearance_mm:.3g} mm, under the {near_mm:.0f} mm within which the qp steers round "
