@@ -13,7 +13,7 @@ import re
 import socket
 import stat
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 from ddwmmr.errors import ParameterError
 
@@ -203,7 +203,10 @@ def read_lock(path: Path) -> str | None:
     return data.decode("utf-8", errors="replace")
 
 
-def _not_a_lock(path: Path, mode: int) -> None:
+def _not_a_lock(path: Path, mode: int) -> NoReturn:
+    """Refuse ``path`` (its ``st_mode`` is ``mode``): something other than a regular file
+    stands at the lock's name, and reading it could block (a FIFO), never end (a device)
+    or take a folder for a dead run's lock."""
     kind = _KINDS.get(stat.S_IFMT(mode), "not a regular file")
     raise ParameterError(
         f"out: {path}, the name of the output folder's lock, is {kind}, not a lock file a "
