@@ -49,6 +49,7 @@ from ddwmmr.gui.settings import (
     simulate_settings,
 )
 from ddwmmr.gui.widgets import (
+    FONT,
     CycleButton,
     Field,
     describe_error,
@@ -64,6 +65,12 @@ from ddwmmr.trajectories import load_trajectory
 #: Playback frame and progress poll intervals (ms).
 FRAME_MS = 40
 POLL_MS = 100
+#: Characters a line of the message box holds in the panel font (the box is 0.325 of the
+#: 16 in window wide; 62 leaves room for the widest letters).
+MESSAGE_CHARS = 62
+#: (font size in points, characters a line) tried in turn until a message fits its box
+#: (two lines in the panel font, three in the smallest).
+MESSAGE_FITS = ((FONT, MESSAGE_CHARS), (FONT - 1, 72), (FONT - 2, 86))
 
 
 @contextlib.contextmanager
@@ -181,10 +188,32 @@ class App(PanelLayout):
     def say(self, text: str, error: bool = False) -> None:
         """Show ``text`` in the message area (red for errors) and redraw."""
         self.message, self.message_is_error = text, error
-        wrapped = "\n".join(textwrap.wrap(text, 62, break_on_hyphens=False)) if text else ""
-        self.message_text.set_text(("error: " if error else "") + wrapped)
+        self._fit_message("error: " if error else "", text)
         self.message_text.set_color("tab:red" if error else "0.1")
         self._redraw()
+
+    def _fit_message(self, prefix: str, text: str) -> None:
+        """Show ``prefix`` + ``text`` wrapped inside the message box: in the panel font at
+        :data:`MESSAGE_CHARS` a line when it fits, else in the first smaller font of
+        :data:`MESSAGE_FITS` that holds it; what still overflows the smallest is cut at a
+        line end, marked ``...`` (a message names its parameter first)."""
+        artist = self.message_text
+        box = artist.axes.bbox
+        renderer = self.figure.canvas.get_renderer()
+
+        def show(lines: list[str]) -> bool:
+            artist.set_text(prefix + "\n".join(lines))
+            extent = artist.get_window_extent(renderer)
+            return extent.y0 >= box.y0 and extent.x1 <= box.x1
+
+        for size, chars in MESSAGE_FITS:
+            lines = textwrap.wrap(text, chars, break_on_hyphens=False) if text else []
+            artist.set_fontsize(size)
+            if show(lines) or not lines:
+                return
+        while len(lines) > 1 and artist.get_window_extent(renderer).y0 < box.y0:
+            lines = [*lines[:-2], lines[-2] + " ..."]
+            show(lines)
 
     def _report(self, text: str) -> None:
         self.say(text, error=True)
