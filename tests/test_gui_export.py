@@ -236,5 +236,5 @@ def test_support_loads_button_draws_the_track_panel_of_a_physics_run(tmp_path):
 def test_support_loads_of_a_run_without_physics_is_a_message(tmp_path):
     app = finished_app(Settings(methods=("clrrmc-cs", None), duration=DURATION), tmp_path / "gui")
     click(app.export_buttons["loads"].ax)
-    assert "only a run on a physics plant measures them (plant: mujoco)" in app.message
+    assert "only a run on a physics plant measures them: choose plant mujoco and Run" in app.message
     assert not any((tmp_path / "gui").rglob("*.png"))

@@ -102,6 +102,10 @@ def guarded(handler: Callable[..., Any]) -> Callable[..., Any]:
     return wrapper
 
 
+#: The title of a support-load window, before the run's label.
+SUPPORT_LOADS_WINDOW = "support loads: "
+
+
 class _OptionGroup:
     """The option widgets of one method in one slot, a page of them created when first
     shown (``make(number, spec)`` builds the widget of option ``number``)."""
@@ -660,12 +664,19 @@ class App(PanelLayout):
         self.show_time(target)
 
     def _on_close(self, _event: Any) -> None:
-        """The window closes: stop the timers and any simulation."""
+        """The window closes: stop the timers and any simulation, and close the support-load
+        windows it opened (the program ends with its window)."""
         self.closed = True
         self._play_timer.stop()
         self._poll_timer.stop()
         if self.worker is not None:
             self.worker.cancel()
+        if self.interactive:
+            import matplotlib.pyplot as plt
+
+            for label in plt.get_figlabels():
+                if label.startswith(SUPPORT_LOADS_WINDOW):
+                    plt.close(label)
 
     @guarded
     def _on_frame(self) -> None:
@@ -758,9 +769,16 @@ class App(PanelLayout):
 
         from ddwmmr.reports import physics_plots as pp
 
+        # The reports modules set pyplot's backend to Agg when they are imported (they only
+        # write files), which may happen after the desktop window was made: pyplot's new
+        # figures are then Agg ones that cannot be shown. The window's own backend is
+        # taken back (layout.desktop_figure's; switching closes no figure).
+        plt.switch_backend("TkAgg")
         for result, label in zip(self.results, self.labels()):
             if pp.is_physics_run(result):
-                window = plt.figure(figsize=pp.SUPPORT_LOADS_FIGSIZE, num=f"support loads: {label}")
+                window = plt.figure(
+                    figsize=pp.SUPPORT_LOADS_FIGSIZE, num=f"{SUPPORT_LOADS_WINDOW}{label}"
+                )
                 window.clear()
                 pp.draw_support_loads(window, result)
                 window.show()

@@ -251,7 +251,8 @@ def write_support_loads(folder: Path, results: Sequence[Any], labels: Sequence[s
     physics = [(r, label) for r, label in zip(results, labels) if pp.is_physics_run(r)]
     if not physics:
         raise ParameterError(
-            "support loads: only a run on a physics plant measures them (plant: mujoco)"
+            "support loads: only a run on a physics plant measures them: choose plant "
+            "mujoco and Run"
         )
     written = []
     for result, label in physics:

@@ -1,0 +1,76 @@
+"""The desktop window's Support loads button opens the panels in a window of their own.
+Importing the reports modules (which write files only) sets pyplot's backend to Agg, so
+the panels were drawn on an Agg figure that cannot be shown: a warning, no window. Runs
+the real Tk window under ``xvfb-run``; skipped where it is not installed (CI). Closing the
+simulator closes the support window too, so the program ends (the run returns)."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+pytestmark = pytest.mark.skipif(
+    shutil.which("xvfb-run") is None,
+    reason="xvfb-run is not installed: the Support loads window needs a display",
+)
+
+SCRIPT = textwrap.dedent(
+    """
+    import sys
+    import matplotlib.pyplot as plt
+    from ddwmmr.gui.app import App
+    from ddwmmr.gui.layout import desktop_figure
+    from ddwmmr.gui.settings import Settings
+
+    figure = desktop_figure()
+    settings = Settings(methods=("qp", None), plant="mujoco", duration=0.2)
+    app = App(figure, settings, interactive=True)
+    app.export_field.submit(sys.argv[1])
+    window = figure.canvas.manager.window
+
+    def steps():
+        app.run()
+        while app.worker is not None:
+            yield 100
+        app.export_support_loads()
+        yield 500
+        others = [plt.figure(n) for n in plt.get_fignums() if plt.figure(n) is not figure]
+        print("message:", app.message)
+        print("windows:", [type(f.canvas).__name__ for f in others])
+        window.tk.call(window.protocol("WM_DELETE_WINDOW"))  # closes the support window too
+
+    order = steps()
+
+    def tick():
+        delay = next(order, None)
+        if delay is not None:
+            window.after(delay, tick)
+
+    window.after(500, tick)
+    plt.show()
+    """
+)
+
+
+def test_support_loads_opens_a_tk_window_of_its_own(tmp_path: Path) -> None:
+    environment = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "MPLBACKEND")}
+    script = tmp_path / "support_loads.py"
+    script.write_text(SCRIPT)
+    command = [sys.executable, str(script), str(tmp_path / "export")]
+    done = subprocess.run(
+        ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", *command],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env=environment,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "message: wrote " in done.stdout and "support_loads.png" in done.stdout
+    assert "windows: ['FigureCanvasTkAgg']" in done.stdout, done.stdout + done.stderr
+    assert "non-interactive" not in done.stderr
