@@ -4,31 +4,18 @@ the run back and is screenshotted. Skipped where ``xvfb-run`` is not installed (
 
 from __future__ import annotations
 
-import os
-import shutil
-import subprocess
 import sys
 from pathlib import Path
 
-import pytest
+from xvfb import NEEDS_XVFB, run_under_xvfb
 
-pytestmark = pytest.mark.skipif(
-    shutil.which("xvfb-run") is None, reason="xvfb-run is not installed (make gui-check skips)"
-)
+pytestmark = NEEDS_XVFB
 
 
 def test_the_tk_window_takes_the_typed_duration_and_the_click(tmp_path: Path) -> None:
     """The check types 5.5 into duration as soon as it starts; a canvas Tk has not mapped
     yet (a loaded machine) dropped those key events, and the run lasted the 6 s set up."""
-    environment = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "MPLBACKEND")}
-    command = [sys.executable, "-m", "ddwmmr.gui.check", str(tmp_path)]
-    done = subprocess.run(
-        ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", *command],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env=environment,
-    )
+    done = run_under_xvfb([sys.executable, "-m", "ddwmmr.gui.check", str(tmp_path)])
     assert done.returncode == 0, done.stderr
     assert "duration typed and Run clicked via Tk" in done.stdout
     assert "playback of 5.5 s" in done.stdout  # the typed duration, not the 6 s set up

@@ -6,19 +6,13 @@ simulator closes the support window too, so the program ends (the run returns)."
 
 from __future__ import annotations
 
-import os
-import shutil
-import subprocess
 import sys
 import textwrap
 from pathlib import Path
 
-import pytest
+from xvfb import NEEDS_XVFB, run_under_xvfb
 
-pytestmark = pytest.mark.skipif(
-    shutil.which("xvfb-run") is None,
-    reason="xvfb-run is not installed: the Support loads window needs a display",
-)
+pytestmark = NEEDS_XVFB
 
 SCRIPT = textwrap.dedent(
     """
@@ -59,17 +53,9 @@ SCRIPT = textwrap.dedent(
 
 
 def test_support_loads_opens_a_tk_window_of_its_own(tmp_path: Path) -> None:
-    environment = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "MPLBACKEND")}
     script = tmp_path / "support_loads.py"
     script.write_text(SCRIPT)
-    command = [sys.executable, str(script), str(tmp_path / "export")]
-    done = subprocess.run(
-        ["xvfb-run", "-a", "-s", "-screen 0 1920x1080x24", *command],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env=environment,
-    )
+    done = run_under_xvfb([sys.executable, str(script), str(tmp_path / "export")])
     assert done.returncode == 0, done.stderr
     assert "message: wrote " in done.stdout and "support_loads.png" in done.stdout
     assert "windows: ['FigureCanvasTkAgg']" in done.stdout, done.stdout + done.stderr
