@@ -1,11 +1,14 @@
 """Something other than a lock file at the name of an output folder's lock (a FIFO, a
-folder, a link, a socket) is refused in one line naming it, at once and untouched: the
+folder, a link, a socket, a device) is refused in one line naming it, at once and untouched: the
 lock was read as text, so a FIFO there hung the tool for ever, a link to /dev/zero filled
-the memory, and a folder was taken for a killed run's lock and moved aside."""
+the memory, and a folder was taken for a killed run's lock and moved aside. The kind is
+named as an output file's target names it (:func:`file_kind`). No test here touches /dev:
+a device is a regular file a patched ``os.lstat`` calls one."""
 
 import os
 import signal
 import socket
+import stat
 import sys
 from pathlib import Path
 
@@ -13,7 +16,7 @@ import pytest
 
 from ddwmmr.errors import ParameterError
 from ddwmmr.outputs.lock import lock_file, output_lock
-from ddwmmr.outputs.owners import lock_holder, owner_token, read_lock
+from ddwmmr.outputs.owners import file_kind, lock_holder, owner_token, read_lock
 
 POSIX = pytest.mark.skipif(os.name == "nt", reason="FIFOs, sockets and links are POSIX's")
 
@@ -87,6 +90,46 @@ def test_a_socket_at_the_lock_is_refused(tmp_path):
         assert "is a socket, not a lock file" in _refused(target)
     finally:
         server.close()
+
+
+@pytest.mark.parametrize(
+    ("kind", "name"), [(stat.S_IFCHR, "a character device"), (stat.S_IFBLK, "a block device")]
+)
+def test_a_device_at_the_lock_is_named_as_an_output_target_names_it(
+    tmp_path, monkeypatch, kind, name
+):
+    target = tmp_path / "out"
+    lock = lock_file(target)
+    lock.write_text("")  # a regular file os.lstat says is a device: taken, not created
+    real_lstat = os.lstat
+
+    def fake_lstat(path, *args, **kwargs):
+        if os.fspath(path) == str(lock):
+            return os.stat_result((kind | 0o666, 0, 0, 1, 0, 0, 0, 0, 0, 0))
+        return real_lstat(path, *args, **kwargs)
+
+    monkeypatch.setattr(os, "lstat", fake_lstat)
+    assert _refused(target) == (
+        f"out: {lock}, the name of the output folder's lock, is {name}, not a lock file a "
+        "ddwmmr run wrote; remove it or choose another --out"
+    )
+
+
+@pytest.mark.parametrize(
+    ("mode", "name"),
+    [
+        (stat.S_IFREG | 0o644, None),
+        (stat.S_IFDIR | 0o755, "a folder"),
+        (stat.S_IFLNK | 0o777, "a symbolic link"),
+        (stat.S_IFCHR | 0o666, "a character device"),
+        (stat.S_IFBLK | 0o660, "a block device"),
+        (stat.S_IFIFO | 0o644, "a FIFO"),
+        (stat.S_IFSOCK | 0o755, "a socket"),
+        (0o150000, "a special file"),  # a Solaris door: a type the list does not name
+    ],
+)
+def test_file_kind_names_every_type_but_a_regular_file(mode, name):
+    assert file_kind(mode) == name
 
 
 def test_a_lock_is_read_at_most_4096_bytes(tmp_path):

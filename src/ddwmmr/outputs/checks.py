@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from ddwmmr.errors import ParameterError, shown
-from ddwmmr.outputs.owners import _is_stale_temp, ended_leftover, temp_prefix
+from ddwmmr.outputs.owners import _is_stale_temp, ended_leftover, file_kind, temp_prefix
 
 #: Name of the manifest file each tool writes into its output folder.
 MANIFEST = ".ddwmmr-manifest.json"
@@ -174,18 +174,6 @@ def existing_folder(label: str, folder: Path) -> Path:
     return existing
 
 
-#: File types an output path may not be, with their names for a message. Every output
-#: file is moved into place by a rename, which would put a regular file where the folder,
-#: device (``/dev/null``, when running as root), FIFO or socket was.
-_NOT_FILES = (
-    (stat.S_ISDIR, "a folder"),
-    (stat.S_ISCHR, "a character device"),
-    (stat.S_ISBLK, "a block device"),
-    (stat.S_ISFIFO, "a FIFO"),
-    (stat.S_ISSOCK, "a socket"),
-)
-
-
 def check_file_target(path: object, label: str = "path") -> Path:
     """``path`` as a :class:`~pathlib.Path` if an output file may be moved there by a rename.
 
@@ -209,8 +197,10 @@ def check_file_target(path: object, label: str = "path") -> Path:
         mode = os.stat(text).st_mode
     except OSError:
         return Path(text)  # absent, or not reachable: creating the file reports why
-    if not stat.S_ISREG(mode):
-        kind = next((name for test, name in _NOT_FILES if test(mode)), "a special file")
+    # Every output file is moved into place by a rename, which would put a regular file
+    # where the folder, device (``/dev/null``, when running as root), FIFO or socket was.
+    kind = file_kind(mode)
+    if kind is not None:
         raise ParameterError(
             f"{label}: {text} exists and is not a regular file ({kind}); give a file name"
         )

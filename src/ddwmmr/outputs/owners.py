@@ -157,15 +157,25 @@ def _is_stale_temp(name: str) -> bool:
 #: Most bytes of a lock file read: its token is a host name, a process id and a time.
 _LOCK_BYTES = 4096
 
-#: What a file type is called in a message.
+#: What each file type but a regular file is called in a message.
 _KINDS = {
     stat.S_IFDIR: "a folder",
-    stat.S_IFIFO: "a FIFO",
     stat.S_IFLNK: "a symbolic link",
-    stat.S_IFCHR: "a device",
-    stat.S_IFBLK: "a device",
+    stat.S_IFCHR: "a character device",
+    stat.S_IFBLK: "a block device",
+    stat.S_IFIFO: "a FIFO",
     stat.S_IFSOCK: "a socket",
 }
+
+
+def file_kind(mode: int) -> str | None:
+    """What a file whose ``st_mode`` is ``mode`` is called in a message ("a folder",
+    "a character device", "a FIFO", ...), or None for a regular file. A type this list
+    does not name (e.g. a Solaris door) is "a special file". ``mode`` from ``os.lstat``
+    can name a symbolic link; from ``os.stat`` it is what the link points to."""
+    if stat.S_ISREG(mode):
+        return None
+    return _KINDS.get(stat.S_IFMT(mode), "a special file")
 
 
 def read_lock(path: Path) -> str | None:
@@ -207,7 +217,7 @@ def _not_a_lock(path: Path, mode: int) -> NoReturn:
     """Refuse ``path`` (its ``st_mode`` is ``mode``): something other than a regular file
     stands at the lock's name, and reading it could block (a FIFO), never end (a device)
     or take a folder for a dead run's lock."""
-    kind = _KINDS.get(stat.S_IFMT(mode), "not a regular file")
+    kind = file_kind(mode)
     raise ParameterError(
         f"out: {path}, the name of the output folder's lock, is {kind}, not a lock file a "
         "ddwmmr run wrote; remove it or choose another --out"
