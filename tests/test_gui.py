@@ -311,6 +311,22 @@ def test_failed_runs_show_a_message(monkeypatch):
     assert app.message == "run failed: RuntimeError: boom" and app.results is None
 
 
+def test_a_blank_dt_longer_than_the_run_is_named_as_t_over_n():
+    """dt left blank is T/N = 1e9 s / 2000: Run names where that 500000 s came from (as
+    the command line does), not "dt must be <= duration (4 s) (got 500000)"."""
+    app = new_app(Settings(methods=("ats", None)))
+    app.geometry_fields["T"].submit("1e9")
+    app.duration_field.submit("4")
+    assert app.settings.dt is None and app.message == ""
+    click(app.transport["run"].ax)
+    app.wait()
+    assert app.results is None
+    assert app.message == (
+        "duration must be >= one step T/N = 1e+09 s / 2000 = 500000 s (got 4); "
+        "raise N or duration, lower T, or set dt"
+    )
+
+
 def test_plant_choice_from_the_engine_list(monkeypatch):
     monkeypatch.setattr(
         ddwmmr.sim, "available_plants", lambda: ["kinematic", "thesis"], raising=False

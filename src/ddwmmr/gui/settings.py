@@ -321,8 +321,9 @@ def check_settings(settings: Settings) -> Settings:
 def check_run_length(settings: Settings) -> int:
     """The number of steps of a run of ``settings`` (:func:`check_step_count`), what
     :func:`check_settings` leaves to the run; a duration shorter than the step is refused
-    naming T and N when the step is their T / N (dt not set). For the command line, which
-    refuses bad input before the window is built."""
+    naming T and N when the step is their T / N (dt not set), a step the user never typed.
+    Called by the command line, which refuses bad input before the window is built, and by
+    :func:`simulate_settings` (the window's Run) before the first step."""
     trajectory = build_trajectory(settings)
     duration = trajectory.duration if settings.duration is None else settings.duration
     dt = control_step(settings, trajectory) or resolution_step(trajectory)
@@ -342,6 +343,9 @@ def simulate_settings(
 
     ``progress(slot_index, step, steps)`` is called after every simulated step.
     """
+    # simulate would refuse such a run too, but as "dt must be <= duration ... (got T/N)"
+    # with a dt the window's blank dt field never showed.
+    check_run_length(settings)
     trajectory = build_trajectory(settings)
     robot = build_robot(settings)
     results = []
