@@ -25,6 +25,7 @@ import numpy as np
 from ddwmmr.errors import (
     LENGTH_RANGE_M,
     MAX_COORDINATE_M,
+    MAX_OBSTACLES,
     ParameterError,
     as_path,
     check_finite,
@@ -97,8 +98,23 @@ class Circle:
         object.__setattr__(self, "radius", check_positive("obstacle radius", self.radius))
 
 
+def check_obstacle_count(count: int, source: str = "") -> int:
+    """``count`` (circles of one run) if it is at most :data:`MAX_OBSTACLES`, else a
+    one-line :class:`ParameterError` naming ``obstacles``, the count and the allowed range.
+    ``source``: the file they were read from, for the message ("": given as a list)."""
+    if count <= MAX_OBSTACLES:
+        return count
+    where = f" {source} has" if source else ""
+    lowest = 1 if source else 0  # a file without [[obstacle]] tables is refused as such
+    raise ParameterError(
+        f"obstacles:{where} {count} obstacles, more than allowed ({lowest} to "
+        f"{MAX_OBSTACLES}; each is checked at every control step)"
+    )
+
+
 def load_obstacles(path: str | Path) -> list[Circle]:
-    """Read circles from a TOML file of ``[[obstacle]]`` tables with x, y, radius (m)."""
+    """Read circles from a TOML file of ``[[obstacle]]`` tables with x, y, radius (m): one
+    to :data:`MAX_OBSTACLES` of them (:func:`check_obstacle_count`)."""
     path = as_path(path, "obstacles")
     data = load_toml(path, "obstacles")
     tables = data.get("obstacle")
@@ -109,6 +125,7 @@ def load_obstacles(path: str | Path) -> list[Circle]:
         )
     if not isinstance(tables, list) or not all(isinstance(t, dict) for t in tables or [None]):
         raise ParameterError(f"obstacles: {path} needs [[obstacle]] tables with x, y, radius in m")
+    check_obstacle_count(len(tables), str(path))
     circles = []
     for i, table in enumerate(tables, start=1):
         keys = set(table)
@@ -145,7 +162,8 @@ def within_limits(x: float, y: float, radius: float) -> Circle:
 def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> list[Circle]:
     """Normalise the ``obstacles`` option: circles, (x, y, radius) triples, or a TOML file:
     a path, or a shipped or folder name such as ``ellipse_post`` looked up as ``track
-    --obstacles`` does (:func:`~ddwmmr.trajectories.files.find_obstacle_file`)."""
+    --obstacles`` does (:func:`~ddwmmr.trajectories.files.find_obstacle_file`). At most
+    :data:`~ddwmmr.errors.MAX_OBSTACLES` circles (:func:`check_obstacle_count`)."""
     if obstacles is None:
         return []
     if isinstance(obstacles, str | Path):
@@ -168,6 +186,7 @@ def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> li
                 f" (got {shown(item)})"
             ) from None
         circles.append(Circle(x, y, radius))
+    check_obstacle_count(len(circles))
     return circles
 
 
