@@ -1,8 +1,9 @@
-"""The desktop window's Support loads button opens the panels in a window of their own.
-Importing the reports modules (which write files only) sets pyplot's backend to Agg, so
-the panels were drawn on an Agg figure that cannot be shown: a warning, no window. Runs
-the real Tk window under ``xvfb-run``; skipped where it is not installed (CI). Closing the
-simulator closes the support window too, so the program ends (the run returns)."""
+"""The desktop window's Support loads button opens the panels in a window of their own:
+pyplot's backend is still the window's TkAgg when they are drawn (the reports modules,
+imported on the way, leave it alone); on an Agg figure they could not be shown (a warning,
+no window). Runs the real Tk window under ``xvfb-run``; skipped where it is not installed
+(CI). Closing the simulator closes the support window too, so the program ends (the run
+returns)."""
 
 from __future__ import annotations
 

@@ -61,7 +61,6 @@ def test_one_method_small_multiples_hold_title_and_legend(one_series: dict) -> N
     assert fig.get_figwidth() == pytest.approx(cp.MIN_MULTIPLES_WIDTH_IN)
     assert _inside_figure(fig, fig._suptitle)
     assert all(_inside_figure(fig, legend) for legend in fig.legends)
-    cp.plt.close(fig)
 
 
 def _discs(ax) -> list[tuple[float, float, float]]:
@@ -77,8 +76,6 @@ def test_compare_figures_draw_the_obstacles(one_series: dict) -> None:
     for ax in (paths.axes[0], multiples.axes[0]):
         assert _discs(ax) == [pytest.approx((-0.2, 1.05, 0.3))]
         assert ax.get_xlim()[0] < -0.5 and ax.get_ylim()[1] > 1.35  # the disc is in frame
-    cp.plt.close(paths)
-    cp.plt.close(multiples)
 
 
 @pytest.mark.parametrize(
@@ -170,8 +167,6 @@ def test_plant_error_axis_stops_below_the_data() -> None:
     plant = {"qp": {"t": t, "position_error_m": np.geomspace(0.04, 2e-3, t.size)}}
     fig = cp.plot_plant_errors(kinematic, plant, {"qp": "C1"}, "mujoco", "ellipse")
     assert fig.axes[0].get_ylim()[0] == pytest.approx(1e-5, rel=1e-9)
-    cp.plt.close(fig)
     converged = {"qp": {"t": t, "position_error_m": np.zeros(t.size)}}
     fig = cp.plot_plant_errors(converged, plant, {"qp": "C1"}, "mujoco", "ellipse")
     assert fig.axes[0].get_ylim()[0] == pytest.approx(cp.ERROR_FLOOR / 2, rel=1e-9)
-    cp.plt.close(fig)

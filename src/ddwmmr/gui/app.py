@@ -769,11 +769,8 @@ class App(PanelLayout):
 
         from ddwmmr.reports import physics_plots as pp
 
-        # The reports modules set pyplot's backend to Agg when they are imported (they only
-        # write files), which may happen after the desktop window was made: pyplot's new
-        # figures are then Agg ones that cannot be shown. The window's own backend is
-        # taken back (layout.desktop_figure's; switching closes no figure).
-        plt.switch_backend("TkAgg")
+        # pyplot's backend is still the desktop window's (layout.desktop_figure's TkAgg):
+        # the reports modules leave it alone, so these figures are Tk windows too.
         for result, label in zip(self.results, self.labels()):
             if pp.is_physics_run(result):
                 window = plt.figure(

@@ -368,6 +368,8 @@ def desktop_figure():
         probe.destroy()
     # Leave room for the toolbar, the title bar and a desktop panel.
     dpi = min(DPI, 0.96 * screen_width / FIGSIZE[0], 0.84 * screen_height / FIGSIZE[1])
+    # The simulator is a Tk program (the probe above, the Tk event loop gui.check drives),
+    # whatever backend matplotlib would pick by itself (Qt where it is installed).
     plt.switch_backend("TkAgg")
     figure = plt.figure(figsize=FIGSIZE, dpi=dpi / max(ratio, 1e-3))
     figure.canvas.manager.set_window_title("ddwmmr simulator")

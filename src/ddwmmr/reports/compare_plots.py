@@ -2,7 +2,9 @@
 
 Every function takes plain data (time series as ``dict[str, np.ndarray]`` with the columns
 of :data:`ddwmmr.sim.simulate.COLUMNS`, keyed by a label) and returns a matplotlib Figure;
-:func:`save` writes it as PNG and closes it. World frame, SI units (m, rad, s).
+:func:`save` writes it as PNG. World frame, SI units (m, rad, s). The figures are not
+pyplot's (:mod:`ddwmmr.reports.canvas`): importing this module leaves the matplotlib
+backend alone.
 """
 
 from __future__ import annotations
@@ -13,15 +15,14 @@ from pathlib import Path
 from typing import Any
 
 import matplotlib
-
-matplotlib.use("Agg")  # files only: the report never needs a screen
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 
 from ddwmmr.model import Robot
+from ddwmmr.reports.canvas import new_figure
 from ddwmmr.reports.legends import legend_beside, place_legend
 from ddwmmr.reports.plots import (  # errors are clipped to the floor on log axes
     ERROR_FLOOR,
@@ -38,10 +39,11 @@ Series = Mapping[str, Mapping[str, np.ndarray]]
 
 
 def save(fig: Figure, path: str | Path) -> Path:
-    """Write ``fig`` as PNG to ``path`` and close it."""
+    """Write ``fig`` as PNG to ``path``. The figure is not pyplot's
+    (:func:`~ddwmmr.reports.canvas.new_figure`): nothing to close, it is freed with its
+    last reference."""
     path = Path(path)
     fig.savefig(path, dpi=DPI)
-    plt.close(fig)
     return path
 
 
@@ -135,7 +137,7 @@ def plot_paths(
         obstacles: the runs' circular obstacles (circles or (x, y, radius) triples, m),
             drawn as grey discs in every panel; the main frame holds them.
     """
-    fig = plt.figure(figsize=(11.5, 6.8))
+    fig = new_figure((11.5, 6.8))
     grid = fig.add_gridspec(max(len(zooms), 1), 2, width_ratios=(1.5, 1))
     ax = fig.add_subplot(grid[:, 0])
     _draw_paths(ax, series, colors, obstacles=obstacles)
@@ -193,7 +195,8 @@ def _draw_paths(
 
 def plot_errors(series: Series, colors: Mapping[str, str], title: str) -> Figure:
     """Position error (log scale) and orientation error vs time for every method."""
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    fig = new_figure((9, 6))
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
     for label, ts in series.items():
         ax1.semilogy(ts["t"], _floor(ts["position_error_m"]), color=colors[label], label=label)
         ax2.plot(*break_wraps(ts["t"], ts["orientation_error_rad"]), color=colors[label], lw=1)
@@ -221,9 +224,8 @@ def plot_wheels(series: Series, colors: Mapping[str, str], limit: float, title: 
     every panel has its time axis labelled, one legend (above the panels) names the
     styles."""
     rows, columns = _grid_shape(len(series))
-    fig, axes = plt.subplots(
-        rows, columns, figsize=(4 * columns, 2.7 * rows + 0.6), sharey=True, squeeze=False
-    )
+    fig = new_figure((4 * columns, 2.7 * rows + 0.6))
+    axes = fig.subplots(rows, columns, sharey=True, squeeze=False)
     for ax, (label, ts) in zip(axes.flat, series.items()):
         ax.plot(ts["t"], ts["wheel_left_rad_s"], color=colors[label], lw=1)
         ax.plot(ts["t"], ts["wheel_right_rad_s"], color=colors[label], lw=1, ls="--")
@@ -238,9 +240,9 @@ def plot_wheels(series: Series, colors: Mapping[str, str], limit: float, title: 
     for ax in axes[:, 0]:
         ax.set_ylabel("wheel speed (rad/s)")
     styles = [
-        plt.Line2D([], [], color="0.2", lw=1, label="left wheel (solid)"),
-        plt.Line2D([], [], color="0.2", lw=1, ls="--", label="right wheel (dashed)"),
-        plt.Line2D([], [], color="0.4", lw=1, ls=":", label=f"limit +-{limit:g} rad/s (dotted)"),
+        Line2D([], [], color="0.2", lw=1, label="left wheel (solid)"),
+        Line2D([], [], color="0.2", lw=1, ls="--", label="right wheel (dashed)"),
+        Line2D([], [], color="0.4", lw=1, ls=":", label=f"limit +-{limit:g} rad/s (dotted)"),
     ]
     fig.suptitle(title)
     fig.tight_layout(rect=(0, 0, 1, 1 - 0.45 / fig.get_figheight()))
@@ -280,7 +282,8 @@ def plot_small_multiples(
 
     rows, columns = _grid_shape(len(series))
     width = max(4.4 * columns, MIN_MULTIPLES_WIDTH_IN)
-    fig, axes = plt.subplots(rows, columns, figsize=(width, 4.2 * rows), squeeze=False)
+    fig = new_figure((width, 4.2 * rows))
+    axes = fig.subplots(rows, columns, squeeze=False)
     handles: list = []
     cx, cy = _obstacle_extent(obstacles)
     for ax, (label, ts) in zip(axes.flat, series.items()):
@@ -363,9 +366,10 @@ def plot_tau_study(
         convergence: method -> tau (s) -> convergence time (s, NaN if never).
         theory: convergence time / tau of a first-order decay (-ln of the fraction).
     """
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig = new_figure((11, 4.2))
+    ax1, ax2 = fig.subplots(1, 2)
     first = next(iter(error_curves))
-    cmap = plt.get_cmap("viridis")
+    cmap = matplotlib.colormaps["viridis"]
     taus = sorted(error_curves[first])
     for i, tau in enumerate(taus):
         t, e = error_curves[first][tau]
@@ -489,7 +493,8 @@ def plot_dt_study(
     Args:
         drift: method -> integrator -> dt (s) -> largest position error (m).
     """
-    fig, ax = plt.subplots(figsize=(10, 5))
+    fig = new_figure((10, 5))
+    ax = fig.subplots()
     styles = {"euler": "-", "rk4": "--"}
     steps = sorted({x for by in drift.values() for values in by.values() for x in values})
     lines = {
@@ -534,7 +539,8 @@ def plot_integrator_study(
         curves: method -> integrator -> (t, position error) arrays.
         dt: the step (s), for the title.
     """
-    fig, ax = plt.subplots(figsize=(9.5, 5))
+    fig = new_figure((9.5, 5))
+    ax = fig.subplots()
     styles = {"euler": "-", "rk4": "--"}
     for method, by_integrator in curves.items():
         for integrator, (t, e) in by_integrator.items():
@@ -566,7 +572,8 @@ def plot_init_study(
             ``final_position_error_m``).
         curves: initial offset (m) -> (t, position error) for ``curve_method``.
     """
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig = new_figure((11, 4.2))
+    ax1, ax2 = fig.subplots(1, 2)
     drawn = {}
     for method, values in final.items():
         xs = sorted(values)
@@ -579,7 +586,7 @@ def plot_init_study(
     ax1.set_ylabel("settled-end RMS position error (m, log)")
     ax1.set_title("open loop keeps the offset, closed loop removes it")
     ax1.grid(alpha=0.3, which="both")
-    cmap = plt.get_cmap("viridis")
+    cmap = matplotlib.colormaps["viridis"]
     offsets = sorted(curves)
     for i, offset in enumerate(offsets):
         t, e = curves[offset]
@@ -619,7 +626,8 @@ def plot_corner_study(
         quarter: time (s) per quarter period T/4, i.e. per pi/2 of alpha.
         corners: corner times (s), alpha = k pi/2.
     """
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    fig = new_figure((9, 6))
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
     for label, ts in series.items():
         x = ts["t"] / quarter
         ax1.semilogy(x, _floor(ts["position_error_m"]), color=colors[label], lw=1.1, label=label)
@@ -644,7 +652,8 @@ def plot_plant_errors(
 ) -> Figure:
     """Position error vs time per method: kinematic plant (dashed) and ``plant`` (solid),
     on a log axis that ends below the smallest error drawn (:func:`_log_bottom`)."""
-    fig, ax = plt.subplots(figsize=(9, 4))
+    fig = new_figure((9, 4))
+    ax = fig.subplots()
     drawn = []
     for label, ts in plant.items():
         base = kinematic[label]

@@ -3,7 +3,8 @@
 Works from a recorded run (a :class:`~ddwmmr.sim.SimulationResult` whose time series has
 the :class:`~ddwmmr.plants.MujocoPlant` columns ``support_force_<name>_n``,
 ``physics_stability``, ``base_tilt_rad`` and the kinematic ``stability``). World frame,
-metres, newtons. The robot is drawn with :func:`ddwmmr.reports.plots.robot_outline`.
+metres, newtons. The robot is drawn with :func:`ddwmmr.reports.plots.robot_outline`. The
+figures are not pyplot's (:mod:`ddwmmr.reports.canvas`): the matplotlib backend is left alone.
 """
 
 from __future__ import annotations
@@ -11,14 +12,11 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")  # files only: never needs a screen
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
+from ddwmmr.reports.canvas import new_figure
 from ddwmmr.reports.plots import robot_outline, run_title
 
 
@@ -77,7 +75,8 @@ def save_physics_animation(
     names = support_names(ts)
     forces = np.column_stack([ts[f"support_force_{n}_n"] for n in names])
     q = np.column_stack([ts[k] for k in ("x", "y", "phi", "th1", "th2")])
-    fig, (ax, ax_s) = plt.subplots(1, 2, figsize=(9.5, 4.2), width_ratios=(1, 1.25))
+    fig = new_figure((9.5, 4.2))
+    ax, ax_s = fig.subplots(1, 2, width_ratios=(1, 1.25))
     reach = robot.reach + 0.5 * robot.base_length
     ax.set_xlim(ts["x"].min() - reach, ts["x"].max() + reach)
     ax.set_ylim(ts["y"].min() - reach, ts["y"].max() + reach)
@@ -142,7 +141,6 @@ def save_physics_animation(
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     animation.save(path, writer=PillowWriter(fps=fps))
-    plt.close(fig)
     return path
 
 
@@ -190,11 +188,14 @@ def is_physics_run(result) -> bool:
     return bool(support_names(ts)) and "base_tilt_rad" in ts
 
 
-def plot_support_loads(result, floor_n: float | None = None):
+def plot_support_loads(result, floor_n: float | None = None) -> Figure:
     """Figure: the load on the supports off each edge of the support polygon (N; the edge
     the base would pivot about when it reaches 0) with the optimisers' floor, and the
-    base's tilt (mrad), against time (:func:`draw_support_loads` on a new pyplot figure)."""
-    return draw_support_loads(plt.figure(figsize=SUPPORT_LOADS_FIGSIZE), result, floor_n)
+    base's tilt (mrad), against time (:func:`draw_support_loads` on a new figure of its
+    own, :func:`~ddwmmr.reports.canvas.new_figure`: not pyplot's; to see it in a pyplot
+    window, draw into ``plt.figure(figsize=SUPPORT_LOADS_FIGSIZE)`` with
+    :func:`draw_support_loads`)."""
+    return draw_support_loads(new_figure(SUPPORT_LOADS_FIGSIZE), result, floor_n)
 
 
 def draw_support_loads(fig: Figure, result, floor_n: float | None = None) -> Figure:
@@ -245,7 +246,6 @@ def save_support_loads(result, path: str | Path, floor_n: float | None = None) -
 
     fig = plot_support_loads(result, floor_n)
     fig.savefig(path, dpi=SUPPORT_LOADS_DPI, metadata=PNG_METADATA)
-    plt.close(fig)
     return Path(path)
 
 

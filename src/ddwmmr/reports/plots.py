@@ -2,6 +2,9 @@
 
 All functions take a :class:`ddwmmr.sim.SimulationResult`; ``save_run_figures`` writes the
 standard set of PNGs that ``python -m ddwmmr.track`` produces. World frame, metres, radians.
+The figures are not pyplot's (:mod:`ddwmmr.reports.canvas`): importing or using this module
+leaves the matplotlib backend as the user chose it; save a returned figure with
+``fig.savefig`` or display it in Jupyter (``plt.show()`` does not show it).
 """
 
 from __future__ import annotations
@@ -9,17 +12,15 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")  # files only: never needs a screen
-import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.patches import Circle
 
 from ddwmmr.model import Robot
 from ddwmmr.reports import palette
+from ddwmmr.reports.canvas import new_figure
 from ddwmmr.reports.legends import legend_beside, place_legend
 
 FIGURE_NAMES = ("path.png", "errors.png", "rates.png", "metrics.png")
@@ -152,7 +153,7 @@ def circles_of(obstacles) -> list[tuple[float, float, float]]:
 def draw_obstacles(ax: Axes, obstacles, label: str = "obstacle") -> None:
     """Grey discs for circular obstacles (world frame, m); one legend entry."""
     for i, (x, y, radius) in enumerate(circles_of(obstacles)):
-        disc = plt.Circle(
+        disc = Circle(
             (x, y), radius, color="0.55", alpha=0.45, lw=1, label=label if i == 0 else None
         )
         ax.add_patch(disc)
@@ -256,7 +257,8 @@ def plot_errors(result) -> Figure:
     """End-effector position error (log scale, floored at :data:`ERROR_FLOOR`) and
     orientation error vs time."""
     ts = result.timeseries
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    fig = new_figure((7, 5))
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
     position = np.maximum(ts["position_error_m"], ERROR_FLOOR)
     ax1.semilogy(ts["t"], position, color="tab:blue")
     at_least_a_decade(ax1, position)
@@ -311,7 +313,8 @@ def plot_rates(result) -> Figure:
     from: the measured one on a plant whose base lags its command (the command then a thin
     dashed line), else the command, which is the motion (:func:`wheels_follow_measured`)."""
     ts, robot = result.timeseries, result.robot
-    fig, (ax1, ax2, ax3) = plt.subplots(3, 1, figsize=(8.6, 6.4), sharex=True)
+    fig = new_figure((8.6, 6.4))
+    ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True)
     ax1.plot(ts["t"], ts["th1dot"], label="th1dot")
     ax1.plot(ts["t"], ts["th2dot"], label="th2dot")
     _limit_lines(ax1, robot.joint_speed_limit, "joint limit")
@@ -369,7 +372,8 @@ def _limit_lines(ax: Axes, limit: float, name: str) -> None:
 def plot_metrics(result) -> Figure:
     """Manipulability eta and tip-over stability S vs time (S = 1 tips)."""
     ts = result.timeseries
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(7, 5), sharex=True)
+    fig = new_figure((7, 5))
+    ax1, ax2 = fig.subplots(2, 1, sharex=True)
     ax1.plot(ts["t"], ts["manipulability"], color="tab:purple")
     ax1.set_ylim(0, 1.05)
     ax1.set_ylabel("manipulability eta")
@@ -404,7 +408,6 @@ def save_run_figures(result, folder: str | Path, obstacles=None) -> list[Path]:
         fig = make(result)
         path = folder / name
         fig.savefig(path, dpi=110, metadata=PNG_METADATA)
-        plt.close(fig)
         paths.append(path)
     return paths
 
@@ -425,7 +428,8 @@ def save_animation(
 
     ts, robot = result.timeseries, result.robot
     q = result.configurations()
-    fig, ax = plt.subplots(figsize=(5, 4.5))
+    fig = new_figure((5, 4.5))
+    ax = fig.subplots()
     draw_obstacles(ax, obstacles)
     ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=1)
     reach = robot.reach + robot.base_length
@@ -458,15 +462,14 @@ def save_animation(
         animation.save(
             path, writer=PillowWriter(fps=fps), progress_callback=lambda i, n: bar.advance()
         )
-    plt.close(fig)
     return path
 
 
 def _axes(ax: Axes | None, figsize: tuple[float, float]) -> tuple[Figure, Axes]:
     if ax is not None:
         return ax.figure, ax
-    fig, ax = plt.subplots(figsize=figsize)
-    return fig, ax
+    fig = new_figure(figsize)
+    return fig, fig.subplots()
 
 
 def _title(result, what: str) -> str:

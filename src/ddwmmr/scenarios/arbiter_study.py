@@ -395,14 +395,11 @@ def plot_weights(
     """
     outcome, history = recorded_run(scenario, config)
     rows = 3 if compare_state_machine else 2
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    from ddwmmr.reports.canvas import new_figure
     from ddwmmr.reports.legends import place_legend
 
-    fig, axes = plt.subplots(rows, 1, figsize=(10, 2.5 * rows), sharex=True, squeeze=False)
+    fig = new_figure((10, 2.5 * rows))  # not pyplot's: the caller's backend is left alone
+    axes = fig.subplots(rows, 1, sharex=True, squeeze=False)
     ax = axes[0, 0]
     for name in BEHAVIOURS:
         values = np.abs(history[f"w_{name}"])

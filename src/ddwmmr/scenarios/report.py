@@ -356,23 +356,21 @@ BEHAVIOUR_COLOURS = {
 
 
 def _figure(rows: int = 1, cols: int = 1, height: float = 3.2):
-    import matplotlib
+    """A figure 10 in wide, ``height`` in per row, and its ``rows`` x ``cols`` axes (a 2-D
+    array). Not pyplot's (:func:`~ddwmmr.reports.canvas.new_figure`): the report leaves the
+    caller's matplotlib backend alone and opens no window."""
+    from ddwmmr.reports.canvas import new_figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt.subplots(rows, cols, figsize=(10, height * rows), squeeze=False)
+    fig = new_figure((10, height * rows))
+    return fig, fig.subplots(rows, cols, squeeze=False)
 
 
 def _save(fig, path, rect: tuple[float, float, float, float] | None = None) -> None:
-    """Lay out ``fig`` (its axes within ``rect``, figure fractions; None: all of it), write
-    it to ``path`` as PNG and close it."""
-    import matplotlib.pyplot as plt
-
+    """Lay out ``fig`` (its axes within ``rect``, figure fractions; None: all of it) and
+    write it to ``path`` as PNG (a figure of :func:`_figure`: nothing to close)."""
     buffer = io.BytesIO()
     fig.tight_layout(rect=rect)
     fig.savefig(buffer, format="png", dpi=110)
-    plt.close(fig)
     write_atomic(path, buffer.getvalue())
 
 
