@@ -3,6 +3,7 @@
 controllers (the simulation loop connects them) -- directly or through other modules."""
 
 import ast
+import functools
 import subprocess
 import sys
 from pathlib import Path
@@ -63,18 +64,34 @@ PLANT_SIDE = ("plants",)
 def imported_modules(path: Path) -> set[str]:
     """Every module named in an import statement of a source file (``from a import b``
     names ``a`` and, when it is a module of the package, ``a.b``)."""
+    return set(_names_imported_by(path.read_text()))
+
+
+@functools.cache
+def _parsed(source: str) -> ast.Module:
+    """The syntax tree of a file's text, cached on the text: every reachable() walk and
+    the layer rule parse the same package modules again (the trees are only read)."""
+    return ast.parse(source)
+
+
+@functools.cache
+def _names_imported_by(source: str) -> frozenset[str]:
+    """imported_modules of a file's text (cached, as _parsed)."""
     names: set[str] = set()
-    for node in ast.walk(ast.parse(path.read_text())):
+    for node in ast.walk(_parsed(source)):
         if isinstance(node, ast.Import):
             names.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom) and node.module:
             names.add(node.module)
             names.update(f"{node.module}.{alias.name}" for alias in node.names)
-    return names
+    return frozenset(names)
 
 
+@functools.cache
 def module_file(name: str, package: Path = PACKAGE) -> Path | None:
-    """The source file of package module ``name`` (None outside the package)."""
+    """The source file of package module ``name`` (None outside the package). Cached: the
+    package's files do not change while the tests run (each sample package of a test is a
+    folder of its own)."""
     if name != "ddwmmr" and not name.startswith("ddwmmr."):
         return None
     parts = name.split(".")[1:]
@@ -146,7 +163,7 @@ def import_targets(path: Path, package: Path = PACKAGE) -> set[str]:
     __version__`` the package itself. Imports inside functions and under TYPE_CHECKING
     count: they are dependencies all the same."""
     targets: set[str] = set()
-    for node in ast.walk(ast.parse(path.read_text())):
+    for node in ast.walk(_parsed(path.read_text())):
         if isinstance(node, ast.Import):
             targets.update(a.name for a in node.names if module_file(a.name, package))
         elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
