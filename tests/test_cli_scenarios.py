@@ -9,7 +9,7 @@ import pytest
 
 from ddwmmr.cli.scenarios import main as cli
 from ddwmmr.scenarios.protocol import METRICS
-from scenarios_cli_helpers import bad_scenarios_run
+from scenarios_cli_helpers import bad_scenarios_main, bad_scenarios_run
 
 SUMMARY_KEYS = {
     "n", "failed", "mean_time_s", "sd_time_s", "mean_speed_m_s", "time_base_s", "time_arm_s",
@@ -108,8 +108,14 @@ def test_obstacle_study_table(tmp_path, capsys):
         (["--controller", "qp", "--arbiter", "state-machine"], "only the thesis controller"),
     ],
 )
-def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, message):
-    assert message in bad_scenarios_run(tmp_path, args)
+def test_bad_input_one_line_exit_2_nothing_written(tmp_path, args, message, capsys):
+    assert message in bad_scenarios_main(tmp_path, args, capsys)
+
+
+def test_bad_input_to_the_module_is_one_line_with_status_2(tmp_path):
+    """The same check on a real ``python -m ddwmmr.scenarios`` process (its exit status
+    and stderr), with an error argparse itself raises."""
+    assert "invalid choice" in bad_scenarios_run(tmp_path, ["--controller", "nope"])
 
 
 def test_refuses_to_replace_a_foreign_folder(tmp_path, capsys):
