@@ -9,6 +9,8 @@ worker thread. It is not shown by ``plt.show()``: save it (``fig.savefig``) or d
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -23,3 +25,33 @@ def new_figure(figsize: tuple[float, float], **kwargs: Any) -> Figure:
     fig = Figure(figsize=figsize, **kwargs)
     FigureCanvasAgg(fig)
     return fig
+
+
+def save_gif(
+    fig: Figure,
+    update: Callable[[int], object],
+    count: int,
+    path: Path,
+    fps: int,
+    advance: Callable[[], object] | None = None,
+) -> Path:
+    """Write ``count`` frames of ``fig`` to the GIF ``path`` at ``fps`` frames per second:
+    for each frame i = 0..count-1, ``update(i)`` sets the artists, the figure is rendered
+    once at ``savefig.dpi`` and ``advance()`` (if given) is called.
+
+    The file is byte for byte what ``FuncAnimation(fig, update, frames=count).save(path,
+    writer=PillowWriter(fps=fps))`` writes, in half the time: that renders every frame twice
+    (a redraw after the update, then the grab), and rendering is nearly all of the time.
+    """
+    from matplotlib import rcParams
+    from matplotlib.animation import PillowWriter
+
+    dpi = rcParams["savefig.dpi"]
+    writer = PillowWriter(fps=fps)
+    with writer.saving(fig, str(path), fig.dpi if dpi == "figure" else dpi):
+        for frame in range(count):
+            update(frame)
+            writer.grab_frame()
+            if advance is not None:
+                advance()
+    return path

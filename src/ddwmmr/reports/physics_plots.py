@@ -16,7 +16,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from ddwmmr.reports.canvas import new_figure
+from ddwmmr.reports.canvas import new_figure, save_gif
 from ddwmmr.reports.plots import robot_outline, run_title
 
 
@@ -64,8 +64,6 @@ def save_physics_animation(
         after_tip_s: a run that tipped (``summary["tip_time_s"]``) is shown only this long
             after it tipped (the top view of a fallen robot means nothing).
     """
-    from matplotlib.animation import FuncAnimation, PillowWriter
-
     robot = result.robot
     ts = result.timeseries
     tip_time = result.summary.get("tip_time_s")
@@ -137,11 +135,9 @@ def save_physics_animation(
 
     ax.set_title(title, fontsize=9)
     fig.tight_layout()
-    animation = FuncAnimation(fig, update, frames=len(indices), blit=False)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    animation.save(path, writer=PillowWriter(fps=fps))
-    return path
+    return save_gif(fig, update, len(indices), path, fps)
 
 
 #: File name of the support-load figure a physics ``track`` run writes.

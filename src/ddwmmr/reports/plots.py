@@ -20,7 +20,7 @@ from matplotlib.patches import Circle
 
 from ddwmmr.model import Robot
 from ddwmmr.reports import palette
-from ddwmmr.reports.canvas import new_figure
+from ddwmmr.reports.canvas import new_figure, save_gif
 from ddwmmr.reports.legends import legend_beside, place_legend
 
 FIGURE_NAMES = ("path.png", "errors.png", "rates.png", "metrics.png")
@@ -422,8 +422,6 @@ def save_animation(
 ) -> Path:
     """Write a GIF of the robot following the trajectory (``frames`` evenly spaced);
     ``progress`` shows the encoding on stderr (:mod:`ddwmmr.progress`)."""
-    from matplotlib.animation import FuncAnimation, PillowWriter
-
     from ddwmmr.progress import ProgressBar
 
     ts, robot = result.timeseries, result.robot
@@ -456,12 +454,9 @@ def save_animation(
         ax.set_title(f"{_title(result, '')} t = {ts['t'][k]:.1f} s")
         return trace, footprint, arm
 
-    animation = FuncAnimation(fig, update, frames=len(indices), blit=False)
     path = Path(path)
     with ProgressBar(len(indices), "track: animation.gif", enabled=progress, unit="frame") as bar:
-        animation.save(
-            path, writer=PillowWriter(fps=fps), progress_callback=lambda i, n: bar.advance()
-        )
+        save_gif(fig, update, len(indices), path, fps, bar.advance)
     return path
 
 
