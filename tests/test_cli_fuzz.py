@@ -309,13 +309,24 @@ CASES += [
 ]  # fmt: skip
 
 
+@pytest.fixture(scope="module")
+def written_files(tmp_path_factory) -> Path:
+    """A folder holding FILES, written once per module (three of them are 10 MB)."""
+    folder = tmp_path_factory.mktemp("fuzz_files")
+    for name, data in FILES.items():
+        (folder / name).write_bytes(data)
+    return folder
+
+
 @pytest.fixture
-def workdir(tmp_path, monkeypatch) -> dict[str, str]:
-    """A fresh working folder with the input files; returns the {name} substitutions."""
+def workdir(tmp_path, monkeypatch, written_files) -> dict[str, str]:
+    """A fresh working folder with the input files; returns the {name} substitutions.
+    The files are hard links to ``written_files``: regular files with FILES' bytes at
+    the same paths, without writing 30 MB per case."""
     inputs = tmp_path / "inputs"
     inputs.mkdir()
-    for name, data in FILES.items():
-        (inputs / name).write_bytes(data)
+    for name in FILES:
+        os.link(written_files / name, inputs / name)
     os.mkfifo(inputs / "fifo.toml")
     os.mkfifo(inputs / "fifo.csv")
     (inputs / "a_dir").mkdir()
