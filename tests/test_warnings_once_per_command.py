@@ -29,11 +29,14 @@ def test_the_one_line_display_shows_a_repeated_warning_once(capsys):
 
 @pytest.mark.parametrize("jobs", ["1", "2"])
 def test_compare_on_the_thesis_plant_warns_about_the_robot_once(tmp_path, jobs):
+    """Two runs (two methods on the ellipse), each building a thesis plant for the robot:
+    in the parent one after the other, or one in each of two pool workers."""
     robot = tmp_path / "heavy.toml"
     robot.write_text(HEAVY)
     done = subprocess.run(
         [sys.executable, "-m", "ddwmmr.compare", "--robot", str(robot), "--plant", "thesis",
-         "--methods", "pi,ats", "--study", "none", "--duration", "1", "--jobs", jobs,
+         "--methods", "pi,ats", "--only", "ellipse", "--study", "none", "--duration", "1",
+         "--jobs", jobs,
          "--out", str(tmp_path / "out"), "--no-progress"],
         capture_output=True, text=True, timeout=300,
     )  # fmt: skip
