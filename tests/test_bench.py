@@ -480,19 +480,33 @@ def test_cli_refuses_an_unusable_out_path_before_running(tmp_path, case):
 
 
 # -- scenario throughput --------------------------------------------------------------------
-def test_scenario_throughput_counts_the_simulated_time_of_every_scenario():
+def test_scenario_throughput_counts_the_simulated_time_of_every_scenario(monkeypatch):
+    """Each controller's row sums the simulated time of every one of the scenarios, each
+    run with that controller's default config: the runs time_scenarios makes are recorded
+    (one run per scenario, not a second run of each) and their times summed here."""
     from ddwmmr.bench import SCENARIO_CONTROLLERS, time_scenarios
+    from ddwmmr.scenarios import executors
     from ddwmmr.scenarios.generator import generate
-    from ddwmmr.scenarios.protocol import RunConfig, run_scenario
+    from ddwmmr.scenarios.protocol import RunConfig
 
+    runs: list[tuple] = []
+
+    def recorded(scenario, config):
+        outcome = run_scenario(scenario, config)
+        runs.append((config, scenario, outcome.metrics["time_s"]))
+        return outcome
+
+    run_scenario = executors.run_scenario
+    monkeypatch.setattr(executors, "run_scenario", recorded)
     rows = time_scenarios(2, jobs=1)
     assert [row["controller"] for row in rows] == list(SCENARIO_CONTROLLERS)
+    scenarios = generate(2, 0)
+    assert len(runs) == len(rows) * len(scenarios)
     for row in rows:
-        expected = sum(
-            run_scenario(s, RunConfig(controller=row["controller"])).metrics["time_s"]
-            for s in generate(2, 0)
-        )
-        assert row["sim_time_s"] == pytest.approx(expected, rel=1e-12)
+        config = RunConfig(controller=row["controller"])
+        times = [time for c, _, time in runs if c == config]
+        assert [s for c, s, _ in runs if c == config] == scenarios
+        assert row["sim_time_s"] == pytest.approx(sum(times), rel=1e-12)
         assert row["wall_time_s"] > 0 and row["failed"] == 0
         assert row["sim_seconds_per_wall_second"] == pytest.approx(
             row["sim_time_s"] / row["wall_time_s"]
@@ -504,11 +518,11 @@ def test_cli_times_scenarios_only_when_asked_with_a_method(tmp_path, capsys):
 
     out = tmp_path / "b.json"
     args = ["--repeats", "1", "--calls", "5", "--duration", "0.1", "--method", "ats"]
-    assert main([*args, "--out", str(out), "--scenarios", "2", "--jobs", "1"]) == 0
+    assert main([*args, "--out", str(out), "--scenarios", "1", "--jobs", "1"]) == 0
     printed = capsys.readouterr().out
     data = json.loads(out.read_text())
-    assert [row["scenarios"] for row in data["scenarios"]] == [2] * len(SCENARIO_CONTROLLERS)
-    assert "scenario benchmark (2 scenarios, seed 0, 1 worker" in printed
+    assert [row["scenarios"] for row in data["scenarios"]] == [1] * len(SCENARIO_CONTROLLERS)
+    assert "scenario benchmark (1 scenario, seed 0, 1 worker" in printed
     assert main([*args, "--out", str(out)]) == 0  # --method alone: no scenarios
     assert json.loads(out.read_text())["scenarios"] == []
     with pytest.raises(SystemExit) as stop:
