@@ -54,27 +54,28 @@ def _run_python(arguments: list[str], cwd: Path) -> subprocess.CompletedProcess:
 
 
 def test_examples_exist() -> None:
-    assert {p.name for p in SCRIPTS} >= set(EXPECTED)
+    assert {p.name for p in SCRIPTS} >= set(EXPECTED) | set(NUMBER_CHECKS)
 
 
-@pytest.fixture(scope="module")
-def printed(tmp_path_factory) -> dict[str, str]:
-    """Each example's standard output (each runs once, in an empty folder)."""
-    outputs = {}
-    for script in SCRIPTS:
-        folder = tmp_path_factory.mktemp(script.stem)
-        done = _run_python([str(script)], folder)
-        assert done.returncode == 0, done.stderr
-        assert list(folder.iterdir()) == []  # nothing written in the working directory
-        outputs[script.name] = done.stdout
-    return outputs
+def run_example(script: Path, folder: Path) -> str:
+    """The standard output of ``script`` run as a user runs it, in the empty ``folder``;
+    it must end with status 0 and write nothing there."""
+    done = _run_python([str(script)], folder)
+    assert done.returncode == 0, done.stderr
+    assert list(folder.iterdir()) == []  # nothing written in the working directory
+    return done.stdout
 
 
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.name)
-def test_example_runs(script: Path, printed) -> None:
-    assert printed[script.name].strip()
+def test_example_runs(script: Path, tmp_path: Path) -> None:
+    """Each example runs once, in a test of its own, and its output is checked here: the
+    texts of EXPECTED and the numbers of its checks in NUMBER_CHECKS."""
+    printed = run_example(script, tmp_path)
+    assert printed.strip()
     for text in EXPECTED.get(script.name, ()):
-        assert text in printed[script.name]
+        assert text in printed
+    for check in NUMBER_CHECKS.get(script.name, ()):
+        check(printed)
 
 
 # -- the examples' numbers against independent expectations --------------------------------
@@ -93,9 +94,10 @@ def _numbers(line: str) -> list[float]:
     return [float(x) for x in re.findall(r"-?\d+\.?\d*(?:e-?\d+)?", line)]
 
 
-def test_quickstart_numbers(printed) -> None:
+def check_quickstart_numbers(printed: str) -> None:
+    """The quickstart's summary against the exact closed-loop decay."""
     values = {}
-    for line in printed["quickstart.py"].splitlines()[1:]:
+    for line in printed.splitlines()[1:]:
         key, _, value = line.strip().partition(" ")
         values[key] = value.strip()
     # One 40 s period of the default ellipse in 2000 RK4 steps of 0.02 s.
@@ -108,10 +110,10 @@ def test_quickstart_numbers(printed) -> None:
     assert int(values["singular_steps"]) == 0
 
 
-def test_quickstart_first_command_tracks_with_the_feedback(printed) -> None:
+def check_quickstart_first_command_tracks_with_the_feedback(printed: str) -> None:
     """u makes the end effector move at Xd_dot + K (Xd - X) (checked by finite differences
     of the forward kinematics), and the shoulder row of the ATS keeps th1dot = 0."""
-    line = next(x for x in printed["quickstart.py"].splitlines() if "first command u" in x)
+    line = next(x for x in printed.splitlines() if "first command u" in x)
     v, w, th1dot, th2dot = _numbers(line.split("=")[1])
     assert th1dot == 0.0
     robot, trajectory = Robot(), Ellipse()
@@ -123,8 +125,9 @@ def test_quickstart_first_command_tracks_with_the_feedback(printed) -> None:
     np.testing.assert_allclose(moved[:2], wanted[:2], atol=2e-4)  # u printed to 4 decimals
 
 
-def test_custom_trajectory_numbers(printed) -> None:
-    lines = {x.split()[0]: _numbers(x) for x in printed["custom_trajectory.py"].splitlines()}
+def check_custom_trajectory_numbers(printed: str) -> None:
+    """Open loop keeps the offset, closed loop decays it as exp(-t / 0.5 s)."""
+    lines = {x.split()[0]: _numbers(x) for x in printed.splitlines()}
     rms, final, singular = lines["ats"]
     # Open loop: the offset is kept (exact velocity feed-forward, RK4 drift far below 1 um).
     assert rms == pytest.approx(1000 * E0, abs=0.01) and final == pytest.approx(1000 * E0, abs=0.01)
@@ -134,9 +137,10 @@ def test_custom_trajectory_numbers(printed) -> None:
     assert final == 0.0 and singular == 0
 
 
-def test_compare_aux_numbers(printed) -> None:
+def check_compare_aux_numbers(printed: str) -> None:
+    """aux = sum is singular on the rectangle, aux = shoulder is not."""
     rows = {}
-    for line in printed["compare_aux.py"].splitlines()[1:]:
+    for line in printed.splitlines()[1:]:
         name, aux, *numbers = line.split()
         rows[(name, aux)] = [float(x) for x in numbers]
     for aux in ("shoulder", "sum"):  # on the ellipse, open loop keeps the offset exactly
@@ -148,8 +152,9 @@ def test_compare_aux_numbers(printed) -> None:
     assert rows[("rectangle", "sum")][0] > 10 * rows[("rectangle", "shoulder")][0]
 
 
-def test_own_robot_numbers(printed) -> None:
-    lines = printed["own_robot.py"].splitlines()
+def check_own_robot_numbers(printed: str) -> None:
+    """Reach, payload, closed-loop RMS and stability of each robot of the example."""
+    lines = printed.splitlines()
     found = {line[:22].strip(): _numbers(line[22:]) for line in lines}
     for label, L1, L2, payload in (
         ("default (thesis)", 0.35, 0.30, 1.25),
@@ -171,7 +176,7 @@ def test_own_robot_numbers(printed) -> None:
     assert "would tip over" in lines[3] and "would tip over" not in "".join(lines[:3])
 
 
-def test_physics_tipping_numbers(printed) -> None:
+def check_physics_tipping_numbers(printed: str) -> None:
     """The static floor alone tips within the first second although its static S stays
     above 1.2; with the arm's lag and the braking step the run finishes but an edge is
     unloaded longer than with the edge-load rows too (the default)."""
@@ -179,7 +184,7 @@ def test_physics_tipping_numbers(printed) -> None:
         r"(TIPPED|ok)\s+at\s+([\d.]+) s, waypoints (\d)/5, static S >= ([\d.]+), "
         r"an edge unloaded ([\d.]+) s"
     )
-    rows = [row.search(line) for line in printed["physics_tipping.py"].splitlines()[1:]]
+    rows = [row.search(line) for line in printed.splitlines()[1:]]
     (static, lagged, default) = [
         (m[1], float(m[2]), int(m[3]), float(m[4]), float(m[5])) for m in rows
     ]
@@ -187,6 +192,19 @@ def test_physics_tipping_numbers(printed) -> None:
     assert lagged[:1] == default[:1] == ("ok",) and lagged[2] == default[2] == 5
     # the edge-load rows keep the wheels loaded (0.24 s unloaded against 2.27 s)
     assert default[4] < 0.6 * lagged[4]
+
+
+#: Per example: the checks of its printed numbers (test_example_runs runs each).
+NUMBER_CHECKS = {
+    "quickstart.py": (
+        check_quickstart_numbers,
+        check_quickstart_first_command_tracks_with_the_feedback,
+    ),
+    "custom_trajectory.py": (check_custom_trajectory_numbers,),
+    "compare_aux.py": (check_compare_aux_numbers,),
+    "own_robot.py": (check_own_robot_numbers,),
+    "physics_tipping.py": (check_physics_tipping_numbers,),
+}
 
 
 def _load(name: str):
@@ -311,13 +329,14 @@ def test_every_example_ends_through_the_shared_runner(script: Path) -> None:
     [("pi", 1183, 3027, 1870), ("ap", 1187, 3638, 2711)],
 )
 def test_quickstart_says_when_a_method_did_not_track(
-    tmp_path, method, singular, final_mm, rms_mm
+    capsys, method, singular, final_mm, rms_mm
 ) -> None:
     """pi and ap end metres off the ellipse: the verdict says so, with the numbers the
-    summary above it prints (in mm) and the singularity as the likely cause."""
-    done = _run_python([str(EXAMPLES / "quickstart.py"), method], tmp_path)
-    assert done.returncode == 0, done.stderr
-    lines = done.stdout.splitlines()
+    summary above it prints (in mm) and the singularity as the likely cause. The script's
+    main is called in-process: the method argument reaching main from the command line is
+    test_quickstart_refuses_an_unknown_method_in_one_line's."""
+    _load("quickstart").main(method)
+    lines = capsys.readouterr().out.splitlines()
     values = {line.split()[0]: float(line.split()[1]) for line in lines[1:10]}
     verdict = " ".join(line.strip() for line in lines[10:-1])
     assert lines[10].startswith("verdict: did not track: singular (damped) ")
