@@ -1,15 +1,24 @@
 """The mpc controller in the thesis protocol: the one loop, wheel forces on the thesis plant."""
 
+import functools
+
 import pytest
 
 from ddwmmr import ParameterError
-from ddwmmr.scenarios import RunConfig, generate, run_scenario
+from ddwmmr.scenarios import Outcome, RunConfig, generate, run_scenario
 
 SCENARIO = generate(5, 0)[4]  # the shortest of the first five (about 14 s for mpc)
 
 
+@functools.cache
+def default_mpc_run() -> Outcome:
+    """SCENARIO run by the mpc with its default options (read only by the tests, which
+    share it: the run is deterministic)."""
+    return run_scenario(SCENARIO, RunConfig(controller="mpc"))
+
+
 def test_mpc_on_the_thesis_plant_beats_the_thesis_controller_and_holds_its_floor():
-    mpc = run_scenario(SCENARIO, RunConfig(controller="mpc"))
+    mpc = default_mpc_run()
     thesis = run_scenario(SCENARIO, RunConfig(controller="thesis"))
     m = mpc.metrics
     assert m["success"] and thesis.metrics["success"]
@@ -21,7 +30,7 @@ def test_mpc_on_the_thesis_plant_beats_the_thesis_controller_and_holds_its_floor
 
 def test_controller_options_reach_the_controller():
     """A 2 s horizon (default 5 s) sees the next waypoint later: a different, slower run."""
-    default = run_scenario(SCENARIO, RunConfig(controller="mpc")).metrics["time_s"]
+    default = default_mpc_run().metrics["time_s"]
     short = RunConfig(controller="mpc", controller_options=(("horizon", 2.0),))
     assert run_scenario(SCENARIO, short).metrics["time_s"] > default + 1.0
     with pytest.raises(ParameterError, match="horizon"):
