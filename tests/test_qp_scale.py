@@ -11,6 +11,7 @@ keeps writing its rows for ``v`` in m/s.
 
 from __future__ import annotations
 
+import functools
 import warnings
 from dataclasses import replace
 
@@ -78,26 +79,45 @@ RUNS = {
 }
 
 
+@functools.cache
+def reference_errors(name: str) -> np.ndarray:
+    """``errors`` of the default robot's run ``RUNS[name]``, computed once per module: the
+    run is deterministic and the tests compare against it at every scale (read only)."""
+    dt, options = RUNS[name]
+    reference = errors(run(Robot(), 1.0, dt, **options))
+    reference.setflags(write=False)
+    return reference
+
+
 @pytest.mark.parametrize("name", list(RUNS))
 @pytest.mark.parametrize("factor", [0.5, 8.0])
 def test_a_power_of_two_scale_gives_the_default_runs_errors_on_every_step(factor, name):
     """Exact, at dt = 2 s too, where the default run itself amplifies one ulp on the
     ellipse's axes to a 50 % different error within 17 steps."""
     dt, options = RUNS[name]
-    reference = errors(run(Robot(), 1.0, dt, **options))
+    reference = reference_errors(name)
     scaled = errors(run(scaled_robot(factor), factor, dt, **options), factor)
     assert reference.shape[1] in (21, 2001)
     assert reference[0].max() > 0.04  # the start offset, 0.03 sqrt(2) m
     np.testing.assert_allclose(scaled, reference, rtol=1e-12, atol=0.0)
 
 
+#: Position tracking round the shipped post (``obstacle_margin`` in m, scaled by ``run``).
+POST_OPTIONS = {"obstacles": [POST], "track_orientation": False, "obstacle_margin": 0.05}
+
+
+@functools.cache
+def post_reference():
+    """The default robot's run round the post, computed once per module (read only)."""
+    return run(Robot(), 1.0, **POST_OPTIONS)
+
+
 @pytest.mark.parametrize("factor", [0.5, 8.0])
 def test_a_power_of_two_scale_with_the_scene_scaled_passes_the_post_alike(factor):
     """Position tracking round the shipped post, the post and ``obstacle_margin`` scaled:
     the obstacle limit, steering and detour work in the robot's unit too."""
-    options = {"obstacles": [POST], "track_orientation": False, "obstacle_margin": 0.05}
-    reference = run(Robot(), 1.0, **options)
-    scaled = run(scaled_robot(factor), factor, **options)
+    reference = post_reference()
+    scaled = run(scaled_robot(factor), factor, **POST_OPTIONS)
     np.testing.assert_allclose(errors(scaled, factor), errors(reference), rtol=1e-12, atol=0.0)
     clearance = reference.summary["min_obstacle_clearance_m"]
     assert 0.0 < clearance < 0.6  # the post was within reach of the limit
@@ -108,7 +128,7 @@ def test_a_power_of_two_scale_with_the_scene_scaled_passes_the_post_alike(factor
 def test_another_scale_differs_from_the_default_run_by_rounding_only(robot, factor):
     """Masses by s^3, torques by s^4 (the kinematic plant uses neither), at the default
     step; at dt = 2 s the default run amplifies rounding (see above), so it is not here."""
-    reference = errors(run(Robot(), 1.0))
+    reference = reference_errors("default")
     scaled = errors(run(robot, factor), factor)
     np.testing.assert_allclose(scaled[0], reference[0], rtol=1e-7)
     np.testing.assert_allclose(scaled[1], reference[1], rtol=0.0, atol=1e-9)
