@@ -134,6 +134,7 @@ def test_compare_records_the_options(tmp_path):
 
     out = tmp_path / "report"
     argv = ["--methods", "pi", "clrrmc-ts", "--study", "none", "--duration", "0.5", "--jobs", "1"]
+    argv += ["--only", "ellipse"]  # the options are recorded per method, not per trajectory
     argv += ["--option", "tau=0.3", "--option", "pi:damping=0.1", "--no-progress"]
     assert compare([*argv, "--out", str(out)]) == 0
     record = json.loads((out / "run.json").read_text())
