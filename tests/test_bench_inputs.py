@@ -302,18 +302,15 @@ def test_a_fifo_as_out_is_never_read_nor_replaced(force, tmp_path):
     assert [p.name for p in tmp_path.iterdir()] == ["fifo.json"]
 
 
-def test_a_deeply_nested_comparison_file_gives_no_traceback(tmp_path):
+def test_a_deeply_nested_comparison_file_gives_no_traceback(tmp_path, monkeypatch, capsys):
+    """In-process: a RecursionError ``main`` let out would fail the test."""
     (tmp_path / "old.json").write_text("[" * 100_000 + "]" * 100_000)
-    result = subprocess.run(
-        [sys.executable, "-m", "ddwmmr.bench", *SMALL, "--compare", "old.json"],
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-        timeout=60,
-    )
-    assert result.returncode == 2 and result.stdout == ""
+    monkeypatch.chdir(tmp_path)
+    status = main([*SMALL, "--compare", "old.json"])
+    captured = capsys.readouterr()
+    assert status == 2 and captured.out == ""
     expected = "error: compare: old.json is not valid JSON (nested too deeply)\n"
-    assert result.stderr == expected
+    assert captured.err == expected
     assert sorted(p.name for p in tmp_path.iterdir()) == ["old.json"]  # no bench.json
 
 
