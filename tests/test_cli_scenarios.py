@@ -263,12 +263,12 @@ BOUNDS_HEADER = "scenario,lower_bound_s,best_known_s,replay_ok"
     ],
 )
 def test_a_bounds_file_that_cannot_serve_the_run_is_refused(
-    tmp_path, tmp_path_factory, header, rows, message
+    tmp_path, tmp_path_factory, header, rows, message, capsys
 ):
     """Audit: a bounds file of other scenarios printed "ratio ... nan"; one with other
     columns "cannot read ... ('replay_ok')" (a raw KeyError)."""
     path = _bounds_file(tmp_path_factory.mktemp("bounds"), header, rows)
-    line = bad_scenarios_run(tmp_path, ["--n", "2", "--no-progress", "--bounds", path])
+    line = bad_scenarios_main(tmp_path, ["--n", "2", "--no-progress", "--bounds", path], capsys)
     assert line.startswith(f"error: bounds: {path} {message}")
 
 
@@ -287,11 +287,11 @@ def test_a_bounds_file_that_cannot_serve_the_run_is_refused(
     ],
 )
 def test_a_bounds_file_with_a_time_no_bracket_has_is_refused(
-    tmp_path, tmp_path_factory, row, message
+    tmp_path, tmp_path_factory, row, message, capsys
 ):
     """A lower bound of 0 was read as none, and the run went on without it."""
     path = _bounds_file(tmp_path_factory.mktemp("bounds"), BOUNDS_HEADER, [row])
-    line = bad_scenarios_run(tmp_path, ["--n", "1", "--no-progress", "--bounds", path])
+    line = bad_scenarios_main(tmp_path, ["--n", "1", "--no-progress", "--bounds", path], capsys)
     assert line.startswith(f"error: bounds: {path} {message}")
 
 
