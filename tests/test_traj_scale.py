@@ -5,8 +5,12 @@ command lines take the factor (or ``robot``), record it and rerun it."""
 
 from __future__ import annotations
 
+import functools
 import json
 import warnings
+from collections.abc import Mapping
+from types import MappingProxyType
+from typing import Any
 
 import numpy as np
 import pytest
@@ -28,16 +32,27 @@ def _run(robot: Robot, trajectory, method: str):
         return simulate(robot, trajectory, method)
 
 
+#: The default robot's runs the scaled ones are compared with: a trajectory and a method.
+CASES = {
+    "ellipse-clrrmc-ts": (Ellipse(), "clrrmc-ts"),
+    "rectangle-qp": (Rectangle(), "qp"),
+    "figure8-ats": (load_trajectory("figure8"), "ats"),
+}
+
+
+@functools.cache
+def default_summary(case: str) -> Mapping[str, Any]:
+    """The summary of the default robot's run ``CASES[case]``, computed once per module:
+    the run is deterministic and every scale is compared with it (read only)."""
+    trajectory, method = CASES[case]
+    return MappingProxyType(_run(Robot(), trajectory, method).summary)
+
+
 @pytest.mark.parametrize("factor", [8.0, 0.0625])
-@pytest.mark.parametrize(
-    ("trajectory", "method"),
-    [(Ellipse(), "clrrmc-ts"), (Rectangle(), "qp"), (load_trajectory("figure8"), "ats")],
-    ids=["ellipse-clrrmc-ts", "rectangle-qp", "figure8-ats"],
-)
-def test_a_scaled_robot_on_the_scaled_trajectory_scales_the_errors_exactly(
-    trajectory, method, factor
-):
-    default = _run(Robot(), trajectory, method).summary
+@pytest.mark.parametrize("case", list(CASES))
+def test_a_scaled_robot_on_the_scaled_trajectory_scales_the_errors_exactly(case, factor):
+    trajectory, method = CASES[case]
+    default = default_summary(case)
     scaled = _run(scaled_robot(factor), ScaledTrajectory(trajectory, factor), method).summary
     for key in LENGTH_KEYS:
         assert scaled[key] == factor * default[key], key
