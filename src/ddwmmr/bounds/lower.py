@@ -221,10 +221,14 @@ class Lags:
 
 def _accelerate_for(target, tc, tau, brakes: bool) -> np.ndarray:
     """``t1`` (s) with ``t1 - t2 = target`` (rest to rest, ``brakes``) or ``t1 - tau (1 -
-    exp(-t1 / tau)) exp(-tc / tau) = target`` (free end), for each coast time ``tc``:
-    both sides grow with ``t1``, so bisection on ``[target, target + tau]``, returning the
-    end below (the lags it gives are then rounded down, never up)."""
-    low, high = np.full_like(tc, target), np.full_like(tc, target + tau)
+    exp(-t1 / tau)) exp(-tc / tau) = target`` (free end), for each coast time ``tc`` (a row)
+    and each ``target`` (s; a column, or one number): both sides grow with ``t1``, so
+    bisection on ``[target, target + tau]``, returning the end below (the lags it gives
+    are then rounded down, never up). Shape: ``target`` and ``tc`` broadcast."""
+    target = np.asarray(target, dtype=float)
+    shape = np.broadcast_shapes(target.shape, np.shape(tc))
+    low = np.array(np.broadcast_to(target, shape))
+    high = np.array(np.broadcast_to(target + tau, shape))
     coast = np.exp(-tc / tau)
     for _ in range(60):
         middle = 0.5 * (low + high)
@@ -235,21 +239,33 @@ def _accelerate_for(target, tc, tau, brakes: bool) -> np.ndarray:
     return low
 
 
-@functools.lru_cache(maxsize=16)
-def _lags(tau: float, top: float, weight: float) -> Lags:
-    """:class:`Lags` for ``tau = m / c1`` (s), ``v_top`` (m/s) and ``lam``."""
+@functools.lru_cache(maxsize=2)
+def _lag_terms(
+    tau: float, top: float
+) -> tuple[np.ndarray, float, np.ndarray, np.ndarray, np.ndarray]:
+    """What :func:`_lags` needs that no weight changes, for ``tau = m / c1`` (s) and
+    ``v_top`` (m/s): the tabulated paths ``D`` (m), the longest coast (s), the coast times
+    ``tc`` (s), and per path (rows) and coast time (columns) the rest-to-rest ``2 t2`` and
+    the free end's ``v_end tau / v_top`` (s). Read-only arrays (shared by the weights)."""
     distance = np.concatenate([np.linspace(0.0, 2.0, 201), np.linspace(2.05, 25.0, 460)])
     limit = 12.0 * tau
     tc = np.linspace(0.0, limit, 1201)
+    target = (distance / top)[:, None]
+    braking = 2.0 * (_accelerate_for(target, tc, tau, brakes=True) - target)
+    ending = _accelerate_for(target, tc, tau, brakes=False) - target
+    for array in (distance, tc, braking, ending):
+        array.flags.writeable = False
+    return distance, limit, tc, braking, ending
+
+
+@functools.lru_cache(maxsize=16)
+def _lags(tau: float, top: float, weight: float) -> Lags:
+    """:class:`Lags` for ``tau = m / c1`` (s), ``v_top`` (m/s) and ``lam``."""
+    distance, limit, tc, braking, ending = _lag_terms(tau, top)
     slope = 1.0 - weight
-    rest, free = np.empty_like(distance), np.empty_like(distance)
-    for k, path in enumerate(distance):
-        t1 = _accelerate_for(path / top, tc, tau, brakes=True)
-        braking = 2.0 * (t1 - path / top)  # 2 t2
-        rest[k] = min(float(np.min(braking[1:] + slope * tc[:-1])), slope * limit)
-        t1 = _accelerate_for(path / top, tc, tau, brakes=False)
-        ending = t1 - path / top  # v_end tau / v_top
-        free[k] = min(float(np.min(ending[1:] + slope * tc[:-1])), slope * limit)
+    coast = slope * tc[:-1]
+    rest = np.minimum(np.min(braking[:, 1:] + coast, axis=1), slope * limit)
+    free = np.minimum(np.min(ending[:, 1:] + coast, axis=1), slope * limit)
     return Lags(weight, distance, rest, float(np.max(rest - free)))
 
 
