@@ -79,7 +79,7 @@ def test_noisy_config_scales_the_default_noise_and_sets_the_seed():
 
 def test_cli_competitive_run_writes_the_weights_figure(tmp_path, capsys):
     out = tmp_path / "comp"
-    args = ["--n", "2", "--time-limit", "10", "--jobs", "1", "--no-progress"]
+    args = ["--n", "2", "--time-limit", "3", "--jobs", "1", "--no-progress"]
     assert cli([*args, "--arbiter", "competitive", "--out", str(out)]) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["config"]["arbiter"] == "competitive"
