@@ -59,21 +59,26 @@ def test_the_protocol_hands_the_route_over_only_with_lookahead():
     assert options["route"] == [tuple(w) for w in scenario.waypoints]
 
 
-def _converged_two_leg_plan():
+@pytest.fixture(scope="module")
+def converged_two_leg_plan():
+    """``(controller, its reach2 problem, the plan w)`` after one IPOPT step from START
+    towards FIRST then SECOND (solved once per worker; the tests only read the plan)."""
     controller = make_controller(
         "mpc", ROBOT, model="thesis", lookahead=True, route=[FIRST, SECOND], solver="ipopt",
         track_orientation=False, dt=0.02,
     )  # fmt: skip
     controller.command(0.0, START, np.array([*FIRST, 0.0]), np.zeros(3), base_velocity=(0, 0))
     problem = controller._problem("reach2")
-    return controller, problem, controller._warm
+    w = controller._warm.copy()
+    w.flags.writeable = False  # shared by the tests: none may change it
+    return controller, problem, w
 
 
-def test_a_two_leg_plan_passes_the_target_then_reaches_the_next():
+def test_a_two_leg_plan_passes_the_target_then_reaches_the_next(converged_two_leg_plan):
     """Solved to convergence (IPOPT): the first leg's last node within the reach cost's
     Huber scale (1 cm) of the target, the last node of the next; the second leg's nodes
     follow the first's in time."""
-    _, problem, w = _converged_two_leg_plan()
+    _, problem, w = converged_two_leg_plan
     ocp = problem.ocp
     xs, _ = ocp.trajectories(w)
     ends = [ROBOT.fk(ocp.model.configuration(xs[k]))[:2] for k in (ocp.split, ocp.N)]
@@ -85,11 +90,13 @@ def test_a_two_leg_plan_passes_the_target_then_reaches_the_next():
     assert 0.1 < t1 < 5.0 and 0.1 < t2 < 12.0
 
 
-def test_the_hand_over_starts_the_next_leg_from_the_plan_that_went_through_the_target():
+def test_the_hand_over_starts_the_next_leg_from_the_plan_that_went_through_the_target(
+    converged_two_leg_plan,
+):
     """At the target the plan's second leg becomes the first: the new first leg ends where
     the old plan ended (the old second leg's last node), and the new second leg waits
     there."""
-    controller, problem, w = _converged_two_leg_plan()
+    controller, problem, w = converged_two_leg_plan
     old = problem.ocp
     xs_old, _ = old.trajectories(w)
     elapsed = 0.5 * old.horizon_of(w)
