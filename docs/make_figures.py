@@ -20,6 +20,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ddwmmr import Ellipse, Rectangle, Robot, simulate
+from ddwmmr.model.kinematics import AUX_ROWS
 from ddwmmr.resolution import kernels
 from ddwmmr.sim.error_dynamics import closed_form_step, error_response, step_response
 
@@ -46,13 +47,17 @@ def _angle_axes(ax: Axes) -> None:
 def singularity_map(robot: Robot) -> Path:
     """|det J_aug| = L1 |cos θ1| and the SVD's smallest singular value of the 4x5 J."""
     th1, th2 = np.meshgrid(GRID, GRID, indexing="ij")
-    sigma = np.empty_like(th1)
-    det = np.empty_like(th1)
-    for i in range(len(GRID)):
-        for j in range(len(GRID)):
-            q = [0.0, 0.0, 0.4, th1[i, j], th2[i, j]]
-            sigma[i, j] = np.linalg.svd(robot.jacobian(q), compute_uv=False)[-1]
-            det[i, j] = abs(np.linalg.det(robot.augmented_jacobian(q, "shoulder")))
+    # Each pose's 4x5 J once, its shoulder row appended: the 5x5 J_aug. The SVDs and
+    # determinants run over the stack (numpy calls LAPACK per matrix, as one by one).
+    jacobians = np.array(
+        [
+            [robot.jacobian([0.0, 0.0, 0.4, th1[i, j], th2[i, j]]) for j in range(len(GRID))]
+            for i in range(len(GRID))
+        ]
+    )
+    shoulder = np.broadcast_to(AUX_ROWS["shoulder"], (*th1.shape, 1, 5))
+    sigma = np.linalg.svd(jacobians, compute_uv=False)[..., -1]
+    det = np.abs(np.linalg.det(np.concatenate([jacobians, shoulder], axis=-2)))
     fig, axes = plt.subplots(1, 2, figsize=(10.5, 4.2), constrained_layout=True)
     panels = (
         (det, "|det J_aug| (m), both aux rows"),
@@ -64,8 +69,7 @@ def singularity_map(robot: Robot) -> Path:
     pi_measure = np.empty_like(th1)
     for i in range(len(GRID)):
         for j in range(len(GRID)):
-            q = [0.0, 0.0, 0.4, th1[i, j], th2[i, j]]
-            a = robot.jacobian(q)[:3] @ _input_matrix(0.4)
+            a = jacobians[i, j, :3] @ _input_matrix(0.4)
             pi_measure[i, j] = (
                 2 * math.sqrt(2) * robot.L1 * abs(math.cos(th1[i, j])) / np.trace(a @ a.T)
             )
