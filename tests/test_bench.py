@@ -324,6 +324,8 @@ def test_cli_writes_the_report_and_compares(tmp_path, capsys):
 
 
 def _run_cli(*args: str, cwd) -> subprocess.CompletedProcess:
+    """``python -m ddwmmr.bench`` as a process: the entry point, exit status and stderr
+    of the real interpreter."""
     return subprocess.run(
         [sys.executable, "-m", "ddwmmr.bench", *args],
         capture_output=True,
@@ -331,6 +333,18 @@ def _run_cli(*args: str, cwd) -> subprocess.CompletedProcess:
         cwd=cwd,
         timeout=120,
     )
+
+
+def _call_cli(capsys, monkeypatch, *args: str, cwd) -> tuple[int, str, str]:
+    """``(status, stdout, stderr)`` of the tool's ``main`` run in this process from ``cwd``
+    (argparse's refusals exit through SystemExit; its status is taken as the return)."""
+    monkeypatch.chdir(cwd)
+    try:
+        status = main(list(args))
+    except SystemExit as stop:
+        status = stop.code
+    out, err = capsys.readouterr()
+    return status, out, err
 
 
 @pytest.mark.parametrize(
@@ -358,21 +372,39 @@ def _run_cli(*args: str, cwd) -> subprocess.CompletedProcess:
         (["--frobnicate"], "unrecognized arguments: --frobnicate"),
     ],
 )
-def test_cli_bad_input_is_one_line_and_exit_2(tmp_path, args, message):
-    result = _run_cli(*args, cwd=tmp_path)
-    assert result.returncode == 2
-    assert result.stdout == ""
-    lines = result.stderr.splitlines()
+def test_cli_bad_input_is_one_line_and_exit_2(tmp_path, capsys, monkeypatch, args, message):
+    status, out, err = _call_cli(capsys, monkeypatch, *args, cwd=tmp_path)
+    assert status == 2
+    assert out == ""
+    lines = err.splitlines()
     assert len(lines) == 1 and lines[0].startswith(("error: ", "python -m ddwmmr.bench: error: "))
     assert message in lines[0]
     assert list(tmp_path.iterdir()) == []  # nothing written
 
 
-def test_cli_refuses_to_replace_a_foreign_file(tmp_path):
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--repeats", "abc"], "argument --repeats: must be an integer in [1, 1000] (got 'abc')"),
+        (["--method", "nope"], "unknown method 'nope' (choose from "),
+    ],
+)
+def test_the_module_refuses_bad_input_in_one_line_exit_2(tmp_path, args, message):
+    """As a process (``python -m ddwmmr.bench``): an argparse refusal and the tool's own,
+    exit status 2, one line on stderr, no traceback, nothing written."""
+    result = _run_cli(*args, cwd=tmp_path)
+    assert result.returncode == 2 and result.stdout == ""
+    lines = result.stderr.splitlines()
+    assert len(lines) == 1 and message in lines[0] and "Traceback" not in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_cli_refuses_to_replace_a_foreign_file(tmp_path, capsys, monkeypatch):
     (tmp_path / "bench.json").write_text("my notes")
-    result = _run_cli("--repeats", "1", "--calls", "5", "--method", "ats", cwd=tmp_path)
-    assert result.returncode == 2 and len(result.stderr.splitlines()) == 1
-    assert "is not a ddwmmr.bench report" in result.stderr
+    args = ("--repeats", "1", "--calls", "5", "--method", "ats")
+    status, _, err = _call_cli(capsys, monkeypatch, *args, cwd=tmp_path)
+    assert status == 2 and len(err.splitlines()) == 1
+    assert "is not a ddwmmr.bench report" in err
     assert (tmp_path / "bench.json").read_text() == "my notes"
 
 
@@ -470,12 +502,13 @@ def test_committed_reference_report_matches_the_docs():
 
 
 @pytest.mark.parametrize("case", ["under a file", "a folder"])
-def test_cli_refuses_an_unusable_out_path_before_running(tmp_path, case):
+def test_cli_refuses_an_unusable_out_path_before_running(tmp_path, capsys, monkeypatch, case):
     (tmp_path / "plain").write_text("x")
     out = tmp_path / "plain" / "b.json" if case == "under a file" else tmp_path
-    result = _run_cli("--out", str(out), "--method", "ats", "--force", cwd=tmp_path)
-    assert result.returncode == 2 and len(result.stderr.splitlines()) == 1
-    assert result.stderr.startswith("error: out: ")
+    args = ("--out", str(out), "--method", "ats", "--force")
+    status, _, err = _call_cli(capsys, monkeypatch, *args, cwd=tmp_path)
+    assert status == 2 and len(err.splitlines()) == 1
+    assert err.startswith("error: out: ")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["plain"]
 
 
