@@ -648,7 +648,27 @@ def test_scenario_tool_gives_ratios_to_both_ends(tmp_path, monkeypatch):
         (["--seed", "-1"], "seed"),
     ],
 )
-def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path, args, message):
+def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path, capsys, args, message):
+    from ddwmmr.cli import bounds as tool
+
+    out = tmp_path / "bad"
+    try:
+        status = tool.main([*args, "--out", str(out)])
+    except SystemExit as stop:  # argparse's refusals
+        status = stop.code
+    assert status == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0]
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [(["--scenarios", "one"], "scenarios must be numbers"), (["--jobs", "0"], "jobs")],
+)
+def test_the_module_refuses_bad_input_in_one_line_exit_2(tmp_path, args, message):
+    """As a process (``python -m ddwmmr.bounds``): exit status 2, one line on stderr, no
+    traceback, nothing written."""
     out = tmp_path / "bad"
     result = subprocess.run(
         [sys.executable, "-m", "ddwmmr.bounds", *args, "--out", str(out)],
