@@ -12,7 +12,7 @@ MuJoCo plant, where tipping is judged by the contact forces, with the ``mpc`` th
 3. the default on this plant: also every edge of the support polygon keeps at least 10 %
    of the weight while moving (``min_edge_load``, the force model's edge loads).
 
-Prints only; about 15 s. The 100-scenario study is
+Prints only; about 25 s of CPU. The 100-scenario study is
 ``python -m ddwmmr.scenarios --controller mpc --plant mujoco`` (docs/mpc.md).
 """
 
