@@ -72,12 +72,14 @@ def test_a_fifo_or_a_device_as_bounds_file_is_refused_in_one_line(tmp_path):
     fifo = tmp_path / "fifo" / "bounds.csv"
     fifo.parent.mkdir()
     os.mkfifo(fifo)
-    with pytest.raises(ParameterError, match=r"^bounds: .*bounds\.csv is not a regular file$"):
+    with pytest.raises(
+        ParameterError, match=r"^bounds: .*bounds\.csv is not a regular file \(a FIFO\)$"
+    ):
         read_bounds_file(fifo, 0, 3.0)
     path = _bounds(tmp_path / "record", ["1,10,12,True"])
     (path.parent / "summary.json").unlink()
     os.mkfifo(path.parent / "summary.json")
-    with pytest.raises(ParameterError, match=r"summary\.json is not a regular file"):
+    with pytest.raises(ParameterError, match=r"summary\.json is not a regular file \(a FIFO\)"):
         read_bounds_file(path, 0, 3.0)
     wide = tmp_path / "wide" / "bounds.csv"
     wide.parent.mkdir()

@@ -225,7 +225,7 @@ def test_a_special_file_or_a_link_is_refused_even_with_force(tmp_path, capsys, n
     refused(["--snapshot", str(link), "--force", *FAST], capsys, "snapshot:", "symbolic link")
     fifo = tmp_path / "pipe.png"
     os.mkfifo(fifo)
-    refused(["--snapshot", str(fifo), "--force", *FAST], capsys, "not a regular file")
+    refused(["--snapshot", str(fifo), "--force", *FAST], capsys, "not a regular file (a FIFO)")
     assert user.read_bytes() == USER_TEXT and link.is_symlink()
     assert files_below(tmp_path) == ["link.png", "pipe.png", "user_notes.txt"]
 

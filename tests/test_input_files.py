@@ -79,10 +79,12 @@ def test_api_robot_magnitudes():
 def test_fifo_is_never_opened(tmp_path):
     fifo = tmp_path / "pipe.toml"
     os.mkfifo(fifo)  # opening it for reading would block forever
-    with pytest.raises(ParameterError, match="is not a regular file"):
+    with pytest.raises(ParameterError, match=r"is not a regular file \(a FIFO\)$"):
         read_text_file(fifo, "robot")
-    with pytest.raises(ParameterError, match="is not a regular file"):
+    with pytest.raises(ParameterError, match=r"is not a regular file \(a FIFO\)$"):
         Robot.from_toml(fifo)
+    with pytest.raises(ParameterError, match=r"is not a regular file \(a folder\)$"):
+        read_text_file(tmp_path, "robot")
 
 
 def test_non_utf8_names_the_byte_and_offset(tmp_path):

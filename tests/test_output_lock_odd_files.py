@@ -14,9 +14,9 @@ from pathlib import Path
 
 import pytest
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, file_kind
 from ddwmmr.outputs.lock import lock_file, output_lock
-from ddwmmr.outputs.owners import file_kind, lock_holder, owner_token, read_lock
+from ddwmmr.outputs.owners import lock_holder, owner_token, read_lock
 
 POSIX = pytest.mark.skipif(os.name == "nt", reason="FIFOs, sockets and links are POSIX's")
 

@@ -357,6 +357,27 @@ def as_path(path: Any, label: str) -> Path:
     raise ParameterError(f"{label}: a file path (str or os.PathLike) is needed (got {shown(path)})")
 
 
+#: What each file type but a regular file is called in a message.
+_KINDS = {
+    stat.S_IFDIR: "a folder",
+    stat.S_IFLNK: "a symbolic link",
+    stat.S_IFCHR: "a character device",
+    stat.S_IFBLK: "a block device",
+    stat.S_IFIFO: "a FIFO",
+    stat.S_IFSOCK: "a socket",
+}
+
+
+def file_kind(mode: int) -> str | None:
+    """What a file whose ``st_mode`` is ``mode`` is called in a message ("a folder",
+    "a character device", "a FIFO", ...), or None for a regular file. A type this list
+    does not name (e.g. a Solaris door) is "a special file". ``mode`` from ``os.lstat``
+    can name a symbolic link; from ``os.stat`` it is what the link points to."""
+    if stat.S_ISREG(mode):
+        return None
+    return _KINDS.get(stat.S_IFMT(mode), "a special file")
+
+
 def read_text_file(path: str | Path, label: str) -> str:
     """The UTF-8 text of a regular file; anything else raises :class:`ParameterError`.
 
@@ -373,8 +394,9 @@ def read_text_file(path: str | Path, label: str) -> str:
         raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
     except ValueError:  # e.g. an embedded NUL byte
         raise ParameterError(f"{label}: invalid file name {shown(str(path))}") from None
-    if not stat.S_ISREG(info.st_mode):
-        raise ParameterError(f"{label}: {path} is not a regular file")
+    kind = file_kind(info.st_mode)
+    if kind is not None:
+        raise ParameterError(f"{label}: {path} is not a regular file ({kind})")
     if info.st_size > MAX_INPUT_BYTES:
         raise ParameterError(
             f"{label}: {path} is too large ({info.st_size} bytes, at most {MAX_INPUT_BYTES})"

@@ -19,10 +19,9 @@ every tool (:func:`ddwmmr.outputs.check_writable`).
 from __future__ import annotations
 
 import os
-import stat
 from pathlib import Path
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, file_kind
 from ddwmmr.outputs import check_output_path, check_writable
 
 #: Suffixes (formats) ``--snapshot`` may have: what matplotlib writes by itself or through
@@ -121,8 +120,9 @@ def check_existing_snapshot(path: Path, text: str, force: bool) -> None:
         return
     except OSError as exc:
         raise ParameterError(f"snapshot: cannot check {text} ({exc.strerror})") from None
-    if not stat.S_ISREG(info.st_mode):
-        raise ParameterError(f"snapshot: {text} exists and is not a regular file")
+    kind = file_kind(info.st_mode)
+    if kind is not None:
+        raise ParameterError(f"snapshot: {text} exists and is not a regular file ({kind})")
     fmt = snapshot_format(text)
     if force or written_by_snapshot(path, fmt):
         return

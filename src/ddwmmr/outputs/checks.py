@@ -18,8 +18,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
-from ddwmmr.errors import ParameterError, shown
-from ddwmmr.outputs.owners import _is_stale_temp, ended_leftover, file_kind, temp_prefix
+from ddwmmr.errors import ParameterError, file_kind, shown
+from ddwmmr.outputs.owners import _is_stale_temp, ended_leftover, temp_prefix
 
 #: Name of the manifest file each tool writes into its output folder.
 MANIFEST = ".ddwmmr-manifest.json"

@@ -15,7 +15,7 @@ import stat
 from pathlib import Path
 from typing import Any, NoReturn
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, file_kind
 
 STAGING_PREFIX = ".ddwmmr-staging-"
 
@@ -156,26 +156,6 @@ def _is_stale_temp(name: str) -> bool:
 
 #: Most bytes of a lock file read: its token is a host name, a process id and a time.
 _LOCK_BYTES = 4096
-
-#: What each file type but a regular file is called in a message.
-_KINDS = {
-    stat.S_IFDIR: "a folder",
-    stat.S_IFLNK: "a symbolic link",
-    stat.S_IFCHR: "a character device",
-    stat.S_IFBLK: "a block device",
-    stat.S_IFIFO: "a FIFO",
-    stat.S_IFSOCK: "a socket",
-}
-
-
-def file_kind(mode: int) -> str | None:
-    """What a file whose ``st_mode`` is ``mode`` is called in a message ("a folder",
-    "a character device", "a FIFO", ...), or None for a regular file. A type this list
-    does not name (e.g. a Solaris door) is "a special file". ``mode`` from ``os.lstat``
-    can name a symbolic link; from ``os.stat`` it is what the link points to."""
-    if stat.S_ISREG(mode):
-        return None
-    return _KINDS.get(stat.S_IFMT(mode), "a special file")
 
 
 def read_lock(path: Path) -> str | None:
