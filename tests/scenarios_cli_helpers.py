@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from ddwmmr.cli.scenarios import main
+from in_process import call_main
 
 
 def _checked(tmp_path: Path, out: Path, status: object, stderr: str) -> str:
@@ -41,9 +42,6 @@ def bad_scenarios_main(tmp_path: Path, args: list[str], capsys: pytest.CaptureFi
     """As :func:`bad_scenarios_run`, through ``main(argv)`` in this process: an exception
     ``main`` lets out fails the test, as a traceback on a real stderr would."""
     out = tmp_path / "bad"
-    capsys.readouterr()
-    try:
-        status: object = main([*args, "--out", str(out)])
-    except SystemExit as exc:  # argparse's own errors
-        status = exc.code
-    return _checked(tmp_path, out, status, capsys.readouterr().err)
+    capsys.readouterr()  # only this run's output
+    status, _, err = call_main(main, [*args, "--out", str(out)], capsys)
+    return _checked(tmp_path, out, status, err)

@@ -34,6 +34,7 @@ from ddwmmr.bench import (
 )
 from ddwmmr.cli.bench import main
 from footprint import outline_clearance
+from in_process import call_main
 
 TINY = {"repeats": 2, "calls": 20, "duration": 0.4}
 ROBOT3 = Robot().with_payload(3.0)
@@ -339,12 +340,7 @@ def _call_cli(capsys, monkeypatch, *args: str, cwd) -> tuple[int, str, str]:
     """``(status, stdout, stderr)`` of the tool's ``main`` run in this process from ``cwd``
     (argparse's refusals exit through SystemExit; its status is taken as the return)."""
     monkeypatch.chdir(cwd)
-    try:
-        status = main(list(args))
-    except SystemExit as stop:
-        status = stop.code
-    out, err = capsys.readouterr()
-    return status, out, err
+    return call_main(main, args, capsys)
 
 
 @pytest.mark.parametrize(

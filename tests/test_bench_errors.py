@@ -7,14 +7,12 @@ from __future__ import annotations
 import pytest
 
 from ddwmmr.cli import bench, track
+from in_process import call_main
 
 
 def _stderr_of(main, argv, capsys) -> tuple[int, str]:
-    try:
-        status = main(argv)
-    except SystemExit as stop:  # argparse exits from parse_args
-        status = stop.code
-    return status, capsys.readouterr().err
+    status, _, err = call_main(main, argv, capsys)
+    return status, err
 
 
 @pytest.mark.parametrize(

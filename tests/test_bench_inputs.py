@@ -31,6 +31,7 @@ from ddwmmr.bench import run as bench_run
 from ddwmmr.cli import bench as bench_cli
 from ddwmmr.cli.bench import build_parser, main
 from ddwmmr.errors import MAX_JOBS
+from in_process import call_main
 
 #: The smallest run: one method, one repeat, five states, 1 s runs, no scenarios.
 SMALL = ["--method", "pi", "--repeats", "1", "--calls", "5", "--duration", "1", "--scenarios", "0"]
@@ -49,12 +50,7 @@ def workdir(tmp_path, monkeypatch) -> Path:
 
 def run_main(args: list[str], capsys) -> tuple[int, str, str]:
     """``main(args)`` in this process: status, stdout, stderr (argparse exits too)."""
-    try:
-        status = main(args)
-    except SystemExit as exc:
-        status = exc.code
-    captured = capsys.readouterr()
-    return status, captured.out, captured.err
+    return call_main(main, args, capsys)
 
 
 def refused(args: list[str], workdir: Path, capsys, monkeypatch) -> str:

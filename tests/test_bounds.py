@@ -29,6 +29,7 @@ from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.min_time import MinimumTimeProblem
 from ddwmmr.scenarios import generate
 from ddwmmr.scenarios.generator import Scenario
+from in_process import call_main
 
 HEAVY = Robot().with_payload(3.0)
 DOCS_BOUNDS = Path(__file__).resolve().parents[1] / "docs" / "bounds"
@@ -652,12 +653,9 @@ def test_bad_input_is_one_line_exit_2_and_nothing_written(tmp_path, capsys, args
     from ddwmmr.cli import bounds as tool
 
     out = tmp_path / "bad"
-    try:
-        status = tool.main([*args, "--out", str(out)])
-    except SystemExit as stop:  # argparse's refusals
-        status = stop.code
+    status, _, err = call_main(tool.main, [*args, "--out", str(out)], capsys)
     assert status == 2
-    lines = capsys.readouterr().err.strip().splitlines()
+    lines = err.strip().splitlines()
     assert len(lines) == 1 and message in lines[0]
     assert not out.exists()
 
