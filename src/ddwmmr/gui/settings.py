@@ -322,9 +322,15 @@ def check_run_length(settings: Settings) -> int:
     """The number of steps of a run of ``settings`` (:func:`check_step_count`), what
     :func:`check_settings` leaves to the run; a duration shorter than the step is refused
     naming T and N when the step is their T / N (dt not set), a step the user never typed.
-    Called by the command line, which refuses bad input before the window is built, and by
-    :func:`simulate_settings` (the window's Run) before the first step."""
-    trajectory = build_trajectory(settings)
+    Called by the command line, which refuses bad input before the window is built; the
+    window's Run (:func:`simulate_settings`) checks the same by :func:`run_length` on the
+    trajectory it runs."""
+    return run_length(settings, build_trajectory(settings))
+
+
+def run_length(settings: Settings, trajectory: Any) -> int:
+    """:func:`check_run_length` of ``settings`` whose trajectory, already built by
+    :func:`build_trajectory`, is ``trajectory`` (a file is then read once per Run)."""
     duration = trajectory.duration if settings.duration is None else settings.duration
     dt = control_step(settings, trajectory) or resolution_step(trajectory)
     if settings.dt is None and dt > duration:
@@ -343,10 +349,10 @@ def simulate_settings(
 
     ``progress(slot_index, step, steps)`` is called after every simulated step.
     """
+    trajectory = build_trajectory(settings)
     # simulate would refuse such a run too, but as "dt must be <= duration ... (got T/N)"
     # with a dt the window's blank dt field never showed.
-    check_run_length(settings)
-    trajectory = build_trajectory(settings)
+    run_length(settings, trajectory)
     robot = build_robot(settings)
     results = []
     for index, slot in enumerate(settings.active_slots):
