@@ -274,14 +274,7 @@ def simulate(
         raise ParameterError(
             f"progress must be a callable progress(step, steps) (got {shown(progress)})"
         )
-    if isinstance(method, str):
-        check_tracks(method)
-        controller = make_controller(method, robot, **controller_options)
-    elif controller_options:
-        raise ParameterError("controller options are only accepted with a method name")
-    else:
-        controller = check_controller(method)
-        warn_other_robot(controller, robot)
+    controller = _controller_for(method, robot, controller_options)
     reference = check_trajectory(trajectory)
     duration = check_positive("duration", trajectory.duration if duration is None else duration)
     the_plant = build_plant(plant, robot, integrator, plant_options)
@@ -296,6 +289,47 @@ def simulate(
     # more corners than they allow is refused now, not after every step has been simulated
     corners = getattr(trajectory, "corner_windows", None)
     windows = corners(duration) if corners is not None else ()
+    q = _start_pose(robot, reference, initial_offset, q0)
+    tipped = _tipped_start(robot, q, tipped_start)
+    task = TrackingTask(reference, the_plant, grid=(dt, steps))
+    run_loop(the_plant, controller, task, q, dt, steps, progress)
+    timeseries = task.timeseries(robot)
+    summary = summarize(timeseries, robot, windows)
+    summary.update(_run_keys(timeseries, robot, trajectory, reference, controller, the_plant, dt))
+    if task.diverged_at is not None:
+        summary.update(diverged_at_step=task.diverged_at, diverged=task.diverged_message)
+    _add_plug_in_summaries(summary, the_plant, controller, timeseries)
+    summary.update(start_stability=start_stability(robot, q), start_tipped=tipped)
+    summary.update(verdict(summary))
+    return SimulationResult(timeseries, summary, robot, trajectory, controller)
+
+
+def _controller_for(method: str | Controller, robot: Robot, options: dict[str, Any]) -> Any:
+    """The controller ``simulate`` runs: ``method`` built by name for ``robot`` with
+    ``options``, or ``method`` itself, a checked controller object (a
+    :class:`UserWarning` if it holds another robot; options with it are a
+    :class:`ParameterError`)."""
+    if isinstance(method, str):
+        check_tracks(method)
+        return make_controller(method, robot, **options)
+    if options:
+        raise ParameterError("controller options are only accepted with a method name")
+    controller = check_controller(method)
+    warn_other_robot(controller, robot)
+    return controller
+
+
+def _start_pose(
+    robot: Robot,
+    reference: Any,
+    initial_offset: Sequence[float] | None,
+    q0: npt.ArrayLike | None,
+) -> np.ndarray:
+    """The run's start configuration ``[x, y, phi, th1, th2]`` (m, m, rad, rad, rad, world
+    frame): ``q0`` checked (x, y within ``MAX_COORDINATE_M``), else the start on
+    ``reference`` with the end effector ``initial_offset`` (dx, dy, m, in its start frame;
+    None: :func:`default_offset`) away. Arm joints outside the robot's ``joint_limits``
+    are a :class:`ParameterError` naming which start."""
     if q0 is None:
         if initial_offset is None:
             initial_offset = default_offset(robot)
@@ -317,37 +351,49 @@ def simulate(
         # run outside its limits, MuJoCo refuses it: no plant gives a meaningful run
         where = "q0" if q0 is not None else "the start pose (initial_offset applied)"
         raise ParameterError(f"{where}: {outside}")
-    tipped = _tipped_start(robot, q, tipped_start)
-    task = TrackingTask(reference, the_plant, grid=(dt, steps))
-    run_loop(the_plant, controller, task, q, dt, steps, progress)
-    timeseries = task.timeseries(robot)
-    summary = summarize(timeseries, robot, windows)
+    return q
+
+
+def _run_keys(
+    timeseries: dict[str, np.ndarray],
+    robot: Robot,
+    trajectory: Any,
+    reference: Any,
+    controller: Any,
+    plant: Plant,
+    dt: float,
+) -> dict[str, Any]:
+    """The summary's keys naming the run: method, trajectory and its extent (m), the
+    robot's length unit (m), plant, integrator, command interface, ``dt`` (s), the
+    recorded duration (s) and steps, and the start's end-effector offset (m)."""
     recorded_steps = len(timeseries["t"]) - 1
-    summary.update(
+    return dict(
         method=getattr(controller, "name", type(controller).__name__),
         trajectory=trajectory_name(trajectory),
         trajectory_extent_m=trajectory_extent(reference, timeseries),
         # the verdict's absolute error limits are in the robot's own length unit
         length_unit_m=length_unit(robot.L1),
-        plant=the_plant.name,
-        integrator=getattr(the_plant, "integrator", None),
+        plant=plant.name,
+        integrator=getattr(plant, "integrator", None),
         # the interface the controller spoke (the mpc chooses its own for the plant)
-        command_interface=spoken_interface(controller, the_plant),
+        command_interface=spoken_interface(controller, plant),
         dt=dt,
         duration=recorded_steps * dt,
         steps=recorded_steps,
         initial_offset_m=float(timeseries["position_error_m"][0]),
     )
-    if task.diverged_at is not None:
-        summary.update(diverged_at_step=task.diverged_at, diverged=task.diverged_message)
-    _add_plug_in_keys(summary, the_plant, "plant", the_plant.summarize(timeseries))
+
+
+def _add_plug_in_summaries(
+    summary: dict, plant: Plant, controller: Any, timeseries: dict[str, np.ndarray]
+) -> None:
+    """``summary`` updated with the plant's ``summarize()`` keys, then the controller's
+    (if it has ``summarize``), then its ``aux`` row (if set)."""
+    _add_plug_in_keys(summary, plant, "plant", plant.summarize(timeseries))
     if hasattr(controller, "summarize"):
         _add_plug_in_keys(summary, controller, "method", controller.summarize(timeseries))
     if getattr(controller, "aux", None) is not None:
         summary["aux"] = controller.aux  # the verdict's likely cause names the slides' row
-    summary.update(start_stability=start_stability(robot, q), start_tipped=tipped)
-    summary.update(verdict(summary))
-    return SimulationResult(timeseries, summary, robot, trajectory, controller)
 
 
 def _add_plug_in_keys(summary: dict, owner: Any, role: str, keys: Mapping[str, Any]) -> None:
