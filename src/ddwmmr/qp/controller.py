@@ -226,6 +226,49 @@ class QPController:
         obstacle_margin = check_margin_in_influence(robot_margin(obstacle_margin, unit), unit)
         if heading_weight is None:
             heading_weight = 0.0 if track_orientation else 1.0
+        heading = self._build_tasks(
+            tracking=(tracking_weight, tau, track_orientation, max_speed),
+            manipulability_weight=manipulability_weight,
+            posture_weight=posture_weight,
+            regularization_weight=regularization_weight,
+            heading_weight=heading_weight,
+        )
+        self.tasks.extend(_pieces("tasks", tasks, Task))
+        self._build_limits(
+            stability=(stability_min, stability_gain),
+            motion=(max_base_speed, max_yaw_rate, max_acceleration, max_yaw_acceleration),
+            speed_budget=speed_budget,
+            singularity_margin=singularity_margin,
+        )
+        if self.obstacles:
+            self._avoid_obstacles(obstacle_margin, heading)
+        self.limits.extend(_pieces("limits", limits, Limit))
+        self.min_edge_load = None if min_edge_load is None else check_min_edge_load(min_edge_load)
+        self.edge_loads: EdgeLoadLimit | None = None  # set by adopt_plant
+        self.min_predicted_edge_load: float | None = None
+        self.edge_relaxed_steps = 0  # steps whose edge rows gave way to the other limits
+        self.problem = QPProblem(self.tasks, self.limits, unit=unit)
+        self._dt_option = None if dt is None else check_positive("dt", dt)
+        self._loop_step: float | None = None
+        self.ctx = StepContext(robot, self._dt_option or DEFAULT_DT)
+        self.fallbacks = 0
+        self.last = StepInfo()
+
+    def _build_tasks(
+        self,
+        *,
+        tracking: tuple[float, float | Sequence[float], bool, float | None],
+        manipulability_weight: float,
+        posture_weight: float,
+        regularization_weight: float,
+        heading_weight: float,
+    ) -> HeadingTask:
+        """``self.tracking`` and ``self.tasks`` in priority order: end-effector tracking
+        (``tracking`` = weight per (m/s)^2, tau s, track_orientation, max_speed m/s or
+        None), manipulability, posture, regularisation, then the heading task if its
+        weight is positive. Returns the heading task (an obstacle detour is set on it)."""
+        robot, unit = self.robot, self.unit
+        tracking_weight, tau, track_orientation, max_speed = tracking
         linear, angular = demand_limits(robot)
         self.tracking = EndEffectorTask(
             tracking_weight,
@@ -244,7 +287,22 @@ class QPController:
         heading = HeadingTask(heading_weight, distance=0.8 * robot.reach, unit=unit)
         if heading_weight > 0.0:
             self.tasks.append(heading)
-        self.tasks.extend(_pieces("tasks", tasks, Task))
+        return heading
+
+    def _build_limits(
+        self,
+        *,
+        stability: tuple[float, float],
+        motion: tuple[float | None, float | None, float | None, float | None],
+        speed_budget: tuple[float, float] | None,
+        singularity_margin: float | None,
+    ) -> None:
+        """``self.limits`` in order: stability (``stability`` = floor S_min, damper gain
+        1/s), wheel speeds, joints, then the base-motion caps if any of ``motion`` =
+        (v m/s, w rad/s, v slew m/s^2, w slew rad/s^2) is set, the speed budget, the
+        shoulder singularity margin (rad) unless None."""
+        robot, unit = self.robot, self.unit
+        stability_min, stability_gain = stability
         self.stability = StabilityLimit(
             robot.com_coefficients,
             stability_min,
@@ -254,7 +312,7 @@ class QPController:
         self.stability_min = self.stability.stability_min
         self.joints = JointLimit(robot)
         self.limits: list[Limit] = [self.stability, WheelSpeedLimit(robot, unit=unit), self.joints]
-        motion = (max_base_speed, max_yaw_rate, max_acceleration, max_yaw_acceleration)
+        max_base_speed, max_yaw_rate, max_acceleration, max_yaw_acceleration = motion
         self.base_motion: BaseMotionLimit | None = None
         if any(value is not None for value in motion):
             self.base_motion = BaseMotionLimit(
@@ -273,34 +331,25 @@ class QPController:
                 singularity_margin, joint_speed=robot.joint_speed_limit
             )
             self.limits.append(self.singularity)
-        if self.obstacles:
-            self.limits.append(
-                ObstacleLimit(robot, self.obstacles, margin=obstacle_margin, unit=unit)
+
+    def _avoid_obstacles(self, margin: float, heading: HeadingTask) -> None:
+        """``self.obstacles`` kept ``margin`` (m) from the base footprint (a limit), steered
+        round (a task after the others so far) and detoured by tracking and ``heading``."""
+        robot, unit = self.robot, self.unit
+        self.limits.append(ObstacleLimit(robot, self.obstacles, margin=margin, unit=unit))
+        self.tasks.append(
+            ObstacleSteeringTask(
+                self.obstacles,
+                0.5 * robot.base_length,
+                0.5 * robot.base_width,
+                # Steering must be able to bend tracking round a post: scale with it.
+                weight=3e-3 * self.tracking.weight,
+                unit=unit,
             )
-            self.tasks.append(
-                ObstacleSteeringTask(
-                    self.obstacles,
-                    0.5 * robot.base_length,
-                    0.5 * robot.base_width,
-                    # Steering must be able to bend tracking round a post: scale with it.
-                    weight=3e-3 * self.tracking.weight,
-                    unit=unit,
-                )
-            )
-            half_diagonal = 0.5 * math.hypot(robot.base_length, robot.base_width)
-            detour = Detour(self.obstacles, half_diagonal + 2.0 * obstacle_margin)
-            self.tracking.detour = heading.detour = detour
-        self.limits.extend(_pieces("limits", limits, Limit))
-        self.min_edge_load = None if min_edge_load is None else check_min_edge_load(min_edge_load)
-        self.edge_loads: EdgeLoadLimit | None = None  # set by adopt_plant
-        self.min_predicted_edge_load: float | None = None
-        self.edge_relaxed_steps = 0  # steps whose edge rows gave way to the other limits
-        self.problem = QPProblem(self.tasks, self.limits, unit=unit)
-        self._dt_option = None if dt is None else check_positive("dt", dt)
-        self._loop_step: float | None = None
-        self.ctx = StepContext(robot, self._dt_option or DEFAULT_DT)
-        self.fallbacks = 0
-        self.last = StepInfo()
+        )
+        half_diagonal = 0.5 * math.hypot(robot.base_length, robot.base_width)
+        detour = Detour(self.obstacles, half_diagonal + 2.0 * margin)
+        self.tracking.detour = heading.detour = detour
 
     def _make_backend(self, solver: str, warm_start: bool | None):
         """The solver backend (overridden by the naive benchmark variant)."""
