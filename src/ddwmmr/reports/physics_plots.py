@@ -65,17 +65,57 @@ def save_physics_animation(
             after it tipped (the top view of a fallen robot means nothing).
     """
     robot = result.robot
-    ts = result.timeseries
     tip_time = result.summary.get("tip_time_s")
-    if tip_time is not None:
-        keep = ts["t"] <= tip_time + after_tip_s
-        ts = {name: values[keep] for name, values in ts.items()}
+    ts = _until_after_tip(result.timeseries, tip_time, after_tip_s)
     names = support_names(ts)
     forces = np.column_stack([ts[f"support_force_{n}_n"] for n in names])
     q = np.column_stack([ts[k] for k in ("x", "y", "phi", "th1", "th2")])
     fig = new_figure((9.5, 4.2))
     ax, ax_s = fig.subplots(1, 2, width_ratios=(1, 1.25))
-    reach = robot.reach + 0.5 * robot.base_length
+    _top_view_axes(ax, ts, robot.reach + 0.5 * robot.base_length)
+    _margins_in_time(ax_s, ts, tip_time)
+    cursor = ax_s.axvline(0.0, color="k", lw=0.8)
+    (footprint,) = ax.plot([], [], color="0.3")
+    (arm,) = ax.plot([], [], color="tab:orange", lw=2, marker="o", ms=3)
+    discs = ax.scatter([], [], s=[], color="tab:blue", alpha=0.6, zorder=3)
+    indices = np.linspace(0, len(q) - 1, frames).astype(int)
+    title = f"{result.summary.get('method', '?')}, payload {robot.payload:g} kg"
+
+    def update(frame: int):
+        k = indices[frame]
+        shape = robot_outline(robot, q[k])
+        footprint.set_data(*shape["footprint"].T)
+        arm.set_data(*shape["arm"].T)
+        discs.set_offsets(support_points_world(q[k], points))
+        discs.set_sizes(np.maximum(600.0 * forces[k] / weight_n, 4.0))
+        discs.set_color(["tab:blue" if f > 1e-3 * weight_n else "tab:red" for f in forces[k]])
+        cursor.set_xdata([ts["t"][k], ts["t"][k]])
+        fallen = " (tipped)" if tip_time is not None and ts["t"][k] >= tip_time else ""
+        ax.set_title(f"{title}: t = {ts['t'][k]:.2f} s{fallen}", fontsize=9)
+        return footprint, arm, discs, cursor
+
+    ax.set_title(title, fontsize=9)
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return save_gif(fig, update, len(indices), path, fps)
+
+
+def _until_after_tip(
+    ts: dict[str, np.ndarray], tip_time: float | None, after_tip_s: float
+) -> dict[str, np.ndarray]:
+    """The time series ``ts`` up to ``after_tip_s`` (s) after ``tip_time`` (s); all of
+    it when the run did not tip (``tip_time`` None)."""
+    if tip_time is None:
+        return ts
+    keep = ts["t"] <= tip_time + after_tip_s
+    return {name: values[keep] for name, values in ts.items()}
+
+
+def _top_view_axes(ax: Axes, ts: dict[str, np.ndarray], reach: float) -> None:
+    """``ax`` as the run's top view (world frame, m, equal aspect): the base path's extent
+    plus ``reach`` (m) on every side, and the desired end-effector path dashed if
+    recorded."""
     ax.set_xlim(ts["x"].min() - reach, ts["x"].max() + reach)
     ax.set_ylim(ts["y"].min() - reach, ts["y"].max() + reach)
     ax.set_aspect("equal")
@@ -83,6 +123,12 @@ def save_physics_animation(
     ax.set_ylabel("y (m)")
     if "xE_d" in ts:
         ax.plot(ts["xE_d"], ts["yE_d"], "k--", lw=0.8)
+
+
+def _margins_in_time(ax_s: Axes, ts: dict[str, np.ndarray], tip_time: float | None) -> None:
+    """``ax_s``: the kinematic S and the physics S_phys over t (s) with the tipping line
+    S = 1 and the tip time (s, if any) marked, and the base tilt (deg) on a right axis;
+    one legend below the plot."""
     ax_s.plot(ts["t"], ts["stability"], color="tab:brown", label="S (kinematic)")
     ax_s.plot(ts["t"], ts["physics_stability"], color="tab:blue", lw=0.8, label="S_phys")
     ax_s.axhline(1.0, color="tab:red", ls="--", lw=0.8)
@@ -113,31 +159,6 @@ def save_physics_animation(
         ncol=3,
         fontsize=8,
     )
-    cursor = ax_s.axvline(0.0, color="k", lw=0.8)
-    (footprint,) = ax.plot([], [], color="0.3")
-    (arm,) = ax.plot([], [], color="tab:orange", lw=2, marker="o", ms=3)
-    discs = ax.scatter([], [], s=[], color="tab:blue", alpha=0.6, zorder=3)
-    indices = np.linspace(0, len(q) - 1, frames).astype(int)
-    title = f"{result.summary.get('method', '?')}, payload {robot.payload:g} kg"
-
-    def update(frame: int):
-        k = indices[frame]
-        shape = robot_outline(robot, q[k])
-        footprint.set_data(*shape["footprint"].T)
-        arm.set_data(*shape["arm"].T)
-        discs.set_offsets(support_points_world(q[k], points))
-        discs.set_sizes(np.maximum(600.0 * forces[k] / weight_n, 4.0))
-        discs.set_color(["tab:blue" if f > 1e-3 * weight_n else "tab:red" for f in forces[k]])
-        cursor.set_xdata([ts["t"][k], ts["t"][k]])
-        fallen = " (tipped)" if tip_time is not None and ts["t"][k] >= tip_time else ""
-        ax.set_title(f"{title}: t = {ts['t'][k]:.2f} s{fallen}", fontsize=9)
-        return footprint, arm, discs, cursor
-
-    ax.set_title(title, fontsize=9)
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return save_gif(fig, update, len(indices), path, fps)
 
 
 #: File name of the support-load figure a physics ``track`` run writes.
