@@ -2,22 +2,33 @@
 
 All functions take a :class:`ddwmmr.sim.SimulationResult`; ``save_run_figures`` writes the
 standard set of PNGs that ``python -m ddwmmr.track`` produces. World frame, metres, radians.
-The figures are not pyplot's (:mod:`ddwmmr.reports.canvas`): importing or using this module
-leaves the matplotlib backend as the user chose it; save a returned figure with
-``fig.savefig`` or display it in Jupyter (``plt.show()`` does not show it).
+
+By default a figure is made here, not by pyplot (:mod:`ddwmmr.reports.canvas`): importing
+or using this module leaves the matplotlib backend as the user chose it. Such a figure is
+saved with ``fig.savefig`` or shown as a Jupyter cell's value, but ``plt.show()`` does not
+show it. To look at a run in a window, draw into pyplot's figures instead:
+``plot_path(result, ax=ax)`` into an axes of ``plt.subplots(layout="constrained")`` (the
+layout makes room for the legend beside the axes), and
+``plot_errors(result, fig=plt.figure())`` (likewise ``plot_rates``, ``plot_metrics``),
+then ``plt.show()``.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.layout_engine import PlaceHolderLayoutEngine
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
 
+from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.reports import palette
 from ddwmmr.reports.canvas import new_figure, save_gif
@@ -175,7 +186,11 @@ def plot_path(result, ax: Axes | None = None, snapshots: int = 6, obstacles=None
     """Desired vs actual end-effector path, base path, the robot at up to ``snapshots``
     times, no base inside another's footprint (one grey per time, named in the legend; see
     :func:`snapshot_indices`) and the obstacles (``(x, y, radius)``
-    circles, m) if any. The axes hold everything drawn; the legend sits beside them."""
+    circles, m) if any. The axes hold everything drawn; the legend sits beside them.
+
+    Without ``ax`` the figure is made here, 8.6 inches wide and as tall as the equal-scale
+    path needs. An ``ax`` of the caller's is drawn into as it is (other runs' paths may
+    share it) and its figure's size and layout are left alone."""
     ts = result.timeseries
     own_figure = ax is None
     fig, ax = _axes(ax, figsize=(8.6, 5.6))
@@ -253,11 +268,17 @@ def _fit_path_figure(fig: Figure, ax: Axes) -> None:
     )
 
 
-def plot_errors(result) -> Figure:
+def plot_errors(result, *, fig: Figure | None = None) -> Figure:
     """End-effector position error (log scale, floored at :data:`ERROR_FLOOR`) and
-    orientation error vs time."""
+    orientation error vs time; returns the figure.
+
+    Drawn on a 7 x 5 inch figure of its own, or into ``fig``, an empty figure of the
+    caller's (``plt.figure()``: then ``plt.show()`` shows it), kept at its size and layout
+    engine; anything else as ``fig`` (not a Figure, or one holding axes) is a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming ``fig``."""
     ts = result.timeseries
-    fig = new_figure((7, 5))
+    own = fig is None
+    fig = new_figure((7, 5)) if fig is None else _figure_to_draw_into(fig)
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     position = np.maximum(ts["position_error_m"], ERROR_FLOOR)
     ax1.semilogy(ts["t"], position, color="tab:blue")
@@ -270,7 +291,7 @@ def plot_errors(result) -> Figure:
     ax2.set_xlabel("t (s)")
     ax2.grid(alpha=0.3)
     ax1.set_title(_title(result, "tracking errors"))
-    fig.tight_layout()
+    _lay_out(fig, own)
     return fig
 
 
@@ -306,14 +327,18 @@ def at_least_a_percent(ax: Axes, values: np.ndarray) -> None:
         ax.set_ylim(centre - 0.5 * span, centre + 0.5 * span)
 
 
-def plot_rates(result) -> Figure:
+def plot_rates(result, *, fig: Figure | None = None) -> Figure:
     """Arm joint rates, base yaw rate and wheel speeds vs time (rad/s), each on its own
     axis, with the robot's limits drawn and named (the base yaw rate has no limit of its
     own: the wheel limit bounds it). The yaw rate drawn is the one the wheel speeds come
     from: the measured one on a plant whose base lags its command (the command then a thin
-    dashed line), else the command, which is the motion (:func:`wheels_follow_measured`)."""
+    dashed line), else the command, which is the motion (:func:`wheels_follow_measured`).
+
+    Drawn on an 8.6 x 6.4 inch figure of its own, or into ``fig`` as :func:`plot_errors`
+    does; returns the figure."""
     ts, robot = result.timeseries, result.robot
-    fig = new_figure((8.6, 6.4))
+    own = fig is None
+    fig = new_figure((8.6, 6.4)) if fig is None else _figure_to_draw_into(fig)
     ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True)
     ax1.plot(ts["t"], ts["th1dot"], label="th1dot")
     ax1.plot(ts["t"], ts["th2dot"], label="th2dot")
@@ -334,7 +359,7 @@ def plot_rates(result) -> Figure:
     for ax in (ax1, ax2, ax3):
         ax.grid(alpha=0.3)
         legend_beside(ax, fontsize=8)
-    fig.tight_layout()
+    _lay_out(fig, own)
     return fig
 
 
@@ -369,10 +394,13 @@ def _limit_lines(ax: Axes, limit: float, name: str) -> None:
         )
 
 
-def plot_metrics(result) -> Figure:
-    """Manipulability eta and tip-over stability S vs time (S = 1 tips)."""
+def plot_metrics(result, *, fig: Figure | None = None) -> Figure:
+    """Manipulability eta and tip-over stability S vs time (S = 1 tips); returns the figure.
+
+    Drawn on a 7 x 5 inch figure of its own, or into ``fig`` as :func:`plot_errors` does."""
     ts = result.timeseries
-    fig = new_figure((7, 5))
+    own = fig is None
+    fig = new_figure((7, 5)) if fig is None else _figure_to_draw_into(fig)
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     ax1.plot(ts["t"], ts["manipulability"], color="tab:purple")
     ax1.set_ylim(0, 1.05)
@@ -389,8 +417,9 @@ def plot_metrics(result) -> Figure:
     ax2.set_xlabel("t (s)")
     ax2.grid(alpha=0.3)
     ax1.set_title(_title(result, "performance metrics"))
-    fig.tight_layout()
-    place_legend(ax2, fontsize=8)
+    _lay_out(fig, own)
+    with _measurable(fig):
+        place_legend(ax2, fontsize=8)
     return fig
 
 
@@ -458,6 +487,56 @@ def save_animation(
     with ProgressBar(len(indices), "track: animation.gif", enabled=progress, unit="frame") as bar:
         save_gif(fig, update, len(indices), path, fps, bar.advance)
     return path
+
+
+def _figure_to_draw_into(fig: object) -> Figure:
+    """``fig`` if it is a :class:`~matplotlib.figure.Figure` holding no axes, else a
+    one-line :class:`~ddwmmr.errors.ParameterError` naming ``fig``.
+
+    A figure that already holds axes is refused rather than cleared or drawn over: the
+    panels are laid out over the whole figure, so they would hide the caller's axes, and
+    clearing would throw the caller's drawing away. (An axes passed to :func:`plot_path`
+    is drawn into as it is: one more path on a map is a meaningful overlay.)"""
+    if not isinstance(fig, Figure):
+        raise ParameterError(
+            f"fig: must be a matplotlib Figure, e.g. plt.figure() (got {type(fig).__name__})"
+        )
+    if fig.axes:
+        raise ParameterError(
+            f"fig: must be an empty Figure (it holds {len(fig.axes)} axes); "
+            "pass a new one, e.g. plt.figure(), or call fig.clear() first"
+        )
+    return fig
+
+
+def _lay_out(fig: Figure, own: bool) -> None:
+    """Lay the panels of ``fig`` out: ``tight_layout`` on a figure made here (``own``) or
+    on a caller's without a layout engine; a caller's figure with an engine of its own
+    (``plt.figure(layout="constrained")``) is laid out by that engine, which it keeps
+    (``tight_layout`` would drop it with a warning)."""
+    engine = fig.get_layout_engine()
+    if own or engine is None or isinstance(engine, PlaceHolderLayoutEngine):
+        fig.tight_layout()
+    else:
+        engine.execute(fig)
+
+
+@contextmanager
+def _measurable(fig: Figure) -> Iterator[Figure]:
+    """``fig`` on a canvas that legends can be measured on (:mod:`ddwmmr.reports.legends`
+    asks the canvas for its renderer). Figures made here and those of pyplot's Agg-based
+    backends (Tk, Qt, macOS, Jupyter's inline) have one; a caller's figure on another
+    canvas (the svg, pdf and cairo backends) is lent an Agg canvas, measured at the same
+    size and dpi, and gets its own canvas back afterwards."""
+    canvas = fig.canvas
+    if hasattr(canvas, "get_renderer"):
+        yield fig
+        return
+    FigureCanvasAgg(fig)
+    try:
+        yield fig
+    finally:
+        fig.set_canvas(canvas)
 
 
 def _axes(ax: Axes | None, figsize: tuple[float, float]) -> tuple[Figure, Axes]:
