@@ -95,12 +95,7 @@ def run_benchmark(
 
     Every argument is checked before anything runs (:class:`ParameterError`, one line).
     """
-    check_int_at_least("repeats", repeats, 1, MAX_REPEATS)
-    check_int_at_least("calls", calls, 1, MAX_CALLS)
-    check_int_at_least("scenarios", scenarios, 0, MAX_SCENARIOS)
-    check_int_at_least("floor_scenarios", floor_scenarios, 0, MAX_SCENARIOS)
-    if scenario_jobs is not None:
-        check_int_at_least("jobs", scenario_jobs, 1, MAX_JOBS)
+    _check_counts(repeats, calls, scenarios, floor_scenarios, scenario_jobs)
     robot = robot if robot is not None else Robot()
     trajectory = trajectory if trajectory is not None else Ellipse()
     duration = check_duration(trajectory, duration)
@@ -124,15 +119,8 @@ def run_benchmark(
             classes = measure_qp_classes(
                 Robot().with_payload(3.0), calls, repeats, overhead_ns, reference, bar
             )
-    floor = []
-    if mpc_floor:
-        with phase("bench: the mpc step against its HPIPM solve", enabled=progress):
-            tracking = [(name, duration) for name, _ in FLOOR_TRACKING]
-            floor = measure_mpc_floor(tracking, floor_scenarios)
-    throughput = []
-    if scenarios > 0:
-        with phase(f"bench: {scenarios} scenarios x {len(SCENARIO_CONTROLLERS)}", enabled=progress):
-            throughput = time_scenarios(scenarios, scenario_jobs)
+    floor = _mpc_floor(duration, floor_scenarios, progress) if mpc_floor else []
+    throughput = _scenario_throughput(scenarios, scenario_jobs, progress) if scenarios > 0 else []
     return {
         "tool": TOOL,
         "version": REPORT_VERSION,
@@ -153,6 +141,39 @@ def run_benchmark(
             "load_average_start": load_start,
         },
     }
+
+
+def _check_counts(
+    repeats: int, calls: int, scenarios: int, floor_scenarios: int, scenario_jobs: int | None
+) -> None:
+    """:func:`run_benchmark`'s counts checked in its order (:class:`ParameterError`, one
+    line naming the count and its range); ``scenario_jobs`` is named ``jobs``, as the
+    command line's flag."""
+    check_int_at_least("repeats", repeats, 1, MAX_REPEATS)
+    check_int_at_least("calls", calls, 1, MAX_CALLS)
+    check_int_at_least("scenarios", scenarios, 0, MAX_SCENARIOS)
+    check_int_at_least("floor_scenarios", floor_scenarios, 0, MAX_SCENARIOS)
+    if scenario_jobs is not None:
+        check_int_at_least("jobs", scenario_jobs, 1, MAX_JOBS)
+
+
+def _mpc_floor(duration: float, floor_scenarios: int, progress: bool) -> list[dict[str, Any]]:
+    """The report's ``mpc_floor`` rows: the ``mpc`` step against its HPIPM solve on the
+    :data:`FLOOR_TRACKING` trajectories tracked for ``duration`` (s) and the first
+    ``floor_scenarios`` scenarios (:func:`measure_mpc_floor`)."""
+    with phase("bench: the mpc step against its HPIPM solve", enabled=progress):
+        tracking = [(name, duration) for name, _ in FLOOR_TRACKING]
+        return measure_mpc_floor(tracking, floor_scenarios)
+
+
+def _scenario_throughput(
+    scenarios: int, scenario_jobs: int | None, progress: bool
+) -> list[dict[str, Any]]:
+    """The report's ``scenarios`` rows: simulated seconds per wall-clock second of the
+    first ``scenarios`` scenarios with each of :data:`SCENARIO_CONTROLLERS`, on
+    ``scenario_jobs`` processes (:func:`time_scenarios`)."""
+    with phase(f"bench: {scenarios} scenarios x {len(SCENARIO_CONTROLLERS)}", enabled=progress):
+        return time_scenarios(scenarios, scenario_jobs)
 
 
 def check_duration(trajectory: Any, duration: float | None) -> float:
