@@ -15,8 +15,9 @@ import io
 import os
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 from ddwmmr.outputs import write_atomic
 
@@ -122,6 +123,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     if report["failure"]:
         print(f"gui-check: {report['failure']}", file=sys.stderr)
         return 1
+    _print_measures(app, report, out)
+    return 0
+
+
+def _print_measures(app: Any, report: Mapping[str, Any], out: Path) -> None:
+    """The passed check's lines on stdout: the window's size (px), the simulation's and
+    the playback's wall times (s, from the ``report``'s perf_counter stamps), the frames
+    and redraws, and the two PNGs written into ``out``."""
     playback = report["played"] - report["simulated"]
     frames = app.frames_shown - report["frames_at_play"]
     width, height, _ = report["screen"]
@@ -136,7 +145,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         f"{report['draws']} full redraws in all"
     )
     print(f"  wrote {out / 'window_screen.png'} and {out / 'window_figure.png'}")
-    return 0
 
 
 if __name__ == "__main__":  # pragma: no cover
