@@ -31,6 +31,7 @@ from ddwmmr.cli.scenarios import main as scenarios_main
 from ddwmmr.cli.track import build_parser as track_parser
 from ddwmmr.cli.track import main as track_main
 from ddwmmr.errors import ParameterError
+from in_process import call_main
 
 MAINS = {
     "track": track_main,
@@ -67,12 +68,8 @@ def run(tool: str, args: list[str], capsys) -> tuple[int, list[str]]:
             base += [option, value]
         i += 2
     progress = {"gui": [], "track": ["--no-progress", "--no-plots"]}.get(tool, ["--no-progress"])
-    try:
-        status = MAINS[tool]([*base, *args, *progress])
-    except SystemExit as exc:  # argparse's own errors
-        status = exc.code
-    captured = capsys.readouterr()
-    return status, captured.err.strip().splitlines()
+    status, _, err = call_main(MAINS[tool], [*base, *args, *progress], capsys)
+    return status, err.strip().splitlines()
 
 
 def refused(tool: str, args: list[str], capsys, workdir: Path) -> str:
