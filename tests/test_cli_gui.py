@@ -20,18 +20,11 @@ from ddwmmr.gui import App, Settings
 from ddwmmr.gui.layout import FIGSIZE
 from ddwmmr.gui.settings import build_trajectory
 from ddwmmr.reports.plots import robot_outline
+from in_process import call_main
 
 #: Snapshot resolution of the tests (the window is 16 x 10 in): 480 x 300 px.
 DPI = "30"
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def run(argv):
-    """Exit status of the tool (argparse errors exit through SystemExit, like track)."""
-    try:
-        return main(argv)
-    except SystemExit as exit_:
-        return exit_.code
 
 
 def trajectory_files(tmp_path):
@@ -210,8 +203,7 @@ def test_options_reach_the_window_settings():
 def test_bad_input_is_one_line_and_exit_2(argv, message, tmp_path, capsys):
     path = tmp_path / "shot.png"
     dpi = [] if "--dpi" in argv else ["--dpi", DPI]  # a tool refuses an option given twice
-    status = run(["--snapshot", str(path), *dpi, *argv])
-    err = capsys.readouterr().err
+    status, _, err = call_main(main, ["--snapshot", str(path), *dpi, *argv], capsys)
     assert status == 2
     assert len(err.strip().splitlines()) == 1 and message in err, err
     assert not path.exists() and not list(tmp_path.iterdir())
@@ -226,9 +218,10 @@ def test_the_integrator_is_only_refused_when_given():
 
 def test_export_with_snapshot_is_refused(tmp_path, capsys):
     path, export = tmp_path / "shot.png", tmp_path / "exports"
-    status = run(["--snapshot", str(path), "--dpi", DPI, "--export", str(export)])
+    argv = ["--snapshot", str(path), "--dpi", DPI, "--export", str(export)]
+    status, _, err = call_main(main, argv, capsys)
     assert status == 2
-    assert capsys.readouterr().err == (
+    assert err == (
         "error: export: --export cannot be combined with --snapshot (it sets the folder of "
         "the window's Export buttons; a snapshot saves only the image)\n"
     )
@@ -251,9 +244,10 @@ def test_geometry_places_a_sampled_trajectory():
 def test_geometry_a_sampled_trajectory_cannot_take_is_refused(tmp_path, capsys):
     flat = tmp_path / "flat.csv"
     flat.write_text("t,x,y\n0,0.0,1.0\n1,0.5,1.0\n2,1.0,1.0\n")  # y never changes
-    status = run(["--snapshot", str(tmp_path / "shot.png"), "--traj", str(flat), "--b", "0.5"])
+    argv = ["--snapshot", str(tmp_path / "shot.png"), "--traj", str(flat), "--b", "0.5"]
+    status, _, err = call_main(main, argv, capsys)
     assert status == 2
-    assert capsys.readouterr().err == (
+    assert err == (
         f"error: b: {flat} does not move along y, so it has no b to change (leave b at its "
         "own value, 0)\n"
     )
@@ -261,8 +255,9 @@ def test_geometry_a_sampled_trajectory_cannot_take_is_refused(tmp_path, capsys):
 
 
 def test_help_states_the_defaults(capsys):
-    assert run(["--help"]) == 0
-    text = " ".join(capsys.readouterr().out.split())
+    status, out, _ = call_main(main, ["--help"], capsys)
+    assert status == 0
+    text = " ".join(out.split())
     for words in (
         "--compare METHOD method of slot B, shown side by side with A (default: none",
         "--plant {kinematic,thesis,mujoco} what the commands drive (default kinematic)",
@@ -284,8 +279,9 @@ def test_help_states_the_defaults(capsys):
     ],
 )
 def test_help_says_what_each_geometry_value_is_and_its_range(capsys, name, words, inside, outside):
-    assert run(["--help"]) == 0
-    assert words in " ".join(capsys.readouterr().out.split())
+    status, out, _ = call_main(main, ["--help"], capsys)
+    assert status == 0
+    assert words in " ".join(out.split())
     gui_settings.check_geometry(name, inside)  # the range the help states is the checked one
     with pytest.raises(ParameterError, match=rf"^{name} must be"):
         gui_settings.check_geometry(name, outside)

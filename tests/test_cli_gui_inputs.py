@@ -4,8 +4,6 @@ exit status 2, the user's files untouched and nothing created."""
 
 import errno
 import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -17,19 +15,11 @@ from ddwmmr.cli import gui as cli
 from ddwmmr.cli.gui import DPI_RANGE, check_dpi, main
 from ddwmmr.errors import ParameterError
 from ddwmmr.gui.paths import SNAPSHOT_FORMATS, check_export_root, check_snapshot_path
+from in_process import call_main
 
-ROOT = Path(__file__).resolve().parents[1]
 #: A fast real run: a fifth of a second, a 160 x 100 px snapshot.
 FAST = ["--duration", "0.2", "--dpi", "10"]
 USER_TEXT = b"USER\n"
-
-
-def run(argv):
-    """Exit status of the tool (argparse errors exit through SystemExit)."""
-    try:
-        return main(argv)
-    except SystemExit as exit_:
-        return exit_.code
 
 
 @pytest.fixture
@@ -48,15 +38,14 @@ def files_below(folder):
 
 def refused(argv, capsys, *fragments):
     """Run ``argv``: exit 2 and one stderr line holding every fragment; return the line."""
-    status = run(argv)
-    captured = capsys.readouterr()
-    assert status == 2, captured.err
+    status, out, err = call_main(main, argv, capsys)
+    assert status == 2, err
     # "error: ..." from the tool, "python -m ddwmmr.gui: error: ..." from argparse
-    assert captured.err.count("\n") == 1 and "error: " in captured.err, captured.err
-    assert "Traceback" not in captured.err and captured.out == ""
+    assert err.count("\n") == 1 and "error: " in err, err
+    assert "Traceback" not in err and out == ""
     for fragment in fragments:
-        assert fragment in captured.err, captured.err
-    return captured.err
+        assert fragment in err, err
+    return err
 
 
 # -- an existing file is never replaced without --force ---------------------------------
@@ -86,8 +75,9 @@ def test_force_does_not_allow_a_suffix_that_is_not_an_image(tmp_path, capsys, no
 def test_force_replaces_an_existing_image_file(tmp_path, capsys):
     user = tmp_path / "user_pic.png"
     user.write_bytes(USER_TEXT)
-    assert run(["--snapshot", str(user), "--force", *FAST]) == 0, capsys.readouterr().err
-    assert capsys.readouterr().out == f"wrote {user}\n"
+    status, out, err = call_main(main, ["--snapshot", str(user), "--force", *FAST], capsys)
+    assert status == 0, err
+    assert out == f"wrote {user}\n"
     with Image.open(user) as image:
         assert image.format == "PNG" and image.size == (160, 100)
     assert files_below(tmp_path) == ["user_pic.png"]  # no temporary file left
@@ -97,11 +87,11 @@ def test_force_replaces_an_existing_image_file(tmp_path, capsys):
 def test_a_rerun_replaces_its_own_snapshot(name, tmp_path, capsys):
     """A file a snapshot wrote carries a mark in its metadata: the rerun may replace it."""
     path = tmp_path / name
-    assert run(["--snapshot", str(path), *FAST]) == 0
-    capsys.readouterr()
+    assert call_main(main, ["--snapshot", str(path), *FAST], capsys)[0] == 0
     first = path.read_bytes()
-    assert run(["--snapshot", str(path), *FAST, "--method", "ats"]) == 0, capsys.readouterr().err
-    assert capsys.readouterr().out == f"wrote {path}\n"
+    status, out, err = call_main(main, ["--snapshot", str(path), *FAST, "--method", "ats"], capsys)
+    assert status == 0, err
+    assert out == f"wrote {path}\n"
     assert path.read_bytes() != first and files_below(tmp_path) == [name]
 
 
@@ -109,7 +99,7 @@ def test_the_snapshot_mark_is_in_the_png_metadata_and_nowhere_else(tmp_path, cap
     from ddwmmr.gui.paths import SNAPSHOT_MARK, written_by_snapshot
 
     path = tmp_path / "shot.png"
-    assert run(["--snapshot", str(path), *FAST]) == 0
+    assert call_main(main, ["--snapshot", str(path), *FAST], capsys)[0] == 0
     with Image.open(path) as image:
         assert image.info["Software"] == SNAPSHOT_MARK
     assert written_by_snapshot(path, "png")
@@ -121,14 +111,14 @@ def test_the_snapshot_mark_is_in_the_png_metadata_and_nowhere_else(tmp_path, cap
     text.write_text(SNAPSHOT_MARK)
     assert not written_by_snapshot(text, "png")
     jpeg = tmp_path / "shot.jpg"
-    assert run(["--snapshot", str(jpeg), *FAST]) == 0
-    capsys.readouterr()
+    assert call_main(main, ["--snapshot", str(jpeg), *FAST], capsys)[0] == 0
     refused(["--snapshot", str(jpeg), *FAST], capsys, "a .jpg file cannot show", "--force")
 
 
 def test_the_suffix_picks_the_format_and_missing_folders_are_made(tmp_path, capsys):
     path = tmp_path / "new" / "sub" / "gui.SVG"
-    assert run(["--snapshot", str(path), *FAST]) == 0, capsys.readouterr().err
+    status, _, err = call_main(main, ["--snapshot", str(path), *FAST], capsys)
+    assert status == 0, err
     assert path.read_bytes().lstrip().startswith(b"<?xml") and b"<svg" in path.read_bytes()
     assert files_below(tmp_path) == ["new", "new/sub", "new/sub/gui.SVG"]
 
@@ -156,8 +146,8 @@ def test_a_failed_write_names_the_snapshot_and_leaves_nothing(tmp_path, capsys, 
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(target.parent / ".x.tmp"))
 
     monkeypatch.setattr(cli, "write_atomic", disk_full)
-    assert run(["--snapshot", str(path), *FAST]) == 1
-    err = capsys.readouterr().err
+    status, _, err = call_main(main, ["--snapshot", str(path), *FAST], capsys)
+    assert status == 1
     assert err == f"error: snapshot: cannot write {path} ({os.strerror(errno.ENOSPC)})\n"
     assert files_below(tmp_path) == []  # the folder made for it is gone too
 
@@ -304,23 +294,17 @@ def test_the_path_checks_accept_what_can_be_written(tmp_path):
     assert files_below(tmp_path) == ["x.png"]  # the writability probe left nothing
 
 
-# -- the audit's command, as a process ----------------------------------------------------
-def test_the_audit_command_keeps_the_users_file(tmp_path):
-    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "MPLBACKEND")}
+# -- the audit's command: a name relative to the working folder ---------------------------
+# (tests/test_cli_gui.py runs the tool as a real process, a refusal included)
+def test_the_audit_command_keeps_the_users_file(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
     for name in ("user_notes.txt", "user_pic.png"):
         user = tmp_path / name
         user.write_bytes(USER_TEXT)
-        done = subprocess.run(
-            [sys.executable, "-m", "ddwmmr.gui", "--duration", "1", "--snapshot", name],
-            capture_output=True,
-            text=True,
-            env=env,
-            cwd=tmp_path,
-            timeout=300,
-        )
-        assert done.returncode == 2, done.stderr
-        assert done.stderr.count("\n") == 1 and done.stderr.startswith(f"error: snapshot: {name}")
-        assert "Traceback" not in done.stderr and done.stdout == ""
+        status, out, err = call_main(main, ["--duration", "1", "--snapshot", name], capsys)
+        assert status == 2, err
+        assert err.count("\n") == 1 and err.startswith(f"error: snapshot: {name}")
+        assert "Traceback" not in err and out == ""
         assert user.read_bytes() == USER_TEXT
     assert files_below(tmp_path) == ["user_notes.txt", "user_pic.png"]
 
