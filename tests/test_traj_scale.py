@@ -20,6 +20,7 @@ from ddwmmr.cli import compare as compare_cli
 from ddwmmr.cli import track as track_cli
 from ddwmmr.errors import ParameterError
 from ddwmmr.trajectories.base import sampler
+from in_process import call_main
 from scaled_robots import scaled_robot
 
 LENGTH_KEYS = ("rms_position_error_m", "max_position_error_m", "final_position_error_m")
@@ -174,11 +175,7 @@ def test_track_scale_one_is_the_run_without_it(tmp_path, capsys):
 def test_a_bad_traj_scale_is_one_line_and_status_2(tool, value, message, tmp_path, capsys):
     argv = ["--traj-scale", value, "--out", str(tmp_path / "out")]
     argv += ["--method", "ats", "--traj", "ellipse"] if tool is track_cli else ["--methods", "ats"]
-    try:
-        status = tool.main(argv)
-    except SystemExit as exit_:  # argparse's refusal
-        status = exit_.code
-    err = capsys.readouterr().err
+    status, _, err = call_main(tool.main, argv, capsys)
     assert status == 2
     assert err.count("\n") == 1 and message in err and "Traceback" not in err
 
