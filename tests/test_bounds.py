@@ -35,7 +35,9 @@ HEAVY = Robot().with_payload(3.0)
 DOCS_BOUNDS = Path(__file__).resolve().parents[1] / "docs" / "bounds"
 #: The thesis robot's wheels: radius (m), half-track (m), top wheel speed (rad/s).
 WHEELS = {"wheel_radius": 0.0975, "half_track": 0.175, "wheel_speed": 15.0}
-#: A light multistart for tests: the 32 direction patterns on a coarse grid, one refined.
+#: A light multistart for tests: the 32 direction patterns on a coarse grid, one refined,
+#: no plan-following step 5 (its mpc runs are most of the time; on the tasks below it beats
+#: no certified time, and test_the_mpc_following_the_best_found_is_a_candidate_too checks it).
 LIGHT = Settings(
     coarse=5,
     fine=12,
@@ -47,7 +49,7 @@ LIGHT = Settings(
     arm_top=0,
     continuation_top=0,
     controllers=(),
-    guided=(("mpc-plan-arrive", ()),),
+    guided=(),
 )
 
 
@@ -243,14 +245,14 @@ def test_lag_at_weight_0_is_the_fastest_drive_between_stops(path):
     assert lags.free_excess > 0.0
 
 
-def _least_cost_drive(path, weight, free_end, steps=120):
-    """``min (1 - weight) T + weight int |F| dt / (2 F_w)`` over drives of ``path`` from
-    rest (to rest unless ``free_end``), by linear programmes over piecewise-constant
-    forces at durations ``T`` in 0.05 s steps: a second formulation, from above (its
-    forces are a subset of all forces)."""
+def _least_force_drives(path, free_end, steps=120):
+    """``(T, int |F| dt / (2 F_w))`` of the least-force drives of ``path`` (m) from rest (to
+    rest unless ``free_end``) at durations ``T`` (s) in 0.05 s steps, by linear programmes
+    over piecewise-constant forces (the durations where none is feasible left out). The
+    force integral does not depend on the weight, so one set serves every weight."""
     d = sym.ThesisDynamics.from_robot(HEAVY)
     tau, force = d.mass / d.c1, 2.0 * d.force_limit
-    best = math.inf
+    drives = []
     for duration in np.arange(path / d.top_speed + 0.05, path / d.top_speed + 4.0, 0.05):
         dt = duration / steps
         decay = math.exp(-dt / tau)
@@ -275,21 +277,32 @@ def _least_cost_drive(path, weight, free_end, steps=120):
             np.full(2 * steps, dt / force), A_ub=a_ub, b_ub=b_ub, A_eq=np.array(a_eq), b_eq=b_eq
         )
         if result.status == 0:
-            best = min(best, (1.0 - weight) * duration + weight * result.fun)
-    return best - path / d.top_speed
+            drives.append((duration, result.fun))
+    return drives
 
 
-@pytest.mark.parametrize("weight", [0.4, 0.6])
-def test_lags_match_a_linear_programme_of_the_drive(weight):
+def _least_cost_drive(path, weight, drives):
+    """``min (1 - weight) T + weight int |F| dt / (2 F_w)`` over ``drives``
+    (:func:`_least_force_drives` of ``path``), less ``path / v_top``: a second formulation
+    of the lag, from above (its forces are a subset of all forces)."""
+    best = min((1.0 - weight) * duration + weight * used for duration, used in drives)
+    return best - path / sym.ThesisDynamics.from_robot(HEAVY).top_speed
+
+
+def test_lags_match_a_linear_programme_of_the_drive():
     """The tabulated lags (accelerate, coast, brake) against linear programmes over all
-    piecewise-constant forces: never above them, and within their grid's slack."""
-    lags = Lags.from_robot(HEAVY, weight)
+    piecewise-constant forces: never above them, and within their grid's slack (weights
+    0.4 and 0.6, on the same programmes)."""
     for path in (0.5, 2.5):
-        rest = _least_cost_drive(path, weight, free_end=False)
-        free = _least_cost_drive(path, weight, free_end=True)
-        assert float(lags.at_rest(path)) <= rest + 1e-6
-        assert rest - float(lags.at_rest(path)) < 0.06
-        assert float(lags.at_rest(path)) - lags.free_excess <= free + 1e-6
+        to_rest = _least_force_drives(path, free_end=False)
+        to_free = _least_force_drives(path, free_end=True)
+        for weight in (0.4, 0.6):
+            lags = Lags.from_robot(HEAVY, weight)
+            rest = _least_cost_drive(path, weight, to_rest)
+            free = _least_cost_drive(path, weight, to_free)
+            assert float(lags.at_rest(path)) <= rest + 1e-6
+            assert rest - float(lags.at_rest(path)) < 0.06
+            assert float(lags.at_rest(path)) - lags.free_excess <= free + 1e-6
 
 
 def test_pricing_the_stops_raises_the_bound_of_a_task_that_turns_back():
