@@ -353,21 +353,10 @@ class MPCController:
             problem.design_terminal((float(q[3]), float(q[4])))
         x0 = self._state(q, base_velocity)
         references = self._references(problem, t, pose_d, velocity_d, following)
-        # the plan that went through the reached target already plans the next leg
-        handover = new_target and self._warm_mode == "reach2" and self._following == target
-        cold = self._warm is None or self._warm_mode != mode or new_target
-        if cold:
-            self._stall.fresh_plan()
-        elif stuck or frozen:
-            cold = True
-            self.restarts += 1
-        source = self._problem("reach2").ocp if handover and self._warm is not None else None
-        leg = self._plan_leg(target) if reach else None
-        if leg is not None and cold:  # the offline plan's leg starts it, not the hand-over
-            source = None
-        warm = self._warm if not cold or source is not None else None
-        start = None if leg is None or not cold else problem.planned_start(x0, self._plan, leg)
-        arrival = None if leg is None else problem.planned_arrival(self._plan, leg)
+        cold = self._cold_start(mode, new_target, restart=stuck or frozen)
+        warm, source, start, arrival = self._solve_starts(
+            problem, x0, target, reach, new_target, cold
+        )
         try:
             w, iterations = problem.solve(
                 t, x0, references, self._u_prev, warm, self._warm_time, source, start, arrival
@@ -376,6 +365,64 @@ class MPCController:
             return self._fallback_command(t, q, pose_d, velocity_d, x0, str(failure))
         self._warm, self._warm_mode, self._warm_time = w, mode, t
         self._target, self._following = target, following
+        self._watch_plan(t, problem, w, mode, reach, new_target, cold)
+        u = problem.first_input(w)
+        braking = self._should_brake(problem, w, x0)
+        if braking:
+            self.brakes += 1
+            u = self._braking_input(q, x0)
+        return self._output(problem, q, x0, u, w, iterations, problem.max_slack(w), braking)
+
+    # -- pieces ---------------------------------------------------------------------------
+    def _cold_start(self, mode: str, new_target: bool, *, restart: bool) -> bool:
+        """Whether this step's solve starts cold: no previous plan, another ``mode``, a
+        ``new_target`` (the stall watch starts afresh), or a ``restart`` (stuck or frozen
+        plan, counted in ``restarts``)."""
+        cold = self._warm is None or self._warm_mode != mode or new_target
+        if cold:
+            self._stall.fresh_plan()
+        elif restart:
+            cold = True
+            self.restarts += 1
+        return cold
+
+    def _solve_starts(
+        self,
+        problem: Problem,
+        x0: np.ndarray,
+        target: tuple[float, float],
+        reach: bool,
+        new_target: bool,
+        cold: bool,
+    ) -> tuple[Any, Any, tuple[np.ndarray, float] | None, np.ndarray | None]:
+        """``(warm, source, start, arrival)`` of :meth:`Problem.solve`: the previous plan
+        to shift (None when ``cold``, unless handed over), the two-target OCP handing its
+        plan through the reached ``target`` (m, world) over to the next leg, and the
+        offline plan's cold start from ``x0`` and arrival state on the leg ending at
+        ``target`` (a plan's leg replaces the hand-over)."""
+        # the plan that went through the reached target already plans the next leg
+        handover = new_target and self._warm_mode == "reach2" and self._following == target
+        source = self._problem("reach2").ocp if handover and self._warm is not None else None
+        leg = self._plan_leg(target) if reach else None
+        if leg is not None and cold:  # the offline plan's leg starts it, not the hand-over
+            source = None
+        warm = self._warm if not cold or source is not None else None
+        start = None if leg is None or not cold else problem.planned_start(x0, self._plan, leg)
+        arrival = None if leg is None else problem.planned_arrival(self._plan, leg)
+        return warm, source, start, arrival
+
+    def _watch_plan(
+        self,
+        t: float,
+        problem: Problem,
+        w: np.ndarray,
+        mode: str,
+        reach: bool,
+        new_target: bool,
+        cold: bool,
+    ) -> None:
+        """The stall watch told of plan ``w`` solved at t (s): whether it arrives at the
+        shortest horizon, its horizon (s) and whether that is free to shrink, its slack."""
         # "there at the shortest horizon" (within a millisecond: the QP's tolerance)
         shortest = problem.ocp.config.min_horizon + 1e-3
         horizon = problem.ocp.horizon_of(w)
@@ -384,19 +431,18 @@ class MPCController:
         self._stall.plan_horizon(t, horizon, free, cold)
         slack = problem.ocp.max_slack(w)
         self._stall.plan_slack(t, slack)
-        u = problem.first_input(w)
-        braking = self.brake_slack is not None and should_brake(
+
+    def _should_brake(self, problem: Problem, w: np.ndarray, x0: np.ndarray) -> bool:
+        """Whether to brake instead of sending plan ``w``'s first input: braking is on,
+        the plan's stability rows need more slack than ``brake_slack`` (m) and the robot
+        at ``x0`` moves (:func:`~ddwmmr.mpc.braking.should_brake`)."""
+        return self.brake_slack is not None and should_brake(
             self.brake_slack,
             problem.max_stability_slack(w),
             (float(x0[5]), float(x0[6])),
             self._predicted_rates,
         )
-        if braking:
-            self.brakes += 1
-            u = self._braking_input(q, x0)
-        return self._output(problem, q, x0, u, w, iterations, problem.max_slack(w), braking)
 
-    # -- pieces ---------------------------------------------------------------------------
     def _state(self, q: np.ndarray, base_velocity: tuple[float, float] | None) -> np.ndarray:
         if self.model_name == "kinematic":
             return q.copy()
