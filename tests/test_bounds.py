@@ -51,6 +51,8 @@ LIGHT = Settings(
     controllers=(),
     guided=(),
 )
+#: Two short legs, the second turning away: a controller run of about 1.6 s.
+SHORT_TASK = ((0.9, 0.4), (1.4, -0.3))
 
 
 # -- Balkcom and Mason ------------------------------------------------------------------
@@ -441,9 +443,9 @@ def test_a_controller_run_that_replays_faster_becomes_the_best_known():
     """The run's recorded forces and joint rates, replayed open loop at the run's own step,
     reach every waypoint with S held at the run's time: it beats no certified solution and
     a slower one, not a faster one; a run cut short of the last waypoint never counts."""
-    scenario = generate(2, 0)[1]
+    scenario = Scenario(0, SHORT_TASK)
     run = controller_guess(scenario, "mpc")
-    assert run is not None
+    assert run is not None and len(run.arrivals) == 2
     settings = Settings()
     found = _faster_run(HEAVY, {"mpc": run}, scenario.waypoints, settings, None)
     assert found is not None and found[0].start == "run-mpc" and found[1].ok
@@ -452,7 +454,8 @@ def test_a_controller_run_that_replays_faster_becomes_the_best_known():
     assert _faster_run(HEAVY, {"mpc": run}, scenario.waypoints, settings, slower) is not slower
     faster = (found[0], dataclasses.replace(found[1], time_s=found[1].time_s - 1.0))
     assert _faster_run(HEAVY, {"mpc": run}, scenario.waypoints, settings, faster) is faster
-    short = len(run.times) - 100  # one second before the last waypoint
+    short = len(run.times) - 30  # 0.3 s before the last waypoint, after the first
+    assert run.arrivals[0] < run.times[short - 1]
     cut = dataclasses.replace(
         run, times=run.times[:short], states=run.states[:short], inputs=run.inputs[: short - 1]
     )
@@ -462,8 +465,9 @@ def test_a_controller_run_that_replays_faster_becomes_the_best_known():
 def test_the_mpc_following_the_best_found_is_a_candidate_too():
     """Step 5: the mpc (lookahead) runs with the best found as its plan (its cold starts
     alone, and arriving as it does; as they are and with the smaller margin), recorded
-    and checked like the controllers' runs; none without ``guided``."""
-    scenario = Scenario(0, ((2.0, 1.5), (-0.5, 2.0)))
+    and checked like the controllers' runs; none without ``guided``. Two short legs: the
+    first leg's steps plan through the second (the mpc's costly lookahead problem)."""
+    scenario = Scenario(0, SHORT_TASK)
     problem = MinimumTimeProblem(
         HEAVY, scenario.waypoints, start_state(HEAVY), intervals_per_leg=12
     )
