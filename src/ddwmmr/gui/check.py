@@ -38,7 +38,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         print("gui-check: no DISPLAY; run it under xvfb-run (make gui-check)", file=sys.stderr)
         return 1
     import matplotlib.pyplot as plt
-    from PIL import ImageGrab, ImageStat
 
     from ddwmmr.gui.app import App
     from ddwmmr.gui.layout import SPEEDS, desktop_figure
@@ -47,58 +46,101 @@ def main(argv: Sequence[str] | None = None) -> int:
     figure = desktop_figure()
     app = App(figure, Settings(methods=CHECK_METHODS, duration=CHECK_DURATION_S), interactive=True)
     app.speed_slider.set_val(SPEEDS.index(8.0))
-    canvas = figure.canvas
-    widget = canvas.get_tk_widget()
-    window = canvas.manager.window
-    report: dict[str, object] = {"draws": 0, "failure": "timed out"}
-    canvas.mpl_connect("draw_event", lambda _e: report.__setitem__("draws", report["draws"] + 1))
-    started = time.perf_counter()
+    drive = _WindowDrive(app, figure, out)
+    drive.window.after(800, drive.type_duration)
+    plt.show()
+    report = drive.report
+    if not report["failure"] and report.get("typed") != float(TYPED_DURATION):
+        report["failure"] = f"typing {TYPED_DURATION} into duration gave {report.get('typed')}"
+    if report["failure"]:
+        print(f"gui-check: {report['failure']}", file=sys.stderr)
+        return 1
+    _print_measures(app, report, out)
+    return 0
 
-    def click(ax) -> None:
+
+class _WindowDrive:
+    """Drives ``app``'s real Tk window (``figure``'s) through a chain of Tk timers: type
+    :data:`TYPED_DURATION` into the duration field, click Run, watch the run be simulated
+    and played back, then save the window's screenshot and its figure into ``out`` and
+    close it. ``report`` collects what happened: ``draws`` (full redraws), ``typed`` (s),
+    the perf_counter stamps (s) ``clicked``, ``simulated``, ``played``, ``frames_at_play``,
+    ``screen`` (width px, height px, grey-level spread) and ``failure`` ("" when passed;
+    "timed out" until then)."""
+
+    def __init__(self, app: Any, figure: Any, out: Path) -> None:
+        self.app, self.figure, self.out = app, figure, out
+        self.canvas = canvas = figure.canvas
+        self.widget = canvas.get_tk_widget()
+        self.window = canvas.manager.window
+        self.report: dict[str, Any] = {"draws": 0, "failure": "timed out"}
+        canvas.mpl_connect("draw_event", self._count_draw)
+        self.started = time.perf_counter()
+
+    def _count_draw(self, _event: Any) -> None:
+        """One more full redraw of the canvas."""
+        self.report["draws"] += 1
+
+    def click(self, ax: Any) -> None:
         """A real Tk mouse click at the centre of ``ax`` (Tk's y axis points down)."""
         x0, y0, x1, y1 = ax.get_window_extent().extents
-        x, y = int((x0 + x1) / 2), int(canvas.figure.bbox.height - (y0 + y1) / 2)
-        widget.event_generate("<Motion>", x=x, y=y, warp=False)
-        widget.event_generate("<ButtonPress-1>", x=x, y=y)
-        widget.event_generate("<ButtonRelease-1>", x=x, y=y)
+        x, y = int((x0 + x1) / 2), int(self.canvas.figure.bbox.height - (y0 + y1) / 2)
+        self.widget.event_generate("<Motion>", x=x, y=y, warp=False)
+        self.widget.event_generate("<ButtonPress-1>", x=x, y=y)
+        self.widget.event_generate("<ButtonRelease-1>", x=x, y=y)
 
-    def type_duration() -> None:
-        # Click into the duration field, replace its text key by key, press Enter. Tk drops
-        # the events sent to a canvas not mapped yet (later than 0.8 s on a loaded machine).
-        if not widget.winfo_viewable() and time.perf_counter() - started < TIMEOUT_S:
-            window.after(100, type_duration)
+    def type_duration(self) -> None:
+        """Click into the duration field, replace its text key by key, press Enter; then
+        Run 0.3 s later."""
+        widget, window = self.widget, self.window
+        # Tk drops the events sent to a canvas not mapped yet (later than 0.8 s on a loaded
+        # machine): wait for it, up to TIMEOUT_S.
+        if not widget.winfo_viewable() and time.perf_counter() - self.started < TIMEOUT_S:
+            window.after(100, self.type_duration)
             return
         widget.focus_force()
-        click(app.duration_field.ax)
-        for _ in app.duration_field.text:
+        self.click(self.app.duration_field.ax)
+        for _ in self.app.duration_field.text:
             widget.event_generate("<KeyPress>", keysym="BackSpace")
         for key in TYPED_DURATION:
             widget.event_generate("<KeyPress>", keysym="period" if key == "." else key)
         widget.event_generate("<KeyPress>", keysym="Return")
-        report["typed"] = app.settings.duration
-        window.after(300, click_run)
+        self.report["typed"] = self.app.settings.duration
+        window.after(300, self.click_run)
 
-    def click_run() -> None:
-        click(app.transport["run"].ax)
-        report["clicked"] = time.perf_counter()
-        window.after(200, watch)
+    def click_run(self) -> None:
+        """Click Run; watch 0.2 s later."""
+        self.click(self.app.transport["run"].ax)
+        self.report["clicked"] = time.perf_counter()
+        self.window.after(200, self.watch)
 
-    def watch() -> None:
+    def watch(self) -> None:
+        """Every 0.1 s: stamp the end of the simulation and of the playback (then finish
+        0.3 s later), or give up after TIMEOUT_S (s) since the start."""
+        import matplotlib.pyplot as plt
+
+        app, report = self.app, self.report
         now = time.perf_counter()
         if app.results is not None and "simulated" not in report:
             report["simulated"] = now
             report["frames_at_play"] = app.frames_shown
         if "simulated" in report and not app.playing:
             report["played"] = now
-            window.after(300, finish)
+            self.window.after(300, self.finish)
             return
-        if now - started > TIMEOUT_S:
+        if now - self.started > TIMEOUT_S:
             report["failure"] = f"no finished playback after {TIMEOUT_S:.0f} s ({app.message})"
-            plt.close(figure)
+            plt.close(self.figure)
             return
-        window.after(100, watch)
+        self.window.after(100, self.watch)
 
-    def finish() -> None:
+    def finish(self) -> None:
+        """Save the window's screenshot (an X grab of its screen area) and the figure as
+        PNGs into ``out``, pass unless the screenshot is blank, close the window."""
+        import matplotlib.pyplot as plt
+        from PIL import ImageGrab, ImageStat
+
+        window, out = self.window, self.out
         window.update()
         left, top = window.winfo_rootx(), window.winfo_rooty()
         width, height = window.winfo_width(), window.winfo_height()
@@ -109,22 +151,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         shot.save(buffer, format="PNG")
         write_atomic(out / "window_screen.png", buffer.getvalue())
         figure_buffer = io.BytesIO()
-        figure.savefig(figure_buffer, format="png")
+        self.figure.savefig(figure_buffer, format="png")
         write_atomic(out / "window_figure.png", figure_buffer.getvalue())
         spread = ImageStat.Stat(shot.convert("L")).stddev[0]  # 0 for a blank screen
-        report["screen"] = (width, height, spread)
-        report["failure"] = "" if spread > 5 else "the screenshot is blank"
-        plt.close(figure)
-
-    window.after(800, type_duration)
-    plt.show()
-    if not report["failure"] and report.get("typed") != float(TYPED_DURATION):
-        report["failure"] = f"typing {TYPED_DURATION} into duration gave {report.get('typed')}"
-    if report["failure"]:
-        print(f"gui-check: {report['failure']}", file=sys.stderr)
-        return 1
-    _print_measures(app, report, out)
-    return 0
+        self.report["screen"] = (width, height, spread)
+        self.report["failure"] = "" if spread > 5 else "the screenshot is blank"
+        plt.close(self.figure)
 
 
 def _print_measures(app: Any, report: Mapping[str, Any], out: Path) -> None:
