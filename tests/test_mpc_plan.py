@@ -17,9 +17,10 @@ from ddwmmr import ParameterError, Robot, make_controller
 from ddwmmr.cli.scenarios import main as scenarios_main
 from ddwmmr.commands import traits_of
 from ddwmmr.controllers.base import WaypointRun
+from ddwmmr.mpc.cache import shared_ocp
 from ddwmmr.mpc.controller import MPCController
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, MinimumTimeProblem, plan_path
-from ddwmmr.mpc.ocp import OCPConfig
+from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP
 from ddwmmr.plants import ThesisPlant
 from ddwmmr.scenarios import RunConfig, Scenario, generate, run_scenario
 from one_line import one_line
@@ -276,10 +277,17 @@ def test_the_arrival_term_is_the_weighted_state_error_at_the_first_legs_end(tmp_
     )
     assert on - off == pytest.approx(0.5 * 3.0 * error @ error, rel=1e-9)
     # without the weight the OCP has neither the term nor its parameters
-    plain = two_leg_controller(tmp_path, turn=0.3, plan_weight=0.0)
+    plain = two_leg_ocp(two_leg_controller(tmp_path, turn=0.3, plan_weight=0.0))
     unplanned = MPCController(ROBOT, model="thesis", lookahead=True, route=ROUTE)
-    assert plain._problem("reach2").ocp.np == unplanned._problem("reach2").ocp.np
-    assert plain._problem("reach2").ocp.arrival_size == 0
+    assert plain.np == two_leg_ocp(unplanned).np
+    assert plain.arrival_size == 0
+
+
+def two_leg_ocp(controller: MPCController) -> ShootingOCP:
+    """The OCP of ``controller``'s two-leg plans (its ``reach2`` problem's), without the
+    solvers its problem would build on it."""
+    config = controller._config("reach2")
+    return shared_ocp(controller._unit_robot, controller._choice, controller._unit_model, config)
 
 
 def test_plan_weight_must_be_nonnegative():
