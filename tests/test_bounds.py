@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import csv
 import dataclasses
+import functools
 import json
 import math
 import re
@@ -55,20 +56,25 @@ LIGHT = Settings(
 SHORT_TASK = ((0.9, 0.4), (1.4, -0.3))
 
 
+#: diffdrive.optimal_time, each pose pair solved once per process (its grid of two-straight
+#: headings takes most of a second; two tests ask for 2 m straight ahead).
+optimal_time = functools.lru_cache(maxsize=None)(diffdrive.optimal_time)
+
+
 # -- Balkcom and Mason ------------------------------------------------------------------
 def test_closed_form_of_the_one_action_and_turn_drive_turn_families():
     r, b, u = WHEELS.values()
     speed, rate = r * u, r * u / b
     # straight ahead: one straight segment at full wheel speed
-    assert diffdrive.optimal_time((0, 0, 0), (2.0, 0, 0), **WHEELS) == pytest.approx(2.0 / speed)
+    assert optimal_time((0, 0, 0), (2.0, 0, 0), **WHEELS) == pytest.approx(2.0 / speed)
     # a turn in place
-    turn = diffdrive.optimal_time((0, 0, 0), (0, 0, 1.2), **WHEELS)
+    turn = optimal_time((0, 0, 0), (0, 0, 1.2), **WHEELS)
     assert turn == pytest.approx(1.2 / rate)
     # backwards is as fast as forwards
-    back = diffdrive.optimal_time((0, 0, 0), (-1.5, 0, 0), **WHEELS)
+    back = optimal_time((0, 0, 0), (-1.5, 0, 0), **WHEELS)
     assert back == pytest.approx(1.5 / speed)
     # far goal at 45 degrees, same heading: turn, drive, turn back
-    far = diffdrive.optimal_time((0, 0, 0), (3.0, 3.0, 0), **WHEELS)
+    far = optimal_time((0, 0, 0), (3.0, 3.0, 0), **WHEELS)
     assert far == pytest.approx(math.hypot(3, 3) / speed + 0.5 * math.pi / rate)
 
 
@@ -85,7 +91,7 @@ def test_closed_form_of_the_one_action_and_turn_drive_turn_families():
 def test_the_ocp_finds_balkcom_and_masons_minimum_time(goal):
     """The transcription the best-known times come from, on the one problem whose optimum
     is known in closed form: within 1 % (the last two goals need two straight segments)."""
-    exact = diffdrive.optimal_time((0.0, 0.0, 0.0), goal, **WHEELS)
+    exact = optimal_time((0.0, 0.0, 0.0), goal, **WHEELS)
     found = diffdrive.ocp_time((0.0, 0.0, 0.0), goal, **WHEELS)
     assert found == pytest.approx(exact, rel=0.01)
 
@@ -99,7 +105,7 @@ def test_two_straight_segments_beat_one_where_the_goal_is_beside_the_heading():
         math.hypot(*goal[:2]) + circular(0.0, h) + circular(h, goal[2])
         for h in (line, line + math.pi)
     )
-    best = diffdrive.optimal_time((0, 0, 0), goal)
+    best = optimal_time((0, 0, 0), goal)
     assert one / best == pytest.approx(1.166, abs=0.002)
 
 
