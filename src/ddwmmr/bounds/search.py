@@ -184,7 +184,33 @@ def best_known(
             )
         return built[key]
 
-    coarse = problem(s.coarse)
+    screened, runs, starts = _screened(robot, scenario, waypoints, start, problem(s.coarse), s)
+    say(f"screened {len(screened)} of {starts} starts")
+    refined = _refined(problem(s.fine), screened, s)
+    best_refined = min((r.total for r in refined.values()), default=math.inf)
+    say(f"refined {len(refined)}: best {best_refined:.3f} s")
+
+    found, grid = certify(robot, refined, waypoints, s, problem, say)
+    if found is not None:
+        tight = problem(grid, s.tight_margin_s, s.tight_margin_m)
+        found = _tightened(robot, found, tight, waypoints, s, say)
+    found = _faster_run(robot, runs, waypoints, s, found)
+    found = follow_plan(robot, scenario, found, s, say)
+    return _result(found, starts, screened, refined, began)
+
+
+def _screened(
+    robot: Robot,
+    scenario,
+    waypoints: list,
+    start: np.ndarray,
+    coarse: MinimumTimeProblem,
+    s: Settings,
+) -> tuple[dict[str, MinimumTime], dict[str, Guess], int]:
+    """Step 1 of :func:`best_known` on the ``coarse`` problem: the successful solves by
+    start label, the controllers' runs that were starts (by controller name) and the
+    number of starts tried. ``start`` is the robot's state at rest at the origin
+    (:func:`start_state`), ``waypoints`` the scenario's (x, y) in m."""
     screened: dict[str, MinimumTime] = {}
 
     def screen(label: str, guess: Guess, lbg=None, ubg=None) -> None:
@@ -221,9 +247,15 @@ def best_known(
             screen(f"continued-{label}", relaxed.as_guess())
     starts = len(patterns) + len(other_elbow) + min(s.turn_top, len(ranked)) * len(waypoints)
     starts += min(s.arm_top, len(ranked)) + len(s.controllers) + 4 + s.continuation_top
-    say(f"screened {len(screened)} of {starts} starts")
+    return screened, runs, starts
 
-    fine = problem(s.fine)
+
+def _refined(
+    fine: MinimumTimeProblem, screened: dict[str, MinimumTime], s: Settings
+) -> dict[str, MinimumTime]:
+    """Step 2 of :func:`best_known`: the best ``s.refine`` distinct ``screened`` optima
+    and the straight-line starts (``fine-<label>``) solved on the ``fine`` problem, the
+    successful solves by label."""
     refined: dict[str, MinimumTime] = {}
     for label in _distinct(screened, s.refine):
         result = fine.solve(screened[label].as_guess(), label)
@@ -236,20 +268,39 @@ def best_known(
         result = fine.solve(fine.straight_line_guess(reverse=reverse, elbow=elbow), label)
         if result.success:
             refined[f"fine-{label}"] = result
-    best_refined = min((r.total for r in refined.values()), default=math.inf)
-    say(f"refined {len(refined)}: best {best_refined:.3f} s")
+    return refined
 
-    found, grid = certify(robot, refined, waypoints, s, problem, say)
-    if found is not None:
-        tight = problem(grid, s.tight_margin_s, s.tight_margin_m)
-        closer = tight.solve(found[0].as_guess(), found[0].start)
-        if closer.success:
-            check = replay(robot, closer, waypoints, s.stability_min, s.tolerance)
-            say(f"tighter margins: {closer.total:.3f} s, replay {check.ok} {check.time_s:.3f} s")
-            if check.ok and check.time_s < found[1].time_s:
-                found = (closer, check)
-    found = _faster_run(robot, runs, waypoints, s, found)
-    found = follow_plan(robot, scenario, found, s, say)
+
+def _tightened(
+    robot: Robot,
+    found: tuple[MinimumTime, Replay],
+    tight: MinimumTimeProblem,
+    waypoints: list,
+    s: Settings,
+    say: Callable[[str], None],
+) -> tuple[MinimumTime, Replay]:
+    """The certified ``found`` solved once more on ``tight`` (its grid, the smaller
+    margins) from itself: that solution and its replay if it replays and is faster (s),
+    else ``found``."""
+    closer = tight.solve(found[0].as_guess(), found[0].start)
+    if closer.success:
+        check = replay(robot, closer, waypoints, s.stability_min, s.tolerance)
+        say(f"tighter margins: {closer.total:.3f} s, replay {check.ok} {check.time_s:.3f} s")
+        if check.ok and check.time_s < found[1].time_s:
+            return (closer, check)
+    return found
+
+
+def _result(
+    found: tuple[MinimumTime, Replay] | None,
+    starts: int,
+    screened: dict[str, MinimumTime],
+    refined: dict[str, MinimumTime],
+    began: float,
+) -> Found:
+    """The search's :class:`Found`: the certified solution's replayed time (s) if any
+    (else inf), the spread (s) of the screened optima, and the wall time (s) since the
+    ``began`` perf_counter stamp."""
     times = [r.total for r in screened.values()]
     spread = max(times) - min(times) if times else math.nan
     base = Found(
