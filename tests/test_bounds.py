@@ -162,6 +162,23 @@ def test_turn_transform_is_the_brute_force_minimum():
     assert np.allclose(turn_transform(cost, step), brute)
 
 
+def test_the_programmes_circular_distance_is_circulars_bit_for_bit():
+    """The drive costs' faster circular distance (arcs' centres against directions from
+    atan2) gives circular's values to the last bit, at the ends of [-pi, pi], at the
+    centres and a step beside them, and where the difference wraps."""
+    from ddwmmr.bounds.lower import _circular_near
+
+    rng = np.random.default_rng(5)
+    for arcs in (2, 20, 60, 120, 144, 180, 1440):
+        centres = -math.pi + (2.0 * math.pi / arcs) * (0.5 + np.arange(arcs))
+        edges = [math.pi, -math.pi, 0.0, -0.0, np.nextafter(math.pi, 0), np.nextafter(-math.pi, 0)]
+        beside = [np.nextafter(centres, 9.0), np.nextafter(centres, -9.0), centres, -centres]
+        directions = np.concatenate([edges, *beside, rng.uniform(-math.pi, math.pi, 500)])
+        fast = _circular_near(centres, directions[:, None])
+        slow = circular(centres, directions[:, None])
+        assert np.array_equal(fast.view(np.int64), slow.view(np.int64))
+
+
 def test_lower_bound_is_below_the_analytic_time_straight_ahead():
     """3 m straight ahead, one waypoint: from rest with full force the base covers at most
     v_top (t - tau (1 - e^{-t/tau})) (tests/test_mpc.py); the bound is below that time and
