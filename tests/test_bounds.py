@@ -162,21 +162,32 @@ def test_turn_transform_is_the_brute_force_minimum():
     assert np.allclose(turn_transform(cost, step), brute)
 
 
-def test_the_programmes_circular_distance_is_circulars_bit_for_bit():
-    """The drive costs' faster circular distance (arcs' centres against directions from
-    atan2) gives circular's values to the last bit, at the ends of [-pi, pi], at the
-    centres and a step beside them, and where the difference wraps."""
-    from ddwmmr.bounds.lower import _circular_near
-
+def test_circular_is_the_remainder_formula_bit_for_bit():
+    """``circular``'s in-place wrap (offsets within (-pi, 3 pi)) gives the definition's
+    ``|remainder(a - b + pi, 2 pi) - pi|`` to the last bit: arcs' centres against
+    directions at the ends of [-pi, pi], at the centres and a step beside them, where the
+    difference wraps; and angles far apart, NaN and inf take the definition itself."""
     rng = np.random.default_rng(5)
+
+    def definition(a, b):
+        return np.abs(np.remainder(np.asarray(a) - b + math.pi, 2.0 * math.pi) - math.pi)
+
     for arcs in (2, 20, 60, 120, 144, 180, 1440):
         centres = -math.pi + (2.0 * math.pi / arcs) * (0.5 + np.arange(arcs))
         edges = [math.pi, -math.pi, 0.0, -0.0, np.nextafter(math.pi, 0), np.nextafter(-math.pi, 0)]
         beside = [np.nextafter(centres, 9.0), np.nextafter(centres, -9.0), centres, -centres]
         directions = np.concatenate([edges, *beside, rng.uniform(-math.pi, math.pi, 500)])
-        fast = _circular_near(centres, directions[:, None])
-        slow = circular(centres, directions[:, None])
-        assert np.array_equal(fast.view(np.int64), slow.view(np.int64))
+        fast = circular(centres, directions[:, None])
+        assert np.array_equal(
+            fast.view(np.int64), definition(centres, directions[:, None]).view(np.int64)
+        )
+    far = rng.uniform(-50.0, 50.0, (40, 30))
+    cases = ((far, 0.3), (far, far.T[:1].T), (np.array([np.nan, 1.0]), 0.5), (np.inf, 0.0))
+    with np.errstate(invalid="ignore"):  # remainder(inf): NaN, as the definition gives
+        for a, b in cases:
+            assert np.array_equal(circular(a, b), definition(a, b), equal_nan=True)
+    assert isinstance(circular(0.25, -3.0), np.floating)  # a scalar for scalar angles
+    assert circular(0.25, -3.0) == definition(0.25, -3.0)
 
 
 def test_lower_bound_is_below_the_analytic_time_straight_ahead():
