@@ -78,7 +78,7 @@ summary.json into --out, and prints the means. Results are cached per scenario i
 --out/cache as they come: an interrupted run started again with the same --out resumes. A
 run of some --scenarios keeps the cache of the others (of the same seed and payload), and
 its bounds.csv holds its own scenarios: --scenarios 1-100 again rebuilds the whole table
-from the cache. A scenario takes about 55 s of CPU on average, 34 s with --quick, 25 s
+from the cache. A scenario takes about 55 s of CPU on average, 34 s with --quick, 19 s
 with --lower-only (docs/mpc.md; the slowest took 6 minutes)."""
 
 EPILOG = """\
