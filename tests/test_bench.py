@@ -509,7 +509,32 @@ def test_cli_refuses_an_unusable_out_path_before_running(tmp_path, capsys, monke
 
 
 # -- scenario throughput --------------------------------------------------------------------
-def test_scenario_throughput_counts_the_simulated_time_of_every_scenario(monkeypatch):
+#: Outcomes of the scenario runs made in this process, by (scenario, config): both frozen.
+SCENARIO_OUTCOMES: dict[tuple, object] = {}
+
+
+@pytest.fixture
+def scenario_runs_once(monkeypatch):
+    """``run_scenario`` made once per (scenario, config) in this process: the throughput
+    test and the command-line test time the same first scenario with the same configs, and
+    a run's outcome depends on nothing else. The tests count and sum the calls
+    ``time_scenarios`` makes, whether run or replayed."""
+    from ddwmmr.scenarios import executors
+
+    run = executors.run_scenario
+
+    def once(scenario, config):
+        key = (scenario, config)
+        if key not in SCENARIO_OUTCOMES:
+            SCENARIO_OUTCOMES[key] = run(scenario, config)
+        return SCENARIO_OUTCOMES[key]
+
+    monkeypatch.setattr(executors, "run_scenario", once)
+
+
+def test_scenario_throughput_counts_the_simulated_time_of_every_scenario(
+    monkeypatch, scenario_runs_once
+):
     """Each controller's row sums the simulated time of every one of the scenarios, each
     run with that controller's default config: the runs time_scenarios makes are recorded
     (one run per scenario, not a second run of each) and their times summed here."""
@@ -542,7 +567,7 @@ def test_scenario_throughput_counts_the_simulated_time_of_every_scenario(monkeyp
         )
 
 
-def test_cli_times_scenarios_only_when_asked_with_a_method(tmp_path, capsys):
+def test_cli_times_scenarios_only_when_asked_with_a_method(tmp_path, capsys, scenario_runs_once):
     from ddwmmr.bench import SCENARIO_CONTROLLERS
 
     out = tmp_path / "b.json"
