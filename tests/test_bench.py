@@ -509,17 +509,30 @@ def test_cli_refuses_an_unusable_out_path_before_running(tmp_path, capsys, monke
 
 
 # -- scenario throughput --------------------------------------------------------------------
+#: Seed 0's scenarios with the shortest mpc runs, 74 and 60 (11.7 s and 12.1 s simulated,
+#: 2-3 s of CPU each; the first two take 23.8 s and 20.2 s): the batch these tests time.
+SHORT_SCENARIOS = (74, 60)
 #: Outcomes of the scenario runs made in this process, by (scenario, config): both frozen.
 SCENARIO_OUTCOMES: dict[tuple, object] = {}
 
 
 @pytest.fixture
-def scenario_runs_once(monkeypatch):
-    """``run_scenario`` made once per (scenario, config) in this process: the throughput
-    test and the command-line test time the same first scenario with the same configs, and
-    a run's outcome depends on nothing else. The tests count and sum the calls
-    ``time_scenarios`` makes, whether run or replayed."""
-    from ddwmmr.scenarios import executors
+def short_batch(monkeypatch) -> tuple[list, list[tuple[int, int]]]:
+    """``(batch, calls)``: ``generate(n, seed)`` returns the first ``n`` scenarios of
+    ``batch`` (seed 0's :data:`SHORT_SCENARIOS`, in that order) and records ``(n, seed)``
+    in ``calls``; ``run_scenario`` runs once per (scenario, config) in this process (an
+    outcome depends on nothing else; the throughput and command-line tests time the same
+    first scenario with the same configs). The tests count the calls time_scenarios
+    makes, whether run or replayed."""
+    from ddwmmr.scenarios import executors, generator
+
+    seed0 = generator.generate(max(SHORT_SCENARIOS), 0)
+    batch = [seed0[number - 1] for number in SHORT_SCENARIOS]
+    calls: list[tuple[int, int]] = []
+
+    def generate(n, seed=0):
+        calls.append((n, seed))
+        return batch[:n]
 
     run = executors.run_scenario
 
@@ -529,18 +542,18 @@ def scenario_runs_once(monkeypatch):
             SCENARIO_OUTCOMES[key] = run(scenario, config)
         return SCENARIO_OUTCOMES[key]
 
+    monkeypatch.setattr(generator, "generate", generate)
     monkeypatch.setattr(executors, "run_scenario", once)
+    return batch, calls
 
 
-def test_scenario_throughput_counts_the_simulated_time_of_every_scenario(
-    monkeypatch, scenario_runs_once
-):
+def test_scenario_throughput_counts_the_simulated_time_of_every_scenario(monkeypatch, short_batch):
     """Each controller's row sums the simulated time of every one of the scenarios, each
     run with that controller's default config: the runs time_scenarios makes are recorded
-    (one run per scenario, not a second run of each) and their times summed here."""
+    (one run per scenario, not a second run of each) and their times summed here. The
+    scenarios are those generate(count, 0) returns (a batch of two short ones here)."""
     from ddwmmr.bench import SCENARIO_CONTROLLERS, time_scenarios
     from ddwmmr.scenarios import executors
-    from ddwmmr.scenarios.generator import generate
     from ddwmmr.scenarios.protocol import RunConfig
 
     runs: list[tuple] = []
@@ -554,7 +567,8 @@ def test_scenario_throughput_counts_the_simulated_time_of_every_scenario(
     monkeypatch.setattr(executors, "run_scenario", recorded)
     rows = time_scenarios(2, jobs=1)
     assert [row["controller"] for row in rows] == list(SCENARIO_CONTROLLERS)
-    scenarios = generate(2, 0)
+    scenarios, generated = short_batch
+    assert generated == [(2, 0)]  # the first two scenarios of seed 0
     assert len(runs) == len(rows) * len(scenarios)
     for row in rows:
         config = RunConfig(controller=row["controller"])
@@ -567,7 +581,7 @@ def test_scenario_throughput_counts_the_simulated_time_of_every_scenario(
         )
 
 
-def test_cli_times_scenarios_only_when_asked_with_a_method(tmp_path, capsys, scenario_runs_once):
+def test_cli_times_scenarios_only_when_asked_with_a_method(tmp_path, capsys, short_batch):
     from ddwmmr.bench import SCENARIO_CONTROLLERS
 
     out = tmp_path / "b.json"
@@ -577,6 +591,7 @@ def test_cli_times_scenarios_only_when_asked_with_a_method(tmp_path, capsys, sce
     data = json.loads(out.read_text())
     assert [row["scenarios"] for row in data["scenarios"]] == [1] * len(SCENARIO_CONTROLLERS)
     assert "scenario benchmark (1 scenario, seed 0, 1 worker" in printed
+    assert short_batch[1] == [(1, 0)]
     assert main([*args, "--out", str(out)]) == 0  # --method alone: no scenarios
     assert json.loads(out.read_text())["scenarios"] == []
     with pytest.raises(SystemExit) as stop:
