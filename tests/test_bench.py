@@ -38,6 +38,28 @@ from in_process import call_main
 
 TINY = {"repeats": 2, "calls": 20, "duration": 0.4}
 ROBOT3 = Robot().with_payload(3.0)
+#: Seed 0's scenarios with the shortest mpc runs, 74 and 60 (11.7 s and 12.1 s simulated,
+#: 2-3 s of CPU each; the first two take 23.8 s and 20.2 s): the scenarios the bench's
+#: scenario sections run in these tests.
+SHORT_SCENARIOS = (74, 60)
+
+
+def use_short_scenarios(patch: pytest.MonkeyPatch) -> tuple[list, list[tuple[int, int]]]:
+    """``(batch, calls)``: through ``patch``, ``generate(n, seed)`` returns the first ``n``
+    scenarios of ``batch`` (seed 0's :data:`SHORT_SCENARIOS`, in that order) and records
+    ``(n, seed)`` in ``calls``."""
+    from ddwmmr.scenarios import generator
+
+    seed0 = generator.generate(max(SHORT_SCENARIOS), 0)
+    batch = [seed0[number - 1] for number in SHORT_SCENARIOS]
+    calls: list[tuple[int, int]] = []
+
+    def generate(n, seed=0):
+        calls.append((n, seed))
+        return batch[:n]
+
+    patch.setattr(generator, "generate", generate)
+    return batch, calls
 
 
 class FakeClock:
@@ -102,7 +124,11 @@ def report() -> dict:
         ExtraCase("naive-again", "ddwmmr.bench:NaivePseudoinverseController", pair="pi"),
         ExtraCase("missing", "ddwmmr.no_such_module:Thing", pair="pi"),
     )
-    return run_benchmark(**TINY, extras=extras, floor_scenarios=1)
+    with pytest.MonkeyPatch.context() as patch:
+        _, generated = use_short_scenarios(patch)  # the mpc floor's scenario: a short one
+        report = run_benchmark(**TINY, extras=extras, floor_scenarios=1)
+    assert generated == [(1, 0), (1, 0)]  # the solver's build, then the timed run
+    return report
 
 
 def test_rows_cover_baseline_and_every_registered_method(report: dict) -> None:
@@ -509,31 +535,19 @@ def test_cli_refuses_an_unusable_out_path_before_running(tmp_path, capsys, monke
 
 
 # -- scenario throughput --------------------------------------------------------------------
-#: Seed 0's scenarios with the shortest mpc runs, 74 and 60 (11.7 s and 12.1 s simulated,
-#: 2-3 s of CPU each; the first two take 23.8 s and 20.2 s): the batch these tests time.
-SHORT_SCENARIOS = (74, 60)
 #: Outcomes of the scenario runs made in this process, by (scenario, config): both frozen.
 SCENARIO_OUTCOMES: dict[tuple, object] = {}
 
 
 @pytest.fixture
 def short_batch(monkeypatch) -> tuple[list, list[tuple[int, int]]]:
-    """``(batch, calls)``: ``generate(n, seed)`` returns the first ``n`` scenarios of
-    ``batch`` (seed 0's :data:`SHORT_SCENARIOS`, in that order) and records ``(n, seed)``
-    in ``calls``; ``run_scenario`` runs once per (scenario, config) in this process (an
-    outcome depends on nothing else; the throughput and command-line tests time the same
-    first scenario with the same configs). The tests count the calls time_scenarios
-    makes, whether run or replayed."""
-    from ddwmmr.scenarios import executors, generator
+    """:func:`use_short_scenarios`, and ``run_scenario`` run once per (scenario, config)
+    in this process (an outcome depends on nothing else; the throughput and command-line
+    tests time the same first scenario with the same configs). The tests count the calls
+    time_scenarios makes, whether run or replayed."""
+    from ddwmmr.scenarios import executors
 
-    seed0 = generator.generate(max(SHORT_SCENARIOS), 0)
-    batch = [seed0[number - 1] for number in SHORT_SCENARIOS]
-    calls: list[tuple[int, int]] = []
-
-    def generate(n, seed=0):
-        calls.append((n, seed))
-        return batch[:n]
-
+    batch, calls = use_short_scenarios(monkeypatch)
     run = executors.run_scenario
 
     def once(scenario, config):
@@ -542,7 +556,6 @@ def short_batch(monkeypatch) -> tuple[list, list[tuple[int, int]]]:
             SCENARIO_OUTCOMES[key] = run(scenario, config)
         return SCENARIO_OUTCOMES[key]
 
-    monkeypatch.setattr(generator, "generate", generate)
     monkeypatch.setattr(executors, "run_scenario", once)
     return batch, calls
 
