@@ -15,8 +15,11 @@ from ddwmmr.model import Robot
 from ddwmmr.mpc.models import PredictionModel
 from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP
 
-#: Most OCPs kept for reuse by :func:`shared_ocp` (a run uses one or two; a benchmark
-#: worker's scenarios share them).
+#: Most OCPs kept for reuse by :func:`shared_ocp`. A run uses one or two (the lookahead
+#: adds the one through the next waypoint); the bounds search's mpc runs (with lookahead,
+#: following the plan, with margins, arriving as it does) use eight, the same for every
+#: scenario, so a worker's scenarios rebuild none. A waypoint OCP with its QP solvers
+#: holds about 12 MB.
 SHARED_OCPS = 8
 _OCPS: OrderedDict[tuple, ShootingOCP] = OrderedDict()
 _OCPS_LOCK = threading.Lock()
