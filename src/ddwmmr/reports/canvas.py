@@ -3,8 +3,9 @@
 A :class:`~matplotlib.figure.Figure` made here belongs to no pyplot figure manager, so
 drawing or saving it never chooses, switches or needs the user's matplotlib backend (their
 ``plt.show()`` keeps working after ``import ddwmmr``), opens no window and may be drawn in a
-worker thread. It is not shown by ``plt.show()``: save it (``fig.savefig``) or display it
-(a Jupyter cell's value, ``IPython.display.display(fig)``). To show a run's figures in a
+worker thread. It is not shown by ``plt.show()``: save it (``fig.savefig``) or, in
+Jupyter once the inline backend is active (``%matplotlib inline``, or after a pyplot
+figure), display it (a cell's value, ``IPython.display.display(fig)``). To show a run's figures in a
 window, the plotting functions of :mod:`ddwmmr.reports.plots` draw into pyplot's instead:
 ``plot_path(result, ax=ax)``, ``plot_errors(result, fig=plt.figure())`` (likewise
 ``plot_rates``, ``plot_metrics``), then ``plt.show()``.

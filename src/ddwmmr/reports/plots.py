@@ -5,7 +5,8 @@ standard set of PNGs that ``python -m ddwmmr.track`` produces. World frame, metr
 
 By default a figure is made here, not by pyplot (:mod:`ddwmmr.reports.canvas`): importing
 or using this module leaves the matplotlib backend as the user chose it. Such a figure is
-saved with ``fig.savefig`` or shown as a Jupyter cell's value, but ``plt.show()`` does not
+saved with ``fig.savefig`` or shown as a Jupyter cell's value (once the inline backend is
+active: ``%matplotlib inline``, or after a pyplot figure), but ``plt.show()`` does not
 show it. To look at a run in a window, draw into pyplot's figures instead:
 ``plot_path(result, ax=ax)`` into an axes of ``plt.subplots(layout="constrained")`` (the
 layout makes room for the legend beside the axes), and
