@@ -150,6 +150,20 @@ def test_what_is_not_a_figure_is_refused_in_one_line(run, name, fig, kind):
 
 
 @pytest.mark.parametrize("name", MAKERS)
+@pytest.mark.parametrize(("size", "shown"), [((0.0, 5.0), "0 x 5"), ((7.0, 0.0), "7 x 0")])
+def test_a_figure_of_zero_width_or_height_is_refused_in_one_line(run, name, size, shown):
+    """No panel fits in it (matplotlib's layout would fail with a singular matrix)."""
+    fig = new_figure(size)
+    with pytest.raises(ParameterError) as info:
+        MAKERS[name](run, fig=fig)
+    assert one_line(info) == (
+        f"fig: must have a positive width and height (it is {shown} inches); "
+        "pass e.g. plt.figure(figsize=(7, 5))"
+    )
+    assert fig.axes == []
+
+
+@pytest.mark.parametrize("name", MAKERS)
 def test_fig_is_keyword_only(run, name):
     with pytest.raises(TypeError):
         MAKERS[name](run, Figure())

@@ -275,8 +275,8 @@ def plot_errors(result, *, fig: Figure | None = None) -> Figure:
 
     Drawn on a 7 x 5 inch figure of its own, or into ``fig``, an empty figure of the
     caller's (``plt.figure()``: then ``plt.show()`` shows it), kept at its size and layout
-    engine; anything else as ``fig`` (not a Figure, or one holding axes) is a one-line
-    :class:`~ddwmmr.errors.ParameterError` naming ``fig``."""
+    engine; anything else as ``fig`` (not a Figure, one holding axes or of zero width or
+    height) is a one-line :class:`~ddwmmr.errors.ParameterError` naming ``fig``."""
     ts = result.timeseries
     own = fig is None
     fig = new_figure((7, 5)) if fig is None else _figure_to_draw_into(fig)
@@ -491,8 +491,9 @@ def save_animation(
 
 
 def _figure_to_draw_into(fig: object) -> Figure:
-    """``fig`` if it is a :class:`~matplotlib.figure.Figure` holding no axes, else a
-    one-line :class:`~ddwmmr.errors.ParameterError` naming ``fig``.
+    """``fig`` if it is a :class:`~matplotlib.figure.Figure` holding no axes, with a
+    positive width and height (inches), else a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming ``fig``.
 
     A figure that already holds axes is refused rather than cleared or drawn over: the
     panels are laid out over the whole figure, so they would hide the caller's axes, and
@@ -506,6 +507,12 @@ def _figure_to_draw_into(fig: object) -> Figure:
         raise ParameterError(
             f"fig: must be an empty Figure (it holds {len(fig.axes)} axes); "
             "pass a new one, e.g. plt.figure(), or call fig.clear() first"
+        )
+    width, height = fig.get_size_inches()
+    if not (width > 0.0 and height > 0.0):  # no panel fits: matplotlib's layout divides by 0
+        raise ParameterError(
+            f"fig: must have a positive width and height (it is {width:g} x {height:g} "
+            "inches); pass e.g. plt.figure(figsize=(7, 5))"
         )
     return fig
 
