@@ -38,9 +38,9 @@ from in_process import call_main
 
 TINY = {"repeats": 2, "calls": 20, "duration": 0.4}
 ROBOT3 = Robot().with_payload(3.0)
-#: Seed 0's scenarios with the shortest mpc runs, 74 and 60 (11.7 s and 12.1 s simulated,
-#: 2-3 s of CPU each; the first two take 23.8 s and 20.2 s): the scenarios the bench's
-#: scenario sections run in these tests.
+#: Seed 0's scenarios with the shortest mpc runs, 74 and 60 (11.7 s and 12.1 s simulated;
+#: the first two simulate 23.8 s and 20.2 s): the scenarios the bench's scenario sections
+#: run in these tests.
 SHORT_SCENARIOS = (74, 60)
 
 

@@ -149,7 +149,7 @@ def circular(a, b):
 
     Where every ``x = a - b + pi`` lies in (-pi, 3 pi) (angles in [-pi, pi], as the
     programme's are) the ``mod`` is done in place, bit for bit what ``np.remainder`` gives
-    and about three times faster on the programme's (cells, cells, arcs) blocks: there
+    without its division, on the programme's (cells, cells, arcs) blocks: there
     ``np.remainder(x, 2 pi)`` (fmod, then ``+ 2 pi`` if negative) is ``x`` on [0, 2 pi),
     ``x - 2 pi`` on [2 pi, 3 pi) (exact: fmod is exact, and so is the difference of numbers
     within a factor of 2 of each other) and ``x + 2 pi`` rounded on (-pi, 0)."""

@@ -64,9 +64,9 @@ class _WindowDrive:
     :data:`TYPED_DURATION` into the duration field, click Run, watch the run be simulated
     and played back, then save the window's screenshot and its figure into ``out`` and
     close it. ``report`` collects what happened: ``draws`` (full redraws), ``typed`` (s),
-    the perf_counter stamps (s) ``clicked``, ``simulated``, ``played``, ``frames_at_play``,
-    ``screen`` (width px, height px, grey-level spread) and ``failure`` ("" when passed;
-    "timed out" until then)."""
+    the perf_counter stamps (s) ``clicked``, ``simulated``, ``played``, the frames shown
+    when the simulation ended ``frames_at_play``, ``screen`` (width px, height px,
+    grey-level spread) and ``failure`` ("" when passed; "timed out" until then)."""
 
     def __init__(self, app: Any, figure: Any, out: Path) -> None:
         self.app, self.figure, self.out = app, figure, out
