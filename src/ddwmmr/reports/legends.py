@@ -68,7 +68,7 @@ def legend_beside(ax: Axes, **kwargs) -> Legend:
 def covers_data(ax: Axes, legend: Legend) -> bool:
     """Whether ``legend`` (drawn where it is now) overlaps a data line, a scatter point
     or a text label of ``ax``."""
-    renderer = ax.figure.canvas.get_renderer()
+    renderer = _renderer(ax)
     ax.apply_aspect()  # an equal-aspect axes takes its final box only when drawn
     box = legend.get_window_extent(renderer).padded(CLEARANCE_PX)
     for line in ax.lines:
@@ -89,6 +89,14 @@ def covers_data(ax: Axes, legend: Legend) -> bool:
         text.get_visible() and text.get_text() and box.overlaps(text.get_window_extent(renderer))
         for text in ax.texts
     )
+
+
+def _renderer(ax: Axes):
+    """The renderer ``ax``'s figure is measured with: its canvas's own where it has one
+    (Agg and the GUI canvases built on it), else the one matplotlib's own ``tight_layout``
+    measures with (``Figure._get_renderer``: the svg, pdf and cairo canvases have no
+    ``get_renderer``), so a legend can be placed in a figure on any canvas."""
+    return ax.figure._get_renderer()
 
 
 def _crosses(transform, xy: np.ndarray, box: Bbox) -> bool:
@@ -114,7 +122,7 @@ def _crosses(transform, xy: np.ndarray, box: Bbox) -> bool:
 
 def _raise_top(ax: Axes, legend: Legend) -> None:
     """Raise the y-axis top so that the data's top sits below the legend's bottom."""
-    renderer = ax.figure.canvas.get_renderer()
+    renderer = _renderer(ax)
     axes_box = ax.get_window_extent(renderer)
     legend_box = legend.get_window_extent(renderer)
     # Fraction of the axes height the data may use: below the legend, with a gap.

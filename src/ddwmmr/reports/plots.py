@@ -17,13 +17,10 @@ then ``plt.show()``.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.layout_engine import PlaceHolderLayoutEngine
 from matplotlib.lines import Line2D
@@ -419,8 +416,7 @@ def plot_metrics(result, *, fig: Figure | None = None) -> Figure:
     ax2.grid(alpha=0.3)
     ax1.set_title(_title(result, "performance metrics"))
     _lay_out(fig, own)
-    with _measurable(fig):
-        place_legend(ax2, fontsize=8)
+    place_legend(ax2, fontsize=8)
     return fig
 
 
@@ -527,24 +523,6 @@ def _lay_out(fig: Figure, own: bool) -> None:
         fig.tight_layout()
     else:
         engine.execute(fig)
-
-
-@contextmanager
-def _measurable(fig: Figure) -> Iterator[Figure]:
-    """``fig`` on a canvas that legends can be measured on (:mod:`ddwmmr.reports.legends`
-    asks the canvas for its renderer). Figures made here and those of pyplot's Agg-based
-    backends (Tk, Qt, macOS, Jupyter's inline) have one; a caller's figure on another
-    canvas (the svg, pdf and cairo backends) is lent an Agg canvas, measured at the same
-    size and dpi, and gets its own canvas back afterwards."""
-    canvas = fig.canvas
-    if hasattr(canvas, "get_renderer"):
-        yield fig
-        return
-    FigureCanvasAgg(fig)
-    try:
-        yield fig
-    finally:
-        fig.set_canvas(canvas)
 
 
 def _axes(ax: Axes | None, figsize: tuple[float, float]) -> tuple[Figure, Axes]:
