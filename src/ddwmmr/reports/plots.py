@@ -275,8 +275,7 @@ def plot_errors(result, *, fig: Figure | None = None) -> Figure:
     engine; anything else as ``fig`` (not a Figure, one holding axes or of zero width or
     height) is a one-line :class:`~ddwmmr.errors.ParameterError` naming ``fig``."""
     ts = result.timeseries
-    own = fig is None
-    fig = new_figure((7, 5)) if fig is None else _figure_to_draw_into(fig)
+    fig, own = _figure_for(fig, (7, 5))
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     position = np.maximum(ts["position_error_m"], ERROR_FLOOR)
     ax1.semilogy(ts["t"], position, color="tab:blue")
@@ -335,8 +334,7 @@ def plot_rates(result, *, fig: Figure | None = None) -> Figure:
     Drawn on an 8.6 x 6.4 inch figure of its own, or into ``fig`` as :func:`plot_errors`
     does; returns the figure."""
     ts, robot = result.timeseries, result.robot
-    own = fig is None
-    fig = new_figure((8.6, 6.4)) if fig is None else _figure_to_draw_into(fig)
+    fig, own = _figure_for(fig, (8.6, 6.4))
     ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True)
     ax1.plot(ts["t"], ts["th1dot"], label="th1dot")
     ax1.plot(ts["t"], ts["th2dot"], label="th2dot")
@@ -397,8 +395,7 @@ def plot_metrics(result, *, fig: Figure | None = None) -> Figure:
 
     Drawn on a 7 x 5 inch figure of its own, or into ``fig`` as :func:`plot_errors` does."""
     ts = result.timeseries
-    own = fig is None
-    fig = new_figure((7, 5)) if fig is None else _figure_to_draw_into(fig)
+    fig, own = _figure_for(fig, (7, 5))
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     ax1.plot(ts["t"], ts["manipulability"], color="tab:purple")
     ax1.set_ylim(0, 1.05)
@@ -484,6 +481,15 @@ def save_animation(
     with ProgressBar(len(indices), "track: animation.gif", enabled=progress, unit="frame") as bar:
         save_gif(fig, update, len(indices), path, fps, bar.advance)
     return path
+
+
+def _figure_for(fig: object, figsize: tuple[float, float]) -> tuple[Figure, bool]:
+    """``(figure, own)``: a new figure of ``figsize`` (width, height in inches) made here
+    when ``fig`` is None (``own`` True), else ``fig``, the caller's, checked by
+    :func:`_figure_to_draw_into` (``own`` False)."""
+    if fig is None:
+        return new_figure(figsize), True
+    return _figure_to_draw_into(fig), False
 
 
 def _figure_to_draw_into(fig: object) -> Figure:
