@@ -1,10 +1,12 @@
-"""plot_errors, plot_rates and plot_metrics draw into a figure the caller passes as ``fig``.
+"""plot_errors, plot_rates and plot_metrics draw into a figure the caller passes as ``fig``,
+plot_path into an axes passed as ``ax``.
 
 By default they draw on a figure of their own that pyplot does not know, so ``plt.show()``
 does not show it; ``fig=plt.figure()`` is how a script looks at them in a window. These
 tests check that the passed figure is the one drawn into (and stays pyplot's), that it holds
 the same panels and lines as the default, that the default is as before, and that a figure
-that cannot be drawn into is refused in one line naming ``fig``."""
+that cannot be drawn into is refused in one line naming ``fig``; and that plot_path's legend
+stays on the caller's figure whatever its layout."""
 
 from __future__ import annotations
 
@@ -14,13 +16,15 @@ import warnings
 import matplotlib.pyplot as plt
 import numpy as np
 import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.backends.backend_svg import FigureCanvasSVG
 from matplotlib.figure import Figure
 from matplotlib.layout_engine import ConstrainedLayoutEngine
 
 from ddwmmr import ParameterError, Robot, load_trajectory, simulate
 from ddwmmr.reports.canvas import new_figure
-from ddwmmr.reports.plots import plot_errors, plot_metrics, plot_rates
+from ddwmmr.reports.legends import place_legend
+from ddwmmr.reports.plots import plot_errors, plot_metrics, plot_path, plot_rates
 from one_line import one_line
 
 MAKERS = {"errors": plot_errors, "rates": plot_rates, "metrics": plot_metrics}
@@ -167,3 +171,34 @@ def test_a_figure_of_zero_width_or_height_is_refused_in_one_line(run, name, size
 def test_fig_is_keyword_only(run, name):
     with pytest.raises(TypeError):
         MAKERS[name](run, Figure())
+
+
+def _path_figure(run, layout: str | None) -> tuple[Figure, object]:
+    """plot_path drawn into the one axes of a 6.4 x 4.8 inch Agg figure of ``layout``."""
+    fig = Figure(layout=layout)
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    plot_path(run, ax=ax)
+    fig.canvas.draw()
+    return fig, ax
+
+
+@pytest.mark.parametrize("layout", [None, "constrained"])
+def test_a_path_legend_drawn_into_a_callers_axes_sits_beside_it_within_the_figure(run, layout):
+    fig, ax = _path_figure(run, layout)
+    legend = ax.get_legend().get_window_extent()
+    assert legend.x0 >= ax.bbox.x1  # beside the axes, off the data
+    assert fig.bbox.x0 <= legend.x0 and legend.x1 <= fig.bbox.x1  # not cut off
+    assert fig.bbox.y0 <= legend.y0 and legend.y1 <= fig.bbox.y1
+    assert tuple(fig.get_size_inches()) == (6.4, 4.8)  # the caller's size is kept
+    if layout == "constrained":  # the caller's engine is kept
+        assert isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine)
+
+
+def test_place_legend_takes_the_labels_of_handles_given_alone():
+    fig = Figure()
+    FigureCanvasAgg(fig)
+    ax = fig.subplots()
+    (line,) = ax.plot([0.0, 1.0], [0.0, 1.0], label="a line")
+    legend = place_legend(ax, handles=[line])
+    assert [t.get_text() for t in legend.get_texts()] == ["a line"]

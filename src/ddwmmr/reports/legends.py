@@ -43,13 +43,13 @@ def place_legend(
 
     ``handles``/``labels`` and ``kwargs`` go to :meth:`Axes.legend`. Returns the legend.
     """
-    args = () if handles is None else (handles,) if labels is None else (handles, labels)
+    kwargs.update(handles=handles, labels=labels)  # None: matplotlib's own choice
     for spot in spots:
-        legend = ax.legend(*args, loc=spot, **kwargs)
+        legend = ax.legend(loc=spot, **kwargs)
         if not covers_data(ax, legend):
             return legend
     upper = next((s for s in spots if s.startswith("upper")), "upper right")
-    legend = ax.legend(*args, loc=upper, **kwargs)
+    legend = ax.legend(loc=upper, **kwargs)
     for _ in range(HEADROOM_ROUNDS):
         if not covers_data(ax, legend):
             break

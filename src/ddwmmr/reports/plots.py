@@ -188,7 +188,9 @@ def plot_path(result, ax: Axes | None = None, snapshots: int = 6, obstacles=None
 
     Without ``ax`` the figure is made here, 8.6 inches wide and as tall as the equal-scale
     path needs. An ``ax`` of the caller's is drawn into as it is (other runs' paths may
-    share it) and its figure's size and layout are left alone."""
+    share it) and its figure keeps its size; it is laid out as :func:`plot_errors` lays
+    out a caller's figure (by its own layout engine, else ``tight_layout``), so that the
+    legend beside the axes stays on the figure."""
     ts = result.timeseries
     own_figure = ax is None
     fig, ax = _axes(ax, figsize=(8.6, 5.6))
@@ -237,6 +239,8 @@ def plot_path(result, ax: Axes | None = None, snapshots: int = 6, obstacles=None
     ax.grid(alpha=0.3)
     if own_figure:
         _fit_path_figure(fig, ax)
+    else:  # make room for the legend beside the axes, as the other makers do
+        _lay_out(fig, own=False)
     return fig
 
 
