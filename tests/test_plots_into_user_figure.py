@@ -173,6 +173,13 @@ def test_fig_is_keyword_only(run, name):
         MAKERS[name](run, Figure())
 
 
+@pytest.fixture(scope="module")
+def wide_run():
+    """Ten seconds of ats on the ellipse: a path wider than tall, so that its equal-aspect
+    axes fill the figure's width and a legend beside them needs room made."""
+    return simulate(Robot(), load_trajectory("ellipse"), "ats", duration=10.0)
+
+
 def _path_figure(run, layout: str | None) -> tuple[Figure, object]:
     """plot_path drawn into the one axes of a 6.4 x 4.8 inch Agg figure of ``layout``."""
     fig = Figure(layout=layout)
@@ -184,8 +191,8 @@ def _path_figure(run, layout: str | None) -> tuple[Figure, object]:
 
 
 @pytest.mark.parametrize("layout", [None, "constrained"])
-def test_a_path_legend_drawn_into_a_callers_axes_sits_beside_it_within_the_figure(run, layout):
-    fig, ax = _path_figure(run, layout)
+def test_a_path_legend_drawn_into_a_callers_axes_sits_beside_it_within_the_figure(wide_run, layout):
+    fig, ax = _path_figure(wide_run, layout)
     legend = ax.get_legend().get_window_extent()
     assert legend.x0 >= ax.bbox.x1  # beside the axes, off the data
     assert fig.bbox.x0 <= legend.x0 and legend.x1 <= fig.bbox.x1  # not cut off
