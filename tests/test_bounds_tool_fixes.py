@@ -301,7 +301,10 @@ def test_the_help_gives_the_measured_times():
     text = " ".join(tool.build_parser().format_help().split())
     assert "about 55 s of CPU on average, 34 s with --quick, 19 s with --lower-only" in text
     assert "46 starts instead of 59-60" in text
-    assert "1-3 minutes" not in text and "half" not in text
+    assert "lower bounds (about 19 s of CPU per scenario)" in text  # the option says it too
+    assert "1-3 minutes" not in text and "half" not in text and "25 s" not in text
+    cli = (Path(__file__).parents[1] / "docs" / "cli.md").read_text()
+    assert "bounds (about 19 s of CPU each;" in cli
     docs = (Path(__file__).parents[1] / "docs" / "mpc.md").read_text()
     assert "About 55 s of CPU per scenario" in docs and "`--quick` (46 starts) about 34 s" in docs
     assert "59-60 starts each" in docs and "About 19 s of CPU per scenario (" in docs

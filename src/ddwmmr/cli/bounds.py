@@ -149,7 +149,7 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--lower-only",
         action="store_true",
-        help="compute only the lower bounds (about 25 s per scenario); best-known times are "
+        help="compute only the lower bounds (about 19 s of CPU per scenario); best-known times are "
         "taken from the cache where there (same settings), else NaN",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
