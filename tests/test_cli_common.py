@@ -30,6 +30,34 @@ def test_the_package_answers_version(capsys):
 
 
 @pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (
+            ["track", "--method", "ats", "--out", "my runs"],
+            "the tools are modules of their own, not subcommands: "
+            "run python -m ddwmmr.track --method ats --out 'my runs'",
+        ),
+        (
+            ["bounds"],
+            "the tools are modules of their own, not subcommands: run python -m ddwmmr.bounds",
+        ),
+        (
+            ["trak"],
+            "no tool 'trak'; run python -m ddwmmr.<tool> "
+            "(track, compare, scenarios, bench, bounds, gui)",
+        ),
+    ],
+)
+def test_the_package_given_a_tool_name_says_how_to_run_that_tool(capsys, argv, message):
+    from ddwmmr.__main__ import main
+
+    assert main(argv) == 2
+    captured = capsys.readouterr()
+    assert captured.err == f"python -m ddwmmr: error: {message}\n"
+    assert captured.out == ""
+
+
+@pytest.mark.parametrize(
     ("tool", "argv", "message"),
     [
         (

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shlex
 import sys
 
 #: (module run with ``python -m``, console script, what it does).
@@ -28,6 +29,17 @@ def usage() -> str:
     return "\n".join(lines)
 
 
+def _not_a_tool_call(arguments: list[str]) -> str:
+    """Why ``python -m ddwmmr ARGUMENTS`` runs nothing, and the command that would: a
+    tool's name as the first argument (``python -m ddwmmr track ...``) is the right tool
+    in the wrong form, so the line gives the form with the user's own arguments."""
+    names = [module.removeprefix("ddwmmr.") for module, _, _ in TOOLS]
+    if arguments[0] in names:
+        call = shlex.join(["python", "-m", "ddwmmr." + arguments[0], *arguments[1:]])
+        return f"the tools are modules of their own, not subcommands: run {call}"
+    return f"no tool {arguments[0]!r}; run python -m ddwmmr.<tool> ({', '.join(names)})"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Print the tools (or, for --version, the version); any other argument than --help
     and --version is an error (status 2)."""
@@ -38,11 +50,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"ddwmmr {package_version()}")
         return 0
     if arguments and arguments[0] not in ("-h", "--help"):
-        print(
-            f"python -m ddwmmr: error: no tool {arguments[0]!r}; run python -m ddwmmr.<tool> "
-            "(track, compare, scenarios, bench, bounds, gui)",
-            file=sys.stderr,
-        )
+        print(f"python -m ddwmmr: error: {_not_a_tool_call(arguments)}", file=sys.stderr)
         return 2
     print(usage())
     return 0
