@@ -12,11 +12,19 @@ called every control step.
 from __future__ import annotations
 
 import math
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import numpy as np
 
 from ddwmmr.errors import ParameterError, float_values, shown
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import numpy.typing as npt
+
+    #: A configuration ``[x, y, phi, th1, th2]`` or a vector of 4 inputs / 5 rates (floats).
+    Vector = Sequence[float] | npt.NDArray[np.float64]
 
 #: Names of the configuration coordinates, in order.
 Q_NAMES = ("x", "y", "phi", "th1", "th2")
@@ -106,7 +114,7 @@ def whole_turns(angle: float) -> float:
     return angle - principal_angle(angle)
 
 
-def forward_kinematics(L1: float, L2: float, q) -> tuple[float, float, float]:
+def forward_kinematics(L1: float, L2: float, q: Vector) -> tuple[float, float, float]:
     """End-effector pose ``(xE, yE, phiE)`` in the world frame (m, m, rad)."""
     x, y, phi, th1, th2 = (float(v) for v in q)
     a1 = phi + th1
@@ -118,7 +126,7 @@ def forward_kinematics(L1: float, L2: float, q) -> tuple[float, float, float]:
     )
 
 
-def _arm_rates(L1: float, L2: float, q) -> tuple[float, float, float, float, float]:
+def _arm_rates(L1: float, L2: float, q: Vector) -> tuple[float, float, float, float, float]:
     """``(phi, dx, dy, dx2, dy2)``: the heading and the end effector's rates (world frame,
     m/rad) per unit of shoulder (and heading) rate, ``(dx, dy)``, and of elbow rate."""
     _, _, phi, th1, th2 = (float(v) for v in q)
@@ -127,7 +135,7 @@ def _arm_rates(L1: float, L2: float, q) -> tuple[float, float, float, float, flo
     return phi, -L1 * s1 - L2 * s12, L1 * c1 + L2 * c12, -L2 * s12, L2 * c12
 
 
-def jacobian(L1: float, L2: float, q) -> np.ndarray:
+def jacobian(L1: float, L2: float, q: Vector) -> np.ndarray:
     """The 4x5 task Jacobian: rows xE, yE, phiE and the nonholonomic constraint.
 
     docs/theory.md, "Configuration, forward kinematics, Jacobian".
@@ -150,7 +158,7 @@ AUX_ROWS = {
 }
 
 
-def augmented_jacobian(L1: float, L2: float, q, aux: str) -> np.ndarray:
+def augmented_jacobian(L1: float, L2: float, q: Vector, aux: str) -> np.ndarray:
     """The square 5x5 augmented Jacobian: :func:`jacobian` plus the auxiliary row ``aux``."""
     return np.vstack([jacobian(L1, L2, q), np.array(AUX_ROWS[aux])])
 
@@ -178,14 +186,14 @@ def base_motion(
     return (v * math.cos(phi), v * math.sin(phi), w, th1dot, th2dot)
 
 
-def qdot_from_u(phi: float, u) -> np.ndarray:
+def qdot_from_u(phi: float, u: Vector) -> np.ndarray:
     """Configuration rate ``qdot`` (5,) produced by inputs ``u = [v, w, th1dot, th2dot]``
     (:func:`base_motion` as an array)."""
     v, w, t1, t2 = (float(a) for a in u)
     return np.array(base_motion(phi, v, w, t1, t2))
 
 
-def u_from_qdot(phi: float, qdot) -> tuple[np.ndarray, float]:
+def u_from_qdot(phi: float, qdot: Vector) -> tuple[np.ndarray, float]:
     """Project a configuration rate on the inputs.
 
     Returns ``(u, residual)`` where ``residual = -xdot sin(phi) + ydot cos(phi)`` (m/s) is
@@ -196,7 +204,7 @@ def u_from_qdot(phi: float, qdot) -> tuple[np.ndarray, float]:
     return np.array([xd * c + yd * s, pd, t1, t2]), -xd * s + yd * c
 
 
-def end_effector_jacobian_u(L1: float, L2: float, q) -> np.ndarray:
+def end_effector_jacobian_u(L1: float, L2: float, q: Vector) -> np.ndarray:
     """The 3x4 Jacobian ``A = J_E B`` mapping inputs u to end-effector rates."""
     phi, dx, dy, dx2, dy2 = _arm_rates(L1, L2, q)
     return np.array(

@@ -11,7 +11,7 @@ import math
 import warnings
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
@@ -35,6 +35,9 @@ from ddwmmr.errors import (
 from ddwmmr.model import kinematics, stability, support_loads
 from ddwmmr.model.mass import YawInertia, total_mass
 from ddwmmr.model.stability import ComCoefficients
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 _PI = math.pi
 #: Allowed range (low, high, unit) of each scalar field; see ddwmmr.errors for the caps.
@@ -635,16 +638,17 @@ def _check_field_type(key: str, value: Any, default: Any) -> None:
         raise ParameterError(f"robot: {key} must be {wanted} (got {shown(value)})")
 
 
-def _pair(name: str, value, unit: str = "") -> tuple[float, float]:
+def _pair(name: str, value: object, unit: str = "") -> tuple[float, float]:
     """``value`` as two finite floats; anything else raises naming ``name`` (or the entry)."""
     return _numbers(name, value, 2, "a pair of", unit)  # type: ignore[return-value]
 
 
-def _triple(name: str, value) -> tuple[float, float, float]:
+def _triple(name: str, value: object) -> tuple[float, float, float]:
     return _numbers(name, value, 3, "3", "[xE, yE, phiE] (m, rad)")  # type: ignore[return-value]
 
 
-def _numbers(name: str, value, size: int, count: str, unit: str) -> tuple[float, ...]:
+# value is Any: unchecked input, whose tuple() raising TypeError is part of the check
+def _numbers(name: str, value: Any, size: int, count: str, unit: str) -> tuple[float, ...]:
     suffix = f" {unit}" if unit else ""
     wanted = f"{name} must be {count} numbers{suffix}"
     if isinstance(value, str | bytes | dict):
@@ -666,7 +670,7 @@ def _check_scalars(*items: tuple[str, Any]) -> None:
             check_finite(name, value)
 
 
-def _configuration(q, name: str = "q") -> list[float]:
+def _configuration(q: object, name: str = "q") -> Sequence[float]:
     """``q`` as a flat sequence of 5 finite numbers, or :class:`ParameterError` naming it;
     for a configuration (``name`` q) the angles must also be within
     +-:data:`~ddwmmr.model.kinematics.MAX_CONFIGURATION_ANGLE_RAD` rad
@@ -694,7 +698,7 @@ def _configuration(q, name: str = "q") -> list[float]:
     return _configuration_slow(q, name)
 
 
-def _configuration_slow(q, name: str) -> list[float]:
+def _configuration_slow(q: object, name: str) -> Sequence[float]:
     wanted = f"{name} must be 5 finite numbers {_Q_ENTRIES[name]}"
     if isinstance(q, str | bytes | dict):
         raise ParameterError(f"{wanted} (got {shown(q, 60)})")
@@ -734,7 +738,8 @@ def _edges_of_points(points: tuple[tuple[float, float], ...]) -> stability.Suppo
     return stability.SupportEdges.from_lines(polygon.normals, polygon.offsets, polygon.vertices)
 
 
-def _points(value) -> tuple[tuple[float, float], ...]:
+# value is Any: unchecked input, whose tuple() raising TypeError is part of the check
+def _points(value: Any) -> tuple[tuple[float, float], ...]:
     name = "caster_positions"
     try:
         if isinstance(value, str | bytes | dict):  # iterable, but not a list of points
@@ -749,7 +754,8 @@ def _points(value) -> tuple[tuple[float, float], ...]:
     return tuple(_pair(f"{name}[{i}]", p, "m") for i, p in enumerate(items, start=1))
 
 
-def _pairs(name: str, value) -> tuple:
+# value is Any: unchecked input, whose tuple() raising TypeError is part of the check
+def _pairs(name: str, value: Any) -> tuple[tuple[float, float], ...]:
     try:
         if isinstance(value, str | bytes | dict):  # iterable, but not two pairs
             raise TypeError

@@ -49,11 +49,19 @@ import math
 import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ddwmmr.errors import MASS_RANGE_KG, ParameterError, check_finite
 from ddwmmr.model.mass import total_mass
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import numpy.typing as npt
+
+    from ddwmmr.model.robot import Robot
 
 #: Reported stability is capped here: a vanishing tipping moment gives an infinite ratio.
 STABILITY_CAP = 10.0
@@ -83,7 +91,9 @@ def check_stability_floor(value: float, name: str = "stability_min") -> float:
     return floor
 
 
-def warn_start_below_floor(method: str, robot, q0, floor: float) -> None:
+def warn_start_below_floor(
+    method: str, robot: Robot, q0: Sequence[float] | npt.NDArray[np.float64], floor: float
+) -> None:
     """Warn (:class:`UserWarning`, one line) when the controller ``method``, holding the
     floor ``floor`` on S (``stability_min``), starts ``robot`` (a
     :class:`~ddwmmr.model.Robot`) in a configuration ``q0`` (``[x, y, phi, th1, th2]``, m
@@ -138,7 +148,12 @@ class SupportEdges:
     rectangle: tuple[float, float] | None
 
     @classmethod
-    def from_lines(cls, normals, offsets, vertices) -> SupportEdges:
+    def from_lines(
+        cls,
+        normals: npt.NDArray[np.float64],
+        offsets: npt.NDArray[np.float64],
+        vertices: npt.NDArray[np.float64],
+    ) -> SupportEdges:
         """The edges of a convex polygon given as :class:`~ddwmmr.model.support_loads.
         SupportPolygon` has it: inward unit normals (k, 2) and offsets (k,) with ``d_e(p) =
         normal . p - offset`` (m, inside > 0), and its vertices (k, 2) in m.
@@ -283,7 +298,7 @@ def tips_in_every_pose(k: ComCoefficients) -> bool:
     return abs(k.A - k.B) >= radius
 
 
-def max_payload(robot, th1: float, th2: float) -> float:
+def max_payload(robot: Robot, th1: float, th2: float) -> float:
     """The heaviest payload (kg) with which ``robot`` (a :class:`~ddwmmr.model.Robot`)
     stands (static S > 1) with its arm at ``th1``, ``th2`` (rad), rounded down so that the
     payload it names stands (:func:`_round_down_payload`: to the gram from 1 kg, to four
@@ -434,7 +449,7 @@ class InertialTerms:
     weight: float
 
 
-def inertial_terms(robot) -> InertialTerms:
+def inertial_terms(robot: Robot) -> InertialTerms:
     """:class:`InertialTerms` of a :class:`~ddwmmr.model.Robot` (lumped as the module
     docstring says)."""
     m1, m2 = robot.link_masses
@@ -452,19 +467,21 @@ def inertial_terms(robot) -> InertialTerms:
 def zero_moment_point(
     k: ComCoefficients,
     terms: InertialTerms,
-    th1,
-    th2,
-    rate1,
-    rate2,
-    v,
-    w,
-    v_dot,
-    w_dot,
-    acc1=0.0,
-    acc2=0.0,
-    cos=math.cos,
-    sin=math.sin,
-):
+    # Any: floats, or casadi expressions for the symbolic twin (docstring); cos and sin are
+    # Any too because dynamic_stability forwards its *motion floats positionally.
+    th1: Any,
+    th2: Any,
+    rate1: Any,
+    rate2: Any,
+    v: Any,
+    w: Any,
+    v_dot: Any,
+    w_dot: Any,
+    acc1: Any = 0.0,
+    acc2: Any = 0.0,
+    cos: Any = math.cos,
+    sin: Any = math.sin,
+) -> tuple[Any, Any]:
     """Zero moment point ``(x, y)`` in the base frame (m) at joints (rad), joint rates
     (rad/s), forward speed v (m/s), yaw rate w (rad/s), their rates (m/s^2, rad/s^2) and
     the joint accelerations ``acc1``, ``acc2`` (rad/s^2).

@@ -36,9 +36,9 @@ symbolically (:func:`ddwmmr.model.symbolic.edge_loads`).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -50,6 +50,11 @@ from ddwmmr.model.stability import (
     inertial_terms,
     zero_moment_point,
 )
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
+
+    from ddwmmr.model.robot import Robot
 
 #: A support lies on an edge of the polygon when closer to its line than this (m).
 ON_EDGE_TOLERANCE_M = 1e-9
@@ -72,7 +77,7 @@ def check_min_edge_load(value: Any) -> float:
     return share
 
 
-def support_points(robot) -> tuple[tuple[float, float], ...]:
+def support_points(robot: Robot) -> tuple[tuple[float, float], ...]:
     """Base-frame floor contact points (m) of a :class:`~ddwmmr.model.Robot`'s supports:
     the left and right wheel ``(0, +-track_width/2)``, then its casters
     (:attr:`~ddwmmr.model.Robot.casters`)."""
@@ -80,7 +85,9 @@ def support_points(robot) -> tuple[tuple[float, float], ...]:
     return ((0.0, half_track), (0.0, -half_track), *robot.casters)
 
 
-def convex_hull(points) -> np.ndarray:
+def convex_hull(
+    points: Iterable[Sequence[float]] | npt.NDArray[np.float64],
+) -> npt.NDArray[np.float64]:
     """Vertices (k, 2) of the convex hull of 2-D points, counter-clockwise (monotone chain).
 
     Points on an edge are dropped; fewer than 3 non-collinear points give a degenerate hull
@@ -90,10 +97,10 @@ def convex_hull(points) -> np.ndarray:
     if len(pts) < 3:
         return np.array(pts, dtype=float).reshape(-1, 2)
 
-    def cross(o, a, b) -> float:
+    def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
         return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
 
-    def chain(seq):
+    def chain(seq: Iterable[tuple[float, float]]) -> list[tuple[float, float]]:
         out: list[tuple[float, float]] = []
         for p in seq:
             while len(out) >= 2 and cross(out[-2], out[-1], p) <= 1e-12:
@@ -119,13 +126,15 @@ class SupportPolygon:
             farthest support behind edge e.
     """
 
-    vertices: np.ndarray
-    normals: np.ndarray
-    offsets: np.ndarray
-    depths: np.ndarray
+    vertices: npt.NDArray[np.float64]
+    normals: npt.NDArray[np.float64]
+    offsets: npt.NDArray[np.float64]
+    depths: npt.NDArray[np.float64]
 
     @classmethod
-    def from_points(cls, points: Sequence[Sequence[float]]) -> SupportPolygon:
+    def from_points(
+        cls, points: Sequence[Sequence[float]] | npt.NDArray[np.float64]
+    ) -> SupportPolygon:
         """The polygon of base-frame support points (n, 2) in m (at least three not on a
         line)."""
         points = np.asarray(points, dtype=float).reshape(-1, 2)
@@ -140,23 +149,23 @@ class SupportPolygon:
         depths = np.max(points @ normals.T - offsets, axis=0)
         return cls(hull, normals, offsets, depths)
 
-    def distances(self, points) -> np.ndarray:
+    def distances(self, points: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Signed distances (n, k) of points (n, 2) from each edge line (inside > 0), m."""
         return np.asarray(points, dtype=float).reshape(-1, 2) @ self.normals.T - self.offsets
 
-    def off_edge(self, points) -> np.ndarray:
+    def off_edge(self, points: npt.ArrayLike) -> npt.NDArray[np.bool_]:
         """(k, n) booleans: point i lies off edge e (farther than
         :data:`ON_EDGE_TOLERANCE_M` from its line), so its load holds e down."""
         return (np.abs(self.distances(points)) > ON_EDGE_TOLERANCE_M).T
 
 
-def support_polygon(robot) -> SupportPolygon:
+def support_polygon(robot: Robot) -> SupportPolygon:
     """The :class:`SupportPolygon` of a :class:`~ddwmmr.model.Robot`'s wheels and casters
     (the footprint ``base_length x base_width`` with the default casters)."""
     return SupportPolygon.from_points(support_points(robot))
 
 
-def edge_loads_at(polygon: SupportPolygon, weight: float, x, y) -> list:
+def edge_loads_at(polygon: SupportPolygon, weight: float, x: Any, y: Any) -> list[Any]:
     """Edge loads ``weight d_e(c) / D_e`` (N) for a normal force ``weight`` (N) acting at
     the centre of pressure ``c = (x, y)`` (m, base frame); plain arithmetic (numbers or
     CasADi symbols)."""
@@ -184,7 +193,7 @@ class EdgeLoadModel:
     polygon: SupportPolygon
 
     @classmethod
-    def from_robot(cls, robot) -> EdgeLoadModel:
+    def from_robot(cls, robot: Robot) -> EdgeLoadModel:
         """The model of a :class:`~ddwmmr.model.Robot` (masses lumped as
         :mod:`ddwmmr.model.stability` has them)."""
         return cls(robot.com_coefficients, inertial_terms(robot), support_polygon(robot))
@@ -194,22 +203,23 @@ class EdgeLoadModel:
         """The robot's weight ``M g`` (N)."""
         return self.terms.weight
 
-    def static_loads(self, th1, th2) -> list:
+    def static_loads(self, th1: float, th2: float) -> list[float]:
         """Edge loads at rest (N) at joint angles th1, th2 (rad): the weight at the centre
         of mass."""
         return edge_loads_at(self.polygon, self.weight, *centre_of_mass(self.com, th1, th2))
 
     def centre_of_pressure(
         self,
-        th1,
-        th2,
+        # Any: floats, or casadi symbols (ddwmmr.model.symbolic builds the same loads)
+        th1: Any,
+        th2: Any,
         rates: Sequence[Any],
         accelerations: Sequence[Any],
         base_acceleration: Sequence[Any],
-        w,
-        w_dot,
-        cos: Callable = math.cos,
-        sin: Callable = math.sin,
+        w: Any,
+        w_dot: Any,
+        cos: Callable[[Any], Any] = math.cos,
+        sin: Callable[[Any], Any] = math.sin,
     ) -> tuple[Any, Any]:
         """The zero moment point ``(x, y)`` (m, base frame) of a general planar motion:
         joints th1, th2 (rad), their ``rates`` (rad/s) and ``accelerations`` (rad/s^2),
@@ -240,16 +250,17 @@ class EdgeLoadModel:
 
     def loads(
         self,
-        th1,
-        th2,
+        # Any: floats, or casadi symbols (ddwmmr.model.symbolic builds the same loads)
+        th1: Any,
+        th2: Any,
         rates: Sequence[Any],
         accelerations: Sequence[Any],
         base_acceleration: Sequence[Any],
-        w,
-        w_dot,
-        cos: Callable = math.cos,
-        sin: Callable = math.sin,
-    ) -> list:
+        w: Any,
+        w_dot: Any,
+        cos: Callable[[Any], Any] = math.cos,
+        sin: Callable[[Any], Any] = math.sin,
+    ) -> list[Any]:
         """Edge loads (N) of the motion of :meth:`centre_of_pressure` (same arguments)."""
         x, y = self.centre_of_pressure(
             th1, th2, rates, accelerations, base_acceleration, w, w_dot, cos=cos, sin=sin
@@ -258,17 +269,18 @@ class EdgeLoadModel:
 
     def loads_of_motion(
         self,
-        th1,
-        th2,
+        # Any: floats, or casadi symbols (ddwmmr.model.symbolic builds the same loads)
+        th1: Any,
+        th2: Any,
         rates: Sequence[Any],
         accelerations: Sequence[Any],
-        v,
-        w,
-        v_dot,
-        w_dot,
-        cos: Callable = math.cos,
-        sin: Callable = math.sin,
-    ) -> list:
+        v: Any,
+        w: Any,
+        v_dot: Any,
+        w_dot: Any,
+        cos: Callable[[Any], Any] = math.cos,
+        sin: Callable[[Any], Any] = math.sin,
+    ) -> list[Any]:
         """Edge loads (N) of a base that rolls without slipping: forward speed v (m/s) and
         its rate v_dot (m/s^2), so that ``base_acceleration = (v_dot, v w)``."""
         return self.loads(

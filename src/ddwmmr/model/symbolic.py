@@ -152,7 +152,14 @@ def stability_edges(
 
 
 def zero_moment_point(
-    robot: Robot, q: Symbolic, rates: Symbolic, v, w, v_dot, w_dot, accelerations=(0.0, 0.0)
+    robot: Robot,
+    q: Symbolic,
+    rates: Symbolic,
+    v: Symbolic,
+    w: Symbolic,
+    v_dot: Symbolic,
+    w_dot: Symbolic,
+    accelerations: Symbolic = (0.0, 0.0),
 ) -> Symbolic:
     """Zero moment point ``[x, y]`` in the base frame (m): the formula of
     :func:`ddwmmr.model.stability.zero_moment_point` built symbolically (joint rates
@@ -220,7 +227,9 @@ def wheel_speeds(robot: Robot, v: Symbolic, w: Symbolic) -> Symbolic:
     return ca.vertcat((2.0 * v - lw * w) / (2.0 * r), (2.0 * v + lw * w) / (2.0 * r))
 
 
-def rk4_step(rhs, x: Symbolic, u: Symbolic, h: float | Symbolic) -> Symbolic:
+def rk4_step(
+    rhs: Callable[[Symbolic, Symbolic], Symbolic], x: Symbolic, u: Symbolic, h: float | Symbolic
+) -> Symbolic:
     """One classical Runge-Kutta step of ``xdot = rhs(x, u)`` with u held over h (s)."""
     k1 = rhs(x, u)
     k2 = rhs(x + 0.5 * h * k1, u)
@@ -229,7 +238,7 @@ def rk4_step(rhs, x: Symbolic, u: Symbolic, h: float | Symbolic) -> Symbolic:
     return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
 
 
-def _trig(value: Symbolic) -> tuple[Callable, Callable]:
+def _trig(value: Symbolic) -> tuple[Callable[[Symbolic], Symbolic], Callable[[Symbolic], Symbolic]]:
     """``(cos, sin)`` for a value: ``math``'s for a plain number (float out), CasADi's for
     a symbol."""
     return (math.cos, math.sin) if isinstance(value, int | float) else (ca.cos, ca.sin)
@@ -345,13 +354,15 @@ class ThesisDynamics:
             ((f_right - f_left) * self.half_width - self.c2 * w) / self.inertia(th2),
         )
 
-    def arm_momentum(self, th2, rates) -> Symbolic:
+    def arm_momentum(self, th2: Symbolic, rates: Symbolic) -> Symbolic:
         """The arm's angular momentum ``H`` about the base centre from its own motion
         (kg m^2/s) at joint rates ``rates`` (rad/s)."""
         a, b = self._arm_levers(_trig(th2)[0](th2))
         return a * rates[0] + b * (rates[0] + rates[1])
 
-    def arm_yaw_reaction(self, th2, w, rates, accelerations) -> Symbolic:
+    def arm_yaw_reaction(
+        self, th2: Symbolic, w: Symbolic, rates: Symbolic, accelerations: Symbolic
+    ) -> Symbolic:
         """Yaw acceleration (rad/s^2) the arm's own motion adds to the base's: the total
         angular momentum ``I(th2) w + H`` about the base centre changes only by the
         wheels' torque and the damping, so ``I wdot`` loses ``dI/dt w + dH/dt``. Joint
@@ -369,7 +380,7 @@ class ThesisDynamics:
         )
         return -change / self.inertia(th2)
 
-    def _arm_levers(self, cos2) -> tuple[Symbolic, Symbolic]:
+    def _arm_levers(self, cos2: Symbolic) -> tuple[Symbolic, Symbolic]:
         """``(a, b)`` of :meth:`arm_momentum` at ``cos th2`` (kg m^2)."""
         k = 0.5 * self.inertia_cos
         return self.shoulder_fixed + k * cos2, self.elbow_fixed + k * cos2
