@@ -48,7 +48,8 @@ def make_plant(name: str, robot: Robot, **options: Any) -> Plant:
         raise ParameterError(
             f"plant {name}: unknown option {shown(unknown[0])} (accepted: {', '.join(accepted)})"
         )
-    return cls(robot, **options)
+    plant: Plant = cls(robot, **options)
+    return plant
 
 
 def __getattr__(name: str) -> Any:

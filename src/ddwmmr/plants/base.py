@@ -39,7 +39,7 @@ from ddwmmr.model.kinematics import check_configuration
 #: A continuous-time control law for integrator stages: ``(t, q) -> u``, time in s, the
 #: configuration as a list of 5 floats, the velocity command as 4 numbers (a tuple of
 #: floats or an array).
-Policy = Callable[[float, list[float]], Sequence[float]]
+Policy = Callable[[float, list[float]], Sequence[float] | np.ndarray]
 
 
 class Observation:
@@ -227,6 +227,7 @@ def check_step(
     of ``dt``; anything else takes the slow path, which names the fault and clears sums
     that merely overflowed.
     """
+    values: list[float]  # the command's tolist() below
     try:
         if isinstance(dt, float) and 0.0 < dt < _INF:
             if type(command) is np.ndarray and command.dtype is FLOAT64:

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -43,6 +43,9 @@ from ddwmmr.plants.base import (
 )
 from ddwmmr.registry import register_plant
 
+if TYPE_CHECKING:
+    import numpy.typing as npt
+
 INTEGRATORS = ("euler", "rk4")
 
 
@@ -50,6 +53,8 @@ INTEGRATORS = ("euler", "rk4")
 class KinematicPlant:
     """Kinematic model of the differential-drive mobile manipulator (velocity interface)."""
 
+    #: Set by the register_plant decorator (declared here for the type checker).
+    interfaces: tuple[str, ...]
     extra_columns: tuple[str, ...] = ()
 
     def __init__(self, robot: Robot, integrator: str = "rk4") -> None:
@@ -93,7 +98,8 @@ class KinematicPlant:
         ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s, rad/s, rad/s), see :meth:`integrate`;
         other arguments are a :class:`ParameterError` (:func:`check_step`), and so is a
         ``policy`` that is neither None nor callable (:func:`check_policy`)."""
-        values = check_step(t, command, dt, self.interfaces)
+        # cast: on the velocity interface alone check_step returns the list of 4 floats
+        values = cast("list[float]", check_step(t, command, dt, self.interfaces))
         check_policy(policy)
         state = self._state
         if command is self._limited:  # limit() saturated this very command
@@ -126,7 +132,11 @@ class KinematicPlant:
         return np.array([v, w, t1, t2]), saturated
 
     def _saturate(
-        self, th1: float, th2: float, u, checked: bool = False
+        self,
+        th1: float,
+        th2: float,
+        u: Sequence[float] | npt.NDArray[np.float64],
+        checked: bool = False,
     ) -> tuple[tuple[float, ...], bool]:
         """:meth:`saturate` on floats (joint angles th1, th2 in rad; ``u`` a tuple of
         floats, an array or any sequence of 4 numbers; a non-finite one, as from a policy
@@ -185,7 +195,8 @@ class KinematicPlant:
             raise ValueError("a policy or a first_command is needed")
         state = q.tolist()
         th1, th2 = state[3], state[4]
-        command = policy(t, state) if first_command is None else first_command
+        # cast: policy is not None when first_command is (refused above)
+        command = cast("Policy", policy)(t, state) if first_command is None else first_command
         if saturated and first_command is not None:
             u0, saturated0 = tuple(first_command.tolist()), False
         else:

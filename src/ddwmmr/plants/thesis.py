@@ -210,6 +210,8 @@ class ThesisPlant:
     sample (N), ``force_left_n`` and ``force_right_n``.
     """
 
+    #: Set by the register_plant decorator (declared here for the type checker).
+    interfaces: tuple[str, ...]
     extra_columns = ("force_left_n", "force_right_n")
 
     def __init__(
@@ -222,7 +224,8 @@ class ThesisPlant:
         velocity_bandwidth: float = VELOCITY_BANDWIDTH,
     ) -> None:
         self.robot = check_instance("robot", robot, Robot)
-        given = {"force_limit": force_limit, "c1": c1, "c2": c2}
+        # Any: the arguments as given, which check_positive checks
+        given: dict[str, Any] = {"force_limit": force_limit, "c1": c1, "c2": c2}
         derived = {
             name: value for name, value in robot_constants(robot).items() if given[name] is None
         }

@@ -49,14 +49,19 @@ from __future__ import annotations
 import math
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, cast
 
-import mujoco
+# mujoco ships no type hints (no py.typed): its objects are Any to mypy
+import mujoco  # type: ignore[import-untyped]
 import numpy as np
 
 from ddwmmr.errors import ParameterError, check_positive, check_range, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import BASE_CLEARANCE_M
 from ddwmmr.model.support_loads import convex_hull
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
 
 #: Radius of the caster spheres (m).
 CASTER_RADIUS = 0.025
@@ -247,7 +252,11 @@ def supports(robot: Robot) -> tuple[Support, ...]:
         names = [f"caster_{corner}" for corner in _CORNER_NAMES]
     else:
         names = [f"caster_{i}" for i in range(1, len(robot.casters) + 1)]
-    casters = tuple(Support(n, tuple(p), "caster") for n, p in zip(names, robot.casters))
+    # cast: each caster is an (x, y) pair (Robot.casters), which tuple() keeps
+    casters = tuple(
+        Support(n, cast("tuple[float, float]", tuple(p)), "caster")
+        for n, p in zip(names, robot.casters)
+    )
     return wheels + casters
 
 
@@ -285,7 +294,7 @@ def check_buildable(robot: Robot) -> None:
         )
 
 
-def _edge_distances(hull: np.ndarray, point) -> np.ndarray:
+def _edge_distances(hull: npt.NDArray[np.float64], point: npt.ArrayLike) -> npt.NDArray[np.float64]:
     """Signed distances (m) of ``point`` from each edge line of a CCW hull (inside > 0)."""
     start, end = hull, np.roll(hull, -1, axis=0)
     edge = end - start
@@ -360,14 +369,18 @@ def reflected_inertias(robot: Robot) -> tuple[float, float, float]:
 def servo_gains(robot: Robot, time_constant: float) -> tuple[float, float, float]:
     """Velocity-servo gains ``(kv_wheel, kv_shoulder, kv_elbow)`` (N m s/rad): each joint's
     largest reflected inertia (:func:`reflected_inertias`) over ``time_constant``."""
-    return tuple(inertia / time_constant for inertia in reflected_inertias(robot))
+    # cast: reflected_inertias gives three, so the tuple has three (mypy counts no generator)
+    return cast(
+        "tuple[float, float, float]",
+        tuple(inertia / time_constant for inertia in reflected_inertias(robot)),
+    )
 
 
 def _fmt(*values: float) -> str:
     return " ".join(f"{v:.17g}" for v in values)
 
 
-def _sub(parent: ET.Element, tag: str, **attributes) -> ET.Element:
+def _sub(parent: ET.Element, tag: str, **attributes: object) -> ET.Element:
     return ET.SubElement(parent, tag, {k: str(v) for k, v in attributes.items()})
 
 

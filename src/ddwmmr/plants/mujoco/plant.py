@@ -25,9 +25,10 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import mujoco
+# mujoco ships no type hints (no py.typed): its objects are Any to mypy
+import mujoco  # type: ignore[import-untyped]
 import numpy as np
 
 from ddwmmr.commands import VELOCITY, WheelForces
@@ -57,6 +58,9 @@ from ddwmmr.plants.mujoco.model import (
 from ddwmmr.plants.mujoco.support import SupportGeometry, centre_of_pressure
 from ddwmmr.plants.thesis import arm_step, damped_base_envelope
 from ddwmmr.registry import register_plant
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
 
 #: Time (s) the robot settles on its supports in :meth:`MujocoPlant.reset` before t = 0,
 #: so that the first recorded contact forces carry the robot's weight (on its tyres: after
@@ -155,6 +159,9 @@ class MujocoPlant:
         ParameterError: for a robot or option MuJoCo cannot build (one line).
     """
 
+    #: Set by the register_plant decorator (declared here for the type checker).
+    interfaces: tuple[str, ...]
+
     def __init__(
         self,
         robot: Robot,
@@ -168,7 +175,8 @@ class MujocoPlant:
         tyre_stiffness: float | None = None,
     ) -> None:
         self.base_damping = _check_damping(base_damping)
-        given = {
+        # Any: the options as given, which EngineOptions checks
+        given: dict[str, Any] = {
             "timestep": timestep,
             "friction": friction,
             "servo_time_constant": servo_time_constant,
@@ -221,8 +229,9 @@ class MujocoPlant:
     def _lookup_ids(self) -> dict[str, Any]:
         model = self.model
 
-        def find(kind, name: str) -> int:
-            return mujoco.mj_name2id(model, kind, name)
+        def find(kind: mujoco.mjtObj, name: str) -> int:
+            index: int = mujoco.mj_name2id(model, kind, name)
+            return index
 
         geom_support = np.full(model.ngeom, -1, dtype=int)
         for i, support in enumerate(self.supports):
@@ -840,7 +849,7 @@ def tip_time_s(
     return detector.tip_time
 
 
-def _heading(quaternion) -> float:
+def _heading(quaternion: npt.NDArray[np.float64]) -> float:
     """Heading (rad) of a body's x axis projected on the floor, from its quaternion."""
     w, x, y, z = (float(v) for v in quaternion)
     return math.atan2(2.0 * (x * y + w * z), 1.0 - 2.0 * (y * y + z * z))

@@ -30,10 +30,17 @@ Definitions (docs/physics.md, "Tip-over from the contact forces"):
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ddwmmr.model.stability import SupportEdges, support_margins
 from ddwmmr.model.support_loads import SupportPolygon
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import numpy.typing as npt
 
 
 class SupportGeometry:
@@ -51,7 +58,7 @@ class SupportGeometry:
             pivoting).
     """
 
-    def __init__(self, points) -> None:
+    def __init__(self, points: npt.ArrayLike) -> None:
         self.points = np.asarray(points, dtype=float).reshape(-1, 2)
         self.polygon = SupportPolygon.from_points(self.points)
         polygon = self.polygon
@@ -59,11 +66,11 @@ class SupportGeometry:
         self.off_edge = polygon.off_edge(self.points)
         self._off_edge_lists = [np.flatnonzero(row).tolist() for row in self.off_edge]
 
-    def distances(self, points) -> np.ndarray:
+    def distances(self, points: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Signed distances (n, k) of points (n, 2) from each edge line (inside > 0), m."""
         return self.polygon.distances(points)
 
-    def edge_loads(self, forces: np.ndarray) -> np.ndarray:
+    def edge_loads(self, forces: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         """Load (N) on the supports off each edge, for support forces (n,) in N."""
         return self.off_edge @ forces
 
@@ -72,14 +79,16 @@ class SupportGeometry:
         read after every control step."""
         return min(sum(forces[i] for i in off) for off in self._off_edge_lists)
 
-    def stability(self, centre_of_pressure) -> float:
+    def stability(self, centre_of_pressure: Sequence[float] | npt.NDArray[np.float64]) -> float:
         """``S_phys`` of a centre of pressure (base frame, m); see the module docstring."""
         return support_margins(
             self.edges, float(centre_of_pressure[0]), float(centre_of_pressure[1])
         )[2]
 
 
-def centre_of_pressure(points: np.ndarray, forces: np.ndarray) -> np.ndarray | None:
+def centre_of_pressure(
+    points: npt.NDArray[np.float64], forces: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64] | None:
     """Force-weighted mean (2,) of contact points (n, 2); None if the total force is ~0."""
     total = float(np.sum(forces))
     if total <= 1e-9:
