@@ -188,7 +188,9 @@ def bernoulli_step(w0: float, alpha: float, beta: float, tau: float) -> float:
     return math.copysign(math.sqrt(u), w0)
 
 
-def _check_inputs(advantages: Sequence[float], interactions, n: int) -> None:
+def _check_inputs(
+    advantages: Sequence[float], interactions: Sequence[Sequence[float]], n: int
+) -> None:
     if len(advantages) != n or len(interactions) != n or any(len(r) != n for r in interactions):
         raise ParameterError(f"advantages and interactions: need {n} and {n}x{n} values")
     total = math.fsum(advantages) + math.fsum(math.fsum(r) for r in interactions)
@@ -358,7 +360,7 @@ class CompetitiveDynamicsArbiter:
             [par.time_constants[b] for b in BEHAVIOURS], par.noise, seed, par.floor
         )
         self.record = record
-        self.history: dict[str, list] = {}
+        self.history: dict[str, list[float | str]] = {}
         self._h_stability = self._saturate(par.stability_gain * (stability.exit - stability.enter))
         self._h_manipulability = self._saturate(
             par.manipulability_gain * (manipulability.exit - manipulability.enter)
@@ -500,9 +502,10 @@ def _state_of(behaviour: str, objective: Proposal) -> str:
 def _inside_buffer(obstacle: Behaviour | None, p: Percept) -> float:
     """How far (m) the base is inside the obstacle behaviour's buffer of its threat (>= 0)."""
     threat = getattr(obstacle, "threat", None)
-    found = threat(p) if callable(threat) else None
+    # ObstacleBehaviour.threat's type: (x, y, radius, distance), m
+    found: tuple[float, float, float, float] | None = threat(p) if callable(threat) else None
     if found is None:
         return 0.0
     _, _, radius, distance = found
-    buffer = obstacle.clearance + obstacle.speed_factor * abs(p.v) + obstacle.bubble + radius  # type: ignore[union-attr]
+    buffer: float = obstacle.clearance + obstacle.speed_factor * abs(p.v) + obstacle.bubble + radius  # type: ignore[union-attr]
     return max(0.0, buffer - distance)

@@ -240,7 +240,8 @@ def make_controller(
     check_known_options(name, options, method_options(name))
     texts = [(option, value) for option, value in options.items() if isinstance(value, NumberText)]
     if not texts:
-        return cls(robot, **options)
+        controller: Controller = cls(robot, **options)
+        return controller
     try:  # the method's own check refuses the text, naming the allowed range
         cls(robot, **options)
     except ParameterError:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -22,6 +23,9 @@ from ddwmmr.model.kinematics import check_angles, principal_angle, refuse_angles
 from ddwmmr.resolution import kernels
 from ddwmmr.resolution.reference import ReferenceTrajectory, start_configuration
 from ddwmmr.trajectories.base import require_trajectory
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
 
 #: Default time constant (s) of every closed-loop channel.
 DEFAULT_TAU = 0.5
@@ -166,7 +170,9 @@ class ConfigurationSpaceController:
                 f"{MAX_STEPS} reference steps; use a larger reference_step"
             ) from None
 
-    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+    def command(
+        self, t: float, q: npt.ArrayLike, pose_d: npt.ArrayLike, velocity_d: npt.ArrayLike
+    ) -> np.ndarray:
         """Reference rate plus configuration-error feedback, projected on the inputs.
 
         The sideways part of the commanded base velocity cannot be produced; it is reported

@@ -229,8 +229,8 @@ def option_spec(
     if words & {"dict", "Mapping"} or isinstance(default, dict):
         return None
     if isinstance(default, bool) or words == {"bool"} or words == {"bool", "None"}:
-        choices = (None, True, False) if optional else (True, False)
-        return OptionSpec(name, default, "choice", choices, optional, unit=unit)
+        flags = (None, True, False) if optional else (True, False)
+        return OptionSpec(name, default, "choice", flags, optional, unit=unit)
     numeric = isinstance(default, int | float) or (default is None and words & {"float", "int"})
     if numeric and not words & {"str", "Path"}:
         several = bool(words & {"Sequence", "tuple", "list"})
@@ -250,7 +250,7 @@ def _annotation_text(parameter: inspect.Parameter) -> str:
 def option_names(method: str) -> tuple[str, ...]:
     """The names of :func:`option_specs` of ``method``, without listing any choice's values
     (no solver is imported): what ``--help`` lists."""
-    unlisted = {name: list for name in _choices(method)}
+    unlisted: dict[str, Callable[[], list[Any]]] = {name: list for name in _choices(method)}
     return tuple(spec.name for spec in _specs(method, unlisted))
 
 
@@ -282,7 +282,7 @@ def split_option(text: str, what: str = "option") -> tuple[str, str]:
     return name, value
 
 
-def parse_options(method: str, texts: Sequence[str] | None, what: str = "option") -> dict:
+def parse_options(method: str, texts: Sequence[str] | None, what: str = "option") -> dict[str, Any]:
     """``{name: value}`` of several ``NAME=VALUE`` texts for ``method`` (see
     :func:`parse_option`); a name given twice is refused."""
     options: dict[str, Any] = {}

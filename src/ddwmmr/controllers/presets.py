@@ -86,4 +86,5 @@ def _same(a: Any, b: Any) -> bool:
         return all(x == b for x in a)
     if isinstance(b, tuple | list) and not isinstance(a, tuple | list):
         return all(a == y for y in b)
-    return a == b
+    same: bool = a == b  # option values: numbers, texts, None
+    return same

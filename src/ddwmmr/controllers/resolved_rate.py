@@ -7,6 +7,7 @@ ignore the pose error, so an initial offset is kept (and integration errors accu
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -17,6 +18,9 @@ from ddwmmr.gains import check_gain
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import AUX_ROWS, whole_turns
 from ddwmmr.resolution import kernels
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
 
 #: An input ``(v, w, th1dot, th2dot)`` as floats (m/s, rad/s, rad/s, rad/s).
 Input = tuple[float, float, float, float]
@@ -56,7 +60,9 @@ class ResolvedRate(ABC):
         check_start(q0)
         self.last = StepInfo()
 
-    def command(self, t, q, pose_d, velocity_d) -> np.ndarray:
+    def command(
+        self, t: float, q: npt.ArrayLike, pose_d: npt.ArrayLike, velocity_d: npt.ArrayLike
+    ) -> np.ndarray:
         """Input ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s) for the desired
         end-effector velocity (world frame, m/s, rad/s); the arguments are validated."""
         q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
@@ -86,7 +92,9 @@ def check_aux(aux: str) -> str:
 class PseudoinverseController(ResolvedRate):
     """RR-PI: pseudoinverse resolution qdot = J^# Xd_dot (open loop)."""
 
-    def law(self, t, q, pose_d, velocity_d) -> tuple[Input, bool]:
+    def law(
+        self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
+    ) -> tuple[Input, bool]:
         """Minimum-norm input for the desired end-effector velocity (m/s, rad/s)."""
         _, _, phi, th1, th2 = q
         xd, yd, pd = velocity_d
@@ -99,11 +107,13 @@ class PseudoinverseController(ResolvedRate):
 class AugmentedTaskSpaceController(ResolvedRate):
     """RR-ATS: augmented task space, one auxiliary row (aux = sum | shoulder), open loop."""
 
-    def __init__(self, robot: Robot, aux: str = "shoulder", **kwargs) -> None:
+    def __init__(self, robot: Robot, aux: str = "shoulder", **kwargs: float | None) -> None:
         super().__init__(robot, **kwargs)
         self.aux = check_aux(aux)
 
-    def law(self, t, q, pose_d, velocity_d) -> tuple[Input, bool]:
+    def law(
+        self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
+    ) -> tuple[Input, bool]:
         """Input solving the square augmented system for the desired velocity."""
         _, _, phi, th1, th2 = q
         xd, yd, pd = velocity_d
@@ -117,7 +127,12 @@ class ArtificialPotentialController(ResolvedRate):
     """RR-AP: pseudoinverse plus null-space descent of V = K1 th1^2 + K2 th2^2 + K3 phi^2."""
 
     def __init__(
-        self, robot: Robot, K1: float = 1.0, K2: float = 0.25, K3: float = 0.66, **kwargs
+        self,
+        robot: Robot,
+        K1: float = 1.0,
+        K2: float = 0.25,
+        K3: float = 0.66,
+        **kwargs: float | None,
     ) -> None:
         super().__init__(robot, **kwargs)
         self.K1 = check_gain("K1", K1, zero=True)
@@ -133,7 +148,9 @@ class ArtificialPotentialController(ResolvedRate):
         super().reset(trajectory, q0)
         self._turns = (whole_turns(float(q0[2])), whole_turns(float(q0[3])))
 
-    def law(self, t, q, pose_d, velocity_d) -> tuple[Input, bool]:
+    def law(
+        self, t: float, q: list[float], pose_d: list[float], velocity_d: list[float]
+    ) -> tuple[Input, bool]:
         """Pseudoinverse input plus the projected potential descent (K2 has no effect: th2
         cannot move without moving the end effector, so it is not in the null space)."""
         _, _, phi, th1, th2 = q

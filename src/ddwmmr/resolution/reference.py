@@ -13,6 +13,7 @@
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -21,6 +22,11 @@ from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import base_motion, principal_angle
 from ddwmmr.resolution import kernels
 from ddwmmr.trajectories.base import sampler
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import numpy.typing as npt
 
 #: Default initial end-effector offset of the default robot (m; of any robot in its length
 #: unit, :func:`default_offset`) in the end effector's start frame (x along its orientation
@@ -52,7 +58,7 @@ OFFSET_TOLERANCE_M = 1e-12
 OFFSET_RELATIVE_TOLERANCE = 1e-14
 
 
-def start_configuration(robot: Robot, trajectory) -> np.ndarray:
+def start_configuration(robot: Robot, trajectory: Any) -> np.ndarray:
     """Configuration with the robot's ``home_pose`` arm whose end effector is at the start
     pose ``trajectory.pose(0)`` (position and orientation).
 
@@ -65,7 +71,11 @@ def start_configuration(robot: Robot, trajectory) -> np.ndarray:
 
 
 def initial_configuration(
-    robot: Robot, trajectory, offset, *, name: str = "initial_offset"
+    robot: Robot,
+    trajectory: Any,
+    offset: Sequence[float] | npt.NDArray[np.float64],
+    *,
+    name: str = "initial_offset",
 ) -> np.ndarray:
     """A run's start: :func:`start_configuration` with the end effector moved by ``offset``
     (dx, dy) m in its frame (:func:`offset_configuration`, whose refusal names the offset
@@ -74,7 +84,11 @@ def initial_configuration(
 
 
 def offset_configuration(
-    robot: Robot, q: np.ndarray, offset, *, name: str = "initial_offset"
+    robot: Robot,
+    q: np.ndarray,
+    offset: Sequence[float] | npt.NDArray[np.float64],
+    *,
+    name: str = "initial_offset",
 ) -> np.ndarray:
     """``q`` with the arm joints changed so the end effector moves by ``offset`` (dx, dy) m.
 
@@ -283,7 +297,7 @@ class ReferenceTrajectory:
     def __init__(
         self,
         robot: Robot,
-        trajectory,
+        trajectory: Any,
         q_start: np.ndarray,
         aux: str = "shoulder",
         step: float = 0.01,
@@ -315,7 +329,8 @@ class ReferenceTrajectory:
         self._last_lookup = 0.0
         if self.horizon is not None:
             piece = self._pieces[0]
-            self._integrate(piece, self._fine_end(piece, self.horizon, None))
+            # cast: with no limit _fine_end always returns an index
+            self._integrate(piece, cast(int, self._fine_end(piece, self.horizon, None)))
             self._end = piece.origin + (piece.count - 1) * piece.step
 
     def _rate(self, q: list[float], velocity: list[float]) -> tuple[list[float], bool]:
