@@ -21,8 +21,10 @@ that are not what a function asks for, a negative mass) is a one-line
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
-import control
+# python-control ships no type hints (no py.typed): its objects are Any to mypy
+import control  # type: ignore[import-untyped]
 import numpy as np
 
 from ddwmmr.errors import (
@@ -34,6 +36,9 @@ from ddwmmr.errors import (
 )
 from ddwmmr.gains import MIN_TAU, check_gain, gains_from_tau
 from ddwmmr.trajectories.base import check_times
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
 
 #: Feedback channels of each closed-loop method, in the order of its ``tau`` values.
 CHANNELS = {
@@ -212,7 +217,9 @@ def saturated_velocity_step(
     check_finite("step", step)
     times = check_response_times(times, spaced=False)
 
-    def update(t, x, u, params):
+    def update(
+        t: float, x: npt.NDArray[np.float64], u: npt.NDArray[np.float64], params: object
+    ) -> list[float]:
         force = damping * u[0] + bandwidth * mass * (u[0] - x[0])
         force = min(force_limit, max(-force_limit, force))
         return [(force - damping * x[0]) / mass]

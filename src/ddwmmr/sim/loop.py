@@ -80,10 +80,10 @@ from __future__ import annotations
 
 import time
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from math import isfinite
-from typing import Any, NoReturn, Protocol
+from typing import Any, NoReturn, Protocol, cast
 
 import numpy as np
 
@@ -180,10 +180,10 @@ def spoken_interface(controller: Any, plant: Plant) -> str:
     """The command interface ``controller`` speaks on ``plant``, unchecked: its
     ``interface`` if it has one, else the first of its declared ``interfaces`` (default
     velocity) that the plant accepts, else the first declared."""
-    interface = getattr(controller, "interface", None)
+    interface: str | None = getattr(controller, "interface", None)
     if interface is not None:
         return interface
-    declared = tuple(getattr(controller, "interfaces", None) or (VELOCITY,))
+    declared: tuple[str, ...] = tuple(getattr(controller, "interfaces", None) or (VELOCITY,))
     return next((i for i in declared if i in plant.interfaces), declared[0])
 
 
@@ -335,12 +335,13 @@ def run_loop(
                 command = command_of(t, np.array(q), pose_d, velocity_d)
             except Exception as error:
                 raise_wrapped(controller, error, k, t, "command")
-            return checked_command(command, False, controller, k, t)
+            checked: np.ndarray = checked_command(command, False, controller, k, t)
+            return checked
         except Exception as error:
             stage_errors.append(error)
             raise
 
-    def law_policy(t: float, q: list[float]) -> tuple[float, ...]:
+    def law_policy(t: float, q: list[float]) -> Sequence[float] | np.ndarray:
         """The same through the controller's float-level ``law`` (no validation, no step
         info: stage states are the integrator's own finite floats). A non-finite result
         goes through ``command`` (:func:`policy`), whose validation names the argument that
@@ -348,7 +349,8 @@ def run_loop(
         pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
         try:
             try:
-                result = law(t, q, pose_d.tolist(), velocity_d.tolist())
+                # cast: law_policy is the stage policy only when law is not None (below)
+                result = cast("Callable[..., Any]", law)(t, q, pose_d.tolist(), velocity_d.tolist())
             except Exception as error:
                 raise_wrapped(controller, error, k, t, "law")
             try:

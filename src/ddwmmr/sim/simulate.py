@@ -6,7 +6,7 @@ import dataclasses
 import math
 import warnings
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -145,14 +145,14 @@ def check_start(
         raise ParameterError(message)
 
 
-def start_stability(robot: Robot, q: Sequence[float]) -> float:
+def start_stability(robot: Robot, q: Sequence[float] | npt.NDArray[np.float64]) -> float:
     """The static tip-over stability margin S of configuration ``q`` (S <= 1: tipped)."""
     return float(robot.stability(np.asarray(q, dtype=float))[2])
 
 
 def tipping_message(
     robot: Robot,
-    q: Sequence[float],
+    q: Sequence[float] | npt.NDArray[np.float64],
     name: str = "payload",
     start: str | None = "the start (q0, initial_offset)",
 ) -> str | None:
@@ -180,7 +180,9 @@ def tipping_message(
     return _arm_tips_message(robot, q, s, start) + doubt
 
 
-def _arm_tips_message(robot: Robot, q: Sequence[float], s: float, start: str | None) -> str:
+def _arm_tips_message(
+    robot: Robot, q: Sequence[float] | npt.NDArray[np.float64], s: float, start: str | None
+) -> str:
     """:func:`tipping_message` for a robot that tips in the start pose ``q`` even without
     its payload: the arm's reach and masses against the base's footprint are the cause,
     and a start pose the advice only where some arm pose might stand."""
@@ -385,7 +387,7 @@ def _run_keys(
 
 
 def _add_plug_in_summaries(
-    summary: dict, plant: Plant, controller: Any, timeseries: dict[str, np.ndarray]
+    summary: dict[str, Any], plant: Plant, controller: Any, timeseries: dict[str, np.ndarray]
 ) -> None:
     """``summary`` updated with the plant's ``summarize()`` keys, then the controller's
     (if it has ``summarize``), then its ``aux`` row (if set)."""
@@ -396,7 +398,9 @@ def _add_plug_in_summaries(
         summary["aux"] = controller.aux  # the verdict's likely cause names the slides' row
 
 
-def _add_plug_in_keys(summary: dict, owner: Any, role: str, keys: Mapping[str, Any]) -> None:
+def _add_plug_in_keys(
+    summary: dict[str, Any], owner: Any, role: str, keys: Mapping[str, Any]
+) -> None:
     """``summary`` updated with the ``keys`` that ``owner``'s ``summarize()`` returned; a
     plug-in's keys that the verdict cannot read (:func:`check_summary`: a count above the
     run's steps, a flag that is no boolean) are a one-line :class:`ParameterError` naming
@@ -466,7 +470,7 @@ def check_tracks(method: str) -> None:
 
 
 def build_plant(
-    plant: str | Plant,
+    plant: str | PlantImplementation,
     robot: Robot,
     integrator: str | None = None,
     options: dict[str, Any] | None = None,
@@ -487,7 +491,9 @@ def build_plant(
             )
         if integrator is not None or options:
             raise ParameterError("integrator and plant_options need a plant name, not an object")
-        return plant
+        # cast: a plant object runs as given; the loop reads a Plant's name and interfaces
+        # from it (register_plant sets them) and its checked calls name what is missing
+        return cast(Plant, plant)
     options = dict(options or {})
     resolved = plant_integrator(plant, integrator)
     if resolved is not None:
@@ -621,7 +627,8 @@ def limit_counts(ts: dict[str, np.ndarray], robot: Robot) -> dict[str, Any]:
 def wheel_speeds(ts: dict[str, np.ndarray]) -> np.ndarray:
     """Per sample, the faster wheel's speed (rad/s, absolute): of the wheel speeds of
     :func:`~ddwmmr.sim.tracking.derive_columns`."""
-    return np.maximum(np.abs(ts["wheel_left_rad_s"]), np.abs(ts["wheel_right_rad_s"]))
+    speeds: np.ndarray = np.maximum(np.abs(ts["wheel_left_rad_s"]), np.abs(ts["wheel_right_rad_s"]))
+    return speeds
 
 
 def joint_rates(ts: dict[str, np.ndarray]) -> np.ndarray:

@@ -142,7 +142,17 @@ class TrackingTask:
             cached = self._cache[t] = (self._pose(t), self._velocity(t))
         return cached
 
-    def record(self, k, t, obs, command, applied, saturated, info, step_ns) -> None:
+    def record(
+        self,
+        k: int,
+        t: float,
+        obs: Observation,
+        command: Any,
+        applied: Any,
+        saturated: bool,
+        info: Any,
+        step_ns: int,
+    ) -> None:
         """One row: t, q, u, the desired pose, flags, timing (us)."""
         if isinstance(applied, WheelForces):
             u = _force_equivalent(obs)
@@ -432,7 +442,7 @@ DIFFERENCE_STEP = 1e-6
 def spot_times(trajectory: Any) -> np.ndarray | None:
     """The times (s) :data:`SPOT_FRACTIONS` of the trajectory's ``duration``, or None when
     the duration is not a finite number > 0 (the run refuses it with its own message)."""
-    duration = getattr(trajectory, "duration", None)
+    duration: Any = getattr(trajectory, "duration", None)
     number = isinstance(duration, int | float | np.integer | np.floating)
     if not number or isinstance(duration, bool) or not 0.0 < float(duration) < math.inf:
         return None
