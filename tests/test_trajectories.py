@@ -15,6 +15,7 @@ from ddwmmr.trajectories.files import (
     package_folder,
 )
 from ddwmmr.trajectories.sampled import csv_text
+from one_line import one_line
 
 
 def numeric_velocity(trajectory, t, h=1e-5):
@@ -139,6 +140,35 @@ def test_csv_with_a_trailing_comma_reads_as_without_it(tmp_path):
     trailing.write_text("t,x,y,\n0,0,0,7\n1,1,0.5,7\n2,2,0,7\n")
     with pytest.raises(ParameterError, match=r"blank column name over values \(column 4\); needs"):
         read_csv(trailing)
+
+
+@pytest.mark.parametrize(
+    ("header", "row", "shown"),
+    [
+        ("t x y", "0 0 0", "'t x y'"),
+        ("t;x;y;phi", "0;0;0;0", "'t;x;y;phi'"),
+        ("t\tx\ty", "0\t0\t0", "'t\\tx\\ty'"),
+        ("t  x   y", "0  0   0", "'t x y'"),  # shown on one line, spaces collapsed
+    ],
+)
+def test_csv_separated_by_something_else_than_commas_says_so(tmp_path, header, row, shown):
+    """A header of accepted names joined by spaces, tabs or semicolons reads as one column:
+    the refusal names the separator as the fault, not the columns."""
+    path = tmp_path / "other.csv"
+    path.write_text(f"{header}\n{row}\n1{row[1:]}\n", encoding="utf-8")
+    with pytest.raises(ParameterError) as refusal:
+        read_csv(path)
+    assert one_line(refusal) == (
+        f"traj: {path} separates its columns by something else than commas (header {shown}); "
+        "needs a header line t,x,y or t,x,y,phi, comma-separated"
+    )
+
+
+def test_a_one_column_header_of_other_names_is_still_unknown_columns(tmp_path):
+    path = tmp_path / "other.csv"
+    path.write_text("time x y\n0 0 0\n", encoding="utf-8")
+    with pytest.raises(ParameterError, match=r"unknown column\(s\) 'time x y' \(accepted"):
+        read_csv(path)
 
 
 # -- shipped files, names and paths (issue 8) ---------------------------------------------

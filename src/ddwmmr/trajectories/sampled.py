@@ -538,6 +538,17 @@ def _plain_values(lines: list[str]) -> npt.NDArray[np.float64] | None:
     return np.array(flat, dtype=float).reshape(-1, columns)
 
 
+def _split_names(name: str) -> list[str]:
+    """The column names a one-column header ``name`` holds when split at semicolons, tabs
+    or spaces (a spreadsheet's or a hand-written export), if they all are accepted
+    columns (:data:`CSV_COLUMNS`) and more than one; else an empty list."""
+    for separator in (";", "\t", None):  # None: runs of whitespace
+        names = [part.strip() for part in name.split(separator)]
+        if len(names) > 1 and all(part in CSV_COLUMNS for part in names):
+            return names
+    return []
+
+
 def read_csv(path: str | Path) -> SampledTrajectory:
     """Load a :class:`SampledTrajectory` from a CSV file with columns t, x, y[, phi]."""
     path = as_path(path, "traj")
@@ -595,6 +606,11 @@ def read_csv(path: str | Path) -> SampledTrajectory:
                 f"{len(header)} columns"
             )
     unknown = [name for name in header if name not in CSV_COLUMNS]
+    if len(header) == 1 and _split_names(header[0]):
+        raise ParameterError(
+            f"traj: {path} separates its columns by something else than commas (header "
+            f"{shown(header[0], 40)}); needs {expected}, comma-separated"
+        )
     if unknown:
         raise ParameterError(
             f"traj: {path} has unknown column(s) {', '.join(shown(n, 40) for n in unknown)} "
