@@ -308,3 +308,18 @@ def test_a_controller_built_for_another_robot_is_named_in_a_warning():
         warnings.simplefilter("error")  # the same robot: no warning
         matched = simulate(heavy, trajectory, make_controller("qp", heavy, stability_min=1.25))
     assert matched.summary["min_stability"] >= 1.25 - 1e-6
+
+
+def test_a_result_prints_as_one_line_naming_the_run():
+    """``print(result)`` is what a user types first: one line, no time-series arrays."""
+    result = simulate(Robot(), load_trajectory("ellipse"), "ats", duration=2.0)
+    text = repr(result)
+    assert "\n" not in text and len(text) < 300
+    rms = result.summary["rms_position_error_m"]
+    assert text == (
+        f"SimulationResult(method='ats', trajectory='ellipse', plant='kinematic', steps=100, "
+        f"rms_position_error_m={rms!r}, verdict='tracked', "
+        f"timeseries=<{len(result.timeseries)} columns>)"
+    )
+    assert 0.04 < rms < 0.045
+    assert str(result) == text

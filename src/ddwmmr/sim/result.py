@@ -32,6 +32,14 @@ class SimulationResult:
     trajectory: Any = None
     controller: Any = field(default=None, repr=False)
 
+    def __repr__(self) -> str:
+        """The run in one line: method, trajectory, plant, steps, RMS position error and
+        verdict (the time series' arrays are left out: thousands of numbers each)."""
+        keys = ("method", "trajectory", "plant", "steps", "rms_position_error_m", "verdict")
+        fields = [f"{key}={self.summary[key]!r}" for key in keys if key in self.summary]
+        fields.append(f"timeseries=<{len(self.timeseries)} columns>")
+        return f"{type(self).__name__}({', '.join(fields)})"
+
     def configurations(self) -> np.ndarray:
         """(n, 5) array of configurations q."""
         return np.column_stack([self.timeseries[k] for k in ("x", "y", "phi", "th1", "th2")])
