@@ -200,6 +200,20 @@ def test_a_caster_triangle_has_its_own_depths():
         SupportPolygon.from_points([(0.0, 0.0), (1.0, 0.0), (2.0, 0.0)])
 
 
+@pytest.mark.parametrize("length", [1e-6, 1e-3, 1e3])  # the allowed range's ends and between
+def test_a_robot_of_any_allowed_size_has_the_scale_free_margin(length):
+    """S is a ratio of lengths: a robot whose every length is ``length`` has the margin of
+    the one whose every length is 1 m, down to the smallest allowed (its supports 5e-7 m
+    from the centre: a fixed collinearity threshold took them for one line)."""
+    keys = ("L1", "L2", "wheel_radius", "track_width", "base_length", "base_width")
+    keys += ("base_height", "arm_height")
+    small = Robot(**dict.fromkeys(keys, length))
+    unit = Robot(**dict.fromkeys(keys, 1.0))
+    for q in ([0.0, 0.0, 0.0, 0.5, -0.7], [1.0, 2.0, 0.3, 2.0, 1.0]):
+        np.testing.assert_allclose(small.stability(q), unit.stability(q), rtol=1e-12)
+    assert len(support_polygon(small).vertices) == len(support_polygon(unit).vertices) == 4
+
+
 def test_a_robot_with_its_own_casters():
     robot = Robot(caster_positions=((0.3, 0.0), (-0.3, 0.1), (-0.3, -0.1))).with_payload(1.0)
     model = EdgeLoadModel.from_robot(robot)

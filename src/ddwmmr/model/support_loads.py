@@ -96,6 +96,10 @@ def convex_hull(
     pts = sorted({(float(x), float(y)) for x, y in points})
     if len(pts) < 3:
         return np.array(pts, dtype=float).reshape(-1, 2)
+    # Collinear below a cross product of 1e-12 of the squared extent: the test is the same
+    # for a robot of any size (lengths from 1e-6 m to 1e3 m are allowed).
+    extent = max(max(abs(x), abs(y)) for x, y in pts)
+    collinear = 1e-12 * extent * extent
 
     def cross(o: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
         return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
@@ -103,7 +107,7 @@ def convex_hull(
     def chain(seq: Iterable[tuple[float, float]]) -> list[tuple[float, float]]:
         out: list[tuple[float, float]] = []
         for p in seq:
-            while len(out) >= 2 and cross(out[-2], out[-1], p) <= 1e-12:
+            while len(out) >= 2 and cross(out[-2], out[-1], p) <= collinear:
                 out.pop()
             out.append(p)
         return out
