@@ -121,3 +121,19 @@ def test_an_option_named_like_a_simulate_keyword_reaches_the_controller(
     expected = simulate(robot, Ellipse(), make_controller("qp", robot, dt=0.05), duration=0.2)
     error = float(row["end_position_error_m"])
     assert error == pytest.approx(expected.summary["end_position_error_m"], rel=1e-6, abs=1e-12)
+
+
+def test_default_out_is_a_new_timestamped_folder_each_run(tmp_path, monkeypatch, capsys):
+    """Without --out, compare wrote to runs/compare and a second run replaced the first
+    report; each run now gets its own runs/compare-<time>/ (as track and scenarios)."""
+    monkeypatch.chdir(tmp_path)
+    quick = ["--only", "ellipse", "--study", "none", "--duration", "0.2", "--jobs", "1"]
+    for method in ("ats", "pi"):
+        assert main(["--methods", method, *quick, "--no-progress"]) == 0
+    first, second = sorted((tmp_path / "runs").iterdir())  # same second: second is first-2
+    assert re.fullmatch(r"compare-\d{8}-\d{6}", first.name), first.name
+    assert re.fullmatch(rf"compare-\d{{8}}-\d{{6}}|{first.name}-2", second.name), second.name
+    with (first / "metrics.csv").open() as a, (second / "metrics.csv").open() as b:
+        assert [r["method"] for r in csv.DictReader(a)] == ["ats"]
+        assert [r["method"] for r in csv.DictReader(b)] == ["pi"]
+    assert f"Report: runs/{second.name}/report.html" in capsys.readouterr().out

@@ -10,7 +10,6 @@ Examples::
 from __future__ import annotations
 
 import argparse
-import datetime as dt
 import math
 import re
 import sys
@@ -26,6 +25,7 @@ from ddwmmr.bounds.search import QUICK, Settings
 from ddwmmr.cli.common import (
     ArgumentParser,
     Terminated,
+    default_run_folder,
     given_text,
     integer_type,
     number_type,
@@ -204,8 +204,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
 
     check_payload(args.payload)  # as the scenarios tool: in range, standing at the start
     if args.out is None:
-        stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-        out = first_free(Path("runs") / f"bounds-{stamp}", folder=True)
+        out = first_free(default_run_folder("bounds"), folder=True)
     else:
         out = Path(given_text("out", args.out, "an output folder"))
     target = _check_out(out, args.force)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import argparse
 import codecs
 import contextlib
+import datetime as dt
 import inspect
 import logging
 import math
@@ -65,6 +66,7 @@ __all__ = [
     "check_output_folder",
     "check_plant_option_names",
     "console_text",
+    "default_run_folder",
     "first_free",
     "given_text",
     "horizon_defaults",
@@ -588,6 +590,14 @@ def add_force_argument(parser: argparse.ArgumentParser) -> None:
         help="also write into an --out that is not this tool's earlier output; deletes only "
         "files a ddwmmr manifest lists, every other file is kept",
     )
+
+
+def default_run_folder(name: str) -> Path:
+    """``runs/<name>-<YYYYmmdd-HHMMSS>`` (local time, relative to the working folder): the
+    output folder of a tool run without ``--out``. The one place the tools make that name;
+    the caller takes :func:`first_free` of it and writes with ``output_folder(...,
+    fresh=True)``, so a default run never replaces an earlier one."""
+    return Path("runs") / f"{name}-{dt.datetime.now().strftime('%Y%m%d-%H%M%S')}"
 
 
 #: Constructor parameters of a plant that ``--plant-option`` does not set: the robot (the

@@ -29,6 +29,8 @@ from ddwmmr.cli.common import (
     add_traj_scale_argument,
     check_output_folder,
     console_text,
+    default_run_folder,
+    first_free,
     given_text,
     horizon_defaults,
     horizon_range,
@@ -85,7 +87,6 @@ from ddwmmr.trajectories import available_trajectories, load_trajectory, traject
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = "python -m ddwmmr.compare"
-DEFAULT_OUT = "runs/compare"
 #: Default number of worker processes: the CPUs, at most 8.
 DEFAULT_JOBS = min(os.cpu_count() or 1, 8)
 
@@ -188,7 +189,10 @@ def build_parser() -> ArgumentParser:
         f"{', '.join(available_methods())})",
     )
     parser.add_argument(
-        "--out", default=DEFAULT_OUT, metavar="DIR", help=f"output folder (default {DEFAULT_OUT})"
+        "--out",
+        metavar="DIR",
+        help="output folder (default runs/compare-<time>/, never replacing anything: -2, "
+        "-3... when taken)",
     )
     parser.add_argument(
         "--jobs",
@@ -616,6 +620,11 @@ def format_summary(
     return "\n".join(lines)
 
 
+def default_out() -> Path:
+    """``runs/compare-<YYYYmmdd-HHMMSS>`` (:func:`default_run_folder`, as track's)."""
+    return default_run_folder("compare")
+
+
 def skipped_notes(config: CompareConfig, plan: Any) -> list[str]:
     """One stderr note per requested study the plan leaves out (every study is requested
     by default): the trajectory it needs is not among the compared ones (``--only``/``--traj``)."""
@@ -630,7 +639,9 @@ def skipped_notes(config: CompareConfig, plan: Any) -> list[str]:
 def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     jobs = check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
-    out = Path(given_text("out", args.out, "an output folder"))
+    fresh = args.out is None  # a default name: never replaces an earlier report
+    base = default_out() if fresh else Path(given_text("out", args.out, "an output folder"))
+    out = first_free(base, folder=True) if fresh else base
     check_output_folder(out, "compare", args.force)  # the path, before anything is loaded
     sources: dict[str, Any] = {}
     config = config_from_arguments(args, argv, sources)
@@ -643,7 +654,8 @@ def _main(argv: Sequence[str] | None) -> int:
     record = run_record(config, sources, argv, jobs)
     progress = not args.no_progress
     start = time.perf_counter()
-    with output_folder(out, "compare", args.force) as staging:
+    writer = output_folder(base, "compare", args.force, fresh)  # numbers from base if fresh
+    with writer as staging:
         outputs = execute(config, specs, jobs=jobs, progress=progress)
         with phase("compare: writing the report (figures, HTML, Markdown)", enabled=progress):
             info = write_report(config, plan, outputs, staging)
@@ -651,6 +663,7 @@ def _main(argv: Sequence[str] | None) -> int:
     seconds = time.perf_counter() - start
     failures = not_tracked(plan, outputs, config.shown)
     runs = runs_text(plan, len(specs))
+    out = out.with_name(writer.path.name)  # fresh: the next free name if out was taken
     print(console_text(format_summary(info, out, runs, seconds, jobs, failures, config.shown)))
     return 0
 

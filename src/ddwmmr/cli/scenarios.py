@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import datetime as dt
 import math
 import os
 import re
@@ -39,6 +38,7 @@ from ddwmmr.cli.common import (
     add_force_argument,
     add_option_argument,
     check_output_folder,
+    default_run_folder,
     first_free,
     given_text,
     horizon_defaults,
@@ -363,8 +363,8 @@ def build_parser() -> ArgumentParser:
 
 
 def default_out() -> Path:
-    """``runs/scenarios-<YYYYmmdd-HHMMSS>`` (like track's default)."""
-    return Path("runs") / f"scenarios-{dt.datetime.now().strftime('%Y%m%d-%H%M%S')}"
+    """``runs/scenarios-<YYYYmmdd-HHMMSS>`` (:func:`default_run_folder`, as track's)."""
+    return default_run_folder("scenarios")
 
 
 def _qp_options(args: argparse.Namespace) -> dict[str, float]:

@@ -10,7 +10,6 @@ Examples::
 from __future__ import annotations
 
 import argparse
-import datetime as dt
 import json
 import sys
 import textwrap
@@ -30,6 +29,7 @@ from ddwmmr.cli.common import (
     built_plant,
     check_output_folder,
     check_plant_option_names,
+    default_run_folder,
     first_free,
     given_text,
     horizon_defaults,
@@ -382,9 +382,8 @@ def controller_options(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def default_out(method: str, traj: str) -> Path:
-    """``runs/<method>-<traj>-<YYYYmmdd-HHMMSS>``."""
-    stamp = dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    return Path("runs") / f"{method}-{Path(traj).stem}-{stamp}"
+    """``runs/<method>-<traj>-<YYYYmmdd-HHMMSS>`` (:func:`default_run_folder`)."""
+    return default_run_folder(f"{method}-{Path(traj).stem}")
 
 
 def format_table(summary: dict[str, Any]) -> str:
