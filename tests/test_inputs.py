@@ -9,6 +9,7 @@ import pytest
 from ddwmmr import Ellipse, ParameterError, Robot, make_controller
 from ddwmmr.controllers.inputs import check_inputs
 from ddwmmr.resolution.reference import start_configuration
+from one_line import one_line
 
 METHODS = ["pi", "ats", "ap", "clrrmc-ts", "clrrmc-cs", "qp"]
 BAD = [math.nan, math.inf, -math.inf]
@@ -74,3 +75,21 @@ def test_huge_finite_values_are_accepted():
     q = np.array([1e308, 1e308, 0.0, 0.1, 0.2])
     check_inputs(0.0, q, np.array([1e308, 1e308, 0.0]), np.zeros(3))
     check_inputs(0.0, list(q), [0.0, 0.0, 0.0], (0.0, 0.0, 0.0))  # plain sequences too
+
+
+@pytest.mark.parametrize("method", [*METHODS, "mpc"])
+@pytest.mark.parametrize("bad", ["0", b"0", True, np.True_])
+def test_text_or_boolean_time_is_refused(method, bad):
+    # float() takes "0" and True, but neither is a time: clrrmc-cs and mpc failed on a
+    # text t with a TypeError, the other methods ran it as 0 s (or 1 s).
+    with pytest.raises(ParameterError) as info:
+        ready(method).command(bad, **{k: v for k, v in finite_arguments().items() if k != "t"})
+    assert one_line(info) == f"t must be a finite time in s (got {bad!r})"
+
+
+@pytest.mark.parametrize("t", [np.float64(0.5), 0, np.int64(0)])
+def test_numpy_and_integer_times_are_times(t):
+    arguments = finite_arguments()
+    del arguments["t"]
+    expected = ready("clrrmc-cs").command(float(t), **arguments)
+    np.testing.assert_array_equal(ready("clrrmc-cs").command(t, **arguments), expected)

@@ -41,6 +41,9 @@ _ARGUMENTS = (
 
 Lists = tuple[list[float], list[float], list[float]]
 _isfinite = math.isfinite
+#: Types float() converts that are no time: text ("0" would reach the methods as a string,
+#: which some compare with floats) and booleans (a flag, not 1 s).
+_NOT_TIMES = (str, bytes, bool, np.bool_)
 
 
 def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
@@ -58,7 +61,14 @@ def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
     try:
         ql, pl, vl = q.tolist(), pose_d.tolist(), velocity_d.tolist()
         values = ql + pl + vl
-        if len(values) == 11 and len(ql) == 5 and len(pl) == 3 and _isfinite(sum(values, t)):
+        # A boolean t sums as a number: refused on the slow path (a text t fails the sum).
+        if (
+            len(values) == 11
+            and len(ql) == 5
+            and len(pl) == 3
+            and _isfinite(sum(values, t))
+            and not isinstance(t, _NOT_TIMES)
+        ):
             return ql, pl, vl
     except (AttributeError, TypeError, OverflowError):  # OverflowError: an int like 10**400
         pass
@@ -104,7 +114,10 @@ def _what(value: Any, size: int) -> str:
 
 
 def _check_time(t: Any) -> None:
-    """The slow path's check of the time ``t`` (s)."""
+    """The slow path's check of the time ``t`` (s): a finite real number (an int, a float,
+    a numpy scalar), not text or a boolean."""
+    if isinstance(t, _NOT_TIMES):
+        raise ParameterError(f"t must be a finite time in s (got {shown(t)})")
     try:
         time = float(t)
     except (TypeError, ValueError, OverflowError):  # OverflowError: an int like 10**400
