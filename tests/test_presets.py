@@ -8,6 +8,7 @@ import pytest
 from ddwmmr import ParameterError, Rectangle, Robot, make_controller, simulate
 from ddwmmr.cli import track
 from ddwmmr.controllers import base, presets
+from one_line import one_line
 
 
 def test_slides_preset_is_the_slides_configuration():
@@ -89,3 +90,11 @@ def test_track_cli_preset(tmp_path, capsys):
     assert ours == pytest.approx(start * math.exp(-8.0), rel=1e-3)
     assert slides == pytest.approx(start, abs=1e-12)
     assert overridden == pytest.approx(ours, rel=1e-3)
+
+
+@pytest.mark.parametrize("preset", [["slides"], {"a": 1}, ("slides",)])
+def test_a_list_or_table_preset_is_refused_by_name(preset):
+    # A list or a table failed "unhashable" when looked up among the presets.
+    with pytest.raises(ParameterError) as info:
+        make_controller("pi", Robot(), preset=preset)
+    assert one_line(info) == f"preset must be one of default, slides (got {preset!r})"

@@ -58,9 +58,11 @@ DEFAULT: dict[str, dict[str, Any]] = {
 _TABLES = {"default": DEFAULT, "slides": SLIDES}
 
 
-def check_preset(preset: str) -> str:
-    """Validate a preset name."""
-    if preset not in _TABLES:
+def check_preset(preset: Any) -> str:
+    """``preset`` if it is one of :data:`PRESETS` (a text), else :class:`ParameterError`
+    naming ``preset`` and the accepted names (a list or a table too: it is not looked up
+    as a key, which would fail unhashable)."""
+    if not isinstance(preset, str) or preset not in _TABLES:
         raise ParameterError(f"preset must be one of {', '.join(PRESETS)} (got {shown(preset)})")
     return preset
 
