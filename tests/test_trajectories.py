@@ -7,8 +7,10 @@ import numpy as np
 import pytest
 
 from ddwmmr import Ellipse, ParameterError, Rectangle, load_trajectory
+from ddwmmr.qp.limits.obstacles import Circle, as_circles
 from ddwmmr.trajectories import SampledTrajectory, read_csv
 from ddwmmr.trajectories.files import (
+    available_trajectories,
     find_obstacle_file,
     find_trajectory_file,
     is_name,
@@ -261,6 +263,12 @@ def test_toml_values_must_have_their_type_and_range(tmp_path, text, message):
             "table [extra] outside [trajectory]",
         ),
         ('shape = "circle"\n', "needs shape = one of ellipse, rectangle (got 'circle')"),
+        # an array or a table failed "unhashable" where the shape was looked up
+        (
+            '[trajectory]\nshape = ["ellipse"]\n',
+            "needs shape = one of ellipse, rectangle (got ['ellipse'])",
+        ),
+        ("shape = {a = 1}\n", "needs shape = one of ellipse, rectangle (got {'a': 1})"),
         (
             '[traj]\nshape = "ellipse"\n',
             "needs shape = one of ellipse, rectangle (no shape key at the top or in a "
@@ -281,6 +289,43 @@ def test_toml_keys_that_would_be_ignored_are_refused(tmp_path, text, message):
         load_trajectory(str(path))
     assert str(info.value).startswith(f"traj: {path}") and message in str(info.value)
     assert "\n" not in str(info.value)
+
+
+def test_a_named_file_with_an_array_shape_is_listed_and_refused_as_others(tmp_path, monkeypatch):
+    # Listed by its file name as any other file in the folders (which are not read to
+    # list them), and refused when loaded, as a file with an unknown shape is.
+    (tmp_path / "listed.toml").write_text('shape = ["ellipse"]\n')
+    monkeypatch.setenv("DDWMMR_TRAJECTORIES", str(tmp_path))
+    assert "listed" in available_trajectories()
+    with pytest.raises(ParameterError) as info:
+        load_trajectory("listed")
+    assert one_line(info) == (
+        f"traj: {tmp_path / 'listed.toml'} needs shape = one of ellipse, rectangle "
+        "(got ['ellipse'])"
+    )
+
+
+@pytest.mark.parametrize("suffix", [".CSV", ".Csv", ".TOML", ".Toml"])
+def test_a_path_suffix_is_matched_in_any_case(tmp_path, monkeypatch, suffix):
+    # RUN.CSV was refused as "neither a trajectory name nor a .toml/.csv path", and
+    # without a folder in it was looked up as a name.
+    source = PROJECT_FOLDER / ("figure8.csv" if suffix.lower() == ".csv" else "ellipse.toml")
+    (tmp_path / f"RUN{suffix}").write_bytes(source.read_bytes())
+    (tmp_path / f"POST{suffix}").write_bytes(
+        (PROJECT_FOLDER / "obstacles" / "ellipse_post.toml").read_bytes()
+    )
+    monkeypatch.chdir(tmp_path)
+    for given in (f"RUN{suffix}", str(tmp_path / f"RUN{suffix}")):
+        assert not is_name(given)
+        assert find_trajectory_file(given) == Path(given)
+        loaded = load_trajectory(given)
+        if suffix.lower() == ".csv":
+            expected = read_csv(source)
+            np.testing.assert_array_equal(loaded.pose(7.25), expected.pose(7.25))
+        else:
+            assert loaded == Ellipse(name="RUN")
+    assert find_obstacle_file(f"POST{suffix}") == Path(f"POST{suffix}")
+    assert as_circles(f"POST{suffix}") == [Circle(-0.2, 1.05, 0.3)]
 
 
 def test_toml_phi_counts_with_the_constant_orientation(tmp_path):

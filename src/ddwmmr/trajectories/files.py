@@ -7,7 +7,8 @@ and the named trajectories shipped inside the package (``ddwmmr/trajectories/dat
 same files as the project's top-level ``trajectories/`` folder, so a wheel install has
 them). The names ``ellipse`` and ``rectangle`` fall back to the built-in defaults if no
 folder holds them. Anything else (a value with a path separator or a ``.toml`` / ``.csv``
-suffix) is a *path* and is read as given; a name never resolves outside the folders.
+suffix, in any case: ``RUN.CSV`` too) is a *path* and is read as given; a name never
+resolves outside the folders.
 
 Obstacle files (``--obstacles``) resolve the same way, in the ``obstacles/`` subfolder.
 
@@ -61,9 +62,17 @@ def trajectory_folders() -> list[Path]:
     return folders
 
 
+def file_suffix(path: str | Path) -> str:
+    """The suffix of a trajectory or obstacle path in lower case (``.csv`` of
+    ``RUN.CSV``): the one rule that matches a path's suffix against :data:`SUFFIXES`,
+    without regard to case as most tools do."""
+    return Path(path).suffix.lower()
+
+
 def is_name(value: str) -> bool:
-    """Whether ``value`` is a trajectory/obstacle *name* rather than a path."""
-    return bool(_NAME.fullmatch(value)) and ".." not in value and not value.endswith(SUFFIXES)
+    """Whether ``value`` is a trajectory/obstacle *name* rather than a path (a value
+    ending in a suffix of :data:`SUFFIXES`, in any case, is a path)."""
+    return bool(_NAME.fullmatch(value)) and ".." not in value and file_suffix(value) not in SUFFIXES
 
 
 def available_trajectories() -> list[str]:
@@ -99,7 +108,7 @@ def find_trajectory_file(name_or_path: str | Path) -> Path | None:
     text = str(name_or_path)
     if not is_name(text):
         path = Path(text)
-        if path.suffix not in SUFFIXES:
+        if file_suffix(path) not in SUFFIXES:
             known = ", ".join(available_trajectories())
             raise ParameterError(
                 f"traj: {shown(text)} is neither a trajectory name ({known}) nor a .toml/.csv path"
@@ -164,7 +173,7 @@ def file_sha256(path: str | Path) -> str:
 
 
 def _load_file(path: Path, overrides: dict):
-    if path.suffix == ".csv":
+    if file_suffix(path) == ".csv":
         if overrides:
             raise ParameterError(f"traj: {path.name} is sampled; parameters cannot be overridden")
         return read_csv(path)
@@ -199,7 +208,7 @@ def read_toml(path: str | Path, **overrides):
         )
     table = dict(table)
     shape = table.pop("shape", None)
-    if shape not in SHAPES:
+    if not isinstance(shape, str) or shape not in SHAPES:  # an array or table is unhashable
         got = (
             "no shape key at the top or in a [trajectory] table"
             if shape is None
