@@ -40,32 +40,29 @@ JOBS: list[tuple[list[str], dict[str, str]]] = [
             )
         },
     ),
-    (["scenarios"], {f"thesis_{n}.png": f"thesis_{n}.png" for n in _THESIS}),
+    (["scenarios"], {f"{n}.png": f"thesis_{n}.png" for n in _THESIS}),
     (
         ["scenarios", "--stability", "1.4", "1.7"],
         {
-            f"thesis_{n}.png": f"thesis_highstab_{n}.png"
+            f"{n}.png": f"thesis_highstab_{n}.png"
             for n in ("times", "stability", "timeline", "paths")
         },
     ),
     (
         ["scenarios", "--controller", "qp", "--plant", "kinematic"],
-        {f"thesis_{n}.png": f"thesis_qp_kinematic_{n}.png" for n in ("paths", "timeline", "times")},
+        {f"{n}.png": f"thesis_qp_kinematic_{n}.png" for n in ("paths", "timeline", "times")},
     ),
     (
         ["scenarios", "--controller", "qp", "--plant", "thesis"],
-        {
-            f"thesis_{n}.png": f"thesis_qp_thesisplant_{n}.png"
-            for n in ("paths", "timeline", "times")
-        },
+        {f"{n}.png": f"thesis_qp_thesisplant_{n}.png" for n in ("paths", "timeline", "times")},
     ),
     (
         ["scenarios", "--study", "obstacles"],
-        {"thesis_obstacle_paths.png": "thesis_obstacle_paths.png"},
+        {"obstacle_paths.png": "thesis_obstacle_paths.png"},
     ),
     (
         ["scenarios", "--study", "obstacles", "--controller", "qp", "--plant", "kinematic"],
-        {"thesis_obstacle_paths.png": "thesis_qp_obstacle_paths.png"},
+        {"obstacle_paths.png": "thesis_qp_obstacle_paths.png"},
     ),
 ]
 

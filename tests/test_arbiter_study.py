@@ -83,7 +83,7 @@ def test_cli_competitive_run_writes_the_weights_figure(tmp_path, capsys):
     assert cli([*args, "--arbiter", "competitive", "--out", str(out)]) == 0
     summary = json.loads((out / "summary.json").read_text())
     assert summary["config"]["arbiter"] == "competitive"
-    assert (out / "thesis_weights.png").stat().st_size > 1000
+    assert (out / "weights.png").stat().st_size > 1000
     assert "competitive arbiter" in capsys.readouterr().out
 
 

@@ -28,8 +28,11 @@ def test_benchmark_writes_csv_summary_table_and_figures(tmp_path, capsys):
     rows = list(csv.DictReader((out / "scenarios.csv").open()))
     assert [r["scenario"] for r in rows] == ["1", "2", "3"]
     assert set(METRICS) == set(rows[0])
-    for name in ("times", "speed", "stability", "manipulability", "paths", "timeline"):
-        assert (out / f"thesis_{name}.png").stat().st_size > 1000
+    # Named after what they show, not "thesis_*" whatever the controller.
+    figures = {"times", "speed", "stability", "manipulability", "paths", "timeline"}
+    assert {p.name for p in out.glob("*.png")} == {f"{name}.png" for name in figures}
+    for name in figures:
+        assert (out / f"{name}.png").stat().st_size > 1000
     printed = capsys.readouterr().out
     assert "No. of failed scenarios" in printed and "Simulation time (s)" in printed
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no staging left
@@ -53,7 +56,7 @@ def test_obstacle_study_table(tmp_path, capsys):
     table = (out / "obstacles.md").read_text()
     assert "scenario 1" in table and "scenario 10" in table
     assert "Time in obstacle state (s)" in table
-    assert (out / "thesis_obstacle_paths.png").exists()
+    assert (out / "obstacle_paths.png").exists()
 
 
 @pytest.mark.parametrize(

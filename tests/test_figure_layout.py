@@ -422,7 +422,7 @@ def test_scenario_figures_show_their_data(tmp_path, monkeypatch):
         config = RunConfig(arbiter=arbiter)
         outcomes = [run_scenario(s, config) for s in scenarios]
         _draw_figures(tmp_path, scenarios, outcomes, config)
-    assert {"thesis_paths.png", "thesis_timeline.png", "thesis_weights.png"} <= set(problems)
+    assert {"paths.png", "timeline.png", "weights.png"} <= set(problems)
     assert {name: found for name, found in problems.items() if found} == {}
 
 

@@ -217,7 +217,7 @@ def test_a_figure_name_is_no_clash_when_track_draws_no_figures(tmp_path):
 
 def test_force_keeps_user_files_that_only_look_like_outputs(tmp_path):
     """Only the exact names a run writes are refused before it: a user's paths_mine.png,
-    a folder study_old/ with a figure in it, and a thesis_stability.png next to a qp batch
+    a folder study_old/ with a figure in it, and a stability.png next to a qp batch
     are kept."""
     compare = tmp_path / "compare"
     (compare / "study_old").mkdir(parents=True)
@@ -228,9 +228,9 @@ def test_force_keeps_user_files_that_only_look_like_outputs(tmp_path):
     assert (compare / "study_old" / "notes.png").read_text() == "mine"
     batch = tmp_path / "batch"
     batch.mkdir()
-    (batch / "thesis_stability.png").write_text("mine")  # qp batches do not draw it
+    (batch / "stability.png").write_text("mine")  # qp batches do not draw it
     assert run("scenarios", batch, "--force", "--controller", "qp") == 0
-    assert (batch / "thesis_stability.png").read_text() == "mine"
+    assert (batch / "stability.png").read_text() == "mine"
 
 
 def test_force_refuses_the_animation_and_study_files_before_the_run(tmp_path, capsys, monkeypatch):

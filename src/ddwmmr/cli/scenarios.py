@@ -102,6 +102,14 @@ from ddwmmr.scenarios.protocol import (
 
 #: The batch summary (holds the run record: everything needed to repeat the batch).
 MARKER = "summary.json"
+#: A batch's figures (in --out), named after what they show, whichever controller ran:
+#: time per state, speed, paths of a few scenarios, state timeline of one; per-scenario
+#: time in each fix state (a controller with an arbiter), the competitive arbiter's
+#: weights; and with --study obstacles every obstacle scenario's path.
+TIMES_FIGURE, SPEED_FIGURE = "times.png", "speed.png"
+PATHS_FIGURE, TIMELINE_FIGURE = "paths.png", "timeline.png"
+FIX_STATE_FIGURES = {"stability": "stability.png", "manipulability": "manipulability.png"}
+WEIGHTS_FIGURE, OBSTACLE_PATHS_FIGURE = "weights.png", "obstacle_paths.png"
 STUDIES = ("thresholds", "obstacles", "arbiters")
 PROG = "python -m ddwmmr.scenarios"
 #: --qp-* options (``RunConfig`` fields, which check their values): the controllers that
@@ -135,8 +143,10 @@ Run the thesis's scenario benchmark: N scenarios of 5 waypoints drawn uniformly 
 an 8 m x 8 m square; the end effector must reach them in order within 0.01 m in {TIME_LIMIT_S:g} s
 ({OBSTACLE_TIME_LIMIT_S:g} s with obstacles) while the tip-over stability S stays above 1.
 Writes scenarios.csv (one row per scenario), summary.json, table.txt (thesis Table 5.2
-format) and figures (per-scenario bars as thesis Figs 5.3-5.9, paths, a state timeline)
-into --out, and prints the table. The controllers are the registered ones that do this
+format) and figures into --out: times.png and speed.png (and with the thesis controller
+stability.png and manipulability.png), per-scenario bars as thesis Figs 5.3-5.9;
+paths.png, a few scenarios' paths; timeline.png, one scenario's states over time. It
+prints the table. The controllers are the registered ones that do this
 waypoint task, the plants the registered ones; --help lists both, each controller with the
 plants it can command."""
 
@@ -614,13 +624,13 @@ def output_names(args: argparse.Namespace, config: RunConfig) -> tuple[str, ...]
         from ddwmmr.scenarios import arbiter_study
 
         return (MARKER, *arbiter_study.output_names())
-    figures = ["thesis_times.png", "thesis_speed.png", "thesis_paths.png", "thesis_timeline.png"]
+    figures = [TIMES_FIGURE, SPEED_FIGURE, PATHS_FIGURE, TIMELINE_FIGURE]
     if controller_traits(config.controller)["arbiter"]:  # time in its fix states
-        figures += ["thesis_stability.png", "thesis_manipulability.png"]
+        figures += FIX_STATE_FIGURES.values()
     if config.arbiter == "competitive":
-        figures.append("thesis_weights.png")
+        figures.append(WEIGHTS_FIGURE)
     if args.study == "obstacles":
-        figures += ["obstacles.md", "thesis_obstacle_paths.png"]
+        figures += ["obstacles.md", OBSTACLE_PATHS_FIGURE]
     return (MARKER, "scenarios.csv", "table.txt", *figures)
 
 
@@ -689,33 +699,31 @@ def _figures(folder: Path, scenarios, outcomes, config: RunConfig, progress: boo
 
 def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
     short = f"{config.controller} controller, {config.plant} plant"
-    report.plot_state_times(outcomes, folder / "thesis_times.png", short)
-    report.plot_speeds(outcomes, folder / "thesis_speed.png", short)
+    report.plot_state_times(outcomes, folder / TIMES_FIGURE, short)
+    report.plot_speeds(outcomes, folder / SPEED_FIGURE, short)
     if controller_traits(config.controller)["arbiter"]:
-        for key in ("stability", "manipulability"):
-            report.plot_fix_state(outcomes, key, folder / f"thesis_{key}.png", short)
+        for key, name in FIX_STATE_FIGURES.items():
+            report.plot_fix_state(outcomes, key, folder / name, short)
     if config.arbiter == "competitive":
         from ddwmmr.scenarios import arbiter_study
 
         focus_scenario = scenarios[highlight(outcomes)]
-        arbiter_study.plot_weights(focus_scenario, config, folder / "thesis_weights.png", short)
+        arbiter_study.plot_weights(focus_scenario, config, folder / WEIGHTS_FIGURE, short)
     # Re-run (deterministically) the scenarios to draw, with a trace: the first two and
     # the one to look at (the first failure, else the most fix-state transitions).
     focus = highlight(outcomes)
     chosen = sorted({0, min(1, len(scenarios) - 1), focus})
     traced = replace(config, record=True)
     items = [(scenarios[i], run_scenario(scenarios[i], traced)) for i in chosen]
-    report.plot_paths(
-        items, folder / "thesis_paths.png", paths_title(short, outcomes, chosen, focus)
-    )
+    report.plot_paths(items, folder / PATHS_FIGURE, paths_title(short, outcomes, chosen, focus))
     scenario, timeline = next((s, o) for (s, o) in items if s.index == scenarios[focus].index)
     report.plot_timeline(
-        timeline, folder / "thesis_timeline.png", short, scenario, **timeline_thresholds(config)
+        timeline, folder / TIMELINE_FIGURE, short, scenario, **timeline_thresholds(config)
     )
 
 
 def paths_title(short: str, outcomes: list[Outcome], chosen: list[int], focus: int) -> str:
-    """The title of thesis_paths.png: which of how many scenarios it shows, and why (the
+    """The title of :data:`PATHS_FIGURE`: which of how many scenarios it shows, and why (the
     first two, and the :func:`highlight` one: the first failure, else the busiest in fix
     states), e.g. "thesis controller, thesis plant: paths of scenarios 1, 2 (the first
     two) and 5 (the first failure) of 6 scenarios run", or "... 1, 2 (the first two; 1: the
@@ -886,7 +894,7 @@ def _run_obstacles(args, config, runner, folder: Path) -> None:
     write_atomic(folder / "obstacles.md", table)
     report.plot_paths(
         [(s, run_scenario(s, replace(config, record=True))) for s in scenarios],
-        folder / "thesis_obstacle_paths.png",
+        folder / OBSTACLE_PATHS_FIGURE,
         f"obstacle study, {config.controller} controller, {config.plant} plant: paths",
         clearance=base_bubble(config_robot(config)),
     )
