@@ -15,6 +15,7 @@ from ddwmmr.qp.controller import QPController
 from ddwmmr.qp.limits import Circle, Limit, exact_stability, stability_terms_gradient
 from ddwmmr.qp.naive import NaiveQPController
 from ddwmmr.qp.tasks import Task
+from one_line import one_line
 
 ROBOT = Robot().with_payload(3.0)
 Q = np.array([0.2, -0.1, 0.3, -0.4, 0.9])
@@ -55,6 +56,26 @@ def test_bad_options_raise_one_line_parameter_errors(options, match):
     with pytest.raises(ParameterError, match=match) as info:
         QPController(ROBOT, **options)
     assert "\n" not in str(info.value)
+
+
+@pytest.mark.parametrize("method", ["qp", "mpc"])
+def test_obstacle_tables_are_refused_as_tables(method):
+    # A TOML file's [[obstacle]] table given as a dict unpacked into its three keys:
+    # "obstacle x must be a finite number (got 'x')".
+    with pytest.raises(ParameterError) as info:
+        make_controller(method, Robot(), obstacles=[{"x": 1, "y": 1, "radius": 0.2}])
+    assert one_line(info) == (
+        "obstacles are Circle(x, y, radius) or (x, y, radius) triples, not tables "
+        "(got {'x': 1, 'y': 1, 'radius': 0.2}); a file of [[obstacle]] tables goes in "
+        "by its path"
+    )
+    with pytest.raises(ParameterError) as info:
+        make_controller(method, Robot(), obstacles=["xyr"])
+    assert one_line(info) == (
+        "obstacles must be Circle(x, y, radius) or (x, y, radius) triples (got 'xyr')"
+    )
+    made = make_controller(method, Robot(), obstacles=[(1, 1, 0.2)])
+    assert list(made.obstacles) == [Circle(1.0, 1.0, 0.2)]
 
 
 def test_tracks_a_feasible_demand_exactly_within_every_limit():

@@ -16,7 +16,7 @@ changes that clearance to first order, ``d_dot >= min(that, 0)`` (:meth:`Obstacl
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -178,6 +178,16 @@ def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> li
         if isinstance(item, Circle):
             circles.append(item)
             continue
+        if isinstance(item, Mapping):  # an obstacle file's table: unpacking gave its keys
+            raise ParameterError(
+                f"obstacles are Circle(x, y, radius) or (x, y, radius) triples, not tables "
+                f"(got {shown(item)}); a file of [[obstacle]] tables goes in by its path"
+            )
+        if isinstance(item, str | bytes):  # three letters unpack as a triple
+            raise ParameterError(
+                f"obstacles must be Circle(x, y, radius) or (x, y, radius) triples"
+                f" (got {shown(item)})"
+            )
         try:
             x, y, radius = item
         except (TypeError, ValueError):
