@@ -27,6 +27,15 @@ POINTS = [[0.0, 0.0], [1.0, 0.0], [2.0, 0.0]]
         (["a", "b", "c"], POINTS, "times must be sample times .*strings"),
         (["0", "1", "2"], POINTS, "times must be sample times .*strings"),
         ([True, False, True], POINTS, "times must be sample times .*booleans"),
+        # a boolean beside numbers: numpy made it 1 or 0 without a word
+        ([0, True, 2], POINTS, r"^trajectory samples: times must be .*\(got booleans\)$"),
+        ([0, 1, 2], [[True, False], [1, 0], [2, 0]], r"points must be .*\(got booleans\)$"),
+        ([0, 1, 2], [[0, 0, True], [1, 0, 0], [2, 0, 0]], r"points must be .*\(got booleans\)"),
+        (
+            [0, 1, 2],
+            [np.array([True, False]), np.array([1, 0]), np.array([2, 0])],
+            r"points must be an \(n, 2\) or \(n, 3\) array \(m, rad\), numbers only \(got bool",
+        ),
         ([0, 1, 10**400], POINTS, "times must be .*beyond float range"),
         ([0, 1, None], POINTS, "times must be .*non-numeric"),
         ([0, 1, math.nan], POINTS, "times must be finite numbers"),

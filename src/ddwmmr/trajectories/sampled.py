@@ -335,7 +335,16 @@ def _float_array(name: str, value, what: str) -> np.ndarray:
     if kind not in "iuf":
         got = {"U": "strings", "S": "bytes", "b": "booleans", "c": "complex numbers"}
         raise ParameterError(f"{wanted} (got {got.get(kind, raw.dtype.name)})")
+    if not isinstance(value, np.ndarray) and _holds_booleans(value):
+        raise ParameterError(f"{wanted} (got booleans)")
     return np.asarray(raw, dtype=float)
+
+
+def _holds_booleans(value: Any) -> bool:
+    """Whether a (regular, numeric) nested sequence holds a boolean: numpy turns ``True``
+    beside numbers into 1 silently, as no other number check of the package does."""
+    entries = np.asarray(value, dtype=object).ravel().tolist()
+    return any(isinstance(v, bool | np.bool_) for v in entries)
 
 
 def _is_number(value) -> bool:
