@@ -13,7 +13,7 @@ import pytest
 
 from ddwmmr import ParameterError, Robot, make_controller
 from ddwmmr.commands import WheelForces
-from ddwmmr.plants import KinematicPlant, MujocoPlant, ThesisPlant
+from ddwmmr.plants import KinematicPlant, MujocoPlant, PlantNotResetError, ThesisPlant
 from ddwmmr.qp.controller import QPController
 from ddwmmr.qp.limits import Limit
 from ddwmmr.trajectories import Ellipse
@@ -196,6 +196,23 @@ def test_plant_step_names_t_and_dt(plant, t, dt, name):
     before = _state(plant)
     _refused(lambda: plant.step(t, np.zeros(4), dt), f"^{name} must be")
     assert _state(plant) == before
+
+
+@pytest.mark.parametrize(
+    ("kind", "name"),
+    [(KinematicPlant, "kinematic"), (ThesisPlant, "thesis"), (MujocoPlant, "mujoco")],
+)
+def test_a_step_before_the_first_reset_says_to_reset(kind, name):
+    # The kinematic and thesis plants ran from q = 0 without a word; mujoco said
+    # "reset(q0, dt) must be called before step" (no plant named).
+    plant = kind(ROBOT)  # new: the module's plants have been reset
+    with pytest.raises(PlantNotResetError) as info:
+        plant.step(0.0, np.zeros(4), 0.02)
+    assert isinstance(info.value, RuntimeError)
+    assert one_line(info) == f"{name} plant: call reset(q0, dt) before step"
+    plant.reset(Q, 0.02)  # then it steps, from the reset's state
+    plant.step(0.0, np.zeros(4), 0.02)
+    assert _state(plant)[:5] == pytest.approx(tuple(Q), abs=1e-3)
 
 
 def test_valid_commands_of_any_sequence_type_give_the_same_state(plant):

@@ -10,6 +10,7 @@ from ddwmmr.plants.base import PlantDivergedError
 from ddwmmr.plants.mujoco import MujocoPlant
 from ddwmmr.plants.mujoco.model import EngineOptions
 from ddwmmr.plants.mujoco.plant import LIFT_TIME_S, UNLOADED_FRACTION, tip_time_s
+from one_line import one_line
 
 DT = 0.02
 #: A 50 g base with 1 g links: too light for the default 2 ms engine step once it moves.
@@ -112,6 +113,18 @@ def test_the_long_arm_robot_rocks_and_tracks():
 def test_engine_options_outside_their_physical_range_are_refused(option, value, refusal):
     with pytest.raises(ParameterError, match=refusal):
         MujocoPlant(Robot(), **{option: value})
+
+
+@pytest.mark.parametrize("value", [1.0, (1.0,), (1, 2, 3), "ab", (True, 1), ("1", "2")])
+def test_base_damping_not_two_numbers_is_refused_with_its_ranges(value):
+    # Was "base_damping must be (N s/m, N m s/rad), two numbers >= 0" (no upper end), and
+    # texts or booleans such as ("1", "2") passed as numbers.
+    with pytest.raises(ParameterError) as info:
+        MujocoPlant(Robot(), base_damping=value)
+    assert one_line(info) == (
+        "base_damping must be two numbers, translation in [0, 1000] N s/m and yaw in "
+        f"[0, 1000] N m s/rad (got {value!r})"
+    )
 
 
 def test_engine_options_at_the_ends_of_their_ranges_build():

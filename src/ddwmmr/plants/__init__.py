@@ -14,7 +14,7 @@ from typing import Any
 
 from ddwmmr.errors import ParameterError, check_instance, shown
 from ddwmmr.model import Robot
-from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+from ddwmmr.plants.base import Observation, Plant, PlantDivergedError, PlantNotResetError
 from ddwmmr.plants.kinematic import INTEGRATORS, KinematicPlant
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState, VelocityServo
 from ddwmmr.registry import PLANTS, register_plant
@@ -66,6 +66,7 @@ __all__ = [
     "Observation",
     "Plant",
     "PlantDivergedError",
+    "PlantNotResetError",
     "ThesisPlant",
     "ThesisState",
     "VelocityServo",

@@ -20,7 +20,9 @@ helpers here (:func:`check_control_step`, :func:`check_limit`, :func:`check_step
 (:func:`~ddwmmr.model.kinematics.check_configuration`): anything
 but finite numbers of the right shape (a ``policy`` that is not callable) is a one-line
 :class:`~ddwmmr.errors.ParameterError` naming ``q0``, ``dt``, ``q``, ``u``, ``t``,
-``command`` or ``policy``, before the state changes.
+``command`` or ``policy``, before the state changes. A ``step`` before the first
+``reset`` is a :class:`PlantNotResetError` (a ``RuntimeError``): the plant has no start
+state yet.
 """
 
 from __future__ import annotations
@@ -106,6 +108,17 @@ class PlantDivergedError(RuntimeError):
 
     The loop stops the run there, keeps what was recorded and reports the step.
     """
+
+
+class PlantNotResetError(RuntimeError):
+    """A plant was stepped before its first ``reset(q0, dt)``, so it has no start state.
+
+    The simulation loop always resets first; a caller driving a plant by hand must too.
+    The message is one line naming the plant.
+    """
+
+    def __init__(self, plant: str) -> None:
+        super().__init__(f"{plant} plant: call reset(q0, dt) before step")
 
 
 #: What each command interface takes, for messages.
@@ -305,9 +318,10 @@ class PlantImplementation(Protocol):
         :class:`~ddwmmr.errors.ParameterError` for a command of another interface, a
         non-finite or misshapen one, a non-finite t or a dt that is not > 0
         (:func:`check_step`) or a ``policy`` that is neither None nor callable
-        (:func:`check_policy`), and :class:`PlantDivergedError` when the new state is not
-        finite. Anything else a plug-in plant (a class from outside the library) raises
-        here is wrapped by the simulation loop in a one-line
+        (:func:`check_policy`), :class:`PlantDivergedError` when the new state is not
+        finite and :class:`PlantNotResetError` before the first ``reset``. Anything else
+        a plug-in plant (a class from outside the library) raises here is wrapped by the
+        simulation loop in a one-line
         :class:`~ddwmmr.errors.PluginError` naming the plant, the step and the time
         (:class:`ddwmmr.plants.checked.CheckedPlant`).
         """

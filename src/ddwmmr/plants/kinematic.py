@@ -33,6 +33,7 @@ from ddwmmr.model.robot import clamp_joints
 from ddwmmr.plants.base import (
     Observation,
     PlantDivergedError,
+    PlantNotResetError,
     Policy,
     arm_rates,
     check_control_step,
@@ -71,6 +72,7 @@ class KinematicPlant:
         self._joint_limits = robot.joint_limits
         self._state = [0.0] * 5  # configuration as floats (a new list every step)
         self._v = self._w = 0.0
+        self._started = False  # reset() gave a start state: step() may run
         self._limited: np.ndarray | None = None
 
     # -- Plant interface ------------------------------------------------------------------
@@ -82,6 +84,7 @@ class KinematicPlant:
         check_control_step(dt)
         self._state = state
         self._v = self._w = 0.0
+        self._started = True
 
     def observe(self) -> Observation:
         """The exact state; ``v``, ``w`` are those of the last applied input (0 at rest)."""
@@ -97,7 +100,10 @@ class KinematicPlant:
         """Advance by dt (s) from time t (s) under velocity ``command``, 4 finite numbers
         ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s, rad/s, rad/s), see :meth:`integrate`;
         other arguments are a :class:`ParameterError` (:func:`check_step`), and so is a
-        ``policy`` that is neither None nor callable (:func:`check_policy`)."""
+        ``policy`` that is neither None nor callable (:func:`check_policy`); before the
+        first :meth:`reset` it is a :class:`PlantNotResetError`."""
+        if not self._started:
+            raise PlantNotResetError("kinematic")
         # cast: on the velocity interface alone check_step returns the list of 4 floats
         values = cast("list[float]", check_step(t, command, dt, self.interfaces))
         check_policy(policy)

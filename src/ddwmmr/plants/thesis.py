@@ -58,6 +58,7 @@ from ddwmmr.model.thesis_base import (  # the base's constants (controllers' mod
 from ddwmmr.plants.base import (
     Observation,
     PlantDivergedError,
+    PlantNotResetError,
     Policy,
     arm_rates,
     check_control_step,
@@ -244,6 +245,7 @@ class ThesisPlant:
         self.servo = VelocityServo(self, velocity_bandwidth)
         self.state = ThesisState()
         self._forces = (0.0, 0.0)
+        self._started = False  # reset() gave a start state: step() may run
 
     # -- Plant interface ------------------------------------------------------------------
     def reset(self, q0: np.ndarray, dt: float) -> None:
@@ -258,6 +260,7 @@ class ThesisPlant:
             raise ParameterError(f"q0: {outside}")
         self.state = ThesisState(*state)
         self._forces = (0.0, 0.0)
+        self._started = True
 
     def observe(self) -> Observation:
         """Configuration and base velocities, exactly."""
@@ -285,7 +288,10 @@ class ThesisPlant:
         ones, or ``th + rate dt`` with the rates of :meth:`joint_rates`) are clipped to the
         joint limits. Non-finite or misshapen arguments are a :class:`ParameterError`
         (:func:`check_step`), and so is a ``policy`` that is neither None nor callable
-        (:func:`check_policy`; this plant holds the command and does not call it)."""
+        (:func:`check_policy`; this plant holds the command and does not call it); before
+        the first :meth:`reset` it is a :class:`PlantNotResetError`."""
+        if not self._started:
+            raise PlantNotResetError("thesis")
         checked = check_step(t, command, dt, self.interfaces)
         check_policy(policy)
         state = self.state

@@ -32,12 +32,13 @@ import mujoco  # type: ignore[import-untyped]
 import numpy as np
 
 from ddwmmr.commands import VELOCITY, WheelForces
-from ddwmmr.errors import ParameterError, check_range, shown
+from ddwmmr.errors import ParameterError, check_range, float_values, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration, wrap_angle
 from ddwmmr.plants.base import (
     Observation,
     PlantDivergedError,
+    PlantNotResetError,
     Policy,
     check_step,
 )
@@ -427,13 +428,14 @@ class MujocoPlant:
         (``policy`` unused). ``command``: ``u = [v, w, th1dot, th2dot]`` (m/s, rad/s) or a
         :class:`~ddwmmr.commands.WheelForces` (N, rad), finite.
 
-        Raises :class:`PlantDivergedError` (naming the step) if the engine state becomes
-        invalid, :class:`ParameterError` for a non-finite or misshapen argument
+        Raises :class:`PlantNotResetError` before the first :meth:`reset`,
+        :class:`PlantDivergedError` (naming the step) if the engine state becomes invalid,
+        :class:`ParameterError` for a non-finite or misshapen argument
         (:func:`~ddwmmr.plants.base.check_step`) or if dt differs from the reset's control
         step and is not an allowed one (:meth:`check_control_step`).
         """
         if self._dt is None:
-            raise RuntimeError("reset(q0, dt) must be called before step")
+            raise PlantNotResetError("mujoco")
         checked = check_step(t, command, dt, self.interfaces)
         substeps = self._substeps if dt == self._dt else self.check_control_step(dt)
         q = self.observe().q
@@ -867,17 +869,18 @@ BASE_DAMPING_MAX = (1e3, 1e3)
 
 
 def _check_damping(value: tuple[float, float] | None) -> tuple[float, float] | None:
-    """Validate the ``base_damping`` option: None or two numbers in [0,
-    :data:`BASE_DAMPING_MAX`]."""
+    """Validate the ``base_damping`` option: None or two numbers ``(c1, c2)`` in [0,
+    :data:`BASE_DAMPING_MAX`] (N s/m, N m s/rad); text and booleans are no numbers."""
     if value is None:
         return None
-    try:
-        c_t, c_yaw = (float(v) for v in value)
-    except (TypeError, ValueError):
-        raise ParameterError(
-            f"base_damping must be (N s/m, N m s/rad), two numbers >= 0 (got {shown(value)})"
-        ) from None
     high_t, high_yaw = BASE_DAMPING_MAX
+    values = float_values(value, 2)
+    if values is None:
+        raise ParameterError(
+            f"base_damping must be two numbers, translation in [0, {high_t:g}] N s/m and "
+            f"yaw in [0, {high_yaw:g}] N m s/rad (got {shown(value)})"
+        )
+    c_t, c_yaw = values
     check_range("base_damping[1]", c_t, 0.0, high_t, "N s/m")
     check_range("base_damping[2]", c_yaw, 0.0, high_yaw, "N m s/rad")
     return c_t, c_yaw
