@@ -18,7 +18,7 @@ def _stderr_of(main, argv, capsys) -> tuple[int, str]:
 @pytest.mark.parametrize(
     ("argv", "line"),
     [
-        (["--out", ""], "error: out: give an output folder (got an empty path)"),
+        (["--out", ""], "error: out: give a report file (got an empty path)"),
         (["--method", "pi,,pi"], "error: --method: an empty name in the list (got 'pi,,pi')"),
         (["--method", "nope"], "error: method: unknown method 'nope' (choose from "),
         (["--compare", "/nonexistent/old.json"], "error: compare: cannot read "),

@@ -88,7 +88,7 @@ def test_the_means_say_which_scenarios_they_are_over(tmp_path, solved, capsys):
     out = tmp_path / "b"
     assert _run(out, "1-2", "--quick") == 0
     assert _run(out, "1-4", "--quick", "--lower-only") == 0
-    line = capsys.readouterr().out.splitlines()[-1]
+    line = capsys.readouterr().out.splitlines()[-2]  # the last: wrote DIR/
     assert line == (
         "4 scenarios: lower bound 12.50 s (mean of all 4); over the 2 with a replayed "
         "best-known time: lower bound 11.50 s, best known 14.00 s, bracket width 1.218 "
@@ -182,7 +182,7 @@ def test_lower_only_says_the_cache_holds_quick_results(tmp_path, solved, capsys)
     out = tmp_path / "b"
     assert _run(out, "1", "--quick") == 0
     assert _run(out, "1", "--lower-only") == 0
-    line = capsys.readouterr().out.splitlines()[-1]
+    line = capsys.readouterr().out.splitlines()[-2]  # the last: wrote DIR/
     assert line == (
         "1 scenario: lower bound 11.00 s, no best-known time with these settings (the cache "
         "holds ones of other settings: --quick; run with those to use them, or without "
@@ -195,7 +195,7 @@ def test_lower_only_says_the_cache_holds_quick_results(tmp_path, solved, capsys)
 def test_lower_only_without_any_best_known_record_says_none_yet(tmp_path, solved, capsys):
     assert _run(tmp_path / "b", "1", "--lower-only") == 0
     assert capsys.readouterr().out.endswith(
-        "no best-known time yet (run without --lower-only for them)\n"
+        f"no best-known time yet (run without --lower-only for them)\nwrote {tmp_path / 'b'}/\n"
     )
 
 

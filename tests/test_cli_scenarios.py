@@ -188,7 +188,7 @@ def test_default_out_is_a_new_timestamped_folder(tmp_path, monkeypatch, capsys):
     assert cli(["--n", "1", "--time-limit", "0.3", "--jobs", "1", "--no-progress"]) == 0
     (folder,) = (tmp_path / "runs").iterdir()
     assert folder.name.startswith("scenarios-") and (folder / "summary.json").is_file()
-    assert f"wrote runs/{folder.name}" in capsys.readouterr().err
+    assert capsys.readouterr().out.endswith(f"\nwrote runs/{folder.name}/\n")
 
 
 def test_payload_that_tips_the_start_pose_is_refused_with_the_limit(tmp_path, capsys):

@@ -422,7 +422,7 @@ def test_a_fresh_run_that_fails_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
-@pytest.mark.parametrize("tool", ["track", "scenarios"])
+@pytest.mark.parametrize("tool", ["track", "compare", "scenarios"])
 def test_default_output_names_are_never_reused(tmp_path, monkeypatch, tool, capsys):
     """Without --out, runs within the same second wrote to the same folder: the later
     replaced the earlier (here every run gets the same stamp)."""
@@ -435,8 +435,7 @@ def test_default_output_names_are_never_reused(tmp_path, monkeypatch, tool, caps
         assert main([*args, *FAST, *jobs]) == 0
     folders = sorted(p.name for p in (tmp_path / "runs").iterdir())
     assert len(folders) == 3 and folders[1:] == [f"{folders[0]}-2", f"{folders[0]}-3"]
-    said = capsys.readouterr()
-    assert f"wrote runs/{folders[0]}-3" in said.out + said.err
+    assert capsys.readouterr().out.endswith(f"\nwrote runs/{folders[0]}-3/\n")
 
 
 def test_keyboard_interrupt_removes_staging(tmp_path):

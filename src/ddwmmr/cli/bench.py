@@ -156,7 +156,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         raise ParameterError(f"method: unknown method {unknown[0]!r} (choose from {choices})")
     # Everything that can be checked is checked before a minute-long run.
     previous = read_report(args.compare) if args.compare is not None else None
-    out = Path(given_text("out", args.out, "an output folder"))
+    out = Path(given_text("out", args.out, "a report file"))
     check_out(out, force=args.force)
     check_duration(Ellipse(), args.duration)
     probe_out(out)
@@ -176,6 +176,9 @@ def _main(argv: Sequence[str] | None = None) -> int:
     print(json.dumps(report, indent=2) if args.json else format_table(report))
     if previous is not None:
         print(format_comparison(report, previous))
+    # Last, as every tool: where the report went. With --json on stderr, so that the
+    # printed report stays one JSON document (bench --json > copy.json).
+    print(f"wrote {out}", file=sys.stderr if args.json else sys.stdout)
     return 0
 
 

@@ -245,7 +245,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         print(note, file=sys.stderr)
     elsewhere = _other_settings(target, scenarios, records, args.payload, settings)
     print(summary_line(len(rows), summary, elsewhere))
-    print(f"wrote {target}", file=sys.stderr)
+    print(f"wrote {out}/")  # as given (target is absolute), last on stdout as every tool
     return 0
 
 

@@ -665,6 +665,7 @@ def _main(argv: Sequence[str] | None) -> int:
     runs = runs_text(plan, len(specs))
     out = out.with_name(writer.path.name)  # fresh: the next free name if out was taken
     print(console_text(format_summary(info, out, runs, seconds, jobs, failures, config.shown)))
+    print(f"wrote {out}/")  # last on stdout, as every tool
     return 0
 
 

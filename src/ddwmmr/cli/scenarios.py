@@ -1028,7 +1028,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
             _run_arbiters(args, config, runner, folder)
         else:
             _run_benchmark(args, config, runner, folder)
-    print(f"wrote {out.with_name(writer.path.name)}", file=sys.stderr)
+    print(f"wrote {out.with_name(writer.path.name)}/")  # last on stdout, as every tool
     return 0
 
 
