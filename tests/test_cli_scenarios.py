@@ -346,3 +346,23 @@ def test_a_bounds_file_covering_part_of_the_run_says_over_how_many(
     assert cli(argv) == 0
     (line,) = [x for x in capsys.readouterr().out.splitlines() if x.startswith("mean ratio")]
     assert line.count("(over 1 of 2)") == 2
+
+
+@pytest.mark.parametrize(
+    ("n", "ran"),
+    [("2", "scenario 1"), ("8", "scenarios 1, 3, 7"), ("200", "scenarios 1, 3, 7, 10")],
+)
+def test_obstacles_says_which_scenarios_run_and_the_table_how_many(tmp_path, capsys, n, ran):
+    """--obstacles --n 2 ran thesis scenario 1 alone (of 1, 3, 7, 10, those up to --n),
+    and --n 200 four, without a word; the table did not say how many it is over."""
+    out = tmp_path / "o"
+    args = ["--obstacles", "--n", n, "--time-limit", "0.2", "--jobs", "1", "--no-progress"]
+    assert cli([*args, "--out", str(out)]) == 0
+    said = capsys.readouterr()
+    note = f"note: --obstacles runs the thesis's obstacle scenarios 1, 3, 7, 10 up to --n {n}: "
+    assert f"{note}{ran}\n" in said.err
+    count = len(ran.split(","))
+    row = next(line for line in said.out.splitlines() if line.startswith("No. of scenarios "))
+    assert row.split() == ["No.", "of", "scenarios", str(count)]
+    assert f"{row}\n" in (out / "table.txt").read_text()
+    assert json.loads((out / "summary.json").read_text())["n"] == count

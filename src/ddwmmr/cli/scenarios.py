@@ -802,6 +802,7 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
     scenarios = generate(args.n, args.seed)
     if args.obstacles:
         scenarios = studies.obstacle_scenarios(scenarios)
+        print(obstacles_note(args.n, [s.index + 1 for s in scenarios]), file=sys.stderr)
     outcomes, wall = runner.run(scenarios, config, "scenarios")
     extra = {"seed": args.seed, "run": _record(args, config, runner.workers)}
     beaten: list[tuple[int, float, float]] = []
@@ -820,6 +821,14 @@ def _run_benchmark(args, config, runner, folder: Path) -> None:
         f"({runner.workers} {args.executor} worker{'s' * (runner.workers != 1)})",
         file=sys.stderr,
     )
+
+
+def obstacles_note(n: int, numbers: Sequence[int]) -> str:
+    """The stderr line of ``--obstacles``: which of the thesis's obstacle scenarios run
+    (those up to ``--n``, here ``numbers``), since ``--n`` alone does not say it."""
+    listed = ", ".join(map(str, studies.OBSTACLE_SCENARIOS))
+    which = f"scenario{'s' * (len(numbers) != 1)} {', '.join(map(str, numbers))}"
+    return f"note: --obstacles runs the thesis's obstacle scenarios {listed} up to --n {n}: {which}"
 
 
 def _bracket_line(b: dict[str, Any], bounds: str, n: int) -> str:

@@ -259,11 +259,13 @@ def table_rows(summary: dict[str, Any]) -> list[tuple[str, str]]:
 
 def format_table(summary: dict[str, Any], title: str) -> str:
     """Plain-text table in the format of thesis Table 5.2: ``title``, the cells' legend
-    (:data:`TABLE_LEGEND`), the rows, and for a controller without states the footnote
-    on its overlapping base and arm times (:data:`OVERLAP_NOTE`)."""
+    (:data:`TABLE_LEGEND`), the number of scenarios the means are over, the rows, and for
+    a controller without states the footnote on its overlapping base and arm times
+    (:data:`OVERLAP_NOTE`)."""
     rows = table_rows(summary)
     width = max(len(label) for label, _ in rows)
     lines = [title, "-" * len(title), *textwrap.wrap(TABLE_LEGEND, width=88)]
+    lines.append(f"{'No. of scenarios':<{width}}  {summary['n']}")
     lines += [f"{label:<{width}}  {value}" for label, value in rows]
     label = "Minimum stability S (lowest run)"
     lines.append(f"{label:<{width}}  {_fmt(summary['min_stability'])}")
