@@ -149,7 +149,7 @@ def test_scenarios_pass_options_to_the_controller_and_refuse_the_protocol_s():
     assert config_from_arguments(scenarios_parser().parse_args(argv)).controller_options == (
         ("horizon", 1.5),
     )
-    with pytest.raises(ParameterError, match=r"^option: the scenarios set dt themselves \(--dt"):
+    with pytest.raises(ParameterError, match=r"^option: the scenarios set dt themselves \(it is"):
         config_from_arguments(scenarios_parser().parse_args(["--option", "dt=0.02"]))
     with pytest.raises(
         ParameterError, match=r"^horizon: --horizon is taken only by --controller mpc"
@@ -291,3 +291,33 @@ def test_the_thesis_controller_takes_adjust_at_the_ends_of_its_range():
         controller = make_controller("thesis", adjust=adjust)
         assert controller.behaviours["manipulability"].adjust == adjust
         assert controller.behaviours["stability"].adjust == adjust
+
+
+@pytest.mark.parametrize("main", [track, compare, scenarios])
+def test_help_says_what_the_dt_option_of_qp_and_mpc_is(main, capsys):
+    """--help listed the qp's and mpc's option dt without a word: it reads as the run's
+    step (--dt), but is the step the controller plans each command for."""
+    with pytest.raises(SystemExit) as stop:
+        main(["--help"])
+    assert stop.value.code == 0
+    text = " ".join(capsys.readouterr().out.split())  # unwrapped
+    assert (
+        "dt (qp, mpc): the step the controller plans each command for, s (qp: the look-ahead "
+        "of its exact stability check and the step of its acceleration limits, docs/qp.md; "
+        "mpc: its plan's first interval, docs/mpc.md); default: the simulation's control "
+        "step (--dt of track and scenarios), which the option does not change" in text
+    )
+
+
+def test_scenarios_refuse_dt_as_the_controller_s_step_not_the_simulation_s(tmp_path, capsys):
+    """--option dt=0.05 was refused as "the scenarios set dt themselves (--dt ...)", as if
+    the option were the scenario step; the line now says what it is, and --dt sets both."""
+    out = tmp_path / "x"
+    argv = ["--controller", "qp", "--option", "dt=0.05", "--out", str(out)]
+    assert scenarios(argv) == 2
+    assert capsys.readouterr().err == (
+        "error: option: the scenarios set dt themselves (it is the controller's planning "
+        "step, not the simulation step; the protocol holds it at the scenario step: set --dt "
+        "for both; got 'dt=0.05')\n"
+    )
+    assert not out.exists()

@@ -557,10 +557,17 @@ def add_option_argument(
 
 def method_options_text(methods: Sequence[str]) -> str:
     """``--help``'s list of each method's options (``--option NAME=VALUE``), one line per
-    method: ``  qp: stability_min, manipulability_weight, ...``."""
-    from ddwmmr.controllers.option_specs import option_names
+    method: ``  qp: stability_min, manipulability_weight, ...``; then, for each option of
+    :data:`~ddwmmr.controllers.option_specs.NOTES` a listed method takes, a line saying
+    what it is: ``  dt (qp, mpc): the step the controller plans each command for, ...``."""
+    from ddwmmr.controllers.option_specs import NOTES, option_names
 
-    lines = [f"  {m}: {', '.join(option_names(m)) or '(none)'}" for m in methods]
+    names = {m: option_names(m) for m in methods}
+    lines = [f"  {m}: {', '.join(names[m]) or '(none)'}" for m in methods]
+    for option, note in NOTES.items():
+        takers = [m for m in methods if option in names[m]]
+        if takers:
+            lines.append(f"  {option} ({', '.join(takers)}): {note}")
     return "options of each method (--option NAME=VALUE; docs/api.md, Controllers):\n" + (
         "\n".join(lines)
     )

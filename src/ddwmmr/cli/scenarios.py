@@ -126,7 +126,11 @@ OPTION_SPELLING = {
 #: Controller options the protocol sets itself, and what sets them instead of --option.
 PROTOCOL_OPTIONS = {
     "obstacles": "each scenario's own, --obstacles",
-    "dt": "--dt",
+    # The controller's planning step (the qp's stability look-ahead, the mpc's first
+    # interval), not the simulation's: the protocol holds it at the scenario step, so that
+    # each command is planned for as long as it is held (the qp's S floor is exact then).
+    "dt": "it is the controller's planning step, not the simulation step; the protocol "
+    "holds it at the scenario step: set --dt for both",
     "stability_min": "--qp-stability-min",
     "max_speed": "--qp-max-speed",
     "arbiter": "--arbiter",

@@ -26,6 +26,7 @@ from ddwmmr.errors import ParameterError, did_you_mean, shown
 
 __all__ = [
     "CHOICES",
+    "NOTES",
     "UNITS",
     "OptionSpec",
     "format_choice",
@@ -74,6 +75,17 @@ UNITS = {
     "joint_acceleration_limit": "rad/s2",
     "brake_slack": "m",
     "lookahead_horizon": "s",
+}
+
+
+#: What an option is, for the option names whose name alone misleads, shown under the
+#: tools' ``--help`` list of each method's options. ``dt`` reads as the run's step
+#: (``--dt``), but the ``qp`` and ``mpc`` take it as the step they plan each command for.
+NOTES = {
+    "dt": "the step the controller plans each command for, s (qp: the look-ahead of its "
+    "exact stability check and the step of its acceleration limits, docs/qp.md; mpc: its "
+    "plan's first interval, docs/mpc.md); default: the simulation's control step (--dt of "
+    "track and scenarios), which the option does not change",
 }
 
 
