@@ -106,7 +106,7 @@ def test_an_empty_scheduler_is_refused_not_the_local_pool(workdir, capsys):
         ("track", "error: out: give an output folder (got an empty path)"),
         ("compare", "error: out: give an output folder (got an empty path)"),
         ("scenarios", "error: out: give an output folder (got an empty path)"),
-        ("bench", "error: out: give an output folder (got an empty path)"),
+        ("bench", "error: out: give a report file (got an empty path)"),  # --out is its JSON
     ],
 )
 def test_an_empty_out_is_refused_naming_out(tool, message, workdir, capsys):
