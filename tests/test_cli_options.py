@@ -34,6 +34,10 @@ def test_every_option_of_every_method_is_reachable_from_track(method):
     assert set(method_options(method)) - set(option_names(method)) == API_ONLY.get(method, set())
     for spec in option_specs(method):
         text = spec.format(spec.default)
+        if spec.default is None and spec.kind == "number":
+            text = "auto"  # the automatic value's word: an empty value is refused
+        if not text:  # a text option's empty default: said by leaving the option out
+            continue
         argv = ["--method", method, "--traj", "ellipse", "--option", f"{spec.name}={text}"]
         options = controller_options(track_parser().parse_args(argv))
         assert options == {spec.name: spec.default}, spec.name
@@ -238,6 +242,16 @@ TAU_RANGE = "> 0 s (at least 0.0001 s), or inf to disable a channel"
         ("scenarios", "thesis", "adjust=abc", "a finite number in [0.01, 5] m"),
         ("gui", "ap", "K1=abc", "a finite number >= 0"),
         ("gui", "qp", "max_speed=fast", "a finite number > 0"),
+        # An empty value is never "not given", even for an option whose blank field in
+        # the simulator means automatic (a shell variable that is not set).
+        ("track", "pi", "damping=", "a finite number in [1e-06, 1000]"),
+        ("compare", "pi", "pi:damping=", "a finite number in [1e-06, 1000]"),
+        ("scenarios", "qp", "singularity_margin=", "a finite number > 0"),
+        ("gui", "pi", "damping=", "a finite number in [1e-06, 1000]"),
+        # Python reads 0_5 as 5 and full-width digits as digits: a typo, refused.
+        ("track", "clrrmc-ts", "tau=0_5", TAU_RANGE),
+        ("gui", "ap", "K1=1_0", "a finite number >= 0"),
+        ("track", "pi", "damping=\uff10.\uff15", "a finite number in [1e-06, 1000]"),
     ],
 )
 def test_a_non_numeric_option_names_the_allowed_range(
@@ -252,6 +266,52 @@ def test_a_non_numeric_option_names_the_allowed_range(
     assert _run_with_option(tool, method, option, tmp_path, capsys) == (2, message, False)
     status, refused_nan, _ = _run_with_option(tool, method, f"{name}=nan", tmp_path, capsys)
     assert status == 2 and refused_nan == message.replace(f"(got {text!r})", "(got nan)")
+
+
+def test_an_empty_text_option_is_refused_not_taken_as_its_default(tmp_path, capsys):
+    status, err, written = _run_with_option("track", "qp", "obstacles=", tmp_path, capsys)
+    assert (status, written) == (2, False)
+    assert err == (
+        "error: option: obstacles has an empty value (got 'obstacles='); "
+        "give one or leave the option out\n"
+    )
+
+
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        ("c1=", "error: c1 must be a finite number > 0 (got '')\n"),
+        ("c1=1_5", "error: c1 must be a finite number > 0 (got '1_5')\n"),
+    ],
+)
+def test_a_plant_option_empty_or_with_underscores_is_refused(tmp_path, capsys, option, message):
+    out = tmp_path / "out"
+    argv = ["--method", "pi", "--traj", "ellipse", "--plant", "thesis", "--duration", "0.2"]
+    status = track([*argv, "--no-plots", "--out", str(out), "--plant-option", option])
+    assert (status, capsys.readouterr().err, out.exists()) == (2, message, False)
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--dt", "0_02"], "argument --dt: must be a number > 0 s (got '0_02')"),
+        (
+            ["--dt", "\uff10.\uff10\uff12"],
+            "argument --dt: must be a number > 0 s (got '\uff10.\uff10\uff12')",
+        ),
+        (["--payload", "1_5"], "argument --payload: must be a number in [0, "),
+    ],
+)
+def test_a_command_line_number_with_underscores_or_other_digits_is_refused(
+    tmp_path, capsys, argv, message
+):
+    """``float`` reads ``0_02`` as 2.0: a mistyped step 100 times the intended one ran."""
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as stop:
+        track(["--method", "pi", "--traj", "ellipse", *argv, "--out", str(out)])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and message in err and err.count("\n") == 1
+    assert not out.exists()
 
 
 def test_a_non_numeric_option_as_a_module_is_one_line_without_traceback(tmp_path):

@@ -196,6 +196,14 @@ def check_number_type(name: str, value: Any) -> Any:
     return value
 
 
+def plain_number_text(text: str) -> bool:
+    """Whether ``text`` may be a number as a user types or a file holds one: ASCII without
+    underscores. Python's ``float`` and ``int`` also read ``1_0`` as 10 and non-ASCII
+    digits (``０.５``); a mistyped ``0_02`` taken as 2.0 would run silently. ``float``
+    or ``int`` decides the rest."""
+    return text.isascii() and "_" not in text
+
+
 def real_number(value: Any) -> float | None:
     """``value`` as a float (finite or not), or None if it is no number: text, a boolean,
     None, or an integer beyond a float. Strings and booleans are not numbers here, even

@@ -25,7 +25,14 @@ import numpy as np
 
 from ddwmmr.bounds.lower import lower_bound
 from ddwmmr.bounds.search import Settings, best_known
-from ddwmmr.errors import DURATION_RANGE_S, MAX_SCENARIOS, ParameterError, read_text_file, shown
+from ddwmmr.errors import (
+    DURATION_RANGE_S,
+    MAX_SCENARIOS,
+    ParameterError,
+    plain_number_text,
+    read_text_file,
+    shown,
+)
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import check_stability_floor
 from ddwmmr.mpc.min_time import PLAN_FOLDER, PLAN_NAME, Guess, kept_trajectory
@@ -413,7 +420,7 @@ def _bounds_time(where: str, row: dict, key: str) -> float:
     text = _bounds_field(where, row, key)
     low, high = DURATION_RANGE_S
     try:
-        if "_" in text or not text.isascii():
+        if not plain_number_text(text):
             raise ValueError(text)
         value = float(text)
     except ValueError:

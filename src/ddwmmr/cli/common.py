@@ -35,7 +35,14 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 from ddwmmr import interrupts
 from ddwmmr.cli.signals import EXIT_INTERRUPTED, EXIT_TERMINATED, STOP_SIGNALS, say, stop_line
-from ddwmmr.errors import MASS_RANGE_KG, ParameterError, PluginError, did_you_mean, shown
+from ddwmmr.errors import (
+    MASS_RANGE_KG,
+    ParameterError,
+    PluginError,
+    did_you_mean,
+    plain_number_text,
+    shown,
+)
 from ddwmmr.model import Robot
 from ddwmmr.outputs import (
     check_output_folder,
@@ -112,6 +119,8 @@ def integer_type(
 
     def parse(text: str) -> int:
         try:
+            if not plain_number_text(text):
+                raise ValueError(text)
             value = int(text)
         except ValueError:
             raise argparse.ArgumentTypeError(
@@ -132,6 +141,8 @@ def number_type(allowed: str, finite: bool = False) -> Callable[[str], float]:
 
     def parse(text: str) -> float:
         try:
+            if not plain_number_text(text):
+                raise ValueError(text)
             value = float(text)
         except ValueError:
             value = math.nan
@@ -666,7 +677,7 @@ def parse_plant_options(plant: str, texts: Sequence[str] | None) -> dict[str, An
     ``--option`` reads one (:meth:`~ddwmmr.controllers.option_specs.OptionSpec.parse`:
     a number option's text that is no number is passed on for the plant's own check,
     :func:`built_plant`); a text without ``=`` or a name given twice is refused."""
-    from ddwmmr.controllers.option_specs import split_option
+    from ddwmmr.controllers.option_specs import parse_typed, split_option
 
     pairs = [(*split_option(text, "plant-option"), text) for text in texts or ()]
     specs = check_plant_option_names(plant, [name for name, _, _ in pairs])
@@ -674,7 +685,7 @@ def parse_plant_options(plant: str, texts: Sequence[str] | None) -> dict[str, An
     for name, value, text in pairs:
         if name in options:
             raise ParameterError(f"plant-option: {name} given twice (got {shown(text)})")
-        options[name] = specs[name].parse(value)
+        options[name] = parse_typed(specs[name], value, "plant-option")
     return options
 
 

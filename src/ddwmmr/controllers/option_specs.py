@@ -22,7 +22,7 @@ from typing import Any
 
 from ddwmmr.controllers.base import NumberText, method_parameters
 from ddwmmr.controllers.base import controller_class as registered_class
-from ddwmmr.errors import ParameterError, did_you_mean, shown
+from ddwmmr.errors import ParameterError, did_you_mean, plain_number_text, shown
 
 __all__ = [
     "CHOICES",
@@ -35,6 +35,7 @@ __all__ = [
     "option_specs",
     "parse_option",
     "parse_options",
+    "parse_typed",
 ]
 
 
@@ -132,7 +133,8 @@ class OptionSpec:
 
     def parse(self, text: str) -> Any:
         """The option value a field's ``text`` stands for; a choice that is not one of the
-        choices raises ParameterError.
+        choices raises ParameterError. An optional option's blank text, or ``auto`` for an
+        optional number, is None (the method's automatic value).
 
         A number option's text that is not one number of the option's kind (``abc``, empty,
         ``1,2`` for one number, ``1.5`` for an integer) comes back as a
@@ -146,7 +148,7 @@ class OptionSpec:
                     return choice
             allowed = ", ".join(format_choice(c) for c in self.choices)
             raise ParameterError(f"{self.name} must be one of {allowed} (got {shown(text)})")
-        if not text:
+        if not text or (text == "auto" and self.optional and self.kind == "number"):
             if self.optional:
                 return None
             if self.kind == "text":
@@ -158,6 +160,8 @@ class OptionSpec:
 
     def _parse_numbers(self, text: str) -> float | int | tuple[float, ...] | NumberText:
         try:
+            if not plain_number_text(text):
+                raise ValueError(text)
             numbers = [float(part) for part in re.split(r"[\s,]+", text) if part]
         except ValueError:  # passed on, as nan is: the method's check names the range
             return NumberText(text)
@@ -280,7 +284,25 @@ def parse_option(method: str, text: str, what: str = "option") -> tuple[str, Any
         raise ParameterError(
             f"{what}: {method} has no option {name!r}{did_you_mean(name, specs)} (options: {known})"
         )
-    return name, specs[name].parse(value)
+    return name, parse_typed(specs[name], value, what)
+
+
+def parse_typed(spec: OptionSpec, value: str, what: str = "option") -> Any:
+    """The value of ``NAME=VALUE`` typed on a command line for the option ``spec``, read
+    as :meth:`OptionSpec.parse` reads a field, except for an empty ``value``: where a
+    blank field means "automatic" (or the default), an empty value typed (``--option
+    damping=``, a shell variable that is not set) is never taken as not given. A number
+    option's comes back as :class:`~ddwmmr.controllers.base.NumberText`, refused by the
+    method's or plant's own check, which names the range; a text option's is a one-line
+    :class:`ParameterError` starting with ``what``; a choice's is refused by ``parse``."""
+    if value.strip() or spec.kind == "choice":
+        return spec.parse(value)
+    if spec.kind == "number":
+        return NumberText(value)
+    raise ParameterError(
+        f"{what}: {spec.name} has an empty value (got {shown(spec.name + '=' + value)}); "
+        "give one or leave the option out"
+    )
 
 
 def split_option(text: str, what: str = "option") -> tuple[str, str]:

@@ -35,6 +35,7 @@ from ddwmmr.errors import (
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
     as_path,
+    plain_number_text,
     read_text_file,
     shown,
 )
@@ -478,21 +479,14 @@ def csv_text(trajectory: SampledTrajectory) -> str:
 CSV_COLUMNS = ("t", "x", "y", "phi")
 
 
-def _plain_number_text(text: str) -> bool:
-    """Whether ``text`` (a value, or a line of values) may hold CSV numbers: ASCII without
-    underscores. Python's ``float`` also reads ``1_0`` as 10 and non-ASCII digits; a CSV
-    number is plain ASCII without underscores. ``float`` decides the rest."""
-    return text.isascii() and "_" not in text
-
-
 def _csv_number(path: Path, number: int, row: dict, key: str) -> float:
     """The value of column ``key`` in data row ``number`` as a float (one-line errors;
-    :func:`_plain_number_text`)."""
+    :func:`~ddwmmr.errors.plain_number_text`)."""
     text = row.get(key)
     if text is None or not text.strip():
         raise ParameterError(f"traj: {path} data row {number} has no value in column {key}")
     try:
-        if not _plain_number_text(text):
+        if not plain_number_text(text):
             raise ValueError(text)
         return float(text)
     except ValueError:
@@ -535,7 +529,7 @@ def _plain_values(lines: list[str]) -> npt.NDArray[np.float64] | None:
             if (
                 line.count(",") != columns - 1
                 or len(line) > _PLAIN_LINE_LIMIT
-                or not _plain_number_text(line)
+                or not plain_number_text(line)
                 or '"' in line
             ):
                 return None
