@@ -283,6 +283,19 @@ def test_an_interrupt_says_the_cache_is_kept_and_the_command_resumes(tmp_path, m
     assert _cache(out, 1, "lower").exists() and not (out / "bounds.csv").exists()
 
 
+def test_an_interrupt_before_any_scenario_finished_promises_no_cache(tmp_path, monkeypatch, capsys):
+    def solve(job: batch.Job) -> dict:
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(batch, "solve", solve)
+    out = tmp_path / "b"
+    assert _run(out, "1-2", "--quick", "--lower-only") == 130
+    assert capsys.readouterr().err.splitlines() == [
+        "interrupted (Ctrl-C): stopped; unfinished output removed"
+    ]
+    assert not out.exists()
+
+
 # -- 7. --scenarios in ASCII digits only -------------------------------------------------
 @pytest.mark.parametrize("text", ["1_0", "+3", "\u0663", "1 - 3", "1-", "-3", "1,,2", "3.0"])
 def test_scenarios_takes_ascii_digits_only(text):

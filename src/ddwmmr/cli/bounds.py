@@ -223,7 +223,8 @@ def _main(argv: Sequence[str] | None = None) -> int:
             target, scenarios, args.payload, settings, jobs, not args.no_progress, args.lower_only
         )
     except (KeyboardInterrupt, Terminated):
-        say(_kept_note(target))  # before the stop line, which says the rest is removed
+        if _cached_any(target):  # before the stop line, which says the rest is removed
+            say(_kept_note(target))
         raise
     rows = [batch.row(i, *records[i]) for i in numbers]
     summary = batch.summarize(rows)
@@ -247,6 +248,16 @@ def _main(argv: Sequence[str] | None = None) -> int:
     print(summary_line(len(rows), summary, elsewhere))
     print(f"wrote {out}/")  # as given (target is absolute), last on stdout as every tool
     return 0
+
+
+def _cached_any(target: Path) -> bool:
+    """Whether the cache in ``target`` holds a scenario's record: there is something the
+    same command would resume from (a run stopped before its first scenario left none)."""
+    cache = target / batch.CACHE
+    if not cache.is_dir():
+        return False
+    names = [f"{batch.CACHE}/{path.name}" for path in cache.iterdir()]
+    return bool(batch.cached_numbers(names))
 
 
 def _kept_note(target: Path) -> str:
