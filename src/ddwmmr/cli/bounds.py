@@ -26,10 +26,10 @@ from ddwmmr.cli.common import (
     ArgumentParser,
     Terminated,
     default_run_folder,
-    given_text,
     integer_type,
     number_type,
     output_folder,
+    output_target,
     payload_type,
     run_main,
 )
@@ -50,7 +50,6 @@ from ddwmmr.outputs import (
     check_output_folder,
     check_output_path,
     check_writable,
-    first_free,
     foreign_contents,
     inspect,
     list_in_manifest,
@@ -203,10 +202,8 @@ def _main(argv: Sequence[str] | None = None) -> int:
     from ddwmmr.scenarios.protocol import check_payload
 
     check_payload(args.payload)  # as the scenarios tool: in range, standing at the start
-    if args.out is None:
-        out = first_free(default_run_folder("bounds"), folder=True)
-    else:
-        out = Path(given_text("out", args.out, "an output folder"))
+    # The cache resumes in place, so the folder is written as given (not fresh).
+    _, out, _ = output_target(args.out, lambda: default_run_folder("bounds"))
     target = _check_out(out, args.force)
     # Tried, not inferred from permission bits (/proc, a read-only mount): the cache is
     # written there as scenarios finish, so an unwritable --out fails before any of them.

@@ -83,6 +83,7 @@ __all__ = [
     "number_type",
     "offset_type",
     "output_folder",
+    "output_target",
     "parse_plant_options",
     "payload_type",
     "plant_option_specs",
@@ -613,9 +614,21 @@ def add_force_argument(parser: argparse.ArgumentParser) -> None:
 def default_run_folder(name: str) -> Path:
     """``runs/<name>-<YYYYmmdd-HHMMSS>`` (local time, relative to the working folder): the
     output folder of a tool run without ``--out``. The one place the tools make that name;
-    the caller takes :func:`first_free` of it and writes with ``output_folder(...,
+    :func:`output_target` takes :func:`first_free` of it for ``output_folder(...,
     fresh=True)``, so a default run never replaces an earlier one."""
     return Path("runs") / f"{name}-{dt.datetime.now().strftime('%Y%m%d-%H%M%S')}"
+
+
+def output_target(given: str | None, default: Callable[[], Path]) -> tuple[Path, Path, bool]:
+    """``(base, out, fresh)`` of a tool's ``--out`` (``given``, None when not given):
+    ``fresh`` when it was not, ``base`` the folder to hand ``output_folder(base, tool,
+    force, fresh)`` (``default()`` if fresh, else the given path, an empty one refused by
+    :func:`given_text`) and ``out`` the folder to check before the run (the first free
+    name from ``base`` if fresh, else ``base``). The folder written is ``out.with_name(
+    writer.path.name)``: a fresh writer takes the next free name when it commits."""
+    fresh = given is None
+    base = default() if fresh else Path(given_text("out", given, "an output folder"))
+    return base, (first_free(base, folder=True) if fresh else base), fresh
 
 
 #: Constructor parameters of a plant that ``--plant-option`` does not set: the robot (the

@@ -30,14 +30,13 @@ from ddwmmr.cli.common import (
     check_output_folder,
     console_text,
     default_run_folder,
-    first_free,
-    given_text,
     horizon_defaults,
     horizon_range,
     integer_type,
     method_options_text,
     number_type,
     output_folder,
+    output_target,
     refuse_plant_option_argument,
     robot_from_arguments,
     run_main,
@@ -639,9 +638,7 @@ def skipped_notes(config: CompareConfig, plan: Any) -> list[str]:
 def _main(argv: Sequence[str] | None) -> int:
     args = build_parser().parse_args(argv)
     jobs = check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
-    fresh = args.out is None  # a default name: never replaces an earlier report
-    base = default_out() if fresh else Path(given_text("out", args.out, "an output folder"))
-    out = first_free(base, folder=True) if fresh else base
+    base, out, fresh = output_target(args.out, default_out)
     check_output_folder(out, "compare", args.force)  # the path, before anything is loaded
     sources: dict[str, Any] = {}
     config = config_from_arguments(args, argv, sources)

@@ -39,7 +39,6 @@ from ddwmmr.cli.common import (
     add_option_argument,
     check_output_folder,
     default_run_folder,
-    first_free,
     given_text,
     horizon_defaults,
     horizon_range,
@@ -47,6 +46,7 @@ from ddwmmr.cli.common import (
     method_options_text,
     number_type,
     output_folder,
+    output_target,
     payload_type,
     run_main,
 )
@@ -1020,9 +1020,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
     config = config_from_arguments(args)
     _check_engine_step(config)
     args.bounds_table = _bounds_table(args, config)
-    fresh = args.out is None  # a default name: never replaces an earlier run
-    base = default_out() if fresh else Path(given_text("out", args.out, "an output folder"))
-    out = first_free(base, folder=True) if fresh else base
+    base, out, fresh = output_target(args.out, default_out)
     check_output_folder(out, "scenarios", args.force, output_names(args, config))
     if config.controller in ("qp", "mpc"):
         # their options are checked by building one for the plant, before any output or

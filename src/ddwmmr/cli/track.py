@@ -30,7 +30,6 @@ from ddwmmr.cli.common import (
     check_output_folder,
     check_plant_option_names,
     default_run_folder,
-    first_free,
     given_text,
     horizon_defaults,
     horizon_range,
@@ -38,6 +37,7 @@ from ddwmmr.cli.common import (
     number_type,
     offset_type,
     output_folder,
+    output_target,
     parse_plant_options,
     robot_from_arguments,
     run_main,
@@ -673,13 +673,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
             raise
         raise _in_record(args.rerun, exc) from None
     plant = run_plant(inputs)
-    fresh = args.out is None  # a default name: never replaces an earlier run
-    base = (
-        default_out(inputs.method, inputs.label)
-        if fresh
-        else Path(given_text("out", args.out, "an output folder"))
-    )
-    out = first_free(base, folder=True) if fresh else base
+    base, out, fresh = output_target(args.out, lambda: default_out(inputs.method, inputs.label))
     physics = hasattr(PLANTS.load(inputs.plant), "tip_time")  # judges tipping: support loads
     names = output_names(not args.no_plots, args.animate, physics)
     check_output_folder(out, "track", args.force, names)
