@@ -8,8 +8,8 @@ or using this module leaves the matplotlib backend as the user chose it. Such a 
 saved with ``fig.savefig`` or shown as a Jupyter cell's value (once the inline backend is
 active: ``%matplotlib inline``, or after a pyplot figure), but ``plt.show()`` does not
 show it. To look at a run in a window, draw into pyplot's figures instead:
-``plot_path(result, ax=ax)`` into an axes of ``plt.subplots(layout="constrained")`` (the
-layout makes room for the legend beside the axes), and
+``plot_path(result, ax=ax)`` into an axes of ``plt.subplots()`` (the figure is laid out
+so that the legend beside the axes stays on it), and
 ``plot_errors(result, fig=plt.figure())`` (likewise ``plot_rates``, ``plot_metrics``),
 then ``plt.show()``.
 """
