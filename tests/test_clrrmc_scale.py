@@ -8,7 +8,8 @@ amplifies rounding turns that into different runs. ``clrrmc-ts`` at its default 
 constant (0.5 s, K = 2/s) with dt = 2 s is such a loop: the RK4 plant evaluates the law at
 its stages, and RK4 multiplies the linear error dynamics ``e_dot = -K e`` by
 ``R(-K dt) = R(-4) = 5`` per step (its real stability limit is ``K dt = 2.785``), so the
-run is kept bounded only by the joint limits (16 of 20 steps saturated here) and is chaotic.
+run is kept bounded only by the joint limits (16 or 17 of 20 steps saturated, by machine)
+and is chaotic.
 The checks below tell that apart from a length in absolute metres:
 
 * a scale by a power of two is exact in binary floating point, so it gives exactly ``s``
