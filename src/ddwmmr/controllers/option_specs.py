@@ -159,10 +159,18 @@ class OptionSpec:
         return self._parse_numbers(text)
 
     def _parse_numbers(self, text: str) -> float | int | tuple[float, ...] | NumberText:
+        items = _number_items(text)
+        if "" in items:  # a doubled, leading or trailing comma: no number there
+            if not self.several:  # one number expected: the method's check names the range
+                return NumberText(text, "one number")
+            raise ParameterError(
+                f"{self.name}: item {items.index('') + 1} is empty (got {shown(text)}); "
+                "separate the numbers by one comma or by spaces"
+            )
         try:
             if not plain_number_text(text):
                 raise ValueError(text)
-            numbers = [float(part) for part in re.split(r"[\s,]+", text) if part]
+            numbers = [float(item) for item in items]
         except ValueError:  # passed on, as nan is: the method's check names the range
             return NumberText(text)
         if len(numbers) > 1:
@@ -177,6 +185,16 @@ class OptionSpec:
                 return NumberText(text, "an integer")
             return int(value)
         return value
+
+
+def _number_items(text: str) -> list[str]:
+    """The items of a number option's ``text``, in order: separated by commas or by
+    whitespace (``"0.5, 0.5 inf"``), an empty string for each comma with no item before
+    or after it (``"0.5,,0.5"``, ``",0.5"``, ``"0.5,"``)."""
+    items: list[str] = []
+    for part in text.split(","):
+        items.extend(part.split() or [""])
+    return items
 
 
 def format_choice(value: Any) -> str:
