@@ -123,8 +123,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=_job_count,
         default=None,
         metavar="N",
-        help=f"worker processes of the scenario timing (default: the CPUs available; at most "
-        f"{MAX_JOBS}, and never more than the scenarios)",
+        help=f"worker processes of the scenario timing, only with --scenarios N >= 1 (default: "
+        f"the CPUs available; at most {MAX_JOBS}, and never more than the scenarios)",
     )
     parser.add_argument(
         "--robot",
@@ -154,15 +154,18 @@ def _main(argv: Sequence[str] | None = None) -> int:
     if unknown:
         choices = ", ".join(method_names())
         raise ParameterError(f"method: unknown method {unknown[0]!r} (choose from {choices})")
+    scenarios = args.scenarios
+    if scenarios is None:
+        scenarios = SCENARIO_COUNT if args.methods is None else 0
+    if args.jobs is not None and scenarios == 0:  # nothing else runs in workers
+        given = "got 0" if args.scenarios is not None else "0 by default with --method"
+        raise ParameterError(f"--jobs: only used with --scenarios N >= 1 ({given})")
     # Everything that can be checked is checked before a minute-long run.
     previous = read_report(args.compare) if args.compare is not None else None
     out = Path(given_text("out", args.out, "a report file"))
     check_out(out, force=args.force)
     check_duration(Ellipse(), args.duration)
     probe_out(out)
-    scenarios = args.scenarios
-    if scenarios is None:
-        scenarios = SCENARIO_COUNT if args.methods is None else 0
     report = run_benchmark(
         args.repeats,
         args.calls,
