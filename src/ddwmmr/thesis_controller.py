@@ -55,6 +55,7 @@ from ddwmmr.behaviours.obstacle import ObstacleAvoidance
 from ddwmmr.behaviours.stability import Stability
 from ddwmmr.commands import WheelForces
 from ddwmmr.controllers.base import WaypointRun, register_controller
+from ddwmmr.controllers.inputs import check_time
 from ddwmmr.errors import check_range, name_of
 from ddwmmr.model import Robot
 
@@ -177,9 +178,11 @@ class ThesisController:
     ) -> WheelForces:
         """Wheel forces and joint targets for the task point ``pose_d[:2]`` (m, world).
 
-        ``base_velocity`` is the measured ``(v, w)`` (m/s, rad/s); ``velocity_d`` is unused
-        (the behaviours work on points, not trajectories).
+        ``t`` (s) is a finite time, taken as a float (:func:`~ddwmmr.controllers.inputs.
+        check_time`); ``base_velocity`` is the measured ``(v, w)`` (m/s, rad/s);
+        ``velocity_d`` is unused (the behaviours work on points, not trajectories).
         """
+        t = check_time(t)
         x, y, _ = pose_d.tolist() if isinstance(pose_d, np.ndarray) else pose_d
         self.target = (float(x), float(y))
         v, w = base_velocity

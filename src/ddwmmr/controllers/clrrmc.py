@@ -178,7 +178,7 @@ class ConfigurationSpaceController:
         The sideways part of the commanded base velocity cannot be produced; it is reported
         in ``last.nonholonomic_residual`` (m/s).
         """
-        q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        t, q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         check_angles(q)
         u, residual, damped = self._input(t, q)
         check_command(u, q, pose_d)

@@ -14,8 +14,9 @@ It runs every control step, so the common case (everything finite) is one sum ov
 values: a sum is finite only if every term is finite. Only when it is not (or when the
 arguments are not flat numeric sequences, or hold an integer beyond a float such as
 ``10**400``) does the slow path look at each argument, which also clears sums that merely
-overflowed. It returns the arguments as lists of floats, which the closed-form controllers
-work with anyway (one conversion instead of two).
+overflowed. It returns the time as a float and the arguments as lists of floats, which the
+closed-form controllers work with anyway (one conversion instead of two): a ``float32``
+time or array computes in double precision as a float would, not in single precision.
 
 :func:`check_start` is the same check for the start configuration ``q0`` of
 ``Controller.reset``.
@@ -39,7 +40,7 @@ _ARGUMENTS = (
 )
 
 
-Lists = tuple[list[float], list[float], list[float]]
+Lists = tuple[float, list[float], list[float], list[float]]
 _isfinite = math.isfinite
 #: Types float() converts that are no time: text ("0" would reach the methods as a string,
 #: which some compare with floats) and booleans (a flag, not 1 s).
@@ -56,7 +57,8 @@ def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
         velocity_d: desired end-effector velocity, 3 numbers.
 
     Returns:
-        ``(q, pose_d, velocity_d)`` as lists of floats.
+        ``(t, q, pose_d, velocity_d)``: ``t`` as a float, the others as lists of floats
+        (Python floats, double precision, whatever the numbers' numpy type).
     """
     try:
         ql, pl, vl = q.tolist(), pose_d.tolist(), velocity_d.tolist()
@@ -69,15 +71,15 @@ def check_inputs(t: float, q: Any, pose_d: Any, velocity_d: Any) -> Lists:
             and _isfinite(sum(values, t))
             and not isinstance(t, _NOT_TIMES)
         ):
-            return ql, pl, vl
+            return (t if type(t) is float else float(t)), ql, pl, vl
     except (AttributeError, TypeError, OverflowError):  # OverflowError: an int like 10**400
         pass
-    _check_time(t)
+    time = check_time(t)
     ql, pl, vl = (
         check_numbers(name, value, size, entries)
         for (name, size, entries), value in zip(_ARGUMENTS, (q, pose_d, velocity_d))
     )
-    return ql, pl, vl
+    return time, ql, pl, vl
 
 
 def check_start(q0: Any) -> list[float]:
@@ -113,9 +115,10 @@ def _what(value: Any, size: int) -> str:
     return shown(value, 60)
 
 
-def _check_time(t: Any) -> None:
-    """The slow path's check of the time ``t`` (s): a finite real number (an int, a float,
-    a numpy scalar), not text or a boolean."""
+def check_time(t: Any) -> float:
+    """The time ``t`` (s) as a float if it is a finite real number (an int, a float, a
+    numpy scalar such as ``float32``), else :class:`ParameterError` naming ``t`` (text and
+    booleans are no time, even where ``float()`` reads them)."""
     if isinstance(t, _NOT_TIMES):
         raise ParameterError(f"t must be a finite time in s (got {shown(t)})")
     try:
@@ -124,6 +127,7 @@ def _check_time(t: Any) -> None:
         raise ParameterError(f"t must be a finite time in s (got {shown(t)})") from None
     if not math.isfinite(time):
         raise ParameterError(f"t must be a finite time in s (got {shown(time)})")
+    return time
 
 
 def check_command(u: tuple[float, ...], q: list[float], pose_d: list[float]) -> None:

@@ -65,7 +65,7 @@ class ResolvedRate(ABC):
     ) -> np.ndarray:
         """Input ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s) for the desired
         end-effector velocity (world frame, m/s, rad/s); the arguments are validated."""
-        q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
+        t, q, pose_d, velocity_d = check_inputs(t, q, pose_d, velocity_d)
         u, singular = self.law(t, q, pose_d, velocity_d)
         check_command(u, q, pose_d)
         self.last = StepInfo(singular=singular)

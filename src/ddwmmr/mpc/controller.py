@@ -328,7 +328,7 @@ class MPCController:
         ``base_velocity = (v, w)`` (m/s, rad/s) is the measured base velocity the thesis
         model needs; without it the previous plan's prediction is used.
         """
-        checked = check_inputs(t, q, pose_d, velocity_d)
+        t, *checked = check_inputs(t, q, pose_d, velocity_d)
         check_angles(checked[0])  # as every other method: angles whose sums overflow
         q, pose_d, velocity_d = (np.array(values) for values in checked)
         reach = self._trajectory is None and not np.any(velocity_d)

@@ -426,7 +426,7 @@ class QPController:
         ``base_velocity``: the measured ``(v, w)`` (the edge-load limit's; else the
         previous command's)."""
         ctx = self.ctx
-        ctx.update_floats(t, *check_inputs(t, q, pose_d, velocity_d))
+        ctx.update_floats(*check_inputs(t, q, pose_d, velocity_d))
         if self.edge_loads is not None:
             measured = base_velocity if base_velocity is not None else ctx.previous_command
             self.edge_loads.observe(*(measured or (0.0, 0.0)))
