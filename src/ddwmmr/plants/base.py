@@ -20,9 +20,10 @@ helpers here (:func:`check_control_step`, :func:`check_limit`, :func:`check_step
 (:func:`~ddwmmr.model.kinematics.check_configuration`): anything
 but finite numbers of the right shape (a ``policy`` that is not callable) is a one-line
 :class:`~ddwmmr.errors.ParameterError` naming ``q0``, ``dt``, ``q``, ``u``, ``t``,
-``command`` or ``policy``, before the state changes. A ``step`` before the first
-``reset`` is a :class:`PlantNotResetError` (a ``RuntimeError``): the plant has no start
-state yet.
+``command`` or ``policy``, before the state changes. Whatever reads or advances the
+state (``step``, ``observe``, ``extra_values``) before the first ``reset`` is a
+:class:`PlantNotResetError` (a ``RuntimeError``): the plant has no start state yet.
+``limit`` reads only its arguments (and the robot's limits) and works before it.
 """
 
 from __future__ import annotations
@@ -111,14 +112,15 @@ class PlantDivergedError(RuntimeError):
 
 
 class PlantNotResetError(RuntimeError):
-    """A plant was stepped before its first ``reset(q0, dt)``, so it has no start state.
+    """A plant was stepped or read (``step``, ``observe``, ``extra_values``) before its
+    first ``reset(q0, dt)``, so it has no start state.
 
     The simulation loop always resets first; a caller driving a plant by hand must too.
-    The message is one line naming the plant.
+    The message is one line naming the plant and the method called (``method``).
     """
 
-    def __init__(self, plant: str) -> None:
-        super().__init__(f"{plant} plant: call reset(q0, dt) before step")
+    def __init__(self, plant: str, method: str = "step") -> None:
+        super().__init__(f"{plant} plant: call reset(q0, dt) before {method}")
 
 
 #: What each command interface takes, for messages.
@@ -298,7 +300,8 @@ class PlantImplementation(Protocol):
         ...
 
     def observe(self) -> Observation:  # pragma: no cover - protocol
-        """The current measured state."""
+        """The current measured state; :class:`PlantNotResetError` before the first
+        ``reset``."""
         ...
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:  # pragma: no cover
@@ -328,7 +331,8 @@ class PlantImplementation(Protocol):
         ...
 
     def extra_values(self) -> Sequence[float]:  # pragma: no cover - protocol
-        """Values of ``extra_columns`` at the current state."""
+        """Values of ``extra_columns`` at the current state; :class:`PlantNotResetError`
+        before the first ``reset``."""
         ...
 
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:  # pragma: no cover

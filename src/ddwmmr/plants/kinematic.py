@@ -87,7 +87,10 @@ class KinematicPlant:
         self._started = True
 
     def observe(self) -> Observation:
-        """The exact state; ``v``, ``w`` are those of the last applied input (0 at rest)."""
+        """The exact state; ``v``, ``w`` are those of the last applied input (0 at rest).
+        Before the first :meth:`reset` it is a :class:`PlantNotResetError`."""
+        if not self._started:
+            raise PlantNotResetError("kinematic", "observe")
         return Observation(tuple(self._state), self._v, self._w)
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -120,7 +123,10 @@ class KinematicPlant:
         self._v, self._w = u0[0], u0[1]
 
     def extra_values(self) -> Sequence[float]:
-        """No plant-specific columns."""
+        """No plant-specific columns (:class:`PlantNotResetError` before the first
+        :meth:`reset`, as every plant's)."""
+        if not self._started:
+            raise PlantNotResetError("kinematic", "extra_values")
         return ()
 
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:

@@ -263,7 +263,10 @@ class ThesisPlant:
         self._started = True
 
     def observe(self) -> Observation:
-        """Configuration and base velocities, exactly."""
+        """Configuration and base velocities, exactly; before the first :meth:`reset` a
+        :class:`PlantNotResetError`."""
+        if not self._started:
+            raise PlantNotResetError("thesis", "observe")
         s = self.state
         return Observation(s.q, s.v, s.w)
 
@@ -312,7 +315,10 @@ class ThesisPlant:
             raise PlantDivergedError(f"thesis plant: non-finite state at t = {t + dt:g} s")
 
     def extra_values(self) -> Sequence[float]:
-        """Wheel forces (N) of the last step."""
+        """Wheel forces (N) of the last step (0 after :meth:`reset`; before the first, a
+        :class:`PlantNotResetError`)."""
+        if not self._started:
+            raise PlantNotResetError("thesis", "extra_values")
         return self._forces
 
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:

@@ -406,7 +406,10 @@ class MujocoPlant:
 
     # -- the plant interface --------------------------------------------------------------
     def observe(self) -> Observation:
-        """Measured ``q`` (world frame), forward speed v (m/s) and yaw rate w (rad/s)."""
+        """Measured ``q`` (world frame), forward speed v (m/s) and yaw rate w (rad/s).
+        Before the first :meth:`reset` (the robot not yet on the floor) it is a
+        :class:`PlantNotResetError`."""
+        self._require_reset("observe")
         qpos, qvel = self.data.qpos, self.data.qvel
         phi = self._phi
         q = np.array(
@@ -434,8 +437,7 @@ class MujocoPlant:
         (:func:`~ddwmmr.plants.base.check_step`) or if dt differs from the reset's control
         step and is not an allowed one (:meth:`check_control_step`).
         """
-        if self._dt is None:
-            raise PlantNotResetError("mujoco")
+        self._require_reset("step")
         checked = check_step(t, command, dt, self.interfaces)
         substeps = self._substeps if dt == self._dt else self.check_control_step(dt)
         q = self.observe().q
@@ -480,6 +482,11 @@ class MujocoPlant:
         every control step that ended so (a wheel chattering on a lightly loaded side
         counts)."""
         return self._unloaded_time
+
+    def _require_reset(self, method: str) -> None:
+        """:class:`PlantNotResetError` naming ``method`` before the first :meth:`reset`."""
+        if self._dt is None:
+            raise PlantNotResetError("mujoco", method)
 
     def _judge_tipping(self, t: float, dt: float) -> None:
         """Feed the tip criterion the state at t (s), which ends a step of dt (s; 0: the
@@ -640,7 +647,8 @@ class MujocoPlant:
     def support_forces(self) -> tuple[np.ndarray, np.ndarray]:
         """Floor normal force on each support (N) and its contact point in the base frame
         (m), in the order of :attr:`supports` (an unloaded support: 0 N at its nominal
-        point)."""
+        point); before the first :meth:`reset` a :class:`PlantNotResetError`."""
+        self._require_reset("support_forces")
         index, normal = self._support_contacts()
         forces = np.array(self._per_support(index, normal))
         ox, oy = self.data.xpos[self._ids["base"]][:2].tolist()
@@ -693,11 +701,15 @@ class MujocoPlant:
         return self.geometry.min_edge_load(self._per_support(*self._support_contacts()))
 
     def base_tilt(self) -> float:
-        """Angle (rad) between the base's z axis and the vertical."""
+        """Angle (rad) between the base's z axis and the vertical (:class:`PlantNotResetError`
+        before the first :meth:`reset`)."""
+        self._require_reset("base_tilt")
         return float(math.acos(min(1.0, max(-1.0, self.data.xmat[self._ids["base"]][8]))))
 
     def wheel_slip(self) -> float:
-        """Largest horizontal speed (m/s) of a wheel's contact point over the floor."""
+        """Largest horizontal speed (m/s) of a wheel's contact point over the floor
+        (:class:`PlantNotResetError` before the first :meth:`reset`)."""
+        self._require_reset("wheel_slip")
         r = self.robot.wheel_radius
         worst = 0.0
         for body in self._ids["wheels"]:
@@ -710,7 +722,9 @@ class MujocoPlant:
         return worst
 
     def extra_values(self) -> tuple[float, ...]:
-        """Values of :attr:`extra_columns` at the current state."""
+        """Values of :attr:`extra_columns` at the current state (:class:`PlantNotResetError`
+        before the first :meth:`reset`)."""
+        self._require_reset("extra_values")
         if self._cache is None:
             forces, points = self.support_forces()
             cop = centre_of_pressure(points, forces)
@@ -729,7 +743,9 @@ class MujocoPlant:
 
     def torque_use(self, actuators: Sequence[int] | None = None) -> float:
         """Largest share of its torque limit any motor uses now (1: saturated); only the
-        motors of ``actuators`` (indices into the model's actuators), if given."""
+        motors of ``actuators`` (indices into the model's actuators), if given;
+        :class:`PlantNotResetError` before the first :meth:`reset`."""
+        self._require_reset("torque_use")
         index = slice(None) if actuators is None else list(actuators)
         limits = self.model.actuator_forcerange[index, 1]
         return float(np.max(np.abs(self.data.actuator_force[index]) / limits))

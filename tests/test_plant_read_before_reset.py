@@ -1,0 +1,43 @@
+"""A plant read before its first ``reset`` (``observe``, ``extra_values``...) says to reset."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from ddwmmr import Robot
+from ddwmmr.plants import KinematicPlant, MujocoPlant, PlantNotResetError, ThesisPlant
+
+ROBOT = Robot()
+Q = np.array([0.1, -0.05, 0.02, 0.31, 0.52])
+
+
+@pytest.mark.parametrize(
+    ("kind", "name"),
+    [(KinematicPlant, "kinematic"), (ThesisPlant, "thesis"), (MujocoPlant, "mujoco")],
+)
+def test_reading_a_plant_before_its_reset_says_to_reset(kind, name):
+    """observe() and extra_values() gave a zero state (the robot at the origin) before
+    reset(); step() already said to reset first."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plant = kind(ROBOT)
+    readers = {"observe": plant.observe, "extra_values": plant.extra_values}
+    if kind is MujocoPlant:
+        readers |= {
+            "support_forces": plant.support_forces,
+            "base_tilt": plant.base_tilt,
+            "wheel_slip": plant.wheel_slip,
+            "torque_use": plant.torque_use,
+        }
+    for method, read in readers.items():
+        with pytest.raises(PlantNotResetError) as info:
+            read()
+        assert str(info.value) == f"{name} plant: call reset(q0, dt) before {method}"
+    applied, saturated = plant.limit(Q, np.array([0.1, 0.0, 0.1, 0.1]))  # reads no state
+    assert applied.tolist() == [0.1, 0.0, 0.1, 0.1] and not saturated
+    plant.reset(Q, 0.02)
+    assert plant.observe().q[:2] == pytest.approx(Q[:2], abs=1e-3)
+    assert len(plant.extra_values()) == len(plant.extra_columns)
