@@ -154,7 +154,8 @@ def test_scenarios_pass_options_to_the_controller_and_refuse_the_protocol_s():
         ("horizon", 1.5),
     )
     with pytest.raises(ParameterError, match=r"^option: the scenarios set dt themselves \(it is"):
-        config_from_arguments(scenarios_parser().parse_args(["--option", "dt=0.02"]))
+        argv = ["--controller", "qp", "--option", "dt=0.02"]
+        config_from_arguments(scenarios_parser().parse_args(argv))
     with pytest.raises(
         ParameterError, match=r"^horizon: --horizon is taken only by --controller mpc"
     ):

@@ -51,7 +51,7 @@ from ddwmmr.cli.common import (
     run_main,
 )
 from ddwmmr.commands import traits_of
-from ddwmmr.controllers import controller_traits, method_description
+from ddwmmr.controllers import controller_traits, method_description, method_options
 from ddwmmr.controllers.option_specs import option_names, parse_options
 from ddwmmr.errors import (
     MAX_JOBS,
@@ -413,7 +413,8 @@ def _option_names() -> Iterator[None]:
 def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, Any], ...]:
     """``--option NAME=VALUE`` and ``--horizon`` as ``RunConfig.controller_options``:
     parsed and checked as the simulator's fields are; the options the protocol sets
-    (:data:`PROTOCOL_OPTIONS`) are refused, naming what sets them. A relative
+    (:data:`PROTOCOL_OPTIONS`, those of them the controller takes) are refused, naming what
+    sets them; one it does not take is refused as any unknown option. A relative
     ``plan=DIR`` becomes absolute here, against this process's working folder: the
     scenarios may run in workers with another one (a Dask worker's)."""
     if args.horizon is not None and "horizon" not in option_names(args.controller):
@@ -426,9 +427,10 @@ def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, An
         *(args.option or ()),
         *(() if args.horizon is None else (f"horizon={args.horizon!r}",)),
     ]
+    taken = method_options(args.controller)
     for text in texts:
         name = text.partition("=")[0].strip()
-        if name in PROTOCOL_OPTIONS:
+        if name in PROTOCOL_OPTIONS and name in taken:
             raise ParameterError(
                 f"option: the scenarios set {name} themselves ({PROTOCOL_OPTIONS[name]}; got "
                 f"{text!r})"
