@@ -6,11 +6,12 @@ increasing (spanning a duration of 1e-6 s to 1e9 s, each step at least
 column may wrap at +-pi (as ``atan2`` writes it): a column within [-pi, pi] (give or take
 :data:`ATAN2_ROUNDING_RAD`) is unwrapped before interpolation (:func:`unwrap_phi`). A
 ``phi`` column that turns far more than the path does draws a warning: degrees read as
-radians (:func:`heading_units_warning`). Without ``phi`` the orientation is the
-direction of travel (unwrapped). If the first and last points coincide the path is
-treated as closed and the tangents at the ends are matched (periodic). Outside the
-samples' time range the trajectory holds still: the pose stays at the first (before) or
-last (after) sample and the velocity is zero.
+radians (:func:`heading_units_warning`); so do a CSV file's positions spanning more than
+a robot's plausible length: millimetres read as metres (:func:`length_units_warning`).
+Without ``phi`` the orientation is the direction of travel (unwrapped). If the first and last
+points coincide the path is treated as closed and the tangents at the ends are matched
+(periodic). Outside the samples' time range the trajectory holds still: the pose stays at
+the first (before) or last (after) sample and the velocity is zero.
 """
 
 from __future__ import annotations
@@ -39,6 +40,7 @@ from ddwmmr.errors import (
     read_text_file,
     shown,
 )
+from ddwmmr.model.robot import PLAUSIBLE_LENGTH_M
 from ddwmmr.trajectories.base import (
     atan2_array,
     check_name,
@@ -414,6 +416,28 @@ def unwrap_phi(points: np.ndarray) -> np.ndarray:
     return unwrapped
 
 
+def length_units_warning(points: np.ndarray) -> str | None:
+    """One line saying the positions (x, y; m) of ``points`` span more than
+    :data:`~ddwmmr.model.robot.PLAUSIBLE_LENGTH_M` in x or y, the length above which a
+    robot file's lengths are taken for millimetres, else None. A path logged in
+    millimetres spans a thousand times the metres it means (a 2 m ellipse spans 2000);
+    where the path lies (an offset) does not count, only its extent. Checked for a CSV
+    file (:func:`read_csv`), not for samples given in code, which a caller may have
+    scaled on purpose (the simulator's placement, ``--traj-scale``)."""
+    spans = np.ptp(points[:, :2], axis=0)
+    long = [
+        f"{axis} spans {span:g} m"
+        for axis, span in zip("xy", spans.tolist())
+        if span > PLAUSIBLE_LENGTH_M
+    ]
+    if not long:
+        return None
+    return (
+        f"{' and '.join(long)}, above {PLAUSIBLE_LENGTH_M:g} m: positions are read in metres "
+        "(given in millimetres? divide them by 1000); taken as given"
+    )
+
+
 def heading_units_warning(points: np.ndarray) -> str | None:
     """One line saying the ``phi`` column (rad, already unwrapped by :func:`unwrap_phi`)
     of ``points`` turns far more than its path plausibly does, else None (no ``phi``, or
@@ -553,7 +577,18 @@ def _split_names(name: str) -> list[str]:
 
 
 def read_csv(path: str | Path) -> SampledTrajectory:
-    """Load a :class:`SampledTrajectory` from a CSV file with columns t, x, y[, phi]."""
+    """Load a :class:`SampledTrajectory` from a CSV file with columns t, x, y[, phi]; a
+    file whose positions look like millimetres (:func:`length_units_warning`) is taken as
+    given after a one-line :class:`UserWarning`, as a robot file's lengths are."""
+    trajectory = _read_samples(path)
+    message = length_units_warning(trajectory.points)
+    if message is not None:
+        warnings.warn(f"trajectory {trajectory.name}: {message}", UserWarning, stacklevel=2)
+    return trajectory
+
+
+def _read_samples(path: str | Path) -> SampledTrajectory:
+    """:func:`read_csv` without the units warning: the file's samples, checked."""
     path = as_path(path, "traj")
     # The text is dropped once split: a large file is held once, as its lines.
     lines = [line for line in read_text_file(path, "traj").splitlines() if not line.startswith("#")]
