@@ -122,7 +122,7 @@ def trajectory_name(trajectory: object) -> str:
     return str(getattr(trajectory, "name", type(trajectory).__name__.lower()))
 
 
-def atan2_array(y: np.ndarray, x: np.ndarray) -> np.ndarray:
+def atan2_array(y: npt.ArrayLike, x: npt.ArrayLike) -> np.ndarray:
     """Elementwise ``math.atan2`` (the C library's): numpy's ``arctan2`` differs from it in
     the last bit for about one value in twelve, and a vectorised ``sample`` must give the
     numbers of the scalar ``pose``."""
@@ -134,7 +134,9 @@ def sampler(trajectory: Any) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndar
     ``velocity``: None when it has none, or when a subclass overrides ``pose`` or
     ``velocity`` below the class that defines ``sample`` (the parent's ``sample`` would
     not know the change)."""
-    sample = getattr(trajectory, "sample", None)
+    sample: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]] | None = getattr(
+        trajectory, "sample", None
+    )
     owner = defining_class(type(trajectory), "sample")
     if sample is None or owner is None:
         return sample  # none, or an instance attribute: the trajectory's own word
@@ -165,7 +167,8 @@ def resolution_step(trajectory: Any) -> float:
     samples = check_int_at_least(
         "trajectory: samples (its resolution N)", getattr(trajectory, "samples", 1000), 1
     )
-    return trajectory.duration / samples
+    step: float = trajectory.duration / samples
+    return step
 
 
 def check_name(name: Any, prefix: str = "") -> str:

@@ -141,7 +141,8 @@ def load_trajectory(
     if path is None:
         name = str(name_or_path)
         _check_overrides(name, overrides)
-        return SHAPES[name](**overrides)
+        shape: Ellipse | Rectangle = SHAPES[name](**overrides)
+        return shape
     return _load_file(path, overrides)
 
 
@@ -172,7 +173,7 @@ def file_sha256(path: str | Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def _load_file(path: Path, overrides: dict):
+def _load_file(path: Path, overrides: dict[str, Any]) -> Ellipse | Rectangle | SampledTrajectory:
     if file_suffix(path) == ".csv":
         if overrides:
             raise ParameterError(f"traj: {path.name} is sampled; parameters cannot be overridden")
@@ -180,7 +181,7 @@ def _load_file(path: Path, overrides: dict):
     return read_toml(path, **overrides)
 
 
-def read_toml(path: str | Path, **overrides):
+def read_toml(path: str | Path, **overrides: Any) -> Ellipse | Rectangle:
     """Load a parametric trajectory (ellipse or rectangle) from a TOML file.
 
     The keys are either all top-level or all in one ``[trajectory]`` table: beside that

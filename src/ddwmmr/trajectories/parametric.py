@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Protocol, cast
 
 import numpy as np
 
@@ -42,6 +43,19 @@ PHI_NEEDS_CONSTANT = (
 )
 _isfinite = math.isfinite
 
+#: An angle or a length of the shapes: a float (pose, velocity) or an array (sample).
+_Real = float | np.ndarray
+
+
+class _Math(Protocol):
+    """The ``math`` functions the shapes use: the ``math`` module (floats) or
+    :class:`_ArrayMath` (arrays)."""
+
+    def sin(self, x: _Real, /) -> _Real: ...
+    def cos(self, x: _Real, /) -> _Real: ...
+    def floor(self, x: _Real, /) -> _Real: ...
+    def atan2(self, y: _Real, x: _Real, /) -> _Real: ...
+
 
 class _ArrayMath:
     """The ``math`` functions the shapes use, on arrays (for :meth:`_Parametric.sample`;
@@ -53,7 +67,8 @@ class _ArrayMath:
     atan2 = staticmethod(atan2_array)
 
 
-_ARRAY_MATH = _ArrayMath()
+# cast: numpy's ufunc stubs have no overload taking float | ndarray; on arrays they give arrays
+_ARRAY_MATH = cast(_Math, _ArrayMath())
 
 
 def check_geometry_value(name: str, value: float) -> float:
@@ -103,6 +118,9 @@ class _Parametric(ABC):
     T: float = 40.0
     orientation: str = "tangent"
     phi: float = 0.0
+    if TYPE_CHECKING:
+        # Each shape's own field, after phi (Ellipse, Rectangle: a default of its own).
+        name: str = ""
 
     def __post_init__(self) -> None:
         check_name(self.name)  # each shape's field, "ellipse" or "rectangle" by default
@@ -156,7 +174,7 @@ class _Parametric(ABC):
         poses = np.column_stack([self.x0 + rx, self.y0 + ry, heading])
         return poses, np.column_stack([vx, vy, np.broadcast_to(turn, t.shape)])
 
-    def _rotate(self, px: float, py: float) -> tuple[float, float]:
+    def _rotate(self, px: _Real, py: _Real) -> tuple[_Real, _Real]:
         cb, sb = math.cos(self.beta), math.sin(self.beta)
         return cb * px - sb * py, sb * px + cb * py
 
@@ -186,19 +204,19 @@ class _Parametric(ABC):
     # Shape-specific pieces, in the unrotated frame, as functions of alpha: a float with
     # m = math, or an array with m = _ARRAY_MATH (the same expressions, vectorised).
     @abstractmethod
-    def _shape(self, alpha: float, m=math) -> tuple[float, float]:
+    def _shape(self, alpha: _Real, m: _Math = math) -> tuple[_Real, _Real]:
         """Unrotated offset from the centre (m)."""
 
     @abstractmethod
-    def _shape_derivative(self, alpha: float, m=math) -> tuple[float, float]:
+    def _shape_derivative(self, alpha: _Real, m: _Math = math) -> tuple[_Real, _Real]:
         """d(offset)/d(alpha) (m/rad)."""
 
     @abstractmethod
-    def _tangent(self, alpha: float, m=math) -> float:
+    def _tangent(self, alpha: _Real, m: _Math = math) -> _Real:
         """Unwrapped direction of travel in the unrotated frame (rad)."""
 
     @abstractmethod
-    def _tangent_rate(self, alpha: float, m=math) -> float:
+    def _tangent_rate(self, alpha: _Real, m: _Math = math) -> _Real:
         """d(tangent)/d(alpha) (dimensionless)."""
 
 
@@ -213,20 +231,20 @@ class Ellipse(_Parametric):
 
     name: str = "ellipse"
 
-    def _shape(self, alpha: float, m=math) -> tuple[float, float]:
+    def _shape(self, alpha: _Real, m: _Math = math) -> tuple[_Real, _Real]:
         return self.a * m.cos(alpha), self.b * m.sin(alpha)
 
-    def _shape_derivative(self, alpha: float, m=math) -> tuple[float, float]:
+    def _shape_derivative(self, alpha: _Real, m: _Math = math) -> tuple[_Real, _Real]:
         return -self.a * m.sin(alpha), self.b * m.cos(alpha)
 
-    def _tangent(self, alpha: float, m=math) -> float:
+    def _tangent(self, alpha: _Real, m: _Math = math) -> _Real:
         # Direction of (-a sin, b cos), measured from the radial normal (-sin, cos) at angle
         # alpha + pi/2; that offset stays in (-pi/2, pi/2), so the sum is continuous.
         s, c = m.sin(alpha), m.cos(alpha)
         offset = m.atan2((self.a - self.b) * s * c, self.a * s * s + self.b * c * c)
         return alpha + 0.5 * math.pi + offset
 
-    def _tangent_rate(self, alpha: float, m=math) -> float:
+    def _tangent_rate(self, alpha: _Real, m: _Math = math) -> _Real:
         # d(heading)/d(alpha) = (x' y'' - y' x'') / |p'|^2 = a b / (a^2 sin^2 + b^2 cos^2)
         s, c = m.sin(alpha), m.cos(alpha)
         return self.a * self.b / (self.a**2 * s * s + self.b**2 * c * c)
@@ -238,24 +256,29 @@ class Rectangle(_Parametric):
 
     name: str = "rectangle"
 
-    def _shape(self, alpha: float, m=math) -> tuple[float, float]:
+    def _shape(self, alpha: _Real, m: _Math = math) -> tuple[_Real, _Real]:
         c, s = m.cos(alpha), m.sin(alpha)
-        return self.a * (abs(c) * c - abs(s) * s), self.b * (abs(c) * c + abs(s) * s)
-
-    def _shape_derivative(self, alpha: float, m=math) -> tuple[float, float]:
-        c, s = m.cos(alpha), m.sin(alpha)
+        # ignore: mypy types abs() of a float | ndarray as object (float * array is fine)
         return (
-            self.a * (-2.0 * abs(c) * s - 2.0 * abs(s) * c),
-            self.b * (-2.0 * abs(c) * s + 2.0 * abs(s) * c),
+            self.a * (abs(c) * c - abs(s) * s),  # type: ignore[operator]
+            self.b * (abs(c) * c + abs(s) * s),  # type: ignore[operator]
         )
 
-    def _tangent(self, alpha: float, m=math) -> float:
+    def _shape_derivative(self, alpha: _Real, m: _Math = math) -> tuple[_Real, _Real]:
+        c, s = m.cos(alpha), m.sin(alpha)
+        # ignore: mypy types abs() of a float | ndarray as object (float * array is fine)
+        return (
+            self.a * (-2.0 * abs(c) * s - 2.0 * abs(s) * c),  # type: ignore[operator]
+            self.b * (-2.0 * abs(c) * s + 2.0 * abs(s) * c),  # type: ignore[operator]
+        )
+
+    def _tangent(self, alpha: _Real, m: _Math = math) -> _Real:
         # Edges run -x, -y, +x, +y in turn; at a corner the edge being entered counts.
         # The small offset keeps sampled corners (alpha = k pi/2 up to rounding) on that edge.
         edge = m.floor(alpha / (0.5 * math.pi) + 1e-9)
         return math.pi + 0.5 * math.pi * edge
 
-    def _tangent_rate(self, alpha: float, m=math) -> float:
+    def _tangent_rate(self, alpha: _Real, m: _Math = math) -> _Real:
         return 0.0
 
     #: Corner window length after each corner, as a share of the period T: the orientation

@@ -21,7 +21,7 @@ import csv
 import itertools
 import math
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -131,7 +131,7 @@ class SampledTrajectory:
     points: np.ndarray
     name: str = "sampled"
     _slopes: np.ndarray = field(init=False, repr=False, compare=False)
-    _knots: list = field(init=False, repr=False, compare=False)
+    _knots: list[float] = field(init=False, repr=False, compare=False)
     _has_phi: bool = field(init=False, repr=False, compare=False)
     _moving: tuple[float, float] = field(init=False, repr=False, compare=False)
 
@@ -235,10 +235,11 @@ class SampledTrajectory:
         """Unwrapped direction of travel at the knots, linearly interpolated (for unwrapping)."""
         i, s, _ = self._segment(t)
         headings = self._knot_headings()
-        return (1 - s) * headings[i] + s * headings[i + 1]
+        heading: float = (1 - s) * headings[i] + s * headings[i + 1]
+        return heading
 
     def _knot_headings(self) -> np.ndarray:
-        cached = self.__dict__.get("_headings_cache")
+        cached: np.ndarray | None = self.__dict__.get("_headings_cache")
         if cached is None:
             cached = np.unwrap(np.arctan2(self._slopes[:, 1], self._slopes[:, 0]))
             self.__dict__["_headings_cache"] = cached
@@ -318,7 +319,7 @@ def _moving_range(first: float, last: float) -> tuple[float, float]:
     return first - slack, last + slack
 
 
-def _float_array(name: str, value, what: str) -> np.ndarray:
+def _float_array(name: str, value: object, what: str) -> np.ndarray:
     """``value`` as a float array (no copy when it already is one); strings, booleans,
     ragged rows and numbers beyond float range raise :class:`ParameterError` naming it."""
     wanted = f"trajectory samples: {name} must be {what}, numbers only"
@@ -350,7 +351,7 @@ def _holds_booleans(value: Any) -> bool:
     return any(isinstance(v, bool | np.bool_) for v in entries)
 
 
-def _is_number(value) -> bool:
+def _is_number(value: object) -> bool:
     return isinstance(value, int | float | np.integer | np.floating) and not isinstance(
         value, bool | np.bool_
     )
@@ -463,7 +464,9 @@ def heading_units_warning(points: np.ndarray) -> str | None:
     )
 
 
-def _hermite_terms(s, p0, p1, m0, m1) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _hermite_terms(
+    s: float | np.ndarray, p0: np.ndarray, p1: np.ndarray, m0: np.ndarray, m1: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Cubic Hermite value and first and second derivatives with respect to s (in 0..1)
     between points p0, p1 with tangents m0, m1 (already times the segment length): one
     segment (``s`` a float, points of shape (d,)) or many (``s`` of shape (n, 1), points
@@ -503,7 +506,7 @@ def csv_text(trajectory: SampledTrajectory) -> str:
 CSV_COLUMNS = ("t", "x", "y", "phi")
 
 
-def _csv_number(path: Path, number: int, row: dict, key: str) -> float:
+def _csv_number(path: Path, number: int, row: Mapping[str, str | None], key: str) -> float:
     """The value of column ``key`` in data row ``number`` as a float (one-line errors;
     :func:`~ddwmmr.errors.plain_number_text`)."""
     text = row.get(key)

@@ -86,15 +86,18 @@ class ScaledTrajectory:
     @property
     def duration(self) -> float:
         """The base's duration (s)."""
-        return self.trajectory.duration
+        duration: float = self.trajectory.duration
+        return duration
 
     def pose(self, t: float) -> np.ndarray:
         """``[s xE, s yE, phiE]`` (m, m, rad) of the base's pose at time t (s)."""
-        return np.asarray(self.trajectory.pose(t), dtype=float) * self._factors
+        pose: np.ndarray = np.asarray(self.trajectory.pose(t), dtype=float) * self._factors
+        return pose
 
     def velocity(self, t: float) -> np.ndarray:
         """``[s xEdot, s yEdot, phiEdot]`` (m/s, m/s, rad/s) of the base's at time t (s)."""
-        return np.asarray(self.trajectory.velocity(t), dtype=float) * self._factors
+        velocity: np.ndarray = np.asarray(self.trajectory.velocity(t), dtype=float) * self._factors
+        return velocity
 
     def sample(self, times: Any) -> tuple[np.ndarray, np.ndarray]:
         """Poses and velocities at many times (s) at once, both ``(len(times), 3)``: the
