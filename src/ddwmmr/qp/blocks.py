@@ -52,9 +52,9 @@ class TaskBlock:
     equalities (lower and upper bound are both views).
     """
 
-    jac: memoryview
+    jac: memoryview[float]
     rows: tuple[int, ...]
-    target_views: tuple[memoryview, ...]
+    target_views: tuple[memoryview[float], ...]
     targets: tuple[int, ...]
     scales: tuple[float, ...]
     slack: bool
@@ -82,10 +82,10 @@ class LimitBlock:
     arrives each step holding the bounds of earlier limits (start: +-INF); only tighten.
     """
 
-    matrix: memoryview
+    matrix: memoryview[float]
     rows: tuple[int, ...]
-    lower: memoryview
-    upper: memoryview
+    lower: memoryview[float]
+    upper: memoryview[float]
     bounds: tuple[int, ...]
     box: list[float]
 

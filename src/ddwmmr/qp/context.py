@@ -23,8 +23,10 @@ NU = 4
 def _floats(values: np.ndarray) -> list[float]:
     """``values`` as a list of Python floats (fast for a float64 array, the usual case)."""
     if type(values) is np.ndarray and values.dtype is FLOAT64:
-        return values.tolist()
-    return np.asarray(values, dtype=float).tolist()
+        floats: list[float] = values.tolist()
+        return floats
+    converted: list[float] = np.asarray(values, dtype=float).tolist()
+    return converted
 
 
 class StepContext:

@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping, Sequence
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -89,7 +89,14 @@ from ddwmmr.qp.limits.edge_loads import EdgeLoadLimit
 from ddwmmr.qp.limits.obstacles import check_margin_in_influence, robot_margin
 from ddwmmr.qp.limits.stability import ascent_direction, stability_rows
 from ddwmmr.qp.problem import QPProblem
-from ddwmmr.qp.solve import MODES, check_mode, installed_solvers, make_backend, solve
+from ddwmmr.qp.solve import (
+    MODES,
+    Backend,
+    check_mode,
+    installed_solvers,
+    make_backend,
+    solve,
+)
 from ddwmmr.qp.tasks import (
     Detour,
     EndEffectorTask,
@@ -351,7 +358,7 @@ class QPController:
         detour = Detour(self.obstacles, half_diagonal + 2.0 * margin)
         self.tracking.detour = heading.detour = detour
 
-    def _make_backend(self, solver: str, warm_start: bool | None):
+    def _make_backend(self, solver: str, warm_start: bool | None) -> Backend:
         """The solver backend (overridden by the naive benchmark variant)."""
         return make_backend(solver, warm_start)
 
@@ -370,10 +377,11 @@ class QPController:
             self.limits.remove(self.edge_loads)
             self.edge_loads = None
         if wanted:
+            # ignore: wanted holds only with min_edge_load and joint_time_constant set
             self.edge_loads = EdgeLoadLimit(
                 self.robot,
-                self.min_edge_load,
-                plant.joint_time_constant,
+                self.min_edge_load,  # type: ignore[arg-type]
+                plant.joint_time_constant,  # type: ignore[arg-type]
                 plant.joint_acceleration_limit,
                 unit=self.unit,
             )
@@ -406,7 +414,10 @@ class QPController:
         self.ctx.dt = control_step(self._dt_option, self._loop_step, trajectory, DEFAULT_DT)
         self.backend.reset()
         self.ctx.previous_command = None
-        self.ctx.start_turns = tuple(whole_turns(angle) for angle in start[2:5])
+        # cast: start holds 5 numbers (check_start), so [2:5] three (mypy counts no generator)
+        self.ctx.start_turns = cast(
+            "tuple[float, float, float]", tuple(whole_turns(angle) for angle in start[2:5])
+        )
         self.fallbacks = 0
         self.last = StepInfo()
         self.min_predicted_edge_load = None
@@ -421,7 +432,7 @@ class QPController:
         pose_d: np.ndarray,
         velocity_d: np.ndarray,
         base_velocity: Sequence[float] | None = None,
-    ):
+    ) -> np.ndarray:
         """Input ``u = (v, w, th1dot, th2dot)`` (m/s, rad/s, rad/s, rad/s) for this step;
         ``base_velocity``: the measured ``(v, w)`` (the edge-load limit's; else the
         previous command's)."""
@@ -433,11 +444,12 @@ class QPController:
         x = self._solve(ctx)
         relaxed = x is None and self.edge_loads is not None
         if relaxed:  # the edge rows conflict with the other limits: they give way
-            self.edge_loads.active = False
+            # ignore: relaxed holds only with an edge-load limit
+            self.edge_loads.active = False  # type: ignore[union-attr]
             try:
                 x = self._solve(ctx)
             finally:
-                self.edge_loads.active = True
+                self.edge_loads.active = True  # type: ignore[union-attr]
             self.edge_relaxed_steps += 1
         if x is None:
             return self._edge_prediction(ctx, self._fallback(ctx), relaxed)

@@ -35,6 +35,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from ctypes import c_int
+from typing import TYPE_CHECKING, cast
 
 import numpy as np
 
@@ -51,6 +52,9 @@ from ddwmmr.qp.blocks import CONSTANT, LimitBlock, TaskBlock
 from ddwmmr.qp.context import NU, StepContext
 from ddwmmr.qp.limits.base import INF, Limit
 from ddwmmr.qp.tasks.base import Task
+
+if TYPE_CHECKING:
+    from typing_extensions import Buffer
 
 #: Added to the Hessian diagonal so it stays positive definite whatever the weights (-).
 HESSIAN_FLOOR = 1e-7
@@ -101,7 +105,9 @@ def _refuse_v(label: str, ctx: StepContext, what: str) -> None:
     )
 
 
-def _refuse_written(label: str, ctx: StepContext, **written: np.ndarray | tuple) -> None:
+def _refuse_written(
+    label: str, ctx: StepContext, **written: np.ndarray | tuple[np.ndarray, ...]
+) -> None:
     """Refuse (one-line :class:`ParameterError`) the piece ``label`` whose ``compute``
     wrote NaN into any of ``written``, or an infinite value into any but its ``bounds``
     (an infinite bound leaves a side open)."""
@@ -171,11 +177,13 @@ def guarded_limit(limit: Limit) -> LimitCompute:
     return guarded
 
 
-def _flat(array: np.ndarray) -> memoryview:
+def _flat(array: np.ndarray) -> memoryview[float]:
     """A flat, writable memoryview of a C-contiguous float array (shares its memory)."""
     flat = array.reshape(-1)
     assert array.size == 0 or np.shares_memory(flat, array)
-    return memoryview(flat)
+    # cast: numpy's stubs make an ndarray a Buffer only from Python 3.12 on, and the
+    # memoryview of a float64 array (format "d") holds floats
+    return cast("memoryview[float]", memoryview(cast("Buffer", flat)))
 
 
 class QPProblem:
@@ -273,6 +281,7 @@ class QPProblem:
         self._generic_slack = []
         self._generic_limits = []
         start = 0
+        block: TaskBlock | LimitBlock
         for task in self.cost_tasks:
             stop = start + task.rows
             block = TaskBlock(
@@ -384,7 +393,8 @@ class QPProblem:
         another length unit than the problem's; a writer has no ``v`` column to check)."""
         ratio = self._v_ratio(piece)
         same_unit = ratio is None or ratio == 1.0
-        writer = piece.compile(block) if self.compiled and same_unit else None
+        # ignore: the callers pair a task with its TaskBlock, a limit with its LimitBlock
+        writer = piece.compile(block) if self.compiled and same_unit else None  # type: ignore[arg-type]
         if writer is None:
             return False
         if writer is not CONSTANT:

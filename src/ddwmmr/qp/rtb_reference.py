@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from typing import Any
 
 import numpy as np
 
@@ -38,7 +39,7 @@ PLANAR_AXES = [True, True, False, False, False, False]
 def unavailable_reason() -> str | None:
     """Why the reference cannot run here (None when it can): the benchmark's skip reason."""
     try:
-        import roboticstoolbox  # noqa: F401
+        import roboticstoolbox  # type: ignore[import-not-found]  # noqa: F401
     except ImportError as exc:
         return (
             f"roboticstoolbox-python is not installed ({exc.name or exc}); "
@@ -47,7 +48,8 @@ def unavailable_reason() -> str | None:
     return None
 
 
-def holistic_robot(robot: Robot):
+# Any: a roboticstoolbox Robot (an optional package without type hints)
+def holistic_robot(robot: Robot) -> Any:
     """The ddwmmr robot as a roboticstoolbox ``Robot`` (joints ``yaw, drive, th1, th2``)."""
     from roboticstoolbox import ET, ETS, Link
     from roboticstoolbox import Robot as ToolboxRobot
@@ -72,7 +74,8 @@ def planar_pose(x: float, y: float, phi: float) -> np.ndarray:
     return np.array([[c, -s, 0.0, x], [s, c, 0.0, y], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
 
 
-def holistic_step(r, Tep: np.ndarray) -> np.ndarray:
+# r is Any: a roboticstoolbox Robot (an optional package without type hints)
+def holistic_step(r: Any, Tep: np.ndarray) -> np.ndarray:
     """One step of the toolbox example's ``step_robot`` for an n-joint robot with the
     two base joints first: joint velocities ``qd`` (rad/s, m/s, rad/s, rad/s)."""
     import qpsolvers

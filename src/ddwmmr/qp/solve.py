@@ -19,8 +19,10 @@ from __future__ import annotations
 import importlib.util
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from types import ModuleType
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -41,7 +43,7 @@ STRICT_PRIMAL_TOL = 1e-9
 _BIG = 0.5 * INF
 
 
-def _qpsolvers():
+def _qpsolvers() -> ModuleType:
     """The qpsolvers package, imported on first use: it loads scipy.sparse and every
     installed solver (several times the rest of the library), which a run that builds no
     qpsolvers backend (any method but ``qp``, or ``qp`` on direct DAQP) does not pay."""
@@ -73,15 +75,27 @@ class SolveResult:
     solves: int
 
 
+class Backend(Protocol):
+    """What :func:`solve` calls (:func:`make_backend` builds one): ``backend(problem)``
+    gives the decision vector or None; ``reset()`` forgets a warm start."""
+
+    name: str
+
+    def reset(self) -> None: ...
+
+    def __call__(self, problem: QPProblem) -> np.ndarray | None: ...
+
+
 class DaqpBackend:
     """DAQP's low-level ``daqp.solve`` on the problem's own arrays (no copies, no checks)."""
 
     name = "daqp"
 
     def __init__(self, warm_start: bool = False) -> None:
-        import daqp  # local: only this backend needs it
+        import daqp  # type: ignore[import-not-found]  # local: only this backend needs it
 
-        self._solve = daqp.solve
+        # daqp.solve (a compiled module, no hints): (x, fval, exitflag, info)
+        self._solve: Callable[..., tuple[np.ndarray, float, int, dict[str, Any]]] = daqp.solve
         self.warm_start = warm_start
         self._previous: np.ndarray | None = None
 
@@ -132,7 +146,7 @@ class QpsolversBackend:
     def __init__(self, solver: str, warm_start: bool = True) -> None:
         self.name = self.solver = check_solver(solver)
         qpsolvers = _qpsolvers()
-        self._solve_qp = qpsolvers.solve_qp
+        self._solve_qp: Callable[..., np.ndarray | None] = qpsolvers.solve_qp
         self.sparse = solver in SPARSE_FOR_REPEATABILITY or (
             solver in qpsolvers.sparse_solvers and solver not in qpsolvers.dense_solvers
         )
@@ -147,7 +161,7 @@ class QpsolversBackend:
         """Convert to ``G x <= h, A x = b`` (finite sides only) and solve."""
         P, q, G, h, A, b = to_standard_form(problem)
         if self.sparse:
-            from scipy import sparse
+            from scipy import sparse  # type: ignore[import-untyped]
 
             P, G, A = sparse.csc_matrix(P), sparse.csc_matrix(G), sparse.csc_matrix(A)
         initvals = self._previous if self.warm_start else None
@@ -160,7 +174,9 @@ class QpsolversBackend:
         return x
 
 
-def to_standard_form(problem: QPProblem):
+def to_standard_form(
+    problem: QPProblem,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``(P, q, G, h, A, b)`` with ``G x <= h`` from the finite box and row bounds and
     ``A x = b`` from the equality rows. Box entries pinned to a narrow band (the frozen
     slack of hierarchical mode) become equalities: a band thinner than a solver's
@@ -187,7 +203,7 @@ def installed_solvers() -> list[str]:
     return [*names, "qpsolvers-daqp"] if "daqp" in names else names
 
 
-def make_backend(solver: str, warm_start: bool | None = None):
+def make_backend(solver: str, warm_start: bool | None = None) -> DaqpBackend | QpsolversBackend:
     """The backend for ``solver``: DAQP direct for ``"daqp"``, qpsolvers for the rest.
 
     ``"qpsolvers-daqp"`` forces DAQP through qpsolvers (for comparisons). A solver that is
@@ -208,7 +224,7 @@ def make_backend(solver: str, warm_start: bool | None = None):
     return QpsolversBackend(solver, warm_start=True if warm_start is None else warm_start)
 
 
-def solve(problem: QPProblem, backend, mode: str = "weighted") -> SolveResult:
+def solve(problem: QPProblem, backend: Backend, mode: str = "weighted") -> SolveResult:
     """Solve the built ``problem`` (see :meth:`QPProblem.build`) in ``mode``.
 
     Returns the decision vector ``x = (u, s)`` or None if a level failed (infeasible

@@ -27,11 +27,15 @@ a servo that gives rotation priority (the thesis plant) turns and gives up speed
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ddwmmr.errors import ParameterError, check_positive, shown
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import Limit
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class BaseMotionLimit(Limit):
@@ -86,7 +90,15 @@ class BaseMotionLimit(Limit):
         # A previous command beyond a cap (e.g. a cap lowered mid-run) must not empty the box.
         return min(low_v, high_v), max(low_v, high_v), min(low_w, high_w), max(low_w, high_w)
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
         """Tighten the (v, w) box; no general rows."""
         low_v, high_v, low_w, high_w = self.envelope(ctx)
         unit = self.unit
@@ -134,7 +146,15 @@ class SpeedBudgetLimit(Limit):
         # |v|/v_top + |w|/w_top <= 1 is the pair of rows -1 <= v/v_top +- w/w_top <= 1.
         self.rows_vw = ((unit / v_top, 1.0 / w_top), (unit / v_top, -1.0 / w_top))
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
         """Constant rows; written every step because the arrays are shared views."""
         for row, (a_v, a_w) in enumerate(self.rows_vw):
             G[row, 0], G[row, 1], G[row, 2], G[row, 3] = a_v, a_w, 0.0, 0.0

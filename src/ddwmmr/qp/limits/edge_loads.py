@@ -39,12 +39,20 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ddwmmr.errors import check_positive
 from ddwmmr.model.support_loads import EdgeLoadModel, check_min_edge_load, edge_loads_at
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import numpy as np
+
+    from ddwmmr.model import Robot
 
 
 class EdgeLoadLimit(Limit):
@@ -68,7 +76,7 @@ class EdgeLoadLimit(Limit):
 
     def __init__(
         self,
-        robot,
+        robot: Robot,
         min_edge_load: float,
         time_constant: float,
         acceleration_limit: tuple[float, float] | None = None,
@@ -100,7 +108,7 @@ class EdgeLoadLimit(Limit):
         """The measured forward speed v (m/s) and yaw rate w (rad/s) of this step."""
         self.v, self.w = float(v), float(w)
 
-    def advance(self, command, dt: float) -> None:
+    def advance(self, command: Sequence[float] | np.ndarray, dt: float) -> None:
         """The joints' rates after holding ``command`` (its rates, rad/s) for dt (s): the
         lag's response, at most the acceleration limit times dt."""
         share = 1.0 - math.exp(-dt / self.time_constant)
@@ -164,7 +172,7 @@ class EdgeLoadLimit(Limit):
         self._last = (rows, floors)
         return rows, floors
 
-    def predict(self, command) -> list[float]:
+    def predict(self, command: Sequence[float] | np.ndarray) -> list[float]:
         """The predicted edge loads (N) of ``command`` in the step whose rows were built
         last (:meth:`rows_and_floors`)."""
         rows, floors = self._last
@@ -189,7 +197,15 @@ class EdgeLoadLimit(Limit):
             return rows
         return [[row[0] * unit, row[1], row[2], row[3]] for row in rows]
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
         """Rows ``G_e`` with the lower bound of :meth:`capped`."""
         rows, floors = self.rows_and_floors(ctx)
         rows = self.in_unit(rows)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ddwmmr.errors import check_nonnegative
 from ddwmmr.gains import check_gain
@@ -10,6 +11,9 @@ from ddwmmr.model import Robot
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import Limit
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class JointLimit(Limit):
@@ -48,7 +52,15 @@ class JointLimit(Limit):
         up = back if back > up else up
         return -down, up
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
         """Tighten the box on th1dot (index 2) and th2dot (index 3)."""
         for index, angle in ((2, ctx.th1), (3, ctx.th2)):
             low, up = self.joint_bounds(angle, index - 2)

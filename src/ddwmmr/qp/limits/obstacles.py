@@ -358,7 +358,15 @@ class ObstacleLimit(Limit):
             return a_v / norm, a_w / norm, min(damper, 0.0) / norm
         return a_v, a_w, min(damper, 0.25 * reach)
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
         """Rows ``[dd/dv, dd/dw, 0, 0]`` for circles within ``influence``."""
         for row, circle in enumerate(self.circles):
             G[row, 0], G[row, 1], lower[row] = self.row(ctx, circle)

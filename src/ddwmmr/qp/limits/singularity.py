@@ -14,12 +14,16 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ddwmmr.errors import ParameterError, check_positive
 from ddwmmr.gains import check_gain
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class ShoulderSingularityLimit(Limit):
@@ -49,7 +53,15 @@ class ShoulderSingularityLimit(Limit):
         achievable = 0.5 * self.joint_speed * abs(slope)
         return slope, min(-self.gain * (ctx.cos_th1**2 - self.floor), achievable)
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
         """The damper row on th1dot."""
         G[0, 0] = G[0, 1] = G[0, 3] = 0.0
         G[0, 2], lower[0] = self.values(ctx)

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ddwmmr.errors import check_positive
 from ddwmmr.gains import check_gain
@@ -39,6 +40,9 @@ from ddwmmr.model.stability import (
 from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 def stability_terms_gradient(
@@ -228,7 +232,15 @@ class StabilityLimit(Limit):
         damper = -self.gain * (s_i - (self.stability_min + self.margin))
         return achievable if achievable < damper else damper  # min(damper, achievable)
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
         """Rows ``[0, 0, dS_e/dth1, dS_e/dth2]`` with lower bound ``-gain (S_e - floor)``."""
         for row, (s_i, g1, g2) in enumerate(stability_rows(self.com, ctx.th1, ctx.th2)):
             G[row, 0] = G[row, 1] = 0.0

@@ -18,10 +18,15 @@ first step after a reset. ``I`` is evaluated at the current arm pose.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ddwmmr.errors import check_positive
 from ddwmmr.model.symbolic import ThesisDynamics
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class WheelForceLimit(Limit):
@@ -43,7 +48,15 @@ class WheelForceLimit(Limit):
         self.bandwidth = check_positive("bandwidth", bandwidth)
         self.fraction = check_positive("fraction", fraction)
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
         """Rows ``[0.5 a_v, -+0.5 a_w, 0, 0]`` with the force bounds shifted by the offsets."""
         d, k = self.dynamics, self.bandwidth
         inertia = d.inertia(float(ctx.th2))

@@ -6,12 +6,16 @@ The wheel map: docs/theory.md, "Wheels".
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 from ddwmmr.errors import check_positive
 from ddwmmr.model import Robot
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import Limit
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 class WheelSpeedLimit(Limit):
@@ -28,7 +32,15 @@ class WheelSpeedLimit(Limit):
         # A hair inside the plant's limit so the plant never has to rescale our command.
         self.limit = robot.wheel_speed_limit * scale * (1.0 - 1e-6)
 
-    def compute(self, ctx: StepContext, G, lower, upper, lb, ub) -> None:
+    def compute(
+        self,
+        ctx: StepContext,
+        G: np.ndarray,
+        lower: np.ndarray,
+        upper: np.ndarray,
+        lb: np.ndarray,
+        ub: np.ndarray,
+    ) -> None:
         """Constant rows; written every step because the arrays are shared views."""
         for row, (a_v, a_w) in enumerate(self.rows_lr):
             G[row, 0], G[row, 1], G[row, 2], G[row, 3] = a_v, a_w, 0.0, 0.0
