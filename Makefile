@@ -44,11 +44,13 @@ LINTED := src tests examples benchmarks docs/*.py
 # .venv). About 6 s cold, under 1 s warm.
 USER_TYPED := examples tests/typecheck/user_api.py
 # The library's core, strict on its own code: the robot model, the plants, the simulation
-# loop, the controllers, the resolution kernels, the arbiters, the trajectories, the QP
-# and the behaviours (same flags and cache).
+# loop, the controllers, the resolution kernels, the arbiters, the trajectories, the QP,
+# the behaviours, and the errors, registry, progress and interrupt modules (same flags
+# and cache).
 STRICT_CORE := src/ddwmmr/model src/ddwmmr/plants src/ddwmmr/sim src/ddwmmr/controllers \
 	src/ddwmmr/resolution src/ddwmmr/arbiters src/ddwmmr/trajectories src/ddwmmr/qp \
-	src/ddwmmr/behaviours
+	src/ddwmmr/behaviours src/ddwmmr/errors.py src/ddwmmr/registry.py \
+	src/ddwmmr/progress.py src/ddwmmr/interrupts.py
 
 lint: $(STAMP_TEST)
 	$(BIN)/ruff check $(LINTED)

@@ -18,7 +18,7 @@ import re
 import stat
 import sys
 import tomllib
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -307,7 +307,7 @@ def bracketed(items: Iterable[Any], spec: str = "g") -> str:
     return "[" + ", ".join(i if isinstance(i, str) else format(i, spec) for i in items) + "]"
 
 
-def round_significant(value: float, digits: int, rounding: Any) -> float:
+def round_significant(value: float, digits: int, rounding: Callable[[float], int]) -> float:
     """``value`` (> 0) to ``digits`` significant digits, rounded by ``rounding``
     (``math.floor`` or ``math.ceil``): a value a message suggests, on the safe side of
     the bound it was computed from."""
@@ -426,7 +426,7 @@ def read_text_file(path: str | Path, label: str) -> str:
 _LONE_CR = re.compile(r"\r(?!\n)")
 
 
-def load_toml(path: str | Path, label: str) -> dict:
+def load_toml(path: str | Path, label: str) -> dict[str, Any]:
     """Parse a TOML file; unreadable, invalid or too deeply nested files (more than
     :data:`MAX_TOML_DEPTH` levels of arrays and tables) raise :class:`ParameterError`.
     Its lines may end in LF, CRLF or CR alone.

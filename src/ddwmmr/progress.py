@@ -29,7 +29,7 @@ import time
 from collections.abc import Iterator
 from typing import TextIO
 
-from tqdm import tqdm
+from tqdm import tqdm  # type: ignore[import-untyped]  # tqdm ships no hints
 
 #: Seconds between the progress lines of a long phase when stderr is not a terminal.
 LOG_INTERVAL_S = 30.0
@@ -82,7 +82,7 @@ def _bar_size(stream: TextIO) -> dict[str, object]:
     return {"dynamic_ncols": True}
 
 
-class _Bar(tqdm):
+class _Bar(tqdm):  # type: ignore[misc]  # tqdm is Any to mypy (no hints)
     """tqdm's bar without tqdm's monitor thread, which would be alive while the tools'
     process pools fork their workers (a forked child gets copies of the locks other
     threads hold, locked for good; Python 3.12+ warns).

@@ -60,7 +60,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from itertools import count
 from pathlib import Path
-from typing import Any, TypeVar
+from typing import Any, TypeVar, cast
 
 from ddwmmr.errors import ParameterError, one_line, shown
 
@@ -183,7 +183,7 @@ class Registry:
                 f"{self.decorator}: name must be {NAME_FORM}, so that the command line can "
                 f"address it (got {shown(name)})"
             )
-        return name
+        return cast(str, name)  # cast: valid holds only for a str
 
     def _traits(self, name: str, given: Mapping[str, Any]) -> dict[str, Any]:
         unknown = sorted(set(given) - set(self.defaults))
