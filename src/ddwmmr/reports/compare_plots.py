@@ -48,7 +48,8 @@ def save(fig: Figure, path: str | Path) -> Path:
 
 
 def _floor(values: np.ndarray) -> np.ndarray:
-    return np.maximum(np.abs(values), ERROR_FLOOR)
+    floored: np.ndarray = np.maximum(np.abs(values), ERROR_FLOOR)
+    return floored
 
 
 def _log_bottom(series: Sequence[np.ndarray]) -> float:
@@ -284,7 +285,7 @@ def plot_small_multiples(
     width = max(4.4 * columns, MIN_MULTIPLES_WIDTH_IN)
     fig = new_figure((width, 4.2 * rows))
     axes = fig.subplots(rows, columns, squeeze=False)
-    handles: list = []
+    handles: list[Line2D] = []
     cx, cy = _obstacle_extent(obstacles)
     for ax, (label, ts) in zip(axes.flat, series.items()):
         draw_obstacles(ax, obstacles)

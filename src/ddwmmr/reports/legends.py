@@ -10,17 +10,39 @@ is computed once, so it is the same on every draw and every run.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
+import numpy.typing as npt
 from matplotlib.axes import Axes
 from matplotlib.collections import PathCollection
 from matplotlib.legend import Legend
 from matplotlib.path import Path
 from matplotlib.transforms import Bbox
 
+if TYPE_CHECKING:
+    from matplotlib.artist import Artist
+    from matplotlib.backend_bases import RendererBase
+    from matplotlib.transforms import Transform
+
+    #: A legend spot inside the axes (matplotlib ``loc`` names).
+    Spot = Literal[
+        "upper right",
+        "upper left",
+        "lower left",
+        "lower right",
+        "right",
+        "center left",
+        "center right",
+        "lower center",
+        "upper center",
+        "center",
+        "best",
+    ]
+
 #: Spots tried in order (matplotlib ``loc`` names).
-SPOTS = (
+SPOTS: tuple[Spot, ...] = (
     "upper right",
     "upper left",
     "lower right",
@@ -37,7 +59,11 @@ HEADROOM_ROUNDS = 6
 
 
 def place_legend(
-    ax: Axes, spots: Sequence[str] = SPOTS, handles=None, labels=None, **kwargs
+    ax: Axes,
+    spots: Sequence[Spot] = SPOTS,
+    handles: Iterable[Artist | tuple[Artist, ...]] | None = None,
+    labels: Iterable[str] | None = None,
+    **kwargs: Any,
 ) -> Legend:
     """Legend of ``ax`` where no data lies under it (see the module docstring).
 
@@ -48,7 +74,7 @@ def place_legend(
         legend = ax.legend(loc=spot, **kwargs)
         if not covers_data(ax, legend):
             return legend
-    upper = next((s for s in spots if s.startswith("upper")), "upper right")
+    upper: Spot = next((s for s in spots if s.startswith("upper")), "upper right")
     legend = ax.legend(loc=upper, **kwargs)
     for _ in range(HEADROOM_ROUNDS):
         if not covers_data(ax, legend):
@@ -57,7 +83,7 @@ def place_legend(
     return legend
 
 
-def legend_beside(ax: Axes, **kwargs) -> Legend:
+def legend_beside(ax: Axes, **kwargs: Any) -> Legend:
     """Legend outside ``ax``, on its right, top-aligned (``tight_layout`` makes room)."""
     kwargs.setdefault("loc", "upper left")
     kwargs.setdefault("bbox_to_anchor", (1.02, 1.0))
@@ -91,15 +117,17 @@ def covers_data(ax: Axes, legend: Legend) -> bool:
     )
 
 
-def _renderer(ax: Axes):
+def _renderer(ax: Axes) -> RendererBase:
     """The renderer ``ax``'s figure is measured with: its canvas's own where it has one
     (Agg and the GUI canvases built on it), else the one matplotlib's own ``tight_layout``
     measures with (``Figure._get_renderer``: the svg, pdf and cairo canvases have no
     ``get_renderer``), so a legend can be placed in a figure on any canvas."""
-    return ax.figure._get_renderer()
+    # ignore: Figure._get_renderer is private, outside matplotlib's stubs
+    renderer: RendererBase = ax.figure._get_renderer()  # type: ignore[union-attr]
+    return renderer
 
 
-def _crosses(transform, xy: np.ndarray, box: Bbox) -> bool:
+def _crosses(transform: Transform, xy: npt.ArrayLike, box: Bbox) -> bool:
     """Whether the polyline ``xy`` (data coordinates, NaN-broken) meets ``box`` (px)."""
     xy = np.asarray(xy, dtype=float)
     if len(xy) == 0:

@@ -10,14 +10,24 @@ figures are not pyplot's (:mod:`ddwmmr.reports.canvas`): the matplotlib backend 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
+import numpy.typing as npt
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ddwmmr.reports.canvas import new_figure, save_gif
 from ddwmmr.reports.plots import robot_outline, run_title
+
+if TYPE_CHECKING:
+    from matplotlib.collections import PathCollection
+    from matplotlib.lines import Line2D
+
+    from ddwmmr.model import Robot
+    from ddwmmr.sim import SimulationResult
 
 
 def support_names(timeseries: dict[str, np.ndarray]) -> list[str]:
@@ -26,7 +36,7 @@ def support_names(timeseries: dict[str, np.ndarray]) -> list[str]:
     return [c[len(prefix) : -len(suffix)] for c in timeseries if c.startswith(prefix)]
 
 
-def support_points_world(q, points) -> np.ndarray:
+def support_points_world(q: Sequence[float] | np.ndarray, points: npt.ArrayLike) -> np.ndarray:
     """Base-frame support points (n, 2) placed at configuration q (world frame, m)."""
     x, y, phi = (float(v) for v in q[:3])
     c, s = math.cos(phi), math.sin(phi)
@@ -34,20 +44,27 @@ def support_points_world(q, points) -> np.ndarray:
     return np.column_stack([x + c * pts[:, 0] - s * pts[:, 1], y + s * pts[:, 0] + c * pts[:, 1]])
 
 
-def draw_supports(ax: Axes, q, points, forces, weight_n: float) -> None:
+def draw_supports(
+    ax: Axes,
+    q: Sequence[float] | np.ndarray,
+    points: npt.ArrayLike,
+    forces: npt.ArrayLike,
+    weight_n: float,
+) -> None:
     """Support points at q as discs whose area is proportional to their load; an unloaded
     support is an empty red ring."""
     world = support_points_world(q, points)
     forces = np.asarray(forces, dtype=float)
     loaded = forces > 1e-3 * weight_n
     sizes = 600.0 * forces / weight_n
-    ax.scatter(*world[loaded].T, s=sizes[loaded], color="tab:blue", alpha=0.6, zorder=3)
-    ax.scatter(*world[~loaded].T, s=40, facecolors="none", edgecolors="tab:red", zorder=3)
+    # ignore: world (n, 2) unpacks to x and y only, so s is not also given by position
+    ax.scatter(*world[loaded].T, s=sizes[loaded], color="tab:blue", alpha=0.6, zorder=3)  # type: ignore[misc]
+    ax.scatter(*world[~loaded].T, s=40, facecolors="none", edgecolors="tab:red", zorder=3)  # type: ignore[misc]
 
 
 def save_physics_animation(
-    result,
-    points,
+    result: SimulationResult,
+    points: npt.ArrayLike,
     weight_n: float,
     path: str | Path,
     frames: int = 60,
@@ -81,7 +98,7 @@ def save_physics_animation(
     indices = np.linspace(0, len(q) - 1, frames).astype(int)
     title = f"{result.summary.get('method', '?')}, payload {robot.payload:g} kg"
 
-    def update(frame: int):
+    def update(frame: int) -> tuple[Line2D, Line2D, PathCollection, Line2D]:
         k = indices[frame]
         shape = robot_outline(robot, q[k])
         footprint.set_data(*shape["footprint"].T)
@@ -167,7 +184,7 @@ SUPPORT_LOADS_FIGURE = "support_loads.png"
 _UNLOADED_SHARE = 1e-4
 
 
-def edge_names(normals) -> list[str]:
+def edge_names(normals: npt.ArrayLike) -> list[str]:
     """A name per support-polygon edge from its inward normal (base frame): ``front``,
     ``back``, ``left``, ``right`` for an edge facing that way, else ``edge <i>``."""
     names = []
@@ -178,7 +195,9 @@ def edge_names(normals) -> list[str]:
     return names
 
 
-def edge_load_series(timeseries: dict[str, np.ndarray], robot) -> tuple[list[str], np.ndarray]:
+def edge_load_series(
+    timeseries: dict[str, np.ndarray], robot: Robot
+) -> tuple[list[str], np.ndarray]:
     """The measured load (N) on the supports off each edge of the robot's support polygon
     at every sample, (samples, edges), from a physics run's ``support_force_<name>_n``
     columns (in :func:`~ddwmmr.model.support_loads.support_points` order), with the
@@ -198,14 +217,14 @@ SUPPORT_LOADS_FIGSIZE = (7.5, 5.2)
 SUPPORT_LOADS_DPI = 110
 
 
-def is_physics_run(result) -> bool:
+def is_physics_run(result: SimulationResult) -> bool:
     """True when ``result`` was recorded on a plant that measures its support forces (the
     ``support_force_<name>_n`` and ``base_tilt_rad`` columns of a physics plant)."""
     ts = result.timeseries
     return bool(support_names(ts)) and "base_tilt_rad" in ts
 
 
-def plot_support_loads(result, floor_n: float | None = None) -> Figure:
+def plot_support_loads(result: SimulationResult, floor_n: float | None = None) -> Figure:
     """Figure: the load on the supports off each edge of the support polygon (N; the edge
     the base would pivot about when it reaches 0) with the optimisers' floor, and the
     base's tilt (mrad), against time (:func:`draw_support_loads` on a new figure of its
@@ -215,7 +234,9 @@ def plot_support_loads(result, floor_n: float | None = None) -> Figure:
     return draw_support_loads(new_figure(SUPPORT_LOADS_FIGSIZE), result, floor_n)
 
 
-def draw_support_loads(fig: Figure, result, floor_n: float | None = None) -> Figure:
+def draw_support_loads(
+    fig: Figure, result: SimulationResult, floor_n: float | None = None
+) -> Figure:
     """Draw the support-load panel into ``fig`` (empty; any canvas: the track figure and
     the simulator's window both use it): each edge's load (N) with the optimisers' floor
     (dashed) above, the base's tilt (mrad) below, against time; steps with an edge
@@ -257,7 +278,9 @@ def draw_support_loads(fig: Figure, result, floor_n: float | None = None) -> Fig
     return fig
 
 
-def save_support_loads(result, path: str | Path, floor_n: float | None = None) -> Path:
+def save_support_loads(
+    result: SimulationResult, path: str | Path, floor_n: float | None = None
+) -> Path:
     """Write :func:`plot_support_loads` to ``path`` (PNG)."""
     from ddwmmr.reports.plots import PNG_METADATA
 

@@ -17,7 +17,9 @@ then ``plt.show()``.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -32,6 +34,24 @@ from ddwmmr.reports import palette
 from ddwmmr.reports.canvas import new_figure, save_gif
 from ddwmmr.reports.legends import legend_beside, place_legend
 
+if TYPE_CHECKING:
+    from ddwmmr.qp.limits.obstacles import Circle as CircleObstacle
+    from ddwmmr.sim import SimulationResult
+
+    #: A configuration ``[x, y, phi, th1, th2]`` (m, rad): a sequence or an array.
+    Configuration = Sequence[float] | np.ndarray
+    #: Circular obstacles: :class:`~ddwmmr.qp.limits.obstacles.Circle` s or
+    #: ``(x, y, radius)`` triples (m), or None for none.
+    Obstacles = Iterable[CircleObstacle | Sequence[float]] | None
+
+    class _Tolerance(TypedDict):
+        """The keywords of :func:`numpy.allclose` that :func:`wheels_follow_measured` passes."""
+
+        rtol: float
+        atol: float
+        equal_nan: bool
+
+
 FIGURE_NAMES = ("path.png", "errors.png", "rates.png", "metrics.png")
 #: PNG text chunks: none (not even the matplotlib version), so equal runs give
 #: byte-identical figures.
@@ -41,7 +61,7 @@ PNG_METADATA = {"Software": None}
 ERROR_FLOOR = 1e-12
 
 
-def robot_outline(robot: Robot, q) -> dict[str, np.ndarray]:
+def robot_outline(robot: Robot, q: Configuration) -> dict[str, np.ndarray]:
     """Polylines (world frame, m) of the robot at q: ``footprint`` (closed) and ``arm``."""
     x, y, phi, th1, _ = (float(v) for v in q)
     c, s = math.cos(phi), math.sin(phi)
@@ -55,7 +75,7 @@ def robot_outline(robot: Robot, q) -> dict[str, np.ndarray]:
     return {"footprint": footprint, "arm": arm, "heading": heading}
 
 
-def wheel_outlines(robot: Robot, q, width: float | None = None) -> list[np.ndarray]:
+def wheel_outlines(robot: Robot, q: Configuration, width: float | None = None) -> list[np.ndarray]:
     """Closed polylines (world frame, m) of the left and right drive wheels at q.
 
     Each wheel is a ``2 r x width`` rectangle along the heading, centred on the axle at
@@ -76,7 +96,7 @@ def wheel_outlines(robot: Robot, q, width: float | None = None) -> list[np.ndarr
     return wheels
 
 
-def snapshot_indices(ts: dict[str, np.ndarray], count: int, spacing: float = 0.0) -> np.ndarray:
+def snapshot_indices(ts: Mapping[str, np.ndarray], count: int, spacing: float = 0.0) -> np.ndarray:
     """Up to ``count`` evenly spaced sample indices of a run, the first and the last (the
     final pose) always included. With ``spacing`` (m), another instant whose base lies
     closer than that to an instant already kept is left out: a base that hardly moves (a
@@ -112,7 +132,11 @@ def snapshot_colors(count: int) -> list[str]:
 
 
 def draw_snapshots(
-    ax: Axes, robot: Robot, ts: dict[str, np.ndarray], indices, lw: float = 1.0
+    ax: Axes,
+    robot: Robot,
+    ts: Mapping[str, np.ndarray],
+    indices: Sequence[int] | np.ndarray,
+    lw: float = 1.0,
 ) -> list[Line2D]:
     """The robot (footprint, heading, arm) at the samples ``indices`` of the time series
     ``ts``, each instant in its own colour (:func:`snapshot_colors`); returns one legend
@@ -129,7 +153,9 @@ def draw_snapshots(
     return handles
 
 
-def outline_points(robot: Robot, ts: dict[str, np.ndarray], indices) -> np.ndarray:
+def outline_points(
+    robot: Robot, ts: Mapping[str, np.ndarray], indices: Sequence[int] | np.ndarray
+) -> np.ndarray:
     """Every vertex of the robot outlines drawn at ``indices`` (world frame, m), to fit
     the axes around them."""
     q = np.column_stack([ts[k] for k in ("x", "y", "phi", "th1", "th2")])
@@ -147,19 +173,20 @@ def fit_equal(ax: Axes, xs: np.ndarray, ys: np.ndarray, margin: float) -> None:
     ax.set_aspect("equal", adjustable="box")
 
 
-def circles_of(obstacles) -> list[tuple[float, float, float]]:
+def circles_of(obstacles: Obstacles) -> list[tuple[float, float, float]]:
     """Obstacles as ``(x, y, radius)`` triples (m): from circles, triples or None."""
     found = []
     for item in obstacles or ():
         if hasattr(item, "radius"):
-            found.append((float(item.x), float(item.y), float(item.radius)))
+            # ignore: hasattr picks the circles; mypy keeps the triples in the union
+            found.append((float(item.x), float(item.y), float(item.radius)))  # type: ignore[union-attr]
         else:
             x, y, radius = (float(v) for v in item)
             found.append((x, y, radius))
     return found
 
 
-def draw_obstacles(ax: Axes, obstacles, label: str = "obstacle") -> None:
+def draw_obstacles(ax: Axes, obstacles: Obstacles, label: str = "obstacle") -> None:
     """Grey discs for circular obstacles (world frame, m); one legend entry."""
     for i, (x, y, radius) in enumerate(circles_of(obstacles)):
         disc = Circle(
@@ -180,7 +207,12 @@ def break_wraps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return np.insert(t, jumps, np.nan), np.insert(angle, jumps, np.nan)
 
 
-def plot_path(result, ax: Axes | None = None, snapshots: int = 6, obstacles=None) -> Figure:
+def plot_path(
+    result: SimulationResult,
+    ax: Axes | None = None,
+    snapshots: int = 6,
+    obstacles: Obstacles = None,
+) -> Figure:
     """Desired vs actual end-effector path, base path, the robot at up to ``snapshots``
     times, no base inside another's footprint (one grey per time, named in the legend; see
     :func:`snapshot_indices`) and the obstacles (``(x, y, radius)``
@@ -270,7 +302,7 @@ def _fit_path_figure(fig: Figure, ax: Axes) -> None:
     )
 
 
-def plot_errors(result, *, fig: Figure | None = None) -> Figure:
+def plot_errors(result: SimulationResult, *, fig: Figure | None = None) -> Figure:
     """End-effector position error (log scale, floored at :data:`ERROR_FLOOR`) and
     orientation error vs time; returns the figure.
 
@@ -328,7 +360,7 @@ def at_least_a_percent(ax: Axes, values: np.ndarray) -> None:
         ax.set_ylim(centre - 0.5 * span, centre + 0.5 * span)
 
 
-def plot_rates(result, *, fig: Figure | None = None) -> Figure:
+def plot_rates(result: SimulationResult, *, fig: Figure | None = None) -> Figure:
     """Arm joint rates, base yaw rate and wheel speeds vs time (rad/s), each on its own
     axis, with the robot's limits drawn and named (the base yaw rate has no limit of its
     own: the wheel limit bounds it). The yaw rate drawn is the one the wheel speeds come
@@ -363,7 +395,7 @@ def plot_rates(result, *, fig: Figure | None = None) -> Figure:
     return fig
 
 
-def wheels_follow_measured(result) -> bool:
+def wheels_follow_measured(result: SimulationResult) -> bool:
     """True when the run's wheel speeds are those of its measured base velocities
     (``v_measured``, ``w_measured``: a plant whose base has dynamics) rather than of the
     command: the yaw rate the wheels imply, ``r (right - left) / track_width`` (rad/s),
@@ -375,7 +407,7 @@ def wheels_follow_measured(result) -> bool:
         robot.wheel_radius * (ts["wheel_right_rad_s"] - ts["wheel_left_rad_s"]) / robot.track_width
     )
     measured, commanded = np.asarray(ts["w_measured"]), np.asarray(ts["w"])
-    tolerance = {"rtol": 1e-9, "atol": 1e-12, "equal_nan": True}
+    tolerance: _Tolerance = {"rtol": 1e-9, "atol": 1e-12, "equal_nan": True}
     return bool(
         np.allclose(implied, measured, **tolerance)
         and not np.allclose(measured, commanded, **tolerance)
@@ -394,7 +426,7 @@ def _limit_lines(ax: Axes, limit: float, name: str) -> None:
         )
 
 
-def plot_metrics(result, *, fig: Figure | None = None) -> Figure:
+def plot_metrics(result: SimulationResult, *, fig: Figure | None = None) -> Figure:
     """Manipulability eta and tip-over stability S vs time (S = 1 tips); returns the figure.
 
     Drawn on a 7 x 5 inch figure of its own, or into ``fig`` as :func:`plot_errors` does."""
@@ -421,11 +453,13 @@ def plot_metrics(result, *, fig: Figure | None = None) -> Figure:
     return fig
 
 
-def save_run_figures(result, folder: str | Path, obstacles=None) -> list[Path]:
+def save_run_figures(
+    result: SimulationResult, folder: str | Path, obstacles: Obstacles = None
+) -> list[Path]:
     """Write path.png (with ``obstacles``), errors.png, rates.png, metrics.png in ``folder``."""
     folder = Path(folder)
     paths = []
-    makers = (
+    makers: tuple[Callable[[SimulationResult], Figure], ...] = (
         lambda r: plot_path(r, obstacles=obstacles),
         plot_errors,
         plot_rates,
@@ -440,11 +474,11 @@ def save_run_figures(result, folder: str | Path, obstacles=None) -> list[Path]:
 
 
 def save_animation(
-    result,
+    result: SimulationResult,
     path: str | Path,
     frames: int = 80,
     fps: int = 15,
-    obstacles=None,
+    obstacles: Obstacles = None,
     progress: bool = False,
 ) -> Path:
     """Write a GIF of the robot following the trajectory (``frames`` evenly spaced);
@@ -472,7 +506,7 @@ def save_animation(
     (arm,) = ax.plot([], [], color="tab:orange", lw=2, marker="o", ms=3)
     indices = np.linspace(0, len(q) - 1, frames).astype(int)
 
-    def update(frame: int):
+    def update(frame: int) -> tuple[Line2D, Line2D, Line2D]:
         k = indices[frame]
         shape = robot_outline(robot, q[k])
         trace.set_data(ts["xE"][: k + 1], ts["yE"][: k + 1])
@@ -537,18 +571,19 @@ def _lay_out(fig: Figure, own: bool) -> None:
 
 def _axes(ax: Axes | None, figsize: tuple[float, float]) -> tuple[Figure, Axes]:
     if ax is not None:
-        return ax.figure, ax
+        # ignore: a caller's axes in a SubFigure give that subfigure, handed back as it is
+        return ax.figure, ax  # type: ignore[return-value]
     fig = new_figure(figsize)
     return fig, fig.subplots()
 
 
-def _title(result, what: str) -> str:
+def _title(result: SimulationResult, what: str) -> str:
     """``"<method> on <trajectory>: <what>"``, with ``" (<plant> plant)"`` after the
     trajectory when the run's plant is not the kinematic model."""
     return run_title(result.summary, what)
 
 
-def run_title(summary: dict, what: str) -> str:
+def run_title(summary: Mapping[str, Any], what: str) -> str:
     """Title of a figure of the run whose summary is ``summary``: method, trajectory, the
     plant unless it is the kinematic model (a summary without one is kinematic), then
     ``what`` after a colon (left out when empty)."""

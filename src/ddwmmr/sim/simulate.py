@@ -649,7 +649,7 @@ def joint_rates(ts: dict[str, np.ndarray]) -> np.ndarray:
     return np.where(np.isnan(rate_1) | np.isnan(rate_2), measured, commanded)
 
 
-def joint_limits_held(ts: dict[str, np.ndarray], robot: Robot) -> tuple[np.ndarray, str | None]:
+def joint_limits_held(ts: Mapping[str, np.ndarray], robot: Robot) -> tuple[np.ndarray, str | None]:
     """Per sample, whether a joint angle (``th1``, ``th2``, rad) is at a position limit
     of ``robot.joint_limits`` (within :data:`JOINT_LIMIT_TOLERANCE_RAD`, or beyond), and
     the limit held on most of the commanded steps in words (``"th2 = 0.3 rad"``), None

@@ -217,9 +217,13 @@ def recommendations(
             )
             continue
         if items and name in items[0].scores:
+            # ignore: the lambda binds name as a default; _best_line calls it with p alone
             lines.append(
                 _best_line(
-                    f"{label} (like the {name})", items, lambda p, n=name: p.scores[n], given
+                    f"{label} (like the {name})",
+                    items,
+                    lambda p, n=name: p.scores[n],  # type: ignore[misc]
+                    given,
                 )
             )
     closed = [p for p in items if p.converges]
@@ -243,14 +247,15 @@ def recommendations(
         )
     ours = [m for m in slides.order if m in SLIDES_ORDER] if slides is not None else []
     if ours:
-        best = ours[0]
+        first = ours[0]
         shown = items[0].shown if items else str
-        scores = ", ".join(f"{shown(n)} {mm(v[best])} mm" for n, v in slides.scores.items())
-        failed = [(n, None) for n in slides.scores if not slides.tracked(n, best)]
+        # ignore: ours is empty without slides (mypy does not carry that narrowing here)
+        scores = ", ".join(f"{shown(n)} {mm(v[first])} mm" for n, v in slides.scores.items())  # type: ignore[union-attr]
+        failed = [(n, None) for n in slides.scores if not slides.tracked(n, first)]  # type: ignore[union-attr]
         lines.append(
             "**Reproducing the slides**: `--preset slides` (their auxiliary row and gains); the "
-            f"best of their methods under their settings is `{best}` ({scores})."
-            + _did_not_track([(best, failed)], shown, " under `--preset slides`")
+            f"best of their methods under their settings is `{first}` ({scores})."
+            + _did_not_track([(first, failed)], shown, " under `--preset slides`")
         )
     return lines
 
@@ -296,7 +301,12 @@ def _overall(p: Profile) -> float:
     return math.exp(sum(logs) / len(logs))
 
 
-def _best_line(label: str, items: Sequence[Profile], key, given: set[str] | None = None) -> str:
+def _best_line(
+    label: str,
+    items: Sequence[Profile],
+    key: Callable[[Profile], float],
+    given: set[str] | None = None,
+) -> str:
     """The best method by ``key`` and everything tied with it; the fastest tied one first;
     ``given`` as :func:`_caveat` takes it."""
     best = min(key(p) for p in items)
@@ -416,7 +426,7 @@ def _singularity_line(items: Sequence[Profile], given: set[str] | None = None) -
     return text + "; ".join(parts) + "." + _caveat(kept, given)
 
 
-def _agree(methods: Sequence[str], one: str, several: str) -> str:
+def _agree(methods: Sequence[object], one: str, several: str) -> str:
     """``one`` (singular verb form) for a single method, else ``several``."""
     return one if len(methods) == 1 else several
 

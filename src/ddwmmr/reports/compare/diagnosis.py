@@ -137,10 +137,11 @@ def diagnose(
     ts, summary = outputs[spec].timeseries, outputs[spec].summary
     findings = []
     outcome, onset = singularity_outcome(ts)
+    # ignore: "lost" and "passes" come with an onset (singularity_outcome), never None
     if outcome == "lost":
-        findings.append(Finding(_singularity_reason(spec, ts, onset, plan, outputs)))
+        findings.append(Finding(_singularity_reason(spec, ts, onset, plan, outputs)))  # type: ignore[arg-type]
     elif outcome == "passes":
-        findings.append(Finding(_passage_text(ts, summary, onset), False))
+        findings.append(Finding(_passage_text(ts, summary, onset), False))  # type: ignore[arg-type]
         onset = None
     jumps = orientation_jumps(ts)
     if jumps and summary["rms_orientation_error_rad"] > 0.5 and onset is None:

@@ -927,7 +927,9 @@ def _tau_overlap(convergence: Mapping[str, Mapping[float, float]]) -> str:
     )
 
 
-def _tau_corner_finding(methods: Sequence[str], runs: Mapping[tuple, RunOutput]) -> str:
+def _tau_corner_finding(
+    methods: Sequence[str], runs: Mapping[tuple[str, str, float], RunOutput]
+) -> str:
     """Where a small tau is worse on the rectangle (corner turns saturate), say so."""
     texts = []
     low, high = TAUS[0], TAUS[-1]
