@@ -26,7 +26,7 @@ import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -47,6 +47,9 @@ from ddwmmr.scenarios.protocol import (
 )
 from ddwmmr.scenarios.studies import table_number
 from ddwmmr.workers import process_pool
+
+if TYPE_CHECKING:
+    import os
 
 #: The two arbiters, in column order, with their labels.
 ARBITER_COLUMNS = (("state-machine", "state machine"), ("competitive", "competitive"))
@@ -112,7 +115,8 @@ def summarize(
     minima = [o.metrics["min_stability"] for o in outcomes]
     summary["median_min_stability"] = float(np.median(minima))
     if enter is not None and all(o.trace is not None for o in outcomes):
-        below = [TRACE_STEP * float(np.sum(np.asarray(o.trace["s"]) < enter)) for o in outcomes]
+        # ignore: the all() above rules a missing trace out
+        below = [TRACE_STEP * float(np.sum(np.asarray(o.trace["s"]) < enter)) for o in outcomes]  # type: ignore[index]
         summary["time_below_enter_s"] = float(np.mean(below))
     else:
         summary["time_below_enter_s"] = math.nan
@@ -160,7 +164,7 @@ def table_52(summaries: Sequence[tuple[str, dict[str, Any]]]) -> str:
     lines.append("|---|" + "---|" * len(summaries))
     for i, (label, _) in enumerate(columns[0]):
         lines.append(f"| {label} | " + " | ".join(col[i][1] for col in columns) + " |")
-    extra = (
+    extra: tuple[tuple[str, Callable[[dict[str, Any]], str]], ...] = (
         ("Minimum stability S", lambda s: table_number(s["min_stability"])),
         (
             "Median over scenarios of the minimum S",
@@ -218,7 +222,7 @@ def variants_table(results: Sequence[VariantResult]) -> str:
 # -- weights: smoothness and chattering ------------------------------------------------------
 def recorded_run(
     scenario: Scenario, config: RunConfig, parameters: CompetitiveParameters | None = None
-) -> tuple[Outcome, dict[str, list]]:
+) -> tuple[Outcome, dict[str, list[float | str]]]:
     """One competitive run with the arbiter's weight history (and the protocol's trace)."""
     arbiter = CompetitiveDynamicsArbiter(
         Hysteresis(*config.stability),
@@ -235,7 +239,7 @@ def _behaviour_of(state: str) -> str:
     return "objective" if state in STATES[:2] else state
 
 
-def history_statistics(history: dict[str, list]) -> dict[str, float]:
+def history_statistics(history: dict[str, list[float | str]]) -> dict[str, float]:
     """Smoothness numbers of one weight history.
 
     Returns: ``switches`` (changes of dominant behaviour), ``reversals`` (A -> B -> A within
@@ -253,7 +257,8 @@ def history_statistics(history: dict[str, list]) -> dict[str, float]:
     dt = np.diff(t)
     squares = w**2
     shares = squares / np.maximum(1.0, squares.sum(axis=0))
-    owners = [_behaviour_of(s) for s in history["state"]]
+    # ignore: the history's state column holds the states' names (the others floats)
+    owners = [_behaviour_of(s) for s in history["state"]]  # type: ignore[arg-type]
     changes = [i for i in range(1, len(owners)) if owners[i] != owners[i - 1]]
     reversals = sum(
         1
@@ -287,7 +292,9 @@ def weight_statistics(
         return list(pool.map(_statistics_of, items, chunksize=max(1, len(items) // (4 * jobs))))
 
 
-def claims_table(rows: Sequence[tuple[str, list[dict[str, float]], dict[str, dict]]]) -> str:
+def claims_table(
+    rows: Sequence[tuple[str, list[dict[str, float]], dict[str, dict[str, Any]]]],
+) -> str:
     """Markdown: per variant, the switching and smoothness numbers of both arbiters.
 
     ``rows``: (variant label, :func:`weight_statistics` of the competitive runs, summaries
@@ -383,7 +390,11 @@ def busiest(outcomes: Sequence[Outcome]) -> int:
 
 
 def plot_weights(
-    scenario: Scenario, config: RunConfig, path, title: str, compare_state_machine: bool = True
+    scenario: Scenario,
+    config: RunConfig,
+    path: str | os.PathLike[str],
+    title: str,
+    compare_state_machine: bool = True,
 ) -> dict[str, float]:
     """Behaviour weights over time for one scenario (the paper's Fig. 5 kind of plot).
 
@@ -463,7 +474,7 @@ def context_line(n: int, seed: int | None, config: RunConfig, noise: bool = True
 
 
 def write_study(
-    folder,
+    folder: str | os.PathLike[str],
     scenarios: list[Scenario],
     config: RunConfig,
     run: Runner,

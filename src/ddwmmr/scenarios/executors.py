@@ -16,6 +16,7 @@ import threading
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import as_completed
 from multiprocessing import resource_tracker
+from types import ModuleType
 from typing import Any
 
 from ddwmmr import interrupts
@@ -104,7 +105,12 @@ def run_many(
     return [outcome for chunk in results for outcome in chunk]
 
 
-def _run_pool(chunks, config, jobs, on_done) -> list[list[Outcome]]:
+def _run_pool(
+    chunks: Sequence[tuple[Scenario, ...]],
+    config: RunConfig,
+    jobs: int,
+    on_done: Callable[[int], None] | None,
+) -> list[list[Outcome]]:
     results: list[list[Outcome] | None] = [None] * len(chunks)
     with process_pool(jobs) as pool:
         futures = {pool.submit(run_chunk, config, c): i for i, c in enumerate(chunks)}
@@ -117,7 +123,13 @@ def _run_pool(chunks, config, jobs, on_done) -> list[list[Outcome]]:
     return results  # type: ignore[return-value]
 
 
-def _run_dask(chunks, config, client, on_done) -> list[list[Outcome]]:
+# client is Any: a dask.distributed Client, as run_many takes it (dask is optional)
+def _run_dask(
+    chunks: Sequence[tuple[Scenario, ...]],
+    config: RunConfig,
+    client: Any,
+    on_done: Callable[[int], None] | None,
+) -> list[list[Outcome]]:
     futures = [client.submit(run_chunk, config, c, pure=False) for c in chunks]
     index = {f.key: i for i, f in enumerate(futures)}
     results: list[list[Outcome] | None] = [None] * len(chunks)
@@ -146,10 +158,11 @@ def _dask_completed(futures: Sequence[Any]) -> Iterator[tuple[Any, Any]]:
     result on a worker the handler stopped is computed again)."""
     from dask.distributed import as_completed as dask_completed
 
-    completed = dask_completed(futures, with_results=True)
-    while not completed.is_empty():
+    # ignore: distributed's as_completed has no hints on these methods
+    completed = dask_completed(futures, with_results=True)  # type: ignore[no-untyped-call]
+    while not completed.is_empty():  # type: ignore[no-untyped-call]
         interrupts.raise_pending()
-        if completed.has_ready():
+        if completed.has_ready():  # type: ignore[no-untyped-call]
             future, result = next(completed)
             if future.status == "cancelled":  # queued with its cancellation as the result
                 future.result()  # raises it, as waiting on the future does
@@ -159,7 +172,7 @@ def _dask_completed(futures: Sequence[Any]) -> Iterator[tuple[Any, Any]]:
             completed.thread_condition.wait(_POLL_S)
 
 
-def _import_distributed():
+def _import_distributed() -> ModuleType:
     try:
         import distributed
     except ImportError:  # pragma: no cover - dask is an optional extra
@@ -218,9 +231,10 @@ def check_scheduler(address: str, timeout: float = CONNECT_TIMEOUT) -> None:
 
 async def _identity(address: str) -> Any:
     """What the server at ``address`` says it is (a dict; ``type`` is ``Scheduler``)."""
-    from distributed.comm import connect
+    # ignore: distributed.comm re-exports connect without __all__, and it has no hints
+    from distributed.comm import connect  # type: ignore[attr-defined]
 
-    comm = await connect(address)
+    comm = await connect(address)  # type: ignore[no-untyped-call]
     try:
         await comm.write({"op": "identity", "reply": True})
         return await comm.read()

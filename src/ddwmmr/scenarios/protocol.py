@@ -586,7 +586,17 @@ class WaypointTask:
             self._goal, self._pose_d = goal, np.array([goal[0], goal[1], 0.0])
         return self._pose_d, self._velocity_d
 
-    def record(self, k, t, obs, command, applied, saturated, info, step_ns) -> None:
+    def record(
+        self,
+        k: int,
+        t: float,
+        obs: Observation,
+        command: Any,
+        applied: Any,
+        saturated: bool,
+        info: Any,
+        step_ns: int,
+    ) -> None:
         """Count the controller's state (state machines) and trace the state at t.
 
         Controllers without states are traced as moving the base when the measured base
@@ -628,7 +638,8 @@ class WaypointTask:
             _, _, _, th1, th2 = obs.values
             dt = self.tally.config.dt
             return max(abs(applied.th1_target - th1), abs(applied.th2_target - th2)) / dt
-        return max(abs(applied[2]), abs(applied[3]))
+        rate: float = max(abs(applied[2]), abs(applied[3]))
+        return rate
 
     def controller_error(self, k: int, error: Exception) -> bool:
         """A controller failure ends the scenario with the error as its reason."""
@@ -761,7 +772,8 @@ def controller_options_record(config: RunConfig, scenario: Scenario) -> dict[str
         adopt(traits_of(plant))
     resolved = getattr(controller, "resolved", None)
     if callable(getattr(resolved, "record", None)):
-        options = dict(resolved.record("reach", config.dt))
+        # ignore: a callable resolved.record above rules None out
+        options = dict(resolved.record("reach", config.dt))  # type: ignore[union-attr]
     else:
         run = WaypointRun(scenario, config, traits_of(plant), robot, _envelope(plant))
         options = waypoint_options(config.controller, run)

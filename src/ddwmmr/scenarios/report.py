@@ -7,8 +7,8 @@ import io
 import json
 import math
 import textwrap
-from collections.abc import Sequence
-from typing import Any
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -28,6 +28,20 @@ from ddwmmr.scenarios.protocol import (
     Outcome,
 )
 from ddwmmr.sim.result import json_safe
+
+if TYPE_CHECKING:
+    import os
+
+    import numpy.typing as npt
+    from matplotlib.axes import Axes
+    from matplotlib.container import BarContainer
+    from matplotlib.figure import Figure
+    from matplotlib.patches import Patch
+
+    #: A figure's output file.
+    OutputPath = str | os.PathLike[str]
+    #: A scenario's trace: column name -> samples (:attr:`Outcome.trace`).
+    Trace = Mapping[str, list[float]]
 
 #: (summary key, metric column) pairs reported as mean and sample standard deviation.
 AVERAGED = (
@@ -55,7 +69,7 @@ def t_quantile_95(dof: int) -> float:
     check_int_at_least("dof", dof, 1)
     # Imported here: scipy.special takes about 0.3 s to import, paid only by a summary
     # of two or more scenarios.
-    from scipy.special import stdtrit
+    from scipy.special import stdtrit  # type: ignore[import-untyped]
 
     return float(stdtrit(dof, 0.975))
 
@@ -74,7 +88,7 @@ def _mean_sd(values: np.ndarray) -> tuple[float, float]:
 LOWER_BOUND_SLACK = 1e-6
 
 
-def bracket(outcomes: Sequence[Outcome], bounds: dict[int, tuple[float, float]]) -> dict:
+def bracket(outcomes: Sequence[Outcome], bounds: dict[int, tuple[float, float]]) -> dict[str, Any]:
     """Each successful scenario's time over both ends of its physical-limit bracket
     (``bounds``: ``{scenario: (lower_bound_s, best_known_s)}``, ``python -m
     ddwmmr.bounds``): the mean ratios to the lower bound and to the best-known time, over
@@ -357,7 +371,7 @@ BEHAVIOUR_COLOURS = {
 }
 
 
-def _figure(rows: int = 1, cols: int = 1, height: float = 3.2):
+def _figure(rows: int = 1, cols: int = 1, height: float = 3.2) -> tuple[Figure, np.ndarray]:
     """A figure 10 in wide, ``height`` in per row, and its ``rows`` x ``cols`` axes (a 2-D
     array). Not pyplot's (:func:`~ddwmmr.reports.canvas.new_figure`): the report leaves the
     caller's matplotlib backend alone and opens no window."""
@@ -367,7 +381,9 @@ def _figure(rows: int = 1, cols: int = 1, height: float = 3.2):
     return fig, fig.subplots(rows, cols, squeeze=False)
 
 
-def _save(fig, path, rect: tuple[float, float, float, float] | None = None) -> None:
+def _save(
+    fig: Figure, path: OutputPath, rect: tuple[float, float, float, float] | None = None
+) -> None:
     """Lay out ``fig`` (its axes within ``rect``, figure fractions; None: all of it) and
     write it to ``path`` as PNG (a figure of :func:`_figure`: nothing to close)."""
     buffer = io.BytesIO()
@@ -388,7 +404,9 @@ def _failed(outcomes: Sequence[Outcome]) -> np.ndarray:
     return np.array([not o.metrics["success"] for o in outcomes], dtype=bool)
 
 
-def _bars(ax, index, values, failed: np.ndarray, **kwargs):
+def _bars(
+    ax: Axes, index: npt.ArrayLike, values: npt.ArrayLike, failed: np.ndarray, **kwargs: Any
+) -> BarContainer:
     """``ax.bar`` with the bars of failed scenarios hatched (dark hatch, no outline)."""
     bars = ax.bar(index, values, **kwargs)
     for patch, hatched in zip(bars.patches, failed):
@@ -399,14 +417,18 @@ def _bars(ax, index, values, failed: np.ndarray, **kwargs):
     return bars
 
 
-def _failed_handle():
+def _failed_handle() -> Patch:
     import matplotlib.patches as patches
 
     return patches.Patch(facecolor="white", edgecolor="0.1", hatch=FAILED_HATCH, label=FAILED_LABEL)
 
 
 def _bar_axes(
-    ax, index, failed: np.ndarray, entries: bool = False, empty: str = "0 in every scenario"
+    ax: Axes,
+    index: Sequence[float] | np.ndarray,
+    failed: np.ndarray,
+    entries: bool = False,
+    empty: str = "0 in every scenario",
 ) -> None:
     """Scenario-number ticks, a y-axis from 0 and a legend beside the axes (never on
     the tallest bars) naming the series (``entries``) and, if any are drawn, the hatched
@@ -419,7 +441,8 @@ def _bar_axes(
         ax.set_xticks(np.asarray(index, dtype=float), [str(int(i)) for i in index])
     else:
         ax.xaxis.set_major_locator(MaxNLocator(integer=True, steps=[1, 2, 5, 10]))
-    heights = [p.get_y() + p.get_height() for p in ax.patches]
+    # ignore: the axes' patches are its bars, Rectangles (Patch has no y or height)
+    heights = [p.get_y() + p.get_height() for p in ax.patches]  # type: ignore[attr-defined]
     top = np.nanmax(heights) if heights and np.any(np.isfinite(heights)) else 0.0
     if top > 0:
         ax.set_ylim(bottom=0.0)
@@ -440,7 +463,7 @@ STATE_TIMES_HEADING = "time per state"
 MOVING_TIMES_HEADING = "total time; time moving: base / arm"
 
 
-def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
+def plot_state_times(outcomes: Sequence[Outcome], path: OutputPath, title: str) -> None:
     """Stacked per-scenario time in each state (thesis Figs 5.3, 5.10, 5.11), titled
     ``"<title>: time per state"`` (``title``: the figure's subject, e.g. the controller
     and plant).
@@ -492,7 +515,7 @@ def plot_state_times(outcomes: Sequence[Outcome], path, title: str) -> None:
 NO_SPEED_LABEL = "did not finish: no speed"
 
 
-def plot_speeds(outcomes: Sequence[Outcome], path, title: str) -> None:
+def plot_speeds(outcomes: Sequence[Outcome], path: OutputPath, title: str) -> None:
     """Per-scenario speed (Fig 5.4) and speed over base-moving time only (Fig 5.5) of the
     scenarios that finished (``speed_m_s`` of :mod:`ddwmmr.scenarios.protocol`); a
     scenario that did not finish has no bar but a red cross on the axis, named in the
@@ -519,7 +542,7 @@ def plot_speeds(outcomes: Sequence[Outcome], path, title: str) -> None:
     _save(fig, path)
 
 
-def plot_fix_state(outcomes: Sequence[Outcome], key: str, path, title: str) -> None:
+def plot_fix_state(outcomes: Sequence[Outcome], key: str, path: OutputPath, title: str) -> None:
     """Per-scenario time in and transitions into one fix state (Figs 5.7, 5.9), in the
     state's colour (:data:`TIME_COLOURS`); bars of scenarios that did not finish are
     hatched."""
@@ -542,7 +565,10 @@ def plot_fix_state(outcomes: Sequence[Outcome], key: str, path, title: str) -> N
 
 
 def plot_paths(
-    items: Sequence[tuple[Scenario, Outcome]], path, title: str, clearance: float | None = None
+    items: Sequence[tuple[Scenario, Outcome]],
+    path: OutputPath,
+    title: str,
+    clearance: float | None = None,
 ) -> None:
     """Base and end-effector paths with waypoints (and obstacles, grey discs) of chosen
     scenarios, under the figure title ``title``. With ``clearance`` (m, the radius of the
@@ -586,7 +612,14 @@ def plot_paths(
 
 
 def _draw_path(
-    ax, trace: dict, x: str, y: str, colour: str, name: str, lw: float, alpha: float = 1.0
+    ax: Axes,
+    trace: Trace,
+    x: str,
+    y: str,
+    colour: str,
+    name: str,
+    lw: float,
+    alpha: float = 1.0,
 ) -> None:
     """The trace's ``x``/``y`` path in ``colour`` (line width ``lw``, points), labelled
     ``name``, with a dot of the same colour where it starts, labelled ``"<name> start"``."""
@@ -602,7 +635,9 @@ Threshold = tuple[float, str]
 THRESHOLD_STYLES = (ENTER_LINE, LEAVE_LINE)
 
 
-def _closest_approach(ax, trace: dict, obstacles, clearance: float) -> float:
+def _closest_approach(
+    ax: Axes, trace: Trace, obstacles: Sequence[tuple[float, float, float]], clearance: float
+) -> float:
     """Draw the base's enclosing circle (radius ``clearance``, m) at the trace sample where
     it came closest to an obstacle and return that gap (m; negative: overlapping; NaN
     without a trace)."""
@@ -633,12 +668,13 @@ def _fitting_size(title: str, fig: Any) -> float:
     figure is cut at both edges; wrapping it instead would shrink the panels under it)."""
     largest, smallest = _TITLE_POINTS
     fitting = fig.get_figwidth() * 72.0 / (0.6 * max(len(title), 1))
-    return max(smallest, min(largest, fitting))
+    size: float = max(smallest, min(largest, fitting))
+    return size
 
 
 def plot_timeline(
     outcome: Outcome,
-    path,
+    path: OutputPath,
     title: str,
     scenario: Scenario | None = None,
     stability_lines: Sequence[Threshold] = (),
@@ -720,8 +756,8 @@ def plot_timeline(
     if not outcome.metrics["success"] and len(t) > 1:
         stopped = f"stopped: {one_line(str(outcome.metrics['reason']), 30)}"
         for axis in (ax, ax2, ax3, ax4):
-            label = stopped if axis is ax4 else None
-            axis.axvline(outcome.metrics["time_s"], color="tab:red", lw=1.2, label=label)
+            stop_label = stopped if axis is ax4 else None
+            axis.axvline(outcome.metrics["time_s"], color="tab:red", lw=1.2, label=stop_label)
     # Beside the panels: the waypoint marks span the whole height of the last one.
     for axis in (ax2, ax3, ax4):
         legend_beside(axis, fontsize=8)
@@ -742,7 +778,7 @@ def outcome_text(metrics: dict[str, Any], waypoints: int | None = None) -> str:
     return f"{reason} at {time:.1f} s, {reached}{of} waypoints reached"
 
 
-def _mark_waypoints(ax, trace: dict, scenario: Scenario, metrics: dict[str, Any]) -> None:
+def _mark_waypoints(ax: Axes, trace: Trace, scenario: Scenario, metrics: dict[str, Any]) -> None:
     """Dotted verticals at the first trace sample after each waypoint was reached, and
     for a finished scenario (``metrics``' ``success``) at its end, ``time_s``: the run
     stops on reaching the last waypoint, so no sample follows that one.

@@ -31,8 +31,10 @@ class Variant:
     thesis: dict[str, float | None]
 
 
-def _row(failed, time=None, sd=None, speed=None, base=None, arm=None, tm=None, nm=None,
-         ts=None, ns=None) -> dict[str, float | None]:  # fmt: skip
+def _row(failed: float, time: float | None = None, sd: float | None = None,
+         speed: float | None = None, base: float | None = None, arm: float | None = None,
+         tm: float | None = None, nm: float | None = None, ts: float | None = None,
+         ns: float | None = None) -> dict[str, float | None]:  # fmt: skip
     return {
         "failed": failed, "time": time, "sd_time": sd, "speed": speed, "base": base,
         "arm": arm, "time_manip": tm, "trans_manip": nm, "time_stab": ts, "trans_stab": ns,
@@ -214,7 +216,8 @@ def obstacle_table(metrics: list[dict[str, Any]], title: str = "") -> str:
                 text = "Yes / " + ("Yes" if ours else f"No ({m['reason']})")
             else:
                 thesis = THESIS_OBSTACLES.get(m["scenario"])
-                ref = thesis[thesis_index] if thesis is not None else None
+                # ignore: every row but "success" has a thesis index
+                ref = thesis[thesis_index] if thesis is not None else None  # type: ignore[index]
                 text = f"{table_number(ref)} / {table_number(ours)}"
             cells.append(text)
         lines.append(f"| {label} | " + " | ".join(cells) + " |")
