@@ -65,15 +65,42 @@ def leftovers(parent: Path) -> list[str]:
     return [p.name for p in parent.iterdir() if p.name.startswith(".ddwmmr-")]
 
 
+def spy_on_checks(monkeypatch, tool: str) -> list[str]:
+    """The names ``tool`` checks before its run (filled as it checks them)."""
+    import importlib
+
+    module = importlib.import_module(f"ddwmmr.cli.{tool}")
+    checked: list[str] = []
+    real = module.check_output_folder
+
+    def spy(target, name, force=False, writes=()):
+        checked.extend(writes)
+        return real(target, name, force, writes)
+
+    monkeypatch.setattr(module, "check_output_folder", spy)
+    return checked
+
+
 @pytest.fixture(scope="module")
-def made(tmp_path_factory) -> dict[str, Path]:
-    """One output folder per tool, made once (tests copy them)."""
+def made_runs(tmp_path_factory) -> tuple[dict[str, Path], dict[str, list[str]]]:
+    """One output folder per tool, made once (tests copy them): each a new folder ``out``
+    made next to a user's file, alone with it in a folder of its own; and the names each
+    run checked before it ran."""
     base = tmp_path_factory.mktemp("made")
-    folders = {}
+    folders, checked = {}, {}
     for tool in TOOLS:
-        assert run(tool, base / tool) == 0
-        folders[tool] = base / tool
-    return folders
+        (base / tool).mkdir()
+        (base / tool / "thesis.tex").write_text("mine")
+        with pytest.MonkeyPatch.context() as monkeypatch:
+            checked[tool] = spy_on_checks(monkeypatch, tool)
+            assert run(tool, base / tool / "out") == 0
+        folders[tool] = base / tool / "out"
+    return folders, checked
+
+
+@pytest.fixture(scope="module")
+def made(made_runs) -> dict[str, Path]:
+    return made_runs[0]
 
 
 def copy_of(made: dict[str, Path], tool: str, where: Path) -> Path:
@@ -95,11 +122,10 @@ def test_manifest_lists_every_file_and_names_the_tool(made, tool):
 
 
 @pytest.mark.parametrize("tool", TOOLS)
-def test_new_folder_next_to_a_user_file(tmp_path, tool, capsys):
-    (tmp_path / "thesis.tex").write_text("mine")
-    assert run(tool, tmp_path / "out") == 0
-    assert (tmp_path / "thesis.tex").read_text() == "mine"
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "thesis.tex"]
+def test_new_folder_next_to_a_user_file(made, tool):
+    parent = made[tool].parent  # the fixture's run: a new folder next to thesis.tex
+    assert (parent / "thesis.tex").read_text() == "mine"
+    assert sorted(p.name for p in parent.iterdir()) == ["out", "thesis.tex"]
 
 
 @pytest.mark.parametrize("tool", TOOLS)
@@ -423,18 +449,22 @@ def test_a_fresh_run_that_fails_leaves_nothing(tmp_path):
 
 
 @pytest.mark.parametrize("tool", ["track", "compare", "scenarios"])
-def test_default_output_names_are_never_reused(tmp_path, monkeypatch, tool, capsys):
+def test_default_output_names_are_never_reused(made, tmp_path, monkeypatch, tool, capsys):
     """Without --out, runs within the same second wrote to the same folder: the later
     replaced the earlier (here every run gets the same stamp)."""
     stamped = Path("runs") / f"{tool}-20261201-120000"
     monkeypatch.setattr(f"ddwmmr.cli.{tool}.default_out", lambda *names: stamped)
     monkeypatch.chdir(tmp_path)
+    # The first run of that second: the fixture's run of the same arguments, as written.
+    shutil.copytree(made[tool], stamped)
+    first = snapshot(stamped)
     main, args = TOOLS[tool]
     jobs = [] if tool == "track" else ["--jobs", "1"]
-    for _ in range(3):
+    for _ in range(2):
         assert main([*args, *FAST, *jobs]) == 0
     folders = sorted(p.name for p in (tmp_path / "runs").iterdir())
     assert len(folders) == 3 and folders[1:] == [f"{folders[0]}-2", f"{folders[0]}-3"]
+    assert snapshot(stamped) == first
     assert capsys.readouterr().out.endswith(f"\nwrote runs/{folders[0]}-3/\n")
 
 
@@ -534,12 +564,16 @@ def test_a_folder_whose_files_cannot_be_replaced_is_refused_before_the_run(
     assert snapshot(out) == before and leftovers(tmp_path) == []
 
 
+def assert_checked_before(checked: list[str], out: Path) -> None:
+    written = set(listed(out))
+    assert written and written <= set(checked), sorted(written - set(checked))
+
+
 @pytest.mark.parametrize(
     ("tool", "extra"),
     [
         ("track", ["--method", "qp", "--traj", "ellipse", "--duration", "0.2", "--animate"]),
         ("compare", ["--plant", "thesis"]),
-        ("scenarios", []),
         ("scenarios", ["--arbiter", "competitive"]),
     ],
 )
@@ -547,26 +581,22 @@ def test_the_names_checked_before_the_run_are_the_files_it_writes(
     tmp_path, tool, extra, monkeypatch
 ):
     """Every file a run writes is among the names its tool checks before the run (so a
-    user's file of that name is refused then, not after the run)."""
-    import importlib
-
-    module = importlib.import_module(f"ddwmmr.cli.{tool}")
-    checked: list[str] = []
-    real = module.check_output_folder
-
-    def spy(target, name, force=False, writes=()):
-        checked.extend(writes)
-        return real(target, name, force, writes)
-
-    monkeypatch.setattr(module, "check_output_folder", spy)
+    user's file of that name is refused then, not after the run). The tools' base runs
+    (scenarios with its default figures among them) are the next test's."""
+    checked = spy_on_checks(monkeypatch, tool)
     main, args = TOOLS[tool]
     if tool == "track":
         args = []  # draws its figures: the base arguments say --no-plots
     jobs = [] if tool == "track" else ["--jobs", "1"]
     out = tmp_path / "out"
     assert main([*args, *extra, *FAST, *jobs, "--out", str(out)]) == 0
-    written = set(listed(out))
-    assert written and written <= set(checked), sorted(written - set(checked))
+    assert_checked_before(checked, out)
+
+
+@pytest.mark.parametrize("tool", TOOLS)
+def test_the_names_the_fixtures_runs_checked_are_the_files_they_write(made_runs, tool):
+    folders, checked = made_runs
+    assert_checked_before(checked[tool], folders[tool])
 
 
 def _commit_together(target: str, number: int, barrier, results) -> None:
