@@ -106,24 +106,27 @@ def test_remaining_trajectories_snapshot(tmp_path, capsys):
         assert path.is_file()
 
 
-def test_every_method_on_every_trajectory_draws_the_final_state(tmp_path):
-    """The window (one, reused) shows where simulate() leaves the robot, for all pairs."""
+def test_every_method_and_every_trajectory_draws_the_final_state(tmp_path):
+    """The window (one, reused) shows where simulate() leaves the robot: every method on
+    the first trajectory, and every trajectory (the built-in ones and a file of each kind)
+    under ``mpc``, the method that reads the trajectory ahead of the step. The window hands
+    the two to simulate() independently, so a cross covers what all pairs did."""
     figure = Figure(figsize=FIGSIZE, dpi=30)
     FigureCanvasAgg(figure)
     app = App(figure, Settings(duration=0.2))
-    for trajectory in [*available_trajectories(), *trajectory_files(tmp_path)]:
-        for method in available_methods():
-            settings = Settings(
-                trajectory=trajectory, methods=(method, None), duration=0.3, dt=0.05
-            )
-            app.apply(settings)
-            app.run()
-            app.wait()
-            assert app.results is not None, (method, trajectory, app.message)
-            app.show_index(app.view.last_index)
-            expected = simulate(Robot(), build_trajectory(settings), method, duration=0.3, dt=0.05)
-            final = robot_outline(Robot(), expected.configurations()[-1])["footprint"]
-            np.testing.assert_allclose(app.view.runs[0].footprint.get_xy(), final, atol=1e-12)
+    trajectories = [*available_trajectories(), *trajectory_files(tmp_path)]
+    pairs = [(method, trajectories[0]) for method in available_methods()]
+    pairs += [("mpc", trajectory) for trajectory in trajectories[1:]]
+    for method, trajectory in pairs:
+        settings = Settings(trajectory=trajectory, methods=(method, None), duration=0.3, dt=0.05)
+        app.apply(settings)
+        app.run()
+        app.wait()
+        assert app.results is not None, (method, trajectory, app.message)
+        app.show_index(app.view.last_index)
+        expected = simulate(Robot(), build_trajectory(settings), method, duration=0.3, dt=0.05)
+        final = robot_outline(Robot(), expected.configurations()[-1])["footprint"]
+        np.testing.assert_allclose(app.view.runs[0].footprint.get_xy(), final, atol=1e-12)
 
 
 def test_options_reach_the_window_settings():
