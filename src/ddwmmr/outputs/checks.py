@@ -17,6 +17,7 @@ import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
+from typing import Any
 
 from ddwmmr.errors import ParameterError, file_kind, shown
 from ddwmmr.outputs.owners import _is_stale_temp, ended_leftover, temp_prefix
@@ -48,7 +49,7 @@ def _safe_relative(name: object) -> bool:
     return not path.is_absolute() and all(part not in ("", ".", "..") for part in path.parts)
 
 
-def read_manifest(folder: Path) -> dict | None:
+def read_manifest(folder: Path) -> dict[str, Any] | None:
     """The folder's manifest if it is a valid one (tool and safe file names), else None."""
     path = folder / MANIFEST
     try:
@@ -184,7 +185,8 @@ def check_file_target(path: object, label: str = "path") -> Path:
     called, nothing is created.
     """
     try:
-        text = os.fspath(path)  # type: ignore[arg-type]
+        # ignore: path may be any object; os.fspath's TypeError is the check
+        text = os.fspath(path)  # type: ignore[call-overload]
     except TypeError:
         text = None
     if not isinstance(text, str) or not text:

@@ -17,6 +17,7 @@ import tempfile
 import threading
 from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path, PurePosixPath
+from typing import TYPE_CHECKING, Any
 
 from ddwmmr.errors import ParameterError
 from ddwmmr.outputs.atomic import first_free, sync_folder, write_atomic
@@ -48,6 +49,9 @@ from ddwmmr.outputs.recovery import (
     remove_stale,
     remove_stale_temp,
 )
+
+if TYPE_CHECKING:
+    from types import TracebackType
 
 #: The signals whose Python handlers wait while a commit moves files (the tools' stop
 #: signals: :mod:`ddwmmr.cli.signals`, which this low layer may not import; SIGBREAK is
@@ -129,7 +133,12 @@ class OutputFolder:
             raise
         return staging
 
-    def __exit__(self, exc_type, exc, traceback) -> bool:
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> bool:
         try:
             return self._finish(exc_type)
         finally:
@@ -427,7 +436,7 @@ def _sync_output(folder: Path) -> None:
     sync_folder(folder.parent)
 
 
-def _write_manifest(folder: Path, manifest: dict) -> None:
+def _write_manifest(folder: Path, manifest: dict[str, Any]) -> None:
     path = folder / MANIFEST
     path.write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
     os.chmod(path, file_mode())

@@ -146,7 +146,9 @@ def _kernel32() -> Any:
 
 def _last_error() -> int:
     """Windows: the error code of the last kernel32 call of this thread."""
-    return ctypes.get_last_error()  # type: ignore[attr-defined]
+    # ignore: typeshed declares get_last_error on Windows only, where this is called
+    code: int = ctypes.get_last_error()  # type: ignore[attr-defined]
+    return code
 
 
 def _is_stale_temp(name: str) -> bool:

@@ -15,6 +15,7 @@ import shutil
 import sys
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ddwmmr.outputs.checks import MANIFEST, _is_regular, _names, missing_folders, read_manifest
 from ddwmmr.outputs.files import folder_mode
@@ -29,6 +30,9 @@ from ddwmmr.outputs.owners import (
     lock_holder,
     temp_prefix,
 )
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable
 
 #: Added to an old folder's name: the file naming the output that folder replaces.
 _NOTE_SUFFIX = ".target"
@@ -166,7 +170,10 @@ def remove_stale_temp(folder: Path, recursive: bool = False) -> list[Path]:
     it) and say so in one line on stderr; returns them. Only regular files whose names
     carry the owner of a run of this host that has ended are touched."""
     removed = []
-    for root, _, files in os.walk(folder) if recursive else [(folder, [], _names(folder))]:
+    walk: Iterable[tuple[str | Path, list[str], list[str]]] = (
+        os.walk(folder) if recursive else [(folder, [], _names(folder))]
+    )
+    for root, _, files in walk:
         for name in files:
             path = Path(root) / name
             if _is_stale_temp(name) and _is_regular(path):
@@ -263,7 +270,7 @@ def _incomplete(folder: Path) -> bool:
     return manifest is None or not all(_is_regular(folder / f) for f in manifest["files"])
 
 
-def _merge_back(old: Path, target: Path, manifest: dict) -> None:
+def _merge_back(old: Path, target: Path, manifest: dict[str, Any]) -> None:
     """Undo a :func:`_merge` killed midway: remove the new files it had moved into
     ``target`` (listed by ``target``'s manifest, not by the earlier ``manifest``), move
     the earlier files back from ``old``, then the earlier manifest."""
@@ -303,7 +310,9 @@ def _say(line: str) -> None:
         print(line, file=sys.stderr)
 
 
-def _move(source: Path, destination: Path, moves: list, made: list[Path]) -> None:
+def _move(
+    source: Path, destination: Path, moves: list[tuple[Path, Path]], made: list[Path]
+) -> None:
     """Rename ``source`` to ``destination``, its missing parent folders made (and added to
     ``made``). The move is added to ``moves`` before it is done, so that an interrupt
     arriving just after the rename is undone too (:func:`_undo` checks what happened)."""
