@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -45,7 +45,12 @@ def gains_from_tau(tau: float | Sequence[float], size: int) -> tuple[float, ...]
     allowed range, :data:`TAU_RANGE`.
     """
     one = isinstance(tau, str | bytes | int | float | np.integer | np.floating)
-    values = [tau] * size if one or tau is None or np.ndim(tau) == 0 else list(tau)
+    # ignore: past the one-value tests tau is a sequence (mypy does not follow `one`)
+    values = (
+        [tau] * size
+        if one or tau is None or np.ndim(tau) == 0
+        else list(cast("Sequence[float]", tau))
+    )
     if len(values) != size:
         raise ParameterError(f"tau must be one value or {size} values in s (got {len(values)})")
     gains = []

@@ -218,7 +218,9 @@ def software_differences(record: dict[str, Any]) -> list[str]:
     Python, NumPy, the :data:`NUMERIC_LIBRARIES`, BLAS and CPU. A key the record lacks
     (written before it was recorded) is not compared."""
     now = header("", "", [])
-    pairs = [(k, record.get(k), now[k]) for k in ("version", "python", "numpy") if k in record]
+    pairs: list[tuple[str, Any, Any]] = [
+        (k, record.get(k), now[k]) for k in ("version", "python", "numpy") if k in record
+    ]
     if "git" in record:
         pairs.append(("commit", _commit(record["git"]), _commit(now["git"])))
     for section, prefix in (("libraries", ""), ("blas", "blas.")):
@@ -272,7 +274,8 @@ def options_record(method: str, given: dict[str, Any]) -> dict[str, Any]:
     defaults = method_options(method)
     merged = {k: v for k, v in defaults.items() if v is not inspect.Parameter.empty}
     merged.update(given)
-    return encode(merged)
+    record: dict[str, Any] = encode(merged)
+    return record
 
 
 def trajectory_record(
@@ -454,7 +457,7 @@ def run_record(
     rerun: str | None,
     tool: str,
     prog: str,
-) -> dict:
+) -> dict[str, Any]:
     """What summary.json["run"] holds: enough to repeat the run (``--rerun``); ``tool``
     names what wrote it, ``prog`` and ``argv`` the command that repeats it (the
     simulator's export writes the same record, with the :data:`TRACK_PROG` arguments of

@@ -39,7 +39,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -58,6 +58,9 @@ from ddwmmr.controllers.base import WaypointRun, register_controller
 from ddwmmr.controllers.inputs import check_time
 from ddwmmr.errors import check_range, name_of
 from ddwmmr.model import Robot
+
+if TYPE_CHECKING:
+    from collections.abc import Mapping
 
 #: Actuator command: (left wheel force N, right wheel force N, th1 target rad, th2 target rad).
 Actuation = tuple[float, float, float, float]
@@ -170,7 +173,7 @@ class ThesisController:
     def command(
         self,
         t: float,
-        q: np.ndarray,
+        q: np.ndarray | tuple[float, float, float, float, float],
         pose_d: np.ndarray,
         velocity_d: np.ndarray,
         *,
@@ -187,7 +190,11 @@ class ThesisController:
         self.target = (float(x), float(y))
         v, w = base_velocity
         if type(q) is not tuple:  # the loop passes a tuple of floats (float_state)
-            q = tuple(q.tolist()) if isinstance(q, np.ndarray) else tuple(float(a) for a in q)
+            # ignore: q holds the five numbers of a configuration (mypy sees a tuple of any length)
+            q = cast(
+                "tuple[float, float, float, float, float]",
+                tuple(q.tolist()) if isinstance(q, np.ndarray) else tuple(float(a) for a in q),
+            )
         f_left, f_right, a1, a2 = self.act(t, q, v, w)
         return WheelForces(f_left, f_right, a1, a2)
 
@@ -267,7 +274,9 @@ class ThesisController:
             o1, o2 = d1 - m1, d2 - m2
             self._holds[name] = (hx - (s1 + s12) * o1 - s12 * o2, hy + (c1 + c12) * o1 + c12 * o2)
 
-    def _proposal(self, name: str, share: float, p: Percept, evaluated) -> Proposal:
+    def _proposal(
+        self, name: str, share: float, p: Percept, evaluated: Mapping[str, Proposal]
+    ) -> Proposal:
         """Behaviour ``name``'s proposal; its own hold point is latched while it is engaged.
 
         Proposals the arbiter evaluated (it derives advantages from them) are used as they

@@ -132,7 +132,8 @@ def _ask_kernel_for_death_signal() -> bool:
         return False
     try:
         libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
-        return libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+        done: bool = libc.prctl(PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+        return done
     except (OSError, AttributeError):  # no libc or no prctl: the watchdog still runs
         return False
 
