@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from concurrent.futures import as_completed
 from dataclasses import asdict, replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ddwmmr import provenance
 from ddwmmr.bounds import batch
@@ -61,6 +62,13 @@ from ddwmmr.scenarios.generator import generate
 from ddwmmr.scenarios.report import summary_json
 from ddwmmr.sim.result import json_safe
 from ddwmmr.workers import process_pool
+
+if TYPE_CHECKING:
+    from ddwmmr.scenarios.generator import Scenario
+
+    #: Each scenario's cached (best-known, lower-bound) records, by 1-based number (None:
+    #: not cached).
+    Records = dict[int, tuple[dict[str, Any] | None, dict[str, Any] | None]]
 
 PROG = "python -m ddwmmr.bounds"
 TOOL = "bounds"
@@ -340,7 +348,7 @@ def _dropped_note(target: Path, dropped: list[int], part: str, why: str) -> str:
     return f"note: removed the {removed} of {where}, keeping the {other}: {why}; {again}"
 
 
-def summary_line(count: int, summary: dict, elsewhere: str | None = None) -> str:
+def summary_line(count: int, summary: dict[str, Any], elsewhere: str | None = None) -> str:
     """The one line the tool prints: the means, and the bracket where both ends are known
     (``--lower-only`` leaves the best-known times to a later run). Each mean says the
     scenarios it is over when not all ``count``: the lower bound's over every scenario,
@@ -372,7 +380,11 @@ def summary_line(count: int, summary: dict, elsewhere: str | None = None) -> str
 
 
 def _other_settings(
-    folder: Path, scenarios: dict, records: dict, payload: float, settings: Settings
+    folder: Path,
+    scenarios: dict[int, Scenario],
+    records: Records,
+    payload: float,
+    settings: Settings,
 ) -> str | None:
     """The options (``--quick``, ``--stability-min S``) of the settings of the cached
     best-known records of other settings than ``settings`` for the ``scenarios`` without
@@ -387,7 +399,7 @@ def _other_settings(
     return None
 
 
-def _settings_options(recorded: dict, settings: Settings) -> str:
+def _settings_options(recorded: dict[str, Any], settings: Settings) -> str:
     """The options that make the method settings ``recorded`` (as a cache key holds them)
     out of a run's ``settings`` (``--quick``, ``without --quick``, ``--stability-min S``),
     or "other method settings" if no options do."""
@@ -407,13 +419,13 @@ def _settings_options(recorded: dict, settings: Settings) -> str:
 
 def _solve_all(
     folder: Path,
-    scenarios: dict,
+    scenarios: dict[int, Scenario],
     payload: float,
     settings: Settings,
     jobs: int,
     progress: bool,
     lower_only: bool = False,
-):
+) -> Records:
     """Every scenario's (best, lower) records: cached ones read, the others solved (in
     ``jobs`` processes) and cached as they finish (``lower_only``: no best-known search)."""
     records, pending = {}, []
@@ -438,7 +450,7 @@ def _solve_all(
     return records
 
 
-def _keep(folder: Path, records: dict, result: dict) -> None:
+def _keep(folder: Path, records: Records, result: dict[str, Any]) -> None:
     """Cache a solved scenario (listed in the folder's manifest: the folder stays this
     tool's own, so a later run resumes from it)."""
     written = batch.store(folder, result)
@@ -448,7 +460,7 @@ def _keep(folder: Path, records: dict, result: dict) -> None:
     records[index] = (result.get("best", best), result.get("lower", lower))
 
 
-def _record(args: argparse.Namespace, settings: Settings, jobs: int) -> dict:
+def _record(args: argparse.Namespace, settings: Settings, jobs: int) -> dict[str, Any]:
     record = provenance.header(TOOL, PROG, args.argv if hasattr(args, "argv") else None)
     record.update(
         seed=args.seed,

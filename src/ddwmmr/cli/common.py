@@ -55,6 +55,8 @@ from ddwmmr.outputs import (
 from ddwmmr.workers import IN_WORKERS, SHOWN
 
 if TYPE_CHECKING:
+    from typing import TextIO
+
     from ddwmmr.controllers.option_specs import OptionSpec
 
 #: Exit status for bad input (argparse uses the same).
@@ -195,7 +197,13 @@ class _StoreOnce(argparse._StoreAction):
     """argparse's ``store``, refused when its option is given a second time in one command
     line (argparse would keep the last value without a word)."""
 
-    def __call__(self, parser, namespace, values, option_string=None) -> None:  # type: ignore[override]
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
         given = getattr(parser, "_given", None)
         if given is not None:
             if self in given:
@@ -223,7 +231,7 @@ class ArgumentParser(argparse.ArgumentParser):
     #: What starts an error line (None: the parser's ``prog``).
     error_prefix: str | None = None
 
-    def __init__(self, *args, **kwargs) -> None:
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
         self._given: dict[argparse.Action, str] | None = None
@@ -233,7 +241,10 @@ class ArgumentParser(argparse.ArgumentParser):
         if self.add_help:
             self.add_argument("--version", action="version", version=f"ddwmmr {package_version()}")
 
-    def parse_known_args(self, args=None, namespace=None):  # type: ignore[override]
+    # ignore: argparse's overloads type the namespace; this one override passes it through
+    def parse_known_args(  # type: ignore[override]
+        self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
+    ) -> tuple[argparse.Namespace, list[str]]:
         outer, self._given = self._given, {}
         try:
             return super().parse_known_args(args, namespace)
@@ -382,7 +393,14 @@ def _one_line_display(previous: Callable[..., None]) -> Callable[..., None]:
 
     shown: set[str] = set()
 
-    def show(message, category, filename, lineno, file=None, line=None) -> None:
+    def show(
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: TextIO | None = None,
+        line: str | None = None,
+    ) -> None:
         ours = os.path.normcase(os.path.abspath(filename)).startswith(_PACKAGE_FOLDER + os.sep)
         if not (ours and issubclass(category, UserWarning)):
             previous(message, category, filename, lineno, file, line)
@@ -490,15 +508,16 @@ def printable_stdout() -> Iterator[None]:
     stream = sys.stdout
     errors = getattr(stream, "errors", None)
     reconfigurable = isinstance(errors, str) and hasattr(stream, "reconfigure")
-    printable = _PRINTABLE_ERRORS.get(errors) if reconfigurable else None
+    # ignore: errors is a str and stream has reconfigure when reconfigurable (checked above)
+    printable = _PRINTABLE_ERRORS.get(errors) if reconfigurable else None  # type: ignore[arg-type]
     if printable is not None:
-        stream.reconfigure(errors=printable)
+        stream.reconfigure(errors=printable)  # type: ignore[union-attr]
     try:
         yield
     finally:
         if printable is not None:
             with contextlib.suppress(OSError, ValueError):  # closed or broken meanwhile
-                stream.reconfigure(errors=errors)
+                stream.reconfigure(errors=errors)  # type: ignore[union-attr]
 
 
 def _complete_output(stop: BaseException, committed: list[Path]) -> Path | None:
@@ -528,11 +547,19 @@ class RefusedOption(argparse.Action):
     Hidden from ``--help``; takes an optional value so that ``--robot FILE`` is one
     refusal."""
 
-    def __init__(self, option_strings: Sequence[str], dest: str, reason: str, **kwargs) -> None:
+    def __init__(
+        self, option_strings: Sequence[str], dest: str, reason: str, **kwargs: Any
+    ) -> None:
         super().__init__(option_strings, dest, nargs="?", help=argparse.SUPPRESS, **kwargs)
         self.reason = reason
 
-    def __call__(self, parser, namespace, values, option_string=None) -> None:
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: str | Sequence[Any] | None,
+        option_string: str | None = None,
+    ) -> None:
         """Refuse the option: ``parser.error`` exits with status 2."""
         parser.error(f"{option_string}: {self.reason}")
 
@@ -601,7 +628,7 @@ def horizon_range() -> str:
     return f"in [{MIN_INTERVAL:g}, {MAX_HORIZON:g}] s"
 
 
-def add_force_argument(parser: argparse.ArgumentParser) -> None:
+def add_force_argument(parser: argparse.ArgumentParser | argparse._ArgumentGroup) -> None:
     """``--force``: write into an existing folder another tool or the user made."""
     parser.add_argument(
         "--force",
@@ -627,7 +654,8 @@ def output_target(given: str | None, default: Callable[[], Path]) -> tuple[Path,
     name from ``base`` if fresh, else ``base``). The folder written is ``out.with_name(
     writer.path.name)``: a fresh writer takes the next free name when it commits."""
     fresh = given is None
-    base = default() if fresh else Path(given_text("out", given, "an output folder"))
+    # ignore: given is a str when not fresh (given_text passes it through)
+    base = default() if fresh else Path(given_text("out", given, "an output folder"))  # type: ignore[arg-type]
     return base, (first_free(base, folder=True) if fresh else base), fresh
 
 
@@ -727,7 +755,7 @@ class _PlantOptionAction(argparse._AppendAction):
         super().__init__(*args, **kwargs)
 
     @property
-    def help(self) -> str:  # type: ignore[override]
+    def help(self) -> str:
         """The help: its text, then each plant's option names."""
         from ddwmmr.plants import available_plants
 

@@ -556,7 +556,8 @@ def not_tracked(plan: Any, outputs: dict[Any, Any], shown: Callable[[str], str] 
     wrong, then each likely cause once; ``shown`` gives a trajectory key's shown name
     (:meth:`CompareConfig.shown`)."""
     judged = judged_runs(plan)
-    lines, causes = [], {}
+    lines: list[str] = []
+    causes: dict[str, list[str]] = {}
     for spec, who, where in judged:
         found, what, cause = explain(outputs[spec].summary)
         if found:

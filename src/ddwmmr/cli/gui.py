@@ -222,7 +222,8 @@ def settings_from_arguments(args: argparse.Namespace) -> Settings:
             raise ParameterError("compare-option needs --compare METHOD")
         what = ("option", "compare-option")[slot]
         for text in texts:
-            name, value = parse_option(settings.methods[slot], text, what)
+            # ignore: the slot has a method when it has texts (refused above otherwise)
+            name, value = parse_option(settings.methods[slot], text, what)  # type: ignore[arg-type]
             settings = settings.with_option(slot, name, value)
     for name, _, _ in GEOMETRY:
         value = getattr(args, name)
@@ -310,7 +311,8 @@ def open_window(settings: Settings, export_dir: str | None = None) -> int:
     app = App(figure, settings, interactive=True)
     if export_dir:
         app.export_field.show(export_dir)
-    figure.ddwmmr_app = app  # keep the app (and its widgets) alive with the window
+    # ignore: an attribute of our own on the figure, which matplotlib's hints do not declare
+    figure.ddwmmr_app = app  # type: ignore[attr-defined]  # keeps the app alive with the window
     plt.show()
     return 0
 

@@ -491,7 +491,8 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
             manipulability=thresholds["manipulability"],
             dt=args.dt,
             time_limit=args.time_limit,
-            **qp_options,
+            # ignore: qp_options holds only the float qp_* fields, not the bool or int ones
+            **qp_options,  # type: ignore[arg-type]
             arbiter=args.arbiter or DEFAULT_ARBITER,
             arbiter_seed=0 if args.arbiter_seed is None else args.arbiter_seed,
             controller_options=controller_options,
@@ -505,10 +506,11 @@ def _check_engine_step(config: RunConfig) -> None:
     if not hasattr(plant_class(config.plant), "check_control_step"):
         return
     plant = make_scenario_plant(config_robot(config), config)
+    # ignore: a physics plant has these (its class checked above); the Plant protocol does not
     try:
-        plant.check_control_step(config.dt)
+        plant.check_control_step(config.dt)  # type: ignore[attr-defined]
     except ParameterError:
-        h = plant.timestep
+        h = plant.timestep  # type: ignore[attr-defined]
         raise ParameterError(
             f"dt must be a whole multiple of the {config.plant} plant's engine step {h:g} s in "
             f"(0, {MAX_DT:g}] s ({', '.join(f'{k * h:g}' for k in (1, 2, 3))}, ...) "
@@ -595,7 +597,9 @@ class Runner:
         self._client = None
         self._held.close()
 
-    def run(self, scenarios: list[Scenario], config: RunConfig, label: str):
+    def run(
+        self, scenarios: list[Scenario], config: RunConfig, label: str
+    ) -> tuple[list[Outcome], float]:
         """Outcomes in scenario order and the wall time (s)."""
         start = time.perf_counter()
         with ProgressBar(len(scenarios), label, enabled=self.progress) as bar:
@@ -618,7 +622,8 @@ def cluster_workers(client: Any) -> int:
 
 def largest_batch(args: argparse.Namespace) -> int:
     """Scenarios in the largest batch a run of ``args`` sends to the workers."""
-    return max(args.n, 10) if args.study == "obstacles" else args.n
+    largest: int = max(args.n, 10) if args.study == "obstacles" else args.n
+    return largest
 
 
 def output_names(args: argparse.Namespace, config: RunConfig) -> tuple[str, ...]:
@@ -698,12 +703,20 @@ def failure_line(summary: dict[str, Any]) -> str:
     )
 
 
-def _figures(folder: Path, scenarios, outcomes, config: RunConfig, progress: bool) -> None:
+def _figures(
+    folder: Path,
+    scenarios: list[Scenario],
+    outcomes: list[Outcome],
+    config: RunConfig,
+    progress: bool,
+) -> None:
     with phase("scenarios: figures", enabled=progress):
         _draw_figures(folder, scenarios, outcomes, config)
 
 
-def _draw_figures(folder: Path, scenarios, outcomes, config: RunConfig) -> None:
+def _draw_figures(
+    folder: Path, scenarios: list[Scenario], outcomes: list[Outcome], config: RunConfig
+) -> None:
     short = f"{config.controller} controller, {config.plant} plant"
     report.plot_state_times(outcomes, folder / TIMES_FIGURE, short)
     report.plot_speeds(outcomes, folder / SPEED_FIGURE, short)
@@ -750,7 +763,9 @@ def paths_title(short: str, outcomes: list[Outcome], chosen: list[int], focus: i
     return f"{short}: paths of scenario{plural} {shown} of {ran} run"
 
 
-def _state_lines(state: str, symbol: str, thresholds) -> list[tuple[float, str]]:
+def _state_lines(
+    state: str, symbol: str, thresholds: tuple[float, float]
+) -> list[tuple[float, str]]:
     """Enter and exit lines of a fix state; one line where they coincide (no hysteresis)."""
     enter, leave = thresholds
     if enter == leave:
@@ -804,7 +819,9 @@ def _count(value: Any) -> float:
     return 0.0 if isinstance(value, float) and math.isnan(value) else float(value)
 
 
-def _run_benchmark(args, config, runner, folder: Path) -> None:
+def _run_benchmark(
+    args: argparse.Namespace, config: RunConfig, runner: Runner, folder: Path
+) -> None:
     scenarios = generate(args.n, args.seed)
     if args.obstacles:
         scenarios = studies.obstacle_scenarios(scenarios)
@@ -872,7 +889,9 @@ def _beaten_line(beaten: list[tuple[int, float, float]], bounds: str) -> str:
     )
 
 
-def _run_thresholds(args, config, runner, folder: Path) -> None:
+def _run_thresholds(
+    args: argparse.Namespace, config: RunConfig, runner: Runner, folder: Path
+) -> None:
     scenarios = generate(args.n, args.seed)
     results = []
     rows = []
@@ -899,7 +918,9 @@ def _run_thresholds(args, config, runner, folder: Path) -> None:
     print(table, end="")
 
 
-def _run_obstacles(args, config, runner, folder: Path) -> None:
+def _run_obstacles(
+    args: argparse.Namespace, config: RunConfig, runner: Runner, folder: Path
+) -> None:
     scenarios = studies.obstacle_scenarios(generate(max(args.n, 10), args.seed))
     outcomes, wall = runner.run(scenarios, config, "obstacles")
     extra = {"seed": args.seed, "study": "obstacles", "run": _record(args, config, runner.workers)}
@@ -917,7 +938,9 @@ def _run_obstacles(args, config, runner, folder: Path) -> None:
     print(table, end="")
 
 
-def _run_arbiters(args, config, runner, folder: Path) -> None:
+def _run_arbiters(
+    args: argparse.Namespace, config: RunConfig, runner: Runner, folder: Path
+) -> None:
     """State machine vs competitive arbiter (scenarios/arbiter_study.py)."""
     from ddwmmr.scenarios import arbiter_study
 
@@ -967,7 +990,9 @@ def _record(args: argparse.Namespace, config: RunConfig, workers: int) -> dict[s
     return record
 
 
-def _bounds_table(args: argparse.Namespace, config: RunConfig):
+def _bounds_table(
+    args: argparse.Namespace, config: RunConfig
+) -> dict[int, tuple[float, float]] | None:
     """``--bounds``: the file's ``{scenario: (lower, best)}``, checked against the run.
 
     Refused (one line) on another plant than the thesis plant: the lower bound prices the

@@ -16,7 +16,7 @@ import textwrap
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from ddwmmr import provenance
 from ddwmmr.cli.common import (
@@ -86,6 +86,8 @@ from ddwmmr.trajectories import ScaledTrajectory, available_trajectories, load_t
 from ddwmmr.trajectories.files import find_obstacle_file, find_trajectory_file
 
 PROG = provenance.TRACK_PROG
+#: A recorded field's type (:func:`_field`).
+_T = TypeVar("_T")
 #: The default plant (``--plant``), and the plant of a record that names none.
 PLANT = "kinematic"
 #: ``--offset``'s default for the default robot, as written on the command line (m).
@@ -541,11 +543,14 @@ def _note_other_software(record: dict[str, Any]) -> None:
         )
 
 
-def _recorded_digest(trajectory_record: dict, source: Any) -> str | None:
+def _recorded_digest(trajectory_record: dict[str, Any], source: Any) -> str | None:
     """The SHA-256 the record gives its trajectory file (a record naming a file must)."""
     if not (isinstance(source, str) and source):
         return None
-    return _inside("trajectory", lambda: provenance.recorded_sha256(trajectory_record))
+    digest: str | None = _inside(
+        "trajectory", lambda: provenance.recorded_sha256(trajectory_record)
+    )
+    return digest
 
 
 def _in_record(path: str, exc: ParameterError) -> ParameterError:
@@ -563,7 +568,7 @@ def _inside(section: str, read: Callable[[], Any]) -> Any:
         raise KeyError(f"{section}.{exc.args[0]}") from None
 
 
-def _field(record: dict[str, Any], key: str, kind: type, what: str) -> Any:
+def _field(record: dict[str, Any], key: str, kind: type[_T], what: str) -> _T:
     """``record[key]`` if it is a ``kind`` (KeyError when missing, TypeError otherwise)."""
     value = record[key]
     if not isinstance(value, kind) or isinstance(value, bool):
@@ -577,7 +582,9 @@ def _plant_options(plant_record: dict[str, Any], plant: str) -> dict[str, Any]:
     by the plant, :func:`check_run`)."""
     if "options" not in plant_record:
         return {}
-    options = provenance.decode(_field(plant_record, "options", dict, "plant options"))
+    options: dict[str, Any] = provenance.decode(
+        _field(plant_record, "options", dict, "plant options")
+    )
     check_plant_option_names(plant, options)
     return options
 

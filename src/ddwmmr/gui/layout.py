@@ -10,7 +10,7 @@ that each reads on its own.
 from __future__ import annotations
 
 import functools
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from matplotlib.patches import Rectangle
 from matplotlib.widgets import Slider
@@ -22,6 +22,9 @@ from ddwmmr.gui.view import RunView, add_view_axes
 from ddwmmr.gui.widgets import FONT, CycleButton, Field, button, panel_axes, radio
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.trajectories import available_trajectories
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 #: Window size (inches) and resolution of the window and its snapshot.
 FIGSIZE = (16.0, 10.0)
@@ -348,7 +351,7 @@ class PanelLayout:
         )
 
 
-def desktop_figure():
+def desktop_figure() -> Figure:
     """A Tk window's figure, its resolution lowered so that the window fits the screen.
 
     The layout is in figure fractions and the fonts in points, so a lower dpi shrinks the

@@ -116,7 +116,7 @@ def warn_other_robot(holder: Any, robot: Robot, parameter: str = "method") -> No
 
 def check_start(
     robot: Robot,
-    q: Sequence[float],
+    q: Sequence[float] | npt.NDArray[np.float64],
     obstacles: Sequence[Any] = (),
     name: str = "payload",
     start: str | None = "the start (q0, initial_offset)",

@@ -19,6 +19,7 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -42,6 +43,9 @@ from ddwmmr.qp.blocks import LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import INF, Limit
 from ddwmmr.trajectories.files import find_obstacle_file
+
+if TYPE_CHECKING:
+    import numpy.typing as npt
 
 #: A circle's row is degenerate when its top clearance rate ``|dd/dv| v_max + |dd/dw|
 #: w_max`` is below this share of ``v_max``, the rate driving straight at the circle: level
@@ -251,7 +255,9 @@ def footprint_clearances(
     return best
 
 
-def check_start_clear(robot: Robot, circles: Sequence[Circle], q: Sequence[float]) -> None:
+def check_start_clear(
+    robot: Robot, circles: Sequence[Circle], q: Sequence[float] | npt.NDArray[np.float64]
+) -> None:
     """Refuse (one-line :class:`ParameterError`) a start pose ``q`` whose base footprint
     overlaps one of ``circles``: the run would start in a collision."""
     half_length, half_width = 0.5 * robot.base_length, 0.5 * robot.base_width
