@@ -103,12 +103,13 @@ def extra_factory(case: ExtraCase) -> Callable[[Robot], Controller] | str:
     target = getattr(module, attribute, None)
     if target is None:
         return f"{module_name} has no attribute {shown(attribute)}"
-    reason = getattr(module, "unavailable_reason", lambda: None)()
+    reason: str | None = getattr(module, "unavailable_reason", lambda: None)()
     if reason:
         return reason
 
     def make(robot: Robot) -> Controller:
-        return target(robot, **case.options)
+        controller: Controller = target(robot, **case.options)
+        return controller
 
     return make
 
@@ -172,7 +173,8 @@ def time_run(robot: Robot, trajectory: Any, controller: Controller, duration: fl
     start = time.perf_counter()
     result = simulate(robot, trajectory, controller, duration=duration)
     elapsed = time.perf_counter() - start
-    return result.summary["steps"] / elapsed
+    steps: int = result.summary["steps"]
+    return steps / elapsed
 
 
 def _meets_target(case: BenchCase, step: float, naive_step: float) -> bool | None:

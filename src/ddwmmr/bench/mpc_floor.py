@@ -150,7 +150,9 @@ def instrumented(clock: Callable[[], int] = DEFAULT_CLOCK) -> Iterator[StepLog]:
     cls = controller_module.MPCController
     log = StepLog(clock)
     command, problem_of, problem_solve = cls.command, cls._problem, Problem.solve
-    guard = controller_module.safe_arm_scale
+    # ignore: the guard mpc.controller imports (and calls by its module name) is patched
+    # there, where it is not re-exported (also below)
+    guard = controller_module.safe_arm_scale  # type: ignore[attr-defined]
 
     def timed_command(self: Any, *args: Any, **kwargs: Any) -> Any:
         log._current = {}
@@ -201,7 +203,7 @@ def instrumented(clock: Callable[[], int] = DEFAULT_CLOCK) -> Iterator[StepLog]:
     cls.command = timed_command  # type: ignore[method-assign]
     cls._problem = instrumented_problem  # type: ignore[method-assign]
     Problem.solve = timed_problem_solve  # type: ignore[method-assign]
-    controller_module.safe_arm_scale = timed_guard  # type: ignore[assignment]
+    controller_module.safe_arm_scale = timed_guard  # type: ignore[attr-defined]
     try:
         yield log
     finally:
@@ -209,7 +211,7 @@ def instrumented(clock: Callable[[], int] = DEFAULT_CLOCK) -> Iterator[StepLog]:
         cls.command = command  # type: ignore[method-assign]
         cls._problem = problem_of  # type: ignore[method-assign]
         Problem.solve = problem_solve  # type: ignore[method-assign]
-        controller_module.safe_arm_scale = guard
+        controller_module.safe_arm_scale = guard  # type: ignore[attr-defined]
 
 
 def floor_summary(log: StepLog) -> dict[str, Any]:

@@ -8,7 +8,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
@@ -23,6 +23,18 @@ from ddwmmr.model.stability import STABILITY_FLOOR
 from ddwmmr.progress import ProgressBar
 from ddwmmr.sim import simulate
 
+if TYPE_CHECKING:
+    import numpy.typing as npt
+
+    from ddwmmr.commands import WheelForces
+    from ddwmmr.qp.context import StepContext
+    from ddwmmr.qp.controller import QPController
+    from ddwmmr.qp.limits import Limit
+    from ddwmmr.qp.tasks import Task
+
+    #: One recorded ``command`` call: ``(t, q, pose_d, velocity_d)`` (s, m, rad).
+    RecordedCall = tuple[float, np.ndarray, np.ndarray, np.ndarray]
+
 #: Targets of the qp step, judged in every state class (docs/api.md, "Benchmark").
 QP_TARGETS = {"median_us": 20.0, "p99_us": 40.0, "reference_ratio": 40.0}
 
@@ -36,7 +48,8 @@ def qp_target_verdict(qp: dict[str, Any], states: int) -> bool | None:
         return False
     if not p99_judgeable(states):
         return None
-    return qp["p99_us"] <= QP_TARGETS["p99_us"]
+    meets: bool = qp["p99_us"] <= QP_TARGETS["p99_us"]
+    return meets
 
 
 #: Phases of a qp step reported by :func:`time_qp_phases` (plus the rest of the step).
@@ -58,24 +71,24 @@ class StateClass:
     trajectory: str
     description: str
     options: dict[str, Any] = field(default_factory=dict)
-    select: Callable[[Robot, dict[str, Any], tuple], bool] | None = None
+    select: Callable[[Robot, dict[str, Any], RecordedCall], bool] | None = None
     start: Callable[[Robot, Any], np.ndarray] | None = None
 
 
-def _near_floor(robot: Robot, options: dict[str, Any], call: tuple) -> bool:
+def _near_floor(robot: Robot, options: dict[str, Any], call: RecordedCall) -> bool:
     from ddwmmr.qp.limits import exact_stability
 
     q = call[1]
-    floor = options.get("stability_min", STABILITY_FLOOR)
+    floor: float = options.get("stability_min", STABILITY_FLOOR)
     return exact_stability(robot.com_coefficients, float(q[3]), float(q[4])) < floor + 0.05
 
 
-def _near_singularity(robot: Robot, options: dict[str, Any], call: tuple) -> bool:
+def _near_singularity(robot: Robot, options: dict[str, Any], call: RecordedCall) -> bool:
     margin = options.get("singularity_margin", 0.25)
     return math.cos(float(call[1][3])) ** 2 - math.sin(margin) ** 2 < 0.05
 
 
-def _near_obstacle(robot: Robot, options: dict[str, Any], call: tuple) -> bool:
+def _near_obstacle(robot: Robot, options: dict[str, Any], call: RecordedCall) -> bool:
     from ddwmmr.qp.limits import footprint_clearances
     from ddwmmr.qp.limits.obstacles import INFLUENCE_M
 
@@ -123,28 +136,33 @@ class _Recorder:
     def __init__(self, inner: Any) -> None:
         self.inner = inner
         self.name = inner.name
-        self.calls: list[tuple[float, np.ndarray, np.ndarray, np.ndarray]] = []
+        self.calls: list[RecordedCall] = []
 
     @property
     def last(self) -> StepInfo:
-        return self.inner.last
+        info: StepInfo = self.inner.last
+        return info
 
     def reset(self, trajectory: Any, q0: np.ndarray) -> None:
         self.inner.reset(trajectory, q0)
 
-    def command(self, t, q, pose_d, velocity_d):
+    def command(
+        self, t: float, q: np.ndarray, pose_d: np.ndarray, velocity_d: np.ndarray
+    ) -> npt.ArrayLike | WheelForces:
         self.calls.append(
             (float(t), np.array(q, float), np.array(pose_d, float), np.array(velocity_d, float))
         )
-        return self.inner.command(t, q, pose_d, velocity_d)
+        u: npt.ArrayLike | WheelForces = self.inner.command(t, q, pose_d, velocity_d)
+        return u
 
     def summarize(self, timeseries: dict[str, np.ndarray]) -> dict[str, Any]:
-        return self.inner.summarize(timeseries)
+        summary: dict[str, Any] = self.inner.summarize(timeseries)
+        return summary
 
 
 def record_class_states(
     state_class: StateClass, robot: Robot, count: int
-) -> tuple[Any, list[tuple]]:
+) -> tuple[Any, list[RecordedCall]]:
     """The trajectory and up to ``count`` evenly spaced selected calls of its qp run."""
     from ddwmmr.trajectories import load_trajectory
 
@@ -152,7 +170,9 @@ def record_class_states(
     options = _resolve_options(state_class.options)
     recorder = _Recorder(make_controller("qp", robot, **options))
     q0 = state_class.start(robot, trajectory) if state_class.start else None
-    simulate(robot, trajectory, recorder, q0=q0)
+    # ignore: _Recorder's last is a read-only forward of the inner controller's; the
+    # Controller protocol declares a plain attribute, which simulate only reads
+    simulate(robot, trajectory, recorder, q0=q0)  # type: ignore[arg-type]
     calls = recorder.calls
     if state_class.select is not None:
         calls = [c for c in calls if state_class.select(robot, options, c)]
@@ -181,7 +201,7 @@ class _UserSpin:
     """Factories of a user task and a user limit (generic path only) for the "+user" row."""
 
     @staticmethod
-    def pieces():
+    def pieces() -> tuple[list[Task], list[Limit]]:
         from ddwmmr.qp.limits import INF, Limit
         from ddwmmr.qp.tasks import Task
 
@@ -191,7 +211,7 @@ class _UserSpin:
             __module__ = USER_MODULE
             name = "spin"
 
-            def compute(self, ctx, jac, error):
+            def compute(self, ctx: StepContext, jac: np.ndarray, error: np.ndarray) -> None:
                 jac[:] = (0.0, 1.0, 0.0, 0.0)
                 error[0] = 0.5
 
@@ -201,7 +221,15 @@ class _UserSpin:
             __module__ = USER_MODULE
             rows = 1
 
-            def compute(self, ctx, G, lower, upper, lb, ub):
+            def compute(
+                self,
+                ctx: StepContext,
+                G: np.ndarray,
+                lower: np.ndarray,
+                upper: np.ndarray,
+                lb: np.ndarray,
+                ub: np.ndarray,
+            ) -> None:
                 G[0] = (0.0, 0.0, 1.0, 1.0)
                 lower[0], upper[0] = -INF, INF
 
@@ -215,7 +243,8 @@ def qp_class_cases(robot: Robot, options: dict[str, Any], reference: bool) -> di
     from ddwmmr.qp.naive import NaiveQPController
 
     cases: dict[str, Any] = {"qp": make_controller("qp", robot, **options)}
-    generic = make_controller("qp", robot, **options)
+    # ignore: make_controller("qp") builds a QPController (the generic path is set on it)
+    generic = cast("QPController", make_controller("qp", robot, **options))
     generic.problem = QPProblem(generic.tasks, generic.limits, compiled=False, unit=generic.unit)
     cases["qp (generic path)"] = generic
     tasks, limits = _UserSpin.pieces()
@@ -232,7 +261,7 @@ def qp_class_cases(robot: Robot, options: dict[str, Any], reference: bool) -> di
 
 def time_qp_phases(
     controller: Any,
-    calls: Sequence[tuple],
+    calls: Sequence[RecordedCall],
     repeats: int,
     clock: Clock = time.perf_counter_ns,
     overhead_ns: float = 0.0,
@@ -302,7 +331,7 @@ def measure_qp_classes(
     bar: ProgressBar,
 ) -> list[dict[str, Any]]:
     """Measure every qp state class (see :data:`QP_CLASSES`)."""
-    results = []
+    results: list[dict[str, Any]] = []
     for state_class in QP_CLASSES:
         try:
             trajectory, recorded = record_class_states(state_class, robot, calls)

@@ -187,7 +187,9 @@ def check_duration(trajectory: Any, duration: float | None) -> float:
     return check_range("duration", duration, dt, MAX_STEPS * dt, "s")
 
 
-def _config(repeats: int, calls: int, trajectory: Any, duration: float, overhead: float):
+def _config(
+    repeats: int, calls: int, trajectory: Any, duration: float, overhead: float
+) -> dict[str, Any]:
     """Conditions of the run (to compare runs over time), with the package's version and
     its source's commit as every tool's run record gives them
     (:func:`ddwmmr.provenance.git_record`): ``package_version``, because the report's own

@@ -34,7 +34,7 @@ def timer_overhead_ns(clock: Clock = time.perf_counter_ns, samples: int = 2001) 
 
 def time_calls(
     command: Callable[..., Any],
-    calls: Sequence[tuple],
+    calls: Sequence[tuple[Any, ...]],
     repeats: int,
     clock: Clock = time.perf_counter_ns,
     overhead_ns: float = 0.0,
