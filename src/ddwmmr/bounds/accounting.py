@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -34,6 +35,9 @@ from ddwmmr.bounds.lower import Prices
 from ddwmmr.bounds.replay import REPLAY_DT, held_commands
 from ddwmmr.model import Robot
 from ddwmmr.plants.thesis import ThesisPlant, first_order_step
+
+if TYPE_CHECKING:
+    from ddwmmr.mpc.min_time import MinimumTime
 
 
 @dataclass(frozen=True)
@@ -92,7 +96,7 @@ def magnitude_and_opposed(
     return abs(before) + abs(integral - before), crossing
 
 
-def account(robot: Robot, result, until: float, dt: float = REPLAY_DT) -> Accounting:
+def account(robot: Robot, result: MinimumTime, until: float, dt: float = REPLAY_DT) -> Accounting:
     """The force-budget accounting (module docstring) of ``result`` (``times``, ``states``,
     ``inputs`` as :class:`~ddwmmr.mpc.min_time.MinimumTime` has them: wheel forces in N,
     joint rates in rad/s) replayed on the thesis plant in steps of at most ``dt`` (s)

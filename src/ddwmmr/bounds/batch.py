@@ -59,7 +59,7 @@ class Job:
     need_lower: bool
 
 
-def keys(scenario: Scenario, payload: float, settings: Settings) -> dict[str, dict]:
+def keys(scenario: Scenario, payload: float, settings: Settings) -> dict[str, dict[str, Any]]:
     """The cache keys of a scenario's two parts."""
     common = {
         "waypoints": [list(w) for w in scenario.waypoints],
@@ -164,12 +164,15 @@ def _same_problem(path: Path, scenario: Scenario, payload: float) -> bool:
     try:
         key = json.loads(path.read_text(encoding="utf-8"))["key"]
         wanted = json_safe(keys(scenario, payload, Settings())["lower"])
-        return key["waypoints"] == wanted["waypoints"] and key["payload"] == wanted["payload"]
+        same: bool = key["waypoints"] == wanted["waypoints"] and key["payload"] == wanted["payload"]
+        return same
     except (OSError, ValueError, KeyError, TypeError):
         return False
 
 
-def read_cached(folder: Path, scenario: Scenario, payload: float, settings: Settings):
+def read_cached(
+    folder: Path, scenario: Scenario, payload: float, settings: Settings
+) -> tuple[dict[str, Any] | None, dict[str, Any] | None]:
     """The cached (best, lower) records of a scenario, each None if absent or stale.
 
     Stale: a key other than ``keys(scenario, payload, settings)``'s; a lower bound that is
@@ -189,12 +192,13 @@ def read_cached(folder: Path, scenario: Scenario, payload: float, settings: Sett
     if best is not None and not usable_best(folder, index, best):
         best = None
     both = best is not None and lower is not None and best["replay_ok"] is True
-    if both and best["best_known_s"] < lower["lower_bound_s"]:
+    # ignore: both rules a missing record out
+    if both and best["best_known_s"] < lower["lower_bound_s"]:  # type: ignore[index]
         lower = None  # the cheaper end, computed again: :func:`row` judges the new one
     return best, lower
 
 
-def _keyed_record(path: Path, key: dict) -> dict | None:
+def _keyed_record(path: Path, key: dict[str, Any]) -> dict[str, Any] | None:
     """The JSON record at ``path`` if it is an object whose ``key`` is ``key``, else None."""
     record = _read_object(path)
     return record if record is not None and record.get("key") == json_safe(key) else None
@@ -206,7 +210,7 @@ def _is_time(value: object) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool) and low <= value <= high
 
 
-def usable_best(folder: Path, index: int, record: dict) -> bool:
+def usable_best(folder: Path, index: int, record: dict[str, Any]) -> bool:
     """Whether scenario ``index``'s (from 1) best-known ``record`` in the cache of the
     output folder ``folder`` can be used: a search that replayed nothing (``replay_ok``
     False) always can; a replayed one needs a best-known time (s, in
@@ -220,7 +224,7 @@ def usable_best(folder: Path, index: int, record: dict) -> bool:
     return not _trajectory_lost(folder, index, record)
 
 
-def _trajectory_lost(folder: Path, index: int, record: dict) -> bool:
+def _trajectory_lost(folder: Path, index: int, record: dict[str, Any]) -> bool:
     """Whether best-known ``record`` of scenario ``index`` is of a search that kept a
     trajectory (``replay_ok`` true and the ``start`` it came from named: :func:`solve`
     then stores the trajectory beside it) which its ``.npz`` in the cache of ``folder``
@@ -235,7 +239,9 @@ def _trajectory_lost(folder: Path, index: int, record: dict) -> bool:
     return False
 
 
-def other_settings(folder: Path, scenario: Scenario, payload: float, settings: Settings):
+def other_settings(
+    folder: Path, scenario: Scenario, payload: float, settings: Settings
+) -> dict[str, Any] | None:
     """The method settings (a dict, as :func:`keys` records them) of scenario
     ``scenario``'s cached best-known record when it is for the same problem and method
     version but other settings than ``settings`` (a ``--quick`` search, another S floor);
@@ -249,7 +255,7 @@ def other_settings(folder: Path, scenario: Scenario, payload: float, settings: S
     return key.get("settings") if same and isinstance(key.get("settings"), dict) else None
 
 
-def _read_object(path: Path) -> dict | None:
+def _read_object(path: Path) -> dict[str, Any] | None:
     """The JSON object at ``path``, or None if missing, unreadable, not a regular file or
     not an object."""
     try:
@@ -297,7 +303,7 @@ def store(folder: Path, result: dict[str, Any]) -> list[str]:
     return written
 
 
-def row(index: int, best: dict | None, lower: dict | None) -> dict[str, Any]:
+def row(index: int, best: dict[str, Any] | None, lower: dict[str, Any] | None) -> dict[str, Any]:
     """One line of bounds.csv; a one-line :class:`ParameterError` naming the scenario's
     cache files when its replayed best-known time is below its lower bound (bounds.csv's
     readers refuse such a row: no achieved time is below its lower bound)."""
@@ -384,7 +390,7 @@ def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
     return out
 
 
-def _bounds_field(where: str, row: dict, key: str) -> str:
+def _bounds_field(where: str, row: Mapping[str, str | None], key: str) -> str:
     """The text of column ``key`` of a bounds.csv row, refused if the row has none."""
     text = row.get(key)
     if text is None or not text.strip():
@@ -392,7 +398,7 @@ def _bounds_field(where: str, row: dict, key: str) -> str:
     return text.strip()
 
 
-def _bounds_scenario(where: str, row: dict) -> int:
+def _bounds_scenario(where: str, row: Mapping[str, str | None]) -> int:
     """A bounds.csv row's scenario number, in 1..:data:`~ddwmmr.errors.MAX_SCENARIOS`."""
     text = _bounds_field(where, row, "scenario")
     number = scenario_number(text) if text.isascii() and text.isdigit() else 0
@@ -414,7 +420,7 @@ def scenario_number(digits: str) -> int:
     return int(significant)
 
 
-def _bounds_time(where: str, row: dict, key: str) -> float:
+def _bounds_time(where: str, row: Mapping[str, str | None], key: str) -> float:
     """A time of a bounds.csv row (s): NaN for ``nan`` (no value), else a number in
     :data:`~ddwmmr.errors.DURATION_RANGE_S`."""
     text = _bounds_field(where, row, key)

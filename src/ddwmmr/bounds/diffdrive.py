@@ -31,10 +31,13 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 
 import casadi as ca
 import numpy as np
-from scipy.optimize import minimize
+
+# ignore: scipy ships no type hints (no scipy-stubs in the environment)
+from scipy.optimize import minimize  # type: ignore[import-untyped]
 
 from ddwmmr.mpc.min_time import FreeTimeOCP, Guess, LegEnd, ShootingModel
 
@@ -46,7 +49,13 @@ def _turn(a: float, b: float) -> float:
     return abs(math.remainder(b - a, TWO_PI))
 
 
-def _two_straights(h, delta, start_heading, goal_heading, half_track) -> float:
+def _two_straights(
+    h: Sequence[float] | np.ndarray,
+    delta: np.ndarray,
+    start_heading: float,
+    goal_heading: float,
+    half_track: float,
+) -> float:
     """Wheel-travel units ``sum |d| + b * turns`` of the two-straight family at headings
     ``h`` (inf where the two lines are parallel)."""
     h1, h2 = h
@@ -56,7 +65,8 @@ def _two_straights(h, delta, start_heading, goal_heading, half_track) -> float:
         return math.inf
     d1, d2 = np.linalg.solve(matrix, delta)
     turns = _turn(start_heading, h1) + _turn(h1, h2) + _turn(h2, goal_heading)
-    return abs(d1) + abs(d2) + half_track * turns
+    units: float = abs(d1) + abs(d2) + half_track * turns
+    return units
 
 
 def optimal_time(
@@ -80,7 +90,7 @@ def optimal_time(
         for h in (line, line + math.pi):
             best = min(best, distance + half_track * (_turn(th0, h) + _turn(h, th1)))
 
-        def cost(h):
+        def cost(h: Sequence[float] | np.ndarray) -> float:
             return _two_straights(h, delta, th0, th1, half_track)
 
         headings = TWO_PI * np.arange(grid) / grid
@@ -101,7 +111,7 @@ def diffdrive_model(wheel_radius: float, half_track: float, wheel_speed: float) 
     """The kinematic differential drive as a :class:`ShootingModel`: state ``[x, y, th]``,
     inputs the wheel speeds ``[u_l, u_r]`` in ``[-u, u]``."""
 
-    def rhs(x, u):
+    def rhs(x: ca.SX, u: ca.SX) -> ca.SX:
         v = 0.5 * wheel_radius * (u[0] + u[1])
         w = 0.5 * wheel_radius * (u[1] - u[0]) / half_track
         return ca.vertcat(v * ca.cos(x[2]), v * ca.sin(x[2]), w)
@@ -144,7 +154,12 @@ def ocp_time(
     return best
 
 
-def _guesses(start, target, phases: int, model_wheels: tuple[float, float, float]) -> list[Guess]:
+def _guesses(
+    start: Sequence[float] | np.ndarray,
+    target: np.ndarray,
+    phases: int,
+    model_wheels: tuple[float, float, float],
+) -> list[Guess]:
     """Starts that turn towards the goal (driving forwards, or backwards), drive, and turn
     to its heading (phases equally long, the wheel speeds to match: a start at rest leaves
     the leg durations without a gradient and IPOPT's restoration fails)."""
@@ -156,7 +171,7 @@ def _guesses(start, target, phases: int, model_wheels: tuple[float, float, float
     times = np.linspace(0.0, total, 4)
     samples = np.linspace(0.0, total, 61)
     arrivals = total * np.arange(1, phases + 1) / phases
-    guesses = []
+    guesses: list[Guess] = []
     for backwards in (False, True):
         direction = line + (math.pi if backwards else 0.0)
         heading = start[2] + math.remainder(direction - start[2], TWO_PI)

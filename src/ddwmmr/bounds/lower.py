@@ -66,7 +66,9 @@ from __future__ import annotations
 import functools
 import math
 import time
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -143,7 +145,7 @@ class Bound:
     wall_s: float
 
 
-def circular(a, b):
+def circular(a: float | np.ndarray, b: float | np.ndarray) -> np.ndarray | np.float64:
     """Distance (rad) between angles on the circle, in [0, pi]: ``|((a - b + pi) mod 2 pi)
     - pi|``.
 
@@ -155,11 +157,14 @@ def circular(a, b):
     within a factor of 2 of each other) and ``x + 2 pi`` rounded on (-pi, 0)."""
     x = np.asarray(np.asarray(a) - b + math.pi, dtype=float)
     if x.size and not (x.min() > -math.pi and x.max() < 3.0 * math.pi):
-        return np.abs(np.remainder(x, TWO_PI) - math.pi)  # NaN, inf or far apart
+        wrapped: np.ndarray | np.float64 = np.abs(np.remainder(x, TWO_PI) - math.pi)
+        return wrapped  # NaN, inf or far apart
     np.subtract(x, TWO_PI, out=x, where=x >= TWO_PI)
     np.add(x, TWO_PI, out=x, where=x < 0.0)
     x -= math.pi
-    return np.abs(x, out=x)[()]  # a scalar for scalar angles, as np.remainder gives
+    # a scalar for scalar angles, as np.remainder gives
+    out: np.ndarray | np.float64 = np.abs(x, out=x)[()]
+    return out
 
 
 def turn_transform(cost: np.ndarray, step: float) -> np.ndarray:
@@ -169,7 +174,9 @@ def turn_transform(cost: np.ndarray, step: float) -> np.ndarray:
     distance less one width. An erosion by one arc, then an L1 distance transform of slope
     ``step`` by passes both ways around the circle (twice, for the wrap)."""
     n = cost.shape[1]
-    out = np.minimum(cost, np.minimum(np.roll(cost, 1, axis=1), np.roll(cost, -1, axis=1)))
+    out: np.ndarray = np.minimum(
+        cost, np.minimum(np.roll(cost, 1, axis=1), np.roll(cost, -1, axis=1))
+    )
     for _ in range(2):
         for j in range(n):
             np.minimum(out[:, j], out[:, j - 1] + step, out=out[:, j])
@@ -178,7 +185,9 @@ def turn_transform(cost: np.ndarray, step: float) -> np.ndarray:
     return out
 
 
-def disc_cells(centre, radius: float, cell: float) -> tuple[np.ndarray, np.ndarray]:
+def disc_cells(
+    centre: Sequence[float], radius: float, cell: float
+) -> tuple[np.ndarray, np.ndarray]:
     """Lower-left corners (x, y) of the squares of side ``cell`` on a grid about
     ``centre`` that meet the disc of ``radius`` (m): together they cover it."""
     count = math.ceil(radius / cell)
@@ -226,14 +235,17 @@ class Lags:
             raise ParameterError("c1 must be > 0 to price the stops (an undamped base)")
         return _lags(d.mass / d.c1, d.top_speed, weight)
 
-    def at_rest(self, length) -> np.ndarray:
+    def at_rest(self, length: np.ndarray) -> np.ndarray:
         """A lower bound (s) on the rest-to-rest lag of any path at least ``length`` (m)
         long: the table's value at the longest tabulated path not above it."""
         index = np.searchsorted(self.distance, length, side="right") - 1
-        return self.rest[np.clip(index, 0, self.rest.size - 1)]
+        lag: np.ndarray = self.rest[np.clip(index, 0, self.rest.size - 1)]
+        return lag
 
 
-def _accelerate_for(target, tc, tau, brakes: bool) -> np.ndarray:
+def _accelerate_for(
+    target: np.ndarray | float, tc: np.ndarray | float, tau: float, brakes: bool
+) -> np.ndarray:
     """``t1`` (s) with ``t1 - t2 = target`` (rest to rest, ``brakes``) or ``t1 - tau (1 -
     exp(-t1 / tau)) exp(-tc / tau) = target`` (free end), for each coast time ``tc`` (a row)
     and each ``target`` (s; a column, or one number): both sides grow with ``t1``, so
@@ -284,8 +296,18 @@ def _lags(tau: float, top: float, weight: float) -> Lags:
 
 
 def _drive_costs(
-    ax, ay, a_size, bx, by, b_size, centres, half_arc, price, travel: bool, with_path: bool
-):
+    ax: np.ndarray,
+    ay: np.ndarray,
+    a_size: float,
+    bx: np.ndarray,
+    by: np.ndarray,
+    b_size: float,
+    centres: np.ndarray,
+    half_arc: float,
+    price: float,
+    travel: bool,
+    with_path: bool,
+) -> tuple[np.ndarray, np.ndarray | None]:
     """Least driving time (s) at ``price`` (s/m) from each square of A to each of B for each
     arc of the leg, and (``with_path``, else None: the force budget alone needs the time
     only) the least path (m) it stands for: (len(A), len(B), arcs) each.
@@ -325,7 +347,8 @@ def _drive_costs(
 
 def opposite(cost: np.ndarray) -> np.ndarray:
     """``min(cost[:, j], cost[:, j + arcs / 2])``: a heading and its reverse as one."""
-    return np.minimum(cost, np.roll(cost, cost.shape[1] // 2, axis=1))
+    out: np.ndarray = np.minimum(cost, np.roll(cost, cost.shape[1] // 2, axis=1))
+    return out
 
 
 # the programme's states: (kind, charged). kind "line": the leg's heading nearest the line
@@ -353,7 +376,13 @@ def _entries(
     return out
 
 
-def _leg_costs(entries, drive, charge, kind: str, stops: bool) -> dict[State, np.ndarray]:
+def _leg_costs(
+    entries: dict[State, np.ndarray],
+    drive: np.ndarray,
+    charge: np.ndarray | float,
+    kind: str,
+    stops: bool,
+) -> dict[State, np.ndarray]:
     """Each state's cost at the leg's end over (start cells, end cells, arcs), before the
     least over the start cells: the entry, the drive, and the lag charged (module
     docstring). A leg without a reversal lies in the open stretch, which is charged the
@@ -370,7 +399,7 @@ def _leg_costs(entries, drive, charge, kind: str, stops: bool) -> dict[State, np
     return {("line", True): paying, ("line", False): charged[:, None, :] + drive}
 
 
-def _items(name: str, value, wanted: str, size: int | None = None) -> tuple:
+def _items(name: str, value: Any, wanted: str, size: int | None = None) -> tuple[Any, ...]:
     """The items of the list ``value`` (``size`` of them, if given); text, a mapping, a
     non-iterable or another length raises :class:`ParameterError` saying ``name`` must be
     ``wanted``."""
@@ -386,7 +415,9 @@ def _items(name: str, value, wanted: str, size: int | None = None) -> tuple:
     return items
 
 
-def _numbers(name: str, value, fields: tuple[tuple[str, float, str], ...], wanted: str):
+def _numbers(
+    name: str, value: Any, fields: tuple[tuple[str, float, str], ...], wanted: str
+) -> tuple[float, ...]:
     """``value`` as one float per ``(field, cap, unit)``, each finite and within ``+-cap``."""
     items = _items(name, value, wanted, len(fields))
     return tuple(
@@ -400,7 +431,7 @@ _POSE = (*_XY, ("heading", MAX_ANGLE_RAD, "rad"))
 _WAYPOINTS = "a non-empty list of (x, y) pairs in m"
 
 
-def _arcs(name: str, value) -> int:
+def _arcs(name: str, value: Any) -> int:
     """``value`` as an even integer in [2, :data:`MAX_ARCS`] (:func:`opposite` pairs each
     arc with the one half the circle away)."""
     try:
@@ -415,7 +446,11 @@ def _arcs(name: str, value) -> int:
 
 
 def _check_block(
-    reach: float, grid: tuple, chunk: int, several: bool, chunk_name: str | None
+    reach: float,
+    grid: tuple[str, float, str, int],
+    chunk: int,
+    several: bool,
+    chunk_name: str | None,
 ) -> None:
     """Refuse a grid whose blocks exceed :data:`MAX_BLOCK_VALUES`, before anything is
     allocated, naming the largest chunk or the smallest cell that fits. ``grid``: ``(cell
@@ -454,7 +489,17 @@ def _check_block(
     )
 
 
-def _checked(robot, waypoints, start, tolerance, grids, chunk, chunk_name: str | None):
+def _checked(
+    robot: Robot,
+    waypoints: Any,
+    start: Any,
+    tolerance: float,
+    grids: Sequence[tuple[str, Any, str, Any]],
+    chunk: int,
+    chunk_name: str | None,
+) -> tuple[
+    tuple[tuple[float, ...], ...], tuple[float, ...], float, list[tuple[str, float, str, int]], int
+]:
     """The inputs :func:`budget_bound` and :func:`lower_bound` share, checked before any
     work: ``(waypoints, start, tolerance, grids, chunk)`` as floats and ints, or the first
     fault as one :class:`ParameterError`. ``grids``: ``(cell name, cell, arcs name,
@@ -487,8 +532,8 @@ def _checked(robot, waypoints, start, tolerance, grids, chunk, chunk_name: str |
 
 def budget_bound(
     robot: Robot,
-    waypoints,
-    start: tuple[float, float, float] = (0.0, 0.0, 0.0),
+    waypoints: Iterable[Sequence[float]],
+    start: Sequence[float] = (0.0, 0.0, 0.0),
     tolerance: float = 0.01,
     cell: float = 0.05,
     arcs: int = 180,
@@ -558,7 +603,8 @@ def budget_bound(
                     travel=kind == "travel",
                     with_path=stops,
                 )
-                charge = lags.at_rest(path) if lags is not None else 0.0
+                # ignore: with lags (stops) _drive_costs returns the path
+                charge = lags.at_rest(path) if lags is not None else 0.0  # type: ignore[arg-type]
                 for key, cost in _leg_costs(block, drive, charge, kind, stops).items():
                     least = np.min(cost, axis=0)
                     states[key] = least if key not in states else np.minimum(states[key], least)
@@ -582,7 +628,7 @@ BUDGET_GRID = (0.05, 144)
 
 def lower_bound(
     robot: Robot,
-    waypoints,
+    waypoints: Iterable[Sequence[float]],
     tolerance: float = 0.01,
     grid: tuple[float, int] = BUDGET_GRID,
     stop_weights: tuple[float, ...] = STOP_WEIGHTS,
@@ -598,7 +644,7 @@ def lower_bound(
     :data:`MAX_ARCS`], with blocks of :data:`CHUNK` start cells within
     :data:`MAX_BLOCK_VALUES`; ``stop_weights`` a list, possibly empty, of weights in
     [0, 1]. All are checked before the first bound is solved."""
-    pairs = []
+    pairs: list[tuple[str, Any, str, Any]] = []
     for name, pair in (("grid", grid), ("stop_grid", stop_grid)):
         cell, arcs = _items(name, pair, "a (cell, arcs) pair", 2)
         pairs.append((f"{name} cell", cell, f"{name} arcs", arcs))

@@ -13,7 +13,7 @@ was reached.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,7 +50,7 @@ class Replay:
 def replay(
     robot: Robot,
     result: MinimumTime,
-    waypoints,
+    waypoints: Sequence[Sequence[float]],
     stability_min: float = 1.25,
     tolerance: float = 0.01,
     dt: float = REPLAY_DT,
@@ -93,7 +93,7 @@ def replay(
 
 
 def held_commands(
-    plant: ThesisPlant, times: np.ndarray, inputs, dt: float
+    plant: ThesisPlant, times: np.ndarray, inputs: np.ndarray, dt: float
 ) -> Iterator[tuple[WheelForces, float]]:
     """The replay's plant commands and step lengths (s): each interval of ``times`` cut into
     equal steps of at most ``dt``, its wheel forces held and the joint targets ``th + rate

@@ -39,9 +39,10 @@ from __future__ import annotations
 import math
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -50,6 +51,10 @@ from ddwmmr.bounds.replay import Replay, replay
 from ddwmmr.bounds.starts import all_patterns, controller_guess, pattern_guess, turn_variants
 from ddwmmr.model import Robot
 from ddwmmr.mpc.min_time import Guess, MinimumTime, MinimumTimeProblem
+
+if TYPE_CHECKING:
+    from ddwmmr.bounds.starts import Pattern
+    from ddwmmr.scenarios.generator import Scenario
 
 #: The smaller floor margin and input cost of the plan-following runs' second variant.
 SMALL_MARGIN = (("stability_margin", 0.001), ("input_weight", 0.001))
@@ -86,7 +91,7 @@ class Settings:
     arm_top: int = 2
     continuation_top: int = 2
     controllers: tuple[str, ...] = ("thesis", "qp", "mpc", "mpc-lookahead")
-    guided: tuple[tuple[str, tuple], ...] = (
+    guided: tuple[tuple[str, tuple[tuple[str, Any], ...]], ...] = (
         ("mpc-plan", (("plan_weight", 0.0),)),
         ("mpc-plan-margin", (("plan_weight", 0.0), *SMALL_MARGIN)),
         ("mpc-plan-arrive", ()),
@@ -135,7 +140,7 @@ class Found:
     wall_s: float = 0.0
     solution: MinimumTime | None = None
 
-    def record(self) -> dict:
+    def record(self) -> dict[str, Any]:
         """JSON-ready summary (no trajectory)."""
         return {
             "best_known_s": self.best_s,
@@ -158,7 +163,7 @@ def start_state(robot: Robot) -> np.ndarray:
 
 def best_known(
     robot: Robot,
-    scenario,
+    scenario: Scenario,
     settings: Settings = Settings(),
     log: Callable[[str], None] | None = None,
 ) -> Found:
@@ -169,9 +174,9 @@ def best_known(
     start = start_state(robot)
     s = settings
 
-    built: dict[tuple, MinimumTimeProblem] = {}
+    built: dict[tuple[int, float, float], MinimumTimeProblem] = {}
 
-    def problem(intervals: int, margin_s: float = 0.0, margin_m: float = 0.0):
+    def problem(intervals: int, margin_s: float = 0.0, margin_m: float = 0.0) -> MinimumTimeProblem:
         key = (intervals, margin_s, margin_m)
         if key not in built:
             built[key] = MinimumTimeProblem(
@@ -201,8 +206,8 @@ def best_known(
 
 def _screened(
     robot: Robot,
-    scenario,
-    waypoints: list,
+    scenario: Scenario,
+    waypoints: list[tuple[float, float]],
     start: np.ndarray,
     coarse: MinimumTimeProblem,
     s: Settings,
@@ -213,7 +218,9 @@ def _screened(
     (:func:`start_state`), ``waypoints`` the scenario's (x, y) in m."""
     screened: dict[str, MinimumTime] = {}
 
-    def screen(label: str, guess: Guess, lbg=None, ubg=None) -> None:
+    def screen(
+        label: str, guess: Guess, lbg: np.ndarray | None = None, ubg: np.ndarray | None = None
+    ) -> None:
         result = coarse.solve(guess, label, lbg, ubg)
         if result.success:
             screened[label] = result
@@ -275,7 +282,7 @@ def _tightened(
     robot: Robot,
     found: tuple[MinimumTime, Replay],
     tight: MinimumTimeProblem,
-    waypoints: list,
+    waypoints: list[tuple[float, float]],
     s: Settings,
     say: Callable[[str], None],
 ) -> tuple[MinimumTime, Replay]:
@@ -324,7 +331,7 @@ def _result(
 def certify(
     robot: Robot,
     refined: dict[str, MinimumTime],
-    waypoints,
+    waypoints: Sequence[Sequence[float]],
     s: Settings,
     problem: Callable[[int, float, float], MinimumTimeProblem],
     say: Callable[[str], None] = lambda message: None,
@@ -355,7 +362,13 @@ def certify(
     return None, s.final
 
 
-def follow_plan(robot: Robot, scenario, found, s: Settings, say=lambda message: None):
+def follow_plan(
+    robot: Robot,
+    scenario: Scenario,
+    found: tuple[MinimumTime, Replay] | None,
+    s: Settings,
+    say: Callable[[str], None] = lambda message: None,
+) -> tuple[MinimumTime, Replay] | None:
     """Step 5: ``found`` (solution, replay) or the fastest run of the plan-following
     ``mpc`` that beats it, following each round's winner in the next round while one
     beats its plan (at most ``s.guided_rounds`` rounds): the closed loop can improve on
@@ -369,12 +382,15 @@ def follow_plan(robot: Robot, scenario, found, s: Settings, say=lambda message: 
         faster = _faster_run(robot, guided, list(scenario.waypoints), s, found)
         if faster is found:
             break
-        say(f"step 5, round {round_}: {faster[1].time_s:.3f} s ({faster[0].start})")
+        # ignore: given a found solution, _faster_run returns one
+        say(f"step 5, round {round_}: {faster[1].time_s:.3f} s ({faster[0].start})")  # type: ignore[index]
         found = faster
     return found
 
 
-def plan_runs(scenario, plan: MinimumTime, s: Settings, payload: float) -> dict[str, Guess]:
+def plan_runs(
+    scenario: Scenario, plan: MinimumTime, s: Settings, payload: float
+) -> dict[str, Guess]:
     """Step 5: the recorded runs of the ``mpc`` with ``lookahead`` following ``plan``
     (one per :data:`Settings.guided` entry; those that did not finish left out)."""
     runs: dict[str, Guess] = {}
@@ -382,7 +398,8 @@ def plan_runs(scenario, plan: MinimumTime, s: Settings, payload: float) -> dict[
         return runs
     with tempfile.TemporaryDirectory() as folder:
         path = Path(folder) / "plan.npz"
-        np.savez(path, **plan.plan_arrays())
+        # ignore: the plan's array names (times, states...) are none of savez's keywords
+        np.savez(path, **plan.plan_arrays())  # type: ignore[arg-type]
         for name, options in s.guided:
             extra = (("plan", str(path)), *options)
             guess = controller_guess(scenario, "mpc-lookahead", payload=payload, options=extra)
@@ -391,7 +408,13 @@ def plan_runs(scenario, plan: MinimumTime, s: Settings, payload: float) -> dict[
     return runs
 
 
-def _faster_run(robot: Robot, runs: dict[str, Guess], waypoints, s: Settings, found):
+def _faster_run(
+    robot: Robot,
+    runs: dict[str, Guess],
+    waypoints: Sequence[Sequence[float]],
+    s: Settings,
+    found: tuple[MinimumTime, Replay] | None,
+) -> tuple[MinimumTime, Replay] | None:
     """``found`` (certified solution, replay), or a controller's recorded run on the thesis
     plant where replaying its wheel forces and joint rates open loop at the run's own step
     (which reproduces the run) passes the same check in less time: the plant did the task
@@ -405,7 +428,9 @@ def _faster_run(robot: Robot, runs: dict[str, Guess], waypoints, s: Settings, fo
     return found
 
 
-def replay_run(robot: Robot, name: str, run: Guess, waypoints, s: Settings):
+def replay_run(
+    robot: Robot, name: str, run: Guess, waypoints: Sequence[Sequence[float]], s: Settings
+) -> tuple[MinimumTime, Replay]:
     """``(solution, replay check)`` of a controller's recorded run
     (:func:`~ddwmmr.bounds.starts.controller_guess`): its wheel forces and joint rates
     replayed open loop on the thesis plant at the run's own step, checked against the
@@ -445,7 +470,7 @@ def _distinct(results: dict[str, MinimumTime], count: int, gap: float = 1e-3) ->
     return chosen
 
 
-def _ranked_patterns(results: dict[str, MinimumTime], patterns) -> list:
+def _ranked_patterns(results: dict[str, MinimumTime], patterns: list[Pattern]) -> list[Pattern]:
     """Patterns in the order of their screened times (converged ones only)."""
     by_label = {p.label: p for p in patterns}
     return [by_label[k] for k in _best(results, len(results)) if k in by_label]

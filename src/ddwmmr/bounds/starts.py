@@ -14,14 +14,19 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.min_time import Guess
+
+if TYPE_CHECKING:
+    from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+    from ddwmmr.scenarios.generator import Scenario
 
 #: Samples of a pattern guess.
 SAMPLES = 600
@@ -71,7 +76,9 @@ def turn_variants(pattern: Pattern) -> list[Pattern]:
     return out
 
 
-def arm_pose(robot: Robot, start_pose: tuple[float, float], elbow: int, arm: str, backwards: bool):
+def arm_pose(
+    robot: Robot, start_pose: tuple[float, float], elbow: int, arm: str, backwards: bool
+) -> tuple[float, float]:
     """Joint angles of a pattern's arm: the start pose on the elbow branch, or stretched
     forwards/backwards (th1 = 0 or pi, a slight bend on the elbow branch)."""
     th1, th2 = start_pose
@@ -84,7 +91,7 @@ def arm_pose(robot: Robot, start_pose: tuple[float, float], elbow: int, arm: str
 
 def pattern_guess(
     robot: Robot,
-    start: Sequence[float],
+    start: Sequence[float] | np.ndarray,
     waypoints: Sequence[tuple[float, float]],
     pattern: Pattern,
     speed: float = 1.0,
@@ -97,8 +104,8 @@ def pattern_guess(
     (rad/s) and the reach the base stops short by (m)."""
     base = np.array(start[:2], dtype=float)
     heading, t = float(start[2]), 0.0
-    knots = [(0.0, base[0], base[1], heading, 0)]
-    arrivals = []
+    knots: list[tuple[float, float, float, float, int]] = [(0.0, base[0], base[1], heading, 0)]
+    arrivals: list[float] = []
     for i, (wx, wy) in enumerate(waypoints):
         delta = np.array([wx, wy]) - base
         direction = math.atan2(delta[1], delta[0])
@@ -115,11 +122,11 @@ def pattern_guess(
         t += distance / speed + 0.5
         knots.append((t, base[0], base[1], heading, i))
         arrivals.append(t)
-    knots = np.array(knots)
+    table = np.array(knots)
     times = np.linspace(0.0, t, SAMPLES)
     states = np.zeros((SAMPLES, sym.NX_FORCE))
     for j, column in enumerate((1, 2, 3)):
-        states[:, j] = np.interp(times, knots[:, 0], knots[:, column])
+        states[:, j] = np.interp(times, table[:, 0], table[:, column])
     leg = np.minimum(np.searchsorted(arrivals, times), len(waypoints) - 1)
     start_pose = (float(start[3]), float(start[4]))
     for i in range(len(waypoints)):
@@ -143,7 +150,14 @@ class RecordingTask:
 
     trajectory = None
 
-    def __init__(self, robot: Robot, plant, waypoints, dt: float, tolerance: float = 0.01):
+    def __init__(
+        self,
+        robot: Robot,
+        plant: Plant,
+        waypoints: Iterable[Sequence[float]],
+        dt: float,
+        tolerance: float = 0.01,
+    ) -> None:
         self.robot, self.plant, self.dt = robot, plant, dt
         self.waypoints = [tuple(w) for w in waypoints]
         self.tolerance = tolerance
@@ -153,10 +167,10 @@ class RecordingTask:
         self.inputs: list[list[float]] = []
         self.arrivals: list[float] = []
 
-    def start(self, obs) -> bool:
+    def start(self, obs: Observation) -> bool:
         return False
 
-    def finished(self, k: int, t: float, obs) -> bool:
+    def finished(self, k: int, t: float, obs: Observation) -> bool:
         xe, ye, _ = self.robot.fk(np.asarray(obs.values))
         while self.index < len(self.waypoints):
             wx, wy = self.waypoints[self.index]
@@ -170,15 +184,25 @@ class RecordingTask:
             self.states.append([*obs.values, obs.v, obs.w])
         return done
 
-    def reference(self, t: float, obs):
+    def reference(self, t: float, obs: Observation) -> tuple[np.ndarray, np.ndarray]:
         wx, wy = self.waypoints[min(self.index, len(self.waypoints) - 1)]
         return np.array([wx, wy, 0.0]), np.zeros(3)
 
-    def record(self, k, t, obs, command, applied, saturated, info, step_ns) -> None:
+    def record(
+        self,
+        k: int,
+        t: float,
+        obs: Observation,
+        command: Any,
+        applied: Any,
+        saturated: bool,
+        info: Any,
+        step_ns: int,
+    ) -> None:
         self.times.append(t)
         self.states.append([*obs.values, obs.v, obs.w])
 
-    def after_step(self, k: int, t: float, obs, applied) -> bool:
+    def after_step(self, k: int, t: float, obs: Observation, applied: Any) -> bool:
         before, after = self.states[-1], obs.values
         left, right = self.plant.extra_values()
         rates = ((after[3] - before[3]) / self.dt, (after[4] - before[4]) / self.dt)
@@ -188,7 +212,7 @@ class RecordingTask:
     def controller_error(self, k: int, error: Exception) -> bool:
         return True
 
-    def diverged(self, k: int, error) -> None:
+    def diverged(self, k: int, error: PlantDivergedError) -> None:
         return None
 
     def guess(self) -> Guess | None:
@@ -204,8 +228,12 @@ class RecordingTask:
 
 
 def controller_guess(
-    scenario, controller: str, payload: float = 3.0, dt: float = 0.01, options: tuple = ()
-):
+    scenario: Scenario,
+    controller: str,
+    payload: float = 3.0,
+    dt: float = 0.01,
+    options: tuple[tuple[str, Any], ...] = (),
+) -> Guess | None:
     """A start from a controller's run of ``scenario`` on the thesis plant (the scenario
     protocol's controllers: ``"thesis"``, ``"competitive"`` (the thesis controller with
     the competitive arbiter), ``"qp"``, ``"mpc"`` or ``"mpc-lookahead"`` (the mpc

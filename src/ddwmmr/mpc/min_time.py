@@ -399,7 +399,7 @@ class FreeTimeOCP:
     def __init__(
         self,
         model: ShootingModel,
-        start: Sequence[float],
+        start: Sequence[float] | np.ndarray,
         ends: Sequence[LegEnd],
         intervals_per_leg: int = 30,
         leg_time_range: tuple[float, float] = LEG_TIME_RANGE,
@@ -565,7 +565,7 @@ class MinimumTimeProblem(FreeTimeOCP):
         self,
         robot: Robot,
         waypoints: Sequence[tuple[float, float]],
-        start: Sequence[float],
+        start: Sequence[float] | np.ndarray,
         dynamics: sym.ThesisDynamics | None = None,
         intervals_per_leg: int = 30,
         stability_min: float = STABILITY_FLOOR,
