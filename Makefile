@@ -46,11 +46,13 @@ USER_TYPED := examples tests/typecheck/user_api.py
 # The library's core, strict on its own code: the robot model, the plants, the simulation
 # loop, the controllers, the resolution kernels, the arbiters, the trajectories, the QP,
 # the behaviours, the reports, the scenarios, the output folders, the command lines, the
-# benchmark, the bounds and every top-level module of the package (same flags and cache).
+# benchmark, the bounds, the mpc and every top-level module of the package (same flags and
+# cache).
 STRICT_CORE := src/ddwmmr/model src/ddwmmr/plants src/ddwmmr/sim src/ddwmmr/controllers \
 	src/ddwmmr/resolution src/ddwmmr/arbiters src/ddwmmr/trajectories src/ddwmmr/qp \
 	src/ddwmmr/behaviours src/ddwmmr/reports src/ddwmmr/scenarios src/ddwmmr/outputs \
-	src/ddwmmr/cli src/ddwmmr/bench src/ddwmmr/bounds $(wildcard src/ddwmmr/*.py)
+	src/ddwmmr/cli src/ddwmmr/bench src/ddwmmr/bounds src/ddwmmr/mpc \
+	$(wildcard src/ddwmmr/*.py)
 
 lint: $(STAMP_TEST)
 	$(BIN)/ruff check $(LINTED)

@@ -49,7 +49,7 @@ def should_brake(
 def braked_velocity(
     dynamics: sym.ThesisDynamics,
     state: np.ndarray,
-    forces: tuple[float, float],
+    forces: tuple[float, float] | np.ndarray,
     dt: float,
 ) -> tuple[float, float]:
     """``(v, w)`` (m/s, rad/s) ``dt`` (s) after the braking ``forces`` (N) from the force

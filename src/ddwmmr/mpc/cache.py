@@ -21,7 +21,7 @@ from ddwmmr.mpc.ocp import OCPConfig, ShootingOCP
 #: scenario, so a worker's scenarios rebuild none. A waypoint OCP with its QP solvers
 #: holds about 12 MB.
 SHARED_OCPS = 8
-_OCPS: OrderedDict[tuple, ShootingOCP] = OrderedDict()
+_OCPS: OrderedDict[tuple[int, Robot, Hashable, OCPConfig], ShootingOCP] = OrderedDict()
 _OCPS_LOCK = threading.Lock()
 
 

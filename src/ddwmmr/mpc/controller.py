@@ -117,6 +117,8 @@ class MPCController:
     #: (``--study-methods mpc`` adds it).
     in_studies = False
 
+    #: The registry name (:func:`register_controller` sets it).
+    name: ClassVar[str]
     #: Options with a closed set of values, for front ends (the app shows a button cycling
     #: through them): option name -> function returning the values.
     option_choices: ClassVar[Mapping[str, Callable[[], list[Any]]]] = {
@@ -154,7 +156,7 @@ class MPCController:
         return self.options.stability_min
 
     @property
-    def obstacles(self) -> list:
+    def obstacles(self) -> list[Circle]:
         """The obstacles (circles) the base keeps clear of (the app draws them)."""
         return list(self.options.obstacles)
 
@@ -297,7 +299,7 @@ class MPCController:
         joint targets ``th + rate dt``), unless ``dt`` was given as an option."""
         self._loop_step = dt
 
-    def reset(self, trajectory: Any, q0: np.ndarray) -> None:
+    def reset(self, trajectory: Any, q0: np.ndarray | Sequence[float]) -> None:
         """Forget warm starts and counters; take the control step (:func:`control_step`).
         ``q0``: the start ``[x, y, phi, th1, th2]``, 5 finite numbers (m, rad)."""
         q0 = check_start(q0)
@@ -353,7 +355,8 @@ class MPCController:
             problem.design_terminal((float(q[3]), float(q[4])))
         x0 = self._state(q, base_velocity)
         references = self._references(problem, t, pose_d, velocity_d, following)
-        cold = self._cold_start(mode, new_target, restart=stuck or frozen)
+        # ignore: the resolved options hold frozen_restart as a bool
+        cold = self._cold_start(mode, new_target, restart=stuck or frozen)  # type: ignore[arg-type]
         warm, source, start, arrival = self._solve_starts(
             problem, x0, target, reach, new_target, cold
         )
@@ -407,8 +410,9 @@ class MPCController:
         if leg is not None and cold:  # the offline plan's leg starts it, not the hand-over
             source = None
         warm = self._warm if not cold or source is not None else None
-        start = None if leg is None or not cold else problem.planned_start(x0, self._plan, leg)
-        arrival = None if leg is None else problem.planned_arrival(self._plan, leg)
+        # ignore: a plan's leg (leg not None) means a plan
+        start = None if leg is None or not cold else problem.planned_start(x0, self._plan, leg)  # type: ignore[arg-type]
+        arrival = None if leg is None else problem.planned_arrival(self._plan, leg)  # type: ignore[arg-type]
         return warm, source, start, arrival
 
     def _watch_plan(
@@ -454,7 +458,12 @@ class MPCController:
         return np.concatenate([q, [float(v), float(w)], lagged])
 
     def _references(
-        self, problem: Problem, t: float, pose_d, velocity_d, following=None
+        self,
+        problem: Problem,
+        t: float,
+        pose_d: np.ndarray,
+        velocity_d: np.ndarray,
+        following: tuple[float, float] | None = None,
     ) -> np.ndarray:
         """Reference poses of nodes 1..N (N, 3); with a ``following`` target (x, y) the
         second leg's nodes aim at it."""
@@ -462,7 +471,7 @@ class MPCController:
         times = ocp.node_times(ocp.config.horizon)[1:]
         if self._trajectory is not None:
             return np.array([self._trajectory.pose(t + tau) for tau in times])
-        references = pose_d[None, :] + times[:, None] * velocity_d[None, :]
+        references: np.ndarray = pose_d[None, :] + times[:, None] * velocity_d[None, :]
         if following is not None:
             references[ocp.split :] = (following[0], following[1], 0.0)
         return references
@@ -486,7 +495,8 @@ class MPCController:
         index = self._on_route(target)
         if index is None or index + 1 >= len(route):
             return None
-        return tuple(route[index + 1])
+        # ignore: MPCOptions holds the route's points as (x, y) pairs
+        return tuple(route[index + 1])  # type: ignore[return-value]
 
     def _plan_leg(self, target: tuple[float, float]) -> int | None:
         """With a ``plan``: the index of its leg that ends at ``target`` (the route's),
@@ -507,7 +517,15 @@ class MPCController:
         )
 
     def _output(
-        self, problem, q, x0, u, w, iterations, slack: float, braking: bool = False
+        self,
+        problem: Problem,
+        q: np.ndarray,
+        x0: np.ndarray,
+        u: np.ndarray,
+        w: np.ndarray,
+        iterations: int,
+        slack: float,
+        braking: bool = False,
     ) -> np.ndarray | WheelForces:
         """The command of plan ``w`` (its first input ``u``), the step's info with the
         plan's ``slack`` (m for the stability rows, m^2 for the obstacle rows,
@@ -531,7 +549,8 @@ class MPCController:
             }
         )
         if ocp.first_edge_loads is not None and not braking:
-            least = float(ocp.first_edge_loads(w, problem.last_parameters).full().min())
+            # ignore: the solve of this step set last_parameters
+            least = float(ocp.first_edge_loads(w, problem.last_parameters).full().min())  # type: ignore[arg-type]
             self.last.extra["min_predicted_edge_load_n"] = least
             if self.min_predicted_edge_load is None or least < self.min_predicted_edge_load:
                 self.min_predicted_edge_load = least
@@ -546,7 +565,13 @@ class MPCController:
         return self._apply(float(u[0]), float(u[1]), r1, r2, q, velocity)
 
     def _apply(
-        self, first: float, second: float, r1: float, r2: float, q, velocity: tuple[float, float]
+        self,
+        first: float,
+        second: float,
+        r1: float,
+        r2: float,
+        q: np.ndarray,
+        velocity: tuple[float, float],
     ) -> np.ndarray | WheelForces:
         """The command ``(first, second, r1, r2)`` as sent (``u``, or wheel forces with
         one-step joint targets from ``q``), remembered for the next step: the input-change
@@ -562,7 +587,15 @@ class MPCController:
             self._predicted_rates = r1 + (old1 - r1) * keep, r2 + (old2 - r2) * keep
         return WheelForces(first, second, float(q[3]) + r1 * self.dt, float(q[4]) + r2 * self.dt)
 
-    def _fallback_command(self, t, q, pose_d, velocity_d, x0, reason: str):
+    def _fallback_command(
+        self,
+        t: float,
+        q: np.ndarray,
+        pose_d: np.ndarray,
+        velocity_d: np.ndarray,
+        x0: np.ndarray,
+        reason: str,
+    ) -> np.ndarray | WheelForces:
         """The ``qp`` command for this step (counted; :mod:`ddwmmr.mpc.fallback`); the
         next step starts cold."""
         self.fallbacks += 1
@@ -586,7 +619,8 @@ class MPCController:
             fallbacks = int(np.sum(commanded_steps(timeseries["fallback"]) > 0))
         else:
             fallbacks = self.fallbacks
-        clearance = run_clearance(self.robot, self.options.obstacles, timeseries)
+        # ignore: MPCOptions turns obstacles into Circles
+        clearance = run_clearance(self.robot, self.options.obstacles, timeseries)  # type: ignore[arg-type]
         mode = "tracking" if self._trajectory is not None else "reach"
         solver = self.options.solver
         return {
@@ -675,7 +709,9 @@ class MPCController:
         return options
 
 
-def warn_start_in_keep_out(robot: Robot, options: MPCOptions, q0: np.ndarray) -> None:
+def warn_start_in_keep_out(
+    robot: Robot, options: MPCOptions, q0: np.ndarray | Sequence[float]
+) -> None:
     """Warn (:class:`UserWarning`, once) when the start ``q0`` (x, y m) puts the base inside
     the keep-out the OCP's obstacle rows hold: its enclosing circle
     (:func:`~ddwmmr.behaviours.obstacle.base_bubble`) less than the robot's
@@ -689,7 +725,7 @@ def warn_start_in_keep_out(robot: Robot, options: MPCOptions, q0: np.ndarray) ->
     margin = options.robot_obstacle_margin(length_unit(robot.L1))
     inside = [
         (math.hypot(q0[0] - c.x, q0[1] - c.y) - c.radius - bubble, number, c)
-        for number, c in enumerate(options.obstacles, start=1)  # type: ignore[arg-type]
+        for number, c in enumerate(options.obstacles, start=1)
     ]
     inside = [entry for entry in inside if entry[0] < margin]
     if not inside:
@@ -766,10 +802,13 @@ def _check_plan_problem(
             )
 
 
-def _model_choice(resolved: MPCOptions, plant: PlantTraits | None) -> tuple:
+def _model_choice(
+    resolved: MPCOptions, plant: PlantTraits | None
+) -> tuple[str, bool | None, float | None, BaseFacts, tuple[float, float] | None]:
     """``(model, dynamic_stability, arm_time_constant, base, joint_acceleration_limit)``:
     what the prediction model is made from (None for no lag, no bound)."""
     model = resolved.model
     base = BaseFacts.of(plant, resolved.wheel_force_limit) if model == "thesis" else BaseFacts()
     lag = resolved.arm_time_constant or None
-    return model, resolved.dynamic_stability, lag, base, resolved.joint_acceleration_limit or None
+    # ignore: resolved options hold the chosen model and the acceleration limit as a pair
+    return model, resolved.dynamic_stability, lag, base, resolved.joint_acceleration_limit or None  # type: ignore[return-value]

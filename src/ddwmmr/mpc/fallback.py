@@ -37,7 +37,7 @@ def make_fallback(
     qp_options: dict[str, Any] = {
         "stability_min": options.stability_min,
         "track_orientation": options.track_orientation and trajectory is not None,
-        "obstacles": list(options.obstacles),  # type: ignore[arg-type]
+        "obstacles": list(options.obstacles),
         "dt": dt,
     }
     if trajectory is None:

@@ -45,6 +45,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import casadi as ca
 import numpy as np
@@ -61,6 +62,9 @@ from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.model.stability import STABILITY_FLOOR, check_stability_floor
 
+if TYPE_CHECKING:
+    import os
+
 #: Points inside each shooting interval where S is checked as well as at the nodes.
 INTERIOR_CHECKS = 3
 #: Leg durations (s) the solver may choose from.
@@ -71,7 +75,7 @@ LEG_TIME_RANGE = (0.05, 120.0)
 PLAN_NAME = "scenario-{:03d}-best.npz"
 PLAN_FOLDER = "cache"
 
-Rows = Callable[..., ca.SX]
+Rows = Callable[..., sym.Symbolic]
 
 
 #: What reading a damaged plan archive raises: EOFError (empty), BadZipFile (truncated,
@@ -226,7 +230,7 @@ class Guess:
 _PLAN_ARRAYS = ("times", "states", "inputs", "legs")
 
 
-def plan_path(folder: str | Path, scenario: int) -> Path:
+def plan_path(folder: str | os.PathLike[str], scenario: int) -> Path:
     """Scenario number ``scenario``'s (from 1) best-known trajectory in the output folder
     of ``python -m ddwmmr.bounds`` (in its ``cache``) or in that cache folder itself; a
     one-line :class:`ParameterError` naming ``folder``, the file expected and how to get
@@ -403,7 +407,7 @@ class FreeTimeOCP:
         ends: Sequence[LegEnd],
         intervals_per_leg: int = 30,
         leg_time_range: tuple[float, float] = LEG_TIME_RANGE,
-        ipopt_options: dict | None = None,
+        ipopt_options: dict[str, Any] | None = None,
     ) -> None:
         intervals_per_leg = check_int_at_least("intervals_per_leg", intervals_per_leg, 2)
         if not ends:
@@ -420,7 +424,7 @@ class FreeTimeOCP:
         self._build(ipopt_options or {})
 
     # -- construction -------------------------------------------------------------------
-    def _build(self, extra: dict) -> None:
+    def _build(self, extra: dict[str, Any]) -> None:
         m, n = self.model, self.n
         nx, nu = m.nx, m.nu
         X = ca.MX.sym("X", nx, n + 1)
@@ -459,7 +463,7 @@ class FreeTimeOCP:
             "f": ca.sum1(T) + regular,
             "g": ca.vertcat(*rows),
         }
-        options = {
+        options: dict[str, Any] = {
             "print_time": False,
             "ipopt.print_level": 0,
             "ipopt.sb": "yes",
@@ -506,7 +510,8 @@ class FreeTimeOCP:
         states[0] = self.start
         inputs = guess.sample(node_times[:-1])[1][:, :nu]
         w0 = np.concatenate([states.ravel(), inputs.ravel(), legs])
-        return np.clip(w0, self.lbw, self.ubw)
+        clipped: np.ndarray = np.clip(w0, self.lbw, self.ubw)
+        return clipped
 
     # -- solve --------------------------------------------------------------------------
     def solve(
@@ -520,7 +525,13 @@ class FreeTimeOCP:
         tolerance for a continuation step; default: the problem's own)."""
         return self._solve(self.initial(guess), label, lbg, ubg)
 
-    def _solve(self, w0, label, lbg=None, ubg=None) -> MinimumTime:
+    def _solve(
+        self,
+        w0: np.ndarray,
+        label: str,
+        lbg: np.ndarray | None = None,
+        ubg: np.ndarray | None = None,
+    ) -> MinimumTime:
         solution = self.solver(
             x0=w0,
             lbx=self.lbw,
@@ -570,7 +581,7 @@ class MinimumTimeProblem(FreeTimeOCP):
         intervals_per_leg: int = 30,
         stability_min: float = STABILITY_FLOOR,
         tolerance: float = 0.01,
-        ipopt_options: dict | None = None,
+        ipopt_options: dict[str, Any] | None = None,
     ) -> None:
         self.robot = robot
         self.dynamics = dynamics or sym.ThesisDynamics.from_robot(robot)
@@ -589,7 +600,7 @@ class MinimumTimeProblem(FreeTimeOCP):
     def _waypoint_end(self, waypoint: tuple[float, float]) -> LegEnd:
         robot = self.robot
 
-        def rows(x):
+        def rows(x: sym.Symbolic) -> sym.Symbolic:
             return ca.sumsqr(sym.forward_kinematics(robot, x[:5])[:2] - ca.DM(waypoint))
 
         return LegEnd(rows, np.zeros(1), np.array([self.tolerance**2]))
@@ -687,7 +698,7 @@ def thesis_model(robot: Robot, dynamics: sym.ThesisDynamics, stability_min: floa
     edges = sym.stability_edges(robot, stability_min)  # None: the rectangle's box
     x_max, y_max = sym.stability_bounds(robot, stability_min) or (np.inf, np.inf)  # or edges
 
-    def held(q):
+    def held(q: sym.Symbolic) -> sym.Symbolic:
         """What the stability rows bound: the centre of mass, or its offset towards each
         edge of the support polygon (m)."""
         com = sym.centre_of_mass(robot, q)
@@ -695,10 +706,10 @@ def thesis_model(robot: Robot, dynamics: sym.ThesisDynamics, stability_min: floa
             return com
         return ca.vertcat(*(n_x * com[0] + n_y * com[1] for n_x, n_y, _, _ in edges))
 
-    def node_rows(x):
+    def node_rows(x: sym.Symbolic) -> sym.Symbolic:
         return ca.vertcat(held(x[:5]), sym.wheel_speeds(robot, x[5], x[6]))
 
-    def interval_rows(x, u, h):
+    def interval_rows(x: sym.Symbolic, u: sym.Symbolic, h: sym.Symbolic) -> sym.Symbolic:
         points = []
         for frac in np.arange(1, INTERIOR_CHECKS + 1) / (INTERIOR_CHECKS + 1):
             moved = ca.vertcat(x[:3], x[3:5] + frac * h * u[2:4])
@@ -761,7 +772,7 @@ def minimum_time(
     waypoints: Sequence[tuple[float, float]],
     start: Sequence[float],
     guesses: dict[str, Guess] | None = None,
-    **options,
+    **options: Any,
 ) -> MinimumTime:
     """Minimum time (s) to take the end effector through ``waypoints`` in order from the
     ``start`` state ``[x, y, phi, th1, th2, v, w]`` under the thesis plant's force limits

@@ -269,15 +269,15 @@ class LaggedArmPrediction(ThesisPrediction):
         tau, start, command = self.tau, x[7:9], u[2:4]
         d = self.dynamics
 
-        def arm(t):
+        def arm(t: Any) -> tuple[Any, Any]:
             decay = ca.exp(-t / tau)
             angles = x[3:5] + command * t + (start - command) * tau * (1.0 - decay)
             return angles, command + (start - command) * decay
 
-        def yaw_rate(angles, rates, momentum):
+        def yaw_rate(angles: Any, rates: Any, momentum: Any) -> Any:
             return (momentum - d.arm_momentum(angles[1], rates)) / d.inertia(angles[1])
 
-        def base_rate(t, b):
+        def base_rate(t: Any, b: Any) -> Any:
             angles, rates = arm(t)
             w = yaw_rate(angles, rates, b[4])
             full = ca.vertcat(b[0], b[1], b[2], angles, b[3], w)

@@ -107,7 +107,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import casadi as ca
 import numpy as np
@@ -125,6 +125,9 @@ from ddwmmr.model.stability import GRAVITY_M_S2, STABILITY_FLOOR, is_longitudina
 from ddwmmr.model.support_loads import DEFAULT_MIN_EDGE_LOAD, EdgeLoadModel
 from ddwmmr.mpc.models import PredictionModel
 from ddwmmr.qp.limits.obstacles import Circle
+
+if TYPE_CHECKING:
+    from ddwmmr.model.support_loads import SupportPolygon
 
 #: Value used for "no bound" in the constraint vectors.
 INF = math.inf
@@ -334,7 +337,9 @@ class ShootingOCP:
         leg = self.config.second_leg_horizon if second is None else second
         return np.concatenate([first, horizon + np.cumsum(self.second_fractions * leg)])
 
-    def _interval(self, nodes: Sequence, k: int, owner: int | None = None):
+    def _interval(
+        self, nodes: Sequence[sym.Symbolic], k: int, owner: int | None = None
+    ) -> sym.Symbolic:
         """Length of interval k: dt for k = 0; fixed (tracking) or a share of ``T - dt``
         (reach, T read from node ``owner``, default k: every node carries the same T), or
         of ``T2`` on a second leg."""
@@ -347,7 +352,9 @@ class ShootingOCP:
             return self.fractions[k - 1] * (node[self.nxm] - self.dt)
         return float(self.lengths[k])
 
-    def _integrate(self, x, u, h, nominal: float):
+    def _integrate(
+        self, x: sym.Symbolic, u: sym.Symbolic, h: sym.Symbolic, nominal: float
+    ) -> sym.Symbolic:
         """The state after h (s) under u: the model's integration (RK4, or its own) in
         equal sub-steps, at most MAX_SUBSTEP long at the interval's nominal length (reach
         mode only shortens intervals)."""
@@ -368,7 +375,7 @@ class ShootingOCP:
             for c in config.obstacles
         ]
         g, lbg, ubg, ng = [], [], [], []
-        self._first_loads: list = []  # the first interval's edge loads (N), both ends
+        self._first_loads: list[sym.Symbolic] = []  # the first interval's edge loads (N), both ends
         for k in range(self.N):
             x_next = self._integrate(xs[k], us[k], self._interval(nodes, k), float(self.lengths[k]))
             # the gap as x_{k+1} - F(x_k, u_k): the only form FATROP's structure detection
@@ -436,7 +443,7 @@ class ShootingOCP:
         self.residual = self._residual(nodes, xs, us, slacks)
         self._bounds_and_linear_cost()
 
-    def _stability_points(self, k: int, x_next) -> list:
+    def _stability_points(self, k: int, x_next: sym.Symbolic) -> list[sym.Symbolic]:
         """The points held in the stability box for stage k: the centre of mass at node
         k+1, and at the last node also that of the pose where the joints, braked at their
         acceleration limit, come to rest."""
@@ -447,7 +454,9 @@ class ShootingOCP:
             points.append(sym.centre_of_mass(robot, stop))
         return points
 
-    def _edge_rows(self, k: int, x_k, x_next, u_k) -> list:
+    def _edge_rows(
+        self, k: int, x_k: sym.Symbolic, x_next: sym.Symbolic, u_k: sym.Symbolic
+    ) -> list[tuple[Any, int, float]]:
         """(dynamic) Each edge's centre-of-pressure distance ``d_e = L_e D_e / W`` (m,
         :func:`ddwmmr.model.symbolic.edge_loads`) at both ends of interval k under u_k,
         as ``(expression, slack index, lower bound min_edge_load D_e)``: the edge's slack
@@ -492,7 +501,9 @@ class ShootingOCP:
             rows += self._edge_load_rows(polygon, loads, weight)
         return rows
 
-    def _edge_load_rows(self, polygon, loads, weight: float) -> list[tuple[Any, int, float]]:
+    def _edge_load_rows(
+        self, polygon: SupportPolygon, loads: sym.Symbolic, weight: float
+    ) -> list[tuple[Any, int, float]]:
         """One ``(expression, slack index, lower bound)`` row per edge of ``polygon``: the
         edge's load ``loads[e]`` (N) scaled by ``depth / weight`` (m, the centre of mass's
         margin it is worth) at least ``min_edge_load * depth``; the slack of the
@@ -528,12 +539,19 @@ class ShootingOCP:
         self.w_lower, self.w_upper = lower, upper
         self.linear_cost = linear
 
-    def _huber_scale(self, error, delta: float | None) -> ca.SX | float:
+    def _huber_scale(self, error: ca.SX, delta: float | None) -> ca.SX | float:
         if delta is None:
             return 1.0
-        return ca.sqrt(2.0 / (1.0 + ca.sqrt(1.0 + ca.sumsqr(error) / delta**2)))
+        scale: ca.SX = ca.sqrt(2.0 / (1.0 + ca.sqrt(1.0 + ca.sumsqr(error) / delta**2)))
+        return scale
 
-    def _residual(self, nodes: Sequence, xs: Sequence, us: Sequence, slacks: Sequence) -> ca.SX:
+    def _residual(
+        self,
+        nodes: Sequence[sym.Symbolic],
+        xs: Sequence[sym.Symbolic],
+        us: Sequence[sym.Symbolic],
+        slacks: Sequence[sym.Symbolic],
+    ) -> ca.SX:
         config, model, robot = self.config, self.model, self.robot
         weights, n, nu = config.weights, self.N, self.num
         refs = ca.reshape(self.p[: 4 * n], 4, n)  # x, y, phi, weight of nodes 1..N
@@ -592,9 +610,10 @@ class ShootingOCP:
                 * self._huber_scale(error, config.huber)
                 * (factor.T @ z)
             )
-        return ca.vertcat(*parts)
+        residual: ca.SX = ca.vertcat(*parts)
+        return residual
 
-    def _reach_cost(self, pose, target, weight: float) -> ca.SX:
+    def _reach_cost(self, pose: sym.Symbolic, target: sym.Symbolic, weight: float) -> ca.SX:
         """The residual of a leg's reach cost at its last node's end-effector ``pose``:
         ``0.5 r^2 = weight huber(|e|) / reach_speed``, ``weight |e| / reach_speed`` seconds
         far from ``target``."""
@@ -602,9 +621,10 @@ class ShootingOCP:
         error = pose[:2] - target[:2]
         delta = config.huber if config.huber is not None else 0.01
         gain = math.sqrt(weight) / math.sqrt(delta * config.reach_speed)
-        return gain * self._huber_scale(error, delta) * error
+        residual: ca.SX = gain * self._huber_scale(error, delta) * error
+        return residual
 
-    def _arrival_cost(self, x) -> ca.SX:
+    def _arrival_cost(self, x: sym.Symbolic) -> ca.SX:
         """The residual of the first leg's last state ``x`` against the arrival state of
         the parameters: ``sqrt(arrival_weight) on [cos phi - cos phi_a, sin phi - sin
         phi_a, x[3:] - x_a[3:]]`` (joint angles, then velocities), ``on`` 1 or 0."""
@@ -612,9 +632,10 @@ class ShootingOCP:
         target, on = self.p[start : start + self.nxm], self.p[start + self.nxm]
         heading = ca.vertcat(ca.cos(x[2]) - ca.cos(target[2]), ca.sin(x[2]) - ca.sin(target[2]))
         error = ca.vertcat(heading, x[3 : self.nxm] - target[3:])
-        return math.sqrt(self.config.arrival_weight) * on * error
+        residual: ca.SX = math.sqrt(self.config.arrival_weight) * on * error
+        return residual
 
-    def _terminal_error(self, x_n, pose, ref) -> ca.SX:
+    def _terminal_error(self, x_n: sym.Symbolic, pose: sym.Symbolic, ref: sym.Symbolic) -> ca.SX:
         """End-effector error in the terminal base frame (and the base velocities)."""
         phi = x_n[2]
         c, s = ca.cos(phi), ca.sin(phi)
@@ -624,7 +645,8 @@ class ShootingOCP:
             parts.append(ca.sin(pose[2] - ref[2]))
         if self.nxm > sym.NQ:
             parts.extend([x_n[5], x_n[6]])
-        return ca.vertcat(*parts)
+        error: ca.SX = ca.vertcat(*parts)
+        return error
 
     # -- numbers per solve ----------------------------------------------------------------
     def parameters(
@@ -790,4 +812,5 @@ def grid_intervals(intervals: int, first: float, horizon: float) -> np.ndarray:
         else:
             high = ratio
     lengths = first * (0.5 * (low + high)) ** np.arange(n)
-    return lengths * (horizon / lengths.sum())
+    scaled: np.ndarray = lengths * (horizon / lengths.sum())
+    return scaled

@@ -112,7 +112,7 @@ class Problem:
 
     def _shifted(
         self, warm: np.ndarray, elapsed: float, x0: np.ndarray, source: ShootingOCP | None = None
-    ) -> tuple:
+    ) -> tuple[np.ndarray, float]:
         """The previous solution moved ``elapsed`` s forward (linear interpolation).
 
         ``source``: the two-leg OCP the solution came from when its first target was just
@@ -142,12 +142,12 @@ class Problem:
 
     def solve(
         self,
-        t,
-        x0,
-        references,
-        u_prev,
-        warm,
-        warm_time,
+        t: float,
+        x0: np.ndarray,
+        references: np.ndarray,
+        u_prev: np.ndarray,
+        warm: np.ndarray | None,
+        warm_time: float,
         source: ShootingOCP | None = None,
         start: tuple[np.ndarray, float] | None = None,
         arrival: np.ndarray | None = None,
@@ -177,7 +177,9 @@ class Problem:
         w = solver.solve(guess, p, lbw, ubw, ocp.lbg, ocp.ubg)
         return w, solver.last_iterations
 
-    def _in_unit(self, x0, references, u_prev) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def _in_unit(
+        self, x0: np.ndarray, references: np.ndarray, u_prev: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The kinematic model's state, references (N, 3) and input with their positions
         (m) and ``v`` (m/s) in the OCP's unit."""
         return (
@@ -186,14 +188,14 @@ class Problem:
             self._inputs_in_unit(u_prev),
         )
 
-    def _states_in_unit(self, states) -> np.ndarray:
+    def _states_in_unit(self, states: np.ndarray) -> np.ndarray:
         """A copy of a state or rows starting with a position (m, references, states) with
         the position in the OCP's unit."""
         states = np.array(states, dtype=float)
         states[..., :2] /= self.unit
         return states
 
-    def _inputs_in_unit(self, inputs) -> np.ndarray:
+    def _inputs_in_unit(self, inputs: np.ndarray) -> np.ndarray:
         """A copy of the kinematic model's input, or of rows of it, with ``v`` (m/s) in the
         OCP's unit."""
         inputs = np.array(inputs, dtype=float)
@@ -235,4 +237,5 @@ def interpolate_rows(times: np.ndarray, rows: np.ndarray, at: np.ndarray) -> np.
     lower = upper - 1
     span = times[upper] - times[lower]
     weight = np.where(span > 0.0, (at - times[lower]) / np.where(span > 0.0, span, 1.0), 0.0)
-    return rows[lower] + weight[:, None] * (rows[upper] - rows[lower])
+    interpolated: np.ndarray = rows[lower] + weight[:, None] * (rows[upper] - rows[lower])
+    return interpolated

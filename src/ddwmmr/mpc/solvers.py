@@ -105,10 +105,12 @@ class QPBuffers:
         self.lba, self.uba, self.lbx, self.ubx = zeros(ng), zeros(ng), zeros(nw), zeros(nw)
         self.step, self.lam_a, self.lam_x = zeros(nw), zeros(ng), zeros(nw)
         self._data, self.evaluate_data = data.buffer()
+        # ignore: CasADi's hints ask for a size its binding reads from the buffer; numpy's
+        # give ndarray the buffer protocol only from Python 3.12
         for i, array in enumerate((self.w, self.p)):
-            self._data.set_arg(i, memoryview(array))
+            self._data.set_arg(i, memoryview(array))  # type: ignore[call-arg, arg-type]
         for i, array in enumerate((self.hessian, self.gradient, self.jacobian, self.g)):
-            self._data.set_res(i, memoryview(array))
+            self._data.set_res(i, memoryview(array))  # type: ignore[call-arg, arg-type]
         self._qp_function = qp
         inputs = {"h": self.hessian, "g": self.gradient, "a": self.jacobian}
         inputs.update(lba=self.lba, uba=self.uba, lbx=self.lbx, ubx=self.ubx)
@@ -117,9 +119,10 @@ class QPBuffers:
         for name, array in inputs.items():
             if qp.nnz_in(name) != array.size:
                 raise ValueError(f"QP input {name}: {qp.nnz_in(name)} nonzeros, data {array.size}")
-        self._qp_inputs = [(qp.index_in(n), memoryview(a)) for n, a in inputs.items()]
+        # ignore: numpy's hints give ndarray the buffer protocol only from Python 3.12
+        self._qp_inputs = [(qp.index_in(n), memoryview(a)) for n, a in inputs.items()]  # type: ignore[arg-type]
         outputs = (("x", self.step), ("lam_a", self.lam_a), ("lam_x", self.lam_x))
-        self._qp_outputs = [(qp.index_out(n), memoryview(a)) for n, a in outputs]
+        self._qp_outputs = [(qp.index_out(n), memoryview(a)) for n, a in outputs]  # type: ignore[arg-type]
         self._last_stats: dict[str, Any] = {}
 
     def solve_qp(self) -> None:
@@ -131,10 +134,11 @@ class QPBuffers:
         the keyword call's do; released, the next call checks out the same memory.
         """
         buffer, solve = self._qp_function.buffer()
+        # ignore: CasADi's hints ask for a size its binding reads from the buffer
         for index, view in self._qp_inputs:
-            buffer.set_arg(index, view)
+            buffer.set_arg(index, view)  # type: ignore[call-arg]
         for index, view in self._qp_outputs:
-            buffer.set_res(index, view)
+            buffer.set_res(index, view)  # type: ignore[call-arg]
         self.step.fill(0.0)
         self.lam_a.fill(0.0)
         self.lam_x.fill(0.0)
@@ -327,11 +331,20 @@ class NLPSolver:
         self._lam_x: np.ndarray | None = None
         self.last_iterations = 0
 
-    def solve(self, w0, p, lbw, ubw, lbg, ubg) -> np.ndarray:
+    def solve(
+        self,
+        w0: np.ndarray,
+        p: np.ndarray,
+        lbw: np.ndarray,
+        ubw: np.ndarray,
+        lbg: np.ndarray,
+        ubg: np.ndarray,
+    ) -> np.ndarray:
         """Solve from the primal guess ``w0``; raises SolverFailure."""
         args = {"x0": w0, "p": p, "lbx": lbw, "ubx": ubw, "lbg": lbg, "ubg": ubg}
         if self._lam_g is not None:
-            args.update(lam_g0=self._lam_g, lam_x0=self._lam_x)
+            # ignore: the solve that sets _lam_g sets _lam_x with it
+            args.update(lam_g0=self._lam_g, lam_x0=self._lam_x)  # type: ignore[arg-type]
         try:
             solution = self._solver(**args)
         except RuntimeError as error:  # CasADi reports solver exceptions this way

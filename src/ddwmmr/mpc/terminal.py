@@ -95,7 +95,8 @@ def design(
     error component of zero weight is left out: module docstring)."""
     # Imported here: python-control (with scipy.signal) takes most of a second to import,
     # which every command-line run would otherwise pay through the method registry.
-    import control
+    # ignore: python-control ships no type hints
+    import control  # type: ignore[import-untyped]
 
     A, B = error_dynamics(robot, model, arm_pose, config.track_orientation)
     nz, nu = B.shape
