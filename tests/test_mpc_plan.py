@@ -55,12 +55,18 @@ ROUTE = [(-0.9, 0.0), (-1.7, 0.0)]
 
 
 def two_leg_controller(folder: Path, turn: float = 0.0, **options) -> MPCController:
-    """The mpc (force model, ``lookahead``) on :data:`ROUTE` with a plan of two legs, 1 s
-    and 3 s, of the base reversing at 0.4 m/s while turning at ``turn`` (rad/s)."""
+    """The mpc (force model, ``lookahead``, the scenarios' 0.01 s step) on :data:`ROUTE`
+    with a plan of two legs, 1 s and 3 s, of the base reversing at 0.4 m/s while turning
+    at ``turn`` (rad/s). Its problems are those of the scenario runs below with the same
+    ``plan_weight``: built once per process, they serve both."""
     arrays = straight_plan(-0.4, turn, duration=4.0, n=40)
     arrays["legs"] = np.array([1.0, 3.0])
     path = str(write_plan(folder / "plan.npz", arrays))
-    return MPCController(ROBOT, model="thesis", lookahead=True, route=ROUTE, plan=path, **options)
+    controller = MPCController(
+        ROBOT, model="thesis", lookahead=True, route=ROUTE, plan=path, dt=0.01, **options
+    )
+    controller.adopt_plant(traits_of(ThesisPlant(ROBOT)))
+    return controller
 
 
 def test_a_stored_plan_loads_with_its_arrival_times_and_samples_its_legs(tmp_path):
@@ -207,11 +213,14 @@ def test_the_cold_start_is_the_plans_leg_on_the_ocps_nodes(tmp_path):
 
 def first_plan(tmp_path: Path, arrays: dict | None) -> tuple[float, float]:
     """The first step's plan toward a waypoint behind the robot, from ``arrays`` as the
-    plan or from the standing guess: its duration T (s) and the heading it ends in (rad)."""
-    options = {"model": "thesis", "route": [BEHIND], "track_orientation": False}
+    plan or from the standing guess: its duration T (s) and the heading it ends in (rad).
+    On the thesis plant at the scenarios' step, as the scenario runs below (whose
+    one-target problems it shares)."""
+    options = {"model": "thesis", "route": [BEHIND], "track_orientation": False, "dt": 0.01}
     if arrays is not None:
         options["plan"] = str(write_plan(tmp_path / "plan.npz", arrays))
     controller = MPCController(ROBOT, **options)
+    controller.adopt_plant(traits_of(ThesisPlant(ROBOT)))
     controller.command(0.0, START, np.array([*BEHIND, 0.0]), np.zeros(3), base_velocity=(0, 0))
     ocp = controller._problem("reach").ocp
     w = np.asarray(controller._warm).ravel()
