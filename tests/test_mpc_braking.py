@@ -11,9 +11,10 @@ from ddwmmr.commands import WheelForces, traits_of
 from ddwmmr.controllers import make_controller
 from ddwmmr.model import symbolic as sym
 from ddwmmr.mpc.braking import BRAKE_SLACK, BRAKE_TIME, braking_input
-from ddwmmr.plants import MujocoPlant, ThesisPlant
+from ddwmmr.plants import ThesisPlant
 from ddwmmr.plants.thesis import ThesisState
 from ddwmmr.scenarios import RunConfig, generate, run_scenario
+from ddwmmr.scenarios.protocol import make_scenario_plant
 
 ROBOT = Robot().with_payload(3.0)
 LIMITS, TAU = (12.8, 33.3), 0.02
@@ -66,8 +67,10 @@ def test_the_braking_step_slows_each_joint_at_its_acceleration_limit():
 
 
 def _physics_mpc(**options):
+    """The mpc on the scenarios' MuJoCo plant (its base damping) at their step: with the
+    default options its problem is scenario 26's below, built once per process."""
     mpc = make_controller("mpc", ROBOT, dt=0.01, **options)
-    mpc.adopt_plant(traits_of(MujocoPlant(ROBOT)))
+    mpc.adopt_plant(traits_of(make_scenario_plant(ROBOT, RunConfig(plant="mujoco"))))
     return mpc
 
 
