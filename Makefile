@@ -3,7 +3,7 @@
 #               main job (writes runs/demo/)
 #   make test   creates .venv, installs with the test extras, runs the suite
 #   make lint   ruff check, ruff format --check, mypy on the user's view of the API and
-#               mypy --strict on the core packages (CI runs make lint test docs-site)
+#               mypy --strict on the whole package (CI runs make lint test docs-site)
 #   make docs-site  the HTML documentation site in site/ (MkDocs, strict; the docs extra)
 PYTHON ?= python3
 VENV := .venv
@@ -43,16 +43,8 @@ LINTED := src tests examples benchmarks docs/*.py
 # them against the package's hints without reporting the package's own code (cache in
 # .venv). About 6 s cold, under 1 s warm.
 USER_TYPED := examples tests/typecheck/user_api.py
-# The library's core, strict on its own code: the robot model, the plants, the simulation
-# loop, the controllers, the resolution kernels, the arbiters, the trajectories, the QP,
-# the behaviours, the reports, the scenarios, the output folders, the command lines, the
-# benchmark, the bounds, the mpc and every top-level module of the package (same flags and
-# cache).
-STRICT_CORE := src/ddwmmr/model src/ddwmmr/plants src/ddwmmr/sim src/ddwmmr/controllers \
-	src/ddwmmr/resolution src/ddwmmr/arbiters src/ddwmmr/trajectories src/ddwmmr/qp \
-	src/ddwmmr/behaviours src/ddwmmr/reports src/ddwmmr/scenarios src/ddwmmr/outputs \
-	src/ddwmmr/cli src/ddwmmr/bench src/ddwmmr/bounds src/ddwmmr/mpc \
-	$(wildcard src/ddwmmr/*.py)
+# The whole package, strict on its own code (same flags and cache).
+STRICT_CORE := src/ddwmmr
 
 lint: $(STAMP_TEST)
 	$(BIN)/ruff check $(LINTED)

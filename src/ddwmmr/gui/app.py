@@ -21,7 +21,7 @@ import textwrap
 import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -61,6 +61,9 @@ from ddwmmr.reports.compare.document import fmt
 from ddwmmr.reports.metrics import METRICS, Metric
 from ddwmmr.sim.verdict import held_limits, lost_support, short_verdict
 from ddwmmr.trajectories import load_trajectory
+
+if TYPE_CHECKING:
+    from matplotlib.widgets import RadioButtons
 
 #: Playback frame and progress poll intervals (ms).
 FRAME_MS = 40
@@ -202,13 +205,16 @@ class App(PanelLayout):
         :data:`MESSAGE_FITS` that holds it; what still overflows the smallest is cut at a
         line end, marked ``...`` (a message names its parameter first)."""
         artist = self.message_text
-        box = artist.axes.bbox
-        renderer = self.figure.canvas.get_renderer()
+        # ignore: the message text sits in its axes
+        box = artist.axes.bbox  # type: ignore[union-attr]
+        # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
+        renderer = self.figure.canvas.get_renderer()  # type: ignore[attr-defined]
 
         def show(lines: list[str]) -> bool:
             artist.set_text(prefix + "\n".join(lines))
             extent = artist.get_window_extent(renderer)
-            return extent.y0 >= box.y0 and extent.x1 <= box.x1
+            fits: bool = extent.y0 >= box.y0 and extent.x1 <= box.x1
+            return fits
 
         for size, chars in MESSAGE_FITS:
             lines = textwrap.wrap(text, chars, break_on_hyphens=False) if text else []
@@ -347,7 +353,7 @@ class App(PanelLayout):
         self._show_geometry()
         self.say(f"trajectory: {target}")
 
-    def _undo_radio(self, buttons, value: str) -> None:
+    def _undo_radio(self, buttons: RadioButtons, value: str) -> None:
         names = [t.get_text() for t in buttons.labels]
         set_radio_silently(buttons, value if value in names else FILE_ENTRY)
 
@@ -403,7 +409,8 @@ class App(PanelLayout):
         method = self.settings.methods[slot]
         for group in self._groups.values():
             group.hide()
-        group = self._option_group(slot, method)
+        # ignore: the edited slot is an active one, which has a method
+        group = self._option_group(slot, method)  # type: ignore[arg-type]
         pages = group.pages
         self._options_page = min(self._options_page, pages - 1)
         shown = group.page(self._options_page)
@@ -512,7 +519,8 @@ class App(PanelLayout):
         settings = self.run_settings or self.settings
         slots = settings.active_slots
         if len(slots) == 1:
-            return [settings.methods[slots[0]]]
+            # ignore: an active slot has a method
+            return [settings.methods[slots[0]]]  # type: ignore[list-item]
         return [f"{SLOTS[s]}-{settings.methods[s]}" for s in slots]
 
     @guarded
@@ -583,7 +591,8 @@ class App(PanelLayout):
         self.results = results
         self._run_stamp = datetime.datetime.now().strftime("%Y%m%d-%H%M%S")
         self.export_dir = None
-        self.view.set_runs(results, self.labels(), self._obstacles(self.run_settings))
+        # ignore: run set run_settings before the worker it takes the results of
+        self.view.set_runs(results, self.labels(), self._obstacles(self.run_settings))  # type: ignore[arg-type]
         self._animate(self._blitting)
         steps = results[0].summary["steps"]
         # The wall time only in a window: a snapshot is a document, the same on every run.
@@ -723,8 +732,9 @@ class App(PanelLayout):
         if self.results is None:
             raise ParameterError("export: no finished run yet (press Run)")
         if self.export_dir is None:
-            settings = self.run_settings
-            names = "-vs-".join(settings.methods[s] for s in settings.active_slots)
+            # ignore: results come with the settings of their run; an active slot has a method
+            settings: Settings = self.run_settings  # type: ignore[assignment]
+            names = "-vs-".join(settings.methods[s] for s in settings.active_slots)  # type: ignore[misc]
             trajectory = Path(settings.trajectory).stem
             root = Path(self.export_field.text.strip() or "runs/gui")
             self.export_dir = export.run_folder(root, f"{names}-{trajectory}-{self._run_stamp}")
@@ -735,7 +745,8 @@ class App(PanelLayout):
         """Export button: timeseries.csv and summary.json (the files `track` writes, with
         the record `python -m ddwmmr.track --rerun` repeats)."""
         folder = self._export_folder()
-        paths = export.write_run_data(folder, self.results, self.labels(), self.run_settings)
+        # ignore: _export_folder refused a missing run (results and run_settings are set)
+        paths = export.write_run_data(folder, self.results, self.labels(), self.run_settings)  # type: ignore[arg-type]
         self.say(f"wrote {len(paths)} files to {folder}")
         return paths
 
@@ -757,7 +768,8 @@ class App(PanelLayout):
         with the optimisers' floor, the base's tilt; the figure a physics ``track`` run
         writes) as ``support_loads.png``, and on the desktop in a window of its own."""
         folder = self._export_folder()
-        written = export.write_support_loads(folder, self.results, self.labels())
+        # ignore: _export_folder refused a missing run (results and run_settings are set)
+        written = export.write_support_loads(folder, self.results, self.labels())  # type: ignore[arg-type]
         if self.interactive:
             self._show_support_loads()
         self.say(f"wrote {', '.join(str(path) for path in written)}")
@@ -771,7 +783,8 @@ class App(PanelLayout):
 
         # pyplot's backend is still the desktop window's (layout.desktop_figure's TkAgg):
         # the reports modules leave it alone, so these figures are Tk windows too.
-        for result, label in zip(self.results, self.labels()):
+        # ignore: called after export_support_loads wrote the run's files
+        for result, label in zip(self.results, self.labels()):  # type: ignore[arg-type]
             if pp.is_physics_run(result):
                 window = plt.figure(
                     figsize=pp.SUPPORT_LOADS_FIGSIZE, num=f"{SUPPORT_LOADS_WINDOW}{label}"
@@ -788,8 +801,9 @@ class App(PanelLayout):
         if self.interactive:  # show the message before the export blocks the window
             self.figure.canvas.draw()
             self.figure.canvas.flush_events()
-        obstacles = self._obstacles(self.run_settings)
-        path = export.write_animation(self.results, self.labels(), obstacles, folder, fmt)
+        # ignore: _export_folder refused a missing run (results and run_settings are set)
+        obstacles = self._obstacles(self.run_settings)  # type: ignore[arg-type]
+        path = export.write_animation(self.results, self.labels(), obstacles, folder, fmt)  # type: ignore[arg-type]
         self.say(f"wrote {path}")
         return path
 

@@ -159,7 +159,8 @@ def run_record(
         integrator=plant_integrator(
             settings.plant, plant_keywords(settings.plant, settings.integrator).get("integrator")
         ),
-        offset=tuple(settings.offset),
+        # ignore: the checked settings hold two numbers (dx, dy)
+        offset=tuple(settings.offset),  # type: ignore[arg-type]
         label=Path(settings.trajectory).stem,
         plant=settings.plant,
     )
@@ -289,7 +290,8 @@ def _use_packaged_ffmpeg() -> None:
     if rcParams["animation.ffmpeg_path"] != "ffmpeg":
         return
     try:
-        import imageio_ffmpeg
+        # ignore: imageio-ffmpeg ships no type hints
+        import imageio_ffmpeg  # type: ignore[import-untyped]
     except ImportError:
         return
     try:
@@ -361,14 +363,16 @@ def _blitted_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterat
     for artist in view.dynamic_artists(legends=False):
         artist.set_animated(True)
     canvas.draw()
-    background = canvas.copy_from_bbox(figure.bbox)
+    # ignore (here and below): animation_figure gives the figure an Agg canvas, which has
+    # the blitting and buffer methods the base class lacks
+    background = canvas.copy_from_bbox(figure.bbox)  # type: ignore[attr-defined]
     size = canvas.get_width_height()
     for index in indices:
         view.show_index(index)
-        canvas.restore_region(background)
+        canvas.restore_region(background)  # type: ignore[attr-defined]
         for artist in view.dynamic_artists(legends=False):
             figure.draw_artist(artist)
-        yield Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert(
+        yield Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert(  # type: ignore[attr-defined]
             "RGB"
         )
 

@@ -24,7 +24,13 @@ from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.trajectories import available_trajectories
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+    from pathlib import Path
+
     from matplotlib.figure import Figure
+    from matplotlib.text import Text
+
+    from ddwmmr.gui.settings import Settings
 
 #: Window size (inches) and resolution of the window and its snapshot.
 FIGSIZE = (16.0, 10.0)
@@ -46,8 +52,38 @@ PAYLOAD_RANGE = (0.0, 5.0)
 class PanelLayout:
     """Builds the window's widgets (mixed into :class:`ddwmmr.gui.app.App`)."""
 
-    figure: Any
-    settings: Any
+    figure: Figure
+    settings: Settings
+
+    if TYPE_CHECKING:  # the handlers, defined by App
+
+        def _report(self, text: str) -> None: ...
+        def _withdraw(self, text: str) -> None: ...
+        def _on_trajectory(self, label: str) -> None: ...
+        def _apply_file(self, text: str) -> str: ...
+        def _apply_geometry(self, name: str, text: str) -> str: ...
+        def _on_method(self, slot: int, label: str) -> None: ...
+        def _on_plant(self, label: str) -> None: ...
+        def _on_integrator(self, label: str) -> None: ...
+        def _apply_options_slot(self, slot_name: str) -> None: ...
+        def _apply_options_page(self, page: int) -> None: ...
+        def _on_payload(self, value: float) -> None: ...
+        def _apply_dt(self, text: str) -> str: ...
+        def _apply_duration(self, text: str) -> str: ...
+        def _apply_offset(self, text: str) -> str: ...
+        def _apply_export_dir(self, text: str) -> str: ...
+        def _apply_option(self, slot: int, spec: OptionSpec, value: Any) -> None: ...
+        def _apply_option_text(self, slot: int, spec: OptionSpec, text: str) -> str: ...
+        def export_data(self) -> list[Path]: ...
+        def export_png(self) -> Path: ...
+        def export_support_loads(self) -> list[Path]: ...
+        def export_animation(self, fmt: str = "gif") -> Path: ...
+        def run(self) -> None: ...
+        def pause(self) -> None: ...
+        def step(self) -> None: ...
+        def reset(self) -> None: ...
+        def _on_speed(self, position: float) -> None: ...
+        def _on_time_slider(self, fraction: float) -> None: ...
 
     def _build(self) -> None:
         fig = self.figure
@@ -74,7 +110,7 @@ class PanelLayout:
             self.time_slider,
         ]
 
-    def _heading(self, x: float, y: float, text: str):
+    def _heading(self, x: float, y: float, text: str) -> Text:
         return self.figure.text(x, y, text, fontsize=FONT + 1.5, weight="bold", color="0.15")
 
     def _build_trajectory(self) -> None:
@@ -82,7 +118,8 @@ class PanelLayout:
         names = [*available_trajectories(), FILE_ENTRY]
         height = min(0.026 * len(names), 0.16)
         self.traj_radio = radio(self.figure, (0.008, 0.935 - height, 0.12, height), names, 0)
-        self.traj_radio.on_clicked(self._on_trajectory)
+        # ignore: a radio button hands its label (matplotlib hints None too, for none active)
+        self.traj_radio.on_clicked(self._on_trajectory)  # type: ignore[arg-type]
         self.file_field = Field(
             self.figure,
             (0.032, 0.905 - height, 0.128, 0.024),
@@ -131,14 +168,16 @@ class PanelLayout:
         plants = plant_names()
         height = 0.026 * len(plants)
         self.plant_radio = radio(self.figure, (0.232, top - height, 0.1, height), plants, 0)
-        self.plant_radio.on_clicked(self._on_plant)
+        # ignore: a radio button hands its label (matplotlib hints None too, for none active)
+        self.plant_radio.on_clicked(self._on_plant)  # type: ignore[arg-type]
         below = top - height - 0.02
         self._heading(0.235, below, "Integrator")
         height = 0.026 * len(INTEGRATORS)
         self.integrator_radio = radio(
             self.figure, (0.232, below - 0.008 - height, 0.1, height), list(INTEGRATORS), 0
         )
-        self.integrator_radio.on_clicked(self._on_integrator)
+        # ignore: a radio button hands its label (matplotlib hints None too, for none active)
+        self.integrator_radio.on_clicked(self._on_integrator)  # type: ignore[arg-type]
         self._methods_bottom = min(top - height_b, below - 0.008 - height)
 
     def _build_options(self) -> None:
@@ -236,7 +275,7 @@ class PanelLayout:
         # leave room for the physics runs' support-load panel
         places = {"data": (0.012, 0.07), "png": (0.086, 0.07), "gif": (0.16, 0.045)}
         places.update(mp4=(0.209, 0.045), loads=(0.258, 0.07))
-        actions = {
+        actions: dict[str, tuple[str, Callable[[], object]]] = {
             "data": ("CSV + JSON", self.export_data),
             "png": ("PNG (window)", self.export_png),
             "gif": ("GIF", functools.partial(self.export_animation, "gif")),
@@ -375,5 +414,6 @@ def desktop_figure() -> Figure:
     # whatever backend matplotlib would pick by itself (Qt where it is installed).
     plt.switch_backend("TkAgg")
     figure = plt.figure(figsize=FIGSIZE, dpi=dpi / max(ratio, 1e-3))
-    figure.canvas.manager.set_window_title("ddwmmr simulator")
+    # ignore: a pyplot figure has a window manager
+    figure.canvas.manager.set_window_title("ddwmmr simulator")  # type: ignore[union-attr]
     return figure

@@ -203,10 +203,11 @@ def geometry_of(trajectory: Any) -> dict[str, float]:
     return values
 
 
-def check_geometry(name: str, value: float) -> float | int:
-    """Validate one geometry value: the signs of :data:`GEOMETRY`, then the documented caps
-    of :mod:`ddwmmr.errors` the parametric trajectories enforce, so that a sampled
-    trajectory placed by the same numbers is refused with a message naming the value."""
+def check_geometry(name: str, value: Any) -> float | int:
+    """Validate one geometry value (any input: text is refused naming the allowed range):
+    the signs of :data:`GEOMETRY`, then the documented caps of :mod:`ddwmmr.errors` the
+    parametric trajectories enforce, so that a sampled trajectory placed by the same
+    numbers is refused with a message naming the value."""
     if name == "N":
         return check_int_at_least("N", value, 2, MAX_TRAJECTORY_SAMPLES)
     return check_geometry_value(name, value)
@@ -233,7 +234,8 @@ def build_trajectory(settings: Settings) -> Any:
         raise ParameterError(
             f"{unknown[0] if unknown else 'geometry'}: not a parameter of {settings.trajectory}"
         )
-    return dataclasses.replace(base, **changes)
+    # ignore: changes holds numbers for the shape's own numeric fields (checked above)
+    return dataclasses.replace(base, **changes)  # type: ignore[arg-type]
 
 
 def place_samples(base: SampledTrajectory, geometry: Mapping[str, float]) -> SampledTrajectory:
@@ -274,7 +276,10 @@ def build_robot(settings: Settings) -> Robot:
 def build_controller(settings: Settings, slot: int) -> Any:
     """The controller of slot ``slot``, built by :func:`make_controller`."""
     return make_controller(
-        settings.methods[slot], build_robot(settings), **dict(settings.options[slot])
+        # ignore: the slots built are active ones, which have a method
+        settings.methods[slot],  # type: ignore[arg-type]
+        build_robot(settings),
+        **dict(settings.options[slot]),
     )
 
 
@@ -371,7 +376,9 @@ def simulate_settings(
                 duration=settings.duration,
                 initial_offset=tuple(settings.offset),
                 progress=report,
-                **plant_keywords(settings.plant, settings.integrator),
+                # ignore: plant_keywords gives plant= and integrator= only (mypy matches
+                # the dict against every keyword, plant_options included)
+                **plant_keywords(settings.plant, settings.integrator),  # type: ignore[arg-type]
             )
         )
     return results

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -23,6 +23,9 @@ from matplotlib.ticker import NullFormatter
 
 from ddwmmr.reports.legends import place_legend
 from ddwmmr.reports.plots import ERROR_FLOOR, robot_outline, wheel_outlines
+
+if TYPE_CHECKING:
+    from ddwmmr.gui.widgets import Rect
 
 #: Plot axes of the view, top to bottom: key -> y-axis label.
 PLOTS = {
@@ -142,9 +145,11 @@ class RunView:
         """Where the top view's legend starts (axes fraction, negative: under the axes):
         0.07 below, or lower if the tick labels and the x label reach further down (a
         short axes, as in the exported animation), so that the legend never covers them."""
-        renderer = self.path_ax.figure.canvas.get_renderer()
-        bottom = self.path_ax.xaxis.get_tightbbox(renderer).y0
-        reached = self.path_ax.transAxes.inverted().transform((0.0, bottom))[1]
+        # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
+        renderer = self.path_ax.figure.canvas.get_renderer()  # type: ignore[attr-defined]
+        # ignore: the x axis is shown, so it has a box
+        bottom = self.path_ax.xaxis.get_tightbbox(renderer).y0  # type: ignore[union-attr]
+        reached: float = self.path_ax.transAxes.inverted().transform((0.0, bottom))[1]
         return min(-0.07, reached - 0.01)
 
     def dynamic_artists(self, legends: bool = True) -> list[Any]:
@@ -291,7 +296,7 @@ class RunView:
         run = _RunArtists(
             result, label, ee_trail, base_trail, footprint, wheels, heading, arm, payload
         )
-        style = {"color": color, "lw": PLOT_WIDTHS[number]}
+        style: dict[str, Any] = {"color": color, "lw": PLOT_WIDTHS[number]}
         plot = self.plot_axes
         run.lines["position"] = plot["position"].plot([], [], label=label, **style)
         # Colours name the runs in the position legend; the other plots use the same ones.
@@ -346,7 +351,8 @@ class RunView:
         x_low, x_high = float(np.min(xs)) - margin, float(np.max(xs)) + margin
         y_low, y_high = float(np.min(ys)) - margin, float(np.max(ys)) + margin
         box = ax.get_position(original=True)
-        width_in, height_in = ax.figure.get_size_inches()
+        # ignore: the view's axes sit on a Figure (no SubFigure)
+        width_in, height_in = ax.figure.get_size_inches()  # type: ignore[union-attr]
         shape = (box.width * width_in) / (box.height * height_in)  # width / height
         x_span, y_span = x_high - x_low, y_high - y_low
         if x_span / y_span < shape:
@@ -396,7 +402,9 @@ def plotted_series(ts: dict[str, np.ndarray], k: int) -> dict[str, list[np.ndarr
     }
 
 
-def add_view_axes(figure: Figure, path_rect: Sequence[float], plots_rect: Sequence[float]):
+def add_view_axes(
+    figure: Figure, path_rect: Rect, plots_rect: Rect
+) -> tuple[Axes, dict[str, Axes]]:
     """Create the path axes and the stacked plot axes in the given figure rectangles.
 
     Rectangles are ``(left, bottom, width, height)`` in figure fractions. Returns

@@ -31,9 +31,11 @@ FONT = 8
 #: Callback receiving an error message to show in the window (``report``), or one to
 #: take back if the window still shows it (``withdraw``).
 Reporter = Callable[[str], None]
+#: A rectangle ``(left, bottom, width, height)`` in figure fractions.
+Rect = tuple[float, float, float, float]
 
 
-def panel_axes(figure: Figure, rect: Sequence[float]) -> Axes:
+def panel_axes(figure: Figure, rect: Rect) -> Axes:
     """A bare axes at ``rect`` (left, bottom, width, height in figure fractions)."""
     ax = figure.add_axes(rect)
     ax.set_navigate(False)
@@ -56,12 +58,15 @@ class QuietTextBox(TextBox):
 
     def _rendercursor(self) -> None:  # overrides matplotlib's cursor redraw
         canvas = self.ax.figure.canvas
-        if self.ax.figure._get_renderer() is None:
-            super()._rendercursor()
+        # ignore: _get_renderer and _rendercursor are matplotlib's private methods (not
+        # in its type hints)
+        if self.ax.figure._get_renderer() is None:  # type: ignore[union-attr]
+            super()._rendercursor()  # type: ignore[misc]
             return
-        canvas.draw = canvas.draw_idle  # the typed key shows at the next idle redraw
+        # ignore: an instance attribute hides the method until deleted below
+        canvas.draw = canvas.draw_idle  # type: ignore[method-assign]
         try:
-            super()._rendercursor()
+            super()._rendercursor()  # type: ignore[misc]
         finally:
             del canvas.draw
 
@@ -107,7 +112,7 @@ class Field(ErrorOwner):
     def __init__(
         self,
         figure: Figure,
-        rect: Sequence[float],
+        rect: Rect,
         label: str,
         text: str,
         apply: Callable[[str], str | None],
@@ -188,7 +193,7 @@ class CycleButton(ErrorOwner):
     def __init__(
         self,
         figure: Figure,
-        rect: Sequence[float],
+        rect: Rect,
         name: str,
         values: Sequence[Any],
         current: Any,
@@ -234,9 +239,7 @@ class CycleButton(ErrorOwner):
         return f"{self.name}: {self.format_value(value)}"
 
 
-def radio(
-    figure: Figure, rect: Sequence[float], labels: Sequence[str], active: int
-) -> RadioButtons:
+def radio(figure: Figure, rect: Rect, labels: Sequence[str], active: int) -> RadioButtons:
     """Vertical radio buttons with panel-size labels and no frame."""
     ax = panel_axes(figure, rect)
     ax.set_frame_on(False)
@@ -255,7 +258,7 @@ def set_radio_silently(buttons: RadioButtons, label: str) -> None:
         buttons.eventson = events
 
 
-def button(figure: Figure, rect: Sequence[float], label: str, action: Callable[[], None]) -> Button:
+def button(figure: Figure, rect: Rect, label: str, action: Callable[[], object]) -> Button:
     """A push button calling ``action()`` when clicked."""
     widget = Button(panel_axes(figure, rect), label, color="0.88", hovercolor="0.97")
     widget.label.set_fontsize(FONT + 1)
@@ -268,14 +271,17 @@ def wrap_to_width(text: str, artist: Text, right: float, indent: str = "    ") -
     figure text), end left of the figure fraction ``right``; continuation lines are
     indented. Lines of ``text`` are wrapped one by one; a piece wider than the room on
     its own keeps a line of its own."""
-    figure = artist.get_figure()
-    renderer = figure.canvas.get_renderer()
+    # ignore: the artist is a figure text (of the window's Figure)
+    figure: Figure = artist.get_figure()  # type: ignore[assignment]
+    # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
+    renderer = figure.canvas.get_renderer()  # type: ignore[attr-defined]
     font = artist.get_fontproperties()
     left = artist.get_transform().transform(artist.get_position())[0]
     room = right * figure.bbox.width - left
 
     def width(candidate: str) -> float:
-        return renderer.get_text_width_height_descent(candidate, font, ismath=False)[0]
+        extent: float = renderer.get_text_width_height_descent(candidate, font, ismath=False)[0]
+        return extent
 
     wrapped: list[str] = []
     for line in text.split("\n"):
