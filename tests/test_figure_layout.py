@@ -335,8 +335,8 @@ def test_gui_view_shows_both_runs_and_no_legend_on_them():
 
 def test_gui_animation_frames_show_both_runs():
     """The figure of the GUI's GIF/MP4 export (the view alone) at six instants."""
-    from ddwmmr.gui.export import frame_indices
     from ddwmmr.gui.view import animation_figure
+    from ddwmmr.reports.canvas import frame_indices
 
     trajectory = load_trajectory("ellipse")
     results = [simulate(None, trajectory, m, duration=10.0) for m in ("qp", "ap")]

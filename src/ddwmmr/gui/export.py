@@ -47,6 +47,7 @@ from ddwmmr.outputs import (
     unwritable_message,
     write_new,
 )
+from ddwmmr.reports.canvas import frame_indices
 from ddwmmr.sim.simulate import plant_integrator
 from ddwmmr.trajectories import SampledTrajectory
 from ddwmmr.trajectories.files import SHAPES, find_trajectory_file, is_name
@@ -375,9 +376,3 @@ def _blitted_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterat
         yield Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert(  # type: ignore[attr-defined]
             "RGB"
         )
-
-
-def frame_indices(last: int, frames: int) -> list[int]:
-    """Up to ``frames`` distinct recorded indices from 0 to ``last``, evenly spread."""
-    count = max(min(frames, last + 1), 1)
-    return sorted({round(last * i / max(count - 1, 1)) for i in range(count)})

@@ -31,6 +31,14 @@ def new_figure(figsize: tuple[float, float], **kwargs: Any) -> Figure:
     return fig
 
 
+def frame_indices(last: int, frames: int) -> list[int]:
+    """Up to ``frames`` distinct recorded indices from 0 to ``last``, evenly spread, both
+    ends included: every index when there are no more than ``frames`` of them (a short
+    run's animation shows each recorded instant once instead of repeating them)."""
+    count = max(min(frames, last + 1), 1)
+    return sorted({round(last * i / max(count - 1, 1)) for i in range(count)})
+
+
 def save_gif(
     fig: Figure,
     update: Callable[[int], object],

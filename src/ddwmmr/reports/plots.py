@@ -31,7 +31,7 @@ from matplotlib.patches import Circle
 from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.reports import palette
-from ddwmmr.reports.canvas import new_figure, save_gif
+from ddwmmr.reports.canvas import frame_indices, new_figure, save_gif
 from ddwmmr.reports.legends import legend_beside, place_legend
 
 if TYPE_CHECKING:
@@ -481,7 +481,8 @@ def save_animation(
     obstacles: Obstacles = None,
     progress: bool = False,
 ) -> Path:
-    """Write a GIF of the robot following the trajectory (``frames`` evenly spaced);
+    """Write a GIF of the robot following the trajectory: ``frames`` evenly spaced
+    recorded instants (every instant of a run with fewer), ``fps`` per second;
     ``progress`` shows the encoding on stderr (:mod:`ddwmmr.progress`)."""
     from ddwmmr.progress import ProgressBar
 
@@ -504,7 +505,7 @@ def save_animation(
     (trace,) = ax.plot([], [], color="tab:blue", lw=1.2)
     (footprint,) = ax.plot([], [], color="0.3")
     (arm,) = ax.plot([], [], color="tab:orange", lw=2, marker="o", ms=3)
-    indices = np.linspace(0, len(q) - 1, frames).astype(int)
+    indices = frame_indices(len(q) - 1, frames)
 
     def update(frame: int) -> tuple[Line2D, Line2D, Line2D]:
         k = indices[frame]
