@@ -136,6 +136,23 @@ def test_simulate_arguments(call, match):
     _refused(call, match)
 
 
+@pytest.mark.parametrize(
+    "offset", [np.array(0.01), {0: 0.01, 1: 0.02}, [[0.01, 0.02]], (0.01, 0.02, 0.0), "ab"]
+)
+def test_initial_offset_must_be_a_pair(offset):
+    # a 0-d array raised a TypeError, a mapping ran from its keys (0, 1) m
+    _refused(
+        lambda: simulate(Robot(), Ellipse(), "pi", duration=0.1, initial_offset=offset),
+        "initial_offset must be two numbers dx, dy in m",
+    )
+
+
+def test_initial_offset_takes_numpy_pairs():
+    pair = simulate(Robot(), Ellipse(), "pi", duration=0.1, initial_offset=(-0.02, 0.01))
+    array = simulate(Robot(), Ellipse(), "pi", duration=0.1, initial_offset=np.array([-0.02, 0.01]))
+    assert pair.summary["initial_offset_m"] == array.summary["initial_offset_m"]
+
+
 @pytest.mark.parametrize("make", [lambda: 10**5000, lambda: 10**400, lambda: "x" * 500])
 def test_messages_stay_one_short_line_for_huge_values(make):
     from ddwmmr.errors import check_positive

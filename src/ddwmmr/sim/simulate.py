@@ -25,6 +25,7 @@ from ddwmmr.errors import (
     check_positive,
     check_range,
     check_step_count,
+    float_values,
     name_of,
     shown,
 )
@@ -335,13 +336,12 @@ def _start_pose(
     if q0 is None:
         if initial_offset is None:
             initial_offset = default_offset(robot)
-        if isinstance(initial_offset, str) or not hasattr(initial_offset, "__len__"):
+        values = float_values(initial_offset, 2)  # a 0-d array, a mapping: no pair
+        if values is None:
             raise ParameterError(
                 f"initial_offset must be two numbers dx, dy in m (got {shown(initial_offset)})"
             )
-        offset = tuple(check_finite("initial_offset", v) for v in initial_offset)
-        if len(offset) != 2:
-            raise ParameterError(f"initial_offset must be two numbers dx, dy in m (got {offset})")
+        offset = tuple(check_finite("initial_offset", v) for v in values)
         q = initial_configuration(robot, reference, offset)
     else:
         q = np.array(check_configuration(q0))
