@@ -94,6 +94,24 @@ def test_a_record_of_other_waypoint_count_is_refused(tmp_path):
         controller_for(folder, seed=0)
 
 
+@pytest.mark.parametrize(
+    ("field", "value", "match"),
+    [
+        ("payload", float("nan"), r"made for a payload of nan kg"),
+        ("waypoints", [[float("nan"), 0.0]] + [[0.0, 0.0]] * 4, r"waypoint 1 is \(nan, 0\) m"),
+    ],
+)
+def test_a_record_holding_nan_is_refused(tmp_path, field, value, match):
+    # NaN compared False with the tolerances: the plan was followed unchecked
+    folder = bounds_folder(tmp_path)
+    record = folder / PLAN_FOLDER / "scenario-001-best.json"
+    data = json.loads(record.read_text())
+    data["key"][field] = value
+    record.write_text(json.dumps(data))
+    with pytest.raises(ParameterError, match=match):
+        controller_for(folder, seed=0)
+
+
 def test_the_scenario_tool_refuses_another_seeds_plan_in_one_line(tmp_path, capsys):
     from ddwmmr.cli.scenarios import main
 

@@ -782,7 +782,9 @@ def _check_plan_problem(
     made for and what differs, unless that is ``route`` (m; the scenario's waypoints in a
     scenario run) and ``payload`` (kg)."""
     advice = "a bounds run of the same seed and payload makes the matching plans"
-    if abs(problem.payload - payload) > PLAN_PAYLOAD_TOLERANCE_KG:
+    # "not within" rather than "beyond": a record holding NaN (damaged, edited) matches
+    # no problem, and NaN compares False either way
+    if not abs(problem.payload - payload) <= PLAN_PAYLOAD_TOLERANCE_KG:
         raise ParameterError(
             f"plan {path} was made for a payload of {problem.payload:g} kg "
             f"({problem.source}), the robot carries {payload:g} kg: {advice}"
@@ -794,7 +796,7 @@ def _check_plan_problem(
             f"(the scenario's) has {len(route)}: {advice}"
         )
     for number, (made, wanted) in enumerate(zip(waypoints, route, strict=True), start=1):
-        if math.dist(made, wanted) > PLAN_WAYPOINT_TOLERANCE_M:
+        if not math.dist(made, wanted) <= PLAN_WAYPOINT_TOLERANCE_M:
             raise ParameterError(
                 f"plan {path} was made for other waypoints than the route's (the "
                 f"scenario's): waypoint {number} is ({made[0]:.6g}, {made[1]:.6g}) m in "
