@@ -102,6 +102,11 @@ def test_a_solutions_stored_arrays_load_back_as_its_trajectory(tmp_path):
         ({"legs": np.array([3.0, 0.0])}, r"legs \(> 0 s\)"),
         ({"times": np.linspace(3.0, 0.0, 31)}, "times .* increasing"),
         ({"inputs": np.full((30, 4), np.nan)}, "all finite"),
+        # a shifted plan and legs of another length than the times loaded, to be followed
+        # against arrivals the trajectory does not have
+        ({"times": np.linspace(5.0, 8.0, 31)}, "times .* increasing from 0"),
+        ({"legs": np.array([1.5])}, r"legs \(> 0 s\) summing to the last time"),
+        ({"legs": np.array([2.0, 2.0])}, r"legs \(> 0 s\) summing to the last time"),
     ],
 )
 def test_a_bad_plan_file_is_a_one_line_error(tmp_path, change, match):

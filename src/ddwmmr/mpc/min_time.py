@@ -150,10 +150,11 @@ class Guess:
     def load(cls, path: str | Path, nx: int = sym.NX_FORCE, nu: int = sym.NU_FORCE) -> Guess:
         """A trajectory stored as ``python -m ddwmmr.bounds`` stores its best-known ones
         (``.npz``: ``times`` (M+1,) s increasing from 0, ``states`` (M+1, nx), ``inputs``
-        (M, nu) held from each time, ``legs`` (one duration per waypoint, s, > 0)); a
-        one-line :class:`ParameterError` naming the file for anything else, a file that
-        cannot be read as such an archive (empty, truncated, damaged, a single ``.npy``
-        array, pickled data, a member that is not a numeric array, a folder) included."""
+        (M, nu) held from each time, ``legs`` (one duration per waypoint, s, > 0, summing
+        to the last time)); a one-line :class:`ParameterError` naming the file for anything
+        else, a file that cannot be read as such an archive (empty, truncated, damaged, a
+        single ``.npy`` array, pickled data, a member that is not a numeric array, a
+        folder) included."""
         if Path(path).is_dir():
             raise ParameterError(
                 f"plan {path} must be a .npz file, not a folder (only the scenario tool's "
@@ -192,10 +193,14 @@ class Guess:
             and len(legs) >= 1
         )
         finite = shapes_ok and all(np.all(np.isfinite(a)) for a in arrays.values())
-        if not (finite and np.all(np.diff(times) > 0.0) and np.all(legs > 0.0)):
+        # the legs end where the times do: the arrivals (their sums) are read against the
+        # times, a plan shifted or with legs of another length would be followed wrong
+        timed = finite and times[0] == 0.0 and np.all(np.diff(times) > 0.0)
+        ends = timed and math.isclose(float(np.sum(legs)), float(times[-1]), rel_tol=1e-9)
+        if not (ends and np.all(legs > 0.0)):
             raise ParameterError(
-                f"plan {path} must hold times (M+1,) increasing, states (M+1, {nx}), "
-                f"inputs (M, {nu}) and legs (> 0 s), all finite"
+                f"plan {path} must hold times (M+1,) increasing from 0, states (M+1, {nx}), "
+                f"inputs (M, {nu}) and legs (> 0 s) summing to the last time, all finite"
             )
         return cls(times, states, inputs, np.cumsum(legs))
 
