@@ -404,6 +404,33 @@ def test_rerun_of_a_damaged_record_is_one_line(
 
 
 @pytest.mark.parametrize(
+    ("parameters", "message"),
+    [
+        ("x", "trajectory.parameters must be a table of the ellipse's parameters (x0, y0, "),
+        ([1, 2], "trajectory.parameters must be a table of the ellipse's parameters (x0, y0, "),
+        ({"zz": 1}, "trajectory.parameters: unknown key 'zz' (known: x0, y0, a, b, "),
+    ],
+)
+def test_rerun_of_bad_trajectory_parameters_names_them(
+    recorded_run, tmp_path, capsys, parameters, message
+):
+    """They were the class's TypeError ("Ellipse() argument after ** must be a mapping",
+    "got an unexpected keyword argument 'zz'") in the line."""
+    damaged = json.loads(json.dumps(recorded_run))
+    trajectory = damaged["run"]["trajectory"]
+    if isinstance(parameters, dict):
+        trajectory["parameters"].update(parameters)
+    else:
+        trajectory["parameters"] = parameters
+    path = tmp_path / "summary.json"
+    path.write_text(json.dumps(damaged))
+    assert run(["--rerun", str(path), "--no-progress", "--out", str(tmp_path / "o")]) == 2
+    error = capsys.readouterr().err.strip().splitlines()
+    assert len(error) == 1 and error[0].startswith(f"error: rerun: {path}: {message}"), error
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["summary.json"]
+
+
+@pytest.mark.parametrize(
     ("field", "value", "message"),
     [
         ("method", "nope", "method: unknown method 'nope' (tracking: pi, ats, ap, "),

@@ -335,6 +335,26 @@ def trajectory_from_record(record: dict[str, Any]) -> Any:
     return trajectory
 
 
+def _shape_from_record(kind: str, parameters: Any) -> Any:
+    """The ``kind`` (a key of ``SHAPES``) a record's ``trajectory.parameters`` describe;
+    a value that is no table, or a key the shape does not have, is a one-line
+    :class:`ParameterError` naming ``trajectory.parameters`` (not the ``TypeError`` the
+    class would raise)."""
+    shape = SHAPES[kind]
+    known = [f.name for f in dataclasses.fields(shape)]
+    if not isinstance(parameters, dict):
+        raise ParameterError(
+            f"trajectory.parameters must be a table of the {kind}'s parameters "
+            f"({', '.join(known)}) (got {shown(parameters)})"
+        )
+    unknown = sorted(set(parameters) - set(known), key=str)
+    if unknown:
+        raise ParameterError(
+            f"trajectory.parameters: unknown key {shown(unknown[0])} (known: {', '.join(known)})"
+        )
+    return shape(**parameters)
+
+
 def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Path | None, str | None]:
     """``(trajectory, file, note)``: the trajectory a :func:`trajectory_record` describes,
     its file (the one its samples were read from; a parametric one's as recorded, as it is
@@ -361,7 +381,7 @@ def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Path | None, st
     if kind in SHAPES:
         source = record.get("file")
         file = Path(source) if isinstance(source, str) and source else None
-        return SHAPES[kind](**decode(record["parameters"])), file, None
+        return _shape_from_record(kind, decode(record["parameters"])), file, None
     if kind != "samples":
         raise ParameterError(f"cannot rebuild a trajectory of type {shown(kind)}")
     path = Path(_recorded_file(record))
