@@ -155,6 +155,24 @@ def test_a_summary_without_seed_and_payload_is_one_line(tmp_path, record):
         read_bounds_file(path, 0, 3.0)
 
 
+@pytest.mark.parametrize(
+    ("record", "seed", "recorded"),
+    [
+        ({"seed": "0", "payload": 3.0}, 0, "seed '0', payload 3.0 kg"),
+        ({"seed": True, "payload": 3.0}, 1, "seed True, payload 3.0 kg"),
+    ],
+)
+def test_a_summary_recording_no_number_is_refused_quoting_it(tmp_path, record, seed, recorded):
+    """A seed "0" read 'is for seed 0, payload 3.0 kg, not seed 0, payload 3 kg'; a seed
+    true was taken for seed 1."""
+    path = tmp_path / "bounds.csv"
+    path.write_text(BOUNDS_CSV)
+    (tmp_path / "summary.json").write_text(json.dumps(record))
+    with pytest.raises(ParameterError) as error:
+        read_bounds_file(path, seed, 3.0)
+    assert str(error.value) == (f"bounds: {path} is for {recorded}, not seed {seed}, payload 3 kg")
+
+
 def test_a_matching_lower_only_bounds_file_still_reads(tmp_path):
     path = tmp_path / "bounds.csv"
     path.write_text(BOUNDS_CSV)

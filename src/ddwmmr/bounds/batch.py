@@ -475,10 +475,13 @@ def read_bounds_file(path: str | Path, seed: int, payload: float) -> dict[int, t
             f"bounds: {record} records no seed and payload (a bounds run's summary.json "
             f"does; the one beside {path.name} must be its)"
         )
-    if summary.get("seed") != seed or summary.get("payload") != payload:
+    recorded = summary["seed"], summary["payload"]
+    # a boolean equals 0 or 1 and a string prints as the number it spells: neither is the
+    # record of a seed or payload, and the message quotes a string
+    if any(isinstance(value, bool | str) for value in recorded) or recorded != (seed, payload):
         raise ParameterError(
-            f"bounds: {path} is for seed {summary.get('seed')}, payload "
-            f"{summary.get('payload')} kg, not seed {seed}, payload {payload:g} kg"
+            f"bounds: {path} is for seed {shown(recorded[0])}, payload "
+            f"{shown(recorded[1])} kg, not seed {seed}, payload {payload:g} kg"
         )
     return table
 
