@@ -240,7 +240,9 @@ def simulate(
         dt: control/integration step (s); default ``duration / samples`` of the trajectory
             (its resolution N), or duration / 1000, rounded to a whole multiple of the
             plant's engine ``timestep`` if it has one.
-        duration: simulated time (s); default one trajectory period.
+        duration: simulated time (s); default one trajectory period. The run takes the
+            nearest whole number of steps ``dt`` (at least one; 0.5 s at dt = 0.3 s runs
+            0.6 s), and the summary's ``duration`` and ``steps`` record what it ran.
         integrator: ``"rk4"`` (default) or ``"euler"``; the kinematic plant's integrator
             (the other plants integrate their own dynamics and take no integrator).
         initial_offset: end-effector offset (dx, dy) in m in the end effector's start frame
