@@ -884,6 +884,15 @@ def test_a_bounds_file_the_csv_reader_gives_up_on_is_one_line(tmp_path):
             "waypoints must be a non-empty list of (x, y) pairs in m (got 'abc')",
         ),
         ({"waypoints": []}, "waypoints must be a non-empty list of (x, y) pairs in m (got [])"),
+        # sets have no order: the waypoints' (and a pair's x and y) were the set's
+        (
+            {"waypoints": {(1.0, 0.0)}},
+            "waypoints must be a non-empty list of (x, y) pairs in m (got {(1.0, 0.0)})",
+        ),
+        (
+            {"waypoints": [frozenset({1.0, 0.5})]},
+            "waypoints[1] must be an (x, y) pair of numbers in m (got frozenset({0.5, 1.0}))",
+        ),
         (
             {"waypoints": [(1.0, 0.0), (1, 2, 3)]},
             "waypoints[2] must be an (x, y) pair of numbers in m (got (1, 2, 3))",

@@ -401,10 +401,11 @@ def _leg_costs(
 
 def _items(name: str, value: Any, wanted: str, size: int | None = None) -> tuple[Any, ...]:
     """The items of the list ``value`` (``size`` of them, if given); text, a mapping, a
-    non-iterable or another length raises :class:`ParameterError` saying ``name`` must be
-    ``wanted``."""
+    set (no order: waypoints in the order a set iterates, an (x, y) pair read as (y, x)),
+    a non-iterable or another length raises :class:`ParameterError` saying ``name`` must
+    be ``wanted``."""
     refused = ParameterError(f"{name} must be {wanted} (got {shown(value, 60)})")
-    if isinstance(value, str | bytes | dict):
+    if isinstance(value, str | bytes | dict | set | frozenset):
         raise refused
     try:
         items = tuple(value)
