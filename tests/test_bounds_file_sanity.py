@@ -6,8 +6,11 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from ddwmmr.bounds.batch import read_bounds, read_bounds_file
 from ddwmmr.cli.scenarios import main as cli
+from ddwmmr.errors import ParameterError
 
 HEADER = "scenario,lower_bound_s,best_known_s,replay_ok"
 
@@ -86,3 +89,24 @@ def test_a_fifo_or_a_device_as_bounds_file_is_refused_in_one_line(tmp_path):
     wide.write_text(HEADER + "\n1,10,12,True\n", encoding="utf-16")
     with pytest.raises(ParameterError, match=r"is not UTF-8 text \(byte 0xff at offset 0\)"):
         read_bounds(wide)
+
+
+def test_a_column_read_twice_or_a_row_longer_than_the_header_is_refused(tmp_path):
+    """The csv module read the last of two scenario columns (scenario 2 for a row of 1,
+    then "covers none of the run's scenario 1") and put the fields beyond the header
+    under a key None, ignored."""
+    twice = tmp_path / "twice.csv"
+    twice.write_text("scenario,scenario,lower_bound_s,best_known_s,replay_ok\n1,2,10,12,True\n")
+    with pytest.raises(ParameterError) as error:
+        read_bounds(twice)
+    assert str(error.value) == (
+        f"bounds: {twice} has the column scenario more than once (a bounds.csv of python -m "
+        "ddwmmr.bounds has each once)"
+    )
+    longer = tmp_path / "longer.csv"
+    longer.write_text(f"{HEADER}\n1,10,12,True,7\n")
+    with pytest.raises(ParameterError) as error:
+        read_bounds(longer)
+    assert str(error.value) == (
+        f"bounds: {longer} line 2 has more fields than the header has columns"
+    )

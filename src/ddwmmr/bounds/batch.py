@@ -348,12 +348,13 @@ def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
     an end it has not computed, e.g. the best-known times of a ``--lower-only`` run), and
     the best-known time of a row whose replay failed (``replay_ok`` False; that column is
     then not read). Refused with a one-line :class:`ParameterError` naming the file, the
-    line (and scenario) and the column: a file without one of :data:`READ_COLUMNS`; a
-    scenario that is not a whole number in 1..``MAX_SCENARIOS`` or appears twice; a
-    ``replay_ok`` other than True or False; a time that is neither ``nan`` nor a number of
-    seconds in :data:`~ddwmmr.errors.DURATION_RANGE_S` (0, negative, inf, 1e-300); a
-    best-known time below the lower bound of its row (a lower bound is at most any time
-    achieved). A UTF-8 byte-order mark (a spreadsheet's "CSV UTF-8") is read as none.
+    line (and scenario) and the column: a file without one of :data:`READ_COLUMNS` or
+    with one twice; a row with more fields than the header; a scenario that is not a whole
+    number in 1..``MAX_SCENARIOS`` or appears twice; a ``replay_ok`` other than True or
+    False; a time that is neither ``nan`` nor a number of seconds in
+    :data:`~ddwmmr.errors.DURATION_RANGE_S` (0, negative, inf, 1e-300); a best-known time
+    below the lower bound of its row (a lower bound is at most any time achieved). A UTF-8
+    byte-order mark (a spreadsheet's "CSV UTF-8") is read as none.
     """
     out = {}
     # read_text_file refuses a FIFO or a device (which would block) and text that is not
@@ -367,8 +368,16 @@ def read_bounds(path: str | Path) -> dict[int, tuple[float, float]]:
             f"{', '.join(missing)} (a bounds.csv of python -m ddwmmr.bounds has "
             f"{', '.join(READ_COLUMNS)})"
         )
+    twice = sorted({c for c in READ_COLUMNS if list(reader.fieldnames or ()).count(c) > 1})
+    if twice:  # the csv module reads the last of them, silently
+        raise ParameterError(
+            f"bounds: {path} has the column{'s' * (len(twice) > 1)} {', '.join(twice)} "
+            "more than once (a bounds.csv of python -m ddwmmr.bounds has each once)"
+        )
     for r in reader:
         where = f"bounds: {path} line {reader.line_num}"
+        if None in r:  # the csv module's key of the fields beyond the header's
+            raise ParameterError(f"{where} has more fields than the header has columns")
         scenario = _bounds_scenario(where, r)
         if scenario in out:
             raise ParameterError(f"{where}: scenario {scenario} appears twice")
