@@ -435,7 +435,7 @@ def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, An
                 f"option: the scenarios set {name} themselves ({PROTOCOL_OPTIONS[name]}; got "
                 f"{text!r})"
             )
-    options = parse_options(args.controller, texts)
+    options = parse_options(args.controller, texts, unlisted=PROTOCOL_OPTIONS)
     if isinstance(options.get("plan"), str) and options["plan"]:  # "" is refused later
         options["plan"] = os.path.abspath(options["plan"])
     return tuple((name, tuple(v) if isinstance(v, list) else v) for name, v in options.items())

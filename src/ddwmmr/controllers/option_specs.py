@@ -15,7 +15,7 @@ from __future__ import annotations
 import inspect
 import math
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from dataclasses import dataclass
 from functools import cache
 from typing import Any
@@ -288,19 +288,25 @@ def option_names(method: str) -> tuple[str, ...]:
     return tuple(spec.name for spec in _specs(method, unlisted))
 
 
-def parse_option(method: str, text: str, what: str = "option") -> tuple[str, Any]:
+def parse_option(
+    method: str, text: str, what: str = "option", unlisted: Collection[str] = ()
+) -> tuple[str, Any]:
     """``NAME=VALUE`` -> (name, value) for ``method``, parsed as the simulator's field
     for that option parses it. A text without ``=`` or a name the method does not take (the
-    message lists the names it takes, and the closest one) is a one-line
-    :class:`ParameterError` starting with ``what`` (the command-line option); a bad choice
-    one naming the option. A number option's text that is no number comes back as a
-    :class:`~ddwmmr.controllers.base.NumberText` for ``make_controller`` to refuse."""
+    message lists the names it takes but ``unlisted``, those a front end sets itself, and
+    the closest of all, which may be one of those: their own message then says what sets
+    it) is a one-line :class:`ParameterError` starting with ``what`` (the
+    command-line option); a bad choice one naming the option. A number option's text that
+    is no number comes back as a :class:`~ddwmmr.controllers.base.NumberText` for
+    ``make_controller`` to refuse."""
     name, value = split_option(text, what)
     specs = {spec.name: spec for spec in option_specs(method)}
     if name not in specs:
-        known = ", ".join(specs) or "none"
+        offered = [known for known in specs if known not in unlisted]
+        listed = ", ".join(offered) or "none"
         raise ParameterError(
-            f"{what}: {method} has no option {name!r}{did_you_mean(name, specs)} (options: {known})"
+            f"{what}: {method} has no option {name!r}{did_you_mean(name, specs)} "
+            f"(options: {listed})"
         )
     return name, parse_typed(specs[name], value, what)
 
@@ -334,12 +340,14 @@ def split_option(text: str, what: str = "option") -> tuple[str, str]:
     return name, value
 
 
-def parse_options(method: str, texts: Sequence[str] | None, what: str = "option") -> dict[str, Any]:
+def parse_options(
+    method: str, texts: Sequence[str] | None, what: str = "option", unlisted: Collection[str] = ()
+) -> dict[str, Any]:
     """``{name: value}`` of several ``NAME=VALUE`` texts for ``method`` (see
     :func:`parse_option`); a name given twice is refused."""
     options: dict[str, Any] = {}
     for text in texts or ():
-        name, value = parse_option(method, text, what)
+        name, value = parse_option(method, text, what, unlisted)
         if name in options:
             raise ParameterError(f"{what}: {name} given twice (got {shown(text)})")
         options[name] = value
