@@ -227,7 +227,7 @@ def format_comparison(report: dict[str, Any], previous: dict[str, Any]) -> str:
         if old:
             lines.append(
                 f"  {row['label']:<14} {old['step_us']:>8.2f} -> {row['step_us']:>8.2f} us "
-                f"({row['step_us'] / old['step_us']:.2f}x)"
+                f"({_ratio(row['step_us'], old['step_us'])})"
             )
     old_classes = {e["name"]: e for e in previous.get("qp_classes", []) if "rows" in e}
     for entry in report.get("qp_classes", []):
@@ -236,7 +236,7 @@ def format_comparison(report: dict[str, Any], previous: dict[str, Any]) -> str:
             new_us, old_us = entry["rows"]["qp"]["median_us"], old["rows"]["qp"]["median_us"]
             lines.append(
                 f"  qp, {entry['name']:<20} {old_us:>8.2f} -> {new_us:>8.2f} us "
-                f"({new_us / old_us:.2f}x)"
+                f"({_ratio(new_us, old_us)})"
             )
     old_scenarios = {row["controller"]: row for row in previous.get("scenarios", [])}
     for row in report.get("scenarios", []):
@@ -248,9 +248,23 @@ def format_comparison(report: dict[str, Any], previous: dict[str, Any]) -> str:
             )
             lines.append(
                 f"  scenarios, {row['controller']:<14} {old_rate:>8.0f} -> {new_rate:>8.0f} "
-                f"simulated s per wall s ({new_rate / old_rate:.2f}x)"
+                f"simulated s per wall s ({_ratio(new_rate, old_rate)})"
             )
     return "\n".join(lines)
+
+
+def _ratio(new: float, old: float) -> str:
+    """``new / old`` (both > 0) as ``1.23x``; a ratio beyond floats (an edited report's
+    tiny or huge number) as ``>1e308x`` or ``<1e-308x`` instead of ``infx`` or ``0.00x``."""
+    try:
+        ratio = new / old
+    except OverflowError:  # integers beyond float
+        ratio = math.inf
+    if ratio == math.inf:
+        return ">1e308x"
+    if ratio == 0.0:  # both are > 0: the quotient underflowed
+        return "<1e-308x"
+    return f"{ratio:.2f}x"
 
 
 def format_source(config: dict[str, Any]) -> str:
@@ -336,10 +350,12 @@ def _positive_number(value: Any) -> bool:
 
 def _entries_problem(data: dict[str, Any], key: str, fields: dict[str, str]) -> str | None:
     """What is wrong with ``data[key]`` as a list of objects with ``fields`` (name ->
-    "text" or "number"; a number must be finite and > 0); None if nothing."""
+    "text" or "number"; a number must be finite and > 0; the first field, the entry's name,
+    given once: a comparison looks entries up by it); None if nothing."""
     entries = data.get(key, [])
     if not isinstance(entries, list):
         return f'"{key}" must be a list (got {_type_name(entries)})'
+    names: set[str] = set()
     for i, entry in enumerate(entries):
         if not isinstance(entry, dict):
             return f'"{key}"[{i}] must be an object (got {_type_name(entry)})'
@@ -350,6 +366,10 @@ def _entries_problem(data: dict[str, Any], key: str, fields: dict[str, str]) -> 
             if kind == "number" and not _positive_number(value):
                 got = shown(value) if isinstance(value, int | float) else _type_name(value)
                 return f'"{key}"[{i}].{name} must be a number > 0 (got {got})'
+        name = next(iter(fields))
+        if entry[name] in names:
+            return f'"{key}"[{i}].{name} {shown(entry[name])} is given twice'
+        names.add(entry[name])
     return None
 
 
