@@ -29,7 +29,7 @@ import time
 from collections.abc import Iterator
 from typing import TextIO
 
-from tqdm import tqdm  # type: ignore[import-untyped]  # tqdm ships no hints
+from tqdm import tqdm  # tqdm ships no hints
 
 #: Seconds between the progress lines of a long phase when stderr is not a terminal.
 LOG_INTERVAL_S = 30.0

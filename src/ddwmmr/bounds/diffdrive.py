@@ -37,7 +37,7 @@ import casadi as ca
 import numpy as np
 
 # ignore: scipy ships no type hints (no scipy-stubs in the environment)
-from scipy.optimize import minimize  # type: ignore[import-untyped]
+from scipy.optimize import minimize
 
 from ddwmmr.mpc.min_time import FreeTimeOCP, Guess, LegEnd, ShootingModel
 

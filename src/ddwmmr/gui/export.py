@@ -292,7 +292,7 @@ def _use_packaged_ffmpeg() -> None:
         return
     try:
         # ignore: imageio-ffmpeg ships no type hints
-        import imageio_ffmpeg  # type: ignore[import-untyped]
+        import imageio_ffmpeg
     except ImportError:
         return
     try:

@@ -96,7 +96,7 @@ def design(
     # Imported here: python-control (with scipy.signal) takes most of a second to import,
     # which every command-line run would otherwise pay through the method registry.
     # ignore: python-control ships no type hints
-    import control  # type: ignore[import-untyped]
+    import control
 
     A, B = error_dynamics(robot, model, arm_pose, config.track_orientation)
     nz, nu = B.shape

@@ -39,7 +39,7 @@ PLANAR_AXES = [True, True, False, False, False, False]
 def unavailable_reason() -> str | None:
     """Why the reference cannot run here (None when it can): the benchmark's skip reason."""
     try:
-        import roboticstoolbox  # type: ignore[import-not-found]  # noqa: F401
+        import roboticstoolbox  # noqa: F401
     except ImportError as exc:
         return (
             f"roboticstoolbox-python is not installed ({exc.name or exc}); "

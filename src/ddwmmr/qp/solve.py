@@ -92,7 +92,7 @@ class DaqpBackend:
     name = "daqp"
 
     def __init__(self, warm_start: bool = False) -> None:
-        import daqp  # type: ignore[import-not-found]  # local: only this backend needs it
+        import daqp  # local: only this backend needs it
 
         # daqp.solve (a compiled module, no hints): (x, fval, exitflag, info)
         self._solve: Callable[..., tuple[np.ndarray, float, int, dict[str, Any]]] = daqp.solve
@@ -161,7 +161,7 @@ class QpsolversBackend:
         """Convert to ``G x <= h, A x = b`` (finite sides only) and solve."""
         P, q, G, h, A, b = to_standard_form(problem)
         if self.sparse:
-            from scipy import sparse  # type: ignore[import-untyped]
+            from scipy import sparse
 
             P, G, A = sparse.csc_matrix(P), sparse.csc_matrix(G), sparse.csc_matrix(A)
         initvals = self._previous if self.warm_start else None

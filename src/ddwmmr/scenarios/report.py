@@ -69,7 +69,7 @@ def t_quantile_95(dof: int) -> float:
     check_int_at_least("dof", dof, 1)
     # Imported here: scipy.special takes about 0.3 s to import, paid only by a summary
     # of two or more scenarios.
-    from scipy.special import stdtrit  # type: ignore[import-untyped]
+    from scipy.special import stdtrit
 
     return float(stdtrit(dof, 0.975))
 

@@ -24,7 +24,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
 # python-control ships no type hints (no py.typed): its objects are Any to mypy
-import control  # type: ignore[import-untyped]
+import control
 import numpy as np
 
 from ddwmmr.errors import (

@@ -52,7 +52,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
 # mujoco ships no type hints (no py.typed): its objects are Any to mypy
-import mujoco  # type: ignore[import-untyped]
+import mujoco
 import numpy as np
 
 from ddwmmr.errors import ParameterError, check_positive, check_range, shown

@@ -28,7 +28,7 @@ from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
 # mujoco ships no type hints (no py.typed): its objects are Any to mypy
-import mujoco  # type: ignore[import-untyped]
+import mujoco
 import numpy as np
 
 from ddwmmr.commands import VELOCITY, WheelForces
