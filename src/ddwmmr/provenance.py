@@ -40,7 +40,14 @@ from ddwmmr.controllers.base import method_options
 from ddwmmr.errors import ParameterError, one_line, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import package_version
-from ddwmmr.trajectories.files import SHAPES, file_sha256, is_name, package_folder
+from ddwmmr.trajectories.files import (
+    SHAPES,
+    check_shape_keys,
+    file_sha256,
+    is_name,
+    package_folder,
+    shape_keys,
+)
 from ddwmmr.trajectories.sampled import SampledTrajectory, read_csv
 from ddwmmr.trajectories.scaled import ScaledTrajectory, check_scale
 
@@ -340,19 +347,13 @@ def _shape_from_record(kind: str, parameters: Any) -> Any:
     a value that is no table, or a key the shape does not have, is a one-line
     :class:`ParameterError` naming ``trajectory.parameters`` (not the ``TypeError`` the
     class would raise)."""
-    shape = SHAPES[kind]
-    known = [f.name for f in dataclasses.fields(shape)]
     if not isinstance(parameters, dict):
         raise ParameterError(
             f"trajectory.parameters must be a table of the {kind}'s parameters "
-            f"({', '.join(known)}) (got {shown(parameters)})"
+            f"({', '.join(shape_keys(kind))}) (got {shown(parameters)})"
         )
-    unknown = sorted(set(parameters) - set(known), key=str)
-    if unknown:
-        raise ParameterError(
-            f"trajectory.parameters: unknown key {shown(unknown[0])} (known: {', '.join(known)})"
-        )
-    return shape(**parameters)
+    check_shape_keys("trajectory.parameters", kind, parameters)
+    return SHAPES[kind](**parameters)
 
 
 def read_trajectory_record(record: dict[str, Any]) -> tuple[Any, Path | None, str | None]:

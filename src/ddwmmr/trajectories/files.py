@@ -220,7 +220,7 @@ def read_toml(path: str | Path, **overrides: Any) -> Ellipse | Rectangle:
     if "shape" in overrides:
         _refuse_shape_override(f"traj: {path}", shape, "the file", overrides["shape"])
     table.update(overrides)
-    known = [f.name for f in fields(SHAPES[shape])]
+    known = shape_keys(shape)
     unknown = sorted(set(table) - set(known))
     if unknown:
         raise ParameterError(
@@ -252,14 +252,26 @@ def _check_overrides(name: str, overrides: dict[str, Any]) -> None:
     where = f"traj: {name}"
     if "shape" in overrides:
         _refuse_shape_override(where, name, "the name", overrides["shape"])
-    known = [f.name for f in fields(SHAPES[name])]
-    unknown = sorted(set(overrides) - set(known))
+    check_shape_keys(where, name, overrides)
+    if "phi" in overrides and overrides.get("orientation", "tangent") == "tangent":
+        raise ParameterError(f"{where}: {PHI_NEEDS_CONSTANT}")
+
+
+def shape_keys(shape: str) -> list[str]:
+    """The keyword arguments (parameters) of the built-in shape named ``shape``."""
+    return [f.name for f in fields(SHAPES[shape])]
+
+
+def check_shape_keys(where: str, shape: str, keys: Iterable[Any]) -> None:
+    """Refuse a key the built-in ``shape`` does not take: one line, ``{where}: unknown key
+    K (known: ...)``, the first unknown key in sorted order (rather than the class's
+    ``TypeError``)."""
+    known = shape_keys(shape)
+    unknown = sorted(set(keys) - set(known), key=str)
     if unknown:
         raise ParameterError(
             f"{where}: unknown key {shown(unknown[0])} (known: {', '.join(known)})"
         )
-    if "phi" in overrides and overrides.get("orientation", "tangent") == "tangent":
-        raise ParameterError(f"{where}: {PHI_NEEDS_CONSTANT}")
 
 
 def _check_types(path: Path, table: dict[str, Any]) -> None:
