@@ -162,8 +162,7 @@ def _main(argv: Sequence[str] | None = None) -> int:
         raise ParameterError(f"--jobs: only used with --scenarios N >= 1 ({given})")
     # Everything that can be checked is checked before a minute-long run.
     previous = read_report(args.compare) if args.compare is not None else None
-    # ignore: --out has a default, so given_text returns a str
-    out = Path(given_text("out", args.out, "a report file"))  # type: ignore[arg-type]
+    out = Path(given_text("out", args.out, "a report file"))
     check_out(out, force=args.force)
     check_duration(Ellipse(), args.duration)
     probe_out(out)

@@ -31,7 +31,7 @@ import threading
 import warnings
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn, overload
 
 from ddwmmr import interrupts
 from ddwmmr.cli.signals import EXIT_INTERRUPTED, EXIT_TERMINATED, STOP_SIGNALS, say, stop_line
@@ -184,6 +184,10 @@ def split_names(values: Sequence[str] | None, option: str) -> list[str]:
     return list(dict.fromkeys(items))
 
 
+@overload
+def given_text(option: str, value: str, what: str, empty: str = "path") -> str: ...
+@overload
+def given_text(option: str, value: None, what: str, empty: str = "path") -> None: ...
 def given_text(option: str, value: str | None, what: str, empty: str = "path") -> str | None:
     """``value`` unless it is an empty (or blank) text, which is refused as ``option: give
     <what> (got an empty <empty>)``: ``--out "$DIR"`` with ``DIR`` unset must not mean the
@@ -654,8 +658,7 @@ def output_target(given: str | None, default: Callable[[], Path]) -> tuple[Path,
     name from ``base`` if fresh, else ``base``). The folder written is ``out.with_name(
     writer.path.name)``: a fresh writer takes the next free name when it commits."""
     fresh = given is None
-    # ignore: given is a str when not fresh (given_text passes it through)
-    base = default() if fresh else Path(given_text("out", given, "an output folder"))  # type: ignore[arg-type]
+    base = default() if given is None else Path(given_text("out", given, "an output folder"))
     return base, (first_free(base, folder=True) if fresh else base), fresh
 
 
