@@ -24,7 +24,8 @@ from ddwmmr.bench import PHASES, REFERENCE_LABEL, TOOL, format_table
 from ddwmmr.bench.report import format_source
 from ddwmmr.sim.result import write_atomic
 
-#: The simulate-throughput target of issue 14 (steps/s of a closed-form method's full run).
+#: The simulate-throughput target, steps/s of a closed-form method's full run
+#: (docs/api.md, "Benchmark").
 RUN_TARGET = 60_000
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,6 +1,6 @@
-"""Where a scenario step's cost goes, and the floor under issue 14's target 3.
+"""Where a scenario step's cost goes, and the floor under the throughput target.
 
-Target 3 asks the thesis benchmark's scenarios to run at twice the simulated seconds per
+The target asks the thesis benchmark's scenarios to run at twice the simulated seconds per
 wall second of commit 1145cc2, for the thesis controller and for ``qp``. This script
 measures how much of a scenario step is the controller and the plant themselves, so the
 target can be judged against what any loop would have to pay. It runs the first N

@@ -1,4 +1,4 @@
-"""``python -m ddwmmr.compare`` options of issue 8: --only, and the install split."""
+"""``python -m ddwmmr.compare`` options: --only, and the install split."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """Bad input to every tool (track, compare, scenarios, bench): one line, exit 2, nothing
 written.
 
-A table of the cases issue 8 found (absurd sizes, broken files, FIFOs, output paths,
+A table of the cases a bad-input review found (absurd sizes, broken files, FIFOs, output paths,
 trajectory names with ``..``, wrong TOML types) plus property tests over invalid numbers.
 Tools run in-process through their ``main(argv)``; the working folder is a fresh
 temporary folder whose content must not change. (A read-only output folder: see

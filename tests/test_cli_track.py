@@ -229,7 +229,7 @@ def test_help_explains_methods():
         assert word in process.stdout
 
 
-# -- reproducibility: summary.json records the run, --rerun repeats it (issue 8) ----------
+# -- reproducibility: summary.json records the run, --rerun repeats it ----------------------
 def _rows_without_timing(path):
     """timeseries.csv with the wall-clock column (step_us) removed, as text rows."""
     lines = path.read_text().splitlines()

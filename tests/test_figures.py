@@ -1,4 +1,4 @@
-"""Track and scenario figures (issue 8 item 9): obstacles drawn, no false wrap jumps,
+"""Track and scenario figures: obstacles drawn, no false wrap jumps,
 labelled timeline axes; the scenario table never divides by zero."""
 
 from __future__ import annotations

@@ -1,8 +1,8 @@
 """Refactors must not change results: replay the runs recorded by tests/golden/make_golden.py.
 
-The reference file holds time series recorded before the loop/plant refactor (issue 10)
-and the QP speed work (issue 14); every column must agree to 1e-12 (absolute, in the
-column's SI unit). A deliberate behaviour change regenerates the file (see its script).
+The reference file holds time series recorded before the loop/plant refactor and the QP
+speed work; every column must agree to 1e-12 (absolute, in the column's SI unit). A
+deliberate behaviour change regenerates the file (see its script).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Input files and values (issue 8): types, documented caps, FIFOs, encodings."""
+"""Input files and values: types, documented caps, FIFOs, encodings."""
 
 from __future__ import annotations
 

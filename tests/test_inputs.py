@@ -1,5 +1,5 @@
-"""Non-finite inputs to ``Controller.command`` raise a one-line error naming the argument
-(issue 8, 4b), the same for every method."""
+"""Non-finite inputs to ``Controller.command`` raise a one-line error naming the argument,
+the same for every method."""
 
 import math
 

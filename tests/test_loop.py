@@ -1,4 +1,4 @@
-"""The one simulation loop and the plant interface (issue 10, "architecture first")."""
+"""The one simulation loop and the plant interface."""
 
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """make_controller's options: every parameter of the class's and its parents' __init__.
 
-Issue 8: ``ats``/``ap`` rejected ``damping`` (the signature read stopped at ``**kwargs``).
+Found before: ``ats``/``ap`` rejected ``damping`` (the signature read stopped at ``**kwargs``).
 """
 
 from __future__ import annotations

@@ -515,7 +515,7 @@ def test_files_and_folders_follow_the_umask(tmp_path, mask):
         assert stat.S_IMODE(path.stat().st_mode) == 0o666 & ~mask, path.name
 
 
-# -- the compare and scenarios records (issue 8 item 6) ----------------------------------
+# -- the compare and scenarios records ---------------------------------------------------
 def test_compare_records_everything_to_rerun(made):
     record = json.loads((made["compare"] / "run.json").read_text())
     assert record["tool"] == "compare" and record["methods"] == ["pi"]

@@ -1,4 +1,4 @@
-"""Every limit of the qp controller holds for every finite state (issue 8, item 4b).
+"""Every limit of the qp controller holds for every finite state.
 
 Found before: at |x| = 1e12 the QP answer broke the joint-speed limit (the huge tracking
 demand swamped the solver's tolerances), and the fallback could drive a joint further past
@@ -136,7 +136,7 @@ def test_every_limit_holds_for_extreme_finite_states(
 @pytest.mark.parametrize(
     "q",
     [
-        [1e12, -1e12, 0.3, -0.4, 0.9],  # issue 8: th2dot 41.2 against the 7.79 rad/s limit
+        [1e12, -1e12, 0.3, -0.4, 0.9],  # found: th2dot 41.2 against the 7.79 rad/s limit
         [0.0, 0.0, 1e12, 50.0, -50.0],  # angles far outside [-pi, pi]
         [0.0, 0.0, 0.0, math.pi, -math.pi],  # both joints at a limit
         [0.0, 0.0, 0.0, 1.57, 0.0],  # stretched sideways: S = 1.0, far below 1.25

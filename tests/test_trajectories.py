@@ -173,7 +173,7 @@ def test_a_one_column_header_of_other_names_is_still_unknown_columns(tmp_path):
         read_csv(path)
 
 
-# -- shipped files, names and paths (issue 8) ---------------------------------------------
+# -- shipped files, names and paths ------------------------------------------------------
 PROJECT_FOLDER = Path(__file__).resolve().parents[1] / "trajectories"
 
 
