@@ -172,9 +172,12 @@ def test_gif_has_the_frames_of_the_run(tmp_path):
 
 def test_mp4_has_the_frames_of_the_run(tmp_path):
     """With ffmpeg (on PATH, or imageio-ffmpeg's, which the test extras install) the MP4
-    holds one frame per recorded instant and shows the robot moving; without, a message."""
-    # A fifth of the other tests' run: 11 recorded instants are enough to count frames and
-    # see the robot move; every frame is a full render here (the GIF's are blitted).
+    holds one frame per recorded instant, each the view at its instant (as a full render
+    of the view draws it, to the encoder's loss); without ffmpeg, a message."""
+    from ddwmmr.gui.view import animation_figure
+
+    # A fifth of the other tests' run: 11 recorded instants, over which the time cursors
+    # cross the plots, so each instant's picture is told from its neighbours'.
     app = finished_app(Settings(methods=("ats", None), duration=DURATION / 5), tmp_path)
     click(app.export_buttons["mp4"].ax)
     movies = list(tmp_path.rglob("*.mp4"))
@@ -190,9 +193,22 @@ def test_mp4_has_the_frames_of_the_run(tmp_path):
     width, height = meta["size"]
     frames = [np.frombuffer(f, dtype=np.uint8).reshape(height, width, 3) for f in reader]
     assert len(frames) == 11 and (width, height) == (880, 448)  # one per step; 80 dpi
-    assert meta["fps"] == pytest.approx(12.0)
-    gray = [frame.mean(axis=2) for frame in (frames[0], frames[-1])]
-    assert np.mean(np.abs(gray[0] - gray[1]) > 30) > 0.002  # the robot moved, plots grew
+    assert meta["fps"] == pytest.approx(12.0) and meta["codec"] == "h264"
+    assert meta["pix_fmt"].startswith("yuv420p")  # what players take
+    figure, view = animation_figure(80.0)
+    view.set_runs(app.results, app.labels(), [])  # ats avoids no obstacles
+    renders = []
+    for index in range(11):
+        view.show_index(index)
+        figure.canvas.draw()
+        renders.append(np.asarray(figure.canvas.buffer_rgba())[..., :3].astype(float))
+    for index, frame in enumerate(frames):
+        difference = [np.mean(np.abs(frame - render)) for render in renders]
+        assert difference[index] < 2.0, index  # of 255: h264's loss, antialiased edges
+        assert np.argmin(difference) == index  # this instant's picture, not a neighbour's
+        wrong = np.abs(frame - renders[index]).max(axis=2) > 100
+        assert np.mean(wrong) < 5e-4, index  # the colours too (a few edges differ)
+    assert np.mean(np.abs(renders[0] - renders[-1]).max(axis=2) > 30) > 0.002  # it moved
 
 
 def test_export_before_a_run_is_a_message(tmp_path):

@@ -31,9 +31,11 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from matplotlib import animation as mpl_animation
 from matplotlib import rcParams
 from matplotlib.figure import Figure
+from numpy.typing import NDArray
 from PIL import Image
 
 from ddwmmr import provenance
@@ -330,7 +332,10 @@ def write_animation(
     indices = frame_indices(view.last_index, frames)
     path = folder / f"animation.{fmt}"
     if fmt == "gif":
-        images = list(_blitted_frames(figure, view, indices))
+        # Each frame is copied out of the canvas (convert) before the next is drawn.
+        images = [
+            Image.fromarray(rgba).convert("RGB") for rgba in _blitted_frames(figure, view, indices)
+        ]
         # One palette for all frames, from the last (it has every trail and colour).
         palette = images[-1].quantize(colors=128, method=Image.Quantize.FASTOCTREE)
         images = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in images]
@@ -344,21 +349,38 @@ def write_animation(
             loop=0,
         )
         return write_new(path, buffer.getvalue())
-    writer = mpl_animation.writers[ANIMATION_WRITERS[fmt]](fps=fps)
+    writer = _FramePipeWriter(fps=fps)
     with tempfile.TemporaryDirectory() as scratch:
         temporary = Path(scratch) / path.name
+        # setup (here) may round the figure's size to even pixels for the codec: the
+        # frames are drawn after it, at that size.
         with writer.saving(figure, str(temporary), dpi):
-            for index in indices:
-                view.show_index(index)
-                writer.grab_frame()
+            for rgba in _blitted_frames(figure, view, indices):
+                writer.write_rgba(rgba)
         return write_new(path, temporary.read_bytes())
 
 
-def _blitted_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterator[Image.Image]:
-    """RGB images of the view at ``indices``: the still parts are rendered once, then
-    every frame redraws only the moving artists on that background (several times faster
-    than full renders, which spend most of their time on the axes' ticks). The legends
-    belong to the background, placed for the whole run."""
+class _FramePipeWriter(mpl_animation.FFMpegWriter):
+    """matplotlib's ffmpeg writer (its command line: codec, pixel format, bitrate and
+    ``animation.ffmpeg_args`` as configured; its errors) fed with frames drawn elsewhere,
+    instead of the full render of the figure that ``grab_frame`` makes per frame."""
+
+    def write_rgba(self, rgba: NDArray[np.uint8]) -> None:
+        """Pipe one frame to ffmpeg: a ``(height, width, 4)`` RGBA array of
+        :attr:`frame_size` (between ``setup`` and ``finish``; ffmpeg reads the bytes as
+        frames of that size, so any other size scrambles the movie)."""
+        # ignore: _proc is the ffmpeg process setup() started (MovieWriter's, untyped)
+        self._proc.stdin.write(np.ascontiguousarray(rgba))  # type: ignore[attr-defined]
+
+
+def _blitted_frames(
+    figure: Figure, view: Any, indices: Sequence[int]
+) -> Iterator[NDArray[np.uint8]]:
+    """The view at ``indices`` as ``(height, width, 4)`` RGBA arrays: the still parts are
+    rendered once, then every frame redraws only the moving artists on that background
+    (several times faster than full renders, which spend most of their time on the axes'
+    ticks). The legends belong to the background, placed for the whole run. Each array
+    views the canvas's buffer: it holds its frame until the next one is drawn."""
     canvas = figure.canvas
     view.show_index(view.last_index)
     for artist in view.dynamic_artists(legends=False):
@@ -367,12 +389,9 @@ def _blitted_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterat
     # ignore (here and below): animation_figure gives the figure an Agg canvas, which has
     # the blitting and buffer methods the base class lacks
     background = canvas.copy_from_bbox(figure.bbox)  # type: ignore[attr-defined]
-    size = canvas.get_width_height()
     for index in indices:
         view.show_index(index)
         canvas.restore_region(background)  # type: ignore[attr-defined]
         for artist in view.dynamic_artists(legends=False):
             figure.draw_artist(artist)
-        yield Image.frombuffer("RGBA", size, canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert(  # type: ignore[attr-defined]
-            "RGB"
-        )
+        yield np.asarray(canvas.buffer_rgba())  # type: ignore[attr-defined]
