@@ -333,16 +333,44 @@ def _artist_name(artist: Artist) -> str:
     )
 
 
+def blitted_and_full(fig: Figure, update, count: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Each frame of :func:`ddwmmr.reports.canvas.blitted_frames` (``fig``, ``update``,
+    ``count``) beside a full render of ``fig`` after the same ``update(i)``: RGB, float."""
+    from ddwmmr.reports.canvas import blitted_frames
+
+    blitted = [frame[..., :3].astype(float) for frame in blitted_frames(fig, update, count)]
+    full = []
+    for frame in range(count):
+        update(frame)
+        fig.canvas.draw()
+        full.append(np.asarray(fig.canvas.buffer_rgba())[..., :3].astype(float))
+    return list(zip(blitted, full))
+
+
 class SavedFigures:
     """Every figure saved while installed (``Figure.savefig`` patched through pytest's
     ``monkeypatch``): its name and :func:`figure_problems`, checked just before it is
-    written. Scripts that save by themselves (the docs figure scripts, an animation's
-    frames) are checked this way without changing them."""
+    written. Scripts that save by themselves (the docs figure scripts) are checked this
+    way without changing them, and so is every frame of an animation
+    (:func:`ddwmmr.reports.canvas.blitted_frames` patched: checked after its update)."""
 
     def __init__(self, monkeypatch, **check) -> None:
+        from ddwmmr.reports import canvas
+
         self.problems: dict[str, list[str]] = {}
         original = Figure.savefig
+        original_frames = canvas.blitted_frames
         saved = self
+
+        def blitted_frames(fig: Figure, update, count: int):
+            def checked(frame: int):
+                artists = update(frame)
+                saved.problems[f"frame#{len(saved.problems)}"] = figure_problems(fig, **check)
+                return artists
+
+            return original_frames(fig, checked, count)
+
+        monkeypatch.setattr(canvas, "blitted_frames", blitted_frames)
 
         def savefig(fig: Figure, fname, *args, **kwargs):
             name = fname.name if isinstance(fname, Path) else str(fname)

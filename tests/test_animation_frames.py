@@ -7,12 +7,15 @@ from __future__ import annotations
 
 import itertools
 
+import numpy as np
 import pytest
+from matplotlib.figure import Figure
 from PIL import Image
 
 from ddwmmr import Ellipse, Robot, simulate
 from ddwmmr.reports import plots
-from ddwmmr.reports.canvas import frame_indices
+from ddwmmr.reports.canvas import blitted_frames, frame_indices, new_figure
+from figure_checks import blitted_and_full
 
 
 def gif_frames(path) -> tuple[int, int]:
@@ -56,3 +59,90 @@ def test_a_long_run_keeps_its_frame_count(tmp_path):
     result = simulate(Robot(), Ellipse(), "ats", duration=3.0)  # 151 recorded instants
     count, _ = gif_frames(plots.save_animation(result, tmp_path / "long.gif", frames=40))
     assert count == 40
+
+
+def moving_figure():
+    """A figure with still parts (axes, ticks, a line, a legend) and moving ones: a growing
+    line, a marker and a title naming the frame, which ``update`` returns. The moving line
+    crosses no spine nor the legend (drawn over it there in a blitted frame)."""
+    fig = new_figure((4.0, 3.0), dpi=60)
+    ax = fig.subplots()
+    ax.plot([0, 1], [-1, 1], color="0.5", label="still")
+    ax.legend(loc="lower left")
+    ax.set_xlim(-0.1, 1.1)
+    ax.set_ylim(-1.2, 1.2)
+    (line,) = ax.plot([], [], color="tab:blue")
+    (dot,) = ax.plot([], [], "o", color="tab:orange")
+    x = np.linspace(0, 1, 50)
+
+    def update(frame: int):
+        k = 10 * (frame + 1)
+        line.set_data(x[:k], np.sin(6 * x[:k]))
+        dot.set_data([x[k - 1]], [np.sin(6 * x[k - 1])])
+        title = ax.set_title(f"frame {frame}: t = {0.37 * frame:.2f} s" + "!" * frame)
+        return line, dot, title
+
+    return fig, ax, update
+
+
+def test_blitted_frames_are_full_renders_with_the_title_of_each_frame(monkeypatch):
+    """Each frame (still parts drawn once, the moving artists over them) is what a full
+    render at that frame shows; the title, which changes, is drawn in each frame, not
+    kept in the still background with another frame's text."""
+    fig, ax, update = moving_figure()
+    draws = []
+    real_draw = Figure.draw
+    monkeypatch.setattr(Figure, "draw", lambda *a: draws.append(1) or real_draw(*a))
+    frames = [frame.copy() for frame in blitted_frames(fig, update, 5)]
+    assert len(draws) == 1 and len(frames) == 5  # the still parts, once
+    assert not any(artist.get_animated() for artist in update(0))  # as they were
+    monkeypatch.undo()
+    pairs = blitted_and_full(fig, update, 5)
+    height = pairs[0][0].shape[0]
+    above = slice(0, height - round(ax.bbox.y1))  # the band of the title, over the axes
+    for frame, (blitted, full) in enumerate(pairs):
+        assert np.array_equal(blitted[above], full[above]), frame  # its own title only
+        assert np.mean(np.abs(blitted - full)) < 0.1, frame  # of 255
+        assert np.mean(np.abs(blitted - full).max(axis=2) > 32) < 1e-3, frame
+    first, last = pairs[0][0], pairs[-1][0]
+    assert np.mean(np.abs(first[above] - last[above]).max(axis=2) > 32) > 0.01  # it changed
+    assert np.mean(np.abs(first - last).max(axis=2) > 32) > 0.01  # so did the line
+
+
+def test_track_gif_frames_are_the_figure_at_their_instants(tmp_path, monkeypatch):
+    """Each decoded frame of ``save_animation``'s GIF is a full render of its figure at
+    its instant (title with the time, trace, robot) to the palette's loss, the white
+    background exactly white; the still parts are drawn once for all frames."""
+    result = simulate(Robot(), Ellipse(), "ats", duration=0.4)  # 21 recorded instants
+    captured = []
+    real_save_gif = plots.save_gif
+    draws = []
+    real_draw = Figure.draw
+
+    def save_gif(fig, update, count, *args):
+        captured.append((fig, update, count))
+        monkeypatch.setattr(Figure, "draw", lambda *a: draws.append(1) or real_draw(*a))
+        try:
+            return real_save_gif(fig, update, count, *args)
+        finally:
+            monkeypatch.setattr(Figure, "draw", real_draw)
+
+    monkeypatch.setattr(plots, "save_gif", save_gif)
+    path = plots.save_animation(result, tmp_path / "run.gif", frames=8)
+    ((fig, update, count),) = captured
+    assert count == 8 and len(draws) == 1
+    with Image.open(path) as movie:
+        decoded = []
+        for index in range(movie.n_frames):
+            movie.seek(index)
+            decoded.append(np.asarray(movie.convert("RGB"), dtype=float))
+    renders = [full for _, full in blitted_and_full(fig, update, count)]
+    assert len(decoded) == count
+    above = slice(0, renders[0].shape[0] - round(fig.axes[0].bbox.y1))  # the title's band
+    for index, frame in enumerate(decoded):
+        difference = [np.mean(np.abs(frame - render)) for render in renders]
+        assert difference[index] < 1.0, index  # of 255
+        title = np.abs(frame[above] - renders[index][above]).max(axis=2)
+        assert np.mean(title > 32) < 1e-3, index  # the title of its own instant
+        assert np.argmin(difference) == index  # this instant's picture, not a neighbour's
+        assert (frame[2, 2] == 255).all()  # the figure's white, not a near white

@@ -11,9 +11,10 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from figure_checks import SavedFigures
+from figure_checks import SavedFigures, blitted_and_full
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 
@@ -104,16 +105,34 @@ def test_physics_runs_figure_with_runs_that_tip(tipping_runs, tmp_path, monkeypa
 
 
 def test_physics_animation_frames(tipping_runs, tmp_path, monkeypatch):
+    """Every frame shows its data, and is a full render of the figure at its instant
+    (the title with the time included; the moving artists are all redrawn)."""
     from ddwmmr.plants.mujoco import MujocoPlant
-    from ddwmmr.reports.physics_plots import save_physics_animation
+    from ddwmmr.reports import physics_plots
 
     result = tipping_runs[4.0, "clrrmc-ts"]
     plant = MujocoPlant(result.robot)
     saved = SavedFigures(monkeypatch)
     points = [s.point for s in plant.supports]
-    save_physics_animation(result, points, plant.weight_n, tmp_path / "tip.gif", frames=6)
-    assert len(saved.problems) >= 6  # every frame is checked as it is grabbed
+    captured = []
+    real_save_gif = physics_plots.save_gif
+    monkeypatch.setattr(
+        physics_plots,
+        "save_gif",
+        lambda fig, update, count, *a: (
+            captured.append((fig, update, count)) or real_save_gif(fig, update, count, *a)
+        ),
+    )
+    path = tmp_path / "tip.gif"
+    physics_plots.save_physics_animation(result, points, plant.weight_n, path, frames=6)
+    assert len(saved.problems) >= 6  # every frame is checked as it is drawn
     assert saved.failing() == {}
+    ((fig, update, count),) = captured
+    top = fig.axes[0]
+    for index, (blitted, full) in enumerate(blitted_and_full(fig, update, count)):
+        above = slice(0, blitted.shape[0] - round(top.bbox.y1))  # the title's band
+        assert np.array_equal(blitted[above], full[above]), index
+        assert np.mean(np.abs(blitted - full)) < 0.5, index  # of 255
 
 
 def test_benchmark_figure(tmp_path, monkeypatch):

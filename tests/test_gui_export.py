@@ -163,6 +163,7 @@ def test_gif_has_the_frames_of_the_run(tmp_path):
     (path,) = tmp_path.rglob("animation.gif")
     with Image.open(path) as movie:
         assert movie.n_frames == 26 and movie.size == (880, 448)  # one per step; 80 dpi
+        assert movie.convert("RGB").getpixel((2, 2)) == (255, 255, 255)  # white, not near
         first = np.asarray(movie.convert("L"), dtype=float)
         movie.seek(movie.n_frames - 1)
         last = np.asarray(movie.convert("L"), dtype=float)

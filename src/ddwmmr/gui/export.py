@@ -49,7 +49,7 @@ from ddwmmr.outputs import (
     unwritable_message,
     write_new,
 )
-from ddwmmr.reports.canvas import frame_indices
+from ddwmmr.reports.canvas import blitted_frames, frame_indices, gif_bytes
 from ddwmmr.sim.simulate import plant_integrator
 from ddwmmr.trajectories import SampledTrajectory
 from ddwmmr.trajectories.files import SHAPES, find_trajectory_file, is_name
@@ -334,28 +334,16 @@ def write_animation(
     if fmt == "gif":
         # Each frame is copied out of the canvas (convert) before the next is drawn.
         images = [
-            Image.fromarray(rgba).convert("RGB") for rgba in _blitted_frames(figure, view, indices)
+            Image.fromarray(rgba).convert("RGB") for rgba in _view_frames(figure, view, indices)
         ]
-        # One palette for all frames, from the last (it has every trail and colour).
-        palette = images[-1].quantize(colors=128, method=Image.Quantize.FASTOCTREE)
-        images = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in images]
-        buffer = io.BytesIO()
-        images[0].save(
-            buffer,
-            format="GIF",
-            save_all=True,
-            append_images=images[1:],
-            duration=round(1000 / fps),
-            loop=0,
-        )
-        return write_new(path, buffer.getvalue())
+        return write_new(path, gif_bytes(images, fps))
     writer = _FramePipeWriter(fps=fps)
     with tempfile.TemporaryDirectory() as scratch:
         temporary = Path(scratch) / path.name
         # setup (here) may round the figure's size to even pixels for the codec: the
         # frames are drawn after it, at that size.
         with writer.saving(figure, str(temporary), dpi):
-            for rgba in _blitted_frames(figure, view, indices):
+            for rgba in _view_frames(figure, view, indices):
                 writer.write_rgba(rgba)
         return write_new(path, temporary.read_bytes())
 
@@ -373,25 +361,15 @@ class _FramePipeWriter(mpl_animation.FFMpegWriter):
         self._proc.stdin.write(np.ascontiguousarray(rgba))  # type: ignore[attr-defined]
 
 
-def _blitted_frames(
-    figure: Figure, view: Any, indices: Sequence[int]
-) -> Iterator[NDArray[np.uint8]]:
-    """The view at ``indices`` as ``(height, width, 4)`` RGBA arrays: the still parts are
-    rendered once, then every frame redraws only the moving artists on that background
-    (several times faster than full renders, which spend most of their time on the axes'
-    ticks). The legends belong to the background, placed for the whole run. Each array
-    views the canvas's buffer: it holds its frame until the next one is drawn."""
-    canvas = figure.canvas
-    view.show_index(view.last_index)
-    for artist in view.dynamic_artists(legends=False):
-        artist.set_animated(True)
-    canvas.draw()
-    # ignore (here and below): animation_figure gives the figure an Agg canvas, which has
-    # the blitting and buffer methods the base class lacks
-    background = canvas.copy_from_bbox(figure.bbox)  # type: ignore[attr-defined]
-    for index in indices:
-        view.show_index(index)
-        canvas.restore_region(background)  # type: ignore[attr-defined]
-        for artist in view.dynamic_artists(legends=False):
-            figure.draw_artist(artist)
-        yield np.asarray(canvas.buffer_rgba())  # type: ignore[attr-defined]
+def _view_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterator[NDArray[np.uint8]]:
+    """The view at the recorded ``indices`` as RGBA arrays
+    (:func:`ddwmmr.reports.canvas.blitted_frames`): the moving artists are the view's
+    :meth:`~ddwmmr.gui.view.RunView.dynamic_artists`; the legends belong to the still
+    background, placed for the whole run (the last index drawn first)."""
+
+    def update(frame: int) -> list[Any]:
+        view.show_index(indices[frame])
+        artists: list[Any] = view.dynamic_artists(legends=False)
+        return artists
+
+    return blitted_frames(figure, update, len(indices))

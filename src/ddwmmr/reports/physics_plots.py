@@ -25,6 +25,7 @@ from ddwmmr.reports.plots import robot_outline, run_title
 if TYPE_CHECKING:
     from matplotlib.collections import PathCollection
     from matplotlib.lines import Line2D
+    from matplotlib.text import Text
 
     from ddwmmr.model import Robot
     from ddwmmr.sim import SimulationResult
@@ -98,7 +99,7 @@ def save_physics_animation(
     indices = np.linspace(0, len(q) - 1, frames).astype(int)
     title = f"{result.summary.get('method', '?')}, payload {robot.payload:g} kg"
 
-    def update(frame: int) -> tuple[Line2D, Line2D, PathCollection, Line2D]:
+    def update(frame: int) -> tuple[Line2D, Line2D, PathCollection, Line2D, Text]:
         k = indices[frame]
         shape = robot_outline(robot, q[k])
         footprint.set_data(*shape["footprint"].T)
@@ -108,8 +109,8 @@ def save_physics_animation(
         discs.set_color(["tab:blue" if f > 1e-3 * weight_n else "tab:red" for f in forces[k]])
         cursor.set_xdata([ts["t"][k], ts["t"][k]])
         fallen = " (tipped)" if tip_time is not None and ts["t"][k] >= tip_time else ""
-        ax.set_title(f"{title}: t = {ts['t'][k]:.2f} s{fallen}", fontsize=9)
-        return footprint, arm, discs, cursor
+        heading = ax.set_title(f"{title}: t = {ts['t'][k]:.2f} s{fallen}", fontsize=9)
+        return footprint, arm, discs, cursor, heading
 
     ax.set_title(title, fontsize=9)
     fig.tight_layout()

@@ -35,6 +35,8 @@ from ddwmmr.reports.canvas import frame_indices, new_figure, save_gif
 from ddwmmr.reports.legends import legend_beside, place_legend
 
 if TYPE_CHECKING:
+    from matplotlib.text import Text
+
     from ddwmmr.qp.limits.obstacles import Circle as CircleObstacle
     from ddwmmr.sim import SimulationResult
 
@@ -507,14 +509,14 @@ def save_animation(
     (arm,) = ax.plot([], [], color="tab:orange", lw=2, marker="o", ms=3)
     indices = frame_indices(len(q) - 1, frames)
 
-    def update(frame: int) -> tuple[Line2D, Line2D, Line2D]:
+    def update(frame: int) -> tuple[Line2D, Line2D, Line2D, Text]:
         k = indices[frame]
         shape = robot_outline(robot, q[k])
         trace.set_data(ts["xE"][: k + 1], ts["yE"][: k + 1])
         footprint.set_data(*shape["footprint"].T)
         arm.set_data(*shape["arm"].T)
-        ax.set_title(f"{_title(result, '')} t = {ts['t'][k]:.1f} s")
-        return trace, footprint, arm
+        title = ax.set_title(f"{_title(result, '')} t = {ts['t'][k]:.1f} s")
+        return trace, footprint, arm, title
 
     path = Path(path)
     with ProgressBar(len(indices), "track: animation.gif", enabled=progress, unit="frame") as bar:
