@@ -51,3 +51,28 @@ def test_a_ratio_beyond_floats_is_said_so_not_printed_as_inf(tmp_path):
     (line,) = [t for t in format_comparison(report, previous).splitlines() if label + " " in t]
     assert line.endswith("(<1e-308x)")
     assert "(1.00x)" in format_comparison(read_report(REPORT), read_report(REPORT))
+
+
+@pytest.mark.parametrize(
+    ("edit", "field"),
+    [
+        (lambda config: config.update(timestamp="2026-12-07\nfake: line"), "timestamp"),
+        (lambda config: config.update(timestamp=20261207), "timestamp"),
+        (lambda config: config.update(package_version="0.1.0\nx"), "package_version"),
+        (lambda config: config["git"].update(commit="f2da\r\n"), "git.commit"),
+    ],
+)
+def test_a_header_field_off_one_line_is_refused(tmp_path, edit, field):
+    # printed in the comparison's header line as it was, a newline split the line
+    with pytest.raises(ParameterError, match=rf'^compare: .* "config"\.{field} must be') as info:
+        read_report(edited(tmp_path, lambda data: edit(data["config"])))
+    assert "\n" not in str(info.value)
+
+
+def test_a_date_only_timestamp_and_a_null_commit_are_read(tmp_path):
+    def edit(data):
+        data["config"]["timestamp"] = "2026-12-07"
+        data["config"]["git"]["commit"] = None
+
+    header = format_comparison(read_report(REPORT), read_report(edited(tmp_path, edit)))
+    assert header.splitlines()[0].startswith("against 2026-12-07 (ddwmmr 0.1.0, no commit)")

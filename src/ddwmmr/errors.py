@@ -18,6 +18,7 @@ import re
 import stat
 import sys
 import tomllib
+import unicodedata
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, NoReturn
@@ -313,6 +314,17 @@ def round_significant(value: float, digits: int, rounding: Callable[[float], int
     the bound it was computed from."""
     scale = 10.0 ** (digits - 1 - math.floor(math.log10(value)))
     return rounding(value * scale) / scale
+
+
+#: Unicode categories a text printed on one line may not hold: control characters (a
+#: newline splits a report's line) and lone surrogates (an undecodable byte of a file name:
+#: it cannot be encoded, so a figure's title fails to draw).
+UNPRINTABLE_CATEGORIES = ("Cc", "Cs")
+
+
+def printable_line(text: str) -> bool:
+    """Whether ``text`` prints as one line: no character of :data:`UNPRINTABLE_CATEGORIES`."""
+    return not any(unicodedata.category(c) in UNPRINTABLE_CATEGORIES for c in text)
 
 
 def one_line(text: str, width: int) -> str:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import math
 import os
+from datetime import datetime
 from pathlib import Path
 from typing import Any
 
@@ -15,6 +16,7 @@ from ddwmmr.bench.qp_classes import qp_target_verdict
 from ddwmmr.bench.timing import P99_MIN_SAMPLES, p99_judgeable
 from ddwmmr.errors import (
     ParameterError,
+    printable_line,
     read_text_file,
     shown,
 )
@@ -373,10 +375,46 @@ def _entries_problem(data: dict[str, Any], key: str, fields: dict[str, str]) -> 
     return None
 
 
+def _config_problem(config: dict[str, Any]) -> str | None:
+    """What is wrong with the fields of ``config`` the comparison's header prints (each
+    may be missing): ``timestamp`` must be an ISO 8601 date and time, the code's names
+    (``package_version``, ``git_commit``, ``git.commit``; null too) text on one line. An
+    edited newline would split the header; None if nothing is wrong."""
+    if "timestamp" in config and not _iso_timestamp(config["timestamp"]):
+        got = shown(config["timestamp"])
+        return f'"config".timestamp must be an ISO 8601 date and time (got {got})'
+    git = config.get("git")
+    texts = {
+        "package_version": config.get("package_version"),
+        "git_commit": config.get("git_commit"),
+        "git.commit": git.get("commit") if isinstance(git, dict) else None,
+    }
+    for name, value in texts.items():
+        if value is not None and not (isinstance(value, str) and printable_line(value)):
+            return (
+                f'"config".{name} must be text on one line, without control characters '
+                f"(got {shown(value)})"
+            )
+    return None
+
+
+def _iso_timestamp(value: Any) -> bool:
+    if not isinstance(value, str):
+        return False
+    try:
+        datetime.fromisoformat(value)
+    except ValueError:
+        return False
+    return True
+
+
 def _layout_problem(data: dict[str, Any]) -> str | None:
     """The first field :func:`format_comparison` would trip over, or None."""
     if not isinstance(data.get("config"), dict):
         return f'"config" must be an object (got {_type_name(data.get("config"))})'
+    problem = _config_problem(data["config"])
+    if problem:
+        return problem
     if "rows" not in data:
         return 'no "rows"'
     problem = _entries_problem(data, "rows", {"label": "text", "step_us": "number"})

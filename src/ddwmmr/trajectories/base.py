@@ -23,7 +23,14 @@ from typing import Any, Protocol, runtime_checkable
 import numpy as np
 import numpy.typing as npt
 
-from ddwmmr.errors import ParameterError, check_finite, check_int_at_least, shown
+from ddwmmr.errors import (
+    UNPRINTABLE_CATEGORIES,
+    ParameterError,
+    check_finite,
+    check_int_at_least,
+    printable_line,
+    shown,
+)
 from ddwmmr.inheritance import defining_class, overrides
 
 
@@ -177,18 +184,12 @@ def check_name(name: Any, prefix: str = "") -> str:
     ``"trajectory samples: "``)."""
     if not isinstance(name, str) or not name:
         raise ParameterError(f"{prefix}name must be a string, not empty (got {shown(name)})")
-    if any(unicodedata.category(c) in _UNPRINTABLE for c in name):
-        # A newline splits the report's lines; a lone surrogate (an undecodable byte of a
-        # file name) cannot be encoded, so the figures' titles fail to draw.
+    if not printable_line(name):
         raise ParameterError(
             f"{prefix}name must be text on one line, without control characters or lone "
             f"surrogates (got {shown(name)})"
         )
     return name
-
-
-#: Unicode categories a trajectory name may not hold: control characters and surrogates.
-_UNPRINTABLE = ("Cc", "Cs")
 
 
 def file_name(path: str | os.PathLike[str]) -> str:
@@ -197,4 +198,4 @@ def file_name(path: str | os.PathLike[str]) -> str:
     locale decoded them as ASCII: ``LC_ALL=POSIX``), any byte that is not UTF-8 as U+FFFD,
     and a control character as ``?``: an odd file name does not make the file unusable."""
     text = os.fsencode(Path(path).stem).decode("utf-8", errors="replace")
-    return "".join("?" if unicodedata.category(c) in _UNPRINTABLE else c for c in text)
+    return "".join("?" if unicodedata.category(c) in UNPRINTABLE_CATEGORIES else c for c in text)
