@@ -134,13 +134,14 @@ def check_weight(name: str, value: float) -> float:
 def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None = None) -> int:
     """Return ``value`` as int if it is an integer >= ``minimum`` (and <= ``maximum``)."""
     allowed = f">= {minimum}" if maximum is None else f"in [{minimum}, {maximum}]"
+    given, value = value, unwrapped(value)
     integral = isinstance(value, int | np.integer) or (
         isinstance(value, float | np.floating)
         and math.isfinite(value)
         and float(value).is_integer()
     )
     if isinstance(value, bool | np.bool_) or not integral:
-        raise ParameterError(f"{name} must be an integer {allowed} (got {shown(value)})")
+        raise ParameterError(f"{name} must be an integer {allowed} (got {shown(given)})")
     number = int(value)
     if number < minimum or (maximum is not None and number > maximum):
         # the integer it is, not its float spelling (a command line reads 1 as 1.0), unless
@@ -152,7 +153,7 @@ def check_int_at_least(name: str, value: int, minimum: int, maximum: int | None 
 
 def check_bool(name: str, value: Any) -> bool:
     """Return ``value`` if it is True or False (numpy's too), else raise."""
-    if not isinstance(value, bool | np.bool_):
+    if not isinstance(unwrapped(value), bool | np.bool_):
         raise ParameterError(f"{name} must be true or false (got {shown(value)})")
     return bool(value)
 
@@ -191,8 +192,12 @@ def check_step_count(duration: float, dt: float) -> int:
 
 
 def check_number_type(name: str, value: Any) -> Any:
-    """Reject values read from a file that are not numbers (strings, booleans, tables)."""
-    if isinstance(value, bool) or not isinstance(value, int | float):
+    """Reject values read from a file, or given to override them, that are not numbers
+    (strings, booleans, tables); numpy's numbers (a 0-d array too) are numbers."""
+    number = unwrapped(value)
+    if isinstance(number, bool | np.bool_) or not isinstance(
+        number, int | float | np.integer | np.floating
+    ):
         raise ParameterError(f"{name} must be a number (got {shown(value)})")
     return value
 
@@ -209,13 +214,24 @@ def real_number(value: Any) -> float | None:
     """``value`` as a float (finite or not), or None if it is no number: text, a boolean,
     None, or an integer beyond a float. Strings and booleans are not numbers here, even
     though float() accepts them: a file saying N = "2000" or L1 = true is a mistake worth
-    reporting."""
+    reporting. A 0-d numpy array stands for the scalar it holds (:func:`unwrapped`)."""
+    value = unwrapped(value)
     if isinstance(value, bool | np.bool_ | str | bytes):
         return None
     try:
         return float(value)
     except (OverflowError, TypeError, ValueError):  # OverflowError: as infinite as inf
         return None
+
+
+def unwrapped(value: Any) -> Any:
+    """The scalar a 0-d numpy array holds (``np.array(36)`` -> ``np.int64(36)``,
+    ``np.array(True)`` -> ``np.True_``), anything else as it is: the number checks take
+    ``np.array(0.2)`` as 0.2 and ``np.array(36)`` as 36, and judge what it holds (a boolean
+    or text inside is no number)."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        return value[()]
+    return value
 
 
 def _as_float(name: str, value: float, allowed: str = "") -> float:

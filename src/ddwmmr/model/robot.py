@@ -31,6 +31,7 @@ from ddwmmr.errors import (
     load_toml,
     shown,
     texts_apart,
+    unwrapped,
 )
 from ddwmmr.model import kinematics, stability, support_loads
 from ddwmmr.model.mass import YawInertia, total_mass
@@ -523,8 +524,8 @@ class Robot:
         """
         if not (isinstance(dx, float) and isinstance(dy, float) and _isfinite(dx + dy)):
             _check_scalars(("dx", dx), ("dy", dy))
-        if elbow not in (1, -1) or isinstance(elbow, bool):
-            raise ParameterError(f"elbow must be +1 or -1 (got {shown(elbow)})")
+        if type(elbow) is not int or elbow not in (1, -1):
+            elbow = _elbow(elbow)
         r2 = dx * dx + dy * dy
         c2 = (r2 - self.L1**2 - self.L2**2) / (2.0 * self.L1 * self.L2)
         if c2 > 1.0 + 1e-12 or c2 < -1.0 - 1e-12:
@@ -660,6 +661,16 @@ def _numbers(name: str, value: Any, size: int, count: str, unit: str) -> tuple[f
     if len(items) != size:
         raise ParameterError(f"{wanted} (got {len(items)} values)")
     return tuple(check_finite(f"{name}[{i}]", v) for i, v in enumerate(items, start=1))
+
+
+def _elbow(value: Any) -> int:
+    """``value`` as the int +1 or -1 (numpy's numbers and 0-d arrays too), else a one-line
+    :class:`ParameterError` naming ``elbow``: a boolean is no sign."""
+    number = unwrapped(value)
+    numeric = isinstance(number, int | float | np.integer | np.floating)
+    if numeric and not isinstance(number, bool | np.bool_) and number in (1, -1):
+        return int(number)
+    raise ParameterError(f"elbow must be +1 or -1 (got {shown(value)})")
 
 
 def _check_scalars(*items: tuple[str, Any]) -> None:
