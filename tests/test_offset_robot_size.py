@@ -179,3 +179,31 @@ def test_every_offset_keeps_the_start_poses_elbow_branch():
     assert np.allclose(
         wrapped.fk(turned), robot.fk(offset_configuration(robot, start, (-0.65, -0.41)))
     )
+
+
+def refusal(offset) -> str:
+    with pytest.raises(ParameterError) as caught:
+        quiet_run(Robot(), Ellipse(), "clrrmc-ts", duration=0.1, initial_offset=offset)
+    message = str(caught.value)
+    assert "\n" not in message
+    return message
+
+
+@pytest.mark.parametrize(
+    ("offset", "fit"),
+    [
+        ((1e300, 0.0), "(0.03, 0)"),
+        ((1e17, 0.0), "(0.03, 0)"),
+        ((-1e300, 1e300), "(-0.8, 0.8)"),
+        ((1.7e308, -1.7e308), "(0.022, -0.022)"),
+    ],
+)
+def test_an_absurd_offset_gets_the_fit_of_one_just_out_of_reach(offset, fit):
+    # the reach search bisected [0, 1] times the offset: at 1e300 m forty halvings never
+    # came near the arm and the message said it reaches (0, 0) m; at 1.7e308 m the target
+    # overflowed and the refusal named q, the configuration, instead of the offset
+    message = refusal(offset)
+    assert message.startswith(f"initial_offset ({offset[0]:g}, {offset[1]:g}) m")
+    assert message.endswith(f"it reaches {fit} m")
+    near = tuple(5.0 * math.copysign(1.0, v) if v else 0.0 for v in offset)
+    assert refusal(near).endswith(f"it reaches {fit} m")

@@ -106,7 +106,8 @@ def offset_configuration(
     """
     q = np.array(q, dtype=float)
     dx, dy = (float(v) for v in offset)
-    placed = _placed(robot, q, (dx, dy))
+    # beyond the arm's span no pose reaches it (and 1e308 m would overflow the target)
+    placed = _placed(robot, q, (dx, dy)) if max(abs(dx), abs(dy)) <= _span(robot) else None
     if placed is not None:
         return placed
     fit_x, fit_y = reachable_offset(robot, q, (dx, dy))
@@ -178,28 +179,39 @@ def reachable_offset(
     """The largest multiple ``k offset`` (0 <= k <= 1; dx, dy in m, end-effector frame at
     ``q``) up to which the arm places the end effector within its joint limits, rounded
     down to two significant digits of its larger component: a value to suggest in place
-    of an offset it cannot reach. ``(0, 0)`` if none but the start is reached."""
+    of an offset it cannot reach. ``(0, 0)`` if none but the start is reached. The search
+    goes no further than the arm's span (:func:`_span`), which no offset passes: an
+    absurd offset (1e300 m) gets the same answer as one just out of reach."""
 
     def fits(k: float) -> bool:
         placed = _placed(robot, q, (k * offset[0], k * offset[1]))
         return placed is not None and robot.joints_outside(placed) is None
 
-    low, high = 0.0, 1.0
-    for k in np.linspace(0.0, 1.0, REACH_SCAN_POINTS + 1)[1:]:
+    larger = max(abs(offset[0]), abs(offset[1]))
+    span = _span(robot)
+    top = min(1.0, span / larger) if larger > span else 1.0
+    low, high = 0.0, top
+    for k in np.linspace(0.0, top, REACH_SCAN_POINTS + 1)[1:]:
         if not fits(float(k)):
             high = float(k)
             break
         low = float(k)
     else:
-        return offset
-    for _ in range(40):
+        if top == 1.0:
+            return offset
+    for _ in range(40 if high > low else 0):
         middle = 0.5 * (low + high)
         low, high = (middle, high) if fits(middle) else (low, middle)
-    larger = max(abs(offset[0]), abs(offset[1]))
     if low * larger <= 0.0:
         return (0.0, 0.0)
     k = round_significant(low * larger, 2, math.floor) / larger
     return (k * offset[0], k * offset[1])
+
+
+def _span(robot: Robot) -> float:
+    """The arm's span ``2 (L1 + L2)`` (m): the farthest the arm alone moves the end
+    effector, from one side of its reach to the other."""
+    return 2.0 * (robot.L1 + robot.L2)
 
 
 def _offset_tolerance(target: np.ndarray) -> float:
