@@ -41,3 +41,19 @@ def test_reading_a_plant_before_its_reset_says_to_reset(kind, name):
     plant.reset(Q, 0.02)
     assert plant.observe().q[:2] == pytest.approx(Q[:2], abs=1e-3)
     assert len(plant.extra_values()) == len(plant.extra_columns)
+
+
+def test_a_physics_plants_tallies_read_not_yet_before_its_reset():
+    """tip_time and unloaded_time_s tally a run since its reset: before the first they
+    read None and 0 (the plant contract, docs/api.md) rather than raising as the state
+    readings do; the kinematic and thesis plants judge no tipping and have neither (the
+    loop tells physics plants by ``tip_time``)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plant = MujocoPlant(ROBOT)
+    assert plant.tip_time is None and plant.unloaded_time_s == 0.0
+    plant.reset(Q, 0.02)
+    assert plant.tip_time is None and plant.unloaded_time_s == 0.0
+    for kind in (KinematicPlant, ThesisPlant):
+        other = kind(ROBOT)
+        assert not hasattr(other, "tip_time") and not hasattr(other, "unloaded_time_s")

@@ -354,9 +354,11 @@ class Plant(PlantImplementation, Protocol):
     that judge tipping over by their own physics (contact forces): when the robot tipped
     since the reset, None while it has not (the scenario protocol fails a run on it), and
     with it ``unloaded_time_s``, the time (s) since the reset with an edge of the support
-    polygon unloaded; ``joint_time_constant`` (s), the lag with which the joints follow
-    their rate targets, and ``damping``, the base's viscous damping ``(c1, c2)`` (N s/m,
-    N m s/rad): what the loop tells controllers of the plant
+    polygon unloaded. Unlike ``observe()`` and the state readings, these two tally a run
+    and raise no :class:`PlantNotResetError`: before the first ``reset`` they read None
+    and 0, true of a run not yet started. ``joint_time_constant`` (s), the lag with which
+    the joints follow their rate targets, and ``damping``, the base's viscous damping
+    ``(c1, c2)`` (N s/m, N m s/rad): what the loop tells controllers of the plant
     (:func:`ddwmmr.commands.traits_of`; the ``mpc`` models both).
     """
 

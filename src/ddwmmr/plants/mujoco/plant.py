@@ -473,14 +473,15 @@ class MujocoPlant:
     @property
     def tip_time(self) -> float | None:
         """Time (s) since the reset at which the robot tipped over by the contact forces
-        (:class:`TipDetector`, judged after every control step), None if it has not."""
+        (:class:`TipDetector`, judged after every control step), None if it has not (also
+        before the first :meth:`reset`: a run not yet started has not tipped)."""
         return self._tip.tip_time
 
     @property
     def unloaded_time_s(self) -> float:
         """Time (s) since the reset with an edge of the support polygon unloaded: dt for
         every control step that ended so (a wheel chattering on a lightly loaded side
-        counts)."""
+        counts); 0 before the first :meth:`reset`."""
         return self._unloaded_time
 
     def _require_reset(self, method: str) -> None:
