@@ -32,10 +32,10 @@ TRAJECTORIES = {
 @pytest.mark.parametrize(
     ("times", "got"),
     [
-        ([NAN], "got nan at index 0"),
-        ([0.0, INF], "got inf at index 1"),
-        (np.array([1.0, -INF]), "got -inf at index 1"),
-        (NAN, "got nan at index 0"),
+        ([NAN], "got nan as times[1]"),
+        ([0.0, INF], "got inf as times[2]"),
+        (np.array([1.0, -INF]), "got -inf as times[2]"),
+        (NAN, "got nan"),
         ("abc", "got 'abc'"),
         (None, "got None"),
         ([True, False], "got [True, False]"),
@@ -178,7 +178,10 @@ def test_valid_geometry_values_pass_unchanged():
         (lambda: error_dynamics.step_response(0.5, []), r"^times must be at least 2 .*0 times"),
         (lambda: error_dynamics.step_response(0.5, [0.0]), r"^times must be at least 2 .*1 time\)"),
         (lambda: error_dynamics.step_response(0.5, [1.0, 2.0]), r"^times .*first time of 1 s"),
-        (lambda: error_dynamics.step_response(0.5, [0, 2, 1]), r"^times .* increasing .*index 2"),
+        (
+            lambda: error_dynamics.step_response(0.5, [0, 2, 1]),
+            r"^times .* increasing .*\(got times\[2\] = 2 s then times\[3\] = 1 s\)",
+        ),
         (lambda: error_dynamics.step_response(0.5, [0, 1, 3]), r"^times .*equally spaced"),
         (lambda: error_dynamics.error_response(0.5, [0, INF]), r"^times must be a finite number"),
         (lambda: error_dynamics.closed_form_step(NAN, [0, 1]), r"^tau must be > 0 s "),

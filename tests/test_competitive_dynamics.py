@@ -269,10 +269,10 @@ def test_noise_kicks_a_weight_off_the_unstable_fixed_point_and_floor_keeps_it_re
     ("make", "message"),
     [
         (lambda: CompetitiveDynamics([]), "at least one behaviour"),
-        (lambda: CompetitiveDynamics([0.1, 0.0]), r"time_constants\[1\] must be > 0"),
+        (lambda: CompetitiveDynamics([0.1, 0.0]), r"time_constants\[2\] must be > 0"),
         (lambda: CompetitiveDynamics([0.1], noise=-1.0), "noise must be >= 0"),
         (lambda: CompetitiveDynamics([0.1], floor=1.0), "floor must be < 1"),
-        (lambda: CompetitiveDynamics([0.1]).reset([2.0]), r"w0\[0\] must be in"),
+        (lambda: CompetitiveDynamics([0.1]).reset([2.0]), r"w0\[1\] must be in"),
         (lambda: CompetitiveDynamics([0.1]).step([math.nan], [[0.0]], 0.01), "finite"),
         (lambda: CompetitiveDynamics([0.1, 0.1]).step([1, 1], [[0, -1], [0, 0]], 0.01), ">= 0"),
         (lambda: CompetitiveDynamics([0.1]).step([1.0], [[0.0]], -0.01), "h must be >= 0"),

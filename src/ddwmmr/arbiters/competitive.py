@@ -87,7 +87,7 @@ class CompetitiveDynamics:
         if not time_constants:
             raise ParameterError("time_constants: need at least one behaviour")
         self.time_constants = tuple(
-            check_positive(f"time_constants[{i}]", t) for i, t in enumerate(time_constants)
+            check_positive(f"time_constants[{i}]", t) for i, t in enumerate(time_constants, start=1)
         )
         self.noise = check_nonnegative("noise", noise)
         self.floor = check_nonnegative("floor", floor)
@@ -106,7 +106,7 @@ class CompetitiveDynamics:
         """Restart from weights ``w0`` (each |w| <= W_LIMIT) and restart the noise."""
         if len(w0) != self.n:
             raise ParameterError(f"w0: need {self.n} weights (got {len(w0)})")
-        for i, value in enumerate(w0):
+        for i, value in enumerate(w0, start=1):
             if not (math.isfinite(value) and abs(value) <= W_LIMIT):
                 raise ParameterError(
                     f"w0[{i}] must be in [-{W_LIMIT:g}, {W_LIMIT:g}] (got {value})"

@@ -358,7 +358,7 @@ def _entries_problem(data: dict[str, Any], key: str, fields: dict[str, str]) -> 
     if not isinstance(entries, list):
         return f'"{key}" must be a list (got {_type_name(entries)})'
     names: set[str] = set()
-    for i, entry in enumerate(entries):
+    for i, entry in enumerate(entries, start=1):
         if not isinstance(entry, dict):
             return f'"{key}"[{i}] must be an object (got {_type_name(entry)})'
         for name, kind in fields.items():
@@ -424,7 +424,7 @@ def _layout_problem(data: dict[str, Any]) -> str | None:
     )
     if problem:
         return problem
-    for i, entry in enumerate(data.get("qp_classes", [])):
+    for i, entry in enumerate(data.get("qp_classes", []), start=1):
         if "rows" in entry:
             rows = entry["rows"]
             qp = rows.get("qp") if isinstance(rows, dict) else None

@@ -124,9 +124,10 @@ def check_response_times(times: Sequence[float] | np.ndarray, spaced: bool) -> n
         raise ParameterError(f"{rule} (got a first time of {array[0]:g} s)")
     steps = np.diff(array)
     if not np.all(steps > 0.0):
-        index = int(np.argmin(steps > 0.0)) + 1
+        index = int(np.argmin(steps > 0.0)) + 1  # times[index + 1] (from 1) goes back
         raise ParameterError(
-            f"{rule} (got {array[index - 1]:g} s then {array[index]:g} s at index {index})"
+            f"{rule} (got times[{index}] = {array[index - 1]:g} s then times[{index + 1}] = "
+            f"{array[index]:g} s)"
         )
     if spaced and not np.allclose(steps, (array[-1] - array[0]) / (array.size - 1)):
         raise ParameterError(f"{rule} (got steps from {np.min(steps):g} s to {np.max(steps):g} s)")

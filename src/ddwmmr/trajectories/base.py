@@ -93,7 +93,8 @@ def check_times(times: Any) -> np.ndarray:
     finite = np.isfinite(array)
     if not np.all(finite):
         index = int(np.argmin(finite.ravel()))
-        raise _bad_times(f"got {shown(float(array.ravel()[index]))} at index {index}")
+        got = f"got {shown(float(array.ravel()[index]))}"
+        raise _bad_times(got if array.ndim == 0 else f"{got} as times[{index + 1}]")
     return array.reshape(1) if array.ndim == 0 else array
 
 
