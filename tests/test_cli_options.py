@@ -363,10 +363,10 @@ def test_help_says_what_the_dt_option_of_qp_and_mpc_is(main, capsys):
     assert stop.value.code == 0
     text = " ".join(capsys.readouterr().out.split())  # unwrapped
     assert (
-        "dt (qp, mpc): the step the controller plans each command for, s (qp: the look-ahead "
-        "of its exact stability check and the step of its acceleration limits, docs/qp.md; "
-        "mpc: its plan's first interval, docs/mpc.md); default: the simulation's control "
-        "step (--dt of track and scenarios), which the option does not change" in text
+        "dt (qp, mpc): the step the controller plans each command for, s (qp: its stability "
+        "check's look-ahead and its acceleration limits' step; mpc: its plan's first "
+        "interval); default: the run's control step (--dt), which the option does not "
+        "change" in text
     )
 
 

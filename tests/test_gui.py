@@ -178,6 +178,28 @@ def test_side_by_side_overlays_two_methods_with_their_own_options():
     assert app.settings.methods == ("clrrmc-ts", None) and app.results is None
 
 
+@pytest.mark.parametrize("method", ["qp", "mpc"])
+def test_the_dt_option_shows_the_note_the_command_lines_give(method):
+    """The qp's and mpc's option dt reads as the run's step; the command lines' --help
+    says what it is (option_specs.NOTES), the window's option fields said nothing."""
+    from ddwmmr.controllers.option_specs import NOTES
+
+    app = new_app(Settings(methods=(method, None), duration=DURATION))
+    group = app._groups[(0, method)]
+    page = [s.name for s in group.specs].index("dt") // len(group.page(0)) + 1
+    assert app.message == "" and "dt" not in app.options_note.get_text()
+    app.say("tau must be > 0", error=True)  # an error is not overwritten by the note
+    app._apply_options_page(page)
+    assert app.message == "tau must be > 0"
+    app.say("")
+    app._apply_options_page(1)
+    app._apply_options_page(page)
+    assert app.message == f"dt ({method}): {NOTES['dt']}" and not app.message_is_error
+    assert app.options_note.get_text().endswith("; dt: see the note below")
+    assert not app.message_text.get_text().endswith("...")  # the whole note fits its box
+    assert " ".join(app.message_text.get_text().split()) == app.message
+
+
 def test_method_list_and_option_widgets_follow_the_registry(registered):
     from ddwmmr.gui.options import method_options
     from ddwmmr.registry import CONTROLLERS

@@ -80,13 +80,14 @@ UNITS = {
 
 
 #: What an option is, for the option names whose name alone misleads, shown under the
-#: tools' ``--help`` list of each method's options. ``dt`` reads as the run's step
-#: (``--dt``), but the ``qp`` and ``mpc`` take it as the step they plan each command for.
+#: tools' ``--help`` list of each method's options and in the app's message area beside
+#: its field. ``dt`` reads as the run's step (``--dt``), but the ``qp`` and ``mpc`` take
+#: it as the step they plan each command for (docs/qp.md, docs/mpc.md). At most about 230
+#: characters: the app's message box holds three lines of its smallest font.
 NOTES = {
-    "dt": "the step the controller plans each command for, s (qp: the look-ahead of its "
-    "exact stability check and the step of its acceleration limits, docs/qp.md; mpc: its "
-    "plan's first interval, docs/mpc.md); default: the simulation's control step (--dt of "
-    "track and scenarios), which the option does not change",
+    "dt": "the step the controller plans each command for, s (qp: its stability check's "
+    "look-ahead and its acceleration limits' step; mpc: its plan's first interval); "
+    "default: the run's control step (--dt), which the option does not change",
 }
 
 

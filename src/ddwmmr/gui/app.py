@@ -36,7 +36,7 @@ from ddwmmr.gui.layout import (
     SUMMARY_RIGHT,
     PanelLayout,
 )
-from ddwmmr.gui.options import OptionSpec, method_options
+from ddwmmr.gui.options import NOTES, OptionSpec, method_options
 from ddwmmr.gui.paths import check_export_root
 from ddwmmr.gui.settings import (
     SLOTS,
@@ -404,7 +404,9 @@ class App(PanelLayout):
         self._show_options()
 
     def _show_options(self) -> None:
-        """Show the option widgets of the edited slot's method (one page of them)."""
+        """Show the option widgets of the edited slot's method (one page of them). An
+        option of the page whose name misleads (``dt``, :data:`NOTES`, the command lines'
+        ``--help`` note) gets that note in the message area, unless it shows an error."""
         slot = self._options_slot
         method = self.settings.methods[slot]
         for group in self._groups.values():
@@ -429,11 +431,15 @@ class App(PanelLayout):
                 widget.show(value)
             else:
                 widget.show(spec.format(value))
+        noted = [spec.name for spec, _ in shown if spec.name in NOTES]
         self.options_note.set_text(
             "none (this method has no options)"
             if not group.specs
             else "blank number field: automatic value (None); Enter applies a field"
+            + (f"; {', '.join(noted)}: see the note below" if noted else "")
         )
+        if noted and not self.message_is_error:
+            self.say(" ".join(f"{name} ({method}): {NOTES[name]}" for name in noted))
         self._redraw()
 
     def _option_group(self, slot: int, method: str) -> _OptionGroup:

@@ -296,6 +296,9 @@ class PanelLayout:
         ax.set_xticks([])
         ax.set_yticks([])
         ax.set_facecolor("0.97")
+        # lines 1.1 apart: three lines of the smallest message font (parentheses and
+        # descenders included) fit at every dpi (matplotlib's 1.2 ran a point over the
+        # box at 40 and 90 dpi, and the message was cut to two)
         self.message_text = ax.text(
             0.02,
             0.94,
@@ -305,6 +308,7 @@ class PanelLayout:
             va="top",
             ha="left",
             family="monospace",
+            linespacing=1.1,
         )
 
     def _build_view(self) -> None:

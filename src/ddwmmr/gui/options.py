@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from ddwmmr.controllers.option_specs import (
     CHOICES,
+    NOTES,
     UNITS,
     OptionSpec,
     format_choice,
@@ -20,6 +21,7 @@ method_options = option_specs
 
 __all__ = [
     "CHOICES",
+    "NOTES",
     "UNITS",
     "OptionSpec",
     "format_choice",
