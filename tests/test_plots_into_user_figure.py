@@ -202,6 +202,23 @@ def test_a_path_legend_drawn_into_a_callers_axes_sits_beside_it_within_the_figur
         assert isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine)
 
 
+@pytest.mark.parametrize("layout", [None, "constrained"])
+def test_a_path_drawn_into_axes_in_a_subfigure_returns_that_subfigure(wide_run, layout):
+    """Axes in a SubFigure: plot_path failed laying it out (a SubFigure has neither
+    tight_layout nor a size); its hint said Figure while it handed back the SubFigure.
+    Now the whole figure is laid out and the SubFigure, the figure ``ax`` is on, returned."""
+    fig = Figure(layout=layout)
+    FigureCanvasAgg(fig)
+    left, _ = fig.subfigures(1, 2)
+    ax = left.subplots()
+    assert plot_path(wide_run, ax=ax) is left
+    fig.canvas.draw()
+    legend = ax.get_legend().get_window_extent()
+    assert legend.x0 >= ax.bbox.x1  # beside the axes, off the data
+    assert fig.bbox.x0 <= legend.x0 and legend.x1 <= fig.bbox.x1  # on the figure
+    assert tuple(fig.get_size_inches()) == (6.4, 4.8)
+
+
 def test_place_legend_takes_the_labels_of_handles_given_alone():
     fig = Figure()
     FigureCanvasAgg(fig)

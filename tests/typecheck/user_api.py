@@ -181,3 +181,19 @@ def trajectories_from_lists_and_files() -> None:
     loaded = load_trajectory("ellipse", a=2.5, T=50.0)
     assert_type(loaded, Ellipse | Rectangle | SampledTrajectory)
     print(samples.pose(2.0), loaded.duration)
+
+
+def path_figure_on_own_or_given_axes(result: SimulationResult) -> None:
+    """``plot_path`` returns its own Figure, or the figure the given axes are on, which
+    is a SubFigure for axes in one."""
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure, SubFigure
+
+    from ddwmmr.reports.plots import plot_path
+
+    own = plot_path(result)
+    assert_type(own, Figure)
+    own.savefig("path.png")
+    whole = Figure()
+    ax: Axes = whole.add_subfigure(whole.add_gridspec(1, 2)[0, 0]).subplots()
+    assert_type(plot_path(result, ax=ax), Figure | SubFigure)

@@ -19,11 +19,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, TypedDict
+from typing import TYPE_CHECKING, Any, TypedDict, overload
 
 import numpy as np
 from matplotlib.axes import Axes
-from matplotlib.figure import Figure
+from matplotlib.figure import Figure, SubFigure
 from matplotlib.layout_engine import PlaceHolderLayoutEngine
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
@@ -209,22 +209,42 @@ def break_wraps(t: np.ndarray, angle: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return np.insert(t, jumps, np.nan), np.insert(angle, jumps, np.nan)
 
 
+@overload
+def plot_path(
+    result: SimulationResult,
+    ax: None = None,
+    snapshots: int = 6,
+    obstacles: Obstacles = None,
+) -> Figure: ...
+
+
+@overload
+def plot_path(
+    result: SimulationResult,
+    ax: Axes,
+    snapshots: int = 6,
+    obstacles: Obstacles = None,
+) -> Figure | SubFigure: ...
+
+
 def plot_path(
     result: SimulationResult,
     ax: Axes | None = None,
     snapshots: int = 6,
     obstacles: Obstacles = None,
-) -> Figure:
+) -> Figure | SubFigure:
     """Desired vs actual end-effector path, base path, the robot at up to ``snapshots``
     times, no base inside another's footprint (one grey per time, named in the legend; see
     :func:`snapshot_indices`) and the obstacles (``(x, y, radius)``
     circles, m) if any. The axes hold everything drawn; the legend sits beside them.
 
     Without ``ax`` the figure is made here, 8.6 inches wide and as tall as the equal-scale
-    path needs. An ``ax`` of the caller's is drawn into as it is (other runs' paths may
-    share it) and its figure keeps its size; it is laid out as :func:`plot_errors` lays
-    out a caller's figure (by its own layout engine, else ``tight_layout``), so that the
-    legend beside the axes stays on the figure."""
+    path needs, and returned. An ``ax`` of the caller's is drawn into as it is (other
+    runs' paths may share it) and its figure keeps its size; it is laid out as
+    :func:`plot_errors` lays out a caller's figure (by its own layout engine, else
+    ``tight_layout``), so that the legend beside the axes stays on the figure, and the
+    figure ``ax`` is on is returned: a :class:`~matplotlib.figure.SubFigure` for axes in
+    one (``plt.figure().subfigures(1, 2)``), whose whole figure is what is laid out."""
     ts = result.timeseries
     own_figure = ax is None
     fig, ax = _axes(ax, figsize=(8.6, 5.6))
@@ -271,7 +291,9 @@ def plot_path(
     handles, _ = ax.get_legend_handles_labels()
     legend_beside(ax, handles=[*handles, *robots], fontsize=8)
     ax.grid(alpha=0.3)
-    if own_figure:
+    if isinstance(fig, SubFigure):  # only the whole figure has a size and a layout
+        _lay_out(fig.figure, own=False)
+    elif own_figure:
         _fit_path_figure(fig, ax)
     else:  # make room for the legend beside the axes, as the other makers do
         _lay_out(fig, own=False)
@@ -572,10 +594,11 @@ def _lay_out(fig: Figure, own: bool) -> None:
         engine.execute(fig)
 
 
-def _axes(ax: Axes | None, figsize: tuple[float, float]) -> tuple[Figure, Axes]:
+def _axes(ax: Axes | None, figsize: tuple[float, float]) -> tuple[Figure | SubFigure, Axes]:
+    """``ax`` and the figure it is on (a caller's axes in a SubFigure: that subfigure), or
+    a new figure of ``figsize`` (inches) and its one axes."""
     if ax is not None:
-        # ignore: a caller's axes in a SubFigure give that subfigure, handed back as it is
-        return ax.figure, ax  # type: ignore[return-value]
+        return ax.figure, ax
     fig = new_figure(figsize)
     return fig, fig.subplots()
 
