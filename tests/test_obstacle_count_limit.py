@@ -52,6 +52,30 @@ def test_a_file_over_the_limit_is_refused_naming_the_count(tmp_path):
     assert str(info.value) == f"obstacles: {path} {too_many}"
 
 
+def test_a_file_far_over_the_limit_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
+    """A file of 100,000 tables was parsed (seconds) before its count was refused: its
+    [[obstacle]] headers are counted in the text first. Headers spelt with quotes, spaces
+    and a comment count too; a file the headers' count admits is parsed as before."""
+    import tomllib
+
+    path = tmp_path / "many.toml"
+    headers = ["[[obstacle]]", '[[ "obstacle" ]]  # quoted', "  [['obstacle']]"]
+    tables = (f"{headers[i % 3]}\nx = {i}\ny = 0\nradius = 0.1\n" for i in range(100_000))
+    path.write_text("\n".join(tables), encoding="utf-8")
+
+    def not_parsed(*args, **kwargs):
+        raise AssertionError("parsed before the count was checked")
+
+    monkeypatch.setattr(tomllib, "loads", not_parsed)
+    with pytest.raises(ParameterError) as info:
+        load_obstacles(path)
+    assert str(info.value) == f"obstacles: {path} has 100000 obstacles, more than allowed {RANGE}"
+    monkeypatch.undo()
+    three = tmp_path / "three.toml"
+    three.write_text("\n".join(f"{h}\nx = 1\ny = 0\nradius = 0.1\n" for h in headers))
+    assert len(load_obstacles(three)) == 3
+
+
 def test_track_refuses_it_in_one_line_with_status_2(tmp_path, capsys):
     path = obstacle_file(tmp_path, 3000)
     args = ["--method", "qp", "--traj", "ellipse", "--obstacles", str(path)]

@@ -454,19 +454,25 @@ def read_text_file(path: str | Path, label: str) -> str:
 _LONE_CR = re.compile(r"\r(?!\n)")
 
 
-def load_toml(path: str | Path, label: str) -> dict[str, Any]:
+def load_toml(
+    path: str | Path, label: str, precheck: Callable[[str], None] | None = None
+) -> dict[str, Any]:
     """Parse a TOML file; unreadable, invalid or too deeply nested files (more than
     :data:`MAX_TOML_DEPTH` levels of arrays and tables) raise :class:`ParameterError`.
     Its lines may end in LF, CRLF or CR alone.
 
     The one place every TOML input is read (robot, trajectory, obstacles, from every tool
     and the API). ``label`` names the option in the message (``robot``, ``traj``,
-    ``obstacles``).
+    ``obstacles``). ``precheck``, if given, is called with the text before it is parsed
+    (the parser takes seconds per megabyte): it may refuse what a glance at the text
+    shows, e.g. far more tables than allowed.
     """
     text = read_text_file(path, label)  # refuses a path of the wrong type (as_path)
     # Lines ended by CR alone (classic Mac OS editors) read as LF: TOML allows no lone CR
     # anywhere, so this changes no valid file, and the CSV inputs take them too.
     text = _LONE_CR.sub("\n", text)
+    if precheck is not None:
+        precheck(text)
     path = Path(path)
     too_deep = ParameterError(
         f"{label}: {path} nests arrays or tables more than {MAX_TOML_DEPTH} levels deep"

@@ -16,6 +16,7 @@ changes that clearance to first order, ``d_dot >= min(that, 0)`` (:meth:`Obstacl
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -116,11 +117,27 @@ def check_obstacle_count(count: int, source: str = "") -> int:
     )
 
 
+#: A line holding an ``[[obstacle]]`` table header (the key bare or quoted, a comment after
+#: it): the tables :func:`load_obstacles` counts before the file is parsed.
+_OBSTACLE_HEADER = re.compile(
+    r"""^[ \t]*\[\[[ \t]*(?:obstacle|"obstacle"|'obstacle')[ \t]*\]\][ \t]*(?:#.*)?$""",
+    re.MULTILINE,
+)
+
+
 def load_obstacles(path: str | Path) -> list[Circle]:
     """Read circles from a TOML file of ``[[obstacle]]`` tables with x, y, radius (m): one
     to :data:`MAX_OBSTACLES` of them (:func:`check_obstacle_count`)."""
     path = as_path(path, "obstacles")
-    data = load_toml(path, "obstacles")
+
+    def count_headers(text: str) -> None:
+        # a file of 100,000 tables took seconds to parse before its count was refused;
+        # the [[obstacle]] headers counted in the text refuse it at once (a header spelt
+        # otherwise is counted when parsed; header lines inside a multi-line string
+        # would count too: a thousand of them make no obstacle file)
+        check_obstacle_count(len(_OBSTACLE_HEADER.findall(text)), str(path))
+
+    data = load_toml(path, "obstacles", count_headers)
     tables = data.get("obstacle")
     unknown = sorted(set(data) - {"obstacle"})
     if unknown:
