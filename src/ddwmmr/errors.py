@@ -158,6 +158,18 @@ def check_bool(name: str, value: Any) -> bool:
     return bool(value)
 
 
+def one_of(value: Any, choices: Iterable[Any]) -> bool:
+    """Whether ``value`` is one of ``choices`` (names of a choice parameter): ``value in
+    choices`` for a hashable value; an unhashable one (a numpy array, a list, a dict) is
+    none of them, where ``in`` would compare an array elementwise and fail on its
+    ambiguous truth."""
+    try:
+        hash(value)
+    except TypeError:
+        return False
+    return value in choices
+
+
 def check_instance(name: str, value: Any, kind: type) -> Any:
     """Return ``value`` if it is a ``kind`` (or a subclass), else raise
     :class:`ParameterError` naming the parameter and the expected type."""

@@ -24,7 +24,15 @@ from typing import Any, NoReturn
 
 from ddwmmr.arbiters.state_machine import STATES
 from ddwmmr.behaviours.base import PROPOSAL_MODES, Behaviour, Percept, Proposal
-from ddwmmr.errors import PluginError, name_of, raise_plugin_error, real_number, shown, texts_apart
+from ddwmmr.errors import (
+    PluginError,
+    name_of,
+    one_of,
+    raise_plugin_error,
+    real_number,
+    shown,
+    texts_apart,
+)
 from ddwmmr.inheritance import from_library
 
 #: What ``select`` must return, for the messages.
@@ -203,7 +211,7 @@ def _check_proposal(name: str, method: str, field: str, proposal: Any, t: float)
     if not isinstance(proposal, Proposal):
         got = f"returned {field} {shown(proposal)}"
         _refuse(name, method, got, t, "it must be a behaviour's Proposal")
-    if proposal.mode not in PROPOSAL_MODES:
+    if not one_of(proposal.mode, PROPOSAL_MODES):
         got = f"returned {field}.mode {shown(proposal.mode)}"
         _refuse(name, method, got, t, f"allowed: {', '.join(PROPOSAL_MODES)}")
     for attribute in ("bx", "by", "heading"):

@@ -37,6 +37,7 @@ from ddwmmr.errors import (
     check_positive,
     check_range,
     check_step_count,
+    one_of,
     shown,
 )
 from ddwmmr.gui.options import method_options, plant_keywords, plant_names
@@ -298,11 +299,11 @@ def check_settings(settings: Settings) -> Settings:
             )
     if settings.methods[0] is None:
         raise ParameterError("method: slot A needs a method")
-    if settings.plant not in plant_names():
+    if not one_of(settings.plant, plant_names()):
         raise ParameterError(
             f"plant must be one of {', '.join(plant_names())} (got {shown(settings.plant)})"
         )
-    if settings.integrator not in INTEGRATORS:
+    if not one_of(settings.integrator, INTEGRATORS):
         raise ParameterError(
             f"integrator must be one of {', '.join(INTEGRATORS)} (got {shown(settings.integrator)})"
         )

@@ -31,6 +31,7 @@ from ddwmmr.errors import (
     check_positive,
     check_range,
     check_weight,
+    one_of,
     shown,
     texts_apart,
 )
@@ -282,13 +283,13 @@ class MPCOptions:
 
     def __post_init__(self) -> None:
         model, solver, qp_solver = self.model, self.solver, self.qp_solver
-        if model is not None and model not in MODELS:
+        if model is not None and not one_of(model, MODELS):
             raise ParameterError(f"model must be one of {', '.join(MODELS)} (got {shown(model)})")
-        if solver not in SOLVERS:
+        if not one_of(solver, SOLVERS):
             raise ParameterError(
                 f"solver must be one of {', '.join(SOLVERS)} (got {shown(solver)})"
             )
-        if qp_solver not in QP_SOLVERS:
+        if not one_of(qp_solver, QP_SOLVERS):
             raise ParameterError(
                 f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {shown(qp_solver)})"
             )

@@ -30,7 +30,7 @@ import casadi as ca
 import numpy as np
 
 from ddwmmr import interrupts
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, one_of, shown
 from ddwmmr.mpc.ocp import ShootingOCP
 
 #: Levenberg-Marquardt floor added to the Gauss-Newton Hessian (keeps it positive definite).
@@ -171,7 +171,7 @@ class GaussNewtonSQP:
         tolerance: float = 1e-6,
         proximal: float = 0.0,
     ) -> None:
-        if qp_solver not in QP_SOLVERS:
+        if not one_of(qp_solver, QP_SOLVERS):
             raise ParameterError(
                 f"qp_solver must be one of {', '.join(QP_SOLVERS)} (got {shown(qp_solver)})"
             )

@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any, cast
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_instance, shown
+from ddwmmr.errors import ParameterError, check_instance, one_of, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import base_motion, check_configuration, qdot_from_u
 from ddwmmr.model.robot import clamp_joints
@@ -59,7 +59,7 @@ class KinematicPlant:
     extra_columns: tuple[str, ...] = ()
 
     def __init__(self, robot: Robot, integrator: str = "rk4") -> None:
-        if integrator not in INTEGRATORS:
+        if not one_of(integrator, INTEGRATORS):
             raise ParameterError(
                 f"integrator must be one of {', '.join(INTEGRATORS)} (got {shown(integrator)})"
             )

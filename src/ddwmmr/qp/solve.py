@@ -26,7 +26,7 @@ from typing import Any, Protocol
 
 import numpy as np
 
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, one_of, shown
 from ddwmmr.qp.limits.base import INF
 from ddwmmr.qp.problem import QPProblem
 
@@ -54,7 +54,7 @@ def _qpsolvers() -> ModuleType:
 
 def check_mode(mode: str) -> str:
     """Validate the ``mode`` option."""
-    if mode not in MODES:
+    if not one_of(mode, MODES):
         raise ParameterError(f"mode must be one of {', '.join(MODES)} (got {shown(mode)})")
     return mode
 
@@ -62,7 +62,7 @@ def check_mode(mode: str) -> str:
 def check_solver(solver: str) -> str:
     """Validate the ``solver`` option against the installed qpsolvers backends."""
     available = _qpsolvers().available_solvers
-    if solver not in available:
+    if not one_of(solver, available):
         raise ParameterError(f"solver must be one of {', '.join(available)} (got {shown(solver)})")
     return solver
 
@@ -209,10 +209,10 @@ def make_backend(solver: str, warm_start: bool | None = None) -> DaqpBackend | Q
     ``"qpsolvers-daqp"`` forces DAQP through qpsolvers (for comparisons). A solver that is
     not installed raises :class:`ParameterError` naming the installed ones.
     """
-    if solver == "daqp" and importlib.util.find_spec("daqp") is not None:
+    if isinstance(solver, str) and solver == "daqp" and importlib.util.find_spec("daqp"):
         return DaqpBackend(warm_start=bool(warm_start))
     installed = installed_solvers()
-    if solver not in installed:
+    if not one_of(solver, installed):
         raise ParameterError(
             f"solver must be one of the installed QP solvers: {', '.join(installed)} "
             f"(got {shown(solver)})"

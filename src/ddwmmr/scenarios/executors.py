@@ -20,7 +20,7 @@ from types import ModuleType
 from typing import Any
 
 from ddwmmr import interrupts
-from ddwmmr.errors import MAX_JOBS, ParameterError, check_finite, check_int_at_least, shown
+from ddwmmr.errors import MAX_JOBS, ParameterError, check_finite, check_int_at_least, one_of, shown
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.scenarios.protocol import Outcome, RunConfig, run_scenario
 from ddwmmr.workers import process_pool, worker_display
@@ -83,7 +83,7 @@ def run_many(
             connecting, or starting a cluster, for this call.
         on_done: called with the number of scenarios finished by each completed chunk.
     """
-    if executor not in EXECUTORS:
+    if not one_of(executor, EXECUTORS):
         raise ParameterError(
             f"executor must be one of {', '.join(EXECUTORS)} (got {shown(executor)})"
         )

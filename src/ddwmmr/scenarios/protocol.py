@@ -72,6 +72,7 @@ from ddwmmr.errors import (
     check_range,
     check_step_count,
     float_values,
+    one_of,
     raise_plugin_error,
     real_number,
     shown,
@@ -209,7 +210,7 @@ class RunConfig:
 
     def __post_init__(self) -> None:
         controllers = scenario_controllers()
-        if self.controller not in controllers:
+        if not one_of(self.controller, controllers):
             raise ParameterError(
                 f"controller must be one of {', '.join(controllers)} (got {shown(self.controller)})"
             )

@@ -27,6 +27,7 @@ from ddwmmr.errors import (
     check_step_count,
     float_values,
     name_of,
+    one_of,
     shown,
 )
 from ddwmmr.gains import gain_step_warning
@@ -419,7 +420,7 @@ def _add_plug_in_keys(
 def _tipped_start(robot: Robot, q: np.ndarray, policy: str) -> bool:
     """Whether the robot has tipped over in the start ``q``; warns or refuses as
     ``policy`` (one of :data:`TIPPED_START`, see :func:`simulate`) says."""
-    if policy not in TIPPED_START:
+    if not one_of(policy, TIPPED_START):
         raise ParameterError(
             f"tipped_start must be one of {', '.join(TIPPED_START)} (got {shown(policy)})"
         )
@@ -528,7 +529,7 @@ def plant_integrator(plant: str, integrator: str | None) -> str | None:
     (``"rk4"`` by default), None for the other plants, which integrate their own dynamics
     (asking one for an integrator is a :class:`ParameterError`)."""
     if plant == "kinematic":
-        return integrator or "rk4"
+        return "rk4" if integrator is None else integrator
     if integrator is not None:
         raise ParameterError(
             f"integrator: only the kinematic plant takes an integrator (plant {shown(plant)})"

@@ -94,8 +94,11 @@ def _named_file(candidates: Iterable[Path]) -> Path | None:
     them said "unknown trajectory 'fifo'" while listing fifo among the known names, which
     list regular files only)."""
     for candidate in candidates:
-        if candidate.is_file() or (os.path.lexists(candidate) and not candidate.is_dir()):
-            return candidate
+        try:
+            if candidate.is_file() or (os.path.lexists(candidate) and not candidate.is_dir()):
+                return candidate
+        except OSError:  # e.g. a name longer than the file system takes: not there
+            continue
     return None
 
 

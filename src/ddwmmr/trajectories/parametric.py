@@ -31,6 +31,7 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_positive,
     check_range,
+    one_of,
     shown,
 )
 from ddwmmr.trajectories.base import atan2_array, check_name, check_time, check_times
@@ -127,7 +128,7 @@ class _Parametric(ABC):
         for name in ("x0", "y0", "beta", "phi", "a", "b", "T"):
             object.__setattr__(self, name, check_geometry_value(name, getattr(self, name)))
         object.__setattr__(self, "N", check_int_at_least("N", self.N, 2, MAX_TRAJECTORY_SAMPLES))
-        if self.orientation not in ORIENTATIONS:
+        if not one_of(self.orientation, ORIENTATIONS):
             raise ParameterError(
                 f"orientation must be one of {', '.join(ORIENTATIONS)}"
                 f" (got {shown(self.orientation)})"

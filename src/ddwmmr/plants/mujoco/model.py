@@ -55,7 +55,7 @@ from typing import TYPE_CHECKING, cast
 import mujoco
 import numpy as np
 
-from ddwmmr.errors import ParameterError, check_positive, check_range, shown
+from ddwmmr.errors import ParameterError, check_positive, check_range, one_of, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import BASE_CLEARANCE_M
 from ddwmmr.model.support_loads import convex_hull
@@ -185,7 +185,7 @@ class EngineOptions:
             object.__setattr__(self, name, check_range(name, getattr(self, name), low, high, unit))
         if self.tyre_stiffness is not None:
             object.__setattr__(self, "tyre_stiffness", _checked_stiffness(self.tyre_stiffness))
-        if self.cone not in CONES:
+        if not one_of(self.cone, CONES):
             raise ParameterError(f"cone must be one of {', '.join(CONES)} (got {shown(self.cone)})")
         if self.contact_time_constant < 2.0 * self.timestep:
             default = (
