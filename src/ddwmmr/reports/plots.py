@@ -28,7 +28,7 @@ from matplotlib.layout_engine import PlaceHolderLayoutEngine
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, as_path, check_instance, check_int_at_least, shown
 from ddwmmr.model import Robot
 from ddwmmr.reports import palette
 from ddwmmr.reports.canvas import frame_indices, new_figure, save_gif
@@ -176,16 +176,21 @@ def fit_equal(ax: Axes, xs: np.ndarray, ys: np.ndarray, margin: float) -> None:
 
 
 def circles_of(obstacles: Obstacles) -> list[tuple[float, float, float]]:
-    """Obstacles as ``(x, y, radius)`` triples (m): from circles, triples or None."""
-    found = []
-    for item in obstacles or ():
-        if hasattr(item, "radius"):
-            # ignore: hasattr picks the circles; mypy keeps the triples in the union
-            found.append((float(item.x), float(item.y), float(item.radius)))  # type: ignore[union-attr]
-        else:
-            x, y, radius = (float(v) for v in item)
-            found.append((x, y, radius))
-    return found
+    """Obstacles as ``(x, y, radius)`` triples (m): from circles (anything with ``x``,
+    ``y`` and ``radius``), triples or None, checked as the ``obstacles`` option of ``qp``
+    and ``mpc`` is (:func:`ddwmmr.qp.limits.obstacles.as_circles`: finite centres, radii >
+    0, at most :data:`~ddwmmr.errors.MAX_OBSTACLES`; anything else a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming ``obstacles``)."""
+    from ddwmmr.qp.limits.obstacles import as_circles  # the qp's package: on first use
+
+    def triple(item: Any) -> Any:  # a circle of another class, as as_circles reads it
+        return (item.x, item.y, item.radius) if hasattr(item, "radius") else item
+
+    given: Any = obstacles  # as given: as_circles refuses what is none of its kinds
+    iterable = hasattr(given, "__iter__") and not isinstance(given, str | bytes | Mapping)
+    if iterable and not (isinstance(given, np.ndarray) and given.ndim == 0):
+        given = [triple(item) for item in given]
+    return [(c.x, c.y, c.radius) for c in as_circles(given)]
 
 
 def draw_obstacles(ax: Axes, obstacles: Obstacles, label: str = "obstacle") -> None:
@@ -245,11 +250,16 @@ def plot_path(
     ``tight_layout``), so that the legend beside the axes stays on the figure, and the
     figure ``ax`` is on is returned: a :class:`~matplotlib.figure.SubFigure` for axes in
     one (``plt.figure().subfigures(1, 2)``), whose whole figure is what is laid out."""
-    ts = result.timeseries
+    ts = _run(result).timeseries
+    if ax is not None:
+        check_instance("ax", ax, Axes)
+    # more instants than samples draw each sample once
+    count = min(check_int_at_least("snapshots", snapshots, 1), len(ts["t"]))
+    circles_of(obstacles)  # refused before anything is drawn
     own_figure = ax is None
     fig, ax = _axes(ax, figsize=(8.6, 5.6))
     draw_obstacles(ax, obstacles)
-    indices = snapshot_indices(ts, snapshots, footprint_spacing(result.robot))
+    indices = snapshot_indices(ts, count, footprint_spacing(result.robot))
     robots = draw_snapshots(ax, result.robot, ts, indices, lw=0.9)
     # The desired path on top of the actual one, dashed: visible where they coincide.
     ax.plot(
@@ -334,7 +344,7 @@ def plot_errors(result: SimulationResult, *, fig: Figure | None = None) -> Figur
     caller's (``plt.figure()``: then ``plt.show()`` shows it), kept at its size and layout
     engine; anything else as ``fig`` (not a Figure, one holding axes or of zero width or
     height) is a one-line :class:`~ddwmmr.errors.ParameterError` naming ``fig``."""
-    ts = result.timeseries
+    ts = _run(result).timeseries
     fig, own = _figure_for(fig, (7, 5))
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     position = np.maximum(ts["position_error_m"], ERROR_FLOOR)
@@ -393,7 +403,7 @@ def plot_rates(result: SimulationResult, *, fig: Figure | None = None) -> Figure
 
     Drawn on an 8.6 x 6.4 inch figure of its own, or into ``fig`` as :func:`plot_errors`
     does; returns the figure."""
-    ts, robot = result.timeseries, result.robot
+    ts, robot = _run(result).timeseries, result.robot
     fig, own = _figure_for(fig, (8.6, 6.4))
     ax1, ax2, ax3 = fig.subplots(3, 1, sharex=True)
     ax1.plot(ts["t"], ts["th1dot"], label="th1dot")
@@ -454,7 +464,7 @@ def plot_metrics(result: SimulationResult, *, fig: Figure | None = None) -> Figu
     """Manipulability eta and tip-over stability S vs time (S = 1 tips); returns the figure.
 
     Drawn on a 7 x 5 inch figure of its own, or into ``fig`` as :func:`plot_errors` does."""
-    ts = result.timeseries
+    ts = _run(result).timeseries
     fig, own = _figure_for(fig, (7, 5))
     ax1, ax2 = fig.subplots(2, 1, sharex=True)
     ax1.plot(ts["t"], ts["manipulability"], color="tab:purple")
@@ -480,8 +490,13 @@ def plot_metrics(result: SimulationResult, *, fig: Figure | None = None) -> Figu
 def save_run_figures(
     result: SimulationResult, folder: str | Path, obstacles: Obstacles = None
 ) -> list[Path]:
-    """Write path.png (with ``obstacles``), errors.png, rates.png, metrics.png in ``folder``."""
-    folder = Path(folder)
+    """Write path.png (with ``obstacles``), errors.png, rates.png, metrics.png in
+    ``folder``, an existing folder; anything else, or a file that cannot be written, is a
+    one-line :class:`~ddwmmr.errors.ParameterError` naming ``folder``."""
+    _run(result)
+    folder = as_path(folder, "folder")
+    if not folder.is_dir():
+        raise ParameterError(f"folder: {folder} is not an existing folder")
     paths = []
     makers: tuple[Callable[[SimulationResult], Figure], ...] = (
         lambda r: plot_path(r, obstacles=obstacles),
@@ -492,7 +507,10 @@ def save_run_figures(
     for name, make in zip(FIGURE_NAMES, makers):
         fig = make(result)
         path = folder / name
-        fig.savefig(path, dpi=110, metadata=PNG_METADATA)
+        try:
+            fig.savefig(path, dpi=110, metadata=PNG_METADATA)
+        except OSError as exc:
+            raise ParameterError(f"folder: cannot write {path} ({exc.strerror or exc})") from None
         paths.append(path)
     return paths
 
@@ -507,10 +525,19 @@ def save_animation(
 ) -> Path:
     """Write a GIF of the robot following the trajectory: ``frames`` evenly spaced
     recorded instants (every instant of a run with fewer), ``fps`` per second;
-    ``progress`` shows the encoding on stderr (:mod:`ddwmmr.progress`)."""
+    ``progress`` shows the encoding on stderr (:mod:`ddwmmr.progress`). ``frames`` is an
+    integer >= 1, ``fps`` one in [1, 100] (a GIF times its frames in hundredths of a
+    second); a ``path`` that is not one, or cannot be written, is a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming it."""
     from ddwmmr.progress import ProgressBar
 
-    ts, robot = result.timeseries, result.robot
+    frames = check_int_at_least("frames", frames, 1)
+    fps = check_int_at_least("fps", fps, 1, 100)
+    path = as_path(path, "path")
+    if path.suffix.lower() != ".gif":  # the writer picks the format by the suffix
+        raise ParameterError(f"path must be a .gif file (got {shown(path.name, 60)})")
+    circles_of(obstacles)  # refused before anything is drawn
+    ts, robot = _run(result).timeseries, result.robot
     q = result.configurations()
     fig = new_figure((5, 4.5))
     ax = fig.subplots()
@@ -540,10 +567,21 @@ def save_animation(
         title = ax.set_title(f"{_title(result, '')} t = {ts['t'][k]:.1f} s")
         return trace, footprint, arm, title
 
-    path = Path(path)
     with ProgressBar(len(indices), "track: animation.gif", enabled=progress, unit="frame") as bar:
-        save_gif(fig, update, len(indices), path, fps, bar.advance)
+        try:
+            save_gif(fig, update, len(indices), path, fps, bar.advance)
+        except OSError as exc:
+            raise ParameterError(f"path: cannot write {path} ({exc.strerror or exc})") from None
     return path
+
+
+def _run(result: SimulationResult) -> SimulationResult:
+    """``result`` if it holds a ``timeseries`` mapping, as a
+    :class:`~ddwmmr.sim.SimulationResult` does, else a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming ``result``."""
+    if not isinstance(getattr(result, "timeseries", None), Mapping):
+        raise ParameterError(f"result must be a SimulationResult (got {shown(result, 60)})")
+    return result
 
 
 def _figure_for(fig: object, figsize: tuple[float, float]) -> tuple[Figure, bool]:

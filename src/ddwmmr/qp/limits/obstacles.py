@@ -189,7 +189,8 @@ def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> li
         return []
     if isinstance(obstacles, str | Path):
         return load_obstacles(find_obstacle_file(obstacles))
-    if not hasattr(obstacles, "__iter__"):
+    zero_d = isinstance(obstacles, np.ndarray) and obstacles.ndim == 0  # not iterable
+    if not hasattr(obstacles, "__iter__") or zero_d:
         raise ParameterError(
             f"obstacles must be circles, (x, y, radius) triples or a TOML file "
             f"(got {shown(obstacles)})"
