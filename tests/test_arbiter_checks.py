@@ -20,7 +20,7 @@ from ddwmmr.arbiters import (
 )
 from ddwmmr.arbiters.checked import check_blend
 from ddwmmr.behaviours import BRAKE, DRIVE, Proposal
-from ddwmmr.errors import PluginError
+from ddwmmr.errors import ParameterError, PluginError
 from ddwmmr.plants import make_plant
 from ddwmmr.scenarios import RunConfig, generate
 from ddwmmr.scenarios.protocol import make_scenario_controller
@@ -311,3 +311,14 @@ def test_checked_arbiter_is_exported_and_names_who_handed_over_a_non_arbiter():
         "controller thesis: waypoint_options gave arbiter 'mine', which has no "
         "select(percept, behaviours) method"
     )
+
+
+def test_make_arbiter_refuses_what_is_no_run_configuration():
+    """make_arbiter(config) read config.arbiter: a name given instead raised
+    AttributeError."""
+    from ddwmmr.arbiters import make_arbiter
+
+    with pytest.raises(
+        ParameterError, match=r"^config must be a RunConfig .*\(got 'competitive'\)"
+    ):
+        make_arbiter("competitive")

@@ -15,7 +15,7 @@ import inspect
 from typing import Any
 
 from ddwmmr.arbiters.state_machine import Hysteresis
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import ParameterError, shown
 from ddwmmr.registry import ARBITERS, CONTROLLERS
 
 #: The arbiter a run uses when it names none.
@@ -52,7 +52,13 @@ def check_arbiter(arbiter: Any, controller: str = "thesis") -> None:
 
 
 def make_arbiter(config: Any) -> Any:
-    """The arbiter a run configuration asks for (``config.arbiter``, thresholds, seed)."""
+    """The arbiter a run configuration asks for (``config.arbiter``, thresholds, seed);
+    ``config`` is a :class:`~ddwmmr.scenarios.protocol.RunConfig` (one without
+    ``arbiter``, such as a name, is a one-line :class:`ParameterError` naming it)."""
+    if not hasattr(config, "arbiter"):
+        raise ParameterError(
+            f"config must be a RunConfig (ddwmmr.scenarios.protocol) (got {shown(config)})"
+        )
     arbiter = config.arbiter
     if not isinstance(arbiter, str):
         return arbiter
