@@ -145,3 +145,30 @@ def test_the_default_worker_count_is_within_what_run_many_accepts(monkeypatch):
     assert default_jobs() == MAX_JOBS == 256
     monkeypatch.setattr(os, "sched_getaffinity", lambda pid: {0, 1}, raising=False)
     assert default_jobs() == 2
+
+
+@pytest.mark.parametrize(
+    ("fields", "message"),
+    [
+        ({"index": None}, r"^scenario index must be an integer >= 0 \(got None\)$"),
+        ({"waypoints": None}, r"^scenario waypoints must be a non-empty sequence of \(x, y\) "),
+        ({"waypoints": ()}, r"^scenario waypoints must be .* \(got none\)$"),
+        ({"waypoints": ((1, 2), (1, "a"))}, r"^scenario waypoints\[2\] must be an \(x, y\) pair"),
+        ({"waypoints": ((float("nan"), 0),)}, r"^scenario waypoints\[1\] x must be a finite "),
+        (
+            {"obstacles": ((1, 2),)},
+            r"^obstacles must be Circle\(x, y, radius\) or \(x, y, radius\)",
+        ),
+    ],
+)
+def test_run_scenario_refuses_a_hand_made_scenario_naming_its_field(fields, message):
+    """A Scenario built by hand was run unchecked: a waypoint list of None raised
+    TypeError (len), an index of None TypeError (+ 1) after the run, a text coordinate
+    TypeError (float - str)."""
+    from ddwmmr.scenarios import run_scenario
+    from ddwmmr.scenarios.generator import Scenario
+
+    scenario = Scenario(**{"index": 0, "waypoints": ((1.0, 1.0),), **fields})
+    with pytest.raises(ParameterError, match=message) as info:
+        run_scenario(scenario, RunConfig(time_limit=0.1))
+    assert "\n" not in str(info.value)

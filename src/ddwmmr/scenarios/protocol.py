@@ -63,6 +63,7 @@ from ddwmmr.controllers.base import (
 )
 from ddwmmr.errors import (
     MASS_RANGE_KG,
+    MAX_COORDINATE_M,
     ParameterError,
     PluginError,
     check_finite,
@@ -677,6 +678,7 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
         raise ParameterError(
             f"config must be a RunConfig (ddwmmr.scenarios.RunConfig) (got {shown(config)})"
         )
+    check_scenario(scenario)
     robot = config_robot(config)
     plant = make_scenario_plant(robot, config)
     controller = make_scenario_controller(robot, scenario, config, plant)
@@ -688,6 +690,38 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
     task = WaypointTask(tally, controller, has_states, plant)
     end = run_loop(plant, controller, task, q0, config.dt, tally.steps)
     return tally.outcome(end.samples * config.dt, end.samples, has_states=has_states)
+
+
+def check_scenario(scenario: Scenario) -> None:
+    """Refuse, in one line naming the field, a :class:`Scenario` built by hand whose
+    ``index`` is not an integer >= 0, whose ``waypoints`` are not a non-empty sequence of
+    (x, y) pairs of finite numbers within +-:data:`~ddwmmr.errors.MAX_COORDINATE_M` m, or
+    whose ``obstacles`` are not (x, y, radius) circles (m) as the ``qp``'s option takes
+    them (:func:`ddwmmr.qp.limits.obstacles.as_circles`)."""
+    from ddwmmr.qp.limits.obstacles import as_circles
+
+    check_int_at_least("scenario index", scenario.index, 0)
+    waypoints: Any = scenario.waypoints
+    wanted = "a non-empty sequence of (x, y) pairs in m"
+    if isinstance(waypoints, str | bytes | Mapping) or not hasattr(waypoints, "__len__"):
+        raise ParameterError(f"scenario waypoints must be {wanted} (got {shown(waypoints)})")
+    if len(waypoints) == 0:
+        raise ParameterError(f"scenario waypoints must be {wanted} (got none)")
+    for number, point in enumerate(waypoints, start=1):
+        pair = float_values(point, 2)
+        if pair is None or isinstance(point, str | bytes):
+            raise ParameterError(
+                f"scenario waypoints[{number}] must be an (x, y) pair in m (got {shown(point)})"
+            )
+        for axis, value in zip("xy", pair):
+            check_range(
+                f"scenario waypoints[{number}] {axis}",
+                value,
+                -MAX_COORDINATE_M,
+                MAX_COORDINATE_M,
+                "m",
+            )
+    as_circles(scenario.obstacles)
 
 
 def make_scenario_plant(robot: Robot, config: RunConfig) -> Plant:
