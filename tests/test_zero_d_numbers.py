@@ -80,3 +80,22 @@ def test_arm_ik_refuses_a_numpy_boolean_elbow_and_takes_a_numpy_sign():
     for flag in (np.True_, np.array(True), True, np.array([1])):
         with pytest.raises(ParameterError, match=r"^elbow must be \+1 or -1 \(got "):
             robot.arm_ik(0.3, 0.2, elbow=flag)
+
+
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        ("speed_budget", r"^speed_budget must be two numbers > 0"),
+        ("tasks", r"^tasks must be a list of Task objects"),
+        ("limits", r"^limits must be a list of Limit objects"),
+        ("obstacles", r"^obstacles must be circles, \(x, y, radius\) triples or a TOML file"),
+    ],
+)
+def test_a_0d_array_where_a_sequence_goes_is_refused_naming_it(option, message):
+    """A 0-d array has __iter__ and __len__, yet iter() and len() raise TypeError: the
+    qp's sequence options took it for a sequence and failed inside."""
+    from ddwmmr.controllers import make_controller
+
+    with pytest.raises(ParameterError, match=message + r".*\(got array\(3\)\)$") as info:
+        make_controller("qp", Robot(), **{option: np.array(3)})
+    one_line(info)

@@ -158,6 +158,24 @@ def check_bool(name: str, value: Any) -> bool:
     return bool(value)
 
 
+def length_of(value: Any) -> int | None:
+    """``len(value)``, or None for what has no length: a number, or a 0-d numpy array,
+    which has ``__len__`` but whose ``len()`` raises."""
+    try:
+        return len(value)
+    except TypeError:
+        return None
+
+
+def iterable(value: Any) -> bool:
+    """Whether ``iter(value)`` works: a 0-d numpy array has ``__iter__`` but refuses."""
+    try:
+        iter(value)
+    except TypeError:
+        return False
+    return True
+
+
 def one_of(value: Any, choices: Iterable[Any]) -> bool:
     """Whether ``value`` is one of ``choices`` (names of a choice parameter): ``value in
     choices`` for a hashable value; an unhashable one (a numpy array, a list, a dict) is

@@ -26,6 +26,7 @@ from ddwmmr.arbiters.state_machine import STATES
 from ddwmmr.behaviours.base import PROPOSAL_MODES, Behaviour, Percept, Proposal
 from ddwmmr.errors import (
     PluginError,
+    length_of,
     name_of,
     one_of,
     raise_plugin_error,
@@ -220,7 +221,7 @@ def _check_proposal(name: str, method: str, field: str, proposal: Any, t: float)
             got = f"returned {field}.{attribute} = {shown(value)}"
             _refuse(name, method, got, t, "it must be a finite number (m, or rad for heading)")
     arm = proposal.arm
-    if not (hasattr(arm, "__len__") and len(arm) == 2 and all(map(_finite, arm))):
+    if not (length_of(arm) == 2 and all(map(_finite, arm))):
         got = f"returned {field}.arm = {shown(arm)}"
         _refuse(name, method, got, t, "it must be two finite joint targets (th1, th2) in rad")
 

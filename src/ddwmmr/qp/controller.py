@@ -63,7 +63,7 @@ from ddwmmr.controllers.base import (
     step_results,
 )
 from ddwmmr.controllers.inputs import check_inputs, check_start
-from ddwmmr.errors import ParameterError, check_bool, check_positive, shown
+from ddwmmr.errors import ParameterError, check_bool, check_positive, iterable, shown
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import whole_turns
 from ddwmmr.model.stability import STABILITY_FLOOR, warn_start_below_floor
@@ -618,7 +618,7 @@ class QPController:
 
 def _pieces(name: str, pieces: Any, kind: type) -> list[Any]:
     """The user's extra tasks or limits as a list (None: none); each must be a ``kind``."""
-    items = list(pieces) if pieces is not None and hasattr(pieces, "__iter__") else None
+    items = list(pieces) if pieces is not None and iterable(pieces) else None
     if items is None and pieces is not None:
         raise ParameterError(
             f"{name} must be a list of {kind.__name__} objects (got {shown(pieces)})"

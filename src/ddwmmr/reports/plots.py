@@ -28,7 +28,14 @@ from matplotlib.layout_engine import PlaceHolderLayoutEngine
 from matplotlib.lines import Line2D
 from matplotlib.patches import Circle
 
-from ddwmmr.errors import ParameterError, as_path, check_instance, check_int_at_least, shown
+from ddwmmr.errors import (
+    ParameterError,
+    as_path,
+    check_instance,
+    check_int_at_least,
+    iterable,
+    shown,
+)
 from ddwmmr.model import Robot
 from ddwmmr.reports import palette
 from ddwmmr.reports.canvas import frame_indices, new_figure, save_gif
@@ -187,8 +194,7 @@ def circles_of(obstacles: Obstacles) -> list[tuple[float, float, float]]:
         return (item.x, item.y, item.radius) if hasattr(item, "radius") else item
 
     given: Any = obstacles  # as given: as_circles refuses what is none of its kinds
-    iterable = hasattr(given, "__iter__") and not isinstance(given, str | bytes | Mapping)
-    if iterable and not (isinstance(given, np.ndarray) and given.ndim == 0):
+    if iterable(given) and not isinstance(given, str | bytes | Mapping):
         given = [triple(item) for item in given]
     return [(c.x, c.y, c.radius) for c in as_circles(given)]
 

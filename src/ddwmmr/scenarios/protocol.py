@@ -73,6 +73,7 @@ from ddwmmr.errors import (
     check_range,
     check_step_count,
     float_values,
+    length_of,
     one_of,
     raise_plugin_error,
     real_number,
@@ -703,7 +704,7 @@ def check_scenario(scenario: Scenario) -> None:
     check_int_at_least("scenario index", scenario.index, 0)
     waypoints: Any = scenario.waypoints
     wanted = "a non-empty sequence of (x, y) pairs in m"
-    if isinstance(waypoints, str | bytes | Mapping) or not hasattr(waypoints, "__len__"):
+    if isinstance(waypoints, str | bytes | Mapping) or length_of(waypoints) is None:
         raise ParameterError(f"scenario waypoints must be {wanted} (got {shown(waypoints)})")
     if len(waypoints) == 0:
         raise ParameterError(f"scenario waypoints must be {wanted} (got none)")

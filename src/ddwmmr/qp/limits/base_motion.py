@@ -29,7 +29,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from ddwmmr.errors import ParameterError, check_positive, shown
+from ddwmmr.errors import ParameterError, check_positive, length_of, shown
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, overrides
 from ddwmmr.qp.context import StepContext
 from ddwmmr.qp.limits.base import Limit
@@ -135,7 +135,7 @@ class SpeedBudgetLimit(Limit):
 
     def __init__(self, speeds: tuple[float, float], unit: float = 1.0) -> None:
         self.unit: float = check_positive("unit", unit)
-        if isinstance(speeds, str) or not hasattr(speeds, "__len__") or len(speeds) != 2:
+        if isinstance(speeds, str) or length_of(speeds) != 2:
             raise ParameterError(
                 f"speed_budget must be two numbers > 0, (v_top m/s, w_top rad/s)"
                 f" (got {shown(speeds)})"

@@ -34,6 +34,7 @@ from ddwmmr.errors import (
     check_nonnegative,
     check_positive,
     check_range,
+    iterable,
     load_toml,
     shown,
     texts_apart,
@@ -189,8 +190,7 @@ def as_circles(obstacles: Sequence[Circle | Sequence[float]] | str | Path) -> li
         return []
     if isinstance(obstacles, str | Path):
         return load_obstacles(find_obstacle_file(obstacles))
-    zero_d = isinstance(obstacles, np.ndarray) and obstacles.ndim == 0  # not iterable
-    if not hasattr(obstacles, "__iter__") or zero_d:
+    if not iterable(obstacles):
         raise ParameterError(
             f"obstacles must be circles, (x, y, radius) triples or a TOML file "
             f"(got {shown(obstacles)})"
