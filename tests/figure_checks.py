@@ -16,6 +16,10 @@ physics, the docs scripts, the GUI):
 - no text of the figure (titles, axis and tick labels, legends, annotations) runs off
   the canvas.
 
+:func:`text_collisions` checks the texts of a whole window (the simulator's: panel
+widgets beside the plots): no drawn text overlaps another, lies on the frame of an axes
+not its own (a label on a neighbouring text box or plot) or runs off the canvas.
+
 Coordinates are display pixels from matplotlib's own transforms and ``get_window_extent``;
 a tolerance of :data:`TOLERANCE_PX` absorbs antialiasing and line caps.
 """
@@ -94,6 +98,48 @@ def assert_figure_shows_its_data(fig: Figure, **kwargs) -> None:
     """Fail with the list of :func:`figure_problems` if there is any."""
     problems = figure_problems(fig, **kwargs)
     assert not problems, "figure hides or cuts data:\n  " + "\n  ".join(problems[:20])
+
+
+def drawn_texts(fig: Figure) -> list[Text]:
+    """The texts a full draw of ``fig`` renders (not the hidden, empty or out-of-view
+    ones, such as the tick labels matplotlib keeps beyond the axis limits)."""
+    renderer = fig.canvas.get_renderer()
+    seen: dict[int, Text] = {}
+    draw_text = renderer.draw_text
+
+    def record(gc, x, y, s, prop, angle, ismath=False, mtext=None):
+        if mtext is not None:
+            seen.setdefault(id(mtext), mtext)
+        return draw_text(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
+
+    renderer.draw_text = record
+    try:
+        fig.canvas.draw()
+    finally:
+        del renderer.draw_text
+    return list(seen.values())
+
+
+def text_collisions(fig: Figure) -> list[str]:
+    """Every drawn text of ``fig`` that overlaps another drawn text, lies on the frame of
+    a visible axes other than its own (a field, a button, a plot), or runs off the canvas,
+    in words (empty: every text stands apart)."""
+    texts = drawn_texts(fig)
+    renderer = fig.canvas.get_renderer()
+    extents = [(text, text.get_window_extent(renderer)) for text in texts]
+    frames = [ax for ax in fig.axes if ax.get_visible() and ax.get_frame_on()]
+    problems = []
+    for i, (text, extent) in enumerate(extents):
+        name = repr(text.get_text()[:40])
+        if not _contains(fig.bbox, extent):
+            problems.append(f"text {name} runs off the figure")
+        for other, other_extent in extents[i + 1 :]:
+            if _overlap(extent, other_extent):
+                problems.append(f"text {name} overlaps text {other.get_text()[:40]!r}")
+        for ax in frames:
+            if ax is not text.axes and _overlap(extent, ax.bbox):
+                problems.append(f"text {name} lies on {_axes_name(ax)} at {ax.bbox.bounds}")
+    return problems
 
 
 def data_polylines(

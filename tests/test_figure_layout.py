@@ -396,6 +396,26 @@ def test_wrap_to_width_breaks_at_commas_within_the_room():
     assert " ".join(piece.strip() for piece in lines) == line
 
 
+def test_wrap_to_width_breaks_a_piece_wider_than_the_room_at_its_spaces():
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from ddwmmr.gui.widgets import wrap_to_width
+
+    figure = Figure(figsize=(6, 2), dpi=100)
+    FigureCanvasAgg(figure)
+    text = figure.text(0.1, 0.9, "", fontsize=8)
+    long_piece = " ".join(f"word{i}" for i in range(40))  # no comma in 240 characters
+    line = f"head, {long_piece}, tail"
+    lines = wrap_to_width(line, text, 0.9).split("\n")
+    renderer = figure.canvas.get_renderer()
+    for piece in lines:
+        text.set_text(piece)
+        assert text.get_window_extent(renderer).width <= 0.8 * 600, piece
+    assert lines[0] == "head," and lines[-1] == "    tail" and len(lines) > 3
+    assert " ".join(piece.strip() for piece in lines) == line
+
+
 # -- scenario figures -------------------------------------------------------------------
 
 

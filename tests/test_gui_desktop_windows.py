@@ -1,16 +1,23 @@
-"""What a user of the desktop window sees beyond the panel's own widgets: a long message
+"""What a user of the desktop window sees beyond the panel's own widgets: the window takes
+the screen's pixels at a legible resolution, its texts stand apart, and a long message
 stays inside the message box. Off-screen (Agg canvases) at the size the window takes on a
-1366 x 768 screen (16 x 10 in at 64.5 dpi, the dpi :func:`desktop_figure` picks there)."""
+1366 x 768 screen (:func:`window_size`: 1032 x 645 px, 12.74 x 7.96 in at 81 dpi)."""
 
 from __future__ import annotations
 
+import re
+
+import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ddwmmr.gui import App, Settings
-from ddwmmr.gui.layout import FIGSIZE
+from ddwmmr.gui.layout import DPI, FIGSIZE, MAX_TEXT_SCALE, MIN_DPI, text_scale, window_size
+from ddwmmr.gui.options import method_options
+from ddwmmr.gui.widgets import FONT, CycleButton
+from figure_checks import drawn_texts, text_collisions
 
-LAPTOP_DPI = 1032 / FIGSIZE[0]  # the window is 1032 px wide on a 1366 x 768 screen
+LAPTOP = (1366, 768)
 #: A trajectory file's refusal as the window shows it (153 characters).
 LONG_MESSAGE = (
     "traj: /tmp/bad.csv: trajectory samples: need at least 3 rows (t, x, y): times must be "
@@ -18,10 +25,63 @@ LONG_MESSAGE = (
 )
 
 
-def laptop_app(canvas_class=FigureCanvasAgg, settings: Settings | None = None) -> App:
-    figure = Figure(figsize=FIGSIZE, dpi=LAPTOP_DPI)
+def window_app(
+    screen: tuple[int, int] = LAPTOP, canvas_class=FigureCanvasAgg, settings=None
+) -> App:
+    """The window as :func:`desktop_figure` sizes it on a ``screen`` (width, height px)."""
+    figsize, dpi = window_size(*screen)
+    figure = Figure(figsize=figsize, dpi=dpi)
     canvas_class(figure)
     return App(figure, settings or Settings(duration=1.0))
+
+
+def laptop_app(canvas_class=FigureCanvasAgg, settings: Settings | None = None) -> App:
+    return window_app(LAPTOP, canvas_class, settings)
+
+
+def test_the_window_takes_the_screens_pixels_at_a_legible_resolution():
+    assert window_size(1920, 1080) == (FIGSIZE, pytest.approx(90.72))  # 1451 x 907 px
+    assert window_size(2560, 1440) == (FIGSIZE, DPI)
+    laptop, dpi = window_size(*LAPTOP)
+    assert (round(laptop[0] * dpi), round(laptop[1] * dpi)) == (1032, 645)  # 16 x 10 in at 64.5
+    assert dpi == MIN_DPI  # ... laid out on 12.7 x 8 in instead
+    assert text_scale(Figure(figsize=laptop)) == pytest.approx(MIN_DPI / 64.5, rel=1e-3)
+    assert text_scale(Figure(figsize=FIGSIZE)) == text_scale(Figure(figsize=(20, 12.5))) == 1.0
+    # Tk multiplies the dpi by its pixel ratio (tk scaling against 96 px per inch).
+    assert window_size(*LAPTOP, ratio=1.25) == (laptop, MIN_DPI / 1.25)
+    (width, _), dpi = window_size(800, 600)  # the text grows by MAX_TEXT_SCALE at most
+    assert FIGSIZE[0] / width == pytest.approx(MAX_TEXT_SCALE) and dpi < MIN_DPI
+
+
+@pytest.mark.parametrize("screen", [LAPTOP, (1920, 1080)], ids=lambda s: "x".join(map(str, s)))
+def test_the_texts_are_legible_and_stand_apart(screen):
+    """After a run, with a long error in the smallest font, and on the option pages with
+    the longest names: every text at least (FONT - 2) pt at MIN_DPI (6.75 px), the panel
+    font at least 9 px, no text on another, on a widget or plot not its own, or off the
+    window; every option label whole."""
+    app = window_app(screen, settings=Settings(methods=("clrrmc-ts", "qp"), duration=2.0))
+    app.run()
+    app.wait()
+    app.show_index(app.view.last_index)
+    app.say(LONG_MESSAGE, error=True)
+    dpi = app.figure.dpi
+    pixels = {
+        text.get_text()[:30]: text.get_fontsize() * dpi / 72 for text in drawn_texts(app.figure)
+    }
+    smallest = min(pixels, key=pixels.__getitem__)
+    assert pixels[smallest] >= (FONT - 2) * MIN_DPI / 72, (smallest, pixels[smallest])
+    assert app.dt_field.box.label.get_fontsize() * dpi / 72 >= FONT * MIN_DPI / 72
+    assert text_collisions(app.figure) == []
+    for method, pages in (("qp", 2), ("mpc", 3)):
+        app.apply(app.settings.replace(methods=(method, None)))
+        for page in range(pages):
+            assert text_collisions(app.figure) == [], (method, page + 1)
+            app.options_page_button.click()
+        group = app._groups[(0, method)]
+        for number, widget in group.widgets.items():
+            label = widget.button.label if isinstance(widget, CycleButton) else widget.box.label
+            spaceless = re.sub(r"\s", "", label.get_text())
+            assert spaceless.startswith(re.sub(r"\s", "", method_options(method)[number].label))
 
 
 def message_extent(app: App):
@@ -55,5 +115,5 @@ def test_a_short_message_keeps_the_panel_font_and_its_lines() -> None:
     app.say("run finished (50 steps per method): playing; drag time to scrub")
     assert app.message_text.get_fontsize() == 8
     assert app.message_text.get_text() == (
-        "run finished (50 steps per method): playing; drag time to\nscrub"
+        "run finished (50 steps per method): playing; drag\ntime to scrub"
     )

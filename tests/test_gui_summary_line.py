@@ -13,8 +13,8 @@ from matplotlib.figure import Figure
 from ddwmmr import Robot, load_trajectory, simulate
 from ddwmmr.gui import App, Settings
 from ddwmmr.gui.app import _summary_line
-from ddwmmr.gui.layout import FIGSIZE, SUMMARY_RIGHT
-from ddwmmr.gui.widgets import wrap_to_width
+from ddwmmr.gui.layout import FIGSIZE, MIN_DPI, SUMMARY_RIGHT, window_size
+from ddwmmr.gui.widgets import FONT, wrap_to_width
 
 
 def new_app(settings: Settings, dpi: int = 100) -> App:
@@ -71,24 +71,27 @@ def test_a_vanishing_manipulability_keeps_its_digits():
     assert "limits held" not in line
 
 
+#: Two runs that each lost support and held three limits (summary of each).
+LONG_SUMMARY = {
+    "rms_position_error_m": 2.394, "max_position_error_m": 4.316,
+    "rms_orientation_error_rad": 1.92, "max_wheel_speed_rad_s": 18.32,
+    "min_stability": 1.2345, "min_manipulability": 1.2246e-16, "saturated_steps": 1234,
+    "fallback_steps": 1999, "steps": 2000, "duration": 40.0, "dt": 0.02,
+    "wheel_limit_steps": 1500, "joint_rate_limit_steps": 1800,
+    "actuator_saturated_time_s": 33.3, "plant": "mujoco", "tipped": False,
+    "tip_time_s": None, "min_physics_stability": 1.21, "support_lost": True,
+    "unloaded_time_s": 12.3,
+    "verdict_reasons": [
+        "singular_most_of_run", "final_error_above_limit", "rms_error_above_limit"
+    ],
+}  # fmt: skip
+
+
 def test_two_long_lines_fit_above_the_transport_buttons():
     """Two runs that each lost support and held three limits: four lines each, wrapped
     to the window, end above the Run button."""
-    summary = {
-        "rms_position_error_m": 2.394, "max_position_error_m": 4.316,
-        "rms_orientation_error_rad": 1.92, "max_wheel_speed_rad_s": 18.32,
-        "min_stability": 1.2345, "min_manipulability": 1.2246e-16, "saturated_steps": 1234,
-        "fallback_steps": 1999, "steps": 2000, "duration": 40.0, "dt": 0.02,
-        "wheel_limit_steps": 1500, "joint_rate_limit_steps": 1800,
-        "actuator_saturated_time_s": 33.3, "plant": "mujoco", "tipped": False,
-        "tip_time_s": None, "min_physics_stability": 1.21, "support_lost": True,
-        "unloaded_time_s": 12.3,
-        "verdict_reasons": [
-            "singular_most_of_run", "final_error_above_limit", "rms_error_above_limit"
-        ],
-    }  # fmt: skip
     app = new_app(Settings(duration=1.0))
-    lines = [_summary_line(label, SimpleNamespace(summary=summary)) for label in "AB"]
+    lines = [_summary_line(label, SimpleNamespace(summary=LONG_SUMMARY)) for label in "AB"]
     wrapped = wrap_to_width("\n".join(lines), app.summary_text, SUMMARY_RIGHT)
     assert wrapped.count("\n") == 7
     app.summary_text.set_text(wrapped)
@@ -96,3 +99,18 @@ def test_two_long_lines_fit_above_the_transport_buttons():
     bottom = app.summary_text.get_window_extent(renderer).y0
     button_top = app.transport["run"].ax.get_window_extent(renderer).y1
     assert bottom > button_top + 2.0
+
+
+def test_two_long_lines_fit_above_the_buttons_of_a_laptop_window():
+    """The same lines in the window a 1366 x 768 screen gets (its text larger against the
+    layout): in a smaller font, still legible, they end above the Run button, inside it."""
+    figsize, dpi = window_size(1366, 768)
+    figure = Figure(figsize=figsize, dpi=dpi)
+    FigureCanvasAgg(figure)
+    app = App(figure, Settings(duration=1.0))
+    lines = [_summary_line(label, SimpleNamespace(summary=LONG_SUMMARY)) for label in "AB"]
+    app._show_summary("\n".join(lines))
+    extent = app.summary_text.get_window_extent(figure.canvas.get_renderer())
+    assert extent.y0 > app.transport["run"].ax.bbox.y1 and extent.x1 <= figure.bbox.width
+    assert app.summary_text.get_fontsize() * dpi / 72 >= (FONT - 2) * MIN_DPI / 72
+    assert app.summary_text.get_text().replace("\n    ", " ") == "\n".join(lines)

@@ -69,10 +69,11 @@ if TYPE_CHECKING:
 FRAME_MS = 40
 POLL_MS = 100
 #: Characters a line of the message box holds in the panel font (the box is 0.325 of the
-#: 16 in window wide; 62 leaves room for the widest letters).
+#: 16 in window wide; 62 leaves room for the widest letters); a window laid out on fewer
+#: inches holds fewer (divided by its text scale, :func:`ddwmmr.gui.layout.text_scale`).
 MESSAGE_CHARS = 62
-#: (font size in points, characters a line) tried in turn until a message fits its box
-#: (two lines in the panel font, three in the smallest).
+#: (font size in points, characters a line at 16 in) tried in turn until a message fits
+#: its box (in the 16 x 10 in window two lines in the panel font, three in the smallest).
 MESSAGE_FITS = ((FONT, MESSAGE_CHARS), (FONT - 1, 72), (FONT - 2, 86))
 
 
@@ -201,7 +202,8 @@ class App(PanelLayout):
 
     def _fit_message(self, prefix: str, text: str) -> None:
         """Show ``prefix`` + ``text`` wrapped inside the message box: in the panel font at
-        :data:`MESSAGE_CHARS` a line when it fits, else in the first smaller font of
+        :data:`MESSAGE_CHARS` a line (fewer in a window of a larger :attr:`text_scale`)
+        when it fits, else in the first smaller font of
         :data:`MESSAGE_FITS` that holds it; what still overflows the smallest is cut at a
         line end, marked ``...`` (a message names its parameter first)."""
         artist = self.message_text
@@ -217,7 +219,8 @@ class App(PanelLayout):
             return fits
 
         for size, chars in MESSAGE_FITS:
-            lines = textwrap.wrap(text, chars, break_on_hyphens=False) if text else []
+            width = int(chars / self.text_scale)
+            lines = textwrap.wrap(text, width, break_on_hyphens=False) if text else []
             artist.set_fontsize(size)
             if show(lines) or not lines:
                 return
@@ -604,12 +607,27 @@ class App(PanelLayout):
         # The wall time only in a window: a snapshot is a document, the same on every run.
         took = f", {elapsed:.1f} s" if self.interactive else ""
         self._set_progress(1.0, f"done: {steps} steps{took}")
-        summary = "\n".join(_summary_line(label, r) for label, r in zip(self.labels(), results))
-        # Wrapped to the window: a physics run's line is longer than the view is wide.
-        self.summary_text.set_text(wrap_to_width(summary, self.summary_text, SUMMARY_RIGHT))
+        self._show_summary(
+            "\n".join(_summary_line(label, r) for label, r in zip(self.labels(), results))
+        )
         self.say(f"run finished ({steps} steps per method): playing; drag time to scrub")
         self.show_index(0)
         self._play()
+
+    def _show_summary(self, summary: str) -> None:
+        """Show the runs' ``summary`` lines under the view, wrapped to the window (a physics
+        run's line is longer than the view is wide): in the panel font, or in the first
+        smaller one (down to ``FONT - 2``) whose lines end above the transport buttons
+        (long lines in a window of a large :attr:`text_scale`), else in that smallest."""
+        artist = self.summary_text
+        # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
+        renderer = self.figure.canvas.get_renderer()  # type: ignore[attr-defined]
+        buttons_top = self.transport["run"].ax.bbox.y1
+        for size in (FONT, FONT - 1, FONT - 2):
+            artist.set_fontsize(size)
+            artist.set_text(wrap_to_width(summary, artist, SUMMARY_RIGHT))
+            if artist.get_window_extent(renderer).y0 > buttons_top:
+                return
 
     def _cancel_worker(self) -> None:
         if self.worker is not None and not self.worker.finished:

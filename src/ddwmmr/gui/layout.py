@@ -1,6 +1,10 @@
 """Where every control of the simulator window sits (figure fractions of a 16 x 10 in
 window) and which handler it calls.
 
+The window's size is decided here (:func:`window_size`): on a small screen it is laid out
+on fewer inches at a higher resolution than the screen would give 16 x 10 in, so that its
+text stays legible; the gaps that hold text then grow with :func:`text_scale`.
+
 :class:`PanelLayout` builds the widgets into ``self.figure``; the handlers
 (``self._on_*``, ``self._apply_*``, ``self.run``, ``self.export_*``...) belong to
 :class:`ddwmmr.gui.app.App`, which inherits this class. Layout and behaviour are apart so
@@ -19,7 +23,15 @@ from ddwmmr.controllers.base import available_methods
 from ddwmmr.gui.options import OptionSpec, format_choice, plant_names
 from ddwmmr.gui.settings import GEOMETRY, SLOTS
 from ddwmmr.gui.view import RunView, add_view_axes
-from ddwmmr.gui.widgets import FONT, CycleButton, Field, button, panel_axes, radio
+from ddwmmr.gui.widgets import (
+    FONT,
+    CycleButton,
+    Field,
+    button,
+    fit_label,
+    panel_axes,
+    radio,
+)
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.trajectories import available_trajectories
 
@@ -35,6 +47,13 @@ if TYPE_CHECKING:
 #: Window size (inches) and resolution of the window and its snapshot.
 FIGSIZE = (16.0, 10.0)
 DPI = 100
+#: Lowest resolution (px per inch) of the desktop window, where the screen allows it
+#: (:func:`window_size`): at 81 px per inch the panel font (8 pt) is 9 px high and the
+#: smallest text (6 pt) 6.75 px.
+MIN_DPI = 81.0
+#: Largest :func:`text_scale` :func:`window_size` gives (a 1280 x 720 screen's is 1.34):
+#: the layout keeps its text apart up to this one; a smaller screen gets smaller text.
+MAX_TEXT_SCALE = 1.35
 #: Entry of the trajectory list that stands for the path typed in the file field.
 FILE_ENTRY = "file"
 #: Entry of slot B's list that switches the side-by-side mode off.
@@ -54,6 +73,8 @@ class PanelLayout:
 
     figure: Figure
     settings: Settings
+    #: :func:`text_scale` of the figure when the window was built (1 at 16 x 10 in).
+    text_scale: float
 
     if TYPE_CHECKING:  # the handlers, defined by App
 
@@ -87,8 +108,9 @@ class PanelLayout:
 
     def _build(self) -> None:
         fig = self.figure
+        self.text_scale = text_scale(fig)
         fig.text(0.012, 0.972, "ddwmmr simulator", fontsize=13, weight="bold")
-        fig.text(0.15, 0.974, "python -m ddwmmr.gui", fontsize=FONT, color="0.4")
+        fig.text(self._grown(0.15, 0.14), 0.974, "python -m ddwmmr.gui", fontsize=FONT, color="0.4")
         self._build_trajectory()
         self._build_methods()
         self._build_options()
@@ -97,6 +119,11 @@ class PanelLayout:
         self._build_messages()
         self._build_view()
         self._build_transport()
+
+    def _grown(self, at: float, per_scale: float) -> float:
+        """The figure fraction ``at`` of the 16 x 10 in window, moved by ``per_scale`` for
+        each unit of :attr:`text_scale` beyond 1 (where a gap holding text grows with it)."""
+        return at + per_scale * (self.text_scale - 1.0)
 
     def _drawing_widgets(self) -> list[Any]:
         """Widgets that redraw the canvas themselves when set (radios, sliders)."""
@@ -238,7 +265,7 @@ class PanelLayout:
         )
         self.duration_field = Field(
             self.figure,
-            (0.255, row, 0.05, 0.023),
+            (self._grown(0.255, 0.03), row, self._grown(0.05, -0.03), 0.023),
             "duration (s)",
             "",
             self._apply_duration,
@@ -291,7 +318,10 @@ class PanelLayout:
         self._export_bottom = row
 
     def _build_messages(self) -> None:
-        bottom, top = 0.015, self._export_bottom - 0.012
+        # A larger text scale takes from the margins above and under the box, so that it
+        # still holds three lines of the smallest font.
+        bottom = self._grown(0.015, -0.03)
+        top = self._export_bottom - self._grown(0.012, -0.01)
         ax = panel_axes(self.figure, (0.008, bottom, 0.325, top - bottom))
         ax.set_xticks([])
         ax.set_yticks([])
@@ -312,12 +342,21 @@ class PanelLayout:
         )
 
     def _build_view(self) -> None:
+        # Larger text takes more room: under the top view (its axis labels, its legend),
+        # between it and the plots (their y labels), under the plots (the summary lines).
+        path_bottom, plots_left, plots_bottom = (
+            self._grown(0.33, 0.25),
+            self._grown(0.745, 0.1),
+            self._grown(0.265, 0.2),
+        )
         path_ax, plot_axes = add_view_axes(
-            self.figure, (0.385, 0.33, 0.31, 0.625), (0.745, 0.265, 0.245, 0.69)
+            self.figure,
+            (0.385, path_bottom, 0.31, 0.955 - path_bottom),
+            (plots_left, plots_bottom, 0.99 - plots_left, 0.955 - plots_bottom),
         )
         self.view = RunView(path_ax, plot_axes)
         self.summary_text = self.figure.text(
-            0.385, 0.228, "", fontsize=FONT, va="top", linespacing=1.3
+            0.385, self._grown(0.228, 0.14), "", fontsize=FONT, va="top", linespacing=1.3
         )
 
     def _build_transport(self) -> None:
@@ -383,23 +422,56 @@ class PanelLayout:
                 self._withdraw,
                 format_choice,
             )
-        return Field(
+        field = Field(
             self.figure,
-            (left + 0.092, bottom, 0.062, 0.024),
+            (left + self._grown(0.092, 0.02), bottom, self._grown(0.062, -0.02), 0.024),
             spec.label,
             spec.format(spec.default),
             lambda text: self._apply_option_text(slot, spec, text),
             self._report,
             self._withdraw,
         )
+        # A long name (and a window of a large text scale) has its label smaller or on
+        # two lines, inside its column and its row.
+        width, height = self.figure.bbox.width, self.figure.bbox.height
+        fit_label(field.box.label, left * width, 0.03 * height, (FONT, FONT - 1, FONT - 2))
+        return field
+
+
+def window_size(
+    screen_width: float, screen_height: float, ratio: float = 1.0
+) -> tuple[tuple[float, float], float]:
+    """The desktop window's figure size (inches) and dpi on a ``screen_width`` x
+    ``screen_height`` px screen whose Tk pixel ratio (``tk scaling`` against the usual 96
+    px per inch) is ``ratio``.
+
+    The window takes the pixels of the 16 x 10 in layout at the resolution that fits the
+    screen (at most :data:`DPI`), leaving room for the toolbar, the title bar and a desktop
+    panel. Where that resolution is below :data:`MIN_DPI`, the same pixels hold fewer
+    inches at a higher resolution (by at most :data:`MAX_TEXT_SCALE`), so that the text,
+    sized in points, stays legible: 16 x 10 in at 90.72 dpi (1451 x 907 px) on a 1920 x
+    1080 screen, 12.74 x 7.96 in at 81 dpi (1032 x 645 px) on 1366 x 768. Tk multiplies
+    the returned dpi by ``ratio``, which the fit includes.
+    """
+    fit = min(DPI, 0.96 * screen_width / FIGSIZE[0], 0.84 * screen_height / FIGSIZE[1])
+    dpi = min(max(fit, MIN_DPI), fit * MAX_TEXT_SCALE)
+    inches = (FIGSIZE[0] * fit / dpi, FIGSIZE[1] * fit / dpi)
+    return inches, dpi / max(ratio, 1e-3)
+
+
+def text_scale(figure: Figure) -> float:
+    """How much larger text is against the layout than in the 16 x 10 in window (whose
+    figure fractions and point sizes the layout is drawn for): ``16 in / width``, at
+    least 1 (a figure of :data:`FIGSIZE`, or larger, is 1)."""
+    return max(1.0, FIGSIZE[0] / float(figure.get_figwidth()))
 
 
 def desktop_figure() -> Figure:
-    """A Tk window's figure, its resolution lowered so that the window fits the screen.
+    """A Tk window's figure, sized by :func:`window_size` to fit the screen.
 
     The layout is in figure fractions and the fonts in points, so a lower dpi shrinks the
-    whole window evenly. Tk multiplies the dpi by its pixel ratio (``tk scaling`` against
-    the usual 96 px per inch), which the fit includes.
+    whole window evenly, down to :data:`MIN_DPI`; on a smaller screen the window is laid
+    out on fewer inches instead, its text larger against the layout.
     """
     import tkinter
 
@@ -412,12 +484,11 @@ def desktop_figure() -> Figure:
         ratio = float(probe.tk.call("tk", "scaling")) * 72.0 / 96.0
     finally:
         probe.destroy()
-    # Leave room for the toolbar, the title bar and a desktop panel.
-    dpi = min(DPI, 0.96 * screen_width / FIGSIZE[0], 0.84 * screen_height / FIGSIZE[1])
+    figsize, dpi = window_size(screen_width, screen_height, ratio)
     # The simulator is a Tk program (the probe above, the Tk event loop gui.check drives),
     # whatever backend matplotlib would pick by itself (Qt where it is installed).
     plt.switch_backend("TkAgg")
-    figure = plt.figure(figsize=FIGSIZE, dpi=dpi / max(ratio, 1e-3))
+    figure = plt.figure(figsize=figsize, dpi=dpi)
     # ignore: a pyplot figure has a window manager
     figure.canvas.manager.set_window_title("ddwmmr simulator")  # type: ignore[union-attr]
     return figure

@@ -136,7 +136,8 @@ class RunView:
         # placed once: they do not move during playback.
         self.show_index(self.last_index)
         for key in ("position", "wheels", "stability"):
-            place_legend(self.plot_axes[key], fontsize=7, ncol=3, framealpha=0.8)
+            ax = self.plot_axes[key]
+            place_legend(ax, fontsize=7, ncol=_legend_columns(ax, 7), framealpha=0.8)
         for cursor in self._cursors:
             cursor.set_visible(True)
         self.show(0.0)
@@ -400,6 +401,22 @@ def plotted_series(ts: dict[str, np.ndarray], k: int) -> dict[str, list[np.ndarr
         "stability": [ts["stability"][:end]],
         "manipulability": [ts["manipulability"][:end]],
     }
+
+
+def _legend_columns(ax: Axes, fontsize: float) -> int:
+    """Columns of ``ax``'s legend: three, or fewer where three make it wider than ``ax``
+    (a window whose text is large against its plots, :func:`ddwmmr.gui.layout.text_scale`)."""
+    # ignore: the view's canvases (Agg, TkAgg) have get_renderer; the base class does not
+    renderer = ax.figure.canvas.get_renderer()  # type: ignore[attr-defined]
+    columns = 3
+    while columns > 1:
+        trial = ax.legend(fontsize=fontsize, ncol=columns)
+        wide = trial.get_window_extent(renderer).width > ax.bbox.width
+        trial.remove()
+        if not wide:
+            break
+        columns -= 1
+    return columns
 
 
 def add_view_axes(

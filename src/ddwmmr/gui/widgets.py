@@ -9,6 +9,7 @@
   values on every click (choices, on/off flags).
 * :func:`radio` - radio buttons with small labels.
 * :func:`wrap_to_width` - a text broken at its commas to fit a width on the canvas.
+* :func:`fit_label` - a label made smaller, or broken in two lines, to fit its room.
 
 Widgets are also driven programmatically (tests, ``--snapshot``): ``Field.submit(text)``
 behaves like typing the text and pressing Enter.
@@ -270,7 +271,7 @@ def wrap_to_width(text: str, artist: Text, right: float, indent: str = "    ") -
     """``text`` broken after its commas into lines that, in the font of ``artist`` (a
     figure text), end left of the figure fraction ``right``; continuation lines are
     indented. Lines of ``text`` are wrapped one by one; a piece wider than the room on
-    its own keeps a line of its own."""
+    its own is broken at its spaces (a word wider than the room keeps a line of its own)."""
     # ignore: the artist is a figure text (of the window's Figure)
     figure: Figure = artist.get_figure()  # type: ignore[assignment]
     # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
@@ -283,6 +284,23 @@ def wrap_to_width(text: str, artist: Text, right: float, indent: str = "    ") -
         extent: float = renderer.get_text_width_height_descent(candidate, font, ismath=False)[0]
         return extent
 
+    def at_spaces(line: str) -> list[str]:
+        """``line`` itself if it fits, else broken at its spaces (a word wider than the
+        room keeps a line of its own)."""
+        if width(line) <= room:
+            return [line]
+        body = line.lstrip(" ")
+        lines, current = [], line[: len(line) - len(body)]
+        for word in body.split(" "):
+            if not current.strip():
+                current += word
+            elif width(f"{current} {word}") <= room:
+                current = f"{current} {word}"
+            else:
+                lines.append(current)
+                current = indent + word
+        return [*lines, current]
+
     wrapped: list[str] = []
     for line in text.split("\n"):
         pieces = line.split(", ")
@@ -292,7 +310,36 @@ def wrap_to_width(text: str, artist: Text, right: float, indent: str = "    ") -
             if width(candidate + ",") <= room:
                 current = candidate
             else:
-                wrapped.append(current + ",")
+                wrapped += at_spaces(current + ",")
                 current = indent + piece
-        wrapped.append(current)
+        wrapped += at_spaces(current)
     return "\n".join(wrapped)
+
+
+def fit_label(label: Text, left: float, height: float, sizes: Sequence[float]) -> None:
+    """Fit ``label`` (a text of the window) into its room: its extent starting at ``left``
+    or right of it and at most ``height`` high (display px). Tried in turn: one line in
+    each font size of ``sizes`` (points, largest first) but the last, two lines in each of
+    those, then the last size on one line and on two. Two lines are broken before the
+    unit (`` (``), else after an underscore (the longest first line first). The first
+    that fits is kept, else the last tried; a label that fits in ``sizes[0]`` on one line
+    stays as it is."""
+    # ignore: the label is a text of the window's Figure
+    figure: Figure = label.get_figure()  # type: ignore[assignment]
+    # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
+    renderer = figure.canvas.get_renderer()  # type: ignore[attr-defined]
+    text = label.get_text()
+    breaks = [text.index(" (")] if " (" in text else []
+    breaks += [i + 1 for i in range(len(text) - 1, 0, -1) if text[i] == "_"]
+    broken = [f"{text[:i].rstrip()}\n{text[i:].lstrip()}" for i in breaks]
+    *larger, smallest = sizes
+    tries = [(size, [text]) for size in larger] + [(size, broken) for size in larger]
+    for size, shapes in [*tries, (smallest, [text, *broken])]:
+        label.set_fontsize(size)
+        for shape in shapes:
+            label.set_text(shape)
+            if "\n" in shape:
+                label.set_linespacing(1.0)  # two lines kept close
+            extent = label.get_window_extent(renderer)
+            if extent.x0 >= left and extent.height <= height:
+                return
