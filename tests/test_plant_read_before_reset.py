@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from ddwmmr import Robot
+from ddwmmr.errors import ParameterError
 from ddwmmr.plants import KinematicPlant, MujocoPlant, PlantNotResetError, ThesisPlant
+from ddwmmr.plants.thesis import ThesisState
 
 ROBOT = Robot()
 Q = np.array([0.1, -0.05, 0.02, 0.31, 0.52])
@@ -32,6 +34,8 @@ def test_reading_a_plant_before_its_reset_says_to_reset(kind, name):
             "wheel_slip": plant.wheel_slip,
             "torque_use": plant.torque_use,
         }
+    if kind is ThesisPlant:  # its public state, read as observe() reads it
+        readers["state"] = lambda: plant.state
     for method, read in readers.items():
         with pytest.raises(PlantNotResetError) as info:
             read()
@@ -57,3 +61,20 @@ def test_a_physics_plants_tallies_read_not_yet_before_its_reset():
     for kind in (KinematicPlant, ThesisPlant):
         other = kind(ROBOT)
         assert not hasattr(other, "tip_time") and not hasattr(other, "unloaded_time_s")
+
+
+def test_the_thesis_plants_state_says_to_reset_before_its_first_reset():
+    """ThesisPlant.state read zeros (the robot at the origin) before reset() while
+    observe() raised; setting it before then is refused the same way, after it takes only
+    a ThesisState (one line naming ``state``)."""
+    plant = ThesisPlant(ROBOT)
+    with pytest.raises(
+        PlantNotResetError, match=r"^thesis plant: call reset\(q0, dt\) before state$"
+    ):
+        plant.state = ThesisState()
+    plant.reset(Q, 0.02)
+    assert plant.state.q == tuple(Q.tolist())
+    with pytest.raises(ParameterError, match=r"^state must be a ThesisState \(got "):
+        plant.state = (0.0,) * 7
+    plant.state = ThesisState(1.0, 2.0, 0.0, 0.3, 0.5, 0.1, 0.0)
+    assert plant.observe().values == (1.0, 2.0, 0.0, 0.3, 0.5)

@@ -21,8 +21,10 @@ helpers here (:func:`check_control_step`, :func:`check_limit`, :func:`check_step
 but finite numbers of the right shape (a ``policy`` that is not callable) is a one-line
 :class:`~ddwmmr.errors.ParameterError` naming ``q0``, ``dt``, ``q``, ``u``, ``t``,
 ``command`` or ``policy``, before the state changes. Whatever reads or advances the
-state (``step``, ``observe``, ``extra_values``) before the first ``reset`` is a
-:class:`PlantNotResetError` (a ``RuntimeError``): the plant has no start state yet.
+state (``step``, ``observe``, ``extra_values``, and a plant's own state readings: the
+thesis plant's ``state``, the MuJoCo plant's ``base_tilt()``...) before the first
+``reset`` is a :class:`PlantNotResetError` (a ``RuntimeError``): the plant has no start
+state yet.
 ``limit`` reads only its arguments (and the robot's limits) and works before it.
 """
 

@@ -243,9 +243,25 @@ class ThesisPlant:
         self._half_width = 0.5 * robot.track_width  # the wheels' lever b
         self._joint_limits = robot.joint_limits
         self.servo = VelocityServo(self, velocity_bandwidth)
-        self.state = ThesisState()
+        self._state = ThesisState()
         self._forces = (0.0, 0.0)
         self._started = False  # reset() gave a start state: step() may run
+
+    @property
+    def state(self) -> ThesisState:
+        """The plant's state (configuration and base velocities), the object :meth:`step`
+        advances in place; before the first :meth:`reset`, as :meth:`observe`, a
+        :class:`PlantNotResetError` (the plant has no start state yet). Setting it (a
+        :class:`ThesisState`, after a reset) moves the plant there."""
+        if not self._started:
+            raise PlantNotResetError("thesis", "state")
+        return self._state
+
+    @state.setter
+    def state(self, value: ThesisState) -> None:
+        if not self._started:
+            raise PlantNotResetError("thesis", "state")
+        self._state = check_instance("state", value, ThesisState)
 
     # -- Plant interface ------------------------------------------------------------------
     def reset(self, q0: np.ndarray, dt: float) -> None:
@@ -258,7 +274,7 @@ class ThesisPlant:
         outside = self.robot.joints_outside(state)
         if outside is not None:
             raise ParameterError(f"q0: {outside}")
-        self.state = ThesisState(*state)
+        self._state = ThesisState(*state)
         self._forces = (0.0, 0.0)
         self._started = True
 
@@ -267,7 +283,7 @@ class ThesisPlant:
         :class:`PlantNotResetError`."""
         if not self._started:
             raise PlantNotResetError("thesis", "observe")
-        s = self.state
+        s = self._state
         return Observation(s.q, s.v, s.w)
 
     def limit(self, q: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -297,7 +313,7 @@ class ThesisPlant:
             raise PlantNotResetError("thesis")
         checked = check_step(t, command, dt, self.interfaces)
         check_policy(policy)
-        state = self.state
+        state = self._state
         inertia = self.inertia(state.th1, state.th2)  # once for the servo and the dynamics
         if isinstance(checked, WheelForces):
             f_left, f_right = checked.left, checked.right
