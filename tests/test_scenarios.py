@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import MAX_OBSTACLES, ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.scenarios import RunConfig, Scenario, generate, place_obstacles, run_scenario
 from ddwmmr.scenarios.executors import run_many
@@ -54,6 +54,28 @@ def test_obstacles_on_legs_keep_clear_of_waypoints():
         (ax, ay, _), (bx, by, _) = s.obstacles
         assert math.hypot(ax - bx, ay - by) >= 2.0  # the base can pass between them
     assert place_obstacles(scenarios[0]) == scenarios[0]
+
+
+@pytest.mark.parametrize(
+    ("count", "got"),
+    [(-1, "-1"), (2.5, "2.5"), (True, "True"), (10**9, "1000000000"), ("2", "'2'")],
+)
+def test_place_obstacles_refuses_a_count_outside_0_to_the_cap(count, got):
+    """A negative, fractional, boolean or huge count placed obstacles anyway (all five
+    legs' worth, or one for True); now it is a one-line error with the allowed range."""
+    with pytest.raises(ParameterError) as info:
+        place_obstacles(generate(1)[0], count=count)
+    assert str(info.value) == f"count must be an integer in [0, {MAX_OBSTACLES}] (got {got})"
+
+
+def test_place_obstacles_of_count_0_places_none_and_a_count_beyond_the_legs_all_it_can():
+    """count = 0 placed one obstacle (the count was compared after the first placement)."""
+    scenario = generate(1)[0]
+    assert place_obstacles(scenario, count=0).obstacles == ()
+    assert len(place_obstacles(scenario, count=1).obstacles) == 1
+    most = place_obstacles(scenario, count=MAX_OBSTACLES).obstacles
+    assert 2 <= len(most) <= len(scenario.waypoints)  # at most one per leg
+    assert place_obstacles(scenario, count=len(most)).obstacles == most
 
 
 # -- success rule -------------------------------------------------------------------------

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ddwmmr.errors import MAX_SCENARIOS, check_int_at_least
+from ddwmmr.errors import MAX_OBSTACLES, MAX_SCENARIOS, check_int_at_least
 
 #: Workspace half-width (m): waypoints lie in [-4, 4] x [-4, 4].
 HALF_SIZE = 4.0
@@ -72,8 +72,13 @@ def place_obstacles(
     leg, skipping points within ``keep_out`` m of the start or a waypoint (so every
     waypoint stays reachable without touching an obstacle) or within ``separation`` m of an
     earlier obstacle (so the base, 0.57 m across, can pass between two). At most one
-    obstacle per leg.
+    obstacle per leg, so fewer than ``count`` where the legs run out.
+
+    ``count``: an integer in [0, :data:`ddwmmr.errors.MAX_OBSTACLES`] (the cap of a run's
+    obstacles; 0: none); anything else raises a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming ``count``.
     """
+    count = check_int_at_least("count", count, 0, MAX_OBSTACLES)
     points = [(0.0, 0.0), *scenario.waypoints]
     legs = sorted(
         range(len(points) - 1),
@@ -81,6 +86,8 @@ def place_obstacles(
     )
     obstacles: list[tuple[float, float, float]] = []
     for i in legs:
+        if len(obstacles) == count:
+            break
         (ax, ay), (bx, by) = points[i], points[i + 1]
         for f in (0.5, 0.4, 0.6, 0.3, 0.7, 0.2, 0.8):
             spot = (ax + f * (bx - ax), ay + f * (by - ay))
@@ -90,6 +97,4 @@ def place_obstacles(
             if not near:
                 obstacles.append((spot[0], spot[1], radius))
                 break
-        if len(obstacles) == count:
-            break
     return Scenario(scenario.index, scenario.waypoints, tuple(obstacles))
