@@ -208,6 +208,14 @@ def test_valid_geometry_values_pass_unchanged():
             lambda: error_dynamics.saturated_velocity_step(1.0, 1.0, 1.0, 1.0, 1.0, [0, 2, 1]),
             r"^times must be at least 2 finite times \(s\), increasing and starting at 0",
         ),
+        (  # numpy's ambiguous truth value before
+            lambda: error_dynamics.check_response_times([0, 1], spaced=np.array([True, False])),
+            r"^spaced must be true or false \(got ",
+        ),
+        (  # a text was taken as True before
+            lambda: error_dynamics.check_response_times([0, 1, 3], spaced="no"),
+            r"^spaced must be true or false \(got 'no'\)$",
+        ),
     ],
 )
 def test_error_loops_refuse_bad_input_naming_the_parameter(call, message):

@@ -29,6 +29,7 @@ import numpy as np
 
 from ddwmmr.errors import (
     ParameterError,
+    check_bool,
     check_finite,
     check_nonnegative,
     check_positive,
@@ -114,7 +115,9 @@ def check_response_times(times: Sequence[float] | np.ndarray, spaced: bool) -> n
     times, strictly increasing, starting at 0 (the step); with ``spaced``, equally spaced
     as python-control's linear simulation needs them (its test: every step within
     ``numpy.allclose`` of the mean step). Anything else is a one-line
-    :class:`~ddwmmr.errors.ParameterError` naming ``times``."""
+    :class:`~ddwmmr.errors.ParameterError` naming ``times``; ``spaced`` must be True or
+    False (else one naming ``spaced``)."""
+    spaced = check_bool("spaced", spaced)
     array = check_times(times)
     wanted = "equally spaced, increasing" if spaced else "increasing"
     rule = f"times must be at least 2 finite times (s), {wanted} and starting at 0"
