@@ -76,6 +76,39 @@ def test_a_file_far_over_the_limit_is_refused_before_it_is_parsed(tmp_path, monk
     assert len(load_obstacles(three)) == 3
 
 
+def inline_file(folder: Path, count: int) -> Path:
+    """``count`` circles as one array of inline tables, with comments holding ``{``."""
+    path = folder / f"inline_{count}.toml"
+    rows = (
+        f"  {{x = {x}, y = {y}, radius = {r}}},  # {{ post {{\n" for x, y, r in far_circles(count)
+    )
+    path.write_text("# posts {x, y, radius}\nobstacle = [\n" + "".join(rows) + "]\n")
+    return path
+
+
+def test_inline_tables_far_over_the_limit_are_refused_before_they_are_parsed(tmp_path, monkeypatch):
+    """``obstacle = [{...}, ...]`` was parsed (seconds for 100,000) before its count was
+    refused: its inline tables are counted by their "{" outside comments first. Exact for
+    a file that loads: one at the limit is read whole, one over it refused by count."""
+    import tomllib
+
+    many = inline_file(tmp_path, 100_000)
+
+    def not_parsed(*args, **kwargs):
+        raise AssertionError("parsed before the count was checked")
+
+    monkeypatch.setattr(tomllib, "loads", not_parsed)
+    with pytest.raises(ParameterError) as info:
+        load_obstacles(many)
+    assert str(info.value) == f"obstacles: {many} has 100000 obstacles, more than allowed {RANGE}"
+    monkeypatch.undo()
+    circles = load_obstacles(inline_file(tmp_path, MAX_OBSTACLES))
+    assert len(circles) == MAX_OBSTACLES and circles[-1] == Circle(124.5, 109.5, 0.1)
+    over = inline_file(tmp_path, MAX_OBSTACLES + 1)
+    with pytest.raises(ParameterError, match=refused(over)):
+        load_obstacles(over)
+
+
 def test_track_refuses_it_in_one_line_with_status_2(tmp_path, capsys):
     path = obstacle_file(tmp_path, 3000)
     args = ["--method", "qp", "--traj", "ellipse", "--obstacles", str(path)]

@@ -124,21 +124,29 @@ _OBSTACLE_HEADER = re.compile(
     r"""^[ \t]*\[\[[ \t]*(?:obstacle|"obstacle"|'obstacle')[ \t]*\]\][ \t]*(?:#.*)?$""",
     re.MULTILINE,
 )
+#: A comment (``#`` to the end of its line): taken out before the inline tables of
+#: ``obstacle = [{x = .., y = .., radius = ..}, ...]`` are counted by their ``{``.
+_COMMENT = re.compile(r"#[^\n]*")
 
 
 def load_obstacles(path: str | Path) -> list[Circle]:
-    """Read circles from a TOML file of ``[[obstacle]]`` tables with x, y, radius (m): one
+    """Read circles from a TOML file of ``[[obstacle]]`` tables with x, y, radius (m) (or
+    one array of inline tables, ``obstacle = [{x = 1, y = 0, radius = 0.3}, ...]``): one
     to :data:`MAX_OBSTACLES` of them (:func:`check_obstacle_count`)."""
     path = as_path(path, "obstacles")
 
-    def count_headers(text: str) -> None:
+    def count_tables(text: str) -> None:
         # a file of 100,000 tables took seconds to parse before its count was refused;
-        # the [[obstacle]] headers counted in the text refuse it at once (a header spelt
-        # otherwise is counted when parsed; header lines inside a multi-line string
-        # would count too: a thousand of them make no obstacle file)
-        check_obstacle_count(len(_OBSTACLE_HEADER.findall(text)), str(path))
+        # the [[obstacle]] headers and the inline tables' "{" outside comments, counted
+        # in the text, refuse it at once. Exact for every file that loads: its only
+        # strings are the keys obstacle, x, y, radius (no "{" or "#"), and an obstacle
+        # holds numbers only. A file with such text in a string (a header line in a
+        # multi-line string) is no obstacle file: counted too, it is refused either way;
+        # a header spelt otherwise is counted when parsed.
+        headers = len(_OBSTACLE_HEADER.findall(text))
+        check_obstacle_count(headers + _COMMENT.sub("", text).count("{"), str(path))
 
-    data = load_toml(path, "obstacles", count_headers)
+    data = load_toml(path, "obstacles", count_tables)
     tables = data.get("obstacle")
     unknown = sorted(set(data) - {"obstacle"})
     if unknown:
