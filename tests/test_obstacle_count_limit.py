@@ -109,6 +109,32 @@ def test_inline_tables_far_over_the_limit_are_refused_before_they_are_parsed(tmp
         load_obstacles(over)
 
 
+def test_a_crlf_file_over_the_limit_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
+    """Lines ended by CRLF (a Windows editor's) are counted as LF ones are: the headers'
+    count refuses the file before the parser sees it; below the limit it parses."""
+    import tomllib
+
+    path = tmp_path / "crlf.toml"
+    tables = "".join(
+        f"[[obstacle]]{' # post' * (i % 2)}\r\nx = {x}\r\ny = {y}\r\nradius = {r}\r\n"
+        for i, (x, y, r) in enumerate(far_circles(MAX_OBSTACLES + 1))
+    )
+    path.write_bytes(tables.encode())
+
+    def not_parsed(*args, **kwargs):
+        raise AssertionError("parsed before the count was checked")
+
+    monkeypatch.setattr(tomllib, "loads", not_parsed)
+    with pytest.raises(ParameterError) as info:
+        load_obstacles(path)
+    too_many = f"has {MAX_OBSTACLES + 1} obstacles, more than allowed {RANGE}"
+    assert str(info.value) == f"obstacles: {path} {too_many}"
+    monkeypatch.undo()
+    two = tmp_path / "two.toml"
+    two.write_bytes(b"[[obstacle]]\r\nx = 1\r\ny = 0\r\nradius = 0.1\r\n" * 2)
+    assert len(load_obstacles(two)) == 2
+
+
 def test_track_refuses_it_in_one_line_with_status_2(tmp_path, capsys):
     path = obstacle_file(tmp_path, 3000)
     args = ["--method", "qp", "--traj", "ellipse", "--obstacles", str(path)]

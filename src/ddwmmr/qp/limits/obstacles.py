@@ -119,9 +119,10 @@ def check_obstacle_count(count: int, source: str = "") -> int:
 
 
 #: A line holding an ``[[obstacle]]`` table header (the key bare or quoted, a comment after
-#: it): the tables :func:`load_obstacles` counts before the file is parsed.
+#: it, the line ended by LF or CRLF): the tables :func:`load_obstacles` counts before the
+#: file is parsed.
 _OBSTACLE_HEADER = re.compile(
-    r"""^[ \t]*\[\[[ \t]*(?:obstacle|"obstacle"|'obstacle')[ \t]*\]\][ \t]*(?:#.*)?$""",
+    r"""^[ \t]*\[\[[ \t]*(?:obstacle|"obstacle"|'obstacle')[ \t]*\]\][ \t]*(?:#.*)?\r?$""",
     re.MULTILINE,
 )
 #: A comment (``#`` to the end of its line): taken out before the inline tables of
