@@ -53,6 +53,20 @@ def test_the_window_takes_the_screens_pixels_at_a_legible_resolution():
     assert FIGSIZE[0] / width == pytest.approx(MAX_TEXT_SCALE) and dpi < MIN_DPI
 
 
+def test_a_narrow_figure_of_the_callers_gets_the_largest_scales_layout():
+    """App takes any figure: one narrower than window_size ever makes (5 in) gets the
+    layout of MAX_TEXT_SCALE, whose gaps stay on the figure. An uncapped scale (3.2) made
+    the duration field's width negative (matplotlib's ValueError)."""
+    assert text_scale(Figure(figsize=(5.0, 3.125))) == MAX_TEXT_SCALE
+    figure = Figure(figsize=(5.0, 3.125), dpi=100)
+    FigureCanvasAgg(figure)
+    app = App(figure, Settings(duration=1.0))
+    assert app.text_scale == MAX_TEXT_SCALE
+    for ax in figure.axes:
+        x0, y0, width, height = ax.get_position().bounds
+        assert width > 0 and height > 0 and x0 >= 0 and y0 >= 0, ax
+
+
 @pytest.mark.parametrize("screen", [LAPTOP, (1920, 1080)], ids=lambda s: "x".join(map(str, s)))
 def test_the_texts_are_legible_and_stand_apart(screen):
     """After a run, with a long error in the smallest font, and on the option pages with

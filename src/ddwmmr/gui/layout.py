@@ -462,8 +462,10 @@ def window_size(
 def text_scale(figure: Figure) -> float:
     """How much larger text is against the layout than in the 16 x 10 in window (whose
     figure fractions and point sizes the layout is drawn for): ``16 in / width``, at
-    least 1 (a figure of :data:`FIGSIZE`, or larger, is 1)."""
-    return max(1.0, FIGSIZE[0] / float(figure.get_figwidth()))
+    least 1 (a figure of :data:`FIGSIZE`, or larger, is 1) and at most
+    :data:`MAX_TEXT_SCALE`, the largest the layout's grown gaps are made for (a narrower
+    figure, such as a caller's own of 5 in, keeps that layout, its text crowded)."""
+    return min(MAX_TEXT_SCALE, max(1.0, FIGSIZE[0] / float(figure.get_figwidth())))
 
 
 def desktop_figure() -> Figure:
