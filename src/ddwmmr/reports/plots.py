@@ -540,7 +540,8 @@ def save_animation(
     frames = check_int_at_least("frames", frames, 1)
     fps = check_int_at_least("fps", fps, 1, 100)
     path = as_path(path, "path")
-    if path.suffix.lower() != ".gif":  # the writer picks the format by the suffix
+    # a GIF is written whatever the name (gif_bytes): a name saying otherwise is a slip
+    if path.suffix.lower() != ".gif":
         raise ParameterError(f"path must be a .gif file (got {shown(path.name, 60)})")
     circles_of(obstacles)  # refused before anything is drawn
     ts, robot = _run(result).timeseries, result.robot
