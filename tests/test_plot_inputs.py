@@ -104,3 +104,24 @@ def test_save_run_figures_needs_an_existing_folder(run, tmp_path):
         "rates.png",
         "metrics.png",
     ]
+
+
+@pytest.mark.parametrize("draw", ["path", "animation"])
+def test_an_obstacle_file_is_read_once_per_figure(run, draw, tmp_path, monkeypatch):
+    """An obstacle file named by the caller is read once, checked and drawn from that."""
+    from ddwmmr.qp.limits import obstacles as obstacle_files
+
+    reads = []
+    original = obstacle_files.load_obstacles
+
+    def counted(path):
+        reads.append(path)
+        return original(path)
+
+    monkeypatch.setattr(obstacle_files, "load_obstacles", counted)
+    if draw == "path":
+        figure = plot_path(run, obstacles="ellipse_post")
+        assert any(patch.get_label() == "obstacle" for patch in figure.axes[0].patches)
+    else:
+        save_animation(run, tmp_path / "run.gif", frames=2, obstacles="ellipse_post")
+    assert len(reads) == 1

@@ -261,7 +261,8 @@ def plot_path(
         check_instance("ax", ax, Axes)
     # more instants than samples draw each sample once
     count = min(check_int_at_least("snapshots", snapshots, 1), len(ts["t"]))
-    circles_of(obstacles)  # refused before anything is drawn
+    # read (a file) and checked once, before anything is drawn
+    obstacles = circles_of(obstacles)
     own_figure = ax is None
     fig, ax = _axes(ax, figsize=(8.6, 5.6))
     draw_obstacles(ax, obstacles)
@@ -543,7 +544,7 @@ def save_animation(
     # a GIF is written whatever the name (gif_bytes): a name saying otherwise is a slip
     if path.suffix.lower() != ".gif":
         raise ParameterError(f"path must be a .gif file (got {shown(path.name, 60)})")
-    circles_of(obstacles)  # refused before anything is drawn
+    obstacles = circles_of(obstacles)  # read and checked once, before anything is drawn
     ts, robot = _run(result).timeseries, result.robot
     q = result.configurations()
     fig = new_figure((5, 4.5))
