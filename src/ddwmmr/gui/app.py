@@ -57,6 +57,7 @@ from ddwmmr.gui.widgets import (
     wrap_to_width,
 )
 from ddwmmr.gui.worker import Worker
+from ddwmmr.reports.canvas import renderer_of
 from ddwmmr.reports.compare.document import fmt
 from ddwmmr.reports.metrics import METRICS, Metric
 from ddwmmr.sim.verdict import held_limits, lost_support, short_verdict
@@ -209,8 +210,7 @@ class App(PanelLayout):
         artist = self.message_text
         # ignore: the message text sits in its axes
         box = artist.axes.bbox  # type: ignore[union-attr]
-        # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
-        renderer = self.figure.canvas.get_renderer()  # type: ignore[attr-defined]
+        renderer = renderer_of(self.figure)
 
         def show(lines: list[str]) -> bool:
             artist.set_text(prefix + "\n".join(lines))
@@ -620,8 +620,7 @@ class App(PanelLayout):
         smaller one (down to ``FONT - 2``) whose lines end above the transport buttons
         (long lines in a window of a large :attr:`text_scale`), else in that smallest."""
         artist = self.summary_text
-        # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
-        renderer = self.figure.canvas.get_renderer()  # type: ignore[attr-defined]
+        renderer = renderer_of(self.figure)
         buttons_top = self.transport["run"].ax.bbox.y1
         for size in (FONT, FONT - 1, FONT - 2):
             artist.set_fontsize(size)

@@ -21,6 +21,7 @@ from matplotlib.patches import Circle as CirclePatch
 from matplotlib.patches import Polygon
 from matplotlib.ticker import NullFormatter
 
+from ddwmmr.reports.canvas import renderer_of
 from ddwmmr.reports.legends import place_legend
 from ddwmmr.reports.plots import ERROR_FLOOR, robot_outline, wheel_outlines
 
@@ -146,8 +147,7 @@ class RunView:
         """Where the top view's legend starts (axes fraction, negative: under the axes):
         0.07 below, or lower if the tick labels and the x label reach further down (a
         short axes, as in the exported animation), so that the legend never covers them."""
-        # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
-        renderer = self.path_ax.figure.canvas.get_renderer()  # type: ignore[attr-defined]
+        renderer = renderer_of(self.path_ax.figure)
         # ignore: the x axis is shown, so it has a box
         bottom = self.path_ax.xaxis.get_tightbbox(renderer).y0  # type: ignore[union-attr]
         reached: float = self.path_ax.transAxes.inverted().transform((0.0, bottom))[1]
@@ -406,8 +406,7 @@ def plotted_series(ts: dict[str, np.ndarray], k: int) -> dict[str, list[np.ndarr
 def _legend_columns(ax: Axes, fontsize: float) -> int:
     """Columns of ``ax``'s legend: three, or fewer where three make it wider than ``ax``
     (a window whose text is large against its plots, :func:`ddwmmr.gui.layout.text_scale`)."""
-    # ignore: the view's canvases (Agg, TkAgg) have get_renderer; the base class does not
-    renderer = ax.figure.canvas.get_renderer()  # type: ignore[attr-defined]
+    renderer = renderer_of(ax.figure)
     columns = 3
     while columns > 1:
         trial = ax.legend(fontsize=fontsize, ncol=columns)

@@ -26,6 +26,7 @@ from matplotlib.text import Text
 from matplotlib.widgets import Button, RadioButtons, TextBox
 
 from ddwmmr.errors import ParameterError
+from ddwmmr.reports.canvas import renderer_of
 
 #: Font size of panel labels and widget texts (points).
 FONT = 8
@@ -274,8 +275,7 @@ def wrap_to_width(text: str, artist: Text, right: float, indent: str = "    ") -
     its own is broken at its spaces (a word wider than the room keeps a line of its own)."""
     # ignore: the artist is a figure text (of the window's Figure)
     figure: Figure = artist.get_figure()  # type: ignore[assignment]
-    # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
-    renderer = figure.canvas.get_renderer()  # type: ignore[attr-defined]
+    renderer = renderer_of(figure)
     font = artist.get_fontproperties()
     left = artist.get_transform().transform(artist.get_position())[0]
     room = right * figure.bbox.width - left
@@ -326,8 +326,7 @@ def fit_label(label: Text, left: float, height: float, sizes: Sequence[float]) -
     stays as it is."""
     # ignore: the label is a text of the window's Figure
     figure: Figure = label.get_figure()  # type: ignore[assignment]
-    # ignore: the window's canvases (Agg, TkAgg) have get_renderer; the base class does not
-    renderer = figure.canvas.get_renderer()  # type: ignore[attr-defined]
+    renderer = renderer_of(figure)
     text = label.get_text()
     breaks = [text.index(" (")] if " (" in text else []
     breaks += [i + 1 for i in range(len(text) - 1, 0, -1) if text[i] == "_"]

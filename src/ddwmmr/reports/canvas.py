@@ -24,8 +24,9 @@ from typing import Any
 
 import numpy as np
 from matplotlib.artist import Artist
+from matplotlib.backend_bases import RendererBase
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
+from matplotlib.figure import Figure, FigureBase
 from numpy.typing import NDArray
 from PIL import Image
 
@@ -38,6 +39,16 @@ def new_figure(figsize: tuple[float, float], **kwargs: Any) -> Figure:
     fig = Figure(figsize=figsize, **kwargs)
     FigureCanvasAgg(fig)
     return fig
+
+
+def renderer_of(figure: FigureBase) -> RendererBase:
+    """The renderer ``figure``'s text and extents are measured with: its canvas's own where
+    it has one (Agg and the window's TkAgg canvas built on it), else the one matplotlib's
+    ``tight_layout`` measures with (the svg, pdf and cairo canvases have no
+    ``get_renderer``), so a layout can be measured in a figure on any canvas."""
+    # ignore: FigureBase._get_renderer is private, outside matplotlib's stubs
+    renderer: RendererBase = figure._get_renderer()  # type: ignore[attr-defined]
+    return renderer
 
 
 def frame_indices(last: int, frames: int) -> list[int]:

@@ -21,9 +21,10 @@ from matplotlib.legend import Legend
 from matplotlib.path import Path
 from matplotlib.transforms import Bbox
 
+from ddwmmr.reports.canvas import renderer_of
+
 if TYPE_CHECKING:
     from matplotlib.artist import Artist
-    from matplotlib.backend_bases import RendererBase
     from matplotlib.transforms import Transform
 
     #: A legend spot inside the axes (matplotlib ``loc`` names).
@@ -94,7 +95,7 @@ def legend_beside(ax: Axes, **kwargs: Any) -> Legend:
 def covers_data(ax: Axes, legend: Legend) -> bool:
     """Whether ``legend`` (drawn where it is now) overlaps a data line, a scatter point
     or a text label of ``ax``."""
-    renderer = _renderer(ax)
+    renderer = renderer_of(ax.figure)
     ax.apply_aspect()  # an equal-aspect axes takes its final box only when drawn
     box = legend.get_window_extent(renderer).padded(CLEARANCE_PX)
     for line in ax.lines:
@@ -115,16 +116,6 @@ def covers_data(ax: Axes, legend: Legend) -> bool:
         text.get_visible() and text.get_text() and box.overlaps(text.get_window_extent(renderer))
         for text in ax.texts
     )
-
-
-def _renderer(ax: Axes) -> RendererBase:
-    """The renderer ``ax``'s figure is measured with: its canvas's own where it has one
-    (Agg and the GUI canvases built on it), else the one matplotlib's own ``tight_layout``
-    measures with (``Figure._get_renderer``: the svg, pdf and cairo canvases have no
-    ``get_renderer``), so a legend can be placed in a figure on any canvas."""
-    # ignore: Figure._get_renderer is private, outside matplotlib's stubs
-    renderer: RendererBase = ax.figure._get_renderer()  # type: ignore[union-attr]
-    return renderer
 
 
 def _crosses(transform: Transform, xy: npt.ArrayLike, box: Bbox) -> bool:
@@ -150,7 +141,7 @@ def _crosses(transform: Transform, xy: npt.ArrayLike, box: Bbox) -> bool:
 
 def _raise_top(ax: Axes, legend: Legend) -> None:
     """Raise the y-axis top so that the data's top sits below the legend's bottom."""
-    renderer = _renderer(ax)
+    renderer = renderer_of(ax.figure)
     axes_box = ax.get_window_extent(renderer)
     legend_box = legend.get_window_extent(renderer)
     # Fraction of the axes height the data may use: below the legend, with a gap.
