@@ -68,6 +68,35 @@ def test_place_obstacles_refuses_a_count_outside_0_to_the_cap(count, got):
     assert str(info.value) == f"count must be an integer in [0, {MAX_OBSTACLES}] (got {got})"
 
 
+@pytest.mark.parametrize(
+    ("name", "value", "message"),
+    [
+        ("keep_out", math.nan, "keep_out must be a finite number >= 0 (got nan)"),
+        ("keep_out", -1.0, "keep_out must be >= 0 (got -1)"),
+        ("separation", math.nan, "separation must be a finite number >= 0 (got nan)"),
+        ("separation", -0.5, "separation must be >= 0 (got -0.5)"),
+        ("radius", 0.0, "radius must be in [1e-06, 1000] m (got 0)"),
+        ("radius", math.nan, "radius must be a finite number in [1e-06, 1000] m (got nan)"),
+        ("radius", math.inf, "radius must be a finite number in [1e-06, 1000] m (got inf)"),
+    ],
+)
+def test_place_obstacles_refuses_a_bad_radius_keep_out_or_separation(name, value, message):
+    """Only count was checked: a NaN keep_out or separation compared false with every
+    distance, so obstacles went on the waypoints (or on one another); a NaN or 0 radius
+    made a Scenario the run then refused as "obstacles", far from the call."""
+    with pytest.raises(ParameterError) as info:
+        place_obstacles(generate(1)[0], **{name: value})
+    assert str(info.value) == message
+
+
+def test_place_obstacles_keeps_its_defaults_and_takes_zero_keep_out_and_separation():
+    scenario = generate(1)[0]
+    assert place_obstacles(scenario) == place_obstacles(
+        scenario, count=2, radius=0.3, keep_out=1.0, separation=2.0
+    )
+    assert len(place_obstacles(scenario, keep_out=0.0, separation=0.0).obstacles) == 2
+
+
 def test_place_obstacles_of_count_0_places_none_and_a_count_beyond_the_legs_all_it_can():
     """count = 0 placed one obstacle (the count was compared after the first placement)."""
     scenario = generate(1)[0]

@@ -13,7 +13,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ddwmmr.errors import MAX_OBSTACLES, MAX_SCENARIOS, check_int_at_least
+from ddwmmr.errors import (
+    LENGTH_RANGE_M,
+    MAX_OBSTACLES,
+    MAX_SCENARIOS,
+    check_int_at_least,
+    check_nonnegative,
+    check_range,
+)
 
 #: Workspace half-width (m): waypoints lie in [-4, 4] x [-4, 4].
 HALF_SIZE = 4.0
@@ -75,10 +82,14 @@ def place_obstacles(
     obstacle per leg, so fewer than ``count`` where the legs run out.
 
     ``count``: an integer in [0, :data:`ddwmmr.errors.MAX_OBSTACLES`] (the cap of a run's
-    obstacles; 0: none); anything else raises a one-line
-    :class:`~ddwmmr.errors.ParameterError` naming ``count``.
+    obstacles; 0: none); ``radius``: in :data:`ddwmmr.errors.LENGTH_RANGE_M` (m);
+    ``keep_out`` and ``separation``: finite, >= 0 (m). Anything else raises a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming the parameter.
     """
     count = check_int_at_least("count", count, 0, MAX_OBSTACLES)
+    radius = check_range("radius", radius, *LENGTH_RANGE_M, "m")
+    keep_out = check_nonnegative("keep_out", keep_out)
+    separation = check_nonnegative("separation", separation)
     points = [(0.0, 0.0), *scenario.waypoints]
     legs = sorted(
         range(len(points) - 1),
