@@ -157,14 +157,20 @@ def test_the_default_worker_count_is_within_what_run_many_accepts(monkeypatch):
         ({"waypoints": ((float("nan"), 0),)}, r"^scenario waypoints\[1\] x must be a finite "),
         (
             {"obstacles": ((1, 2),)},
-            r"^obstacles must be Circle\(x, y, radius\) or \(x, y, radius\)",
+            r"^scenario obstacles must be Circle\(x, y, radius\) or \(x, y, radius\)",
         ),
+        (
+            {"obstacles": ((1, 2, -0.3),)},
+            r"^scenario obstacles: obstacle radius must be > 0 \(got -0.3\)$",
+        ),
+        ({"obstacles": 5}, r"^scenario obstacles must be circles, \(x, y, radius\) triples "),
     ],
 )
 def test_run_scenario_refuses_a_hand_made_scenario_naming_its_field(fields, message):
     """A Scenario built by hand was run unchecked: a waypoint list of None raised
     TypeError (len), an index of None TypeError (+ 1) after the run, a text coordinate
-    TypeError (float - str)."""
+    TypeError (float - str). Bad obstacles were named ``obstacles`` only (the message of
+    ``as_circles``), not ``scenario obstacles`` as the index and waypoints are."""
     from ddwmmr.scenarios import run_scenario
     from ddwmmr.scenarios.generator import Scenario
 

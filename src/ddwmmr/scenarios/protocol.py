@@ -698,7 +698,8 @@ def check_scenario(scenario: Scenario) -> None:
     ``index`` is not an integer >= 0, whose ``waypoints`` are not a non-empty sequence of
     (x, y) pairs of finite numbers within +-:data:`~ddwmmr.errors.MAX_COORDINATE_M` m, or
     whose ``obstacles`` are not (x, y, radius) circles (m) as the ``qp``'s option takes
-    them (:func:`ddwmmr.qp.limits.obstacles.as_circles`)."""
+    them (:func:`ddwmmr.qp.limits.obstacles.as_circles`; its refusal prefixed with
+    ``scenario obstacles``)."""
     from ddwmmr.qp.limits.obstacles import as_circles
 
     check_int_at_least("scenario index", scenario.index, 0)
@@ -722,7 +723,12 @@ def check_scenario(scenario: Scenario) -> None:
                 MAX_COORDINATE_M,
                 "m",
             )
-    as_circles(scenario.obstacles)
+    try:
+        as_circles(scenario.obstacles)
+    except ParameterError as exc:
+        message = str(exc)
+        field = "" if message.startswith("obstacles") else "obstacles: "
+        raise ParameterError(f"scenario {field}{message}") from None
 
 
 def make_scenario_plant(robot: Robot, config: RunConfig) -> Plant:
