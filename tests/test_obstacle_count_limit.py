@@ -19,6 +19,20 @@ from ddwmmr.qp.limits.obstacles import Circle, load_obstacles
 RANGE = f"(1 to {MAX_OBSTACLES}; each is checked at every control step)"
 
 
+def refusal_before_parsing(path: Path) -> str:
+    """``load_obstacles(path)``'s refusal, with the TOML parser made to fail if it runs."""
+    import tomllib
+
+    def not_parsed(*args, **kwargs):
+        raise AssertionError("parsed before the count was checked")
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(tomllib, "loads", not_parsed)
+        with pytest.raises(ParameterError) as info:
+            load_obstacles(path)
+    return str(info.value)
+
+
 def far_circles(count: int) -> list[tuple[float, float, float]]:
     """``count`` posts of 0.1 m, 0.5 m apart, 100 m from the ellipse: never in the way."""
     return [(100.0 + 0.5 * (i % 50), 100.0 + 0.5 * (i // 50), 0.1) for i in range(count)]
@@ -52,25 +66,17 @@ def test_a_file_over_the_limit_is_refused_naming_the_count(tmp_path):
     assert str(info.value) == f"obstacles: {path} {too_many}"
 
 
-def test_a_file_far_over_the_limit_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
+def test_a_file_far_over_the_limit_is_refused_before_it_is_parsed(tmp_path):
     """A file of 100,000 tables was parsed (seconds) before its count was refused: its
     [[obstacle]] headers are counted in the text first. Headers spelt with quotes, spaces
     and a comment count too; a file the headers' count admits is parsed as before."""
-    import tomllib
-
     path = tmp_path / "many.toml"
     headers = ["[[obstacle]]", '[[ "obstacle" ]]  # quoted', "  [['obstacle']]"]
     tables = (f"{headers[i % 3]}\nx = {i}\ny = 0\nradius = 0.1\n" for i in range(100_000))
     path.write_text("\n".join(tables), encoding="utf-8")
 
-    def not_parsed(*args, **kwargs):
-        raise AssertionError("parsed before the count was checked")
-
-    monkeypatch.setattr(tomllib, "loads", not_parsed)
-    with pytest.raises(ParameterError) as info:
-        load_obstacles(path)
-    assert str(info.value) == f"obstacles: {path} has 100000 obstacles, more than allowed {RANGE}"
-    monkeypatch.undo()
+    refusal = refusal_before_parsing(path)
+    assert refusal == f"obstacles: {path} has 100000 obstacles, more than allowed {RANGE}"
     three = tmp_path / "three.toml"
     three.write_text("\n".join(f"{h}\nx = 1\ny = 0\nradius = 0.1\n" for h in headers))
     assert len(load_obstacles(three)) == 3
@@ -86,22 +92,13 @@ def inline_file(folder: Path, count: int) -> Path:
     return path
 
 
-def test_inline_tables_far_over_the_limit_are_refused_before_they_are_parsed(tmp_path, monkeypatch):
+def test_inline_tables_far_over_the_limit_are_refused_before_they_are_parsed(tmp_path):
     """``obstacle = [{...}, ...]`` was parsed (seconds for 100,000) before its count was
     refused: its inline tables are counted by their "{" outside comments first. Exact for
     a file that loads: one at the limit is read whole, one over it refused by count."""
-    import tomllib
-
     many = inline_file(tmp_path, 100_000)
-
-    def not_parsed(*args, **kwargs):
-        raise AssertionError("parsed before the count was checked")
-
-    monkeypatch.setattr(tomllib, "loads", not_parsed)
-    with pytest.raises(ParameterError) as info:
-        load_obstacles(many)
-    assert str(info.value) == f"obstacles: {many} has 100000 obstacles, more than allowed {RANGE}"
-    monkeypatch.undo()
+    refusal = refusal_before_parsing(many)
+    assert refusal == f"obstacles: {many} has 100000 obstacles, more than allowed {RANGE}"
     circles = load_obstacles(inline_file(tmp_path, MAX_OBSTACLES))
     assert len(circles) == MAX_OBSTACLES and circles[-1] == Circle(124.5, 109.5, 0.1)
     over = inline_file(tmp_path, MAX_OBSTACLES + 1)
@@ -109,11 +106,9 @@ def test_inline_tables_far_over_the_limit_are_refused_before_they_are_parsed(tmp
         load_obstacles(over)
 
 
-def test_a_crlf_file_over_the_limit_is_refused_before_it_is_parsed(tmp_path, monkeypatch):
+def test_a_crlf_file_over_the_limit_is_refused_before_it_is_parsed(tmp_path):
     """Lines ended by CRLF (a Windows editor's) are counted as LF ones are: the headers'
     count refuses the file before the parser sees it; below the limit it parses."""
-    import tomllib
-
     path = tmp_path / "crlf.toml"
     tables = "".join(
         f"[[obstacle]]{' # post' * (i % 2)}\r\nx = {x}\r\ny = {y}\r\nradius = {r}\r\n"
@@ -121,15 +116,8 @@ def test_a_crlf_file_over_the_limit_is_refused_before_it_is_parsed(tmp_path, mon
     )
     path.write_bytes(tables.encode())
 
-    def not_parsed(*args, **kwargs):
-        raise AssertionError("parsed before the count was checked")
-
-    monkeypatch.setattr(tomllib, "loads", not_parsed)
-    with pytest.raises(ParameterError) as info:
-        load_obstacles(path)
     too_many = f"has {MAX_OBSTACLES + 1} obstacles, more than allowed {RANGE}"
-    assert str(info.value) == f"obstacles: {path} {too_many}"
-    monkeypatch.undo()
+    assert refusal_before_parsing(path) == f"obstacles: {path} {too_many}"
     two = tmp_path / "two.toml"
     two.write_bytes(b"[[obstacle]]\r\nx = 1\r\ny = 0\r\nradius = 0.1\r\n" * 2)
     assert len(load_obstacles(two)) == 2
