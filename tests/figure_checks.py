@@ -430,3 +430,29 @@ class SavedFigures:
     def failing(self) -> dict[str, list[str]]:
         """The saved figures with problems (name -> the first five)."""
         return {name: found[:5] for name, found in self.problems.items() if found}
+
+
+class SaveGifCalls:
+    """Each call of ``module.save_gif`` while installed (patched through pytest's
+    ``monkeypatch``), recorded then made by the real one: :attr:`calls` holds its
+    ``(fig, update, count)``, :attr:`draws` counts the full renders (``Figure.draw``) made
+    during the calls."""
+
+    def __init__(self, monkeypatch, module) -> None:
+        self.calls: list[tuple[Figure, Callable, int]] = []
+        self.draws = 0
+        real_save_gif = module.save_gif
+        real_draw = Figure.draw
+        recorded = self
+
+        def draw(*args):
+            recorded.draws += 1
+            return real_draw(*args)
+
+        def save_gif(fig: Figure, update, count: int, *args):
+            recorded.calls.append((fig, update, count))
+            with monkeypatch.context() as during:
+                during.setattr(Figure, "draw", draw)
+                return real_save_gif(fig, update, count, *args)
+
+        monkeypatch.setattr(module, "save_gif", save_gif)

@@ -15,7 +15,7 @@ from PIL import Image
 from ddwmmr import Ellipse, Robot, simulate
 from ddwmmr.reports import plots
 from ddwmmr.reports.canvas import blitted_frames, frame_indices, new_figure
-from figure_checks import blitted_and_full
+from figure_checks import SaveGifCalls, blitted_and_full
 
 
 def gif_frames(path) -> tuple[int, int]:
@@ -39,16 +39,9 @@ def test_frame_indices_are_distinct_spread_and_keep_both_ends(last, frames):
 
 def test_a_short_run_is_animated_once_per_recorded_instant(tmp_path, monkeypatch):
     result = simulate(Robot(), Ellipse(), "ats", duration=0.2)  # 11 recorded instants
-    rendered = []
-    real_save_gif = plots.save_gif
-    monkeypatch.setattr(
-        plots,
-        "save_gif",
-        lambda fig, update, count, *a: (
-            rendered.append(count) or real_save_gif(fig, update, count, *a)
-        ),
-    )
+    saved = SaveGifCalls(monkeypatch, plots)
     path = plots.save_animation(result, tmp_path / "short.gif", frames=80, fps=15)
+    rendered = [count for _, _, count in saved.calls]
     assert rendered == [11]
     count, duration_ms = gif_frames(path)
     assert count == 11
@@ -114,23 +107,10 @@ def test_track_gif_frames_are_the_figure_at_their_instants(tmp_path, monkeypatch
     its instant (title with the time, trace, robot) to the palette's loss, the white
     background exactly white; the still parts are drawn once for all frames."""
     result = simulate(Robot(), Ellipse(), "ats", duration=0.4)  # 21 recorded instants
-    captured = []
-    real_save_gif = plots.save_gif
-    draws = []
-    real_draw = Figure.draw
-
-    def save_gif(fig, update, count, *args):
-        captured.append((fig, update, count))
-        monkeypatch.setattr(Figure, "draw", lambda *a: draws.append(1) or real_draw(*a))
-        try:
-            return real_save_gif(fig, update, count, *args)
-        finally:
-            monkeypatch.setattr(Figure, "draw", real_draw)
-
-    monkeypatch.setattr(plots, "save_gif", save_gif)
+    saved = SaveGifCalls(monkeypatch, plots)
     path = plots.save_animation(result, tmp_path / "run.gif", frames=8)
-    ((fig, update, count),) = captured
-    assert count == 8 and len(draws) == 1
+    ((fig, update, count),) = saved.calls
+    assert count == 8 and saved.draws == 1
     with Image.open(path) as movie:
         decoded = []
         for index in range(movie.n_frames):

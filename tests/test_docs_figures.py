@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from figure_checks import SavedFigures, blitted_and_full
+from figure_checks import SavedFigures, SaveGifCalls, blitted_and_full
 
 DOCS = Path(__file__).resolve().parent.parent / "docs"
 
@@ -114,20 +114,12 @@ def test_physics_animation_frames(tipping_runs, tmp_path, monkeypatch):
     plant = MujocoPlant(result.robot)
     saved = SavedFigures(monkeypatch)
     points = [s.point for s in plant.supports]
-    captured = []
-    real_save_gif = physics_plots.save_gif
-    monkeypatch.setattr(
-        physics_plots,
-        "save_gif",
-        lambda fig, update, count, *a: (
-            captured.append((fig, update, count)) or real_save_gif(fig, update, count, *a)
-        ),
-    )
+    calls = SaveGifCalls(monkeypatch, physics_plots)
     path = tmp_path / "tip.gif"
     physics_plots.save_physics_animation(result, points, plant.weight_n, path, frames=6)
     assert len(saved.problems) >= 6  # every frame is checked as it is drawn
     assert saved.failing() == {}
-    ((fig, update, count),) = captured
+    ((fig, update, count),) = calls.calls
     top = fig.axes[0]
     for index, (blitted, full) in enumerate(blitted_and_full(fig, update, count)):
         above = slice(0, blitted.shape[0] - round(top.bbox.y1))  # the title's band
