@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import itertools
 
+import matplotlib as mpl
 import numpy as np
 import pytest
 from matplotlib.figure import Figure
@@ -14,7 +15,7 @@ from PIL import Image
 
 from ddwmmr import Ellipse, Robot, simulate
 from ddwmmr.reports import plots
-from ddwmmr.reports.canvas import blitted_frames, frame_indices, new_figure
+from ddwmmr.reports.canvas import blitted_frames, frame_indices, new_figure, save_gif
 from figure_checks import SaveGifCalls, blitted_and_full
 
 
@@ -126,3 +127,72 @@ def test_track_gif_frames_are_the_figure_at_their_instants(tmp_path, monkeypatch
         assert np.mean(title > 32) < 1e-3, index  # the title of its own instant
         assert np.argmin(difference) == index  # this instant's picture, not a neighbour's
         assert (frame[2, 2] == 255).all()  # the figure's white, not a near white
+
+
+def gif_rgba(path) -> list[np.ndarray]:
+    """The decoded frames of a GIF file, RGBA, int (transparent pixels: alpha 0)."""
+    with Image.open(path) as movie:
+        decoded = []
+        for index in range(movie.n_frames):
+            movie.seek(index)
+            decoded.append(np.asarray(movie.convert("RGBA"), dtype=int))
+    return decoded
+
+
+def savefig_rgba(fig) -> np.ndarray:
+    """``fig`` as a PNG of ``fig.savefig`` (the rcParams in force), decoded: RGBA, int."""
+    import io
+
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png")
+    buffer.seek(0)
+    with Image.open(buffer) as image:
+        return np.asarray(image.convert("RGBA"), dtype=int)
+
+
+def test_gif_frames_take_the_savefig_colours(tmp_path):
+    """A GIF's frames are painted as savefig paints a PNG of the figure: the figure's face
+    and edge in ``savefig.facecolor`` and ``savefig.edgecolor``; the figure keeps its own
+    colours afterwards."""
+    fig, _, update = moving_figure()
+    fig.patch.set_linewidth(6)  # an edge to paint
+    colours = {"savefig.facecolor": "black", "savefig.edgecolor": "red"}
+    with mpl.rc_context(colours):
+        save_gif(fig, update, 5, tmp_path / "dark.gif", 5)
+        update(4)
+        png = savefig_rgba(fig)
+    frames = gif_rgba(tmp_path / "dark.gif")
+    assert len(frames) == 5 and frames[-1].shape == png.shape
+    middle = png.shape[0] // 2
+    for picture in (png, frames[-1]):
+        assert (picture[middle, 1] == [255, 0, 0, 255]).all()  # the edge
+        assert (picture[middle, 8] == [0, 0, 0, 255]).all()  # the face, beside the axes
+    assert np.mean(np.abs(frames[-1] - png)) < 1.0  # the whole picture, to the palette
+    assert fig.get_facecolor() == (1, 1, 1, 1) and fig.get_edgecolor() == (1, 1, 1, 1)
+    with mpl.rc_context({"savefig.facecolor": "auto"}):
+        assert (savefig_rgba(fig)[middle, 8] == 255).all()  # white again
+
+
+def test_a_transparent_savefig_makes_a_transparent_gif(tmp_path):
+    """Under ``savefig.transparent``, each frame is transparent where a PNG of the figure
+    at that frame is less than half opaque (the figure's and the axes' backgrounds), and
+    shows its colours elsewhere; no frame shows through the next. The figure's and the
+    axes' backgrounds are theirs again afterwards."""
+    fig, ax, update = moving_figure()
+    with mpl.rc_context({"savefig.transparent": True}):
+        save_gif(fig, update, 5, tmp_path / "clear.gif", 5)
+        pngs = []
+        for frame in range(5):
+            update(frame)
+            pngs.append(savefig_rgba(fig))
+    frames = gif_rgba(tmp_path / "clear.gif")
+    assert len(frames) == 5
+    for index, (decoded, png) in enumerate(zip(frames, pngs)):
+        opaque = png[..., 3] >= 128
+        assert 0.01 < np.mean(opaque) < 0.2, index  # the lines and texts only
+        assert set(np.unique(decoded[..., 3])) == {0, 255}, index
+        mismatched = (decoded[..., 3] == 255) != opaque
+        assert np.mean(mismatched) < 1e-3, index  # where the moving line crosses still ones
+        both = opaque & (decoded[..., 3] == 255)
+        assert np.mean(np.abs(decoded[both][:, :3] - png[both][:, :3])) < 3.0, index
+    assert fig.get_facecolor() == (1, 1, 1, 1) and ax.get_facecolor() == (1, 1, 1, 1)

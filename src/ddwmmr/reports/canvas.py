@@ -12,13 +12,15 @@ window, the plotting functions of :mod:`ddwmmr.reports.plots` draw into pyplot's
 
 Animations of such figures (`track --animate`, the physics animation, the window's GIF
 and MP4 export) all take their frames from :func:`blitted_frames`; GIFs are encoded by
-:func:`gif_bytes`.
+:func:`gif_bytes`. :func:`save_gif` (the first two) paints its frames as ``savefig``
+paints a PNG under the user's rcParams (:func:`as_saved`).
 """
 
 from __future__ import annotations
 
 import io
 from collections.abc import Callable, Iterable, Iterator, Sequence
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -98,6 +100,45 @@ def blitted_frames(
             artist.set_animated(animated)
 
 
+@contextmanager
+def as_saved(fig: Figure) -> Iterator[Figure]:
+    """``fig`` as ``fig.savefig`` renders it under the user's rcParams, restored on exit:
+    at ``savefig.dpi`` (``'figure'``: its own), its face and edge painted in
+    ``savefig.facecolor`` and ``savefig.edgecolor`` (``'auto'``: its own) and, with
+    ``savefig.transparent``, the figure's and every axes' (and subfigure's) background
+    clear, as savefig clears them. ``savefig.bbox`` is not applied: every frame of an
+    animation is the whole figure (as matplotlib's ``Animation.save`` does)."""
+    from matplotlib import rcParams
+    from matplotlib.axes import Axes
+    from matplotlib.figure import SubFigure
+    from matplotlib.patches import Patch
+
+    dpi = rcParams["savefig.dpi"]
+    colors = {
+        "facecolor": rcParams["savefig.facecolor"],
+        "edgecolor": rcParams["savefig.edgecolor"],
+    }
+    backgrounds: list[Patch] = [fig.patch]
+    if rcParams["savefig.transparent"]:
+        colors = {"facecolor": "none", "edgecolor": "none"}
+        backgrounds += [
+            found.patch for found in fig.findobj() if isinstance(found, Axes | SubFigure)
+        ]
+    with ExitStack() as restore:
+        figure_dpi = fig.dpi
+        if dpi != "figure" and dpi != figure_dpi:
+            fig.dpi = dpi
+            restore.callback(setattr, fig, "dpi", figure_dpi)
+        for patch in backgrounds:
+            for name, color in colors.items():
+                if isinstance(color, str) and color == "auto":
+                    continue
+                own = getattr(patch, f"get_{name}")()
+                getattr(patch, f"set_{name}")(color)
+                restore.callback(getattr(patch, f"set_{name}"), own)
+        yield fig
+
+
 def save_gif(
     fig: Figure,
     update: Callable[[int], Iterable[Artist]],
@@ -108,23 +149,17 @@ def save_gif(
 ) -> Path:
     """Write ``count`` frames of ``fig`` to the GIF ``path`` at ``fps`` frames per second
     (:func:`gif_bytes`): the frames of :func:`blitted_frames` (``update(i)`` sets frame i
-    and returns the artists that move), rendered at ``savefig.dpi``; ``advance()`` (if
-    given) is called after each frame is drawn."""
-    from matplotlib import rcParams
-
-    dpi = rcParams["savefig.dpi"]
-    figure_dpi = fig.dpi
+    and returns the artists that move), each the figure as a PNG of ``fig.savefig`` shows
+    it (:func:`as_saved`: ``savefig.dpi``, ``savefig.facecolor``, ``savefig.edgecolor``,
+    ``savefig.transparent``); ``advance()`` (if given) is called after each frame is drawn.
+    A transparent background is transparent in the GIF, to its one transparent colour
+    (:func:`gif_bytes`)."""
     images = []
-    try:
-        if dpi != "figure":
-            fig.dpi = dpi
+    with as_saved(fig):
         for rgba in blitted_frames(fig, update, count):
-            images.append(Image.fromarray(rgba).convert("RGB"))  # a copy, out of the canvas
+            images.append(Image.fromarray(rgba).copy())  # a copy, out of the canvas
             if advance is not None:
                 advance()
-    finally:
-        if fig.dpi != figure_dpi:
-            fig.dpi = figure_dpi
     Path(path).write_bytes(gif_bytes(images, fps))
     return path
 
@@ -134,20 +169,50 @@ GIF_COLORS = 128
 
 
 def gif_bytes(images: Sequence[Image.Image], fps: int) -> bytes:
-    """The RGB ``images`` as a looping GIF, ``fps`` frames per second.
+    """The RGB or RGBA ``images`` as a looping GIF, ``fps`` frames per second.
 
     One palette serves every frame: :data:`GIF_COLORS` colours of the last image (an
     animation's last frame has every trail and colour), its most common colour (the
-    background) exactly, each pixel mapped to its nearest entry without dithering."""
-    last = images[-1]
-    palette = last.quantize(colors=GIF_COLORS, method=Image.Quantize.FASTOCTREE)
+    background) exactly, each pixel mapped to its nearest entry without dithering.
+
+    A GIF pixel is either opaque or transparent (one palette entry, added for it): where
+    an RGBA image's alpha is below half (128), its pixel is transparent, elsewhere opaque
+    in its own colour, so antialiased edges over a clear background keep their colour
+    without the partial transparency of a PNG. Each frame of such a GIF replaces the one
+    before (disposal 2), none shows through another. Images without a transparent pixel
+    make an opaque GIF, as RGB ones."""
+    clear = [
+        np.asarray(image.getchannel("A")) < 128 if image.mode == "RGBA" else None
+        for image in images
+    ]
+    transparent = any(mask is not None and mask.any() for mask in clear)
+    pictures = [image if image.mode == "RGB" else image.convert("RGB") for image in images]
+    last = pictures[-1]
+    if transparent and clear[-1] is not None and not clear[-1].all():
+        # the palette and background of the last image's opaque pixels only
+        last = Image.fromarray(np.asarray(last)[~clear[-1]][np.newaxis])
+    palette = last.quantize(colors=GIF_COLORS - transparent, method=Image.Quantize.FASTOCTREE)
     # every pixel's colour is counted (at most one per pixel): never None
     _, common = max(last.getcolors(last.width * last.height) or [])
     background = np.asarray(common, dtype=int)
     entries = np.asarray(palette.getpalette(), dtype=int).reshape(-1, 3)
     entries[np.argmin(np.abs(entries - background).sum(axis=1))] = background
     palette.putpalette(entries.astype(np.uint8).tobytes())
-    frames = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in images]
+    frames = [image.quantize(palette=palette, dither=Image.Dither.NONE) for image in pictures]
+    options: dict[str, Any] = {}
+    if transparent:
+        # one more palette entry, for the clear pixels only (the quantized ones map to the
+        # entries above), of a colour no other entry has: Pillow's encoder tells a frame's
+        # pixels from the cleared background (disposal 2) by colour, dropping any opaque
+        # pixel of the transparent entry's colour
+        index = len(entries)
+        used = {tuple(entry) for entry in entries.tolist()}
+        unused = next(c for v in range(256) if (c := (v, 255 - v, v)) not in used)
+        for frame, mask in zip(frames, clear):
+            frame.putpalette(np.append(entries, [unused], axis=0).astype(np.uint8).tobytes())
+            if mask is not None:
+                frame.paste(index, mask=Image.fromarray(mask))
+        options = {"transparency": index, "disposal": 2}
     buffer = io.BytesIO()
     frames[0].save(
         buffer,
@@ -156,5 +221,6 @@ def gif_bytes(images: Sequence[Image.Image], fps: int) -> bytes:
         append_images=frames[1:],
         duration=round(1000 / fps),
         loop=0,
+        **options,
     )
     return buffer.getvalue()
