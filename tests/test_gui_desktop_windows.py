@@ -5,6 +5,7 @@ stays inside the message box. Off-screen (Agg canvases) at the size the window t
 
 from __future__ import annotations
 
+import io
 import re
 
 import pytest
@@ -131,3 +132,50 @@ def test_a_short_message_keeps_the_panel_font_and_its_lines() -> None:
     assert app.message_text.get_text() == (
         "run finished (50 steps per method): playing; drag\ntime to scrub"
     )
+
+
+def canvas_resized(app: App, width: float, height: float) -> bool:
+    """What the Tk canvas does to the figure when the user resizes the window to a
+    ``width`` x ``height`` px canvas (new inches at the same dpi), then what the app does
+    once the resizing pauses (:meth:`App.fit_canvas`)."""
+    figure = app.figure
+    figure.set_size_inches(width / figure.dpi, height / figure.dpi, forward=False)
+    return app.fit_canvas()
+
+
+def window_png(app: App) -> bytes:
+    buffer = io.BytesIO()
+    app.figure.savefig(buffer, format="png")
+    return buffer.getvalue()
+
+
+def test_a_resized_window_is_laid_out_for_its_new_size():
+    """The 1920 x 1080 screen's window (1451 x 907 px at 90.72 px per inch) resized to a
+    1366 x 768 laptop's maximised canvas takes that screen's 81 px per inch and its larger
+    text scale, to a larger canvas a larger resolution; its texts stand apart and the
+    message stays in its box at every size; resized back, it is drawn as it opened, byte
+    for byte; a pixel more keeps the layout. Before, the dpi and the text scale chosen at
+    the start stayed: the text did not grow with the window nor shrink with it."""
+    app = window_app((1920, 1080), settings=Settings(methods=("clrrmc-ts", "qp"), duration=1.0))
+    app.run()
+    app.wait()
+    app.show_index(app.view.last_index)
+    app.say(LONG_MESSAGE, error=True)
+    opened, (width, height) = window_png(app), app.figure.bbox.size
+    panel_px = {}
+    for canvas in [(1366, 718), (1920, 1030), (800, 550), (1366, 718)]:
+        assert canvas_resized(app, *canvas), canvas
+        assert app.figure.bbox.size == pytest.approx(canvas)
+        panel_px[canvas] = app.dt_field.box.label.get_fontsize() * app.figure.dpi / 72
+        assert text_collisions(app.figure) == [], canvas
+        box = app.message_text.axes.bbox
+        assert message_extent(app).y0 >= box.y0 and message_extent(app).x1 <= box.x1, canvas
+    assert app.text_scale == pytest.approx(MIN_DPI / 71.8)  # 718 px / 10 in: 71.8 px per in
+    assert panel_px[(1366, 718)] == pytest.approx(FONT * MIN_DPI / 72)  # 9 px
+    assert panel_px[(1920, 1030)] == pytest.approx(FONT * 103 / 72)  # 11.4 px
+    assert canvas_resized(app, width, height)
+    assert (app.figure.dpi, app.text_scale) == (pytest.approx(90.72), 1.0)
+    assert window_png(app) == opened
+    assert not canvas_resized(app, width + 1, height)
+    assert not canvas_resized(app, 300, 20)  # too small to follow: the layout stays
+    assert (app.figure.dpi, app.text_scale) == (pytest.approx(90.72), 1.0)

@@ -35,6 +35,9 @@ from ddwmmr.gui.layout import (
     SPEEDS,
     SUMMARY_RIGHT,
     PanelLayout,
+    canvas_size,
+    scale_of,
+    text_scale,
 )
 from ddwmmr.gui.options import NOTES, OptionSpec, method_options
 from ddwmmr.gui.paths import check_export_root
@@ -69,6 +72,16 @@ if TYPE_CHECKING:
 #: Playback frame and progress poll intervals (ms).
 FRAME_MS = 40
 POLL_MS = 100
+#: After a resize of the desktop window, the layout follows once no further resize came
+#: for this long (ms): dragging a window's edge sends a resize per pixel.
+RESIZE_SETTLE_MS = 250
+#: A resized window is laid out again where its text scale changes by more than this, or
+#: its resolution by more than this fraction (a window whose canvas is a pixel off the size
+#: it was opened at keeps its layout).
+RESCALE_STEP = 0.01
+#: The smallest canvas (px) the layout follows: one dragged smaller keeps its last layout,
+#: cut (a few px per inch would make fonts too small for FreeType to draw).
+SMALLEST_FOLLOWED = (320, 200)
 #: Characters a line of the message box holds in the panel font (the box is 0.325 of the
 #: 16 in window wide; 62 leaves room for the widest letters); a window laid out on fewer
 #: inches holds fewer (divided by its text scale, :func:`ddwmmr.gui.layout.text_scale`).
@@ -142,6 +155,12 @@ class _OptionGroup:
         for widget in self.widgets.values():
             widget.set_visible(False)
 
+    def remove(self) -> None:
+        """Take every widget made so far off the window (they are made again when shown)."""
+        for widget in self.widgets.values():
+            widget.remove()
+        self.widgets.clear()
+
 
 class App(PanelLayout):
     """The simulator window in ``figure`` (see the module docstring).
@@ -173,10 +192,15 @@ class App(PanelLayout):
         self._groups: dict[tuple[int, str], _OptionGroup] = {}
         self._last_tick = 0.0
         self._moving_slider = False
+        self._summary = ""  # the runs' summary lines before wrapping (_show_summary)
+        self._resizes = 0  # resize events of the desktop window so far
         self.closed = False  # the desktop window was closed
         self.frames_shown = 0  # instants drawn by show_index (playback frames)
         with _drawing_deferred(figure.canvas):
             self._build()
+        # The layout the window opened with: the figure's own dpi (the canvas multiplies it
+        # by its pixel ratio) and the text scale (fit_canvas).
+        self._opened = (figure.dpi / figure.canvas.device_pixel_ratio, self.text_scale)
         for widget in self._drawing_widgets():
             widget.drawon = interactive
         self.time_slider.drawon = False  # drawn with the playback frames (see _refresh)
@@ -192,6 +216,84 @@ class App(PanelLayout):
         self._poll_timer = figure.canvas.new_timer(interval=POLL_MS)
         self._poll_timer.add_callback(self._poll)
         figure.canvas.mpl_connect("close_event", self._on_close)
+        self._resize_timer = figure.canvas.new_timer(interval=RESIZE_SETTLE_MS)
+        self._resize_timer.single_shot = True
+        self._resize_timer.add_callback(self._on_resize_settled)
+        if interactive:
+            figure.canvas.mpl_connect("resize_event", self._on_resize)
+
+    # ================================================================ window size
+    def _on_resize(self, _event: Any) -> None:
+        """The window was resized: lay it out again once the resizing pauses."""
+        self._resizes += 1
+        self._resize_timer.stop()
+        self._resize_timer.start()
+
+    @guarded
+    def _on_resize_settled(self) -> None:
+        """No resize for :data:`RESIZE_SETTLE_MS`: fit the layout to the canvas, unless a
+        resize was still queued (a window being mapped takes its size in steps, a full
+        draw between them): that one's own timer decides."""
+        seen = self._resizes
+        self.figure.canvas.flush_events()
+        if self._resizes == seen and not self.closed and self.fit_canvas():
+            self._redraw()
+
+    def fit_canvas(self) -> bool:
+        """Give the figure the resolution and the inches :func:`canvas_size` gives its
+        canvas's current size in pixels, as the window's were chosen when it opened
+        (:func:`ddwmmr.gui.layout.window_size`), and lay it out again for its new text
+        scale (:meth:`relayout`). A canvas whose layout would be within
+        :data:`RESCALE_STEP` of the window's opening one takes that one (a canvas a pixel
+        off its opening size, or back from another, is drawn as the window opened).
+        Returns False, changing nothing, where the layout is within that step of the
+        current one, or where the canvas is smaller than :data:`SMALLEST_FOLLOWED`."""
+        figure = self.figure
+        ratio = figure.canvas.device_pixel_ratio  # a HiDPI screen's pixels per logical px
+        width, height = figure.bbox.width, figure.bbox.height  # px of the canvas
+        if width < SMALLEST_FOLLOWED[0] or height < SMALLEST_FOLLOWED[1]:
+            return False
+        inches, dpi = canvas_size(width, height)
+        # (the figure's own dpi, which the canvas multiplies by the ratio; text scale)
+        layout = (dpi / ratio, scale_of(*inches))
+        if _near(layout, self._opened):
+            layout = self._opened
+        if _near(layout, (figure.dpi / ratio, self.text_scale)):
+            return False
+        own_dpi, scale = layout
+        # ignore: Figure._set_dpi and _original_dpi are matplotlib's own (not in its hints):
+        # the dpi without resizing the window (forward=False), and the dpi the canvas
+        # multiplies by its ratio and saves the figure at
+        figure._set_dpi(own_dpi * ratio, forward=False)  # type: ignore[attr-defined]
+        figure._original_dpi = own_dpi  # type: ignore[attr-defined]
+        figure.set_size_inches(width / figure.dpi, height / figure.dpi, forward=False)
+        self.relayout(scale)
+        return True
+
+    def relayout(self, scale: float | None = None) -> None:
+        """Lay the window out again for the text scale ``scale`` (default: its figure's
+        :func:`text_scale`): the grown gaps, the option widgets (their labels fitted anew),
+        the view and its legends, the summary lines and the message wrapped anew. The
+        settings, the run and the instant shown stay."""
+        self.text_scale = text_scale(self.figure) if scale is None else scale
+        message, error = self.message, self.message_is_error
+        with _drawing_deferred(self.figure.canvas):
+            self._place_again()
+            for group in self._groups.values():
+                group.remove()
+            self._show_options()
+            if self.results is not None and self.run_settings is not None:
+                index = self.view.index
+                obstacles = self._obstacles(self.run_settings)
+                self.view.set_runs(self.results, self.labels(), obstacles)
+                self.view.show_index(index)
+            else:
+                self.view.preview(build_trajectory(self.settings), self._obstacles(self.settings))
+            self._animate(self._blitting)
+            self._background = None  # saved again by the next full draw
+            if self._summary:
+                self._show_summary(self._summary)
+            self.say(message, error)
 
     # ================================================================ messages
     def say(self, text: str, error: bool = False) -> None:
@@ -518,6 +620,7 @@ class App(PanelLayout):
     def _preview(self) -> None:
         self.view.preview(build_trajectory(self.settings), self._obstacles(self.settings))
         self._animate(self._blitting)
+        self._summary = ""
         self.summary_text.set_text("")
         self._set_slider_time(0.0)
         self._set_progress(0.0, "idle")
@@ -619,6 +722,7 @@ class App(PanelLayout):
         run's line is longer than the view is wide): in the panel font, or in the first
         smaller one (down to ``FONT - 2``) whose lines end above the transport buttons
         (long lines in a window of a large :attr:`text_scale`), else in that smallest."""
+        self._summary = summary
         artist = self.summary_text
         renderer = renderer_of(self.figure)
         buttons_top = self.transport["run"].ax.bbox.y1
@@ -829,6 +933,14 @@ class App(PanelLayout):
         path = export.write_animation(self.results, self.labels(), obstacles, folder, fmt)  # type: ignore[arg-type]
         self.say(f"wrote {path}")
         return path
+
+
+def _near(layout: tuple[float, float], other: tuple[float, float]) -> bool:
+    """Whether the (dpi, text scale) ``layout`` is within :data:`RESCALE_STEP` of ``other``
+    (the dpi by that fraction, the scale by that much)."""
+    return abs(layout[0] / other[0] - 1.0) <= RESCALE_STEP and (
+        abs(layout[1] - other[1]) <= RESCALE_STEP
+    )
 
 
 def _optional_positive(name: str, text: str) -> float | None:

@@ -3,7 +3,10 @@ window) and which handler it calls.
 
 The window's size is decided here (:func:`window_size`): on a small screen it is laid out
 on fewer inches at a higher resolution than the screen would give 16 x 10 in, so that its
-text stays legible; the gaps that hold text then grow with :func:`text_scale`.
+text stays legible; the gaps that hold text then grow with :func:`text_scale`. A window the
+user resizes takes the resolution the same rule gives its new size (:func:`canvas_size`,
+:meth:`ddwmmr.gui.app.App.fit_canvas`); the placements that depend on the text scale are
+recorded (:meth:`PanelLayout._place`) and set again (:meth:`PanelLayout._place_again`).
 
 :class:`PanelLayout` builds the widgets into ``self.figure``; the handlers
 (``self._on_*``, ``self._apply_*``, ``self.run``, ``self.export_*``...) belong to
@@ -22,11 +25,12 @@ from matplotlib.widgets import Slider
 from ddwmmr.controllers.base import available_methods
 from ddwmmr.gui.options import OptionSpec, format_choice, plant_names
 from ddwmmr.gui.settings import GEOMETRY, SLOTS
-from ddwmmr.gui.view import RunView, add_view_axes
+from ddwmmr.gui.view import RunView, add_view_axes, stacked_rects
 from ddwmmr.gui.widgets import (
     FONT,
     CycleButton,
     Field,
+    Rect,
     button,
     fit_label,
     panel_axes,
@@ -39,6 +43,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
     from pathlib import Path
 
+    from matplotlib.axes import Axes
     from matplotlib.figure import Figure
     from matplotlib.text import Text
 
@@ -66,6 +71,9 @@ SUMMARY_RIGHT = 0.99
 #: Method options shown per page (two columns).
 OPTIONS_PER_PAGE = 12
 PAYLOAD_RANGE = (0.0, 5.0)
+#: Where a placed artist goes: a rectangle (left, bottom, width, height) for an axes, a
+#: point (x, y) for a text, in figure fractions.
+Place = Rect | tuple[float, float]
 
 
 class PanelLayout:
@@ -73,8 +81,11 @@ class PanelLayout:
 
     figure: Figure
     settings: Settings
-    #: :func:`text_scale` of the figure when the window was built (1 at 16 x 10 in).
+    #: :func:`text_scale` of the figure when the window was last laid out (1 at 16 x 10 in).
     text_scale: float
+    #: The axes and texts whose place depends on :attr:`text_scale`, each with the function
+    #: that gives it (:meth:`_place`).
+    _placed: list[tuple[Axes | Text, Callable[[], Place]]]
 
     if TYPE_CHECKING:  # the handlers, defined by App
 
@@ -109,8 +120,15 @@ class PanelLayout:
     def _build(self) -> None:
         fig = self.figure
         self.text_scale = text_scale(fig)
+        self._placed = []
         fig.text(0.012, 0.972, "ddwmmr simulator", fontsize=13, weight="bold")
-        fig.text(self._grown(0.15, 0.14), 0.974, "python -m ddwmmr.gui", fontsize=FONT, color="0.4")
+
+        def command_at() -> tuple[float, float]:
+            return (self._grown(0.15, 0.14), 0.974)
+
+        x, y = command_at()
+        command = fig.text(x, y, "python -m ddwmmr.gui", fontsize=FONT, color="0.4")
+        self._place(command, command_at)
         self._build_trajectory()
         self._build_methods()
         self._build_options()
@@ -119,6 +137,17 @@ class PanelLayout:
         self._build_messages()
         self._build_view()
         self._build_transport()
+
+    def _place(self, artist: Axes | Text, where: Callable[[], Place]) -> None:
+        """Record that ``artist`` (created at ``where()``) goes to ``where()`` again when the
+        text scale changes (:meth:`_place_again`): ``where`` reads :attr:`text_scale`."""
+        self._placed.append((artist, where))
+
+    def _place_again(self) -> None:
+        """Move every recorded artist (:meth:`_place`) to its place at :attr:`text_scale`."""
+        for artist, where in self._placed:
+            # ignore: an axes takes a rectangle and a text a point, as recorded
+            artist.set_position(where())  # type: ignore[arg-type]
 
     def _grown(self, at: float, per_scale: float) -> float:
         """The figure fraction ``at`` of the 16 x 10 in window, moved by ``per_scale`` for
@@ -253,6 +282,10 @@ class PanelLayout:
         self.payload_slider.valtext.set_fontsize(FONT)
         self.payload_slider.on_changed(self._on_payload)
         row = top - 0.062
+
+        def duration_rect() -> Rect:
+            return (self._grown(0.255, 0.03), row, self._grown(0.05, -0.03), 0.023)
+
         self.dt_field = Field(
             self.figure,
             (0.09, row, 0.06, 0.023),
@@ -265,7 +298,7 @@ class PanelLayout:
         )
         self.duration_field = Field(
             self.figure,
-            (self._grown(0.255, 0.03), row, self._grown(0.05, -0.03), 0.023),
+            duration_rect(),
             "duration (s)",
             "",
             self._apply_duration,
@@ -273,6 +306,7 @@ class PanelLayout:
             self._withdraw,
             hint="blank: T",
         )
+        self._place(self.duration_field.ax, duration_rect)
         self.offset_field = Field(
             self.figure,
             (0.09, row - 0.03, 0.09, 0.023),
@@ -318,11 +352,15 @@ class PanelLayout:
         self._export_bottom = row
 
     def _build_messages(self) -> None:
-        # A larger text scale takes from the margins above and under the box, so that it
-        # still holds three lines of the smallest font.
-        bottom = self._grown(0.015, -0.03)
-        top = self._export_bottom - self._grown(0.012, -0.01)
-        ax = panel_axes(self.figure, (0.008, bottom, 0.325, top - bottom))
+        def box_rect() -> Rect:
+            # A larger text scale takes from the margins above and under the box, so that
+            # it still holds three lines of the smallest font.
+            bottom = self._grown(0.015, -0.03)
+            top = self._export_bottom - self._grown(0.012, -0.01)
+            return (0.008, bottom, 0.325, top - bottom)
+
+        ax = panel_axes(self.figure, box_rect())
+        self._place(ax, box_rect)
         ax.set_xticks([])
         ax.set_yticks([])
         ax.set_facecolor("0.97")
@@ -344,20 +382,28 @@ class PanelLayout:
     def _build_view(self) -> None:
         # Larger text takes more room: under the top view (its axis labels, its legend),
         # between it and the plots (their y labels), under the plots (the summary lines).
-        path_bottom, plots_left, plots_bottom = (
-            self._grown(0.33, 0.25),
-            self._grown(0.745, 0.1),
-            self._grown(0.265, 0.2),
-        )
-        path_ax, plot_axes = add_view_axes(
-            self.figure,
-            (0.385, path_bottom, 0.31, 0.955 - path_bottom),
-            (plots_left, plots_bottom, 0.99 - plots_left, 0.955 - plots_bottom),
-        )
+        def path_rect() -> Rect:
+            path_bottom = self._grown(0.33, 0.25)
+            return (0.385, path_bottom, 0.31, 0.955 - path_bottom)
+
+        def plots_rect() -> Rect:
+            plots_left, plots_bottom = self._grown(0.745, 0.1), self._grown(0.265, 0.2)
+            return (plots_left, plots_bottom, 0.99 - plots_left, 0.955 - plots_bottom)
+
+        def plot_rect(number: int) -> Rect:
+            return stacked_rects(plots_rect())[number]
+
+        def summary_at() -> tuple[float, float]:
+            return (0.385, self._grown(0.228, 0.14))
+
+        path_ax, plot_axes = add_view_axes(self.figure, path_rect(), plots_rect())
+        self._place(path_ax, path_rect)
+        for number, ax in enumerate(plot_axes.values()):
+            self._place(ax, functools.partial(plot_rect, number))
         self.view = RunView(path_ax, plot_axes)
-        self.summary_text = self.figure.text(
-            0.385, self._grown(0.228, 0.14), "", fontsize=FONT, va="top", linespacing=1.3
-        )
+        x, y = summary_at()
+        self.summary_text = self.figure.text(x, y, "", fontsize=FONT, va="top", linespacing=1.3)
+        self._place(self.summary_text, summary_at)
 
     def _build_transport(self) -> None:
         row = 0.07
@@ -454,18 +500,42 @@ def window_size(
     the returned dpi by ``ratio``, which the fit includes.
     """
     fit = min(DPI, 0.96 * screen_width / FIGSIZE[0], 0.84 * screen_height / FIGSIZE[1])
-    dpi = min(max(fit, MIN_DPI), fit * MAX_TEXT_SCALE)
+    dpi = resolution(fit)
     inches = (FIGSIZE[0] * fit / dpi, FIGSIZE[1] * fit / dpi)
     return inches, dpi / max(ratio, 1e-3)
 
 
+def resolution(fit: float) -> float:
+    """The window's resolution (px per inch) where the 16 x 10 in layout fits its pixels
+    at ``fit`` px per inch: ``fit`` itself, but at least :data:`MIN_DPI` (the layout then
+    on fewer inches, its text larger against it), by a factor of at most
+    :data:`MAX_TEXT_SCALE` (:func:`text_scale` is this over ``fit``)."""
+    return min(max(fit, MIN_DPI), fit * MAX_TEXT_SCALE)
+
+
+def canvas_size(width: float, height: float) -> tuple[tuple[float, float], float]:
+    """The figure size (inches) and resolution (px per inch) of a window whose canvas the
+    user resized to ``width`` x ``height`` px: the :func:`resolution` of the 16 x 10 in
+    layout fitted into those pixels (no :data:`DPI` cap, so that the text grows with a
+    window larger than 1600 x 1000 px), on the inches that fill them."""
+    dpi = resolution(min(width / FIGSIZE[0], height / FIGSIZE[1]))
+    return (width / dpi, height / dpi), dpi
+
+
 def text_scale(figure: Figure) -> float:
     """How much larger text is against the layout than in the 16 x 10 in window (whose
-    figure fractions and point sizes the layout is drawn for): ``16 in / width``, at
+    figure fractions and point sizes the layout is drawn for): ``16 in / width`` or
+    ``10 in / height``, whichever is larger (a resized window need not be 16 x 10), at
     least 1 (a figure of :data:`FIGSIZE`, or larger, is 1) and at most
     :data:`MAX_TEXT_SCALE`, the largest the layout's grown gaps are made for (a narrower
     figure, such as a caller's own of 5 in, keeps that layout, its text crowded)."""
-    return min(MAX_TEXT_SCALE, max(1.0, FIGSIZE[0] / float(figure.get_figwidth())))
+    width, height = (float(size) for size in figure.get_size_inches())
+    return scale_of(width, height)
+
+
+def scale_of(width: float, height: float) -> float:
+    """:func:`text_scale` of a figure of ``width`` x ``height`` in."""
+    return min(MAX_TEXT_SCALE, max(1.0, FIGSIZE[0] / width, FIGSIZE[1] / height))
 
 
 def desktop_figure() -> Figure:

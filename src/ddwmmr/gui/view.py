@@ -427,17 +427,23 @@ def add_view_axes(
     ``(path_ax, {key: plot_ax})`` ready for :class:`RunView`.
     """
     path_ax = figure.add_axes(path_rect)
-    left, bottom, width, height = plots_rect
-    gap = 0.012
-    each = (height - gap * (len(PLOTS) - 1)) / len(PLOTS)
     plot_axes: dict[str, Axes] = {}
     shared = None
-    for number, key in enumerate(PLOTS):
-        top = bottom + height - number * (each + gap)
-        ax = figure.add_axes((left, top - each, width, each), sharex=shared)
+    for key, rect in zip(PLOTS, stacked_rects(plots_rect)):
+        ax = figure.add_axes(rect, sharex=shared)
         shared = shared or ax
         plot_axes[key] = ax
     return path_ax, plot_axes
+
+
+def stacked_rects(plots_rect: Rect) -> list[Rect]:
+    """The rectangles (figure fractions) of the plot axes stacked in ``plots_rect``, top to
+    bottom (one per key of :data:`PLOTS`)."""
+    left, bottom, width, height = plots_rect
+    gap = 0.012
+    each = (height - gap * (len(PLOTS) - 1)) / len(PLOTS)
+    tops = [bottom + height - number * (each + gap) for number in range(len(PLOTS))]
+    return [(left, top - each, width, each) for top in tops]
 
 
 def animation_figure(dpi: float = 80.0) -> tuple[Figure, RunView]:

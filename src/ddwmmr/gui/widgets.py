@@ -164,6 +164,11 @@ class Field(ErrorOwner):
         self.ax.set_visible(visible)
         self.box.set_active(visible)
 
+    def remove(self) -> None:
+        """Take the box off the window: its axes and its canvas callbacks."""
+        self.box.disconnect_events()
+        self.ax.remove()
+
     def _submitted(self, text: str) -> None:
         if text == self.valid_text:  # the valid value already applied
             self.accepted()
@@ -236,6 +241,11 @@ class CycleButton(ErrorOwner):
         """Show or hide the button (a hidden button ignores clicks)."""
         self.ax.set_visible(visible)
         self.button.set_active(visible)
+
+    def remove(self) -> None:
+        """Take the button off the window: its axes and its canvas callbacks."""
+        self.button.disconnect_events()
+        self.ax.remove()
 
     def _caption(self, value: Any) -> str:
         return f"{self.name}: {self.format_value(value)}"
