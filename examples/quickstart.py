@@ -34,7 +34,14 @@ KEYS = (
 
 
 def main(method: str = "clrrmc-ts") -> None:
-    """Simulate ``method`` for one period (40 s, 2000 RK4 steps) and print the summary."""
+    """Simulate ``method`` for one period (40 s, 2000 RK4 steps) and print the summary
+    (``-h`` or ``--help``: the usage instead)."""
+    if method in ("-h", "--help"):
+        print(
+            "usage: python examples/quickstart.py [METHOD]: one method on the default "
+            f"ellipse (default clrrmc-ts; methods: {', '.join(available_methods())})"
+        )
+        return
     robot, trajectory = Robot(), Ellipse()
     result = simulate(robot, trajectory, method)
     print(f"{method} on {trajectory.name} (methods: {', '.join(available_methods())})")

@@ -318,6 +318,16 @@ def test_quickstart_refuses_an_unknown_method_in_one_line(tmp_path) -> None:
     assert done.stdout == ""
 
 
+@pytest.mark.parametrize("flag", ["--help", "-h"])
+def test_quickstart_help_prints_its_usage_not_an_unknown_method(tmp_path, flag) -> None:
+    """A newcomer's first try, `quickstart.py --help`, is the usage, not a refusal."""
+    done = _run_python([str(EXAMPLES / "quickstart.py"), flag], tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""
+    assert done.stdout.startswith("usage: python examples/quickstart.py [METHOD]")
+    assert "clrrmc-ts" in done.stdout and "mpc" in done.stdout
+
+
 @pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.name)
 def test_every_example_ends_through_the_shared_runner(script: Path) -> None:
     """One pattern, not a copy per script: each __main__ block hands main to run_script."""
