@@ -182,7 +182,8 @@ def test_help_states_the_controller_option_defaults(capsys):
         run(["--help"])
     text = " ".join(capsys.readouterr().out.split())
     for words in (
-        "hard floor on the stability margin S (default 1.25) [qp, mpc]",
+        "hard floor on the tip-over stability margin S (S <= 1 tips over), in (0, 10) "
+        "(default 1.25) [qp, mpc]",
         "weight of the manipulability reward (default 0.5) [qp, mpc]",
         "drawn in path.png (default none) [qp, mpc]",
         "(default daqp for qp, rti for mpc) [qp, mpc]",

@@ -70,7 +70,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=_repeat_count,
         default=5,
         metavar="N",
-        help=f"repeats (default 5, at most {MAX_REPEATS})",
+        help="times every timing is repeated (the --calls states and the full runs); each "
+        f"state's median over the repeats counts (default 5, at most {MAX_REPEATS})",
     )
     parser.add_argument(
         "--calls",

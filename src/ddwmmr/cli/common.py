@@ -571,7 +571,10 @@ class RefusedOption(argparse.Action):
 def add_robot_arguments(parser: argparse.ArgumentParser) -> None:
     """``--robot FILE`` and ``--payload KG``."""
     parser.add_argument(
-        "--robot", metavar="FILE", help="robot description (TOML, keys = Robot fields)"
+        "--robot",
+        metavar="FILE",
+        help="robot description: a TOML file whose keys are Robot fields, in m, kg and rad "
+        "(default: the thesis robot, Robot())",
     )
     parser.add_argument(
         "--payload",

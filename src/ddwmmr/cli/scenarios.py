@@ -369,8 +369,9 @@ def build_parser() -> ArgumentParser:
     parser.add_argument(
         "--bounds",
         metavar="FILE",
-        help="a bounds.csv of python -m ddwmmr.bounds (same seed): the summary gives the "
-        "mean ratio of each scenario's time to its lower bound and best-known time",
+        help="a bounds.csv of python -m ddwmmr.bounds (same seed and payload; only with "
+        "--plant thesis, without --study or --obstacles): the summary gives the mean ratio "
+        "of each scenario's time to its lower bound and best-known time",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
     return parser  # fmt: skip

@@ -294,7 +294,11 @@ def build_parser() -> ArgumentParser:
         "--stability-min",
         type=number_type(f"in (0, {STABILITY_CAP:g})"),
         metavar="S",
-        help=_option_help("hard floor on the stability margin S", "stability_min"),
+        help=_option_help(
+            f"hard floor on the tip-over stability margin S (S <= 1 tips over), in (0, "
+            f"{STABILITY_CAP:g})",
+            "stability_min",
+        ),
     )
     qp.add_argument(
         "--manipulability-weight",
