@@ -129,7 +129,8 @@ All runs use the same robot, start configuration (home arm pose on the trajector
 end effector moved with the arm by the robot's default offset: -0.03, -0.03 times its
 length unit L1/0.35 m in its start frame, (-30, -30) mm for the default robot; for
 another offset run python -m ddwmmr.track --offset), integrator (rk4) and step (the
-trajectory's T/N). Results do not depend on --jobs; only the step latency
+trajectory's own: T/N, or a CSV's row spacing made no coarser than 0.02 s, as
+python -m ddwmmr.track takes it). Results do not depend on --jobs; only the step latency
 (a wall-clock timing) varies. Bad input prints one line on stderr and exits with status 2.
 """
 
@@ -149,10 +150,10 @@ def build_parser() -> ArgumentParser:
     """The argument parser (``--help`` documents every option, output and study)."""
     parser = ArgumentParser(
         prog=PROG,
-        description=(
-            "Compare redundancy-resolution and control methods of the differential-drive "
-            "mobile manipulator: run every registered method (or --methods) on the ellipse "
-            "and the rectangle (plus any --traj) and write a report with metrics tables, "
+        description=(  # wrapped by hand: the raw formatter keeps the epilog's columns
+            "Compare redundancy-resolution and control methods of the differential-drive\n"
+            "mobile manipulator: run every registered method (or --methods) on the ellipse\n"
+            "and the rectangle (plus any --traj) and write a report with metrics tables,\n"
             "figures, a ranking and optional studies."
         ),
         epilog=epilog(),

@@ -189,7 +189,7 @@ def build_parser() -> ArgumentParser:
         type=seconds_type,
         metavar="S",
         help="step in s (default: the trajectory's own, T/N, 0.02 s for the shipped ones; "
-        "a CSV's row spacing made no coarser than 0.02 s)",
+        "for a CSV without --N its row spacing made no coarser than 0.02 s)",
     )
     parser.add_argument(
         "--duration",
