@@ -175,8 +175,10 @@ class QPController:
             (:class:`~ddwmmr.qp.limits.edge_loads.EdgeLoadLimit`); on a plant that judges
             tipping by its physics and reports its joints' lag (MuJoCo), where the inertial
             loads it predicts are real; None: off.
-        dt: look-ahead step of the exact stability check (s); default the trajectory's
-            ``duration / samples`` at reset, else 0.02 s.
+        dt: look-ahead step of the exact stability check (s); default the step the loop
+            holds each command (``adopt_control_step``), else the trajectory's
+            ``duration / samples`` at reset, else 0.02 s
+            (:func:`~ddwmmr.controllers.base.control_step`).
         warm_start: pass the previous solution to the solver (default: on for the
             qpsolvers path, off for direct DAQP where it does not pay off).
         tasks, limits: extra user-defined :class:`Task`/:class:`Limit` objects.
