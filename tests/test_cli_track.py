@@ -685,10 +685,27 @@ def test_a_start_outside_the_robots_joint_limits_is_one_line(tmp_path, capsys):
     assert run(argv) == 2
     assert capsys.readouterr().err == (
         "error: the start pose: joint th1 = -0.437856 rad is outside joint_limits[1] = "
-        "[-0.31, -0.29] rad; change the robot's joint_limits or --offset\n"
+        "[-0.31, -0.29] rad; change the robot's joint_limits or the default --offset\n"
     )
     assert not out.exists()
     assert run([*argv, "--offset", "0", "0", "--duration", "0.2", "--no-plots"]) == 0
+
+
+def test_an_unreachable_default_offset_is_not_blamed_on_an_offset_never_given(tmp_path, capsys):
+    """Without --offset the robot's default (0.03 of its length unit each way) is used; a
+    robot whose arm cannot make it reads "the default --offset", not "--offset"."""
+    robot = tmp_path / "lopsided.toml"
+    robot.write_text("L1 = 3.5\nL2 = 0.01\n")
+    out = tmp_path / "run"
+    argv = ["--method", "ats", "--traj", "ellipse", "--robot", str(robot), "--out", str(out)]
+    assert run(argv) == 2
+    assert capsys.readouterr().err == (
+        "error: the default --offset (-0.3, -0.3) m (end-effector frame) cannot be reached "
+        "with the arm alone; along that direction it reaches (-0.075, -0.075) m\n"
+    )
+    assert run([*argv, "--offset", "-0.3", "-0.3"]) == 2
+    assert capsys.readouterr().err.startswith("error: --offset (-0.3, -0.3) m")
+    assert not out.exists()
 
 
 def test_qp_mode_is_the_qps_even_where_a_plug_in_has_a_mode(tmp_path, capsys, registered):

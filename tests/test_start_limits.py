@@ -76,7 +76,7 @@ def test_track_names_the_heaviest_payload_of_its_start_pose(tmp_path, capsys):
     assert err == (
         "error: payload: a 6 kg payload tips the robot over in this run's start pose "
         "(S = 0.959 <= 1), which holds at most 5.535 kg; lighten the payload or change "
-        "--offset\n"
+        "the default --offset\n"
     )
     assert not out.exists()
     ok = [*argv, "--no-progress", "--payload", "5.535", "--out", str(out)]

@@ -442,7 +442,9 @@ def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
         plant,
         plant_options=plant_options,
     )
-    return check_run(inputs, "payload" if args.payload is not None else "robot", "--offset")
+    # a newcomer who gave no --offset must not read that theirs is wrong
+    start = "--offset" if args.offset is not None else "the default --offset"
+    return check_run(inputs, "payload" if args.payload is not None else "robot", start)
 
 
 def check_run(inputs: RunInputs, holder: str, start: str) -> RunInputs:
