@@ -112,6 +112,8 @@ def test_payload_robot_file_and_animation(tmp_path):
             "(got --method pi)\n",
         ),
         (["--method", "ats", "--traj", "missing.toml"], "no such file"),
+        ([], "error: method: --method and --traj are required, e.g. --method ats --traj ellipse"),
+        (["--method", "pi"], "error: traj: --traj is required, e.g. --method ats --traj ellipse"),
         (["--method", "ats", "--traj", "ellipse", "--robot", "missing.toml"], "cannot read"),
     ],
 )

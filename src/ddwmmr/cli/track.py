@@ -410,9 +410,16 @@ def format_table(summary: dict[str, Any]) -> str:
 
 def inputs_from_arguments(args: argparse.Namespace) -> RunInputs:
     """Validated inputs from the command-line options."""
-    if args.method is None or args.traj is None:
-        missing = "--method" if args.method is None else "--traj"
-        raise ParameterError(f"{missing.lstrip('-')}: {missing} is required (or give --rerun)")
+    missing = [
+        flag for flag, given in (("--method", args.method), ("--traj", args.traj)) if given is None
+    ]
+    if missing:
+        # both named at once: a newcomer should not learn them one refusal at a time
+        verb = "is" if len(missing) == 1 else "are"
+        raise ParameterError(
+            f"{missing[0].lstrip('-')}: {' and '.join(missing)} {verb} required, e.g. "
+            "--method ats --traj ellipse (or give --rerun)"
+        )
     plant = args.plant or PLANT
     robot = robot_from_arguments(args, (plant,))
     source = find_trajectory_file(args.traj)
