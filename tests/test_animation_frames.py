@@ -15,7 +15,13 @@ from PIL import Image
 
 from ddwmmr import Ellipse, Robot, simulate
 from ddwmmr.reports import plots
-from ddwmmr.reports.canvas import blitted_frames, frame_indices, new_figure, save_gif
+from ddwmmr.reports.canvas import (
+    blitted_frames,
+    frame_durations_ms,
+    frame_indices,
+    new_figure,
+    save_gif,
+)
 from figure_checks import SaveGifCalls, blitted_and_full
 
 
@@ -46,7 +52,18 @@ def test_a_short_run_is_animated_once_per_recorded_instant(tmp_path, monkeypatch
     assert rendered == [11]
     count, duration_ms = gif_frames(path)
     assert count == 11
-    assert duration_ms == pytest.approx(11 * 1000 / 15, abs=11 * 10)  # GIF: 10 ms units
+    assert duration_ms == pytest.approx(11 * 1000 / 15, abs=5)  # GIF: 10 ms units
+
+
+@pytest.mark.parametrize("fps", [1, 7, 12, 15, 24, 30, 33, 100])
+def test_gif_frames_keep_the_pace_in_whole_centiseconds(fps):
+    """A GIF stores each frame's time in hundredths of a second: 15 fps cannot be 66.7 ms
+    frames, so they alternate (70, 60, 70...) and every frame shows when it should, to
+    5 ms (one per frame, cut to 60 ms, ran 15 fps at 16.7)."""
+    durations = frame_durations_ms(300, fps)
+    assert all(d % 10 == 0 and abs(d - 1000 / fps) < 10 for d in durations)
+    elapsed = np.cumsum(durations)
+    assert np.abs(elapsed - np.arange(1, 301) * 1000 / fps).max() <= 5.0
 
 
 def test_a_long_run_keeps_its_frame_count(tmp_path):
