@@ -231,7 +231,7 @@ FOLDED_ARM_NO_CORNERS = (
     "the arm folded to a joint limit (min manipulability 0): a resolution that only "
     "integrates Xd_dot ({methods}) loses what each step misses of the trajectory's turning "
     "(this one has no corners): a smaller dt (this run's: {dt}) or a slower trajectory "
-    """(see docs/comparing.md, "Does the slides' ranking hold?")"""
+    """(see docs/comparing.md, "Step size and integrator: Euler drifts, RK4 does not")"""
 )
 #: The methods whose commands only integrate Xd_dot (open loop, or ``clrrmc-cs``'s
 #: configuration reference): :data:`FOLDED_ARM`'s explanation is theirs.
