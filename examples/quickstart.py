@@ -19,6 +19,7 @@ from ddwmmr import (
     simulate,
 )
 from ddwmmr.cli.common import run_script  # bad input: one line, status 2
+from ddwmmr.errors import ParameterError
 
 KEYS = (
     "rms_position_error_m",
@@ -33,9 +34,13 @@ KEYS = (
 )
 
 
-def main(method: str = "clrrmc-ts") -> None:
+def main(method: str = "clrrmc-ts", *more: str) -> None:
     """Simulate ``method`` for one period (40 s, 2000 RK4 steps) and print the summary
-    (``-h`` or ``--help``: the usage instead)."""
+    (``-h`` or ``--help``: the usage instead); one method per run."""
+    if more:
+        raise ParameterError(
+            f"method: one METHOD per run (got {len(more) + 1}: {method} {' '.join(more)})"
+        )
     if method in ("-h", "--help"):
         print(
             "usage: python examples/quickstart.py [METHOD]: one method on the default "
@@ -64,4 +69,4 @@ def main(method: str = "clrrmc-ts") -> None:
 
 
 if __name__ == "__main__":
-    run_script(main, *sys.argv[1:2])
+    run_script(main, *sys.argv[1:])

@@ -318,6 +318,13 @@ def test_quickstart_refuses_an_unknown_method_in_one_line(tmp_path) -> None:
     assert done.stdout == ""
 
 
+def test_quickstart_refuses_a_second_method_in_one_line(tmp_path) -> None:
+    """`quickstart.py ats pi` ran ats alone, the pi silently dropped."""
+    done = _run_python([str(EXAMPLES / "quickstart.py"), "ats", "pi"], tmp_path)
+    assert_one_line_refusal(done, "error: method: one METHOD per run (got 2: ats pi)")
+    assert done.stdout == ""
+
+
 @pytest.mark.parametrize("flag", ["--help", "-h"])
 def test_quickstart_help_prints_its_usage_not_an_unknown_method(tmp_path, flag) -> None:
     """A newcomer's first try, `quickstart.py --help`, is the usage, not a refusal."""
