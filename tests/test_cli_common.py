@@ -98,6 +98,37 @@ def test_a_mistyped_option_gets_the_closest_one(tool, argv, message, capsys):
     assert capsys.readouterr().err == message
 
 
+@pytest.mark.parametrize(
+    ("tool", "argv", "hint"),
+    [
+        ("bench", ["--method", "ats", "pi"], "pi (--method takes one value, repeat it)"),
+        ("track", ["--method=ats", "pi", "--traj", "ellipse"], "pi (--method takes one value)"),
+        ("scenarios", ["--controller", "qp", "mpc"], "mpc (--controller takes one value)"),
+        (
+            "track",
+            ["--offset", "1", "2", "-3e-2", "--method", "ats"],
+            "-3e-2 (--offset takes 2 values)",
+        ),
+        (
+            "track",
+            ["--method", "ats", "ats", "--traj", "ellipse"],
+            "ats (--method takes one value)",
+        ),
+        ("track", ["--methd", "ats", "--traj", "ellipse"], "(did you mean --method?) ats\n"),
+    ],
+)
+def test_a_second_value_names_the_option_that_takes_one(tool, argv, hint, capsys):
+    """`bench --method ats pi` said only "unrecognized arguments: pi"; a newcomer reads
+    which option took one value (the value of an unknown option gets no such hint)."""
+    with pytest.raises(SystemExit) as stop:
+        TOOLS[tool].main(argv)
+    assert stop.value.code == 2
+    error = capsys.readouterr().err
+    assert error.startswith(f"python -m ddwmmr.{tool}: error: unrecognized arguments: ")
+    assert error.endswith(hint if hint.endswith("\n") else f"{hint}\n")
+    assert error.count("takes") <= 1
+
+
 def test_a_record_of_a_checkout_has_its_commit_else_says_why(monkeypatch):
     record = provenance.git_record()
     if (ROOT / ".git").exists():  # these tests run from the source checkout

@@ -239,6 +239,7 @@ class ArgumentParser(argparse.ArgumentParser):
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
         self._given: dict[argparse.Action, str] | None = None
+        self._words: list[str] = []  # the command line being parsed
         # argparse's own hook: the default action, and "store", are the refusing store
         for name in (None, "store"):
             self.register("action", name, _StoreOnce)
@@ -250,6 +251,7 @@ class ArgumentParser(argparse.ArgumentParser):
         self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
     ) -> tuple[argparse.Namespace, list[str]]:
         outer, self._given = self._given, {}
+        self._words = list(sys.argv[1:] if args is None else args)
         try:
             return super().parse_known_args(args, namespace)
         finally:
@@ -260,17 +262,45 @@ class ArgumentParser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{prefix}: error: {self._with_suggestions(message)}\n")
 
     def _with_suggestions(self, message: str) -> str:
-        """``message``, with the closest known option after each unknown one."""
+        """``message``, with the closest known option after each unknown one, and after a
+        value that follows another option's one value (``--method ats pi``) that option."""
         if not message.startswith(UNRECOGNISED):
             return message
         known = [o for o in self._option_string_actions if o.startswith("--")]
-        words = [
-            f"{word}{did_you_mean(word.split('=')[0], known)}"
-            if word.startswith("--") and not NEGATIVE_NUMBER.match(word)
-            else word
-            for word in message[len(UNRECOGNISED) :].split()
-        ]
+        strays = self._stray_values()
+        words = []
+        for word in message[len(UNRECOGNISED) :].split():
+            if word.startswith("--") and not NEGATIVE_NUMBER.match(word):
+                word += did_you_mean(word.split("=")[0], known)
+            elif word in strays:
+                action = self._option_string_actions[strays[word]]
+                count = "one value" if action.nargs in (None, 1) else f"{action.nargs} values"
+                again = ", repeat it" if isinstance(action, argparse._AppendAction) else ""
+                word += f" ({strays.pop(word)} takes {count}{again})"
+            words.append(word)
         return UNRECOGNISED + " ".join(words)
+
+    def _stray_values(self) -> dict[str, str]:
+        """The words of the command line that follow the values of an option taking a
+        fixed number of them (``--method ats pi``, ``--method=ats pi``: ``{"pi":
+        "--method"}``; ``--offset 1 2 3``: ``{"3": "--offset"}``), the first such option
+        of each word."""
+        strays: dict[str, str] = {}
+        words = self._words
+        for at, word in enumerate(words):
+            option, inline, _ = word.partition("=")
+            action = self._option_string_actions.get(option)
+            if not option.startswith("--") or action is None:
+                continue
+            count = 1 if action.nargs is None else action.nargs
+            if not isinstance(count, int) or count < 1 or (inline and count != 1):
+                continue
+            after = at + 1 + (0 if inline else count)
+            if after < len(words) and (
+                not words[after].startswith("-") or NEGATIVE_NUMBER.match(words[after])
+            ):
+                strays.setdefault(words[after], option)
+        return strays
 
 
 class Terminated(BaseException):
