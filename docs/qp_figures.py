@@ -254,6 +254,14 @@ def solvers(repeats: int = 3) -> str:
                 f"{1000 * result.summary['rms_position_error_m']:.3f}",
             ]
         )
+    solvers_figure(labels, medians)
+    header = ["backend", "median step (us)", "p90 (us)", "RMS pos. error (mm)"]
+    return _table(header, rows)
+
+
+def solvers_figure(labels: list[str], medians: list[float]) -> None:
+    """``qp_solvers.png``: each backend's median step (us) against the qp's targets
+    (docs/api.md, "Benchmark")."""
     fig, ax = plt.subplots(figsize=(8, 4))
     ax.barh(labels[::-1], medians[::-1], color="C0")
     ax.axvline(20.0, color="C1", lw=0.8)
@@ -262,12 +270,10 @@ def solvers(repeats: int = 3) -> str:
     ax.set_xlim(1.0, 2.0 * max(medians))
     ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    ax.set_xlabel("median step (us), log scale; orange: 20 us (issue 14), red: 60 us (issue 3)")
+    ax.set_xlabel("median step (us), log scale; orange: 20 us target, red: 60 us budget")
     fig.tight_layout()
     fig.savefig(FIGURES / "qp_solvers.png", dpi=110)
     plt.close(fig)
-    header = ["backend", "median step (us)", "p90 (us)", "RMS pos. error (mm)"]
-    return _table(header, rows)
 
 
 def waypoints(scenarios: int = 10, seed: int = 0) -> str:
