@@ -37,7 +37,10 @@ from ddwmmr.errors import (
         ),
         ('joint_limits = "ab"', r"joint_limits must be two \[min, max\] pairs \(got 'ab'\)"),
         ('joint_limits = [[-1, 1], [-1, "a"]]', r"joint_limits\[2\]\[2\] must be a number"),
-        ('caster_positions = "corners"', r"caster_positions must be a list of \(x, y\) pairs"),
+        (
+            'caster_positions = "corners"',
+            r"caster_positions must be a non-empty list of \(x, y\) pairs in m",
+        ),
         ("base_mas = 10.0", r"unknown parameter 'base_mas' \(did you mean base_mass\?\)"),
         ("[[robot]]\nL1 = 0.4", r"\[robot\] must be one table .*\[\[robot\]\]"),
         ("robot = 3", r"\[robot\] must be one table"),
@@ -64,7 +67,9 @@ def test_api_robot_shapes_are_named_whole():
         Robot(joint_limits=[-1, 1])
     with pytest.raises(ParameterError, match=r"joint_limits must be two \(min, max\) pairs"):
         Robot(joint_limits="ab")
-    with pytest.raises(ParameterError, match=r"caster_positions must be a list of \(x, y\)"):
+    with pytest.raises(
+        ParameterError, match=r"caster_positions must be a non-empty list of \(x, y\)"
+    ):
         Robot(caster_positions="corners")
 
 

@@ -24,8 +24,11 @@ FIRST, SECOND = (1.6, 0.4), (1.6, 2.2)
     [
         ({"lookahead_weight": 1.5}, r"lookahead_weight must be in \[0, 1\]"),
         ({"lookahead_horizon": 0.1}, r"lookahead_horizon must be in \[0.5, 100\] s"),
-        ({"route": "nowhere"}, "route must be a list of"),
-        ({"route": [(1.0, 2.0, 3.0)]}, r"route must be a list of finite \(x, y\) points"),
+        ({"route": "nowhere"}, r"^route must be a list of \(x, y\) pairs in m \(got 'nowhere'\)$"),
+        (
+            {"route": [(1.0, 2.0, 3.0)]},
+            r"^route\[1\] must be an \(x, y\) pair of numbers in m \(got \(1.0, 2.0, 3.0\)\)$",
+        ),
     ],
 )
 def test_bad_lookahead_options_are_one_line_errors(options, match):

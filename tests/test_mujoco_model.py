@@ -187,7 +187,10 @@ def test_robots_mujoco_cannot_build_give_one_line(options, message):
             {"joint_torque_limits": (5.0, -1.0)},
             "joint_torque_limits[2] must be in [1e-06, 1e+06] N m (got -1)",
         ),
-        ({"caster_positions": []}, "caster_positions must list at least one"),
+        (
+            {"caster_positions": []},
+            "caster_positions must be a non-empty list of (x, y) pairs in m (got [])",
+        ),
         ({"arm_height": float("nan")}, "arm_height must be a finite number"),
     ],
 )

@@ -151,9 +151,10 @@ def test_the_default_worker_count_is_within_what_run_many_accepts(monkeypatch):
     ("fields", "message"),
     [
         ({"index": None}, r"^scenario index must be an integer >= 0 \(got None\)$"),
-        ({"waypoints": None}, r"^scenario waypoints must be a non-empty sequence of \(x, y\) "),
-        ({"waypoints": ()}, r"^scenario waypoints must be .* \(got none\)$"),
-        ({"waypoints": ((1, 2), (1, "a"))}, r"^scenario waypoints\[2\] must be an \(x, y\) pair"),
+        ({"waypoints": None}, r"^scenario waypoints must be a non-empty list of \(x, y\) "),
+        ({"waypoints": ()}, r"^scenario waypoints must be .* \(got \(\)\)$"),
+        ({"waypoints": ((1, 2), (1, "a"))}, r"^scenario waypoints\[2\] y must be a finite "),
+        ({"waypoints": ((1, 2), (1, 2, 3))}, r"^scenario waypoints\[2\] must be an \(x, y\) pair"),
         ({"waypoints": ((float("nan"), 0),)}, r"^scenario waypoints\[1\] x must be a finite "),
         (
             {"obstacles": ((1, 2),)},

@@ -19,7 +19,7 @@ import stat
 import sys
 import tomllib
 import unicodedata
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any, NoReturn
 
@@ -174,6 +174,51 @@ def iterable(value: Any) -> bool:
     except TypeError:
         return False
     return True
+
+
+def list_items(name: str, value: Any, wanted: str, size: int | None = None) -> tuple[Any, ...]:
+    """The items of ``value``, an ordered collection (a list, a tuple, a numpy array, an
+    iterator: read once), ``size`` of them if given; else a one-line
+    :class:`ParameterError` "<name> must be <wanted> (got ...)". Text, a mapping, a set
+    and a frozenset are refused though iterable: a text's letters, a mapping's keys and a
+    set's members in the order the set iterates (waypoints visited in hash order, an
+    (x, y) pair read as (y, x)) are no list."""
+    refused = ParameterError(f"{name} must be {wanted} (got {shown(value, 60)})")
+    if isinstance(value, str | bytes | Mapping | set | frozenset):
+        raise refused
+    try:
+        items = tuple(value)
+    except TypeError:  # not iterable, or a 0-d numpy array
+        raise refused from None
+    if size is not None and len(items) != size:
+        raise refused
+    return items
+
+
+def xy_pairs(name: str, value: Any, empty: bool = False) -> tuple[tuple[float, float], ...]:
+    """``value``, a list of (x, y) points in m (waypoints, a route), as a tuple of float
+    pairs, each coordinate finite and within +-:data:`MAX_COORDINATE_M`; at least one
+    point unless ``empty``. Anything else raises a one-line :class:`ParameterError` naming
+    ``name``, the entry (numbered from 1) and the coordinate at fault, and the allowed
+    range: "waypoints must be a non-empty list of (x, y) pairs in m (got [])",
+    "waypoints[2] must be an (x, y) pair of numbers in m (got (1, 2, 3))", "waypoints[2] y
+    must be in [-1e+06, 1e+06] m (got 2e+07)". What :func:`list_items` refuses is refused
+    here too, at either level (a set of pairs, a pair given as a set)."""
+    wanted = f"a {'' if empty else 'non-empty '}list of (x, y) pairs in m"
+    items = list_items(name, value, wanted)
+    if not items and not empty:
+        raise ParameterError(f"{name} must be {wanted} (got {shown(value, 60)})")
+    points = []
+    for number, item in enumerate(items, start=1):
+        entry = f"{name}[{number}]"
+        x, y = list_items(entry, item, "an (x, y) pair of numbers in m", 2)
+        points.append(
+            (
+                check_range(f"{entry} x", x, -MAX_COORDINATE_M, MAX_COORDINATE_M, "m"),
+                check_range(f"{entry} y", y, -MAX_COORDINATE_M, MAX_COORDINATE_M, "m"),
+            )
+        )
+    return tuple(points)
 
 
 def one_of(value: Any, choices: Iterable[Any]) -> bool:

@@ -79,7 +79,9 @@ from ddwmmr.errors import (
     check_instance,
     check_int_at_least,
     check_range,
+    list_items,
     shown,
+    xy_pairs,
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
@@ -399,28 +401,11 @@ def _leg_costs(
     return {("line", True): paying, ("line", False): charged[:, None, :] + drive}
 
 
-def _items(name: str, value: Any, wanted: str, size: int | None = None) -> tuple[Any, ...]:
-    """The items of the list ``value`` (``size`` of them, if given); text, a mapping, a
-    set (no order: waypoints in the order a set iterates, an (x, y) pair read as (y, x)),
-    a non-iterable or another length raises :class:`ParameterError` saying ``name`` must
-    be ``wanted``."""
-    refused = ParameterError(f"{name} must be {wanted} (got {shown(value, 60)})")
-    if isinstance(value, str | bytes | dict | set | frozenset):
-        raise refused
-    try:
-        items = tuple(value)
-    except TypeError:
-        raise refused from None
-    if size is not None and len(items) != size:
-        raise refused
-    return items
-
-
 def _numbers(
     name: str, value: Any, fields: tuple[tuple[str, float, str], ...], wanted: str
 ) -> tuple[float, ...]:
     """``value`` as one float per ``(field, cap, unit)``, each finite and within ``+-cap``."""
-    items = _items(name, value, wanted, len(fields))
+    items = list_items(name, value, wanted, len(fields))
     return tuple(
         check_range(f"{name} {field}", item, -cap, cap, unit)
         for (field, cap, unit), item in zip(fields, items)
@@ -429,7 +414,6 @@ def _numbers(
 
 _XY = (("x", MAX_COORDINATE_M, "m"), ("y", MAX_COORDINATE_M, "m"))
 _POSE = (*_XY, ("heading", MAX_ANGLE_RAD, "rad"))
-_WAYPOINTS = "a non-empty list of (x, y) pairs in m"
 
 
 def _arcs(name: str, value: Any) -> int:
@@ -506,13 +490,7 @@ def _checked(
     fault as one :class:`ParameterError`. ``grids``: ``(cell name, cell, arcs name,
     arcs)`` each; ``chunk_name``: as in :func:`_check_block`."""
     check_instance("robot", robot, Robot)
-    items = _items("waypoints", waypoints, _WAYPOINTS)
-    if not items:
-        raise ParameterError(f"waypoints must be {_WAYPOINTS} (got {shown(waypoints)})")
-    pair = "an (x, y) pair of numbers in m"
-    points = tuple(
-        _numbers(f"waypoints[{i}]", item, _XY, pair) for i, item in enumerate(items, start=1)
-    )
+    points = xy_pairs("waypoints", waypoints)
     start = _numbers("start", start, _POSE, "(x, y, heading): 3 numbers in m, m, rad")
     tolerance = check_range("tolerance", tolerance, *TOLERANCE_RANGE_M, "m")
     grids = [
@@ -547,7 +525,7 @@ def budget_bound(
     Args:
         robot: a :class:`~ddwmmr.model.Robot`.
         waypoints: a non-empty list of (x, y) pairs (m), each coordinate finite and within
-            +-``MAX_COORDINATE_M`` (1e6 m).
+            +-``MAX_COORDINATE_M`` (1e6 m) (:func:`~ddwmmr.errors.xy_pairs`; no set).
         start: the base's (x, y, heading) in m, m, rad: x and y within +-1e6 m, the heading
             within +-``MAX_ANGLE_RAD`` (1e6 rad).
         tolerance: waypoint radius (m), in :data:`TOLERANCE_RANGE_M` ([0, 0.1] m).
@@ -647,7 +625,7 @@ def lower_bound(
     [0, 1]. All are checked before the first bound is solved."""
     pairs: list[tuple[str, Any, str, Any]] = []
     for name, pair in (("grid", grid), ("stop_grid", stop_grid)):
-        cell, arcs = _items(name, pair, "a (cell, arcs) pair", 2)
+        cell, arcs = list_items(name, pair, "a (cell, arcs) pair", 2)
         pairs.append((f"{name} cell", cell, f"{name} arcs", arcs))
     # the checked waypoints go on: a generator would be spent by the check
     waypoints, _, tolerance, pairs, _ = _checked(
@@ -656,7 +634,7 @@ def lower_bound(
     weights = tuple(
         check_range(f"stop_weights[{i}]", weight, 0.0, 1.0)
         for i, weight in enumerate(
-            _items("stop_weights", stop_weights, "a list of weights in [0, 1]"), start=1
+            list_items("stop_weights", stop_weights, "a list of weights in [0, 1]"), start=1
         )
     )
     (_, cell, _, arcs), (_, stop_cell, _, stop_arcs) = pairs

@@ -28,10 +28,12 @@ from ddwmmr.errors import (
     check_finite,
     check_range,
     did_you_mean,
+    list_items,
     load_toml,
     shown,
     texts_apart,
     unwrapped,
+    xy_pairs,
 )
 from ddwmmr.model import kinematics, stability, support_loads
 from ddwmmr.model.mass import YawInertia, total_mass
@@ -225,7 +227,9 @@ class Robot:
             check_range(f"joint_torque_limits[{i}]", torque, *TORQUE_RANGE_N_M, "N m")
         object.__setattr__(self, "joint_torque_limits", torques)
         if self.caster_positions is not None:
-            object.__setattr__(self, "caster_positions", _points(self.caster_positions))
+            object.__setattr__(
+                self, "caster_positions", xy_pairs("caster_positions", self.caster_positions)
+            )
         self._check_magnitudes()
         object.__setattr__(
             self,
@@ -648,18 +652,12 @@ def _triple(name: str, value: object) -> tuple[float, float, float]:
     return _numbers(name, value, 3, "3", "[xE, yE, phiE] (m, rad)")  # type: ignore[return-value]
 
 
-# value is Any: unchecked input, whose tuple() raising TypeError is part of the check
-def _numbers(name: str, value: Any, size: int, count: str, unit: str) -> tuple[float, ...]:
+def _numbers(name: str, value: object, size: int, count: str, unit: str) -> tuple[float, ...]:
     suffix = f" {unit}" if unit else ""
-    wanted = f"{name} must be {count} numbers{suffix}"
-    if isinstance(value, str | bytes | dict):
-        raise ParameterError(f"{wanted} (got {shown(value, 60)})")
-    try:
-        items = tuple(value)
-    except TypeError:
-        raise ParameterError(f"{wanted} (got {shown(value, 60)})") from None
+    wanted = f"{count} numbers{suffix}"
+    items = list_items(name, value, wanted)  # no set: its order is undefined
     if len(items) != size:
-        raise ParameterError(f"{wanted} (got {len(items)} values)")
+        raise ParameterError(f"{name} must be {wanted} (got {len(items)} values)")
     return tuple(check_finite(f"{name}[{i}]", v) for i, v in enumerate(items, start=1))
 
 
@@ -749,32 +747,9 @@ def _edges_of_points(points: tuple[tuple[float, float], ...]) -> stability.Suppo
     return stability.SupportEdges.from_lines(polygon.normals, polygon.offsets, polygon.vertices)
 
 
-# value is Any: unchecked input, whose tuple() raising TypeError is part of the check
-def _points(value: Any) -> tuple[tuple[float, float], ...]:
-    name = "caster_positions"
-    try:
-        if isinstance(value, str | bytes | dict):  # iterable, but not a list of points
-            raise TypeError
-        items = tuple(value)
-    except TypeError:
-        raise ParameterError(
-            f"{name} must be a list of (x, y) pairs in m (got {shown(value, 60)})"
-        ) from None
-    if not items:
-        raise ParameterError(f"{name} must list at least one (x, y) pair (got {shown(value)})")
-    return tuple(_pair(f"{name}[{i}]", p, "m") for i, p in enumerate(items, start=1))
-
-
-# value is Any: unchecked input, whose tuple() raising TypeError is part of the check
-def _pairs(name: str, value: Any) -> tuple[tuple[float, float], ...]:
-    try:
-        if isinstance(value, str | bytes | dict):  # iterable, but not two pairs
-            raise TypeError
-        items = tuple(value)
-    except TypeError:
-        raise ParameterError(
-            f"{name} must be two (min, max) pairs (got {shown(value, 60)})"
-        ) from None
+def _pairs(name: str, value: object) -> tuple[tuple[float, float], ...]:
+    wanted = "two (min, max) pairs"
+    items = list_items(name, value, wanted)  # no set: its order is undefined
     if len(items) != 2 or any(isinstance(p, int | float) for p in items):
-        raise ParameterError(f"{name} must be two (min, max) pairs (got {shown(value, 60)})")
+        raise ParameterError(f"{name} must be {wanted} (got {shown(value, 60)})")
     return tuple(_pair(f"{name}[{i}]", p, "rad") for i, p in enumerate(items, start=1))

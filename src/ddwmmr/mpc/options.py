@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import copy
 import inspect
-import math
 import os
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields
@@ -34,6 +33,7 @@ from ddwmmr.errors import (
     one_of,
     shown,
     texts_apart,
+    xy_pairs,
 )
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
@@ -176,8 +176,9 @@ class MPCOptions:
             second leg cannot reach its target that ties with giving up the first).
         lookahead_horizon: the second leg's longest duration (s), with as many intervals
             as the first leg.
-        route: the task's waypoints ``(x, y)`` in order (m, world) that ``lookahead``
-            and ``plan`` look along; the scenario protocol fills it in with either.
+        route: the task's waypoints ``(x, y)`` in order (m, world; a list, not a set)
+            that ``lookahead`` and ``plan`` look along; the scenario protocol fills it in
+            with either.
         plan: waypoint mode: a minimum-time trajectory of the whole task, one leg per
             waypoint of ``route`` (a ``.npz`` as ``python -m ddwmmr.bounds`` stores its
             best-known ones, :meth:`ddwmmr.mpc.min_time.Guess.load`; in the scenario tool
@@ -576,16 +577,9 @@ def _fallback_option(value: Any) -> dict[str, Any]:
 
 
 def _route_option(value: Any) -> tuple[tuple[float, float], ...]:
-    """The ``route`` option: points ``(x, y)`` (m), kept as a tuple of float pairs."""
-    try:
-        points = [tuple(float(c) for c in point) for point in value]
-    except (TypeError, ValueError):
-        raise ParameterError("route must be a list of (x, y) points in m") from None
-    for point in points:
-        if len(point) != 2 or not all(math.isfinite(c) for c in point):
-            raise ParameterError(f"route must be a list of finite (x, y) points in m (got {point})")
-    # ignore: the loop above holds every point to two numbers
-    return tuple(points)  # type: ignore[arg-type]
+    """The ``route`` option: points ``(x, y)`` (m), kept as a tuple of float pairs
+    (:func:`~ddwmmr.errors.xy_pairs`, possibly empty)."""
+    return xy_pairs("route", value, empty=True)
 
 
 def _acceleration_option(value: Any) -> tuple[float, float] | tuple[()] | None:

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
-from dataclasses import astuple, dataclass
+from dataclasses import astuple, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -63,7 +63,6 @@ from ddwmmr.controllers.base import (
 )
 from ddwmmr.errors import (
     MASS_RANGE_KG,
-    MAX_COORDINATE_M,
     ParameterError,
     PluginError,
     check_finite,
@@ -73,12 +72,12 @@ from ddwmmr.errors import (
     check_range,
     check_step_count,
     float_values,
-    length_of,
     one_of,
     raise_plugin_error,
     real_number,
     shown,
     texts_apart,
+    xy_pairs,
 )
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import (
@@ -679,7 +678,7 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
         raise ParameterError(
             f"config must be a RunConfig (ddwmmr.scenarios.RunConfig) (got {shown(config)})"
         )
-    check_scenario(scenario)
+    scenario = check_scenario(scenario)
     robot = config_robot(config)
     plant = make_scenario_plant(robot, config)
     controller = make_scenario_controller(robot, scenario, config, plant)
@@ -693,42 +692,27 @@ def run_scenario(scenario: Scenario, config: RunConfig) -> Outcome:
     return tally.outcome(end.samples * config.dt, end.samples, has_states=has_states)
 
 
-def check_scenario(scenario: Scenario) -> None:
-    """Refuse, in one line naming the field, a :class:`Scenario` built by hand whose
-    ``index`` is not an integer >= 0, whose ``waypoints`` are not a non-empty sequence of
-    (x, y) pairs of finite numbers within +-:data:`~ddwmmr.errors.MAX_COORDINATE_M` m, or
-    whose ``obstacles`` are not (x, y, radius) circles (m) as the ``qp``'s option takes
-    them (:func:`ddwmmr.qp.limits.obstacles.as_circles`; its refusal prefixed with
-    ``scenario obstacles``)."""
+def check_scenario(scenario: Scenario) -> Scenario:
+    """``scenario`` with its ``waypoints`` as a tuple of float pairs, if it is a
+    :class:`Scenario` (built by hand, say) whose ``index`` is an integer >= 0, whose
+    ``waypoints`` are a non-empty list of (x, y) pairs in m
+    (:func:`~ddwmmr.errors.xy_pairs`: finite, within
+    +-:data:`~ddwmmr.errors.MAX_COORDINATE_M` m; not a set, whose order is undefined), and
+    whose ``obstacles`` are (x, y, radius) circles (m) as the ``qp``'s option takes them
+    (:func:`ddwmmr.qp.limits.obstacles.as_circles`; its refusal prefixed with ``scenario
+    obstacles``); else a one-line :class:`ParameterError` naming the field."""
     from ddwmmr.qp.limits.obstacles import as_circles
 
     check_int_at_least("scenario index", scenario.index, 0)
-    waypoints: Any = scenario.waypoints
-    wanted = "a non-empty sequence of (x, y) pairs in m"
-    if isinstance(waypoints, str | bytes | Mapping) or length_of(waypoints) is None:
-        raise ParameterError(f"scenario waypoints must be {wanted} (got {shown(waypoints)})")
-    if len(waypoints) == 0:
-        raise ParameterError(f"scenario waypoints must be {wanted} (got none)")
-    for number, point in enumerate(waypoints, start=1):
-        pair = float_values(point, 2)
-        if pair is None or isinstance(point, str | bytes):
-            raise ParameterError(
-                f"scenario waypoints[{number}] must be an (x, y) pair in m (got {shown(point)})"
-            )
-        for axis, value in zip("xy", pair):
-            check_range(
-                f"scenario waypoints[{number}] {axis}",
-                value,
-                -MAX_COORDINATE_M,
-                MAX_COORDINATE_M,
-                "m",
-            )
+    waypoints = xy_pairs("scenario waypoints", scenario.waypoints)
     try:
         as_circles(scenario.obstacles)
     except ParameterError as exc:
         message = str(exc)
         field = "" if message.startswith("obstacles") else "obstacles: "
         raise ParameterError(f"scenario {field}{message}") from None
+    # the checked list: an iterator is spent by the check, a numpy array's rows are arrays
+    return replace(scenario, waypoints=waypoints)
 
 
 def make_scenario_plant(robot: Robot, config: RunConfig) -> Plant:
