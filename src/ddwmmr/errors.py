@@ -69,7 +69,25 @@ MAX_COST_WEIGHT = 1e6
 
 
 class ParameterError(ValueError):
-    """A parameter, option or input file is invalid (message: one line, names the parameter)."""
+    """A parameter, option or input file is invalid (message: one line, names the parameter).
+
+    One line by construction: a control character in the message (a line break or a tab
+    in a file name it quotes) is written as its escape, ``\\n`` or ``\\t``
+    (:func:`escaped_controls`)."""
+
+    def __init__(self, *args: object) -> None:
+        if len(args) == 1 and isinstance(args[0], str):
+            args = (escaped_controls(args[0]),)
+        super().__init__(*args)
+
+
+def escaped_controls(text: str) -> str:
+    """``text`` with each control character (Unicode category Cc: a line break, a tab, an
+    escape) written as Python writes it in a string's repr (``\\n``, ``\\t``,
+    ``\\x1b``), so that it prints on one line; ``text`` itself when it has none."""
+    if text.isprintable() or printable_line(text, undecodable=True):
+        return text
+    return "".join(repr(c)[1:-1] if unicodedata.category(c) == "Cc" else c for c in text)
 
 
 class PluginError(RuntimeError):
@@ -413,9 +431,12 @@ def round_significant(value: float, digits: int, rounding: Callable[[float], int
 UNPRINTABLE_CATEGORIES = ("Cc", "Cs")
 
 
-def printable_line(text: str) -> bool:
-    """Whether ``text`` prints as one line: no character of :data:`UNPRINTABLE_CATEGORIES`."""
-    return not any(unicodedata.category(c) in UNPRINTABLE_CATEGORIES for c in text)
+def printable_line(text: str, undecodable: bool = False) -> bool:
+    """Whether ``text`` prints as one line: no character of :data:`UNPRINTABLE_CATEGORIES`
+    (``undecodable``: lone surrogates allowed, as a file name's undecodable bytes, which
+    a tool's output streams write back as the bytes they were)."""
+    refused = UNPRINTABLE_CATEGORIES[:1] if undecodable else UNPRINTABLE_CATEGORIES
+    return not any(unicodedata.category(c) in refused for c in text)
 
 
 def one_line(text: str, width: int) -> str:

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 from typing import Any
 
-from ddwmmr.errors import ParameterError, file_kind, shown
+from ddwmmr.errors import ParameterError, file_kind, printable_line, shown
 from ddwmmr.outputs.owners import _is_stale_temp, ended_leftover, temp_prefix
 
 #: Name of the manifest file each tool writes into its output folder.
@@ -244,14 +244,20 @@ def unwritable_message(label: str, name: str, folder: Path, existing: Path, erro
 
 def check_output_path(target: str | Path, what: str = "folder", probe: bool = True) -> Path:
     """Refuse (one-line :class:`ParameterError`) an ``--out`` path that cannot be written:
-    the current folder or a parent, a symbolic link (dangling too), a name too long, a
-    parent that is not a writable folder. Returns the absolute path (it may not exist).
+    the current folder or a parent, a symbolic link (dangling too), a name too long or
+    holding a control character (a line break would split the tool's last line, ``wrote
+    <path>``), a parent that is not a writable folder. Returns the absolute path (it may not exist).
     ``probe``: also try a file in the parent (:func:`check_writable`); a caller with
     refusals of its own passes False and probes after them, so that a refused ``--out``
     leaves even the parent's modification time alone."""
     text = str(target)
     if "\0" in text:
         raise ParameterError(f"out: the {what} name contains a NUL byte")
+    if not printable_line(text, undecodable=True):  # a line break would split "wrote <path>"
+        raise ParameterError(
+            f"out: the {what} name holds a control character (a line break, a tab, an "
+            f"escape) (got {shown(text, 60)}); give one without"
+        )
     path = Path(os.path.abspath(text or "."))
     cwd = Path.cwd()
     real = Path(os.path.realpath(path))
