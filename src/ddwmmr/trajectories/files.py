@@ -117,7 +117,7 @@ def find_trajectory_file(name_or_path: str | Path) -> Path | None:
                 f"traj: {shown(text)} is neither a trajectory name ({known}) nor a .toml/.csv path"
             )
         if not os.path.lexists(path):
-            raise ParameterError(f"traj: no such file {path}")
+            raise ParameterError(f"traj: no such file {path}{_name_hint(path)}")
         return path
     found = _named_file(f / f"{text}{suffix}" for f in trajectory_folders() for suffix in SUFFIXES)
     if found is not None:
@@ -128,6 +128,14 @@ def find_trajectory_file(name_or_path: str | Path) -> Path | None:
         f"traj: unknown trajectory {shown(text)} "
         f"(known: {', '.join(available_trajectories())}; or give a .toml/.csv path)"
     )
+
+
+def _name_hint(path: Path) -> str:
+    """For a bare file name that is not there but names a trajectory the folders have
+    (``ellipse.toml`` typed in another folder), the hint to give the name instead."""
+    if path.parent != Path(".") or path.stem not in available_trajectories():
+        return ""
+    return f" here (the trajectory {path.stem} is found by its name: {path.stem})"
 
 
 def load_trajectory(
