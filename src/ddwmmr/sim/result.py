@@ -62,13 +62,20 @@ class SimulationResult:
         """Write the summary as JSON to ``path``, with ``extra`` keys (e.g. ``run``),
         atomically, with :func:`write_atomic` (as :meth:`write_csv`). A value JSON cannot
         hold (an object, a set; numpy scalars and non-finite floats are converted,
-        :func:`json_safe`) is a one-line :class:`ParameterError` naming its key, before
-        anything is written."""
+        :func:`json_safe`), or an extra key the summary has already (``verdict``: the
+        file would not say what the run did), is a one-line :class:`ParameterError`
+        naming the key, before anything is written."""
         write_atomic(path, self.summary_text(**extra))
 
     def summary_text(self, **extra: Any) -> str:
         """The text of :meth:`write_summary`'s file (JSON, indented, ending in a newline),
         with its refusals."""
+        taken = next((key for key in extra if key in self.summary), None)
+        if taken is not None:
+            raise ParameterError(
+                f"summary: the extra key {taken!r} is one of the run's own summary keys; give "
+                "it another name"
+            )
         data = json_safe({**self.summary, **extra})
         try:
             text = json.dumps(data, indent=2)
