@@ -26,6 +26,7 @@ from ddwmmr.errors import (
     ParameterError,
     bracketed,
     check_finite,
+    check_positive,
     check_range,
     did_you_mean,
     list_items,
@@ -355,7 +356,9 @@ class Robot:
         computation measuring lengths in ``unit`` sees it (only the masses' ratios place
         the centre of mass); this robot itself for a unit of 1.0. A length that leaves
         ``LENGTH_RANGE_M`` once divided is a one-line :class:`ParameterError` naming it as
-        given (m), not its quotient: the lengths too far apart for one unit."""
+        given (m), not its quotient: the lengths too far apart for one unit. A ``unit``
+        that is not a finite number > 0 is one naming ``unit``."""
+        unit = check_positive("unit", unit)
         if unit == 1.0:
             return self
         lengths = {name: getattr(self, name) / unit for name in _LENGTHS}
