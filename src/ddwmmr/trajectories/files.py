@@ -231,21 +231,24 @@ def read_toml(path: str | Path, **overrides: Any) -> Ellipse | Rectangle:
     if "shape" in overrides:
         _refuse_shape_override(f"traj: {path}", shape, "the file", overrides["shape"])
     table.update(overrides)
+    # a value given as an override is not the file's: the message says which were given
+    given = ", ".join(sorted(map(str, overrides)))
+    where = f"traj: {path} with {given} given" if overrides else f"traj: {path}"
     known = shape_keys(shape)
     unknown = sorted(set(table) - set(known))
     if unknown:
         raise ParameterError(
-            f"traj: {path}: unknown key {shown(unknown[0])} (known: shape, {', '.join(known)})"
+            f"{where}: unknown key {shown(unknown[0])} (known: shape, {', '.join(known)})"
         )
-    _check_types(path, table)
+    _check_types(where, table)
     if "phi" in table and table.get("orientation", "tangent") == "tangent":
-        raise ParameterError(f"traj: {path}: {PHI_NEEDS_CONSTANT}")
+        raise ParameterError(f"{where}: {PHI_NEEDS_CONSTANT}")
     try:
         return SHAPES[shape](**table)
     except TypeError as exc:
-        raise ParameterError(f"traj: {path}: {exc}") from None
+        raise ParameterError(f"{where}: {exc}") from None
     except ParameterError as exc:
-        raise ParameterError(f"traj: {path}: {exc}") from None
+        raise ParameterError(f"{where}: {exc}") from None
 
 
 def _refuse_shape_override(where: str, shape: str, setter: str, value: Any) -> None:
@@ -285,13 +288,13 @@ def check_shape_keys(where: str, shape: str, keys: Iterable[Any]) -> None:
         )
 
 
-def _check_types(path: Path, table: dict[str, Any]) -> None:
+def _check_types(where: str, table: dict[str, Any]) -> None:
     for key, value in table.items():
         if key in _STRING_KEYS:
             if not isinstance(value, str):
-                raise ParameterError(f"traj: {path}: {key} must be a string (got {shown(value)})")
+                raise ParameterError(f"{where}: {key} must be a string (got {shown(value)})")
         else:
             try:
                 check_number_type(key, value)
             except ParameterError as exc:
-                raise ParameterError(f"traj: {path}: {exc}") from None
+                raise ParameterError(f"{where}: {exc}") from None
