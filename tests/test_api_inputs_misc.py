@@ -180,7 +180,7 @@ def test_valid_geometry_values_pass_unchanged():
         (lambda: error_dynamics.step_response(0.5, [1.0, 2.0]), r"^times .*first time of 1 s"),
         (
             lambda: error_dynamics.step_response(0.5, [0, 2, 1]),
-            r"^times .* increasing .*\(got times\[2\] = 2 s then times\[3\] = 1 s\)",
+            r"^times .* increasing, .*\(got times\[2\] = 2 s then times\[3\] = 1 s\)",
         ),
         (lambda: error_dynamics.step_response(0.5, [0, 1, 3]), r"^times .*equally spaced"),
         (lambda: error_dynamics.error_response(0.5, [0, INF]), r"^times must be a finite number"),
@@ -206,7 +206,7 @@ def test_valid_geometry_values_pass_unchanged():
         ),
         (
             lambda: error_dynamics.saturated_velocity_step(1.0, 1.0, 1.0, 1.0, 1.0, [0, 2, 1]),
-            r"^times must be at least 2 finite times \(s\), increasing and starting at 0",
+            r"^times must be at least 2 finite times \(s\), increasing, starting at 0 and ending ",
         ),
         (  # numpy's ambiguous truth value before
             lambda: error_dynamics.check_response_times([0, 1], spaced=np.array([True, False])),

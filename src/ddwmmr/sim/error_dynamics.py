@@ -28,6 +28,7 @@ import control
 import numpy as np
 
 from ddwmmr.errors import (
+    DURATION_RANGE_S,
     ParameterError,
     check_bool,
     check_finite,
@@ -101,18 +102,20 @@ def closed_form_step(tau: float, times: Sequence[float] | np.ndarray) -> np.ndar
     """Analytic step response ``1 - exp(-t/tau)`` (dimensionless) at ``times`` (s): one
     time or a 1-D sequence, each finite and >= 0 (the step is at t = 0), in any order;
     ``tau`` as in :func:`error_loop` (``inf``: no feedback, 0 throughout)."""
-    gains_from_tau(tau, 1)  # checks tau: a time constant, or inf
+    gains_from_tau(tau, 1)  # checks tau: a time constant, or inf (one, or a list of one)
     checked = check_times(times)
     if np.any(checked < 0.0):
         raise ParameterError(
             f"times must be >= 0 s (the step is at t = 0) (got {float(np.min(checked)):g})"
         )
-    return 1.0 - np.exp(-np.asarray(times, dtype=float) / float(tau))
+    (value,) = np.asarray(tau, dtype=float).reshape(-1)
+    return 1.0 - np.exp(-np.asarray(times, dtype=float) / float(value))
 
 
 def check_response_times(times: Sequence[float] | np.ndarray, spaced: bool) -> np.ndarray:
     """``times`` (s) of a simulated response as a 1-D float array: at least 2 finite
-    times, strictly increasing, starting at 0 (the step); with ``spaced``, equally spaced
+    times, strictly increasing, starting at 0 (the step) and ending by the longest
+    duration, :data:`~ddwmmr.errors.DURATION_RANGE_S` (1e9 s); with ``spaced``, equally spaced
     as python-control's linear simulation needs them (its test: every step within
     ``numpy.allclose`` of the mean step). Anything else is a one-line
     :class:`~ddwmmr.errors.ParameterError` naming ``times``; ``spaced`` must be True or
@@ -120,11 +123,17 @@ def check_response_times(times: Sequence[float] | np.ndarray, spaced: bool) -> n
     spaced = check_bool("spaced", spaced)
     array = check_times(times)
     wanted = "equally spaced, increasing" if spaced else "increasing"
-    rule = f"times must be at least 2 finite times (s), {wanted} and starting at 0"
+    last = DURATION_RANGE_S[1]
+    rule = (
+        f"times must be at least 2 finite times (s), {wanted}, starting at 0 and ending by "
+        f"{last:g} s"
+    )
     if array.size < 2:
         raise ParameterError(f"{rule} (got {array.size} time{'' if array.size == 1 else 's'})")
     if array[0] != 0.0:
         raise ParameterError(f"{rule} (got a first time of {array[0]:g} s)")
+    if array[-1] > last:  # python-control's simulation gave NaN from about 1e50 s
+        raise ParameterError(f"{rule} (got a last time of {array[-1]:g} s)")
     steps = np.diff(array)
     if not np.all(steps > 0.0):
         index = int(np.argmin(steps > 0.0)) + 1  # times[index + 1] (from 1) goes back
