@@ -601,7 +601,11 @@ def nesting_depth(value: Any) -> int:
 
 def did_you_mean(word: str, known: Iterable[str], prefix: str = "") -> str:
     """`` (did you mean PREFIXNAME?)`` for the name in ``known`` closest to ``word``, or
-    ``""`` when none is close (difflib's similarity ratio >= 0.6): the one wording of the
-    suggestion every tool makes for a mistyped name."""
-    close = difflib.get_close_matches(word, list(known), n=1)
+    ``""`` when none is close: the one wording of the suggestion every tool makes for a
+    mistyped name. A name that differs from ``word`` in case alone is the closest (``l1``:
+    ``L1``, which difflib's similarity ratio, 0.5, finds too far), else the closest by
+    that ratio, if >= 0.6."""
+    names = list(known)
+    same = [name for name in names if name.casefold() == word.casefold()]
+    close = same[:1] or difflib.get_close_matches(word, names, n=1)
     return f" (did you mean {prefix}{close[0]}?)" if close else ""
