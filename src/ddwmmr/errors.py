@@ -515,9 +515,11 @@ def read_text_file(path: str | Path, label: str) -> str:
 
     The file is checked with ``os.stat`` before it is opened, so a FIFO, a device or a
     folder is refused instead of blocking or failing; files above :data:`MAX_INPUT_BYTES`
-    are refused too. ``label`` names the option in the message. A UTF-8 byte-order mark at
-    the start is not part of the text. ``path`` must be a ``str`` or an ``os.PathLike``
-    (:func:`as_path`).
+    are refused too, by their size or, where that says 0 (a kernel's file under /proc),
+    by what reading them gives (:func:`read_at_most`, which never blocks: /proc/kmsg read
+    as root waited for the kernel's next message). ``label`` names the option in the
+    message. A UTF-8 byte-order mark at the start is not part of the text. ``path`` must
+    be a ``str`` or an ``os.PathLike`` (:func:`as_path`).
     """
     path = as_path(path, label)
     try:
@@ -534,9 +536,14 @@ def read_text_file(path: str | Path, label: str) -> str:
             f"{label}: {path} is too large ({info.st_size} bytes, at most {MAX_INPUT_BYTES})"
         )
     try:
-        data = path.read_bytes()
+        data = read_at_most(path, MAX_INPUT_BYTES + 1)
     except OSError as exc:
         raise ParameterError(f"{label}: cannot read {path} ({exc.strerror})") from None
+    if len(data) > MAX_INPUT_BYTES:
+        raise ParameterError(
+            f"{label}: {path} is too large (more than {MAX_INPUT_BYTES} bytes read, at most "
+            f"{MAX_INPUT_BYTES})"
+        )
     try:
         return data.decode("utf-8-sig")  # a leading byte-order mark (some editors') dropped
     except UnicodeDecodeError as exc:
@@ -544,6 +551,27 @@ def read_text_file(path: str | Path, label: str) -> str:
             f"{label}: {path} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
             f"{exc.start})"
         ) from None
+
+
+def read_at_most(path: Path, limit: int) -> bytes:
+    """The first ``limit`` bytes of the file ``path`` (all of a shorter one), read without
+    blocking: opened with ``O_NONBLOCK`` (where the platform has it), which a regular
+    file ignores and which turns a read that would wait (/proc/kmsg, a FIFO put in the
+    file's place after it was checked) into an :class:`OSError` or an end of file."""
+    flags = os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0)
+    fd = os.open(path, flags)
+    try:
+        chunks: list[bytes] = []
+        left = limit
+        while left > 0:
+            chunk = os.read(fd, min(left, 1 << 20))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            left -= len(chunk)
+        return b"".join(chunks)
+    finally:
+        os.close(fd)
 
 
 #: A carriage return not followed by a line feed.

@@ -1,0 +1,45 @@
+"""Input files are read without blocking and within the size cap even where ``os.stat``
+cannot tell: /proc/kmsg (a regular file of size 0 to stat) waited, as root, for the
+kernel's next message; a FIFO put in a checked file's place blocked the read."""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+
+from ddwmmr import errors
+from ddwmmr.errors import ParameterError, read_text_file
+
+pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="FIFOs and /proc are POSIX")
+
+
+def test_a_fifo_taken_for_a_regular_file_does_not_block(tmp_path, monkeypatch):
+    fifo = tmp_path / "robot.toml"
+    os.mkfifo(fifo)
+    monkeypatch.setattr(errors, "file_kind", lambda mode: None)  # the check passed it
+    result: list[object] = []
+    reader = threading.Thread(target=lambda: result.append(read_text_file(fifo, "robot")))
+    reader.daemon = True
+    reader.start()
+    reader.join(timeout=10)
+    blocked = reader.is_alive()
+    if blocked:  # the old read: free it
+        with open(fifo, "wb"):
+            pass
+        reader.join(timeout=10)
+    assert not blocked
+    assert result == [""]
+
+
+@pytest.mark.skipif(not Path("/proc/self/maps").is_file(), reason="needs Linux's /proc")
+def test_a_file_of_size_0_to_stat_is_held_to_the_cap_by_what_it_gives(monkeypatch):
+    monkeypatch.setattr(errors, "MAX_INPUT_BYTES", 10)
+    with pytest.raises(ParameterError) as info:
+        read_text_file("/proc/self/maps", "traj")
+    assert str(info.value) == (
+        "traj: /proc/self/maps is too large (more than 10 bytes read, at most 10)"
+    )
