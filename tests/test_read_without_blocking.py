@@ -43,3 +43,30 @@ def test_a_file_of_size_0_to_stat_is_held_to_the_cap_by_what_it_gives(monkeypatc
     assert str(info.value) == (
         "traj: /proc/self/maps is too large (more than 10 bytes read, at most 10)"
     )
+
+
+def test_a_plan_that_is_a_fifo_or_proc_file_is_refused_without_waiting(tmp_path):
+    """Guess.load (the mpc's plan= option) opened the file with numpy: a FIFO waited for
+    a writer forever, as /proc/kmsg did as root."""
+    from ddwmmr.mpc.min_time import Guess
+
+    fifo = tmp_path / "plan.npz"
+    os.mkfifo(fifo)
+    result: list[str] = []
+
+    def load() -> None:
+        try:
+            Guess.load(fifo)
+        except ParameterError as error:
+            result.append(str(error))
+
+    reader = threading.Thread(target=load, daemon=True)
+    reader.start()
+    reader.join(timeout=10)
+    blocked = reader.is_alive()
+    if blocked:  # the old read: free it
+        with open(fifo, "wb"):
+            pass
+        reader.join(timeout=10)
+    assert not blocked
+    assert result == [f"plan: {fifo} is not a regular file (a FIFO)"]

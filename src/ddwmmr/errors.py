@@ -511,15 +511,29 @@ def file_kind(mode: int) -> str | None:
 
 
 def read_text_file(path: str | Path, label: str) -> str:
-    """The UTF-8 text of a regular file; anything else raises :class:`ParameterError`.
+    """The UTF-8 text of a regular file (:func:`read_input_bytes`); anything else raises
+    :class:`ParameterError`. ``label`` names the option in the message. A UTF-8
+    byte-order mark at the start is not part of the text."""
+    data = read_input_bytes(path, label)
+    try:
+        return data.decode("utf-8-sig")  # a leading byte-order mark (some editors') dropped
+    except UnicodeDecodeError as exc:
+        raise ParameterError(
+            f"{label}: {path} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
+            f"{exc.start})"
+        ) from None
+
+
+def read_input_bytes(path: str | Path, label: str) -> bytes:
+    """The bytes of an input file, a regular file of at most :data:`MAX_INPUT_BYTES`;
+    anything else raises :class:`ParameterError` naming ``label``, the option.
 
     The file is checked with ``os.stat`` before it is opened, so a FIFO, a device or a
     folder is refused instead of blocking or failing; files above :data:`MAX_INPUT_BYTES`
     are refused too, by their size or, where that says 0 (a kernel's file under /proc),
     by what reading them gives (:func:`read_at_most`, which never blocks: /proc/kmsg read
-    as root waited for the kernel's next message). ``label`` names the option in the
-    message. A UTF-8 byte-order mark at the start is not part of the text. ``path`` must
-    be a ``str`` or an ``os.PathLike`` (:func:`as_path`).
+    as root waited for the kernel's next message). ``path`` must be a ``str`` or an
+    ``os.PathLike`` (:func:`as_path`).
     """
     path = as_path(path, label)
     try:
@@ -544,13 +558,7 @@ def read_text_file(path: str | Path, label: str) -> str:
             f"{label}: {path} is too large (more than {MAX_INPUT_BYTES} bytes read, at most "
             f"{MAX_INPUT_BYTES})"
         )
-    try:
-        return data.decode("utf-8-sig")  # a leading byte-order mark (some editors') dropped
-    except UnicodeDecodeError as exc:
-        raise ParameterError(
-            f"{label}: {path} is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset "
-            f"{exc.start})"
-        ) from None
+    return data
 
 
 def read_at_most(path: Path, limit: int) -> bytes:

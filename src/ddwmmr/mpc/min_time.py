@@ -36,9 +36,11 @@ that the transcription finds true optima.
 
 from __future__ import annotations
 
+import io
 import itertools
 import json
 import math
+import os
 import zipfile
 import zlib
 from collections.abc import Callable, Sequence
@@ -56,6 +58,7 @@ from ddwmmr.errors import (
     check_int_at_least,
     check_positive,
     finite_values,
+    read_input_bytes,
     shown,
 )
 from ddwmmr.model import Robot
@@ -163,13 +166,16 @@ class Guess:
             )
         arrays = None
         reason = "a single array, not an archive"
+        if not os.path.lexists(path):
+            raise ParameterError(f"plan {path}: no such file")
+        # read as every input file is (a FIFO, /proc/kmsg or a file above the cap refused,
+        # never waited on), then parsed from memory
+        data = read_input_bytes(path, "plan")
         try:
-            loaded = np.load(path, allow_pickle=False)
+            loaded = np.load(io.BytesIO(data), allow_pickle=False)
             if isinstance(loaded, np.lib.npyio.NpzFile):
                 with loaded:
                     arrays = {key: np.asarray(loaded[key], dtype=float) for key in _PLAN_ARRAYS}
-        except FileNotFoundError:
-            raise ParameterError(f"plan {path}: no such file") from None
         except _DAMAGED_ARCHIVE as error:
             # a damaged file fails wherever numpy, zipfile or the decompressor notices
             reason = type(error).__name__
