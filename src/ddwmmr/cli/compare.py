@@ -498,7 +498,8 @@ def config_from_arguments(
         shown,
         lambda trajectory: scaled_trajectory(trajectory, args.traj_scale, robot),
     )
-    command = " ".join([PROG, *(argv if argv is not None else sys.argv[1:])])
+    # quoted as the run record quotes it: the report's line repeats the run when pasted
+    command = provenance.command_record(PROG, argv)["command"]
     methods = parse_methods(args.methods)
     study_methods = (
         parse_methods(args.study_methods, "study-methods") if args.study_methods else None
