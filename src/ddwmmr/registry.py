@@ -164,6 +164,8 @@ class Registry:
             for trait in self.sets:
                 setattr(cls, trait, resolved[trait])
             with _LOCK:
+                if cls.__module__ not in BUILTIN_MODULES:
+                    _know_builtins()  # a built-in's name is refused here, not at a query
                 self._add(cls, name, resolved, description)
             return cls
 
@@ -300,6 +302,7 @@ _LOCK = threading.RLock()
 _SEQUENCE = count()
 _discovered = False
 _discovering = False
+_builtins_known = False  # _know_builtins read them (a plug-in registered before a query)
 
 
 def discover() -> None:
@@ -321,6 +324,17 @@ def discover() -> None:
             _discovered = True  # a failure leaves it False: the next query fails alike
         finally:
             _discovering = False
+
+
+def _know_builtins() -> None:
+    """The built-in plug-ins' entries (:func:`_read_builtins`) before a plug-in of another
+    module is added: one registered before the first query under a built-in's name (a
+    user's own ``pi``) is refused by its ``register``, where reading the built-ins at that
+    query refused it (and every later query) instead."""
+    global _builtins_known
+    if not (_builtins_known or _discovered or _discovering):
+        _read_builtins()
+        _builtins_known = True
 
 
 def _read_builtins() -> None:
