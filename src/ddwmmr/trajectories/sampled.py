@@ -162,18 +162,23 @@ class SampledTrajectory:
                 f"trajectory samples: at most {MAX_TRAJECTORY_SAMPLES} rows (got {len(times)})"
             )
         if not np.all(np.isfinite(times)):
-            raise ParameterError("trajectory samples: times must be finite numbers (s)")
+            raise ParameterError(
+                f"trajectory samples: times must be finite numbers (s) ({_where(times, None)})"
+            )
         if not np.all(np.isfinite(points)):
-            raise ParameterError("trajectory samples: points must be finite numbers (m, rad)")
+            raise ParameterError(
+                "trajectory samples: points must be finite numbers (m, rad) "
+                f"({_where(points, None)})"
+            )
         if np.max(np.abs(points)) > MAX_COORDINATE_M:
             raise ParameterError(
                 f"trajectory samples: points |x|, |y|, |phi| must be <= {MAX_COORDINATE_M:g} "
-                f"(m, rad) (got {np.max(np.abs(points)):g})"
+                f"(m, rad) ({_where(points, MAX_COORDINATE_M)})"
             )
         if np.max(np.abs(times)) > MAX_TIME_S:
             raise ParameterError(
                 f"trajectory samples: times |t| must be <= {MAX_TIME_S:g} s "
-                f"(got {np.max(np.abs(times)):g})"
+                f"({_where(times, MAX_TIME_S)})"
             )
         _check_steps(times)
         points = unwrap_phi(points)
@@ -355,6 +360,18 @@ def _is_number(value: object) -> bool:
     return isinstance(value, int | float | np.integer | np.floating) and not isinstance(
         value, bool | np.bool_
     )
+
+
+def _where(values: np.ndarray, cap: float | None) -> str:
+    """Where the first bad sample is, for a message: ``got nan in row 12, column x``
+    (rows numbered from 1, the data rows of a CSV file), the first value that is not
+    finite (``cap`` None) or whose magnitude exceeds ``cap``."""
+    bad = ~np.isfinite(values) if cap is None else np.abs(values) > cap
+    index = np.unravel_index(int(np.argmax(bad)), values.shape)
+    where = f"row {int(index[0]) + 1}"
+    if values.ndim == 2:
+        where += f", column {('x', 'y', 'phi')[int(index[1])]}"
+    return f"got {float(values[index]):g} in {where}"
 
 
 def _check_steps(times: np.ndarray) -> None:
