@@ -368,10 +368,10 @@ def load_trajectories(
     repeated one. The key is the loaded trajectory's name (a scaled ellipse is still the
     ``ellipse`` the studies run on), the shown name the scaled one's (``ellipse x10``).
     """
-    chosen = split_names(only, "only")
+    chosen = _trajectory_values(only, "only")
     # each value with the option that gave it first, for the messages
     values = {v: "only" for v in chosen or DEFAULT_TRAJECTORIES}
-    values.update({v: "traj" for v in split_names(extra, "traj") if v not in values})
+    values.update({v: "traj" for v in _trajectory_values(extra, "traj") if v not in values})
     trajectories: dict[str, Any] = {}
     files: dict[str, Any] = {}
     names: dict[str, str] = {}
@@ -389,6 +389,17 @@ def load_trajectories(
     if shown is not None:
         shown.update(names)
     return trajectories
+
+
+def _trajectory_values(values: Sequence[str] | None, option: str) -> list[str]:
+    """The trajectories of ``--traj`` or ``--only``: comma-separated lists
+    (:func:`split_names`), except a value that is a file's whole name, a comma in it
+    (``run 3,4.csv``), which is that one file."""
+    items: list[str] = []
+    for value in values or []:
+        whole = "," in value and os.path.isfile(value)
+        items.extend([value] if whole else split_names([value], option))
+    return list(dict.fromkeys(items))
 
 
 def _load(value: str, option: str, read: Callable[[str], Any] = load_trajectory) -> Any:
