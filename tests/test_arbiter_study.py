@@ -125,7 +125,10 @@ def test_study_context_names_scenarios_plant_limit_and_arbiter_seed():
         (["--arbiter", "vote"], "invalid choice"),
         (["--arbiter", "competitive", "--controller", "qp"], "only the thesis controller"),
         (["--study", "arbiters", "--controller", "qp"], "arbiter study needs --controller thesis"),
-        (["--arbiter", "competitive", "--arbiter-seed", "-1"], "arbiter-seed must be >= 0"),
+        (
+            ["--arbiter", "competitive", "--arbiter-seed", "-1"],
+            "arbiter-seed must be an integer >= 0",
+        ),
         (["--arbiter-seed", "5"], "--arbiter-seed: only used with --arbiter competitive"),
         (["--study", "arbiters", "--arbiter", "competitive"], "runs both arbiters"),
     ],

@@ -285,7 +285,7 @@ CASES += [
     ("scenarios", ["--time-limit", "inf"], "time-limit must be > 0"),
     ("scenarios", ["--payload", "10"], "10 kg tips the robot over in the start pose"),
     ("scenarios", ["--payload", "1e300"], "payload must be in [0, 100000] kg"),
-    ("scenarios", ["--seed", "-1"], "seed must be >= 0"),
+    ("scenarios", ["--seed", "-1"], "seed must be an integer >= 0 (got -1)"),
     ("scenarios", ["--stability", "nan", "1"], "stability thresholds must be in (0, 10]"),
     ("scenarios", ["--jobs", "0"], "jobs must be an integer in [1, 256]"),
     ("bench", ["--repeats", "0"], "--repeats: must be an integer in [1, 1000] (got '0')"),

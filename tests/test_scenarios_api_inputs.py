@@ -38,7 +38,7 @@ REFUSED = [
     (
         {"arbiter": "competitive", "arbiter_seed": -1},
         ["--arbiter", "competitive", "--arbiter-seed", "-1"],
-        "arbiter_seed must be >= 0 (got -1)",
+        "arbiter_seed must be an integer >= 0 (got -1)",
     ),
     (
         {"controller": "qp", "plant": "kinematic", "qp_stability_min": 10.0},

@@ -41,7 +41,6 @@ from ddwmmr.errors import (
     MAX_SCENARIOS,
     ParameterError,
     check_int_at_least,
-    check_nonnegative,
     check_range,
     shown,
 )
@@ -201,7 +200,7 @@ def _settings(args: argparse.Namespace) -> Settings:
 
 def _main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    check_nonnegative("seed", args.seed)
+    check_int_at_least("seed", args.seed, 0)
     numbers = parse_scenarios(args.scenarios)
     jobs = (
         default_jobs() if args.jobs is None else check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)

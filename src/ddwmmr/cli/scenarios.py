@@ -59,7 +59,6 @@ from ddwmmr.errors import (
     MAX_STEPS,
     ParameterError,
     check_int_at_least,
-    check_nonnegative,
     shown,
 )
 from ddwmmr.model import Robot
@@ -445,7 +444,7 @@ def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, An
 def config_from_arguments(args: argparse.Namespace) -> RunConfig:
     """Validate the options and build the run configuration (before any output exists)."""
     check_int_at_least("n", args.n, 1, MAX_SCENARIOS)
-    check_nonnegative("seed", args.seed)
+    check_int_at_least("seed", args.seed, 0)
     if args.jobs is not None:
         check_int_at_least("jobs", args.jobs, 1, MAX_JOBS)
     given_text("scheduler", args.scheduler, "a Dask scheduler address", "address")

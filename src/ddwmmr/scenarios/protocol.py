@@ -67,7 +67,6 @@ from ddwmmr.errors import (
     PluginError,
     check_finite,
     check_int_at_least,
-    check_nonnegative,
     check_positive,
     check_range,
     check_step_count,
@@ -228,8 +227,7 @@ class RunConfig:
         check_thresholds("stability", self.stability)
         check_thresholds("manipulability", self.manipulability)
         check_arbiter(self.arbiter, self.controller)
-        check_nonnegative("arbiter_seed", self.arbiter_seed)
-        check_int_at_least("arbiter_seed", self.arbiter_seed, 0)
+        check_int_at_least("arbiter_seed", self.arbiter_seed, 0)  # any size: a seed
         # In the command line's order (python -m ddwmmr.scenarios), so that a bad value
         # gets its words there: dt's own range before the step count it makes.
         check_dt(self.dt)
