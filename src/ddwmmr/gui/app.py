@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, plain_number_text, shown
 from ddwmmr.gui import export
 from ddwmmr.gui.layout import (
     FILE_ENTRY,
@@ -56,6 +56,7 @@ from ddwmmr.gui.widgets import (
     CycleButton,
     Field,
     describe_error,
+    drawable,
     set_radio_silently,
     wrap_to_width,
 )
@@ -310,6 +311,7 @@ class App(PanelLayout):
         :data:`MESSAGE_FITS` that holds it; what still overflows the smallest is cut at a
         line end, marked ``...`` (a message names its parameter first)."""
         artist = self.message_text
+        text = drawable(text, artist)
         # ignore: the message text sits in its axes
         box = artist.axes.bbox  # type: ignore[union-attr]
         renderer = renderer_of(self.figure)
@@ -392,12 +394,16 @@ class App(PanelLayout):
         self._sync_widgets()
 
     def _set_settings(self, settings: Settings) -> None:
-        """Take checked settings; a run made with other settings is dropped."""
+        """Take checked settings; a run made with other settings is dropped, one being
+        simulated is stopped (the message says so: "simulating ..." would stay)."""
         changed = settings != self.settings
         self.settings = settings
         if changed:
+            simulating = self.worker is not None and not self.worker.finished
             self._cancel_worker()
-            if self.results is not None:
+            if simulating:
+                self.say("settings changed: simulation stopped; press Run")
+            elif self.results is not None:
                 self.results = None
                 self.run_settings = None
                 self.say("settings changed: press Run")
@@ -474,7 +480,7 @@ class App(PanelLayout):
 
     def _apply_geometry(self, name: str, text: str) -> str:
         try:
-            number: float | str = float(text)
+            number: float | str = typed_number(text)
         except ValueError:
             number = text  # not a number: the check refuses it naming the allowed range
         value = check_geometry(name, number)
@@ -594,7 +600,7 @@ class App(PanelLayout):
     def _apply_offset(self, text: str) -> str:
         parts = text.replace(",", " ").split()
         try:
-            values = tuple(float(p) for p in parts)
+            values = tuple(typed_number(p) for p in parts)
         except ValueError:
             raise ParameterError(
                 f"offset must be two numbers dx dy in m (got {shown(text)})"
@@ -943,12 +949,21 @@ def _near(layout: tuple[float, float], other: tuple[float, float]) -> bool:
     )
 
 
+def typed_number(text: str) -> float:
+    """The number a field's ``text`` holds, read as the command lines read one
+    (:func:`ddwmmr.errors.plain_number_text`: ASCII, no underscores, so a mistyped
+    ``0_02`` or a full-width digit is no number); ValueError if it holds none."""
+    if not plain_number_text(text):
+        raise ValueError(text)
+    return float(text)
+
+
 def _optional_positive(name: str, text: str) -> float | None:
     text = text.strip()
     if not text:
         return None
     try:
-        value = float(text)
+        value = typed_number(text)
     except ValueError:
         raise ParameterError(
             f"{name} must be a number > 0 in s, or blank (got {shown(text)})"

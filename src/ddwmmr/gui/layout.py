@@ -377,6 +377,7 @@ class PanelLayout:
             ha="left",
             family="monospace",
             linespacing=1.1,
+            parse_math=False,  # a message quotes what was typed: "$" is a dollar sign
         )
 
     def _build_view(self) -> None:
@@ -402,7 +403,9 @@ class PanelLayout:
             self._place(ax, functools.partial(plot_rect, number))
         self.view = RunView(path_ax, plot_axes)
         x, y = summary_at()
-        self.summary_text = self.figure.text(x, y, "", fontsize=FONT, va="top", linespacing=1.3)
+        self.summary_text = self.figure.text(
+            x, y, "", fontsize=FONT, va="top", linespacing=1.3, parse_math=False
+        )
         self._place(self.summary_text, summary_at)
 
     def _build_transport(self) -> None:

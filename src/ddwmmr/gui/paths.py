@@ -21,7 +21,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from ddwmmr.errors import ParameterError, file_kind
+from ddwmmr.errors import ParameterError, file_kind, printable_line, shown
 from ddwmmr.outputs import check_output_path, check_writable
 
 #: Suffixes (formats) ``--snapshot`` may have: what matplotlib writes by itself or through
@@ -144,6 +144,10 @@ def check_export_root(text: str) -> Path:
         raise ParameterError("export folder must not be empty")
     if "\0" in text:
         raise ParameterError("export: the folder name contains a NUL byte")
+    if not printable_line(text):
+        raise ParameterError(
+            f"export: the folder name must be one line of printable characters (got {shown(text)})"
+        )
     path = Path(os.path.abspath(text))
     if os.path.lexists(path) and not path.is_dir():
         raise ParameterError(f"export: {text} exists and is not a folder")

@@ -23,7 +23,7 @@ from matplotlib.ticker import NullFormatter
 
 from ddwmmr.reports.canvas import renderer_of
 from ddwmmr.reports.legends import place_legend
-from ddwmmr.reports.plots import ERROR_FLOOR, robot_outline, wheel_outlines
+from ddwmmr.reports.plots import ERROR_FLOOR, at_least_a_percent, robot_outline, wheel_outlines
 
 if TYPE_CHECKING:
     from ddwmmr.gui.widgets import Rect
@@ -206,7 +206,10 @@ class RunView:
             cursor.set_xdata([self.time, self.time])
         names = " vs ".join(run.label for run in self.runs)
         trajectory = self.runs[0].result.summary.get("trajectory", "?")
-        self.path_ax.set_title(f"{names} on {trajectory}   t = {self.time:.2f} s", fontsize=9)
+        # a file's name is the trajectory's: "$" in it is a dollar sign, not mathtext
+        self.path_ax.set_title(
+            f"{names} on {trajectory}   t = {self.time:.2f} s", fontsize=9, parse_math=False
+        )
         return k
 
     # -- drawing pieces -----------------------------------------------------------------
@@ -386,6 +389,9 @@ class RunView:
             low, high = float(values.min()), float(values.max())
             pad = 0.08 * (high - low) if high > low else 0.1 * max(abs(high), 1.0)
             ax.set_ylim(low - pad, high + pad)
+            # a near-constant series (an orientation error no controller corrects, tau
+            # inf) would be ticked in its last digits, labels running over the top view
+            at_least_a_percent(ax, values)
 
 
 def plotted_series(ts: dict[str, np.ndarray], k: int) -> dict[str, list[np.ndarray]]:

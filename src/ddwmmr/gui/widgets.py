@@ -17,15 +17,17 @@ behaves like typing the text and pressing Enter.
 
 from __future__ import annotations
 
+import unicodedata
 from collections.abc import Callable, Sequence
 from typing import Any
 
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.font_manager import findfont, get_font
 from matplotlib.text import Text
 from matplotlib.widgets import Button, RadioButtons, TextBox
 
-from ddwmmr.errors import ParameterError
+from ddwmmr.errors import UNPRINTABLE_CATEGORIES, ParameterError, printable_line
 from ddwmmr.reports.canvas import renderer_of
 
 #: Font size of panel labels and widget texts (points).
@@ -73,12 +75,38 @@ class QuietTextBox(TextBox):
             del canvas.draw
 
 
+def message_line(text: str) -> str:
+    """``text`` as one line of the message area: every character of
+    :data:`~ddwmmr.errors.UNPRINTABLE_CATEGORIES` (a newline, a tab, a NUL, e.g. of a file
+    name an error quotes) written as its Python escape (``\\n``), so nothing after it is
+    lost and no font is asked for a glyph it has not; trailing whitespace dropped."""
+    text = text.rstrip()
+    if printable_line(text):
+        return text
+    return "".join(
+        ascii(c)[1:-1] if unicodedata.category(c) in UNPRINTABLE_CATEGORIES else c for c in text
+    )
+
+
+def drawable(text: str, artist: Text) -> str:
+    """``text`` with each character the font of ``artist`` has no glyph for (a full-width
+    digit a message quotes) written as its Python escape (``\\uff11``): matplotlib would
+    draw an empty box and warn on the console at every draw."""
+    if text.isascii():
+        return text
+    font = get_font(findfont(artist.get_fontproperties()))
+    return "".join(
+        c if c.isascii() or font.get_char_index(ord(c)) else ascii(c)[1:-1] for c in text
+    )
+
+
 def describe_error(exc: Exception) -> str:
-    """One line for the message area: a ParameterError's own text, else type and text."""
+    """One line for the message area (:func:`message_line`): a ParameterError's own text
+    (whole: a line break in it is one of a value it quotes), else type and first line."""
     if isinstance(exc, ParameterError):
-        return str(exc).splitlines()[0]
+        return message_line(str(exc))
     text = str(exc).splitlines()[0] if str(exc) else ""
-    return f"{type(exc).__name__}: {text}".rstrip(": ")
+    return message_line(f"{type(exc).__name__}: {text}".rstrip(": "))
 
 
 class ErrorOwner:

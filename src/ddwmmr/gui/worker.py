@@ -14,6 +14,7 @@ from collections.abc import Callable
 from typing import Any
 
 from ddwmmr.errors import ParameterError, PluginError
+from ddwmmr.gui.widgets import message_line
 
 #: A job: called with a progress callback ``progress(part, step, steps)``; returns a value.
 Job = Callable[[Callable[[int, int, int], None]], Any]
@@ -115,7 +116,7 @@ class Worker:
             self._finish("cancelled")
         except ParameterError as exc:
             self.bad_input = True
-            self._finish("failed", error=str(exc))
+            self._finish("failed", error=message_line(str(exc)))  # its quoted values whole
         except PluginError as exc:  # a user's controller raised: the line says so
             self._finish("failed", error=f"run failed: {exc}")
         except Exception as exc:  # the window shows it; the app must not die
@@ -125,7 +126,7 @@ class Worker:
 
     def _finish(self, state: str, result: Any = None, error: str = "") -> None:
         with self._lock:
-            self.result, self.error = result, error.splitlines()[0] if error else ""
+            self.result, self.error = result, message_line(error.splitlines()[0]) if error else ""
             if state == "done":
                 self._fraction = 1.0
             self._state = state

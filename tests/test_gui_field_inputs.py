@@ -1,0 +1,157 @@
+"""What the simulator window's fields make of text a user types (off-screen, Agg): numbers
+read as the command lines read them, a folder name on one line, and every message whole
+on one line, whatever the quoted value holds."""
+
+from __future__ import annotations
+
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.gui import App, Settings
+from ddwmmr.gui.layout import FIGSIZE
+from ddwmmr.gui.widgets import describe_error, message_line
+from ddwmmr.gui.worker import Worker
+from figure_checks import text_collisions
+
+
+def offscreen_app() -> App:
+    figure = Figure(figsize=FIGSIZE, dpi=30)
+    FigureCanvasAgg(figure)
+    return App(figure, Settings(duration=1.0))
+
+
+FIELDS = {
+    "x0": lambda app: app.geometry_fields["x0"],
+    "N": lambda app: app.geometry_fields["N"],
+    "T": lambda app: app.geometry_fields["T"],
+    "dt": lambda app: app.dt_field,
+    "duration": lambda app: app.duration_field,
+    "offset": lambda app: app.offset_field,
+}
+
+
+@pytest.mark.parametrize("name", sorted(FIELDS))
+@pytest.mark.parametrize("typed", ["1_000", "0_02", "0.0_1", "\uff11", "\uff10.\uff15"])
+def test_a_number_field_reads_numbers_as_the_command_lines_do(name: str, typed: str) -> None:
+    """``1_000`` and full-width digits are no numbers to ``--dt``, ``--N``... (Python's
+    float reads them): the field refuses them naming itself and keeps its value."""
+    app = offscreen_app()
+    field = FIELDS[name](app)
+    before, shown = app.settings, field.text
+    text = f"{typed} 0" if name == "offset" else typed
+    field.submit(text)
+    assert app.message_is_error and app.message.startswith(name), app.message
+    assert app.settings == before and field.text == shown
+
+
+def test_an_export_folder_name_on_more_than_one_line_is_refused(tmp_path) -> None:
+    app = offscreen_app()
+    for name in (f"{tmp_path}/runs\ngui", f"{tmp_path}/a\rb", f"{tmp_path}/tab\there"):
+        app.export_field.submit(name)
+        assert app.message_is_error and app.message.startswith("export:"), app.message
+        assert "one line of printable characters" in app.message
+        assert "\n" not in app.message and app.export_field.text == "runs/gui"
+    assert list(tmp_path.iterdir()) == []
+    app.export_field.submit(str(tmp_path / "runs"))  # the next good name is taken
+    assert not app.message_is_error and app.export_field.text == str(tmp_path / "runs")
+
+
+def test_a_files_error_is_shown_whole_when_its_name_holds_a_newline(tmp_path) -> None:
+    """The reason comes after the name: cutting the message at the name's newline left
+    ``traj: .../new`` alone in the window."""
+    path = tmp_path / "new\nline.csv"
+    path.write_text("t,x,y\n0,0,0\n1,1,1\n")
+    app = offscreen_app()
+    app.file_field.submit(str(path))
+    assert app.message_is_error and app.message.startswith("traj:")
+    assert "new\\nline.csv" in app.message and "at least 3 rows" in app.message
+    assert app.settings.trajectory == "ellipse"
+
+
+def test_a_message_is_one_printable_line() -> None:
+    assert message_line("a\nb\tc\x00d\udcff ") == "a\\nb\\tc\\x00d\\udcff"
+    assert message_line("plain text, é") == "plain text, é"
+    assert describe_error(ParameterError("x: one\ntwo")) == "x: one\\ntwo"
+    assert describe_error(OSError("disk full\nmore")) == "OSError: disk full"  # first line
+
+
+def test_a_failed_runs_message_keeps_what_follows_a_newline() -> None:
+    def job(_progress):
+        raise ParameterError("plan: /tmp/a\nb.npz is not a plan")
+
+    worker = Worker(job, 1)
+    worker.start()
+    worker.join()
+    assert worker.state == "failed" and worker.error == "plan: /tmp/a\\nb.npz is not a plan"
+
+
+@pytest.mark.parametrize("change", ["plant", "duration"])
+def test_a_setting_changed_while_simulating_says_the_run_stopped(change: str) -> None:
+    """The run is cancelled: "simulating ..." must not stay in the window."""
+    app = offscreen_app()
+    app.apply(app.settings.replace(duration=40.0))
+    app.worker_started = app.run()
+    app.pause()  # hold the worker mid-run, whatever the machine's speed
+    assert app.worker is not None and app.worker.state == "paused"
+    if change == "plant":
+        app._on_plant("thesis")
+    else:
+        app.duration_field.submit("2")
+    assert app.worker is None and app.results is None
+    assert app.message == "settings changed: simulation stopped; press Run"
+    app.run()
+    app.wait()
+    assert app.results is not None, app.message
+
+
+@pytest.mark.parametrize("typed", ["$$", "$\\frac{$", "a$x^$b"])
+def test_dollar_signs_in_a_message_are_drawn_as_typed(typed: str) -> None:
+    """A message quotes what was typed; as mathtext, ``$$`` made every later draw of the
+    window raise (the field's Enter too), until another message replaced it."""
+    app = offscreen_app()
+    app.dt_field.submit(typed)
+    assert app.message == f"dt must be a number > 0 in s, or blank (got {typed!r})"
+    app.figure.canvas.draw()  # raised ValueError (mathtext) before
+    assert repr(typed) in app.message_text.get_text()
+    app.dt_field.submit("0.02")
+    assert app.settings.dt == 0.02
+
+
+def test_a_trajectory_file_named_with_dollars_runs_and_is_drawn(tmp_path) -> None:
+    path = tmp_path / "a$x^$.csv"
+    path.write_text("t,x,y\n" + "".join(f"{k / 10},{k / 100},0\n" for k in range(41)))
+    app = offscreen_app()
+    app.file_field.submit(str(path))
+    assert app.settings.trajectory == str(path), app.message
+    app.run()
+    app.wait()
+    assert app.results is not None, app.message
+    app.figure.canvas.draw()
+    assert "on a$x^$" in app.view.path_ax.get_title()
+
+
+def test_a_glyph_the_font_lacks_is_shown_as_its_escape(recwarn) -> None:
+    app = offscreen_app()
+    app.dt_field.submit("\uff11")
+    app.figure.canvas.draw()
+    assert "(got '\\uff11')" in app.message_text.get_text()
+    assert not [w for w in recwarn if "missing from font" in str(w.message)]
+
+
+def test_a_near_constant_error_plot_keeps_short_tick_labels() -> None:
+    """tau = inf disables the correction (a documented value): the orientation error then
+    drifts by 1e-13 rad, and its ticks, labelled in their last digits, ran over the top
+    view."""
+    figure = Figure(figsize=FIGSIZE, dpi=60)
+    FigureCanvasAgg(figure)
+    app = App(figure, Settings(duration=1.0, options=({"tau": float("inf")}, {})))
+    app.run()
+    app.wait()
+    assert app.results is not None, app.message
+    app.show_index(0)
+    figure.canvas.draw()
+    assert text_collisions(figure) == []
+    labels = [t.get_text() for t in app.view.plot_axes["orientation"].get_yticklabels()]
+    assert labels and max(len(label) for label in labels) <= 8, labels
