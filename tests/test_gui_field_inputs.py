@@ -4,10 +4,13 @@ on one line, whatever the quoted value holds."""
 
 from __future__ import annotations
 
+import threading
+
 import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+import ddwmmr.gui.app as app_module
 from ddwmmr.errors import ParameterError
 from ddwmmr.gui import App, Settings
 from ddwmmr.gui.layout import FIGSIZE
@@ -87,20 +90,36 @@ def test_a_failed_runs_message_keeps_what_follows_a_newline() -> None:
     assert worker.state == "failed" and worker.error == "plan: /tmp/a\\nb.npz is not a plan"
 
 
+@pytest.fixture
+def held_run(monkeypatch):
+    """Runs of the window wait for ``release.set()`` before they simulate, reporting
+    progress (a run is still being simulated, whatever the machine's speed)."""
+    release = threading.Event()
+    real = app_module.simulate_settings
+
+    def held(settings, progress):
+        while not release.wait(0.01):  # a cancel ends it at a progress report
+            progress(0, 0, 1)
+        return real(settings, progress)
+
+    monkeypatch.setattr(app_module, "simulate_settings", held)
+    yield release
+    release.set()
+
+
 @pytest.mark.parametrize("change", ["plant", "duration"])
-def test_a_setting_changed_while_simulating_says_the_run_stopped(change: str) -> None:
+def test_a_setting_changed_while_simulating_says_the_run_stopped(change: str, held_run) -> None:
     """The run is cancelled: "simulating ..." must not stay in the window."""
     app = offscreen_app()
-    app.apply(app.settings.replace(duration=40.0))
-    app.worker_started = app.run()
-    app.pause()  # hold the worker mid-run, whatever the machine's speed
-    assert app.worker is not None and app.worker.state == "paused"
+    app.run()
+    assert app.worker is not None and not app.worker.finished
     if change == "plant":
         app._on_plant("thesis")
     else:
         app.duration_field.submit("2")
-    assert app.worker is None and app.results is None
     assert app.message == "settings changed: simulation stopped; press Run"
+    assert app.worker is None and app.results is None
+    held_run.set()
     app.run()
     app.wait()
     assert app.results is not None, app.message
@@ -155,3 +174,30 @@ def test_a_near_constant_error_plot_keeps_short_tick_labels() -> None:
     assert text_collisions(figure) == []
     labels = [t.get_text() for t in app.view.plot_axes["orientation"].get_yticklabels()]
     assert labels and max(len(label) for label in labels) <= 8, labels
+
+
+@pytest.mark.parametrize(("trajectory", "name"), [("figure8", "x0"), ("sideways_reach", "beta")])
+def test_a_geometry_value_placing_samples_out_of_range_is_named(trajectory, name) -> None:
+    """The samples' own check named no field ("trajectory samples: points ... (got
+    1e+06)"), though the field had taken a value within its stated range."""
+    app = offscreen_app()
+    app.apply(app.settings.replace(trajectory=trajectory))
+    app.geometry_fields[name].submit("1e6")
+    assert app.message.startswith(f"{name}: placing the samples of {trajectory} there: ")
+    assert "must be <= 1e+06" in app.message and app.settings.geometry == {}
+    app.geometry_fields[name].submit("5")
+    assert app.settings.geometry == {name: 5.0} and not app.message_is_error
+
+
+def test_export_and_step_during_a_run_say_it_is_still_simulated(tmp_path, held_run) -> None:
+    """ "no finished run yet (press Run)" sent the user to a button that does nothing
+    while the run is simulated."""
+    app = offscreen_app()
+    app.export_field.submit(str(tmp_path / "runs"))
+    app.run()
+    for action, what in ((app.export_data, "export"), (app.step, "step")):
+        action()
+        assert app.message == f"{what}: the run is still being simulated; wait for it"
+    held_run.set()
+    app.wait()
+    assert app.export_data() and not app.message_is_error

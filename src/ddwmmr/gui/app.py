@@ -767,11 +767,18 @@ class App(PanelLayout):
         self._stop()
         self.say(f"paused at t = {self.view.time:.2f} s")
 
+    def _no_run(self, what: str) -> ParameterError:
+        """Why ``what`` (step, export) has no run to act on: none finished yet, or one is
+        still being simulated (Run would not start another)."""
+        if self.worker is not None and not self.worker.finished:
+            return ParameterError(f"{what}: the run is still being simulated; wait for it")
+        return ParameterError(f"{what}: no finished run yet (press Run)")
+
     @guarded
     def step(self) -> None:
         """Step button: pause and move the playback one recorded step (dt) forward."""
         if self.results is None:
-            raise ParameterError("step: no finished run yet (press Run)")
+            raise self._no_run("step")
         self._stop()
         self.show_index(self.view.index + 1)
 
@@ -863,7 +870,7 @@ class App(PanelLayout):
     # ================================================================ export
     def _export_folder(self) -> Path:
         if self.results is None:
-            raise ParameterError("export: no finished run yet (press Run)")
+            raise self._no_run("export")
         if self.export_dir is None:
             # ignore: results come with the settings of their run; an active slot has a method
             settings: Settings = self.run_settings  # type: ignore[assignment]

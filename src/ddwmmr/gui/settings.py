@@ -228,7 +228,13 @@ def build_trajectory(settings: Settings) -> Any:
                     f"{name}: {settings.trajectory} does not move along {axis}, so it has no "
                     f"{name} to change (leave {name} at its own value, 0)"
                 )
-        return place_samples(base, {**own, **changes})
+        try:
+            return place_samples(base, {**own, **changes})
+        except ParameterError as exc:  # the samples' check names no geometry value
+            names = ", ".join(name for name, _, _ in GEOMETRY if name in changes)
+            raise ParameterError(
+                f"{names}: placing the samples of {settings.trajectory} there: {exc}"
+            ) from None
     own = geometry_of(base)
     unknown = sorted(set(changes) - set(own) - {"N"})
     if unknown or not dataclasses.is_dataclass(base):
