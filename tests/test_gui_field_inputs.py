@@ -201,3 +201,17 @@ def test_export_and_step_during_a_run_say_it_is_still_simulated(tmp_path, held_r
     held_run.set()
     app.wait()
     assert app.export_data() and not app.message_is_error
+
+
+def test_a_tilde_in_the_export_folder_is_the_home_folder(tmp_path, monkeypatch) -> None:
+    """No shell reads the field: "~/runs" made a folder named "~" in the current one."""
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    app = offscreen_app()
+    app.export_field.submit("~/runs")
+    assert app.export_field.text == str(tmp_path / "home" / "runs"), app.message
+    app.run()
+    app.wait()
+    app.export_data()
+    assert not app.message_is_error, app.message
+    assert not (tmp_path / "~").exists() and len(list((tmp_path / "home/runs").iterdir())) == 1

@@ -17,6 +17,7 @@ from __future__ import annotations
 import contextlib
 import datetime
 import functools
+import os
 import textwrap
 import time
 from collections.abc import Callable, Iterator
@@ -611,10 +612,12 @@ class App(PanelLayout):
         return f"{values[0]:g} {values[1]:g}"
 
     def _apply_export_dir(self, text: str) -> str:
+        # no shell reads the field: ~ is the home folder here too (not a folder named ~)
+        text = os.path.expanduser(text.strip())
         check_export_root(text)  # a folder, or where one can be made
         self.export_dir = None  # the next export makes a new run folder under the new root
-        self.say(f"export folder: {text.strip()}")
-        return text.strip()
+        self.say(f"export folder: {text}")
+        return text
 
     # ================================================================ preview and runs
     def _obstacles(self, settings: Settings) -> list[Any]:
