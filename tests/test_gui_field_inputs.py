@@ -215,3 +215,18 @@ def test_a_tilde_in_the_export_folder_is_the_home_folder(tmp_path, monkeypatch) 
     app.export_data()
     assert not app.message_is_error, app.message
     assert not (tmp_path / "~").exists() and len(list((tmp_path / "home/runs").iterdir())) == 1
+
+
+def test_an_export_folder_name_too_long_is_refused_at_the_field(tmp_path) -> None:
+    """It was taken, and the export failed later with the reason cut from the box."""
+    app = offscreen_app()
+    long_name = "x" * 300
+    app.export_field.submit(str(tmp_path / long_name / "runs"))
+    assert app.message == (
+        "export: the folder name xxxxxxxxxxxxxxxxxxxx... is too long (300 bytes, at most 255)"
+    )
+    assert app.export_field.text == "runs/gui"
+    app.export_field.submit(str(tmp_path / ("a/" * 2100)))
+    assert app.message == "export: the folder's path is too long (at most 4095 bytes)"
+    app.export_field.submit(str(tmp_path / ("y" * 255)))  # the longest name is taken
+    assert not app.message_is_error
