@@ -81,13 +81,17 @@ class ParameterError(ValueError):
         super().__init__(*args)
 
 
-def escaped_controls(text: str) -> str:
+def escaped_controls(text: str, undecodable: bool = True) -> str:
     """``text`` with each control character (Unicode category Cc: a line break, a tab, an
     escape) written as Python writes it in a string's repr (``\\n``, ``\\t``,
-    ``\\x1b``), so that it prints on one line; ``text`` itself when it has none."""
-    if text.isprintable() or printable_line(text, undecodable=True):
+    ``\\x1b``), so that it prints on one line; ``text`` itself when it has none.
+    ``undecodable``: a lone surrogate (a file name's undecodable byte, which a tool's output
+    streams write back as that byte) is kept; else it is escaped too (``\\udcff``: a
+    window draws no such character)."""
+    if text.isprintable() or printable_line(text, undecodable):
         return text
-    return "".join(repr(c)[1:-1] if unicodedata.category(c) == "Cc" else c for c in text)
+    refused = UNPRINTABLE_CATEGORIES[:1] if undecodable else UNPRINTABLE_CATEGORIES
+    return "".join(repr(c)[1:-1] if unicodedata.category(c) in refused else c for c in text)
 
 
 class PluginError(RuntimeError):

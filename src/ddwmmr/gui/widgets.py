@@ -17,7 +17,6 @@ behaves like typing the text and pressing Enter.
 
 from __future__ import annotations
 
-import unicodedata
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -27,7 +26,7 @@ from matplotlib.font_manager import findfont, get_font
 from matplotlib.text import Text
 from matplotlib.widgets import Button, RadioButtons, TextBox
 
-from ddwmmr.errors import UNPRINTABLE_CATEGORIES, ParameterError, printable_line
+from ddwmmr.errors import ParameterError, escaped_controls
 from ddwmmr.reports.canvas import renderer_of
 
 #: Font size of panel labels and widget texts (points).
@@ -80,12 +79,7 @@ def message_line(text: str) -> str:
     :data:`~ddwmmr.errors.UNPRINTABLE_CATEGORIES` (a newline, a tab, a NUL, e.g. of a file
     name an error quotes) written as its Python escape (``\\n``), so nothing after it is
     lost and no font is asked for a glyph it has not; trailing whitespace dropped."""
-    text = text.rstrip()
-    if printable_line(text):
-        return text
-    return "".join(
-        ascii(c)[1:-1] if unicodedata.category(c) in UNPRINTABLE_CATEGORIES else c for c in text
-    )
+    return escaped_controls(text.rstrip(), undecodable=False)
 
 
 def drawable(text: str, artist: Text) -> str:
