@@ -258,4 +258,27 @@ def test_support_loads_of_a_run_without_physics_is_a_message(tmp_path):
     app = finished_app(Settings(methods=("clrrmc-cs", None), duration=DURATION), tmp_path / "gui")
     click(app.export_buttons["loads"].ax)
     assert "only a run on a physics plant measures them: choose plant mujoco and Run" in app.message
-    assert not any((tmp_path / "gui").rglob("*.png"))
+    assert not list((tmp_path / "gui").iterdir())  # no empty run folder left behind
+    click(app.export_buttons["data"].ax)  # the next export makes its folder anew
+    (folder,) = (tmp_path / "gui").iterdir()
+    assert sorted(p.name for p in folder.iterdir()) == ["summary.json", "timeseries.csv"]
+
+
+def test_a_failed_export_keeps_what_earlier_exports_wrote(tmp_path, monkeypatch):
+    """A failing writer (an MP4 encoder missing) leaves no empty folder, and never takes
+    away a folder an earlier export of the run wrote into."""
+    from ddwmmr.errors import ParameterError
+    from ddwmmr.gui import export
+
+    def unavailable(*_args, **_kwargs):
+        raise ParameterError("export: mp4 needs ffmpeg")
+
+    monkeypatch.setattr(export, "write_animation", unavailable)
+    app = finished_app(Settings(methods=("ats", None), duration=DURATION), tmp_path / "gui")
+    click(app.export_buttons["mp4"].ax)
+    assert app.message == "export: mp4 needs ffmpeg"
+    assert not list((tmp_path / "gui").iterdir())
+    click(app.export_buttons["data"].ax)
+    click(app.export_buttons["mp4"].ax)
+    (folder,) = (tmp_path / "gui").iterdir()
+    assert sorted(p.name for p in folder.iterdir()) == ["summary.json", "timeseries.csv"]

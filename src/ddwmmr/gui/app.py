@@ -883,23 +883,38 @@ class App(PanelLayout):
             self.export_dir = export.run_folder(root, f"{names}-{trajectory}-{self._run_stamp}")
         return self.export_dir
 
+    @contextlib.contextmanager
+    def _exporting(self) -> Iterator[Path]:
+        """The run's export folder (:meth:`_export_folder`) for one export; where the
+        export fails and left nothing in a folder it made, the folder goes again (the
+        next export makes it anew), so a refused export leaves no empty folder behind."""
+        made = self.export_dir is None
+        folder = self._export_folder()
+        try:
+            yield folder
+        except BaseException:
+            if made and folder.is_dir() and not any(folder.iterdir()):
+                folder.rmdir()
+                self.export_dir = None
+            raise
+
     @guarded
     def export_data(self) -> list[Path]:
         """Export button: timeseries.csv and summary.json (the files `track` writes, with
         the record `python -m ddwmmr.track --rerun` repeats)."""
-        folder = self._export_folder()
-        # ignore: _export_folder refused a missing run (results and run_settings are set)
-        paths = export.write_run_data(folder, self.results, self.labels(), self.run_settings)  # type: ignore[arg-type]
+        with self._exporting() as folder:
+            # ignore: _export_folder refused a missing run (results, run_settings are set)
+            paths = export.write_run_data(folder, self.results, self.labels(), self.run_settings)  # type: ignore[arg-type]
         self.say(f"wrote {len(paths)} files to {folder}")
         return paths
 
     @guarded
     def export_png(self) -> Path:
         """Export button: a PNG of the whole window."""
-        folder = self._export_folder()
         self._animate(False)  # a saved figure leaves animated artists out
         try:
-            path = export.write_window_png(self.figure, folder)
+            with self._exporting() as folder:
+                path = export.write_window_png(self.figure, folder)
         finally:
             self._animate(self._blitting)
         self.say(f"wrote {path}")
@@ -910,9 +925,9 @@ class App(PanelLayout):
         """Support loads button: each physics run's support-load panel (every edge's load
         with the optimisers' floor, the base's tilt; the figure a physics ``track`` run
         writes) as ``support_loads.png``, and on the desktop in a window of its own."""
-        folder = self._export_folder()
-        # ignore: _export_folder refused a missing run (results and run_settings are set)
-        written = export.write_support_loads(folder, self.results, self.labels())  # type: ignore[arg-type]
+        with self._exporting() as folder:
+            # ignore: _export_folder refused a missing run (results, run_settings are set)
+            written = export.write_support_loads(folder, self.results, self.labels())  # type: ignore[arg-type]
         if self.interactive:
             self._show_support_loads()
         self.say(f"wrote {', '.join(str(path) for path in written)}")
@@ -939,14 +954,14 @@ class App(PanelLayout):
     @guarded
     def export_animation(self, fmt: str = "gif") -> Path:
         """Export button: the run's animation as GIF or MP4."""
-        folder = self._export_folder()
-        self.say(f"writing {fmt} ...")
-        if self.interactive:  # show the message before the export blocks the window
-            self.figure.canvas.draw()
-            self.figure.canvas.flush_events()
-        # ignore: _export_folder refused a missing run (results and run_settings are set)
-        obstacles = self._obstacles(self.run_settings)  # type: ignore[arg-type]
-        path = export.write_animation(self.results, self.labels(), obstacles, folder, fmt)  # type: ignore[arg-type]
+        with self._exporting() as folder:
+            self.say(f"writing {fmt} ...")
+            if self.interactive:  # show the message before the export blocks the window
+                self.figure.canvas.draw()
+                self.figure.canvas.flush_events()
+            # ignore: _export_folder refused a missing run (results, run_settings are set)
+            obstacles = self._obstacles(self.run_settings)  # type: ignore[arg-type]
+            path = export.write_animation(self.results, self.labels(), obstacles, folder, fmt)  # type: ignore[arg-type]
         self.say(f"wrote {path}")
         return path
 
