@@ -64,3 +64,15 @@ def test_a_damaged_file_of_another_name_in_a_cache_folder_is_one_line(tmp_path):
     with pytest.raises(ParameterError) as info:
         Guess.load(cache / "best.npz")
     assert "bounds" not in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("name", "reason"), [("a" * 10_000, "File name too long"), ("a\x00b", "invalid file name")]
+)
+def test_a_plan_name_the_system_cannot_look_up_is_named_as_the_plan(name, reason):
+    """A 10,000-character plan path raised the OS's own error (no `plan`, a traceback at
+    the API) from the folder check before the file was read."""
+    with pytest.raises(ParameterError) as info:
+        Guess.load(name)
+    message = str(info.value)
+    assert message.startswith("plan: ") and reason in message

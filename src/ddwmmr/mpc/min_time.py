@@ -158,7 +158,7 @@ class Guess:
         else, a file that cannot be read as such an archive (empty, truncated, damaged, a
         single ``.npy`` array, pickled data, a member that is not a numeric array, a
         folder) included."""
-        if Path(path).is_dir():
+        if os.path.isdir(path):  # False where the name cannot be looked up: read below
             raise ParameterError(
                 f"plan {path} must be a .npz file, not a folder (only the scenario tool's "
                 "--option plan=DIR takes the output folder of python -m ddwmmr.bounds, "
@@ -166,8 +166,12 @@ class Guess:
             )
         arrays = None
         reason = "a single array, not an archive"
-        if not os.path.lexists(path):
-            raise ParameterError(f"plan {path}: no such file")
+        try:
+            os.lstat(path)
+        except FileNotFoundError:
+            raise ParameterError(f"plan {path}: no such file") from None
+        except (OSError, ValueError):
+            pass  # a name too long, a NUL in it...: read_input_bytes says so, naming plan
         # read as every input file is (a FIFO, /proc/kmsg or a file above the cap refused,
         # never waited on), then parsed from memory
         data = read_input_bytes(path, "plan")
