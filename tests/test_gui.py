@@ -148,6 +148,9 @@ def test_transport_step_pause_reset_speed():
     assert app.worker is None and app.playing
     app.advance(100.0)
     assert app.view.index == app.view.last_index and not app.playing
+    click(app.transport["step"].ax)  # at the end: said, not silently nothing
+    assert app.view.index == app.view.last_index
+    assert app.message == f"step: the run ends here (t = {DURATION:.2f} s); Reset goes to 0"
 
 
 def test_side_by_side_overlays_two_methods_with_their_own_options():

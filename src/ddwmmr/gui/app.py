@@ -779,10 +779,14 @@ class App(PanelLayout):
 
     @guarded
     def step(self) -> None:
-        """Step button: pause and move the playback one recorded step (dt) forward."""
+        """Step button: pause and move the playback one recorded step (dt) forward; at
+        the run's last instant it says so (a press there changes nothing)."""
         if self.results is None:
             raise self._no_run("step")
         self._stop()
+        if self.view.index >= self.view.last_index:
+            self.say(f"step: the run ends here (t = {self.view.time:.2f} s); Reset goes to 0")
+            return
         self.show_index(self.view.index + 1)
 
     @guarded
