@@ -625,6 +625,8 @@ def _read_samples(path: str | Path) -> SampledTrajectory:
             raise ParameterError(f"traj: {path}: {exc}") from None
     try:
         reader = csv.DictReader(lines)
+        if reader.fieldnames:  # "t, x, y": names are read without the spaces around them
+            reader.fieldnames = [name.strip() for name in reader.fieldnames]
         rows = list(reader)
     except csv.Error as exc:
         raise ParameterError(f"traj: {path} is not valid CSV ({exc})") from None
