@@ -223,10 +223,10 @@ def test_an_export_folder_name_too_long_is_refused_at_the_field(tmp_path) -> Non
     long_name = "x" * 300
     app.export_field.submit(str(tmp_path / long_name / "runs"))
     assert app.message == (
-        "export: the folder name xxxxxxxxxxxxxxxxxxxx... is too long (300 bytes, at most 255)"
+        "export: the name xxxxxxxxxxxxxxxxxxxx... is too long (300 bytes, at most 255)"
     )
     assert app.export_field.text == "runs/gui"
     app.export_field.submit(str(tmp_path / ("a/" * 2100)))
-    assert app.message == "export: the folder's path is too long (at most 4095 bytes)"
+    assert app.message == "export: the path is too long (at most 4095 bytes)"
     app.export_field.submit(str(tmp_path / ("y" * 255)))  # the longest name is taken
     assert not app.message_is_error

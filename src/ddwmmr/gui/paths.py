@@ -22,7 +22,12 @@ import os
 from pathlib import Path
 
 from ddwmmr.errors import ParameterError, file_kind, printable_line, shown
-from ddwmmr.outputs import check_output_path, check_writable, nearest_existing
+from ddwmmr.outputs import (
+    check_name_lengths,
+    check_output_path,
+    check_writable,
+    nearest_existing,
+)
 
 #: Suffixes (formats) ``--snapshot`` may have: what matplotlib writes by itself or through
 #: Pillow (pgf needs LaTeX; raw/rgba are headerless pixel dumps, not image files).
@@ -151,26 +156,6 @@ def check_export_root(text: str) -> Path:
     path = Path(os.path.abspath(text))
     if os.path.lexists(path) and not path.is_dir():
         raise ParameterError(f"export: {text} exists and is not a folder")
-    check_new_names(path)
+    check_name_lengths("export", path, nearest_existing(path))
     check_writable("export", path, text)
     return path
-
-
-def check_new_names(path: Path) -> None:
-    """Refuse (one line, ``export:``) a folder ``path`` whose names yet to be made are
-    longer than its file system takes, or a path longer than the system's limit: the
-    export would fail only later, its message ending in the reason cut from the box."""
-    ancestor = nearest_existing(path)
-    try:
-        name_max = os.pathconf(ancestor if ancestor.is_dir() else "/", "PC_NAME_MAX")
-    except (OSError, ValueError):
-        name_max = 255
-    for part in path.relative_to(ancestor).parts:
-        size = len(os.fsencode(part))
-        if size > name_max:
-            raise ParameterError(
-                f"export: the folder name {part[:20]}... is too long ({size} bytes, at most "
-                f"{name_max})"
-            )
-    if len(os.fsencode(str(path))) >= 4096:
-        raise ParameterError("export: the folder's path is too long (at most 4095 bytes)")

@@ -45,6 +45,7 @@ from ddwmmr.outputs.atomic import first_free, sync_folder, write_atomic, write_n
 from ddwmmr.outputs.checks import (
     MANIFEST,
     Existing,
+    check_name_lengths,
     check_output_file,
     check_output_folder,
     check_output_path,
@@ -72,6 +73,7 @@ __all__ = [
     "MANIFEST",
     "STAGING_PREFIX",
     "Existing",
+    "check_name_lengths",
     "check_output_file",
     "check_output_folder",
     "check_output_path",

@@ -147,6 +147,26 @@ def _name_max(folder: Path) -> int:
         return 255
 
 
+#: The longest path (bytes) a system call takes, less one: Linux's PATH_MAX is 4096.
+MAX_PATH_BYTES = 4095
+
+
+def check_name_lengths(label: str, path: Path, ancestor: Path) -> None:
+    """Refuse (one line, ``label:``) a ``path`` whose names below its existing
+    ``ancestor`` (those yet to be made) are longer than the file system there takes
+    (``PC_NAME_MAX``, else 255 bytes), or which is longer than :data:`MAX_PATH_BYTES`:
+    writing it would fail only later, mid-run or mid-export."""
+    name_max = _name_max(ancestor if ancestor.is_dir() else Path("/"))
+    for part in path.relative_to(ancestor).parts:
+        size = len(os.fsencode(part))
+        if size > name_max:
+            raise ParameterError(
+                f"{label}: the name {part[:20]}... is too long ({size} bytes, at most {name_max})"
+            )
+    if len(os.fsencode(str(path))) > MAX_PATH_BYTES:
+        raise ParameterError(f"{label}: the path is too long (at most {MAX_PATH_BYTES} bytes)")
+
+
 def nearest_existing(path: Path) -> Path:
     """``path`` if it exists (a dangling link counts), else its nearest existing ancestor."""
     for candidate in [path, *path.parents]:
@@ -270,15 +290,7 @@ def check_output_path(target: str | Path, what: str = "folder", probe: bool = Tr
             f"out: {text} is a symbolic link (to {os.readlink(path)}); give a real {what}"
         )
     ancestor = nearest_existing(path.parent)
-    name_max = _name_max(ancestor if ancestor.is_dir() else Path("/"))
-    for part in path.relative_to(ancestor).parts:
-        size = len(os.fsencode(part))
-        if size > name_max:
-            raise ParameterError(
-                f"out: the name {part[:20]}... is too long ({size} bytes, at most {name_max})"
-            )
-    if len(os.fsencode(str(path))) >= 4096:
-        raise ParameterError("out: the path is too long (at most 4095 bytes)")
+    check_name_lengths("out", path, ancestor)
     if os.path.islink(ancestor) and not ancestor.exists():
         raise ParameterError(f"out: {ancestor} is a dangling symbolic link")
     if not ancestor.is_dir():
