@@ -116,7 +116,7 @@ class Worker:
             self._finish("cancelled")
         except ParameterError as exc:
             self.bad_input = True
-            self._finish("failed", error=message_line(str(exc)))  # its quoted values whole
+            self._finish("failed", error=str(exc))  # one line: ParameterError escapes
         except PluginError as exc:  # a user's controller raised: the line says so
             self._finish("failed", error=f"run failed: {exc}")
         except Exception as exc:  # the window shows it; the app must not die

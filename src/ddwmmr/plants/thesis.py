@@ -154,7 +154,7 @@ def first_order_step(
         push = gain / tau * u * dt  # what u adds to x over dt without the decay
         return x0 * math.exp(-s) + push * phi1, (x0 * phi1 + push * phi2) * dt
     x_ss = gain * u
-    decay = math.exp(-dt / tau)
+    decay = math.exp(-s)
     return x_ss + (x0 - x_ss) * decay, x_ss * dt + (x0 - x_ss) * tau * (1.0 - decay)
 
 

@@ -208,8 +208,9 @@ def gif_bytes(images: Sequence[Image.Image], fps: int) -> bytes:
         index = len(entries)
         used = {tuple(entry) for entry in entries.tolist()}
         unused = next(c for v in range(256) if (c := (v, 255 - v, v)) not in used)
+        with_clear = np.append(entries, [unused], axis=0).astype(np.uint8).tobytes()
         for frame, mask in zip(frames, clear):
-            frame.putpalette(np.append(entries, [unused], axis=0).astype(np.uint8).tobytes())
+            frame.putpalette(with_clear)
             if mask is not None:
                 frame.paste(index, mask=Image.fromarray(mask))
         options = {"transparency": index, "disposal": 2}
