@@ -157,7 +157,11 @@ def save_gif(
     images = []
     with as_saved(fig):
         for rgba in blitted_frames(fig, update, count):
-            images.append(Image.fromarray(rgba).copy())  # a copy, out of the canvas
+            image = Image.fromarray(rgba)
+            # a copy, out of the canvas; RGB where every pixel is opaque to gif_bytes, so
+            # that an opaque animation's frames are held at 3 bytes a pixel, not 4
+            clear = bool((rgba[..., 3] < GIF_OPAQUE).any())
+            images.append(image.copy() if clear else image.convert("RGB"))
             if advance is not None:
                 advance()
     Path(path).write_bytes(gif_bytes(images, fps))
@@ -166,6 +170,8 @@ def save_gif(
 
 #: Colours of an animated GIF's one palette.
 GIF_COLORS = 128
+#: The alpha (of 255) from which a pixel of an RGBA image is opaque in a GIF.
+GIF_OPAQUE = 128
 
 
 def gif_bytes(images: Sequence[Image.Image], fps: int) -> bytes:
@@ -182,7 +188,7 @@ def gif_bytes(images: Sequence[Image.Image], fps: int) -> bytes:
     before (disposal 2), none shows through another. Images without a transparent pixel
     make an opaque GIF, as RGB ones."""
     clear = [
-        np.asarray(image.getchannel("A")) < 128 if image.mode == "RGBA" else None
+        np.asarray(image.getchannel("A")) < GIF_OPAQUE if image.mode == "RGBA" else None
         for image in images
     ]
     transparent = any(mask is not None and mask.any() for mask in clear)
