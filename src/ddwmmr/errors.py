@@ -307,6 +307,15 @@ def plain_number_text(text: str) -> bool:
     return text.isascii() and "_" not in text
 
 
+def plain_float(text: str) -> float:
+    """The number ``text`` holds, read as a number a user types or a file holds
+    (:func:`plain_number_text`: a mistyped ``0_02`` or a full-width digit is none);
+    ValueError for a text that holds none, as ``float`` raises it."""
+    if not plain_number_text(text):
+        raise ValueError(text)
+    return float(text)
+
+
 def real_number(value: Any) -> float | None:
     """``value`` as a float (finite or not), or None if it is no number: text, a boolean,
     None, or an integer beyond a float. Strings and booleans are not numbers here, even

@@ -29,7 +29,7 @@ from ddwmmr.errors import (
     DURATION_RANGE_S,
     MAX_SCENARIOS,
     ParameterError,
-    plain_number_text,
+    plain_float,
     read_text_file,
     shown,
 )
@@ -435,9 +435,7 @@ def _bounds_time(where: str, row: Mapping[str, str | None], key: str) -> float:
     text = _bounds_field(where, row, key)
     low, high = DURATION_RANGE_S
     try:
-        if not plain_number_text(text):
-            raise ValueError(text)
-        value = float(text)
+        value = plain_float(text)
     except ValueError:
         value = None
     if value is None or not (math.isnan(value) or low <= value <= high):

@@ -40,6 +40,7 @@ from ddwmmr.errors import (
     ParameterError,
     PluginError,
     did_you_mean,
+    plain_float,
     plain_number_text,
     shown,
 )
@@ -144,9 +145,7 @@ def number_type(allowed: str, finite: bool = False) -> Callable[[str], float]:
 
     def parse(text: str) -> float:
         try:
-            if not plain_number_text(text):
-                raise ValueError(text)
-            value = float(text)
+            value = plain_float(text)
         except ValueError:
             value = math.nan
             finite_only = True

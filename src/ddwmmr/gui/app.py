@@ -27,7 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from ddwmmr.errors import ParameterError, plain_number_text, shown
+from ddwmmr.errors import ParameterError, plain_float, shown
 from ddwmmr.gui import export
 from ddwmmr.gui.layout import (
     FILE_ENTRY,
@@ -481,7 +481,7 @@ class App(PanelLayout):
 
     def _apply_geometry(self, name: str, text: str) -> str:
         try:
-            number: float | str = typed_number(text)
+            number: float | str = plain_float(text)
         except ValueError:
             number = text  # not a number: the check refuses it naming the allowed range
         value = check_geometry(name, number)
@@ -601,7 +601,7 @@ class App(PanelLayout):
     def _apply_offset(self, text: str) -> str:
         parts = text.replace(",", " ").split()
         try:
-            values = tuple(typed_number(p) for p in parts)
+            values = tuple(plain_float(p) for p in parts)
         except ValueError:
             raise ParameterError(
                 f"offset must be two numbers dx dy in m (got {shown(text)})"
@@ -978,21 +978,12 @@ def _near(layout: tuple[float, float], other: tuple[float, float]) -> bool:
     )
 
 
-def typed_number(text: str) -> float:
-    """The number a field's ``text`` holds, read as the command lines read one
-    (:func:`ddwmmr.errors.plain_number_text`: ASCII, no underscores, so a mistyped
-    ``0_02`` or a full-width digit is no number); ValueError if it holds none."""
-    if not plain_number_text(text):
-        raise ValueError(text)
-    return float(text)
-
-
 def _optional_positive(name: str, text: str) -> float | None:
     text = text.strip()
     if not text:
         return None
     try:
-        value = typed_number(text)
+        value = plain_float(text)
     except ValueError:
         raise ParameterError(
             f"{name} must be a number > 0 in s, or blank (got {shown(text)})"
