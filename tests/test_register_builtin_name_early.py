@@ -48,3 +48,27 @@ def test_a_builtins_name_is_refused_by_register_before_any_query():
         "(ddwmmr.controllers.resolved_rate.PseudoinverseController and __main__.Mine)"
     )
     assert lines[1] == "['pi', 'ats', 'ap', 'clrrmc-ts', 'clrrmc-cs', 'qp', 'mpc', 'mine']"
+
+
+def test_the_builtins_are_read_once_when_a_plugin_comes_before_the_first_query():
+    """register read the built-ins' sources (for the refusal above), and the first query
+    read them all again."""
+    script = """
+from ddwmmr import available_methods, register, registry
+
+reads = []
+real_read_source = registry._read_source
+registry._read_source = lambda module: reads.append(module) or real_read_source(module)
+register("mine")(type("Mine", (), {}))
+methods = available_methods()
+assert "pi" in methods and "mine" in methods, methods
+print(len(reads), len(set(reads)), len(registry.BUILTIN_MODULES))
+"""
+    source = str(Path(ddwmmr.__file__).resolve().parents[1])
+    env = {**os.environ, "PYTHONPATH": source, "DDWMMR_PLUGINS": ""}
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, env=env, timeout=120
+    )
+    assert done.returncode == 0, done.stderr
+    reads, distinct, modules = map(int, done.stdout.split())
+    assert reads == distinct == modules

@@ -318,7 +318,8 @@ def discover() -> None:
             return
         _discovering = True
         try:
-            _read_builtins()
+            if not _builtins_known:  # else read when a plug-in was registered
+                _read_builtins()
             for module in _plugin_modules():
                 _import_plugin(module)
             _discovered = True  # a failure leaves it False: the next query fails alike
