@@ -22,6 +22,16 @@ def test_a_parameter_error_is_one_line_by_construction():
     assert escaped_controls("café \udcff ok") == "café \udcff ok"  # undecodable bytes kept
 
 
+@pytest.mark.parametrize("separator", ["\u2028", "\u2029"])
+def test_the_unicode_line_separators_are_escaped_too(separator, tmp_path):
+    """str.splitlines cuts at U+2028 and U+2029 as at a newline: a message quoting a file
+    named with one printed as two lines."""
+    error = ParameterError(f"robot: cannot read a{separator}b.toml")
+    assert len(str(error).splitlines()) == 1 and str(error).endswith("b.toml")
+    with pytest.raises(ParameterError):
+        check_output_path(tmp_path / f"run{separator}1")
+
+
 def test_a_robot_file_named_with_a_line_break_is_named_on_one_line(tmp_path):
     """Robot.from_toml's message quoted the name as it is: two lines."""
     path = tmp_path / "bad\nrobot.toml"

@@ -82,15 +82,16 @@ class ParameterError(ValueError):
 
 
 def escaped_controls(text: str, undecodable: bool = True) -> str:
-    """``text`` with each control character (Unicode category Cc: a line break, a tab, an
-    escape) written as Python writes it in a string's repr (``\\n``, ``\\t``,
-    ``\\x1b``), so that it prints on one line; ``text`` itself when it has none.
+    """``text`` with each character that breaks a line (:data:`LINE_BREAKING_CATEGORIES`:
+    a line break, a tab, an escape, U+2028) written as Python writes it in a string's repr
+    (``\\n``, ``\\t``, ``\\x1b``, ``\\u2028``), so that it prints on one line; ``text``
+    itself when it has none.
     ``undecodable``: a lone surrogate (a file name's undecodable byte, which a tool's output
     streams write back as that byte) is kept; else it is escaped too (``\\udcff``: a
     window draws no such character)."""
     if text.isprintable() or printable_line(text, undecodable):
         return text
-    refused = UNPRINTABLE_CATEGORIES[:1] if undecodable else UNPRINTABLE_CATEGORIES
+    refused = LINE_BREAKING_CATEGORIES if undecodable else UNPRINTABLE_CATEGORIES
     return "".join(repr(c)[1:-1] if unicodedata.category(c) in refused else c for c in text)
 
 
@@ -438,17 +439,21 @@ def round_significant(value: float, digits: int, rounding: Callable[[float], int
     return rounding(value * scale) / scale
 
 
-#: Unicode categories a text printed on one line may not hold: control characters (a
-#: newline splits a report's line) and lone surrogates (an undecodable byte of a file name:
-#: it cannot be encoded, so a figure's title fails to draw).
-UNPRINTABLE_CATEGORIES = ("Cc", "Cs")
+#: Unicode categories that break a line: control characters (a newline splits a report's
+#: line) and the line and paragraph separators U+2028 and U+2029 (``str.splitlines`` cuts
+#: at them).
+LINE_BREAKING_CATEGORIES = ("Cc", "Zl", "Zp")
+#: Unicode categories a text printed on one line may not hold: those that break a line and
+#: lone surrogates (an undecodable byte of a file name: it cannot be encoded, so a
+#: figure's title fails to draw).
+UNPRINTABLE_CATEGORIES = (*LINE_BREAKING_CATEGORIES, "Cs")
 
 
 def printable_line(text: str, undecodable: bool = False) -> bool:
     """Whether ``text`` prints as one line: no character of :data:`UNPRINTABLE_CATEGORIES`
     (``undecodable``: lone surrogates allowed, as a file name's undecodable bytes, which
     a tool's output streams write back as the bytes they were)."""
-    refused = UNPRINTABLE_CATEGORIES[:1] if undecodable else UNPRINTABLE_CATEGORIES
+    refused = LINE_BREAKING_CATEGORIES if undecodable else UNPRINTABLE_CATEGORIES
     return not any(unicodedata.category(c) in refused for c in text)
 
 
