@@ -32,6 +32,8 @@ from matplotlib.figure import Figure, FigureBase
 from numpy.typing import NDArray
 from PIL import Image
 
+from ddwmmr.errors import ParameterError, as_path, check_int_at_least, shown
+
 
 def new_figure(figsize: tuple[float, float], **kwargs: Any) -> Figure:
     """A figure of ``figsize`` (width, height in inches; ``kwargs``: the other
@@ -137,6 +139,23 @@ def as_saved(fig: Figure) -> Iterator[Figure]:
                 getattr(patch, f"set_{name}")(color)
                 restore.callback(getattr(patch, f"set_{name}"), own)
         yield fig
+
+
+#: The fastest GIF animation: a GIF times its frames in hundredths of a second.
+MAX_FPS = 100
+
+
+def checked_gif_options(path: Any, frames: Any, fps: Any) -> tuple[Path, int, int]:
+    """``(path, frames, fps)`` of an animation, checked before anything is drawn: ``path``
+    a ``.gif`` file's path (a name saying another format is a slip: a GIF is written
+    whatever it says), ``frames`` an integer >= 1, ``fps`` one in [1, :data:`MAX_FPS`];
+    else a one-line :class:`~ddwmmr.errors.ParameterError` naming the parameter."""
+    frames = check_int_at_least("frames", frames, 1)
+    fps = check_int_at_least("fps", fps, 1, MAX_FPS)
+    path = as_path(path, "path")
+    if path.suffix.lower() != ".gif":
+        raise ParameterError(f"path must be a .gif file (got {shown(path.name, 60)})")
+    return path, frames, fps
 
 
 def save_gif(

@@ -19,7 +19,8 @@ import numpy.typing as npt
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from ddwmmr.reports.canvas import new_figure, save_gif
+from ddwmmr.errors import check_nonnegative
+from ddwmmr.reports.canvas import checked_gif_options, new_figure, save_gif
 from ddwmmr.reports.plots import robot_outline, run_title
 
 if TYPE_CHECKING:
@@ -79,9 +80,16 @@ def save_physics_animation(
         points: nominal base-frame support points (n, 2), in the order of the columns.
         weight_n: the robot's weight (N), to scale the load discs.
         path: output ``.gif``.
+        frames: recorded instants shown (an integer >= 1), ``fps`` per second (in [1,
+            100]).
         after_tip_s: a run that tipped (``summary["tip_time_s"]``) is shown only this long
-            after it tipped (the top view of a fallen robot means nothing).
+            after it tipped (the top view of a fallen robot means nothing; s, >= 0).
+
+    Bad ``path``, ``frames``, ``fps`` or ``after_tip_s`` is a one-line
+    :class:`~ddwmmr.errors.ParameterError` naming it, before anything is drawn.
     """
+    path, frames, fps = checked_gif_options(path, frames, fps)
+    after_tip_s = check_nonnegative("after_tip_s", after_tip_s)
     robot = result.robot
     tip_time = result.summary.get("tip_time_s")
     ts = _until_after_tip(result.timeseries, tip_time, after_tip_s)
@@ -114,7 +122,6 @@ def save_physics_animation(
 
     ax.set_title(title, fontsize=9)
     fig.tight_layout()
-    path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     return save_gif(fig, update, len(indices), path, fps)
 

@@ -38,7 +38,7 @@ from ddwmmr.errors import (
 )
 from ddwmmr.model import Robot
 from ddwmmr.reports import palette
-from ddwmmr.reports.canvas import frame_indices, new_figure, save_gif
+from ddwmmr.reports.canvas import checked_gif_options, frame_indices, new_figure, save_gif
 from ddwmmr.reports.legends import legend_beside, place_legend
 
 if TYPE_CHECKING:
@@ -538,12 +538,7 @@ def save_animation(
     :class:`~ddwmmr.errors.ParameterError` naming it."""
     from ddwmmr.progress import ProgressBar
 
-    frames = check_int_at_least("frames", frames, 1)
-    fps = check_int_at_least("fps", fps, 1, 100)
-    path = as_path(path, "path")
-    # a GIF is written whatever the name (gif_bytes): a name saying otherwise is a slip
-    if path.suffix.lower() != ".gif":
-        raise ParameterError(f"path must be a .gif file (got {shown(path.name, 60)})")
+    path, frames, fps = checked_gif_options(path, frames, fps)
     obstacles = circles_of(obstacles)  # read and checked once, before anything is drawn
     ts, robot = _run(result).timeseries, result.robot
     q = result.configurations()
