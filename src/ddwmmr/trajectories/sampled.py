@@ -36,6 +36,7 @@ from ddwmmr.errors import (
     MAX_TRAJECTORY_SAMPLES,
     ParameterError,
     as_path,
+    plain_float,
     plain_number_text,
     read_text_file,
     shown,
@@ -525,14 +526,12 @@ CSV_COLUMNS = ("t", "x", "y", "phi")
 
 def _csv_number(path: Path, number: int, row: Mapping[str, str | None], key: str) -> float:
     """The value of column ``key`` in data row ``number`` as a float (one-line errors;
-    :func:`~ddwmmr.errors.plain_number_text`)."""
+    :func:`~ddwmmr.errors.plain_float`)."""
     text = row.get(key)
     if text is None or not text.strip():
         raise ParameterError(f"traj: {path} data row {number} has no value in column {key}")
     try:
-        if not plain_number_text(text):
-            raise ValueError(text)
-        return float(text)
+        return plain_float(text)
     except ValueError:
         # Stripped of ASCII blanks only: str.strip would also take off a no-break space
         # that made the value unreadable, and show a plain number.
