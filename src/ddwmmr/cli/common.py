@@ -250,6 +250,7 @@ class ArgumentParser(argparse.ArgumentParser):
         self, args: Sequence[str] | None = None, namespace: argparse.Namespace | None = None
     ) -> tuple[argparse.Namespace, list[str]]:
         outer, self._given = self._given, {}
+        # kept after the parse: parse_args refuses the words left over once this returns
         self._words = list(sys.argv[1:] if args is None else args)
         try:
             return super().parse_known_args(args, namespace)
@@ -274,6 +275,7 @@ class ArgumentParser(argparse.ArgumentParser):
             elif word in strays:
                 action = self._option_string_actions[strays[word]]
                 count = "one value" if action.nargs in (None, 1) else f"{action.nargs} values"
+                # argparse names no public type for action="append"; its class is stable
                 again = ", repeat it" if isinstance(action, argparse._AppendAction) else ""
                 word += f" ({strays.pop(word)} takes {count}{again})"
             words.append(word)
