@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ddwmmr.commands import PlantTraits, WheelForces
-from ddwmmr.errors import ParameterError, check_instance, shown
+from ddwmmr.errors import ParameterError, check_instance, raise_plugin_error, shown
 from ddwmmr.model import Robot
 from ddwmmr.registry import CONTROLLERS, PluginClass
 from ddwmmr.trajectories.base import resolution_step
@@ -229,7 +229,10 @@ def make_controller(
     supplies option values; explicit ``options`` override them. Unknown method names,
     presets and options (see :func:`method_options`) raise :class:`ParameterError`, and so
     does a :class:`NumberText` value: the method's own check words it with the allowed
-    range, and a method that would take it unchecked never receives it.
+    range, and a method that would take it unchecked never receives it. Anything else
+    the constructor of a plug-in (a class from outside the library) raises is a one-line
+    :class:`~ddwmmr.errors.PluginError` naming the method, its class and what it raised
+    (the ``__cause__``).
     """
     cls = controller_class(name)
     robot = check_instance("robot", robot if robot is not None else Robot(), Robot)
@@ -240,7 +243,13 @@ def make_controller(
     check_known_options(name, options, method_options(name))
     texts = [(option, value) for option, value in options.items() if isinstance(value, NumberText)]
     if not texts:
-        controller: Controller = cls(robot, **options)
+        try:
+            controller: Controller = cls(robot, **options)
+        except Exception as error:
+            if cls.__module__.split(".")[0] == "ddwmmr":
+                raise  # a bug of ours keeps its traceback
+            call = f"method: {name}: {cls.__qualname__}(robot, **options)"
+            raise_plugin_error(call, error, quoted=True)
         return controller
     try:  # the method's own check refuses the text, naming the allowed range
         cls(robot, **options)

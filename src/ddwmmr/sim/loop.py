@@ -266,6 +266,21 @@ def raise_wrapped(controller: Any, error: Exception, k: int, t: float, method: s
     raise_plugin_error(call, error, f" at step {k}, t = {t:g} s", quoted=True)
 
 
+def prepare(controller: Any, method: str, *args: Any) -> None:
+    """Call ``controller.<method>(*args)`` before the first step (``adopt_plant``,
+    ``adopt_control_step``, ``reset``). What a controller from outside the library raises
+    there is a one-line :class:`PluginError` naming it, the call and what it raised (the
+    ``__cause__``); a ParameterError, and anything a library controller raises, pass as
+    they are."""
+    try:
+        getattr(controller, method)(*args)
+    except Exception as error:
+        if from_library(controller):
+            raise
+        call = f"method: {name_of(controller)}.{method}()"
+        raise_plugin_error(call, error, " before the first step", quoted=True)
+
+
 def bad_law(controller: Any, result: Any, k: int, t: float) -> NoReturn:
     """Raise the one-line :class:`ParameterError` for what ``controller.law`` returned at a
     stage of step ``k`` (time ``t`` s) when it is not ``(u, ...)`` with ``u`` 4 numbers."""
@@ -304,15 +319,13 @@ def run_loop(
     sequence of one sample and the controller contract.
     """
     plant = checked_plant(plant, task.controller_error)  # a plug-in's calls checked
-    adopt_plant = getattr(controller, "adopt_plant", None)
-    if adopt_plant is not None:
-        adopt_plant(traits_of(plant))
+    if getattr(controller, "adopt_plant", None) is not None:
+        prepare(controller, "adopt_plant", traits_of(plant))
     force = check_interface(controller, plant) == FORCE
     plant.reset(q0, dt)
-    adopt = getattr(controller, "adopt_control_step", None)
-    if adopt is not None:
-        adopt(dt)
-    controller.reset(task.trajectory, np.array(q0, dtype=float))
+    if getattr(controller, "adopt_control_step", None) is not None:
+        prepare(controller, "adopt_control_step", dt)
+    prepare(controller, "reset", task.trajectory, np.array(q0, dtype=float))
     wants_velocity = getattr(controller, "wants_base_velocity", False)
     float_state = getattr(controller, "float_state", False)
     command_of = controller.command
