@@ -28,6 +28,10 @@ traits:
 * :func:`register_arbiter` (no traits; built as ``cls(stability=..., manipulability=...)``,
   plus ``seed=`` when its constructor takes one).
 
+A trait's value is checked when the class is registered (a tuple trait: a non-empty tuple,
+or list, of the words above; ``arbiter``: a bool); anything else is a one-line
+:class:`~ddwmmr.errors.ParameterError` naming the trait.
+
 Every decorator sets the class attribute ``name``. A name is what the command line types
 (``--method NAME``, ``--option NAME:KEY=VALUE``, comma-separated lists, the run folder
 ``runs/NAME-...``), so it must match :data:`NAME_PATTERN`: 1 to :data:`MAX_NAME_LENGTH`
@@ -131,6 +135,7 @@ class Registry:
             :func:`~ddwmmr.errors.shown` echoes it) and
             ``known`` (the registered names, comma separated).
         sets: traits the decorator also sets as class attributes.
+        allowed: the words each tuple trait may hold.
     """
 
     def __init__(
@@ -140,6 +145,7 @@ class Registry:
         defaults: Mapping[str, Any],
         unknown: str,
         sets: tuple[str, ...] = (),
+        allowed: Mapping[str, tuple[str, ...]] | None = None,
     ) -> None:
         self.kind = kind
         self.label = label
@@ -147,6 +153,7 @@ class Registry:
         self.defaults = dict(defaults)
         self.unknown = unknown
         self.sets = sets
+        self.allowed = dict(allowed or {})
         self._entries: dict[str, Entry] = {}
 
     # -- registration -----------------------------------------------------------------
@@ -196,7 +203,31 @@ class Registry:
             )
         resolved = {key: given.get(key, default) for key, default in self.defaults.items()}
         # Lists become tuples: traits are compared and filtered as tuples.
-        return {k: tuple(v) if isinstance(v, list) else v for k, v in resolved.items()}
+        resolved = {k: tuple(v) if isinstance(v, list) else v for k, v in resolved.items()}
+        for key, value in resolved.items():
+            self._check_trait(name, key, value)
+        return resolved
+
+    def _check_trait(self, name: str, key: str, value: Any) -> None:
+        """Refuse (one-line :class:`ParameterError`) a trait value of the wrong kind: a
+        tuple trait must be a non-empty tuple of its allowed words, a bool trait a bool
+        (a misspelt ``tasks=("track",)`` would list the plug-in in no tool)."""
+        default = self.defaults[key]
+        where = f"{self.decorator}({name!r}): {key}"
+        if isinstance(default, bool):
+            if not isinstance(value, bool):
+                raise ParameterError(f"{where} must be True or False (got {shown(value)})")
+            return
+        allowed = self.allowed[key]
+        if not (
+            isinstance(value, tuple)
+            and value
+            and all(isinstance(word, str) and word in allowed for word in value)
+        ):
+            raise ParameterError(
+                f"{where} must be a tuple of one or more of {', '.join(map(repr, allowed))} "
+                f"(got {shown(value)})"
+            )
 
     def _add(self, cls: type, name: str, traits: dict[str, Any], description: str | None) -> None:
         entry = self._entries.get(name)
@@ -279,6 +310,7 @@ CONTROLLERS = Registry(
     {"tasks": ("tracking",), "interfaces": ("velocity",), "arbiter": False},
     "method: unknown method {name} (known: {known})",
     sets=("interfaces",),
+    allowed={"tasks": ("tracking", "waypoints"), "interfaces": ("velocity", "force")},
 )
 PLANTS = Registry(
     "plant",
@@ -286,6 +318,7 @@ PLANTS = Registry(
     {"interfaces": ("velocity",)},
     "plant must be one of {known} (got {name})",
     sets=("interfaces",),
+    allowed={"interfaces": ("velocity", "force")},
 )
 ARBITERS = Registry(
     "arbiter",

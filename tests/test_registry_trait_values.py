@@ -1,0 +1,67 @@
+"""A decorator's trait values are checked when the plug-in is registered: a misspelt
+task or interface would otherwise list the plug-in in no tool, without a word."""
+
+import pytest
+
+from ddwmmr.errors import ParameterError
+from ddwmmr.registry import CONTROLLERS, register_controller, register_plant
+
+
+@pytest.mark.parametrize(
+    ("decorator", "traits", "message"),
+    [
+        (
+            register_controller,
+            {"tasks": ("track",)},
+            "register_controller('mine'): tasks must be a tuple of one or more of "
+            "'tracking', 'waypoints' (got ('track',))",
+        ),
+        (
+            register_controller,
+            {"tasks": "tracking"},  # a str, not a tuple of words
+            "register_controller('mine'): tasks must be a tuple of one or more of "
+            "'tracking', 'waypoints' (got 'tracking')",
+        ),
+        (
+            register_controller,
+            {"tasks": ()},
+            "register_controller('mine'): tasks must be a tuple of one or more of "
+            "'tracking', 'waypoints' (got ())",
+        ),
+        (
+            register_controller,
+            {"interfaces": ("speed",)},
+            "register_controller('mine'): interfaces must be a tuple of one or more of "
+            "'velocity', 'force' (got ('speed',))",
+        ),
+        (
+            register_controller,
+            {"arbiter": "yes"},
+            "register_controller('mine'): arbiter must be True or False (got 'yes')",
+        ),
+        (
+            register_plant,
+            {"interfaces": ["velocity", "torque"]},
+            "register_plant('mine'): interfaces must be a tuple of one or more of "
+            "'velocity', 'force' (got ('velocity', 'torque'))",
+        ),
+    ],
+)
+def test_a_trait_value_of_the_wrong_kind_is_refused_naming_it(decorator, traits, message):
+    with pytest.raises(ParameterError) as error:
+        decorator("mine", **traits)
+    assert str(error.value) == message
+    assert "mine" not in CONTROLLERS.names()
+
+
+def test_valid_traits_are_taken_lists_as_tuples(registered):
+    class Both:
+        """Both tasks, both interfaces."""
+
+    registered(CONTROLLERS, "mine", Both, tasks=["tracking", "waypoints"], interfaces=("force",))
+    assert CONTROLLERS.traits("mine") == {
+        "tasks": ("tracking", "waypoints"),
+        "interfaces": ("force",),
+        "arbiter": False,
+    }
+    assert Both.interfaces == ("force",)
