@@ -1,5 +1,6 @@
-"""A plug-in controller's constructor, reset() and adopt_*() hooks: what they raise is one
-line naming the plug-in and the call, as for command() (tests/test_api_inputs.py)."""
+"""A plug-in controller's constructor, reset() and adopt_*() hooks, a plug-in plant's
+constructor and reset(): what they raise is one line naming the plug-in and the call, as
+for command() and step() (tests/test_api_inputs.py, tests/test_checked_plant.py)."""
 
 import numpy as np
 import pytest
@@ -7,7 +8,8 @@ import pytest
 from ddwmmr import Ellipse, Robot, make_controller, simulate
 from ddwmmr.controllers import StepInfo
 from ddwmmr.errors import ParameterError, PluginError
-from ddwmmr.registry import CONTROLLERS
+from ddwmmr.plants import KinematicPlant, make_plant
+from ddwmmr.registry import CONTROLLERS, PLANTS
 
 
 class _Plain:
@@ -111,3 +113,37 @@ def test_track_prints_a_raising_reset_in_one_line(tmp_path, capsys, registered):
         "error: method: my-hook.reset() raised KeyError: \"'boom'\" before the first step"
     ]
     assert not out.exists()
+
+
+class _PlantInitRaises(KinematicPlant):
+    """A plug-in plant whose constructor raises."""
+
+    def __init__(self, robot):
+        raise KeyError("boom")
+
+
+class _PlantResetRaises(KinematicPlant):
+    """A plug-in plant whose reset raises."""
+
+    def reset(self, q0, dt):
+        raise KeyError("boom")
+
+
+def test_a_plug_in_plant_raising_in_its_constructor_is_one_line(registered):
+    registered(PLANTS, "my-plant", _PlantInitRaises)
+    with pytest.raises(PluginError) as error:
+        make_plant("my-plant", Robot())
+    assert str(error.value) == (
+        "plant: my-plant: _PlantInitRaises(robot, **options) raised KeyError: \"'boom'\""
+    )
+    assert isinstance(error.value.__cause__, KeyError)
+
+
+def test_a_plug_in_plant_raising_in_reset_is_one_line(registered):
+    registered(PLANTS, "my-plant", _PlantResetRaises)
+    with pytest.raises(PluginError) as error:
+        simulate(Robot(), Ellipse(), "ats", plant="my-plant", duration=0.1)
+    assert str(error.value) == (
+        "plant: my-plant.reset() raised KeyError: \"'boom'\" before the first step"
+    )
+    assert isinstance(error.value.__cause__, KeyError)

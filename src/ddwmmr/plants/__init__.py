@@ -12,7 +12,7 @@ from __future__ import annotations
 import inspect
 from typing import Any
 
-from ddwmmr.errors import ParameterError, check_instance, shown
+from ddwmmr.errors import ParameterError, check_instance, raise_plugin_error, shown
 from ddwmmr.model import Robot
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError, PlantNotResetError
 from ddwmmr.plants.kinematic import INTEGRATORS, KinematicPlant
@@ -38,7 +38,10 @@ def plant_class(name: str) -> type:
 
 def make_plant(name: str, robot: Robot, **options: Any) -> Plant:
     """Build the plant ``name`` for ``robot`` with its keyword ``options``; an unknown
-    option is a :class:`ParameterError` naming the accepted ones."""
+    option is a :class:`ParameterError` naming the accepted ones. Anything but a
+    ParameterError the constructor of a plug-in (a class from outside the library) raises
+    is a one-line :class:`~ddwmmr.errors.PluginError` naming the plant, its class and what
+    it raised (the ``__cause__``)."""
     cls = plant_class(name)
     check_instance("robot", robot, Robot)
     parameters = inspect.signature(cls).parameters
@@ -48,7 +51,14 @@ def make_plant(name: str, robot: Robot, **options: Any) -> Plant:
         raise ParameterError(
             f"plant {name}: unknown option {shown(unknown[0])} (accepted: {', '.join(accepted)})"
         )
-    plant: Plant = cls(robot, **options)
+    try:
+        plant: Plant = cls(robot, **options)
+    except Exception as error:
+        if cls.__module__.split(".")[0] == "ddwmmr":
+            raise  # a bug of ours keeps its traceback
+        raise_plugin_error(
+            f"plant: {name}: {cls.__qualname__}(robot, **options)", error, quoted=True
+        )
     return plant
 
 

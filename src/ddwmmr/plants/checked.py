@@ -87,8 +87,13 @@ class CheckedPlant:
         return getattr(self.plant, attribute)
 
     def reset(self, q0: Any, dt: float) -> None:
-        """The plant's ``reset(q0, dt)``; the count starts again at sample 0."""
-        self.plant.reset(q0, dt)
+        """The plant's ``reset(q0, dt)``; the count starts again at sample 0. What it raises
+        is a one-line PluginError naming the plant (a ParameterError passes as it is)."""
+        try:
+            self.plant.reset(q0, dt)
+        except Exception as error:
+            call = f"plant: {name_of(self.plant)}.reset()"
+            raise_as(plugin_raised(call, error, " before the first step", quoted=True), error)
         self._k, self._dt, self._observed_at, self._stage_failed = 0, dt, 0.0, False
 
     def observe(self) -> Observation:
