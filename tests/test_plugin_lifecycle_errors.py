@@ -147,3 +147,24 @@ def test_a_plug_in_plant_raising_in_reset_is_one_line(registered):
         "plant: my-plant.reset() raised KeyError: \"'boom'\" before the first step"
     )
     assert isinstance(error.value.__cause__, KeyError)
+
+
+class _ArbiterInitRaises:
+    """A plug-in arbiter whose constructor raises."""
+
+    def __init__(self, stability=None, manipulability=None):
+        raise KeyError("boom")
+
+
+def test_a_plug_in_arbiter_raising_in_its_constructor_is_one_line(registered):
+    from ddwmmr.arbiters import make_arbiter
+    from ddwmmr.registry import ARBITERS
+    from ddwmmr.scenarios import RunConfig
+
+    registered(ARBITERS, "my-arbiter", _ArbiterInitRaises)
+    with pytest.raises(PluginError) as error:
+        make_arbiter(RunConfig(arbiter="my-arbiter"))
+    assert str(error.value) == (
+        "arbiter my-arbiter: _ArbiterInitRaises(**thresholds) raised KeyError: 'boom'"
+    )
+    assert isinstance(error.value.__cause__, KeyError)

@@ -15,7 +15,7 @@ import inspect
 from typing import Any
 
 from ddwmmr.arbiters.state_machine import Hysteresis
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, raise_plugin_error, shown
 from ddwmmr.registry import ARBITERS, CONTROLLERS
 
 #: The arbiter a run uses when it names none.
@@ -54,7 +54,10 @@ def check_arbiter(arbiter: Any, controller: str = "thesis") -> None:
 def make_arbiter(config: Any) -> Any:
     """The arbiter a run configuration asks for (``config.arbiter``, thresholds, seed);
     ``config`` is a :class:`~ddwmmr.scenarios.protocol.RunConfig` (one without
-    ``arbiter``, such as a name, is a one-line :class:`ParameterError` naming it)."""
+    ``arbiter``, such as a name, is a one-line :class:`ParameterError` naming it). Anything
+    but a ParameterError a plug-in's constructor raises is a one-line
+    :class:`~ddwmmr.errors.PluginError` naming the arbiter (the ``__cause__`` what it
+    raised)."""
     if not hasattr(config, "arbiter"):
         raise ParameterError(
             f"config must be a RunConfig (ddwmmr.scenarios.protocol) (got {shown(config)})"
@@ -77,4 +80,9 @@ def make_arbiter(config: Any) -> Any:
         )
     if "seed" in parameters:
         options["seed"] = config.arbiter_seed
-    return cls(**options)
+    try:
+        return cls(**options)
+    except Exception as error:
+        if cls.__module__.split(".")[0] == "ddwmmr":
+            raise  # a bug of ours keeps its traceback
+        raise_plugin_error(f"arbiter {arbiter}: {cls.__qualname__}(**thresholds)", error)
