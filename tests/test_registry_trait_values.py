@@ -1,5 +1,6 @@
-"""A decorator's trait values are checked when the plug-in is registered: a misspelt
-task or interface would otherwise list the plug-in in no tool, without a word."""
+"""A decorator's trait values, and that it decorates a class, are checked when the plug-in
+is registered: a misspelt task or interface would otherwise list the plug-in in no tool,
+without a word, and a function fail later with an AttributeError."""
 
 import pytest
 
@@ -65,3 +66,10 @@ def test_valid_traits_are_taken_lists_as_tuples(registered):
         "arbiter": False,
     }
     assert Both.interfaces == ("force",)
+
+
+@pytest.mark.parametrize("thing", [lambda robot: None, object()])
+def test_only_a_class_is_registered(thing):
+    with pytest.raises(ParameterError, match=r"^register_controller\('mine'\) registers a class "):
+        register_controller("mine")(thing)
+    assert "mine" not in CONTROLLERS.names()

@@ -167,6 +167,10 @@ class Registry:
         resolved = self._traits(name, traits)
 
         def decorate(cls: PluginClass) -> PluginClass:
+            if not isinstance(cls, type):  # a function or an instance has no class to build
+                raise ParameterError(
+                    f"{self.decorator}({name!r}) registers a class (got {shown(cls)})"
+                )
             cls.name = name  # type: ignore[attr-defined]
             for trait in self.sets:
                 setattr(cls, trait, resolved[trait])
