@@ -26,4 +26,9 @@ def overrides(obj: object, owner: type, name: str) -> bool:
 
 def from_library(obj: object) -> bool:
     """Whether ``obj``'s class is one of the library's (defined in a ``ddwmmr`` module)."""
-    return type(obj).__module__.split(".")[0] == "ddwmmr"
+    return class_from_library(type(obj))
+
+
+def class_from_library(cls: type) -> bool:
+    """Whether the class ``cls`` is one of the library's (defined in a ``ddwmmr`` module)."""
+    return cls.__module__.split(".")[0] == "ddwmmr"

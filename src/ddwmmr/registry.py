@@ -66,7 +66,8 @@ from itertools import count
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
-from ddwmmr.errors import ParameterError, one_line, shown
+from ddwmmr.errors import ParameterError, one_line, raise_plugin_error, shown
+from ddwmmr.inheritance import class_from_library
 
 #: The built-in plug-in modules, in listing order.
 BUILTIN_MODULES = (
@@ -469,3 +470,24 @@ __all__ = [
     "register_controller",
     "register_plant",
 ]
+
+
+def build(
+    cls: Any,
+    call: str,
+    args: tuple[Any, ...] = (),
+    options: Mapping[str, Any] | None = None,
+    quoted: bool = True,
+) -> Any:
+    """``cls(*args, **options)``, a registered class built for a run (the user's options
+    in a mapping of their own: any name is theirs). What the constructor
+    of a plug-in (a class from outside the library) raises, but a ParameterError, is a
+    one-line :class:`~ddwmmr.errors.PluginError` "<call> raised <type>: <message>" (the
+    ``__cause__`` what it raised; ``quoted``: the message as its repr); a library class's
+    error keeps its traceback (a bug of ours)."""
+    try:
+        return cls(*args, **(options or {}))
+    except Exception as error:
+        if class_from_library(cls):
+            raise
+        raise_plugin_error(call, error, quoted=quoted)

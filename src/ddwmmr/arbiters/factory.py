@@ -15,8 +15,8 @@ import inspect
 from typing import Any
 
 from ddwmmr.arbiters.state_machine import Hysteresis
-from ddwmmr.errors import ParameterError, raise_plugin_error, shown
-from ddwmmr.registry import ARBITERS, CONTROLLERS
+from ddwmmr.errors import ParameterError, shown
+from ddwmmr.registry import ARBITERS, CONTROLLERS, build
 
 #: The arbiter a run uses when it names none.
 DEFAULT_ARBITER = "state-machine"
@@ -80,9 +80,6 @@ def make_arbiter(config: Any) -> Any:
         )
     if "seed" in parameters:
         options["seed"] = config.arbiter_seed
-    try:
-        return cls(**options)
-    except Exception as error:
-        if cls.__module__.split(".")[0] == "ddwmmr":
-            raise  # a bug of ours keeps its traceback
-        raise_plugin_error(f"arbiter {arbiter}: {cls.__qualname__}(**thresholds)", error)
+    return build(
+        cls, f"arbiter {arbiter}: {cls.__qualname__}(**thresholds)", options=options, quoted=False
+    )

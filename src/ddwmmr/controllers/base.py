@@ -24,9 +24,9 @@ import numpy as np
 import numpy.typing as npt
 
 from ddwmmr.commands import PlantTraits, WheelForces
-from ddwmmr.errors import ParameterError, check_instance, raise_plugin_error, shown
+from ddwmmr.errors import ParameterError, check_instance, shown
 from ddwmmr.model import Robot
-from ddwmmr.registry import CONTROLLERS, PluginClass
+from ddwmmr.registry import CONTROLLERS, PluginClass, build
 from ddwmmr.trajectories.base import resolution_step
 
 
@@ -243,13 +243,8 @@ def make_controller(
     check_known_options(name, options, method_options(name))
     texts = [(option, value) for option, value in options.items() if isinstance(value, NumberText)]
     if not texts:
-        try:
-            controller: Controller = cls(robot, **options)
-        except Exception as error:
-            if cls.__module__.split(".")[0] == "ddwmmr":
-                raise  # a bug of ours keeps its traceback
-            call = f"method: {name}: {cls.__qualname__}(robot, **options)"
-            raise_plugin_error(call, error, quoted=True)
+        call = f"method: {name}: {cls.__qualname__}(robot, **options)"
+        controller: Controller = build(cls, call, (robot,), options)
         return controller
     try:  # the method's own check refuses the text, naming the allowed range
         cls(robot, **options)

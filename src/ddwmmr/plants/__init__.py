@@ -12,12 +12,12 @@ from __future__ import annotations
 import inspect
 from typing import Any
 
-from ddwmmr.errors import ParameterError, check_instance, raise_plugin_error, shown
+from ddwmmr.errors import ParameterError, check_instance, shown
 from ddwmmr.model import Robot
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError, PlantNotResetError
 from ddwmmr.plants.kinematic import INTEGRATORS, KinematicPlant
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState, VelocityServo
-from ddwmmr.registry import PLANTS, register_plant
+from ddwmmr.registry import PLANTS, build, register_plant
 
 
 def available_plants(interface: str | None = None) -> list[str]:
@@ -51,14 +51,9 @@ def make_plant(name: str, robot: Robot, **options: Any) -> Plant:
         raise ParameterError(
             f"plant {name}: unknown option {shown(unknown[0])} (accepted: {', '.join(accepted)})"
         )
-    try:
-        plant: Plant = cls(robot, **options)
-    except Exception as error:
-        if cls.__module__.split(".")[0] == "ddwmmr":
-            raise  # a bug of ours keeps its traceback
-        raise_plugin_error(
-            f"plant: {name}: {cls.__qualname__}(robot, **options)", error, quoted=True
-        )
+    plant: Plant = build(
+        cls, f"plant: {name}: {cls.__qualname__}(robot, **options)", (robot,), options
+    )
     return plant
 
 
