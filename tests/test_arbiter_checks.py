@@ -85,7 +85,7 @@ def test_an_unknown_behaviour_from_an_arbiter_given_to_the_controller_is_one_lin
     with pytest.raises(PluginError) as error:
         _act(arbiter)
     assert str(error.value) == (
-        f"arbiter picker: select() returned behaviour 'nope' at t = 0 s; {GIVEN}"
+        f"arbiter: picker.select() returned behaviour 'nope' at t = 0 s; {GIVEN}"
     )
 
 
@@ -94,7 +94,7 @@ def test_a_nan_share_from_an_arbiter_given_to_the_controller_is_refused():
     with pytest.raises(PluginError) as error:
         _act(Weighing({"objective": math.nan}))
     assert str(error.value) == (
-        f"arbiter weigher: weigh() returned shares['objective'] = nan at t = 0 s; {SHARES}"
+        f"arbiter: weigher.weigh() returned shares['objective'] = nan at t = 0 s; {SHARES}"
     )
 
 
@@ -137,7 +137,7 @@ def test_something_without_select_is_refused_by_name():
     with pytest.raises(PluginError) as error:
         ThesisController(ROBOT, Nothing())
     assert str(error.value) == (
-        "arbiter Nothing: has no select(percept, behaviours) method "
+        "arbiter: Nothing has no select(percept, behaviours) method "
         "(ddwmmr.arbiters.Arbiter: state, reset(), select())"
     )
 
@@ -159,43 +159,43 @@ def _blend_error(**fields) -> str:
 
 def test_a_blend_naming_an_unknown_dominant_behaviour_is_refused():
     assert _blend_error(behaviour="dancing") == (
-        f"arbiter mine: weigh() returned behaviour 'dancing' at t = 0.25 s; {GIVEN}"
+        f"arbiter: mine.weigh() returned behaviour 'dancing' at t = 0.25 s; {GIVEN}"
     )
 
 
 def test_blend_proposals_of_the_wrong_shape_or_with_nan_are_named():
     drive = Proposal(DRIVE, (0.1, 0.2), 1.0, 2.0)
     assert _blend_error(proposals=[drive]) == (
-        "arbiter mine: weigh() returned proposals [Proposal(mode='drive', arm=(0.1, 0.2... at "
+        "arbiter: mine.weigh() returned proposals [Proposal(mode='drive', arm=(0.1, 0.2... at "
         "t = 0.25 s; they must be a mapping behaviour -> Proposal"
     )
     assert _blend_error(proposals={"jump": drive}) == (
-        f"arbiter mine: weigh() returned proposals key 'jump' at t = 0.25 s; {GIVEN}"
+        f"arbiter: mine.weigh() returned proposals key 'jump' at t = 0.25 s; {GIVEN}"
     )
     assert _blend_error(proposals={"objective": (1.0, 2.0)}) == (
-        "arbiter mine: weigh() returned proposals['objective'] (1.0, 2.0) at t = 0.25 s; "
+        "arbiter: mine.weigh() returned proposals['objective'] (1.0, 2.0) at t = 0.25 s; "
         "it must be a behaviour's Proposal"
     )
     assert _blend_error(proposals={"stability": dataclasses.replace(drive, by=math.nan)}) == (
-        "arbiter mine: weigh() returned proposals['stability'].by = nan at t = 0.25 s; "
+        "arbiter: mine.weigh() returned proposals['stability'].by = nan at t = 0.25 s; "
         "it must be a finite number (m, or rad for heading)"
     )
     assert _blend_error(proposals={"objective": dataclasses.replace(drive, arm=(0.1,))}) == (
-        "arbiter mine: weigh() returned proposals['objective'].arm = (0.1,) at t = 0.25 s; "
+        "arbiter: mine.weigh() returned proposals['objective'].arm = (0.1,) at t = 0.25 s; "
         "it must be two finite joint targets (th1, th2) in rad"
     )
     assert _blend_error(proposals={"objective": dataclasses.replace(drive, mode="fly")}) == (
-        "arbiter mine: weigh() returned proposals['objective'].mode 'fly' at t = 0.25 s; "
+        "arbiter: mine.weigh() returned proposals['objective'].mode 'fly' at t = 0.25 s; "
         "allowed: drive, turn, brake"
     )
 
 
 def test_shares_out_of_range_or_adding_up_beyond_one_are_named():
     assert _blend_error(shares={"stability": -0.25}) == (
-        f"arbiter mine: weigh() returned shares['stability'] = -0.25 at t = 0.25 s; {SHARES}"
+        f"arbiter: mine.weigh() returned shares['stability'] = -0.25 at t = 0.25 s; {SHARES}"
     )
     assert _blend_error(shares={"objective": 0.75, "stability": 0.5}) == (
-        f"arbiter mine: weigh() returned shares adding up to 1.25 at t = 0.25 s; {SHARES}"
+        f"arbiter: mine.weigh() returned shares adding up to 1.25 at t = 0.25 s; {SHARES}"
     )
     # a valid blend passes, rounding of shares normalised to 1 included
     thirds = {name: 1.0 / 3.0 for name in ("objective", "manipulability", "stability")}
@@ -211,14 +211,14 @@ def test_shares_out_of_range_or_adding_up_beyond_one_are_named():
     # an excess that :g would print as 1 is spelt out
     over = {"objective": 0.5, "stability": 0.5 + 2e-6}
     assert _blend_error(shares=over) == (
-        "arbiter mine: weigh() returned shares adding up to 1.0000019999999998 at "
+        "arbiter: mine.weigh() returned shares adding up to 1.0000019999999998 at "
         f"t = 0.25 s; {SHARES}"
     )
 
 
 def test_an_integer_beyond_a_float_is_no_finite_share():
     assert _blend_error(shares={"objective": 10**400}) == (
-        "arbiter mine: weigh() returned shares['objective'] = "
+        "arbiter: mine.weigh() returned shares['objective'] = "
         f"an integer of about 1e400 at t = 0.25 s; {SHARES}"
     )
 
@@ -233,7 +233,7 @@ def test_a_selected_proposal_with_nan_is_named():
     with pytest.raises(PluginError) as error:
         checked.select(BASE_PERCEPT, behaviours())
     assert str(error.value) == (
-        "arbiter picker: select() returned proposal.arm = (nan, 0.0) at t = 0 s; "
+        "arbiter: picker.select() returned proposal.arm = (nan, 0.0) at t = 0 s; "
         "it must be two finite joint targets (th1, th2) in rad"
     )
 
@@ -250,7 +250,7 @@ def test_a_share_for_a_behaviour_with_nothing_to_propose_is_one_line():
     with pytest.raises(PluginError) as error:
         controller.act(0.5, Q, 0.0, 0.0)
     assert str(error.value) == (
-        "arbiter weigher: weigh() returned shares['obstacle'] = 0.25 at t = 0.5 s; obstacle "
+        "arbiter: weigher.weigh() returned shares['obstacle'] = 0.25 at t = 0.5 s; obstacle "
         "proposes nothing now (propose() returned None) and proposals has no entry for it: "
         "share only behaviours that propose, or return their proposals"
     )
@@ -290,12 +290,12 @@ def test_a_state_outside_states_is_refused_when_the_controller_is_built_or_reset
     tally then counts a state it has no column for)."""
     with pytest.raises(PluginError) as error:
         ThesisController(ROBOT, Stating("dancing"))
-    assert str(error.value) == f"arbiter picker: state is 'dancing'; {STATE_ALLOWED}"
+    assert str(error.value) == f"arbiter: picker.state is 'dancing'; {STATE_ALLOWED}"
     controller = ThesisController(ROBOT, Stating(MOVE_BASE, after_reset=None))
     assert controller.state == MOVE_BASE
     with pytest.raises(PluginError) as error:
         controller.reset((3.0, 0.0))
-    assert str(error.value) == f"arbiter picker: state is None; {STATE_ALLOWED}"
+    assert str(error.value) == f"arbiter: picker.state is None; {STATE_ALLOWED}"
 
 
 def test_checked_arbiter_is_exported_and_names_who_handed_over_a_non_arbiter():

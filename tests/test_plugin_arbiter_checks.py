@@ -63,7 +63,7 @@ def test_an_unknown_state_ends_the_scenario_in_one_line_naming_the_arbiter():
     """Without the check the protocol's tally raised KeyError: 'dance' and ended the batch."""
     reason = _reason(Delegating(lambda s, b, p: Selection("dance", s.behaviour, s.proposal)))
     assert reason == (
-        "controller error: PluginError: arbiter Delegating: select() returned state 'dance' "
+        "controller error: PluginError: arbiter: Delegating.select() returned state 'dance' "
         f"at t = 0 s; {ALLOWED} (ddwmmr.arbiters.STATES)"
     )
 
@@ -71,12 +71,12 @@ def test_an_unknown_state_ends_the_scenario_in_one_line_naming_the_arbiter():
 def test_no_selection_or_an_unknown_behaviour_is_named():
     none = _reason(Delegating(lambda s, b, p: None))
     assert none == (
-        "controller error: PluginError: arbiter Delegating: select() returned None at t = 0 s; "
+        "controller error: PluginError: arbiter: Delegating.select() returned None at t = 0 s; "
         "it must return a Selection(state, behaviour, proposal) (ddwmmr.arbiters.Selection)"
     )
     late = Delegating(lambda s, b, p: s if p.t < 0.25 else Selection(s.state, "nope", s.proposal))
     assert _reason(late) == (
-        "controller error: PluginError: arbiter Delegating: select() returned behaviour 'nope' "
+        "controller error: PluginError: arbiter: Delegating.select() returned behaviour 'nope' "
         "at t = 0.25 s; allowed: objective, manipulability, stability (the behaviours it was given)"
     )
     assert late.calls == 26  # steps 0 .. 25 of 0.01 s: the run stopped at the bad one
@@ -87,7 +87,7 @@ def test_what_an_arbiter_raises_is_named():
         raise KeyError("nope")
 
     assert _reason(Delegating(boom)) == (
-        "controller error: PluginError: arbiter Delegating: select() raised KeyError: 'nope' "
+        "controller error: PluginError: arbiter: Delegating.select() raised KeyError: 'nope' "
         "at t = 0 s"
     )
 
@@ -103,7 +103,7 @@ def test_an_arbiter_without_a_state_is_refused_in_one_line():
     with pytest.raises(PluginError) as error:
         _reason(Stateless())
     assert str(error.value) == (
-        "arbiter Stateless: has no attribute state (the state it is in, one of "
+        "arbiter: Stateless has no attribute state (the state it is in, one of "
         "ddwmmr.arbiters.STATES; ddwmmr.arbiters.Arbiter)"
     )
 
@@ -139,7 +139,7 @@ def test_a_blending_plug_in_is_checked_and_keeps_its_weigh():
 
     Blender.weigh = weigh
     assert _reason(Blender()) == (
-        "controller error: PluginError: arbiter blender94: weigh() returned state 'dancing' at "
+        "controller error: PluginError: arbiter: blender94.weigh() returned state 'dancing' at "
         f"t = 0 s; {ALLOWED} (ddwmmr.arbiters.STATES)"
     )
 

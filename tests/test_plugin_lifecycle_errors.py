@@ -165,6 +165,6 @@ def test_a_plug_in_arbiter_raising_in_its_constructor_is_one_line(registered):
     with pytest.raises(PluginError) as error:
         make_arbiter(RunConfig(arbiter="my-arbiter"))
     assert str(error.value) == (
-        "arbiter my-arbiter: _ArbiterInitRaises(**thresholds) raised KeyError: 'boom'"
+        "arbiter: my-arbiter: _ArbiterInitRaises(**thresholds) raised KeyError: 'boom'"
     )
     assert isinstance(error.value.__cause__, KeyError)

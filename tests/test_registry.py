@@ -266,7 +266,7 @@ def test_an_arbiter_plug_in_without_the_thresholds_is_refused_in_one_line(regist
     with pytest.raises(ParameterError) as error:
         make_arbiter(SimpleNamespace(**vars(config), arbiter="no-thresholds"))
     assert str(error.value) == (
-        "arbiter no-thresholds: its constructor must take the keyword arguments stability "
+        "arbiter: no-thresholds: its constructor must take the keyword arguments stability "
         "and manipulability (ddwmmr.arbiters.Hysteresis thresholds; lacks stability)"
     )
     made = make_arbiter(SimpleNamespace(**vars(config), arbiter="anything"))

@@ -465,7 +465,7 @@ def one_line(text: str, width: int) -> str:
 
 
 def plugin_raised(call: str, error: Exception, where: str = "", quoted: bool = False) -> Exception:
-    """What a run raises when a plug-in's ``call`` (``"arbiter mine: select()"``) raised
+    """What a run raises when a plug-in's ``call`` (``"arbiter: mine.select()"``) raised
     ``error``: a :class:`ParameterError` or :class:`PluginError` as it is (one line
     already), anything else a one-line :class:`PluginError` "<call> raised <type>:
     <message><where>", the message on one line and cut to 120 characters (``quoted``: as

@@ -62,7 +62,7 @@ def checked_arbiter(arbiter: Any, origin: str | None = None) -> Any:
         if origin is not None:
             raise PluginError(f"{origin} gave arbiter {shown(arbiter)}, which has no {method}")
         raise PluginError(
-            f"arbiter {name}: has no {method} (ddwmmr.arbiters.Arbiter: state, reset(), select())"
+            f"arbiter: {name} has no {method} (ddwmmr.arbiters.Arbiter: state, reset(), select())"
         )
     return CheckedArbiter(arbiter, name)
 
@@ -94,13 +94,13 @@ class CheckedArbiter:
             state = self.arbiter.state
         except AttributeError:
             raise PluginError(
-                f"arbiter {self.name}: has no attribute state (the state it is in, one of "
+                f"arbiter: {self.name} has no attribute state (the state it is in, one of "
                 "ddwmmr.arbiters.STATES; ddwmmr.arbiters.Arbiter)"
             ) from None
         if not (isinstance(state, str) and state in STATES):
             # the scenario protocol counts this state from the first step on
             raise PluginError(
-                f"arbiter {self.name}: state is {shown(state)}; allowed: {', '.join(STATES)} "
+                f"arbiter: {self.name}.state is {shown(state)}; allowed: {', '.join(STATES)} "
                 "(ddwmmr.arbiters.STATES)"
             )
         return state
@@ -134,7 +134,7 @@ class CheckedArbiter:
         """Re-raise what the arbiter's ``method`` raised: a ParameterError or PluginError as
         it is (one line already), anything else as a PluginError naming the arbiter."""
         when = "" if t is None else f" at t = {t:g} s"
-        raise_plugin_error(f"arbiter {self.name}: {method}()", error, when)
+        raise_plugin_error(f"arbiter: {self.name}.{method}()", error, when)
 
 
 def check_selection(
@@ -254,4 +254,4 @@ def _check_behaviour(
 
 def _refuse(name: str, method: str, got: str, t: float, wanted: str) -> NoReturn:
     """One line: the arbiter, what its ``method`` returned at time ``t`` (s), what is wanted."""
-    raise PluginError(f"arbiter {name}: {method}() {got} at t = {t:g} s; {wanted}")
+    raise PluginError(f"arbiter: {name}.{method}() {got} at t = {t:g} s; {wanted}")

@@ -75,11 +75,11 @@ def make_arbiter(config: Any) -> Any:
     missing = [name for name in options if name not in parameters and not any_keyword]
     if missing:  # a plug-in's constructor: say what the interface passes, not a TypeError
         raise ParameterError(
-            f"arbiter {arbiter}: its constructor must take the keyword arguments stability "
+            f"arbiter: {arbiter}: its constructor must take the keyword arguments stability "
             f"and manipulability (ddwmmr.arbiters.Hysteresis thresholds; lacks {missing[0]})"
         )
     if "seed" in parameters:
         options["seed"] = config.arbiter_seed
     return build(
-        cls, f"arbiter {arbiter}: {cls.__qualname__}(**thresholds)", options=options, quoted=False
+        cls, f"arbiter: {arbiter}: {cls.__qualname__}(**thresholds)", options=options, quoted=False
     )
