@@ -109,7 +109,7 @@ class Entry:
 
     Attributes:
         name: what the tools and the factories call it.
-        description: first line of its class docstring ("" without one).
+        description: first line of its class docstring ("(no description)" without one).
         traits: the decorator's keyword arguments over the kind's defaults.
         module, qualname: where its class is defined.
         cls: the class, None until its module is imported.
@@ -240,7 +240,10 @@ class Registry:
             cls.__module__,
             cls.__qualname__,
         ):
-            entry.cls = cls  # a built-in read from source, now imported (or reloaded)
+            # the same class again (a built-in read from source, now imported; a reload,
+            # in a notebook): it replaces the entry's class, traits and description
+            entry.cls, entry.traits = cls, traits
+            entry.description = description if description is not None else _first_line(cls.__doc__)
             return
         if entry is not None:
             raise self.twice(name, entry, f"{cls.__module__}.{cls.__qualname__}")
@@ -303,9 +306,14 @@ def _has(traits: Mapping[str, Any], key: str, value: Any) -> bool:
     return value in have if isinstance(have, tuple) else have == value
 
 
+#: The description of a plug-in registered without a docstring (or a blank one).
+NO_DESCRIPTION = "(no description)"
+
+
 def _first_line(doc: str | None) -> str:
+    """The first line of docstring ``doc``, else :data:`NO_DESCRIPTION`."""
     lines = inspect.cleandoc(doc or "").splitlines()
-    return lines[0] if lines else ""
+    return lines[0] if lines and lines[0] else NO_DESCRIPTION
 
 
 #: The three registries (see the module docstring for their traits).

@@ -9,9 +9,10 @@ A plug-in plant is held to the same contract by :class:`CheckedPlant`, which the
 * an ``observe()`` that is not an :class:`~ddwmmr.plants.base.Observation` of finite
   numbers, or a ``limit()`` that is not ``(u, saturated)`` with ``u`` 4 finite numbers, is
   a one-line ParameterError naming the plant, the step and the time;
-* anything else its ``observe()``, ``limit()`` or ``step()`` raise becomes a one-line
-  :class:`~ddwmmr.errors.PluginError` "plant: <name>.<method>() raised <type>:
-  '<message>' at step <k>, t = <t> s" (:func:`~ddwmmr.errors.plugin_raised`, the message
+* anything else its ``reset()``, ``observe()``, ``limit()`` or ``step()`` raise becomes a
+  one-line :class:`~ddwmmr.errors.PluginError` "plant: <name>.<method>() raised <type>:
+  '<message>' at step <k>, t = <t> s" ("before the first step" for ``reset()``;
+  :func:`~ddwmmr.errors.plugin_raised`, the message
   quoted), the exception it raised its ``__cause__``; but a ParameterError or a
   PluginError passes as it is (already one line), a PlantDivergedError from ``step()``
   ends the run as "diverged", and whatever ``step()`` raises after the control law it
@@ -62,6 +63,32 @@ def checked_plant(plant: Plant, failed: Failed) -> Plant:
     return plant if from_library(plant) else CheckedPlant(plant, failed)
 
 
+def checked_extra_values(plant: Plant) -> Callable[[], Any]:
+    """``plant.extra_values`` as a run's recorder calls it, once per sample: the library's
+    plants' as it is; a plug-in's checked to return one number per name of its
+    ``extra_columns``, else a one-line :class:`~ddwmmr.errors.ParameterError` naming the
+    plant (the values are recorded as columns of the time series)."""
+    extra_values = plant.extra_values
+    if from_library(plant):
+        return extra_values
+    names = tuple(plant.extra_columns)
+
+    def checked() -> tuple[float, ...]:
+        values = extra_values()
+        try:
+            row = tuple(float(value) for value in values)
+        except (TypeError, ValueError):
+            row = None
+        if row is None or len(row) != len(names):
+            raise ParameterError(
+                f"plant: {name_of(plant)}.extra_values() must return {len(names)} numbers, "
+                f"one per extra_columns name ({', '.join(names)}) (got {shown(values, 60)})"
+            )
+        return row
+
+    return checked
+
+
 class CheckedPlant:
     """Plug-in ``plant`` with its ``observe()``, ``limit()`` and ``step()`` checked (see
     the module docstring); ``failed(k, error)`` is the task's verdict on a failure.
@@ -88,12 +115,17 @@ class CheckedPlant:
 
     def reset(self, q0: Any, dt: float) -> None:
         """The plant's ``reset(q0, dt)``; the count starts again at sample 0. What it raises
-        is a one-line PluginError naming the plant (a ParameterError passes as it is)."""
+        is a one-line PluginError naming the plant (a ParameterError passes as it is),
+        handed to the task as a failure of any other method is (PlantFailed at 0 samples
+        if the task ends the run on it)."""
         try:
             self.plant.reset(q0, dt)
         except Exception as error:
             call = f"plant: {name_of(self.plant)}.reset()"
-            raise_as(plugin_raised(call, error, " before the first step", quoted=True), error)
+            wrapped = plugin_raised(call, error, " before the first step", quoted=True)
+            if self._failed(0, wrapped):
+                raise PlantFailed(0) from None
+            raise_as(wrapped, error)
         self._k, self._dt, self._observed_at, self._stage_failed = 0, dt, 0.0, False
 
     def observe(self) -> Observation:

@@ -40,7 +40,8 @@ Controller contract (class attributes, all optional):
 * ``float_state``: True when ``command`` takes the configuration ``q`` as a tuple of 5
   floats (:attr:`~ddwmmr.plants.base.Observation.values`) instead of an array: the loop
   then passes the floats, and a plant that measures floats never builds an array.
-* ``last``: a :class:`~ddwmmr.controllers.base.StepInfo` about the last command.
+* ``last``: a :class:`~ddwmmr.controllers.base.StepInfo` about the last command (a
+  plug-in's checked once, after its first command: :func:`check_info`).
 * ``adopt_plant(traits)``: called first with the plant's
   :class:`~ddwmmr.commands.PlantTraits` (its interfaces, whether it judges tipping by its
   physics, its joints' lag and acceleration limits, its base damping, its wheels' force
@@ -72,7 +73,9 @@ by the :class:`~ddwmmr.plants.checked.CheckedPlant` the loop puts around it: wha
 ParameterError), and anything else its methods raise (but PlantDivergedError, which ends
 the run as "diverged") is wrapped in a one-line PluginError naming the plant, the method,
 the step and the time. Both go through ``task.controller_error`` (the scenario protocol
-records them as the scenario's failure; a tracking run raises them). The library's own
+records them as the scenario's failure; a tracking run raises them), and so do a plug-in
+controller's or plant's errors before the first step (``adopt_plant``,
+``adopt_control_step``, ``reset``: :func:`prepare`, ``CheckedPlant.reset``). The library's own
 plants keep their errors as they are.
 """
 
@@ -89,17 +92,20 @@ import numpy as np
 
 from ddwmmr import interrupts
 from ddwmmr.commands import FORCE, VELOCITY, WheelForces, traits_of
+from ddwmmr.controllers.base import StepInfo
 from ddwmmr.errors import (
     FLOAT64,
     ParameterError,
     finite_values,
     name_of,
+    plugin_raised,
+    raise_as,
     raise_plugin_error,
     shown,
 )
 from ddwmmr.inheritance import defining_class, from_library, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
-from ddwmmr.plants.checked import PlantFailed, checked_plant
+from ddwmmr.plants.checked import Failed, PlantFailed, checked_plant
 
 #: Progress callback: (samples done, samples in all).
 Progress = Callable[[int, int], None]
@@ -266,19 +272,38 @@ def raise_wrapped(controller: Any, error: Exception, k: int, t: float, method: s
     raise_plugin_error(call, error, f" at step {k}, t = {t:g} s", quoted=True)
 
 
-def prepare(controller: Any, method: str, *args: Any) -> None:
+def prepare(controller: Any, method: str, *args: Any, failed: Failed | None = None) -> bool:
     """Call ``controller.<method>(*args)`` before the first step (``adopt_plant``,
     ``adopt_control_step``, ``reset``). What a controller from outside the library raises
     there is a one-line :class:`PluginError` naming it, the call and what it raised (the
     ``__cause__``); a ParameterError, and anything a library controller raises, pass as
-    they are."""
+    they are. A plug-in's error is handed to ``failed`` (the task's
+    ``controller_error(0, error)``) first: True (returned) when the task ends the run on
+    it, as on an error of ``command``; else it is raised."""
     try:
         getattr(controller, method)(*args)
     except Exception as error:
         if from_library(controller):
             raise
         call = f"method: {name_of(controller)}.{method}()"
-        raise_plugin_error(call, error, " before the first step", quoted=True)
+        wrapped = plugin_raised(call, error, " before the first step", quoted=True)
+        if failed is not None and failed(0, wrapped):
+            return True
+        raise_as(wrapped, error)
+    return False
+
+
+def check_info(controller: Any, info: Any, k: int, t: float) -> None:
+    """Refuse, in one line naming ``controller``, a step info ``info`` (its ``last`` after
+    the command of step ``k``, time ``t`` s) that is not a
+    :class:`~ddwmmr.controllers.base.StepInfo`: the run records its fields at every step.
+    The loop checks a plug-in's once, at its first step."""
+    if not isinstance(info, StepInfo | NoInfo):
+        raise ParameterError(
+            f"method: {name_of(controller)}.last must be a StepInfo(singular, "
+            f"nonholonomic_residual, fallback, extra) (got {shown(info, 60)} after the "
+            f"command of step {k}, t = {t:g} s)"
+        )
 
 
 def bad_law(controller: Any, result: Any, k: int, t: float) -> NoReturn:
@@ -318,14 +343,22 @@ def run_loop(
     The plant and the controller are reset first. See the module docstring for the
     sequence of one sample and the controller contract.
     """
-    plant = checked_plant(plant, task.controller_error)  # a plug-in's calls checked
-    if getattr(controller, "adopt_plant", None) is not None:
-        prepare(controller, "adopt_plant", traits_of(plant))
-    force = check_interface(controller, plant) == FORCE
-    plant.reset(q0, dt)
-    if getattr(controller, "adopt_control_step", None) is not None:
-        prepare(controller, "adopt_control_step", dt)
-    prepare(controller, "reset", task.trajectory, np.array(q0, dtype=float))
+    failed = task.controller_error  # its verdict on a plug-in's error: end the run?
+    plant = checked_plant(plant, failed)  # a plug-in's calls checked
+    try:
+        adopt = getattr(controller, "adopt_plant", None) is not None
+        if adopt and prepare(controller, "adopt_plant", traits_of(plant), failed=failed):
+            return LoopEnd(0, "controller_error")
+        force = check_interface(controller, plant) == FORCE
+        plant.reset(q0, dt)
+        adopt = getattr(controller, "adopt_control_step", None) is not None
+        if adopt and prepare(controller, "adopt_control_step", dt, failed=failed):
+            return LoopEnd(0, "controller_error")
+        q_start = np.array(q0, dtype=float)
+        if prepare(controller, "reset", task.trajectory, q_start, failed=failed):
+            return LoopEnd(0, "controller_error")
+    except PlantFailed:  # a plug-in plant's reset failed; the task ended the run on it
+        return LoopEnd(0, "plant_error")
     wants_velocity = getattr(controller, "wants_base_velocity", False)
     float_state = getattr(controller, "float_state", False)
     command_of = controller.command
@@ -333,6 +366,7 @@ def run_loop(
 
     reference = task.reference
     law = stage_law(controller)
+    unchecked_info = not from_library(controller)  # a plug-in's step info, checked once
 
     k = 0  # the step being taken, for the message of a bad command at a stage
 
@@ -401,11 +435,14 @@ def run_loop(
                     command = command_of(t, q, pose_d, velocity_d)
                 elapsed = clock() - start
                 command = checked_command(command, force, controller, k, t)
+                info = getattr(controller, "last", _NO_INFO)
+                if unchecked_info:
+                    check_info(controller, info, k, t)
+                    unchecked_info = False
             except Exception as error:
                 if task.controller_error(k, error):
                     return LoopEnd(k, "controller_error")
                 raise_wrapped(controller, error, k, t, "command")
-            info = getattr(controller, "last", _NO_INFO)
             if force:
                 applied, saturated = command, False
             else:

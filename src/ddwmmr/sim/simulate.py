@@ -407,10 +407,17 @@ def _add_plug_in_keys(
     """``summary`` updated with the ``keys`` that ``owner``'s ``summarize()`` returned; a
     plug-in's keys that the verdict cannot read (:func:`check_summary`: a count above the
     run's steps, a flag that is no boolean) are a one-line :class:`ParameterError` naming
-    the plug-in (``role`` ``"plant"`` or ``"method"``), not the summary."""
-    summary.update(keys)
+    the plug-in (``role`` ``"plant"`` or ``"method"``), not the summary; so is a plug-in's
+    ``summarize()`` that returned no mapping."""
     if from_library(owner):
+        summary.update(keys)
         return
+    if not isinstance(keys, Mapping):
+        raise ParameterError(
+            f"{role}: {name_of(owner)}.summarize() must return a mapping of summary keys "
+            f"(a dict, {{}} for none; got {shown(keys, 60)})"
+        )
+    summary.update(keys)
     try:
         check_summary(summary)
     except ParameterError as error:

@@ -26,6 +26,7 @@ from ddwmmr.inheritance import defining_class
 from ddwmmr.model import Robot
 from ddwmmr.model.stability import stability_arrays
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+from ddwmmr.plants.checked import checked_extra_values
 from ddwmmr.trajectories.base import Trajectory, sample_each, sampler, trajectory_name
 from ddwmmr.trajectories.scaled import ScaledTrajectory
 
@@ -111,7 +112,7 @@ class TrackingTask:
         sample = sampler(trajectory)
         self._blocks = None if grid is None or sample is None else ReferenceBlocks(sample, *grid)
         self._table: dict[float, tuple[np.ndarray, np.ndarray]] = {}
-        self._extra_values = plant.extra_values if plant.extra_columns else None
+        self._extra_values = checked_extra_values(plant) if plant.extra_columns else None
 
     # -- Task protocol ----------------------------------------------------------------------
     def start(self, obs: Observation) -> bool:
