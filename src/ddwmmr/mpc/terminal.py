@@ -25,6 +25,11 @@ terminal cost, like the stage cost, ignores them. With no error component weight
 the cost-to-go is zero (``P = 0``, ``K = 0``). This is not a regularisation: a plain
 ``dlqr`` on the full error would have no stabilising solution there (an unweighted
 integrator is neither regulated nor seen by the cost).
+
+A weight below :data:`NEGLIGIBLE` times the design's largest weight (of ``Q`` and ``R``)
+is left out the same way: the Riccati solver cannot resolve it in double precision (a
+``position_weight`` of 1e-100 or an ``orientation_weight`` of 1e-40 made ``dlqr`` fail),
+and its share of the cost-to-go is below that rounding anyway.
 """
 
 from __future__ import annotations
@@ -40,6 +45,10 @@ from ddwmmr.mpc.ocp import OCPConfig
 
 #: Added to R's diagonal so the design stays well posed with a zero input weight.
 R_FLOOR = 1e-9
+
+#: Error weights below this share of the design's largest weight (of Q and R) are left out
+#: of the design as zero weights are (module docstring).
+NEGLIGIBLE = 1e-12
 
 
 @dataclass(frozen=True)
@@ -111,9 +120,10 @@ def design(
     Q = h * np.diag(q)
     R = h * np.diag(weights.input / np.asarray(model.u_scale, dtype=float) ** 2 + R_FLOOR)
     # unweighted error components are left out (module docstring): nothing depends on them
-    keep = np.array([i for i in range(nz) if i >= rows or q[i] > 0.0], dtype=int)
+    floor = NEGLIGIBLE * max(float(np.max(Q)), float(np.max(np.diag(R))))
+    keep = np.array([i for i in range(nz) if i >= rows or Q[i, i] > floor], dtype=int)
     P, K = np.zeros((nz, nz)), np.zeros((nu, nz))
-    if np.any(q[keep] > 0.0):
+    if np.any(np.diag(Q)[keep] > floor):
         part = np.ix_(keep, keep)
         K_kept, P_kept, _ = control.dlqr(Ad[part], Bd[keep], Q[part], R)
         P[part] = 0.5 * (P_kept + P_kept.T)
