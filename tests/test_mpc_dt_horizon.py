@@ -62,3 +62,20 @@ def test_the_grid_check_itself():
     assert shooting_grid(10, 0.9991, 1e-4, 1.0)[0] == 0.9991
     with pytest.raises(ParameterError, match=r"^dt must be > 0"):
         check_step_in_horizon(0.0, 1.0, 10)
+
+
+@pytest.mark.parametrize("value", ["1e-300", "5e-324", "9.9e-05"])
+def test_the_dt_option_below_the_least_interval_is_refused(tmp_path, capsys, value):
+    """The mpc's plan starts with an interval of dt: ``--option dt=1e-300`` used to run
+    (and report "tracked") with a first interval 1e-300 s long, where first_interval and
+    every later interval must be >= 1e-4 s."""
+    out = tmp_path / "run"
+    args = ["--method", "mpc", "--traj", "ellipse", "--option", f"dt={value}", "--no-plots"]
+    assert track([*args, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.splitlines()[-1]
+    assert (
+        err == f"error: dt: the mpc's step must be >= 0.0001 s, the least interval of its "
+        f"plan (got {float(value):g})"
+    )
+    assert not out.exists()
+    make_controller("mpc", Robot(), dt=1e-4)  # the least interval itself is accepted

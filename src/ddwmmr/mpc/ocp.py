@@ -768,8 +768,9 @@ def shooting_grid(intervals: int, dt: float, first: float, horizon: float) -> np
 
 
 def check_step_in_horizon(dt: float, horizon: float, intervals: int) -> float:
-    """The control step ``dt`` (s, > 0) if it leaves room in ``horizon`` (s) for the
-    ``intervals - 1`` later intervals of at least :data:`MIN_INTERVAL` each, else a
+    """The control step ``dt`` (s, at least :data:`MIN_INTERVAL`, as every interval of
+    the plan: the OCP's first interval is ``dt``) if it leaves room in ``horizon`` (s) for
+    the ``intervals - 1`` later intervals of at least :data:`MIN_INTERVAL` each, else a
     one-line :class:`ParameterError` naming ``dt``.
 
     Checked before ``first_interval``: the controller derives that from the horizon's
@@ -777,6 +778,11 @@ def check_step_in_horizon(dt: float, horizon: float, intervals: int) -> float:
     as the horizon would otherwise be refused as a first interval the user never set.
     """
     dt = check_positive("dt", dt)
+    if dt < MIN_INTERVAL:
+        raise ParameterError(
+            f"dt: the mpc's step must be >= {MIN_INTERVAL:g} s, the least interval of its "
+            f"plan (got {dt:g})"
+        )
     if not horizon > dt:
         raise ParameterError(
             f"dt: the mpc's step must be < its horizon, {horizon:g} s (got {dt:g})"
