@@ -11,7 +11,8 @@ import math
 import numpy as np
 import pytest
 
-from ddwmmr import Robot, make_controller
+from ddwmmr import Robot, load_trajectory, make_controller, simulate
+from ddwmmr.cli.track import main as track
 from ddwmmr.errors import ParameterError
 from ddwmmr.plants.mujoco import MujocoPlant
 from ddwmmr.plants.thesis import ThesisPlant, ThesisState, damped_base_envelope
@@ -96,3 +97,33 @@ def test_previously_looping_scenario_completes_on_the_physics_plant():
     trace = outcome.trace
     base_path = float(np.sum(np.hypot(np.diff(trace["x"]), np.diff(trace["y"]))))
     assert base_path < 1.2 * scenario.path_length()  # was 1.35 x, in loops
+
+
+@pytest.mark.parametrize(
+    ("budget", "message"),
+    [
+        ((1e-300, 1e-300), "speed_budget v_top must be >= 1e-06 m/s"),
+        ((5e-324, 1.0), "speed_budget v_top must be >= 1e-06 m/s"),
+        ((1.0, 1e-300), "speed_budget w_top must be >= 1e-06 rad/s"),
+    ],
+)
+def test_a_top_too_small_for_the_solvers_is_refused(tmp_path, capsys, budget, message):
+    """With tops of 1e-300 the rows' coefficients 1/top overflowed the solvers: DAQP
+    dropped the rows (the base drove at 0.24 m/s through a 1e-300 m/s budget and the run
+    "tracked"), OSQP raised its own error from inside the run."""
+    with pytest.raises(ParameterError, match=f"^{message}, a row the QP solvers can hold"):
+        make_controller("qp", ROBOT, speed_budget=budget)
+    out = tmp_path / "run"
+    text = ",".join(repr(top) for top in budget)
+    args = ["--method", "qp", "--traj", "ellipse", "--option", f"speed_budget={text}"]
+    assert track([*args, "--no-plots", "--out", str(out)]) == 2
+    assert capsys.readouterr().err.splitlines()[-1].startswith(f"error: {message}")
+    assert not out.exists()
+
+
+def test_the_least_top_is_held():
+    """At the least tops the rows still hold: the base stays within the budget."""
+    budget = (1e-6, 1e-6)
+    result = simulate(ROBOT, load_trajectory("ellipse"), "qp", duration=0.2, speed_budget=budget)
+    v, w = result.timeseries["v"], result.timeseries["w"]
+    assert np.max(np.abs(v) / budget[0] + np.abs(w) / budget[1]) <= 1.0 + 1e-6

@@ -119,6 +119,12 @@ class BaseMotionLimit(Limit):
         return write
 
 
+#: Least top speed (m/s) and yaw rate (rad/s) of :class:`SpeedBudgetLimit`: its rows'
+#: coefficients are their inverses, and far smaller tops (1e-300) gave coefficients the
+#: solvers cannot hold (DAQP dropped the rows, OSQP failed to factorise).
+MIN_TOP = 1e-6
+
+
 class SpeedBudgetLimit(Limit):
     """Two rows: ``v`` and ``w`` share the wheels' force budget, ``|v|/v_top + |w|/w_top <= 1``.
 
@@ -126,7 +132,8 @@ class SpeedBudgetLimit(Limit):
         speeds: ``(v_top, w_top)``, the steady-state top speed (m/s, all the force driving)
             and top yaw rate (rad/s, all the force turning) of the base; for a damped base
             with force limit F per wheel ``(2 F / c1, 2 F (width/2) / c2)``
-            (:func:`ddwmmr.plants.thesis.damped_base_envelope` with ``speed_budget=True``).
+            (:func:`ddwmmr.plants.thesis.damped_base_envelope` with ``speed_budget=True``),
+            each at least :data:`MIN_TOP`.
         unit: the length unit (m) in which the rows take ``v`` (:attr:`Limit.unit`).
     """
 
@@ -142,6 +149,12 @@ class SpeedBudgetLimit(Limit):
             )
         v_top = check_positive("speed_budget v_top", speeds[0])
         w_top = check_positive("speed_budget w_top", speeds[1])
+        for name, top, unit_name in (("v_top", v_top, "m/s"), ("w_top", w_top, "rad/s")):
+            if top < MIN_TOP:
+                raise ParameterError(
+                    f"speed_budget {name} must be >= {MIN_TOP:g} {unit_name}, a row the QP "
+                    f"solvers can hold (got {top:g})"
+                )
         self.speeds = (v_top, w_top)
         # |v|/v_top + |w|/w_top <= 1 is the pair of rows -1 <= v/v_top +- w/w_top <= 1.
         self.rows_vw = ((unit / v_top, 1.0 / w_top), (unit / v_top, -1.0 / w_top))
