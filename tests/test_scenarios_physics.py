@@ -85,6 +85,14 @@ def test_base_damping_is_validated(bad):
         MujocoPlant(Robot(), base_damping=bad)
 
 
+@pytest.mark.parametrize("damping", [(0.0, 0.0), (0.0, 4.0), (15.0, 0.0)])
+def test_a_zero_damping_has_no_velocity_envelope(damping):
+    """base_damping accepts 0 per axis (no drag); the envelope divided by it
+    (ZeroDivisionError). No drag on an axis: no top speed, as without damping."""
+    assert MujocoPlant(Robot(), base_damping=damping).velocity_envelope() is None
+    assert MujocoPlant(Robot(), base_damping=(15.0, 4.0)).velocity_envelope() is not None
+
+
 def test_thesis_controller_still_refuses_the_kinematic_plant():
     with pytest.raises(ParameterError, match="thesis or mujoco"):
         RunConfig(controller="thesis", plant="kinematic")

@@ -273,9 +273,10 @@ class MujocoPlant:
         (:func:`~ddwmmr.plants.thesis.damped_base_envelope` with the wheel force the motor
         torque limit allows, ``wheel_torque_limit / wheel_radius``), with the speed budget
         (the wheel servos saturate one by one: at a corner of the speed box the base
-        would lose its yaw and drive in loops); None without damping (no drag: the
-        wheel-speed and torque limits are the whole story)."""
-        if self.base_damping is None:
+        would lose its yaw and drive in loops); None without damping, or with a zero
+        damping on either axis (no drag there: no top speed to keep within; the wheel-speed
+        and torque limits are the whole story)."""
+        if self.base_damping is None or min(self.base_damping) == 0.0:
             return None
         robot = self.robot
         return damped_base_envelope(
