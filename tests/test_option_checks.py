@@ -165,3 +165,16 @@ def test_the_qp_runs_the_same_start_without_refusing_it():
     assert (rate_v, rate_w) == (pytest.approx(1.0), pytest.approx(0.0, abs=1e-12))
     assert lower == pytest.approx(0.06, rel=1e-9)
     assert u[0] >= 0.06 - 1e-6  # it drives forward, away from the circle behind
+
+
+@pytest.mark.parametrize("margin", ["1e300", "1.7976931348623157e308", "1000001"])
+def test_an_mpc_obstacle_margin_beyond_any_coordinate_is_refused(tmp_path, capsys, margin):
+    """The mpc took any finite margin and squares it building its OCP: 1e300 with an
+    obstacle ended in OverflowError, a traceback. Capped as an obstacle's coordinates."""
+    out = tmp_path / "run"
+    args = ["--method", "mpc", "--traj", "ellipse", "--obstacles", "ellipse_post"]
+    assert track_main([*args, "--option", f"obstacle_margin={margin}", "--out", str(out)]) == 2
+    err = capsys.readouterr().err.splitlines()[-1]
+    assert err == f"error: obstacle_margin must be in [0, 1e+06] m (got {float(margin):g})"
+    assert not out.exists()
+    make_controller("mpc", ROBOT, obstacle_margin=1e6)  # the cap itself is accepted

@@ -66,13 +66,19 @@ MARGIN = 0.05
 
 def robot_margin(margin: float | None, unit: float) -> float:
     """The ``obstacle_margin`` (m) of a robot whose length unit is ``unit`` (m,
-    :func:`~ddwmmr.resolution.kernels.length_unit`): ``margin`` as given (m, finite, >=
-    0), None for :data:`MARGIN` of the unit (the robot's own), else a one-line
+    :func:`~ddwmmr.resolution.kernels.length_unit`): ``margin`` as given (m, in [0,
+    :data:`~ddwmmr.errors.MAX_COORDINATE_M`], as an obstacle's own coordinates), None for
+    :data:`MARGIN` of the unit (the robot's own), else a one-line
     :class:`ParameterError`. The mpc takes it as it is; the qp also needs it below its
     obstacle influence (:func:`check_margin_in_influence`)."""
     if margin is None:
         return MARGIN * unit
-    return check_nonnegative("obstacle_margin", margin)
+    value = check_nonnegative("obstacle_margin", margin)
+    if value > MAX_COORDINATE_M:  # the mpc squares it: 1e300 overflowed building the OCP
+        raise ParameterError(
+            f"obstacle_margin must be in [0, {MAX_COORDINATE_M:g}] m (got {value:g})"
+        )
+    return value
 
 
 def check_margin_in_influence(margin: float, unit: float) -> float:
