@@ -53,7 +53,7 @@ def test_the_command_line_refuses_a_qp_backend_with_ipopt(capsys, tmp_path):
 # -- a floor at or above S's cap ------------------------------------------------------------
 @pytest.mark.parametrize(
     ("stability_min", "margin", "room"),
-    [(1.25, 100.0, "8.75"), (1.25, 8.75, "8.75"), (9.995, 0.01, "0.005")],
+    [(1.25, 100.0, "8.75"), (1.25, 8.75, "8.75"), (9.995, 0.02, "0.005")],
 )
 def test_a_margin_that_lifts_the_floor_to_the_cap_is_refused(stability_min, margin, room):
     with pytest.raises(ParameterError) as error:
@@ -62,6 +62,18 @@ def test_a_margin_that_lifts_the_floor_to_the_cap_is_refused(stability_min, marg
         f"stability_margin must be in [0, {room}) with stability_min {stability_min:g}: the "
         "OCP keeps S >= stability_min + stability_margin, and S is capped at 10 "
         f"(got {margin:g})"
+    )
+
+
+@pytest.mark.parametrize("stability_min", [9.99, 9.995])
+def test_a_floor_that_the_default_margin_lifts_to_the_cap_names_the_floor(stability_min):
+    """`--option stability_min=9.99` named stability_margin, which the user never set, and
+    its range as [0, 0.009999999999999787)."""
+    with pytest.raises(ParameterError) as error:
+        MPCOptions(stability_min=stability_min)
+    assert str(error.value) == (
+        "stability_min must be in (0, 9.99) with stability_margin 0.01: the OCP keeps S >= "
+        f"stability_min + stability_margin, and S is capped at 10 (got {stability_min:g})"
     )
 
 

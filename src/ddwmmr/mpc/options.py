@@ -67,6 +67,8 @@ from ddwmmr.qp.limits.obstacles import robot_margin
 MODELS = ("kinematic", "thesis")
 #: Control step (s) when neither ``dt`` nor the trajectory's resolution is known.
 DEFAULT_DT = 0.02
+#: ``stability_margin`` when it is not given: the OCP's floor on S above ``stability_min``.
+DEFAULT_STABILITY_MARGIN = 0.01
 #: Defaults per objective: (intervals, first interval s, horizon s). Chosen by the horizon
 #: study in docs/mpc.md.
 GRID_DEFAULTS = {"tracking": (10, 0.05, 1.0), "reach": (12, 0.05, 5.0)}
@@ -270,7 +272,7 @@ class MPCOptions:
     plan: str | None = None
     plan_weight: float = 2.0
     proximal: float = 0.01
-    stability_margin: float = 0.01
+    stability_margin: float = DEFAULT_STABILITY_MARGIN
     dynamic_stability: bool | None = None
     min_edge_load: float = DEFAULT_MIN_EDGE_LOAD
     arm_time_constant: float | None = None
@@ -374,6 +376,13 @@ class MPCOptions:
         floor, margin = self.stability_min, self.stability_margin
         if valid_stability_floor(floor + margin):
             return
+        if margin == DEFAULT_STABILITY_MARGIN:  # the floor the user set is what lifts it
+            got, (top,) = texts_apart(floor, STABILITY_CAP - margin)
+            raise ParameterError(
+                f"stability_min must be in (0, {top}) with stability_margin {margin:g}: the "
+                f"OCP keeps S >= stability_min + stability_margin, and S is capped at "
+                f"{STABILITY_CAP:g} (got {got})"
+            )
         got, (room,) = texts_apart(margin, STABILITY_CAP - floor)
         raise ParameterError(
             f"stability_margin must be in [0, {room}) with stability_min {floor:g}: the OCP "
