@@ -35,9 +35,11 @@ and its share of the cost-to-go is below that rounding anyway.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from ddwmmr.errors import ParameterError
 from ddwmmr.model import Robot
 from ddwmmr.model import kinematics as kin
 from ddwmmr.mpc.models import PredictionModel, ThesisPrediction
@@ -108,14 +110,39 @@ def design(
     import control
 
     A, B = error_dynamics(robot, model, arm_pose, config.track_orientation)
-    nz, nu = B.shape
     h, weights = float(config.interval_lengths()[-1]), config.weights
+    try:
+        return _designed(control, A, B, h, weights, model, config.track_orientation)
+    except (np.linalg.LinAlgError, ValueError):
+        if not isinstance(model, ThesisPrediction):
+            raise  # the kinematic model's design always exists (module docstring)
+        d = model.dynamics
+        raise ParameterError(
+            f"mpc: the force model cannot plan for this base: c1 = {d.c1:g} N s/m and c2 = "
+            f"{d.c2:g} N m s/rad make its time constants m / c1 = {d.mass / d.c1:.3g} s and "
+            f"I / c2 = {d.inertia(arm_pose[1]) / d.c2:.3g} s, which its intervals (the last "
+            f"{h:.3g} s) cannot resolve (no finite terminal LQR); give the plant a damping "
+            "nearer the thesis's (15 N s/m, 4 N m s/rad) or use model='kinematic'"
+        ) from None
+
+
+def _designed(
+    control: Any,
+    A: np.ndarray,
+    B: np.ndarray,
+    h: float,
+    weights: Any,
+    model: PredictionModel,
+    track_orientation: bool,
+) -> TerminalDesign:
+    """:func:`design` once the continuous error dynamics ``(A, B)`` are known."""
+    nz, nu = B.shape
     discrete = control.c2d(control.ss(A, B, np.eye(nz), np.zeros((nz, nu))), h)
     Ad, Bd = np.asarray(discrete.A), np.asarray(discrete.B)
-    rows = 3 if config.track_orientation else 2  # the end-effector error; then (v, w)
+    rows = 3 if track_orientation else 2  # the end-effector error; then (v, w)
     q = np.zeros(nz)
     q[:2] = weights.position
-    if config.track_orientation:
+    if track_orientation:
         q[2] = weights.orientation
     Q = h * np.diag(q)
     R = h * np.diag(weights.input / np.asarray(model.u_scale, dtype=float) ** 2 + R_FLOOR)
