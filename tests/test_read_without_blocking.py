@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 import sys
 import threading
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -17,21 +18,26 @@ from ddwmmr.errors import ParameterError, read_text_file
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="FIFOs and /proc are POSIX")
 
 
+def returns_without_blocking(fifo: Path, read: Callable[[], object]) -> bool:
+    """Whether ``read()``, run in a thread, returns within 10 s; a read left waiting on
+    ``fifo`` for a writer (the old code) is freed by opening it for writing."""
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
+    reader.join(timeout=10)
+    blocked = reader.is_alive()
+    if blocked:
+        with open(fifo, "wb"):
+            pass
+        reader.join(timeout=10)
+    return not blocked
+
+
 def test_a_fifo_taken_for_a_regular_file_does_not_block(tmp_path, monkeypatch):
     fifo = tmp_path / "robot.toml"
     os.mkfifo(fifo)
     monkeypatch.setattr(errors, "file_kind", lambda mode: None)  # the check passed it
     result: list[object] = []
-    reader = threading.Thread(target=lambda: result.append(read_text_file(fifo, "robot")))
-    reader.daemon = True
-    reader.start()
-    reader.join(timeout=10)
-    blocked = reader.is_alive()
-    if blocked:  # the old read: free it
-        with open(fifo, "wb"):
-            pass
-        reader.join(timeout=10)
-    assert not blocked
+    assert returns_without_blocking(fifo, lambda: result.append(read_text_file(fifo, "robot")))
     assert result == [""]
 
 
@@ -60,13 +66,5 @@ def test_a_plan_that_is_a_fifo_or_proc_file_is_refused_without_waiting(tmp_path)
         except ParameterError as error:
             result.append(str(error))
 
-    reader = threading.Thread(target=load, daemon=True)
-    reader.start()
-    reader.join(timeout=10)
-    blocked = reader.is_alive()
-    if blocked:  # the old read: free it
-        with open(fifo, "wb"):
-            pass
-        reader.join(timeout=10)
-    assert not blocked
+    assert returns_without_blocking(fifo, load)
     assert result == [f"plan: {fifo} is not a regular file (a FIFO)"]
