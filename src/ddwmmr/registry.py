@@ -460,26 +460,6 @@ def _import_plugin(module: str) -> None:
         ) from exc
 
 
-__all__ = [
-    "ARBITERS",
-    "BUILTIN_MODULES",
-    "CONTROLLERS",
-    "ENTRY_POINT_GROUP",
-    "MAX_NAME_LENGTH",
-    "NAME_FORM",
-    "NAME_PATTERN",
-    "PLANTS",
-    "PLUGINS_VARIABLE",
-    "Entry",
-    "PluginClass",
-    "Registry",
-    "discover",
-    "register_arbiter",
-    "register_controller",
-    "register_plant",
-]
-
-
 def build(
     cls: Any,
     call: str,
@@ -499,3 +479,23 @@ def build(
         if class_from_library(cls):
             raise
         raise_plugin_error(call, error, quoted=quoted)
+
+
+__all__ = [
+    "ARBITERS",
+    "BUILTIN_MODULES",
+    "CONTROLLERS",
+    "ENTRY_POINT_GROUP",
+    "MAX_NAME_LENGTH",
+    "NAME_FORM",
+    "NAME_PATTERN",
+    "PLANTS",
+    "PLUGINS_VARIABLE",
+    "Entry",
+    "PluginClass",
+    "Registry",
+    "discover",
+    "register_arbiter",
+    "register_controller",
+    "register_plant",
+]
