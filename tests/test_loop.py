@@ -229,3 +229,29 @@ def test_the_loop_tells_sampled_data_controllers_its_step():
         fixed = make_controller(method, robot, dt=0.03)
         simulate(robot, Ellipse(), fixed, dt=0.01, duration=0.05)
         assert (fixed.dt if method == "mpc" else fixed.ctx.dt) == 0.03, method
+
+
+def test_an_undeclared_interface_attribute_is_warned_about_at_run_loops_caller():
+    """The deprecation warning of an ``interface`` attribute outside the declared
+    ``interfaces`` names the line that called ``run_loop``, not the loop's own code."""
+    import warnings
+
+    from ddwmmr.resolution.reference import start_configuration
+    from ddwmmr.sim.loop import run_loop
+    from ddwmmr.sim.tracking import TrackingTask
+
+    class Pusher(ConstantController):
+        interface, interfaces = "force", ("velocity",)
+
+        def command(self, t, q, pose_d, velocity_d, base_velocity=None):
+            return WheelForces(0.0, 0.0, 0.0, 0.0)
+
+    trajectory, plant = Ellipse(), ThesisPlant(ROBOT)
+    task = TrackingTask(trajectory, plant)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        end = run_loop(
+            plant, Pusher([0.0] * 4), task, start_configuration(ROBOT, trajectory), 0.02, 2
+        )
+    assert end.reason == "steps"
+    assert [(w.category, w.filename) for w in caught] == [(FutureWarning, __file__)]

@@ -5,14 +5,16 @@ Every run of the library goes through :func:`run_loop`: trajectory tracking
 waypoint protocol (:mod:`ddwmmr.scenarios`). What differs between them is the *task*
 (:class:`Task`): where the references come from, what is recorded, when a run ends or
 fails. What differs between plants (kinematic, thesis dynamics, physics) is behind
-:class:`ddwmmr.plants.base.Plant`. One sample ``k`` (time ``t = k dt``) is::
+:class:`ddwmmr.plants.base.Plant`. A run prepares the controller and the plant
+(:func:`prepare_run`), builds the policy the integrator evaluates at its stages
+(:func:`stage_policy`), then takes samples ``k = 0 .. steps``; one (time ``t = k dt``) is::
 
     obs = plant.observe()                         # measured state at t
     if task.finished(k, t, obs): stop             # e.g. every waypoint reached
     pose_d, velocity_d = task.reference(t, obs)
     command = controller.command(t, obs.q, pose_d, velocity_d)   # timed
     applied, saturated = plant.limit(obs.q, command)             # velocity commands
-    task.record(k, t, obs, applied, saturated, info, step_ns)
+    task.record(k, t, obs, command, applied, saturated, info, step_ns)
     plant.step(t, applied, dt, policy)            # not after the last sample
     if task.after_step(k, t, plant.observe(), applied): stop      # e.g. tipped over
 
@@ -75,7 +77,7 @@ the run as "diverged") is wrapped in a one-line PluginError naming the plant, th
 the step and the time. Both go through ``task.controller_error`` (the scenario protocol
 records them as the scenario's failure; a tracking run raises them), and so do a plug-in
 controller's or plant's errors before the first step (``adopt_plant``,
-``adopt_control_step``, ``reset``: :func:`prepare`, ``CheckedPlant.reset``). The library's own
+``adopt_control_step``, ``reset``: :func:`prepare_run`, ``CheckedPlant.reset``). The library's own
 plants keep their errors as they are.
 """
 
@@ -104,7 +106,7 @@ from ddwmmr.errors import (
     shown,
 )
 from ddwmmr.inheritance import defining_class, from_library, overrides
-from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
+from ddwmmr.plants.base import Observation, Plant, PlantDivergedError, Policy
 from ddwmmr.plants.checked import Failed, PlantFailed, checked_plant
 
 #: Progress callback: (samples done, samples in all).
@@ -193,11 +195,12 @@ def spoken_interface(controller: Any, plant: Plant) -> str:
     return next((i for i in declared if i in plant.interfaces), declared[0])
 
 
-def check_interface(controller: Any, plant: Plant) -> str:
+def check_interface(controller: Any, plant: Plant, stacklevel: int = 3) -> str:
     """The command interface ``controller`` sends on ``plant`` (see the module docstring):
     its ``interface`` if it has one, else the first of its declared ``interfaces`` that the
     plant accepts (chosen afresh for every plant: nothing is stored on the controller); a
-    one-line :class:`ParameterError` if the plant does not accept it."""
+    one-line :class:`ParameterError` if the plant does not accept it. ``stacklevel``: that
+    of the deprecation warning, the frame of its caller's caller by default."""
     declared = tuple(getattr(controller, "interfaces", None) or (VELOCITY,))
     interface = spoken_interface(controller, plant)
     own = getattr(controller, "interface", None) is not None
@@ -208,7 +211,7 @@ def check_interface(controller: Any, plant: Plant) -> str:
             f"@register_controller(..., interfaces=...); the interface attribute alone is "
             "deprecated",
             FutureWarning,
-            stacklevel=3,
+            stacklevel=stacklevel,
         )
     if interface not in plant.interfaces:
         name = getattr(controller, "name", type(controller).__name__)
@@ -329,27 +332,27 @@ def stage_law(controller: Any) -> Callable[..., Any] | None:
     return None if overrides(controller, owner, "command") else law
 
 
-def run_loop(
-    plant: Plant,
-    controller: Any,
-    task: Task,
-    q0: np.ndarray,
-    dt: float,
-    steps: int,
-    progress: Progress | None = None,
-) -> LoopEnd:
-    """Run ``controller`` on ``plant`` from ``q0`` for up to ``steps`` steps of ``dt`` (s).
+def prepare_run(
+    plant: Plant, controller: Any, task: Task, q0: np.ndarray, dt: float
+) -> str | LoopEnd:
+    """Make ``controller`` and the (checked) ``plant`` ready for a run from ``q0``
+    (``[x, y, phi, th1, th2]``, m and rad) with control step ``dt`` (s), in this order:
+    ``controller.adopt_plant(traits)`` (if it has it: it may choose its interface for this
+    plant), the command interface (:func:`check_interface`), ``plant.reset(q0, dt)``,
+    ``controller.adopt_control_step(dt)`` (if it has it) and ``controller.reset(trajectory,
+    q0)`` with the task's trajectory and a float copy of ``q0``.
 
-    The plant and the controller are reset first. See the module docstring for the
-    sequence of one sample and the controller contract.
+    Returns the interface the controller sends (``"velocity"`` or ``"force"``), or the
+    :class:`LoopEnd` at sample 0 when a plug-in failed here and the task ended the run on
+    it (``"controller_error"``, ``"plant_error"``). Anything else is raised (:func:`prepare`).
     """
     failed = task.controller_error  # its verdict on a plug-in's error: end the run?
-    plant = checked_plant(plant, failed)  # a plug-in's calls checked
     try:
         adopt = getattr(controller, "adopt_plant", None) is not None
         if adopt and prepare(controller, "adopt_plant", traits_of(plant), failed=failed):
             return LoopEnd(0, "controller_error")
-        force = check_interface(controller, plant) == FORCE
+        # stacklevel: its deprecation warning names run_loop's caller, as from run_loop
+        interface = check_interface(controller, plant, stacklevel=4)
         plant.reset(q0, dt)
         adopt = getattr(controller, "adopt_control_step", None) is not None
         if adopt and prepare(controller, "adopt_control_step", dt, failed=failed):
@@ -359,33 +362,53 @@ def run_loop(
             return LoopEnd(0, "controller_error")
     except PlantFailed:  # a plug-in plant's reset failed; the task ended the run on it
         return LoopEnd(0, "plant_error")
-    wants_velocity = getattr(controller, "wants_base_velocity", False)
-    float_state = getattr(controller, "float_state", False)
-    command_of = controller.command
-    clock = time.perf_counter_ns
+    return interface
 
-    reference = task.reference
+
+class Stages:
+    """What the loop and its integrator-stage policy (:func:`stage_policy`) share in a run:
+    ``k``, the sample whose step the plant is taking (the loop sets it before each
+    ``plant.step``; the messages of a failure at a stage name it), and ``errors``, the
+    controller's errors raised at the stages. Those reach the loop out of ``plant.step``,
+    not where they arose: the loop tells them from the plant's own by this list."""
+
+    __slots__ = ("errors", "k")
+
+    def __init__(self) -> None:
+        self.k = 0
+        self.errors: list[Exception] = []
+
+
+def stage_policy(
+    controller: Any,
+    command_of: Callable[..., Any],
+    reference: Callable[[float, Any], tuple[np.ndarray, np.ndarray]],
+    force: bool,
+    stages: Stages,
+) -> Policy | None:
+    """The policy ``(t, q) -> u`` the kinematic plant's integrator evaluates at its stages
+    (t in s, q and u as in ``command``; not recorded), or None when the command is held
+    over the step: force commands, and a ``zero_order_hold`` controller.
+
+    The policy is the closed-loop law against the task's ``reference`` (called with no
+    observation): the controller's ``command`` (``command_of``) checked as at a sample
+    (:func:`checked_command`), or its float-level ``law`` where that may stand for it
+    (:func:`stage_law`). A failure there is raised as at a sample, named with step
+    ``stages.k``, and kept in ``stages.errors`` on its way out of ``plant.step``."""
     law = stage_law(controller)
-    unchecked_info = not from_library(controller)  # a plug-in's step info, checked once
-
-    k = 0  # the step being taken, for the message of a bad command at a stage
-
-    #: The controller's error at an integrator stage (it reaches the loop through the
-    #: plant's step, which is not where it arose): routed as the controller's, below.
-    stage_errors: list[Exception] = []
 
     def policy(t: float, q: list[float]) -> np.ndarray:
-        """The closed-loop law at an integrator stage (not recorded)."""
-        pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
+        """The closed-loop law at an integrator stage, through ``command``."""
+        pose_d, velocity_d = reference(t, None)
         try:
             try:
                 command = command_of(t, np.array(q), pose_d, velocity_d)
             except Exception as error:
-                raise_wrapped(controller, error, k, t, "command")
-            checked: np.ndarray = checked_command(command, False, controller, k, t)
+                raise_wrapped(controller, error, stages.k, t, "command")
+            checked: np.ndarray = checked_command(command, False, controller, stages.k, t)
             return checked
         except Exception as error:
-            stage_errors.append(error)
+            stages.errors.append(error)
             raise
 
     def law_policy(t: float, q: list[float]) -> Sequence[float] | np.ndarray:
@@ -393,29 +416,65 @@ def run_loop(
         info: stage states are the integrator's own finite floats). A non-finite result
         goes through ``command`` (:func:`policy`), whose validation names the argument that
         made it."""
-        pose_d, velocity_d = reference(t, None)  # type: ignore[arg-type]
+        pose_d, velocity_d = reference(t, None)
         try:
             try:
                 # cast: law_policy is the stage policy only when law is not None (below)
                 result = cast("Callable[..., Any]", law)(t, q, pose_d.tolist(), velocity_d.tolist())
             except Exception as error:
-                raise_wrapped(controller, error, k, t, "law")
+                raise_wrapped(controller, error, stages.k, t, "law")
             try:
                 u = result[0]
                 finite = isfinite(u[0] + u[1] + u[2] + u[3]) if len(u) == 4 else None
             except Exception:  # not (u, ...): a plain u of floats, None, text
                 finite = None
             if finite is None:
-                bad_law(controller, result, k, t)
+                bad_law(controller, result, stages.k, t)
         except Exception as error:
-            stage_errors.append(error)
+            stages.errors.append(error)
             raise
         return u if finite else policy(t, q)
 
-    stage_policy = None
-    if not (force or getattr(controller, "zero_order_hold", False)):
-        stage_policy = policy if law is None else law_policy
+    if force or getattr(controller, "zero_order_hold", False):
+        return None
+    return policy if law is None else law_policy
 
+
+def run_loop(
+    plant: Plant,
+    controller: Any,
+    task: Task,
+    q0: np.ndarray,
+    dt: float,
+    steps: int,
+    progress: Progress | None = None,
+) -> LoopEnd:
+    """Run ``controller`` on ``plant`` from ``q0`` (``[x, y, phi, th1, th2]``, m and rad)
+    for up to ``steps`` steps of ``dt`` (s), ``task`` giving the references and judging;
+    ``progress(k, steps)`` (optional) is called after each step, k the steps done.
+
+    Samples ``k = 0 .. steps`` at ``t = k dt``: each is recorded, every one but the last
+    is followed by a step. Returns how the run ended (:class:`LoopEnd`). See the module
+    docstring for one sample's sequence and the controller contract, :func:`prepare_run`
+    for what comes before the first sample.
+    """
+    plant = checked_plant(plant, task.controller_error)  # a plug-in's calls checked
+    interface = prepare_run(plant, controller, task, q0, dt)
+    if isinstance(interface, LoopEnd):
+        return interface
+    force = interface == FORCE  # wheel forces: applied as sent, held over the step
+    # what every sample needs, looked up once: the loop below runs per step, and its own
+    # overhead is a share of a cheap controller's step
+    wants_velocity = getattr(controller, "wants_base_velocity", False)
+    float_state = getattr(controller, "float_state", False)
+    command_of = controller.command
+    stages = Stages()
+    policy = stage_policy(controller, command_of, task.reference, force, stages)
+    unchecked_info = not from_library(controller)  # a plug-in's step info, checked once
+    clock = time.perf_counter_ns
+
+    # One sample per pass, inline (no function per sample: a call costs a share of a cheap
+    # controller's step).
     try:
         obs = plant.observe()
         if task.start(obs):
@@ -426,6 +485,8 @@ def run_loop(
             if task.finished(k, t, obs):
                 return LoopEnd(k, "finished")
             pose_d, velocity_d = task.reference(t, obs)
+
+            # the command; step_us times the controller's call alone
             try:
                 q = obs.values if float_state else obs.q
                 start = clock()
@@ -443,23 +504,28 @@ def run_loop(
                 if task.controller_error(k, error):
                     return LoopEnd(k, "controller_error")
                 raise_wrapped(controller, error, k, t, "command")
+
+            # what the plant applies: velocities within its limits, wheel forces as sent
             if force:
                 applied, saturated = command, False
             else:
                 applied, saturated = plant.limit(obs.q, command)
             task.record(k, t, obs, command, applied, saturated, info, elapsed)
             if k == steps:
-                break
+                break  # the last sample is recorded, not stepped
+
+            # the step to sample k + 1
+            stages.k = k
             try:
-                plant.step(t, applied, dt, stage_policy)
+                plant.step(t, applied, dt, policy)
             except PlantDivergedError as error:
                 task.diverged(k, error)
                 return LoopEnd(k + 1, "diverged")
             except Exception:
-                if not stage_errors:
+                if not stages.errors:
                     raise  # the plant's own (a plug-in's one line, from CheckedPlant)
                 # the controller failed at a stage, inside the plant's step: its error
-                if task.controller_error(k, stage_errors[-1]):
+                if task.controller_error(k, stages.errors[-1]):
                     return LoopEnd(k, "controller_error")
                 raise
             obs = plant.observe()

@@ -275,6 +275,8 @@ def simulate(
         the time series hold what was recorded until then. ``summary["verdict"]`` says
         whether the run tracked (:mod:`ddwmmr.sim.verdict`).
     """
+    # The inputs, checked and built in this order (the first bad one is the error), all
+    # before the first step: a bad input costs no simulated time.
     robot = check_instance("robot", robot if robot is not None else Robot(), Robot)
     if progress is not None and not callable(progress):
         raise ParameterError(
@@ -297,8 +299,11 @@ def simulate(
     windows = corners(duration) if corners is not None else ()
     q = _start_pose(robot, reference, initial_offset, q0)
     tipped = _tipped_start(robot, q, tipped_start)
+    # The run: how it ended is in what the task recorded (its length, diverged_at).
     task = TrackingTask(reference, the_plant, grid=(dt, steps))
     run_loop(the_plant, controller, task, q, dt, steps, progress)
+    # The summary: metrics, what was run, the plug-ins' own keys, then the verdict, which
+    # reads all of them.
     timeseries = task.timeseries(robot)
     summary = summarize(timeseries, robot, windows)
     summary.update(_run_keys(timeseries, robot, trajectory, reference, controller, the_plant, dt))
