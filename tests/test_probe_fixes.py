@@ -170,3 +170,20 @@ def test_plant_error_axis_stops_below_the_data() -> None:
     converged = {"qp": {"t": t, "position_error_m": np.zeros(t.size)}}
     fig = cp.plot_plant_errors(converged, plant, {"qp": "C1"}, "mujoco", "ellipse")
     assert fig.axes[0].get_ylim()[0] == pytest.approx(cp.ERROR_FLOOR / 2, rel=1e-9)
+
+
+@pytest.mark.parametrize("parameter", ["method", "plant"])
+def test_an_object_for_another_robot_is_warned_at_the_callers_line(parameter: str) -> None:
+    """The warning names the line that called ``simulate`` (as Python's own warnings
+    name the caller), whether the controller or the plant holds the other robot."""
+    from ddwmmr import make_controller
+
+    other = Robot().with_payload(5.0)
+    given = {"method": make_controller("ats", other)} if parameter == "method" else {}
+    if parameter == "plant":
+        given = {"method": "ats", "plant": KinematicPlant(other)}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        simulate(Robot(), Ellipse(), duration=0.05, **given)
+    found = [w for w in caught if "another robot" in str(w.message)]
+    assert [w.filename for w in found] == [__file__]

@@ -92,12 +92,16 @@ _OTHER_ROBOT = {
 }
 
 
-def warn_other_robot(holder: Any, robot: Robot, parameter: str = "method") -> None:
+def warn_other_robot(
+    holder: Any, robot: Robot, parameter: str = "method", stacklevel: int = 3
+) -> None:
     """Warn (:class:`UserWarning`) when ``holder``, the object passed as ``parameter``
     (``"method"``: a controller, ``"plant"``: a plant), holds a ``robot`` other than the
     simulated one, naming the fields that differ: a controller's model, e.g. its stability
     floor's payload, is then not the plant's; a plant simulates other physics than the
-    summary judges. That can be meant (a study of model error), so it is not refused."""
+    summary judges. That can be meant (a study of model error), so it is not refused.
+    ``stacklevel`` counts frames as :func:`warnings.warn` does, from this function: the
+    warning names the user's call to :func:`simulate`."""
     own = getattr(holder, "robot", None)
     if not isinstance(own, Robot) or own == robot:
         return
@@ -112,7 +116,7 @@ def warn_other_robot(holder: Any, robot: Robot, parameter: str = "method") -> No
         f"({'; '.join(differ[:3])}{'; ...' if len(differ) > 3 else ''}): {meaning}; "
         "build it with the same Robot unless that is the point",
         UserWarning,
-        stacklevel=3,
+        stacklevel=stacklevel,
     )
 
 
@@ -326,7 +330,7 @@ def _controller_for(method: str | Controller, robot: Robot, options: dict[str, A
     if options:
         raise ParameterError("controller options are only accepted with a method name")
     controller = check_controller(method)
-    warn_other_robot(controller, robot)
+    warn_other_robot(controller, robot, stacklevel=4)  # from simulate's caller
     return controller
 
 
