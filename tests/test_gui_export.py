@@ -212,6 +212,55 @@ def test_mp4_has_the_frames_of_the_run(tmp_path):
     assert np.mean(np.abs(renders[0] - renders[-1]).max(axis=2) > 30) > 0.002  # it moved
 
 
+def animation_frame(app, folder, fmt, rc):
+    """The last frame of the run's ``fmt`` animation (3 frames) written under the
+    rcParams ``rc``, decoded as RGBA; None when matplotlib cannot write ``fmt`` here."""
+    import matplotlib as mpl
+
+    from ddwmmr.gui import export
+
+    if not animation_available(fmt):
+        return None
+    with mpl.rc_context(rc):
+        path = export.write_animation(app.results, app.labels(), [], folder, fmt, frames=3)
+    if fmt == "gif":
+        with Image.open(path) as movie:
+            movie.seek(movie.n_frames - 1)
+            return np.asarray(movie.convert("RGBA"), dtype=int)
+    imageio_ffmpeg = pytest.importorskip("imageio_ffmpeg", reason="reads the MP4 back")
+    reader = imageio_ffmpeg.read_frames(str(path))
+    width, height = next(reader)["size"]
+    *_, last = reader
+    rgb = np.frombuffer(last, dtype=np.uint8).reshape(height, width, 3).astype(int)
+    return np.dstack([rgb, np.full((height, width), 255)])
+
+
+def test_animations_are_painted_as_savefig_paints_a_png(tmp_path):
+    """The exported animation takes the user's savefig colours, as `track --animate`'s
+    GIF and the window's PNG do: the figure's face in ``savefig.facecolor``; under
+    ``savefig.transparent`` a GIF's figure and axes backgrounds are transparent, while an
+    MP4 (no alpha) shows them white, as matplotlib's own movie writer does."""
+    app = finished_app(Settings(methods=("ats", None), duration=DURATION / 5), tmp_path)
+    corner = (3, 3)  # the figure's face, outside every axes
+    inside = (200, 300)  # the top view's background, away from the paths
+    for fmt in ("gif", "mp4"):
+        folder = tmp_path / fmt
+        folder.mkdir()
+        plain = animation_frame(app, folder / "plain", fmt, {})
+        if plain is None:
+            continue  # no ffmpeg here: test_mp4_has_the_frames_of_the_run says so
+        assert (np.abs(plain[corner] - 255) <= 3).all(), fmt
+        dark = animation_frame(app, folder / "dark", fmt, {"savefig.facecolor": "black"})
+        assert (np.abs(dark[corner][:3]) <= 3).all() and dark[corner][3] == 255, fmt
+        assert (np.abs(dark[inside] - 255) <= 3).all(), fmt  # the axes keep theirs
+        clear = animation_frame(app, folder / "clear", fmt, {"savefig.transparent": True})
+        if fmt == "gif":
+            assert clear[corner][3] == 0 and clear[inside][3] == 0
+            assert np.mean(clear[..., 3] == 255) < 0.2  # the lines and texts only
+        else:
+            assert np.mean(np.abs(clear - plain)) < 1.0  # as without: white
+
+
 def test_export_before_a_run_is_a_message(tmp_path):
     figure = Figure(figsize=FIGSIZE, dpi=30)
     FigureCanvasAgg(figure)

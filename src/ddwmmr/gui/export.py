@@ -27,16 +27,17 @@ import dataclasses
 import io
 import json
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from matplotlib import animation as mpl_animation
 from matplotlib import rcParams
+from matplotlib.artist import Artist
+from matplotlib.backend_bases import RendererBase
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
-from PIL import Image
 
 from ddwmmr import provenance
 from ddwmmr.errors import ParameterError
@@ -49,7 +50,7 @@ from ddwmmr.outputs import (
     unwritable_message,
     write_new,
 )
-from ddwmmr.reports.canvas import blitted_frames, frame_indices, gif_bytes
+from ddwmmr.reports.canvas import frame_indices, new_figure, saved_frames, saved_gif_bytes
 from ddwmmr.sim.simulate import plant_integrator
 from ddwmmr.trajectories import SampledTrajectory
 from ddwmmr.trajectories.files import SHAPES, find_trajectory_file, is_name
@@ -315,8 +316,11 @@ def write_animation(
 ) -> Path:
     """``animation.<fmt>``: the view (robot, paths, plots) at ``frames`` evenly spaced times.
 
-    Drawn by the window's own :class:`ddwmmr.gui.view.RunView` in a separate figure;
-    a run shorter than ``frames`` recorded instants gives one frame per instant.
+    Drawn by the window's own :class:`ddwmmr.gui.view.RunView` in a separate figure at
+    ``dpi``, each frame painted as ``savefig`` paints a PNG under the user's rcParams
+    (:func:`ddwmmr.reports.canvas.saved_frames`: ``savefig.facecolor``, ``edgecolor``,
+    and ``transparent`` in a GIF; an MP4 has no alpha, its clear parts show white); a run
+    shorter than ``frames`` recorded instants gives one frame per instant.
     """
     from ddwmmr.gui.view import animation_figure
 
@@ -330,40 +334,45 @@ def write_animation(
     figure, view = animation_figure(dpi)
     view.set_runs(results, labels, obstacles)
     indices = frame_indices(view.last_index, frames)
+    update = _view_update(view, indices)
     path = folder / f"animation.{fmt}"
     if fmt == "gif":
-        # Each frame is copied out of the canvas (convert) before the next is drawn.
-        images = [
-            Image.fromarray(rgba).convert("RGB") for rgba in _view_frames(figure, view, indices)
-        ]
-        return write_new(path, gif_bytes(images, fps))
-    writer = _FramePipeWriter(fps=fps)
+        return write_new(path, saved_gif_bytes(figure, update, len(indices), fps, dpi=dpi))
+    writer = mpl_animation.FFMpegWriter(fps=fps)
+    # The writer's figure only shows each frame, drawn by the view's figure.
+    screen = new_figure((figure.get_figwidth(), figure.get_figheight()), dpi=dpi)
+    shown = _Picture()
+    screen.add_artist(shown)
     with tempfile.TemporaryDirectory() as scratch:
         temporary = Path(scratch) / path.name
-        # setup (here) may round the figure's size to even pixels for the codec: the
-        # frames are drawn after it, at that size.
-        with writer.saving(figure, str(temporary), dpi):
-            for rgba in _view_frames(figure, view, indices):
-                writer.write_rgba(rgba)
+        with writer.saving(screen, str(temporary), dpi):
+            # setup may have rounded the size to even pixels for the codec: the view is
+            # drawn at that size. An MP4 has no alpha: savefig.transparent is left aside
+            # and what is left clear shows white, as matplotlib's Animation.save does.
+            figure.set_size_inches(screen.get_figwidth(), screen.get_figheight())
+            for rgba in saved_frames(figure, update, len(indices), dpi, transparent=False):
+                shown.rgba = rgba
+                writer.grab_frame(facecolor="white", transparent=False)
         return write_new(path, temporary.read_bytes())
 
 
-class _FramePipeWriter(mpl_animation.FFMpegWriter):
-    """matplotlib's ffmpeg writer (its command line: codec, pixel format, bitrate and
-    ``animation.ffmpeg_args`` as configured; its errors) fed with frames drawn elsewhere,
-    instead of the full render of the figure that ``grab_frame`` makes per frame."""
+class _Picture(Artist):
+    """An RGBA picture (``rgba``: a ``(height, width, 4)`` array) drawn pixel for pixel
+    from the figure's lower left corner, over its face."""
 
-    def write_rgba(self, rgba: NDArray[np.uint8]) -> None:
-        """Pipe one frame to ffmpeg: a ``(height, width, 4)`` RGBA array of
-        :attr:`frame_size` (between ``setup`` and ``finish``; ffmpeg reads the bytes as
-        frames of that size, so any other size scrambles the movie)."""
-        # ignore: _proc is the ffmpeg process setup() started (MovieWriter's, untyped)
-        self._proc.stdin.write(np.ascontiguousarray(rgba))  # type: ignore[attr-defined]
+    def __init__(self) -> None:
+        super().__init__()
+        self.rgba: NDArray[np.uint8] = np.zeros((1, 1, 4), dtype=np.uint8)
+
+    def draw(self, renderer: RendererBase) -> None:
+        gc = renderer.new_gc()
+        renderer.draw_image(gc, 0, 0, self.rgba[::-1])  # its rows from the bottom up
+        gc.restore()
 
 
-def _view_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterator[NDArray[np.uint8]]:
-    """The view at the recorded ``indices`` as RGBA arrays
-    (:func:`ddwmmr.reports.canvas.blitted_frames`): the moving artists are the view's
+def _view_update(view: Any, indices: Sequence[int]) -> Callable[[int], list[Any]]:
+    """The ``update`` of :func:`ddwmmr.reports.canvas.saved_frames` that shows the view
+    at the recorded ``indices``: the moving artists are the view's
     :meth:`~ddwmmr.gui.view.RunView.dynamic_artists`; the legends belong to the still
     background, placed for the whole run (the last index drawn first)."""
 
@@ -372,4 +381,4 @@ def _view_frames(figure: Figure, view: Any, indices: Sequence[int]) -> Iterator[
         artists: list[Any] = view.dynamic_artists(legends=False)
         return artists
 
-    return blitted_frames(figure, update, len(indices))
+    return update

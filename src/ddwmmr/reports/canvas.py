@@ -11,9 +11,10 @@ window, the plotting functions of :mod:`ddwmmr.reports.plots` draw into pyplot's
 ``plot_rates``, ``plot_metrics``), then ``plt.show()``.
 
 Animations of such figures (`track --animate`, the physics animation, the window's GIF
-and MP4 export) all take their frames from :func:`blitted_frames`; GIFs are encoded by
-:func:`gif_bytes`. :func:`save_gif` (the first two) paints its frames as ``savefig``
-paints a PNG under the user's rcParams (:func:`as_saved`).
+and MP4 export) all take their frames from :func:`saved_frames`: the frames of
+:func:`blitted_frames` painted as ``savefig`` paints a PNG under the user's rcParams
+(:func:`as_saved`); GIFs are encoded by :func:`gif_bytes` (:func:`saved_gif_bytes`,
+:func:`save_gif`).
 """
 
 from __future__ import annotations
@@ -103,25 +104,31 @@ def blitted_frames(
 
 
 @contextmanager
-def as_saved(fig: Figure) -> Iterator[Figure]:
+def as_saved(
+    fig: Figure, dpi: float | None = None, transparent: bool | None = None
+) -> Iterator[Figure]:
     """``fig`` as ``fig.savefig`` renders it under the user's rcParams, restored on exit:
-    at ``savefig.dpi`` (``'figure'``: its own), its face and edge painted in
-    ``savefig.facecolor`` and ``savefig.edgecolor`` (``'auto'``: its own) and, with
-    ``savefig.transparent``, the figure's and every axes' (and subfigure's) background
-    clear, as savefig clears them. ``savefig.bbox`` is not applied: every frame of an
-    animation is the whole figure (as matplotlib's ``Animation.save`` does)."""
+    at ``dpi`` (as savefig's own argument; default ``savefig.dpi``, where ``'figure'`` is
+    its own), its face and edge painted in ``savefig.facecolor`` and ``savefig.edgecolor``
+    (``'auto'``: its own) and, if ``transparent`` (default ``savefig.transparent``), the
+    figure's and every axes' (and subfigure's) background clear, as savefig clears them.
+    ``savefig.bbox`` is not applied: every frame of an animation is the whole figure (as
+    matplotlib's ``Animation.save`` does)."""
     from matplotlib import rcParams
     from matplotlib.axes import Axes
     from matplotlib.figure import SubFigure
     from matplotlib.patches import Patch
 
-    dpi = rcParams["savefig.dpi"]
+    if dpi is None:
+        dpi = rcParams["savefig.dpi"]
+    if transparent is None:
+        transparent = rcParams["savefig.transparent"]
     colors = {
         "facecolor": rcParams["savefig.facecolor"],
         "edgecolor": rcParams["savefig.edgecolor"],
     }
     backgrounds: list[Patch] = [fig.patch]
-    if rcParams["savefig.transparent"]:
+    if transparent:
         colors = {"facecolor": "none", "edgecolor": "none"}
         backgrounds += [
             found.patch for found in fig.findobj() if isinstance(found, Axes | SubFigure)
@@ -158,6 +165,47 @@ def checked_gif_options(path: Any, frames: Any, fps: Any) -> tuple[Path, int, in
     return path, frames, fps
 
 
+def saved_frames(
+    fig: Figure,
+    update: Callable[[int], Iterable[Artist]],
+    count: int,
+    dpi: float | None = None,
+    transparent: bool | None = None,
+) -> Iterator[NDArray[np.uint8]]:
+    """The frames of :func:`blitted_frames` (``update(i)`` sets frame i and returns the
+    artists that move), each the figure as a PNG of ``fig.savefig`` shows it
+    (:func:`as_saved` with ``dpi`` and ``transparent``: by default ``savefig.dpi``,
+    ``savefig.facecolor``, ``savefig.edgecolor``, ``savefig.transparent``). The figure is
+    its own again once the frames are exhausted (or the iterator closed)."""
+    with as_saved(fig, dpi, transparent):
+        yield from blitted_frames(fig, update, count)
+
+
+def saved_gif_bytes(
+    fig: Figure,
+    update: Callable[[int], Iterable[Artist]],
+    count: int,
+    fps: int,
+    advance: Callable[[], object] | None = None,
+    dpi: float | None = None,
+) -> bytes:
+    """A GIF of ``count`` frames of ``fig`` at ``fps`` frames per second
+    (:func:`gif_bytes`): the frames of :func:`saved_frames` (at ``dpi``, default
+    ``savefig.dpi``); ``advance()`` (if given) is called after each frame is drawn. A
+    transparent background (``savefig.transparent``) is transparent in the GIF, to its one
+    transparent colour (:func:`gif_bytes`)."""
+    images = []
+    for rgba in saved_frames(fig, update, count, dpi):
+        image = Image.fromarray(rgba)
+        # a copy, out of the canvas; RGB where every pixel is opaque to gif_bytes, so
+        # that an opaque animation's frames are held at 3 bytes a pixel, not 4
+        clear = bool((rgba[..., 3] < GIF_OPAQUE).any())
+        images.append(image.copy() if clear else image.convert("RGB"))
+        if advance is not None:
+            advance()
+    return gif_bytes(images, fps)
+
+
 def save_gif(
     fig: Figure,
     update: Callable[[int], Iterable[Artist]],
@@ -166,24 +214,11 @@ def save_gif(
     fps: int,
     advance: Callable[[], object] | None = None,
 ) -> Path:
-    """Write ``count`` frames of ``fig`` to the GIF ``path`` at ``fps`` frames per second
-    (:func:`gif_bytes`): the frames of :func:`blitted_frames` (``update(i)`` sets frame i
-    and returns the artists that move), each the figure as a PNG of ``fig.savefig`` shows
-    it (:func:`as_saved`: ``savefig.dpi``, ``savefig.facecolor``, ``savefig.edgecolor``,
-    ``savefig.transparent``); ``advance()`` (if given) is called after each frame is drawn.
-    A transparent background is transparent in the GIF, to its one transparent colour
-    (:func:`gif_bytes`)."""
-    images = []
-    with as_saved(fig):
-        for rgba in blitted_frames(fig, update, count):
-            image = Image.fromarray(rgba)
-            # a copy, out of the canvas; RGB where every pixel is opaque to gif_bytes, so
-            # that an opaque animation's frames are held at 3 bytes a pixel, not 4
-            clear = bool((rgba[..., 3] < GIF_OPAQUE).any())
-            images.append(image.copy() if clear else image.convert("RGB"))
-            if advance is not None:
-                advance()
-    Path(path).write_bytes(gif_bytes(images, fps))
+    """Write ``count`` frames of ``fig`` to the GIF ``path`` at ``fps`` frames per second:
+    :func:`saved_gif_bytes` (``update(i)`` sets frame i and returns the artists that
+    move; each frame as a PNG of ``fig.savefig`` shows it under the user's rcParams;
+    ``advance()``, if given, called after each frame is drawn)."""
+    Path(path).write_bytes(saved_gif_bytes(fig, update, count, fps, advance))
     return path
 
 
