@@ -49,6 +49,26 @@ def test_a_number_field_reads_numbers_as_the_command_lines_do(name: str, typed: 
     assert app.settings == before and field.text == shown
 
 
+@pytest.mark.parametrize("typed", ["0,3", "0,0", "-0,03 -0,03", "0.1,0.2"])
+def test_the_offset_refuses_a_comma_between_digits(typed: str) -> None:
+    """The text 0,3 is 0.3 to a reader of decimal commas, (0, 3) to one of lists: the offset
+    field takes neither reading and says how to write the two numbers; a comma beside a
+    space or a sign stays a separator."""
+    app = offscreen_app()
+    before, shown = app.settings, app.offset_field.text
+    app.offset_field.submit(typed)
+    assert app.message_is_error, app.message
+    assert app.message.startswith("offset must be two numbers dx dy in m, a point the decimal")
+    assert "a comma between digits could be a decimal comma; write e.g. 0 0.3 or 0, 0.3" in (
+        app.message
+    )
+    assert app.settings == before and app.offset_field.text == shown
+    for accepted in ("0, 0.3", "0 0.3", "0.01,-0.02", "0.01 , 0.02"):
+        app.offset_field.submit(accepted)
+        assert not app.message_is_error, (accepted, app.message)
+    assert app.settings.offset == (0.01, 0.02)
+
+
 def test_an_export_folder_name_on_more_than_one_line_is_refused(tmp_path) -> None:
     app = offscreen_app()
     for name in (f"{tmp_path}/runs\ngui", f"{tmp_path}/a\rb", f"{tmp_path}/tab\there"):

@@ -18,6 +18,7 @@ import contextlib
 import datetime
 import functools
 import os
+import re
 import textwrap
 import time
 from collections.abc import Callable, Iterator
@@ -599,6 +600,15 @@ class App(PanelLayout):
         return "" if value is None else f"{value:g}"
 
     def _apply_offset(self, text: str) -> str:
+        """The offset field: two numbers dx dy in m, apart by spaces, a comma or both, a
+        point the decimal mark; a comma between two digits ("0,3") is refused, being a
+        decimal comma to many readers (0.3, not 0 and 3)."""
+        if re.search(r"\d,\d", text):
+            raise ParameterError(
+                f"offset must be two numbers dx dy in m, a point the decimal mark (got "
+                f"{shown(text)}: a comma between digits could be a decimal comma; write "
+                "e.g. 0 0.3 or 0, 0.3)"
+            )
         parts = text.replace(",", " ").split()
         try:
             values = tuple(plain_float(p) for p in parts)
