@@ -114,3 +114,28 @@ def test_two_long_lines_fit_above_the_buttons_of_a_laptop_window():
     assert extent.y0 > app.transport["run"].ax.bbox.y1 and extent.x1 <= figure.bbox.width
     assert app.summary_text.get_fontsize() * dpi / 72 >= (FONT - 2) * MIN_DPI / 72
     assert app.summary_text.get_text().replace("\n    ", " ") == "\n".join(lines)
+
+
+@pytest.mark.parametrize(
+    "figsize, dpi",
+    [(FIGSIZE, 100), (FIGSIZE, MIN_DPI), window_size(1366, 768), window_size(1920, 1080)],
+)
+def test_the_summary_starts_below_the_plots_time_label(figsize, dpi):
+    """The first summary line, running under the plots, starts below their ``t (s)``
+    label with a pixel to spare, in the snapshot's window and in the desktop's."""
+    figure = Figure(figsize=figsize, dpi=dpi)
+    FigureCanvasAgg(figure)
+    app = App(figure, Settings(duration=1.0), interactive=False)
+    app.run()
+    app.wait()
+    assert app.results is not None, app.message
+    lines = [_summary_line(label, SimpleNamespace(summary=LONG_SUMMARY)) for label in "AB"]
+    app._show_summary("\n".join(lines))
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    label = app.view.plot_axes["manipulability"].xaxis.label
+    assert label.get_text() == "t (s)" and label.get_visible()
+    below = label.get_window_extent(renderer)
+    summary = app.summary_text.get_window_extent(renderer)
+    assert summary.x1 > below.x1  # the first line runs under the label
+    assert below.y0 - summary.y1 >= 1.0

@@ -388,7 +388,7 @@ class PanelLayout:
             return (0.385, path_bottom, 0.31, 0.955 - path_bottom)
 
         def plots_rect() -> Rect:
-            plots_left, plots_bottom = self._grown(0.745, 0.1), self._grown(0.265, 0.2)
+            plots_left, plots_bottom = self._grown(0.745, 0.1), self._grown(0.27, 0.2)
             return (plots_left, plots_bottom, 0.99 - plots_left, 0.955 - plots_bottom)
 
         def plot_rect(number: int) -> Rect:
