@@ -179,6 +179,25 @@ def test_a_glyph_the_font_lacks_is_shown_as_its_escape(recwarn) -> None:
     assert not [w for w in recwarn if "missing from font" in str(w.message)]
 
 
+def test_an_accepted_folder_the_font_lacks_is_named_once_not_warned(recwarn, tmp_path) -> None:
+    """A folder name in a script the font lacks is taken as typed: the message names it
+    with its characters escaped, the box keeps (and draws) the name itself, and no draw
+    warns on the console, whatever text or size the box is drawn at."""
+    app = offscreen_app()
+    folder = f"{tmp_path}/runs-\u65e5\u672c"
+    app.export_field.submit(folder)
+    assert not app.message_is_error and app.export_field.text == folder
+    assert app.message_text.get_text().endswith("runs-\\u65e5\\u672c")
+    box = app.export_field.box.text_disp
+    app.figure.canvas.draw()
+    box.set_text(folder + "2")  # as typing it changes
+    box.get_window_extent(app.figure.canvas.get_renderer())
+    app.figure.canvas.draw()
+    app.figure.set_dpi(40)
+    app.figure.canvas.draw()
+    assert not [w for w in recwarn if "missing from font" in str(w.message)]
+
+
 def test_a_near_constant_error_plot_keeps_short_tick_labels() -> None:
     """tau = inf disables the correction (a documented value): the orientation error then
     drifts by 1e-13 rad, and its ticks, labelled in their last digits, ran over the top

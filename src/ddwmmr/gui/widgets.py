@@ -17,6 +17,8 @@ behaves like typing the text and pressing Enter.
 
 from __future__ import annotations
 
+import functools
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -36,6 +38,8 @@ FONT = 8
 Reporter = Callable[[str], None]
 #: A rectangle ``(left, bottom, width, height)`` in figure fractions.
 Rect = tuple[float, float, float, float]
+#: matplotlib's warning of a character its fonts have no glyph for (a regular expression).
+MISSING_GLYPH = r"Glyph \d+ .* missing from font"
 
 
 def panel_axes(figure: Figure, rect: Rect) -> Axes:
@@ -53,7 +57,19 @@ class QuietTextBox(TextBox):
     click took seconds); and it draws the full figure on every key typed. Here ending
     typing does nothing unless this box is being typed in, and a key schedules an idle
     redraw instead of drawing at once.
+
+    A character the font has no glyph for (a folder name in a script the font lacks) is
+    drawn as matplotlib draws it, without its console warning, which matplotlib repeats
+    whenever the text or the window's size changes: the window's message names such
+    text once, its characters escaped (:func:`drawable`). The box keeps the text itself,
+    the value it applies.
     """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        for name in ("draw", "get_window_extent"):  # the two that lay the text out
+            method = getattr(self.text_disp, name)
+            setattr(self.text_disp, name, _without_glyph_warnings(self.text_disp, method))
 
     def stop_typing(self) -> None:
         if self.capturekeystrokes:
@@ -72,6 +88,21 @@ class QuietTextBox(TextBox):
             super()._rendercursor()  # type: ignore[misc]
         finally:
             del canvas.draw
+
+
+def _without_glyph_warnings(text: Text, method: Callable[..., Any]) -> Callable[..., Any]:
+    """``method`` of ``text``, silent about the glyphs its font lacks (:data:`MISSING_GLYPH`)
+    while ``text`` holds any non-ASCII character (every font has every ASCII glyph)."""
+
+    @functools.wraps(method)
+    def quietly(*args: Any, **kwargs: Any) -> Any:
+        if text.get_text().isascii():
+            return method(*args, **kwargs)
+        with warnings.catch_warnings():
+            warnings.filterwarnings("ignore", MISSING_GLYPH, UserWarning)
+            return method(*args, **kwargs)
+
+    return quietly
 
 
 def message_line(text: str) -> str:
