@@ -22,6 +22,7 @@ SCRIPT = textwrap.dedent(
     from ddwmmr.gui.app import App
     from ddwmmr.gui.layout import desktop_figure
     from ddwmmr.gui.settings import Settings
+    from tk_steps import close, run_steps
 
     figure = desktop_figure()
     settings = Settings(methods=("qp", None), plant="mujoco", duration=0.2)
@@ -38,17 +39,9 @@ SCRIPT = textwrap.dedent(
         others = [plt.figure(n) for n in plt.get_fignums() if plt.figure(n) is not figure]
         print("message:", app.message)
         print("windows:", [type(f.canvas).__name__ for f in others])
-        window.tk.call(window.protocol("WM_DELETE_WINDOW"))  # closes the support window too
+        close(window)  # closes the support window too
 
-    order = steps()
-
-    def tick():
-        delay = next(order, None)
-        if delay is not None:
-            window.after(delay, tick)
-
-    window.after(500, tick)
-    plt.show()
+    run_steps(window, steps(), 500)
     """
 )
 

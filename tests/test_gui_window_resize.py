@@ -17,7 +17,6 @@ from xvfb import NEEDS_XVFB, run_under_xvfb
 
 pytestmark = NEEDS_XVFB
 
-TESTS = Path(__file__).resolve().parent
 #: Window sizes (px, toolbar included) the script sets in turn; 0 x 0: as opened.
 SIZES = [(0, 0), (1366, 768), (1920, 1080), (1366, 768)]
 
@@ -27,16 +26,14 @@ SCRIPT = textwrap.dedent(
     import sys
     import time
 
-    import matplotlib.pyplot as plt
-
-    sys.path.insert(0, sys.argv[1])
     from figure_checks import text_collisions
+    from tk_steps import close, run_steps
 
     from ddwmmr.gui.app import App
     from ddwmmr.gui.layout import desktop_figure
     from ddwmmr.gui.settings import Settings
 
-    sizes = json.loads(sys.argv[2])
+    sizes = json.loads(sys.argv[1])
     figure = desktop_figure()
     app = App(figure, Settings(methods=("clrrmc-ts", "qp"), duration=1.0), interactive=True)
     window, canvas = figure.canvas.manager.window, figure.canvas.get_tk_widget()
@@ -86,17 +83,9 @@ SCRIPT = textwrap.dedent(
             yield 200
         drag = {"resizes": len(resized) - events, "relayouts": len(relayouts) - before}
         print("drag", json.dumps(drag), flush=True)
-        window.tk.call(window.protocol("WM_DELETE_WINDOW"))
+        close(window)
 
-    order = steps()
-
-    def tick():
-        delay = next(order, None)
-        if delay is not None:
-            window.after(delay, tick)
-
-    window.after(300, tick)
-    plt.show()
+    run_steps(window, steps(), 300)
     """
 )
 
@@ -104,7 +93,7 @@ SCRIPT = textwrap.dedent(
 def test_the_window_follows_its_size(tmp_path: Path) -> None:
     script = tmp_path / "resize.py"
     script.write_text(SCRIPT)
-    done = run_under_xvfb([sys.executable, str(script), str(TESTS), json.dumps(SIZES)])
+    done = run_under_xvfb([sys.executable, str(script), json.dumps(SIZES)])
     assert done.returncode == 0, done.stderr
     lines = done.stdout.splitlines()
     sizes = [json.loads(line.split(" ", 1)[1]) for line in lines if line.startswith("size ")]
