@@ -50,9 +50,9 @@ class _ArmStill(Task):
         error[:] = 0.0
 
 
-def _run(solver: str = "daqp", **pieces):
+def _run(solver: str = "daqp", **options):
     robot = Robot()
-    controller = make_controller("qp", robot, solver=solver, **pieces)
+    controller = make_controller("qp", robot, solver=solver, **options)
     return simulate(robot, Ellipse(a=2.0, b=1.5, T=40.0), controller, duration=1.0)
 
 
@@ -109,3 +109,57 @@ def test_library_pieces_run_unguarded_on_the_generic_path():
     problem = QPProblem(controller.tasks, controller.limits, compiled=False)
     for piece, compute, *_ in problem._generic_cost + problem._generic_limits:
         assert (compute == piece.compute) == (piece.__module__.startswith("ddwmmr."))
+
+
+class _Box(Limit):
+    """Sets the box on input ``index`` to ``[-cap, cap]``: by assignment (``assign``,
+    which widens a tighter box it was given) or as the contract has it (max / min)."""
+
+    name = "box"
+
+    def __init__(self, index: int, cap: float, assign: bool, unit: float = 1.0) -> None:
+        self.index, self.cap, self.assign, self.unit = index, cap, assign, unit
+
+    def compute(self, ctx, G, lower, upper, lb, ub):
+        i, cap = self.index, self.cap
+        if self.assign:
+            lb[i], ub[i] = -cap, cap
+        else:
+            lb[i], ub[i] = max(lb[i], -cap), min(ub[i], cap)
+
+
+def test_a_limit_widening_the_box_it_was_given_is_refused_in_one_line():
+    """The joints' speed limit (2 rad/s, less the solver's margin) is in the box a user's
+    limit receives: assigning +-10 rad/s lifted it (the run went on at up to 10 rad/s)."""
+    with pytest.raises(ParameterError) as info:
+        _run(limits=[_Box(2, 10.0, assign=True)])
+    message = str(info.value)
+    assert message.startswith(
+        "_Box 'box': compute() widened the input box at t = 0 s: lb[2] (th1dot) from "
+        "-1.999998 to -10 (a limit only tightens lb, ub"
+    )
+    assert "\n" not in message
+
+
+@pytest.mark.parametrize("unit", [1.0, 0.5])  # 0.5: the box on v passes through its unit
+def test_a_limit_that_tightens_or_keeps_the_box_runs(unit):
+    for index in range(4):
+        for cap, assign in ((0.1, False), (0.1, True), (1e9, False)):  # 1e9: kept as given
+            result = _run(limits=[_Box(index, cap, assign, unit)], max_base_speed=0.5)
+            rate = np.abs(result.timeseries[("v", "w", "th1dot", "th2dot")[index]])
+            assert np.max(rate) <= min(cap * (unit if index == 0 else 1.0), 2.0) + 1e-6
+
+
+def test_a_limit_may_write_inf_on_an_open_side():
+    """w's box is open (+-INF, 1e30) by default: +-inf there leaves it open."""
+    _run(limits=[_Box(1, math.inf, assign=True)])
+
+
+def test_a_limit_widening_v_in_its_own_unit_is_refused():
+    """max_base_speed 0.5 m/s: +-1 in a unit of 0.5 m; +-1000 widens it."""
+    with pytest.raises(
+        ParameterError,
+        match=r"^_Box 'box': compute\(\) widened .* lb\[0\] \(v\) "
+        r"from -1 to -1000 ",
+    ):
+        _run(limits=[_Box(0, 1e3, assign=True, unit=0.5)], max_base_speed=0.5)

@@ -48,6 +48,7 @@ from ddwmmr.errors import (
     shown,
 )
 from ddwmmr.inheritance import from_library
+from ddwmmr.model.kinematics import U_NAMES
 from ddwmmr.qp.blocks import CONSTANT, LimitBlock, TaskBlock
 from ddwmmr.qp.context import NU, StepContext
 from ddwmmr.qp.limits.base import INF, Limit
@@ -151,8 +152,33 @@ def guarded_task(task: Task) -> TaskCompute:
     return guarded
 
 
+def _refuse_widened(
+    label: str, ctx: StepContext, before: list[float], lb: list[float], ub: list[float]
+) -> None:
+    """Refuse (one-line :class:`ParameterError`) the limit ``label`` if its ``compute``
+    loosened a bound of the input box it was given: ``before`` holds ``lb`` then ``ub`` as
+    they arrived (the earlier limits' box), ``lb``, ``ub`` what it left. An open side
+    (``+-INF``, or beyond) may be written ``+-inf``; a NaN passes here
+    (:func:`_refuse_written`'s to refuse)."""
+    for i in range(NU):
+        side, old, new = "lb", before[i], lb[i]
+        if not (new < old and old > -INF):
+            side, old, new = "ub", before[NU + i], ub[i]
+            if not (new > old and old < INF):
+                continue
+        raise ParameterError(
+            f"{label}: compute() widened the input box at t = {ctx.t:g} s: {side}[{i}] "
+            f"({U_NAMES[i]}) from {old:.9g} to {new:.9g} (a limit only tightens lb, ub, which "
+            f"hold the earlier limits' bounds: lb[i] = max(lb[i], ...), ub[i] = min(ub[i], ...))"
+        )
+
+
 def guarded_limit(limit: Limit) -> LimitCompute:
-    """``limit.compute``, for a user's limit wrapped like :func:`guarded_task`."""
+    """``limit.compute``, for a user's limit wrapped like :func:`guarded_task` and refused
+    in one line when it widens the input box it was given (:func:`_refuse_widened`): the
+    box holds the earlier limits' bounds, the library's among them, which hold whatever
+    a user's limit asks. The library's own limits only tighten by construction and run
+    unwrapped."""
     if from_library(limit):
         return limit.compute
     label, compute, rows = piece_label(limit), limit.compute, limit.rows
@@ -169,10 +195,14 @@ def guarded_limit(limit: Limit) -> LimitCompute:
         lb: np.ndarray,
         ub: np.ndarray,
     ) -> None:
+        before = lb.tolist() + ub.tolist()
         try:
             compute(ctx, G, lower, upper, lb, ub)
         except Exception as exc:
             raise_plugin_error(f"{label}: compute()", exc, f" at t = {ctx.t:g} s ({contract})")
+        after_lb, after_ub = lb.tolist(), ub.tolist()
+        if after_lb + after_ub != before:  # a tightened (or NaN) bound: which, if any, widened
+            _refuse_widened(label, ctx, before, after_lb, after_ub)
 
     return guarded
 
