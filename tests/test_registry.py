@@ -144,7 +144,7 @@ def test_a_name_registered_twice_is_refused():
 
     with pytest.raises(ParameterError, match="'ats' is registered twice"):
         CONTROLLERS.register("ats")(Other)
-    with pytest.raises(TypeError, match="unknown trait 'speed'"):
+    with pytest.raises(ParameterError, match="unknown keyword 'speed'"):
         CONTROLLERS.register("fast", speed=3)
 
 

@@ -5,7 +5,7 @@ without a word, and a function fail later with an AttributeError."""
 import pytest
 
 from ddwmmr.errors import ParameterError
-from ddwmmr.registry import CONTROLLERS, register_controller, register_plant
+from ddwmmr.registry import CONTROLLERS, register_arbiter, register_controller, register_plant
 
 
 @pytest.mark.parametrize(
@@ -72,4 +72,47 @@ def test_valid_traits_are_taken_lists_as_tuples(registered):
 def test_only_a_class_is_registered(thing):
     with pytest.raises(ParameterError, match=r"^register_controller\('mine'\) registers a class "):
         register_controller("mine")(thing)
+    assert "mine" not in CONTROLLERS.names()
+
+
+@pytest.mark.parametrize(
+    ("decorator", "args", "traits", "message"),
+    [
+        (
+            register_controller,
+            (),
+            {"taks": ("tracking",)},
+            "register_controller('mine'): unknown keyword 'taks' (did you mean tasks?) "
+            "(keywords: tasks, interfaces, arbiter, description)",
+        ),
+        (
+            register_plant,
+            (),
+            {"interface": ("velocity",)},
+            "register_plant('mine'): unknown keyword 'interface' (did you mean interfaces?) "
+            "(keywords: interfaces, description)",
+        ),
+        (
+            register_arbiter,
+            (),
+            {"seed": 3},
+            "register_arbiter('mine'): unknown keyword 'seed' (keywords: description)",
+        ),
+        (
+            register_controller,
+            (("tracking",),),
+            {},
+            "register_controller('mine'): takes the name alone by position, the traits as "
+            "keywords (tasks, interfaces, arbiter, description; got 2 positional arguments)",
+        ),
+    ],
+)
+def test_a_keyword_the_decorator_does_not_take_is_one_line_naming_the_allowed(
+    decorator, args, traits, message
+):
+    """Python's own TypeError before: no suggestion, and the plug-in module's import
+    failed as a TypeError of the registry."""
+    with pytest.raises(ParameterError) as error:
+        decorator("mine", *args, **traits)
+    assert str(error.value) == message
     assert "mine" not in CONTROLLERS.names()

@@ -30,7 +30,8 @@ traits:
 
 A trait's value is checked when the class is registered (a tuple trait: a non-empty tuple,
 or list, of the words above; ``arbiter``: a bool); anything else is a one-line
-:class:`~ddwmmr.errors.ParameterError` naming the trait.
+:class:`~ddwmmr.errors.ParameterError` naming the trait, and so is a keyword the decorator
+does not take (:meth:`Registry.keywords`: its traits and ``description``), naming it.
 
 Every decorator sets the class attribute ``name``. A name is what the command line types
 (``--method NAME``, ``--option NAME:KEY=VALUE``, comma-separated lists, the run folder
@@ -66,7 +67,7 @@ from itertools import count
 from pathlib import Path
 from typing import Any, TypeVar, cast
 
-from ddwmmr.errors import ParameterError, one_line, raise_plugin_error, shown
+from ddwmmr.errors import ParameterError, did_you_mean, one_line, raise_plugin_error, shown
 from ddwmmr.inheritance import class_from_library
 
 #: The built-in plug-in modules, in listing order.
@@ -158,12 +159,21 @@ class Registry:
         self._entries: dict[str, Entry] = {}
 
     # -- registration -----------------------------------------------------------------
-    def register(self, name: str, **traits: Any) -> Callable[[PluginClass], PluginClass]:
+    def register(
+        self, name: str, *extra: Any, **traits: Any
+    ) -> Callable[[PluginClass], PluginClass]:
         """Class decorator: register the class under ``name`` with ``traits`` (see the
         module docstring; ``description=`` overrides the docstring's first line). A name
-        the command line cannot address (not :data:`NAME_FORM`) is a
-        :class:`~ddwmmr.errors.ParameterError` naming ``name``, raised here."""
+        the command line cannot address (not :data:`NAME_FORM`), a trait given by position
+        (``extra``) or a keyword the decorator does not take (``taks=``) is a one-line
+        :class:`~ddwmmr.errors.ParameterError`, raised here."""
         self.check_name(name)
+        if extra:
+            raise ParameterError(
+                f"{self.decorator}({name!r}): takes the name alone by position, the traits "
+                f"as keywords ({', '.join(self.keywords())}; got {len(extra) + 1} positional "
+                "arguments)"
+            )
         description = traits.pop("description", None)
         resolved = self._traits(name, traits)
 
@@ -199,12 +209,17 @@ class Registry:
             )
         return cast(str, name)  # cast: valid holds only for a str
 
+    def keywords(self) -> tuple[str, ...]:
+        """The keywords the decorator takes: the kind's traits, then ``description``."""
+        return (*self.defaults, "description")
+
     def _traits(self, name: str, given: Mapping[str, Any]) -> dict[str, Any]:
         unknown = sorted(set(given) - set(self.defaults))
         if unknown:
-            raise TypeError(
-                f"{self.decorator}({name!r}): unknown trait {unknown[0]!r} "
-                f"(known: {', '.join(self.defaults) or 'none'})"
+            raise ParameterError(
+                f"{self.decorator}({name!r}): unknown keyword {unknown[0]!r}"
+                f"{did_you_mean(unknown[0], self.keywords())} "
+                f"(keywords: {', '.join(self.keywords())})"
             )
         resolved = {key: given.get(key, default) for key, default in self.defaults.items()}
         # Lists become tuples: traits are compared and filtered as tuples.
