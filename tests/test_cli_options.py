@@ -104,6 +104,39 @@ def test_help_lists_the_options_of_each_method(parser):
         assert "  ats: aux, singularity_threshold, damping" in text
 
 
+def test_track_and_scenarios_take_method_colon_name_for_their_method():
+    """``METHOD:NAME=VALUE``, which compare takes, was refused by track ("mpc has no option
+    'mpc:horizon'"): it now means NAME=VALUE when METHOD is the run's, and names the run's
+    method when it is another's. A value's colon does not mark a method."""
+    base = ["--method", "mpc", "--traj", "ellipse"]
+    args = track_parser().parse_args([*base, "--option", "mpc:horizon=2", "--option", "aux=sum"])
+    with pytest.raises(ParameterError, match=r"^option: mpc has no option 'aux'"):
+        controller_options(args)  # NAME=VALUE alone stays as it was
+    args = track_parser().parse_args([*base, "--option", "mpc:horizon=2"])
+    assert controller_options(args) == {"horizon": 2.0}
+    args = track_parser().parse_args([*base, "--option", "qp:tau=0.3"])
+    with pytest.raises(ParameterError) as error:
+        controller_options(args)
+    assert str(error.value) == (
+        "option: 'qp' is not the method of this run (--method mpc); METHOD:NAME=VALUE takes "
+        "mpc:NAME=VALUE or NAME=VALUE (got 'qp:tau=0.3')"
+    )
+    argv = ["--controller", "thesis", "--option", "thesis:adjust=0.3"]
+    config = config_from_arguments(scenarios_parser().parse_args(argv))
+    assert config.controller_options == (("adjust", 0.3),)
+    argv = ["--controller", "thesis", "--option", "qp:tau=0.3"]
+    with pytest.raises(ParameterError, match=r"^option: 'qp' is not the method of this run \(--c"):
+        config_from_arguments(scenarios_parser().parse_args(argv))
+
+
+def test_the_method_prefix_of_an_option_is_read_in_one_place():
+    from ddwmmr.cli.common import option_target
+
+    assert option_target("mpc:horizon=2") == ("mpc", "horizon=2")
+    assert option_target("plan=C:/runs") == (None, "plan=C:/runs")
+    assert option_target("horizon=2") == (None, "horizon=2")
+
+
 def test_compare_options_go_to_the_methods_that_take_them():
     methods = ("pi", "clrrmc-ts", "mpc")
     options = parse_method_options(["tau=0.3", "pi:damping=0.1"], methods, horizon=2.0)

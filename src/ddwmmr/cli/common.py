@@ -85,6 +85,7 @@ __all__ = [
     "method_options_text",
     "number_type",
     "offset_type",
+    "option_target",
     "output_folder",
     "output_target",
     "parse_plant_options",
@@ -93,6 +94,7 @@ __all__ = [
     "refuse_plant_option_argument",
     "robot_from_arguments",
     "run_main",
+    "run_method_options",
     "scaled_trajectory",
     "seconds_type",
     "split_names",
@@ -630,6 +632,33 @@ def add_option_argument(
         help=f"{what}; repeatable, e.g. {examples}. The options of each method are listed "
         "at the end; the common ones also have a flag of their own",
     )
+
+
+def option_target(text: str) -> tuple[str | None, str]:
+    """``--option METHOD:NAME=VALUE`` -> ``(METHOD, "NAME=VALUE")``; ``NAME=VALUE`` ->
+    ``(None, text)``. A colon marks a method only before the first ``=``: a value may hold
+    one (``plan=C:/runs``), a name never does (:data:`ddwmmr.registry.NAME_PATTERN`)."""
+    target, colon, rest = text.partition(":")
+    if colon and "=" not in target:
+        return target, rest
+    return None, text
+
+
+def run_method_options(texts: Sequence[str] | None, method: str, flag: str) -> list[str]:
+    """The ``--option`` texts of a tool that runs the one method ``method`` (chosen with
+    ``flag``, e.g. ``--method``) as ``NAME=VALUE``: ``METHOD:NAME=VALUE`` is taken, as
+    ``compare`` takes it, when METHOD is ``method``, and refused in one line when it
+    names another."""
+    options = []
+    for text in texts or ():
+        target, rest = option_target(text)
+        if target is not None and target != method:
+            raise ParameterError(
+                f"option: {target!r} is not the method of this run ({flag} {method}); "
+                f"METHOD:NAME=VALUE takes {method}:NAME=VALUE or NAME=VALUE (got {text!r})"
+            )
+        options.append(rest)
+    return options
 
 
 def method_options_text(methods: Sequence[str]) -> str:

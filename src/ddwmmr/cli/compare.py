@@ -35,6 +35,7 @@ from ddwmmr.cli.common import (
     integer_type,
     method_options_text,
     number_type,
+    option_target,
     output_folder,
     output_target,
     refuse_plant_option_argument,
@@ -271,8 +272,8 @@ def parse_method_options(
     texts = [*(texts or ()), *(() if horizon is None else (f"horizon={horizon!r}",))]
     chosen: dict[str, list[str]] = {m: [] for m in methods}
     for text in texts:
-        target, colon, rest = text.partition(":")
-        if colon and "=" not in target:  # METHOD:NAME=VALUE
+        target, rest = option_target(text)
+        if target is not None:  # METHOD:NAME=VALUE
             if target not in chosen:
                 raise ParameterError(
                     f"option: {target!r} is not a compared method{did_you_mean(target, chosen)}"

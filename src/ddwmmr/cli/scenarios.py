@@ -49,6 +49,7 @@ from ddwmmr.cli.common import (
     output_target,
     payload_type,
     run_main,
+    run_method_options,
 )
 from ddwmmr.commands import traits_of
 from ddwmmr.controllers import controller_traits, method_description, method_options
@@ -424,7 +425,7 @@ def scenario_controller_options(args: argparse.Namespace) -> tuple[tuple[str, An
             f" (got --controller {args.controller})"
         )
     texts = [
-        *(args.option or ()),
+        *run_method_options(args.option, args.controller, "--controller"),
         *(() if args.horizon is None else (f"horizon={args.horizon!r}",)),
     ]
     taken = method_options(args.controller)

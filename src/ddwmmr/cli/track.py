@@ -41,6 +41,7 @@ from ddwmmr.cli.common import (
     parse_plant_options,
     robot_from_arguments,
     run_main,
+    run_method_options,
     scaled_trajectory,
     seconds_type,
 )
@@ -355,7 +356,8 @@ def build_parser() -> ArgumentParser:
 
 def controller_options(args: argparse.Namespace) -> dict[str, Any]:
     """Controller keyword arguments from the CLI options that were given: the named flags
-    and ``--option NAME=VALUE`` (one option may not be given both ways)."""
+    and ``--option [METHOD:]NAME=VALUE`` (METHOD: the run's, :func:`run_method_options`;
+    one option may not be given both ways)."""
     options: dict[str, Any] = {}
     for attribute, keyword in METHOD_OPTIONS.items():
         value = getattr(args, attribute)
@@ -374,7 +376,8 @@ def controller_options(args: argparse.Namespace) -> dict[str, Any]:
             value = value[0]
         options[keyword] = value
     flags = {keyword: attribute for attribute, keyword in METHOD_OPTIONS.items()}
-    for name, value in parse_options(args.method, args.option).items():
+    texts = run_method_options(args.option, args.method, "--method")
+    for name, value in parse_options(args.method, texts).items():
         if name in options:
             flag = "--" + flags[name].replace("_", "-")
             raise ParameterError(f"option: {name} is given both as {flag} and as --option")
