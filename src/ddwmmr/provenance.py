@@ -29,7 +29,7 @@ import shlex
 import subprocess
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -40,6 +40,7 @@ from ddwmmr.controllers.base import method_options
 from ddwmmr.errors import ParameterError, one_line, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import package_version
+from ddwmmr.registry import PLUGINS_VARIABLE, plugin_modules, used_plugins
 from ddwmmr.trajectories.files import (
     SHAPES,
     check_shape_keys,
@@ -122,27 +123,41 @@ def _git(top: Path, *arguments: str) -> str:
     return done.stdout.strip()
 
 
-def command_record(prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
+def command_record(
+    prog: str, argv: Sequence[str] | None, plugins: Mapping[str, Mapping[str, str]] | None = None
+) -> dict[str, Any]:
     """``command``: a command that repeats the run, ``prog`` (the tool's ``python -m``
     form, also when the run was started by its console script) and the arguments, quoted
-    for this platform's shell (POSIX ``sh``; ``cmd.exe`` on Windows);
+    for this platform's shell (POSIX ``sh``; ``cmd.exe`` on Windows), after the setting
+    of ``DDWMMR_PLUGINS`` to the modules of ``plugins`` when the run used a plug-in
+    (:func:`ddwmmr.registry.used_plugins`; ``DDWMMR_PLUGINS=p_only python -m ...``);
     ``argv``: the arguments as given (``argv``, or ``sys.argv[1:]``); ``cwd``: the
-    working folder."""
+    working folder; ``plugins``: the plug-ins, only when there are any (a run of the
+    built-ins has the record it had before plug-ins were recorded)."""
     arguments = list(argv if argv is not None else sys.argv[1:])
     words = [*shlex.split(prog), *arguments]
     # cmd.exe passes single quotes on literally: Windows gets its own quoting
     command = subprocess.list2cmdline(words) if os.name == "nt" else shlex.join(words)
-    return {
-        "command": command,
-        "argv": arguments,
-        "cwd": os.getcwd(),
-    }
+    modules = ",".join(plugin_modules(plugins or {}))
+    if modules and os.name == "nt":
+        command = f'set "{PLUGINS_VARIABLE}={modules}" && {command}'
+    elif modules:
+        command = f"{PLUGINS_VARIABLE}={shlex.quote(modules)} {command}"
+    record: dict[str, Any] = {"command": command, "argv": arguments, "cwd": os.getcwd()}
+    if plugins:
+        record["plugins"] = {label: dict(named) for label, named in plugins.items()}
+    return record
 
 
-def header(tool: str, prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
+def header(
+    tool: str,
+    prog: str,
+    argv: Sequence[str] | None,
+    plugins: Mapping[str, Mapping[str, str]] | None = None,
+) -> dict[str, Any]:
     """The start of every record: tool, versions, commit, the command that repeats the
-    run (:func:`command_record`), and what decides the last bits of the numbers
-    (:func:`numerics_record`)."""
+    run and the plug-ins it used (:func:`command_record`), and what decides the last bits
+    of the numbers (:func:`numerics_record`)."""
     return {
         "record_version": RECORD_VERSION,
         "tool": tool,
@@ -151,7 +166,7 @@ def header(tool: str, prog: str, argv: Sequence[str] | None) -> dict[str, Any]:
         "python": sys.version.split()[0],
         "numpy": np.__version__,
         **numerics_record(),
-        **command_record(prog, argv),
+        **command_record(prog, argv, plugins),
     }
 
 
@@ -483,7 +498,8 @@ def run_record(
     names what wrote it, ``prog`` and ``argv`` the command that repeats it (the
     simulator's export writes the same record, with the :data:`TRACK_PROG` arguments of
     its settings)."""
-    record = header(tool, prog, argv)
+    plugins = used_plugins(method=[inputs.method], plant=[inputs.plant])
+    record = header(tool, prog, argv, plugins)
     record.update(
         method=inputs.method,
         options=options_record(inputs.method, inputs.options),

@@ -50,7 +50,9 @@ come from:
   (comma separated, importable from ``sys.path``);
 * any module imported before a registry is asked (registration happens on import).
 
-Entry points and ``DDWMMR_PLUGINS`` are imported the first time a registry is asked.
+Entry points and ``DDWMMR_PLUGINS`` are imported the first time a registry is asked. A
+run's record names the modules of the plug-ins it used (:func:`used_plugins`), and an
+unknown name's error says how plug-ins are loaded (:func:`unknown_hint`).
 """
 
 from __future__ import annotations
@@ -61,7 +63,7 @@ import inspect
 import os
 import re
 import threading
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from itertools import count
 from pathlib import Path
@@ -85,6 +87,11 @@ BUILTIN_MODULES = (
 )
 #: Environment variable naming plug-in modules to import (comma separated).
 PLUGINS_VARIABLE = "DDWMMR_PLUGINS"
+#: How an error for an unknown name says plug-ins are loaded (:func:`unknown_hint`).
+PLUGINS_HINT = (
+    f"a plug-in's name is known once its module is imported: {PLUGINS_VARIABLE}=MODULE "
+    '(docs/api.md, "Extending")'
+)
 #: Entry-point group of plug-in modules of other packages.
 ENTRY_POINT_GROUP = "ddwmmr.plugins"
 #: Longest plug-in name (characters): it becomes part of a run folder's name.
@@ -290,13 +297,24 @@ class Registry:
 
     def entry(self, name: str) -> Entry:
         """The entry of ``name``; an unknown name is a one-line :class:`ParameterError`
-        naming the registered ones."""
+        naming the registered ones (and how a plug-in's name is loaded:
+        :func:`unknown_hint`)."""
         discover()
         entry = self._entries.get(name) if isinstance(name, str) else None
         if entry is None:
-            known = ", ".join(self.names())
-            raise ParameterError(self.unknown.format(name=shown(name), known=known))
+            names = self.names()
+            text = self.unknown.format(name=shown(name), known=", ".join(names))
+            raise ParameterError(text + unknown_hint(name, names))
         return entry
+
+    def plugin_module(self, name: str) -> str | None:
+        """The module that registered ``name`` when it is a plug-in from outside the
+        built-in modules (None for a built-in or an unknown name)."""
+        discover()
+        entry = self._entries.get(name)
+        if entry is None or entry.module in BUILTIN_MODULES:
+            return None
+        return entry.module
 
     def load(self, name: str) -> type:
         """The class registered as ``name`` (its module imported on first use)."""
@@ -314,6 +332,65 @@ class Registry:
     def traits(self, name: str) -> dict[str, Any]:
         """The traits of ``name`` (a copy)."""
         return dict(self.entry(name).traits)
+
+
+def unknown_hint(name: Any, known: Iterable[str]) -> str:
+    """What follows the error for an unknown ``name`` among ``known``: the closest known
+    name (:func:`~ddwmmr.errors.did_you_mean`), else, for a name a plug-in could have,
+    how plug-ins are loaded (``"; a plug-in's name is known once its module is imported:
+    DDWMMR_PLUGINS=MODULE ..."``), else nothing."""
+    if not isinstance(name, str):
+        return ""
+    close = did_you_mean(name, known)
+    if close or NAME_PATTERN.fullmatch(name) is None:
+        return close
+    return f"; {PLUGINS_HINT}"
+
+
+def used_plugins(**names: Iterable[str]) -> dict[str, dict[str, str]]:
+    """``{label: {name: module}}`` of the plug-ins among ``names``, given per registry
+    label (``method``, ``plant``, ``arbiter``): the module that registered each name
+    not built in, which ``DDWMMR_PLUGINS`` must name to run it again (a run's record
+    holds it, :func:`ddwmmr.provenance.header`). Empty when every name is built in."""
+    found: dict[str, dict[str, str]] = {}
+    for label, given in names.items():
+        registry = _LABELS[label]
+        for name in given:
+            module = registry.plugin_module(name)
+            if module is not None:
+                found.setdefault(label, {})[name] = module
+    return found
+
+
+def check_recorded_plugins(plugins: Any) -> None:
+    """Refuse (one-line :class:`~ddwmmr.errors.ParameterError`) to run a record's
+    ``plugins`` (:func:`used_plugins`'s answer, as a run's record holds it) when one of
+    its names is not registered: it names the plug-in, its module and the
+    ``DDWMMR_PLUGINS`` setting that loads them all. Anything but a mapping of mappings of
+    texts is left to the record's other checks."""
+    if not isinstance(plugins, Mapping):
+        return
+    named = [
+        (label, name, module)
+        for label, given in plugins.items()
+        if label in _LABELS and isinstance(given, Mapping)
+        for name, module in given.items()
+        if isinstance(name, str) and isinstance(module, str)
+    ]
+    for label, name, module in named:
+        if name not in _LABELS[label].names():
+            modules = ",".join(dict.fromkeys(m for _, _, m in named))
+            raise ParameterError(
+                f"{label}: {name!r} is the plug-in of module {module!r}, which is not loaded: "
+                f"run with {PLUGINS_VARIABLE}={modules} (importable from sys.path, e.g. with "
+                'PYTHONPATH; docs/api.md, "Extending")'
+            )
+
+
+def plugin_modules(plugins: Mapping[str, Mapping[str, str]]) -> list[str]:
+    """The modules of :func:`used_plugins`'s answer, each once, in order: what
+    ``DDWMMR_PLUGINS`` is set to to run them again."""
+    return list(dict.fromkeys(m for named in plugins.values() for m in named.values()))
 
 
 def _has(traits: Mapping[str, Any], key: str, value: Any) -> bool:
@@ -355,6 +432,7 @@ ARBITERS = Registry(
     "arbiter must be one of {known} (got {name})",
 )
 _REGISTRIES = {r.decorator: r for r in (CONTROLLERS, PLANTS, ARBITERS)}
+_LABELS = {r.label: r for r in (CONTROLLERS, PLANTS, ARBITERS)}
 register_controller = CONTROLLERS.register
 register_plant = PLANTS.register
 register_arbiter = ARBITERS.register
@@ -505,12 +583,17 @@ __all__ = [
     "NAME_FORM",
     "NAME_PATTERN",
     "PLANTS",
+    "PLUGINS_HINT",
     "PLUGINS_VARIABLE",
     "Entry",
     "PluginClass",
     "Registry",
+    "check_recorded_plugins",
     "discover",
+    "plugin_modules",
     "register_arbiter",
     "register_controller",
     "register_plant",
+    "unknown_hint",
+    "used_plugins",
 ]

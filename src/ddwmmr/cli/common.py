@@ -16,6 +16,7 @@ behaviour for everything that is not a result:
 from __future__ import annotations
 
 import argparse
+import ast
 import codecs
 import contextlib
 import datetime as dt
@@ -111,6 +112,11 @@ NEGATIVE_NUMBER = re.compile(
 
 #: argparse's message for options it does not know (``--methd x``).
 UNRECOGNISED = "unrecognized arguments: "
+#: argparse's message for a value not among an option's choices (the value as its repr).
+INVALID_CHOICE = re.compile(
+    r"argument (?:[^:]*/)?(?P<option>--[\w-]+): invalid choice: "
+    r"(?P<value>'(?:[^'\\]|\\.)*'|\"(?:[^\"\\]|\\.)*\")"
+)
 
 
 def integer_type(
@@ -265,9 +271,11 @@ class ArgumentParser(argparse.ArgumentParser):
 
     def _with_suggestions(self, message: str) -> str:
         """``message``, with the closest known option after each unknown one, and after a
-        value that follows another option's one value (``--method ats pi``) that option."""
+        value that follows another option's one value (``--method ats pi``) that option;
+        an unknown name of a registry's choice (``--method``, ``--plant``...) gets what
+        :func:`ddwmmr.registry.unknown_hint` adds."""
         if not message.startswith(UNRECOGNISED):
-            return message
+            return message + self._choice_hint(message)
         known = [o for o in self._option_string_actions if o.startswith("--")]
         strays = self._stray_values()
         words = []
@@ -282,6 +290,24 @@ class ArgumentParser(argparse.ArgumentParser):
                 word += f" ({strays.pop(word)} takes {count}{again})"
             words.append(word)
         return UNRECOGNISED + " ".join(words)
+
+    def _choice_hint(self, message: str) -> str:
+        """For argparse's "argument --method: invalid choice: 'x' (choose from ...)" of an
+        option whose choices are plug-in names, the closest choice or how plug-ins are
+        loaded (:func:`~ddwmmr.registry.unknown_hint`); else nothing."""
+        from ddwmmr.registry import ARBITERS, CONTROLLERS, PLANTS, unknown_hint
+
+        found = INVALID_CHOICE.match(message)
+        action = found and self._option_string_actions.get(found["option"])
+        if not found or action is None or not action.choices:
+            return ""
+        choices = [str(choice) for choice in action.choices]
+        value = ast.literal_eval(found["value"])
+        for registry in (CONTROLLERS, PLANTS, ARBITERS):
+            names = registry.names()
+            if set(choices) <= set(names):  # a registered name not offered: no plug-in's
+                return "" if value in names else unknown_hint(value, choices)
+        return ""
 
     def _stray_values(self) -> dict[str, str]:
         """The words of the command line that follow the values of an option taking a

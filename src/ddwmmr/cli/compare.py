@@ -58,6 +58,7 @@ from ddwmmr.errors import (
 from ddwmmr.outputs import write_atomic
 from ddwmmr.plants import available_plants
 from ddwmmr.progress import phase
+from ddwmmr.registry import unknown_hint, used_plugins
 from ddwmmr.reports.compare import (
     DEFAULT_TRAJECTORIES,
     OFFSET_SCALES,
@@ -320,6 +321,7 @@ def parse_plants(values: Sequence[str] | None) -> tuple[str, ...]:
         if name not in extra_plants():
             raise ParameterError(
                 f"plant: unknown plant {name!r} (one of {', '.join(extra_plants())})"
+                + unknown_hint(name, available_plants())
             )
     return tuple(plants)
 
@@ -330,7 +332,10 @@ def parse_methods(values: Sequence[str] | None, option: str = "methods") -> tupl
     methods = split_names(values, option) or known
     for method in methods:
         if method not in known:
-            raise ParameterError(f"{option}: unknown method {method!r} (known: {', '.join(known)})")
+            raise ParameterError(
+                f"{option}: unknown method {method!r} (known: {', '.join(known)})"
+                + unknown_hint(method, known)
+            )
     return tuple(methods)
 
 
@@ -457,6 +462,13 @@ def check_runs(config: CompareConfig, specs: Sequence[Any]) -> None:
             raise ParameterError(f"{exc} (run {spec.label()} on {where})") from None
 
 
+def compared_plugins(config: CompareConfig) -> dict[str, dict[str, str]]:
+    """The plug-ins a comparison runs (:func:`ddwmmr.registry.used_plugins`): its
+    methods, those of its studies, and its plants."""
+    methods = [*config.methods, *config.studied]
+    return used_plugins(method=list(dict.fromkeys(methods)), plant=list(config.plants))
+
+
 def run_record(
     config: CompareConfig, sources: dict[str, Any], argv: Sequence[str] | None, jobs: int
 ) -> dict[str, Any]:
@@ -464,7 +476,7 @@ def run_record(
     ``integrator`` and ``initial_offset`` (m, in the end effector's start frame) are the
     main comparison's on the kinematic plant, encoded as in track's record (the studies
     sweep them; a physics plant rounds the step to its engine's)."""
-    record = provenance.header("compare", PROG, argv)
+    record = provenance.header("compare", PROG, argv, compared_plugins(config))
     runs = {name: main_spec(config, config.methods[0], name) for name in config.trajectories}
     first = next(iter(runs.values()))
     record.update(
@@ -510,8 +522,6 @@ def config_from_arguments(
         shown,
         lambda trajectory: scaled_trajectory(trajectory, args.traj_scale, robot),
     )
-    # quoted as the run record quotes it: the report's line repeats the run when pasted
-    command = provenance.command_record(PROG, argv)["command"]
     methods = parse_methods(args.methods)
     study_methods = (
         parse_methods(args.study_methods, "study-methods") if args.study_methods else None
@@ -519,19 +529,23 @@ def config_from_arguments(
     studies = parse_studies(args.study)
     if study_methods is not None and not studies:
         raise ParameterError("study-methods: only used with a study (got --study none)")
-    return CompareConfig(
+    config = CompareConfig(
         methods=methods,
         study_methods=study_methods,
         trajectories=trajectories,
         robot=robot,
         duration=check_duration(args.duration, trajectories),
         studies=studies,
-        command=command,
         preset=args.preset,
         plants=plants,
         options=parse_method_options(args.option, methods, args.horizon),
         shown_names=shown,
     )
+    # quoted as the run record quotes it (with the plug-ins' DDWMMR_PLUGINS): the report's
+    # line repeats the run when pasted
+    plugins = compared_plugins(config)
+    config.command = provenance.command_record(PROG, argv, plugins)["command"]
+    return config
 
 
 def judged_runs(plan: Any) -> list[tuple[Any, str, str]]:

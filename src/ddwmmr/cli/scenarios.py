@@ -67,6 +67,7 @@ from ddwmmr.model.stability import STABILITY_CAP, STABILITY_FLOOR
 from ddwmmr.outputs import write_atomic
 from ddwmmr.plants import available_plants, plant_class, plant_description
 from ddwmmr.progress import ProgressBar, phase
+from ddwmmr.registry import used_plugins
 from ddwmmr.scenarios import report, studies
 from ddwmmr.scenarios.executors import (
     CONNECT_TIMEOUT,
@@ -971,11 +972,19 @@ def config_record(config: RunConfig) -> dict[str, Any]:
     return record
 
 
+def batch_plugins(config: RunConfig) -> dict[str, dict[str, str]]:
+    """The plug-ins a batch runs (:func:`ddwmmr.registry.used_plugins`): its controller,
+    plant and, for a controller with an arbiter, the arbiter."""
+    arbitrated = controller_traits(config.controller)["arbiter"]
+    arbiters = [config.arbiter] if arbitrated and isinstance(config.arbiter, str) else []
+    return used_plugins(method=[config.controller], plant=[config.plant], arbiter=arbiters)
+
+
 def _record(args: argparse.Namespace, config: RunConfig, workers: int) -> dict[str, Any]:
     """summary.json["run"]: everything needed to repeat the batch, and how it ran: ``jobs``
     is the ``--jobs`` given (None: the default), ``workers`` the workers the batch ran on
     (:attr:`Runner.workers`)."""
-    record = provenance.header("scenarios", PROG, args.argv)
+    record = provenance.header("scenarios", PROG, args.argv, batch_plugins(config))
     record.update(
         config=provenance.encode(config_record(config)),
         n=args.n,

@@ -68,7 +68,7 @@ from ddwmmr.plants.base import Plant
 from ddwmmr.plants.kinematic import INTEGRATORS
 from ddwmmr.progress import ProgressBar, phase
 from ddwmmr.provenance import RunInputs, run_record
-from ddwmmr.registry import PLANTS
+from ddwmmr.registry import PLANTS, check_recorded_plugins, unknown_hint
 from ddwmmr.reports.metrics import METRICS
 from ddwmmr.resolution.reference import (
     DEFAULT_INITIAL_OFFSET,
@@ -505,10 +505,14 @@ def inputs_from_record(args: argparse.Namespace) -> RunInputs:
     given_text("rerun", args.rerun, "the path of a summary.json")
     record = load_run_record(args.rerun)
     try:
+        check_recorded_plugins(record.get("plugins"))  # before "unknown method"
         plant_record = _field(record, "plant", dict, "plant")
         plant = _inside("plant", lambda: _field(plant_record, "name", str, "plant name"))
         if plant not in available_plants():
-            raise ParameterError(f"plant {plant!r} is not supported by this version")
+            raise ParameterError(
+                f"plant {plant!r} is not supported by this version"
+                + unknown_hint(plant, available_plants())
+            )
         trajectory_record = _field(record, "trajectory", dict, "trajectory")
         trajectory, source, file_note = _inside(
             "trajectory", lambda: provenance.read_trajectory_record(trajectory_record)

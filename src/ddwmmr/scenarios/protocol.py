@@ -89,7 +89,7 @@ from ddwmmr.model.stability import (
 from ddwmmr.model.thesis_base import C1_DEFAULT, C2_DEFAULT
 from ddwmmr.plants import available_plants, make_plant
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
-from ddwmmr.registry import BUILTIN_MODULES, CONTROLLERS, PLANTS
+from ddwmmr.registry import BUILTIN_MODULES, CONTROLLERS, PLANTS, unknown_hint
 from ddwmmr.scenarios.generator import Scenario
 from ddwmmr.sim.loop import run_loop
 
@@ -211,8 +211,10 @@ class RunConfig:
     def __post_init__(self) -> None:
         controllers = scenario_controllers()
         if not one_of(self.controller, controllers):
+            known = CONTROLLERS.names()
             raise ParameterError(
                 f"controller must be one of {', '.join(controllers)} (got {shown(self.controller)})"
+                + ("" if one_of(self.controller, known) else unknown_hint(self.controller, known))
             )
         PLANTS.entry(self.plant)  # an unknown name: one line naming the known ones
         accepted = plants_for(self.controller)

@@ -38,7 +38,7 @@ from ddwmmr.model.robot import long_lengths
 from ddwmmr.model.stability import max_payload, tips_in_every_pose
 from ddwmmr.plants import available_plants, make_plant, plant_class
 from ddwmmr.plants.base import Plant, PlantImplementation
-from ddwmmr.registry import CONTROLLERS
+from ddwmmr.registry import CONTROLLERS, unknown_hint
 from ddwmmr.resolution.kernels import length_unit
 from ddwmmr.resolution.reference import default_offset, initial_configuration
 from ddwmmr.sim.loop import run_loop, spoken_interface
@@ -480,6 +480,7 @@ def check_tracks(method: str) -> None:
     if method not in CONTROLLERS.names():
         raise ParameterError(
             f"method: unknown method {shown(method)} (tracking: {', '.join(tracking)})"
+            + unknown_hint(method, CONTROLLERS.names())
         )
     tasks = CONTROLLERS.traits(method)["tasks"]
     raise ParameterError(
