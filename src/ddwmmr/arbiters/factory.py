@@ -6,20 +6,27 @@ used) or an arbiter instance, used as it is with its own thresholds (``reset()``
 before every run, so an instance can be reused; one that records keeps the history of the
 last run). An arbiter class is registered with :func:`ddwmmr.registry.register_arbiter`
 and built as ``cls(stability=Hysteresis, manipulability=Hysteresis)``, plus
-``seed=config.arbiter_seed`` when its constructor takes a ``seed``.
+``seed=config.arbiter_seed`` when its constructor takes a ``seed``, plus
+``config.arbiter_options`` (its other keyword parameters: :func:`arbiter_option_specs`).
 """
 
 from __future__ import annotations
 
 import inspect
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ddwmmr.arbiters.state_machine import Hysteresis
-from ddwmmr.errors import ParameterError, shown
+from ddwmmr.errors import ParameterError, did_you_mean, shown
 from ddwmmr.registry import ARBITERS, CONTROLLERS, build
+
+if TYPE_CHECKING:
+    from ddwmmr.controllers.option_specs import OptionSpec
 
 #: The arbiter a run uses when it names none.
 DEFAULT_ARBITER = "state-machine"
+#: Constructor parameters of an arbiter that the run sets itself (the thresholds, the
+#: seed, the arbiter study's recording), not ``arbiter_options``.
+ARBITER_ARGUMENTS = ("stability", "manipulability", "seed", "record")
 
 
 def available_arbiters() -> list[str]:
@@ -51,6 +58,44 @@ def check_arbiter(arbiter: Any, controller: str = "thesis") -> None:
         raise ParameterError(refusal)
 
 
+def arbiter_option_specs(arbiter: str) -> dict[str, OptionSpec]:
+    """The options ``RunConfig.arbiter_options`` (``--arbiter-option NAME=VALUE``) sets on
+    the registered arbiter ``arbiter``: its constructor's keyword parameters but
+    :data:`ARBITER_ARGUMENTS`, typed as a method's options are (name -> spec). The
+    built-in arbiters have none."""
+    from ddwmmr.controllers.option_specs import constructor_option_specs
+
+    return constructor_option_specs(ARBITERS.load(arbiter), ARBITER_ARGUMENTS)
+
+
+def check_arbiter_options(options: Any, arbiter: Any, controller: str) -> None:
+    """Refuse (one-line :class:`ParameterError`) ``RunConfig.arbiter_options`` (already
+    checked as ``(name, value)`` pairs) that no arbiter would read: given for a controller
+    without an arbiter or with an arbiter instance (built already), or naming an option
+    the arbiter's constructor does not take (with the closest and the list)."""
+    if not options:
+        return
+    takes = CONTROLLERS.names(arbiter=True)
+    if controller not in takes:
+        raise ParameterError(
+            f"arbiter_options: only the {' or '.join(takes)} controller has an arbiter"
+        )
+    if not isinstance(arbiter, str):
+        raise ParameterError(
+            "arbiter_options: only for an arbiter given by name (an instance is built "
+            f"already; got {shown(arbiter)})"
+        )
+    specs = arbiter_option_specs(arbiter)
+    for name, _ in options:
+        if name not in specs:
+            listed = ", ".join(specs) or "none"
+            set_by = " (the run sets it)" if name in ARBITER_ARGUMENTS else ""
+            raise ParameterError(
+                f"arbiter_options: the {arbiter} arbiter has no option {name!r}{set_by}"
+                f"{did_you_mean(name, specs)} (options: {listed})"
+            )
+
+
 def make_arbiter(config: Any) -> Any:
     """The arbiter a run configuration asks for (``config.arbiter``, thresholds, seed);
     ``config`` is a :class:`~ddwmmr.scenarios.protocol.RunConfig` (one without
@@ -80,6 +125,7 @@ def make_arbiter(config: Any) -> Any:
         )
     if "seed" in parameters:
         options["seed"] = config.arbiter_seed
+    options.update(getattr(config, "arbiter_options", ()))
     return build(
         cls, f"arbiter: {arbiter}: {cls.__qualname__}(**thresholds)", options=options, quoted=False
     )

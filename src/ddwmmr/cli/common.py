@@ -20,7 +20,6 @@ import ast
 import codecs
 import contextlib
 import datetime as dt
-import inspect
 import logging
 import math
 import multiprocessing
@@ -761,25 +760,12 @@ def plant_option_specs(plant: str) -> dict[str, OptionSpec]:
     """The options ``--plant-option NAME=VALUE`` sets on the registered plant ``plant``
     (name -> :class:`~ddwmmr.controllers.option_specs.OptionSpec`): the keyword parameters
     of its constructor but :data:`PLANT_ARGUMENTS`, each read as ``--option`` reads a
-    method's option of that type (:func:`~ddwmmr.controllers.option_specs.option_spec`).
-    Imports the plant's module (MuJoCo's: about 0.4 s)."""
-    from ddwmmr.controllers.option_specs import option_spec
+    method's option of that type (:func:`~ddwmmr.controllers.option_specs.
+    constructor_option_specs`). Imports the plant's module (MuJoCo's: about 0.4 s)."""
+    from ddwmmr.controllers.option_specs import constructor_option_specs
     from ddwmmr.plants import plant_class
 
-    specs = {}
-    for parameter in inspect.signature(plant_class(plant)).parameters.values():
-        variadic = parameter.kind in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD)
-        if variadic or parameter.name in PLANT_ARGUMENTS:
-            continue
-        annotation = parameter.annotation
-        if annotation is inspect.Parameter.empty:
-            annotation = ""
-        elif not isinstance(annotation, str):
-            annotation = inspect.formatannotation(annotation)
-        spec = option_spec(parameter.name, parameter.default, annotation)
-        if spec is not None:
-            specs[spec.name] = spec
-    return specs
+    return constructor_option_specs(plant_class(plant), PLANT_ARGUMENTS)
 
 
 def check_plant_option_names(plant: str, names: Iterable[str]) -> dict[str, OptionSpec]:

@@ -118,12 +118,13 @@ PROG = "python -m ddwmmr.scenarios"
 QP_OPTIONS = {"qp_stability_min": ("qp", "mpc"), "qp_max_speed": ("qp",)}
 #: ``RunConfig`` fields only a controller with an arbiter (the thesis controller) reads:
 #: its fix states' thresholds and its arbiter.
-ARBITER_FIELDS = ("stability", "manipulability", "arbiter", "arbiter_seed")
+ARBITER_FIELDS = ("stability", "manipulability", "arbiter", "arbiter_seed", "arbiter_options")
 #: ``RunConfig`` fields whose option is spelt otherwise, for its messages.
 OPTION_SPELLING = {
     field: field.replace("_", "-")
     for field in ("time_limit", "arbiter_seed", "qp_stability_min", "qp_max_speed")
 }
+OPTION_SPELLING["arbiter_options"] = "arbiter-option"
 #: Controller options the protocol sets itself, and what sets them instead of --option.
 PROTOCOL_OPTIONS = {
     "obstacles": "each scenario's own, --obstacles",
@@ -211,6 +212,14 @@ def build_parser() -> ArgumentParser:
         metavar="N",
         help="noise seed of the competitive arbiter, an integer >= 0 (--arbiter competitive "
         "or --study arbiters; default: 0)",
+    )
+    parser.add_argument(
+        "--arbiter-option",
+        action="append",
+        metavar="NAME=VALUE",
+        help="an option of a plug-in --arbiter (repeatable): a keyword parameter of its "
+        "constructor but the thresholds and seed, read as --option reads a method's (the "
+        "built-in arbiters have none)",
     )
     parser.add_argument(
         "--plant",
@@ -498,7 +507,37 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
             arbiter=args.arbiter or DEFAULT_ARBITER,
             arbiter_seed=0 if args.arbiter_seed is None else args.arbiter_seed,
             controller_options=controller_options,
+            arbiter_options=_arbiter_options(args),
         )
+
+
+def _arbiter_options(args: argparse.Namespace) -> tuple[tuple[str, Any], ...]:
+    """``--arbiter-option NAME=VALUE`` as ``RunConfig.arbiter_options``: each name one the
+    arbiter takes (:func:`~ddwmmr.arbiters.factory.check_arbiter_options`, which
+    ``RunConfig`` calls again), its value read as ``--option`` reads one; a number option's
+    text that is no number is refused here (the plug-in's constructor may not check)."""
+    from ddwmmr.arbiters.factory import arbiter_option_specs, check_arbiter_options
+    from ddwmmr.controllers.base import NumberText
+    from ddwmmr.controllers.option_specs import parse_typed, split_option
+
+    if not args.arbiter_option:
+        return ()
+    if args.study == "arbiters":
+        raise ParameterError("--arbiter-option: the arbiter study runs the built-in arbiters")
+    arbiter = args.arbiter or DEFAULT_ARBITER
+    pairs = [(*split_option(text, "arbiter-option"), text) for text in args.arbiter_option]
+    with _option_names():
+        check_arbiter_options([(n, v) for n, v, _ in pairs], arbiter, args.controller)
+    specs = arbiter_option_specs(arbiter)
+    options: dict[str, Any] = {}
+    for name, text, given in pairs:
+        if name in options:
+            raise ParameterError(f"arbiter-option: {name} given twice (got {shown(given)})")
+        value = parse_typed(specs[name], text, "arbiter-option")
+        if isinstance(value, NumberText):
+            raise ParameterError(f"arbiter-option: {name} must be a number (got {shown(given)})")
+        options[name] = tuple(value) if isinstance(value, list) else value
+    return tuple(options.items())
 
 
 def _check_engine_step(config: RunConfig) -> None:
@@ -966,6 +1005,8 @@ def config_record(config: RunConfig) -> dict[str, Any]:
     takes its default, which the controller ignores as it ignored the recorded value."""
     record = asdict(config)
     unused = [] if controller_traits(config.controller)["arbiter"] else list(ARBITER_FIELDS)
+    if not config.arbiter_options and "arbiter_options" not in unused:
+        unused.append("arbiter_options")  # a batch without them: recorded as before them
     unused += [name for name, takers in QP_OPTIONS.items() if config.controller not in takers]
     for name in unused:
         del record[name]

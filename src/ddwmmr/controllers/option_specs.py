@@ -282,6 +282,27 @@ def _annotation_text(parameter: inspect.Parameter) -> str:
     return annotation if isinstance(annotation, str) else inspect.formatannotation(annotation)
 
 
+def constructor_option_specs(cls: type, skip: Collection[str]) -> dict[str, OptionSpec]:
+    """The options a command line sets on the class ``cls`` (a plant, an arbiter): the
+    keyword parameters of its constructor but ``skip`` (those the tool passes itself),
+    each an :class:`OptionSpec` as :func:`option_spec` types it (name -> spec); a
+    parameter no text stands for (a mapping, an object) is left out."""
+    specs: dict[str, OptionSpec] = {}
+    for parameter in inspect.signature(cls).parameters.values():
+        variadic = parameter.kind in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD)
+        if variadic or parameter.name in skip:
+            continue
+        annotation = parameter.annotation
+        if annotation is inspect.Parameter.empty:
+            annotation = ""
+        elif not isinstance(annotation, str):
+            annotation = inspect.formatannotation(annotation)
+        spec = option_spec(parameter.name, parameter.default, annotation)
+        if spec is not None:
+            specs[spec.name] = spec
+    return specs
+
+
 def option_names(method: str) -> tuple[str, ...]:
     """The names of :func:`option_specs` of ``method``, without listing any choice's values
     (no solver is imported): what ``--help`` lists."""

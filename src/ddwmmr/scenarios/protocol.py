@@ -40,7 +40,7 @@ import numpy as np
 
 from ddwmmr import provenance
 from ddwmmr.arbiters.checked import checked_arbiter
-from ddwmmr.arbiters.factory import check_arbiter
+from ddwmmr.arbiters.factory import check_arbiter, check_arbiter_options
 from ddwmmr.arbiters.state_machine import (
     MANIPULABILITY,
     MOVE_ARM,
@@ -187,6 +187,10 @@ class RunConfig:
             (``ddwmmr.arbiters.available_arbiters()``: ``"state-machine"``, ``"competitive"``;
             thresholds above) or an arbiter instance (``ddwmmr.arbiters.make_arbiter``).
         arbiter_seed: noise seed of the competitive arbiter, an integer >= 0.
+        arbiter_options: further ``(name, value)`` options of the arbiter named by
+            ``arbiter`` (a plug-in's constructor parameters but the thresholds and seed,
+            :func:`ddwmmr.arbiters.factory.arbiter_option_specs`; the built-in arbiters
+            have none), pairs as ``controller_options`` takes them.
 
     Each field is checked on construction; a bad one raises a one-line
     :class:`~ddwmmr.errors.ParameterError` worded as ``python -m ddwmmr.scenarios``
@@ -207,6 +211,7 @@ class RunConfig:
     record: bool = False
     arbiter: Any = "state-machine"
     arbiter_seed: int = 0
+    arbiter_options: tuple[tuple[str, Any], ...] = ()
 
     def __post_init__(self) -> None:
         controllers = scenario_controllers()
@@ -243,6 +248,9 @@ class RunConfig:
         object.__setattr__(
             self, "controller_options", check_controller_options(self.controller_options)
         )
+        arbiter_options = check_controller_options(self.arbiter_options, "arbiter_options")
+        check_arbiter_options(arbiter_options, self.arbiter, self.controller)
+        object.__setattr__(self, "arbiter_options", arbiter_options)
         # Checked here rather than when a worker reaches a scenario halfway through a
         # batch. Without a time_limit, the shorter default: dt above it would run no step
         # at all; whether 120 s (obstacles) stays within the cap depends on the scenario,
@@ -326,22 +334,23 @@ def max_start_payload() -> float:
     return max_payload(robot, *default_pose(robot))
 
 
-def check_controller_options(options: Any) -> tuple[tuple[str, Any], ...]:
-    """``options`` as a tuple if it is ``RunConfig.controller_options``: a tuple (or list)
-    of ``(name, value)`` pairs, each name a str given once, else a one-line
-    :class:`ParameterError` (text or a dict would otherwise fail in the controller's
-    ``dict()`` of them, and a name given twice would silently keep its last value)."""
+def check_controller_options(
+    options: Any, field: str = "controller_options"
+) -> tuple[tuple[str, Any], ...]:
+    """``options`` as a tuple if it is ``RunConfig.controller_options`` (or the ``field``
+    of the same form, ``arbiter_options``): a tuple (or list) of ``(name, value)`` pairs,
+    each name a str given once, else a one-line :class:`ParameterError` (text or a dict
+    would otherwise fail in the controller's ``dict()`` of them, and a name given twice
+    would silently keep its last value)."""
     wanted = 'a tuple of (name, value) pairs with distinct names, e.g. (("horizon", 3.0),)'
     if not isinstance(options, (tuple, list)):
-        raise ParameterError(f"controller_options must be {wanted} (got {shown(options)})")
+        raise ParameterError(f"{field} must be {wanted} (got {shown(options)})")
     seen: set[str] = set()
     for pair in options:
         if not (isinstance(pair, (tuple, list)) and len(pair) == 2 and isinstance(pair[0], str)):
-            raise ParameterError(f"controller_options must be {wanted} (got {shown(pair)})")
+            raise ParameterError(f"{field} must be {wanted} (got {shown(pair)})")
         if pair[0] in seen:
-            raise ParameterError(
-                f"controller_options: {pair[0]!r} is given twice; each name once ({wanted})"
-            )
+            raise ParameterError(f"{field}: {pair[0]!r} is given twice; each name once ({wanted})")
         seen.add(pair[0])
     return tuple((name, value) for name, value in options)
 
