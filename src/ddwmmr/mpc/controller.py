@@ -76,7 +76,7 @@ from ddwmmr.mpc.braking import braked_velocity, braking_input, should_brake
 from ddwmmr.mpc.fallback import fallback_input, make_fallback
 from ddwmmr.mpc.min_time import Guess, PlanProblem, plan_path, plan_problem
 from ddwmmr.mpc.models import PredictionModel, make_model
-from ddwmmr.mpc.ocp import OCPConfig
+from ddwmmr.mpc.ocp import OCPConfig, check_integrable, longest_substep
 from ddwmmr.mpc.options import (
     DEFAULT_DT,
     GRID_DEFAULTS,
@@ -310,10 +310,22 @@ class MPCController:
         self.fallbacks = 0
         self.last = StepInfo()
         self._reset_memory()
+        self._check_integrable(trajectory is not None)
         if trajectory is not None:
             arm = (float(q0[3]), float(q0[4]))
             self._problem("tracking").design_terminal(arm)
         self._fallback = None  # rebuilt on the first failure with this run's dt
+
+    def _check_integrable(self, tracking: bool) -> None:
+        """Refuse a base the force model's RK4 cannot follow on the grids of this run's
+        objectives at its control step (:func:`~ddwmmr.mpc.ocp.check_integrable`)."""
+        if self.dynamics is None:
+            return
+        modes = (
+            ["tracking"] if tracking else ["reach", "reach2"][: 2 if self.options.lookahead else 1]
+        )
+        substep = max(longest_substep(self._config(mode).interval_lengths()) for mode in modes)
+        check_integrable(self.dynamics, self.robot.joint_limits[1], substep)
 
     def command(
         self,

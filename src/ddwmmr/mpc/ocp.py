@@ -118,7 +118,9 @@ from ddwmmr.errors import (
     check_positive,
     check_range,
     check_weight,
+    round_significant,
 )
+from ddwmmr.gains import STABLE_GAIN_STEP
 from ddwmmr.model import Robot
 from ddwmmr.model import symbolic as sym
 from ddwmmr.model.stability import GRAVITY_M_S2, STABILITY_FLOOR, is_longitudinal
@@ -358,8 +360,7 @@ class ShootingOCP:
         """The state after h (s) under u: the model's integration (RK4, or its own) in
         equal sub-steps, at most MAX_SUBSTEP long at the interval's nominal length (reach
         mode only shortens intervals)."""
-        substeps = max(1, math.ceil(nominal / MAX_SUBSTEP - 1e-9))
-        return self.model.integrate(x, u, h, substeps)
+        return self.model.integrate(x, u, h, substeps(nominal))
 
     def _build(self) -> None:
         config, model, robot = self.config, self.model, self.robot
@@ -820,3 +821,98 @@ def grid_intervals(intervals: int, first: float, horizon: float) -> np.ndarray:
     lengths = first * (0.5 * (low + high)) ** np.arange(n)
     scaled: np.ndarray = lengths * (horizon / lengths.sum())
     return scaled
+
+
+def substeps(length: float) -> int:
+    """The RK4 sub-steps of an interval of nominal ``length`` (s): the fewest equal ones
+    at most :data:`MAX_SUBSTEP` long (a reach plan's free horizon only shortens them)."""
+    return max(1, math.ceil(length / MAX_SUBSTEP - 1e-9))
+
+
+def longest_substep(lengths: Sequence[float] | np.ndarray) -> float:
+    """The longest RK4 sub-step (s) of intervals of nominal ``lengths`` (s)."""
+    return max(float(length) / substeps(float(length)) for length in lengths)
+
+
+def largest_cosine(low: float, high: float) -> float:
+    """The largest ``cos th`` over ``th`` in [low, high] (rad): 1 where the range holds a
+    multiple of 2 pi, else the cosine at the end nearer one."""
+    turn = 2.0 * math.pi
+    if turn * math.ceil(low / turn) <= high:
+        return 1.0
+    return max(math.cos(low), math.cos(high))
+
+
+def base_time_constants(
+    dynamics: sym.ThesisDynamics, elbow: tuple[float, float]
+) -> tuple[float, float]:
+    """The force model's time constants (s): ``m / c1`` of the base's speed and the
+    longest ``I / c2`` of its yaw rate over the elbow's joint range ``elbow`` (rad), at its
+    largest yaw inertia ``I(th2) = inertia_fixed + inertia_cos cos th2`` (``inertia_cos >=
+    0``: the arm stretched as far as the range allows); infinite for an undamped motion
+    (c = 0)."""
+    inertia = dynamics.inertia_fixed + dynamics.inertia_cos * largest_cosine(*elbow)
+    return (
+        dynamics.mass / dynamics.c1 if dynamics.c1 > 0.0 else math.inf,
+        inertia / dynamics.c2 if dynamics.c2 > 0.0 else math.inf,
+    )
+
+
+def check_integrable(
+    dynamics: sym.ThesisDynamics, elbow: tuple[float, float], substep: float
+) -> None:
+    """Refuse, in one line naming c1 and/or c2, their time constants and the sub-step, a
+    base damped too stiffly for the force model's RK4 at sub-steps up to ``substep`` (s,
+    :func:`longest_substep` of the plan's intervals).
+
+    The damping makes the base's speeds first-order lags, ``v' = (F - c1 v) / m`` and
+    ``w' = (T - c2 w) / I(th2)`` (the lagged arm's yaw momentum ``L = I w + H`` alike,
+    ``L' = T - c2 (L - H) / I``), with time constants ``tau = m / c1`` and ``I / c2``;
+    every other state integrates these or moves at a commanded rate. One RK4 sub-step
+    ``h`` scales such a lag's own response by ``R(-h / tau)``, ``R(z) = 1 + z + z^2/2 +
+    z^3/6 + z^4/24``, which stays within [0.27, 1] up to ``h / tau = 2.785``
+    (:data:`~ddwmmr.gains.STABLE_GAIN_STEP` ``"rk4"``, the real root of ``x^3 - 4 x^2 + 12
+    x - 24``, where R is 1 again) and exceeds 1 beyond it: the predicted speed then grows
+    every sub-step instead of decaying (c1 = 1e6 N s/m on ``Robot()``: every step fell
+    back). A lag at the limit or within it is taken. The yaw's time constant depends on
+    the elbow; it is taken at the pose of largest yaw inertia (:func:`base_time_constants`),
+    so that only a base the model cannot follow at any pose of the elbow's range is
+    refused: one unstable near the folded arm only (the lengths-times-8 robot of
+    docs/mpc.md, "Robot size", on the thesis plant: from ``I / c2`` = 0.065 s folded to
+    0.54 s stretched) runs, as its plans keep away from that pose. Sub-steps are at most
+    :data:`MAX_SUBSTEP` (0.2 s), so a time constant of 0.072 s or more is always taken:
+    the thesis's base has 0.88 s and 0.15-0.33 s (``Robot()``, c1 = 15 N s/m, c2 = 4 N m
+    s/rad), and the damping the thesis plant derives for another robot keeps its time
+    constants (docs/thesis.md, "Another robot's constants")."""
+    limit = STABLE_GAIN_STEP["rk4"]
+    tau_v, tau_w = base_time_constants(dynamics, elbow)
+    stiff = [
+        (name, value, unit, what, tau)
+        for name, value, unit, what, tau in (
+            ("c1", dynamics.c1, "N s/m", "m / c1", tau_v),
+            ("c2", dynamics.c2, "N m s/rad", "I / c2", tau_w),
+        )
+        if substep > limit * tau
+    ]
+    if not stiff:
+        return
+    dampings = " and ".join(f"{name} = {value:g} {unit}" for name, value, unit, _, _ in stiff)
+    constants = " and ".join(f"{what} = {tau:.3g} s" for _, _, _, what, tau in stiff)
+    most = " and ".join(  # the damping whose time constant is substep / limit
+        f"{name} <= {round_significant(value * tau * limit / substep, 3, math.floor):g} {unit}"
+        for name, value, unit, _, tau in stiff
+    )
+    longest = round_significant(limit * min(tau for *_, tau in stiff), 3, math.floor)
+    finer = (
+        f", a plan whose intervals are all at most {longest:g} s (dt, horizon, "
+        "intervals, first_interval)"
+        if longest >= MIN_INTERVAL
+        else ""
+    )
+    verb, plural = ("make", "s") if len(stiff) > 1 else ("makes", "")
+    raise ParameterError(
+        f"mpc: the force model cannot plan for this base: {dampings} {verb} its time "
+        f"constant{plural} {constants}, and its RK4 sub-steps of up to {substep:.3g} s "
+        f"follow a lag only up to {limit:.4g} time constants long; "
+        f"give the plant {most}{finer} or use model='kinematic'"
+    )
