@@ -134,6 +134,7 @@ class MPCController:
         #: The robot's length unit (m), whatever the model: the unit of the defaults of
         #: ``obstacle_margin`` and ``reach_speed`` (docs/mpc.md, "Robot size").
         self.length_unit = length_unit(robot.L1)
+        self.options.robot_reach_speed(self.length_unit)  # refuses one below the robot's least
         self._plan = _load_plan(self.options, robot.payload)
         self._configure(self.options.adopt_plant(None), None)
         self._loop_step: float | None = None

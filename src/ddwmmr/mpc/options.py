@@ -22,6 +22,7 @@ from typing import Any
 from ddwmmr.commands import FORCE, PlantTraits
 from ddwmmr.errors import (
     LENGTH_RANGE_M,
+    MAX_COST_WEIGHT,
     ParameterError,
     check_bool,
     check_finite,
@@ -543,8 +544,26 @@ class MPCOptions:
     def robot_reach_speed(self, length: float) -> float:
         """The waypoint mode's ``reach_speed`` (m/s) for a robot of length unit ``length``
         (m, whatever the model): ``reach_speed``, else :data:`REACH_SPEED` of the unit per
-        second."""
-        return REACH_SPEED * length if self.reach_speed is None else self.reach_speed
+        second. A ``reach_speed`` below the robot's least, ``length /``
+        :data:`~ddwmmr.errors.MAX_COST_WEIGHT` (1e-6 of the unit per second, 1e-6 m/s on
+        ``Robot()``), is a one-line :class:`ParameterError` naming that range: its
+        reciprocal is the reach cost's weight, seconds per unit of distance left at the
+        horizon's end, capped as every cost weight. At the cap a unit left costs 1e6 s,
+        1e4 times the longest horizon (:data:`~ddwmmr.mpc.ocp.MAX_HORIZON`), so a lower
+        speed changes nothing a plan weighs (reaching outweighs time either way) but the
+        solver's conditioning (1e-300 m/s: every step fell back)."""
+        if self.reach_speed is None:
+            return REACH_SPEED * length
+        least = length / MAX_COST_WEIGHT
+        if self.reach_speed < least * (1.0 - 1e-12):  # the unit's own rounding passes
+            got, (low,) = texts_apart(self.reach_speed, least)
+            raise ParameterError(
+                f"reach_speed must be >= {low} m/s for this robot, {1.0 / MAX_COST_WEIGHT:g} "
+                f"of its length unit ({length:g} m) per second: its reciprocal weighs the "
+                f"distance left, at most {MAX_COST_WEIGHT:g} s per unit as every cost weight "
+                f"(got {got})"
+            )
+        return self.reach_speed
 
     # -- reporting ----------------------------------------------------------------------
     def record(
