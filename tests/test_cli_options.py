@@ -314,8 +314,11 @@ def test_an_empty_text_option_is_refused_not_taken_as_its_default(tmp_path, caps
 @pytest.mark.parametrize(
     ("option", "message"),
     [
-        ("c1=", "error: c1 must be a finite number > 0 (got '')\n"),
-        ("c1=1_5", "error: c1 must be a finite number > 0 (got '1_5')\n"),
+        ("c1=", "error: c1 must be a finite number in [1e-20, 1e+13] N s/m (got '')\n"),
+        (
+            "c1=1_5",
+            "error: c1 must be a finite number in [1e-20, 1e+13] N s/m (got '1_5')\n",
+        ),
     ],
 )
 def test_a_plant_option_empty_or_with_underscores_is_refused(tmp_path, capsys, option, message):

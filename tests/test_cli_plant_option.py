@@ -92,7 +92,7 @@ def test_rerun_refuses_plant_options_given_with_it(tmp_path, capsys):
     ("recorded", "message"),
     [
         ({"force_limt": 20.0}, "plant-option: the thesis plant has no option 'force_limt'"),
-        ({"c2": -1.0}, "c2 must be > 0 (got -1)"),
+        ({"c2": -1.0}, "c2 must be in [1e-20, 1e+13] N m s/rad (got -1)"),
         ([1, 2], "the plant options must be a dict"),
     ],
 )
@@ -117,10 +117,13 @@ def test_rerun_of_recorded_plant_options_checks_them(tmp_path, capsys, recorded,
             "plant-option: the thesis plant has no option 'force_limt' (did you mean "
             "force_limit?) (options: c1, c2, force_limit, joint_speed, velocity_bandwidth)",
         ),
-        (["--plant", "thesis", "--plant-option", "c2=-1"], "c2 must be > 0 (got -1)"),
+        (
+            ["--plant", "thesis", "--plant-option", "c2=-1"],
+            "c2 must be in [1e-20, 1e+13] N m s/rad (got -1)",
+        ),
         (
             ["--plant", "thesis", "--plant-option", "c1=abc"],
-            "c1 must be a finite number > 0 (got 'abc')",
+            "c1 must be a finite number in [1e-20, 1e+13] N s/m (got 'abc')",
         ),
         (
             ["--plant", "thesis", "--plant-option", "c1"],

@@ -43,7 +43,15 @@ from typing import Any
 import numpy as np
 
 from ddwmmr.commands import WheelForces
-from ddwmmr.errors import ParameterError, check_instance, check_positive
+from ddwmmr.errors import (
+    DURATION_RANGE_S,
+    SPEED_RANGE_RAD_S,
+    ParameterError,
+    check_instance,
+    check_positive,
+    check_range,
+)
+from ddwmmr.gains import MAX_GAIN
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import check_configuration
 from ddwmmr.model.robot import clamp_joints
@@ -70,6 +78,39 @@ from ddwmmr.registry import register_plant
 
 #: Bandwidth (1/s) of the velocity servo that follows velocity commands.
 VELOCITY_BANDWIDTH = 10.0
+#: Allowed range ``(low, high, unit)`` of each constant :class:`ThesisPlant` takes (its
+#: arguments, ``track --plant-option``), the same for every robot. The force limit and
+#: the dampings hold what :func:`robot_constants` derives for every robot within
+#: :class:`~ddwmmr.model.Robot`'s ranges (:mod:`ddwmmr.errors`: lengths 1e-6 to 1e3 m,
+#: masses up to 1e5 kg, wheel torques 1e-6 to 1e6 N m): force limits of 4.9e-10 to
+#: 4.9e11 N (the thesis's 10 of 20.5 N of motors giving 1e-9 to 1e12 N), c1 up to 3.75e5
+#: N s/m (3e5 kg of base and links), c2 from 5e-9 (the least base inertia, 1e-9 kg m^2)
+#: up to 1.3e12 N m s/rad (links of 1 km and 1e5 kg). A damping of 1e-20 leaves the thesis
+#: robot's base undamped to 2e-11 over the longest run (1e9 s against ``m / c1`` = 1.3e21 s
+#: and ``I / c2`` >= 5.9e19 s; 1e-16 tracks the ellipse as 1e-3 does,
+#: tests/test_thesis_plant_damping.py): a smaller one is the same base. Within
+#: these ranges every constant derived from them stays finite with room to square it, on
+#: every robot: top speeds ``2 F / c1`` and ``2 F b / c2`` (at most 2e32 m/s and 1e35
+#: rad/s), time constants ``m / c1`` and ``I / c2``, the servo's forces. The arm servo's
+#: speed has the range of the robot's ``joint_speed_limit``; the velocity servo's
+#: bandwidth ``k`` is a gain up to every controller's largest,
+#: :data:`~ddwmmr.gains.MAX_GAIN` (as the servo's loop in
+#: :func:`ddwmmr.sim.error_dynamics.velocity_loop`), from a time constant ``1 / k`` as long
+#: as the longest duration.
+CONSTANT_RANGES = {
+    "force_limit": (1e-10, 1e12, "N"),
+    "c1": (1e-20, 1e13, "N s/m"),
+    "c2": (1e-20, 1e13, "N m s/rad"),
+    "joint_speed": (*SPEED_RANGE_RAD_S, "rad/s"),
+    "velocity_bandwidth": (1.0 / DURATION_RANGE_S[1], MAX_GAIN, "1/s"),
+}
+
+
+def check_constant(name: str, value: Any) -> float:
+    """``value`` as a float if it is in the range of the plant's constant ``name`` (a key
+    of :data:`CONSTANT_RANGES`), else a one-line :class:`ParameterError` naming it and
+    the range."""
+    return check_range(name, value, *CONSTANT_RANGES[name])
 
 
 def warn_derived_constants(robot: Robot, derived: dict[str, float]) -> None:
@@ -226,6 +267,11 @@ class ThesisPlant:
             ``joint_speed_limit``.
         velocity_bandwidth: bandwidth of the velocity servo for velocity commands (1/s).
 
+    A constant given outside its range (:data:`CONSTANT_RANGES`: c1 and c2 in [1e-20,
+    1e13], force_limit in [1e-10, 1e12] N, joint_speed in [1e-6, 1e6] rad/s,
+    velocity_bandwidth in [1e-9, 1e4] 1/s) is a one-line :class:`ParameterError` naming it
+    and the range.
+
     Extra time-series columns: the wheel forces applied over the step that starts at the
     sample (N), ``force_left_n`` and ``force_right_n``.
     """
@@ -244,19 +290,22 @@ class ThesisPlant:
         velocity_bandwidth: float = VELOCITY_BANDWIDTH,
     ) -> None:
         self.robot = check_instance("robot", robot, Robot)
-        # Any: the arguments as given, which check_positive checks
+        # Any: the arguments as given, which check_constant checks
         given: dict[str, Any] = {"force_limit": force_limit, "c1": c1, "c2": c2}
         derived = {
             name: value for name, value in robot_constants(robot).items() if given[name] is None
         }
         self.force_limit, self.c1, self.c2 = (
-            check_positive(name, derived.get(name, given[name])) for name in THESIS_CONSTANTS
+            check_positive(name, derived[name])
+            if name in derived
+            else check_constant(name, given[name])
+            for name in THESIS_CONSTANTS
         )
         if derived:
             warn_derived_constants(robot, derived)
         if joint_speed is None:
             joint_speed = robot.joint_speed_limit
-        self.joint_speed = check_positive("joint_speed", joint_speed)
+        self.joint_speed = check_constant("joint_speed", joint_speed)
         self.mass = robot.total_mass
         self._yaw_inertia = robot.yaw_inertia.at
         self._half_width = 0.5 * robot.track_width  # the wheels' lever b
@@ -470,7 +519,7 @@ class VelocityServo:
 
     def __init__(self, plant: ThesisPlant, bandwidth: float = VELOCITY_BANDWIDTH) -> None:
         self.plant = plant
-        self.bandwidth = check_positive("velocity_bandwidth", bandwidth)
+        self.bandwidth = check_constant("velocity_bandwidth", bandwidth)
         self._half_width = plant.wheel_lever
         self._total = 2.0 * plant.force_limit
 
