@@ -23,6 +23,7 @@ from ddwmmr import interrupts
 from ddwmmr.cli import common
 from ddwmmr.cli.scenarios import main as cli
 from ddwmmr.scenarios import RunConfig, executors, generate
+from terminal_signals import FROM_A_TERMINAL, end
 from test_cli_signals import alive, children, staging, wait_for
 
 distributed = pytest.importorskip("distributed")
@@ -133,14 +134,13 @@ def test_stopping_the_workers_silences_every_dask_logger():
 def test_a_signal_during_a_dask_run_says_one_line(tmp_path, signum, status, group):
     """SIGTERM to the tool, or a closed terminal's SIGHUP to its whole process group: the
     scheduler and nannies in the tool would log every lost worker, the workers and
-    multiprocessing's resource tracker would die with messages of their own."""
-    if group and signal.getsignal(signal.SIGHUP) is signal.SIG_IGN:
-        pytest.skip("started under nohup: the tool inherits SIGHUP ignored, and runs on")
+    multiprocessing's resource tracker would die with messages of their own. Started as
+    from a terminal (SIGHUP at its default, under a suite started by ``nohup`` too)."""
     process = subprocess.Popen(
         [sys.executable, "-m", "ddwmmr.scenarios", "--n", "400", "--jobs", "2",
          "--no-progress", "--executor", "dask", "--out", str(tmp_path / "out")],
         cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        env={**os.environ, "MPLBACKEND": "Agg"}, start_new_session=True,
+        env={**os.environ, "MPLBACKEND": "Agg"}, start_new_session=True, **FROM_A_TERMINAL,
     )  # fmt: skip
     workers: set[int] = set()
     try:
@@ -154,16 +154,17 @@ def test_a_signal_during_a_dask_run_says_one_line(tmp_path, signum, status, grou
             os.killpg(process.pid, signum)
         else:
             process.send_signal(signum)
-        _, err = process.communicate(timeout=60)  # about 3 s, on a loaded machine too
-    except subprocess.TimeoutExpired:
-        process.kill()
-        pytest.fail(f"still running 60 s after the signal; stderr:\n{process.communicate()[1]}")
+        try:
+            _, err = process.communicate(timeout=60)  # about 3 s, on a loaded machine too
+        except subprocess.TimeoutExpired:
+            process.kill()
+            pytest.fail(f"still running 60 s after the signal; stderr:\n{process.communicate()[1]}")
+        assert process.returncode == status, err
+        assert len(err.strip().splitlines()) == 1 and "terminated" in err, err
+        assert list(Path(tmp_path).iterdir()) == []
+        wait_for(lambda: not any(alive(pid) for pid in workers), timeout=20)
     finally:
-        process.kill()
-    assert process.returncode == status, err
-    assert len(err.strip().splitlines()) == 1 and "terminated" in err, err
-    assert list(Path(tmp_path).iterdir()) == []
-    wait_for(lambda: not any(alive(pid) for pid in workers), timeout=20)
+        end(process, workers=workers)
 
 
 @pytest.mark.parametrize(("executor", "jobs"), [("dask", 1), ("local", 2)])

@@ -1,8 +1,9 @@
 """Ctrl-C, SIGTERM, SIGHUP, SIGQUIT: one line, exit 128 + the signal, staging removed,
 worker processes stopped; SIGKILL of a tool: its workers end with it.
 
-The tools run as a user runs them (``python -m``, a subprocess); the signal is sent once
-the staging folder exists (and, with ``--jobs 2``, once the worker processes run).
+The tools run as a user runs them (``python -m``, a subprocess, from a terminal: the
+terminal's signals at their defaults, however the suite was started); the signal is sent
+once the staging folder exists (and, with ``--jobs 2``, once the worker processes run).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from pathlib import Path
 import pytest
 
 from ddwmmr.outputs.owners import STAGING_PREFIX
+from terminal_signals import FROM_A_TERMINAL, end, from_a_terminal
 
 LONG = {
     "track": ["--method", "ats", "--traj", "ellipse", "--duration", "20000", "--no-plots"],
@@ -57,6 +59,9 @@ def wait_for(condition, timeout: float = 60.0) -> None:
 
 
 def start(tool: str, folder: Path, **popen) -> subprocess.Popen:
+    """``tool`` busy for a long time, writing into ``folder / "out"``; ``popen``: more
+    ``subprocess.Popen`` keywords (by default started as from a terminal)."""
+    popen = {**FROM_A_TERMINAL, **popen}
     return subprocess.Popen(
         [sys.executable, "-m", f"ddwmmr.{tool}", *LONG[tool], "--no-progress",
          "--out", str(folder / "out")],
@@ -89,6 +94,7 @@ def staging(folder: Path) -> list[Path]:
 )
 def test_signal_stops_cleanly(tmp_path, tool, signum, status, word):
     process = start(tool, tmp_path)
+    workers: set[int] = set()
     try:
         wait_for(lambda: staging(tmp_path) or process.poll() is not None)
         if "--jobs" in LONG[tool]:
@@ -98,19 +104,20 @@ def test_signal_stops_cleanly(tmp_path, tool, signum, status, word):
         assert process.poll() is None, process.stderr.read()
         process.send_signal(signum)
         _, err = process.communicate(timeout=60)
+        assert process.returncode == status, err
+        lines = err.strip().splitlines()
+        assert len(lines) == 1 and word in lines[0], err
+        assert "Traceback" not in err
+        assert list(tmp_path.iterdir()) == []  # neither out nor its staging folder
+        wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
     finally:
-        process.kill()
-    assert process.returncode == status, err
-    lines = err.strip().splitlines()
-    assert len(lines) == 1 and word in lines[0], err
-    assert "Traceback" not in err
-    assert list(tmp_path.iterdir()) == []  # neither out nor its staging folder
-    wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
+        end(process, workers=workers)
 
 
 def test_ctrl_c_on_the_whole_process_group(tmp_path):
     """A terminal's Ctrl-C reaches the workers too: still one line, no worker traceback."""
     process = start("compare", tmp_path, start_new_session=True)
+    workers: set[int] = set()
     try:
         wait_for(lambda: len(children(process.pid)) >= 2 or process.poll() is not None)
         workers = children(process.pid)
@@ -119,18 +126,19 @@ def test_ctrl_c_on_the_whole_process_group(tmp_path):
         assert process.poll() is None, process.stderr.read()
         os.killpg(process.pid, signal.SIGINT)
         _, err = process.communicate(timeout=60)
+        assert process.returncode == 130, err
+        assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
+        assert list(tmp_path.iterdir()) == []
+        wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
     finally:
-        process.kill()
-    assert process.returncode == 130, err
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err, err
-    assert list(tmp_path.iterdir()) == []
-    wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
+        end(process, workers=workers)
 
 
 @pytest.mark.parametrize("tool", ["compare", "scenarios"])
 def test_workers_end_with_a_killed_tool(tmp_path, tool):
     """``kill -9`` of the tool: nothing can clean up in it, but its workers end too."""
     process = start(tool, tmp_path)
+    workers: set[int] = set()
     try:
         wait_for(lambda: len(children(process.pid)) >= 2 or process.poll() is not None)
         workers = children(process.pid)
@@ -140,9 +148,7 @@ def test_workers_end_with_a_killed_tool(tmp_path, tool):
         process.communicate(timeout=60)
         wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
     finally:
-        for pid in workers:
-            if alive(pid):  # do not leave them to the next test
-                os.kill(pid, signal.SIGKILL)
+        end(process, workers=workers)  # do not leave them to the next test
 
 
 POOL_SCRIPT = """
@@ -175,10 +181,7 @@ def test_pool_workers_end_with_their_parent(tmp_path, mechanism):
         process.wait(timeout=60)
         wait_for(lambda: not any(alive(pid) for pid in workers), timeout=10)
     finally:
-        process.kill()
-        for pid in workers:
-            if alive(pid):
-                os.kill(pid, signal.SIGKILL)
+        end(process, workers=workers)
 
 
 def test_the_next_run_removes_a_killed_runs_staging_folder(tmp_path):
@@ -189,7 +192,7 @@ def test_the_next_run_removes_a_killed_runs_staging_folder(tmp_path):
         process.kill()
         process.communicate(timeout=60)
     finally:
-        process.kill()
+        end(process)
     assert [p.name for p in staging(tmp_path)] == [p.name for p in left]  # nobody cleaned up
     again = subprocess.run(
         [sys.executable, "-m", "ddwmmr.track", "--method", "ats", "--traj", "ellipse",
@@ -212,7 +215,8 @@ def test_a_tool_started_under_nohup_ignores_sighup(tmp_path):
     """``nohup`` starts a tool with SIGHUP ignored: a closed terminal must not stop it,
     while SIGTERM still does."""
 
-    def ignore_hangup() -> None:
+    def ignore_hangup() -> None:  # nohup, typed in a terminal
+        from_a_terminal()
         signal.signal(signal.SIGHUP, signal.SIG_IGN)
 
     proc = start("track", tmp_path, preexec_fn=ignore_hangup)
@@ -225,7 +229,7 @@ def test_a_tool_started_under_nohup_ignores_sighup(tmp_path):
         proc.send_signal(signal.SIGTERM)
         _, err = proc.communicate(timeout=60)
     finally:
-        proc.kill()
+        end(proc)
     assert proc.returncode == 143, err
     assert "terminated (SIGTERM)" in err
 

@@ -2,8 +2,9 @@
 package is imported (the package's exports load on first use, and the tool's start guard,
 ``ddwmmr.cli.signals.guard_start``, is in place before the heavy imports begin).
 
-The tools run as a user runs them (``python -m``, a console script), in subprocesses; the
-signal is sent while they import numpy and the rest, or 0.2 s after they begin to.
+The tools run as a user runs them (``python -m``, a console script, from a terminal:
+SIGINT at its default, however the suite was started), in subprocesses; the signal is
+sent while they import numpy and the rest, or 0.2 s after they begin to.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ import pytest
 
 import ddwmmr
 from ddwmmr.__main__ import TOOLS
+from terminal_signals import FROM_A_TERMINAL, end
 
 #: Arguments that would keep each tool busy for a long time after its imports.
 BUSY = {
@@ -45,6 +47,7 @@ def start(command: list[str], folder: Path) -> subprocess.Popen:
         stderr=subprocess.PIPE,
         text=True,
         env={**os.environ, "MPLBACKEND": "Agg"},
+        **FROM_A_TERMINAL,
     )
 
 
@@ -77,10 +80,7 @@ def interrupt(processes: list[subprocess.Popen], when: str) -> None:
 
 
 def check_stopped(process: subprocess.Popen, label: str) -> None:
-    try:
-        _, err = process.communicate(timeout=60)
-    finally:
-        process.kill()
+    _, err = process.communicate(timeout=60)
     assert process.returncode == 130, f"{label}: status {process.returncode}\n{err}"
     assert "Traceback" not in err, f"{label}:\n{err}"
     assert err.strip().splitlines() == [INTERRUPTED], f"{label}:\n{err}"
@@ -91,15 +91,18 @@ def check_stopped(process: subprocess.Popen, label: str) -> None:
 def test_ctrl_c_while_every_tool_starts(tmp_path, when):
     """All six tools at once (a few seconds in all): each is interrupted in its imports."""
     running = []
-    for tool, arguments in BUSY.items():
-        folder = tmp_path / tool
-        folder.mkdir()
-        command = [sys.executable, "-m", f"ddwmmr.{tool}", *arguments]
-        running.append((tool, folder, start(command, folder)))
-    interrupt([process for _, _, process in running], when)
-    for tool, folder, process in running:
-        check_stopped(process, tool)
-        assert list(folder.iterdir()) == [], tool
+    try:
+        for tool, arguments in BUSY.items():
+            folder = tmp_path / tool
+            folder.mkdir()
+            command = [sys.executable, "-m", f"ddwmmr.{tool}", *arguments]
+            running.append((tool, folder, start(command, folder)))
+        interrupt([process for _, _, process in running], when)
+        for tool, folder, process in running:
+            check_stopped(process, tool)
+            assert list(folder.iterdir()) == [], tool
+    finally:  # a failed check leaves none of the busy tools running
+        end(*(process for _, _, process in running))
 
 
 def test_ctrl_c_while_a_console_script_starts(tmp_path):
@@ -107,13 +110,20 @@ def test_ctrl_c_while_a_console_script_starts(tmp_path):
     if not script.exists():
         pytest.skip("the console scripts are not installed")
     process = start([str(script), *BUSY["track"]], tmp_path)
-    interrupt([process], "numpy")
-    check_stopped(process, "ddwmmr-track")
+    try:
+        interrupt([process], "numpy")
+        check_stopped(process, "ddwmmr-track")
+    finally:
+        end(process)
 
 
-def run_python(code: str, *options: str) -> list[str]:
+def run_python(code: str, *options: str, **popen) -> list[str]:
     out = subprocess.run(
-        [sys.executable, *options, "-c", code], capture_output=True, text=True, timeout=120
+        [sys.executable, *options, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        **popen,
     )
     assert out.returncode == 0, out.stderr
     return out.stdout.split()
@@ -121,7 +131,8 @@ def run_python(code: str, *options: str) -> list[str]:
 
 def test_import_ddwmmr_is_light_and_leaves_the_signals_alone():
     """``import ddwmmr`` imports neither numpy nor CasADi and installs no signal handler
-    (a library's import must not); the first public name used imports its module."""
+    (a library's import must not); the first public name used imports its module. Started
+    as from a terminal: Python's own SIGINT handler is there to be left alone."""
     code = (
         "import signal, sys; import ddwmmr; "
         "print('numpy' in sys.modules, 'casadi' in sys.modules, "
@@ -129,7 +140,7 @@ def test_import_ddwmmr_is_light_and_leaves_the_signals_alone():
         "signal.getsignal(signal.SIGTERM) is signal.SIG_DFL); "
         "ddwmmr.Robot; print('numpy' in sys.modules)"
     )
-    assert run_python(code) == ["False", "False", "True", "True", "True"]
+    assert run_python(code, **FROM_A_TERMINAL) == ["False", "False", "True", "True", "True"]
 
 
 def test_every_public_name_resolves():

@@ -11,6 +11,8 @@ import time
 
 import pytest
 
+from terminal_signals import FROM_A_TERMINAL, end
+
 
 @pytest.mark.skipif(not hasattr(signal, "SIGINT"), reason="needs SIGINT")
 def test_a_ctrl_c_inside_exec_code_still_exits_130(tmp_path):
@@ -37,6 +39,7 @@ def test_a_ctrl_c_inside_exec_code_still_exits_130(tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        **FROM_A_TERMINAL,  # Ctrl-C in a terminal: SIGINT at its default
     )
     try:
         assert process.stdout.readline().strip() == "ready"
@@ -44,6 +47,6 @@ def test_a_ctrl_c_inside_exec_code_still_exits_130(tmp_path):
         process.send_signal(signal.SIGINT)
         _, err = process.communicate(timeout=30)
     finally:
-        process.kill()
+        end(process)
     assert process.returncode == 130, err
     assert err.strip() == "interrupted (Ctrl-C): stopped; unfinished output removed"

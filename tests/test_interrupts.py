@@ -10,12 +10,15 @@ from ddwmmr import interrupts
 from ddwmmr.bounds import diffdrive
 from ddwmmr.cli import common
 from ddwmmr.cli.common import Terminated, interruptible
+from terminal_signals import at_defaults
 
 
 @pytest.fixture(autouse=True)
 def nothing_pending():
-    """No interrupt a test recorded outlives it (the next solve would raise it)."""
-    yield
+    """No interrupt a test recorded outlives it (the next solve would raise it); SIGINT
+    at Python's default, as in a tool run from a terminal, whatever the suite's start."""
+    with at_defaults():
+        yield
     interrupts.clear()
 
 

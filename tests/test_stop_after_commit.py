@@ -12,15 +12,19 @@ from ddwmmr import interrupts
 from ddwmmr.cli import common, track
 from ddwmmr.cli.common import run_main
 from ddwmmr.outputs import output_folder
+from terminal_signals import at_defaults
 
 SIGNALS = [signal.SIGINT, signal.SIGTERM, *([signal.SIGHUP] if hasattr(signal, "SIGHUP") else [])]
 
 
 @pytest.fixture(autouse=True)
 def no_worker_stop(monkeypatch):
-    """The handler stops the tool's workers and silences every logger: not pytest's."""
+    """The handler stops the tool's workers and silences every logger: not pytest's. The
+    terminal's signals at their defaults (as in a tool run from one), whatever the suite's
+    start: the tool leaves a signal it was started ignoring ignored."""
     monkeypatch.setattr(common, "stop_workers", lambda: None)
-    yield
+    with at_defaults():
+        yield
     interrupts.clear()
 
 
