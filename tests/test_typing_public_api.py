@@ -101,7 +101,7 @@ def test_sampled_trajectory_refuses_as_before():
 
 def test_the_heading_warning_still_names_the_caller():
     """The constructor adds no frame: the degrees warning points at the line that built
-    the trajectory (stacklevel counts the frames up from the check)."""
+    the trajectory (the first frame outside the package)."""
     times = np.linspace(0.0, 10.0, 11)
     points = np.column_stack([times * 0.1, np.zeros(11), np.linspace(0.0, 90.0, 11)])
     with warnings.catch_warnings(record=True) as caught:

@@ -28,7 +28,6 @@ import re
 import shlex
 import subprocess
 import sys
-import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,6 +50,7 @@ from ddwmmr.trajectories.files import (
 )
 from ddwmmr.trajectories.sampled import SampledTrajectory, read_csv
 from ddwmmr.trajectories.scaled import ScaledTrajectory, check_scale
+from ddwmmr.user_warnings import warn_user
 
 #: Version of the record layout (bump when a key changes meaning).
 RECORD_VERSION = 1
@@ -353,7 +353,7 @@ def trajectory_from_record(record: dict[str, Any]) -> Any:
     :func:`read_trajectory_record`)."""
     trajectory, _, note = read_trajectory_record(record)
     if note is not None:
-        warnings.warn(note, UserWarning, stacklevel=2)
+        warn_user(note)
     return trajectory
 
 

@@ -53,6 +53,7 @@ from ddwmmr.outputs import (
     package_version,
     recording_commits,
 )
+from ddwmmr.user_warnings import library_warning
 from ddwmmr.workers import IN_WORKERS, SHOWN
 
 if TYPE_CHECKING:
@@ -418,16 +419,13 @@ def forget_unhandled_interrupt() -> None:
     exec("pass")
 
 
-#: The package's folder: a warning issued from a file below it is the library's own.
-_PACKAGE_FOLDER = os.path.normcase(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-
-
 @contextlib.contextmanager
 def one_line_warnings() -> Iterator[None]:
-    """Show the library's own warnings (a :class:`UserWarning` issued from the package)
-    as one line on stderr, ``warning: <message>`` (their messages name the parameter and
-    what to change), instead of Python's default form (the source file, line number and
-    line of the library's code, which reads like a traceback); any other warning (another
+    """Show the library's own warnings (a :class:`UserWarning` the package issued,
+    :func:`~ddwmmr.user_warnings.library_warning`, whichever line it names) as one line
+    on stderr, ``warning: <message>`` (their messages name the parameter and what to
+    change), instead of Python's default form (the source file, line number and
+    line of code, which reads like a traceback); any other warning (another
     library's, or a NumPy ``RuntimeWarning`` whose location is the clue) is shown as
     Python would. Each line is shown once: a warning that every run repeats (a plant's
     about the robot) is said once per command. The worker processes of
@@ -463,8 +461,7 @@ def _one_line_display(previous: Callable[..., None]) -> Callable[..., None]:
         file: TextIO | None = None,
         line: str | None = None,
     ) -> None:
-        ours = os.path.normcase(os.path.abspath(filename)).startswith(_PACKAGE_FOLDER + os.sep)
-        if not (ours and issubclass(category, UserWarning)):
+        if not (library_warning(message, filename) and issubclass(category, UserWarning)):
             previous(message, category, filename, lineno, file, line)
             return
         text = f"warning: {' '.join(str(message).split())}"

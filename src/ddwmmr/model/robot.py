@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import functools
 import math
-import warnings
 from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -39,6 +38,7 @@ from ddwmmr.errors import (
 from ddwmmr.model import kinematics, stability, support_loads
 from ddwmmr.model.mass import YawInertia, total_mass
 from ddwmmr.model.stability import ComCoefficients
+from ddwmmr.user_warnings import warn_user
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -611,10 +611,10 @@ def _degrees_hint(angle: float) -> str:
 
 def _warn_unit_doubts(robot: Robot, where: str) -> None:
     """A :class:`UserWarning` per :func:`unit_doubts` note, prefixed with ``where`` (the
-    file) and pointing at the caller of ``from_toml`` / ``from_dict``: the robot is taken
+    file) and naming the user's line (:func:`~ddwmmr.user_warnings.warn_user`): the robot is taken
     as given (a giant robot may be meant), so the user sees why it behaves as it does."""
     for doubt in unit_doubts(robot):
-        warnings.warn(f"{where}: {doubt}; taken as given", UserWarning, stacklevel=3)
+        warn_user(f"{where}: {doubt}; taken as given")
 
 
 def _check_field_type(key: str, value: Any, default: Any) -> None:

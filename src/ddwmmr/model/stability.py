@@ -46,7 +46,6 @@ are left out.)
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -55,6 +54,7 @@ import numpy as np
 
 from ddwmmr.errors import MASS_RANGE_KG, ParameterError, check_finite
 from ddwmmr.model.mass import total_mass
+from ddwmmr.user_warnings import warn_user
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -106,12 +106,10 @@ def warn_start_below_floor(
     if not 1.0 < s < floor:
         return
     lower = math.floor(s * 100.0 - 1e-9) / 100.0  # strictly below s, as a short number
-    warnings.warn(
+    warn_user(
         f"stability_min: the start pose has S = {s:.4g}, below the {method}'s stability "
         f"floor stability_min = {floor:g}, which the run starts by breaking; lower the floor "
-        f"(stability_min={lower:g}) or start where S >= {floor:g}",
-        UserWarning,
-        stacklevel=3,
+        f"(stability_min={lower:g}) or start where S >= {floor:g}"
     )
 
 

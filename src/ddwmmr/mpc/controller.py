@@ -49,7 +49,6 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import fields
 from typing import Any, ClassVar, cast
@@ -91,6 +90,7 @@ from ddwmmr.mpc.stall import StallWatch
 from ddwmmr.qp.limits import run_clearance, safe_arm_scale
 from ddwmmr.qp.limits.obstacles import Circle
 from ddwmmr.resolution.kernels import length_unit
+from ddwmmr.user_warnings import warn_user
 
 #: Share of the planned wheel force (``mpc_wheel_force_limit_n``) at or above which a
 #: wheel's measured force counts as held at it (``mpc_wheel_force_bound_time_s``): the
@@ -748,13 +748,11 @@ def warn_start_in_keep_out(
     gap = (
         f"overlaps it by {-clearance:.3g} m" if clearance < 0.0 else f"is {clearance:.3g} m from it"
     )
-    warnings.warn(
+    warn_user(
         f"obstacles: the start pose is inside the mpc's keep-out of obstacle {number} (x "
         f"{circle.x:g} m, y {circle.y:g} m, radius {circle.radius:g} m){more}: the base's "
         f"enclosing circle (radius {bubble:.3g} m) {gap}, within obstacle_margin {margin:g} "
-        f"m; the run starts violating its obstacle constraint",
-        UserWarning,
-        stacklevel=3,
+        f"m; the run starts violating its obstacle constraint"
     )
 
 

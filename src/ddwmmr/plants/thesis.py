@@ -35,7 +35,6 @@ given; derived constants that differ from the thesis's get a one-line warning.
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -75,6 +74,7 @@ from ddwmmr.plants.base import (
     check_step,
 )
 from ddwmmr.registry import register_plant
+from ddwmmr.user_warnings import warn_user
 
 #: Bandwidth (1/s) of the velocity servo that follows velocity commands.
 VELOCITY_BANDWIDTH = 10.0
@@ -133,11 +133,9 @@ def warn_derived_constants(robot: Robot, derived: dict[str, float]) -> None:
     keywords = ", ".join(f"{name}=..." for name in derived)
     options = " ".join(f"--plant-option {name}=..." for name in derived)
     them = "them" if len(derived) > 1 else "it"
-    warnings.warn(
+    warn_user(
         f"thesis plant: {values} derived for this robot (ThesisPlant(robot, {keywords}) "
-        f"sets {them}; track: {options})",
-        UserWarning,
-        stacklevel=2,
+        f"sets {them}; track: {options})"
     )
 
 

@@ -84,7 +84,6 @@ plants keep their errors as they are.
 from __future__ import annotations
 
 import time
-import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from math import isfinite
@@ -108,6 +107,7 @@ from ddwmmr.errors import (
 from ddwmmr.inheritance import defining_class, from_library, overrides
 from ddwmmr.plants.base import Observation, Plant, PlantDivergedError, Policy
 from ddwmmr.plants.checked import Failed, PlantFailed, checked_plant
+from ddwmmr.user_warnings import warn_user
 
 #: Progress callback: (samples done, samples in all).
 Progress = Callable[[int, int], None]
@@ -195,23 +195,23 @@ def spoken_interface(controller: Any, plant: Plant) -> str:
     return next((i for i in declared if i in plant.interfaces), declared[0])
 
 
-def check_interface(controller: Any, plant: Plant, stacklevel: int = 3) -> str:
+def check_interface(controller: Any, plant: Plant) -> str:
     """The command interface ``controller`` sends on ``plant`` (see the module docstring):
     its ``interface`` if it has one, else the first of its declared ``interfaces`` that the
     plant accepts (chosen afresh for every plant: nothing is stored on the controller); a
-    one-line :class:`ParameterError` if the plant does not accept it. ``stacklevel``: that
-    of the deprecation warning, the frame of its caller's caller by default."""
+    one-line :class:`ParameterError` if the plant does not accept it. An ``interface``
+    outside the declared ``interfaces`` is a :class:`FutureWarning` naming the user's line
+    (:func:`~ddwmmr.user_warnings.warn_user`)."""
     declared = tuple(getattr(controller, "interfaces", None) or (VELOCITY,))
     interface = spoken_interface(controller, plant)
     own = getattr(controller, "interface", None) is not None
     if own and hasattr(controller, "interfaces") and interface not in declared:
-        warnings.warn(
+        warn_user(
             f"{name_of(controller)} sends {interface} commands (its interface attribute) "
             f"but declares interfaces={declared}: declare them with "
             f"@register_controller(..., interfaces=...); the interface attribute alone is "
             "deprecated",
             FutureWarning,
-            stacklevel=stacklevel,
         )
     if interface not in plant.interfaces:
         name = getattr(controller, "name", type(controller).__name__)
@@ -351,8 +351,7 @@ def prepare_run(
         adopt = getattr(controller, "adopt_plant", None) is not None
         if adopt and prepare(controller, "adopt_plant", traits_of(plant), failed=failed):
             return LoopEnd(0, "controller_error")
-        # stacklevel: its deprecation warning names run_loop's caller, as from run_loop
-        interface = check_interface(controller, plant, stacklevel=4)
+        interface = check_interface(controller, plant)
         plant.reset(q0, dt)
         adopt = getattr(controller, "adopt_control_step", None) is not None
         if adopt and prepare(controller, "adopt_control_step", dt, failed=failed):

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import warnings
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any, cast
 
@@ -51,6 +50,7 @@ from ddwmmr.trajectories.base import (
     sampler,
     trajectory_name,
 )
+from ddwmmr.user_warnings import warn_user
 
 __all__ = ["COLUMNS", "build_plant", "max_condition_number", "simulate", "summarize"]
 
@@ -92,16 +92,13 @@ _OTHER_ROBOT = {
 }
 
 
-def warn_other_robot(
-    holder: Any, robot: Robot, parameter: str = "method", stacklevel: int = 3
-) -> None:
+def warn_other_robot(holder: Any, robot: Robot, parameter: str = "method") -> None:
     """Warn (:class:`UserWarning`) when ``holder``, the object passed as ``parameter``
     (``"method"``: a controller, ``"plant"``: a plant), holds a ``robot`` other than the
     simulated one, naming the fields that differ: a controller's model, e.g. its stability
     floor's payload, is then not the plant's; a plant simulates other physics than the
     summary judges. That can be meant (a study of model error), so it is not refused.
-    ``stacklevel`` counts frames as :func:`warnings.warn` does, from this function: the
-    warning names the user's call to :func:`simulate`."""
+    The warning names the user's line (:func:`~ddwmmr.user_warnings.warn_user`)."""
     own = getattr(holder, "robot", None)
     if not isinstance(own, Robot) or own == robot:
         return
@@ -111,12 +108,10 @@ def warn_other_robot(
         if f.init and getattr(own, f.name) != getattr(robot, f.name)
     ]
     what, meaning = _OTHER_ROBOT[parameter]
-    warnings.warn(
+    warn_user(
         f"{parameter}: {what} was built for another robot than the one simulated "
         f"({'; '.join(differ[:3])}{'; ...' if len(differ) > 3 else ''}): {meaning}; "
-        "build it with the same Robot unless that is the point",
-        UserWarning,
-        stacklevel=stacklevel,
+        "build it with the same Robot unless that is the point"
     )
 
 
@@ -330,7 +325,7 @@ def _controller_for(method: str | Controller, robot: Robot, options: dict[str, A
     if options:
         raise ParameterError("controller options are only accepted with a method name")
     controller = check_controller(method)
-    warn_other_robot(controller, robot, stacklevel=4)  # from simulate's caller
+    warn_other_robot(controller, robot)
     return controller
 
 
@@ -446,11 +441,9 @@ def _tipped_start(robot: Robot, q: np.ndarray, policy: str) -> bool:
     if policy == "refuse":
         raise ParameterError(message)
     if policy == "warn":
-        warnings.warn(
+        warn_user(
             f"{message}; simulating anyway (summary['start_tipped'] is True; "
-            'tipped_start="refuse" refuses, "allow" silences this)',
-            UserWarning,
-            stacklevel=3,
+            'tipped_start="refuse" refuses, "allow" silences this)'
         )
     return True
 
@@ -467,7 +460,7 @@ def warn_gain_step(controller: Any, plant: Any, dt: float) -> None:
     scheme = "rk4" if stages and not getattr(controller, "zero_order_hold", False) else "hold"
     message = gain_step_warning(gains, dt, scheme)
     if message is not None:
-        warnings.warn(message, UserWarning, stacklevel=3)
+        warn_user(message)
 
 
 def check_tracks(method: str) -> None:

@@ -15,7 +15,6 @@ command on a velocity-only plant (the kinematic model, where the command is the 
 from __future__ import annotations
 
 import math
-import warnings
 from typing import Any, NoReturn
 
 import numpy as np
@@ -29,6 +28,7 @@ from ddwmmr.plants.base import Observation, Plant, PlantDivergedError
 from ddwmmr.plants.checked import checked_extra_values
 from ddwmmr.trajectories.base import Trajectory, sample_each, sampler, trajectory_name
 from ddwmmr.trajectories.scaled import ScaledTrajectory
+from ddwmmr.user_warnings import warn_user
 
 #: Column names of the recorded time series, in order (plant columns follow).
 COLUMNS = (
@@ -470,13 +470,11 @@ def _sample_agrees(checked: CheckedTrajectory, sample: Any, times: np.ndarray) -
             (velocity, found[1][index], "velocity"),
         ):
             if not np.allclose(what, own, rtol=SAMPLE_TOLERANCE, atol=SAMPLE_TOLERANCE):
-                warnings.warn(
+                warn_user(
                     f"trajectory {_name(checked)}: sample(times) disagrees with {name}(t) at "
                     f"t = {times[index]:g} s ({_numbers(what)} vs {_numbers(own)}); simulating "
                     "with pose(t) and velocity(t) call by call instead (slower): make sample "
-                    "give their numbers",
-                    UserWarning,
-                    stacklevel=6,  # simulate() -> check_trajectory -> checked_trajectory -> here
+                    "give their numbers"
                 )
                 return False
     return True
@@ -508,13 +506,11 @@ def _check_derivative(checked: CheckedTrajectory, times: np.ndarray) -> None:
             bad.append((t, velocity, difference))
     if 2 * len(bad) > len(times):
         t, velocity, difference = bad[0]
-        warnings.warn(
+        warn_user(
             f"trajectory {_name(checked)}: velocity(t) is not the time derivative of pose(t) "
             f"at {len(bad)} of {len(times)} checked times (t = {t:g} s: {_numbers(velocity)} vs "
             f"{_numbers(difference)} from pose); the open-loop methods integrate velocity, so "
-            "the run follows another path",
-            UserWarning,
-            stacklevel=6,  # simulate() -> check_trajectory -> checked_trajectory -> here
+            "the run follows another path"
         )
 
 

@@ -20,7 +20,6 @@ import bisect
 import csv
 import itertools
 import math
-import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -49,6 +48,7 @@ from ddwmmr.trajectories.base import (
     check_times,
     file_name,
 )
+from ddwmmr.user_warnings import warn_user
 
 MAX_TIME_S = DURATION_RANGE_S[1]
 #: Smallest step between two sample times, as a share of the duration (last minus first
@@ -185,7 +185,7 @@ class SampledTrajectory:
         points = unwrap_phi(points)
         message = heading_units_warning(points)
         if message is not None:
-            warnings.warn(f"trajectory {self.name}: {message}", UserWarning, stacklevel=3)
+            warn_user(f"trajectory {self.name}: {message}")
         periodic = bool(np.allclose(points[0, :2], points[-1, :2], atol=1e-9))
         object.__setattr__(self, "times", times)
         object.__setattr__(self, "points", points)
@@ -602,7 +602,7 @@ def read_csv(path: str | Path) -> SampledTrajectory:
     trajectory = _read_samples(path)
     message = length_units_warning(trajectory.points)
     if message is not None:
-        warnings.warn(f"trajectory {trajectory.name}: {message}", UserWarning, stacklevel=2)
+        warn_user(f"trajectory {trajectory.name}: {message}")
     return trajectory
 
 
