@@ -163,3 +163,127 @@ def test_a_limit_widening_v_in_its_own_unit_is_refused():
         r"from -1 to -1000 ",
     ):
         _run(limits=[_Box(0, 1e3, assign=True, unit=0.5)], max_base_speed=0.5)
+
+
+class _CompiledRow(Limit):
+    """_RowLimit's row, and _Box's box on ``th1dot``, written by a compiled writer
+    (``compile``) that ``how`` spoils; ``unit = None`` declares rows without ``v``."""
+
+    rows = 1
+
+    def __init__(self, how: str = "", unit: float | None = 1.0) -> None:
+        self.how, self.unit = how, unit
+
+    def compute(self, ctx, G, lower, upper, lb, ub):
+        G[0] = (0.0, 1.0, 0.0, 0.0) if self.unit is None else (1.0, 1.0, 0.0, 0.0)
+        lower[0], upper[0] = -0.1, 0.1
+        lb[2], ub[2] = max(lb[2], -1.0), min(ub[2], 1.0)
+
+    def compile(self, block):
+        if self.how == "compile raise":
+            raise ValueError("no block for me")
+        (row,), (bound,), how, box = block.rows, block.bounds, self.how, block.box
+        G, lower, upper = block.matrix, block.lower, block.upper
+
+        def write(ctx):
+            G[row], G[row + 1] = (0.0 if self.unit is None else 1.0), 1.0
+            lower[bound], upper[bound] = -0.1, 0.1
+            box[2], box[6] = max(box[2], -1.0), min(box[6], 1.0)
+            if how == "G nan":
+                G[row + 1] = math.nan
+            elif how == "upper nan":
+                upper[bound] = math.nan
+            elif how == "box nan":
+                box[6] = math.nan
+            elif how == "widen":
+                box[2] = -10.0
+            elif how == "v":
+                G[row] = 1.0
+            elif how == "raise":
+                raise RuntimeError("writer broke")
+
+        return write
+
+
+class _CompiledStill(_ArmStill):
+    """_ArmStill by a compiled writer; ``how = "nan"`` writes a NaN target."""
+
+    def compile(self, block):
+        (target,), how = block.target_views, self.how
+        block.write_constant_rows([[0, 0, 1, 0], [0, 0, 0, 1]])
+
+        def write(ctx):
+            target[block.targets[0]] = target[block.targets[1]] = 0.0
+            if how == "nan":
+                target[block.targets[1]] = math.nan
+
+        return write
+
+
+def test_a_user_piece_s_compiled_writer_runs_as_its_compute_does():
+    """Its writer is used, not its compute, and the run is the compute path's to the bit."""
+    from ddwmmr.qp.problem import QPProblem
+
+    controller = make_controller("qp", Robot(), limits=[_CompiledRow()])
+    problem = QPProblem(controller.tasks, controller.limits)
+    assert all(limit.__module__.startswith("ddwmmr.") for limit, *_ in problem._generic_limits)
+    compiled = _run(limits=[_CompiledRow()])
+    generic = _run(limits=[_RowLimit(), _Box(2, 1.0, assign=False)])
+    for column in ("v", "w", "th1dot", "th2dot"):
+        np.testing.assert_array_equal(compiled.timeseries[column], generic.timeseries[column])
+    assert np.max(np.abs(compiled.timeseries["th1dot"])) <= 1.0 + 1e-6
+    still = simulate(Robot(), Ellipse(), _with_task(_CompiledStill(1.0)), duration=0.2)
+    plain = simulate(Robot(), Ellipse(), _with_task(_ArmStill(1.0)), duration=0.2)
+    np.testing.assert_array_equal(still.timeseries["th1dot"], plain.timeseries["th1dot"])
+
+
+def _with_task(task):
+    """A qp controller with the user's ``task``."""
+    return make_controller("qp", Robot(), tasks=[task])
+
+
+@pytest.mark.parametrize(
+    ("how", "message"),
+    [
+        ("G nan", "wrote a non-finite value into its matrix at t = 0 s (they must be finite)"),
+        ("upper nan", "wrote a non-finite value into its bounds at t = 0 s (they must not be "),
+        ("box nan", "wrote a NaN into the input box at t = 0 s (bounds must not be NaN; "),
+        ("widen", "widened the input box at t = 0 s: lb[2] (th1dot) from -1.999998 to -10 "),
+    ],
+)
+def test_a_user_piece_s_compiled_writer_is_checked_as_its_compute_is(how, message):
+    with pytest.raises(ParameterError) as info:
+        _run(limits=[_CompiledRow(how)])
+    assert str(info.value).startswith(f"_CompiledRow: compile()'s writer {message}")
+    assert "\n" not in str(info.value)
+
+
+def test_a_user_task_s_compiled_writer_is_checked_and_what_it_raises_named():
+    with pytest.raises(
+        ParameterError,
+        match=r"^_CompiledStill 'armstill': compile\(\)'s writer "
+        r"wrote a non-finite value into its error at t = 0 s",
+    ):
+        simulate(Robot(), Ellipse(), _with_task(_CompiledStill(1.0, "nan")), duration=0.2)
+    with pytest.raises(
+        PluginError,
+        match=r"^_CompiledRow: compile\(\)'s writer raised "
+        r"RuntimeError: writer broke at t = 0 s$",
+    ):
+        _run(limits=[_CompiledRow("raise")])
+    with pytest.raises(
+        PluginError,
+        match=r"^_CompiledRow: compile\(\) raised ValueError: "
+        r"no block for me \(building the QP\)$",
+    ):
+        _run(limits=[_CompiledRow("compile raise")])
+
+
+def test_a_compiled_writer_without_v_that_writes_v_is_refused():
+    _run(limits=[_CompiledRow(unit=None)])
+    with pytest.raises(
+        ParameterError,
+        match=r"^_CompiledRow: unit = None \(rows without v\) "
+        r"but compile\(\)'s writer wrote \[1\.0\] into its v column at t = 0 s",
+    ):
+        _run(limits=[_CompiledRow("v", unit=None)])

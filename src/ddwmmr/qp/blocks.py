@@ -15,6 +15,10 @@ what changes, as Python floats, straight into flat ``memoryview`` s of the probl
 * None (the default of the base classes) to be called through ``compute`` instead: a user's
   own piece plugs in unchanged and pays the generic path's cost only for itself.
 
+A user's piece may implement ``compile`` too: its writer is checked every step as its
+``compute`` would be (:func:`ddwmmr.qp.problem.guarded_writer`), and it writes only its
+block's entries (``rows``, ``targets``/``bounds``) and tightens ``box``.
+
 A built-in piece whose ``compute`` a subclass overrides falls back to the generic path
 (see :func:`overrides`), so a subclass never has its ``compute`` silently bypassed.
 

@@ -26,8 +26,9 @@ subclass overriding ``compute``) is called through its generic ``compute`` on nu
 and a cost task's rows are then weighted with one numpy product. Both give the same
 numbers to the last bit. Nothing is allocated per step except inside numpy's two products.
 A user's piece (a class from outside the library) is called through a guard
-(:func:`guarded_task`, :func:`guarded_limit`) that checks what it wrote every step before
-the solve and names it in one line when it raises; the library's own pieces run unguarded.
+(:func:`guarded_task`, :func:`guarded_limit`; :func:`guarded_writer` for the writer of
+one that implements ``compile``) that checks what it wrote every step before the solve
+and names it in one line when it raises; the library's own pieces run unguarded.
 """
 
 from __future__ import annotations
@@ -96,22 +97,25 @@ def piece_unit(piece: Task | Limit) -> float | None:
     return number
 
 
-def _refuse_v(label: str, ctx: StepContext, what: str) -> None:
+def _refuse_v(label: str, ctx: StepContext, what: str, by: str = "compute()") -> None:
     """Refuse (one-line :class:`ParameterError`) the piece ``label`` whose ``unit`` is None
-    (rows without ``v``) but whose ``compute`` did ``what`` to ``v``: the problem would
-    read that ``v`` in its own length unit, not in m/s."""
+    (rows without ``v``) but whose ``compute`` (or what ``by`` names) did ``what`` to
+    ``v``: the problem would read that ``v`` in its own length unit, not in m/s."""
     raise ParameterError(
-        f"{label}: unit = None (rows without v) but compute() {what} at t = {ctx.t:g} s "
+        f"{label}: unit = None (rows without v) but {by} {what} at t = {ctx.t:g} s "
         "(declare unit = 1.0 for v in m/s, or a length in m for v in that unit per second)"
     )
 
 
 def _refuse_written(
-    label: str, ctx: StepContext, **written: np.ndarray | tuple[np.ndarray, ...]
+    label: str,
+    ctx: StepContext,
+    by: str = "compute()",
+    **written: np.ndarray | tuple[np.ndarray, ...],
 ) -> None:
     """Refuse (one-line :class:`ParameterError`) the piece ``label`` whose ``compute``
-    wrote NaN into any of ``written``, or an infinite value into any but its ``bounds``
-    (an infinite bound leaves a side open)."""
+    (or what ``by`` names: :data:`WRITER`) wrote NaN into any of ``written``, or an
+    infinite value into any but its ``bounds`` (an infinite bound leaves a side open)."""
     for what, value in written.items():
         arrays = value if isinstance(value, tuple) else (value,)
         bad = any(
@@ -124,7 +128,7 @@ def _refuse_written(
                 else "must be finite"
             )
             raise ParameterError(
-                f"{label}: compute() wrote a non-finite value into its {what} "
+                f"{label}: {by} wrote a non-finite value into its {what} "
                 f"at t = {ctx.t:g} s (they {rule})"
             )
 
@@ -153,13 +157,18 @@ def guarded_task(task: Task) -> TaskCompute:
 
 
 def _refuse_widened(
-    label: str, ctx: StepContext, before: list[float], lb: list[float], ub: list[float]
+    label: str,
+    ctx: StepContext,
+    before: list[float],
+    lb: list[float],
+    ub: list[float],
+    by: str = "compute()",
 ) -> None:
     """Refuse (one-line :class:`ParameterError`) the limit ``label`` if its ``compute``
-    loosened a bound of the input box it was given: ``before`` holds ``lb`` then ``ub`` as
-    they arrived (the earlier limits' box), ``lb``, ``ub`` what it left. An open side
-    (``+-INF``, or beyond) may be written ``+-inf``; a NaN passes here
-    (:func:`_refuse_written`'s to refuse)."""
+    (or what ``by`` names) loosened a bound of the input box it was given: ``before``
+    holds ``lb`` then ``ub`` as they arrived (the earlier limits' box), ``lb``, ``ub``
+    what it left. An open side (``+-INF``, or beyond) may be written ``+-inf``; a NaN
+    passes here (:func:`_refuse_written`'s to refuse)."""
     for i in range(NU):
         side, old, new = "lb", before[i], lb[i]
         if not (new < old and old > -INF):
@@ -167,7 +176,7 @@ def _refuse_widened(
             if not (new > old and old < INF):
                 continue
         raise ParameterError(
-            f"{label}: compute() widened the input box at t = {ctx.t:g} s: {side}[{i}] "
+            f"{label}: {by} widened the input box at t = {ctx.t:g} s: {side}[{i}] "
             f"({U_NAMES[i]}) from {old:.9g} to {new:.9g} (a limit only tightens lb, ub, which "
             f"hold the earlier limits' bounds: lb[i] = max(lb[i], ...), ub[i] = min(ub[i], ...))"
         )
@@ -203,6 +212,81 @@ def guarded_limit(limit: Limit) -> LimitCompute:
         after_lb, after_ub = lb.tolist(), ub.tolist()
         if after_lb + after_ub != before:  # a tightened (or NaN) bound: which, if any, widened
             _refuse_widened(label, ctx, before, after_lb, after_ub)
+
+    return guarded
+
+
+#: How a refusal names a user's compiled writer (what its ``compile`` returned).
+WRITER = "compile()'s writer"
+
+
+def guarded_writer(
+    piece: Task | Limit,
+    writer: Callable[[StepContext], None],
+    rows: np.ndarray,
+    targets: tuple[np.ndarray, ...],
+    box: list[float] | None,
+    v_free: bool,
+) -> Callable[[StepContext], None]:
+    """The writer a user's piece's ``compile`` returned, checked every step as its
+    ``compute`` would be (:func:`guarded_task`, :func:`guarded_limit`): what it raises
+    is a one-line :class:`~ddwmmr.errors.PluginError` naming it; a NaN (or, outside a
+    limit's bounds, an infinite value) among the entries of its block, ``rows`` (its
+    rows of the stacked matrix, C-contiguous, as stored) and ``targets`` (a task's
+    targets, a limit's lower and upper bounds), a NaN or a widened bound of the input
+    ``box`` (a limit's, else None), and, for ``v_free`` (``unit = None``), a ``v``
+    entry or bound, are each refused in one line. The library's writers run unwrapped."""
+    label = piece_label(piece)
+    flat = rows.reshape(-1)
+    assert rows.size == 0 or np.shares_memory(flat, rows)
+    # the sums of a block's few entries (cheaper than ndarray.dot at this size): NaN or
+    # infinite when one entry is, or past 1e308 when none is (then refuse() returns)
+    if box is None:
+        finite = [flat, *targets]
+
+        def written_ok() -> bool:
+            return all(math.isfinite(sum(array.tolist())) for array in finite)
+
+        def refuse(ctx: StepContext) -> None:
+            _refuse_written(label, ctx, WRITER, jacobian=rows, error=targets)
+
+    else:
+        lower, upper = targets
+
+        def written_ok() -> bool:
+            return (
+                math.isfinite(sum(flat.tolist()))
+                and not math.isnan(sum(lower.tolist()))
+                and not math.isnan(sum(upper.tolist()))
+            )
+
+        def refuse(ctx: StepContext) -> None:
+            _refuse_written(label, ctx, WRITER, matrix=rows, bounds=targets)
+
+    def guarded(ctx: StepContext) -> None:
+        before = box[:] if box is not None else None
+        try:
+            writer(ctx)
+        except Exception as exc:
+            raise_plugin_error(f"{label}: {WRITER}", exc, f" at t = {ctx.t:g} s")
+        if not written_ok():
+            refuse(ctx)
+        if v_free and rows[:, 0].any():
+            column = shown(rows[:, 0].tolist())
+            _refuse_v(label, ctx, f"wrote {column} into its v column", WRITER)
+        if box is None or before is None or box == before:
+            return
+        if math.isnan(sum(box)) and any(map(math.isnan, box)):  # the sum: -inf + inf too
+            raise ParameterError(
+                f"{label}: {WRITER} wrote a NaN into the input box at t = {ctx.t:g} s "
+                "(bounds must not be NaN; +-inf leaves a side open)"
+            )
+        for i in range(NU):
+            if box[i] < before[i] or box[NU + i] > before[NU + i]:  # or an open side opened
+                _refuse_widened(label, ctx, before, box[:NU], box[NU:], WRITER)
+                break
+        if v_free and (box[0], box[NU]) != (before[0], before[NU]):
+            _refuse_v(label, ctx, "bounded v in lb, ub", WRITER)
 
     return guarded
 
@@ -322,7 +406,8 @@ class QPProblem:
                 scales=tuple(sqrt_w[start:stop]),
                 slack=False,
             )
-            if not self._add_writer(task, block):
+            targets: tuple[np.ndarray, ...] = (self.ew[start:stop],)
+            if not self._add_writer(task, block, self.Jw[start:stop], targets):
                 self._generic_cost.append(
                     (
                         task,
@@ -348,7 +433,8 @@ class QPProblem:
                 scales=(1.0,) * task.rows,
                 slack=True,
             )
-            if not self._add_writer(task, block):
+            targets = (self.cl[start:stop], self.cu[start:stop])
+            if not self._add_writer(task, block, self.C[start:stop], targets):
                 self._generic_slack.append(
                     (
                         task,
@@ -371,7 +457,8 @@ class QPProblem:
                 bounds=tuple(n + r for r in range(start, stop)),
                 box=self.box,
             )
-            if not self._add_writer(limit, block):
+            targets = (self.lower[n + start : n + stop], self.upper[n + start : n + stop])
+            if not self._add_writer(limit, block, self.C[start:stop], targets):
                 self._generic_limits.append(
                     (
                         limit,
@@ -418,15 +505,35 @@ class QPProblem:
             return 1.0 if from_library(piece) else None
         return self.unit / unit
 
-    def _add_writer(self, piece: Task | Limit, block: TaskBlock | LimitBlock) -> bool:
+    def _add_writer(
+        self,
+        piece: Task | Limit,
+        block: TaskBlock | LimitBlock,
+        rows: np.ndarray,
+        targets: tuple[np.ndarray, ...],
+    ) -> bool:
         """Compile ``piece`` into ``block``; False when it has no fast path (or works in
-        another length unit than the problem's; a writer has no ``v`` column to check)."""
+        another length unit than the problem's: a writer has no ``v`` column to convert).
+        A user's piece's writer, :data:`~ddwmmr.qp.blocks.CONSTANT` too, is checked every
+        step (:func:`guarded_writer`) in its ``rows`` (of the stacked matrix) and
+        ``targets`` (a task's targets, a limit's bounds), and what its ``compile`` raises
+        named in one line; the library's run unchecked."""
         ratio = self._v_ratio(piece)
-        same_unit = ratio is None or ratio == 1.0
-        # ignore: the callers pair a task with its TaskBlock, a limit with its LimitBlock
-        writer = piece.compile(block) if self.compiled and same_unit else None  # type: ignore[arg-type]
+        if not (self.compiled and (ratio is None or ratio == 1.0)):
+            return False
+        user = not from_library(piece)
+        try:
+            # ignore: the callers pair a task with its TaskBlock, a limit with its LimitBlock
+            writer = piece.compile(block)  # type: ignore[arg-type]
+        except Exception as exc:
+            if not user:
+                raise
+            raise_plugin_error(f"{piece_label(piece)}: compile()", exc, " (building the QP)")
         if writer is None:
             return False
+        if user:
+            box = block.box if isinstance(block, LimitBlock) else None
+            writer = guarded_writer(piece, writer, rows, targets, box, ratio is None)
         if writer is not CONSTANT:
             self._writers.append(writer)
         return True
