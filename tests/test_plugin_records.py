@@ -8,6 +8,7 @@ from __future__ import annotations
 import importlib
 import json
 import sys
+import types
 from pathlib import Path
 
 import pytest
@@ -19,7 +20,16 @@ from ddwmmr.cli.scenarios import build_parser as scenarios_parser
 from ddwmmr.cli.scenarios import config_from_arguments as scenarios_config
 from ddwmmr.cli.track import main as track
 from ddwmmr.errors import ParameterError
-from ddwmmr.registry import ARBITERS, CONTROLLERS, PLANTS
+from ddwmmr.provenance import command_record
+from ddwmmr.registry import (
+    ARBITERS,
+    CONTROLLERS,
+    INTERACTIVE,
+    PLANTS,
+    SCRIPT_ADVICE,
+    register_controller,
+    used_plugins,
+)
 
 PLUGINS = Path(__file__).with_name("plugins")
 FILES = {"p_only": (CONTROLLERS, "p-only"), "ideal_plant": (PLANTS, "ideal")}
@@ -119,3 +129,81 @@ def test_an_unknown_name_says_how_plug_ins_are_loaded_unless_one_is_close(tmp_pa
     with pytest.raises(ParameterError) as error:
         compare_config(compare_parser().parse_args(["--methods", "p-only"]), [])
     assert str(error.value).endswith(f"; {HINT}")
+
+
+class _ScriptPlugin:
+    """A controller a script registers in its own ``__main__``."""
+
+    def __init__(self, robot, gain=2.0):
+        self.inner = make_controller("pi", robot)
+        self.last = self.inner.last
+
+    def reset(self, trajectory, q0):
+        self.inner.reset(trajectory, q0)
+
+    def command(self, t, q, pose_d, velocity_d):
+        u = self.inner.command(t, q, pose_d, velocity_d)
+        self.last = self.inner.last
+        return u
+
+
+def _register_in_main(monkeypatch, script: str | None) -> None:
+    """``script-p`` registered by ``__main__``, a script at ``script`` (None: no file, as
+    ``python -c`` or a notebook), for this test."""
+    main = types.ModuleType("__main__")
+    if script is not None:
+        main.__file__ = script
+    monkeypatch.setitem(sys.modules, "__main__", main)
+    cls = type("ScriptP", (_ScriptPlugin,), {"__module__": "__main__"})
+    register_controller("script-p", tasks=("tracking",))(cls)
+
+
+@pytest.fixture
+def script_plugin(monkeypatch):
+    yield lambda script: _register_in_main(monkeypatch, script)
+    CONTROLLERS.unregister("script-p")
+
+
+def test_a_script_s_own_plug_in_records_the_script_and_no_loadable_module(
+    plugins, script_plugin, tmp_path, capsys
+):
+    script = str(tmp_path / "study.py")
+    script_plugin(script)
+    record = _run(tmp_path, "--method", "script-p", "--plant", "ideal")
+    assert record["plugins"] == {"method": {"script-p": script}, "plant": {"ideal": "ideal_plant"}}
+    # DDWMMR_PLUGINS names what it can load; the note says what else the command needs
+    assert record["command"].startswith("DDWMMR_PLUGINS=ideal_plant python -m ddwmmr.track ")
+    assert record["command_note"] == (
+        f"needs method 'script-p' of the script {script}, which DDWMMR_PLUGINS cannot load: "
+        f"{SCRIPT_ADVICE}"
+    )
+    assert list(record).index("command_note") == list(record).index("command") + 1
+    summary = tmp_path / "out" / "summary.json"
+    CONTROLLERS.unregister("script-p")  # a new process, DDWMMR_PLUGINS set as recorded
+    capsys.readouterr()
+    assert track(["--rerun", str(summary), "--out", str(tmp_path / "again")]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"error: rerun: {summary}: method: 'script-p' is the plug-in of the script {script}, "
+        f"which DDWMMR_PLUGINS cannot load: {SCRIPT_ADVICE}"
+    ]
+    script_plugin(script)  # the script again, rerunning its record: the run repeats
+    again = tmp_path / "again"
+    assert track(["--rerun", str(summary), "--out", str(again), "--no-progress"]) == 0
+    assert json.loads((again / "summary.json").read_text())["run"]["plugins"] == record["plugins"]
+
+
+def test_a_plug_in_of_a_main_without_a_file_is_recorded_as_interactive(script_plugin):
+    script_plugin(None)
+    plugins = used_plugins(method=["script-p"])
+    assert plugins == {"method": {"script-p": INTERACTIVE}}
+    record = command_record("python -m ddwmmr.track", ["--method", "script-p"], plugins)
+    assert record["command"] == "python -m ddwmmr.track --method script-p"
+    assert record["command_note"].startswith(
+        "needs method 'script-p' of a script without a file (python -c, an interactive "
+        "session or a notebook), which DDWMMR_PLUGINS cannot load: "
+    )
+    argv = ["--methods", "script-p,pi", "--only", "ellipse", "--study", "none"]
+    config = compare_config(compare_parser().parse_args(argv), argv)
+    assert config.command.startswith("python -m ddwmmr.compare --methods script-p,pi ")
+    assert config.command_note == record["command_note"]
+

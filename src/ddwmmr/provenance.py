@@ -39,7 +39,7 @@ from ddwmmr.controllers.base import method_options
 from ddwmmr.errors import ParameterError, one_line, shown
 from ddwmmr.model import Robot
 from ddwmmr.outputs import package_version
-from ddwmmr.registry import PLUGINS_VARIABLE, plugin_modules, used_plugins
+from ddwmmr.registry import PLUGINS_VARIABLE, plugin_modules, script_note, used_plugins
 from ddwmmr.trajectories.files import (
     SHAPES,
     check_shape_keys,
@@ -131,9 +131,12 @@ def command_record(
     for this platform's shell (POSIX ``sh``; ``cmd.exe`` on Windows), after the setting
     of ``DDWMMR_PLUGINS`` to the modules of ``plugins`` when the run used a plug-in
     (:func:`ddwmmr.registry.used_plugins`; ``DDWMMR_PLUGINS=p_only python -m ...``);
-    ``argv``: the arguments as given (``argv``, or ``sys.argv[1:]``); ``cwd``: the
-    working folder; ``plugins``: the plug-ins, only when there are any (a run of the
-    built-ins has the record it had before plug-ins were recorded)."""
+    ``command_note``, only when a plug-in was registered by a script in its own
+    ``__main__``, which no setting loads: what the command needs besides
+    (:func:`ddwmmr.registry.script_note`); ``argv``: the arguments as given (``argv``, or
+    ``sys.argv[1:]``); ``cwd``: the working folder; ``plugins``: the plug-ins, only when
+    there are any (a run of the built-ins has the record it had before plug-ins were
+    recorded)."""
     arguments = list(argv if argv is not None else sys.argv[1:])
     words = [*shlex.split(prog), *arguments]
     # cmd.exe passes single quotes on literally: Windows gets its own quoting
@@ -143,7 +146,11 @@ def command_record(
         command = f'set "{PLUGINS_VARIABLE}={modules}" && {command}'
     elif modules:
         command = f"{PLUGINS_VARIABLE}={shlex.quote(modules)} {command}"
-    record: dict[str, Any] = {"command": command, "argv": arguments, "cwd": os.getcwd()}
+    record: dict[str, Any] = {"command": command}
+    note = script_note(plugins or {})
+    if note:
+        record["command_note"] = note
+    record.update(argv=arguments, cwd=os.getcwd())
     if plugins:
         record["plugins"] = {label: dict(named) for label, named in plugins.items()}
     return record

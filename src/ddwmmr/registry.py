@@ -51,8 +51,10 @@ come from:
 * any module imported before a registry is asked (registration happens on import).
 
 Entry points and ``DDWMMR_PLUGINS`` are imported the first time a registry is asked. A
-run's record names the modules of the plug-ins it used (:func:`used_plugins`), and an
-unknown name's error says how plug-ins are loaded (:func:`unknown_hint`).
+run's record names the modules of the plug-ins it used (:func:`used_plugins`; a plug-in a
+script registered in its own ``__main__`` by the script's path, which ``DDWMMR_PLUGINS``
+cannot load: :func:`plugin_source`), and an unknown name's error says how plug-ins are
+loaded (:func:`unknown_hint`).
 """
 
 from __future__ import annotations
@@ -62,6 +64,7 @@ import importlib
 import inspect
 import os
 import re
+import sys
 import threading
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
@@ -90,6 +93,17 @@ PLUGINS_VARIABLE = "DDWMMR_PLUGINS"
 #: How an error for an unknown name says plug-ins are loaded (:func:`unknown_hint`).
 PLUGINS_HINT = (
     f"a plug-in's name is known once its module is imported: {PLUGINS_VARIABLE}=MODULE "
+    '(docs/api.md, "Extending")'
+)
+#: What a run's record names as the source of a plug-in registered in a ``__main__``
+#: without a file (``python -c``, an interactive session, a notebook): :func:`plugin_source`.
+INTERACTIVE = "<interactive>"
+#: A module name ``DDWMMR_PLUGINS`` can import: dotted identifiers (:func:`loadable`).
+MODULE_PATTERN = re.compile(r"[^\W\d]\w*(?:\.[^\W\d]\w*)*")
+#: How to run again a plug-in a script registered in its own ``__main__``.
+SCRIPT_ADVICE = (
+    "repeat the run in a process that registers it first (the script, then the tool's "
+    f"main() with the recorded argv), or move the class into a module named in {PLUGINS_VARIABLE} "
     '(docs/api.md, "Extending")'
 )
 #: Entry-point group of plug-in modules of other packages.
@@ -347,18 +361,39 @@ def unknown_hint(name: Any, known: Iterable[str]) -> str:
     return f"; {PLUGINS_HINT}"
 
 
+def plugin_source(module: str) -> str:
+    """Where a run's record says a plug-in registered by ``module`` comes from: the
+    module's name, which ``DDWMMR_PLUGINS`` imports; for ``__main__``, a class the running
+    script registered itself (``python study.py``, ``python -m pkg.study``), the script's
+    absolute path, or :data:`INTERACTIVE` when ``__main__`` has no file (``python -c``, an
+    interactive session, a notebook). A script is not recorded as a module: importing it
+    by name would run whatever its top level runs, so no setting of ``DDWMMR_PLUGINS``
+    is known to load it (:func:`loadable`)."""
+    if module != "__main__":
+        return module
+    path = getattr(sys.modules.get("__main__"), "__file__", None)
+    return os.path.abspath(path) if isinstance(path, str) and path else INTERACTIVE
+
+
+def loadable(source: str) -> bool:
+    """Whether a recorded :func:`plugin_source` is a module ``DDWMMR_PLUGINS`` can import
+    (a dotted name), not a script's path or :data:`INTERACTIVE`."""
+    return MODULE_PATTERN.fullmatch(source) is not None and source != "__main__"
+
+
 def used_plugins(**names: Iterable[str]) -> dict[str, dict[str, str]]:
-    """``{label: {name: module}}`` of the plug-ins among ``names``, given per registry
-    label (``method``, ``plant``, ``arbiter``): the module that registered each name
-    not built in, which ``DDWMMR_PLUGINS`` must name to run it again (a run's record
-    holds it, :func:`ddwmmr.provenance.header`). Empty when every name is built in."""
+    """``{label: {name: source}}`` of the plug-ins among ``names``, given per registry
+    label (``method``, ``plant``, ``arbiter``): for each name not built in, the module
+    that registered it, which ``DDWMMR_PLUGINS`` must name to run it again, or the script
+    that registered it in its own ``__main__`` (:func:`plugin_source`). A run's record
+    holds it (:func:`ddwmmr.provenance.header`). Empty when every name is built in."""
     found: dict[str, dict[str, str]] = {}
     for label, given in names.items():
         registry = _LABELS[label]
         for name in given:
             module = registry.plugin_module(name)
             if module is not None:
-                found.setdefault(label, {})[name] = module
+                found.setdefault(label, {})[name] = plugin_source(module)
     return found
 
 
@@ -378,19 +413,50 @@ def check_recorded_plugins(plugins: Any) -> None:
         if isinstance(name, str) and isinstance(module, str)
     ]
     for label, name, module in named:
-        if name not in _LABELS[label].names():
-            modules = ",".join(dict.fromkeys(m for _, _, m in named))
+        if name in _LABELS[label].names():
+            continue
+        if not loadable(module):
             raise ParameterError(
-                f"{label}: {name!r} is the plug-in of module {module!r}, which is not loaded: "
-                f"run with {PLUGINS_VARIABLE}={modules} (importable from sys.path, e.g. with "
-                'PYTHONPATH; docs/api.md, "Extending")'
+                f"{label}: {name!r} is the plug-in of {_script(module)}, which "
+                f"{PLUGINS_VARIABLE} cannot load: {SCRIPT_ADVICE}"
             )
+        modules = ",".join(m for m in dict.fromkeys(m for _, _, m in named) if loadable(m))
+        raise ParameterError(
+            f"{label}: {name!r} is the plug-in of module {module!r}, which is not loaded: "
+            f"run with {PLUGINS_VARIABLE}={modules} (importable from sys.path, e.g. with "
+            'PYTHONPATH; docs/api.md, "Extending")'
+        )
 
 
 def plugin_modules(plugins: Mapping[str, Mapping[str, str]]) -> list[str]:
-    """The modules of :func:`used_plugins`'s answer, each once, in order: what
-    ``DDWMMR_PLUGINS`` is set to to run them again."""
-    return list(dict.fromkeys(m for named in plugins.values() for m in named.values()))
+    """The modules of :func:`used_plugins`'s answer that ``DDWMMR_PLUGINS`` can import
+    (:func:`loadable`), each once, in order: what it is set to to run them again."""
+    sources = (m for named in plugins.values() for m in named.values())
+    return [m for m in dict.fromkeys(sources) if loadable(m)]
+
+
+def _script(source: str) -> str:
+    """How a message names the script a recorded source that is not :func:`loadable`
+    stands for."""
+    if source == INTERACTIVE:
+        return "a script without a file (python -c, an interactive session or a notebook)"
+    return f"the script {source}"
+
+
+def script_note(plugins: Mapping[str, Mapping[str, str]]) -> str:
+    """For :func:`used_plugins`'s answer, what a run's repeat command needs besides
+    ``DDWMMR_PLUGINS``: the plug-ins registered by a script (:func:`plugin_source`),
+    which no setting loads (``"needs method 'mine' of the script /home/me/study.py,
+    which DDWMMR_PLUGINS cannot load: ..."``); empty when there are none."""
+    scripts = [
+        f"{label} {name!r} of {_script(source)}"
+        for label, named in plugins.items()
+        for name, source in named.items()
+        if not loadable(source)
+    ]
+    if not scripts:
+        return ""
+    return f"needs {', '.join(scripts)}, which {PLUGINS_VARIABLE} cannot load: {SCRIPT_ADVICE}"
 
 
 def _has(traits: Mapping[str, Any], key: str, value: Any) -> bool:
@@ -579,21 +645,27 @@ __all__ = [
     "BUILTIN_MODULES",
     "CONTROLLERS",
     "ENTRY_POINT_GROUP",
+    "INTERACTIVE",
     "MAX_NAME_LENGTH",
+    "MODULE_PATTERN",
     "NAME_FORM",
     "NAME_PATTERN",
     "PLANTS",
     "PLUGINS_HINT",
     "PLUGINS_VARIABLE",
+    "SCRIPT_ADVICE",
     "Entry",
     "PluginClass",
     "Registry",
     "check_recorded_plugins",
     "discover",
+    "loadable",
     "plugin_modules",
+    "plugin_source",
     "register_arbiter",
     "register_controller",
     "register_plant",
+    "script_note",
     "unknown_hint",
     "used_plugins",
 ]

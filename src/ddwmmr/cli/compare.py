@@ -542,9 +542,9 @@ def config_from_arguments(
         shown_names=shown,
     )
     # quoted as the run record quotes it (with the plug-ins' DDWMMR_PLUGINS): the report's
-    # line repeats the run when pasted
-    plugins = compared_plugins(config)
-    config.command = provenance.command_record(PROG, argv, plugins)["command"]
+    # line repeats the run when pasted, or says what else it needs
+    command = provenance.command_record(PROG, argv, compared_plugins(config))
+    config.command, config.command_note = command["command"], command.get("command_note", "")
     return config
 
 

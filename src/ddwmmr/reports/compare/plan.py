@@ -95,6 +95,8 @@ class CompareConfig:
             as an MPC, is then compared and ranked but not swept); naming it here
             includes it.
         command: the command line, quoted in the report so it can be reproduced.
+        command_note: what ``command`` needs besides, shown after it (a plug-in a script
+            registered: :func:`ddwmmr.registry.script_note`); empty for none.
         preset: the option preset of the main comparison and the studies (``"default"``
             or ``"slides"``); the report also ranks the methods under the other one.
         plants: extra plants (``"thesis"``, ``"mujoco"``) on which the main comparison is
@@ -114,6 +116,7 @@ class CompareConfig:
     studies: tuple[str, ...] = STUDIES
     study_methods: tuple[str, ...] | None = None
     command: str = ""
+    command_note: str = ""
     preset: str = "default"
     plants: tuple[str, ...] = ()
     options: dict[str, dict[str, Any]] = field(default_factory=dict)

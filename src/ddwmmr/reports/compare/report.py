@@ -211,7 +211,8 @@ def _setup_section(c: _Context) -> None:
     ]
     items += _obstacle_items(config)
     if config.command:
-        items.append(f"command: `{config.command}`")
+        note = f" ({config.command_note})" if config.command_note else ""
+        items.append(f"command: `{config.command}`{note}")
     c.doc.heading("Setup")
     c.doc.bullets(items)
 
