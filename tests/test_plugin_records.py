@@ -207,3 +207,24 @@ def test_a_plug_in_of_a_main_without_a_file_is_recorded_as_interactive(script_pl
     assert config.command.startswith("python -m ddwmmr.compare --methods script-p,pi ")
     assert config.command_note == record["command_note"]
 
+
+def test_the_simulator_and_bench_refuse_an_unknown_name_with_the_plug_in_hint(capsys):
+    from ddwmmr.cli.bench import main as bench
+    from ddwmmr.gui.settings import Settings, check_settings
+
+    for settings, start in [
+        (Settings(methods=("p-only", None)), "method: unknown method 'p-only' (tracking: pi, "),
+        (Settings(methods=("pi", "p-only")), "method: unknown method 'p-only' (tracking: pi, "),
+        (Settings(plant="ideal"), "plant must be one of kinematic, "),
+    ]:
+        with pytest.raises(ParameterError) as error:
+            check_settings(settings)
+        assert str(error.value).startswith(start) and str(error.value).endswith(f"; {HINT}")
+    with pytest.raises(ParameterError, match=r"unknown method 'qpp' .*\(did you mean qp\?\)$"):
+        check_settings(Settings(methods=("qpp", None)))
+    with pytest.raises(ParameterError, match="the thesis controller does not track"):
+        check_settings(Settings(methods=("thesis", None)))  # registered, not tracking
+    assert bench(["--method", "p-only"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: method: unknown method 'p-only' (choose from ")
+    assert err.endswith(f"; {HINT}\n") and err.count("\n") == 1

@@ -33,6 +33,7 @@ from ddwmmr.cli.common import (
 )
 from ddwmmr.controllers.base import available_methods
 from ddwmmr.errors import MAX_JOBS, MAX_SCENARIOS, MAX_STEPS, ParameterError
+from ddwmmr.registry import unknown_hint
 from ddwmmr.trajectories import Ellipse
 from ddwmmr.trajectories.base import resolution_step
 
@@ -154,7 +155,10 @@ def _main(argv: Sequence[str] | None = None) -> int:
     unknown = sorted(set(args.methods or ()) - set(method_names()))
     if unknown:
         choices = ", ".join(method_names())
-        raise ParameterError(f"method: unknown method {unknown[0]!r} (choose from {choices})")
+        raise ParameterError(
+            f"method: unknown method {unknown[0]!r} (choose from {choices})"
+            + unknown_hint(unknown[0], method_names())
+        )
     scenarios = args.scenarios
     if scenarios is None:
         scenarios = SCENARIO_COUNT if args.methods is None else 0

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from ddwmmr.controllers.base import available_methods, make_controller
+from ddwmmr.controllers.base import make_controller
 from ddwmmr.errors import (
     DURATION_RANGE_S,
     LENGTH_RANGE_M,
@@ -43,9 +43,10 @@ from ddwmmr.errors import (
 from ddwmmr.gui.options import method_options, plant_keywords, plant_names
 from ddwmmr.model import Robot
 from ddwmmr.plants.kinematic import INTEGRATORS
+from ddwmmr.registry import unknown_hint
 from ddwmmr.resolution.reference import default_offset, initial_configuration
 from ddwmmr.sim import SimulationResult, simulate
-from ddwmmr.sim.simulate import check_start
+from ddwmmr.sim.simulate import check_start, check_tracks
 from ddwmmr.trajectories import SampledTrajectory, load_trajectory
 from ddwmmr.trajectories.base import resolution_step
 from ddwmmr.trajectories.parametric import check_geometry_value
@@ -296,18 +297,15 @@ def check_settings(settings: Settings) -> Settings:
     Everything a run needs is built once (trajectory, robot, controllers); what only the
     simulation itself can find (e.g. dt longer than the run) shows when it runs.
     """
-    methods = available_methods()
-    for slot in settings.active_slots:
-        if settings.methods[slot] not in methods:
-            raise ParameterError(
-                f"method: unknown method {shown(settings.methods[slot])}"
-                f" (known: {', '.join(methods)})"
-            )
+    for slot in settings.active_slots:  # as simulate refuses them, with the plug-in hint
+        # ignore: an active slot holds a method (None is an inactive slot)
+        check_tracks(settings.methods[slot])  # type: ignore[arg-type]
     if settings.methods[0] is None:
         raise ParameterError("method: slot A needs a method")
     if not one_of(settings.plant, plant_names()):
         raise ParameterError(
             f"plant must be one of {', '.join(plant_names())} (got {shown(settings.plant)})"
+            + unknown_hint(settings.plant, plant_names())
         )
     if not one_of(settings.integrator, INTEGRATORS):
         raise ParameterError(
