@@ -228,3 +228,27 @@ def test_the_simulator_and_bench_refuse_an_unknown_name_with_the_plug_in_hint(ca
     err = capsys.readouterr().err
     assert err.startswith("error: method: unknown method 'p-only' (choose from ")
     assert err.endswith(f"; {HINT}\n") and err.count("\n") == 1
+
+
+def test_a_close_name_is_suggested_only_among_the_names_the_check_takes():
+    """The closest name an unknown one's error suggests is one the refusing check would
+    take: a close name it refuses too (a controller the scenarios do not run, the
+    kinematic plant compare always runs, a controller that does not track) is not
+    offered, the plug-in hint is."""
+    from ddwmmr.cli.compare import parse_plants
+    from ddwmmr.scenarios.protocol import RunConfig
+    from ddwmmr.sim.simulate import check_tracks
+
+    for refused in [
+        lambda: RunConfig(controller="clrrmc-t"),  # clrrmc-ts is no scenario controller
+        lambda: parse_plants(["kinematc"]),  # --plant adds others than kinematic
+        lambda: check_tracks("thesiss"),  # the thesis controller does not track
+    ]:
+        with pytest.raises(ParameterError) as error:
+            refused()
+        assert "did you mean" not in str(error.value)
+        assert str(error.value).endswith(f"; {HINT}")
+    with pytest.raises(ParameterError, match=r"\(did you mean qp\?\)$"):
+        RunConfig(controller="qpp")
+    with pytest.raises(ParameterError, match=r"\(did you mean mujoco\?\)$"):
+        parse_plants(["mujoc"])

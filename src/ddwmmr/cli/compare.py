@@ -321,7 +321,7 @@ def parse_plants(values: Sequence[str] | None) -> tuple[str, ...]:
         if name not in extra_plants():
             raise ParameterError(
                 f"plant: unknown plant {name!r} (one of {', '.join(extra_plants())})"
-                + unknown_hint(name, available_plants())
+                + unknown_hint(name, extra_plants())
             )
     return tuple(plants)
 

@@ -219,7 +219,11 @@ class RunConfig:
             known = CONTROLLERS.names()
             raise ParameterError(
                 f"controller must be one of {', '.join(controllers)} (got {shown(self.controller)})"
-                + ("" if one_of(self.controller, known) else unknown_hint(self.controller, known))
+                + (
+                    ""
+                    if one_of(self.controller, known)
+                    else unknown_hint(self.controller, controllers)
+                )
             )
         PLANTS.entry(self.plant)  # an unknown name: one line naming the known ones
         accepted = plants_for(self.controller)

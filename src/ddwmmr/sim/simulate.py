@@ -473,7 +473,7 @@ def check_tracks(method: str) -> None:
     if method not in CONTROLLERS.names():
         raise ParameterError(
             f"method: unknown method {shown(method)} (tracking: {', '.join(tracking)})"
-            + unknown_hint(method, CONTROLLERS.names())
+            + unknown_hint(method, tracking)
         )
     tasks = CONTROLLERS.traits(method)["tasks"]
     raise ParameterError(
