@@ -873,17 +873,16 @@ def check_integrable(
     z^3/6 + z^4/24``, which stays within [0.27, 1] up to ``h / tau = 2.785``
     (:data:`~ddwmmr.gains.STABLE_GAIN_STEP` ``"rk4"``, the real root of ``x^3 - 4 x^2 + 12
     x - 24``, where R is 1 again) and exceeds 1 beyond it: the predicted speed then grows
-    every sub-step instead of decaying (c1 = 1e6 N s/m on ``Robot()``: every step fell
-    back). A lag at the limit or within it is taken. The yaw's time constant depends on
-    the elbow; it is taken at the pose of largest yaw inertia (:func:`base_time_constants`),
-    so that only a base the model cannot follow at any pose of the elbow's range is
-    refused: one unstable near the folded arm only (the lengths-times-8 robot of
-    docs/mpc.md, "Robot size", on the thesis plant: from ``I / c2`` = 0.065 s folded to
-    0.54 s stretched) runs, as its plans keep away from that pose. Sub-steps are at most
-    :data:`MAX_SUBSTEP` (0.2 s), so a time constant of 0.072 s or more is always taken:
-    the thesis's base has 0.88 s and 0.15-0.33 s (``Robot()``, c1 = 15 N s/m, c2 = 4 N m
-    s/rad), and the damping the thesis plant derives for another robot keeps its time
-    constants (docs/thesis.md, "Another robot's constants")."""
+    every sub-step instead of decaying. A lag at the limit or within it is taken. The
+    yaw's time constant depends on the elbow; it is taken at the pose of largest yaw
+    inertia (:func:`base_time_constants`), so that only a base the model cannot follow at
+    any pose of the elbow's range is refused: one unstable near the folded arm only runs,
+    as its plans keep away from that pose (docs/mpc.md, "python-control: the linear
+    designs", its stiff-base item). Sub-steps are at most :data:`MAX_SUBSTEP` (0.2 s),
+    so a time constant of 0.072 s or more is always taken: the thesis's base has 0.88 s
+    and 0.15-0.33 s (``Robot()``, c1 = 15 N s/m, c2 = 4 N m s/rad), and the damping the
+    thesis plant derives for another robot keeps its time constants (docs/thesis.md,
+    "Another robot's constants")."""
     limit = STABLE_GAIN_STEP["rk4"]
     tau_v, tau_w = base_time_constants(dynamics, elbow)
     stiff = [

@@ -551,7 +551,7 @@ class MPCOptions:
         horizon's end, capped as every cost weight. At the cap a unit left costs 1e6 s,
         1e4 times the longest horizon (:data:`~ddwmmr.mpc.ocp.MAX_HORIZON`), so a lower
         speed changes nothing a plan weighs (reaching outweighs time either way) but the
-        solver's conditioning (1e-300 m/s: every step fell back)."""
+        solver's conditioning."""
         if self.reach_speed is None:
             return REACH_SPEED * length
         least = length / MAX_COST_WEIGHT
