@@ -380,7 +380,6 @@ class Stages:
 
 def stage_policy(
     controller: Any,
-    command_of: Callable[..., Any],
     reference: Callable[[float, Any], tuple[np.ndarray, np.ndarray]],
     force: bool,
     stages: Stages,
@@ -390,11 +389,12 @@ def stage_policy(
     over the step: force commands, and a ``zero_order_hold`` controller.
 
     The policy is the closed-loop law against the task's ``reference`` (called with no
-    observation): the controller's ``command`` (``command_of``) checked as at a sample
+    observation): the controller's ``command`` checked as at a sample
     (:func:`checked_command`), or its float-level ``law`` where that may stand for it
     (:func:`stage_law`). A failure there is raised as at a sample, named with step
     ``stages.k``, and kept in ``stages.errors`` on its way out of ``plant.step``."""
     law = stage_law(controller)
+    command_of = controller.command
 
     def policy(t: float, q: list[float]) -> np.ndarray:
         """The closed-loop law at an integrator stage, through ``command``."""
@@ -468,7 +468,7 @@ def run_loop(
     float_state = getattr(controller, "float_state", False)
     command_of = controller.command
     stages = Stages()
-    policy = stage_policy(controller, command_of, task.reference, force, stages)
+    policy = stage_policy(controller, task.reference, force, stages)
     unchecked_info = not from_library(controller)  # a plug-in's step info, checked once
     clock = time.perf_counter_ns
 
