@@ -39,6 +39,7 @@ LAYERS: tuple[tuple[str, tuple[str, ...]], ...] = (
             "progress",
             "outputs",
             "workers",
+            "user_warnings",
         ),
     ),
     ("registry", ("registry",)),
