@@ -322,9 +322,10 @@ class MPCController:
         objectives at its control step (:func:`~ddwmmr.mpc.ocp.check_integrable`)."""
         if self.dynamics is None:
             return
-        modes = (
-            ["tracking"] if tracking else ["reach", "reach2"][: 2 if self.options.lookahead else 1]
-        )
+        if tracking:
+            modes = ["tracking"]
+        else:
+            modes = ["reach", "reach2"] if self.options.lookahead else ["reach"]
         substep = max(longest_substep(self._config(mode).interval_lengths()) for mode in modes)
         check_integrable(self.dynamics, self.robot.joint_limits[1], substep)
 
