@@ -48,7 +48,7 @@ def test_registered_without_its_benchmark_twin():
         ({"tau": (0.5, 0.5)}, "tau must be one value or 3"),
         ({"obstacles": [(1.0, 2.0)]}, "obstacles must be Circle"),
         ({"obstacles": [(1.0, 2.0, -0.3)]}, "obstacle radius must be > 0"),
-        ({"dt": 0.0}, "dt must be > 0"),
+        ({"dt": 0.0}, r"dt must be in \[0.0001, 100\] s"),
         ({"tasks": [object()]}, "tasks must be"),
     ],
 )
@@ -263,3 +263,19 @@ def test_one_step_keeps_exact_stability_above_the_floor(th1, side, elbow, excess
 def test_unknown_or_missing_solver_is_a_parameter_error():
     with pytest.raises(ParameterError, match="solver must be one of the installed QP solvers"):
         make_controller("qp", ROBOT, solver="nope")
+
+
+@pytest.mark.parametrize("dt", [1e-300, 9.9e-5, 0.0, 100.1, 1e300])
+def test_the_dt_option_is_a_control_step_in_range(dt):
+    """``dt`` took anything from 1e-300 s to 1e300 s: a step no run has."""
+    with pytest.raises(ParameterError, match=r"^dt must be in \[0\.0001, 100\] s \(got "):
+        make_controller("qp", ROBOT, dt=dt)
+
+
+def test_the_dt_range_is_the_mpcs_step_range():
+    from ddwmmr.mpc.ocp import MAX_HORIZON, MIN_INTERVAL
+    from ddwmmr.qp.controller import DT_RANGE_S
+
+    assert DT_RANGE_S == (MIN_INTERVAL, MAX_HORIZON)
+    for dt in DT_RANGE_S:
+        make_controller("qp", ROBOT, dt=dt)

@@ -77,8 +77,39 @@ class ParameterError(ValueError):
 
     def __init__(self, *args: object) -> None:
         if len(args) == 1 and isinstance(args[0], str):
-            args = (escaped_controls(args[0]),)
+            args = (message_line(args[0]),)
         super().__init__(*args)
+
+
+#: Most characters of one word (a run without whitespace) a message shows
+#: (:func:`clipped_words`): a file path, a name or a number a user gave, quoted whole
+#: unless it is absurdly long (a 5000-digit ``--seed``).
+MAX_WORD = 200
+
+
+def message_line(text: str) -> str:
+    """``text``, an error message, as every message is shown: on one line
+    (:func:`escaped_controls`) with each word of more than :data:`MAX_WORD` characters cut
+    (:func:`clipped_words`). :class:`ParameterError` and the tools' argparse errors
+    (:class:`ddwmmr.cli.common.ArgumentParser`) pass their message through it."""
+    return clipped_words(escaped_controls(text))
+
+
+def clipped_words(text: str, width: int = MAX_WORD) -> str:
+    """``text`` with each word (run without whitespace) longer than ``width`` characters
+    cut in the middle to ``width``, "..." in place of the middle: the start and the end
+    of a long path or number stay (``'99999...99999'``); ``text`` itself when no word is
+    that long."""
+    if len(text) <= width or all(len(word) <= width for word in text.split()):
+        return text
+    head = (width - 3) * 2 // 3
+    tail = width - 3 - head
+
+    def clip(match: re.Match[str]) -> str:
+        word = match.group()
+        return word if len(word) <= width else f"{word[:head]}...{word[-tail:]}"
+
+    return re.sub(r"\S+", clip, text)
 
 
 def escaped_controls(text: str, undecodable: bool = True) -> str:
@@ -311,10 +342,60 @@ def plain_number_text(text: str) -> bool:
 def plain_float(text: str) -> float:
     """The number ``text`` holds, read as a number a user types or a file holds
     (:func:`plain_number_text`: a mistyped ``0_02`` or a full-width digit is none);
-    ValueError for a text that holds none, as ``float`` raises it."""
+    ValueError for a text that holds none, as ``float`` raises it, and for one whose
+    number a float cannot hold (:func:`float_range_note`: ``1e999`` would read as inf,
+    ``1e-400`` as 0). ``inf``, ``nan`` and a zero (``0``, ``-0.0``) are read as they are."""
     if not plain_number_text(text):
         raise ValueError(text)
-    return float(text)
+    value = float(text)
+    if float_range_note(text, value):
+        raise ValueError(text)
+    return value
+
+
+#: Largest float's magnitude, as a message states it.
+_FLOAT_LIMIT = f"{sys.float_info.max:.4g}"
+#: The texts ``float`` reads as an infinity (after a sign), in lower case.
+_INFINITY_WORDS = ("inf", "infinity")
+
+
+def float_range_note(text: str, value: float | None = None) -> str:
+    """Why ``float(text)`` (``value``, computed when not given) is not the number
+    ``text`` holds, for a message: ", beyond the largest float, 1.798e+308" for a number
+    that reads as an infinity (``1e999``, ``-1e999``, a 400-digit integer), ", too small
+    for a float, which reads it as 0" for a non-zero one that reads as 0 (``1e-400``);
+    "" for every other text (one ``float`` refuses too)."""
+    if value is None:
+        try:
+            value = float(text)
+        except ValueError:
+            return ""
+    if math.isinf(value) and text.strip().lstrip("+-").lower() not in _INFINITY_WORDS:
+        return f", beyond the largest float, {_FLOAT_LIMIT}"
+    mantissa = text.lower().partition("e")[0]
+    if value == 0.0 and any(digit in mantissa for digit in "123456789"):
+        return ", too small for a float, which reads it as 0"
+    return ""
+
+
+def integer_digits_note(text: str) -> str:
+    """Why ``int(text)`` refuses ``text`` though it is an integer, for a message: ", N
+    digits, more than the 4300 Python reads" for one beyond Python's limit on the digits of
+    an integer text (``sys.get_int_max_str_digits``); "" for every other text."""
+    limit = sys.get_int_max_str_digits()
+    digits = text.strip().lstrip("+-")
+    if limit and digits.isascii() and digits.isdigit() and len(digits) > limit:
+        return f", {len(digits)} digits, more than the {limit} Python reads"
+    return ""
+
+
+def shown_number_text(text: str, integer: bool = False) -> str:
+    """``text``, given for a number and refused, as a message quotes it: :func:`shown`,
+    then why it is no number where it looks like one (:func:`float_range_note`; for an
+    ``integer``, :func:`integer_digits_note`):
+    ``'1e-400', too small for a float, which reads it as 0``."""
+    note = integer_digits_note(text) if integer else float_range_note(text)
+    return shown(text) + note
 
 
 def real_number(value: Any) -> float | None:

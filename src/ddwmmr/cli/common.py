@@ -40,9 +40,11 @@ from ddwmmr.errors import (
     ParameterError,
     PluginError,
     did_you_mean,
+    message_line,
     plain_float,
     plain_number_text,
     shown,
+    shown_number_text,
 )
 from ddwmmr.model import Robot
 from ddwmmr.outputs import (
@@ -123,11 +125,16 @@ def integer_type(
     low: int, high: int | None = None, *, checked_later: bool = False
 ) -> Callable[[str], int]:
     """An argparse ``type``: an integer >= ``low`` (and <= ``high``); anything else (a
-    fraction, ``nan``, an empty text) is refused as ``argument --n: must be an integer in
-    [low, high] (got '1.5')`` (argparse names the option; status 2). ``checked_later``:
-    the option's own check refuses an integer out of the range (in its words); here only
-    a text that is no integer is, stating the same range."""
+    fraction, ``nan``, an empty text, an integer of more digits than Python reads) is
+    refused as ``argument --n: must be an integer in [low, high] (got '1.5')`` (argparse
+    names the option; status 2; the text as :func:`shown_number_text` quotes it).
+    ``checked_later``: the option's own check refuses an integer out of the range (in its
+    words); here only a text that is no integer is, stating the same range."""
     allowed = f">= {low}" if high is None else f"in [{low}, {high}]"
+
+    def refused(text: str) -> argparse.ArgumentTypeError:
+        got = shown_number_text(text, integer=True)
+        return argparse.ArgumentTypeError(f"must be an integer {allowed} (got {got})")
 
     def parse(text: str) -> int:
         try:
@@ -135,21 +142,22 @@ def integer_type(
                 raise ValueError(text)
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(
-                f"must be an integer {allowed} (got {text!r})"
-            ) from None
+            raise refused(text) from None
         if not checked_later and (value < low or (high is not None and value > high)):
-            raise argparse.ArgumentTypeError(f"must be an integer {allowed} (got {text!r})")
+            raise refused(text)
         return value
 
     return parse
 
 
 def number_type(allowed: str, finite: bool = False) -> Callable[[str], float]:
-    """An argparse ``type``: a float. A text that is none (``abc``, an empty text; with
+    """An argparse ``type``: a float. A text that is none (``abc``, an empty text, a
+    number a float cannot hold, ``1e999`` or ``1e-400``: :func:`plain_float`; with
     ``finite``, also ``nan`` and ``inf``) is refused as ``argument --dt: must be a number
-    <allowed> (got 'abc')``; ``allowed`` states the range (``"> 0 s"``, ``"in [0, 1] m"``),
-    the one the option's own check enforces on the number, which states it alike."""
+    <allowed> (got '1e-400', too small for a float, which reads it as 0)`` (the text as
+    :func:`shown_number_text` quotes it); ``allowed`` states the range (``"> 0 s"``,
+    ``"in [0, 1] m"``), the one the option's own check enforces on the number, which
+    states it alike."""
 
     def parse(text: str) -> float:
         try:
@@ -160,7 +168,9 @@ def number_type(allowed: str, finite: bool = False) -> Callable[[str], float]:
         else:
             finite_only = finite
         if finite_only and not math.isfinite(value):
-            raise argparse.ArgumentTypeError(f"must be a number {allowed} (got {text!r})")
+            raise argparse.ArgumentTypeError(
+                f"must be a number {allowed} (got {shown_number_text(text)})"
+            )
         return value
 
     return parse
@@ -267,7 +277,8 @@ class ArgumentParser(argparse.ArgumentParser):
 
     def error(self, message: str) -> None:  # type: ignore[override]
         prefix = self.prog if self.error_prefix is None else self.error_prefix
-        self.exit(EXIT_USAGE, f"{prefix}: error: {self._with_suggestions(message)}\n")
+        line = message_line(self._with_suggestions(message))  # as a ParameterError's
+        self.exit(EXIT_USAGE, f"{prefix}: error: {line}\n")
 
     def _with_suggestions(self, message: str) -> str:
         """``message``, with the closest known option after each unknown one, and after a

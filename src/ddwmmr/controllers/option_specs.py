@@ -22,7 +22,7 @@ from typing import Any
 
 from ddwmmr.controllers.base import NumberText, method_parameters
 from ddwmmr.controllers.base import controller_class as registered_class
-from ddwmmr.errors import ParameterError, did_you_mean, plain_number_text, shown
+from ddwmmr.errors import ParameterError, did_you_mean, plain_float, plain_number_text, shown
 
 __all__ = [
     "CHOICES",
@@ -138,7 +138,8 @@ class OptionSpec:
         optional number, is None (the method's automatic value).
 
         A number option's text that is not one number of the option's kind (``abc``, empty,
-        ``1,2`` for one number, ``1.5`` for an integer) comes back as a
+        ``1,2`` for one number, ``1.5`` for an integer, a number a float cannot hold:
+        ``1e999``, ``1e-400``, :func:`~ddwmmr.errors.plain_float`) comes back as a
         :class:`~ddwmmr.controllers.base.NumberText`, as ``nan`` comes back as nan: the
         method's own check (``make_controller``), the one place that knows the allowed
         range, refuses it naming the range."""
@@ -171,7 +172,7 @@ class OptionSpec:
         try:
             if not plain_number_text(text):
                 raise ValueError(text)
-            numbers = [float(item) for item in items]
+            numbers = [plain_float(item) for item in items]  # 1e-400 is not 0
         except ValueError:  # passed on, as nan is: the method's check names the range
             return NumberText(text)
         if len(numbers) > 1:

@@ -63,7 +63,8 @@ from ddwmmr.controllers.base import (
     step_results,
 )
 from ddwmmr.controllers.inputs import check_inputs, check_start
-from ddwmmr.errors import ParameterError, check_bool, check_positive, iterable, shown
+from ddwmmr.errors import ParameterError, check_bool, check_range, iterable, shown
+from ddwmmr.gains import MIN_TAU
 from ddwmmr.model import Robot
 from ddwmmr.model.kinematics import whole_turns
 from ddwmmr.model.stability import STABILITY_FLOOR, warn_start_below_floor
@@ -111,6 +112,13 @@ from ddwmmr.resolution.kernels import length_unit
 
 #: Look-ahead step (s) when neither ``dt`` nor the trajectory's resolution is known.
 DEFAULT_DT = 0.02
+#: Allowed range (s) of the ``dt`` option, the control step the qp plans each command for:
+#: the range of the ``mpc``'s step, which its fallback qp takes ([MIN_INTERVAL,
+#: MAX_HORIZON] of :mod:`ddwmmr.mpc.ocp`, not imported here: that imports CasADi). Below
+#: it no gain of the library (at most 1/:data:`~ddwmmr.gains.MIN_TAU`) acts within a step
+#: and the acceleration limits hold every command still; above it a step outlasts any
+#: horizon a plan looks ahead.
+DT_RANGE_S = (MIN_TAU, 100.0)
 
 #: Default solver: the fastest measured (docs/qp.md, "Solvers").
 DEFAULT_SOLVER = "daqp"
@@ -175,7 +183,8 @@ class QPController:
             (:class:`~ddwmmr.qp.limits.edge_loads.EdgeLoadLimit`); on a plant that judges
             tipping by its physics and reports its joints' lag (MuJoCo), where the inertial
             loads it predicts are real; None: off.
-        dt: look-ahead step of the exact stability check (s); default the step the loop
+        dt: look-ahead step of the exact stability check and the acceleration limits' step
+            (s), in :data:`DT_RANGE_S` (1e-4 to 100 s); default the step the loop
             holds each command (``adopt_control_step``), else the trajectory's
             ``duration / samples`` at reset, else 0.02 s
             (:func:`~ddwmmr.controllers.base.control_step`).
@@ -257,7 +266,7 @@ class QPController:
         self.min_predicted_edge_load: float | None = None
         self.edge_relaxed_steps = 0  # steps whose edge rows gave way to the other limits
         self.problem = QPProblem(self.tasks, self.limits, unit=unit)
-        self._dt_option = None if dt is None else check_positive("dt", dt)
+        self._dt_option = None if dt is None else check_range("dt", dt, *DT_RANGE_S, "s")
         self._loop_step: float | None = None
         self.ctx = StepContext(robot, self._dt_option or DEFAULT_DT)
         self.fallbacks = 0
