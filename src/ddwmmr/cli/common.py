@@ -29,7 +29,7 @@ import signal
 import sys
 import threading
 import warnings
-from collections.abc import Callable, Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn, overload
 
@@ -801,25 +801,42 @@ def check_plant_option_names(plant: str, names: Iterable[str]) -> dict[str, Opti
 def parse_plant_options(plant: str, texts: Sequence[str] | None) -> dict[str, Any]:
     """``{name: value}`` of the ``--plant-option NAME=VALUE`` texts for the plant named
     ``plant``: a name as :func:`check_plant_option_names` allows, a value read as
-    ``--option`` reads one (:meth:`~ddwmmr.controllers.option_specs.OptionSpec.parse`:
-    a number option's text that is no number is passed on for the plant's own check,
-    :func:`built_plant`); a text without ``=`` or a name given twice is refused."""
+    :func:`parse_named_options` reads one (a number option's text that is no number is
+    passed on for the plant's own check, :func:`built_plant`)."""
+    return parse_named_options(
+        texts or (), "plant-option", lambda names: check_plant_option_names(plant, names)
+    )
+
+
+def parse_named_options(
+    texts: Sequence[str],
+    flag: str,
+    specs_for: Callable[[list[str]], Mapping[str, OptionSpec]],
+) -> dict[str, Any]:
+    """``{name: value}`` of ``NAME=VALUE`` texts given to ``--flag`` (a plant's or an
+    arbiter's constructor options): ``specs_for(names)`` refuses a name the object does
+    not take and returns the specs of those it does; each value is read as ``--option``
+    reads one (:meth:`~ddwmmr.controllers.option_specs.OptionSpec.parse`: a number
+    option's text that is no number comes back as a
+    :class:`~ddwmmr.controllers.base.NumberText` for the caller to refuse). A text
+    without ``=`` or a name given twice is a one-line :class:`ParameterError`."""
     from ddwmmr.controllers.option_specs import parse_typed, split_option
 
-    pairs = [(*split_option(text, "plant-option"), text) for text in texts or ()]
-    specs = check_plant_option_names(plant, [name for name, _, _ in pairs])
+    pairs = [(*split_option(text, flag), text) for text in texts]
+    specs = specs_for([name for name, _, _ in pairs])
     options: dict[str, Any] = {}
     for name, value, text in pairs:
         if name in options:
-            raise ParameterError(f"plant-option: {name} given twice (got {shown(text)})")
-        options[name] = parse_typed(specs[name], value, "plant-option")
+            raise ParameterError(f"{flag}: {name} given twice (got {shown(text)})")
+        options[name] = parse_typed(specs[name], value, flag)
     return options
 
 
 def built_plant(plant: str, robot: Robot, options: dict[str, Any]) -> Any:
     """The plant named ``plant`` built for ``robot`` with ``options``: a value it refuses
-    is its own one-line :class:`ParameterError` (``c2 must be > 0 (got -1)``), raised
-    before the run. Its warnings are left to the run's own plant, which says them once."""
+    is its own one-line :class:`ParameterError` (``c2 must be in [1e-20, 1e+13] N m s/rad
+    (got -1)``), raised before the run. Its warnings are left to the run's own plant,
+    which says them once."""
     from ddwmmr.controllers.base import NumberText
     from ddwmmr.plants import make_plant
 

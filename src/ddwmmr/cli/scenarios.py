@@ -47,6 +47,7 @@ from ddwmmr.cli.common import (
     number_type,
     output_folder,
     output_target,
+    parse_named_options,
     payload_type,
     run_main,
     run_method_options,
@@ -514,30 +515,30 @@ def config_from_arguments(args: argparse.Namespace) -> RunConfig:
 def _arbiter_options(args: argparse.Namespace) -> tuple[tuple[str, Any], ...]:
     """``--arbiter-option NAME=VALUE`` as ``RunConfig.arbiter_options``: each name one the
     arbiter takes (:func:`~ddwmmr.arbiters.factory.check_arbiter_options`, which
-    ``RunConfig`` calls again), its value read as ``--option`` reads one; a number option's
-    text that is no number is refused here (the plug-in's constructor may not check)."""
+    ``RunConfig`` calls again), its value read as ``--plant-option`` reads one
+    (:func:`~ddwmmr.cli.common.parse_named_options`); a number option's text that is no
+    number is refused here (the plug-in's constructor may not check)."""
     from ddwmmr.arbiters.factory import arbiter_option_specs, check_arbiter_options
     from ddwmmr.controllers.base import NumberText
-    from ddwmmr.controllers.option_specs import parse_typed, split_option
 
     if not args.arbiter_option:
         return ()
     if args.study == "arbiters":
         raise ParameterError("--arbiter-option: the arbiter study runs the built-in arbiters")
     arbiter = args.arbiter or DEFAULT_ARBITER
-    pairs = [(*split_option(text, "arbiter-option"), text) for text in args.arbiter_option]
-    with _option_names():
-        check_arbiter_options([(n, v) for n, v, _ in pairs], arbiter, args.controller)
-    specs = arbiter_option_specs(arbiter)
-    options: dict[str, Any] = {}
-    for name, text, given in pairs:
-        if name in options:
-            raise ParameterError(f"arbiter-option: {name} given twice (got {shown(given)})")
-        value = parse_typed(specs[name], text, "arbiter-option")
+
+    def specs_for(names: list[str]) -> dict[str, Any]:
+        with _option_names():
+            check_arbiter_options([(name, None) for name in names], arbiter, args.controller)
+        return arbiter_option_specs(arbiter)
+
+    options = parse_named_options(args.arbiter_option, "arbiter-option", specs_for)
+    for name, value in options.items():
         if isinstance(value, NumberText):
-            raise ParameterError(f"arbiter-option: {name} must be a number (got {shown(given)})")
-        options[name] = tuple(value) if isinstance(value, list) else value
-    return tuple(options.items())
+            raise ParameterError(
+                f"arbiter-option: {name} must be {value.expected} (got {shown(value)})"
+            )
+    return tuple((n, tuple(v) if isinstance(v, list) else v) for n, v in options.items())
 
 
 def _check_engine_step(config: RunConfig) -> None:
