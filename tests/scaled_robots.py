@@ -1,9 +1,11 @@
 """Robots at other sizes than the default, scaled as a physical robot scales: lengths by
 ``s``, masses by ``s^3``, the base's yaw inertia by ``s^5``, torque limits by ``s^4``."""
 
+import warnings
 from dataclasses import replace
+from typing import Any
 
-from ddwmmr import Robot
+from ddwmmr import Ellipse, Robot, simulate
 
 #: The default robot ten times as long, 1000 times as heavy (its motors scaled to match).
 TEN_TIMES = Robot(
@@ -79,3 +81,26 @@ def scaled_robot(factor: float) -> Robot:
     A power-of-two ``factor`` scales exactly in floating point."""
     default = Robot()
     return replace(default, **{name: getattr(default, name) * factor for name in LENGTHS})
+
+
+#: Start offset (m) on the default robot, along both end-effector axes (scaled with it).
+OFFSET = -0.03
+
+
+def mpc_on_scaled_ellipse(robot: Robot, factor: float, duration: float, **options: Any) -> Any:
+    """``simulate``'s result of the ``mpc`` on ``robot`` tracking the ellipse and the start
+    offset (:data:`OFFSET`) scaled by ``factor`` for ``duration`` s, with ``options`` for
+    ``simulate`` (the plant, the controller's). Warnings are silenced: a scaled robot's
+    lengths and derived plant constants warn."""
+    ellipse = Ellipse()
+    task = replace(ellipse, a=factor * ellipse.a, b=factor * ellipse.b)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return simulate(
+            robot,
+            task,
+            "mpc",
+            duration=duration,
+            initial_offset=(factor * OFFSET, factor * OFFSET),
+            **options,
+        )

@@ -10,19 +10,16 @@ units, does not. The robot with masses kept and wheel torques ``~ s^5`` is anoth
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from ddwmmr import Ellipse, Robot, simulate
+from ddwmmr import Robot
 from ddwmmr.plants.thesis import robot_constants
-from scaled_robots import scaled_robot
+from scaled_robots import mpc_on_scaled_ellipse, scaled_robot
 
 DEFAULT = Robot()
-#: Start offset (m) on the default robot, along both end-effector axes (scaled below).
-OFFSET = -0.03
 
 
 def physical_robot(factor: float) -> Robot:
@@ -44,18 +41,7 @@ def run(robot: Robot, factor: float, model: str, duration: float) -> dict:
     """The ``mpc`` with ``model`` on the thesis plant of ``robot``, tracking the ellipse
     and start offset scaled by ``factor`` for ``duration`` s: the summary, with the
     per-step position errors divided by ``factor`` (m) as ``"errors"``."""
-    task = replace(Ellipse(), a=factor * Ellipse().a, b=factor * Ellipse().b)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # the thesis plant's constants derived for the robot
-        result = simulate(
-            robot,
-            task,
-            "mpc",
-            plant="thesis",
-            duration=duration,
-            initial_offset=(factor * OFFSET, factor * OFFSET),
-            model=model,
-        )
+    result = mpc_on_scaled_ellipse(robot, factor, duration, plant="thesis", model=model)
     errors = np.asarray(result.timeseries["position_error_m"]) / factor
     return {**result.summary, "errors": errors}
 

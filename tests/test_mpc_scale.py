@@ -13,20 +13,22 @@ from __future__ import annotations
 
 import functools
 import warnings
-from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from ddwmmr import Ellipse, ParameterError, Robot, make_controller, simulate
+from ddwmmr import ParameterError, Robot, make_controller
 from ddwmmr.cli.track import main as track_main
 from ddwmmr.mpc.fallback import make_fallback
 from ddwmmr.mpc.min_time import Guess
-from scaled_robots import TEN_TIMES, TWENTIETH, scaled_options, scaled_robot
+from scaled_robots import (
+    TEN_TIMES,
+    TWENTIETH,
+    mpc_on_scaled_ellipse,
+    scaled_options,
+    scaled_robot,
+)
 
-ELLIPSE = Ellipse()
-#: Start offset (m) on the default robot, along both end-effector axes.
-OFFSET = -0.03
 #: A short run (s): the offset's transient and a stretch of the ellipse.
 DURATION = 3.0
 #: Options in m or m/s, scaled with the robot below.
@@ -36,18 +38,8 @@ METRE_OPTIONS = ("obstacle_margin", "reach_speed", "huber")
 def errors(robot: Robot, factor: float, **options) -> np.ndarray:
     """Position errors divided by ``factor`` (m) and orientation errors (rad), per step, of
     the ``mpc`` on ``robot`` tracking the ellipse and start offset scaled by ``factor``."""
-    task = replace(ELLIPSE, a=factor * ELLIPSE.a, b=factor * ELLIPSE.b)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # a small robot's lengths look like unit mistakes
-        result = simulate(
-            robot,
-            task,
-            "mpc",
-            duration=DURATION,
-            initial_offset=(factor * OFFSET, factor * OFFSET),
-            **scaled_options(options, factor, METRE_OPTIONS),
-        )
-    series = result.timeseries
+    options = scaled_options(options, factor, METRE_OPTIONS)
+    series = mpc_on_scaled_ellipse(robot, factor, DURATION, **options).timeseries
     return np.array(
         [
             np.asarray(series["position_error_m"]) / factor,
