@@ -48,9 +48,9 @@ def test_the_minimum_time_solve_raises_an_interrupt_that_came_during_it():
 def test_the_tools_handler_records_what_it_raises(monkeypatch):
     # the handler stops the tool's workers (and silences their loggers): not this process's
     monkeypatch.setattr(common, "stop_workers", lambda: None)
-    with interruptible(), pytest.raises(Terminated):
+    with pytest.raises(Terminated), interruptible():
         signal.raise_signal(signal.SIGTERM)
-    # the handler recorded it too, and leaving the context dropped it
+    # the handler recorded it too, and the context it left by the stop dropped it
     interrupts.raise_pending()
     with interruptible():
         with contextlib.suppress(KeyboardInterrupt):  # as a solver in C would

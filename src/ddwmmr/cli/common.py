@@ -34,6 +34,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn, overload
 
 from ddwmmr import interrupts
+from ddwmmr.cli import signals
 from ddwmmr.cli.signals import EXIT_INTERRUPTED, EXIT_TERMINATED, STOP_SIGNALS, say, stop_line
 from ddwmmr.errors import (
     MASS_RANGE_KG,
@@ -388,6 +389,13 @@ def interruptible() -> Iterator[None]:
     Ctrl-C, a Ctrl-\\ or a closed terminal reaches the whole process group, and the parent
     stops the workers itself, so they print no traceback) and exits at once on SIGTERM
     (the parent's :func:`stop_workers`).
+
+    Python runs a handler wherever the main thread is, a weakref callback or a ``__del__``
+    included, where what it raises is printed as "Exception ignored in ..." with a
+    traceback and dropped; other C code drops it silently. Such a stop says nothing
+    here (it is recorded, :mod:`ddwmmr.interrupts`) and is raised at the next check, at
+    the latest when the block ends; an exception that ends the block after a stop (a
+    process pool its handler broke) gives way to the stop: one signal, one ending.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
@@ -408,15 +416,31 @@ def interruptible() -> Iterator[None]:
         stop_workers()
         stop = KeyboardInterrupt() if signum == signal.SIGINT else Terminated(signum)
         interrupts.record(stop)  # a solver in C may swallow what is raised here
+        raised.append(stop)
         raise stop
 
+    raised: list[BaseException] = []
+    shown = sys.unraisablehook
+
+    def unraisable(report: sys.UnraisableHookArgs) -> None:
+        if not any(report.exc_value is stop for stop in raised):
+            shown(report)
+
+    sys.unraisablehook = unraisable
     previous = {s: signal.signal(s, handle) for s in handled}
     try:
         yield
+    except BaseException as error:
+        if raised and error is not raised[0]:  # what the stop caused (a broken pool), or
+            raise raised[0] from error  # what the code it left did: the stop ends the tool
+        raise
+    else:
+        interrupts.raise_pending()  # a stop dropped after the run's last check
     finally:
         interrupts.clear()
         for number, handler in previous.items():
             signal.signal(number, handler)
+        sys.unraisablehook = shown
 
 
 def forget_unhandled_interrupt() -> None:
@@ -516,6 +540,7 @@ def run_main(main: Callable[[Sequence[str] | None], int], argv: Sequence[str] | 
     when it comes after ``main`` committed its output folder (while it prints its summary
     or stops its workers); its line then says that output is complete, not removed."""
     committed: list[Path] = []  # the output folders main completed (recording_commits)
+    signals.report_outputs(committed)  # for a stop while the process exits (the guard's)
     try:
         with (
             interruptible(),

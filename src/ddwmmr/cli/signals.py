@@ -5,7 +5,8 @@ A tool stopped by SIGINT (Ctrl-C) or one of :data:`STOP_SIGNALS` says one line o
 (:func:`stop_line`) and exits with 128 + the signal number, the shell convention. While
 the tool runs, :func:`ddwmmr.cli.common.run_main` does this after stopping the workers
 and unwinding the stack; before (the imports of numpy, CasADi, matplotlib... take a few
-tenths of a second) and after it, the guard of :func:`guard_start` does it at once.
+tenths of a second) and after it (the process's exit: its ``atexit`` functions, the
+workers' end), the guard of :func:`guard_start` does it at once.
 
 Standard library only: the package imports this module while a tool starts
 (:mod:`ddwmmr`), before anything heavy.
@@ -54,6 +55,18 @@ def say(line: str) -> None:
         sys.stderr.flush()
 
 
+#: The output folders the tool's run completed, in order (a list
+#: :func:`~ddwmmr.cli.common.run_main` fills, :func:`report_outputs`).
+_completed: list[Path] = []
+
+
+def report_outputs(completed: list[Path]) -> None:
+    """From now on, the guard's line says the last folder in ``completed`` (a list the
+    caller fills as the run completes each output) is complete, not removed."""
+    global _completed
+    _completed = completed
+
+
 def guard_start() -> None:
     """From now on, SIGINT and :data:`STOP_SIGNALS` end this process at once with the tool's
     line and status (signals the process was started ignoring, e.g. under ``nohup``, stay
@@ -72,5 +85,5 @@ def guard_start() -> None:
 def _stop_at_once(signum: int, frame: object) -> None:
     with contextlib.suppress(OSError, ValueError, RuntimeError):
         sys.stdout.flush()  # what the tool printed before (os._exit does not flush)
-    say(stop_line(signum))
+    say(stop_line(signum, _completed[-1] if _completed else None))
     os._exit(128 + signum)
