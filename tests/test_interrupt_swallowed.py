@@ -36,6 +36,18 @@ def signal_in_a_weakref_callback(signum: int = signal.SIGINT) -> None:
     assert ref() is None
 
 
+def run_tool(folder: Path) -> subprocess.CompletedProcess[str]:
+    """Run ``folder/tool.py`` in ``folder`` as from a terminal (stderr and stdout caught)."""
+    return subprocess.run(
+        [sys.executable, "tool.py"],
+        cwd=folder,
+        capture_output=True,
+        text=True,
+        timeout=60,
+        **FROM_A_TERMINAL,
+    )
+
+
 @pytest.fixture(autouse=True)
 def no_worker_stop(monkeypatch):
     """The handler stops the tool's workers and silences every logger: not pytest's; the
@@ -113,14 +125,7 @@ def test_a_tool_process_prints_no_exception_ignored_traceback(tmp_path: Path):
             """
         )
     )
-    done = subprocess.run(
-        [sys.executable, "tool.py"],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=60,
-        **FROM_A_TERMINAL,
-    )
+    done = run_tool(tmp_path)
     assert (done.returncode, done.stderr) == (130, INTERRUPTED + "\n")
 
 
@@ -147,14 +152,7 @@ def test_a_stop_while_the_tool_exits_says_its_output_is_complete(tmp_path: Path)
             """
         )
     )
-    done = subprocess.run(
-        [sys.executable, "tool.py"],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=60,
-        **FROM_A_TERMINAL,
-    )
+    done = run_tool(tmp_path)
     line = f"interrupted (Ctrl-C): stopped; the output in {tmp_path / 'out'} is complete\n"
     assert (done.returncode, done.stderr) == (130, line)
     assert (tmp_path / "out" / "summary.json").read_text() == "{}\n"
