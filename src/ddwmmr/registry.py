@@ -405,27 +405,25 @@ def check_recorded_plugins(plugins: Any) -> None:
     texts is left to the record's other checks."""
     if not isinstance(plugins, Mapping):
         return
-    named = [
-        (label, name, module)
+    named = {
+        label: {n: m for n, m in given.items() if isinstance(n, str) and isinstance(m, str)}
         for label, given in plugins.items()
         if label in _LABELS and isinstance(given, Mapping)
-        for name, module in given.items()
-        if isinstance(name, str) and isinstance(module, str)
-    ]
-    for label, name, module in named:
-        if name in _LABELS[label].names():
-            continue
-        if not loadable(module):
+    }
+    for label, given in named.items():
+        for name, module in given.items():
+            if name in _LABELS[label].names():
+                continue
+            if not loadable(module):
+                raise ParameterError(
+                    f"{label}: {name!r} is the plug-in of {_script(module)}, which "
+                    f"{PLUGINS_VARIABLE} cannot load: {SCRIPT_ADVICE}"
+                )
             raise ParameterError(
-                f"{label}: {name!r} is the plug-in of {_script(module)}, which "
-                f"{PLUGINS_VARIABLE} cannot load: {SCRIPT_ADVICE}"
+                f"{label}: {name!r} is the plug-in of module {module!r}, which is not "
+                f"loaded: run with {PLUGINS_VARIABLE}={','.join(plugin_modules(named))} "
+                '(importable from sys.path, e.g. with PYTHONPATH; docs/api.md, "Extending")'
             )
-        modules = ",".join(m for m in dict.fromkeys(m for _, _, m in named) if loadable(m))
-        raise ParameterError(
-            f"{label}: {name!r} is the plug-in of module {module!r}, which is not loaded: "
-            f"run with {PLUGINS_VARIABLE}={modules} (importable from sys.path, e.g. with "
-            'PYTHONPATH; docs/api.md, "Extending")'
-        )
 
 
 def plugin_modules(plugins: Mapping[str, Mapping[str, str]]) -> list[str]:
