@@ -281,10 +281,7 @@ def guarded_writer(
                 f"{label}: {WRITER} wrote a NaN into the input box at t = {ctx.t:g} s "
                 "(bounds must not be NaN; +-inf leaves a side open)"
             )
-        for i in range(NU):
-            if box[i] < before[i] or box[NU + i] > before[NU + i]:  # or an open side opened
-                _refuse_widened(label, ctx, before, box[:NU], box[NU:], WRITER)
-                break
+        _refuse_widened(label, ctx, before, box[:NU], box[NU:], WRITER)
         if v_free and (box[0], box[NU]) != (before[0], before[NU]):
             _refuse_v(label, ctx, "bounded v in lb, ub", WRITER)
 
