@@ -277,6 +277,8 @@ def option_spec(
 
 
 def _annotation_text(parameter: inspect.Parameter) -> str:
+    """``parameter``'s annotation as text (as ``from __future__ import annotations``
+    leaves it, or formatted), "" for none."""
     annotation = parameter.annotation
     if annotation is inspect.Parameter.empty:
         return ""
@@ -293,12 +295,7 @@ def constructor_option_specs(cls: type, skip: Collection[str]) -> dict[str, Opti
         variadic = parameter.kind in (parameter.VAR_POSITIONAL, parameter.VAR_KEYWORD)
         if variadic or parameter.name in skip:
             continue
-        annotation = parameter.annotation
-        if annotation is inspect.Parameter.empty:
-            annotation = ""
-        elif not isinstance(annotation, str):
-            annotation = inspect.formatannotation(annotation)
-        spec = option_spec(parameter.name, parameter.default, annotation)
+        spec = option_spec(parameter.name, parameter.default, _annotation_text(parameter))
         if spec is not None:
             specs[spec.name] = spec
     return specs
